@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The lab's set-up in one place. Quick start (see README.md):
+#   ./lab.sh          set up (.venv, package installed editable) and open JupyterLab on notebooks/
+#   ./lab.sh test     set up (with the test extras) and run the whole test suite
+# Further: ./lab.sh setup [--test]   only set up;   ./lab.sh help
+# Set PYTHON=/path/to/python3.x to choose the interpreter (3.11 to 3.13).
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+cd "$here"
+venv="$here/.venv"
+
+usage() {
+  sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'
+}
+
+find_python() {
+  if [ -n "${PYTHON:-}" ]; then echo "$PYTHON"; return; fi
+  for candidate in python3 python3.13 python3.12 python3.11; do
+    if command -v "$candidate" >/dev/null 2>&1 &&
+       "$candidate" -c 'import sys; sys.exit(not ((3, 11) <= sys.version_info[:2] <= (3, 13)))' 2>/dev/null; then
+      echo "$candidate"; return
+    fi
+  done
+  echo "lab.sh: error: no Python 3.11 to 3.13 found; install one, or set PYTHON=/path/to/python3.x" >&2
+  exit 1
+}
+
+setup() {
+  local extras="$1"   # "" or "[test]"
+  if [ ! -x "$venv/bin/python" ]; then
+    local py; py="$(find_python)"
+    echo "lab.sh: creating the virtual environment .venv with $("$py" --version)"
+    "$py" -m venv "$venv"
+  fi
+  # Install only when pyproject.toml or the extras changed, so a set-up machine works offline.
+  # The stamp holds "CHECKSUM EXTRAS" lines; an install with [test] also serves the plain one.
+  local stamp="$venv/.rosfpga-lab-installed" sum want
+  sum="$(cksum < pyproject.toml)"
+  want="$sum $extras"
+  if ! grep -qxF -e "$want" -e "$sum [test]" "$stamp" 2>/dev/null; then
+    echo "lab.sh: installing rosfpga-lab$extras into .venv (editable)"
+    "$venv/bin/python" -m pip install --quiet --upgrade pip
+    "$venv/bin/python" -m pip install --quiet -e ".$extras"
+    echo "$want" >> "$stamp"
+  fi
+}
+
+cmd="${1:-lab}"
+[ $# -gt 0 ] && shift
+case "$cmd" in
+  lab|open)
+    setup ""
+    exec "$venv/bin/jupyter" lab --ServerApp.ip=127.0.0.1 --notebook-dir="$here/notebooks" "$@" ;;
+  test)
+    setup "[test]"
+    exec "$venv/bin/python" -m pytest "$@" ;;
+  setup)
+    if [ "${1:-}" = "--test" ]; then setup "[test]"; else setup ""; fi ;;
+  help|-h|--help)
+    usage ;;
+  *)
+    echo "lab.sh: error: unknown command '$cmd'" >&2; usage >&2; exit 2 ;;
+esac

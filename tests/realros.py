@@ -1,0 +1,190 @@
+"""Helpers for tests that check the lab against real ROS 1 Noetic (Debian's packages).
+
+Debian's rospy, genpy and rosmaster run under the system interpreter ``/usr/bin/python3``, not
+the lab's virtual environment, so every real ROS program is started as a subprocess. On a
+machine without ROS, those tests skip with a one-line reason; with ``ROSFPGA_REQUIRE_ROS=1``
+(set by ``.ci/run`` under CI) the same situation is a failure, so CI can never skip them.
+
+Everything here talks to loopback addresses only and cleans up what it starts.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import hashlib
+import os
+import shutil
+import socket
+import subprocess
+import tempfile
+import time
+import xmlrpc.client
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+ROS_PYTHON = "/usr/bin/python3"
+HERE = Path(__file__).resolve().parent
+ROS_PROGRAMS = HERE / "ros_programs"
+ROSCPP_LIBS = [
+    "-lroscpp", "-lrosconsole", "-lroscpp_serialization", "-lrostime",
+    "-lxmlrpcpp", "-lcpp_common", "-lboost_system",
+]
+
+
+def _required(variable: str) -> bool:
+    return os.environ.get(variable, "") not in ("", "0", "false", "no")
+
+
+def skip_or_fail(reason: str, variable: str) -> None:
+    """Skip with ``reason``, or fail when ``variable`` says the tool is mandatory (CI)."""
+    if _required(variable):
+        pytest.fail(f"{reason} (and {variable}=1 says it must be there)", pytrace=False)
+    pytest.skip(reason)
+
+
+@functools.cache
+def ros_missing_reason() -> str | None:
+    """Why real ROS 1 cannot be used here, or None when it can."""
+    if not Path(ROS_PYTHON).exists():
+        return f"real ROS 1 not installed: {ROS_PYTHON} not found"
+    if shutil.which("rosmaster") is None:
+        return "real ROS 1 not installed: no rosmaster (apt-get install python3-rosmaster)"
+    probe = subprocess.run(
+        [ROS_PYTHON, "-c", "import rospy, genpy, std_msgs.msg, sensor_msgs.msg, geometry_msgs.msg"],
+        capture_output=True, text=True, timeout=60,
+    )
+    if probe.returncode != 0:
+        last = (probe.stderr.strip().splitlines() or ["?"])[-1]
+        return f"real ROS 1 not installed: rospy/genpy do not import ({last})"
+    return None
+
+
+def require_ros() -> None:
+    """Skip (or fail under CI) unless real ROS 1 is usable."""
+    reason = ros_missing_reason()
+    if reason:
+        skip_or_fail(reason, "ROSFPGA_REQUIRE_ROS")
+
+
+@functools.cache
+def cxx_missing_reason() -> str | None:
+    """Why no C++ compiler can be used here, or None when g++ is there."""
+    return None if shutil.which("g++") else "no C++ compiler (g++) on this machine"
+
+
+def require_cxx() -> None:
+    """Skip (or fail under CI) unless g++ is usable."""
+    reason = cxx_missing_reason()
+    if reason:
+        skip_or_fail(reason, "ROSFPGA_REQUIRE_CXX")
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that was free a moment ago."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def ros_env(master_uri: str, home: Path | None = None) -> dict[str, str]:
+    """Environment for a real ROS program talking to ``master_uri`` over loopback only."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "PYTHON"))}
+    env.update(
+        ROS_MASTER_URI=master_uri,
+        ROS_HOSTNAME="127.0.0.1",
+        ROS_HOME=str(home or Path(tempfile.gettempdir()) / "rosfpga-lab-ros-home"),
+        ROSCONSOLE_STDOUT_LINE_BUFFERED="1",
+        PYTHONUNBUFFERED="1",
+    )
+    return env
+
+
+def wait_for_master(uri: str, timeout: float = 20.0) -> None:
+    """Block until the master at ``uri`` answers getUri, or raise TimeoutError."""
+    deadline = time.monotonic() + timeout
+    last: Exception | None = None
+    while time.monotonic() < deadline:
+        try:
+            code, _msg, _val = xmlrpc.client.ServerProxy(uri).getUri("/rosfpga_lab_test")
+            if code == 1:
+                return
+        except (OSError, xmlrpc.client.Error) as exc:
+            last = exc
+        time.sleep(0.1)
+    raise TimeoutError(f"master at {uri} did not answer within {timeout} s: {last}")
+
+
+def stop_process(proc: subprocess.Popen, timeout: float = 5.0) -> None:
+    """Terminate ``proc`` (SIGTERM, then SIGKILL) and reap it."""
+    if proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(timeout)
+
+
+@contextlib.contextmanager
+def real_rosmaster(tmp_path: Path) -> Iterator[str]:
+    """Run Debian's ``rosmaster --core`` on a free loopback port; yield its URI."""
+    require_ros()
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
+    log = open(tmp_path / f"rosmaster-{port}.log", "wb")
+    proc = subprocess.Popen(
+        ["rosmaster", "--core", "-p", str(port), "-w", "2"],
+        env=ros_env(uri, tmp_path), stdout=log, stderr=subprocess.STDOUT,
+    )
+    try:
+        wait_for_master(uri)
+        yield uri
+    finally:
+        stop_process(proc)
+        log.close()
+
+
+def run_ros_python(code: str, *, env: dict[str, str] | None = None, timeout: float = 60.0,
+                   input: bytes | None = None) -> subprocess.CompletedProcess:
+    """Run ``code`` under the system Python with Debian's rospy/genpy; raise on failure."""
+    require_ros()
+    proc = subprocess.run(
+        [ROS_PYTHON, "-c", code], input=input, capture_output=True, timeout=timeout,
+        env=env if env is not None else {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")},
+    )
+    if proc.returncode != 0:
+        raise AssertionError(
+            f"system-Python ROS helper failed ({proc.returncode}):\n{proc.stderr.decode(errors='replace')}"
+        )
+    return proc
+
+
+def build_roscpp_program(source: Path) -> Path:
+    """Compile a roscpp test program (cached by source hash); return the binary's path."""
+    require_ros()
+    require_cxx()
+    text = source.read_bytes()
+    digest = hashlib.sha256(text).hexdigest()[:16]
+    cache = Path(tempfile.gettempdir()) / "rosfpga-lab-roscpp-cache"
+    cache.mkdir(exist_ok=True)
+    binary = cache / f"{source.stem}-{digest}"
+    if not binary.exists():
+        tmp = binary.with_suffix(".tmp")
+        proc = subprocess.run(
+            ["g++", "-O1", "-std=c++17", "-o", str(tmp), str(source), *ROSCPP_LIBS],
+            capture_output=True, text=True, timeout=300,
+        )
+        if proc.returncode != 0:
+            raise AssertionError(f"building {source.name} failed:\n{proc.stderr}")
+        tmp.replace(binary)
+    return binary
+
+
+__all__ = [
+    "ROS_PYTHON", "ROS_PROGRAMS", "build_roscpp_program", "cxx_missing_reason", "free_port",
+    "real_rosmaster", "require_cxx", "require_ros", "ros_env", "ros_missing_reason",
+    "run_ros_python", "skip_or_fail", "stop_process", "wait_for_master",
+]

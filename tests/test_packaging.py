@@ -1,0 +1,63 @@
+"""The promised layout, the dependency lists and the command line's entry points."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _requirement_names(lines: list[str]) -> dict[str, str]:
+    out = {}
+    for line in lines:
+        line = line.split("#", 1)[0].strip()
+        if line:
+            name = re.split(r"[<>=!~ ;\[]", line, maxsplit=1)[0].lower()
+            out[name] = line.replace(" ", "")
+    return out
+
+
+def test_layout_promised_to_users_exists() -> None:
+    for name in ("notebooks", "rosfpga_lab", "data", "tests"):
+        assert (ROOT / name).is_dir(), name
+    for name in ("environment.txt", "README.md", "pyproject.toml", ".ci/run", "lab.sh"):
+        assert (ROOT / name).is_file(), name
+
+
+def test_environment_txt_matches_pyproject_dependencies() -> None:
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    from_pyproject = _requirement_names(project["dependencies"])
+    from_env = _requirement_names((ROOT / "environment.txt").read_text().splitlines())
+    assert from_env == from_pyproject
+    for name in ("jupyterlab", "numpy", "opencv-python-headless", "matplotlib", "ipywidgets"):
+        assert ">=" in from_env[name], f"{name} needs a lower bound"
+
+
+def test_readme_dependency_table_names_every_dependency() -> None:
+    readme = (ROOT / "README.md").read_text()
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    for name in _requirement_names(project["dependencies"]):
+        assert f"`{name}`" in readme, f"README's dependency table does not explain {name}"
+
+
+def test_cli_help_lists_subcommands_and_module_entry_point_works() -> None:
+    out = subprocess.run([sys.executable, "-m", "rosfpga_lab", "--help"], capture_output=True,
+                         text=True, check=True).stdout
+    assert "usage: rosfpga-lab" in out
+    assert "msg" in out
+
+
+def test_every_subcommand_has_help() -> None:
+    from rosfpga_lab.cli import build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    assert sub.choices, "no sub-commands registered"
+    for name, subparser in sub.choices.items():
+        text = subparser.format_help()
+        assert text.startswith("usage: rosfpga-lab " + name), name
+        assert subparser.description, f"sub-command {name} has no description"
