@@ -1,0 +1,55 @@
+"""TCPROS, sans-IO: connection-header and frame codecs and the handshake state machines.
+
+Nothing here touches a socket or a thread: feed bytes, get events (see ``handshake``); the
+``graph`` layer does the I/O. Byte layouts match rospy and roscpp exactly (fields sorted by key).
+"""
+
+from rosfpga_lab.tcpros.errors import (
+    HANDSHAKE_TIMEOUT,
+    MAX_FIELD_BYTES,
+    MAX_FRAME_BYTES,
+    MAX_HEADER_BYTES,
+    FrameError,
+    HandshakeRejected,
+    HandshakeTimeout,
+    HeaderFormatError,
+    IncompleteError,
+    ProtocolError,
+    RemoteError,
+    StateError,
+)
+from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame, frame_prefix
+from rosfpga_lab.tcpros.handshake import (
+    ANY,
+    STATES,
+    TRANSITIONS,
+    Closed,
+    Connected,
+    Frame,
+    HeaderReceived,
+    PublisherHandshake,
+    Rejected,
+    SubscriberHandshake,
+    TopicSpec,
+    Transition,
+    check_publisher_header,
+    check_subscriber_header,
+)
+from rosfpga_lab.tcpros.header import (
+    HeaderDecoder,
+    HeaderField,
+    decode_header,
+    encode_error_header,
+    encode_header,
+    parse_fields,
+)
+
+__all__ = [
+    "ANY", "HANDSHAKE_TIMEOUT", "MAX_FIELD_BYTES", "MAX_FRAME_BYTES", "MAX_HEADER_BYTES",
+    "STATES", "TRANSITIONS", "Closed", "Connected", "Frame", "FrameDecoder", "FrameError",
+    "HandshakeRejected", "HandshakeTimeout", "HeaderDecoder", "HeaderField", "HeaderFormatError",
+    "HeaderReceived", "IncompleteError", "ProtocolError", "PublisherHandshake", "Rejected",
+    "RemoteError", "StateError", "SubscriberHandshake", "TopicSpec", "Transition",
+    "check_publisher_header", "check_subscriber_header", "decode_header", "encode_error_header",
+    "encode_frame", "encode_header", "frame_prefix", "parse_fields",
+]

@@ -1,0 +1,130 @@
+"""TCPROS message framing: ``uint32 length`` (little-endian) then ``length`` body bytes.
+
+:class:`FrameDecoder` accepts any chunking: one byte at a time, many frames in one chunk, a
+frame split over chunks. When a whole frame sits inside one chunk it is returned as a
+zero-copy ``memoryview`` of that chunk; a frame assembled from several chunks is returned as
+``bytes`` (one copy into a buffer sized from the length prefix). Either way the caller gets a
+bytes-like object; call ``bytes(body)`` to keep it beyond the chunk's lifetime.
+"""
+
+from __future__ import annotations
+
+import struct
+
+from rosfpga_lab.tcpros.errors import MAX_FRAME_BYTES, FrameError, IncompleteError
+
+_U32 = struct.Struct("<I")
+
+
+def encode_frame(body: bytes | bytearray | memoryview) -> bytes:
+    """Prefix ``body`` with its 4-byte little-endian length."""
+    return _U32.pack(len(body)) + bytes(body)
+
+
+def frame_prefix(length: int) -> bytes:
+    """Just the 4-byte length prefix (send it, then the body, to avoid copying a big body)."""
+    return _U32.pack(length)
+
+
+class FrameDecoder:
+    """Incremental frame decoder.
+
+    Attributes:
+        frames: number of complete frames returned so far.
+        offset: bytes consumed from the stream so far (for error messages).
+    """
+
+    def __init__(self, *, max_frame: int = MAX_FRAME_BYTES, stream_offset: int = 0) -> None:
+        self.max_frame = max_frame
+        self.frames = 0
+        self.offset = stream_offset
+        self._prefix = bytearray()
+        self._body: bytearray | None = None
+        self._have = 0
+        self._start = stream_offset
+        #: stream offsets of the length prefixes of the frames returned by the last feed()
+        self.starts: list[int] = []
+
+    @property
+    def in_frame(self) -> bool:
+        """True when part of a frame (prefix or body) has been fed but not completed."""
+        return bool(self._prefix) or self._body is not None
+
+    def _check(self, length: int) -> None:
+        if length > self.max_frame:
+            raise FrameError(
+                f"frame at stream byte {self._start} declares {length} bytes, over the limit of "
+                f"{self.max_frame}: the stream is out of sync, or raise max_frame",
+                offset=self._start)
+
+    def feed(self, data: bytes | bytearray | memoryview) -> list[bytes | memoryview]:
+        """Add bytes; return every frame body completed by them (possibly none).
+
+        Raises:
+            FrameError: a length prefix over ``max_frame`` (the decoder is then unusable).
+        """
+        view = memoryview(data).cast("B") if not isinstance(data, memoryview) else data.cast("B")
+        out: list[bytes | memoryview] = []
+        self.starts = []
+        pos, end = 0, len(view)
+        while pos < end:
+            if self._body is None:
+                if not self._prefix:
+                    self._start = self.offset
+                if not self._prefix and end - pos >= 4:
+                    (length,) = _U32.unpack_from(view, pos)
+                    self._check(length)
+                    if end - pos - 4 >= length:  # whole frame in this chunk: zero copy
+                        out.append(view[pos + 4:pos + 4 + length])
+                        self.starts.append(self._start)
+                        pos += 4 + length
+                        self.offset += 4 + length
+                        self.frames += 1
+                        continue
+                    self._body = bytearray(length)
+                    self._have = 0
+                    pos += 4
+                    self.offset += 4
+                    continue
+                take = min(4 - len(self._prefix), end - pos)
+                self._prefix += view[pos:pos + take]
+                pos += take
+                self.offset += take
+                if len(self._prefix) < 4:
+                    break
+                (length,) = _U32.unpack_from(self._prefix, 0)
+                self._check(length)
+                self._prefix = bytearray()
+                if length == 0:
+                    out.append(b"")
+                    self.starts.append(self._start)
+                    self.frames += 1
+                    continue
+                self._body = bytearray(length)
+                self._have = 0
+            take = min(len(self._body) - self._have, end - pos)
+            self._body[self._have:self._have + take] = view[pos:pos + take]
+            self._have += take
+            pos += take
+            self.offset += take
+            if self._have == len(self._body):
+                out.append(bytes(self._body))
+                self.starts.append(self._start)
+                self._body = None
+                self.frames += 1
+        return out
+
+    def eof(self) -> None:
+        """Tell the decoder the stream ended.
+
+        Raises:
+            IncompleteError: the stream ended inside a frame.
+        """
+        if self._prefix:
+            raise IncompleteError(
+                f"connection closed inside a frame's length prefix ({len(self._prefix)} of 4 "
+                f"bytes, stream byte {self.offset})", offset=self.offset)
+        if self._body is not None:
+            raise IncompleteError(
+                f"connection closed mid-frame: {self._have} of {len(self._body)} body bytes "
+                f"received (stream byte {self.offset})", offset=self.offset)
