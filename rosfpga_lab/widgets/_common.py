@@ -1,0 +1,168 @@
+"""Shared pieces of the notebook widgets: the error type, limits, colours, HTML helpers.
+
+Everything here is plain Python (no front-end needed), so the widgets' logic can be tested in
+pytest and their static HTML forms can be produced without a kernel.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import itertools
+from typing import Any
+
+import numpy as np
+
+from rosfpga_lab.errors import LabError
+
+# --- limits (one place) --------------------------------------------------------------------
+#: Bytes shown per page of the byte viewer (32 rows of 16). The browser never gets more.
+BYTE_PAGE_SIZE = 512
+#: Largest page the byte viewer accepts, so a page always stays a small piece of HTML.
+BYTE_PAGE_SIZE_MAX = 8192
+#: Bytes per hex row.
+BYTE_ROW_SIZE = 16
+#: Fields listed in the live field list and in static field tables before "... N more".
+FIELD_LIST_LIMIT = 2000
+#: Characters of a decoded value shown before it is cut with an ellipsis.
+VALUE_TEXT_LIMIT = 80
+#: Mismatch positions kept in an image diff summary (the count is always exact).
+DIFF_POSITIONS_LIMIT = 1000
+#: Side (pixels) of the largest zoom region whose values are tabulated.
+ZOOM_MAX = 16
+#: Beats per page of the beat table, and beats shown in the waveform.
+BEAT_PAGE_SIZE = 32
+WAVE_BEATS = 16
+#: Live view: default most frames per second pushed to the browser.
+LIVE_MAX_FPS = 10.0
+#: Largest width (pixels) of an image sent to the browser; bigger ones are scaled down.
+DISPLAY_MAX_WIDTH = 640
+
+
+class WidgetError(LabError):
+    """Bad input to a notebook widget (wrong shape, overlapping fields, unknown field name)."""
+
+
+# Pastel colours that keep black text readable; adjacent fields get different ones.
+PALETTE = (
+    "#ffd6a5", "#caffbf", "#9bf6ff", "#bdb2ff", "#ffc6ff", "#fdffb6",
+    "#ffadad", "#a0c4ff", "#d0f4de", "#f1c0e8", "#cfbaf0", "#b9fbc0",
+)
+#: Fixed colours for bytes whose role matters more than which field they belong to.
+ROLE_COLOURS = {
+    "length": "#d9d9d9",   # length prefixes of strings, arrays, header fields, frames
+    "padding": "#ffffff",
+}
+
+
+def colour_for(index: int, role: str = "") -> str:
+    """The background colour of field number ``index`` (role colours win)."""
+    role = (role or "").lower()
+    for key, colour in ROLE_COLOURS.items():
+        if key in role:
+            return colour
+    return PALETTE[index % len(PALETTE)]
+
+
+def esc(value: Any) -> str:
+    """HTML-escape ``str(value)`` including quotes (safe inside attributes)."""
+    return html.escape(str(value), quote=True)
+
+
+def shorten(text: str, limit: int = VALUE_TEXT_LIMIT) -> str:
+    """``text`` cut to ``limit`` characters with an ellipsis when longer."""
+    return text if len(text) <= limit else text[: max(0, limit - 1)] + "\u2026"
+
+
+def format_value(value: Any, limit: int = VALUE_TEXT_LIMIT) -> str:
+    """A short, readable text for a decoded field value (arrays and bytes are summarised)."""
+    if value is None:
+        return ""
+    if isinstance(value, (bytes, bytearray, memoryview)):
+        raw = bytes(value)
+        preview = " ".join(f"{b:02x}" for b in raw[:16])
+        more = " \u2026" if len(raw) > 16 else ""
+        return shorten(f"{len(raw)} bytes: {preview}{more}", limit)
+    if isinstance(value, np.ndarray):
+        flat = value.ravel()
+        preview = " ".join(str(v) for v in flat[:12])
+        more = " \u2026" if flat.size > 12 else ""
+        return shorten(f"{value.dtype}{list(value.shape)}: {preview}{more}", limit)
+    if isinstance(value, (list, tuple)) and len(value) > 12:
+        head = ", ".join(repr(v) for v in value[:12])
+        return shorten(f"[{head}, \u2026] ({len(value)} items)", limit)
+    if isinstance(value, str):
+        return shorten(repr(value), limit)
+    return shorten(str(value), limit)
+
+
+def hex_bytes(data: bytes, limit: int = 16) -> str:
+    """``data`` as spaced hex, cut after ``limit`` bytes."""
+    text = " ".join(f"{b:02x}" for b in data[:limit])
+    return text + (" \u2026" if len(data) > limit else "")
+
+
+_ids = itertools.count(1)
+
+
+def unique_id(prefix: str) -> str:
+    """An id unique within this process, for scoping static HTML."""
+    return f"{prefix}{next(_ids)}"
+
+
+def as_image(array: Any, name: str = "image") -> np.ndarray:
+    """``array`` checked to be an image: HxW or HxWxC (C in 1, 3, 4), dtype uint8.
+
+    Raises:
+        WidgetError: when the shape or dtype is not an image's.
+    """
+    img = np.asarray(array)
+    if img.dtype != np.uint8:
+        raise WidgetError(f"{name}: expected dtype uint8, got {img.dtype} (convert with .astype(np.uint8))")
+    if img.ndim == 3 and img.shape[2] in (1, 3, 4):
+        return img
+    if img.ndim == 2:
+        return img
+    raise WidgetError(f"{name}: expected shape HxW or HxWxC with C in 1, 3, 4, got {img.shape}")
+
+
+def display_rgb(img: np.ndarray, channel_order: str = "rgb") -> np.ndarray:
+    """An HxWx3 RGB view of ``img`` for display (alpha dropped, grey expanded, BGR swapped)."""
+    if img.ndim == 2:
+        img = img[:, :, None]
+    if img.shape[2] == 1:
+        return np.repeat(img, 3, axis=2)
+    rgb = img[:, :, :3]
+    if channel_order.lower().startswith("bgr"):
+        rgb = rgb[:, :, ::-1]
+    return np.ascontiguousarray(rgb)
+
+
+def png_bytes(rgb: np.ndarray, scale: int = 1) -> bytes:
+    """PNG bytes of an HxWx3 RGB uint8 image, enlarged ``scale`` times by nearest neighbour."""
+    import cv2
+
+    if scale > 1:
+        rgb = np.repeat(np.repeat(rgb, scale, axis=0), scale, axis=1)
+    ok, buf = cv2.imencode(".png", np.ascontiguousarray(rgb[:, :, ::-1]))
+    if not ok:  # pragma: no cover - cv2 only fails on impossible input
+        raise WidgetError("could not encode image as PNG")
+    return buf.tobytes()
+
+
+def png_data_uri(rgb: np.ndarray, scale: int = 1) -> str:
+    """A ``data:image/png;base64,...`` URI of ``rgb`` (for self-contained static HTML)."""
+    return "data:image/png;base64," + base64.b64encode(png_bytes(rgb, scale)).decode("ascii")
+
+
+def display_scale(width: int, max_width: int = DISPLAY_MAX_WIDTH) -> int:
+    """Integer enlargement so small images are visible (never shrinks)."""
+    if width <= 0:
+        return 1
+    return max(1, min(16, max_width // width))
+
+
+def downscale(rgb: np.ndarray, max_width: int = DISPLAY_MAX_WIDTH) -> np.ndarray:
+    """``rgb`` reduced by an integer step so it is at most ``max_width`` wide."""
+    step = -(-rgb.shape[1] // max_width) if rgb.shape[1] > max_width else 1
+    return rgb[::step, ::step] if step > 1 else rgb

@@ -1,0 +1,203 @@
+"""Browser test: JupyterLab in Debian's headless Chromium runs a notebook with a byte viewer,
+a byte is clicked, and both the page and the kernel report the field.
+
+No browser is downloaded: Playwright drives ``/usr/bin/chromium``. Without it (or without the
+playwright package) the test skips with a reason; ``ROSFPGA_REQUIRE_BROWSER=1`` makes that a
+failure. The JupyterLab server, its kernel and Chromium use temporary directories only, listen
+on loopback, and are stopped at the end. The screenshot is kept in the test's tmp dir.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import nbformat
+import pytest
+
+from realros import free_port, skip_or_fail
+
+CHROMIUM = os.environ.get("ROSFPGA_CHROMIUM", "/usr/bin/chromium")
+CHROMIUM_ARGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--disable-dev-shm-usage",
+]
+TOKEN = "rosfpga-lab-browser-test"
+
+# A sensor_msgs/Image serialised by hand (ROS 1 wire format: little endian, uint32 length
+# prefixes on strings and arrays), so the test pins the offsets independently of the library.
+FRAME_ID = "camera"
+HEIGHT_OFFSET = 4 + 4 + 4 + 4 + len(FRAME_ID)  # seq, secs, nsecs, frame_id length, frame_id
+
+BUILD_CELL = f'''
+import struct
+import numpy as np
+from rosfpga_lab.widgets import ByteViewer
+
+frame_id, encoding, h, w = {FRAME_ID!r}, "rgb8", 3, 4
+pixels = (np.arange(h * w * 3) % 251).astype(np.uint8).tobytes()
+parts = [
+    ("header.seq", "uint32", struct.pack("<I", 7), 7, ""),
+    ("header.stamp.secs", "uint32", struct.pack("<I", 1700000000), 1700000000, ""),
+    ("header.stamp.nsecs", "uint32", struct.pack("<I", 5), 5, ""),
+    ("header.frame_id.length", "uint32", struct.pack("<I", len(frame_id)), len(frame_id), "length"),
+    ("header.frame_id", "string", frame_id.encode(), frame_id, ""),
+    ("height", "uint32", struct.pack("<I", h), h, ""),
+    ("width", "uint32", struct.pack("<I", w), w, ""),
+    ("encoding.length", "uint32", struct.pack("<I", len(encoding)), len(encoding), "length"),
+    ("encoding", "string", encoding.encode(), encoding, ""),
+    ("is_bigendian", "uint8", b"\\x00", 0, ""),
+    ("step", "uint32", struct.pack("<I", w * 3), w * 3, ""),
+    ("data.length", "uint32", struct.pack("<I", len(pixels)), len(pixels), "length"),
+    ("data", "uint8[]", pixels, None, ""),
+]
+raw, spans, off = b"", [], 0
+for path, typ, chunk, value, role in parts:
+    spans.append(dict(offset=off, size=len(chunk), path=path, type=typ, value=value, role=role))
+    raw += chunk
+    off += len(chunk)
+viewer = ByteViewer(raw, spans, title="sensor_msgs/Image")
+viewer
+'''
+REPORT_CELL = 'print("SELECTED", viewer.selection.path, viewer.selection.offset, viewer.selection.size)'
+
+
+def _require_browser() -> None:
+    if not Path(CHROMIUM).exists():
+        skip_or_fail(f"no Chromium at {CHROMIUM} (apt-get install chromium)", "ROSFPGA_REQUIRE_BROWSER")
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        skip_or_fail("the playwright Python package is not installed", "ROSFPGA_REQUIRE_BROWSER")
+
+
+def _wait_http(url: str, timeout: float, proc: subprocess.Popen, log: Path) -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            raise AssertionError(f"JupyterLab exited early ({proc.returncode}):\n{log.read_text()[-3000:]}")
+        try:
+            with urllib.request.urlopen(url, timeout=2) as resp:
+                if resp.status == 200:
+                    return
+        except OSError:
+            time.sleep(0.3)
+    raise AssertionError(f"JupyterLab did not answer {url} within {timeout} s:\n{log.read_text()[-3000:]}")
+
+
+def _stop_server(proc: subprocess.Popen, base: str) -> None:
+    try:
+        req = urllib.request.Request(f"{base}api/shutdown?token={TOKEN}", method="POST", data=b"")
+        urllib.request.urlopen(req, timeout=5).close()
+        proc.wait(15)
+    except (OSError, subprocess.TimeoutExpired):
+        pass
+    if proc.poll() is None:  # the server's own session: its kernels go with it
+        os.killpg(proc.pid, signal.SIGTERM)
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(10)
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+@pytest.mark.timeout(180)
+def test_click_a_byte_in_jupyterlab_names_its_field(tmp_path: Path) -> None:
+    _require_browser()
+    from playwright.sync_api import sync_playwright
+
+    notebooks = tmp_path / "notebooks"
+    notebooks.mkdir()
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_code_cell(BUILD_CELL), nbformat.v4.new_code_cell(REPORT_CELL)]
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nbformat.write(nb, notebooks / "smoke.ipynb")
+
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("JUPYTER", "IPYTHON"))}
+    for name in ("JUPYTER_CONFIG_DIR", "JUPYTER_RUNTIME_DIR", "JUPYTER_DATA_DIR", "IPYTHONDIR",
+                 "JUPYTERLAB_SETTINGS_DIR", "JUPYTERLAB_WORKSPACES_DIR"):
+        path = tmp_path / name.lower()
+        path.mkdir()
+        env[name] = str(path)
+    env["JUPYTER_PLATFORM_DIRS"] = "1"
+    # answer JupyterLab's "get news?" question with no, so nothing is fetched and no toast covers the page
+    settings = tmp_path / "jupyterlab_settings_dir" / "@jupyterlab" / "apputils-extension"
+    settings.mkdir(parents=True)
+    (settings / "notification.jupyterlab-settings").write_text(json.dumps({"fetchNews": "false"}))
+    port = free_port()
+    base = f"http://127.0.0.1:{port}/"
+    log = tmp_path / "jupyterlab.log"
+    with open(log, "wb") as log_file:
+        server = subprocess.Popen(
+            [sys.executable, "-m", "jupyterlab", "--no-browser", f"--port={port}", "--port-retries=0",
+             "--ServerApp.ip=127.0.0.1", f"--IdentityProvider.token={TOKEN}",
+             f"--ServerApp.root_dir={notebooks}", "--LabApp.expose_app_in_browser=True",
+             "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
+             "--LabApp.extension_manager=readonly",
+             *(["--allow-root"] if os.geteuid() == 0 else [])],
+            env=env, cwd=notebooks, stdout=log_file, stderr=subprocess.STDOUT, start_new_session=True,
+        )
+    try:
+        _wait_http(f"{base}api/status?token={TOKEN}", 60, server, log)
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch_persistent_context(
+                str(tmp_path / "chromium-profile"), executable_path=CHROMIUM, headless=True,
+                args=CHROMIUM_ARGS, viewport={"width": 1400, "height": 900},
+            )
+            try:
+                page = browser.pages[0] if browser.pages else browser.new_page()
+                page.set_default_timeout(60_000)
+                page.goto(f"{base}lab/tree/smoke.ipynb?reset&token={TOKEN}")
+                page.wait_for_function("window.jupyterapp && window.jupyterapp.shell.currentWidget"
+                                       " && window.jupyterapp.shell.currentWidget.sessionContext"
+                                       " && window.jupyterapp.shell.currentWidget.sessionContext.session"
+                                       " && window.jupyterapp.shell.currentWidget.sessionContext.session.kernel")
+                page.evaluate("window.jupyterapp.shell.currentWidget.sessionContext.ready")
+                page.evaluate("window.jupyterapp.commands.execute('notebook:run-all-cells')")
+
+                byte = page.locator(f'.rfl-bv .rfl-bv-hex .b[data-off="{HEIGHT_OFFSET}"]')
+                byte.wait_for(state="visible")
+                byte.click()
+                info = page.locator(".rfl-bv-info")
+                page.wait_for_function(
+                    "document.querySelector('.rfl-bv-info').textContent.includes('height')")
+                text = info.text_content()
+                assert "height" in text and "uint32" in text, text
+                assert f"offset {HEIGHT_OFFSET}" in text and "size 4" in text and "value 3" in text, text
+                # all four bytes of `height` are highlighted, and nothing else
+                lit = page.eval_on_selector_all(".rfl-bv-hex .b.hl", "els => els.map(e => Number(e.dataset.off))")
+                assert lit == list(range(HEIGHT_OFFSET, HEIGHT_OFFSET + 4)), lit
+                # the click reached the kernel: re-run the report cell and read its output
+                page.evaluate("""() => { const nb = window.jupyterapp.shell.currentWidget;
+                                          nb.content.activeCellIndex = 1;
+                                          return window.jupyterapp.commands.execute('notebook:run-cell'); }""")
+                page.wait_for_function(
+                    "[...document.querySelectorAll('.jp-OutputArea-output')]"
+                    ".some(e => e.textContent.includes('SELECTED height'))")
+                outputs = page.eval_on_selector_all(".jp-OutputArea-output", "els => els.map(e => e.textContent)")
+                assert any(f"SELECTED height {HEIGHT_OFFSET} 4" in o for o in outputs), outputs
+                # the field list selects the same way: click `width` in the list
+                page.locator('.rfl-bv-list tr[data-i="6"]').click()
+                page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.includes('width')")
+                lit = page.eval_on_selector_all(".rfl-bv-hex .b.hl", "els => els.map(e => Number(e.dataset.off))")
+                assert lit == list(range(HEIGHT_OFFSET + 4, HEIGHT_OFFSET + 8)), lit
+                shot = tmp_path / "byteviewer.png"
+                page.screenshot(path=str(shot), full_page=True)
+                assert shot.stat().st_size > 10_000
+                keep = os.environ.get("ROSFPGA_SCREENSHOT_DIR")
+                if keep:
+                    shutil.copy(shot, Path(keep) / shot.name)
+            finally:
+                browser.close()
+    finally:
+        _stop_server(server, base)
