@@ -1,0 +1,41 @@
+"""The ROS 1 message model: ``.msg`` definitions, md5 sums, full texts and the wire format.
+
+Everything above this layer (TCPROS, the node, the hardware models, the generator, the byte
+viewers) describes messages through it::
+
+    from rosfpga_lab.msg import default_registry, serialize, deserialize, field_layout
+    reg = default_registry()                      # shipped std_msgs, sensor_msgs, geometry_msgs
+    reg.md5("sensor_msgs/Image")                  # '060021388200f6f0f447d0fcd9c64743'
+    body = serialize(reg, "std_msgs/String", {"data": "hi"})   # b'\\x02\\x00\\x00\\x00hi'
+    deserialize(reg, "std_msgs/String", body)     # {'data': 'hi'}
+    field_layout(reg, "std_msgs/String", body)    # [FieldSpan('data', 0, 4, 'uint32', 2, 'length'), ...]
+
+Modules: ``parser`` (text -> MsgSpec), ``registry`` (types, md5, full text), ``decode`` and
+``encode`` (the fast wire codecs), ``layout`` (byte spans, and the plain reference decoder),
+``values`` (defaults, new_message), ``builtins`` (types, Time, Duration), ``limits``, ``errors``.
+"""
+
+from rosfpga_lab.msg.builtins import BUILTIN_TYPES, PRIMITIVE_TYPES, Duration, Time
+from rosfpga_lab.msg.decode import deserialize, deserialize_partial, min_size
+from rosfpga_lab.msg.encode import serialize
+from rosfpga_lab.msg.errors import (
+    DeserializeError, MsgDefinitionError, MsgError, SerializeError, UnknownTypeError,
+)
+from rosfpga_lab.msg.layout import FieldSpan, deserialize_reference, field_layout
+from rosfpga_lab.msg.limits import DEFAULT_LIMITS, MsgLimits
+from rosfpga_lab.msg.parser import (
+    Constant, Field, MsgSpec, parse_msg, split_full_text, strip_comments,
+)
+from rosfpga_lab.msg.registry import (
+    DEFINITIONS_DIR, SHIPPED_PACKAGES, MsgRegistry, default_registry, registry_with,
+)
+from rosfpga_lab.msg.values import default_value, new_message
+
+__all__ = [
+    "BUILTIN_TYPES", "Constant", "DEFAULT_LIMITS", "DEFINITIONS_DIR", "DeserializeError",
+    "Duration", "Field", "FieldSpan", "MsgDefinitionError", "MsgError", "MsgLimits",
+    "MsgRegistry", "MsgSpec", "PRIMITIVE_TYPES", "SHIPPED_PACKAGES", "SerializeError", "Time",
+    "UnknownTypeError", "default_registry", "default_value", "deserialize",
+    "deserialize_partial", "deserialize_reference", "field_layout", "min_size", "new_message",
+    "parse_msg", "registry_with", "serialize", "split_full_text", "strip_comments",
+]

@@ -1,0 +1,217 @@
+"""Where every byte of a serialized message comes from: :func:`field_layout`.
+
+How this works: a deliberately plain reader walks the message one field at a time with
+``struct`` (no compiled plans, no grouping), recording a :class:`FieldSpan` for each value and
+each length prefix. It is also the *reference model* of :mod:`decode`:
+:func:`deserialize_reference` returns the same values the fast decoder does, and a property
+test holds them equal. The spans of a whole message cover every byte exactly once; spans of size
+zero (an empty string's text, an empty array's elements) are left out.
+
+Roles: ``"length"`` (a uint32 length prefix of a string or variable array), ``"value"`` (one
+scalar, one time/duration half, or one string's bytes), ``"array"`` (a block of numeric array
+elements in one span, used when the array has more than ``element_spans`` elements), and in
+``partial`` mode ``"error"`` (the undecodable rest) and ``"trailing"`` (bytes after the message).
+"""
+
+from __future__ import annotations
+
+import struct
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from rosfpga_lab.msg.builtins import SCALARS, TIME_CLASS
+from rosfpga_lab.msg.decode import min_size
+from rosfpga_lab.msg.errors import DeserializeError
+from rosfpga_lab.msg.limits import DEFAULT_LIMITS, LAYOUT_ELEMENT_SPANS, MsgLimits
+from rosfpga_lab.msg.parser import Field
+from rosfpga_lab.msg.registry import MsgRegistry
+
+ROLE_LENGTH = "length"
+ROLE_VALUE = "value"
+ROLE_ARRAY = "array"
+ROLE_ERROR = "error"
+ROLE_TRAILING = "trailing"
+
+
+class FieldSpan(NamedTuple):
+    """The bytes of one value (or length prefix) in a serialized message.
+
+    Attributes:
+        path: field path, e.g. ``header.stamp.secs``, ``data``, ``points[3].x``.
+        offset: first byte, from the start of the body.
+        size: number of bytes.
+        type: ROS type of these bytes (``uint32`` for a length prefix, ``uint8[]`` for a block).
+        value: the decoded value.
+        role: ``length``, ``value``, ``array`` (or ``error``/``trailing`` in partial mode).
+    """
+
+    path: str
+    offset: int
+    size: int
+    type: str
+    value: Any
+    role: str
+
+    @property
+    def end(self) -> int:
+        """One past the last byte."""
+        return self.offset + self.size
+
+
+class _Reader:
+    """Plain field-by-field reader that records spans."""
+
+    def __init__(self, reg: MsgRegistry, data: Any, limits: MsgLimits, element_spans: int) -> None:
+        self.reg = reg
+        self.buf = bytes(data)
+        self.pos = 0
+        self.limits = limits
+        self.element_spans = element_spans
+        self.spans: list[FieldSpan] = []
+
+    def _take(self, size: int, path: str, what: str) -> bytes:
+        if self.pos + size > len(self.buf):
+            raise DeserializeError(
+                f"message ends early: {what} at byte offset {self.pos} needs {size} byte(s), "
+                f"only {len(self.buf) - self.pos} left (field {path})", path, self.pos)
+        chunk = self.buf[self.pos:self.pos + size]
+        self.pos += size
+        return chunk
+
+    def _span(self, path: str, start: int, type_: str, value: Any, role: str) -> None:
+        if self.pos > start:
+            self.spans.append(FieldSpan(path, start, self.pos - start, type_, value, role))
+
+    def scalar(self, kind: str, path: str) -> Any:
+        start = self.pos
+        sc = SCALARS[kind]
+        (value,) = struct.unpack("<" + sc.struct_char, self._take(sc.size, path, kind))
+        self._span(path, start, kind, value, ROLE_VALUE)
+        return value
+
+    def length(self, path: str, elem_min: int, limit: int, limit_name: str) -> int:
+        start = self.pos
+        (n,) = struct.unpack("<I", self._take(4, path, "the uint32 length prefix"))
+        if n > limit:
+            raise DeserializeError(f"field {path}: length prefix at byte offset {start} declares "
+                                   f"{n}, more than {limit_name}={limit}", path, start)
+        if n * elem_min > len(self.buf) - self.pos:
+            raise DeserializeError(
+                f"field {path}: length prefix at byte offset {start} declares {n} element(s) "
+                f"({n * elem_min} byte(s) at least) but only {len(self.buf) - self.pos} byte(s) "
+                "are left", path, start)
+        self._span(path, start, "uint32", n, ROLE_LENGTH)
+        return n
+
+    def string(self, path: str) -> str:
+        n = self.length(path, 1, self.limits.max_string_bytes, "max_string_bytes")
+        start = self.pos
+        text = self._take(n, path, "string").decode("utf-8", "surrogateescape")
+        self._span(path, start, "string", text, ROLE_VALUE)
+        return text
+
+    def element(self, base: str, path: str) -> Any:
+        if base in SCALARS:
+            value = self.scalar(base, path)
+            return bool(value) if base == "bool" else value
+        if base in TIME_CLASS:
+            half = "uint32" if base == "time" else "int32"
+            return TIME_CLASS[base](self.scalar(half, f"{path}.secs"),
+                                    self.scalar(half, f"{path}.nsecs"))
+        if base == "string":
+            return self.string(path)
+        return self.message(base, path)
+
+    def field(self, f: Field, path: str) -> Any:
+        if not f.is_array:
+            return self.element(f.base_type, path)
+        base = f.base_type
+        if base in SCALARS:
+            elem_min = SCALARS[base].size
+        elif base in TIME_CLASS:
+            elem_min = 8
+        elif base == "string":
+            elem_min = 4
+        else:
+            elem_min = min_size(self.reg, base)
+        if f.array_length is None:
+            n = self.length(path, elem_min, self.limits.max_array_length, "max_array_length")
+        else:
+            n = f.array_length
+        if base in SCALARS and n > self.element_spans:
+            start = self.pos
+            dtype = SCALARS[base].dtype
+            raw = self._take(n * dtype.itemsize, path, f"{n} x {base}")
+            arr = np.frombuffer(raw, dtype=dtype)
+            arr = arr.astype(bool) if base == "bool" else arr
+            self._span(path, start, f.type, arr, ROLE_ARRAY)
+            return arr
+        items = [self.element(base, f"{path}[{i}]") for i in range(n)]
+        if base in SCALARS:
+            return np.array(items, dtype=bool if base == "bool" else SCALARS[base].dtype)
+        return items
+
+    def message(self, type_name: str, prefix: str = "") -> dict:
+        spec = self.reg.check(type_name)
+        out = {}
+        for f in spec.fields:
+            out[f.name] = self.field(f, f"{prefix}.{f.name}" if prefix else f.name)
+        return out
+
+
+def _read(reg: MsgRegistry, type_name: str, data: Any, allow_trailing: bool, partial: bool,
+          limits: MsgLimits, element_spans: int) -> tuple[dict | None, list[FieldSpan]]:
+    reader = _Reader(reg, data, limits, element_spans)
+    try:
+        value: dict | None = reader.message(type_name)
+    except DeserializeError as exc:
+        if not partial:
+            raise
+        start = reader.spans[-1].end if reader.spans else 0
+        reader.spans.append(FieldSpan(exc.path, start, len(reader.buf) - start, "error",
+                                      str(exc), ROLE_ERROR))
+        return None, reader.spans
+    rest = len(reader.buf) - reader.pos
+    if rest:
+        if not (allow_trailing or partial):
+            raise DeserializeError(
+                f"{rest} byte(s) left over after a complete {reg.resolve(type_name)} at byte "
+                f"offset {reader.pos} (pass allow_trailing=True to ignore)", "", reader.pos)
+        reader.spans.append(FieldSpan("", reader.pos, rest, "uint8[]",
+                                      reader.buf[reader.pos:], ROLE_TRAILING))
+    return value, reader.spans
+
+
+def field_layout(reg: MsgRegistry, type_name: str, data: Any, *, allow_trailing: bool = False,
+                 partial: bool = False, limits: MsgLimits = DEFAULT_LIMITS,
+                 element_spans: int = LAYOUT_ELEMENT_SPANS) -> list[FieldSpan]:
+    """The byte layout of a serialized message, one :class:`FieldSpan` per value or prefix.
+
+    Args:
+        reg: the registry holding the type.
+        type_name: e.g. ``sensor_msgs/Image``.
+        data: the message body.
+        allow_trailing: accept bytes after the message (they get a ``trailing`` span).
+        partial: never raise on bad bytes; the undecodable rest gets one ``error`` span whose
+            value is the error message (for byte viewers of broken frames).
+        limits: limits on declared lengths.
+        element_spans: numeric arrays longer than this get one ``array`` span.
+
+    Returns:
+        Spans in byte order; together they cover the body exactly once.
+
+    Raises:
+        DeserializeError: (unless ``partial``) as :func:`deserialize` would.
+    """
+    return _read(reg, type_name, data, allow_trailing, partial, limits, element_spans)[1]
+
+
+def deserialize_reference(reg: MsgRegistry, type_name: str, data: Any, *,
+                          allow_trailing: bool = False,
+                          limits: MsgLimits = DEFAULT_LIMITS) -> dict:
+    """The plain reference decoder: same result as :func:`deserialize`, one field at a time."""
+    value, _spans = _read(reg, type_name, data, allow_trailing, False, limits,
+                          LAYOUT_ELEMENT_SPANS)
+    assert value is not None
+    return value
