@@ -1,0 +1,72 @@
+"""Bit-exact models of the FPGA component's data path (STEPs 2 and 3 and the application).
+
+The paper's circuit, stage by stage, each in two implementations: a readable ``reference``
+model that moves one byte or beat per step and mirrors the HLS C++, and a ``fast`` numpy model
+for real frames; property tests hold them equal.
+
+Quick start::
+
+    from rosfpga_lab.hw import Pipeline, image_frame
+    pipe = Pipeline(width=640, height=480, encoding="rgba8", op="dilate", ksize=(3, 3))
+    res = pipe.process(frame_bytes)      # one TCPROS frame: 4-byte length + Image body
+    res.output_frame                     # the TCPROS frame the publisher circuit writes
+    res.fields, res.output_fields        # decoded / written header fields (ImageFields)
+    res.input_image, res.output_image    # (rows, cols, channels) uint8
+    res.input_beats, res.output_beats    # Beats: tdata/tkeep/tuser/tlast numpy arrays
+    res.cycles, res.latency              # per stage, at II=1
+    res.total_cycles, res.frame_time_s, res.network_time_s, res.fifo_high_water, res.status
+    print(res.summary())
+
+Stages (``reference`` / ``fast``), importable for notebooks:
+
+* receive FIFO: :func:`receive_reference` / :func:`receive_fast_check` (module ``rx``);
+* interpreter: :class:`Interpreter` (state machine over :data:`INTERPRETER_TABLE`),
+  :func:`interpret_reference` / :func:`interpret_fast`;
+* ``fifo2axi`` / ``axi2fifo``: :func:`fifo2axi_reference`, :func:`fifo2axi_fast`,
+  :func:`axi2fifo_reference`, :func:`axi2fifo_fast` (packing rules in :data:`PIXEL_FORMATS`);
+* ``AXIvideo2Mat`` / ``Mat2AXIvideo``: :func:`axivideo2mat_reference`, :func:`axivideo2mat_fast`,
+  :func:`mat2axivideo_reference`, :func:`mat2axivideo_fast` with :class:`Mat`;
+* application: :func:`morph_reference` / :func:`morph_fast` (``dilate``, ``erode``, ``copy``);
+* message generator: :func:`generate_reference` / :func:`generate_fast` (:data:`GENERATOR_TABLE`).
+
+Streams: :class:`Fifo`, :class:`ByteFIFO`, :class:`Beat`, :class:`Beats`. Faults:
+:class:`DropByte`, :class:`DuplicateByte`, :class:`SwapByteOrder`, :class:`LoseTlast`,
+:class:`LoseTuser`, :class:`ShallowFifo`. Errors: :class:`PipelineError` and subclasses.
+"""
+
+from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference
+from rosfpga_lab.hw.cycles import CycleReport, account
+from rosfpga_lab.hw.encodings import PIXEL_FORMATS, PixelFormat, pixel_format
+from rosfpga_lab.hw.errors import (
+    FifoOverflowError, FrameFieldError, FrameLengthError, FrameTruncatedError,
+    PipelineConfigError, PipelineError, StreamStarvedError, UnsupportedEncodingError,
+)
+from rosfpga_lab.hw.faults import (
+    DropByte, DuplicateByte, Fault, LoseTlast, LoseTuser, ShallowFifo, SwapByteOrder,
+)
+from rosfpga_lab.hw.generator import GENERATOR_TABLE, frame_length, generate_fast, generate_reference
+from rosfpga_lab.hw.interpreter import (
+    INTERPRETER_TABLE, ImageFields, Interpreter, Transition, interpret_fast, interpret_reference,
+)
+from rosfpga_lab.hw.morph import OPS, morph_fast, morph_reference
+from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame
+from rosfpga_lab.hw.rx import receive_fast_check, receive_reference
+from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
+from rosfpga_lab.hw.video import (
+    ERROR_IO_EOL_EARLY, ERROR_IO_EOL_LATE, ERROR_IO_SOF_EARLY, Mat, axivideo2mat_fast,
+    axivideo2mat_reference, mat2axivideo_fast, mat2axivideo_reference,
+)
+
+__all__ = [
+    "ERROR_IO_EOL_EARLY", "ERROR_IO_EOL_LATE", "ERROR_IO_SOF_EARLY", "GENERATOR_TABLE",
+    "INTERPRETER_TABLE", "OPS", "PIXEL_FORMATS", "Beat", "Beats", "ByteFIFO", "CycleReport",
+    "DropByte", "DuplicateByte", "Fault", "Fifo", "FifoOverflowError", "FrameFieldError",
+    "FrameLengthError", "FrameTruncatedError", "ImageFields", "Interpreter", "LoseTlast",
+    "LoseTuser", "Mat", "Pipeline", "PipelineConfigError", "PipelineError", "PipelineResult",
+    "PixelFormat", "ShallowFifo", "StreamStarvedError", "SwapByteOrder", "Transition",
+    "UnsupportedEncodingError", "account", "axi2fifo_fast", "axi2fifo_reference",
+    "axivideo2mat_fast", "axivideo2mat_reference", "fifo2axi_fast", "fifo2axi_reference",
+    "frame_length", "generate_fast", "generate_reference", "image_frame", "interpret_fast",
+    "interpret_reference", "mat2axivideo_fast", "mat2axivideo_reference", "morph_fast",
+    "morph_reference", "pixel_format", "receive_fast_check", "receive_reference",
+]

@@ -1,0 +1,91 @@
+"""Typed errors of the hardware-model layer, all under :class:`rosfpga_lab.errors.LabError`.
+
+Every error names the stage that found it; frame errors also name the ``sensor_msgs/Image``
+field and the byte offset in the TCPROS frame (offset 0 is the first byte of the 4-byte frame
+length). After any of these errors the stage (and the :class:`~rosfpga_lab.hw.Pipeline`) has
+reset itself: the next good frame comes out right.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rosfpga_lab.errors import LabError
+
+
+class PipelineError(LabError):
+    """Base class of every error the hardware models raise on purpose.
+
+    Attributes:
+        stage: name of the stage that found the problem (``"interpreter"``, ``"fifo2axi"`` ...).
+        partial: whatever the stage had produced so far (an image, beats, bytes) or ``None``;
+            notebooks show it to make a fault visible.
+    """
+
+    def __init__(self, message: str, stage: str = "", partial: Any = None) -> None:
+        self.stage = stage
+        self.partial = partial
+        super().__init__(f"{stage}: {message}" if stage else message)
+
+
+class PipelineConfigError(PipelineError):
+    """A :class:`Pipeline` or stage was configured with impossible values (the message names it)."""
+
+
+class FrameFieldError(PipelineError):
+    """A field of the incoming ``sensor_msgs/Image`` frame has a value the circuit refuses.
+
+    Attributes:
+        field: the field name (``"height"``, ``"encoding"``, ``"data length"`` ...).
+        offset: byte offset of the field's first byte in the TCPROS frame.
+        value: the decoded value.
+    """
+
+    def __init__(self, message: str, field: str, offset: int, value: Any = None,
+                 stage: str = "interpreter") -> None:
+        self.field = field
+        self.offset = offset
+        self.value = value
+        super().__init__(f"field {field!r} at byte {offset}: {message}", stage)
+
+
+class UnsupportedEncodingError(FrameFieldError):
+    """The frame's ``encoding`` is not one the circuit packs (see ``hw.PIXEL_FORMATS``)."""
+
+
+class FrameTruncatedError(FrameFieldError):
+    """The frame ended (or its ``frame length`` ran out) before the named field was complete."""
+
+
+class FrameLengthError(FrameFieldError):
+    """The 4-byte frame length disagrees with the message it announces."""
+
+
+class StreamStarvedError(PipelineError):
+    """A stage needed another byte or beat and its input stream was empty.
+
+    In the circuit the stage would wait for ever (a hang); the model reports it instead.
+
+    Attributes:
+        needed: how many items the stage needed in total.
+        got: how many it had read when the stream ran dry.
+    """
+
+    def __init__(self, message: str, stage: str, needed: int, got: int, partial: Any = None) -> None:
+        self.needed = needed
+        self.got = got
+        super().__init__(message, stage, partial)
+
+
+class FifoOverflowError(PipelineError):
+    """A write met a full FIFO: the circuit would have lost the byte.
+
+    Attributes:
+        depth: the FIFO's depth.
+        needed: the occupancy the traffic would have needed (the high-water mark without loss).
+    """
+
+    def __init__(self, message: str, stage: str, depth: int, needed: int) -> None:
+        self.depth = depth
+        self.needed = needed
+        super().__init__(message, stage)

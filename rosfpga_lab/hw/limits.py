@@ -1,0 +1,23 @@
+"""The hardware-model layer's limits and defaults, in one place."""
+
+from __future__ import annotations
+
+#: Largest ``width`` / ``height`` the interpreter accepts (an "absurd" value is larger).
+MAX_WIDTH = 8192
+MAX_HEIGHT = 8192
+#: Longest ``header.frame_id`` and ``encoding`` strings the interpreter stores.
+MAX_FRAME_ID_BYTES = 256
+MAX_ENCODING_BYTES = 32
+#: Largest TCPROS frame (4-byte length excluded) the interpreter accepts: 64 MiB.
+MAX_FRAME_BYTES = 64 * 1024 * 1024
+#: Width of the AXI4-Stream data bus between fifo2axi and the application, in bits.
+TDATA_BITS = 32
+TDATA_BYTES = TDATA_BITS // 8
+#: Largest rectangular kernel of the dilate/erode application.
+MAX_KSIZE = 15
+
+#: Defaults of :class:`rosfpga_lab.hw.Pipeline`.
+DEFAULT_CLOCK_HZ = 100e6
+DEFAULT_LINE_RATE_BPS = 1e9
+DEFAULT_RX_FIFO_DEPTH = 2048
+DEFAULT_RX_BURST_BYTES = 1

@@ -1,0 +1,94 @@
+"""The application circuit: rectangular dilate (``hls::Dilate``) and erode (``hls::Erode``).
+
+The reference model is a streaming filter as HLS builds it: pixels arrive one per clock in
+raster order; a *line buffer* keeps the last ``kh`` rows of every column; a ``kw x kh``
+*window* slides along the row, taking one new column from the line buffer per clock. Window
+cells outside the image hold ``None`` and are ignored, so each output is the maximum (dilate)
+or minimum (erode) over the part of the rectangle inside the image: exactly ``cv2.dilate`` /
+``cv2.erode`` with their default border. The anchor is the kernel centre (``k // 2``), as
+OpenCV's default; the output pixel at ``(r, c)`` can only be produced once input pixel
+``(r + dy, c + dx)`` has arrived, so the loops run ``dy`` rows and ``dx`` columns past the
+image (the flush) and the output lags the input by ``dy`` lines and ``dx`` pixels.
+
+``ksize`` is ``(width, height)``, OpenCV's order. The fast model calls ``cv2.dilate`` /
+``cv2.erode`` (the tests hold it equal to the reference).
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from rosfpga_lab.hw import limits
+from rosfpga_lab.hw.errors import PipelineConfigError
+from rosfpga_lab.hw.video import Mat
+
+OPS = ("dilate", "erode", "copy")
+
+
+def check_op(op: str, ksize: tuple[int, int]) -> tuple[int, int]:
+    """Validate ``op`` and ``ksize``; return ``ksize`` as a tuple of ints.
+
+    Raises:
+        PipelineConfigError: unknown op, or a kernel side outside ``1..MAX_KSIZE``.
+    """
+    if op not in OPS:
+        raise PipelineConfigError(f"unknown op {op!r}; choose one of {', '.join(OPS)}")
+    try:
+        kw, kh = (int(k) for k in ksize)
+    except (TypeError, ValueError):
+        raise PipelineConfigError(f"ksize must be (width, height), got {ksize!r}") from None
+    for name, k in (("width", kw), ("height", kh)):
+        if not 1 <= k <= limits.MAX_KSIZE:
+            raise PipelineConfigError(
+                f"ksize {name} {k} is outside 1..{limits.MAX_KSIZE} (hw.limits.MAX_KSIZE)")
+    return kw, kh
+
+
+def flush_extent(ksize: tuple[int, int]) -> tuple[int, int]:
+    """``(dx, dy)``: how far the window reaches right of and below its anchor."""
+    kw, kh = ksize
+    return kw - 1 - kw // 2, kh - 1 - kh // 2
+
+
+def morph_reference(src: Mat, dst: Mat, op: str, ksize: tuple[int, int]) -> None:
+    """Reference streaming dilate/erode/copy from ``src`` to ``dst`` (one pixel per clock)."""
+    kw, kh = check_op(op, ksize)
+    rows, cols, channels = src.rows, src.cols, src.channels
+    if op == "copy":
+        for _ in range(rows * cols):
+            dst.write(src.read(op, rows * cols))
+        return
+    pick = max if op == "dilate" else min
+    dx, dy = flush_extent((kw, kh))
+    line_buffer: list[list[tuple[int, ...] | None]] = [[None] * cols for _ in range(kh)]
+    for row in range(rows + dy):
+        window: list[list[tuple[int, ...] | None]] = [[None] * kh for _ in range(kw)]
+        for col in range(cols + dx):
+            if col < cols:
+                # 1. the next input pixel (none once the loop is past the last row)
+                pixel = src.read(op, rows * cols) if row < rows else None
+                # 2. shift this column of the line buffer up; the new pixel goes in at the bottom
+                for k in range(kh - 1):
+                    line_buffer[k][col] = line_buffer[k + 1][col]
+                line_buffer[kh - 1][col] = pixel
+                column = [line_buffer[k][col] for k in range(kh)]
+            else:
+                column = [None] * kh                     # right of the image
+            # 3. slide the window one column left and bring the new column in on the right
+            window = window[1:] + [column]
+            # 4. once the window is centred on an image pixel, write one output pixel
+            if row >= dy and col >= dx:
+                inside = [p for c in window for p in c if p is not None]
+                dst.write(tuple(pick(p[ch] for p in inside) for ch in range(channels)))
+
+
+def morph_fast(image: np.ndarray, op: str, ksize: tuple[int, int]) -> np.ndarray:
+    """Fast dilate/erode/copy of a ``(rows, cols, channels)`` uint8 image (OpenCV)."""
+    kw, kh = check_op(op, ksize)
+    if op == "copy":
+        return image.copy()
+    kernel = np.ones((kh, kw), np.uint8)
+    fn = cv2.dilate if op == "dilate" else cv2.erode
+    out = fn(np.ascontiguousarray(image), kernel)
+    return out.reshape(image.shape)

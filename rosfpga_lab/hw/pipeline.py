@@ -1,0 +1,344 @@
+"""The whole circuit: TCPROS frame in, dilated (or eroded) TCPROS frame out.
+
+:class:`Pipeline` strings the stages together in the paper's order::
+
+    rx FIFO -> interpreter -> [pixels_in] -> fifo2axi -> [axis_in] -> AXIvideo2Mat -> dilate/erode
+      -> Mat2AXIvideo -> [axis_out] -> axi2fifo -> [pixels_out] -> message generator -> frame out
+
+``model="reference"`` runs every stage one byte or beat at a time (slow; small images);
+``model="fast"`` runs the numpy models. Stages run one after another over the whole frame, as
+HLS C-simulation runs a dataflow region; the timing of the concurrent circuit comes from the
+cycle accounting (:mod:`rosfpga_lab.hw.cycles`). Faults (:mod:`rosfpga_lab.hw.faults`) are
+applied to the named streams between stages.
+
+Any :class:`~rosfpga_lab.hw.errors.PipelineError` resets every stage before it propagates, so
+the next good frame comes out right. Items left in a stream after a frame (a duplicated byte,
+a missing ``tlast``) are reported in :attr:`PipelineResult.status` and flushed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from rosfpga_lab.hw import limits
+from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference
+from rosfpga_lab.hw.cycles import CycleReport, account
+from rosfpga_lab.hw.encodings import PIXEL_FORMATS, pixel_format
+from rosfpga_lab.hw.errors import PipelineConfigError, PipelineError
+from rosfpga_lab.hw.faults import BeatFault, ByteFault, Fault, ShallowFifo
+from rosfpga_lab.hw.generator import frame_length, generate_fast, generate_reference
+from rosfpga_lab.hw.interpreter import ImageFields, Interpreter, interpret_fast
+from rosfpga_lab.hw.morph import check_op, morph_fast, morph_reference
+from rosfpga_lab.hw.rx import check_rx, receive_fast_check, receive_reference
+from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
+from rosfpga_lab.hw.video import (
+    Mat, axivideo2mat_fast, axivideo2mat_reference, beats_to_fifo, mat2axivideo_fast,
+    mat2axivideo_reference, status_names,
+)
+
+MODELS = ("fast", "reference")
+SEQ_MODES = ("count", "carry")
+
+
+@dataclass
+class PipelineResult:
+    """Everything one frame did in the pipeline.
+
+    Attributes:
+        output_frame: the TCPROS frame the publisher circuit wrote (4-byte length + body).
+        fields: the fields the interpreter decoded from the input frame.
+        output_fields: the fields the generator wrote (seq, stamp, frame_id as configured).
+        input_image / output_image: ``(rows, cols, channels)`` uint8 before / after the filter.
+        input_beats / output_beats: the AXI4-Stream into ``AXIvideo2Mat`` / out of
+            ``Mat2AXIvideo`` (after any fault at that tap).
+        cycles, latency: per stage (see :mod:`rosfpga_lab.hw.cycles`).
+        total_cycles, sequential_cycles: dataflow estimate and no-overlap sum.
+        frame_time_s: ``total_cycles / clock_hz``.
+        network_time_s: the input frame's bytes at ``line_rate_bps`` (payload only).
+        fifo_high_water: ``{"rx": bytes}``, the receive FIFO's highest level.
+        status: problems that did not stop the frame (``AXIvideo2Mat`` flags, leftovers).
+        model: ``"fast"`` or ``"reference"``.
+    """
+
+    output_frame: bytes
+    fields: ImageFields
+    output_fields: ImageFields
+    input_image: np.ndarray
+    output_image: np.ndarray
+    input_beats: Beats
+    output_beats: Beats
+    report: CycleReport
+    clock_hz: float
+    line_rate_bps: float
+    fifo_high_water: dict[str, int]
+    status: list[str] = field(default_factory=list)
+    model: str = "fast"
+
+    @property
+    def cycles(self) -> dict[str, int]:
+        return self.report.cycles
+
+    @property
+    def latency(self) -> dict[str, int]:
+        return self.report.latency
+
+    @property
+    def total_cycles(self) -> int:
+        return self.report.total
+
+    @property
+    def sequential_cycles(self) -> int:
+        return self.report.sequential
+
+    @property
+    def frame_time_s(self) -> float:
+        return self.report.total / self.clock_hz
+
+    @property
+    def network_time_s(self) -> float:
+        return 8 * (4 + self.fields.frame_length) / self.line_rate_bps
+
+    @property
+    def ok(self) -> bool:
+        """True when the frame passed without any status flag."""
+        return not self.status
+
+    def summary(self) -> str:
+        """A small text table of the cycle figures (for notebooks and the CLI)."""
+        lines = [f"{'stage':<14}{'cycles':>12}{'latency':>10}"]
+        for name, cyc in self.cycles.items():
+            lines.append(f"{name:<14}{cyc:>12,}{self.latency[name]:>10,}")
+        lines.append(f"total {self.total_cycles:,} cycles = {self.frame_time_s * 1e3:.3f} ms at "
+                     f"{self.clock_hz / 1e6:g} MHz (bottleneck: {self.report.bottleneck}); "
+                     f"network {self.network_time_s * 1e3:.3f} ms at {self.line_rate_bps / 1e9:g} Gb/s")
+        return "\n".join(lines)
+
+
+class Pipeline:
+    """The FPGA component's data path, configured like the circuit HLS would build.
+
+    Args:
+        width, height, encoding: the image the circuit is built for; ``None`` accepts any legal
+            value (up to ``hw.limits``). A frame that disagrees is refused.
+        op: ``"dilate"`` (the paper's), ``"erode"`` or ``"copy"``.
+        ksize: the rectangle ``(width, height)``, OpenCV's order; the paper uses ``(3, 3)``.
+        model: ``"fast"`` (numpy) or ``"reference"`` (one byte/beat at a time).
+        clock_hz: the circuit's clock, for ``frame_time_s``.
+        line_rate_bps: the network's line rate, for ``network_time_s``.
+        rx_fifo_depth, rx_burst_bytes: the receive FIFO and the network's burst size.
+        seq: ``"count"`` (the generator numbers frames from ``seq_start``, as rospy does) or
+            ``"carry"`` (copy the input's seq).
+        seq_start: first seq when counting.
+        stamp: ``(secs, nsecs)`` to write, or ``None`` to carry the input's stamp.
+        frame_id: the frame_id to write, or ``None`` to carry the input's.
+        faults: faults to inject (:mod:`rosfpga_lab.hw.faults`).
+
+    Raises:
+        PipelineConfigError: an impossible setting (the message names it).
+    """
+
+    def __init__(self, width: int | None = None, height: int | None = None,
+                 encoding: str | None = None, op: str = "dilate",
+                 ksize: tuple[int, int] = (3, 3), model: str = "fast",
+                 clock_hz: float = limits.DEFAULT_CLOCK_HZ,
+                 line_rate_bps: float = limits.DEFAULT_LINE_RATE_BPS,
+                 rx_fifo_depth: int = limits.DEFAULT_RX_FIFO_DEPTH,
+                 rx_burst_bytes: int = limits.DEFAULT_RX_BURST_BYTES,
+                 seq: str = "count", seq_start: int = 1,
+                 stamp: tuple[int, int] | None = None, frame_id: str | None = None,
+                 faults: Sequence[Fault] = ()) -> None:
+        if model not in MODELS:
+            raise PipelineConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        if seq not in SEQ_MODES:
+            raise PipelineConfigError(f"seq must be one of {', '.join(SEQ_MODES)}, got {seq!r}")
+        if encoding is not None:
+            pixel_format(encoding)
+        for name, value, limit in (("width", width, limits.MAX_WIDTH), ("height", height, limits.MAX_HEIGHT)):
+            if value is not None and not 1 <= value <= limit:
+                raise PipelineConfigError(f"{name} must be in 1..{limit}, got {value}")
+        if clock_hz <= 0 or line_rate_bps <= 0:
+            raise PipelineConfigError("clock_hz and line_rate_bps must be positive")
+        self.ksize = check_op(op, ksize)
+        self.width, self.height, self.encoding, self.op, self.model = width, height, encoding, op, model
+        self.clock_hz, self.line_rate_bps = float(clock_hz), float(line_rate_bps)
+        self.seq_mode, self.seq_start, self.stamp, self.frame_id = seq, seq_start, stamp, frame_id
+        self.faults = tuple(faults)
+        for fault in self.faults:
+            if not isinstance(fault, Fault):
+                raise PipelineConfigError(f"not a fault: {fault!r}")
+        shallow = [f for f in self.faults if isinstance(f, ShallowFifo)]
+        self.rx_fifo_depth = shallow[-1].depth if shallow else rx_fifo_depth
+        self.rx_burst_bytes = shallow[-1].burst_bytes if shallow else rx_burst_bytes
+        check_rx(self.rx_fifo_depth, self.rx_burst_bytes)
+        self.frames_out = 0
+        self.errors = 0
+        self.reset()
+
+    def reset(self) -> None:
+        """Reset every stage (the frame counter of the generator keeps counting)."""
+        self._interp = Interpreter(ByteFIFO(name="pixels_in"), self.width, self.height, self.encoding)
+
+    @property
+    def next_seq(self) -> int:
+        """The seq the generator writes on the next frame (``seq="count"``)."""
+        return (self.seq_start + self.frames_out) & 0xFFFFFFFF
+
+    def process(self, frame: bytes) -> PipelineResult:
+        """Run one whole TCPROS frame (4-byte length + ``sensor_msgs/Image`` body) through.
+
+        Raises:
+            PipelineError: (a subclass) bad frame, stream starved, FIFO overflow; every stage
+                has been reset, the next good frame will come out right.
+        """
+        try:
+            if self.model == "fast":
+                result = self._run_fast(bytes(frame))
+            else:
+                result = self._run_reference(bytes(frame))
+        except PipelineError:
+            self.errors += 1
+            self.reset()
+            raise
+        self.frames_out += 1
+        return result
+
+    # -- helpers shared by both models --------------------------------------------------------
+    def _faults(self, tap: str) -> list[Fault]:
+        return [f for f in self.faults if f.tap == tap and not isinstance(f, ShallowFifo)]
+
+    def _bytes_at(self, tap: str, data: np.ndarray) -> np.ndarray:
+        for fault in self._faults(tap):
+            assert isinstance(fault, ByteFault)
+            data = fault.apply(data)
+        return data
+
+    def _beats_at(self, tap: str, beats: Beats) -> Beats:
+        for fault in self._faults(tap):
+            assert isinstance(fault, BeatFault)
+            beats = fault.apply(beats)
+        return beats
+
+    def _output_fields(self, fields: ImageFields) -> ImageFields:
+        changes: dict = {}
+        if self.seq_mode == "count":
+            changes["seq"] = self.next_seq
+        if self.stamp is not None:
+            changes["stamp_secs"], changes["stamp_nsecs"] = self.stamp
+        if self.frame_id is not None:
+            changes["frame_id"] = self.frame_id
+        out = dataclasses.replace(fields, **changes)
+        return dataclasses.replace(out, frame_length=frame_length(out))
+
+    def _finish(self, frame: bytes, fields: ImageFields, out_fields: ImageFields, output: bytes,
+                images: tuple[np.ndarray, np.ndarray], beats: tuple[Beats, Beats], high_water: int,
+                status: list[str]) -> PipelineResult:
+        report = account(fields, self.op, self.ksize, len(frame), len(output))
+        return PipelineResult(output, fields, out_fields, images[0], images[1], beats[0], beats[1],
+                              report, self.clock_hz, self.line_rate_bps, {"rx": high_water},
+                              status, self.model)
+
+    @staticmethod
+    def _leftover(status: list[str], stream: str, left: int, unit: str) -> None:
+        if left:
+            status.append(f"{left} {unit}{'s' if left != 1 else ''} left in '{stream}' after the "
+                          "frame (flushed): the stream was out of step")
+
+    # -- the fast model -----------------------------------------------------------------------
+    def _run_fast(self, frame: bytes) -> PipelineResult:
+        status: list[str] = []
+        raw = self._bytes_at("rx", np.frombuffer(frame, np.uint8))
+        frame = raw.tobytes() if self._faults("rx") else frame
+        high_water = receive_fast_check(len(frame), self.rx_fifo_depth, self.rx_burst_bytes)
+        fields, pixels = interpret_fast(frame, width=self.width, height=self.height,
+                                        encoding=self.encoding)
+        fmt = PIXEL_FORMATS[fields.encoding]
+        rows, cols = fields.height, fields.width
+        pixels = self._bytes_at("pixels_in", pixels)
+        beats_in, left = fifo2axi_fast(pixels, rows, cols, fmt)
+        self._leftover(status, "pixels_in", left, "byte")
+        beats_in = self._beats_at("axis_in", beats_in)
+        image_in, flags, left = axivideo2mat_fast(beats_in, rows, cols, fmt)
+        status += [f"AXIvideo2Mat: {name}" for name in status_names(flags)]
+        self._leftover(status, "axis_in", left, "beat")
+        image_out = morph_fast(image_in, self.op, self.ksize)
+        beats_out = self._beats_at("axis_out", mat2axivideo_fast(image_out, fmt))
+        data_out, left = axi2fifo_fast(beats_out, rows * cols)
+        self._leftover(status, "axis_out", left, "beat")
+        data_out = self._bytes_at("pixels_out", data_out)
+        out_fields = self._output_fields(fields)
+        output = generate_fast(out_fields, data_out)
+        self._leftover(status, "pixels_out", data_out.size - out_fields.data_length, "byte")
+        return self._finish(frame, fields, out_fields, output, (image_in, image_out),
+                            (beats_in, beats_out), high_water, status)
+
+    # -- the reference model ------------------------------------------------------------------
+    def _refill_bytes(self, tap: str, fifo: ByteFIFO) -> None:
+        if self._faults(tap):
+            data = self._bytes_at(tap, np.frombuffer(bytes(fifo.drain()), np.uint8))
+            fifo.extend(data.tolist())
+
+    def _refill_beats(self, tap: str, fifo: Fifo[Beat]) -> None:
+        if self._faults(tap):
+            fifo.extend(self._beats_at(tap, Beats.from_list(fifo.drain())).to_list())
+
+    def _run_reference(self, frame: bytes) -> PipelineResult:
+        status: list[str] = []
+        if self._faults("rx"):
+            frame = self._bytes_at("rx", np.frombuffer(frame, np.uint8)).tobytes()
+        pixels_in = self._interp.out
+        high_water = receive_reference(frame, self._interp, self.rx_fifo_depth, self.rx_burst_bytes)
+        fields = self._interp.fields
+        assert fields is not None
+        fmt = PIXEL_FORMATS[fields.encoding]
+        rows, cols, channels = fields.height, fields.width, fmt.bytes_per_pixel
+        self._refill_bytes("pixels_in", pixels_in)
+        axis_in: Fifo[Beat] = Fifo(None, "axis_in")
+        fifo2axi_reference(pixels_in, axis_in, rows, cols, fmt)
+        self._leftover(status, "pixels_in", len(pixels_in.drain()), "byte")
+        self._refill_beats("axis_in", axis_in)
+        beats_in = Beats.from_list(axis_in)
+        src = Mat(rows, cols, channels, "src")
+        flags = axivideo2mat_reference(axis_in, src)
+        status += [f"AXIvideo2Mat: {name}" for name in status_names(flags)]
+        self._leftover(status, "axis_in", len(axis_in.drain()), "beat")
+        image_in = src.to_numpy()
+        dst = Mat(rows, cols, channels, "dst")
+        morph_reference(src, dst, self.op, self.ksize)
+        image_out = dst.to_numpy()
+        axis_out: Fifo[Beat] = Fifo(None, "axis_out")
+        mat2axivideo_reference(dst, axis_out, fmt)
+        self._refill_beats("axis_out", axis_out)
+        beats_out = Beats.from_list(axis_out)
+        pixels_out = ByteFIFO(name="pixels_out")
+        axi2fifo_reference(axis_out, pixels_out, rows * cols)
+        self._leftover(status, "axis_out", len(axis_out.drain()), "beat")
+        self._refill_bytes("pixels_out", pixels_out)
+        out_fields = self._output_fields(fields)
+        tx = ByteFIFO(name="tx")
+        generate_reference(out_fields, pixels_out, tx)
+        self._leftover(status, "pixels_out", len(pixels_out.drain()), "byte")
+        return self._finish(frame, fields, out_fields, tx.to_bytes(), (image_in, image_out),
+                            (beats_in, beats_out), high_water, status)
+
+
+def image_frame(image: np.ndarray, encoding: str, *, seq: int = 0, stamp: tuple[int, int] = (0, 0),
+                frame_id: str = "", is_bigendian: int = 0) -> bytes:
+    """A TCPROS ``sensor_msgs/Image`` frame holding ``image`` (for notebooks and benchmarks).
+
+    Written with the generator's fast model; the tests check it against the message layer's
+    ``serialize`` and real genpy.
+    """
+    fmt = pixel_format(encoding)
+    img = np.ascontiguousarray(image, dtype=np.uint8)
+    rows, cols = img.shape[:2]
+    if img.size != rows * cols * fmt.bytes_per_pixel:
+        raise PipelineConfigError(
+            f"image of shape {img.shape} does not hold {fmt.bytes_per_pixel} bytes per pixel ({encoding})")
+    fields = ImageFields(seq, stamp[0], stamp[1], frame_id, rows, cols, encoding, is_bigendian,
+                         cols * fmt.bytes_per_pixel, img.size)
+    fields = dataclasses.replace(fields, frame_length=frame_length(fields))
+    return generate_fast(fields, img.reshape(-1))
