@@ -28,7 +28,7 @@ import numpy as np
 
 from rosfpga_lab.hw.encodings import PixelFormat
 from rosfpga_lab.hw.errors import StreamStarvedError
-from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
+from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo, frame_flags
 
 LANE = np.arange(4, dtype=np.uint8)
 
@@ -74,7 +74,7 @@ def fifo2axi_fast(data: np.ndarray, rows: int, cols: int, fmt: PixelFormat) -> t
     data = np.asarray(data, dtype=np.uint8)
     if data.size < needed:
         whole = data.size // bpp
-        partial = _pack(data[: whole * bpp], whole, 1, fmt) if whole else Beats.empty()
+        partial = _pack(data[: whole * bpp], whole, 1, fmt).copy() if whole else Beats.empty()
         if whole:
             partial.tlast[:] = (np.arange(whole) % cols) == cols - 1
         raise StreamStarvedError(
@@ -88,16 +88,13 @@ def _pack(data: np.ndarray, rows: int, cols: int, fmt: PixelFormat) -> Beats:
     n = rows * cols
     bpp = fmt.bytes_per_pixel
     if bpp == 4:
-        tdata = data.view("<u4").astype(np.uint32, copy=True)
+        tdata = data.view(np.uint32)  # no copy: the beats alias the frame's pixel bytes
     else:
         lanes = np.zeros((n, 4), np.uint8)
         lanes[:, :bpp] = data.reshape(n, bpp)
         tdata = lanes.view("<u4").reshape(n)
-    tuser = np.zeros(n, bool)
-    tuser[0] = True
-    tlast = np.zeros((rows, cols), bool)
-    tlast[:, -1] = True
-    return Beats(tdata, fmt.tkeep, tuser, tlast.reshape(n))
+    tuser, tlast = frame_flags(rows, cols)
+    return Beats(tdata, fmt.tkeep, tuser, tlast)
 
 
 def axi2fifo_reference(inp: Fifo[Beat], out: ByteFIFO, beats: int) -> None:
@@ -130,10 +127,12 @@ def axi2fifo_fast(beats: Beats, count: int) -> tuple[np.ndarray, int]:
         StreamStarvedError: as the reference model.
     """
     use = min(count, len(beats))
-    lanes = beats.tdata[:use].astype("<u4").view(np.uint8).reshape(use, 4)
+    lanes = beats.tdata[:use].view(np.uint8).reshape(use, 4)
     keep = beats.tkeep[:use]
-    if use and np.all(keep == keep[0]) and keep[0] in (0b0001, 0b0011, 0b0111, 0b1111):
-        data = lanes[:, : int(keep[0]).bit_length()].reshape(-1).copy()
+    if use and keep[0] == 0b1111 and np.all(keep == 0b1111):
+        data = lanes.reshape(-1)
+    elif use and np.all(keep == keep[0]) and keep[0] in (0b0001, 0b0011, 0b0111):
+        data = lanes[:, : int(keep[0]).bit_length()].reshape(-1)
     else:
         mask = ((keep[:, None] >> LANE) & 1).astype(bool)
         data = lanes[mask]

@@ -91,4 +91,4 @@ def generate_fast(fields: ImageFields, data: np.ndarray) -> bytes:
         encoding,
         struct.pack("<BII", fields.is_bigendian & 0xFF, fields.step, fields.data_length),
     ))
-    return head + data[: fields.data_length].tobytes()
+    return b"".join((head, np.ascontiguousarray(data[: fields.data_length])))

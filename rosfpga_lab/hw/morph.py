@@ -16,6 +16,8 @@ image (the flush) and the output lags the input by ``dy`` lines and ``dx`` pixel
 
 from __future__ import annotations
 
+import functools
+
 import cv2
 import numpy as np
 
@@ -83,12 +85,30 @@ def morph_reference(src: Mat, dst: Mat, op: str, ksize: tuple[int, int]) -> None
                 dst.write(tuple(pick(p[ch] for p in inside) for ch in range(channels)))
 
 
-def morph_fast(image: np.ndarray, op: str, ksize: tuple[int, int]) -> np.ndarray:
-    """Fast dilate/erode/copy of a ``(rows, cols, channels)`` uint8 image (OpenCV)."""
+def morph_fast(image: np.ndarray, op: str, ksize: tuple[int, int],
+               out: np.ndarray | None = None) -> np.ndarray:
+    """Fast dilate/erode/copy of a ``(rows, cols, channels)`` uint8 image (OpenCV).
+
+    Args:
+        out: optional C-contiguous array of the image's shape to write into.
+    """
     kw, kh = check_op(op, ksize)
+    if out is None:
+        out = np.empty(image.shape, np.uint8)
     if op == "copy":
-        return image.copy()
-    kernel = np.ones((kh, kw), np.uint8)
+        np.copyto(out, image)
+        return out
     fn = cv2.dilate if op == "dilate" else cv2.erode
-    out = fn(np.ascontiguousarray(image), kernel)
-    return out.reshape(image.shape)
+    src = np.ascontiguousarray(image)
+    dst = out if out.ndim == 2 or out.shape[2] > 1 else out.reshape(out.shape[:2])
+    if src.ndim == 3 and src.shape[2] == 1:
+        src = src.reshape(src.shape[:2])
+    result = fn(src, _kernel(kw, kh), dst=dst)
+    if result is not dst and not np.shares_memory(result, dst):
+        np.copyto(dst, result)
+    return out
+
+
+@functools.lru_cache(maxsize=32)
+def _kernel(kw: int, kh: int) -> np.ndarray:
+    return np.ones((kh, kw), np.uint8)

@@ -176,11 +176,17 @@ class Pipeline:
         check_rx(self.rx_fifo_depth, self.rx_burst_bytes)
         self.frames_out = 0
         self.errors = 0
+        self._scratch_image: np.ndarray | None = None
         self.reset()
 
     def reset(self) -> None:
         """Reset every stage (the frame counter of the generator keeps counting)."""
         self._interp = Interpreter(ByteFIFO(name="pixels_in"), self.width, self.height, self.encoding)
+
+    def _scratch(self, shape: tuple[int, ...]) -> np.ndarray:
+        if self._scratch_image is None or self._scratch_image.shape != shape:
+            self._scratch_image = np.empty(shape, np.uint8)
+        return self._scratch_image
 
     @property
     def next_seq(self) -> int:
@@ -264,7 +270,9 @@ class Pipeline:
         image_in, flags, left = axivideo2mat_fast(beats_in, rows, cols, fmt)
         status += [f"AXIvideo2Mat: {name}" for name in status_names(flags)]
         self._leftover(status, "axis_in", left, "beat")
-        image_out = morph_fast(image_in, self.op, self.ksize)
+        # The filter writes into a scratch image owned by the pipeline (no fresh pages per frame);
+        # the result's output image and beats then become read-only views of the output frame.
+        image_out = morph_fast(image_in, self.op, self.ksize, out=self._scratch(image_in.shape))
         beats_out = self._beats_at("axis_out", mat2axivideo_fast(image_out, fmt))
         data_out, left = axi2fifo_fast(beats_out, rows * cols)
         self._leftover(status, "axis_out", left, "beat")
@@ -272,6 +280,12 @@ class Pipeline:
         out_fields = self._output_fields(fields)
         output = generate_fast(out_fields, data_out)
         self._leftover(status, "pixels_out", data_out.size - out_fields.data_length, "byte")
+        if self._faults("axis_out") or self._faults("pixels_out"):
+            image_out, beats_out = image_out.copy(), beats_out.copy()
+        else:
+            image_out = np.frombuffer(output, np.uint8, out_fields.data_length,
+                                      len(output) - out_fields.data_length).reshape(image_out.shape)
+            beats_out = mat2axivideo_fast(image_out, fmt)
         return self._finish(frame, fields, out_fields, output, (image_in, image_out),
                             (beats_in, beats_out), high_water, status)
 

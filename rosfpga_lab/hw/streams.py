@@ -15,6 +15,7 @@
 
 from __future__ import annotations
 
+import functools
 from collections import deque
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
@@ -157,6 +158,38 @@ class Beat:
                 f"tuser={int(self.tuser)}, tlast={int(self.tlast)})")
 
 
+def _signal(value: Any, dtype: Any, n: int, name: str) -> np.ndarray:
+    if np.ndim(value) == 0:
+        return _constant(int(value), np.dtype(dtype).str, n)
+    array = np.asarray(value, dtype=dtype).reshape(-1)
+    if array.shape[0] != n:
+        raise PipelineConfigError(f"Beats: {name} has {array.shape[0]} entries, tdata has {n}")
+    return array
+
+
+def frame_flags(rows: int, cols: int) -> tuple[np.ndarray, np.ndarray]:
+    """Read-only ``(tuser, tlast)`` of a well-formed ``rows x cols`` frame (cached)."""
+    return _frame_flags(rows, cols)
+
+
+@functools.lru_cache(maxsize=32)
+def _constant(value: int, dtype: str, n: int) -> np.ndarray:
+    array = np.full(n, value, np.dtype(dtype))
+    array.setflags(write=False)
+    return array
+
+
+@functools.lru_cache(maxsize=16)
+def _frame_flags(rows: int, cols: int) -> tuple[np.ndarray, np.ndarray]:
+    tuser = np.zeros(rows * cols, bool)
+    tuser[0] = True
+    tlast = np.zeros((rows, cols), bool)
+    tlast[:, -1] = True
+    tuser.setflags(write=False)
+    tlast.setflags(write=False)
+    return tuser, tlast.reshape(-1)
+
+
 class Beats:
     """Many beats as a struct of numpy arrays (``tdata`` uint32, ``tkeep`` uint8, flags bool).
 
@@ -166,11 +199,12 @@ class Beats:
     __slots__ = ("tdata", "tkeep", "tuser", "tlast")
 
     def __init__(self, tdata: Any, tkeep: Any, tuser: Any, tlast: Any) -> None:
-        self.tdata = np.ascontiguousarray(tdata, dtype=np.uint32)
+        # Arrays are taken as they are (no copy); a scalar is spread over every beat.
+        self.tdata = np.ascontiguousarray(tdata, dtype=np.uint32).reshape(-1)
         n = self.tdata.shape[0]
-        self.tkeep = np.broadcast_to(np.asarray(tkeep, dtype=np.uint8), (n,)).copy()
-        self.tuser = np.broadcast_to(np.asarray(tuser, dtype=bool), (n,)).copy()
-        self.tlast = np.broadcast_to(np.asarray(tlast, dtype=bool), (n,)).copy()
+        self.tkeep = _signal(tkeep, np.uint8, n, "tkeep")
+        self.tuser = _signal(tuser, np.bool_, n, "tuser")
+        self.tlast = _signal(tlast, np.bool_, n, "tlast")
 
     @classmethod
     def empty(cls) -> Beats:
@@ -193,7 +227,8 @@ class Beats:
                 zip(self.tdata.tolist(), self.tkeep.tolist(), self.tuser.tolist(), self.tlast.tolist())]
 
     def copy(self) -> Beats:
-        return Beats(self.tdata.copy(), self.tkeep, self.tuser, self.tlast)
+        """A deep copy (its arrays are writable and shared with nothing)."""
+        return Beats(self.tdata.copy(), self.tkeep.copy(), self.tuser.copy(), self.tlast.copy())
 
     def __len__(self) -> int:
         return int(self.tdata.shape[0])

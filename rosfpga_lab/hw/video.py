@@ -26,7 +26,7 @@ import numpy as np
 
 from rosfpga_lab.hw.encodings import PixelFormat
 from rosfpga_lab.hw.errors import StreamStarvedError
-from rosfpga_lab.hw.streams import Beat, Beats, Fifo
+from rosfpga_lab.hw.streams import Beat, Beats, Fifo, frame_flags
 
 ERROR_IO_EOL_EARLY = 1 << 0
 ERROR_IO_EOL_LATE = 1 << 1
@@ -123,8 +123,10 @@ def axivideo2mat_fast(beats: Beats, rows: int, cols: int, fmt: PixelFormat
     """
     n = rows * cols
     if len(beats) >= n and _well_formed(beats, rows, cols):
-        image = beats.tdata[:n].astype("<u4").view(np.uint8).reshape(rows, cols, 4)
-        return image[:, :, : fmt.bytes_per_pixel].copy(), 0, len(beats) - n
+        image = beats.tdata[:n].view(np.uint8).reshape(rows, cols, 4)
+        if fmt.bytes_per_pixel != 4:
+            image = np.ascontiguousarray(image[:, :, : fmt.bytes_per_pixel])
+        return image, 0, len(beats) - n
     stream = beats_to_fifo(beats.to_list(), "axis_in")
     img = Mat(rows, cols, fmt.bytes_per_pixel)
     status = axivideo2mat_reference(stream, img)
@@ -135,9 +137,8 @@ def _well_formed(beats: Beats, rows: int, cols: int) -> bool:
     n = rows * cols
     if not beats.tuser[0] or beats.tuser[1:n].any():
         return False
-    expected = np.zeros((rows, cols), bool)
-    expected[:, -1] = True
-    return bool(np.array_equal(beats.tlast[:n], expected.reshape(n)))
+    tlast = beats.tlast[:n].reshape(rows, cols)
+    return bool(tlast[:, -1].all()) and not tlast[:, :-1].any()
 
 
 def mat2axivideo_reference(img: Mat, out: Fifo[Beat], fmt: PixelFormat) -> None:
@@ -161,16 +162,13 @@ def mat2axivideo_fast(image: np.ndarray, fmt: PixelFormat) -> Beats:
     n = rows * cols
     channels = image.reshape(n, -1)
     if channels.shape[1] == 4:
-        tdata = np.ascontiguousarray(channels).view("<u4").reshape(n).astype(np.uint32)
+        tdata = np.ascontiguousarray(channels).view(np.uint32).reshape(n)
     else:
         lanes = np.zeros((n, 4), np.uint8)
         lanes[:, : channels.shape[1]] = channels
         tdata = lanes.view("<u4").reshape(n)
-    tuser = np.zeros(n, bool)
-    tuser[0] = True
-    tlast = np.zeros((rows, cols), bool)
-    tlast[:, -1] = True
-    return Beats(tdata, fmt.tkeep, tuser, tlast.reshape(n))
+    tuser, tlast = frame_flags(rows, cols)
+    return Beats(tdata, fmt.tkeep, tuser, tlast)
 
 
 def beats_to_fifo(beats: Iterable[Beat], name: str = "axis") -> Fifo[Beat]:
