@@ -80,6 +80,17 @@ def _need(buf: memoryview, pos: int, size: int, path: str, what: str) -> None:
             f"only {len(buf) - pos} left (field {path})", path, pos)
 
 
+def too_long(path: str, offset: int, n: int, elem_min: int, left: int,
+             limit_name: str) -> DeserializeError:
+    """The error for a length prefix declaring more than the bytes left."""
+    if limit_name == "max_string_bytes":
+        what = f"{n} byte(s)"
+    else:
+        what = f"{n} element(s) ({n * elem_min} byte(s) at least)"
+    return DeserializeError(f"field {path}: length prefix at byte offset {offset} declares "
+                            f"{what} but only {left} byte(s) are left", path, offset)
+
+
 def _read_count(buf: memoryview, pos: int, path: str, elem_min: int, limit: int,
                 limit_name: str) -> tuple[int, int]:
     """Read a uint32 length prefix and check it fits the bytes left and the limit."""
@@ -92,10 +103,7 @@ def _read_count(buf: memoryview, pos: int, path: str, elem_min: int, limit: int,
             f"{limit_name}={limit} (raise it with deserialize(..., limits=MsgLimits(...)))",
             path, pos - 4)
     if n * elem_min > len(buf) - pos:
-        raise DeserializeError(
-            f"field {path}: length prefix at byte offset {pos - 4} declares {n} element(s) "
-            f"({n * elem_min} byte(s) at least) but only {len(buf) - pos} byte(s) are left",
-            path, pos - 4)
+        raise too_long(path, pos - 4, n, elem_min, len(buf) - pos, limit_name)
     return n, pos
 
 

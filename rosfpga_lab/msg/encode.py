@@ -169,6 +169,16 @@ def _byte_array(value: Any, path: str, type_name: str) -> Any:
 
 def _numeric_array(value: Any, path: str, base: str, type_name: str) -> np.ndarray:
     target = SCALARS[base].dtype
+    if isinstance(value, (list, tuple)) and target.kind in "iu" and value:
+        # Python ints may exceed int64 (uint64 values): check them as Python ints.
+        if all(isinstance(x, (int, np.integer)) for x in value):
+            info = np.iinfo(target)
+            low, high = min(value), max(value)
+            if low < info.min or high > info.max:
+                bad = low if low < info.min else high
+                raise _fail(path, type_name, value,
+                            f"element {bad} is out of range {info.min}..{info.max}")
+            return np.array(value, dtype=target)
     try:
         arr = np.asarray(value)
     except (ValueError, TypeError) as exc:

@@ -21,7 +21,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from rosfpga_lab.msg.builtins import SCALARS, TIME_CLASS
-from rosfpga_lab.msg.decode import min_size
+from rosfpga_lab.msg.decode import min_size, too_long
 from rosfpga_lab.msg.errors import DeserializeError
 from rosfpga_lab.msg.limits import DEFAULT_LIMITS, LAYOUT_ELEMENT_SPANS, MsgLimits
 from rosfpga_lab.msg.parser import Field
@@ -93,15 +93,12 @@ class _Reader:
     def length(self, path: str, elem_min: int, limit: int, limit_name: str) -> int:
         start = self.pos
         (n,) = struct.unpack("<I", self._take(4, path, "the uint32 length prefix"))
+        self._span(path, start, "uint32", n, ROLE_LENGTH)
         if n > limit:
             raise DeserializeError(f"field {path}: length prefix at byte offset {start} declares "
                                    f"{n}, more than {limit_name}={limit}", path, start)
         if n * elem_min > len(self.buf) - self.pos:
-            raise DeserializeError(
-                f"field {path}: length prefix at byte offset {start} declares {n} element(s) "
-                f"({n * elem_min} byte(s) at least) but only {len(self.buf) - self.pos} byte(s) "
-                "are left", path, start)
-        self._span(path, start, "uint32", n, ROLE_LENGTH)
+            raise too_long(path, start, n, elem_min, len(self.buf) - self.pos, limit_name)
         return n
 
     def string(self, path: str) -> str:

@@ -44,6 +44,7 @@ class MsgRegistry:
         self._specs: dict[str, MsgSpec] = {}
         self._searched: list[str] = []
         self._frozen = False
+        self._direct = 0  # types registered with add()/add_full_text() rather than from files
         #: Caches of values derived from the definitions (md5, codecs); cleared on change.
         self._derived: dict[tuple[str, str], Any] = {}
 
@@ -65,7 +66,8 @@ class MsgRegistry:
         self._frozen = True
         return self
 
-    def add(self, full_name: str, text: str, source: str | None = None) -> MsgSpec:
+    def add(self, full_name: str, text: str, source: str | None = None, *,
+            _loading_file: bool = False) -> MsgSpec:
         """Parse ``text`` as the definition of ``full_name`` and register it.
 
         Args:
@@ -82,6 +84,8 @@ class MsgRegistry:
         """
         self._check_mutable()
         spec = parse_msg(text, full_name, source)
+        if full_name not in self._specs and not _loading_file:
+            self._direct += 1
         self._specs[full_name] = spec
         self._derived.clear()
         return spec
@@ -102,7 +106,7 @@ class MsgRegistry:
                                      str(path)) from None
         except OSError as exc:
             raise MsgDefinitionError(f"cannot read: {exc.strerror or exc}", str(path)) from None
-        return self.add(full_name, text, str(path))
+        return self.add(full_name, text, str(path), _loading_file=True)
 
     def load_path(self, root: str | Path, label: str | None = None) -> list[str]:
         """Register every ``PKG/msg/NAME.msg`` under ``root``.
@@ -151,7 +155,10 @@ class MsgRegistry:
         return sorted({s.package for s in self._specs.values()})
 
     def _where(self) -> str:
-        return ", ".join(self._searched) if self._searched else "nothing (empty registry)"
+        places = list(self._searched)
+        if self._direct:
+            places.append(f"{self._direct} type(s) registered with add()")
+        return ", ".join(places) if places else "nothing (empty registry)"
 
     def resolve(self, name: str, package: str | None = None) -> str:
         """The full name ``name`` refers to (``Header``, ``Name`` in ``package``, unique ``Name``).
