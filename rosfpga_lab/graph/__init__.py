@@ -1,0 +1,50 @@
+"""The ROS graph on real sockets: embedded Master + Parameter Server, Slave API, nodes, trace.
+
+Quick use::
+
+    from rosfpga_lab.graph import EmbeddedMaster, Node
+    with EmbeddedMaster(port=0) as master:
+        talker = Node("/talker", master=master)
+        listener = Node("/listener", master=master)
+        sub = listener.subscribe("/chatter", "std_msgs/String", print)
+        pub = talker.advertise("/chatter", "std_msgs/String")
+        pub.wait_for_subscribers()
+        pub.publish({"data": "hello"})
+        ...
+        talker.shutdown(); listener.shutdown()
+
+Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``master`` (EmbeddedMaster),
+``node`` (Node, Slave API, TCPROS server), ``publisher``, ``subscriber``, ``trace`` (the recorded
+conversation; its docstring documents the format), ``names`` (names, ROS_* environment),
+``errors`` (errors and limits).
+"""
+
+from rosfpga_lab.graph.errors import (
+    CONNECT_TIMEOUT,
+    MAX_HTTP_HEAD,
+    MAX_XMLRPC_BODY,
+    RECONNECT_FIRST,
+    RECONNECT_MAX,
+    XMLRPC_TIMEOUT,
+    ApiArgumentError,
+    ConfigError,
+    GraphError,
+    MasterError,
+    XmlRpcError,
+)
+from rosfpga_lab.graph.master import EmbeddedMaster, ParamTree
+from rosfpga_lab.graph.names import OpenBindWarning, default_host, master_uri_from_env, resolve
+from rosfpga_lab.graph.node import Node, shared_master, stop_shared_master
+from rosfpga_lab.graph.publisher import LinkStats, Publisher, PublisherStats
+from rosfpga_lab.graph.subscriber import MessageInfo, Subscriber, SubscriberStats
+from rosfpga_lab.graph.trace import KINDS, Trace, TraceEvent
+from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call, parse_xmlrpc
+
+__all__ = [
+    "CONNECT_TIMEOUT", "KINDS", "MAX_HTTP_HEAD", "MAX_XMLRPC_BODY", "RECONNECT_FIRST",
+    "RECONNECT_MAX", "XMLRPC_TIMEOUT", "ApiArgumentError", "ConfigError", "EmbeddedMaster",
+    "GraphError", "LinkStats", "MasterError", "MessageInfo", "Node", "OpenBindWarning",
+    "ParamTree", "Publisher", "PublisherStats", "Subscriber", "SubscriberStats", "Trace",
+    "TraceEvent", "XmlRpcError", "XmlRpcServer", "call", "default_host", "master_uri_from_env",
+    "parse_xmlrpc", "resolve", "shared_master", "stop_shared_master",
+]

@@ -1,0 +1,421 @@
+"""An embedded ROS Master and Parameter Server: what ``roscore`` gives nodes.
+
+How it works: an :class:`~rosfpga_lab.graph.xmlrpc.XmlRpcServer` answers the Master API and
+Parameter Server API with the same ``[code, status, value]`` replies as Noetic's rosmaster
+(status texts included). Registrations live in dicts under one lock. Whenever a topic's
+publisher list changes, every subscriber of that topic gets ``publisherUpdate`` from a
+notifier thread, as rosmaster does; parameter subscribers get ``paramUpdate``; a node that
+registers under a name already taken by another URI makes the master tell the old one to
+``shutdown``. Real rospy, roscpp, rostopic and rosnode work against it unchanged.
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import threading
+import uuid
+from typing import Any
+
+from rosfpga_lab.graph.apicheck import api_methods, checked
+from rosfpga_lab.graph.errors import JOIN_TIMEOUT, XmlRpcError
+from rosfpga_lab.graph.names import bind_address, canonical, namespace_of
+from rosfpga_lab.graph.trace import Trace
+from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call
+
+MASTER_ID = "/master"
+NOTIFY_TIMEOUT = 5.0
+
+
+class ParamTree:
+    """The parameter store: a tree of dicts, keys are global names."""
+
+    def __init__(self) -> None:
+        self.root: dict[str, Any] = {}
+
+    @staticmethod
+    def _parts(key: str) -> list[str]:
+        return [p for p in canonical(key).split("/") if p]
+
+    def set(self, key: str, value: Any) -> None:
+        parts = self._parts(key)
+        if not parts:
+            if not isinstance(value, dict):
+                raise ValueError("cannot set the root namespace to a non-dictionary")
+            self.root = _copy(value)
+            return
+        node = self.root
+        for p in parts[:-1]:
+            if not isinstance(node.get(p), dict):
+                node[p] = {}
+            node = node[p]
+        node[parts[-1]] = _copy(value)
+
+    def get(self, key: str) -> Any:
+        node: Any = self.root
+        for p in self._parts(key):
+            if not isinstance(node, dict) or p not in node:
+                raise KeyError(key)
+            node = node[p]
+        return _copy(node)
+
+    def has(self, key: str) -> bool:
+        try:
+            self.get(key)
+            return True
+        except KeyError:
+            return False
+
+    def delete(self, key: str) -> None:
+        parts = self._parts(key)
+        if not parts:
+            raise KeyError(key)
+        node: Any = self.root
+        for p in parts[:-1]:
+            if not isinstance(node, dict) or p not in node:
+                raise KeyError(key)
+            node = node[p]
+        if not isinstance(node, dict) or parts[-1] not in node:
+            raise KeyError(key)
+        del node[parts[-1]]
+
+    def names(self) -> list[str]:
+        out: list[str] = []
+
+        def walk(prefix: str, node: dict) -> None:
+            for k, v in node.items():
+                if isinstance(v, dict) and v:
+                    walk(prefix + k + "/", v)
+                else:
+                    out.append(prefix + k)
+
+        walk("/", self.root)
+        return out
+
+
+def _copy(v: Any) -> Any:
+    return {k: _copy(x) for k, x in v.items()} if isinstance(v, dict) else v
+
+
+class EmbeddedMaster:
+    """A ROS master in this process.
+
+    Args:
+        host: address to bind and advertise (127.0.0.1 by default; "0.0.0.0" binds every
+            interface and warns: ROS 1 has no authentication).
+        port: TCP port (11311 is roscore's; 0 picks a free one).
+        trace: record every XML-RPC exchange here (a new Trace by default).
+        allow_remote_shutdown: honour the ``shutdown`` API call (off by default).
+
+    Example:
+        >>> m = EmbeddedMaster(port=0); m.start(); m.uri  # doctest: +SKIP
+        'http://127.0.0.1:41234/'
+    """
+
+    def __init__(self, host: str = "127.0.0.1", port: int = 11311, *, trace: Trace | None = None,
+                 allow_remote_shutdown: bool = False) -> None:
+        self.trace = trace if trace is not None else Trace()
+        self.allow_remote_shutdown = allow_remote_shutdown
+        self._server = XmlRpcServer(self._handle, host=bind_address(host), port=port,
+                                    trace=self.trace, name=MASTER_ID, advertise_host=host)
+        self._methods = api_methods(self)
+        self._lock = threading.RLock()
+        self.publishers: dict[str, dict[str, str]] = {}   # topic -> caller_id -> api
+        self.subscribers: dict[str, dict[str, str]] = {}
+        self.services: dict[str, dict[str, tuple[str, str]]] = {}  # service -> caller -> (service_api, api)
+        self.param_subscribers: dict[str, dict[str, str]] = {}
+        self.topic_types: dict[str, str] = {}
+        self.nodes: dict[str, str] = {}                   # caller_id -> api
+        self.params = ParamTree()
+        self.params.set("/run_id", str(uuid.uuid1()))
+        self.params.set("/rosdistro", "noetic\n")
+        self.params.set("/rosversion", "1.16.0\n")
+        self._notify_q: queue.Queue = queue.Queue()
+        self._notifier: threading.Thread | None = None
+        self.notify_errors: list[str] = []
+        self.running = False
+
+    # ------------------------------------------------------------------ life cycle
+    @property
+    def uri(self) -> str:
+        """The master's URI (what ROS_MASTER_URI should say)."""
+        return self._server.uri
+
+    @property
+    def port(self) -> int:
+        """The bound port."""
+        return self._server.port
+
+    def start(self) -> EmbeddedMaster:
+        """Start serving; returns self."""
+        self._server.start()
+        self.trace.names[self.uri] = MASTER_ID
+        self._notifier = threading.Thread(target=self._notify_loop, name="rosfpga-master-notify",
+                                          daemon=True)
+        self._notifier.start()
+        self.running = True
+        return self
+
+    def stop(self) -> None:
+        """Stop serving and join every thread."""
+        if not self.running:
+            return
+        self.running = False
+        self._server.stop()
+        self._notify_q.put(None)
+        if self._notifier is not None:
+            self._notifier.join(JOIN_TIMEOUT)
+
+    def __enter__(self) -> EmbeddedMaster:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def _handle(self, method: str, params: tuple) -> Any:
+        f = self._methods.get(method)
+        if f is None:
+            raise Fault(1, f'method "{method}" is not supported')
+        return f(*params)
+
+    # ------------------------------------------------------------------ notifications
+    def _notify_loop(self) -> None:
+        while True:
+            item = self._notify_q.get()
+            if item is None:
+                return
+            api, method, args = item
+            try:
+                call(api, method, MASTER_ID, *args, trace=self.trace, caller=MASTER_ID,
+                     timeout=NOTIFY_TIMEOUT)
+            except (XmlRpcError, ValueError) as exc:
+                self.notify_errors.append(str(exc))
+
+    def _notify_topic(self, topic: str) -> None:
+        pubs = list(self.publishers.get(topic, {}).values())
+        for api in self.subscribers.get(topic, {}).values():
+            self._notify_q.put((api, "publisherUpdate", (topic, pubs)))
+
+    def _register_node(self, caller_id: str, api: str) -> None:
+        old = self.nodes.get(caller_id)
+        if old is not None and old != api:
+            self._notify_q.put((old, "shutdown", ("[%s] Reason: new node registered with same name" % caller_id,)))
+            for table in (self.publishers, self.subscribers, self.param_subscribers):
+                for regs in table.values():
+                    if regs.get(caller_id) == old:
+                        del regs[caller_id]
+        self.nodes[caller_id] = api
+        self.trace.names[api] = caller_id
+
+    def _forget_if_idle(self, caller_id: str) -> None:
+        for table in (self.publishers, self.subscribers, self.param_subscribers):
+            if any(caller_id in regs for regs in table.values()):
+                return
+        if any(caller_id in regs for regs in self.services.values()):
+            return
+        self.nodes.pop(caller_id, None)
+
+    # ------------------------------------------------------------------ master API
+    @checked((), 0)
+    def getPid(self, caller_id: str) -> tuple:
+        return 1, "", os.getpid()
+
+    @checked((), "")
+    def getUri(self, caller_id: str) -> tuple:
+        return 1, "", self.uri
+
+    @checked((("msg", "any"),), 0)
+    def shutdown(self, caller_id: str, msg: Any) -> tuple:
+        if not self.allow_remote_shutdown:
+            return -1, "remote shutdown of the embedded master is disabled", 0
+        threading.Thread(target=self.stop, daemon=True).start()
+        return 1, "shutdown", 0
+
+    @checked((("topic", "topic"), ("topic_type", "type"), ("caller_api", "api")), [])
+    def registerPublisher(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> tuple:
+        with self._lock:
+            self._register_node(caller_id, caller_api)
+            self.publishers.setdefault(topic, {})[caller_id] = caller_api
+            if topic_type != "*" or topic not in self.topic_types:
+                self.topic_types[topic] = topic_type
+            self._notify_topic(topic)
+            subs = list(self.subscribers.get(topic, {}).values())
+        return 1, f"Registered [{caller_id}] as publisher of [{topic}]", subs
+
+    @checked((("topic", "topic"), ("caller_api", "api")), 0)
+    def unregisterPublisher(self, caller_id: str, topic: str, caller_api: str) -> tuple:
+        return self._unregister(self.publishers, "publisher", caller_id, topic, caller_api, notify=True)
+
+    @checked((("topic", "topic"), ("topic_type", "type"), ("caller_api", "api")), [])
+    def registerSubscriber(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> tuple:
+        with self._lock:
+            self._register_node(caller_id, caller_api)
+            self.subscribers.setdefault(topic, {})[caller_id] = caller_api
+            if topic not in self.topic_types and topic_type != "*":
+                self.topic_types[topic] = topic_type
+            pubs = list(self.publishers.get(topic, {}).values())
+        return 1, f"Subscribed to [{topic}]", pubs
+
+    @checked((("topic", "topic"), ("caller_api", "api")), 0)
+    def unregisterSubscriber(self, caller_id: str, topic: str, caller_api: str) -> tuple:
+        return self._unregister(self.subscribers, "subscriber", caller_id, topic, caller_api)
+
+    def _unregister(self, table: dict, what: str, caller_id: str, key: str, api: str,
+                    notify: bool = False) -> tuple:
+        with self._lock:
+            if caller_id not in self.nodes:
+                return 1, f"[{caller_id}] is not a registered node", 0
+            regs = table.get(key, {})
+            if regs.get(caller_id) != api:
+                return 1, f"[{caller_id}] is not a registered {what} of [{key}]", 0
+            del regs[caller_id]
+            if not regs:
+                table.pop(key, None)
+            if notify:
+                self._notify_topic(key)
+            self._forget_if_idle(caller_id)
+        return 1, f"Unregistered [{caller_id}] as provider of [{key}]", 1
+
+    @checked((("service", "topic"), ("service_api", "api"), ("caller_api", "api")), 0)
+    def registerService(self, caller_id: str, service: str, service_api: str, caller_api: str) -> tuple:
+        with self._lock:
+            self._register_node(caller_id, caller_api)
+            self.services[service] = {caller_id: (service_api, caller_api)}
+        return 1, f"Registered [{caller_id}] as provider of [{service}]", 1
+
+    @checked((("service", "topic"), ("service_api", "api")), 0)
+    def unregisterService(self, caller_id: str, service: str, service_api: str) -> tuple:
+        with self._lock:
+            regs = self.services.get(service, {})
+            if caller_id not in regs or regs[caller_id][0] != service_api:
+                return 1, f"[{caller_id}] is not a registered provider of [{service}]", 0
+            del self.services[service]
+            self._forget_if_idle(caller_id)
+        return 1, f"Unregistered [{caller_id}] as provider of [{service}]", 1
+
+    @checked((("service", "topic"),), "")
+    def lookupService(self, caller_id: str, service: str) -> tuple:
+        with self._lock:
+            regs = self.services.get(service)
+            if regs:
+                url = next(iter(regs.values()))[0]
+                return 1, f"rosrpc URI: [{url}]", url
+        return -1, "no provider", ""
+
+    @checked((("node", "name"),), "")
+    def lookupNode(self, caller_id: str, node: str) -> tuple:
+        with self._lock:
+            api = self.nodes.get(node)
+        if api is None:
+            return -1, f"unknown node [{node}]", ""
+        return 1, "node api", api
+
+    @checked((("subgraph", "opt_name"),), [])
+    def getPublishedTopics(self, caller_id: str, subgraph: str) -> tuple:
+        if subgraph and not subgraph.endswith("/"):
+            subgraph += "/"
+        with self._lock:
+            topics = [[t, self.topic_types.get(t, "*")] for t in self.publishers if t.startswith(subgraph)]
+        return 1, "current topics", topics
+
+    @checked((), [])
+    def getTopicTypes(self, caller_id: str) -> tuple:
+        with self._lock:
+            return 1, "current system state", [[t, ty] for t, ty in self.topic_types.items()]
+
+    @checked((), [[], [], []])
+    def getSystemState(self, caller_id: str) -> tuple:
+        with self._lock:
+            state = [
+                [[t, sorted(r)] for t, r in self.publishers.items() if r],
+                [[t, sorted(r)] for t, r in self.subscribers.items() if r],
+                [[s, sorted(r)] for s, r in self.services.items() if r],
+            ]
+        return 1, "current system state", state
+
+    # ------------------------------------------------------------------ parameter server
+    @checked((("key", "name"),), 0)
+    def deleteParam(self, caller_id: str, key: str) -> tuple:
+        with self._lock:
+            try:
+                self.params.delete(key)
+            except KeyError:
+                return -1, f"parameter [{key}] is not set", 0
+            self._notify_params(key, {})
+        return 1, f"parameter {key} deleted", 0
+
+    @checked((("key", "name"), ("value", "any")), 0)
+    def setParam(self, caller_id: str, key: str, value: Any) -> tuple:
+        with self._lock:
+            try:
+                self.params.set(key, value)
+            except ValueError as exc:
+                return -1, str(exc), 0
+            self._notify_params(key, value)
+        return 1, f"parameter {key} set", 0
+
+    @checked((("key", "name"),), 0)
+    def getParam(self, caller_id: str, key: str) -> tuple:
+        with self._lock:
+            try:
+                return 1, f"Parameter [{key}]", self.params.get(key)
+            except KeyError:
+                return -1, f"Parameter [{key}] is not set", 0
+
+    @checked((("key", "str"),), "")
+    def searchParam(self, caller_id: str, key: str) -> tuple:
+        if key.startswith("/"):
+            with self._lock:
+                found = self.params.has(key)
+            return (1, f"Found [{key}]", key) if found else \
+                (-1, f"Cannot find parameter [{key}] in an upwards search", "")
+        first = key.lstrip("~").split("/")[0]
+        rest = key.lstrip("~")[len(first):]
+        ns = namespace_of(caller_id)
+        with self._lock:
+            while True:
+                candidate = canonical(ns + first)
+                if self.params.has(candidate):
+                    full = canonical(candidate + rest)
+                    return 1, f"Found [{full}]", full
+                if ns == "/":
+                    break
+                ns = namespace_of(ns.rstrip("/"))
+        return -1, f"Cannot find parameter [{key}] in an upwards search", ""
+
+    @checked((("caller_api", "api"), ("key", "name")), 0)
+    def subscribeParam(self, caller_id: str, caller_api: str, key: str) -> tuple:
+        with self._lock:
+            self._register_node(caller_id, caller_api)
+            self.param_subscribers.setdefault(key, {})[caller_id] = caller_api
+            try:
+                value = self.params.get(key)
+            except KeyError:
+                value = {}
+        return 1, f"Subscribed to parameter [{key}]", value
+
+    @checked((("caller_api", "api"), ("key", "name")), 0)
+    def unsubscribeParam(self, caller_id: str, caller_api: str, key: str) -> tuple:
+        code, _status, n = self._unregister(self.param_subscribers, "parameter subscriber",
+                                            caller_id, key, caller_api)
+        return 1, f"Unsubscribe to parameter [{key}]", n
+
+    @checked((("key", "name"),), False)
+    def hasParam(self, caller_id: str, key: str) -> tuple:
+        with self._lock:
+            return 1, key, self.params.has(key)
+
+    @checked((), [])
+    def getParamNames(self, caller_id: str) -> tuple:
+        with self._lock:
+            return 1, "Parameter names", self.params.names()
+
+    def _notify_params(self, key: str, value: Any) -> None:
+        for sub_key, regs in self.param_subscribers.items():
+            if sub_key == key or sub_key.startswith(key.rstrip("/") + "/") or key.startswith(sub_key.rstrip("/") + "/"):
+                try:
+                    sub_value = self.params.get(sub_key)
+                except KeyError:
+                    sub_value = {}
+                for api in regs.values():
+                    self._notify_q.put((api, "paramUpdate", (sub_key + "/" if sub_key != "/" else "/", sub_value)))

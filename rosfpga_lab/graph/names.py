@@ -1,0 +1,100 @@
+"""ROS graph names and the environment (ROS_MASTER_URI, ROS_IP, ROS_HOSTNAME).
+
+Names follow rosgraph.names: ``/ns/name`` is global, ``name`` is relative to the caller's
+namespace, ``~name`` is private (under the caller's own name).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import warnings
+
+from rosfpga_lab.graph.errors import ConfigError
+
+_LEGAL = re.compile(r"^[~/A-Za-z][\w/]*$")
+ALL_INTERFACES = ("0.0.0.0", "", "::")
+
+
+class OpenBindWarning(UserWarning):
+    """Binding to every network interface: ROS 1 has no authentication."""
+
+
+def is_legal_name(name: str) -> bool:
+    """rosgraph's rule: empty, or starts with ~ / or a letter, then word characters and /."""
+    return name == "" or (bool(_LEGAL.match(name)) and "//" not in name)
+
+
+def canonical(name: str) -> str:
+    """Collapse repeated slashes and drop a trailing one (except for the root)."""
+    if not name:
+        return name
+    lead = "/" if name.startswith("/") else ""
+    parts = [p for p in name.split("/") if p]
+    return lead + "/".join(parts) if parts else "/"
+
+
+def namespace_of(name: str) -> str:
+    """``/a/b/c`` -> ``/a/b/``; ``/c`` -> ``/``."""
+    name = canonical(name)
+    return name[: name.rfind("/") + 1] if "/" in name else "/"
+
+
+def resolve(name: str, caller_id: str = "/") -> str:
+    """Resolve ``name`` against ``caller_id`` the way the master and rospy do."""
+    if not name:
+        return namespace_of(caller_id)
+    if name.startswith("/"):
+        return canonical(name)
+    if name.startswith("~"):
+        return canonical(canonical(caller_id) + "/" + name[1:])
+    return canonical(namespace_of(caller_id) + name)
+
+
+def check_node_name(name: str) -> str:
+    """Return the canonical global node name.
+
+    Raises:
+        ConfigError: illegal characters or empty.
+    """
+    if not name or not is_legal_name(name) or name.startswith("~"):
+        raise ConfigError(f"illegal node name {name!r}: use letters, digits, '_' and '/', "
+                          "starting with a letter or '/'")
+    return resolve(name, "/")
+
+
+def master_uri_from_env() -> str | None:
+    """``ROS_MASTER_URI`` if set and non-empty, else None."""
+    value = os.environ.get("ROS_MASTER_URI", "").strip()
+    return value or None
+
+
+def default_host() -> str:
+    """The address nodes bind to and advertise: ROS_IP, then ROS_HOSTNAME, else 127.0.0.1.
+
+    Unlike ROS (which defaults to the machine's hostname, reachable from the network), the lab
+    defaults to loopback: a workshop network should not see students' nodes by accident.
+    """
+    for var in ("ROS_IP", "ROS_HOSTNAME"):
+        value = os.environ.get(var, "").strip()
+        if value:
+            return value
+    return "127.0.0.1"
+
+
+def bind_address(host: str) -> str:
+    """The address to bind for an advertised ``host``; warn when it opens every interface."""
+    if host in ALL_INTERFACES:
+        warnings.warn(
+            "binding to all network interfaces: ROS 1 has no authentication, anyone who can "
+            "reach this machine can publish, subscribe and stop nodes. Use 127.0.0.1 unless "
+            "you need other machines.", OpenBindWarning, stacklevel=3)
+        return "0.0.0.0"
+    if host in ("localhost",):
+        return "127.0.0.1"
+    if re.fullmatch(r"[0-9.]+", host):
+        return host
+    # a hostname (ROS_HOSTNAME): bind every interface it may resolve to, like roscpp does
+    warnings.warn(f"binding to all interfaces to serve the hostname {host!r}; ROS 1 has no "
+                  "authentication", OpenBindWarning, stacklevel=3)
+    return "0.0.0.0"

@@ -1,0 +1,480 @@
+"""A ROS 1 node on real sockets: Slave API over XML-RPC, TCPROS server, publishers, subscribers.
+
+How it works: a :class:`Node` starts two servers on its host (127.0.0.1 by default): the
+XML-RPC Slave API (``requestTopic``, ``publisherUpdate``, ``getBusInfo`` ...) and a TCPROS
+port. :meth:`Node.advertise` registers a publisher with the master; a subscriber that calls
+``requestTopic`` learns the TCPROS port, connects, and a handshake thread runs
+:class:`~rosfpga_lab.tcpros.PublisherHandshake` (with a time-out, so a silent client cannot
+hold anything) before handing the socket to the publisher. :meth:`Node.subscribe` registers a
+subscriber and connects to every publisher the master lists (see ``subscriber``). Everything
+runs in daemon threads, so a node works inside a running Jupyter kernel; :meth:`shutdown`
+unregisters, closes every socket and joins every thread.
+
+Master selection (``master_uri``): an explicit URI; else ``ROS_MASTER_URI``; else the shared
+embedded master of this process (:func:`shared_master`), started on first use on port 11311
+(or a free port if 11311 is taken). Pass ``master=`` an :class:`EmbeddedMaster` to use it.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from rosfpga_lab.graph.apicheck import api_methods, checked
+from rosfpga_lab.graph.errors import (
+    JOIN_TIMEOUT,
+    ConfigError,
+    GraphError,
+    MasterError,
+    XmlRpcError,
+)
+from rosfpga_lab.graph.master import MASTER_ID, EmbeddedMaster
+from rosfpga_lab.graph.names import (
+    bind_address,
+    check_node_name,
+    default_host,
+    master_uri_from_env,
+    resolve,
+)
+from rosfpga_lab.graph.publisher import Publisher
+from rosfpga_lab.graph.subscriber import Subscriber
+from rosfpga_lab.graph.trace import Trace, new_connection_id
+from rosfpga_lab.graph.wire import hard_close
+from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, split_uri
+from rosfpga_lab.tcpros import (
+    HANDSHAKE_TIMEOUT,
+    MAX_FRAME_BYTES,
+    Closed,
+    Connected,
+    HeaderReceived,
+    PublisherHandshake,
+    Rejected,
+    TopicSpec,
+)
+
+_shared_lock = threading.Lock()
+_shared: EmbeddedMaster | None = None
+
+
+def shared_master(port: int = 11311) -> EmbeddedMaster:
+    """The process-wide embedded master (started on first call; stopped by :func:`stop_shared_master`)."""
+    global _shared
+    with _shared_lock:
+        if _shared is None or not _shared.running:
+            try:
+                _shared = EmbeddedMaster(port=port).start()
+            except XmlRpcError:
+                _shared = EmbeddedMaster(port=0).start()
+        return _shared
+
+
+def stop_shared_master() -> None:
+    """Stop the shared embedded master, if one runs."""
+    global _shared
+    with _shared_lock:
+        if _shared is not None:
+            _shared.stop()
+            _shared = None
+
+
+class Node:
+    """A ROS node.
+
+    Args:
+        name: node name (global, e.g. ``/fpga_node``; a relative name is made global).
+        master_uri: the master to use; None: ``ROS_MASTER_URI`` if set, else the shared
+            embedded master (see module docstring).
+        host: address to bind and advertise; None: ``ROS_IP``, ``ROS_HOSTNAME``, else
+            127.0.0.1. "0.0.0.0" binds every interface (with a warning).
+        master: an :class:`EmbeddedMaster` to use (overrides ``master_uri``).
+        trace: where to record the conversation (a new :class:`Trace` by default;
+            share one between nodes and the master for a single timeline).
+        registry: message registry for md5 sums and (de)serialization (default: shipped types).
+        tcpros_port, xmlrpc_port: fixed ports (0: any free one).
+
+    Raises:
+        ConfigError: bad name or master URI.
+        XmlRpcError: a port cannot be bound.
+    """
+
+    def __init__(self, name: str, master_uri: str | None = None, host: str | None = None, *,
+                 master: EmbeddedMaster | None = None, trace: Trace | None = None,
+                 registry: Any = None, tcpros_port: int = 0, xmlrpc_port: int = 0) -> None:
+        self.name = check_node_name(name)
+        if master is not None:
+            master_uri = master.uri
+        elif master_uri is None:
+            master_uri = master_uri_from_env() or shared_master().uri
+        split_uri(master_uri)
+        self.master_uri = master_uri
+        self.host = host or default_host()
+        self.trace = trace if trace is not None else Trace()
+        if registry is None:
+            from rosfpga_lab.msg import default_registry
+
+            registry = default_registry()
+        self.registry = registry
+        self._lock = threading.RLock()
+        self.publishers: dict[str, Publisher] = {}
+        self.subscribers: dict[str, Subscriber] = {}
+        self._handshakes: set[threading.Thread] = set()
+        self._pending: set[socket.socket] = set()
+        self.is_shutdown = False
+        bind = bind_address(self.host)
+        self._xmlrpc = XmlRpcServer(self._handle_xmlrpc, host=bind, port=xmlrpc_port,
+                                    trace=self.trace, name=self.name, advertise_host=self.host)
+        self._xmlrpc.start()
+        self._methods = api_methods(self)
+        self._tcp = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self._tcp.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            self._tcp.bind((bind, tcpros_port))
+        except OSError as exc:
+            self._tcp.close()
+            self._xmlrpc.stop()
+            raise XmlRpcError(f"cannot bind TCPROS port {bind}:{tcpros_port}: {exc}") from None
+        self._tcp.listen(64)
+        self.tcpros_port = self._tcp.getsockname()[1]
+        self._accept = threading.Thread(target=self._accept_loop, daemon=True,
+                                        name=f"rosfpga-tcpros-accept-{self.name}")
+        self._accept.start()
+        self.trace.names[self.uri] = self.name
+        self.trace.names[f"{self.host}:{self.tcpros_port}"] = self.name
+        self.trace.names.setdefault(self.master_uri, MASTER_ID)
+
+    # ------------------------------------------------------------------ basics
+    @property
+    def uri(self) -> str:
+        """This node's XML-RPC (Slave API) URI."""
+        return self._xmlrpc.uri
+
+    def __enter__(self) -> Node:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.shutdown()
+
+    def __repr__(self) -> str:
+        return f"<Node {self.name} {self.uri} master={self.master_uri}>"
+
+    def _master(self, method: str, *args: Any) -> Any:
+        reply = call(self.master_uri, method, self.name, *args, trace=self.trace, caller=self.name,
+                     callee=MASTER_ID)
+        if not (isinstance(reply, list) and len(reply) == 3):
+            raise MasterError(f"master's {method} reply is not [code, status, value]: {reply!r}")
+        code, status, value = reply
+        if code != 1:
+            raise MasterError(f"master refused {method}{args}: {status}", code, status)
+        return value
+
+    def _type_info(self, type_name: str, md5sum: str | None,
+                   message_definition: str | None) -> tuple[str, str]:
+        if md5sum is not None:
+            return md5sum, message_definition or ""
+        if type_name == "*":
+            return "*", ""
+        return self.registry.md5(type_name), (
+            message_definition if message_definition is not None else self.registry.full_text(type_name))
+
+    # ------------------------------------------------------------------ publishing
+    def advertise(self, topic: str, type_name: str, queue_size: int = 10, latch: bool = False, *,
+                  md5sum: str | None = None, message_definition: str | None = None) -> Publisher:
+        """Register as publisher of ``topic`` and return the :class:`Publisher`.
+
+        Args:
+            topic: topic name (relative names resolve in the node's namespace).
+            type_name: ``pkg/Type`` known to the registry (or give ``md5sum``).
+            queue_size: frames queued per subscriber before the oldest is dropped (<= 0: no limit).
+            latch: send the last message to every new subscriber.
+            md5sum, message_definition: override the registry (for types it does not know).
+
+        Raises:
+            GraphError: the topic is already advertised by this node.
+            MasterError, XmlRpcError: the master refused or cannot be reached.
+            MsgError: unknown type.
+        """
+        topic = resolve(topic, self.name)
+        md5, definition = self._type_info(type_name, md5sum, message_definition)
+        with self._lock:
+            if self.is_shutdown:
+                raise GraphError(f"node {self.name} is shut down")
+            if topic in self.publishers:
+                raise GraphError(f"{self.name} already publishes {topic}; use the existing publisher")
+            pub = Publisher(self, topic, type_name, md5, definition, queue_size=queue_size, latch=latch)
+            self.publishers[topic] = pub
+        try:
+            self._master("registerPublisher", topic, type_name, self.uri)
+        except Exception:
+            with self._lock:
+                self.publishers.pop(topic, None)
+            raise
+        return pub
+
+    def _unadvertise(self, pub: Publisher) -> None:
+        with self._lock:
+            if self.publishers.get(pub.topic) is pub:
+                del self.publishers[pub.topic]
+        try:
+            self._master("unregisterPublisher", pub.topic, self.uri)
+        except GraphError:
+            pass
+        pub._close()
+
+    def _lookup_spec(self, topic: str) -> TopicSpec | None:
+        pub = self.publishers.get(topic)
+        return pub.spec if pub is not None and not pub.closed else None
+
+    # ------------------------------------------------------------------ subscribing
+    def subscribe(self, topic: str, type_name: str, callback: Callable[..., Any] | None = None, *,
+                  raw: bool = False, queue_size: int = 10, tcp_nodelay: bool = False,
+                  md5sum: str | None = None, send_definition: bool = False,
+                  max_frame: int = MAX_FRAME_BYTES) -> Subscriber:
+        """Subscribe to ``topic``; return the :class:`Subscriber`.
+
+        Args:
+            callback: ``callback(value_dict)``; with ``raw=True`` ``callback(body, info)``
+                where body is the serialized message (bytes or memoryview, no frame length) and
+                info a :class:`MessageInfo`. None: only ``wait_for_message``/``last``.
+            queue_size: frames queued for the callback before the oldest is dropped (<= 0: no limit).
+            tcp_nodelay: ask publishers for TCP_NODELAY.
+            md5sum: override the registry (``"*"`` with type ``"*"`` accepts any type, raw only).
+            send_definition: also send ``message_definition`` (as rospy does; roscpp does not).
+
+        Raises:
+            GraphError: already subscribed to this topic in this node.
+            MasterError, XmlRpcError: the master refused or cannot be reached.
+        """
+        topic = resolve(topic, self.name)
+        md5, definition = self._type_info(type_name, md5sum, None)
+        if type_name == "*" and not raw:
+            raise GraphError("subscribing with type '*' needs raw=True (nothing to deserialize with)")
+        with self._lock:
+            if self.is_shutdown:
+                raise GraphError(f"node {self.name} is shut down")
+            if topic in self.subscribers:
+                raise GraphError(f"{self.name} already subscribes to {topic}")
+            sub = Subscriber(self, topic, type_name, md5, callback, raw=raw, queue_size=queue_size,
+                             tcp_nodelay=tcp_nodelay,
+                             message_definition=definition if send_definition else None,
+                             max_frame=max_frame)
+            self.subscribers[topic] = sub
+        try:
+            pubs = self._master("registerSubscriber", topic, type_name, self.uri)
+        except Exception:
+            with self._lock:
+                self.subscribers.pop(topic, None)
+            sub._close()
+            raise
+        sub._update_publishers([u for u in pubs if isinstance(u, str)])
+        return sub
+
+    def _unsubscribe(self, sub: Subscriber) -> None:
+        with self._lock:
+            if self.subscribers.get(sub.topic) is sub:
+                del self.subscribers[sub.topic]
+        try:
+            self._master("unregisterSubscriber", sub.topic, self.uri)
+        except GraphError:
+            pass
+        sub._close()
+
+    # ------------------------------------------------------------------ TCPROS server
+    def _accept_loop(self) -> None:
+        while not self.is_shutdown:
+            try:
+                conn, addr = self._tcp.accept()
+            except OSError:
+                return
+            if self.is_shutdown:
+                hard_close(conn)
+                return
+            t = threading.Thread(target=self._handshake, args=(conn, f"{addr[0]}:{addr[1]}"),
+                                 daemon=True, name=f"rosfpga-tcpros-handshake-{self.name}")
+            with self._lock:
+                self._handshakes.add(t)
+                self._pending.add(conn)
+            t.start()
+
+    def _handshake(self, conn: socket.socket, peer: str) -> None:
+        handed_over = False
+        try:
+            handed_over = self._run_handshake(conn, peer)
+        except OSError:
+            pass
+        finally:
+            with self._lock:
+                self._pending.discard(conn)
+                self._handshakes.discard(threading.current_thread())
+            if not handed_over:
+                hard_close(conn)
+
+    def _run_handshake(self, conn: socket.socket, peer: str) -> bool:
+        conn_id = new_connection_id()
+        tr = self.trace
+        tr.record("tcp_connect", self.name, role="in", src=peer, dst=self.name, conn=conn_id)
+        hs = PublisherHandshake(callerid=self.name, lookup=self._lookup_spec, peer=peer)
+        deadline = time.monotonic() + HANDSHAKE_TIMEOUT
+        src = peer
+        while hs.state == "AWAIT_HEADER":
+            left = deadline - time.monotonic()
+            if left <= 0:
+                events = hs.timeout()
+            else:
+                conn.settimeout(left)
+                try:
+                    data = conn.recv(65536)
+                except TimeoutError:
+                    events = hs.timeout()
+                else:
+                    events = hs.receive_data(data) if data else hs.receive_eof()
+            for ev in events:
+                if isinstance(ev, HeaderReceived):
+                    src = ev.fields.get("callerid", peer)
+                    tr.record("tcpros_header", self.name, role="in", src=src, dst=self.name,
+                              method=ev.fields.get("topic", ""), args=dict(ev.fields), raw=ev.raw,
+                              size=len(ev.raw), conn=conn_id)
+                elif isinstance(ev, Rejected):
+                    tr.record("tcpros_header", self.name, role="out", src=self.name, dst=src,
+                              args={"error": str(ev.error)}, raw=ev.reply, size=len(ev.reply),
+                              conn=conn_id, result=str(ev.error))
+                    conn.settimeout(1.0)
+                    conn.sendall(ev.reply)
+                    return False
+                elif isinstance(ev, Connected):
+                    tr.record("tcpros_header", self.name, role="out", src=self.name, dst=src,
+                              method=ev.topic, args=hs.reply_fields(hs.spec), raw=ev.reply,
+                              size=len(ev.reply), conn=conn_id)
+                    conn.settimeout(5.0)
+                    conn.sendall(ev.reply)
+                    pub = self.publishers.get(ev.topic)
+                    if pub is None:
+                        return False
+                    pub._add_link(conn, conn_id, src, ev.tcp_nodelay)
+                    return True
+                elif isinstance(ev, Closed):
+                    return False
+        return False
+
+    # ------------------------------------------------------------------ Slave API
+    def _handle_xmlrpc(self, method: str, params: tuple) -> Any:
+        f = self._methods.get(method)
+        if f is None:
+            raise Fault(1, f'method "{method}" is not supported')
+        return f(*params)
+
+    @checked((), "")
+    def getMasterUri(self, caller_id: str) -> tuple:
+        return 1, "", self.master_uri
+
+    @checked((), 0)
+    def getPid(self, caller_id: str) -> tuple:
+        return 1, "", os.getpid()
+
+    @checked((("msg", "any"),), 0)
+    def _api_shutdown(self, caller_id: str, msg: Any = "") -> tuple:
+        threading.Thread(target=self._shutdown, args=(f"remote shutdown by {caller_id}: {msg}",),
+                         daemon=True, name=f"rosfpga-shutdown-{self.name}").start()
+        return 1, "shutdown", 0
+
+    @checked((), [])
+    def getSubscriptions(self, caller_id: str) -> tuple:
+        return 1, "subscriptions", [[s.topic, s.type_name] for s in list(self.subscribers.values())]
+
+    @checked((), [])
+    def getPublications(self, caller_id: str) -> tuple:
+        return 1, "publications", [[p.topic, p.type_name] for p in list(self.publishers.values())]
+
+    @checked((("key", "str"), ("value", "any")), 0)
+    def paramUpdate(self, caller_id: str, key: str, value: Any) -> tuple:
+        return 1, "", 0
+
+    @checked((("topic", "topic"), ("publishers", "list")), 0)
+    def publisherUpdate(self, caller_id: str, topic: str, publishers: list) -> tuple:
+        bad = [p for p in publishers if not (isinstance(p, str) and p.startswith("http://"))]
+        if bad:
+            return -1, f"publisherUpdate for {topic}: publishers must be http:// URIs, got {bad[:3]!r}", 0
+        sub = self.subscribers.get(topic)
+        if sub is None:
+            return 1, f"not subscribed to {topic}", 0
+        sub._update_publishers(publishers)
+        return 1, "", 0
+
+    @checked((("topic", "topic"), ("protocols", "list")), [])
+    def requestTopic(self, caller_id: str, topic: str, protocols: list) -> tuple:
+        if self._lookup_spec(topic) is None:
+            return -1, f"Not a publisher of [{topic}]", []
+        for proto in protocols:
+            if isinstance(proto, list) and proto and proto[0] == "TCPROS":
+                return 1, f"ready on {self.host}:{self.tcpros_port}", ["TCPROS", self.host, self.tcpros_port]
+        return 0, "no supported protocol implementations", []
+
+    @checked((), [])
+    def getBusInfo(self, caller_id: str) -> tuple:
+        info = []
+        for pub in list(self.publishers.values()):
+            for link in pub.stats.links:
+                if link.connected:
+                    info.append([link.conn, link.peer, "o", "TCPROS", pub.topic, True,
+                                 f"TCPROS connection on port {self.tcpros_port} to [{link.peer}]"])
+        for sub in list(self.subscribers.values()):
+            for uri, link in list(sub._links.items()):
+                info.append([0, uri, "i", "TCPROS", sub.topic, link.connected,
+                             f"TCPROS connection to [{uri}]"])
+        return 1, "bus info", info
+
+    @checked((), [[], [], []])
+    def getBusStats(self, caller_id: str) -> tuple:
+        pubs = []
+        for pub in list(self.publishers.values()):
+            st = pub.stats
+            pubs.append([pub.topic, st.bytes, [[l.conn, l.bytes, l.frames, l.connected] for l in st.links]])
+        subs = []
+        for sub in list(self.subscribers.values()):
+            st = sub.stats
+            subs.append([sub.topic, [[0, st.bytes, st.drops, st.connections > 0]]])
+        return 1, "", [pubs, subs, []]
+
+    # ------------------------------------------------------------------ shutdown
+    def shutdown(self, reason: str = "") -> None:
+        """Unregister everything, close every socket, join every thread (idempotent)."""
+        self._shutdown(reason)
+
+    _api_shutdown.ros_name = "shutdown"  # type: ignore[attr-defined]
+
+    def _shutdown(self, reason: str = "") -> None:
+        with self._lock:
+            if self.is_shutdown:
+                return
+            self.is_shutdown = True
+            pubs = list(self.publishers.values())
+            subs = list(self.subscribers.values())
+            self.publishers.clear()
+            self.subscribers.clear()
+        for sub in subs:
+            try:
+                self._master("unregisterSubscriber", sub.topic, self.uri)
+            except GraphError:
+                pass
+            sub._close()
+        for pub in pubs:
+            try:
+                self._master("unregisterPublisher", pub.topic, self.uri)
+            except GraphError:
+                pass
+            pub._close()
+        hard_close(self._tcp)
+        with self._lock:
+            pending = list(self._pending)
+            handshakes = list(self._handshakes)
+        for conn in pending:
+            hard_close(conn)
+        for t in handshakes:
+            if t is not threading.current_thread():
+                t.join(JOIN_TIMEOUT)
+        if self._accept is not threading.current_thread():
+            self._accept.join(JOIN_TIMEOUT)
+        self._xmlrpc.stop()

@@ -1,0 +1,364 @@
+"""A topic subscriber: one connection thread per publisher, one dispatcher thread.
+
+How it works: the master's ``registerSubscriber`` reply and later ``publisherUpdate`` calls
+give the publishers' XML-RPC URIs. For each, a link thread asks ``requestTopic`` for a TCPROS
+address, connects, runs the subscriber side of the handshake and reads frames into the
+subscriber's bounded queue (``queue_size``: the oldest frame is dropped and counted when the
+callback falls behind). A dispatcher thread calls the callback, so a slow callback never
+stalls the socket. When a connection drops, the link retries with exponential back-off
+(0.1 s doubling up to ``RECONNECT_MAX``) for as long as the master still lists that
+publisher; a refused handshake (md5 mismatch, ``error=`` reply) is not retried.
+"""
+
+from __future__ import annotations
+
+import collections
+import socket
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from rosfpga_lab.graph.errors import (
+    CONNECT_TIMEOUT,
+    JOIN_TIMEOUT,
+    RECONNECT_FACTOR,
+    RECONNECT_FIRST,
+    RECONNECT_MAX,
+    GraphError,
+    MasterError,
+    XmlRpcError,
+)
+from rosfpga_lab.graph.trace import new_connection_id
+from rosfpga_lab.graph.wire import RECV_CHUNK, hard_close, set_nodelay
+from rosfpga_lab.graph.xmlrpc import call
+from rosfpga_lab.errors import LabError
+from rosfpga_lab.tcpros import (
+    HANDSHAKE_TIMEOUT,
+    Closed,
+    Connected,
+    Frame,
+    HandshakeRejected,
+    HeaderReceived,
+    ProtocolError,
+    RemoteError,
+    SubscriberHandshake,
+)
+
+if TYPE_CHECKING:
+    from rosfpga_lab.graph.node import Node
+
+MAX_ERRORS_KEPT = 50
+
+
+@dataclass(frozen=True)
+class MessageInfo:
+    """Where a message came from (second argument of a raw callback)."""
+
+    topic: str
+    publisher: str          # the publisher's callerid
+    conn: int               # connection id (as in the trace)
+    index: int              # frame number on that connection
+    size: int               # body bytes
+    received: float         # time.time() when the frame was complete
+    header: dict[str, str] = field(repr=False, default_factory=dict)  # publisher's connection header
+
+
+@dataclass
+class SubscriberStats:
+    """Frames/bytes received, drops in our queue, publishers connected, errors seen."""
+
+    frames: int = 0
+    bytes: int = 0
+    drops: int = 0
+    connections: int = 0
+    callback_errors: int = 0
+    errors: list[str] = field(default_factory=list)
+
+
+class _PublisherLink:
+    def __init__(self, sub: Subscriber, pub_uri: str) -> None:
+        self.sub = sub
+        self.pub_uri = pub_uri
+        self.stop = threading.Event()
+        self.sock: socket.socket | None = None
+        self.connected = False
+        self.permanent_error: str | None = None
+        self.thread = threading.Thread(target=self._run, daemon=True,
+                                       name=f"rosfpga-sub-link-{sub.topic}")
+
+    def _run(self) -> None:
+        delay = RECONNECT_FIRST
+        while not self.stop.is_set():
+            try:
+                got_frames = self._connect_once()
+                if got_frames:
+                    delay = RECONNECT_FIRST
+            except (RemoteError, HandshakeRejected) as exc:
+                self.permanent_error = str(exc)
+                self.sub._error(f"{self.pub_uri}: {exc} (not retrying)")
+                return
+            except (LabError, OSError) as exc:
+                if not self.stop.is_set():
+                    self.sub._error(f"{self.pub_uri}: {exc}")
+            finally:
+                self._drop_socket()
+            if self.stop.wait(delay):
+                return
+            delay = min(delay * RECONNECT_FACTOR, RECONNECT_MAX)
+
+    def _drop_socket(self) -> None:
+        if self.connected:
+            self.connected = False
+            self.sub._connections_changed(-1)
+        if self.sock is not None:
+            hard_close(self.sock)
+            self.sock = None
+
+    def _connect_once(self) -> bool:
+        sub, node = self.sub, self.sub.node
+        reply = call(self.pub_uri, "requestTopic", node.name, sub.topic, [["TCPROS"]],
+                     trace=node.trace, caller=node.name, timeout=CONNECT_TIMEOUT)
+        if not (isinstance(reply, list) and len(reply) == 3 and reply[0] == 1):
+            raise MasterError(f"requestTopic refused: {reply!r}")
+        proto = reply[2]
+        if not (isinstance(proto, list) and len(proto) >= 3 and proto[0] == "TCPROS"
+                and isinstance(proto[1], str) and isinstance(proto[2], int)):
+            raise GraphError(f"requestTopic gave an unusable protocol description: {proto!r}")
+        host, port = proto[1], proto[2]
+        if self.stop.is_set():
+            return False
+        sock = socket.create_connection((host, port), timeout=CONNECT_TIMEOUT)
+        self.sock = sock
+        if self.stop.is_set():
+            return False
+        if sub.tcp_nodelay:
+            set_nodelay(sock)
+        conn = new_connection_id()
+        peer = f"{host}:{port}"
+        local = sock.getsockname()
+        node.trace.names[f"{local[0]}:{local[1]}"] = node.name
+        node.trace.record("tcp_connect", node.name, role="out", src=node.name,
+                          dst=node.trace.name_of(self.pub_uri), method=sub.topic, conn=conn)
+        hs = SubscriberHandshake(callerid=node.name, topic=sub.topic, md5sum=sub.md5sum,
+                                 type_name=sub.type_name, message_definition=sub.message_definition,
+                                 tcp_nodelay=sub.tcp_nodelay, max_frame=sub.max_frame)
+        request = hs.initiate()
+        sock.sendall(request)
+        node.trace.record("tcpros_header", node.name, role="out", src=node.name,
+                          dst=node.trace.name_of(self.pub_uri), method=sub.topic,
+                          args=dict(hs.fields), raw=request, size=len(request), conn=conn)
+        deadline = time.monotonic() + HANDSHAKE_TIMEOUT
+        publisher, header = peer, {}
+        got = False
+        while not self.stop.is_set():
+            if hs.state == "AWAIT_HEADER":
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    hs.timeout()
+                sock.settimeout(remaining)
+            try:
+                data = sock.recv(RECV_CHUNK)
+            except TimeoutError:
+                hs.timeout()
+                raise
+            events = hs.receive_data(data) if data else hs.receive_eof()
+            for ev in events:
+                if isinstance(ev, Frame):
+                    got = True
+                    sub._deliver(ev.body, MessageInfo(sub.topic, publisher, conn, ev.index,
+                                                      len(ev.body), time.time(), header), ev.offset)
+                elif isinstance(ev, HeaderReceived):
+                    publisher = ev.fields.get("callerid", peer)
+                    header = ev.fields
+                    node.trace.names[peer] = publisher
+                    node.trace.record("tcpros_header", node.name, role="in", src=publisher,
+                                      dst=node.name, method=sub.topic, args=dict(ev.fields),
+                                      raw=ev.raw, size=len(ev.raw), conn=conn,
+                                      result=ev.fields.get("error"))
+                elif isinstance(ev, Connected):
+                    sock.settimeout(None)
+                    self.connected = True
+                    sub._connections_changed(+1)
+                elif isinstance(ev, Closed):
+                    node.trace.record("tcp_close", node.name, role="in", src=publisher,
+                                      dst=node.name, method=sub.topic, conn=conn)
+                    return got
+            if not data:
+                return got
+        return got
+
+    def close(self) -> None:
+        self.stop.set()
+        sock = self.sock
+        if sock is not None:
+            hard_close(sock)
+
+
+class Subscriber:
+    """Subscribes to one topic. Create with :meth:`Node.subscribe`, not directly."""
+
+    def __init__(self, node: Node, topic: str, type_name: str, md5sum: str,
+                 callback: Callable[..., Any] | None, *, raw: bool, queue_size: int,
+                 tcp_nodelay: bool, message_definition: str | None, max_frame: int) -> None:
+        self.node = node
+        self.topic = topic
+        self.type_name = type_name
+        self.md5sum = md5sum
+        self.callback = callback
+        self.raw = raw
+        self.queue_size = int(queue_size or 0)
+        self.tcp_nodelay = tcp_nodelay
+        self.message_definition = message_definition
+        self.max_frame = max_frame
+        self._stats = SubscriberStats()
+        self._links: dict[str, _PublisherLink] = {}
+        self._queue: collections.deque = collections.deque()
+        self._cond = threading.Condition()
+        self._lock = threading.Lock()
+        self.closed = False
+        self.last: tuple[Any, MessageInfo] | None = None
+        self._dispatcher = threading.Thread(target=self._dispatch_loop, daemon=True,
+                                            name=f"rosfpga-sub-dispatch-{topic}")
+        self._dispatcher.start()
+
+    # ----------------------------------------------------------------- publishers
+    def _update_publishers(self, uris: list[str]) -> None:
+        with self._lock:
+            if self.closed:
+                return
+            wanted = list(dict.fromkeys(uris))
+            gone = [u for u in self._links if u not in wanted]
+            for uri in gone:
+                self._links.pop(uri).close()
+            for uri in wanted:
+                link = self._links.get(uri)
+                if link is None or not link.thread.is_alive() and link.permanent_error is None:
+                    link = _PublisherLink(self, uri)
+                    self._links[uri] = link
+                    link.thread.start()
+
+    def _connections_changed(self, delta: int) -> None:
+        with self._cond:
+            self._stats.connections += delta
+            self._cond.notify_all()
+
+    def _error(self, text: str) -> None:
+        with self._cond:
+            self._stats.errors.append(text)
+            del self._stats.errors[:-MAX_ERRORS_KEPT]
+        self.node.trace.record("error", self.node.name, src=self.node.name, method=self.topic,
+                               result=text)
+
+    # ----------------------------------------------------------------- delivery
+    def _deliver(self, body: bytes | memoryview, info: MessageInfo, offset: int) -> None:
+        node = self.node
+        if node.trace.frames:
+            node.trace.record("tcpros_frame", node.name, role="in", src=info.publisher,
+                              dst=node.name, method=self.topic,
+                              raw=len(body).to_bytes(4, "little") + bytes(body[:node.trace.frame_bytes]),
+                              size=4 + len(body), conn=info.conn, index=info.index, offset=offset)
+        with self._cond:
+            self._stats.frames += 1
+            self._stats.bytes += len(body)
+            limit = self.queue_size
+            while limit > 0 and len(self._queue) >= limit:
+                self._queue.popleft()
+                self._stats.drops += 1
+            self._queue.append((body, info))
+            self._cond.notify_all()
+
+    def _dispatch_loop(self) -> None:
+        from rosfpga_lab.msg import deserialize
+
+        while True:
+            with self._cond:
+                while not self._queue and not self.closed:
+                    self._cond.wait()
+                if self.closed:
+                    return
+                body, info = self._queue.popleft()
+            try:
+                value = body if self.raw else deserialize(self.node.registry, self.type_name, body)
+            except LabError as exc:
+                self._error(f"cannot deserialize frame #{info.index} from {info.publisher}: {exc}")
+                continue
+            with self._cond:
+                self.last = (value, info)
+                self._cond.notify_all()
+            if self.callback is None:
+                continue
+            try:
+                if self.raw:
+                    self.callback(value, info)
+                else:
+                    self.callback(value)
+            except Exception as exc:  # a user's callback must not kill the dispatcher
+                with self._cond:
+                    self._stats.callback_errors += 1
+                self._error(f"callback raised {type(exc).__name__}: {exc}")
+
+    # ----------------------------------------------------------------- user API
+    @property
+    def stats(self) -> SubscriberStats:
+        """Counters (a snapshot)."""
+        with self._cond:
+            s = self._stats
+            return SubscriberStats(s.frames, s.bytes, s.drops, s.connections, s.callback_errors,
+                                   list(s.errors))
+
+    def get_num_connections(self) -> int:
+        """Publishers connected right now."""
+        return self.stats.connections
+
+    def wait_for_connection(self, n: int = 1, timeout: float = 10.0) -> bool:
+        """Wait until at least ``n`` publishers are connected; False on time-out."""
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            while self._stats.connections < n:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self._cond.wait(left)
+        return True
+
+    def wait_for_message(self, timeout: float = 10.0) -> tuple[Any, MessageInfo]:
+        """Wait for the next message handled by the dispatcher; return ``(value, info)``.
+
+        Raises:
+            GraphError: nothing arrived within ``timeout`` seconds.
+        """
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            before = self.last
+            while self.last is before or self.last is None:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    raise GraphError(f"no message on {self.topic} within {timeout} s "
+                                     f"(connections: {self._stats.connections}, "
+                                     f"errors: {self._stats.errors[-1:] or 'none'})")
+                self._cond.wait(left)
+            return self.last
+
+    def unregister(self) -> None:
+        """Stop: unregister from the master, close every connection."""
+        self.node._unsubscribe(self)
+
+    def _close(self) -> None:
+        with self._lock:
+            self.closed = True
+            links = list(self._links.values())
+            self._links.clear()
+        for link in links:
+            link.close()
+        with self._cond:
+            self._cond.notify_all()
+        for link in links:
+            if link.thread.is_alive():
+                link.thread.join(JOIN_TIMEOUT)
+        if self._dispatcher is not threading.current_thread():
+            self._dispatcher.join(JOIN_TIMEOUT)
+
+    def __repr__(self) -> str:
+        return f"<Subscriber {self.topic} [{self.type_name}] connections={self.get_num_connections()}>"

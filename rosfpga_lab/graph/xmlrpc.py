@@ -1,0 +1,393 @@
+"""XML-RPC over HTTP/1.1, small and safe, recording the exact bytes.
+
+How it works: the server accepts connections on a loopback socket (unless told otherwise),
+gives each connection a thread, reads the HTTP head (capped at :data:`MAX_HTTP_HEAD`) and a
+``Content-Length`` body (capped at :data:`MAX_XMLRPC_BODY`), parses it with defusedxml's
+expat parser (no entity expansion, no DTDs, no external references), calls the handler and
+writes the reply; keep-alive is honoured as rospy's and roscpp's clients expect. The client
+opens one connection per call. Both sides record request and response bytes in a
+:class:`~rosfpga_lab.graph.trace.Trace`. The stdlib ``xmlrpc.client`` is used only to
+marshal (build XML), never to parse.
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+import urllib.parse
+import xmlrpc.client
+from collections.abc import Callable
+from typing import Any
+
+from defusedxml.xmlrpc import DefusedExpatParser
+
+from rosfpga_lab.graph.errors import (
+    JOIN_TIMEOUT,
+    MAX_HTTP_HEAD,
+    MAX_XMLRPC_BODY,
+    XMLRPC_IDLE_TIMEOUT,
+    XMLRPC_TIMEOUT,
+    ConfigError,
+    XmlRpcError,
+)
+from rosfpga_lab.graph.trace import Trace
+
+Handler = Callable[[str, tuple], Any]
+
+
+class Fault(Exception):
+    """Raise from a handler to answer with an XML-RPC fault (not a LabError: it is a reply)."""
+
+    def __init__(self, code: int, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+        self.message = message
+
+
+def parse_xmlrpc(data: bytes) -> tuple[tuple, str | None]:
+    """Parse an XML-RPC request or response safely.
+
+    Returns:
+        ``(params, method_name)``; method_name is None for responses.
+
+    Raises:
+        XmlRpcError: malformed XML, forbidden XML constructs, not XML-RPC, or a fault reply.
+    """
+    unmarshaller = xmlrpc.client.Unmarshaller(use_builtin_types=True)
+    parser = DefusedExpatParser(unmarshaller)
+    try:
+        parser.feed(data)
+        parser.close()
+        params = unmarshaller.close()
+    except xmlrpc.client.Fault as fault:
+        raise XmlRpcError(f"XML-RPC fault {fault.faultCode}: {fault.faultString}") from None
+    except Exception as exc:  # expat, defusedxml, ResponseError, bad int/float/base64 text
+        raise XmlRpcError(f"malformed XML-RPC document: {type(exc).__name__}: {exc}") from None
+    return params, unmarshaller.getmethodname()
+
+
+def dump_response(value: Any) -> bytes:
+    """Marshal a handler's return value (ints clamped to int32 as ROS expects)."""
+    return xmlrpc.client.dumps((_clamp(value),), methodresponse=True, allow_none=False).encode()
+
+
+def _clamp(v: Any) -> Any:
+    if isinstance(v, bool):
+        return v
+    if isinstance(v, int):
+        return max(-(2**31), min(2**31 - 1, v))
+    if isinstance(v, (list, tuple)):
+        return [_clamp(x) for x in v]
+    if isinstance(v, dict):
+        return {k: _clamp(x) for k, x in v.items()}
+    return v
+
+
+def split_uri(uri: str) -> tuple[str, int, str]:
+    """``http://host:port/path`` -> (host, port, path).
+
+    Raises:
+        ConfigError: not an http URI with a host and port.
+    """
+    parts = urllib.parse.urlsplit(uri)
+    try:
+        port = parts.port
+    except ValueError:
+        port = None
+    if parts.scheme != "http" or not parts.hostname or port is None:
+        raise ConfigError(f"not an XML-RPC URI (want http://host:port/): {uri!r}")
+    return parts.hostname, port, parts.path or "/"
+
+
+def _read_head(sock: socket.socket, buf: bytearray) -> bytes | None:
+    """Read until the end of an HTTP head; return it (buf keeps the rest). None on clean EOF."""
+    while True:
+        end = buf.find(b"\r\n\r\n")
+        if end >= 0:
+            head = bytes(buf[:end + 4])
+            del buf[:end + 4]
+            return head
+        if len(buf) > MAX_HTTP_HEAD:
+            raise XmlRpcError(f"HTTP head longer than {MAX_HTTP_HEAD} bytes")
+        chunk = sock.recv(65536)
+        if not chunk:
+            if buf:
+                raise XmlRpcError(f"connection closed inside an HTTP head ({len(buf)} bytes)")
+            return None
+        buf += chunk
+
+
+def _parse_head(head: bytes) -> tuple[str, dict[str, str]]:
+    lines = head.decode("latin-1").split("\r\n")
+    headers: dict[str, str] = {}
+    for line in lines[1:]:
+        if not line:
+            continue
+        name, sep, value = line.partition(":")
+        if not sep:
+            raise XmlRpcError(f"malformed HTTP header line: {line[:80]!r}")
+        headers[name.strip().lower()] = value.strip()
+    return lines[0], headers
+
+
+def _read_body(sock: socket.socket, buf: bytearray, headers: dict[str, str], *,
+               until_eof: bool = False) -> bytes:
+    length_text = headers.get("content-length")
+    if length_text is None:
+        if not until_eof:
+            raise XmlRpcError("HTTP message without Content-Length")
+        while len(buf) <= MAX_XMLRPC_BODY:
+            chunk = sock.recv(65536)
+            if not chunk:
+                body = bytes(buf)
+                buf.clear()
+                return body
+            buf += chunk
+        raise XmlRpcError(f"HTTP body over the limit of {MAX_XMLRPC_BODY} bytes")
+    try:
+        length = int(length_text)
+    except ValueError:
+        raise XmlRpcError(f"bad Content-Length {length_text!r}") from None
+    if length < 0 or length > MAX_XMLRPC_BODY:
+        raise XmlRpcError(f"HTTP body of {length} bytes, over the limit of {MAX_XMLRPC_BODY}")
+    while len(buf) < length:
+        chunk = sock.recv(max(65536, length - len(buf)))
+        if not chunk:
+            raise XmlRpcError(f"connection closed after {len(buf)} of {length} body bytes")
+        buf += chunk
+    body = bytes(buf[:length])
+    del buf[:length]
+    return body
+
+
+def _http_response(status: str, body: bytes, keep_alive: bool) -> bytes:
+    head = (f"HTTP/1.1 {status}\r\nServer: rosfpga-lab/XMLRPC\r\n"
+            f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\n"
+            f"Connection: {'keep-alive' if keep_alive else 'close'}\r\n\r\n")
+    return head.encode("latin-1") + body
+
+
+class XmlRpcServer:
+    """A threaded XML-RPC server on one TCP port.
+
+    Args:
+        handler: ``handler(method, params) -> value``; raise :class:`Fault` for a fault reply.
+        host: address to bind (127.0.0.1 by default; "0.0.0.0" binds every interface).
+        port: port, 0 for any free one.
+        trace: where to record each exchange (role ``server``).
+        name: recorder name (node name or ``master``).
+        advertise_host: host written in :attr:`uri` (defaults to ``host``).
+    """
+
+    def __init__(self, handler: Handler, *, host: str = "127.0.0.1", port: int = 0,
+                 trace: Trace | None = None, name: str = "", advertise_host: str | None = None) -> None:
+        self.handler = handler
+        self.host = host
+        self.port = port
+        self.trace = trace
+        self.name = name
+        self.advertise_host = advertise_host or host
+        self._sock: socket.socket | None = None
+        self._threads: set[threading.Thread] = set()
+        self._conns: set[socket.socket] = set()
+        self._lock = threading.Lock()
+        self._running = False
+        self.requests = 0
+
+    @property
+    def uri(self) -> str:
+        """``http://host:port/`` of this server."""
+        host = self.advertise_host
+        if host in ("0.0.0.0", ""):
+            host = socket.gethostname()
+        return f"http://{host}:{self.port}/"
+
+    def start(self) -> None:
+        """Bind, listen and start the accept thread."""
+        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            sock.bind((self.host, self.port))
+        except OSError as exc:
+            sock.close()
+            raise XmlRpcError(f"cannot bind XML-RPC server to {self.host}:{self.port}: {exc}") from None
+        sock.listen(64)
+        self._sock = sock
+        self.port = sock.getsockname()[1]
+        self._running = True
+        self._spawn(self._accept_loop, "xmlrpc-accept")
+
+    def _spawn(self, target: Callable, name: str, *args: Any) -> None:
+        t = threading.Thread(target=self._run_thread, args=(target, *args),
+                             name=f"rosfpga-{name}-{self.name}", daemon=True)
+        with self._lock:
+            self._threads.add(t)
+        t.start()
+
+    def _run_thread(self, target: Callable, *args: Any) -> None:
+        try:
+            target(*args)
+        finally:
+            with self._lock:
+                self._threads.discard(threading.current_thread())
+
+    def _accept_loop(self) -> None:
+        assert self._sock is not None
+        while self._running:
+            try:
+                conn, addr = self._sock.accept()
+            except OSError:
+                break
+            if not self._running:
+                conn.close()
+                break
+            conn.settimeout(XMLRPC_IDLE_TIMEOUT)
+            with self._lock:
+                self._conns.add(conn)
+            self._spawn(self._serve_connection, "xmlrpc-conn", conn, f"{addr[0]}:{addr[1]}")
+
+    def _serve_connection(self, conn: socket.socket, peer: str) -> None:
+        buf = bytearray()
+        try:
+            while self._running:
+                try:
+                    head = _read_head(conn, buf)
+                    if head is None:
+                        return
+                    request_line, headers = _parse_head(head)
+                except XmlRpcError as exc:
+                    conn.sendall(_http_response("400 Bad Request", str(exc).encode(), False))
+                    return
+                t0 = time.time()
+                parts = request_line.split()
+                version = parts[2] if len(parts) == 3 else "HTTP/1.0"
+                keep = (version == "HTTP/1.1" and headers.get("connection", "").lower() != "close") or \
+                       headers.get("connection", "").lower() == "keep-alive"
+                if len(parts) != 3 or parts[0] != "POST":
+                    conn.sendall(_http_response("405 Method Not Allowed", b"", False))
+                    return
+                try:
+                    body = _read_body(conn, buf, headers)
+                except XmlRpcError as exc:
+                    status = "413 Payload Too Large" if "limit" in str(exc) else "400 Bad Request"
+                    conn.sendall(_http_response(status, str(exc).encode(), False))
+                    return
+                reply_body, method, params, result = self._dispatch(body)
+                reply = _http_response("200 OK", reply_body, keep)
+                conn.sendall(reply)
+                self.requests += 1
+                if self.trace is not None:
+                    caller = params[0] if params and isinstance(params[0], str) else peer
+                    self.trace.record("xmlrpc", self.name, role="server", src=caller,
+                                      dst=self.name, method=method, args=list(params),
+                                      result=result, raw=head + body, raw_reply=reply,
+                                      size=len(head) + len(body) + len(reply), t0=t0)
+                if not keep:
+                    return
+        except OSError:
+            return
+        finally:
+            with self._lock:
+                self._conns.discard(conn)
+            conn.close()
+
+    def _dispatch(self, body: bytes) -> tuple[bytes, str, tuple, Any]:
+        try:
+            params, method = parse_xmlrpc(body)
+        except XmlRpcError as exc:
+            return _fault(-32700, f"parse error: {exc}"), "", (), f"fault: {exc}"
+        if method is None:
+            return _fault(-32600, "not an XML-RPC request (no methodName)"), "", params, "fault"
+        try:
+            value = self.handler(method, params)
+            return dump_response(value), method, params, value
+        except Fault as fault:
+            return _fault(fault.code, fault.message), method, params, f"fault: {fault.message}"
+        except Exception as exc:  # a bug in a handler must not kill the server thread
+            return _fault(1, f"internal error: {type(exc).__name__}: {exc}"), method, params, "fault"
+
+    def stop(self) -> None:
+        """Stop accepting, close every connection, join every thread."""
+        self._running = False
+        if self._sock is not None:
+            try:
+                self._sock.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+            self._sock.close()
+        with self._lock:
+            conns = list(self._conns)
+        for c in conns:
+            try:
+                c.shutdown(socket.SHUT_RDWR)
+            except OSError:
+                pass
+        deadline = time.monotonic() + JOIN_TIMEOUT
+        while True:
+            with self._lock:
+                threads = [t for t in self._threads if t is not threading.current_thread()]
+            if not threads or time.monotonic() > deadline:
+                break
+            threads[0].join(max(0.0, deadline - time.monotonic()))
+
+
+def _fault(code: int, message: str) -> bytes:
+    return xmlrpc.client.dumps(xmlrpc.client.Fault(code, message), methodresponse=True).encode()
+
+
+def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller: str = "",
+         callee: str = "", timeout: float = XMLRPC_TIMEOUT) -> Any:
+    """Call ``method(*params)`` at ``uri``; return the result.
+
+    Args:
+        uri: ``http://host:port/``.
+        trace: where to record the exchange (role ``client``).
+        caller: recorder/source name; callee: destination name for the trace (default: uri).
+        timeout: seconds for connect, send and receive.
+
+    Raises:
+        XmlRpcError: connection, HTTP or XML problem, or a fault.
+        ConfigError: malformed uri.
+    """
+    host, port, path = split_uri(uri)
+    body = xmlrpc.client.dumps(tuple(_clamp(list(params))), methodname=method,
+                               allow_none=False).encode()
+    head = (f"POST {path} HTTP/1.1\r\nHost: {host}:{port}\r\nUser-Agent: rosfpga-lab\r\n"
+            f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\nConnection: close\r\n\r\n")
+    request = head.encode("latin-1") + body
+    t0 = time.time()
+    buf = bytearray()
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.sendall(request)
+            reply_head = _read_head(sock, buf)
+            if reply_head is None:
+                raise XmlRpcError("connection closed before any reply")
+            status_line, headers = _parse_head(reply_head)
+            reply_body = _read_body(sock, buf, headers, until_eof=True)
+    except (OSError, XmlRpcError) as exc:
+        if trace is not None:
+            trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or uri,
+                         method=method, args=list(params), result=f"error: {exc}", raw=request, t0=t0)
+        raise XmlRpcError(f"XML-RPC call {method} to {uri} failed: {exc}") from None
+    if trace is not None:
+        ev = trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or trace.name_of(uri),
+                          method=method, args=list(params), raw=request,
+                          raw_reply=reply_head + reply_body,
+                          size=len(request) + len(reply_head) + len(reply_body), t0=t0)
+    else:
+        ev = None
+    parts = status_line.split(None, 2)
+    if len(parts) < 2 or parts[1] != "200":
+        raise XmlRpcError(f"XML-RPC call {method} to {uri}: HTTP status {status_line!r}")
+    try:
+        result, _ = parse_xmlrpc(reply_body)
+    except XmlRpcError as exc:
+        if ev is not None:
+            ev.result = f"error: {exc}"
+        raise XmlRpcError(f"XML-RPC call {method} to {uri}: {exc}") from None
+    value = result[0] if len(result) == 1 else list(result)
+    if ev is not None:
+        ev.result = value
+    return value
