@@ -1,0 +1,504 @@
+"""The node configuration: one YAML file describes one ROS-compliant FPGA component.
+
+The same file drives the generator (``rosfpga-lab generate``) and the emulated FPGA node
+(``rosfpga_lab.component``). It holds the paper's input (b) -- node name, topic names, master
+URI, IP address and ports -- plus what the circuit fixes at synthesis time: image size and
+encoding, the application, FIFO depths and the clock. Example (every key but ``node.name``,
+``subscriber.topic``, ``publisher.topic`` and ``image`` has a default)::
+
+    node:
+      name: /fpga_dilate                  # ROS node name
+      master_uri: http://127.0.0.1:11311/ # where the ROS master listens
+      ip_address: 127.0.0.1               # address the node binds and advertises
+      xmlrpc_port: 0                      # slave API port; 0 = any free port
+      tcpros_port: 0                      # TCPROS server port; 0 = any free port
+    subscriber:
+      topic: /image_raw
+      type: sensor_msgs/Image
+    publisher:
+      topic: /image_dilated
+      type: sensor_msgs/Image
+    image: {width: 640, height: 480, encoding: rgba8}
+    application:
+      op: dilate          # dilate | erode | passthrough | custom
+      ksize: 3            # odd, 1..15 (dilate and erode)
+      source: null        # C++ file of image_filter(), relative to this file (op: custom)
+    fifo: {input_depth: 2048, output_depth: 2048, axis_depth: 16}
+    clock_mhz: 100
+    frame_id_max: 256     # longest header.frame_id the circuit keeps
+    part: xc7z020clg400-1 # FPGA part for the HLS project script (Zynq-7020)
+
+How this works: the YAML is *composed* (not just loaded) so every key and value keeps its line
+number; a small walker checks each section against a schema table (key -> type, default),
+refusing unknown, duplicate, missing and mistyped keys, then checks values (ROS names, ports,
+sizes, encodings, the message type against the message registry, the application file).
+Every problem is a :class:`ConfigError` naming the file, line and dotted key, raised before the
+caller writes anything.
+"""
+
+from __future__ import annotations
+
+import difflib
+import ipaddress
+import re
+import urllib.parse
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from rosfpga_lab.hls import limits
+from rosfpga_lab.hls.errors import ConfigError
+from rosfpga_lab.hw.encodings import PIXEL_FORMATS
+
+#: Operations the generated application can perform.
+OPS = ("dilate", "erode", "passthrough", "custom")
+#: Encodings the templates can serve, with bytes per pixel (the hw layer's packing rule).
+ENCODINGS: dict[str, int] = {name: fmt.bytes_per_pixel for name, fmt in PIXEL_FORMATS.items()}
+
+# ROS 1 graph resource names (wiki.ros.org/Names): first character a letter, '/' or '~'; then
+# letters, digits, '_' and '/'. The lab also refuses '//' and a trailing '/' (roscpp does).
+_ROS_NAME = re.compile(r"^[A-Za-z/~][A-Za-z0-9_/]*$")
+_BASE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+@dataclass(frozen=True)
+class NodeSection:
+    """The ROS side of the node (the paper's input (b)).
+
+    Attributes:
+        name: node name, e.g. ``/fpga_dilate`` (a relative name is taken in the root namespace).
+        master_uri: the ROS master's XML-RPC URI.
+        ip_address: IPv4 address the node binds and advertises (loopback by default).
+        xmlrpc_port: port of the node's XML-RPC slave API; 0 = any free port.
+        tcpros_port: port of the node's TCPROS server (its publisher); 0 = any free port.
+    """
+
+    name: str
+    master_uri: str = limits.DEFAULT_MASTER_URI
+    ip_address: str = limits.DEFAULT_IP_ADDRESS
+    xmlrpc_port: int = 0
+    tcpros_port: int = 0
+
+    @property
+    def global_name(self) -> str:
+        """The node name resolved in the root namespace (``fpga`` -> ``/fpga``)."""
+        return self.name if self.name.startswith("/") else "/" + self.name
+
+
+@dataclass(frozen=True)
+class TopicConfig:
+    """One topic of the node.
+
+    Attributes:
+        topic: topic name, e.g. ``/image_raw``.
+        type: message type, ``package/Name`` (only ``sensor_msgs/Image`` streams through the
+            circuit).
+    """
+
+    topic: str
+    type: str = limits.IMAGE_TYPE
+
+
+@dataclass(frozen=True)
+class ImageConfig:
+    """The image geometry fixed at synthesis time.
+
+    Attributes:
+        width: pixels per line.
+        height: lines per frame.
+        encoding: ROS encoding (``rgba8``, ``bgra8``, ``rgb8``, ``bgr8``, ``mono8``).
+    """
+
+    width: int
+    height: int
+    encoding: str
+
+    @property
+    def bytes_per_pixel(self) -> int:
+        return ENCODINGS[self.encoding]
+
+    @property
+    def step(self) -> int:
+        """Bytes per line (``sensor_msgs/Image.step``)."""
+        return self.width * self.bytes_per_pixel
+
+    @property
+    def data_bytes(self) -> int:
+        """Bytes of ``sensor_msgs/Image.data``."""
+        return self.step * self.height
+
+
+@dataclass(frozen=True)
+class ApplicationConfig:
+    """The application circuit between fifo2axi and axi2fifo (the paper's input (c)).
+
+    Attributes:
+        op: ``dilate`` | ``erode`` | ``passthrough`` | ``custom``.
+        ksize: side of the square structuring element (dilate, erode).
+        source: for ``custom``, the C++ file defining ``image_filter()`` (absolute path).
+    """
+
+    op: str = "dilate"
+    ksize: int = 3
+    source: Path | None = None
+
+
+@dataclass(frozen=True)
+class FifoConfig:
+    """FIFO depths of the circuit (items).
+
+    Attributes:
+        input_depth: the 8-bit FIFO between the network and the subscriber (bytes).
+        output_depth: the 8-bit FIFO between the publisher and the network (bytes).
+        axis_depth: the AXI4-Stream FIFOs around the application (beats).
+    """
+
+    input_depth: int = limits.DEFAULT_INPUT_FIFO_DEPTH
+    output_depth: int = limits.DEFAULT_OUTPUT_FIFO_DEPTH
+    axis_depth: int = limits.DEFAULT_AXIS_FIFO_DEPTH
+
+
+@dataclass(frozen=True)
+class NodeConfig:
+    """One ROS-compliant FPGA component, as read from its YAML file.
+
+    Attributes:
+        node: the ROS node (name, master, address, ports).
+        subscriber: the topic the circuit consumes (its subscriber, paper's (d)).
+        publisher: the topic the circuit produces (its publisher, paper's (e)).
+        image: geometry and encoding.
+        application: what the circuit does to the image.
+        fifo: FIFO depths.
+        clock_mhz: the circuit's clock (MHz).
+        frame_id_max: longest ``header.frame_id`` kept (longer frames are refused).
+        part: the FPGA part named in the HLS project script.
+        path: the file it was read from (None when parsed from a string).
+    """
+
+    node: NodeSection
+    subscriber: TopicConfig
+    publisher: TopicConfig
+    image: ImageConfig
+    application: ApplicationConfig = ApplicationConfig()
+    fifo: FifoConfig = FifoConfig()
+    clock_mhz: float = limits.DEFAULT_CLOCK_MHZ
+    frame_id_max: int = limits.DEFAULT_FRAME_ID_MAX
+    part: str = limits.DEFAULT_PART
+    path: Path | None = None
+
+
+# ---------------------------------------------------------------------------------------------
+# Schema: section -> key -> (python type, default or _REQUIRED). Sections map to dataclasses.
+
+_REQUIRED = object()
+_SCHEMA: dict[str, dict[str, tuple[type | tuple[type, ...], Any]]] = {
+    "node": {"name": (str, _REQUIRED), "master_uri": (str, limits.DEFAULT_MASTER_URI),
+             "ip_address": (str, limits.DEFAULT_IP_ADDRESS), "xmlrpc_port": (int, 0),
+             "tcpros_port": (int, 0)},
+    "subscriber": {"topic": (str, _REQUIRED), "type": (str, limits.IMAGE_TYPE)},
+    "publisher": {"topic": (str, _REQUIRED), "type": (str, limits.IMAGE_TYPE)},
+    "image": {"width": (int, _REQUIRED), "height": (int, _REQUIRED), "encoding": (str, _REQUIRED)},
+    "application": {"op": (str, "dilate"), "ksize": (int, 3), "source": ((str, type(None)), None)},
+    "fifo": {"input_depth": (int, limits.DEFAULT_INPUT_FIFO_DEPTH),
+             "output_depth": (int, limits.DEFAULT_OUTPUT_FIFO_DEPTH),
+             "axis_depth": (int, limits.DEFAULT_AXIS_FIFO_DEPTH)},
+}
+_TOP_SCALARS: dict[str, tuple[type | tuple[type, ...], Any]] = {
+    "clock_mhz": ((int, float), limits.DEFAULT_CLOCK_MHZ),
+    "frame_id_max": (int, limits.DEFAULT_FRAME_ID_MAX),
+    "part": (str, limits.DEFAULT_PART),
+}
+_REQUIRED_SECTIONS = ("node", "subscriber", "publisher", "image")
+
+
+class _Ctx:
+    """Where we are: the file name, for error messages."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+
+    def error(self, message: str, node: yaml.Node | None = None, key: str = "") -> ConfigError:
+        line = node.start_mark.line + 1 if node is not None else 0
+        return ConfigError(message, path=self.source, line=line, key=key)
+
+
+def _scalar(ctx: _Ctx, node: yaml.Node, key: str) -> Any:
+    if not isinstance(node, yaml.ScalarNode):
+        raise ctx.error("expected a single value, found a "
+                        + ("mapping" if isinstance(node, yaml.MappingNode) else "list"), node, key)
+    return yaml.constructor.SafeConstructor().construct_object(node, deep=True)
+
+
+def _mapping(ctx: _Ctx, node: yaml.Node, key: str,
+             allowed: dict[str, Any]) -> dict[str, tuple[yaml.Node, yaml.Node]]:
+    """Keys of a mapping node -> (key node, value node); unknown or duplicate keys refused."""
+    if not isinstance(node, yaml.MappingNode):
+        where = f"section {key!r}" if key else "the file"
+        raise ctx.error(f"{where} must be a mapping of 'key: value' lines", node, key)
+    out: dict[str, tuple[yaml.Node, yaml.Node]] = {}
+    for knode, vnode in node.value:
+        name = knode.value if isinstance(knode, yaml.ScalarNode) else None
+        dotted = f"{key}.{name}" if key else str(name)
+        if not isinstance(name, str):
+            raise ctx.error("keys must be plain names", knode, key)
+        if name in out:
+            first = out[name][0].start_mark.line + 1
+            raise ctx.error(f"duplicate key (first given on line {first})", knode, dotted)
+        if name not in allowed:
+            close = difflib.get_close_matches(name, list(allowed), n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+            raise ctx.error(f"unknown key{hint} (known: {', '.join(allowed)})", knode, dotted)
+        out[name] = (knode, vnode)
+    return out
+
+
+def _typed(ctx: _Ctx, vnode: yaml.Node, dotted: str, kind: type | tuple[type, ...]) -> Any:
+    value = _scalar(ctx, vnode, dotted)
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    if isinstance(value, bool) or not isinstance(value, kinds):
+        names = " or ".join("null" if k is type(None) else k.__name__ for k in kinds)
+        raise ctx.error(f"expected {names}, got {value!r}", vnode, dotted)
+    return value
+
+
+def _section(ctx: _Ctx, top: dict[str, tuple[yaml.Node, yaml.Node]], name: str,
+             ) -> tuple[dict[str, Any], dict[str, yaml.Node]]:
+    """Values of one section with defaults filled in, and the node of each given value."""
+    schema = _SCHEMA[name]
+    if name not in top:
+        if name in _REQUIRED_SECTIONS:
+            raise ctx.error(f"missing section '{name}:' (keys: {', '.join(schema)})", None, name)
+        return {k: d for k, (_t, d) in schema.items()}, {}
+    knode, vnode = top[name]
+    if isinstance(vnode, yaml.ScalarNode) and vnode.value == "" and vnode.tag.endswith(":null"):
+        vnode = yaml.MappingNode("tag:yaml.org,2002:map", [], knode.start_mark, knode.end_mark)
+    given = _mapping(ctx, vnode, name, schema)
+    values: dict[str, Any] = {}
+    nodes: dict[str, yaml.Node] = {}
+    for key, (kind, default) in schema.items():
+        dotted = f"{name}.{key}"
+        if key in given:
+            values[key] = _typed(ctx, given[key][1], dotted, kind)
+            nodes[key] = given[key][1]
+        elif default is _REQUIRED:
+            raise ctx.error(f"missing key '{key}' in section '{name}'", knode, dotted)
+        else:
+            values[key] = default
+    return values, nodes
+
+
+def _check(ctx: _Ctx, ok: bool, message: str, nodes: dict[str, yaml.Node], key: str,
+           section: str) -> None:
+    if not ok:
+        raise ctx.error(message, nodes.get(key), f"{section}.{key}")
+
+
+def ros_name_problem(name: str, *, node_name: bool = False) -> str | None:
+    """Why ``name`` breaks ROS 1 naming rules, or None when it is legal.
+
+    Args:
+        name: a graph resource name (topic or node).
+        node_name: apply the extra rules of node names (not private, base name legal).
+    """
+    if not name:
+        return "a ROS name cannot be empty"
+    if not _ROS_NAME.fullmatch(name):
+        bad = next((c for c in name if not (c.isascii() and (c.isalnum() or c in "_/~"))), None)
+        if bad is not None:
+            return f"character {bad!r} is not allowed in a ROS name (letters, digits, '_', '/')"
+        return "a ROS name starts with a letter, '/' or '~'"
+    if "~" in name[1:]:
+        return "'~' may only start a ROS name"
+    if "//" in name:
+        return "a ROS name cannot contain '//'"
+    if len(name) > 1 and name.endswith("/"):
+        return "a ROS name cannot end with '/'"
+    for part in name.lstrip("/~").split("/"):
+        if part and not _BASE_NAME.fullmatch(part):
+            return f"name part {part!r} must start with a letter"
+    if node_name:
+        if name.startswith("~"):
+            return "a node name cannot be private ('~')"
+        if name == "/":
+            return "a node name cannot be '/'"
+    return None
+
+
+def _check_type(ctx: _Ctx, type_name: str, nodes: dict[str, yaml.Node], section: str,
+                known: Callable[[str], bool]) -> None:
+    if not known(type_name):
+        raise ctx.error(f"unknown message type {type_name!r} (not in the lab's message registry)",
+                        nodes.get("type"), f"{section}.type")
+    if type_name != limits.IMAGE_TYPE:
+        raise ctx.error(f"message type {type_name!r} cannot stream through the circuit: the "
+                        f"templates serve {limits.IMAGE_TYPE} only", nodes.get("type"),
+                        f"{section}.type")
+
+
+def _known_type(type_name: str) -> bool:
+    from rosfpga_lab.msg import default_registry
+
+    return type_name in default_registry()
+
+
+def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None = None,
+                 known_type: Callable[[str], bool] | None = None) -> NodeConfig:
+    """Parse and validate configuration text.
+
+    Args:
+        text: the YAML text.
+        source: file name used in error messages.
+        base_dir: directory that ``application.source`` is relative to (default: cwd).
+        known_type: predicate "is this message type known" (default: the lab's registry).
+
+    Returns:
+        The validated configuration (``path`` is None; :func:`load_config` sets it).
+
+    Raises:
+        ConfigError: the text is not YAML, or a key or value is wrong (file:line and key given).
+    """
+    ctx = _Ctx(source)
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = mark.line + 1 if mark is not None else 0
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise ConfigError(f"not valid YAML: {problem}", path=source, line=line) from None
+    if root is None:
+        raise ConfigError("the configuration is empty", path=source)
+    allowed = {**{k: None for k in _SCHEMA}, **_TOP_SCALARS}
+    top = _mapping(ctx, root, "", allowed)
+    sec = {name: _section(ctx, top, name) for name in _SCHEMA}
+    scalars: dict[str, Any] = {}
+    for key, (kind, default) in _TOP_SCALARS.items():
+        scalars[key] = _typed(ctx, top[key][1], key, kind) if key in top else default
+    top_nodes = {k: v[1] for k, v in top.items()}
+
+    # node
+    n, nn = sec["node"]
+    problem = ros_name_problem(n["name"], node_name=True)
+    _check(ctx, problem is None, f"{problem}: {n['name']!r}", nn, "name", "node")
+    uri = urllib.parse.urlsplit(n["master_uri"])
+    try:
+        uri_port = uri.port
+    except ValueError:
+        uri_port = None
+    _check(ctx, uri.scheme == "http" and bool(uri.hostname) and uri_port is not None,
+           f"expected http://HOST:PORT/, got {n['master_uri']!r}", nn, "master_uri", "node")
+    try:
+        ipaddress.IPv4Address(n["ip_address"])
+        ip_ok = True
+    except ValueError:
+        ip_ok = False
+    _check(ctx, ip_ok, f"expected an IPv4 address like 127.0.0.1, got {n['ip_address']!r}",
+           nn, "ip_address", "node")
+    for key in ("xmlrpc_port", "tcpros_port"):
+        _check(ctx, 0 <= n[key] <= 65535, f"port must be 0..65535 (0 = any free port), got {n[key]}",
+               nn, key, "node")
+    _check(ctx, n["xmlrpc_port"] == 0 or n["xmlrpc_port"] != n["tcpros_port"],
+           "the XML-RPC and TCPROS ports must differ", nn, "tcpros_port", "node")
+
+    # topics
+    known = known_type or _known_type
+    for section in ("subscriber", "publisher"):
+        t, tn = sec[section]
+        problem = ros_name_problem(t["topic"])
+        _check(ctx, problem is None, f"{problem}: {t['topic']!r}", tn, "topic", section)
+        _check_type(ctx, t["type"], tn, section, known)
+    if sec["subscriber"][0]["topic"] == sec["publisher"][0]["topic"]:
+        raise ctx.error("the node would publish to the topic it subscribes to",
+                        sec["publisher"][1].get("topic"), "publisher.topic")
+
+    # image
+    im, imn = sec["image"]
+    _check(ctx, limits.MIN_WIDTH <= im["width"] <= limits.MAX_WIDTH,
+           f"width must be {limits.MIN_WIDTH}..{limits.MAX_WIDTH}, got {im['width']}",
+           imn, "width", "image")
+    _check(ctx, limits.MIN_HEIGHT <= im["height"] <= limits.MAX_HEIGHT,
+           f"height must be {limits.MIN_HEIGHT}..{limits.MAX_HEIGHT}, got {im['height']}",
+           imn, "height", "image")
+    _check(ctx, im["encoding"] in ENCODINGS,
+           f"encoding {im['encoding']!r} is not one the circuit can pack (supported: "
+           f"{', '.join(ENCODINGS)})", imn, "encoding", "image")
+
+    # application
+    ap, apn = sec["application"]
+    _check(ctx, ap["op"] in OPS, f"op must be one of {', '.join(OPS)}, got {ap['op']!r}",
+           apn, "op", "application")
+    _check(ctx, ap["ksize"] % 2 == 1 and 1 <= ap["ksize"] <= limits.MAX_KSIZE,
+           f"ksize must be odd, 1..{limits.MAX_KSIZE}, got {ap['ksize']}", apn, "ksize",
+           "application")
+    source_path: Path | None = None
+    if ap["op"] == "custom":
+        _check(ctx, bool(ap["source"]), "op 'custom' needs 'source: FILE.cpp' (the C++ file "
+               "defining image_filter)", apn, "op", "application")
+        source_path = ((base_dir or Path.cwd()) / ap["source"]).resolve()
+        _check(ctx, source_path.is_file(), f"application file not found: {source_path}",
+               apn, "source", "application")
+    else:
+        _check(ctx, ap["source"] is None, f"'source' is only used with op 'custom' (op is "
+               f"{ap['op']!r})", apn, "source", "application")
+
+    # fifo, clock, limits
+    f, fn = sec["fifo"]
+    for key in ("input_depth", "output_depth", "axis_depth"):
+        _check(ctx, 2 <= f[key] <= limits.MAX_FIFO_DEPTH,
+               f"FIFO depth must be 2..{limits.MAX_FIFO_DEPTH}, got {f[key]}", fn, key, "fifo")
+    if not limits.MIN_CLOCK_MHZ <= scalars["clock_mhz"] <= limits.MAX_CLOCK_MHZ:
+        raise ctx.error(f"clock must be {limits.MIN_CLOCK_MHZ:g}..{limits.MAX_CLOCK_MHZ:g} MHz, "
+                        f"got {scalars['clock_mhz']}", top_nodes.get("clock_mhz"), "clock_mhz")
+    if not 1 <= scalars["frame_id_max"] <= limits.MAX_FRAME_ID_MAX:
+        raise ctx.error(f"must be 1..{limits.MAX_FRAME_ID_MAX}, got {scalars['frame_id_max']}",
+                        top_nodes.get("frame_id_max"), "frame_id_max")
+    if not re.fullmatch(r"[A-Za-z0-9_.-]+", scalars["part"]):
+        raise ctx.error(f"expected an FPGA part name like xc7z020clg400-1, got {scalars['part']!r}",
+                        top_nodes.get("part"), "part")
+
+    return NodeConfig(
+        node=NodeSection(**n),
+        subscriber=TopicConfig(**sec["subscriber"][0]),
+        publisher=TopicConfig(**sec["publisher"][0]),
+        image=ImageConfig(**im),
+        application=ApplicationConfig(op=ap["op"], ksize=ap["ksize"], source=source_path),
+        fifo=FifoConfig(**f),
+        clock_mhz=float(scalars["clock_mhz"]),
+        frame_id_max=scalars["frame_id_max"],
+        part=scalars["part"],
+    )
+
+
+def load_config(path: str | Path) -> NodeConfig:
+    """Read and validate a node configuration file.
+
+    Args:
+        path: the YAML file. ``application.source`` is relative to its directory.
+
+    Returns:
+        The validated, frozen :class:`NodeConfig` (its ``path`` set).
+
+    Raises:
+        ConfigError: the file is missing, too large, not YAML, or a key or value is wrong.
+    """
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except OSError as exc:
+        raise ConfigError(f"cannot read the configuration: {exc.strerror}", path=str(p)) from None
+    if len(raw) > limits.MAX_CONFIG_BYTES:
+        raise ConfigError(f"file is larger than {limits.MAX_CONFIG_BYTES} bytes", path=str(p))
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"not UTF-8 text (byte {exc.start})", path=str(p)) from None
+    config = parse_config(text, source=str(p), base_dir=p.resolve().parent)
+    return _with_path(config, p.resolve())
+
+
+def _with_path(config: NodeConfig, path: Path) -> NodeConfig:
+    from dataclasses import replace
+
+    return replace(config, path=path)
