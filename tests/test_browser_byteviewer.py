@@ -32,39 +32,23 @@ CHROMIUM_ARGS = [
 ]
 TOKEN = "rosfpga-lab-browser-test"
 
-# A sensor_msgs/Image serialised by hand (ROS 1 wire format: little endian, uint32 length
-# prefixes on strings and arrays), so the test pins the offsets independently of the library.
+# A real sensor_msgs/Image, serialised by the lab's msg layer; the offsets the test checks are
+# worked out here by hand from the ROS 1 wire format (little endian, uint32 length prefixes).
 FRAME_ID = "camera"
 HEIGHT_OFFSET = 4 + 4 + 4 + 4 + len(FRAME_ID)  # seq, secs, nsecs, frame_id length, frame_id
 
 BUILD_CELL = f'''
-import struct
 import numpy as np
-from rosfpga_lab.widgets import ByteViewer
+from rosfpga_lab import msg
+from rosfpga_lab.widgets import message_viewer
 
-frame_id, encoding, h, w = {FRAME_ID!r}, "rgb8", 3, 4
-pixels = (np.arange(h * w * 3) % 251).astype(np.uint8).tobytes()
-parts = [
-    ("header.seq", "uint32", struct.pack("<I", 7), 7, ""),
-    ("header.stamp.secs", "uint32", struct.pack("<I", 1700000000), 1700000000, ""),
-    ("header.stamp.nsecs", "uint32", struct.pack("<I", 5), 5, ""),
-    ("header.frame_id.length", "uint32", struct.pack("<I", len(frame_id)), len(frame_id), "length"),
-    ("header.frame_id", "string", frame_id.encode(), frame_id, ""),
-    ("height", "uint32", struct.pack("<I", h), h, ""),
-    ("width", "uint32", struct.pack("<I", w), w, ""),
-    ("encoding.length", "uint32", struct.pack("<I", len(encoding)), len(encoding), "length"),
-    ("encoding", "string", encoding.encode(), encoding, ""),
-    ("is_bigendian", "uint8", b"\\x00", 0, ""),
-    ("step", "uint32", struct.pack("<I", w * 3), w * 3, ""),
-    ("data.length", "uint32", struct.pack("<I", len(pixels)), len(pixels), "length"),
-    ("data", "uint8[]", pixels, None, ""),
-]
-raw, spans, off = b"", [], 0
-for path, typ, chunk, value, role in parts:
-    spans.append(dict(offset=off, size=len(chunk), path=path, type=typ, value=value, role=role))
-    raw += chunk
-    off += len(chunk)
-viewer = ByteViewer(raw, spans, title="sensor_msgs/Image")
+reg = msg.default_registry()
+h, w = 3, 4
+image = {{"header": {{"seq": 7, "stamp": {{"secs": 1700000000, "nsecs": 5}}, "frame_id": {FRAME_ID!r}}},
+          "height": h, "width": w, "encoding": "rgb8", "is_bigendian": 0, "step": w * 3,
+          "data": (np.arange(h * w * 3) % 251).astype(np.uint8).tobytes()}}
+body = msg.serialize(reg, "sensor_msgs/Image", image)
+viewer = message_viewer("sensor_msgs/Image", body)
 viewer
 '''
 REPORT_CELL = 'print("SELECTED", viewer.selection.path, viewer.selection.offset, viewer.selection.size)'

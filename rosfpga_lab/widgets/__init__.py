@@ -2,10 +2,50 @@
 
 Every widget is constructible without a running kernel or front end (so plain pytest can test
 its logic), and each has a static HTML form (``to_html()``) that needs no JavaScript, for
-exported notebooks and GitHub's notebook view.
+exported notebooks and GitHub's notebook view. Quick reference::
+
+    from rosfpga_lab import widgets as W
+    W.ByteViewer(raw, spans)                          # any bytes + [(offset, size, path, type, value, role)]
+    W.message_viewer("sensor_msgs/Image", body)       # fields from rosfpga_lab.msg.field_layout
+    W.ByteViewer(hdr, W.spans_from_connection_header(hdr))   # TCPROS connection header
+    W.ByteViewer(req, W.spans_from_http(req))         # HTTP / XML-RPC request or response
+    W.ImageDiffViewer(output, reference, input)       # or frames=[(input, output, reference), ...]
+    W.BeatViewer(beats, width=w, height=h, bytes_per_pixel=4)  # hw Beats (tdata/tkeep/tuser/tlast)
+    W.SequenceDiagram(trace)                          # graph Trace or [SeqEvent(src, dst, label, raw, t, kind)]
+    live = W.LiveView(max_fps=10); live.update(frame, stamp=t)   # from any thread
+    with W.Progress(total, "dilate") as p: p.update()  # or W.track(iterable, desc=...)
 """
 
 from rosfpga_lab.widgets._common import WidgetError
+from rosfpga_lab.widgets.beats import BeatMap, BeatViewer, MarkerMismatch
+from rosfpga_lab.widgets.byte_sources import (
+    message_spans,
+    message_viewer,
+    spans_for,
+    spans_from_connection_header,
+    spans_from_field_layout,
+    spans_from_frame,
+    spans_from_http,
+)
 from rosfpga_lab.widgets.byteview import ByteMap, ByteViewer, Span, as_span
+from rosfpga_lab.widgets.imagediff import FrameDiff, ImageDiffViewer
+from rosfpga_lab.widgets.live import LiveView, RateMeter, Throttle
+from rosfpga_lab.widgets.progress import Progress, in_notebook, track
+from rosfpga_lab.widgets.sequence import (
+    SeqEvent,
+    SequenceDiagram,
+    SvgPane,
+    events_from_trace,
+    participants_of,
+    sequence_html,
+    sequence_svg,
+)
 
-__all__ = ["ByteMap", "ByteViewer", "Span", "WidgetError", "as_span"]
+__all__ = [
+    "BeatMap", "BeatViewer", "ByteMap", "ByteViewer", "FrameDiff", "ImageDiffViewer", "LiveView",
+    "MarkerMismatch", "Progress", "RateMeter", "SeqEvent", "SequenceDiagram", "Span", "SvgPane",
+    "Throttle", "WidgetError", "as_span", "events_from_trace", "in_notebook", "message_spans",
+    "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
+    "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
+    "spans_from_http", "track",
+]

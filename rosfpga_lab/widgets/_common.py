@@ -52,6 +52,8 @@ PALETTE = (
 ROLE_COLOURS = {
     "length": "#d9d9d9",   # length prefixes of strings, arrays, header fields, frames
     "padding": "#ffffff",
+    "error": "#ff8080",     # bytes that could not be decoded
+    "trailing": "#eeeeee",  # bytes after the end of the message or header
 }
 
 

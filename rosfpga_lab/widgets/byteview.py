@@ -37,7 +37,6 @@ from rosfpga_lab.widgets._common import (
     esc,
     format_value,
     hex_bytes,
-    unique_id,
 )
 
 STATIC = Path(__file__).resolve().parent / "static"
@@ -158,14 +157,17 @@ class ByteMap:
         return None
 
     def find(self, path: str) -> int:
-        """Index of the first span named ``path``.
+        """Index of the first span named ``path`` (its value span if a length prefix shares the name).
 
         Raises:
             WidgetError: no such field (the message suggests close names).
         """
-        for i, s in enumerate(self.spans):
-            if s.path == path:
+        matches = [i for i, s in enumerate(self.spans) if s.path == path]
+        for i in matches:  # a value rather than its length prefix when both share the path
+            if self.spans[i].role != "length":
                 return i
+        if matches:
+            return matches[0]
         close = difflib.get_close_matches(path, [s.path for s in self.spans], n=3)
         hint = f"; did you mean {', '.join(close)}?" if close else ""
         raise WidgetError(f"no field {path!r} in this byte map{hint}")
@@ -177,7 +179,7 @@ class ByteMap:
     def describe(self, index: int) -> str:
         """One line naming span ``index``: path, type, offset, size and decoded value."""
         s = self.spans[index]
-        parts = [s.path]
+        parts = [s.path + (f" [{s.role}]" if s.role not in ("", "value") else "")]
         if s.type:
             parts.append(s.type)
         parts += [f"offset {s.offset}", f"size {s.size}"]
@@ -253,9 +255,8 @@ class ByteMap:
         tooltip naming the field, and the table lists each field on the page with its colour.
         """
         start, stop = self.page_range(page)
-        uid = unique_id("rfl-bm-")
         mono = "font-family:ui-monospace,SFMono-Regular,Menlo,Consolas,monospace;font-size:12px"
-        out = [f'<div id="{uid}" class="rfl-bytemap" style="{mono};line-height:1.5">']
+        out = [f'<div class="rfl-bytemap" style="{mono};line-height:1.5">']
         cap = f"{esc(self.title)} \u2014 " if self.title else ""
         out.append(
             f"<div><b>{cap}{len(self.data)} bytes, {len(self.spans)} fields</b>; page {page + 1} of "
@@ -414,7 +415,8 @@ class ByteViewer(anywidget.AnyWidget):
     # --- sync ---------------------------------------------------------------------------------
     def _field_dict(self, i: int) -> dict[str, Any]:
         s = self.bytemap.spans[i]
-        return {"i": i, "path": s.path, "type": s.type, "offset": s.offset, "size": s.size,
+        label = s.path + (f" [{s.role}]" if s.role not in ("", "value") else "")
+        return {"i": i, "path": s.path, "label": label, "type": s.type, "offset": s.offset, "size": s.size,
                 "colour": self.bytemap.colour(i), "info": self.bytemap.describe(i)}
 
     def _send_page(self) -> None:

@@ -131,7 +131,7 @@ function render({ model, el: root }) {
       tr.dataset.i = f.i;
       const sw = el("td", "sw");
       sw.style.background = f.colour;
-      tr.append(sw, el("td", "", f.path), el("td", "", f.type), el("td", "", String(f.offset)), el("td", "", String(f.size)));
+      tr.append(sw, el("td", "", f.label), el("td", "", f.type), el("td", "", String(f.offset)), el("td", "", String(f.size)));
       tr.title = f.info;
       table.append(tr);
     }

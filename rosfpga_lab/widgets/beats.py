@@ -1,0 +1,332 @@
+"""Beat viewer: AXI4-Stream beats as a table and a waveform, linked to the pixels they carry.
+
+How this works: the bytes a stream carries are the *kept* byte lanes of each beat (``tkeep``
+bit i set -> byte lane i, ``tdata`` bits 8i+7..8i, is data), in beat order. Numbered from 0, byte
+``b`` belongs to pixel ``b // bytes_per_pixel``, which sits at ``x = p % width, y = p // width``.
+So a :class:`BeatMap` needs only the four signals and the image geometry; it works for one
+pixel per beat (the lab's packing, see ``rosfpga_lab.hw.encodings``), several pixels per beat, or
+beats with null lanes. It also says where ``tuser`` (start of frame: the beat with the first
+byte) and ``tlast`` (end of line: the beat with a row's last byte) *should* be, and lists every
+beat where the signal differs, which is how a lost or repeated beat shows up.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import ipywidgets as w
+import numpy as np
+
+from rosfpga_lab.widgets._common import BEAT_PAGE_SIZE, WAVE_BEATS, WidgetError, esc
+
+TUSER_COLOUR = "#b9fbc0"
+TLAST_COLOUR = "#a0c4ff"
+WRONG_COLOUR = "#ff8080"
+
+
+@dataclass(frozen=True)
+class MarkerMismatch:
+    """A beat whose ``tuser``/``tlast`` differs from what the pixel positions call for."""
+
+    beat: int
+    signal: str       # "tuser" or "tlast"
+    expected: bool
+    actual: bool
+
+
+class BeatMap:
+    """Beats plus image geometry: beat <-> pixel mapping and marker checks.
+
+    Args:
+        beats: an object with ``tdata``, ``tkeep``, ``tuser``, ``tlast`` arrays (such as
+            ``rosfpga_lab.hw.streams.Beats``), or None when the arrays are given separately.
+        width, height: image size in pixels.
+        bytes_per_pixel: bytes of one pixel (3 for rgb8, 4 for rgba8, 1 for mono8).
+        tdata: (N,) unsigned words (byte lane 0 = bits 7..0) or (N, bus_bytes) uint8 lanes.
+        tkeep: (N,) bit masks or (N, bus_bytes) booleans; default: all lanes kept.
+        tuser, tlast: (N,) booleans; default all False.
+        bus_bytes: bytes per beat (4 for the lab's 32-bit bus).
+
+    Raises:
+        WidgetError: mismatched lengths, bad geometry.
+    """
+
+    def __init__(self, beats: Any = None, *, width: int, height: int, bytes_per_pixel: int,
+                 tdata: Any = None, tkeep: Any = None, tuser: Any = None, tlast: Any = None,
+                 bus_bytes: int = 4) -> None:
+        if beats is not None:
+            tdata, tkeep, tuser, tlast = beats.tdata, beats.tkeep, beats.tuser, beats.tlast
+        if tdata is None:
+            raise WidgetError("BeatMap needs beats (an object with tdata/tkeep/tuser/tlast) or tdata=")
+        if width < 1 or height < 1 or bytes_per_pixel < 1:
+            raise WidgetError(f"bad geometry: width={width}, height={height}, bytes_per_pixel={bytes_per_pixel}")
+        self.width, self.height, self.bpp, self.bus_bytes = width, height, bytes_per_pixel, bus_bytes
+        td = np.asarray(tdata)
+        if td.ndim == 2:
+            if td.shape[1] != bus_bytes:
+                raise WidgetError(f"tdata lanes: expected {bus_bytes} per beat, got {td.shape[1]}")
+            lanes = td.astype(np.uint8)
+        elif td.ndim == 1:
+            words = td.astype(np.uint64)
+            lanes = ((words[:, None] >> (8 * np.arange(bus_bytes, dtype=np.uint64))) & 0xFF).astype(np.uint8)
+        else:
+            raise WidgetError(f"tdata must be (N,) words or (N, {bus_bytes}) lanes, got shape {td.shape}")
+        n = lanes.shape[0]
+        self.lanes = lanes
+        if tkeep is None:
+            keep = np.ones((n, bus_bytes), bool)
+        else:
+            tk = np.asarray(tkeep)
+            if tk.ndim == 2:
+                keep = tk.astype(bool)
+            else:
+                tk = np.broadcast_to(tk, (n,)).astype(np.uint64)
+                keep = ((tk[:, None] >> np.arange(bus_bytes, dtype=np.uint64)) & 1).astype(bool)
+        self.keep = keep
+        self.tuser = np.zeros(n, bool) if tuser is None else np.broadcast_to(np.asarray(tuser, bool), (n,)).copy()
+        self.tlast = np.zeros(n, bool) if tlast is None else np.broadcast_to(np.asarray(tlast, bool), (n,)).copy()
+        if keep.shape != (n, bus_bytes):
+            raise WidgetError(f"tkeep has shape {keep.shape}, tdata has {n} beats of {bus_bytes} bytes")
+        counts = keep.sum(axis=1)
+        self.ends = np.cumsum(counts)            # stream bytes up to and including beat i
+        self.starts = self.ends - counts         # first stream byte of beat i
+        self.frame_bytes = width * height * bytes_per_pixel
+
+    def __len__(self) -> int:
+        return int(self.lanes.shape[0])
+
+    @property
+    def stream_bytes(self) -> int:
+        """Kept bytes carried by all beats."""
+        return int(self.ends[-1]) if len(self) else 0
+
+    def check_beat(self, beat: int) -> int:
+        if not 0 <= beat < len(self):
+            raise WidgetError(f"beat {beat} does not exist; beats are 0..{len(self) - 1}")
+        return beat
+
+    def beat_bytes(self, beat: int) -> bytes:
+        """The kept bytes of ``beat``, lane 0 first."""
+        self.check_beat(beat)
+        return self.lanes[beat][self.keep[beat]].tobytes()
+
+    def beat_pixels(self, beat: int) -> list[tuple[int, int]]:
+        """``(x, y)`` of every pixel with a byte in ``beat`` (none for null beats or past the frame)."""
+        self.check_beat(beat)
+        a, b = int(self.starts[beat]), int(self.ends[beat])
+        if a == b:
+            return []
+        first, last = a // self.bpp, (b - 1) // self.bpp
+        n = self.width * self.height
+        return [(p % self.width, p // self.width) for p in range(first, min(last, n - 1) + 1)]
+
+    def pixel_beat(self, x: int, y: int) -> int | None:
+        """The beat carrying the first byte of pixel ``(x, y)``, or None if the stream ends first."""
+        if not (0 <= x < self.width and 0 <= y < self.height):
+            raise WidgetError(f"pixel ({x}, {y}) is outside the {self.width}x{self.height} image")
+        byte = (y * self.width + x) * self.bpp
+        beat = int(np.searchsorted(self.ends, byte, side="right"))
+        return beat if beat < len(self) else None
+
+    def pixel_bytes(self, x: int, y: int) -> bytes:
+        """The bytes of pixel ``(x, y)`` as the stream carries them (short if the stream ends)."""
+        start = (y * self.width + x) * self.bpp
+        stream = self.lanes[self.keep]
+        return stream[start:start + self.bpp].tobytes()
+
+    def expected_markers(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(tuser, tlast)`` as the pixel positions call for them."""
+        n = len(self)
+        eu, el = np.zeros(n, bool), np.zeros(n, bool)
+        if n == 0:
+            return eu, el
+        first = int(np.searchsorted(self.ends, 0, side="right"))
+        if first < n:
+            eu[first] = True
+        row_last = (np.arange(1, self.height + 1) * self.width * self.bpp) - 1
+        beats = np.searchsorted(self.ends, row_last, side="right")
+        el[beats[beats < n]] = True
+        return eu, el
+
+    def marker_mismatches(self) -> list[MarkerMismatch]:
+        """Every beat whose ``tuser`` or ``tlast`` differs from the expected one, in beat order."""
+        eu, el = self.expected_markers()
+        out = [MarkerMismatch(int(i), "tuser", bool(eu[i]), bool(self.tuser[i])) for i in np.flatnonzero(eu != self.tuser)]
+        out += [MarkerMismatch(int(i), "tlast", bool(el[i]), bool(self.tlast[i])) for i in np.flatnonzero(el != self.tlast)]
+        return sorted(out, key=lambda m: (m.beat, m.signal))
+
+    def summary(self) -> str:
+        """One line: beats, bytes carried vs the frame's, marker counts and mismatches."""
+        wrong = self.marker_mismatches()
+        return (f"{len(self)} beats carrying {self.stream_bytes} bytes (frame: {self.frame_bytes} = "
+                f"{self.width}x{self.height}x{self.bpp}); tuser on {int(self.tuser.sum())}, tlast on "
+                f"{int(self.tlast.sum())} beats; {len(wrong)} marker mismatch{'es' if len(wrong) != 1 else ''}")
+
+    def describe_beat(self, beat: int) -> str:
+        """One line about ``beat``: signals, bytes and the pixels it carries."""
+        self.check_beat(beat)
+        px = self.beat_pixels(beat)
+        where = ", ".join(f"({x}, {y})" for x, y in px[:4]) + (" \u2026" if len(px) > 4 else "")
+        return (f"beat {beat}: tdata 0x{self._word(beat):0{2 * self.bus_bytes}x} tkeep 0b{self._keep(beat):0{self.bus_bytes}b}"
+                f" tuser {int(self.tuser[beat])} tlast {int(self.tlast[beat])}; bytes "
+                f"{self.beat_bytes(beat).hex(' ') or '(none)'} -> pixel {where or '(none)'}")
+
+    def _word(self, beat: int) -> int:
+        return int.from_bytes(self.lanes[beat].tobytes(), "little")
+
+    def _keep(self, beat: int) -> int:
+        return int(sum(1 << i for i in range(self.bus_bytes) if self.keep[beat, i]))
+
+    # --- HTML ---------------------------------------------------------------------------------
+    def table_html(self, start: int = 0, count: int = BEAT_PAGE_SIZE, selected: int | None = None) -> str:
+        """An HTML table of beats ``start .. start+count-1``; TUSER/TLAST rows coloured, wrong ones red."""
+        eu, el = self.expected_markers()
+        stop = min(len(self), start + count)
+        rows = ['<table style="border-collapse:collapse;font-family:monospace;font-size:12px">'
+                "<tr><th>beat</th><th>tdata</th><th>tkeep</th><th>tuser</th><th>tlast</th><th>pixels (x, y)</th></tr>"]
+        for i in range(max(0, start), stop):
+            def flag(actual: bool, expected: bool, colour: str) -> str:
+                bg = WRONG_COLOUR if actual != expected else (colour if actual else "")
+                note = "" if actual == expected else f" (expected {int(expected)})"
+                return f'<td style="background:{bg};text-align:center">{int(actual)}{note}</td>'
+            px = self.beat_pixels(i)
+            where = " ".join(f"({x}, {y})" for x, y in px[:3]) + (" \u2026" if len(px) > 3 else "")
+            sel = ' style="outline:2px solid #d00"' if i == selected else ""
+            rows.append(f"<tr{sel}><td>{i}</td><td>0x{self._word(i):0{2 * self.bus_bytes}x}</td>"
+                        f"<td>0b{self._keep(i):0{self.bus_bytes}b}</td>"
+                        + flag(bool(self.tuser[i]), bool(eu[i]), TUSER_COLOUR)
+                        + flag(bool(self.tlast[i]), bool(el[i]), TLAST_COLOUR)
+                        + f"<td>{esc(where)}</td></tr>")
+        rows.append("</table>")
+        return "".join(rows)
+
+    def waveform_svg(self, start: int = 0, count: int = WAVE_BEATS, selected: int | None = None) -> str:
+        """A logic-analyser style SVG of beats ``start ..``: clock, tdata, tkeep, tuser, tlast."""
+        stop = min(len(self), start + count)
+        cw, rh, left = 64, 22, 60
+        n = max(0, stop - start)
+        width, height = left + cw * max(n, 1) + 4, rh * 5 + 20
+        out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
+               f'font-family="monospace" font-size="10">']
+        names = ("aclk", "tdata", "tkeep", "tuser", "tlast")
+        for r, name in enumerate(names):
+            out.append(f'<text x="2" y="{rh * r + 15}">{name}</text>')
+        for k, i in enumerate(range(start, stop)):
+            x0 = left + k * cw
+            if i == selected:
+                out.append(f'<rect x="{x0}" y="0" width="{cw}" height="{rh * 5}" fill="#ffe08a" opacity="0.6"/>')
+            out.append(f'<polyline fill="none" stroke="#555" points="{x0},{rh - 4} {x0},6 {x0 + cw // 2},6 '
+                       f'{x0 + cw // 2},{rh - 4} {x0 + cw},{rh - 4}"/>')
+            out.append(f'<polygon fill="#eef" stroke="#333" points="{x0 + 3},{rh + 11} {x0 + 6},{rh + 4} '
+                       f'{x0 + cw - 6},{rh + 4} {x0 + cw - 3},{rh + 11} {x0 + cw - 6},{rh + 18} {x0 + 6},{rh + 18}"/>')
+            out.append(f'<text x="{x0 + 8}" y="{rh + 15}">{self._word(i):0{2 * self.bus_bytes}x}</text>')
+            out.append(f'<text x="{x0 + 8}" y="{2 * rh + 15}">{self._keep(i):0{self.bus_bytes}b}</text>')
+            for r, sig in ((3, self.tuser), (4, self.tlast)):
+                y = rh * r + (6 if sig[i] else rh - 4)
+                colour = "#070" if sig[i] else "#555"
+                out.append(f'<line x1="{x0}" y1="{y}" x2="{x0 + cw}" y2="{y}" stroke="{colour}" stroke-width="2"/>')
+            out.append(f'<text x="{x0 + 2}" y="{rh * 5 + 14}" fill="#777">{i}</text>')
+        out.append("</svg>")
+        return "".join(out)
+
+    def to_html(self, start: int = 0, count: int = BEAT_PAGE_SIZE) -> str:
+        """Static HTML: summary, waveform of the first beats, the beat table, marker mismatches."""
+        wrong = self.marker_mismatches()
+        parts = [f"<div><b>{esc(self.summary())}</b></div>", self.waveform_svg(start, min(count, WAVE_BEATS)),
+                 self.table_html(start, count)]
+        if wrong:
+            items = "".join(f"<li>beat {m.beat}: {m.signal} is {int(m.actual)}, expected {int(m.expected)}</li>"
+                            for m in wrong[:20])
+            more = f"<li>\u2026 {len(wrong) - 20} more</li>" if len(wrong) > 20 else ""
+            parts.append(f"<div>Marker mismatches:</div><ul>{items}{more}</ul>")
+        return "<div>" + "".join(parts) + "</div>"
+
+    def _repr_html_(self) -> str:
+        return self.to_html()
+
+
+class BeatViewer(w.VBox):
+    """Beats linked to pixels: pick a beat to see its pixel, or a pixel to see its beat.
+
+    Args: as :class:`BeatMap` (or pass a ready ``BeatMap`` as ``beats``).
+    """
+
+    def __init__(self, beats: Any = None, **kwargs: Any) -> None:
+        self.map = beats if isinstance(beats, BeatMap) else BeatMap(beats, **kwargs)
+        m = self.map
+        last = max(0, len(m) - 1)
+        self.beat = w.BoundedIntText(0, min=0, max=last, description="beat")
+        self.x = w.BoundedIntText(0, min=0, max=m.width - 1, description="pixel x")
+        self.y = w.BoundedIntText(0, min=0, max=m.height - 1, description="pixel y")
+        self.info = w.HTML()
+        self.wave = w.HTML()
+        self.table = w.HTML()
+        self._busy = False
+        self.beat.observe(self._on_beat, "value")
+        self.x.observe(self._on_pixel, "value")
+        self.y.observe(self._on_pixel, "value")
+        super().__init__([w.HTML(f"<b>{esc(m.summary())}</b>"), w.HBox([self.beat, self.x, self.y]),
+                          self.info, self.wave, self.table])
+        self._render()
+
+    def select_beat(self, beat: int) -> list[tuple[int, int]]:
+        """Select ``beat``; the pixel fields follow. Returns the beat's pixels."""
+        self.map.check_beat(beat)
+        self.beat.value = beat
+        return self.map.beat_pixels(beat)
+
+    def select_pixel(self, x: int, y: int) -> int | None:
+        """Select pixel ``(x, y)``; the beat field follows. Returns its beat (None: not carried)."""
+        beat = self.map.pixel_beat(x, y)
+        self._busy = True
+        try:
+            self.x.value, self.y.value = x, y
+        finally:
+            self._busy = False
+        if beat is not None:
+            self._busy = True
+            try:
+                self.beat.value = beat
+            finally:
+                self._busy = False
+        self._render(pixel=(x, y))
+        return beat
+
+    def _on_beat(self, change: Any) -> None:
+        if self._busy:
+            return
+        px = self.map.beat_pixels(self.beat.value) if len(self.map) else []
+        if px:
+            self._busy = True
+            try:
+                self.x.value, self.y.value = px[0]
+            finally:
+                self._busy = False
+        self._render(pixel=px[0] if px else None)
+
+    def _on_pixel(self, change: Any) -> None:
+        if not self._busy:
+            self.select_pixel(self.x.value, self.y.value)
+
+    def _render(self, pixel: tuple[int, int] | None = None) -> None:
+        m = self.map
+        if not len(m):
+            self.info.value = "no beats"
+            return
+        b = self.beat.value
+        pix = pixel or (m.beat_pixels(b)[0] if m.beat_pixels(b) else None)
+        text = esc(m.describe_beat(b))
+        if pix is not None:
+            carried = m.pixel_beat(*pix)
+            text += (f"<br>pixel ({pix[0]}, {pix[1]}): bytes {m.pixel_bytes(*pix).hex(' ') or '(not carried)'}"
+                     f"; first byte in beat {carried if carried is not None else '(stream ended)'}")
+        self.info.value = f'<div style="font-family:monospace">{text}</div>'
+        start = max(0, b - WAVE_BEATS // 2)
+        self.wave.value = m.waveform_svg(start, WAVE_BEATS, selected=b)
+        tstart = max(0, b - BEAT_PAGE_SIZE // 2)
+        self.table.value = m.table_html(tstart, BEAT_PAGE_SIZE, selected=b)
+
+    def to_html(self) -> str:
+        """Static HTML form (see :meth:`BeatMap.to_html`)."""
+        return self.map.to_html()

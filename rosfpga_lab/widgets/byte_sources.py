@@ -1,0 +1,176 @@
+"""Adapters: field spans for the byte viewer from messages, TCPROS and HTTP/XML-RPC bytes.
+
+Each function takes raw bytes (plus what it needs to interpret them) and returns a list of
+:class:`~rosfpga_lab.widgets.byteview.Span`, covering the bytes in order. They never raise on
+malformed input: what cannot be parsed gets one ``error`` span whose value says why, so a broken
+frame can still be looked at byte by byte.
+"""
+
+from __future__ import annotations
+
+import re
+import struct
+import xmlrpc.client
+from typing import Any
+
+from rosfpga_lab.widgets.byteview import ByteViewer, Span
+
+_U32 = struct.Struct("<I")
+
+
+def spans_from_field_layout(layout: list[Any], base: int = 0) -> list[Span]:
+    """Spans from ``rosfpga_lab.msg.field_layout`` output (FieldSpan), shifted by ``base`` bytes."""
+    return [Span(f.offset + base, f.size, f.path or f"({f.role})", f.type, f.value, f.role) for f in layout]
+
+
+def message_spans(type_name: str, body: bytes, *, registry: Any = None, base: int = 0) -> list[Span]:
+    """Spans of a serialized ROS message body (every byte in one span; bad bytes in an ``error`` span).
+
+    Args:
+        type_name: e.g. ``sensor_msgs/Image``.
+        body: the serialized message (without the TCPROS 4-byte frame length).
+        registry: a ``rosfpga_lab.msg.MsgRegistry``; default: the shipped types.
+        base: offset added to every span (e.g. 4 when ``body`` follows a frame prefix).
+    """
+    from rosfpga_lab import msg
+
+    reg = registry if registry is not None else msg.default_registry()
+    return spans_from_field_layout(msg.field_layout(reg, type_name, body, partial=True), base)
+
+
+def message_viewer(type_name: str, body: bytes, *, registry: Any = None, title: str = "", **kwargs: Any) -> ByteViewer:
+    """A :class:`ByteViewer` of one serialized message, fields from the message layout."""
+    return ByteViewer(body, message_spans(type_name, body, registry=registry), title=title or type_name, **kwargs)
+
+
+def spans_from_frame(raw: bytes, type_name: str | None = None, *, registry: Any = None) -> list[Span]:
+    """Spans of a TCPROS message frame: the 4-byte length, then the body (by fields if ``type_name``)."""
+    if len(raw) < 4:
+        return [Span(0, len(raw), "frame length (truncated)", "uint32", f"{len(raw)} of 4 bytes", "error")]
+    (length,) = _U32.unpack_from(raw, 0)
+    spans = [Span(0, 4, "frame length", "uint32", length, "length")]
+    body = raw[4:]
+    if not body:
+        return spans
+    if type_name is not None and len(body) >= length:
+        spans += message_spans(type_name, body[:length], registry=registry, base=4)
+        if len(body) > length:
+            spans.append(Span(4 + length, len(body) - length, "(next frame)", "bytes", None, "trailing"))
+        return spans
+    note = f"{len(body)} of {length} body bytes recorded" if len(body) < length else f"{length} bytes"
+    spans.append(Span(4, len(body), "message body", "bytes", note, "value"))
+    return spans
+
+
+def spans_from_connection_header(raw: bytes) -> list[Span]:
+    """Spans of a TCPROS connection header: total length, then each field's length and ``key=value``.
+
+    A field's span is named by its key and its value is the field's value; its length prefix is
+    ``<key>.length``. Parsing follows ``rosfpga_lab.tcpros.parse_fields``; the first malformed
+    field and everything after it become one ``error`` span.
+    """
+    if len(raw) < 4:
+        return [Span(0, len(raw), "header length (truncated)", "uint32", f"{len(raw)} of 4 bytes", "error")]
+    (total,) = _U32.unpack_from(raw, 0)
+    spans = [Span(0, 4, "header length", "uint32", total, "length")]
+    end = min(len(raw), 4 + total)
+    pos = 4
+    while pos < end:
+        if end - pos < 4:
+            spans.append(Span(pos, end - pos, "(truncated field length)", "bytes", "fewer than 4 bytes left", "error"))
+            pos = end
+            break
+        (size,) = _U32.unpack_from(raw, pos)
+        if size == 0 or pos + 4 + size > end:
+            why = "zero-length field" if size == 0 else f"field declares {size} bytes, only {end - pos - 4} left"
+            spans.append(Span(pos, end - pos, "(malformed field)", "bytes", why, "error"))
+            pos = end
+            break
+        text = raw[pos + 4:pos + 4 + size].decode("utf-8", errors="replace")
+        key, sep, value = text.partition("=")
+        name = key if sep else "(field without '=')"
+        spans.append(Span(pos, 4, f"{name}.length", "uint32", size, "length"))
+        spans.append(Span(pos + 4, size, name, "key=value", value if sep else text, "value"))
+        pos += 4 + size
+    if len(raw) > end:
+        spans.append(Span(end, len(raw) - end, "(after the header)", "bytes", None, "trailing"))
+    return spans
+
+
+_XML_PIECES = re.compile(rb"<methodName>.*?</methodName>|<param>.*?</param>|<fault>.*?</fault>", re.S)
+
+
+def _xmlrpc_values(body: bytes) -> tuple[str | None, list[Any]]:
+    try:
+        params, method = xmlrpc.client.loads(body.decode("utf-8", errors="replace"))
+        return method, list(params)
+    except Exception:  # noqa: BLE001 - any parse failure: just no decoded values
+        return None, []
+
+
+def spans_from_http(raw: bytes) -> list[Span]:
+    """Spans of an HTTP request or response (as XML-RPC sends them).
+
+    The start line, each header line (named by its header), the blank line that ends the
+    headers, and the body; an XML-RPC body is split further into ``methodName`` and one span
+    per ``param`` (valued with the decoded parameter), the XML between them as ``xml``.
+    """
+    spans: list[Span] = []
+    head_end = raw.find(b"\r\n\r\n")
+    head_stop = len(raw) if head_end < 0 else head_end + 2
+    pos = 0
+    first = True
+    while pos < head_stop:
+        nl = raw.find(b"\r\n", pos, head_stop)
+        stop = head_stop if nl < 0 else nl + 2
+        line = raw[pos:stop].rstrip(b"\r\n").decode("latin-1")
+        if first:
+            kind = "status line" if line.startswith("HTTP/") else "request line"
+            spans.append(Span(pos, stop - pos, kind, "http", line, "value"))
+            first = False
+        else:
+            name, _, value = line.partition(":")
+            spans.append(Span(pos, stop - pos, f"header {name.strip()}", "http", value.strip(), "value"))
+        pos = stop
+    if head_end < 0:
+        return spans
+    spans.append(Span(head_end + 2, 2, "end of headers", "CRLF", None, "length"))
+    body_at = head_end + 4
+    body = raw[body_at:]
+    if not body:
+        return spans
+    method, params = _xmlrpc_values(body)
+    pieces = list(_XML_PIECES.finditer(body))
+    if not pieces:
+        spans.append(Span(body_at, len(body), "body", "bytes", None, "value"))
+        return spans
+    pos, k = 0, 0
+    for m in pieces:
+        if m.start() > pos:
+            spans.append(Span(body_at + pos, m.start() - pos, "xml", "xml", None, "padding"))
+        tag = m.group(0)
+        if tag.startswith(b"<methodName>"):
+            spans.append(Span(body_at + m.start(), m.end() - m.start(), "methodName", "xml", method, "value"))
+        elif tag.startswith(b"<fault>"):
+            spans.append(Span(body_at + m.start(), m.end() - m.start(), "fault", "xml", None, "error"))
+        else:
+            value = params[k] if k < len(params) else None
+            spans.append(Span(body_at + m.start(), m.end() - m.start(), f"param[{k}]", "xml", value, "value"))
+            k += 1
+        pos = m.end()
+    if pos < len(body):
+        spans.append(Span(body_at + pos, len(body) - pos, "xml", "xml", None, "padding"))
+    return spans
+
+
+def spans_for(raw: bytes, kind: str = "", type_name: str | None = None) -> list[Span]:
+    """Spans for bytes of a known ``kind`` (``xmlrpc``/``http``, ``tcpros_header``,
+    ``tcpros_frame``); with no kind, HTTP is recognised by its first bytes, else one span."""
+    kind = kind.lower()
+    if "header" in kind:
+        return spans_from_connection_header(raw)
+    if "frame" in kind or "message" in kind:
+        return spans_from_frame(raw, type_name)
+    if "http" in kind or "xmlrpc" in kind or raw.startswith((b"POST ", b"GET ", b"HTTP/")):
+        return spans_from_http(raw)
+    return [Span(0, len(raw), "bytes", "bytes", None, "value")] if raw else []

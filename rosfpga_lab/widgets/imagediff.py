@@ -1,0 +1,313 @@
+"""Image diff: input, model output, reference output and where they differ, down to pixel values.
+
+How this works: :class:`FrameDiff` compares a model's output with the reference (OpenCV) output
+pixel by pixel; a pixel mismatches when any channel differs by more than ``tolerance``. It keeps
+the exact count, the first ``DIFF_POSITIONS_LIMIT`` positions in row-major order, the bounding
+box and the largest difference, and renders a difference view (reference dimmed to grey,
+mismatches in red; when an image is shrunk for display a block is red if any pixel in it is).
+:meth:`FrameDiff.zoom_html` tabulates the values of a small region of all three images.
+:class:`ImageDiffViewer` shows one frame or a sequence with a slider, plus zoom controls.
+Images are numpy arrays HxW or HxWxC (C = 1, 3, 4), uint8, channels in ``channel_order``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+import ipywidgets as w
+import numpy as np
+
+from rosfpga_lab.widgets._common import (
+    DIFF_POSITIONS_LIMIT,
+    DISPLAY_MAX_WIDTH,
+    ZOOM_MAX,
+    WidgetError,
+    as_image,
+    display_rgb,
+    display_scale,
+    esc,
+    png_bytes,
+    png_data_uri,
+)
+
+MISMATCH_RGB = (255, 0, 0)
+
+
+def _pool_any(mask: np.ndarray, step: int) -> np.ndarray:
+    """Shrink a boolean mask by ``step``, a block being True if any pixel in it is."""
+    if step <= 1:
+        return mask
+    h, w_ = mask.shape
+    ph, pw = -(-h // step) * step, -(-w_ // step) * step
+    padded = np.zeros((ph, pw), bool)
+    padded[:h, :w_] = mask
+    return padded.reshape(ph // step, step, pw // step, step).any(axis=(1, 3))
+
+
+class FrameDiff:
+    """One frame's comparison of model output against reference.
+
+    Args:
+        output: the model's image.
+        reference: the reference (e.g. ``cv2.dilate``) image, same shape.
+        input: the input image (optional, shown beside them).
+        tolerance: largest per-channel difference still counted as equal (0 = bit exact).
+        channel_order: ``"rgb"`` or ``"bgr"`` (how to show colour images; 4th channel ignored).
+
+    Attributes:
+        mask: HxW bool, True where a pixel mismatches.
+        count: number of mismatching pixels (exact).
+        positions: up to ``DIFF_POSITIONS_LIMIT`` mismatching ``(x, y)``, row-major.
+        bbox: ``(x0, y0, x1, y1)`` inclusive box around all mismatches, or None.
+        max_abs: the largest channel difference.
+
+    Raises:
+        WidgetError: not images, or output and reference differ in shape.
+    """
+
+    def __init__(self, output: Any, reference: Any, input: Any = None, *, tolerance: int = 0,
+                 channel_order: str = "rgb") -> None:
+        self.output = as_image(output, "output")
+        self.reference = as_image(reference, "reference")
+        self.input = None if input is None else as_image(input, "input")
+        if self.output.shape != self.reference.shape:
+            raise WidgetError(f"output shape {self.output.shape} differs from reference shape "
+                              f"{self.reference.shape}; compare images of the same size and encoding")
+        self.tolerance, self.channel_order = int(tolerance), channel_order
+        diff = np.abs(self.output.astype(np.int16) - self.reference.astype(np.int16))
+        self.mask = (diff > self.tolerance) if diff.ndim == 2 else (diff > self.tolerance).any(axis=2)
+        self.count = int(self.mask.sum())
+        self.max_abs = int(diff.max()) if diff.size else 0
+        ys, xs = np.nonzero(self.mask)
+        self.positions: list[tuple[int, int]] = list(zip(xs[:DIFF_POSITIONS_LIMIT].tolist(),
+                                                         ys[:DIFF_POSITIONS_LIMIT].tolist()))
+        self.bbox = (int(xs.min()), int(ys.min()), int(xs.max()), int(ys.max())) if self.count else None
+
+    @property
+    def height(self) -> int:
+        return int(self.output.shape[0])
+
+    @property
+    def width(self) -> int:
+        return int(self.output.shape[1])
+
+    @property
+    def equal(self) -> bool:
+        """True when no pixel mismatches."""
+        return self.count == 0
+
+    def summary(self) -> str:
+        """One line: equal, or how many pixels differ, where and by how much."""
+        total = self.width * self.height
+        if self.equal:
+            return f"bit-exact: all {total} pixels equal" + (f" (tolerance {self.tolerance})" if self.tolerance else "")
+        x0, y0, x1, y1 = self.bbox  # type: ignore[misc]
+        first = ", ".join(f"({x}, {y})" for x, y in self.positions[:5])
+        return (f"{self.count} of {total} pixels differ ({100 * self.count / total:.3g} %), in x {x0}..{x1}, "
+                f"y {y0}..{y1}; largest channel difference {self.max_abs}; first at {first}")
+
+    def next_mismatch(self, x: int, y: int) -> tuple[int, int] | None:
+        """The first mismatching pixel after ``(x, y)`` in row-major order (wrapping), or None."""
+        if not self.count:
+            return None
+        flat = np.flatnonzero(self.mask.ravel())
+        i = int(np.searchsorted(flat, y * self.width + x, side="right")) % flat.size
+        p = int(flat[i])
+        return p % self.width, p // self.width
+
+    def diff_rgb(self, max_width: int = DISPLAY_MAX_WIDTH, box: tuple[int, int, int, int] | None = None) -> np.ndarray:
+        """The difference view at display size: reference in dim grey, mismatches red, ``box`` outlined."""
+        step = -(-self.width // max_width) if self.width > max_width else 1
+        ref = display_rgb(self.reference, self.channel_order)[::step, ::step]
+        grey = (ref.mean(axis=2) * 0.35 + 150).astype(np.uint8)
+        out = np.repeat(grey[:, :, None], 3, axis=2)
+        out[_pool_any(self.mask, step)[: out.shape[0], : out.shape[1]]] = MISMATCH_RGB
+        if box is not None:
+            x0, y0, x1, y1 = (v // step for v in box)
+            x1, y1 = min(x1, out.shape[1] - 1), min(y1, out.shape[0] - 1)
+            out[y0, x0:x1 + 1] = out[y1, x0:x1 + 1] = (0, 0, 255)
+            out[y0:y1 + 1, x0] = out[y0:y1 + 1, x1] = (0, 0, 255)
+        return out
+
+    def views(self, max_width: int = DISPLAY_MAX_WIDTH) -> dict[str, np.ndarray]:
+        """Display RGB images by name: ``input`` (if given), ``output``, ``reference``, ``difference``."""
+        step = -(-self.width // max_width) if self.width > max_width else 1
+        out = {}
+        if self.input is not None:
+            istep = -(-self.input.shape[1] // max_width) if self.input.shape[1] > max_width else 1
+            out["input"] = display_rgb(self.input, self.channel_order)[::istep, ::istep]
+        out["output"] = display_rgb(self.output, self.channel_order)[::step, ::step]
+        out["reference"] = display_rgb(self.reference, self.channel_order)[::step, ::step]
+        out["difference"] = self.diff_rgb(max_width)
+        return out
+
+    def region(self, x: int, y: int, size: int = 8) -> tuple[int, int, int, int]:
+        """The inclusive box ``(x0, y0, x1, y1)`` of a ``size`` square around ``(x, y)``, inside the image."""
+        size = max(1, min(int(size), ZOOM_MAX, self.width, self.height))
+        x0 = min(max(0, x - size // 2), self.width - size)
+        y0 = min(max(0, y - size // 2), self.height - size)
+        return x0, y0, x0 + size - 1, y0 + size - 1
+
+    def zoom_html(self, x: int, y: int, size: int = 8) -> str:
+        """Tables of pixel values around ``(x, y)`` for output, reference (and input); mismatches red."""
+        if not (0 <= x < self.width and 0 <= y < self.height):
+            raise WidgetError(f"pixel ({x}, {y}) is outside the {self.width}x{self.height} image")
+        x0, y0, x1, y1 = self.region(x, y, size)
+        tables = []
+        named = [("output", self.output), ("reference", self.reference)]
+        if self.input is not None and self.input.shape[:2] == self.output.shape[:2]:
+            named.insert(0, ("input", self.input))
+        for name, img in named:
+            rows = [f'<table style="border-collapse:collapse;font-family:monospace;font-size:10px">'
+                    f'<caption>{name} x {x0}..{x1}, y {y0}..{y1}</caption><tr><th>y\\x</th>'
+                    + "".join(f"<th>{xx}</th>" for xx in range(x0, x1 + 1)) + "</tr>"]
+            for yy in range(y0, y1 + 1):
+                cells = []
+                for xx in range(x0, x1 + 1):
+                    v = img[yy, xx]
+                    text = ",".join(str(int(c)) for c in np.atleast_1d(v))
+                    bg = "#ff9e9e" if self.mask[yy, xx] and name != "input" else ""
+                    mark = ";outline:2px solid #00f" if (xx, yy) == (x, y) else ""
+                    cells.append(f'<td style="border:1px solid #ccc;padding:1px 3px;background:{bg}{mark}">{text}</td>')
+                rows.append(f"<tr><th>{yy}</th>{''.join(cells)}</tr>")
+            rows.append("</table>")
+            tables.append("".join(rows))
+        return '<div style="display:flex;gap:12px;flex-wrap:wrap">' + "".join(tables) + "</div>"
+
+    def to_html(self, max_width: int = 320) -> str:
+        """Self-contained HTML: the images side by side, the summary, positions and a zoom."""
+        imgs = []
+        for name, rgb in self.views(max_width).items():
+            scale = display_scale(rgb.shape[1], max_width)
+            imgs.append(f'<figure style="margin:4px"><img src="{png_data_uri(rgb, scale)}" '
+                        f'style="image-rendering:pixelated" alt="{name}"/><figcaption>{name}</figcaption></figure>')
+        parts = ['<div style="display:flex;flex-wrap:wrap">' + "".join(imgs) + "</div>",
+                 f"<div><b>{esc(self.summary())}</b></div>"]
+        if not self.equal:
+            shown = ", ".join(f"({x}, {y})" for x, y in self.positions[:50])
+            more = f" \u2026 ({self.count - 50} more)" if self.count > 50 else ""
+            parts.append(f"<div>mismatching pixels (x, y): {shown}{more}</div>")
+            parts.append(self.zoom_html(*self.positions[0]))
+        return "<div>" + "".join(parts) + "</div>"
+
+    def _repr_html_(self) -> str:
+        return self.to_html()
+
+
+def _as_frames(frames: Iterable[Any], tolerance: int, channel_order: str) -> list[FrameDiff]:
+    out = []
+    for i, f in enumerate(frames):
+        if isinstance(f, FrameDiff):
+            out.append(f)
+        elif isinstance(f, dict):
+            out.append(FrameDiff(f["output"], f["reference"], f.get("input"), tolerance=tolerance,
+                                 channel_order=channel_order))
+        elif isinstance(f, (tuple, list)) and len(f) in (2, 3):
+            inp, outp, ref = (None, *f) if len(f) == 2 else f
+            out.append(FrameDiff(outp, ref, inp, tolerance=tolerance, channel_order=channel_order))
+        else:
+            raise WidgetError(f"frame {i}: expected FrameDiff, dict or (input, output, reference), got {type(f).__name__}")
+    if not out:
+        raise WidgetError("no frames to show")
+    return out
+
+
+class ImageDiffViewer(w.VBox):
+    """Input, model output, reference and difference for one frame or a sequence (slider).
+
+    Args:
+        output, reference, input: one frame's images; or leave them out and pass ``frames``.
+        frames: a sequence of :class:`FrameDiff`, dicts with ``input``/``output``/``reference``
+            keys, or ``(input, output, reference)`` (or ``(output, reference)``) tuples.
+        tolerance, channel_order: as :class:`FrameDiff`.
+        max_width: largest display width of each image.
+    """
+
+    def __init__(self, output: Any = None, reference: Any = None, input: Any = None, *,
+                 frames: Sequence[Any] | None = None, tolerance: int = 0, channel_order: str = "rgb",
+                 max_width: int = 320) -> None:
+        if frames is None:
+            if output is None or reference is None:
+                raise WidgetError("give output= and reference= (and optionally input=), or frames=")
+            frames = [FrameDiff(output, reference, input, tolerance=tolerance, channel_order=channel_order)]
+        self.frames = _as_frames(frames, tolerance, channel_order)
+        self.max_width = max_width
+        self.frame = w.IntSlider(0, min=0, max=len(self.frames) - 1, description="frame",
+                                 layout=w.Layout(display="" if len(self.frames) > 1 else "none"))
+        self.images: dict[str, w.Image] = {}
+        self.image_box = w.HBox()
+        self.summary = w.HTML()
+        self.x = w.BoundedIntText(0, min=0, max=10**6, description="zoom x", layout=w.Layout(width="160px"))
+        self.y = w.BoundedIntText(0, min=0, max=10**6, description="zoom y", layout=w.Layout(width="160px"))
+        self.size = w.BoundedIntText(8, min=1, max=ZOOM_MAX, description="size", layout=w.Layout(width="140px"))
+        self.next_button = w.Button(description="next mismatch")
+        self.zoom = w.HTML()
+        self.frame.observe(lambda _c: self._show_frame(), "value")
+        for c in (self.x, self.y, self.size):
+            c.observe(lambda _c: self._show_zoom(), "value")
+        self.next_button.on_click(lambda _b: self.next_mismatch())
+        super().__init__([self.frame, self.image_box, self.summary,
+                          w.HBox([self.x, self.y, self.size, self.next_button]), self.zoom])
+        self._show_frame()
+
+    @property
+    def current(self) -> FrameDiff:
+        """The frame on screen."""
+        return self.frames[self.frame.value]
+
+    def show(self, index: int) -> FrameDiff:
+        """Show frame ``index``."""
+        if not 0 <= index < len(self.frames):
+            raise WidgetError(f"frame {index} does not exist; frames are 0..{len(self.frames) - 1}")
+        self.frame.value = index
+        return self.current
+
+    def zoom_to(self, x: int, y: int, size: int | None = None) -> None:
+        """Zoom onto ``(x, y)``."""
+        f = self.current
+        if not (0 <= x < f.width and 0 <= y < f.height):
+            raise WidgetError(f"pixel ({x}, {y}) is outside the {f.width}x{f.height} image")
+        with self.hold_trait_notifications():
+            self.x.value, self.y.value = x, y
+            if size is not None:
+                self.size.value = size
+        self._show_zoom()
+
+    def next_mismatch(self) -> tuple[int, int] | None:
+        """Zoom onto the next mismatching pixel after the current zoom point; returns it."""
+        p = self.current.next_mismatch(self.x.value, self.y.value)
+        if p is not None:
+            self.zoom_to(*p)
+        return p
+
+    def _show_frame(self) -> None:
+        f = self.current
+        self.x.max, self.y.max = f.width - 1, f.height - 1
+        labels = []
+        for name, rgb in f.views(self.max_width).items():
+            scale = display_scale(rgb.shape[1], self.max_width)
+            img = self.images.get(name) or w.Image(format="png")
+            img.value = png_bytes(rgb, scale)
+            img.layout.width = f"{rgb.shape[1] * scale}px"
+            self.images[name] = img
+            labels.append(w.VBox([img, w.Label(name)]))
+        self.image_box.children = labels
+        self.summary.value = f"<b>{esc(f.summary())}</b>"
+        if f.count:
+            self.zoom_to(*f.positions[0])
+        else:
+            self._show_zoom()
+
+    def _show_zoom(self) -> None:
+        f = self.current
+        x, y = min(self.x.value, f.width - 1), min(self.y.value, f.height - 1)
+        self.zoom.value = f.zoom_html(x, y, self.size.value)
+        rgb = f.diff_rgb(self.max_width, box=f.region(x, y, self.size.value))
+        scale = display_scale(rgb.shape[1], self.max_width)
+        self.images["difference"].value = png_bytes(rgb, scale)
+
+    def to_html(self) -> str:
+        """Static HTML of every frame (each as :meth:`FrameDiff.to_html`)."""
+        return "".join(f"<h4>frame {i}</h4>" * (len(self.frames) > 1) + f.to_html(self.max_width)
+                       for i, f in enumerate(self.frames))

@@ -1,0 +1,207 @@
+"""Live view: frames as they arrive, with fps and latency, throttled so the browser keeps up.
+
+How this works: :meth:`LiveView.update` may be called from any thread (a subscriber callback)
+at any rate. It always records the frame's arrival (for the incoming fps) and latency, and
+keeps only the newest frame. A :class:`Throttle` lets at most ``max_fps`` frames per second
+through to the browser; a frame that arrives too early is not dropped at once but parked, and a
+timer shows the newest parked frame when the next slot opens (so the last frame of a burst
+always appears). Encoding happens outside the state lock; one lock serialises pushes.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from typing import Any
+
+import ipywidgets as w
+import numpy as np
+
+from rosfpga_lab.widgets._common import LIVE_MAX_FPS, WidgetError, as_image, display_rgb, downscale
+
+
+class Throttle:
+    """Lets events through at most ``max_rate`` times per second (leading edge).
+
+    Args:
+        max_rate: events per second (> 0).
+        clock: a monotonic clock in seconds (injectable for tests).
+    """
+
+    def __init__(self, max_rate: float, clock: Callable[[], float] = time.monotonic) -> None:
+        if max_rate <= 0:
+            raise WidgetError(f"max_rate must be positive, got {max_rate}")
+        self.interval = 1.0 / max_rate
+        self.clock = clock
+        self._last: float | None = None
+
+    def wait_time(self, now: float | None = None) -> float:
+        """Seconds until the next event may pass (0 if now)."""
+        now = self.clock() if now is None else now
+        return 0.0 if self._last is None else max(0.0, self._last + self.interval - now)
+
+    def ready(self, now: float | None = None) -> bool:
+        """True (and the slot is taken) if an event may pass now."""
+        now = self.clock() if now is None else now
+        if self.wait_time(now) > 0:
+            return False
+        self._last = now
+        return True
+
+
+class RateMeter:
+    """Events per second over the last ``window`` seconds."""
+
+    def __init__(self, window: float = 2.0, clock: Callable[[], float] = time.monotonic) -> None:
+        self.window, self.clock = window, clock
+        self._times: deque[float] = deque()
+
+    def tick(self, now: float | None = None) -> None:
+        now = self.clock() if now is None else now
+        self._times.append(now)
+        while self._times and self._times[0] < now - self.window:
+            self._times.popleft()
+
+    def rate(self, now: float | None = None) -> float:
+        """Events per second: (events in window - 1) / time they span; 0 with fewer than two."""
+        now = self.clock() if now is None else now
+        times = [t for t in self._times if t >= now - self.window]
+        if len(times) < 2 or times[-1] <= times[0]:
+            return 0.0
+        return (len(times) - 1) / (times[-1] - times[0])
+
+
+class LiveView(w.VBox):
+    """Shows the newest frame, incoming and shown fps, and latency; safe to update from any thread.
+
+    Args:
+        max_fps: most frames per second sent to the browser.
+        max_width: frames wider than this are shrunk (by an integer step) before sending.
+        channel_order: ``"rgb"`` or ``"bgr"`` for colour frames.
+        image_format: ``"jpeg"`` (small, fast) or ``"png"`` (exact pixels).
+        trailing: show the newest parked frame when the throttle reopens (needs a timer thread).
+        clock: monotonic clock (injectable for tests).
+    """
+
+    def __init__(self, *, max_fps: float = LIVE_MAX_FPS, max_width: int = 480, channel_order: str = "rgb",
+                 image_format: str = "jpeg", trailing: bool = True, title: str = "",
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        if image_format not in ("jpeg", "png"):
+            raise WidgetError(f"image_format must be 'jpeg' or 'png', got {image_format!r}")
+        self.throttle = Throttle(max_fps, clock)
+        self.clock = clock
+        self.max_width, self.channel_order, self.image_format, self.trailing = max_width, channel_order, image_format, trailing
+        self.incoming, self.shown_rate = RateMeter(clock=clock), RateMeter(clock=clock)
+        self.received = 0
+        self.shown = 0
+        self.latencies: deque[float] = deque(maxlen=50)
+        self._lock = threading.Lock()
+        self._push_lock = threading.Lock()
+        self._pending: np.ndarray | None = None
+        self._timer: threading.Timer | None = None
+        self._closed = False
+        self.image = w.Image(format=image_format)
+        self.status = w.HTML("waiting for frames\u2026")
+        super().__init__([w.HTML(f"<b>{title}</b>") if title else w.HTML(), self.image, self.status])
+
+    def update(self, frame: Any, *, latency: float | None = None, stamp: float | None = None) -> bool:
+        """Offer a new frame (any thread). Returns True if it was pushed to the browser now.
+
+        Args:
+            frame: HxW or HxWxC uint8 image.
+            latency: seconds from capture to now, if known.
+            stamp: capture time as ``time.time()`` (e.g. the message's header stamp);
+                latency is then ``time.time() - stamp``.
+        """
+        img = as_image(frame, "frame")
+        if latency is None and stamp is not None:
+            latency = time.time() - stamp
+        with self._lock:
+            if self._closed:
+                return False
+            self.received += 1
+            self.incoming.tick()
+            if latency is not None:
+                self.latencies.append(float(latency))
+            if self.throttle.ready():
+                self._pending = None
+                go = True
+            else:
+                self._pending = img
+                go = False
+                if self.trailing and self._timer is None:
+                    self._timer = threading.Timer(self.throttle.wait_time() + 1e-3, self._fire)
+                    self._timer.daemon = True
+                    self._timer.start()
+        if go:
+            self._push(img)
+        return go
+
+    def _fire(self) -> None:
+        with self._lock:
+            self._timer = None
+            if self._closed or self._pending is None:
+                return
+            if not self.throttle.ready():  # a direct push took the slot; try again later
+                self._timer = threading.Timer(self.throttle.wait_time() + 1e-3, self._fire)
+                self._timer.daemon = True
+                self._timer.start()
+                return
+            img, self._pending = self._pending, None
+        self._push(img)
+
+    def flush(self) -> bool:
+        """Show the parked frame now, ignoring the throttle. Returns True if there was one."""
+        with self._lock:
+            img, self._pending = self._pending, None
+        if img is None:
+            return False
+        self._push(img)
+        return True
+
+    def _push(self, img: np.ndarray) -> None:
+        import cv2
+
+        rgb = downscale(display_rgb(img, self.channel_order), self.max_width)
+        ext = ".jpg" if self.image_format == "jpeg" else ".png"
+        ok, buf = cv2.imencode(ext, np.ascontiguousarray(rgb[:, :, ::-1]))
+        if not ok:  # pragma: no cover
+            raise WidgetError("could not encode the frame")
+        with self._push_lock:
+            with self._lock:
+                self.shown += 1
+                self.shown_rate.tick()
+                text = self.status_text()
+            self.image.value = buf.tobytes()
+            self.status.value = text
+
+    @property
+    def stats(self) -> dict[str, float]:
+        """Counters: received, shown, skipped, fps_in, fps_shown, latency_last/mean (s, NaN if unknown)."""
+        lat = list(self.latencies)
+        return {
+            "received": self.received, "shown": self.shown, "skipped": self.received - self.shown,
+            "fps_in": self.incoming.rate(), "fps_shown": self.shown_rate.rate(),
+            "latency_last": lat[-1] if lat else float("nan"),
+            "latency_mean": sum(lat) / len(lat) if lat else float("nan"),
+        }
+
+    def status_text(self) -> str:
+        """The status line shown under the frame."""
+        s = self.stats
+        lat = "" if s["latency_last"] != s["latency_last"] else (
+            f"; latency {s['latency_last'] * 1000:.1f} ms (mean {s['latency_mean'] * 1000:.1f} ms)")
+        return (f"{s['received']} frames received ({s['fps_in']:.1f} fps), {s['shown']} shown "
+                f"({s['fps_shown']:.1f} fps, at most {1 / self.throttle.interval:g}){lat}")
+
+    def close(self) -> None:
+        """Stop the timer and close the widget (no more updates are shown)."""
+        with self._lock:
+            self._closed = True
+            timer, self._timer = self._timer, None
+        if timer is not None:
+            timer.cancel()
+            timer.join(1.0)
+        super().close()

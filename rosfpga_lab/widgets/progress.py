@@ -1,0 +1,147 @@
+"""Progress for long work (the reference model on a large image, a C simulation).
+
+In a Jupyter kernel it shows an ipywidgets progress bar; anywhere else it writes text to a
+stream (stderr by default): one updating line on a terminal, or a line per 10 % otherwise (so
+CI logs stay short). Updates are throttled to ``min_interval`` seconds, so calling it once per
+pixel is cheap. Use it as a context manager, a callback ``progress(done, total)``, or wrap an
+iterable with :func:`track`.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable, Iterable, Iterator
+from typing import Any, TextIO, TypeVar
+
+from rosfpga_lab.widgets._common import WidgetError
+
+T = TypeVar("T")
+
+
+def in_notebook() -> bool:
+    """True when running inside a Jupyter kernel (where widgets can be displayed)."""
+    try:
+        from IPython import get_ipython
+    except ImportError:  # pragma: no cover
+        return False
+    ip = get_ipython()
+    return ip is not None and "IPKernelApp" in getattr(ip, "config", {})
+
+
+class Progress:
+    """A progress display that works in a notebook and in a terminal.
+
+    Args:
+        total: units of work (None: unknown; shows a count only).
+        desc: what is being done.
+        unit: unit name shown after counts (e.g. ``"rows"``).
+        mode: ``"auto"`` (widget in a kernel, else text), ``"widget"``, ``"text"`` or ``"off"``.
+        file: text stream for text mode (default ``sys.stderr``).
+        min_interval: least seconds between display updates.
+        clock: monotonic clock (injectable for tests).
+    """
+
+    def __init__(self, total: int | None = None, desc: str = "", *, unit: str = "", mode: str = "auto",
+                 file: TextIO | None = None, min_interval: float = 0.1,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        if mode not in ("auto", "widget", "text", "off"):
+            raise WidgetError(f"mode must be auto, widget, text or off, got {mode!r}")
+        if total is not None and total < 0:
+            raise WidgetError(f"total must be >= 0, got {total}")
+        self.total, self.desc, self.unit = total, desc, unit
+        self.mode = ("widget" if in_notebook() else "text") if mode == "auto" else mode
+        self.file = file if file is not None else sys.stderr
+        self.min_interval, self.clock = min_interval, clock
+        self.done = 0
+        self.start = clock()
+        self._last_shown = -1e18
+        self._last_decile = -1
+        self._last_written = -1
+        self.closed = False
+        self.widget: Any = None
+        if self.mode == "widget":
+            import ipywidgets as w
+            from IPython.display import display
+
+            self._bar = w.IntProgress(value=0, min=0, max=max(1, total or 1), description=desc[:20])
+            self._label = w.Label("")
+            self.widget = w.HBox([self._bar, self._label])
+            display(self.widget)
+
+    # --- feeding ------------------------------------------------------------------------------
+    def update(self, n: int = 1) -> None:
+        """Add ``n`` units of finished work."""
+        self.set(self.done + n)
+
+    def set(self, done: int, total: int | None = None) -> None:
+        """Say ``done`` units are finished (and, optionally, a new total)."""
+        if total is not None:
+            self.total = total
+        self.done = done
+        now = self.clock()
+        if now - self._last_shown >= self.min_interval:
+            self._show(now)
+
+    def __call__(self, done: int, total: int | None = None) -> None:
+        """Callback form: ``progress(done, total)``."""
+        self.set(done, total)
+
+    def close(self) -> None:
+        """Show the final state (once)."""
+        if self.closed:
+            return
+        self.closed = True
+        self._show(self.clock(), final=True)
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    # --- display ------------------------------------------------------------------------------
+    def text(self, now: float | None = None) -> str:
+        """The progress line, e.g. ``dilate  45% 450/1000 rows  1.2 s, 0.8 s left``."""
+        now = self.clock() if now is None else now
+        elapsed = now - self.start
+        unit = f" {self.unit}" if self.unit else ""
+        if self.total:
+            frac = min(1.0, self.done / self.total)
+            bar = "#" * int(frac * 20)
+            left = f", {elapsed * (1 - frac) / frac:.1f} s left" if 0 < frac < 1 else ""
+            return f"{self.desc} [{bar:<20}] {frac * 100:3.0f}% {self.done}/{self.total}{unit}  {elapsed:.1f} s{left}".strip()
+        return f"{self.desc} {self.done}{unit}  {elapsed:.1f} s".strip()
+
+    def _show(self, now: float, final: bool = False) -> None:
+        self._last_shown = now
+        if self.mode == "off":
+            return
+        line = self.text(now)
+        if self.mode == "widget":
+            self._bar.max = max(1, self.total or max(self.done, 1))
+            self._bar.value = min(self.done, self._bar.max)
+            self._label.value = line
+            if final:
+                self._bar.bar_style = "success"
+            return
+        if self.file.isatty() if hasattr(self.file, "isatty") else False:
+            self.file.write("\r" + line + ("\n" if final else ""))
+            self.file.flush()
+            return
+        decile = int(10 * self.done / self.total) if self.total else -1
+        if (final and self.done != self._last_written) or decile > self._last_decile:
+            self._last_written = self.done
+            self._last_decile = decile
+            self.file.write(line + "\n")
+            self.file.flush()
+
+
+def track(iterable: Iterable[T], total: int | None = None, desc: str = "", **kwargs: Any) -> Iterator[T]:
+    """Iterate ``iterable`` while showing progress (``total`` defaults to ``len(iterable)``)."""
+    if total is None and hasattr(iterable, "__len__"):
+        total = len(iterable)  # type: ignore[arg-type]
+    with Progress(total, desc, **kwargs) as bar:
+        for item in iterable:
+            yield item
+            bar.update()

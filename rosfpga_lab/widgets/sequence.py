@@ -1,0 +1,278 @@
+"""Sequence diagram of a recorded XML-RPC / TCPROS conversation (the paper's Figure 2).
+
+How this works: a conversation is a list of :class:`SeqEvent` (from, to, label, raw bytes,
+timestamp, kind). :func:`sequence_svg` draws one lifeline per participant and one numbered arrow
+per event, top to bottom in time order; every arrow is an SVG group with ``data-index`` and a
+tooltip. :class:`SequenceDiagram` makes the arrows clickable (a small anywidget) and shows the
+clicked event's bytes in a :class:`~rosfpga_lab.widgets.byteview.ByteViewer`, fields from
+:func:`~rosfpga_lab.widgets.byte_sources.spans_for`. :func:`events_from_trace` turns a
+``rosfpga_lab.graph`` trace into events (an XML-RPC call gives a request and a reply arrow).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import anywidget
+import ipywidgets as w
+import traitlets
+
+from rosfpga_lab.widgets._common import WidgetError, esc, hex_bytes
+from rosfpga_lab.widgets.byte_sources import spans_for
+from rosfpga_lab.widgets.byteview import ByteMap, ByteViewer, Span
+
+STATIC = Path(__file__).resolve().parent / "static"
+
+#: Arrow colour and dash per event kind.
+KIND_STYLE = {
+    "xmlrpc": ("#1f5fbf", ""),
+    "xmlrpc_reply": ("#6b86b3", "6 4"),
+    "tcp_connect": ("#555555", "2 3"),
+    "tcp_close": ("#555555", "2 3"),
+    "tcpros_header": ("#c46200", ""),
+    "tcpros_frame": ("#1b8a3a", ""),
+    "error": ("#cc0000", ""),
+}
+
+
+@dataclass
+class SeqEvent:
+    """One arrow of the diagram.
+
+    Attributes:
+        src, dst: participant names (the same name means a self-message).
+        label: text on the arrow, e.g. ``registerPublisher``.
+        raw: the bytes on the wire (may be empty).
+        t: timestamp in seconds (any origin), or None.
+        kind: ``xmlrpc``, ``xmlrpc_reply``, ``tcpros_header``, ``tcpros_frame``, ``tcp_connect`` ...
+            (chooses colour and how ``raw`` is split into fields).
+        detail: tooltip text.
+        type_name: message type of a ``tcpros_frame`` (so its body is shown field by field).
+        spans: explicit byte fields for ``raw`` (default: worked out from ``kind``).
+    """
+
+    src: str
+    dst: str
+    label: str
+    raw: bytes = b""
+    t: float | None = None
+    kind: str = ""
+    detail: str = ""
+    type_name: str | None = None
+    spans: list[Any] | None = field(default=None, repr=False)
+
+    def byte_spans(self) -> list[Span]:
+        """The fields of :attr:`raw` for the byte viewer."""
+        if self.spans is not None:
+            return list(self.spans)
+        return spans_for(self.raw, self.kind, self.type_name)
+
+
+def _as_event(item: Any) -> SeqEvent:
+    if isinstance(item, SeqEvent):
+        return item
+    if isinstance(item, dict):
+        return SeqEvent(**item)
+    if isinstance(item, (tuple, list)):
+        return SeqEvent(*item)
+    raise WidgetError(f"cannot use {type(item).__name__} as a sequence event; use SeqEvent, dict or tuple")
+
+
+def participants_of(events: Sequence[SeqEvent], first: Sequence[str] = ()) -> list[str]:
+    """Participants in order: ``first`` (those that appear), then by first appearance."""
+    seen: list[str] = []
+    present = {e.src for e in events} | {e.dst for e in events}
+    for name in first:
+        if name in present and name not in seen:
+            seen.append(name)
+    for e in events:
+        for name in (e.src, e.dst):
+            if name not in seen:
+                seen.append(name)
+    return seen
+
+
+def events_from_trace(trace: Any, *, frames_per_connection: int = 2, replies: bool = True) -> list[SeqEvent]:
+    """Events from a ``rosfpga_lab.graph`` ``Trace`` (or a list of its ``TraceEvent``).
+
+    Args:
+        trace: a Trace (its ``conversation()`` is used) or TraceEvent-like objects.
+        frames_per_connection: message frames drawn per TCPROS connection; the rest are
+            summarised in one "... N more" arrow.
+        replies: draw the reply arrow of each XML-RPC call.
+    """
+    items = trace.conversation() if hasattr(trace, "conversation") else list(trace)
+    out: list[SeqEvent] = []
+    types: dict[int, str] = {}
+    frames: dict[int, int] = {}
+    skipped: dict[int, tuple[Any, int]] = {}
+    for e in items:
+        kind = e.kind
+        if kind == "xmlrpc":
+            args = ", ".join(repr(a) for a in (e.args or []))
+            out.append(SeqEvent(e.src, e.dst, e.method, bytes(e.raw), e.t0, "xmlrpc",
+                                detail=f"{e.method}({args})"[:300]))
+            if replies and (e.raw_reply or e.result is not None):
+                res = e.result
+                status = res[1] if isinstance(res, (list, tuple)) and len(res) > 1 else res
+                out.append(SeqEvent(e.dst, e.src, f"\u21a9 {status}"[:60], bytes(e.raw_reply), e.t,
+                                    "xmlrpc_reply", detail=repr(res)[:300]))
+        elif kind == "tcpros_header":
+            if isinstance(e.args, dict) and "type" in e.args and e.args.get("type") != "*":
+                types[e.conn] = e.args["type"]
+            who = "error" if isinstance(e.args, dict) and "error" in e.args else "header"
+            out.append(SeqEvent(e.src, e.dst, f"TCPROS {who} {e.method}".strip(), bytes(e.raw), e.t0,
+                                "tcpros_header", detail=repr(e.args)[:300]))
+        elif kind == "tcpros_frame":
+            n = frames.get(e.conn, 0)
+            frames[e.conn] = n + 1
+            if n < frames_per_connection:
+                out.append(SeqEvent(e.src, e.dst, f"message #{e.index} ({e.size} B)", bytes(e.raw), e.t0,
+                                    "tcpros_frame", detail=f"{e.method} frame {e.index}, {e.size} bytes",
+                                    type_name=types.get(e.conn)))
+            else:
+                first, count = skipped.get(e.conn, (e, 0))
+                skipped[e.conn] = (first, count + 1)
+        elif kind in ("tcp_connect", "tcp_close", "error"):
+            label = {"tcp_connect": "TCP connect", "tcp_close": "TCP close"}.get(kind, f"error: {e.result}")
+            out.append(SeqEvent(e.src, e.dst, label[:60], b"", e.t0, kind, detail=str(e.result or "")[:300]))
+    for _conn, (first, count) in skipped.items():
+        out.append(SeqEvent(first.src, first.dst, f"\u2026 {count} more messages", b"", first.t0 + 1e-9,
+                            "tcpros_frame"))
+    out.sort(key=lambda ev: (ev.t if ev.t is not None else 0.0))
+    return out
+
+
+def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None = None, *,
+                 selected: int | None = None, col: int = 220, row: int = 34) -> str:
+    """The diagram as an SVG string: lifelines, numbered arrows (``<g data-index=k>``), times."""
+    names = list(participants) if participants else participants_of(events)
+    missing = ({e.src for e in events} | {e.dst for e in events}) - set(names)
+    if missing:
+        raise WidgetError(f"participants {sorted(missing)} appear in events but not in participants=")
+    left, top = 80, 50
+    xs = {n: left + col // 2 + i * col for i, n in enumerate(names)}
+    height = top + 20 + row * max(len(events), 1) + 20
+    width = left + col * max(len(names), 1) + 20
+    t0 = next((e.t for e in events if e.t is not None), None)
+    out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
+           f'font-family="sans-serif" font-size="12">',
+           '<defs><marker id="rfl-ah" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="8" '
+           'markerHeight="8" orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" fill="context-stroke"/>'
+           "</marker></defs>"]
+    for n, x in xs.items():
+        out.append(f'<rect x="{x - col // 2 + 10}" y="8" width="{col - 20}" height="26" rx="4" fill="#f0f0f0" stroke="#333"/>')
+        out.append(f'<text x="{x}" y="26" text-anchor="middle" font-weight="bold">{esc(n)}</text>')
+        out.append(f'<line x1="{x}" y1="34" x2="{x}" y2="{height - 10}" stroke="#999" stroke-dasharray="4 4"/>')
+    for k, e in enumerate(events):
+        y = top + 20 + k * row
+        colour, dash = KIND_STYLE.get(e.kind, ("#333333", ""))
+        dash_attr = f' stroke-dasharray="{dash}"' if dash else ""
+        sel = " sel" if k == selected else ""
+        tip = esc(f"{k + 1}. {e.src} \u2192 {e.dst}: {e.label}" + (f" ({len(e.raw)} bytes)" if e.raw else "")
+                  + (f"\n{e.detail}" if e.detail else ""))
+        out.append(f'<g class="rfl-arrow{sel}" data-index="{k}"><title>{tip}</title>')
+        x1, x2 = xs[e.src], xs[e.dst]
+        if x1 == x2:
+            path = f"M{x1},{y - 8} h40 v14 h-40"
+            out.append(f'<path d="{path}" fill="none" stroke="transparent" stroke-width="12"/>')
+            out.append(f'<path class="rfl-vis" d="{path}" fill="none" stroke="{colour}" stroke-width="1.5"{dash_attr} marker-end="url(#rfl-ah)"/>')
+            tx, anchor = x1 + 46, "start"
+        else:
+            out.append(f'<line x1="{x1}" y1="{y}" x2="{x2}" y2="{y}" stroke="transparent" stroke-width="14"/>')
+            out.append(f'<line class="rfl-vis" x1="{x1}" y1="{y}" x2="{x2}" y2="{y}" stroke="{colour}" '
+                       f'stroke-width="1.5"{dash_attr} marker-end="url(#rfl-ah)"/>')
+            tx, anchor = (x1 + x2) / 2, "middle"
+        size = f" [{len(e.raw)} B]" if e.raw else ""
+        out.append(f'<text x="{tx}" y="{y - 5}" text-anchor="{anchor}" fill="{colour}">{k + 1}. {esc(e.label)}{size}</text>')
+        if e.t is not None and t0 is not None:
+            out.append(f'<text x="4" y="{y + 4}" fill="#777" font-size="10">+{(e.t - t0) * 1000:.1f} ms</text>')
+        out.append("</g>")
+    out.append("</svg>")
+    return "".join(out)
+
+
+def _events_table(events: Sequence[SeqEvent], with_bytes: bool) -> str:
+    t0 = next((e.t for e in events if e.t is not None), None)
+    rows = ['<table style="border-collapse:collapse;font-size:12px"><tr><th>#</th><th>time</th><th>from</th>'
+            "<th>to</th><th>what</th><th>bytes</th></tr>"]
+    for k, e in enumerate(events):
+        when = f"+{(e.t - t0) * 1000:.1f} ms" if e.t is not None and t0 is not None else ""
+        rows.append(f"<tr><td>{k + 1}</td><td>{when}</td><td>{esc(e.src)}</td><td>{esc(e.dst)}</td>"
+                    f"<td>{esc(e.label)}</td><td style=\"font-family:monospace\">{len(e.raw)}: {esc(hex_bytes(e.raw, 12))}</td></tr>")
+        if with_bytes and e.raw:
+            page = ByteMap(e.raw, e.byte_spans(), title=f"{k + 1}. {e.label}", page_size=256).to_html(0, max_table_rows=40)
+            rows.append(f'<tr><td></td><td colspan="5"><details><summary>bytes of {k + 1}</summary>{page}</details></td></tr>')
+    rows.append("</table>")
+    return "".join(rows)
+
+
+def sequence_html(events: Iterable[Any], participants: Sequence[str] | None = None, *, with_bytes: bool = True) -> str:
+    """Static HTML: the SVG diagram and a table of every arrow with its bytes (no JavaScript needed)."""
+    evs = [_as_event(e) for e in events]
+    return "<div>" + sequence_svg(evs, participants) + _events_table(evs, with_bytes) + "</div>"
+
+
+class SvgPane(anywidget.AnyWidget):
+    """An SVG whose elements with ``data-index`` are clickable; the index lands in ``selected``."""
+
+    _esm = STATIC / "svgpane.js"
+    _css = STATIC / "svgpane.css"
+    svg = traitlets.Unicode("").tag(sync=True)
+    selected = traitlets.Int(-1).tag(sync=True)
+
+
+class SequenceDiagram(w.VBox):
+    """The clickable diagram, a list of the arrows, and a byte viewer of the selected arrow's bytes.
+
+    Args:
+        events: :class:`SeqEvent` (or dicts / tuples of its fields), or a ``graph`` Trace.
+        participants: lifeline order (default: order of appearance).
+        static_fallback: put the static HTML form in the output too (exported notebooks, GitHub).
+    """
+
+    def __init__(self, events: Any, participants: Sequence[str] | None = None, *,
+                 static_fallback: bool = True) -> None:
+        if hasattr(events, "conversation"):
+            events = events_from_trace(events)
+        self.events = [_as_event(e) for e in events]
+        self.participants = list(participants) if participants else participants_of(self.events)
+        self.static_fallback = static_fallback
+        self.pane = SvgPane(svg=sequence_svg(self.events, self.participants))
+        self.list = w.Dropdown(options=[(f"{k + 1}. {e.src} \u2192 {e.dst}: {e.label}", k)
+                                        for k, e in enumerate(self.events)],
+                               value=None, description="arrow", layout=w.Layout(width="640px"))
+        self.bytes = ByteViewer(b"", static_fallback=False)
+        self.pane.observe(lambda c: self.select(c["new"]) if c["new"] >= 0 else None, "selected")
+        self.list.observe(lambda c: self.select(c["new"]) if c["new"] is not None else None, "value")
+        super().__init__([self.pane, self.list, self.bytes])
+
+    @property
+    def selected(self) -> SeqEvent | None:
+        """The selected event, or None."""
+        k = self.pane.selected
+        return self.events[k] if 0 <= k < len(self.events) else None
+
+    def select(self, index: int) -> SeqEvent:
+        """Select arrow ``index`` (0-based): highlight it and show its bytes."""
+        if not 0 <= index < len(self.events):
+            raise WidgetError(f"arrow {index} does not exist; there are {len(self.events)}")
+        e = self.events[index]
+        self.pane.selected = index
+        self.list.value = index
+        self.bytes.set_data(e.raw, e.byte_spans(), title=f"{index + 1}. {e.src} \u2192 {e.dst}: {e.label}")
+        return e
+
+    def to_html(self, with_bytes: bool = True) -> str:
+        """The static HTML form (see :func:`sequence_html`)."""
+        return sequence_html(self.events, self.participants, with_bytes=with_bytes)
+
+    def _repr_mimebundle_(self, **kwargs: Any) -> Any:
+        bundle = super()._repr_mimebundle_(**kwargs)
+        if self.static_fallback and bundle is not None:
+            data, meta = bundle if isinstance(bundle, tuple) else (bundle, {})
+            return dict(data, **{"text/html": self.to_html()}), meta
+        return bundle
