@@ -348,13 +348,11 @@ class Node:
                     tr.record("tcpros_header", self.name, role="out", src=self.name, dst=src,
                               method=ev.topic, args=hs.reply_fields(hs.spec), raw=ev.reply,
                               size=len(ev.reply), conn=conn_id)
-                    conn.settimeout(5.0)
-                    conn.sendall(ev.reply)
                     pub = self.publishers.get(ev.topic)
                     if pub is None:
                         return False
-                    pub._add_link(conn, conn_id, src, ev.tcp_nodelay)
-                    return True
+                    # the link sends our header, then frames: nothing published from now on is lost
+                    return pub._add_link(conn, conn_id, src, ev.tcp_nodelay, ev.reply)
                 elif isinstance(ev, Closed):
                     return False
         return False

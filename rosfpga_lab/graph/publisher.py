@@ -41,8 +41,9 @@ class LinkStats:
 
 class _SubscriberLink:
     def __init__(self, pub: Publisher, sock: socket.socket, conn_id: int, peer: str,
-                 tcp_nodelay: bool) -> None:
+                 tcp_nodelay: bool, header: bytes) -> None:
         self.pub = pub
+        self.header = header
         self.sock = sock
         self.stats = LinkStats(conn_id, peer)
         self.queue: collections.deque = collections.deque()
@@ -73,6 +74,11 @@ class _SubscriberLink:
 
     def _write_loop(self) -> None:
         node = self.pub.node
+        try:
+            self.sock.sendall(self.header)  # our connection header goes before any frame
+        except OSError:
+            self.close()
+            return
         while True:
             with self.cond:
                 while not self.queue and not self.closed:
@@ -184,17 +190,19 @@ class Publisher:
             link.enqueue(body)
 
     # ----------------------------------------------------------------- links
-    def _add_link(self, sock: socket.socket, conn_id: int, peer: str, tcp_nodelay: bool) -> None:
-        link = _SubscriberLink(self, sock, conn_id, peer, tcp_nodelay)
+    def _add_link(self, sock: socket.socket, conn_id: int, peer: str, tcp_nodelay: bool,
+                  header: bytes) -> bool:
+        """Take over a socket whose handshake succeeded; ``header`` is our reply, sent first."""
+        link = _SubscriberLink(self, sock, conn_id, peer, tcp_nodelay, header)
         with self._lock:
             if self.closed:
-                hard_close(sock)
-                return
+                return False
             self._links.append(link)
             self._all_links.append(link)
             if self.latch and self._last is not None:
                 link.enqueue(self._last)
         link.start()
+        return True
 
     def _remove_link(self, link: _SubscriberLink) -> None:
         with self._lock:

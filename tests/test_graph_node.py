@@ -1,0 +1,312 @@
+"""Lab nodes on real loopback sockets: pub/sub, queues, latching, reconnect, bad peers, shutdown."""
+
+from __future__ import annotations
+
+import os
+import socket
+import threading
+import time
+import xmlrpc.client
+
+import numpy as np
+import pytest
+
+from rosfpga_lab.graph import EmbeddedMaster, GraphError, Node, Trace
+from rosfpga_lab.msg import Time, default_registry, deserialize, serialize
+from rosfpga_lab.tcpros import decode_header, encode_header
+
+pytestmark = pytest.mark.timeout(60)
+STRING_MD5 = "992ce8a1687cec8c8bd883ec73ca41d1"
+
+
+def fd_count() -> int:
+    return len(os.listdir("/proc/self/fd"))
+
+
+@pytest.fixture
+def master():
+    m = EmbeddedMaster(port=0).start()
+    yield m
+    m.stop()
+
+
+@pytest.fixture
+def nodes(master):
+    made: list[Node] = []
+
+    def make(name: str, **kw) -> Node:
+        n = Node(name, master=master, **kw)
+        made.append(n)
+        return n
+
+    yield make
+    for n in made:
+        n.shutdown()
+
+
+def wait_until(pred, timeout: float = 5.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if pred():
+            return True
+        time.sleep(0.01)
+    return pred()
+
+
+def test_string_roundtrip_and_figure2_trace(master) -> None:
+    tr = Trace()
+    master.trace = tr  # one timeline for everybody (set before any call)
+    master._server.trace = tr
+    talker = Node("/talker", master=master, trace=tr)
+    listener = Node("/listener", master=master, trace=tr)
+    try:
+        got: list[dict] = []
+        sub = listener.subscribe("/chatter", "std_msgs/String", got.append)
+        pub = talker.advertise("/chatter", "std_msgs/String")
+        assert pub.wait_for_subscribers(1, 5) and sub.wait_for_connection(1, 5)
+        for i in range(3):
+            pub.publish({"data": f"hello {i}"})
+        assert wait_until(lambda: len(got) == 3)
+        assert got == [{"data": f"hello {i}"} for i in range(3)]
+    finally:
+        talker.shutdown()
+        listener.shutdown()
+    conv = tr.conversation()
+    steps = [(e.kind, e.method, e.src, e.dst) for e in conv]
+    order = [
+        ("xmlrpc", "registerSubscriber", "/listener", "/master"),
+        ("xmlrpc", "registerPublisher", "/talker", "/master"),
+        ("xmlrpc", "publisherUpdate", "/master", "/listener"),
+        ("xmlrpc", "requestTopic", "/listener", "/talker"),
+        ("tcp_connect", "/chatter", "/listener", "/talker"),
+        ("tcpros_header", "/chatter", "/listener", "/talker"),
+        ("tcpros_header", "/chatter", "/talker", "/listener"),
+        ("tcpros_frame", "/chatter", "/talker", "/listener"),
+    ]
+    positions = [steps.index(s) for s in order]
+    assert positions == sorted(positions), steps
+    assert sum(1 for s in steps if s == order[-1]) == 3  # each frame once, not twice
+    req = next(e for e in conv if e.method == "requestTopic")
+    assert req.raw.startswith(b"POST ") and b"<string>TCPROS</string>" in req.raw
+    assert req.result[0] == 1 and req.result[2][0] == "TCPROS"
+    hdr = next(e for e in conv if e.kind == "tcpros_header" and e.src == "/talker")
+    assert decode_header(hdr.raw)[0]["md5sum"] == STRING_MD5
+    frame = next(e for e in conv if e.kind == "tcpros_frame")
+    body0 = serialize(default_registry(), "std_msgs/String", {"data": "hello 0"})
+    assert frame.raw == len(body0).to_bytes(4, "little") + body0 and frame.size == 4 + 11
+    assert all(isinstance(d, dict) for d in tr.to_dicts())
+
+
+def test_image_raw_path_every_byte(nodes) -> None:
+    reg = default_registry()
+    a, b = nodes("/cam"), nodes("/fpga_node")
+    frames: list[bytes] = []
+    infos = []
+    sub = b.subscribe("/image", "sensor_msgs/Image",
+                      lambda body, info: (frames.append(bytes(body)), infos.append(info)), raw=True)
+    pub = a.advertise("/image", "sensor_msgs/Image", queue_size=0)
+    assert pub.wait_for_subscribers(1, 5)
+    rng = np.random.default_rng(1)
+    sent = []
+    for i in range(3):
+        img = {"header": {"seq": i, "stamp": Time(5, i), "frame_id": "cam"}, "height": 480, "width": 640, "encoding": "rgba8",
+               "is_bigendian": 0, "step": 2560, "data": rng.integers(0, 256, 640 * 480 * 4, dtype=np.uint8)}
+        body = serialize(reg, "sensor_msgs/Image", img)
+        sent.append(body)
+        pub.publish_body(body)
+    assert wait_until(lambda: len(frames) == 3, 10)
+    assert frames == sent
+    assert infos[0].publisher == "/cam" and infos[2].index == 2 and infos[0].size == len(sent[0])
+    assert deserialize(reg, "sensor_msgs/Image", frames[1])["header"]["seq"] == 1
+    assert pub.stats.frames == 3 and sub.stats.bytes == sum(len(s) for s in sent)
+
+
+def test_queue_drops_oldest_and_counts(nodes) -> None:
+    a, b = nodes("/fast"), nodes("/slow")
+    release = threading.Event()
+    got: list[str] = []
+
+    def slow(msg: dict) -> None:
+        release.wait(5)
+        got.append(msg["data"])
+
+    sub = b.subscribe("/q", "std_msgs/String", slow, queue_size=2)
+    pub = a.advertise("/q", "std_msgs/String", queue_size=0)
+    assert pub.wait_for_subscribers(1, 5)
+    for i in range(20):
+        pub.publish({"data": str(i)})
+    assert wait_until(lambda: sub.stats.frames == 20)
+    release.set()
+    assert wait_until(lambda: got and got[-1] == "19")
+    st = sub.stats
+    assert st.drops >= 20 - 2 - 1 and len(got) == 20 - st.drops
+    assert got[-2:] == ["18", "19"]
+
+
+def test_latched_message_reaches_late_subscriber(nodes) -> None:
+    a, b = nodes("/latcher"), nodes("/late")
+    pub = a.advertise("/map", "std_msgs/String", latch=True)
+    pub.publish({"data": "old"})
+    pub.publish({"data": "the map"})
+    sub = b.subscribe("/map", "std_msgs/String")
+    value, info = sub.wait_for_message(5)
+    assert value == {"data": "the map"} and info.header["latching"] == "1"
+
+
+def test_reconnect_after_connection_loss(nodes) -> None:
+    a, b = nodes("/pubr"), nodes("/subr")
+    got: list[str] = []
+    sub = b.subscribe("/r", "std_msgs/String", lambda m: got.append(m["data"]))
+    pub = a.advertise("/r", "std_msgs/String")
+    assert pub.wait_for_subscribers(1, 5)
+    pub._links[0].close()  # the wire is cut; the publisher stays registered
+    assert wait_until(lambda: sub.get_num_connections() == 0 or pub.get_num_connections() == 0)
+    assert pub.wait_for_subscribers(1, 5) and sub.wait_for_connection(1, 5)
+    pub.publish({"data": "after"})
+    assert wait_until(lambda: got == ["after"])
+    assert len([l for l in pub.stats.links]) == 2
+
+
+def test_publisher_update_drops_and_adds(nodes, master) -> None:
+    a, b = nodes("/p1"), nodes("/s1")
+    sub = b.subscribe("/u", "std_msgs/String")
+    pub = a.advertise("/u", "std_msgs/String")
+    assert sub.wait_for_connection(1, 5)
+    p = xmlrpc.client.ServerProxy(b.uri)
+    assert p.publisherUpdate("/master", "/u", []) == [1, "", 0]  # empty list: no publishers left
+    assert wait_until(lambda: sub.get_num_connections() == 0)
+    bad = p.publisherUpdate("/master", "/u", ["not a uri", 3])
+    assert bad[0] == -1 and "http://" in bad[1]
+    assert p.publisherUpdate("/master", "/u", "nolist")[0] == -1
+    assert p.publisherUpdate("/master")[0] == -1
+    assert p.publisherUpdate("/master", "/u", [a.uri]) == [1, "", 0]
+    assert sub.wait_for_connection(1, 5)
+    pub.publish({"data": "x"})
+    assert sub.wait_for_message(5)[0] == {"data": "x"}
+
+
+def test_slave_api(nodes, master) -> None:
+    a = nodes("/api")
+    a.advertise("/o", "std_msgs/String")
+    a.subscribe("/i", "std_msgs/String")
+    p = xmlrpc.client.ServerProxy(a.uri)
+    assert p.getPid("/x") == [1, "", os.getpid()]
+    assert p.getMasterUri("/x") == [1, "", master.uri]
+    assert p.getPublications("/x")[2] == [["/o", "std_msgs/String"]]
+    assert p.getSubscriptions("/x")[2] == [["/i", "std_msgs/String"]]
+    assert p.requestTopic("/x", "/o", [["UDPROS"]]) == [0, "no supported protocol implementations", []]
+    assert p.requestTopic("/x", "/none", [["TCPROS"]]) == [-1, "Not a publisher of [/none]", []]
+    code, _, proto = p.requestTopic("/x", "/o", [["TCPROS"]])
+    assert code == 1 and proto == ["TCPROS", "127.0.0.1", a.tcpros_port]
+    assert p.requestTopic("/x", "/o")[0] == -1  # wrong count
+    assert p.getBusInfo("/x")[0] == 1 and p.getBusStats("/x")[0] == 1
+    assert p.paramUpdate("/master", "/k/", 1) == [1, "", 0]
+
+
+def tcpros_exchange(port: int, data: bytes, timeout: float = 5.0, eof: bool = False) -> bytes:
+    with socket.create_connection(("127.0.0.1", port), timeout=timeout) as s:
+        s.sendall(data)
+        if eof:
+            s.shutdown(socket.SHUT_WR)
+        out = b""
+        try:
+            while chunk := s.recv(65536):
+                out += chunk
+        except TimeoutError:
+            pass
+        return out
+
+
+def good_request(topic: str = "/t", md5: str = STRING_MD5) -> bytes:
+    return encode_header({"callerid": "/raw", "md5sum": md5, "topic": topic, "type": "std_msgs/String"})
+
+
+BAD_TCPROS = [
+    ("zero-length field", b"\x08\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00", "zero-length header field"),
+    ("no '='", b"\x0c\x00\x00\x00\x08\x00\x00\x00callerid", "has no '='"),
+    ("not UTF-8", b"\x0c\x00\x00\x00\x08\x00\x00\x00topic=\xff\xfe", "not UTF-8"),
+    ("header over cap", b"\xff\xff\xff\x7f", "over the limit"),
+    ("truncated field", b"\x06\x00\x00\x00\x10\x00\x00\x00ab", "only 2 remain"),
+    ("missing topic", encode_header({"callerid": "/r", "md5sum": STRING_MD5}), "required element: topic"),
+    ("missing md5sum", encode_header({"callerid": "/r", "topic": "/t"}), "required elements: md5sum, topic, callerid"),
+    ("missing callerid", encode_header({"md5sum": STRING_MD5, "topic": "/t"}), "required elements: md5sum, topic, callerid"),
+    ("unknown topic", good_request("/other"), "nonexistent topic [/other]"),
+    ("md5 mismatch", good_request(md5="0" * 32), "wants topic /t to have datatype/md5sum"),
+]
+
+
+@pytest.mark.parametrize("name,data,text", BAD_TCPROS, ids=[b[0] for b in BAD_TCPROS])
+def test_bad_subscriber_gets_error_header_and_node_keeps_serving(nodes, name, data, text) -> None:
+    a, b = nodes("/pub_bad"), nodes("/sub_good")
+    pub = a.advertise("/t", "std_msgs/String")
+    reply = tcpros_exchange(a.tcpros_port, data)
+    fields, _ = decode_header(reply)
+    assert list(fields) == ["error"] and text in fields["error"]
+    sub = b.subscribe("/t", "std_msgs/String")
+    assert sub.wait_for_connection(1, 5)
+    pub.publish({"data": "still fine"})
+    assert sub.wait_for_message(5)[0] == {"data": "still fine"}
+
+
+def test_eof_mid_header_and_silent_client_timeout(nodes, monkeypatch) -> None:
+    import rosfpga_lab.graph.node as node_mod
+
+    monkeypatch.setattr(node_mod, "HANDSHAKE_TIMEOUT", 0.5)
+    a = nodes("/pub_t")
+    a.advertise("/t", "std_msgs/String")
+    # EOF mid-header: the node hangs up without a reply (nothing to answer)
+    assert tcpros_exchange(a.tcpros_port, good_request()[:10], eof=True) == b""
+    silent = socket.create_connection(("127.0.0.1", a.tcpros_port), timeout=5)
+    try:
+        t0 = time.monotonic()
+        reply = b""
+        while chunk := silent.recv(4096):
+            reply += chunk
+        assert time.monotonic() - t0 < 3
+        assert "no complete connection header" in decode_header(reply)[0]["error"]
+    finally:
+        silent.close()
+    ok = tcpros_exchange(a.tcpros_port, good_request(), timeout=1)
+    assert decode_header(ok)[0]["md5sum"] == STRING_MD5
+
+
+def test_md5_mismatch_lab_to_lab(nodes) -> None:
+    a, b = nodes("/pub_m"), nodes("/sub_m")
+    a.advertise("/m", "std_msgs/String")
+    sub = b.subscribe("/m", "std_msgs/Int32")
+    assert wait_until(lambda: sub.stats.errors)
+    err = sub.stats.errors[0]
+    assert "wants topic /m to have datatype/md5sum [std_msgs/Int32/" in err and "not retrying" in err
+
+
+def test_publisher_reports_mismatch_from_subscriber_side(nodes) -> None:
+    # a lab publisher with a different md5 than the subscriber's type: subscriber-side check
+    a, b = nodes("/pub_x"), nodes("/sub_x")
+    a.advertise("/x", "std_msgs/String", md5sum="*")  # wildcard publisher: accepted by anyone
+    sub = b.subscribe("/x", "std_msgs/String")
+    assert sub.wait_for_connection(1, 5)
+
+
+def test_shutdown_leaves_no_threads_or_sockets(master) -> None:
+    time.sleep(0.1)
+    threads_before, fds_before = set(threading.enumerate()), fd_count()
+    a, b = Node("/a", master=master), Node("/b", master=master)
+    sub = b.subscribe("/s", "std_msgs/String")
+    pub = a.advertise("/s", "std_msgs/String")
+    assert sub.wait_for_connection(1, 5)
+    pub.publish({"data": "x"})
+    sub.wait_for_message(5)
+    a.shutdown()
+    b.shutdown()
+    a.shutdown()  # idempotent
+    assert wait_until(lambda: set(threading.enumerate()) <= threads_before, 5), \
+        set(threading.enumerate()) - threads_before
+    assert fd_count() <= fds_before
+    with pytest.raises(GraphError, match="shut down"):
+        a.advertise("/again", "std_msgs/String")
+
+
+def test_remote_shutdown(nodes) -> None:
+    a = nodes("/victim")
+    assert xmlrpc.client.ServerProxy(a.uri).shutdown("/x", "bye") == [1, "shutdown", 0]
+    assert wait_until(lambda: a.is_shutdown)
