@@ -210,9 +210,10 @@ class Interpreter:
             return
         t = self.transition
         label = t.label if t else "frame"
+        start = self._field_start if self._count else self.offset
         error = FrameTruncatedError(
             f"the frame was cut short: input ended at byte {self.offset}, "
-            f"{self._count} of this field's bytes had arrived", label, self._field_start,
+            f"{self._count} of this field's bytes had arrived", label, start,
         )
         self.reset()
         raise error
@@ -350,6 +351,7 @@ def interpret_reference(rx: ByteFIFO, out: ByteFIFO, *, width: int | None = None
         if interp.frames:
             break
     interp.finish()
+    require_frame(interp)
     check_trailing(interp, rx.level)
     assert interp.fields is not None
     return interp.fields
@@ -384,10 +386,17 @@ def interpret_fast(frame: bytes, *, width: int | None = None, height: int | None
         interp.reset()
     else:
         interp.finish()
+        require_frame(interp)
         pixels = np.zeros(0, np.uint8)
     check_trailing(interp, len(view) - pos)
     assert interp.fields is not None
     return interp.fields, pixels
+
+
+def require_frame(interp: Interpreter, frames_before: int = 0) -> None:
+    """Raise :class:`FrameTruncatedError` when the input ended before any frame began."""
+    if interp.frames == frames_before:
+        raise FrameTruncatedError("the input held no bytes at all", "frame length", 0)
 
 
 def check_trailing(interp: Interpreter, left: int) -> None:

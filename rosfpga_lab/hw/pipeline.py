@@ -304,6 +304,7 @@ class Pipeline:
         if self._faults("rx"):
             frame = self._bytes_at("rx", np.frombuffer(frame, np.uint8)).tobytes()
         pixels_in = self._interp.out
+        pixels_in.reset()
         high_water = receive_reference(frame, self._interp, self.rx_fifo_depth, self.rx_burst_bytes)
         fields = self._interp.fields
         assert fields is not None

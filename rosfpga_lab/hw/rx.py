@@ -11,7 +11,7 @@ clock, the FIFO never holds more than one byte.
 from __future__ import annotations
 
 from rosfpga_lab.hw.errors import FifoOverflowError, PipelineConfigError
-from rosfpga_lab.hw.interpreter import Interpreter, check_trailing
+from rosfpga_lab.hw.interpreter import Interpreter, check_trailing, require_frame
 from rosfpga_lab.hw.streams import ByteFIFO
 
 
@@ -59,6 +59,7 @@ def receive_reference(frame: bytes, interp: Interpreter, depth: int, burst_bytes
                 break
         clock += 1
     interp.finish()
+    require_frame(interp, frames_before)
     left = rx.level + len(frame) - min(pos, len(frame))
     if left:
         check_trailing(interp, left)
