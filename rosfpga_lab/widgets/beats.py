@@ -93,6 +93,18 @@ class BeatMap:
         self.starts = self.ends - counts         # first stream byte of beat i
         self.frame_bytes = width * height * bytes_per_pixel
 
+    @classmethod
+    def from_result(cls, result: Any, which: str = "input") -> BeatMap:
+        """The beats of a ``rosfpga_lab.hw`` ``PipelineResult``: ``which`` is ``input`` (into
+        ``AXIvideo2Mat``) or ``output`` (out of ``Mat2AXIvideo``); geometry from its fields."""
+        from rosfpga_lab.hw.encodings import pixel_format
+
+        if which not in ("input", "output"):
+            raise WidgetError(f"which must be 'input' or 'output', got {which!r}")
+        f = result.fields
+        beats = result.input_beats if which == "input" else result.output_beats
+        return cls(beats, width=f.width, height=f.height, bytes_per_pixel=pixel_format(f.encoding).bytes_per_pixel)
+
     def __len__(self) -> int:
         return int(self.lanes.shape[0])
 
@@ -269,6 +281,11 @@ class BeatViewer(w.VBox):
         super().__init__([w.HTML(f"<b>{esc(m.summary())}</b>"), w.HBox([self.beat, self.x, self.y]),
                           self.info, self.wave, self.table])
         self._render()
+
+    @classmethod
+    def from_result(cls, result: Any, which: str = "input") -> BeatViewer:
+        """A viewer of a ``PipelineResult``'s input or output beats (see :meth:`BeatMap.from_result`)."""
+        return cls(BeatMap.from_result(result, which))
 
     def select_beat(self, beat: int) -> list[tuple[int, int]]:
         """Select ``beat``; the pixel fields follow. Returns the beat's pixels."""

@@ -84,6 +84,12 @@ class FrameDiff:
                                                          ys[:DIFF_POSITIONS_LIMIT].tolist()))
         self.bbox = (int(xs.min()), int(ys.min()), int(xs.max()), int(ys.max())) if self.count else None
 
+    @classmethod
+    def from_result(cls, result: Any, reference: Any, **kwargs: Any) -> FrameDiff:
+        """Compare a ``rosfpga_lab.hw`` ``PipelineResult``'s output image with ``reference``
+        (its input image is shown too)."""
+        return cls(result.output_image, reference, result.input_image, **kwargs)
+
     @property
     def height(self) -> int:
         return int(self.output.shape[0])

@@ -198,6 +198,8 @@ class LiveView(w.VBox):
 
     def close(self) -> None:
         """Stop the timer and close the widget (no more updates are shown)."""
+        if not hasattr(self, "_lock"):  # constructor failed early; nothing to stop
+            return
         with self._lock:
             self._closed = True
             timer, self._timer = self._timer, None

@@ -22,9 +22,12 @@ import traitlets
 
 from rosfpga_lab.widgets._common import WidgetError, esc, hex_bytes
 from rosfpga_lab.widgets.byte_sources import spans_for
-from rosfpga_lab.widgets.byteview import ByteMap, ByteViewer, Span
+from rosfpga_lab.widgets.byteview import ByteMap, ByteViewer, Span, as_span
 
 STATIC = Path(__file__).resolve().parent / "static"
+
+#: Lifelines drawn first when present (the master), as in the paper's Figure 2.
+FIRST_PARTICIPANTS = ("/master", "master")
 
 #: Arrow colour and dash per event kind.
 KIND_STYLE = {
@@ -67,7 +70,7 @@ class SeqEvent:
     def byte_spans(self) -> list[Span]:
         """The fields of :attr:`raw` for the byte viewer."""
         if self.spans is not None:
-            return list(self.spans)
+            return [as_span(s) for s in self.spans]
         return spans_for(self.raw, self.kind, self.type_name)
 
 
@@ -118,7 +121,7 @@ def events_from_trace(trace: Any, *, frames_per_connection: int = 2, replies: bo
             if replies and (e.raw_reply or e.result is not None):
                 res = e.result
                 status = res[1] if isinstance(res, (list, tuple)) and len(res) > 1 else res
-                out.append(SeqEvent(e.dst, e.src, f"\u21a9 {status}"[:60], bytes(e.raw_reply), e.t,
+                out.append(SeqEvent(e.dst, e.src, f"\u21a9 {status or 'reply'}"[:60], bytes(e.raw_reply), e.t,
                                     "xmlrpc_reply", detail=repr(res)[:300]))
         elif kind == "tcpros_header":
             if isinstance(e.args, dict) and "type" in e.args and e.args.get("type") != "*":
@@ -149,7 +152,7 @@ def events_from_trace(trace: Any, *, frames_per_connection: int = 2, replies: bo
 def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None = None, *,
                  selected: int | None = None, col: int = 220, row: int = 34) -> str:
     """The diagram as an SVG string: lifelines, numbered arrows (``<g data-index=k>``), times."""
-    names = list(participants) if participants else participants_of(events)
+    names = list(participants) if participants else participants_of(events, FIRST_PARTICIPANTS)
     missing = ({e.src for e in events} | {e.dst for e in events}) - set(names)
     if missing:
         raise WidgetError(f"participants {sorted(missing)} appear in events but not in participants=")
@@ -186,7 +189,7 @@ def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None 
             out.append(f'<line class="rfl-vis" x1="{x1}" y1="{y}" x2="{x2}" y2="{y}" stroke="{colour}" '
                        f'stroke-width="1.5"{dash_attr} marker-end="url(#rfl-ah)"/>')
             tx, anchor = (x1 + x2) / 2, "middle"
-        size = f" [{len(e.raw)} B]" if e.raw else ""
+        size = f" [{len(e.raw)} B]" if e.raw and e.kind != "tcpros_frame" else ""
         out.append(f'<text x="{tx}" y="{y - 5}" text-anchor="{anchor}" fill="{colour}">{k + 1}. {esc(e.label)}{size}</text>')
         if e.t is not None and t0 is not None:
             out.append(f'<text x="4" y="{y + 4}" fill="#777" font-size="10">+{(e.t - t0) * 1000:.1f} ms</text>')
@@ -239,7 +242,7 @@ class SequenceDiagram(w.VBox):
         if hasattr(events, "conversation"):
             events = events_from_trace(events)
         self.events = [_as_event(e) for e in events]
-        self.participants = list(participants) if participants else participants_of(self.events)
+        self.participants = list(participants) if participants else participants_of(self.events, FIRST_PARTICIPANTS)
         self.static_fallback = static_fallback
         self.pane = SvgPane(svg=sequence_svg(self.events, self.participants))
         self.list = w.Dropdown(options=[(f"{k + 1}. {e.src} \u2192 {e.dst}: {e.label}", k)

@@ -1,0 +1,238 @@
+"""Image diff and beat viewer: mismatch counts and positions, zoom, beat <-> pixel mapping."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rosfpga_lab.widgets import BeatMap, BeatViewer, FrameDiff, ImageDiffViewer, WidgetError
+from rosfpga_lab.widgets._common import DIFF_POSITIONS_LIMIT
+
+
+def _image(h: int = 12, w: int = 16, c: int = 3, seed: int = 0) -> np.ndarray:
+    return np.random.default_rng(seed).integers(0, 256, (h, w, c), dtype=np.uint8)
+
+
+# --- image diff ---------------------------------------------------------------------------------
+
+def test_equal_images_are_bit_exact() -> None:
+    img = _image()
+    ref = cv2.dilate(img, np.ones((3, 3), np.uint8))
+    d = FrameDiff(ref.copy(), ref, img)
+    assert d.equal and d.count == 0 and d.positions == [] and d.bbox is None
+    assert d.summary() == "bit-exact: all 192 pixels equal"
+    assert d.next_mismatch(0, 0) is None
+
+
+def test_counts_positions_bbox_and_tolerance() -> None:
+    ref = _image()
+    out = ref.copy()
+    out[2, 5, 0] ^= 1        # (x=5, y=2): off by one in one channel
+    out[7, 1] = 255 - out[7, 1]  # (x=1, y=7): all channels
+    out[7, 9, 2] ^= 0x80     # (x=9, y=7)
+    d = FrameDiff(out, ref)
+    assert d.count == 3
+    assert d.positions == [(5, 2), (1, 7), (9, 7)]  # row-major
+    assert d.bbox == (1, 2, 9, 7)
+    assert d.mask.sum() == 3 and d.mask[2, 5] and d.mask[7, 1] and d.mask[7, 9]
+    assert d.summary().startswith("3 of 192 pixels differ (1.56 %), in x 1..9, y 2..7")
+    assert FrameDiff(out, ref, tolerance=1).count == 2  # the off-by-one is tolerated
+    assert d.next_mismatch(5, 2) == (1, 7) and d.next_mismatch(9, 7) == (5, 2)  # wraps
+    assert d.next_mismatch(0, 0) == (5, 2)
+
+
+def test_positions_are_capped_but_count_is_exact() -> None:
+    ref = np.zeros((50, 50), np.uint8)
+    out = np.ones((50, 50), np.uint8)
+    d = FrameDiff(out, ref)
+    assert d.count == 2500 and len(d.positions) == DIFF_POSITIONS_LIMIT
+    assert d.positions[:3] == [(0, 0), (1, 0), (2, 0)] and d.positions[50] == (0, 1)
+
+
+def test_shape_and_dtype_errors_are_clear() -> None:
+    with pytest.raises(WidgetError, match=r"output shape \(4, 4, 3\) differs from reference shape \(4, 5, 3\)"):
+        FrameDiff(np.zeros((4, 4, 3), np.uint8), np.zeros((4, 5, 3), np.uint8))
+    with pytest.raises(WidgetError, match="expected dtype uint8"):
+        FrameDiff(np.zeros((4, 4), np.float32), np.zeros((4, 4), np.float32))
+    with pytest.raises(WidgetError, match="HxW or HxWxC"):
+        FrameDiff(np.zeros((4, 4, 2), np.uint8), np.zeros((4, 4, 2), np.uint8))
+
+
+def test_difference_view_marks_mismatches_red_even_when_shrunk() -> None:
+    ref = np.zeros((40, 2000, 3), np.uint8)
+    out = ref.copy()
+    out[13, 1001] = 9  # one pixel in a wide image
+    d = FrameDiff(out, ref)
+    view = d.diff_rgb(max_width=500)  # shrunk by 4
+    assert view.shape == (10, 500, 3)
+    red = np.argwhere((view == (255, 0, 0)).all(axis=2))
+    assert red.tolist() == [[13 // 4, 1001 // 4]]
+
+
+def test_zoom_region_and_value_tables() -> None:
+    ref = np.arange(10 * 10, dtype=np.uint8).reshape(10, 10)
+    out = ref.copy()
+    out[4, 6] = 200
+    d = FrameDiff(out, ref)
+    assert d.region(6, 4, 4) == (4, 2, 7, 5)
+    assert d.region(0, 0, 4) == (0, 0, 3, 3) and d.region(9, 9, 4) == (6, 6, 9, 9)  # clamped inside
+    assert d.region(5, 5, 99) == (0, 0, 9, 9)  # at most the image (and ZOOM_MAX)
+    html = d.zoom_html(6, 4, 3)
+    assert "output x 5..7, y 3..5" in html and "reference x 5..7, y 3..5" in html
+    assert html.count("#ff9e9e") == 2  # the one mismatching cell, in output and reference tables
+    assert ">200</td>" in html and f">{ref[4, 6]}</td>" in html
+    with pytest.raises(WidgetError, match="outside"):
+        d.zoom_html(10, 0)
+
+
+def test_static_html_is_self_contained() -> None:
+    ref = _image(6, 8)
+    out = ref.copy()
+    out[1, 2] = 0
+    html = FrameDiff(out, ref, ref).to_html()
+    assert html.count("data:image/png;base64,") == 4 and "<script" not in html
+    assert "1 of 48 pixels differ" in html and "(2, 1)" in html
+
+
+def test_viewer_single_frame_and_sequence() -> None:
+    ref = _image(8, 8)
+    bad = ref.copy()
+    bad[3, 4] = 0
+    bad[6, 1] = 1
+    v = ImageDiffViewer(frames=[(ref, ref.copy(), ref), (ref, bad, ref), {"output": bad, "reference": bad}])
+    assert v.frame.max == 2 and v.current.equal
+    v.show(1)
+    assert v.current.count == 2 and (v.x.value, v.y.value) == (4, 3)  # zoomed onto first mismatch
+    assert "2 of 64 pixels differ" in v.summary.value
+    assert v.next_mismatch() == (1, 6) and (v.x.value, v.y.value) == (1, 6)
+    assert set(v.images) == {"input", "output", "reference", "difference"}
+    assert bytes(v.images["difference"].value).startswith(b"\x89PNG")
+    with pytest.raises(WidgetError, match="frame 3 does not exist"):
+        v.show(3)
+    single = ImageDiffViewer(bad, ref)
+    assert single.frame.layout.display == "none" and set(single.images) == {"output", "reference", "difference"}
+    with pytest.raises(WidgetError, match="give output= and reference="):
+        ImageDiffViewer()
+
+
+def test_from_pipeline_result() -> None:
+    from rosfpga_lab.hw import Pipeline, image_frame
+
+    img = _image(6, 5)
+    res = Pipeline(op="dilate", ksize=(3, 3)).process(image_frame(img, "rgb8"))
+    d = FrameDiff.from_result(res, cv2.dilate(img, np.ones((3, 3), np.uint8)))
+    assert d.equal and d.input is not None
+    wrong = FrameDiff.from_result(res, img)  # not dilated: many pixels differ
+    assert wrong.count > 0
+
+
+# --- beats ----------------------------------------------------------------------------------------
+
+def _rgb_beats(img: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """One pixel per 32-bit beat, written out by hand: R in bits 7..0, G 15..8, B 23..16."""
+    h, w, _ = img.shape
+    px = img.reshape(-1, 3).astype(np.uint32)
+    tdata = px[:, 0] | (px[:, 1] << 8) | (px[:, 2] << 16)
+    tuser = np.zeros(h * w, bool)
+    tuser[0] = True
+    tlast = (np.arange(h * w) % w) == w - 1
+    return tdata, np.full(h * w, 0b0111, np.uint8), tuser, tlast
+
+
+def test_beat_pixel_mapping_one_pixel_per_beat() -> None:
+    img = _image(3, 4)
+    td, tk, tu, tl = _rgb_beats(img)
+    m = BeatMap(tdata=td, tkeep=tk, tuser=tu, tlast=tl, width=4, height=3, bytes_per_pixel=3)
+    assert len(m) == 12 and m.stream_bytes == 36 and m.marker_mismatches() == []
+    assert m.beat_pixels(6) == [(2, 1)]
+    assert m.pixel_beat(2, 1) == 6 and m.pixel_beat(3, 2) == 11
+    assert m.beat_bytes(6) == img[1, 2].tobytes() == m.pixel_bytes(2, 1)
+    assert m.describe_beat(0).startswith(f"beat 0: tdata 0x{int(td[0]):08x} tkeep 0b0111 tuser 1 tlast 0")
+    with pytest.raises(WidgetError, match="outside the 4x3 image"):
+        m.pixel_beat(4, 0)
+    with pytest.raises(WidgetError, match="beat 12 does not exist"):
+        m.beat_pixels(12)
+
+
+def test_hw_beats_object_and_marker_mismatches_after_faults() -> None:
+    from rosfpga_lab.hw import LoseTlast, LoseTuser, fifo2axi_fast, pixel_format
+
+    img = _image(5, 4, 4)
+    beats, left = fifo2axi_fast(img.ravel(), 5, 4, pixel_format("rgba8"))
+    assert left == 0
+    m = BeatMap(beats, width=4, height=5, bytes_per_pixel=4)
+    assert m.marker_mismatches() == [] and m.beat_bytes(9) == img[2, 1].tobytes()
+    lost = BeatMap(LoseTlast(line=1).apply(beats), width=4, height=5, bytes_per_pixel=4)
+    assert [(x.beat, x.signal, x.expected, x.actual) for x in lost.marker_mismatches()] == [(7, "tlast", True, False)]
+    nouser = BeatMap(LoseTuser().apply(beats), width=4, height=5, bytes_per_pixel=4)
+    assert [(x.beat, x.signal) for x in nouser.marker_mismatches()] == [(0, "tuser")]
+    assert "1 marker mismatch" in nouser.summary()
+
+
+def test_a_lost_beat_shifts_pixels_and_markers() -> None:
+    img = _image(2, 3)
+    td, tk, tu, tl = _rgb_beats(img)
+    keep = np.arange(6) != 1  # beat 1 is lost
+    m = BeatMap(tdata=td[keep], tkeep=tk[keep], tuser=tu[keep], tlast=tl[keep], width=3, height=2, bytes_per_pixel=3)
+    assert m.beat_pixels(1) == [(1, 0)]  # what was pixel (2, 0) now lands at (1, 0)
+    assert m.pixel_beat(2, 1) is None  # the stream ends before the last pixel
+    # beats now carry pixels 0, 1, 2, 3, 4 but their tlast flags were meant for pixels 0, 2, 3, 4, 5
+    assert [(x.beat, x.signal, x.expected) for x in m.marker_mismatches()] == [
+        (1, "tlast", False), (2, "tlast", True), (4, "tlast", False)]
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(1, 5), st.integers(1, 5), st.sampled_from([1, 2, 3, 4, 6]),
+       st.lists(st.integers(0, 15), min_size=1, max_size=60))
+def test_mapping_matches_a_naive_byte_walk(w: int, h: int, bpp: int, keeps: list[int]) -> None:
+    n = len(keeps)
+    rng = np.random.default_rng(n)
+    lanes = rng.integers(0, 256, (n, 4), dtype=np.uint8)
+    m = BeatMap(tdata=lanes, tkeep=np.array(keeps), width=w, height=h, bytes_per_pixel=bpp)
+    # naive model: walk every lane of every beat in order, numbering kept bytes
+    owner_beat, stream, pixels_of = [], [], [[] for _ in range(n)]
+    for i, k in enumerate(keeps):
+        for lane in range(4):
+            if k >> lane & 1:
+                p = len(stream) // bpp
+                if p < w * h and (p % w, p // w) not in pixels_of[i]:
+                    pixels_of[i].append((p % w, p // w))
+                owner_beat.append(i)
+                stream.append(int(lanes[i, lane]))
+    for i in range(n):
+        assert m.beat_pixels(i) == pixels_of[i]
+        assert m.beat_bytes(i) == bytes(int(lanes[i, ln]) for ln in range(4) if keeps[i] >> ln & 1)
+    for p in range(w * h):
+        first = p * bpp
+        assert m.pixel_beat(p % w, p // w) == (owner_beat[first] if first < len(stream) else None)
+        assert m.pixel_bytes(p % w, p // w) == bytes(stream[first:first + bpp])
+
+
+def test_beat_viewer_links_beats_and_pixels() -> None:
+    img = _image(3, 4)
+    td, tk, tu, tl = _rgb_beats(img)
+    v = BeatViewer(tdata=td, tkeep=tk, tuser=tu, tlast=tl, width=4, height=3, bytes_per_pixel=3)
+    assert v.select_beat(7) == [(3, 1)] and (v.x.value, v.y.value) == (3, 1)
+    assert v.select_pixel(1, 2) == 9 and v.beat.value == 9
+    assert f"pixel (1, 2): bytes {img[2, 1].tobytes().hex(' ')}" in v.info.value
+    v.x.value = 0  # editing a pixel coordinate moves the beat
+    assert v.beat.value == 8
+    v.beat.value = 3  # and the other way round
+    assert (v.x.value, v.y.value) == (3, 0)
+    assert "<svg" in v.wave.value and 'outline:2px solid #d00"><td>3</td>' in v.table.value
+
+
+def test_beat_table_and_static_html_mark_tuser_tlast_and_errors() -> None:
+    img = _image(2, 3)
+    td, tk, tu, tl = _rgb_beats(img)
+    tl[2] = False
+    m = BeatMap(tdata=td, tkeep=tk, tuser=tu, tlast=tl, width=3, height=2, bytes_per_pixel=3)
+    table = m.table_html()
+    assert table.count("#b9fbc0") == 1  # tuser on beat 0
+    assert table.count("#a0c4ff") == 1  # tlast on beat 5 only
+    assert "0 (expected 1)" in table    # beat 2 lost its tlast
+    html = m.to_html()
+    assert "beat 2: tlast is 0, expected 1" in html and "<svg" in html and "<script" not in html
