@@ -19,8 +19,18 @@ pytestmark = pytest.mark.timeout(60)
 STRING_MD5 = "992ce8a1687cec8c8bd883ec73ca41d1"
 
 
+def fds() -> dict[str, str]:
+    out = {}
+    for fd in os.listdir("/proc/self/fd"):
+        try:
+            out[fd] = os.readlink(f"/proc/self/fd/{fd}")
+        except OSError:
+            pass
+    return out
+
+
 def fd_count() -> int:
-    return len(os.listdir("/proc/self/fd"))
+    return len(fds())
 
 
 @pytest.fixture
@@ -289,7 +299,7 @@ def test_publisher_reports_mismatch_from_subscriber_side(nodes) -> None:
 
 def test_shutdown_leaves_no_threads_or_sockets(master) -> None:
     time.sleep(0.1)
-    threads_before, fds_before = set(threading.enumerate()), fd_count()
+    threads_before, fds_before = set(threading.enumerate()), fds()
     a, b = Node("/a", master=master), Node("/b", master=master)
     sub = b.subscribe("/s", "std_msgs/String")
     pub = a.advertise("/s", "std_msgs/String")
@@ -301,7 +311,8 @@ def test_shutdown_leaves_no_threads_or_sockets(master) -> None:
     a.shutdown()  # idempotent
     assert wait_until(lambda: set(threading.enumerate()) <= threads_before, 5), \
         set(threading.enumerate()) - threads_before
-    assert fd_count() <= fds_before
+    assert wait_until(lambda: fd_count() <= len(fds_before), 5), \
+        {k: v for k, v in fds().items() if fds_before.get(k) != v}
     with pytest.raises(GraphError, match="shut down"):
         a.advertise("/again", "std_msgs/String")
 

@@ -297,7 +297,7 @@ class Node:
             with self._lock:
                 self._handshakes.add(t)
                 self._pending.add(conn)
-            t.start()
+                t.start()
 
     def _handshake(self, conn: socket.socket, peer: str) -> None:
         handed_over = False
@@ -345,9 +345,6 @@ class Node:
                     conn.sendall(ev.reply)
                     return False
                 elif isinstance(ev, Connected):
-                    tr.record("tcpros_header", self.name, role="out", src=self.name, dst=src,
-                              method=ev.topic, args=hs.reply_fields(hs.spec), raw=ev.reply,
-                              size=len(ev.reply), conn=conn_id)
                     pub = self.publishers.get(ev.topic)
                     if pub is None:
                         return False

@@ -74,11 +74,15 @@ class _SubscriberLink:
 
     def _write_loop(self) -> None:
         node = self.pub.node
+        t0 = time.time()
         try:
             self.sock.sendall(self.header)  # our connection header goes before any frame
         except OSError:
             self.close()
             return
+        node.trace.record("tcpros_header", node.name, role="out", src=node.name, dst=self.stats.peer,
+                          method=self.pub.topic, args=self.pub.node_reply_fields(), raw=self.header,
+                          size=len(self.header), conn=self.stats.conn, t0=t0)
         while True:
             with self.cond:
                 while not self.queue and not self.closed:
@@ -86,6 +90,7 @@ class _SubscriberLink:
                 if self.closed:
                     return
                 body = self.queue.popleft()
+            t0 = time.time()
             try:
                 size = send_frame(self.sock, body)
             except OSError:
@@ -98,7 +103,7 @@ class _SubscriberLink:
                     "tcpros_frame", node.name, role="out", src=node.name, dst=self.stats.peer,
                     method=self.pub.topic,
                     raw=len(body).to_bytes(4, "little") + bytes(body[:node.trace.frame_bytes]),
-                    size=size, conn=self.stats.conn, index=self.stats.frames - 1)
+                    size=size, conn=self.stats.conn, index=self.stats.frames - 1, t0=t0)
 
     def _read_loop(self) -> None:
         try:
@@ -188,6 +193,12 @@ class Publisher:
             self._bytes += len(body)
         for link in links:
             link.enqueue(body)
+
+    def node_reply_fields(self) -> dict[str, str]:
+        """The header fields this publisher answers subscribers with."""
+        return {"callerid": self.node.name, "latching": "1" if self.latch else "0",
+                "md5sum": self.md5sum, "message_definition": self.message_definition,
+                "topic": self.topic, "type": self.type_name}
 
     # ----------------------------------------------------------------- links
     def _add_link(self, sock: socket.socket, conn_id: int, peer: str, tcp_nodelay: bool,

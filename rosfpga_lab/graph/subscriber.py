@@ -145,10 +145,11 @@ class _PublisherLink:
                                  type_name=sub.type_name, message_definition=sub.message_definition,
                                  tcp_nodelay=sub.tcp_nodelay, max_frame=sub.max_frame)
         request = hs.initiate()
+        t0 = time.time()
         sock.sendall(request)
         node.trace.record("tcpros_header", node.name, role="out", src=node.name,
                           dst=node.trace.name_of(self.pub_uri), method=sub.topic,
-                          args=dict(hs.fields), raw=request, size=len(request), conn=conn)
+                          args=dict(hs.fields), raw=request, size=len(request), conn=conn, t0=t0)
         deadline = time.monotonic() + HANDSHAKE_TIMEOUT
         publisher, header = peer, {}
         got = False

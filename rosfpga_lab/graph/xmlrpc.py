@@ -223,7 +223,7 @@ class XmlRpcServer:
                              name=f"rosfpga-{name}-{self.name}", daemon=True)
         with self._lock:
             self._threads.add(t)
-        t.start()
+            t.start()
 
     def _run_thread(self, target: Callable, *args: Any) -> None:
         try:
