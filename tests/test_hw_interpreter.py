@@ -57,6 +57,15 @@ def test_table_is_a_connected_chain_over_every_image_field():
         "encoding", "is_bigendian", "step", "data length", "data"]
 
 
+def test_table_as_text_for_notebooks():
+    from rosfpga_lab.hw import format_table
+    lines = format_table().splitlines()
+    assert lines[0].split() == ["state", "field", "bytes", "next", "check"]
+    assert lines[1].split() == ["FRAME_LEN", "frame", "length", "4", "SEQ", "frame_length"]
+    assert lines[-1].split() == ["DATA", "data", "=", "data_length", "FRAME_LEN", "frame_end"]
+    assert len(lines) == len(INTERPRETER_TABLE) + 1
+
+
 def test_decodes_a_frame_written_by_the_message_layer():
     fields, pixels = both(GOOD)
     assert (fields.seq, fields.stamp_secs, fields.stamp_nsecs, fields.frame_id) == (7, 11, 12, "camera")

@@ -44,6 +44,10 @@ def test_whole_frame_comes_out_as_the_dilated_image_message(model, encoding):
     assert np.array_equal(res.output_image, morph_oracle(image, "dilate", 3, 3))
     assert res.fields.seq == 41 and res.output_fields.seq == 1
     assert len(res.input_beats) == len(res.output_beats) == 9 * 13
+    assert res.streams["pixels_in"].tobytes() == image.tobytes()
+    assert res.streams["pixels_out"].tobytes() == res.output_image.tobytes()
+    assert res.streams["axis_in"] == res.input_beats and res.streams["tx"] == res.output_frame
+    assert not res.output_image.flags.writeable
     # the next frame counts seq up, as a rospy publisher does
     assert decode_frame(pipe.process(frame).output_frame)["header"]["seq"] == 2
 

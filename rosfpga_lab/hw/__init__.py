@@ -46,7 +46,8 @@ from rosfpga_lab.hw.faults import (
 )
 from rosfpga_lab.hw.generator import GENERATOR_TABLE, frame_length, generate_fast, generate_reference
 from rosfpga_lab.hw.interpreter import (
-    INTERPRETER_TABLE, ImageFields, Interpreter, Transition, interpret_fast, interpret_reference,
+    INTERPRETER_TABLE, ImageFields, Interpreter, Transition, format_table, interpret_fast,
+    interpret_reference,
 )
 from rosfpga_lab.hw.morph import OPS, morph_fast, morph_reference
 from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame
@@ -66,7 +67,7 @@ __all__ = [
     "PixelFormat", "ShallowFifo", "StreamStarvedError", "SwapByteOrder", "Transition",
     "UnsupportedEncodingError", "account", "axi2fifo_fast", "axi2fifo_reference",
     "axivideo2mat_fast", "axivideo2mat_reference", "fifo2axi_fast", "fifo2axi_reference",
-    "frame_length", "generate_fast", "generate_reference", "image_frame", "interpret_fast",
+    "format_table", "frame_length", "generate_fast", "generate_reference", "image_frame", "interpret_fast",
     "interpret_reference", "mat2axivideo_fast", "mat2axivideo_reference", "morph_fast",
     "morph_reference", "pixel_format", "receive_fast_check", "receive_reference",
 ]

@@ -86,6 +86,16 @@ _FIXED = {"u32": 4, "u8": 1}
 MIN_BODY_BYTES = 4 + 4 + 4 + 4 + 4 + 4 + 4 + 1 + 4 + 4
 
 
+def format_table(table: tuple[Transition, ...] = INTERPRETER_TABLE) -> str:
+    """The state table as aligned text (what a notebook prints before drawing it)."""
+    rows = [("state", "field", "bytes", "next", "check")]
+    for t in table:
+        size = str(_FIXED[t.kind]) if t.length_of is None else f"= {t.length_of}"
+        rows.append((t.state, t.label, size, t.next, t.check or "-"))
+    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
+
+
 @dataclass(frozen=True)
 class ImageFields:
     """The decoded fields of one ``sensor_msgs/Image`` frame (everything but the pixels).

@@ -62,6 +62,9 @@ class PipelineResult:
         fifo_high_water: ``{"rx": bytes}``, the receive FIFO's highest level.
         status: problems that did not stop the frame (``AXIvideo2Mat`` flags, leftovers).
         model: ``"fast"`` or ``"reference"``.
+        streams: what travelled on each tap (after its faults): ``"rx"`` (bytes),
+            ``"pixels_in"``, ``"pixels_out"`` (read-only uint8 arrays), ``"axis_in"``,
+            ``"axis_out"`` (:class:`Beats`), ``"tx"`` (the output frame).
     """
 
     output_frame: bytes
@@ -77,6 +80,7 @@ class PipelineResult:
     fifo_high_water: dict[str, int]
     status: list[str] = field(default_factory=list)
     model: str = "fast"
+    streams: dict[str, bytes | np.ndarray | Beats] = field(default_factory=dict)
 
     @property
     def cycles(self) -> dict[str, int]:
@@ -241,11 +245,16 @@ class Pipeline:
 
     def _finish(self, frame: bytes, fields: ImageFields, out_fields: ImageFields, output: bytes,
                 images: tuple[np.ndarray, np.ndarray], beats: tuple[Beats, Beats], high_water: int,
-                status: list[str]) -> PipelineResult:
+                status: list[str], pixels: tuple[np.ndarray, np.ndarray]) -> PipelineResult:
         report = account(fields, self.op, self.ksize, len(frame), len(output))
+        for array in (*pixels, *images):
+            array.setflags(write=False)  # results are records: nothing may change them later
+        streams: dict[str, bytes | np.ndarray | Beats] = {
+            "rx": frame, "pixels_in": pixels[0], "axis_in": beats[0], "axis_out": beats[1],
+            "pixels_out": pixels[1], "tx": output}
         return PipelineResult(output, fields, out_fields, images[0], images[1], beats[0], beats[1],
                               report, self.clock_hz, self.line_rate_bps, {"rx": high_water},
-                              status, self.model)
+                              status, self.model, streams)
 
     @staticmethod
     def _leftover(status: list[str], stream: str, left: int, unit: str) -> None:
@@ -264,6 +273,7 @@ class Pipeline:
         fmt = PIXEL_FORMATS[fields.encoding]
         rows, cols = fields.height, fields.width
         pixels = self._bytes_at("pixels_in", pixels)
+        pixels_in_bytes = pixels
         beats_in, left = fifo2axi_fast(pixels, rows, cols, fmt)
         self._leftover(status, "pixels_in", left, "byte")
         beats_in = self._beats_at("axis_in", beats_in)
@@ -282,12 +292,15 @@ class Pipeline:
         self._leftover(status, "pixels_out", data_out.size - out_fields.data_length, "byte")
         if self._faults("axis_out") or self._faults("pixels_out"):
             image_out, beats_out = image_out.copy(), beats_out.copy()
+            pixels_out = data_out.copy()
         else:
-            image_out = np.frombuffer(output, np.uint8, out_fields.data_length,
-                                      len(output) - out_fields.data_length).reshape(image_out.shape)
+            pixels_out = np.frombuffer(output, np.uint8, out_fields.data_length,
+                                       len(output) - out_fields.data_length)
+            image_out = pixels_out.reshape(image_out.shape)
             beats_out = mat2axivideo_fast(image_out, fmt)
         return self._finish(frame, fields, out_fields, output, (image_in, image_out),
-                            (beats_in, beats_out), high_water, status)
+                            (beats_in, beats_out), high_water, status,
+                            (pixels_in_bytes, pixels_out))
 
     # -- the reference model ------------------------------------------------------------------
     def _refill_bytes(self, tap: str, fifo: ByteFIFO) -> None:
@@ -311,6 +324,7 @@ class Pipeline:
         fmt = PIXEL_FORMATS[fields.encoding]
         rows, cols, channels = fields.height, fields.width, fmt.bytes_per_pixel
         self._refill_bytes("pixels_in", pixels_in)
+        pixels_in_bytes = np.frombuffer(pixels_in.to_bytes(), np.uint8)
         axis_in: Fifo[Beat] = Fifo(None, "axis_in")
         fifo2axi_reference(pixels_in, axis_in, rows, cols, fmt)
         self._leftover(status, "pixels_in", len(pixels_in.drain()), "byte")
@@ -332,12 +346,14 @@ class Pipeline:
         axi2fifo_reference(axis_out, pixels_out, rows * cols)
         self._leftover(status, "axis_out", len(axis_out.drain()), "beat")
         self._refill_bytes("pixels_out", pixels_out)
+        pixels_out_bytes = np.frombuffer(pixels_out.to_bytes(), np.uint8)
         out_fields = self._output_fields(fields)
         tx = ByteFIFO(name="tx")
         generate_reference(out_fields, pixels_out, tx)
         self._leftover(status, "pixels_out", len(pixels_out.drain()), "byte")
         return self._finish(frame, fields, out_fields, tx.to_bytes(), (image_in, image_out),
-                            (beats_in, beats_out), high_water, status)
+                            (beats_in, beats_out), high_water, status,
+                            (pixels_in_bytes, pixels_out_bytes))
 
 
 def image_frame(image: np.ndarray, encoding: str, *, seq: int = 0, stamp: tuple[int, int] = (0, 0),

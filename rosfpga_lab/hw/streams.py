@@ -73,13 +73,14 @@ class Fifo(Generic[T]):
 
     def write(self, item: T) -> bool:
         """Push ``item``; returns False (and sets ``overflow``) when the FIFO was full."""
-        if self.full:
+        items = self._items
+        if self.depth is not None and len(items) >= self.depth:
             self.overflow = True
             self.dropped += 1
             return False
-        self._items.append(item)
-        if len(self._items) > self.high_water:
-            self.high_water = len(self._items)
+        items.append(item)
+        if len(items) > self.high_water:
+            self.high_water = len(items)
         return True
 
     def read(self, reader: str = "", needed: int = 0) -> T:
@@ -133,7 +134,7 @@ class ByteFIFO(Fifo[int]):
     def write(self, item: int) -> bool:
         if not 0 <= item <= 0xFF:
             raise PipelineConfigError(f"FIFO {self.name!r} is 8 bits wide; cannot hold {item}")
-        return super().write(item)
+        return Fifo.write(self, item)
 
     def to_bytes(self) -> bytes:
         """The stored bytes, oldest first (without removing them)."""
