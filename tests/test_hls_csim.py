@@ -1,0 +1,256 @@
+"""C simulation of the generated HLS C++ with g++, against the Python models, bit for bit.
+
+For each shipped configuration the generated project is compiled once per session (with the
+Makefile: ``g++ -std=c++14 -Wall -Werror`` against the lab's HLS headers) and fed TCPROS frames
+serialized by real ROS (genpy, under the system Python; the lab's own serializer stands in only
+where ROS is not installed). The output bytes and the AXI4-Stream beats on both sides of the
+application must equal those of :class:`rosfpga_lab.hw.Pipeline` for the same configuration,
+and the output image must equal OpenCV's dilate/erode of the input. Without g++ these tests
+skip (with ROSFPGA_REQUIRE_CXX=1, as in CI, they fail).
+"""
+
+from __future__ import annotations
+
+import struct
+import subprocess
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from realros import require_cxx, ros_missing_reason, run_ros_python
+from rosfpga_lab.hls import CsimError, build_csim, generate, load_config, pipeline_for, run_csim
+from rosfpga_lab.hls.csim import CsimResult
+from rosfpga_lab.hw import PipelineError, image_frame
+from rosfpga_lab.msg import default_registry, deserialize
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = ROOT / "data"
+CONFIGS = ["fpga_dilate_rgba8", "fpga_erode_mono8", "fpga_passthrough_rgb8"]
+IMAGE_MD5 = "060021388200f6f0f447d0fcd9c64743"  # sensor_msgs/Image, from genpy
+
+GENPY_FRAME = """
+import io, struct, sys
+import genpy
+from sensor_msgs.msg import Image
+m = Image()
+m.header.seq = {seq}
+m.header.stamp = genpy.Time({secs}, {nsecs})
+m.header.frame_id = {frame_id!r}
+m.height, m.width, m.encoding, m.is_bigendian, m.step = {h}, {w}, {encoding!r}, {big}, {step}
+m.data = sys.stdin.buffer.read()
+buf = io.BytesIO()
+m.serialize(buf)
+sys.stdout.buffer.write(struct.pack('<I', len(buf.getvalue())) + buf.getvalue())
+"""
+
+
+def ros_frame(image: np.ndarray, encoding: str, *, seq: int = 3, stamp: tuple[int, int] = (1700000000, 5),
+              frame_id: str = "camera_link", step: int | None = None, is_bigendian: int = 0) -> bytes:
+    """A TCPROS frame (length + Image) serialized by genpy; by the lab where ROS is missing."""
+    h, w = image.shape[:2]
+    step = image.shape[1] * (image.shape[2] if image.ndim == 3 else 1) if step is None else step
+    if ros_missing_reason() is not None:
+        return image_frame(image, encoding, seq=seq, stamp=stamp, frame_id=frame_id,
+                           is_bigendian=is_bigendian)
+    code = GENPY_FRAME.format(seq=seq, secs=stamp[0], nsecs=stamp[1], frame_id=frame_id, h=h, w=w,
+                              encoding=encoding, big=is_bigendian, step=step)
+    frame = run_ros_python(code, input=image.tobytes()).stdout
+    if step == image.shape[1] * (image.shape[2] if image.ndim == 3 else 1):
+        # The lab's frame builder must agree with genpy (so the fallback is the same frame).
+        assert frame == image_frame(image, encoding, seq=seq, stamp=stamp, frame_id=frame_id,
+                                    is_bigendian=is_bigendian)
+    return frame
+
+
+def random_image(config_stem: str, seed: int = 1) -> tuple[np.ndarray, str]:
+    config = load_config(DATA / f"{config_stem}.yaml")
+    rng = np.random.default_rng(seed)
+    img = config.image
+    image = rng.integers(0, 256, (img.height, img.width, img.bytes_per_pixel), dtype=np.uint8)
+    image[rng.random((img.height, img.width)) < 0.9] //= 4  # sparse bright dots: dilation shows
+    return image, img.encoding
+
+
+class Project:
+    def __init__(self, path: Path, binary: Path) -> None:
+        self.path, self.binary = path, binary
+
+    def run(self, frames: bytes) -> CsimResult:
+        return run_csim(self.path, frames, binary=self.binary)
+
+
+@pytest.fixture(scope="module")
+def projects(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Project]:
+    """Generated and compiled projects, built on first use, once per session."""
+    require_cxx()
+    cache: dict[str, Project] = {}
+
+    class Lazy(dict):
+        def __missing__(self, stem: str) -> Project:
+            out = tmp_path_factory.mktemp(stem)
+            generate(load_config(DATA / f"{stem}.yaml"), out / "proj")
+            cache[stem] = Project(out / "proj", build_csim(out / "proj"))
+            self[stem] = cache[stem]
+            return cache[stem]
+
+    return Lazy()
+
+
+def _decode(frame: bytes) -> dict:
+    (length,) = struct.unpack_from("<I", frame)
+    assert length == len(frame) - 4
+    return deserialize(default_registry(), "sensor_msgs/Image", frame[4:])
+
+
+@pytest.mark.parametrize("stem", CONFIGS)
+def test_csim_equals_python_models_and_opencv(projects: dict[str, Project], stem: str) -> None:
+    image, encoding = random_image(stem)
+    frame = ros_frame(image, encoding)
+    got = projects[stem].run(frame)
+    config = load_config(DATA / f"{stem}.yaml")
+    model = pipeline_for(config).process(frame)
+    assert got.status == ((0, "SUB_OK"),)
+    assert len(got.input_beats) == config.image.width * config.image.height
+    assert got.input_beats == model.input_beats, f"first differing beat {got.input_beats.first_difference(model.input_beats)}"
+    assert got.output_beats == model.output_beats, f"first differing beat {got.output_beats.first_difference(model.output_beats)}"
+    assert got.output == model.output_frame
+    # Independent oracle: OpenCV on the input image, and the header as ROS would publish it.
+    out = _decode(got.output)
+    kernel = np.ones((config.application.ksize,) * 2, np.uint8)
+    expected = {"dilate": lambda a: cv2.dilate(a, kernel), "erode": lambda a: cv2.erode(a, kernel),
+                "passthrough": lambda a: a}[config.application.op](image)
+    assert np.array_equal(np.frombuffer(bytes(out["data"]), np.uint8).reshape(image.shape),
+                          expected.reshape(image.shape))
+    assert out["header"]["seq"] == 1 and out["header"]["frame_id"] == "camera_link"
+    assert (out["header"]["stamp"].secs, out["header"]["stamp"].nsecs) == (1700000000, 5)
+    assert (out["height"], out["width"], out["encoding"]) == (image.shape[0], image.shape[1], encoding)
+    assert got.log.count("WARNING") == 0, got.log
+
+
+@pytest.mark.parametrize("stem", CONFIGS)
+def test_make_csim_passes_on_the_shipped_test_frame(projects: dict[str, Project], stem: str) -> None:
+    proj = projects[stem]
+    proc = subprocess.run(["make", "-s", "csim"], cwd=proj.path, capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "csim: PASS: output equals tb_expected.bin" in proc.stdout
+    assert "WARNING" not in proc.stderr
+
+
+def _header_fields(data: bytes) -> dict[str, str]:
+    (total,) = struct.unpack_from("<I", data)
+    assert total == len(data) - 4
+    fields, pos, keys = {}, 4, []
+    while pos < len(data):
+        (n,) = struct.unpack_from("<I", data, pos)
+        key, _, value = data[pos + 4:pos + 4 + n].decode().partition("=")
+        fields[key] = value
+        keys.append(key)
+        pos += 4 + n
+    assert keys == sorted(keys)  # roscpp and rospy order
+    return fields
+
+
+def test_connection_headers_from_the_circuit(projects: dict[str, Project]) -> None:
+    image, encoding = random_image("fpga_passthrough_rgb8")
+    got = projects["fpga_passthrough_rgb8"].run(image_frame(image, encoding))
+    sub = _header_fields(got.subscriber_header)
+    pub = _header_fields(got.publisher_header)
+    assert sub["md5sum"] == pub["md5sum"] == IMAGE_MD5
+    assert sub["type"] == pub["type"] == "sensor_msgs/Image"
+    assert sub["callerid"] == pub["callerid"] == "/fpga_passthrough"
+    assert (sub["topic"], pub["topic"]) == ("/image_rgb", "/image_rgb_copy")
+    assert sub["tcp_nodelay"] == "1" and pub["latching"] == "0"
+    definition = sub["message_definition"]
+    assert definition == pub["message_definition"]
+    assert definition.startswith("Header header\n") and "MSG: std_msgs/Header" in definition
+    assert "uint8[] data" in definition
+
+
+def test_refused_frames_are_skipped_and_the_next_good_frame_comes_out_right(
+        projects: dict[str, Project]) -> None:
+    stem = "fpga_erode_mono8"
+    config = load_config(DATA / f"{stem}.yaml")
+    image, encoding = random_image(stem, seed=5)
+    other, _ = random_image(stem, seed=6)
+    frames = [
+        ("wrong width", image_frame(image[:, :-1], encoding), "SUB_BAD_WIDTH"),
+        ("wrong height", image_frame(image[:-1], encoding), "SUB_BAD_HEIGHT"),
+        ("wrong encoding", image_frame(np.repeat(image, 3, axis=2), "rgb8"), "SUB_BAD_ENCODING"),
+        ("good", ros_frame(image, encoding, seq=10), "SUB_OK"),
+        ("frame_id too long", image_frame(image, encoding, frame_id="f" * 300), "SUB_BAD_FRAME_ID_LENGTH"),
+        ("frame length too short", struct.pack("<I", 10) + bytes(10), "SUB_BAD_FRAME_LENGTH"),
+        ("good again", ros_frame(other, encoding, seq=11, frame_id="cam2"), "SUB_OK"),
+    ]
+    stream = b"".join(f for _, f, _ in frames)
+    got = projects[stem].run(stream)
+    offsets = np.cumsum([0] + [len(f) for _, f, _ in frames])[:-1]
+    assert got.status == tuple((int(o), s) for o, (_, _, s) in zip(offsets, frames))
+    # The Python model refuses the same frames and numbers the accepted ones 1, 2.
+    pipe = pipeline_for(config)
+    expected, beats_in, beats_out = b"", [], []
+    for name, frame, status in frames:
+        try:
+            res = pipe.process(frame)
+        except PipelineError:
+            assert status != "SUB_OK", name
+            continue
+        assert status == "SUB_OK", name
+        expected += res.output_frame
+        beats_in.append(res.input_beats)
+        beats_out.append(res.output_beats)
+    assert got.output == expected
+    first = 4 + struct.unpack_from("<I", got.output)[0]
+    one, two = _decode(got.output[:first]), _decode(got.output[first:])
+    assert (one["header"]["seq"], one["header"]["frame_id"]) == (1, "camera_link")
+    assert (two["header"]["seq"], two["header"]["frame_id"]) == (2, "cam2")
+    n = config.image.width * config.image.height
+    assert len(got.input_beats) == 2 * n
+    for i in range(2):
+        part = got.input_beats.tdata[i * n:(i + 1) * n]
+        assert np.array_equal(part, beats_in[i].tdata)
+        assert np.array_equal(got.output_beats.tdata[i * n:(i + 1) * n], beats_out[i].tdata)
+
+
+CUSTOM_FILTER = r"""
+// A user's application: invert every channel (the paper's input (c), written by hand).
+#include "ros_node.h"
+
+void image_filter(pixel_stream& in, pixel_stream& out) {
+    for (int p = 0; p < IMG_HEIGHT * IMG_WIDTH; p++) {
+        pixel_beat beat = in.read();
+        beat.data = (~beat.data.to_uint()) & PIXEL_MASK;
+        out.write(beat);
+    }
+}
+"""
+
+
+def test_custom_application_file(tmp_path: Path) -> None:
+    require_cxx()
+    (tmp_path / "invert.cpp").write_text(CUSTOM_FILTER)
+    text = (DATA / "fpga_erode_mono8.yaml").read_text().replace(
+        "  op: erode\n  ksize: 5\n", "  op: custom\n  source: invert.cpp\n")
+    (tmp_path / "node.yaml").write_text(text)
+    config = load_config(tmp_path / "node.yaml")
+    result = generate(config, tmp_path / "proj")
+    assert "tb_expected.bin" not in result.files
+    assert (tmp_path / "proj" / "image_filter.cpp").read_text() == CUSTOM_FILTER
+    image, encoding = random_image("fpga_erode_mono8", seed=9)
+    got = run_csim(tmp_path / "proj", image_frame(image, encoding, frame_id="x"))
+    out = _decode(got.output)
+    assert np.array_equal(np.frombuffer(bytes(out["data"]), np.uint8).reshape(image.shape), 255 - image)
+    assert got.output_beats.tkeep.tolist() == [1] * image.size
+
+
+def test_build_failure_quotes_the_compiler(tmp_path: Path) -> None:
+    require_cxx()
+    (tmp_path / "broken.cpp").write_text('#include "ros_node.h"\nvoid image_filter(pixel_stream& in) {}\n')
+    text = (DATA / "fpga_erode_mono8.yaml").read_text().replace(
+        "  op: erode\n  ksize: 5\n", "  op: custom\n  source: broken.cpp\n")
+    (tmp_path / "node.yaml").write_text(text)
+    generate(load_config(tmp_path / "node.yaml"), tmp_path / "proj")
+    with pytest.raises(CsimError, match="building the testbench .* failed"):
+        build_csim(tmp_path / "proj")

@@ -1,0 +1,201 @@
+"""The generator: golden files, determinism, the manifest and --force, the CLI, the SLOC table.
+
+Golden files live in ``tests/golden/hls/<config>/``: every text file the generator writes for
+the three shipped configurations. A template change shows up here as a diff. To accept a
+change on purpose, regenerate them and review the diff before committing::
+
+    ROSFPGA_UPDATE_GOLDEN=1 .venv/bin/python -m pytest tests/test_hls_generate.py -k golden
+    git diff tests/golden/hls
+"""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rosfpga_lab.hls import (
+    GenerateError, HlsError, count_sloc, format_table, generate, load_config, render,
+)
+from rosfpga_lab.hls.generator import MANIFEST, TEMPLATE_FILES
+from rosfpga_lab.hls.sloc import PAPER_TABLE1, sloc
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = ROOT / "data"
+GOLDEN = Path(__file__).resolve().parent / "golden" / "hls"
+CONFIGS = ["fpga_dilate_rgba8", "fpga_erode_mono8", "fpga_passthrough_rgb8"]
+UPDATE = os.environ.get("ROSFPGA_UPDATE_GOLDEN", "") not in ("", "0")
+
+
+def _tree(root: Path) -> dict[str, str]:
+    return {str(p.relative_to(root)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+@pytest.mark.parametrize("stem", CONFIGS)
+def test_golden_files(stem: str) -> None:
+    texts = render(load_config(DATA / f"{stem}.yaml"))
+    assert set(texts) == set(TEMPLATE_FILES)
+    folder = GOLDEN / stem
+    if UPDATE:
+        folder.mkdir(parents=True, exist_ok=True)
+        for name, text in texts.items():
+            (folder / name).write_text(text, encoding="utf-8")
+    problems = []
+    for name, text in sorted(texts.items()):
+        golden = folder / name
+        if not golden.exists():
+            problems.append(f"{golden} missing (regenerate: see this module's docstring)")
+            continue
+        expected = golden.read_text(encoding="utf-8")
+        if expected != text:
+            diff = "".join(difflib.unified_diff(expected.splitlines(True), text.splitlines(True),
+                                                f"golden/{stem}/{name}", f"generated/{name}", n=2))
+            problems.append(diff)
+    assert not problems, "generated code differs from the golden files:\n" + "\n".join(problems)
+
+
+def test_generation_is_deterministic(tmp_path: Path) -> None:
+    config = load_config(DATA / "fpga_erode_mono8.yaml")
+    generate(config, tmp_path / "a")
+    generate(config, tmp_path / "b")
+    a, b = _tree(tmp_path / "a"), _tree(tmp_path / "b")
+    assert a == b
+    assert len(a) == 17  # 10 rendered + 4 headers + input + expected + manifest
+    # The same file elsewhere generates the same bytes (only its name appears in the output).
+    moved = tmp_path / "elsewhere" / "fpga_erode_mono8.yaml"
+    moved.parent.mkdir()
+    moved.write_bytes((DATA / "fpga_erode_mono8.yaml").read_bytes())
+    generate(load_config(moved), tmp_path / "c")
+    assert _tree(tmp_path / "c") == a
+
+
+def test_generated_code_names_the_configuration() -> None:
+    config = load_config(DATA / "fpga_dilate_rgba8.yaml")
+    texts = render(config)
+    assert '#define IMG_WIDTH 640' in texts["ros_node.h"]
+    assert '"rgba8"' in texts["ros_node.h"]
+    assert "hls::Dilate(src, dst)" in texts["image_filter.cpp"]
+    assert "md5sum=060021388200f6f0f447d0fcd9c64743" in texts["connection_headers.cpp"]
+    assert "topic=/image_raw" in texts["connection_headers.cpp"]
+    assert "topic=/image_dilated" in texts["connection_headers.cpp"]
+    assert "callerid=/fpga_dilate" in texts["connection_headers.cpp"]
+    assert "set part xc7z020clg400-1" in texts["run_hls.tcl"]
+    assert "create_clock -period $clock_period" in texts["run_hls.tcl"]
+    assert "set clock_period 10" in texts["run_hls.tcl"]
+    for top in ("subscriber", "image_filter", "publisher"):
+        assert top in texts["run_hls.tcl"]
+    assert "-std=c++14 -Wall -Werror" in texts["Makefile"]
+    erode = render(load_config(DATA / "fpga_erode_mono8.yaml"))
+    assert "hls::Erode<hls::MORPH_RECT, 1>(src, dst, kernel)" in erode["image_filter.cpp"]
+    assert "hls::Window<5, 5, unsigned char>" in erode["image_filter.cpp"]
+
+
+def test_regenerating_refuses_then_force_replaces(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    generate(load_config(DATA / "fpga_passthrough_rgb8.yaml"), out)
+    before = _tree(out)
+    with pytest.raises(GenerateError, match="--force"):
+        generate(load_config(DATA / "fpga_erode_mono8.yaml"), out)
+    assert _tree(out) == before  # nothing touched
+    (out / "notes.txt").write_text("mine")
+    (out / "csim_out").mkdir()
+    (out / "csim_out" / "output.bin").write_bytes(b"old")
+    result = generate(load_config(DATA / "fpga_erode_mono8.yaml"), out, force=True)
+    assert "csim_out/" in result.removed and "subscriber.cpp" in result.removed
+    assert result.kept == ("notes.txt",)
+    assert (out / "notes.txt").read_text() == "mine"
+    assert not (out / "csim_out").exists()
+    manifest = json.loads((out / MANIFEST).read_text())
+    assert manifest["config"] == "fpga_erode_mono8.yaml"
+    on_disk = set(_tree(out)) - {MANIFEST, "notes.txt"}
+    assert on_disk == set(manifest["files"])  # no file of the old generation remains
+    for name, digest in manifest["files"].items():
+        assert hashlib.sha256((out / name).read_bytes()).hexdigest() == digest
+    assert "IMG_ENCODING_LENGTH 5" in (out / "ros_node.h").read_text()  # mono8, not rgb8
+
+
+def test_refuses_foreign_directory_even_with_nothing_generated(tmp_path: Path) -> None:
+    (tmp_path / "main.c").write_text("int main(){}")
+    with pytest.raises(GenerateError, match="not written by rosfpga-lab"):
+        generate(load_config(DATA / "fpga_erode_mono8.yaml"), tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["main.c"]
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(GenerateError, match="not a directory"):
+        generate(load_config(DATA / "fpga_erode_mono8.yaml"), tmp_path / "file")
+
+
+def test_damaged_manifest_is_refused(tmp_path: Path) -> None:
+    generate(load_config(DATA / "fpga_erode_mono8.yaml"), tmp_path)
+    (tmp_path / MANIFEST).write_text(json.dumps({"files": {"../../etc/passwd": "x"}}))
+    with pytest.raises(GenerateError, match="outside the directory"):
+        generate(load_config(DATA / "fpga_erode_mono8.yaml"), tmp_path, force=True)
+    (tmp_path / MANIFEST).write_text("{not json")
+    with pytest.raises(GenerateError, match="damaged"):
+        generate(load_config(DATA / "fpga_erode_mono8.yaml"), tmp_path, force=True)
+
+
+def test_cli_generate_and_sloc(tmp_path: Path) -> None:
+    out = tmp_path / "proj"
+    cmd = [sys.executable, "-m", "rosfpga_lab", "generate", str(DATA / "fpga_dilate_rgba8.yaml"),
+           "-o", str(out)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    assert "rendering templates" in proc.stderr and "writing 16 files" in proc.stderr
+    assert f"make -C {out} csim" in proc.stdout
+    again = subprocess.run(cmd, capture_output=True, text=True)
+    assert again.returncode == 1 and "--force" in again.stderr
+    forced = subprocess.run(cmd + ["--force", "-q"], capture_output=True, text=True)
+    assert forced.returncode == 0 and forced.stdout == "" and forced.stderr == ""
+
+    table = subprocess.run([sys.executable, "-m", "rosfpga_lab", "sloc", str(out)],
+                           capture_output=True, text=True)
+    assert table.returncode == 0, table.stderr
+    counts = count_sloc(out)
+    lines = table.stdout.splitlines()
+    row = {line.split()[0]: line.split()[1:] for line in lines if line.split()[:1] in
+           (["subscriber"], ["publisher"], ["total"])}
+    assert row["subscriber"] == [str(counts.subscriber), "57", "415"]
+    assert row["publisher"] == [str(counts.publisher), "70", "445"]
+    assert row["total"] == [str(counts.total), "127", "860"]
+    assert counts.total == counts.subscriber + counts.publisher
+    missing = subprocess.run([sys.executable, "-m", "rosfpga_lab", "sloc", str(tmp_path)],
+                             capture_output=True, text=True)
+    assert missing.returncode == 1 and "subscriber.cpp" in missing.stderr
+
+
+def test_sloc_counts_like_table1() -> None:
+    text = (
+        "// a comment\n"
+        "\n"
+        "int a = 1;  // trailing comment\n"
+        "/* block\n"
+        "   still block */\n"
+        "int b = 2; /* inline */ int c = 3;\n"
+        "   \t\n"
+        "const char* s = \"// not a comment\";\n"
+        "const char* t = \"/* nor this */\";\n"
+        "char q = '\\'';  /* quote inside a char literal */\n"
+        "#pragma HLS PIPELINE II=1\n"
+        "/* one */ /* two */\n"
+        "}\n"
+    )
+    assert sloc(text) == 7
+    assert PAPER_TABLE1["total"] == (127, 860)
+    assert PAPER_TABLE1["subscriber"][0] + PAPER_TABLE1["publisher"][0] == 127
+
+
+def test_sloc_table_text() -> None:
+    from rosfpga_lab.hls.sloc import SlocTable
+
+    text = format_table(SlocTable(100, 40, {"image_filter.cpp": 12}), title="T")
+    assert text.splitlines()[0] == "T"
+    assert "total" in text and "140" in text and "860" in text and "image_filter.cpp" in text
+    with pytest.raises(HlsError):
+        count_sloc(ROOT / "no_such_dir")
