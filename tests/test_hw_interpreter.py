@@ -87,6 +87,14 @@ def test_byte_by_byte_states_and_pixel_output():
     assert interp.out.to_bytes() == IMG.tobytes()
 
 
+def test_trace_records_state_and_field_per_byte():
+    rows = Interpreter().trace(GOOD, limit=30)
+    assert rows[0] == (0, GOOD[0], "FRAME_LEN", "frame length")
+    assert rows[4] == (4, 7, "SEQ", "header.seq")
+    assert [r[3] for r in rows[20:26]] == ["header.frame_id"] * 6
+    assert rows[26][2:] == ("HEIGHT", "height")
+
+
 def test_two_frames_back_to_back_and_trailing_bytes():
     interp = Interpreter()
     other = tcpros_frame(image_msg(IMG[:1], "rgba8", seq=8))

@@ -117,7 +117,8 @@ def test_bad_frame_is_refused_and_the_next_frame_is_right(model, frame, error, f
 def test_bad_configuration_is_refused():
     for kwargs in ({"model": "rtl"}, {"op": "blur"}, {"encoding": "yuv422"}, {"width": 0},
                    {"ksize": (0, 3)}, {"seq": "random"}, {"clock_hz": 0}, {"rx_fifo_depth": 0},
-                   {"faults": ["drop"]}):
+                   {"faults": ["drop"]}, {"seq_start": -1}, {"stamp": (1, 2, 3)},
+                   {"stamp": (-1, 0)}, {"frame_id": 5}, {"frame_id": "x" * 1000}):
         with pytest.raises(PipelineConfigError):
             Pipeline(**kwargs)
     with pytest.raises(PipelineConfigError):
@@ -267,3 +268,25 @@ def test_output_frame_equals_what_a_rospy_publisher_sends(real_ros):
             res = Pipeline(model=model).process(frames[f"{encoding}/in"])
             assert res.fields.seq == 17 and res.fields.frame_id == "camera_" + encoding
             assert res.output_frame == frames[f"{encoding}/out"], (encoding, model)
+
+
+FAULTS = st.one_of(
+    st.builds(DropByte, index=st.integers(0, 120), tap=st.sampled_from(["rx", "pixels_in", "pixels_out"])),
+    st.builds(DuplicateByte, index=st.integers(0, 120),
+              tap=st.sampled_from(["rx", "pixels_in", "pixels_out"])),
+    st.builds(SwapByteOrder, tap=st.sampled_from(["axis_in", "axis_out"])),
+    st.builds(LoseTlast, line=st.integers(0, 5), tap=st.sampled_from(["axis_in", "axis_out"])),
+    st.builds(LoseTuser, tap=st.sampled_from(["axis_in", "axis_out"])),
+    st.builds(ShallowFifo, depth=st.integers(1, 200), burst_bytes=st.integers(1, 200)),
+)
+
+
+@given(images(max_side=5), st.lists(FAULTS, max_size=3))
+@settings(max_examples=120, deadline=None)
+def test_any_faults_end_the_same_way_in_both_models_and_never_hang(img_enc, faults):
+    """A result or a PipelineError (never another exception), identical in both models."""
+    image, encoding = img_enc
+    frame = tcpros_frame(image_msg(image, encoding, frame_id="f"))
+    outcome = both_models(faults, frame=frame)
+    if not isinstance(outcome, Exception) and not faults:
+        assert outcome.output_frame == expected_frame(image, encoding, frame_id="f")

@@ -205,6 +205,23 @@ class Interpreter:
                 f"the frame length ({self.values['frame_length']}) ends inside this field",
                 t.label, self._field_start, self.values["frame_length"]))
 
+    def trace(self, data: bytes, limit: int | None = None) -> list[tuple[int, int, str, str]]:
+        """Push bytes one at a time, recording ``(offset, byte, state, field label)`` before each.
+
+        For notebooks: a table of what the state machine did with every byte. Errors propagate
+        (the rows up to the bad byte are lost with them; trace a prefix to see them).
+
+        Args:
+            data: the bytes to push.
+            limit: stop after this many bytes (``None``: all of them).
+        """
+        rows = []
+        for byte in data[:limit] if limit is not None else data:
+            t = self.transition
+            rows.append((self.offset, byte, self.state, t.label if t else "(skipping)"))
+            self.push(byte)
+        return rows
+
     def feed(self, data: bytes) -> None:
         """Push every byte of ``data`` (stops at the first error, which propagates)."""
         for byte in data:

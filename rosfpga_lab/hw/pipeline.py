@@ -36,8 +36,8 @@ from rosfpga_lab.hw.morph import check_op, morph_fast, morph_reference
 from rosfpga_lab.hw.rx import check_rx, receive_fast_check, receive_reference
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
 from rosfpga_lab.hw.video import (
-    Mat, axivideo2mat_fast, axivideo2mat_reference, beats_to_fifo, mat2axivideo_fast,
-    mat2axivideo_reference, status_names,
+    Mat, axivideo2mat_fast, axivideo2mat_reference, mat2axivideo_fast, mat2axivideo_reference,
+    status_names,
 )
 
 MODELS = ("fast", "reference")
@@ -166,6 +166,15 @@ class Pipeline:
                 raise PipelineConfigError(f"{name} must be in 1..{limit}, got {value}")
         if clock_hz <= 0 or line_rate_bps <= 0:
             raise PipelineConfigError("clock_hz and line_rate_bps must be positive")
+        if not 0 <= seq_start < 2**32:
+            raise PipelineConfigError(f"seq_start must be a uint32, got {seq_start}")
+        if stamp is not None and (len(stamp) != 2 or not all(0 <= int(v) < 2**32 for v in stamp)):
+            raise PipelineConfigError(f"stamp must be (secs, nsecs), two uint32, got {stamp!r}")
+        if frame_id is not None and (not isinstance(frame_id, str)
+                                     or len(frame_id.encode("utf-8", "surrogateescape"))
+                                     > limits.MAX_FRAME_ID_BYTES):
+            raise PipelineConfigError(
+                f"frame_id must be a str of at most {limits.MAX_FRAME_ID_BYTES} bytes, got {frame_id!r}")
         self.ksize = check_op(op, ksize)
         self.width, self.height, self.encoding, self.op, self.model = width, height, encoding, op, model
         self.clock_hz, self.line_rate_bps = float(clock_hz), float(line_rate_bps)
