@@ -73,8 +73,14 @@ def test_header_policies_carry_or_set():
     frame = tcpros_frame(image_msg(image, "mono8", seq=77, stamp=(5, 6), frame_id="in"))
     res = Pipeline(seq="carry", stamp=(9, 10), frame_id="out").process(frame)
     assert res.output_frame == expected_frame(image, "mono8", seq=77, stamp=(9, 10), frame_id="out")
-    res = Pipeline(seq_start=100).process(frame)
-    assert decode_frame(res.output_frame)["header"]["seq"] == 100
+    pipe = Pipeline(seq_start=100)
+    assert decode_frame(pipe.process(frame).output_frame)["header"]["seq"] == 100
+    assert pipe.next_seq == 101
+    pipe.reset()
+    assert pipe.next_seq == 101
+    pipe.reset(seq=True)
+    assert decode_frame(pipe.process(frame).output_frame)["header"]["seq"] == 100
+    assert "op='dilate'" in repr(pipe)
 
 
 def test_image_frame_helper_matches_the_message_layer():
@@ -117,7 +123,7 @@ def test_bad_frame_is_refused_and_the_next_frame_is_right(model, frame, error, f
 def test_bad_configuration_is_refused():
     for kwargs in ({"model": "rtl"}, {"op": "blur"}, {"encoding": "yuv422"}, {"width": 0},
                    {"ksize": (0, 3)}, {"seq": "random"}, {"clock_hz": 0}, {"rx_fifo_depth": 0},
-                   {"faults": ["drop"]}, {"seq_start": -1}, {"stamp": (1, 2, 3)},
+                   {"faults": ["drop"]}, {"seq_start": -1}, {"stamp": (1, 2, 3)}, {"stamp": 5},
                    {"stamp": (-1, 0)}, {"frame_id": 5}, {"frame_id": "x" * 1000}):
         with pytest.raises(PipelineConfigError):
             Pipeline(**kwargs)

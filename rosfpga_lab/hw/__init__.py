@@ -15,12 +15,21 @@ Quick start::
     res.input_beats, res.output_beats    # Beats: tdata/tkeep/tuser/tlast numpy arrays
     res.cycles, res.latency              # per stage, at II=1
     res.total_cycles, res.frame_time_s, res.network_time_s, res.fifo_high_water, res.status
-    print(res.summary())
+    res.streams                          # what travelled on every tap between stages
+    print(res.summary())                 # cycles/latency table, frame time vs network time
+
+A bad frame raises a :class:`PipelineError` subclass naming the field and byte offset
+(:class:`FrameFieldError`, :class:`UnsupportedEncodingError`, :class:`FrameTruncatedError`,
+:class:`FrameLengthError`); a broken stream raises :class:`StreamStarvedError` or
+:class:`FifoOverflowError` (``.partial`` holds what was made so far). Either way every stage
+has been reset and the next good frame comes out right. ``Pipeline(model="reference")`` runs
+the byte/beat-at-a-time models (small images: a 160x120 frame takes about half a second).
 
 Stages (``reference`` / ``fast``), importable for notebooks:
 
 * receive FIFO: :func:`receive_reference` / :func:`receive_fast_check` (module ``rx``);
-* interpreter: :class:`Interpreter` (state machine over :data:`INTERPRETER_TABLE`),
+* interpreter: :class:`Interpreter` (state machine over :data:`INTERPRETER_TABLE`, printed
+  by :func:`format_table`; ``Interpreter().trace(frame)`` lists state and field per byte),
   :func:`interpret_reference` / :func:`interpret_fast`;
 * ``fifo2axi`` / ``axi2fifo``: :func:`fifo2axi_reference`, :func:`fifo2axi_fast`,
   :func:`axi2fifo_reference`, :func:`axi2fifo_fast` (packing rules in :data:`PIXEL_FORMATS`);

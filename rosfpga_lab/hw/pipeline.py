@@ -168,8 +168,15 @@ class Pipeline:
             raise PipelineConfigError("clock_hz and line_rate_bps must be positive")
         if not 0 <= seq_start < 2**32:
             raise PipelineConfigError(f"seq_start must be a uint32, got {seq_start}")
-        if stamp is not None and (len(stamp) != 2 or not all(0 <= int(v) < 2**32 for v in stamp)):
-            raise PipelineConfigError(f"stamp must be (secs, nsecs), two uint32, got {stamp!r}")
+        if stamp is not None:
+            try:
+                secs, nsecs = (int(v) for v in stamp)
+                good = 0 <= secs < 2**32 and 0 <= nsecs < 2**32
+            except (TypeError, ValueError):
+                good = False
+            if not good:
+                raise PipelineConfigError(f"stamp must be (secs, nsecs), two uint32, got {stamp!r}")
+            stamp = (secs, nsecs)
         if frame_id is not None and (not isinstance(frame_id, str)
                                      or len(frame_id.encode("utf-8", "surrogateescape"))
                                      > limits.MAX_FRAME_ID_BYTES):
@@ -192,9 +199,21 @@ class Pipeline:
         self._scratch_image: np.ndarray | None = None
         self.reset()
 
-    def reset(self) -> None:
-        """Reset every stage (the frame counter of the generator keeps counting)."""
+    def reset(self, *, seq: bool = False) -> None:
+        """Reset every stage.
+
+        Args:
+            seq: also restart the generator's frame counter (``seq_start`` comes next); by
+                default it keeps counting, as a publisher's does across a bad frame.
+        """
         self._interp = Interpreter(ByteFIFO(name="pixels_in"), self.width, self.height, self.encoding)
+        if seq:
+            self.frames_out = 0
+
+    def __repr__(self) -> str:
+        return (f"Pipeline(width={self.width}, height={self.height}, encoding={self.encoding!r}, "
+                f"op={self.op!r}, ksize={self.ksize}, model={self.model!r}, "
+                f"clock_hz={self.clock_hz:g}, faults={list(self.faults)})")
 
     def _scratch(self, shape: tuple[int, ...]) -> np.ndarray:
         if self._scratch_image is None or self._scratch_image.shape != shape:
