@@ -5,7 +5,8 @@ raster order; a *line buffer* keeps the last ``kh`` rows of every column; a ``kw
 *window* slides along the row, taking one new column from the line buffer per clock. Window
 cells outside the image hold ``None`` and are ignored, so each output is the maximum (dilate)
 or minimum (erode) over the part of the rectangle inside the image: exactly ``cv2.dilate`` /
-``cv2.erode`` with their default border. The anchor is the kernel centre (``k // 2``), as
+``cv2.erode`` with their default border (for a maximum or minimum, a replicated border, as
+HLS line-buffer filters often use, gives the same result). The anchor is the kernel centre (``k // 2``), as
 OpenCV's default; the output pixel at ``(r, c)`` can only be produced once input pixel
 ``(r + dy, c + dx)`` has arrived, so the loops run ``dy`` rows and ``dx`` columns past the
 image (the flush) and the output lags the input by ``dy`` lines and ``dx`` pixels.
