@@ -153,6 +153,8 @@ def both_models(faults, frame=FAULT_FRAME, **kwargs):
         return fast
     assert ref.output_frame == fast.output_frame and ref.status == fast.status
     assert ref.input_beats == fast.input_beats and ref.output_beats == fast.output_beats
+    assert ref.fifo_high_water == fast.fifo_high_water
+    assert np.array_equal(ref.input_image, fast.input_image)
     return fast
 
 
