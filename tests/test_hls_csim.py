@@ -254,3 +254,19 @@ def test_build_failure_quotes_the_compiler(tmp_path: Path) -> None:
     generate(load_config(tmp_path / "node.yaml"), tmp_path / "proj")
     with pytest.raises(CsimError, match="building the testbench .* failed"):
         build_csim(tmp_path / "proj")
+
+
+def test_builds_without_make(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    require_cxx()
+    import rosfpga_lab.hls.csim as csim
+
+    real_which = csim.shutil.which
+    monkeypatch.setattr(csim.shutil, "which", lambda name: None if name == "make" else real_which(name))
+    config = load_config(DATA / "fpga_passthrough_rgb8.yaml")
+    generate(config, tmp_path / "proj")
+    binary = build_csim(tmp_path / "proj")
+    frame = (tmp_path / "proj" / "tb_input.bin").read_bytes()
+    got = run_csim(tmp_path / "proj", frame, binary=binary)
+    assert got.output == (tmp_path / "proj" / "tb_expected.bin").read_bytes()
+    with pytest.raises(CsimError, match="no C\\+\\+ compiler"):
+        build_csim(tmp_path / "proj", cxx="no-such-g++")

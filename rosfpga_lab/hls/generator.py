@@ -27,7 +27,6 @@ import jinja2
 import numpy as np
 
 from rosfpga_lab import __version__
-from rosfpga_lab.hls import limits
 from rosfpga_lab.hls.config import NodeConfig
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
@@ -159,7 +158,7 @@ def pipeline_for(config: NodeConfig, model: str = "fast") -> Pipeline:
     ksize = (app.ksize, app.ksize) if op != "copy" else (1, 1)
     return Pipeline(width=config.image.width, height=config.image.height,
                     encoding=config.image.encoding, op=op, ksize=ksize, model=model,
-                    clock_hz=config.clock_mhz * 1e6)
+                    clock_hz=config.clock_mhz * 1e6, rx_fifo_depth=config.fifo.input_depth)
 
 
 def sample_image(config: NodeConfig) -> np.ndarray:

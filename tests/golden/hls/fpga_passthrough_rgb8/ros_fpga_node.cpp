@@ -15,8 +15,8 @@ int ros_fpga_node(byte_stream& in, byte_stream& out) {
     static pixel_stream to_filter("to_filter");
     static pixel_stream from_filter("from_filter");
     static meta_stream meta("meta");
-    HLS_PRAGMA(HLS STREAM variable = to_filter depth = 16)
-    HLS_PRAGMA(HLS STREAM variable = from_filter depth = 16)
+    HLS_PRAGMA(HLS STREAM variable = to_filter depth = AXIS_FIFO_DEPTH)
+    HLS_PRAGMA(HLS STREAM variable = from_filter depth = AXIS_FIFO_DEPTH)
     int status = subscriber(in, to_filter, meta);
     if (status != SUB_OK) return status;
     image_filter(to_filter, from_filter);

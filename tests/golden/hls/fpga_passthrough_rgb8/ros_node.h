@@ -41,6 +41,12 @@ static const char IMG_ENCODING[IMG_ENCODING_LENGTH + 1] = "rgb8";
 #define HLS_PRAGMA(x)
 #endif
 
+// FIFO depths of the block design: the 8-bit FIFO IP cores between the network and the
+// circuit (bytes), and the AXI4-Stream FIFOs around the application (beats).
+#define RX_FIFO_DEPTH 2048
+#define TX_FIFO_DEPTH 2048
+#define AXIS_FIFO_DEPTH 16
+
 typedef ap_uint<8> byte_t;                   // one entry of the 8-bit FIFOs
 typedef hls::stream<byte_t> byte_stream;
 typedef ap_axiu<32, 1, 1, 1> pixel_beat;     // TDATA, TKEEP, TSTRB, TUSER, TLAST, TID, TDEST
