@@ -182,3 +182,40 @@ def test_stop_leaves_no_threads() -> None:
     proxy(m).getUri("/x")
     m.stop()
     assert set(threading.enumerate()) <= before
+
+
+# ----------------------------------------------------------------------------- fuzzing
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from rosfpga_lab.errors import LabError  # noqa: E402
+
+XMLRPC_PIECES = [b"<?xml version='1.0'?>", b"<methodCall>", b"</methodCall>", b"<methodName>",
+                 b"</methodName>", b"<params>", b"<param>", b"<value>", b"<int>", b"12", b"</int>",
+                 b"<string>", b"x", b"</string>", b"<array><data>", b"</data></array>", b"<struct>",
+                 b"<member><name>a</name>", b"</member>", b"</struct>", b"</value>", b"</param>",
+                 b"</params>", b"<base64>", b"!!", b"<double>", b"nan", b"<!ENTITY a 'b'>", b"&a;",
+                 b"<boolean>", b"2", b"<nil/>", b"\xff"]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.one_of(st.binary(max_size=200),
+                 st.lists(st.sampled_from(XMLRPC_PIECES), max_size=25).map(b"".join)))
+def test_fuzz_xmlrpc_parser_only_lab_errors(data: bytes) -> None:
+    try:
+        parse_xmlrpc(data)
+    except LabError:
+        pass
+
+
+def test_fuzz_server_survives_garbage(master) -> None:
+    import random
+
+    rnd = random.Random(7)
+    for _ in range(30):
+        junk = bytes(rnd.randrange(256) for _ in range(rnd.randrange(1, 300)))
+        try:
+            raw_http(master.port, junk + b"\r\n\r\n")
+        except OSError:
+            pass
+    assert proxy(master).getUri("/x")[0] == 1

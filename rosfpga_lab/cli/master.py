@@ -1,0 +1,49 @@
+"""``rosfpga-lab master``: run the lab's embedded ROS master (like ``roscore``'s master)."""
+
+from __future__ import annotations
+
+import argparse
+import threading
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``master`` sub-command."""
+    p = subparsers.add_parser(
+        "master", help="run a ROS master + parameter server (like roscore)",
+        description="Run the lab's embedded ROS 1 master and parameter server. Real rospy, "
+        "roscpp and rostopic work with it: export the ROS_MASTER_URI it prints. It binds "
+        "127.0.0.1 unless --host says otherwise; ROS 1 has no authentication, so binding to "
+        "a network interface lets anyone on that network control your nodes.")
+    p.add_argument("--port", type=int, default=11311, help="TCP port (default: 11311, roscore's)")
+    p.add_argument("--host", default="127.0.0.1",
+                   help="address to bind and advertise (default: 127.0.0.1; 0.0.0.0 = every "
+                   "interface, with a warning)")
+    p.add_argument("--trace", action="store_true",
+                   help="print every XML-RPC call the master serves")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Serve until Ctrl-C."""
+    from rosfpga_lab.graph import EmbeddedMaster
+
+    master = EmbeddedMaster(host=args.host, port=args.port)
+    master.start()
+    print(f"ROS master running; export ROS_MASTER_URI={master.uri}", flush=True)
+    stop = threading.Event()
+    seen = 0
+    try:
+        while not stop.wait(0.2):
+            if args.trace:
+                events = master.trace.events
+                for ev in events[seen:] if len(events) >= seen else events:
+                    if ev.role == "server":
+                        code = ev.result[0] if isinstance(ev.result, list) and ev.result else ev.result
+                        print(f"{ev.src} -> {ev.method}{tuple(ev.args[1:]) if ev.args else ()} = {code}",
+                              flush=True)
+                seen = len(events)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        master.stop()
+    return 0

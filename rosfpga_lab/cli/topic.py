@@ -1,0 +1,160 @@
+"""``rosfpga-lab topic``: list, info, echo, pub and hz, like ``rostopic``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+import time
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``topic`` sub-command and its actions."""
+    p = subparsers.add_parser(
+        "topic", help="inspect and use ROS topics (like rostopic)",
+        description="Inspect and use topics of a running ROS graph (the lab's or real ROS). "
+        "The master is --master-uri, else ROS_MASTER_URI, else http://127.0.0.1:11311/.")
+    p.add_argument("--master-uri", help="master to talk to (default: ROS_MASTER_URI or "
+                   "http://127.0.0.1:11311/)")
+    sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
+    ls = sub.add_parser("list", help="list topics", description="List the topics the master knows.")
+    ls.add_argument("-v", "--verbose", action="store_true", help="show types and counts")
+    info = sub.add_parser("info", help="type, publishers, subscribers",
+                          description="Show a topic's type, publishers and subscribers.")
+    info.add_argument("topic", help="topic name, e.g. /chatter")
+    echo = sub.add_parser("echo", help="print messages",
+                          description="Print the messages published on a topic.")
+    echo.add_argument("topic", help="topic name")
+    echo.add_argument("-n", type=int, default=0, help="exit after N messages (default: forever)")
+    echo.add_argument("--hex", action="store_true", help="print the raw body bytes in hex instead")
+    echo.add_argument("--timeout", type=float, default=0.0,
+                      help="give up after this many seconds (default: never)")
+    pub = sub.add_parser("pub", help="publish a message",
+                         description="Publish a message, e.g.: topic pub /chatter std_msgs/String "
+                         "'data: hello'. Arguments are YAML: one mapping, or field values in order.")
+    pub.add_argument("topic", help="topic name")
+    pub.add_argument("type", help="message type, e.g. std_msgs/String")
+    pub.add_argument("values", nargs="*", help="YAML mapping or field values")
+    pub.add_argument("-r", "--rate", type=float, default=0.0, help="publish at this rate (Hz)")
+    pub.add_argument("-1", "--once", action="store_true", help="publish once, wait 3 s, exit")
+    pub.add_argument("-l", "--latch", action="store_true", help="latch the message")
+    pub.add_argument("-n", "--count", type=int, default=0, help="with --rate: stop after N messages")
+    hz = sub.add_parser("hz", help="measure the publishing rate",
+                        description="Print the rate at which messages arrive on a topic.")
+    hz.add_argument("topic", help="topic name")
+    hz.add_argument("-w", "--window", type=int, default=1000, help="window size in messages")
+    hz.add_argument("--duration", type=float, default=0.0,
+                    help="stop after this many seconds (default: Ctrl-C)")
+    p.set_defaults(func=run)
+
+
+def _node(uri: str, kind: str):
+    from rosfpga_lab.graph import Node
+
+    return Node(f"/rosfpga_lab_topic_{kind}_{int(time.time() * 1000) % 10**8}", master_uri=uri)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Dispatch the action."""
+    from rosfpga_lab.graph import tools
+
+    uri = tools.pick_master_uri(args.master_uri)
+    if args.action == "list":
+        print(tools.format_topic_list(uri, args.verbose))
+        return 0
+    if args.action == "info":
+        print(tools.format_topic_info(uri, args.topic))
+        return 0
+    if args.action == "echo":
+        return _echo(args, uri)
+    if args.action == "pub":
+        return _pub(args, uri)
+    return _hz(args, uri)
+
+
+def _echo(args: argparse.Namespace, uri: str) -> int:
+    from rosfpga_lab.graph import GraphError, tools
+
+    type_name = tools.topic_type(uri, args.topic)
+    node = _node(uri, "echo")
+    done = threading.Event()
+    count = [0]
+
+    def show(body, info) -> None:
+        if done.is_set():
+            return
+        if args.hex:
+            print(bytes(body).hex(), flush=True)
+        else:
+            from rosfpga_lab.msg import deserialize
+
+            print(tools.format_message(deserialize(node.registry, type_name, body)), flush=True)
+        print("---", flush=True)
+        count[0] += 1
+        if args.n and count[0] >= args.n:
+            done.set()
+
+    try:
+        known = type_name in node.registry.types() if hasattr(node.registry, "types") else True
+        if not known and not args.hex:
+            raise GraphError(f"type {type_name} is not in the lab's registry; use --hex to see "
+                             "the raw bytes")
+        node.subscribe(args.topic, type_name if known else "*", show, raw=True, queue_size=100,
+                       md5sum=None if known else "*")
+        done.wait(args.timeout or None)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.shutdown()
+    return 0 if (not args.n or count[0] >= args.n) else 1
+
+
+def _pub(args: argparse.Namespace, uri: str) -> int:
+    from rosfpga_lab.graph import tools
+
+    node = _node(uri, "pub")
+    try:
+        value = tools.parse_message_value(node.registry, args.type, args.values)
+        pub = node.advertise(args.topic, args.type, latch=args.latch or args.once or not args.rate)
+        if args.rate > 0:
+            print(f"publishing to {args.topic} at {args.rate} Hz (Ctrl-C to stop)", file=sys.stderr)
+            n = 0
+            while not args.count or n < args.count:
+                pub.publish(value)
+                n += 1
+                time.sleep(1.0 / args.rate)
+        else:
+            pub.publish(value)
+            print(f"publishing and latching message{' for 3.0 seconds' if args.once else '. Press ctrl-C to terminate'}",
+                  file=sys.stderr)
+            if args.once:
+                time.sleep(3.0)
+            else:
+                while True:
+                    time.sleep(1.0)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.shutdown()
+    return 0
+
+
+def _hz(args: argparse.Namespace, uri: str) -> int:
+    from rosfpga_lab.graph import tools
+
+    meter = tools.RateMeter(args.window)
+    node = _node(uri, "hz")
+    try:
+        node.subscribe(args.topic, "*", lambda body, info: meter.tick(), raw=True, queue_size=0,
+                       md5sum="*")
+        print(f"subscribed to [{args.topic}]", flush=True)
+        start = time.monotonic()
+        while not args.duration or time.monotonic() - start < args.duration:
+            time.sleep(1.0)
+            report = meter.report()
+            print(report if report else "no new messages", flush=True)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.shutdown()
+    return 0

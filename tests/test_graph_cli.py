@@ -1,0 +1,125 @@
+"""``rosfpga-lab master`` and ``rosfpga-lab topic`` end to end, as subprocesses."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from realros import free_port, stop_process, wait_for_master
+from rosfpga_lab.graph import EmbeddedMaster, Node
+from rosfpga_lab.graph.tools import RateMeter, format_message, parse_message_value
+from rosfpga_lab.msg import Time, default_registry
+
+pytestmark = pytest.mark.timeout(90)
+
+
+def cli(*args: str, timeout: float = 30) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
+    return subprocess.run([sys.executable, "-m", "rosfpga_lab", *args], capture_output=True,
+                          text=True, timeout=timeout, env=env)
+
+
+@pytest.fixture
+def graph():
+    with EmbeddedMaster(port=0) as m:
+        talker = Node("/talker", master=m)
+        listener = Node("/listener", master=m)
+        pub = talker.advertise("/chatter", "std_msgs/String")
+        sub = listener.subscribe("/chatter", "std_msgs/String")
+        stop = threading.Event()
+
+        def loop() -> None:
+            while not stop.wait(0.05):
+                pub.publish({"data": "hi"})
+
+        t = threading.Thread(target=loop, daemon=True)
+        t.start()
+        yield m, talker, listener, sub
+        stop.set()
+        t.join(5)
+        talker.shutdown()
+        listener.shutdown()
+
+
+def test_master_cli_serves_and_stops() -> None:
+    port = free_port()
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
+    proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "master", "--port", str(port)],
+                            stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        assert line.strip() == f"ROS master running; export ROS_MASTER_URI=http://127.0.0.1:{port}/"
+        wait_for_master(f"http://127.0.0.1:{port}/", timeout=10)
+        node = Node("/probe", master_uri=f"http://127.0.0.1:{port}/")
+        node.advertise("/x", "std_msgs/String")
+        out = cli("topic", "--master-uri", f"http://127.0.0.1:{port}/", "list")
+        assert out.stdout.split() == ["/x"]
+        node.shutdown()
+    finally:
+        stop_process(proc)
+        proc.stdout.close()  # type: ignore[union-attr]
+
+
+def test_topic_list_info(graph) -> None:
+    m, talker, listener, _ = graph
+    out = cli("topic", "--master-uri", m.uri, "list", "-v")
+    assert out.returncode == 0, out.stderr
+    assert " * /chatter [std_msgs/String] 1 publisher" in out.stdout
+    assert " * /chatter [std_msgs/String] 1 subscriber" in out.stdout
+    info = cli("topic", "--master-uri", m.uri, "info", "/chatter").stdout
+    assert info.startswith("Type: std_msgs/String\n")
+    assert f" * /talker ({talker.uri})" in info and f" * /listener ({listener.uri})" in info
+
+
+def test_topic_echo_and_hz(graph) -> None:
+    m = graph[0]
+    out = cli("topic", "--master-uri", m.uri, "echo", "-n", "2", "--timeout", "20", "/chatter")
+    assert out.returncode == 0, out.stderr
+    assert out.stdout == 'data: "hi"\n---\n' * 2
+    hexed = cli("topic", "--master-uri", m.uri, "echo", "-n", "1", "--hex", "/chatter").stdout
+    assert hexed.split()[0] == "020000006869"
+    hz = cli("topic", "--master-uri", m.uri, "hz", "--duration", "2.5", "/chatter").stdout
+    rates = [float(line.split(":")[1]) for line in hz.splitlines() if line.startswith("average rate")]
+    assert rates and all(5 < r < 40 for r in rates), hz
+
+
+def test_topic_pub_reaches_a_lab_subscriber() -> None:
+    with EmbeddedMaster(port=0) as m:
+        node = Node("/listener", master=m)
+        try:
+            sub = node.subscribe("/cmd", "std_msgs/String")
+            out = cli("topic", "--master-uri", m.uri, "pub", "-1", "/cmd", "std_msgs/String", "data: go")
+            assert out.returncode == 0, out.stderr
+            assert sub.last is not None and sub.last[0] == {"data": "go"}
+        finally:
+            node.shutdown()
+
+
+def test_topic_errors_are_clear() -> None:
+    out = cli("topic", "--master-uri", f"http://127.0.0.1:{free_port()}/", "list")
+    assert out.returncode == 1 and "cannot reach the ROS master" in out.stderr
+    with EmbeddedMaster(port=0) as m:
+        out = cli("topic", "--master-uri", m.uri, "info", "/nope")
+        assert out.returncode == 1 and "topic /nope is unknown" in out.stderr
+
+
+def test_format_and_parse_helpers() -> None:
+    reg = default_registry()
+    v = parse_message_value(reg, "sensor_msgs/Image", ["{header: {frame_id: cam}, width: 2, encoding: rgba8}"])
+    assert v["header"]["frame_id"] == "cam" and v["width"] == 2 and v["height"] == 0
+    v["header"]["stamp"] = Time(3, 4)
+    text = format_message(v)
+    assert "header: \n  seq: 0\n  stamp: \n    secs: 3\n    nsecs:         4\n  frame_id: \"cam\"" in text
+    assert parse_message_value(reg, "std_msgs/String", ["hello"]) == {"data": "hello"}
+    with pytest.raises(Exception, match="no field 'nope'"):
+        parse_message_value(reg, "std_msgs/String", ["{nope: 1}"])
+    meter = RateMeter()
+    for t in (0.0, 0.1, 0.2, 0.3):
+        meter.tick(t)
+    assert meter.report().startswith("average rate: 10.000")
