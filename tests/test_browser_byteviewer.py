@@ -17,6 +17,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+from collections.abc import Iterator
 from pathlib import Path
 
 import nbformat
@@ -93,34 +94,61 @@ def _stop_server(proc: subprocess.Popen, base: str) -> None:
             proc.wait(10)
 
 
-@pytest.mark.browser
-@pytest.mark.slow
-@pytest.mark.timeout(180)
-def test_click_a_byte_in_jupyterlab_names_its_field(tmp_path: Path) -> None:
+class Lab:
+    """A JupyterLab server and a Chromium context, both on loopback and in temporary dirs."""
+
+    def __init__(self, root: Path, base: str, browser: object) -> None:
+        self.root, self.base, self.browser = root, base, browser
+        self.errors: list[str] = []
+
+    def run_notebook(self, name: str, cells: list[str]) -> object:
+        """Write a notebook, open it in a new tab, run all cells; return the page."""
+        nb = nbformat.v4.new_notebook()
+        nb.cells = [nbformat.v4.new_code_cell(c) for c in cells]
+        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+        nbformat.write(nb, self.root / name)
+        page = self.browser.new_page()
+        page.set_default_timeout(60_000)
+        page.on("pageerror", lambda exc: self.errors.append(str(exc)))
+        page.goto(f"{self.base}lab/tree/{name}?reset&token={TOKEN}")
+        page.wait_for_function("window.jupyterapp && window.jupyterapp.shell.currentWidget"
+                               " && window.jupyterapp.shell.currentWidget.sessionContext"
+                               " && window.jupyterapp.shell.currentWidget.sessionContext.session"
+                               " && window.jupyterapp.shell.currentWidget.sessionContext.session.kernel")
+        page.evaluate("window.jupyterapp.shell.currentWidget.sessionContext.ready")
+        page.evaluate("window.jupyterapp.commands.execute('notebook:run-all-cells')")
+        return page
+
+    def screenshot(self, page: object, path: Path) -> None:
+        page.screenshot(path=str(path), full_page=True)
+        assert path.stat().st_size > 10_000
+        keep = os.environ.get("ROSFPGA_SCREENSHOT_DIR")
+        if keep:
+            shutil.copy(path, Path(keep) / path.name)
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Lab]:
     _require_browser()
     from playwright.sync_api import sync_playwright
 
-    notebooks = tmp_path / "notebooks"
+    tmp = tmp_path_factory.mktemp("jupyterlab")
+    notebooks = tmp / "notebooks"
     notebooks.mkdir()
-    nb = nbformat.v4.new_notebook()
-    nb.cells = [nbformat.v4.new_code_cell(BUILD_CELL), nbformat.v4.new_code_cell(REPORT_CELL)]
-    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-    nbformat.write(nb, notebooks / "smoke.ipynb")
-
     env = {k: v for k, v in os.environ.items() if not k.startswith(("JUPYTER", "IPYTHON"))}
     for name in ("JUPYTER_CONFIG_DIR", "JUPYTER_RUNTIME_DIR", "JUPYTER_DATA_DIR", "IPYTHONDIR",
                  "JUPYTERLAB_SETTINGS_DIR", "JUPYTERLAB_WORKSPACES_DIR"):
-        path = tmp_path / name.lower()
+        path = tmp / name.lower()
         path.mkdir()
         env[name] = str(path)
     env["JUPYTER_PLATFORM_DIRS"] = "1"
     # answer JupyterLab's "get news?" question with no, so nothing is fetched and no toast covers the page
-    settings = tmp_path / "jupyterlab_settings_dir" / "@jupyterlab" / "apputils-extension"
+    settings = tmp / "jupyterlab_settings_dir" / "@jupyterlab" / "apputils-extension"
     settings.mkdir(parents=True)
     (settings / "notification.jupyterlab-settings").write_text(json.dumps({"fetchNews": "false"}))
     port = free_port()
     base = f"http://127.0.0.1:{port}/"
-    log = tmp_path / "jupyterlab.log"
+    log = tmp / "jupyterlab.log"
     with open(log, "wb") as log_file:
         server = subprocess.Popen(
             [sys.executable, "-m", "jupyterlab", "--no-browser", f"--port={port}", "--port-retries=0",
@@ -135,53 +163,99 @@ def test_click_a_byte_in_jupyterlab_names_its_field(tmp_path: Path) -> None:
         _wait_http(f"{base}api/status?token={TOKEN}", 60, server, log)
         with sync_playwright() as pw:
             browser = pw.chromium.launch_persistent_context(
-                str(tmp_path / "chromium-profile"), executable_path=CHROMIUM, headless=True,
+                str(tmp / "chromium-profile"), executable_path=CHROMIUM, headless=True,
                 args=CHROMIUM_ARGS, viewport={"width": 1400, "height": 900},
             )
             try:
-                page = browser.pages[0] if browser.pages else browser.new_page()
-                page.set_default_timeout(60_000)
-                page.goto(f"{base}lab/tree/smoke.ipynb?reset&token={TOKEN}")
-                page.wait_for_function("window.jupyterapp && window.jupyterapp.shell.currentWidget"
-                                       " && window.jupyterapp.shell.currentWidget.sessionContext"
-                                       " && window.jupyterapp.shell.currentWidget.sessionContext.session"
-                                       " && window.jupyterapp.shell.currentWidget.sessionContext.session.kernel")
-                page.evaluate("window.jupyterapp.shell.currentWidget.sessionContext.ready")
-                page.evaluate("window.jupyterapp.commands.execute('notebook:run-all-cells')")
-
-                byte = page.locator(f'.rfl-bv .rfl-bv-hex .b[data-off="{HEIGHT_OFFSET}"]')
-                byte.wait_for(state="visible")
-                byte.click()
-                info = page.locator(".rfl-bv-info")
-                page.wait_for_function(
-                    "document.querySelector('.rfl-bv-info').textContent.includes('height')")
-                text = info.text_content()
-                assert "height" in text and "uint32" in text, text
-                assert f"offset {HEIGHT_OFFSET}" in text and "size 4" in text and "value 3" in text, text
-                # all four bytes of `height` are highlighted, and nothing else
-                lit = page.eval_on_selector_all(".rfl-bv-hex .b.hl", "els => els.map(e => Number(e.dataset.off))")
-                assert lit == list(range(HEIGHT_OFFSET, HEIGHT_OFFSET + 4)), lit
-                # the click reached the kernel: re-run the report cell and read its output
-                page.evaluate("""() => { const nb = window.jupyterapp.shell.currentWidget;
-                                          nb.content.activeCellIndex = 1;
-                                          return window.jupyterapp.commands.execute('notebook:run-cell'); }""")
-                page.wait_for_function(
-                    "[...document.querySelectorAll('.jp-OutputArea-output')]"
-                    ".some(e => e.textContent.includes('SELECTED height'))")
-                outputs = page.eval_on_selector_all(".jp-OutputArea-output", "els => els.map(e => e.textContent)")
-                assert any(f"SELECTED height {HEIGHT_OFFSET} 4" in o for o in outputs), outputs
-                # the field list selects the same way: click `width` in the list
-                page.locator('.rfl-bv-list tr[data-i="6"]').click()
-                page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.includes('width')")
-                lit = page.eval_on_selector_all(".rfl-bv-hex .b.hl", "els => els.map(e => Number(e.dataset.off))")
-                assert lit == list(range(HEIGHT_OFFSET + 4, HEIGHT_OFFSET + 8)), lit
-                shot = tmp_path / "byteviewer.png"
-                page.screenshot(path=str(shot), full_page=True)
-                assert shot.stat().st_size > 10_000
-                keep = os.environ.get("ROSFPGA_SCREENSHOT_DIR")
-                if keep:
-                    shutil.copy(shot, Path(keep) / shot.name)
+                yield Lab(notebooks, base, browser)
             finally:
                 browser.close()
     finally:
         _stop_server(server, base)
+
+
+def _highlighted(page: object) -> list[int]:
+    return page.eval_on_selector_all(".rfl-bv-hex .b.hl", "els => els.map(e => Number(e.dataset.off))")
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+@pytest.mark.timeout(120)
+def test_click_a_byte_in_jupyterlab_names_its_field(lab: Lab, tmp_path: Path) -> None:
+    page = lab.run_notebook("byteviewer.ipynb", [BUILD_CELL, REPORT_CELL])
+    byte = page.locator(f'.rfl-bv .rfl-bv-hex .b[data-off="{HEIGHT_OFFSET}"]')
+    byte.wait_for(state="visible")
+    byte.click()
+    page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.includes('height')")
+    text = page.locator(".rfl-bv-info").text_content()
+    assert "height" in text and "uint32" in text, text
+    assert f"offset {HEIGHT_OFFSET}" in text and "size 4" in text and "value 3" in text, text
+    assert _highlighted(page) == list(range(HEIGHT_OFFSET, HEIGHT_OFFSET + 4))  # its four bytes only
+    # the click reached the kernel: re-run the report cell and read its output
+    page.evaluate("""() => { const nb = window.jupyterapp.shell.currentWidget;
+                              nb.content.activeCellIndex = 1;
+                              return window.jupyterapp.commands.execute('notebook:run-cell'); }""")
+    page.wait_for_function("[...document.querySelectorAll('.jp-OutputArea-output')]"
+                           ".some(e => e.textContent.includes('SELECTED height'))")
+    outputs = page.eval_on_selector_all(".jp-OutputArea-output", "els => els.map(e => e.textContent)")
+    assert any(f"SELECTED height {HEIGHT_OFFSET} 4" in o for o in outputs), outputs
+    # the field list selects the same way: click `width` in the list
+    page.locator('.rfl-bv-list tr[data-i="6"]').click()
+    page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.includes('width')")
+    assert _highlighted(page) == list(range(HEIGHT_OFFSET + 4, HEIGHT_OFFSET + 8))
+    lab.screenshot(page, tmp_path / "byteviewer.png")
+    assert lab.errors == []
+    page.close()
+
+
+OTHERS_CELL = r"""
+import struct
+import numpy as np
+from rosfpga_lab.widgets import SeqEvent, SequenceDiagram, ImageDiffViewer, BeatViewer, LiveView
+
+header = struct.pack("<I", 27) + struct.pack("<I", 11) + b"callerid=/a" + struct.pack("<I", 8) + b"topic=/t"
+diagram = SequenceDiagram([
+    SeqEvent("/talker", "/master", "registerPublisher", b"POST /RPC2 HTTP/1.1\r\n\r\n", 0.0, "xmlrpc"),
+    SeqEvent("/listener", "/talker", "TCPROS header", header, 0.004, "tcpros_header"),
+])
+display(diagram)
+ref = (np.arange(8 * 8 * 3) % 256).astype(np.uint8).reshape(8, 8, 3)
+out = ref.copy(); out[2, 5] = 0
+display(ImageDiffViewer(out, ref, ref))
+td = np.arange(12, dtype=np.uint32)
+display(BeatViewer(tdata=td, tkeep=0b0111, tuser=td == 0, tlast=td % 4 == 3, width=4, height=3, bytes_per_pixel=3))
+live = LiveView(max_fps=5, trailing=False)
+display(live)
+live.update(ref)
+"""
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+@pytest.mark.timeout(120)
+def test_other_widgets_render_and_a_sequence_arrow_opens_its_bytes(lab: Lab, tmp_path: Path) -> None:
+    page = lab.run_notebook("others.ipynb", [OTHERS_CELL])
+    arrow = page.locator('.rfl-svgpane g[data-index="1"] text').first  # the arrow's label
+    try:
+        arrow.wait_for(state="visible", timeout=20_000)
+    except Exception:
+        lab.screenshot(page, tmp_path / "failure.png")
+        raise
+    arrow.click()
+    # the byte viewer below the diagram now shows the header's fields
+    page.wait_for_function("[...document.querySelectorAll('.rfl-bv-list td')].some(e => e.textContent === 'callerid')")
+    page.locator('.rfl-bv .rfl-bv-hex .b[data-off="10"]').click()
+    page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.includes('callerid')")
+    assert "value '/a'" in page.locator(".rfl-bv-info").text_content()
+    assert page.locator('.rfl-svgpane g.sel[data-index="1"]').count() == 1
+    # image diff, beat viewer and live view drew their images and tables
+    page.wait_for_function("document.querySelectorAll('.jp-OutputArea-output img').length >= 5")
+    text = page.locator(".jp-OutputArea").first.text_content()
+    assert "1 of 64 pixels differ" in text and "12 beats carrying 36 bytes" in text and "1 frames received" in text
+    lab.screenshot(page, tmp_path / "widgets.png")
+    page.locator(".jp-OutputArea-output img").first.scroll_into_view_if_needed()
+    lab.screenshot(page, tmp_path / "widgets-2.png")
+    page.locator(".jp-OutputArea-output img").last.scroll_into_view_if_needed()
+    lab.screenshot(page, tmp_path / "widgets-3.png")
+    assert lab.errors == []
+    page.close()

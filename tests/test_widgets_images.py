@@ -88,6 +88,18 @@ def test_zoom_region_and_value_tables() -> None:
         d.zoom_html(10, 0)
 
 
+def test_zoom_box_is_outlined_outside_the_region_on_the_enlarged_view() -> None:
+    ref = np.zeros((10, 10), np.uint8)
+    d = FrameDiff(ref, ref)
+    png = d.diff_png(max_width=40, box=(2, 3, 4, 5))  # enlarged 4x: region covers x 8..19, y 12..23
+    img = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)[:, :, ::-1]
+    blue = (img == (0, 0, 255)).all(axis=2)
+    assert img.shape == (40, 40, 3)
+    assert blue[11, 7:21].all() and blue[24, 7:21].all() and blue[11:25, 7].all() and blue[11:25, 20].all()
+    assert not blue[12:24, 8:20].any()  # the region's own pixels stay visible
+    assert blue.sum() == 2 * 14 + 2 * 12
+
+
 def test_static_html_is_self_contained() -> None:
     ref = _image(6, 8)
     out = ref.copy()

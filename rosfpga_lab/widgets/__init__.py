@@ -9,6 +9,7 @@ exported notebooks and GitHub's notebook view. Quick reference::
     W.message_viewer("sensor_msgs/Image", body)       # fields from rosfpga_lab.msg.field_layout
     W.ByteViewer(hdr, W.spans_from_connection_header(hdr))   # TCPROS connection header
     W.ByteViewer(req, W.spans_from_http(req))         # HTTP / XML-RPC request or response
+    W.view_bytes(raw, "tcpros_frame", "sensor_msgs/Image")   # fields chosen by kind
     W.ImageDiffViewer(output, reference, input)       # or frames=[(input, output, reference), ...]
     W.BeatViewer(beats, width=w, height=h, bytes_per_pixel=4)  # hw Beats (tdata/tkeep/tuser/tlast)
     W.SequenceDiagram(trace)                          # graph Trace or [SeqEvent(src, dst, label, raw, t, kind)]
@@ -26,6 +27,7 @@ from rosfpga_lab.widgets.byte_sources import (
     spans_from_field_layout,
     spans_from_frame,
     spans_from_http,
+    view_bytes,
 )
 from rosfpga_lab.widgets.byteview import ByteMap, ByteViewer, Span, as_span
 from rosfpga_lab.widgets.imagediff import FrameDiff, ImageDiffViewer
@@ -47,5 +49,5 @@ __all__ = [
     "Throttle", "WidgetError", "as_span", "events_from_trace", "in_notebook", "message_spans",
     "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
-    "spans_from_http", "track",
+    "spans_from_http", "track", "view_bytes",
 ]

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import base64
 import html
-import itertools
 from typing import Any
 
 import numpy as np
@@ -102,14 +101,6 @@ def hex_bytes(data: bytes, limit: int = 16) -> str:
     """``data`` as spaced hex, cut after ``limit`` bytes."""
     text = " ".join(f"{b:02x}" for b in data[:limit])
     return text + (" \u2026" if len(data) > limit else "")
-
-
-_ids = itertools.count(1)
-
-
-def unique_id(prefix: str) -> str:
-    """An id unique within this process, for scoping static HTML."""
-    return f"{prefix}{next(_ids)}"
 
 
 def as_image(array: Any, name: str = "image") -> np.ndarray:

@@ -195,7 +195,7 @@ class BeatMap:
         """An HTML table of beats ``start .. start+count-1``; TUSER/TLAST rows coloured, wrong ones red."""
         eu, el = self.expected_markers()
         stop = min(len(self), start + count)
-        rows = ['<table style="border-collapse:collapse;font-family:monospace;font-size:12px">'
+        rows = ['<table style="border-collapse:collapse;font-family:monospace;font-size:12px" cellpadding="2">'
                 "<tr><th>beat</th><th>tdata</th><th>tkeep</th><th>tuser</th><th>tlast</th><th>pixels (x, y)</th></tr>"]
         for i in range(max(0, start), stop):
             def flag(actual: bool, expected: bool, colour: str) -> str:
@@ -234,11 +234,19 @@ class BeatMap:
                        f'{x0 + cw - 6},{rh + 4} {x0 + cw - 3},{rh + 11} {x0 + cw - 6},{rh + 18} {x0 + 6},{rh + 18}"/>')
             out.append(f'<text x="{x0 + 8}" y="{rh + 15}">{self._word(i):0{2 * self.bus_bytes}x}</text>')
             out.append(f'<text x="{x0 + 8}" y="{2 * rh + 15}">{self._keep(i):0{self.bus_bytes}b}</text>')
-            for r, sig in ((3, self.tuser), (4, self.tlast)):
-                y = rh * r + (6 if sig[i] else rh - 4)
-                colour = "#070" if sig[i] else "#555"
-                out.append(f'<line x1="{x0}" y1="{y}" x2="{x0 + cw}" y2="{y}" stroke="{colour}" stroke-width="2"/>')
             out.append(f'<text x="{x0 + 2}" y="{rh * 5 + 14}" fill="#777">{i}</text>')
+        eu, el = self.expected_markers()
+        for r, sig, exp in ((3, self.tuser, eu), (4, self.tlast, el)):
+            points = []
+            for k, i in enumerate(range(start, stop)):
+                x0 = left + k * cw
+                y = rh * r + (6 if sig[i] else rh - 4)
+                if sig[i] != exp[i]:  # wrong marker: red band, labelled with what was expected
+                    out.append(f'<rect x="{x0}" y="{rh * r + 2}" width="{cw}" height="{rh - 4}" fill="{WRONG_COLOUR}"/>')
+                    out.append(f'<text x="{x0 + 4}" y="{rh * r + 15}" font-size="9">expect {int(exp[i])}</text>')
+                points += [f"{x0},{y}", f"{x0 + cw},{y}"]
+            if points:
+                out.append(f'<polyline fill="none" stroke="#070" stroke-width="2" points="{" ".join(points)}"/>')
         out.append("</svg>")
         return "".join(out)
 

@@ -174,3 +174,12 @@ def spans_for(raw: bytes, kind: str = "", type_name: str | None = None) -> list[
     if "http" in kind or "xmlrpc" in kind or raw.startswith((b"POST ", b"GET ", b"HTTP/")):
         return spans_from_http(raw)
     return [Span(0, len(raw), "bytes", "bytes", None, "value")] if raw else []
+
+
+def view_bytes(raw: bytes, kind: str = "", type_name: str | None = None, *, title: str = "", **kwargs: Any) -> ByteViewer:
+    """A :class:`ByteViewer` of ``raw`` with fields worked out by :func:`spans_for`.
+
+    Example: ``view_bytes(header_bytes, "tcpros_header")``, ``view_bytes(frame, "tcpros_frame",
+    "sensor_msgs/Image")``, ``view_bytes(http_request)`` (HTTP is recognised by itself).
+    """
+    return ByteViewer(raw, spans_for(raw, kind, type_name), title=title, **kwargs)

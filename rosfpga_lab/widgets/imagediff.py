@@ -122,19 +122,33 @@ class FrameDiff:
         p = int(flat[i])
         return p % self.width, p // self.width
 
-    def diff_rgb(self, max_width: int = DISPLAY_MAX_WIDTH, box: tuple[int, int, int, int] | None = None) -> np.ndarray:
-        """The difference view at display size: reference in dim grey, mismatches red, ``box`` outlined."""
+    def diff_rgb(self, max_width: int = DISPLAY_MAX_WIDTH) -> np.ndarray:
+        """The difference view at display size: reference in dim grey, mismatches red."""
         step = -(-self.width // max_width) if self.width > max_width else 1
         ref = display_rgb(self.reference, self.channel_order)[::step, ::step]
         grey = (ref.mean(axis=2) * 0.35 + 150).astype(np.uint8)
         out = np.repeat(grey[:, :, None], 3, axis=2)
         out[_pool_any(self.mask, step)[: out.shape[0], : out.shape[1]]] = MISMATCH_RGB
-        if box is not None:
-            x0, y0, x1, y1 = (v // step for v in box)
-            x1, y1 = min(x1, out.shape[1] - 1), min(y1, out.shape[0] - 1)
-            out[y0, x0:x1 + 1] = out[y1, x0:x1 + 1] = (0, 0, 255)
-            out[y0:y1 + 1, x0] = out[y0:y1 + 1, x1] = (0, 0, 255)
         return out
+
+    def diff_png(self, max_width: int = DISPLAY_MAX_WIDTH, box: tuple[int, int, int, int] | None = None) -> bytes:
+        """PNG of the difference view as displayed (enlarged if small), ``box`` outlined in blue."""
+        view = self.diff_rgb(max_width)
+        step = -(-self.width // max_width) if self.width > max_width else 1
+        scale = display_scale(view.shape[1], max_width)
+        big = np.repeat(np.repeat(view, scale, axis=0), scale, axis=1) if scale > 1 else view.copy()
+        if box is not None:  # a one-pixel outline just outside the box, on the displayed image
+            h, w_ = big.shape[:2]
+            x0, y0 = box[0] // step * scale - 1, box[1] // step * scale - 1
+            x1, y1 = (box[2] // step + 1) * scale, (box[3] // step + 1) * scale
+            xs, ys = slice(max(x0, 0), min(x1, w_ - 1) + 1), slice(max(y0, 0), min(y1, h - 1) + 1)
+            for y in (y0, y1):
+                if 0 <= y < h:
+                    big[y, xs] = (0, 0, 255)
+            for x in (x0, x1):
+                if 0 <= x < w_:
+                    big[ys, x] = (0, 0, 255)
+        return png_bytes(big)
 
     def views(self, max_width: int = DISPLAY_MAX_WIDTH) -> dict[str, np.ndarray]:
         """Display RGB images by name: ``input`` (if given), ``output``, ``reference``, ``difference``."""
@@ -309,9 +323,7 @@ class ImageDiffViewer(w.VBox):
         f = self.current
         x, y = min(self.x.value, f.width - 1), min(self.y.value, f.height - 1)
         self.zoom.value = f.zoom_html(x, y, self.size.value)
-        rgb = f.diff_rgb(self.max_width, box=f.region(x, y, self.size.value))
-        scale = display_scale(rgb.shape[1], self.max_width)
-        self.images["difference"].value = png_bytes(rgb, scale)
+        self.images["difference"].value = f.diff_png(self.max_width, box=f.region(x, y, self.size.value))
 
     def to_html(self) -> str:
         """Static HTML of every frame (each as :meth:`FrameDiff.to_html`)."""

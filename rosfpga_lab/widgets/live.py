@@ -19,7 +19,14 @@ from typing import Any
 import ipywidgets as w
 import numpy as np
 
-from rosfpga_lab.widgets._common import LIVE_MAX_FPS, WidgetError, as_image, display_rgb, downscale
+from rosfpga_lab.widgets._common import (
+    LIVE_MAX_FPS,
+    WidgetError,
+    as_image,
+    display_rgb,
+    display_scale,
+    downscale,
+)
 
 
 class Throttle:
@@ -165,11 +172,17 @@ class LiveView(w.VBox):
         import cv2
 
         rgb = downscale(display_rgb(img, self.channel_order), self.max_width)
+        scale = display_scale(rgb.shape[1], self.max_width)
+        if scale > 1:  # small frames: enlarge by whole pixels so they stay sharp
+            rgb = np.repeat(np.repeat(rgb, scale, axis=0), scale, axis=1)
         ext = ".jpg" if self.image_format == "jpeg" else ".png"
         ok, buf = cv2.imencode(ext, np.ascontiguousarray(rgb[:, :, ::-1]))
         if not ok:  # pragma: no cover
             raise WidgetError("could not encode the frame")
+        width = f"{rgb.shape[1]}px"
         with self._push_lock:
+            if self.image.layout.width != width:
+                self.image.layout.width = width
             with self._lock:
                 self.shown += 1
                 self.shown_rate.tick()
