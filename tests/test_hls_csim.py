@@ -270,3 +270,13 @@ def test_builds_without_make(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) ->
     assert got.output == (tmp_path / "proj" / "tb_expected.bin").read_bytes()
     with pytest.raises(CsimError, match="no C\\+\\+ compiler"):
         build_csim(tmp_path / "proj", cxx="no-such-g++")
+
+
+def test_a_frame_cut_short_is_not_simulated(projects: dict[str, Project]) -> None:
+    proj = projects["fpga_passthrough_rgb8"]
+    good = (proj.path / "tb_input.bin").read_bytes()
+    got = proj.run(good + good[: len(good) // 2])
+    assert got.status == ((0, "SUB_OK"),)
+    assert got.output == (proj.path / "tb_expected.bin").read_bytes()
+    assert f"the frame at byte {len(good)} is cut short ({len(good) // 2} of {len(good)} bytes)" in got.log
+    assert "WARNING" not in got.log
