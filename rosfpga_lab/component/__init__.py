@@ -1,0 +1,36 @@
+"""The ROS-compliant FPGA component as a running node, with a camera, a viewer and a demo.
+
+Quick use::
+
+    from rosfpga_lab.component import FpgaComponent
+    fpga = FpgaComponent.from_config("data/fpga_dilate_rgba8.yaml").start()  # master from the file
+    ...                                   # frames on /image_raw come out dilated on /image_dilated
+    print(fpga.stats.report())            # frames in/out/dropped/refused, latency, cycles, FIFOs
+    fpga.add_observer(lambda rec: ...)    # every FrameRecord (input, output, result, latency)
+    fpga.stop()
+
+    from rosfpga_lab.component import run_demo
+    result = run_demo(frames=60)          # master + camera + component + bit-exact checker
+    print("\\n".join(result.lines()))
+
+Modules: ``fpga`` (:class:`FpgaComponent`, :class:`FrameRecord`), ``stats``
+(:class:`ComponentStats`), ``sources`` (pictures: synthetic, grace_hopper, files), ``camera``
+(:class:`Camera`, :class:`Viewer`), ``checker`` (:class:`Checker`, OpenCV as the oracle),
+``demo`` (:func:`run_demo`), ``limits``, ``errors``.
+"""
+
+from rosfpga_lab.component.camera import Camera, SentFrame, ViewedFrame, Viewer, stamp_of
+from rosfpga_lab.component.checker import CheckReport, Checker, expected_output
+from rosfpga_lab.component.demo import DemoResult, default_config, run_demo, write_figure
+from rosfpga_lab.component.errors import ComponentConfigError, ComponentError, SourceError
+from rosfpga_lab.component.fpga import FpgaComponent, FrameRecord
+from rosfpga_lab.component.sources import SOURCES, ImageSource, open_source, to_rgb
+from rosfpga_lab.component.stats import ComponentStats, LatencySummary, LatencyWindow
+
+__all__ = [
+    "SOURCES", "Camera", "CheckReport", "Checker", "ComponentConfigError", "ComponentError",
+    "ComponentStats", "DemoResult", "FpgaComponent", "FrameRecord", "ImageSource",
+    "LatencySummary", "LatencyWindow", "SentFrame", "SourceError", "ViewedFrame", "Viewer",
+    "default_config", "expected_output", "open_source", "run_demo", "stamp_of", "to_rgb",
+    "write_figure",
+]

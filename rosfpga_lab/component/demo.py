@@ -1,0 +1,196 @@
+"""The whole paper in one call: master, camera, FPGA component and a bit-exact checker.
+
+How this works: :func:`run_demo` starts an embedded master on a free loopback port, the
+component from a node configuration (its master URI replaced by the embedded one), a checker
+subscribed to the component's output and a camera publishing on the component's input at the
+configured size and encoding. It waits until every frame came back (or a time-out), checks
+each output against OpenCV on its input (:mod:`rosfpga_lab.component.checker`), writes a PNG
+of input, output and difference, stops everything and returns a :class:`DemoResult`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from rosfpga_lab.component.camera import Camera
+from rosfpga_lab.component.checker import CheckReport, Checker
+from rosfpga_lab.component.fpga import FpgaComponent
+from rosfpga_lab.component.sources import to_rgb
+from rosfpga_lab.component.stats import ComponentStats, LatencySummary
+from rosfpga_lab.graph import EmbeddedMaster
+from rosfpga_lab.hls import NodeConfig, load_config, parse_config
+
+#: The configuration used when the lab's data/ directory is not at hand (same as the file).
+DEFAULT_CONFIG_NAME = "fpga_dilate_rgba8.yaml"
+_FALLBACK_CONFIG = """\
+node: {name: /fpga_dilate}
+subscriber: {topic: /image_raw, type: sensor_msgs/Image}
+publisher: {topic: /image_dilated, type: sensor_msgs/Image}
+image: {width: 640, height: 480, encoding: rgba8}
+application: {op: dilate, ksize: 3}
+"""
+#: Difference images are multiplied by this to be visible.
+DIFF_GAIN = 8
+
+
+def default_config() -> NodeConfig:
+    """``data/fpga_dilate_rgba8.yaml`` from the lab's checkout, or the same values built in."""
+    path = Path(__file__).resolve().parents[2] / "data" / DEFAULT_CONFIG_NAME
+    if path.exists():
+        return load_config(path)
+    return parse_config(_FALLBACK_CONFIG, source=f"<built-in {DEFAULT_CONFIG_NAME}>")
+
+
+@dataclass
+class DemoResult:
+    """What the demo measured.
+
+    Attributes:
+        sent: frames the camera published; received: outputs the checker got.
+        check: the checker's report (bit-exact count, mismatches).
+        fps: output frames per second at the checker.
+        latency: camera publish -> checker receive (header.stamp to arrival).
+        component: the component's own counters at the end.
+        elapsed: seconds from the first frame to the last output.
+        png: the figure written (or None).
+    """
+
+    sent: int
+    received: int
+    check: CheckReport
+    fps: float
+    latency: LatencySummary
+    component: ComponentStats
+    elapsed: float
+    png: Path | None
+    config: NodeConfig
+
+    @property
+    def ok(self) -> bool:
+        """Every frame sent came back, and every output was bit-exact."""
+        return self.sent > 0 and self.received == self.sent and self.check.bit_exact == self.sent
+
+    def lines(self) -> list[str]:
+        """The demo's printed summary."""
+        cfg = self.config
+        c = self.component
+        out = [
+            f"circuit: {cfg.application.op} {cfg.application.ksize}x{cfg.application.ksize} on "
+            f"{cfg.image.width}x{cfg.image.height} {cfg.image.encoding}, "
+            f"{cfg.subscriber.topic} -> {cfg.node.global_name} -> {cfg.publisher.topic}",
+            f"frames: sent {self.sent}, received {self.received}, dropped {c.dropped}, "
+            f"refused {c.refused} in {self.elapsed:.2f} s",
+            f"fps: {self.fps:.1f} at the checker",
+            f"latency camera -> component -> checker: {self.latency.ms()}; inside the component "
+            f"(receive -> publish): {c.latency.ms()}",
+        ]
+        if c.cycles:
+            out.append(f"modelled circuit: {c.circuit_time_s * 1e3:.2f} ms per frame at "
+                       f"{cfg.clock_mhz:g} MHz; FIFO high water {c.fifo_high_water}")
+        out.append(f"bit-exact: {self.check.bit_exact}/{self.sent}")
+        out += [f"  mismatch: {m}" for m in self.check.mismatches[:5]]
+        if self.png is not None:
+            out.append(f"figure: {self.png}")
+        return out
+
+
+def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
+             rate: float = 30.0, source: str = "grace_hopper", png: str | Path | None = "demo.png",
+             model: str = "fast", timeout: float = 30.0, png_scale: float = 1.0,
+             oracle_op: str | None = None,
+             progress: Callable[[str], None] | None = None) -> DemoResult:
+    """Run the demo (see module docstring).
+
+    Args:
+        config: node configuration (path or loaded); None: :func:`default_config`.
+        frames: frames the camera sends; rate: frames per second.
+        source: camera source (``grace_hopper``, ``synthetic``, a file or directory).
+        png: where to write the input/output/difference figure (None: no figure).
+        model: the circuit model, ``fast`` or ``reference``.
+        timeout: seconds to wait for the last output after the last input.
+        png_scale: scale of the figure (0.5 halves it).
+        oracle_op: check against this op instead of the configuration's (a negative control:
+            a wrong oracle must give mismatches).
+        progress: called with a line of text at each step.
+    """
+    say = progress or (lambda _text: None)
+    if config is None:
+        config = default_config()
+    elif not isinstance(config, NodeConfig):
+        config = load_config(config)
+    app = config.application
+    op = oracle_op or ("copy" if app.op == "passthrough" else app.op)
+    with EmbeddedMaster(port=0) as master:
+        say(f"master: embedded at {master.uri}")
+        component = FpgaComponent.from_config(config, master=master, model=model,
+                                              watchdog=False).start()
+        checker = camera = None
+        try:
+            checker = Checker(config.publisher.topic, op, (app.ksize, app.ksize), master=master)
+            camera = Camera(config.subscriber.topic, width=config.image.width,
+                            height=config.image.height, encoding=config.image.encoding,
+                            rate=rate, source=source, master=master, on_sent=checker.sent,
+                            queue_size=0)
+            say(f"component: {component!r}")
+            if not (camera.publisher.wait_for_subscribers(1, 10.0)
+                    and component.wait_for_subscribers(1, 10.0)):
+                say("warning: connections were not all up after 10 s")
+            say(f"camera: {frames} frames of {source!r} at {rate:g} fps")
+            t0 = time.monotonic()
+            camera.run(count=frames)
+            checker.wait_for(camera.sent, timeout)
+            elapsed = time.monotonic() - t0
+            stats = component.stats
+        finally:
+            for part in (camera, checker):
+                if part is not None:
+                    part.stop()
+            component.stop()
+    report = checker.report
+    png_path = None
+    if png is not None and (checker.last is not None or report.first_bad is not None):
+        png_path = write_figure(report.first_bad or checker.last, config.image.encoding, png,
+                                scale=png_scale, title=f"{op} {app.ksize}x{app.ksize}")
+    return DemoResult(camera.sent, report.received, report, checker.fps, checker.latency.summary(),
+                      stats, elapsed, png_path, config)
+
+
+def write_figure(images: tuple[np.ndarray, np.ndarray, np.ndarray], encoding: str,
+                 path: str | Path, *, scale: float = 1.0, title: str = "dilate") -> Path:
+    """Write input | output | (output - input) x DIFF_GAIN side by side as a PNG.
+
+    Args:
+        images: ``(input, output, expected)`` pictures in ``encoding``.
+        path: the PNG to write (parent directories are created).
+        scale: resize factor of each panel.
+    """
+    src, out, _expected = images
+    diff = np.clip((out.astype(np.int16) - src.astype(np.int16)) * DIFF_GAIN, 0, 255).astype(np.uint8)
+    panels = [to_rgb(src, encoding), to_rgb(out, encoding), to_rgb(diff, encoding)]
+    labels = ["input (camera)", f"output (FPGA {title})", f"difference x{DIFF_GAIN}"]
+    h, w = panels[0].shape[:2]
+    size = (max(1, round(w * scale)), max(1, round(h * scale)))
+    band = max(18, size[1] // 16)
+    tiles = []
+    for panel, label in zip(panels, labels):
+        tile = cv2.resize(panel, size, interpolation=cv2.INTER_AREA) if scale != 1.0 else panel
+        head = np.full((band, size[0], 3), 255, np.uint8)
+        cv2.putText(head, label, (4, band - 5), cv2.FONT_HERSHEY_SIMPLEX, band / 32, (0, 0, 0), 1,
+                    cv2.LINE_AA)
+        tiles.append(np.vstack([head, tile]))
+        tiles.append(np.full((size[1] + band, 4, 3), 255, np.uint8))
+    figure = np.hstack(tiles[:-1])
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not cv2.imwrite(str(path), cv2.cvtColor(figure, cv2.COLOR_RGB2BGR),
+                       [cv2.IMWRITE_PNG_COMPRESSION, 9]):
+        from rosfpga_lab.component.errors import ComponentError
+
+        raise ComponentError(f"could not write {path} (is the directory writable?)")
+    return path

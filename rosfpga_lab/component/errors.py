@@ -1,0 +1,17 @@
+"""Typed errors of the component layer (all under :class:`rosfpga_lab.errors.LabError`)."""
+
+from __future__ import annotations
+
+from rosfpga_lab.errors import LabError
+
+
+class ComponentError(LabError):
+    """Base of errors the component, camera, viewer or demo raise on purpose."""
+
+
+class ComponentConfigError(ComponentError):
+    """The component cannot be built from this configuration (the message says why and what to do)."""
+
+
+class SourceError(ComponentError):
+    """An image source (file, photo, size or encoding for the camera) is unusable."""

@@ -1,0 +1,417 @@
+"""The ROS-compliant FPGA component, emulated: a ROS node whose TCPROS data path is the circuit.
+
+How this works (Figure 3 of the paper): the *software* side is an ordinary
+:class:`rosfpga_lab.graph.Node`. It registers with the master (embedded or real) as
+subscriber of the input topic and publisher of the output topic, answers the Slave API and
+runs the TCPROS handshakes. The *hardware* side is the data path: every complete TCPROS frame
+the subscriber reads (the raw bytes, never deserialized in software) goes through the
+modelled circuit -- :class:`rosfpga_lab.hw.Pipeline` built by
+:func:`rosfpga_lab.hls.pipeline_for` from the same node configuration the generator reads --
+and the frame the circuit's message generator writes is sent, as bytes, to every subscriber.
+
+Queues (drop policy, as roscpp's): frames wait in front of the circuit in the subscriber's
+queue (``input_queue`` deep; when the circuit is busy and it is full, the oldest waiting frame
+is dropped and counted) and behind it in one queue per downstream subscriber
+(``output_queue``; a subscriber too slow for the rate loses the oldest frames, the others are
+not held back). A frame the circuit refuses (wrong size, encoding, truncated) is counted under
+its reason and logged; the pipeline has reset itself and the next good frame comes out right.
+A watchdog checks once a second that the master still knows the node and registers it again
+after a master restart.
+
+Observe it live with :meth:`FpgaComponent.add_observer` (called with a :class:`FrameRecord`
+for every frame, in the component's thread: keep it short) or :attr:`FpgaComponent.recent`
+(the last few records).
+"""
+
+from __future__ import annotations
+
+import collections
+import logging
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rosfpga_lab.component import limits
+from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
+from rosfpga_lab.component.stats import ComponentStats, LatencyWindow
+from rosfpga_lab.errors import LabError
+from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
+from rosfpga_lab.hls import NodeConfig, load_config, pipeline_for
+from rosfpga_lab.hw import FrameFieldError, PipelineError, PipelineResult
+
+log = logging.getLogger("rosfpga_lab.component")
+
+MAX_REASONS = 20
+
+
+@dataclass(frozen=True)
+class FrameRecord:
+    """One frame through the component (what a live view shows).
+
+    Attributes:
+        index: frames seen by the circuit so far, counting from 0 (refused ones included).
+        input_frame: the TCPROS frame received (4-byte length + ``sensor_msgs/Image`` body).
+        output_frame: the frame published (empty when refused).
+        result: the pipeline's :class:`~rosfpga_lab.hw.PipelineResult` (None when refused).
+        error: the refusal reason (empty when the frame went through).
+        publisher: callerid of the node that sent the frame.
+        received: ``time.time()`` when the frame was complete on the input connection.
+        published: ``time.time()`` when the output was handed to the publisher.
+    """
+
+    index: int
+    input_frame: bytes
+    output_frame: bytes
+    result: PipelineResult | None
+    error: str
+    publisher: str
+    received: float
+    published: float
+
+    @property
+    def latency(self) -> float:
+        """Seconds from receive-complete to publish."""
+        return self.published - self.received
+
+    @property
+    def input_image(self) -> np.ndarray | None:
+        return None if self.result is None else self.result.input_image
+
+    @property
+    def output_image(self) -> np.ndarray | None:
+        return None if self.result is None else self.result.output_image
+
+
+def _reason(exc: PipelineError) -> str:
+    text = str(exc)
+    if isinstance(exc, FrameFieldError):
+        return f"{exc.field}: {text}"
+    return text
+
+
+class FpgaComponent:
+    """The FPGA node: software registration and handshakes, the modelled circuit on the data path.
+
+    Args:
+        config: the node configuration (as :func:`rosfpga_lab.hls.load_config` returns it).
+        master_uri: the master to use instead of the configuration's ``node.master_uri``.
+        master: an :class:`~rosfpga_lab.graph.EmbeddedMaster` to use (overrides both).
+        model: ``"fast"`` (numpy) or ``"reference"`` (one byte or beat at a time; small images).
+        input_queue: frames waiting in front of the circuit (see module docstring).
+        output_queue: frames waiting per downstream subscriber.
+        history: records kept in :attr:`recent`.
+        name: node name instead of the configuration's ``node.name``.
+        host: address to bind and advertise instead of ``node.ip_address``.
+        trace: a :class:`~rosfpga_lab.graph.Trace` to record the conversation into.
+        watchdog: check the master once a second and register again after a restart.
+
+    Raises:
+        ComponentConfigError: the configuration cannot be run (``op: custom``, wrong type).
+    """
+
+    def __init__(self, config: NodeConfig, *, master_uri: str | None = None,
+                 master: EmbeddedMaster | None = None, model: str = "fast",
+                 input_queue: int = limits.DEFAULT_INPUT_QUEUE,
+                 output_queue: int = limits.DEFAULT_OUTPUT_QUEUE,
+                 history: int = limits.DEFAULT_HISTORY, name: str | None = None,
+                 host: str | None = None, trace: Any = None, watchdog: bool = True) -> None:
+        for section, topic in (("subscriber", config.subscriber), ("publisher", config.publisher)):
+            if topic.type != "sensor_msgs/Image":
+                raise ComponentConfigError(
+                    f"{section}.type is {topic.type!r}: the circuit streams sensor_msgs/Image only")
+        try:
+            self.pipeline = pipeline_for(config, model=model)
+        except LabError as exc:
+            raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
+        if input_queue < 1 or output_queue < 1:
+            raise ComponentConfigError("input_queue and output_queue must be at least 1")
+        self.config = config
+        self.model = model
+        self.master = master
+        self.master_uri = master.uri if master is not None else (master_uri or config.node.master_uri)
+        self.name = name or config.node.global_name
+        self.host = host or config.node.ip_address
+        self.input_topic = config.subscriber.topic
+        self.output_topic = config.publisher.topic
+        self.input_queue, self.output_queue = input_queue, output_queue
+        self.trace = trace
+        self.watchdog = watchdog
+        pixels = config.image.width * config.image.height
+        if model == "reference" and pixels > limits.REFERENCE_WARN_PIXELS:
+            log.warning("reference model with %dx%d frames: expect seconds per frame; "
+                        "use model='fast' for real-time rates", config.image.width,
+                        config.image.height)
+        self.recent: collections.deque[FrameRecord] = collections.deque(maxlen=max(1, history))
+        self._observers: list[Callable[[FrameRecord], Any]] = []
+        self._lock = threading.Lock()
+        self._latency = LatencyWindow(limits.LATENCY_WINDOW)
+        self._process = LatencyWindow(limits.LATENCY_WINDOW)
+        self._published_times: collections.deque[float] = collections.deque(maxlen=256)
+        self._counts = {"seen": 0, "processed": 0, "published": 0, "refused": 0,
+                        "reregistered": 0, "observer_errors": 0}
+        self._reasons: dict[str, int] = {}
+        self._high_water: dict[str, int] = {}
+        self._last: PipelineResult | None = None
+        self._last_error = ""
+        self._master_ok = True
+        self._done = threading.Condition(self._lock)
+        self._stop = threading.Event()
+        self._watch: threading.Thread | None = None
+        self.node: Node | None = None
+        self._pub: Any = None
+        self._sub: Any = None
+
+    @classmethod
+    def from_config(cls, config: str | Path | NodeConfig, master_uri: str | None = None,
+                    model: str = "fast", **kwargs: Any) -> FpgaComponent:
+        """Build the component from a node configuration file (or a loaded one).
+
+        Args:
+            config: path of the YAML file the generator reads, or a :class:`NodeConfig`.
+            master_uri, model, kwargs: as for :class:`FpgaComponent`.
+
+        Raises:
+            ConfigError: the file is not a valid node configuration.
+            ComponentConfigError: it cannot be run as a component.
+        """
+        if not isinstance(config, NodeConfig):
+            config = load_config(config)
+        return cls(config, master_uri=master_uri, model=model, **kwargs)
+
+    # ------------------------------------------------------------------ life cycle
+    @property
+    def running(self) -> bool:
+        return self.node is not None and not self.node.is_shutdown
+
+    def start(self) -> FpgaComponent:
+        """Register with the master, subscribe to the input, advertise the output.
+
+        Raises:
+            GraphError: the master cannot be reached or refused (nothing is left running).
+        """
+        if self.node is not None:
+            raise ComponentError(f"component {self.name} was already started")
+        kw: dict[str, Any] = {"master": self.master} if self.master is not None else {
+            "master_uri": self.master_uri}
+        if self.trace is not None:
+            kw["trace"] = self.trace
+        node = Node(self.name, host=self.host, xmlrpc_port=self.config.node.xmlrpc_port,
+                    tcpros_port=self.config.node.tcpros_port, **kw)
+        try:
+            self._pub = node.advertise(self.output_topic, "sensor_msgs/Image",
+                                       queue_size=self.output_queue)
+            self._sub = node.subscribe(self.input_topic, "sensor_msgs/Image", self._on_frame,
+                                       raw=True, queue_size=self.input_queue, tcp_nodelay=True)
+        except BaseException:
+            node.shutdown()
+            raise
+        self.node = node
+        self._stop.clear()
+        if self.watchdog:
+            self._watch = threading.Thread(target=self._watch_loop, daemon=True,
+                                           name=f"rosfpga-component-watchdog-{self.name}")
+            self._watch.start()
+        log.info("%s: %s -> %s circuit (%s model) -> %s; master %s", self.name, self.input_topic,
+                 self.pipeline.op, self.model, self.output_topic, self.master_uri)
+        return self
+
+    def stop(self) -> None:
+        """Unregister, close every connection, join every thread (idempotent)."""
+        self._stop.set()
+        if self._watch is not None and self._watch is not threading.current_thread():
+            self._watch.join(5.0)
+        if self.node is not None:
+            self.node.shutdown("component stopped")
+
+    def __enter__(self) -> FpgaComponent:
+        if self.node is None:
+            self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def __repr__(self) -> str:
+        state = "running" if self.running else "stopped"
+        return (f"<FpgaComponent {self.name} {self.input_topic} -> {self.pipeline.op} -> "
+                f"{self.output_topic} {state}>")
+
+    # ------------------------------------------------------------------ observers
+    def add_observer(self, callback: Callable[[FrameRecord], Any]) -> None:
+        """Call ``callback(record)`` after every frame (in the component's thread; keep it short)."""
+        with self._lock:
+            self._observers.append(callback)
+
+    def remove_observer(self, callback: Callable[[FrameRecord], Any]) -> None:
+        """Stop calling ``callback``."""
+        with self._lock:
+            if callback in self._observers:
+                self._observers.remove(callback)
+
+    # ------------------------------------------------------------------ the data path
+    def _on_frame(self, body: bytes | memoryview, info: MessageInfo) -> None:
+        frame = len(body).to_bytes(4, "little") + body
+        t0 = time.perf_counter()
+        try:
+            result = self.pipeline.process(frame)
+        except PipelineError as exc:
+            self._refuse(exc, frame, info)
+            return
+        t1 = time.perf_counter()
+        self._pub.publish_body(memoryview(result.output_frame)[4:])
+        now = time.time()
+        for problem in result.status:
+            log.warning("%s: frame from %s passed with a problem: %s", self.name, info.publisher,
+                        problem)
+        self._latency.add(now - info.received)
+        self._process.add(t1 - t0)
+        with self._lock:
+            index = self._counts["seen"]
+            self._counts["seen"] += 1
+            self._counts["processed"] += 1
+            self._counts["published"] += 1
+            self._published_times.append(time.monotonic())
+            self._last = result
+            for fifo, level in result.fifo_high_water.items():
+                self._high_water[fifo] = max(level, self._high_water.get(fifo, 0))
+            self._done.notify_all()
+        self._observe(FrameRecord(index, frame, result.output_frame, result, "", info.publisher,
+                                  info.received, now))
+
+    def _refuse(self, exc: PipelineError, frame: bytes, info: MessageInfo) -> None:
+        reason = _reason(exc)
+        with self._lock:
+            self._counts["seen"] += 1
+            self._counts["refused"] += 1
+            key = reason if reason in self._reasons or len(self._reasons) < MAX_REASONS else "other"
+            n = self._reasons[key] = self._reasons.get(key, 0) + 1
+            self._last_error = f"refused a frame from {info.publisher}: {reason}"
+            index = self._counts["seen"] - 1
+            self._done.notify_all()
+        if n <= limits.LOG_FIRST or n % limits.LOG_EVERY == 0:
+            log.warning("%s: refused frame #%d from %s (%d so far for this reason): %s", self.name,
+                        info.index, info.publisher, n, reason)
+        self._observe(FrameRecord(index, frame, b"", None, reason, info.publisher, info.received,
+                                  time.time()))
+
+    def _observe(self, record: FrameRecord) -> None:
+        self.recent.append(record)
+        with self._lock:
+            observers = list(self._observers)
+        for callback in observers:
+            try:
+                callback(record)
+            except Exception as exc:  # an observer must never stop the data path
+                with self._lock:
+                    self._counts["observer_errors"] += 1
+                log.warning("%s: observer %r raised %s: %s", self.name, callback,
+                            type(exc).__name__, exc)
+
+    # ------------------------------------------------------------------ master watchdog
+    def _watch_loop(self) -> None:
+        while not self._stop.wait(limits.WATCHDOG_PERIOD):
+            node = self.node
+            if node is None or node.is_shutdown:
+                return
+            try:
+                self.check_master()
+            except LabError as exc:
+                if self._master_ok:
+                    log.warning("%s: master %s unreachable: %s (will keep trying)", self.name,
+                                self.master_uri, exc)
+                self._master_ok = False
+
+    def check_master(self) -> bool:
+        """Ask the master whether it knows this node; register again if it does not.
+
+        Returns:
+            True when the node had to register again (the master restarted).
+
+        Raises:
+            GraphError: the master cannot be reached.
+        """
+        node = self.node
+        if node is None:
+            raise ComponentError("component not started")
+        reply = call(self.master_uri, "lookupNode", self.name, self.name, timeout=2.0)
+        self._master_ok = True
+        if isinstance(reply, list) and len(reply) == 3 and reply[0] == 1 and reply[2] == node.uri:
+            return False
+        call(self.master_uri, "registerPublisher", self.name, self.output_topic,
+             "sensor_msgs/Image", node.uri, timeout=2.0)
+        reply = call(self.master_uri, "registerSubscriber", self.name, self.input_topic,
+                     "sensor_msgs/Image", node.uri, timeout=2.0)
+        publishers = reply[2] if isinstance(reply, list) and len(reply) == 3 else []
+        node.publisherUpdate("/master", self.input_topic,
+                             [p for p in publishers if isinstance(p, str)])
+        with self._lock:
+            self._counts["reregistered"] += 1
+        log.warning("%s: the master %s did not know this node (restarted?); registered again",
+                    self.name, self.master_uri)
+        return True
+
+    # ------------------------------------------------------------------ figures
+    @property
+    def stats(self) -> ComponentStats:
+        """A snapshot of the counters (see :class:`ComponentStats`)."""
+        sub_stats = self._sub.stats if self._sub is not None else None
+        pub_stats = self._pub.stats if self._pub is not None else None
+        by_peer: dict[str, int] = {}
+        if pub_stats is not None:
+            for link in pub_stats.links:
+                if link.drops:
+                    by_peer[link.peer] = by_peer.get(link.peer, 0) + link.drops
+        now = time.monotonic()
+        with self._lock:
+            c = dict(self._counts)
+            times = [t for t in self._published_times if t >= now - 2.0]
+            fps = (len(times) - 1) / (times[-1] - times[0]) if len(times) > 1 and times[-1] > times[0] else 0.0
+            if times and now - times[-1] > 1.0:
+                fps = 0.0
+            last = self._last
+            return ComponentStats(
+                received=sub_stats.frames if sub_stats else 0,
+                processed=c["processed"], published=c["published"], refused=c["refused"],
+                refused_reasons=dict(self._reasons),
+                dropped_input=sub_stats.drops if sub_stats else 0,
+                dropped_output=sum(by_peer.values()), dropped_output_by_peer=by_peer,
+                subscribers=pub_stats.connections if pub_stats else 0,
+                publishers=sub_stats.connections if sub_stats else 0,
+                latency=self._latency.summary(), process_time=self._process.summary(),
+                circuit_time_s=last.frame_time_s if last is not None else float("nan"),
+                cycles=dict(last.cycles) if last is not None else {},
+                fifo_high_water=dict(self._high_water), fps=fps,
+                master_reregistrations=c["reregistered"], master_ok=self._master_ok,
+                observer_errors=c["observer_errors"], last_error=self._last_error)
+
+    def latency_samples(self) -> list[float]:
+        """The kept receive-to-publish latencies (seconds), oldest first."""
+        return self._latency.samples()
+
+    def wait_for_subscribers(self, n: int = 1, timeout: float = 10.0) -> bool:
+        """Wait until ``n`` subscribers are connected to the output; False on time-out."""
+        return self._pub is not None and self._pub.wait_for_subscribers(n, timeout)
+
+    def wait_for_publishers(self, n: int = 1, timeout: float = 10.0) -> bool:
+        """Wait until ``n`` publishers of the input are connected; False on time-out."""
+        return self._sub is not None and self._sub.wait_for_connection(n, timeout)
+
+    def wait_for(self, frames: int, timeout: float = 10.0) -> bool:
+        """Wait until the circuit has handled ``frames`` frames (published + refused).
+
+        Returns:
+            False on time-out.
+        """
+        deadline = time.monotonic() + timeout
+        with self._done:
+            while self._counts["seen"] < frames:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self._done.wait(left)
+        return True

@@ -1,0 +1,25 @@
+"""Limits and defaults of the component layer, in one place."""
+
+from __future__ import annotations
+
+#: Frames queued in front of the circuit (the subscriber's queue): when the circuit is busy and
+#: the queue is full, the oldest waiting frame is dropped and counted ("input queue full").
+#: One frame waiting while one is processed matches a double-buffered input.
+DEFAULT_INPUT_QUEUE = 2
+#: Frames queued per downstream subscriber before the oldest is dropped ("output queue full").
+DEFAULT_OUTPUT_QUEUE = 2
+#: Recent frames kept for a live view (:attr:`FpgaComponent.recent`).
+DEFAULT_HISTORY = 4
+#: Latency samples kept for medians and percentiles.
+LATENCY_WINDOW = 1000
+#: Seconds between checks that the master still knows the component (re-registers after a
+#: master restart).
+WATCHDOG_PERIOD = 1.0
+#: Refusal log lines per reason before the log is thinned to one line per LOG_EVERY refusals.
+LOG_FIRST = 3
+LOG_EVERY = 100
+#: The reference model moves one byte per Python step: warn above this many pixels per frame.
+REFERENCE_WARN_PIXELS = 160 * 120
+#: Camera limits: frames per second and image side.
+MAX_CAMERA_RATE = 1000.0
+MAX_CAMERA_SIDE = 8192

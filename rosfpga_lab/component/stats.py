@@ -1,0 +1,158 @@
+"""Counters and latency figures of a running component (snapshots, safe to hand to any thread)."""
+
+from __future__ import annotations
+
+import collections
+import statistics
+import threading
+from dataclasses import dataclass, field
+
+
+class LatencyWindow:
+    """The last ``size`` latency samples (seconds), with median and percentiles.
+
+    Args:
+        size: samples kept (older ones are forgotten).
+    """
+
+    def __init__(self, size: int) -> None:
+        self._samples: collections.deque[float] = collections.deque(maxlen=size)
+        self._lock = threading.Lock()
+        self.count = 0
+
+    def add(self, seconds: float) -> None:
+        """Record one sample."""
+        with self._lock:
+            self._samples.append(seconds)
+            self.count += 1
+
+    def samples(self) -> list[float]:
+        """The kept samples, oldest first."""
+        with self._lock:
+            return list(self._samples)
+
+    def summary(self) -> LatencySummary:
+        """Median, 95th percentile and maximum of the kept samples."""
+        return LatencySummary.of(self.samples())
+
+
+@dataclass(frozen=True)
+class LatencySummary:
+    """Latency figures in seconds (``nan`` when there are no samples)."""
+
+    count: int
+    median: float
+    p95: float
+    max: float
+
+    @classmethod
+    def of(cls, samples: list[float]) -> LatencySummary:
+        """Summarize ``samples`` (seconds)."""
+        if not samples:
+            nan = float("nan")
+            return cls(0, nan, nan, nan)
+        ordered = sorted(samples)
+        p95 = ordered[min(len(ordered) - 1, int(round(0.95 * (len(ordered) - 1))))]
+        return cls(len(ordered), statistics.median(ordered), p95, ordered[-1])
+
+    def ms(self) -> str:
+        """``"median 1.9 ms, p95 2.4 ms"`` (or ``"n/a"``)."""
+        if not self.count:
+            return "n/a"
+        return f"median {self.median * 1e3:.1f} ms, p95 {self.p95 * 1e3:.1f} ms"
+
+
+@dataclass(frozen=True)
+class ComponentStats:
+    """What the component did so far.
+
+    Attributes:
+        received: complete frames read off the input connections.
+        processed: frames the circuit turned into output frames.
+        published: output frames handed to the publisher (one per processed frame).
+        refused: frames the circuit refused (wrong size, encoding, truncated ...).
+        refused_reasons: refusal count per reason (e.g. ``"width: 320 != 640"``).
+        dropped_input: frames dropped in front of the circuit (input queue full: the circuit
+            was busy).
+        dropped_output: frames dropped behind it (a downstream subscriber too slow), over all
+            subscribers; ``dropped_output_by_peer`` splits them.
+        subscribers: downstream subscribers connected now; ``publishers``: upstream publishers.
+        latency: receive-complete to handed-to-publisher, per frame, in this process.
+        process_time: time in the circuit model alone.
+        circuit_time_s: the modelled circuit's time for the last frame (cycles / clock).
+        cycles: per-stage cycles of the last frame; ``fifo_high_water``: highest level seen
+            per FIFO over all frames.
+        fps: output frames per second over the last two seconds.
+        master_reregistrations: times the component registered again (a master restart).
+        master_ok: the master answered the last check.
+        observer_errors: exceptions raised by observers (they never stop the component).
+        last_error: the most recent refusal or problem, as text.
+    """
+
+    received: int = 0
+    processed: int = 0
+    published: int = 0
+    refused: int = 0
+    refused_reasons: dict[str, int] = field(default_factory=dict)
+    dropped_input: int = 0
+    dropped_output: int = 0
+    dropped_output_by_peer: dict[str, int] = field(default_factory=dict)
+    subscribers: int = 0
+    publishers: int = 0
+    latency: LatencySummary = LatencySummary(0, float("nan"), float("nan"), float("nan"))
+    process_time: LatencySummary = LatencySummary(0, float("nan"), float("nan"), float("nan"))
+    circuit_time_s: float = float("nan")
+    cycles: dict[str, int] = field(default_factory=dict)
+    fifo_high_water: dict[str, int] = field(default_factory=dict)
+    fps: float = 0.0
+    master_reregistrations: int = 0
+    master_ok: bool = True
+    observer_errors: int = 0
+    last_error: str = ""
+
+    @property
+    def dropped(self) -> int:
+        """All drops: in front of and behind the circuit."""
+        return self.dropped_input + self.dropped_output
+
+    def status_line(self) -> str:
+        """One line for a terminal status display."""
+        lat = f"{self.latency.median * 1e3:.1f} ms" if self.latency.count else "-"
+        text = (f"in {self.received}  out {self.published}  {self.fps:5.1f} fps  "
+                f"latency {lat}  dropped {self.dropped}  refused {self.refused}  "
+                f"subs {self.subscribers}")
+        if not self.master_ok:
+            text += "  MASTER UNREACHABLE"
+        return text
+
+    def report(self) -> str:
+        """A multi-line summary (printed when ``rosfpga-lab node`` stops)."""
+        lines = [
+            f"frames: received {self.received}, processed {self.processed}, published "
+            f"{self.published}, refused {self.refused}, dropped {self.dropped} "
+            f"(input queue {self.dropped_input}, output queues {self.dropped_output})",
+            f"latency (receive -> publish): {self.latency.ms()}; circuit model alone: "
+            f"{self.process_time.ms()}",
+        ]
+        if self.cycles:
+            total = self.circuit_time_s * 1e3
+            lines.append("cycles per stage (last frame): " + ", ".join(
+                f"{name} {n:,}" for name, n in self.cycles.items())
+                + f"; modelled circuit time {total:.2f} ms")
+        if self.fifo_high_water:
+            lines.append("FIFO high water: " + ", ".join(
+                f"{name} {n}" for name, n in self.fifo_high_water.items()))
+        for reason, n in sorted(self.refused_reasons.items(), key=lambda kv: -kv[1]):
+            lines.append(f"refused x{n}: {reason}")
+        if self.dropped_input:
+            lines.append(f"dropped x{self.dropped_input}: input queue full (the circuit was busy; "
+                         "the oldest waiting frame goes)")
+        for peer, n in sorted(self.dropped_output_by_peer.items()):
+            lines.append(f"dropped x{n}: output queue full for subscriber {peer} (too slow for "
+                         "the rate; the oldest queued frame goes)")
+        if self.master_reregistrations:
+            lines.append(f"registered again with the master {self.master_reregistrations} time(s) "
+                         "(master restarted)")
+        if self.observer_errors:
+            lines.append(f"observer callbacks raised {self.observer_errors} time(s)")
+        return "\n".join(lines)
