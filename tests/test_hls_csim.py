@@ -280,3 +280,30 @@ def test_a_frame_cut_short_is_not_simulated(projects: dict[str, Project]) -> Non
     assert got.output == (proj.path / "tb_expected.bin").read_bytes()
     assert f"the frame at byte {len(good)} is cut short ({len(good) // 2} of {len(good)} bytes)" in got.log
     assert "WARNING" not in got.log
+
+
+def test_a_batch_of_varied_frames_equals_the_models(projects: dict[str, Project]) -> None:
+    """Many frames in one run: frame_id from empty to the limit (and one past), stamps,
+    is_bigendian, pixel content; the circuit and the Python model agree on every one."""
+    stem = "fpga_erode_mono8"
+    config = load_config(DATA / f"{stem}.yaml")
+    rng = np.random.default_rng(11)
+    frames = []
+    for i, n in enumerate([0, 1, 7, 255, 256, 257, 3, 64]):
+        image = rng.integers(0, 256, (config.image.height, config.image.width, 1), dtype=np.uint8)
+        frame_id = "".join(chr(c) for c in rng.integers(97, 123, n))
+        frames.append(image_frame(image, "mono8", seq=int(rng.integers(0, 2**32)),
+                                  stamp=(int(rng.integers(0, 2**32)), int(rng.integers(0, 10**9))),
+                                  frame_id=frame_id, is_bigendian=i % 2))
+    got = projects[stem].run(b"".join(frames))
+    pipe = pipeline_for(config)
+    expected, statuses = b"", []
+    for frame in frames:
+        try:
+            expected += pipe.process(frame).output_frame
+            statuses.append("SUB_OK")
+        except PipelineError:
+            statuses.append("refused")
+    assert statuses.count("refused") == 1  # the 257-byte frame_id
+    assert [s if s == "SUB_OK" else "refused" for _, s in got.status] == statuses
+    assert got.output == expected
