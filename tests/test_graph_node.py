@@ -321,3 +321,106 @@ def test_remote_shutdown(nodes) -> None:
     a = nodes("/victim")
     assert xmlrpc.client.ServerProxy(a.uri).shutdown("/x", "bye") == [1, "shutdown", 0]
     assert wait_until(lambda: a.is_shutdown)
+
+
+# ----------------------------------------------------------------------------- hostile publishers
+class FakePublisher:
+    """A slave API + TCP port that answers the handshake correctly, then misbehaves."""
+
+    def __init__(self, after_header: bytes) -> None:
+        from rosfpga_lab.graph import XmlRpcServer
+
+        self.after_header = after_header
+        self.tcp = socket.socket()
+        self.tcp.bind(("127.0.0.1", 0))
+        self.tcp.listen(8)
+        self.port = self.tcp.getsockname()[1]
+        self.accepted = 0
+        self.api = XmlRpcServer(lambda m, p: [1, "ready", ["TCPROS", "127.0.0.1", self.port]], name="/fake")
+        self.api.start()
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self) -> None:
+        while True:
+            try:
+                conn, _ = self.tcp.accept()
+            except OSError:
+                return
+            with conn:
+                self.accepted += 1
+                conn.settimeout(5)
+                conn.recv(65536)
+                conn.sendall(encode_header({"callerid": "/fake", "latching": "0", "md5sum": STRING_MD5,
+                                            "message_definition": "string data\n", "topic": "/t",
+                                            "type": "std_msgs/String"}) + self.after_header)
+
+    def close(self) -> None:
+        self.tcp.close()
+        self.api.stop()
+        self.thread.join(5)
+
+
+@pytest.mark.parametrize("tail,text", [
+    ((16).to_bytes(4, "little") + b"only half", "closed mid-frame: 9 of 16"),
+    ((0x7FFFFFFF).to_bytes(4, "little"), "over the limit"),
+    (b"\x05\x00", "inside a frame's length prefix"),
+], ids=["eof-mid-frame", "frame-over-cap", "eof-mid-prefix"])
+def test_subscriber_survives_bad_publisher_and_retries(nodes, tail, text) -> None:
+    fake = FakePublisher((5).to_bytes(4, "little") + b"\x01\x00\x00\x00A" + tail)
+    try:
+        node = nodes("/victim_sub")
+        got: list[dict] = []
+        sub = node.subscribe("/t", "std_msgs/String", got.append)
+        node._handle_xmlrpc("publisherUpdate", ("/master", "/t", [fake.api.uri]))
+        assert wait_until(lambda: any(text in e for e in sub.stats.errors), 10), sub.stats.errors
+        assert wait_until(lambda: fake.accepted >= 2, 10)  # reconnects with back-off
+        assert got and got[0] == {"data": "A"}  # the good frame before the bad bytes came through
+    finally:
+        fake.close()
+
+
+# ----------------------------------------------------------------------------- master selection, hosts
+def test_default_master_selection(monkeypatch) -> None:
+    from realros import free_port
+
+    import rosfpga_lab.graph.node as node_mod
+
+    monkeypatch.setenv("ROS_MASTER_URI", "http://127.0.0.1:5/")
+    assert node_mod.default_master_uri() == "http://127.0.0.1:5/"
+    monkeypatch.delenv("ROS_MASTER_URI")
+    port = free_port()
+    monkeypatch.setattr(node_mod, "DEFAULT_MASTER_PORT", port)
+    with EmbeddedMaster(port=port):  # something answers on the default port: use it
+        assert node_mod.default_master_uri() == f"http://127.0.0.1:{port}/"
+    try:  # nothing answers: the shared embedded master starts on the default port
+        uri = node_mod.default_master_uri()
+        assert uri == f"http://127.0.0.1:{port}/" and node_mod._shared is not None
+        n = Node("/auto")
+        assert n.master_uri == uri
+        n.shutdown()
+    finally:
+        node_mod.stop_shared_master()
+
+
+def test_ros_ip_and_hostname_are_honoured(monkeypatch) -> None:
+    from rosfpga_lab.graph import default_host
+
+    monkeypatch.delenv("ROS_IP", raising=False)
+    monkeypatch.delenv("ROS_HOSTNAME", raising=False)
+    assert default_host() == "127.0.0.1"
+    monkeypatch.setenv("ROS_HOSTNAME", "localhost")
+    assert default_host() == "localhost"
+    monkeypatch.setenv("ROS_IP", "127.0.0.1")
+    assert default_host() == "127.0.0.1"
+
+
+def test_node_on_localhost_hostname(master, monkeypatch) -> None:
+    monkeypatch.setenv("ROS_HOSTNAME", "localhost")
+    monkeypatch.delenv("ROS_IP", raising=False)
+    a = Node("/by_name", master=master)
+    try:
+        assert a.uri.startswith("http://localhost:")
+        assert xmlrpc.client.ServerProxy(a.uri).getPid("/x")[0] == 1
+    finally:
+        a.shutdown()

@@ -261,3 +261,11 @@ def test_fuzz_frame_decoder_only_lab_errors(data: bytes, chunk: int) -> None:
 @given(fields=st.dictionaries(st.text(min_size=1).filter(lambda k: "=" not in k), st.text(), max_size=6))
 def test_header_roundtrip(fields: dict[str, str]) -> None:
     assert decode_header(encode_header(fields))[0] == fields
+
+
+def test_frames_before_a_bad_length_are_not_lost() -> None:
+    dec = FrameDecoder(max_frame=100)
+    with pytest.raises(FrameError) as info:
+        dec.feed(encode_frame(b"good") + encode_frame(b"too") + u32(101))
+    assert [bytes(b) for b in info.value.partial] == [b"good", b"too"]
+    assert info.value.offset == 15

@@ -226,3 +226,18 @@ def test_fuzz_machines_only_lab_errors(data: bytes, chunk: int) -> None:
     except LabError:
         pass
     p.receive_eof()
+
+
+def test_frames_before_bad_length_are_delivered_as_partial_events() -> None:
+    from rosfpga_lab.tcpros import FrameError
+
+    s = SubscriberHandshake(callerid="/l", topic="/chatter", md5sum=MD5, type_name="std_msgs/String",
+                            max_frame=100)
+    s.initiate()
+    reply = encode_header(PublisherHandshake(callerid="/t", lookup=lookup).reply_fields(SPEC))
+    with pytest.raises(FrameError) as info:
+        s.receive_data(reply + encode_frame(BODY) + b"\xff\xff\xff\xff")
+    kinds = [type(e) for e in info.value.partial]
+    assert kinds == [HeaderReceived, Connected, Frame]
+    assert bytes(info.value.partial[-1].body) == BODY
+    assert s.state == "FAILED" and [t.trigger for t in s.history][-2:] == ["frame", "frame_bad"]

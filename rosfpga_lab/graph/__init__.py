@@ -34,7 +34,7 @@ from rosfpga_lab.graph.errors import (
 )
 from rosfpga_lab.graph.master import EmbeddedMaster, ParamTree
 from rosfpga_lab.graph.names import OpenBindWarning, default_host, master_uri_from_env, resolve
-from rosfpga_lab.graph.node import Node, shared_master, stop_shared_master
+from rosfpga_lab.graph.node import Node, default_master_uri, shared_master, stop_shared_master
 from rosfpga_lab.graph.publisher import LinkStats, Publisher, PublisherStats
 from rosfpga_lab.graph.subscriber import MessageInfo, Subscriber, SubscriberStats
 from rosfpga_lab.graph.trace import KINDS, Trace, TraceEvent
@@ -45,6 +45,6 @@ __all__ = [
     "RECONNECT_MAX", "XMLRPC_TIMEOUT", "ApiArgumentError", "ConfigError", "EmbeddedMaster",
     "GraphError", "LinkStats", "MasterError", "MessageInfo", "Node", "OpenBindWarning",
     "ParamTree", "Publisher", "PublisherStats", "Subscriber", "SubscriberStats", "Trace",
-    "TraceEvent", "XmlRpcError", "XmlRpcServer", "call", "default_host", "master_uri_from_env",
+    "TraceEvent", "XmlRpcError", "XmlRpcServer", "call", "default_host", "default_master_uri", "master_uri_from_env",
     "parse_xmlrpc", "resolve", "shared_master", "stop_shared_master",
 ]

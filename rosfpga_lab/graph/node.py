@@ -10,9 +10,10 @@ subscriber and connects to every publisher the master lists (see ``subscriber``)
 runs in daemon threads, so a node works inside a running Jupyter kernel; :meth:`shutdown`
 unregisters, closes every socket and joins every thread.
 
-Master selection (``master_uri``): an explicit URI; else ``ROS_MASTER_URI``; else the shared
-embedded master of this process (:func:`shared_master`), started on first use on port 11311
-(or a free port if 11311 is taken). Pass ``master=`` an :class:`EmbeddedMaster` to use it.
+Master selection (``master_uri``): an explicit URI; else ``ROS_MASTER_URI``; else a master
+already answering on 127.0.0.1:11311; else the shared embedded master of this process
+(:func:`shared_master`), started on first use on port 11311 (or a free port if 11311 is
+taken). Pass ``master=`` an :class:`EmbeddedMaster` to use that one.
 """
 
 from __future__ import annotations
@@ -58,15 +59,18 @@ from rosfpga_lab.tcpros import (
 
 _shared_lock = threading.Lock()
 _shared: EmbeddedMaster | None = None
+#: Port of roscore's master, probed and (if free) used by the shared embedded master.
+DEFAULT_MASTER_PORT = 11311
 
 
-def shared_master(port: int = 11311) -> EmbeddedMaster:
-    """The process-wide embedded master (started on first call; stopped by :func:`stop_shared_master`)."""
+def shared_master(port: int | None = None) -> EmbeddedMaster:
+    """The process-wide embedded master, started on first call on ``port`` (default 11311,
+    or any free port if that one is taken). Stop it with :func:`stop_shared_master`."""
     global _shared
     with _shared_lock:
         if _shared is None or not _shared.running:
             try:
-                _shared = EmbeddedMaster(port=port).start()
+                _shared = EmbeddedMaster(port=DEFAULT_MASTER_PORT if port is None else port).start()
             except XmlRpcError:
                 _shared = EmbeddedMaster(port=0).start()
         return _shared
@@ -81,13 +85,35 @@ def stop_shared_master() -> None:
             _shared = None
 
 
+def default_master_uri() -> str:
+    """The master a node uses when none is given.
+
+    ``ROS_MASTER_URI`` if set; else a master already answering on 127.0.0.1:11311 (a roscore
+    or ``rosfpga-lab master``); else the shared embedded master of this process.
+    """
+    env = master_uri_from_env()
+    if env:
+        return env
+    with _shared_lock:
+        if _shared is not None and _shared.running:
+            return _shared.uri
+    probe = f"http://127.0.0.1:{DEFAULT_MASTER_PORT}/"
+    try:
+        reply = call(probe, "getUri", "/rosfpga_lab_probe", timeout=0.5)
+        if isinstance(reply, list) and reply and reply[0] == 1:
+            return probe
+    except GraphError:
+        pass
+    return shared_master().uri
+
+
 class Node:
     """A ROS node.
 
     Args:
         name: node name (global, e.g. ``/fpga_node``; a relative name is made global).
-        master_uri: the master to use; None: ``ROS_MASTER_URI`` if set, else the shared
-            embedded master (see module docstring).
+        master_uri: the master to use; None: see :func:`default_master_uri` (ROS_MASTER_URI,
+            else a master on 127.0.0.1:11311, else the shared embedded master).
         host: address to bind and advertise; None: ``ROS_IP``, ``ROS_HOSTNAME``, else
             127.0.0.1. "0.0.0.0" binds every interface (with a warning).
         master: an :class:`EmbeddedMaster` to use (overrides ``master_uri``).
@@ -108,7 +134,7 @@ class Node:
         if master is not None:
             master_uri = master.uri
         elif master_uri is None:
-            master_uri = master_uri_from_env() or shared_master().uri
+            master_uri = default_master_uri()
         split_uri(master_uri)
         self.master_uri = master_uri
         self.host = host or default_host()

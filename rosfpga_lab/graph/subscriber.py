@@ -164,7 +164,11 @@ class _PublisherLink:
             except TimeoutError:
                 hs.timeout()
                 raise
-            events = hs.receive_data(data) if data else hs.receive_eof()
+            failure: ProtocolError | None = None
+            try:
+                events = hs.receive_data(data) if data else hs.receive_eof()
+            except ProtocolError as exc:  # deliver what came before the bad bytes, then fail
+                events, failure = exc.partial, exc
             for ev in events:
                 if isinstance(ev, Frame):
                     got = True
@@ -186,6 +190,8 @@ class _PublisherLink:
                     node.trace.record("tcp_close", node.name, role="in", src=publisher,
                                       dst=node.name, method=sub.topic, conn=conn)
                     return got
+            if failure is not None:
+                raise failure
             if not data:
                 return got
         return got

@@ -39,6 +39,9 @@ class ProtocolError(LabError):
     def __init__(self, message: str, *, offset: int | None = None) -> None:
         super().__init__(message)
         self.offset = offset
+        #: results decoded from the same input *before* the problem (frame bodies for a
+        #: FrameDecoder, events for a handshake machine): deliver them, nothing good is lost
+        self.partial: list = []
 
 
 class HeaderFormatError(ProtocolError):

@@ -3,8 +3,8 @@
 :class:`FrameDecoder` accepts any chunking: one byte at a time, many frames in one chunk, a
 frame split over chunks. When a whole frame sits inside one chunk it is returned as a
 zero-copy ``memoryview`` of that chunk; a frame assembled from several chunks is returned as
-``bytes`` (one copy into a buffer sized from the length prefix). Either way the caller gets a
-bytes-like object; call ``bytes(body)`` to keep it beyond the chunk's lifetime.
+a ``bytearray`` (one copy into a buffer sized from the length prefix, then handed over). Either
+way the caller gets a bytes-like object; call ``bytes(body)`` for an immutable copy.
 """
 
 from __future__ import annotations
@@ -57,15 +57,24 @@ class FrameDecoder:
                 f"{self.max_frame}: the stream is out of sync, or raise max_frame",
                 offset=self._start)
 
-    def feed(self, data: bytes | bytearray | memoryview) -> list[bytes | memoryview]:
+    def feed(self, data: bytes | bytearray | memoryview) -> list[bytes | bytearray | memoryview]:
         """Add bytes; return every frame body completed by them (possibly none).
 
         Raises:
-            FrameError: a length prefix over ``max_frame`` (the decoder is then unusable).
+            FrameError: a length prefix over ``max_frame`` (the decoder is then unusable); the
+                frames completed before it are in the exception's ``partial`` list.
         """
-        view = memoryview(data).cast("B") if not isinstance(data, memoryview) else data.cast("B")
-        out: list[bytes | memoryview] = []
+        out: list[bytes | bytearray | memoryview] = []
         self.starts = []
+        try:
+            self._feed(data, out)
+        except FrameError as exc:
+            exc.partial = out
+            raise
+        return out
+
+    def _feed(self, data: bytes | bytearray | memoryview, out: list) -> None:
+        view = memoryview(data).cast("B") if not isinstance(data, memoryview) else data.cast("B")
         pos, end = 0, len(view)
         while pos < end:
             if self._body is None:
@@ -108,11 +117,10 @@ class FrameDecoder:
             pos += take
             self.offset += take
             if self._have == len(self._body):
-                out.append(bytes(self._body))
+                out.append(self._body)  # a fresh buffer per frame: hand it over, no copy
                 self.starts.append(self._start)
                 self._body = None
                 self.frames += 1
-        return out
 
     def eof(self) -> None:
         """Tell the decoder the stream ended.

@@ -258,7 +258,8 @@ class SubscriberHandshake(_Machine):
         """Feed bytes from the publisher; return the events they complete.
 
         Raises:
-            RemoteError, HandshakeRejected, HeaderFormatError, FrameError: see the table.
+            RemoteError, HandshakeRejected, HeaderFormatError, FrameError: see the table. A
+                FrameError's ``partial`` holds the events decoded before the bad length.
         """
         if self.state == "AWAIT_HEADER":
             try:
@@ -284,7 +285,11 @@ class SubscriberHandshake(_Machine):
                                     self.fields["tcp_nodelay"] == "1"))
             self._frames = FrameDecoder(max_frame=self._max_frame, stream_offset=self._header.consumed)
             if self._header.remainder:
-                events += self._frames_from(self._header.remainder)
+                try:
+                    events += self._frames_from(self._header.remainder)
+                except ProtocolError as exc:
+                    exc.partial = events + exc.partial
+                    raise
             return events
         if self.state == "STREAMING":
             return self._frames_from(data)
@@ -293,11 +298,15 @@ class SubscriberHandshake(_Machine):
     def _frames_from(self, data: bytes | memoryview) -> list[Event]:
         assert self._frames is not None
         dec = self._frames
+        start = dec.frames
         try:
-            start = dec.frames
             bodies = dec.feed(data)
-        except ProtocolError:
+        except ProtocolError as exc:
+            good = [Frame(b, start + i, at) for i, (b, at) in enumerate(zip(exc.partial, dec.starts))]
+            for _ in good:
+                self._fire("frame")
             self._fire("frame_bad")
+            exc.partial = good
             raise
         out: list[Event] = []
         for i, (body, at) in enumerate(zip(bodies, dec.starts)):
