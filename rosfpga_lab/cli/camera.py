@@ -1,0 +1,156 @@
+"""``rosfpga-lab camera`` (publish images) and ``rosfpga-lab view TOPIC`` (receive and save them).
+
+Both live here because they are the two ends of the same test set-up: a camera when there is
+no camera, and a screen when there is no screen.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import threading
+import time
+from pathlib import Path
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"size must be WIDTHxHEIGHT, e.g. 640x480, got {text!r}") from None
+    return w, h
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--master-uri", metavar="URI",
+                   help="ROS master (default: ROS_MASTER_URI, else http://127.0.0.1:11311/ "
+                   "from --config, else the lab's embedded master in this process)")
+    p.add_argument("--name", metavar="NODE", help="node name")
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``camera`` and ``view`` sub-commands."""
+    p = subparsers.add_parser(
+        "camera", help="publish sensor_msgs/Image frames: a photo, files or a moving scene",
+        description="Publish sensor_msgs/Image frames at a fixed rate, size and encoding, for "
+        "when there is no camera: a moving synthetic scene, the photo matplotlib ships "
+        "(grace_hopper), an image file or a directory of images, panned so frames differ. "
+        "header.stamp is the publish time (for latency), header.seq the frame number. With "
+        "--config the topic, size and encoding come from a node configuration, so the frames "
+        "fit its circuit. Example: rosfpga-lab camera --config data/fpga_dilate_rgba8.yaml")
+    p.add_argument("--config", type=Path, metavar="CONFIG",
+                   help="take topic (the circuit's input), size, encoding and master from this "
+                   "node configuration")
+    p.add_argument("--topic", help="topic to publish (default: /image_raw)")
+    p.add_argument("--size", type=_size, metavar="WxH", help="frame size (default: 640x480)")
+    p.add_argument("--encoding", choices=("rgba8", "bgra8", "rgb8", "bgr8", "mono8"),
+                   help="image encoding (default: rgba8)")
+    p.add_argument("--rate", type=float, default=30.0, help="frames per second (default: 30)")
+    p.add_argument("--source", default="synthetic",
+                   help="synthetic (default), grace_hopper, an image file or a directory")
+    p.add_argument("--count", type=int, default=None, help="stop after N frames (default: run on)")
+    p.add_argument("--frame-id", default="camera", help="header.frame_id (default: camera)")
+    _common(p)
+    p.set_defaults(func=run_camera)
+
+    v = subparsers.add_parser(
+        "view", help="receive sensor_msgs/Image frames: count, time and save them as PNG",
+        description="Subscribe to an image topic and show what arrives: a status line with "
+        "frames, fps and latency (receive time minus header.stamp), and, with --save, PNG files "
+        "of the frames (mono8, rgb8, bgr8, rgba8, bgra8). Example: "
+        "rosfpga-lab view /image_dilated --save out --every 30")
+    v.add_argument("topic", metavar="TOPIC", help="the image topic")
+    v.add_argument("--save", type=Path, metavar="DIR", help="write frames as PNG into DIR")
+    v.add_argument("--every", type=int, default=1, metavar="N", help="save one frame in N (default: 1)")
+    v.add_argument("--latest", action="store_true",
+                   help="overwrite DIR/latest.png instead of numbering the files")
+    v.add_argument("--count", type=int, default=None, help="stop after N frames")
+    v.add_argument("--timeout", type=float, default=None, metavar="S",
+                   help="give up after S seconds (exit code 1 if fewer than --count arrived)")
+    _common(v)
+    v.set_defaults(func=run_view)
+
+
+def _master_uri(args: argparse.Namespace, config_uri: str | None = None) -> str | None:
+    from rosfpga_lab.graph import master_uri_from_env
+
+    return args.master_uri or master_uri_from_env() or config_uri
+
+
+def run_camera(args: argparse.Namespace) -> int:
+    """Publish until Ctrl-C or --count."""
+    from rosfpga_lab.component import Camera
+    from rosfpga_lab.hls import load_config
+
+    topic, size, encoding, config_uri = "/image_raw", (640, 480), "rgba8", None
+    if args.config is not None:
+        cfg = load_config(args.config)
+        topic, size, encoding = cfg.subscriber.topic, (cfg.image.width, cfg.image.height), cfg.image.encoding
+        config_uri = cfg.node.master_uri
+    topic = args.topic or topic
+    size = args.size or size
+    encoding = args.encoding or encoding
+    cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
+                 source=args.source, name=args.name or "/camera", master_uri=_master_uri(args, config_uri),
+                 frame_id=args.frame_id)
+    print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on {topic} "
+          f"at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop", flush=True)
+    stop = threading.Event()
+    tty = sys.stdout.isatty()
+    worker = threading.Thread(target=cam.run, kwargs={"count": args.count, "stop": stop}, daemon=True)
+    worker.start()
+    try:
+        while worker.is_alive():
+            worker.join(0.5)
+            if tty:
+                print(f"\rsent {cam.sent}  subscribers {cam.publisher.get_num_connections()}   ",
+                      end="", flush=True)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        stop.set()
+        worker.join(5.0)
+        if tty:
+            print()
+        cam.stop()
+    print(f"sent {cam.sent} frames", flush=True)
+    return 0
+
+
+def run_view(args: argparse.Namespace) -> int:
+    """Receive until Ctrl-C, --count or --timeout."""
+    from rosfpga_lab.component import Viewer
+
+    viewer = Viewer(args.topic, save_dir=args.save, every=args.every, latest_only=args.latest,
+                    name=args.name or "/viewer", master_uri=_master_uri(args))
+    print(f"{viewer.node.name}: listening on {args.topic}; master {viewer.node.master_uri}"
+          + (f"; saving into {args.save}" if args.save else "") + "; Ctrl-C to stop", flush=True)
+    tty = sys.stdout.isatty()
+    deadline = None if args.timeout is None else time.monotonic() + args.timeout
+    try:
+        while args.count is None or viewer.received < args.count:
+            if deadline is not None and time.monotonic() >= deadline:
+                break
+            time.sleep(0.2)
+            if tty:
+                lat = viewer.latency.summary()
+                last = viewer.last
+                what = f"{last.width}x{last.height} {last.encoding}" if last else "-"
+                print(f"\rframes {viewer.received}  {viewer.fps:5.1f} fps  {what}  latency "
+                      f"{lat.ms()}   ", end="", flush=True)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if tty:
+            print()
+        viewer.stop()
+    lat = viewer.latency.summary()
+    print(f"received {viewer.received} frames; latency (stamp -> arrival) {lat.ms()}"
+          + (f"; saved {len(viewer.saved)} PNG files in {args.save}" if args.save else ""))
+    for problem in viewer.problems[:5]:
+        print(f"problem: {problem}", file=sys.stderr)
+    if args.count is not None and viewer.received < args.count:
+        print(f"rosfpga-lab view: only {viewer.received} of {args.count} frames arrived",
+              file=sys.stderr)
+        return 1
+    return 0

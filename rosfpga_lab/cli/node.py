@@ -1,0 +1,119 @@
+"""``rosfpga-lab node CONFIG``: run the emulated FPGA component until Ctrl-C."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``node`` sub-command."""
+    p = subparsers.add_parser(
+        "node", help="run the ROS-compliant FPGA component (emulated) from a node config",
+        description="Run the FPGA component described by a node configuration (the same YAML "
+        "file 'rosfpga-lab generate' reads): it registers with the ROS master, subscribes to "
+        "the input topic, pushes every TCPROS frame through the modelled circuit and publishes "
+        "the result. A status line shows frames, fps, drops and latency; Ctrl-C stops it "
+        "cleanly and prints a summary. Example: rosfpga-lab node data/fpga_dilate_rgba8.yaml")
+    p.add_argument("config", type=Path, metavar="CONFIG", help="the node configuration file (YAML)")
+    p.add_argument("--master-uri", metavar="URI",
+                   help="ROS master to use instead of the configuration's node.master_uri")
+    p.add_argument("--embedded-master", action="store_true",
+                   help="start the lab's embedded master at that URI when none answers there")
+    p.add_argument("--model", choices=("fast", "reference"), default="fast",
+                   help="circuit model: fast (numpy, default) or reference (byte at a time; "
+                   "small images only)")
+    p.add_argument("--input-queue", type=int, default=None, metavar="N",
+                   help="frames waiting in front of the circuit before the oldest is dropped "
+                   "(default: 2)")
+    p.add_argument("--output-queue", type=int, default=None, metavar="N",
+                   help="frames waiting per downstream subscriber before the oldest is dropped "
+                   "(default: 2)")
+    p.add_argument("--duration", type=float, default=None, metavar="S",
+                   help="stop by itself after S seconds (default: run until Ctrl-C)")
+    p.add_argument("--status-interval", type=float, default=0.5, metavar="S",
+                   help="seconds between status updates (default: 0.5; 0: no status line)")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="no status line and no log lines, only the final summary")
+    p.set_defaults(func=run)
+
+
+def _master_answers(uri: str) -> bool:
+    from rosfpga_lab.graph import GraphError, call
+
+    try:
+        call(uri, "getPid", "/rosfpga_lab_node", timeout=2.0)
+        return True
+    except GraphError:
+        return False
+
+
+def run(args: argparse.Namespace) -> int:
+    """Start the component, show the status until interrupted, stop cleanly."""
+    from rosfpga_lab.component import FpgaComponent, limits
+    from rosfpga_lab.graph import EmbeddedMaster
+    from rosfpga_lab.graph.xmlrpc import split_uri
+
+    if not args.quiet:
+        logging.basicConfig(level=logging.INFO, format="[%(levelname)s] %(message)s",
+                            stream=sys.stderr)
+    kw = {}
+    if args.input_queue is not None:
+        kw["input_queue"] = args.input_queue
+    if args.output_queue is not None:
+        kw["output_queue"] = args.output_queue
+    component = FpgaComponent.from_config(args.config, master_uri=args.master_uri,
+                                          model=args.model, **kw)
+    master = None
+    if not _master_answers(component.master_uri):
+        if not args.embedded_master:
+            print(f"rosfpga-lab node: error: no ROS master answers at {component.master_uri}; "
+                  "start one (roscore, or 'rosfpga-lab master') or add --embedded-master",
+                  file=sys.stderr)
+            return 1
+        host, port, _path = split_uri(component.master_uri)
+        master = EmbeddedMaster(host=host, port=port).start()
+        print(f"started the embedded master at {master.uri}", file=sys.stderr)
+    stop = threading.Event()
+    previous = signal.getsignal(signal.SIGTERM)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    component.start()
+    tty = sys.stdout.isatty()
+    print(f"{component.name}: {component.input_topic} -> {component.pipeline.op} "
+          f"({args.model} model) -> {component.output_topic}; master {component.master_uri}; "
+          "Ctrl-C to stop", flush=True)
+    t_end = None if args.duration is None else time.monotonic() + args.duration
+    interval = args.status_interval if args.status_interval > 0 and not args.quiet else 1.0
+    last_print = 0.0
+    try:
+        while not stop.wait(min(interval, limits.WATCHDOG_PERIOD)):
+            now = time.monotonic()
+            if t_end is not None and now >= t_end:
+                break
+            if args.quiet or args.status_interval <= 0:
+                continue
+            line = component.stats.status_line()
+            if tty:
+                print("\r" + line.ljust(100), end="", flush=True)
+            elif now - last_print >= max(5.0, interval):
+                print(line, flush=True)
+                last_print = now
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if tty and not args.quiet:
+            print()
+        stats = component.stats
+        component.stop()
+        if master is not None:
+            master.stop()
+        if threading.current_thread() is threading.main_thread():
+            signal.signal(signal.SIGTERM, previous)
+    print(stats.report(), flush=True)
+    return 0
