@@ -36,39 +36,49 @@ def _scalar(base: str) -> st.SearchStrategy:
     return st.integers(low, high)
 
 
-def element(reg: MsgRegistry, base: str, max_len: int) -> st.SearchStrategy:
-    """Strategy of one element of builtin or message type ``base``."""
+def element(reg: MsgRegistry, base: str, max_len: int,
+            canonical_time: bool = False) -> st.SearchStrategy:
+    """Strategy of one element of builtin or message type ``base``.
+
+    ``canonical_time`` keeps time/duration nsecs in [0, 1e9) (genpy canonicalizes on decode).
+    """
     if base in SCALARS:
         return _scalar(base)
+    canon = st.integers(0, 999_999_999)
     if base == "time":
-        return st.builds(Time, st.integers(0, 2**32 - 1), st.integers(0, 2**32 - 1))
+        return st.builds(Time, st.integers(0, 2**32 - 1),
+                         canon if canonical_time else st.integers(0, 2**32 - 1))
     if base == "duration":
-        return st.builds(Duration, st.integers(-2**31, 2**31 - 1), st.integers(-2**31, 2**31 - 1))
+        return st.builds(Duration, st.integers(-2**31, 2**31 - 1),
+                         canon if canonical_time else st.integers(-2**31, 2**31 - 1))
     if base == "string":
         return st.text(max_size=6)
-    return message(reg, base, max_len)
+    return message(reg, base, max_len, canonical_time)
 
 
-def field(reg: MsgRegistry, f: Field, max_len: int) -> st.SearchStrategy:
+def field(reg: MsgRegistry, f: Field, max_len: int,
+          canonical_time: bool = False) -> st.SearchStrategy:
     """Strategy of the value of field ``f`` (arrays up to ``max_len`` elements)."""
     if not f.is_array:
-        return element(reg, f.base_type, max_len)
+        return element(reg, f.base_type, max_len, canonical_time)
     low, high = (f.array_length, f.array_length) if f.array_length is not None else (0, max_len)
     base = f.base_type
     if base in ("uint8", "char"):
         return st.binary(min_size=low, max_size=high if f.array_length is not None else 12) \
             .flatmap(lambda b: st.sampled_from([b, np.frombuffer(b, np.uint8), list(b)]))
-    items = st.lists(element(reg, base, max_len), min_size=low, max_size=high)
+    items = st.lists(element(reg, base, max_len, canonical_time), min_size=low, max_size=high)
     if base in SCALARS:
         dtype = SCALARS[base].dtype
         return items.flatmap(lambda xs: st.sampled_from([xs, np.array(xs, dtype=dtype)]))
     return items
 
 
-def message(reg: MsgRegistry, type_name: str, max_len: int = MAX_LEN) -> st.SearchStrategy:
+def message(reg: MsgRegistry, type_name: str, max_len: int = MAX_LEN,
+            canonical_time: bool = False) -> st.SearchStrategy:
     """Strategy of dict values of ``type_name`` (arrays up to ``max_len`` elements)."""
     spec = reg.get(type_name)
-    return st.fixed_dictionaries({f.name: field(reg, f, max_len) for f in spec.fields})
+    return st.fixed_dictionaries({f.name: field(reg, f, max_len, canonical_time)
+                                  for f in spec.fields})
 
 
 def normalize(reg: MsgRegistry, type_name: str, value: Any) -> Any:
