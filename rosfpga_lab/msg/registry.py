@@ -188,10 +188,12 @@ class MsgRegistry:
                 raise UnknownTypeError(
                     f"message type {name!r} is ambiguous: {', '.join(sorted(matches))}; "
                     "give the package (PKG/Name)", name, tuple(self._searched))
-            candidates = [f"*/{name}"]
+            raise UnknownTypeError(
+                f"unknown message type {name!r}: no loaded package has a type of that name; "
+                f"searched: {self._where()}", name, tuple(self._searched))
         pkg = candidates[0].split("/")[0]
         hint = ""
-        if pkg != "*" and pkg not in self.packages():
+        if pkg not in self.packages():
             hint = f" (no package {pkg!r} is loaded; add its folder with --msg-path / load_path)"
         raise UnknownTypeError(
             f"unknown message type {candidates[0]!r}{hint}; searched: {self._where()}",
