@@ -356,6 +356,10 @@ class FakePublisher:
                                             "type": "std_msgs/String"}) + self.after_header)
 
     def close(self) -> None:
+        try:
+            self.tcp.shutdown(socket.SHUT_RDWR)  # wakes the accept() of _serve
+        except OSError:
+            pass
         self.tcp.close()
         self.api.stop()
         self.thread.join(5)
