@@ -25,6 +25,7 @@ from rosfpga_lab.widgets import (
     spans_from_connection_header,
     spans_from_frame,
     spans_from_http,
+    spans_from_tcpros_stream,
 )
 from rosfpga_lab.widgets._common import PALETTE, ROLE_COLOURS
 
@@ -154,7 +155,8 @@ def test_static_html_carries_meaning_without_css_or_js() -> None:
     # every field: a tooltip on its bytes and a table row with its colour swatch
     for i, s in enumerate(bm.spans):
         assert f'title="{html.escape(bm.describe(i), quote=True)}"' in out
-        assert f'<td style="background:{bm.colour(i)};width:14px;border:1px solid #888"></td><td>{s.path}</td>' in out
+        assert f'<td style="background:{bm.colour(i)};width:14px;border:1px solid #888"></td><td>{bm.label(i)}</td>' in out
+    assert bm.label(3) == "header.frame_id [length]" and bm.label(4) == "header.frame_id"
 
 
 def test_static_html_of_a_megabyte_is_one_page() -> None:
@@ -290,3 +292,24 @@ def test_message_viewer_on_a_sensor_msgs_image() -> None:
     span = v.select_byte(height_at + 2)
     assert (span.path, span.offset, span.size, span.value) == ("height", height_at, 4, 2)
     assert "height \u00b7 uint32 \u00b7 offset 19 \u00b7 size 4 \u00b7 value 2" in v.bytemap.describe(v.selected)
+
+
+def test_tcpros_stream_spans_header_then_frames() -> None:
+    from rosfpga_lab import msg
+    from rosfpga_lab.tcpros import encode_header
+
+    reg = msg.default_registry()
+    header = encode_header({"type": "std_msgs/String"})
+    frames = b"".join(struct.pack("<I", 4 + len(t)) + struct.pack("<I", len(t)) + t for t in (b"a", b"bc"))
+    raw = header + frames + b"\x09\x00"  # plus the first 2 bytes of a third frame's length
+    spans = spans_from_tcpros_stream(raw, "std_msgs/String", registry=reg)
+    assert sum(s.size for s in spans) == len(raw)
+    ByteMap(raw, spans)
+    by = {s.path: s for s in spans}
+    h = len(header)
+    assert by["type"].value == "std_msgs/String"
+    assert (by["msg[0].frame length"].offset, by["msg[0].frame length"].value) == (h, 5)
+    assert [s.value for s in spans if s.path == "msg[1].data"] == [2, "bc"]
+    # frame 0 took 9 bytes; frame 1: its 4-byte length, the string's length prefix, the text
+    assert [s.offset for s in spans if s.path == "msg[1].data"] == [h + 9 + 4, h + 9 + 8]
+    assert by["msg[2].frame length (truncated)"].role == "error"

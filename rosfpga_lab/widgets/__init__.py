@@ -2,7 +2,10 @@
 
 Every widget is constructible without a running kernel or front end (so plain pytest can test
 its logic), and each has a static HTML form (``to_html()``) that needs no JavaScript, for
-exported notebooks and GitHub's notebook view. Quick reference::
+exported notebooks and GitHub's notebook view: the widgets put it in their output beside the
+live view (as ``text/html``), ``show_static(w)`` displays it alone, and exporting an executed
+notebook with ``NbConvertBase.display_data_priority = STATIC_EXPORT_PRIORITY`` picks it. Quick
+reference::
 
     from rosfpga_lab import widgets as W
     W.ByteViewer(raw, spans)                          # any bytes + [(offset, size, path, type, value, role)]
@@ -17,7 +20,7 @@ exported notebooks and GitHub's notebook view. Quick reference::
     with W.Progress(total, "dilate") as p: p.update()  # or W.track(iterable, desc=...)
 """
 
-from rosfpga_lab.widgets._common import WidgetError
+from rosfpga_lab.widgets._common import STATIC_EXPORT_PRIORITY, WidgetError, show_static
 from rosfpga_lab.widgets.beats import BeatMap, BeatViewer, MarkerMismatch
 from rosfpga_lab.widgets.byte_sources import (
     message_spans,
@@ -27,6 +30,7 @@ from rosfpga_lab.widgets.byte_sources import (
     spans_from_field_layout,
     spans_from_frame,
     spans_from_http,
+    spans_from_tcpros_stream,
     view_bytes,
 )
 from rosfpga_lab.widgets.byteview import ByteMap, ByteViewer, Span, as_span
@@ -44,10 +48,11 @@ from rosfpga_lab.widgets.sequence import (
 )
 
 __all__ = [
+    "STATIC_EXPORT_PRIORITY", "show_static",
     "BeatMap", "BeatViewer", "ByteMap", "ByteViewer", "FrameDiff", "ImageDiffViewer", "LiveView",
     "MarkerMismatch", "Progress", "RateMeter", "SeqEvent", "SequenceDiagram", "Span", "SvgPane",
     "Throttle", "WidgetError", "as_span", "events_from_trace", "in_notebook", "message_spans",
     "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
-    "spans_from_http", "track", "view_bytes",
+    "spans_from_http", "spans_from_tcpros_stream", "track", "view_bytes",
 ]

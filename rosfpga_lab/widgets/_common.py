@@ -42,6 +42,40 @@ class WidgetError(LabError):
     """Bad input to a notebook widget (wrong shape, overlapping fields, unknown field name)."""
 
 
+#: Output priority for exporting executed notebooks to self-contained HTML that needs no widget
+#: JavaScript (offline): static forms first. Pass as ``NbConvertBase.display_data_priority``.
+STATIC_EXPORT_PRIORITY = ["text/html", "image/svg+xml", "image/png", "image/jpeg", "text/markdown",
+                          "text/latex", "text/plain"]
+
+
+def show_static(widget: Any) -> None:
+    """Display ``widget.to_html()`` as plain HTML (a frozen copy that needs no kernel to render)."""
+    from IPython.display import HTML, display
+
+    display(HTML(widget.to_html()))
+
+
+class StaticFallback:
+    """Mixin for widgets: put ``self.to_html()`` in the output beside the live widget view.
+
+    JupyterLab shows the live view; exported HTML, nbviewer and GitHub (which run no widget
+    JavaScript) show the static HTML instead. Set ``static_fallback = False`` on an instance
+    to leave it out.
+    """
+
+    static_fallback = True
+
+    def to_html(self) -> str:  # pragma: no cover - every user defines it
+        raise NotImplementedError
+
+    def _repr_mimebundle_(self, **kwargs: Any) -> Any:
+        bundle = super()._repr_mimebundle_(**kwargs)  # type: ignore[misc]
+        if not self.static_fallback or bundle is None:
+            return bundle
+        data, meta = bundle if isinstance(bundle, tuple) else (bundle, {})
+        return dict(data, **{"text/html": self.to_html()}), meta
+
+
 # Pastel colours that keep black text readable; adjacent fields get different ones.
 PALETTE = (
     "#ffd6a5", "#caffbf", "#9bf6ff", "#bdb2ff", "#ffc6ff", "#fdffb6",

@@ -18,7 +18,7 @@ from typing import Any
 import ipywidgets as w
 import numpy as np
 
-from rosfpga_lab.widgets._common import BEAT_PAGE_SIZE, WAVE_BEATS, WidgetError, esc
+from rosfpga_lab.widgets._common import BEAT_PAGE_SIZE, WAVE_BEATS, StaticFallback, WidgetError, esc
 
 TUSER_COLOUR = "#b9fbc0"
 TLAST_COLOUR = "#a0c4ff"
@@ -266,10 +266,13 @@ class BeatMap:
         return self.to_html()
 
 
-class BeatViewer(w.VBox):
+class BeatViewer(StaticFallback, w.VBox):
     """Beats linked to pixels: pick a beat to see its pixel, or a pixel to see its beat.
 
     Args: as :class:`BeatMap` (or pass a ready ``BeatMap`` as ``beats``).
+
+    Its output carries the static form (:meth:`BeatMap.to_html`: summary, waveform and table of
+    the first beats, marker mismatches) for views without a kernel.
     """
 
     def __init__(self, beats: Any = None, **kwargs: Any) -> None:

@@ -97,6 +97,32 @@ def spans_from_connection_header(raw: bytes) -> list[Span]:
     return spans
 
 
+def spans_from_tcpros_stream(raw: bytes, type_name: str | None = None, *, registry: Any = None) -> list[Span]:
+    """Spans of one direction of a TCPROS connection: the connection header, then message frames.
+
+    Header spans are named as in :func:`spans_from_connection_header`; frame ``k``'s spans are
+    prefixed ``msg[k].`` (``msg[0].frame length``, ``msg[0].header.seq`` ...). A frame cut off by
+    the end of ``raw`` is labelled as such.
+    """
+    if len(raw) < 4:
+        return spans_from_connection_header(raw)
+    (total,) = _U32.unpack_from(raw, 0)
+    end = min(len(raw), 4 + total)
+    spans = [s for s in spans_from_connection_header(raw[:end])]
+    pos, k = end, 0
+    while pos < len(raw):
+        rest = raw[pos:]
+        length = _U32.unpack_from(rest, 0)[0] if len(rest) >= 4 else None
+        chunk = rest if length is None else rest[:4 + length]
+        full = length is not None and len(chunk) == 4 + length
+        inner = spans_from_frame(chunk, type_name if full else None, registry=registry)
+        for sp in inner:
+            spans.append(Span(sp.offset + pos, sp.size, f"msg[{k}].{sp.path}", sp.type, sp.value, sp.role))
+        pos += len(chunk)
+        k += 1
+    return spans
+
+
 _XML_PIECES = re.compile(rb"<methodName>.*?</methodName>|<param>.*?</param>|<fault>.*?</fault>", re.S)
 
 

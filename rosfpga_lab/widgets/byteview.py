@@ -32,6 +32,7 @@ from rosfpga_lab.widgets._common import (
     BYTE_PAGE_SIZE_MAX,
     BYTE_ROW_SIZE,
     FIELD_LIST_LIMIT,
+    StaticFallback,
     WidgetError,
     colour_for,
     esc,
@@ -176,10 +177,16 @@ class ByteMap:
         """Background colour of span ``index``."""
         return colour_for(index, self.spans[index].role)
 
+    def label(self, index: int) -> str:
+        """Span ``index``'s path, with its role in brackets unless it is a plain value
+        (``header.frame_id [length]``)."""
+        s = self.spans[index]
+        return s.path + (f" [{s.role}]" if s.role not in ("", "value") else "")
+
     def describe(self, index: int) -> str:
         """One line naming span ``index``: path, type, offset, size and decoded value."""
         s = self.spans[index]
-        parts = [s.path + (f" [{s.role}]" if s.role not in ("", "value") else "")]
+        parts = [self.label(index)]
         if s.type:
             parts.append(s.type)
         parts += [f"offset {s.offset}", f"size {s.size}"]
@@ -289,7 +296,7 @@ class ByteMap:
             value = format_value(s.value) if s.value is not None else hex_bytes(self.data[s.offset:s.offset + s.size], 8)
             out.append(
                 f'<tr><td style="background:{self.colour(idx)};width:14px;border:1px solid #888"></td>'
-                f"<td>{esc(s.path)}</td><td>{esc(s.type)}</td><td>{s.offset}</td><td>{s.size}</td>"
+                f"<td>{esc(self.label(idx))}</td><td>{esc(s.type)}</td><td>{s.offset}</td><td>{s.size}</td>"
                 f"<td>{esc(value)}</td></tr>")
         if len(rows) > max_table_rows:
             out.append(f'<tr><td></td><td colspan="5">\u2026 {len(rows) - max_table_rows} more fields on this page</td></tr>')
@@ -304,7 +311,7 @@ class ByteMap:
         return self.to_html(0)
 
 
-class ByteViewer(anywidget.AnyWidget):
+class ByteViewer(StaticFallback, anywidget.AnyWidget):
     """Live byte viewer: hover a byte to name its field, click to select it, page through.
 
     Args:
@@ -404,19 +411,10 @@ class ByteViewer(anywidget.AnyWidget):
         """The static HTML form (current page unless ``page`` is given)."""
         return self.bytemap.to_html(self.page if page is None else page)
 
-    def _repr_mimebundle_(self, **kwargs: Any) -> Any:
-        bundle = super()._repr_mimebundle_(**kwargs)
-        if self.static_fallback and bundle is not None:
-            data, meta = bundle
-            data = dict(data, **{"text/html": self.to_html()})
-            return data, meta
-        return bundle
-
     # --- sync ---------------------------------------------------------------------------------
     def _field_dict(self, i: int) -> dict[str, Any]:
         s = self.bytemap.spans[i]
-        label = s.path + (f" [{s.role}]" if s.role not in ("", "value") else "")
-        return {"i": i, "path": s.path, "label": label, "type": s.type, "offset": s.offset, "size": s.size,
+        return {"i": i, "path": s.path, "label": self.bytemap.label(i), "type": s.type, "offset": s.offset, "size": s.size,
                 "colour": self.bytemap.colour(i), "info": self.bytemap.describe(i)}
 
     def _send_page(self) -> None:

@@ -21,6 +21,7 @@ import numpy as np
 from rosfpga_lab.widgets._common import (
     DIFF_POSITIONS_LIMIT,
     DISPLAY_MAX_WIDTH,
+    StaticFallback,
     ZOOM_MAX,
     WidgetError,
     as_image,
@@ -233,7 +234,7 @@ def _as_frames(frames: Iterable[Any], tolerance: int, channel_order: str) -> lis
     return out
 
 
-class ImageDiffViewer(w.VBox):
+class ImageDiffViewer(StaticFallback, w.VBox):
     """Input, model output, reference and difference for one frame or a sequence (slider).
 
     Args:
@@ -242,6 +243,8 @@ class ImageDiffViewer(w.VBox):
             keys, or ``(input, output, reference)`` (or ``(output, reference)``) tuples.
         tolerance, channel_order: as :class:`FrameDiff`.
         max_width: largest display width of each image.
+
+    Its output carries a static form (:meth:`to_html`) for views without a kernel.
     """
 
     def __init__(self, output: Any = None, reference: Any = None, input: Any = None, *,
@@ -325,7 +328,15 @@ class ImageDiffViewer(w.VBox):
         self.zoom.value = f.zoom_html(x, y, self.size.value)
         self.images["difference"].value = f.diff_png(self.max_width, box=f.region(x, y, self.size.value))
 
-    def to_html(self) -> str:
-        """Static HTML of every frame (each as :meth:`FrameDiff.to_html`)."""
-        return "".join(f"<h4>frame {i}</h4>" * (len(self.frames) > 1) + f.to_html(self.max_width)
-                       for i, f in enumerate(self.frames))
+    def to_html(self, all_frames: bool = False) -> str:
+        """Static HTML: the frame on screen in full (:meth:`FrameDiff.to_html`) and, for a
+        sequence, one summary line per frame (``all_frames=True`` renders every frame in full,
+        which for long sequences makes a large page)."""
+        k = self.frame.value
+        if len(self.frames) == 1:
+            return self.current.to_html(self.max_width)
+        rows = "".join(f"<tr><td>{i}</td><td>{esc(f.summary())}</td></tr>" for i, f in enumerate(self.frames))
+        table = f'<table style="font-size:12px"><tr><th>frame</th><th>result</th></tr>{rows}</table>'
+        shown = range(len(self.frames)) if all_frames else [k]
+        body = "".join(f"<h4>frame {i}</h4>" + self.frames[i].to_html(self.max_width) for i in shown)
+        return f"<div>{table}{body}</div>"

@@ -20,7 +20,7 @@ import anywidget
 import ipywidgets as w
 import traitlets
 
-from rosfpga_lab.widgets._common import WidgetError, esc, hex_bytes
+from rosfpga_lab.widgets._common import StaticFallback, WidgetError, esc, hex_bytes
 from rosfpga_lab.widgets.byte_sources import spans_for
 from rosfpga_lab.widgets.byteview import ByteMap, ByteViewer, Span, as_span
 
@@ -228,7 +228,7 @@ class SvgPane(anywidget.AnyWidget):
     selected = traitlets.Int(-1).tag(sync=True)
 
 
-class SequenceDiagram(w.VBox):
+class SequenceDiagram(StaticFallback, w.VBox):
     """The clickable diagram, a list of the arrows, and a byte viewer of the selected arrow's bytes.
 
     Args:
@@ -272,10 +272,3 @@ class SequenceDiagram(w.VBox):
     def to_html(self, with_bytes: bool = True) -> str:
         """The static HTML form (see :func:`sequence_html`)."""
         return sequence_html(self.events, self.participants, with_bytes=with_bytes)
-
-    def _repr_mimebundle_(self, **kwargs: Any) -> Any:
-        bundle = super()._repr_mimebundle_(**kwargs)
-        if self.static_fallback and bundle is not None:
-            data, meta = bundle if isinstance(bundle, tuple) else (bundle, {})
-            return dict(data, **{"text/html": self.to_html()}), meta
-        return bundle
