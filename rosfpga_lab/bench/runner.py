@@ -1,0 +1,180 @@
+"""``rosfpga-lab bench``: every figure in one run, printed side by side.
+
+How this works: (1) :func:`~rosfpga_lab.bench.pipeline.bench_pipeline` times the fast circuit
+model against ``cv2.dilate`` alone; (2) :func:`~rosfpga_lab.bench.path.measure` runs the same
+publisher and subscriber around each middle in turn -- nothing (baseline), the FPGA component,
+roscpp's ``topic_tools relay`` and a rospy relay (the last two only where real ROS 1 is
+installed) -- and the table shows their frames/s, drops and latency in one place.
+"""
+
+from __future__ import annotations
+
+import math
+import platform
+import subprocess
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rosfpga_lab.bench.path import (
+    PROGRAMS, ROS_PYTHON, PathFigures, bench_images, component_command, find_relay, measure,
+    ros_env, rospy_missing,
+)
+from rosfpga_lab.bench.pipeline import PipelineFigures, bench_pipeline
+from rosfpga_lab.component import default_config, expected_output
+from rosfpga_lab.graph import EmbeddedMaster
+from rosfpga_lab.hls import NodeConfig, load_config
+
+MIDDLES = ("direct", "component", "roscpp", "rospy")
+
+
+@dataclass
+class BenchReport:
+    """Everything one ``rosfpga-lab bench`` run measured."""
+
+    machine: str
+    config: NodeConfig
+    pipeline: PipelineFigures | None
+    paths: list[PathFigures] = field(default_factory=list)
+
+    def table(self) -> str:
+        """The printed report (Markdown tables)."""
+        cfg = self.config
+        img = f"{cfg.image.width}x{cfg.image.height} {cfg.image.encoding}"
+        out = [f"machine: {self.machine}", ""]
+        if self.pipeline is not None:
+            p = self.pipeline
+            out += [
+                f"(1) circuit model vs OpenCV alone, {img}, {cfg.application.op} "
+                f"{cfg.application.ksize}x{cfg.application.ksize}, {p.frames} frames:",
+                "",
+                "| what | frames/s |",
+                "|---|---:|",
+                f"| fast pipeline model (TCPROS frame in -> frame out, all stages) | {p.pipeline_fps:,.0f} |",
+                f"| cv2.{cfg.application.op} alone (image in -> image out) | {p.opencv_fps:,.0f} |",
+                f"| modelled circuit at {cfg.clock_mhz:g} MHz (cycle count) | {p.circuit_fps:,.1f} |",
+                "",
+                f"OpenCV alone is {p.ratio:.1f}x the pipeline model; the model's output equals "
+                f"OpenCV's: {'yes' if p.bit_exact else 'NO'}",
+                "",
+            ]
+        if self.paths:
+            base = next((f for f in self.paths if f.name.startswith("direct") and f.available), None)
+            out += [
+                f"(2) publisher -> middle -> subscriber, {img}, loopback, each middle its own "
+                "process:",
+                "",
+                "| middle | sustained frames/s | at rate: received/sent | latency median | p95 "
+                "| added median | outputs correct |",
+                "|---|---:|---:|---:|---:|---:|---:|",
+            ]
+            for f in self.paths:
+                if not f.available:
+                    out.append(f"| {f.name} | not run: {f.note} | | | | | |")
+                    continue
+                added = (f.latency.median - base.latency.median) * 1e3 if base is not None else math.nan
+                added_text = "(baseline)" if f is base else f"{added:+.1f} ms"
+                out.append(
+                    f"| {f.name} | {f.sustained_fps:.1f} | {f.received}/{f.sent} at {f.rate:g}/s | "
+                    f"{f.latency.median * 1e3:.1f} ms | {f.latency.p95 * 1e3:.1f} ms | {added_text} | "
+                    f"{f.correct}/{f.checked} |")
+            out.append("")
+            out += self.verdict()
+        return "\n".join(out)
+
+    def verdict(self) -> list[str]:
+        """The issue's goals, each with what was measured."""
+        comp = next((f for f in self.paths if f.name.startswith("FPGA") and f.available), None)
+        relay = next((f for f in self.paths if f.name.startswith("roscpp") and f.available), None)
+        base = next((f for f in self.paths if f.name.startswith("direct") and f.available), None)
+        lines = []
+        if comp is not None and relay is not None:
+            ok = comp.sustained_fps >= relay.sustained_fps
+            lines.append(f"goal: component at least as fast as the roscpp relay: "
+                         f"{'met' if ok else 'NOT met'} ({comp.sustained_fps:.1f} vs "
+                         f"{relay.sustained_fps:.1f} frames/s)")
+        if comp is not None:
+            ok = comp.drops == 0
+            lines.append(f"goal: no drops at {comp.rate:g} frames/s: {'met' if ok else 'NOT met'} "
+                         f"({comp.drops} dropped of {comp.sent})")
+            if base is not None:
+                added = (comp.latency.median - base.latency.median) * 1e3
+                lines.append(f"goal: median added latency < 5 ms: {'met' if added < 5 else 'NOT met'} "
+                             f"({added:+.1f} ms over the direct path)")
+        return lines
+
+
+def machine_description() -> str:
+    """CPU model and core count (as lscpu reports them)."""
+    model = platform.processor() or platform.machine()
+    cores = ""
+    try:
+        text = subprocess.run(["lscpu"], capture_output=True, text=True, timeout=10).stdout
+        for line in text.splitlines():
+            key, _, value = line.partition(":")
+            if key.strip() == "Model name":
+                model = value.strip()
+            elif key.strip() == "CPU(s)":
+                cores = value.strip()
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return f"{model}, {cores or '?'} CPU(s), Python {platform.python_version()}, {platform.system()}"
+
+
+def run_bench(config: NodeConfig | str | Path | None = None, *, middles: tuple[str, ...] = MIDDLES,
+              frames: int = 300, window: int = 2, rate: float = 30.0, rate_frames: int = 90,
+              pipeline_frames: int = 100, skip_pipeline: bool = False,
+              progress: Callable[[str], None] | None = None) -> BenchReport:
+    """Measure everything (see module docstring); middles whose tools are missing are noted."""
+    say = progress or (lambda _t: None)
+    if config is None:
+        config = default_config()
+    elif not isinstance(config, NodeConfig):
+        config = load_config(config)
+    report = BenchReport(machine_description(), config, None)
+    if not skip_pipeline:
+        say("pipeline model vs OpenCV ...")
+        report.pipeline = bench_pipeline(config, pipeline_frames)
+    cfg = config.image
+    images = bench_images(cfg.width, cfg.height, cfg.encoding)
+    app = config.application
+    op = "copy" if app.op == "passthrough" else app.op
+    dilate = lambda img: expected_output(img, op, (app.ksize, app.ksize))  # noqa: E731
+    same = lambda img: img  # noqa: E731
+    in_topic, out_topic = config.subscriber.topic, config.publisher.topic
+    with tempfile.TemporaryDirectory(prefix="rosfpga-bench-") as tmp:
+        config_path = config.path
+        if config_path is None:
+            from rosfpga_lab.component.demo import _FALLBACK_CONFIG
+
+            config_path = Path(tmp) / "fpga.yaml"
+            config_path.write_text(_FALLBACK_CONFIG)
+        with EmbeddedMaster(port=0) as master:
+            env = ros_env(master.uri)
+            plan: list[tuple[str, list[str] | None, object, str]] = []
+            if "direct" in middles:
+                plan.append(("direct (no middle, baseline)", None, same, ""))
+            if "component" in middles:
+                plan.append((f"FPGA component ({app.op}, lab)",
+                             component_command(config_path, master.uri), dilate, ""))
+            if "roscpp" in middles:
+                relay = find_relay()
+                plan.append(("roscpp topic_tools relay", [relay, in_topic, out_topic] if relay else None,
+                             same, "" if relay else "topic_tools not installed"))
+            if "rospy" in middles:
+                missing = rospy_missing()
+                plan.append(("rospy relay (AnyMsg)",
+                             None if missing else [ROS_PYTHON, str(PROGRAMS / "rospy_relay.py"),
+                                                   in_topic, out_topic],
+                             same, missing or ""))
+            for name, command, expect, missing in plan:
+                if missing:
+                    report.paths.append(PathFigures(name, available=False, note=missing))
+                    continue
+                say(f"{name} ...")
+                fig = measure(name, master, in_topic, out_topic, command, env=env, images=images,
+                              encoding=cfg.encoding, expect=expect, frames=frames, window=window,
+                              rate=rate, rate_frames=rate_frames)
+                report.paths.append(fig)
+    return report

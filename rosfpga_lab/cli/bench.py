@@ -1,0 +1,50 @@
+"""``rosfpga-lab bench``: the circuit model against OpenCV, and the component against relays."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``bench`` sub-command."""
+    p = subparsers.add_parser(
+        "bench", help="benchmark the circuit model and the component against ROS relays",
+        description="Print, from one run: (1) the fast circuit model's frames/s beside "
+        "cv2.dilate alone; (2) a publisher -> middle -> subscriber path on loopback, with no "
+        "middle (baseline), the FPGA component, roscpp's topic_tools relay and a rospy relay "
+        "(the last two where real ROS 1 is installed): sustained frames/s, drops and latency at "
+        "a fixed rate, and the latency each middle adds. Each middle runs as its own process. "
+        "Takes about a minute; close other heavy programs for steady figures.")
+    p.add_argument("--config", type=Path, metavar="CONFIG",
+                   help="node configuration (default: data/fpga_dilate_rgba8.yaml, 640x480 rgba8)")
+    p.add_argument("--middles", default=",".join(("direct", "component", "roscpp", "rospy")),
+                   help="comma-separated subset of direct,component,roscpp,rospy (default: all)")
+    p.add_argument("--frames", type=int, default=300,
+                   help="frames in the sustained phase, per middle (default: 300)")
+    p.add_argument("--window", type=int, default=2,
+                   help="frames in flight in the sustained phase (default: 2)")
+    p.add_argument("--rate", type=float, default=30.0, help="rate of the second phase (default: 30)")
+    p.add_argument("--rate-frames", type=int, default=90,
+                   help="frames sent in the second phase (default: 90)")
+    p.add_argument("--no-pipeline", action="store_true", help="skip the model-vs-OpenCV part")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the benchmark and print the tables."""
+    from rosfpga_lab.bench import MIDDLES, run_bench
+
+    middles = tuple(m.strip() for m in args.middles.split(",") if m.strip())
+    unknown = [m for m in middles if m not in MIDDLES]
+    if unknown:
+        print(f"rosfpga-lab bench: error: unknown middle(s) {', '.join(unknown)}; choose from "
+              f"{', '.join(MIDDLES)}", file=sys.stderr)
+        return 2
+    report = run_bench(args.config, middles=middles, frames=args.frames, window=args.window,
+                       rate=args.rate, rate_frames=args.rate_frames, skip_pipeline=args.no_pipeline,
+                       progress=None if args.quiet else (lambda t: print(t, file=sys.stderr, flush=True)))
+    print(report.table(), flush=True)
+    return 0
