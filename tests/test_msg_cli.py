@@ -98,3 +98,11 @@ def test_module_entry_point() -> None:
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "geometry_msgs/Pose e45d45a5a1ce597b249e23fb30fc871f\n"
+
+
+def test_bench_script_prints_a_table() -> None:
+    from rosfpga_lab.msg import bench
+
+    table = bench.run(repeat=1)
+    assert "Image 640x480 rgba8" in table and "PoseArray 1000 poses" in table
+    assert "1228848" in table  # body size of the 640x480 rgba8 image with frame_id 'camera'
