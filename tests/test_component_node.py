@@ -1,0 +1,353 @@
+"""The FPGA component on the lab's own graph: frames through, figures, bad input and faults.
+
+Every output is compared with OpenCV run on the input (never with the lab's own circuit
+models). Everything runs on loopback against an embedded master on a free port.
+"""
+
+from __future__ import annotations
+
+import logging
+import socket
+import threading
+import time
+
+import cv2
+import numpy as np
+import pytest
+
+from rosfpga_lab.component import ComponentConfigError, FpgaComponent
+from rosfpga_lab.graph import EmbeddedMaster, Node
+from rosfpga_lab.hls import load_config, parse_config
+from rosfpga_lab.hw import image_frame
+from rosfpga_lab.msg import default_registry
+from rosfpga_lab.tcpros import encode_header
+
+CONFIG = """\
+node: {{name: /fpga_test}}
+subscriber: {{topic: /cam, type: sensor_msgs/Image}}
+publisher: {{topic: /cam_out, type: sensor_msgs/Image}}
+image: {{width: {w}, height: {h}, encoding: {enc}}}
+application: {{op: {op}, ksize: {k}}}
+"""
+
+
+def config(w: int = 64, h: int = 48, enc: str = "rgba8", op: str = "dilate", k: int = 3):
+    return parse_config(CONFIG.format(w=w, h=h, enc=enc, op=op, k=k))
+
+
+def picture(k: int, h: int = 48, w: int = 64, c: int = 4) -> np.ndarray:
+    rng = np.random.default_rng(k)
+    return rng.integers(0, 256, (h, w, c), dtype=np.uint8)
+
+
+def cv2_dilate(img: np.ndarray, k: int = 3) -> np.ndarray:
+    return cv2.dilate(img, np.ones((k, k), np.uint8)).reshape(img.shape)
+
+
+class Collector:
+    """A lab subscriber that keeps every output frame's body."""
+
+    def __init__(self, master: EmbeddedMaster, topic: str = "/cam_out", name: str = "/collector",
+                 **kw) -> None:
+        self.bodies: list[bytes] = []
+        self.cond = threading.Condition()
+        self.node = Node(name, master=master)
+        self.sub = self.node.subscribe(topic, "sensor_msgs/Image", self._cb, raw=True,
+                                       queue_size=0, **kw)
+
+    def _cb(self, body, info) -> None:
+        with self.cond:
+            self.bodies.append(bytes(body))
+            self.cond.notify_all()
+
+    def wait(self, n: int, timeout: float = 10.0) -> bool:
+        deadline = time.monotonic() + timeout
+        with self.cond:
+            while len(self.bodies) < n:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self.cond.wait(left)
+        return True
+
+    def images(self, shape: tuple[int, ...]) -> list[np.ndarray]:
+        size = int(np.prod(shape))
+        return [np.frombuffer(b[-size:], np.uint8).reshape(shape) for b in self.bodies]
+
+
+@pytest.fixture
+def master():
+    with EmbeddedMaster(port=0) as m:
+        yield m
+
+
+@pytest.fixture
+def rig(master):
+    """A started component (64x48 rgba8 dilate 3x3), a publisher node and a collector."""
+    comp = FpgaComponent.from_config(config(), master=master).start()
+    src = Node("/source", master=master)
+    pub = src.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+    out = Collector(master)
+    assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+    yield comp, pub, out
+    out.node.shutdown()
+    src.shutdown()
+    comp.stop()
+
+
+def send(pub, img: np.ndarray, k: int, encoding: str = "rgba8") -> None:
+    pub.publish_body(image_frame(img, encoding, seq=k, stamp=(100 + k, k), frame_id="cam")[4:])
+
+
+def test_every_output_is_opencvs_dilation_and_header_is_carried(rig) -> None:
+    comp, pub, out = rig
+    sent = [picture(k) for k in range(20)]
+    for k, img in enumerate(sent):
+        send(pub, img, k)
+        assert comp.wait_for(k + 1, 10)
+    assert out.wait(20), comp.stats.report()
+    reg = default_registry()
+    from rosfpga_lab.msg import deserialize
+
+    for k, (img, body) in enumerate(zip(sent, out.bodies)):
+        msg = deserialize(reg, "sensor_msgs/Image", body)
+        got = np.asarray(msg["data"], np.uint8).reshape(img.shape)
+        assert np.array_equal(got, cv2_dilate(img)), f"frame {k}"
+        assert (msg["header"]["stamp"][0], msg["header"]["stamp"][1]) == (100 + k, k)
+        assert msg["header"]["frame_id"] == "cam"
+        assert (msg["height"], msg["width"], msg["encoding"], msg["step"]) == (48, 64, "rgba8", 256)
+    st = comp.stats
+    assert (st.received, st.processed, st.published, st.refused, st.dropped) == (20, 20, 20, 0, 0)
+    assert st.latency.count == 20 and 0 < st.latency.median < 1.0
+    # cycle figures of a 64x48 rgba8 frame: 12,288 data bytes through the byte-wide stages
+    assert st.cycles["fifo2axi"] == 64 * 48 * 4 and st.cycles["axivideo2mat"] == 64 * 48
+    assert st.fifo_high_water == {"rx": 1}
+    assert st.subscribers == 1 and st.publishers == 1
+
+
+def test_wrong_size_and_encoding_are_refused_counted_and_next_frame_is_right(rig, caplog) -> None:
+    comp, pub, out = rig
+    caplog.set_level(logging.WARNING, logger="rosfpga_lab.component")
+    send(pub, picture(1, h=24, w=32), 0)                         # wrong size
+    assert comp.wait_for(1, 10)
+    send(pub, picture(2, c=3), 1, encoding="rgb8")               # wrong encoding
+    assert comp.wait_for(2, 10)
+    send(pub, picture(3, c=1), 2, encoding="mono8")              # wrong encoding
+    assert comp.wait_for(3, 10)
+    # a frame whose data is one byte short of height*step (a broken publisher)
+    short = bytearray(image_frame(picture(4), "rgba8", seq=3, stamp=(9, 9))[4:])
+    pub.publish_body(bytes(short[:-1]))
+    assert comp.wait_for(4, 10)
+    good = picture(5)
+    send(pub, good, 4)
+    assert comp.wait_for(5, 10)
+    assert out.wait(1)
+    time.sleep(0.1)
+    assert len(out.bodies) == 1
+    assert np.array_equal(out.images(good.shape)[0], cv2_dilate(good))
+    st = comp.stats
+    assert st.refused == 4 and st.published == 1 and comp.running
+    reasons = " | ".join(st.refused_reasons)
+    assert "height: " in reasons and "encoding: " in reasons and "'rgb8'" in reasons
+    assert "'mono8'" in reasons
+    assert sum(st.refused_reasons.values()) == 4
+    assert "refused x" in st.report()
+    logged = [r.getMessage() for r in caplog.records if "refused frame" in r.getMessage()]
+    assert len(logged) == 4 and any("circuit was built for" in m for m in logged)
+    recs = list(comp.recent)
+    assert [r.error != "" for r in recs] == [True, True, True, False]  # history 4: last four
+    assert recs[-1].result is not None and recs[-1].latency >= 0
+
+
+def test_observers_see_frames_and_a_raising_observer_does_not_stop_the_path(rig) -> None:
+    comp, pub, out = rig
+    seen = []
+
+    def bad(_rec):
+        raise RuntimeError("observer bug")
+
+    comp.add_observer(seen.append)
+    comp.add_observer(bad)
+    for k in range(3):
+        send(pub, picture(k), k)
+        assert comp.wait_for(k + 1, 10)
+    assert out.wait(3)
+    assert comp.wait_for(3)
+    time.sleep(0.05)
+    assert [r.index for r in seen] == [0, 1, 2]
+    assert np.array_equal(seen[0].output_image, cv2_dilate(picture(0)))
+    assert comp.stats.observer_errors == 3
+    comp.remove_observer(bad)
+    send(pub, picture(9), 9)
+    assert out.wait(4)
+    assert comp.stats.observer_errors == 3
+
+
+def test_busy_circuit_drops_oldest_input_and_says_so(master) -> None:
+    comp = FpgaComponent.from_config(config(), master=master, input_queue=1).start()
+    gate = threading.Event()
+    comp.add_observer(lambda rec: gate.wait(5))  # the circuit stalls on its first frame
+    src = Node("/source", master=master)
+    pub = src.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+    out = Collector(master)
+    try:
+        assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+        for k in range(6):
+            send(pub, picture(k), k)
+        deadline = time.monotonic() + 5
+        while comp.stats.received < 6 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        gate.set()
+        assert out.wait(2)
+        time.sleep(0.2)
+        st = comp.stats
+        # first frame in the circuit, one waiting (queue 1): the other four were dropped
+        assert st.received == 6 and st.dropped_input == 4 and st.published == 2
+        assert "input queue full" in st.report()
+        got = out.images((48, 64, 4))
+        assert np.array_equal(got[-1], cv2_dilate(picture(5)))  # the newest frame survived
+    finally:
+        out.node.shutdown()
+        src.shutdown()
+        comp.stop()
+
+
+def test_slow_subscriber_loses_frames_by_queue_policy_others_do_not(rig, master) -> None:
+    comp, pub, out = rig
+    big = FpgaComponent.from_config(config(640, 480), master=master, name="/fpga_big",
+                                    output_queue=2)
+    # topics of its own so the two components do not meet
+    big.input_topic, big.output_topic = "/big_in", "/big_out"
+    big.start()
+    src = Node("/big_source", master=master)
+    bpub = src.advertise("/big_in", "sensor_msgs/Image", queue_size=0)
+    fast = Collector(master, "/big_out", "/fast_reader")
+    # the slow subscriber: handshakes, then never reads (tiny receive buffer)
+    slow = socket.socket()
+    slow.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    slow.connect(("127.0.0.1", big.node.tcpros_port))
+    slow.sendall(encode_header({"callerid": "/slow_reader", "topic": "/big_out",
+                                "md5sum": default_registry().md5("sensor_msgs/Image"),
+                                "type": "sensor_msgs/Image"}))
+    try:
+        assert big.wait_for_subscribers(2, 10) and bpub.wait_for_subscribers(1, 10)
+        img = picture(7, 480, 640)
+        for k in range(12):
+            send(bpub, img, k)
+            time.sleep(0.01)
+        assert fast.wait(12, 20), big.stats.report()
+        assert big.wait_for(12, 10)
+        time.sleep(0.3)
+        st = big.stats
+        assert st.dropped_output > 0 and st.dropped_output_by_peer.keys() == {"/slow_reader"}
+        assert "output queue full for subscriber /slow_reader" in st.report()
+        assert st.published == 12 and st.dropped_input == 0
+        assert all(np.array_equal(g, cv2_dilate(img)) for g in fast.images(img.shape))
+    finally:
+        slow.close()
+        fast.node.shutdown()
+        src.shutdown()
+        big.stop()
+
+
+def test_input_publisher_dies_and_returns(rig, master) -> None:
+    comp, pub, out = rig
+    send(pub, picture(0), 0)
+    assert out.wait(1)
+    pub.node.shutdown()                       # the publisher goes away (unregisters)
+    time.sleep(0.3)
+    assert comp.stats.publishers == 0 and comp.running
+    again = Node("/source", master=master)    # and comes back under the same name
+    try:
+        pub2 = again.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+        assert pub2.wait_for_subscribers(1, 10)
+        send(pub2, picture(1), 1)
+        assert out.wait(2)
+        assert np.array_equal(out.images((48, 64, 4))[1], cv2_dilate(picture(1)))
+    finally:
+        again.shutdown()
+
+
+def test_master_restart_component_registers_again(master) -> None:
+    port = master.port
+    comp = FpgaComponent.from_config(config(), master_uri=master.uri).start()
+    out = Collector(master)
+    try:
+        assert comp.wait_for_subscribers(1, 10)
+        master.stop()
+        time.sleep(1.5)                                   # a watchdog round sees no master
+        assert not comp.stats.master_ok
+        with EmbeddedMaster(port=port) as master2:        # the master comes back, empty
+            deadline = time.monotonic() + 5
+            while comp.stats.master_reregistrations == 0 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            st = comp.stats
+            assert st.master_reregistrations == 1 and st.master_ok
+            # a publisher that starts after the restart finds the component through the new master
+            src = Node("/late_source", master=master2)
+            try:
+                pub = src.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+                assert pub.wait_for_subscribers(1, 10)
+                send(pub, picture(3), 3)
+                assert out.wait(1, 10)                    # the old output connection still works
+                assert np.array_equal(out.images((48, 64, 4))[0], cv2_dilate(picture(3)))
+            finally:
+                src.shutdown()
+            assert "registered again with the master 1 time" in comp.stats.report()
+    finally:
+        out.node.shutdown()
+        comp.stop()
+
+
+def test_stop_is_clean_and_idempotent(master) -> None:
+    before = {t.ident for t in threading.enumerate()}
+    comp = FpgaComponent.from_config(config(), master=master).start()
+    assert comp.running and "running" in repr(comp)
+    comp.stop()
+    comp.stop()
+    assert not comp.running
+    time.sleep(0.1)
+    left = [t.name for t in threading.enumerate() if t.ident not in before and t.is_alive()]
+    assert left == []
+    reply = master.getSystemState("/t")
+    assert all("/fpga_test" not in nodes for _topic, nodes in reply[2][0] + reply[2][1])
+
+
+def test_started_from_the_generator_config_file(master) -> None:
+    cfg = load_config("data/fpga_erode_mono8.yaml")
+    comp = FpgaComponent.from_config("data/fpga_erode_mono8.yaml", master=master)
+    assert comp.name == cfg.node.global_name == "/fpga_erode"
+    assert (comp.input_topic, comp.output_topic) == ("/camera/image_mono", "/camera/image_eroded")
+    assert (comp.pipeline.width, comp.pipeline.height, comp.pipeline.encoding) == (320, 240, "mono8")
+    assert (comp.pipeline.op, comp.pipeline.ksize) == ("erode", (5, 5))
+    assert comp.master_uri == master.uri
+    assert FpgaComponent.from_config(cfg).master_uri == "http://127.0.0.1:11311/"
+
+
+def test_custom_application_cannot_be_emulated(tmp_path) -> None:
+    src = tmp_path / "f.cpp"
+    src.write_text("void image_filter() {}\n")
+    cfg = parse_config(CONFIG.format(w=8, h=8, enc="mono8", op="custom", k=3).replace(
+        "ksize: 3}", f"ksize: 3, source: {src}}}"), base_dir=tmp_path)
+    with pytest.raises(ComponentConfigError, match="custom"):
+        FpgaComponent(cfg)
+    with pytest.raises(ComponentConfigError, match="at least 1"):
+        FpgaComponent(config(), input_queue=0)
+
+
+def test_reference_model_gives_the_same_bytes(master) -> None:
+    comp = FpgaComponent.from_config(config(16, 12), master=master, model="reference").start()
+    src = Node("/source", master=master)
+    pub = src.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+    out = Collector(master)
+    try:
+        assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+        img = picture(11, 12, 16)
+        send(pub, img, 0)
+        assert out.wait(1, 20)
+        assert np.array_equal(out.images(img.shape)[0], cv2_dilate(img))
+        assert comp.stats.cycles["axivideo2mat"] == 16 * 12
+    finally:
+        out.node.shutdown()
+        src.shutdown()
+        comp.stop()
