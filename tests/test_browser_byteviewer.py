@@ -21,6 +21,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import nbformat
+import numpy as np
 import pytest
 
 from realros import free_port, skip_or_fail
@@ -185,6 +186,9 @@ def test_click_a_byte_in_jupyterlab_names_its_field(lab: Lab, tmp_path: Path) ->
     page = lab.run_notebook("byteviewer.ipynb", [BUILD_CELL, REPORT_CELL])
     byte = page.locator(f'.rfl-bv .rfl-bv-hex .b[data-off="{HEIGHT_OFFSET}"]')
     byte.wait_for(state="visible")
+    # hovering names the field under the mouse (here `width`, the next four bytes)
+    page.locator(f'.rfl-bv .rfl-bv-hex .b[data-off="{HEIGHT_OFFSET + 5}"]').hover()
+    page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.startsWith('width')")
     byte.click()
     page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.includes('height')")
     text = page.locator(".rfl-bv-info").text_content()
@@ -221,9 +225,11 @@ diagram = SequenceDiagram([
 display(diagram)
 ref = (np.arange(8 * 8 * 3) % 256).astype(np.uint8).reshape(8, 8, 3)
 out = ref.copy(); out[2, 5] = 0
-display(ImageDiffViewer(out, ref, ref))
+diff = ImageDiffViewer(out, ref, ref)
+display(diff)
 td = np.arange(12, dtype=np.uint32)
-display(BeatViewer(tdata=td, tkeep=0b0111, tuser=td == 0, tlast=td % 4 == 3, width=4, height=3, bytes_per_pixel=3))
+display(BeatViewer(tdata=td, tkeep=0b0111, tuser=td == 0, tlast=td % 4 == 3, width=4, height=3,
+                   bytes_per_pixel=3, image=ref[:3, :4]))
 live = LiveView(max_fps=5, trailing=False)
 display(live)
 live.update(ref)
@@ -249,8 +255,17 @@ def test_other_widgets_render_and_a_sequence_arrow_opens_its_bytes(lab: Lab, tmp
     assert "value '/a'" in page.locator(".rfl-bv-info").text_content()
     assert page.locator('.rfl-svgpane g.sel[data-index="1"]').count() == 1
     # image diff, beat viewer and live view drew their images and tables
-    page.wait_for_function("document.querySelectorAll('.jp-OutputArea-output img').length >= 5")
+    page.wait_for_function("document.querySelectorAll('.jp-OutputArea-output img').length >= 6")
     text = page.locator(".jp-OutputArea").first.text_content()
+    # clicking the output image's pixel (1, 6) zooms there: its value table is outlined at (1, 6)
+    picture = page.locator(".rfl-clickimage img").nth(1)
+    box = picture.bounding_box()
+    picture.click(position={"x": box["width"] * 1.5 / 8, "y": box["height"] * 6.5 / 8})
+    page.wait_for_function("[...document.querySelectorAll('.jp-OutputArea-output input')]"
+                           ".some(e => e.value === '6')")
+    cells = page.eval_on_selector_all("td", "els => els.filter(e => e.style.outline.includes('solid'))"
+                                            ".map(e => e.textContent)")
+    assert ",".join(str(v) for v in (np.arange(8 * 8 * 3) % 256).reshape(8, 8, 3)[6, 1]) in cells, cells
     assert "1 of 64 pixels differ" in text and "12 beats carrying 36 bytes" in text and "1 frames received" in text
     lab.screenshot(page, tmp_path / "widgets.png")
     page.locator(".jp-OutputArea-output img").first.scroll_into_view_if_needed()

@@ -121,7 +121,11 @@ def test_viewer_single_frame_and_sequence() -> None:
     assert "2 of 64 pixels differ" in v.summary.value
     assert v.next_mismatch() == (1, 6) and (v.x.value, v.y.value) == (1, 6)
     assert set(v.images) == {"input", "output", "reference", "difference"}
-    assert bytes(v.images["difference"].value).startswith(b"\x89PNG")
+    assert v.images["difference"].png.startswith(b"\x89PNG")
+    v.images["output"].click(6, 7)  # a click on any image zooms there
+    assert (v.x.value, v.y.value) == (6, 7) and "output x 0..7, y 0..7" in v.zoom.value
+    marked = ",".join(str(c) for c in bad[7, 6])
+    assert f"outline:2px solid #00f\">{marked}</td>" in v.zoom.value
     with pytest.raises(WidgetError, match="frame 3 does not exist"):
         v.show(3)
     single = ImageDiffViewer(bad, ref)
@@ -234,7 +238,7 @@ def test_beat_viewer_links_beats_and_pixels() -> None:
     assert v.beat.value == 8
     v.beat.value = 3  # and the other way round
     assert (v.x.value, v.y.value) == (3, 0)
-    assert "<svg" in v.wave.value and 'outline:2px solid #d00"><td>3</td>' in v.table.value
+    assert "<svg" in v.wave.value and 'outline:2px solid #d00"><td style="padding:1px 4px">3</td>' in v.table.value
 
 
 def test_beat_table_and_static_html_mark_tuser_tlast_and_errors() -> None:
@@ -248,3 +252,31 @@ def test_beat_table_and_static_html_mark_tuser_tlast_and_errors() -> None:
     assert "0 (expected 1)" in table    # beat 2 lost its tlast
     html = m.to_html()
     assert "beat 2: tlast is 0, expected 1" in html and "<svg" in html and "<script" not in html
+
+
+def test_beat_viewer_picture_click_selects_the_pixels_beat() -> None:
+    img = _image(3, 4)
+    td, tk, tu, tl = _rgb_beats(img)
+    v = BeatViewer(tdata=td, tkeep=tk, tuser=tu, tlast=tl, width=4, height=3, bytes_per_pixel=3, image=img)
+    assert v.picture is not None and v.picture.png.startswith(b"\x89PNG")
+    v.picture.click(2, 1)
+    assert v.beat.value == 6 and (v.x.value, v.y.value) == (2, 1)
+    shown = cv2.imdecode(np.frombuffer(v.picture.png, np.uint8), cv2.IMREAD_COLOR)[:, :, ::-1]
+    scale = shown.shape[1] // 4
+    blue = np.argwhere((shown == (0, 0, 255)).all(axis=2))
+    # the outline sits just outside pixel (2, 1) of the enlarged picture
+    assert blue[:, 1].min() == 2 * scale - 1 and blue[:, 1].max() == 3 * scale
+    assert blue[:, 0].min() == 1 * scale - 1 and blue[:, 0].max() == 2 * scale
+    with pytest.raises(WidgetError, match="image is 3x3 but the beats carry 4x3 pixels"):
+        BeatViewer(tdata=td, width=4, height=3, bytes_per_pixel=3, image=img[:, :3])
+
+
+def test_beat_viewer_from_pipeline_result() -> None:
+    from rosfpga_lab.hw import Pipeline, image_frame
+
+    img = _image(4, 5, 4)
+    res = Pipeline(op="dilate").process(image_frame(img, "rgba8"))
+    v = BeatViewer.from_result(res, "output")
+    assert len(v.map) == 20 and v.map.marker_mismatches() == []
+    assert v.map.beat_bytes(7) == res.output_image[1, 2].tobytes()
+    assert v.picture is not None

@@ -193,3 +193,32 @@ def downscale(rgb: np.ndarray, max_width: int = DISPLAY_MAX_WIDTH) -> np.ndarray
     """``rgb`` reduced by an integer step so it is at most ``max_width`` wide."""
     step = -(-rgb.shape[1] // max_width) if rgb.shape[1] > max_width else 1
     return rgb[::step, ::step] if step > 1 else rgb
+
+
+def enlarged_png(rgb: np.ndarray, *, step: int = 1, max_width: int = DISPLAY_MAX_WIDTH,
+                 box: tuple[int, int, int, int] | None = None) -> tuple[bytes, int]:
+    """PNG of ``rgb`` (already shrunk by ``step``) enlarged for display, with an optional box.
+
+    Args:
+        rgb: HxWx3 display image.
+        step: how much ``rgb`` was shrunk from the source (box coordinates are source pixels).
+        max_width: enlargement stops below this width.
+        box: inclusive ``(x0, y0, x1, y1)`` in source pixels, outlined in blue one pixel outside.
+
+    Returns:
+        ``(png bytes, displayed width)``.
+    """
+    scale = display_scale(rgb.shape[1], max_width)
+    big = np.repeat(np.repeat(rgb, scale, axis=0), scale, axis=1) if scale > 1 else rgb.copy()
+    if box is not None:
+        h, w_ = big.shape[:2]
+        x0, y0 = box[0] // step * scale - 1, box[1] // step * scale - 1
+        x1, y1 = (box[2] // step + 1) * scale, (box[3] // step + 1) * scale
+        xs, ys = slice(max(x0, 0), min(x1, w_ - 1) + 1), slice(max(y0, 0), min(y1, h - 1) + 1)
+        for y in (y0, y1):
+            if 0 <= y < h:
+                big[y, xs] = (0, 0, 255)
+        for x in (x0, x1):
+            if 0 <= x < w_:
+                big[ys, x] = (0, 0, 255)
+    return png_bytes(big), int(big.shape[1])

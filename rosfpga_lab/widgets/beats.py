@@ -18,7 +18,17 @@ from typing import Any
 import ipywidgets as w
 import numpy as np
 
-from rosfpga_lab.widgets._common import BEAT_PAGE_SIZE, WAVE_BEATS, StaticFallback, WidgetError, esc
+from rosfpga_lab.widgets._common import (
+    BEAT_PAGE_SIZE,
+    WAVE_BEATS,
+    StaticFallback,
+    WidgetError,
+    as_image,
+    display_rgb,
+    enlarged_png,
+    esc,
+)
+from rosfpga_lab.widgets.clickimage import ClickImage
 
 TUSER_COLOUR = "#b9fbc0"
 TLAST_COLOUR = "#a0c4ff"
@@ -201,15 +211,16 @@ class BeatMap:
             def flag(actual: bool, expected: bool, colour: str) -> str:
                 bg = WRONG_COLOUR if actual != expected else (colour if actual else "")
                 note = "" if actual == expected else f" (expected {int(expected)})"
-                return f'<td style="background:{bg};text-align:center">{int(actual)}{note}</td>'
+                return f'<td style="background:{bg};text-align:center;padding:1px 4px">{int(actual)}{note}</td>'
             px = self.beat_pixels(i)
             where = " ".join(f"({x}, {y})" for x, y in px[:3]) + (" \u2026" if len(px) > 3 else "")
             sel = ' style="outline:2px solid #d00"' if i == selected else ""
-            rows.append(f"<tr{sel}><td>{i}</td><td>0x{self._word(i):0{2 * self.bus_bytes}x}</td>"
-                        f"<td>0b{self._keep(i):0{self.bus_bytes}b}</td>"
+            td = '<td style="padding:1px 4px">'
+            rows.append(f"<tr{sel}>{td}{i}</td>{td}0x{self._word(i):0{2 * self.bus_bytes}x}</td>"
+                        f"{td}0b{self._keep(i):0{self.bus_bytes}b}</td>"
                         + flag(bool(self.tuser[i]), bool(eu[i]), TUSER_COLOUR)
                         + flag(bool(self.tlast[i]), bool(el[i]), TLAST_COLOUR)
-                        + f"<td>{esc(where)}</td></tr>")
+                        + f"{td}{esc(where)}</td></tr>")
         rows.append("</table>")
         return "".join(rows)
 
@@ -269,15 +280,30 @@ class BeatMap:
 class BeatViewer(StaticFallback, w.VBox):
     """Beats linked to pixels: pick a beat to see its pixel, or a pixel to see its beat.
 
-    Args: as :class:`BeatMap` (or pass a ready ``BeatMap`` as ``beats``).
+    Args:
+        beats: as :class:`BeatMap` (or a ready ``BeatMap``); other keywords go to ``BeatMap``.
+        image: the frame (HxW or HxWxC uint8) the beats carry; shown with the selected pixel
+            outlined, and clicking a pixel selects its beat.
+        channel_order: ``"rgb"`` or ``"bgr"``, for showing ``image``.
 
     Its output carries the static form (:meth:`BeatMap.to_html`: summary, waveform and table of
     the first beats, marker mismatches) for views without a kernel.
     """
 
-    def __init__(self, beats: Any = None, **kwargs: Any) -> None:
+    def __init__(self, beats: Any = None, *, image: Any = None, channel_order: str = "rgb", **kwargs: Any) -> None:
         self.map = beats if isinstance(beats, BeatMap) else BeatMap(beats, **kwargs)
         m = self.map
+        self.frame_rgb = None
+        self.picture: ClickImage | None = None
+        if image is not None:
+            img = as_image(image, "image")
+            if img.shape[:2] != (m.height, m.width):
+                raise WidgetError(f"image is {img.shape[1]}x{img.shape[0]} but the beats carry "
+                                  f"{m.width}x{m.height} pixels")
+            self.frame_rgb = display_rgb(img, channel_order)
+            self.picture = ClickImage(src_width=m.width, src_height=m.height,
+                                      caption="click a pixel to find its beat")
+            self.picture.on_click(lambda x, y: self.select_pixel(x, y))
         last = max(0, len(m) - 1)
         self.beat = w.BoundedIntText(0, min=0, max=last, description="beat")
         self.x = w.BoundedIntText(0, min=0, max=m.width - 1, description="pixel x")
@@ -289,14 +315,17 @@ class BeatViewer(StaticFallback, w.VBox):
         self.beat.observe(self._on_beat, "value")
         self.x.observe(self._on_pixel, "value")
         self.y.observe(self._on_pixel, "value")
+        tables = w.VBox([self.wave, self.table])
+        body = w.HBox([self.picture, tables]) if self.picture is not None else tables
         super().__init__([w.HTML(f"<b>{esc(m.summary())}</b>"), w.HBox([self.beat, self.x, self.y]),
-                          self.info, self.wave, self.table])
+                          self.info, body])
         self._render()
 
     @classmethod
     def from_result(cls, result: Any, which: str = "input") -> BeatViewer:
-        """A viewer of a ``PipelineResult``'s input or output beats (see :meth:`BeatMap.from_result`)."""
-        return cls(BeatMap.from_result(result, which))
+        """A viewer of a ``PipelineResult``'s input or output beats and image (see :meth:`BeatMap.from_result`)."""
+        image = result.input_image if which == "input" else result.output_image
+        return cls(BeatMap.from_result(result, which), image=image)
 
     def select_beat(self, beat: int) -> list[tuple[int, int]]:
         """Select ``beat``; the pixel fields follow. Returns the beat's pixels."""
@@ -350,6 +379,11 @@ class BeatViewer(StaticFallback, w.VBox):
             text += (f"<br>pixel ({pix[0]}, {pix[1]}): bytes {m.pixel_bytes(*pix).hex(' ') or '(not carried)'}"
                      f"; first byte in beat {carried if carried is not None else '(stream ended)'}")
         self.info.value = f'<div style="font-family:monospace">{text}</div>'
+        if self.picture is not None and pix is not None and self.frame_rgb is not None:
+            step = -(-m.width // 320) if m.width > 320 else 1
+            png, width = enlarged_png(self.frame_rgb[::step, ::step], step=step, max_width=320,
+                                      box=(pix[0], pix[1], pix[0], pix[1]))
+            self.picture.png, self.picture.display_width = png, width
         start = max(0, b - WAVE_BEATS // 2)
         self.wave.value = m.waveform_svg(start, WAVE_BEATS, selected=b)
         tstart = max(0, b - BEAT_PAGE_SIZE // 2)

@@ -18,6 +18,7 @@ from typing import Any
 import ipywidgets as w
 import numpy as np
 
+from rosfpga_lab.widgets.clickimage import ClickImage
 from rosfpga_lab.widgets._common import (
     DIFF_POSITIONS_LIMIT,
     DISPLAY_MAX_WIDTH,
@@ -27,6 +28,7 @@ from rosfpga_lab.widgets._common import (
     as_image,
     display_rgb,
     display_scale,
+    enlarged_png,
     esc,
     png_bytes,
     png_data_uri,
@@ -134,22 +136,8 @@ class FrameDiff:
 
     def diff_png(self, max_width: int = DISPLAY_MAX_WIDTH, box: tuple[int, int, int, int] | None = None) -> bytes:
         """PNG of the difference view as displayed (enlarged if small), ``box`` outlined in blue."""
-        view = self.diff_rgb(max_width)
         step = -(-self.width // max_width) if self.width > max_width else 1
-        scale = display_scale(view.shape[1], max_width)
-        big = np.repeat(np.repeat(view, scale, axis=0), scale, axis=1) if scale > 1 else view.copy()
-        if box is not None:  # a one-pixel outline just outside the box, on the displayed image
-            h, w_ = big.shape[:2]
-            x0, y0 = box[0] // step * scale - 1, box[1] // step * scale - 1
-            x1, y1 = (box[2] // step + 1) * scale, (box[3] // step + 1) * scale
-            xs, ys = slice(max(x0, 0), min(x1, w_ - 1) + 1), slice(max(y0, 0), min(y1, h - 1) + 1)
-            for y in (y0, y1):
-                if 0 <= y < h:
-                    big[y, xs] = (0, 0, 255)
-            for x in (x0, x1):
-                if 0 <= x < w_:
-                    big[ys, x] = (0, 0, 255)
-        return png_bytes(big)
+        return enlarged_png(self.diff_rgb(max_width), step=step, max_width=max_width, box=box)[0]
 
     def views(self, max_width: int = DISPLAY_MAX_WIDTH) -> dict[str, np.ndarray]:
         """Display RGB images by name: ``input`` (if given), ``output``, ``reference``, ``difference``."""
@@ -258,7 +246,7 @@ class ImageDiffViewer(StaticFallback, w.VBox):
         self.max_width = max_width
         self.frame = w.IntSlider(0, min=0, max=len(self.frames) - 1, description="frame",
                                  layout=w.Layout(display="" if len(self.frames) > 1 else "none"))
-        self.images: dict[str, w.Image] = {}
+        self.images: dict[str, ClickImage] = {}
         self.image_box = w.HBox()
         self.summary = w.HTML()
         self.x = w.BoundedIntText(0, min=0, max=10**6, description="zoom x", layout=w.Layout(width="160px"))
@@ -307,26 +295,34 @@ class ImageDiffViewer(StaticFallback, w.VBox):
     def _show_frame(self) -> None:
         f = self.current
         self.x.max, self.y.max = f.width - 1, f.height - 1
-        labels = []
+        boxes = []
         for name, rgb in f.views(self.max_width).items():
             scale = display_scale(rgb.shape[1], self.max_width)
-            img = self.images.get(name) or w.Image(format="png")
-            img.value = png_bytes(rgb, scale)
-            img.layout.width = f"{rgb.shape[1] * scale}px"
-            self.images[name] = img
-            labels.append(w.VBox([img, w.Label(name)]))
-        self.image_box.children = labels
-        self.summary.value = f"<b>{esc(f.summary())}</b>"
+            img = self.images.get(name)
+            if img is None:
+                img = self.images[name] = ClickImage(caption=name)
+                img.on_click(lambda x, y, _n=name: self._clicked(_n, x, y))
+            src = f.input if name == "input" and f.input is not None else f.output
+            img.src_height, img.src_width = int(src.shape[0]), int(src.shape[1])
+            img.display_width = rgb.shape[1] * scale
+            img.png = png_bytes(rgb, scale)
+            boxes.append(img)
+        self.image_box.children = boxes
+        self.summary.value = f"<b>{esc(f.summary())}</b> (click an image to zoom there)"
         if f.count:
             self.zoom_to(*f.positions[0])
         else:
             self._show_zoom()
 
+    def _clicked(self, name: str, x: int, y: int) -> None:
+        f = self.current
+        self.zoom_to(min(x, f.width - 1), min(y, f.height - 1))
+
     def _show_zoom(self) -> None:
         f = self.current
         x, y = min(self.x.value, f.width - 1), min(self.y.value, f.height - 1)
         self.zoom.value = f.zoom_html(x, y, self.size.value)
-        self.images["difference"].value = f.diff_png(self.max_width, box=f.region(x, y, self.size.value))
+        self.images["difference"].png = f.diff_png(self.max_width, box=f.region(x, y, self.size.value))
 
     def to_html(self, all_frames: bool = False) -> str:
         """Static HTML: the frame on screen in full (:meth:`FrameDiff.to_html`) and, for a
