@@ -141,6 +141,17 @@ def test_huge_length_refused_before_allocation() -> None:
         deserialize(REG, "std_msgs/Float64MultiArray", body)
 
 
+def test_arrays_of_empty_messages_are_bounded() -> None:
+    reg = MsgRegistry.with_defaults()
+    reg.add("t/Empties", "std_msgs/Empty[] e\n")
+    assert deserialize(reg, "t/Empties", struct.pack("<I", 3)) == {"e": [{}, {}, {}]}
+    body = struct.pack("<I", 100_000_000)  # 4 bytes asking for 1e8 empty dicts
+    with pytest.raises(DeserializeError, match="max_empty_elements=65536"):
+        deserialize(reg, "t/Empties", body)
+    with pytest.raises(DeserializeError, match="max_empty_elements=65536"):
+        field_layout(reg, "t/Empties", body)
+
+
 def test_limits_are_applied() -> None:
     body = serialize(REG, "std_msgs/String", {"data": "hello"})
     with pytest.raises(DeserializeError, match="max_string_bytes=3"):

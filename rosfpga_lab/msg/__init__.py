@@ -8,11 +8,31 @@ viewers) describes messages through it::
     reg.md5("sensor_msgs/Image")                  # '060021388200f6f0f447d0fcd9c64743'
     body = serialize(reg, "std_msgs/String", {"data": "hi"})   # b'\\x02\\x00\\x00\\x00hi'
     deserialize(reg, "std_msgs/String", body)     # {'data': 'hi'}
-    field_layout(reg, "std_msgs/String", body)    # [FieldSpan('data', 0, 4, 'uint32', 2, 'length'), ...]
+    field_layout(reg, "std_msgs/String", body)    # [FieldSpan(path='data', offset=0, size=4,
+                                                  #   type='uint32', value=2, role='length'), ...]
+
+Python values of ROS fields (what ``deserialize`` returns and ``serialize``/``new_message`` take):
+
+=====================================  =========================================================
+ROS field                              Python value
+=====================================  =========================================================
+nested message                         dict (serialize also takes objects with the attributes)
+``time`` / ``duration``                ``Time(secs, nsecs)`` / ``Duration(secs, nsecs)`` (also
+                                       (secs, nsecs) tuples or {"secs", "nsecs"} dicts on input)
+``string``                             str (UTF-8; bytes accepted on input)
+``bool``                               bool
+integers, floats (incl. byte, char)    int, float
+``uint8[]``, ``char[]`` (any length)   read-only numpy uint8 view into the input buffer; on
+                                       input any bytes-like value, numpy array or list
+other numeric and ``bool`` arrays      read-only numpy array of the little-endian dtype; on
+                                       input numpy arrays or lists (range-checked)
+arrays of strings, times, messages     lists
+=====================================  =========================================================
 
 Modules: ``parser`` (text -> MsgSpec), ``registry`` (types, md5, full text), ``decode`` and
 ``encode`` (the fast wire codecs), ``layout`` (byte spans, and the plain reference decoder),
-``values`` (defaults, new_message), ``builtins`` (types, Time, Duration), ``limits``, ``errors``.
+``values`` (defaults, new_message), ``builtins`` (types, Time, Duration), ``limits``, ``errors``,
+``describe`` (text views), ``strategies`` (hypothesis strategies, for tests), ``bench``.
 """
 
 from rosfpga_lab.msg.builtins import BUILTIN_TYPES, PRIMITIVE_TYPES, Duration, Time

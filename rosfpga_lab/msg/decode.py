@@ -42,13 +42,6 @@ def _join(prefix: str, path: str) -> str:
     return f"{prefix}{path}" if path.startswith("[") else f"{prefix}.{path}"
 
 
-def _describe(value: Any) -> str:
-    text = repr(value)
-    if len(text) > 60:
-        text = text[:57] + "..."
-    return f"{type(value).__name__} {text}"
-
-
 def min_size(reg: MsgRegistry, type_name: str) -> int:
     """Smallest possible serialized size of ``type_name`` (empty strings and arrays)."""
     spec = reg.check(type_name)
@@ -200,10 +193,16 @@ def _field_decoder(reg: MsgRegistry, f: Field) -> Callable:
             return pos
         return op
     sub = compiled_decoder(reg, base)
-    elem_min = max(min_size(reg, base), 0)
+    elem_min = min_size(reg, base)
 
     def op(buf, pos, out, limits):
         n, pos = count(buf, pos, limits, elem_min)
+        if elem_min == 0 and n > limits.max_empty_elements:
+            # elements of zero bytes (e.g. std_msgs/Empty): the bytes left cannot bound n
+            raise DeserializeError(
+                f"field {name}: length prefix at byte offset {pos - 4} declares {n} elements of "
+                f"{base} (0 bytes each), more than max_empty_elements={limits.max_empty_elements}",
+                name, pos - 4)
         items = []
         try:
             for i in range(n):

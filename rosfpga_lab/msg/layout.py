@@ -134,6 +134,11 @@ class _Reader:
             elem_min = min_size(self.reg, base)
         if f.array_length is None:
             n = self.length(path, elem_min, self.limits.max_array_length, "max_array_length")
+            if elem_min == 0 and n > self.limits.max_empty_elements:
+                raise DeserializeError(
+                    f"field {path}: length prefix at byte offset {self.pos - 4} declares {n} "
+                    f"elements of {base} (0 bytes each), more than max_empty_elements="
+                    f"{self.limits.max_empty_elements}", path, self.pos - 4)
         else:
             n = f.array_length
         if base in SCALARS and n > self.element_spans:

@@ -14,6 +14,9 @@ from dataclasses import dataclass
 MAX_STRING_BYTES = 64 * 1024 * 1024
 #: Most elements a variable-length array may declare.
 MAX_ARRAY_LENGTH = 256 * 1024 * 1024
+#: Most elements an array of zero-byte messages (e.g. ``std_msgs/Empty[]``) may declare; for
+#: every other array the bytes left already bound the count.
+MAX_EMPTY_ELEMENTS = 65_536
 #: Deepest nesting of message types a definition may use (guards against runaway recursion).
 MAX_NESTING_DEPTH = 64
 #: Most ``.msg`` files ``MsgRegistry.load_path`` reads from one folder tree.
@@ -31,10 +34,12 @@ class MsgLimits:
     Attributes:
         max_string_bytes: longest string a body may declare.
         max_array_length: most elements a variable-length array may declare.
+        max_empty_elements: most elements an array of zero-byte messages may declare.
     """
 
     max_string_bytes: int = MAX_STRING_BYTES
     max_array_length: int = MAX_ARRAY_LENGTH
+    max_empty_elements: int = MAX_EMPTY_ELEMENTS
 
 
 DEFAULT_LIMITS = MsgLimits()
