@@ -313,3 +313,43 @@ def test_tcpros_stream_spans_header_then_frames() -> None:
     # frame 0 took 9 bytes; frame 1: its 4-byte length, the string's length prefix, the text
     assert [s.offset for s in spans if s.path == "msg[1].data"] == [h + 9 + 4, h + 9 + 8]
     assert by["msg[2].frame length (truncated)"].role == "error"
+
+
+_NAMES = st.text(alphabet=st.sampled_from('ab<>&"\' .'), min_size=1, max_size=8)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.binary(min_size=0, max_size=80), st.lists(st.tuples(st.integers(0, 5), _NAMES), max_size=12))
+def test_static_html_text_is_exactly_the_hex_and_ascii_of_the_bytes(data: bytes, cuts: list) -> None:
+    spans, off = [], 0
+    for size, name in cuts:  # consecutive spans with hostile names; the rest uncovered
+        if off + size > len(data):
+            break
+        spans.append((off, size, name, "t<", name))
+        off += size
+    out = ByteMap(data, spans, page_size=32).to_html(0)
+    pre = out.split("<pre", 1)[1].split(">", 1)[1].split("</pre>")[0]
+    lines = html.unescape(re.sub(r"<[^>]+>", "", pre)).splitlines()
+    expected = []  # written independently: offset, 16 hex columns padded, |ascii|
+    for row in range(0, min(32, len(data)), 16):
+        chunk = data[row:min(row + 16, 32)]
+        hexes = " ".join(f"{b:02x}" for b in chunk).ljust(16 * 3 - 1)
+        text = "".join(chr(b) if 32 <= b < 127 else "." for b in chunk)
+        expected.append(f"{row:08x}  {hexes}  |{text}|")
+    assert lines == expected
+    assert "<script" not in out
+    if any(size for _off, size, *_ in spans):
+        assert 'title="' in out
+
+
+def test_live_viewer_state_stays_small_for_a_megabyte() -> None:
+    import json
+
+    data = bytes(range(256)) * 4800  # 1,228,800 bytes
+    v = ByteViewer(data, [(0, len(data), "data", "uint8[]")])
+    state = v.get_state()
+    sizes = {k: len(json.dumps(val, default=str)) for k, val in state.items() if not k.startswith("_")}
+    assert len(v.page_hex) == 2 * 512
+    assert sum(sizes.values()) < 10_000, sizes
+    v.page = v.n_pages - 1
+    assert v.page_start == len(data) - 512 and len(v.page_hex) == 1024
