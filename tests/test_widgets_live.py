@@ -159,3 +159,18 @@ def test_progress_widget_mode_and_track() -> None:
     assert Progress(3, mode="auto").mode == "text"  # plain pytest is not a kernel
     with pytest.raises(WidgetError, match="mode must be"):
         Progress(mode="fancy")
+
+
+def test_progress_step_messages_as_the_hls_and_component_layers_send_them() -> None:
+    out = io.StringIO()
+    clock = FakeClock()
+    p = Progress(desc="generate", mode="text", file=out, min_interval=10.0, clock=clock)
+    for k, msg in enumerate(("rendering templates", "compiling the testbench", "running C simulation")):
+        clock.now = float(k)
+        p(msg)  # steps are shown at once, whatever min_interval says
+    p.close()
+    assert out.getvalue().splitlines() == [
+        "generate 1  0.0 s \u2013 rendering templates",
+        "generate 2  1.0 s \u2013 compiling the testbench",
+        "generate 3  2.0 s \u2013 running C simulation",
+    ]

@@ -3,8 +3,9 @@
 In a Jupyter kernel it shows an ipywidgets progress bar; anywhere else it writes text to a
 stream (stderr by default): one updating line on a terminal, or a line per 10 % otherwise (so
 CI logs stay short). Updates are throttled to ``min_interval`` seconds, so calling it once per
-pixel is cheap. Use it as a context manager, a callback ``progress(done, total)``, or wrap an
-iterable with :func:`track`.
+pixel is cheap. Use it as a context manager, a callback ``progress(done, total)``, a step
+callback ``progress("compiling the testbench")`` (what ``rosfpga_lab.hls`` and
+``rosfpga_lab.component`` accept as ``progress=``), or wrap an iterable with :func:`track`.
 """
 
 from __future__ import annotations
@@ -58,6 +59,7 @@ class Progress:
         self._last_shown = -1e18
         self._last_decile = -1
         self._last_written = -1
+        self.note = ""
         self.closed = False
         self.widget: Any = None
         if self.mode == "widget":
@@ -83,9 +85,18 @@ class Progress:
         if now - self._last_shown >= self.min_interval:
             self._show(now)
 
-    def __call__(self, done: int, total: int | None = None) -> None:
-        """Callback form: ``progress(done, total)``."""
-        self.set(done, total)
+    def __call__(self, done: int | str, total: int | None = None) -> None:
+        """Callback form: ``progress(done, total)``, or ``progress("message")`` for a step."""
+        if isinstance(done, str):
+            self.step(done)
+        else:
+            self.set(done, total)
+
+    def step(self, message: str) -> None:
+        """One step of work done, described by ``message`` (always shown, not throttled)."""
+        self.note = message
+        self.done += 1
+        self._show(self.clock(), note=True)
 
     def close(self) -> None:
         """Show the final state (once)."""
@@ -106,14 +117,15 @@ class Progress:
         now = self.clock() if now is None else now
         elapsed = now - self.start
         unit = f" {self.unit}" if self.unit else ""
+        note = f" \u2013 {self.note}" if self.note else ""
         if self.total:
             frac = min(1.0, self.done / self.total)
             bar = "#" * int(frac * 20)
             left = f", {elapsed * (1 - frac) / frac:.1f} s left" if 0 < frac < 1 else ""
-            return f"{self.desc} [{bar:<20}] {frac * 100:3.0f}% {self.done}/{self.total}{unit}  {elapsed:.1f} s{left}".strip()
-        return f"{self.desc} {self.done}{unit}  {elapsed:.1f} s".strip()
+            return f"{self.desc} [{bar:<20}] {frac * 100:3.0f}% {self.done}/{self.total}{unit}  {elapsed:.1f} s{left}{note}".strip()
+        return f"{self.desc} {self.done}{unit}  {elapsed:.1f} s{note}".strip()
 
-    def _show(self, now: float, final: bool = False) -> None:
+    def _show(self, now: float, final: bool = False, note: bool = False) -> None:
         self._last_shown = now
         if self.mode == "off":
             return
@@ -126,11 +138,11 @@ class Progress:
                 self._bar.bar_style = "success"
             return
         if self.file.isatty() if hasattr(self.file, "isatty") else False:
-            self.file.write("\r" + line + ("\n" if final else ""))
+            self.file.write("\r" + line + ("\n" if final or note else ""))
             self.file.flush()
             return
         decile = int(10 * self.done / self.total) if self.total else -1
-        if (final and self.done != self._last_written) or decile > self._last_decile:
+        if note or (final and self.done != self._last_written) or decile > self._last_decile:
             self._last_written = self.done
             self._last_decile = decile
             self.file.write(line + "\n")
