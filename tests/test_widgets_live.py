@@ -174,3 +174,25 @@ def test_progress_step_messages_as_the_hls_and_component_layers_send_them() -> N
         "generate 2  1.0 s \u2013 compiling the testbench",
         "generate 3  2.0 s \u2013 running C simulation",
     ]
+
+
+def test_live_view_feed_takes_viewed_frames_and_swaps_bgr() -> None:
+    from types import SimpleNamespace
+
+    from rosfpga_lab.component.camera import ViewedFrame
+
+    v = LiveView(trailing=False, image_format="png")
+    bgr = np.zeros((2, 2, 3), np.uint8)
+    bgr[:, :, 0] = 200  # blue in BGR order
+    assert v.feed(ViewedFrame(0, {}, 2, 2, "bgr8", bgr, None, 0.25))
+    shown = cv2_decode(bytes(v.image.value))
+    assert (shown[0, 0] == (0, 0, 200)).all()  # shown as blue (RGB)
+    assert v.stats["latency_last"] == 0.25
+    assert not v.feed(SimpleNamespace(image=None, encoding="yuv422", latency=0.1))
+    v.close()
+
+
+def cv2_decode(png: bytes) -> np.ndarray:
+    import cv2
+
+    return cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)[:, :, ::-1]

@@ -113,7 +113,8 @@ class LiveView(w.VBox):
         self.status = w.HTML("waiting for frames\u2026")
         super().__init__([w.HTML(f"<b>{title}</b>") if title else w.HTML(), self.image, self.status])
 
-    def update(self, frame: Any, *, latency: float | None = None, stamp: float | None = None) -> bool:
+    def update(self, frame: Any, *, latency: float | None = None, stamp: float | None = None,
+               channel_order: str | None = None) -> bool:
         """Offer a new frame (any thread). Returns True if it was pushed to the browser now.
 
         Args:
@@ -121,8 +122,11 @@ class LiveView(w.VBox):
             latency: seconds from capture to now, if known.
             stamp: capture time as ``time.time()`` (e.g. the message's header stamp);
                 latency is then ``time.time() - stamp``.
+            channel_order: ``"rgb"``/``"bgr"`` for this frame (default: the view's).
         """
         img = as_image(frame, "frame")
+        if channel_order is not None and channel_order != self.channel_order:
+            img = img[:, :, [2, 1, 0] + ([3] if img.shape[2] == 4 else [])] if img.ndim == 3 and img.shape[2] >= 3 else img
         if latency is None and stamp is not None:
             latency = time.time() - stamp
         with self._lock:
@@ -145,6 +149,15 @@ class LiveView(w.VBox):
         if go:
             self._push(img)
         return go
+
+    def feed(self, frame: Any) -> bool:
+        """Callback for ``rosfpga_lab.component.Viewer(on_frame=live.feed)``: shows a
+        ``ViewedFrame`` (its ``image``, ``encoding`` and ``latency``). Returns as :meth:`update`."""
+        image = getattr(frame, "image", None)
+        if image is None:
+            return False
+        order = "bgr" if str(getattr(frame, "encoding", "")).startswith("bgr") else "rgb"
+        return self.update(image, latency=getattr(frame, "latency", None), channel_order=order)
 
     def _fire(self) -> None:
         with self._lock:
