@@ -1,0 +1,63 @@
+"""``rosfpga-lab demo`` as a test: the teacher's headless check, and the checker's own teeth."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+
+import cv2
+import numpy as np
+import pytest
+
+from rosfpga_lab.cli import main
+from rosfpga_lab.component import run_demo
+
+
+def test_demo_command_passes_bit_exact(tmp_path, capsys) -> None:
+    png = tmp_path / "demo.png"
+    t0 = time.monotonic()
+    code = main(["demo", "--frames", "45", "--output", str(png), "--scale", "0.5"])
+    elapsed = time.monotonic() - t0
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "bit-exact: 45/45" in out
+    assert "frames: sent 45, received 45" in out
+    assert "fps:" in out and "latency camera -> component -> checker: median" in out
+    assert elapsed < 60
+    figure = cv2.imread(str(png))
+    assert figure is not None and figure.shape[1] > 3 * 320 and figure.shape[0] > 240
+
+
+def test_demo_as_a_separate_process_exits_zero(tmp_path) -> None:
+    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "demo", "--frames", "10",
+                           "--source", "synthetic", "--no-figure"], capture_output=True, text=True,
+                          timeout=120, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "bit-exact: 10/10" in proc.stdout
+
+
+def test_demo_with_another_config_erode_mono8(tmp_path) -> None:
+    result = run_demo("data/fpga_erode_mono8.yaml", frames=10, rate=60, source="synthetic",
+                      png=tmp_path / "erode.png")
+    assert result.ok, "\n".join(result.lines())
+    assert result.check.bit_exact == 10 and result.component.cycles["erode"] > 0
+    assert (tmp_path / "erode.png").exists()
+
+
+def test_checker_catches_a_wrong_circuit(tmp_path) -> None:
+    """Negative control: checked against erode, the dilating component must fail every frame."""
+    result = run_demo(frames=5, rate=60, source="synthetic", png=tmp_path / "bad.png",
+                      oracle_op="erode")
+    assert not result.ok
+    assert result.received == 5 and result.check.bit_exact == 0
+    assert all("differ from OpenCV's cv2.erode" in m for m in result.check.mismatches)
+    assert "bit-exact: 0/5" in "\n".join(result.lines())
+    src, got, want = result.check.first_bad
+    assert not np.array_equal(got, want)
+
+
+def test_demo_rejects_bad_arguments(capsys) -> None:
+    assert main(["demo", "--frames", "0"]) == 2
+    assert main(["demo", "--source", "/no/such/picture.png", "--frames", "1", "--no-figure"]) == 1
+    assert "unknown image source" in capsys.readouterr().err
