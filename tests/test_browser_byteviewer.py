@@ -45,7 +45,7 @@ from rosfpga_lab import msg
 from rosfpga_lab.widgets import message_viewer
 
 reg = msg.default_registry()
-h, w = 3, 4
+h, w = 20, 21  # 1260 pixel bytes: three pages of 512
 image = {{"header": {{"seq": 7, "stamp": {{"secs": 1700000000, "nsecs": 5}}, "frame_id": {FRAME_ID!r}}},
           "height": h, "width": w, "encoding": "rgb8", "is_bigendian": 0, "step": w * 3,
           "data": (np.arange(h * w * 3) % 251).astype(np.uint8).tobytes()}}
@@ -193,7 +193,7 @@ def test_click_a_byte_in_jupyterlab_names_its_field(lab: Lab, tmp_path: Path) ->
     page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.includes('height')")
     text = page.locator(".rfl-bv-info").text_content()
     assert "height" in text and "uint32" in text, text
-    assert f"offset {HEIGHT_OFFSET}" in text and "size 4" in text and "value 3" in text, text
+    assert f"offset {HEIGHT_OFFSET}" in text and "size 4" in text and "value 20" in text, text
     assert _highlighted(page) == list(range(HEIGHT_OFFSET, HEIGHT_OFFSET + 4))  # its four bytes only
     # the click reached the kernel: re-run the report cell and read its output
     page.evaluate("""() => { const nb = window.jupyterapp.shell.currentWidget;
@@ -208,6 +208,14 @@ def test_click_a_byte_in_jupyterlab_names_its_field(lab: Lab, tmp_path: Path) ->
     page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.includes('width')")
     assert _highlighted(page) == list(range(HEIGHT_OFFSET + 4, HEIGHT_OFFSET + 8))
     lab.screenshot(page, tmp_path / "byteviewer.png")
+    # paging: the next page starts at byte 512, inside the pixel data
+    page.locator(".rfl-bv-next").click()
+    page.wait_for_selector('.rfl-bv-hex .b[data-off="512"]')
+    assert page.locator(".rfl-bv-hex .b").count() == 512
+    assert page.locator('.rfl-bv-hex .b[data-off="0"]').count() == 0
+    page.locator('.rfl-bv-hex .b[data-off="600"]').hover()
+    page.wait_for_function("document.querySelector('.rfl-bv-info').textContent.startsWith('data [array]')")
+    assert "size 1260" in page.locator(".rfl-bv-info").text_content()
     assert lab.errors == []
     page.close()
 
