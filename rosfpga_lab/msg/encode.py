@@ -59,6 +59,8 @@ def _getter(spec: MsgSpec) -> Callable[[Any, str], Any]:
     names = set(spec.field_names)
 
     def get(msg: Any, name: str) -> Any:
+        if type(msg) is dict and name in msg:  # the common case, without the ABC check
+            return msg[name]
         if isinstance(msg, Mapping):
             value = msg.get(name, _MISSING)
         else:
@@ -73,8 +75,12 @@ def _getter(spec: MsgSpec) -> Callable[[Any, str], Any]:
                 name, spec.full_name)
         return value
 
+    count = len(names)
+
     def check_keys(msg: Any) -> None:
-        if isinstance(msg, Mapping) and len(msg) != len(names):
+        if type(msg) is dict and len(msg) == count:
+            return
+        if isinstance(msg, Mapping) and len(msg) != count:
             extra = sorted(str(k) for k in msg if k not in names)
             if extra:
                 raise SerializeError(
@@ -122,7 +128,10 @@ def _group_encoder(names: list[str], kinds: list[str]) -> Callable:
     has_bool = "bool" in kinds
 
     def op(msg: Any, get: Callable, chunks: list) -> None:
-        vals = [get(msg, n) for n in names]
+        try:
+            vals = [msg[n] for n in names] if type(msg) is dict else [get(msg, n) for n in names]
+        except KeyError:
+            vals = [get(msg, n) for n in names]  # raises the error naming the missing field
         try:
             if has_bool:
                 for v, k, n in zip(vals, kinds, names):
