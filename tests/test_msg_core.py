@@ -62,6 +62,7 @@ def test_bare_header_resolves(reg: MsgRegistry) -> None:
     assert reg.md5("Header") == "2176decaecbce78abc3b96ef049fabed"
     assert reg.get("Image").full_name == "sensor_msgs/Image"  # unique short name
     assert reg.get("Point", package="geometry_msgs").full_name == "geometry_msgs/Point"
+    assert reg.get("sensor_msgs/msg/Image").full_name == "sensor_msgs/Image"
 
 
 def test_shipped_packages_complete(reg: MsgRegistry) -> None:

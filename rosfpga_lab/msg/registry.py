@@ -161,7 +161,10 @@ class MsgRegistry:
         return ", ".join(places) if places else "nothing (empty registry)"
 
     def resolve(self, name: str, package: str | None = None) -> str:
-        """The full name ``name`` refers to (``Header``, ``Name`` in ``package``, unique ``Name``).
+        """The full name ``name`` refers to.
+
+        Accepted: ``pkg/Name``, ``pkg/msg/Name``, ``Header`` (std_msgs/Header), ``Name`` in
+        ``package``, or a ``Name`` only one loaded package has.
 
         Raises:
             UnknownTypeError: nothing (or more than one type) matches; says where it looked.
@@ -171,6 +174,9 @@ class MsgRegistry:
             raise UnknownTypeError(f"{name!r} is a builtin type, not a message type", name)
         if name == HEADER:
             name = HEADER_FULL_NAME
+        parts = name.split("/")
+        if len(parts) == 3 and parts[1] == "msg":  # 'pkg/msg/Name' (rosbags, ROS 2 style)
+            name = f"{parts[0]}/{parts[2]}"
         if "/" in name:
             if name in self._specs:
                 return name
