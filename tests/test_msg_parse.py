@@ -2,7 +2,7 @@
 lookups and folder loading, and the comment-stripping rule.
 
 The md5 sums and full-text hashes below were computed by Debian's genmsg
-(tests/ros_programs/genmsg_md5.py) from exactly these texts; test_msg_realros.py recomputes them
+(tests/ros_programs/genpy_genmsg_md5.py) from exactly these texts; test_msg_realros.py recomputes them
 live in CI. genmsg rejects every definition in BAD as well.
 """
 

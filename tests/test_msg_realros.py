@@ -99,7 +99,7 @@ def test_shipped_definitions_match_genpy(genpy: dict[str, dict]) -> None:
 
 
 def test_tricky_definitions_against_genmsg(real_ros: None) -> None:
-    result = run_helper("genmsg_md5.py", stdin={**TRICKY, **{k: v[0] for k, v in BAD.items()}})
+    result = run_helper("genpy_genmsg_md5.py", stdin={**TRICKY, **{k: v[0] for k, v in BAD.items()}})
     reg = MsgRegistry()
     for name, text in TRICKY.items():
         reg.add(name, text)
