@@ -59,12 +59,14 @@ BAD_CALLS = [
     ("registerPublisher", ("/t",), -1, "bad call arity"),
     ("registerPublisher", ("/t", "/a", "std_msgs/String", API, "extra"), -1, "bad call arity"),
     ("registerPublisher", (5, "/a", "std_msgs/String", API), -1, "caller_id must be a string"),
-    ("registerPublisher", ("/t", 7, "std_msgs/String", API), -1, "[topic] must be a string"),
+    ("registerPublisher", ("/t", 7, "std_msgs/String", API), -1, "[topic] must be a non-empty string"),
     ("registerPublisher", ("/t", "/a", "String", API), -1, "not a valid package resource name"),
-    ("registerPublisher", ("/t", "/a", "std_msgs/String", "ftp://x"), -1, "not an XML-RPC URI"),
-    ("registerSubscriber", ("/t", "bad name!", "std_msgs/String", API), -1, "not a valid name"),
+    ("registerPublisher", ("/t", "/a", "std_msgs/String", "ftp://x"), -1, "[caller_api] is not an RPC URI"),
+    ("registerPublisher", ("/t", "/", "std_msgs/String", API), -1, "cannot be the global namespace"),
+    ("registerSubscriber", ("/t", "bad name", "std_msgs/String", API), -1, "contains illegal chars"),
+    ("setParam", ("/t", "", 1), -1, "[key] must be specified and non-empty"),
     ("getParam", ("/t", ["list"]), -1, "[key] must be a string"),
-    ("lookupNode", ("/t", 1.5), -1, "must be a string"),
+    ("lookupNode", ("/t", 1.5), -1, "[node] must be a non-empty string"),
 ]
 
 

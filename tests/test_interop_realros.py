@@ -279,3 +279,54 @@ def test_rostopic_against_embedded_master_and_lab_nodes(tmp_path, lab_nodes) -> 
             stop.set()
             t.join(5)
         assert echo.count('data: "hello from the lab"') == 2 and echo.count("---") == 2
+
+
+# ------------------------------------------------------------------------- the master, call by call
+API = "http://127.0.0.1:9/"
+MASTER_CALLS = [
+    ("registerSubscriber", "/l", "/chatter", "std_msgs/String", API),
+    ("registerPublisher", "/t", "/chatter", "std_msgs/String", API),
+    ("registerPublisher", "/ns/t", "rel", "std_msgs/String", API),
+    ("getSystemState", "/x"), ("getPublishedTopics", "/x", ""), ("getPublishedTopics", "/x", "/ns"),
+    ("getTopicTypes", "/x"), ("lookupNode", "/x", "/t"), ("lookupNode", "/x", "/nobody"),
+    ("unregisterPublisher", "/t", "/chatter", API), ("unregisterPublisher", "/t", "/chatter", API),
+    ("unregisterPublisher", "/zz", "/chatter", API), ("unregisterSubscriber", "/l", "/chatter", API),
+    ("lookupService", "/x", "/srv"), ("hasParam", "/x", "/p"), ("setParam", "/ns/n", "~p", 3),
+    ("getParam", "/x", "/ns/n/p"), ("setParam", "/x", "/d", {"a": 1, "b": {"c": 2.5}}),
+    ("getParam", "/x", "/d"), ("getParam", "/x", "/d/b"), ("searchParam", "/d/x/y", "b"),
+    ("searchParam", "/x", "nope"), ("deleteParam", "/x", "/d/b"), ("deleteParam", "/x", "/d/b"),
+    ("getParam", "/x", "/nope"), ("hasParam", "/x", "/d"), ("getParamNames", "/x"),
+    ("subscribeParam", "/x", API, "/d"), ("unsubscribeParam", "/x", API, "/d"),
+    ("unsubscribeParam", "/x", API, "/d"), ("getUri", "/x"),
+    ("registerPublisher", "/t"), ("registerPublisher",), ("registerPublisher", 5, "/a", "std_msgs/String", API),
+    ("registerPublisher", "/t", "/a", "String", API), ("registerPublisher", "/t", 3, "std_msgs/String", API),
+    ("registerPublisher", "/t", "/a b", "std_msgs/String", API), ("registerPublisher", "/t", "/", "std_msgs/String", API),
+    ("registerPublisher", "/t", "/a", "std_msgs/String", "bad"), ("setParam", "/x", "", 1),
+    ("lookupNode", "/x", 1.5), ("getPublishedTopics", "/x", 3), ("getPid", 3), ("searchParam", "/x", 3),
+    ("getTopicTypes", 3), ("getSystemState", 3), ("hasParam", "/x", ""), ("getParam", "/x", ""),
+    ("lookupService", "/x", ""), ("subscribeParam", "/x", "nope", "/d"),
+    ("unregisterSubscriber", "/l", "x y", API),
+]
+ROSCORE_PARAMS = {"/run_id", "/rosdistro", "/rosversion"}  # set by roscore (roslaunch), not rosmaster --core
+
+
+def master_replies(uri: str) -> list[str]:
+    import xmlrpc.client
+
+    proxy = xmlrpc.client.ServerProxy(uri)
+    out = []
+    for method, *args in MASTER_CALLS:
+        reply = getattr(proxy, method)(*args)
+        if method == "getParamNames":
+            reply[2] = [n for n in reply[2] if n not in ROSCORE_PARAMS]
+        out.append(repr(reply).replace(uri, "MASTER_URI"))
+    return out
+
+
+def test_master_api_replies_match_rosmaster(tmp_path) -> None:
+    with real_rosmaster(tmp_path) as uri:
+        real = master_replies(uri)
+    with EmbeddedMaster(port=0) as m:
+        lab = master_replies(m.uri)
+    for call_, want, got in zip(MASTER_CALLS, real, lab):
+        assert got == want, f"{call_}: rosmaster {want} vs lab {got}"

@@ -2,9 +2,9 @@
 
 Every ROS XML-RPC API takes ``caller_id`` first and answers ``[code, status, value]``.
 :func:`checked` wraps an implementation with a per-argument spec and produces exactly the
-error replies rosmaster's ``apivalidate`` does (missing caller_id, bad arity, caller_id not a
-string) plus a clear one for each wrongly typed argument, so a bad call never raises in the
-server and the server keeps serving.
+error replies of rosmaster's ``apivalidate`` and validators (missing caller_id, bad arity,
+caller_id not a string, each argument's check, same texts; tests compare them with a real
+rosmaster), so a bad call never raises in the server and the server keeps serving.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from rosfpga_lab.graph.names import is_legal_name, resolve
+from rosfpga_lab.graph.names import resolve
 
 Spec = tuple[tuple[str, str], ...]  # (argument name, kind)
 
@@ -22,32 +22,50 @@ class ArgError(Exception):
 
 
 def _check(kind: str, name: str, value: Any, caller_id: str) -> Any:
+    """rosmaster's validators (rosmaster/validators.py), same texts."""
     if kind == "any":
         return value
-    if kind in ("str", "name", "topic", "type", "api", "opt_name"):
+    if kind == "key":  # non_empty_str
+        if not value:
+            raise ArgError(f"ERROR: parameter [{name}] must be specified and non-empty")
         if not isinstance(value, str):
-            raise ArgError(f"ERROR: parameter [{name}] must be a string, got {type(value).__name__}")
-    if kind in ("name", "topic"):
-        if not value or not is_legal_name(value):
-            raise ArgError(f"ERROR: parameter [{name}] is not a valid name: {value!r}")
-        return resolve(value, caller_id)
-    if kind == "opt_name":
-        if value and not is_legal_name(value):
-            raise ArgError(f"ERROR: parameter [{name}] is not a valid name: {value!r}")
-        return resolve(value, caller_id) if value else ""
-    if kind == "type":
-        if value != "*" and (value.count("/") != 1 or not all(value.split("/"))):
-            raise ArgError(f"ERROR: parameter [{name}] is not a valid package resource name: {value!r}")
+            raise ArgError(f"ERROR: parameter [{name}] must be a string")
         return value
-    if kind == "api":
+    if kind == "str":
+        if not isinstance(value, str):
+            raise ArgError(f"ERROR: parameter [{name}] must be a string")
+        return value
+    if kind in ("name", "topic"):  # valid_name / is_topic / is_service
+        if not value or not isinstance(value, str):
+            raise ArgError(f"ERROR: parameter [{name}] must be a non-empty string")
+        if ":" in value or " " in value:
+            raise ArgError(f"ERROR: parameter [{name}] contains illegal chars")
+        if kind == "topic" and value == "/":
+            raise ArgError(f"ERROR: parameter [{name}] cannot be the global namespace")
+        return resolve(value, caller_id)
+    if kind == "opt_name":  # empty_or_valid_name
+        if not isinstance(value, str):
+            raise ArgError(f"ERROR: parameter [{name}] must be a string")
+        return resolve(value, caller_id) if value else ""
+    if kind == "type":  # valid_type_name
+        if value == "*":
+            return value
+        if not value or not isinstance(value, str):
+            raise ArgError(f"ERROR: parameter [{name}] must be a non-empty string")
+        if len(value.split("/")) != 2:
+            raise ArgError(f"ERROR: parameter [{name}] is not a valid package resource name")
+        return value
+    if kind == "api":  # is_api
+        if not value or not isinstance(value, str):
+            raise ArgError(f"ERROR: parameter [{name}] is not an XMLRPC URI")
         if not value.startswith(("http://", "rosrpc://")):
-            raise ArgError(f"ERROR: parameter [{name}] is not an XML-RPC URI: {value!r}")
+            raise ArgError(f"ERROR: parameter [{name}] is not an RPC URI")
         return value
     if kind == "list":
         if not isinstance(value, list):
-            raise ArgError(f"ERROR: parameter [{name}] must be a list, got {type(value).__name__}")
+            raise ArgError(f"ERROR: parameter [{name}] must be a list")
         return value
-    return value
+    raise AssertionError(f"unknown argument kind {kind}")
 
 
 def checked(spec: Spec, error_value: Any) -> Callable[[Callable], Callable]:
@@ -58,9 +76,7 @@ def checked(spec: Spec, error_value: Any) -> Callable[[Callable], Callable]:
             if len(params) == 0:
                 return [-1, "missing required caller_id parameter", error_value]
             if len(params) != len(spec) + 1:
-                return [-1, f"Error: bad call arity (expected {len(spec) + 1} arguments: caller_id, "
-                        f"{', '.join(n for n, _ in spec) or 'nothing else'}; got {len(params)})",
-                        error_value]
+                return [-1, "Error: bad call arity", error_value]
             caller_id = params[0]
             if not isinstance(caller_id, str):
                 return [-1, "caller_id must be a string", error_value]

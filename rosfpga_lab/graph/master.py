@@ -19,7 +19,7 @@ from typing import Any
 
 from rosfpga_lab.graph.apicheck import api_methods, checked
 from rosfpga_lab.graph.errors import JOIN_TIMEOUT, XmlRpcError
-from rosfpga_lab.graph.names import bind_address, canonical, namespace_of
+from rosfpga_lab.graph.names import bind_address, canonical, namespace_of, resolve
 from rosfpga_lab.graph.trace import Trace
 from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call
 
@@ -216,7 +216,7 @@ class EmbeddedMaster:
         self.nodes.pop(caller_id, None)
 
     # ------------------------------------------------------------------ master API
-    @checked((), 0)
+    @checked((), -1)
     def getPid(self, caller_id: str) -> tuple:
         return 1, "", os.getpid()
 
@@ -267,7 +267,7 @@ class EmbeddedMaster:
                 return 1, f"[{caller_id}] is not a registered node", 0
             regs = table.get(key, {})
             if regs.get(caller_id) != api:
-                return 1, f"[{caller_id}] is not a registered {what} of [{key}]", 0
+                return 1, f"[{caller_id}] is not a known provider of [{key}]", 0
             del regs[caller_id]
             if not regs:
                 table.pop(key, None)
@@ -310,7 +310,7 @@ class EmbeddedMaster:
             return -1, f"unknown node [{node}]", ""
         return 1, "node api", api
 
-    @checked((("subgraph", "opt_name"),), [])
+    @checked((("subgraph", "opt_name"),), 0)
     def getPublishedTopics(self, caller_id: str, subgraph: str) -> tuple:
         if subgraph and not subgraph.endswith("/"):
             subgraph += "/"
@@ -334,8 +334,9 @@ class EmbeddedMaster:
         return 1, "current system state", state
 
     # ------------------------------------------------------------------ parameter server
-    @checked((("key", "name"),), 0)
+    @checked((("key", "key"),), 0)
     def deleteParam(self, caller_id: str, key: str) -> tuple:
+        key = resolve(key, caller_id)
         with self._lock:
             try:
                 self.params.delete(key)
@@ -344,8 +345,9 @@ class EmbeddedMaster:
             self._notify_params(key, {})
         return 1, f"parameter {key} deleted", 0
 
-    @checked((("key", "name"), ("value", "any")), 0)
+    @checked((("key", "key"), ("value", "any")), 0)
     def setParam(self, caller_id: str, key: str, value: Any) -> tuple:
+        key = resolve(key, caller_id)
         with self._lock:
             try:
                 self.params.set(key, value)
@@ -354,15 +356,16 @@ class EmbeddedMaster:
             self._notify_params(key, value)
         return 1, f"parameter {key} set", 0
 
-    @checked((("key", "name"),), 0)
+    @checked((("key", "key"),), 0)
     def getParam(self, caller_id: str, key: str) -> tuple:
+        key = resolve(key, caller_id)
         with self._lock:
             try:
                 return 1, f"Parameter [{key}]", self.params.get(key)
             except KeyError:
                 return -1, f"Parameter [{key}] is not set", 0
 
-    @checked((("key", "str"),), "")
+    @checked((("key", "key"),), 0)
     def searchParam(self, caller_id: str, key: str) -> tuple:
         if key.startswith("/"):
             with self._lock:
@@ -383,8 +386,9 @@ class EmbeddedMaster:
                 ns = namespace_of(ns.rstrip("/"))
         return -1, f"Cannot find parameter [{key}] in an upwards search", ""
 
-    @checked((("caller_api", "api"), ("key", "name")), 0)
+    @checked((("caller_api", "api"), ("key", "key")), 0)
     def subscribeParam(self, caller_id: str, caller_api: str, key: str) -> tuple:
+        key = resolve(key, caller_id)
         with self._lock:
             self._register_node(caller_id, caller_api)
             self.param_subscribers.setdefault(key, {})[caller_id] = caller_api
@@ -394,14 +398,15 @@ class EmbeddedMaster:
                 value = {}
         return 1, f"Subscribed to parameter [{key}]", value
 
-    @checked((("caller_api", "api"), ("key", "name")), 0)
+    @checked((("caller_api", "api"), ("key", "key")), 0)
     def unsubscribeParam(self, caller_id: str, caller_api: str, key: str) -> tuple:
-        code, _status, n = self._unregister(self.param_subscribers, "parameter subscriber",
-                                            caller_id, key, caller_api)
-        return 1, f"Unsubscribe to parameter [{key}]", n
+        key = resolve(key, caller_id)
+        self._unregister(self.param_subscribers, "parameter subscriber", caller_id, key, caller_api)
+        return 1, f"Unsubscribe to parameter [{key}]", 1  # rosmaster always answers 1
 
-    @checked((("key", "name"),), False)
+    @checked((("key", "key"),), False)
     def hasParam(self, caller_id: str, key: str) -> tuple:
+        key = resolve(key, caller_id)
         with self._lock:
             return 1, key, self.params.has(key)
 
