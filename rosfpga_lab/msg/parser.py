@@ -31,18 +31,12 @@ COMMENT_CHAR = "#"
 CONST_CHAR = "="
 SEP = "/"
 
-_RESOURCE_NAME = re.compile(r"^[A-Za-z][\w/]*$")
 _BASE_NAME = re.compile(r"^[A-Za-z]\w*$")
 
 
 def is_legal_base_name(name: str) -> bool:
     """genmsg's rule for field names, package names and short type names."""
     return bool(_BASE_NAME.fullmatch(name))
-
-
-def is_legal_resource_name(name: str) -> bool:
-    """genmsg's rule for a type name that may contain ``/`` (not ``//``)."""
-    return bool(_RESOURCE_NAME.fullmatch(name)) and "//" not in name
 
 
 def bare_type(type_name: str) -> str:
@@ -225,8 +219,8 @@ def _parse_field(orig: str, clean: str, package: str, lineno: int,
             f"{name!r} is not a legal field name (a letter, then letters, digits or '_')",
             source, lineno, orig)
     base = bare_type(type_name)
-    if not is_legal_resource_name(base) or not all(map(is_legal_base_name, base.split(SEP))) \
-            or base.count(SEP) > 1:
+    parts = base.split(SEP)
+    if len(parts) > 2 or not all(map(is_legal_base_name, parts)):
         raise MsgDefinitionError(f"{type_name!r} is not a legal field type", source, lineno, orig)
     if type_name.count("[") > 1:
         raise MsgDefinitionError(f"{type_name!r}: only one-dimensional arrays are supported",
