@@ -73,7 +73,7 @@ BAD = {  # name: (text, words expected in our message)
     "bad/Float": ("int32 X=1.5\n", "invalid int32 constant value '1.5'"),
     "bad/Bracket": ("int32[x] a\n", "malformed array suffix"),
     "bad/TwoSlashes": ("a/b/C x\n", "not a legal field type"),
-    "bad/Bounded": ("string<=5 s\n", "not a legal field type"),  # ROS 2 only
+    "bad/Bounded": ("string<=5 s\n", "not a legal constant type"),  # ROS 2 only; "=" -> constant
 }
 
 
