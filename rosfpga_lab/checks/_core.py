@@ -1,0 +1,223 @@
+"""What every exercise check shares: the result, the error, and byte-by-byte explanations.
+
+How this works: a check function compares the reader's answer with the right one and either
+returns a :class:`CheckResult` (which a notebook shows as a green line saying what was right)
+or raises :class:`ExerciseError` listing *what* is wrong, e.g. ``byte 12 (field
+header.frame_id length, uint32 at bytes 12..15) is 5, expected 7``. The error renders in
+IPython as those lines only (no traceback through the library), so a student sees the finding,
+not the machinery. :func:`describe_byte_difference` is the workhorse of the byte-level checks:
+given the expected bytes and a list of :class:`ByteField` it names the field of the first
+differing byte and decodes numbers.
+"""
+
+from __future__ import annotations
+
+import html
+import struct
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from rosfpga_lab.errors import LabError
+
+#: How many problems one failed check lists at most.
+MAX_PROBLEMS = 5
+
+_STRUCT = {"uint8": "<B", "int8": "<b", "uint16": "<H", "int16": "<h", "uint32": "<I",
+           "int32": "<i", "uint64": "<Q", "int64": "<q", "float32": "<f", "float64": "<d",
+           "bool": "<B", "char": "<B", "byte": "<b"}
+
+
+class ExerciseError(LabError):
+    """The answer to an exercise is not (yet) right.
+
+    Attributes:
+        exercise: the exercise's name, e.g. ``"3.2 marshal an Image"``.
+        problems: what is wrong, one finding per entry.
+    """
+
+    def __init__(self, exercise: str, problems: Sequence[str]) -> None:
+        self.exercise = exercise
+        self.problems = list(problems)
+        lines = [f"Exercise {exercise}: not right yet"]
+        lines += [f"  - {p}" for p in self.problems[:MAX_PROBLEMS]]
+        if len(self.problems) > MAX_PROBLEMS:
+            lines.append(f"  ... and {len(self.problems) - MAX_PROBLEMS} more")
+        super().__init__("\n".join(lines))
+
+    def _render_traceback_(self) -> list[str]:
+        """What IPython shows instead of a traceback: the findings, in red."""
+        red, bold, reset = "\x1b[31m", "\x1b[1m", "\x1b[0m"
+        text = str(self).splitlines()
+        return [f"{red}{bold}\u2718 {text[0]}{reset}"] + [f"{red}{line}{reset}" for line in text[1:]]
+
+
+@dataclass
+class CheckResult:
+    """A passed check: which exercise and what was verified.
+
+    Attributes:
+        exercise: the exercise's name.
+        details: what the check verified, one line each.
+    """
+
+    exercise: str
+    details: list[str] = field(default_factory=list)
+    ok: bool = True
+
+    def __str__(self) -> str:
+        lines = [f"\u2714 Exercise {self.exercise}: correct"] + [f"  {d}" for d in self.details]
+        return "\n".join(lines)
+
+    __repr__ = __str__
+
+    def _repr_html_(self) -> str:
+        items = "".join(f"<li>{html.escape(d)}</li>" for d in self.details)
+        return (f"<div style='color:#1b7a32'><b>\u2714 Exercise {html.escape(self.exercise)}: "
+                f"correct</b><ul style='margin:2px 0'>{items}</ul></div>")
+
+
+def fail(exercise: str, *problems: str) -> ExerciseError:
+    """An :class:`ExerciseError` to raise (``raise fail(...)``)."""
+    return ExerciseError(exercise, [p for p in problems if p])
+
+
+def require_answer(exercise: str, name: str, value: Any) -> None:
+    """Refuse a placeholder answer (``...``, ``None``, ``NotImplemented``).
+
+    Raises:
+        ExerciseError: the answer is still a placeholder.
+    """
+    if value is ... or value is None or value is NotImplemented:
+        raise fail(exercise, f"{name} is still {value!r}: replace it with your answer")
+
+
+def require_type(exercise: str, name: str, value: Any, kinds: type | tuple[type, ...],
+                 hint: str = "") -> None:
+    """Refuse an answer of the wrong Python type (bool is not accepted as an int).
+
+    Raises:
+        ExerciseError: ``value`` is not an instance of ``kinds``.
+    """
+    require_answer(exercise, name, value)
+    kinds_t = kinds if isinstance(kinds, tuple) else (kinds,)
+    bad_bool = isinstance(value, bool) and bool not in kinds_t
+    if bad_bool or not isinstance(value, kinds_t):
+        want = " or ".join(k.__name__ for k in kinds_t)
+        raise fail(exercise, f"{name} should be {want}, you gave {type(value).__name__} "
+                             f"{_short(value)}" + (f" ({hint})" if hint else ""))
+
+
+def as_bytes(exercise: str, name: str, value: Any) -> bytes:
+    """``value`` as bytes (bytes, bytearray, memoryview or a uint8 numpy array)."""
+    require_answer(exercise, name, value)
+    if isinstance(value, (bytes, bytearray, memoryview)):
+        return bytes(value)
+    if hasattr(value, "dtype") and getattr(value, "dtype").itemsize == 1:
+        return bytes(value.tobytes())
+    raise fail(exercise, f"{name} should be bytes, you gave {type(value).__name__} {_short(value)} "
+                         "(build it with struct.pack(...) and b''.join(...))")
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+@dataclass(frozen=True)
+class ByteField:
+    """A named run of bytes, for explaining a difference.
+
+    Attributes:
+        offset: first byte.
+        size: number of bytes.
+        name: what the bytes are, e.g. ``header.frame_id length``.
+        type: ``uint32`` and the like (decoded in messages), or ``bytes``/``string``.
+    """
+
+    offset: int
+    size: int
+    name: str
+    type: str = "bytes"
+
+    @property
+    def end(self) -> int:
+        return self.offset + self.size
+
+
+def field_at(fields: Iterable[ByteField], offset: int) -> ByteField | None:
+    """The field holding byte ``offset``, or None."""
+    for f in fields:
+        if f.offset <= offset < f.end:
+            return f
+    return None
+
+
+def _decode(f: ByteField, data: bytes) -> Any:
+    if f.end > len(data):
+        return None
+    raw = data[f.offset:f.end]
+    fmt = _STRUCT.get(f.type)
+    if fmt is not None and struct.calcsize(fmt) == f.size:
+        return struct.unpack(fmt, raw)[0]
+    if f.type == "string":
+        return raw.decode("utf-8", "replace")
+    return None
+
+
+def _byte(b: int) -> str:
+    shown = chr(b) if 32 <= b < 127 else ""
+    return f"0x{b:02x} ({b}{', ' + repr(shown) if shown else ''})"
+
+
+def describe_byte_difference(got: bytes, expected: bytes, fields: Sequence[ByteField],
+                             limit: int = 3) -> list[str]:
+    """Say where ``got`` first departs from ``expected``, naming the field and its value.
+
+    Args:
+        got: the reader's bytes.
+        expected: the right bytes.
+        fields: the fields of ``expected`` (offsets into it).
+        limit: at most this many differing fields are described.
+
+    Returns:
+        Findings (empty when the bytes are equal).
+    """
+    if got == expected:
+        return []
+    out: list[str] = []
+    n = min(len(got), len(expected))
+    seen: set[ByteField | None] = set()
+    i = 0
+    while i < n and len(out) < limit:
+        if got[i] == expected[i]:
+            i += 1
+            continue
+        f = field_at(fields, i)
+        if f in seen:
+            i += 1
+            continue
+        seen.add(f)
+        if f is None:
+            out.append(f"byte {i} is {_byte(got[i])}, expected {_byte(expected[i])}")
+            i += 1
+            continue
+        want, have = _decode(f, expected), _decode(f, got)
+        where = f"field {f.name}"
+        if f.size > 1:
+            where += f", {f.type} at bytes {f.offset}..{f.end - 1}"
+        if want is not None and have is not None:
+            out.append(f"byte {i} ({where}) is {have!r}, expected {want!r}")
+        else:
+            out.append(f"byte {i} ({where}) is {_byte(got[i])}, expected {_byte(expected[i])}")
+        # differences inside one field count once; continue after it
+        i = max(i + 1, f.end)
+    if len(out) < limit and len(got) != len(expected):
+        if len(got) < len(expected):
+            f = field_at(fields, len(got))
+            out.append(f"your bytes end after {len(got)} bytes, expected {len(expected)}"
+                       + (f" (missing from field {f.name} on)" if f else ""))
+        else:
+            out.append(f"you have {len(got) - len(expected)} byte(s) too many: {len(got)} bytes, "
+                       f"expected {len(expected)}")
+    return out

@@ -1,0 +1,48 @@
+"""``rosfpga-lab notebooks build``: the student notebooks from the instructor notebooks."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``notebooks`` sub-command."""
+    parser = subparsers.add_parser(
+        "notebooks",
+        help="build the student notebooks from the instructor notebooks (solutions)",
+        description="The instructor notebooks in notebooks/solutions/ are the one source of the "
+        "course. 'build' writes notebooks/NN_*.ipynb from them, replacing each "
+        "'# BEGIN SOLUTION' ... '# END SOLUTION' block by '# YOUR CODE HERE' and dropping cells "
+        "tagged 'solution'; outputs are stripped from both. 'build --check' writes nothing and "
+        "fails when a student notebook is out of date.",
+    )
+    sub = parser.add_subparsers(dest="action", metavar="ACTION")
+    build = sub.add_parser("build", help="write (or with --check: verify) the student notebooks",
+                           description="Generate the student notebooks from the solutions.")
+    build.add_argument("--source", type=Path, default=Path("notebooks/solutions"), metavar="DIR",
+                       help="instructor notebooks (default: notebooks/solutions)")
+    build.add_argument("--output", type=Path, default=None, metavar="DIR",
+                       help="where the student notebooks go (default: the parent of --source)")
+    build.add_argument("--check", action="store_true",
+                       help="write nothing; exit 1 if any student notebook differs from what "
+                       "the build would write")
+    build.set_defaults(func=run)
+    parser.set_defaults(func=lambda _args: (parser.print_help(), 2)[1])
+
+
+def run(args: argparse.Namespace) -> int:
+    """Build or check; print one line per notebook."""
+    from rosfpga_lab.checks.nbbuild import build
+
+    output = args.output if args.output is not None else args.source.parent
+    items = build(args.source, output, check=args.check)
+    stale = [i for i in items if i.changed]
+    for item in items:
+        state = ("out of date" if args.check else "written") if item.changed else "up to date"
+        print(f"{item.target}: {state} ({item.exercises} exercise block(s))")
+    if args.check and stale:
+        print(f"{len(stale)} student notebook(s) differ from their solutions source; run "
+              "'rosfpga-lab notebooks build'")
+        return 1
+    return 0
