@@ -149,6 +149,12 @@ def test_load_path_reads_package_folders(tmp_path: Path) -> None:
     other = MsgRegistry.with_defaults()
     assert other.load_path(tmp_path / "my_msgs") == ["my_msgs/Blob", "my_msgs/Pair"]
     assert other.md5("my_msgs/Pair") == reg.md5("my_msgs/Pair")
+    deep = tmp_path / "ws" / "src" / "group" / "deep_msgs" / "msg"  # catkin workspace layout
+    deep.mkdir(parents=True)
+    (deep / "D.msg").write_text("int8 x\n")
+    (tmp_path / "ws" / ".hidden" / "h_msgs" / "msg").mkdir(parents=True)
+    (tmp_path / "ws" / ".hidden" / "h_msgs" / "msg" / "H.msg").write_text("int8 x\n")
+    assert MsgRegistry().load_path(tmp_path / "ws") == ["deep_msgs/D"]
 
 
 def test_malformed_file_names_file_and_line(tmp_path: Path) -> None:

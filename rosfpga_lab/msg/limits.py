@@ -21,6 +21,8 @@ MAX_EMPTY_ELEMENTS = 65_536
 MAX_NESTING_DEPTH = 64
 #: Most ``.msg`` files ``MsgRegistry.load_path`` reads from one folder tree.
 MAX_MSG_FILES = 10_000
+#: How many folder levels ``MsgRegistry.load_path`` descends looking for packages.
+MAX_SEARCH_DEPTH = 4
 #: Largest ``.msg`` file read (bytes).
 MAX_MSG_FILE_BYTES = 1024 * 1024
 #: Numeric arrays up to this many elements get one FieldSpan per element in ``field_layout``.

@@ -24,7 +24,9 @@ from typing import Any
 
 from rosfpga_lab.msg.builtins import BUILTIN_TYPES, HEADER, HEADER_FULL_NAME
 from rosfpga_lab.msg.errors import MsgDefinitionError, MsgError, UnknownTypeError
-from rosfpga_lab.msg.limits import MAX_MSG_FILE_BYTES, MAX_MSG_FILES, MAX_NESTING_DEPTH
+from rosfpga_lab.msg.limits import (
+    MAX_MSG_FILE_BYTES, MAX_MSG_FILES, MAX_NESTING_DEPTH, MAX_SEARCH_DEPTH,
+)
 from rosfpga_lab.msg.parser import MsgSpec, bare_type, is_legal_base_name, parse_msg, split_full_text
 
 #: Folder of the definitions the lab ships (``PKG/msg/NAME.msg``).
@@ -111,8 +113,9 @@ class MsgRegistry:
     def load_path(self, root: str | Path, label: str | None = None) -> list[str]:
         """Register every ``PKG/msg/NAME.msg`` under ``root``.
 
-        ``root`` may be a package folder itself (it has a ``msg/`` folder) or a folder of
-        package folders (like a catkin ``src`` folder, one level deep).
+        ``root`` may be a package folder itself (it has a ``msg/`` folder) or any folder above
+        packages (a catkin ``src`` folder, a metapackage): like rospkg, the search descends up
+        to MAX_SEARCH_DEPTH levels, skips hidden folders, and stops at a package.
 
         Args:
             root: the folder.
@@ -130,10 +133,7 @@ class MsgRegistry:
         if not root.is_dir():
             raise MsgError(f"message path {str(root)!r} is not a folder "
                            "(expected PKG/msg/NAME.msg files under it)")
-        packages = [root] if (root / "msg").is_dir() else \
-            sorted(p for p in root.iterdir() if (p / "msg").is_dir())
-        files = [f for pkg in packages for f in sorted((pkg / "msg").glob("*.msg"))
-                 if is_legal_base_name(pkg.name)]
+        files = [f for pkg in _find_packages(root) for f in sorted((pkg / "msg").glob("*.msg"))]
         if len(files) > MAX_MSG_FILES:
             raise MsgError(f"{root}: {len(files)} .msg files, more than MAX_MSG_FILES={MAX_MSG_FILES}")
         self._searched.append(label or str(root))
@@ -320,6 +320,22 @@ class MsgRegistry:
             self.add(dep or full_name, text, source or f"<full text of {full_name}>")
             names.append(dep or full_name)
         return names
+
+
+def _find_packages(root: Path, depth: int = 0) -> list[Path]:
+    """Package folders (with a ``msg/`` folder and a legal name) at or under ``root``."""
+    if (root / "msg").is_dir():
+        return [root] if is_legal_base_name(root.name) else []
+    if depth >= MAX_SEARCH_DEPTH:
+        return []
+    found: list[Path] = []
+    try:
+        children = sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith("."))
+    except OSError:
+        return []
+    for child in children:
+        found += _find_packages(child, depth + 1)
+    return found
 
 
 @functools.cache
