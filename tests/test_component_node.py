@@ -185,14 +185,21 @@ def test_observers_see_frames_and_a_raising_observer_does_not_stop_the_path(rig)
 
 def test_busy_circuit_drops_oldest_input_and_says_so(master) -> None:
     comp = FpgaComponent.from_config(config(), master=master, input_queue=1).start()
-    gate = threading.Event()
-    comp.add_observer(lambda rec: gate.wait(5))  # the circuit stalls on its first frame
+    gate, inside = threading.Event(), threading.Event()
+
+    def stall(_rec) -> None:  # the circuit stalls on its first frame
+        inside.set()
+        gate.wait(5)
+
+    comp.add_observer(stall)
     src = Node("/source", master=master)
     pub = src.advertise("/cam", "sensor_msgs/Image", queue_size=0)
     out = Collector(master)
     try:
         assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
-        for k in range(6):
+        send(pub, picture(0), 0)
+        assert inside.wait(5)
+        for k in range(1, 6):
             send(pub, picture(k), k)
         deadline = time.monotonic() + 5
         while comp.stats.received < 6 and time.monotonic() < deadline:
@@ -202,7 +209,7 @@ def test_busy_circuit_drops_oldest_input_and_says_so(master) -> None:
         time.sleep(0.2)
         st = comp.stats
         # first frame in the circuit, one waiting (queue 1): the other four were dropped
-        assert st.received == 6 and st.dropped_input == 4 and st.published == 2
+        assert (st.received, st.dropped_input, st.published) == (6, 4, 2), st.report()
         assert "input queue full" in st.report()
         got = out.images((48, 64, 4))
         assert np.array_equal(got[-1], cv2_dilate(picture(5)))  # the newest frame survived
@@ -234,7 +241,7 @@ def test_slow_subscriber_loses_frames_by_queue_policy_others_do_not(rig, master)
         img = picture(7, 480, 640)
         for k in range(12):
             send(bpub, img, k)
-            time.sleep(0.01)
+            assert big.wait_for(k + 1, 10)
         assert fast.wait(12, 20), big.stats.report()
         assert big.wait_for(12, 10)
         time.sleep(0.3)
