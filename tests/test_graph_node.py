@@ -428,3 +428,20 @@ def test_node_on_localhost_hostname(master, monkeypatch) -> None:
         assert xmlrpc.client.ServerProxy(a.uri).getPid("/x")[0] == 1
     finally:
         a.shutdown()
+
+
+def test_many_reconnects_keep_bounded_link_stats(nodes, monkeypatch) -> None:
+    import rosfpga_lab.graph.publisher as pub_mod
+
+    monkeypatch.setattr(pub_mod, "MAX_CLOSED_LINKS_KEPT", 4)
+    a, b = nodes("/pub_many"), nodes("/sub_many")
+    sub = b.subscribe("/many", "std_msgs/String")
+    pub = a.advertise("/many", "std_msgs/String")
+    for _ in range(6):
+        assert pub.wait_for_subscribers(1, 5)
+        pub._links[0].close()
+        assert wait_until(lambda: pub.get_num_connections() == 0, 5)
+    assert pub.wait_for_subscribers(1, 5)
+    assert len(pub.stats.links) <= 4 and pub.stats.connections == 1
+    pub.publish({"data": "still"})
+    assert sub.wait_for_message(5)[0] == {"data": "still"}

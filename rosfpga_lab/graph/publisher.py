@@ -21,6 +21,9 @@ from rosfpga_lab.graph.errors import JOIN_TIMEOUT, GraphError
 from rosfpga_lab.graph.wire import hard_close, send_frame, set_nodelay
 from rosfpga_lab.tcpros import TopicSpec
 
+#: Closed connections whose counters ``stats.links`` still reports.
+MAX_CLOSED_LINKS_KEPT = 64
+
 if TYPE_CHECKING:
     import socket
 
@@ -210,6 +213,10 @@ class Publisher:
                 return False
             self._links.append(link)
             self._all_links.append(link)
+            if len(self._all_links) > MAX_CLOSED_LINKS_KEPT:  # keep stats of recent links only
+                closed = [l for l in self._all_links if l.closed]
+                self._all_links = closed[-MAX_CLOSED_LINKS_KEPT // 2:] + \
+                    [l for l in self._all_links if not l.closed]
             if self.latch and self._last is not None:
                 link.enqueue(self._last)
         link.start()
@@ -252,7 +259,7 @@ class Publisher:
             links = list(self._links)
         for link in links:
             link.close()
-        for link in self._all_links:
+        for link in {*self._all_links, *links}:
             link.join(JOIN_TIMEOUT)
 
     def __repr__(self) -> str:

@@ -92,8 +92,7 @@ class _PublisherLink:
         delay = RECONNECT_FIRST
         while not self.stop.is_set():
             try:
-                got_frames = self._connect_once()
-                if got_frames:
+                if self._connect_once():  # the handshake succeeded: back-off starts over (as roscpp)
                     delay = RECONNECT_FIRST
             except (RemoteError, HandshakeRejected) as exc:
                 self.permanent_error = str(exc)
@@ -171,7 +170,6 @@ class _PublisherLink:
                 events, failure = exc.partial, exc
             for ev in events:
                 if isinstance(ev, Frame):
-                    got = True
                     sub._deliver(ev.body, MessageInfo(sub.topic, publisher, conn, ev.index,
                                                       len(ev.body), time.time(), header), ev.offset)
                 elif isinstance(ev, HeaderReceived):
@@ -183,6 +181,7 @@ class _PublisherLink:
                                       raw=ev.raw, size=len(ev.raw), conn=conn,
                                       result=ev.fields.get("error"))
                 elif isinstance(ev, Connected):
+                    got = True
                     sock.settimeout(None)
                     self.connected = True
                     sub._connections_changed(+1)
