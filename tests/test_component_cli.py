@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import signal
 import subprocess
 import sys
@@ -237,5 +236,3 @@ def test_bench_runs_and_checks_outputs(capsys) -> None:
     assert total > 0 and good == total
     assert main(["bench", "--middles", "nonsense"]) == 2
 
-
-_ = os

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from realros import (
-    ROS_PROGRAMS, ROS_PYTHON, free_port, real_rosmaster, require_ros, ros_env, stop_process,
+    ROS_PROGRAMS, ROS_PYTHON, free_port, require_ros, ros_env, stop_process,
     wait_for_master,
 )
 from rosfpga_lab.component import Camera, FpgaComponent
@@ -61,11 +61,9 @@ def parse_image(body: bytes) -> dict:
 def start(cmd: list[str], uri: str, tmp_path: Path) -> subprocess.Popen:
     proc = subprocess.Popen(cmd, env=ros_env(uri, tmp_path), stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE)
-    line = b""
     found = threading.Event()
 
     def reader() -> None:
-        nonlocal line
         for line in proc.stdout:  # type: ignore[union-attr]
             if line.strip() == b"READY":
                 found.set()
@@ -224,5 +222,3 @@ def test_parse_image_reads_what_the_lab_writes() -> None:
             m["step"], m["data"], m["end"]) == (5, (6, 7), "abc", 2, 3, "rgba8", 12, img.tobytes(),
                                                 len(body))
 
-
-_ = real_rosmaster  # the rosmaster_uri fixture (conftest) uses it

@@ -8,7 +8,6 @@ import time
 
 import cv2
 import numpy as np
-import pytest
 
 from rosfpga_lab.cli import main
 from rosfpga_lab.component import run_demo

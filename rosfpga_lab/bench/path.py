@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rosfpga_lab.component import LatencySummary, expected_output, open_source
+from rosfpga_lab.component import LatencySummary, open_source
 from rosfpga_lab.graph import EmbeddedMaster, GraphError, MessageInfo, Node, call
 from rosfpga_lab.hw import image_frame
 
