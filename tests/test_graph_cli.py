@@ -6,7 +6,6 @@ import os
 import subprocess
 import sys
 import threading
-import time
 
 import pytest
 
@@ -123,3 +122,23 @@ def test_format_and_parse_helpers() -> None:
     for t in (0.0, 0.1, 0.2, 0.3):
         meter.tick(t)
     assert meter.report().startswith("average rate: 10.000")
+
+
+def test_master_cli_trace_prints_calls() -> None:
+    import xmlrpc.client
+
+    port = free_port()
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
+    proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "master", "--port", str(port), "--trace"],
+                            stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert proc.stdout is not None
+        proc.stdout.readline()
+        uri = f"http://127.0.0.1:{port}/"
+        wait_for_master(uri, timeout=10)
+        xmlrpc.client.ServerProxy(uri).lookupNode("/probe", "/nobody")
+        lines = [proc.stdout.readline().strip() for _ in range(2)]
+        assert "/probe -> lookupNode('/nobody',) = -1" in lines, lines
+    finally:
+        stop_process(proc)
+        proc.stdout.close()  # type: ignore[union-attr]

@@ -31,17 +31,18 @@ def run(args: argparse.Namespace) -> int:
     master.start()
     print(f"ROS master running; export ROS_MASTER_URI={master.uri}", flush=True)
     stop = threading.Event()
-    seen = 0
+    last_seq = -1
     try:
         while not stop.wait(0.2):
             if args.trace:
-                events = master.trace.events
-                for ev in events[seen:] if len(events) >= seen else events:
+                for ev in master.trace.events:
+                    if ev.seq <= last_seq:
+                        continue
+                    last_seq = ev.seq
                     if ev.role == "server":
                         code = ev.result[0] if isinstance(ev.result, list) and ev.result else ev.result
                         print(f"{ev.src} -> {ev.method}{tuple(ev.args[1:]) if ev.args else ()} = {code}",
                               flush=True)
-                seen = len(events)
     except KeyboardInterrupt:
         pass
     finally:

@@ -28,7 +28,6 @@ from typing import Any
 from rosfpga_lab.graph.apicheck import api_methods, checked
 from rosfpga_lab.graph.errors import (
     JOIN_TIMEOUT,
-    ConfigError,
     GraphError,
     MasterError,
     XmlRpcError,

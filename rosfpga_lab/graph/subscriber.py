@@ -28,7 +28,6 @@ from rosfpga_lab.graph.errors import (
     RECONNECT_MAX,
     GraphError,
     MasterError,
-    XmlRpcError,
 )
 from rosfpga_lab.graph.trace import new_connection_id
 from rosfpga_lab.graph.wire import RECV_CHUNK, hard_close, set_nodelay

@@ -18,7 +18,7 @@ sans-IO: bytes in, events out; the caller owns the socket and the clock (it call
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from rosfpga_lab.tcpros.errors import (
     MAX_FIELD_BYTES,
