@@ -43,12 +43,15 @@ def _cases() -> list[tuple[str, str, dict]]:
                        intensities=rng.random(1080, np.float32))
     poses = new_message(reg, "geometry_msgs/PoseArray", poses=[
         new_message(reg, "geometry_msgs/Pose", position={"x": float(i)}) for i in range(1000)])
+    points = new_message(reg, "sensor_msgs/PointCloud", points=[
+        {"x": float(i), "y": 0.5, "z": -1.0} for i in range(10_000)])
     joints = new_message(reg, "sensor_msgs/JointState", name=[f"j{i}" for i in range(6)],
                          position=np.arange(6.0), velocity=np.zeros(6), effort=np.zeros(6))
     return [("Image 640x480 rgba8", "sensor_msgs/Image", image),
             ("PointCloud2 100k points", "sensor_msgs/PointCloud2", cloud),
             ("LaserScan 1080 rays", "sensor_msgs/LaserScan", scan),
             ("PoseArray 1000 poses", "geometry_msgs/PoseArray", poses),
+            ("PointCloud 10k Point32", "sensor_msgs/PointCloud", points),
             ("JointState 6 joints", "sensor_msgs/JointState", joints)]
 
 

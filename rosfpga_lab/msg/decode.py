@@ -65,6 +65,21 @@ def min_size(reg: MsgRegistry, type_name: str) -> int:
     return reg.cached("min_size", spec.full_name, build)
 
 
+def flat_fields(reg: MsgRegistry, type_name: str) -> tuple[list[str], list[str]] | None:
+    """(names, types) if every field of the type is a non-array integer or float, else None.
+
+    Arrays of such "flat" messages (Point32, Vector3, ColorRGBA ...) take a vectorized path.
+    """
+    spec = reg.check(type_name)
+
+    def build() -> tuple[list[str], list[str]] | None:
+        if not spec.fields or any(f.is_array or f.base_type not in SCALARS or f.base_type == "bool"
+                                  for f in spec.fields):
+            return None
+        return spec.field_names, [f.base_type for f in spec.fields]
+    return reg.cached("flat", spec.full_name, build)
+
+
 # --------------------------------------------------------------------------- decoding
 def _need(buf: memoryview, pos: int, size: int, path: str, what: str) -> None:
     if pos + size > len(buf):
@@ -191,6 +206,17 @@ def _field_decoder(reg: MsgRegistry, f: Field) -> Callable:
                 items.append(s)
             out[name] = items
             return pos
+        return op
+    flat = flat_fields(reg, base)
+    if flat is not None:
+        names = flat[0]
+        row = np.dtype([(n, SCALARS[k].dtype) for n, k in zip(*flat)])
+
+        def op(buf, pos, out, limits):
+            n, pos = count(buf, pos, limits, row.itemsize)
+            rows = np.frombuffer(buf, dtype=row, count=n, offset=pos).tolist() if n else []
+            out[name] = [dict(zip(names, r)) for r in rows]
+            return pos + n * row.itemsize
         return op
     sub = compiled_decoder(reg, base)
     elem_min = min_size(reg, base)

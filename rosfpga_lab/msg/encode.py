@@ -19,6 +19,7 @@ import numpy as np
 from rosfpga_lab.msg.builtins import (
     BYTE_ARRAY_TYPES, FLOAT_TYPES, SCALARS, TIME_CLASS, TIME_STRUCT, Duration, Time,
 )
+from rosfpga_lab.msg.decode import flat_fields
 from rosfpga_lab.msg.errors import SerializeError
 from rosfpga_lab.msg.parser import Field, MsgSpec
 from rosfpga_lab.msg.registry import MsgRegistry
@@ -284,14 +285,33 @@ def _field_encoder(reg: MsgRegistry, f: Field) -> Callable:
         return op
     sub = compiled_encoder(reg, base)
 
-    def op(msg, get, chunks):
-        items = seq(get(msg, name))
-        head(len(items), items, chunks)
+    def generic(items: list, chunks: list) -> None:
         for i, item in enumerate(items):
             try:
                 sub(item, chunks)
             except SerializeError as exc:
                 raise _prefixed(exc, f"{name}[{i}]") from None
+
+    flat = flat_fields(reg, base)
+    if flat is None:
+        def op(msg, get, chunks):
+            items = seq(get(msg, name))
+            head(len(items), items, chunks)
+            generic(items, chunks)
+        return op
+    names = flat[0]
+    row = struct.Struct("<" + "".join(SCALARS[k].struct_char for k in flat[1]))
+
+    def op(msg, get, chunks):
+        items = seq(get(msg, name))
+        head(len(items), items, chunks)
+        try:  # flat messages as dicts: one struct per element, no per-field calls
+            if all(type(it) is dict and len(it) == len(names) for it in items):
+                chunks.append(b"".join([row.pack(*[it[n] for n in names]) for it in items]))
+                return
+        except (KeyError, struct.error, OverflowError, TypeError):
+            pass
+        generic(items, chunks)  # anything else, and every error, takes the general path
     return op
 
 
