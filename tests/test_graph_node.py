@@ -445,3 +445,26 @@ def test_many_reconnects_keep_bounded_link_stats(nodes, monkeypatch) -> None:
     assert len(pub.stats.links) <= 4 and pub.stats.connections == 1
     pub.publish({"data": "still"})
     assert sub.wait_for_message(5)[0] == {"data": "still"}
+
+
+def test_connection_floods_are_bounded(nodes, monkeypatch) -> None:
+    import rosfpga_lab.graph.node as node_mod
+    import rosfpga_lab.graph.xmlrpc as xmlrpc_mod
+
+    monkeypatch.setattr(node_mod, "MAX_PENDING_HANDSHAKES", 3)
+    monkeypatch.setattr(xmlrpc_mod, "MAX_XMLRPC_CONNECTIONS", 3)
+    a, b = nodes("/flooded"), nodes("/fine")
+    pub = a.advertise("/f", "std_msgs/String")
+    idle = []
+    try:
+        for _ in range(5):
+            idle.append(socket.create_connection(("127.0.0.1", a.tcpros_port), timeout=5))
+            idle.append(socket.create_connection(("127.0.0.1", a._xmlrpc.port), timeout=5))
+        assert wait_until(lambda: a.refused_connections >= 2 and a._xmlrpc.refused >= 2, 5)
+    finally:
+        for s in idle:
+            s.close()
+    sub = b.subscribe("/f", "std_msgs/String")  # once the flood is gone, service is back
+    assert sub.wait_for_connection(1, 10)
+    pub.publish({"data": "ok"})
+    assert sub.wait_for_message(5)[0] == {"data": "ok"}

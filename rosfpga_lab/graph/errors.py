@@ -13,6 +13,10 @@ MAX_HTTP_HEAD = 16 << 10
 XMLRPC_TIMEOUT = 10.0
 #: Seconds an idle keep-alive XML-RPC connection stays open on our servers.
 XMLRPC_IDLE_TIMEOUT = 30.0
+#: Open XML-RPC connections a server accepts at once (more get "503" and are closed).
+MAX_XMLRPC_CONNECTIONS = 128
+#: TCPROS connections still in their handshake a node accepts at once (more are refused).
+MAX_PENDING_HANDSHAKES = 64
 #: Seconds to connect to a publisher's TCPROS port.
 CONNECT_TIMEOUT = 5.0
 #: Reconnect back-off after a publisher vanishes: first delay, factor, cap (roscpp: 0.1 s x2 up to 20 s).

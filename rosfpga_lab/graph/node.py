@@ -28,6 +28,7 @@ from typing import Any
 from rosfpga_lab.graph.apicheck import api_methods, checked
 from rosfpga_lab.graph.errors import (
     JOIN_TIMEOUT,
+    MAX_PENDING_HANDSHAKES,
     GraphError,
     MasterError,
     XmlRpcError,
@@ -148,6 +149,7 @@ class Node:
         self.subscribers: dict[str, Subscriber] = {}
         self._handshakes: set[threading.Thread] = set()
         self._pending: set[socket.socket] = set()
+        self.refused_connections = 0
         self.is_shutdown = False
         bind = bind_address(self.host)
         self._xmlrpc = XmlRpcServer(self._handle_xmlrpc, host=bind, port=xmlrpc_port,
@@ -320,6 +322,10 @@ class Node:
             t = threading.Thread(target=self._handshake, args=(conn, f"{addr[0]}:{addr[1]}"),
                                  daemon=True, name=f"rosfpga-tcpros-handshake-{self.name}")
             with self._lock:
+                if len(self._pending) >= MAX_PENDING_HANDSHAKES:
+                    self.refused_connections += 1
+                    hard_close(conn)
+                    continue
                 self._handshakes.add(t)
                 self._pending.add(conn)
                 t.start()

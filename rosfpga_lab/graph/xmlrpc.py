@@ -25,6 +25,7 @@ from defusedxml.xmlrpc import DefusedExpatParser
 from rosfpga_lab.graph.errors import (
     JOIN_TIMEOUT,
     MAX_HTTP_HEAD,
+    MAX_XMLRPC_CONNECTIONS,
     MAX_XMLRPC_BODY,
     XMLRPC_IDLE_TIMEOUT,
     XMLRPC_TIMEOUT,
@@ -194,6 +195,7 @@ class XmlRpcServer:
         self._lock = threading.Lock()
         self._running = False
         self.requests = 0
+        self.refused = 0
 
     @property
     def uri(self) -> str:
@@ -244,7 +246,18 @@ class XmlRpcServer:
                 break
             conn.settimeout(XMLRPC_IDLE_TIMEOUT)
             with self._lock:
-                self._conns.add(conn)
+                busy = len(self._conns) >= MAX_XMLRPC_CONNECTIONS
+                if not busy:
+                    self._conns.add(conn)
+            if busy:  # a flood of idle connections must not cost a thread each
+                self.refused += 1
+                try:
+                    conn.settimeout(1.0)
+                    conn.sendall(_http_response("503 Service Unavailable", b"too many connections", False))
+                except OSError:
+                    pass
+                conn.close()
+                continue
             self._spawn(self._serve_connection, "xmlrpc-conn", conn, f"{addr[0]}:{addr[1]}")
 
     def _serve_connection(self, conn: socket.socket, peer: str) -> None:
