@@ -1,6 +1,6 @@
 """The FPGA component in a real ROS 1 graph (Debian's rosmaster, rospy, rostopic).
 
-A real rospy publisher feeds the component, a real rospy subscriber receives its output; every
+A real rospy publisher feeds the component, a real rospy or roscpp subscriber receives its output; every
 frame received must be OpenCV's dilation of a frame sent (compared byte for byte, found by
 stamp), with the header carried. ``rostopic`` must see the component like any node.
 These tests skip without ROS and fail under CI when ROS is missing (tests/realros.py).
@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from realros import (
-    ROS_PROGRAMS, ROS_PYTHON, free_port, require_ros, ros_env, stop_process,
+    ROS_PROGRAMS, ROS_PYTHON, build_roscpp_program, free_port, require_ros, ros_env, stop_process,
     wait_for_master,
 )
 from rosfpga_lab.component import Camera, FpgaComponent
@@ -85,15 +85,20 @@ def finish(proc: subprocess.Popen, timeout: float = 60.0) -> None:
     assert rc == 0, proc.stderr.read().decode()[-3000:]  # type: ignore[union-attr]
 
 
-def test_rospy_publisher_component_rospy_subscriber_every_frame_bit_exact(rosmaster_uri,
-                                                                            tmp_path) -> None:
+@pytest.mark.parametrize("subscriber", ["rospy", "roscpp"])
+def test_rospy_publisher_component_real_subscriber_every_frame_bit_exact(
+        rosmaster_uri, tmp_path, subscriber) -> None:
     count = 20
+    if subscriber == "roscpp":
+        sub_cmd = [str(build_roscpp_program(ROS_PROGRAMS / "component_roscpp_sub.cpp"))]
+    else:
+        sub_cmd = [ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "sub"]
     comp = FpgaComponent.from_config(CONFIG, master_uri=rosmaster_uri).start()
     procs = []
     try:
         sent_file, got_file = tmp_path / "sent.bin", tmp_path / "got.bin"
-        sub = start([ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "sub",
-                     "/image_dilated", str(count), str(got_file), "60"], rosmaster_uri, tmp_path)
+        sub = start(sub_cmd + ["/image_dilated", str(count), str(got_file), "60"], rosmaster_uri,
+                    tmp_path)
         procs.append(sub)
         assert comp.wait_for_subscribers(1, 20), "the rospy subscriber never connected"
         pub = start([ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "pub", "/image_raw",
