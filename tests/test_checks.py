@@ -329,3 +329,17 @@ def test_sloc():
     assert "that is every line" in problems_of(C.check_sloc, 6, SNIPPET)
     assert "still counts comment-only lines" in problems_of(C.check_sloc, 5, SNIPPET)
     assert "leaves out the preprocessor lines" in problems_of(C.check_sloc, 1, SNIPPET)
+
+
+def test_marshal_explains_a_shift_instead_of_listing_every_byte_after_it():
+    four_byte_flag = (struct.pack("<III", 3, 10, 20) + pack_str("camera") + struct.pack("<II", 1, 2)
+                      + pack_str("mono8") + struct.pack("<II", 0, 2) + pack_str(b"\x01\x02"))
+    msg = problems_of(C.check_marshal, four_byte_flag, image_msg())
+    assert "something before byte 40 is 3 byte(s) too long (the field before is is_bigendian, uint8: 1 byte)" in msg
+    assert msg.count("\n  - ") == 2, "one finding and one explanation, not every later byte"
+    pixels = bytes(range(1, 9))
+    msg8 = {**image_msg(), "height": 2, "width": 4, "step": 4, "data": pixels}
+    right = image_body(width=4, height=2, data=pixels)
+    no_length = right[:-12] + pixels     # data without its uint32 length
+    assert "field data length (uint32, 4 byte(s) at 44..47) is missing" in \
+        problems_of(C.check_marshal, no_length, msg8)

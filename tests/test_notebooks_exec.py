@@ -14,6 +14,9 @@ compiles the generated C++ when g++ is there.
 
 from __future__ import annotations
 
+import os
+import re
+import sys
 import time
 from pathlib import Path
 
@@ -23,6 +26,9 @@ from nbclient import NotebookClient
 from nbclient.exceptions import CellExecutionError
 
 from rosfpga_lab.checks import nbbuild
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from realros import ros_missing_reason  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -63,6 +69,24 @@ def test_solution_notebook_runs_and_every_check_passes(path: Path):
             shown = text_of(cell)
             assert "\u2714 Exercise" in shown and "correct" in shown, \
                 f"{path.name} cell {index}: the check did not report success: {shown[:300]}"
+    if path.stem == "07_workshop_demo":
+        check_real_ros_part(nb)
+
+
+def check_real_ros_part(nb: nbformat.NotebookNode) -> None:
+    """With real ROS 1 here, its programs must really have joined (a failure, never a skip, in CI)."""
+    text = "\n".join(text_of(c) for c in nb.cells if c.cell_type == "code")
+    reason = ros_missing_reason()
+    if reason is not None:
+        if os.environ.get("ROSFPGA_REQUIRE_ROS", "") not in ("", "0", "false", "no"):
+            pytest.fail(f"notebook 7 ran without real ROS ({reason}) and ROSFPGA_REQUIRE_ROS=1")
+        assert "NOT available" in text
+        return
+    assert "real ROS 1: available" in text
+    assert "Publishers: \n * /fpga_dilate" in text, "rostopic info did not see the component"
+    assert "average rate" in text, "rostopic hz measured nothing"
+    found = re.search(r"frames from the rospy camera: (\d+), bit-exact: (\d+)", text)
+    assert found and int(found[1]) > 0 and found[1] == found[2], found and found[0]
 
 
 STUDENT_NOTEBOOKS = [p for p in sorted(NOTEBOOKS.glob(nbbuild.NOTEBOOK_GLOB))
@@ -87,3 +111,40 @@ def test_student_notebook_runs_with_only_the_placeholders_failing(path: Path):
             else:
                 client.execute_cell(cell, index)
     assert placeholders >= 2
+
+
+def test_workshop_demo_explains_itself_without_real_ros(monkeypatch: pytest.MonkeyPatch):
+    """Notebook 7 on a machine without ROS tools: it says so, skips those cells, runs the rest."""
+    monkeypatch.setenv("PATH", str(Path(sys.executable).parent))   # no rostopic on PATH
+    client, nb = client_for(SOLUTIONS / "07_workshop_demo.ipynb")
+    client.execute()
+    text = "\n".join(text_of(c) for c in nb.cells if c.cell_type == "code")
+    assert "real ROS 1: NOT available: rostopic is not on PATH" in text
+    assert text.count("skipped (real ROS 1 not available") == 3
+    assert "frames from the rospy camera: 0, bit-exact: 0" in text
+    assert "camera sent 60, viewer received 60" in text
+
+
+def test_a_wrong_answer_shows_the_finding_not_a_traceback():
+    """A student's typical slip in exercise 3.2 (is_bigendian packed as 4 bytes), run in a kernel."""
+    client, nb = client_for(NOTEBOOKS / "03_message_conversion.ipynb")
+    cell = next(c for c in nb.cells if "check_marshal(my_body" in c.source)
+    cell.source = cell.source.replace(nbbuild.RAISE, (
+        "h = exercise_msg['header']\n"
+        "s = lambda raw: struct.pack('<I', len(raw)) + raw\n"
+        "my_body = (struct.pack('<III', 3, 12, 345) + s(b'cam_left') + struct.pack('<II', 2, 3)\n"
+        "           + s(b'mono8') + struct.pack('<II', 0, 3) + s(bytes([10, 20, 30, 40, 50, 60])))"))
+    index = nb.cells.index(cell)
+    with client.setup_kernel():
+        for i, c in enumerate(nb.cells[:index]):
+            if c.cell_type == "code" and nbbuild.PLACEHOLDER not in c.source:
+                client.execute_cell(c, i)
+        with pytest.raises(CellExecutionError) as info:
+            client.execute_cell(cell, index)
+    assert info.value.ename == "ExerciseError"
+    error = next(o for o in cell.outputs if o.output_type == "error")
+    shown = "\n".join(error.traceback)
+    assert "Exercise 3.2 (marshal an Image): not right yet" in shown
+    assert "byte 42 (field step, uint32 at bytes 42..45) is 50331648, expected 3" in shown
+    assert "before byte 42 is 3 byte(s) too long (the field before is is_bigendian, uint8" in shown
+    assert "Traceback" not in shown and "File " not in shown, "students see the finding only"

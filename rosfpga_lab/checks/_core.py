@@ -170,6 +170,38 @@ def _byte(b: int) -> str:
     return f"0x{b:02x} ({b}{', ' + repr(shown) if shown else ''})"
 
 
+#: Bytes compared when looking for a shifted stream, and the largest shift looked for.
+SHIFT_WINDOW = 16
+MAX_SHIFT = 8
+
+
+def _shift(got: bytes, expected: bytes, i: int) -> int:
+    """``k > 0``: ``got`` has ``k`` extra bytes before ``i``; ``k < 0``: ``-k`` bytes missing; else 0."""
+    for k in range(1, MAX_SHIFT + 1):
+        want = expected[i:i + SHIFT_WINDOW]
+        if len(want) >= 4 and got[i + k:i + k + len(want)] == want:
+            return k
+        have = got[i:i + SHIFT_WINDOW]
+        if len(have) >= 4 and expected[i + k:i + k + len(have)] == have:
+            return -k
+    return 0
+
+
+def _explain_shift(k: int, i: int, fields: Sequence[ByteField]) -> str:
+    before = field_at(fields, i - 1) if i else None
+    what = (f" (the field before is {before.name}, {before.type}: {before.size} byte"
+            f"{'s' if before.size != 1 else ''})" if before else "")
+    if k > 0:
+        return (f"from byte {i} on your bytes are the expected ones {k} byte(s) later: something "
+                f"before byte {i} is {k} byte(s) too long{what}")
+    here = field_at(fields, i)
+    if here is not None and here.offset == i and here.size == -k:
+        return (f"field {here.name} ({here.type}, {here.size} byte(s) at {i}..{here.end - 1}) is "
+                "missing: your bytes go on with what follows it")
+    return (f"from byte {i} on your bytes are the expected ones {-k} byte(s) early: something "
+            f"before byte {i} is {-k} byte(s) too short or missing{what}")
+
+
 def describe_byte_difference(got: bytes, expected: bytes, fields: Sequence[ByteField],
                              limit: int = 3) -> list[str]:
     """Say where ``got`` first departs from ``expected``, naming the field and its value.
@@ -210,6 +242,10 @@ def describe_byte_difference(got: bytes, expected: bytes, fields: Sequence[ByteF
             out.append(f"byte {i} ({where}) is {have!r}, expected {want!r}")
         else:
             out.append(f"byte {i} ({where}) is {_byte(got[i])}, expected {_byte(expected[i])}")
+        shift = _shift(got, expected, i)
+        if shift:
+            out.append(_explain_shift(shift, i, fields))
+            return out  # everything after a shift differs; listing it would only confuse
         # differences inside one field count once; continue after it
         i = max(i + 1, f.end)
     if len(out) < limit and len(got) != len(expected):
