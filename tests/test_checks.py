@@ -343,3 +343,9 @@ def test_marshal_explains_a_shift_instead_of_listing_every_byte_after_it():
     no_length = right[:-12] + pixels     # data without its uint32 length
     assert "field data length (uint32, 4 byte(s) at 44..47) is missing" in \
         problems_of(C.check_marshal, no_length, msg8)
+
+
+def test_numpy_scalars_count_as_numbers_but_bools_do_not():
+    assert C.check_tdata(np.uint32(0x04030201), (1, 2, 3, 4)).ok
+    assert C.check_frame_timing(np.int64(308_321), np.float32(3.08321), "byte-wide stages").ok
+    assert "should be int, you gave bool" in problems_of(C.check_data_offset, True, b"")

@@ -158,4 +158,4 @@ def test_the_real_sources_build_into_an_empty_directory(tmp_path: Path):
     items = nbbuild.build(tmp_path / "solutions", tmp_path)
     assert [i.exercises for i in items] == [0, 3, 3, 3, 3, 2, 2, 0]
     for item in items:
-        assert item.target.read_bytes() == (NOTEBOOKS / item.target.name).read_bytes()
+        assert item.target.read_text(encoding="utf-8") == (NOTEBOOKS / item.target.name).read_text(encoding="utf-8")

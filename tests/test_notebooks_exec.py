@@ -25,10 +25,8 @@ import pytest
 from nbclient import NotebookClient
 from nbclient.exceptions import CellExecutionError
 
+from realros import ros_missing_reason   # tests/ is on sys.path (conftest.py)
 from rosfpga_lab.checks import nbbuild
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from realros import ros_missing_reason  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"

@@ -18,6 +18,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from rosfpga_lab.errors import LabError
 
 #: How many problems one failed check lists at most.
@@ -94,15 +96,17 @@ def require_answer(exercise: str, name: str, value: Any) -> None:
 
 def require_type(exercise: str, name: str, value: Any, kinds: type | tuple[type, ...],
                  hint: str = "") -> None:
-    """Refuse an answer of the wrong Python type (bool is not accepted as an int).
+    """Refuse an answer of the wrong Python type (numpy scalars count as int/float, bool does not).
 
     Raises:
         ExerciseError: ``value`` is not an instance of ``kinds``.
     """
     require_answer(exercise, name, value)
     kinds_t = kinds if isinstance(kinds, tuple) else (kinds,)
-    bad_bool = isinstance(value, bool) and bool not in kinds_t
-    if bad_bool or not isinstance(value, kinds_t):
+    accepted = kinds_t + ((np.integer,) if int in kinds_t else ()) + (
+        (np.integer, np.floating) if float in kinds_t else ())
+    bad_bool = isinstance(value, (bool, np.bool_)) and bool not in kinds_t
+    if bad_bool or not isinstance(value, accepted):
         want = " or ".join(k.__name__ for k in kinds_t)
         raise fail(exercise, f"{name} should be {want}, you gave {type(value).__name__} "
                              f"{_short(value)}" + (f" ({hint})" if hint else ""))

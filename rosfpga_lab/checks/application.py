@@ -89,7 +89,7 @@ def check_frame_timing(filter_cycles: Any, frame_ms: Any, bottleneck: Any, *, wi
         ExerciseError: the wrong figure, with the likely slip.
     """
     ex = "5.2 (cycles and time per frame)"
-    require_type(ex, "filter_cycles", filter_cycles, (int, np.integer))
+    require_type(ex, "filter_cycles", filter_cycles, int)
     require_type(ex, "frame_ms", frame_ms, (int, float))
     require_type(ex, "bottleneck", bottleneck, str)
     want_cycles = (height + 1) * (width + 1)
