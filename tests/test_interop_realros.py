@@ -31,7 +31,7 @@ from rosfpga_lab.graph import EmbeddedMaster, Node
 from rosfpga_lab.msg import Time, default_registry, deserialize, serialize
 from rosfpga_lab.tcpros import decode_header
 
-pytestmark = [pytest.mark.ros, pytest.mark.timeout(120)]
+pytestmark = [pytest.mark.ros, pytest.mark.slow, pytest.mark.timeout(120)]
 
 TYPES = {"String": "std_msgs/String", "Image": "sensor_msgs/Image", "Int32": "std_msgs/Int32"}
 COUNT = {"String": 5, "Image": 3}
