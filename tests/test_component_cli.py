@@ -225,7 +225,7 @@ def test_bench_runs_and_checks_outputs(capsys) -> None:
     """Not a timing test: the bench runs end to end and the component's outputs are right."""
     code = main(["bench", "--config", str(ROOT / "data" / "fpga_passthrough_rgb8.yaml"),
                  "--middles", "direct,component", "--frames", "20", "--rate-frames", "10",
-                 "--rate", "50", "-q"])
+                 "--rate", "50", "--rounds", "1", "-q"])
     out = capsys.readouterr().out
     assert code == 0, out
     assert "model's output equals OpenCV's: yes" in out

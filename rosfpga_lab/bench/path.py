@@ -7,7 +7,10 @@ the baseline), the FPGA component (``python -m rosfpga_lab node CONFIG``), roscp
 ``topic_tools relay`` or a rospy relay (``rospy.AnyMsg``, no deserialization). Two phases:
 
 * *sustained*: publish as fast as the path delivers, with at most ``window`` frames in flight
-  (a frame is sent when an earlier one has come out), for ``frames`` frames: frames/s;
+  (a frame is sent when an earlier one has come out), for ``frames`` frames: frames/s. With
+  one frame in flight this is one frame at a time (latency-bound); with two, receiving the next
+  frame overlaps handling the current one. The runner repeats this phase in interleaved rounds
+  and reports the median, because other programs on the machine make single runs noisy;
 * *at a rate*: ``rate`` frames/s for ``rate_frames`` frames: how many came out (drops), and the
   latency from ``header.stamp`` (set when the frame is published) to its arrival.
 
@@ -51,9 +54,8 @@ class PathFigures:
     name: str
     available: bool = True
     note: str = ""
-    sustained_fps: float = float("nan")
-    sustained_frames: int = 0
-    sustained_lost: int = 0
+    sustained: dict[int, list[float]] = field(default_factory=dict)   # window -> fps per round
+    sustained_lost: dict[int, int] = field(default_factory=dict)      # window -> frames lost
     rate: float = 0.0
     sent: int = 0
     received: int = 0
@@ -65,6 +67,25 @@ class PathFigures:
     @property
     def drops(self) -> int:
         return self.sent - self.received
+
+    def fps(self, window: int) -> float:
+        """Median sustained frames/s over the rounds with ``window`` frames in flight."""
+        runs = sorted(self.sustained.get(window, []))
+        if not runs:
+            return float("nan")
+        mid = len(runs) // 2
+        return runs[mid] if len(runs) % 2 else (runs[mid - 1] + runs[mid]) / 2
+
+    def merge(self, other: PathFigures) -> None:
+        """Add another round's sustained figures (and its notes) to these."""
+        for window, runs in other.sustained.items():
+            self.sustained.setdefault(window, []).extend(runs)
+        for window, lost in other.sustained_lost.items():
+            self.sustained_lost[window] = self.sustained_lost.get(window, 0) + lost
+        self.checked += other.checked
+        self.correct += other.correct
+        if not other.available:
+            self.available, self.note = False, other.note
 
 
 def find_relay() -> str | None:
@@ -215,10 +236,11 @@ def _wait_subscribed(master: EmbeddedMaster, topic: str, proc: subprocess.Popen 
 
 def measure(name: str, master: EmbeddedMaster, in_topic: str, out_topic: str,
             command: list[str] | None, *, env: dict[str, str] | None, images: list[np.ndarray],
-            encoding: str, expect: Callable[[np.ndarray], np.ndarray], frames: int, window: int,
-            rate: float, rate_frames: int, check_every: int = 5,
+            encoding: str, expect: Callable[[np.ndarray], np.ndarray], frames: int,
+            windows: tuple[int, ...], rate: float, rate_frames: int, check_every: int = 5,
             max_seconds: float = 15.0) -> PathFigures:
-    """Run one middle (``command``; None: direct) and measure both phases."""
+    """Run one middle (``command``; None: direct) and measure: the sustained phase once per
+    window in ``windows``, then (if ``rate_frames``) the at-rate phase."""
     fig = PathFigures(name, rate=rate)
     proc = None
     probe = None
@@ -238,11 +260,14 @@ def measure(name: str, master: EmbeddedMaster, in_topic: str, out_topic: str,
         if probe.received < 5:
             raise GraphError(f"no output on {out_topic} within {START_TIMEOUT} s")
         time.sleep(0.2)
-        fig.sustained_fps, fig.sustained_frames, fig.sustained_lost = probe.sustained(
-            frames, window, max_seconds)
-        time.sleep(0.2)
-        fig.sent, fig.received, lat = probe.at_rate(rate, rate_frames)
-        fig.latency = LatencySummary.of(lat)
+        for window in windows:
+            fps, _delivered, lost = probe.sustained(frames, window, max_seconds)
+            fig.sustained[window] = [fps]
+            fig.sustained_lost[window] = lost
+            time.sleep(0.1)
+        if rate_frames:
+            fig.sent, fig.received, lat = probe.at_rate(rate, rate_frames)
+            fig.latency = LatencySummary.of(lat)
         fig.checked, fig.correct = probe.checked, probe.correct
     except GraphError as exc:
         fig.available, fig.note = False, str(exc)
