@@ -7,6 +7,7 @@ models). Everything runs on loopback against an embedded master on a free port.
 from __future__ import annotations
 
 import logging
+import re
 import socket
 import threading
 import time
@@ -183,7 +184,8 @@ def test_observers_see_frames_and_a_raising_observer_does_not_stop_the_path(rig)
     assert comp.stats.observer_errors == 3
 
 
-def test_busy_circuit_drops_oldest_input_and_says_so(master) -> None:
+def test_busy_circuit_drops_oldest_input_and_says_so(master, caplog) -> None:
+    caplog.set_level(logging.INFO, logger="rosfpga_lab.component")
     comp = FpgaComponent.from_config(config(), master=master, input_queue=1).start()
     gate, inside = threading.Event(), threading.Event()
 
@@ -211,6 +213,14 @@ def test_busy_circuit_drops_oldest_input_and_says_so(master) -> None:
         # first frame in the circuit, one waiting (queue 1): the other four were dropped
         assert (st.received, st.dropped_input, st.published) == (6, 4, 2), st.report()
         assert "input queue full" in st.report()
+        def logged_drops() -> int:  # the monitor logs drops once a second
+            found = [re.search(r"dropped (\d+) input frame", r.getMessage()) for r in caplog.records]
+            return sum(int(m.group(1)) for m in found if m)
+
+        deadline = time.monotonic() + 3
+        while time.monotonic() < deadline and logged_drops() < 4:
+            time.sleep(0.05)
+        assert logged_drops() == 4
         got = out.images((48, 64, 4))
         assert np.array_equal(got[-1], cv2_dilate(picture(5)))  # the newest frame survived
     finally:
@@ -219,7 +229,8 @@ def test_busy_circuit_drops_oldest_input_and_says_so(master) -> None:
         comp.stop()
 
 
-def test_slow_subscriber_loses_frames_by_queue_policy_others_do_not(rig, master) -> None:
+def test_slow_subscriber_loses_frames_by_queue_policy_others_do_not(rig, master, caplog) -> None:
+    caplog.set_level(logging.INFO, logger="rosfpga_lab.component")
     comp, pub, out = rig
     big = FpgaComponent.from_config(config(640, 480), master=master, name="/fpga_big",
                                     output_queue=2)
@@ -248,6 +259,11 @@ def test_slow_subscriber_loses_frames_by_queue_policy_others_do_not(rig, master)
         st = big.stats
         assert st.dropped_output > 0 and st.dropped_output_by_peer.keys() == {"/slow_reader"}
         assert "output queue full for subscriber /slow_reader" in st.report()
+        deadline = time.monotonic() + 3                # the monitor says so in the log too
+        while time.monotonic() < deadline and not any(
+                "for subscriber /slow_reader" in r.getMessage() for r in caplog.records):
+            time.sleep(0.05)
+        assert any("too slow for the rate" in r.getMessage() for r in caplog.records)
         assert st.published == 12 and st.dropped_input == 0
         assert all(np.array_equal(g, cv2_dilate(img)) for g in fast.images(img.shape))
     finally:

@@ -15,8 +15,9 @@ is dropped and counted) and behind it in one queue per downstream subscriber
 (``output_queue``; a subscriber too slow for the rate loses the oldest frames, the others are
 not held back). A frame the circuit refuses (wrong size, encoding, truncated) is counted under
 its reason and logged; the pipeline has reset itself and the next good frame comes out right.
-A watchdog checks once a second that the master still knows the node and registers it again
-after a master restart.
+A monitor thread checks once a second that the master still knows the node (registering it
+again after a master restart) and logs what changed: drops by either queue, publishers and
+subscribers coming and going.
 
 Observe it live with :meth:`FpgaComponent.add_observer` (called with a :class:`FrameRecord`
 for every frame, in the component's thread: keep it short) or :attr:`FpgaComponent.recent`
@@ -108,7 +109,8 @@ class FpgaComponent:
         name: node name instead of the configuration's ``node.name``.
         host: address to bind and advertise instead of ``node.ip_address``.
         trace: a :class:`~rosfpga_lab.graph.Trace` to record the conversation into.
-        watchdog: check the master once a second and register again after a restart.
+        watchdog: check the master once a second and register again after a restart (the
+            monitor thread runs either way, logging drops and connections).
 
     Raises:
         ComponentConfigError: the configuration cannot be run (``op: custom``, wrong type).
@@ -212,10 +214,9 @@ class FpgaComponent:
             raise
         self.node = node
         self._stop.clear()
-        if self.watchdog:
-            self._watch = threading.Thread(target=self._watch_loop, daemon=True,
-                                           name=f"rosfpga-component-watchdog-{self.name}")
-            self._watch.start()
+        self._watch = threading.Thread(target=self._watch_loop, daemon=True,
+                                       name=f"rosfpga-component-monitor-{self.name}")
+        self._watch.start()
         log.info("%s: %s -> %s circuit (%s model) -> %s; master %s", self.name, self.input_topic,
                  self.pipeline.op, self.model, self.output_topic, self.master_uri)
         return self
@@ -314,17 +315,39 @@ class FpgaComponent:
 
     # ------------------------------------------------------------------ master watchdog
     def _watch_loop(self) -> None:
+        before = self.stats
         while not self._stop.wait(limits.WATCHDOG_PERIOD):
             node = self.node
             if node is None or node.is_shutdown:
                 return
-            try:
-                self.check_master()
-            except LabError as exc:
-                if self._master_ok:
-                    log.warning("%s: master %s unreachable: %s (will keep trying)", self.name,
-                                self.master_uri, exc)
-                self._master_ok = False
+            if self.watchdog:
+                try:
+                    self.check_master()
+                except LabError as exc:
+                    if self._master_ok:
+                        log.warning("%s: master %s unreachable: %s (will keep trying)", self.name,
+                                    self.master_uri, exc)
+                    self._master_ok = False
+            now = self.stats
+            self._log_changes(before, now)
+            before = now
+
+    def _log_changes(self, old: ComponentStats, new: ComponentStats) -> None:
+        if new.dropped_input > old.dropped_input:
+            log.warning("%s: dropped %d input frame(s): input queue full (%d deep), the circuit "
+                        "was busy; the oldest waiting frame goes", self.name,
+                        new.dropped_input - old.dropped_input, self.input_queue)
+        for peer, n in new.dropped_output_by_peer.items():
+            if n > old.dropped_output_by_peer.get(peer, 0):
+                log.warning("%s: dropped %d output frame(s) for subscriber %s: its queue (%d "
+                            "deep) is full, it is too slow for the rate", self.name,
+                            n - old.dropped_output_by_peer.get(peer, 0), peer, self.output_queue)
+        if new.publishers != old.publishers:
+            log.info("%s: %d publisher(s) of %s connected (was %d)", self.name, new.publishers,
+                     self.input_topic, old.publishers)
+        if new.subscribers != old.subscribers:
+            log.info("%s: %d subscriber(s) of %s connected (was %d)", self.name, new.subscribers,
+                     self.output_topic, old.subscribers)
 
     def check_master(self) -> bool:
         """Ask the master whether it knows this node; register again if it does not.
