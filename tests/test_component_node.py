@@ -374,3 +374,20 @@ def test_reference_model_gives_the_same_bytes(master) -> None:
         out.node.shutdown()
         src.shutdown()
         comp.stop()
+
+
+def test_a_newer_node_with_the_same_name_wins(master) -> None:
+    """ROS's rule: the master shuts the older node down; the older never registers again."""
+    old = FpgaComponent.from_config(config(), master=master).start()
+    new = FpgaComponent.from_config(config(), master=master).start()
+    try:
+        deadline = time.monotonic() + 5
+        while old.running and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not old.running and new.running
+        time.sleep(1.5)  # a monitor round of each
+        assert master.lookupNode("/t", "/fpga_test")[2] == new.node.uri
+        assert new.stats.master_reregistrations == 0
+    finally:
+        new.stop()
+        old.stop()

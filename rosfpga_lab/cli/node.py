@@ -91,10 +91,16 @@ def run(args: argparse.Namespace) -> int:
     t_end = None if args.duration is None else time.monotonic() + args.duration
     interval = args.status_interval if args.status_interval > 0 and not args.quiet else 1.0
     last_print = 0.0
+    exit_code = 0
     try:
         while not stop.wait(min(interval, limits.WATCHDOG_PERIOD)):
             now = time.monotonic()
             if t_end is not None and now >= t_end:
+                break
+            if not component.running:
+                print("\nthe node was shut down from outside (a 'shutdown' call: another node "
+                      "took its name, or rosnode kill)", file=sys.stderr, flush=True)
+                exit_code = 1
                 break
             if args.quiet or args.status_interval <= 0:
                 continue
@@ -116,4 +122,4 @@ def run(args: argparse.Namespace) -> int:
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGTERM, previous)
     print(stats.report(), flush=True)
-    return 0
+    return exit_code

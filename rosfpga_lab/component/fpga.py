@@ -161,6 +161,7 @@ class FpgaComponent:
         self._last: PipelineResult | None = None
         self._last_error = ""
         self._master_ok = True
+        self._name_taken = False
         self._done = threading.Condition(self._lock)
         self._stop = threading.Event()
         self._watch: threading.Thread | None = None
@@ -363,7 +364,13 @@ class FpgaComponent:
             raise ComponentError("component not started")
         reply = call(self.master_uri, "lookupNode", self.name, self.name, timeout=2.0)
         self._master_ok = True
-        if isinstance(reply, list) and len(reply) == 3 and reply[0] == 1 and reply[2] == node.uri:
+        if isinstance(reply, list) and len(reply) == 3 and reply[0] == 1:
+            if reply[2] != node.uri and not self._name_taken:
+                # Another node took the name: ROS's rule is that the newer one wins (the master
+                # shuts the older down), so never register again over it.
+                self._name_taken = True
+                log.error("%s: another node (%s) registered under this name; not registering "
+                          "again", self.name, reply[2])
             return False
         call(self.master_uri, "registerPublisher", self.name, self.output_topic,
              "sensor_msgs/Image", node.uri, timeout=2.0)
