@@ -146,6 +146,11 @@ def test_build_writes_check_detects_drift_and_cli_exit_codes(tmp_path: Path, cap
     assert target.read_text(encoding="utf-8") == first, "rebuilding is deterministic"
     target.write_text(first.replace("check(answer)", "check(answer)  # edited by hand"), encoding="utf-8")
     assert main(["notebooks", "build", "--source", str(src), "--check"]) == 1
+    assert main(["notebooks", "build", "--source", str(src)]) == 0
+    (tmp_path / "02_renamed.ipynb").write_text(first, encoding="utf-8")   # its source is gone
+    capsys.readouterr()
+    assert main(["notebooks", "build", "--source", str(src), "--check"]) == 1
+    assert "02_renamed.ipynb: no source" in capsys.readouterr().out
 
 
 def test_build_without_sources_says_where_it_looked(tmp_path: Path, capsys):

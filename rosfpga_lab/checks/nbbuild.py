@@ -181,6 +181,12 @@ class BuildItem:
     exercises: int
 
 
+def orphans(source_dir: str | Path, target_dir: str | Path) -> list[Path]:
+    """Student notebooks in ``target_dir`` whose source in ``source_dir`` no longer exists."""
+    names = {p.name for p in Path(source_dir).glob(NOTEBOOK_GLOB)}
+    return sorted(p for p in Path(target_dir).glob(NOTEBOOK_GLOB) if p.name not in names)
+
+
 def build(source_dir: str | Path, target_dir: str | Path, *, check: bool = False,
           clean_sources: bool = True) -> list[BuildItem]:
     """Write the student notebooks of every ``NN_*.ipynb`` in ``source_dir`` into ``target_dir``.

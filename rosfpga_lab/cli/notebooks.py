@@ -33,7 +33,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Build or check; print one line per notebook."""
-    from rosfpga_lab.checks.nbbuild import build
+    from rosfpga_lab.checks.nbbuild import build, orphans
 
     output = args.output if args.output is not None else args.source.parent
     items = build(args.source, output, check=args.check)
@@ -41,8 +41,11 @@ def run(args: argparse.Namespace) -> int:
     for item in items:
         state = ("out of date" if args.check else "written") if item.changed else "up to date"
         print(f"{item.target}: {state} ({item.exercises} exercise block(s))")
-    if args.check and stale:
-        print(f"{len(stale)} student notebook(s) differ from their solutions source; run "
-              "'rosfpga-lab notebooks build'")
+    lost = orphans(args.source, output)
+    for path in lost:
+        print(f"{path}: no source in {args.source} (renamed or removed? delete it by hand)")
+    if args.check and (stale or lost):
+        print(f"{len(stale) + len(lost)} student notebook(s) do not match their solutions source; "
+              "run 'rosfpga-lab notebooks build'")
         return 1
     return 0
