@@ -468,3 +468,17 @@ def test_connection_floods_are_bounded(nodes, monkeypatch) -> None:
     assert sub.wait_for_connection(1, 10)
     pub.publish({"data": "ok"})
     assert sub.wait_for_message(5)[0] == {"data": "ok"}
+
+
+def test_all_interfaces_advertises_hostname(master) -> None:
+    from rosfpga_lab.graph import OpenBindWarning
+
+    with pytest.warns(OpenBindWarning):
+        a = Node("/open", master=master, host="0.0.0.0")
+    try:
+        assert a.host == socket.gethostname() and a.uri.startswith(f"http://{socket.gethostname()}:")
+        a.advertise("/o", "std_msgs/String")
+        reply = xmlrpc.client.ServerProxy(f"http://127.0.0.1:{a._xmlrpc.port}/").requestTopic("/x", "/o", [["TCPROS"]])
+        assert reply[2] == ["TCPROS", socket.gethostname(), a.tcpros_port]
+    finally:
+        a.shutdown()

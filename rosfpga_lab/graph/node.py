@@ -35,6 +35,7 @@ from rosfpga_lab.graph.errors import (
 )
 from rosfpga_lab.graph.master import MASTER_ID, EmbeddedMaster
 from rosfpga_lab.graph.names import (
+    ALL_INTERFACES,
     bind_address,
     check_node_name,
     default_host,
@@ -115,7 +116,8 @@ class Node:
         master_uri: the master to use; None: see :func:`default_master_uri` (ROS_MASTER_URI,
             else a master on 127.0.0.1:11311, else the shared embedded master).
         host: address to bind and advertise; None: ``ROS_IP``, ``ROS_HOSTNAME``, else
-            127.0.0.1. "0.0.0.0" binds every interface (with a warning).
+            127.0.0.1. "0.0.0.0" binds every interface (with a warning) and advertises the
+            machine's hostname.
         master: an :class:`EmbeddedMaster` to use (overrides ``master_uri``).
         trace: where to record the conversation (a new :class:`Trace` by default;
             share one between nodes and the master for a single timeline).
@@ -152,6 +154,8 @@ class Node:
         self.refused_connections = 0
         self.is_shutdown = False
         bind = bind_address(self.host)
+        if self.host in ALL_INTERFACES:  # peers need a reachable name, not 0.0.0.0
+            self.host = socket.gethostname()
         self._xmlrpc = XmlRpcServer(self._handle_xmlrpc, host=bind, port=xmlrpc_port,
                                     trace=self.trace, name=self.name, advertise_host=self.host)
         self._xmlrpc.start()
