@@ -291,6 +291,7 @@ def test_frame_timing():
     assert "one clock per pixel" in msg and "bottleneck 'filter'" in msg
     assert "counts bytes" in problems_of(C.check_frame_timing, 1_228_800, 12.288, "byte-wide stages")
     assert "in microseconds" in problems_of(C.check_frame_timing, 308_321, 3083.21, "byte-wide stages")
+    assert "in seconds: multiply by 1000" in problems_of(C.check_frame_timing, 308_321, 0.00308321, "fifo")
 
 
 # ------------------------------------------------------------------------------ notebook 6

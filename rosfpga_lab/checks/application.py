@@ -107,6 +107,8 @@ def check_frame_timing(filter_cycles: Any, frame_ms: Any, bottleneck: Any, *, wi
     if abs(float(frame_ms) - want_ms) > 1e-3 * want_ms:
         if abs(float(frame_ms) - want_ms * 1e3) < 1e-3 * want_ms * 1e3:
             problems.append("frame_ms is in microseconds: divide by 1000")
+        elif abs(float(frame_ms) * 1e3 - want_ms) < 1e-3 * want_ms:
+            problems.append("frame_ms is in seconds: multiply by 1000")
         elif abs(float(frame_ms) - filter_cycles / clock_hz * 1e3) < 1e-6 and filter_cycles != want_cycles:
             pass  # follows from the wrong cycle count, already reported
         else:
