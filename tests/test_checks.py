@@ -106,6 +106,7 @@ def test_http_body():
     assert "off by 2" in problems_of(C.check_http_body, HTTP, 36, 5)
     assert "is the whole request" in problems_of(C.check_http_body, HTTP, 38, len(HTTP))
     assert "body_start should be int" in problems_of(C.check_http_body, HTTP, "38", 5)
+    assert "not an HTTP message" in problems_of(C.check_http_body, b"hello", 0, 5)
 
 
 # ------------------------------------------------------------------------------ notebook 2

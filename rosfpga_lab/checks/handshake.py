@@ -154,7 +154,8 @@ def check_http_body(raw: bytes, body_start: Any, content_length: Any) -> CheckRe
     raw = bytes(raw)
     blank = raw.find(b"\r\n\r\n")
     if blank < 0:
-        raise ValueError("raw is not an HTTP message (no blank line)")
+        raise fail(ex, "raw is not an HTTP message (no blank line after the head); use the "
+                       "recorded request, e.g. reg_pub.raw")
     start = blank + 4
     length = len(raw) - start
     problems = []
