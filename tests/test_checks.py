@@ -11,10 +11,14 @@ import struct
 import cv2
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rosfpga_lab import checks as C
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, Node
+from rosfpga_lab.msg import default_registry, field_layout, serialize
+from rosfpga_lab.msg import strategies as msg_st
 
 
 def problems_of(fn, *args, **kwargs) -> str:
@@ -351,3 +355,18 @@ def test_numpy_scalars_count_as_numbers_but_bools_do_not():
     assert C.check_tdata(np.uint32(0x04030201), (1, 2, 3, 4)).ok
     assert C.check_frame_timing(np.int64(308_321), np.float32(3.08321), "byte-wide stages").ok
     assert "should be int, you gave bool" in problems_of(C.check_data_offset, True, b"")
+
+
+@settings(max_examples=100, deadline=None)
+@given(data=st.data())
+def test_a_corrupted_byte_is_named_by_the_field_that_holds_it(data):
+    reg = default_registry()
+    type_name = data.draw(st.sampled_from(["std_msgs/Header", "geometry_msgs/Pose", "sensor_msgs/Image"]))
+    body = serialize(reg, type_name, data.draw(msg_st.message(reg, type_name, max_len=6)))
+    i = data.draw(st.integers(0, len(body) - 1))
+    bad = bytearray(body)
+    bad[i] ^= data.draw(st.integers(1, 255))
+    owner = next(s for s in field_layout(reg, type_name, body) if s.offset <= i < s.end)
+    name = f"{owner.path} length" if owner.role == "length" else owner.path
+    findings = C.describe_byte_difference(bytes(bad), body, C.message_fields(type_name, body))
+    assert findings and findings[0].startswith(f"byte {i} (field {name}"), findings
