@@ -236,3 +236,11 @@ def test_bench_runs_and_checks_outputs(capsys) -> None:
     assert total > 0 and good == total
     assert main(["bench", "--middles", "nonsense"]) == 2
 
+
+
+def test_camera_and_view_without_a_master_say_what_to_do(capsys) -> None:
+    uri = f"http://127.0.0.1:{free_port()}/"
+    assert main(["camera", "--master-uri", uri, "--count", "1"]) == 1
+    assert main(["view", "/x", "--master-uri", uri, "--count", "1"]) == 1
+    err = capsys.readouterr().err
+    assert err.count(f"no ROS master answers at {uri}") == 2 and "rosfpga-lab master" in err

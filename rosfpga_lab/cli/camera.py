@@ -21,10 +21,13 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+DEFAULT_MASTER = "http://127.0.0.1:11311/"
+
+
 def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--master-uri", metavar="URI",
-                   help="ROS master (default: ROS_MASTER_URI, else http://127.0.0.1:11311/ "
-                   "from --config, else the lab's embedded master in this process)")
+                   help="ROS master (default: ROS_MASTER_URI, else the --config file's "
+                   f"node.master_uri, else {DEFAULT_MASTER})")
     p.add_argument("--name", metavar="NODE", help="node name")
 
 
@@ -71,10 +74,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     v.set_defaults(func=run_view)
 
 
-def _master_uri(args: argparse.Namespace, config_uri: str | None = None) -> str | None:
+def _master_uri(args: argparse.Namespace, config_uri: str | None = None) -> str:
+    """The master to use; raises ComponentError (printed by the CLI) when none answers there."""
+    from rosfpga_lab.component import ComponentError, master_answers
     from rosfpga_lab.graph import master_uri_from_env
 
-    return args.master_uri or master_uri_from_env() or config_uri
+    uri = args.master_uri or master_uri_from_env() or config_uri or DEFAULT_MASTER
+    if not master_answers(uri):
+        raise ComponentError(f"no ROS master answers at {uri}; start one (roscore, or "
+                             "'rosfpga-lab master') or give --master-uri")
+    return uri
 
 
 def run_camera(args: argparse.Namespace) -> int:

@@ -43,19 +43,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _master_answers(uri: str) -> bool:
-    from rosfpga_lab.graph import GraphError, call
-
-    try:
-        call(uri, "getPid", "/rosfpga_lab_node", timeout=2.0)
-        return True
-    except GraphError:
-        return False
-
-
 def run(args: argparse.Namespace) -> int:
     """Start the component, show the status until interrupted, stop cleanly."""
-    from rosfpga_lab.component import FpgaComponent, limits
+    from rosfpga_lab.component import FpgaComponent, limits, master_answers
     from rosfpga_lab.graph import EmbeddedMaster
     from rosfpga_lab.graph.xmlrpc import split_uri
 
@@ -70,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     component = FpgaComponent.from_config(args.config, master_uri=args.master_uri,
                                           model=args.model, **kw)
     master = None
-    if not _master_answers(component.master_uri):
+    if not master_answers(component.master_uri):
         if not args.embedded_master:
             print(f"rosfpga-lab node: error: no ROS master answers at {component.master_uri}; "
                   "start one (roscore, or 'rosfpga-lab master') or add --embedded-master",

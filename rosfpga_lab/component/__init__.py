@@ -23,7 +23,7 @@ from rosfpga_lab.component.camera import Camera, SentFrame, ViewedFrame, Viewer,
 from rosfpga_lab.component.checker import CheckReport, Checker, expected_output
 from rosfpga_lab.component.demo import DemoResult, default_config, run_demo, write_figure
 from rosfpga_lab.component.errors import ComponentConfigError, ComponentError, SourceError
-from rosfpga_lab.component.fpga import FpgaComponent, FrameRecord
+from rosfpga_lab.component.fpga import FpgaComponent, FrameRecord, master_answers
 from rosfpga_lab.component.sources import SOURCES, ImageSource, open_source, to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary, LatencyWindow
 
@@ -31,6 +31,6 @@ __all__ = [
     "SOURCES", "Camera", "CheckReport", "Checker", "ComponentConfigError", "ComponentError",
     "ComponentStats", "DemoResult", "FpgaComponent", "FrameRecord", "ImageSource",
     "LatencySummary", "LatencyWindow", "SentFrame", "SourceError", "ViewedFrame", "Viewer",
-    "default_config", "expected_output", "open_source", "run_demo", "stamp_of", "to_rgb",
-    "write_figure",
+    "default_config", "expected_output", "master_answers", "open_source", "run_demo", "stamp_of",
+    "to_rgb", "write_figure",
 ]

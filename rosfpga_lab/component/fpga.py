@@ -88,6 +88,15 @@ class FrameRecord:
         return None if self.result is None else self.result.output_image
 
 
+def master_answers(uri: str, timeout: float = 2.0) -> bool:
+    """True when a ROS master (or any ROS XML-RPC server) answers ``getPid`` at ``uri``."""
+    try:
+        call(uri, "getPid", "/rosfpga_lab_probe", timeout=timeout)
+        return True
+    except LabError:
+        return False
+
+
 def _reason(exc: PipelineError) -> str:
     text = str(exc)
     if isinstance(exc, FrameFieldError):
