@@ -60,3 +60,11 @@ def test_demo_rejects_bad_arguments(capsys) -> None:
     assert main(["demo", "--frames", "0"]) == 2
     assert main(["demo", "--source", "/no/such/picture.png", "--frames", "1", "--no-figure"]) == 1
     assert "unknown image source" in capsys.readouterr().err
+
+
+def test_demo_with_the_reference_model_checks_every_frame() -> None:
+    result = run_demo("data/fpga_passthrough_rgb8.yaml", frames=3, rate=30, source="synthetic",
+                      png=None, model="reference")
+    assert result.ok, "\n".join(result.lines())
+    assert result.component.dropped == 0 and result.check.bit_exact == 3
+    assert "circuit: passthrough on 160x120 rgb8" in result.lines()[0]

@@ -30,7 +30,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="scale of the figure's panels (default: 1; 0.5 for a small file)")
     p.add_argument("--no-figure", action="store_true", help="do not write the figure")
     p.add_argument("--model", choices=("fast", "reference"), default="fast",
-                   help="circuit model (reference: byte at a time, small images only)")
+                   help="circuit model (reference: byte at a time, about 0.3 s per 160x120 "
+                   "frame; try --config data/fpga_passthrough_rgb8.yaml --frames 5)")
     p.add_argument("--timeout", type=float, default=30.0,
                    help="seconds to wait for the last output (default: 30)")
     p.add_argument("-v", "--verbose", action="store_true", help="print each step")

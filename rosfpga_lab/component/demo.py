@@ -80,8 +80,10 @@ class DemoResult:
         """The demo's printed summary."""
         cfg = self.config
         c = self.component
+        kernel = (f" {cfg.application.ksize}x{cfg.application.ksize}"
+                  if cfg.application.op in ("dilate", "erode") else "")
         out = [
-            f"circuit: {cfg.application.op} {cfg.application.ksize}x{cfg.application.ksize} on "
+            f"circuit: {cfg.application.op}{kernel} on "
             f"{cfg.image.width}x{cfg.image.height} {cfg.image.encoding}, "
             f"{cfg.subscriber.topic} -> {cfg.node.global_name} -> {cfg.publisher.topic}",
             f"frames: sent {self.sent}, received {self.received}, dropped {c.dropped}, "
@@ -128,8 +130,11 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
     op = oracle_op or ("copy" if app.op == "passthrough" else app.op)
     with EmbeddedMaster(port=0) as master:
         say(f"master: embedded at {master.uri}")
+        # The reference model is slow (a byte per Python step): queue every frame in front of
+        # it rather than drop, so the demo still checks all of them.
+        queue = max(frames, 2) if model == "reference" else 2
         component = FpgaComponent.from_config(config, master=master, model=model,
-                                              watchdog=False).start()
+                                              watchdog=False, input_queue=queue).start()
         checker = camera = None
         try:
             checker = Checker(config.publisher.topic, op, (app.ksize, app.ksize), master=master)
