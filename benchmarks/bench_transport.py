@@ -7,6 +7,9 @@ publish-to-callback, measured with the wall-clock stamp in header.stamp) for:
 * with real ROS 1 installed: rospy -> rospy, roscpp -> roscpp, lab -> roscpp, roscpp -> lab.
 
 Every pair registers with one lab EmbeddedMaster (the master is not on the data path).
+The lab's subscribers use the raw path (``raw=True``: the callback gets the body bytes and
+reads only the header stamp), except the "typed" row, which deserializes every frame into a
+dict as rospy and roscpp deserialize into message objects.
 Run:  .venv/bin/python benchmarks/bench_transport.py [--frames 100] [--lat-frames 30] [--no-ros]
 Figures depend on the machine and its load; compare the rows of one run, not across runs.
 """
@@ -55,9 +58,17 @@ class LabSink:
         self.arrivals: list[float] = []
         self.done = threading.Event()
 
+    def typed(self, msg: dict) -> None:
+        """Callback for a typed (deserialized) subscription."""
+        stamp = msg["header"]["stamp"]
+        self._arrived(time.time(), stamp.secs + stamp.nsecs * 1e-9, msg["header"]["frame_id"])
+
     def __call__(self, body, info) -> None:
         now = time.time()
         stamp, phase = _stamp_and_phase(body)
+        self._arrived(now, stamp, phase)
+
+    def _arrived(self, now: float, stamp: float, phase: str) -> None:
         if phase == "lat":
             self.lat_ms.append((now - stamp) * 1000.0)
         else:
@@ -145,11 +156,14 @@ def run_pair(pub_impl: str, sub_impl: str, master_uri: str, nlat: int, nthr: int
             stop_process(p)
 
 
-def run_in_process(master_uri: str, nlat: int, nthr: int) -> dict:
+def run_in_process(master_uri: str, nlat: int, nthr: int, typed: bool = False) -> dict:
     a, b = Node("/bench_inproc_pub", master_uri=master_uri), Node("/bench_inproc_sub", master_uri=master_uri)
     try:
         sink = LabSink(nlat, nthr)
-        b.subscribe(TOPIC + "_inproc", "sensor_msgs/Image", sink, raw=True, queue_size=0)
+        if typed:
+            b.subscribe(TOPIC + "_inproc", "sensor_msgs/Image", sink.typed, queue_size=0)
+        else:
+            b.subscribe(TOPIC + "_inproc", "sensor_msgs/Image", sink, raw=True, queue_size=0)
         pub = a.advertise(TOPIC + "_inproc", "sensor_msgs/Image", queue_size=0)
         pub.wait_for_subscribers(1, 10)
         lab_publish(pub, nlat, nthr)
@@ -192,6 +206,8 @@ def main() -> int:
         print(f"{'publisher -> subscriber':<34} {'frames/s':>9} {'MB/s':>9} {'lat p50':>9} {'lat p95':>9} lat/thr")
         print(f"{'':<34} {'':>9} {'':>9} {'ms':>9} {'ms':>9} frames")
         print(row("lab -> lab (one process)", run_in_process(master.uri, args.lat_frames, args.frames)), flush=True)
+        print(row("lab -> lab typed (one process)",
+                  run_in_process(master.uri, args.lat_frames, args.frames, typed=True)), flush=True)
         for pub_impl, sub_impl in pairs:
             name = f"{pub_impl} -> {sub_impl} (two processes)"
             try:
