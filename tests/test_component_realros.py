@@ -32,10 +32,13 @@ CONFIG = Path(__file__).resolve().parents[1] / "data" / "fpga_dilate_rgba8.yaml"
 
 
 def records(path: Path) -> list[bytes]:
+    """Complete ``uint32 length + bytes`` records (a killed writer may leave a partial last one)."""
     data = path.read_bytes()
     out, pos = [], 0
-    while pos < len(data):
+    while pos + 4 <= len(data):
         (n,) = struct.unpack_from("<I", data, pos)
+        if pos + 4 + n > len(data):
+            break
         out.append(data[pos + 4:pos + 4 + n])
         pos += 4 + n
     return out
@@ -227,3 +230,48 @@ def test_parse_image_reads_what_the_lab_writes() -> None:
             m["step"], m["data"], m["end"]) == (5, (6, 7), "abc", 2, 3, "rgba8", 12, img.tobytes(),
                                                 len(body))
 
+
+
+def test_real_publisher_killed_and_restarted_component_keeps_serving(rosmaster_uri,
+                                                                      tmp_path) -> None:
+    from rosfpga_lab.graph import Node
+
+    comp = FpgaComponent.from_config(CONFIG, master_uri=rosmaster_uri).start()
+    got: list[bytes] = []
+    lab = Node("/collector", master_uri=rosmaster_uri)
+    lab.subscribe("/image_dilated", "sensor_msgs/Image", lambda b, _i: got.append(bytes(b)),
+                  raw=True, queue_size=0)
+    procs = []
+    pub_cmd = [ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "pub", "/image_raw"]
+    try:
+        assert comp.wait_for_subscribers(1, 20)
+        first = start(pub_cmd + ["0", "640", "480", "rgba8", str(tmp_path / "a.bin"), "10", "60"],
+                      rosmaster_uri, tmp_path)
+        procs.append(first)
+        deadline = time.monotonic() + 20
+        while len(got) < 3 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert len(got) >= 3
+        first.kill()                                   # dies without unregistering
+        first.wait(10)
+        deadline = time.monotonic() + 10
+        while comp.stats.publishers and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert comp.stats.publishers == 0 and comp.running
+        before = len(got)
+        second = start(pub_cmd + ["5", "640", "480", "rgba8", str(tmp_path / "b.bin"), "10", "60"],
+                       rosmaster_uri, tmp_path)        # same node name, new URI
+        procs.append(second)
+        finish(second)
+        after = [parse_image(b) for b in got[before:]]
+        sent = {parse_image(b)["stamp"]: parse_image(b) for b in records(tmp_path / "b.bin")}
+        assert len(after) == 5, comp.stats.report()
+        for out in after:
+            image = np.frombuffer(sent[out["stamp"]]["data"], np.uint8).reshape(480, 640, 4)
+            assert out["data"] == cv2.dilate(image, np.ones((3, 3), np.uint8)).tobytes()
+        assert comp.stats.refused == 0
+    finally:
+        for p in procs:
+            stop_process(p)
+        lab.shutdown()
+        comp.stop()

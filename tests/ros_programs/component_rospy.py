@@ -3,8 +3,9 @@
 Usage:
   component_rospy.py pub TOPIC COUNT WIDTH HEIGHT ENCODING OUTFILE [RATE] [TIMEOUT]
       wait for a subscriber, publish COUNT sensor_msgs/Image frames of pseudo-random pixels
-      (seeded by the frame number, so each differs) at RATE per second; write every message
-      as genpy serialized it (uint32 length + bytes) to OUTFILE.
+      (seeded by the frame number, so each differs) at RATE per second (COUNT 0: until
+      TIMEOUT); write every message as genpy serialized it (uint32 length + bytes) to OUTFILE,
+      flushed after each.
   component_rospy.py sub TOPIC COUNT OUTFILE [TIMEOUT]
       subscribe with the real sensor_msgs/Image class; write every message received,
       re-serialized by genpy, to OUTFILE; exit after COUNT messages (or TIMEOUT).
@@ -67,11 +68,14 @@ def main():
             time.sleep(0.01)
         time.sleep(0.3)
         with open(outfile, "wb") as out:
-            for k in range(count):
+            k = 0
+            while (count == 0 or k < count) and time.time() < deadline:
                 msg = make(k, width, height, encoding)
                 pub.publish(msg)
                 b = body(msg)
                 out.write(struct.pack("<I", len(b)) + b)
+                out.flush()
+                k += 1
                 time.sleep(1.0 / rate)
         time.sleep(1.0)
     print("DONE", flush=True)
