@@ -180,6 +180,8 @@ def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
     assert "frames: received 15, processed 15, published 15, refused 0, dropped 0" in out
     assert "cycles per stage (last frame): interpreter 1,228,8" in out
     assert "FIFO high water: rx 1" in out
+    assert "latency since capture (input header.stamp -> publish): median" in out
+    assert "over 15 frames" in out
     # it unregistered on the way out
     assert not any("/fpga_dilate" in n for _t, n in state[0] + state[1])
 

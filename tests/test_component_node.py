@@ -120,6 +120,7 @@ def test_every_output_is_opencvs_dilation_and_header_is_carried(rig) -> None:
     st = comp.stats
     assert (st.received, st.processed, st.published, st.refused, st.dropped) == (20, 20, 20, 0, 0)
     assert st.latency.count == 20 and 0 < st.latency.median < 1.0
+    assert st.since_stamp.count == 0  # stamps of 1970 are not a camera's capture time
     # cycle figures of a 64x48 rgba8 frame: 12,288 data bytes through the byte-wide stages
     assert st.cycles["fifo2axi"] == 64 * 48 * 4 and st.cycles["axivideo2mat"] == 64 * 48
     assert st.fifo_high_water == {"rx": 1}

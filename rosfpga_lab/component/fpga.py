@@ -162,6 +162,7 @@ class FpgaComponent:
         self._lock = threading.Lock()
         self._latency = LatencyWindow(limits.LATENCY_WINDOW)
         self._process = LatencyWindow(limits.LATENCY_WINDOW)
+        self._since_stamp = LatencyWindow(limits.LATENCY_WINDOW)
         self._published_times: collections.deque[float] = collections.deque(maxlen=256)
         self._counts = {"seen": 0, "processed": 0, "published": 0, "refused": 0,
                         "reregistered": 0, "observer_errors": 0}
@@ -281,6 +282,9 @@ class FpgaComponent:
                         problem)
         self._latency.add(now - info.received)
         self._process.add(t1 - t0)
+        since_stamp = now - (result.fields.stamp_secs + result.fields.stamp_nsecs * 1e-9)
+        if 0 <= since_stamp < limits.STAMP_PLAUSIBLE:  # a wall-clock stamp (a camera's)
+            self._since_stamp.add(since_stamp)
         with self._lock:
             index = self._counts["seen"]
             self._counts["seen"] += 1
@@ -422,6 +426,7 @@ class FpgaComponent:
                 subscribers=pub_stats.connections if pub_stats else 0,
                 publishers=sub_stats.connections if sub_stats else 0,
                 latency=self._latency.summary(), process_time=self._process.summary(),
+                since_stamp=self._since_stamp.summary(),
                 circuit_time_s=last.frame_time_s if last is not None else float("nan"),
                 cycles=dict(last.cycles) if last is not None else {},
                 fifo_high_water=dict(self._high_water), fps=fps,

@@ -12,6 +12,9 @@ DEFAULT_OUTPUT_QUEUE = 2
 DEFAULT_HISTORY = 4
 #: Latency samples kept for medians and percentiles.
 LATENCY_WINDOW = 1000
+#: A frame's header.stamp within this many seconds before its publication counts as a camera's
+#: wall-clock capture time (for "latency since stamp"); other stamps are left out of that figure.
+STAMP_PLAUSIBLE = 60.0
 #: Seconds between checks that the master still knows the component (re-registers after a
 #: master restart).
 WATCHDOG_PERIOD = 1.0

@@ -79,6 +79,8 @@ class ComponentStats:
         subscribers: downstream subscribers connected now; ``publishers``: upstream publishers.
         latency: receive-complete to handed-to-publisher, per frame, in this process.
         process_time: time in the circuit model alone.
+        since_stamp: input ``header.stamp`` to output handed to the publisher: the end-to-end
+            latency from capture, for frames whose stamp is wall-clock time (a camera's).
         circuit_time_s: the modelled circuit's time for the last frame (cycles / clock).
         cycles: per-stage cycles of the last frame; ``fifo_high_water``: highest level seen
             per FIFO over all frames.
@@ -101,6 +103,7 @@ class ComponentStats:
     publishers: int = 0
     latency: LatencySummary = LatencySummary(0, float("nan"), float("nan"), float("nan"))
     process_time: LatencySummary = LatencySummary(0, float("nan"), float("nan"), float("nan"))
+    since_stamp: LatencySummary = LatencySummary(0, float("nan"), float("nan"), float("nan"))
     circuit_time_s: float = float("nan")
     cycles: dict[str, int] = field(default_factory=dict)
     fifo_high_water: dict[str, int] = field(default_factory=dict)
@@ -134,6 +137,9 @@ class ComponentStats:
             f"latency (receive -> publish): {self.latency.ms()}; circuit model alone: "
             f"{self.process_time.ms()}",
         ]
+        if self.since_stamp.count:
+            lines.append(f"latency since capture (input header.stamp -> publish): "
+                         f"{self.since_stamp.ms()} over {self.since_stamp.count} frames")
         if self.cycles:
             total = self.circuit_time_s * 1e3
             lines.append("cycles per stage (last frame): " + ", ".join(
