@@ -62,7 +62,14 @@ class PathFigures:
     latency: LatencySummary = LatencySummary(0, float("nan"), float("nan"), float("nan"))
     checked: int = 0
     correct: int = 0
+    cpu_seconds: float = 0.0   # CPU time the middle's process used in the sustained runs
+    cpu_frames: int = 0        # frames delivered in those runs
     middle_output: str = field(default="", repr=False)
+
+    @property
+    def cpu_ms_per_frame(self) -> float:
+        """The middle's CPU time per frame (user + system), NaN when unknown."""
+        return self.cpu_seconds / self.cpu_frames * 1e3 if self.cpu_frames else float("nan")
 
     @property
     def drops(self) -> int:
@@ -84,6 +91,8 @@ class PathFigures:
             self.sustained_lost[window] = self.sustained_lost.get(window, 0) + lost
         self.checked += other.checked
         self.correct += other.correct
+        self.cpu_seconds += other.cpu_seconds
+        self.cpu_frames += other.cpu_frames
         if not other.available:
             self.available, self.note = False, other.note
 
@@ -221,6 +230,17 @@ class _Probe:
             return frames, self.received, list(self.latencies)
 
 
+def cpu_time(proc: subprocess.Popen | None) -> float | None:
+    """User + system CPU seconds of ``proc`` so far (Linux /proc), None when unknown."""
+    if proc is None:
+        return None
+    try:
+        fields = Path(f"/proc/{proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return None
+
+
 def _wait_subscribed(master: EmbeddedMaster, topic: str, proc: subprocess.Popen | None) -> None:
     deadline = time.monotonic() + START_TIMEOUT
     while time.monotonic() < deadline:
@@ -260,11 +280,17 @@ def measure(name: str, master: EmbeddedMaster, in_topic: str, out_topic: str,
         if probe.received < 5:
             raise GraphError(f"no output on {out_topic} within {START_TIMEOUT} s")
         time.sleep(0.2)
+        cpu0 = cpu_time(proc)
         for window in windows:
-            fps, _delivered, lost = probe.sustained(frames, window, max_seconds)
+            fps, delivered, lost = probe.sustained(frames, window, max_seconds)
             fig.sustained[window] = [fps]
             fig.sustained_lost[window] = lost
-            time.sleep(0.1)
+            fig.cpu_frames += delivered
+        cpu1 = cpu_time(proc)
+        if cpu0 is None or cpu1 is None:
+            fig.cpu_frames = 0
+        else:
+            fig.cpu_seconds = cpu1 - cpu0
         if rate_frames:
             fig.sent, fig.received, lat = probe.at_rate(rate, rate_frames)
             fig.latency = LatencySummary.of(lat)

@@ -68,13 +68,14 @@ class BenchReport:
                 f"(2) publisher -> middle -> subscriber, {img}, loopback, each middle its own "
                 f"process; sustained frames/s: median of {rounds} interleaved rounds:",
                 "",
-                f"| middle | sustained, {w1} in flight | sustained, {w2} in flight | at rate: "
-                "received/sent | latency median | p95 | added median | outputs correct |",
-                "|---|---:|---:|---:|---:|---:|---:|---:|",
+                f"| middle | sustained, {w1} in flight | sustained, {w2} in flight | middle's CPU "
+                "per frame | at rate: received/sent | latency median | p95 | added median "
+                "| outputs correct |",
+                "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
             ]
             for f in self.paths:
                 if not f.available:
-                    out.append(f"| {f.name} | not run: {f.note} | | | | | | |")
+                    out.append(f"| {f.name} | not run: {f.note} | | | | | | | |")
                     continue
                 added = (f.latency.median - base.latency.median) * 1e3 if base is not None else math.nan
                 added_text = "(baseline)" if f is base else f"{added:+.1f} ms"
@@ -82,8 +83,10 @@ class BenchReport:
                 for w in self.windows:
                     lost = f.sustained_lost.get(w, 0)
                     cells.append(f"{f.fps(w):.0f}" + (f" ({lost} lost)" if lost else ""))
+                cpu = "-" if math.isnan(f.cpu_ms_per_frame) else f"{f.cpu_ms_per_frame:.2f} ms"
                 out.append(
-                    f"| {f.name} | {cells[0]} | {cells[1]} | {f.received}/{f.sent} at {f.rate:g}/s | "
+                    f"| {f.name} | {cells[0]} | {cells[1]} | {cpu} | {f.received}/{f.sent} at "
+                    f"{f.rate:g}/s | "
                     f"{f.latency.median * 1e3:.1f} ms | {f.latency.p95 * 1e3:.1f} ms | {added_text} | "
                     f"{f.correct}/{f.checked} |")
             out.append("")
