@@ -11,6 +11,7 @@ import re
 import socket
 import threading
 import time
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -338,8 +339,9 @@ def test_stop_is_clean_and_idempotent(master) -> None:
 
 
 def test_started_from_the_generator_config_file(master) -> None:
-    cfg = load_config("data/fpga_erode_mono8.yaml")
-    comp = FpgaComponent.from_config("data/fpga_erode_mono8.yaml", master=master)
+    path = Path(__file__).resolve().parents[1] / "data" / "fpga_erode_mono8.yaml"
+    cfg = load_config(path)
+    comp = FpgaComponent.from_config(path, master=master)
     assert comp.name == cfg.node.global_name == "/fpga_erode"
     assert (comp.input_topic, comp.output_topic) == ("/camera/image_mono", "/camera/image_eroded")
     assert (comp.pipeline.width, comp.pipeline.height, comp.pipeline.encoding) == (320, 240, "mono8")

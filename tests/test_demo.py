@@ -5,12 +5,15 @@ from __future__ import annotations
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import cv2
 import numpy as np
 
 from rosfpga_lab.cli import main
 from rosfpga_lab.component import run_demo
+
+DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 def test_demo_command_passes_bit_exact(tmp_path, capsys) -> None:
@@ -37,7 +40,7 @@ def test_demo_as_a_separate_process_exits_zero(tmp_path) -> None:
 
 
 def test_demo_with_another_config_erode_mono8(tmp_path) -> None:
-    result = run_demo("data/fpga_erode_mono8.yaml", frames=10, rate=60, source="synthetic",
+    result = run_demo(DATA / "fpga_erode_mono8.yaml", frames=10, rate=60, source="synthetic",
                       png=tmp_path / "erode.png")
     assert result.ok, "\n".join(result.lines())
     assert result.check.bit_exact == 10 and result.component.cycles["erode"] > 0
@@ -63,7 +66,7 @@ def test_demo_rejects_bad_arguments(capsys) -> None:
 
 
 def test_demo_with_the_reference_model_checks_every_frame() -> None:
-    result = run_demo("data/fpga_passthrough_rgb8.yaml", frames=3, rate=30, source="synthetic",
+    result = run_demo(DATA / "fpga_passthrough_rgb8.yaml", frames=3, rate=30, source="synthetic",
                       png=None, model="reference")
     assert result.ok, "\n".join(result.lines())
     assert result.component.dropped == 0 and result.check.bit_exact == 3
