@@ -62,7 +62,8 @@ class Camera:
         name: node name. master, master_uri, host: as for :class:`rosfpga_lab.graph.Node`.
         frame_id: ``header.frame_id`` of every frame.
         queue_size: frames queued per subscriber (oldest dropped when full).
-        on_sent: ``on_sent(SentFrame)`` after each publish (e.g. a checker remembering inputs).
+        on_sent: ``on_sent(SentFrame)`` just before each publish (e.g. a checker remembering
+            inputs).
 
     Raises:
         SourceError: bad source, size, encoding or rate.
@@ -101,11 +102,11 @@ class Camera:
         stamp = stamp_of(now)
         frame = image_frame(image, self.source.encoding, seq=k & 0xFFFFFFFF, stamp=stamp,
                             frame_id=self.frame_id)
-        self.publisher.publish_body(memoryview(frame)[4:])
-        self.sent += 1
         sent = SentFrame(k, stamp, image, now, self.source.encoding, self.frame_id)
         if self.on_sent is not None:
-            self.on_sent(sent)
+            self.on_sent(sent)  # before publishing: an answer may come back at once
+        self.publisher.publish_body(memoryview(frame)[4:])
+        self.sent += 1
         return sent
 
     def run(self, count: int | None = None, duration: float | None = None,

@@ -75,6 +75,11 @@ class FrameRecord:
     published: float
 
     @property
+    def ok(self) -> bool:
+        """True when the circuit took the frame (False: refused, see :attr:`error`)."""
+        return self.result is not None
+
+    @property
     def latency(self) -> float:
         """Seconds from receive-complete to publish."""
         return self.published - self.received
