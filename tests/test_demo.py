@@ -71,3 +71,20 @@ def test_demo_with_the_reference_model_checks_every_frame() -> None:
     assert result.ok, "\n".join(result.lines())
     assert result.component.dropped == 0 and result.check.bit_exact == 3
     assert "circuit: passthrough on 160x120 rgb8" in result.lines()[0]
+
+
+def test_demo_rig_runs_in_the_background_for_a_live_view() -> None:
+    import threading
+
+    from rosfpga_lab.component import DemoRig
+
+    before = {t.ident for t in threading.enumerate()}
+    seen = []
+    with DemoRig(DATA / "fpga_erode_mono8.yaml", rate=50, source="synthetic") as rig:
+        rig.component.add_observer(lambda rec: seen.append((rec.ok, rec.output_image.shape)))
+        rig.start_camera()
+        assert rig.checker.wait_for(10, 10)
+        assert rig.checker.report.bit_exact == rig.checker.report.received >= 10
+    assert seen[:3] == [(True, (240, 320, 1))] * 3
+    time.sleep(0.1)
+    assert [t.name for t in threading.enumerate() if t.ident not in before and t.is_alive()] == []

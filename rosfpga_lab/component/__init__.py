@@ -13,6 +13,11 @@ Quick use::
     result = run_demo(frames=60)          # master + camera + component + bit-exact checker
     print("\\n".join(result.lines()))
 
+    with DemoRig(source="synthetic") as rig:   # the same, non-blocking (notebooks)
+        rig.component.add_observer(lambda rec: ...)   # e.g. a live view
+        rig.start_camera()
+        ...
+
 Modules: ``fpga`` (:class:`FpgaComponent`, :class:`FrameRecord`), ``stats``
 (:class:`ComponentStats`), ``sources`` (pictures: synthetic, grace_hopper, files), ``camera``
 (:class:`Camera`, :class:`Viewer`), ``checker`` (:class:`Checker`, OpenCV as the oracle),
@@ -21,7 +26,9 @@ Modules: ``fpga`` (:class:`FpgaComponent`, :class:`FrameRecord`), ``stats``
 
 from rosfpga_lab.component.camera import Camera, SentFrame, ViewedFrame, Viewer, stamp_of
 from rosfpga_lab.component.checker import CheckReport, Checker, expected_output
-from rosfpga_lab.component.demo import DemoResult, default_config, run_demo, write_figure
+from rosfpga_lab.component.demo import (
+    DemoResult, DemoRig, default_config, run_demo, write_figure,
+)
 from rosfpga_lab.component.errors import ComponentConfigError, ComponentError, SourceError
 from rosfpga_lab.component.fpga import FpgaComponent, FrameRecord, master_answers
 from rosfpga_lab.component.sources import SOURCES, ImageSource, open_source, to_rgb
@@ -29,7 +36,7 @@ from rosfpga_lab.component.stats import ComponentStats, LatencySummary, LatencyW
 
 __all__ = [
     "SOURCES", "Camera", "CheckReport", "Checker", "ComponentConfigError", "ComponentError",
-    "ComponentStats", "DemoResult", "FpgaComponent", "FrameRecord", "ImageSource",
+    "ComponentStats", "DemoResult", "DemoRig", "FpgaComponent", "FrameRecord", "ImageSource",
     "LatencySummary", "LatencyWindow", "SentFrame", "SourceError", "ViewedFrame", "Viewer",
     "default_config", "expected_output", "master_answers", "open_source", "run_demo", "stamp_of",
     "to_rgb", "write_figure",

@@ -102,6 +102,78 @@ class DemoResult:
         return out
 
 
+class DemoRig:
+    """Master, component, checker and camera, started together (for notebooks: non-blocking).
+
+    Use as a context manager, or call :meth:`stop`. The camera is not running until
+    :meth:`run` (blocking) or :meth:`start_camera` (background); attach a live view with
+    ``rig.component.add_observer(...)``.
+
+    Args:
+        config: node configuration (path or loaded); None: :func:`default_config`.
+        rate, source: the camera's frames per second and picture source.
+        model: the circuit model, ``fast`` or ``reference``.
+        oracle_op: check against this op instead of the configuration's.
+        input_queue: frames waiting in front of the circuit.
+    """
+
+    def __init__(self, config: NodeConfig | str | Path | None = None, *, rate: float = 30.0,
+                 source: str = "grace_hopper", model: str = "fast", oracle_op: str | None = None,
+                 input_queue: int = 2) -> None:
+        if config is None:
+            config = default_config()
+        elif not isinstance(config, NodeConfig):
+            config = load_config(config)
+        self.config = config
+        app = config.application
+        self.op = oracle_op or ("copy" if app.op == "passthrough" else app.op)
+        self.master = EmbeddedMaster(port=0).start()
+        self.component: FpgaComponent | None = None
+        self.checker: Checker | None = None
+        self.camera: Camera | None = None
+        try:
+            self.component = FpgaComponent.from_config(config, master=self.master, model=model,
+                                                       watchdog=False,
+                                                       input_queue=input_queue).start()
+            self.checker = Checker(config.publisher.topic, self.op, (app.ksize, app.ksize),
+                                   master=self.master)
+            self.camera = Camera(config.subscriber.topic, width=config.image.width,
+                                 height=config.image.height, encoding=config.image.encoding,
+                                 rate=rate, source=source, master=self.master,
+                                 on_sent=self.checker.sent, queue_size=0)
+        except BaseException:
+            self.stop()
+            raise
+        self.connected = (self.camera.publisher.wait_for_subscribers(1, 10.0)
+                          and self.component.wait_for_subscribers(1, 10.0))
+
+    def run(self, frames: int, timeout: float = 30.0) -> float:
+        """Send ``frames`` frames on schedule and wait for their outputs; return seconds taken."""
+        assert self.camera is not None and self.checker is not None
+        t0 = time.monotonic()
+        self.camera.run(count=frames)
+        self.checker.wait_for(self.camera.sent, timeout)
+        return time.monotonic() - t0
+
+    def start_camera(self, frames: int | None = None) -> None:
+        """Run the camera in the background (``frames=None``: until :meth:`stop`)."""
+        assert self.camera is not None
+        self.camera.start(count=frames)
+
+    def stop(self) -> None:
+        """Stop everything (idempotent)."""
+        for part in (self.camera, self.checker, self.component):
+            if part is not None:
+                part.stop()
+        self.master.stop()
+
+    def __enter__(self) -> DemoRig:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
 def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
              rate: float = 30.0, source: str = "grace_hopper", png: str | Path | None = "demo.png",
              model: str = "fast", timeout: float = 30.0, png_scale: float = 1.0,
@@ -122,48 +194,28 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         progress: called with a line of text at each step.
     """
     say = progress or (lambda _text: None)
-    if config is None:
-        config = default_config()
-    elif not isinstance(config, NodeConfig):
-        config = load_config(config)
+    # The reference model is slow (a byte per Python step): queue every frame in front of it
+    # rather than drop, so the demo still checks all of them.
+    queue = max(frames, 2) if model == "reference" else 2
+    with DemoRig(config, rate=rate, source=source, model=model, oracle_op=oracle_op,
+                 input_queue=queue) as rig:
+        assert rig.component is not None and rig.checker is not None and rig.camera is not None
+        say(f"master: embedded at {rig.master.uri}")
+        say(f"component: {rig.component!r}")
+        if not rig.connected:
+            say("warning: connections were not all up after 10 s")
+        say(f"camera: {frames} frames of {source!r} at {rate:g} fps")
+        elapsed = rig.run(frames, timeout)
+        stats = rig.component.stats
+    checker, config = rig.checker, rig.config
     app = config.application
-    op = oracle_op or ("copy" if app.op == "passthrough" else app.op)
-    with EmbeddedMaster(port=0) as master:
-        say(f"master: embedded at {master.uri}")
-        # The reference model is slow (a byte per Python step): queue every frame in front of
-        # it rather than drop, so the demo still checks all of them.
-        queue = max(frames, 2) if model == "reference" else 2
-        component = FpgaComponent.from_config(config, master=master, model=model,
-                                              watchdog=False, input_queue=queue).start()
-        checker = camera = None
-        try:
-            checker = Checker(config.publisher.topic, op, (app.ksize, app.ksize), master=master)
-            camera = Camera(config.subscriber.topic, width=config.image.width,
-                            height=config.image.height, encoding=config.image.encoding,
-                            rate=rate, source=source, master=master, on_sent=checker.sent,
-                            queue_size=0)
-            say(f"component: {component!r}")
-            if not (camera.publisher.wait_for_subscribers(1, 10.0)
-                    and component.wait_for_subscribers(1, 10.0)):
-                say("warning: connections were not all up after 10 s")
-            say(f"camera: {frames} frames of {source!r} at {rate:g} fps")
-            t0 = time.monotonic()
-            camera.run(count=frames)
-            checker.wait_for(camera.sent, timeout)
-            elapsed = time.monotonic() - t0
-            stats = component.stats
-        finally:
-            for part in (camera, checker):
-                if part is not None:
-                    part.stop()
-            component.stop()
     report = checker.report
     png_path = None
     if png is not None and (checker.last is not None or report.first_bad is not None):
         png_path = write_figure(report.first_bad or checker.last, config.image.encoding, png,
-                                scale=png_scale, title=f"{op} {app.ksize}x{app.ksize}")
-    return DemoResult(camera.sent, report.received, report, checker.fps, checker.latency.summary(),
-                      stats, elapsed, png_path, config)
+                                scale=png_scale, title=f"{rig.op} {app.ksize}x{app.ksize}")
+    return DemoResult(rig.camera.sent, report.received, report, checker.fps,
+                      checker.latency.summary(), stats, elapsed, png_path, config)
 
 
 def write_figure(images: tuple[np.ndarray, np.ndarray, np.ndarray], encoding: str,
