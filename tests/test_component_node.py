@@ -394,3 +394,28 @@ def test_a_newer_node_with_the_same_name_wins(master) -> None:
     finally:
         new.stop()
         old.stop()
+
+
+def test_a_publisher_of_another_type_is_refused_at_the_handshake_and_reported(rig, master,
+                                                                             caplog) -> None:
+    caplog.set_level(logging.WARNING, logger="rosfpga_lab.component")
+    comp, pub, out = rig
+    wrong = Node("/string_talker", master=master)
+    try:
+        wrong.advertise("/cam", "std_msgs/String", queue_size=0)
+        deadline = time.monotonic() + 5
+        while not comp.stats.connection_errors and time.monotonic() < deadline:
+            time.sleep(0.05)
+        problems = " ".join(comp.stats.connection_errors)
+        assert "std_msgs/String" in problems and "sensor_msgs/Image" in problems, problems
+        assert "input connection problem" in comp.stats.report()
+        send(pub, picture(1), 1)                   # the right publisher still gets through
+        assert out.wait(1)
+        assert np.array_equal(out.images((48, 64, 4))[0], cv2_dilate(picture(1)))
+        deadline = time.monotonic() + 3
+        while time.monotonic() < deadline and not any(
+                "input connection problem" in r.getMessage() for r in caplog.records):
+            time.sleep(0.05)
+        assert any("input connection problem" in r.getMessage() for r in caplog.records)
+    finally:
+        wrong.shutdown()

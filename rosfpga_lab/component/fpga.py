@@ -361,6 +361,9 @@ class FpgaComponent:
                 log.warning("%s: dropped %d output frame(s) for subscriber %s: its queue (%d "
                             "deep) is full, it is too slow for the rate", self.name,
                             n - old.dropped_output_by_peer.get(peer, 0), peer, self.output_queue)
+        fresh = [e for e in new.connection_errors if e not in old.connection_errors]
+        for problem in fresh[-3:]:
+            log.warning("%s: input connection problem: %s", self.name, problem)
         if new.publishers != old.publishers:
             log.info("%s: %d publisher(s) of %s connected (was %d)", self.name, new.publishers,
                      self.input_topic, old.publishers)
@@ -436,7 +439,8 @@ class FpgaComponent:
                 cycles=dict(last.cycles) if last is not None else {},
                 fifo_high_water=dict(self._high_water), fps=fps,
                 master_reregistrations=c["reregistered"], master_ok=self._master_ok,
-                observer_errors=c["observer_errors"], last_error=self._last_error)
+                observer_errors=c["observer_errors"], last_error=self._last_error,
+                connection_errors=list(sub_stats.errors) if sub_stats else [])
 
     def latency_samples(self) -> list[float]:
         """The kept receive-to-publish latencies (seconds), oldest first."""

@@ -89,6 +89,8 @@ class ComponentStats:
         master_ok: the master answered the last check.
         observer_errors: exceptions raised by observers (they never stop the component).
         last_error: the most recent refusal or problem, as text.
+        connection_errors: the input side's recent connection problems (a publisher of another
+            type on the input topic, a refused handshake, a publisher gone), newest last.
     """
 
     received: int = 0
@@ -112,6 +114,7 @@ class ComponentStats:
     master_ok: bool = True
     observer_errors: int = 0
     last_error: str = ""
+    connection_errors: list[str] = field(default_factory=list)
 
     @property
     def dropped(self) -> int:
@@ -159,6 +162,8 @@ class ComponentStats:
         if self.master_reregistrations:
             lines.append(f"registered again with the master {self.master_reregistrations} time(s) "
                          "(master restarted)")
+        for problem in self.connection_errors[-3:]:
+            lines.append(f"input connection problem: {problem}")
         if self.observer_errors:
             lines.append(f"observer callbacks raised {self.observer_errors} time(s)")
         return "\n".join(lines)
