@@ -419,3 +419,27 @@ def test_a_publisher_of_another_type_is_refused_at_the_handshake_and_reported(ri
         assert any("input connection problem" in r.getMessage() for r in caplog.records)
     finally:
         wrong.shutdown()
+
+
+@pytest.mark.parametrize("enc,channels,op,k", [("bgr8", 3, "dilate", 5), ("mono8", 1, "erode", 3),
+                                               ("bgra8", 4, "erode", 7), ("rgb8", 3, "passthrough", 3)])
+def test_other_circuits_match_opencv(master, enc, channels, op, k) -> None:
+    comp = FpgaComponent.from_config(config(40, 30, enc, op, k), master=master).start()
+    src = Node("/source", master=master)
+    pub = src.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+    out = Collector(master)
+    try:
+        assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+        sent = [picture(k * 10 + j, 30, 40, channels) for j in range(3)]
+        for j, img in enumerate(sent):
+            send(pub, img, j, encoding=enc)
+            assert comp.wait_for(j + 1, 10)
+        assert out.wait(3)
+        kernel = np.ones((k, k), np.uint8)
+        fn = {"dilate": cv2.dilate, "erode": cv2.erode, "passthrough": lambda i, _k: i}[op]
+        for img, got in zip(sent, out.images(sent[0].shape)):
+            assert np.array_equal(got, fn(img, kernel).reshape(img.shape))
+    finally:
+        out.node.shutdown()
+        src.shutdown()
+        comp.stop()
