@@ -162,7 +162,7 @@ def test_rostopic_sees_the_component_like_any_node(rosmaster_uri, tmp_path) -> N
         rates = [float(line.split(":")[1]) for line in out.splitlines()
                  if line.strip().startswith("average rate:")]
         assert rates, out + err
-        assert 15.0 < rates[-1] < 25.0, out
+        assert 12.0 < rates[-1] < 28.0, out  # the camera publishes at 20/s
         assert comp.stats.published > 50 and comp.stats.refused == 0
     finally:
         if hz is not None and hz.poll() is None:
