@@ -1,4 +1,4 @@
-// roscpp side of benchmarks/bench_transport.py; same contract as wire_bench_rospy.py.
+// roscpp side of tests/benchmarks/bench_transport.py; same contract as wire_bench_rospy.py.
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 

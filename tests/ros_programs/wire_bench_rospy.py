@@ -1,4 +1,4 @@
-"""rospy side of benchmarks/bench_transport.py (run by /usr/bin/python3).
+"""rospy side of tests/benchmarks/bench_transport.py (run by /usr/bin/python3).
 
   wire_bench_rospy.py sub TOPIC NLAT NTHR   -> prints one JSON line with the results
   wire_bench_rospy.py pub TOPIC NLAT NTHR   -> NLAT frames at 10 Hz ("lat"), then NTHR back to back ("thr")

@@ -7,7 +7,7 @@
 * reference model: beats/s and the time of one 160x120 rgba8 frame through every stage
   (target: under 1 s).
 
-Usage: ``python benchmarks/bench_pipeline.py [--repeat N] [--ref-size 160x120]``
+Usage: ``python tests/benchmarks/bench_pipeline.py [--repeat N] [--ref-size 160x120]``
 """
 
 from __future__ import annotations

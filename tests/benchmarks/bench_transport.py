@@ -10,7 +10,7 @@ Every pair registers with one lab EmbeddedMaster (the master is not on the data 
 The lab's subscribers use the raw path (``raw=True``: the callback gets the body bytes and
 reads only the header stamp), except the "typed" row, which deserializes every frame into a
 dict as rospy and roscpp deserialize into message objects.
-Run:  .venv/bin/python benchmarks/bench_transport.py [--frames 100] [--lat-frames 30] [--no-ros]
+Run:  .venv/bin/python tests/benchmarks/bench_transport.py [--frames 100] [--lat-frames 30] [--no-ros]
 Figures depend on the machine and its load; compare the rows of one run, not across runs.
 """
 
@@ -26,7 +26,7 @@ import threading
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests"))
 
 from rosfpga_lab.graph import EmbeddedMaster, Node  # noqa: E402
