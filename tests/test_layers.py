@@ -1,0 +1,54 @@
+"""A layer imports only the layers below it (DESIGN.md); this test keeps it so."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent.parent / "rosfpga_lab"
+# Bottom to top; names on one level may not import each other.
+LEVELS = [
+    {"errors"}, {"msg"}, {"tcpros"}, {"graph"}, {"hw"}, {"hls"}, {"component"},
+    {"widgets", "checks"}, {"bench"}, {"cli"}, {"__main__"},
+]
+RANK = {name: level for level, names in enumerate(LEVELS) for name in names}
+
+
+def _imported_layers(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(), filename=str(path))
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names = [node.module]
+        elif isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        else:
+            continue
+        for name in names:
+            parts = name.split(".")
+            if parts[0] == "rosfpga_lab" and len(parts) > 1:
+                found.add(parts[1])
+    return found
+
+
+def test_every_module_belongs_to_a_known_layer() -> None:
+    for path in PACKAGE.iterdir():
+        if path.name.startswith((".", "_")) and path.name != "__main__.py":
+            continue
+        if path.is_dir() or path.suffix == ".py":
+            assert path.stem in RANK, f"{path.name} is in no layer of DESIGN.md"
+
+
+def test_no_layer_imports_a_layer_above_it() -> None:
+    offences = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE).parts
+        layer = parts[0].removesuffix(".py")
+        if layer not in RANK:
+            continue
+        for dep in _imported_layers(path):
+            if dep in RANK and RANK[dep] > RANK[layer]:
+                offences.append(f"{path.relative_to(PACKAGE)}: {layer} imports {dep}")
+            if dep in RANK and RANK[dep] == RANK[layer] and dep != layer:
+                offences.append(f"{path.relative_to(PACKAGE)}: {layer} imports its sibling {dep}")
+    assert offences == []
