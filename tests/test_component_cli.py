@@ -147,6 +147,37 @@ def test_size_argument_is_checked(capsys) -> None:
     assert "WIDTHxHEIGHT" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("argv,words", [
+    (["camera", "--count", "0"], "argument --count: want a number of at least 1, got 0"),
+    (["view", "/x", "--every", "0"], "argument --every: want a number of at least 1, got 0"),
+    (["view", "/x", "--count", "-1"], "argument --count: want a number of at least 1, got -1"),
+    (["view", "/x", "--timeout", "soon"], "argument --timeout: want a number, got 'soon'"),
+    (["node", str(CONFIG), "--duration", "-1"], "argument --duration: want a number greater than 0"),
+    (["node", str(CONFIG), "--input-queue", "0"], "argument --input-queue: want a number of at least 1"),
+    (["node", str(CONFIG), "--status-interval", "-1"], "argument --status-interval: want a number of at least 0"),
+    (["demo", "--frames", "0"], "argument --frames: want a number of at least 1, got 0"),
+    (["demo", "--scale", "0"], "argument --scale: want a number greater than 0, got 0"),
+    (["bench", "--frames", "0"], "argument --frames: want a number of at least 1, got 0"),
+    (["bench", "--rounds", "0"], "argument --rounds: want a number of at least 1, got 0"),
+])
+def test_numbers_out_of_range_are_refused_by_the_parser(argv, words, capsys) -> None:
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == 2
+    assert words in capsys.readouterr().err
+
+
+def test_view_into_an_unwritable_directory_is_a_clear_error(tmp_path, capsys) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    with EmbeddedMaster(port=0) as master:
+        code = main(["view", "/x", "--save", str(blocker / "out"), "--count", "1", "--timeout", "0.1",
+                     "--master-uri", master.uri])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert f"cannot save frames into {blocker / 'out'}" in err and "Traceback" not in err
+
+
 # ------------------------------------------------------------------------------- node command
 def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
     with EmbeddedMaster(port=0) as master:

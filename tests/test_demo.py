@@ -9,6 +9,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+import pytest
 
 from rosfpga_lab.cli import main
 from rosfpga_lab.component import run_demo
@@ -60,9 +61,13 @@ def test_checker_catches_a_wrong_circuit(tmp_path) -> None:
 
 
 def test_demo_rejects_bad_arguments(capsys) -> None:
-    assert main(["demo", "--frames", "0"]) == 2
+    with pytest.raises(SystemExit) as info:
+        main(["demo", "--frames", "0"])
+    assert info.value.code == 2
     assert main(["demo", "--source", "/no/such/picture.png", "--frames", "1", "--no-figure"]) == 1
     assert "unknown image source" in capsys.readouterr().err
+    assert main(["demo", "--frames", "1", "--output", "demo.jpg"]) == 1
+    assert "the figure is a PNG: give a file name ending in .png, not demo.jpg" in capsys.readouterr().err
 
 
 def test_demo_with_the_reference_model_checks_every_frame() -> None:

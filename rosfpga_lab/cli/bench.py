@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from rosfpga_lab.cli._args import positive_int
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``bench`` sub-command."""
@@ -22,15 +24,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="node configuration (default: data/fpga_dilate_rgba8.yaml, 640x480 rgba8)")
     p.add_argument("--middles", default=",".join(("direct", "component", "roscpp", "rospy")),
                    help="comma-separated subset of direct,component,roscpp,rospy (default: all)")
-    p.add_argument("--frames", type=int, default=200,
+    p.add_argument("--frames", type=positive_int, default=200,
                    help="frames per sustained run, per middle (default: 200)")
     p.add_argument("--windows", default="1,2", metavar="A,B",
                    help="frames in flight in the two sustained columns (default: 1,2)")
-    p.add_argument("--rounds", type=int, default=3,
+    p.add_argument("--rounds", type=positive_int, default=3,
                    help="interleaved rounds of the sustained runs; the table shows the median "
                    "(default: 3)")
     p.add_argument("--rate", type=float, default=30.0, help="rate of the second phase (default: 30)")
-    p.add_argument("--rate-frames", type=int, default=90,
+    p.add_argument("--rate-frames", type=positive_int, default=90,
                    help="frames sent in the second phase (default: 90)")
     p.add_argument("--no-pipeline", action="store_true", help="skip the model-vs-OpenCV part")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress lines")

@@ -12,6 +12,8 @@ import threading
 import time
 from pathlib import Path
 
+from rosfpga_lab.cli._args import positive_float, positive_int
+
 
 def _size(text: str) -> tuple[int, int]:
     try:
@@ -24,10 +26,10 @@ def _size(text: str) -> tuple[int, int]:
 DEFAULT_MASTER = "http://127.0.0.1:11311/"
 
 
-def _common(p: argparse.ArgumentParser) -> None:
+def _common(p: argparse.ArgumentParser, *, with_config: bool) -> None:
+    from_config = "the --config file's node.master_uri, else " if with_config else ""
     p.add_argument("--master-uri", metavar="URI",
-                   help="ROS master (default: ROS_MASTER_URI, else the --config file's "
-                   f"node.master_uri, else {DEFAULT_MASTER})")
+                   help=f"ROS master (default: ROS_MASTER_URI, else {from_config}{DEFAULT_MASTER})")
     p.add_argument("--name", metavar="NODE", help="node name")
 
 
@@ -51,9 +53,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--rate", type=float, default=30.0, help="frames per second (default: 30)")
     p.add_argument("--source", default="synthetic",
                    help="synthetic (default), grace_hopper, an image file or a directory")
-    p.add_argument("--count", type=int, default=None, help="stop after N frames (default: run on)")
+    p.add_argument("--count", type=positive_int, default=None,
+                   help="stop after N frames (default: run on)")
     p.add_argument("--frame-id", default="camera", help="header.frame_id (default: camera)")
-    _common(p)
+    _common(p, with_config=True)
     p.set_defaults(func=run_camera)
 
     v = subparsers.add_parser(
@@ -64,13 +67,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "rosfpga-lab view /image_dilated --save out --every 30")
     v.add_argument("topic", metavar="TOPIC", help="the image topic")
     v.add_argument("--save", type=Path, metavar="DIR", help="write frames as PNG into DIR")
-    v.add_argument("--every", type=int, default=1, metavar="N", help="save one frame in N (default: 1)")
+    v.add_argument("--every", type=positive_int, default=1, metavar="N", help="save one frame in N (default: 1)")
     v.add_argument("--latest", action="store_true",
                    help="overwrite DIR/latest.png instead of numbering the files")
-    v.add_argument("--count", type=int, default=None, help="stop after N frames")
-    v.add_argument("--timeout", type=float, default=None, metavar="S",
+    v.add_argument("--count", type=positive_int, default=None, help="stop after N frames")
+    v.add_argument("--timeout", type=positive_float, default=None, metavar="S",
                    help="give up after S seconds (exit code 1 if fewer than --count arrived)")
-    _common(v)
+    _common(v, with_config=False)
     v.set_defaults(func=run_view)
 
 

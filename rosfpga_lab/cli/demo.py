@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
+
+from rosfpga_lab.cli._args import positive_float, positive_int
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -20,19 +21,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--config", type=Path, metavar="CONFIG",
                    help="node configuration (default: data/fpga_dilate_rgba8.yaml, 640x480 rgba8 "
                    "3x3 dilation)")
-    p.add_argument("--frames", type=int, default=60, help="frames to send (default: 60)")
+    p.add_argument("--frames", type=positive_int, default=60, help="frames to send (default: 60)")
     p.add_argument("--rate", type=float, default=30.0, help="camera frames per second (default: 30)")
     p.add_argument("--source", default="grace_hopper",
                    help="camera source: grace_hopper (default), synthetic, an image file or a directory")
     p.add_argument("--output", type=Path, default=Path("demo.png"), metavar="PNG",
                    help="figure to write (default: demo.png)")
-    p.add_argument("--scale", type=float, default=1.0,
+    p.add_argument("--scale", type=positive_float, default=1.0,
                    help="scale of the figure's panels (default: 1; 0.5 for a small file)")
     p.add_argument("--no-figure", action="store_true", help="do not write the figure")
     p.add_argument("--model", choices=("fast", "reference"), default="fast",
                    help="circuit model (reference: byte at a time, about 0.3 s per 160x120 "
                    "frame; try --config data/fpga_passthrough_rgb8.yaml --frames 5)")
-    p.add_argument("--timeout", type=float, default=30.0,
+    p.add_argument("--timeout", type=positive_float, default=30.0,
                    help="seconds to wait for the last output (default: 30)")
     p.add_argument("-v", "--verbose", action="store_true", help="print each step")
     p.set_defaults(func=run)
@@ -42,9 +43,6 @@ def run(args: argparse.Namespace) -> int:
     """Run the demo; 0 when every frame came back bit-exact."""
     from rosfpga_lab.component import run_demo
 
-    if args.frames < 1:
-        print("rosfpga-lab demo: error: --frames must be at least 1", file=sys.stderr)
-        return 2
     result = run_demo(args.config, frames=args.frames, rate=args.rate, source=args.source,
                       png=None if args.no_figure else args.output, model=args.model,
                       timeout=args.timeout, png_scale=args.scale,

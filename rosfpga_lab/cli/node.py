@@ -10,6 +10,8 @@ import threading
 import time
 from pathlib import Path
 
+from rosfpga_lab.cli._args import non_negative_float, positive_float, positive_int
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``node`` sub-command."""
@@ -28,15 +30,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--model", choices=("fast", "reference"), default="fast",
                    help="circuit model: fast (numpy, default) or reference (byte at a time; "
                    "small images only)")
-    p.add_argument("--input-queue", type=int, default=None, metavar="N",
+    p.add_argument("--input-queue", type=positive_int, default=None, metavar="N",
                    help="frames waiting in front of the circuit before the oldest is dropped "
                    "(default: 2)")
-    p.add_argument("--output-queue", type=int, default=None, metavar="N",
+    p.add_argument("--output-queue", type=positive_int, default=None, metavar="N",
                    help="frames waiting per downstream subscriber before the oldest is dropped "
                    "(default: 2)")
-    p.add_argument("--duration", type=float, default=None, metavar="S",
+    p.add_argument("--duration", type=positive_float, default=None, metavar="S",
                    help="stop by itself after S seconds (default: run until Ctrl-C)")
-    p.add_argument("--status-interval", type=float, default=0.5, metavar="S",
+    p.add_argument("--status-interval", type=non_negative_float, default=0.5, metavar="S",
                    help="seconds between status updates (default: 0.5; 0: no status line)")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no status line and no log lines, only the final summary")

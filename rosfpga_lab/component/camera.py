@@ -192,7 +192,11 @@ class Viewer:
         self.topic = topic
         self.save_dir = Path(save_dir) if save_dir is not None else None
         if self.save_dir is not None:
-            self.save_dir.mkdir(parents=True, exist_ok=True)
+            try:
+                self.save_dir.mkdir(parents=True, exist_ok=True)
+            except OSError as exc:
+                raise ComponentError(f"cannot save frames into {self.save_dir}: {exc.strerror}; "
+                                     "give a writable directory") from None
         self.every, self.latest_only, self.on_frame = max(1, every), latest_only, on_frame
         self.received = 0
         self.saved: list[Path] = []

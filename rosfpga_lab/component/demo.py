@@ -20,6 +20,7 @@ import numpy as np
 
 from rosfpga_lab.component.camera import Camera
 from rosfpga_lab.component.checker import CheckReport, Checker
+from rosfpga_lab.component.errors import ComponentError
 from rosfpga_lab.component.fpga import FpgaComponent
 from rosfpga_lab.component.sources import to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary
@@ -194,6 +195,8 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         progress: called with a line of text at each step.
     """
     say = progress or (lambda _text: None)
+    if png is not None:
+        _png_path(png)   # a wrong name is refused before the run, not after it
     # The reference model is slow (a byte per Python step): queue every frame in front of it
     # rather than drop, so the demo still checks all of them.
     queue = max(frames, 2) if model == "reference" else 2
@@ -243,11 +246,20 @@ def write_figure(images: tuple[np.ndarray, np.ndarray, np.ndarray], encoding: st
         tiles.append(np.vstack([head, tile]))
         tiles.append(np.full((size[1] + band, 4, 3), 255, np.uint8))
     figure = np.hstack(tiles[:-1])
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if not cv2.imwrite(str(path), cv2.cvtColor(figure, cv2.COLOR_RGB2BGR),
-                       [cv2.IMWRITE_PNG_COMPRESSION, 9]):
-        from rosfpga_lab.component.errors import ComponentError
-
+    path = _png_path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        written = cv2.imwrite(str(path), cv2.cvtColor(figure, cv2.COLOR_RGB2BGR),
+                              [cv2.IMWRITE_PNG_COMPRESSION, 9])
+    except OSError:
+        written = False
+    if not written:
         raise ComponentError(f"could not write {path} (is the directory writable?)")
+    return path
+
+
+def _png_path(path: str | Path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() != ".png":
+        raise ComponentError(f"the figure is a PNG: give a file name ending in .png, not {path}")
     return path
