@@ -22,7 +22,7 @@ import pytest
 from realros import require_cxx, ros_missing_reason, run_ros_python
 from rosfpga_lab.hls import CsimError, build_csim, generate, load_config, pipeline_for, run_csim
 from rosfpga_lab.hls.csim import CsimResult
-from rosfpga_lab.hw import PipelineError, image_frame
+from rosfpga_lab.hw import Beats, PipelineError, image_frame
 from rosfpga_lab.msg import default_registry, deserialize
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -169,12 +169,22 @@ def test_connection_headers_from_the_circuit(projects: dict[str, Project]) -> No
     assert "uint8[] data" in definition
 
 
+def _frame(body: bytes) -> bytes:
+    return struct.pack("<I", len(body)) + body
+
+
 def test_refused_frames_are_skipped_and_the_next_good_frame_comes_out_right(
         projects: dict[str, Project]) -> None:
     stem = "fpga_erode_mono8"
     config = load_config(DATA / f"{stem}.yaml")
     image, encoding = random_image(stem, seed=5)
     other, _ = random_image(stem, seed=6)
+    # Frames whose strings fit the frame length but whose fixed fields after them do not: the
+    # circuit must refuse them without reading past the frame's end (into the next frame).
+    stamp = struct.pack("<III", 1, 2, 3)
+    fid_overrun = _frame(stamp + struct.pack("<I", 30) + b"f" * 30 + struct.pack("<I", 240) + b"\x40")
+    enc_overrun = _frame(stamp + struct.pack("<I", 3) + b"cam" + struct.pack("<III", 240, 320, 5)
+                         + b"mono8" + b"\x00" + b"\x40\x01")
     frames = [
         ("wrong width", image_frame(image[:, :-1], encoding), "SUB_BAD_WIDTH"),
         ("wrong height", image_frame(image[:-1], encoding), "SUB_BAD_HEIGHT"),
@@ -182,10 +192,17 @@ def test_refused_frames_are_skipped_and_the_next_good_frame_comes_out_right(
         ("good", ros_frame(image, encoding, seq=10), "SUB_OK"),
         ("frame_id too long", image_frame(image, encoding, frame_id="f" * 300), "SUB_BAD_FRAME_ID_LENGTH"),
         ("frame length too short", struct.pack("<I", 10) + bytes(10), "SUB_BAD_FRAME_LENGTH"),
+        ("frame ends after frame_id", fid_overrun, "SUB_BAD_FRAME_ID_LENGTH"),
+        ("frame ends after encoding", enc_overrun, "SUB_BAD_ENCODING_LENGTH"),
+        ("data length differs from step x height",
+         _frame(image_frame(image, encoding)[4:-4 - image.size] + struct.pack("<I", image.size - 1)
+                + image.tobytes()[:-1]), "SUB_BAD_DATA_LENGTH"),
         ("good again", ros_frame(other, encoding, seq=11, frame_id="cam2"), "SUB_OK"),
     ]
     stream = b"".join(f for _, f, _ in frames)
     got = projects[stem].run(stream)
+    # Every frame was read exactly to its end: no read of an empty stream, no byte left over.
+    assert "WARNING" not in got.log, got.log
     offsets = np.cumsum([0] + [len(f) for _, f, _ in frames])[:-1]
     assert got.status == tuple((int(o), s) for o, (_, _, s) in zip(offsets, frames))
     # The Python model refuses the same frames and numbers the accepted ones 1, 2.
@@ -207,11 +224,12 @@ def test_refused_frames_are_skipped_and_the_next_good_frame_comes_out_right(
     assert (one["header"]["seq"], one["header"]["frame_id"]) == (1, "camera_link")
     assert (two["header"]["seq"], two["header"]["frame_id"]) == (2, "cam2")
     n = config.image.width * config.image.height
-    assert len(got.input_beats) == 2 * n
+    assert len(got.input_beats) == len(got.output_beats) == 2 * n
     for i in range(2):
-        part = got.input_beats.tdata[i * n:(i + 1) * n]
-        assert np.array_equal(part, beats_in[i].tdata)
-        assert np.array_equal(got.output_beats.tdata[i * n:(i + 1) * n], beats_out[i].tdata)
+        for side, model_beats in ((got.input_beats, beats_in[i]), (got.output_beats, beats_out[i])):
+            part = Beats(side.tdata[i * n:(i + 1) * n], side.tkeep[i * n:(i + 1) * n],
+                         side.tuser[i * n:(i + 1) * n], side.tlast[i * n:(i + 1) * n])
+            assert part == model_beats, f"frame {i}: first differing beat {part.first_difference(model_beats)}"
 
 
 CUSTOM_FILTER = r"""
@@ -307,3 +325,26 @@ def test_a_batch_of_varied_frames_equals_the_models(projects: dict[str, Project]
     assert statuses.count("refused") == 1  # the 257-byte frame_id
     assert [s if s == "SUB_OK" else "refused" for _, s in got.status] == statuses
     assert got.output == expected
+
+
+def test_frame_id_max_is_the_same_limit_in_the_circuit_and_the_models(tmp_path: Path) -> None:
+    """``frame_id_max`` below the lab's limit: C and Python refuse the same frames."""
+    require_cxx()
+    text = (DATA / "fpga_passthrough_rgb8.yaml").read_text() + "frame_id_max: 16\n"
+    (tmp_path / "node.yaml").write_text(text)
+    config = load_config(tmp_path / "node.yaml")
+    generate(config, tmp_path / "proj")
+    image, encoding = random_image("fpga_passthrough_rgb8", seed=3)
+    frames = [image_frame(image, encoding, frame_id="f" * n) for n in (15, 16, 17, 0)]
+    got = run_csim(tmp_path / "proj", b"".join(frames))
+    assert [s for _, s in got.status] == ["SUB_OK", "SUB_OK", "SUB_BAD_FRAME_ID_LENGTH", "SUB_OK"]
+    pipe = pipeline_for(config)
+    expected = b""
+    for n, frame in zip((15, 16, 17, 0), frames):
+        if n == 17:
+            with pytest.raises(PipelineError, match="header.frame_id length"):
+                pipe.process(frame)
+        else:
+            expected += pipe.process(frame).output_frame
+    assert got.output == expected
+    assert "WARNING" not in got.log, got.log

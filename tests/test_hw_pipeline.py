@@ -120,6 +120,20 @@ def test_bad_frame_is_refused_and_the_next_frame_is_right(model, frame, error, f
     assert decode_frame(first)["data"].tobytes() == decode_frame(again.output_frame)["data"].tobytes()
 
 
+@pytest.mark.parametrize("model", ["fast", "reference"])
+def test_frame_id_longer_than_the_configured_limit_is_refused(model):
+    pipe = Pipeline(model=model, max_frame_id_bytes=3)
+    with pytest.raises(FrameFieldError) as info:
+        pipe.process(GOOD)  # frame_id "cam" fits; "cams" does not
+        pipe.process(tcpros_frame(image_msg(GOOD_IMAGE, "rgba8", frame_id="cams")))
+    assert info.value.field == "header.frame_id length" and "max_frame_id_bytes" in str(info.value)
+    assert info.value.offset == 16 and info.value.value == 4
+    again = pipe.process(GOOD)
+    assert again.output_frame == expected_frame(GOOD_IMAGE, "rgba8", seq=2, frame_id="cam")
+    with pytest.raises(PipelineConfigError):
+        Pipeline(max_frame_id_bytes=0)
+
+
 def test_bad_configuration_is_refused():
     for kwargs in ({"model": "rtl"}, {"op": "blur"}, {"encoding": "yuv422"}, {"width": 0},
                    {"ksize": (0, 3)}, {"seq": "random"}, {"clock_hz": 0}, {"rx_fifo_depth": 0},

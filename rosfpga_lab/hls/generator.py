@@ -31,7 +31,7 @@ from rosfpga_lab.hls.config import NodeConfig
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
 from rosfpga_lab.hw import limits as hw_limits
-from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES
+from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, fixed_after
 from rosfpga_lab.msg import default_registry
 from rosfpga_lab.tcpros import encode_header
 
@@ -158,7 +158,8 @@ def pipeline_for(config: NodeConfig, model: str = "fast") -> Pipeline:
     ksize = (app.ksize, app.ksize) if op != "copy" else (1, 1)
     return Pipeline(width=config.image.width, height=config.image.height,
                     encoding=config.image.encoding, op=op, ksize=ksize, model=model,
-                    clock_hz=config.clock_mhz * 1e6, rx_fifo_depth=config.fifo.input_depth)
+                    clock_hz=config.clock_mhz * 1e6, rx_fifo_depth=config.fifo.input_depth,
+                    max_frame_id_bytes=config.frame_id_max)
 
 
 def sample_image(config: NodeConfig) -> np.ndarray:
@@ -223,6 +224,7 @@ def render(config: NodeConfig) -> dict[str, str]:
         "frame_id_max": config.frame_id_max, "max_encoding_bytes": hw_limits.MAX_ENCODING_BYTES,
         "max_frame_bytes": hw_limits.MAX_FRAME_BYTES, "min_body_bytes": MIN_BODY_BYTES,
         "checked": checked, "interp_table": interp, "gen_table": GENERATOR_TABLE,
+        "after_frame_id": fixed_after("frame_id"), "after_encoding": fixed_after("encoding"),
         "tb_input": TB_INPUT,
         "tb_expected": TB_EXPECTED if config.application.op != "custom" else "",
         "headers": [

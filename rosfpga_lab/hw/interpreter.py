@@ -86,6 +86,26 @@ _FIXED = {"u32": 4, "u8": 1}
 MIN_BODY_BYTES = 4 + 4 + 4 + 4 + 4 + 4 + 4 + 1 + 4 + 4
 
 
+def fixed_after(field_name: str, table: tuple[Transition, ...] = INTERPRETER_TABLE
+                ) -> tuple[int, tuple[str, ...]]:
+    """The fixed-size fields between ``field_name`` and the next variable-length one.
+
+    The generated subscriber checks that a string *and* these fields fit in the frame before
+    reading on, so it never reads past the frame's end.
+
+    Returns:
+        ``(bytes, labels)``: their total size and their labels, in wire order.
+    """
+    names = [t.field for t in table]
+    size, labels = 0, []
+    for t in table[names.index(field_name) + 1:]:
+        if t.length_of is not None:
+            break
+        size += _FIXED[t.kind]
+        labels.append(t.label)
+    return size, tuple(labels)
+
+
 def format_table(table: tuple[Transition, ...] = INTERPRETER_TABLE) -> str:
     """The state table as aligned text (what a notebook prints before drawing it)."""
     rows = [("state", "field", "bytes", "next", "check")]
@@ -130,6 +150,8 @@ class Interpreter:
         out: where pixel bytes go (a fresh unbounded :class:`ByteFIFO` when omitted).
         width, height, encoding: what the circuit was built for; ``None`` accepts any legal
             value. A frame that disagrees is refused, naming the field.
+        max_frame_id_bytes: longest ``header.frame_id`` the circuit keeps (the node
+            configuration's ``frame_id_max``); a longer one is refused.
 
     Attributes:
         state: the current state (a ``Transition.state``, or ``"SKIP"``).
@@ -144,8 +166,12 @@ class Interpreter:
     height: int | None = None
     encoding: str | None = None
     table: tuple[Transition, ...] = INTERPRETER_TABLE
+    max_frame_id_bytes: int = limits.MAX_FRAME_ID_BYTES
 
     def __post_init__(self) -> None:
+        if not 1 <= self.max_frame_id_bytes <= limits.MAX_FRAME_ID_BYTES:
+            raise PipelineConfigError(f"max_frame_id_bytes must be in 1..{limits.MAX_FRAME_ID_BYTES}, "
+                                      f"got {self.max_frame_id_bytes}")
         if self.encoding is not None and self.encoding not in PIXEL_FORMATS:
             raise PipelineConfigError(
                 f"unsupported encoding {self.encoding!r}; the circuit packs {', '.join(PIXEL_FORMATS)}")
@@ -301,18 +327,17 @@ class Interpreter:
 
     def _check_string(self, value: int, t: Transition, limit: int, limit_name: str) -> None:
         if value > limit:
-            self._refuse(t, f"{value} exceeds the limit of {limit} bytes (hw.limits.{limit_name})",
-                         value)
+            self._refuse(t, f"{value} exceeds the limit of {limit} bytes ({limit_name})", value)
         left = 4 + self.values["frame_length"] - self.offset
         if value > left:
             self._refuse(t, f"{value} bytes announced but the frame length leaves only {left}",
                          value, FrameLengthError)
 
     def _check_frame_id_length(self, value: int, t: Transition) -> None:
-        self._check_string(value, t, limits.MAX_FRAME_ID_BYTES, "MAX_FRAME_ID_BYTES")
+        self._check_string(value, t, self.max_frame_id_bytes, "max_frame_id_bytes")
 
     def _check_encoding_length(self, value: int, t: Transition) -> None:
-        self._check_string(value, t, limits.MAX_ENCODING_BYTES, "MAX_ENCODING_BYTES")
+        self._check_string(value, t, limits.MAX_ENCODING_BYTES, "hw.limits.MAX_ENCODING_BYTES")
 
     def _check_dimension(self, value: int, t: Transition, limit: int, configured: int | None) -> None:
         if value == 0:
@@ -363,7 +388,8 @@ class Interpreter:
 
 
 def interpret_reference(rx: ByteFIFO, out: ByteFIFO, *, width: int | None = None,
-                        height: int | None = None, encoding: str | None = None) -> ImageFields:
+                        height: int | None = None, encoding: str | None = None,
+                        max_frame_id_bytes: int = limits.MAX_FRAME_ID_BYTES) -> ImageFields:
     """Run the reference interpreter over every byte in ``rx`` (one frame).
 
     Returns:
@@ -372,7 +398,7 @@ def interpret_reference(rx: ByteFIFO, out: ByteFIFO, *, width: int | None = None
     Raises:
         FrameFieldError: a bad field, a frame cut short, or bytes left after the frame.
     """
-    interp = Interpreter(out, width, height, encoding)
+    interp = Interpreter(out, width, height, encoding, max_frame_id_bytes=max_frame_id_bytes)
     while not rx.empty:
         interp.push(rx.read(STAGE))
         if interp.frames:
@@ -385,7 +411,8 @@ def interpret_reference(rx: ByteFIFO, out: ByteFIFO, *, width: int | None = None
 
 
 def interpret_fast(frame: bytes, *, width: int | None = None, height: int | None = None,
-                   encoding: str | None = None) -> tuple[ImageFields, np.ndarray]:
+                   encoding: str | None = None,
+                   max_frame_id_bytes: int = limits.MAX_FRAME_ID_BYTES) -> tuple[ImageFields, np.ndarray]:
     """Fast model: the same state machine over the header, the pixels as one numpy slice.
 
     Returns:
@@ -394,7 +421,8 @@ def interpret_fast(frame: bytes, *, width: int | None = None, height: int | None
     Raises:
         FrameFieldError: exactly as :func:`interpret_reference` would.
     """
-    interp = Interpreter(ByteFIFO(name="pixels_in"), width, height, encoding)
+    interp = Interpreter(ByteFIFO(name="pixels_in"), width, height, encoding,
+                         max_frame_id_bytes=max_frame_id_bytes)
     view = memoryview(frame)
     pos = 0
     while pos < len(view) and interp.state != "DATA" and not interp.frames:

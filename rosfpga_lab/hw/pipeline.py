@@ -139,6 +139,8 @@ class Pipeline:
         seq_start: first seq when counting.
         stamp: ``(secs, nsecs)`` to write, or ``None`` to carry the input's stamp.
         frame_id: the frame_id to write, or ``None`` to carry the input's.
+        max_frame_id_bytes: longest input ``header.frame_id`` the interpreter keeps (the
+            generated circuit's ``FRAME_ID_MAX``); a frame with a longer one is refused.
         faults: faults to inject (:mod:`rosfpga_lab.hw.faults`).
 
     Raises:
@@ -154,6 +156,7 @@ class Pipeline:
                  rx_burst_bytes: int = limits.DEFAULT_RX_BURST_BYTES,
                  seq: str = "count", seq_start: int = 1,
                  stamp: tuple[int, int] | None = None, frame_id: str | None = None,
+                 max_frame_id_bytes: int = limits.MAX_FRAME_ID_BYTES,
                  faults: Sequence[Fault] = ()) -> None:
         if model not in MODELS:
             raise PipelineConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
@@ -186,6 +189,7 @@ class Pipeline:
         self.width, self.height, self.encoding, self.op, self.model = width, height, encoding, op, model
         self.clock_hz, self.line_rate_bps = float(clock_hz), float(line_rate_bps)
         self.seq_mode, self.seq_start, self.stamp, self.frame_id = seq, seq_start, stamp, frame_id
+        self.max_frame_id_bytes = max_frame_id_bytes
         self.faults = tuple(faults)
         for fault in self.faults:
             if not isinstance(fault, Fault):
@@ -206,7 +210,8 @@ class Pipeline:
             seq: also restart the generator's frame counter (``seq_start`` comes next); by
                 default it keeps counting, as a publisher's does across a bad frame.
         """
-        self._interp = Interpreter(ByteFIFO(name="pixels_in"), self.width, self.height, self.encoding)
+        self._interp = Interpreter(ByteFIFO(name="pixels_in"), self.width, self.height, self.encoding,
+                                   max_frame_id_bytes=self.max_frame_id_bytes)
         if seq:
             self.frames_out = 0
 
@@ -297,7 +302,8 @@ class Pipeline:
         frame = raw.tobytes() if self._faults("rx") else frame
         high_water = receive_fast_check(len(frame), self.rx_fifo_depth, self.rx_burst_bytes)
         fields, pixels = interpret_fast(frame, width=self.width, height=self.height,
-                                        encoding=self.encoding)
+                                        encoding=self.encoding,
+                                        max_frame_id_bytes=self.max_frame_id_bytes)
         fmt = PIXEL_FORMATS[fields.encoding]
         rows, cols = fields.height, fields.width
         pixels = self._bytes_at("pixels_in", pixels)

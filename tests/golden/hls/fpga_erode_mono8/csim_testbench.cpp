@@ -108,6 +108,17 @@ int main(int argc, char** argv) {
         std::vector<unsigned char> published = drain(out);
         output.insert(output.end(), published.begin(), published.end());
         std::fprintf(status_log, "%zu %s\n", offset, status_name(status));
+        // The circuit must read each frame exactly to its end (a refused one too), or it would
+        // take bytes of the next frame for its own. (Reading past the end already warns.)
+        std::size_t unread = drain(in).size();
+        if (status == SUB_BAD_FRAME_LENGTH) {
+            std::cout << "csim: the frame at byte " << offset << " has a frame length the circuit"
+                      << " refuses; it waits for a new frame length (" << unread
+                      << " byte(s) dropped here)\n";
+        } else if (unread != 0) {
+            std::cout << "csim: WARNING: the subscriber left " << unread << " byte(s) of the frame"
+                      << " at byte " << offset << " unread\n";
+        }
 
         // The stages again, to tap the AXI4-Stream beats.
         byte_stream tap_in("tap_in");
@@ -122,8 +133,7 @@ int main(int argc, char** argv) {
             tap(beats_out, sink, out_log);
             while (!sink.empty()) sink.read();
         }
-        while (!in.empty()) in.read();
-        while (!tap_in.empty()) tap_in.read();
+        drain(tap_in);
         frames++;
         if (status != SUB_OK) refused++;
         offset += size;

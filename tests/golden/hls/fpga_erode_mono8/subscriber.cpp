@@ -9,6 +9,11 @@
 // end, so the next frame is read right.
 #include "ros_node.h"
 
+// Bytes of the fixed-size fields after each string. A string is accepted only if it and
+// these fit in the frame, so the subscriber never reads past the frame's end (into the next).
+#define AFTER_FRAME_ID_BYTES 12  // height, width, encoding length
+#define AFTER_ENCODING_BYTES 9  // is_bigendian, step, data length
+
 // Read one byte; pos counts the bytes of the frame read so far.
 static byte_t read_u8(byte_stream& in, ap_uint<32>& pos) {
     pos++;
@@ -70,7 +75,7 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
         meta.stamp_nsecs = read_u32(in, pos);
         // header.frame_id length (uint32)
         ap_uint<32> frame_id_length = read_u32(in, pos);
-        if (frame_id_length > FRAME_ID_MAX || pos + frame_id_length > end) {
+        if (frame_id_length > FRAME_ID_MAX || pos + frame_id_length + AFTER_FRAME_ID_BYTES > end) {
             status = SUB_BAD_FRAME_ID_LENGTH;
             break;
         }
@@ -91,7 +96,7 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
         }
         // encoding length (uint32)
         ap_uint<32> encoding_length = read_u32(in, pos);
-        if (encoding_length > ENCODING_MAX || pos + encoding_length > end) {
+        if (encoding_length > ENCODING_MAX || pos + encoding_length + AFTER_ENCODING_BYTES > end) {
             status = SUB_BAD_ENCODING_LENGTH;
             break;
         }
