@@ -97,6 +97,32 @@ def test_generated_code_names_the_configuration() -> None:
     assert "hls::Window<5, 5, unsigned char>" in erode["image_filter.cpp"]
 
 
+@pytest.mark.parametrize("stem, bpp", [("fpga_dilate_rgba8", 4), ("fpga_erode_mono8", 1),
+                                       ("fpga_passthrough_rgb8", 3)])
+def test_hls_directives_where_vivado_hls_needs_them(stem: str, bpp: int) -> None:
+    texts = render(load_config(DATA / f"{stem}.yaml"))
+    sub, pub, app = texts["subscriber.cpp"], texts["publisher.cpp"], texts["image_filter.cpp"]
+    for text, ports in ((sub, ("ap_fifo port = in", "axis port = out", "ap_fifo port = meta_out")),
+                        (pub, ("axis port = in", "ap_fifo port = meta_in", "ap_fifo port = out")),
+                        (app, ("axis port = in", "axis port = out"))):
+        for port in ports:
+            assert f"HLS_PRAGMA(HLS INTERFACE {port})" in text
+    assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_out)" in sub
+    assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_in)" in pub
+    assert "HLS_PRAGMA(HLS DATAFLOW)" in app
+    # Every loop over a variable number of bytes moves one byte per clock.
+    for text in (sub, pub):
+        lines = text.splitlines()
+        for i, line in enumerate(lines):
+            if "LOOP_TRIPCOUNT" in line:
+                assert "HLS_PRAGMA(HLS PIPELINE II = 1)" in lines[i - 1], lines[i - 2:i + 1]
+    # fifo2axi / axi2fifo: one byte per clock on the FIFO side, so one beat per bpp clocks.
+    assert sub.count(f"HLS_PRAGMA(HLS PIPELINE II = {bpp})") >= 1
+    assert pub.count(f"HLS_PRAGMA(HLS PIPELINE II = {bpp})") >= 1
+    # In C simulation the directives vanish (no unknown-pragma warning under -Wall -Werror).
+    assert "#define HLS_PRAGMA(x)\n" in texts["ros_node.h"]
+
+
 def test_regenerating_refuses_then_force_replaces(tmp_path: Path) -> None:
     out = tmp_path / "out"
     generate(load_config(DATA / "fpga_passthrough_rgb8.yaml"), out)

@@ -33,6 +33,7 @@ static ap_uint<32> read_u32(byte_stream& in, ap_uint<32>& pos) {
 static void read_string(byte_stream& in, ap_uint<32>& pos, byte_t buf[FRAME_ID_MAX],
                         ap_uint<32> length) {
     for (ap_uint<32> i = 0; i < length; i++) {
+        HLS_PRAGMA(HLS PIPELINE II = 1)
         HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 256)
         buf[i] = read_u8(in, pos);
     }
@@ -43,6 +44,7 @@ static bool match_string(byte_stream& in, ap_uint<32>& pos, ap_uint<32> length,
                          const char* expected, int expected_length) {
     bool same = (length == ap_uint<32>(expected_length));
     for (ap_uint<32> i = 0; i < length; i++) {
+        HLS_PRAGMA(HLS PIPELINE II = 1)
         HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 32)
         byte_t c = read_u8(in, pos);
         if (i >= ap_uint<32>(expected_length) || c != byte_t(expected[i])) same = false;
@@ -56,6 +58,7 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
     HLS_PRAGMA(HLS INTERFACE axis port = out)
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_out)
+    HLS_PRAGMA(HLS DATA_PACK variable = meta_out)  // one wide FIFO word per frame
     image_meta meta;
     ap_uint<32> pos = 0;  // offset in the frame; 0 is the first byte of the frame length
 
@@ -128,6 +131,7 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
 
     // Refused: skip the rest of the frame.
     while (pos < end) {
+        HLS_PRAGMA(HLS PIPELINE II = 1)
         HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 67108864)
         read_u8(in, pos);
     }
@@ -136,6 +140,8 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
 
 // fifo2axi (the paper's Figure 7): one pixel per beat, byte i of the pixel in TDATA bits
 // 8i+7..8i, TUSER on the first pixel of the frame, TLAST on the last pixel of every line.
+// The 8-bit FIFO gives one byte per clock, so a beat of IMG_BYTES_PER_PIXEL bytes takes as
+// many clocks: that is the loop's initiation interval.
 void fifo2axi(byte_stream& in, pixel_stream& out) {
     for (int y = 0; y < IMG_HEIGHT; y++) {
         for (int x = 0; x < IMG_WIDTH; x++) {

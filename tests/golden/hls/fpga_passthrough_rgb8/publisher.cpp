@@ -17,7 +17,8 @@ static void write_u32(byte_stream& out, ap_uint<32> value) {
     }
 }
 
-// axi2fifo: for every pixel beat, the bytes of the lanes whose TKEEP bit is set, lane 0 first.
+// axi2fifo: for every pixel beat, the bytes of the lanes whose TKEEP bit is set, lane 0 first,
+// one byte per clock into the 8-bit FIFO (hence the initiation interval of IMG_BYTES_PER_PIXEL).
 void axi2fifo(pixel_stream& in, byte_stream& out) {
     for (int p = 0; p < IMG_HEIGHT * IMG_WIDTH; p++) {
         HLS_PRAGMA(HLS PIPELINE II = 3)
@@ -32,6 +33,7 @@ void axi2fifo(pixel_stream& in, byte_stream& out) {
 void publisher(pixel_stream& in, meta_stream& meta_in, byte_stream& out) {
     HLS_PRAGMA(HLS INTERFACE axis port = in)
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_in)
+    HLS_PRAGMA(HLS DATA_PACK variable = meta_in)  // one wide FIFO word per frame
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = out)
     static ap_uint<32> seq = 0;  // messages published so far
     image_meta meta = meta_in.read();
@@ -47,6 +49,7 @@ void publisher(pixel_stream& in, meta_stream& meta_in, byte_stream& out) {
     // header.frame_id (string): as received
     write_u32(out, meta.frame_id_length);
     for (ap_uint<32> i = 0; i < meta.frame_id_length; i++) {
+        HLS_PRAGMA(HLS PIPELINE II = 1)
         HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 256)
         out.write(meta.frame_id[i]);
     }
@@ -57,6 +60,7 @@ void publisher(pixel_stream& in, meta_stream& meta_in, byte_stream& out) {
     // encoding (string): "rgb8"
     write_u32(out, IMG_ENCODING_LENGTH);
     for (int i = 0; i < IMG_ENCODING_LENGTH; i++) {
+        HLS_PRAGMA(HLS PIPELINE II = 1)
         out.write(IMG_ENCODING[i]);
     }
     // is_bigendian (uint8): as received
