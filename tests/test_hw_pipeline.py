@@ -221,6 +221,39 @@ def test_fifo_too_shallow_for_a_burst():
     assert res.fifo_high_water == {"rx": 100} and res.output_frame == expected_frame(FAULT_IMAGE, "rgba8")
 
 
+@pytest.mark.parametrize("model", ["fast", "reference"])
+@pytest.mark.parametrize("fault", [
+    DuplicateByte(index=10, tap="pixels_in"), DropByte(index=3, tap="pixels_in"),
+    DropByte(index=30, tap="rx"), DuplicateByte(index=30, tap="rx"), DropByte(index=5, tap="pixels_out"),
+    SwapByteOrder(tap="axis_in"), LoseTlast(line=2), LoseTuser(), LoseTlast(line=0, tap="axis_out"),
+], ids=repr)
+def test_after_a_fault_the_next_good_frame_comes_out_right(model, fault):
+    """The same pipeline, its fault then removed: no state of the faulty frame lingers."""
+    pipe = Pipeline(model=model, faults=[fault])
+    try:
+        bad = pipe.process(FAULT_FRAME)
+    except PipelineError:
+        pass
+    else:  # the fault did show: in the output bytes, or (a lost TLAST on the way out) the beats
+        clean = Pipeline(model=model).process(FAULT_FRAME)
+        assert bad.output_frame != clean.output_frame or bad.output_beats != clean.output_beats
+    pipe.faults = ()
+    res = pipe.process(GOOD)
+    assert res.ok and res.output_frame == expected_frame(GOOD_IMAGE, "rgba8", seq=res.output_fields.seq,
+                                                         frame_id="cam")
+
+
+@pytest.mark.parametrize("model", ["fast", "reference"])
+def test_after_a_fifo_overflow_the_next_frame_that_fits_comes_out_right(model):
+    pipe = Pipeline(model=model, faults=[ShallowFifo(depth=64, burst_bytes=100)])
+    with pytest.raises(FifoOverflowError):
+        pipe.process(FAULT_FRAME)
+    small = random_image(1, 1, "mono8")
+    frame = tcpros_frame(image_msg(small, "mono8"))
+    assert len(frame) <= 64
+    assert pipe.process(frame).output_frame == expected_frame(small, "mono8", seq=1)
+
+
 def test_fault_index_outside_the_stream_is_a_config_error():
     with pytest.raises(PipelineConfigError, match="outside"):
         Pipeline(faults=[DropByte(index=10**6)]).process(FAULT_FRAME)
