@@ -153,6 +153,10 @@ def test_progress_widget_mode_and_track() -> None:
     assert (p._bar.value, p._bar.max) == (4, 10) and "40%" in p._label.value
     p.close()
     assert p._bar.bar_style == "success"
+    bundle = p.mimebundle()   # what an exported notebook shows instead of the live bar
+    assert "application/vnd.jupyter.widget-view+json" in bundle
+    assert "40% 4/10" in bundle["text/plain"] and "<pre>work [########" in bundle["text/html"]
+    assert "IntProgress" not in bundle["text/plain"]
     out = io.StringIO()
     assert list(track(range(5), desc="t", mode="text", file=out, min_interval=0)) == [0, 1, 2, 3, 4]
     assert out.getvalue().splitlines()[-1].startswith("t [####################] 100% 5/5")
@@ -196,3 +200,46 @@ def cv2_decode(png: bytes) -> np.ndarray:
     import cv2
 
     return cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_COLOR)[:, :, ::-1]
+
+
+def test_live_view_static_form_and_close_freezes_the_output(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Exported notebooks show the newest frame and the figures, not the widget's repr."""
+    import base64
+
+    import IPython.display
+
+    shown: list[tuple[dict, dict]] = []
+
+    class Handle:
+        def update(self, data: dict, **kw: object) -> None:
+            shown.append((data, kw))
+
+    def fake_display(data: dict, **kw: object) -> Handle:
+        shown.append((data, kw))
+        return Handle()
+
+    monkeypatch.setattr(IPython.display, "display", fake_display)
+    v = LiveView(trailing=False, image_format="png", title="/out <&>")
+    v._ipython_display_()
+    first, kw = shown[0]
+    assert kw == {"raw": True, "display_id": True}
+    assert "application/vnd.jupyter.widget-view+json" in first
+    assert "waiting for frames" in first["text/html"] and "/out &lt;&amp;&gt;" in first["text/html"]
+    assert "<img" not in first["text/html"]
+    frame = np.zeros((3, 5, 3), np.uint8)
+    frame[1, 2] = (255, 0, 0)
+    v.update(frame)
+    v.close()
+    frozen, kw = shown[-1]
+    assert kw == {"raw": True} and "application/vnd.jupyter.widget-view+json" not in frozen
+    assert frozen["text/plain"].startswith("1 frames received")
+    uri = frozen["text/html"].split('src="data:image/png;base64,')[1].split('"')[0]
+    import cv2
+
+    img = cv2.imdecode(np.frombuffer(base64.b64decode(uri), np.uint8), cv2.IMREAD_COLOR)
+    assert img is not None and img.shape[1] >= 5                # the frame itself, enlarged
+    scale = img.shape[1] // 5
+    assert tuple(img[1 * scale, 2 * scale]) == (0, 0, 255)      # BGR of the red pixel
+    assert len(shown) == 2                                      # closing twice adds nothing
+    v.close()
+    assert len(shown) == 2

@@ -6,10 +6,16 @@ keeps only the newest frame. A :class:`Throttle` lets at most ``max_fps`` frames
 through to the browser; a frame that arrives too early is not dropped at once but parked, and a
 timer shows the newest parked frame when the next slot opens (so the last frame of a burst
 always appears). Encoding happens outside the state lock; one lock serialises pushes.
+
+Static form: the view's output carries HTML of the newest frame and the status line beside the
+live widget. It is displayed with a display id, and :meth:`LiveView.close` replaces the output
+with that HTML, so an exported or reopened notebook shows the last frame and the final figures
+(not the widget's Python repr, nor a "model not found" box for a closed widget).
 """
 
 from __future__ import annotations
 
+import base64
 import threading
 import time
 from collections import deque
@@ -21,11 +27,13 @@ import numpy as np
 
 from rosfpga_lab.widgets._common import (
     LIVE_MAX_FPS,
+    StaticFallback,
     WidgetError,
     as_image,
     display_rgb,
     display_scale,
     downscale,
+    esc,
 )
 
 
@@ -80,7 +88,7 @@ class RateMeter:
         return (len(times) - 1) / (times[-1] - times[0])
 
 
-class LiveView(w.VBox):
+class LiveView(StaticFallback, w.VBox):
     """Shows the newest frame, incoming and shown fps, and latency; safe to update from any thread.
 
     Args:
@@ -109,6 +117,8 @@ class LiveView(w.VBox):
         self._pending: np.ndarray | None = None
         self._timer: threading.Timer | None = None
         self._closed = False
+        self._handle: Any = None
+        self.title = title
         self.image = w.Image(format=image_format)
         self.status = w.HTML("waiting for frames\u2026")
         super().__init__([w.HTML(f"<b>{title}</b>") if title else w.HTML(), self.image, self.status])
@@ -203,6 +213,24 @@ class LiveView(w.VBox):
             self.image.value = buf.tobytes()
             self.status.value = text
 
+    def to_html(self) -> str:
+        """Static HTML: the title, the newest frame shown (if any) and the status line."""
+        head = f"<b>{esc(self.title)}</b>" if self.title else ""
+        img = ""
+        if self.image.value:
+            mime = "jpeg" if self.image_format == "jpeg" else "png"
+            data = base64.b64encode(self.image.value).decode("ascii")
+            img = f'<div><img src="data:image/{mime};base64,{data}" alt="newest frame"/></div>'
+        status = self.status_text() if self.received else "waiting for frames\u2026"
+        return f"<div>{head}{img}<div>{esc(status)}</div></div>"
+
+    def _ipython_display_(self) -> None:
+        from IPython.display import display
+
+        data = self._repr_mimebundle_()
+        data = data[0] if isinstance(data, tuple) else data
+        self._handle = display(data, raw=True, display_id=True)
+
     @property
     def stats(self) -> dict[str, float]:
         """Counters: received, shown, skipped, fps_in, fps_shown, latency_last/mean (s, NaN if unknown)."""
@@ -232,4 +260,8 @@ class LiveView(w.VBox):
         if timer is not None:
             timer.cancel()
             timer.join(1.0)
+        if self._handle is not None:  # freeze the output: the last frame and the final figures
+            self._handle.update({"text/html": self.to_html(), "text/plain": self.status_text()},
+                                raw=True)
+            self._handle = None
         super().close()

@@ -1,6 +1,8 @@
 """Progress for long work (the reference model on a large image, a C simulation).
 
-In a Jupyter kernel it shows an ipywidgets progress bar; anywhere else it writes text to a
+In a Jupyter kernel it shows an ipywidgets progress bar (its output also carries the progress
+line as text, updated once at the end, so an exported notebook shows the final state rather
+than the bar's Python repr); anywhere else it writes text to a
 stream (stderr by default): one updating line on a terminal, or a line per 10 % otherwise (so
 CI logs stay short). Updates are throttled to ``min_interval`` seconds, so calling it once per
 pixel is cheap. Use it as a context manager, a callback ``progress(done, total)``, a step
@@ -10,6 +12,7 @@ callback ``progress("compiling the testbench")`` (what ``rosfpga_lab.hls`` and
 
 from __future__ import annotations
 
+import html
 import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
@@ -62,6 +65,7 @@ class Progress:
         self.note = ""
         self.closed = False
         self.widget: Any = None
+        self._handle: Any = None
         if self.mode == "widget":
             import ipywidgets as w
             from IPython.display import display
@@ -69,7 +73,16 @@ class Progress:
             self._bar = w.IntProgress(value=0, min=0, max=max(1, total or 1), description=desc[:20])
             self._label = w.Label("")
             self.widget = w.HBox([self._bar, self._label])
-            display(self.widget)
+            self._handle = display(self.mimebundle(), raw=True, display_id=True)
+
+    def mimebundle(self) -> dict[str, str]:
+        """The widget's output: its live view plus the progress line as text and HTML."""
+        data = self.widget._repr_mimebundle_()
+        data = dict(data[0] if isinstance(data, tuple) else data)
+        line = self.text()
+        data["text/plain"] = line
+        data["text/html"] = f"<pre>{html.escape(line)}</pre>"
+        return data
 
     # --- feeding ------------------------------------------------------------------------------
     def update(self, n: int = 1) -> None:
@@ -136,6 +149,8 @@ class Progress:
             self._label.value = line
             if final:
                 self._bar.bar_style = "success"
+                if self._handle is not None:
+                    self._handle.update(self.mimebundle(), raw=True)
             return
         if self.file.isatty() if hasattr(self.file, "isatty") else False:
             self.file.write("\r" + line + ("\n" if final or note else ""))
