@@ -106,6 +106,29 @@ def test_camera_rate_and_viewer_saves_pngs(tmp_path) -> None:
     assert viewer.latency.summary().count == 20
 
 
+def test_viewer_gives_no_latency_for_a_stamp_that_is_not_wall_clock_time() -> None:
+    """A rospy node that leaves header.stamp at 0 (notebook 7 has one): no 55-year latency."""
+    from rosfpga_lab.graph import Node
+
+    image = {"header": {"seq": 0, "stamp": {"secs": 0, "nsecs": 0}, "frame_id": ""}, "height": 1,
+             "width": 2, "encoding": "mono8", "is_bigendian": 0, "step": 2, "data": b"\x01\x02"}
+    with EmbeddedMaster(port=0) as master:
+        viewer = Viewer("/img", master=master)
+        node = Node("/plain_pub", master=master)
+        try:
+            pub = node.advertise("/img", "sensor_msgs/Image")
+            assert pub.wait_for_subscribers(1, 10)
+            pub.publish(image)
+            pub.publish({**image, "header": {**image["header"], "stamp": {"secs": int(time.time()),
+                                                                           "nsecs": 0}}})
+            assert viewer.wait_for(2, 10)
+        finally:
+            node.shutdown()
+            viewer.stop()
+    assert viewer.last.latency is not None and 0 <= viewer.last.latency < 5
+    assert viewer.latency.summary().count == 1      # the zero stamp left out of the figures
+
+
 def test_camera_refuses_a_bad_rate() -> None:
     with pytest.raises(SourceError, match="rate"):
         Camera("/img", rate=0)

@@ -28,7 +28,7 @@ import numpy as np
 from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import ComponentError, SourceError
 from rosfpga_lab.component.sources import ImageSource, open_source, to_rgb
-from rosfpga_lab.component.stats import LatencyWindow
+from rosfpga_lab.component.stats import LatencyWindow, since_stamp
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node
 from rosfpga_lab.hw import image_frame
 
@@ -169,7 +169,7 @@ class ViewedFrame:
     encoding: str
     image: np.ndarray | None   # (rows, cols, channels) uint8, None when undisplayable
     info: MessageInfo
-    latency: float             # receive time minus header.stamp (seconds)
+    latency: float | None      # receive time minus header.stamp (s); None: no wall-clock stamp
 
 
 class Viewer:
@@ -220,8 +220,9 @@ class Viewer:
         header = msg["header"]
         stamp = header["stamp"]
         secs, nsecs = (stamp["secs"], stamp["nsecs"]) if isinstance(stamp, dict) else stamp
-        latency = info.received - (secs + nsecs * 1e-9)
-        self.latency.add(latency)
+        latency = since_stamp(info.received, secs, nsecs)
+        if latency is not None:
+            self.latency.add(latency)
         h, w, enc = msg["height"], msg["width"], msg["encoding"]
         image = None
         try:

@@ -20,7 +20,7 @@ import numpy as np
 
 from rosfpga_lab.component.camera import SentFrame
 from rosfpga_lab.component.errors import ComponentError
-from rosfpga_lab.component.stats import LatencyWindow
+from rosfpga_lab.component.stats import LatencyWindow, since_stamp
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node
 from rosfpga_lab.msg import default_registry, deserialize
 
@@ -106,7 +106,9 @@ class Checker:
         msg = deserialize(self._registry, "sensor_msgs/Image", bytes(body))
         stamp_v = msg["header"]["stamp"]
         stamp = (stamp_v["secs"], stamp_v["nsecs"]) if isinstance(stamp_v, dict) else tuple(stamp_v)
-        self.latency.add(info.received - (stamp[0] + stamp[1] * 1e-9))
+        latency = since_stamp(info.received, *stamp)
+        if latency is not None:
+            self.latency.add(latency)
         with self._lock:
             source = self._inputs.pop(stamp, None)
             self.report.received += 1

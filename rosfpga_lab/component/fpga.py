@@ -39,7 +39,7 @@ import numpy as np
 
 from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
-from rosfpga_lab.component.stats import ComponentStats, LatencyWindow
+from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, since_stamp
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
 from rosfpga_lab.hls import NodeConfig, load_config, pipeline_for
@@ -287,9 +287,9 @@ class FpgaComponent:
                         problem)
         self._latency.add(now - info.received)
         self._process.add(t1 - t0)
-        since_stamp = now - (result.fields.stamp_secs + result.fields.stamp_nsecs * 1e-9)
-        if 0 <= since_stamp < limits.STAMP_PLAUSIBLE:  # a wall-clock stamp (a camera's)
-            self._since_stamp.add(since_stamp)
+        from_stamp = since_stamp(now, result.fields.stamp_secs, result.fields.stamp_nsecs)
+        if from_stamp is not None:  # a wall-clock stamp (a camera's)
+            self._since_stamp.add(from_stamp)
         with self._lock:
             index = self._counts["seen"]
             self._counts["seen"] += 1

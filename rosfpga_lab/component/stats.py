@@ -7,6 +7,20 @@ import statistics
 import threading
 from dataclasses import dataclass, field
 
+from rosfpga_lab.component import limits
+
+
+def since_stamp(now: float, secs: int, nsecs: int) -> float | None:
+    """Seconds from a ``header.stamp`` to ``now`` (wall clock), or None when the stamp is not a
+    recent wall-clock time (zero, a simulated clock, the future): no latency to speak of then.
+
+    Args:
+        now: wall-clock time (``time.time()``) of arrival or publication.
+        secs, nsecs: the stamp.
+    """
+    seconds = now - (secs + nsecs * 1e-9)
+    return seconds if 0 <= seconds < limits.STAMP_PLAUSIBLE else None
+
 
 class LatencyWindow:
     """The last ``size`` latency samples (seconds), with median and percentiles.
