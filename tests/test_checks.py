@@ -335,6 +335,8 @@ def test_sloc():
     assert "that is every line" in problems_of(C.check_sloc, 6, SNIPPET)
     assert "still counts comment-only lines" in problems_of(C.check_sloc, 5, SNIPPET)
     assert "leaves out the preprocessor lines" in problems_of(C.check_sloc, 1, SNIPPET)
+    assert "too many: is a line inside a /* ... */ comment counted?" in problems_of(C.check_sloc, 3, SNIPPET)
+    assert "too few: a line with code before a // comment counts" in problems_of(C.check_sloc, 0, SNIPPET)
 
 
 def test_marshal_explains_a_shift_instead_of_listing_every_byte_after_it():

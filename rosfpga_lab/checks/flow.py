@@ -82,5 +82,8 @@ def check_sloc(answer: Any, source: str) -> CheckResult:
         want - sum(1 for line in lines if line.strip().startswith("#")):
             "that leaves out the preprocessor lines; #include and #pragma HLS lines count",
     }
+    direction = ("too many: is a line inside a /* ... */ comment counted?" if answer > want else
+                 "too few: a line with code before a // comment counts")
     raise fail(ex, f"you counted {answer}, expected another number: "
-                   + hints.get(answer, "count the lines that hold code after removing comments"))
+                   + hints.get(answer, f"{direction} Count the lines that hold code after removing "
+                                       "comments"))
