@@ -131,6 +131,29 @@ def test_image_raw_path_every_byte(nodes) -> None:
     assert pub.stats.frames == 3 and sub.stats.bytes == sum(len(s) for s in sent)
 
 
+def test_image_bodies_are_received_in_place(nodes, monkeypatch) -> None:
+    from rosfpga_lab.graph.wire import RECV_CHUNK
+    from rosfpga_lab.tcpros import FrameDecoder
+
+    in_place = []
+    filled = FrameDecoder.filled
+    monkeypatch.setattr(FrameDecoder, "filled", lambda self, n: in_place.append(n) or filled(self, n))
+    a, b = nodes("/cam"), nodes("/fpga_node")
+    frames: list = []
+    b.subscribe("/image", "sensor_msgs/Image", lambda body, info: frames.append(body), raw=True,
+                queue_size=0)
+    pub = a.advertise("/image", "sensor_msgs/Image", queue_size=0)
+    assert pub.wait_for_subscribers(1, 5)
+    sent = [bytes([i]) * 1_228_850 for i in range(4)]
+    for body in sent:
+        pub.publish_body(body)
+    assert wait_until(lambda: len(frames) == 4, 10)
+    assert [bytes(f) for f in frames] == sent
+    # only the first chunk of each frame (at most RECV_CHUNK bytes) is copied out of a recv()
+    # buffer; the rest of the body is received straight into the frame's own buffer
+    assert sum(in_place) >= sum(len(s) for s in sent) - 4 * RECV_CHUNK
+
+
 def test_queue_drops_oldest_and_counts(nodes) -> None:
     a, b = nodes("/fast"), nodes("/slow")
     release = threading.Event()

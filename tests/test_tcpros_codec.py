@@ -269,3 +269,89 @@ def test_frames_before_a_bad_length_are_not_lost() -> None:
         dec.feed(encode_frame(b"good") + encode_frame(b"too") + u32(101))
     assert [bytes(b) for b in info.value.partial] == [b"good", b"too"]
     assert info.value.offset == 15
+
+
+# ------------------------------------------------------------------------------ receive in place
+def read_in_place(stream: bytes, chunks: list[int], lends: list[int]) -> tuple[list, list[int], int]:
+    """Drive a decoder as the subscriber's socket loop does: feed() a chunk between frame bodies,
+    write straight into pending_body() inside one. Returns (bodies, starts, bytes written in place)."""
+    dec = FrameDecoder()
+    out: list = []
+    starts: list[int] = []
+    pos, i, in_place = 0, 0, 0
+    while pos < len(stream):
+        view = dec.pending_body()
+        if view is None:
+            size = chunks[i % len(chunks)] if chunks else 1
+            got = dec.feed(stream[pos:pos + size])
+            pos += min(size, len(stream) - pos)
+        else:
+            n = min(lends[i % len(lends)] if lends else len(view), len(view), len(stream) - pos)
+            view[:n] = stream[pos:pos + n]  # what sock.recv_into(view) does
+            got = dec.filled(n)
+            assert not got or got[0] is view.obj  # the buffer lent is the body handed over
+            pos += n
+            in_place += n
+        out += got
+        starts += dec.starts
+        i += 1
+    dec.eof()
+    return out, starts, in_place
+
+
+def expected_starts(bodies: list[bytes]) -> list[int]:
+    starts, at = [], 0
+    for b in bodies:
+        starts.append(at)
+        at += 4 + len(b)
+    return starts
+
+
+def test_big_frame_received_in_place() -> None:
+    bodies = [bytes(range(256)) * 40, STRING_BODY, b"", b"\x07" * 5000]
+    stream = b"".join(encode_frame(b) for b in bodies)
+    out, starts, in_place = read_in_place(stream, chunks=[100], lends=[])
+    assert [bytes(b) for b in out] == bodies
+    assert starts == expected_starts(bodies)
+    # a 100-byte chunk at each frame start (the first: prefix + 96 body bytes; the second: the
+    # String and empty frames whole, then prefix + 72 body bytes); the rest went in place
+    assert in_place == (10240 - 96) + (5000 - 72)
+    assert isinstance(out[0], bytearray) and isinstance(out[3], bytearray)
+
+
+@settings(max_examples=100, deadline=None)
+@given(bodies=st.lists(st.binary(max_size=600), max_size=8),
+       chunks=st.lists(st.integers(1, 700), max_size=6), lends=st.lists(st.integers(1, 700), max_size=6))
+def test_in_place_reads_equal_plain_feeding(bodies: list[bytes], chunks: list[int], lends: list[int]) -> None:
+    stream = b"".join(encode_frame(b) for b in bodies)
+    out, starts, _ = read_in_place(stream, chunks, lends)
+    assert [bytes(b) for b in out] == bodies
+    assert starts == expected_starts(bodies)
+
+
+def test_limit_is_checked_before_a_buffer_is_lent() -> None:
+    dec = FrameDecoder(max_frame=10)
+    dec.feed(u32(10) + b"ab")
+    assert len(dec.pending_body()) == 8
+    dec.pending_body()[:8] = b"cdefghij"
+    assert [bytes(b) for b in dec.filled(8)] == [b"abcdefghij"]
+    assert dec.pending_body() is None
+    with pytest.raises(FrameError, match="declares 11 bytes"):
+        dec.feed(u32(11))
+    assert dec.pending_body() is None  # nothing allocated for the refused frame
+
+
+@pytest.mark.parametrize("before,n,text", [
+    (b"", 1, "misses 0 bytes"),             # between frames: nothing lent
+    (b"\x05\x00", 1, "misses 0 bytes"),     # inside the length prefix
+    (u32(5) + b"ab", 4, "misses 3 bytes"),  # more than the body still misses
+    (u32(5) + b"ab", 0, "filled\\(0\\)"),
+])
+def test_filled_refuses_a_wrong_count(before: bytes, n: int, text: str) -> None:
+    from rosfpga_lab.tcpros import StateError
+
+    dec = FrameDecoder()
+    dec.feed(before)
+    with pytest.raises(StateError, match=text):
+        dec.filled(n)
+    assert dec.offset == len(before)  # nothing was counted

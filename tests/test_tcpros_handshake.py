@@ -241,3 +241,28 @@ def test_frames_before_bad_length_are_delivered_as_partial_events() -> None:
     assert kinds == [HeaderReceived, Connected, Frame]
     assert bytes(info.value.partial[-1].body) == BODY
     assert s.state == "FAILED" and [t.trigger for t in s.history][-2:] == ["frame", "frame_bad"]
+
+
+def test_subscriber_receives_a_body_in_place() -> None:
+    s = sub()
+    assert s.body_buffer() is None  # not connected yet
+    s.initiate()
+    with pytest.raises(StateError, match="AWAIT_HEADER"):
+        s.receive_into(1)
+    reply = encode_header(PublisherHandshake(callerid="/t", lookup=lookup).reply_fields(SPEC))
+    big = bytes(range(256)) * 10
+    wire = encode_frame(big)
+    events = s.receive_data(reply + wire[:100])
+    assert [type(e) for e in events] == [HeaderReceived, Connected]
+    view = s.body_buffer()
+    assert len(view) == len(big) - 96
+    view[:1000] = wire[100:1100]
+    assert s.receive_into(1000) == []
+    view = s.body_buffer()
+    view[:] = wire[1100:]
+    (frame,) = s.receive_into(len(view))
+    assert bytes(frame.body) == big and frame.index == 0 and frame.offset == len(reply)
+    assert s.body_buffer() is None  # between frames: back to receive_data
+    (second,) = s.receive_data(encode_frame(BODY))
+    assert bytes(second.body) == BODY and second.index == 1 and second.offset == len(reply) + len(wire)
+    assert [t.trigger for t in s.history] == ["connect", "header_ok", "frame", "frame"]

@@ -45,7 +45,7 @@ from rosfpga_lab.graph.names import (
 from rosfpga_lab.graph.publisher import Publisher
 from rosfpga_lab.graph.subscriber import Subscriber
 from rosfpga_lab.graph.trace import Trace, new_connection_id
-from rosfpga_lab.graph.wire import hard_close
+from rosfpga_lab.graph.wire import RECV_CHUNK, hard_close
 from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, split_uri
 from rosfpga_lab.tcpros import (
     HANDSHAKE_TIMEOUT,
@@ -361,7 +361,7 @@ class Node:
             else:
                 conn.settimeout(left)
                 try:
-                    data = conn.recv(65536)
+                    data = conn.recv(RECV_CHUNK)
                 except TimeoutError:
                     events = hs.timeout()
                 else:

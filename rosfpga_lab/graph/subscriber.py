@@ -3,7 +3,8 @@
 How it works: the master's ``registerSubscriber`` reply and later ``publisherUpdate`` calls
 give the publishers' XML-RPC URIs. For each, a link thread asks ``requestTopic`` for a TCPROS
 address, connects, runs the subscriber side of the handshake and reads frames into the
-subscriber's bounded queue (``queue_size``: the oldest frame is dropped and counted when the
+subscriber's bounded queue (a frame body is received straight into a buffer of its announced
+length, so a big image is not copied on its way in) (``queue_size``: the oldest frame is dropped and counted when the
 callback falls behind). A dispatcher thread calls the callback, so a slow callback never
 stalls the socket. When a connection drops, the link retries with exponential back-off
 (0.1 s doubling up to ``RECONNECT_MAX``) for as long as the master still lists that
@@ -157,14 +158,25 @@ class _PublisherLink:
                 if remaining <= 0:
                     hs.timeout()
                 sock.settimeout(remaining)
+            # inside a frame body the bytes land straight in the frame's buffer (no copy);
+            # otherwise a small chunk, whose whole frames come out as zero-copy views of it
+            view = hs.body_buffer()
             try:
-                data = sock.recv(RECV_CHUNK)
+                if view is not None:
+                    n = sock.recv_into(view)
+                    view.release()
+                else:
+                    data = sock.recv(RECV_CHUNK)
+                    n = len(data)
             except TimeoutError:
                 hs.timeout()
                 raise
             failure: ProtocolError | None = None
             try:
-                events = hs.receive_data(data) if data else hs.receive_eof()
+                if not n:
+                    events = hs.receive_eof()
+                else:
+                    events = hs.receive_data(data) if view is None else hs.receive_into(n)
             except ProtocolError as exc:  # deliver what came before the bad bytes, then fail
                 events, failure = exc.partial, exc
             for ev in events:
@@ -190,7 +202,7 @@ class _PublisherLink:
                     return got
             if failure is not None:
                 raise failure
-            if not data:
+            if not n:
                 return got
         return got
 

@@ -6,8 +6,11 @@ import socket
 
 from rosfpga_lab.tcpros import frame_prefix
 
-#: Bytes asked of each recv() on a TCPROS stream (a 640x480 rgba8 frame is 1.2 MB).
-RECV_CHUNK = 1 << 20
+#: Bytes asked of each recv() on a TCPROS stream between frame bodies (handshake, length
+#: prefixes, small frames). A body longer than what such a chunk holds is received straight
+#: into its own buffer (``recv_into``), so this stays small: it bounds the part of a big frame
+#: copied once, and the memory each recv() allocates.
+RECV_CHUNK = 1 << 16
 
 
 def send_frame(sock: socket.socket, body: bytes | bytearray | memoryview) -> int:

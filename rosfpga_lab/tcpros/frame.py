@@ -5,13 +5,19 @@ frame split over chunks. When a whole frame sits inside one chunk it is returned
 zero-copy ``memoryview`` of that chunk; a frame assembled from several chunks is returned as
 a ``bytearray`` (one copy into a buffer sized from the length prefix, then handed over). Either
 way the caller gets a bytes-like object; call ``bytes(body)`` for an immutable copy.
+
+For big frames a reader can skip even that copy: once a frame's length prefix has been fed,
+:meth:`FrameDecoder.pending_body` lends the still-empty rest of that frame's buffer; the reader
+receives straight into it (``sock.recv_into``) and reports the byte count with
+:meth:`FrameDecoder.filled`. The decoder keeps every framing rule (the length limit is checked
+when the prefix arrives, before the buffer exists); the reader only chooses where bytes land.
 """
 
 from __future__ import annotations
 
 import struct
 
-from rosfpga_lab.tcpros.errors import MAX_FRAME_BYTES, FrameError, IncompleteError
+from rosfpga_lab.tcpros.errors import MAX_FRAME_BYTES, FrameError, IncompleteError, StateError
 
 _U32 = struct.Struct("<I")
 
@@ -113,14 +119,47 @@ class FrameDecoder:
                 self._have = 0
             take = min(len(self._body) - self._have, end - pos)
             self._body[self._have:self._have + take] = view[pos:pos + take]
-            self._have += take
             pos += take
-            self.offset += take
-            if self._have == len(self._body):
-                out.append(self._body)  # a fresh buffer per frame: hand it over, no copy
-                self.starts.append(self._start)
-                self._body = None
-                self.frames += 1
+            self._advance(take, out)
+
+    def _advance(self, n: int, out: list) -> None:
+        """``n`` more body bytes are in ``self._body``; hand the frame over when it is full."""
+        assert self._body is not None
+        self._have += n
+        self.offset += n
+        if self._have == len(self._body):
+            out.append(self._body)  # a fresh buffer per frame: hand it over, no copy
+            self.starts.append(self._start)
+            self._body = None
+            self.frames += 1
+
+    def pending_body(self) -> memoryview | None:
+        """The unfilled rest of the frame body being assembled, to receive into; else None.
+
+        None between frames and inside a length prefix: then :meth:`feed` the next bytes.
+        Write into the view (e.g. ``n = sock.recv_into(view)``), then call :meth:`filled`.
+        """
+        if self._body is None:
+            return None
+        return memoryview(self._body)[self._have:]
+
+    def filled(self, n: int) -> list[bytearray]:
+        """Account ``n`` bytes written into the view of :meth:`pending_body`.
+
+        Returns:
+            ``[body]`` when those bytes complete the frame (the buffer itself, no copy), else [].
+
+        Raises:
+            StateError: no frame body is pending, or ``n`` is not in 1..bytes still missing.
+        """
+        missing = 0 if self._body is None else len(self._body) - self._have
+        if not 0 < n <= missing:
+            raise StateError(f"filled({n}): the pending frame body misses {missing} bytes "
+                             "(write into pending_body() first; feed() between frames)")
+        out: list[bytearray] = []
+        self.starts = []
+        self._advance(n, out)
+        return out
 
     def eof(self) -> None:
         """Tell the decoder the stream ended.

@@ -302,17 +302,40 @@ class SubscriberHandshake(_Machine):
         try:
             bodies = dec.feed(data)
         except ProtocolError as exc:
-            good = [Frame(b, start + i, at) for i, (b, at) in enumerate(zip(exc.partial, dec.starts))]
-            for _ in good:
-                self._fire("frame")
+            exc.partial = self._frame_events(exc.partial, start)
             self._fire("frame_bad")
-            exc.partial = good
             raise
+        return self._frame_events(bodies, start)
+
+    def _frame_events(self, bodies: list, start: int) -> list[Event]:
+        assert self._frames is not None
         out: list[Event] = []
-        for i, (body, at) in enumerate(zip(bodies, dec.starts)):
+        for i, (body, at) in enumerate(zip(bodies, self._frames.starts)):
             self._fire("frame")
             out.append(Frame(body, start + i, at))
         return out
+
+    def body_buffer(self) -> memoryview | None:
+        """While streaming inside a frame body: the writable rest of that body, else None.
+
+        A reader receives big frames straight into it (``n = sock.recv_into(view)``, then
+        :meth:`receive_into`) instead of copying from a chunk; when this is None it feeds
+        :meth:`receive_data`. See :meth:`FrameDecoder.pending_body`.
+        """
+        if self.state != "STREAMING" or self._frames is None:
+            return None
+        return self._frames.pending_body()
+
+    def receive_into(self, n: int) -> list[Event]:
+        """``n`` (> 0) bytes were written into the view of :meth:`body_buffer`: the events.
+
+        Raises:
+            StateError: not streaming, no body pending, or ``n`` larger than what it misses.
+        """
+        if self.state != "STREAMING" or self._frames is None:
+            raise StateError(f"subscriber handshake: receive_into in state {self.state}")
+        start = self._frames.frames
+        return self._frame_events(self._frames.filled(n), start)
 
     def receive_eof(self) -> list[Event]:
         """The publisher closed the connection.

@@ -7,6 +7,8 @@ publish-to-callback, measured with the wall-clock stamp in header.stamp) for:
 * with real ROS 1 installed: rospy -> rospy, roscpp -> roscpp, lab -> roscpp, roscpp -> lab.
 
 Every pair registers with one lab EmbeddedMaster (the master is not on the data path).
+"sub CPU" is the CPU time the lab's subscribing process spent per frame during the burst (all
+its threads; in the one-process rows the publisher's work is included), "-" for real ROS.
 The lab's subscribers use the raw path (``raw=True``: the callback gets the body bytes and
 reads only the header stamp), except the "typed" row, which deserializes every frame into a
 dict as rospy and roscpp deserialize into message objects.
@@ -56,6 +58,7 @@ class LabSink:
         self.nlat, self.nthr = nlat, nthr
         self.lat_ms: list[float] = []
         self.arrivals: list[float] = []
+        self.cpu: list[float] = []  # process CPU seconds at the first and the last burst frame
         self.done = threading.Event()
 
     def typed(self, msg: dict) -> None:
@@ -73,12 +76,17 @@ class LabSink:
             self.lat_ms.append((now - stamp) * 1000.0)
         else:
             self.arrivals.append(now)
+            if len(self.arrivals) in (1, self.nthr):
+                self.cpu.append(time.process_time())
         if len(self.lat_ms) >= self.nlat and len(self.arrivals) >= self.nthr:
             self.done.set()
 
     def result(self) -> dict:
         span = self.arrivals[-1] - self.arrivals[0] if len(self.arrivals) > 1 else float("nan")
-        return {"lat_ms": self.lat_ms, "thr_frames": len(self.arrivals), "thr_seconds": span}
+        cpu_ms = ((self.cpu[-1] - self.cpu[0]) * 1000.0 / (len(self.arrivals) - 1)
+                  if len(self.cpu) == 2 else None)
+        return {"lat_ms": self.lat_ms, "thr_frames": len(self.arrivals), "thr_seconds": span,
+                "cpu_ms": cpu_ms}
 
 
 def lab_publish(pub, nlat: int, nthr: int) -> None:
@@ -178,8 +186,9 @@ def row(name: str, r: dict) -> str:
     fps = (r["thr_frames"] - 1) / r["thr_seconds"] if r["thr_seconds"] and r["thr_seconds"] > 0 else float("nan")
     lat = sorted(r["lat_ms"]) or [float("nan")]
     p95 = lat[min(len(lat) - 1, int(round(0.95 * (len(lat) - 1))))]
+    cpu = f"{r['cpu_ms']:9.2f}" if r.get("cpu_ms") is not None else f"{'-':>9}"
     return (f"{name:<34} {fps:9.1f} {fps * FRAME_BYTES / 1e6:9.1f} {statistics.median(lat):9.2f} "
-            f"{p95:9.2f} {len(r['lat_ms']):>4}/{r['thr_frames']:<4}")
+            f"{p95:9.2f} {cpu} {len(r['lat_ms']):>4}/{r['thr_frames']:<4}")
 
 
 def main() -> int:
@@ -203,8 +212,9 @@ def main() -> int:
     with EmbeddedMaster(port=0) as master:
         print(f"640x480 rgba8 sensor_msgs/Image ({FRAME_BYTES:,} data bytes), loopback, "
               f"{args.frames} frames back to back, {args.lat_frames} paced at 10 Hz\n")
-        print(f"{'publisher -> subscriber':<34} {'frames/s':>9} {'MB/s':>9} {'lat p50':>9} {'lat p95':>9} lat/thr")
-        print(f"{'':<34} {'':>9} {'':>9} {'ms':>9} {'ms':>9} frames")
+        print(f"{'publisher -> subscriber':<34} {'frames/s':>9} {'MB/s':>9} {'lat p50':>9} "
+              f"{'lat p95':>9} {'sub CPU':>9} lat/thr")
+        print(f"{'':<34} {'':>9} {'':>9} {'ms':>9} {'ms':>9} {'ms/frame':>9} frames")
         print(row("lab -> lab (one process)", run_in_process(master.uri, args.lat_frames, args.frames)), flush=True)
         print(row("lab -> lab typed (one process)",
                   run_in_process(master.uri, args.lat_frames, args.frames, typed=True)), flush=True)
