@@ -155,6 +155,8 @@ def test_refuses_foreign_directory_even_with_nothing_generated(tmp_path: Path) -
     (tmp_path / "file").write_text("x")
     with pytest.raises(GenerateError, match="not a directory"):
         generate(load_config(DATA / "fpga_erode_mono8.yaml"), tmp_path / "file")
+    with pytest.raises(GenerateError, match="cannot write into .*Not a directory"):
+        generate(load_config(DATA / "fpga_erode_mono8.yaml"), tmp_path / "file" / "below")
 
 
 def test_damaged_manifest_is_refused(tmp_path: Path) -> None:
@@ -179,6 +181,13 @@ def test_cli_generate_and_sloc(tmp_path: Path) -> None:
     assert again.returncode == 1 and "--force" in again.stderr
     forced = subprocess.run(cmd + ["--force", "-q"], capture_output=True, text=True)
     assert forced.returncode == 0 and forced.stdout == "" and forced.stderr == ""
+    loud = subprocess.run(cmd + ["--force"], capture_output=True, text=True)
+    assert loud.returncode == 0
+    assert loud.stderr.index("removed 17 files") < loud.stderr.index("writing 16 files")
+    unwritable = subprocess.run(cmd[:-1] + [str(out / "Makefile" / "below")], capture_output=True,
+                                text=True)
+    assert unwritable.returncode == 1 and "Traceback" not in unwritable.stderr
+    assert "error: cannot write into" in unwritable.stderr
 
     table = subprocess.run([sys.executable, "-m", "rosfpga_lab", "sloc", str(out)],
                            capture_output=True, text=True)

@@ -40,8 +40,6 @@ def run(args: argparse.Namespace) -> int:
 
     config = load_config(args.config)
     result = generate(config, args.output, force=args.force, progress=say)
-    if result.removed:
-        say(f"removed {len(result.removed)} files of the earlier generation")
     if result.kept:
         say(f"left alone {len(result.kept)} files not written by the generator: "
             + ", ".join(result.kept[:5]) + (" ..." if len(result.kept) > 5 else ""))

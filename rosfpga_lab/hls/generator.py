@@ -320,7 +320,8 @@ def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
         What was written, removed and kept.
 
     Raises:
-        GenerateError: ``out_dir`` holds files and ``force`` is False, or is not a directory.
+        GenerateError: ``out_dir`` holds files and ``force`` is False, is not a directory, or
+            cannot be written.
     """
     say = progress or (lambda _msg: None)
     out = Path(out_dir)
@@ -342,25 +343,30 @@ def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
         f"({config.image.width}x{config.image.height} {config.image.encoding})")
     tb_input, tb_expected = sample_frames(config)
 
-    removed = _clean(out, manifest) if manifest is not None else []
-    out.mkdir(parents=True, exist_ok=True)
-
     blobs: dict[str, bytes] = {name: text.encode("utf-8") for name, text in texts.items()}
     for header in HLS_HEADERS:
         blobs[f"hls_include/{header}"] = (INCLUDE_DIR / header).read_bytes()
     blobs[TB_INPUT] = tb_input
     if tb_expected:
         blobs[TB_EXPECTED] = tb_expected
-    manifest = {"generator": f"rosfpga-lab {__version__}",
-                "config": config.path.name if config.path else "<string>",
-                "files": {name: _sha256(data) for name, data in sorted(blobs.items())}}
-    # The manifest goes first, so even an interrupted run can be cleaned with --force.
-    (out / MANIFEST).write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n",
-                                encoding="utf-8")
-    say(f"writing {len(blobs)} files into {out}")
-    for name, data in sorted(blobs.items()):
-        path = out / name
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(data)
+    new_manifest = {"generator": f"rosfpga-lab {__version__}",
+                    "config": config.path.name if config.path else "<string>",
+                    "files": {name: _sha256(data) for name, data in sorted(blobs.items())}}
+    try:
+        removed = _clean(out, manifest) if manifest is not None else []
+        if removed:
+            say(f"removed {len(removed)} files of the earlier generation")
+        out.mkdir(parents=True, exist_ok=True)
+        # The manifest goes first, so even an interrupted run can be cleaned with --force.
+        (out / MANIFEST).write_text(json.dumps(new_manifest, indent=1, sort_keys=True) + "\n",
+                                    encoding="utf-8")
+        say(f"writing {len(blobs)} files into {out}")
+        for name, data in sorted(blobs.items()):
+            path = out / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+    except OSError as exc:
+        where = exc.filename or out
+        raise GenerateError(f"cannot write into {out}: {exc.strerror or exc} ({where})") from None
     kept = [p for p in _existing(out) if p not in blobs and p != MANIFEST]
     return GenerationResult(out, tuple(sorted(blobs)), tuple(removed), tuple(kept))
