@@ -1,4 +1,4 @@
-"""``rosfpga-lab notebooks build``: the student notebooks from the instructor notebooks."""
+"""``rosfpga-lab notebooks build|html``: student notebooks from the solutions; offline HTML pages."""
 
 from __future__ import annotations
 
@@ -15,7 +15,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "course. 'build' writes notebooks/NN_*.ipynb from them, replacing each "
         "'# BEGIN SOLUTION' ... '# END SOLUTION' block by '# YOUR CODE HERE' and dropping cells "
         "tagged 'solution'; outputs are stripped from both. 'build --check' writes nothing and "
-        "fails when a student notebook is out of date.",
+        "fails when a student notebook is out of date. 'html' runs notebooks and writes pages "
+        "that show every widget without JavaScript (for offline reading or a course website).",
     )
     sub = parser.add_subparsers(dest="action", metavar="ACTION")
     build = sub.add_parser("build", help="write (or with --check: verify) the student notebooks",
@@ -28,6 +29,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                        help="write nothing; exit 1 if any student notebook differs from what "
                        "the build would write")
     build.set_defaults(func=run)
+    html = sub.add_parser(
+        "html", help="run notebooks and write self-contained HTML pages (widgets in static form)",
+        description="Run each notebook top to bottom in a fresh kernel (in its own directory) and "
+        "write DIR/<name>.html. Unlike 'jupyter nbconvert --execute --to html', whose widgets "
+        "need JavaScript from the internet, every widget shows its static form: byte tables, "
+        "images, beat tables, the sequence diagram. Example: rosfpga-lab notebooks html "
+        "notebooks/solutions/*.ipynb --output-dir site")
+    html.add_argument("notebooks", type=Path, nargs="+", metavar="NOTEBOOK", help="the .ipynb files")
+    html.add_argument("--output-dir", type=Path, default=Path("html"), metavar="DIR",
+                      help="where the pages go (default: html)")
+    html.add_argument("--no-execute", action="store_true",
+                      help="export the outputs stored in the files instead of running them")
+    html.add_argument("--allow-errors", action="store_true",
+                      help="keep going past failing cells (student notebooks stop at each exercise)")
+    html.set_defaults(func=run_html)
     parser.set_defaults(func=lambda _args: (parser.print_help(), 2)[1])
 
 
@@ -48,4 +64,16 @@ def run(args: argparse.Namespace) -> int:
         print(f"{len(stale) + len(lost)} student notebook(s) do not match their solutions source; "
               "run 'rosfpga-lab notebooks build'")
         return 1
+    return 0
+
+
+def run_html(args: argparse.Namespace) -> int:
+    """Export each notebook; print one line per page."""
+    from rosfpga_lab.widgets.export import export_html
+
+    for notebook in args.notebooks:
+        done = export_html(notebook, args.output_dir, execute=not args.no_execute,
+                           allow_errors=args.allow_errors)
+        errors = f", {done.errors} cell(s) with errors" if done.errors else ""
+        print(f"{done.html}: from {notebook} in {done.seconds:.1f} s{errors}", flush=True)
     return 0
