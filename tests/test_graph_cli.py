@@ -100,9 +100,34 @@ def test_topic_pub_reaches_a_lab_subscriber() -> None:
             node.shutdown()
 
 
+@pytest.mark.parametrize("action", [["list"], ["info", "/x"], ["echo", "/x"],
+                                    ["pub", "-1", "/x", "std_msgs/String", "hi"],
+                                    ["hz", "--duration", "1", "/x"]], ids=lambda a: a[0])
+def test_topic_without_a_master_stops_with_a_hint(action: list[str]) -> None:
+    dead = f"http://127.0.0.1:{free_port()}/"
+    out = cli("topic", "--master-uri", dead, *action)
+    assert out.returncode == 1 and out.stdout == ""
+    assert out.stderr.startswith(f"rosfpga-lab topic: error: cannot reach the ROS master at {dead}")
+    assert "Start one with `rosfpga-lab master`" in out.stderr and "Traceback" not in out.stderr
+
+
+def test_topic_default_master_is_roscores(monkeypatch) -> None:
+    from rosfpga_lab.graph.tools import pick_master_uri
+
+    monkeypatch.delenv("ROS_MASTER_URI", raising=False)
+    assert pick_master_uri(None) == "http://127.0.0.1:11311/"  # never a private embedded master
+    monkeypatch.setenv("ROS_MASTER_URI", "http://127.0.0.1:5/")
+    assert pick_master_uri(None) == "http://127.0.0.1:5/"
+    assert pick_master_uri("http://10.0.0.1:7/") == "http://10.0.0.1:7/"
+
+
+def test_topic_names_resolve_like_rostopic(graph) -> None:
+    m = graph[0]
+    info = cli("topic", "--master-uri", m.uri, "info", "chatter")
+    assert info.returncode == 0 and info.stdout.startswith("Type: std_msgs/String\n"), info.stderr
+
+
 def test_topic_errors_are_clear() -> None:
-    out = cli("topic", "--master-uri", f"http://127.0.0.1:{free_port()}/", "list")
-    assert out.returncode == 1 and "cannot reach the ROS master" in out.stderr
     with EmbeddedMaster(port=0) as m:
         out = cli("topic", "--master-uri", m.uri, "info", "/nope")
         assert out.returncode == 1 and "topic /nope is unknown" in out.stderr

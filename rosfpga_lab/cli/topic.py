@@ -13,7 +13,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "topic", help="inspect and use ROS topics (like rostopic)",
         description="Inspect and use topics of a running ROS graph (the lab's or real ROS). "
-        "The master is --master-uri, else ROS_MASTER_URI, else http://127.0.0.1:11311/.")
+        "The master is --master-uri, else ROS_MASTER_URI, else http://127.0.0.1:11311/; when "
+        "none answers there the command stops with an error (it never starts a master of its "
+        "own: start one with `rosfpga-lab master` or roscore).")
     p.add_argument("--master-uri", help="master to talk to (default: ROS_MASTER_URI or "
                    "http://127.0.0.1:11311/)")
     sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
@@ -56,9 +58,12 @@ def _node(uri: str, kind: str):
 
 def run(args: argparse.Namespace) -> int:
     """Dispatch the action."""
-    from rosfpga_lab.graph import tools
+    from rosfpga_lab.graph import resolve, tools
 
     uri = tools.pick_master_uri(args.master_uri)
+    tools.check_master(uri)  # never end up alone: a clear error when no master answers
+    if getattr(args, "topic", None):
+        args.topic = resolve(args.topic)  # "chatter" means /chatter, as for rostopic
     if args.action == "list":
         print(tools.format_topic_list(uri, args.verbose))
         return 0

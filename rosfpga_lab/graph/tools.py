@@ -44,6 +44,15 @@ def master_call(uri: str, method: str, *args: Any) -> Any:
     return value
 
 
+def check_master(uri: str) -> None:
+    """Make sure a master answers at ``uri`` before a tool starts a node against it.
+
+    Raises:
+        GraphError: nobody answers (the text says how to start a master).
+    """
+    master_call(uri, "getUri")
+
+
 def topic_types(uri: str) -> dict[str, str]:
     """topic -> type as the master knows them."""
     return {t: ty for t, ty in master_call(uri, "getTopicTypes")}
