@@ -258,6 +258,13 @@ def test_node_command_embedded_master_and_duration(capsys) -> None:
     assert "frames: received 0" in out.out
 
 
+def test_node_command_follows_ros_master_uri_like_every_ros_node(monkeypatch, capsys) -> None:
+    with EmbeddedMaster(port=0) as master:
+        monkeypatch.setenv("ROS_MASTER_URI", master.uri)   # the config says :11311
+        assert main(["node", str(CONFIG), "--duration", "0.3", "-q"]) == 0
+    assert f"master {master.uri}" in capsys.readouterr().out
+
+
 def test_node_command_bad_config(tmp_path, capsys) -> None:
     bad = tmp_path / "bad.yaml"
     bad.write_text("node: {name: /x}\n")

@@ -93,3 +93,23 @@ def test_demo_rig_runs_in_the_background_for_a_live_view() -> None:
     assert seen[:3] == [(True, (240, 320, 1))] * 3
     time.sleep(0.1)
     assert [t.name for t in threading.enumerate() if t.ident not in before and t.is_alive()] == []
+
+
+def test_demo_interrupted_says_so_and_exits_130(tmp_path) -> None:
+    import signal
+
+    proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "demo", "--frames", "1000",
+                             "--source", "synthetic", "--no-figure", "-v"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        for line in proc.stdout:                     # wait until the camera runs
+            if line.startswith("camera:"):
+                break
+        proc.send_signal(signal.SIGINT)
+        _out, err = proc.communicate(timeout=20)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 130
+    assert "rosfpga-lab demo: interrupted" in err and "Traceback" not in err

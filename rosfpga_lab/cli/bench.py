@@ -57,8 +57,14 @@ def run(args: argparse.Namespace) -> int:
         print(f"rosfpga-lab bench: error: --windows wants two positive integers like 1,2, got "
               f"{args.windows!r}", file=sys.stderr)
         return 2
-    report = run_bench(args.config, middles=middles, frames=args.frames, windows=windows,
-                       rounds=args.rounds, rate=args.rate, rate_frames=args.rate_frames, skip_pipeline=args.no_pipeline,
-                       progress=None if args.quiet else (lambda t: print(t, file=sys.stderr, flush=True)))
+    try:
+        report = run_bench(args.config, middles=middles, frames=args.frames, windows=windows,
+                           rounds=args.rounds, rate=args.rate, rate_frames=args.rate_frames,
+                           skip_pipeline=args.no_pipeline,
+                           progress=None if args.quiet else (lambda t: print(t, file=sys.stderr, flush=True)))
+    except KeyboardInterrupt:
+        print("rosfpga-lab bench: interrupted (the middles it started are stopped); no table",
+              file=sys.stderr)
+        return 130
     print(report.table(), flush=True)
     return 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from rosfpga_lab.cli._args import positive_float, positive_int
@@ -43,9 +44,14 @@ def run(args: argparse.Namespace) -> int:
     """Run the demo; 0 when every frame came back bit-exact."""
     from rosfpga_lab.component import run_demo
 
-    result = run_demo(args.config, frames=args.frames, rate=args.rate, source=args.source,
-                      png=None if args.no_figure else args.output, model=args.model,
-                      timeout=args.timeout, png_scale=args.scale,
-                      progress=print if args.verbose else None)
+    try:
+        result = run_demo(args.config, frames=args.frames, rate=args.rate, source=args.source,
+                          png=None if args.no_figure else args.output, model=args.model,
+                          timeout=args.timeout, png_scale=args.scale,
+                          progress=print if args.verbose else None)
+    except KeyboardInterrupt:
+        print("rosfpga-lab demo: interrupted (everything it started is stopped); no verdict",
+              file=sys.stderr)
+        return 130
     print("\n".join(result.lines()), flush=True)
     return 0 if result.ok else 1

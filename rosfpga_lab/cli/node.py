@@ -24,7 +24,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "cleanly and prints a summary. Example: rosfpga-lab node data/fpga_dilate_rgba8.yaml")
     p.add_argument("config", type=Path, metavar="CONFIG", help="the node configuration file (YAML)")
     p.add_argument("--master-uri", metavar="URI",
-                   help="ROS master to use instead of the configuration's node.master_uri")
+                   help="ROS master (default: ROS_MASTER_URI, else the configuration's "
+                   "node.master_uri)")
     p.add_argument("--embedded-master", action="store_true",
                    help="start the lab's embedded master at that URI when none answers there")
     p.add_argument("--model", choices=("fast", "reference"), default="fast",
@@ -48,7 +49,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Start the component, show the status until interrupted, stop cleanly."""
     from rosfpga_lab.component import FpgaComponent, limits, master_answers
-    from rosfpga_lab.graph import EmbeddedMaster
+    from rosfpga_lab.graph import EmbeddedMaster, master_uri_from_env
     from rosfpga_lab.graph.xmlrpc import split_uri
 
     if not args.quiet:
@@ -59,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
         kw["input_queue"] = args.input_queue
     if args.output_queue is not None:
         kw["output_queue"] = args.output_queue
-    component = FpgaComponent.from_config(args.config, master_uri=args.master_uri,
+    component = FpgaComponent.from_config(args.config, master_uri=args.master_uri or master_uri_from_env(),
                                           model=args.model, **kw)
     master = None
     if not master_answers(component.master_uri):
