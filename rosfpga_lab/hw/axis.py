@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rosfpga_lab.hw.encodings import PixelFormat
+from rosfpga_lab.hw.encodings import PixelFormat, pack_lanes, unpack_lanes
 from rosfpga_lab.hw.errors import StreamStarvedError
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo, frame_flags
 
@@ -85,14 +85,8 @@ def fifo2axi_fast(data: np.ndarray, rows: int, cols: int, fmt: PixelFormat) -> t
 
 
 def _pack(data: np.ndarray, rows: int, cols: int, fmt: PixelFormat) -> Beats:
-    n = rows * cols
-    bpp = fmt.bytes_per_pixel
-    if bpp == 4:
-        tdata = data.view(np.uint32)  # no copy: the beats alias the frame's pixel bytes
-    else:
-        lanes = np.zeros((n, 4), np.uint8)
-        lanes[:, :bpp] = data.reshape(n, bpp)
-        tdata = lanes.view("<u4").reshape(n)
+    # rgba8/bgra8: no copy, the beats alias the frame's pixel bytes
+    tdata = pack_lanes(data.reshape(rows * cols, fmt.bytes_per_pixel))
     tuser, tlast = frame_flags(rows, cols)
     return Beats(tdata, fmt.tkeep, tuser, tlast)
 
@@ -127,13 +121,11 @@ def axi2fifo_fast(beats: Beats, count: int) -> tuple[np.ndarray, int]:
         StreamStarvedError: as the reference model.
     """
     use = min(count, len(beats))
-    lanes = beats.tdata[:use].view(np.uint8).reshape(use, 4)
     keep = beats.tkeep[:use]
-    if use and keep[0] == 0b1111 and np.all(keep == 0b1111):
-        data = lanes.reshape(-1)
-    elif use and np.all(keep == keep[0]) and keep[0] in (0b0001, 0b0011, 0b0111):
-        data = lanes[:, : int(keep[0]).bit_length()].reshape(-1)
+    if use and int(keep[0]) in (0b0001, 0b0011, 0b0111, 0b1111) and beats.uniform_tkeep(use):
+        data = unpack_lanes(beats.tdata[:use], int(keep[0]).bit_length()).reshape(-1)
     else:
+        lanes = beats.tdata[:use].view(np.uint8).reshape(use, 4)
         mask = ((keep[:, None] >> LANE) & 1).astype(bool)
         data = lanes[mask]
     if len(beats) < count:

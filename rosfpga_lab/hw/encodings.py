@@ -24,6 +24,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from rosfpga_lab.hw.errors import PipelineConfigError
 
 
@@ -65,3 +67,44 @@ def pixel_format(encoding: str) -> PixelFormat:
         raise PipelineConfigError(
             f"unsupported encoding {encoding!r}; the circuit packs {', '.join(PIXEL_FORMATS)}"
         ) from None
+
+
+def pack_lanes(pixels: np.ndarray) -> np.ndarray:
+    """``tdata`` of one beat per pixel: byte ``i`` of each pixel in bits ``8i+7..8i``, rest zero.
+
+    The fast models' packing rule, shared by ``fifo2axi`` and ``Mat2AXIvideo``. Lanes are
+    copied one column at a time (a copy with an inner dimension of 3 is ~7x slower in numpy).
+
+    Args:
+        pixels: ``(n, bytes_per_pixel)`` uint8, 1 to 4 bytes per pixel.
+
+    Returns:
+        ``(n,)`` uint32; a view of ``pixels`` when it holds 4 contiguous bytes per pixel.
+    """
+    n, bpp = pixels.shape
+    if bpp == 4:
+        return np.ascontiguousarray(pixels).view(np.uint32).reshape(n)
+    if bpp == 1:
+        return pixels.reshape(n).astype(np.uint32)
+    lanes = np.zeros((n, 4), np.uint8)
+    for lane in range(bpp):
+        lanes[:, lane] = pixels[:, lane]
+    return lanes.view("<u4").reshape(n)
+
+
+def unpack_lanes(tdata: np.ndarray, bpp: int) -> np.ndarray:
+    """The low ``bpp`` byte lanes of every beat, the inverse of :func:`pack_lanes`.
+
+    Returns:
+        ``(n, bpp)`` uint8, C-contiguous; a view of ``tdata`` when ``bpp`` is 4.
+    """
+    n = tdata.shape[0]
+    if bpp == 4:
+        return tdata.view(np.uint8).reshape(n, 4)
+    if bpp == 1:
+        return tdata.astype(np.uint8).reshape(n, 1)  # keeps bits 7..0
+    lanes = tdata.view(np.uint8).reshape(n, 4)
+    out = np.empty((n, bpp), np.uint8)
+    for lane in range(bpp):
+        out[:, lane] = lanes[:, lane]
+    return out

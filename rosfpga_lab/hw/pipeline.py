@@ -330,8 +330,10 @@ class Pipeline:
         else:
             pixels_out = np.frombuffer(output, np.uint8, out_fields.data_length,
                                        len(output) - out_fields.data_length)
-            image_out = pixels_out.reshape(image_out.shape)
-            beats_out = mat2axivideo_fast(image_out, fmt)
+            scratch = image_out
+            image_out = pixels_out.reshape(scratch.shape)
+            if np.may_share_memory(beats_out.tdata, scratch):  # 4-byte pixels: a view of it
+                beats_out = mat2axivideo_fast(image_out, fmt)
         return self._finish(frame, fields, out_fields, output, (image_in, image_out),
                             (beats_in, beats_out), high_water, status,
                             (pixels_in_bytes, pixels_out))

@@ -162,7 +162,9 @@ class Beat:
 def _signal(value: Any, dtype: Any, n: int, name: str) -> np.ndarray:
     if np.ndim(value) == 0:
         return _constant(int(value), np.dtype(dtype).str, n)
-    array = np.asarray(value, dtype=dtype).reshape(-1)
+    array = np.asarray(value, dtype=dtype)
+    if array.ndim != 1:
+        array = array.reshape(-1)  # (a 1-D array is kept as it is: cached flags stay recognisable)
     if array.shape[0] != n:
         raise PipelineConfigError(f"Beats: {name} has {array.shape[0]} entries, tdata has {n}")
     return array
@@ -173,11 +175,9 @@ def frame_flags(rows: int, cols: int) -> tuple[np.ndarray, np.ndarray]:
     return _frame_flags(rows, cols)
 
 
-@functools.lru_cache(maxsize=32)
 def _constant(value: int, dtype: str, n: int) -> np.ndarray:
-    array = np.full(n, value, np.dtype(dtype))
-    array.setflags(write=False)
-    return array
+    # One stored element seen n times (stride 0, read-only): no memory, and recognisable.
+    return np.broadcast_to(np.array(value, np.dtype(dtype)), (n,))
 
 
 @functools.lru_cache(maxsize=16)
@@ -226,6 +226,16 @@ class Beats:
         """One :class:`Beat` per transfer (slow for big frames: notebooks and tests)."""
         return [Beat(int(d), int(k), bool(u), bool(la)) for d, k, u, la in
                 zip(self.tdata.tolist(), self.tkeep.tolist(), self.tuser.tolist(), self.tlast.tolist())]
+
+    def uniform_tkeep(self, count: int | None = None) -> bool:
+        """True when the first ``count`` beats (all by default) share one ``tkeep``.
+
+        Free for beats built with a scalar ``tkeep`` (a read-only constant); a scan otherwise.
+        """
+        keep = self.tkeep if count is None else self.tkeep[:count]
+        if keep.size == 0 or keep.strides == (0,):
+            return True
+        return bool(np.all(keep == keep[0]))
 
     def copy(self) -> Beats:
         """A deep copy (its arrays are writable and shared with nothing)."""

@@ -24,7 +24,7 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from rosfpga_lab.hw.encodings import PixelFormat
+from rosfpga_lab.hw.encodings import PixelFormat, pack_lanes, unpack_lanes
 from rosfpga_lab.hw.errors import StreamStarvedError
 from rosfpga_lab.hw.streams import Beat, Beats, Fifo, frame_flags
 
@@ -123,9 +123,7 @@ def axivideo2mat_fast(beats: Beats, rows: int, cols: int, fmt: PixelFormat
     """
     n = rows * cols
     if len(beats) >= n and _well_formed(beats, rows, cols):
-        image = beats.tdata[:n].view(np.uint8).reshape(rows, cols, 4)
-        if fmt.bytes_per_pixel != 4:
-            image = np.ascontiguousarray(image[:, :, : fmt.bytes_per_pixel])
+        image = unpack_lanes(beats.tdata[:n], fmt.bytes_per_pixel).reshape(rows, cols, -1)
         return image, 0, len(beats) - n
     stream = beats_to_fifo(beats.to_list(), "axis_in")
     img = Mat(rows, cols, fmt.bytes_per_pixel)
@@ -135,6 +133,9 @@ def axivideo2mat_fast(beats: Beats, rows: int, cols: int, fmt: PixelFormat
 
 def _well_formed(beats: Beats, rows: int, cols: int) -> bool:
     n = rows * cols
+    tuser, tlast = frame_flags(rows, cols)
+    if len(beats) == n and beats.tuser is tuser and beats.tlast is tlast:
+        return True  # the (read-only) flags fifo2axi gives a well-formed frame
     if not beats.tuser[0] or beats.tuser[1:n].any():
         return False
     tlast = beats.tlast[:n].reshape(rows, cols)
@@ -159,14 +160,7 @@ def mat2axivideo_reference(img: Mat, out: Fifo[Beat], fmt: PixelFormat) -> None:
 def mat2axivideo_fast(image: np.ndarray, fmt: PixelFormat) -> Beats:
     """Fast ``Mat2AXIvideo`` of a ``(rows, cols, channels)`` uint8 image."""
     rows, cols = image.shape[:2]
-    n = rows * cols
-    channels = image.reshape(n, -1)
-    if channels.shape[1] == 4:
-        tdata = np.ascontiguousarray(channels).view(np.uint32).reshape(n)
-    else:
-        lanes = np.zeros((n, 4), np.uint8)
-        lanes[:, : channels.shape[1]] = channels
-        tdata = lanes.view("<u4").reshape(n)
+    tdata = pack_lanes(image.reshape(rows * cols, -1))
     tuser, tlast = frame_flags(rows, cols)
     return Beats(tdata, fmt.tkeep, tuser, tlast)
 
