@@ -11,6 +11,7 @@ skip (with ROSFPGA_REQUIRE_CXX=1, as in CI, they fail).
 
 from __future__ import annotations
 
+import os
 import struct
 import subprocess
 from pathlib import Path
@@ -48,10 +49,14 @@ sys.stdout.buffer.write(struct.pack('<I', len(buf.getvalue())) + buf.getvalue())
 
 def ros_frame(image: np.ndarray, encoding: str, *, seq: int = 3, stamp: tuple[int, int] = (1700000000, 5),
               frame_id: str = "camera_link", step: int | None = None, is_bigendian: int = 0) -> bytes:
-    """A TCPROS frame (length + Image) serialized by genpy; by the lab where ROS is missing."""
+    """A TCPROS frame (length + Image) serialized by genpy; by the lab where ROS is missing
+    (unless ROSFPGA_REQUIRE_ROS=1, as in CI: then a missing ROS fails the test)."""
     h, w = image.shape[:2]
     step = image.shape[1] * (image.shape[2] if image.ndim == 3 else 1) if step is None else step
-    if ros_missing_reason() is not None:
+    reason = ros_missing_reason()
+    if reason is not None:
+        if os.environ.get("ROSFPGA_REQUIRE_ROS", "") not in ("", "0", "false", "no"):
+            pytest.fail(f"{reason} (and ROSFPGA_REQUIRE_ROS=1 says it must be there)", pytrace=False)
         return image_frame(image, encoding, seq=seq, stamp=stamp, frame_id=frame_id,
                            is_bigendian=is_bigendian)
     code = GENPY_FRAME.format(seq=seq, secs=stamp[0], nsecs=stamp[1], frame_id=frame_id, h=h, w=w,
