@@ -107,6 +107,7 @@ def test_static_html_is_self_contained() -> None:
     html = FrameDiff(out, ref, ref).to_html()
     assert html.count("data:image/png;base64,") == 4 and "<script" not in html
     assert "1 of 48 pixels differ" in html and "(2, 1)" in html
+    assert "<figcaption>difference (grey: equal, red: differs)</figcaption>" in html
 
 
 def test_viewer_single_frame_and_sequence() -> None:
@@ -122,6 +123,7 @@ def test_viewer_single_frame_and_sequence() -> None:
     assert v.next_mismatch() == (1, 6) and (v.x.value, v.y.value) == (1, 6)
     assert set(v.images) == {"input", "output", "reference", "difference"}
     assert v.images["difference"].png.startswith(b"\x89PNG")
+    assert v.images["difference"].caption == "difference (grey: equal, red: differs)"
     v.images["output"].click(6, 7)  # a click on any image zooms there
     assert (v.x.value, v.y.value) == (6, 7) and "output x 0..7, y 0..7" in v.zoom.value
     marked = ",".join(str(c) for c in bad[7, 6])

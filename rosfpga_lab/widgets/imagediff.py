@@ -48,6 +48,15 @@ def _pool_any(mask: np.ndarray, step: int) -> np.ndarray:
     return padded.reshape(ph // step, step, pw // step, step).any(axis=(1, 3))
 
 
+#: What each picture's caption says (the difference view needs its key).
+CAPTIONS = {"difference": "difference (grey: equal, red: differs)"}
+
+
+def caption(name: str) -> str:
+    """The caption under the picture called ``name``."""
+    return CAPTIONS.get(name, name)
+
+
 class FrameDiff:
     """One frame's comparison of model output against reference.
 
@@ -190,7 +199,7 @@ class FrameDiff:
         for name, rgb in self.views(max_width).items():
             scale = display_scale(rgb.shape[1], max_width)
             imgs.append(f'<figure style="margin:4px"><img src="{png_data_uri(rgb, scale)}" '
-                        f'style="image-rendering:pixelated" alt="{name}"/><figcaption>{name}</figcaption></figure>')
+                        f'style="image-rendering:pixelated" alt="{name}"/><figcaption>{caption(name)}</figcaption></figure>')
         parts = ['<div style="display:flex;flex-wrap:wrap">' + "".join(imgs) + "</div>",
                  f"<div><b>{esc(self.summary())}</b></div>"]
         if not self.equal:
@@ -300,7 +309,7 @@ class ImageDiffViewer(StaticFallback, w.VBox):
             scale = display_scale(rgb.shape[1], self.max_width)
             img = self.images.get(name)
             if img is None:
-                img = self.images[name] = ClickImage(caption=name)
+                img = self.images[name] = ClickImage(caption=caption(name))
                 img.on_click(lambda x, y, _n=name: self._clicked(_n, x, y))
             src = f.input if name == "input" and f.input is not None else f.output
             img.src_height, img.src_width = int(src.shape[0]), int(src.shape[1])
