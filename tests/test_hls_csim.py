@@ -142,6 +142,13 @@ def test_make_csim_passes_on_the_shipped_test_frame(projects: dict[str, Project]
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "csim: PASS: output equals tb_expected.bin" in proc.stdout
     assert "WARNING" not in proc.stderr
+    # Other frames: simulated, not compared with the shipped frame's expected output.
+    two = proj.path / "two_frames.bin"
+    two.write_bytes((proj.path / "tb_input.bin").read_bytes() * 2)
+    other = subprocess.run(["make", "-s", "csim", f"INPUT={two}", "OUT=csim_two"], cwd=proj.path,
+                           capture_output=True, text=True, timeout=300)
+    assert other.returncode == 0, other.stdout + other.stderr
+    assert "2 frame(s) in, 0 refused" in other.stdout and "PASS" not in other.stdout
 
 
 def _header_fields(data: bytes) -> dict[str, str]:
