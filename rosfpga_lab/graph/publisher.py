@@ -161,7 +161,6 @@ class Publisher:
         self.latch = latch
         self.spec = TopicSpec(topic, type_name, md5sum, message_definition, latch)
         self._links: list[_SubscriberLink] = []
-        self._closed_links: list[LinkStats] = []
         self._all_links: list[_SubscriberLink] = []
         self._lock = threading.Lock()
         self._last: bytes | memoryview | None = None

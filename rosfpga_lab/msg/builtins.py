@@ -47,7 +47,6 @@ SCALARS: dict[str, Scalar] = {
 }
 #: Builtins whose arrays are carried as raw bytes (numpy uint8 views).
 BYTE_ARRAY_TYPES = frozenset({"uint8", "char"})
-INTEGER_TYPES = frozenset(n for n in SCALARS if n not in ("bool", "float32", "float64"))
 FLOAT_TYPES = frozenset({"float32", "float64"})
 
 
