@@ -167,3 +167,21 @@ def test_master_cli_trace_prints_calls() -> None:
     finally:
         stop_process(proc)
         proc.stdout.close()  # type: ignore[union-attr]
+
+
+def test_master_cli_bad_ports_are_clear() -> None:
+    with EmbeddedMaster(port=0) as m:  # the port is taken
+        out = cli("master", "--port", str(m.port), timeout=20)
+    assert out.returncode == 1 and "Traceback" not in out.stderr
+    assert "Address already in use" in out.stderr and "pick another --port" in out.stderr
+    out = cli("master", "--port", "99999")
+    assert out.returncode == 2 and "'99999' is not a TCP port (0..65535)" in out.stderr
+
+
+def test_out_of_range_ports_are_lab_errors() -> None:
+    from rosfpga_lab.graph import XmlRpcError, XmlRpcServer
+
+    with pytest.raises(XmlRpcError, match="cannot bind XML-RPC server to 127.0.0.1:70000"):
+        XmlRpcServer(lambda m, p: 0, port=70000).start()
+    with EmbeddedMaster(port=0) as m, pytest.raises(XmlRpcError, match="cannot bind TCPROS port"):
+        Node("/n", master=m, tcpros_port=70000)

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import threading
+import warnings
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -14,7 +16,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "roscpp and rostopic work with it: export the ROS_MASTER_URI it prints. It binds "
         "127.0.0.1 unless --host says otherwise; ROS 1 has no authentication, so binding to "
         "a network interface lets anyone on that network control your nodes.")
-    p.add_argument("--port", type=int, default=11311, help="TCP port (default: 11311, roscore's)")
+    p.add_argument("--port", type=_port, default=11311,
+                   help="TCP port, 0 for any free one (default: 11311, roscore's)")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to bind and advertise (default: 127.0.0.1; 0.0.0.0 = every "
                    "interface, with a warning)")
@@ -23,12 +26,30 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def _port(text: str) -> int:
+    try:
+        port = int(text)
+    except ValueError:
+        port = -1
+    if not 0 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a TCP port (0..65535)")
+    return port
+
+
 def run(args: argparse.Namespace) -> int:
     """Serve until Ctrl-C."""
-    from rosfpga_lab.graph import EmbeddedMaster
+    from rosfpga_lab.graph import EmbeddedMaster, OpenBindWarning, XmlRpcError
 
-    master = EmbeddedMaster(host=args.host, port=args.port)
-    master.start()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", OpenBindWarning)
+        master = EmbeddedMaster(host=args.host, port=args.port)
+        try:
+            master.start()
+        except XmlRpcError as exc:
+            raise XmlRpcError(f"{exc} (is a roscore or another `rosfpga-lab master` already "
+                              "running there? pick another --port)") from None
+    for w in caught:
+        print(f"rosfpga-lab master: warning: {w.message}", file=sys.stderr)
     print(f"ROS master running; export ROS_MASTER_URI={master.uri}", flush=True)
     stop = threading.Event()
     last_seq = -1

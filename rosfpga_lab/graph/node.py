@@ -164,7 +164,7 @@ class Node:
         self._tcp.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             self._tcp.bind((bind, tcpros_port))
-        except OSError as exc:
+        except (OSError, OverflowError) as exc:  # OverflowError: a port outside 0..65535
             self._tcp.close()
             self._xmlrpc.stop()
             raise XmlRpcError(f"cannot bind TCPROS port {bind}:{tcpros_port}: {exc}") from None

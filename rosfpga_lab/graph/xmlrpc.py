@@ -211,7 +211,7 @@ class XmlRpcServer:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             sock.bind((self.host, self.port))
-        except OSError as exc:
+        except (OSError, OverflowError) as exc:  # OverflowError: a port outside 0..65535
             sock.close()
             raise XmlRpcError(f"cannot bind XML-RPC server to {self.host}:{self.port}: {exc}") from None
         sock.listen(64)
