@@ -49,8 +49,8 @@ def account(fields: ImageFields, op: str, ksize: tuple[int, int], in_frame_bytes
     """Cycles and latency of every stage for one frame described by ``fields``."""
     rows, cols = fields.height, fields.width
     pixels = rows * cols
-    data = pixels * PIXEL_FORMATS[fields.encoding].bytes_per_pixel
     bpp = PIXEL_FORMATS[fields.encoding].bytes_per_pixel
+    data = pixels * bpp
     if op == "copy":
         filt, filt_latency = pixels, 1
     else:
