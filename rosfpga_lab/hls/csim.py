@@ -21,7 +21,7 @@ import numpy as np
 from rosfpga_lab.hls.errors import CsimError
 from rosfpga_lab.hw import Beats
 
-#: The flags of the generated Makefile (used when make is missing).
+#: The flags and sources of the generated Makefile (also used directly when make is missing).
 CXXFLAGS = ("-std=c++14", "-Wall", "-Werror", "-O2")
 SOURCES = ("subscriber.cpp", "publisher.cpp", "image_filter.cpp", "ros_fpga_node.cpp",
            "connection_headers.cpp", "csim_testbench.cpp")

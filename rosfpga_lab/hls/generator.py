@@ -28,6 +28,7 @@ import numpy as np
 
 from rosfpga_lab import __version__
 from rosfpga_lab.hls.config import NodeConfig
+from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, SOURCES
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
 from rosfpga_lab.hw import limits as hw_limits
@@ -225,7 +226,8 @@ def render(config: NodeConfig) -> dict[str, str]:
         "max_frame_bytes": hw_limits.MAX_FRAME_BYTES, "min_body_bytes": MIN_BODY_BYTES,
         "checked": checked, "interp_table": interp, "gen_table": GENERATOR_TABLE,
         "after_frame_id": fixed_after("frame_id"), "after_encoding": fixed_after("encoding"),
-        "tb_input": TB_INPUT,
+        "tb_input": TB_INPUT, "cxxflags": CXXFLAGS, "csim_sources": SOURCES,
+        "design_sources": [src for src in SOURCES if src != f"{BINARY}.cpp"],
         "tb_expected": TB_EXPECTED if config.application.op != "custom" else "",
         "headers": [
             _header_context(f"Subscriber: sent to each publisher of {config.subscriber.topic}",
