@@ -69,7 +69,7 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
     }
     const ap_uint<32> end = frame_length + 4;
     int status = SUB_OK;
-    do {
+    do {  // the fields in wire order; a refused one breaks out to the skip below
         // header.seq (uint32): not kept; the publisher numbers its own messages.
         read_u32(in, pos);
         // header.stamp.secs (uint32): carried over.
