@@ -485,17 +485,9 @@ class Node:
             self.publishers.clear()
             self.subscribers.clear()
         for sub in subs:
-            try:
-                self._master("unregisterSubscriber", sub.topic, self.uri)
-            except GraphError:
-                pass
-            sub._close()
+            self._unsubscribe(sub)
         for pub in pubs:
-            try:
-                self._master("unregisterPublisher", pub.topic, self.uri)
-            except GraphError:
-                pass
-            pub._close()
+            self._unadvertise(pub)
         hard_close(self._tcp)
         with self._lock:
             pending = list(self._pending)

@@ -104,9 +104,7 @@ class _SubscriberLink:
             if node.trace.frames:
                 node.trace.record(
                     "tcpros_frame", node.name, role="out", src=node.name, dst=self.stats.peer,
-                    method=self.pub.topic,
-                    raw=len(body).to_bytes(4, "little") + bytes(body[:node.trace.frame_bytes]),
-                    size=size, conn=self.stats.conn, index=self.stats.frames - 1, t0=t0)
+                    method=self.pub.topic, raw=node.trace.frame_raw(body), size=size, conn=self.stats.conn, index=self.stats.frames - 1, t0=t0)
 
     def _read_loop(self) -> None:
         try:

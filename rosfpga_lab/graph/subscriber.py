@@ -274,7 +274,7 @@ class Subscriber:
         if node.trace.frames:
             node.trace.record("tcpros_frame", node.name, role="in", src=info.publisher,
                               dst=node.name, method=self.topic,
-                              raw=len(body).to_bytes(4, "little") + bytes(body[:node.trace.frame_bytes]),
+                              raw=node.trace.frame_raw(body),
                               size=4 + len(body), conn=info.conn, index=info.index, offset=offset)
         with self._cond:
             self._stats.frames += 1

@@ -117,6 +117,11 @@ class Trace:
                 self.dropped += 1
         return ev
 
+    def frame_raw(self, body: bytes | bytearray | memoryview) -> bytes:
+        """What a ``tcpros_frame`` event keeps of a frame: its 4-byte length prefix and the
+        first :attr:`frame_bytes` body bytes."""
+        return len(body).to_bytes(4, "little") + bytes(body[:self.frame_bytes])
+
     def name_of(self, endpoint: str) -> str:
         """The node name for a URI or host:port when known, else the endpoint itself."""
         return self.names.get(endpoint, endpoint)
