@@ -260,3 +260,45 @@ def test_registry_changes_invalidate_codecs() -> None:
     assert serialize(reg, "a/B", {"x": 1}) == struct.pack("<i", 1)
     reg.add("a/B", "int64 x\n")
     assert serialize(reg, "a/B", {"x": 1}) == struct.pack("<q", 1)
+
+
+FUZZ_TYPES = ["std_msgs/String", "sensor_msgs/Image", "sensor_msgs/JointState",
+              "geometry_msgs/PolygonStamped", "std_msgs/Float64MultiArray", "sensor_msgs/CameraInfo"]
+
+
+def _outcome(decode, type_name: str, body: bytes):
+    try:
+        return normalize(REG, type_name, decode(REG, type_name, body))
+    except DeserializeError as exc:
+        assert 0 <= exc.offset <= len(body)
+        # the offsets may differ inside a field: the fast decoder names the start of a short
+        # time field, the reference the start of its missing secs/nsecs half
+        return "error"
+
+
+@pytest.mark.parametrize("type_name", FUZZ_TYPES)
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_fuzz_decoders_only_typed_errors_and_agree(type_name: str, data: st.DataObject) -> None:
+    """Random bytes, or a valid body with a few bytes overwritten: the fast decoder, the plain
+    reference decoder and field_layout raise nothing but DeserializeError, and the two decoders
+    accept the same bodies with the same values."""
+    if data.draw(st.booleans(), label="mutate a valid body"):
+        body = bytearray(serialize(REG, type_name, data.draw(message(REG, type_name), label="value")))
+        for _ in range(data.draw(st.integers(1, 3), label="edits")):
+            if body:
+                body[data.draw(st.integers(0, len(body) - 1))] = data.draw(st.integers(0, 255))
+        body = bytes(body)
+    else:
+        body = data.draw(st.binary(max_size=200), label="bytes")
+    fast = _outcome(deserialize, type_name, body)
+    # repr: a float field overwritten into NaN is still "the same value"
+    assert repr(_outcome(deserialize_reference, type_name, body)) == repr(fast)
+    try:
+        field_layout(REG, type_name, body)
+    except DeserializeError:
+        assert fast == "error"
+    else:
+        assert fast != "error"
+    spans = field_layout(REG, type_name, body, partial=True)
+    assert spans[-1].end == len(body) or spans[-1].role != "error"
