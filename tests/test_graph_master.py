@@ -108,6 +108,28 @@ def test_new_node_with_same_name_replaces_old(master: EmbeddedMaster) -> None:
 
 
 # ----------------------------------------------------------------------------- XML-RPC safety
+def test_a_node_with_an_unusable_uri_does_not_stop_notifications(master: EmbeddedMaster) -> None:
+    import time
+
+    from rosfpga_lab.graph import Node
+
+    p = proxy(master)
+    # passes rosmaster's is_api check (starts with http://) but has no port to call
+    assert p.registerSubscriber("/broken", "/t", "std_msgs/String", "http://noport")[0] == 1
+    assert p.registerPublisher("/pub1", "/t", "std_msgs/String", API)[0] == 1
+    node = Node("/good", master=master)
+    try:
+        sub = node.subscribe("/t", "std_msgs/String")
+        assert p.registerPublisher("/pub2", "/t", "std_msgs/String", "http://127.0.0.1:8/")[0] == 1
+        deadline = time.monotonic() + 5
+        while "http://127.0.0.1:8/" not in sub._links and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert set(sub._links) == {API, "http://127.0.0.1:8/"}  # publisherUpdate still arrives
+        assert any("publisherUpdate to http://noport: ConfigError" in e for e in master.notify_errors)
+    finally:
+        node.shutdown()
+
+
 BOMB = b"""<?xml version="1.0"?>
 <!DOCTYPE x [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">]>
 <methodCall><methodName>getUri</methodName><params><param><value>&b;</value></param></params></methodCall>"""

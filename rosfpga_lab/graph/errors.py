@@ -25,6 +25,13 @@ RECONNECT_FACTOR = 2.0
 RECONNECT_MAX = 5.0
 #: Seconds stop()/shutdown() waits for each worker thread.
 JOIN_TIMEOUT = 5.0
+#: Seconds the master waits on one publisherUpdate/paramUpdate/shutdown notification.
+NOTIFY_TIMEOUT = 5.0
+#: Error texts kept by a subscriber (``stats.errors``) and by the master (``notify_errors``):
+#: the most recent ones.
+MAX_ERRORS_KEPT = 50
+#: Closed connections whose counters a publisher's ``stats.links`` still reports.
+MAX_CLOSED_LINKS_KEPT = 64
 
 
 class GraphError(LabError):

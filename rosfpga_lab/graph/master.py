@@ -18,13 +18,12 @@ import uuid
 from typing import Any
 
 from rosfpga_lab.graph.apicheck import api_methods, checked
-from rosfpga_lab.graph.errors import JOIN_TIMEOUT, XmlRpcError
+from rosfpga_lab.graph.errors import JOIN_TIMEOUT, MAX_ERRORS_KEPT, NOTIFY_TIMEOUT
 from rosfpga_lab.graph.names import bind_address, canonical, namespace_of, resolve
 from rosfpga_lab.graph.trace import Trace
 from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call
 
 MASTER_ID = "/master"
-NOTIFY_TIMEOUT = 5.0
 
 
 class ParamTree:
@@ -188,8 +187,9 @@ class EmbeddedMaster:
             try:
                 call(api, method, MASTER_ID, *args, trace=self.trace, caller=MASTER_ID,
                      timeout=NOTIFY_TIMEOUT)
-            except (XmlRpcError, ValueError) as exc:
-                self.notify_errors.append(str(exc))
+            except Exception as exc:  # one bad node (e.g. an unusable URI) must not stop the rest
+                self.notify_errors.append(f"{method} to {api}: {type(exc).__name__}: {exc}")
+                del self.notify_errors[:-MAX_ERRORS_KEPT]
 
     def _notify_topic(self, topic: str) -> None:
         pubs = list(self.publishers.get(topic, {}).values())

@@ -17,12 +17,9 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from rosfpga_lab.graph.errors import JOIN_TIMEOUT, GraphError
+from rosfpga_lab.graph.errors import JOIN_TIMEOUT, MAX_CLOSED_LINKS_KEPT, GraphError
 from rosfpga_lab.graph.wire import hard_close, send_frame, set_nodelay
 from rosfpga_lab.tcpros import TopicSpec
-
-#: Closed connections whose counters ``stats.links`` still reports.
-MAX_CLOSED_LINKS_KEPT = 64
 
 if TYPE_CHECKING:
     import socket

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 from rosfpga_lab.graph.errors import (
     CONNECT_TIMEOUT,
     JOIN_TIMEOUT,
+    MAX_ERRORS_KEPT,
     RECONNECT_FACTOR,
     RECONNECT_FIRST,
     RECONNECT_MAX,
@@ -48,8 +49,6 @@ from rosfpga_lab.tcpros import (
 
 if TYPE_CHECKING:
     from rosfpga_lab.graph.node import Node
-
-MAX_ERRORS_KEPT = 50
 
 
 @dataclass(frozen=True)
