@@ -267,6 +267,9 @@ def test_other_widgets_render_and_a_sequence_arrow_opens_its_bytes(lab: Lab, tmp
     text = page.locator(".jp-OutputArea").first.text_content()
     # clicking the output image's pixel (1, 6) zooms there: its value table is outlined at (1, 6)
     picture = page.locator(".rfl-clickimage img").nth(1)
+    # measure only once the pictures have loaded (before that the box is not the picture's)
+    page.wait_for_function("[...document.querySelectorAll('.rfl-clickimage img')]"
+                           ".every(i => i.complete && i.naturalWidth > 0)")
     box = picture.bounding_box()
     picture.click(position={"x": box["width"] * 1.5 / 8, "y": box["height"] * 6.5 / 8})
     page.wait_for_function("[...document.querySelectorAll('.jp-OutputArea-output input')]"
