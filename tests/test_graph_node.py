@@ -430,6 +430,23 @@ def test_default_master_selection(monkeypatch) -> None:
         node_mod.stop_shared_master()
 
 
+def test_private_master_on_another_port_is_announced(monkeypatch) -> None:
+    import rosfpga_lab.graph.node as node_mod
+
+    monkeypatch.delenv("ROS_MASTER_URI", raising=False)
+    squatter = socket.socket()  # something that is not a master holds the default port
+    squatter.bind(("127.0.0.1", 0))
+    squatter.listen(1)
+    monkeypatch.setattr(node_mod, "DEFAULT_MASTER_PORT", squatter.getsockname()[1])
+    try:
+        with pytest.warns(RuntimeWarning, match="private ROS master .* will not find this one"):
+            uri = node_mod.default_master_uri()
+        assert uri == node_mod._shared.uri and uri != f"http://127.0.0.1:{squatter.getsockname()[1]}/"
+    finally:
+        node_mod.stop_shared_master()
+        squatter.close()
+
+
 def test_ros_ip_and_hostname_are_honoured(monkeypatch) -> None:
     from rosfpga_lab.graph import default_host
 

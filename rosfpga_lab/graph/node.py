@@ -22,6 +22,7 @@ import os
 import socket
 import threading
 import time
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -66,14 +67,21 @@ DEFAULT_MASTER_PORT = 11311
 
 def shared_master(port: int | None = None) -> EmbeddedMaster:
     """The process-wide embedded master, started on first call on ``port`` (default 11311,
-    or any free port if that one is taken). Stop it with :func:`stop_shared_master`."""
+    or any free port if that one is taken, with a warning: other processes will not find
+    it). Stop it with :func:`stop_shared_master`."""
     global _shared
     with _shared_lock:
         if _shared is None or not _shared.running:
+            wanted = DEFAULT_MASTER_PORT if port is None else port
             try:
-                _shared = EmbeddedMaster(port=DEFAULT_MASTER_PORT if port is None else port).start()
-            except XmlRpcError:
+                _shared = EmbeddedMaster(port=wanted).start()
+            except XmlRpcError as exc:
                 _shared = EmbeddedMaster(port=0).start()
+                warnings.warn(
+                    f"started a private ROS master at {_shared.uri} because port {wanted} is "
+                    f"taken ({exc}); nodes of other processes will not find this one. Set "
+                    "ROS_MASTER_URI (or pass master_uri=) to join an existing master.",
+                    RuntimeWarning, stacklevel=2)
         return _shared
 
 
