@@ -61,6 +61,9 @@ def test_describe_byte_difference_names_field_and_decodes():
     short = C.describe_byte_difference(want[:5], want, fields)
     assert short == ["your bytes end after 5 bytes, expected 6 (missing from field b on)"]
     assert "1 byte(s) too many" in C.describe_byte_difference(want + b"!", want, fields)[0]
+    swapped = C.describe_byte_difference(struct.pack(">I", 7) + b"hi", want, fields)
+    assert swapped == ["byte 0 (field a, uint32 at bytes 0..3) is 117440512, expected 7: its bytes "
+                       "are in big-endian order; ROS is little-endian (struct format '<')"]
 
 
 # ------------------------------------------------------------------------------ notebook 1

@@ -243,7 +243,11 @@ def describe_byte_difference(got: bytes, expected: bytes, fields: Sequence[ByteF
         if f.size > 1:
             where += f", {f.type} at bytes {f.offset}..{f.end - 1}"
         if want is not None and have is not None:
-            out.append(f"byte {i} ({where}) is {have!r}, expected {want!r}")
+            swapped = (f.size > 1 and f.end <= len(got)
+                       and got[f.offset:f.end] == expected[f.offset:f.end][::-1])
+            out.append(f"byte {i} ({where}) is {have!r}, expected {want!r}"
+                       + (": its bytes are in big-endian order; ROS is little-endian "
+                          "(struct format '<')" if swapped else ""))
         else:
             out.append(f"byte {i} ({where}) is {_byte(got[i])}, expected {_byte(expected[i])}")
         shift = _shift(got, expected, i)
