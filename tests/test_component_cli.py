@@ -97,7 +97,7 @@ def test_camera_rate_and_viewer_saves_pngs(tmp_path) -> None:
         finally:
             cam.stop()
             viewer.stop()
-    assert 19 / 50 <= elapsed < 19 / 50 + 1.0          # the schedule: frame k at k / rate
+    assert 19 / 50 <= elapsed < 19 / 50 + 5.0          # paced by the schedule (frame k at k / rate), slack for a loaded machine
     assert viewer.received == 20 and not viewer.problems
     assert [p.name for p in viewer.saved] == [f"frame_{k:06d}.png" for k in (0, 5, 10, 15)]
     saved = cv2.imread(str(viewer.saved[1]))             # BGR file == the bgr8 frame 5 sent

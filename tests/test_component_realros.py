@@ -96,7 +96,10 @@ def test_rospy_publisher_component_real_subscriber_every_frame_bit_exact(
         sub_cmd = [str(build_roscpp_program(ROS_PROGRAMS / "component_roscpp_sub.cpp"))]
     else:
         sub_cmd = [ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "sub"]
-    comp = FpgaComponent.from_config(CONFIG, master_uri=rosmaster_uri).start()
+    # Queues as deep as the run: this test is about every frame coming out bit-exact; the
+    # drop-oldest policy under a slow subscriber is tested in test_component_node.py.
+    comp = FpgaComponent.from_config(CONFIG, master_uri=rosmaster_uri, input_queue=count,
+                                     output_queue=count).start()
     procs = []
     try:
         sent_file, got_file = tmp_path / "sent.bin", tmp_path / "got.bin"

@@ -19,15 +19,12 @@ DATA = Path(__file__).resolve().parents[1] / "data"
 
 def test_demo_command_passes_bit_exact(tmp_path, capsys) -> None:
     png = tmp_path / "demo.png"
-    t0 = time.monotonic()
     code = main(["demo", "--frames", "45", "--output", str(png), "--scale", "0.5"])
-    elapsed = time.monotonic() - t0
     out = capsys.readouterr().out
     assert code == 0, out
     assert "bit-exact: 45/45" in out
     assert "frames: sent 45, received 45" in out
     assert "fps:" in out and "latency camera -> component -> checker: median" in out
-    assert elapsed < 60
     figure = cv2.imread(str(png))
     assert figure is not None and figure.shape[1] > 3 * 320 and figure.shape[0] > 240
 
