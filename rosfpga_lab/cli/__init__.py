@@ -48,4 +48,5 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"rosfpga-lab {args.command}: error: {exc}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
+        print(f"rosfpga-lab {args.command}: interrupted", file=sys.stderr)
         return 130
