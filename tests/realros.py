@@ -18,6 +18,7 @@ import shutil
 import socket
 import subprocess
 import tempfile
+import threading
 import time
 import xmlrpc.client
 from collections.abc import Iterator
@@ -128,6 +129,34 @@ def stop_process(proc: subprocess.Popen, timeout: float = 5.0) -> None:
             proc.wait(timeout)
 
 
+def wait_line(proc: subprocess.Popen, word: bytes, timeout: float) -> None:
+    """Block until ``proc`` prints the line ``word`` on stdout; stop it and fail otherwise."""
+    found = threading.Event()
+
+    def reader() -> None:
+        for line in proc.stdout:  # type: ignore[union-attr]
+            if line.strip() == word:
+                found.set()
+                return
+
+    threading.Thread(target=reader, daemon=True).start()
+    if not found.wait(timeout):
+        stop_process(proc)
+        tail = proc.stderr.read().decode(errors="replace")[-2000:] if proc.stderr else ""
+        raise AssertionError(f"{proc.args[0]} never printed {word!r}: {tail}")
+
+
+def finish(proc: subprocess.Popen, timeout: float = 60.0) -> None:
+    """Wait for ``proc`` to exit by itself with status 0; stop it and fail otherwise."""
+    try:
+        rc = proc.wait(timeout)
+    except subprocess.TimeoutExpired:
+        stop_process(proc)
+        raise AssertionError(f"{proc.args} did not finish in {timeout} s") from None
+    tail = proc.stderr.read().decode(errors="replace")[-3000:] if proc.stderr else ""
+    assert rc == 0, tail
+
+
 @contextlib.contextmanager
 def real_rosmaster(tmp_path: Path) -> Iterator[str]:
     """Run Debian's ``rosmaster --core`` on a free loopback port; yield its URI."""
@@ -184,7 +213,7 @@ def build_roscpp_program(source: Path) -> Path:
 
 
 __all__ = [
-    "ROS_PYTHON", "ROS_PROGRAMS", "build_roscpp_program", "cxx_missing_reason", "free_port",
+    "ROS_PYTHON", "ROS_PROGRAMS", "build_roscpp_program", "cxx_missing_reason", "finish", "free_port",
     "real_rosmaster", "require_cxx", "require_ros", "ros_env", "ros_missing_reason",
-    "run_ros_python", "skip_or_fail", "stop_process", "wait_for_master",
+    "run_ros_python", "skip_or_fail", "stop_process", "wait_for_master", "wait_line",
 ]

@@ -11,7 +11,6 @@ from __future__ import annotations
 import signal
 import struct
 import subprocess
-import threading
 import time
 from pathlib import Path
 
@@ -20,8 +19,8 @@ import numpy as np
 import pytest
 
 from realros import (
-    ROS_PROGRAMS, ROS_PYTHON, build_roscpp_program, free_port, require_ros, ros_env, stop_process,
-    wait_for_master,
+    ROS_PROGRAMS, ROS_PYTHON, build_roscpp_program, finish, free_port, require_ros, ros_env,
+    stop_process, wait_for_master, wait_line,
 )
 from rosfpga_lab.component import Camera, FpgaComponent
 from rosfpga_lab.hls import load_config
@@ -64,28 +63,8 @@ def parse_image(body: bytes) -> dict:
 def start(cmd: list[str], uri: str, tmp_path: Path) -> subprocess.Popen:
     proc = subprocess.Popen(cmd, env=ros_env(uri, tmp_path), stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE)
-    found = threading.Event()
-
-    def reader() -> None:
-        for line in proc.stdout:  # type: ignore[union-attr]
-            if line.strip() == b"READY":
-                found.set()
-                return
-
-    threading.Thread(target=reader, daemon=True).start()
-    if not found.wait(30):
-        stop_process(proc)
-        raise AssertionError(f"{cmd[1]} never printed READY: {proc.stderr.read().decode()[-2000:]}")  # type: ignore[union-attr]
+    wait_line(proc, b"READY", 30)
     return proc
-
-
-def finish(proc: subprocess.Popen, timeout: float = 60.0) -> None:
-    try:
-        rc = proc.wait(timeout)
-    except subprocess.TimeoutExpired:
-        stop_process(proc)
-        raise AssertionError(f"{proc.args} did not finish in {timeout} s") from None
-    assert rc == 0, proc.stderr.read().decode()[-3000:]  # type: ignore[union-attr]
 
 
 @pytest.mark.parametrize("subscriber", ["rospy", "roscpp"])

@@ -22,10 +22,12 @@ from realros import (
     ROS_PROGRAMS,
     ROS_PYTHON,
     build_roscpp_program,
+    finish,
     real_rosmaster,
     require_ros,
     ros_env,
     stop_process,
+    wait_line,
 )
 from rosfpga_lab.graph import EmbeddedMaster, Node
 from rosfpga_lab.msg import Time, default_registry, deserialize, serialize
@@ -87,31 +89,6 @@ def programs(tmp_path):
         for stream in (p.stdout, p.stderr):
             if stream:
                 stream.close()
-
-
-def wait_line(proc: subprocess.Popen, word: bytes, timeout: float) -> None:
-    found = threading.Event()
-
-    def reader() -> None:
-        for line in proc.stdout:  # type: ignore[union-attr]
-            if line.strip() == word:
-                found.set()
-                return
-
-    t = threading.Thread(target=reader, daemon=True)
-    t.start()
-    if not found.wait(timeout):
-        stop_process(proc)
-        raise AssertionError(f"{proc.args[0]} never printed {word!r}: {proc.stderr.read().decode()[-2000:]}")  # type: ignore[union-attr]
-
-
-def finish(proc: subprocess.Popen, timeout: float = 40.0) -> None:
-    try:
-        rc = proc.wait(timeout)
-    except subprocess.TimeoutExpired:
-        stop_process(proc)
-        raise AssertionError(f"{proc.args} did not finish in {timeout} s") from None
-    assert rc == 0, proc.stderr.read().decode()[-3000:]  # type: ignore[union-attr]
 
 
 def records(path: Path) -> list[bytes]:

@@ -186,7 +186,7 @@ def test_unknown_types_say_what_and_where(tmp_path: Path) -> None:
     with pytest.raises(UnknownTypeError) as info:
         mine.md5("p/A")
     text = str(info.value)
-    assert "'p/Missing'" in text and "field 'm' of p/A" in text and f"A.msg:2" in text
+    assert "'p/Missing'" in text and "field 'm' of p/A" in text and "A.msg:2" in text
     assert str(tmp_path) in text  # where it searched
 
 
