@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The lab's set-up in one place. Quick start (see README.md):
 #   ./lab.sh          set up (.venv, package installed editable) and open JupyterLab on notebooks/
-#   ./lab.sh test     set up (with the test extras) and run the whole test suite
+#                     (options go to JupyterLab: ./lab.sh --port 8889 --no-browser)
+#   ./lab.sh test     set up (with the test extras) and run the whole test suite (options go to pytest)
 # Further: ./lab.sh setup [--test]   only set up;   ./lab.sh help
 # Set PYTHON=/path/to/python3.x to choose the interpreter (3.11 to 3.13).
 set -euo pipefail
@@ -10,7 +11,7 @@ cd "$here"
 venv="$here/.venv"
 
 usage() {
-  sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'
 }
 
 find_python() {
@@ -45,8 +46,12 @@ setup() {
   fi
 }
 
-cmd="${1:-lab}"
-[ $# -gt 0 ] && shift
+# No command, or only options for JupyterLab (./lab.sh --port 8889): open the lab.
+if [ $# -eq 0 ] || { [[ "$1" == -* ]] && [[ "$1" != "-h" && "$1" != "--help" ]]; }; then
+  set -- lab "$@"
+fi
+cmd="$1"
+shift
 case "$cmd" in
   lab|open)
     setup ""
