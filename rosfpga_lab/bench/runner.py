@@ -164,10 +164,10 @@ def run_bench(config: NodeConfig | str | Path | None = None, *, middles: tuple[s
     with tempfile.TemporaryDirectory(prefix="rosfpga-bench-") as tmp:
         config_path = config.path
         if config_path is None:
-            from rosfpga_lab.component.demo import _FALLBACK_CONFIG
+            from rosfpga_lab.component.demo import BUILTIN_CONFIG_YAML  # the path-less default_config()
 
             config_path = Path(tmp) / "fpga.yaml"
-            config_path.write_text(_FALLBACK_CONFIG)
+            config_path.write_text(BUILTIN_CONFIG_YAML)
         with EmbeddedMaster(port=0) as master:
             env = ros_env(master.uri)
             plan: list[tuple[str, list[str] | None, object, str]] = []

@@ -27,9 +27,11 @@ from rosfpga_lab.component.stats import ComponentStats, LatencySummary
 from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.hls import NodeConfig, load_config, parse_config
 
-#: The configuration used when the lab's data/ directory is not at hand (same as the file).
+#: The demo's configuration file in the lab's data/ directory.
 DEFAULT_CONFIG_NAME = "fpga_dilate_rgba8.yaml"
-_FALLBACK_CONFIG = """\
+#: The same values, for when data/ is not at hand; ``default_config()`` then parses this text,
+#: so a path-less configuration from it is this one.
+BUILTIN_CONFIG_YAML = """\
 node: {name: /fpga_dilate}
 subscriber: {topic: /image_raw, type: sensor_msgs/Image}
 publisher: {topic: /image_dilated, type: sensor_msgs/Image}
@@ -45,7 +47,7 @@ def default_config() -> NodeConfig:
     path = Path(__file__).resolve().parents[2] / "data" / DEFAULT_CONFIG_NAME
     if path.exists():
         return load_config(path)
-    return parse_config(_FALLBACK_CONFIG, source=f"<built-in {DEFAULT_CONFIG_NAME}>")
+    return parse_config(BUILTIN_CONFIG_YAML, source=f"<built-in {DEFAULT_CONFIG_NAME}>")
 
 
 @dataclass
