@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 
 
 def positive_int(text: str) -> int:
@@ -16,23 +17,21 @@ def positive_int(text: str) -> int:
     return value
 
 
-def positive_float(text: str) -> float:
-    """A number greater than 0 (seconds, rates, scales)."""
+def _float(text: str, ok: Callable[[float], bool], want: str) -> float:
     try:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"want a number, got {text!r}") from None
-    if not value > 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"want a number greater than 0, got {text}")
+    if not ok(value) or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"want a number {want}, got {text}")
     return value
+
+
+def positive_float(text: str) -> float:
+    """A number greater than 0 (seconds, rates, scales)."""
+    return _float(text, lambda v: v > 0, "greater than 0")
 
 
 def non_negative_float(text: str) -> float:
     """A number of at least 0 (0 meaning 'off' where the option's help says so)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"want a number, got {text!r}") from None
-    if not value >= 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"want a number of at least 0, got {text}")
-    return value
+    return _float(text, lambda v: v >= 0, "of at least 0")
