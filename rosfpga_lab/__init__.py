@@ -1,7 +1,7 @@
 """rosfpga_lab: rebuild a ROS-compliant FPGA component, byte for byte, in Python.
 
 The package is layered (see ``DESIGN.md`` in the course material and the README):
-``msg`` -> ``tcpros`` -> ``graph`` -> ``hw`` -> ``hls`` -> ``component`` -> ``widgets``/``checks``
+``msg`` -> ``tcpros`` -> ``config`` -> ``graph`` -> ``hw`` -> ``hls`` -> ``component`` -> ``widgets``/``checks``
 -> ``cli``. A layer imports only the layers below it.
 """
 

@@ -276,7 +276,7 @@ def test_component_refuses_non_image_topics() -> None:
     """The loader refuses this already; the component checks again for hand-built configs."""
     import dataclasses
 
-    from rosfpga_lab.hls import TopicConfig, load_config
+    from rosfpga_lab.config import TopicConfig, load_config
 
     cfg = dataclasses.replace(load_config(CONFIG), subscriber=TopicConfig("/a", "std_msgs/String"))
     with pytest.raises(ComponentConfigError, match="sensor_msgs/Image only"):

@@ -19,7 +19,7 @@ import pytest
 
 from rosfpga_lab.component import ComponentConfigError, FpgaComponent
 from rosfpga_lab.graph import EmbeddedMaster, Node
-from rosfpga_lab.hls import load_config, parse_config
+from rosfpga_lab.config import load_config, parse_config
 from rosfpga_lab.hw import image_frame
 from rosfpga_lab.msg import default_registry
 from rosfpga_lab.tcpros import encode_header

@@ -23,7 +23,7 @@ from realros import (
     stop_process, wait_for_master, wait_line,
 )
 from rosfpga_lab.component import Camera, FpgaComponent
-from rosfpga_lab.hls import load_config
+from rosfpga_lab.config import load_config
 
 pytestmark = pytest.mark.ros
 

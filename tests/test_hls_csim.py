@@ -21,7 +21,9 @@ import numpy as np
 import pytest
 
 from realros import require_cxx, ros_missing_reason, run_ros_python
-from rosfpga_lab.hls import CsimError, build_csim, generate, load_config, pipeline_for, run_csim
+from rosfpga_lab.config import load_config
+from rosfpga_lab.hls import CsimError, build_csim, generate, run_csim
+from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.hls.csim import CsimResult
 from rosfpga_lab.hw import Beats, PipelineError, image_frame
 from rosfpga_lab.msg import default_registry, deserialize
@@ -115,7 +117,7 @@ def test_csim_equals_python_models_and_opencv(projects: dict[str, Project], stem
     frame = ros_frame(image, encoding)
     got = projects[stem].run(frame)
     config = load_config(DATA / f"{stem}.yaml")
-    model = pipeline_for(config).process(frame)
+    model = Pipeline.from_config(config).process(frame)
     assert got.status == ((0, "SUB_OK"),)
     assert len(got.input_beats) == config.image.width * config.image.height
     assert got.input_beats == model.input_beats, f"first differing beat {got.input_beats.first_difference(model.input_beats)}"
@@ -218,7 +220,7 @@ def test_refused_frames_are_skipped_and_the_next_good_frame_comes_out_right(
     offsets = np.cumsum([0] + [len(f) for _, f, _ in frames])[:-1]
     assert got.status == tuple((int(o), s) for o, (_, _, s) in zip(offsets, frames))
     # The Python model refuses the same frames and numbers the accepted ones 1, 2.
-    pipe = pipeline_for(config)
+    pipe = Pipeline.from_config(config)
     expected, beats_in, beats_out = b"", [], []
     for name, frame, status in frames:
         try:
@@ -326,7 +328,7 @@ def test_a_batch_of_varied_frames_equals_the_models(projects: dict[str, Project]
                                   stamp=(int(rng.integers(0, 2**32)), int(rng.integers(0, 10**9))),
                                   frame_id=frame_id, is_bigendian=i % 2))
     got = projects[stem].run(b"".join(frames))
-    pipe = pipeline_for(config)
+    pipe = Pipeline.from_config(config)
     expected, statuses = b"", []
     for frame in frames:
         try:
@@ -350,7 +352,7 @@ def test_frame_id_max_is_the_same_limit_in_the_circuit_and_the_models(tmp_path: 
     frames = [image_frame(image, encoding, frame_id="f" * n) for n in (15, 16, 17, 0)]
     got = run_csim(tmp_path / "proj", b"".join(frames))
     assert [s for _, s in got.status] == ["SUB_OK", "SUB_OK", "SUB_BAD_FRAME_ID_LENGTH", "SUB_OK"]
-    pipe = pipeline_for(config)
+    pipe = Pipeline.from_config(config)
     expected = b""
     for n, frame in zip((15, 16, 17, 0), frames):
         if n == 17:

@@ -20,9 +20,8 @@ from pathlib import Path
 
 import pytest
 
-from rosfpga_lab.hls import (
-    GenerateError, HlsError, count_sloc, format_table, generate, load_config, render,
-)
+from rosfpga_lab.config import load_config
+from rosfpga_lab.hls import GenerateError, HlsError, count_sloc, format_table, generate, render
 from rosfpga_lab.hls.generator import MANIFEST, TEMPLATE_FILES
 from rosfpga_lab.hls.sloc import PAPER_TABLE1, sloc
 

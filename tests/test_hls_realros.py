@@ -24,7 +24,9 @@ import numpy as np
 import pytest
 
 from realros import ROS_PYTHON, free_port, require_cxx, ros_env, stop_process
-from rosfpga_lab.hls import build_csim, generate, load_config, pipeline_for, run_csim
+from rosfpga_lab.config import load_config
+from rosfpga_lab.hls import build_csim, generate, run_csim
+from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.msg import default_registry, deserialize
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -125,7 +127,7 @@ def test_real_rospy_publisher_accepts_the_generated_subscriber(
         pub.stdout.close()  # type: ignore[union-attr]
         pub.stderr.close()  # type: ignore[union-attr]
     got = run_csim(proj, frame, binary=binary)
-    model = pipeline_for(load_config(CONFIG)).process(frame)
+    model = Pipeline.from_config(load_config(CONFIG)).process(frame)
     assert got.status == ((0, "SUB_OK"),)
     assert got.input_beats == model.input_beats and got.output_beats == model.output_beats
     assert got.output == model.output_frame

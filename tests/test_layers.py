@@ -8,7 +8,7 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parent.parent / "rosfpga_lab"
 # Bottom to top; names on one level may not import each other.
 LEVELS = [
-    {"errors"}, {"msg"}, {"tcpros"}, {"graph"}, {"hw"}, {"hls"}, {"component"},
+    {"errors"}, {"msg"}, {"tcpros"}, {"config"}, {"graph"}, {"hw"}, {"hls"}, {"component"},
     {"widgets", "checks"}, {"bench"}, {"cli"}, {"__main__"},
 ]
 RANK = {name: level for level, names in enumerate(LEVELS) for name in names}
@@ -52,3 +52,22 @@ def test_no_layer_imports_a_layer_above_it() -> None:
             if dep in RANK and RANK[dep] == RANK[layer] and dep != layer:
                 offences.append(f"{path.relative_to(PACKAGE)}: {layer} imports its sibling {dep}")
     assert offences == []
+
+
+def test_loading_a_configuration_imports_neither_opencv_nor_jinja2() -> None:
+    """The node configuration is read by every layer above it; it must stay light."""
+    import subprocess
+    import sys
+
+    data = PACKAGE.parent / "data"
+    code = (
+        "import sys\n"
+        "from rosfpga_lab.config import load_config\n"
+        f"config = load_config({str(data / 'fpga_dilate_rgba8.yaml')!r})\n"
+        "assert config.image.width == 640, config\n"
+        "heavy = sorted(m for m in ('cv2', 'jinja2', 'numpy') if m in sys.modules)\n"
+        "print(','.join(heavy))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert "cv2" not in out.stdout and "jinja2" not in out.stdout, out.stdout

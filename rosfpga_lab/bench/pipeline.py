@@ -9,7 +9,8 @@ import cv2
 import numpy as np
 
 from rosfpga_lab.component import open_source
-from rosfpga_lab.hls import NodeConfig, pipeline_for
+from rosfpga_lab.config import NodeConfig
+from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.hw import image_frame
 
 
@@ -45,7 +46,7 @@ def bench_pipeline(config: NodeConfig, frames: int = 100) -> PipelineFigures:
     cfg = config.image
     image = open_source("synthetic", cfg.width, cfg.height, cfg.encoding).frame(0)
     frame = image_frame(image, cfg.encoding, stamp=(1, 2), frame_id="bench")
-    pipe = pipeline_for(config, model="fast")
+    pipe = Pipeline.from_config(config, model="fast")
     app = config.application
     kernel = np.ones((app.ksize, app.ksize), np.uint8)
     op = {"dilate": cv2.dilate, "erode": cv2.erode}.get(app.op, lambda img, _k: img.copy())

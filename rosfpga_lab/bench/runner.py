@@ -24,7 +24,7 @@ from rosfpga_lab.bench.path import (
 from rosfpga_lab.bench.pipeline import PipelineFigures, bench_pipeline
 from rosfpga_lab.component import default_config, expected_output
 from rosfpga_lab.graph import EmbeddedMaster
-from rosfpga_lab.hls import NodeConfig, load_config
+from rosfpga_lab.config import NodeConfig, load_config
 
 MIDDLES = ("direct", "component", "roscpp", "rospy")
 

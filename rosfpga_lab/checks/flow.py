@@ -5,7 +5,8 @@ from __future__ import annotations
 from typing import Any
 
 from rosfpga_lab.checks._core import CheckResult, fail, require_type
-from rosfpga_lab.hls import ConfigError, parse_config, sloc
+from rosfpga_lab.config import ConfigError, parse_config
+from rosfpga_lab.hls import sloc
 
 #: Exercise 6.1: what the reader's configuration must say (dotted key -> value).
 EROSION_NODE = {

@@ -92,7 +92,7 @@ def _master_uri(args: argparse.Namespace, config_uri: str | None = None) -> str:
 def run_camera(args: argparse.Namespace) -> int:
     """Publish until Ctrl-C or --count."""
     from rosfpga_lab.component import Camera
-    from rosfpga_lab.hls import load_config
+    from rosfpga_lab.config import load_config
 
     topic, size, encoding, config_uri = "/image_raw", (640, 480), "rgba8", None
     if args.config is not None:

@@ -32,7 +32,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Validate the configuration, then generate (errors are LabErrors, printed by the CLI)."""
-    from rosfpga_lab.hls import generate, load_config
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.hls import generate
 
     def say(message: str) -> None:
         if not args.quiet:

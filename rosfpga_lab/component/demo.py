@@ -25,7 +25,7 @@ from rosfpga_lab.component.fpga import FpgaComponent
 from rosfpga_lab.component.sources import to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary
 from rosfpga_lab.graph import EmbeddedMaster
-from rosfpga_lab.hls import NodeConfig, load_config, parse_config
+from rosfpga_lab.config import NodeConfig, load_config, parse_config
 
 #: The demo's configuration file in the lab's data/ directory.
 DEFAULT_CONFIG_NAME = "fpga_dilate_rgba8.yaml"

@@ -6,7 +6,7 @@ subscriber of the input topic and publisher of the output topic, answers the Sla
 runs the TCPROS handshakes. The *hardware* side is the data path: every complete TCPROS frame
 the subscriber reads (the raw bytes, never deserialized in software) goes through the
 modelled circuit -- :class:`rosfpga_lab.hw.Pipeline` built by
-:func:`rosfpga_lab.hls.pipeline_for` from the same node configuration the generator reads --
+:meth:`rosfpga_lab.hw.Pipeline.from_config` from the same node configuration the generator reads --
 and the frame the circuit's message generator writes is sent, as bytes, to every subscriber.
 
 Queues (drop policy, as roscpp's): frames wait in front of the circuit in the subscriber's
@@ -40,10 +40,10 @@ import numpy as np
 from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
 from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, since_stamp
+from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
-from rosfpga_lab.hls import NodeConfig, load_config, pipeline_for
-from rosfpga_lab.hw import FrameFieldError, PipelineError, PipelineResult
+from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineResult
 
 log = logging.getLogger("rosfpga_lab.component")
 
@@ -113,7 +113,7 @@ class FpgaComponent:
     """The FPGA node: software registration and handshakes, the modelled circuit on the data path.
 
     Args:
-        config: the node configuration (as :func:`rosfpga_lab.hls.load_config` returns it).
+        config: the node configuration (as :func:`rosfpga_lab.config.load_config` returns it).
         master_uri: the master to use instead of the configuration's ``node.master_uri``.
         master: an :class:`~rosfpga_lab.graph.EmbeddedMaster` to use (overrides both).
         model: ``"fast"`` (numpy) or ``"reference"`` (one byte or beat at a time; small images).
@@ -141,7 +141,7 @@ class FpgaComponent:
                 raise ComponentConfigError(
                     f"{section}.type is {topic.type!r}: the circuit streams sensor_msgs/Image only")
         try:
-            self.pipeline = pipeline_for(config, model=model)
+            self.pipeline = Pipeline.from_config(config, model=model)
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         if input_queue < 1 or output_queue < 1:

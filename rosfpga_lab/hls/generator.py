@@ -27,7 +27,7 @@ import jinja2
 import numpy as np
 
 from rosfpga_lab import __version__
-from rosfpga_lab.hls.config import NodeConfig
+from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, SOURCES
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
@@ -145,24 +145,6 @@ def _app_summary(config: NodeConfig) -> str:
     return f"{app.ksize}x{app.ksize} {app.op}"
 
 
-def pipeline_for(config: NodeConfig, model: str = "fast") -> Pipeline:
-    """The Python model (:class:`rosfpga_lab.hw.Pipeline`) of the circuit ``config`` describes.
-
-    Raises:
-        GenerateError: ``op: custom`` (the lab cannot model the user's C++).
-    """
-    app = config.application
-    if app.op == "custom":
-        raise GenerateError("a custom application has no Python model; compare its C simulation "
-                            "against your own expectation")
-    op = "copy" if app.op == "passthrough" else app.op
-    ksize = (app.ksize, app.ksize) if op != "copy" else (1, 1)
-    return Pipeline(width=config.image.width, height=config.image.height,
-                    encoding=config.image.encoding, op=op, ksize=ksize, model=model,
-                    clock_hz=config.clock_mhz * 1e6, rx_fifo_depth=config.fifo.input_depth,
-                    max_frame_id_bytes=config.frame_id_max)
-
-
 def sample_image(config: NodeConfig) -> np.ndarray:
     """A deterministic test picture for the testbench: gradients, a grid and bright dots.
 
@@ -187,7 +169,7 @@ def sample_frames(config: NodeConfig) -> tuple[bytes, bytes]:
                         stamp=(1_700_000_000, 123_456_789), frame_id="camera")
     if config.application.op == "custom":
         return frame, b""
-    return frame, pipeline_for(config).process(frame).output_frame
+    return frame, Pipeline.from_config(config).process(frame).output_frame
 
 
 def render(config: NodeConfig) -> dict[str, str]:
@@ -312,7 +294,7 @@ def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
     """Write the HLS C++ project of ``config`` into ``out_dir``.
 
     Args:
-        config: a validated configuration (:func:`rosfpga_lab.hls.load_config`).
+        config: a validated configuration (:func:`rosfpga_lab.config.load_config`).
         out_dir: the output directory (created when missing).
         force: replace an earlier generation: delete the files its manifest lists (and the
             testbench's build products) first. Files the generator did not write are kept.

@@ -22,37 +22,12 @@ The channels are never reordered: the morphology application treats each lane al
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from rosfpga_lab.config.vocabulary import PIXEL_FORMATS, PixelFormat
 from rosfpga_lab.hw.errors import PipelineConfigError
 
-
-@dataclass(frozen=True)
-class PixelFormat:
-    """The packing rule of one encoding.
-
-    Attributes:
-        encoding: the ROS encoding string.
-        bytes_per_pixel: bytes of one pixel in the message (= channels, all are 8-bit).
-        tkeep: the ``tkeep`` of every beat carrying one pixel.
-        channels: channel names, byte 0 first.
-    """
-
-    encoding: str
-    bytes_per_pixel: int
-    tkeep: int
-    channels: str
-
-
-PIXEL_FORMATS: dict[str, PixelFormat] = {
-    "rgba8": PixelFormat("rgba8", 4, 0b1111, "RGBA"),
-    "bgra8": PixelFormat("bgra8", 4, 0b1111, "BGRA"),
-    "rgb8": PixelFormat("rgb8", 3, 0b0111, "RGB"),
-    "bgr8": PixelFormat("bgr8", 3, 0b0111, "BGR"),
-    "mono8": PixelFormat("mono8", 1, 0b0001, "Y"),
-}
+__all__ = ["PIXEL_FORMATS", "PixelFormat", "pack_lanes", "pixel_format", "unpack_lanes"]
 
 
 def pixel_format(encoding: str) -> PixelFormat:

@@ -1,12 +1,18 @@
-"""The hardware-model layer's limits and defaults, in one place."""
+"""The hardware-model layer's limits and defaults, in one place.
+
+The image-size, kernel and ``frame_id`` limits are the node configuration's
+(:mod:`rosfpga_lab.config.limits`); the rest belong to the models.
+"""
 
 from __future__ import annotations
 
+from rosfpga_lab.config import limits as _config
+
 #: Largest ``width`` / ``height`` the interpreter accepts (an "absurd" value is larger).
-MAX_WIDTH = 8192
-MAX_HEIGHT = 8192
+MAX_WIDTH = _config.MAX_WIDTH
+MAX_HEIGHT = _config.MAX_HEIGHT
 #: Longest ``header.frame_id`` and ``encoding`` strings the interpreter stores.
-MAX_FRAME_ID_BYTES = 256
+MAX_FRAME_ID_BYTES = _config.MAX_FRAME_ID_MAX
 MAX_ENCODING_BYTES = 32
 #: Largest TCPROS frame (4-byte length excluded) the interpreter accepts: 64 MiB.
 MAX_FRAME_BYTES = 64 * 1024 * 1024
@@ -14,7 +20,7 @@ MAX_FRAME_BYTES = 64 * 1024 * 1024
 TDATA_BITS = 32
 TDATA_BYTES = TDATA_BITS // 8
 #: Largest rectangular kernel of the dilate/erode application.
-MAX_KSIZE = 15
+MAX_KSIZE = _config.MAX_KSIZE
 
 #: Defaults of :class:`rosfpga_lab.hw.Pipeline`.
 DEFAULT_CLOCK_HZ = 100e6

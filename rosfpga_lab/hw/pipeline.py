@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference
 from rosfpga_lab.hw.cycles import CycleReport, account
@@ -146,6 +147,25 @@ class Pipeline:
     Raises:
         PipelineConfigError: an impossible setting (the message names it).
     """
+
+    @classmethod
+    def from_config(cls, config: NodeConfig, model: str = "fast") -> Pipeline:
+        """The model of the circuit a node configuration describes (the generator's, the RTL's
+        and the emulated node's one wiring of configuration to model).
+
+        Raises:
+            PipelineConfigError: ``op: custom`` (the lab cannot model the user's C++).
+        """
+        app = config.application
+        if app.op == "custom":
+            raise PipelineConfigError("a custom application has no Python model; compare its C "
+                                      "simulation against your own expectation")
+        op = "copy" if app.op == "passthrough" else app.op
+        ksize = (app.ksize, app.ksize) if op != "copy" else (1, 1)
+        return cls(width=config.image.width, height=config.image.height,
+                   encoding=config.image.encoding, op=op, ksize=ksize, model=model,
+                   clock_hz=config.clock_mhz * 1e6, rx_fifo_depth=config.fifo.input_depth,
+                   max_frame_id_bytes=config.frame_id_max)
 
     def __init__(self, width: int | None = None, height: int | None = None,
                  encoding: str | None = None, op: str = "dilate",

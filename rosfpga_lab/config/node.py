@@ -49,14 +49,9 @@ from typing import Any
 
 import yaml
 
-from rosfpga_lab.hls import limits
-from rosfpga_lab.hls.errors import ConfigError
-from rosfpga_lab.hw.encodings import PIXEL_FORMATS
-
-#: Operations the generated application can perform.
-OPS = ("dilate", "erode", "passthrough", "custom")
-#: Encodings the templates can serve, with bytes per pixel (the hw layer's packing rule).
-ENCODINGS: dict[str, int] = {name: fmt.bytes_per_pixel for name, fmt in PIXEL_FORMATS.items()}
+from rosfpga_lab.config import limits
+from rosfpga_lab.config.errors import ConfigError
+from rosfpga_lab.config.vocabulary import ENCODINGS, OPS
 
 # ROS 1 graph resource names (wiki.ros.org/Names): first character a letter, '/' or '~'; then
 # letters, digits, '_' and '/'. The lab also refuses '//' and a trailing '/' (roscpp does).

@@ -1,23 +1,22 @@
-"""Limits and defaults of the HLS layer, in one place.
+"""Limits and defaults of a node configuration, in one place.
 
-The image limits follow what the circuit (and its Python models in ``rosfpga_lab.hw``) accept;
-the FIFO defaults are those of the paper's block design.
+They bound what the circuit accepts: the hardware models (:mod:`rosfpga_lab.hw.limits`), the
+generated HLS C++ and the RTL derive their limits from these. The FIFO defaults are those of the
+paper's block design.
 """
 
 from __future__ import annotations
 
-from rosfpga_lab.hw import limits as hw_limits
-
-#: Image sizes the templates can serve (the interpreter refuses larger).
+#: Image sizes the circuit can serve (the interpreter refuses larger).
 MIN_WIDTH = 1
 MIN_HEIGHT = 1
-MAX_WIDTH = hw_limits.MAX_WIDTH
-MAX_HEIGHT = hw_limits.MAX_HEIGHT
+MAX_WIDTH = 8192
+MAX_HEIGHT = 8192
 #: Odd kernel sizes from 1 to this for dilate/erode.
-MAX_KSIZE = hw_limits.MAX_KSIZE
-#: Longest header.frame_id the generated subscriber stores and the publisher re-sends.
-DEFAULT_FRAME_ID_MAX = hw_limits.MAX_FRAME_ID_BYTES
-MAX_FRAME_ID_MAX = hw_limits.MAX_FRAME_ID_BYTES
+MAX_KSIZE = 15
+#: Longest header.frame_id the circuit stores and the publisher re-sends.
+MAX_FRAME_ID_MAX = 256
+DEFAULT_FRAME_ID_MAX = MAX_FRAME_ID_MAX
 #: FIFO depths (items) and their bounds.
 DEFAULT_INPUT_FIFO_DEPTH = 2048
 DEFAULT_OUTPUT_FIFO_DEPTH = 2048
@@ -30,7 +29,7 @@ MAX_CLOCK_MHZ = 1000.0
 #: Node defaults (safe: loopback unless the configuration says otherwise).
 DEFAULT_MASTER_URI = "http://127.0.0.1:11311/"
 DEFAULT_IP_ADDRESS = "127.0.0.1"
-#: The only message type the templates can stream through the circuit.
+#: The only message type that can stream through the circuit.
 IMAGE_TYPE = "sensor_msgs/Image"
 #: Largest configuration file read (bytes).
 MAX_CONFIG_BYTES = 1 << 20

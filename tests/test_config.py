@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from rosfpga_lab.errors import LabError
-from rosfpga_lab.hls import ConfigError, load_config, parse_config, ros_name_problem
+from rosfpga_lab.config import ConfigError, load_config, parse_config, ros_name_problem
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "data"

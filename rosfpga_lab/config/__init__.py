@@ -1,0 +1,28 @@
+"""The node configuration and the lab's shared vocabulary, light enough to load anywhere.
+
+One YAML file describes one ROS-compliant FPGA component (:func:`load_config`); the generator
+(``hls``), the RTL (``rtl``), the emulated node (``component``), the benchmarks and the exercise
+checks all read it through this package. Loading a configuration imports neither OpenCV nor
+Jinja2 (a test holds that)::
+
+    from rosfpga_lab.config import load_config
+    config = load_config("data/fpga_dilate_rgba8.yaml")
+    config.image.width, config.application.op, config.node.master_uri
+
+Owners: :mod:`~rosfpga_lab.config.vocabulary` (encodings and operations),
+:mod:`~rosfpga_lab.config.limits` (limits and defaults), :mod:`~rosfpga_lab.config.node` (the
+schema, its checker and the dataclasses).
+"""
+
+from rosfpga_lab.config.errors import ConfigError
+from rosfpga_lab.config.node import (
+    ApplicationConfig, FifoConfig, ImageConfig, NodeConfig, NodeSection, TopicConfig,
+    load_config, parse_config, ros_name_problem,
+)
+from rosfpga_lab.config.vocabulary import ENCODINGS, OPS, PIXEL_FORMATS, PixelFormat
+
+__all__ = [
+    "ENCODINGS", "OPS", "PIXEL_FORMATS", "ApplicationConfig", "ConfigError", "FifoConfig",
+    "ImageConfig", "NodeConfig", "NodeSection", "PixelFormat", "TopicConfig", "load_config",
+    "parse_config", "ros_name_problem",
+]

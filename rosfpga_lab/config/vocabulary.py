@@ -1,0 +1,43 @@
+"""The lab's shared vocabulary: the image encodings the circuit packs and the applications it runs.
+
+Every other module derives its lists from these tables (the configuration checker, the
+hardware models, the generator, the camera and the command line), so adding an encoding or an
+operation is one edit here. The packing rule itself (how a pixel's bytes sit in ``tdata``) is
+documented and implemented in :mod:`rosfpga_lab.hw.encodings`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class PixelFormat:
+    """The packing rule of one encoding.
+
+    Attributes:
+        encoding: the ROS encoding string.
+        bytes_per_pixel: bytes of one pixel in the message (= channels, all are 8-bit).
+        tkeep: the ``tkeep`` of every beat carrying one pixel.
+        channels: channel names, byte 0 first.
+    """
+
+    encoding: str
+    bytes_per_pixel: int
+    tkeep: int
+    channels: str
+
+
+PIXEL_FORMATS: dict[str, PixelFormat] = {
+    "rgba8": PixelFormat("rgba8", 4, 0b1111, "RGBA"),
+    "bgra8": PixelFormat("bgra8", 4, 0b1111, "BGRA"),
+    "rgb8": PixelFormat("rgb8", 3, 0b0111, "RGB"),
+    "bgr8": PixelFormat("bgr8", 3, 0b0111, "BGR"),
+    "mono8": PixelFormat("mono8", 1, 0b0001, "Y"),
+}
+
+#: Encodings the circuit can pack, with bytes per pixel.
+ENCODINGS: dict[str, int] = {name: fmt.bytes_per_pixel for name, fmt in PIXEL_FORMATS.items()}
+
+#: Operations the generated application can perform (``application.op`` of a node configuration).
+OPS = ("dilate", "erode", "passthrough", "custom")
