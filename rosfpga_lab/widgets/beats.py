@@ -214,7 +214,7 @@ class BeatMap:
                 return f'<td style="background:{bg};text-align:center;padding:1px 4px">{int(actual)}{note}</td>'
             px = self.beat_pixels(i)
             where = " ".join(f"({x}, {y})" for x, y in px[:3]) + (" \u2026" if len(px) > 3 else "")
-            sel = ' style="outline:2px solid #d00"' if i == selected else ""
+            sel = ' style="background:#ffe08a"' if i == selected else ""  # red means wrong here
             td = '<td style="padding:1px 4px">'
             rows.append(f"<tr{sel}>{td}{i}</td>{td}0x{self._word(i):0{2 * self.bus_bytes}x}</td>"
                         f"{td}0b{self._keep(i):0{self.bus_bytes}b}</td>"
