@@ -291,5 +291,5 @@ def test_selected_beat_row_is_not_drawn_in_the_error_colour() -> None:
     td, tk, tu, tl = _rgb_beats(_image(2, 4))
     html = BeatMap(width=4, height=2, bytes_per_pixel=3, tdata=td, tkeep=tk, tuser=tu,
                    tlast=tl).table_html(0, 8, selected=2)
-    row = html.split("<tr")[3]  # header, beat 0, beat 1, beat 2
+    row = html.split("<tr")[4]  # before the rows, header, beat 0, beat 1, beat 2
     assert "#ffe08a" in row and "#d00" not in row and WRONG_COLOUR not in row
