@@ -139,27 +139,37 @@ class Waves:
         return cls(out, period_ns=period_ns, title=title)
 
     @classmethod
-    def from_vcd(cls, path: str | Path, *, clock: str | None = None,
-                 signals: Iterable[str] | None = None, title: str = "") -> Waves:
-        """Signals of a VCD dump sampled at the rising edges of its clock (``rosfpga_lab.rtl.vcd``).
+    def from_vcd(cls, source: Any, *, clock: str = "aclk", signals: Iterable[str] | None = None,
+                 short_names: bool = True, title: str = "") -> Waves:
+        """Signals of a VCD dump sampled at the rising edges of its clock.
 
         Args:
-            path: the ``.vcd`` file.
-            clock: the clock's name (default: the reader's choice, ``aclk`` or ``clk``).
-            signals: names to keep, in this order (default: every signal of the dump).
+            source: a ``.vcd`` path or its bytes, or a dump already read by
+                :func:`rosfpga_lab.rtl.vcd.read_vcd`.
+            clock: the clock's name or unique name suffix.
+            signals: names or unique suffixes to keep, in this order (default: all).
+            short_names: label signals by their last scope part (``m_axis_tdata``) when that
+                is unique.
         """
         from rosfpga_lab.rtl.vcd import read_vcd
 
-        dump = read_vcd(path, clock=clock) if clock else read_vcd(path)
-        names = list(signals) if signals is not None else list(dump.signals)
+        dump = source if hasattr(source, "values") and hasattr(source, "signals") else \
+            read_vcd(source, clock=clock, signals=list(signals) if signals is not None else None)
+        names = [dump.resolve(n) for n in signals] if signals is not None else list(dump.signals)
+        tails = [n.rsplit(".", 1)[-1] for n in names]
+        unique = short_names and len(set(tails)) == len(tails)
         out = []
-        for name in names:
-            values = dump.values(name)
-            known = dump.known(name) if hasattr(dump, "known") else None
-            out.append(Signal(name, int(dump.width(name)), np.asarray(values, np.uint64),
-                              None if known is None else np.asarray(known, bool)))
-        period = float(getattr(dump, "period_ns", 10.0) or 10.0)
-        return cls(out, period_ns=period, title=title or Path(path).name)
+        for name, tail in zip(names, tails):
+            width = int(dump.width(name))
+            if width > 64:
+                continue  # wider buses are not drawn (the lab's are at most 32 bits)
+            values = np.asarray(dump.values(name))
+            known = ~np.asarray(dump.unknown(name), bool)
+            out.append(Signal(tail if unique else name, width, values.astype(np.uint64),
+                              None if known.all() else known))
+        period = dump.period
+        label = title or (Path(source).name if isinstance(source, (str, Path)) else "")
+        return cls(out, period_ns=period * 1e9 if period else 10.0, title=label)
 
     # --- look-ups --------------------------------------------------------------------------------
     def signal(self, name: str) -> Signal:
