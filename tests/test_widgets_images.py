@@ -240,7 +240,7 @@ def test_beat_viewer_links_beats_and_pixels() -> None:
     assert v.beat.value == 8
     v.beat.value = 3  # and the other way round
     assert (v.x.value, v.y.value) == (3, 0)
-    assert "<svg" in v.wave.value and 'outline:2px solid #d00"><td style="padding:1px 4px">3</td>' in v.table.value
+    assert "<svg" in v.wave.value and '<tr style="background:#ffe08a"><td style="padding:1px 4px">3</td>' in v.table.value
 
 
 def test_beat_table_and_static_html_mark_tuser_tlast_and_errors() -> None:
@@ -282,3 +282,33 @@ def test_beat_viewer_from_pipeline_result() -> None:
     assert len(v.map) == 20 and v.map.marker_mismatches() == []
     assert v.map.beat_bytes(7) == res.output_image[1, 2].tobytes()
     assert v.picture is not None
+
+
+def test_selected_beat_row_is_not_drawn_in_the_error_colour() -> None:
+    """Red marks wrong markers in the beat table; the selected row uses the highlight colour."""
+    from rosfpga_lab.widgets.beats import WRONG_COLOUR
+
+    td, tk, tu, tl = _rgb_beats(_image(2, 4))
+    html = BeatMap(width=4, height=2, bytes_per_pixel=3, tdata=td, tkeep=tk, tuser=tu,
+                   tlast=tl).table_html(0, 8, selected=2)
+    row = html.split("<tr")[4]  # before the rows, header, beat 0, beat 1, beat 2
+    assert "#ffe08a" in row and "#d00" not in row and WRONG_COLOUR not in row
+
+
+def test_beat_waveform_is_clock_true_and_agrees_with_the_clocked_model() -> None:
+    """rgba8: one beat every 4 clocks, as the byte-wide fifo2axi makes them and hw.cycles counts."""
+    from rosfpga_lab.hw import PIXEL_FORMATS, fifo2axi_fast
+    from rosfpga_lab.hw.clocked import fifo2axi_clocks
+
+    rows, cols = 2, 3
+    data = np.arange(rows * cols * 4, dtype=np.uint8) * 7
+    beats, _ = fifo2axi_fast(data, rows, cols, PIXEL_FORMATS["rgba8"])
+    m = BeatMap(beats, width=cols, height=rows, bytes_per_pixel=4)
+    arrays = m.clock_arrays(0, rows * cols)
+    model = fifo2axi_clocks(data, cols, 4)
+    n = arrays["aclk"].size
+    for name in ("s_tdata", "m_axis_tvalid", "m_axis_tdata", "m_axis_tuser", "m_axis_tlast"):
+        assert arrays[name].astype(np.uint64).tolist() == model[name][:n].tolist(), name
+    assert np.flatnonzero(arrays["m_axis_tvalid"]).tolist() == [4, 8, 12, 16, 20, 24]
+    svg = m.waveform_svg(0, 6, selected=2)
+    assert "m_axis_tready" in svg and "s_tdata" in svg and 'stroke="#d00"' in svg

@@ -1,4 +1,4 @@
-"""Notebook widgets: byte viewer, image diff, beat viewer, sequence diagram, live view, progress.
+"""Notebook widgets: byte viewer, image diff, beat viewer, waveforms, sequence diagram, live view, progress.
 
 Every widget is constructible without a running kernel or front end (so plain pytest can test
 its logic), and each has a static HTML form (``to_html()``) that needs no JavaScript, for
@@ -16,6 +16,7 @@ reference::
     W.ImageDiffViewer(output, reference, input)       # or frames=[(input, output, reference), ...]
     W.BeatViewer(beats, width=w, height=h, bytes_per_pixel=4)  # hw Beats (tdata/tkeep/tuser/tlast)
     W.SequenceDiagram(trace)                          # graph Trace or [SeqEvent(src, dst, label, raw, t, kind)]
+    W.WaveformViewer(W.Waves.from_vcd("dump.vcd"), width=640)   # per-clock signals; or Waves.from_arrays({...})
     live = W.LiveView(max_fps=10); live.update(frame, stamp=t)   # from any thread
     with W.Progress(total, "dilate") as p: p.update()  # or W.track(iterable, desc=...)
 """
@@ -37,6 +38,7 @@ from rosfpga_lab.widgets.byteview import ByteMap, ByteViewer, Span, as_span
 from rosfpga_lab.widgets.imagediff import FrameDiff, ImageDiffViewer
 from rosfpga_lab.widgets.live import LiveView, RateMeter, Throttle
 from rosfpga_lab.widgets.progress import Progress, in_notebook, track
+from rosfpga_lab.widgets.waveform import Marker, Signal, WaveformViewer, Waves
 from rosfpga_lab.widgets.sequence import (
     SeqEvent,
     SequenceDiagram,
@@ -55,4 +57,5 @@ __all__ = [
     "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
     "spans_from_http", "spans_from_tcpros_stream", "track", "view_bytes",
+    "Marker", "Signal", "WaveformViewer", "Waves",
 ]

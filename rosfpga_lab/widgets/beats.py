@@ -214,7 +214,7 @@ class BeatMap:
                 return f'<td style="background:{bg};text-align:center;padding:1px 4px">{int(actual)}{note}</td>'
             px = self.beat_pixels(i)
             where = " ".join(f"({x}, {y})" for x, y in px[:3]) + (" \u2026" if len(px) > 3 else "")
-            sel = ' style="outline:2px solid #d00"' if i == selected else ""
+            sel = ' style="background:#ffe08a"' if i == selected else ""  # red means wrong here
             td = '<td style="padding:1px 4px">'
             rows.append(f"<tr{sel}>{td}{i}</td>{td}0x{self._word(i):0{2 * self.bus_bytes}x}</td>"
                         f"{td}0b{self._keep(i):0{self.bus_bytes}b}</td>"
@@ -224,42 +224,62 @@ class BeatMap:
         rows.append("</table>")
         return "".join(rows)
 
-    def waveform_svg(self, start: int = 0, count: int = WAVE_BEATS, selected: int | None = None) -> str:
-        """A logic-analyser style SVG of beats ``start ..``: clock, tdata, tkeep, tuser, tlast."""
+    def clock_arrays(self, start: int = 0, count: int = WAVE_BEATS) -> dict[str, np.ndarray]:
+        """Per-clock signals of beats ``start ..`` as ``fifo2axi`` makes them from the 8-bit FIFO.
+
+        One byte enters per clock, so a beat is on the bus the clock after its last byte: a
+        pixel of ``B`` bytes every ``B`` clocks (4 for ``rgba8``), no gaps, no backpressure (the
+        timing of :func:`rosfpga_lab.hw.clocked.fifo2axi_clocks`; the RTL's dump shows the same).
+        The beats' own ``tdata``/``tuser``/``tlast`` are drawn, wrong ones included, held in
+        the output register until the next beat loads.
+        """
         stop = min(len(self), start + count)
-        cw, rh, left = 64, 22, 60
-        n = max(0, stop - start)
-        width, height = left + cw * max(n, 1) + 4, rh * 5 + 20
-        out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
-               f'font-family="monospace" font-size="10">']
-        names = ("aclk", "tdata", "tkeep", "tuser", "tlast")
-        for r, name in enumerate(names):
-            out.append(f'<text x="2" y="{rh * r + 15}">{name}</text>')
-        for k, i in enumerate(range(start, stop)):
-            x0 = left + k * cw
-            if i == selected:
-                out.append(f'<rect x="{x0}" y="0" width="{cw}" height="{rh * 5}" fill="#ffe08a" opacity="0.6"/>')
-            out.append(f'<polyline fill="none" stroke="#555" points="{x0},{rh - 4} {x0},6 {x0 + cw // 2},6 '
-                       f'{x0 + cw // 2},{rh - 4} {x0 + cw},{rh - 4}"/>')
-            out.append(f'<polygon fill="#eef" stroke="#333" points="{x0 + 3},{rh + 11} {x0 + 6},{rh + 4} '
-                       f'{x0 + cw - 6},{rh + 4} {x0 + cw - 3},{rh + 11} {x0 + cw - 6},{rh + 18} {x0 + 6},{rh + 18}"/>')
-            out.append(f'<text x="{x0 + 8}" y="{rh + 15}">{self._word(i):0{2 * self.bus_bytes}x}</text>')
-            out.append(f'<text x="{x0 + 8}" y="{2 * rh + 15}">{self._keep(i):0{self.bus_bytes}b}</text>')
-            out.append(f'<text x="{x0 + 2}" y="{rh * 5 + 14}" fill="#777">{i}</text>')
-        eu, el = self.expected_markers()
-        for r, sig, exp in ((3, self.tuser, eu), (4, self.tlast, el)):
-            points = []
-            for k, i in enumerate(range(start, stop)):
-                x0 = left + k * cw
-                y = rh * r + (6 if sig[i] else rh - 4)
-                if sig[i] != exp[i]:  # wrong marker: red band, labelled with what was expected
-                    out.append(f'<rect x="{x0}" y="{rh * r + 2}" width="{cw}" height="{rh - 4}" fill="{WRONG_COLOUR}"/>')
-                    out.append(f'<text x="{x0 + 4}" y="{rh * r + 15}" font-size="9">expect {int(exp[i])}</text>')
-                points += [f"{x0},{y}", f"{x0 + cw},{y}"]
-            if points:
-                out.append(f'<polyline fill="none" stroke="#070" stroke-width="2" points="{" ".join(points)}"/>')
-        out.append("</svg>")
-        return "".join(out)
+        if stop <= start:
+            raise WidgetError(f"no beats from {start}; beats are 0..{len(self) - 1}")
+        first_byte = int(self.starts[start])
+        last_clock = int(self.ends[stop - 1]) - first_byte  # the last beat's clock
+        n = last_clock + 1
+        stream = self.lanes[self.keep]
+        s_tdata = np.zeros(n, np.uint64)
+        nbytes = int(self.ends[stop - 1]) - first_byte
+        s_tdata[:nbytes] = stream[first_byte:first_byte + nbytes]
+        s_tvalid = np.zeros(n, bool)
+        s_tvalid[:nbytes] = True
+        on = (self.ends[start:stop] - first_byte).astype(np.int64)  # clock of each beat
+        valid = np.zeros(n, bool)
+        valid[on] = True
+        # register contents: each beat's values from its clock until the next beat's
+        idx = np.full(n, -1, np.int64)
+        idx[on] = np.arange(start, stop)
+        idx = np.maximum.accumulate(idx)
+        have = idx >= 0
+        words = (self.lanes.astype(np.uint64) << (8 * np.arange(self.bus_bytes, dtype=np.uint64))).sum(axis=1)
+        keeps = (self.keep.astype(np.uint64) << np.arange(self.bus_bytes, dtype=np.uint64)).sum(axis=1)
+        def held(values: np.ndarray) -> np.ndarray:
+            out = np.zeros(n, np.uint64)
+            out[have] = values[idx[have]]
+            return out
+        return {"aclk": np.ones(n, bool), "s_tdata": s_tdata, "s_tvalid": s_tvalid,
+                "s_tready": np.ones(n, bool), "m_axis_tvalid": valid, "m_axis_tready": np.ones(n, bool),
+                "m_axis_tdata": held(words), "m_axis_tkeep": held(keeps),
+                "m_axis_tuser": held(self.tuser.astype(np.uint64)).astype(bool),
+                "m_axis_tlast": held(self.tlast.astype(np.uint64)).astype(bool)}
+
+    def waveform_svg(self, start: int = 0, count: int = WAVE_BEATS, selected: int | None = None) -> str:
+        """A logic-analyser picture of beats ``start ..``, clock by clock: the 8-bit stream into
+        ``fifo2axi`` and the beats out of it with ``tvalid``/``tready``; the cursor on ``selected``."""
+        from rosfpga_lab.widgets.waveform import Waves
+
+        if not len(self):
+            return "<div>no beats</div>"
+        arrays = self.clock_arrays(start, count)
+        waves = Waves.from_arrays(arrays, widths={"s_tdata": 8, "m_axis_tdata": 8 * self.bus_bytes,
+                                                  "m_axis_tkeep": self.bus_bytes})
+        first = int(self.starts[start])
+        cursor = None
+        if selected is not None and start <= selected < min(len(self), start + count):
+            cursor = int(self.ends[selected]) - first
+        return waves.svg(0, waves.clocks, cursor=cursor)
 
     def to_html(self, start: int = 0, count: int = BEAT_PAGE_SIZE) -> str:
         """Static HTML: summary, waveform of the first beats, the beat table, marker mismatches."""
