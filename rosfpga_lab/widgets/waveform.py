@@ -612,9 +612,11 @@ class WaveformViewer(StaticFallback, w.VBox):
             self.values.value = ""
             return
         vals = self.waves.values_at(self.cursor)
-        rows = "".join(f"<tr><td>{esc(k)}</td><td>{esc(v)}</td></tr>" for k, v in vals.items())
-        self.values.value = (f'<div style="font-family:monospace;font-size:12px"><b>clock {self.cursor}</b>'
-                             f'<table>{rows}</table></div>')
+        items = "".join(f'<span data-signal="{esc(k)}">{esc(k)} = <b>{esc(v)}</b></span>'
+                        for k, v in vals.items())
+        self.values.value = (f'<div class="rfl-wave-values" style="font-family:monospace;font-size:12px">'
+                             f'<b>clock {self.cursor}</b><div style="display:flex;flex-wrap:wrap;'
+                             f'gap:2px 18px">{items}</div></div>')
 
     def to_html(self) -> str:
         return self.waves.to_html(self.start, self.span)
