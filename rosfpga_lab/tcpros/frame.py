@@ -44,13 +44,20 @@ def frame_prefix(length: int) -> bytes:
 class FrameDecoder:
     """Incremental frame decoder.
 
+    Args:
+        max_frame: largest body length accepted (checked when the prefix arrives).
+        stream_offset: stream offset of the first byte fed (for error messages).
+        first_buffer: first size of a lent body buffer (see the module docstring).
+
     Attributes:
         frames: number of complete frames returned so far.
         offset: bytes consumed from the stream so far (for error messages).
     """
 
-    def __init__(self, *, max_frame: int = MAX_FRAME_BYTES, stream_offset: int = 0) -> None:
+    def __init__(self, *, max_frame: int = MAX_FRAME_BYTES, stream_offset: int = 0,
+                 first_buffer: int = FRAME_BUFFER_FIRST) -> None:
         self.max_frame = max_frame
+        self.first_buffer = max(1, first_buffer)
         self.frames = 0
         self.offset = stream_offset
         self._prefix = bytearray()
@@ -164,8 +171,13 @@ class FrameDecoder:
         if self._body is None:
             return None
         if len(self._body) == self._have:
-            room = min(self._length, max(2 * self._have, FRAME_BUFFER_FIRST)) - self._have
-            self._body += bytes(room)
+            room = min(self._length, max(2 * self._have, self.first_buffer)) - self._have
+            try:
+                self._body += bytes(room)  # in place (realloc), so lent views stay valid
+            except BufferError:  # the reader still holds a view: grow into a new buffer
+                grown = bytearray(self._have + room)
+                grown[:self._have] = self._body
+                self._body = grown
         return memoryview(self._body)[self._have:]
 
     def filled(self, n: int) -> list[bytearray]:
