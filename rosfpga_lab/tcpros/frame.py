@@ -7,7 +7,8 @@ a ``bytearray`` (the bytes copied into it as they arrive, then handed over). Eit
 caller gets a bytes-like object; call ``bytes(body)`` for an immutable copy.
 
 Memory follows the bytes received, never the length a peer declares: a frame's buffer starts
-at most :data:`FRAME_BUFFER_FIRST` bytes long and at most doubles each time it fills, so a
+at most :data:`FRAME_BUFFER_FIRST` bytes long and at most doubles (by 4 MiB at most) each
+time it fills, so a
 peer that declares 60 MiB and sends 1 MiB costs about 2 MiB. For big frames a reader can skip
 the copy: once a frame's length prefix has been fed, :meth:`FrameDecoder.pending_body` lends
 the still-empty room of that frame's buffer (growing it first when it is full); the reader
@@ -29,6 +30,9 @@ from rosfpga_lab.tcpros.errors import (
 )
 
 _U32 = struct.Struct("<I")
+#: Zeros a growing body buffer is extended with (its largest step). Never written, so its pages
+#: stay unmapped/shared: it costs address space, not memory.
+_ZEROS = bytes(4 << 20)
 
 
 def encode_frame(body: bytes | bytearray | memoryview) -> bytes:
@@ -163,17 +167,17 @@ class FrameDecoder:
         """Room in the frame body being assembled, to receive into; else None.
 
         The room is never larger than what the frame still misses; when the buffer is full it
-        first grows to at most twice the bytes received so far (at least
-        :data:`FRAME_BUFFER_FIRST`), so memory follows received bytes. None between frames and
+        first grows to at most twice the bytes received so far (at least ``first_buffer``,
+        by 4 MiB at most), so memory follows received bytes. None between frames and
         inside a length prefix: then :meth:`feed` the next bytes. Write into the view (e.g.
         ``n = sock.recv_into(view)``), release it, then call :meth:`filled`.
         """
         if self._body is None:
             return None
         if len(self._body) == self._have:
-            room = min(self._length, max(2 * self._have, self.first_buffer)) - self._have
-            try:
-                self._body += bytes(room)  # in place (realloc), so lent views stay valid
+            room = min(self._length - self._have, max(self._have, self.first_buffer), len(_ZEROS))
+            try:  # in place (realloc), from one shared zero block: no temporary per growth
+                self._body += memoryview(_ZEROS)[:room]
             except BufferError:  # the reader still holds a view: grow into a new buffer
                 grown = bytearray(self._have + room)
                 grown[:self._have] = self._body
