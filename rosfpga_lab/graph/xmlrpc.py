@@ -254,7 +254,11 @@ def _read_body(sock: socket.socket, buf: bytearray, headers: dict[str, str],
         if not chunk:
             raise XmlRpcError(f"connection closed after {len(buf)} of {length} body bytes")
         buf += chunk
-    body = bytes(buf[:length])
+    if len(buf) == length:  # the usual case: one copy, not a slice and then a copy
+        body = bytes(buf)
+        buf.clear()
+        return body
+    body = bytes(memoryview(buf)[:length])
     del buf[:length]
     return body
 
