@@ -221,7 +221,7 @@ def test_whole_request_deadline_closes_a_dripping_socket() -> None:
                 reply = s.recv(4096)
             except OSError:
                 pass
-        assert time.monotonic() - t0 < 3.5
+        assert time.monotonic() - t0 < 2.5  # closed soon after 0.5 s, not after 30 s of idling
         assert reply == b"" or b"408" in reply.split(b"\r\n", 1)[0] or b"400" in reply
     finally:
         server.stop()
