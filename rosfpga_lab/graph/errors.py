@@ -34,6 +34,9 @@ MAX_PENDING_HANDSHAKES = 64
 #: connection ...) and the longest pause; the pause doubles while accept keeps failing.
 ACCEPT_BACKOFF_FIRST = 0.01
 ACCEPT_BACKOFF_MAX = 0.5
+#: Seconds between two log lines about failing accept() calls of one server (the ones between
+#: are counted and reported with the next line).
+ACCEPT_LOG_INTERVAL = 10.0
 #: Publishers one subscriber links to at once (each link is a thread and a socket); URIs past
 #: this in a publisher list are ignored and logged. ``Node.subscribe(max_publishers=)``.
 MAX_PUBLISHERS_PER_TOPIC = 100
