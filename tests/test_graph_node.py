@@ -489,18 +489,19 @@ def test_many_reconnects_keep_bounded_link_stats(nodes, monkeypatch) -> None:
 
 def test_connection_floods_are_bounded(nodes, monkeypatch) -> None:
     import rosfpga_lab.graph.node as node_mod
-    import rosfpga_lab.graph.xmlrpc as xmlrpc_mod
 
     monkeypatch.setattr(node_mod, "MAX_PENDING_HANDSHAKES", 3)
-    monkeypatch.setattr(xmlrpc_mod, "MAX_XMLRPC_CONNECTIONS", 3)
     a, b = nodes("/flooded"), nodes("/fine")
+    a._xmlrpc.max_connections = 3
     pub = a.advertise("/f", "std_msgs/String")
     idle = []
     try:
         for _ in range(5):
             idle.append(socket.create_connection(("127.0.0.1", a.tcpros_port), timeout=5))
             idle.append(socket.create_connection(("127.0.0.1", a._xmlrpc.port), timeout=5))
-        assert wait_until(lambda: a.refused_connections >= 2 and a._xmlrpc.refused >= 2, 5)
+        # the oldest idle connections make room: never more than the caps are kept
+        assert wait_until(lambda: a.refused_connections >= 2 and a._xmlrpc.evicted >= 2, 5)
+        assert len(a._pending) <= 3 and len(a._xmlrpc._conns) <= 3
     finally:
         for s in idle:
             s.close()

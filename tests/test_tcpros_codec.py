@@ -272,10 +272,11 @@ def test_frames_before_a_bad_length_are_not_lost() -> None:
 
 
 # ------------------------------------------------------------------------------ receive in place
-def read_in_place(stream: bytes, chunks: list[int], lends: list[int]) -> tuple[list, list[int], int]:
+def read_in_place(stream: bytes, chunks: list[int], lends: list[int],
+                  first_buffer: int | None = None) -> tuple[list, list[int], int]:
     """Drive a decoder as the subscriber's socket loop does: feed() a chunk between frame bodies,
     write straight into pending_body() inside one. Returns (bodies, starts, bytes written in place)."""
-    dec = FrameDecoder()
+    dec = FrameDecoder() if first_buffer is None else FrameDecoder(first_buffer=first_buffer)
     out: list = []
     starts: list[int] = []
     pos, i, in_place = 0, 0, 0
@@ -288,8 +289,10 @@ def read_in_place(stream: bytes, chunks: list[int], lends: list[int]) -> tuple[l
         else:
             n = min(lends[i % len(lends)] if lends else len(view), len(view), len(stream) - pos)
             view[:n] = stream[pos:pos + n]  # what sock.recv_into(view) does
+            lent = view.obj
+            view.release()
             got = dec.filled(n)
-            assert not got or got[0] is view.obj  # the buffer lent is the body handed over
+            assert not got or got[0] is lent  # the buffer lent is the body handed over
             pos += n
             in_place += n
         out += got
@@ -327,6 +330,64 @@ def test_in_place_reads_equal_plain_feeding(bodies: list[bytes], chunks: list[in
     out, starts, _ = read_in_place(stream, chunks, lends)
     assert [bytes(b) for b in out] == bodies
     assert starts == expected_starts(bodies)
+
+
+@settings(max_examples=100, deadline=None)
+@given(bodies=st.lists(st.binary(max_size=600), max_size=8),
+       chunks=st.lists(st.integers(1, 700), max_size=6), lends=st.lists(st.integers(1, 700), max_size=6),
+       first=st.integers(1, 64))
+def test_growing_buffers_read_the_same_frames(bodies: list[bytes], chunks: list[int],
+                                              lends: list[int], first: int) -> None:
+    """Tiny first buffers make every lent body grow many times: same frames, same offsets."""
+    stream = b"".join(encode_frame(b) for b in bodies)
+    out, starts, _ = read_in_place(stream, chunks, lends, first_buffer=first)
+    assert [bytes(b) for b in out] == bodies
+    assert starts == expected_starts(bodies)
+
+
+def _peak_while(fn) -> int:
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        fn()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_memory_follows_bytes_received_not_the_declared_length() -> None:
+    """A peer declares 60 MiB and sends 1 MiB: the decoder holds about 1-2 MiB, either path."""
+    declared, sent = 60 << 20, 1 << 20
+    payload = bytes(range(256)) * (sent // 256)
+
+    def fed() -> None:
+        dec = FrameDecoder()
+        for i in range(0, sent, 65536):
+            first = u32(declared) if i == 0 else b""
+            assert dec.feed(first + payload[i:i + 65536]) == []
+        assert dec.in_frame
+
+    def lent() -> None:
+        dec = FrameDecoder()
+        dec.feed(u32(declared))
+        got = 0
+        while got < sent:
+            view = dec.pending_body()
+            n = min(len(view), 65536, sent - got)
+            view[:n] = payload[got:got + n]
+            view.release()
+            dec.filled(n)
+            got += n
+
+    assert _peak_while(fed) < 4 << 20
+    assert _peak_while(lent) < 4 << 20
+
+
+def test_an_honest_big_frame_grows_in_place() -> None:
+    body = bytes(range(256)) * (3 << 12)  # 3 MiB
+    out, _, in_place = read_in_place(encode_frame(body) + encode_frame(b"x"), chunks=[4], lends=[])
+    assert bytes(out[0]) == body and bytes(out[1]) == b"x" and in_place == len(body) + 1  # both bodies lent
 
 
 def test_limit_is_checked_before_a_buffer_is_lent() -> None:

@@ -266,3 +266,20 @@ def test_subscriber_receives_a_body_in_place() -> None:
     (second,) = s.receive_data(encode_frame(BODY))
     assert bytes(second.body) == BODY and second.index == 1 and second.offset == len(reply) + len(wire)
     assert [t.trigger for t in s.history] == ["connect", "header_ok", "frame", "frame"]
+
+
+def test_history_stays_short_over_a_long_stream() -> None:
+    """A million frames leave a handshake history of a few entries (repeats are counted)."""
+    s, p = sub(), pub()
+    p.receive_data(s.initiate())
+    reply = p.reply_fields(p.spec)
+    from rosfpga_lab.tcpros import encode_header, encode_frame
+
+    s.receive_data(encode_header(reply))
+    chunk = encode_frame(BODY) * 1000
+    for _ in range(1000):
+        assert len(s.receive_data(chunk)) == 1000
+        p.send(BODY)
+    assert len(s.history) <= 8 and len(p.history) <= 8
+    assert s.repeats["frame"] == 1_000_000 - 3 and p.repeats["send"] == 1000 - 3
+    assert [t.trigger for t in s.history] == ["connect", "header_ok", "frame", "frame", "frame"]

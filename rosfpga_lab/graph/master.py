@@ -3,27 +3,71 @@
 How it works: an :class:`~rosfpga_lab.graph.xmlrpc.XmlRpcServer` answers the Master API and
 Parameter Server API with the same ``[code, status, value]`` replies as Noetic's rosmaster
 (status texts included). Registrations live in dicts under one lock. Whenever a topic's
-publisher list changes, every subscriber of that topic gets ``publisherUpdate`` from a
-notifier thread, as rosmaster does; parameter subscribers get ``paramUpdate``; a node that
-registers under a name already taken by another URI makes the master tell the old one to
-``shutdown``. Real rospy, roscpp, rostopic and rosnode work against it unchanged.
+publisher list changes, every subscriber of that topic gets ``publisherUpdate``, as rosmaster
+does; parameter subscribers get ``paramUpdate``; a node that registers under a name already
+taken by another URI makes the master tell the old one to ``shutdown``. Real rospy, roscpp,
+rostopic and rosnode work against it unchanged.
+
+Notifications go out from :data:`NOTIFY_WORKERS` threads, one node at a time per worker and in
+order per node; a notification that replaces a still-waiting one for the same node and topic
+(or key) takes its place (coalescing), so a silent node holds one worker and its own queue,
+never the graph. Registrations and unregistrations are logged as rosmaster logs them (``+PUB
+[/topic] /caller http://api``...) on the ``rosfpga_lab.graph.master`` logger, with the peer's
+address; parameter values are refused when they hold ``<nil/>`` or integers outside XML-RPC's
+32-bit range (rosmaster stores those and then fails every ``getParam`` that reaches them).
 """
 
 from __future__ import annotations
 
+import collections
+import logging
 import os
-import queue
 import threading
 import uuid
 from typing import Any
 
 from rosfpga_lab.graph.apicheck import api_methods, checked
-from rosfpga_lab.graph.errors import JOIN_TIMEOUT, MAX_ERRORS_KEPT, NOTIFY_TIMEOUT
+from rosfpga_lab.graph.errors import (
+    JOIN_TIMEOUT,
+    MAX_ERRORS_KEPT,
+    MAX_NOTIFY_PENDING,
+    MAX_XMLRPC_DEPTH,
+    NOTIFY_TIMEOUT,
+    NOTIFY_WORKERS,
+    XmlRpcError,
+)
 from rosfpga_lab.graph.names import bind_address, canonical, namespace_of, resolve
 from rosfpga_lab.graph.trace import Trace
-from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call
+from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, check_int_range, request_peer, value_depth
 
 MASTER_ID = "/master"
+log = logging.getLogger("rosfpga_lab.graph.master")
+
+
+def check_param_value(value: Any) -> str | None:
+    """Why the parameter server refuses ``value`` (rosmaster-style text), or None when fine.
+
+    Refused: ``<nil/>`` anywhere, integers outside XML-RPC's 32-bit range, nesting deeper than
+    :data:`MAX_XMLRPC_DEPTH`. Each would make later ``getParam`` calls fail for every node.
+    """
+    if value is None:
+        return "ERROR: parameter [value] must be specified"  # rosmaster's text for <nil/>
+    if value_depth(value, MAX_XMLRPC_DEPTH + 1) > MAX_XMLRPC_DEPTH:
+        return f"ERROR: parameter [value] is nested deeper than {MAX_XMLRPC_DEPTH} levels"
+    stack = [value]
+    while stack:
+        v = stack.pop()
+        if v is None:
+            return "ERROR: parameter [value] must not contain nil values"
+        if isinstance(v, (list, tuple)):
+            stack.extend(v)
+        elif isinstance(v, dict):
+            stack.extend(v.values())
+    try:
+        check_int_range(value)
+    except XmlRpcError as exc:
+        return f"ERROR: parameter [value]: {exc}"
+    return None
 
 
 class ParamTree:
@@ -129,9 +173,17 @@ class EmbeddedMaster:
         self.params.set("/run_id", str(uuid.uuid1()))
         self.params.set("/rosdistro", "noetic\n")
         self.params.set("/rosversion", "1.16.0\n")
-        self._notify_q: queue.Queue = queue.Queue()
-        self._notifier: threading.Thread | None = None
+        # api -> {(method, topic or key): args}, waiting; _ready: apis no worker serves yet
+        self._pending: dict[str, dict[tuple[str, str], tuple]] = {}
+        self._pending_count = 0
+        self._ready: collections.deque[str] = collections.deque()
+        self._serving: set[str] = set()
+        self._notify_cond = threading.Condition()
+        self._notifiers: list[threading.Thread] = []
+        self._stopping = False
         self.notify_errors: list[str] = []
+        #: notifications dropped because MAX_NOTIFY_PENDING were waiting
+        self.notify_dropped = 0
         self.running = False
 
     # ------------------------------------------------------------------ life cycle
@@ -149,9 +201,12 @@ class EmbeddedMaster:
         """Start serving; returns self."""
         self._server.start()
         self.trace.names[self.uri] = MASTER_ID
-        self._notifier = threading.Thread(target=self._notify_loop, name="rosfpga-master-notify",
-                                          daemon=True)
-        self._notifier.start()
+        self._stopping = False
+        self._notifiers = [threading.Thread(target=self._notify_loop, daemon=True,
+                                            name=f"rosfpga-master-notify-{i}")
+                           for i in range(NOTIFY_WORKERS)]
+        for t in self._notifiers:
+            t.start()
         self.running = True
         return self
 
@@ -161,9 +216,11 @@ class EmbeddedMaster:
             return
         self.running = False
         self._server.stop()
-        self._notify_q.put(None)
-        if self._notifier is not None:
-            self._notifier.join(JOIN_TIMEOUT)
+        with self._notify_cond:
+            self._stopping = True
+            self._notify_cond.notify_all()
+        for t in self._notifiers:
+            t.join(JOIN_TIMEOUT)
 
     def __enter__(self) -> EmbeddedMaster:
         return self.start()
@@ -178,28 +235,65 @@ class EmbeddedMaster:
         return f(*params)
 
     # ------------------------------------------------------------------ notifications
+    def _notify(self, api: str, method: str, key: str, args: tuple) -> None:
+        """Queue ``method(MASTER_ID, *args)`` to ``api``; replaces a waiting one with the same key."""
+        with self._notify_cond:
+            waiting = self._pending.setdefault(api, {})
+            if (method, key) not in waiting:
+                if self._pending_count >= MAX_NOTIFY_PENDING:
+                    self.notify_dropped += 1
+                    self._note_error(f"{method} to {api} dropped: {MAX_NOTIFY_PENDING} "
+                                     "notifications already waiting")
+                    if not waiting:
+                        del self._pending[api]
+                    return
+                self._pending_count += 1
+            waiting[(method, key)] = args
+            if api not in self._serving and api not in self._ready:
+                self._ready.append(api)
+                self._notify_cond.notify()
+
+    def _note_error(self, text: str) -> None:
+        self.notify_errors.append(text)
+        del self.notify_errors[:-MAX_ERRORS_KEPT]
+
     def _notify_loop(self) -> None:
         while True:
-            item = self._notify_q.get()
-            if item is None:
-                return
-            api, method, args = item
-            try:
-                call(api, method, MASTER_ID, *args, trace=self.trace, caller=MASTER_ID,
-                     timeout=NOTIFY_TIMEOUT)
-            except Exception as exc:  # one bad node (e.g. an unusable URI) must not stop the rest
-                self.notify_errors.append(f"{method} to {api}: {type(exc).__name__}: {exc}")
-                del self.notify_errors[:-MAX_ERRORS_KEPT]
+            with self._notify_cond:
+                while not self._ready and not self._stopping:
+                    self._notify_cond.wait()
+                if self._stopping:
+                    return
+                api = self._ready.popleft()
+                items = self._pending.pop(api, {})
+                self._pending_count -= len(items)
+                self._serving.add(api)
+            for (method, _key), args in items.items():
+                if self._stopping:
+                    break
+                try:
+                    call(api, method, MASTER_ID, *args, trace=self.trace, caller=MASTER_ID,
+                         timeout=NOTIFY_TIMEOUT)
+                except Exception as exc:  # one bad node (e.g. an unusable URI) must not stop the rest
+                    with self._notify_cond:
+                        self._note_error(f"{method} to {api}: {type(exc).__name__}: {exc}")
+            with self._notify_cond:
+                self._serving.discard(api)
+                if self._pending.get(api):  # more came while we were busy with this node
+                    self._ready.append(api)
+                    self._notify_cond.notify()
 
     def _notify_topic(self, topic: str) -> None:
         pubs = list(self.publishers.get(topic, {}).values())
         for api in self.subscribers.get(topic, {}).values():
-            self._notify_q.put((api, "publisherUpdate", (topic, pubs)))
+            self._notify(api, "publisherUpdate", topic, (topic, pubs))
 
     def _register_node(self, caller_id: str, api: str) -> None:
         old = self.nodes.get(caller_id)
         if old is not None and old != api:
-            self._notify_q.put((old, "shutdown", ("[%s] Reason: new node registered with same name" % caller_id,)))
+            log.info("node [%s] re-registered with %s (was %s): telling the old one to shut down "
+                     "(from %s)", caller_id, api, old, request_peer())
+            self._notify(old, "shutdown", "", ("[%s] Reason: new node registered with same name" % caller_id,))
             for table in (self.publishers, self.subscribers, self.param_subscribers):
                 for regs in table.values():
                     if regs.get(caller_id) == old:
@@ -214,6 +308,16 @@ class EmbeddedMaster:
         if any(caller_id in regs for regs in self.services.values()):
             return
         self.nodes.pop(caller_id, None)
+
+    @staticmethod
+    def _log(tag: str, key: str, caller_id: str, api: str, refused: str = "") -> None:
+        """One rosmaster-style line: ``+PUB [/topic] /caller http://api (from host:port)``."""
+        if refused:
+            log.warning("%s [%s] %s %s (from %s): refused: %s", tag, key, caller_id, api,
+                        request_peer() or "this process", refused)
+        else:
+            log.info("%s [%s] %s %s (from %s)", tag, key, caller_id, api,
+                     request_peer() or "this process")
 
     # ------------------------------------------------------------------ master API
     @checked((), -1)
@@ -240,11 +344,12 @@ class EmbeddedMaster:
                 self.topic_types[topic] = topic_type
             self._notify_topic(topic)
             subs = list(self.subscribers.get(topic, {}).values())
+        self._log("+PUB", topic, caller_id, caller_api)
         return 1, f"Registered [{caller_id}] as publisher of [{topic}]", subs
 
     @checked((("topic", "topic"), ("caller_api", "api")), 0)
     def unregisterPublisher(self, caller_id: str, topic: str, caller_api: str) -> tuple:
-        return self._unregister(self.publishers, "publisher", caller_id, topic, caller_api, notify=True)
+        return self._unregister(self.publishers, "-PUB", caller_id, topic, caller_api, notify=True)
 
     @checked((("topic", "topic"), ("topic_type", "type"), ("caller_api", "api")), [])
     def registerSubscriber(self, caller_id: str, topic: str, topic_type: str, caller_api: str) -> tuple:
@@ -254,20 +359,24 @@ class EmbeddedMaster:
             if topic not in self.topic_types and topic_type != "*":
                 self.topic_types[topic] = topic_type
             pubs = list(self.publishers.get(topic, {}).values())
+        self._log("+SUB", topic, caller_id, caller_api)
         return 1, f"Subscribed to [{topic}]", pubs
 
     @checked((("topic", "topic"), ("caller_api", "api")), 0)
     def unregisterSubscriber(self, caller_id: str, topic: str, caller_api: str) -> tuple:
-        return self._unregister(self.subscribers, "subscriber", caller_id, topic, caller_api)
+        return self._unregister(self.subscribers, "-SUB", caller_id, topic, caller_api)
 
-    def _unregister(self, table: dict, what: str, caller_id: str, key: str, api: str,
+    def _unregister(self, table: dict, tag: str, caller_id: str, key: str, api: str,
                     notify: bool = False) -> tuple:
         with self._lock:
             if caller_id not in self.nodes:
+                self._log(tag, key, caller_id, api, "not a registered node")
                 return 1, f"[{caller_id}] is not a registered node", 0
             regs = table.get(key, {})
             if regs.get(caller_id) != api:
+                self._log(tag, key, caller_id, api, f"registered with {regs.get(caller_id)}")
                 return 1, f"[{caller_id}] is not a known provider of [{key}]", 0
+            self._log(tag, key, caller_id, api)
             del regs[caller_id]
             if not regs:
                 table.pop(key, None)
@@ -281,6 +390,7 @@ class EmbeddedMaster:
         with self._lock:
             self._register_node(caller_id, caller_api)
             self.services[service] = {caller_id: (service_api, caller_api)}
+        self._log("+SERVICE", service, caller_id, caller_api)
         return 1, f"Registered [{caller_id}] as provider of [{service}]", 1
 
     @checked((("service", "topic"), ("service_api", "api")), 0)
@@ -288,7 +398,9 @@ class EmbeddedMaster:
         with self._lock:
             regs = self.services.get(service, {})
             if caller_id not in regs or regs[caller_id][0] != service_api:
+                self._log("-SERVICE", service, caller_id, service_api, "not its provider")
                 return 1, f"[{caller_id}] is not a registered provider of [{service}]", 0
+            self._log("-SERVICE", service, caller_id, service_api)
             del self.services[service]
             self._forget_if_idle(caller_id)
         return 1, f"Unregistered [{caller_id}] as provider of [{service}]", 1
@@ -343,17 +455,23 @@ class EmbeddedMaster:
             except KeyError:
                 return -1, f"parameter [{key}] is not set", 0
             self._notify_params(key, {})
+        log.info("-PARAM [%s] by %s (from %s)", key, caller_id, request_peer() or "this process")
         return 1, f"parameter {key} deleted", 0
 
     @checked((("key", "key"), ("value", "any")), 0)
     def setParam(self, caller_id: str, key: str, value: Any) -> tuple:
         key = resolve(key, caller_id)
+        problem = check_param_value(value)
+        if problem is not None:
+            self._log("+PARAM", key, caller_id, "", problem)
+            return -1, problem, 0
         with self._lock:
             try:
                 self.params.set(key, value)
             except ValueError as exc:
                 return -1, str(exc), 0
             self._notify_params(key, value)
+        log.info("+PARAM [%s] by %s (from %s)", key, caller_id, request_peer() or "this process")
         return 1, f"parameter {key} set", 0
 
     @checked((("key", "key"),), 0)
@@ -392,6 +510,7 @@ class EmbeddedMaster:
         with self._lock:
             self._register_node(caller_id, caller_api)
             self.param_subscribers.setdefault(key, {})[caller_id] = caller_api
+            self._log("+CACHEDPARAM", key, caller_id, caller_api)
             try:
                 value = self.params.get(key)
             except KeyError:
@@ -401,7 +520,7 @@ class EmbeddedMaster:
     @checked((("caller_api", "api"), ("key", "key")), 0)
     def unsubscribeParam(self, caller_id: str, caller_api: str, key: str) -> tuple:
         key = resolve(key, caller_id)
-        self._unregister(self.param_subscribers, "parameter subscriber", caller_id, key, caller_api)
+        self._unregister(self.param_subscribers, "-CACHEDPARAM", caller_id, key, caller_api)
         return 1, f"Unsubscribe to parameter [{key}]", 1  # rosmaster always answers 1
 
     @checked((("key", "key"),), False)
@@ -423,4 +542,5 @@ class EmbeddedMaster:
                 except KeyError:
                     sub_value = {}
                 for api in regs.values():
-                    self._notify_q.put((api, "paramUpdate", (sub_key + "/" if sub_key != "/" else "/", sub_value)))
+                    self._notify(api, "paramUpdate", sub_key,
+                                 (sub_key + "/" if sub_key != "/" else "/", sub_value))

@@ -5,7 +5,9 @@ XML-RPC Slave API (``requestTopic``, ``publisherUpdate``, ``getBusInfo`` ...) an
 port. :meth:`Node.advertise` registers a publisher with the master; a subscriber that calls
 ``requestTopic`` learns the TCPROS port, connects, and a handshake thread runs
 :class:`~rosfpga_lab.tcpros.PublisherHandshake` (with a time-out, so a silent client cannot
-hold anything) before handing the socket to the publisher. :meth:`Node.subscribe` registers a
+hold anything) before handing the socket to the publisher; at ``MAX_PENDING_HANDSHAKES`` a new
+connection evicts the oldest one still in its handshake (an honest subscriber sends its header
+at once, so only idle peers are evicted). :meth:`Node.subscribe` registers a
 subscriber and connects to every publisher the master lists (see ``subscriber``). Everything
 runs in daemon threads, so a node works inside a running Jupyter kernel; :meth:`shutdown`
 unregisters, closes every socket and joins every thread.
@@ -30,6 +32,7 @@ from rosfpga_lab.graph.apicheck import api_methods, checked
 from rosfpga_lab.graph.errors import (
     JOIN_TIMEOUT,
     MAX_PENDING_HANDSHAKES,
+    MAX_PUBLISHERS_PER_TOPIC,
     GraphError,
     MasterError,
     XmlRpcError,
@@ -46,7 +49,7 @@ from rosfpga_lab.graph.names import (
 from rosfpga_lab.graph.publisher import Publisher
 from rosfpga_lab.graph.subscriber import Subscriber
 from rosfpga_lab.graph.trace import Trace, new_connection_id
-from rosfpga_lab.graph.wire import RECV_CHUNK, hard_close
+from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close
 from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, split_uri
 from rosfpga_lab.tcpros import (
     HANDSHAKE_TIMEOUT,
@@ -158,7 +161,8 @@ class Node:
         self.publishers: dict[str, Publisher] = {}
         self.subscribers: dict[str, Subscriber] = {}
         self._handshakes: set[threading.Thread] = set()
-        self._pending: set[socket.socket] = set()
+        self._pending: dict[socket.socket, float] = {}  # socket -> when it was accepted
+        #: TCPROS connections closed in their handshake to make room for a newer one
         self.refused_connections = 0
         self.is_shutdown = False
         bind = bind_address(self.host)
@@ -271,7 +275,8 @@ class Node:
     def subscribe(self, topic: str, type_name: str, callback: Callable[..., Any] | None = None, *,
                   raw: bool = False, queue_size: int = 10, tcp_nodelay: bool = False,
                   md5sum: str | None = None, send_definition: bool = False,
-                  max_frame: int = MAX_FRAME_BYTES) -> Subscriber:
+                  max_frame: int = MAX_FRAME_BYTES,
+                  max_publishers: int = MAX_PUBLISHERS_PER_TOPIC) -> Subscriber:
         """Subscribe to ``topic``; return the :class:`Subscriber`.
 
         Args:
@@ -282,6 +287,9 @@ class Node:
             tcp_nodelay: ask publishers for TCP_NODELAY.
             md5sum: override the registry (``"*"`` with type ``"*"`` accepts any type, raw only).
             send_definition: also send ``message_definition`` (as rospy does; roscpp does not).
+            max_frame: largest frame body accepted from a publisher.
+            max_publishers: publishers linked at once (a thread and a socket each); further
+                URIs in the master's list are ignored with a logged warning.
 
         Raises:
             GraphError: already subscribed to this topic in this node.
@@ -299,7 +307,7 @@ class Node:
             sub = Subscriber(self, topic, type_name, md5, callback, raw=raw, queue_size=queue_size,
                              tcp_nodelay=tcp_nodelay,
                              message_definition=definition if send_definition else None,
-                             max_frame=max_frame)
+                             max_frame=max_frame, max_publishers=max_publishers)
             self.subscribers[topic] = sub
         try:
             pubs = self._master("registerSubscriber", topic, type_name, self.uri)
@@ -323,24 +331,29 @@ class Node:
 
     # ------------------------------------------------------------------ TCPROS server
     def _accept_loop(self) -> None:
-        while not self.is_shutdown:
+        accept_loop(self._tcp, lambda: not self.is_shutdown, self._admit,
+                    f"TCPROS server of {self.name}")
+
+    def _admit(self, conn: socket.socket, peer: str) -> None:
+        t = threading.Thread(target=self._handshake, args=(conn, peer),
+                             daemon=True, name=f"rosfpga-tcpros-handshake-{self.name}")
+        with self._lock:
+            if len(self._pending) >= MAX_PENDING_HANDSHAKES:
+                oldest = min(self._pending, key=self._pending.__getitem__)
+                del self._pending[oldest]
+                self.refused_connections += 1
+                try:  # wakes its handshake thread, which closes it
+                    oldest.shutdown(socket.SHUT_RDWR)
+                except OSError:
+                    pass
+            self._handshakes.add(t)
+            self._pending[conn] = time.monotonic()
             try:
-                conn, addr = self._tcp.accept()
-            except OSError:
-                return
-            if self.is_shutdown:
-                hard_close(conn)
-                return
-            t = threading.Thread(target=self._handshake, args=(conn, f"{addr[0]}:{addr[1]}"),
-                                 daemon=True, name=f"rosfpga-tcpros-handshake-{self.name}")
-            with self._lock:
-                if len(self._pending) >= MAX_PENDING_HANDSHAKES:
-                    self.refused_connections += 1
-                    hard_close(conn)
-                    continue
-                self._handshakes.add(t)
-                self._pending.add(conn)
                 t.start()
+            except RuntimeError:  # no thread to be had: this connection is lost, not the loop
+                self._handshakes.discard(t)
+                self._pending.pop(conn, None)
+                raise
 
     def _handshake(self, conn: socket.socket, peer: str) -> None:
         handed_over = False
@@ -350,7 +363,7 @@ class Node:
             pass
         finally:
             with self._lock:
-                self._pending.discard(conn)
+                self._pending.pop(conn, None)
                 self._handshakes.discard(threading.current_thread())
             if not handed_over:
                 hard_close(conn)

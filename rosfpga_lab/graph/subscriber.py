@@ -5,7 +5,8 @@ give the publishers' XML-RPC URIs. For each, a link thread asks ``requestTopic``
 address, connects, runs the subscriber side of the handshake and reads frames into the
 subscriber's bounded queue (a frame body is received straight into a buffer of its announced
 length, so a big image is not copied on its way in) (``queue_size``: the oldest frame is dropped and counted when the
-callback falls behind). A dispatcher thread calls the callback, so a slow callback never
+callback falls behind). At most ``max_publishers`` links exist at once (a publisher list
+longer than that is cut, keeping the links already open, and logged). A dispatcher thread calls the callback, so a slow callback never
 stalls the socket. When a connection drops, the link retries with exponential back-off
 (0.1 s doubling up to ``RECONNECT_MAX``) for as long as the master still lists that
 publisher; a refused handshake (md5 mismatch, ``error=`` reply) is not retried.
@@ -14,6 +15,7 @@ publisher; a refused handshake (md5 mismatch, ``error=`` reply) is not retried.
 from __future__ import annotations
 
 import collections
+import logging
 import socket
 import threading
 import time
@@ -49,6 +51,8 @@ from rosfpga_lab.tcpros import (
 
 if TYPE_CHECKING:
     from rosfpga_lab.graph.node import Node
+
+log = logging.getLogger("rosfpga_lab.graph")
 
 
 @dataclass(frozen=True)
@@ -217,7 +221,8 @@ class Subscriber:
 
     def __init__(self, node: Node, topic: str, type_name: str, md5sum: str,
                  callback: Callable[..., Any] | None, *, raw: bool, queue_size: int,
-                 tcp_nodelay: bool, message_definition: str | None, max_frame: int) -> None:
+                 tcp_nodelay: bool, message_definition: str | None, max_frame: int,
+                 max_publishers: int) -> None:
         self.node = node
         self.topic = topic
         self.type_name = type_name
@@ -228,6 +233,7 @@ class Subscriber:
         self.tcp_nodelay = tcp_nodelay
         self.message_definition = message_definition
         self.max_frame = max_frame
+        self.max_publishers = max(1, int(max_publishers))
         self._stats = SubscriberStats()
         self._links: dict[str, _PublisherLink] = {}
         self._queue: collections.deque = collections.deque()
@@ -245,6 +251,16 @@ class Subscriber:
             if self.closed:
                 return
             wanted = list(dict.fromkeys(uris))
+            if len(wanted) > self.max_publishers:  # links already open stay, then list order
+                old = [u for u in wanted if u in self._links]
+                new = [u for u in wanted if u not in self._links]
+                kept = (old + new)[:self.max_publishers]
+                text = (f"{len(wanted)} publishers listed for {self.topic}; linking to "
+                        f"{len(kept)} (max_publishers), ignoring {len(wanted) - len(kept)}")
+                log.warning("%s: %s", self.node.name, text)
+                self._error(text)
+                keep = set(kept)
+                wanted = [u for u in wanted if u in keep]
             gone = [u for u in self._links if u not in wanted]
             for uri in gone:
                 self._links.pop(uri).close()

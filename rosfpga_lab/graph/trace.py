@@ -22,12 +22,20 @@ method     XML-RPC method name; for TCPROS the topic
 args       XML-RPC parameters (list) or TCPROS header fields (dict)
 result     XML-RPC result (``[code, status, value]`` for ROS APIs), or an error text
 raw        exact bytes on the wire: xmlrpc ``raw`` is the HTTP request, ``raw_reply`` the HTTP
-           response; for frames the 4-byte prefix plus the first ``frame_bytes`` body bytes
+           response; for frames the 4-byte prefix plus the first ``frame_bytes`` body bytes.
+           A payload longer than ``excerpt_bytes`` keeps only its first ``excerpt_bytes``
+           bytes, and then ``args``/``result`` keep an excerpt too (long strings cut, long
+           lists shortened, each marked with its full length)
 raw_reply  see above (xmlrpc only)
 size       total bytes on the wire (for frames: 4 + body length)
 conn       connection id (same for the header and frames of one TCPROS link)
 index      frame number on its connection; offset: stream offset of the frame's prefix
 ========== ============================================================================
+
+Bounds: a trace keeps at most ``max_events`` events and about ``max_bytes`` bytes (raw bytes
+plus an estimate of the decoded values); the oldest events go first and ``dropped`` counts
+them. :meth:`Trace.excerpt`, :meth:`Trace.frame_raw` and :func:`excerpt_value` are the one
+place that decides what of a payload is kept.
 
 A sequence diagram draws one arrow per xmlrpc event (``src -> dst`` at ``t0`` labelled
 ``method``, and back at ``t`` labelled ``result[1]``) and one per TCPROS event.
@@ -44,6 +52,8 @@ from collections import deque
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
+from rosfpga_lab.graph.errors import TRACE_EXCERPT_BYTES, TRACE_MAX_BYTES, TRACE_MAX_EVENTS
+
 KINDS = ("xmlrpc", "tcp_connect", "tcpros_header", "tcpros_frame", "tcp_close", "error")
 
 _conn_ids = itertools.count(1)
@@ -52,6 +62,49 @@ _conn_ids = itertools.count(1)
 def new_connection_id() -> int:
     """A process-wide unique id for a TCPROS connection."""
     return next(_conn_ids)
+
+
+#: Bytes an event costs beyond its raw bytes (the dataclass, its small fields).
+_EVENT_OVERHEAD = 512
+#: What :func:`excerpt_value` keeps: characters of one string, items overall, nesting levels.
+_TEXT_KEPT = 256
+_ITEMS_KEPT = 64
+_DEPTH_KEPT = 8
+
+
+def excerpt_value(value: Any) -> Any:
+    """A small copy of a decoded XML-RPC value or header dict, for a trace.
+
+    Strings and bytes longer than 256 keep their start and say their length; lists and dicts
+    keep their first items (64 over the whole value) and say how many there were; nesting
+    deeper than 8 levels is replaced by a note.
+    """
+    budget = [_ITEMS_KEPT]
+
+    def cut(v: Any, depth: int) -> Any:
+        if isinstance(v, (str, bytes, bytearray)):
+            if len(v) <= _TEXT_KEPT:
+                return v
+            note = f"... ({len(v)} {'chars' if isinstance(v, str) else 'bytes'})"
+            return v[:_TEXT_KEPT] + (note if isinstance(v, str) else note.encode())
+        if not isinstance(v, (list, tuple, dict)):
+            return v
+        if depth >= _DEPTH_KEPT:
+            return f"... (nested deeper than {_DEPTH_KEPT} levels)"
+        items = list(v.items()) if isinstance(v, dict) else list(v)
+        kept = items[:max(0, budget[0])]
+        budget[0] -= len(kept)
+        if isinstance(v, dict):
+            out: Any = {k: cut(x, depth + 1) for k, x in kept}
+            if len(kept) < len(items):
+                out["..."] = f"{len(items)} keys"
+            return out
+        out = [cut(x, depth + 1) for x in kept]
+        if len(kept) < len(items):
+            out.append(f"... ({len(items)} items)")
+        return out
+
+    return cut(value, 0)
 
 
 @dataclass
@@ -88,15 +141,24 @@ class Trace:
         max_events: keep at most this many (oldest evicted, counted in ``dropped``).
         frame_bytes: body bytes of each frame to keep in ``raw`` (the rest is only counted).
         frames: record frame events at all (headers and XML-RPC are always recorded).
+        max_bytes: keep about this many bytes at most (oldest evicted, counted in ``dropped``).
+        excerpt_bytes: bytes of one payload (``raw``, ``raw_reply``) kept; a longer one keeps
+            its start, and the event's ``args``/``result`` are cut with :func:`excerpt_value`.
     """
 
-    def __init__(self, max_events: int = 20_000, frame_bytes: int = 64, frames: bool = True) -> None:
+    def __init__(self, max_events: int = TRACE_MAX_EVENTS, frame_bytes: int = 64,
+                 frames: bool = True, *, max_bytes: int = TRACE_MAX_BYTES,
+                 excerpt_bytes: int = TRACE_EXCERPT_BYTES) -> None:
         self.max_events = max_events
         self.frame_bytes = frame_bytes
         self.frames = frames
+        self.max_bytes = max_bytes
+        self.excerpt_bytes = excerpt_bytes
         self.enabled = True
         self.dropped = 0
         self._events: deque[TraceEvent] = deque()
+        self._costs: deque[int] = deque()
+        self._held = 0
         self._seq = 0
         self._lock = threading.Lock()
         #: URI or host:port -> node name, filled in by nodes and masters as they learn them
@@ -108,14 +170,56 @@ class Trace:
             return None
         now = time.time()
         fields.setdefault("t0", now)
+        # a caller that cut the payload already (Trace.excerpt) says so through a larger size
+        cut = kind != "tcpros_frame" and fields.get("size", 0) > \
+            len(fields.get("raw", b"")) + len(fields.get("raw_reply", b""))
+        for key in ("raw", "raw_reply"):
+            data = fields.get(key)
+            if data is not None and len(data) > self.excerpt_bytes:
+                fields[key] = self.excerpt(data)
+                cut = True
+        if cut:
+            for key in ("args", "result"):
+                if key in fields:
+                    fields[key] = excerpt_value(fields[key])
+        # the decoded args/result are about as big as the bytes they came from: count them twice
+        cost = _EVENT_OVERHEAD + 2 * (len(fields.get("raw", b"")) + len(fields.get("raw_reply", b"")))
         with self._lock:
             ev = TraceEvent(seq=self._seq, t=now, kind=kind, recorder=recorder, **fields)
             self._seq += 1
             self._events.append(ev)
-            while len(self._events) > self.max_events:
+            self._costs.append(cost)
+            self._held += cost
+            while self._events and (len(self._events) > self.max_events or self._held > self.max_bytes):
                 self._events.popleft()
+                self._held -= self._costs.popleft()
                 self.dropped += 1
         return ev
+
+    def set_result(self, ev: TraceEvent | None, value: Any) -> None:
+        """Fill in an event's ``result`` afterwards (an excerpt when its reply was cut)."""
+        if ev is None:
+            return
+        if ev.kind != "tcpros_frame" and len(ev.raw) + len(ev.raw_reply) < ev.size:
+            value = excerpt_value(value)
+        ev.result = value
+
+    def excerpt(self, *parts: bytes | bytearray | memoryview) -> bytes:
+        """What an event keeps of a payload (given whole or as consecutive parts, e.g. an HTTP
+        head and body): all of it up to :attr:`excerpt_bytes`, else its first that many bytes.
+        Give the event the full length as ``size``."""
+        out = bytearray()
+        for part in parts:
+            room = self.excerpt_bytes - len(out)
+            if room <= 0:
+                break
+            out += part[:room]
+        return bytes(out)
+
+    @property
+    def bytes_held(self) -> int:
+        """About how many bytes the kept events hold (what ``max_bytes`` bounds)."""
+        return self._held
 
     def frame_raw(self, body: bytes | bytearray | memoryview) -> bytes:
         """What a ``tcpros_frame`` event keeps of a frame: its 4-byte length prefix and the
@@ -139,6 +243,8 @@ class Trace:
         """Forget every event (``seq`` keeps counting)."""
         with self._lock:
             self._events.clear()
+            self._costs.clear()
+            self._held = 0
 
     def to_dicts(self) -> list[dict[str, Any]]:
         """The events as plain dicts (for pandas, JSON after encoding bytes, widgets)."""

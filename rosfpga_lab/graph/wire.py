@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
+import logging
 import socket
+import time
+from collections.abc import Callable
 
+from rosfpga_lab.graph.errors import ACCEPT_BACKOFF_FIRST, ACCEPT_BACKOFF_MAX, ACCEPT_LOG_INTERVAL
 from rosfpga_lab.tcpros import frame_prefix
+
+log = logging.getLogger("rosfpga_lab.graph")
 
 #: Bytes asked of each recv() on a TCPROS stream between frame bodies (handshake, length
 #: prefixes, small frames). A body longer than what such a chunk holds is received straight
@@ -49,3 +55,53 @@ def set_nodelay(sock: socket.socket) -> None:
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
     except OSError:
         pass
+
+
+def accept_loop(sock: socket.socket, running: Callable[[], bool],
+                handle: Callable[[socket.socket, str], None], what: str) -> None:
+    """Accept connections on ``sock`` and pass each to ``handle(conn, "host:port")`` while
+    ``running()`` is true: the accept thread of every server (XML-RPC and TCPROS).
+
+    A failing ``accept()`` (out of file descriptors: EMFILE/ENFILE; ECONNABORTED; out of
+    buffers) does not end the loop: it is retried after a pause that doubles from
+    ``ACCEPT_BACKOFF_FIRST`` up to ``ACCEPT_BACKOFF_MAX`` seconds, so the server serves again
+    within that pause once descriptors are free. The first failure is logged (a warning), later
+    ones at most every ``ACCEPT_LOG_INTERVAL`` seconds with a count, recovery once. The loop
+    ends only when ``running()`` turns false (the owner closes ``sock`` after clearing it). A
+    ``handle`` that raises (say, no thread can be started) loses that one connection only.
+    """
+    delay = ACCEPT_BACKOFF_FIRST
+    failing = False          # the last accept() failed
+    reported = False         # this run of failures was logged
+    unlogged = 0             # failures since the last log line
+    last_log = -ACCEPT_LOG_INTERVAL
+    while running():
+        try:
+            conn, addr = sock.accept()
+        except OSError as exc:
+            if not running():
+                return
+            unlogged += 1
+            now = time.monotonic()
+            if now - last_log >= ACCEPT_LOG_INTERVAL:
+                log.warning("%s: accept() failed (%s; %d failure(s) since the last report); "
+                            "retrying with back-off up to %.1f s", what, exc, unlogged,
+                            ACCEPT_BACKOFF_MAX)
+                last_log, unlogged, reported = now, 0, True
+            failing = True
+            time.sleep(delay)
+            delay = min(delay * 2, ACCEPT_BACKOFF_MAX)
+            continue
+        if failing:
+            if reported:
+                log.info("%s: accepting connections again", what)
+            failing, reported, delay = False, False, ACCEPT_BACKOFF_FIRST
+        if not running():
+            hard_close(conn)
+            return
+        try:
+            handle(conn, f"{addr[0]}:{addr[1]}")
+        except Exception as exc:  # noqa: BLE001 - the loop must outlive one bad connection
+            log.warning("%s: dropped a connection from %s:%s: %s: %s", what, addr[0], addr[1],
+                        type(exc).__name__, exc)
+            hard_close(conn)

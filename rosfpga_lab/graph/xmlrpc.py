@@ -3,9 +3,13 @@
 How it works: the server accepts connections on a loopback socket (unless told otherwise),
 gives each connection a thread, reads the HTTP head (capped at :data:`MAX_HTTP_HEAD`) and a
 ``Content-Length`` body (capped at :data:`MAX_XMLRPC_BODY`), parses it with defusedxml's
-expat parser (no entity expansion, no DTDs, no external references), calls the handler and
-writes the reply; keep-alive is honoured as rospy's and roscpp's clients expect. The client
-opens one connection per call. Both sides record request and response bytes in a
+expat parser (no entity expansion, no DTDs, no external references; nesting capped at
+:data:`MAX_XMLRPC_DEPTH`), calls the handler and writes the reply; keep-alive is honoured as
+rospy's and roscpp's clients expect. A request must be complete within
+:data:`XMLRPC_REQUEST_TIMEOUT` of its first byte (a deadline for the whole request, not per
+``recv``); at :data:`MAX_XMLRPC_CONNECTIONS` a new connection evicts the one that has waited
+longest for request bytes, so peers holding sockets open cannot lock others out. The client
+opens one connection per call, and its ``timeout`` bounds the whole call. Both sides record request and response bytes in a
 :class:`~rosfpga_lab.graph.trace.Trace`. The stdlib ``xmlrpc.client`` is used only to
 marshal (build XML), never to parse.
 """
@@ -15,6 +19,7 @@ from __future__ import annotations
 import socket
 import threading
 import time
+from dataclasses import dataclass
 import urllib.parse
 import xmlrpc.client
 from collections.abc import Callable
@@ -25,14 +30,20 @@ from defusedxml.xmlrpc import DefusedExpatParser
 from rosfpga_lab.graph.errors import (
     JOIN_TIMEOUT,
     MAX_HTTP_HEAD,
-    MAX_XMLRPC_CONNECTIONS,
     MAX_XMLRPC_BODY,
+    MAX_XMLRPC_CONNECTIONS,
+    MAX_XMLRPC_DEPTH,
     XMLRPC_IDLE_TIMEOUT,
+    XMLRPC_REQUEST_TIMEOUT,
     XMLRPC_TIMEOUT,
     ConfigError,
     XmlRpcError,
 )
 from rosfpga_lab.graph.trace import Trace
+from rosfpga_lab.graph.wire import accept_loop, hard_close
+
+#: XML-RPC's <int>/<i4> range (ROS's XmlRpcValue and rospy's marshaller refuse anything else).
+INT32_MIN, INT32_MAX = -(2**31), 2**31 - 1
 
 Handler = Callable[[str, tuple], Any]
 
@@ -53,7 +64,8 @@ def parse_xmlrpc(data: bytes) -> tuple[tuple, str | None]:
         ``(params, method_name)``; method_name is None for responses.
 
     Raises:
-        XmlRpcError: malformed XML, forbidden XML constructs, not XML-RPC, or a fault reply.
+        XmlRpcError: malformed XML, forbidden XML constructs, not XML-RPC, nested deeper than
+            :data:`MAX_XMLRPC_DEPTH`, or a fault reply.
     """
     unmarshaller = xmlrpc.client.Unmarshaller(use_builtin_types=True)
     parser = DefusedExpatParser(unmarshaller)
@@ -65,7 +77,50 @@ def parse_xmlrpc(data: bytes) -> tuple[tuple, str | None]:
         raise XmlRpcError(f"XML-RPC fault {fault.faultCode}: {fault.faultString}") from None
     except Exception as exc:  # expat, defusedxml, ResponseError, bad int/float/base64 text
         raise XmlRpcError(f"malformed XML-RPC document: {type(exc).__name__}: {exc}") from None
+    depth = value_depth(params, MAX_XMLRPC_DEPTH + 1)
+    if depth > MAX_XMLRPC_DEPTH:
+        raise XmlRpcError(f"XML-RPC values nested deeper than {MAX_XMLRPC_DEPTH} levels are refused")
     return params, unmarshaller.getmethodname()
+
+
+def value_depth(value: Any, stop: int | None = None) -> int:
+    """Nesting depth of lists/tuples/dicts in ``value`` (a scalar is 0), without recursion.
+
+    Args:
+        stop: return as soon as the depth reaches this (enough to know a limit is passed).
+    """
+    deepest = 0
+    stack = [(value, 0)]
+    while stack:
+        v, d = stack.pop()
+        if isinstance(v, (list, tuple, dict)):
+            d += 1
+            deepest = max(deepest, d)
+            if stop is not None and deepest >= stop:
+                return deepest
+            stack.extend((x, d) for x in (v.values() if isinstance(v, dict) else v))
+    return deepest
+
+
+def check_int_range(value: Any) -> None:
+    """Refuse ints XML-RPC cannot carry (outside int32), anywhere in ``value``, without recursion.
+
+    Raises:
+        XmlRpcError: naming the first such integer.
+    """
+    stack = [value]
+    while stack:
+        v = stack.pop()
+        if isinstance(v, bool):
+            continue
+        if isinstance(v, int):
+            if not INT32_MIN <= v <= INT32_MAX:
+                raise XmlRpcError(f"integer {v} is outside XML-RPC's 32-bit range "
+                                  f"[{INT32_MIN}, {INT32_MAX}]")
+        elif isinstance(v, (list, tuple)):
+            stack.extend(v)
+        elif isinstance(v, dict):
+            stack.extend(v.values())
 
 
 def dump_response(value: Any) -> bytes:
@@ -77,7 +132,7 @@ def _clamp(v: Any) -> Any:
     if isinstance(v, bool):
         return v
     if isinstance(v, int):
-        return max(-(2**31), min(2**31 - 1, v))
+        return max(INT32_MIN, min(INT32_MAX, v))
     if isinstance(v, (list, tuple)):
         return [_clamp(x) for x in v]
     if isinstance(v, dict):
@@ -101,17 +156,59 @@ def split_uri(uri: str) -> tuple[str, int, str]:
     return parts.hostname, port, parts.path or "/"
 
 
-def _read_head(sock: socket.socket, buf: bytearray) -> bytes | None:
-    """Read until the end of an HTTP head; return it (buf keeps the rest). None on clean EOF."""
+class _Deadline:
+    """When the bytes of one request (or of one call) must have arrived.
+
+    Args:
+        first: seconds to wait for the first byte.
+        whole: seconds for everything once the first byte is in (None: ``first`` bounds all).
+    """
+
+    def __init__(self, first: float, whole: float | None = None) -> None:
+        now = time.monotonic()
+        self.at = now + first
+        self.whole = whole
+        self.what = "reply" if whole is None else "request"
+
+    def started(self) -> None:
+        """The first byte arrived: from now on the whole-request limit applies."""
+        if self.whole is not None:
+            self.at = time.monotonic() + self.whole
+            self.whole = None
+
+    def recv(self, sock: socket.socket, n: int) -> bytes:
+        """``sock.recv(n)`` within the deadline.
+
+        Raises:
+            TimeoutError: the deadline passed (before or during this recv).
+        """
+        left = self.at - time.monotonic()
+        if left <= 0:
+            raise TimeoutError(f"{self.what} not complete in time")
+        sock.settimeout(left)
+        chunk = sock.recv(n)
+        if chunk:
+            self.started()
+        return chunk
+
+
+def _read_head(sock: socket.socket, buf: bytearray, deadline: _Deadline) -> bytes | None:
+    """Read until the end of an HTTP head; return it (buf keeps the rest). None on clean EOF.
+
+    Raises:
+        XmlRpcError: the head is longer than :data:`MAX_HTTP_HEAD` (however it was chunked),
+            or the connection closed inside it.
+        TimeoutError: ``deadline`` passed.
+    """
     while True:
-        end = buf.find(b"\r\n\r\n")
+        end = buf.find(b"\r\n\r\n", 0, MAX_HTTP_HEAD)
         if end >= 0:
             head = bytes(buf[:end + 4])
             del buf[:end + 4]
             return head
-        if len(buf) > MAX_HTTP_HEAD:
+        if len(buf) >= MAX_HTTP_HEAD:
             raise XmlRpcError(f"HTTP head longer than {MAX_HTTP_HEAD} bytes")
-        chunk = sock.recv(65536)
+        chunk = deadline.recv(sock, 65536)
         if not chunk:
             if buf:
                 raise XmlRpcError(f"connection closed inside an HTTP head ({len(buf)} bytes)")
@@ -132,14 +229,14 @@ def _parse_head(head: bytes) -> tuple[str, dict[str, str]]:
     return lines[0], headers
 
 
-def _read_body(sock: socket.socket, buf: bytearray, headers: dict[str, str], *,
-               until_eof: bool = False) -> bytes:
+def _read_body(sock: socket.socket, buf: bytearray, headers: dict[str, str],
+               deadline: _Deadline, *, until_eof: bool = False) -> bytes:
     length_text = headers.get("content-length")
     if length_text is None:
         if not until_eof:
             raise XmlRpcError("HTTP message without Content-Length")
         while len(buf) <= MAX_XMLRPC_BODY:
-            chunk = sock.recv(65536)
+            chunk = deadline.recv(sock, 65536)
             if not chunk:
                 body = bytes(buf)
                 buf.clear()
@@ -153,11 +250,15 @@ def _read_body(sock: socket.socket, buf: bytearray, headers: dict[str, str], *,
     if length < 0 or length > MAX_XMLRPC_BODY:
         raise XmlRpcError(f"HTTP body of {length} bytes, over the limit of {MAX_XMLRPC_BODY}")
     while len(buf) < length:
-        chunk = sock.recv(max(65536, length - len(buf)))
+        chunk = deadline.recv(sock, min(max(65536, length - len(buf)), 1 << 20))
         if not chunk:
             raise XmlRpcError(f"connection closed after {len(buf)} of {length} body bytes")
         buf += chunk
-    body = bytes(buf[:length])
+    if len(buf) == length:  # the usual case: one copy, not a slice and then a copy
+        body = bytes(buf)
+        buf.clear()
+        return body
+    body = bytes(memoryview(buf)[:length])
     del buf[:length]
     return body
 
@@ -169,33 +270,59 @@ def _http_response(status: str, body: bytes, keep_alive: bool) -> bytes:
     return head.encode("latin-1") + body
 
 
+_context = threading.local()
+
+
+def request_peer() -> str:
+    """``host:port`` of the peer whose request this server thread is handling ("" elsewhere)."""
+    return getattr(_context, "peer", "")
+
+
+@dataclass
+class _Conn:
+    """A served connection: since when it waits for request bytes, and whether a handler runs."""
+
+    since: float
+    busy: bool = False
+
+
 class XmlRpcServer:
     """A threaded XML-RPC server on one TCP port.
 
     Args:
         handler: ``handler(method, params) -> value``; raise :class:`Fault` for a fault reply.
+            :func:`request_peer` tells it who is calling.
         host: address to bind (127.0.0.1 by default; "0.0.0.0" binds every interface).
         port: port, 0 for any free one.
         trace: where to record each exchange (role ``server``).
         name: recorder name (node name or ``master``).
         advertise_host: host written in :attr:`uri` (defaults to ``host``).
+        request_timeout: seconds for a whole request once its first byte arrived.
+        max_connections: connections kept open at once (see the module docstring).
     """
 
     def __init__(self, handler: Handler, *, host: str = "127.0.0.1", port: int = 0,
-                 trace: Trace | None = None, name: str = "", advertise_host: str | None = None) -> None:
+                 trace: Trace | None = None, name: str = "", advertise_host: str | None = None,
+                 request_timeout: float = XMLRPC_REQUEST_TIMEOUT,
+                 max_connections: int = MAX_XMLRPC_CONNECTIONS) -> None:
         self.handler = handler
         self.host = host
         self.port = port
         self.trace = trace
         self.name = name
         self.advertise_host = advertise_host or host
+        self.request_timeout = request_timeout
+        self.max_connections = max_connections
         self._sock: socket.socket | None = None
         self._threads: set[threading.Thread] = set()
-        self._conns: set[socket.socket] = set()
+        self._conns: dict[socket.socket, _Conn] = {}
         self._lock = threading.Lock()
         self._running = False
         self.requests = 0
+        #: connections answered "503" (every kept connection was busy in a handler)
         self.refused = 0
+        #: connections closed to make room for a new one (the longest-waiting first)
+        self.evicted = 0
 
     @property
     def uri(self) -> str:
@@ -236,36 +363,57 @@ class XmlRpcServer:
 
     def _accept_loop(self) -> None:
         assert self._sock is not None
-        while self._running:
+        accept_loop(self._sock, lambda: self._running, self._admit,
+                    f"XML-RPC server {self.name or self.uri}")
+
+    def _admit(self, conn: socket.socket, peer: str) -> None:
+        with self._lock:
+            full = len(self._conns) >= self.max_connections
+            if full:
+                waiting = [(st.since, c) for c, st in self._conns.items() if not st.busy]
+                if waiting:  # the longest-waiting connection makes room (a legit call is quick)
+                    victim = min(waiting, key=lambda x: x[0])[1]
+                    del self._conns[victim]
+                    self.evicted += 1
+                    full = False
+                    try:  # wakes its thread, which closes it (closing here could race its recv)
+                        victim.shutdown(socket.SHUT_RDWR)
+                    except OSError:
+                        pass
+            if not full:
+                self._conns[conn] = _Conn(time.monotonic())
+        if full:  # every connection is inside a handler: refuse without costing a thread
+            self.refused += 1
             try:
-                conn, addr = self._sock.accept()
+                conn.settimeout(1.0)
+                conn.sendall(_http_response("503 Service Unavailable", b"too many connections", False))
             except OSError:
-                break
-            if not self._running:
-                conn.close()
-                break
-            conn.settimeout(XMLRPC_IDLE_TIMEOUT)
-            with self._lock:
-                busy = len(self._conns) >= MAX_XMLRPC_CONNECTIONS
-                if not busy:
-                    self._conns.add(conn)
-            if busy:  # a flood of idle connections must not cost a thread each
-                self.refused += 1
-                try:
-                    conn.settimeout(1.0)
-                    conn.sendall(_http_response("503 Service Unavailable", b"too many connections", False))
-                except OSError:
-                    pass
-                conn.close()
-                continue
-            self._spawn(self._serve_connection, "xmlrpc-conn", conn, f"{addr[0]}:{addr[1]}")
+                pass
+            hard_close(conn)
+            return
+        self._spawn(self._serve_connection, "xmlrpc-conn", conn, peer)
+
+    def _set_busy(self, conn: socket.socket, busy: bool) -> bool:
+        """Mark ``conn`` busy (in a handler) or waiting again; False when it was evicted."""
+        with self._lock:
+            st = self._conns.get(conn)
+            if st is None:
+                return False
+            st.busy = busy
+            if not busy:
+                st.since = time.monotonic()
+            return True
 
     def _serve_connection(self, conn: socket.socket, peer: str) -> None:
         buf = bytearray()
+        _context.peer = peer
         try:
             while self._running:
+                deadline = _Deadline(XMLRPC_IDLE_TIMEOUT, self.request_timeout)
                 try:
-                    head = _read_head(conn, buf)
+                    if buf:
+                        deadline.started()
+                    head = _read_head(conn, buf, deadline)
                     if head is None:
                         return
                     request_line, headers = _parse_head(head)
@@ -281,29 +429,42 @@ class XmlRpcServer:
                     conn.sendall(_http_response("405 Method Not Allowed", b"", False))
                     return
                 try:
-                    body = _read_body(conn, buf, headers)
+                    body = _read_body(conn, buf, headers, deadline)
                 except XmlRpcError as exc:
                     status = "413 Payload Too Large" if "limit" in str(exc) else "400 Bad Request"
                     conn.sendall(_http_response(status, str(exc).encode(), False))
                     return
+                except TimeoutError:
+                    conn.settimeout(1.0)
+                    conn.sendall(_http_response("408 Request Timeout", (
+                        f"request not complete within {self.request_timeout} s").encode(), False))
+                    return
+                if not self._set_busy(conn, True):
+                    return
                 reply_body, method, params, result = self._dispatch(body)
                 reply = _http_response("200 OK", reply_body, keep)
+                if not self._set_busy(conn, False):
+                    return
+                conn.settimeout(self.request_timeout)
                 conn.sendall(reply)
                 self.requests += 1
                 if self.trace is not None:
                     caller = params[0] if params and isinstance(params[0], str) else peer
                     self.trace.record("xmlrpc", self.name, role="server", src=caller,
                                       dst=self.name, method=method, args=list(params),
-                                      result=result, raw=head + body, raw_reply=reply,
+                                      result=result, raw=self.trace.excerpt(head, body),
+                                      raw_reply=self.trace.excerpt(reply),
                                       size=len(head) + len(body) + len(reply), t0=t0)
+                del body, reply, reply_body, params, result
                 if not keep:
                     return
         except OSError:
             return
         finally:
+            _context.peer = ""
             with self._lock:
-                self._conns.discard(conn)
-            conn.close()
+                self._conns.pop(conn, None)
+            hard_close(conn)
 
     def _dispatch(self, body: bytes) -> tuple[bytes, str, tuple, Any]:
         try:
@@ -360,25 +521,28 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
         timeout: seconds for connect, send and receive.
 
     Raises:
-        XmlRpcError: connection, HTTP or XML problem, or a fault.
+        XmlRpcError: connection, HTTP or XML problem, a fault, no complete reply within
+            ``timeout``, or an integer parameter outside XML-RPC's 32-bit range.
         ConfigError: malformed uri.
     """
     host, port, path = split_uri(uri)
-    body = xmlrpc.client.dumps(tuple(_clamp(list(params))), methodname=method,
-                               allow_none=False).encode()
+    check_int_range(params)
+    body = xmlrpc.client.dumps(tuple(params), methodname=method, allow_none=False).encode()
     head = (f"POST {path} HTTP/1.1\r\nHost: {host}:{port}\r\nUser-Agent: rosfpga-lab\r\n"
             f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\nConnection: close\r\n\r\n")
     request = head.encode("latin-1") + body
     t0 = time.time()
     buf = bytearray()
+    deadline = _Deadline(timeout)
     try:
         with socket.create_connection((host, port), timeout=timeout) as sock:
+            sock.settimeout(max(0.001, deadline.at - time.monotonic()))
             sock.sendall(request)
-            reply_head = _read_head(sock, buf)
+            reply_head = _read_head(sock, buf, deadline)
             if reply_head is None:
                 raise XmlRpcError("connection closed before any reply")
             status_line, headers = _parse_head(reply_head)
-            reply_body = _read_body(sock, buf, headers, until_eof=True)
+            reply_body = _read_body(sock, buf, headers, deadline, until_eof=True)
     except (OSError, XmlRpcError) as exc:
         if trace is not None:
             trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or uri,
@@ -386,8 +550,8 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
         raise XmlRpcError(f"XML-RPC call {method} to {uri} failed: {exc}") from None
     if trace is not None:
         ev = trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or trace.name_of(uri),
-                          method=method, args=list(params), raw=request,
-                          raw_reply=reply_head + reply_body,
+                          method=method, args=list(params), raw=trace.excerpt(request),
+                          raw_reply=trace.excerpt(reply_head, reply_body),
                           size=len(request) + len(reply_head) + len(reply_body), t0=t0)
     else:
         ev = None
@@ -397,10 +561,10 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
     try:
         result, _ = parse_xmlrpc(reply_body)
     except XmlRpcError as exc:
-        if ev is not None:
-            ev.result = f"error: {exc}"
+        if trace is not None:
+            trace.set_result(ev, f"error: {exc}")
         raise XmlRpcError(f"XML-RPC call {method} to {uri}: {exc}") from None
     value = result[0] if len(result) == 1 else list(result)
-    if ev is not None:
-        ev.result = value
+    if trace is not None:
+        trace.set_result(ev, value)
     return value

@@ -21,6 +21,12 @@ MAX_FIELD_BYTES = 1 << 20
 #: Largest message body (the 4-byte frame length's value) the lab accepts by default: 64 MiB,
 #: room for a 4K rgba8 image (33 MB).
 MAX_FRAME_BYTES = 64 << 20
+#: First buffer of a frame body being assembled (bytes); it at most doubles as bytes arrive, so
+#: a declared length costs nothing until its bytes come.
+FRAME_BUFFER_FIRST = 1 << 18
+#: Transitions a handshake machine keeps in ``history``: a self-loop (``frame``, ``send``) is
+#: kept this many times in a row, later repeats are only counted (``repeats``).
+HISTORY_REPEATS = 3
 #: Seconds a peer may take to complete its connection header before we give up on it.
 HANDSHAKE_TIMEOUT = 5.0
 

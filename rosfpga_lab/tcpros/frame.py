@@ -3,23 +3,36 @@
 :class:`FrameDecoder` accepts any chunking: one byte at a time, many frames in one chunk, a
 frame split over chunks. When a whole frame sits inside one chunk it is returned as a
 zero-copy ``memoryview`` of that chunk; a frame assembled from several chunks is returned as
-a ``bytearray`` (one copy into a buffer sized from the length prefix, then handed over). Either
-way the caller gets a bytes-like object; call ``bytes(body)`` for an immutable copy.
+a ``bytearray`` (the bytes copied into it as they arrive, then handed over). Either way the
+caller gets a bytes-like object; call ``bytes(body)`` for an immutable copy.
 
-For big frames a reader can skip even that copy: once a frame's length prefix has been fed,
-:meth:`FrameDecoder.pending_body` lends the still-empty rest of that frame's buffer; the reader
+Memory follows the bytes received, never the length a peer declares: a frame's buffer starts
+at most :data:`FRAME_BUFFER_FIRST` bytes long and at most doubles (by 4 MiB at most) each
+time it fills, so a
+peer that declares 60 MiB and sends 1 MiB costs about 2 MiB. For big frames a reader can skip
+the copy: once a frame's length prefix has been fed, :meth:`FrameDecoder.pending_body` lends
+the still-empty room of that frame's buffer (growing it first when it is full); the reader
 receives straight into it (``sock.recv_into``) and reports the byte count with
 :meth:`FrameDecoder.filled`. The decoder keeps every framing rule (the length limit is checked
-when the prefix arrives, before the buffer exists); the reader only chooses where bytes land.
+when the prefix arrives, before any buffer exists); the reader only chooses where bytes land.
 """
 
 from __future__ import annotations
 
 import struct
 
-from rosfpga_lab.tcpros.errors import MAX_FRAME_BYTES, FrameError, IncompleteError, StateError
+from rosfpga_lab.tcpros.errors import (
+    FRAME_BUFFER_FIRST,
+    MAX_FRAME_BYTES,
+    FrameError,
+    IncompleteError,
+    StateError,
+)
 
 _U32 = struct.Struct("<I")
+#: Zeros a growing body buffer is extended with (its largest step). Never written, so its pages
+#: stay unmapped/shared: it costs address space, not memory.
+_ZEROS = bytes(4 << 20)
 
 
 def encode_frame(body: bytes | bytearray | memoryview) -> bytes:
@@ -35,18 +48,26 @@ def frame_prefix(length: int) -> bytes:
 class FrameDecoder:
     """Incremental frame decoder.
 
+    Args:
+        max_frame: largest body length accepted (checked when the prefix arrives).
+        stream_offset: stream offset of the first byte fed (for error messages).
+        first_buffer: first size of a lent body buffer (see the module docstring).
+
     Attributes:
         frames: number of complete frames returned so far.
         offset: bytes consumed from the stream so far (for error messages).
     """
 
-    def __init__(self, *, max_frame: int = MAX_FRAME_BYTES, stream_offset: int = 0) -> None:
+    def __init__(self, *, max_frame: int = MAX_FRAME_BYTES, stream_offset: int = 0,
+                 first_buffer: int = FRAME_BUFFER_FIRST) -> None:
         self.max_frame = max_frame
+        self.first_buffer = max(1, first_buffer)
         self.frames = 0
         self.offset = stream_offset
         self._prefix = bytearray()
-        self._body: bytearray | None = None
-        self._have = 0
+        self._body: bytearray | None = None  # the frame being assembled (its room may exceed _have)
+        self._length = 0                      # its declared length
+        self._have = 0                        # body bytes received
         self._start = stream_offset
         #: stream offsets of the length prefixes of the frames returned by the last feed()
         self.starts: list[int] = []
@@ -96,8 +117,7 @@ class FrameDecoder:
                         self.offset += 4 + length
                         self.frames += 1
                         continue
-                    self._body = bytearray(length)
-                    self._have = 0
+                    self._start_body(length)
                     pos += 4
                     self.offset += 4
                     continue
@@ -115,32 +135,53 @@ class FrameDecoder:
                     self.starts.append(self._start)
                     self.frames += 1
                     continue
-                self._body = bytearray(length)
-                self._have = 0
-            take = min(len(self._body) - self._have, end - pos)
-            self._body[self._have:self._have + take] = view[pos:pos + take]
+                self._start_body(length)
+            take = min(self._length - self._have, end - pos)
+            h = self._have
+            if len(self._body) - h >= take:
+                self._body[h:h + take] = view[pos:pos + take]
+            else:  # replaces the room left and grows by the rest: memory = bytes received
+                self._body[h:] = view[pos:pos + take]
             pos += take
             self._advance(take, out)
 
+    def _start_body(self, length: int) -> None:
+        self._body = bytearray()
+        self._length = length
+        self._have = 0
+
     def _advance(self, n: int, out: list) -> None:
-        """``n`` more body bytes are in ``self._body``; hand the frame over when it is full."""
+        """``n`` more body bytes are in ``self._body``; hand the frame over when it is complete."""
         assert self._body is not None
         self._have += n
         self.offset += n
-        if self._have == len(self._body):
+        if self._have == self._length:
+            if len(self._body) > self._have:
+                del self._body[self._have:]
             out.append(self._body)  # a fresh buffer per frame: hand it over, no copy
             self.starts.append(self._start)
             self._body = None
             self.frames += 1
 
     def pending_body(self) -> memoryview | None:
-        """The unfilled rest of the frame body being assembled, to receive into; else None.
+        """Room in the frame body being assembled, to receive into; else None.
 
-        None between frames and inside a length prefix: then :meth:`feed` the next bytes.
-        Write into the view (e.g. ``n = sock.recv_into(view)``), then call :meth:`filled`.
+        The room is never larger than what the frame still misses; when the buffer is full it
+        first grows to at most twice the bytes received so far (at least ``first_buffer``,
+        by 4 MiB at most), so memory follows received bytes. None between frames and
+        inside a length prefix: then :meth:`feed` the next bytes. Write into the view (e.g.
+        ``n = sock.recv_into(view)``), release it, then call :meth:`filled`.
         """
         if self._body is None:
             return None
+        if len(self._body) == self._have:
+            room = min(self._length - self._have, max(self._have, self.first_buffer), len(_ZEROS))
+            try:  # in place (realloc), from one shared zero block: no temporary per growth
+                self._body += memoryview(_ZEROS)[:room]
+            except BufferError:  # the reader still holds a view: grow into a new buffer
+                grown = bytearray(self._have + room)
+                grown[:self._have] = self._body
+                self._body = grown
         return memoryview(self._body)[self._have:]
 
     def filled(self, n: int) -> list[bytearray]:
@@ -152,10 +193,12 @@ class FrameDecoder:
         Raises:
             StateError: no frame body is pending, or ``n`` is not in 1..bytes still missing.
         """
-        missing = 0 if self._body is None else len(self._body) - self._have
-        if not 0 < n <= missing:
-            raise StateError(f"filled({n}): the pending frame body misses {missing} bytes "
-                             "(write into pending_body() first; feed() between frames)")
+        missing = 0 if self._body is None else self._length - self._have
+        room = 0 if self._body is None else len(self._body) - self._have
+        if not 0 < n <= room:
+            raise StateError(f"filled({n}): the pending frame body misses {missing} bytes, its "
+                             f"buffer has room for {room} (write into pending_body() first; "
+                             "feed() between frames)")
         out: list[bytearray] = []
         self.starts = []
         self._advance(n, out)
@@ -173,5 +216,5 @@ class FrameDecoder:
                 f"bytes, stream byte {self.offset})", offset=self.offset)
         if self._body is not None:
             raise IncompleteError(
-                f"connection closed mid-frame: {self._have} of {len(self._body)} body bytes "
+                f"connection closed mid-frame: {self._have} of {self._length} body bytes "
                 f"received (stream byte {self.offset})", offset=self.offset)

@@ -21,6 +21,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 from rosfpga_lab.tcpros.errors import (
+    HISTORY_REPEATS,
     MAX_FIELD_BYTES,
     MAX_FRAME_BYTES,
     MAX_HEADER_BYTES,
@@ -205,13 +206,22 @@ class _Machine:
 
     def __init__(self, initial: str) -> None:
         self.state = initial
+        #: the transitions taken, in order; a self-loop (``frame``, ``send``) appears at most
+        #: ``HISTORY_REPEATS`` times in a row, so the list stays short on a long stream
         self.history: list[Transition] = []
+        #: self-loop transitions taken but not kept in ``history``, by trigger
+        self.repeats: dict[str, int] = {}
 
     def _fire(self, trigger: str) -> Transition:
         for t in TRANSITIONS:
             if t.role == self.role and t.source == self.state and t.trigger == trigger:
                 self.state = t.target
-                self.history.append(t)
+                h = self.history
+                if t.source == t.target and len(h) >= HISTORY_REPEATS and \
+                        all(x is t for x in h[-HISTORY_REPEATS:]):
+                    self.repeats[trigger] = self.repeats.get(trigger, 0) + 1
+                else:
+                    h.append(t)
                 return t
         raise StateError(f"{self.role} handshake: '{trigger}' is not allowed in state {self.state}")
 
