@@ -28,13 +28,27 @@ for tool in npm useradd groupadd; do
 done
 umask 022
 
-py="${PYTHON:-python3}"
+# The interpreter must be one every user may run (not one under /root, as pyenv's is).
+py="${PYTHON:-}"
+if [ -z "$py" ]; then
+  for candidate in /usr/bin/python3 python3; do
+    if "$candidate" -c 'import sys, venv; sys.exit(not (3, 11) <= sys.version_info[:2] <= (3, 13))' 2>/dev/null; then
+      py="$candidate"; break
+    fi
+  done
+fi
+if [ -z "$py" ] || ! setpriv --reuid=nobody --regid=nogroup --clear-groups "$py" -c '' 2>/dev/null; then
+  echo "setup.sh: error: no Python 3.11 to 3.13 that every user may run (${py:-none found});" \
+       "set PYTHON=/usr/bin/python3.x (Debian: apt-get install python3-venv)" >&2
+  exit 1
+fi
 echo "setup.sh: shared environment $PREFIX/venv ($("$py" --version))"
 mkdir -p "$PREFIX"
 [ -x "$PREFIX/venv/bin/python" ] || "$py" -m venv "$PREFIX/venv"
 "$PREFIX/venv/bin/python" -m pip install --quiet --upgrade pip
-"$PREFIX/venv/bin/python" -m pip install --quiet -r "$repo/environment.txt"
-"$PREFIX/venv/bin/python" -m pip install --quiet "$repo[course]"
+"$PREFIX/venv/bin/python" -m pip install --quiet -r "$repo/environment.txt" "$repo[course]"
+# the lab itself again, so a re-run after `git pull` installs the new version of the same number
+"$PREFIX/venv/bin/python" -m pip install --quiet --no-deps --force-reinstall "$repo"
 
 echo "setup.sh: configurable-http-proxy into $here/node_modules"
 (cd "$here" && npm ci --no-audit --no-fund --loglevel=error)
@@ -64,6 +78,7 @@ cat <<EOF
 setup.sh: done. Next:
   add students:  useradd -m -G $(group_of STUDENTS_GROUP) alice && passwd alice
   add a teacher: useradd -m -G $(group_of TEACHERS_GROUP) bob && passwd bob
-  start the hub: cd $STATE && $PREFIX/venv/bin/jupyterhub -f $here/jupyterhub_config.py
+  start the hub: cd $STATE && ROSFPGA_COURSE_NOTEBOOKS=$PREFIX/notebooks \\
+                 $PREFIX/venv/bin/jupyterhub -f $here/jupyterhub_config.py
                  (add --ip 0.0.0.0 --ssl-key KEY --ssl-cert CERT to open it to the network)
 EOF

@@ -10,8 +10,10 @@ notebooks must be that user's own copies, and the three users' ROS masters must 
 different ones. A user's node that relies on the default master must not join another user's.
 Users, groups and servers are removed afterwards, also on failure.
 
-It needs root, JupyterHub (the ``[course]`` extra) and configurable-http-proxy (``npm ci`` in
-``course/``); without them it skips with a reason, with ``ROSFPGA_REQUIRE_COURSE=1`` (CI) fails.
+It needs root and the course server that ``course/setup.sh`` installs (the shared environment in
+``/opt/rosfpga-lab`` or ``ROSFPGA_COURSE_PREFIX``, holding this checkout's lab, and
+configurable-http-proxy); without them it skips with a reason, with ``ROSFPGA_REQUIRE_COURSE=1``
+(CI, whose ``.ci/run`` runs ``course/setup.sh`` first) it fails.
 """
 
 from __future__ import annotations
@@ -43,7 +45,9 @@ from rosfpga_lab.checks import nbbuild
 ROOT = Path(__file__).resolve().parents[1]
 COURSE = ROOT / "course"
 HUB_CONFIG = COURSE / "jupyterhub_config.py"
-BIN = Path(sys.executable).parent
+#: Where course/setup.sh installed the shared environment and the student notebooks.
+SHARED = Path(os.environ.get("ROSFPGA_COURSE_PREFIX", "/opt/rosfpga-lab"))
+BIN = SHARED / "venv" / "bin"
 REQUIRE = "ROSFPGA_REQUIRE_COURSE"
 #: The notebooks every user runs at once: (name in the user's folder, where it comes from).
 RUNS = [("00_overview.ipynb", None),
@@ -66,16 +70,31 @@ def _missing() -> str | None:
         return "a course server needs Linux (local Unix users)"
     if os.geteuid() != 0:
         return "not root: the test creates Unix users and JupyterHub spawns servers as them"
-    try:
-        import jupyterhub  # noqa: F401
-        import tornado.websocket  # noqa: F401
-    except ImportError:
-        return "JupyterHub not installed (pip install -e '.[course]')"
-    if _proxy_command() is None:
-        return "configurable-http-proxy not installed (cd course && npm ci)"
     for tool in ("useradd", "userdel", "groupadd", "groupdel", "chpasswd"):
         if shutil.which(tool) is None:
             return f"{tool} not found"
+    if not (BIN / "jupyterhub").exists():
+        return (f"no course server set up in {SHARED} (run course/setup.sh as root; "
+                "ROSFPGA_COURSE_PREFIX names another place)")
+    if _proxy_command() is None:
+        return "configurable-http-proxy not installed (cd course && npm ci)"
+    return _stale()
+
+
+def _stale() -> str | None:
+    """Why the shared environment does not hold this checkout's lab and notebooks, or None."""
+    where = subprocess.run([str(BIN / "python"), "-c",
+                            "import rosfpga_lab, os; print(os.path.dirname(rosfpga_lab.__file__))"],
+                           capture_output=True, text=True, timeout=60)
+    if where.returncode != 0:
+        return f"the course environment {SHARED} has no rosfpga_lab: {where.stderr.strip()[-300:]}"
+    pairs = [(p, Path(where.stdout.strip()) / p.relative_to(ROOT / "rosfpga_lab"))
+             for p in (ROOT / "rosfpga_lab").rglob("*.py")]
+    pairs += [(p, SHARED / "notebooks" / p.name)
+              for p in (ROOT / "notebooks").glob(nbbuild.NOTEBOOK_GLOB)]
+    for mine, theirs in pairs:
+        if not theirs.exists() or theirs.read_bytes() != mine.read_bytes():
+            return f"the course environment {SHARED} holds another version ({theirs}); re-run course/setup.sh"
     return None
 
 
@@ -101,15 +120,16 @@ def unix_users() -> Iterator[list[tuple[str, str]]]:
         skip_or_fail(reason, REQUIRE)
     settings = _course_settings()
     group = next(g for g in settings["students"] if g not in settings["teachers"])
-    made_group = False
-    try:
-        grp.getgrnam(group)
-    except KeyError:
-        _sh("groupadd", group)
-        made_group = True
+    made_groups: list[str] = []
     tag = secrets.token_hex(3)
     users: list[tuple[str, str]] = []
     try:
+        for name in sorted(set(settings["students"]) | set(settings["teachers"])):
+            try:
+                grp.getgrnam(name)
+            except KeyError:   # as course/setup.sh does
+                _sh("groupadd", name)
+                made_groups.append(name)
         for i in range(USERS):
             name, password = f"rfl{tag}s{i}", secrets.token_urlsafe(12)
             _sh("useradd", "--create-home", "--shell", "/bin/bash", "--groups", group, name)
@@ -120,8 +140,8 @@ def unix_users() -> Iterator[list[tuple[str, str]]]:
     finally:
         for name, _ in users:
             subprocess.run(["userdel", "--remove", name], capture_output=True, timeout=60)
-        if made_group:
-            subprocess.run(["groupdel", group], capture_output=True, timeout=60)
+        for name in made_groups:
+            subprocess.run(["groupdel", name], capture_output=True, timeout=60)
 
 
 class Hub:
@@ -142,7 +162,7 @@ class Hub:
             "c.JupyterHub.load_roles = [{'name': 'course-test', 'services': ['course-test'],\n"
             "    'scopes': ['admin:users', 'admin:servers', 'access:servers', 'read:users']}]\n")
         env = dict(os.environ, PATH=f"{BIN}{os.pathsep}{os.environ.get('PATH', '')}",
-                   ROSFPGA_COURSE_NOTEBOOKS=str(ROOT / "notebooks"))
+                   ROSFPGA_COURSE_NOTEBOOKS=str(SHARED / "notebooks"))
         self.log = state / "jupyterhub.log"
         with open(self.log, "wb") as log:
             self.proc = subprocess.Popen([str(BIN / "jupyterhub"), "-f", str(config)], cwd=state,
