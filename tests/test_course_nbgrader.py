@@ -3,7 +3,8 @@
 * ``nbgrader generate_assignment`` on the course source that ``rosfpga-lab notebooks nbgrader``
   derives from ``notebooks/solutions/`` gives, cell for cell, the student notebooks of
   ``rosfpga-lab notebooks build`` (each exercise cell split into its answer and its check).
-* ``nbgrader autograde`` scores notebook 2 (three exercises, one point each): the solution 3,
+* Released, fetched, submitted and collected through an nbgrader exchange (one student; the
+  others' files are put in place, to keep the test short), then ``nbgrader autograde`` scores notebook 2 (three exercises, one point each): the solution 3,
   the untouched student copy 0, a half-done copy (one right, one wrong, one untouched) 1, and
   the wrong answer's findings from its check appear in the graded notebook.
 
@@ -140,11 +141,26 @@ def test_autograde_scores_solution_untouched_and_half_done(nbgrader_cmd: list[st
         gid = cell["metadata"].get("nbgrader", {}).get("grade_id")
         if gid in solved:
             cell["source"] = solved[gid]
-    for student, nb in (("solved", full), ("untouched", release_nb), ("half", half)):
+    # release, fetch, submit and collect through an exchange, as on a course server
+    exchange = tmp_path / "exchange"
+    exchange.mkdir(mode=0o777)
+    where = [f"--Exchange.root={exchange}", "--CourseDirectory.course_id=test-course"]
+    run(nbgrader_cmd + ["release_assignment", GRADED] + where, course)
+    students = {"solved": full, "untouched": release_nb, "half": half}
+    home = tmp_path / "half"                   # one student goes through the exchange ...
+    home.mkdir()
+    run(nbgrader_cmd + ["fetch_assignment", GRADED] + where, home)
+    fetched = home / GRADED / f"{GRADED}.ipynb"
+    assert fetched.read_text(encoding="utf-8") == release.read_text(encoding="utf-8")
+    fetched.write_text(json.dumps(half), encoding="utf-8")
+    run(nbgrader_cmd + ["submit", GRADED, "--student=half"] + where, home)
+    for student in ("solved", "untouched"):    # ... two hand theirs in by other means
         target = course / "submitted" / student / GRADED / f"{GRADED}.ipynb"
         target.parent.mkdir(parents=True)
-        target.write_text(json.dumps(nb), encoding="utf-8")
-        run(nbgrader_cmd + ["db", "student", "add", student], course)
+        target.write_text(json.dumps(students[student]), encoding="utf-8")
+    (tmp_path / "students.csv").write_text("id\n" + "\n".join(students) + "\n")
+    run(nbgrader_cmd + ["db", "student", "import", str(tmp_path / "students.csv")], course)
+    run(nbgrader_cmd + ["collect", GRADED] + where, course)
     run(nbgrader_cmd + ["autograde", GRADED, "--force"], course)
     run(nbgrader_cmd + ["export", "--to", str(tmp_path / "grades.csv")], course)
 
