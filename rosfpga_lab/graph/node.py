@@ -121,7 +121,7 @@ def default_master_uri() -> str:
             f"the ROS master on {probe} belongs to another user (uid {others[0]}); this "
             "process uses a master of its own. Set ROS_MASTER_URI (or pass master_uri=) to "
             "join that one on purpose.", RuntimeWarning, stacklevel=3)
-        return shared_master().uri
+        return shared_master(port=0).uri   # 11311 is taken: no second warning about it
     try:
         reply = call(probe, "getUri", "/rosfpga_lab_probe", timeout=0.5)
         if isinstance(reply, list) and reply and reply[0] == 1:
