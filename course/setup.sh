@@ -6,7 +6,8 @@
 #   1. the shared environment PREFIX/venv (default /opt/rosfpga-lab): the lab with its [course]
 #      extra (JupyterHub, nbgrader), installed once for every user;
 #   2. JupyterHub's proxy, configurable-http-proxy, from npm into course/node_modules (npm ci);
-#   3. the student notebooks in PREFIX/notebooks (every user gets a copy at first login);
+#   3. the student notebooks in PREFIX/notebooks (every user gets a copy at first login); of
+#      nbgrader's JupyterLab panels only the students' Assignments list;
 #   4. the Unix groups of jupyterhub_config.py (students, teachers), the hub's state directory
 #      STATE (default /srv/rosfpga-lab) and nbgrader's exchange for releasing and collecting.
 # Then start the hub with the command it prints. Set PYTHON=/path/to/python3.x (3.11 to 3.13),
@@ -49,6 +50,13 @@ mkdir -p "$PREFIX"
 "$PREFIX/venv/bin/python" -m pip install --quiet -r "$repo/environment.txt" "$repo[course]"
 # the lab itself again, so a re-run after `git pull` installs the new version of the same number
 "$PREFIX/venv/bin/python" -m pip install --quiet --no-deps --force-reinstall "$repo"
+
+# Students see nbgrader's Assignments list (fetch, validate, submit); the teacher's panels stay
+# hidden, as the teacher grades from the command line (README).
+"$PREFIX/venv/bin/jupyter" labextension disable --level=sys_prefix @jupyter/nbgrader:formgrader \
+    @jupyter/nbgrader:create-assignment @jupyter/nbgrader:course-list >/dev/null 2>&1
+"$PREFIX/venv/bin/jupyter" server extension disable --sys-prefix \
+    nbgrader.server_extensions.formgrader nbgrader.server_extensions.course_list >/dev/null 2>&1
 
 echo "setup.sh: configurable-http-proxy into $here/node_modules"
 (cd "$here" && npm ci --no-audit --no-fund --loglevel=error)
