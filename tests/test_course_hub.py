@@ -8,6 +8,8 @@ proxy, runs notebooks 0, 2 (solved) and 7 in all three servers at the same time:
 goes to a kernel over the Jupyter server's kernel websocket. Every cell must pass, each user's
 notebooks must be that user's own copies, and the three users' ROS masters must be three
 different ones. A user's node that relies on the default master must not join another user's.
+Then the teacher releases notebook 2 with nbgrader, each student fetches and submits it through
+JupyterLab's Assignments panel (its REST calls, through the hub), and the teacher collects.
 Users, groups and servers are removed afterwards, also on failure.
 
 It needs root and the course server that ``course/setup.sh`` installs (the shared environment in
@@ -255,8 +257,9 @@ async def run_notebook(hub: Hub, user: str, path: str, extra: list[str], *,
     kernel = session["kernel"]["id"]
     ws_url = (f"ws://127.0.0.1:{hub.port}{base}/kernels/{kernel}/channels"
               f"?session_id={uuid.uuid4().hex}")
-    conn = await websocket_connect(HTTPRequest(ws_url, headers={
-        "Authorization": f"token {hub.token}"}), max_message_size=64 * 2**20)
+    conn = await websocket_connect(HTTPRequest(  # answers once the kernel runs: slow under load
+        ws_url, headers={"Authorization": f"token {hub.token}"}, connect_timeout=CELL_TIMEOUT,
+        request_timeout=CELL_TIMEOUT), max_message_size=64 * 2**20)
     session_id = uuid.uuid4().hex
 
     async def execute(code: str) -> tuple[list[dict], str]:
@@ -366,7 +369,51 @@ async def _course(hub: Hub, users: list[tuple[str, str]]) -> dict[str, dict[str,
     for path in kept:
         await hub.request("DELETE", path, ok=(204, 404))
     assert len(set(defaults)) == USERS, f"users share a default master: {defaults}"
+
+    await _assignments(hub, [name for name, _ in users], state=hub.log.parent)
     return results
+
+
+def _nbgrader(args: list[str], cwd: Path) -> None:
+    env = dict(os.environ, PATH=f"{BIN}{os.pathsep}{os.environ.get('PATH', '')}")
+    proc = subprocess.run([str(BIN / "nbgrader"), *args], cwd=cwd, env=env, capture_output=True,
+                          text=True, timeout=240)
+    assert proc.returncode == 0, f"nbgrader {' '.join(args)}:\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}"
+
+
+async def _assignments(hub: Hub, names: list[str], state: Path) -> None:
+    """The teacher releases notebook 2 (nbgrader, server-wide exchange of course/setup.sh); each
+    student fetches and submits it in JupyterLab (nbgrader's Assignments panel, through the hub);
+    the teacher collects all three."""
+    from traitlets.config.loader import PyFileConfigLoader
+
+    exchange = Path(PyFileConfigLoader("nbgrader_config.py", "/etc/jupyter").load_config()
+                    .Exchange.root)
+    course_id, assignment = f"{names[0]}-course", "02_tcpros"
+    course = state / "course"
+    subprocess.run([str(BIN / "rosfpga-lab"), "notebooks", "nbgrader", str(course), assignment,
+                    "--source", str(ROOT / "notebooks" / "solutions")], check=True, timeout=120,
+                   capture_output=True)
+    where = [f"--CourseDirectory.course_id={course_id}"]
+    try:
+        _nbgrader(["generate_assignment", assignment] + where, course)
+        _nbgrader(["release_assignment", assignment] + where, course)
+        query = urllib.parse.urlencode({"course_id": course_id, "assignment_id": assignment})
+        for name in names:
+            listed = await hub.request("GET", f"/user/{name}/assignments?course_id={course_id}")
+            assert any(a["assignment_id"] == assignment and a["status"] == "released"
+                       for a in listed["value"]), listed
+            fetched = await hub.request("POST", f"/user/{name}/assignments/fetch?{query}")
+            assert fetched["success"], fetched
+            copy = Path(pwd.getpwnam(name).pw_dir) / assignment / f"{assignment}.ipynb"
+            assert copy.stat().st_uid == pwd.getpwnam(name).pw_uid, f"{copy} is not {name}'s"
+            submitted = await hub.request("POST", f"/user/{name}/assignments/submit?{query}")
+            assert submitted["success"], submitted
+        _nbgrader(["collect", assignment] + where, course)
+        for name in names:
+            assert (course / "submitted" / name / assignment / f"{assignment}.ipynb").exists(), name
+    finally:
+        shutil.rmtree(exchange / course_id, ignore_errors=True)
 
 
 def test_three_users_run_notebooks_0_2_7_at_once_through_jupyterhub(
