@@ -177,3 +177,7 @@ def test_autograde_scores_solution_untouched_and_half_done(nbgrader_cmd: list[st
     assert "not right yet" in outputs and "md5" in outputs            # the wrong answer's findings
     assert "correct" in outputs                                       # the right answer's line
     assert "NotImplementedError" in outputs                           # the untouched one
+
+    run(nbgrader_cmd + ["generate_feedback", GRADED, "--student=half", "--force"], course)
+    page = (course / "feedback" / "half" / GRADED / f"{GRADED}.html").read_text(encoding="utf-8")
+    assert "not right yet" in page and "Score: 1.0 / 3.0" in page     # what the student gets back
