@@ -38,7 +38,7 @@ if [ -z "$py" ]; then
     fi
   done
 fi
-if [ -z "$py" ] || ! setpriv --reuid=nobody --regid=nogroup --clear-groups "$py" -c '' 2>/dev/null; then
+if [ -z "$py" ] || ! setpriv --reuid="$(id -u nobody)" --regid="$(id -g nobody)" --clear-groups "$py" -c '' 2>/dev/null; then
   echo "setup.sh: error: no Python 3.11 to 3.13 that every user may run (${py:-none found});" \
        "set PYTHON=/usr/bin/python3.x (Debian: apt-get install python3-venv)" >&2
   exit 1

@@ -51,6 +51,8 @@ HUB_CONFIG = COURSE / "jupyterhub_config.py"
 #: Where course/setup.sh installed the shared environment and the student notebooks.
 SHARED = Path(os.environ.get("ROSFPGA_COURSE_PREFIX", "/opt/rosfpga-lab"))
 BIN = SHARED / "venv" / "bin"
+#: nbgrader's settings for every user of the server (course id, exchange), by course/setup.sh.
+NBGRADER_SERVER_CONFIG = Path("/etc/jupyter/nbgrader_config.py")
 REQUIRE = "ROSFPGA_REQUIRE_COURSE"
 #: The notebooks every user runs at once: (name in the user's folder, where it comes from).
 RUNS = [("00_overview.ipynb", None),
@@ -81,6 +83,8 @@ def _missing() -> str | None:
                 "ROSFPGA_COURSE_PREFIX names another place)")
     if _proxy_command() is None:
         return "configurable-http-proxy not installed (cd course && npm ci)"
+    if not NBGRADER_SERVER_CONFIG.exists():
+        return f"no {NBGRADER_SERVER_CONFIG} (nbgrader's exchange): run course/setup.sh as root"
     return _stale()
 
 
@@ -386,8 +390,8 @@ async def _assignments(hub: Hub, names: list[str], state: Path) -> None:
     the teacher collects all three."""
     from traitlets.config.loader import PyFileConfigLoader
 
-    exchange = Path(PyFileConfigLoader("nbgrader_config.py", "/etc/jupyter").load_config()
-                    .Exchange.root)
+    exchange = Path(PyFileConfigLoader(NBGRADER_SERVER_CONFIG.name, str(
+        NBGRADER_SERVER_CONFIG.parent)).load_config().Exchange.root)
     course_id, assignment = f"{names[0]}-course", "02_tcpros"
     course = state / "course"
     subprocess.run([str(BIN / "rosfpga-lab"), "notebooks", "nbgrader", str(course), assignment,
