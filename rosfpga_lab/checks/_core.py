@@ -73,6 +73,13 @@ class CheckResult:
 
     __repr__ = __str__
 
+    def _ipython_display_(self) -> None:
+        """Show as display data, not as the cell's value: nbgrader would read a test cell's
+        value as partial credit (and warns when it is not a number)."""
+        from IPython.display import display
+
+        display({"text/plain": str(self), "text/html": self._repr_html_()}, raw=True)
+
     def _repr_html_(self) -> str:
         items = "".join(f"<li>{html.escape(d)}</li>" for d in self.details)
         return (f"<div style='color:#1b7a32'><b>\u2714 Exercise {html.escape(self.exercise)}: "

@@ -1,4 +1,5 @@
-"""``rosfpga-lab notebooks build|html``: student notebooks from the solutions; offline HTML pages."""
+"""``rosfpga-lab notebooks build|nbgrader|html``: student notebooks from the solutions, an nbgrader
+course's source, offline HTML pages."""
 
 from __future__ import annotations
 
@@ -29,6 +30,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                        help="write nothing; exit 1 if any student notebook differs from what "
                        "the build would write")
     build.set_defaults(func=run)
+    grading = sub.add_parser(
+        "nbgrader", help="write an nbgrader course's source notebooks (exercises graded by the checks)",
+        description="Write COURSE_DIR/source/<assignment>/NN_name.ipynb from the instructor "
+        "notebooks, with nbgrader's cell metadata derived from them: each exercise cell becomes "
+        "an autograded answer cell (the part up to '# END SOLUTION') and a locked autograder "
+        "test cell (the check call after it, worth one point). Also writes "
+        "COURSE_DIR/nbgrader_config.py when missing. Then, in COURSE_DIR: nbgrader "
+        "generate_assignment NAME, release_assignment, collect, autograde (README: Teaching a "
+        "course). Needs no nbgrader itself; the course server has it (pip install -e '.[course]').")
+    grading.add_argument("course_dir", type=Path, metavar="COURSE_DIR",
+                         help="the nbgrader course directory (created if missing)")
+    grading.add_argument("notebooks", nargs="*", metavar="NOTEBOOK",
+                         help="only these notebooks, by stem or file name (default: all)")
+    grading.add_argument("--source", type=Path, default=Path("notebooks/solutions"), metavar="DIR",
+                         help="instructor notebooks (default: notebooks/solutions)")
+    grading.add_argument("--assignment", default=None, metavar="NAME",
+                         help="one assignment holding all the notebooks (default: one assignment "
+                         "per notebook, named after it)")
+    grading.set_defaults(func=run_nbgrader)
     html = sub.add_parser(
         "html", help="run notebooks and write self-contained HTML pages (widgets in static form)",
         description="Run each notebook top to bottom in a fresh kernel (in its own directory) and "
@@ -64,6 +84,17 @@ def run(args: argparse.Namespace) -> int:
         print(f"{len(stale) + len(lost)} student notebook(s) do not match their solutions source; "
               "run 'rosfpga-lab notebooks build'")
         return 1
+    return 0
+
+
+def run_nbgrader(args: argparse.Namespace) -> int:
+    """Write the nbgrader course source; print one line per notebook."""
+    from rosfpga_lab.checks.grading import write_course_source
+
+    for item in write_course_source(args.source, args.course_dir, args.notebooks,
+                                    assignment=args.assignment):
+        print(f"{item.notebook}: assignment {item.name}, {item.checks} graded check(s), "
+              f"{item.points} point(s)")
     return 0
 
 

@@ -15,7 +15,8 @@ Quick use::
 
 Which master a :class:`Node` talks to: ``master=`` or ``master_uri=`` when given; else
 ``ROS_MASTER_URI``; else a master already answering on 127.0.0.1:11311 (roscore or
-``rosfpga-lab master``); else this process's own embedded master (:func:`shared_master`),
+``rosfpga-lab master``) that runs as the same Unix user (on a shared server, another user's
+master is never joined unasked: ``owner``); else this process's own embedded master (:func:`shared_master`),
 started on 11311, or on a free port (with a RuntimeWarning) when 11311 is taken. The last
 step is what makes a notebook work with nothing installed, but other processes find that
 master only on 11311 (on a fallback port, nobody else does): a node there may be alone.
@@ -26,6 +27,7 @@ with an error and a hint when no master answers there).
 Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``master`` (EmbeddedMaster),
 ``node`` (Node, Slave API, TCPROS server), ``publisher``, ``subscriber``, ``trace`` (the recorded
 conversation; its docstring documents the format), ``names`` (names, ROS_* environment),
+``owner`` (which Unix user listens on a port),
 ``errors`` (errors and limits).
 """
 

@@ -13,7 +13,7 @@ runs in daemon threads, so a node works inside a running Jupyter kernel; :meth:`
 unregisters, closes every socket and joins every thread.
 
 Master selection (``master_uri``): an explicit URI; else ``ROS_MASTER_URI``; else a master
-already answering on 127.0.0.1:11311; else the shared embedded master of this process
+already answering on 127.0.0.1:11311 that runs as the same Unix user (see ``owner``); else the shared embedded master of this process
 (:func:`shared_master`), started on first use on port 11311 (or a free port if 11311 is
 taken). Pass ``master=`` an :class:`EmbeddedMaster` to use that one.
 """
@@ -46,6 +46,7 @@ from rosfpga_lab.graph.names import (
     master_uri_from_env,
     resolve,
 )
+from rosfpga_lab.graph.owner import listener_uids
 from rosfpga_lab.graph.publisher import Publisher
 from rosfpga_lab.graph.subscriber import Subscriber
 from rosfpga_lab.graph.trace import Trace, new_connection_id
@@ -101,7 +102,9 @@ def default_master_uri() -> str:
     """The master a node uses when none is given.
 
     ``ROS_MASTER_URI`` if set; else a master already answering on 127.0.0.1:11311 (a roscore
-    or ``rosfpga-lab master``); else the shared embedded master of this process.
+    or ``rosfpga-lab master``) if it runs as this process's user (on Linux, where the owner of
+    a port is known: on a shared server another user's master is never joined unasked, with a
+    RuntimeWarning); else the shared embedded master of this process.
     """
     env = master_uri_from_env()
     if env:
@@ -110,6 +113,15 @@ def default_master_uri() -> str:
         if _shared is not None and _shared.running:
             return _shared.uri
     probe = f"http://127.0.0.1:{DEFAULT_MASTER_PORT}/"
+    owners = listener_uids(DEFAULT_MASTER_PORT)
+    others = sorted((owners or set()) - {os.geteuid()})
+    if others:
+        # A shared server (a course on JupyterHub): never join another user's graph unasked.
+        warnings.warn(
+            f"the ROS master on {probe} belongs to another user (uid {others[0]}); this "
+            "process uses a master of its own. Set ROS_MASTER_URI (or pass master_uri=) to "
+            "join that one on purpose.", RuntimeWarning, stacklevel=3)
+        return shared_master(port=0).uri   # 11311 is taken: no second warning about it
     try:
         reply = call(probe, "getUri", "/rosfpga_lab_probe", timeout=0.5)
         if isinstance(reply, list) and reply and reply[0] == 1:
