@@ -113,6 +113,16 @@ def has_outputs(nb: dict[str, Any]) -> list[int]:
             if c.get("cell_type") == "code" and (c.get("outputs") or c.get("execution_count") is not None)]
 
 
+#: The note a student notebook with exercises carries after its title cell (the build adds it).
+RUN_ALL_NOTE_ID = "run-all-note"
+RUN_ALL_NOTE = (
+    "> **Run All stops at the first exercise.** Each exercise cell starts as `raise "
+    "NotImplementedError(...)`, so *Run > Run All Cells* runs the notebook up to there and stops. "
+    "Write your answer in place of that line and run the cell; then go on from the next cell with "
+    "*Run > Run Selected Cell and All Below*."
+)
+
+
 def is_exercise_cell(cell: dict[str, Any]) -> bool:
     """True for a code cell of a source notebook holding a solution block."""
     return cell.get("cell_type") == "code" and BEGIN in cell_source(cell)
@@ -120,6 +130,8 @@ def is_exercise_cell(cell: dict[str, Any]) -> bool:
 
 def student_notebook(nb: dict[str, Any], name: str = "") -> dict[str, Any]:
     """The student version of an instructor notebook (a new dict; ``nb`` is not changed).
+
+    A notebook with exercises gets :data:`RUN_ALL_NOTE` after its title cell.
 
     Raises:
         NotebookBuildError: unbalanced markers.
@@ -135,6 +147,9 @@ def student_notebook(nb: dict[str, Any], name: str = "") -> dict[str, Any]:
         elif cell.get("cell_type") == "markdown":
             _set_source(cell, strip_markdown_solution(cell_source(cell), where=where))
         cells.append(cell)
+    if any(is_exercise_cell(c) for c in nb.get("cells", [])):
+        note = {"cell_type": "markdown", "id": RUN_ALL_NOTE_ID, "metadata": {}, "source": RUN_ALL_NOTE}
+        cells.insert(1 if cells else 0, note)
     out["cells"] = cells
     out.setdefault("metadata", {})["rosfpga_lab"] = {
         "generated_from": f"solutions/{name}" if name else "solutions",
