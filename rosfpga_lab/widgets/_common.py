@@ -29,10 +29,9 @@ VALUE_TEXT_LIMIT = 80
 DIFF_POSITIONS_LIMIT = 1000
 #: Side (pixels) of the largest zoom region whose values are tabulated.
 ZOOM_MAX = 16
-#: Beats per page of the beat table, and beats shown in the waveform (11 beats of 64 px and
-#: the signal names fit a notebook 1,000 px wide).
+#: Beats per page of the beat table, and beats shown in the waveform.
 BEAT_PAGE_SIZE = 32
-WAVE_BEATS = 11
+WAVE_BEATS = 16
 #: Live view: default most frames per second pushed to the browser.
 LIVE_MAX_FPS = 10.0
 #: Largest width (pixels) of an image sent to the browser; bigger ones are scaled down.
