@@ -51,9 +51,11 @@ MEASURE = """() => {
         if (r.width === 0 || r.height === 0) continue;
         if (r.right > right + 0.5) { right = r.right; widest = el.tagName.toLowerCase() + '.' + el.className; }
       }
+      // the widget's own width: its widest drawn piece (blocks that merely span the area do not count)
       let content = 0;
-      for (const el of area.querySelectorAll('img, svg, table, pre, canvas, .jupyter-widgets, .widget-box, .rfl-bv, .rfl-svgpane'))
-        content = Math.max(content, el.getBoundingClientRect().right - box.left);
+      for (const el of area.querySelectorAll('img, svg, canvas, table, button, input, select, .rfl-bv-grid, summary, code'))
+        if (!el.closest('svg') || el.tagName.toLowerCase() === 'svg')
+          content = Math.max(content, el.getBoundingClientRect().right - box.left);
       const kinds = [];
       if (area.querySelector('.rfl-svgpane')) kinds.push('sequence diagram');
       if (area.querySelector('.rfl-bv')) kinds.push('byte viewer');
@@ -165,12 +167,13 @@ def _screenshots(page: object, name: str, tmp_path: Path) -> None:
     top, as far as the window shows it."""
     stem = name.split(".")[0]
     wanted = {"sequence": ".rfl-svgpane", "images": ".jp-OutputArea-output:has(.rfl-clickimage)",
+              "images-last": ".jp-OutputArea-output:has(.rfl-clickimage) >> nth=-1",
               "live": ".jp-OutputArea-output:has(.widget-image)", "states": ".jp-OutputArea-output:has(svg .rfl-state)",
               "code": ".jp-OutputArea-output:has(details pre)", "bytes": ".rfl-bv",
               "beats": ".jp-OutputArea-output:has(.widget-html-content svg)"}
     for kind, selector in wanted.items():
-        element = page.locator(selector).first
-        if element.count() == 0:
+        element = page.locator(selector) if "nth=" in selector else page.locator(selector).first
+        if element.count() == 0 or (kind == "images-last" and page.locator(selector.split(" >>")[0]).count() < 2):
             continue
         element.evaluate("e => e.scrollIntoView({block: 'start'})")
         page.wait_for_timeout(200)
