@@ -44,6 +44,13 @@ setup() {
     "$venv/bin/python" -m pip install --quiet -e ".$extras"
     echo "$want" >> "$stamp"
   fi
+  # JupyterLab's own defaults for this lab: no "get news?" pop-up over the outputs, no update
+  # check (the lab runs offline). JupyterLab reads them from its app settings directory.
+  local settings="$venv/share/jupyter/lab/settings"
+  if ! cmp -s "$here/data/jupyterlab_overrides.json" "$settings/overrides.json"; then
+    mkdir -p "$settings"
+    cp "$here/data/jupyterlab_overrides.json" "$settings/overrides.json"
+  fi
 }
 
 # No command, or only options for JupyterLab (./lab.sh --port 8889): open the lab.
@@ -55,7 +62,8 @@ shift
 case "$cmd" in
   lab|open)
     setup ""
-    exec "$venv/bin/jupyter" lab --ServerApp.ip=127.0.0.1 --notebook-dir="$here/notebooks" "$@" ;;
+    exec "$venv/bin/jupyter" lab --ServerApp.ip=127.0.0.1 --notebook-dir="$here/notebooks" \
+      --LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate "$@" ;;
   test)
     setup "[test]"
     exec "$venv/bin/python" -m pytest "$@" ;;

@@ -18,6 +18,7 @@ import sys
 import time
 import urllib.request
 from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import nbformat
@@ -128,12 +129,18 @@ class Lab:
             shutil.copy(path, Path(keep) / path.name)
 
 
-@pytest.fixture(scope="module")
-def lab(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Lab]:
+#: The lab's own JupyterLab settings (what ./lab.sh installs): no news pop-up, no update check.
+LAB_OVERRIDES = Path(__file__).resolve().parents[1] / "data" / "jupyterlab_overrides.json"
+
+
+@contextmanager
+def lab_session(tmp: Path, width: int = 1400, height: int = 900,
+                settings: dict | None = None) -> Iterator[Lab]:
+    """JupyterLab (with the lab's settings overrides plus ``settings``) and Chromium at
+    ``width`` x ``height``, both stopped at the end."""
     _require_browser()
     from playwright.sync_api import sync_playwright
 
-    tmp = tmp_path_factory.mktemp("jupyterlab")
     notebooks = tmp / "notebooks"
     notebooks.mkdir()
     env = {k: v for k, v in os.environ.items() if not k.startswith(("JUPYTER", "IPYTHON"))}
@@ -143,10 +150,14 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Lab]:
         path.mkdir()
         env[name] = str(path)
     env["JUPYTER_PLATFORM_DIRS"] = "1"
-    # answer JupyterLab's "get news?" question with no, so nothing is fetched and no toast covers the page
-    settings = tmp / "jupyterlab_settings_dir" / "@jupyterlab" / "apputils-extension"
-    settings.mkdir(parents=True)
-    (settings / "notification.jupyterlab-settings").write_text(json.dumps({"fetchNews": "false"}))
+    # the lab's overrides answer JupyterLab's "get news?" question with no (nothing fetched, no
+    # toast over the outputs); the test checks that no such toast appears
+    overrides = json.loads(LAB_OVERRIDES.read_text())
+    for plugin, values in (settings or {}).items():
+        overrides.setdefault(plugin, {}).update(values)
+    app_settings = tmp / "app_settings"
+    app_settings.mkdir()
+    (app_settings / "overrides.json").write_text(json.dumps(overrides))
     port = free_port()
     base = f"http://127.0.0.1:{port}/"
     log = tmp / "jupyterlab.log"
@@ -156,7 +167,7 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Lab]:
              "--ServerApp.ip=127.0.0.1", f"--IdentityProvider.token={TOKEN}",
              f"--ServerApp.root_dir={notebooks}", "--LabApp.expose_app_in_browser=True",
              "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
-             "--LabApp.extension_manager=readonly",
+             "--LabApp.extension_manager=readonly", f"--LabApp.app_settings_dir={app_settings}",
              *(["--allow-root"] if os.geteuid() == 0 else [])],
             env=env, cwd=notebooks, stdout=log_file, stderr=subprocess.STDOUT, start_new_session=True,
         )
@@ -165,7 +176,7 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Lab]:
         with sync_playwright() as pw:
             browser = pw.chromium.launch_persistent_context(
                 str(tmp / "chromium-profile"), executable_path=CHROMIUM, headless=True,
-                args=CHROMIUM_ARGS, viewport={"width": 1400, "height": 900},
+                args=CHROMIUM_ARGS, viewport={"width": width, "height": height},
             )
             try:
                 yield Lab(notebooks, base, browser)
@@ -173,6 +184,12 @@ def lab(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Lab]:
                 browser.close()
     finally:
         _stop_server(server, base)
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Lab]:
+    with lab_session(tmp_path_factory.mktemp("jupyterlab")) as session:
+        yield session
 
 
 def _highlighted(page: object) -> list[int]:

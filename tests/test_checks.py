@@ -131,7 +131,9 @@ def test_connection_header_right():
 
 def test_connection_header_wrong_answers():
     unsorted = {"type": "*", "topic": "/t", "md5sum": "*", "callerid": "/s"}
-    assert "sorted by key" in problems_of(C.check_connection_header, by_hand(unsorted, order=list), unsorted)
+    unsorted_msg = problems_of(C.check_connection_header, by_hand(unsorted, order=list), unsorted)
+    assert "the protocol accepts any order" in unsorted_msg
+    assert "rospy and roscpp write them sorted by key" in unsorted_msg
     assert "total length at the start is missing" in problems_of(C.check_connection_header, by_hand(FIELDS)[4:], FIELDS)
     assert "big-endian" in problems_of(C.check_connection_header, by_hand(FIELDS, fmt=">I"), FIELDS)
     bad = bytearray(by_hand(FIELDS))
@@ -315,8 +317,11 @@ application: {op: erode, ksize: 5}
 def test_node_config():
     assert C.check_node_config(GOOD_CONFIG).ok
     no_ksize = GOOD_CONFIG.replace(", ksize: 5", "")
-    assert "application.ksize is 3, expected 5 (the default: the key is missing?)" in \
-        problems_of(C.check_node_config, no_ksize)
+    assert "application.ksize is 3, expected 5 (the default: the key ksize is missing from the text)" \
+        in problems_of(C.check_node_config, no_ksize)
+    # an explicit 3 is a wrong value, not a missing key
+    explicit = problems_of(C.check_node_config, GOOD_CONFIG.replace("ksize: 5", "ksize: 3"))
+    assert "application.ksize is 3, expected 5" in explicit and "missing" not in explicit
     swapped = GOOD_CONFIG.replace("width: 320, height: 240", "width: 240, height: 320")
     msg = problems_of(C.check_node_config, swapped)
     assert "image.width is 240, expected 320" in msg and "image.height is 320, expected 240" in msg
@@ -337,7 +342,7 @@ def test_sloc():
     assert C.check_sloc(2, SNIPPET).ok
     assert "that is every line" in problems_of(C.check_sloc, 6, SNIPPET)
     assert "still counts comment-only lines" in problems_of(C.check_sloc, 5, SNIPPET)
-    assert "leaves out the preprocessor lines" in problems_of(C.check_sloc, 1, SNIPPET)
+    assert "leaves out the #pragma HLS lines; they count" in problems_of(C.check_sloc, 1, SNIPPET)
     assert "too many: is a line inside a /* ... */ comment counted?" in problems_of(C.check_sloc, 3, SNIPPET)
     assert "too few: a line with code before a // comment counts" in problems_of(C.check_sloc, 0, SNIPPET)
 
@@ -348,6 +353,7 @@ def test_marshal_explains_a_shift_instead_of_listing_every_byte_after_it():
     msg = problems_of(C.check_marshal, four_byte_flag, image_msg())
     assert "something before byte 40 is 3 byte(s) too long (the field before is is_bigendian, uint8: 1 byte)" in msg
     assert msg.count("\n  - ") == 2, "one finding and one explanation, not every later byte"
+    assert "big-endian" not in msg
     pixels = bytes(range(1, 9))
     msg8 = {**image_msg(), "height": 2, "width": 4, "step": 4, "data": pixels}
     right = image_body(width=4, height=2, data=pixels)
@@ -375,3 +381,45 @@ def test_a_corrupted_byte_is_named_by_the_field_that_holds_it(data):
     name = f"{owner.path} length" if owner.role == "length" else owner.path
     findings = C.describe_byte_difference(bytes(bad), body, C.message_fields(type_name, body))
     assert findings and findings[0].startswith(f"byte {i} (field {name}"), findings
+
+
+NOTEBOOK_6_SNIPPET = """\
+/* Copy one frame.
+   Pixels arrive in raster order. */
+#include "ros_node.h"
+
+void copy(pixel_stream& in, pixel_stream& out) {
+#pragma HLS INTERFACE axis port=in
+    // one pixel per clock
+    for (int i = 0; i < ROWS * COLS; i++) {
+#pragma HLS PIPELINE II=1
+        out << in.read();   // pass it on
+    }
+}
+"""
+
+
+def test_sloc_notebook_6_slips_get_their_own_diagnosis():
+    # counted by hand: #include, void, #pragma, for, #pragma, out, }, } = 8
+    assert C.check_sloc(8, NOTEBOOK_6_SNIPPET).ok
+    no_pragmas = problems_of(C.check_sloc, 6, NOTEBOOK_6_SNIPPET)
+    assert "leaves out the #pragma HLS lines; they count" in no_pragmas and no_pragmas.endswith(".")
+    no_directives = problems_of(C.check_sloc, 5, NOTEBOOK_6_SNIPPET)
+    assert "leaves out the preprocessor lines" in no_directives
+    too_few = problems_of(C.check_sloc, 4, NOTEBOOK_6_SNIPPET)
+    assert "comment counts. Count the lines" in too_few and too_few.endswith(".")
+
+
+def test_marshal_native_alignment_is_named_not_big_endian():
+    """Exercise 3.2 written with struct's native mode: '@BI' pads is_bigendian to 4 bytes."""
+    msg = image_msg()
+    body = (struct.pack("<III", 3, 10, 20) + pack_str("camera") + struct.pack("<II", 1, 2)
+            + pack_str("mono8") + struct.pack("@BI", 0, 2) + pack_str(b"\x01\x02"))
+    assert struct.calcsize("@BI") == 8  # the padding this test is about
+    found = problems_of(C.check_marshal, body, msg)
+    assert "big-endian" not in found
+    assert "3 zero byte(s) follow is_bigendian" in found and "native mode" in found
+    assert "start every format with '<'" in found
+    # a real big-endian step is still called big-endian
+    swapped = image_body()[:-10] + struct.pack(">I", 2) + pack_str(b"\x01\x02")
+    assert "big-endian" in problems_of(C.check_marshal, swapped, msg)

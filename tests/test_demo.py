@@ -110,3 +110,49 @@ def test_demo_interrupted_says_so_and_exits_130(tmp_path) -> None:
             proc.communicate()
     assert proc.returncode == 130
     assert "rosfpga-lab demo: interrupted" in err and "Traceback" not in err
+
+
+def test_demo_view_serves_a_live_page_while_it_runs(tmp_path) -> None:
+    """``demo --view``: the printed URL serves the page, a frame image and counters on
+    loopback while the demo runs, and nothing after it ended."""
+    import json
+    import re
+    import urllib.error
+    import urllib.request
+
+    proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "demo", "--view", "--frames", "45",
+                             "--rate", "15", "--source", "synthetic", "--no-figure"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=tmp_path)
+    try:
+        first = proc.stdout.readline()
+        found = re.match(r"live view: (http://127\.0\.0\.1:\d+/) ", first)
+        assert found, first
+        url = found[1]
+        with urllib.request.urlopen(url, timeout=5) as resp:
+            page = resp.read().decode()
+        assert "<img id=\"input\"" in page and "<img id=\"output\"" in page
+        assert not re.search(r"(src|href)=\"https?://", page), "the page loads nothing from elsewhere"
+        deadline = time.monotonic() + 20
+        stats = {}
+        while time.monotonic() < deadline:
+            with urllib.request.urlopen(url + "stats.json", timeout=5) as resp:
+                stats = json.loads(resp.read())
+            if stats["frame"] > 0:
+                break
+            time.sleep(0.2)
+        assert stats["frame"] > 0 and stats["sent"] > 0, stats
+        with urllib.request.urlopen(url + "frame/output.jpg", timeout=5) as resp:
+            jpeg = resp.read()
+        picture = cv2.imdecode(np.frombuffer(jpeg, np.uint8), cv2.IMREAD_COLOR)
+        assert picture is not None and picture.shape[:2] == (480, 640)
+        with pytest.raises(urllib.error.HTTPError):
+            urllib.request.urlopen(url + "etc/passwd", timeout=5)
+        out, _ = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 0, out
+    assert "bit-exact: 45/45" in out
+    with pytest.raises(OSError):   # the page stopped with the demo
+        urllib.request.urlopen(url, timeout=2)

@@ -206,7 +206,7 @@ def test_lost_tlast_and_tuser():
     assert np.array_equal(err.partial[:3], FAULT_IMAGE[:3])          # rows before the fault are right
     assert np.array_equal(err.partial[3], FAULT_IMAGE[4])            # then the image slips a line
     err = both_models([LoseTuser()])
-    assert isinstance(err, StreamStarvedError) and "made 0 of 40" in str(err)
+    assert isinstance(err, StreamStarvedError) and "made 0 of the 40 pixels" in str(err)
     # a tlast lost on the way out goes unnoticed by axi2fifo: the bytes are still right
     res = both_models([LoseTlast(line=0, tap="axis_out")])
     assert res.output_frame == expected_frame(FAULT_IMAGE, "rgba8")
@@ -345,3 +345,20 @@ def test_any_faults_end_the_same_way_in_both_models_and_never_hang(img_enc, faul
     outcome = both_models(faults, frame=frame)
     if not isinstance(outcome, Exception) and not faults:
         assert outcome.output_frame == expected_frame(image, encoding, frame_id="f")
+
+
+def test_wire_time_counts_tcp_ip_and_ethernet_overhead() -> None:
+    """A frame on gigabit Ethernet: 1,448 payload bytes per 1,500-byte packet (IPv4 20 + TCP 20
+    + timestamps 12), and 1,538 bytes per packet on the line (preamble 8, MAC 14, FCS 4, gap 12)."""
+    from rosfpga_lab.hw import wire_bytes
+
+    assert wire_bytes(1448) == 1538
+    assert wire_bytes(1449) == 1449 + 2 * 90
+    assert wire_bytes(10 * 1448) == 10 * 1538
+    frame = image_frame(np.zeros((480, 640, 4), np.uint8), "rgba8")
+    r = Pipeline(width=640, height=480, encoding="rgba8").process(frame)
+    payload = len(frame)
+    assert r.network_time_s == pytest.approx(8 * payload / 1e9)
+    segments = -(-payload // 1448)
+    assert r.wire_time_s == pytest.approx(8 * (payload + 90 * segments) / 1e9)
+    assert 10.3e-3 < r.wire_time_s < 10.5e-3   # vs 9.83 ms for the payload alone

@@ -191,8 +191,12 @@ def test_axivideo2mat_flags_and_starvation_by_hand():
     # a lost tuser: the wait-for-start loop eats the whole frame, never a hang
     lost = good.copy()
     lost.tuser[0] = False
-    with pytest.raises(StreamStarvedError, match="AXIvideo2Mat had made 0 of 6"):
+    with pytest.raises(StreamStarvedError) as info:
         axivideo2mat_fast(lost, 2, 3, fmt)
+    said = str(info.value)
+    assert "waiting for a start of frame (tuser); it had made 0 of the 6 pixels" in said
+    assert "of the 6 needed" not in said   # it read 6 beats; "6 of the 6 needed" would contradict itself
+    assert info.value.got == 0 and info.value.needed == 6
     # an extra tlast late in the stream after a frame-long line: EOL_LATE is flagged
     beats = Beats(good.tdata, good.tkeep, good.tuser, [False, False, False, False, False, True])
     with pytest.raises(StreamStarvedError):

@@ -164,3 +164,19 @@ def test_the_real_sources_build_into_an_empty_directory(tmp_path: Path):
     assert [i.exercises for i in items] == [0, 3, 3, 3, 3, 2, 2, 0]
     for item in items:
         assert item.target.read_text(encoding="utf-8") == (NOTEBOOKS / item.target.name).read_text(encoding="utf-8")
+
+
+def test_student_notebooks_with_exercises_say_run_all_stops_at_the_first() -> None:
+    """A student who presses Run All sees, near the top, why it stops at the first exercise."""
+    from rosfpga_lab.checks import nbbuild
+
+    root = Path(__file__).resolve().parents[1] / "notebooks"
+    for path in sorted(root.glob(nbbuild.NOTEBOOK_GLOB)):
+        cells = json.loads(path.read_text(encoding="utf-8"))["cells"]
+        has_exercises = any(nbbuild.PLACEHOLDER in "".join(c["source"]) for c in cells)
+        notes = [i for i, c in enumerate(cells) if c.get("id") == nbbuild.RUN_ALL_NOTE_ID]
+        if has_exercises:
+            assert notes == [1], path.name
+            assert "Run All stops at the first exercise" in "".join(cells[1]["source"])
+        else:
+            assert notes == [], path.name

@@ -69,6 +69,46 @@ def test_solution_notebook_runs_and_every_check_passes(path: Path):
                 f"{path.name} cell {index}: the check did not report success: {shown[:300]}"
     if path.stem == "07_workshop_demo":
         check_real_ros_part(nb)
+    check_claims(path.stem, nb)
+
+
+def html_of(cell: nbformat.NotebookNode) -> str:
+    return "\n".join(o.get("data", {}).get("text/html", "") for o in cell.get("outputs", [])
+                     if o.get("output_type") in ("execute_result", "display_data"))
+
+
+def check_claims(stem: str, nb: nbformat.NotebookNode) -> None:
+    """What the texts promise is what the run shows (figures computed here, by hand)."""
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    text = "\n".join(text_of(c) for c in code)
+    html = "\n".join(html_of(c) for c in code)
+    if stem == "02_tcpros":
+        assert "<svg" in html and 'class="rfl-state" data-state="STREAMING"' in html  # drawn, not a text table
+    if stem == "03_message_conversion":
+        assert "data[0] = pixel (x 0, y 0) R" in text and "data[47] = pixel (x 3, y 2) A" in text
+    if stem == "04_fifo_to_axi_stream":
+        for fault in ("duplicate byte 5", "byte order swapped", "drop byte 5", "tlast lost on line 60",
+                      "tuser lost"):
+            assert fault in html, f"the gallery has no frame named {fault!r}"
+        assert "19200 of the 19200" not in text and "19200 items of the 19200" not in text
+        # the lost-TLAST picture (made before the dilate) against the input: rows 61..119 differ only
+        assert re.search(r"tlast lost on line 60.*?in x \d+\.\.\d+, y 61\.\.119", html, re.S), \
+            "the lost-TLAST frame is not compared with what AXIvideo2Mat should have made"
+    if stem == "05_application":
+        payload = 640 * 480 * 4 + 4 + 4 + 8 + 4 + 4 + 4 + 4 + len("rgba8") + 1 + 4 + 4  # frame of the table
+        segments = -(-payload // 1448)
+        wire_ms = 8 * (payload + 90 * segments) / 1e9 * 1e3
+        assert re.search(rf"640x480 rgba8\s+{payload:,}\s+\S+\s+{8 * payload / 1e6:.2f}\s+{wire_ms:.2f}", text), \
+            (payload, wire_ms, text[-900:])
+    if stem == "06_design_flow":
+        table = re.search(r"total\s+(\d+)\s+127\s+860", text)
+        assert table, text[-1500:]
+        total = int(table[1])
+        assert f"860 / {total} = {860 / total:.1f}x" in text and "860 / 127 = 6.8x" in text
+        assert "((0, 'SUB_OK'),)" not in text
+        if "No g++" not in text:
+            assert "subscriber status: SUB_OK (the frame at byte 0 of the input)" in text
+        assert "<details open><summary><code>subscriber.cpp</code>" in html
 
 
 def check_real_ros_part(nb: nbformat.NotebookNode) -> None:

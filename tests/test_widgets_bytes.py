@@ -255,8 +255,11 @@ def test_http_spans_split_start_line_headers_and_xmlrpc_params() -> None:
     assert by["header Content-Length"].value == str(len(body))
     assert raw[by["end of headers"].offset:by["end of headers"].offset + 2] == b"\r\n"
     assert by["methodName"].value == "registerPublisher"
-    assert [by[f"param[{i}]"].value for i in range(4)] == ["/pub", "/chatter", "std_msgs/String", "http://127.0.0.1:1/"]
-    p1 = by["param[1]"]
+    # named as in the ROS Master API: registerPublisher(caller_id, topic, topic_type, caller_api)
+    assert [by[n].value for n in ("caller_id", "topic", "topic_type", "caller_api")] == \
+        ["/pub", "/chatter", "std_msgs/String", "http://127.0.0.1:1/"]
+    assert not any(s.path.startswith("param[") for s in spans)
+    p1 = by["topic"]
     assert raw[p1.offset:p1.offset + p1.size].startswith(b"<param>") and b"/chatter" in raw[p1.offset:p1.offset + p1.size]
     reply = b"HTTP/1.0 200 OK\r\nServer: x\r\n\r\n"
     assert [s.path for s in spans_from_http(reply)] == ["status line", "header Server", "end of headers"]
@@ -353,3 +356,22 @@ def test_live_viewer_state_stays_small_for_a_megabyte() -> None:
     assert sum(sizes.values()) < 10_000, sizes
     v.page = v.n_pages - 1
     assert v.page_start == len(data) - 512 and len(v.page_hex) == 1024
+
+
+def test_image_pixel_bytes_are_named_by_pixel_and_channel() -> None:
+    """Notebook 3: data[45] of a 4-pixel-wide rgba8 image is pixel (3, 2)'s green byte
+    (45 = 2 rows of 16 bytes + 13 = pixel 3, byte 1)."""
+    from rosfpga_lab.msg import default_registry, serialize
+    from rosfpga_lab.widgets import message_spans
+    from rosfpga_lab.widgets.byte_sources import pixel_label
+
+    image = {"header": {"seq": 1, "stamp": {"secs": 0, "nsecs": 0}, "frame_id": "c"},
+             "height": 3, "width": 4, "encoding": "rgba8", "is_bigendian": 0, "step": 16,
+             "data": bytes(48)}
+    spans = message_spans("sensor_msgs/Image", serialize(default_registry(), "sensor_msgs/Image", image))
+    names = [s.path for s in spans if s.path.startswith("data[")]
+    assert len(names) == 48 and names[45] == "data[45] = pixel (x 3, y 2) G"
+    assert names[0] == "data[0] = pixel (x 0, y 0) R"
+    # rgb8, 2 pixels (6 bytes) in a row of step 8: bytes 6 and 7 pad the row
+    assert pixel_label(6, 2, 8, "rgb8") == "data[6] = row 0 padding"
+    assert pixel_label(11, 2, 8, "bgr8") == "data[11] = pixel (x 1, y 1) B"

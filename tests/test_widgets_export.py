@@ -63,3 +63,25 @@ def test_a_failing_cell_is_named_or_kept_with_allow_errors(tmp_path: Path, capsy
     assert "a cell failed: NotImplementedError: exercise: your code" in err and "\x1b[" not in err
     assert main(["notebooks", "html", str(src), "--output-dir", str(tmp_path), "--allow-errors"]) == 0
     assert "1 cell(s) with errors" in capsys.readouterr().out
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(120)
+def test_pages_load_no_cdn_script_and_do_not_ask_to_click(tmp_path: Path) -> None:
+    """A course page works offline and says nothing about clicking: nothing in it is clickable."""
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [nbformat.v4.new_markdown_cell(
+                    'The bytes of every arrow. <span class="rfl-live-only">Click an arrow to see its '
+                    "bytes.</span> Math stays text: $x^2$."),
+                nbformat.v4.new_code_cell(VIEWER_CELL)]
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    src = tmp_path / "page.ipynb"
+    nbformat.write(nb, src)
+    assert main(["notebooks", "html", str(src), "--output-dir", str(tmp_path / "site")]) == 0
+    page = (tmp_path / "site" / "page.html").read_text(encoding="utf-8")
+    assert not re.findall(r"<script[^>]*\bsrc=[\"']?https?://", page, flags=re.I), "a CDN script"
+    assert "unpkg.com" not in page and "cdnjs" not in page and "cdn.jsdelivr" not in page
+    assert "widget-state+json" not in page
+    text = re.sub(r"<(script|style)\b.*?</\1>", "", page, flags=re.S | re.I)
+    assert "click" not in text.lower()
+    assert "The bytes of every arrow." in page and "std_msgs/String" in page

@@ -105,9 +105,11 @@ def test_static_html_is_self_contained() -> None:
     out = ref.copy()
     out[1, 2] = 0
     html = FrameDiff(out, ref, ref).to_html()
-    assert html.count("data:image/png;base64,") == 4 and "<script" not in html
+    assert html.count("data:image/png;base64,") == 5 and "<script" not in html
     assert "1 of 48 pixels differ" in html and "(2, 1)" in html
-    assert "<figcaption>difference (grey: equal, red: differs)</figcaption>" in html
+    assert "<figcaption>output vs reference (grey: equal, red: differs)</figcaption>" in html
+    assert "<figcaption>input vs output (grey: unchanged, red: changed, the redder the more)</figcaption>" in html
+    assert "<details><summary>pixel values around (2, 1)</summary>" in html  # the zoom is folded
 
 
 def test_viewer_single_frame_and_sequence() -> None:
@@ -121,9 +123,11 @@ def test_viewer_single_frame_and_sequence() -> None:
     assert v.current.count == 2 and (v.x.value, v.y.value) == (4, 3)  # zoomed onto first mismatch
     assert "2 of 64 pixels differ" in v.summary.value
     assert v.next_mismatch() == (1, 6) and (v.x.value, v.y.value) == (1, 6)
-    assert set(v.images) == {"input", "output", "reference", "difference"}
-    assert v.images["difference"].png.startswith(b"\x89PNG")
-    assert v.images["difference"].caption == "difference (grey: equal, red: differs)"
+    assert set(v.images) == {"input", "output", "reference", "output vs reference", "input vs output"}
+    assert v.images["output vs reference"].png.startswith(b"\x89PNG")
+    assert v.images["output vs reference"].caption == "output vs reference (grey: equal, red: differs)"
+    assert v.images["input vs output"].caption == "input vs output (grey: unchanged, red: changed, the redder the more)"
+    assert v.zoom_fold.selected_index is None  # the value tables start folded
     v.images["output"].click(6, 7)  # a click on any image zooms there
     assert (v.x.value, v.y.value) == (6, 7) and "output x 0..7, y 0..7" in v.zoom.value
     marked = ",".join(str(c) for c in bad[7, 6])
@@ -131,7 +135,8 @@ def test_viewer_single_frame_and_sequence() -> None:
     with pytest.raises(WidgetError, match="frame 3 does not exist"):
         v.show(3)
     single = ImageDiffViewer(bad, ref)
-    assert single.frame.layout.display == "none" and set(single.images) == {"output", "reference", "difference"}
+    assert single.frame.layout.display == "none"
+    assert set(single.images) == {"output", "reference", "output vs reference"}
     with pytest.raises(WidgetError, match="give output= and reference="):
         ImageDiffViewer()
 
@@ -312,3 +317,40 @@ def test_beat_waveform_is_clock_true_and_agrees_with_the_clocked_model() -> None
     assert np.flatnonzero(arrays["m_axis_tvalid"]).tolist() == [4, 8, 12, 16, 20, 24]
     svg = m.waveform_svg(0, 6, selected=2)
     assert "m_axis_tready" in svg and "s_tdata" in svg and 'stroke="#d00"' in svg
+
+
+def test_named_frames_and_the_input_vs_output_view() -> None:
+    """Frames carry names (the slider says which fault it is) and a reference of their own; the
+    zoom starts where something changed even when the output is right."""
+    inp = np.zeros((6, 6, 3), np.uint8)
+    out = inp.copy()
+    out[2:5, 1:4] = 200            # what the circuit did
+    v = ImageDiffViewer(frames=[
+        {"input": inp, "output": out, "reference": out.copy(), "name": "no fault"},
+        {"input": inp, "output": inp.copy(), "reference": inp.copy(), "name": "tuser lost",
+         "reference_name": "what AXIvideo2Mat should have made"},
+    ])
+    assert "1 of 2" in v.frame_name.value and "no fault" in v.frame_name.value
+    assert v.current.equal and (v.x.value, v.y.value) == (1, 2)   # the largest change, first in row-major order
+    changed = cv2.imdecode(np.frombuffer(v.current.diff_png(which="input vs output"), np.uint8),
+                           cv2.IMREAD_COLOR)
+    assert changed is not None
+    assert int(v.current.changed.sum()) == 9
+    v.show(1)
+    assert "2 of 2" in v.frame_name.value and "tuser lost" in v.frame_name.value
+    assert v.images["reference"].caption == "what AXIvideo2Mat should have made"
+    assert v.images["output vs reference"].caption.startswith("output vs what AXIvideo2Mat should have made")
+    html = v.to_html()
+    assert "tuser lost" in html and "no fault" in html
+
+
+def test_input_vs_output_shows_how_much_changed() -> None:
+    inp = np.zeros((1, 3, 3), np.uint8)
+    out = inp.copy()
+    out[0, 1] = 6      # a small change
+    out[0, 2] = 200    # a big one
+    view = FrameDiff(out, out.copy(), inp).diff_rgb(which="input vs output")
+    grey, small, big = (view[0, k].astype(int) for k in range(3))
+    assert grey[0] == grey[1] == grey[2]                    # unchanged: grey
+    assert big.tolist() == [255, 0, 0]                      # a big change: full red
+    assert small[0] > small[1] and small[1] > 0             # a small one: a paler red, still visible

@@ -151,6 +151,9 @@ def test_progress_widget_mode_and_track() -> None:
     p = Progress(10, "work", mode="widget", min_interval=0)
     p.set(4)
     assert (p._bar.value, p._bar.max) == (4, 10) and "40%" in p._label.value
+    # the label is not cut to the description and does not draw a second, ASCII bar
+    assert p._label.value.startswith("work  40% 4/10") and "#" not in p._label.value
+    assert p._bar.description == ""
     p.close()
     assert p._bar.bar_style == "success"
     bundle = p.mimebundle()   # what an exported notebook shows instead of the live bar
@@ -243,3 +246,32 @@ def test_live_view_static_form_and_close_freezes_the_output(monkeypatch: pytest.
     assert len(shown) == 2                                      # closing twice adds nothing
     v.close()
     assert len(shown) == 2
+
+
+def test_progress_without_a_total_says_running_not_an_empty_bar_and_zero() -> None:
+    """The C simulation's progress (no total): no bar, no "0", but what it is doing."""
+    clock = iter([0.0, 0.0, 2.8, 2.8]).__next__
+    p = Progress(None, "C simulation", mode="widget", min_interval=0, clock=clock)
+    assert p._bar.layout.display == "none"
+    p.close()
+    assert p._label.value == "C simulation done in  2.8 s"
+    stepped = Progress(2, "C simulation", mode="text", file=io.StringIO(), min_interval=0)
+    stepped.step("compiled with g++")
+    assert stepped.text().endswith("\u2013 compiled with g++") and "1/2" in stepped.text()
+
+
+def test_live_view_shows_input_beside_output_and_stops_once() -> None:
+    stopped = []
+    live = LiveView(max_fps=100, trailing=False, stop=lambda: stopped.append(True))
+    assert live._input_box.layout.display == "none" and live.stop_button.layout.display == ""
+    out = np.full((4, 6, 3), 200, np.uint8)
+    inp = np.zeros((4, 6, 3), np.uint8)
+    assert live.update(out, input=inp)
+    assert live.input_image.value and live.image.value and live._input_box.layout.display == ""
+    html = live.to_html()
+    assert "alt=\"newest input\"" in html and "alt=\"newest output\"" in html
+    live.stop_button.click()
+    live.stop_button.click()                 # a second press does nothing more
+    assert stopped == [True] and live.stop_button.disabled
+    assert LiveView(trailing=False).stop_button.layout.display == "none"   # no stop: no button
+    live.close()

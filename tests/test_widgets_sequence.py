@@ -47,7 +47,7 @@ def test_svg_has_one_numbered_clickable_arrow_per_event() -> None:
     assert "1. registerPublisher" in svg and "4. note &lt;&amp;&gt;" in svg and "note <&>" not in svg
     assert "+2.0 ms" in svg  # times relative to the first event
     # lifelines: master first, then the order of appearance
-    xs = {m[1]: float(m[0]) for m in re.findall(r'<text x="([\d.]+)" y="26" text-anchor="middle" font-weight="bold">([^<]+)<', svg)}
+    xs = {m[1]: float(m[0]) for m in re.findall(r'<text x="([\d.]+)" y="26" text-anchor="middle" font-weight="bold" font-size="11">([^<]+)<', svg)}
     assert xs["/master"] < xs["/pub"] < xs["/sub"]
     with pytest.raises(WidgetError, match=r"\['/sub'\] appear in events"):
         sequence_svg(EVENTS, ["/pub", "/master"])
@@ -71,7 +71,8 @@ def test_static_html_lists_every_arrow_with_its_bytes() -> None:
 
 def test_widget_selection_shows_the_arrow_bytes() -> None:
     d = SequenceDiagram([e.__dict__ for e in EVENTS])  # dicts work too
-    assert d.selected is None and d.bytes.total == 0
+    # it opens on the first arrow's bytes (not on an empty viewer)
+    assert d.selected is not None and d.pane.selected == 0 and d.bytes.total == len(EVENTS[0].raw) > 0
     d.pane.selected = 2  # as a click in the browser would
     assert d.selected is EVENTS[2] or d.selected.label == "TCPROS header"
     assert d.list.value == 2 and d.bytes.total == len(HEADER)
@@ -122,3 +123,40 @@ def test_a_real_conversation_from_the_graph_layer() -> None:
     reg = next(i for i, e in enumerate(diagram.events) if e.label == "registerPublisher")
     diagram.select(reg)
     assert any(f["path"] == "methodName" for f in diagram.bytes.fields)
+
+
+def test_trace_parties_are_named_retries_folded_and_the_diagram_fits() -> None:
+    """One node is one lifeline whether the trace saw its name, its slave URI or its TCP address;
+    retries fold into one arrow; many lifelines still fit a 1,000 px notebook."""
+    from rosfpga_lab.graph.trace import TraceEvent
+    from rosfpga_lab.widgets.sequence import FIT_WIDTH, events_from_trace
+
+    uri = "http://127.0.0.1:40000/"
+    items = [
+        TraceEvent(1, 0.001, "xmlrpc", "/fpga", src="/cam", dst="/master", method="registerPublisher",
+                   args=["/cam", "/image_raw", "sensor_msgs/Image", uri], t0=0.0),
+        TraceEvent(2, 0.011, "xmlrpc", "/fpga", src="/fpga", dst=uri, method="requestTopic",
+                   args=["/fpga", "/image_raw", [["TCPROS"]]], t0=0.01),
+        TraceEvent(3, 0.021, "tcp_connect", "/fpga", src="/fpga", dst="127.0.0.1:5000", conn=7, t0=0.02),
+        TraceEvent(4, 0.031, "tcpros_header", "/fpga", src="/fpga", dst="127.0.0.1:5000", conn=7,
+                   args={"callerid": "/fpga", "topic": "/image_raw"}, t0=0.03),
+        TraceEvent(5, 0.041, "tcpros_header", "/fpga", src="/cam", dst="/fpga", conn=7,
+                   args={"callerid": "/cam", "topic": "/image_raw"}, t0=0.04),
+    ] + [TraceEvent(6 + i, 0.05 + i / 100, "error", "/fpga", src="/fpga", dst="", t0=0.05 + i / 100,
+                    result=f"{uri}: XML-RPC call requestTopic to {uri} failed: [Errno 111] Connection refused")
+         for i in range(3)]   # a retried call to a vanished node: no peer but the URI in the text
+    events = events_from_trace(items)
+    parties = {e.src for e in events} | {e.dst for e in events}
+    assert parties == {"/cam", "/master", "/fpga"}, parties
+    errors = [e for e in events if e.kind == "error"]
+    assert len(errors) == 1 and errors[0].label == "error: [Errno 111] Connection refused \u00d73"
+    assert errors[0].dst == "/cam" and errors[0].detail.count("repeated") == 1
+    assert len(events_from_trace(items, fold=False)) == len(events) + 2
+    many = [SeqEvent(f"/node_{i}", f"/node_{i + 1}", "a rather long label for one arrow " * 2)
+            for i in range(7)]  # 8 lifelines: columns narrow to fit (more: the SVG scales down)
+    svg = sequence_svg(many)
+    width = int(re.search(r'<svg [^>]*width="(\d+)"', svg)[1])
+    assert width <= FIT_WIDTH + 100 and 'style="max-width:100%;height:auto"' in svg
+    labels = re.findall(r'stroke-linejoin="round">([^<]*)</text>', svg)
+    assert len(labels) == 7 and all(t.endswith("\u2026") and len(t) < 40 for t in labels), labels  # cut
+    assert "a rather long label for one arrow a rather long label for one arrow" in svg  # whole in the tooltip

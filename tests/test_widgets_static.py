@@ -82,3 +82,17 @@ def test_executed_notebook_outputs_have_a_static_form(tmp_path: Path, monkeypatc
     # image diff (a sequence: a line per frame) and beats
     assert "bit-exact: all 16 pixels equal" in text and "1 of 16 pixels differ" in text
     assert "16 beats carrying 48 bytes" in text
+
+
+def test_code_files_fold_one_block_per_file_highlighted(tmp_path) -> None:
+    from rosfpga_lab.widgets import CodeFiles
+
+    a = tmp_path / "subscriber.cpp"
+    a.write_text("#include <x.h>\nint main() { return 0; }  // done\n")
+    b = tmp_path / "run_hls.tcl"
+    b.write_text("open_project p\n")
+    html = CodeFiles([a, b], open=["subscriber.cpp"]).to_html()
+    assert html.count("<details") == 2 and "<details open><summary><code>subscriber.cpp</code> (2 lines)" in html
+    assert "<summary><code>run_hls.tcl</code> (1 lines)</summary>" in html
+    assert 'style="color:' in html and "<script" not in html   # highlighted with inline colours
+    assert "white-space:pre-wrap" in html                        # long lines wrap, never scroll

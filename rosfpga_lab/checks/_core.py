@@ -198,13 +198,20 @@ def _shift(got: bytes, expected: bytes, i: int) -> int:
     return 0
 
 
-def _explain_shift(k: int, i: int, fields: Sequence[ByteField]) -> str:
+def _explain_shift(k: int, i: int, fields: Sequence[ByteField], got: bytes = b"") -> str:
     before = field_at(fields, i - 1) if i else None
     what = (f" (the field before is {before.name}, {before.type}: {before.size} byte"
             f"{'s' if before.size != 1 else ''})" if before else "")
     if k > 0:
+        pad = ""
+        if (before is not None and before.end == i and before.size < 4 and k == 4 - before.size
+                and not any(got[i:i + k])):
+            pad = (f": {k} zero byte(s) follow {before.name}, which is what struct's native mode "
+                   "adds (a format without '<', such as 'BI' or '@BI', pads the uint32 after it "
+                   "to a multiple of 4; ROS messages have no padding, so start every format "
+                   f"with '<'), or {before.name} was packed as a 4-byte integer")
         return (f"from byte {i} on your bytes are the expected ones {k} byte(s) later: something "
-                f"before byte {i} is {k} byte(s) too long{what}")
+                f"before byte {i} is {k} byte(s) too long{what}{pad}")
     here = field_at(fields, i)
     if here is not None and here.offset == i and here.size == -k:
         return (f"field {here.name} ({here.type}, {here.size} byte(s) at {i}..{here.end - 1}) is "
@@ -249,17 +256,19 @@ def describe_byte_difference(got: bytes, expected: bytes, fields: Sequence[ByteF
         where = f"field {f.name}"
         if f.size > 1:
             where += f", {f.type} at bytes {f.offset}..{f.end - 1}"
+        shift = _shift(got, expected, i)
         if want is not None and have is not None:
-            swapped = (f.size > 1 and f.end <= len(got)
+            # a shifted stream can look byte-swapped (zero padding before a small value); the
+            # shift is the real cause, so it alone is named
+            swapped = (not shift and f.size > 1 and f.end <= len(got)
                        and got[f.offset:f.end] == expected[f.offset:f.end][::-1])
             out.append(f"byte {i} ({where}) is {have!r}, expected {want!r}"
                        + (": its bytes are in big-endian order; ROS is little-endian "
                           "(struct format '<')" if swapped else ""))
         else:
             out.append(f"byte {i} ({where}) is {_byte(got[i])}, expected {_byte(expected[i])}")
-        shift = _shift(got, expected, i)
         if shift:
-            out.append(_explain_shift(shift, i, fields))
+            out.append(_explain_shift(shift, i, fields, got))
             return out  # everything after a shift differs; listing it would only confuse
         # differences inside one field count once; continue after it
         i = max(i + 1, f.end)

@@ -28,6 +28,21 @@ def _get(config: Any, dotted: str) -> Any:
     return value
 
 
+def _written(text: str, dotted: str) -> bool:
+    """True when the YAML ``text`` spells out the key ``dotted`` (rather than leaving a default)."""
+    import yaml
+
+    try:
+        value: Any = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return True
+    for part in dotted.split("."):
+        if not isinstance(value, dict) or part not in value:
+            return False
+        value = value[part]
+    return True
+
+
 def check_node_config(text: Any, expected: dict[str, Any] | None = None) -> CheckResult:
     """Exercise 6.1: a node configuration (YAML text) for a given component.
 
@@ -50,8 +65,10 @@ def check_node_config(text: Any, expected: dict[str, Any] | None = None) -> Chec
     for key, value in want.items():
         have = _get(config, key)
         if have != value:
-            default = " (the default: the key is missing?)" if key == "application.ksize" and have == 3 else ""
-            problems.append(f"{key} is {have!r}, expected {value!r}{default}")
+            hint = ""
+            if not _written(text, key):
+                hint = f" (the default: the key {key.split('.')[-1]} is missing from the text)"
+            problems.append(f"{key} is {have!r}, expected {value!r}{hint}")
     if problems:
         raise fail(ex, *problems)
     return CheckResult(ex, [f"{config.node.name}: {config.subscriber.topic} -> "
@@ -76,15 +93,19 @@ def check_sloc(answer: Any, source: str) -> CheckResult:
                                 "#pragma HLS lines do"])
     lines = source.splitlines()
     blank = sum(1 for line in lines if not line.strip())
-    hints = {
-        len(lines): "that is every line; leave out blank and comment-only lines",
+    pragmas = sum(1 for line in lines if line.strip().startswith("#pragma"))
+    directives = sum(1 for line in lines if line.strip().startswith("#"))
+    hints = {  # later entries win when two slips give the same number
+        len(lines): "that is every line; leave out blank and comment-only lines.",
         len(lines) - blank: "that leaves out blank lines but still counts comment-only lines "
-                            "(// ... and inside /* ... */)",
-        want - sum(1 for line in lines if line.strip().startswith("#")):
-            "that leaves out the preprocessor lines; #include and #pragma HLS lines count",
+                            "(// ... and inside /* ... */).",
+        want - directives: "that leaves out the preprocessor lines; #include and #pragma HLS "
+                           "lines count.",
+        want - pragmas: "that leaves out the #pragma HLS lines; they count (they are code: they "
+                        "tell HLS how to build the circuit).",
     }
     direction = ("too many: is a line inside a /* ... */ comment counted?" if answer > want else
-                 "too few: a line with code before a // comment counts")
+                 "too few: a line with code before a // comment counts.")
     raise fail(ex, f"you counted {answer}, expected another number: "
                    + hints.get(answer, f"{direction} Count the lines that hold code after removing "
-                                       "comments"))
+                                       "comments."))

@@ -47,6 +47,7 @@ from rosfpga_lab.checks.nbbuild import (
     is_exercise_cell,
     load,
     strip_outputs,
+    with_run_all_note,
 )
 
 #: Points of one check cell (one exercise).
@@ -132,7 +133,7 @@ def nbgrader_notebook(nb: dict[str, Any], name: str) -> dict[str, Any]:
             meta["nbgrader"] = _nbgrader_meta(f"{stem}-{cell_id or i}", solution=True,
                                               grade=False, locked=False)
         cells.append(cell)
-    out["cells"] = cells
+    out["cells"] = with_run_all_note(cells, nb)   # as the student build has it
     return strip_outputs(out)
 
 

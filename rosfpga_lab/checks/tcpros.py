@@ -44,8 +44,9 @@ def check_connection_header(answer: Any, fields: Mapping[str, str]) -> CheckResu
     if got == want[4:]:
         problems.append("the 4-byte total length at the start is missing")
     elif got == encode_header(fields, sort=False):
-        problems.append("the fields are in the order given; rospy and roscpp write them sorted "
-                        "by key (sorted(fields.items()))")
+        problems.append("the fields are in the order given: the protocol accepts any order, but "
+                        "rospy and roscpp write them sorted by key and this exercise asks for "
+                        "their bytes (sorted(fields.items()))")
     elif got == _big_endian_header(fields):
         problems.append("the lengths are big-endian; TCPROS lengths are little-endian "
                         "(struct.pack('<I', n))")

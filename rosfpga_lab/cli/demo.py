@@ -17,8 +17,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "from a node configuration, a camera publishing on its input, and a subscriber that "
         "checks EVERY output frame bit for bit against OpenCV (cv2.dilate / cv2.erode) run on "
         "the input. Prints frames, fps, latency and 'bit-exact: N/N'; writes input, output and "
-        "difference to a PNG. Exit code 0 only when every frame came back bit-exact. Needs "
-        "nothing beyond the lab; takes a few seconds.")
+        "their difference (output - input: what the circuit changed) to a PNG. Exit code 0 only "
+        "when every frame came back bit-exact. Needs nothing beyond the lab; takes a few seconds. "
+        "For a room: --view serves a live page (input, output, counters) on 127.0.0.1 while it "
+        "runs, e.g. rosfpga-lab demo --view --frames 900 --rate 15 (a minute).")
     p.add_argument("--config", type=Path, metavar="CONFIG",
                    help="node configuration (default: data/fpga_dilate_rgba8.yaml, 640x480 rgba8 "
                    "3x3 dilation)")
@@ -36,8 +38,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "frame; try --config data/fpga_passthrough_rgb8.yaml --frames 5)")
     p.add_argument("--timeout", type=positive_float, default=30.0,
                    help="seconds to wait for the last output (default: 30)")
+    p.add_argument("--view", action="store_true",
+                   help="serve a live page (input, output, counters) on 127.0.0.1 at a free port "
+                   "while the demo runs; its URL is printed first. The page needs no internet "
+                   "and stops with the demo")
     p.add_argument("-v", "--verbose", action="store_true", help="print each step")
     p.set_defaults(func=run)
+
+
+def _announce(url: str) -> None:
+    print(f"live view: {url}  (open it in a browser; it stops with the demo)", flush=True)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -48,7 +58,8 @@ def run(args: argparse.Namespace) -> int:
         result = run_demo(args.config, frames=args.frames, rate=args.rate, source=args.source,
                           png=None if args.no_figure else args.output, model=args.model,
                           timeout=args.timeout, png_scale=args.scale,
-                          progress=print if args.verbose else None)
+                          progress=print if args.verbose else None,
+                          view=_announce if args.view else None)
     except KeyboardInterrupt:
         print("rosfpga-lab demo: interrupted (everything it started is stopped); no verdict",
               file=sys.stderr)

@@ -24,6 +24,7 @@ from rosfpga_lab.component.errors import ComponentError
 from rosfpga_lab.component.fpga import FpgaComponent
 from rosfpga_lab.component.sources import to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary
+from rosfpga_lab.component.webview import DemoPage
 from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.config import NodeConfig, load_config, parse_config
 
@@ -181,7 +182,8 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
              rate: float = 30.0, source: str = "grace_hopper", png: str | Path | None = "demo.png",
              model: str = "fast", timeout: float = 30.0, png_scale: float = 1.0,
              oracle_op: str | None = None,
-             progress: Callable[[str], None] | None = None) -> DemoResult:
+             progress: Callable[[str], None] | None = None,
+             view: Callable[[str], None] | None = None) -> DemoResult:
     """Run the demo (see module docstring).
 
     Args:
@@ -195,6 +197,8 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         oracle_op: check against this op instead of the configuration's (a negative control:
             a wrong oracle must give mismatches).
         progress: called with a line of text at each step.
+        view: serve a live page (input, output, counters) on a free loopback port while the
+            demo runs; called with its URL before the first frame. The page stops with the demo.
     """
     say = progress or (lambda _text: None)
     if png is not None:
@@ -210,7 +214,18 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         if not rig.connected:
             say("warning: connections were not all up after 10 s")
         say(f"camera: {frames} frames of {source!r} at {rate:g} fps")
-        elapsed = rig.run(frames, timeout)
+        page = None
+        if view is not None:
+            page = DemoPage(lambda: _counters(rig), encoding=rig.config.image.encoding,
+                            title=f"ROS-compliant FPGA component: {rig.op} {rig.config.application.ksize}"
+                                  f"x{rig.config.application.ksize}, live").start()
+            rig.component.add_observer(page.observe)
+            view(page.url)
+        try:
+            elapsed = rig.run(frames, timeout)
+        finally:
+            if page is not None:
+                page.stop()
         stats = rig.component.stats
     checker, config = rig.checker, rig.config
     app = config.application
@@ -223,9 +238,23 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
                       checker.latency.summary(), stats, elapsed, png_path, config)
 
 
+def _counters(rig: DemoRig) -> dict[str, object]:
+    """What the live page shows (see ``webview.COUNTER_LABELS``)."""
+    assert rig.camera is not None and rig.checker is not None and rig.component is not None
+    report, stats = rig.checker.report, rig.component.stats
+    latency = rig.checker.latency.summary()
+    return {"sent": rig.camera.sent, "processed": stats.processed, "received": report.received,
+            "bit_exact": f"{report.bit_exact}/{report.received}", "refused": stats.refused,
+            "fps": f"{rig.checker.fps:.1f}",
+            "latency_ms": f"{latency.median * 1e3:.1f} ms" if latency.count else "n/a"}
+
+
 def write_figure(images: tuple[np.ndarray, np.ndarray, np.ndarray], encoding: str,
                  path: str | Path, *, scale: float = 1.0, title: str = "dilate") -> Path:
     """Write input | output | (output - input) x DIFF_GAIN side by side as a PNG.
+
+    The third panel is what the circuit changed (output against its input), not a check: the
+    notebooks' "output vs reference" view compares the output with OpenCV's.
 
     Args:
         images: ``(input, output, expected)`` pictures in ``encoding``.
@@ -235,7 +264,7 @@ def write_figure(images: tuple[np.ndarray, np.ndarray, np.ndarray], encoding: st
     src, out, _expected = images
     diff = np.clip((out.astype(np.int16) - src.astype(np.int16)) * DIFF_GAIN, 0, 255).astype(np.uint8)
     panels = [to_rgb(src, encoding), to_rgb(out, encoding), to_rgb(diff, encoding)]
-    labels = ["input (camera)", f"output (FPGA {title})", f"difference x{DIFF_GAIN}"]
+    labels = ["input (camera)", f"output (FPGA {title})", f"output - input, x{DIFF_GAIN}"]
     h, w = panels[0].shape[:2]
     size = (max(1, round(w * scale)), max(1, round(h * scale)))
     band = max(18, size[1] // 16)

@@ -90,6 +90,7 @@ def checked(spec: Spec, error_value: Any) -> Callable[[Callable], Callable]:
         api.__name__ = f.__name__
         api.__doc__ = f.__doc__
         api.ros_api = True  # type: ignore[attr-defined]
+        api.ros_params = ("caller_id", *(name for name, _kind in spec))  # type: ignore[attr-defined]
         return api
 
     return wrap

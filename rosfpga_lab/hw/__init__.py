@@ -59,7 +59,7 @@ from rosfpga_lab.hw.interpreter import (
     interpret_reference,
 )
 from rosfpga_lab.hw.morph import OPS, morph_fast, morph_reference
-from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame
+from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame, wire_bytes
 from rosfpga_lab.hw.rx import receive_fast_check, receive_reference
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
 from rosfpga_lab.hw.video import (
@@ -72,7 +72,7 @@ __all__ = [
     "INTERPRETER_TABLE", "OPS", "PIXEL_FORMATS", "Beat", "Beats", "ByteFIFO", "CycleReport",
     "DropByte", "DuplicateByte", "Fault", "Fifo", "FifoOverflowError", "FrameFieldError",
     "FrameLengthError", "FrameTruncatedError", "ImageFields", "Interpreter", "LoseTlast",
-    "LoseTuser", "Mat", "Pipeline", "PipelineConfigError", "PipelineError", "PipelineResult",
+    "LoseTuser", "Mat", "Pipeline", "PipelineConfigError", "PipelineError", "PipelineResult", "wire_bytes",
     "PixelFormat", "ShallowFifo", "StreamStarvedError", "SwapByteOrder", "Transition",
     "UnsupportedEncodingError", "account", "axi2fifo_fast", "axi2fifo_reference",
     "axivideo2mat_fast", "axivideo2mat_reference", "fifo2axi_fast", "fifo2axi_reference",

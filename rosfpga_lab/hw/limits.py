@@ -27,3 +27,11 @@ DEFAULT_CLOCK_HZ = 100e6
 DEFAULT_LINE_RATE_BPS = 1e9
 DEFAULT_RX_FIFO_DEPTH = 2048
 DEFAULT_RX_BURST_BYTES = 1
+
+#: What a TCP byte stream costs on (gigabit) Ethernet, for ``PipelineResult.wire_time_s``:
+#: IPv4 (20) + TCP (20) headers plus the 12-byte timestamp option Linux sends, inside a
+#: 1,500-byte MTU, and per Ethernet frame the preamble and start delimiter (8), MAC header
+#: (14), FCS (4) and the inter-frame gap (12).
+ETHERNET_MTU = 1500
+TCP_IP_HEADER_BYTES = 20 + 20 + 12
+ETHERNET_FRAMING_BYTES = 8 + 14 + 4 + 12

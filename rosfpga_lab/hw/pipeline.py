@@ -42,6 +42,15 @@ from rosfpga_lab.hw.video import (
 )
 
 MODELS = ("fast", "reference")
+
+
+def wire_bytes(payload: int, mtu: int = limits.ETHERNET_MTU) -> int:
+    """Bytes on the Ethernet line for ``payload`` bytes of one TCP stream, sent in full-size
+    segments: each carries ``mtu - TCP_IP_HEADER_BYTES`` payload bytes and costs ``mtu +
+    ETHERNET_FRAMING_BYTES`` on the line (acknowledgements travel the other way)."""
+    per_segment = mtu - limits.TCP_IP_HEADER_BYTES
+    segments = -(-payload // per_segment)
+    return payload + segments * (limits.TCP_IP_HEADER_BYTES + limits.ETHERNET_FRAMING_BYTES)
 SEQ_MODES = ("count", "carry")
 
 
@@ -60,6 +69,8 @@ class PipelineResult:
         total_cycles, sequential_cycles: dataflow estimate and no-overlap sum.
         frame_time_s: ``total_cycles / clock_hz``.
         network_time_s: the input frame's bytes at ``line_rate_bps`` (payload only).
+        wire_time_s: the same bytes as TCP over Ethernet: with the IP, TCP and Ethernet
+            overhead of every full-size packet (:func:`wire_bytes`).
         fifo_high_water: ``{"rx": bytes}``, the receive FIFO's highest level.
         status: problems that did not stop the frame (``AXIvideo2Mat`` flags, leftovers).
         model: ``"fast"`` or ``"reference"``.
@@ -108,6 +119,10 @@ class PipelineResult:
         return 8 * (4 + self.fields.frame_length) / self.line_rate_bps
 
     @property
+    def wire_time_s(self) -> float:
+        return 8 * wire_bytes(4 + self.fields.frame_length) / self.line_rate_bps
+
+    @property
     def ok(self) -> bool:
         """True when the frame passed without any status flag."""
         return not self.status
@@ -119,7 +134,8 @@ class PipelineResult:
             lines.append(f"{name:<14}{cyc:>12,}{self.latency[name]:>10,}")
         lines.append(f"total {self.total_cycles:,} cycles = {self.frame_time_s * 1e3:.3f} ms at "
                      f"{self.clock_hz / 1e6:g} MHz (bottleneck: {self.report.bottleneck}); "
-                     f"network {self.network_time_s * 1e3:.3f} ms at {self.line_rate_bps / 1e9:g} Gb/s")
+                     f"network {self.network_time_s * 1e3:.3f} ms at {self.line_rate_bps / 1e9:g} Gb/s "
+                     f"(payload; {self.wire_time_s * 1e3:.3f} ms as TCP over Ethernet)")
         return "\n".join(lines)
 
 

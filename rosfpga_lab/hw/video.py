@@ -82,19 +82,21 @@ def axivideo2mat_reference(inp: Fifo[Beat], img: Mat) -> int:
     res = 0
     rows, cols, depth = img.rows, img.cols, 8
     needed = rows * cols
+    waiting = "a start of frame (tuser)"   # what the stage waits for, for the error message
     try:
         sof = False
         while not sof:                                   # loop_wait_for_start
-            axi = inp.read("axivideo2mat", needed)
+            axi = inp.read("axivideo2mat")
             sof = axi.tuser
         for i in range(rows):                            # loop_height
             eol = False
+            waiting = f"the pixels of line {i}"
             for j in range(cols):                        # loop_width
                 if sof or eol:
                     sof = False
                     eol = axi.tlast
                 else:
-                    axi = inp.read("axivideo2mat", needed)
+                    axi = inp.read("axivideo2mat")
                     eol = axi.tlast
                     if axi.tuser:
                         res |= ERROR_IO_SOF_EARLY
@@ -102,13 +104,16 @@ def axivideo2mat_reference(inp: Fifo[Beat], img: Mat) -> int:
                     res |= ERROR_IO_EOL_EARLY
                 pix = tuple((axi.tdata >> (k * depth)) & 0xFF for k in range(img.channels))
                 img.write(pix)
+            waiting = f"the end of line {i} (tlast)"
             while not eol:                               # loop_wait_for_eol
-                axi = inp.read("axivideo2mat", needed)
+                axi = inp.read("axivideo2mat")
                 eol = axi.tlast
                 res |= ERROR_IO_EOL_LATE
     except StreamStarvedError as exc:
         exc.partial = img.to_numpy()
-        exc.args = (f"{exc.args[0]} [AXIvideo2Mat had made {img.level} of {needed} pixels]",)
+        exc.needed, exc.got = needed, img.level
+        exc.args = (f"{exc.args[0]} [AXIvideo2Mat was waiting for {waiting}; it had made "
+                    f"{img.level} of the {needed} pixels of the frame]",)
         raise
     return res
 

@@ -23,8 +23,42 @@ def spans_from_field_layout(layout: list[Any], base: int = 0) -> list[Span]:
     return [Span(f.offset + base, f.size, f.path or f"({f.role})", f.type, f.value, f.role) for f in layout]
 
 
+def pixel_label(index: int, width: int, step: int, encoding: str) -> str:
+    """What byte ``index`` of an Image's ``data`` is: ``data[5] = pixel (x 1, y 0) G``.
+
+    The channel letter comes from the encoding's lanes (``rosfpga_lab.hw.PIXEL_FORMATS``);
+    for an encoding the lab does not model, the byte's number within the pixel is given.
+    """
+    from rosfpga_lab.hw import PIXEL_FORMATS
+
+    fmt = PIXEL_FORMATS.get(encoding)
+    bpp = fmt.bytes_per_pixel if fmt else (step // width if width and step >= width else 1)
+    y, in_row = divmod(index, step) if step else (0, index)
+    x, k = divmod(in_row, bpp)
+    if x >= width:   # row padding past the last pixel
+        return f"data[{index}] = row {y} padding"
+    channel = fmt.channels[k] if fmt else f"byte {k}"
+    return f"data[{index}] = pixel (x {x}, y {y}) {channel}"
+
+
+def _label_pixels(spans: list[Span]) -> list[Span]:
+    by = {s.path: s for s in spans}
+    width, step, enc = (by.get(k) for k in ("width", "step", "encoding"))
+    if width is None or step is None or enc is None or not isinstance(width.value, int):
+        return spans
+    out = []
+    for s in spans:
+        if s.path.startswith("data[") and s.path.endswith("]") and s.path[5:-1].isdigit():
+            s = Span(s.offset, s.size, pixel_label(int(s.path[5:-1]), width.value, step.value or 0,
+                                                   str(enc.value)), s.type, s.value, s.role)
+        out.append(s)
+    return out
+
+
 def message_spans(type_name: str, body: bytes, *, registry: Any = None, base: int = 0) -> list[Span]:
     """Spans of a serialized ROS message body (every byte in one span; bad bytes in an ``error`` span).
+
+    An Image's pixel bytes are named by pixel and channel (:func:`pixel_label`).
 
     Args:
         type_name: e.g. ``sensor_msgs/Image``.
@@ -35,7 +69,9 @@ def message_spans(type_name: str, body: bytes, *, registry: Any = None, base: in
     from rosfpga_lab import msg
 
     reg = registry if registry is not None else msg.default_registry()
-    return spans_from_field_layout(msg.field_layout(reg, type_name, body, partial=True), base)
+    spans = spans_from_field_layout(msg.field_layout(reg, type_name, body, partial=True), base)
+    # an image's pixel bytes are named by pixel and channel, not only by index
+    return _label_pixels(spans) if type_name == "sensor_msgs/Image" else spans
 
 
 def message_viewer(type_name: str, body: bytes, *, registry: Any = None, title: str = "", **kwargs: Any) -> ByteViewer:
@@ -181,12 +217,26 @@ def spans_from_http(raw: bytes) -> list[Span]:
             spans.append(Span(body_at + m.start(), m.end() - m.start(), "fault", "xml", None, "error"))
         else:
             value = params[k] if k < len(params) else None
-            spans.append(Span(body_at + m.start(), m.end() - m.start(), f"param[{k}]", "xml", value, "value"))
+            names = api_param_names(method) if method else ()
+            name = names[k] if k < len(names) else f"param[{k}]"
+            spans.append(Span(body_at + m.start(), m.end() - m.start(), name, "xml", value, "value"))
             k += 1
         pos = m.end()
     if pos < len(body):
         spans.append(Span(body_at + pos, len(body) - pos, "xml", "xml", None, "padding"))
     return spans
+
+
+def api_param_names(method: str) -> tuple[str, ...]:
+    """The parameter names of a ROS Master or Slave API call (``caller_id``, ``topic``, ...),
+    as the lab's master and node declare them; ``()`` for a method they do not serve."""
+    from rosfpga_lab.graph import EmbeddedMaster, Node
+
+    for cls in (EmbeddedMaster, Node):
+        for attr in vars(cls).values():
+            if getattr(attr, "ros_api", False) and getattr(attr, "ros_name", attr.__name__) == method:
+                return tuple(getattr(attr, "ros_params", ()))
+    return ()
 
 
 def spans_for(raw: bytes, kind: str = "", type_name: str | None = None) -> list[Span]:

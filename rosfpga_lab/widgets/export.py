@@ -5,10 +5,16 @@ the widget JavaScript from a CDN: offline, or on a page without scripts, every w
 empty box. :func:`export_html` runs a notebook in a fresh kernel (in its own directory, as
 JupyterLab does) and writes HTML with :data:`STATIC_EXPORT_PRIORITY`, so each widget shows the
 static form it carries (byte tables, images, beat tables, the sequence diagram).
+
+The page loads nothing from the internet: the widget state is left out (the static forms stand
+in for it) and a template drops nbconvert's CDN scripts (RequireJS, MathJax, Mermaid and the
+widget manager). Text that only holds in a live notebook ("click an arrow") is marked in the
+notebooks' Markdown as ``<span class="rfl-live-only">...</span>`` and left out of the page.
 """
 
 from __future__ import annotations
 
+import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,6 +23,21 @@ from rosfpga_lab.widgets._common import STATIC_EXPORT_PRIORITY, WidgetError
 
 #: Seconds one cell may run before the export gives up.
 CELL_TIMEOUT = 300
+#: Markdown marked with this class speaks of the live notebook only; pages leave it out.
+LIVE_ONLY_CLASS = "rfl-live-only"
+_LIVE_ONLY = re.compile(rf'<span class="{LIVE_ONLY_CLASS}">.*?</span>[ \t]*', re.S)
+#: The lab template without the blocks that load scripts from a CDN.
+OFFLINE_TEMPLATE = """{%- extends 'lab/index.html.j2' -%}
+{%- block html_head_js_requirejs -%}{%- endblock html_head_js_requirejs -%}
+{%- block jupyter_widgets -%}{%- endblock jupyter_widgets -%}
+{%- block html_head_js_mathjax -%}{%- endblock html_head_js_mathjax -%}
+{%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
+"""
+
+
+def drop_live_only(markdown: str) -> str:
+    """``markdown`` without the ``rfl-live-only`` spans (what a page without a kernel leaves out)."""
+    return _LIVE_ONLY.sub("", markdown)
 
 
 @dataclass(frozen=True)
@@ -71,8 +92,16 @@ def export_html(notebook: str | Path, output_dir: str | Path, *, execute: bool =
                               "anyway)") from None
     errors = sum(1 for c in nb.cells if c.cell_type == "code"
                  for o in c.get("outputs", []) if o.get("output_type") == "error")
+    nb.metadata.pop("widgets", None)   # the static forms stand in for the live widgets
+    for cell in nb.cells:
+        if cell.cell_type == "markdown":
+            cell.source = drop_live_only(cell.source)
+    import jinja2
+
     config = Config({"NbConvertBase": {"display_data_priority": STATIC_EXPORT_PRIORITY}})
-    page, _ = HTMLExporter(config=config).from_notebook_node(nb)
+    exporter = HTMLExporter(config=config, template_file="rosfpga_offline.html.j2",
+                            extra_loaders=[jinja2.DictLoader({"rosfpga_offline.html.j2": OFFLINE_TEMPLATE})])
+    page, _ = exporter.from_notebook_node(nb)
     out = Path(output_dir) / f"{path.stem}.html"
     try:
         out.parent.mkdir(parents=True, exist_ok=True)

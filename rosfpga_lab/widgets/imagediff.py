@@ -37,6 +37,21 @@ from rosfpga_lab.widgets._common import (
 MISMATCH_RGB = (255, 0, 0)
 
 
+#: A change (largest channel difference) this big or bigger is drawn full red in "input vs output".
+CHANGE_FULL = 48
+
+
+def _pool_max(values: np.ndarray, step: int) -> np.ndarray:
+    """Shrink a 2-D array by ``step``, a block taking its largest value."""
+    if step <= 1:
+        return values
+    h, w_ = values.shape
+    ph, pw = -(-h // step) * step, -(-w_ // step) * step
+    padded = np.zeros((ph, pw), values.dtype)
+    padded[:h, :w_] = values
+    return padded.reshape(ph // step, step, pw // step, step).max(axis=(1, 3))
+
+
 def _pool_any(mask: np.ndarray, step: int) -> np.ndarray:
     """Shrink a boolean mask by ``step``, a block being True if any pixel in it is."""
     if step <= 1:
@@ -48,13 +63,24 @@ def _pool_any(mask: np.ndarray, step: int) -> np.ndarray:
     return padded.reshape(ph // step, step, pw // step, step).any(axis=(1, 3))
 
 
-#: What each picture's caption says (the difference view needs its key).
-CAPTIONS = {"difference": "difference (grey: equal, red: differs)"}
+#: The two difference views: the model's output against the reference (is the circuit right?)
+#: and the input against the output (what did the circuit change?).
+DIFF_VS_REFERENCE = "output vs reference"
+DIFF_VS_INPUT = "input vs output"
+#: What each picture's caption says (the difference views need their key).
+CAPTIONS = {DIFF_VS_REFERENCE: "output vs reference (grey: equal, red: differs)",
+            DIFF_VS_INPUT: "input vs output (grey: unchanged, red: changed, the redder the more)"}
 
 
-def caption(name: str) -> str:
-    """The caption under the picture called ``name``."""
-    return CAPTIONS.get(name, name)
+def caption(name: str, reference_name: str = "reference") -> str:
+    """The caption under the picture called ``name`` (``reference_name`` replaces "reference")."""
+    text = CAPTIONS.get(name, name)
+    return text.replace("reference", reference_name) if reference_name != "reference" else text
+
+
+def _mismatch_mask(a: np.ndarray, b: np.ndarray, tolerance: int) -> np.ndarray:
+    diff = np.abs(a.astype(np.int16) - b.astype(np.int16))
+    return (diff > tolerance) if diff.ndim == 2 else (diff > tolerance).any(axis=2)
 
 
 class FrameDiff:
@@ -66,9 +92,13 @@ class FrameDiff:
         input: the input image (optional, shown beside them).
         tolerance: largest per-channel difference still counted as equal (0 = bit exact).
         channel_order: ``"rgb"`` or ``"bgr"`` (how to show colour images; 4th channel ignored).
+        name: what this frame is (shown by the viewer, e.g. the fault that made it).
+        reference_name: what the reference is, e.g. ``"what AXIvideo2Mat should have made"``.
 
     Attributes:
-        mask: HxW bool, True where a pixel mismatches.
+        mask: HxW bool, True where a pixel mismatches (output vs reference).
+        changed: HxW bool, True where the output differs from the input (None without a
+            same-sized input).
         count: number of mismatching pixels (exact).
         positions: up to ``DIFF_POSITIONS_LIMIT`` mismatching ``(x, y)``, row-major.
         bbox: ``(x0, y0, x1, y1)`` inclusive box around all mismatches, or None.
@@ -79,7 +109,7 @@ class FrameDiff:
     """
 
     def __init__(self, output: Any, reference: Any, input: Any = None, *, tolerance: int = 0,
-                 channel_order: str = "rgb") -> None:
+                 channel_order: str = "rgb", name: str = "", reference_name: str = "reference") -> None:
         self.output = as_image(output, "output")
         self.reference = as_image(reference, "reference")
         self.input = None if input is None else as_image(input, "input")
@@ -87,8 +117,14 @@ class FrameDiff:
             raise WidgetError(f"output shape {self.output.shape} differs from reference shape "
                               f"{self.reference.shape}; compare images of the same size and encoding")
         self.tolerance, self.channel_order = int(tolerance), channel_order
+        self.name, self.reference_name = name, reference_name
         diff = np.abs(self.output.astype(np.int16) - self.reference.astype(np.int16))
         self.mask = (diff > self.tolerance) if diff.ndim == 2 else (diff > self.tolerance).any(axis=2)
+        self.change: np.ndarray | None = None   # per pixel, the largest channel change input -> output
+        if self.input is not None and self.input.shape == self.output.shape:
+            delta = np.abs(self.output.astype(np.int16) - self.input.astype(np.int16)).astype(np.uint8)
+            self.change = delta if delta.ndim == 2 else delta.max(axis=2)
+        self.changed = None if self.change is None else self.change > 0
         self.count = int(self.mask.sum())
         self.max_abs = int(diff.max()) if diff.size else 0
         ys, xs = np.nonzero(self.mask)
@@ -134,22 +170,40 @@ class FrameDiff:
         p = int(flat[i])
         return p % self.width, p // self.width
 
-    def diff_rgb(self, max_width: int = DISPLAY_MAX_WIDTH) -> np.ndarray:
-        """The difference view at display size: reference in dim grey, mismatches red."""
+    def diff_rgb(self, max_width: int = DISPLAY_MAX_WIDTH, which: str = DIFF_VS_REFERENCE) -> np.ndarray:
+        """A difference view at display size: the image in dim grey, differing pixels red.
+
+        ``which`` is :data:`DIFF_VS_REFERENCE` (output against reference, red: wrong) or
+        :data:`DIFF_VS_INPUT` (input against output, red: changed by the circuit).
+        """
         step = -(-self.width // max_width) if self.width > max_width else 1
-        ref = display_rgb(self.reference, self.channel_order)[::step, ::step]
+        base, mask = ((self.reference, self.mask) if which == DIFF_VS_REFERENCE else
+                      (self.input, self.changed))
+        if base is None or mask is None:
+            raise WidgetError(f"no {which!r} view: it needs an input of the output's shape")
+        ref = display_rgb(base, self.channel_order)[::step, ::step]
         grey = (ref.mean(axis=2) * 0.35 + 150).astype(np.uint8)
         out = np.repeat(grey[:, :, None], 3, axis=2)
-        out[_pool_any(self.mask, step)[: out.shape[0], : out.shape[1]]] = MISMATCH_RGB
+        if which == DIFF_VS_INPUT and self.change is not None:
+            # how much changed, not only whether: a change of CHANGE_FULL or more is full red
+            h, w_ = out.shape[:2]
+            amount = _pool_max(self.change, step)[:h, :w_].astype(np.float32)
+            alpha = np.clip(amount / CHANGE_FULL, 0.0, 1.0)[:, :, None]
+            alpha[amount > 0] = np.maximum(alpha[amount > 0], 0.15)   # any change stays visible
+            out = (out * (1 - alpha) + np.array(MISMATCH_RGB, np.float32) * alpha).astype(np.uint8)
+            return out
+        out[_pool_any(mask, step)[: out.shape[0], : out.shape[1]]] = MISMATCH_RGB
         return out
 
-    def diff_png(self, max_width: int = DISPLAY_MAX_WIDTH, box: tuple[int, int, int, int] | None = None) -> bytes:
-        """PNG of the difference view as displayed (enlarged if small), ``box`` outlined in blue."""
+    def diff_png(self, max_width: int = DISPLAY_MAX_WIDTH, box: tuple[int, int, int, int] | None = None,
+                 which: str = DIFF_VS_REFERENCE) -> bytes:
+        """PNG of a difference view as displayed (enlarged if small), ``box`` outlined in blue."""
         step = -(-self.width // max_width) if self.width > max_width else 1
-        return enlarged_png(self.diff_rgb(max_width), step=step, max_width=max_width, box=box)[0]
+        return enlarged_png(self.diff_rgb(max_width, which), step=step, max_width=max_width, box=box)[0]
 
     def views(self, max_width: int = DISPLAY_MAX_WIDTH) -> dict[str, np.ndarray]:
-        """Display RGB images by name: ``input`` (if given), ``output``, ``reference``, ``difference``."""
+        """Display RGB images by name: ``input`` (if given), ``output``, ``reference``, then the
+        difference views :data:`DIFF_VS_REFERENCE` and (with a same-sized input) :data:`DIFF_VS_INPUT`."""
         step = -(-self.width // max_width) if self.width > max_width else 1
         out = {}
         if self.input is not None:
@@ -157,8 +211,20 @@ class FrameDiff:
             out["input"] = display_rgb(self.input, self.channel_order)[::istep, ::istep]
         out["output"] = display_rgb(self.output, self.channel_order)[::step, ::step]
         out["reference"] = display_rgb(self.reference, self.channel_order)[::step, ::step]
-        out["difference"] = self.diff_rgb(max_width)
+        out[DIFF_VS_REFERENCE] = self.diff_rgb(max_width)
+        if self.changed is not None:
+            out[DIFF_VS_INPUT] = self.diff_rgb(max_width, DIFF_VS_INPUT)
         return out
+
+    def start_point(self) -> tuple[int, int]:
+        """Where a zoom starts: the first wrong pixel, else where the circuit changed the input
+        most (the first such pixel), else (0, 0)."""
+        if self.count:
+            return self.positions[0]
+        if self.change is not None and self.change.any():
+            y, x = np.unravel_index(int(np.argmax(self.change)), self.change.shape)
+            return int(x), int(y)
+        return 0, 0
 
     def region(self, x: int, y: int, size: int = 8) -> tuple[int, int, int, int]:
         """The inclusive box ``(x0, y0, x1, y1)`` of a ``size`` square around ``(x, y)``, inside the image."""
@@ -173,7 +239,7 @@ class FrameDiff:
             raise WidgetError(f"pixel ({x}, {y}) is outside the {self.width}x{self.height} image")
         x0, y0, x1, y1 = self.region(x, y, size)
         tables = []
-        named = [("output", self.output), ("reference", self.reference)]
+        named = [("output", self.output), (self.reference_name, self.reference)]
         if self.input is not None and self.input.shape[:2] == self.output.shape[:2]:
             named.insert(0, ("input", self.input))
         for name, img in named:
@@ -185,7 +251,7 @@ class FrameDiff:
                 for xx in range(x0, x1 + 1):
                     v = img[yy, xx]
                     text = ",".join(str(int(c)) for c in np.atleast_1d(v))
-                    bg = "#ff9e9e" if self.mask[yy, xx] and name != "input" else ""
+                    bg = "#ff9e9e" if self.mask[yy, xx] and img is not self.input else ""
                     mark = ";outline:2px solid #00f" if (xx, yy) == (x, y) else ""
                     cells.append(f'<td style="border:1px solid #ccc;padding:1px 3px;background:{bg}{mark}">{text}</td>')
                 rows.append(f"<tr><th>{yy}</th>{''.join(cells)}</tr>")
@@ -194,19 +260,23 @@ class FrameDiff:
         return '<div style="display:flex;gap:12px;flex-wrap:wrap">' + "".join(tables) + "</div>"
 
     def to_html(self, max_width: int = 320) -> str:
-        """Self-contained HTML: the images side by side, the summary, positions and a zoom."""
+        """Self-contained HTML: the images (wrapping to the page's width), the summary,
+        positions and a folded zoom."""
         imgs = []
         for name, rgb in self.views(max_width).items():
             scale = display_scale(rgb.shape[1], max_width)
-            imgs.append(f'<figure style="margin:4px"><img src="{png_data_uri(rgb, scale)}" '
-                        f'style="image-rendering:pixelated" alt="{name}"/><figcaption>{caption(name)}</figcaption></figure>')
-        parts = ['<div style="display:flex;flex-wrap:wrap">' + "".join(imgs) + "</div>",
+            imgs.append(f'<figure style="margin:4px;max-width:100%"><img src="{png_data_uri(rgb, scale)}" '
+                        f'style="image-rendering:pixelated;max-width:100%" alt="{esc(name)}"/>'
+                        f'<figcaption>{esc(caption(name, self.reference_name))}</figcaption></figure>')
+        title = f"<div><b>{esc(self.name)}</b></div>" if self.name else ""
+        parts = [title + '<div style="display:flex;flex-wrap:wrap">' + "".join(imgs) + "</div>",
                  f"<div><b>{esc(self.summary())}</b></div>"]
         if not self.equal:
             shown = ", ".join(f"({x}, {y})" for x, y in self.positions[:50])
             more = f" \u2026 ({self.count - 50} more)" if self.count > 50 else ""
             parts.append(f"<div>mismatching pixels (x, y): {shown}{more}</div>")
-            parts.append(self.zoom_html(*self.positions[0]))
+            parts.append(f"<details><summary>pixel values around ({self.positions[0][0]}, "
+                         f"{self.positions[0][1]})</summary>{self.zoom_html(*self.positions[0])}</details>")
         return "<div>" + "".join(parts) + "</div>"
 
     def _repr_html_(self) -> str:
@@ -220,7 +290,8 @@ def _as_frames(frames: Iterable[Any], tolerance: int, channel_order: str) -> lis
             out.append(f)
         elif isinstance(f, dict):
             out.append(FrameDiff(f["output"], f["reference"], f.get("input"), tolerance=tolerance,
-                                 channel_order=channel_order))
+                                 channel_order=channel_order, name=f.get("name", ""),
+                                 reference_name=f.get("reference_name", "reference")))
         elif isinstance(f, (tuple, list)) and len(f) in (2, 3):
             inp, outp, ref = (None, *f) if len(f) == 2 else f
             out.append(FrameDiff(outp, ref, inp, tolerance=tolerance, channel_order=channel_order))
@@ -237,7 +308,8 @@ class ImageDiffViewer(StaticFallback, w.VBox):
     Args:
         output, reference, input: one frame's images; or leave them out and pass ``frames``.
         frames: a sequence of :class:`FrameDiff`, dicts with ``input``/``output``/``reference``
-            keys, or ``(input, output, reference)`` (or ``(output, reference)``) tuples.
+            keys (and optionally ``name``, ``reference_name``), or ``(input, output, reference)``
+            (or ``(output, reference)``) tuples. A frame's ``name`` is shown beside the slider.
         tolerance, channel_order: as :class:`FrameDiff`.
         max_width: largest display width of each image.
 
@@ -253,22 +325,30 @@ class ImageDiffViewer(StaticFallback, w.VBox):
             frames = [FrameDiff(output, reference, input, tolerance=tolerance, channel_order=channel_order)]
         self.frames = _as_frames(frames, tolerance, channel_order)
         self.max_width = max_width
-        self.frame = w.IntSlider(0, min=0, max=len(self.frames) - 1, description="frame",
-                                 layout=w.Layout(display="" if len(self.frames) > 1 else "none"))
+        many = len(self.frames) > 1
+        self.frame = w.IntSlider(0, min=0, max=len(self.frames) - 1, description="frame", readout=False,
+                                 layout=w.Layout(display="" if many else "none"))
+        self.frame_name = w.HTML(layout=w.Layout(display="" if many or self.frames[0].name else "none"))
         self.images: dict[str, ClickImage] = {}
-        self.image_box = w.HBox()
+        # pictures wrap onto further rows rather than widen the notebook
+        self.image_box = w.HBox(layout=w.Layout(flex_flow="row wrap", width="100%"))
         self.summary = w.HTML()
         self.x = w.BoundedIntText(0, min=0, max=10**6, description="zoom x", layout=w.Layout(width="160px"))
         self.y = w.BoundedIntText(0, min=0, max=10**6, description="zoom y", layout=w.Layout(width="160px"))
         self.size = w.BoundedIntText(8, min=1, max=ZOOM_MAX, description="size", layout=w.Layout(width="140px"))
         self.next_button = w.Button(description="next mismatch")
         self.zoom = w.HTML()
+        # the value tables are tall: folded until asked for
+        self.zoom_fold = w.Accordion(children=[w.VBox([w.HBox([self.x, self.y, self.size, self.next_button],
+                                                               layout=w.Layout(flex_flow="row wrap")),
+                                                        self.zoom])],
+                                     titles=("pixel values (zoom)",), selected_index=None)
         self.frame.observe(lambda _c: self._show_frame(), "value")
         for c in (self.x, self.y, self.size):
             c.observe(lambda _c: self._show_zoom(), "value")
         self.next_button.on_click(lambda _b: self.next_mismatch())
-        super().__init__([self.frame, self.image_box, self.summary,
-                          w.HBox([self.x, self.y, self.size, self.next_button]), self.zoom])
+        super().__init__([w.HBox([self.frame, self.frame_name], layout=w.Layout(flex_flow="row wrap")),
+                          self.image_box, self.summary, self.zoom_fold])
         self._show_frame()
 
     @property
@@ -309,19 +389,20 @@ class ImageDiffViewer(StaticFallback, w.VBox):
             scale = display_scale(rgb.shape[1], self.max_width)
             img = self.images.get(name)
             if img is None:
-                img = self.images[name] = ClickImage(caption=caption(name))
+                img = self.images[name] = ClickImage()
                 img.on_click(lambda x, y, _n=name: self._clicked(_n, x, y))
+            img.caption = caption(name, f.reference_name)
             src = f.input if name == "input" and f.input is not None else f.output
             img.src_height, img.src_width = int(src.shape[0]), int(src.shape[1])
             img.display_width = rgb.shape[1] * scale
             img.png = png_bytes(rgb, scale)
             boxes.append(img)
         self.image_box.children = boxes
+        k = self.frame.value
+        self.frame_name.value = (f"{k + 1} of {len(self.frames)}" if len(self.frames) > 1 else "") + (
+            f": <b>{esc(f.name)}</b>" if f.name and len(self.frames) > 1 else f"<b>{esc(f.name)}</b>")
         self.summary.value = f"<b>{esc(f.summary())}</b> (click an image to zoom there)"
-        if f.count:
-            self.zoom_to(*f.positions[0])
-        else:
-            self._show_zoom()
+        self.zoom_to(*f.start_point())
 
     def _clicked(self, name: str, x: int, y: int) -> None:
         f = self.current
@@ -331,7 +412,11 @@ class ImageDiffViewer(StaticFallback, w.VBox):
         f = self.current
         x, y = min(self.x.value, f.width - 1), min(self.y.value, f.height - 1)
         self.zoom.value = f.zoom_html(x, y, self.size.value)
-        self.images["difference"].png = f.diff_png(self.max_width, box=f.region(x, y, self.size.value))
+        box = f.region(x, y, self.size.value)
+        self.zoom_fold.set_title(0, f"pixel values around ({x}, {y})")
+        for which in (DIFF_VS_REFERENCE, DIFF_VS_INPUT):
+            if which in self.images and (which == DIFF_VS_REFERENCE or f.changed is not None):
+                self.images[which].png = f.diff_png(self.max_width, box=box, which=which)
 
     def to_html(self, all_frames: bool = False) -> str:
         """Static HTML: the frame on screen in full (:meth:`FrameDiff.to_html`) and, for a
@@ -340,8 +425,11 @@ class ImageDiffViewer(StaticFallback, w.VBox):
         k = self.frame.value
         if len(self.frames) == 1:
             return self.current.to_html(self.max_width)
-        rows = "".join(f"<tr><td>{i}</td><td>{esc(f.summary())}</td></tr>" for i, f in enumerate(self.frames))
-        table = f'<table style="font-size:12px"><tr><th>frame</th><th>result</th></tr>{rows}</table>'
+        rows = "".join(f"<tr><td>{i + 1}</td><td>{esc(f.name)}</td><td>{esc(f.summary())}</td></tr>"
+                       for i, f in enumerate(self.frames))
+        table = (f'<table style="font-size:12px"><tr><th>frame</th><th>name</th><th>result</th></tr>'
+                 f"{rows}</table>")
         shown = range(len(self.frames)) if all_frames else [k]
-        body = "".join(f"<h4>frame {i}</h4>" + self.frames[i].to_html(self.max_width) for i in shown)
+        body = "".join(f"<h4>frame {i + 1} of {len(self.frames)}</h4>" + self.frames[i].to_html(self.max_width)
+                       for i in shown)
         return f"<div>{table}{body}</div>"

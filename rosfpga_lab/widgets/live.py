@@ -97,11 +97,16 @@ class LiveView(StaticFallback, w.VBox):
         channel_order: ``"rgb"`` or ``"bgr"`` for colour frames.
         image_format: ``"jpeg"`` (small, fast) or ``"png"`` (exact pixels).
         trailing: show the newest parked frame when the throttle reopens (needs a timer thread).
+        title: a line above the pictures.
+        stop: called (once) when the view's Stop button is pressed; no button without it.
         clock: monotonic clock (injectable for tests).
+
+    Give :meth:`update` an ``input=`` picture too and the view shows input beside output.
     """
 
     def __init__(self, *, max_fps: float = LIVE_MAX_FPS, max_width: int = 480, channel_order: str = "rgb",
                  image_format: str = "jpeg", trailing: bool = True, title: str = "",
+                 stop: Callable[[], Any] | None = None,
                  clock: Callable[[], float] = time.monotonic) -> None:
         if image_format not in ("jpeg", "png"):
             raise WidgetError(f"image_format must be 'jpeg' or 'png', got {image_format!r}")
@@ -114,17 +119,39 @@ class LiveView(StaticFallback, w.VBox):
         self.latencies: deque[float] = deque(maxlen=50)
         self._lock = threading.Lock()
         self._push_lock = threading.Lock()
-        self._pending: np.ndarray | None = None
+        self._pending: tuple[np.ndarray, np.ndarray | None] | None = None
         self._timer: threading.Timer | None = None
         self._closed = False
         self._handle: Any = None
         self.title = title
-        self.image = w.Image(format=image_format)
+        self.image = w.Image(format=image_format, layout=w.Layout(max_width="100%"))
+        self.input_image = w.Image(format=image_format, layout=w.Layout(max_width="100%"))
+        self._input_box = w.VBox([w.HTML("<b>input</b>"), self.input_image],
+                                 layout=w.Layout(display="none", margin="0 12px 0 0", max_width="100%"))
+        self._output_caption = w.HTML("", layout=w.Layout(display="none"))
+        pictures = w.HBox([self._input_box, w.VBox([self._output_caption, self.image],
+                                                   layout=w.Layout(max_width="100%"))],
+                          layout=w.Layout(flex_flow="row wrap", max_width="100%"))
         self.status = w.HTML("waiting for frames\u2026")
-        super().__init__([w.HTML(f"<b>{title}</b>") if title else w.HTML(), self.image, self.status])
+        self._stop = stop
+        self.stop_button = w.Button(description="Stop", icon="stop", button_style="danger",
+                                    layout=w.Layout(display="" if stop else "none", width="auto"))
+        self.stop_button.on_click(lambda _b: self.press_stop())
+        self.stopped = False
+        super().__init__([w.HTML(f"<b>{esc(title)}</b>") if title else w.HTML(), pictures,
+                          w.HBox([self.stop_button, self.status], layout=w.Layout(flex_flow="row wrap"))])
+
+    def press_stop(self) -> None:
+        """What the Stop button does: call ``stop`` once, then say so."""
+        if self.stopped or self._stop is None:
+            return
+        self.stopped = True
+        self.stop_button.disabled = True
+        self.stop_button.description = "Stopped"
+        self._stop()
 
     def update(self, frame: Any, *, latency: float | None = None, stamp: float | None = None,
-               channel_order: str | None = None) -> bool:
+               channel_order: str | None = None, input: Any = None) -> bool:
         """Offer a new frame (any thread). Returns True if it was pushed to the browser now.
 
         Args:
@@ -133,10 +160,14 @@ class LiveView(StaticFallback, w.VBox):
             stamp: capture time as ``time.time()`` (e.g. the message's header stamp);
                 latency is then ``time.time() - stamp``.
             channel_order: ``"rgb"``/``"bgr"`` for this frame (default: the view's).
+            input: the picture the frame was made from, shown beside it.
         """
         img = as_image(frame, "frame")
+        inp = None if input is None else as_image(input, "input")
         if channel_order is not None and channel_order != self.channel_order:
-            img = img[:, :, [2, 1, 0] + ([3] if img.shape[2] == 4 else [])] if img.ndim == 3 and img.shape[2] >= 3 else img
+            img, inp = (None if a is None else
+                        a[:, :, [2, 1, 0] + ([3] if a.shape[2] == 4 else [])] if a.ndim == 3 and a.shape[2] >= 3 else a
+                        for a in (img, inp))
         if latency is None and stamp is not None:
             latency = time.time() - stamp
         with self._lock:
@@ -150,14 +181,14 @@ class LiveView(StaticFallback, w.VBox):
                 self._pending = None
                 go = True
             else:
-                self._pending = img
+                self._pending = (img, inp)
                 go = False
                 if self.trailing and self._timer is None:
                     self._timer = threading.Timer(self.throttle.wait_time() + 1e-3, self._fire)
                     self._timer.daemon = True
                     self._timer.start()
         if go:
-            self._push(img)
+            self._push(img, inp)
         return go
 
     def feed(self, frame: Any) -> bool:
@@ -179,19 +210,19 @@ class LiveView(StaticFallback, w.VBox):
                 self._timer.daemon = True
                 self._timer.start()
                 return
-            img, self._pending = self._pending, None
-        self._push(img)
+            pair, self._pending = self._pending, None
+        self._push(*pair)
 
     def flush(self) -> bool:
         """Show the parked frame now, ignoring the throttle. Returns True if there was one."""
         with self._lock:
-            img, self._pending = self._pending, None
-        if img is None:
+            pair, self._pending = self._pending, None
+        if pair is None:
             return False
-        self._push(img)
+        self._push(*pair)
         return True
 
-    def _push(self, img: np.ndarray) -> None:
+    def _encode(self, img: np.ndarray) -> tuple[bytes, str]:
         import cv2
 
         rgb = downscale(display_rgb(img, self.channel_order), self.max_width)
@@ -202,25 +233,43 @@ class LiveView(StaticFallback, w.VBox):
         ok, buf = cv2.imencode(ext, np.ascontiguousarray(rgb[:, :, ::-1]))
         if not ok:  # pragma: no cover
             raise WidgetError("could not encode the frame")
-        width = f"{rgb.shape[1]}px"
+        return buf.tobytes(), f"{rgb.shape[1]}px"
+
+    def _push(self, img: np.ndarray, inp: np.ndarray | None = None) -> None:
+        data, width = self._encode(img)
+        inp_data, inp_width = self._encode(inp) if inp is not None else (b"", "")
         with self._push_lock:
             if self.image.layout.width != width:
                 self.image.layout.width = width
+            if inp is not None:
+                if self._input_box.layout.display == "none":
+                    self._input_box.layout.display = ""
+                    self._output_caption.value = "<b>output</b>"
+                    self._output_caption.layout.display = ""
+                if self.input_image.layout.width != inp_width:
+                    self.input_image.layout.width = inp_width
+                self.input_image.value = inp_data
             with self._lock:
                 self.shown += 1
                 self.shown_rate.tick()
                 text = self.status_text()
-            self.image.value = buf.tobytes()
+            self.image.value = data
             self.status.value = text
 
     def to_html(self) -> str:
         """Static HTML: the title, the newest frame shown (if any) and the status line."""
         head = f"<b>{esc(self.title)}</b>" if self.title else ""
         img = ""
-        if self.image.value:
-            mime = "jpeg" if self.image_format == "jpeg" else "png"
-            data = base64.b64encode(self.image.value).decode("ascii")
-            img = f'<div><img src="data:image/{mime};base64,{data}" alt="newest frame"/></div>'
+        mime = "jpeg" if self.image_format == "jpeg" else "png"
+        pictures = [(name, widget.value) for name, widget in (("input", self.input_image),
+                                                              ("output", self.image)) if widget.value]
+        if pictures:
+            both = len(pictures) > 1
+            img = '<div style="display:flex;flex-wrap:wrap;gap:12px">' + "".join(
+                f'<figure style="margin:0;max-width:100%"><img style="max-width:100%" '
+                f'src="data:image/{mime};base64,{base64.b64encode(raw).decode("ascii")}" alt="newest {name}"/>'
+                + (f"<figcaption>{name}</figcaption>" if both else "") + "</figure>"
+                for name, raw in pictures) + "</div>"
         status = self.status_text() if self.received else "waiting for frames\u2026"
         return f"<div>{head}{img}<div>{esc(status)}</div></div>"
 

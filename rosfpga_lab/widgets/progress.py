@@ -70,9 +70,13 @@ class Progress:
             import ipywidgets as w
             from IPython.display import display
 
-            self._bar = w.IntProgress(value=0, min=0, max=max(1, total or 1), description=desc[:20])
-            self._label = w.Label("")
-            self.widget = w.HBox([self._bar, self._label])
+            # the bar draws the fraction, the label says the rest in words (no second, ASCII
+            # bar; the description is in the label, where it is never cut short); with no
+            # total there is no fraction to draw, so no bar
+            self._bar = w.IntProgress(value=0, min=0, max=max(1, total or 1),
+                                      layout=w.Layout(display="" if total else "none"))
+            self._label = w.Label("", layout=w.Layout(width="auto"))
+            self.widget = w.HBox([self._bar, self._label], layout=w.Layout(flex_flow="row wrap"))
             self._handle = display(self.mimebundle(), raw=True, display_id=True)
 
     def mimebundle(self) -> dict[str, str]:
@@ -125,18 +129,22 @@ class Progress:
         self.close()
 
     # --- display ------------------------------------------------------------------------------
-    def text(self, now: float | None = None) -> str:
-        """The progress line, e.g. ``dilate  45% 450/1000 rows  1.2 s, 0.8 s left``."""
+    def text(self, now: float | None = None, *, bar: bool = True) -> str:
+        """The progress line, e.g. ``dilate [#########           ]  45% 450/1000 rows  1.2 s, 0.8 s left``
+        (``bar=False``: without the ASCII bar, for beside a drawn one)."""
         now = self.clock() if now is None else now
         elapsed = now - self.start
         unit = f" {self.unit}" if self.unit else ""
         note = f" \u2013 {self.note}" if self.note else ""
         if self.total:
             frac = min(1.0, self.done / self.total)
-            bar = "#" * int(frac * 20)
+            hashes = "#" * int(frac * 20)
+            drawn = f" [{hashes:<20}]" if bar else ""
             left = f", {elapsed * (1 - frac) / frac:.1f} s left" if 0 < frac < 1 else ""
-            return f"{self.desc} [{bar:<20}] {frac * 100:3.0f}% {self.done}/{self.total}{unit}  {elapsed:.1f} s{left}{note}".strip()
-        return f"{self.desc} {self.done}{unit}  {elapsed:.1f} s{note}".strip()
+            return f"{self.desc}{drawn} {frac * 100:3.0f}% {self.done}/{self.total}{unit}  {elapsed:.1f} s{left}{note}".strip()
+        count = f" {self.done}{unit}" if self.done else ""   # no total, nothing counted: no "0"
+        state = "" if self.done or self.note else (" done in" if self.closed else " running,")
+        return f"{self.desc}{count}{state}  {elapsed:.1f} s{note}".strip()
 
     def _show(self, now: float, final: bool = False, note: bool = False) -> None:
         self._last_shown = now
@@ -146,7 +154,8 @@ class Progress:
         if self.mode == "widget":
             self._bar.max = max(1, self.total or max(self.done, 1))
             self._bar.value = min(self.done, self._bar.max)
-            self._label.value = line
+            self._bar.layout.display = "" if self.total else "none"
+            self._label.value = self.text(now, bar=False)
             if final:
                 self._bar.bar_style = "success"
                 if self._handle is not None:

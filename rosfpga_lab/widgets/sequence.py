@@ -11,6 +11,7 @@ clicked event's bytes in a :class:`~rosfpga_lab.widgets.byteview.ByteViewer`, fi
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +29,18 @@ STATIC = Path(__file__).resolve().parent / "static"
 
 #: Lifelines drawn first when present (the master), as in the paper's Figure 2.
 FIRST_PARTICIPANTS = ("/master", "master")
+
+#: Widest a diagram is drawn (pixels): a notebook's output area at 1,000 px is about 940 wide.
+#: Columns narrow to fit; beyond that the SVG scales down (it never makes the page scroll).
+FIT_WIDTH = 920
+#: Narrowest and widest lifeline column.
+COL_MIN, COL_MAX = 96, 220
+#: A repeated arrow (same ends, kind and label) within this many arrows is folded into the first.
+FOLD_WINDOW = 4
+#: Average width of a label character at the diagram's font size, to cut labels to their arrow.
+CHAR_PX = 6.6
+#: Room a label gets on a short arrow (pixels).
+LABEL_MIN_PX = 210
 
 #: Arrow colour and dash per event kind.
 KIND_STYLE = {
@@ -98,7 +111,62 @@ def participants_of(events: Sequence[SeqEvent], first: Sequence[str] = ()) -> li
     return seen
 
 
-def events_from_trace(trace: Any, *, frames_per_connection: int = 2, replies: bool = True) -> list[SeqEvent]:
+def peer_names(items: Sequence[Any]) -> dict[str, str]:
+    """Node names for the other labels a trace gives the same party: slave API URIs and TCP
+    peer addresses (``host:port``).
+
+    Sources: ``registerPublisher``/``registerSubscriber`` calls (``caller_api`` -> ``caller_id``),
+    and the connection headers of each TCPROS connection (both sides send ``callerid``: a
+    label on that connection that is not a node name belongs to the side it is not).
+    """
+    names: dict[str, str] = {}
+    for e in items:
+        if e.kind == "xmlrpc" and e.method in ("registerPublisher", "registerSubscriber") \
+                and isinstance(e.args, (list, tuple)) and len(e.args) >= 3:
+            names.setdefault(str(e.args[-1]), str(e.src))
+    by_conn: dict[int, list[Any]] = {}
+    for e in items:
+        if e.kind in ("tcpros_header", "tcpros_frame", "tcp_connect", "tcp_close", "error") and e.conn:
+            by_conn.setdefault(e.conn, []).append(e)
+    for evs in by_conn.values():
+        callers = {e.args["callerid"] for e in evs if e.kind == "tcpros_header"
+                   and isinstance(e.args, dict) and e.args.get("callerid")}
+        for e in evs:
+            for label, other in ((e.src, e.dst), (e.dst, e.src)):
+                if label and not label.startswith("/"):
+                    rest = callers - {other}
+                    if len(rest) == 1:
+                        names.setdefault(label, next(iter(rest)))
+    return names
+
+
+_URI_PREFIX = re.compile(r"((?:http|rosrpc)://[^\s/]+/?):\s*")
+
+
+def _fold_repeats(events: list[SeqEvent]) -> list[SeqEvent]:
+    """Fold an arrow that repeats one of the last :data:`FOLD_WINDOW` (retries) into it."""
+    out: list[SeqEvent] = []
+    keys: list[tuple[str, str, str, str]] = []
+    counts: list[int] = []
+    details: list[str] = []
+    for e in events:
+        key = (e.src, e.dst, e.kind, e.label)
+        for j in range(len(out) - 1, max(-1, len(out) - 1 - FOLD_WINDOW), -1):
+            if keys[j] == key:
+                counts[j] += 1
+                out[j].label = f"{key[3]} \u00d7{counts[j]}"
+                out[j].detail = (details[j] + f"\n(repeated {counts[j]} times; bytes of the first)").strip()
+                break
+        else:
+            out.append(e)
+            keys.append(key)
+            counts.append(1)
+            details.append(e.detail)
+    return out
+
+
+def events_from_trace(trace: Any, *, frames_per_connection: int = 2, replies: bool = True,
+                      fold: bool = True) -> list[SeqEvent]:
     """Events from a ``rosfpga_lab.graph`` ``Trace`` (or a list of its ``TraceEvent``).
 
     Args:
@@ -106,8 +174,13 @@ def events_from_trace(trace: Any, *, frames_per_connection: int = 2, replies: bo
         frames_per_connection: message frames drawn per TCPROS connection; the rest are
             summarised in one "... N more" arrow.
         replies: draw the reply arrow of each XML-RPC call.
+        fold: fold retries (an arrow repeating a recent one) into one arrow marked ``xN``.
+
+    Parties are named by node name wherever the trace tells it (:func:`peer_names`), so one
+    node is one lifeline, whether it was seen by name, slave API URI or TCP address.
     """
     items = trace.conversation() if hasattr(trace, "conversation") else list(trace)
+    alias = peer_names(items)
     out: list[SeqEvent] = []
     types: dict[int, str] = {}
     frames: dict[int, int] = {}
@@ -140,35 +213,60 @@ def events_from_trace(trace: Any, *, frames_per_connection: int = 2, replies: bo
                 first, count = skipped.get(e.conn, (e, 0))
                 skipped[e.conn] = (first, count + 1)
         elif kind in ("tcp_connect", "tcp_close", "error"):
-            label = {"tcp_connect": "TCP connect", "tcp_close": "TCP close"}.get(kind, f"error: {e.result}")
-            out.append(SeqEvent(e.src, e.dst, label[:60], b"", e.t0, kind, detail=str(e.result or "")[:300]))
+            result, dst = str(e.result or ""), e.dst
+            found = _URI_PREFIX.match(result) if kind == "error" else None
+            if found:   # "http://host:port/: what failed": the URI is the peer, the rest the label
+                dst = dst or found[1]
+                result = result[found.end():]
+                result = result.split(" failed: ")[-1] if " failed: " in result else result
+            label = {"tcp_connect": "TCP connect", "tcp_close": "TCP close"}.get(kind, f"error: {result}")
+            out.append(SeqEvent(e.src, dst, label[:60], b"", e.t0, kind, detail=str(e.result or "")[:300]))
     for _conn, (first, count) in skipped.items():
         out.append(SeqEvent(first.src, first.dst, f"\u2026 {count} more messages", b"", first.t0 + 1e-9,
                             "tcpros_frame"))
+    for ev in out:
+        ev.src = alias.get(ev.src, ev.src) or "(unknown)"
+        ev.dst = alias.get(ev.dst, ev.dst) or "(unknown)"
     out.sort(key=lambda ev: (ev.t if ev.t is not None else 0.0))
-    return out
+    return _fold_repeats(out) if fold else out
+
+
+def _fit(text: str, px: float) -> str:
+    """``text`` cut with an ellipsis to about ``px`` pixels."""
+    n = max(4, int(px / CHAR_PX))
+    return text if len(text) <= n else text[: n - 1] + "\u2026"
 
 
 def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None = None, *,
-                 selected: int | None = None, col: int = 220, row: int = 34) -> str:
-    """The diagram as an SVG string: lifelines, numbered arrows (``<g data-index=k>``), times."""
+                 selected: int | None = None, col: int | None = None, row: int = 34,
+                 fit_width: int = FIT_WIDTH) -> str:
+    """The diagram as an SVG string: lifelines, numbered arrows (``<g data-index=k>``), times.
+
+    Columns are as wide as ``fit_width`` allows (``col`` forces a width); labels are cut to
+    their arrow (the tooltip has the full text) and drawn on a white halo so lifelines do not
+    cross them; the SVG scales down to its container rather than overflow it.
+    """
     names = list(participants) if participants else participants_of(events, FIRST_PARTICIPANTS)
     missing = ({e.src for e in events} | {e.dst for e in events}) - set(names)
     if missing:
         raise WidgetError(f"participants {sorted(missing)} appear in events but not in participants=")
     left, top = 80, 50
+    if col is None:
+        col = max(COL_MIN, min(COL_MAX, (fit_width - left - 20) // max(len(names), 1)))
     xs = {n: left + col // 2 + i * col for i, n in enumerate(names)}
     height = top + 20 + row * max(len(events), 1) + 20
     width = left + col * max(len(names), 1) + 20
     t0 = next((e.t for e in events if e.t is not None), None)
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
+           f'viewBox="0 0 {width} {height}" style="max-width:100%;height:auto" '
            f'font-family="sans-serif" font-size="12">',
            '<defs><marker id="rfl-ah" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="8" '
            'markerHeight="8" orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" fill="context-stroke"/>'
            "</marker></defs>"]
     for n, x in xs.items():
         out.append(f'<rect x="{x - col // 2 + 10}" y="8" width="{col - 20}" height="26" rx="4" fill="#f0f0f0" stroke="#333"/>')
-        out.append(f'<text x="{x}" y="26" text-anchor="middle" font-weight="bold">{esc(n)}</text>')
+        out.append(f'<text x="{x}" y="26" text-anchor="middle" font-weight="bold" font-size="11">'
+                   f'{esc(_fit(n, (col - 14) * 1.1))}</text>')
         out.append(f'<line x1="{x}" y1="34" x2="{x}" y2="{height - 10}" stroke="#999" stroke-dasharray="4 4"/>')
     for k, e in enumerate(events):
         y = top + 20 + k * row
@@ -183,14 +281,18 @@ def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None 
             path = f"M{x1},{y - 8} h40 v14 h-40"
             out.append(f'<path d="{path}" fill="none" stroke="transparent" stroke-width="12"/>')
             out.append(f'<path class="rfl-vis" d="{path}" fill="none" stroke="{colour}" stroke-width="1.5"{dash_attr} marker-end="url(#rfl-ah)"/>')
-            tx, anchor = x1 + 46, "start"
+            tx, anchor, room = x1 + 46, "start", col - 50
         else:
             out.append(f'<line x1="{x1}" y1="{y}" x2="{x2}" y2="{y}" stroke="transparent" stroke-width="14"/>')
             out.append(f'<line class="rfl-vis" x1="{x1}" y1="{y}" x2="{x2}" y2="{y}" stroke="{colour}" '
                        f'stroke-width="1.5"{dash_attr} marker-end="url(#rfl-ah)"/>')
-            tx, anchor = (x1 + x2) / 2, "middle"
+            # a label may run past a short arrow's ends: its white halo keeps it readable
+            tx, anchor, room = (x1 + x2) / 2, "middle", max(abs(x2 - x1) - 16, min(2.2 * col, LABEL_MIN_PX))
         size = f" [{len(e.raw)} B]" if e.raw and e.kind != "tcpros_frame" else ""
-        out.append(f'<text x="{tx}" y="{y - 5}" text-anchor="{anchor}" fill="{colour}">{k + 1}. {esc(e.label)}{size}</text>')
+        label = _fit(f"{k + 1}. {e.label}{size}", room)
+        out.append(f'<text x="{tx}" y="{y - 5}" text-anchor="{anchor}" fill="{colour}" '
+                   f'paint-order="stroke" stroke="#fff" stroke-width="4" stroke-linejoin="round">'
+                   f'{esc(label)}</text>')
         if e.t is not None and t0 is not None:
             out.append(f'<text x="4" y="{y + 4}" fill="#777" font-size="10">+{(e.t - t0) * 1000:.1f} ms</text>')
         out.append("</g>")
@@ -247,11 +349,14 @@ class SequenceDiagram(StaticFallback, w.VBox):
         self.pane = SvgPane(svg=sequence_svg(self.events, self.participants))
         self.list = w.Dropdown(options=[(f"{k + 1}. {e.src} \u2192 {e.dst}: {e.label}", k)
                                         for k, e in enumerate(self.events)],
-                               value=None, description="arrow", layout=w.Layout(width="640px"))
+                               value=None, description="arrow",
+                               layout=w.Layout(width="640px", max_width="100%"))
         self.bytes = ByteViewer(b"", static_fallback=False)
         self.pane.observe(lambda c: self.select(c["new"]) if c["new"] >= 0 else None, "selected")
         self.list.observe(lambda c: self.select(c["new"]) if c["new"] is not None else None, "value")
         super().__init__([self.pane, self.list, self.bytes])
+        if self.events:  # the byte viewer starts on the first arrow, not on "0 bytes"
+            self.select(0)
 
     @property
     def selected(self) -> SeqEvent | None:

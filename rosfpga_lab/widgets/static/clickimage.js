@@ -7,6 +7,8 @@ function render({ model, el }) {
   img.style.imageRendering = "pixelated";
   img.style.cursor = "crosshair";
   img.style.display = "block";
+  img.style.maxWidth = "100%";   // never wider than the notebook: shrink rather than scroll
+  el.style.maxWidth = "100%";
   const cap = document.createElement("div");
   cap.className = "rfl-clickimage-cap";
   el.append(img, cap);

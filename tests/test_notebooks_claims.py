@@ -1,0 +1,80 @@
+"""What the notebooks' texts claim, held against the code and the README (no kernel needed).
+
+The claims that need a run (Table 1's ratio, the wire time, the fault gallery) are checked on
+the executed notebooks in ``test_notebooks_exec.py``.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from rosfpga_lab.checks import nbbuild
+
+ROOT = Path(__file__).resolve().parents[1]
+SOLUTIONS = ROOT / "notebooks" / "solutions"
+NOTEBOOKS = sorted(SOLUTIONS.glob(nbbuild.NOTEBOOK_GLOB))
+
+
+def cells(name: str) -> list[dict]:
+    return json.loads((SOLUTIONS / name).read_text(encoding="utf-8"))["cells"]
+
+
+def markdown(name: str) -> str:
+    return "\n".join("".join(c["source"]) for c in cells(name) if c["cell_type"] == "markdown")
+
+
+def test_table_1_ratio_is_computed_not_written() -> None:
+    text = markdown("06_design_flow.ipynb")
+    assert "order of magnitude" not in text            # 860 / 163 is 5.3x, the paper's own 6.8x
+    assert not re.search(r"\d(\.\d)?\s*x\b|\d+ times", text), "a ratio written into the text"
+    code = "\n".join("".join(c["source"]) for c in cells("06_design_flow.ipynb") if c["cell_type"] == "code")
+    assert "paper_verilog / table.total" in code and "hls.PAPER_TABLE1" in code
+
+
+def test_workshop_notebook_names_the_packages_the_readme_installs() -> None:
+    text = markdown("07_workshop_demo.ipynb")
+    assert "ros-*" not in text
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    apt = re.search(r"sudo apt-get install (python3-rospy[^`]*?)```", readme, re.S)[1]
+    named = set(re.findall(r"`(python3-[a-z-]+|lib[a-z-]+)`", text))
+    assert named and named <= set(apt.replace("\\", " ").split()), named
+
+
+def test_network_time_says_what_it_counts() -> None:
+    text = markdown("05_application.ipynb")
+    assert "9.8 ms" in text and "10.4 ms on the wire" in text and "hw.wire_bytes" in text
+
+
+def test_difference_views_are_named_for_what_they_compare() -> None:
+    text = markdown("00_overview.ipynb")
+    assert "*output vs reference*" in text and "*input vs output*" in text
+    from rosfpga_lab.component import demo
+    assert "output - input" in Path(demo.__file__).read_text()   # demo.png's third panel
+
+
+def test_course_map_and_readme_list_notebooks_08_and_09() -> None:
+    course = markdown("00_overview.ipynb")
+    assert "| 8 The circuit in RTL |" in course and "| 9 ROS 2 on the wire |" in course
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert "| `08_rtl` |" in readme and "| `09_ros2_wire` |" in readme
+
+
+@pytest.mark.parametrize("name", ["00_overview.ipynb", "04_fifo_to_axi_stream.ipynb",
+                                  "05_application.ipynb", "06_design_flow.ipynb"])
+def test_notebooks_that_speak_of_cycles_point_to_notebook_08(name: str) -> None:
+    text = markdown(name)
+    assert "Notebook 08" in text or "notebook 08" in text
+    assert "cycle" in text or "clock" in text
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
+def test_clicking_is_only_mentioned_where_something_is_clickable(path: Path) -> None:
+    """A page exported without a kernel drops ``rfl-live-only`` spans; nothing else asks to click."""
+    from rosfpga_lab.widgets.export import drop_live_only
+
+    text = drop_live_only(markdown(path.name))
+    assert not re.search(r"\b(click|hover)", text, re.I), re.search(r".{0,60}\b(click|hover).{0,60}", text, re.I)[0]
