@@ -150,16 +150,34 @@ def test_wrong_size_and_encoding_are_refused_counted_and_next_frame_is_right(rig
     assert np.array_equal(out.images(good.shape)[0], cv2_dilate(good))
     st = comp.stats
     assert st.refused == 4 and st.published == 1 and comp.running
-    reasons = " | ".join(st.refused_reasons)
-    assert "height: " in reasons and "encoding: " in reasons and "'rgb8'" in reasons
-    assert "'mono8'" in reasons
+    built_for = "not what the circuit was built for"
+    assert st.refused_reasons[f"height: {built_for}"] == 1
+    assert st.refused_reasons[f"encoding: {built_for}"] == 2      # rgb8 and mono8: one kind
+    assert "'rgb8'" in st.refused_examples[f"encoding: {built_for}"]   # the first one's text
     assert sum(st.refused_reasons.values()) == 4
-    assert "refused x" in st.report()
+    assert f"refused x2: encoding: {built_for} (first: " in st.report()
     logged = [r.getMessage() for r in caplog.records if "refused frame" in r.getMessage()]
     assert len(logged) == 4 and any("circuit was built for" in m for m in logged)
     recs = list(comp.recent)
     assert [r.error != "" for r in recs] == [True, True, True, False]  # history 4: last four
     assert recs[-1].result is not None and recs[-1].latency >= 0
+
+
+def test_refusals_count_by_kind_whatever_the_values(rig) -> None:
+    """Reasons carry field values; 30 frames of 30 wrong widths are one kind, not 30 texts
+    (with a cap on distinct texts, everything after the 20th was once counted as "other")."""
+    comp, pub, _out = rig
+    for k in range(30):   # one at a time: the input queue is 2 deep
+        send(pub, picture(k, w=8 + k), k)
+        assert comp.wait_for(k + 1, 10)
+    send(pub, picture(99, c=3), 30, encoding="rgb8")
+    assert comp.wait_for(31, 10)
+    st = comp.stats
+    width = "width: not what the circuit was built for"
+    assert st.refused_reasons == {width: 30, "encoding: not what the circuit was built for": 1}
+    assert "8 but the circuit was built for width 64" in st.refused_examples[width]
+    assert f"refused x30: {width} (first: " in st.report()
+    assert "other" not in st.report()
 
 
 def test_observers_see_frames_and_a_raising_observer_does_not_stop_the_path(rig) -> None:
