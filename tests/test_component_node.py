@@ -342,6 +342,66 @@ def test_master_restart_component_registers_again(master) -> None:
         comp.stop()
 
 
+def test_master_restart_keeps_frames_flowing(master) -> None:
+    """A master restart while a camera streams: the component registers again and keeps the
+    camera's connection (as roscpp does); it used to apply the new master's empty publisher
+    list and cut its input, with no output until the camera registered again (this one never
+    does, like rospy and roscpp nodes). A publisher list from the new master that does not name
+    the camera does not cut it either; when the camera goes, its link is not retried."""
+    port = master.port
+    comp = FpgaComponent.from_config(config(), master_uri=master.uri).start()
+    out = Collector(master)
+    src = Node("/source", master=master)
+    stop = threading.Event()
+    try:
+        pub = src.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+        assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+        link_before = dict(comp._sub._links)
+
+        def stream() -> None:
+            k = 0
+            while not stop.wait(0.05):
+                send(pub, picture(k % 4), k)
+                k += 1
+
+        threading.Thread(target=stream, daemon=True).start()
+        assert out.wait(3, 10)
+        master.stop()
+        deadline = time.monotonic() + 10
+        while comp.stats.master_ok and time.monotonic() < deadline:
+            time.sleep(0.05)
+        with EmbeddedMaster(port=port) as master2:        # back, and empty
+            deadline = time.monotonic() + 10
+            while comp.stats.master_reregistrations == 0 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert comp.stats.master_reregistrations == 1
+            seen = len(out.bodies)
+            assert out.wait(seen + 5, 10), "no output after the component registered again"
+            assert comp._sub._links == link_before        # the same link, never reconnected
+            assert comp.stats.publishers == 1
+            late = Node("/late_source", master=master2)  # the new master's list: late only
+            try:
+                late_pub = late.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+                assert late_pub.wait_for_subscribers(1, 10)
+                assert comp.wait_for_publishers(2, 10)
+                seen = len(out.bodies)
+                assert out.wait(seen + 5, 10)             # the camera still streams
+                assert set(link_before) <= set(comp._sub._links)
+            finally:
+                late.shutdown()
+            stop.set()
+            src.shutdown()                                # the camera goes: no retries
+            deadline = time.monotonic() + 10
+            while comp._sub._links and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert comp._sub._links == {} and comp.stats.publishers == 0   # none retrying
+    finally:
+        stop.set()
+        src.shutdown()
+        out.node.shutdown()
+        comp.stop()
+
+
 def test_stop_is_clean_and_idempotent(master) -> None:
     before = {t.ident for t in threading.enumerate()}
     comp = FpgaComponent.from_config(config(), master=master).start()

@@ -407,13 +407,7 @@ class FpgaComponent:
                 log.error("%s: another node (%s) registered under this name; not registering "
                           "again", self.name, reply[2])
             return False
-        call(self.master_uri, "registerPublisher", self.name, self.output_topic,
-             "sensor_msgs/Image", node.uri, timeout=2.0)
-        reply = call(self.master_uri, "registerSubscriber", self.name, self.input_topic,
-                     "sensor_msgs/Image", node.uri, timeout=2.0)
-        publishers = reply[2] if isinstance(reply, list) and len(reply) == 3 else []
-        node.publisherUpdate("/master", self.input_topic,
-                             [p for p in publishers if isinstance(p, str)])
+        node.register_again()   # established input links stay up (the camera keeps streaming)
         with self._lock:
             self._counts["reregistered"] += 1
         log.warning("%s: the master %s did not know this node (restarted?); registered again",

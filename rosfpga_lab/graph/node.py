@@ -333,6 +333,27 @@ class Node:
         sub._update_publishers([u for u in pubs if isinstance(u, str)])
         return sub
 
+    def register_again(self) -> None:
+        """Register every publisher and subscriber of this node again, after the master
+        restarted and forgot the graph.
+
+        Established input connections stay up, as roscpp's do across a master restart: the new
+        master does not list their publishers until those register again (many never do), so
+        its lists cannot tell a vanished publisher from a forgotten one. Such a link ends when
+        its publisher closes it (see :mod:`rosfpga_lab.graph.subscriber`).
+
+        Raises:
+            MasterError, XmlRpcError: the master refused or cannot be reached.
+        """
+        with self._lock:
+            pubs = list(self.publishers.values())
+            subs = list(self.subscribers.values())
+        for pub in pubs:
+            self._master("registerPublisher", pub.topic, pub.type_name, self.uri)
+        for sub in subs:
+            uris = self._master("registerSubscriber", sub.topic, sub.type_name, self.uri)
+            sub._update_publishers([u for u in uris if isinstance(u, str)], keep_live=True)
+
     def _unsubscribe(self, sub: Subscriber) -> None:
         with self._lock:
             if self.subscribers.get(sub.topic) is sub:
