@@ -22,8 +22,8 @@ from rosfpga_lab.bench.path import (
 )
 from rosfpga_lab.bench.pipeline import PipelineFigures, bench_pipeline
 from rosfpga_lab.component import default_config, expected_output
-from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.config import NodeConfig, load_config
+from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.graph.realros import ROS_PYTHON, ros_env, ros_missing
 
 MIDDLES = ("direct", "component", "roscpp", "rospy")
