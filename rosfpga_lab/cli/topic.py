@@ -25,12 +25,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                           description="Show a topic's type, publishers and subscribers.")
     info.add_argument("topic", help="topic name, e.g. /chatter")
     echo = sub.add_parser("echo", help="print messages",
-                          description="Print the messages published on a topic.")
+                          description="Print the messages published on a topic. A topic not "
+                          "published yet: warn and wait for it, as rostopic does.")
     echo.add_argument("topic", help="topic name")
     echo.add_argument("-n", type=int, default=0, help="exit after N messages (default: forever)")
     echo.add_argument("--hex", action="store_true", help="print the raw body bytes in hex instead")
     echo.add_argument("--timeout", type=float, default=0.0,
-                      help="give up after this many seconds (default: never)")
+                      help="give up after this many seconds, waiting included (default: never)")
     pub = sub.add_parser("pub", help="publish a message",
                          description="Publish a message, e.g.: topic pub /chatter std_msgs/String "
                          "'data: hello'. Arguments are YAML: one mapping, or field values in order.")

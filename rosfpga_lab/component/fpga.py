@@ -16,7 +16,8 @@ is dropped and counted) and behind it in one queue per downstream subscriber
 not held back). A frame the circuit refuses (wrong size, encoding, truncated) is counted under
 its reason and logged; the pipeline has reset itself and the next good frame comes out right.
 A monitor thread checks once a second that the master still knows the node (registering it
-again after a master restart) and logs what changed: drops by either queue, publishers and
+again after a master restart, keeping the established input connections:
+:meth:`rosfpga_lab.graph.Node.register_again`) and logs what changed: drops by either queue, publishers and
 subscribers coming and going.
 
 Observe it live with :meth:`FpgaComponent.add_observer` (called with a :class:`FrameRecord`
