@@ -436,7 +436,8 @@ class XmlRpcServer:
                 try:
                     body = _read_body(conn, buf, headers, deadline)
                 except XmlRpcError as exc:
-                    status = "413 Payload Too Large" if "limit" in str(exc) else "400 Bad Request"
+                    status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
+                              else "400 Bad Request")
                     conn.sendall(_http_response(status, str(exc).encode(), False))
                     return
                 except TimeoutError:
