@@ -1,7 +1,9 @@
 """Helpers for tests that check the lab against real ROS 1 Noetic (Debian's packages).
 
 Debian's rospy, genpy and rosmaster run under the system interpreter ``/usr/bin/python3``, not
-the lab's virtual environment, so every real ROS program is started as a subprocess. On a
+the lab's virtual environment, so every real ROS program is started as a subprocess; the
+interpreter, the environment and the "is it installed" probe come from the library
+(:mod:`rosfpga_lab.graph.realros`, shared with the bench and notebook 7). On a
 machine without ROS, those tests skip with a one-line reason; with ``ROSFPGA_REQUIRE_ROS=1``
 (set by ``.ci/run`` under CI) the same situation is a failure, so CI can never skip them.
 
@@ -17,7 +19,6 @@ import os
 import shutil
 import socket
 import subprocess
-import tempfile
 import threading
 import time
 import xmlrpc.client
@@ -26,7 +27,8 @@ from pathlib import Path
 
 import pytest
 
-ROS_PYTHON = "/usr/bin/python3"
+from rosfpga_lab.graph.realros import ROS_PYTHON, ros_env, ros_missing, user_temp_dir
+
 HERE = Path(__file__).resolve().parent
 ROS_PROGRAMS = HERE / "ros_programs"
 ROSCPP_LIBS = [
@@ -48,19 +50,9 @@ def skip_or_fail(reason: str, variable: str) -> None:
 
 @functools.cache
 def ros_missing_reason() -> str | None:
-    """Why real ROS 1 cannot be used here, or None when it can."""
-    if not Path(ROS_PYTHON).exists():
-        return f"real ROS 1 not installed: {ROS_PYTHON} not found"
-    if shutil.which("rosmaster") is None:
-        return "real ROS 1 not installed: no rosmaster (apt-get install python3-rosmaster)"
-    probe = subprocess.run(
-        [ROS_PYTHON, "-c", "import rospy, genpy, std_msgs.msg, sensor_msgs.msg, geometry_msgs.msg"],
-        capture_output=True, text=True, timeout=60,
-    )
-    if probe.returncode != 0:
-        last = (probe.stderr.strip().splitlines() or ["?"])[-1]
-        return f"real ROS 1 not installed: rospy/genpy do not import ({last})"
-    return None
+    """Why real ROS 1 cannot be used here, or None when it can (the library's probe, plus rosmaster)."""
+    reason = ros_missing(tools=("rosmaster",))
+    return None if reason is None else f"real ROS 1 not installed: {reason}"
 
 
 def require_ros() -> None:
@@ -88,19 +80,6 @@ def free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:
         sock.bind(("127.0.0.1", 0))
         return sock.getsockname()[1]
-
-
-def ros_env(master_uri: str, home: Path | None = None) -> dict[str, str]:
-    """Environment for a real ROS program talking to ``master_uri`` over loopback only."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "PYTHON"))}
-    env.update(
-        ROS_MASTER_URI=master_uri,
-        ROS_HOSTNAME="127.0.0.1",
-        ROS_HOME=str(home or Path(tempfile.gettempdir()) / "rosfpga-lab-ros-home"),
-        ROSCONSOLE_STDOUT_LINE_BUFFERED="1",
-        PYTHONUNBUFFERED="1",
-    )
-    return env
 
 
 def wait_for_master(uri: str, timeout: float = 20.0) -> None:
@@ -197,11 +176,10 @@ def build_roscpp_program(source: Path) -> Path:
     require_cxx()
     text = source.read_bytes()
     digest = hashlib.sha256(text).hexdigest()[:16]
-    cache = Path(tempfile.gettempdir()) / "rosfpga-lab-roscpp-cache"
-    cache.mkdir(exist_ok=True)
+    cache = user_temp_dir("roscpp-cache")   # per user: another user's binaries are not ours
     binary = cache / f"{source.stem}-{digest}"
     if not binary.exists():
-        tmp = binary.with_suffix(".tmp")
+        tmp = binary.with_name(f"{binary.name}.{os.getpid()}.tmp")
         proc = subprocess.run(
             ["g++", "-O1", "-std=c++17", "-o", str(tmp), str(source), *ROSCPP_LIBS],
             capture_output=True, text=True, timeout=300,

@@ -150,16 +150,34 @@ def test_wrong_size_and_encoding_are_refused_counted_and_next_frame_is_right(rig
     assert np.array_equal(out.images(good.shape)[0], cv2_dilate(good))
     st = comp.stats
     assert st.refused == 4 and st.published == 1 and comp.running
-    reasons = " | ".join(st.refused_reasons)
-    assert "height: " in reasons and "encoding: " in reasons and "'rgb8'" in reasons
-    assert "'mono8'" in reasons
+    built_for = "not what the circuit was built for"
+    assert st.refused_reasons[f"height: {built_for}"] == 1
+    assert st.refused_reasons[f"encoding: {built_for}"] == 2      # rgb8 and mono8: one kind
+    assert "'rgb8'" in st.refused_examples[f"encoding: {built_for}"]   # the first one's text
     assert sum(st.refused_reasons.values()) == 4
-    assert "refused x" in st.report()
+    assert f"refused x2: encoding: {built_for} (first: " in st.report()
     logged = [r.getMessage() for r in caplog.records if "refused frame" in r.getMessage()]
     assert len(logged) == 4 and any("circuit was built for" in m for m in logged)
     recs = list(comp.recent)
     assert [r.error != "" for r in recs] == [True, True, True, False]  # history 4: last four
     assert recs[-1].result is not None and recs[-1].latency >= 0
+
+
+def test_refusals_count_by_kind_whatever_the_values(rig) -> None:
+    """Reasons carry field values; 30 frames of 30 wrong widths are one kind, not 30 texts
+    (with a cap on distinct texts, everything after the 20th was once counted as "other")."""
+    comp, pub, _out = rig
+    for k in range(30):   # one at a time: the input queue is 2 deep
+        send(pub, picture(k, w=8 + k), k)
+        assert comp.wait_for(k + 1, 10)
+    send(pub, picture(99, c=3), 30, encoding="rgb8")
+    assert comp.wait_for(31, 10)
+    st = comp.stats
+    width = "width: not what the circuit was built for"
+    assert st.refused_reasons == {width: 30, "encoding: not what the circuit was built for": 1}
+    assert "8 but the circuit was built for width 64" in st.refused_examples[width]
+    assert f"refused x30: {width} (first: " in st.report()
+    assert "other" not in st.report()
 
 
 def test_observers_see_frames_and_a_raising_observer_does_not_stop_the_path(rig) -> None:
@@ -320,6 +338,66 @@ def test_master_restart_component_registers_again(master) -> None:
                 src.shutdown()
             assert "registered again with the master 1 time" in comp.stats.report()
     finally:
+        out.node.shutdown()
+        comp.stop()
+
+
+def test_master_restart_keeps_frames_flowing(master) -> None:
+    """A master restart while a camera streams: the component registers again and keeps the
+    camera's connection (as roscpp does); it used to apply the new master's empty publisher
+    list and cut its input, with no output until the camera registered again (this one never
+    does, like rospy and roscpp nodes). A publisher list from the new master that does not name
+    the camera does not cut it either; when the camera goes, its link is not retried."""
+    port = master.port
+    comp = FpgaComponent.from_config(config(), master_uri=master.uri).start()
+    out = Collector(master)
+    src = Node("/source", master=master)
+    stop = threading.Event()
+    try:
+        pub = src.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+        assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+        link_before = dict(comp._sub._links)
+
+        def stream() -> None:
+            k = 0
+            while not stop.wait(0.05):
+                send(pub, picture(k % 4), k)
+                k += 1
+
+        threading.Thread(target=stream, daemon=True).start()
+        assert out.wait(3, 10)
+        master.stop()
+        deadline = time.monotonic() + 10
+        while comp.stats.master_ok and time.monotonic() < deadline:
+            time.sleep(0.05)
+        with EmbeddedMaster(port=port) as master2:        # back, and empty
+            deadline = time.monotonic() + 10
+            while comp.stats.master_reregistrations == 0 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert comp.stats.master_reregistrations == 1
+            seen = len(out.bodies)
+            assert out.wait(seen + 5, 10), "no output after the component registered again"
+            assert comp._sub._links == link_before        # the same link, never reconnected
+            assert comp.stats.publishers == 1
+            late = Node("/late_source", master=master2)  # the new master's list: late only
+            try:
+                late_pub = late.advertise("/cam", "sensor_msgs/Image", queue_size=0)
+                assert late_pub.wait_for_subscribers(1, 10)
+                assert comp.wait_for_publishers(2, 10)
+                seen = len(out.bodies)
+                assert out.wait(seen + 5, 10)             # the camera still streams
+                assert set(link_before) <= set(comp._sub._links)
+            finally:
+                late.shutdown()
+            stop.set()
+            src.shutdown()                                # the camera goes: no retries
+            deadline = time.monotonic() + 10
+            while comp._sub._links and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert comp._sub._links == {} and comp.stats.publishers == 0   # none retrying
+    finally:
+        stop.set()
+        src.shutdown()
         out.node.shutdown()
         comp.stop()
 

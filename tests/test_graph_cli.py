@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import os
+import socket
 import subprocess
 import sys
 import threading
+import time
 
 import pytest
 
 from realros import free_port, stop_process, wait_for_master
-from rosfpga_lab.graph import EmbeddedMaster, Node
+from rosfpga_lab.graph import MAX_XMLRPC_BODY, MAX_XMLRPC_REPLY, EmbeddedMaster, Node, call
 from rosfpga_lab.graph.tools import RateMeter, format_message, parse_message_value
 from rosfpga_lab.msg import Time, default_registry
 
@@ -185,3 +187,132 @@ def test_out_of_range_ports_are_lab_errors() -> None:
         XmlRpcServer(lambda m, p: 0, port=70000).start()
     with EmbeddedMaster(port=0) as m, pytest.raises(XmlRpcError, match="cannot bind TCPROS port"):
         Node("/n", master=m, tcpros_port=70000)
+
+
+# ---- behaviour as rostopic's (issue 10, defect 9) ---------------------------------------------
+def popen_cli(*args: str) -> subprocess.Popen:
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
+    return subprocess.Popen([sys.executable, "-m", "rosfpga_lab", *args], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=env)
+
+
+def tool_node(m: EmbeddedMaster, topic: str, timeout: float = 20.0) -> str:
+    """Name of the topic tool's node once the master lists it on ``topic``."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        pubs, subs, _ = call(m.uri, "getSystemState", "/test")[2]
+        for t, nodes in pubs + subs:
+            for n in nodes:
+                if t == topic and n.startswith("/rosfpga_lab_topic_"):
+                    return n
+        time.sleep(0.05)
+    raise AssertionError(f"no topic tool registered on {topic}")
+
+
+def test_topic_echo_waits_for_a_topic_not_yet_published() -> None:
+    """rostopic echo prints a warning and waits; it used to exit with "unknown to the master"."""
+    with EmbeddedMaster(port=0) as m:
+        proc = popen_cli("topic", "--master-uri", m.uri, "echo", "-n", "1", "/later")
+        try:
+            assert proc.stderr is not None
+            line = proc.stderr.readline()
+            assert line == "WARNING: topic [/later] does not appear to be published yet\n"
+            time.sleep(0.5)
+            assert proc.poll() is None, "echo gave up instead of waiting"
+            node = Node("/late_talker", master=m)
+            try:
+                node.advertise("/later", "std_msgs/String", latch=True).publish({"data": "now"})
+                out, err = proc.communicate(timeout=20)
+            finally:
+                node.shutdown()
+            assert proc.returncode == 0, err
+            assert out == 'data: "now"\n---\n'
+        finally:
+            stop_process(proc)
+
+
+def test_topic_hz_says_no_new_messages_when_they_stop() -> None:
+    with EmbeddedMaster(port=0) as m:
+        node = Node("/burst", master=m)
+        try:
+            pub = node.advertise("/burst", "std_msgs/String")
+            proc = popen_cli("topic", "--master-uri", m.uri, "hz", "--duration", "5", "/burst")
+            assert pub.wait_for_subscribers(1, 20)
+            for _ in range(30):   # 1.5 s at 20 Hz, then silence
+                pub.publish({"data": "x"})
+                time.sleep(0.05)
+            out, err = proc.communicate(timeout=30)
+        finally:
+            node.shutdown()
+    assert proc.returncode == 0, err
+    lines = out.splitlines()
+    last_rate = max(i for i, line in enumerate(lines) if line.startswith("average rate"))
+    after = [line for line in lines[last_rate + 2:]]
+    assert after and set(after) == {"no new messages"}, out   # not the old rate, again and again
+
+
+@pytest.mark.parametrize("action", [["echo", "/chatter"], ["hz", "/chatter"],
+                                    ["pub", "-l", "/latched", "std_msgs/String", "data: x"]],
+                         ids=lambda a: a[0])
+def test_topic_tools_exit_after_a_remote_shutdown(graph, action: list[str]) -> None:
+    """A slave-API ``shutdown`` ends rostopic with its reason; the lab's tools ran on."""
+    m = graph[0]
+    proc = popen_cli("topic", "--master-uri", m.uri, *action)
+    try:
+        name = tool_node(m, action[1] if action[0] != "pub" else action[2])
+        api = call(m.uri, "lookupNode", "/test", name)[2]
+        assert call(api, "shutdown", "/killer", "go away")[0] == 1
+        out, err = proc.communicate(timeout=15)
+    finally:
+        stop_process(proc)
+    assert proc.returncode == 0, err
+    assert "shutdown request: remote shutdown by /killer: go away" in err
+    assert "Traceback" not in err
+
+
+def test_topic_tools_handle_a_large_graph() -> None:
+    """900 topics with long names: getSystemState is over 8 MiB. rostopic lists them; the lab's
+    tools said "cannot reach the ROS master"."""
+    long = "x" * 5000
+    with EmbeddedMaster(port=0) as m:
+        for i in range(900):
+            call(m.uri, "registerPublisher", f"/node_{i}_{long}", f"/topic_{i}_{long}",
+                 "std_msgs/String", f"http://127.0.0.1:{1000 + i}/")
+        import xmlrpc.client
+
+        reply = xmlrpc.client.dumps((call(m.uri, "getSystemState", "/test"),), methodresponse=True)
+        assert len(reply) > MAX_XMLRPC_BODY
+        out = cli("topic", "--master-uri", m.uri, "list", timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert len(out.stdout.split()) == 900 and f"/topic_7_{long}" in out.stdout.split()
+
+
+def test_a_reply_over_the_cap_is_named_not_called_unreachable() -> None:
+    """A master whose reply is over the client's cap answered: say so, with the sizes."""
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(4)
+    server.settimeout(30)
+    huge = MAX_XMLRPC_REPLY + 1
+
+    def serve() -> None:
+        for _ in range(2):
+            try:
+                conn, _ = server.accept()
+            except OSError:
+                return
+            with conn:
+                conn.recv(65536)
+                conn.sendall(f"HTTP/1.1 200 OK\r\nContent-Length: {huge}\r\n\r\n".encode())
+
+    t = threading.Thread(target=serve, daemon=True)
+    t.start()
+    try:
+        out = cli("topic", "--master-uri", f"http://127.0.0.1:{server.getsockname()[1]}/", "list")
+    finally:
+        server.close()
+        t.join(5)
+    assert out.returncode == 1 and "Traceback" not in out.stderr
+    assert "cannot reach" not in out.stderr
+    assert "answered getUri, but the reply is too large" in out.stderr
+    assert f"HTTP body of {huge} bytes, over the limit of {MAX_XMLRPC_REPLY}" in out.stderr

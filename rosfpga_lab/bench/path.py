@@ -38,7 +38,6 @@ from rosfpga_lab.component import LatencySummary, open_source
 from rosfpga_lab.graph import EmbeddedMaster, GraphError, MessageInfo, Node, call
 from rosfpga_lab.hw import image_frame
 
-ROS_PYTHON = "/usr/bin/python3"
 RELAY_FALLBACK = "/usr/lib/topic_tools/relay"
 PROGRAMS = Path(__file__).resolve().parent / "ros_programs"
 #: Seconds to wait for a middle to register, and for its first frame.
@@ -108,27 +107,6 @@ def find_relay() -> str | None:
         if line.endswith("/relay") and os.access(line, os.X_OK):
             return line
     return None
-
-
-def rospy_missing() -> str | None:
-    """Why the system rospy cannot run, or None."""
-    if not Path(ROS_PYTHON).exists():
-        return f"{ROS_PYTHON} not found"
-    try:
-        probe = subprocess.run([ROS_PYTHON, "-c", "import rospy, sensor_msgs.msg"],
-                               capture_output=True, text=True, timeout=60)
-    except (OSError, subprocess.SubprocessError) as exc:
-        return str(exc)
-    return None if probe.returncode == 0 else "rospy does not import under /usr/bin/python3"
-
-
-def ros_env(master_uri: str) -> dict[str, str]:
-    """Environment for a ROS program on loopback talking to ``master_uri``."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "PYTHON"))}
-    env.update(ROS_MASTER_URI=master_uri, ROS_HOSTNAME="127.0.0.1", PYTHONUNBUFFERED="1",
-               ROS_HOME=str(Path(tempfile.gettempdir()) / "rosfpga-lab-bench-ros-home"),
-               ROSCONSOLE_STDOUT_LINE_BUFFERED="1")
-    return env
 
 
 class _Probe:
@@ -326,5 +304,4 @@ def bench_images(width: int, height: int, encoding: str, n: int = 8) -> list[np.
     return [src.frame(k) for k in range(n)]
 
 
-__all__ = ["PathFigures", "bench_images", "component_command", "find_relay", "measure", "ros_env",
-           "rospy_missing"]
+__all__ = ["PathFigures", "bench_images", "component_command", "find_relay", "measure"]

@@ -18,13 +18,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from rosfpga_lab.bench.path import (
-    PROGRAMS, ROS_PYTHON, PathFigures, bench_images, component_command, find_relay, measure,
-    ros_env, rospy_missing,
+    PROGRAMS, PathFigures, bench_images, component_command, find_relay, measure,
 )
 from rosfpga_lab.bench.pipeline import PipelineFigures, bench_pipeline
 from rosfpga_lab.component import default_config, expected_output
-from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.config import NodeConfig, load_config
+from rosfpga_lab.graph import EmbeddedMaster
+from rosfpga_lab.graph.realros import ROS_PYTHON, ros_env, ros_missing
 
 MIDDLES = ("direct", "component", "roscpp", "rospy")
 
@@ -181,7 +181,7 @@ def run_bench(config: NodeConfig | str | Path | None = None, *, middles: tuple[s
                 plan.append(("roscpp topic_tools relay", [relay, in_topic, out_topic] if relay else None,
                              same, "" if relay else "topic_tools not installed"))
             if "rospy" in middles:
-                missing = rospy_missing()
+                missing = ros_missing()
                 plan.append(("rospy relay (AnyMsg)",
                              None if missing else [ROS_PYTHON, str(PROGRAMS / "rospy_relay.py"),
                                                    in_topic, out_topic],

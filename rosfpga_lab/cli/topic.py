@@ -25,12 +25,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                           description="Show a topic's type, publishers and subscribers.")
     info.add_argument("topic", help="topic name, e.g. /chatter")
     echo = sub.add_parser("echo", help="print messages",
-                          description="Print the messages published on a topic.")
+                          description="Print the messages published on a topic. A topic not "
+                          "published yet: warn and wait for it, as rostopic does.")
     echo.add_argument("topic", help="topic name")
     echo.add_argument("-n", type=int, default=0, help="exit after N messages (default: forever)")
     echo.add_argument("--hex", action="store_true", help="print the raw body bytes in hex instead")
     echo.add_argument("--timeout", type=float, default=0.0,
-                      help="give up after this many seconds (default: never)")
+                      help="give up after this many seconds, waiting included (default: never)")
     pub = sub.add_parser("pub", help="publish a message",
                          description="Publish a message, e.g.: topic pub /chatter std_msgs/String "
                          "'data: hello'. Arguments are YAML: one mapping, or field values in order.")
@@ -77,10 +78,29 @@ def run(args: argparse.Namespace) -> int:
     return _hz(args, uri)
 
 
+def _stopped_remotely(node) -> bool:
+    """True (after printing its reason) when something other than this tool shut the node down
+    (a slave-API ``shutdown``, as rostopic prints it)."""
+    if node.is_shutdown:
+        print(f"shutdown request: {node.shutdown_reason}", file=sys.stderr, flush=True)
+        return True
+    return False
+
+
 def _echo(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import GraphError, tools
 
-    type_name = tools.topic_type(uri, args.topic)
+    start = time.monotonic()
+    try:
+        type_name = tools.wait_for_topic_type(
+            uri, args.topic, args.timeout or None,
+            notice=lambda text: print(text, file=sys.stderr, flush=True))
+    except KeyboardInterrupt:
+        return 1
+    if type_name is None:
+        print(f"topic echo: {args.topic} was not published within {args.timeout} s",
+              file=sys.stderr)
+        return 1
     node = _node(uri, "echo")
     done = threading.Event()
     count = [0]
@@ -106,7 +126,11 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
                              "the raw bytes")
         node.subscribe(args.topic, type_name if known else "*", show, raw=True, queue_size=100,
                        md5sum=None if known else "*")
-        done.wait(args.timeout or None)
+        end = start + args.timeout if args.timeout else None
+        while not done.is_set() and not _stopped_remotely(node):
+            if end is not None and time.monotonic() >= end:
+                break
+            done.wait(0.1)
     except KeyboardInterrupt:
         pass
     finally:
@@ -127,16 +151,15 @@ def _pub(args: argparse.Namespace, uri: str) -> int:
             while not args.count or n < args.count:
                 pub.publish(value)
                 n += 1
-                time.sleep(1.0 / args.rate)
+                if node.wait_for_shutdown(1.0 / args.rate):
+                    _stopped_remotely(node)
+                    break
         else:
             pub.publish(value)
             print(f"publishing and latching message{' for 3.0 seconds' if args.once else '. Press ctrl-C to terminate'}",
                   file=sys.stderr)
-            if args.once:
-                time.sleep(3.0)
-            else:
-                while True:
-                    time.sleep(1.0)
+            if node.wait_for_shutdown(3.0 if args.once else None):
+                _stopped_remotely(node)
     except KeyboardInterrupt:
         pass
     finally:
@@ -155,7 +178,9 @@ def _hz(args: argparse.Namespace, uri: str) -> int:
         print(f"subscribed to [{args.topic}]", flush=True)
         start = time.monotonic()
         while not args.duration or time.monotonic() - start < args.duration:
-            time.sleep(1.0)
+            if node.wait_for_shutdown(1.0):
+                _stopped_remotely(node)
+                break
             report = meter.report()
             print(report if report else "no new messages", flush=True)
     except KeyboardInterrupt:

@@ -16,7 +16,8 @@ is dropped and counted) and behind it in one queue per downstream subscriber
 not held back). A frame the circuit refuses (wrong size, encoding, truncated) is counted under
 its reason and logged; the pipeline has reset itself and the next good frame comes out right.
 A monitor thread checks once a second that the master still knows the node (registering it
-again after a master restart) and logs what changed: drops by either queue, publishers and
+again after a master restart, keeping the established input connections:
+:meth:`rosfpga_lab.graph.Node.register_again`) and logs what changed: drops by either queue, publishers and
 subscribers coming and going.
 
 Observe it live with :meth:`FpgaComponent.add_observer` (called with a :class:`FrameRecord`
@@ -47,7 +48,9 @@ from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineRes
 
 log = logging.getLogger("rosfpga_lab.component")
 
-MAX_REASONS = 20
+#: Refusal kinds counted separately (kinds are field + rule, a few dozen at most; any beyond
+#: this count under "other").
+MAX_REFUSAL_KINDS = 64
 
 
 @dataclass(frozen=True)
@@ -107,6 +110,14 @@ def _reason(exc: PipelineError) -> str:
     if isinstance(exc, FrameFieldError):
         return f"{exc.field}: {text}"
     return text
+
+
+def refusal_kind(exc: PipelineError) -> str:
+    """What a refusal is counted under: ``"field: rule"`` for a bad field (the same for every
+    value that broke the rule), else the stage and the error's class."""
+    if isinstance(exc, FrameFieldError):
+        return exc.kind
+    return f"{exc.stage or 'pipeline'}: {type(exc).__name__}"
 
 
 class FpgaComponent:
@@ -171,7 +182,8 @@ class FpgaComponent:
         self._published_times: collections.deque[float] = collections.deque(maxlen=256)
         self._counts = {"seen": 0, "processed": 0, "published": 0, "refused": 0,
                         "reregistered": 0, "observer_errors": 0}
-        self._reasons: dict[str, int] = {}
+        self._reasons: dict[str, int] = {}        # refusal kind -> count
+        self._examples: dict[str, str] = {}       # refusal kind -> the first reason text seen
         self._high_water: dict[str, int] = {}
         self._last: PipelineResult | None = None
         self._last_error = ""
@@ -305,17 +317,20 @@ class FpgaComponent:
 
     def _refuse(self, exc: PipelineError, frame: bytes, info: MessageInfo) -> None:
         reason = _reason(exc)
+        kind = refusal_kind(exc)
         with self._lock:
             self._counts["seen"] += 1
             self._counts["refused"] += 1
-            key = reason if reason in self._reasons or len(self._reasons) < MAX_REASONS else "other"
-            n = self._reasons[key] = self._reasons.get(key, 0) + 1
+            if kind not in self._reasons and len(self._reasons) >= MAX_REFUSAL_KINDS:
+                kind = "other"
+            n = self._reasons[kind] = self._reasons.get(kind, 0) + 1
+            self._examples.setdefault(kind, reason)
             self._last_error = f"refused a frame from {info.publisher}: {reason}"
             index = self._counts["seen"] - 1
             self._done.notify_all()
         if n <= limits.LOG_FIRST or n % limits.LOG_EVERY == 0:
-            log.warning("%s: refused frame #%d from %s (%d so far for this reason): %s", self.name,
-                        info.index, info.publisher, n, reason)
+            log.warning("%s: refused frame #%d from %s (%d so far of this kind: %s): %s",
+                        self.name, info.index, info.publisher, n, kind, reason)
         self._observe(FrameRecord(index, frame, b"", None, reason, info.publisher, info.received,
                                   time.time()))
 
@@ -393,13 +408,7 @@ class FpgaComponent:
                 log.error("%s: another node (%s) registered under this name; not registering "
                           "again", self.name, reply[2])
             return False
-        call(self.master_uri, "registerPublisher", self.name, self.output_topic,
-             "sensor_msgs/Image", node.uri, timeout=2.0)
-        reply = call(self.master_uri, "registerSubscriber", self.name, self.input_topic,
-                     "sensor_msgs/Image", node.uri, timeout=2.0)
-        publishers = reply[2] if isinstance(reply, list) and len(reply) == 3 else []
-        node.publisherUpdate("/master", self.input_topic,
-                             [p for p in publishers if isinstance(p, str)])
+        node.register_again()   # established input links stay up (the camera keeps streaming)
         with self._lock:
             self._counts["reregistered"] += 1
         log.warning("%s: the master %s did not know this node (restarted?); registered again",
@@ -428,7 +437,7 @@ class FpgaComponent:
             return ComponentStats(
                 received=sub_stats.frames if sub_stats else 0,
                 processed=c["processed"], published=c["published"], refused=c["refused"],
-                refused_reasons=dict(self._reasons),
+                refused_reasons=dict(self._reasons), refused_examples=dict(self._examples),
                 dropped_input=sub_stats.drops if sub_stats else 0,
                 dropped_output=sum(by_peer.values()), dropped_output_by_peer=by_peer,
                 subscribers=pub_stats.connections if pub_stats else 0,

@@ -85,7 +85,9 @@ class ComponentStats:
         processed: frames the circuit turned into output frames.
         published: output frames handed to the publisher (one per processed frame).
         refused: frames the circuit refused (wrong size, encoding, truncated ...).
-        refused_reasons: refusal count per reason (e.g. ``"width: 320 != 640"``).
+        refused_reasons: refusal count per kind of reason, ``"field: rule"`` (e.g.
+            ``"width: not what the circuit was built for"``), whatever the values were.
+        refused_examples: per kind, the full text of its first refusal (with the values).
         dropped_input: frames dropped in front of the circuit (input queue full: the circuit
             was busy).
         dropped_output: frames dropped behind it (a downstream subscriber too slow), over all
@@ -112,6 +114,7 @@ class ComponentStats:
     published: int = 0
     refused: int = 0
     refused_reasons: dict[str, int] = field(default_factory=dict)
+    refused_examples: dict[str, str] = field(default_factory=dict)
     dropped_input: int = 0
     dropped_output: int = 0
     dropped_output_by_peer: dict[str, int] = field(default_factory=dict)
@@ -165,8 +168,9 @@ class ComponentStats:
         if self.fifo_high_water:
             lines.append("FIFO high water: " + ", ".join(
                 f"{name} {n}" for name, n in self.fifo_high_water.items()))
-        for reason, n in sorted(self.refused_reasons.items(), key=lambda kv: -kv[1]):
-            lines.append(f"refused x{n}: {reason}")
+        for kind, n in sorted(self.refused_reasons.items(), key=lambda kv: -kv[1]):
+            example = self.refused_examples.get(kind)
+            lines.append(f"refused x{n}: {kind}" + (f" (first: {example})" if example else ""))
         if self.dropped_input:
             lines.append(f"dropped x{self.dropped_input}: input queue full (the circuit was busy; "
                          "the oldest waiting frame goes)")

@@ -35,6 +35,7 @@ from rosfpga_lab.graph.errors import (
     CONNECT_TIMEOUT,
     MAX_HTTP_HEAD,
     MAX_XMLRPC_BODY,
+    MAX_XMLRPC_REPLY,
     RECONNECT_FIRST,
     RECONNECT_MAX,
     XMLRPC_TIMEOUT,
@@ -43,6 +44,7 @@ from rosfpga_lab.graph.errors import (
     GraphError,
     MasterError,
     XmlRpcError,
+    XmlRpcTooLargeError,
 )
 from rosfpga_lab.graph.master import EmbeddedMaster, ParamTree
 from rosfpga_lab.graph.names import OpenBindWarning, default_host, master_uri_from_env, resolve
@@ -53,10 +55,10 @@ from rosfpga_lab.graph.trace import KINDS, Trace, TraceEvent
 from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call, parse_xmlrpc
 
 __all__ = [
-    "CONNECT_TIMEOUT", "KINDS", "MAX_HTTP_HEAD", "MAX_XMLRPC_BODY", "RECONNECT_FIRST",
+    "CONNECT_TIMEOUT", "KINDS", "MAX_HTTP_HEAD", "MAX_XMLRPC_BODY", "MAX_XMLRPC_REPLY", "RECONNECT_FIRST",
     "RECONNECT_MAX", "XMLRPC_TIMEOUT", "ApiArgumentError", "ConfigError", "EmbeddedMaster",
     "GraphError", "LinkStats", "MasterError", "MessageInfo", "Node", "OpenBindWarning",
     "ParamTree", "Publisher", "PublisherStats", "Subscriber", "SubscriberStats", "Trace",
-    "TraceEvent", "XmlRpcError", "XmlRpcServer", "call", "default_host", "default_master_uri", "master_uri_from_env",
+    "TraceEvent", "XmlRpcError", "XmlRpcTooLargeError", "XmlRpcServer", "call", "default_host", "default_master_uri", "master_uri_from_env",
     "parse_xmlrpc", "resolve", "shared_master", "stop_shared_master",
 ]

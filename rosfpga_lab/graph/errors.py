@@ -11,6 +11,10 @@ from rosfpga_lab.errors import LabError
 #: Largest HTTP request/response body accepted (XML-RPC payloads are small; 8 MiB leaves room
 #: for a big getSystemState or parameter tree).
 MAX_XMLRPC_BODY = 8 << 20
+#: Largest XML-RPC reply body a client call accepts. A master's ``getSystemState`` grows with the
+#: graph (900 topics with long names pass 8 MiB) and rosmaster sets no limit, so replies get more
+#: room than requests; the cap only bounds what a broken or hostile server can make us hold.
+MAX_XMLRPC_REPLY = 64 << 20
 #: Largest HTTP head (request line + headers).
 MAX_HTTP_HEAD = 16 << 10
 #: Seconds an XML-RPC call (connect + request + reply) may take.
@@ -75,6 +79,10 @@ class GraphError(LabError):
 
 class XmlRpcError(GraphError):
     """An XML-RPC call failed: network, HTTP, XML or an XML-RPC fault."""
+
+
+class XmlRpcTooLargeError(XmlRpcError):
+    """An HTTP body (request or reply) is over the size limit; the message gives both sizes."""
 
 
 class MasterError(GraphError):

@@ -177,6 +177,8 @@ class Node:
         #: TCPROS connections closed in their handshake to make room for a newer one
         self.refused_connections = 0
         self.is_shutdown = False
+        self.shutdown_reason = ""   # why it shut down (e.g. a remote slave-API shutdown's message)
+        self._down = threading.Event()
         bind = bind_address(self.host)
         if self.host in ALL_INTERFACES:  # peers need a reachable name, not 0.0.0.0
             self.host = socket.gethostname()
@@ -330,6 +332,27 @@ class Node:
             raise
         sub._update_publishers([u for u in pubs if isinstance(u, str)])
         return sub
+
+    def register_again(self) -> None:
+        """Register every publisher and subscriber of this node again, after the master
+        restarted and forgot the graph.
+
+        Established input connections stay up, as roscpp's do across a master restart: the new
+        master does not list their publishers until those register again (many never do), so
+        its lists cannot tell a vanished publisher from a forgotten one. Such a link ends when
+        its publisher closes it (see :mod:`rosfpga_lab.graph.subscriber`).
+
+        Raises:
+            MasterError, XmlRpcError: the master refused or cannot be reached.
+        """
+        with self._lock:
+            pubs = list(self.publishers.values())
+            subs = list(self.subscribers.values())
+        for pub in pubs:
+            self._master("registerPublisher", pub.topic, pub.type_name, self.uri)
+        for sub in subs:
+            uris = self._master("registerSubscriber", sub.topic, sub.type_name, self.uri)
+            sub._update_publishers([u for u in uris if isinstance(u, str)], keep_live=True)
 
     def _unsubscribe(self, sub: Subscriber) -> None:
         with self._lock:
@@ -508,11 +531,17 @@ class Node:
 
     _api_shutdown.ros_name = "shutdown"  # type: ignore[attr-defined]
 
+    def wait_for_shutdown(self, timeout: float | None = None) -> bool:
+        """Block until the node has shut down (by :meth:`shutdown` or a remote slave-API
+        ``shutdown``; :attr:`shutdown_reason` says which); False when ``timeout`` ran out."""
+        return self._down.wait(timeout)
+
     def _shutdown(self, reason: str = "") -> None:
         with self._lock:
             if self.is_shutdown:
                 return
             self.is_shutdown = True
+            self.shutdown_reason = reason or "shut down"
             pubs = list(self.publishers.values())
             subs = list(self.subscribers.values())
             self.publishers.clear()
@@ -533,3 +562,4 @@ class Node:
         if self._accept is not threading.current_thread():
             self._accept.join(JOIN_TIMEOUT)
         self._xmlrpc.stop()
+        self._down.set()

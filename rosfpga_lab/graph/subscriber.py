@@ -10,6 +10,12 @@ longer than that is cut, keeping the links already open, and logged). A dispatch
 stalls the socket. When a connection drops, the link retries with exponential back-off
 (0.1 s doubling up to ``RECONNECT_MAX``) for as long as the master still lists that
 publisher; a refused handshake (md5 mismatch, ``error=`` reply) is not retried.
+
+Across a master restart (:meth:`Node.register_again`) established links are kept, as roscpp keeps
+them: the new master does not list their publishers until those register again (rospy and
+roscpp never do), so such a link is *kept* rather than confirmed. Later publisher lists never
+remove a kept link; one that lists its publisher confirms it; when its publisher closes the
+connection, it ends without retrying.
 """
 
 from __future__ import annotations
@@ -87,6 +93,7 @@ class _PublisherLink:
         self.stop = threading.Event()
         self.sock: socket.socket | None = None
         self.connected = False
+        self.kept = False   # kept across a master restart, not (yet) listed by the master
         self.permanent_error: str | None = None
         self.thread = threading.Thread(target=self._run, daemon=True,
                                        name=f"rosfpga-sub-link-{sub.topic}")
@@ -106,6 +113,8 @@ class _PublisherLink:
                     self.sub._error(f"{self.pub_uri}: {exc}")
             finally:
                 self._drop_socket()
+            if self.kept and self.sub._forget(self):
+                return  # its publisher closed it and the master does not list it: no retry
             if self.stop.wait(delay):
                 return
             delay = min(delay * RECONNECT_FACTOR, RECONNECT_MAX)
@@ -246,7 +255,12 @@ class Subscriber:
         self._dispatcher.start()
 
     # ----------------------------------------------------------------- publishers
-    def _update_publishers(self, uris: list[str]) -> None:
+    def _update_publishers(self, uris: list[str], *, keep_live: bool = False) -> None:
+        """Make the links follow the master's publisher list ``uris``.
+
+        With ``keep_live`` (a restarted master's first list), a connected link whose publisher
+        is not listed is kept (see the module docstring) instead of closed.
+        """
         with self._lock:
             if self.closed:
                 return
@@ -261,15 +275,29 @@ class Subscriber:
                 self._error(text)
                 keep = set(kept)
                 wanted = [u for u in wanted if u in keep]
-            gone = [u for u in self._links if u not in wanted]
-            for uri in gone:
+            for uri in [u for u in self._links if u not in wanted]:
+                link = self._links[uri]
+                if link.kept or keep_live and link.connected:
+                    link.kept = True
+                    continue
                 self._links.pop(uri).close()
             for uri in wanted:
                 link = self._links.get(uri)
+                if link is not None:
+                    link.kept = False   # the master lists it again: an ordinary link
                 if link is None or not link.thread.is_alive() and link.permanent_error is None:
                     link = _PublisherLink(self, uri)
                     self._links[uri] = link
                     link.thread.start()
+
+    def _forget(self, link: _PublisherLink) -> bool:
+        """Drop a kept link whose connection ended; False when the master listed it meanwhile."""
+        with self._lock:
+            if not link.kept:
+                return False
+            if self._links.get(link.pub_uri) is link:
+                del self._links[link.pub_uri]
+            return True
 
     def _connections_changed(self, delta: int) -> None:
         with self._cond:

@@ -8,11 +8,12 @@ from __future__ import annotations
 import math
 import statistics
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-from rosfpga_lab.graph.errors import GraphError, MasterError
+from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcTooLargeError
 from rosfpga_lab.graph.names import master_uri_from_env
 from rosfpga_lab.graph.xmlrpc import call
 
@@ -20,6 +21,8 @@ DEFAULT_MASTER_URI = "http://127.0.0.1:11311/"
 #: Arrays longer than this are summarised by :func:`format_message` (rostopic echo --noarr style).
 MAX_ARRAY_SHOWN = 64
 TOOL_ID = "/rosfpga_lab_topic"
+#: Seconds between two asks of the master while waiting for a topic to appear (rostopic: 0.1).
+TOPIC_POLL = 0.1
 
 
 def pick_master_uri(explicit: str | None = None) -> str:
@@ -35,6 +38,9 @@ def master_call(uri: str, method: str, *args: Any) -> Any:
     """
     try:
         reply = call(uri, method, TOOL_ID, *args, timeout=5.0)
+    except XmlRpcTooLargeError as exc:  # the master answered: it is not "unreachable"
+        raise GraphError(f"the ROS master at {uri} answered {method}, but the reply is too large "
+                         f"for this tool ({exc})") from None
     except GraphError as exc:
         raise GraphError(f"cannot reach the ROS master at {uri} ({exc}). Start one with "
                          "`rosfpga-lab master` (or roscore), or set ROS_MASTER_URI.") from None
@@ -69,6 +75,35 @@ def topic_type(uri: str, topic: str) -> str:
         raise GraphError(f"topic {topic} is unknown to the master at {uri} "
                          f"(known: {', '.join(sorted(types)) or 'none'})")
     return types[topic]
+
+
+def wait_for_topic_type(uri: str, topic: str, timeout: float | None = None,
+                        notice: Callable[[str], Any] | None = None) -> str | None:
+    """The type of ``topic``, waiting until the master knows it (as ``rostopic echo`` does).
+
+    Args:
+        timeout: seconds to wait; None: for ever.
+        notice: called once with a warning text when the topic is not known yet.
+
+    Returns:
+        The type, or None when ``timeout`` ran out first.
+
+    Raises:
+        GraphError: the master cannot be reached.
+    """
+    deadline = None if timeout is None else time.monotonic() + timeout
+    warned = False
+    while True:
+        found = topic_types(uri).get(topic)
+        if found is not None:
+            return found
+        if not warned and notice is not None:
+            notice(f"WARNING: topic [{topic}] does not appear to be published yet")
+            warned = True
+        if deadline is not None and time.monotonic() >= deadline:
+            return None
+        time.sleep(TOPIC_POLL if deadline is None else
+                   max(0.0, min(TOPIC_POLL, deadline - time.monotonic())))
 
 
 def format_topic_list(uri: str, verbose: bool = False) -> str:
@@ -201,6 +236,7 @@ class RateMeter:
         self.window = window
         self.times: list[float] = []
         self.count = 0
+        self.reported = 0   # count at the last report
 
     def tick(self, t: float | None = None) -> None:
         """Record one arrival (now by default)."""
@@ -209,9 +245,11 @@ class RateMeter:
         del self.times[:-self.window - 1]
 
     def report(self) -> str | None:
-        """rostopic-style report, or None before two messages arrived."""
-        if len(self.times) < 2:
+        """rostopic-style report; None (print "no new messages") before two messages arrived or
+        when none arrived since the last report (the old rate would hide that they stopped)."""
+        if len(self.times) < 2 or self.count == self.reported:
             return None
+        self.reported = self.count
         gaps = [b - a for a, b in zip(self.times, self.times[1:])]
         mean = sum(gaps) / len(gaps)
         std = statistics.pstdev(gaps)

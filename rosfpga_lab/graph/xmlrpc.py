@@ -33,11 +33,13 @@ from rosfpga_lab.graph.errors import (
     MAX_XMLRPC_BODY,
     MAX_XMLRPC_CONNECTIONS,
     MAX_XMLRPC_DEPTH,
+    MAX_XMLRPC_REPLY,
     XMLRPC_IDLE_TIMEOUT,
     XMLRPC_REQUEST_TIMEOUT,
     XMLRPC_TIMEOUT,
     ConfigError,
     XmlRpcError,
+    XmlRpcTooLargeError,
 )
 from rosfpga_lab.graph.trace import Trace
 from rosfpga_lab.graph.wire import accept_loop, hard_close
@@ -230,25 +232,28 @@ def _parse_head(head: bytes) -> tuple[str, dict[str, str]]:
 
 
 def _read_body(sock: socket.socket, buf: bytearray, headers: dict[str, str],
-               deadline: _Deadline, *, until_eof: bool = False) -> bytes:
+               deadline: _Deadline, *, until_eof: bool = False,
+               limit: int = MAX_XMLRPC_BODY) -> bytes:
     length_text = headers.get("content-length")
     if length_text is None:
         if not until_eof:
             raise XmlRpcError("HTTP message without Content-Length")
-        while len(buf) <= MAX_XMLRPC_BODY:
+        while len(buf) <= limit:
             chunk = deadline.recv(sock, 65536)
             if not chunk:
                 body = bytes(buf)
                 buf.clear()
                 return body
             buf += chunk
-        raise XmlRpcError(f"HTTP body over the limit of {MAX_XMLRPC_BODY} bytes")
+        raise XmlRpcTooLargeError(f"HTTP body over the limit of {limit} bytes")
     try:
         length = int(length_text)
     except ValueError:
         raise XmlRpcError(f"bad Content-Length {length_text!r}") from None
-    if length < 0 or length > MAX_XMLRPC_BODY:
-        raise XmlRpcError(f"HTTP body of {length} bytes, over the limit of {MAX_XMLRPC_BODY}")
+    if length < 0:
+        raise XmlRpcError(f"bad Content-Length {length_text!r}")
+    if length > limit:
+        raise XmlRpcTooLargeError(f"HTTP body of {length} bytes, over the limit of {limit}")
     while len(buf) < length:
         chunk = deadline.recv(sock, min(max(65536, length - len(buf)), 1 << 20))
         if not chunk:
@@ -431,7 +436,8 @@ class XmlRpcServer:
                 try:
                     body = _read_body(conn, buf, headers, deadline)
                 except XmlRpcError as exc:
-                    status = "413 Payload Too Large" if "limit" in str(exc) else "400 Bad Request"
+                    status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
+                              else "400 Bad Request")
                     conn.sendall(_http_response(status, str(exc).encode(), False))
                     return
                 except TimeoutError:
@@ -542,11 +548,15 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
             if reply_head is None:
                 raise XmlRpcError("connection closed before any reply")
             status_line, headers = _parse_head(reply_head)
-            reply_body = _read_body(sock, buf, headers, deadline, until_eof=True)
+            reply_body = _read_body(sock, buf, headers, deadline, until_eof=True,
+                                    limit=MAX_XMLRPC_REPLY)
     except (OSError, XmlRpcError) as exc:
         if trace is not None:
             trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or uri,
                          method=method, args=list(params), result=f"error: {exc}", raw=request, t0=t0)
+        if isinstance(exc, XmlRpcTooLargeError):  # the server answered: say so, not "failed"
+            raise XmlRpcTooLargeError(f"XML-RPC call {method} to {uri}: the reply's {exc} "
+                                      "(graph.errors.MAX_XMLRPC_REPLY)") from None
         raise XmlRpcError(f"XML-RPC call {method} to {uri} failed: {exc}") from None
     if trace is not None:
         ev = trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or trace.name_of(uri),

@@ -39,26 +39,43 @@ class FrameFieldError(PipelineError):
         field: the field name (``"height"``, ``"encoding"``, ``"data length"`` ...).
         offset: byte offset of the field's first byte in the TCPROS frame.
         value: the decoded value.
+        rule: the rule the value broke, in a few words without the value (``"over the limit"``,
+            ``"not what the circuit was built for"`` ...): refusals count by :attr:`kind`.
     """
 
+    #: The rule when the raiser names none.
+    default_rule = "value refused"
+
     def __init__(self, message: str, field: str, offset: int, value: Any = None,
-                 stage: str = "interpreter") -> None:
+                 stage: str = "interpreter", *, rule: str = "") -> None:
         self.field = field
         self.offset = offset
         self.value = value
+        self.rule = rule or self.default_rule
         super().__init__(f"field {field!r} at byte {offset}: {message}", stage)
+
+    @property
+    def kind(self) -> str:
+        """``"field: rule"``: the same for every frame that broke the same rule, whatever its value."""
+        return f"{self.field}: {self.rule}"
 
 
 class UnsupportedEncodingError(FrameFieldError):
     """The frame's ``encoding`` is not one the circuit packs (see ``hw.PIXEL_FORMATS``)."""
 
+    default_rule = "unsupported encoding"
+
 
 class FrameTruncatedError(FrameFieldError):
     """The frame ended (or its ``frame length`` ran out) before the named field was complete."""
 
+    default_rule = "cut short"
+
 
 class FrameLengthError(FrameFieldError):
     """The 4-byte frame length disagrees with the message it announces."""
+
+    default_rule = "frame length disagrees"
 
 
 class StreamStarvedError(PipelineError):

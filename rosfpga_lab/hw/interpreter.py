@@ -314,24 +314,28 @@ class Interpreter:
         raise error
 
     # -- the checks run when a field completes ------------------------------------------------
-    def _refuse(self, t: Transition, message: str, value: Any, cls: type = FrameFieldError) -> None:
-        self._fail(cls(message, t.label, self._field_start, value))
+    def _refuse(self, t: Transition, message: str, value: Any, cls: type = FrameFieldError, *,
+                rule: str = "") -> None:
+        self._fail(cls(message, t.label, self._field_start, value, rule=rule))
 
     def _check_frame_length(self, value: int, t: Transition) -> None:
         if value < MIN_BODY_BYTES:
             self._refuse(t, f"{value} is shorter than the smallest sensor_msgs/Image "
-                            f"({MIN_BODY_BYTES} bytes)", value, FrameLengthError)
+                            f"({MIN_BODY_BYTES} bytes)", value, FrameLengthError,
+                         rule="below the minimum")
         if value > limits.MAX_FRAME_BYTES:
             self._refuse(t, f"{value} exceeds the limit of {limits.MAX_FRAME_BYTES} bytes "
-                            "(hw.limits.MAX_FRAME_BYTES)", value, FrameLengthError)
+                            "(hw.limits.MAX_FRAME_BYTES)", value, FrameLengthError,
+                         rule="over the limit")
 
     def _check_string(self, value: int, t: Transition, limit: int, limit_name: str) -> None:
         if value > limit:
-            self._refuse(t, f"{value} exceeds the limit of {limit} bytes ({limit_name})", value)
+            self._refuse(t, f"{value} exceeds the limit of {limit} bytes ({limit_name})", value,
+                         rule="over the limit")
         left = 4 + self.values["frame_length"] - self.offset
         if value > left:
             self._refuse(t, f"{value} bytes announced but the frame length leaves only {left}",
-                         value, FrameLengthError)
+                         value, FrameLengthError, rule="past the frame end")
 
     def _check_frame_id_length(self, value: int, t: Transition) -> None:
         self._check_string(value, t, self.max_frame_id_bytes, "max_frame_id_bytes")
@@ -341,12 +345,14 @@ class Interpreter:
 
     def _check_dimension(self, value: int, t: Transition, limit: int, configured: int | None) -> None:
         if value == 0:
-            self._refuse(t, "is 0: an image needs at least one row and one column", value)
+            self._refuse(t, "is 0: an image needs at least one row and one column", value,
+                         rule="zero")
         if value > limit:
             self._refuse(t, f"{value} exceeds the limit of {limit} (hw.limits.MAX_{t.field.upper()})",
-                         value)
+                         value, rule="over the limit")
         if configured is not None and value != configured:
-            self._refuse(t, f"{value} but the circuit was built for {t.field} {configured}", value)
+            self._refuse(t, f"{value} but the circuit was built for {t.field} {configured}", value,
+                         rule="not what the circuit was built for")
 
     def _check_height(self, value: int, t: Transition) -> None:
         self._check_dimension(value, t, limits.MAX_HEIGHT, self.height)
@@ -360,7 +366,7 @@ class Interpreter:
                             f"{', '.join(PIXEL_FORMATS)}", value, UnsupportedEncodingError)
         if self.encoding is not None and value != self.encoding:
             self._refuse(t, f"{value!r} but the circuit was built for {self.encoding!r}", value,
-                         UnsupportedEncodingError)
+                         UnsupportedEncodingError, rule="not what the circuit was built for")
 
     def _check_step(self, value: int, t: Transition) -> None:
         row = self.values["width"] * PIXEL_FORMATS[self.values["encoding"]].bytes_per_pixel
@@ -368,13 +374,14 @@ class Interpreter:
             self._refuse(t, f"{value} but width {self.values['width']} x "
                             f"{PIXEL_FORMATS[self.values['encoding']].bytes_per_pixel} bytes/pixel "
                             f"({self.values['encoding']}) = {row}; padded rows are not supported",
-                         value)
+                         value, rule="not width x bytes per pixel")
 
     def _check_data_length(self, value: int, t: Transition) -> None:
         expected = self.values["step"] * self.values["height"]
         if value != expected:
             self._refuse(t, f"{value} but step x height = {self.values['step']} x "
-                            f"{self.values['height']} = {expected}", value)
+                            f"{self.values['height']} = {expected}", value,
+                         rule="not step x height")
         left = 4 + self.values["frame_length"] - self.offset
         if value != left:
             self._fail(FrameLengthError(
