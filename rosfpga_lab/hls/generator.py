@@ -32,7 +32,7 @@ from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, SOURCES
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
 from rosfpga_lab.hw import limits as hw_limits
-from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, fixed_after
+from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, SUBSCRIBER_STATUSES, fixed_after
 from rosfpga_lab.msg import default_registry
 from rosfpga_lab.tcpros import encode_header
 
@@ -188,8 +188,7 @@ def render(config: NodeConfig) -> dict[str, str]:
                             "the templates know; update templates/subscriber.cpp.j2")
     img = config.image
     fmt = PIXEL_FORMATS[img.encoding]
-    checked = [{"status": f"SUB_BAD_{t.field.upper()}", "label": t.label}
-               for t in INTERPRETER_TABLE if t.check and t.check != "frame_end"]
+    checked = [{"status": name, "label": label} for name, label in SUBSCRIBER_STATUSES[1:]]
     status_of = {t.field: f"SUB_BAD_{t.field.upper()}" for t in INTERPRETER_TABLE}
     interp = [{"field": t.field, "label": t.label, "kind": t.kind, "status": status_of[t.field]}
               for t in INTERPRETER_TABLE]
