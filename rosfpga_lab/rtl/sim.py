@@ -91,30 +91,40 @@ def verilog_sources() -> list[Path]:
     return sorted(VERILOG_DIR.glob("*.v"))
 
 
-def write_sources(params: RtlParams, dest: str | Path, *, note: str = "",
-                  extra_sources: Sequence[str | Path] = ()) -> list[str]:
-    """Copy the Verilog and the testbench into ``dest`` and write ``rfl_node.v``.
+def source_files(params: RtlParams, *, note: str = "",
+                 extra_sources: Sequence[str | Path] = ()) -> dict[str, bytes]:
+    """The simulation's files: the lab's Verilog, the status include, the testbench, ``rfl_node.v``.
 
     Args:
         params: the configuration's parameters.
-        dest: the directory (created when missing).
         note: a comment line for ``rfl_node.v``.
-        extra_sources: further Verilog files to copy (a module the package lacks).
+        extra_sources: further Verilog files (a module the package lacks).
 
     Returns:
-        The file names written, relative to ``dest``, sorted.
+        ``{file name: bytes}``.
+    """
+    have = {p.name for p in verilog_sources()}
+    files = {}
+    for src in [*verilog_sources(), VERILOG_DIR / STATUS_HEADER, *sorted(TB_DIR.glob("*.v")),
+                *(Path(p) for p in extra_sources if Path(p).name not in have)]:
+        files[src.name] = src.read_bytes()
+    files[NODE_FILE] = node_wrapper(params, note).encode("utf-8")
+    return files
+
+
+def write_sources(params: RtlParams, dest: str | Path, *, note: str = "",
+                  extra_sources: Sequence[str | Path] = ()) -> list[str]:
+    """Write :func:`source_files` into ``dest`` (created when missing).
+
+    Returns:
+        The file names written, sorted.
     """
     out = Path(dest)
     out.mkdir(parents=True, exist_ok=True)
-    written = []
-    have = {p.name for p in verilog_sources()}
-    for src in [*verilog_sources(), VERILOG_DIR / STATUS_HEADER, *sorted(TB_DIR.glob("*.v")),
-                *(Path(p) for p in extra_sources if Path(p).name not in have)]:
-        (out / src.name).write_bytes(src.read_bytes())
-        written.append(src.name)
-    (out / NODE_FILE).write_text(node_wrapper(params, note), encoding="utf-8")
-    written.append(NODE_FILE)
-    return sorted(written)
+    files = source_files(params, note=note, extra_sources=extra_sources)
+    for name, data in files.items():
+        (out / name).write_bytes(data)
+    return sorted(files)
 
 
 @dataclass(frozen=True)
