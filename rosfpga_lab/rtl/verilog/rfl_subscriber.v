@@ -128,12 +128,21 @@ module rfl_subscriber #(
                 cnt <= cnt + 32'd1;
                 case (state)
                     S_FLEN: if (u32_done) begin
-                        if (value < MIN_BODY || value > MAX_FRAME) begin
+                        if (value > MAX_FRAME) begin
                             // Not to be trusted for skipping: wait for the next frame length.
                             status_valid <= 1'b1;
                             status <= SUB_BAD_FRAME_LENGTH;
                             cnt <= 32'd0;
                             pos <= 32'd0;
+                        end else if (value < MIN_BODY) begin
+                            // Too short for an Image, but framed: skip its bytes, as the HLS
+                            // testbench and the Python interpreter do.
+                            status_valid <= 1'b1;
+                            status <= SUB_BAD_FRAME_LENGTH;
+                            cnt <= 32'd0;
+                            endp <= value + 32'd4;
+                            if (value == 0) pos <= 32'd0;
+                            else state <= S_SKIP;
                         end else begin
                             endp <= value + 32'd4;
                             advance(S_SEQ);

@@ -1,0 +1,217 @@
+"""The Verilog RTL of the message path, simulated, against the Python models and the HLS C++.
+
+The file-based testbench (``rosfpga_lab/rtl/tb/rfl_tb.v``) streams TCPROS frames, serialized by
+real ROS (genpy) where it is installed, into the circuit with random input gaps and random
+output backpressure; every output byte must equal the Python models' (:class:`hw.Pipeline`)
+and, where g++ is present, the HLS C simulation's. Small images keep Icarus Verilog quick; the
+640x480 ``rgba8`` frame runs on Verilator when it is installed. Without a simulator these tests
+skip; with ROSFPGA_REQUIRE_RTL=1 (CI) they fail.
+"""
+
+from __future__ import annotations
+
+import struct
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from realros import cxx_missing_reason, require_rtl
+from rosfpga_lab.hls import generate, load_config, parse_config, pipeline_for, run_csim, sample_frames
+from rosfpga_lab.hw import PIXEL_FORMATS, PipelineError, image_frame
+from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
+from rosfpga_lab.rtl import RtlError, build, rtl_params, run, status_header
+from rosfpga_lab.rtl.params import STATUS_HEADER
+from rosfpga_lab.rtl.project import generate_project
+from rosfpga_lab.rtl.sim import VERILOG_DIR
+from test_hls_csim import ros_frame
+
+pytestmark = pytest.mark.rtl
+
+ROOT = Path(__file__).resolve().parent.parent
+DATA = ROOT / "data"
+SMALL = {"rgba8": ("dilate", 3), "bgra8": ("erode", 3), "rgb8": ("dilate", 5),
+         "bgr8": ("passthrough", 3), "mono8": ("erode", 5)}
+
+
+def small_config(encoding: str, width: int = 11, height: int = 7, frame_id_max: int = 256):
+    op, ksize = SMALL[encoding]
+    text = (DATA / "fpga_dilate_rgba8.yaml").read_text()
+    text = text.replace("width: 640", f"width: {width}").replace("height: 480", f"height: {height}")
+    text = text.replace("encoding: rgba8", f"encoding: {encoding}")
+    text = text.replace("op: dilate", f"op: {op}").replace("ksize: 3", f"ksize: {ksize}")
+    text = text.replace("frame_id_max: 256", f"frame_id_max: {frame_id_max}")
+    return parse_config(text, source=f"small_{encoding}.yaml")
+
+
+def random_image(config, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    img = config.image
+    image = rng.integers(0, 256, (img.height, img.width, img.bytes_per_pixel), dtype=np.uint8)
+    image[rng.random((img.height, img.width)) < 0.8] //= 4
+    return image
+
+
+def model_output(config, frames: list[bytes]) -> tuple[bytes, list[str]]:
+    """What the Python models send for ``frames``, and accepted/refused per frame."""
+    pipe = pipeline_for(config)
+    out, verdicts = b"", []
+    for frame in frames:
+        try:
+            out += pipe.process(frame).output_frame
+            verdicts.append("SUB_OK")
+        except PipelineError:
+            verdicts.append("refused")
+    return out, verdicts
+
+
+def test_status_include_is_generated_from_the_interpreter_table() -> None:
+    assert (VERILOG_DIR / STATUS_HEADER).read_text() == status_header()
+    assert status_header().count("localparam") == len(SUBSCRIBER_STATUSES)
+
+
+@pytest.mark.parametrize("encoding", list(PIXEL_FORMATS))
+def test_every_encoding_with_random_gaps_and_backpressure(encoding: str, tmp_path: Path) -> None:
+    """Three frames (genpy-serialized where ROS is installed), frame_ids of several lengths,
+    30 % input gaps and 50 % output backpressure: bytes equal to the models' and the csim's."""
+    sim_name = require_rtl()
+    config = small_config(encoding)
+    frames = [ros_frame(random_image(config, seed), encoding, seq=seed, stamp=(seed, 1000 + seed),
+                        frame_id="f" * (seed * 5)) for seed in (1, 2, 3)]
+    sim = build(rtl_params(config), tmp_path / "rtl", simulator=sim_name)
+    got = run(sim, b"".join(frames), seed=7, gap=300, bp=500)
+    expected, verdicts = model_output(config, frames)
+    assert verdicts == ["SUB_OK"] * 3
+    offsets = [0, len(frames[0]), len(frames[0]) + len(frames[1])]
+    assert got.status == tuple((o, "SUB_OK") for o in offsets)
+    assert got.output == expected
+    assert got.streams["app_in"].count == 3 * config.image.width * config.image.height
+    if cxx_missing_reason() is None:
+        generate(config, tmp_path / "hls")
+        csim = run_csim(tmp_path / "hls", b"".join(frames))
+        assert csim.output == got.output
+
+
+def test_every_refusal_reason_then_a_good_frame(tmp_path: Path) -> None:
+    """Each status of the interpreter's table, each followed by a good frame: the RTL refuses
+    what the HLS subscriber and the Python interpreter refuse, and numbers the good ones 1, 2..."""
+    sim_name = require_rtl()
+    config = small_config("mono8", frame_id_max=16)
+    image = random_image(config, 5)
+    h, w = image.shape[:2]
+    good = [ros_frame(random_image(config, 10 + i), "mono8", seq=i, frame_id=f"g{i}")
+            for i in range(len(SUBSCRIBER_STATUSES))]
+
+    def body(frame: bytes) -> bytes:
+        return frame[4:]
+
+    def framed(b: bytes) -> bytes:
+        return struct.pack("<I", len(b)) + b
+
+    stamp = struct.pack("<III", 1, 2, 3)
+    bad = {
+        "SUB_BAD_FRAME_LENGTH": struct.pack("<I", 10) + bytes(10),
+        "SUB_BAD_FRAME_ID_LENGTH": image_frame(image, "mono8", frame_id="f" * 17),
+        "SUB_BAD_HEIGHT": image_frame(image[:-1], "mono8"),
+        "SUB_BAD_WIDTH": image_frame(image[:, :-1], "mono8"),
+        "SUB_BAD_ENCODING_LENGTH": framed(stamp + struct.pack("<I", 3) + b"cam"
+                                          + struct.pack("<III", h, w, 5) + b"mono8" + b"\x00\x40"),
+        "SUB_BAD_ENCODING": image_frame(np.repeat(image, 3, axis=2)[:, :, :3], "rgb8"),
+        "SUB_BAD_STEP": framed(body(image_frame(image, "mono8"))[:-8 - image.size]
+                               + struct.pack("<II", w + 1, image.size) + image.tobytes()),
+        "SUB_BAD_DATA_LENGTH": framed(body(image_frame(image, "mono8"))[:-4 - image.size]
+                                      + struct.pack("<I", image.size - 1) + image.tobytes()[:-1]),
+    }
+    assert set(bad) == {name for name, _ in SUBSCRIBER_STATUSES[1:]}  # every reason, no more
+    frames, names = [], []
+    for i, (name, frame) in enumerate(bad.items()):
+        frames += [frame, good[i]]
+        names += [name, "SUB_OK"]
+    sim = build(rtl_params(config), tmp_path / "rtl", simulator=sim_name)
+    got = run(sim, b"".join(frames), seed=3, gap=200, bp=300)
+    offsets = np.cumsum([0] + [len(f) for f in frames])[:-1]
+    assert got.status == tuple((int(o), n) for o, n in zip(offsets, names))
+    expected, verdicts = model_output(config, frames)
+    assert verdicts == ["refused" if n != "SUB_OK" else "SUB_OK" for n in names]
+    assert got.output == expected
+    if cxx_missing_reason() is None:
+        generate(config, tmp_path / "hls")
+        csim = run_csim(tmp_path / "hls", b"".join(frames))
+        assert [s for _, s in csim.status] == names
+        assert csim.output == got.output
+
+
+@pytest.mark.parametrize("stem", ["fpga_erode_mono8", "fpga_passthrough_rgb8"])
+def test_shipped_configs_with_backpressure(stem: str, tmp_path: Path) -> None:
+    sim_name = require_rtl()
+    config = load_config(DATA / f"{stem}.yaml")
+    frame, expected = sample_frames(config)
+    sim = build(rtl_params(config), tmp_path / "rtl", simulator=sim_name)
+    got = run(sim, frame, seed=11, gap=100, bp=500)
+    assert got.status == ((0, "SUB_OK"),)
+    assert got.output == expected
+
+
+def test_full_640x480_rgba8_frame(tmp_path: Path) -> None:
+    """The paper's component on one whole frame (Verilator when installed: seconds, not minutes)."""
+    sim_name = "verilator" if _has("verilator") else require_rtl()
+    config = load_config(DATA / "fpga_dilate_rgba8.yaml")
+    image = random_image(config, 640)
+    frame = ros_frame(image, "rgba8", seq=9, frame_id="camera")
+    sim = build(rtl_params(config), tmp_path / "rtl", simulator=sim_name)
+    got = run(sim, frame, seed=5, gap=50, bp=100)
+    assert got.status == ((0, "SUB_OK"),)
+    expected, _ = model_output(config, [frame])
+    assert len(got.output) == len(expected) == 4 + 37 + 6 + 5 + 640 * 480 * 4
+    assert got.output == expected
+
+
+def _has(simulator: str) -> bool:
+    from rosfpga_lab.rtl import simulator_missing_reason
+    return simulator_missing_reason(simulator) is None
+
+
+def test_make_rtlsim_passes_and_fails_on_a_difference(tmp_path: Path) -> None:
+    require_rtl("iverilog")
+    config = load_config(DATA / "fpga_passthrough_rgb8.yaml")
+    result = generate_project(config, tmp_path / "proj")
+    assert "rtl/rfl_node.v" in result.files and "rtl/rfl_tb.v" in result.files
+    proj = tmp_path / "proj"
+    proc = subprocess.run(["make", "-s", "rtlsim", "SIM=iverilog", "GAP=100", "BP=200"], cwd=proj,
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "rtlsim: PASS: output equals tb_expected.bin" in proc.stdout
+    assert (proj / "rtlsim_out" / "output.bin").read_bytes() == (proj / "tb_expected.bin").read_bytes()
+    wrong = bytearray((proj / "tb_expected.bin").read_bytes())
+    wrong[-1] ^= 1
+    (proj / "wrong.bin").write_bytes(bytes(wrong))
+    other = subprocess.run(["make", "-s", "rtlsim", "SIM=iverilog", "EXPECTED=wrong.bin", "OUT=o2",
+                            "VCD=1"], cwd=proj, capture_output=True, text=True, timeout=600)
+    assert other.returncode != 0
+    assert "rtlsim: FAIL: output differs from wrong.bin" in other.stdout
+    assert (proj / "o2" / "output.bin").exists()
+    assert (proj / "o2" / "wave.vcd").read_text().count("$var") > 20
+
+
+def test_a_custom_application_has_no_rtl(tmp_path: Path) -> None:
+    text = (DATA / "fpga_erode_mono8.yaml").read_text().replace(
+        "  op: erode\n  ksize: 5\n", "  op: custom\n  source: invert.cpp\n")
+    (tmp_path / "invert.cpp").write_text("// user code\n")
+    (tmp_path / "node.yaml").write_text(text)
+    config = load_config(tmp_path / "node.yaml")
+    with pytest.raises(RtlError, match="custom application has no RTL"):
+        rtl_params(config)
+    result = generate_project(config, tmp_path / "proj")
+    assert not any(f.startswith("rtl/") for f in result.files)
+    assert "rtlsim" not in (tmp_path / "proj" / "Makefile").read_text()
+
+
+def test_bad_settings_are_refused(tmp_path: Path) -> None:
+    sim_name = require_rtl()
+    config = small_config("mono8")
+    sim = build(rtl_params(config), tmp_path / "rtl", simulator=sim_name)
+    with pytest.raises(RtlError, match="bp must be"):
+        run(sim, b"", bp=1000)
+    with pytest.raises(RtlError, match="seed must be"):
+        run(sim, b"", seed=0)
