@@ -34,7 +34,8 @@ NODE_FILE = "rfl_node.v"
 #: The simulators the runner knows, in the order it prefers them.
 SIMULATORS = ("iverilog", "verilator")
 #: The streams the testbench times, in its ``hs`` vector's bit order (bit 0 first).
-STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx")
+STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx",
+           "axis_out")
 #: Seconds allowed for one build and for one run.
 BUILD_TIMEOUT = 600.0
 RUN_TIMEOUT = 900.0

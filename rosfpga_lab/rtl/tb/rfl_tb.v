@@ -31,8 +31,9 @@ module rfl_tb;
     always #5 clk = ~clk;
 
     // The streams whose handshakes are timed: name, valid, ready.
-    localparam NS = 8;
+    localparam NS = 9;
     wire [NS-1:0] hs = {
+        dut.u_top.axis_out_tvalid && dut.u_top.axis_out_tready,          // 8 axi2fifo in
         m_tvalid && m_tready,                                            // 7 tx (out)
         dut.u_top.tx_tvalid && dut.u_top.tx_tready,                      // 6 publisher out
         dut.u_top.pix_out_tvalid && dut.u_top.pix_out_tready,            // 5 axi2fifo out

@@ -1,0 +1,56 @@
+"""Cycles of the RTL against the cycle model (``hw.cycles``), every encoding, with and without
+random backpressure on the output.
+
+Tolerances, and why:
+
+* No backpressure: the model's ``total`` (first byte in to last byte out) is within 1 % + 8
+  clocks of the RTL's. The model leaves out the FIFO registers on the way (a clock or two each)
+  and takes the filter's latency from the HLS loop (which also runs over the padding columns),
+  while the RTL's filter is a few pixels quicker.
+* 50 % backpressure: the output takes a byte on a random half of the clocks, so sending ``n``
+  bytes takes a negative-binomial number of clocks: mean ``n / p``, standard deviation
+  ``sqrt(n (1 - p)) / p``. The RTL must be within four standard deviations (+ 16 clocks) of the
+  model; seeds are fixed, so the test is repeatable.
+* Exact: fifo2axi makes a beat every ``bytes_per_pixel`` clocks (4 for ``rgba8``), the model's
+  ``clocks_per_beat``; its span is the data bytes plus one clock (its output register).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from realros import require_rtl
+from rosfpga_lab.hls import pipeline_for
+from rosfpga_lab.hw import PIXEL_FORMATS, image_frame
+from rosfpga_lab.rtl import build, rtl_params
+from rosfpga_lab.rtl.cycles import compare, format_rows, model_report
+from test_rtl_sim import random_image, small_config
+
+pytestmark = pytest.mark.rtl
+
+
+@pytest.mark.parametrize("encoding", list(PIXEL_FORMATS))
+def test_model_and_rtl_agree_on_cycles(encoding: str, tmp_path: Path) -> None:
+    sim_name = require_rtl()
+    config = small_config(encoding, width=48, height=24)
+    sim = build(rtl_params(config), tmp_path, simulator=sim_name)
+    frame = image_frame(random_image(config, 1), encoding, frame_id="cam")
+    pipe = pipeline_for(config)
+    bpp = PIXEL_FORMATS[encoding].bytes_per_pixel
+    pixels = config.image.width * config.image.height
+
+    free = compare(encoding, sim, pipe, frame)
+    assert abs(free.rtl - free.model) <= 0.01 * free.model + 8, format_rows([free])
+    report = model_report(pipe, frame)
+    assert report.clocks_per_beat == bpp
+    assert free.spans["fifo2axi"] == report.cycles["fifo2axi"] + 1 == pixels * bpp + 1
+
+    p = 0.5
+    loaded = compare(encoding, sim, pipe, frame, bp=500, seed=3)
+    n = len(pipe.process(frame).output_frame)
+    sigma = math.sqrt(n * (1 - p)) / p
+    assert abs(loaded.rtl - loaded.model) <= 4 * sigma + 16, format_rows([free, loaded])
+    assert loaded.rtl > 1.8 * free.rtl  # the output, not the input, now sets the pace
