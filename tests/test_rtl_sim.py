@@ -215,3 +215,32 @@ def test_bad_settings_are_refused(tmp_path: Path) -> None:
         run(sim, b"", bp=1000)
     with pytest.raises(RtlError, match="seed must be"):
         run(sim, b"", seed=0)
+
+
+def test_cli_rtl_sim_and_cycles(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from rosfpga_lab.cli import main
+
+    require_rtl("iverilog")
+    config = small_config("rgb8")
+    (tmp_path / "node.yaml").write_text(
+        (DATA / "fpga_dilate_rgba8.yaml").read_text().replace("width: 640", "width: 11")
+        .replace("height: 480", "height: 7").replace("encoding: rgba8", "encoding: rgb8"))
+    frames = [image_frame(random_image(config, s), "rgb8", frame_id="c") for s in (1, 2)]
+    stream = frames[0] + image_frame(random_image(config, 3)[:-1], "rgb8") + frames[1]
+    (tmp_path / "in.bin").write_bytes(stream)
+    args = ["rtl", "sim", str(tmp_path / "node.yaml"), "--simulator", "iverilog", "--input",
+            str(tmp_path / "in.bin"), "-o", str(tmp_path / "out.bin"), "--bp", "500",
+            "--vcd", str(tmp_path / "w.vcd")]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "SUB_BAD_HEIGHT" in out and "PASS: the output equals the Python models' output" in out
+    expected, _ = model_output(config, [frames[0], frames[1]])
+    assert (tmp_path / "out.bin").read_bytes() == expected
+    assert "$enddefinitions" in (tmp_path / "w.vcd").read_text()
+    (tmp_path / "bad.bin").write_bytes(expected[:-1] + bytes([expected[-1] ^ 1]))
+    assert main(args[:7] + ["--expected", str(tmp_path / "bad.bin")]) == 1
+    assert f"differs from the expected bytes at byte {len(expected) - 1}" in capsys.readouterr().out
+    assert main(["rtl", "cycles", str(tmp_path / "node.yaml"), "--simulator", "iverilog",
+                 "--size", "16x8", "--encoding", "mono8"]) == 0
+    table = capsys.readouterr().out
+    assert "mono8 16x8" in table and "50%" in table and "model" in table
