@@ -221,10 +221,10 @@ def test_cli_rtl_sim_and_cycles(tmp_path: Path, capsys: pytest.CaptureFixture[st
     from rosfpga_lab.cli import main
 
     require_rtl("iverilog")
-    config = small_config("rgb8")
     (tmp_path / "node.yaml").write_text(
         (DATA / "fpga_dilate_rgba8.yaml").read_text().replace("width: 640", "width: 11")
         .replace("height: 480", "height: 7").replace("encoding: rgba8", "encoding: rgb8"))
+    config = load_config(tmp_path / "node.yaml")
     frames = [image_frame(random_image(config, s), "rgb8", frame_id="c") for s in (1, 2)]
     stream = frames[0] + image_frame(random_image(config, 3)[:-1], "rgb8") + frames[1]
     (tmp_path / "in.bin").write_bytes(stream)
