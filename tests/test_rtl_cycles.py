@@ -23,8 +23,7 @@ from pathlib import Path
 import pytest
 
 from realros import require_rtl
-from rosfpga_lab.hls import pipeline_for
-from rosfpga_lab.hw import PIXEL_FORMATS, image_frame
+from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, image_frame
 from rosfpga_lab.rtl import build, rtl_params
 from rosfpga_lab.rtl.cycles import compare, format_rows, model_report
 from test_rtl_sim import random_image, small_config
@@ -38,7 +37,7 @@ def test_model_and_rtl_agree_on_cycles(encoding: str, tmp_path: Path) -> None:
     config = small_config(encoding, width=48, height=24)
     sim = build(rtl_params(config), tmp_path, simulator=sim_name)
     frame = image_frame(random_image(config, 1), encoding, frame_id="cam")
-    pipe = pipeline_for(config)
+    pipe = Pipeline.from_config(config)
     bpp = PIXEL_FORMATS[encoding].bytes_per_pixel
     pixels = config.image.width * config.image.height
 

@@ -18,8 +18,9 @@ import numpy as np
 import pytest
 
 from realros import cxx_missing_reason, require_rtl
-from rosfpga_lab.hls import generate, load_config, parse_config, pipeline_for, run_csim, sample_frames
-from rosfpga_lab.hw import PIXEL_FORMATS, PipelineError, image_frame
+from rosfpga_lab.config import load_config, parse_config
+from rosfpga_lab.hls import generate, run_csim, sample_frames
+from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, PipelineError, image_frame
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl import RtlError, build, rtl_params, run, status_header
 from rosfpga_lab.rtl.params import STATUS_HEADER
@@ -55,7 +56,7 @@ def random_image(config, seed: int) -> np.ndarray:
 
 def model_output(config, frames: list[bytes]) -> tuple[bytes, list[str]]:
     """What the Python models send for ``frames``, and accepted/refused per frame."""
-    pipe = pipeline_for(config)
+    pipe = Pipeline.from_config(config)
     out, verdicts = b"", []
     for frame in frames:
         try:

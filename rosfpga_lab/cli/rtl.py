@@ -103,8 +103,9 @@ def _say(message: str) -> None:
 def run_sim(args: argparse.Namespace) -> int:
     """Simulate, compare, report."""
     from rosfpga_lab.errors import LabError
-    from rosfpga_lab.hls import load_config, pipeline_for, sample_frames
-    from rosfpga_lab.hw import PipelineError
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.hls import sample_frames
+    from rosfpga_lab.hw import Pipeline, PipelineError
     from rosfpga_lab.rtl import build, rtl_params, run
 
     config = load_config(args.config)
@@ -123,7 +124,7 @@ def run_sim(args: argparse.Namespace) -> int:
         except OSError as exc:
             raise LabError(f"cannot read {args.expected}: {exc.strerror}") from None
     if expected is None:
-        expected = _model_output(pipeline_for(config), frames, PipelineError)
+        expected = _model_output(Pipeline.from_config(config), frames, PipelineError)
     _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ...")
     sim = build(params, simulator=args.simulator, trace=args.vcd is not None)
     _say(f"built with {sim.simulator} in {sim.seconds:.1f} s; simulating {len(frames):,} bytes")
@@ -163,9 +164,9 @@ def run_cycles(args: argparse.Namespace) -> int:
     """Print the model-vs-RTL cycle table."""
     import dataclasses
 
-    from rosfpga_lab.hls import load_config, pipeline_for
+    from rosfpga_lab.config import load_config
     from rosfpga_lab.hls.generator import sample_image
-    from rosfpga_lab.hw import PIXEL_FORMATS, image_frame
+    from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, image_frame
     from rosfpga_lab.rtl import build, rtl_params
     from rosfpga_lab.rtl.cycles import compare, format_rows
 
@@ -186,7 +187,7 @@ def run_cycles(args: argparse.Namespace) -> int:
         sim = build(rtl_params(cfg), simulator=args.simulator)
         frame = image_frame(sample_image(cfg), enc, frame_id="camera")
         for bp in (0, args.bp):
-            rows.append(compare(f"{enc} {w}x{h}", sim, pipeline_for(cfg), frame, bp=bp))
+            rows.append(compare(f"{enc} {w}x{h}", sim, Pipeline.from_config(cfg), frame, bp=bp))
     print(f"Clocks per frame, first byte in to last byte out ({config.application.op}"
           f"{'' if config.application.op == 'passthrough' else f' {config.application.ksize}x{config.application.ksize}'}); "
           "stage columns: the RTL's span of each stage")

@@ -1,7 +1,7 @@
 """The RTL's parameters, read from the node configuration (the one place that reads it).
 
 How this works: :func:`rtl_params` takes a :class:`NodeConfig` and the Python model the HLS
-generator builds from it (:func:`rosfpga_lab.hls.pipeline_for`, so image, application, FIFO
+configuration gives (:meth:`rosfpga_lab.hw.Pipeline.from_config`, so image, application, FIFO
 depths, ``frame_id_max`` and the first ``header.seq`` come from the same owners), adds the
 interpreter's limits and layout facts, and returns a frozen :class:`RtlParams`.
 :func:`node_wrapper` renders ``rfl_node.v``, the top level with those parameters, and
@@ -14,7 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 from pathlib import Path
 
-from rosfpga_lab.hls import NodeConfig, load_config, pipeline_for
+from rosfpga_lab.config import NodeConfig, load_config
+from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.encodings import PIXEL_FORMATS
 from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, SUBSCRIBER_STATUSES, fixed_after
@@ -71,7 +72,7 @@ def rtl_params(config: NodeConfig) -> RtlParams:
     if config.application.op == "custom":
         raise RtlError("a custom application has no RTL: the lab's Verilog holds dilate, erode "
                        "and passthrough only")
-    pipe = pipeline_for(config)
+    pipe = Pipeline.from_config(config)
     for name, depth in (("input_depth", config.fifo.input_depth),
                         ("output_depth", config.fifo.output_depth),
                         ("axis_depth", config.fifo.axis_depth)):

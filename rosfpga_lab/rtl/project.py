@@ -11,7 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from rosfpga_lab import __version__
-from rosfpga_lab.hls import GenerationResult, NodeConfig, generate
+from rosfpga_lab.config import NodeConfig
+from rosfpga_lab.hls import GenerationResult, generate
 from rosfpga_lab.hls.generator import Progress
 from rosfpga_lab.rtl.params import rtl_params
 from rosfpga_lab.rtl.sim import source_files

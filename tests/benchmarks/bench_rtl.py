@@ -18,7 +18,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-from rosfpga_lab.hls import load_config, pipeline_for, sample_frames
+from rosfpga_lab.config import load_config
+from rosfpga_lab.hls import sample_frames
+from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.rtl import build, rtl_params, run, simulator_missing_reason
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -27,7 +29,7 @@ DATA = Path(__file__).resolve().parents[2] / "data"
 def bench(stem: str, simulator: str) -> None:
     config = load_config(DATA / f"{stem}.yaml")
     frame, _ = sample_frames(config)
-    expected = pipeline_for(config).process(frame).output_frame
+    expected = Pipeline.from_config(config).process(frame).output_frame
     with tempfile.TemporaryDirectory(prefix="rosfpga-bench-rtl-") as tmp:
         sim = build(rtl_params(config), Path(tmp), simulator=simulator)
         result = run(sim, frame)
