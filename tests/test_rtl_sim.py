@@ -149,7 +149,7 @@ def test_shipped_configs_with_backpressure(stem: str, tmp_path: Path) -> None:
     config = load_config(DATA / f"{stem}.yaml")
     frame, expected = sample_frames(config)
     sim = build(rtl_params(config), tmp_path / "rtl", simulator=sim_name)
-    got = run(sim, frame, seed=11, gap=100, bp=500)
+    got = run(sim, frame, seed=11, gap=100, bp=300)
     assert got.status == ((0, "SUB_OK"),)
     assert got.output == expected
 

@@ -138,6 +138,7 @@ class RtlBuild:
         directory: where its sources and products are.
         params: the parameters it was built with.
         seconds: how long the build took.
+        trace: it can write a VCD (always with Icarus; Verilator only when built with trace).
     """
 
     simulator: str
@@ -145,6 +146,7 @@ class RtlBuild:
     directory: Path
     params: RtlParams
     seconds: float
+    trace: bool = True
 
 
 def build(params: RtlParams, directory: str | Path | None = None, *,
@@ -183,7 +185,8 @@ def build(params: RtlParams, directory: str | Path | None = None, *,
     if proc.returncode != 0:
         raise RtlError(f"building the simulation in {where} failed ({' '.join(cmd)}):\n"
                        f"{proc.stdout}{proc.stderr}")
-    return RtlBuild(sim, run_cmd, where, params, time.perf_counter() - start)
+    return RtlBuild(sim, run_cmd, where, params, time.perf_counter() - start,
+                    trace or sim == "iverilog")
 
 
 @dataclass(frozen=True)
@@ -246,6 +249,8 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
         RtlError: bad settings, the simulation failed, stalled or ran out of time.
     """
     gap, bp = _per_mille("gap", gap), _per_mille("bp", bp)
+    if vcd is not None and not sim.trace:
+        raise RtlError("this Verilator build cannot write a VCD: build it with trace=True")
     if not 1 <= seed < 2**31:
         raise RtlError(f"seed must be in 1..2**31-1, got {seed}")
     p = sim.params
