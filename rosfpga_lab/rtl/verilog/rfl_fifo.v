@@ -19,6 +19,7 @@ module rfl_fifo #(
 );
     localparam MEMD = DEPTH - 1;
     localparam AW = (MEMD > 1) ? $clog2(MEMD) : 1;
+    localparam [AW-1:0] LAST = MEMD - 1;        // the RAM's last address
 
     reg [WIDTH-1:0] mem [0:MEMD-1];
     reg [AW-1:0] wptr, rptr;
@@ -47,8 +48,8 @@ module rfl_fifo #(
             cnt <= 0;
             dvalid <= 1'b0;
         end else begin
-            if (wr) wptr <= (wptr == MEMD - 1) ? {AW{1'b0}} : wptr + 1'b1;
-            if (load) rptr <= (rptr == MEMD - 1) ? {AW{1'b0}} : rptr + 1'b1;
+            if (wr) wptr <= (wptr == LAST) ? {AW{1'b0}} : wptr + 1'b1;
+            if (load) rptr <= (rptr == LAST) ? {AW{1'b0}} : rptr + 1'b1;
             if (wr && !load) cnt <= cnt + 1'b1;
             else if (load && !wr) cnt <= cnt - 1'b1;
             if (load) dvalid <= 1'b1;

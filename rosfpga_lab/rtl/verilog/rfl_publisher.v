@@ -51,7 +51,8 @@ module rfl_publisher #(
 
     wire [31:0] fid_len = {{(32-FIDW){1'b0}}, meta_fid_len};
     wire [31:0] enc_index = ENC_LEN - 1 - i;
-    wire [7:0]  enc_byte = ENCODING >> (8 * enc_index);
+    wire [8*32-1:0] enc_shifted = ENCODING >> (8 * enc_index);
+    wire [7:0]  enc_byte = enc_shifted[7:0];
 
     always @* begin
         case (f)

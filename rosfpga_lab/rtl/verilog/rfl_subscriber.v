@@ -73,7 +73,8 @@ module rfl_subscriber #(
     wire        u32_done = (cnt == 32'd3);
     wire [32:0] pos_next = {1'b0, pos} + 33'd1; // pos after this byte
     wire [31:0] enc_index = ENC_LEN - 1 - cnt;
-    wire [7:0]  enc_byte = ENCODING >> (8 * enc_index);
+    wire [8*32-1:0] enc_shifted = ENCODING >> (8 * enc_index);
+    wire [7:0]  enc_byte = enc_shifted[7:0];
     wire        enc_ok = same && (cnt < ENC_LEN) && (s_tdata == enc_byte);
 
     always @(posedge clk) begin
