@@ -175,7 +175,7 @@ def build(params: RtlParams, directory: str | Path | None = None, *,
     else:
         cmd = [_verilator() or "verilator", "--binary", "--timing", "-O3", "-Wno-fatal",
                "-Wno-lint", "-Wno-style", "-I.", "--top-module", TB_TOP, "-Mdir", "obj_dir",
-               "-o", "rfl_sim", *(["--trace"] if trace else []), *files]
+               "-o", "rfl_sim", *(["--trace", "--trace-depth", "3"] if trace else []), *files]
         run_cmd = (str(where / "obj_dir" / "rfl_sim"),)
     start = time.perf_counter()
     try:
