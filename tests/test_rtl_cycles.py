@@ -12,7 +12,9 @@ Tolerances, and why:
   ``sqrt(n (1 - p)) / p``. The RTL must be within four standard deviations (+ 16 clocks) of the
   model; seeds are fixed, so the test is repeatable.
 * Exact: fifo2axi makes a beat every ``bytes_per_pixel`` clocks (4 for ``rgba8``), the model's
-  ``clocks_per_beat``; its span is the data bytes plus one clock (its output register).
+  ``clocks_per_beat``; its span is the data bytes plus one clock (its output register); the
+  subscriber's span is the frame's bytes and axi2fifo's the data bytes plus one, as the model's
+  per-stage ``cycles`` say.
 """
 
 from __future__ import annotations
@@ -46,6 +48,9 @@ def test_model_and_rtl_agree_on_cycles(encoding: str, tmp_path: Path) -> None:
     report = model_report(pipe, frame)
     assert report.clocks_per_beat == bpp
     assert free.spans["fifo2axi"] == report.cycles["fifo2axi"] + 1 == pixels * bpp + 1
+    # The byte-wide stages take exactly their byte counts (+1: an output register).
+    assert free.spans["subscriber"] == report.cycles["interpreter"] == len(frame)
+    assert free.spans["axi2fifo"] == report.cycles["axi2fifo"] + 1
 
     p = 0.5
     loaded = compare(encoding, sim, pipe, frame, bp=500, seed=3)
