@@ -245,3 +245,17 @@ def test_cli_rtl_sim_and_cycles(tmp_path: Path, capsys: pytest.CaptureFixture[st
                  "--size", "16x8", "--encoding", "mono8"]) == 0
     table = capsys.readouterr().out
     assert "mono8 16x8" in table and "50%" in table and "model" in table
+
+
+def test_input_cut_short_inside_a_frame(tmp_path: Path) -> None:
+    """The circuit waits for the rest; the runner says so instead of hanging (even with heavy
+    gaps and backpressure, which must not be mistaken for the end)."""
+    sim_name = require_rtl()
+    config = small_config("rgb8")
+    frame, expected = sample_frames(config)
+    sim = build(rtl_params(config), tmp_path, simulator=sim_name)
+    got = run(sim, frame + frame[: len(frame) // 2], seed=4, gap=950, bp=950)
+    assert got.cut_short
+    assert got.output[:len(expected)] == expected
+    whole = run(sim, frame, seed=4, gap=950, bp=950)
+    assert not whole.cut_short and whole.output == expected

@@ -39,6 +39,10 @@ STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "pub
 #: Seconds allowed for one build and for one run.
 BUILD_TIMEOUT = 600.0
 RUN_TIMEOUT = 900.0
+#: Clocks without a handshake on any stream that end a run: the input ended inside a frame (or
+#: the circuit hangs). Even at 990 per mille gaps and backpressure, a stream moves every ~100
+#: clocks on average; 20,000 idle clocks in a row would happen with a chance below 1e-40.
+IDLE_LIMIT = 20_000
 #: Per mille: the largest input gap / backpressure share (1000 would never move).
 MAX_PER_MILLE = 990
 
@@ -219,6 +223,12 @@ class RtlResult:
     seconds: float
 
     @property
+    def cut_short(self) -> bool:
+        """The input ended inside a frame: the circuit was left waiting for the rest (a frame
+        it had accepted may have its header, but not all its pixels, in ``output``)."""
+        return "the input ended inside a frame" in self.log
+
+    @property
     def clocks_per_second(self) -> float:
         """Simulated clocks per wall-clock second."""
         return self.cycles / self.seconds if self.seconds > 0 else 0.0
@@ -253,8 +263,7 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
         raise RtlError("this Verilator build cannot write a VCD: build it with trace=True")
     if not 1 <= seed < 2**31:
         raise RtlError(f"seed must be in 1..2**31-1, got {seed}")
-    p = sim.params
-    limit = idle_limit or 64 * (p.WIDTH * p.BYTES * (p.KSIZE + 1) + 4096)
+    limit = idle_limit or IDLE_LIMIT
     with tempfile.TemporaryDirectory(prefix="rosfpga-rtlsim-") as tmp:
         work = Path(work_dir) if work_dir else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
