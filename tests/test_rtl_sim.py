@@ -20,7 +20,7 @@ import pytest
 from realros import cxx_missing_reason, require_rtl
 from rosfpga_lab.config import load_config, parse_config
 from rosfpga_lab.hls import generate, run_csim, sample_frames
-from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, PipelineError, image_frame
+from rosfpga_lab.hw import PIXEL_FORMATS, Beats, Pipeline, PipelineError, image_frame
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl import RtlError, build, rtl_params, run, status_header
 from rosfpga_lab.rtl.params import STATUS_HEADER
@@ -81,8 +81,19 @@ def test_every_encoding_with_random_gaps_and_backpressure(encoding: str, tmp_pat
     frames = [ros_frame(random_image(config, seed), encoding, seq=seed, stamp=(seed, 1000 + seed),
                         frame_id="f" * (seed * 5)) for seed in (1, 2, 3)]
     sim = build(rtl_params(config), tmp_path / "rtl", simulator=sim_name)
-    got = run(sim, b"".join(frames), seed=7, gap=300, bp=500)
+    got = run(sim, b"".join(frames), seed=7, gap=300, bp=500, beats=True)
     expected, verdicts = model_output(config, frames)
+    # The beats on both sides of the application equal the models' (unused lanes included).
+    pipe = Pipeline.from_config(config)
+    n = config.image.width * config.image.height
+    assert got.input_beats is not None and got.output_beats is not None
+    assert len(got.input_beats) == len(got.output_beats) == 3 * n
+    for i, frame in enumerate(frames):
+        res = pipe.process(frame)
+        for side, model in ((got.input_beats, res.input_beats), (got.output_beats, res.output_beats)):
+            part = Beats(side.tdata[i * n:(i + 1) * n], side.tkeep[i * n:(i + 1) * n],
+                         side.tuser[i * n:(i + 1) * n], side.tlast[i * n:(i + 1) * n])
+            assert part == model, f"frame {i}: first differing beat {part.first_difference(model)}"
     assert verdicts == ["SUB_OK"] * 3
     offsets = [0, len(frames[0]), len(frames[0]) + len(frames[1])]
     assert got.status == tuple((o, "SUB_OK") for o in offsets)

@@ -23,6 +23,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from rosfpga_lab.hls.csim import read_beats
+from rosfpga_lab.hw import Beats
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
 from rosfpga_lab.rtl.params import STATUS_HEADER, RtlParams, node_wrapper
@@ -213,6 +215,8 @@ class RtlResult:
         cycles: clocks simulated.
         log: the simulator's output.
         seconds: wall-clock time of the run.
+        input_beats, output_beats: the beats into and out of the application, all frames
+            (``run(..., beats=True)``; else None).
     """
 
     output: bytes
@@ -221,6 +225,8 @@ class RtlResult:
     cycles: int
     log: str
     seconds: float
+    input_beats: Beats | None = None
+    output_beats: Beats | None = None
 
     @property
     def cut_short(self) -> bool:
@@ -242,7 +248,7 @@ def _per_mille(name: str, value: int) -> int:
 
 def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 0,
         vcd: str | Path | None = None, work_dir: str | Path | None = None,
-        idle_limit: int | None = None) -> RtlResult:
+        idle_limit: int | None = None, beats: bool = False) -> RtlResult:
     """Simulate the circuit on TCPROS frames.
 
     Args:
@@ -253,7 +259,8 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
         bp: per mille of clocks the output is not ready (backpressure).
         vcd: write a VCD of the stream and FIFO signals there (Verilator: build with trace).
         work_dir: where the files go (default: a temporary directory, removed after).
-        idle_limit: clocks without any handshake that end the run (default: ample for a frame).
+        idle_limit: clocks without any handshake that end the run (default :data:`IDLE_LIMIT`).
+        beats: also record the AXI4-Stream beats into and out of the application.
 
     Raises:
         RtlError: bad settings, the simulation failed, stalled or ran out of time.
@@ -273,6 +280,8 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
                 f"+seed={seed}", f"+gap={gap}", f"+bp={bp}", f"+idle_limit={limit}"]
         if vcd is not None:
             args.append(f"+vcd={Path(vcd).resolve()}")
+        if beats:
+            args += [f"+beats_in={work / 'input_beats.txt'}", f"+beats_out={work / 'output_beats.txt'}"]
         start = time.perf_counter()
         try:
             proc = subprocess.run([*sim.command, *args], cwd=work, capture_output=True, text=True,
@@ -299,8 +308,10 @@ def _read_result(work: Path, log: str, seconds: float) -> RtlResult:
             cycles = int(parts[1])
         else:
             streams[STREAMS[int(parts[0])]] = StreamTiming(*(int(v) for v in parts[1:]))
+    beats = [read_beats(work / f"{side}_beats.txt") if (work / f"{side}_beats.txt").exists()
+             else None for side in ("input", "output")]
     return RtlResult((work / "output.bin").read_bytes(), tuple(status), streams, cycles, log,
-                     seconds)
+                     seconds, beats[0], beats[1])
 
 
 def env_required() -> bool:

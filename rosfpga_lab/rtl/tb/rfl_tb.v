@@ -46,7 +46,7 @@ module rfl_tb;
 
     // The testbench's own bookkeeping stays out of a Verilator waveform.
     /* verilator tracing_off */
-    integer fin, fout, fstatus, fstats, c, i;
+    integer fin, fout, fstatus, fstats, fbin, fbout, c, i;
     integer seed, gap, bp, idle_limit;
     reg [31:0] rnd;
     reg [8*1024-1:0] path;
@@ -100,6 +100,10 @@ module rfl_tb;
         if (fout == 0 || fstatus == 0 || fstats == 0) begin
             $fatal(1, "rtlsim: ERROR: cannot open an output file");
         end
+        fbin = 0;
+        fbout = 0;
+        if ($value$plusargs("beats_in=%s", path)) fbin = $fopen(path, "w");
+        if ($value$plusargs("beats_out=%s", path)) fbout = $fopen(path, "w");
         if (!$value$plusargs("seed=%d", seed)) seed = 1;
         if (!$value$plusargs("gap=%d", gap)) gap = 0;
         if (!$value$plusargs("bp=%d", bp)) bp = 0;
@@ -144,6 +148,13 @@ module rfl_tb;
             frames = frames + 1;
             if (status != 0) refused = refused + 1;
         end
+        // the beats into and out of the application (fifo2axi's and rfl_morph's outputs)
+        if (fbin != 0 && hs[2])
+            $fwrite(fbin, "%08x %x %x %x\n", dut.u_top.axis_in_tdata, dut.u_top.axis_in_tkeep,
+                    dut.u_top.axis_in_tuser, dut.u_top.axis_in_tlast);
+        if (fbout != 0 && hs[4])
+            $fwrite(fbout, "%08x %x %x %x\n", dut.u_top.app_out_tdata, dut.u_top.app_out_tkeep,
+                    dut.u_top.app_out_tuser, dut.u_top.app_out_tlast);
         for (i = 0; i < NS; i = i + 1) if (hs[i]) begin
             if (count[i] == 0) first[i] = cycle;
             last[i] = cycle;
@@ -167,6 +178,8 @@ module rfl_tb;
             $fclose(fout);
             $fclose(fstatus);
             $fclose(fstats);
+            if (fbin != 0) $fclose(fbin);
+            if (fbout != 0) $fclose(fbout);
             $display("rtlsim: %0d frame(s) in, %0d refused, %0d bytes in, %0d bytes out, %0d clocks",
                      frames, refused, in_bytes, out_bytes, cycle);
             if (failed) $fatal(1, "rtlsim: %0s", note);
