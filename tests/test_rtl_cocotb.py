@@ -12,27 +12,26 @@ from pathlib import Path
 import pytest
 
 from realros import require_rtl
+from rosfpga_lab.hw import PIXEL_FORMATS
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl import rtl_params, write_sources
 from test_hls_csim import ros_frame
-from test_rtl_sim import model_output, random_image, small_config
+from test_rtl_sim import model_output, random_image, refusal_frames, small_config
 
 pytestmark = pytest.mark.rtl
 HERE = Path(__file__).resolve().parent
 
 
-@pytest.mark.parametrize("encoding", ["rgba8", "mono8"])
-def test_cocotb_drives_real_frames_through_the_rtl(encoding: str, tmp_path: Path) -> None:
+def cosimulate(config, frames: list[bytes], tmp_path: Path, seed: int = 5) -> list[str]:
+    """Run the cocotb testbench on ``frames``; it asserts the output equals the models'.
+
+    Returns:
+        The subscriber's statuses, one per frame it decided on.
+    """
     require_rtl("iverilog")
     runner_mod = pytest.importorskip("cocotb_tools.runner", reason="cocotb not installed")
-    config = small_config(encoding, width=9, height=5)
-    frames = [ros_frame(random_image(config, s), encoding, seq=s, frame_id="cam" * s)
-              for s in (1, 2)]
-    bad = ros_frame(random_image(config, 3)[:, :-1], encoding)
-    stream = frames[0] + bad + frames[1]
-    expected, verdicts = model_output(config, [frames[0], bad, frames[1]])
-    assert verdicts == ["SUB_OK", "refused", "SUB_OK"]
-    (tmp_path / "frames.bin").write_bytes(stream)
+    expected, _ = model_output(config, frames)
+    (tmp_path / "frames.bin").write_bytes(b"".join(frames))
     (tmp_path / "expected.bin").write_bytes(expected)
     files = write_sources(rtl_params(config), tmp_path / "src")
     sources = [tmp_path / "src" / f for f in files if f.endswith(".v") and f != "rfl_tb.v"]
@@ -44,8 +43,26 @@ def test_cocotb_drives_real_frames_through_the_rtl(encoding: str, tmp_path: Path
                           extra_env={"RFL_FRAMES": str(tmp_path / "frames.bin"),
                                      "RFL_EXPECTED": str(tmp_path / "expected.bin"),
                                      "RFL_STATUS_OUT": str(tmp_path / "status.txt"),
-                                     "RFL_SEED": "5"})
+                                     "RFL_SEED": str(seed)})
     failed = runner_mod.get_results(results)[1]
-    assert failed == 0, (tmp_path / "build").as_posix()
+    assert failed == 0, f"the cocotb test failed; its log is in {tmp_path / 'build'}"
     codes = [int(c) for c in (tmp_path / "status.txt").read_text().split()]
-    assert [SUBSCRIBER_STATUSES[c][0] for c in codes] == ["SUB_OK", "SUB_BAD_WIDTH", "SUB_OK"]
+    return [SUBSCRIBER_STATUSES[c][0] for c in codes]
+
+
+@pytest.mark.parametrize("encoding", list(PIXEL_FORMATS))
+def test_cocotb_drives_real_frames_through_the_rtl(encoding: str, tmp_path: Path) -> None:
+    config = small_config(encoding, width=9, height=5)
+    frames = [ros_frame(random_image(config, s), encoding, seq=s, frame_id="cam" * s)
+              for s in (1, 2)]
+    bad = ros_frame(random_image(config, 3)[:, :-1], encoding)
+    _, verdicts = model_output(config, [frames[0], bad, frames[1]])
+    assert verdicts == ["SUB_OK", "refused", "SUB_OK"]
+    statuses = cosimulate(config, [frames[0], bad, frames[1]], tmp_path)
+    assert statuses == ["SUB_OK", "SUB_BAD_WIDTH", "SUB_OK"]
+
+
+def test_cocotb_every_refusal_reason_then_a_good_frame(tmp_path: Path) -> None:
+    config = small_config("mono8", width=6, height=4, frame_id_max=16)
+    frames, names = refusal_frames(config)
+    assert cosimulate(config, frames, tmp_path, seed=9) == names

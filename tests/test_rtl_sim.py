@@ -105,11 +105,9 @@ def test_every_encoding_with_random_gaps_and_backpressure(encoding: str, tmp_pat
         assert csim.output == got.output
 
 
-def test_every_refusal_reason_then_a_good_frame(tmp_path: Path) -> None:
-    """Each status of the interpreter's table, each followed by a good frame: the RTL refuses
-    what the HLS subscriber and the Python interpreter refuse, and numbers the good ones 1, 2..."""
-    sim_name = require_rtl()
-    config = small_config("mono8", frame_id_max=16)
+def refusal_frames(config) -> tuple[list[bytes], list[str]]:
+    """One frame per refusal reason of the interpreter's table, each followed by a good frame
+    (for a ``mono8`` configuration with ``frame_id_max: 16``); and the statuses expected."""
     image = random_image(config, 5)
     h, w = image.shape[:2]
     good = [ros_frame(random_image(config, 10 + i), "mono8", seq=i, frame_id=f"g{i}")
@@ -140,6 +138,15 @@ def test_every_refusal_reason_then_a_good_frame(tmp_path: Path) -> None:
     for i, (name, frame) in enumerate(bad.items()):
         frames += [frame, good[i]]
         names += [name, "SUB_OK"]
+    return frames, names
+
+
+def test_every_refusal_reason_then_a_good_frame(tmp_path: Path) -> None:
+    """Each status of the interpreter's table, each followed by a good frame: the RTL refuses
+    what the HLS subscriber and the Python interpreter refuse, and numbers the good ones 1, 2..."""
+    sim_name = require_rtl()
+    config = small_config("mono8", frame_id_max=16)
+    frames, names = refusal_frames(config)
     sim = build(rtl_params(config), tmp_path / "rtl", simulator=sim_name)
     got = run(sim, b"".join(frames), seed=3, gap=200, bp=300)
     offsets = np.cumsum([0] + [len(f) for f in frames])[:-1]
