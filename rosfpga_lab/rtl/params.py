@@ -79,6 +79,9 @@ def rtl_params(config: NodeConfig) -> RtlParams:
         if depth < 2:
             raise RtlError(f"fifo.{name} is {depth}; the RTL FIFOs need a depth of at least 2")
     assert pipe.encoding is not None and pipe.width is not None and pipe.height is not None
+    if pipe.seq_mode != "count" or pipe.stamp is not None or pipe.frame_id is not None:
+        raise RtlError("the RTL publisher numbers its frames and carries stamp and frame_id "
+                       "over; the model of this configuration does otherwise")
     return RtlParams(
         WIDTH=pipe.width, HEIGHT=pipe.height,
         BYTES=PIXEL_FORMATS[pipe.encoding].bytes_per_pixel, ENCODING=pipe.encoding,
