@@ -40,6 +40,7 @@ def cosimulate(config, frames: list[bytes], tmp_path: Path, seed: int = 5) -> li
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"))
     results = runner.test(hdl_toplevel="rfl_node", test_module="cocotb_rfl_node",
                           test_dir=HERE / "rtl", build_dir=tmp_path / "build",
+                          results_xml=str(tmp_path / "results.xml"),
                           extra_env={"RFL_FRAMES": str(tmp_path / "frames.bin"),
                                      "RFL_EXPECTED": str(tmp_path / "expected.bin"),
                                      "RFL_STATUS_OUT": str(tmp_path / "status.txt"),
