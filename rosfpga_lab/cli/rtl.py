@@ -14,6 +14,17 @@ from pathlib import Path
 from rosfpga_lab.cli._args import positive_int
 
 PER_MILLE_HELP = "per mille of clocks (0..990)"
+#: Bytes of input above which Verilator's fast simulation repays its slow compilation.
+BIG_INPUT = 200_000
+
+
+def _pick_simulator(chosen: str | None, input_bytes: int) -> str | None:
+    """``chosen``, else Verilator for a big input when it is installed, else the default."""
+    from rosfpga_lab.rtl import simulator_missing_reason
+
+    if chosen is None and input_bytes > BIG_INPUT and simulator_missing_reason("verilator") is None:
+        return "verilator"
+    return chosen
 
 
 def _per_mille(text: str) -> int:
@@ -39,7 +50,9 @@ def _size(text: str) -> tuple[int, int]:
 def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("config", type=Path, metavar="CONFIG", help="the node configuration (YAML)")
     parser.add_argument("--simulator", choices=("iverilog", "verilator"),
-                        help="the simulator (default: Icarus Verilog when installed, else Verilator)")
+                        help="the simulator (default: Verilator for frames over "
+                        f"{BIG_INPUT // 1000} kB when installed, it compiles slowly but runs "
+                        "fast; else Icarus Verilog when installed, else Verilator)")
 
 
 def _register_sim(subparsers: argparse._SubParsersAction) -> None:
@@ -126,7 +139,8 @@ def run_sim(args: argparse.Namespace) -> int:
     if expected is None:
         expected = _model_output(Pipeline.from_config(config), frames, PipelineError)
     _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ...")
-    sim = build(params, simulator=args.simulator, trace=args.vcd is not None)
+    sim = build(params, simulator=_pick_simulator(args.simulator, len(frames)),
+                trace=args.vcd is not None)
     _say(f"built with {sim.simulator} in {sim.seconds:.1f} s; simulating {len(frames):,} bytes")
     result = run(sim, frames, seed=args.seed, gap=args.gap, bp=args.bp, vcd=args.vcd)
     for offset, status in result.status:
@@ -186,7 +200,8 @@ def run_cycles(args: argparse.Namespace) -> int:
         cfg = dataclasses.replace(config, image=dataclasses.replace(
             config.image, width=w, height=h, encoding=enc))
         _say(f"{enc} {w}x{h}: building and simulating ...")
-        sim = build(rtl_params(cfg), simulator=args.simulator)
+        params = rtl_params(cfg)
+        sim = build(params, simulator=_pick_simulator(args.simulator, params.data_bytes))
         frame = image_frame(sample_image(cfg), enc, frame_id="camera")
         for bp in (0, args.bp):
             rows.append(compare(f"{enc} {w}x{h}", sim, Pipeline.from_config(cfg), frame, bp=bp))
