@@ -232,10 +232,12 @@ def test_bad_settings_are_refused(tmp_path: Path) -> None:
         run(sim, b"", seed=0)
 
 
-def test_cli_rtl_sim_and_cycles(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_rtl_sim_and_cycles(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                monkeypatch: pytest.MonkeyPatch) -> None:
     from rosfpga_lab.cli import main
 
     require_rtl("iverilog")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))  # builds are cached there
     (tmp_path / "node.yaml").write_text(
         (DATA / "fpga_dilate_rgba8.yaml").read_text().replace("width: 640", "width: 11")
         .replace("height: 480", "height: 7").replace("encoding: rgba8", "encoding: rgb8"))
@@ -294,3 +296,18 @@ def test_a_batch_of_varied_frames_equals_the_models(tmp_path: Path) -> None:
     assert verdicts.count("refused") == 1  # the 17-byte frame_id
     assert [s if s == "SUB_OK" else "refused" for _, s in got.status] == verdicts
     assert got.output == expected
+
+
+def test_a_cached_build_is_reused_and_keyed_by_the_sources(tmp_path: Path,
+                                                            monkeypatch: pytest.MonkeyPatch) -> None:
+    sim_name = require_rtl("iverilog")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    config = small_config("mono8")
+    first = build(rtl_params(config), simulator=sim_name, cache=True)
+    again = build(rtl_params(config), simulator=sim_name, cache=True)
+    assert again.directory == first.directory and again.seconds == 0.0
+    assert first.directory.parent == tmp_path / "rosfpga-lab" / "rtl"
+    other = build(rtl_params(small_config("mono8", width=12)), simulator=sim_name, cache=True)
+    assert other.directory != first.directory
+    frame, expected = sample_frames(config)
+    assert run(again, frame).output == expected

@@ -49,6 +49,9 @@ def _size(text: str) -> tuple[int, int]:
 
 def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("config", type=Path, metavar="CONFIG", help="the node configuration (YAML)")
+    parser.add_argument("--no-cache", action="store_true",
+                        help="compile afresh instead of reusing a build of the same sources "
+                        "($XDG_CACHE_HOME/rosfpga-lab/rtl, ~/.cache by default)")
     parser.add_argument("--simulator", choices=("iverilog", "verilator"),
                         help="the simulator (default: Verilator for frames over "
                         f"{BIG_INPUT // 1000} kB when installed, it compiles slowly but runs "
@@ -140,8 +143,10 @@ def run_sim(args: argparse.Namespace) -> int:
         expected = _model_output(Pipeline.from_config(config), frames, PipelineError)
     _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ...")
     sim = build(params, simulator=_pick_simulator(args.simulator, len(frames)),
-                trace=args.vcd is not None)
-    _say(f"built with {sim.simulator} in {sim.seconds:.1f} s; simulating {len(frames):,} bytes")
+                trace=args.vcd is not None, cache=not args.no_cache)
+    how = f"built with {sim.simulator} in {sim.seconds:.1f} s" if sim.seconds else \
+        f"{sim.simulator} build reused from {sim.directory}"
+    _say(f"{how}; simulating {len(frames):,} bytes")
     result = run(sim, frames, seed=args.seed, gap=args.gap, bp=args.bp, vcd=args.vcd)
     for offset, status in result.status:
         print(f"frame at byte {offset}: {status}")
@@ -201,7 +206,8 @@ def run_cycles(args: argparse.Namespace) -> int:
             config.image, width=w, height=h, encoding=enc))
         _say(f"{enc} {w}x{h}: building and simulating ...")
         params = rtl_params(cfg)
-        sim = build(params, simulator=_pick_simulator(args.simulator, params.data_bytes))
+        sim = build(params, simulator=_pick_simulator(args.simulator, params.data_bytes),
+                    cache=not args.no_cache)
         frame = image_frame(sample_image(cfg), enc, frame_id="camera")
         for bp in (0, args.bp):
             rows.append(compare(f"{enc} {w}x{h}", sim, Pipeline.from_config(cfg), frame, bp=bp))

