@@ -36,13 +36,17 @@ SMALL = {"rgba8": ("dilate", 3), "bgra8": ("erode", 3), "rgb8": ("dilate", 5),
          "bgr8": ("passthrough", 3), "mono8": ("erode", 5)}
 
 
-def small_config(encoding: str, width: int = 11, height: int = 7, frame_id_max: int = 256):
+def small_config(encoding: str, width: int = 11, height: int = 7, frame_id_max: int = 256,
+                 fifo_depth: int | None = None):
     op, ksize = SMALL[encoding]
     text = (DATA / "fpga_dilate_rgba8.yaml").read_text()
     text = text.replace("width: 640", f"width: {width}").replace("height: 480", f"height: {height}")
     text = text.replace("encoding: rgba8", f"encoding: {encoding}")
     text = text.replace("op: dilate", f"op: {op}").replace("ksize: 3", f"ksize: {ksize}")
     text = text.replace("frame_id_max: 256", f"frame_id_max: {frame_id_max}")
+    if fifo_depth is not None:
+        for key, depth in (("input_depth", 2048), ("output_depth", 2048), ("axis_depth", 16)):
+            text = text.replace(f"{key}: {depth}", f"{key}: {fifo_depth}")
     return parse_config(text, source=f"small_{encoding}.yaml")
 
 

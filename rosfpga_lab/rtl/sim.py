@@ -299,7 +299,8 @@ def _per_mille(name: str, value: int) -> int:
 
 def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 0,
         vcd: str | Path | None = None, work_dir: str | Path | None = None,
-        idle_limit: int | None = None, beats: bool = False) -> RtlResult:
+        idle_limit: int | None = None, beats: bool = False,
+        plusargs: Sequence[str] = ()) -> RtlResult:
     """Simulate the circuit on TCPROS frames.
 
     Args:
@@ -312,6 +313,7 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
         work_dir: where the files go (default: a temporary directory, removed after).
         idle_limit: clocks without any handshake that end the run (default :data:`IDLE_LIMIT`).
         beats: also record the AXI4-Stream beats into and out of the application.
+        plusargs: further testbench options (``+clocks_f2a=FILE``: fifo2axi's ports per clock).
 
     Raises:
         RtlError: bad settings, the simulation failed, stalled or ran out of time.
@@ -333,6 +335,7 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
             args.append(f"+vcd={Path(vcd).resolve()}")
         if beats:
             args += [f"+beats_in={work / 'input_beats.txt'}", f"+beats_out={work / 'output_beats.txt'}"]
+        args += list(plusargs)
         start = time.perf_counter()
         try:
             proc = subprocess.run([*sim.command, *args], cwd=work, capture_output=True, text=True,

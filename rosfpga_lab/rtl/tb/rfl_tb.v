@@ -46,7 +46,8 @@ module rfl_tb;
 
     // The testbench's own bookkeeping stays out of a Verilator waveform.
     /* verilator tracing_off */
-    integer fin, fout, fstatus, fstats, fbin, fbout, c, i;
+    integer fin, fout, fstatus, fstats, fbin, fbout, ff2a, c, i;
+    reg f2a_on;
     integer seed, gap, bp, idle_limit;
     reg [31:0] rnd;
     reg [8*1024-1:0] path;
@@ -104,6 +105,9 @@ module rfl_tb;
         fbout = 0;
         if ($value$plusargs("beats_in=%s", path)) fbin = $fopen(path, "w");
         if ($value$plusargs("beats_out=%s", path)) fbout = $fopen(path, "w");
+        ff2a = 0;
+        f2a_on = 1'b0;
+        if ($value$plusargs("clocks_f2a=%s", path)) ff2a = $fopen(path, "w");
         if (!$value$plusargs("seed=%d", seed)) seed = 1;
         if (!$value$plusargs("gap=%d", gap)) gap = 0;
         if (!$value$plusargs("bp=%d", bp)) bp = 0;
@@ -148,6 +152,14 @@ module rfl_tb;
             frames = frames + 1;
             if (status != 0) refused = refused + 1;
         end
+        // fifo2axi's ports at every clock from its first byte offered (+clocks_f2a): s_tvalid
+        // s_tready s_tdata m_axis_tvalid m_axis_tready m_axis_tdata m_axis_tuser m_axis_tlast
+        if (ff2a != 0 && dut.u_top.pix_in_tvalid) f2a_on = 1'b1;
+        if (ff2a != 0 && f2a_on)
+            $fwrite(ff2a, "%0d %0d %02x %0d %0d %08x %0d %0d\n", dut.u_top.pix_in_tvalid,
+                    dut.u_top.pix_in_tready, dut.u_top.pix_in_tdata, dut.u_top.axis_in_tvalid,
+                    dut.u_top.axis_in_tready, dut.u_top.axis_in_tdata, dut.u_top.axis_in_tuser,
+                    dut.u_top.axis_in_tlast);
         // the beats into and out of the application (fifo2axi's and rfl_morph's outputs)
         if (fbin != 0 && hs[2])
             $fwrite(fbin, "%08x %x %x %x\n", dut.u_top.axis_in_tdata, dut.u_top.axis_in_tkeep,
@@ -180,6 +192,7 @@ module rfl_tb;
             $fclose(fstats);
             if (fbin != 0) $fclose(fbin);
             if (fbout != 0) $fclose(fbout);
+            if (ff2a != 0) $fclose(ff2a);
             $display("rtlsim: %0d frame(s) in, %0d refused, %0d bytes in, %0d bytes out, %0d clocks",
                      frames, refused, in_bytes, out_bytes, cycle);
             if (failed) $fatal(1, "rtlsim: %0s", note);
