@@ -315,3 +315,19 @@ def test_a_cached_build_is_reused_and_keyed_by_the_sources(tmp_path: Path,
     assert other.directory != first.directory
     frame, expected = sample_frames(config)
     assert run(again, frame).output == expected
+
+
+def test_the_node_wrapper_carries_the_configuration() -> None:
+    from rosfpga_lab.rtl.project import rtl_files
+
+    config = load_config(DATA / "fpga_erode_mono8.yaml")
+    files = rtl_files(config)
+    assert files == rtl_files(config)  # deterministic
+    node = files["rtl/rfl_node.v"].decode()
+    for param in ('.WIDTH(320)', '.HEIGHT(240)', '.BYTES(1)', '.ENCODING("mono8")', '.ENC_LEN(5)',
+                  '.OP(1)', '.KSIZE(5)', f'.FRAME_ID_MAX({config.frame_id_max})',
+                  f'.RX_DEPTH({config.fifo.input_depth})', f'.TX_DEPTH({config.fifo.output_depth})',
+                  f'.AXIS_DEPTH({config.fifo.axis_depth})', '.SEQ_START(1)'):
+        assert param in node, param
+    assert "fpga_erode_mono8.yaml" in node
+    assert {f"rtl/{p.name}" for p in VERILOG_DIR.glob("*.v")} <= set(files)
