@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from realros import require_rtl
+from realros import require_rtl, skip_or_fail
 from rosfpga_lab.hw import PIXEL_FORMATS
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl import rtl_params, write_sources
@@ -29,7 +29,10 @@ def cosimulate(config, frames: list[bytes], tmp_path: Path, seed: int = 5) -> li
         The subscriber's statuses, one per frame it decided on.
     """
     require_rtl("iverilog")
-    runner_mod = pytest.importorskip("cocotb_tools.runner", reason="cocotb not installed")
+    try:
+        import cocotb_tools.runner as runner_mod
+    except ImportError:
+        skip_or_fail("cocotb not installed (pip install cocotb cocotbext-axi)", "ROSFPGA_REQUIRE_RTL")
     expected, _ = model_output(config, frames)
     (tmp_path / "frames.bin").write_bytes(b"".join(frames))
     (tmp_path / "expected.bin").write_bytes(expected)
