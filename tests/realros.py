@@ -75,6 +75,23 @@ def require_cxx() -> None:
         skip_or_fail(reason, "ROSFPGA_REQUIRE_CXX")
 
 
+def require_rtl(simulator: str | None = None) -> str:
+    """Skip (or fail under CI: ROSFPGA_REQUIRE_RTL=1) unless a Verilog simulator is usable.
+
+    Args:
+        simulator: ``"iverilog"`` or ``"verilator"``; None: the first installed.
+
+    Returns:
+        The simulator's name.
+    """
+    from rosfpga_lab.rtl import find_simulator, simulator_missing_reason
+
+    reason = simulator_missing_reason(simulator)
+    if reason:
+        skip_or_fail(reason, "ROSFPGA_REQUIRE_RTL")
+    return find_simulator(simulator)
+
+
 def free_port() -> int:
     """A TCP port on 127.0.0.1 that was free a moment ago."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as sock:

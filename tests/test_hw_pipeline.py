@@ -271,11 +271,13 @@ def test_cycles_for_the_papers_frame_at_100_mhz():
         "interpreter": data + 46, "fifo2axi": data, "axivideo2mat": 307200,
         "dilate": 481 * 641, "mat2axivideo": 307200, "axi2fifo": data, "generator": data + 46,
     }
-    assert res.latency["dilate"] == 641 + 2 and res.latency["interpreter"] == 47
-    assert res.report.bottleneck == "interpreter"
-    assert res.total_cycles == data + 46 + sum(res.latency.values())
+    # The filter's first pixel out after 641 + 2 pixels in, one pixel every 4 clocks.
+    assert res.latency["dilate"] == (641 + 1) * 4 + 1 and res.latency["interpreter"] == 47
+    assert res.report.bottleneck == "interpreter" and res.report.clocks_per_beat == 4
+    # The last byte leaves the filter's lag after the last byte came in (checked in the RTL).
+    assert res.total_cycles == data + 46 + res.latency["dilate"]
     assert res.frame_time_s == pytest.approx(res.total_cycles / 100e6)
-    assert res.frame_time_s == pytest.approx(0.01229, rel=1e-3)
+    assert res.frame_time_s == pytest.approx(0.01231, rel=1e-3)
     assert res.network_time_s == pytest.approx((data + 46) * 8 / 1e9)
     assert "bottleneck: interpreter" in res.summary()
     fast_clock = Pipeline(clock_hz=200e6, line_rate_bps=10e9).process(frame)

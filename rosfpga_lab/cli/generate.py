@@ -15,7 +15,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Generate, from a node configuration (YAML), the HLS C++ of a ROS-compliant "
         "FPGA component: subscriber, publisher, connection headers, application, top level, "
         "a C-simulation testbench with a test frame and the Python models' expected output, a "
-        "Makefile ('make csim' builds and runs it with g++) and a Vivado HLS Tcl script. "
+        "Makefile ('make csim' builds and runs it with g++; 'make rtlsim' simulates the same "
+        "circuit's Verilog, written into DIR/rtl/) and a Vivado HLS Tcl script. "
         "Examples: data/fpga_dilate_rgba8.yaml, data/fpga_erode_mono8.yaml, "
         "data/fpga_passthrough_rgb8.yaml.",
     )
@@ -33,18 +34,19 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Validate the configuration, then generate (errors are LabErrors, printed by the CLI)."""
     from rosfpga_lab.config import load_config
-    from rosfpga_lab.hls import generate
+    from rosfpga_lab.rtl.project import generate_project
 
     def say(message: str) -> None:
         if not args.quiet:
             print(f"generate: {message}", file=sys.stderr)
 
     config = load_config(args.config)
-    result = generate(config, args.output, force=args.force, progress=say)
+    result = generate_project(config, args.output, force=args.force, progress=say)
     if result.kept:
         say(f"left alone {len(result.kept)} files not written by the generator: "
             + ", ".join(result.kept[:5]) + (" ..." if len(result.kept) > 5 else ""))
     if not args.quiet:
         print(f"wrote {len(result.files)} files into {result.out_dir}; "
-              f"next: make -C {result.out_dir} csim")
+              f"next: make -C {result.out_dir} csim"
+              + (f" (or rtlsim)" if config.application.op != "custom" else ""))
     return 0

@@ -84,7 +84,9 @@ def build_csim(project_dir: str | Path, *, cxx: str = "g++") -> Path:
     return project / BINARY
 
 
-def _read_beats(path: Path) -> Beats:
+def read_beats(path: Path) -> Beats:
+    """Beats from a text file of ``tdata tkeep tuser tlast`` lines in hexadecimal (what the
+    C-simulation testbench and the RTL testbench write)."""
     text = path.read_text()
     if not text.strip():
         return Beats.empty()
@@ -129,8 +131,8 @@ def run_csim(project_dir: str | Path, frames: bytes, *, binary: str | Path | Non
             status.append((int(offset), name))
         return CsimResult(
             output=(work / "output.bin").read_bytes(),
-            input_beats=_read_beats(work / "input_beats.txt"),
-            output_beats=_read_beats(work / "output_beats.txt"),
+            input_beats=read_beats(work / "input_beats.txt"),
+            output_beats=read_beats(work / "output_beats.txt"),
             status=tuple(status),
             subscriber_header=(work / "subscriber_header.bin").read_bytes(),
             publisher_header=(work / "publisher_header.bin").read_bytes(),

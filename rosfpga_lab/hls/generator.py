@@ -19,7 +19,7 @@ from __future__ import annotations
 import hashlib
 import json
 import shutil
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,7 +32,7 @@ from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, SOURCES
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
 from rosfpga_lab.hw import limits as hw_limits
-from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, fixed_after
+from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, SUBSCRIBER_STATUSES, fixed_after
 from rosfpga_lab.msg import default_registry
 from rosfpga_lab.tcpros import encode_header
 
@@ -58,7 +58,7 @@ TB_INPUT = "tb_input.bin"
 TB_EXPECTED = "tb_expected.bin"
 #: What ``make csim`` and ``vivado_hls -f run_hls.tcl`` leave behind; --force removes these too.
 BUILD_PRODUCTS = ("csim_testbench", "csim_out", "hls_subscriber", "hls_image_filter",
-                  "hls_publisher", "vivado_hls.log")
+                  "hls_publisher", "vivado_hls.log", "rtlsim_out", "rtl/rfl_sim.vvp", "rtl/obj_dir")
 #: Bytes per line of the hexadecimal arrays in connection_headers.cpp.
 HEX_BYTES_PER_LINE = 16
 _OP_CPP = {"dilate": "Dilate", "erode": "Erode"}
@@ -188,8 +188,7 @@ def render(config: NodeConfig) -> dict[str, str]:
                             "the templates know; update templates/subscriber.cpp.j2")
     img = config.image
     fmt = PIXEL_FORMATS[img.encoding]
-    checked = [{"status": f"SUB_BAD_{t.field.upper()}", "label": t.label}
-               for t in INTERPRETER_TABLE if t.check and t.check != "frame_end"]
+    checked = [{"status": name, "label": label} for name, label in SUBSCRIBER_STATUSES[1:]]
     status_of = {t.field: f"SUB_BAD_{t.field.upper()}" for t in INTERPRETER_TABLE}
     interp = [{"field": t.field, "label": t.label, "kind": t.kind, "status": status_of[t.field]}
               for t in INTERPRETER_TABLE]
@@ -208,7 +207,7 @@ def render(config: NodeConfig) -> dict[str, str]:
         "max_frame_bytes": hw_limits.MAX_FRAME_BYTES, "min_body_bytes": MIN_BODY_BYTES,
         "checked": checked, "interp_table": interp, "gen_table": GENERATOR_TABLE,
         "after_frame_id": fixed_after("frame_id"), "after_encoding": fixed_after("encoding"),
-        "tb_input": TB_INPUT, "cxxflags": CXXFLAGS, "csim_sources": SOURCES,
+        "tb_input": TB_INPUT, "cxxflags": CXXFLAGS, "rtl": config.application.op != "custom", "csim_sources": SOURCES,
         "design_sources": [src for src in SOURCES if src != f"{BINARY}.cpp"],
         "tb_expected": TB_EXPECTED if config.application.op != "custom" else "",
         "headers": [
@@ -290,7 +289,8 @@ def _clean(out_dir: Path, manifest: dict) -> list[str]:
 
 
 def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
-             progress: Progress | None = None) -> GenerationResult:
+             progress: Progress | None = None,
+             extra_files: Mapping[str, bytes] | None = None) -> GenerationResult:
     """Write the HLS C++ project of ``config`` into ``out_dir``.
 
     Args:
@@ -299,6 +299,8 @@ def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
         force: replace an earlier generation: delete the files its manifest lists (and the
             testbench's build products) first. Files the generator did not write are kept.
         progress: called with a short message before each long step.
+        extra_files: more files to write (``{relative path: bytes}``) under the same manifest:
+            a layer above adds its own (``rosfpga_lab.rtl`` adds ``rtl/``, the Verilog).
 
     Returns:
         What was written, removed and kept.
@@ -330,6 +332,8 @@ def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
     blobs: dict[str, bytes] = {name: text.encode("utf-8") for name, text in texts.items()}
     for header in HLS_HEADERS:
         blobs[f"hls_include/{header}"] = (INCLUDE_DIR / header).read_bytes()
+    for name, data in (extra_files or {}).items():
+        blobs[name] = bytes(data)
     blobs[TB_INPUT] = tb_input
     if tb_expected:
         blobs[TB_EXPECTED] = tb_expected

@@ -78,6 +78,12 @@ INTERPRETER_TABLE: tuple[Transition, ...] = (
     Transition("DATA_LEN", "data_length", "data length", "u32", None, "DATA", "data_length"),
     Transition("DATA", "data", "data", "pixels", "data_length", "FRAME_LEN", "frame_end"),
 )
+#: The subscriber circuit's status codes, in code order: ``SUB_OK`` (0), then one per checked
+#: field of the table (``SUB_BAD_<FIELD>``), with the field's label. The generated HLS C++
+#: (``enum subscriber_status``) and the Verilog (``rfl_status.vh``) number them from here.
+SUBSCRIBER_STATUSES: tuple[tuple[str, str], ...] = (("SUB_OK", "frame accepted"),) + tuple(
+    (f"SUB_BAD_{t.field.upper()}", t.label) for t in INTERPRETER_TABLE
+    if t.check and t.check != "frame_end")
 #: Extra state entered after an error when the rest of the bad frame can be skipped.
 SKIP_STATE = "SKIP"
 _BY_STATE = {t.state: t for t in INTERPRETER_TABLE}

@@ -66,7 +66,8 @@ class PipelineResult:
         input_beats / output_beats: the AXI4-Stream into ``AXIvideo2Mat`` / out of
             ``Mat2AXIvideo`` (after any fault at that tap).
         cycles, latency: per stage (see :mod:`rosfpga_lab.hw.cycles`).
-        total_cycles, sequential_cycles: dataflow estimate and no-overlap sum.
+        total_cycles, sequential_cycles: first byte in to last byte out (the circuit's
+            concurrent stages, checked against the RTL) and the no-overlap sum.
         frame_time_s: ``total_cycles / clock_hz``.
         network_time_s: the input frame's bytes at ``line_rate_bps`` (payload only).
         wire_time_s: the same bytes as TCP over Ethernet: with the IP, TCP and Ethernet

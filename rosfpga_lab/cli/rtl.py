@@ -1,0 +1,219 @@
+"""``rosfpga-lab rtl ...``: the Verilog RTL of the circuit (simulation, cycles, synthesis).
+
+Each ``rtl`` sub-command is one ``_register_<name>(subparsers)`` function listed in
+:data:`SUBCOMMANDS`; adding one (``rtl synth``) means adding a function and a list entry.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from rosfpga_lab.cli._args import positive_int
+
+PER_MILLE_HELP = "per mille of clocks (0..990)"
+#: Bytes of input above which Verilator's fast simulation repays its slow compilation.
+BIG_INPUT = 200_000
+
+
+def _pick_simulator(chosen: str | None, input_bytes: int) -> str | None:
+    """``chosen``, else Verilator for a big input when it is installed, else the default."""
+    from rosfpga_lab.rtl import simulator_missing_reason
+
+    if chosen is None and input_bytes > BIG_INPUT and simulator_missing_reason("verilator") is None:
+        return "verilator"
+    return chosen
+
+
+def _per_mille(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"want a whole number, got {text!r}") from None
+    if not 0 <= value <= 990:
+        raise argparse.ArgumentTypeError(f"want 0..990 (per mille), got {value}")
+    return value
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"want WIDTHxHEIGHT such as 64x48, got {text!r}") from None
+    if w < 1 or h < 1:
+        raise argparse.ArgumentTypeError(f"want a positive size, got {text!r}")
+    return w, h
+
+
+def _common(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("config", type=Path, metavar="CONFIG", help="the node configuration (YAML)")
+    parser.add_argument("--no-cache", action="store_true",
+                        help="compile afresh instead of reusing a build of the same sources "
+                        "($XDG_CACHE_HOME/rosfpga-lab/rtl, ~/.cache by default)")
+    parser.add_argument("--simulator", choices=("iverilog", "verilator"),
+                        help="the simulator (default: Verilator for frames over "
+                        f"{BIG_INPUT // 1000} kB when installed, it compiles slowly but runs "
+                        "fast; else Icarus Verilog when installed, else Verilator)")
+
+
+def _register_sim(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "sim", help="simulate the RTL on TCPROS frames and compare with the Python models",
+        description="Simulate the Verilog of the component CONFIG describes (subscriber, "
+        "fifo2axi, application, axi2fifo, publisher and FIFOs) on TCPROS frames, with random "
+        "input gaps and output backpressure if asked, and compare every output byte with the "
+        "Python models' output (or --expected). Exit status 1 on any difference.")
+    _common(parser)
+    parser.add_argument("--input", type=Path, metavar="FRAMES",
+                        help="TCPROS frames (default: the configuration's test frame)")
+    parser.add_argument("--expected", type=Path, metavar="FILE",
+                        help="the bytes the output must equal (default: the Python models' output)")
+    parser.add_argument("-o", "--output", type=Path, metavar="FILE", help="write the output bytes here")
+    parser.add_argument("--vcd", type=Path, metavar="FILE",
+                        help="write a VCD of the stream and FIFO signals")
+    parser.add_argument("--gap", type=_per_mille, default=0, help=f"input gaps, {PER_MILLE_HELP}")
+    parser.add_argument("--bp", type=_per_mille, default=0,
+                        help=f"output backpressure, {PER_MILLE_HELP}")
+    parser.add_argument("--seed", type=positive_int, default=1, help="random seed (default 1)")
+    parser.set_defaults(func=run_sim)
+
+
+def _register_cycles(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "cycles", help="cycles per frame and per stage in the RTL beside the cycle model",
+        description="For every encoding (the configuration's operation, kernel and FIFOs), "
+        "simulate one frame with and without random output backpressure and print the clocks "
+        "from its first byte in to its last byte out, the model's figure (hw.cycles) and every "
+        "stage's span.")
+    _common(parser)
+    parser.add_argument("--size", type=_size, metavar="WxH",
+                        help="image size (default: the configuration's)")
+    parser.add_argument("--bp", type=_per_mille, default=500,
+                        help=f"the backpressure of the second row, {PER_MILLE_HELP} (default 500)")
+    parser.add_argument("--encoding", action="append", metavar="ENC",
+                        help="only these encodings (repeatable; default: all)")
+    parser.set_defaults(func=run_cycles)
+
+
+SUBCOMMANDS = [_register_sim, _register_cycles]
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``rtl`` sub-command and its own sub-commands."""
+    parser = subparsers.add_parser(
+        "rtl", help="the Verilog RTL of the circuit: simulate it, count its cycles",
+        description="The circuit as Verilog (rosfpga_lab/rtl/verilog): simulation with Icarus "
+        "Verilog or Verilator, cycles against the model.")
+    sub = parser.add_subparsers(dest="rtl_command", metavar="RTL_COMMAND")
+    for add in SUBCOMMANDS:
+        add(sub)
+    parser.set_defaults(func=lambda args: (parser.print_help(), 2)[1])
+
+
+def _say(message: str) -> None:
+    print(f"rtl: {message}", file=sys.stderr, flush=True)
+
+
+def run_sim(args: argparse.Namespace) -> int:
+    """Simulate, compare, report."""
+    from rosfpga_lab.errors import LabError
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.hls import sample_frames
+    from rosfpga_lab.hw import Pipeline, PipelineError
+    from rosfpga_lab.rtl import build, rtl_params, run
+
+    config = load_config(args.config)
+    params = rtl_params(config)
+    if args.input is not None:
+        try:
+            frames = args.input.read_bytes()
+        except OSError as exc:
+            raise LabError(f"cannot read {args.input}: {exc.strerror}") from None
+        expected = None
+    else:
+        frames, expected = sample_frames(config)
+    if args.expected is not None:
+        try:
+            expected = args.expected.read_bytes()
+        except OSError as exc:
+            raise LabError(f"cannot read {args.expected}: {exc.strerror}") from None
+    if expected is None:
+        expected = _model_output(Pipeline.from_config(config), frames, PipelineError)
+    _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ...")
+    sim = build(params, simulator=_pick_simulator(args.simulator, len(frames)),
+                trace=args.vcd is not None, cache=not args.no_cache)
+    how = f"built with {sim.simulator} in {sim.seconds:.1f} s" if sim.seconds else \
+        f"{sim.simulator} build reused from {sim.directory}"
+    _say(f"{how}; simulating {len(frames):,} bytes")
+    result = run(sim, frames, seed=args.seed, gap=args.gap, bp=args.bp, vcd=args.vcd)
+    for offset, status in result.status:
+        print(f"frame at byte {offset}: {status}")
+    print(f"{len(result.status)} frame(s), {len(result.output):,} bytes out, {result.cycles:,} clocks "
+          f"in {result.seconds:.2f} s ({result.clocks_per_second:,.0f} clocks/s, {sim.simulator})")
+    if result.cut_short:
+        print("the input ended inside a frame: the circuit waits for the rest of it")
+    if args.output is not None:
+        args.output.write_bytes(result.output)
+    if args.vcd is not None:
+        print(f"waveform: {args.vcd}")
+    if result.output == expected:
+        print(f"PASS: the output equals {'the Python models' + chr(39) + ' output' if args.expected is None else args.expected}")
+        return 0
+    diff = next((i for i, (a, b) in enumerate(zip(result.output, expected)) if a != b),
+                min(len(result.output), len(expected)))
+    print(f"FAIL: the output differs from the expected bytes at byte {diff} "
+          f"({len(result.output):,} bytes out, {len(expected):,} expected)")
+    return 1
+
+
+def _model_output(pipe, frames: bytes, error: type) -> bytes:
+    """The Python models' output for a stream of frames (refused ones give nothing)."""
+    out, pos = b"", 0
+    while pos + 4 <= len(frames):
+        size = 4 + int.from_bytes(frames[pos:pos + 4], "little")
+        try:
+            out += pipe.process(frames[pos:pos + size]).output_frame
+        except error:
+            pass
+        pos += size
+    return out
+
+
+def run_cycles(args: argparse.Namespace) -> int:
+    """Print the model-vs-RTL cycle table."""
+    import dataclasses
+
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.hls.generator import sample_image
+    from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, image_frame
+    from rosfpga_lab.rtl import build, rtl_params
+    from rosfpga_lab.rtl.cycles import compare, format_rows
+
+    config = load_config(args.config)
+    encodings = args.encoding or list(PIXEL_FORMATS)
+    unknown = [e for e in encodings if e not in PIXEL_FORMATS]
+    if unknown:
+        from rosfpga_lab.rtl import RtlError
+        raise RtlError(f"unknown encoding(s) {', '.join(unknown)}; the circuit packs "
+                       f"{', '.join(PIXEL_FORMATS)}")
+    rows = []
+    start = time.perf_counter()
+    for enc in encodings:
+        w, h = args.size or (config.image.width, config.image.height)
+        cfg = dataclasses.replace(config, image=dataclasses.replace(
+            config.image, width=w, height=h, encoding=enc))
+        _say(f"{enc} {w}x{h}: building and simulating ...")
+        params = rtl_params(cfg)
+        sim = build(params, simulator=_pick_simulator(args.simulator, params.data_bytes),
+                    cache=not args.no_cache)
+        frame = image_frame(sample_image(cfg), enc, frame_id="camera")
+        for bp in (0, args.bp):
+            rows.append(compare(f"{enc} {w}x{h}", sim, Pipeline.from_config(cfg), frame, bp=bp))
+    print(f"Clocks per frame, first byte in to last byte out ({config.application.op}"
+          f"{'' if config.application.op == 'passthrough' else f' {config.application.ksize}x{config.application.ksize}'}); "
+          "stage columns: the RTL's span of each stage")
+    print(format_rows(rows))
+    _say(f"done in {time.perf_counter() - start:.1f} s")
+    return 0

@@ -1,0 +1,27 @@
+"""The circuit as a circuit: Verilog RTL of the data path and its simulation.
+
+The Verilog (``verilog/``, module prefix ``rfl_``) is the paper's conventional design of the
+same circuit the HLS C++ describes: ``rfl_subscriber`` (TCPROS frame in, fields checked, pixel
+bytes out), ``rfl_fifo2axi`` (Figure 7), the application ``rfl_morph``, ``rfl_axi2fifo``,
+``rfl_publisher`` (TCPROS frame out) and ``rfl_fifo``, joined by ``rfl_top``. Parameters come
+from the node configuration (:func:`rtl_params`); :func:`build` and :func:`run` simulate it with
+Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
+
+    from rosfpga_lab.rtl import build, load_config, rtl_params, run
+    sim = build(rtl_params(load_config("data/fpga_dilate_rgba8.yaml")))
+    result = run(sim, frames, gap=100, bp=500)   # result.output: the frames sent
+"""
+
+from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
+from rosfpga_lab.rtl.params import OP_CODES, RtlParams, load_config, node_wrapper, rtl_params, status_header
+from rosfpga_lab.rtl.sim import (
+    SIMULATORS, STREAMS, RtlBuild, RtlResult, StreamTiming, build, find_simulator, run,
+    simulator_missing_reason, verilog_sources, write_sources,
+)
+
+__all__ = [
+    "OP_CODES", "SIMULATORS", "STREAMS", "RtlBuild", "RtlError", "RtlParams", "RtlResult",
+    "SimulatorMissingError", "StreamTiming", "build", "find_simulator", "load_config",
+    "node_wrapper", "rtl_params", "run", "simulator_missing_reason", "status_header",
+    "verilog_sources", "write_sources",
+]

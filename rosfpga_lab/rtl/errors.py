@@ -1,0 +1,13 @@
+"""The RTL layer's errors."""
+
+from __future__ import annotations
+
+from rosfpga_lab.errors import LabError
+
+
+class RtlError(LabError):
+    """A configuration the RTL cannot be built for, or a failed build or simulation."""
+
+
+class SimulatorMissingError(RtlError):
+    """No Verilog simulator (Icarus Verilog or Verilator) on this machine."""

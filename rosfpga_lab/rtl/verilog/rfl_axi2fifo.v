@@ -1,0 +1,35 @@
+// rfl_axi2fifo -- AXI4-Stream video beats back to bytes: for every beat, the bytes of the lanes
+// whose TKEEP bit is set, lane 0 first, one byte per clock onto the 8-bit stream.
+module rfl_axi2fifo (
+    input         clk,
+    input         rst_n,
+    input  [31:0] s_axis_tdata,
+    input  [3:0]  s_axis_tkeep,
+    input         s_axis_tvalid,
+    output        s_axis_tready,
+    output [7:0]  m_tdata,
+    output        m_tvalid,
+    input         m_tready
+);
+    reg [31:0] d;                               // the beat being unpacked
+    reg [3:0]  left;                            // its lanes not yet sent
+
+    wire [1:0] lane = left[0] ? 2'd0 : left[1] ? 2'd1 : left[2] ? 2'd2 : 2'd3;
+    wire [3:0] rest = left & ~(4'b0001 << lane);
+
+    assign m_tdata = d[8 * lane +: 8];
+    assign m_tvalid = (left != 4'd0);
+    assign s_axis_tready = (left == 4'd0) || (m_tready && rest == 4'd0);
+
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            d <= 32'd0;
+            left <= 4'd0;
+        end else if (s_axis_tvalid && s_axis_tready) begin
+            d <= s_axis_tdata;
+            left <= s_axis_tkeep;
+        end else if (m_tvalid && m_tready) begin
+            left <= rest;
+        end
+    end
+endmodule

@@ -1,0 +1,246 @@
+// rfl_morph -- the application circuit: rectangular dilate / erode of an AXI4-Stream video frame.
+//
+// One pixel per beat (tdata byte i = channel i, BYTES lanes used, the rest zero), tuser on the
+// first pixel of a frame, tlast on the last pixel of each line: the lab's packing rule
+// (rosfpga_lab/hw/encodings.py). Each output byte lane is the maximum (dilate) or minimum
+// (erode) of that lane over the KSIZE x KSIZE window centred on the pixel, clipped to the image:
+// cv2.dilate / cv2.erode with their default border. OP 2 copies the frame.
+//
+// How it works: the frame is a sequence of steps, one per clock when neither side stalls.
+// Step s scans position (vrow, vcol) of an image extended by D = KSIZE/2 rows below: it takes
+// the input pixel (rows < HEIGHT), writes it into one of KSIZE-1 line memories (row r lives in
+// memory r mod (KSIZE-1), so no data moves between memories) and reads the KSIZE-1 rows above
+// it, giving the vertical extreme V of column vcol over rows vrow-KSIZE+1 .. vrow (the rows in
+// the image only). V goes into a KSIZE-long shift register; the output pixel D rows and D
+// columns behind the scan takes the extreme of the entries that lie on its own line. The
+// window's right part of the last pixel needs D more steps without input (the flush). A frame
+// is (HEIGHT + D) * WIDTH + D steps; the first output leaves D * WIDTH + D steps after the first
+// input, plus the three pipeline registers.
+//
+// Handshake: the step pipeline (issue, line-memory read, shift register, output register)
+// advances as a whole when the output register is empty or being taken (adv); s_axis_tready is
+// adv while the step needs a pixel. Beats before a tuser beat are dropped (the HLS video
+// library's loop_wait_for_start); inside the frame the circuit counts WIDTH x HEIGHT pixels and
+// does not look at tuser or tlast again.
+`default_nettype none
+
+module rfl_morph #(
+    parameter WIDTH  = 640,
+    parameter HEIGHT = 480,
+    parameter KSIZE  = 3,
+    parameter OP     = 0,   // 0 dilate, 1 erode, 2 passthrough
+    parameter BYTES  = 4    // bytes per pixel: 4, 3 or 1
+) (
+    input  wire        aclk,
+    input  wire        aresetn,
+    input  wire [31:0] s_axis_tdata,
+    input  wire [3:0]  s_axis_tkeep,
+    input  wire        s_axis_tuser,
+    input  wire        s_axis_tlast,
+    input  wire        s_axis_tvalid,
+    output wire        s_axis_tready,
+    output reg  [31:0] m_axis_tdata,
+    output wire [3:0]  m_axis_tkeep,
+    output reg         m_axis_tuser,
+    output reg         m_axis_tlast,
+    output reg         m_axis_tvalid,
+    input  wire        m_axis_tready
+);
+
+    localparam K    = (OP == 2) ? 1 : KSIZE;
+    localparam D    = K / 2;
+    localparam W    = 8 * BYTES;
+    localparam NL   = (K > 1) ? K - 1 : 1;           // line memories (1 unused when K == 1)
+    localparam LEAD = D * WIDTH + D;                 // steps before the first output
+    localparam VROWS = HEIGHT + D;                   // scan rows
+    localparam RW   = $clog2(VROWS + 1);
+    localparam CW   = $clog2(WIDTH + 1);
+    localparam OW   = $clog2(HEIGHT + 1);
+    localparam LW   = (LEAD > 0) ? $clog2(LEAD + 1) : 1;
+    localparam SW   = (NL > 1) ? $clog2(NL) : 1;
+    localparam [W-1:0] ID = (OP == 1) ? {W{1'b1}} : {W{1'b0}};  // identity of max / min
+    localparam [3:0] KEEP = (BYTES == 4) ? 4'b1111 : (BYTES == 3) ? 4'b0111 :
+                            (BYTES == 2) ? 4'b0011 : 4'b0001;
+
+    // per-lane maximum (dilate) or minimum (erode)
+    function [W-1:0] pick(input [W-1:0] a, input [W-1:0] b);
+        integer l;
+        begin
+            for (l = 0; l < BYTES; l = l + 1)
+                if (OP == 1)
+                    pick[8*l +: 8] = (b[8*l +: 8] < a[8*l +: 8]) ? b[8*l +: 8] : a[8*l +: 8];
+                else
+                    pick[8*l +: 8] = (b[8*l +: 8] > a[8*l +: 8]) ? b[8*l +: 8] : a[8*l +: 8];
+        end
+    endfunction
+
+    // ---- step issue ------------------------------------------------------------------------
+    reg           run;         // inside a frame (else waiting for a tuser beat)
+    reg [RW-1:0]  vrow;        // scan position
+    reg [CW-1:0]  vcol;
+    reg [LW-1:0]  lead;        // steps left before outputs start
+    reg [OW-1:0]  orow;        // position of the next output pixel
+    reg [CW-1:0]  ocol;
+    reg [NL-1:0]  mvalid;      // line memory m holds a row of this frame's image
+    reg [SW-1:0]  wsel;        // line memory the current scan row is written to
+
+    wire adv     = !m_axis_tvalid || m_axis_tready;
+    wire vact    = (vrow < VROWS);
+    wire in_row  = (vrow < HEIGHT);
+    wire need_in = !run || (vact && in_row);
+    wire fire    = adv && (run ? (!need_in || s_axis_tvalid) : (s_axis_tvalid && s_axis_tuser));
+    wire emit    = (lead == 0);
+    wire last_px = emit && (orow == HEIGHT - 1) && (ocol == WIDTH - 1);
+
+    assign s_axis_tready = adv && need_in;
+
+    // which shift-register entries lie on the output pixel's line (entry j is column ocol+D-j)
+    reg [K-1:0] hmask_n;
+    integer j;
+    always @* begin
+        for (j = 0; j < K; j = j + 1)
+            hmask_n[j] = (ocol + D >= j) && (ocol + D <= WIDTH - 1 + j);
+    end
+
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            run <= 1'b0;
+            vrow <= 0; vcol <= 0; lead <= LEAD; orow <= 0; ocol <= 0;
+            mvalid <= 0; wsel <= 0;
+        end else if (fire) begin
+            run <= 1'b1;
+            if (vact) begin
+                if (vcol == WIDTH - 1) begin
+                    vcol <= 0;
+                    vrow <= vrow + 1'b1;
+                    mvalid[wsel] <= in_row;
+                    wsel <= (wsel == NL - 1) ? 0 : wsel + 1'b1;
+                end else begin
+                    vcol <= vcol + 1'b1;
+                end
+            end
+            if (!emit) begin
+                lead <= lead - 1'b1;
+            end else if (ocol == WIDTH - 1) begin
+                ocol <= 0;
+                orow <= orow + 1'b1;
+            end else begin
+                ocol <= ocol + 1'b1;
+            end
+            if (last_px) begin       // frame done: back to waiting for the next tuser
+                run <= 1'b0;
+                vrow <= 0; vcol <= 0; lead <= LEAD; orow <= 0; ocol <= 0;
+                mvalid <= 0; wsel <= 0;
+            end
+        end
+    end
+
+    // ---- stage 1: line memories read, current pixel, validity flags --------------------------
+    reg           valid1;
+    reg [W-1:0]   p1;
+    reg           pv1;         // p1 is an image pixel
+    reg [NL-1:0]  mv1;         // line memory outputs that are image pixels
+    reg           emit1, first1, eol1;
+    reg [K-1:0]   hmask1;
+    wire [NL*W-1:0] qall;
+
+    genvar m;
+    generate
+        if (K > 1) begin : lines
+            for (m = 0; m < NL; m = m + 1) begin : line
+                reg [W-1:0] mem [0:WIDTH-1];
+                reg [W-1:0] q;
+                always @(posedge aclk) begin
+                    if (fire && vact) begin
+                        if (wsel == m) mem[vcol] <= s_axis_tdata[W-1:0];
+                        q <= mem[vcol];          // read-first: the row written KSIZE-1 rows ago
+                    end
+                end
+                assign qall[m*W +: W] = q;
+            end
+        end else begin : nolines
+            assign qall = {NL*W{1'b0}};
+        end
+    endgenerate
+
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            valid1 <= 1'b0;
+        end else if (adv) begin
+            valid1 <= fire;
+            p1     <= s_axis_tdata[W-1:0];
+            pv1    <= vact && in_row;
+            mv1    <= vact ? mvalid : {NL{1'b0}};
+            emit1  <= emit;
+            first1 <= (orow == 0) && (ocol == 0);
+            eol1   <= (ocol == WIDTH - 1);
+            hmask1 <= hmask_n;
+        end
+    end
+
+    // vertical extreme of the column over the image rows of the window
+    reg [W-1:0] vext;
+    integer i;
+    always @* begin
+        vext = pv1 ? p1 : ID;
+        for (i = 0; i < NL; i = i + 1)
+            if (mv1[i]) vext = pick(vext, qall[i*W +: W]);
+    end
+
+    // ---- stage 2: horizontal shift register of vertical extremes -----------------------------
+    reg           valid2, emit2, first2, eol2;
+    reg [K-1:0]   hmask2;
+    reg [K*W-1:0] sr;          // entry 0 newest
+
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            valid2 <= 1'b0;
+        end else if (adv) begin
+            valid2 <= valid1;
+            emit2  <= emit1;
+            first2 <= first1;
+            eol2   <= eol1;
+            hmask2 <= hmask1;
+        end
+    end
+
+    generate
+        if (K > 1) begin : shift
+            always @(posedge aclk) if (adv && valid1) sr <= {sr[K*W-W-1:0], vext};
+        end else begin : noshift
+            always @(posedge aclk) if (adv && valid1) sr <= vext;
+        end
+    endgenerate
+
+    reg [W-1:0] hext;
+    integer h;
+    always @* begin
+        hext = ID;
+        for (h = 0; h < K; h = h + 1)
+            if (hmask2[h]) hext = pick(hext, sr[h*W +: W]);
+    end
+
+    // ---- stage 3: output register ------------------------------------------------------------
+    assign m_axis_tkeep = KEEP;
+
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            m_axis_tvalid <= 1'b0;
+            m_axis_tdata  <= 32'd0;
+            m_axis_tuser  <= 1'b0;
+            m_axis_tlast  <= 1'b0;
+        end else if (adv) begin
+            m_axis_tvalid <= valid2 && emit2;
+            m_axis_tdata  <= 32'd0;
+            m_axis_tdata[W-1:0] <= hext;
+            m_axis_tuser  <= first2;
+            m_axis_tlast  <= eol2;
+        end
+    end
+
+    // tkeep and tlast of the input are not needed: the frame is counted
+    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tlast};
+
+endmodule
+
+`default_nettype wire

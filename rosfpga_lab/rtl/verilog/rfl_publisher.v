@@ -1,0 +1,117 @@
+// rfl_publisher -- the publisher circuit: writes one TCPROS frame of sensor_msgs/Image onto the
+// 8-bit valid/ready output stream for every frame the subscriber accepted, one byte per clock:
+// the frame length first (computed from sizes the circuit knows), then every field in wire
+// order: header.seq (counting from SEQ_START, as a rospy publisher does), the stamp and
+// frame_id carried over from the subscriber, the image's fixed fields, and the pixel bytes
+// from axi2fifo last, passed straight through.
+module rfl_publisher #(
+    parameter WIDTH = 640,
+    parameter HEIGHT = 480,
+    parameter BYTES = 4,
+    parameter ENC_LEN = 5,
+    parameter [8*32-1:0] ENCODING = "rgba8",
+    parameter FRAME_ID_MAX = 256,
+    parameter MIN_BODY = 37,
+    parameter [31:0] SEQ_START = 1,
+    parameter FIDW = $clog2(FRAME_ID_MAX + 1)
+) (
+    input                 clk,
+    input                 rst_n,
+    input      [7:0]      s_tdata,              // pixel bytes from axi2fifo
+    input                 s_tvalid,
+    output                s_tready,
+    output reg [7:0]      m_tdata,              // the outgoing frame (combinational)
+    output                m_tvalid,
+    input                 m_tready,
+    input                 meta_valid,
+    output                meta_release,
+    input      [31:0]     meta_secs,
+    input      [31:0]     meta_nsecs,
+    input      [7:0]      meta_bigendian,
+    input      [FIDW-1:0] meta_fid_len,
+    output     [FIDW-1:0] fid_raddr,
+    input      [7:0]      fid_rdata,
+    output                frame_done,
+    output                idle                  // no frame being written
+);
+    localparam [31:0] STEP = WIDTH * BYTES;
+    localparam [31:0] DATA_BYTES = WIDTH * HEIGHT * BYTES;
+    localparam [31:0] BODY = MIN_BODY + ENC_LEN + DATA_BYTES;  // all but frame_id
+
+    localparam [3:0] F_IDLE = 4'd0, F_LEN = 4'd1, F_SEQ = 4'd2, F_SECS = 4'd3, F_NSECS = 4'd4,
+                     F_FIDLEN = 4'd5, F_FID = 4'd6, F_HEIGHT = 4'd7, F_WIDTH = 4'd8,
+                     F_ENCLEN = 4'd9, F_ENC = 4'd10, F_BIG = 4'd11, F_STEP = 4'd12,
+                     F_DLEN = 4'd13, F_DATA = 4'd14;
+
+    reg [3:0]  f;                               // the field being written
+    reg [31:0] i;                               // its byte being written
+    reg [31:0] seq;
+    reg [31:0] word;                            // the field's value, for uint32 fields
+    reg [31:0] flen;                            // the field's length in bytes
+
+    wire [31:0] fid_len = {{(32-FIDW){1'b0}}, meta_fid_len};
+    wire [31:0] enc_index = ENC_LEN - 1 - i;
+    wire [8*32-1:0] enc_shifted = ENCODING >> (8 * enc_index);
+    wire [7:0]  enc_byte = enc_shifted[7:0];
+
+    always @* begin
+        case (f)
+            F_LEN:    word = BODY + fid_len;
+            F_SEQ:    word = seq;
+            F_SECS:   word = meta_secs;
+            F_NSECS:  word = meta_nsecs;
+            F_FIDLEN: word = fid_len;
+            F_HEIGHT: word = HEIGHT;
+            F_WIDTH:  word = WIDTH;
+            F_ENCLEN: word = ENC_LEN;
+            F_STEP:   word = STEP;
+            F_DLEN:   word = DATA_BYTES;
+            default:  word = 32'd0;
+        endcase
+        case (f)
+            F_FID:   flen = fid_len;
+            F_ENC:   flen = ENC_LEN;
+            F_BIG:   flen = 32'd1;
+            F_DATA:  flen = DATA_BYTES;
+            default: flen = 32'd4;
+        endcase
+        case (f)
+            F_FID:   m_tdata = fid_rdata;
+            F_ENC:   m_tdata = enc_byte;
+            F_BIG:   m_tdata = meta_bigendian;
+            F_DATA:  m_tdata = s_tdata;
+            default: m_tdata = word[8 * i[1:0] +: 8];
+        endcase
+    end
+
+    assign m_tvalid = (f != F_IDLE) && (f != F_DATA || s_tvalid);
+    assign s_tready = (f == F_DATA) && m_tready;
+    assign fid_raddr = i[FIDW-1:0];
+    wire put = m_tvalid && m_tready;
+    wire field_done = put && (i == flen - 1);
+    assign meta_release = field_done && (f == F_BIG);  // the last field taken from the subscriber
+    assign frame_done = field_done && (f == F_DATA);
+    assign idle = (f == F_IDLE);
+
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            f <= F_IDLE;
+            i <= 32'd0;
+            seq <= SEQ_START;
+        end else if (f == F_IDLE) begin
+            if (meta_valid) f <= F_LEN;
+        end else if (field_done) begin
+            i <= 32'd0;
+            case (f)
+                F_FIDLEN: f <= (fid_len == 0) ? F_HEIGHT : F_FID;
+                F_DATA: begin
+                    f <= F_IDLE;
+                    seq <= seq + 32'd1;
+                end
+                default: f <= f + 4'd1;
+            endcase
+        end else if (put) begin
+            i <= i + 32'd1;
+        end
+    end
+endmodule

@@ -1,0 +1,65 @@
+"""Benchmark the RTL simulation (prints figures; not a test).
+
+* one 640x480 ``rgba8`` frame (data/fpga_dilate_rgba8.yaml: 3x3 dilate) through the whole RTL:
+  subscriber, fifo2axi, rfl_morph, axi2fifo, publisher and the FIFOs, with every output byte
+  compared to the Python models'. Target: under 10 s of simulation on this 2-core machine.
+* simulated clocks per second, per simulator installed (Icarus Verilog is timed on a
+  160x120 ``rgb8`` frame unless --full-icarus: it is far slower than Verilator).
+
+The build (compilation) time is printed apart: it is paid once per configuration.
+
+Usage: ``python tests/benchmarks/bench_rtl.py [--simulator verilator] [--full-icarus]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+from rosfpga_lab.config import load_config
+from rosfpga_lab.hls import sample_frames
+from rosfpga_lab.hw import Pipeline
+from rosfpga_lab.rtl import build, rtl_params, run, simulator_missing_reason
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+
+
+def bench(stem: str, simulator: str) -> None:
+    config = load_config(DATA / f"{stem}.yaml")
+    frame, _ = sample_frames(config)
+    expected = Pipeline.from_config(config).process(frame).output_frame
+    with tempfile.TemporaryDirectory(prefix="rosfpga-bench-rtl-") as tmp:
+        sim = build(rtl_params(config), Path(tmp), simulator=simulator)
+        result = run(sim, frame)
+    same = "equal to the Python models" if result.output == expected else "DIFFERENT from the models"
+    img = config.image
+    print(f"{simulator:<10} {img.width}x{img.height} {img.encoding:<6} build {sim.seconds:6.1f} s   "
+          f"frame {result.seconds:6.2f} s   {result.cycles:>10,} clocks   "
+          f"{result.clocks_per_second:>10,.0f} clocks/s   output {same}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--simulator", choices=("iverilog", "verilator"), action="append",
+                        help="only this simulator (repeatable; default: every one installed)")
+    parser.add_argument("--full-icarus", action="store_true",
+                        help="time Icarus Verilog on the 640x480 frame too (minutes)")
+    args = parser.parse_args(argv)
+    sims = [s for s in (args.simulator or ["verilator", "iverilog"])
+            if simulator_missing_reason(s) is None]
+    if not sims:
+        print(f"no simulator: {simulator_missing_reason()}", file=sys.stderr)
+        return 1
+    for simulator in sims:
+        if simulator == "verilator" or args.full_icarus:
+            bench("fpga_dilate_rgba8", simulator)
+        else:
+            bench("fpga_passthrough_rgb8", simulator)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
