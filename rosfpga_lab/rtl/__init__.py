@@ -1,4 +1,4 @@
-"""The circuit as a circuit: Verilog RTL of the data path and its simulation.
+"""The circuit as a circuit: Verilog RTL of the data path, its simulation and synthesis.
 
 The Verilog (``verilog/``, module prefix ``rfl_``) is the paper's conventional design of the
 same circuit the HLS C++ describes: ``rfl_subscriber`` (TCPROS frame in, fields checked, pixel
@@ -10,6 +10,10 @@ Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
     from rosfpga_lab.rtl import build, load_config, rtl_params, run
     sim = build(rtl_params(load_config("data/fpga_dilate_rgba8.yaml")))
     result = run(sim, frames, gap=100, bp=500)   # result.output: the frames sent
+
+:mod:`rosfpga_lab.rtl.vcd` reads waveform dumps into per-clock arrays,
+:mod:`rosfpga_lab.rtl.synth` synthesizes the modules with Yosys and
+:mod:`rosfpga_lab.rtl.sloc` counts their lines for the paper's Table 1.
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError

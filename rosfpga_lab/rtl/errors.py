@@ -11,3 +11,11 @@ class RtlError(LabError):
 
 class SimulatorMissingError(RtlError):
     """No Verilog simulator (Icarus Verilog or Verilator) on this machine."""
+
+
+class VcdError(RtlError):
+    """A waveform dump cannot be read: not a VCD, malformed, or past the reader's limits."""
+
+
+class SynthError(RtlError):
+    """Synthesis could not run (no Yosys) or Yosys refused the RTL (the message quotes it)."""

@@ -15,7 +15,8 @@
 // columns behind the scan takes the extreme of the entries that lie on its own line. The
 // window's right part of the last pixel needs D more steps without input (the flush). A frame
 // is (HEIGHT + D) * WIDTH + D steps; the first output leaves D * WIDTH + D steps after the first
-// input, plus the three pipeline registers.
+// input, plus the three pipeline registers. No input is taken during the flush, so the next
+// frame's first pixel goes in (HEIGHT + D) * WIDTH + D clocks after this frame's first one.
 //
 // Handshake: the step pipeline (issue, line-memory read, shift register, output register)
 // advances as a whole when the output register is empty or being taken (adv); s_axis_tready is
@@ -59,6 +60,15 @@ module rfl_morph #(
     localparam LW   = (LEAD > 0) ? $clog2(LEAD + 1) : 1;
     localparam SW   = (NL > 1) ? $clog2(NL) : 1;
     localparam [W-1:0] ID = (OP == 1) ? {W{1'b1}} : {W{1'b0}};  // identity of max / min
+    // the same constants at the widths of the counters they are compared with
+    localparam [31:0] VROWS_32 = VROWS, HEIGHT_32 = HEIGHT, LAST_ROW_32 = HEIGHT - 1,
+                      LAST_COL_32 = WIDTH - 1, LEAD_32 = LEAD, LAST_LINE_32 = NL - 1;
+    localparam [RW-1:0] VROWS_R   = VROWS_32[RW-1:0];
+    localparam [RW-1:0] HEIGHT_R  = HEIGHT_32[RW-1:0];
+    localparam [OW-1:0] LAST_ROW  = LAST_ROW_32[OW-1:0];
+    localparam [CW-1:0] LAST_COL  = LAST_COL_32[CW-1:0];
+    localparam [LW-1:0] LEAD_R    = LEAD_32[LW-1:0];
+    localparam [SW-1:0] LAST_LINE = LAST_LINE_32[SW-1:0];
     localparam [3:0] KEEP = (BYTES == 4) ? 4'b1111 : (BYTES == 3) ? 4'b0111 :
                             (BYTES == 2) ? 4'b0011 : 4'b0001;
 
@@ -85,43 +95,44 @@ module rfl_morph #(
     reg [SW-1:0]  wsel;        // line memory the current scan row is written to
 
     wire adv     = !m_axis_tvalid || m_axis_tready;
-    wire vact    = (vrow < VROWS);
-    wire in_row  = (vrow < HEIGHT);
+    wire vact    = (vrow < VROWS_R);
+    wire in_row  = (vrow < HEIGHT_R);
     wire need_in = !run || (vact && in_row);
     wire fire    = adv && (run ? (!need_in || s_axis_tvalid) : (s_axis_tvalid && s_axis_tuser));
     wire emit    = (lead == 0);
-    wire last_px = emit && (orow == HEIGHT - 1) && (ocol == WIDTH - 1);
+    wire last_px = emit && (orow == LAST_ROW) && (ocol == LAST_COL);
 
     assign s_axis_tready = adv && need_in;
 
     // which shift-register entries lie on the output pixel's line (entry j is column ocol+D-j)
     reg [K-1:0] hmask_n;
-    integer j;
+    integer j, oc;
     always @* begin
+        oc = {{(32 - CW){1'b0}}, ocol} + D;
         for (j = 0; j < K; j = j + 1)
-            hmask_n[j] = (ocol + D >= j) && (ocol + D <= WIDTH - 1 + j);
+            hmask_n[j] = (oc >= j) && (oc <= WIDTH - 1 + j);
     end
 
     always @(posedge aclk) begin
         if (!aresetn) begin
             run <= 1'b0;
-            vrow <= 0; vcol <= 0; lead <= LEAD; orow <= 0; ocol <= 0;
+            vrow <= 0; vcol <= 0; lead <= LEAD_R; orow <= 0; ocol <= 0;
             mvalid <= 0; wsel <= 0;
         end else if (fire) begin
             run <= 1'b1;
             if (vact) begin
-                if (vcol == WIDTH - 1) begin
+                if (vcol == LAST_COL) begin
                     vcol <= 0;
                     vrow <= vrow + 1'b1;
                     mvalid[wsel] <= in_row;
-                    wsel <= (wsel == NL - 1) ? 0 : wsel + 1'b1;
+                    wsel <= (wsel == LAST_LINE) ? {SW{1'b0}} : wsel + 1'b1;
                 end else begin
                     vcol <= vcol + 1'b1;
                 end
             end
             if (!emit) begin
                 lead <= lead - 1'b1;
-            end else if (ocol == WIDTH - 1) begin
+            end else if (ocol == LAST_COL) begin
                 ocol <= 0;
                 orow <= orow + 1'b1;
             end else begin
@@ -129,7 +140,7 @@ module rfl_morph #(
             end
             if (last_px) begin       // frame done: back to waiting for the next tuser
                 run <= 1'b0;
-                vrow <= 0; vcol <= 0; lead <= LEAD; orow <= 0; ocol <= 0;
+                vrow <= 0; vcol <= 0; lead <= LEAD_R; orow <= 0; ocol <= 0;
                 mvalid <= 0; wsel <= 0;
             end
         end
@@ -148,11 +159,12 @@ module rfl_morph #(
     generate
         if (K > 1) begin : lines
             for (m = 0; m < NL; m = m + 1) begin : line
+                localparam [SW-1:0] SEL = m;
                 reg [W-1:0] mem [0:WIDTH-1];
                 reg [W-1:0] q;
                 always @(posedge aclk) begin
                     if (fire && vact) begin
-                        if (wsel == m) mem[vcol] <= s_axis_tdata[W-1:0];
+                        if (wsel == SEL) mem[vcol] <= s_axis_tdata[W-1:0];
                         q <= mem[vcol];          // read-first: the row written KSIZE-1 rows ago
                     end
                 end
@@ -173,7 +185,7 @@ module rfl_morph #(
             mv1    <= vact ? mvalid : {NL{1'b0}};
             emit1  <= emit;
             first1 <= (orow == 0) && (ocol == 0);
-            eol1   <= (ocol == WIDTH - 1);
+            eol1   <= (ocol == LAST_COL);
             hmask1 <= hmask_n;
         end
     end
@@ -238,8 +250,8 @@ module rfl_morph #(
         end
     end
 
-    // tkeep and tlast of the input are not needed: the frame is counted
-    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tlast};
+    // tkeep, tlast and the unused lanes of the input are not needed: the frame is counted
+    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tlast, s_axis_tdata};
 
 endmodule
 
