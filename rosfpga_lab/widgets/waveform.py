@@ -139,22 +139,37 @@ class Waves:
         return cls(out, period_ns=period_ns, title=title)
 
     @classmethod
-    def from_vcd(cls, source: Any, *, clock: str = "aclk", signals: Iterable[str] | None = None,
+    def from_vcd(cls, source: Any, *, clock: str | None = None, signals: Iterable[str] | None = None,
                  short_names: bool = True, title: str = "") -> Waves:
         """Signals of a VCD dump sampled at the rising edges of its clock.
 
         Args:
             source: a ``.vcd`` path or its bytes, or a dump already read by
                 :func:`rosfpga_lab.rtl.vcd.read_vcd`.
-            clock: the clock's name or unique name suffix.
+            clock: the clock's name or unique name suffix (default: the first of
+                :data:`CLOCK_NAMES` the dump has).
             signals: names or unique suffixes to keep, in this order (default: all).
             short_names: label signals by their last scope part (``m_axis_tdata``) when that
                 is unique.
         """
+        from rosfpga_lab.rtl.errors import VcdError
         from rosfpga_lab.rtl.vcd import read_vcd
 
-        dump = source if hasattr(source, "values") and hasattr(source, "signals") else \
-            read_vcd(source, clock=clock, signals=list(signals) if signals is not None else None)
+        if hasattr(source, "values") and hasattr(source, "signals"):
+            dump = source
+        else:
+            keep = list(signals) if signals is not None else None
+            dump = None
+            for name in ([clock] if clock else CLOCK_NAMES):
+                try:
+                    dump = read_vcd(source, clock=name, signals=keep)
+                    break
+                except VcdError as exc:
+                    if clock or "no signal" not in str(exc):
+                        raise WidgetError(str(exc)) from None
+            if dump is None:
+                raise WidgetError(f"the dump has none of the clocks {', '.join(CLOCK_NAMES)}; "
+                                  "name it with clock=")
         names = [dump.resolve(n) for n in signals] if signals is not None else list(dump.signals)
         tails = [n.rsplit(".", 1)[-1] for n in names]
         unique = short_names and len(set(tails)) == len(tails)
