@@ -51,6 +51,9 @@ def test_beats_are_the_handshakes_and_markers_sit_on_them() -> None:
     assert markers[0].clock == clocks[0]
     assert [m.clock for m in markers if m.kind == "tlast"] == [int(clocks[k]) for k in (3, 7, 11)]
     assert waves.beat_clock("s_axis", 5) == int(clocks[5])
+    assert waves.stream_values("s_axis").tolist() == [0x11223300 + k for k in range(12)]
+    with pytest.raises(WidgetError, match="no tkeep"):
+        waves.stream_values("s_axis", "tkeep")
     assert waves.pixel_clock("s_axis", 1, 2, width=4) == int(clocks[9])
     with pytest.raises(WidgetError, match="carries beats 0..11"):
         waves.beat_clock("s_axis", 12)

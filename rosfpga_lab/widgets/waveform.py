@@ -240,6 +240,13 @@ class Waves:
             fire &= ready.values.astype(bool)
         return np.flatnonzero(fire)
 
+    def stream_values(self, stream: str, part: str = "tdata") -> np.ndarray:
+        """What ``stream`` carried: ``part`` (``tdata``, ``tuser``...) at each of its handshakes."""
+        sig = self._stream_signal(stream, part)
+        if sig is None:
+            raise WidgetError(f"stream {stream!r} has no {part} signal")
+        return sig.values[self.beat_clocks(stream)]
+
     def beat_clock(self, stream: str, beat: int) -> int:
         """The clock of beat number ``beat`` (from 0) of ``stream``."""
         clocks = self.beat_clocks(stream)
