@@ -179,3 +179,15 @@ def test_bad_input_is_refused_with_a_reason() -> None:
     viewer = WaveformViewer(waves)
     with pytest.raises(WidgetError, match="width="):
         viewer.jump_to_pixel("m_axis", 0, 0)
+
+
+def test_a_chosen_set_of_signals_draws_only_its_streams_markers_and_the_static_form_follows() -> None:
+    arrays = _stream(6, 3, width=3)
+    arrays.update({k.replace("s_axis", "m_axis"): v for k, v in _stream(6, 3, width=2).items() if k != "aclk"})
+    waves = Waves.from_arrays(arrays)
+    only_s = waves.svg(0, 40, names=["aclk", "s_axis_tvalid", "s_axis_tlast"])
+    assert "s_axis tlast" in only_s and "m_axis tlast" not in only_s
+    viewer = WaveformViewer(waves, names=["aclk", "m_axis_tvalid"], span=20)
+    viewer.set_cursor(5)
+    static = viewer.to_html()
+    assert "m_axis_tvalid" in static and "s_axis_tdata" not in static and 'stroke="#d00"' in static

@@ -349,7 +349,10 @@ class Waves:
         # markers row
         y0 = _ROW
         out.append(f'<text x="2" y="{y0 + 14}" fill="#555">TUSER/TLAST</text>')
-        for m in self.markers(start, start + span)[:MAX_EDGES]:
+        shown = {s.name for s in chosen}
+        streams = {st for st in self.streams()
+                   if any(f"{st}{sep}tvalid" in shown or (not st and "tvalid" in shown) for sep in "_.")}
+        for m in [m for m in self.markers(start, start + span) if m.stream in streams][:MAX_EDGES]:
             x = _LEFT + (m.clock - start + 0.5) * px
             colour, label = ("#2a9d3a", "U") if m.kind == "tuser" else ("#1f5fbf", "L")
             out.append(f'<g class="rfl-marker"><title>{esc(m.stream)} {m.kind} at clock {m.clock}</title>'
@@ -444,20 +447,23 @@ class Waves:
 
     def summary(self) -> str:
         """One line: clocks, signals, beats per stream."""
-        beats = ", ".join(f"{st or 'stream'} {self.beat_clocks(st).size} beats" for st in self.streams())
+        streams = self.streams()
+        beats = ", ".join(f"{st or 'stream'} {self.beat_clocks(st).size} beats" for st in streams[:4])
+        beats += f" (+{len(streams) - 4} more streams)" if len(streams) > 4 else ""
         time = self.clocks * self.period_ns
         unit, scale = ("ms", 1e-6) if time >= 1e6 else ("\u00b5s", 1e-3) if time >= 1e3 else ("ns", 1.0)
         return (f"{self.clocks} clocks ({time * scale:.4g} {unit} at {1e3 / self.period_ns:g} MHz), "
                 f"{len(self.signals)} signals" + (f"; {beats}" if beats else ""))
 
-    def to_html(self, start: int = 0, span: int = DEFAULT_SPAN) -> str:
+    def to_html(self, start: int = 0, span: int = DEFAULT_SPAN, cursor: int | None = None,
+                names: Sequence[str] | None = None) -> str:
         """Static HTML: title, summary, and the picture of one window (no kernel needed)."""
         start, span = self.clamp_window(start, span)
         head = f"<b>{esc(self.title)}</b> " if self.title else ""
         return (f'<div><div>{head}{esc(self.summary())}</div>'
                 f'<div style="font-size:11px;color:#555">clocks {start}..{start + span - 1}; '
                 f'U = TUSER, L = TLAST handshake; hatched = too many changes to draw at this zoom</div>'
-                f"{self.svg(start, span)}</div>")
+                f"{self.svg(start, span, cursor, names)}</div>")
 
     def _repr_html_(self) -> str:
         return self.to_html()
@@ -641,4 +647,4 @@ class WaveformViewer(StaticFallback, w.VBox):
                              f'gap:2px 18px">{items}</div></div>')
 
     def to_html(self) -> str:
-        return self.waves.to_html(self.start, self.span)
+        return self.waves.to_html(self.start, self.span, self.cursor, self.names)
