@@ -1,0 +1,65 @@
+"""Notebook 8's checks: right answers pass, and each typical wrong answer gets its own diagnosis."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from rosfpga_lab.checks import ExerciseError
+from rosfpga_lab.checks.circuit import (
+    BUG_SIGNAL, check_frame_clocks, check_ksize_rerun, check_planted_bug, planted_bug_arrays,
+)
+from rosfpga_lab.hls import sample_image
+from rosfpga_lab.hw import Pipeline, image_frame
+from rosfpga_lab.rtl import rtl_params
+from rosfpga_lab.rtl.demo import demo_config
+
+
+def test_the_planted_bug_is_tlast_one_beat_late() -> None:
+    sig = planted_bug_arrays()
+    fire = np.flatnonzero(sig["m_axis_tvalid"].astype(bool) & sig["m_axis_tready"].astype(bool))
+    assert sig[BUG_SIGNAL][fire].astype(int).tolist() == [0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0]
+    assert sig["m_axis_tuser"][fire].astype(int).tolist() == [1] + [0] * 11
+    assert "m_axis_tlast" in str(check_planted_bug("m_axis_tlast", 3))
+
+
+@pytest.mark.parametrize("signal,beat,says", [
+    ("m_axis_tuser", 0, "as fifo2axi makes it"),
+    ("m_axis_tlast", 4, "an earlier beat is already wrong"),
+    ("m_axis_tlast", 1, "its TLAST is right"),
+    ("s_tdata", 3, "the 8-bit side is fine"),
+    (..., 3, "replace it with your answer"),
+])
+def test_wrong_bug_answers_are_explained(signal, beat, says) -> None:
+    with pytest.raises(ExerciseError, match=says):
+        check_planted_bug(signal, beat)
+
+
+def test_frame_clocks() -> None:
+    result = check_frame_clocks(129, 257, 513)
+    assert "halves" in str(result)
+    with pytest.raises(ExerciseError, match="number of beats"):
+        check_frame_clocks(128, 257, 513)
+    with pytest.raises(ExerciseError, match="only every other clock"):
+        check_frame_clocks(129, 129, 513)
+    with pytest.raises(ExerciseError, match="costs nothing"):
+        check_frame_clocks(129, 257, 1025)
+
+
+def test_ksize_rerun_checks_the_parameters_and_the_output() -> None:
+    config = demo_config()
+    base = rtl_params(config)
+    good = image_frame(sample_image(config), config.image.encoding)
+    five = dataclasses.replace(base, KSIZE=5)
+    assert "not re-run" in str(check_ksize_rerun(five, base, None, good))
+    model5 = Pipeline(width=16, height=8, encoding="rgba8", op="dilate", ksize=(5, 5)).process(good)
+    assert "cv2.dilate" in str(check_ksize_rerun(five, base, model5.output_frame, good))
+    model3 = Pipeline.from_config(config).process(good)
+    with pytest.raises(ExerciseError, match="not the 5x5 dilate"):
+        check_ksize_rerun(five, base, model3.output_frame, good)
+    with pytest.raises(ExerciseError, match="KSIZE is 3"):
+        check_ksize_rerun(base, base, None, good)
+    with pytest.raises(ExerciseError, match="these changed too: WIDTH"):
+        check_ksize_rerun(dataclasses.replace(five, WIDTH=17), base, None, good)
