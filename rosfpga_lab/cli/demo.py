@@ -42,6 +42,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="serve a live page (input, output, counters) on 127.0.0.1 at a free port "
                    "while the demo runs; its URL is printed first. The page needs no internet "
                    "and stops with the demo")
+    p.add_argument("--pcap", type=Path, metavar="FILE",
+                   help="write the whole conversation (XML-RPC, TCPROS) as a capture file for "
+                   "Wireshark (pcapng; .pcap for classic pcap); frames keep the trace's excerpt "
+                   "of their bytes. TCPROS: tshark --enable-heuristic tcpros_tcp, or Decode As")
     p.add_argument("-v", "--verbose", action="store_true", help="print each step")
     p.set_defaults(func=run)
 
@@ -59,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
                           png=None if args.no_figure else args.output, model=args.model,
                           timeout=args.timeout, png_scale=args.scale,
                           progress=print if args.verbose else None,
-                          view=_announce if args.view else None)
+                          view=_announce if args.view else None, pcap=args.pcap)
     except KeyboardInterrupt:
         print("rosfpga-lab demo: interrupted (everything it started is stopped); no verdict",
               file=sys.stderr)
