@@ -321,7 +321,7 @@ def parse_message(data: bytes | bytearray | memoryview) -> RtpsMessage:
     """
     data = bytes(data)
     if len(data) < HEADER_SIZE:
-        if data != MAGIC[:len(data)]:
+        if data[:4] != MAGIC[:len(data)]:
             raise RtpsError(f"not an RTPS message: starts with {data[:4]!r}, not {MAGIC!r}", 0)
         raise RtpsTruncatedError(f"RTPS header needs {HEADER_SIZE} bytes, the datagram has "
                                  f"{len(data)}", len(data))
