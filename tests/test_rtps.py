@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rosfpga_lab.graph.capture import udp_datagrams
+from rosfpga_lab.graph.capture_read import udp_datagrams
 from rosfpga_lab.msg import deserialize_cdr
 from rosfpga_lab.rtps import (
     AckNack, Data, DataFrag, FragmentAssembler, Gap, Heartbeat, HeartbeatFrag, RtpsError, RtpsTruncatedError,

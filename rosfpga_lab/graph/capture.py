@@ -274,29 +274,3 @@ def write_capture(path: str | Path, *traces: Trace) -> int:
         raise GraphError(f"cannot write the capture {path}: {exc.strerror or exc}") from None
     return len(packets)
 
-
-def udp_datagrams(path: str | Path) -> list[tuple[float, str, str, bytes]]:
-    """``(time, "src:port", "dst:port", payload)`` of every UDP datagram in a capture file
-    (pcap or pcapng), e.g. RTPS messages for ``rosfpga_lab.rtps.parse_message``.
-
-    Raises:
-        GraphError: the file cannot be read as a capture.
-    """
-    from scapy.error import Scapy_Exception
-    from scapy.layers.inet import IP, UDP
-    from scapy.layers.inet6 import IPv6
-    from scapy.utils import PcapReader
-
-    out = []
-    try:
-        with PcapReader(str(path)) as reader:
-            for pkt in reader:
-                if UDP not in pkt:
-                    continue
-                ip = pkt[IP] if IP in pkt else pkt[IPv6]
-                udp = pkt[UDP]
-                out.append((float(pkt.time), f"{ip.src}:{udp.sport}", f"{ip.dst}:{udp.dport}",
-                            bytes(udp.payload)))
-    except (OSError, Scapy_Exception) as exc:
-        raise GraphError(f"cannot read the capture {path}: {exc}") from None
-    return out

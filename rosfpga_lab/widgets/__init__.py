@@ -16,6 +16,7 @@ reference::
     W.ImageDiffViewer(output, reference, input)       # or frames=[(input, output, reference), ...]
     W.BeatViewer(beats, width=w, height=h, bytes_per_pixel=4)  # hw Beats (tdata/tkeep/tuser/tlast)
     W.SequenceDiagram(trace)                          # graph Trace or [SeqEvent(src, dst, label, raw, t, kind)]
+    W.SequenceDiagram("data/ros1_image.pcapng")       # a capture of real ROS 1 traffic
     W.WaveformViewer(W.Waves.from_vcd("dump.vcd"), width=640)   # per-clock signals; or Waves.from_arrays({...})
     live = W.LiveView(max_fps=10); live.update(frame, stamp=t)   # from any thread
     with W.Progress(total, "dilate") as p: p.update()  # or W.track(iterable, desc=...)
@@ -43,6 +44,7 @@ from rosfpga_lab.widgets.sequence import (
     SeqEvent,
     SequenceDiagram,
     SvgPane,
+    events_from_capture,
     events_from_trace,
     participants_of,
     sequence_html,
@@ -56,7 +58,7 @@ __all__ = [
     "BeatMap", "BeatViewer", "ByteMap", "CodeFiles", "code_html", "ByteViewer", "FrameDiff", "ImageDiffViewer", "LiveView",
     "MarkerMismatch", "Progress", "RateMeter", "SeqEvent", "SequenceDiagram", "Span", "StateDiagram",
     "SvgPane", "state_diagram_svg",
-    "Throttle", "WidgetError", "as_span", "events_from_trace", "in_notebook", "message_spans",
+    "Throttle", "WidgetError", "as_span", "events_from_capture", "events_from_trace", "in_notebook", "message_spans",
     "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
     "spans_from_http", "spans_from_tcpros_stream", "track", "view_bytes",
