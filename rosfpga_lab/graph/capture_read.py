@@ -23,6 +23,10 @@ from rosfpga_lab.graph.trace import Trace
 from rosfpga_lab.graph.xmlrpc import _parse_head, parse_xmlrpc, split_uri
 from rosfpga_lab.tcpros import FrameDecoder, ProtocolError, decode_header
 
+#: The lab's data/ folder and the real captures shipped in it (each made by the script beside it).
+DATA_DIR = Path(__file__).resolve().parents[2] / "data"
+ROS1_CAPTURE = DATA_DIR / "ros1_image.pcapng"
+RTPS_CAPTURE = DATA_DIR / "rtps_image.pcapng"
 #: Most bytes one direction of one connection may hold when read from a capture.
 MAX_STREAM_BYTES = 256 * 1024 * 1024
 #: Master API methods whose 4th parameter is the caller's XML-RPC URI.
