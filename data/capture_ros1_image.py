@@ -2,7 +2,7 @@
 """Make data/ros1_image.pcapng: real rosmaster, rospy and roscpp exchanging a small Image.
 
 Rerun as root (dumpcap needs it) from the lab's checkout:
-    sudo .venv/bin/python data/capture_ros1_image.py
+    sudo .venv/bin/python data/capture_ros1_image.py [--out FILE]
 It needs Debian's ROS 1 Noetic (rosmaster, python3-rospy, python3-sensor-msgs,
 libroscpp-dev, libsensor-msgs-dev), g++ and tshark (for dumpcap), as the lab's real-ROS
 tests do.
@@ -16,6 +16,7 @@ so other loopback traffic on the machine stays out.
 
 from __future__ import annotations
 
+import argparse
 import os
 import shutil
 import socket
@@ -91,6 +92,9 @@ def free_port() -> int:
 
 
 def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=OUT, help=f"capture to write (default: {OUT})")
+    out = parser.parse_args().out
     if os.geteuid() != 0:
         print("run as root (dumpcap on lo)", file=sys.stderr)
         return 2
@@ -128,8 +132,8 @@ def main() -> int:
         code, _, sub_uri = master.lookupNode("/capture", "/roscpp_viewer")
         assert code == 1, sub_uri
         sub_xmlrpc = int(sub_uri.rstrip("/").rsplit(":", 1)[1])
-        out, _ = sub.communicate(timeout=60)
-        print(out.decode(), end="")
+        printed, _ = sub.communicate(timeout=60)
+        print(printed.decode(), end="")
         pub.wait(timeout=30)
         time.sleep(1.0)
     finally:
@@ -144,10 +148,10 @@ def main() -> int:
         print("the roscpp subscriber did not get every frame", file=sys.stderr)
         return 1
     ports = ", ".join(str(p) for p in (master_port, pub_xmlrpc, pub_tcpros, sub_xmlrpc))
-    subprocess.run(["tshark", "-r", str(raw), "-Y", f"tcp.port in {{{ports}}}", "-w", str(OUT)],
+    subprocess.run(["tshark", "-r", str(raw), "-Y", f"tcp.port in {{{ports}}}", "-w", str(out)],
                    check=True, stderr=subprocess.DEVNULL)
-    OUT.chmod(0o644)
-    print(f"wrote {OUT} ({OUT.stat().st_size} bytes); ports master {master_port}, rospy "
+    out.chmod(0o644)
+    print(f"wrote {out} ({out.stat().st_size} bytes); ports master {master_port}, rospy "
           f"XML-RPC {pub_xmlrpc}, TCPROS {pub_tcpros}, roscpp XML-RPC {sub_xmlrpc}")
     return 0
 

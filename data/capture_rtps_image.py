@@ -2,8 +2,8 @@
 """Make data/rtps_image.pcapng: Cyclone DDS sending a ROS 2-style Image over loopback.
 
 Rerun as root (dumpcap needs it) from the lab's checkout, with the lab's environment:
-    sudo .venv/bin/python data/capture_rtps_image.py
-It needs Debian's tshark (for dumpcap) and PyPI's cyclonedds (the lab's [test] extra).
+    sudo .venv/bin/python data/capture_rtps_image.py [--out FILE]
+It needs Debian's tshark (for dumpcap) and PyPI's cyclonedds (in the lab's [test] extra).
 
 A subscriber and a publisher (two processes, DDS domain 0) find each other by SPDP/SEDP over
 127.0.0.1 only (no multicast: the peer list is 127.0.0.1), then the publisher sends FRAMES
@@ -14,6 +14,7 @@ is far larger than a UDP datagram, so it travels as DATA_FRAG submessages.
 
 from __future__ import annotations
 
+import argparse
 import os
 import shutil
 import subprocess
@@ -99,6 +100,9 @@ sys.exit(0 if got >= int(sys.argv[1]) else 1)
 
 
 def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=OUT, help=f"capture to write (default: {OUT})")
+    out = parser.parse_args().out
     dumpcap = shutil.which("dumpcap") or "/usr/bin/dumpcap"
     if os.geteuid() != 0:
         print("run as root (dumpcap on lo)", file=sys.stderr)
@@ -120,8 +124,9 @@ def main() -> int:
     if pub.returncode or sub_rc:
         print(f"publisher exit {pub.returncode}, subscriber exit {sub_rc}", file=sys.stderr)
         return 1
-    shutil.copy(work / "raw.pcapng", OUT)
-    print(f"wrote {OUT} ({OUT.stat().st_size} bytes)")
+    shutil.copy(work / "raw.pcapng", out)
+    out.chmod(0o644)
+    print(f"wrote {out} ({out.stat().st_size} bytes)")
     return 0
 
 

@@ -12,10 +12,10 @@ import pytest
 from rosfpga_lab.graph.capture_read import udp_datagrams
 from rosfpga_lab.msg import deserialize_cdr
 from rosfpga_lab.rtps import (
-    AckNack, Data, DataFrag, FragmentAssembler, Gap, Heartbeat, HeartbeatFrag, RtpsError, RtpsTruncatedError,
+    AckNack, DataFrag, FragmentAssembler, Gap, RtpsError, RtpsTruncatedError,
     discovery, parse_message, parse_parameters,
 )
-from wiretools import tshark_fields
+from wiretools import assert_rtps_agrees_with_tshark
 
 CAPTURE = Path(__file__).resolve().parent.parent / "data" / "rtps_image.pcapng"
 DATAGRAMS = [d[3] for d in udp_datagrams(CAPTURE)]
@@ -55,30 +55,8 @@ def test_fragments_reassemble_into_the_published_image() -> None:
         assert np.array_equal(img["data"], expected.astype(np.uint8))
 
 
-def _sequence_numbers(sub: object) -> list[int]:
-    """The sequence numbers tshark shows as rtps.sm.seqNumber, in its order."""
-    if isinstance(sub, Heartbeat):
-        return [sub.first, sub.last]
-    if isinstance(sub, AckNack):
-        return [sub.base]
-    if isinstance(sub, Gap):
-        return [sub.start, sub.list_base]
-    if isinstance(sub, (Data, DataFrag, HeartbeatFrag)):
-        return [sub.seq]
-    return []
-
-
 def test_decoder_agrees_with_tshark() -> None:
-    rows = tshark_fields(CAPTURE, ["rtps.sm.id", "rtps.sm.wrEntityId", "rtps.sm.seqNumber",
-                                   "rtps.data_frag.number"], display_filter="rtps")
-    assert len(rows) == len(MESSAGES)
-    for row, msg in zip(rows, MESSAGES):
-        ids, writers, seqs, frags = (r.split("|") if r else [] for r in row)
-        subs = msg.submessages
-        assert [f"0x{s.kind:02x}" for s in subs] == ids
-        assert [f"0x{s.writer_id:08x}" for s in subs if hasattr(s, "writer_id")] == writers
-        assert [str(n) for s in subs for n in _sequence_numbers(s)] == seqs
-        assert [str(s.frag_start) for s in subs if isinstance(s, DataFrag)] == frags
+    assert assert_rtps_agrees_with_tshark(CAPTURE) == len(MESSAGES)
 
 
 @pytest.mark.parametrize("index", [0, 1, 2, 5, 40])
