@@ -114,3 +114,12 @@ def test_assembler_bounds_memory() -> None:
                     frag_count=1, frag_size=4, sample_size=10**9, payload=b"abcd")
     with pytest.raises(RtpsError, match="max_sample_bytes"):
         FragmentAssembler().add(b"p" * 12, frag)
+
+
+def test_assembler_ignores_fragment_numbers_past_the_sample() -> None:
+    asm = FragmentAssembler()
+    common = dict(kind=0x16, flags=1, offset=0, size=0, writer_id=1, seq=1, frag_size=4,
+                  sample_size=6)
+    assert asm.add(b"p" * 12, DataFrag(**common, frag_start=9, frag_count=1, payload=b"zzzz")) is None
+    assert asm.add(b"p" * 12, DataFrag(**common, frag_start=2, frag_count=1, payload=b"ef")) is None
+    assert asm.add(b"p" * 12, DataFrag(**common, frag_start=1, frag_count=1, payload=b"abcd")) == b"abcdef"

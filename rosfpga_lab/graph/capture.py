@@ -119,8 +119,8 @@ def connections(traces: Iterable[Trace]) -> list[Connection]:
         if client is None:
             # only the accepting end's TCPROS link recorded (its tcp_connect was evicted)
             client = evs[0].remote
-        server = next(a for e in evs for a in (e.local, e.remote) if a != client) \
-            if len({e.local for e in evs} | {e.remote for e in evs}) > 1 else client
+        others = {a for e in evs for a in (e.local, e.remote)} - {client}
+        server = min(others) if others else client
         out.append(_connection(client, server, evs))
     return sorted(out, key=lambda c: c.opened or 0.0)
 

@@ -133,16 +133,17 @@ class FragmentAssembler:
                             frag.offset)
         if frag.frag_size == 0:
             raise RtpsError(f"DATA_FRAG at byte {frag.offset} has fragment size 0", frag.offset)
+        total = -(-frag.sample_size // frag.frag_size)
         key = (guid_prefix, frag.writer_id, frag.seq)
         parts = self._pending.setdefault(key, {})
         if len(self._pending) > self.max_pending:
             self._pending.pop(next(iter(self._pending)))
             self.dropped += 1
         for i in range(frag.frag_count):
-            chunk = frag.payload[i * frag.frag_size:(i + 1) * frag.frag_size]
-            parts[frag.frag_start + i] = chunk
-        total = -(-frag.sample_size // frag.frag_size)
-        if len(parts) < total or any(n not in parts for n in range(1, total + 1)):
+            number = frag.frag_start + i
+            if 1 <= number <= total:       # numbers past the sample's end are ignored
+                parts[number] = frag.payload[i * frag.frag_size:(i + 1) * frag.frag_size]
+        if len(parts) < total:
             return None
         del self._pending[key]
         sample = b"".join(parts[n] for n in range(1, total + 1))[:frag.sample_size]

@@ -232,11 +232,11 @@ class _Body:
         return chunk
 
 
-def _data_common(b: _Body) -> tuple[int, int, int, int, int]:
+def _data_common(b: _Body) -> tuple[int, int, int, int]:
     _extra, to_qos = b.unpack("HH", "extraFlags/octetsToInlineQos")
     qos_at = b.pos + to_qos
     reader, writer, seq = b.entity("readerId"), b.entity("writerId"), b.seq("writerSN")
-    return to_qos, qos_at, reader, writer, seq
+    return qos_at, reader, writer, seq
 
 
 def _inline_qos(b: _Body, data: bytes) -> bytes:
@@ -262,14 +262,14 @@ def _submessage(data: bytes, kind: int, flags: int, offset: int, end: int) -> Su
     if kind == 0x0E:
         return InfoDst(**common, guid_prefix=b.take(12, "guidPrefix"))
     if kind == 0x15:  # DATA: Q=0x02 D=0x04 K=0x08
-        _to, qos_at, reader, writer, seq = _data_common(b)
+        qos_at, reader, writer, seq = _data_common(b)
         b.take(max(0, qos_at - b.pos), "the bytes before the inline QoS")
         qos = _inline_qos(b, data) if flags & 0x02 else b""
         payload = b.rest() if flags & 0x0C else b""
         return Data(**common, reader_id=reader, writer_id=writer, seq=seq, inline_qos=qos,
                     payload=payload, key=bool(flags & 0x08))
     if kind == 0x16:  # DATA_FRAG: Q=0x02 K=0x04
-        _to, qos_at, reader, writer, seq = _data_common(b)
+        qos_at, reader, writer, seq = _data_common(b)
         start, count, size, sample = b.unpack("IHHI", "fragment fields")
         b.take(max(0, qos_at - b.pos), "the bytes before the inline QoS")
         qos = _inline_qos(b, data) if flags & 0x02 else b""
