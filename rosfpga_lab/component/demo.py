@@ -25,8 +25,8 @@ from rosfpga_lab.component.fpga import FpgaComponent
 from rosfpga_lab.component.sources import to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary
 from rosfpga_lab.component.webview import DemoPage
-from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.config import NodeConfig, load_config, parse_config
+from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.graph.capture import write_capture
 
 #: The demo's configuration file in the lab's data/ directory.
