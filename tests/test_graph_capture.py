@@ -117,3 +117,16 @@ def test_tshark_finds_no_tcp_analysis_warnings(demo_capture: Path, tmp_path: Pat
             if i != victim:
                 w.write(p)
     assert tshark_fields(broken, ["frame.number"], display_filter="tcp.analysis.flags") != []
+
+
+def test_demo_command_writes_the_capture(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    out = tmp_path / "demo.pcap"   # classic pcap by its name
+    run = subprocess.run([sys.executable, "-m", "rosfpga_lab", "demo", "--frames", "2", "--source",
+                          "synthetic", "--no-figure", "--pcap", str(out)],
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert f"capture: {out} (" in run.stdout
+    assert out.read_bytes()[:4] == bytes.fromhex("d4c3b2a1")   # pcap magic, little-endian
