@@ -130,3 +130,19 @@ def test_demo_command_writes_the_capture(tmp_path: Path) -> None:
     assert run.returncode == 0, run.stdout + run.stderr
     assert f"capture: {out} (" in run.stdout
     assert out.read_bytes()[:4] == bytes.fromhex("d4c3b2a1")   # pcap magic, little-endian
+
+
+def test_whole_frames_decode_in_tshark(tmp_path: Path) -> None:
+    from rosfpga_lab.component import run_demo
+
+    path = tmp_path / "full.pcapng"
+    result = run_demo(None, frames=2, source="synthetic", png=None, pcap=path,
+                      pcap_frame_bytes=1_300_000)
+    assert result.ok
+    rows = tshark_fields(path, ["tcpros.message.length", "tcpros.message.header.frame.value"],
+                         display_filter="tcpros.message",
+                         options=["-2", "--enable-heuristic", "tcpros_tcp"])
+    body = 640 * 480 * 4 + 4 + 8 + 4 + len("camera") + 4 + 4 + 4 + len("rgba8") + 1 + 4 + 4
+    assert rows == [[str(body), "camera"]] * 4        # 2 frames in, 2 out, each whole
+    assert tshark_fields(path, ["frame.number"],
+                         display_filter="tcp.analysis.flags || _ws.expert.severity >= warning") == []

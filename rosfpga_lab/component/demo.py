@@ -107,8 +107,7 @@ class DemoResult:
         if self.png is not None:
             out.append(f"figure: {self.png}")
         if self.pcap is not None:
-            out.append(f"capture: {self.pcap} ({self.pcap_packets} packets; TCPROS frames cut to "
-                       f"the trace's excerpts)")
+            out.append(f"capture: {self.pcap} ({self.pcap_packets} packets)")
         return out
 
 
@@ -197,7 +196,7 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
              oracle_op: str | None = None,
              progress: Callable[[str], None] | None = None,
              view: Callable[[str], None] | None = None,
-             pcap: str | Path | None = None) -> DemoResult:
+             pcap: str | Path | None = None, pcap_frame_bytes: int | None = None) -> DemoResult:
     """Run the demo (see module docstring).
 
     Args:
@@ -215,6 +214,9 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
             demo runs; called with its URL before the first frame. The page stops with the demo.
         pcap: write the whole conversation (XML-RPC and TCPROS, every connection as a TCP
             stream) to this capture file (``.pcap`` or pcapng), after everything stopped.
+        pcap_frame_bytes: body bytes of each TCPROS frame the traces keep (default: the
+            trace's excerpt, ``Trace.frame_bytes``); at least the frame size keeps whole frames
+            (memory and file then grow by a frame per frame sent and received).
     """
     say = progress or (lambda _text: None)
     if png is not None:
@@ -229,6 +231,9 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         say(f"component: {rig.component!r}")
         if not rig.connected:
             say("warning: connections were not all up after 10 s")
+        if pcap_frame_bytes is not None:
+            for trace in rig.traces():
+                trace.frame_bytes = pcap_frame_bytes
         say(f"camera: {frames} frames of {source!r} at {rate:g} fps")
         page = None
         if view is not None:

@@ -16,7 +16,8 @@ the wire (so sequence numbers stay consistent and Wireshark's TCP analysis has n
 flag) but carries only the recorded bytes, and the first segment of such a frame has a pcapng
 comment saying how many bytes the trace kept. Wireshark shows those packets as "[Packet size
 limited during capture]". Record with ``Trace(frame_bytes=...)`` large enough for whole frames
-when you want every byte (``rosfpga-lab demo --pcap-frame-bytes``).
+when you want every byte (``rosfpga-lab demo --pcap-frame-bytes``). Events a trace evicted
+(``Trace.dropped``) are missing from the file, and its first packet's comment says so.
 
 Why scapy: of the well-kept packet libraries (scapy, dpkt, python-pcapng) it is the one whose
 public writer records a packet's length on the wire apart from its captured bytes, and per-
@@ -260,6 +261,12 @@ def write_capture(path: str | Path, *traces: Trace) -> int:
 
     path = Path(path)
     packets = capture_packets(*traces)
+    dropped = sum(tr.dropped for tr in traces)
+    if dropped and packets:
+        # events the traces evicted are not in the file: say so where a reader looks first
+        note = (f"rosfpga-lab: the traces had evicted {dropped} event(s) before this capture "
+                f"was written; their bytes are missing from it")
+        packets[0].comment = f"{note}. {packets[0].comment}" if packets[0].comment else note
     writer_class = PcapWriter if path.suffix.lower() == ".pcap" else PcapNgWriter
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
