@@ -11,7 +11,8 @@ A rosmaster on a free loopback port, a rospy node publishing FRAMES 64x48 rgb8 i
 /image_raw and a roscpp node subscribing to it: the XML-RPC registration, the master's
 publisherUpdate, requestTopic, the TCPROS connection headers and the frames, all on
 127.0.0.1. The capture is cut down to the connections of these three programs (their ports),
-so other loopback traffic on the machine stays out.
+so other loopback traffic on the machine stays out. The script itself asks the master once
+(``lookupNode``, as ``/capture``) for the roscpp node's port; that call is in the capture too.
 """
 
 from __future__ import annotations

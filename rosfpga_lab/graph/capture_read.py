@@ -19,7 +19,7 @@ from pathlib import Path
 
 from rosfpga_lab.graph.errors import GraphError, XmlRpcError
 from rosfpga_lab.graph.master import MASTER_ID
-from rosfpga_lab.graph.trace import Trace
+from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.xmlrpc import _parse_head, parse_xmlrpc, split_uri
 from rosfpga_lab.tcpros import FrameDecoder, ProtocolError, decode_header
 
@@ -208,7 +208,7 @@ def _xmlrpc(tr: Trace, st: TcpStream, c2s: bytes, s2c: bytes, ends: dict) -> Non
 
 
 def _tcpros(tr: Trace, st: TcpStream, c2s: bytes, s2c: bytes, ends: dict) -> None:
-    conn = len(tr.events) + 1
+    conn = new_connection_id()
     ev = tr.record("tcp_connect", "capture", role="out", src=st.client, dst=st.server,
                    conn=conn, t0=st.opened, **ends)
     ev.t = st.opened
