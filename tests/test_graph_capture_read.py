@@ -89,3 +89,16 @@ def test_not_a_capture_is_a_typed_error(tmp_path: Path) -> None:
     bad.write_bytes(b"not a capture at all")
     with pytest.raises(GraphError, match="cannot read the capture"):
         trace_from_capture(bad)
+
+
+def test_byte_viewer_accepts_the_capture() -> None:
+    from rosfpga_lab import widgets as W
+
+    viewer = W.capture_viewer(CAPTURE, 2, kind="tcpros_frame")
+    span = viewer.select("width")
+    assert (span.value, span.type) == (64, "uint32")
+    assert viewer.select("header.seq").value == 3     # the third frame rospy sent
+    header = W.capture_viewer(CAPTURE, 0, kind="tcpros_header")
+    assert any("md5sum" in s.path for s in header.bytemap.spans)
+    with pytest.raises(W.WidgetError, match="index 9"):
+        W.capture_viewer(CAPTURE, 9, kind="tcpros_frame")

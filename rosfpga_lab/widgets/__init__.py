@@ -17,6 +17,7 @@ reference::
     W.BeatViewer(beats, width=w, height=h, bytes_per_pixel=4)  # hw Beats (tdata/tkeep/tuser/tlast)
     W.SequenceDiagram(trace)                          # graph Trace or [SeqEvent(src, dst, label, raw, t, kind)]
     W.SequenceDiagram("data/ros1_image.pcapng")       # a capture of real ROS 1 traffic
+    W.capture_viewer("data/ros1_image.pcapng", 0, kind="tcpros_frame")   # one step's bytes
     W.WaveformViewer(W.Waves.from_vcd("dump.vcd"), width=640)   # per-clock signals; or Waves.from_arrays({...})
     W.cdr_viewer("sensor_msgs/Image", payload)        # ROS 2 CDR, alignment padding in red
     W.SequenceDiagram(W.events_from_rtps("data/rtps_image.pcapng"))   # RTPS (DDS) traffic
@@ -42,7 +43,9 @@ from rosfpga_lab.widgets.imagediff import FrameDiff, ImageDiffViewer
 from rosfpga_lab.widgets.live import LiveView, RateMeter, Throttle
 from rosfpga_lab.widgets.progress import Progress, in_notebook, track
 from rosfpga_lab.widgets.waveform import Marker, Signal, WaveformViewer, Waves
-from rosfpga_lab.widgets.wire import cdr_spans, cdr_viewer, events_from_rtps, rtps_spans
+from rosfpga_lab.widgets.wire import (
+    capture_viewer, cdr_spans, cdr_viewer, events_from_rtps, rtps_spans,
+)
 from rosfpga_lab.widgets.sequence import (
     SeqEvent,
     SequenceDiagram,
@@ -66,5 +69,5 @@ __all__ = [
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
     "spans_from_http", "spans_from_tcpros_stream", "track", "view_bytes",
     "Marker", "Signal", "WaveformViewer", "Waves",
-    "cdr_spans", "cdr_viewer", "events_from_rtps", "rtps_spans",
+    "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_rtps", "rtps_spans",
 ]

@@ -17,8 +17,9 @@ from typing import Any
 from rosfpga_lab.msg import cdr_layout
 from rosfpga_lab.rtps import Data, DataFrag, InfoDst, RtpsError, parse_message, parse_parameters
 from rosfpga_lab.rtps.discovery import PID_TOPIC_NAME, SEDP_PUBLICATIONS_WRITER, SEDP_SUBSCRIPTIONS_WRITER
+from rosfpga_lab.widgets._common import WidgetError
 from rosfpga_lab.widgets.byteview import ByteViewer, Span
-from rosfpga_lab.widgets.sequence import SeqEvent
+from rosfpga_lab.widgets.sequence import SeqEvent, events_from_capture
 
 #: The role the byte viewer colours CDR alignment padding with (see ``_common.ROLE_COLOURS``).
 ALIGNMENT_ROLE = "alignment"
@@ -44,6 +45,27 @@ def cdr_viewer(type_name: str, payload: bytes, *, registry: Any = None, title: s
     """A :class:`ByteViewer` of a CDR payload with its padding bytes highlighted."""
     return ByteViewer(payload, cdr_spans(type_name, payload, registry=registry),
                       title=title or f"{type_name} as CDR ({len(payload)} bytes)", **kwargs)
+
+
+def capture_viewer(path: str | Path, index: int = 0, *, kind: str = "", **kwargs: Any) -> ByteViewer:
+    """A :class:`ByteViewer` of one step of the ROS 1 conversation in a capture file.
+
+    Args:
+        path: a pcap/pcapng of real ROS 1 traffic.
+        index: which step (as numbered in ``SequenceDiagram(path)``, from 0), counted among the
+            steps of ``kind`` when given (``xmlrpc``, ``xmlrpc_reply``, ``tcpros_header``,
+            ``tcpros_frame``).
+
+    Raises:
+        WidgetError: no such step.
+    """
+    events = [e for e in events_from_capture(path, frames_per_connection=1 << 30)
+              if e.raw and (not kind or e.kind == kind)]
+    if not 0 <= index < len(events):
+        raise WidgetError(f"{path} has {len(events)} step(s) with bytes"
+                          f"{' of kind ' + kind if kind else ''}; index {index} is not one of them")
+    e = events[index]
+    return ByteViewer(e.raw, e.byte_spans(), title=f"{e.src} \u2192 {e.dst}: {e.label}", **kwargs)
 
 
 def rtps_spans(datagram: bytes) -> list[Span]:
@@ -123,4 +145,5 @@ def events_from_rtps(datagrams: Any, *, max_events: int = 60) -> list[SeqEvent]:
     return out
 
 
-__all__ = ["ALIGNMENT_ROLE", "cdr_spans", "cdr_viewer", "events_from_rtps", "rtps_spans"]
+__all__ = ["ALIGNMENT_ROLE", "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_rtps",
+           "rtps_spans"]
