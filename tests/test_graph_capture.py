@@ -146,3 +146,19 @@ def test_whole_frames_decode_in_tshark(tmp_path: Path) -> None:
     assert rows == [[str(body), "camera"]] * 4        # 2 frames in, 2 out, each whole
     assert tshark_fields(path, ["frame.number"],
                          display_filter="tcp.analysis.flags || _ws.expert.severity >= warning") == []
+
+
+def test_xmlrpc_excerpts_keep_their_true_lengths(tmp_path: Path) -> None:
+    tr = Trace(excerpt_bytes=120)
+    body = b"<?xml version='1.0'?><methodCall><methodName>getParam</methodName>" + b" " * 500 + b"</methodCall>"
+    request = b"POST / HTTP/1.1\r\nContent-Length: %d\r\n\r\n" % len(body) + body
+    reply = b"HTTP/1.1 200 OK\r\nContent-Length: 300\r\n\r\n" + b"x" * 300
+    tr.record("xmlrpc", "/a", role="client", method="getParam", raw=tr.excerpt(request),
+              raw_reply=tr.excerpt(reply), size=len(request) + len(reply),
+              local="127.0.0.1:40000", remote="127.0.0.1:11311", t0=1.0)
+    data = [p for p in capture_packets(tr) if p.length]
+    assert [(p.length, len(p.data)) for p in data] == [(len(request), 120), (len(reply), 120)]
+    assert f"kept 120 of the {len(request)} bytes" in data[0].comment
+    path = tmp_path / "x.pcapng"
+    write_capture(path, tr)
+    assert tshark_fields(path, ["frame.number"], display_filter="tcp.analysis.flags") == []

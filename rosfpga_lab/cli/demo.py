@@ -48,7 +48,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "of their bytes. TCPROS: tshark -2 --enable-heuristic tcpros_tcp, or Decode As")
     p.add_argument("--pcap-frame-bytes", type=positive_int, metavar="N",
                    help="keep N bytes of each frame for the capture (default 64; 1300000 keeps "
-                   "whole 640x480 rgba8 frames: use few --frames, each costs 1.2 MB twice)")
+                   "whole 640x480 rgba8 frames: use few --frames, each costs 1.2 MB twice, and "
+                   "the traces are bounded in bytes: past that the oldest events go, and the "
+                   "capture says so)")
     p.add_argument("-v", "--verbose", action="store_true", help="print each step")
     p.set_defaults(func=run)
 

@@ -216,7 +216,8 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
             stream) to this capture file (``.pcap`` or pcapng), after everything stopped.
         pcap_frame_bytes: body bytes of each TCPROS frame the traces keep (default: the
             trace's excerpt, ``Trace.frame_bytes``); at least the frame size keeps whole frames
-            (memory and file then grow by a frame per frame sent and received).
+            (memory and file then grow by a frame per frame sent and received, up to each
+            trace's ``max_bytes``: past it the oldest events go, and the capture says so).
     """
     say = progress or (lambda _text: None)
     if png is not None:
@@ -232,8 +233,9 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         if not rig.connected:
             say("warning: connections were not all up after 10 s")
         if pcap_frame_bytes is not None:
-            for trace in rig.traces():
+            for trace in rig.traces():   # frames are kept up to both bounds of a trace
                 trace.frame_bytes = pcap_frame_bytes
+                trace.excerpt_bytes = max(trace.excerpt_bytes, pcap_frame_bytes + 4)
         say(f"camera: {frames} frames of {source!r} at {rate:g} fps")
         page = None
         if view is not None:

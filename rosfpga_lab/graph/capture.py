@@ -10,8 +10,9 @@ the trace saw the connection close (XML-RPC connections always close: ``Connecti
 :func:`write_capture` writes them with scapy (pcapng, or classic pcap for a ``.pcap`` name) on
 an Ethernet link with zero MAC addresses, as ``tcpdump -i lo`` records loopback.
 
-A trace keeps only the first ``frame_bytes`` body bytes of each TCPROS frame. The capture then
-says so the way a capture with a small snap length does: each segment keeps its true length on
+A trace keeps only the first ``frame_bytes`` body bytes of each TCPROS frame (and the first
+``excerpt_bytes`` of a longer XML-RPC message or header). The capture then says so the way a
+capture with a small snap length does: each segment keeps its true length on
 the wire (so sequence numbers stay consistent and Wireshark's TCP analysis has nothing to
 flag) but carries only the recorded bytes, and the first segment of such a frame has a pcapng
 comment saying how many bytes the trace kept. Wireshark shows those packets as "[Packet size
@@ -126,15 +127,35 @@ def connections(traces: Iterable[Trace]) -> list[Connection]:
     return sorted(out, key=lambda c: c.opened or 0.0)
 
 
+def _http_length(raw: bytes) -> int | None:
+    """Length of the HTTP message ``raw`` starts with (head + Content-Length), None if unknown."""
+    end = raw.find(b"\r\n\r\n")
+    for line in raw[:max(end, 0)].split(b"\r\n")[1:]:
+        name, _, value = line.partition(b":")
+        if name.strip().lower() == b"content-length" and value.strip().isdigit():
+            return end + 4 + int(value.strip())
+    return None
+
+
+def _xmlrpc_lengths(e: TraceEvent) -> tuple[int, int]:
+    """Bytes on the wire of an XML-RPC event's request and reply, also when the trace kept
+    only excerpts of them (``size`` is then more than the bytes kept)."""
+    request, reply = len(e.raw), len(e.raw_reply)
+    if e.size > request + reply:
+        request = max(_http_length(e.raw) or request, request)
+        reply = max(e.size - request, reply) if e.raw_reply else 0
+    return request, reply
+
+
 def _connection(client: str, server: str, evs: list[TraceEvent]) -> Connection:
     conn = Connection(client, server)
     xml = [e for e in evs if e.kind == "xmlrpc" and e.raw]
     mine = [e for e in xml if e.role == "client"] or xml
     for e in mine:
-        conn.pieces.append(Piece(e.t0, True, e.raw, len(e.raw), f"XML-RPC {e.method}"))
+        request, reply = _xmlrpc_lengths(e)
+        conn.pieces.append(Piece(e.t0, True, e.raw, request, f"XML-RPC {e.method}"))
         if e.raw_reply:
-            conn.pieces.append(Piece(e.t, False, e.raw_reply, len(e.raw_reply),
-                                     f"XML-RPC {e.method} reply"))
+            conn.pieces.append(Piece(e.t, False, e.raw_reply, reply, f"XML-RPC {e.method} reply"))
     if mine:
         conn.closed = max(e.t for e in mine)
     tcpros = [e for e in evs if e.kind in ("tcpros_header", "tcpros_frame") and e.raw]

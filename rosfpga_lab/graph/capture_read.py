@@ -17,7 +17,7 @@ import bisect
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from rosfpga_lab.graph.errors import GraphError, XmlRpcError
+from rosfpga_lab.graph.errors import TRACE_EXCERPT_BYTES, GraphError, XmlRpcError
 from rosfpga_lab.graph.master import MASTER_ID
 from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.xmlrpc import _parse_head, parse_xmlrpc, split_uri
@@ -152,12 +152,14 @@ def trace_from_capture(path: str | Path, *, frame_bytes: int = 1 << 20) -> Trace
 
     Args:
         path: a pcap or pcapng file (e.g. ``data/ros1_image.pcapng``).
-        frame_bytes: body bytes of each TCPROS frame kept in its event's ``raw``.
+        frame_bytes: body bytes of each TCPROS frame kept in its event's ``raw``. The trace is
+            bounded as any (``max_events``, ``max_bytes``): its ``dropped`` counts what did
+            not fit.
 
     Raises:
         GraphError: the file cannot be read.
     """
-    tr = Trace(max_events=100_000, frame_bytes=frame_bytes)
+    tr = Trace(frame_bytes=frame_bytes, excerpt_bytes=max(TRACE_EXCERPT_BYTES, frame_bytes + 4))
     rec = "capture"
     for st in tcp_streams(path):
         c2s, s2c = bytes(st.data[True]), bytes(st.data[False])
