@@ -8,7 +8,8 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parent.parent / "rosfpga_lab"
 # Bottom to top; names on one level may not import each other.
 LEVELS = [
-    {"errors"}, {"msg"}, {"tcpros"}, {"config"}, {"graph"}, {"hw"}, {"hls"}, {"rtl"}, {"component"},
+    {"errors"}, {"msg"}, {"tcpros", "rtps"}, {"config"}, {"graph"}, {"hw"}, {"hls"}, {"rtl"},
+    {"component"},
     {"widgets", "checks"}, {"bench"}, {"cli"}, {"__main__"},
 ]
 RANK = {name: level for level, names in enumerate(LEVELS) for name in names}

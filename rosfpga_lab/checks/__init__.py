@@ -20,6 +20,7 @@ notebook  checks
 4         :func:`check_tdata`, :func:`check_markers`, :func:`check_fifo2axi`
 5         :func:`check_dilate`, :func:`check_frame_timing`
 6         :func:`check_node_config`, :func:`check_sloc`
+9         :func:`check_cdr_data_offset`, :func:`check_fragment_count`
 ========  ======================================================================
 
 :mod:`rosfpga_lab.checks.nbbuild` makes the student notebooks from the instructor notebooks
@@ -37,6 +38,7 @@ from rosfpga_lab.checks.handshake import (
 from rosfpga_lab.checks.message import (
     check_data_offset, check_extract, check_marshal, frame_fields, message_fields,
 )
+from rosfpga_lab.checks.ros2 import check_cdr_data_offset, check_fragment_count
 from rosfpga_lab.checks.stream import check_fifo2axi, check_markers, check_tdata
 from rosfpga_lab.checks.tcpros import (
     check_connection_header, check_frame_split, check_md5, header_fields,
@@ -44,8 +46,8 @@ from rosfpga_lab.checks.tcpros import (
 
 __all__ = [
     "ByteField", "CheckResult", "EROSION_NODE", "ExerciseError", "SUBSCRIBER_FIRST_CALLS",
-    "check_call_order", "check_connection_header", "check_data_offset", "check_dilate",
-    "check_extract", "check_fifo2axi", "check_frame_split", "check_frame_timing",
+    "check_call_order", "check_cdr_data_offset", "check_connection_header", "check_data_offset", "check_dilate",
+    "check_extract", "check_fifo2axi", "check_fragment_count", "check_frame_split", "check_frame_timing",
     "check_http_body", "check_markers", "check_marshal", "check_md5", "check_node_config",
     "check_sloc", "check_talker_contact", "check_tdata", "describe_byte_difference", "field_at",
     "frame_fields", "header_fields", "message_fields",

@@ -42,6 +42,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="serve a live page (input, output, counters) on 127.0.0.1 at a free port "
                    "while the demo runs; its URL is printed first. The page needs no internet "
                    "and stops with the demo")
+    p.add_argument("--pcap", type=Path, metavar="FILE",
+                   help="write the whole conversation (XML-RPC, TCPROS) as a capture file for "
+                   "Wireshark (pcapng; .pcap for classic pcap); frames keep the trace's excerpt "
+                   "of their bytes. TCPROS: tshark -2 --enable-heuristic tcpros_tcp, or Decode As")
+    p.add_argument("--pcap-frame-bytes", type=positive_int, metavar="N",
+                   help="keep N bytes of each frame for the capture (default 64; 1300000 keeps "
+                   "whole 640x480 rgba8 frames: use few --frames, each costs 1.2 MB twice, and "
+                   "the traces are bounded in bytes: past that the oldest events go, and the "
+                   "capture says so)")
     p.add_argument("-v", "--verbose", action="store_true", help="print each step")
     p.set_defaults(func=run)
 
@@ -59,7 +68,8 @@ def run(args: argparse.Namespace) -> int:
                           png=None if args.no_figure else args.output, model=args.model,
                           timeout=args.timeout, png_scale=args.scale,
                           progress=print if args.verbose else None,
-                          view=_announce if args.view else None)
+                          view=_announce if args.view else None, pcap=args.pcap,
+                          pcap_frame_bytes=args.pcap_frame_bytes)
     except KeyboardInterrupt:
         print("rosfpga-lab demo: interrupted (everything it started is stopped); no verdict",
               file=sys.stderr)

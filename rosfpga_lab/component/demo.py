@@ -25,8 +25,9 @@ from rosfpga_lab.component.fpga import FpgaComponent
 from rosfpga_lab.component.sources import to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary
 from rosfpga_lab.component.webview import DemoPage
-from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.config import NodeConfig, load_config, parse_config
+from rosfpga_lab.graph import EmbeddedMaster
+from rosfpga_lab.graph.capture import write_capture
 
 #: The demo's configuration file in the lab's data/ directory.
 DEFAULT_CONFIG_NAME = "fpga_dilate_rgba8.yaml"
@@ -74,6 +75,8 @@ class DemoResult:
     elapsed: float
     png: Path | None
     config: NodeConfig
+    pcap: Path | None = None
+    pcap_packets: int = 0
 
     @property
     def ok(self) -> bool:
@@ -103,6 +106,8 @@ class DemoResult:
         out += [f"  mismatch: {m}" for m in self.check.mismatches[:5]]
         if self.png is not None:
             out.append(f"figure: {self.png}")
+        if self.pcap is not None:
+            out.append(f"capture: {self.pcap} ({self.pcap_packets} packets)")
         return out
 
 
@@ -164,6 +169,13 @@ class DemoRig:
         assert self.camera is not None
         self.camera.start(count=frames)
 
+    def traces(self) -> list:
+        """The master's and every node's recorded conversation (for a capture file)."""
+        nodes = [self.component.node if self.component else None,
+                 self.checker.node if self.checker else None,
+                 self.camera.node if self.camera else None]
+        return [self.master.trace] + [n.trace for n in nodes if n is not None]
+
     def stop(self) -> None:
         """Stop everything (idempotent)."""
         for part in (self.camera, self.checker, self.component):
@@ -183,7 +195,8 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
              model: str = "fast", timeout: float = 30.0, png_scale: float = 1.0,
              oracle_op: str | None = None,
              progress: Callable[[str], None] | None = None,
-             view: Callable[[str], None] | None = None) -> DemoResult:
+             view: Callable[[str], None] | None = None,
+             pcap: str | Path | None = None, pcap_frame_bytes: int | None = None) -> DemoResult:
     """Run the demo (see module docstring).
 
     Args:
@@ -199,6 +212,12 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         progress: called with a line of text at each step.
         view: serve a live page (input, output, counters) on a free loopback port while the
             demo runs; called with its URL before the first frame. The page stops with the demo.
+        pcap: write the whole conversation (XML-RPC and TCPROS, every connection as a TCP
+            stream) to this capture file (``.pcap`` or pcapng), after everything stopped.
+        pcap_frame_bytes: body bytes of each TCPROS frame the traces keep (default: the
+            trace's excerpt, ``Trace.frame_bytes``); at least the frame size keeps whole frames
+            (memory and file then grow by a frame per frame sent and received, up to each
+            trace's ``max_bytes``: past it the oldest events go, and the capture says so).
     """
     say = progress or (lambda _text: None)
     if png is not None:
@@ -213,6 +232,10 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         say(f"component: {rig.component!r}")
         if not rig.connected:
             say("warning: connections were not all up after 10 s")
+        if pcap_frame_bytes is not None:
+            for trace in rig.traces():   # frames are kept up to both bounds of a trace
+                trace.frame_bytes = pcap_frame_bytes
+                trace.excerpt_bytes = max(trace.excerpt_bytes, pcap_frame_bytes + 4)
         say(f"camera: {frames} frames of {source!r} at {rate:g} fps")
         page = None
         if view is not None:
@@ -228,6 +251,11 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
                 page.stop()
         stats = rig.component.stats
     checker, config = rig.checker, rig.config
+    pcap_path, packets = None, 0
+    if pcap is not None:
+        pcap_path = Path(pcap)
+        packets = write_capture(pcap_path, *rig.traces())
+        say(f"capture: {packets} packets in {pcap_path}")
     app = config.application
     report = checker.report
     png_path = None
@@ -235,7 +263,7 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
         png_path = write_figure(report.first_bad or checker.last, config.image.encoding, png,
                                 scale=png_scale, title=f"{rig.op} {app.ksize}x{app.ksize}")
     return DemoResult(rig.camera.sent, report.received, report, checker.fps,
-                      checker.latency.summary(), stats, elapsed, png_path, config)
+                      checker.latency.summary(), stats, elapsed, png_path, config, pcap_path, packets)
 
 
 def _counters(rig: DemoRig) -> dict[str, object]:

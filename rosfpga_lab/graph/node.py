@@ -50,7 +50,7 @@ from rosfpga_lab.graph.owner import listener_uids
 from rosfpga_lab.graph.publisher import Publisher
 from rosfpga_lab.graph.subscriber import Subscriber
 from rosfpga_lab.graph.trace import Trace, new_connection_id
-from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close
+from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close, socket_ends
 from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, split_uri
 from rosfpga_lab.tcpros import (
     HANDSHAKE_TIMEOUT,
@@ -406,7 +406,9 @@ class Node:
     def _run_handshake(self, conn: socket.socket, peer: str) -> bool:
         conn_id = new_connection_id()
         tr = self.trace
-        tr.record("tcp_connect", self.name, role="in", src=peer, dst=self.name, conn=conn_id)
+        ends = socket_ends(conn)
+        tr.record("tcp_connect", self.name, role="in", src=peer, dst=self.name, conn=conn_id,
+                  **ends)
         hs = PublisherHandshake(callerid=self.name, lookup=self._lookup_spec, peer=peer)
         deadline = time.monotonic() + HANDSHAKE_TIMEOUT
         src = peer
@@ -427,11 +429,11 @@ class Node:
                     src = ev.fields.get("callerid", peer)
                     tr.record("tcpros_header", self.name, role="in", src=src, dst=self.name,
                               method=ev.fields.get("topic", ""), args=dict(ev.fields), raw=ev.raw,
-                              size=len(ev.raw), conn=conn_id)
+                              size=len(ev.raw), conn=conn_id, **ends)
                 elif isinstance(ev, Rejected):
                     tr.record("tcpros_header", self.name, role="out", src=self.name, dst=src,
                               args={"error": str(ev.error)}, raw=ev.reply, size=len(ev.reply),
-                              conn=conn_id, result=str(ev.error))
+                              conn=conn_id, result=str(ev.error), **ends)
                     conn.settimeout(1.0)
                     conn.sendall(ev.reply)
                     return False

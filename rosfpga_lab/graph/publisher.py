@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from rosfpga_lab.graph.errors import JOIN_TIMEOUT, MAX_CLOSED_LINKS_KEPT, GraphError
-from rosfpga_lab.graph.wire import hard_close, send_frame, set_nodelay
+from rosfpga_lab.graph.wire import hard_close, send_frame, set_nodelay, socket_ends
 from rosfpga_lab.tcpros import TopicSpec
 
 if TYPE_CHECKING:
@@ -46,6 +46,7 @@ class _SubscriberLink:
         self.header = header
         self.sock = sock
         self.stats = LinkStats(conn_id, peer)
+        self.ends = socket_ends(sock)
         self.queue: collections.deque = collections.deque()
         self.cond = threading.Condition()
         self.closed = False
@@ -82,7 +83,7 @@ class _SubscriberLink:
             return
         node.trace.record("tcpros_header", node.name, role="out", src=node.name, dst=self.stats.peer,
                           method=self.pub.topic, args=self.pub.node_reply_fields(), raw=self.header,
-                          size=len(self.header), conn=self.stats.conn, t0=t0)
+                          size=len(self.header), conn=self.stats.conn, t0=t0, **self.ends)
         while True:
             with self.cond:
                 while not self.queue and not self.closed:
@@ -101,7 +102,8 @@ class _SubscriberLink:
             if node.trace.frames:
                 node.trace.record(
                     "tcpros_frame", node.name, role="out", src=node.name, dst=self.stats.peer,
-                    method=self.pub.topic, raw=node.trace.frame_raw(body), size=size, conn=self.stats.conn, index=self.stats.frames - 1, t0=t0)
+                    method=self.pub.topic, raw=node.trace.frame_raw(body), size=size, conn=self.stats.conn, index=self.stats.frames - 1, t0=t0,
+                    **self.ends)
 
     def _read_loop(self) -> None:
         try:
@@ -122,7 +124,7 @@ class _SubscriberLink:
         hard_close(self.sock)
         node = self.pub.node
         node.trace.record("tcp_close", node.name, role="out", src=node.name, dst=self.stats.peer,
-                          method=self.pub.topic, conn=self.stats.conn)
+                          method=self.pub.topic, conn=self.stats.conn, **self.ends)
         self.pub._remove_link(self)
 
     def join(self, timeout: float) -> None:

@@ -40,7 +40,7 @@ from rosfpga_lab.graph.errors import (
     MasterError,
 )
 from rosfpga_lab.graph.trace import new_connection_id
-from rosfpga_lab.graph.wire import RECV_CHUNK, hard_close, set_nodelay
+from rosfpga_lab.graph.wire import RECV_CHUNK, hard_close, set_nodelay, socket_ends
 from rosfpga_lab.graph.xmlrpc import call
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.tcpros import (
@@ -148,10 +148,10 @@ class _PublisherLink:
             set_nodelay(sock)
         conn = new_connection_id()
         peer = f"{host}:{port}"
-        local = sock.getsockname()
-        node.trace.names[f"{local[0]}:{local[1]}"] = node.name
+        ends = socket_ends(sock)
+        node.trace.names[ends["local"]] = node.name
         node.trace.record("tcp_connect", node.name, role="out", src=node.name,
-                          dst=node.trace.name_of(self.pub_uri), method=sub.topic, conn=conn)
+                          dst=node.trace.name_of(self.pub_uri), method=sub.topic, conn=conn, **ends)
         hs = SubscriberHandshake(callerid=node.name, topic=sub.topic, md5sum=sub.md5sum,
                                  type_name=sub.type_name, message_definition=sub.message_definition,
                                  tcp_nodelay=sub.tcp_nodelay, max_frame=sub.max_frame)
@@ -160,7 +160,8 @@ class _PublisherLink:
         sock.sendall(request)
         node.trace.record("tcpros_header", node.name, role="out", src=node.name,
                           dst=node.trace.name_of(self.pub_uri), method=sub.topic,
-                          args=dict(hs.fields), raw=request, size=len(request), conn=conn, t0=t0)
+                          args=dict(hs.fields), raw=request, size=len(request), conn=conn, t0=t0,
+                          **ends)
         deadline = time.monotonic() + HANDSHAKE_TIMEOUT
         publisher, header = peer, {}
         got = False
@@ -194,7 +195,7 @@ class _PublisherLink:
             for ev in events:
                 if isinstance(ev, Frame):
                     sub._deliver(ev.body, MessageInfo(sub.topic, publisher, conn, ev.index,
-                                                      len(ev.body), time.time(), header), ev.offset)
+                                                      len(ev.body), time.time(), header), ev.offset, ends)
                 elif isinstance(ev, HeaderReceived):
                     publisher = ev.fields.get("callerid", peer)
                     header = ev.fields
@@ -202,7 +203,7 @@ class _PublisherLink:
                     node.trace.record("tcpros_header", node.name, role="in", src=publisher,
                                       dst=node.name, method=sub.topic, args=dict(ev.fields),
                                       raw=ev.raw, size=len(ev.raw), conn=conn,
-                                      result=ev.fields.get("error"))
+                                      result=ev.fields.get("error"), **ends)
                 elif isinstance(ev, Connected):
                     got = True
                     sock.settimeout(None)
@@ -210,7 +211,7 @@ class _PublisherLink:
                     sub._connections_changed(+1)
                 elif isinstance(ev, Closed):
                     node.trace.record("tcp_close", node.name, role="in", src=publisher,
-                                      dst=node.name, method=sub.topic, conn=conn)
+                                      dst=node.name, method=sub.topic, conn=conn, **ends)
                     return got
             if failure is not None:
                 raise failure
@@ -312,13 +313,15 @@ class Subscriber:
                                result=text)
 
     # ----------------------------------------------------------------- delivery
-    def _deliver(self, body: bytes | memoryview, info: MessageInfo, offset: int) -> None:
+    def _deliver(self, body: bytes | memoryview, info: MessageInfo, offset: int,
+                 ends: dict[str, str] | None = None) -> None:
         node = self.node
         if node.trace.frames:
             node.trace.record("tcpros_frame", node.name, role="in", src=info.publisher,
                               dst=node.name, method=self.topic,
                               raw=node.trace.frame_raw(body),
-                              size=4 + len(body), conn=info.conn, index=info.index, offset=offset)
+                              size=4 + len(body), conn=info.conn, index=info.index, offset=offset,
+                              **(ends or {}))
         with self._cond:
             self._stats.frames += 1
             self._stats.bytes += len(body)

@@ -30,6 +30,10 @@ raw_reply  see above (xmlrpc only)
 size       total bytes on the wire (for frames: 4 + body length)
 conn       connection id (same for the header and frames of one TCPROS link)
 index      frame number on its connection; offset: stream offset of the frame's prefix
+local,     ``host:port`` of the recorder's and of the peer's end of the TCP connection that
+remote     carried the bytes (empty when unknown); with ``role`` they give the bytes'
+           direction, and a ``tcp_connect`` (role ``out``: the recorder connected) or an xmlrpc
+           event (the client connected) tells which end opened it (capture files use this)
 ========== ============================================================================
 
 Bounds: a trace keeps at most ``max_events`` events and about ``max_bytes`` bytes (raw bytes
@@ -128,6 +132,8 @@ class TraceEvent:
     index: int = -1
     offset: int = -1
     t0: float = 0.0
+    local: str = ""
+    remote: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         """The event as a plain dict."""

@@ -37,6 +37,19 @@ def send_frame(sock: socket.socket, body: bytes | bytearray | memoryview) -> int
     return total
 
 
+def socket_ends(sock: socket.socket) -> dict[str, str]:
+    """``{"local": "host:port", "remote": "host:port"}`` of a connected socket, for trace
+    events (empty strings once the socket is gone)."""
+    ends = {}
+    for key, get in (("local", sock.getsockname), ("remote", sock.getpeername)):
+        try:
+            host, port = get()[:2]
+            ends[key] = f"{host}:{port}"
+        except OSError:
+            ends[key] = ""
+    return ends
+
+
 def hard_close(sock: socket.socket) -> None:
     """Shut down both directions (wakes threads blocked in recv) and close."""
     try:

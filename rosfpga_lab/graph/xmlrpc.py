@@ -42,7 +42,7 @@ from rosfpga_lab.graph.errors import (
     XmlRpcTooLargeError,
 )
 from rosfpga_lab.graph.trace import Trace
-from rosfpga_lab.graph.wire import accept_loop, hard_close
+from rosfpga_lab.graph.wire import accept_loop, hard_close, socket_ends
 
 #: XML-RPC's <int>/<i4> range (ROS's XmlRpcValue and rospy's marshaller refuse anything else).
 INT32_MIN, INT32_MAX = -(2**31), 2**31 - 1
@@ -412,6 +412,7 @@ class XmlRpcServer:
     def _serve_connection(self, conn: socket.socket, peer: str) -> None:
         buf = bytearray()
         _context.peer = peer
+        ends = socket_ends(conn)
         try:
             while self._running:
                 deadline = _Deadline(XMLRPC_IDLE_TIMEOUT, self.request_timeout)
@@ -460,7 +461,7 @@ class XmlRpcServer:
                                       dst=self.name, method=method, args=list(params),
                                       result=result, raw=self.trace.excerpt(head, body),
                                       raw_reply=self.trace.excerpt(reply),
-                                      size=len(head) + len(body) + len(reply), t0=t0)
+                                      size=len(head) + len(body) + len(reply), t0=t0, **ends)
                 del body, reply, reply_body, params, result
                 if not keep:
                     return
@@ -540,8 +541,10 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
     t0 = time.time()
     buf = bytearray()
     deadline = _Deadline(timeout)
+    ends: dict[str, str] = {}
     try:
         with socket.create_connection((host, port), timeout=timeout) as sock:
+            ends = socket_ends(sock)
             sock.settimeout(max(0.001, deadline.at - time.monotonic()))
             sock.sendall(request)
             reply_head = _read_head(sock, buf, deadline)
@@ -553,7 +556,8 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
     except (OSError, XmlRpcError) as exc:
         if trace is not None:
             trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or uri,
-                         method=method, args=list(params), result=f"error: {exc}", raw=request, t0=t0)
+                         method=method, args=list(params), result=f"error: {exc}", raw=request, t0=t0,
+                         **ends)
         if isinstance(exc, XmlRpcTooLargeError):  # the server answered: say so, not "failed"
             raise XmlRpcTooLargeError(f"XML-RPC call {method} to {uri}: the reply's {exc} "
                                       "(graph.errors.MAX_XMLRPC_REPLY)") from None
@@ -562,7 +566,7 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
         ev = trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or trace.name_of(uri),
                           method=method, args=list(params), raw=trace.excerpt(request),
                           raw_reply=trace.excerpt(reply_head, reply_body),
-                          size=len(request) + len(reply_head) + len(reply_body), t0=t0)
+                          size=len(request) + len(reply_head) + len(reply_body), t0=t0, **ends)
     else:
         ev = None
     parts = status_line.split(None, 2)

@@ -32,10 +32,12 @@ arrays of strings, times, messages     lists
 Modules: ``parser`` (text -> MsgSpec), ``registry`` (types, md5, full text), ``decode`` and
 ``encode`` (the fast wire codecs), ``layout`` (byte spans, and the plain reference decoder),
 ``values`` (defaults, new_message), ``builtins`` (types, Time, Duration), ``limits``, ``errors``,
-``describe`` (text views), ``strategies`` (hypothesis strategies, for tests), ``bench``.
+``describe`` (text views), ``ros2`` (the ROS 2 forms of the types) and ``cdr`` (the ROS 2
+wire format: ``serialize_cdr``, ``deserialize_cdr``, ``cdr_layout``), ``strategies`` (hypothesis strategies, for tests), ``bench``.
 """
 
 from rosfpga_lab.msg.builtins import BUILTIN_TYPES, PRIMITIVE_TYPES, Duration, Time
+from rosfpga_lab.msg.cdr import cdr_layout, deserialize_cdr, serialize_cdr
 from rosfpga_lab.msg.decode import deserialize, deserialize_partial, min_size
 from rosfpga_lab.msg.encode import serialize
 from rosfpga_lab.msg.errors import (
@@ -49,6 +51,7 @@ from rosfpga_lab.msg.parser import (
 from rosfpga_lab.msg.registry import (
     DEFINITIONS_DIR, SHIPPED_PACKAGES, MsgRegistry, default_registry, registry_with,
 )
+from rosfpga_lab.msg.ros2 import ros2_registry, to_ros2_value
 from rosfpga_lab.msg.values import default_value, new_message
 
 __all__ = [
@@ -58,4 +61,5 @@ __all__ = [
     "UnknownTypeError", "default_registry", "default_value", "deserialize",
     "deserialize_partial", "deserialize_reference", "field_layout", "min_size", "new_message",
     "parse_msg", "registry_with", "serialize", "split_full_text", "strip_comments",
+    "cdr_layout", "deserialize_cdr", "ros2_registry", "serialize_cdr", "to_ros2_value",
 ]

@@ -16,7 +16,11 @@ reference::
     W.ImageDiffViewer(output, reference, input)       # or frames=[(input, output, reference), ...]
     W.BeatViewer(beats, width=w, height=h, bytes_per_pixel=4)  # hw Beats (tdata/tkeep/tuser/tlast)
     W.SequenceDiagram(trace)                          # graph Trace or [SeqEvent(src, dst, label, raw, t, kind)]
+    W.SequenceDiagram("data/ros1_image.pcapng")       # a capture of real ROS 1 traffic
+    W.capture_viewer("data/ros1_image.pcapng", 0, kind="tcpros_frame")   # one step's bytes
     W.WaveformViewer(W.Waves.from_vcd("dump.vcd"), width=640)   # per-clock signals; or Waves.from_arrays({...})
+    W.cdr_viewer("sensor_msgs/Image", payload)        # ROS 2 CDR, alignment padding in red
+    W.SequenceDiagram(W.events_from_rtps("data/rtps_image.pcapng"))   # RTPS (DDS) traffic
     live = W.LiveView(max_fps=10); live.update(frame, stamp=t)   # from any thread
     with W.Progress(total, "dilate") as p: p.update()  # or W.track(iterable, desc=...)
 """
@@ -39,10 +43,14 @@ from rosfpga_lab.widgets.imagediff import FrameDiff, ImageDiffViewer
 from rosfpga_lab.widgets.live import LiveView, RateMeter, Throttle
 from rosfpga_lab.widgets.progress import Progress, in_notebook, track
 from rosfpga_lab.widgets.waveform import Marker, Signal, WaveformViewer, Waves
+from rosfpga_lab.widgets.wire import (
+    capture_viewer, cdr_spans, cdr_viewer, events_from_rtps, rtps_spans,
+)
 from rosfpga_lab.widgets.sequence import (
     SeqEvent,
     SequenceDiagram,
     SvgPane,
+    events_from_capture,
     events_from_trace,
     participants_of,
     sequence_html,
@@ -56,9 +64,10 @@ __all__ = [
     "BeatMap", "BeatViewer", "ByteMap", "CodeFiles", "code_html", "ByteViewer", "FrameDiff", "ImageDiffViewer", "LiveView",
     "MarkerMismatch", "Progress", "RateMeter", "SeqEvent", "SequenceDiagram", "Span", "StateDiagram",
     "SvgPane", "state_diagram_svg",
-    "Throttle", "WidgetError", "as_span", "events_from_trace", "in_notebook", "message_spans",
+    "Throttle", "WidgetError", "as_span", "events_from_capture", "events_from_trace", "in_notebook", "message_spans",
     "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
     "spans_from_http", "spans_from_tcpros_stream", "track", "view_bytes",
     "Marker", "Signal", "WaveformViewer", "Waves",
+    "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_rtps", "rtps_spans",
 ]

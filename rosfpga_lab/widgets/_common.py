@@ -85,6 +85,7 @@ PALETTE = (
 ROLE_COLOURS = {
     "length": "#d9d9d9",   # length prefixes of strings, arrays, header fields, frames
     "padding": "#ffffff",
+    "alignment": "#ff595e",  # CDR alignment padding (ROS 2): bytes a circuit must skip
     "error": "#ff8080",     # bytes that could not be decoded
     "trailing": "#eeeeee",  # bytes after the end of the message or header
 }

@@ -6,7 +6,8 @@ per event, top to bottom in time order; every arrow is an SVG group with ``data-
 tooltip. :class:`SequenceDiagram` makes the arrows clickable (a small anywidget) and shows the
 clicked event's bytes in a :class:`~rosfpga_lab.widgets.byteview.ByteViewer`, fields from
 :func:`~rosfpga_lab.widgets.byte_sources.spans_for`. :func:`events_from_trace` turns a
-``rosfpga_lab.graph`` trace into events (an XML-RPC call gives a request and a reply arrow).
+``rosfpga_lab.graph`` trace into events (an XML-RPC call gives a request and a reply arrow);
+:func:`events_from_capture` does the same for a capture file of real traffic.
 """
 
 from __future__ import annotations
@@ -237,6 +238,14 @@ def _fit(text: str, px: float) -> str:
     return text if len(text) <= n else text[: n - 1] + "\u2026"
 
 
+def events_from_capture(path: str | Path, **options: Any) -> list[SeqEvent]:
+    """Events of the ROS 1 conversation in a capture file (pcap/pcapng of real traffic), via
+    ``rosfpga_lab.graph.capture_read.trace_from_capture``; options as :func:`events_from_trace`."""
+    from rosfpga_lab.graph.capture_read import trace_from_capture
+
+    return events_from_trace(trace_from_capture(path), **options)
+
+
 def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None = None, *,
                  selected: int | None = None, col: int | None = None, row: int = 34,
                  fit_width: int = FIT_WIDTH) -> str:
@@ -334,14 +343,17 @@ class SequenceDiagram(StaticFallback, w.VBox):
     """The clickable diagram, a list of the arrows, and a byte viewer of the selected arrow's bytes.
 
     Args:
-        events: :class:`SeqEvent` (or dicts / tuples of its fields), or a ``graph`` Trace.
+        events: :class:`SeqEvent` (or dicts / tuples of its fields), a ``graph`` Trace, or the
+            path of a capture file of real ROS 1 traffic (pcap/pcapng).
         participants: lifeline order (default: order of appearance).
         static_fallback: put the static HTML form in the output too (exported notebooks, GitHub).
     """
 
     def __init__(self, events: Any, participants: Sequence[str] | None = None, *,
                  static_fallback: bool = True) -> None:
-        if hasattr(events, "conversation"):
+        if isinstance(events, (str, Path)):
+            events = events_from_capture(events)
+        elif hasattr(events, "conversation"):
             events = events_from_trace(events)
         self.events = [_as_event(e) for e in events]
         self.participants = list(participants) if participants else participants_of(self.events, FIRST_PARTICIPANTS)

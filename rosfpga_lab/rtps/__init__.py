@@ -1,0 +1,26 @@
+"""RTPS, the wire protocol of DDS (ROS 2): a sans-IO decoder of whole RTPS messages.
+
+Bytes in, events out: :func:`parse_message` takes one UDP datagram and returns an
+:class:`RtpsMessage` (its header and one dataclass per submessage: INFO_TS, INFO_DST, DATA,
+DATA_FRAG, HEARTBEAT, HEARTBEAT_FRAG, ACKNACK, NACK_FRAG, GAP; others as ``Unknown``).
+:func:`parse_parameters` reads SPDP/SEDP parameter lists, :func:`discovery` names participants,
+topics and types from them, and :class:`FragmentAssembler` puts DATA_FRAG fragments back
+together into the serialized sample (a CDR payload for ``rosfpga_lab.msg.deserialize_cdr``).
+"""
+
+from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
+from rosfpga_lab.rtps.message import (
+    ENTITY_NAMES, SUBMESSAGE_NAMES, AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag,
+    InfoDst, InfoTs, NackFrag, RtpsHeader, RtpsMessage, Submessage, Unknown, entity_name,
+    parse_message,
+)
+from rosfpga_lab.rtps.discovery import (
+    Endpoint, FragmentAssembler, Participant, discovery, parse_parameters,
+)
+
+__all__ = [
+    "AckNack", "Data", "DataFrag", "ENTITY_NAMES", "Endpoint", "FragmentAssembler", "Gap",
+    "Heartbeat", "HeartbeatFrag", "InfoDst", "InfoTs", "NackFrag", "Participant", "RtpsError",
+    "RtpsHeader", "RtpsMessage", "RtpsTruncatedError", "SUBMESSAGE_NAMES", "Submessage",
+    "Unknown", "discovery", "entity_name", "parse_message", "parse_parameters",
+]

@@ -1,0 +1,153 @@
+"""Discovery without a master (SPDP/SEDP parameter lists), and DATA_FRAG reassembly.
+
+How this works: DDS participants announce themselves (SPDP, on the built-in participant
+writer) and their readers and writers (SEDP, on the built-in publications/subscriptions
+writers) as DATA samples whose payload is a *parameter list*: a 4-byte encapsulation header
+(``00 03`` PL_CDR_LE or ``00 02`` PL_CDR_BE), then (pid uint16, length uint16, value padded to
+4 bytes) entries up to PID_SENTINEL. :func:`discovery` reads them from decoded messages and
+names the participants, topics and types; no master is involved.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
+from rosfpga_lab.rtps.message import Data, DataFrag, RtpsMessage
+
+PID_SENTINEL = 0x0001
+PID_TOPIC_NAME = 0x0005
+PID_TYPE_NAME = 0x0007
+PID_PARTICIPANT_GUID = 0x0050
+PID_ENDPOINT_GUID = 0x005A
+PID_ENTITY_NAME = 0x0062
+SPDP_WRITER = 0x000100C2
+SEDP_PUBLICATIONS_WRITER = 0x000003C2
+SEDP_SUBSCRIPTIONS_WRITER = 0x000004C2
+PL_CDR_BE, PL_CDR_LE = b"\x00\x02", b"\x00\x03"
+#: Largest sample :class:`FragmentAssembler` puts together, and most samples it holds at once.
+MAX_SAMPLE_BYTES = 64 * 1024 * 1024
+MAX_PENDING_SAMPLES = 16
+
+
+def parse_parameters(payload: bytes) -> dict[int, list[bytes]]:
+    """A parameter list payload (encapsulation header first) as ``{pid: [values]}``.
+
+    Raises:
+        RtpsError: not a parameter list; RtpsTruncatedError: it ends before PID_SENTINEL.
+    """
+    kind = payload[:2]
+    if kind not in (PL_CDR_BE, PL_CDR_LE):
+        raise RtpsError(f"not a parameter list: encapsulation {payload[:4].hex(' ')}", 0)
+    order = "<" if kind == PL_CDR_LE else ">"
+    out: dict[int, list[bytes]] = {}
+    pos = 4
+    while True:
+        if pos + 4 > len(payload):
+            raise RtpsTruncatedError(f"parameter list ends at byte {len(payload)} without "
+                                     f"PID_SENTINEL", pos)
+        pid, length = struct.unpack(order + "HH", payload[pos:pos + 4])
+        if pid == PID_SENTINEL:
+            return out
+        if pos + 4 + length > len(payload):
+            raise RtpsTruncatedError(f"parameter 0x{pid:04x} at byte {pos} declares {length} "
+                                     f"bytes, only {len(payload) - pos - 4} left", pos)
+        out.setdefault(pid & 0x3FFF if not pid & 0x8000 else pid, []).append(
+            payload[pos + 4:pos + 4 + length])
+        pos += 4 + length
+
+
+def _string(value: bytes, little: bool) -> str:
+    (n,) = struct.unpack("<I" if little else ">I", value[:4])
+    return value[4:4 + n].rstrip(b"\x00").decode("utf-8", "replace")
+
+
+@dataclass(frozen=True)
+class Participant:
+    """A participant announced by SPDP: GUID prefix (12 bytes) and name when it gave one."""
+
+    guid_prefix: bytes
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class Endpoint:
+    """A reader or writer announced by SEDP."""
+
+    guid: bytes
+    kind: str            # "writer" or "reader"
+    topic: str
+    type_name: str
+
+
+def discovery(messages: Iterable[RtpsMessage]) -> tuple[list[Participant], list[Endpoint]]:
+    """Participants (SPDP) and endpoints (SEDP) announced in ``messages``, each once."""
+    participants: dict[bytes, Participant] = {}
+    endpoints: dict[bytes, Endpoint] = {}
+    for msg in messages:
+        for sub in msg.submessages:
+            if not isinstance(sub, Data) or not sub.payload or sub.key:
+                continue
+            if sub.writer_id not in (SPDP_WRITER, SEDP_PUBLICATIONS_WRITER, SEDP_SUBSCRIPTIONS_WRITER):
+                continue
+            try:
+                params = parse_parameters(sub.payload)
+            except RtpsError:
+                continue
+            little = sub.payload[:2] == PL_CDR_LE
+            if sub.writer_id == SPDP_WRITER:
+                guid = (params.get(PID_PARTICIPANT_GUID) or [msg.header.guid_prefix])[0][:12]
+                name = params.get(PID_ENTITY_NAME)
+                participants[guid] = Participant(guid, _string(name[0], little) if name else "")
+            elif PID_TOPIC_NAME in params and PID_ENDPOINT_GUID in params:
+                guid = params[PID_ENDPOINT_GUID][0][:16]
+                kind = "writer" if sub.writer_id == SEDP_PUBLICATIONS_WRITER else "reader"
+                endpoints[guid] = Endpoint(guid, kind, _string(params[PID_TOPIC_NAME][0], little),
+                                           _string(params[PID_TYPE_NAME][0], little)
+                                           if PID_TYPE_NAME in params else "")
+    return list(participants.values()), list(endpoints.values())
+
+
+class FragmentAssembler:
+    """Puts DATA_FRAG fragments back together into whole serialized samples.
+
+    Memory follows the fragments received: a sample's buffer grows as fragments arrive, and a
+    sample may declare at most ``max_sample_bytes``; at most ``max_pending`` samples are held
+    (the oldest is dropped and counted in ``dropped``).
+    """
+
+    def __init__(self, max_sample_bytes: int = MAX_SAMPLE_BYTES,
+                 max_pending: int = MAX_PENDING_SAMPLES) -> None:
+        self.max_sample_bytes = max_sample_bytes
+        self.max_pending = max_pending
+        self.dropped = 0
+        self._pending: dict[tuple[bytes, int, int], dict[int, bytes]] = {}
+
+    def add(self, guid_prefix: bytes, frag: DataFrag) -> bytes | None:
+        """Add one DATA_FRAG; return the whole sample once its last missing fragment came."""
+        if frag.sample_size > self.max_sample_bytes:
+            raise RtpsError(f"DATA_FRAG at byte {frag.offset} declares a {frag.sample_size}-byte "
+                            f"sample, more than max_sample_bytes={self.max_sample_bytes}",
+                            frag.offset)
+        if frag.frag_size == 0:
+            raise RtpsError(f"DATA_FRAG at byte {frag.offset} has fragment size 0", frag.offset)
+        total = -(-frag.sample_size // frag.frag_size)
+        key = (guid_prefix, frag.writer_id, frag.seq)
+        parts = self._pending.setdefault(key, {})
+        if len(self._pending) > self.max_pending:
+            self._pending.pop(next(iter(self._pending)))
+            self.dropped += 1
+        for i in range(frag.frag_count):
+            number = frag.frag_start + i
+            if 1 <= number <= total:       # numbers past the sample's end are ignored
+                parts[number] = frag.payload[i * frag.frag_size:(i + 1) * frag.frag_size]
+        if len(parts) < total:
+            return None
+        del self._pending[key]
+        sample = b"".join(parts[n] for n in range(1, total + 1))[:frag.sample_size]
+        if len(sample) != frag.sample_size:
+            raise RtpsError(f"sample {frag.seq} reassembled to {len(sample)} bytes, it declared "
+                            f"{frag.sample_size}", frag.offset)
+        return sample

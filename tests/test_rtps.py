@@ -1,0 +1,125 @@
+"""The RTPS decoder on a real Cyclone DDS capture, against Wireshark's RTPS dissector."""
+
+from __future__ import annotations
+
+import struct
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rosfpga_lab.graph.capture_read import udp_datagrams
+from rosfpga_lab.msg import deserialize_cdr
+from rosfpga_lab.rtps import (
+    AckNack, DataFrag, FragmentAssembler, Gap, RtpsError, RtpsTruncatedError,
+    discovery, parse_message, parse_parameters,
+)
+from wiretools import assert_rtps_agrees_with_tshark
+
+CAPTURE = Path(__file__).resolve().parent.parent / "data" / "rtps_image.pcapng"
+DATAGRAMS = [d[3] for d in udp_datagrams(CAPTURE)]
+MESSAGES = [parse_message(d) for d in DATAGRAMS]
+HEADER = b"RTPS\x02\x01\x01\x10" + bytes(range(12))
+
+
+def test_capture_has_every_kind_the_issue_names() -> None:
+    kinds = Counter(s.name for m in MESSAGES for s in m.submessages)
+    assert {"INFO_TS", "INFO_DST", "DATA", "DATA_FRAG", "HEARTBEAT", "ACKNACK"} <= set(kinds)
+
+
+def test_discovery_names_topic_type_and_participants() -> None:
+    participants, endpoints = discovery(MESSAGES)
+    assert len(participants) == 2
+    assert {(e.kind, e.topic, e.type_name) for e in endpoints} == {
+        ("writer", "rt/image_raw", "sensor_msgs::msg::dds_::Image_"),
+        ("reader", "rt/image_raw", "sensor_msgs::msg::dds_::Image_")}
+
+
+def test_fragments_reassemble_into_the_published_image() -> None:
+    asm = FragmentAssembler()
+    images = []
+    for msg in MESSAGES:
+        for sub in msg.submessages:
+            if isinstance(sub, DataFrag):
+                sample = asm.add(msg.header.guid_prefix, sub)
+                if sample is not None:
+                    images.append(deserialize_cdr(None, "sensor_msgs/Image", sample))
+    assert len(images) == 2
+    for i, img in enumerate(images):
+        assert (img["width"], img["height"], img["encoding"], img["step"]) == (640, 480, "rgb8", 1920)
+        assert img["header"] == {"stamp": {"sec": 1_700_000_000 + i, "nanosec": 500},
+                                 "frame_id": "camera"}
+        # the script's pixels: (x * 7 + i) % 256 for byte x
+        expected = (np.arange(640 * 480 * 3) * 7 + i) % 256
+        assert np.array_equal(img["data"], expected.astype(np.uint8))
+
+
+def test_decoder_agrees_with_tshark() -> None:
+    assert assert_rtps_agrees_with_tshark(CAPTURE) == len(MESSAGES)
+
+
+@pytest.mark.parametrize("index", [0, 1, 2, 5, 40])
+def test_every_prefix_is_a_shorter_message_or_a_typed_error(index: int) -> None:
+    data = DATAGRAMS[index]
+    whole = parse_message(data).submessages
+    ends = {s.offset + s.size for s in whole}
+    for n in range(len(data)):
+        try:
+            part = parse_message(data[:n]).submessages
+        except RtpsTruncatedError as exc:
+            assert 0 <= exc.offset <= n
+            continue
+        # a prefix that parses ends between two submessages, or cuts the last one whose length
+        # says "to the end of the message"
+        assert n in ends or n == 20 or part[-1].size == n - part[-1].offset
+        assert [s.kind for s in part] == [s.kind for s in whole[:len(part)]]
+
+
+def test_trailing_bytes_are_refused_or_read_as_submessages() -> None:
+    data = DATAGRAMS[3]
+    with pytest.raises(RtpsTruncatedError, match="too few for a submessage header"):
+        parse_message(data + b"\x00\x01")
+    more = parse_message(data + b"\x01\x01\x00\x00")  # a PAD submessage after the rest
+    assert more.submessages[-1].name == "PAD"
+    assert more.submessages[:-1] == parse_message(data).submessages
+    with pytest.raises(RtpsError, match="not an RTPS message"):
+        parse_message(b"RTPX" + data[4:])
+
+
+def test_gap_and_acknack_bitmaps_from_bytes() -> None:
+    gap = struct.pack("<BBH4s4siIiIII", 0x08, 0x01, 32, b"\x00\x00\x02\x04", b"\x00\x00\x02\x03",
+                      0, 5, 0, 9, 3, 0xA0000000)
+    (sub,) = parse_message(HEADER + gap).submessages
+    assert isinstance(sub, Gap) and (sub.start, sub.list_base, sub.listed) == (5, 9, (9, 11))
+    ack = struct.pack(">BBH4s4siIIIi", 0x06, 0x00, 28, b"\x00\x00\x02\x04", b"\x00\x00\x02\x03",
+                      0, 7, 2, 0x40000000, 3)
+    (sub,) = parse_message(HEADER + ack).submessages
+    assert isinstance(sub, AckNack) and (sub.base, sub.missing, sub.count) == (7, (8,), 3)
+    assert sub.writer_id == 0x00000203 and not sub.little_endian
+    with pytest.raises(RtpsTruncatedError):
+        parse_message(HEADER + ack[:-4])  # declares 28 bytes, has 24
+
+
+def test_parameter_list_errors() -> None:
+    with pytest.raises(RtpsError, match="not a parameter list"):
+        parse_parameters(b"\x00\x01\x00\x00")
+    with pytest.raises(RtpsTruncatedError, match="PID_SENTINEL"):
+        parse_parameters(b"\x00\x03\x00\x00\x05\x00\x04\x00abcd")
+    assert parse_parameters(b"\x00\x03\x00\x00\x05\x00\x04\x00abcd\x01\x00\x00\x00") == {5: [b"abcd"]}
+
+
+def test_assembler_bounds_memory() -> None:
+    frag = DataFrag(kind=0x16, flags=1, offset=0, size=0, writer_id=1, seq=1, frag_start=1,
+                    frag_count=1, frag_size=4, sample_size=10**9, payload=b"abcd")
+    with pytest.raises(RtpsError, match="max_sample_bytes"):
+        FragmentAssembler().add(b"p" * 12, frag)
+
+
+def test_assembler_ignores_fragment_numbers_past_the_sample() -> None:
+    asm = FragmentAssembler()
+    common = dict(kind=0x16, flags=1, offset=0, size=0, writer_id=1, seq=1, frag_size=4,
+                  sample_size=6)
+    assert asm.add(b"p" * 12, DataFrag(**common, frag_start=9, frag_count=1, payload=b"zzzz")) is None
+    assert asm.add(b"p" * 12, DataFrag(**common, frag_start=2, frag_count=1, payload=b"ef")) is None
+    assert asm.add(b"p" * 12, DataFrag(**common, frag_start=1, frag_count=1, payload=b"abcd")) == b"abcdef"
