@@ -5,7 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import pytest
+
+from realros import require_rtl
 
 from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
@@ -37,13 +38,7 @@ def test_the_shipped_dump_shows_a_refusal_then_the_models_output() -> None:
 
 
 def test_the_shipped_dump_is_what_the_rtl_makes_today(tmp_path: Path) -> None:
-    from rosfpga_lab.rtl.sim import env_required, simulator_missing_reason
-
-    reason = simulator_missing_reason(DUMP_SIMULATOR)
-    if reason is not None:
-        if env_required():
-            pytest.fail(reason)
-        pytest.skip(reason)
+    require_rtl(DUMP_SIMULATOR)
     fresh = tmp_path / "rtl_demo.vcd"
     run_demo(fresh, simulator=DUMP_SIMULATOR)
     old, new = read_vcd(shipped_dump(), clock="clk"), read_vcd(fresh, clock="clk")

@@ -331,3 +331,17 @@ def test_the_node_wrapper_carries_the_configuration() -> None:
         assert param in node, param
     assert "fpga_erode_mono8.yaml" in node
     assert {f"rtl/{p.name}" for p in VERILOG_DIR.glob("*.v")} <= set(files)
+
+
+def test_a_temporary_build_is_removed_with_its_object() -> None:
+    """build() without a directory makes a temporary one; it must not outlive the build."""
+    import gc
+
+    from rosfpga_lab.rtl.demo import demo_config
+
+    sim = build(rtl_params(demo_config()), simulator=require_rtl())
+    where = sim.directory
+    assert where.is_dir()
+    del sim
+    gc.collect()
+    assert not where.exists()

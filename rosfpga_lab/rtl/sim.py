@@ -20,6 +20,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -234,10 +235,18 @@ def build(params: RtlParams, directory: str | Path | None = None, *,
         return RtlBuild(sim, _run_command(sim, target), target, params,
                         time.perf_counter() - start, trace)
     where = Path(directory) if directory else Path(tempfile.mkdtemp(prefix="rosfpga-rtl-"))
-    write_sources(params, where, extra_sources=extra_sources)
-    _compile(sim, where, files, trace)
-    return RtlBuild(sim, _run_command(sim, where), where, params, time.perf_counter() - start,
-                    trace)
+    try:
+        write_sources(params, where, extra_sources=extra_sources)
+        _compile(sim, where, files, trace)
+    except BaseException:
+        if directory is None:
+            shutil.rmtree(where, ignore_errors=True)
+        raise
+    built = RtlBuild(sim, _run_command(sim, where), where, params, time.perf_counter() - start,
+                     trace)
+    if directory is None:  # a temporary build goes when its RtlBuild does (or at exit)
+        weakref.finalize(built, shutil.rmtree, where, True)
+    return built
 
 
 def simulator_version(sim: str) -> str:
