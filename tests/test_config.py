@@ -198,3 +198,31 @@ def test_cli_refuses_bad_config_before_writing(tmp_path: Path) -> None:
     assert proc.returncode == 1
     assert f"{bad}:16: image.encoding" in proc.stderr
     assert not out.exists()
+
+
+def test_one_vocabulary_for_operations_and_encodings() -> None:
+    """Every layer takes its operations and encodings from config.vocabulary: the identity op is
+    "passthrough" from the YAML file to the models' name, and "copy" is only an accepted alias."""
+    import argparse
+
+    from rosfpga_lab.cli import camera as cli_camera
+    from rosfpga_lab.component.checker import expected_output
+    from rosfpga_lab.config import ENCODINGS, MODEL_OPS, OPS, canonical_op
+    from rosfpga_lab.hw import OPS as HW_OPS
+    from rosfpga_lab.hw import Pipeline
+
+    assert OPS == ("dilate", "erode", "passthrough", "custom") and HW_OPS == MODEL_OPS == OPS[:3]
+    assert canonical_op("copy") == "passthrough" and canonical_op("erode") == "erode"
+    config = load_config(DATA / "fpga_passthrough_rgb8.yaml")
+    pipe = Pipeline.from_config(config)
+    assert (pipe.op, pipe.ksize) == ("passthrough", (1, 1))
+    assert Pipeline(op="copy").op == "passthrough"
+    import numpy as np
+
+    image = np.arange(12, dtype=np.uint8).reshape(2, 2, 3)
+    assert expected_output(image, config.application.op, (3, 3)) is image
+    parser = argparse.ArgumentParser()
+    cli_camera.register(parser.add_subparsers())
+    enc_action = next(a for a in parser._subparsers._group_actions[0].choices["camera"]._actions
+                      if a.dest == "encoding")
+    assert tuple(enc_action.choices) == tuple(ENCODINGS)

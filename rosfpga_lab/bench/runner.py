@@ -157,8 +157,7 @@ def run_bench(config: NodeConfig | str | Path | None = None, *, middles: tuple[s
     cfg = config.image
     images = bench_images(cfg.width, cfg.height, cfg.encoding)
     app = config.application
-    op = "copy" if app.op == "passthrough" else app.op
-    dilate = lambda img: expected_output(img, op, (app.ksize, app.ksize))  # noqa: E731
+    dilate = lambda img: expected_output(img, app.op, (app.ksize, app.ksize))  # noqa: E731
     same = lambda img: img  # noqa: E731
     in_topic, out_topic = config.subscriber.topic, config.publisher.topic
     with tempfile.TemporaryDirectory(prefix="rosfpga-bench-") as tmp:

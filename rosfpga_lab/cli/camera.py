@@ -13,6 +13,7 @@ import time
 from pathlib import Path
 
 from rosfpga_lab.cli._args import positive_float, positive_int
+from rosfpga_lab.config.vocabulary import DEFAULT_ENCODING, ENCODINGS
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -48,8 +49,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "node configuration")
     p.add_argument("--topic", help="topic to publish (default: /image_raw)")
     p.add_argument("--size", type=_size, metavar="WxH", help="frame size (default: 640x480)")
-    p.add_argument("--encoding", choices=("rgba8", "bgra8", "rgb8", "bgr8", "mono8"),
-                   help="image encoding (default: rgba8)")
+    p.add_argument("--encoding", choices=tuple(ENCODINGS),
+                   help=f"image encoding (default: {DEFAULT_ENCODING})")
     p.add_argument("--rate", type=float, default=30.0, help="frames per second (default: 30)")
     p.add_argument("--source", default="synthetic",
                    help="synthetic (default), grace_hopper, an image file or a directory")
@@ -63,7 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "view", help="receive sensor_msgs/Image frames: count, time and save them as PNG",
         description="Subscribe to an image topic and show what arrives: a status line with "
         "frames, fps and latency (receive time minus header.stamp), and, with --save, PNG files "
-        "of the frames (mono8, rgb8, bgr8, rgba8, bgra8). Example: "
+        f"of the frames ({', '.join(ENCODINGS)}). Example: "
         "rosfpga-lab view /image_dilated --save out --every 30")
     v.add_argument("topic", metavar="TOPIC", help="the image topic")
     v.add_argument("--save", type=Path, metavar="DIR", help="write frames as PNG into DIR")
@@ -94,7 +95,7 @@ def run_camera(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Camera
     from rosfpga_lab.config import load_config
 
-    topic, size, encoding, config_uri = "/image_raw", (640, 480), "rgba8", None
+    topic, size, encoding, config_uri = "/image_raw", (640, 480), DEFAULT_ENCODING, None
     if args.config is not None:
         cfg = load_config(args.config)
         topic, size, encoding = cfg.subscriber.topic, (cfg.image.width, cfg.image.height), cfg.image.encoding

@@ -29,6 +29,7 @@ from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import ComponentError, SourceError
 from rosfpga_lab.component.sources import ImageSource, open_source, to_rgb
 from rosfpga_lab.component.stats import LatencyWindow, since_stamp
+from rosfpga_lab.config import DEFAULT_ENCODING, PIXEL_FORMATS
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node
 from rosfpga_lab.hw import image_frame
 
@@ -70,7 +71,7 @@ class Camera:
     """
 
     def __init__(self, topic: str = "/image_raw", *, width: int = 640, height: int = 480,
-                 encoding: str = "rgba8", rate: float = 30.0, source: str | ImageSource = "synthetic",
+                 encoding: str = DEFAULT_ENCODING, rate: float = 30.0, source: str | ImageSource = "synthetic",
                  name: str = "/camera", master: EmbeddedMaster | None = None,
                  master_uri: str | None = None, host: str | None = None, frame_id: str = "camera",
                  queue_size: int = 2, on_sent: Callable[[SentFrame], Any] | None = None) -> None:
@@ -226,7 +227,7 @@ class Viewer:
         h, w, enc = msg["height"], msg["width"], msg["encoding"]
         image = None
         try:
-            channels = {"mono8": 1, "rgb8": 3, "bgr8": 3, "rgba8": 4, "bgra8": 4}[enc]
+            channels = PIXEL_FORMATS[enc].bytes_per_pixel
             data = np.frombuffer(msg["data"], np.uint8)
             image = data[:h * msg["step"]].reshape(h, msg["step"])[:, :w * channels].reshape(
                 h, w, channels)

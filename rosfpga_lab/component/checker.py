@@ -21,6 +21,7 @@ import numpy as np
 from rosfpga_lab.component.camera import SentFrame
 from rosfpga_lab.component.errors import ComponentError
 from rosfpga_lab.component.stats import LatencyWindow, since_stamp
+from rosfpga_lab.config import PASSTHROUGH, canonical_op
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node
 from rosfpga_lab.msg import default_registry, deserialize
 
@@ -32,10 +33,12 @@ def expected_output(image: np.ndarray, op: str, ksize: tuple[int, int]) -> np.nd
     """OpenCV's answer for ``image`` (``(rows, cols, channels)`` uint8).
 
     Args:
-        op: ``"dilate"``, ``"erode"``, ``"copy"`` or ``"passthrough"``.
+        op: one of :data:`~rosfpga_lab.config.vocabulary.MODEL_OPS` (or an alias
+            :func:`~rosfpga_lab.config.vocabulary.canonical_op` accepts).
         ksize: kernel ``(width, height)`` (OpenCV's order).
     """
-    if op in ("copy", "passthrough"):
+    op = canonical_op(op)
+    if op == PASSTHROUGH:
         return image
     kernel = np.ones((ksize[1], ksize[0]), np.uint8)
     fn = {"dilate": cv2.dilate, "erode": cv2.erode}.get(op)

@@ -135,7 +135,7 @@ class DemoRig:
             config = load_config(config)
         self.config = config
         app = config.application
-        self.op = oracle_op or ("copy" if app.op == "passthrough" else app.op)
+        self.op = oracle_op or app.op
         self.master = EmbeddedMaster(port=0).start()
         self.component: FpgaComponent | None = None
         self.checker: Checker | None = None

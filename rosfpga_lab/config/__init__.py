@@ -19,10 +19,13 @@ from rosfpga_lab.config.node import (
     ApplicationConfig, FifoConfig, ImageConfig, NodeConfig, NodeSection, TopicConfig,
     load_config, parse_config, ros_name_problem,
 )
-from rosfpga_lab.config.vocabulary import ENCODINGS, OPS, PIXEL_FORMATS, PixelFormat
+from rosfpga_lab.config.vocabulary import (
+    CUSTOM, DEFAULT_ENCODING, DEFAULT_OP, ENCODINGS, MODEL_OPS, OPS, PASSTHROUGH, PIXEL_FORMATS, PixelFormat,
+    canonical_op, model_ksize,
+)
 
 __all__ = [
-    "ENCODINGS", "OPS", "PIXEL_FORMATS", "ApplicationConfig", "ConfigError", "FifoConfig",
+    "CUSTOM", "DEFAULT_ENCODING", "DEFAULT_OP", "ENCODINGS", "MODEL_OPS", "OPS", "PASSTHROUGH", "PIXEL_FORMATS", "ApplicationConfig", "ConfigError", "FifoConfig",
     "ImageConfig", "NodeConfig", "NodeSection", "PixelFormat", "TopicConfig", "load_config",
-    "parse_config", "ros_name_problem",
+    "parse_config", "ros_name_problem", "canonical_op", "model_ksize",
 ]

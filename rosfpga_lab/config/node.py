@@ -51,7 +51,7 @@ import yaml
 
 from rosfpga_lab.config import limits
 from rosfpga_lab.config.errors import ConfigError
-from rosfpga_lab.config.vocabulary import ENCODINGS, OPS
+from rosfpga_lab.config.vocabulary import CUSTOM, DEFAULT_OP, ENCODINGS, OPS
 
 # ROS 1 graph resource names (wiki.ros.org/Names): first character a letter, '/' or '~'; then
 # letters, digits, '_' and '/'. The lab also refuses '//' and a trailing '/' (roscpp does).
@@ -136,7 +136,7 @@ class ApplicationConfig:
         source: for ``custom``, the C++ file defining ``image_filter()`` (absolute path).
     """
 
-    op: str = "dilate"
+    op: str = DEFAULT_OP
     ksize: int = 3
     source: Path | None = None
 
@@ -196,7 +196,7 @@ _SCHEMA: dict[str, dict[str, tuple[type | tuple[type, ...], Any]]] = {
     "subscriber": {"topic": (str, _REQUIRED), "type": (str, limits.IMAGE_TYPE)},
     "publisher": {"topic": (str, _REQUIRED), "type": (str, limits.IMAGE_TYPE)},
     "image": {"width": (int, _REQUIRED), "height": (int, _REQUIRED), "encoding": (str, _REQUIRED)},
-    "application": {"op": (str, "dilate"), "ksize": (int, 3), "source": ((str, type(None)), None)},
+    "application": {"op": (str, DEFAULT_OP), "ksize": (int, 3), "source": ((str, type(None)), None)},
     "fifo": {"input_depth": (int, limits.DEFAULT_INPUT_FIFO_DEPTH),
              "output_depth": (int, limits.DEFAULT_OUTPUT_FIFO_DEPTH),
              "axis_depth": (int, limits.DEFAULT_AXIS_FIFO_DEPTH)},
@@ -428,7 +428,7 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
            f"ksize must be odd, 1..{limits.MAX_KSIZE}, got {ap['ksize']}", apn, "ksize",
            "application")
     source_path: Path | None = None
-    if ap["op"] == "custom":
+    if ap["op"] == CUSTOM:
         _check(ctx, bool(ap["source"]), "op 'custom' needs 'source: FILE.cpp' (the C++ file "
                "defining image_filter)", apn, "op", "application")
         source_path = ((base_dir or Path.cwd()) / ap["source"]).resolve()

@@ -27,7 +27,7 @@ import jinja2
 import numpy as np
 
 from rosfpga_lab import __version__
-from rosfpga_lab.config import NodeConfig
+from rosfpga_lab.config import CUSTOM, PASSTHROUGH, NodeConfig
 from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, SOURCES
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
@@ -138,9 +138,9 @@ def _header_context(title: str, array: str, function: str, fields: dict[str, str
 
 def _app_summary(config: NodeConfig) -> str:
     app = config.application
-    if app.op == "custom":
+    if app.op == CUSTOM:
         return f"the user's image_filter() from {app.source.name if app.source else '?'}"
-    if app.op == "passthrough":
+    if app.op == PASSTHROUGH:
         return "pass-through, no processing"
     return f"{app.ksize}x{app.ksize} {app.op}"
 
@@ -167,7 +167,7 @@ def sample_frames(config: NodeConfig) -> tuple[bytes, bytes]:
     """The testbench's input frame and the output frame the Python models give for it."""
     frame = image_frame(sample_image(config), config.image.encoding, seq=7,
                         stamp=(1_700_000_000, 123_456_789), frame_id="camera")
-    if config.application.op == "custom":
+    if config.application.op == CUSTOM:
         return frame, b""
     return frame, Pipeline.from_config(config).process(frame).output_frame
 
@@ -209,7 +209,7 @@ def render(config: NodeConfig) -> dict[str, str]:
         "after_frame_id": fixed_after("frame_id"), "after_encoding": fixed_after("encoding"),
         "tb_input": TB_INPUT, "cxxflags": CXXFLAGS, "rtl": config.application.op != "custom", "csim_sources": SOURCES,
         "design_sources": [src for src in SOURCES if src != f"{BINARY}.cpp"],
-        "tb_expected": TB_EXPECTED if config.application.op != "custom" else "",
+        "tb_expected": TB_EXPECTED if config.application.op != CUSTOM else "",
         "headers": [
             _header_context(f"Subscriber: sent to each publisher of {config.subscriber.topic}",
                             "SUBSCRIBER_HEADER", "subscriber_connection_header",
@@ -225,7 +225,7 @@ def render(config: NodeConfig) -> dict[str, str]:
     )
     out: dict[str, str] = {}
     for target, template in TEMPLATE_FILES.items():
-        if target == "image_filter.cpp" and config.application.op == "custom":
+        if target == "image_filter.cpp" and config.application.op == CUSTOM:
             assert config.application.source is not None
             try:
                 out[target] = config.application.source.read_text(encoding="utf-8")
