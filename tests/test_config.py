@@ -226,3 +226,19 @@ def test_one_vocabulary_for_operations_and_encodings() -> None:
     enc_action = next(a for a in parser._subparsers._group_actions[0].choices["camera"]._actions
                       if a.dest == "encoding")
     assert tuple(enc_action.choices) == tuple(ENCODINGS)
+
+
+def test_one_master_uri_rule() -> None:
+    """explicit > ROS_MASTER_URI > the configuration's node.master_uri > roscore's default."""
+    from rosfpga_lab.config import master_uri
+    from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
+
+    cfg = parse_config(GOOD.replace("master_uri: http://127.0.0.1:11311/", "master_uri: http://10.0.0.2:1/"))
+    env = {"ROS_MASTER_URI": "http://10.0.0.3:2/"}
+    assert DEFAULT_MASTER_URI == "http://127.0.0.1:11311/"
+    assert master_uri("http://10.0.0.1:9/", cfg, env) == "http://10.0.0.1:9/"
+    assert master_uri(None, cfg, env) == "http://10.0.0.3:2/"
+    assert master_uri(None, cfg, {"ROS_MASTER_URI": "  "}) == "http://10.0.0.2:1/"
+    assert master_uri("", cfg, {}) == "http://10.0.0.2:1/"
+    assert master_uri(None, None, {}) == DEFAULT_MASTER_URI
+    assert master_uri(None, None, env) == "http://10.0.0.3:2/"

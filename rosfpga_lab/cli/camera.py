@@ -11,9 +11,14 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rosfpga_lab.cli._args import positive_float, positive_int
+from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
 from rosfpga_lab.config.vocabulary import DEFAULT_ENCODING, ENCODINGS
+
+if TYPE_CHECKING:
+    from rosfpga_lab.config import NodeConfig
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -24,13 +29,10 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
-DEFAULT_MASTER = "http://127.0.0.1:11311/"
-
-
 def _common(p: argparse.ArgumentParser, *, with_config: bool) -> None:
     from_config = "the --config file's node.master_uri, else " if with_config else ""
     p.add_argument("--master-uri", metavar="URI",
-                   help=f"ROS master (default: ROS_MASTER_URI, else {from_config}{DEFAULT_MASTER})")
+                   help=f"ROS master (default: ROS_MASTER_URI, else {from_config}{DEFAULT_MASTER_URI})")
     p.add_argument("--name", metavar="NODE", help="node name")
 
 
@@ -78,12 +80,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     v.set_defaults(func=run_view)
 
 
-def _master_uri(args: argparse.Namespace, config_uri: str | None = None) -> str:
+def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> str:
     """The master to use; raises ComponentError (printed by the CLI) when none answers there."""
     from rosfpga_lab.component import ComponentError, master_answers
-    from rosfpga_lab.graph import master_uri_from_env
+    from rosfpga_lab.config import master_uri
 
-    uri = args.master_uri or master_uri_from_env() or config_uri or DEFAULT_MASTER
+    uri = master_uri(args.master_uri, config)
     if not master_answers(uri):
         raise ComponentError(f"no ROS master answers at {uri}; start one (roscore, or "
                              "'rosfpga-lab master') or give --master-uri")
@@ -95,16 +97,15 @@ def run_camera(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Camera
     from rosfpga_lab.config import load_config
 
-    topic, size, encoding, config_uri = "/image_raw", (640, 480), DEFAULT_ENCODING, None
+    topic, size, encoding, cfg = "/image_raw", (640, 480), DEFAULT_ENCODING, None
     if args.config is not None:
         cfg = load_config(args.config)
         topic, size, encoding = cfg.subscriber.topic, (cfg.image.width, cfg.image.height), cfg.image.encoding
-        config_uri = cfg.node.master_uri
     topic = args.topic or topic
     size = args.size or size
     encoding = args.encoding or encoding
     cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
-                 source=args.source, name=args.name or "/camera", master_uri=_master_uri(args, config_uri),
+                 source=args.source, name=args.name or "/camera", master_uri=_master_uri(args, cfg),
                  frame_id=args.frame_id)
     print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on {topic} "
           f"at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop", flush=True)

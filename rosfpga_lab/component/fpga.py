@@ -42,6 +42,7 @@ from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
 from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, since_stamp
 from rosfpga_lab.config import NodeConfig, load_config
+from rosfpga_lab.config import master_uri as pick_master_uri
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
 from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineResult
@@ -160,7 +161,9 @@ class FpgaComponent:
         self.config = config
         self.model = model
         self.master = master
-        self.master_uri = master.uri if master is not None else (master_uri or config.node.master_uri)
+        # the Python API takes the file's master, not ROS_MASTER_URI (commands add the environment)
+        self.master_uri = master.uri if master is not None else pick_master_uri(
+            master_uri, config, environ={})
         self.name = name or config.node.global_name
         self.host = host or config.node.ip_address
         self.input_topic = config.subscriber.topic

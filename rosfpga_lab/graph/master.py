@@ -26,6 +26,7 @@ import threading
 import uuid
 from typing import Any
 
+from rosfpga_lab.config.limits import DEFAULT_MASTER_PORT
 from rosfpga_lab.graph.apicheck import api_methods, checked
 from rosfpga_lab.graph.errors import (
     JOIN_TIMEOUT,
@@ -155,7 +156,7 @@ class EmbeddedMaster:
         'http://127.0.0.1:41234/'
     """
 
-    def __init__(self, host: str = "127.0.0.1", port: int = 11311, *, trace: Trace | None = None,
+    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_MASTER_PORT, *, trace: Trace | None = None,
                  allow_remote_shutdown: bool = False) -> None:
         self.trace = trace if trace is not None else Trace()
         self.allow_remote_shutdown = allow_remote_shutdown

@@ -10,6 +10,7 @@ import os
 import re
 import warnings
 
+from rosfpga_lab.config.master import master_uri_from_env  # noqa: F401  (re-exported; the rule's owner)
 from rosfpga_lab.graph.errors import ConfigError
 
 _LEGAL = re.compile(r"^[~/A-Za-z][\w/]*$")
@@ -61,12 +62,6 @@ def check_node_name(name: str) -> str:
         raise ConfigError(f"illegal node name {name!r}: use letters, digits, '_' and '/', "
                           "starting with a letter or '/'")
     return resolve(name, "/")
-
-
-def master_uri_from_env() -> str | None:
-    """``ROS_MASTER_URI`` if set and non-empty, else None."""
-    value = os.environ.get("ROS_MASTER_URI", "").strip()
-    return value or None
 
 
 def default_host() -> str:

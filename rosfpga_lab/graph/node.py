@@ -28,6 +28,8 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
+from rosfpga_lab.config import limits as config_limits
+from rosfpga_lab.config.master import master_uri_from_env
 from rosfpga_lab.graph.apicheck import api_methods, checked
 from rosfpga_lab.graph.errors import (
     JOIN_TIMEOUT,
@@ -43,7 +45,6 @@ from rosfpga_lab.graph.names import (
     bind_address,
     check_node_name,
     default_host,
-    master_uri_from_env,
     resolve,
 )
 from rosfpga_lab.graph.owner import listener_uids
@@ -66,7 +67,7 @@ from rosfpga_lab.tcpros import (
 _shared_lock = threading.Lock()
 _shared: EmbeddedMaster | None = None
 #: Port of roscore's master, probed and (if free) used by the shared embedded master.
-DEFAULT_MASTER_PORT = 11311
+DEFAULT_MASTER_PORT = config_limits.DEFAULT_MASTER_PORT
 
 
 def shared_master(port: int | None = None) -> EmbeddedMaster:
@@ -106,7 +107,7 @@ def default_master_uri() -> str:
     a port is known: on a shared server another user's master is never joined unasked, with a
     RuntimeWarning); else the shared embedded master of this process.
     """
-    env = master_uri_from_env()
+    env = master_uri_from_env()  # steps 1-2 of rosfpga_lab.config.master's rule (no explicit URI here)
     if env:
         return env
     with _shared_lock:

@@ -14,10 +14,9 @@ from typing import Any
 import numpy as np
 
 from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcTooLargeError
-from rosfpga_lab.graph.names import master_uri_from_env
+from rosfpga_lab.config.master import master_uri
 from rosfpga_lab.graph.xmlrpc import call
 
-DEFAULT_MASTER_URI = "http://127.0.0.1:11311/"
 #: Arrays longer than this are summarised by :func:`format_message` (rostopic echo --noarr style).
 MAX_ARRAY_SHOWN = 64
 TOOL_ID = "/rosfpga_lab_topic"
@@ -26,8 +25,8 @@ TOPIC_POLL = 0.1
 
 
 def pick_master_uri(explicit: str | None = None) -> str:
-    """``explicit``, else ROS_MASTER_URI, else roscore's default http://127.0.0.1:11311/."""
-    return explicit or master_uri_from_env() or DEFAULT_MASTER_URI
+    """``explicit``, else ROS_MASTER_URI, else roscore's default (:func:`rosfpga_lab.config.master_uri`)."""
+    return master_uri(explicit)
 
 
 def master_call(uri: str, method: str, *args: Any) -> Any:
