@@ -51,13 +51,8 @@ import yaml
 
 from rosfpga_lab.config import limits
 from rosfpga_lab.config.errors import ConfigError
+from rosfpga_lab.config.names import canonical, name_problem
 from rosfpga_lab.config.vocabulary import CUSTOM, DEFAULT_OP, ENCODINGS, OPS
-
-# ROS 1 graph resource names (wiki.ros.org/Names): first character a letter, '/' or '~'; then
-# letters, digits, '_' and '/'. The lab also refuses '//' and a trailing '/' (roscpp does).
-_ROS_NAME = re.compile(r"^[A-Za-z/~][A-Za-z0-9_/]*$")
-_BASE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-
 
 @dataclass(frozen=True)
 class NodeSection:
@@ -292,34 +287,20 @@ def _check(ctx: _Ctx, ok: bool, message: str, nodes: dict[str, yaml.Node], key: 
 
 
 def ros_name_problem(name: str, *, node_name: bool = False) -> str | None:
-    """Why ``name`` breaks ROS 1 naming rules, or None when it is legal.
+    """Why ``name`` cannot be a topic (or node) name in a configuration, or None.
+
+    The ROS rules of :func:`rosfpga_lab.config.names.name_problem`, plus one of the configuration:
+    the name is written in canonical form (no trailing ``/``), as the circuit sends it verbatim
+    in its connection headers.
 
     Args:
         name: a graph resource name (topic or node).
         node_name: apply the extra rules of node names (not private, base name legal).
     """
-    if not name:
-        return "a ROS name cannot be empty"
-    if not _ROS_NAME.fullmatch(name):
-        bad = next((c for c in name if not (c.isascii() and (c.isalnum() or c in "_/~"))), None)
-        if bad is not None:
-            return f"character {bad!r} is not allowed in a ROS name (letters, digits, '_', '/')"
-        return "a ROS name starts with a letter, '/' or '~'"
-    if "~" in name[1:]:
-        return "'~' may only start a ROS name"
-    if "//" in name:
-        return "a ROS name cannot contain '//'"
-    if len(name) > 1 and name.endswith("/"):
-        return "a ROS name cannot end with '/'"
-    for part in name.lstrip("/~").split("/"):
-        if part and not _BASE_NAME.fullmatch(part):
-            return f"name part {part!r} must start with a letter"
-    if node_name:
-        if name.startswith("~"):
-            return "a node name cannot be private ('~')"
-        if name == "/":
-            return "a node name cannot be '/'"
-    return None
+    problem = name_problem(name, node_name=node_name)
+    if problem is None and name != canonical(name):
+        return f"write the name in canonical form, {canonical(name)!r} (no trailing '/')"
+    return problem
 
 
 def _check_type(ctx: _Ctx, type_name: str, nodes: dict[str, yaml.Node], section: str,

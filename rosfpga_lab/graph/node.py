@@ -44,8 +44,8 @@ from rosfpga_lab.graph.names import (
     ALL_INTERFACES,
     bind_address,
     check_node_name,
+    check_topic_name,
     default_host,
-    resolve,
 )
 from rosfpga_lab.graph.owner import listener_uids
 from rosfpga_lab.graph.publisher import Publisher
@@ -255,7 +255,7 @@ class Node:
             MasterError, XmlRpcError: the master refused or cannot be reached.
             MsgError: unknown type.
         """
-        topic = resolve(topic, self.name)
+        topic = check_topic_name(topic, self.name)
         md5, definition = self._type_info(type_name, md5sum, message_definition)
         with self._lock:
             if self.is_shutdown:
@@ -310,7 +310,7 @@ class Node:
             GraphError: already subscribed to this topic in this node.
             MasterError, XmlRpcError: the master refused or cannot be reached.
         """
-        topic = resolve(topic, self.name)
+        topic = check_topic_name(topic, self.name)
         md5, definition = self._type_info(type_name, md5sum, None)
         if type_name == "*" and not raw:
             raise GraphError("subscribing with type '*' needs raw=True (nothing to deserialize with)")
