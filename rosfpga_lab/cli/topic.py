@@ -172,7 +172,7 @@ def _pub(args: argparse.Namespace, uri: str) -> int:
 def _hz(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import tools
 
-    meter = tools.RateMeter(args.window)
+    meter = tools.RateMeter(samples=args.window + 1)  # the last N intervals, as rostopic hz -w N
     node = _node(uri, "hz")
     try:
         node.subscribe(args.topic, "*", lambda body, info: meter.tick(), raw=True, queue_size=0,

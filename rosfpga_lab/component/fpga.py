@@ -40,7 +40,7 @@ import numpy as np
 
 from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
-from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, since_stamp
+from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, fps_meter, since_stamp
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.config import master_uri as pick_master_uri
 from rosfpga_lab.errors import LabError
@@ -182,7 +182,7 @@ class FpgaComponent:
         self._latency = LatencyWindow(limits.LATENCY_WINDOW)
         self._process = LatencyWindow(limits.LATENCY_WINDOW)
         self._since_stamp = LatencyWindow(limits.LATENCY_WINDOW)
-        self._published_times: collections.deque[float] = collections.deque(maxlen=256)
+        self._published_rate = fps_meter()
         self._counts = {"seen": 0, "processed": 0, "published": 0, "refused": 0,
                         "reregistered": 0, "observer_errors": 0}
         self._reasons: dict[str, int] = {}        # refusal kind -> count
@@ -310,7 +310,7 @@ class FpgaComponent:
             self._counts["seen"] += 1
             self._counts["processed"] += 1
             self._counts["published"] += 1
-            self._published_times.append(time.monotonic())
+            self._published_rate.tick()
             self._last = result
             for fifo, level in result.fifo_high_water.items():
                 self._high_water[fifo] = max(level, self._high_water.get(fifo, 0))
@@ -429,13 +429,9 @@ class FpgaComponent:
             for link in pub_stats.links:
                 if link.drops:
                     by_peer[link.peer] = by_peer.get(link.peer, 0) + link.drops
-        now = time.monotonic()
         with self._lock:
             c = dict(self._counts)
-            times = [t for t in self._published_times if t >= now - 2.0]
-            fps = (len(times) - 1) / (times[-1] - times[0]) if len(times) > 1 and times[-1] > times[0] else 0.0
-            if times and now - times[-1] > 1.0:
-                fps = 0.0
+            fps = self._published_rate.rate()
             last = self._last
             return ComponentStats(
                 received=sub_stats.frames if sub_stats else 0,

@@ -34,6 +34,8 @@ BEAT_PAGE_SIZE = 32
 WAVE_BEATS = 16
 #: Live view: default most frames per second pushed to the browser.
 LIVE_MAX_FPS = 10.0
+#: Live view: seconds of arrivals its fps figures count.
+LIVE_RATE_WINDOW = 2.0
 #: Largest width (pixels) of an image sent to the browser; bigger ones are scaled down.
 DISPLAY_MAX_WIDTH = 640
 
