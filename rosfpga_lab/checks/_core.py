@@ -20,10 +20,9 @@ from typing import Any
 
 import numpy as np
 
+from rosfpga_lab.checks.limits import MAX_PROBLEMS, MAX_SHIFT, SHIFT_WINDOW
 from rosfpga_lab.errors import LabError
 
-#: How many problems one failed check lists at most.
-MAX_PROBLEMS = 5
 
 _STRUCT = {"uint8": "<B", "int8": "<b", "uint16": "<H", "int16": "<h", "uint32": "<I",
            "int32": "<i", "uint64": "<Q", "int64": "<q", "float32": "<f", "float64": "<d",
@@ -181,9 +180,6 @@ def _byte(b: int) -> str:
     return f"0x{b:02x} ({b}{', ' + repr(shown) if shown else ''})"
 
 
-#: Bytes compared when looking for a shifted stream, and the largest shift looked for.
-SHIFT_WINDOW = 16
-MAX_SHIFT = 8
 
 
 def _shift(got: bytes, expected: bytes, i: int) -> int:

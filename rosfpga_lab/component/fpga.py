@@ -49,9 +49,6 @@ from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineRes
 
 log = logging.getLogger("rosfpga_lab.component")
 
-#: Refusal kinds counted separately (kinds are field + rule, a few dozen at most; any beyond
-#: this count under "other").
-MAX_REFUSAL_KINDS = 64
 
 
 @dataclass(frozen=True)
@@ -324,7 +321,7 @@ class FpgaComponent:
         with self._lock:
             self._counts["seen"] += 1
             self._counts["refused"] += 1
-            if kind not in self._reasons and len(self._reasons) >= MAX_REFUSAL_KINDS:
+            if kind not in self._reasons and len(self._reasons) >= limits.MAX_REFUSAL_KINDS:
                 kind = "other"
             n = self._reasons[kind] = self._reasons.get(kind, 0) + 1
             self._examples.setdefault(kind, reason)

@@ -32,6 +32,11 @@ FPS_SAMPLES = 256
 #: samples it keeps.
 CHECKER_PENDING = 512
 CHECKER_LATENCY_WINDOW = 100_000
+#: Distinct frames an image source makes before it repeats.
+DEFAULT_SOURCE_PERIOD = 60
+#: Refusal kinds counted separately (kinds are field + rule, a few dozen at most; any beyond
+#: this count under "other").
+MAX_REFUSAL_KINDS = 64
 #: Camera limits: frames per second and image side.
 MAX_CAMERA_RATE = 1000.0
 MAX_CAMERA_SIDE = 8192

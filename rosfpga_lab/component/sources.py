@@ -28,7 +28,7 @@ from rosfpga_lab.config import PIXEL_FORMATS
 #: Named sources (besides a path).
 SOURCES = ("synthetic", "grace_hopper")
 #: Distinct frames before a source repeats.
-DEFAULT_PERIOD = 60
+DEFAULT_PERIOD = limits.DEFAULT_SOURCE_PERIOD
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
 
 
