@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 from rosfpga_lab.graph.errors import JOIN_TIMEOUT, MAX_CLOSED_LINKS_KEPT, GraphError
 from rosfpga_lab.graph.wire import hard_close, send_frame, set_nodelay, socket_ends
-from rosfpga_lab.tcpros import TopicSpec
+from rosfpga_lab.tcpros import TopicSpec, publisher_reply_fields
 
 if TYPE_CHECKING:
     import socket
@@ -195,9 +195,7 @@ class Publisher:
 
     def node_reply_fields(self) -> dict[str, str]:
         """The header fields this publisher answers subscribers with."""
-        return {"callerid": self.node.name, "latching": "1" if self.latch else "0",
-                "md5sum": self.md5sum, "message_definition": self.message_definition,
-                "topic": self.topic, "type": self.type_name}
+        return publisher_reply_fields(self.node.name, self.spec)
 
     # ----------------------------------------------------------------- links
     def _add_link(self, sock: socket.socket, conn_id: int, peer: str, tcp_nodelay: bool,

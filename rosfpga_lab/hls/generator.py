@@ -34,7 +34,7 @@ from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pi
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, SUBSCRIBER_STATUSES, fixed_after
 from rosfpga_lab.msg import default_registry
-from rosfpga_lab.tcpros import encode_header
+from rosfpga_lab.tcpros import TopicSpec, encode_header, publisher_reply_fields, subscriber_request_fields
 
 TEMPLATES_DIR = Path(__file__).resolve().parent / "templates"
 INCLUDE_DIR = Path(__file__).resolve().parent / "include"
@@ -99,9 +99,10 @@ def subscriber_header_fields(config: NodeConfig) -> dict[str, str]:
     """
     reg = default_registry()
     t = config.subscriber.type
-    return {"callerid": config.node.global_name, "md5sum": reg.md5(t),
-            "message_definition": reg.full_text(t), "tcp_nodelay": "1",
-            "topic": config.subscriber.topic, "type": t}
+    return subscriber_request_fields(callerid=config.node.global_name,
+                                     topic=config.subscriber.topic, md5sum=reg.md5(t),
+                                     type_name=t, message_definition=reg.full_text(t),
+                                     tcp_nodelay=True)
 
 
 def publisher_header_fields(config: NodeConfig) -> dict[str, str]:
@@ -115,8 +116,8 @@ def publisher_header_fields(config: NodeConfig) -> dict[str, str]:
     """
     reg = default_registry()
     t = config.publisher.type
-    return {"callerid": config.node.global_name, "latching": "0", "md5sum": reg.md5(t),
-            "message_definition": reg.full_text(t), "topic": config.publisher.topic, "type": t}
+    return publisher_reply_fields(config.node.global_name,
+                                  TopicSpec(config.publisher.topic, t, reg.md5(t), reg.full_text(t)))
 
 
 def _hex_rows(data: bytes) -> list[str]:

@@ -34,6 +34,8 @@ from rosfpga_lab.tcpros.handshake import (
     Transition,
     check_publisher_header,
     check_subscriber_header,
+    publisher_reply_fields,
+    subscriber_request_fields,
 )
 from rosfpga_lab.tcpros.header import (
     HeaderDecoder,
@@ -51,5 +53,6 @@ __all__ = [
     "HeaderReceived", "IncompleteError", "ProtocolError", "PublisherHandshake", "Rejected",
     "RemoteError", "StateError", "SubscriberHandshake", "TopicSpec", "Transition",
     "check_publisher_header", "check_subscriber_header", "decode_header", "encode_error_header",
-    "encode_frame", "encode_header", "frame_prefix", "parse_fields",
+    "encode_frame", "encode_header", "frame_prefix", "parse_fields", "publisher_reply_fields",
+    "subscriber_request_fields",
 ]

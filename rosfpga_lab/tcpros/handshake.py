@@ -155,6 +155,47 @@ class TopicSpec:
     latching: bool = False
 
 
+# ------------------------------------------------------------------------- header builders
+def subscriber_request_fields(*, callerid: str, topic: str, md5sum: str, type_name: str,
+                              message_definition: str | None = None,
+                              tcp_nodelay: bool = False) -> dict[str, str]:
+    """The connection header a subscriber opens with (rospy's field set; roscpp leaves out
+    ``message_definition``). The one definition used by :class:`SubscriberHandshake` and by the
+    generated circuit's precomputed header.
+
+    Args:
+        callerid: the subscribing node's name.
+        topic, md5sum, type_name: what it subscribes to (``*`` for md5sum and type: any).
+        message_definition: the full text of the type; None leaves the field out.
+        tcp_nodelay: ask the publisher for TCP_NODELAY.
+
+    Returns:
+        ``{key: value}`` in key order (as the wire has them).
+    """
+    fields = {"callerid": callerid, "md5sum": md5sum, "tcp_nodelay": "1" if tcp_nodelay else "0",
+              "topic": topic, "type": type_name}
+    if message_definition is not None:
+        fields["message_definition"] = message_definition
+    return dict(sorted(fields.items()))
+
+
+def publisher_reply_fields(callerid: str, spec: TopicSpec) -> dict[str, str]:
+    """The connection header a publisher answers an accepted subscriber with (roscpp's field
+    set). The one definition used by :class:`PublisherHandshake`, the graph's publisher and the
+    generated circuit's precomputed header.
+
+    Args:
+        callerid: the publishing node's name.
+        spec: what it publishes on the topic.
+
+    Returns:
+        ``{key: value}`` in key order: callerid, latching, md5sum, message_definition, topic, type.
+    """
+    return {"callerid": callerid, "latching": "1" if spec.latching else "0",
+            "md5sum": spec.md5sum, "message_definition": spec.message_definition,
+            "topic": spec.topic, "type": spec.type}
+
+
 # ---------------------------------------------------------------------------------- checks
 def check_subscriber_header(fields: Mapping[str, str], spec: TopicSpec | None,
                             peer: str = "") -> str | None:
@@ -250,10 +291,9 @@ class SubscriberHandshake(_Machine):
                  max_header: int = MAX_HEADER_BYTES, max_field: int = MAX_FIELD_BYTES,
                  max_frame: int = MAX_FRAME_BYTES) -> None:
         super().__init__("IDLE")
-        self.fields: dict[str, str] = {"callerid": callerid, "md5sum": md5sum, "topic": topic,
-                                       "type": type_name, "tcp_nodelay": "1" if tcp_nodelay else "0"}
-        if message_definition is not None:
-            self.fields["message_definition"] = message_definition
+        self.fields: dict[str, str] = subscriber_request_fields(
+            callerid=callerid, topic=topic, md5sum=md5sum, type_name=type_name,
+            message_definition=message_definition, tcp_nodelay=tcp_nodelay)
         self._header = HeaderDecoder(max_header=max_header, max_field=max_field)
         self._max_frame = max_frame
         self._frames: FrameDecoder | None = None
@@ -399,10 +439,8 @@ class PublisherHandshake(_Machine):
         self.frames_sent = 0
 
     def reply_fields(self, spec: TopicSpec) -> dict[str, str]:
-        """Our answer header for ``spec`` (roscpp's field set)."""
-        return {"callerid": self.callerid, "latching": "1" if spec.latching else "0",
-                "md5sum": spec.md5sum, "message_definition": spec.message_definition,
-                "topic": spec.topic, "type": spec.type}
+        """Our answer header for ``spec`` (:func:`publisher_reply_fields`)."""
+        return publisher_reply_fields(self.callerid, spec)
 
     def _reject(self, trigger: str, error: ProtocolError) -> list[Event]:
         self._fire(trigger)
