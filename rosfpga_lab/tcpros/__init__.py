@@ -18,7 +18,7 @@ from rosfpga_lab.tcpros.errors import (
     RemoteError,
     StateError,
 )
-from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame, frame_prefix
+from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame, frame_prefix, frame_spans
 from rosfpga_lab.tcpros.handshake import (
     ANY,
     STATES,
@@ -39,20 +39,20 @@ from rosfpga_lab.tcpros.handshake import (
 )
 from rosfpga_lab.tcpros.header import (
     HeaderDecoder,
-    HeaderField,
     decode_header,
     encode_error_header,
     encode_header,
+    header_spans,
     parse_fields,
 )
 
 __all__ = [
     "ANY", "HANDSHAKE_TIMEOUT", "MAX_FIELD_BYTES", "MAX_FRAME_BYTES", "MAX_HEADER_BYTES",
     "STATES", "TRANSITIONS", "Closed", "Connected", "Frame", "FrameDecoder", "FrameError",
-    "HandshakeRejected", "HandshakeTimeout", "HeaderDecoder", "HeaderField", "HeaderFormatError",
+    "HandshakeRejected", "HandshakeTimeout", "HeaderDecoder", "HeaderFormatError",
     "HeaderReceived", "IncompleteError", "ProtocolError", "PublisherHandshake", "Rejected",
     "RemoteError", "StateError", "SubscriberHandshake", "TopicSpec", "Transition",
     "check_publisher_header", "check_subscriber_header", "decode_header", "encode_error_header",
-    "encode_frame", "encode_header", "frame_prefix", "parse_fields", "publisher_reply_fields",
+    "encode_frame", "encode_header", "frame_prefix", "frame_spans", "header_spans", "parse_fields", "publisher_reply_fields",
     "subscriber_request_fields",
 ]

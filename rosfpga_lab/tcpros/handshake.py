@@ -33,7 +33,8 @@ from rosfpga_lab.tcpros.errors import (
     StateError,
 )
 from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame
-from rosfpga_lab.tcpros.header import HeaderDecoder, HeaderField, encode_header
+from rosfpga_lab.msg.span import Span
+from rosfpga_lab.tcpros.header import HeaderDecoder, encode_header
 
 #: md5sum (and type) wildcard: "any type" (used by rostopic echo and topic_tools).
 ANY = "*"
@@ -95,7 +96,7 @@ class HeaderReceived:
 
     fields: dict[str, str]
     raw: bytes
-    layout: tuple[HeaderField, ...]
+    layout: tuple[Span, ...]  # the header's fields as spans (parse_fields)
 
 
 @dataclass(frozen=True)

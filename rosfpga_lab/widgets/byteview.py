@@ -27,6 +27,7 @@ import anywidget
 import numpy as np
 import traitlets
 
+from rosfpga_lab.msg.span import Span
 from rosfpga_lab.widgets._common import (
     BYTE_PAGE_SIZE,
     BYTE_PAGE_SIZE_MAX,
@@ -41,27 +42,6 @@ from rosfpga_lab.widgets._common import (
 )
 
 STATIC = Path(__file__).resolve().parent / "static"
-
-
-@dataclass(frozen=True)
-class Span:
-    """One field's bytes: ``data[offset:offset + size]``.
-
-    Attributes:
-        offset: first byte of the field.
-        size: number of bytes (0 for an empty array; it is listed but owns no byte).
-        path: the field's name, e.g. ``header.stamp.secs`` or ``data``.
-        type: its type as text, e.g. ``uint32``, ``string``, ``uint8[]``.
-        value: the decoded value (any object; shown shortened).
-        role: what the bytes are for, e.g. ``length`` for a length prefix (chooses a fixed colour).
-    """
-
-    offset: int
-    size: int
-    path: str
-    type: str = ""
-    value: Any = None
-    role: str = ""
 
 
 def as_span(item: Any) -> Span:
