@@ -61,6 +61,7 @@ from rosfpga_lab.tcpros import (
     HeaderReceived,
     PublisherHandshake,
     Rejected,
+    State,
     TopicSpec,
 )
 
@@ -413,7 +414,7 @@ class Node:
         hs = PublisherHandshake(callerid=self.name, lookup=self._lookup_spec, peer=peer)
         deadline = time.monotonic() + HANDSHAKE_TIMEOUT
         src = peer
-        while hs.state == "AWAIT_HEADER":
+        while hs.state is State.AWAIT_HEADER:
             left = deadline - time.monotonic()
             if left <= 0:
                 events = hs.timeout()

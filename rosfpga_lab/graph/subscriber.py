@@ -52,6 +52,7 @@ from rosfpga_lab.tcpros import (
     HeaderReceived,
     ProtocolError,
     RemoteError,
+    State,
     SubscriberHandshake,
 )
 
@@ -166,7 +167,7 @@ class _PublisherLink:
         publisher, header = peer, {}
         got = False
         while not self.stop.is_set():
-            if hs.state == "AWAIT_HEADER":
+            if hs.state is State.AWAIT_HEADER:
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     hs.timeout()
