@@ -259,8 +259,9 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
     app = config.application
     report = checker.report
     png_path = None
-    if png is not None and (checker.last is not None or report.first_bad is not None):
-        png_path = write_figure(report.first_bad or checker.last, config.image.encoding, png,
+    shown = report.first_bad or checker.last
+    if png is not None and shown is not None:
+        png_path = write_figure(shown, config.image.encoding, png,
                                 scale=png_scale, title=f"{rig.op} {app.ksize}x{app.ksize}")
     return DemoResult(rig.camera.sent, report.received, report, checker.fps,
                       checker.latency.summary(), stats, elapsed, png_path, config, pcap_path, packets)

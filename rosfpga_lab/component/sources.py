@@ -166,8 +166,8 @@ def _grace_hopper() -> np.ndarray:
     try:
         from matplotlib import cbook
 
-        with cbook.get_sample_data("grace_hopper.jpg") as f:
-            data = np.frombuffer(f.read(), np.uint8)
+        sample = Path(cbook.get_sample_data("grace_hopper.jpg", asfileobj=False))
+        data = np.frombuffer(sample.read_bytes(), np.uint8)
     except (OSError, ValueError) as exc:
         raise SourceError(f"matplotlib's sample photo grace_hopper.jpg is missing ({exc}); "
                           "use --source synthetic") from None

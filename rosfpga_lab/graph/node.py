@@ -511,8 +511,8 @@ class Node:
                     info.append([link.conn, link.peer, "o", "TCPROS", pub.topic, True,
                                  f"TCPROS connection on port {self.tcpros_port} to [{link.peer}]"])
         for sub in list(self.subscribers.values()):
-            for uri, link in list(sub._links.items()):
-                info.append([0, uri, "i", "TCPROS", sub.topic, link.connected,
+            for uri, sub_link in list(sub._links.items()):
+                info.append([0, uri, "i", "TCPROS", sub.topic, sub_link.connected,
                              f"TCPROS connection to [{uri}]"])
         return 1, "bus info", info
 
@@ -524,8 +524,8 @@ class Node:
             pubs.append([pub.topic, st.bytes, [[l.conn, l.bytes, l.frames, l.connected] for l in st.links]])
         subs = []
         for sub in list(self.subscribers.values()):
-            st = sub.stats
-            subs.append([sub.topic, [[0, st.bytes, st.drops, st.connections > 0]]])
+            sub_st = sub.stats
+            subs.append([sub.topic, [[0, sub_st.bytes, sub_st.drops, sub_st.connections > 0]]])
         return 1, "", [pubs, subs, []]
 
     # ------------------------------------------------------------------ shutdown

@@ -62,7 +62,7 @@ class _SubscriberLink:
         self.writer.start()
         self.reader.start()
 
-    def enqueue(self, body: bytes | memoryview) -> None:
+    def enqueue(self, body: bytes | bytearray | memoryview) -> None:
         with self.cond:
             if self.closed:
                 return
@@ -160,7 +160,7 @@ class Publisher:
         self._links: list[_SubscriberLink] = []
         self._all_links: list[_SubscriberLink] = []
         self._lock = threading.Lock()
-        self._last: bytes | memoryview | None = None
+        self._last: bytes | bytearray | memoryview | None = None
         self._frames = 0
         self._bytes = 0
         self.closed = False

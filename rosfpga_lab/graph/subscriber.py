@@ -164,7 +164,7 @@ class _PublisherLink:
                           args=dict(hs.fields), raw=request, size=len(request), conn=conn, t0=t0,
                           **ends)
         deadline = time.monotonic() + HANDSHAKE_TIMEOUT
-        publisher, header = peer, {}
+        publisher, header = peer, dict[str, str]()
         got = False
         while not self.stop.is_set():
             if hs.state is State.AWAIT_HEADER:

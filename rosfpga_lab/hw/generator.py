@@ -58,7 +58,7 @@ def generate_reference(fields: ImageFields, inp: ByteFIFO, out: ByteFIFO) -> Non
         elif kind is Kind.U8:
             out.write(value & 0xFF)
         elif kind is Kind.STRING:
-            raw = _text(value)
+            raw = _text(str(value))
             for i in range(4):
                 out.write((len(raw) >> (8 * i)) & 0xFF)
             for byte in raw:
@@ -91,4 +91,4 @@ def generate_fast(fields: ImageFields, data: np.ndarray) -> bytes:
         encoding,
         struct.pack("<BII", fields.is_bigendian & 0xFF, fields.step, fields.data_length),
     ))
-    return b"".join((head, np.ascontiguousarray(data[: fields.data_length])))
+    return b"".join((head, np.ascontiguousarray(data[: fields.data_length]).data))

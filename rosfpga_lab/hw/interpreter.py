@@ -302,7 +302,7 @@ class Interpreter:
             data: the bytes to push.
             limit: stop after this many bytes (``None``: all of them).
         """
-        rows = []
+        rows: list[tuple[int, int, str, str]] = []
         for byte in data[:limit] if limit is not None else data:
             t = self.transition
             rows.append((self.offset, byte, self.state, t.label if t else "(skipping)"))

@@ -524,7 +524,7 @@ class PublisherHandshake(_Machine):
         """The handshake time-out expired: returns Rejected (send its reply, close)."""
         if self.state is not State.AWAIT_HEADER:
             return []
-        return self._reject("timeout", HandshakeTimeout(
+        return self._reject(Trigger.TIMEOUT, HandshakeTimeout(
             "no complete connection header received in time; closing"))
 
     def send(self, body: bytes | memoryview) -> bytes:

@@ -180,10 +180,10 @@ def spans_from_http(raw: bytes) -> list[Span]:
         elif tag.startswith(b"<fault>"):
             spans.append(Span(body_at + m.start(), m.end() - m.start(), "fault", "xml", None, "error"))
         else:
-            value = params[k] if k < len(params) else None
+            param = params[k] if k < len(params) else None
             names = api_param_names(method) if method else ()
             name = names[k] if k < len(names) else f"param[{k}]"
-            spans.append(Span(body_at + m.start(), m.end() - m.start(), name, "xml", value, "value"))
+            spans.append(Span(body_at + m.start(), m.end() - m.start(), name, "xml", param, "value"))
             k += 1
         pos = m.end()
     if pos < len(body):

@@ -316,8 +316,8 @@ class ByteViewer(StaticFallback, anywidget.AnyWidget):
     page_start = traitlets.Int(0).tag(sync=True)
     row_size = traitlets.Int(BYTE_ROW_SIZE).tag(sync=True)
     page_hex = traitlets.Unicode("").tag(sync=True)
-    fields = traitlets.List([]).tag(sync=True)
-    page_fields = traitlets.List([]).tag(sync=True)
+    fields: traitlets.List[Any] = traitlets.List([]).tag(sync=True)
+    page_fields: traitlets.List[Any] = traitlets.List([]).tag(sync=True)
     fields_truncated = traitlets.Int(0).tag(sync=True)
     #: Index of the selected field in the byte map's spans, -1 for none.
     selected = traitlets.Int(-1).tag(sync=True)
