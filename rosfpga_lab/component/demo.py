@@ -25,7 +25,7 @@ from rosfpga_lab.component.fpga import FpgaComponent
 from rosfpga_lab.component.sources import to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary
 from rosfpga_lab.component.webview import DemoPage
-from rosfpga_lab.config import NodeConfig, load_config, parse_config
+from rosfpga_lab.config import CUSTOM, PASSTHROUGH, NodeConfig, load_config, parse_config
 from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.graph.capture import write_capture
 
@@ -88,7 +88,7 @@ class DemoResult:
         cfg = self.config
         c = self.component
         kernel = (f" {cfg.application.ksize}x{cfg.application.ksize}"
-                  if cfg.application.op in ("dilate", "erode") else "")
+                  if cfg.application.op not in (PASSTHROUGH, CUSTOM) else "")
         out = [
             f"circuit: {cfg.application.op}{kernel} on "
             f"{cfg.image.width}x{cfg.image.height} {cfg.image.encoding}, "
