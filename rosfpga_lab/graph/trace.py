@@ -89,8 +89,9 @@ def excerpt_value(value: Any) -> Any:
         if isinstance(v, (str, bytes, bytearray)):
             if len(v) <= _TEXT_KEPT:
                 return v
-            note = f"... ({len(v)} {'chars' if isinstance(v, str) else 'bytes'})"
-            return v[:_TEXT_KEPT] + (note if isinstance(v, str) else note.encode())
+            if isinstance(v, str):
+                return v[:_TEXT_KEPT] + f"... ({len(v)} chars)"
+            return bytes(v[:_TEXT_KEPT]) + f"... ({len(v)} bytes)".encode()
         if not isinstance(v, (list, tuple, dict)):
             return v
         if depth >= _DEPTH_KEPT:

@@ -143,6 +143,7 @@ class FrameDecoder:
                 self._start_body(length)
             take = min(self._length - self._have, end - pos)
             h = self._have
+            assert self._body is not None  # a body buffer exists once a length prefix was read
             if len(self._body) - h >= take:
                 self._body[h:h + take] = view[pos:pos + take]
             else:  # replaces the room left and grows by the rest: memory = bytes received

@@ -296,7 +296,7 @@ class _Machine:
         #: ``HISTORY_REPEATS`` times in a row, so the list stays short on a long stream
         self.history: list[Transition] = []
         #: self-loop transitions taken but not kept in ``history``, by trigger
-        self.repeats: dict[str, int] = {}
+        self.repeats: dict[Trigger, int] = {}
 
     def _fire(self, trigger: Trigger) -> Transition:
         for t in TRANSITIONS:
