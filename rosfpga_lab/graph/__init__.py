@@ -28,10 +28,18 @@ Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``master`` (EmbeddedM
 ``node`` (Node, Slave API, TCPROS server), ``publisher``, ``subscriber``, ``trace`` (the recorded
 conversation; its docstring documents the format), ``names`` (names, ROS_* environment),
 ``owner`` (which Unix user listens on a port), ``rate`` (RateMeter, every events-per-second
-figure), ``errors`` (errors and limits).
+figure), ``errors`` (errors), ``limits`` (limits).
 """
 
 from rosfpga_lab.graph.errors import (
+    ApiArgumentError,
+    ConfigError,
+    GraphError,
+    MasterError,
+    XmlRpcError,
+    XmlRpcTooLargeError,
+)
+from rosfpga_lab.graph.limits import (
     CONNECT_TIMEOUT,
     MAX_HTTP_HEAD,
     MAX_XMLRPC_BODY,
@@ -39,12 +47,6 @@ from rosfpga_lab.graph.errors import (
     RECONNECT_FIRST,
     RECONNECT_MAX,
     XMLRPC_TIMEOUT,
-    ApiArgumentError,
-    ConfigError,
-    GraphError,
-    MasterError,
-    XmlRpcError,
-    XmlRpcTooLargeError,
 )
 from rosfpga_lab.graph.master import EmbeddedMaster, ParamTree
 from rosfpga_lab.graph.names import OpenBindWarning, default_host, master_uri_from_env, resolve

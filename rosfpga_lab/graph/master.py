@@ -28,14 +28,14 @@ from typing import Any
 
 from rosfpga_lab.config.limits import DEFAULT_MASTER_PORT
 from rosfpga_lab.graph.apicheck import api_methods, checked
-from rosfpga_lab.graph.errors import (
+from rosfpga_lab.graph.errors import XmlRpcError
+from rosfpga_lab.graph.limits import (
     JOIN_TIMEOUT,
     MAX_ERRORS_KEPT,
     MAX_NOTIFY_PENDING,
     MAX_XMLRPC_DEPTH,
     NOTIFY_TIMEOUT,
     NOTIFY_WORKERS,
-    XmlRpcError,
 )
 from rosfpga_lab.graph.names import bind_address, canonical, namespace_of, resolve
 from rosfpga_lab.graph.trace import Trace

@@ -31,14 +31,8 @@ from typing import Any
 from rosfpga_lab.config import limits as config_limits
 from rosfpga_lab.config.master import master_uri_from_env
 from rosfpga_lab.graph.apicheck import api_methods, checked
-from rosfpga_lab.graph.errors import (
-    JOIN_TIMEOUT,
-    MAX_PENDING_HANDSHAKES,
-    MAX_PUBLISHERS_PER_TOPIC,
-    GraphError,
-    MasterError,
-    XmlRpcError,
-)
+from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcError
+from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MAX_PENDING_HANDSHAKES, MAX_PUBLISHERS_PER_TOPIC
 from rosfpga_lab.graph.master import MASTER_ID, EmbeddedMaster
 from rosfpga_lab.graph.names import (
     ALL_INTERFACES,

@@ -17,7 +17,8 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from rosfpga_lab.graph.errors import JOIN_TIMEOUT, MAX_CLOSED_LINKS_KEPT, GraphError
+from rosfpga_lab.graph.errors import GraphError
+from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MAX_CLOSED_LINKS_KEPT
 from rosfpga_lab.graph.wire import hard_close, send_frame, set_nodelay, socket_ends
 from rosfpga_lab.tcpros import TopicSpec, publisher_reply_fields
 

@@ -14,8 +14,8 @@ import time
 from collections import deque
 from collections.abc import Callable
 
-#: Arrival times a meter keeps unless told otherwise.
-DEFAULT_SAMPLES = 1000
+from rosfpga_lab.graph.limits import RATE_SAMPLES
+
 
 
 class RateMeter:
@@ -33,7 +33,7 @@ class RateMeter:
         count: arrivals ever recorded.
     """
 
-    def __init__(self, *, samples: int = DEFAULT_SAMPLES, window_s: float | None = None,
+    def __init__(self, *, samples: int = RATE_SAMPLES, window_s: float | None = None,
                  stale_s: float | None = None, clock: Callable[[], float] = time.monotonic) -> None:
         if samples < 2:
             raise ValueError(f"a rate needs at least 2 samples, got {samples}")

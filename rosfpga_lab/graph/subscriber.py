@@ -29,15 +29,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from rosfpga_lab.graph.errors import (
+from rosfpga_lab.graph.errors import GraphError, MasterError
+from rosfpga_lab.graph.limits import (
     CONNECT_TIMEOUT,
     JOIN_TIMEOUT,
     MAX_ERRORS_KEPT,
     RECONNECT_FACTOR,
     RECONNECT_FIRST,
     RECONNECT_MAX,
-    GraphError,
-    MasterError,
 )
 from rosfpga_lab.graph.trace import new_connection_id
 from rosfpga_lab.graph.wire import RECV_CHUNK, hard_close, set_nodelay, socket_ends

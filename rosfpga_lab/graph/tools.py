@@ -14,14 +14,11 @@ import numpy as np
 
 from rosfpga_lab.config.master import master_uri
 from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcTooLargeError
+from rosfpga_lab.graph.limits import MAX_ARRAY_SHOWN, TOPIC_POLL
 from rosfpga_lab.graph.rate import RateMeter  # noqa: F401  (rostopic hz's meter, re-exported)
 from rosfpga_lab.graph.xmlrpc import call
 
-#: Arrays longer than this are summarised by :func:`format_message` (rostopic echo --noarr style).
-MAX_ARRAY_SHOWN = 64
 TOOL_ID = "/rosfpga_lab_topic"
-#: Seconds between two asks of the master while waiting for a topic to appear (rostopic: 0.1).
-TOPIC_POLL = 0.1
 
 
 def pick_master_uri(explicit: str | None = None) -> str:

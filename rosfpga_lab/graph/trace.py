@@ -56,7 +56,7 @@ from collections import deque
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
-from rosfpga_lab.graph.errors import TRACE_EXCERPT_BYTES, TRACE_MAX_BYTES, TRACE_MAX_EVENTS
+from rosfpga_lab.graph.limits import TRACE_EXCERPT_BYTES, TRACE_MAX_BYTES, TRACE_MAX_EVENTS
 
 KINDS = ("xmlrpc", "tcp_connect", "tcpros_header", "tcpros_frame", "tcp_close", "error")
 

@@ -7,7 +7,7 @@ import socket
 import time
 from collections.abc import Callable
 
-from rosfpga_lab.graph.errors import ACCEPT_BACKOFF_FIRST, ACCEPT_BACKOFF_MAX, ACCEPT_LOG_INTERVAL
+from rosfpga_lab.graph.limits import ACCEPT_BACKOFF_FIRST, ACCEPT_BACKOFF_MAX, ACCEPT_LOG_INTERVAL
 from rosfpga_lab.tcpros import frame_prefix
 
 log = logging.getLogger("rosfpga_lab.graph")

@@ -5,10 +5,6 @@ Nothing here touches a socket or a thread: feed bytes, get events (see ``handsha
 """
 
 from rosfpga_lab.tcpros.errors import (
-    HANDSHAKE_TIMEOUT,
-    MAX_FIELD_BYTES,
-    MAX_FRAME_BYTES,
-    MAX_HEADER_BYTES,
     FrameError,
     HandshakeRejected,
     HandshakeTimeout,
@@ -17,6 +13,12 @@ from rosfpga_lab.tcpros.errors import (
     ProtocolError,
     RemoteError,
     StateError,
+)
+from rosfpga_lab.tcpros.limits import (
+    HANDSHAKE_TIMEOUT,
+    MAX_FIELD_BYTES,
+    MAX_FRAME_BYTES,
+    MAX_HEADER_BYTES,
 )
 from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame, frame_prefix, frame_spans
 from rosfpga_lab.tcpros.handshake import (

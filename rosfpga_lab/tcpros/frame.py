@@ -23,13 +23,8 @@ import struct
 from typing import TYPE_CHECKING
 
 from rosfpga_lab.msg.span import ROLE_ERROR, ROLE_LENGTH, ROLE_TRAILING, ROLE_VALUE, Span
-from rosfpga_lab.tcpros.errors import (
-    FRAME_BUFFER_FIRST,
-    MAX_FRAME_BYTES,
-    FrameError,
-    IncompleteError,
-    StateError,
-)
+from rosfpga_lab.tcpros.errors import FrameError, IncompleteError, StateError
+from rosfpga_lab.tcpros.limits import FRAME_BUFFER_FIRST, MAX_FRAME_BYTES
 
 _U32 = struct.Struct("<I")
 #: Zeros a growing body buffer is extended with (its largest step). Never written, so its pages

@@ -22,16 +22,18 @@ from dataclasses import dataclass
 from enum import StrEnum
 
 from rosfpga_lab.tcpros.errors import (
-    HISTORY_REPEATS,
-    MAX_FIELD_BYTES,
-    MAX_FRAME_BYTES,
-    MAX_HEADER_BYTES,
     HandshakeRejected,
     HandshakeTimeout,
     IncompleteError,
     ProtocolError,
     RemoteError,
     StateError,
+)
+from rosfpga_lab.tcpros.limits import (
+    HISTORY_REPEATS,
+    MAX_FIELD_BYTES,
+    MAX_FRAME_BYTES,
+    MAX_HEADER_BYTES,
 )
 from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame
 from rosfpga_lab.msg.span import Span

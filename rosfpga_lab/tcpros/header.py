@@ -19,12 +19,8 @@ import struct
 from collections.abc import Iterable, Mapping
 
 from rosfpga_lab.msg.span import ROLE_ERROR, ROLE_LENGTH, ROLE_TRAILING, ROLE_VALUE, Span
-from rosfpga_lab.tcpros.errors import (
-    MAX_FIELD_BYTES,
-    MAX_HEADER_BYTES,
-    HeaderFormatError,
-    IncompleteError,
-)
+from rosfpga_lab.tcpros.errors import HeaderFormatError, IncompleteError
+from rosfpga_lab.tcpros.limits import MAX_FIELD_BYTES, MAX_HEADER_BYTES
 
 _U32 = struct.Struct("<I")
 
