@@ -44,6 +44,7 @@ from rosfpga_lab.graph.names import (
 from rosfpga_lab.graph.owner import listener_uids
 from rosfpga_lab.graph.publisher import Publisher
 from rosfpga_lab.graph.subscriber import Subscriber
+from rosfpga_lab.graph.topic import TopicContext
 from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close, socket_ends
 from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, split_uri
@@ -257,7 +258,8 @@ class Node:
                 raise GraphError(f"node {self.name} is shut down")
             if topic in self.publishers:
                 raise GraphError(f"{self.name} already publishes {topic}; use the existing publisher")
-            pub = Publisher(self, topic, type_name, md5, definition, queue_size=queue_size, latch=latch)
+            pub = Publisher(self._context(), topic, type_name, md5, definition,
+                            queue_size=queue_size, latch=latch)
             self.publishers[topic] = pub
         try:
             self._master("registerPublisher", topic, type_name, self.uri)
@@ -267,15 +269,22 @@ class Node:
             raise
         return pub
 
-    def _unadvertise(self, pub: Publisher) -> None:
+    def _context(self) -> TopicContext:
+        """What this node's publishers and subscribers may use of it."""
+        return TopicContext(self.name, self.trace, self.registry, self._leave)
+
+    def _leave(self, topic_object: Publisher | Subscriber) -> None:
+        """Forget a publisher or subscriber and tell the master (it closes itself)."""
+        table: dict[str, Any] = (self.publishers if isinstance(topic_object, Publisher)
+                                 else self.subscribers)
+        method = "unregisterPublisher" if isinstance(topic_object, Publisher) else "unregisterSubscriber"
         with self._lock:
-            if self.publishers.get(pub.topic) is pub:
-                del self.publishers[pub.topic]
+            if table.get(topic_object.topic) is topic_object:
+                del table[topic_object.topic]
         try:
-            self._master("unregisterPublisher", pub.topic, self.uri)
+            self._master(method, topic_object.topic, self.uri)
         except GraphError:
             pass
-        pub._close()
 
     def _lookup_spec(self, topic: str) -> TopicSpec | None:
         pub = self.publishers.get(topic)
@@ -314,7 +323,8 @@ class Node:
                 raise GraphError(f"node {self.name} is shut down")
             if topic in self.subscribers:
                 raise GraphError(f"{self.name} already subscribes to {topic}")
-            sub = Subscriber(self, topic, type_name, md5, callback, raw=raw, queue_size=queue_size,
+            sub = Subscriber(self._context(), topic, type_name, md5, callback, raw=raw,
+                             queue_size=queue_size,
                              tcp_nodelay=tcp_nodelay,
                              message_definition=definition if send_definition else None,
                              max_frame=max_frame, max_publishers=max_publishers)
@@ -324,9 +334,9 @@ class Node:
         except Exception:
             with self._lock:
                 self.subscribers.pop(topic, None)
-            sub._close()
+            sub.close()
             raise
-        sub._update_publishers([u for u in pubs if isinstance(u, str)])
+        sub.update_publishers([u for u in pubs if isinstance(u, str)])
         return sub
 
     def register_again(self) -> None:
@@ -348,17 +358,7 @@ class Node:
             self._master("registerPublisher", pub.topic, pub.type_name, self.uri)
         for sub in subs:
             uris = self._master("registerSubscriber", sub.topic, sub.type_name, self.uri)
-            sub._update_publishers([u for u in uris if isinstance(u, str)], keep_live=True)
-
-    def _unsubscribe(self, sub: Subscriber) -> None:
-        with self._lock:
-            if self.subscribers.get(sub.topic) is sub:
-                del self.subscribers[sub.topic]
-        try:
-            self._master("unregisterSubscriber", sub.topic, self.uri)
-        except GraphError:
-            pass
-        sub._close()
+            sub.update_publishers([u for u in uris if isinstance(u, str)], keep_live=True)
 
     # ------------------------------------------------------------------ TCPROS server
     def _accept_loop(self) -> None:
@@ -438,7 +438,7 @@ class Node:
                     if pub is None:
                         return False
                     # the link sends our header, then frames: nothing published from now on is lost
-                    return pub._add_link(conn, conn_id, src, ev.tcp_nodelay, ev.reply)
+                    return pub.attach(conn, conn_id, src, hs, ev.tcp_nodelay, ev.reply)
                 elif isinstance(ev, Closed):
                     return False
         return False
@@ -484,7 +484,7 @@ class Node:
         sub = self.subscribers.get(topic)
         if sub is None:
             return 1, f"not subscribed to {topic}", 0
-        sub._update_publishers(publishers)
+        sub.update_publishers(publishers)
         return 1, "", 0
 
     @checked((("topic", "topic"), ("protocols", "list")), [])
@@ -505,8 +505,8 @@ class Node:
                     info.append([link.conn, link.peer, "o", "TCPROS", pub.topic, True,
                                  f"TCPROS connection on port {self.tcpros_port} to [{link.peer}]"])
         for sub in list(self.subscribers.values()):
-            for uri, sub_link in list(sub._links.items()):
-                info.append([0, uri, "i", "TCPROS", sub.topic, sub_link.connected,
+            for uri, connected in sub.publisher_links():
+                info.append([0, uri, "i", "TCPROS", sub.topic, connected,
                              f"TCPROS connection to [{uri}]"])
         return 1, "bus info", info
 
@@ -544,10 +544,10 @@ class Node:
             subs = list(self.subscribers.values())
             self.publishers.clear()
             self.subscribers.clear()
-        for sub in subs:
-            self._unsubscribe(sub)
-        for pub in pubs:
-            self._unadvertise(pub)
+        topic_objects: list[Publisher | Subscriber] = [*subs, *pubs]
+        for topic_object in topic_objects:
+            self._leave(topic_object)
+            topic_object.close()
         hard_close(self._tcp)
         with self._lock:
             pending = list(self._pending)

@@ -35,7 +35,7 @@ from rosfpga_lab.tcpros.limits import (
     MAX_FRAME_BYTES,
     MAX_HEADER_BYTES,
 )
-from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame
+from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame, frame_prefix
 from rosfpga_lab.msg.span import Span
 from rosfpga_lab.tcpros.header import HeaderDecoder, encode_header
 
@@ -530,10 +530,26 @@ class PublisherHandshake(_Machine):
             "no complete connection header received in time; closing"))
 
     def send(self, body: bytes | memoryview) -> bytes:
-        """Frame ``body`` for sending (only once streaming)."""
+        """Frame ``body`` for sending (only once streaming).
+
+        Raises:
+            StateError: not streaming (before the handshake, or after eof/close).
+        """
         self._fire(Trigger.SEND)
         self.frames_sent += 1
         return encode_frame(body)
+
+    def send_parts(self, body: bytes | bytearray | memoryview) -> tuple[bytes, memoryview]:
+        """:meth:`send` without joining: ``(length prefix, body)`` for a vectored write, so a
+        big image is not copied. This is what a node's publisher streams through.
+
+        Raises:
+            StateError: not streaming (before the handshake, or after eof/close).
+        """
+        view = memoryview(body).cast("B")
+        self._fire(Trigger.SEND)
+        self.frames_sent += 1
+        return frame_prefix(len(view)), view
 
 
 __all__ = [
