@@ -187,10 +187,10 @@ def _explain_shift(k: int, i: int, fields: Sequence[ByteField], got: bytes = b""
         pad = ""
         if (before is not None and before.end == i and before.size < 4 and k == 4 - before.size
                 and not any(got[i:i + k])):
-            pad = (f": {k} zero byte(s) follow {before.name}, which is what struct's native mode "
+            pad = (f": {k} zero byte(s) follow {before.label}, which is what struct's native mode "
                    "adds (a format without '<', such as 'BI' or '@BI', pads the uint32 after it "
                    "to a multiple of 4; ROS messages have no padding, so start every format "
-                   f"with '<'), or {before.name} was packed as a 4-byte integer")
+                   f"with '<'), or {before.label} was packed as a 4-byte integer")
         return (f"from byte {i} on your bytes are the expected ones {k} byte(s) later: something "
                 f"before byte {i} is {k} byte(s) too long{what}{pad}")
     here = field_at(fields, i)

@@ -81,7 +81,7 @@ def caption(name: str, reference_name: str = "reference") -> str:
 
 def _mismatch_mask(a: np.ndarray, b: np.ndarray, tolerance: int) -> np.ndarray:
     diff = np.abs(a.astype(np.int16) - b.astype(np.int16))
-    return (diff > tolerance) if diff.ndim == 2 else (diff > tolerance).any(axis=2)
+    return np.asarray((diff > tolerance) if diff.ndim == 2 else (diff > tolerance).any(axis=2))
 
 
 class FrameDiff:

@@ -146,9 +146,10 @@ class LiveView(StaticFallback, w.VBox):
         img = as_image(frame, "frame")
         inp = None if input is None else as_image(input, "input")
         if channel_order is not None and channel_order != self.channel_order:
-            img, inp = (None if a is None else
-                        a[:, :, [2, 1, 0] + ([3] if a.shape[2] == 4 else [])] if a.ndim == 3 and a.shape[2] >= 3 else a
-                        for a in (img, inp))
+            def swap(a: np.ndarray) -> np.ndarray:
+                return a[:, :, [2, 1, 0] + ([3] if a.shape[2] == 4 else [])] if a.ndim == 3 and a.shape[2] >= 3 else a
+            img = swap(img)
+            inp = None if inp is None else swap(inp)
         if latency is None and stamp is not None:
             latency = time.time() - stamp
         with self._lock:
