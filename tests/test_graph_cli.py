@@ -333,6 +333,10 @@ def test_one_rate_meter_windowed_stale_overall_and_bounded() -> None:
     assert m.rate(now=2.5) == pytest.approx(2.0)       # 1.5, 2.0, 2.5 in the last second
     assert m.rate(now=3.1) == 0.0                      # stale: nothing for 0.6 s
     assert m.overall_rate() == pytest.approx(13 / 2.5)  # all arrivals, though only 5 are kept
-    assert m.report() is not None and "window: 5" in m.report()
+    report = m.report()
+    assert report is not None and "window: 5" in report
+    assert m.report() is None                          # nothing new since: "no new messages"
+    m.tick(2.6)
+    assert m.report() is not None
     f = fps_meter()
     assert (f.window_s, f.stale_s) == (2.0, 1.0)

@@ -282,9 +282,9 @@ class Subscriber:
                 keep = set(kept)
                 wanted = [u for u in wanted if u in keep]
             for uri in [u for u in self._links if u not in wanted]:
-                link = self._links[uri]
-                if link.kept or keep_live and link.connected:
-                    link.kept = True
+                stale = self._links[uri]
+                if stale.kept or keep_live and stale.connected:
+                    stale.kept = True
                     continue
                 self._links.pop(uri).close()
             for uri in wanted:
@@ -292,9 +292,9 @@ class Subscriber:
                 if link is not None:
                     link.kept = False   # the master lists it again: an ordinary link
                 if link is None or not link.thread.is_alive() and link.permanent_error is None:
-                    link = _PublisherLink(self, uri)
-                    self._links[uri] = link
-                    link.thread.start()
+                    fresh = _PublisherLink(self, uri)
+                    self._links[uri] = fresh
+                    fresh.thread.start()
 
     def _forget(self, link: _PublisherLink) -> bool:
         """Drop a kept link whose connection ended; False when the master listed it meanwhile."""
