@@ -157,9 +157,10 @@ def check_ksize_rerun(params: Any, base: Any, frame: bytes) -> CheckResult:
         details.append("the RTL was not re-run here (no Verilog simulator); with Icarus Verilog "
                        "or Verilator installed this check also compares the output")
         return CheckResult(ex, details)
+    given: Any = params  # checked above to be an RtlParams instance
     try:
-        model = Pipeline(width=params.WIDTH, height=params.HEIGHT, encoding=params.ENCODING,
-                         op=params.op_name, ksize=(5, 5)).process(frame)
+        model = Pipeline(width=given.WIDTH, height=given.HEIGHT, encoding=given.ENCODING,
+                         op=given.op_name, ksize=(5, 5)).process(frame)
     except PipelineError as exc:
         raise fail(ex, f"the frame does not fit the circuit: {exc}") from None
     if bytes(output) != model.output_frame:
