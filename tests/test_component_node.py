@@ -297,7 +297,7 @@ def test_input_publisher_dies_and_returns(rig, master) -> None:
     comp, pub, out = rig
     send(pub, picture(0), 0)
     assert out.wait(1)
-    pub.node.shutdown()                       # the publisher goes away (unregisters)
+    pub.unregister()                          # the publisher goes away (unregisters)
     time.sleep(0.3)
     assert comp.stats.publishers == 0 and comp.running
     again = Node("/source", master=master)    # and comes back under the same name

@@ -105,8 +105,12 @@ BAD = [
     ("topic starting with a digit", _replace("  topic: /in", "  topic: 9in"), "subscriber.topic", 8,
      "starts with a letter"),
     ("topic with //", _replace("  topic: /out", "  topic: /a//b"), "publisher.topic", 11, "'//'"),
-    ("topic part starting with a digit", _replace("  topic: /out", "  topic: /a/9b"), "publisher.topic",
-     11, "must start with a letter"),
+    ("node base name starting with a digit", _replace("/fpga_test", "/ns/9fpga"), "node.name", 2,
+     "must start with a letter"),
+    ("topic with a trailing slash", _replace("  topic: /out", "  topic: /out/"), "publisher.topic",
+     11, "canonical form"),
+    ("non-ASCII topic", _replace("  topic: /out", "  topic: /kamera_ü"), "publisher.topic", 11,
+     "'ü'"),
     ("topic with a dash", _replace("  topic: /out", "  topic: /my-topic"), "publisher.topic", 11, "'-'"),
     ("same topic in and out", _replace("  topic: /out", "  topic: /in"), "publisher.topic", 11,
      "subscribes to"),
@@ -183,7 +187,7 @@ def test_custom_source_is_relative_to_the_config(tmp_path: Path) -> None:
 @pytest.mark.parametrize("name,ok", [
     ("/image_raw", True), ("image", True), ("~private", True), ("/a/b_c/d2", True), ("/", True),
     ("", False), ("/a b", False), ("2abc", False), ("/a//b", False), ("/a/", False), ("/a~b", False),
-    ("/a/_b", False), ("/ä", False),
+    ("/a/_b", True), ("/1a", True), ("/ä", False), ("/kamera_ü", False),
 ])
 def test_ros_names(name: str, ok: bool) -> None:
     assert (ros_name_problem(name) is None) is ok
@@ -198,3 +202,100 @@ def test_cli_refuses_bad_config_before_writing(tmp_path: Path) -> None:
     assert proc.returncode == 1
     assert f"{bad}:16: image.encoding" in proc.stderr
     assert not out.exists()
+
+
+def test_one_vocabulary_for_operations_and_encodings() -> None:
+    """Every layer takes its operations and encodings from config.vocabulary: the identity op is
+    "passthrough" from the YAML file to the models' name, and "copy" is only an accepted alias."""
+    import argparse
+
+    from rosfpga_lab.cli import camera as cli_camera
+    from rosfpga_lab.component.checker import expected_output
+    from rosfpga_lab.config import ENCODINGS, MODEL_OPS, OPS, canonical_op
+    from rosfpga_lab.hw import OPS as HW_OPS
+    from rosfpga_lab.hw import Pipeline
+
+    assert OPS == ("dilate", "erode", "passthrough", "custom") and HW_OPS == MODEL_OPS == OPS[:3]
+    assert canonical_op("copy") == "passthrough" and canonical_op("erode") == "erode"
+    config = load_config(DATA / "fpga_passthrough_rgb8.yaml")
+    pipe = Pipeline.from_config(config)
+    assert (pipe.op, pipe.ksize) == ("passthrough", (1, 1))
+    assert Pipeline(op="copy").op == "passthrough"
+    import numpy as np
+
+    image = np.arange(12, dtype=np.uint8).reshape(2, 2, 3)
+    assert expected_output(image, config.application.op, (3, 3)) is image
+    parser = argparse.ArgumentParser()
+    cli_camera.register(parser.add_subparsers())
+    enc_action = next(a for a in parser._subparsers._group_actions[0].choices["camera"]._actions
+                      if a.dest == "encoding")
+    assert tuple(enc_action.choices) == tuple(ENCODINGS)
+
+
+def test_one_master_uri_rule() -> None:
+    """explicit > ROS_MASTER_URI > the configuration's node.master_uri > roscore's default."""
+    from rosfpga_lab.config import master_uri
+    from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
+
+    cfg = parse_config(GOOD.replace("master_uri: http://127.0.0.1:11311/", "master_uri: http://10.0.0.2:1/"))
+    env = {"ROS_MASTER_URI": "http://10.0.0.3:2/"}
+    assert DEFAULT_MASTER_URI == "http://127.0.0.1:11311/"
+    assert master_uri("http://10.0.0.1:9/", cfg, env) == "http://10.0.0.1:9/"
+    assert master_uri(None, cfg, env) == "http://10.0.0.3:2/"
+    assert master_uri(None, cfg, {"ROS_MASTER_URI": "  "}) == "http://10.0.0.2:1/"
+    assert master_uri("", cfg, {}) == "http://10.0.0.2:1/"
+    assert master_uri(None, None, {}) == DEFAULT_MASTER_URI
+    assert master_uri(None, None, env) == "http://10.0.0.3:2/"
+
+
+# Names and what rosgraph.names says of them (is_legal_name, is_legal_base_name); the table is
+# checked against real rosgraph below. Non-ASCII names are the one deliberate difference.
+NAME_TABLE = [
+    "", "/", "~", "a", "/a", "~a", "/a/b", "a/b", "/a/", "a_b", "/a_b2/c3", "/1a", "1a", "/a/1b",
+    "/a/_b", "_a", "__a", "/a//b", "//a", "/a b", "/a-b", "/a.b", "/a~b", "~/a", "~a/b", "/a\n",
+    "a\n", "/kamera_ü", "kamera_ü", "/ä", "é", "/a:b", "Ab9_", "9", "/a/b/", "~~a",
+]
+
+
+def test_lab_names_follow_rosgraph_table() -> None:
+    """The lab's one validator: rosgraph's rules, ASCII letters only; used by config and graph."""
+    from rosfpga_lab.config.names import is_legal_base_name, is_legal_name, name_problem
+    from rosfpga_lab.graph.errors import ConfigError as GraphConfigError
+    from rosfpga_lab.graph.names import check_node_name, check_topic_name
+
+    for name in NAME_TABLE:
+        assert (name_problem(name) is None) == (bool(name) and is_legal_name(name)), name
+        if name and is_legal_name(name):
+            assert check_topic_name(name) is not None
+        elif name:
+            with pytest.raises(GraphConfigError):
+                check_topic_name(name)
+    assert not is_legal_name("/kamera_ü") and is_legal_name("/1a") and not is_legal_base_name("1a")
+    assert name_problem("/1a", node_name=True) == "a node's base name must start with a letter, got '1a'"
+    with pytest.raises(GraphConfigError, match="kamera"):
+        check_node_name("/kamera_ü")
+    assert check_node_name("/ns/cam_2/") == "/ns/cam_2"
+    # the configuration adds one rule of its own: canonical form
+    assert ros_name_problem("/a/") is not None and name_problem("/a/") is None
+
+
+def test_lab_names_match_real_rosgraph() -> None:
+    """Run the table through real rosgraph.names under ROS's own Python."""
+    import json
+
+    from realros import ROS_PYTHON, require_ros
+
+    from rosfpga_lab.config.names import is_legal_base_name, is_legal_name
+
+    require_ros()
+    program = ("import json, sys, rosgraph.names as n; names = json.load(sys.stdin); "
+               "print(json.dumps([[n.is_legal_name(x), n.is_legal_base_name(x)] for x in names]))")
+    done = subprocess.run([ROS_PYTHON, "-c", program], input=json.dumps(NAME_TABLE),
+                          capture_output=True, text=True, timeout=60, check=True)
+    theirs = json.loads(done.stdout)
+    for name, (legal, base) in zip(NAME_TABLE, theirs, strict=True):
+        if name.isascii():
+            assert (is_legal_name(name), is_legal_base_name(name)) == (legal, base), name
+        else:  # rosgraph's \w is Unicode in Python 3; roscpp and the lab allow ASCII only
+            assert not is_legal_name(name) and not is_legal_base_name(name), name
+    assert dict(zip(NAME_TABLE, theirs))["/kamera_ü"] == [True, False]  # the difference, documented

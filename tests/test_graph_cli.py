@@ -316,3 +316,27 @@ def test_a_reply_over_the_cap_is_named_not_called_unreachable() -> None:
     assert "cannot reach" not in out.stderr
     assert "answered getUri, but the reply is too large" in out.stderr
     assert f"HTTP body of {huge} bytes, over the limit of {MAX_XMLRPC_REPLY}" in out.stderr
+
+
+def test_one_rate_meter_windowed_stale_overall_and_bounded() -> None:
+    """graph.rate.RateMeter is the meter of rostopic hz, the live view and the component's fps."""
+    from rosfpga_lab.component.stats import fps_meter
+    from rosfpga_lab.widgets import RateMeter as WidgetRateMeter
+
+    assert WidgetRateMeter is RateMeter
+    m = RateMeter(samples=5, window_s=1.0, stale_s=0.5, clock=lambda: 0.0)
+    for k in range(11):              # 10 Hz from 0 to 1 s, then 2 Hz from 1.5 s to 2.5 s
+        m.tick(k / 10)
+    for t in (1.5, 2.0, 2.5):
+        m.tick(t)
+    assert len(m.times) == 5 and m.count == 14
+    assert m.rate(now=2.5) == pytest.approx(2.0)       # 1.5, 2.0, 2.5 in the last second
+    assert m.rate(now=3.1) == 0.0                      # stale: nothing for 0.6 s
+    assert m.overall_rate() == pytest.approx(13 / 2.5)  # all arrivals, though only 5 are kept
+    report = m.report()
+    assert report is not None and "window: 5" in report
+    assert m.report() is None                          # nothing new since: "no new messages"
+    m.tick(2.6)
+    assert m.report() is not None
+    f = fps_meter()
+    assert (f.window_s, f.stale_s) == (2.0, 1.0)

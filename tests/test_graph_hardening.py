@@ -18,7 +18,7 @@ import xmlrpc.client
 import pytest
 
 from rosfpga_lab.graph import EmbeddedMaster, Node, Trace, XmlRpcError, XmlRpcServer, call
-from rosfpga_lab.graph.errors import MAX_HTTP_HEAD, MAX_PUBLISHERS_PER_TOPIC, MAX_XMLRPC_DEPTH
+from rosfpga_lab.graph.limits import MAX_HTTP_HEAD, MAX_PUBLISHERS_PER_TOPIC, MAX_XMLRPC_DEPTH
 
 pytestmark = pytest.mark.timeout(90)
 

@@ -523,3 +523,29 @@ def test_all_interfaces_advertises_hostname(master) -> None:
         assert reply[2] == ["TCPROS", socket.gethostname(), a.tcpros_port]
     finally:
         a.shutdown()
+
+
+def test_running_publisher_streams_through_the_handshake_table(nodes) -> None:
+    """A node's publisher sends every frame through its PublisherHandshake (STREAMING --send-->)
+    and ends the link through the table too: eof when the subscriber hangs up, close when the
+    publisher closes. So the rows notebook 2 draws are the ones a running node follows."""
+    a, b, c = nodes("/streamer"), nodes("/hangs_up"), nodes("/stays")
+    pub = a.advertise("/words", "std_msgs/String")
+    gone = b.subscribe("/words", "std_msgs/String")
+    stays = c.subscribe("/words", "std_msgs/String")
+    assert pub.wait_for_subscribers(2, 5)
+    for k in range(5):
+        pub.publish({"data": f"w{k}"})
+    assert wait_until(lambda: gone.stats.frames == 5 and stays.stats.frames == 5)
+    links = {link.stats.conn: link for link in pub._all_links}
+    assert all(link.handshake.frames_sent == 5 for link in links.values())
+    gone.unregister()                                   # the subscriber hangs up: eof
+    assert wait_until(lambda: pub.get_num_connections() == 1)
+    pub.close()                                         # we hang up: close
+    triggers = sorted([t.trigger for t in link.handshake.history][-1] for link in links.values())
+    assert triggers == ["close", "eof"]
+    for link in links.values():
+        history = [(t.source, t.trigger, t.target) for t in link.handshake.history]
+        assert history[0] == ("AWAIT_HEADER", "header_ok", "STREAMING")
+        assert ("STREAMING", "send", "STREAMING") in history and history[-1][2] == "CLOSED"
+        assert link.handshake.repeats.get("send", 0) == 5 - 3  # kept 3 in a row, counted the rest

@@ -211,3 +211,19 @@ def test_finish_reports_a_cut_frame_and_resets():
     interp.feed(GOOD)
     interp.finish()
     assert interp.frames == 1
+
+
+def test_one_vocabulary_for_states_kinds_and_checks() -> None:
+    """The tables use enum names, not free strings: every check has its method, the generator's
+    kinds are the interpreter's, and the names still print as the notebooks show them."""
+    from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, Check, IState, Kind, format_table
+    from rosfpga_lab.hw.interpreter import _CHECKS
+
+    assert set(_CHECKS) == set(Check) == {t.check for t in INTERPRETER_TABLE if t.check}
+    assert {t.state for t in INTERPRETER_TABLE} | {IState.SKIP} == set(IState)
+    by_label = {t.label: t.kind for t in INTERPRETER_TABLE}
+    for label, kind, _attr in GENERATOR_TABLE:
+        assert isinstance(kind, Kind) and by_label[label] is kind
+    assert Kind.STRING == "string" and repr(Kind.STRING) == "string"
+    assert "FRAME_ID_LEN  header.frame_id length  4                  FRAME_ID      frame_id_length" \
+        in format_table()

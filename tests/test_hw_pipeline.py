@@ -25,7 +25,7 @@ def random_image(rows: int, cols: int, encoding: str) -> np.ndarray:
 
 
 def expected_frame(image, encoding, op="dilate", ksize=(3, 3), seq=1, **header) -> bytes:
-    out = image if op == "copy" else morph_oracle(image, op, *ksize)
+    out = image if op == "passthrough" else morph_oracle(image, op, *ksize)
     return tcpros_frame(image_msg(out, encoding, seq=seq, **header))
 
 
@@ -52,7 +52,7 @@ def test_whole_frame_comes_out_as_the_dilated_image_message(model, encoding):
     assert decode_frame(pipe.process(frame).output_frame)["header"]["seq"] == 2
 
 
-@given(images(max_side=6), st.sampled_from(["dilate", "erode", "copy"]), st.integers(1, 4),
+@given(images(max_side=6), st.sampled_from(["dilate", "erode", "passthrough"]), st.integers(1, 4),
        st.integers(1, 4), st.text(max_size=6))
 @settings(max_examples=40, deadline=None)
 def test_reference_pipeline_equals_fast_pipeline(img_enc, op, kw, kh, frame_id):
@@ -196,7 +196,7 @@ def test_swapped_byte_order_reverses_the_channels():
     assert np.array_equal(res.output_image, FAULT_IMAGE[:, :, ::-1]) and res.ok
     rgb = random_image(3, 3, "rgb8")
     res = both_models([SwapByteOrder(tap="axis_out")], frame=tcpros_frame(image_msg(rgb, "rgb8")),
-                      op="copy")
+                      op="passthrough")
     assert decode_frame(res.output_frame)["data"].tobytes() == rgb[:, :, ::-1].tobytes()
 
 

@@ -72,3 +72,13 @@ def test_loading_a_configuration_imports_neither_opencv_nor_jinja2() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert "cv2" not in out.stdout and "jinja2" not in out.stdout, out.stdout
+
+
+def test_limits_live_in_limits_modules() -> None:
+    """One convention: a layer's limits are in its ``limits.py``; ``errors.py`` holds errors (the
+    graph and tcpros errors modules only re-export their old limit names)."""
+    import re
+
+    for path in sorted(PACKAGE.rglob("errors.py")):
+        own = re.findall(r"^([A-Z][A-Z0-9_]*)\s*(?::[^=]*)?=", path.read_text(), flags=re.M)
+        assert own == [], f"{path.relative_to(PACKAGE)} defines limits {own}: move them to limits.py"

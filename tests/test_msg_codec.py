@@ -84,7 +84,8 @@ def test_partial_layout_marks_the_rest() -> None:
     assert [(s.role, s.offset, s.size) for s in spans] == [("length", 0, 4), ("error", 4, 2)]
     assert "declares 5 byte(s)" in spans[-1].value
     spans = field_layout(REG, "std_msgs/String", body + b"xy", partial=True)
-    assert spans[-1][1:] == (9, 2, "uint8[]", b"xy", "trailing")
+    s = spans[-1]
+    assert (s.offset, s.size, s.type, s.value, s.role) == (9, 2, "uint8[]", b"xy", "trailing")
 
 
 def test_layout_paths_of_message_arrays() -> None:

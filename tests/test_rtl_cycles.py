@@ -51,7 +51,7 @@ def test_model_and_rtl_agree_on_cycles(encoding: str, tmp_path: Path) -> None:
     assert free.spans["fifo2axi"] == report.cycles["fifo2axi"] + 1 == pixels * bpp + 1
     # The byte-wide stages take exactly their byte counts (+1: an output register).
     assert free.spans["subscriber"] == report.cycles["interpreter"] == len(frame)
-    if pipe.op == "copy":  # pixels reach the publisher while it still writes its header
+    if pipe.op == "passthrough":  # pixels reach the publisher while it still writes its header
         assert free.spans["axi2fifo"] > report.cycles["axi2fifo"] + 1
     else:
         assert free.spans["axi2fifo"] == report.cycles["axi2fifo"] + 1

@@ -77,9 +77,11 @@ def test_decode_with_trailing_in_one_chunk() -> None:
 
 def test_layout_offsets() -> None:
     layout = parse_fields(ROSPY_SUB_HEADER[4:])
-    assert [f.key for f in layout] == sorted(ROSPY_SUB_FIELDS)
-    assert layout[0].offset == 4 and layout[0].length == len(b"callerid=/listener")
-    assert layout[1].offset == 4 + 4 + len(b"callerid=/listener")
+    assert [s.path for s in layout[1::2]] == sorted(ROSPY_SUB_FIELDS)
+    assert [s.path for s in layout[::2]] == [f"{k}.length" for k in sorted(ROSPY_SUB_FIELDS)]
+    assert (layout[0].offset, layout[0].size, layout[0].value) == (4, 4, len(b"callerid=/listener"))
+    assert (layout[1].offset, layout[1].size) == (8, len(b"callerid=/listener"))
+    assert layout[2].offset == 4 + 4 + len(b"callerid=/listener")
 
 
 def test_value_may_contain_equals_and_repeated_key_keeps_last() -> None:
@@ -416,3 +418,51 @@ def test_filled_refuses_a_wrong_count(before: bytes, n: int, text: str) -> None:
     with pytest.raises(StateError, match=text):
         dec.filled(n)
     assert dec.offset == len(before)  # nothing was counted
+
+
+def test_header_spans_strict_and_lenient_one_parser() -> None:
+    """header_spans is parse_fields with the total length and trailing bytes; lenient mode turns
+    the strict error into one error span carrying the same message, and covers every byte."""
+    from rosfpga_lab.msg import Span
+    from rosfpga_lab.tcpros import header_spans
+
+    raw = encode_header({"callerid": "/a", "topic": "/t"})
+    spans = header_spans(raw + b"xyz")
+    assert all(isinstance(s, Span) for s in spans)
+    assert [(s.path, s.offset, s.size, s.value) for s in spans] == [
+        ("header length", 0, 4, 27), ("callerid.length", 4, 4, 11), ("callerid", 8, 11, "/a"),
+        ("topic.length", 19, 4, 8), ("topic", 23, 8, "/t"), ("(after the header)", 31, 3, None)]
+    assert header_spans(raw, lenient=False) == spans[:-1]
+    dec = HeaderDecoder()
+    dec.feed(raw)
+    assert dec.layout == spans[1:-1]
+    for bad, words in [(raw_header(b"callerid"), "no '='"), (raw_header(b"a=\xff"), "not UTF-8"),
+                       (u32(6) + u32(0) + b"ab", "zero-length")]:
+        with pytest.raises(HeaderFormatError) as info:
+            header_spans(bad, lenient=False)
+        lenient = header_spans(bad)
+        assert lenient[-1].role == "error" and lenient[-1].value == str(info.value)
+        assert words in lenient[-1].value
+        assert sum(s.size for s in lenient) == len(bad)
+    with pytest.raises(IncompleteError):
+        header_spans(raw[:10], lenient=False)
+    cut = header_spans(raw[:10])
+    assert sum(s.size for s in cut) == 10 and cut[-1].role == "error"
+    assert header_spans(b"\x01")[0].role == "error" and header_spans(b"") == []
+
+
+def test_frame_spans_are_the_checks_and_the_viewers() -> None:
+    from rosfpga_lab.checks.message import frame_fields
+    from rosfpga_lab.msg import default_registry, serialize
+    from rosfpga_lab.tcpros import frame_spans
+    from rosfpga_lab.widgets import spans_from_frame
+
+    reg = default_registry()
+    frame = encode_frame(serialize(reg, "std_msgs/String", {"data": "hi"}))
+    spans = frame_spans(frame + b"\x01", "std_msgs/String")
+    assert [(s.label, s.offset, s.size) for s in spans] == [
+        ("frame length", 0, 4), ("data length", 4, 4), ("data", 8, 2), ("(next frame)", 10, 1)]
+    assert spans_from_frame(frame, "std_msgs/String") == frame_fields("std_msgs/String", frame) \
+        == spans[:-1]
+    assert [s.path for s in frame_spans(frame[:7], "std_msgs/String")] == ["frame length", "message body"]
+    assert frame_spans(b"\x01\x00")[0].role == "error"

@@ -283,3 +283,29 @@ def test_history_stays_short_over_a_long_stream() -> None:
     assert len(s.history) <= 8 and len(p.history) <= 8
     assert s.repeats["frame"] == 1_000_000 - 3 and p.repeats["send"] == 1000 - 3
     assert [t.trigger for t in s.history] == ["connect", "header_ok", "frame", "frame", "frame"]
+
+
+def test_one_builder_per_header_field_set() -> None:
+    """The request and reply field sets are built once (tcpros) and used by graph and hls."""
+    from pathlib import Path
+
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.hls import publisher_header_fields, subscriber_header_fields
+    from rosfpga_lab.msg import default_registry
+    from rosfpga_lab.tcpros import publisher_reply_fields, subscriber_request_fields
+
+    reg = default_registry()
+    config = load_config(Path(__file__).resolve().parent.parent / "data" / "fpga_dilate_rgba8.yaml")
+    t = "sensor_msgs/Image"
+    assert list(subscriber_header_fields(config)) == [
+        "callerid", "md5sum", "message_definition", "tcp_nodelay", "topic", "type"]
+    assert subscriber_header_fields(config)["md5sum"] == "060021388200f6f0f447d0fcd9c64743"
+    assert publisher_header_fields(config) == {
+        "callerid": config.node.global_name, "latching": "0", "md5sum": reg.md5(t),
+        "message_definition": reg.full_text(t), "topic": config.publisher.topic, "type": t}
+    sub = SubscriberHandshake(callerid="/s", topic="/x", md5sum="*", type_name="*", tcp_nodelay=True)
+    assert sub.fields == subscriber_request_fields(callerid="/s", topic="/x", md5sum="*",
+                                                   type_name="*", tcp_nodelay=True)
+    assert "message_definition" not in sub.fields and sub.fields["tcp_nodelay"] == "1"
+    pub = PublisherHandshake(callerid="/t", lookup=lambda _t: SPEC)
+    assert pub.reply_fields(SPEC) == publisher_reply_fields("/t", SPEC)

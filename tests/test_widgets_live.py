@@ -40,7 +40,7 @@ def test_throttle_lets_through_at_most_the_rate() -> None:
 
 def test_rate_meter_over_a_window() -> None:
     clock = FakeClock()
-    m = RateMeter(window=1.0, clock=clock)
+    m = RateMeter(window_s=1.0, clock=clock)
     assert m.rate() == 0.0
     for k in range(31):  # 30 intervals of 1/30 s
         clock.now = k / 30

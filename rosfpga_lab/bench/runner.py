@@ -17,6 +17,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from rosfpga_lab.bench.path import (
     PROGRAMS, PathFigures, bench_images, component_command, find_relay, measure,
 )
@@ -37,7 +39,7 @@ class BenchReport:
     config: NodeConfig
     pipeline: PipelineFigures | None
     paths: list[PathFigures] = field(default_factory=list)
-    windows: tuple[int, int] = (1, 2)
+    windows: tuple[int, ...] = (1, 2)
 
     def table(self) -> str:
         """The printed report (Markdown tables)."""
@@ -157,8 +159,7 @@ def run_bench(config: NodeConfig | str | Path | None = None, *, middles: tuple[s
     cfg = config.image
     images = bench_images(cfg.width, cfg.height, cfg.encoding)
     app = config.application
-    op = "copy" if app.op == "passthrough" else app.op
-    dilate = lambda img: expected_output(img, op, (app.ksize, app.ksize))  # noqa: E731
+    dilate = lambda img: expected_output(img, app.op, (app.ksize, app.ksize))  # noqa: E731
     same = lambda img: img  # noqa: E731
     in_topic, out_topic = config.subscriber.topic, config.publisher.topic
     with tempfile.TemporaryDirectory(prefix="rosfpga-bench-") as tmp:
@@ -170,7 +171,7 @@ def run_bench(config: NodeConfig | str | Path | None = None, *, middles: tuple[s
             config_path.write_text(BUILTIN_CONFIG_YAML)
         with EmbeddedMaster(port=0) as master:
             env = ros_env(master.uri)
-            plan: list[tuple[str, list[str] | None, object, str]] = []
+            plan: list[tuple[str, list[str] | None, Callable[[np.ndarray], np.ndarray], str]] = []
             if "direct" in middles:
                 plan.append(("direct (no middle, baseline)", None, same, ""))
             if "component" in middles:

@@ -20,10 +20,10 @@ from typing import Any
 
 import numpy as np
 
+from rosfpga_lab.checks.limits import MAX_PROBLEMS, MAX_SHIFT, SHIFT_WINDOW
 from rosfpga_lab.errors import LabError
+from rosfpga_lab.msg.span import Span
 
-#: How many problems one failed check lists at most.
-MAX_PROBLEMS = 5
 
 _STRUCT = {"uint8": "<B", "int8": "<b", "uint16": "<H", "int16": "<h", "uint32": "<I",
            "int32": "<i", "uint64": "<Q", "int64": "<q", "float32": "<f", "float64": "<d",
@@ -135,25 +135,9 @@ def _short(value: Any, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-@dataclass(frozen=True)
-class ByteField:
-    """A named run of bytes, for explaining a difference.
-
-    Attributes:
-        offset: first byte.
-        size: number of bytes.
-        name: what the bytes are, e.g. ``header.frame_id length``.
-        type: ``uint32`` and the like (decoded in messages), or ``bytes``/``string``.
-    """
-
-    offset: int
-    size: int
-    name: str
-    type: str = "bytes"
-
-    @property
-    def end(self) -> int:
-        return self.offset + self.size
+#: A named run of bytes, for explaining a difference: the lab's one span type
+#: (:class:`rosfpga_lab.msg.Span`); checks name bytes by its :attr:`~rosfpga_lab.msg.Span.label`.
+ByteField = Span
 
 
 def field_at(fields: Iterable[ByteField], offset: int) -> ByteField | None:
@@ -181,9 +165,6 @@ def _byte(b: int) -> str:
     return f"0x{b:02x} ({b}{', ' + repr(shown) if shown else ''})"
 
 
-#: Bytes compared when looking for a shifted stream, and the largest shift looked for.
-SHIFT_WINDOW = 16
-MAX_SHIFT = 8
 
 
 def _shift(got: bytes, expected: bytes, i: int) -> int:
@@ -200,21 +181,21 @@ def _shift(got: bytes, expected: bytes, i: int) -> int:
 
 def _explain_shift(k: int, i: int, fields: Sequence[ByteField], got: bytes = b"") -> str:
     before = field_at(fields, i - 1) if i else None
-    what = (f" (the field before is {before.name}, {before.type}: {before.size} byte"
+    what = (f" (the field before is {before.label}, {before.type}: {before.size} byte"
             f"{'s' if before.size != 1 else ''})" if before else "")
     if k > 0:
         pad = ""
         if (before is not None and before.end == i and before.size < 4 and k == 4 - before.size
                 and not any(got[i:i + k])):
-            pad = (f": {k} zero byte(s) follow {before.name}, which is what struct's native mode "
+            pad = (f": {k} zero byte(s) follow {before.label}, which is what struct's native mode "
                    "adds (a format without '<', such as 'BI' or '@BI', pads the uint32 after it "
                    "to a multiple of 4; ROS messages have no padding, so start every format "
-                   f"with '<'), or {before.name} was packed as a 4-byte integer")
+                   f"with '<'), or {before.label} was packed as a 4-byte integer")
         return (f"from byte {i} on your bytes are the expected ones {k} byte(s) later: something "
                 f"before byte {i} is {k} byte(s) too long{what}{pad}")
     here = field_at(fields, i)
     if here is not None and here.offset == i and here.size == -k:
-        return (f"field {here.name} ({here.type}, {here.size} byte(s) at {i}..{here.end - 1}) is "
+        return (f"field {here.label} ({here.type}, {here.size} byte(s) at {i}..{here.end - 1}) is "
                 "missing: your bytes go on with what follows it")
     return (f"from byte {i} on your bytes are the expected ones {-k} byte(s) early: something "
             f"before byte {i} is {-k} byte(s) too short or missing{what}")
@@ -237,23 +218,23 @@ def describe_byte_difference(got: bytes, expected: bytes, fields: Sequence[ByteF
         return []
     out: list[str] = []
     n = min(len(got), len(expected))
-    seen: set[ByteField | None] = set()
+    seen: set[int] = set()  # ids of the fields already described
     i = 0
     while i < n and len(out) < limit:
         if got[i] == expected[i]:
             i += 1
             continue
         f = field_at(fields, i)
-        if f in seen:
+        if id(f) in seen:
             i += 1
             continue
-        seen.add(f)
+        seen.add(id(f))
         if f is None:
             out.append(f"byte {i} is {_byte(got[i])}, expected {_byte(expected[i])}")
             i += 1
             continue
         want, have = _decode(f, expected), _decode(f, got)
-        where = f"field {f.name}"
+        where = f"field {f.label}"
         if f.size > 1:
             where += f", {f.type} at bytes {f.offset}..{f.end - 1}"
         shift = _shift(got, expected, i)
@@ -276,7 +257,7 @@ def describe_byte_difference(got: bytes, expected: bytes, fields: Sequence[ByteF
         if len(got) < len(expected):
             f = field_at(fields, len(got))
             out.append(f"your bytes end after {len(got)} bytes, expected {len(expected)}"
-                       + (f" (missing from field {f.name} on)" if f else ""))
+                       + (f" (missing from field {f.label} on)" if f else ""))
         else:
             out.append(f"you have {len(got) - len(expected)} byte(s) too many: {len(got)} bytes, "
                        f"expected {len(expected)}")

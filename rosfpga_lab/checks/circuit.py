@@ -150,16 +150,17 @@ def check_ksize_rerun(params: Any, base: Any, frame: bytes) -> CheckResult:
     if problems:
         raise fail(ex, *problems)
     details = ["KSIZE = 5, every other parameter as before"]
+    given: Any = params  # checked above to be an RtlParams instance
     output = None
     if simulator_missing_reason() is None:
-        output = run(build(params), frame).output
+        output = run(build(given), frame).output
     if output is None:
         details.append("the RTL was not re-run here (no Verilog simulator); with Icarus Verilog "
                        "or Verilator installed this check also compares the output")
         return CheckResult(ex, details)
     try:
-        model = Pipeline(width=params.WIDTH, height=params.HEIGHT, encoding=params.ENCODING,
-                         op=params.op_name, ksize=(5, 5)).process(frame)
+        model = Pipeline(width=given.WIDTH, height=given.HEIGHT, encoding=given.ENCODING,
+                         op=given.op_name, ksize=(5, 5)).process(frame)
     except PipelineError as exc:
         raise fail(ex, f"the frame does not fit the circuit: {exc}") from None
     if bytes(output) != model.output_frame:

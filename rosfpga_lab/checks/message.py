@@ -10,6 +10,7 @@ from rosfpga_lab.checks._core import (
     require_type,
 )
 from rosfpga_lab.msg import MsgRegistry, default_registry, field_layout, serialize
+from rosfpga_lab.tcpros import frame_spans
 
 IMAGE = "sensor_msgs/Image"
 
@@ -18,23 +19,18 @@ def message_fields(type_name: str, body: bytes, *, base: int = 0,
                    registry: MsgRegistry | None = None) -> list[ByteField]:
     """Byte fields of a serialized message, named by field path (``... length`` for prefixes)."""
     reg = registry or default_registry()
-    out = []
-    for s in field_layout(reg, type_name, body, partial=True):
-        name = f"{s.path} length" if s.role == "length" else (s.path or f"({s.role})")
-        kind = s.type if s.role != "array" else "bytes"
-        out.append(ByteField(s.offset + base, s.size, name, kind))
-    return out
+    return [s.moved(base) for s in field_layout(reg, type_name, body, partial=True)]
 
 
 def frame_fields(type_name: str, frame: bytes, registry: MsgRegistry | None = None) -> list[ByteField]:
-    """Byte fields of a TCPROS frame: ``frame length``, then the message's fields."""
-    return [ByteField(0, 4, "frame length", "uint32")] + message_fields(
-        type_name, frame[4:], base=4, registry=registry)
+    """Byte fields of a TCPROS frame: ``frame length``, then the message's fields
+    (:func:`rosfpga_lab.tcpros.frame_spans`, the same spans the byte viewer shows)."""
+    return frame_spans(frame, type_name, registry=registry)
 
 
 def data_offset(fields: list[ByteField]) -> int:
     """Offset of the first byte of ``data`` (pixels) among an Image's fields."""
-    return next(f.end for f in fields if f.name == "data length")
+    return next(f.end for f in fields if f.label == "data length")
 
 
 def check_data_offset(answer: Any, frame: bytes) -> CheckResult:
@@ -67,7 +63,7 @@ def check_data_offset(answer: Any, frame: bytes) -> CheckResult:
 
 def _name_at(fields: list[ByteField], offset: int) -> str | None:
     f = field_at(fields, offset)
-    return f.name if f else None
+    return f.label if f else None
 
 
 def check_marshal(answer: Any, message: Mapping[str, Any]) -> CheckResult:

@@ -18,9 +18,10 @@ from rosfpga_lab.tcpros import FrameDecoder, encode_header, parse_fields
 def header_fields(raw: bytes) -> list[ByteField]:
     """Byte fields of an encoded connection header (total length, then length + text per field)."""
     fields = [ByteField(0, 4, "total length", "uint32")]
-    for f in parse_fields(raw[4:], base_offset=4):
-        fields.append(ByteField(f.offset, 4, f"length of field '{f.key}=...'", "uint32"))
-        fields.append(ByteField(f.offset + 4, f.length, f"text '{f.key}={f.value}'", "bytes"))
+    spans = parse_fields(raw[4:], base_offset=4)
+    for length, text in zip(spans[::2], spans[1::2]):  # a length prefix, then its key=value
+        fields.append(ByteField(length.offset, 4, f"length of field '{text.path}=...'", "uint32"))
+        fields.append(ByteField(text.offset, text.size, f"text '{text.path}={text.value}'", "bytes"))
     return fields
 
 

@@ -11,8 +11,14 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rosfpga_lab.cli._args import positive_float, positive_int
+from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
+from rosfpga_lab.config.vocabulary import DEFAULT_ENCODING, ENCODINGS
+
+if TYPE_CHECKING:
+    from rosfpga_lab.config import NodeConfig
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -23,13 +29,10 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
-DEFAULT_MASTER = "http://127.0.0.1:11311/"
-
-
 def _common(p: argparse.ArgumentParser, *, with_config: bool) -> None:
     from_config = "the --config file's node.master_uri, else " if with_config else ""
     p.add_argument("--master-uri", metavar="URI",
-                   help=f"ROS master (default: ROS_MASTER_URI, else {from_config}{DEFAULT_MASTER})")
+                   help=f"ROS master (default: ROS_MASTER_URI, else {from_config}{DEFAULT_MASTER_URI})")
     p.add_argument("--name", metavar="NODE", help="node name")
 
 
@@ -48,8 +51,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "node configuration")
     p.add_argument("--topic", help="topic to publish (default: /image_raw)")
     p.add_argument("--size", type=_size, metavar="WxH", help="frame size (default: 640x480)")
-    p.add_argument("--encoding", choices=("rgba8", "bgra8", "rgb8", "bgr8", "mono8"),
-                   help="image encoding (default: rgba8)")
+    p.add_argument("--encoding", choices=tuple(ENCODINGS),
+                   help=f"image encoding (default: {DEFAULT_ENCODING})")
     p.add_argument("--rate", type=float, default=30.0, help="frames per second (default: 30)")
     p.add_argument("--source", default="synthetic",
                    help="synthetic (default), grace_hopper, an image file or a directory")
@@ -63,7 +66,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "view", help="receive sensor_msgs/Image frames: count, time and save them as PNG",
         description="Subscribe to an image topic and show what arrives: a status line with "
         "frames, fps and latency (receive time minus header.stamp), and, with --save, PNG files "
-        "of the frames (mono8, rgb8, bgr8, rgba8, bgra8). Example: "
+        f"of the frames ({', '.join(ENCODINGS)}). Example: "
         "rosfpga-lab view /image_dilated --save out --every 30")
     v.add_argument("topic", metavar="TOPIC", help="the image topic")
     v.add_argument("--save", type=Path, metavar="DIR", help="write frames as PNG into DIR")
@@ -77,12 +80,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     v.set_defaults(func=run_view)
 
 
-def _master_uri(args: argparse.Namespace, config_uri: str | None = None) -> str:
+def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> str:
     """The master to use; raises ComponentError (printed by the CLI) when none answers there."""
     from rosfpga_lab.component import ComponentError, master_answers
-    from rosfpga_lab.graph import master_uri_from_env
+    from rosfpga_lab.config import master_uri
 
-    uri = args.master_uri or master_uri_from_env() or config_uri or DEFAULT_MASTER
+    uri = master_uri(args.master_uri, config)
     if not master_answers(uri):
         raise ComponentError(f"no ROS master answers at {uri}; start one (roscore, or "
                              "'rosfpga-lab master') or give --master-uri")
@@ -94,16 +97,15 @@ def run_camera(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Camera
     from rosfpga_lab.config import load_config
 
-    topic, size, encoding, config_uri = "/image_raw", (640, 480), "rgba8", None
+    topic, size, encoding, cfg = "/image_raw", (640, 480), DEFAULT_ENCODING, None
     if args.config is not None:
         cfg = load_config(args.config)
         topic, size, encoding = cfg.subscriber.topic, (cfg.image.width, cfg.image.height), cfg.image.encoding
-        config_uri = cfg.node.master_uri
     topic = args.topic or topic
     size = args.size or size
     encoding = args.encoding or encoding
     cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
-                 source=args.source, name=args.name or "/camera", master_uri=_master_uri(args, config_uri),
+                 source=args.source, name=args.name or "/camera", master_uri=_master_uri(args, cfg),
                  frame_id=args.frame_id)
     print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on {topic} "
           f"at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop", flush=True)

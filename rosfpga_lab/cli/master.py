@@ -7,6 +7,8 @@ import sys
 import threading
 import warnings
 
+from rosfpga_lab.config.limits import DEFAULT_MASTER_PORT
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``master`` sub-command."""
@@ -16,8 +18,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "roscpp and rostopic work with it: export the ROS_MASTER_URI it prints. It binds "
         "127.0.0.1 unless --host says otherwise; ROS 1 has no authentication, so binding to "
         "a network interface lets anyone on that network control your nodes.")
-    p.add_argument("--port", type=_port, default=11311,
-                   help="TCP port, 0 for any free one (default: 11311, roscore's)")
+    p.add_argument("--port", type=_port, default=DEFAULT_MASTER_PORT,
+                   help=f"TCP port, 0 for any free one (default: {DEFAULT_MASTER_PORT}, roscore's)")
     p.add_argument("--host", default="127.0.0.1",
                    help="address to bind and advertise (default: 127.0.0.1; 0.0.0.0 = every "
                    "interface, with a warning)")

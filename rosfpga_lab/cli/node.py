@@ -49,7 +49,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Start the component, show the status until interrupted, stop cleanly."""
     from rosfpga_lab.component import FpgaComponent, limits, master_answers
-    from rosfpga_lab.graph import EmbeddedMaster, master_uri_from_env
+    from rosfpga_lab.config import load_config, master_uri
+    from rosfpga_lab.graph import EmbeddedMaster
     from rosfpga_lab.graph.xmlrpc import split_uri
 
     if not args.quiet:
@@ -60,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
         kw["input_queue"] = args.input_queue
     if args.output_queue is not None:
         kw["output_queue"] = args.output_queue
-    component = FpgaComponent.from_config(args.config, master_uri=args.master_uri or master_uri_from_env(),
+    config = load_config(args.config)
+    component = FpgaComponent.from_config(config, master_uri=master_uri(args.master_uri, config),
                                           model=args.model, **kw)
     master = None
     if not master_answers(component.master_uri):

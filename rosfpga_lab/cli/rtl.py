@@ -192,7 +192,7 @@ def run_sim(args: argparse.Namespace) -> int:
     return 1
 
 
-def _model_output(pipe, frames: bytes, error: type) -> bytes:
+def _model_output(pipe, frames: bytes, error: type[BaseException]) -> bytes:
     """The Python models' output for a stream of frames (refused ones give nothing)."""
     out, pos = b"", 0
     while pos + 4 <= len(frames):

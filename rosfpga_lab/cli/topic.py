@@ -7,17 +7,19 @@ import sys
 import threading
 import time
 
+from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``topic`` sub-command and its actions."""
     p = subparsers.add_parser(
         "topic", help="inspect and use ROS topics (like rostopic)",
         description="Inspect and use topics of a running ROS graph (the lab's or real ROS). "
-        "The master is --master-uri, else ROS_MASTER_URI, else http://127.0.0.1:11311/; when "
+        f"The master is --master-uri, else ROS_MASTER_URI, else {DEFAULT_MASTER_URI}; when "
         "none answers there the command stops with an error (it never starts a master of its "
         "own: start one with `rosfpga-lab master` or roscore).")
     p.add_argument("--master-uri", help="master to talk to (default: ROS_MASTER_URI or "
-                   "http://127.0.0.1:11311/)")
+                   f"{DEFAULT_MASTER_URI})")
     sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     ls = sub.add_parser("list", help="list topics", description="List the topics the master knows.")
     ls.add_argument("-v", "--verbose", action="store_true", help="show types and counts")
@@ -170,7 +172,7 @@ def _pub(args: argparse.Namespace, uri: str) -> int:
 def _hz(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import tools
 
-    meter = tools.RateMeter(args.window)
+    meter = tools.RateMeter(samples=args.window + 1)  # the last N intervals, as rostopic hz -w N
     node = _node(uri, "hz")
     try:
         node.subscribe(args.topic, "*", lambda body, info: meter.tick(), raw=True, queue_size=0,

@@ -28,7 +28,8 @@ import numpy as np
 from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import ComponentError, SourceError
 from rosfpga_lab.component.sources import ImageSource, open_source, to_rgb
-from rosfpga_lab.component.stats import LatencyWindow, since_stamp
+from rosfpga_lab.component.stats import LatencyWindow, fps_meter, since_stamp
+from rosfpga_lab.config import DEFAULT_ENCODING, PIXEL_FORMATS
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node
 from rosfpga_lab.hw import image_frame
 
@@ -70,7 +71,7 @@ class Camera:
     """
 
     def __init__(self, topic: str = "/image_raw", *, width: int = 640, height: int = 480,
-                 encoding: str = "rgba8", rate: float = 30.0, source: str | ImageSource = "synthetic",
+                 encoding: str = DEFAULT_ENCODING, rate: float = 30.0, source: str | ImageSource = "synthetic",
                  name: str = "/camera", master: EmbeddedMaster | None = None,
                  master_uri: str | None = None, host: str | None = None, frame_id: str = "camera",
                  queue_size: int = 2, on_sent: Callable[[SentFrame], Any] | None = None) -> None:
@@ -203,7 +204,7 @@ class Viewer:
         self.problems: list[str] = []
         self.latency = LatencyWindow(limits.LATENCY_WINDOW)
         self.last: ViewedFrame | None = None
-        self._times: list[float] = []
+        self._rate = fps_meter()
         self._lock = threading.Lock()
         self.node = Node(name, master_uri, host, master=master)
         try:
@@ -226,7 +227,7 @@ class Viewer:
         h, w, enc = msg["height"], msg["width"], msg["encoding"]
         image = None
         try:
-            channels = {"mono8": 1, "rgb8": 3, "bgr8": 3, "rgba8": 4, "bgra8": 4}[enc]
+            channels = PIXEL_FORMATS[enc].bytes_per_pixel
             data = np.frombuffer(msg["data"], np.uint8)
             image = data[:h * msg["step"]].reshape(h, msg["step"])[:, :w * channels].reshape(
                 h, w, channels)
@@ -236,8 +237,7 @@ class Viewer:
         with self._lock:
             index = self.received
             self.received += 1
-            self._times.append(time.monotonic())
-            del self._times[:-64]
+            self._rate.tick()
         frame = ViewedFrame(index, header, w, h, enc, image, info, latency)
         self.last = frame
         if image is not None and self.save_dir is not None and index % self.every == 0:
@@ -252,12 +252,9 @@ class Viewer:
 
     @property
     def fps(self) -> float:
-        """Frames per second over the last (up to 64) frames."""
+        """Frames per second over the last seconds (:func:`~rosfpga_lab.component.stats.fps_meter`)."""
         with self._lock:
-            t = list(self._times)
-        if len(t) < 2 or time.monotonic() - t[-1] > 1.0:
-            return 0.0
-        return (len(t) - 1) / (t[-1] - t[0]) if t[-1] > t[0] else 0.0
+            return self._rate.rate()
 
     def wait_for(self, frames: int, timeout: float = 10.0) -> bool:
         """Wait until ``frames`` frames arrived; False on time-out."""

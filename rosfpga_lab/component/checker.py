@@ -18,24 +18,28 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
+from rosfpga_lab.component import limits
 from rosfpga_lab.component.camera import SentFrame
 from rosfpga_lab.component.errors import ComponentError
 from rosfpga_lab.component.stats import LatencyWindow, since_stamp
-from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node
+from rosfpga_lab.config import PASSTHROUGH, canonical_op
+from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, RateMeter
 from rosfpga_lab.msg import default_registry, deserialize
 
 #: Inputs remembered for matching (older ones are forgotten).
-MAX_PENDING = 512
+MAX_PENDING = limits.CHECKER_PENDING
 
 
 def expected_output(image: np.ndarray, op: str, ksize: tuple[int, int]) -> np.ndarray:
     """OpenCV's answer for ``image`` (``(rows, cols, channels)`` uint8).
 
     Args:
-        op: ``"dilate"``, ``"erode"``, ``"copy"`` or ``"passthrough"``.
+        op: one of :data:`~rosfpga_lab.config.vocabulary.MODEL_OPS` (or an alias
+            :func:`~rosfpga_lab.config.vocabulary.canonical_op` accepts).
         ksize: kernel ``(width, height)`` (OpenCV's order).
     """
-    if op in ("copy", "passthrough"):
+    op = canonical_op(op)
+    if op == PASSTHROUGH:
         return image
     kernel = np.ones((ksize[1], ksize[0]), np.uint8)
     fn = {"dilate": cv2.dilate, "erode": cv2.erode}.get(op)
@@ -80,11 +84,11 @@ class Checker:
         expected_output(np.zeros((3, 3, 1), np.uint8), op, ksize)  # refuse unknown ops now
         self.op, self.ksize = op, ksize
         self.report = CheckReport()
-        self.latency = LatencyWindow(100_000)
+        self.latency = LatencyWindow(limits.CHECKER_LATENCY_WINDOW)
         self.last: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._inputs: dict[tuple[int, int], SentFrame] = {}
         self._lock = threading.Condition()
-        self._arrivals: list[float] = []
+        self._arrivals = RateMeter()
         self._registry = default_registry()
         self.node = Node(name, master_uri, host, master=master)
         try:
@@ -112,7 +116,7 @@ class Checker:
         with self._lock:
             source = self._inputs.pop(stamp, None)
             self.report.received += 1
-            self._arrivals.append(info.received)
+            self._arrivals.tick(info.received)
         if source is None:
             with self._lock:
                 self.report.unmatched += 1
@@ -171,8 +175,7 @@ class Checker:
     def fps(self) -> float:
         """Output frames per second between the first and the last arrival."""
         with self._lock:
-            t = list(self._arrivals)
-        return (len(t) - 1) / (t[-1] - t[0]) if len(t) > 1 and t[-1] > t[0] else 0.0
+            return self._arrivals.overall_rate()
 
     def stop(self) -> None:
         """Unsubscribe and shut the node down."""

@@ -25,7 +25,7 @@ from rosfpga_lab.component.fpga import FpgaComponent
 from rosfpga_lab.component.sources import to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary
 from rosfpga_lab.component.webview import DemoPage
-from rosfpga_lab.config import NodeConfig, load_config, parse_config
+from rosfpga_lab.config import CUSTOM, PASSTHROUGH, NodeConfig, load_config, parse_config
 from rosfpga_lab.graph import EmbeddedMaster
 from rosfpga_lab.graph.capture import write_capture
 
@@ -88,7 +88,7 @@ class DemoResult:
         cfg = self.config
         c = self.component
         kernel = (f" {cfg.application.ksize}x{cfg.application.ksize}"
-                  if cfg.application.op in ("dilate", "erode") else "")
+                  if cfg.application.op not in (PASSTHROUGH, CUSTOM) else "")
         out = [
             f"circuit: {cfg.application.op}{kernel} on "
             f"{cfg.image.width}x{cfg.image.height} {cfg.image.encoding}, "
@@ -135,7 +135,7 @@ class DemoRig:
             config = load_config(config)
         self.config = config
         app = config.application
-        self.op = oracle_op or ("copy" if app.op == "passthrough" else app.op)
+        self.op = oracle_op or app.op
         self.master = EmbeddedMaster(port=0).start()
         self.component: FpgaComponent | None = None
         self.checker: Checker | None = None
@@ -259,8 +259,9 @@ def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
     app = config.application
     report = checker.report
     png_path = None
-    if png is not None and (checker.last is not None or report.first_bad is not None):
-        png_path = write_figure(report.first_bad or checker.last, config.image.encoding, png,
+    shown = report.first_bad or checker.last
+    if png is not None and shown is not None:
+        png_path = write_figure(shown, config.image.encoding, png,
                                 scale=png_scale, title=f"{rig.op} {app.ksize}x{app.ksize}")
     return DemoResult(rig.camera.sent, report.received, report, checker.fps,
                       checker.latency.summary(), stats, elapsed, png_path, config, pcap_path, packets)

@@ -40,17 +40,15 @@ import numpy as np
 
 from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
-from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, since_stamp
+from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, fps_meter, since_stamp
 from rosfpga_lab.config import NodeConfig, load_config
+from rosfpga_lab.config import master_uri as pick_master_uri
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
 from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineResult
 
 log = logging.getLogger("rosfpga_lab.component")
 
-#: Refusal kinds counted separately (kinds are field + rule, a few dozen at most; any beyond
-#: this count under "other").
-MAX_REFUSAL_KINDS = 64
 
 
 @dataclass(frozen=True)
@@ -160,7 +158,9 @@ class FpgaComponent:
         self.config = config
         self.model = model
         self.master = master
-        self.master_uri = master.uri if master is not None else (master_uri or config.node.master_uri)
+        # the Python API takes the file's master, not ROS_MASTER_URI (commands add the environment)
+        self.master_uri = master.uri if master is not None else pick_master_uri(
+            master_uri, config, environ={})
         self.name = name or config.node.global_name
         self.host = host or config.node.ip_address
         self.input_topic = config.subscriber.topic
@@ -179,7 +179,7 @@ class FpgaComponent:
         self._latency = LatencyWindow(limits.LATENCY_WINDOW)
         self._process = LatencyWindow(limits.LATENCY_WINDOW)
         self._since_stamp = LatencyWindow(limits.LATENCY_WINDOW)
-        self._published_times: collections.deque[float] = collections.deque(maxlen=256)
+        self._published_rate = fps_meter()
         self._counts = {"seen": 0, "processed": 0, "published": 0, "refused": 0,
                         "reregistered": 0, "observer_errors": 0}
         self._reasons: dict[str, int] = {}        # refusal kind -> count
@@ -307,7 +307,7 @@ class FpgaComponent:
             self._counts["seen"] += 1
             self._counts["processed"] += 1
             self._counts["published"] += 1
-            self._published_times.append(time.monotonic())
+            self._published_rate.tick()
             self._last = result
             for fifo, level in result.fifo_high_water.items():
                 self._high_water[fifo] = max(level, self._high_water.get(fifo, 0))
@@ -321,7 +321,7 @@ class FpgaComponent:
         with self._lock:
             self._counts["seen"] += 1
             self._counts["refused"] += 1
-            if kind not in self._reasons and len(self._reasons) >= MAX_REFUSAL_KINDS:
+            if kind not in self._reasons and len(self._reasons) >= limits.MAX_REFUSAL_KINDS:
                 kind = "other"
             n = self._reasons[kind] = self._reasons.get(kind, 0) + 1
             self._examples.setdefault(kind, reason)
@@ -426,13 +426,9 @@ class FpgaComponent:
             for link in pub_stats.links:
                 if link.drops:
                     by_peer[link.peer] = by_peer.get(link.peer, 0) + link.drops
-        now = time.monotonic()
         with self._lock:
             c = dict(self._counts)
-            times = [t for t in self._published_times if t >= now - 2.0]
-            fps = (len(times) - 1) / (times[-1] - times[0]) if len(times) > 1 and times[-1] > times[0] else 0.0
-            if times and now - times[-1] > 1.0:
-                fps = 0.0
+            fps = self._published_rate.rate()
             last = self._last
             return ComponentStats(
                 received=sub_stats.frames if sub_stats else 0,

@@ -23,6 +23,20 @@ LOG_FIRST = 3
 LOG_EVERY = 100
 #: The reference model moves one byte per Python step: warn above this many pixels per frame.
 REFERENCE_WARN_PIXELS = 160 * 120
+#: Frames per second figures (status lines, the viewer): arrivals of the last FPS_WINDOW seconds
+#: (at most FPS_SAMPLES of them); 0 once no frame came for FPS_STALE seconds.
+FPS_WINDOW = 2.0
+FPS_STALE = 1.0
+FPS_SAMPLES = 256
+#: Input frames a checker remembers for matching (older ones are forgotten), and latency
+#: samples it keeps.
+CHECKER_PENDING = 512
+CHECKER_LATENCY_WINDOW = 100_000
+#: Distinct frames an image source makes before it repeats.
+DEFAULT_SOURCE_PERIOD = 60
+#: Refusal kinds counted separately (kinds are field + rule, a few dozen at most; any beyond
+#: this count under "other").
+MAX_REFUSAL_KINDS = 64
 #: Camera limits: frames per second and image side.
 MAX_CAMERA_RATE = 1000.0
 MAX_CAMERA_SIDE = 8192

@@ -23,21 +23,30 @@ import numpy as np
 
 from rosfpga_lab.component import limits
 from rosfpga_lab.component.errors import SourceError
-from rosfpga_lab.hw import PIXEL_FORMATS
+from rosfpga_lab.config import PIXEL_FORMATS
 
 #: Named sources (besides a path).
 SOURCES = ("synthetic", "grace_hopper")
 #: Distinct frames before a source repeats.
-DEFAULT_PERIOD = 60
+DEFAULT_PERIOD = limits.DEFAULT_SOURCE_PERIOD
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp")
 
-_FROM_BGR = {
-    "rgba8": cv2.COLOR_BGR2RGBA, "bgra8": cv2.COLOR_BGR2BGRA, "rgb8": cv2.COLOR_BGR2RGB,
-    "bgr8": None, "mono8": cv2.COLOR_BGR2GRAY,
+
+
+def _cv_name(channels: str) -> str:
+    """OpenCV's name of a channel order (``"Y"`` is ``GRAY``)."""
+    return "GRAY" if channels == "Y" else channels
+
+
+# OpenCV colour conversions per encoding, derived from the channel order each encoding declares
+# (None: already in that order).
+_FROM_BGR: dict[str, int | None] = {
+    enc: None if _cv_name(fmt.channels) == "BGR" else getattr(cv2, f"COLOR_BGR2{_cv_name(fmt.channels)}")
+    for enc, fmt in PIXEL_FORMATS.items()
 }
-_TO_RGB = {
-    "rgba8": cv2.COLOR_RGBA2RGB, "bgra8": cv2.COLOR_BGRA2RGB, "rgb8": None,
-    "bgr8": cv2.COLOR_BGR2RGB, "mono8": cv2.COLOR_GRAY2RGB,
+_TO_RGB: dict[str, int | None] = {
+    enc: None if _cv_name(fmt.channels) == "RGB" else getattr(cv2, f"COLOR_{_cv_name(fmt.channels)}2RGB")
+    for enc, fmt in PIXEL_FORMATS.items()
 }
 
 
@@ -75,7 +84,7 @@ def to_rgb(image: np.ndarray, encoding: str) -> np.ndarray:
     code = _TO_RGB[encoding]
     if code is None:
         return np.ascontiguousarray(img)
-    src = img[:, :, 0] if encoding == "mono8" else img
+    src = img[:, :, 0] if PIXEL_FORMATS[encoding].bytes_per_pixel == 1 else img
     return cv2.cvtColor(np.ascontiguousarray(src), code)
 
 
@@ -157,8 +166,8 @@ def _grace_hopper() -> np.ndarray:
     try:
         from matplotlib import cbook
 
-        with cbook.get_sample_data("grace_hopper.jpg") as f:
-            data = np.frombuffer(f.read(), np.uint8)
+        sample = Path(cbook.get_sample_data("grace_hopper.jpg", asfileobj=False))
+        data = np.frombuffer(sample.read_bytes(), np.uint8)
     except (OSError, ValueError) as exc:
         raise SourceError(f"matplotlib's sample photo grace_hopper.jpg is missing ({exc}); "
                           "use --source synthetic") from None

@@ -8,6 +8,7 @@ import threading
 from dataclasses import dataclass, field
 
 from rosfpga_lab.component import limits
+from rosfpga_lab.graph.rate import RateMeter
 
 
 def since_stamp(now: float, secs: int, nsecs: int) -> float | None:
@@ -20,6 +21,12 @@ def since_stamp(now: float, secs: int, nsecs: int) -> float | None:
     """
     seconds = now - (secs + nsecs * 1e-9)
     return seconds if 0 <= seconds < limits.STAMP_PLAUSIBLE else None
+
+
+def fps_meter() -> RateMeter:
+    """The meter behind every frames-per-second figure of the component layer: arrivals of the
+    last :data:`~rosfpga_lab.component.limits.FPS_WINDOW` seconds, 0 once frames stop."""
+    return RateMeter(samples=limits.FPS_SAMPLES, window_s=limits.FPS_WINDOW, stale_s=limits.FPS_STALE)
 
 
 class LatencyWindow:

@@ -104,7 +104,7 @@ class DemoPage:
     def url(self) -> str:
         """The page's address, e.g. ``http://127.0.0.1:43123/``."""
         host, port = self._server.server_address[:2]
-        return f"http://{host}:{port}/"
+        return f"http://{host.decode() if isinstance(host, bytes) else host}:{port}/"
 
     def start(self) -> DemoPage:
         """Serve in a background thread."""

@@ -10,19 +10,25 @@ Jinja2 (a test holds that)::
     config.image.width, config.application.op, config.node.master_uri
 
 Owners: :mod:`~rosfpga_lab.config.vocabulary` (encodings and operations),
-:mod:`~rosfpga_lab.config.limits` (limits and defaults), :mod:`~rosfpga_lab.config.node` (the
+:mod:`~rosfpga_lab.config.limits` (limits and defaults), :mod:`~rosfpga_lab.config.master` (which
+ROS master a program talks to), :mod:`~rosfpga_lab.config.node` (the
 schema, its checker and the dataclasses).
 """
 
 from rosfpga_lab.config.errors import ConfigError
+from rosfpga_lab.config.master import master_uri, master_uri_from_env
 from rosfpga_lab.config.node import (
     ApplicationConfig, FifoConfig, ImageConfig, NodeConfig, NodeSection, TopicConfig,
     load_config, parse_config, ros_name_problem,
 )
-from rosfpga_lab.config.vocabulary import ENCODINGS, OPS, PIXEL_FORMATS, PixelFormat
+from rosfpga_lab.config.vocabulary import (
+    CUSTOM, DEFAULT_ENCODING, DEFAULT_OP, ENCODINGS, MODEL_OPS, OPS, PASSTHROUGH, PIXEL_FORMATS, PixelFormat,
+    canonical_op, model_ksize,
+)
 
 __all__ = [
-    "ENCODINGS", "OPS", "PIXEL_FORMATS", "ApplicationConfig", "ConfigError", "FifoConfig",
+    "CUSTOM", "DEFAULT_ENCODING", "DEFAULT_OP", "ENCODINGS", "MODEL_OPS", "OPS", "PASSTHROUGH", "PIXEL_FORMATS", "ApplicationConfig", "ConfigError", "FifoConfig",
     "ImageConfig", "NodeConfig", "NodeSection", "PixelFormat", "TopicConfig", "load_config",
-    "parse_config", "ros_name_problem",
+    "parse_config", "ros_name_problem", "canonical_op", "master_uri", "master_uri_from_env",
+    "model_ksize",
 ]

@@ -27,7 +27,9 @@ DEFAULT_CLOCK_MHZ = 100.0
 MIN_CLOCK_MHZ = 1.0
 MAX_CLOCK_MHZ = 1000.0
 #: Node defaults (safe: loopback unless the configuration says otherwise).
-DEFAULT_MASTER_URI = "http://127.0.0.1:11311/"
+#: roscore's port, and the URI of a master on it (the one literal of the default master).
+DEFAULT_MASTER_PORT = 11311
+DEFAULT_MASTER_URI = f"http://127.0.0.1:{DEFAULT_MASTER_PORT}/"
 DEFAULT_IP_ADDRESS = "127.0.0.1"
 #: The only message type that can stream through the circuit.
 IMAGE_TYPE = "sensor_msgs/Image"

@@ -51,13 +51,8 @@ import yaml
 
 from rosfpga_lab.config import limits
 from rosfpga_lab.config.errors import ConfigError
-from rosfpga_lab.config.vocabulary import ENCODINGS, OPS
-
-# ROS 1 graph resource names (wiki.ros.org/Names): first character a letter, '/' or '~'; then
-# letters, digits, '_' and '/'. The lab also refuses '//' and a trailing '/' (roscpp does).
-_ROS_NAME = re.compile(r"^[A-Za-z/~][A-Za-z0-9_/]*$")
-_BASE_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-
+from rosfpga_lab.config.names import canonical, name_problem
+from rosfpga_lab.config.vocabulary import CUSTOM, DEFAULT_OP, ENCODINGS, OPS
 
 @dataclass(frozen=True)
 class NodeSection:
@@ -136,7 +131,7 @@ class ApplicationConfig:
         source: for ``custom``, the C++ file defining ``image_filter()`` (absolute path).
     """
 
-    op: str = "dilate"
+    op: str = DEFAULT_OP
     ksize: int = 3
     source: Path | None = None
 
@@ -196,7 +191,7 @@ _SCHEMA: dict[str, dict[str, tuple[type | tuple[type, ...], Any]]] = {
     "subscriber": {"topic": (str, _REQUIRED), "type": (str, limits.IMAGE_TYPE)},
     "publisher": {"topic": (str, _REQUIRED), "type": (str, limits.IMAGE_TYPE)},
     "image": {"width": (int, _REQUIRED), "height": (int, _REQUIRED), "encoding": (str, _REQUIRED)},
-    "application": {"op": (str, "dilate"), "ksize": (int, 3), "source": ((str, type(None)), None)},
+    "application": {"op": (str, DEFAULT_OP), "ksize": (int, 3), "source": ((str, type(None)), None)},
     "fifo": {"input_depth": (int, limits.DEFAULT_INPUT_FIFO_DEPTH),
              "output_depth": (int, limits.DEFAULT_OUTPUT_FIFO_DEPTH),
              "axis_depth": (int, limits.DEFAULT_AXIS_FIFO_DEPTH)},
@@ -292,34 +287,20 @@ def _check(ctx: _Ctx, ok: bool, message: str, nodes: dict[str, yaml.Node], key: 
 
 
 def ros_name_problem(name: str, *, node_name: bool = False) -> str | None:
-    """Why ``name`` breaks ROS 1 naming rules, or None when it is legal.
+    """Why ``name`` cannot be a topic (or node) name in a configuration, or None.
+
+    The ROS rules of :func:`rosfpga_lab.config.names.name_problem`, plus one of the configuration:
+    the name is written in canonical form (no trailing ``/``), as the circuit sends it verbatim
+    in its connection headers.
 
     Args:
         name: a graph resource name (topic or node).
         node_name: apply the extra rules of node names (not private, base name legal).
     """
-    if not name:
-        return "a ROS name cannot be empty"
-    if not _ROS_NAME.fullmatch(name):
-        bad = next((c for c in name if not (c.isascii() and (c.isalnum() or c in "_/~"))), None)
-        if bad is not None:
-            return f"character {bad!r} is not allowed in a ROS name (letters, digits, '_', '/')"
-        return "a ROS name starts with a letter, '/' or '~'"
-    if "~" in name[1:]:
-        return "'~' may only start a ROS name"
-    if "//" in name:
-        return "a ROS name cannot contain '//'"
-    if len(name) > 1 and name.endswith("/"):
-        return "a ROS name cannot end with '/'"
-    for part in name.lstrip("/~").split("/"):
-        if part and not _BASE_NAME.fullmatch(part):
-            return f"name part {part!r} must start with a letter"
-    if node_name:
-        if name.startswith("~"):
-            return "a node name cannot be private ('~')"
-        if name == "/":
-            return "a node name cannot be '/'"
-    return None
+    problem = name_problem(name, node_name=node_name)
+    if problem is None and name != canonical(name):
+        return f"write the name in canonical form, {canonical(name)!r} (no trailing '/')"
+    return problem
 
 
 def _check_type(ctx: _Ctx, type_name: str, nodes: dict[str, yaml.Node], section: str,
@@ -428,7 +409,7 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
            f"ksize must be odd, 1..{limits.MAX_KSIZE}, got {ap['ksize']}", apn, "ksize",
            "application")
     source_path: Path | None = None
-    if ap["op"] == "custom":
+    if ap["op"] == CUSTOM:
         _check(ctx, bool(ap["source"]), "op 'custom' needs 'source: FILE.cpp' (the C++ file "
                "defining image_filter)", apn, "op", "application")
         source_path = ((base_dir or Path.cwd()) / ap["source"]).resolve()

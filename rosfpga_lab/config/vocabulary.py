@@ -39,5 +39,35 @@ PIXEL_FORMATS: dict[str, PixelFormat] = {
 #: Encodings the circuit can pack, with bytes per pixel.
 ENCODINGS: dict[str, int] = {name: fmt.bytes_per_pixel for name, fmt in PIXEL_FORMATS.items()}
 
+#: The encoding a camera or a command uses when none is given.
+DEFAULT_ENCODING = "rgba8"
+
+#: The identity operation: the image passes through the circuit unchanged. It is called
+#: ``passthrough`` in every layer (configuration, models, generator, oracle); the hardware models
+#: once called it ``copy``, a name :func:`canonical_op` still accepts.
+PASSTHROUGH = "passthrough"
+#: The user's own C++ ``image_filter()`` (no Python model, no OpenCV oracle).
+CUSTOM = "custom"
+#: The operation a configuration without ``application.op`` gets (the paper's).
+DEFAULT_OP = "dilate"
+#: Operations the lab computes itself: the hardware models and the OpenCV oracle.
+MODEL_OPS = ("dilate", "erode", PASSTHROUGH)
 #: Operations the generated application can perform (``application.op`` of a node configuration).
-OPS = ("dilate", "erode", "passthrough", "custom")
+OPS = (*MODEL_OPS, CUSTOM)
+
+_OP_ALIASES = {"copy": PASSTHROUGH}
+
+
+def canonical_op(op: str) -> str:
+    """The one name of ``op`` (``"copy"`` -> ``"passthrough"``; other names unchanged).
+
+    Args:
+        op: an operation name, possibly an accepted older alias.
+    """
+    return _OP_ALIASES.get(op, op)
+
+
+def model_ksize(op: str, ksize: int) -> tuple[int, int]:
+    """The ``(width, height)`` kernel the models use for ``op`` with a configured square ``ksize``
+    (a pass-through has no window: ``(1, 1)``)."""
+    return (1, 1) if canonical_op(op) == PASSTHROUGH else (ksize, ksize)

@@ -27,18 +27,11 @@ with an error and a hint when no master answers there).
 Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``master`` (EmbeddedMaster),
 ``node`` (Node, Slave API, TCPROS server), ``publisher``, ``subscriber``, ``trace`` (the recorded
 conversation; its docstring documents the format), ``names`` (names, ROS_* environment),
-``owner`` (which Unix user listens on a port),
-``errors`` (errors and limits).
+``owner`` (which Unix user listens on a port), ``rate`` (RateMeter, every events-per-second
+figure), ``errors`` (errors), ``limits`` (limits).
 """
 
 from rosfpga_lab.graph.errors import (
-    CONNECT_TIMEOUT,
-    MAX_HTTP_HEAD,
-    MAX_XMLRPC_BODY,
-    MAX_XMLRPC_REPLY,
-    RECONNECT_FIRST,
-    RECONNECT_MAX,
-    XMLRPC_TIMEOUT,
     ApiArgumentError,
     ConfigError,
     GraphError,
@@ -46,10 +39,20 @@ from rosfpga_lab.graph.errors import (
     XmlRpcError,
     XmlRpcTooLargeError,
 )
+from rosfpga_lab.graph.limits import (
+    CONNECT_TIMEOUT,
+    MAX_HTTP_HEAD,
+    MAX_XMLRPC_BODY,
+    MAX_XMLRPC_REPLY,
+    RECONNECT_FIRST,
+    RECONNECT_MAX,
+    XMLRPC_TIMEOUT,
+)
 from rosfpga_lab.graph.master import EmbeddedMaster, ParamTree
 from rosfpga_lab.graph.names import OpenBindWarning, default_host, master_uri_from_env, resolve
 from rosfpga_lab.graph.node import Node, default_master_uri, shared_master, stop_shared_master
 from rosfpga_lab.graph.publisher import LinkStats, Publisher, PublisherStats
+from rosfpga_lab.graph.rate import RateMeter
 from rosfpga_lab.graph.subscriber import MessageInfo, Subscriber, SubscriberStats
 from rosfpga_lab.graph.trace import KINDS, Trace, TraceEvent
 from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call, parse_xmlrpc
@@ -58,7 +61,7 @@ __all__ = [
     "CONNECT_TIMEOUT", "KINDS", "MAX_HTTP_HEAD", "MAX_XMLRPC_BODY", "MAX_XMLRPC_REPLY", "RECONNECT_FIRST",
     "RECONNECT_MAX", "XMLRPC_TIMEOUT", "ApiArgumentError", "ConfigError", "EmbeddedMaster",
     "GraphError", "LinkStats", "MasterError", "MessageInfo", "Node", "OpenBindWarning",
-    "ParamTree", "Publisher", "PublisherStats", "Subscriber", "SubscriberStats", "Trace",
+    "ParamTree", "Publisher", "PublisherStats", "RateMeter", "Subscriber", "SubscriberStats", "Trace",
     "TraceEvent", "XmlRpcError", "XmlRpcTooLargeError", "XmlRpcServer", "call", "default_host", "default_master_uri", "master_uri_from_env",
     "parse_xmlrpc", "resolve", "shared_master", "stop_shared_master",
 ]

@@ -172,7 +172,8 @@ def trace_from_capture(path: str | Path, *, frame_bytes: int = 1 << 20) -> Trace
         if st.closed is not None:
             ev = tr.record("tcp_close", rec, role="out", src=st.client, dst=st.server,
                            t0=st.closed, **ends)
-            ev.t = st.closed
+            if ev is not None:  # a full trace drops events
+                ev.t = st.closed
     return tr
 
 
@@ -206,14 +207,16 @@ def _xmlrpc(tr: Trace, st: TcpStream, c2s: bytes, s2c: bytes, ends: dict) -> Non
                        method=method or "", args=list(params), result=result, raw=head + body,
                        raw_reply=raw_reply, size=len(head) + len(body) + len(raw_reply),
                        t0=st.time_at(True, off), **ends)
-        ev.t = t_end
+        if ev is not None:  # a full trace drops events
+            ev.t = t_end
 
 
 def _tcpros(tr: Trace, st: TcpStream, c2s: bytes, s2c: bytes, ends: dict) -> None:
     conn = new_connection_id()
     ev = tr.record("tcp_connect", "capture", role="out", src=st.client, dst=st.server,
                    conn=conn, t0=st.opened, **ends)
-    ev.t = st.opened
+    if ev is not None:  # a full trace drops events
+        ev.t = st.opened
     topic = ""
     for from_client, data in ((True, c2s), (False, s2c)):
         if not data:
@@ -230,7 +233,8 @@ def _tcpros(tr: Trace, st: TcpStream, c2s: bytes, s2c: bytes, ends: dict) -> Non
         ev = tr.record("tcpros_header", "capture", role="out", src=src, dst=dst, method=topic,
                        args=fields, raw=data[:used], size=used, conn=conn,
                        t0=st.time_at(from_client, 0), **ends)
-        ev.t = ev.t0
+        if ev is not None:  # a full trace drops events
+            ev.t = ev.t0
         if from_client:
             continue
         dec = FrameDecoder(stream_offset=used)
@@ -242,7 +246,8 @@ def _tcpros(tr: Trace, st: TcpStream, c2s: bytes, s2c: bytes, ends: dict) -> Non
             ev = tr.record("tcpros_frame", "capture", role="out", src=src, dst=dst, method=topic,
                            raw=tr.frame_raw(body), size=4 + len(body), conn=conn, index=index,
                            offset=start, t0=st.time_at(False, start), **ends)
-            ev.t = st.time_at(False, start + 4 + len(body) - 1)
+            if ev is not None:  # a full trace drops events
+                ev.t = st.time_at(False, start + 4 + len(body) - 1)
 
 
 def udp_datagrams(path: str | Path) -> list[tuple[float, str, str, bytes]]:

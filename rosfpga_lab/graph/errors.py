@@ -1,4 +1,4 @@
-"""Errors and limits of the graph layer (XML-RPC master/slave, node runtime).
+"""Errors of the graph layer (XML-RPC master/slave, node runtime).
 
 The parameter server refuses values nested deeper than :data:`MAX_XMLRPC_DEPTH`, integers
 outside XML-RPC's 32-bit range and ``<nil/>`` (see ``master``).
@@ -7,70 +7,35 @@ outside XML-RPC's 32-bit range and ``<nil/>`` (see ``master``).
 from __future__ import annotations
 
 from rosfpga_lab.errors import LabError
-
-#: Largest HTTP request/response body accepted (XML-RPC payloads are small; 8 MiB leaves room
-#: for a big getSystemState or parameter tree).
-MAX_XMLRPC_BODY = 8 << 20
-#: Largest XML-RPC reply body a client call accepts. A master's ``getSystemState`` grows with the
-#: graph (900 topics with long names pass 8 MiB) and rosmaster sets no limit, so replies get more
-#: room than requests; the cap only bounds what a broken or hostile server can make us hold.
-MAX_XMLRPC_REPLY = 64 << 20
-#: Largest HTTP head (request line + headers).
-MAX_HTTP_HEAD = 16 << 10
-#: Seconds an XML-RPC call (connect + request + reply) may take.
-XMLRPC_TIMEOUT = 10.0
-#: Seconds an idle keep-alive XML-RPC connection stays open on our servers.
-XMLRPC_IDLE_TIMEOUT = 30.0
-#: Seconds a server gives one whole request (head and body) once its first byte arrived: a
-#: peer dripping bytes cannot hold a connection longer than this.
-XMLRPC_REQUEST_TIMEOUT = 10.0
-#: Open XML-RPC connections a server keeps at once. A new one beyond this evicts the
-#: connection that has waited longest for request bytes; only when every one is busy in a
-#: handler does the newcomer get "503".
-MAX_XMLRPC_CONNECTIONS = 128
-#: Deepest nesting of arrays/structs accepted in an XML-RPC document (a parameter tree is a
-#: few levels; deeper documents are refused before any handler or trace sees them).
-MAX_XMLRPC_DEPTH = 64
-#: TCPROS connections still in their handshake a node keeps at once; a new one beyond this
-#: evicts the oldest (an honest subscriber sends its header at once, a silent one waits).
-MAX_PENDING_HANDSHAKES = 64
-#: Accept loops: first pause after a failed accept() (out of file descriptors, aborted
-#: connection ...) and the longest pause; the pause doubles while accept keeps failing.
-ACCEPT_BACKOFF_FIRST = 0.01
-ACCEPT_BACKOFF_MAX = 0.5
-#: Seconds between two log lines about failing accept() calls of one server (the ones between
-#: are counted and reported with the next line).
-ACCEPT_LOG_INTERVAL = 10.0
-#: Publishers one subscriber links to at once (each link is a thread and a socket); URIs past
-#: this in a publisher list are ignored and logged. ``Node.subscribe(max_publishers=)``.
-MAX_PUBLISHERS_PER_TOPIC = 100
-#: Seconds to connect to a publisher's TCPROS port.
-CONNECT_TIMEOUT = 5.0
-#: Reconnect back-off after a publisher vanishes: first delay, factor, cap (roscpp: 0.1 s x2 up to 20 s).
-RECONNECT_FIRST = 0.1
-RECONNECT_FACTOR = 2.0
-RECONNECT_MAX = 5.0
-#: Seconds stop()/shutdown() waits for each worker thread.
-JOIN_TIMEOUT = 5.0
-#: Seconds the master waits on one publisherUpdate/paramUpdate/shutdown notification.
-NOTIFY_TIMEOUT = 5.0
-#: Threads the master notifies nodes with (each serves one node at a time, so a silent node
-#: holds one worker, not the graph; rosmaster's pool has 10).
-NOTIFY_WORKERS = 10
-#: Notifications waiting in the master at once (after coalescing: one per node, method and
-#: topic or key); more are dropped and counted in ``notify_errors``.
-MAX_NOTIFY_PENDING = 10_000
-#: Error texts kept by a subscriber (``stats.errors``) and by the master (``notify_errors``):
-#: the most recent ones.
-MAX_ERRORS_KEPT = 50
-#: A trace's default budget: events kept, bytes they hold (raw bytes plus an estimate of the
-#: decoded arguments and results), and bytes of one payload (an HTTP message, a connection
-#: header) kept as its excerpt; ``size`` always tells the full length.
-TRACE_MAX_EVENTS = 20_000
-TRACE_MAX_BYTES = 16 << 20
-TRACE_EXCERPT_BYTES = 64 << 10
-#: Closed connections whose counters a publisher's ``stats.links`` still reports.
-MAX_CLOSED_LINKS_KEPT = 64
+# The limits live in limits.py; re-exported here for code written before the move.
+from rosfpga_lab.graph.limits import (  # noqa: F401
+    MAX_XMLRPC_BODY,
+    MAX_XMLRPC_REPLY,
+    MAX_HTTP_HEAD,
+    XMLRPC_TIMEOUT,
+    XMLRPC_IDLE_TIMEOUT,
+    XMLRPC_REQUEST_TIMEOUT,
+    MAX_XMLRPC_CONNECTIONS,
+    MAX_XMLRPC_DEPTH,
+    MAX_PENDING_HANDSHAKES,
+    ACCEPT_BACKOFF_FIRST,
+    ACCEPT_BACKOFF_MAX,
+    ACCEPT_LOG_INTERVAL,
+    MAX_PUBLISHERS_PER_TOPIC,
+    CONNECT_TIMEOUT,
+    RECONNECT_FIRST,
+    RECONNECT_FACTOR,
+    RECONNECT_MAX,
+    JOIN_TIMEOUT,
+    NOTIFY_TIMEOUT,
+    NOTIFY_WORKERS,
+    MAX_NOTIFY_PENDING,
+    MAX_ERRORS_KEPT,
+    TRACE_MAX_EVENTS,
+    TRACE_MAX_BYTES,
+    TRACE_EXCERPT_BYTES,
+    MAX_CLOSED_LINKS_KEPT,
+)
 
 
 class GraphError(LabError):

@@ -26,15 +26,16 @@ import threading
 import uuid
 from typing import Any
 
+from rosfpga_lab.config.limits import DEFAULT_MASTER_PORT
 from rosfpga_lab.graph.apicheck import api_methods, checked
-from rosfpga_lab.graph.errors import (
+from rosfpga_lab.graph.errors import XmlRpcError
+from rosfpga_lab.graph.limits import (
     JOIN_TIMEOUT,
     MAX_ERRORS_KEPT,
     MAX_NOTIFY_PENDING,
     MAX_XMLRPC_DEPTH,
     NOTIFY_TIMEOUT,
     NOTIFY_WORKERS,
-    XmlRpcError,
 )
 from rosfpga_lab.graph.names import bind_address, canonical, namespace_of, resolve
 from rosfpga_lab.graph.trace import Trace
@@ -155,7 +156,7 @@ class EmbeddedMaster:
         'http://127.0.0.1:41234/'
     """
 
-    def __init__(self, host: str = "127.0.0.1", port: int = 11311, *, trace: Trace | None = None,
+    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_MASTER_PORT, *, trace: Trace | None = None,
                  allow_remote_shutdown: bool = False) -> None:
         self.trace = trace if trace is not None else Trace()
         self.allow_remote_shutdown = allow_remote_shutdown

@@ -1,7 +1,8 @@
 """ROS graph names and the environment (ROS_MASTER_URI, ROS_IP, ROS_HOSTNAME).
 
 Names follow rosgraph.names: ``/ns/name`` is global, ``name`` is relative to the caller's
-namespace, ``~name`` is private (under the caller's own name).
+namespace, ``~name`` is private (under the caller's own name). Which names are legal is decided
+by :mod:`rosfpga_lab.config.names` (the lab's one validator); this module resolves them.
 """
 
 from __future__ import annotations
@@ -10,28 +11,15 @@ import os
 import re
 import warnings
 
+from rosfpga_lab.config.master import master_uri_from_env  # noqa: F401  (re-exported; the rule's owner)
+from rosfpga_lab.config.names import canonical, is_legal_name, name_problem  # noqa: F401  (re-exported)
 from rosfpga_lab.graph.errors import ConfigError
 
-_LEGAL = re.compile(r"^[~/A-Za-z][\w/]*$")
 ALL_INTERFACES = ("0.0.0.0", "", "::")
 
 
 class OpenBindWarning(UserWarning):
     """Binding to every network interface: ROS 1 has no authentication."""
-
-
-def is_legal_name(name: str) -> bool:
-    """rosgraph's rule: empty, or starts with ~ / or a letter, then word characters and /."""
-    return name == "" or (bool(_LEGAL.match(name)) and "//" not in name)
-
-
-def canonical(name: str) -> str:
-    """Collapse repeated slashes and drop a trailing one (except for the root)."""
-    if not name:
-        return name
-    lead = "/" if name.startswith("/") else ""
-    parts = [p for p in name.split("/") if p]
-    return lead + "/".join(parts) if parts else "/"
 
 
 def namespace_of(name: str) -> str:
@@ -55,18 +43,24 @@ def check_node_name(name: str) -> str:
     """Return the canonical global node name.
 
     Raises:
-        ConfigError: illegal characters or empty.
+        ConfigError: not a legal node name (:func:`rosfpga_lab.config.names.name_problem`).
     """
-    if not name or not is_legal_name(name) or name.startswith("~"):
-        raise ConfigError(f"illegal node name {name!r}: use letters, digits, '_' and '/', "
-                          "starting with a letter or '/'")
+    problem = name_problem(name, node_name=True)
+    if problem:
+        raise ConfigError(f"illegal node name {name!r}: {problem}")
     return resolve(name, "/")
 
 
-def master_uri_from_env() -> str | None:
-    """``ROS_MASTER_URI`` if set and non-empty, else None."""
-    value = os.environ.get("ROS_MASTER_URI", "").strip()
-    return value or None
+def check_topic_name(name: str, caller_id: str = "/") -> str:
+    """Return ``name`` resolved against ``caller_id`` (see :func:`resolve`).
+
+    Raises:
+        ConfigError: not a legal ROS name (:func:`rosfpga_lab.config.names.name_problem`).
+    """
+    problem = name_problem(name)
+    if problem:
+        raise ConfigError(f"illegal topic name {name!r}: {problem}")
+    return resolve(name, caller_id)
 
 
 def default_host() -> str:

@@ -28,27 +28,23 @@ import warnings
 from collections.abc import Callable
 from typing import Any
 
+from rosfpga_lab.config import limits as config_limits
+from rosfpga_lab.config.master import master_uri_from_env
 from rosfpga_lab.graph.apicheck import api_methods, checked
-from rosfpga_lab.graph.errors import (
-    JOIN_TIMEOUT,
-    MAX_PENDING_HANDSHAKES,
-    MAX_PUBLISHERS_PER_TOPIC,
-    GraphError,
-    MasterError,
-    XmlRpcError,
-)
+from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcError
+from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MAX_PENDING_HANDSHAKES, MAX_PUBLISHERS_PER_TOPIC
 from rosfpga_lab.graph.master import MASTER_ID, EmbeddedMaster
 from rosfpga_lab.graph.names import (
     ALL_INTERFACES,
     bind_address,
     check_node_name,
+    check_topic_name,
     default_host,
-    master_uri_from_env,
-    resolve,
 )
 from rosfpga_lab.graph.owner import listener_uids
 from rosfpga_lab.graph.publisher import Publisher
 from rosfpga_lab.graph.subscriber import Subscriber
+from rosfpga_lab.graph.topic import TopicContext
 from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close, socket_ends
 from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, split_uri
@@ -60,13 +56,14 @@ from rosfpga_lab.tcpros import (
     HeaderReceived,
     PublisherHandshake,
     Rejected,
+    State,
     TopicSpec,
 )
 
 _shared_lock = threading.Lock()
 _shared: EmbeddedMaster | None = None
 #: Port of roscore's master, probed and (if free) used by the shared embedded master.
-DEFAULT_MASTER_PORT = 11311
+DEFAULT_MASTER_PORT = config_limits.DEFAULT_MASTER_PORT
 
 
 def shared_master(port: int | None = None) -> EmbeddedMaster:
@@ -106,7 +103,7 @@ def default_master_uri() -> str:
     a port is known: on a shared server another user's master is never joined unasked, with a
     RuntimeWarning); else the shared embedded master of this process.
     """
-    env = master_uri_from_env()
+    env = master_uri_from_env()  # steps 1-2 of rosfpga_lab.config.master's rule (no explicit URI here)
     if env:
         return env
     with _shared_lock:
@@ -254,14 +251,15 @@ class Node:
             MasterError, XmlRpcError: the master refused or cannot be reached.
             MsgError: unknown type.
         """
-        topic = resolve(topic, self.name)
+        topic = check_topic_name(topic, self.name)
         md5, definition = self._type_info(type_name, md5sum, message_definition)
         with self._lock:
             if self.is_shutdown:
                 raise GraphError(f"node {self.name} is shut down")
             if topic in self.publishers:
                 raise GraphError(f"{self.name} already publishes {topic}; use the existing publisher")
-            pub = Publisher(self, topic, type_name, md5, definition, queue_size=queue_size, latch=latch)
+            pub = Publisher(self._context(), topic, type_name, md5, definition,
+                            queue_size=queue_size, latch=latch)
             self.publishers[topic] = pub
         try:
             self._master("registerPublisher", topic, type_name, self.uri)
@@ -271,15 +269,22 @@ class Node:
             raise
         return pub
 
-    def _unadvertise(self, pub: Publisher) -> None:
+    def _context(self) -> TopicContext:
+        """What this node's publishers and subscribers may use of it."""
+        return TopicContext(self.name, self.trace, self.registry, self._leave)
+
+    def _leave(self, topic_object: Publisher | Subscriber) -> None:
+        """Forget a publisher or subscriber and tell the master (it closes itself)."""
+        table: dict[str, Any] = (self.publishers if isinstance(topic_object, Publisher)
+                                 else self.subscribers)
+        method = "unregisterPublisher" if isinstance(topic_object, Publisher) else "unregisterSubscriber"
         with self._lock:
-            if self.publishers.get(pub.topic) is pub:
-                del self.publishers[pub.topic]
+            if table.get(topic_object.topic) is topic_object:
+                del table[topic_object.topic]
         try:
-            self._master("unregisterPublisher", pub.topic, self.uri)
+            self._master(method, topic_object.topic, self.uri)
         except GraphError:
             pass
-        pub._close()
 
     def _lookup_spec(self, topic: str) -> TopicSpec | None:
         pub = self.publishers.get(topic)
@@ -309,7 +314,7 @@ class Node:
             GraphError: already subscribed to this topic in this node.
             MasterError, XmlRpcError: the master refused or cannot be reached.
         """
-        topic = resolve(topic, self.name)
+        topic = check_topic_name(topic, self.name)
         md5, definition = self._type_info(type_name, md5sum, None)
         if type_name == "*" and not raw:
             raise GraphError("subscribing with type '*' needs raw=True (nothing to deserialize with)")
@@ -318,7 +323,8 @@ class Node:
                 raise GraphError(f"node {self.name} is shut down")
             if topic in self.subscribers:
                 raise GraphError(f"{self.name} already subscribes to {topic}")
-            sub = Subscriber(self, topic, type_name, md5, callback, raw=raw, queue_size=queue_size,
+            sub = Subscriber(self._context(), topic, type_name, md5, callback, raw=raw,
+                             queue_size=queue_size,
                              tcp_nodelay=tcp_nodelay,
                              message_definition=definition if send_definition else None,
                              max_frame=max_frame, max_publishers=max_publishers)
@@ -328,9 +334,9 @@ class Node:
         except Exception:
             with self._lock:
                 self.subscribers.pop(topic, None)
-            sub._close()
+            sub.close()
             raise
-        sub._update_publishers([u for u in pubs if isinstance(u, str)])
+        sub.update_publishers([u for u in pubs if isinstance(u, str)])
         return sub
 
     def register_again(self) -> None:
@@ -352,17 +358,7 @@ class Node:
             self._master("registerPublisher", pub.topic, pub.type_name, self.uri)
         for sub in subs:
             uris = self._master("registerSubscriber", sub.topic, sub.type_name, self.uri)
-            sub._update_publishers([u for u in uris if isinstance(u, str)], keep_live=True)
-
-    def _unsubscribe(self, sub: Subscriber) -> None:
-        with self._lock:
-            if self.subscribers.get(sub.topic) is sub:
-                del self.subscribers[sub.topic]
-        try:
-            self._master("unregisterSubscriber", sub.topic, self.uri)
-        except GraphError:
-            pass
-        sub._close()
+            sub.update_publishers([u for u in uris if isinstance(u, str)], keep_live=True)
 
     # ------------------------------------------------------------------ TCPROS server
     def _accept_loop(self) -> None:
@@ -412,7 +408,7 @@ class Node:
         hs = PublisherHandshake(callerid=self.name, lookup=self._lookup_spec, peer=peer)
         deadline = time.monotonic() + HANDSHAKE_TIMEOUT
         src = peer
-        while hs.state == "AWAIT_HEADER":
+        while hs.state is State.AWAIT_HEADER:
             left = deadline - time.monotonic()
             if left <= 0:
                 events = hs.timeout()
@@ -442,7 +438,7 @@ class Node:
                     if pub is None:
                         return False
                     # the link sends our header, then frames: nothing published from now on is lost
-                    return pub._add_link(conn, conn_id, src, ev.tcp_nodelay, ev.reply)
+                    return pub.attach(conn, conn_id, src, hs, ev.tcp_nodelay, ev.reply)
                 elif isinstance(ev, Closed):
                     return False
         return False
@@ -488,7 +484,7 @@ class Node:
         sub = self.subscribers.get(topic)
         if sub is None:
             return 1, f"not subscribed to {topic}", 0
-        sub._update_publishers(publishers)
+        sub.update_publishers(publishers)
         return 1, "", 0
 
     @checked((("topic", "topic"), ("protocols", "list")), [])
@@ -509,8 +505,8 @@ class Node:
                     info.append([link.conn, link.peer, "o", "TCPROS", pub.topic, True,
                                  f"TCPROS connection on port {self.tcpros_port} to [{link.peer}]"])
         for sub in list(self.subscribers.values()):
-            for uri, link in list(sub._links.items()):
-                info.append([0, uri, "i", "TCPROS", sub.topic, link.connected,
+            for uri, connected in sub.publisher_links():
+                info.append([0, uri, "i", "TCPROS", sub.topic, connected,
                              f"TCPROS connection to [{uri}]"])
         return 1, "bus info", info
 
@@ -522,8 +518,8 @@ class Node:
             pubs.append([pub.topic, st.bytes, [[l.conn, l.bytes, l.frames, l.connected] for l in st.links]])
         subs = []
         for sub in list(self.subscribers.values()):
-            st = sub.stats
-            subs.append([sub.topic, [[0, st.bytes, st.drops, st.connections > 0]]])
+            sub_st = sub.stats
+            subs.append([sub.topic, [[0, sub_st.bytes, sub_st.drops, sub_st.connections > 0]]])
         return 1, "", [pubs, subs, []]
 
     # ------------------------------------------------------------------ shutdown
@@ -548,10 +544,10 @@ class Node:
             subs = list(self.subscribers.values())
             self.publishers.clear()
             self.subscribers.clear()
-        for sub in subs:
-            self._unsubscribe(sub)
-        for pub in pubs:
-            self._unadvertise(pub)
+        topic_objects: list[Publisher | Subscriber] = [*subs, *pubs]
+        for topic_object in topic_objects:
+            self._leave(topic_object)
+            topic_object.close()
         hard_close(self._tcp)
         with self._lock:
             pending = list(self._pending)

@@ -1,7 +1,11 @@
 """A topic publisher: one queue and one writer thread per connected subscriber.
 
 How it works: the node's TCPROS server runs the publisher side of the handshake; a
-successful one hands the socket to :meth:`Publisher._add_link`. Each link owns a bounded
+successful one hands the socket and the handshake machine (now ``STREAMING``) to
+:meth:`Publisher.attach`. Every frame goes out through that machine
+(:meth:`~rosfpga_lab.tcpros.PublisherHandshake.send_parts`), and the subscriber hanging up or
+the publisher closing runs its ``eof``/``close`` rows, so the table the notebooks draw is the
+one a running node follows. Each link owns a bounded
 queue (``queue_size``; when full the oldest frame is dropped and counted, as roscpp's
 ``TransportSubscriberLink`` does), a writer thread that sends frames, and a reader thread
 whose only job is to notice the subscriber hanging up. ``publish()`` serializes once and
@@ -17,14 +21,14 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from rosfpga_lab.graph.errors import JOIN_TIMEOUT, MAX_CLOSED_LINKS_KEPT, GraphError
-from rosfpga_lab.graph.wire import hard_close, send_frame, set_nodelay, socket_ends
-from rosfpga_lab.tcpros import TopicSpec
+from rosfpga_lab.graph.errors import GraphError
+from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MAX_CLOSED_LINKS_KEPT
+from rosfpga_lab.graph.topic import TopicContext
+from rosfpga_lab.graph.wire import hard_close, send_parts, set_nodelay, socket_ends
+from rosfpga_lab.tcpros import PublisherHandshake, TopicSpec, publisher_reply_fields
 
 if TYPE_CHECKING:
     import socket
-
-    from rosfpga_lab.graph.node import Node
 
 
 @dataclass
@@ -41,8 +45,9 @@ class LinkStats:
 
 class _SubscriberLink:
     def __init__(self, pub: Publisher, sock: socket.socket, conn_id: int, peer: str,
-                 tcp_nodelay: bool, header: bytes) -> None:
+                 handshake: PublisherHandshake, tcp_nodelay: bool, header: bytes) -> None:
         self.pub = pub
+        self.handshake = handshake  # STREAMING: every frame, the eof and the close run through it
         self.header = header
         self.sock = sock
         self.stats = LinkStats(conn_id, peer)
@@ -62,7 +67,7 @@ class _SubscriberLink:
         self.writer.start()
         self.reader.start()
 
-    def enqueue(self, body: bytes | memoryview) -> None:
+    def enqueue(self, body: bytes | bytearray | memoryview) -> None:
         with self.cond:
             if self.closed:
                 return
@@ -74,16 +79,16 @@ class _SubscriberLink:
             self.cond.notify()
 
     def _write_loop(self) -> None:
-        node = self.pub.node
+        ctx = self.pub.context
         t0 = time.time()
         try:
             self.sock.sendall(self.header)  # our connection header goes before any frame
         except OSError:
-            self.close()
+            self.close(by_peer=True)
             return
-        node.trace.record("tcpros_header", node.name, role="out", src=node.name, dst=self.stats.peer,
-                          method=self.pub.topic, args=self.pub.node_reply_fields(), raw=self.header,
-                          size=len(self.header), conn=self.stats.conn, t0=t0, **self.ends)
+        ctx.trace.record("tcpros_header", ctx.name, role="out", src=ctx.name, dst=self.stats.peer,
+                         method=self.pub.topic, args=self.pub.node_reply_fields(), raw=self.header,
+                         size=len(self.header), conn=self.stats.conn, t0=t0, **self.ends)
         while True:
             with self.cond:
                 while not self.queue and not self.closed:
@@ -91,18 +96,20 @@ class _SubscriberLink:
                 if self.closed:
                     return
                 body = self.queue.popleft()
+                prefix, view = self.handshake.send_parts(body)  # the table's STREAMING --send-->
             t0 = time.time()
             try:
-                size = send_frame(self.sock, body)
+                size = send_parts(self.sock, prefix, view)
             except OSError:
-                self.close()
+                self.close(by_peer=True)
                 return
             self.stats.frames += 1
             self.stats.bytes += size
-            if node.trace.frames:
-                node.trace.record(
-                    "tcpros_frame", node.name, role="out", src=node.name, dst=self.stats.peer,
-                    method=self.pub.topic, raw=node.trace.frame_raw(body), size=size, conn=self.stats.conn, index=self.stats.frames - 1, t0=t0,
+            if ctx.trace.frames:
+                ctx.trace.record(
+                    "tcpros_frame", ctx.name, role="out", src=ctx.name, dst=self.stats.peer,
+                    method=self.pub.topic, raw=ctx.trace.frame_raw(body), size=size,
+                    conn=self.stats.conn, index=self.stats.frames - 1, t0=t0,
                     **self.ends)
 
     def _read_loop(self) -> None:
@@ -112,19 +119,25 @@ class _SubscriberLink:
                     break
         except OSError:
             pass
-        self.close()
+        self.close(by_peer=True)
 
-    def close(self) -> None:
+    def close(self, by_peer: bool = False) -> None:
+        """End the link: the subscriber hung up (``by_peer``: the table's ``eof``) or we do
+        (``close``)."""
         with self.cond:
             if self.closed:
                 return
             self.closed = True
             self.stats.connected = False
+            if by_peer:
+                self.handshake.receive_eof()
+            else:
+                self.handshake.close()
             self.cond.notify_all()
         hard_close(self.sock)
-        node = self.pub.node
-        node.trace.record("tcp_close", node.name, role="out", src=node.name, dst=self.stats.peer,
-                          method=self.pub.topic, conn=self.stats.conn, **self.ends)
+        ctx = self.pub.context
+        ctx.trace.record("tcp_close", ctx.name, role="out", src=ctx.name, dst=self.stats.peer,
+                         method=self.pub.topic, conn=self.stats.conn, **self.ends)
         self.pub._remove_link(self)
 
     def join(self, timeout: float) -> None:
@@ -145,11 +158,15 @@ class PublisherStats:
 
 
 class Publisher:
-    """Publishes one topic. Create with :meth:`Node.advertise`, not directly."""
+    """Publishes one topic. Create with :meth:`Node.advertise`, not directly.
 
-    def __init__(self, node: Node, topic: str, type_name: str, md5sum: str,
+    Args:
+        context: what the publisher may use of its node (:class:`TopicContext`).
+    """
+
+    def __init__(self, context: TopicContext, topic: str, type_name: str, md5sum: str,
                  message_definition: str, *, queue_size: int, latch: bool) -> None:
-        self.node = node
+        self.context = context
         self.topic = topic
         self.type_name = type_name
         self.md5sum = md5sum
@@ -160,7 +177,7 @@ class Publisher:
         self._links: list[_SubscriberLink] = []
         self._all_links: list[_SubscriberLink] = []
         self._lock = threading.Lock()
-        self._last: bytes | memoryview | None = None
+        self._last: bytes | bytearray | memoryview | None = None
         self._frames = 0
         self._bytes = 0
         self.closed = False
@@ -175,7 +192,7 @@ class Publisher:
         """
         from rosfpga_lab.msg import serialize
 
-        self.publish_body(serialize(self.node.registry, self.type_name, value))
+        self.publish_body(serialize(self.context.registry, self.type_name, value))
 
     def publish_body(self, body: bytes | bytearray | memoryview) -> None:
         """Publish an already serialized body (no frame length): the raw bytes path.
@@ -195,15 +212,15 @@ class Publisher:
 
     def node_reply_fields(self) -> dict[str, str]:
         """The header fields this publisher answers subscribers with."""
-        return {"callerid": self.node.name, "latching": "1" if self.latch else "0",
-                "md5sum": self.md5sum, "message_definition": self.message_definition,
-                "topic": self.topic, "type": self.type_name}
+        return publisher_reply_fields(self.context.name, self.spec)
 
     # ----------------------------------------------------------------- links
-    def _add_link(self, sock: socket.socket, conn_id: int, peer: str, tcp_nodelay: bool,
-                  header: bytes) -> bool:
-        """Take over a socket whose handshake succeeded; ``header`` is our reply, sent first."""
-        link = _SubscriberLink(self, sock, conn_id, peer, tcp_nodelay, header)
+    def attach(self, sock: socket.socket, conn_id: int, peer: str,
+               handshake: PublisherHandshake, tcp_nodelay: bool, header: bytes) -> bool:
+        """Take over a socket whose handshake succeeded (``handshake`` is ``STREAMING``);
+        ``header`` is our reply, sent first. Returns False when the publisher is closed (the
+        caller then closes the socket)."""
+        link = _SubscriberLink(self, sock, conn_id, peer, handshake, tcp_nodelay, header)
         with self._lock:
             if self.closed:
                 return False
@@ -247,9 +264,12 @@ class Publisher:
 
     def unregister(self) -> None:
         """Stop publishing: unregister from the master and close every link."""
-        self.node._unadvertise(self)
+        self.context.leave(self)
+        self.close()
 
-    def _close(self) -> None:
+    def close(self) -> None:
+        """Close every link (the node calls this on shutdown; :meth:`unregister` also tells
+        the master)."""
         with self._lock:
             self.closed = True
             links = list(self._links)

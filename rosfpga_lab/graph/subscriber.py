@@ -29,15 +29,14 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from rosfpga_lab.graph.errors import (
+from rosfpga_lab.graph.errors import GraphError, MasterError
+from rosfpga_lab.graph.limits import (
     CONNECT_TIMEOUT,
     JOIN_TIMEOUT,
     MAX_ERRORS_KEPT,
     RECONNECT_FACTOR,
     RECONNECT_FIRST,
     RECONNECT_MAX,
-    GraphError,
-    MasterError,
 )
 from rosfpga_lab.graph.trace import new_connection_id
 from rosfpga_lab.graph.wire import RECV_CHUNK, hard_close, set_nodelay, socket_ends
@@ -52,11 +51,12 @@ from rosfpga_lab.tcpros import (
     HeaderReceived,
     ProtocolError,
     RemoteError,
+    State,
     SubscriberHandshake,
 )
 
 if TYPE_CHECKING:
-    from rosfpga_lab.graph.node import Node
+    from rosfpga_lab.graph.topic import TopicContext
 
 log = logging.getLogger("rosfpga_lab.graph")
 
@@ -128,7 +128,7 @@ class _PublisherLink:
             self.sock = None
 
     def _connect_once(self) -> bool:
-        sub, node = self.sub, self.sub.node
+        sub, node = self.sub, self.sub.context
         reply = call(self.pub_uri, "requestTopic", node.name, sub.topic, [["TCPROS"]],
                      trace=node.trace, caller=node.name, timeout=CONNECT_TIMEOUT)
         if not (isinstance(reply, list) and len(reply) == 3 and reply[0] == 1):
@@ -163,10 +163,10 @@ class _PublisherLink:
                           args=dict(hs.fields), raw=request, size=len(request), conn=conn, t0=t0,
                           **ends)
         deadline = time.monotonic() + HANDSHAKE_TIMEOUT
-        publisher, header = peer, {}
+        publisher, header = peer, dict[str, str]()
         got = False
         while not self.stop.is_set():
-            if hs.state == "AWAIT_HEADER":
+            if hs.state is State.AWAIT_HEADER:
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     hs.timeout()
@@ -227,13 +227,17 @@ class _PublisherLink:
 
 
 class Subscriber:
-    """Subscribes to one topic. Create with :meth:`Node.subscribe`, not directly."""
+    """Subscribes to one topic. Create with :meth:`Node.subscribe`, not directly.
 
-    def __init__(self, node: Node, topic: str, type_name: str, md5sum: str,
+    Args:
+        context: what the subscriber may use of its node (:class:`TopicContext`).
+    """
+
+    def __init__(self, context: TopicContext, topic: str, type_name: str, md5sum: str,
                  callback: Callable[..., Any] | None, *, raw: bool, queue_size: int,
                  tcp_nodelay: bool, message_definition: str | None, max_frame: int,
                  max_publishers: int) -> None:
-        self.node = node
+        self.context = context
         self.topic = topic
         self.type_name = type_name
         self.md5sum = md5sum
@@ -256,8 +260,9 @@ class Subscriber:
         self._dispatcher.start()
 
     # ----------------------------------------------------------------- publishers
-    def _update_publishers(self, uris: list[str], *, keep_live: bool = False) -> None:
-        """Make the links follow the master's publisher list ``uris``.
+    def update_publishers(self, uris: list[str], *, keep_live: bool = False) -> None:
+        """Make the links follow the master's publisher list ``uris`` (``registerSubscriber``'s
+        reply, ``publisherUpdate``): new ones are connected, vanished ones closed.
 
         With ``keep_live`` (a restarted master's first list), a connected link whose publisher
         is not listed is kept (see the module docstring) instead of closed.
@@ -272,14 +277,14 @@ class Subscriber:
                 kept = (old + new)[:self.max_publishers]
                 text = (f"{len(wanted)} publishers listed for {self.topic}; linking to "
                         f"{len(kept)} (max_publishers), ignoring {len(wanted) - len(kept)}")
-                log.warning("%s: %s", self.node.name, text)
+                log.warning("%s: %s", self.context.name, text)
                 self._error(text)
                 keep = set(kept)
                 wanted = [u for u in wanted if u in keep]
             for uri in [u for u in self._links if u not in wanted]:
-                link = self._links[uri]
-                if link.kept or keep_live and link.connected:
-                    link.kept = True
+                stale = self._links[uri]
+                if stale.kept or keep_live and stale.connected:
+                    stale.kept = True
                     continue
                 self._links.pop(uri).close()
             for uri in wanted:
@@ -287,9 +292,9 @@ class Subscriber:
                 if link is not None:
                     link.kept = False   # the master lists it again: an ordinary link
                 if link is None or not link.thread.is_alive() and link.permanent_error is None:
-                    link = _PublisherLink(self, uri)
-                    self._links[uri] = link
-                    link.thread.start()
+                    fresh = _PublisherLink(self, uri)
+                    self._links[uri] = fresh
+                    fresh.thread.start()
 
     def _forget(self, link: _PublisherLink) -> bool:
         """Drop a kept link whose connection ended; False when the master listed it meanwhile."""
@@ -309,13 +314,13 @@ class Subscriber:
         with self._cond:
             self._stats.errors.append(text)
             del self._stats.errors[:-MAX_ERRORS_KEPT]
-        self.node.trace.record("error", self.node.name, src=self.node.name, method=self.topic,
-                               result=text)
+        self.context.trace.record("error", self.context.name, src=self.context.name,
+                                  method=self.topic, result=text)
 
     # ----------------------------------------------------------------- delivery
     def _deliver(self, body: bytes | memoryview, info: MessageInfo, offset: int,
                  ends: dict[str, str] | None = None) -> None:
-        node = self.node
+        node = self.context
         if node.trace.frames:
             node.trace.record("tcpros_frame", node.name, role="in", src=info.publisher,
                               dst=node.name, method=self.topic,
@@ -343,7 +348,7 @@ class Subscriber:
                     return
                 body, info = self._queue.popleft()
             try:
-                value = body if self.raw else deserialize(self.node.registry, self.type_name, body)
+                value = body if self.raw else deserialize(self.context.registry, self.type_name, body)
             except LabError as exc:
                 self._error(f"cannot deserialize frame #{info.index} from {info.publisher}: {exc}")
                 continue
@@ -370,6 +375,11 @@ class Subscriber:
             s = self._stats
             return SubscriberStats(s.frames, s.bytes, s.drops, s.connections, s.callback_errors,
                                    list(s.errors))
+
+    def publisher_links(self) -> list[tuple[str, bool]]:
+        """``(publisher XML-RPC URI, connected)`` of every publisher linked to now."""
+        with self._lock:
+            return [(uri, link.connected) for uri, link in self._links.items()]
 
     def get_num_connections(self) -> int:
         """Publishers connected right now."""
@@ -406,9 +416,12 @@ class Subscriber:
 
     def unregister(self) -> None:
         """Stop: unregister from the master, close every connection."""
-        self.node._unsubscribe(self)
+        self.context.leave(self)
+        self.close()
 
-    def _close(self) -> None:
+    def close(self) -> None:
+        """Close every connection and stop the dispatcher (the node calls this on shutdown;
+        :meth:`unregister` also tells the master)."""
         with self._lock:
             self.closed = True
             links = list(self._links.values())

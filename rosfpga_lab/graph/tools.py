@@ -6,28 +6,24 @@ The CLI modules stay thin and call these; notebooks can call them too.
 from __future__ import annotations
 
 import math
-import statistics
 import time
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
+from rosfpga_lab.config.master import master_uri
 from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcTooLargeError
-from rosfpga_lab.graph.names import master_uri_from_env
+from rosfpga_lab.graph.limits import MAX_ARRAY_SHOWN, TOPIC_POLL
+from rosfpga_lab.graph.rate import RateMeter  # noqa: F401  (rostopic hz's meter, re-exported)
 from rosfpga_lab.graph.xmlrpc import call
 
-DEFAULT_MASTER_URI = "http://127.0.0.1:11311/"
-#: Arrays longer than this are summarised by :func:`format_message` (rostopic echo --noarr style).
-MAX_ARRAY_SHOWN = 64
 TOOL_ID = "/rosfpga_lab_topic"
-#: Seconds between two asks of the master while waiting for a topic to appear (rostopic: 0.1).
-TOPIC_POLL = 0.1
 
 
 def pick_master_uri(explicit: str | None = None) -> str:
-    """``explicit``, else ROS_MASTER_URI, else roscore's default http://127.0.0.1:11311/."""
-    return explicit or master_uri_from_env() or DEFAULT_MASTER_URI
+    """``explicit``, else ROS_MASTER_URI, else roscore's default (:func:`rosfpga_lab.config.master_uri`)."""
+    return master_uri(explicit)
 
 
 def master_call(uri: str, method: str, *args: Any) -> Any:
@@ -227,32 +223,3 @@ def _merge(into: dict, new: dict, where: str) -> None:
             _merge(into[k], v, f"{where}.{k}")
         else:
             into[k] = v
-
-
-class RateMeter:
-    """``rostopic hz``: arrival times in a sliding window -> rate and interval statistics."""
-
-    def __init__(self, window: int = 1000) -> None:
-        self.window = window
-        self.times: list[float] = []
-        self.count = 0
-        self.reported = 0   # count at the last report
-
-    def tick(self, t: float | None = None) -> None:
-        """Record one arrival (now by default)."""
-        self.times.append(time.monotonic() if t is None else t)
-        self.count += 1
-        del self.times[:-self.window - 1]
-
-    def report(self) -> str | None:
-        """rostopic-style report; None (print "no new messages") before two messages arrived or
-        when none arrived since the last report (the old rate would hide that they stopped)."""
-        if len(self.times) < 2 or self.count == self.reported:
-            return None
-        self.reported = self.count
-        gaps = [b - a for a, b in zip(self.times, self.times[1:])]
-        mean = sum(gaps) / len(gaps)
-        std = statistics.pstdev(gaps)
-        rate = 1.0 / mean if mean > 0 else float("inf")
-        return (f"average rate: {rate:.3f}\n\tmin: {min(gaps):.3f}s max: {max(gaps):.3f}s "
-                f"std dev: {std:.5f}s window: {len(self.times)}")

@@ -56,7 +56,7 @@ from collections import deque
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
-from rosfpga_lab.graph.errors import TRACE_EXCERPT_BYTES, TRACE_MAX_BYTES, TRACE_MAX_EVENTS
+from rosfpga_lab.graph.limits import TRACE_EXCERPT_BYTES, TRACE_MAX_BYTES, TRACE_MAX_EVENTS
 
 KINDS = ("xmlrpc", "tcp_connect", "tcpros_header", "tcpros_frame", "tcp_close", "error")
 
@@ -89,8 +89,9 @@ def excerpt_value(value: Any) -> Any:
         if isinstance(v, (str, bytes, bytearray)):
             if len(v) <= _TEXT_KEPT:
                 return v
-            note = f"... ({len(v)} {'chars' if isinstance(v, str) else 'bytes'})"
-            return v[:_TEXT_KEPT] + (note if isinstance(v, str) else note.encode())
+            if isinstance(v, str):
+                return v[:_TEXT_KEPT] + f"... ({len(v)} chars)"
+            return bytes(v[:_TEXT_KEPT]) + f"... ({len(v)} bytes)".encode()
         if not isinstance(v, (list, tuple, dict)):
             return v
         if depth >= _DEPTH_KEPT:

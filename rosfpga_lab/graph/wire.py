@@ -7,7 +7,7 @@ import socket
 import time
 from collections.abc import Callable
 
-from rosfpga_lab.graph.errors import ACCEPT_BACKOFF_FIRST, ACCEPT_BACKOFF_MAX, ACCEPT_LOG_INTERVAL
+from rosfpga_lab.graph.limits import ACCEPT_BACKOFF_FIRST, ACCEPT_BACKOFF_MAX, ACCEPT_LOG_INTERVAL
 from rosfpga_lab.tcpros import frame_prefix
 
 log = logging.getLogger("rosfpga_lab.graph")
@@ -22,8 +22,13 @@ RECV_CHUNK = 1 << 16
 def send_frame(sock: socket.socket, body: bytes | bytearray | memoryview) -> int:
     """Send a 4-byte length prefix and ``body`` without joining them; return bytes sent."""
     view = memoryview(body).cast("B")
-    parts = [memoryview(frame_prefix(len(view))), view]
-    total = 4 + len(view)
+    return send_parts(sock, frame_prefix(len(view)), view)
+
+
+def send_parts(sock: socket.socket, *pieces: bytes | memoryview) -> int:
+    """Send ``pieces`` one after the other with vectored writes (no joining); return bytes sent."""
+    parts = [memoryview(p).cast("B") for p in pieces if len(p)]
+    total = sum(len(p) for p in parts)
     sent_total = 0
     while parts:
         sent = sock.sendmsg(parts)

@@ -27,7 +27,8 @@ from typing import Any
 
 from defusedxml.xmlrpc import DefusedExpatParser
 
-from rosfpga_lab.graph.errors import (
+from rosfpga_lab.graph.errors import ConfigError, XmlRpcError, XmlRpcTooLargeError
+from rosfpga_lab.graph.limits import (
     JOIN_TIMEOUT,
     MAX_HTTP_HEAD,
     MAX_XMLRPC_BODY,
@@ -37,9 +38,6 @@ from rosfpga_lab.graph.errors import (
     XMLRPC_IDLE_TIMEOUT,
     XMLRPC_REQUEST_TIMEOUT,
     XMLRPC_TIMEOUT,
-    ConfigError,
-    XmlRpcError,
-    XmlRpcTooLargeError,
 )
 from rosfpga_lab.graph.trace import Trace
 from rosfpga_lab.graph.wire import accept_loop, hard_close, socket_ends
@@ -560,7 +558,7 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
                          **ends)
         if isinstance(exc, XmlRpcTooLargeError):  # the server answered: say so, not "failed"
             raise XmlRpcTooLargeError(f"XML-RPC call {method} to {uri}: the reply's {exc} "
-                                      "(graph.errors.MAX_XMLRPC_REPLY)") from None
+                                      "(graph.limits.MAX_XMLRPC_REPLY)") from None
         raise XmlRpcError(f"XML-RPC call {method} to {uri} failed: {exc}") from None
     if trace is not None:
         ev = trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or trace.name_of(uri),

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from rosfpga_lab.hls.errors import CsimError
+from rosfpga_lab.hls.limits import BUILD_TIMEOUT, RUN_TIMEOUT
 from rosfpga_lab.hw import Beats
 
 #: The flags and sources of the generated Makefile (also used directly when make is missing).
@@ -26,9 +27,6 @@ CXXFLAGS = ("-std=c++14", "-Wall", "-Werror", "-O2")
 SOURCES = ("subscriber.cpp", "publisher.cpp", "image_filter.cpp", "ros_fpga_node.cpp",
            "connection_headers.cpp", "csim_testbench.cpp")
 BINARY = "csim_testbench"
-#: Seconds allowed for one build and for one run.
-BUILD_TIMEOUT = 300.0
-RUN_TIMEOUT = 300.0
 
 
 @dataclass(frozen=True)

@@ -27,14 +27,14 @@ import jinja2
 import numpy as np
 
 from rosfpga_lab import __version__
-from rosfpga_lab.config import NodeConfig
+from rosfpga_lab.config import CUSTOM, PASSTHROUGH, NodeConfig
 from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, SOURCES
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, SUBSCRIBER_STATUSES, fixed_after
 from rosfpga_lab.msg import default_registry
-from rosfpga_lab.tcpros import encode_header
+from rosfpga_lab.tcpros import TopicSpec, encode_header, publisher_reply_fields, subscriber_request_fields
 
 TEMPLATES_DIR = Path(__file__).resolve().parent / "templates"
 INCLUDE_DIR = Path(__file__).resolve().parent / "include"
@@ -99,9 +99,10 @@ def subscriber_header_fields(config: NodeConfig) -> dict[str, str]:
     """
     reg = default_registry()
     t = config.subscriber.type
-    return {"callerid": config.node.global_name, "md5sum": reg.md5(t),
-            "message_definition": reg.full_text(t), "tcp_nodelay": "1",
-            "topic": config.subscriber.topic, "type": t}
+    return subscriber_request_fields(callerid=config.node.global_name,
+                                     topic=config.subscriber.topic, md5sum=reg.md5(t),
+                                     type_name=t, message_definition=reg.full_text(t),
+                                     tcp_nodelay=True)
 
 
 def publisher_header_fields(config: NodeConfig) -> dict[str, str]:
@@ -115,8 +116,8 @@ def publisher_header_fields(config: NodeConfig) -> dict[str, str]:
     """
     reg = default_registry()
     t = config.publisher.type
-    return {"callerid": config.node.global_name, "latching": "0", "md5sum": reg.md5(t),
-            "message_definition": reg.full_text(t), "topic": config.publisher.topic, "type": t}
+    return publisher_reply_fields(config.node.global_name,
+                                  TopicSpec(config.publisher.topic, t, reg.md5(t), reg.full_text(t)))
 
 
 def _hex_rows(data: bytes) -> list[str]:
@@ -138,9 +139,9 @@ def _header_context(title: str, array: str, function: str, fields: dict[str, str
 
 def _app_summary(config: NodeConfig) -> str:
     app = config.application
-    if app.op == "custom":
+    if app.op == CUSTOM:
         return f"the user's image_filter() from {app.source.name if app.source else '?'}"
-    if app.op == "passthrough":
+    if app.op == PASSTHROUGH:
         return "pass-through, no processing"
     return f"{app.ksize}x{app.ksize} {app.op}"
 
@@ -167,7 +168,7 @@ def sample_frames(config: NodeConfig) -> tuple[bytes, bytes]:
     """The testbench's input frame and the output frame the Python models give for it."""
     frame = image_frame(sample_image(config), config.image.encoding, seq=7,
                         stamp=(1_700_000_000, 123_456_789), frame_id="camera")
-    if config.application.op == "custom":
+    if config.application.op == CUSTOM:
         return frame, b""
     return frame, Pipeline.from_config(config).process(frame).output_frame
 
@@ -209,7 +210,7 @@ def render(config: NodeConfig) -> dict[str, str]:
         "after_frame_id": fixed_after("frame_id"), "after_encoding": fixed_after("encoding"),
         "tb_input": TB_INPUT, "cxxflags": CXXFLAGS, "rtl": config.application.op != "custom", "csim_sources": SOURCES,
         "design_sources": [src for src in SOURCES if src != f"{BINARY}.cpp"],
-        "tb_expected": TB_EXPECTED if config.application.op != "custom" else "",
+        "tb_expected": TB_EXPECTED if config.application.op != CUSTOM else "",
         "headers": [
             _header_context(f"Subscriber: sent to each publisher of {config.subscriber.topic}",
                             "SUBSCRIBER_HEADER", "subscriber_connection_header",
@@ -225,7 +226,7 @@ def render(config: NodeConfig) -> dict[str, str]:
     )
     out: dict[str, str] = {}
     for target, template in TEMPLATE_FILES.items():
-        if target == "image_filter.cpp" and config.application.op == "custom":
+        if target == "image_filter.cpp" and config.application.op == CUSTOM:
             assert config.application.source is not None
             try:
                 out[target] = config.application.source.read_text(encoding="utf-8")

@@ -55,7 +55,8 @@ from rosfpga_lab.hw.faults import (
 )
 from rosfpga_lab.hw.generator import GENERATOR_TABLE, frame_length, generate_fast, generate_reference
 from rosfpga_lab.hw.interpreter import (
-    INTERPRETER_TABLE, ImageFields, Interpreter, Transition, format_table, interpret_fast,
+    INTERPRETER_TABLE, Check, ImageFields, Interpreter, IState, Kind, Transition, format_table,
+    interpret_fast,
     interpret_reference,
 )
 from rosfpga_lab.hw.morph import OPS, morph_fast, morph_reference
@@ -69,9 +70,9 @@ from rosfpga_lab.hw.video import (
 
 __all__ = [
     "ERROR_IO_EOL_EARLY", "ERROR_IO_EOL_LATE", "ERROR_IO_SOF_EARLY", "GENERATOR_TABLE",
-    "INTERPRETER_TABLE", "OPS", "PIXEL_FORMATS", "Beat", "Beats", "ByteFIFO", "CycleReport",
+    "INTERPRETER_TABLE", "OPS", "PIXEL_FORMATS", "Beat", "Beats", "ByteFIFO", "Check", "CycleReport",
     "DropByte", "DuplicateByte", "Fault", "Fifo", "FifoOverflowError", "FrameFieldError",
-    "FrameLengthError", "FrameTruncatedError", "ImageFields", "Interpreter", "LoseTlast",
+    "FrameLengthError", "FrameTruncatedError", "IState", "ImageFields", "Interpreter", "Kind", "LoseTlast",
     "LoseTuser", "Mat", "Pipeline", "PipelineConfigError", "PipelineError", "PipelineResult", "wire_bytes",
     "PixelFormat", "ShallowFifo", "StreamStarvedError", "SwapByteOrder", "Transition",
     "UnsupportedEncodingError", "account", "axi2fifo_fast", "axi2fifo_reference",

@@ -31,6 +31,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from rosfpga_lab.config.vocabulary import PASSTHROUGH, canonical_op
 from rosfpga_lab.hw.encodings import PIXEL_FORMATS
 from rosfpga_lab.hw.interpreter import ImageFields
 from rosfpga_lab.hw.morph import flush_extent
@@ -79,7 +80,7 @@ def account(fields: ImageFields, op: str, ksize: tuple[int, int], in_frame_bytes
     pixels = rows * cols
     bpp = PIXEL_FORMATS[fields.encoding].bytes_per_pixel
     data = pixels * bpp
-    if op == "copy":
+    if canonical_op(op) == PASSTHROUGH:
         filt, filt_latency = pixels, 1
     else:
         dx, dy = flush_extent(ksize)

@@ -16,22 +16,22 @@ import struct
 import numpy as np
 
 from rosfpga_lab.hw.errors import StreamStarvedError
-from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, ImageFields
+from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, ImageFields, Kind
 from rosfpga_lab.hw.streams import ByteFIFO
 
-#: (label, kind, attribute of ImageFields) in wire order; kind as in the interpreter's table.
-GENERATOR_TABLE: tuple[tuple[str, str, str], ...] = (
-    ("frame length", "u32", "frame_length"),
-    ("header.seq", "u32", "seq"),
-    ("header.stamp.secs", "u32", "stamp_secs"),
-    ("header.stamp.nsecs", "u32", "stamp_nsecs"),
-    ("header.frame_id", "string", "frame_id"),
-    ("height", "u32", "height"),
-    ("width", "u32", "width"),
-    ("encoding", "string", "encoding"),
-    ("is_bigendian", "u8", "is_bigendian"),
-    ("step", "u32", "step"),
-    ("data", "pixels", "data_length"),
+#: (label, kind, attribute of ImageFields) in wire order; kinds are the interpreter's :class:`Kind`.
+GENERATOR_TABLE: tuple[tuple[str, Kind, str], ...] = (
+    ("frame length", Kind.U32, "frame_length"),
+    ("header.seq", Kind.U32, "seq"),
+    ("header.stamp.secs", Kind.U32, "stamp_secs"),
+    ("header.stamp.nsecs", Kind.U32, "stamp_nsecs"),
+    ("header.frame_id", Kind.STRING, "frame_id"),
+    ("height", Kind.U32, "height"),
+    ("width", Kind.U32, "width"),
+    ("encoding", Kind.STRING, "encoding"),
+    ("is_bigendian", Kind.U8, "is_bigendian"),
+    ("step", Kind.U32, "step"),
+    ("data", Kind.PIXELS, "data_length"),
 )
 
 
@@ -52,13 +52,13 @@ def generate_reference(fields: ImageFields, inp: ByteFIFO, out: ByteFIFO) -> Non
     """
     for label, kind, attr in GENERATOR_TABLE:
         value = frame_length(fields) if attr == "frame_length" else getattr(fields, attr)
-        if kind == "u32":
+        if kind is Kind.U32:
             for i in range(4):
                 out.write((value >> (8 * i)) & 0xFF)
-        elif kind == "u8":
+        elif kind is Kind.U8:
             out.write(value & 0xFF)
-        elif kind == "string":
-            raw = _text(value)
+        elif kind is Kind.STRING:
+            raw = _text(str(value))
             for i in range(4):
                 out.write((len(raw) >> (8 * i)) & 0xFF)
             for byte in raw:
@@ -91,4 +91,4 @@ def generate_fast(fields: ImageFields, data: np.ndarray) -> bytes:
         encoding,
         struct.pack("<BII", fields.is_bigendian & 0xFF, fields.step, fields.data_length),
     ))
-    return b"".join((head, np.ascontiguousarray(data[: fields.data_length])))
+    return b"".join((head, np.ascontiguousarray(data[: fields.data_length]).data))

@@ -7,8 +7,10 @@ field little-endian, checking it when complete, and writing the pixel bytes of `
 output :class:`~rosfpga_lab.hw.streams.ByteFIFO`.
 
 Each row of the table is a state: the field it collects, how long the field is (4 bytes for
-``u32``, 1 for ``u8``, or the value of an earlier length field for ``bytes``/``pixels``), the
-next state and the check run on the finished field. A zero-length string skips its state.
+``u32``, 1 for ``u8``, or the value of an earlier length field for ``string``/``pixels``), the
+next state and the check run on the finished field. States, field kinds and checks are names of
+one vocabulary each (:class:`IState`, :class:`Kind`, :class:`Check`); the message generator and
+the HLS templates use the same :class:`Kind` names. A zero-length string skips its state.
 
 On a bad field the interpreter raises a :class:`~rosfpga_lab.hw.errors.FrameFieldError` naming
 field and byte offset, then resynchronises: if the frame length was sane it skips the rest of
@@ -20,7 +22,9 @@ over the header and takes the pixel bytes as one numpy slice.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Any
 
 import numpy as np
@@ -36,6 +40,56 @@ from rosfpga_lab.hw.streams import ByteFIFO
 STAGE = "interpreter"
 
 
+class _Name(StrEnum):
+    """A name of the tables' vocabulary: equal to its text and shown as it (like h11's sentinels)."""
+
+    def __repr__(self) -> str:
+        return self.value
+
+
+class Kind(_Name):
+    """How a field sits in the frame (the interpreter's and the generator's one vocabulary)."""
+
+    U32 = "u32"        # 4 bytes, little-endian
+    U8 = "u8"          # 1 byte
+    STRING = "string"  # a string's bytes (its uint32 length is the field before)
+    PIXELS = "pixels"  # the image bytes of ``data`` (its length is the field before)
+
+
+class IState(_Name):
+    """States of the interpreter: one per field, plus SKIP (the rest of a refused frame)."""
+
+    FRAME_LEN = "FRAME_LEN"
+    SEQ = "SEQ"
+    STAMP_SECS = "STAMP_SECS"
+    STAMP_NSECS = "STAMP_NSECS"
+    FRAME_ID_LEN = "FRAME_ID_LEN"
+    FRAME_ID = "FRAME_ID"
+    HEIGHT = "HEIGHT"
+    WIDTH = "WIDTH"
+    ENCODING_LEN = "ENCODING_LEN"
+    ENCODING = "ENCODING"
+    IS_BIGENDIAN = "IS_BIGENDIAN"
+    STEP = "STEP"
+    DATA_LEN = "DATA_LEN"
+    DATA = "DATA"
+    SKIP = "SKIP"
+
+
+class Check(_Name):
+    """The checks run when a field completes (each has one method of :class:`Interpreter`)."""
+
+    FRAME_LENGTH = "frame_length"
+    FRAME_ID_LENGTH = "frame_id_length"
+    HEIGHT = "height"
+    WIDTH = "width"
+    ENCODING_LENGTH = "encoding_length"
+    ENCODING = "encoding"
+    STEP = "step"
+    DATA_LENGTH = "data_length"
+    FRAME_END = "frame_end"
+
+
 @dataclass(frozen=True)
 class Transition:
     """One state of the interpreter.
@@ -44,39 +98,40 @@ class Transition:
         state: the state's name.
         field: key of the value in :attr:`Interpreter.values`.
         label: the field as error messages and notebooks name it.
-        kind: ``"u32"`` (4 bytes LE), ``"u8"``, ``"bytes"`` (a string's bytes) or ``"pixels"``.
-        length_of: for ``bytes``/``pixels``: the field whose value is the length.
+        kind: how the field sits in the frame (:class:`Kind`).
+        length_of: for ``string``/``pixels``: the field whose value is the length.
         next: the state after this one.
         check: name of the check run when the field is complete (``None``: no check).
     """
 
-    state: str
+    state: IState
     field: str
     label: str
-    kind: str
+    kind: Kind
     length_of: str | None
-    next: str
-    check: str | None
+    next: IState
+    check: Check | None
 
 
+_R, S, K, C = Transition, IState, Kind, Check
 INTERPRETER_TABLE: tuple[Transition, ...] = (
-    Transition("FRAME_LEN", "frame_length", "frame length", "u32", None, "SEQ", "frame_length"),
-    Transition("SEQ", "seq", "header.seq", "u32", None, "STAMP_SECS", None),
-    Transition("STAMP_SECS", "stamp_secs", "header.stamp.secs", "u32", None, "STAMP_NSECS", None),
-    Transition("STAMP_NSECS", "stamp_nsecs", "header.stamp.nsecs", "u32", None, "FRAME_ID_LEN", None),
-    Transition("FRAME_ID_LEN", "frame_id_length", "header.frame_id length", "u32", None, "FRAME_ID",
-               "frame_id_length"),
-    Transition("FRAME_ID", "frame_id", "header.frame_id", "bytes", "frame_id_length", "HEIGHT", None),
-    Transition("HEIGHT", "height", "height", "u32", None, "WIDTH", "height"),
-    Transition("WIDTH", "width", "width", "u32", None, "ENCODING_LEN", "width"),
-    Transition("ENCODING_LEN", "encoding_length", "encoding length", "u32", None, "ENCODING",
-               "encoding_length"),
-    Transition("ENCODING", "encoding", "encoding", "bytes", "encoding_length", "IS_BIGENDIAN",
-               "encoding"),
-    Transition("IS_BIGENDIAN", "is_bigendian", "is_bigendian", "u8", None, "STEP", None),
-    Transition("STEP", "step", "step", "u32", None, "DATA_LEN", "step"),
-    Transition("DATA_LEN", "data_length", "data length", "u32", None, "DATA", "data_length"),
-    Transition("DATA", "data", "data", "pixels", "data_length", "FRAME_LEN", "frame_end"),
+    _R(S.FRAME_LEN, "frame_length", "frame length", K.U32, None, S.SEQ, C.FRAME_LENGTH),
+    _R(S.SEQ, "seq", "header.seq", K.U32, None, S.STAMP_SECS, None),
+    _R(S.STAMP_SECS, "stamp_secs", "header.stamp.secs", K.U32, None, S.STAMP_NSECS, None),
+    _R(S.STAMP_NSECS, "stamp_nsecs", "header.stamp.nsecs", K.U32, None, S.FRAME_ID_LEN, None),
+    _R(S.FRAME_ID_LEN, "frame_id_length", "header.frame_id length", K.U32, None, S.FRAME_ID,
+       C.FRAME_ID_LENGTH),
+    _R(S.FRAME_ID, "frame_id", "header.frame_id", K.STRING, "frame_id_length", S.HEIGHT, None),
+    _R(S.HEIGHT, "height", "height", K.U32, None, S.WIDTH, C.HEIGHT),
+    _R(S.WIDTH, "width", "width", K.U32, None, S.ENCODING_LEN, C.WIDTH),
+    _R(S.ENCODING_LEN, "encoding_length", "encoding length", K.U32, None, S.ENCODING,
+       C.ENCODING_LENGTH),
+    _R(S.ENCODING, "encoding", "encoding", K.STRING, "encoding_length", S.IS_BIGENDIAN,
+       C.ENCODING),
+    _R(S.IS_BIGENDIAN, "is_bigendian", "is_bigendian", K.U8, None, S.STEP, None),
+    _R(S.STEP, "step", "step", K.U32, None, S.DATA_LEN, C.STEP),
+    _R(S.DATA_LEN, "data_length", "data length", K.U32, None, S.DATA, C.DATA_LENGTH),
+    _R(S.DATA, "data", "data", K.PIXELS, "data_length", S.FRAME_LEN, C.FRAME_END),
 )
 #: The subscriber circuit's status codes, in code order: ``SUB_OK`` (0), then one per checked
 #: field of the table (``SUB_BAD_<FIELD>``), with the field's label. The generated HLS C++
@@ -85,9 +140,9 @@ SUBSCRIBER_STATUSES: tuple[tuple[str, str], ...] = (("SUB_OK", "frame accepted")
     (f"SUB_BAD_{t.field.upper()}", t.label) for t in INTERPRETER_TABLE
     if t.check and t.check != "frame_end")
 #: Extra state entered after an error when the rest of the bad frame can be skipped.
-SKIP_STATE = "SKIP"
+SKIP_STATE = IState.SKIP
 _BY_STATE = {t.state: t for t in INTERPRETER_TABLE}
-_FIXED = {"u32": 4, "u8": 1}
+_FIXED = {Kind.U32: 4, Kind.U8: 1}
 #: Bytes of an Image body with empty strings and no pixels (the smallest legal frame length).
 MIN_BODY_BYTES = 4 + 4 + 4 + 4 + 4 + 4 + 4 + 1 + 4 + 4
 
@@ -160,7 +215,7 @@ class Interpreter:
             configuration's ``frame_id_max``); a longer one is refused.
 
     Attributes:
-        state: the current state (a ``Transition.state``, or ``"SKIP"``).
+        state: the current state (a ``Transition.state``, or ``IState.SKIP``).
         offset: byte offset in the current frame of the next byte.
         values: the fields decoded so far in this frame.
         frames: how many frames were completed since construction.
@@ -188,7 +243,7 @@ class Interpreter:
     # -- state handling ---------------------------------------------------------------------
     def reset(self) -> None:
         """Back to waiting for a frame length (a synchronous reset of the state machine)."""
-        self.state = "FRAME_LEN"
+        self.state = IState.FRAME_LEN
         self.offset = 0
         self.values: dict[str, Any] = {}
         self._acc = 0            # little-endian accumulator of a number field
@@ -214,7 +269,7 @@ class Interpreter:
             FrameFieldError: (or a subclass) a field has a value the circuit refuses; the
                 interpreter has already resynchronised.
         """
-        if self.state == SKIP_STATE:
+        if self.state is IState.SKIP:
             self._skip -= 1
             if self._skip == 0:
                 self.reset()
@@ -223,16 +278,16 @@ class Interpreter:
         if self._count == 0:
             self._field_start = self.offset
         self.offset += 1
-        if t.kind == "pixels":
+        if t.kind is Kind.PIXELS:
             self.out.write(byte)
-        elif t.kind == "bytes":
+        elif t.kind is Kind.STRING:
             self._buf.append(byte)
         else:
             self._acc |= byte << (8 * self._count)
         self._count += 1
         if self._count == self.field_length(t):
             self._complete(t)
-        elif self.state != "FRAME_LEN" and self.offset == 4 + self.values["frame_length"]:
+        elif self.state is not IState.FRAME_LEN and self.offset == 4 + self.values["frame_length"]:
             self._fail(FrameLengthError(
                 f"the frame length ({self.values['frame_length']}) ends inside this field",
                 t.label, self._field_start, self.values["frame_length"]))
@@ -247,7 +302,7 @@ class Interpreter:
             data: the bytes to push.
             limit: stop after this many bytes (``None``: all of them).
         """
-        rows = []
+        rows: list[tuple[int, int, str, str]] = []
         for byte in data[:limit] if limit is not None else data:
             t = self.transition
             rows.append((self.offset, byte, self.state, t.label if t else "(skipping)"))
@@ -265,7 +320,7 @@ class Interpreter:
         Raises:
             FrameTruncatedError: the input stopped inside a frame; names the field being read.
         """
-        if self.state == "FRAME_LEN" and self._count == 0:
+        if self.state is IState.FRAME_LEN and self._count == 0:
             return
         t = self.transition
         label = t.label if t else "frame"
@@ -278,20 +333,20 @@ class Interpreter:
         raise error
 
     def _complete(self, t: Transition) -> None:
-        if t.kind == "bytes":
+        if t.kind is Kind.STRING:
             value: Any = bytes(self._buf).decode("utf-8", "surrogateescape")
-        elif t.kind == "pixels":
+        elif t.kind is Kind.PIXELS:
             value = None
         else:
             value = self._acc
         self.values[t.field] = value
         self._acc, self._buf, self._count = 0, bytearray(), 0
         if t.check is not None:
-            getattr(self, f"_check_{t.check}")(value, t)
+            _CHECKS[t.check](self, value, t)
         self.state = t.next
-        if self.state == "DATA":
+        if self.state is IState.DATA:
             self.fields = self._make_fields()
-        if t.kind == "pixels":
+        if t.kind is Kind.PIXELS:
             self.frames += 1
             self.reset()
             return
@@ -316,7 +371,7 @@ class Interpreter:
         remaining = 4 + frame_length - self.offset if frame_length is not None else 0
         self.reset()
         if remaining > 0:
-            self.state, self._skip = SKIP_STATE, remaining
+            self.state, self._skip = IState.SKIP, remaining
         raise error
 
     # -- the checks run when a field completes ------------------------------------------------
@@ -400,6 +455,20 @@ class Interpreter:
         assert self.offset == 4 + self.values["frame_length"]
 
 
+#: The method that runs each check (one per :class:`Check`; a test holds the two equal).
+_CHECKS: dict[Check, Callable[[Interpreter, Any, Transition], None]] = {
+    Check.FRAME_LENGTH: Interpreter._check_frame_length,
+    Check.FRAME_ID_LENGTH: Interpreter._check_frame_id_length,
+    Check.HEIGHT: Interpreter._check_height,
+    Check.WIDTH: Interpreter._check_width,
+    Check.ENCODING_LENGTH: Interpreter._check_encoding_length,
+    Check.ENCODING: Interpreter._check_encoding,
+    Check.STEP: Interpreter._check_step,
+    Check.DATA_LENGTH: Interpreter._check_data_length,
+    Check.FRAME_END: Interpreter._check_frame_end,
+}
+
+
 def interpret_reference(rx: ByteFIFO, out: ByteFIFO, *, width: int | None = None,
                         height: int | None = None, encoding: str | None = None,
                         max_frame_id_bytes: int = limits.MAX_FRAME_ID_BYTES) -> ImageFields:
@@ -438,10 +507,10 @@ def interpret_fast(frame: bytes, *, width: int | None = None, height: int | None
                          max_frame_id_bytes=max_frame_id_bytes)
     view = memoryview(frame)
     pos = 0
-    while pos < len(view) and interp.state != "DATA" and not interp.frames:
+    while pos < len(view) and interp.state is not IState.DATA and not interp.frames:
         interp.push(view[pos])
         pos += 1
-    if interp.state == "DATA":
+    if interp.state is IState.DATA:
         n = interp.values["data_length"]
         if len(view) - pos < n:
             got = len(view) - pos

@@ -7,6 +7,7 @@ The image-size, kernel and ``frame_id`` limits are the node configuration's
 from __future__ import annotations
 
 from rosfpga_lab.config import limits as _config
+from rosfpga_lab.tcpros import MAX_FRAME_BYTES as _tcpros_max_frame_bytes
 
 #: Largest ``width`` / ``height`` the interpreter accepts (an "absurd" value is larger).
 MAX_WIDTH = _config.MAX_WIDTH
@@ -14,8 +15,8 @@ MAX_HEIGHT = _config.MAX_HEIGHT
 #: Longest ``header.frame_id`` and ``encoding`` strings the interpreter stores.
 MAX_FRAME_ID_BYTES = _config.MAX_FRAME_ID_MAX
 MAX_ENCODING_BYTES = 32
-#: Largest TCPROS frame (4-byte length excluded) the interpreter accepts: 64 MiB.
-MAX_FRAME_BYTES = 64 * 1024 * 1024
+#: Largest TCPROS frame (4-byte length excluded) the interpreter accepts: the TCPROS layer's.
+MAX_FRAME_BYTES = _tcpros_max_frame_bytes
 #: Width of the AXI4-Stream data bus between fifo2axi and the application, in bits.
 TDATA_BITS = 32
 TDATA_BYTES = TDATA_BITS // 8
@@ -23,9 +24,9 @@ TDATA_BYTES = TDATA_BITS // 8
 MAX_KSIZE = _config.MAX_KSIZE
 
 #: Defaults of :class:`rosfpga_lab.hw.Pipeline`.
-DEFAULT_CLOCK_HZ = 100e6
+DEFAULT_CLOCK_HZ = _config.DEFAULT_CLOCK_MHZ * 1e6
 DEFAULT_LINE_RATE_BPS = 1e9
-DEFAULT_RX_FIFO_DEPTH = 2048
+DEFAULT_RX_FIFO_DEPTH = _config.DEFAULT_INPUT_FIFO_DEPTH
 DEFAULT_RX_BURST_BYTES = 1
 
 #: What a TCP byte stream costs on (gigabit) Ethernet, for ``PipelineResult.wire_time_s``:

@@ -22,20 +22,24 @@ import functools
 import cv2
 import numpy as np
 
+from rosfpga_lab.config.vocabulary import MODEL_OPS, PASSTHROUGH, canonical_op
 from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.errors import PipelineConfigError
 from rosfpga_lab.hw.video import Mat
 
-OPS = ("dilate", "erode", "copy")
+#: Operations the models run (the configuration vocabulary's :data:`~rosfpga_lab.config.vocabulary.MODEL_OPS`).
+OPS = MODEL_OPS
 
 
 def check_op(op: str, ksize: tuple[int, int]) -> tuple[int, int]:
     """Validate ``op`` and ``ksize``; return ``ksize`` as a tuple of ints.
 
+    ``op`` may be an accepted alias (``"copy"``); see :func:`canonical_op`.
+
     Raises:
         PipelineConfigError: unknown op, or a kernel side outside ``1..MAX_KSIZE``.
     """
-    if op not in OPS:
+    if canonical_op(op) not in OPS:
         raise PipelineConfigError(f"unknown op {op!r}; choose one of {', '.join(OPS)}")
     try:
         kw, kh = (int(k) for k in ksize)
@@ -55,10 +59,11 @@ def flush_extent(ksize: tuple[int, int]) -> tuple[int, int]:
 
 
 def morph_reference(src: Mat, dst: Mat, op: str, ksize: tuple[int, int]) -> None:
-    """Reference streaming dilate/erode/copy from ``src`` to ``dst`` (one pixel per clock)."""
+    """Reference streaming dilate/erode/passthrough from ``src`` to ``dst`` (one pixel per clock)."""
     kw, kh = check_op(op, ksize)
+    op = canonical_op(op)
     rows, cols, channels = src.rows, src.cols, src.channels
-    if op == "copy":
+    if op == PASSTHROUGH:
         for _ in range(rows * cols):
             dst.write(src.read(op, rows * cols))
         return
@@ -88,7 +93,7 @@ def morph_reference(src: Mat, dst: Mat, op: str, ksize: tuple[int, int]) -> None
 
 def morph_fast(image: np.ndarray, op: str, ksize: tuple[int, int],
                out: np.ndarray | None = None) -> np.ndarray:
-    """Fast dilate/erode/copy of a ``(rows, cols, channels)`` uint8 image (OpenCV).
+    """Fast dilate/erode/passthrough of a ``(rows, cols, channels)`` uint8 image (OpenCV).
 
     Args:
         out: optional C-contiguous array of the image's shape to write into.
@@ -96,7 +101,7 @@ def morph_fast(image: np.ndarray, op: str, ksize: tuple[int, int],
     kw, kh = check_op(op, ksize)
     if out is None:
         out = np.empty(image.shape, np.uint8)
-    if op == "copy":
+    if canonical_op(op) == PASSTHROUGH:
         np.copyto(out, image)
         return out
     fn = cv2.dilate if op == "dilate" else cv2.erode

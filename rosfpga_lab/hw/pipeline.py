@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rosfpga_lab.config import NodeConfig
+from rosfpga_lab.config import CUSTOM, DEFAULT_OP, NodeConfig, canonical_op, model_ksize
 from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference
 from rosfpga_lab.hw.cycles import CycleReport, account
@@ -146,7 +146,7 @@ class Pipeline:
     Args:
         width, height, encoding: the image the circuit is built for; ``None`` accepts any legal
             value (up to ``hw.limits``). A frame that disagrees is refused.
-        op: ``"dilate"`` (the paper's), ``"erode"`` or ``"copy"``.
+        op: ``"dilate"`` (the paper's), ``"erode"`` or ``"passthrough"`` (``"copy"`` accepted).
         ksize: the rectangle ``(width, height)``, OpenCV's order; the paper uses ``(3, 3)``.
         model: ``"fast"`` (numpy) or ``"reference"`` (one byte/beat at a time).
         clock_hz: the circuit's clock, for ``frame_time_s``.
@@ -174,18 +174,17 @@ class Pipeline:
             PipelineConfigError: ``op: custom`` (the lab cannot model the user's C++).
         """
         app = config.application
-        if app.op == "custom":
+        if app.op == CUSTOM:
             raise PipelineConfigError("a custom application has no Python model; compare its C "
                                       "simulation against your own expectation")
-        op = "copy" if app.op == "passthrough" else app.op
-        ksize = (app.ksize, app.ksize) if op != "copy" else (1, 1)
         return cls(width=config.image.width, height=config.image.height,
-                   encoding=config.image.encoding, op=op, ksize=ksize, model=model,
+                   encoding=config.image.encoding, op=app.op,
+                   ksize=model_ksize(app.op, app.ksize), model=model,
                    clock_hz=config.clock_mhz * 1e6, rx_fifo_depth=config.fifo.input_depth,
                    max_frame_id_bytes=config.frame_id_max)
 
     def __init__(self, width: int | None = None, height: int | None = None,
-                 encoding: str | None = None, op: str = "dilate",
+                 encoding: str | None = None, op: str = DEFAULT_OP,
                  ksize: tuple[int, int] = (3, 3), model: str = "fast",
                  clock_hz: float = limits.DEFAULT_CLOCK_HZ,
                  line_rate_bps: float = limits.DEFAULT_LINE_RATE_BPS,
@@ -223,7 +222,8 @@ class Pipeline:
             raise PipelineConfigError(
                 f"frame_id must be a str of at most {limits.MAX_FRAME_ID_BYTES} bytes, got {frame_id!r}")
         self.ksize = check_op(op, ksize)
-        self.width, self.height, self.encoding, self.op, self.model = width, height, encoding, op, model
+        self.width, self.height, self.encoding, self.model = width, height, encoding, model
+        self.op = canonical_op(op)
         self.clock_hz, self.line_rate_bps = float(clock_hz), float(line_rate_bps)
         self.seq_mode, self.seq_start, self.stamp, self.frame_id = seq, seq_start, stamp, frame_id
         self.max_frame_id_bytes = max_frame_id_bytes

@@ -8,7 +8,7 @@ viewers) describes messages through it::
     reg.md5("sensor_msgs/Image")                  # '060021388200f6f0f447d0fcd9c64743'
     body = serialize(reg, "std_msgs/String", {"data": "hi"})   # b'\\x02\\x00\\x00\\x00hi'
     deserialize(reg, "std_msgs/String", body)     # {'data': 'hi'}
-    field_layout(reg, "std_msgs/String", body)    # [FieldSpan(path='data', offset=0, size=4,
+    field_layout(reg, "std_msgs/String", body)    # [Span(offset=0, size=4, path='data',
                                                   #   type='uint32', value=2, role='length'), ...]
 
 Python values of ROS fields (what ``deserialize`` returns and ``serialize``/``new_message`` take):
@@ -52,12 +52,13 @@ from rosfpga_lab.msg.registry import (
     DEFINITIONS_DIR, SHIPPED_PACKAGES, MsgRegistry, default_registry, registry_with,
 )
 from rosfpga_lab.msg.ros2 import ros2_registry, to_ros2_value
+from rosfpga_lab.msg.span import Span
 from rosfpga_lab.msg.values import default_value, new_message
 
 __all__ = [
     "BUILTIN_TYPES", "Constant", "DEFAULT_LIMITS", "DEFINITIONS_DIR", "DeserializeError",
     "Duration", "Field", "FieldSpan", "MsgDefinitionError", "MsgError", "MsgLimits",
-    "MsgRegistry", "MsgSpec", "PRIMITIVE_TYPES", "SHIPPED_PACKAGES", "SerializeError", "Time",
+    "MsgRegistry", "MsgSpec", "PRIMITIVE_TYPES", "SHIPPED_PACKAGES", "SerializeError", "Span", "Time",
     "UnknownTypeError", "default_registry", "default_value", "deserialize",
     "deserialize_partial", "deserialize_reference", "field_layout", "min_size", "new_message",
     "parse_msg", "registry_with", "serialize", "split_full_text", "strip_comments",

@@ -29,6 +29,7 @@ from rosfpga_lab.msg.decode import too_long
 from rosfpga_lab.msg.encode import _byte_array, _check_scalar, _numeric_array
 from rosfpga_lab.msg.errors import DeserializeError, SerializeError
 from rosfpga_lab.msg.layout import ROLE_ARRAY, ROLE_LENGTH, ROLE_VALUE, FieldSpan
+from rosfpga_lab.msg.span import ROLE_PADDING, ROLE_TRAILING, Span
 from rosfpga_lab.msg.limits import DEFAULT_LIMITS, LAYOUT_ELEMENT_SPANS, MsgLimits
 from rosfpga_lab.msg.parser import Field
 from rosfpga_lab.msg.registry import MsgRegistry
@@ -42,9 +43,8 @@ CDR_BE = b"\x00\x00\x00\x00"
 ENCAPSULATION_SIZE = 4
 #: The byte a message with no fields is sent as.
 EMPTY_STRUCT = b"\x00"
-ROLE_PADDING = "padding"
+#: The role of CDR's 4-byte encapsulation header (the other roles are the span vocabulary's).
 ROLE_ENCAPSULATION = "encapsulation"
-ROLE_TRAILING = "trailing"
 
 
 def _align(pos: int, size: int) -> int:
@@ -181,7 +181,7 @@ class _Reader:
         if n:
             start = self.pos
             raw = bytes(self._take(n, path, "alignment padding"))
-            self.spans.append(FieldSpan(path, start, n, "padding", raw, ROLE_PADDING))
+            self.spans.append(Span(start, n, path, "padding", raw, ROLE_PADDING))
 
     def encapsulation(self) -> None:
         head = bytes(self._take(ENCAPSULATION_SIZE, "", "the encapsulation header"))
@@ -189,15 +189,14 @@ class _Reader:
             kind = "CDR big-endian" if head[:2] == CDR_BE[:2] else f"representation 0x{head[:2].hex()}"
             raise DeserializeError(f"encapsulation header {head.hex(' ')} says {kind}; only CDR "
                                    f"little-endian ({CDR_LE.hex(' ')}) is read", "", 0)
-        self.spans.append(FieldSpan("", 0, ENCAPSULATION_SIZE, "encapsulation", "CDR_LE",
-                                    ROLE_ENCAPSULATION))
+        self.spans.append(Span(0, ENCAPSULATION_SIZE, "", "encapsulation", "CDR_LE", ROLE_ENCAPSULATION))
 
     def scalar(self, kind: str, path: str, role: str = ROLE_VALUE) -> Any:
         sc = SCALARS[kind]
         self.pad(sc.size, path)
         start = self.pos
         (value,) = struct.unpack("<" + sc.struct_char, self._take(sc.size, path, kind))
-        self.spans.append(FieldSpan(path, start, sc.size, kind, value, role))
+        self.spans.append(Span(start, sc.size, path, kind, value, role))
         return bool(value) if kind == "bool" else value
 
     def count(self, path: str, elem_min: int, limit: int, limit_name: str) -> int:
@@ -222,7 +221,7 @@ class _Reader:
             raise DeserializeError(f"field {path}: string at byte offset {start} does not end "
                                    f"with NUL", path, start + n - 1)
         text = raw[:-1].decode("utf-8", "surrogateescape")
-        self.spans.append(FieldSpan(path, start, n, "string", text, ROLE_VALUE))
+        self.spans.append(Span(start, n, path, "string", text, ROLE_VALUE))
         return text
 
     def element(self, base: str, path: str) -> Any:
@@ -249,7 +248,7 @@ class _Reader:
             start = self.pos
             arr = np.frombuffer(self._take(n * dtype.itemsize, path, f"{n} x {base}"), dtype)
             arr = arr.astype(bool) if base == "bool" else arr
-            self.spans.append(FieldSpan(path, start, self.pos - start, f.type, arr, ROLE_ARRAY))
+            self.spans.append(Span(start, self.pos - start, path, f.type, arr, ROLE_ARRAY))
             return arr
         items = [self.element(base, f"{path}[{i}]") for i in range(n)]
         if base in SCALARS:
@@ -261,7 +260,7 @@ class _Reader:
         if not spec.fields:
             start = self.pos
             self._take(len(EMPTY_STRUCT), prefix, "the byte of an empty message")
-            self.spans.append(FieldSpan(prefix, start, 1, "uint8", 0, ROLE_PADDING))
+            self.spans.append(Span(start, 1, prefix, "uint8", 0, ROLE_PADDING))
             return {}
         return {f.name: self.field(f, f"{prefix}.{f.name}" if prefix else f.name)
                 for f in spec.fields}
@@ -277,8 +276,7 @@ def _read(reg: MsgRegistry | None, type_name: str, data: Any, allow_trailing: bo
         if not partial:
             raise
         start = reader.spans[-1].end if reader.spans else 0
-        reader.spans.append(FieldSpan(exc.path, start, len(reader.view) - start, "error",
-                                      str(exc), "error"))
+        reader.spans.append(Span(start, len(reader.view) - start, exc.path, "error", str(exc), "error"))
         return None, reader.spans
     rest = len(reader.view) - reader.pos
     if rest:
@@ -286,8 +284,7 @@ def _read(reg: MsgRegistry | None, type_name: str, data: Any, allow_trailing: bo
             raise DeserializeError(
                 f"{rest} byte(s) left over after a complete {reader.reg.resolve(type_name)} at "
                 f"byte offset {reader.pos} (pass allow_trailing=True to ignore)", "", reader.pos)
-        reader.spans.append(FieldSpan("", reader.pos, rest, "uint8[]",
-                                      bytes(reader.view[reader.pos:]), ROLE_TRAILING))
+        reader.spans.append(Span(reader.pos, rest, "", "uint8[]", bytes(reader.view[reader.pos:]), ROLE_TRAILING))
     return value, reader.spans
 
 

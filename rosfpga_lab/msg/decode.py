@@ -52,7 +52,7 @@ def min_size(reg: MsgRegistry, type_name: str) -> int:
             if f.is_array and f.array_length is None:
                 total += 4
                 continue
-            count = f.array_length if f.is_array else 1
+            count = f.array_length if f.array_length is not None else 1
             if f.base_type in SCALARS:
                 total += count * SCALARS[f.base_type].size
             elif f.base_type in (TIME, DURATION):
@@ -221,7 +221,7 @@ def _field_decoder(reg: MsgRegistry, f: Field) -> Callable:
     sub = compiled_decoder(reg, base)
     elem_min = min_size(reg, base)
 
-    def op(buf, pos, out, limits):
+    def op_elements(buf, pos, out, limits):
         n, pos = count(buf, pos, limits, elem_min)
         if elem_min == 0 and n > limits.max_empty_elements:
             # elements of zero bytes (e.g. std_msgs/Empty): the bytes left cannot bound n
@@ -238,7 +238,7 @@ def _field_decoder(reg: MsgRegistry, f: Field) -> Callable:
             raise _prefixed(exc, f"{name}[{len(items)}]") from None
         out[name] = items
         return pos
-    return op
+    return op_elements
 
 
 def _prefixed(exc: DeserializeError, prefix: str) -> DeserializeError:
@@ -259,7 +259,7 @@ def _scalar_kind(f: Field) -> str | None:
 def _build_ops(reg: MsgRegistry, spec: MsgSpec, group: Callable, single: Callable) -> list:
     ops: list = []
     run: list[Field] = []
-    for f in spec.fields + (None,):  # type: ignore[operator]
+    for f in spec.fields + (None,):
         if f is not None and _scalar_kind(f):
             run.append(f)
             continue

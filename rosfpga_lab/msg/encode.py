@@ -302,7 +302,7 @@ def _field_encoder(reg: MsgRegistry, f: Field) -> Callable:
     names = flat[0]
     row = struct.Struct("<" + "".join(SCALARS[k].struct_char for k in flat[1]))
 
-    def op(msg, get, chunks):
+    def op_flat(msg, get, chunks):
         items = seq(get(msg, name))
         head(len(items), items, chunks)
         try:  # flat messages as dicts: one struct per element, no per-field calls
@@ -312,7 +312,7 @@ def _field_encoder(reg: MsgRegistry, f: Field) -> Callable:
         except (KeyError, struct.error, OverflowError, TypeError):
             pass
         generic(items, chunks)  # anything else, and every error, takes the general path
-    return op
+    return op_flat
 
 
 def compiled_encoder(reg: MsgRegistry, type_name: str) -> Encoder:

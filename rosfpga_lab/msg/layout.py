@@ -16,7 +16,7 @@ elements in one span, used when the array has more than ``element_spans`` elemen
 from __future__ import annotations
 
 import struct
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
@@ -26,37 +26,10 @@ from rosfpga_lab.msg.errors import DeserializeError
 from rosfpga_lab.msg.limits import DEFAULT_LIMITS, LAYOUT_ELEMENT_SPANS, MsgLimits
 from rosfpga_lab.msg.parser import Field
 from rosfpga_lab.msg.registry import MsgRegistry
+from rosfpga_lab.msg.span import ROLE_ARRAY, ROLE_ERROR, ROLE_LENGTH, ROLE_TRAILING, ROLE_VALUE, Span
 
-ROLE_LENGTH = "length"
-ROLE_VALUE = "value"
-ROLE_ARRAY = "array"
-ROLE_ERROR = "error"
-ROLE_TRAILING = "trailing"
-
-
-class FieldSpan(NamedTuple):
-    """The bytes of one value (or length prefix) in a serialized message.
-
-    Attributes:
-        path: field path, e.g. ``header.stamp.secs``, ``data``, ``points[3].x``.
-        offset: first byte, from the start of the body.
-        size: number of bytes.
-        type: ROS type of these bytes (``uint32`` for a length prefix, ``uint8[]`` for a block).
-        value: the decoded value.
-        role: ``length``, ``value``, ``array`` (or ``error``/``trailing`` in partial mode).
-    """
-
-    path: str
-    offset: int
-    size: int
-    type: str
-    value: Any
-    role: str
-
-    @property
-    def end(self) -> int:
-        """One past the last byte."""
-        return self.offset + self.size
+#: The span type of a message layout (the lab's one :class:`~rosfpga_lab.msg.span.Span`).
+FieldSpan = Span
 
 
 class _Reader:
@@ -81,7 +54,7 @@ class _Reader:
 
     def _span(self, path: str, start: int, type_: str, value: Any, role: str) -> None:
         if self.pos > start:
-            self.spans.append(FieldSpan(path, start, self.pos - start, type_, value, role))
+            self.spans.append(Span(start, self.pos - start, path, type_, value, role))
 
     def scalar(self, kind: str, path: str) -> Any:
         start = self.pos
@@ -171,8 +144,8 @@ def _read(reg: MsgRegistry, type_name: str, data: Any, allow_trailing: bool, par
         if not partial:
             raise
         start = reader.spans[-1].end if reader.spans else 0
-        reader.spans.append(FieldSpan(exc.path, start, len(reader.buf) - start, "error",
-                                      str(exc), ROLE_ERROR))
+        reader.spans.append(Span(start, len(reader.buf) - start, exc.path, "error", str(exc),
+                                 ROLE_ERROR))
         return None, reader.spans
     rest = len(reader.buf) - reader.pos
     if rest:
@@ -180,8 +153,8 @@ def _read(reg: MsgRegistry, type_name: str, data: Any, allow_trailing: bool, par
             raise DeserializeError(
                 f"{rest} byte(s) left over after a complete {reg.resolve(type_name)} at byte "
                 f"offset {reader.pos} (pass allow_trailing=True to ignore)", "", reader.pos)
-        reader.spans.append(FieldSpan("", reader.pos, rest, "uint8[]",
-                                      reader.buf[reader.pos:], ROLE_TRAILING))
+        reader.spans.append(Span(reader.pos, rest, "", "uint8[]", reader.buf[reader.pos:],
+                                 ROLE_TRAILING))
     return value, reader.spans
 
 

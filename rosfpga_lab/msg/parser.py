@@ -264,12 +264,15 @@ def parse_msg(text: str, full_name: str, source: str | None = None) -> MsgSpec:
         clean = _strip_line(orig)
         if not clean:
             continue
+        item: Field | Constant
         if CONST_CHAR in clean:
-            item: Field | Constant = _parse_constant(orig, clean, lineno, source)
-            constants.append(item)
+            constant = _parse_constant(orig, clean, lineno, source)
+            constants.append(constant)
+            item = constant
         else:
-            item = _parse_field(orig, clean, package, lineno, source)
-            fields.append(item)
+            field = _parse_field(orig, clean, package, lineno, source)
+            fields.append(field)
+            item = field
         if item.name in seen:
             raise MsgDefinitionError(
                 f"duplicate name {item.name!r} (first declared on line {seen[item.name]})",

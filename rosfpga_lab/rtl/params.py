@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 from pathlib import Path
 
-from rosfpga_lab.config import NodeConfig, load_config
+from rosfpga_lab.config import CUSTOM, MODEL_OPS, PASSTHROUGH, NodeConfig, load_config
 from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.encodings import PIXEL_FORMATS
@@ -23,8 +23,10 @@ from rosfpga_lab.rtl.errors import RtlError
 
 __all__ = ["OP_CODES", "RtlParams", "load_config", "node_wrapper", "rtl_params", "status_header"]
 
-#: ``rfl_morph``'s OP parameter per Python-model operation.
-OP_CODES = {"dilate": 0, "erode": 1, "copy": 2}
+#: ``rfl_morph``'s OP parameter per operation (the names of :data:`~rosfpga_lab.config.MODEL_OPS`;
+#: the codes are the Verilog's).
+OP_CODES = {"dilate": 0, "erode": 1, PASSTHROUGH: 2}
+assert set(OP_CODES) == set(MODEL_OPS), "every operation the models run has an RTL code"
 #: Longest encoding string the RTL's ENCODING parameter holds (bytes).
 ENCODING_PARAM_BYTES = 32
 #: The status include's file name (beside the Verilog sources).
@@ -69,7 +71,7 @@ def rtl_params(config: NodeConfig) -> RtlParams:
     Raises:
         RtlError: ``op: custom`` (the RTL has no user application), or a FIFO shallower than 2.
     """
-    if config.application.op == "custom":
+    if config.application.op == CUSTOM:
         raise RtlError("a custom application has no RTL: the lab's Verilog holds dilate, erode "
                        "and passthrough only")
     pipe = Pipeline.from_config(config)

@@ -5,10 +5,6 @@ Nothing here touches a socket or a thread: feed bytes, get events (see ``handsha
 """
 
 from rosfpga_lab.tcpros.errors import (
-    HANDSHAKE_TIMEOUT,
-    MAX_FIELD_BYTES,
-    MAX_FRAME_BYTES,
-    MAX_HEADER_BYTES,
     FrameError,
     HandshakeRejected,
     HandshakeTimeout,
@@ -18,7 +14,13 @@ from rosfpga_lab.tcpros.errors import (
     RemoteError,
     StateError,
 )
-from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame, frame_prefix
+from rosfpga_lab.tcpros.limits import (
+    HANDSHAKE_TIMEOUT,
+    MAX_FIELD_BYTES,
+    MAX_FRAME_BYTES,
+    MAX_HEADER_BYTES,
+)
+from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame, frame_prefix, frame_spans
 from rosfpga_lab.tcpros.handshake import (
     ANY,
     STATES,
@@ -29,27 +31,34 @@ from rosfpga_lab.tcpros.handshake import (
     HeaderReceived,
     PublisherHandshake,
     Rejected,
+    Role,
+    State,
     SubscriberHandshake,
     TopicSpec,
     Transition,
+    Trigger,
     check_publisher_header,
     check_subscriber_header,
+    publisher_reply_fields,
+    subscriber_request_fields,
 )
 from rosfpga_lab.tcpros.header import (
     HeaderDecoder,
-    HeaderField,
     decode_header,
     encode_error_header,
     encode_header,
+    header_spans,
     parse_fields,
 )
 
 __all__ = [
     "ANY", "HANDSHAKE_TIMEOUT", "MAX_FIELD_BYTES", "MAX_FRAME_BYTES", "MAX_HEADER_BYTES",
     "STATES", "TRANSITIONS", "Closed", "Connected", "Frame", "FrameDecoder", "FrameError",
-    "HandshakeRejected", "HandshakeTimeout", "HeaderDecoder", "HeaderField", "HeaderFormatError",
+    "HandshakeRejected", "HandshakeTimeout", "HeaderDecoder", "HeaderFormatError",
     "HeaderReceived", "IncompleteError", "ProtocolError", "PublisherHandshake", "Rejected",
-    "RemoteError", "StateError", "SubscriberHandshake", "TopicSpec", "Transition",
+    "RemoteError", "Role", "State", "StateError", "SubscriberHandshake", "TopicSpec", "Transition",
+    "Trigger",
     "check_publisher_header", "check_subscriber_header", "decode_header", "encode_error_header",
-    "encode_frame", "encode_header", "frame_prefix", "parse_fields",
+    "encode_frame", "encode_header", "frame_prefix", "frame_spans", "header_spans", "parse_fields", "publisher_reply_fields",
+    "subscriber_request_fields",
 ]

@@ -1,34 +1,23 @@
-"""Errors and limits of the TCPROS layer.
+"""Errors of the TCPROS layer.
 
 Every problem the codecs or the handshake machines detect is a :class:`ProtocolError`
 (a :class:`~rosfpga_lab.errors.LabError`). ``local`` tells who broke the protocol: ``True``
 when the *peer* sent bytes we refuse (we detected it here), ``False`` when the peer told us
 it refused *our* request with an ``error=`` header (:class:`RemoteError`).
-
-The limits are the lab's defaults; every codec takes its own limits as arguments. roscpp
-refuses header or frame lengths over 1e9 bytes and header fields over 1e6 bytes; the lab is
-stricter so that a garbage length cannot make a notebook allocate gigabytes.
 """
 
 from __future__ import annotations
 
 from rosfpga_lab.errors import LabError
-
-#: Largest connection header (the 4-byte total length's value) the lab accepts by default.
-MAX_HEADER_BYTES = 1 << 20
-#: Largest single ``key=value`` field of a connection header.
-MAX_FIELD_BYTES = 1 << 20
-#: Largest message body (the 4-byte frame length's value) the lab accepts by default: 64 MiB,
-#: room for a 4K rgba8 image (33 MB).
-MAX_FRAME_BYTES = 64 << 20
-#: First buffer of a frame body being assembled (bytes); it at most doubles as bytes arrive, so
-#: a declared length costs nothing until its bytes come.
-FRAME_BUFFER_FIRST = 1 << 18
-#: Transitions a handshake machine keeps in ``history``: a self-loop (``frame``, ``send``) is
-#: kept this many times in a row, later repeats are only counted (``repeats``).
-HISTORY_REPEATS = 3
-#: Seconds a peer may take to complete its connection header before we give up on it.
-HANDSHAKE_TIMEOUT = 5.0
+# The limits live in limits.py; re-exported here for code written before the move.
+from rosfpga_lab.tcpros.limits import (  # noqa: F401
+    MAX_HEADER_BYTES,
+    MAX_FIELD_BYTES,
+    MAX_FRAME_BYTES,
+    FRAME_BUFFER_FIRST,
+    HISTORY_REPEATS,
+    HANDSHAKE_TIMEOUT,
+)
 
 
 class ProtocolError(LabError):

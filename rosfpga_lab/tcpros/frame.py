@@ -20,19 +20,19 @@ when the prefix arrives, before any buffer exists); the reader only chooses wher
 from __future__ import annotations
 
 import struct
+from typing import TYPE_CHECKING
 
-from rosfpga_lab.tcpros.errors import (
-    FRAME_BUFFER_FIRST,
-    MAX_FRAME_BYTES,
-    FrameError,
-    IncompleteError,
-    StateError,
-)
+from rosfpga_lab.msg.span import ROLE_ERROR, ROLE_LENGTH, ROLE_TRAILING, ROLE_VALUE, Span
+from rosfpga_lab.tcpros.errors import FrameError, IncompleteError, StateError
+from rosfpga_lab.tcpros.limits import FRAME_BUFFER_FIRST, MAX_FRAME_BYTES
 
 _U32 = struct.Struct("<I")
 #: Zeros a growing body buffer is extended with (its largest step). Never written, so its pages
 #: stay unmapped/shared: it costs address space, not memory.
 _ZEROS = bytes(4 << 20)
+
+if TYPE_CHECKING:
+    from rosfpga_lab.msg import MsgRegistry
 
 
 def encode_frame(body: bytes | bytearray | memoryview) -> bytes:
@@ -138,6 +138,7 @@ class FrameDecoder:
                 self._start_body(length)
             take = min(self._length - self._have, end - pos)
             h = self._have
+            assert self._body is not None  # a body buffer exists once a length prefix was read
             if len(self._body) - h >= take:
                 self._body[h:h + take] = view[pos:pos + take]
             else:  # replaces the room left and grows by the rest: memory = bytes received
@@ -218,3 +219,40 @@ class FrameDecoder:
             raise IncompleteError(
                 f"connection closed mid-frame: {self._have} of {self._length} body bytes "
                 f"received (stream byte {self.offset})", offset=self.offset)
+
+
+def frame_spans(raw: bytes | memoryview, type_name: str | None = None, *,
+                registry: MsgRegistry | None = None) -> list[Span]:
+    """Spans of one message frame, leniently: its 4-byte length (``frame length``), then the body
+    by fields when ``type_name`` is given and the body is complete, else one ``message body``
+    span; bytes past the frame are ``(next frame)``. Never raises on bad bytes (an undecodable
+    body ends in an ``error`` span, as :func:`rosfpga_lab.msg.field_layout` makes in partial mode).
+
+    Args:
+        raw: the frame, from its length prefix on.
+        type_name: the message type, e.g. ``sensor_msgs/Image``; None: the body is not split.
+        registry: a :class:`~rosfpga_lab.msg.MsgRegistry`; default: the shipped types.
+    """
+    data = bytes(raw)
+    if len(data) < 4:
+        return [Span(0, len(data), "frame length (truncated)", "uint32", f"{len(data)} of 4 bytes",
+                     ROLE_ERROR)]
+    (length,) = _U32.unpack_from(data, 0)
+    spans = [Span(0, 4, "frame length", "uint32", length, ROLE_LENGTH)]
+    body = data[4:]
+    if not body:
+        return spans
+    if type_name is not None and len(body) >= length:
+        from rosfpga_lab.msg import default_registry, field_layout
+
+        reg = registry if registry is not None else default_registry()
+        for s in field_layout(reg, type_name, body[:length], partial=True):
+            spans.append(s.moved(4) if s.path else Span(s.offset + 4, s.size, f"({s.role})", s.type,
+                                                         s.value, s.role))
+        if len(body) > length:
+            spans.append(Span(4 + length, len(body) - length, "(next frame)", "bytes", None,
+                              ROLE_TRAILING))
+        return spans
+    note = f"{len(body)} of {length} body bytes recorded" if len(body) < length else f"{length} bytes"
+    spans.append(Span(4, len(body), "message body", "bytes", note, ROLE_VALUE))
+    return spans

@@ -19,12 +19,9 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from enum import StrEnum
 
 from rosfpga_lab.tcpros.errors import (
-    HISTORY_REPEATS,
-    MAX_FIELD_BYTES,
-    MAX_FRAME_BYTES,
-    MAX_HEADER_BYTES,
     HandshakeRejected,
     HandshakeTimeout,
     IncompleteError,
@@ -32,59 +29,109 @@ from rosfpga_lab.tcpros.errors import (
     RemoteError,
     StateError,
 )
-from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame
-from rosfpga_lab.tcpros.header import HeaderDecoder, HeaderField, encode_header
+from rosfpga_lab.tcpros.limits import (
+    HISTORY_REPEATS,
+    MAX_FIELD_BYTES,
+    MAX_FRAME_BYTES,
+    MAX_HEADER_BYTES,
+)
+from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame, frame_prefix
+from rosfpga_lab.msg.span import Span
+from rosfpga_lab.tcpros.header import HeaderDecoder, encode_header
 
 #: md5sum (and type) wildcard: "any type" (used by rostopic echo and topic_tools).
 ANY = "*"
+
+
+class _Name(StrEnum):
+    """A name from the handshake's vocabulary: compares equal to its text and prints as it
+    (``State.STREAMING == "STREAMING"``; shown as ``STREAMING``), like h11's sentinels."""
+
+    def __repr__(self) -> str:
+        return self.value
+
+
+class Role(_Name):
+    """The two sides of a TCPROS connection."""
+
+    SUBSCRIBER = "subscriber"
+    PUBLISHER = "publisher"
+
+
+class State(_Name):
+    """Handshake states (both roles)."""
+
+    IDLE = "IDLE"
+    AWAIT_HEADER = "AWAIT_HEADER"
+    STREAMING = "STREAMING"
+    FAILED = "FAILED"
+    REJECTED = "REJECTED"
+    CLOSED = "CLOSED"
+
+
+class Trigger(_Name):
+    """What happened: the events that move a handshake machine."""
+
+    CONNECT = "connect"
+    HEADER_OK = "header_ok"
+    HEADER_ERROR = "header_error"
+    HEADER_BAD = "header_bad"
+    HEADER_REJECTED = "header_rejected"
+    EOF = "eof"
+    TIMEOUT = "timeout"
+    FRAME = "frame"
+    FRAME_BAD = "frame_bad"
+    SEND = "send"
+    CLOSE = "close"
 
 
 @dataclass(frozen=True)
 class Transition:
     """One row of the handshake table."""
 
-    role: str      # "subscriber" or "publisher"
-    source: str    # state before
-    trigger: str   # what happened
-    target: str    # state after
-    action: str    # what the machine does / emits, in words (drawn by the notebooks)
+    role: Role
+    source: State    # state before
+    trigger: Trigger  # what happened
+    target: State    # state after
+    action: str      # what the machine does / emits, in words (drawn by the notebooks)
 
 
-_T = Transition
+_T, S, T = Transition, State, Trigger
+SUB, PUB = Role.SUBSCRIBER, Role.PUBLISHER
 TRANSITIONS: tuple[Transition, ...] = (
-    _T("subscriber", "IDLE", "connect", "AWAIT_HEADER",
+    _T(SUB, S.IDLE, T.CONNECT, S.AWAIT_HEADER,
        "send our header: callerid, md5sum, [message_definition], tcp_nodelay, topic, type"),
-    _T("subscriber", "AWAIT_HEADER", "header_ok", "STREAMING",
+    _T(SUB, S.AWAIT_HEADER, T.HEADER_OK, S.STREAMING,
        "publisher header has md5sum and type, md5 matches (or '*'): emit Connected"),
-    _T("subscriber", "AWAIT_HEADER", "header_error", "FAILED",
+    _T(SUB, S.AWAIT_HEADER, T.HEADER_ERROR, S.FAILED,
        "publisher answered error=...: raise RemoteError"),
-    _T("subscriber", "AWAIT_HEADER", "header_bad", "FAILED",
+    _T(SUB, S.AWAIT_HEADER, T.HEADER_BAD, S.FAILED,
        "header malformed, field missing or md5 mismatch: raise HeaderFormatError/HandshakeRejected"),
-    _T("subscriber", "AWAIT_HEADER", "eof", "FAILED", "closed before the header: raise IncompleteError"),
-    _T("subscriber", "AWAIT_HEADER", "timeout", "FAILED", "no header in time: raise HandshakeTimeout"),
-    _T("subscriber", "STREAMING", "frame", "STREAMING", "emit Frame(body)"),
-    _T("subscriber", "STREAMING", "frame_bad", "FAILED", "length over the limit: raise FrameError"),
-    _T("subscriber", "STREAMING", "eof", "CLOSED", "emit Closed (IncompleteError if mid-frame)"),
-    _T("subscriber", "STREAMING", "close", "CLOSED", "we hang up"),
-    _T("subscriber", "AWAIT_HEADER", "close", "CLOSED", "we hang up"),
-    _T("publisher", "AWAIT_HEADER", "header_ok", "STREAMING",
+    _T(SUB, S.AWAIT_HEADER, T.EOF, S.FAILED, "closed before the header: raise IncompleteError"),
+    _T(SUB, S.AWAIT_HEADER, T.TIMEOUT, S.FAILED, "no header in time: raise HandshakeTimeout"),
+    _T(SUB, S.STREAMING, T.FRAME, S.STREAMING, "emit Frame(body)"),
+    _T(SUB, S.STREAMING, T.FRAME_BAD, S.FAILED, "length over the limit: raise FrameError"),
+    _T(SUB, S.STREAMING, T.EOF, S.CLOSED, "emit Closed (IncompleteError if mid-frame)"),
+    _T(SUB, S.STREAMING, T.CLOSE, S.CLOSED, "we hang up"),
+    _T(SUB, S.AWAIT_HEADER, T.CLOSE, S.CLOSED, "we hang up"),
+    _T(PUB, S.AWAIT_HEADER, T.HEADER_OK, S.STREAMING,
        "subscriber header valid: send our header (callerid, latching, md5sum, "
        "message_definition, topic, type), then the latched message if any"),
-    _T("publisher", "AWAIT_HEADER", "header_rejected", "REJECTED",
+    _T(PUB, S.AWAIT_HEADER, T.HEADER_REJECTED, S.REJECTED,
        "field missing, unknown topic or md5 mismatch: send error=..., hang up"),
-    _T("publisher", "AWAIT_HEADER", "header_bad", "REJECTED",
+    _T(PUB, S.AWAIT_HEADER, T.HEADER_BAD, S.REJECTED,
        "malformed header (bad length, no '=', not UTF-8): send error=..., hang up"),
-    _T("publisher", "AWAIT_HEADER", "eof", "CLOSED", "subscriber left before its header"),
-    _T("publisher", "AWAIT_HEADER", "timeout", "REJECTED",
+    _T(PUB, S.AWAIT_HEADER, T.EOF, S.CLOSED, "subscriber left before its header"),
+    _T(PUB, S.AWAIT_HEADER, T.TIMEOUT, S.REJECTED,
        "no header in time: send error=..., hang up (keeps the port free for others)"),
-    _T("publisher", "STREAMING", "send", "STREAMING", "write Frame(body)"),
-    _T("publisher", "STREAMING", "eof", "CLOSED", "subscriber hung up"),
-    _T("publisher", "STREAMING", "close", "CLOSED", "we hang up"),
+    _T(PUB, S.STREAMING, T.SEND, S.STREAMING, "write Frame(body)"),
+    _T(PUB, S.STREAMING, T.EOF, S.CLOSED, "subscriber hung up"),
+    _T(PUB, S.STREAMING, T.CLOSE, S.CLOSED, "we hang up"),
 )
 
-STATES: dict[str, tuple[str, ...]] = {
+STATES: dict[Role, tuple[State, ...]] = {
     role: tuple(dict.fromkeys(s for t in TRANSITIONS if t.role == role for s in (t.source, t.target)))
-    for role in ("subscriber", "publisher")
+    for role in Role
 }
 
 
@@ -95,7 +142,7 @@ class HeaderReceived:
 
     fields: dict[str, str]
     raw: bytes
-    layout: tuple[HeaderField, ...]
+    layout: tuple[Span, ...]  # the header's fields as spans (parse_fields)
 
 
 @dataclass(frozen=True)
@@ -155,6 +202,47 @@ class TopicSpec:
     latching: bool = False
 
 
+# ------------------------------------------------------------------------- header builders
+def subscriber_request_fields(*, callerid: str, topic: str, md5sum: str, type_name: str,
+                              message_definition: str | None = None,
+                              tcp_nodelay: bool = False) -> dict[str, str]:
+    """The connection header a subscriber opens with (rospy's field set; roscpp leaves out
+    ``message_definition``). The one definition used by :class:`SubscriberHandshake` and by the
+    generated circuit's precomputed header.
+
+    Args:
+        callerid: the subscribing node's name.
+        topic, md5sum, type_name: what it subscribes to (``*`` for md5sum and type: any).
+        message_definition: the full text of the type; None leaves the field out.
+        tcp_nodelay: ask the publisher for TCP_NODELAY.
+
+    Returns:
+        ``{key: value}`` in key order (as the wire has them).
+    """
+    fields = {"callerid": callerid, "md5sum": md5sum, "tcp_nodelay": "1" if tcp_nodelay else "0",
+              "topic": topic, "type": type_name}
+    if message_definition is not None:
+        fields["message_definition"] = message_definition
+    return dict(sorted(fields.items()))
+
+
+def publisher_reply_fields(callerid: str, spec: TopicSpec) -> dict[str, str]:
+    """The connection header a publisher answers an accepted subscriber with (roscpp's field
+    set). The one definition used by :class:`PublisherHandshake`, the graph's publisher and the
+    generated circuit's precomputed header.
+
+    Args:
+        callerid: the publishing node's name.
+        spec: what it publishes on the topic.
+
+    Returns:
+        ``{key: value}`` in key order: callerid, latching, md5sum, message_definition, topic, type.
+    """
+    return {"callerid": callerid, "latching": "1" if spec.latching else "0",
+            "md5sum": spec.md5sum, "message_definition": spec.message_definition,
+            "topic": spec.topic, "type": spec.type}
+
+
 # ---------------------------------------------------------------------------------- checks
 def check_subscriber_header(fields: Mapping[str, str], spec: TopicSpec | None,
                             peer: str = "") -> str | None:
@@ -202,17 +290,17 @@ def check_publisher_header(fields: Mapping[str, str], md5sum: str, type_name: st
 
 # ---------------------------------------------------------------------------------- machines
 class _Machine:
-    role = ""
+    role: Role
 
-    def __init__(self, initial: str) -> None:
+    def __init__(self, initial: State) -> None:
         self.state = initial
         #: the transitions taken, in order; a self-loop (``frame``, ``send``) appears at most
         #: ``HISTORY_REPEATS`` times in a row, so the list stays short on a long stream
         self.history: list[Transition] = []
         #: self-loop transitions taken but not kept in ``history``, by trigger
-        self.repeats: dict[str, int] = {}
+        self.repeats: dict[Trigger, int] = {}
 
-    def _fire(self, trigger: str) -> Transition:
+    def _fire(self, trigger: Trigger) -> Transition:
         for t in TRANSITIONS:
             if t.role == self.role and t.source == self.state and t.trigger == trigger:
                 self.state = t.target
@@ -227,8 +315,8 @@ class _Machine:
 
     def close(self) -> None:
         """We hang up (allowed while waiting or streaming; a no-op once finished)."""
-        if self.state in ("AWAIT_HEADER", "STREAMING"):
-            self._fire("close")
+        if self.state in (State.AWAIT_HEADER, State.STREAMING):
+            self._fire(Trigger.CLOSE)
 
 
 class SubscriberHandshake(_Machine):
@@ -243,17 +331,16 @@ class SubscriberHandshake(_Machine):
         tcp_nodelay: ask the publisher for TCP_NODELAY.
     """
 
-    role = "subscriber"
+    role = Role.SUBSCRIBER
 
     def __init__(self, *, callerid: str, topic: str, md5sum: str, type_name: str,
                  message_definition: str | None = None, tcp_nodelay: bool = False,
                  max_header: int = MAX_HEADER_BYTES, max_field: int = MAX_FIELD_BYTES,
                  max_frame: int = MAX_FRAME_BYTES) -> None:
-        super().__init__("IDLE")
-        self.fields: dict[str, str] = {"callerid": callerid, "md5sum": md5sum, "topic": topic,
-                                       "type": type_name, "tcp_nodelay": "1" if tcp_nodelay else "0"}
-        if message_definition is not None:
-            self.fields["message_definition"] = message_definition
+        super().__init__(State.IDLE)
+        self.fields: dict[str, str] = subscriber_request_fields(
+            callerid=callerid, topic=topic, md5sum=md5sum, type_name=type_name,
+            message_definition=message_definition, tcp_nodelay=tcp_nodelay)
         self._header = HeaderDecoder(max_header=max_header, max_field=max_field)
         self._max_frame = max_frame
         self._frames: FrameDecoder | None = None
@@ -261,7 +348,7 @@ class SubscriberHandshake(_Machine):
 
     def initiate(self) -> bytes:
         """Return our connection header (to send right after connecting)."""
-        self._fire("connect")
+        self._fire(Trigger.CONNECT)
         return encode_header(self.fields)
 
     def receive_data(self, data: bytes | memoryview) -> list[Event]:
@@ -271,11 +358,11 @@ class SubscriberHandshake(_Machine):
             RemoteError, HandshakeRejected, HeaderFormatError, FrameError: see the table. A
                 FrameError's ``partial`` holds the events decoded before the bad length.
         """
-        if self.state == "AWAIT_HEADER":
+        if self.state is State.AWAIT_HEADER:
             try:
                 fields = self._header.feed(data)
             except ProtocolError:
-                self._fire("header_bad")
+                self._fire(Trigger.HEADER_BAD)
                 raise
             if fields is None:
                 return []
@@ -283,12 +370,12 @@ class SubscriberHandshake(_Machine):
             try:
                 check_publisher_header(fields, self.fields["md5sum"], self.fields["type"])
             except RemoteError:
-                self._fire("header_error")
+                self._fire(Trigger.HEADER_ERROR)
                 raise
             except ProtocolError:
-                self._fire("header_bad")
+                self._fire(Trigger.HEADER_BAD)
                 raise
-            self._fire("header_ok")
+            self._fire(Trigger.HEADER_OK)
             self.peer = fields
             events.append(Connected(fields, b"", self.fields["topic"],
                                     fields.get("latching", "0") == "1",
@@ -301,7 +388,7 @@ class SubscriberHandshake(_Machine):
                     exc.partial = events + exc.partial
                     raise
             return events
-        if self.state == "STREAMING":
+        if self.state is State.STREAMING:
             return self._frames_from(data)
         raise StateError(f"subscriber handshake: data received in state {self.state}")
 
@@ -313,7 +400,7 @@ class SubscriberHandshake(_Machine):
             bodies = dec.feed(data)
         except ProtocolError as exc:
             exc.partial = self._frame_events(exc.partial, start)
-            self._fire("frame_bad")
+            self._fire(Trigger.FRAME_BAD)
             raise
         return self._frame_events(bodies, start)
 
@@ -321,7 +408,7 @@ class SubscriberHandshake(_Machine):
         assert self._frames is not None
         out: list[Event] = []
         for i, (body, at) in enumerate(zip(bodies, self._frames.starts)):
-            self._fire("frame")
+            self._fire(Trigger.FRAME)
             out.append(Frame(body, start + i, at))
         return out
 
@@ -332,7 +419,7 @@ class SubscriberHandshake(_Machine):
         :meth:`receive_into`) instead of copying from a chunk; when this is None it feeds
         :meth:`receive_data`. See :meth:`FrameDecoder.pending_body`.
         """
-        if self.state != "STREAMING" or self._frames is None:
+        if self.state is not State.STREAMING or self._frames is None:
             return None
         return self._frames.pending_body()
 
@@ -342,7 +429,7 @@ class SubscriberHandshake(_Machine):
         Raises:
             StateError: not streaming, no body pending, or ``n`` larger than what it misses.
         """
-        if self.state != "STREAMING" or self._frames is None:
+        if self.state is not State.STREAMING or self._frames is None:
             raise StateError(f"subscriber handshake: receive_into in state {self.state}")
         start = self._frames.frames
         return self._frame_events(self._frames.filled(n), start)
@@ -353,11 +440,11 @@ class SubscriberHandshake(_Machine):
         Raises:
             IncompleteError: closed before the header completed, or mid-frame.
         """
-        if self.state == "AWAIT_HEADER":
-            self._fire("eof")
+        if self.state is State.AWAIT_HEADER:
+            self._fire(Trigger.EOF)
             self._header.eof()
-        if self.state == "STREAMING":
-            self._fire("eof")
+        if self.state is State.STREAMING:
+            self._fire(Trigger.EOF)
             assert self._frames is not None
             self._frames.eof()
             return [Closed(self._frames.frames)]
@@ -369,8 +456,8 @@ class SubscriberHandshake(_Machine):
         Raises:
             HandshakeTimeout: always (when still waiting for the header).
         """
-        if self.state == "AWAIT_HEADER":
-            self._fire("timeout")
+        if self.state is State.AWAIT_HEADER:
+            self._fire(Trigger.TIMEOUT)
             raise HandshakeTimeout(
                 f"publisher sent no complete connection header for {self.fields['topic']} in time")
 
@@ -384,12 +471,12 @@ class PublisherHandshake(_Machine):
         peer: description of the remote end, used in error texts.
     """
 
-    role = "publisher"
+    role = Role.PUBLISHER
 
     def __init__(self, *, callerid: str, lookup: Callable[[str], TopicSpec | None],
                  peer: str = "", max_header: int = MAX_HEADER_BYTES,
                  max_field: int = MAX_FIELD_BYTES) -> None:
-        super().__init__("AWAIT_HEADER")
+        super().__init__(State.AWAIT_HEADER)
         self.callerid = callerid
         self.lookup = lookup
         self.peer_desc = peer
@@ -399,32 +486,30 @@ class PublisherHandshake(_Machine):
         self.frames_sent = 0
 
     def reply_fields(self, spec: TopicSpec) -> dict[str, str]:
-        """Our answer header for ``spec`` (roscpp's field set)."""
-        return {"callerid": self.callerid, "latching": "1" if spec.latching else "0",
-                "md5sum": spec.md5sum, "message_definition": spec.message_definition,
-                "topic": spec.topic, "type": spec.type}
+        """Our answer header for ``spec`` (:func:`publisher_reply_fields`)."""
+        return publisher_reply_fields(self.callerid, spec)
 
-    def _reject(self, trigger: str, error: ProtocolError) -> list[Event]:
+    def _reject(self, trigger: Trigger, error: ProtocolError) -> list[Event]:
         self._fire(trigger)
         return [Rejected(error, encode_header({"error": str(error)}))]
 
     def receive_data(self, data: bytes | memoryview) -> list[Event]:
         """Feed bytes from the subscriber; return the events (Connected or Rejected)."""
-        if self.state != "AWAIT_HEADER":
+        if self.state is not State.AWAIT_HEADER:
             return []  # subscribers send nothing after their header; ignore stray bytes
         try:
             fields = self._header.feed(data)
         except ProtocolError as exc:
-            return self._reject("header_bad", exc)
+            return self._reject(Trigger.HEADER_BAD, exc)
         if fields is None:
             return []
         events: list[Event] = [HeaderReceived(fields, self._header.raw, tuple(self._header.layout))]
         spec = self.lookup(fields["topic"]) if "topic" in fields else None
         problem = check_subscriber_header(fields, spec, self.peer_desc)
         if problem is not None:
-            return events + self._reject("header_rejected", HandshakeRejected(problem))
+            return events + self._reject(Trigger.HEADER_REJECTED, HandshakeRejected(problem))
         assert spec is not None
-        self._fire("header_ok")
+        self._fire(Trigger.HEADER_OK)
         self.spec, self.peer = spec, fields
         events.append(Connected(fields, encode_header(self.reply_fields(spec)), spec.topic,
                                 spec.latching, fields.get("tcp_nodelay", "0").strip() == "1"))
@@ -432,23 +517,39 @@ class PublisherHandshake(_Machine):
 
     def receive_eof(self) -> list[Event]:
         """The subscriber closed the connection."""
-        if self.state in ("AWAIT_HEADER", "STREAMING"):
-            self._fire("eof")
+        if self.state in (State.AWAIT_HEADER, State.STREAMING):
+            self._fire(Trigger.EOF)
             return [Closed(self.frames_sent)]
         return []
 
     def timeout(self) -> list[Event]:
         """The handshake time-out expired: returns Rejected (send its reply, close)."""
-        if self.state != "AWAIT_HEADER":
+        if self.state is not State.AWAIT_HEADER:
             return []
-        return self._reject("timeout", HandshakeTimeout(
+        return self._reject(Trigger.TIMEOUT, HandshakeTimeout(
             "no complete connection header received in time; closing"))
 
     def send(self, body: bytes | memoryview) -> bytes:
-        """Frame ``body`` for sending (only once streaming)."""
-        self._fire("send")
+        """Frame ``body`` for sending (only once streaming).
+
+        Raises:
+            StateError: not streaming (before the handshake, or after eof/close).
+        """
+        self._fire(Trigger.SEND)
         self.frames_sent += 1
         return encode_frame(body)
+
+    def send_parts(self, body: bytes | bytearray | memoryview) -> tuple[bytes, memoryview]:
+        """:meth:`send` without joining: ``(length prefix, body)`` for a vectored write, so a
+        big image is not copied. This is what a node's publisher streams through.
+
+        Raises:
+            StateError: not streaming (before the handshake, or after eof/close).
+        """
+        view = memoryview(body).cast("B")
+        self._fire(Trigger.SEND)
+        self.frames_sent += 1
+        return frame_prefix(len(view)), view
 
 
 __all__ = [

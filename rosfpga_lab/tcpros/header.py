@@ -17,14 +17,10 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 
-from rosfpga_lab.tcpros.errors import (
-    MAX_FIELD_BYTES,
-    MAX_HEADER_BYTES,
-    HeaderFormatError,
-    IncompleteError,
-)
+from rosfpga_lab.msg.span import ROLE_ERROR, ROLE_LENGTH, ROLE_TRAILING, ROLE_VALUE, Span
+from rosfpga_lab.tcpros.errors import HeaderFormatError, IncompleteError
+from rosfpga_lab.tcpros.limits import MAX_FIELD_BYTES, MAX_HEADER_BYTES
 
 _U32 = struct.Struct("<I")
 
@@ -63,69 +59,111 @@ def encode_error_header(message: str) -> bytes:
     return encode_header({"error": message})
 
 
-@dataclass(frozen=True)
-class HeaderField:
-    """Where one field sits in an encoded header (for drawing byte maps)."""
-
-    offset: int   # offset of the field's 4-byte length, from the start of the header
-    length: int   # value of that length
-    key: str
-    value: str
-
-
 def parse_fields(payload: bytes | memoryview, *, base_offset: int = 4,
-                 max_field: int = MAX_FIELD_BYTES) -> list[HeaderField]:
+                 max_field: int = MAX_FIELD_BYTES, lenient: bool = False) -> list[Span]:
     """Split a header payload (the bytes after the total length) into fields.
 
     Args:
         payload: the ``total_length`` bytes of fields.
-        base_offset: offset of ``payload`` in the stream, used in error messages.
+        base_offset: offset of ``payload`` in the stream (span offsets and error messages).
         max_field: largest field length accepted.
+        lenient: never raise: the first malformed field and everything after it become one
+            ``error`` span whose value is the error message (for viewers of broken bytes).
 
     Returns:
-        The fields in wire order.
+        Two spans per field, in wire order: its 4-byte length (path ``<key>.length``, role
+        ``length``, value the length) and its text (path ``<key>``, type ``key=value``, role
+        ``value``, value the value).
 
     Raises:
-        HeaderFormatError: truncated or zero-length field, field over ``max_field``, field
-            without '=', bytes that are not UTF-8.
+        HeaderFormatError: (not lenient) truncated or zero-length field, field over
+            ``max_field``, field without '=', bytes that are not UTF-8.
     """
     data = bytes(payload)
-    out: list[HeaderField] = []
+    out: list[Span] = []
     pos = 0
     while pos < len(data):
-        where = base_offset + pos
-        if len(data) - pos < 4:
-            raise HeaderFormatError(
-                f"header field length truncated at byte {where}: {len(data) - pos} of 4 bytes left",
-                offset=where)
-        (size,) = _U32.unpack_from(data, pos)
-        if size == 0:
-            raise HeaderFormatError(f"zero-length header field at byte {where}", offset=where)
-        if size > max_field:
-            raise HeaderFormatError(
-                f"header field at byte {where} declares {size} bytes, over the limit of "
-                f"{max_field} (raise max_field if this is legitimate)", offset=where)
-        if pos + 4 + size > len(data):
-            raise HeaderFormatError(
-                f"header field at byte {where} declares {size} bytes but only "
-                f"{len(data) - pos - 4} remain in the header", offset=where)
-        raw = data[pos + 4:pos + 4 + size]
         try:
-            line = raw.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            bad = where + 4 + exc.start
-            raise HeaderFormatError(
-                f"header field at byte {where} is not UTF-8 (byte {bad}: {raw[exc.start]:#04x})",
-                offset=bad) from None
-        key, sep, value = line.partition("=")
-        if not sep:
-            raise HeaderFormatError(
-                f"header field at byte {where} has no '=': {line[:60]!r}", offset=where)
-        if not key:
-            raise HeaderFormatError(f"header field at byte {where} has an empty key", offset=where)
-        out.append(HeaderField(where, size, key, value))
+            key, value, size = _parse_field(data, pos, base_offset, max_field)
+        except HeaderFormatError as exc:
+            if not lenient:
+                raise
+            out.append(Span(base_offset + pos, len(data) - pos, "(malformed field)", "bytes",
+                            str(exc), ROLE_ERROR))
+            break
+        where = base_offset + pos
+        out.append(Span(where, 4, f"{key}.length", "uint32", size, ROLE_LENGTH))
+        out.append(Span(where + 4, size, key, "key=value", value, ROLE_VALUE))
         pos += 4 + size
     return out
+
+
+def _parse_field(data: bytes, pos: int, base_offset: int, max_field: int) -> tuple[str, str, int]:
+    """``(key, value, size)`` of the field whose length starts at ``data[pos]``."""
+    where = base_offset + pos
+    if len(data) - pos < 4:
+        raise HeaderFormatError(
+            f"header field length truncated at byte {where}: {len(data) - pos} of 4 bytes left",
+            offset=where)
+    (size,) = _U32.unpack_from(data, pos)
+    if size == 0:
+        raise HeaderFormatError(f"zero-length header field at byte {where}", offset=where)
+    if size > max_field:
+        raise HeaderFormatError(
+            f"header field at byte {where} declares {size} bytes, over the limit of "
+            f"{max_field} (raise max_field if this is legitimate)", offset=where)
+    if pos + 4 + size > len(data):
+        raise HeaderFormatError(
+            f"header field at byte {where} declares {size} bytes but only "
+            f"{len(data) - pos - 4} remain in the header", offset=where)
+    raw = data[pos + 4:pos + 4 + size]
+    try:
+        line = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        bad = where + 4 + exc.start
+        raise HeaderFormatError(
+            f"header field at byte {where} is not UTF-8 (byte {bad}: {raw[exc.start]:#04x})",
+            offset=bad) from None
+    key, sep, value = line.partition("=")
+    if not sep:
+        raise HeaderFormatError(
+            f"header field at byte {where} has no '=': {line[:60]!r}", offset=where)
+    if not key:
+        raise HeaderFormatError(f"header field at byte {where} has an empty key", offset=where)
+    return key, value, size
+
+
+def header_spans(raw: bytes | memoryview, *, lenient: bool = True,
+                 max_field: int = MAX_FIELD_BYTES) -> list[Span]:
+    """Spans of a whole connection header: its total length, its fields (:func:`parse_fields`),
+    then any bytes after it (``trailing``). Every byte of ``raw`` is in one span.
+
+    Args:
+        raw: the header bytes, from its 4-byte total length on.
+        lenient: (default) never raise; a header cut short or a bad field gets an ``error``
+            span. False: raise as :func:`parse_fields` does.
+        max_field: largest field length accepted.
+
+    Raises:
+        HeaderFormatError, IncompleteError: only when not ``lenient``.
+    """
+    data = bytes(raw)
+    if len(data) < 4:
+        if not lenient:
+            raise IncompleteError(f"connection header length truncated: {len(data)} of 4 bytes",
+                                  offset=len(data))
+        return [Span(0, len(data), "header length (truncated)", "uint32",
+                     f"{len(data)} of 4 bytes", ROLE_ERROR)] if data else []
+    (total,) = _U32.unpack_from(data, 0)
+    end = min(len(data), 4 + total)
+    if not lenient and end < 4 + total:
+        raise IncompleteError(f"connection header declares {total} bytes, only {end - 4} given",
+                              offset=end)
+    spans = [Span(0, 4, "header length", "uint32", total, ROLE_LENGTH)]
+    spans += parse_fields(data[4:end], base_offset=4, max_field=max_field, lenient=lenient)
+    if len(data) > end:
+        spans.append(Span(end, len(data) - end, "(after the header)", "bytes", None, ROLE_TRAILING))
+    return spans
 
 
 def decode_header(data: bytes | memoryview, *, max_header: int = MAX_HEADER_BYTES,
@@ -161,7 +199,7 @@ class HeaderDecoder:
         self._buf = bytearray()
         self._need: int | None = None
         self.fields: dict[str, str] | None = None
-        self.layout: list[HeaderField] = []
+        self.layout: list[Span] = []
         self.raw: bytes = b""
         self.remainder: bytes = b""
 
@@ -196,7 +234,7 @@ class HeaderDecoder:
             return None
         raw = bytes(self._buf[:self._need])
         self.layout = parse_fields(raw[4:], base_offset=4, max_field=self.max_field)
-        self.fields = {f.key: f.value for f in self.layout}
+        self.fields = {s.path: s.value for s in self.layout if s.role == ROLE_VALUE}
         self.raw = raw
         self.remainder = bytes(self._buf[self._need:])
         self._buf = bytearray()

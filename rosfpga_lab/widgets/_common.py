@@ -1,4 +1,4 @@
-"""Shared pieces of the notebook widgets: the error type, limits, colours, HTML helpers.
+"""Shared pieces of the notebook widgets: the error type, colours, HTML helpers (limits: ``limits``).
 
 Everything here is plain Python (no front-end needed), so the widgets' logic can be tested in
 pytest and their static HTML forms can be produced without a kernel.
@@ -13,29 +13,20 @@ from typing import Any
 import numpy as np
 
 from rosfpga_lab.errors import LabError
-
-# --- limits (one place) --------------------------------------------------------------------
-#: Bytes shown per page of the byte viewer (32 rows of 16). The browser never gets more.
-BYTE_PAGE_SIZE = 512
-#: Largest page the byte viewer accepts, so a page always stays a small piece of HTML.
-BYTE_PAGE_SIZE_MAX = 8192
-#: Bytes per hex row.
-BYTE_ROW_SIZE = 16
-#: Fields listed in the live field list and in static field tables before "... N more".
-FIELD_LIST_LIMIT = 2000
-#: Characters of a decoded value shown before it is cut with an ellipsis.
-VALUE_TEXT_LIMIT = 80
-#: Mismatch positions kept in an image diff summary (the count is always exact).
-DIFF_POSITIONS_LIMIT = 1000
-#: Side (pixels) of the largest zoom region whose values are tabulated.
-ZOOM_MAX = 16
-#: Beats per page of the beat table, and beats shown in the waveform.
-BEAT_PAGE_SIZE = 32
-WAVE_BEATS = 16
-#: Live view: default most frames per second pushed to the browser.
-LIVE_MAX_FPS = 10.0
-#: Largest width (pixels) of an image sent to the browser; bigger ones are scaled down.
-DISPLAY_MAX_WIDTH = 640
+from rosfpga_lab.widgets.limits import (  # noqa: F401  (re-exported: widgets import them from here)
+    BYTE_PAGE_SIZE,
+    BYTE_PAGE_SIZE_MAX,
+    BYTE_ROW_SIZE,
+    FIELD_LIST_LIMIT,
+    VALUE_TEXT_LIMIT,
+    DIFF_POSITIONS_LIMIT,
+    ZOOM_MAX,
+    BEAT_PAGE_SIZE,
+    WAVE_BEATS,
+    LIVE_MAX_FPS,
+    LIVE_RATE_WINDOW,
+    DISPLAY_MAX_WIDTH,
+)
 
 
 class WidgetError(LabError):

@@ -1,7 +1,8 @@
 """Adapters: field spans for the byte viewer from messages, TCPROS and HTTP/XML-RPC bytes.
 
 Each function takes raw bytes (plus what it needs to interpret them) and returns a list of
-:class:`~rosfpga_lab.widgets.byteview.Span`, covering the bytes in order. They never raise on
+:class:`~rosfpga_lab.msg.Span` (the lab's one span type), covering the bytes in order. TCPROS
+headers and frames are split by the tcpros parsers in their lenient mode. They never raise on
 malformed input: what cannot be parsed gets one ``error`` span whose value says why, so a broken
 frame can still be looked at byte by byte.
 """
@@ -13,13 +14,15 @@ import struct
 import xmlrpc.client
 from typing import Any
 
+from rosfpga_lab.tcpros import frame_spans, header_spans
 from rosfpga_lab.widgets.byteview import ByteViewer, Span
 
 _U32 = struct.Struct("<I")
 
 
 def spans_from_field_layout(layout: list[Any], base: int = 0) -> list[Span]:
-    """Spans from ``rosfpga_lab.msg.field_layout`` output (FieldSpan), shifted by ``base`` bytes."""
+    """Spans from ``rosfpga_lab.msg.field_layout`` output, shifted by ``base`` bytes (an unnamed
+    span is named by its role, e.g. ``(trailing)``)."""
     return [Span(f.offset + base, f.size, f.path or f"({f.role})", f.type, f.value, f.role) for f in layout]
 
 
@@ -80,57 +83,19 @@ def message_viewer(type_name: str, body: bytes, *, registry: Any = None, title: 
 
 
 def spans_from_frame(raw: bytes, type_name: str | None = None, *, registry: Any = None) -> list[Span]:
-    """Spans of a TCPROS message frame: the 4-byte length, then the body (by fields if ``type_name``)."""
-    if len(raw) < 4:
-        return [Span(0, len(raw), "frame length (truncated)", "uint32", f"{len(raw)} of 4 bytes", "error")]
-    (length,) = _U32.unpack_from(raw, 0)
-    spans = [Span(0, 4, "frame length", "uint32", length, "length")]
-    body = raw[4:]
-    if not body:
-        return spans
-    if type_name is not None and len(body) >= length:
-        spans += message_spans(type_name, body[:length], registry=registry, base=4)
-        if len(body) > length:
-            spans.append(Span(4 + length, len(body) - length, "(next frame)", "bytes", None, "trailing"))
-        return spans
-    note = f"{len(body)} of {length} body bytes recorded" if len(body) < length else f"{length} bytes"
-    spans.append(Span(4, len(body), "message body", "bytes", note, "value"))
-    return spans
+    """Spans of a TCPROS message frame: the 4-byte length, then the body (by fields if
+    ``type_name``); :func:`rosfpga_lab.tcpros.frame_spans`."""
+    return frame_spans(raw, type_name, registry=registry)
 
 
 def spans_from_connection_header(raw: bytes) -> list[Span]:
     """Spans of a TCPROS connection header: total length, then each field's length and ``key=value``.
 
     A field's span is named by its key and its value is the field's value; its length prefix is
-    ``<key>.length``. Parsing follows ``rosfpga_lab.tcpros.parse_fields``; the first malformed
-    field and everything after it become one ``error`` span.
+    ``<key>.length``. This is :func:`rosfpga_lab.tcpros.header_spans` (the tcpros parser in its
+    lenient mode): the first malformed field and everything after it become one ``error`` span.
     """
-    if len(raw) < 4:
-        return [Span(0, len(raw), "header length (truncated)", "uint32", f"{len(raw)} of 4 bytes", "error")]
-    (total,) = _U32.unpack_from(raw, 0)
-    spans = [Span(0, 4, "header length", "uint32", total, "length")]
-    end = min(len(raw), 4 + total)
-    pos = 4
-    while pos < end:
-        if end - pos < 4:
-            spans.append(Span(pos, end - pos, "(truncated field length)", "bytes", "fewer than 4 bytes left", "error"))
-            pos = end
-            break
-        (size,) = _U32.unpack_from(raw, pos)
-        if size == 0 or pos + 4 + size > end:
-            why = "zero-length field" if size == 0 else f"field declares {size} bytes, only {end - pos - 4} left"
-            spans.append(Span(pos, end - pos, "(malformed field)", "bytes", why, "error"))
-            pos = end
-            break
-        text = raw[pos + 4:pos + 4 + size].decode("utf-8", errors="replace")
-        key, sep, value = text.partition("=")
-        name = key if sep else "(field without '=')"
-        spans.append(Span(pos, 4, f"{name}.length", "uint32", size, "length"))
-        spans.append(Span(pos + 4, size, name, "key=value", value if sep else text, "value"))
-        pos += 4 + size
-    if len(raw) > end:
-        spans.append(Span(end, len(raw) - end, "(after the header)", "bytes", None, "trailing"))
-    return spans
+    return header_spans(raw, lenient=True)
 
 
 def spans_from_tcpros_stream(raw: bytes, type_name: str | None = None, *, registry: Any = None) -> list[Span]:
@@ -152,8 +117,7 @@ def spans_from_tcpros_stream(raw: bytes, type_name: str | None = None, *, regist
         chunk = rest if length is None else rest[:4 + length]
         full = length is not None and len(chunk) == 4 + length
         inner = spans_from_frame(chunk, type_name if full else None, registry=registry)
-        for sp in inner:
-            spans.append(Span(sp.offset + pos, sp.size, f"msg[{k}].{sp.path}", sp.type, sp.value, sp.role))
+        spans += [sp.moved(pos, f"msg[{k}].") for sp in inner]
         pos += len(chunk)
         k += 1
     return spans
@@ -216,10 +180,10 @@ def spans_from_http(raw: bytes) -> list[Span]:
         elif tag.startswith(b"<fault>"):
             spans.append(Span(body_at + m.start(), m.end() - m.start(), "fault", "xml", None, "error"))
         else:
-            value = params[k] if k < len(params) else None
+            param = params[k] if k < len(params) else None
             names = api_param_names(method) if method else ()
             name = names[k] if k < len(names) else f"param[{k}]"
-            spans.append(Span(body_at + m.start(), m.end() - m.start(), name, "xml", value, "value"))
+            spans.append(Span(body_at + m.start(), m.end() - m.start(), name, "xml", param, "value"))
             k += 1
         pos = m.end()
     if pos < len(body):

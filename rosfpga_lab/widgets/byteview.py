@@ -27,6 +27,7 @@ import anywidget
 import numpy as np
 import traitlets
 
+from rosfpga_lab.msg.span import Span
 from rosfpga_lab.widgets._common import (
     BYTE_PAGE_SIZE,
     BYTE_PAGE_SIZE_MAX,
@@ -41,27 +42,6 @@ from rosfpga_lab.widgets._common import (
 )
 
 STATIC = Path(__file__).resolve().parent / "static"
-
-
-@dataclass(frozen=True)
-class Span:
-    """One field's bytes: ``data[offset:offset + size]``.
-
-    Attributes:
-        offset: first byte of the field.
-        size: number of bytes (0 for an empty array; it is listed but owns no byte).
-        path: the field's name, e.g. ``header.stamp.secs`` or ``data``.
-        type: its type as text, e.g. ``uint32``, ``string``, ``uint8[]``.
-        value: the decoded value (any object; shown shortened).
-        role: what the bytes are for, e.g. ``length`` for a length prefix (chooses a fixed colour).
-    """
-
-    offset: int
-    size: int
-    path: str
-    type: str = ""
-    value: Any = None
-    role: str = ""
 
 
 def as_span(item: Any) -> Span:
@@ -336,8 +316,8 @@ class ByteViewer(StaticFallback, anywidget.AnyWidget):
     page_start = traitlets.Int(0).tag(sync=True)
     row_size = traitlets.Int(BYTE_ROW_SIZE).tag(sync=True)
     page_hex = traitlets.Unicode("").tag(sync=True)
-    fields = traitlets.List([]).tag(sync=True)
-    page_fields = traitlets.List([]).tag(sync=True)
+    fields: traitlets.List[Any] = traitlets.List([]).tag(sync=True)
+    page_fields: traitlets.List[Any] = traitlets.List([]).tag(sync=True)
     fields_truncated = traitlets.Int(0).tag(sync=True)
     #: Index of the selected field in the byte map's spans, -1 for none.
     selected = traitlets.Int(-1).tag(sync=True)

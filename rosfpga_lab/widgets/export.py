@@ -20,9 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosfpga_lab.widgets._common import STATIC_EXPORT_PRIORITY, WidgetError
+from rosfpga_lab.widgets.limits import CELL_TIMEOUT
 
-#: Seconds one cell may run before the export gives up.
-CELL_TIMEOUT = 300
 #: Markdown marked with this class speaks of the live notebook only; pages leave it out.
 LIVE_ONLY_CLASS = "rfl-live-only"
 _LIVE_ONLY = re.compile(rf'<span class="{LIVE_ONLY_CLASS}">.*?</span>[ \t]*', re.S)

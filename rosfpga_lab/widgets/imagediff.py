@@ -12,6 +12,7 @@ Images are numpy arrays HxW or HxWxC (C = 1, 3, 4), uint8, channels in ``channel
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Iterable, Sequence
 from typing import Any
 
@@ -60,7 +61,7 @@ def _pool_any(mask: np.ndarray, step: int) -> np.ndarray:
     ph, pw = -(-h // step) * step, -(-w_ // step) * step
     padded = np.zeros((ph, pw), bool)
     padded[:h, :w_] = mask
-    return padded.reshape(ph // step, step, pw // step, step).any(axis=(1, 3))
+    return np.asarray(padded.reshape(ph // step, step, pw // step, step).any(axis=(1, 3)))
 
 
 #: The two difference views: the model's output against the reference (is the circuit right?)
@@ -80,7 +81,7 @@ def caption(name: str, reference_name: str = "reference") -> str:
 
 def _mismatch_mask(a: np.ndarray, b: np.ndarray, tolerance: int) -> np.ndarray:
     diff = np.abs(a.astype(np.int16) - b.astype(np.int16))
-    return (diff > tolerance) if diff.ndim == 2 else (diff > tolerance).any(axis=2)
+    return np.asarray((diff > tolerance) if diff.ndim == 2 else (diff > tolerance).any(axis=2))
 
 
 class FrameDiff:
@@ -119,7 +120,8 @@ class FrameDiff:
         self.tolerance, self.channel_order = int(tolerance), channel_order
         self.name, self.reference_name = name, reference_name
         diff = np.abs(self.output.astype(np.int16) - self.reference.astype(np.int16))
-        self.mask = (diff > self.tolerance) if diff.ndim == 2 else (diff > self.tolerance).any(axis=2)
+        self.mask: np.ndarray = np.asarray(
+            (diff > self.tolerance) if diff.ndim == 2 else (diff > self.tolerance).any(axis=2))
         self.change: np.ndarray | None = None   # per pixel, the largest channel change input -> output
         if self.input is not None and self.input.shape == self.output.shape:
             delta = np.abs(self.output.astype(np.int16) - self.input.astype(np.int16)).astype(np.uint8)
@@ -390,7 +392,7 @@ class ImageDiffViewer(StaticFallback, w.VBox):
             img = self.images.get(name)
             if img is None:
                 img = self.images[name] = ClickImage()
-                img.on_click(lambda x, y, _n=name: self._clicked(_n, x, y))
+                img.on_click(functools.partial(self._clicked, name))
             img.caption = caption(name, f.reference_name)
             src = f.input if name == "input" and f.input is not None else f.output
             img.src_height, img.src_width = int(src.shape[0]), int(src.shape[1])

@@ -25,8 +25,10 @@ from typing import Any
 import ipywidgets as w
 import numpy as np
 
+from rosfpga_lab.graph.rate import RateMeter
 from rosfpga_lab.widgets._common import (
     LIVE_MAX_FPS,
+    LIVE_RATE_WINDOW,
     StaticFallback,
     WidgetError,
     as_image,
@@ -66,28 +68,6 @@ class Throttle:
         return True
 
 
-class RateMeter:
-    """Events per second over the last ``window`` seconds."""
-
-    def __init__(self, window: float = 2.0, clock: Callable[[], float] = time.monotonic) -> None:
-        self.window, self.clock = window, clock
-        self._times: deque[float] = deque()
-
-    def tick(self, now: float | None = None) -> None:
-        now = self.clock() if now is None else now
-        self._times.append(now)
-        while self._times and self._times[0] < now - self.window:
-            self._times.popleft()
-
-    def rate(self, now: float | None = None) -> float:
-        """Events per second: (events in window - 1) / time they span; 0 with fewer than two."""
-        now = self.clock() if now is None else now
-        times = [t for t in self._times if t >= now - self.window]
-        if len(times) < 2 or times[-1] <= times[0]:
-            return 0.0
-        return (len(times) - 1) / (times[-1] - times[0])
-
-
 class LiveView(StaticFallback, w.VBox):
     """Shows the newest frame, incoming and shown fps, and latency; safe to update from any thread.
 
@@ -113,7 +93,8 @@ class LiveView(StaticFallback, w.VBox):
         self.throttle = Throttle(max_fps, clock)
         self.clock = clock
         self.max_width, self.channel_order, self.image_format, self.trailing = max_width, channel_order, image_format, trailing
-        self.incoming, self.shown_rate = RateMeter(clock=clock), RateMeter(clock=clock)
+        self.incoming = RateMeter(window_s=LIVE_RATE_WINDOW, clock=clock)
+        self.shown_rate = RateMeter(window_s=LIVE_RATE_WINDOW, clock=clock)
         self.received = 0
         self.shown = 0
         self.latencies: deque[float] = deque(maxlen=50)
@@ -165,9 +146,10 @@ class LiveView(StaticFallback, w.VBox):
         img = as_image(frame, "frame")
         inp = None if input is None else as_image(input, "input")
         if channel_order is not None and channel_order != self.channel_order:
-            img, inp = (None if a is None else
-                        a[:, :, [2, 1, 0] + ([3] if a.shape[2] == 4 else [])] if a.ndim == 3 and a.shape[2] >= 3 else a
-                        for a in (img, inp))
+            def swap(a: np.ndarray) -> np.ndarray:
+                return a[:, :, [2, 1, 0] + ([3] if a.shape[2] == 4 else [])] if a.ndim == 3 and a.shape[2] >= 3 else a
+            img = swap(img)
+            inp = None if inp is None else swap(inp)
         if latency is None and stamp is not None:
             latency = time.time() - stamp
         with self._lock:

@@ -286,6 +286,8 @@ def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None 
                   + (f"\n{e.detail}" if e.detail else ""))
         out.append(f'<g class="rfl-arrow{sel}" data-index="{k}"><title>{tip}</title>')
         x1, x2 = xs[e.src], xs[e.dst]
+        tx: float
+        room: float
         if x1 == x2:
             path = f"M{x1},{y - 8} h40 v14 h-40"
             out.append(f'<path d="{path}" fill="none" stroke="transparent" stroke-width="12"/>')

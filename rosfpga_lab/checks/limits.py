@@ -1,0 +1,9 @@
+"""Limits of the exercise checks, in one place."""
+
+from __future__ import annotations
+
+#: How many problems one failed check lists at most.
+MAX_PROBLEMS = 5
+#: Bytes compared when looking for a shifted stream, and the largest shift looked for.
+SHIFT_WINDOW = 16
+MAX_SHIFT = 8
