@@ -8,29 +8,14 @@ from __future__ import annotations
 
 import functools
 import importlib.util
-import shutil
-import sys
 from pathlib import Path
 
 from realros import skip_or_fail
+from rosfpga_lab.rtl.sim import VERILOG_DIR, cxx_compiler
+from rosfpga_lab.rtl.sim import find_tool as tool
 
 REQUIRE = "ROSFPGA_REQUIRE_RTL"
-VERILOG_DIR = Path(__file__).resolve().parent.parent / "rosfpga_lab" / "rtl" / "verilog"
 TB_DIR = Path(__file__).resolve().parent / "rtl"
-
-
-def tool(name: str) -> str | None:
-    """``name`` on PATH or beside this Python (a virtual environment's ``bin``)."""
-    found = shutil.which(name)
-    if found:
-        return found
-    beside = Path(sys.executable).parent / name
-    return str(beside) if beside.exists() else None
-
-
-def cxx_compiler() -> str | None:
-    """A C++ compiler (Verilator compiles its model with one), or None."""
-    return shutil.which("g++") or shutil.which("c++") or shutil.which("clang++")
 
 
 @functools.cache

@@ -20,37 +20,9 @@ import pytest
 from rosfpga_lab.graph import EmbeddedMaster, Node, Trace, XmlRpcError, XmlRpcServer, call
 from rosfpga_lab.graph.limits import MAX_HTTP_HEAD, MAX_PUBLISHERS_PER_TOPIC, MAX_XMLRPC_DEPTH
 
+from test_graph_node import master, nodes, wait_until  # noqa: F401  (the graph tests' fixtures)
+
 pytestmark = pytest.mark.timeout(90)
-
-
-@pytest.fixture
-def master():
-    m = EmbeddedMaster(port=0).start()
-    yield m
-    m.stop()
-
-
-@pytest.fixture
-def nodes(master):
-    made: list[Node] = []
-
-    def make(name: str, **kw) -> Node:
-        n = Node(name, master=master, **kw)
-        made.append(n)
-        return n
-
-    yield make
-    for n in made:
-        n.shutdown()
-
-
-def wait_until(pred, timeout: float = 5.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if pred():
-            return True
-        time.sleep(0.02)
-    return pred()
 
 
 def http_post(port: int, body: bytes, extra_head: bytes = b"", timeout: float = 10.0) -> bytes:

