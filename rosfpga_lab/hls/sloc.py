@@ -10,6 +10,7 @@ character literal there (it is part of sized numbers such as ``8'hFF``).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -89,6 +90,25 @@ class SlocTable:
         return self.subscriber + self.publisher
 
 
+def count_files(root: Path, counted: Mapping[str, Sequence[str]], others: Sequence[str],
+                count: Callable[[str], int], missing: Callable[[Path], Exception]) -> SlocTable:
+    """Table 1's counts of one folder: the ``counted`` files of the subscriber and the publisher
+    (each must exist, else ``missing(path)`` is raised) and those of ``others`` that are there,
+    each file counted with ``count`` (the C++ rule, or the Verilog one)."""
+    counts = {}
+    for part, files in counted.items():
+        total = 0
+        for name in files:
+            path = root / name
+            if not path.is_file():
+                raise missing(path)
+            total += count(path.read_text(encoding="utf-8"))
+        counts[part] = total
+    present = {name: count((root / name).read_text(encoding="utf-8"))
+               for name in others if (root / name).is_file()}
+    return SlocTable(counts["subscriber"], counts["publisher"], present)
+
+
 def count_sloc(project_dir: str | Path) -> SlocTable:
     """Count the lines of a generated project.
 
@@ -96,19 +116,8 @@ def count_sloc(project_dir: str | Path) -> SlocTable:
         HlsError: the directory lacks subscriber.cpp or publisher.cpp.
     """
     root = Path(project_dir)
-    counts = {}
-    for part, files in COUNTED.items():
-        total = 0
-        for name in files:
-            path = root / name
-            if not path.is_file():
-                raise HlsError(f"{path} not found: is {root} a directory written by "
-                               "'rosfpga-lab generate'?")
-            total += sloc(path.read_text(encoding="utf-8"))
-        counts[part] = total
-    others = {name: sloc((root / name).read_text(encoding="utf-8"))
-              for name in OTHERS if (root / name).is_file()}
-    return SlocTable(counts["subscriber"], counts["publisher"], others)
+    return count_files(root, COUNTED, OTHERS, sloc, lambda path: HlsError(
+        f"{path} not found: is {root} a directory written by 'rosfpga-lab generate'?"))
 
 
 def format_table(table: SlocTable, title: str = "", verilog: SlocTable | None = None) -> str:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rosfpga_lab.hls.sloc import SlocTable, sloc
+from rosfpga_lab.hls.sloc import SlocTable, count_files, sloc
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.sim import VERILOG_DIR
 
@@ -38,16 +38,5 @@ def count_verilog(directory: str | Path | None = None) -> SlocTable:
         RtlError: a counted file is missing.
     """
     root = Path(directory) if directory is not None else VERILOG_DIR
-    counts = {}
-    for part, files in COUNTED.items():
-        total = 0
-        for name in files:
-            path = root / name
-            if not path.is_file():
-                raise RtlError(f"{path} not found: is {root} the rtl/ folder of a generated "
-                               "project?")
-            total += verilog_sloc(path.read_text(encoding="utf-8"))
-        counts[part] = total
-    others = {name: verilog_sloc((root / name).read_text(encoding="utf-8"))
-              for name in OTHERS if (root / name).is_file()}
-    return SlocTable(counts["subscriber"], counts["publisher"], others)
+    return count_files(root, COUNTED, OTHERS, verilog_sloc, lambda path: RtlError(
+        f"{path} not found: is {root} the rtl/ folder of a generated project?"))
