@@ -216,12 +216,16 @@ def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
                     break
                 time.sleep(0.05)
             cam = Camera("/image_raw", rate=30, master=master, source="synthetic")
+            viewer = Viewer("/image_dilated", master=master, queue_size=20)
             try:
                 assert cam.publisher.wait_for_subscribers(1, 10)
-                cam.run(count=15)
-                time.sleep(0.5)
+                assert viewer.subscriber.wait_for_connection(1, 10)
+                for sent in range(1, 16):  # in lock step: the report's counts, not the load, decide
+                    cam.publish_one()
+                    assert viewer.wait_for(sent, timeout=20), f"frame {sent} never came out"
             finally:
                 cam.stop()
+                viewer.stop()
             proc.send_signal(signal.SIGINT)
             out, err = proc.communicate(timeout=20)
         finally:

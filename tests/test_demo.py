@@ -12,14 +12,17 @@ import numpy as np
 import pytest
 
 from rosfpga_lab.cli import main
-from rosfpga_lab.component import run_demo
+from rosfpga_lab.component import ComponentConfigError, run_demo
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 def test_demo_command_passes_bit_exact(tmp_path, capsys) -> None:
     png = tmp_path / "demo.png"
-    code = main(["demo", "--frames", "45", "--output", str(png), "--scale", "0.5"])
+    # a queue as deep as the run: a loaded machine may be slower than the camera, and this test
+    # checks the summary's counts, not the machine (drops are test_a_slow_circuit_drops_...)
+    code = main(["demo", "--frames", "45", "--input-queue", "45", "--output", str(png),
+                 "--scale", "0.5"])
     out = capsys.readouterr().out
     assert code == 0, out
     assert "bit-exact: 45/45" in out
@@ -31,7 +34,8 @@ def test_demo_command_passes_bit_exact(tmp_path, capsys) -> None:
 
 def test_demo_as_a_separate_process_exits_zero(tmp_path) -> None:
     proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "demo", "--frames", "10",
-                           "--source", "synthetic", "--no-figure"], capture_output=True, text=True,
+                           "--source", "synthetic", "--no-figure", "--input-queue", "10"],
+                          capture_output=True, text=True,
                           timeout=120, cwd=tmp_path)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "bit-exact: 10/10" in proc.stdout
@@ -39,7 +43,7 @@ def test_demo_as_a_separate_process_exits_zero(tmp_path) -> None:
 
 def test_demo_with_another_config_erode_mono8(tmp_path) -> None:
     result = run_demo(DATA / "fpga_erode_mono8.yaml", frames=10, rate=60, source="synthetic",
-                      png=tmp_path / "erode.png")
+                      png=tmp_path / "erode.png", input_queue=10)
     assert result.ok, "\n".join(result.lines())
     assert result.check.bit_exact == 10 and result.component.cycles["erode"] > 0
     assert (tmp_path / "erode.png").exists()
@@ -48,7 +52,7 @@ def test_demo_with_another_config_erode_mono8(tmp_path) -> None:
 def test_checker_catches_a_wrong_circuit(tmp_path) -> None:
     """Negative control: checked against erode, the dilating component must fail every frame."""
     result = run_demo(frames=5, rate=60, source="synthetic", png=tmp_path / "bad.png",
-                      oracle_op="erode")
+                      oracle_op="erode", input_queue=5)
     assert not result.ok
     assert result.received == 5 and result.check.bit_exact == 0
     assert all("differ from OpenCV's cv2.erode" in m for m in result.check.mismatches)
@@ -73,6 +77,34 @@ def test_demo_with_the_reference_model_checks_every_frame() -> None:
     assert result.ok, "\n".join(result.lines())
     assert result.component.dropped == 0 and result.check.bit_exact == 3
     assert "circuit: passthrough on 160x120 rgb8" in result.lines()[0]
+
+
+def test_a_slow_circuit_drops_frames_and_the_demo_counts_them() -> None:
+    """The reference model (about 0.1 s a 160x120 frame) behind a one-frame queue, a camera at
+    30 frames/s: the queue keeps the newest frame and drops the rest, as a ROS queue does. The
+    verdict holds (every output bit-exact, every frame accounted for) and the summary says why."""
+    from dataclasses import replace
+
+    result = run_demo(DATA / "fpga_passthrough_rgb8.yaml", frames=8, rate=30, source="synthetic",
+                      png=None, model="reference", input_queue=1)
+    dropped = result.component.dropped
+    lines = "\n".join(result.lines())
+    assert dropped > 0 and result.received + dropped == result.sent == 8, lines
+    assert result.ok and result.lost == 0, lines
+    assert f"bit-exact: {result.received}/{result.received}" in lines
+    assert f"dropped {dropped} of 8: the circuit model was slower than the camera" in lines
+    vanished = replace(result, received=result.received - 1)   # an output that never came
+    assert vanished.lost == 1 and not vanished.ok
+    assert "lost 1 of 8: sent, never came back, and not dropped by the component" in \
+        "\n".join(vanished.lines())
+
+
+def test_demo_input_queue_is_checked(capsys) -> None:
+    with pytest.raises(SystemExit):
+        main(["demo", "--input-queue", "0"])
+    assert "argument --input-queue: want a number of at least 1, got 0" in capsys.readouterr().err
+    with pytest.raises(ComponentConfigError, match="input_queue must be at least 1, not 0"):
+        run_demo(frames=1, png=None, input_queue=0)
 
 
 def test_demo_rig_runs_in_the_background_for_a_live_view() -> None:

@@ -18,7 +18,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "checks EVERY output frame bit for bit against OpenCV (cv2.dilate / cv2.erode) run on "
         "the input. Prints frames, fps, latency and 'bit-exact: N/N'; writes input, output and "
         "their difference (output - input: what the circuit changed) to a PNG. Exit code 0 only "
-        "when every frame came back bit-exact. Needs nothing beyond the lab; takes a few seconds. "
+        "when every output came back bit-exact and every frame sent is accounted for (back, or "
+        "dropped by a full queue in front of a slower circuit, counted). Needs nothing beyond the "
+        "lab; takes a few seconds. "
         "For a room: --view serves a live page (input, output, counters) on 127.0.0.1 while it "
         "runs, e.g. rosfpga-lab demo --view --frames 900 --rate 15 (a minute).")
     p.add_argument("--config", type=Path, metavar="CONFIG",
@@ -36,6 +38,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--model", choices=("fast", "reference"), default="fast",
                    help="circuit model (reference: byte at a time, about 0.3 s per 160x120 "
                    "frame; try --config data/fpga_passthrough_rgb8.yaml --frames 5)")
+    p.add_argument("--input-queue", type=positive_int, metavar="N",
+                   help="frames waiting in front of the circuit (default: 2, as a camera "
+                   "driver's queue; every frame with --model reference). A circuit slower than "
+                   "the camera drops the oldest waiting frame and the summary counts it; "
+                   "--input-queue at least --frames never drops")
     p.add_argument("--timeout", type=positive_float, default=30.0,
                    help="seconds to wait for the last output (default: 30)")
     p.add_argument("--view", action="store_true",
@@ -60,7 +67,7 @@ def _announce(url: str) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the demo; 0 when every frame came back bit-exact."""
+    """Run the demo; 0 when every output came back bit-exact and no frame was lost."""
     from rosfpga_lab.component import run_demo
 
     try:
@@ -69,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
                           timeout=args.timeout, png_scale=args.scale,
                           progress=print if args.verbose else None,
                           view=_announce if args.view else None, pcap=args.pcap,
-                          pcap_frame_bytes=args.pcap_frame_bytes)
+                          pcap_frame_bytes=args.pcap_frame_bytes, input_queue=args.input_queue)
     except KeyboardInterrupt:
         print("rosfpga-lab demo: interrupted (everything it started is stopped); no verdict",
               file=sys.stderr)

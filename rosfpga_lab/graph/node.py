@@ -548,16 +548,22 @@ class Node:
         for topic_object in topic_objects:
             self._leave(topic_object)
             topic_object.close()
-        hard_close(self._tcp)
-        with self._lock:
-            pending = list(self._pending)
+        try:  # wakes the accept thread; the socket is closed once that thread has left accept()
+            self._tcp.shutdown(socket.SHUT_RDWR)
+        except OSError:
+            pass
+        with self._lock:  # a handshake thread takes its socket out of _pending before closing it
             handshakes = list(self._handshakes)
-        for conn in pending:
-            hard_close(conn)
+            for conn in self._pending:  # wakes its handshake thread, which closes it
+                try:
+                    conn.shutdown(socket.SHUT_RDWR)
+                except OSError:
+                    pass
         for t in handshakes:
             if t is not threading.current_thread():
                 t.join(JOIN_TIMEOUT)
         if self._accept is not threading.current_thread():
             self._accept.join(JOIN_TIMEOUT)
+        self._tcp.close()
         self._xmlrpc.stop()
         self._down.set()

@@ -489,19 +489,17 @@ class XmlRpcServer:
     def stop(self) -> None:
         """Stop accepting, close every connection, join every thread."""
         self._running = False
-        if self._sock is not None:
-            try:
+        if self._sock is not None:  # wakes the accept thread; closed once it has left accept()
+            try:                    # (a descriptor closed under a thread's syscall can be reused)
                 self._sock.shutdown(socket.SHUT_RDWR)
             except OSError:
                 pass
-            self._sock.close()
-        with self._lock:
-            conns = list(self._conns)
-        for c in conns:
-            try:
-                c.shutdown(socket.SHUT_RDWR)
-            except OSError:
-                pass
+        with self._lock:  # a connection's thread takes it out of _conns before closing it
+            for c in self._conns:
+                try:
+                    c.shutdown(socket.SHUT_RDWR)
+                except OSError:
+                    pass
         deadline = time.monotonic() + JOIN_TIMEOUT
         while True:
             with self._lock:
@@ -509,6 +507,8 @@ class XmlRpcServer:
             if not threads or time.monotonic() > deadline:
                 break
             threads[0].join(max(0.0, deadline - time.monotonic()))
+        if self._sock is not None:
+            self._sock.close()
 
 
 def _fault(code: int, message: str) -> bytes:
