@@ -342,6 +342,7 @@ def test_shutdown_leaves_no_threads_or_sockets(master) -> None:
 
 def test_remote_shutdown(nodes) -> None:
     a = nodes("/victim")
+    assert not a.is_shutdown, a.shutdown_reason   # nothing else may have stopped it first
     assert xmlrpc.client.ServerProxy(a.uri).shutdown("/x", "bye") == [1, "shutdown", 0]
     assert wait_until(lambda: a.is_shutdown)
 

@@ -28,8 +28,9 @@ from rosfpga_lab.msg.builtins import BYTE_ARRAY_TYPES, SCALARS, TIME_CLASS
 from rosfpga_lab.msg.decode import too_long
 from rosfpga_lab.msg.encode import _byte_array, _check_scalar, _numeric_array
 from rosfpga_lab.msg.errors import DeserializeError, SerializeError
-from rosfpga_lab.msg.layout import ROLE_ARRAY, ROLE_LENGTH, ROLE_VALUE, FieldSpan
-from rosfpga_lab.msg.span import ROLE_PADDING, ROLE_TRAILING, Span
+from rosfpga_lab.msg.layout import FieldSpan
+from rosfpga_lab.msg.span import ROLE_LENGTH, ROLE_PADDING, ROLE_VALUE, Span
+from rosfpga_lab.msg.spanreader import SpanReader
 from rosfpga_lab.msg.limits import DEFAULT_LIMITS, LAYOUT_ELEMENT_SPANS, MsgLimits
 from rosfpga_lab.msg.parser import Field
 from rosfpga_lab.msg.registry import MsgRegistry
@@ -156,27 +157,16 @@ def serialize_cdr(reg: MsgRegistry | None, type_name: str, value: Any) -> bytes:
     return bytes(w.out)
 
 
-class _Reader:
+class _Reader(SpanReader):
     """Plain field-by-field CDR reader that records spans (the decoder and the layout)."""
 
-    def __init__(self, reg: MsgRegistry, data: Any, limits: MsgLimits, element_spans: int) -> None:
-        self.reg = reg
-        self.view = memoryview(data).cast("B")
-        self.pos = 0
-        self.limits = limits
-        self.element_spans = element_spans
-        self.spans: list[FieldSpan] = []
+    body = "payload"
 
-    def _take(self, size: int, path: str, what: str) -> memoryview:
-        if self.pos + size > len(self.view):
-            raise DeserializeError(
-                f"payload ends early: {what} at byte offset {self.pos} needs {size} byte(s), "
-                f"only {len(self.view) - self.pos} left (field {path})", path, self.pos)
-        chunk = self.view[self.pos:self.pos + size]
-        self.pos += size
-        return chunk
+    @staticmethod
+    def hold(data: Any) -> memoryview:
+        return memoryview(data).cast("B")   # uint8[] values are views into the payload
 
-    def pad(self, size: int, path: str) -> None:
+    def align(self, size: int, path: str) -> None:
         n = _align(self.pos - ENCAPSULATION_SIZE, size)
         if n:
             start = self.pos
@@ -193,7 +183,7 @@ class _Reader:
 
     def scalar(self, kind: str, path: str, role: str = ROLE_VALUE) -> Any:
         sc = SCALARS[kind]
-        self.pad(sc.size, path)
+        self.align(sc.size, path)
         start = self.pos
         (value,) = struct.unpack("<" + sc.struct_char, self._take(sc.size, path, kind))
         self.spans.append(Span(start, sc.size, path, kind, value, role))
@@ -205,8 +195,8 @@ class _Reader:
         if n > limit:
             raise DeserializeError(f"field {path}: length at byte offset {start} declares {n}, "
                                    f"more than {limit_name}={limit}", path, start)
-        if n * elem_min > len(self.view) - self.pos:
-            raise too_long(path, start, n, elem_min, len(self.view) - self.pos, limit_name)
+        if n * elem_min > self.left:
+            raise too_long(path, start, n, elem_min, self.left, limit_name)
         return n
 
     def string(self, path: str) -> str:
@@ -242,18 +232,9 @@ class _Reader:
             n = self.count(path, elem_min, self.limits.max_array_length, "max_array_length")
         else:
             n = f.array_length
-        if base in SCALARS and n > self.element_spans:
-            dtype = SCALARS[base].dtype
-            self.pad(dtype.itemsize, path)
-            start = self.pos
-            arr = np.frombuffer(self._take(n * dtype.itemsize, path, f"{n} x {base}"), dtype)
-            arr = arr.astype(bool) if base == "bool" else arr
-            self.spans.append(Span(start, self.pos - start, path, f.type, arr, ROLE_ARRAY))
-            return arr
-        items = [self.element(base, f"{path}[{i}]") for i in range(n)]
         if base in SCALARS:
-            return np.array(items, dtype=bool if base == "bool" else SCALARS[base].dtype)
-        return items
+            return self.scalar_array(base, f.type, n, path)
+        return [self.element(base, f"{path}[{i}]") for i in range(n)]
 
     def message(self, type_name: str, prefix: str = "") -> dict:
         spec = self.reg.check(type_name)
@@ -269,23 +250,7 @@ class _Reader:
 def _read(reg: MsgRegistry | None, type_name: str, data: Any, allow_trailing: bool,
           partial: bool, limits: MsgLimits, element_spans: int) -> tuple[dict | None, list[FieldSpan]]:
     reader = _Reader(reg or ros2_registry(), data, limits, element_spans)
-    try:
-        reader.encapsulation()
-        value: dict | None = reader.message(type_name)
-    except DeserializeError as exc:
-        if not partial:
-            raise
-        start = reader.spans[-1].end if reader.spans else 0
-        reader.spans.append(Span(start, len(reader.view) - start, exc.path, "error", str(exc), "error"))
-        return None, reader.spans
-    rest = len(reader.view) - reader.pos
-    if rest:
-        if not (allow_trailing or partial):
-            raise DeserializeError(
-                f"{rest} byte(s) left over after a complete {reader.reg.resolve(type_name)} at "
-                f"byte offset {reader.pos} (pass allow_trailing=True to ignore)", "", reader.pos)
-        reader.spans.append(Span(reader.pos, rest, "", "uint8[]", bytes(reader.view[reader.pos:]), ROLE_TRAILING))
-    return value, reader.spans
+    return reader.read(type_name, allow_trailing, partial, start=reader.encapsulation)
 
 
 def deserialize_cdr(reg: MsgRegistry | None, type_name: str, data: Any, *,

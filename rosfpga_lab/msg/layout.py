@@ -18,39 +18,21 @@ from __future__ import annotations
 import struct
 from typing import Any
 
-import numpy as np
-
 from rosfpga_lab.msg.builtins import SCALARS, TIME_CLASS
 from rosfpga_lab.msg.decode import min_size, too_long
 from rosfpga_lab.msg.errors import DeserializeError
 from rosfpga_lab.msg.limits import DEFAULT_LIMITS, LAYOUT_ELEMENT_SPANS, MsgLimits
 from rosfpga_lab.msg.parser import Field
 from rosfpga_lab.msg.registry import MsgRegistry
-from rosfpga_lab.msg.span import ROLE_ARRAY, ROLE_ERROR, ROLE_LENGTH, ROLE_TRAILING, ROLE_VALUE, Span
+from rosfpga_lab.msg.span import ROLE_LENGTH, ROLE_VALUE, Span
+from rosfpga_lab.msg.spanreader import SpanReader
 
 #: The span type of a message layout (the lab's one :class:`~rosfpga_lab.msg.span.Span`).
 FieldSpan = Span
 
 
-class _Reader:
-    """Plain field-by-field reader that records spans."""
-
-    def __init__(self, reg: MsgRegistry, data: Any, limits: MsgLimits, element_spans: int) -> None:
-        self.reg = reg
-        self.buf = bytes(data)
-        self.pos = 0
-        self.limits = limits
-        self.element_spans = element_spans
-        self.spans: list[FieldSpan] = []
-
-    def _take(self, size: int, path: str, what: str) -> bytes:
-        if self.pos + size > len(self.buf):
-            raise DeserializeError(
-                f"message ends early: {what} at byte offset {self.pos} needs {size} byte(s), "
-                f"only {len(self.buf) - self.pos} left (field {path})", path, self.pos)
-        chunk = self.buf[self.pos:self.pos + size]
-        self.pos += size
-        return chunk
+class _Reader(SpanReader):
+    """Plain field-by-field TCPROS reader that records spans."""
 
     def _span(self, path: str, start: int, type_: str, value: Any, role: str) -> None:
         if self.pos > start:
@@ -70,14 +52,14 @@ class _Reader:
         if n > limit:
             raise DeserializeError(f"field {path}: length prefix at byte offset {start} declares "
                                    f"{n}, more than {limit_name}={limit}", path, start)
-        if n * elem_min > len(self.buf) - self.pos:
-            raise too_long(path, start, n, elem_min, len(self.buf) - self.pos, limit_name)
+        if n * elem_min > self.left:
+            raise too_long(path, start, n, elem_min, self.left, limit_name)
         return n
 
     def string(self, path: str) -> str:
         n = self.length(path, 1, self.limits.max_string_bytes, "max_string_bytes")
         start = self.pos
-        text = self._take(n, path, "string").decode("utf-8", "surrogateescape")
+        text = bytes(self._take(n, path, "string")).decode("utf-8", "surrogateescape")
         self._span(path, start, "string", text, ROLE_VALUE)
         return text
 
@@ -114,18 +96,9 @@ class _Reader:
                     f"{self.limits.max_empty_elements}", path, self.pos - 4)
         else:
             n = f.array_length
-        if base in SCALARS and n > self.element_spans:
-            start = self.pos
-            dtype = SCALARS[base].dtype
-            raw = self._take(n * dtype.itemsize, path, f"{n} x {base}")
-            arr = np.frombuffer(raw, dtype=dtype)
-            arr = arr.astype(bool) if base == "bool" else arr
-            self._span(path, start, f.type, arr, ROLE_ARRAY)
-            return arr
-        items = [self.element(base, f"{path}[{i}]") for i in range(n)]
         if base in SCALARS:
-            return np.array(items, dtype=bool if base == "bool" else SCALARS[base].dtype)
-        return items
+            return self.scalar_array(base, f.type, n, path)
+        return [self.element(base, f"{path}[{i}]") for i in range(n)]
 
     def message(self, type_name: str, prefix: str = "") -> dict:
         spec = self.reg.check(type_name)
@@ -137,25 +110,7 @@ class _Reader:
 
 def _read(reg: MsgRegistry, type_name: str, data: Any, allow_trailing: bool, partial: bool,
           limits: MsgLimits, element_spans: int) -> tuple[dict | None, list[FieldSpan]]:
-    reader = _Reader(reg, data, limits, element_spans)
-    try:
-        value: dict | None = reader.message(type_name)
-    except DeserializeError as exc:
-        if not partial:
-            raise
-        start = reader.spans[-1].end if reader.spans else 0
-        reader.spans.append(Span(start, len(reader.buf) - start, exc.path, "error", str(exc),
-                                 ROLE_ERROR))
-        return None, reader.spans
-    rest = len(reader.buf) - reader.pos
-    if rest:
-        if not (allow_trailing or partial):
-            raise DeserializeError(
-                f"{rest} byte(s) left over after a complete {reg.resolve(type_name)} at byte "
-                f"offset {reader.pos} (pass allow_trailing=True to ignore)", "", reader.pos)
-        reader.spans.append(Span(reader.pos, rest, "", "uint8[]", reader.buf[reader.pos:],
-                                 ROLE_TRAILING))
-    return value, reader.spans
+    return _Reader(reg, data, limits, element_spans).read(type_name, allow_trailing, partial)
 
 
 def field_layout(reg: MsgRegistry, type_name: str, data: Any, *, allow_trailing: bool = False,
