@@ -82,3 +82,23 @@ def test_limits_live_in_limits_modules() -> None:
     for path in sorted(PACKAGE.rglob("errors.py")):
         own = re.findall(r"^([A-Z][A-Z0-9_]*)\s*(?::[^=]*)?=", path.read_text(), flags=re.M)
         assert own == [], f"{path.relative_to(PACKAGE)} defines limits {own}: move them to limits.py"
+
+
+def test_timeouts_and_maxima_live_in_limits_modules() -> None:
+    """A time-out or a maximum set as a number belongs in its layer's ``limits.py``, where the
+    next reader looks for it (``graph/realros.py`` keeps its own: it imports only the standard
+    library, so tests without the lab's extras can use it)."""
+    import re
+
+    rule = re.compile(r"^([A-Z][A-Z0-9_]*(?:TIMEOUT|_MAX|MAX_)[A-Z0-9_]*)\s*(?::[^=]*)?=\s*[0-9]",
+                      flags=re.M)
+    allowed = {Path("graph/realros.py")}
+    found = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE)
+        if path.name == "limits.py" or rel in allowed:
+            continue
+        names = rule.findall(path.read_text())
+        if names:
+            found[str(rel)] = names
+    assert found == {}, f"move these to the layer's limits.py: {found}"

@@ -34,16 +34,15 @@ from pathlib import Path
 
 import numpy as np
 
+from rosfpga_lab.bench.limits import (
+    START_TIMEOUT, STALL_TIMEOUT, SUSTAINED_MAX_SECONDS, TOOL_TIMEOUT,
+)
 from rosfpga_lab.component import LatencySummary, open_source
 from rosfpga_lab.graph import EmbeddedMaster, GraphError, MessageInfo, Node, call
 from rosfpga_lab.hw import image_frame
 
 RELAY_FALLBACK = "/usr/lib/topic_tools/relay"
 PROGRAMS = Path(__file__).resolve().parent / "ros_programs"
-#: Seconds to wait for a middle to register, and for its first frame.
-START_TIMEOUT = 20.0
-#: Seconds without an output before in-flight frames count as lost (sustained phase).
-STALL_TIMEOUT = 1.0
 
 
 @dataclass
@@ -100,7 +99,7 @@ def find_relay() -> str | None:
     """roscpp's topic_tools relay binary (from ``dpkg -L topic-tools``), or None."""
     try:
         listing = subprocess.run(["dpkg", "-L", "topic-tools"], capture_output=True, text=True,
-                                 timeout=20).stdout.splitlines()
+                                 timeout=TOOL_TIMEOUT).stdout.splitlines()
     except (OSError, subprocess.SubprocessError):
         listing = []
     for line in listing + [RELAY_FALLBACK]:
@@ -236,7 +235,7 @@ def measure(name: str, master: EmbeddedMaster, in_topic: str, out_topic: str,
             command: list[str] | None, *, env: dict[str, str] | None, images: list[np.ndarray],
             encoding: str, expect: Callable[[np.ndarray], np.ndarray], frames: int,
             windows: tuple[int, ...], rate: float, rate_frames: int, check_every: int = 5,
-            max_seconds: float = 15.0) -> PathFigures:
+            max_seconds: float = SUSTAINED_MAX_SECONDS) -> PathFigures:
     """Run one middle (``command``; None: direct) and measure: the sustained phase once per
     window in ``windows``, then (if ``rate_frames``) the at-rate phase."""
     fig = PathFigures(name, rate=rate)

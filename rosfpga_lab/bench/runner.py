@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rosfpga_lab.bench.limits import TOOL_TIMEOUT
 from rosfpga_lab.bench.path import (
     PROGRAMS, PathFigures, bench_images, component_command, find_relay, measure,
 )
@@ -123,7 +124,7 @@ def machine_description() -> str:
     model = platform.processor() or platform.machine()
     cores = ""
     try:
-        text = subprocess.run(["lscpu"], capture_output=True, text=True, timeout=10).stdout
+        text = subprocess.run(["lscpu"], capture_output=True, text=True, timeout=TOOL_TIMEOUT).stdout
         for line in text.splitlines():
             key, _, value = line.partition(":")
             if key.strip() == "Model name":

@@ -40,3 +40,6 @@ MAX_REFUSAL_KINDS = 64
 #: Camera limits: frames per second and image side.
 MAX_CAMERA_RATE = 1000.0
 MAX_CAMERA_SIDE = 8192
+
+#: Pictures wider than this are shrunk before encoding (pixels).
+PAGE_IMAGE_MAX_WIDTH = 640

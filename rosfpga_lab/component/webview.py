@@ -20,12 +20,11 @@ from typing import Any
 import cv2
 import numpy as np
 
+from rosfpga_lab.component.limits import PAGE_IMAGE_MAX_WIDTH
 from rosfpga_lab.component.sources import to_rgb
 
 #: How often the page asks for new pictures and counters (milliseconds).
 REFRESH_MS = 250
-#: Pictures wider than this are shrunk before encoding (pixels).
-PAGE_IMAGE_MAX_WIDTH = 640
 #: JPEG quality of the pictures.
 JPEG_QUALITY = 85
 

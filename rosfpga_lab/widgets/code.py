@@ -11,9 +11,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from rosfpga_lab.widgets._common import WidgetError, esc
-
-#: Largest file shown (bytes); a larger one is cut with a note.
-CODE_MAX_BYTES = 200_000
+from rosfpga_lab.widgets.limits import CODE_MAX_BYTES
 
 
 def code_html(text: str, language: str = "cpp") -> str:

@@ -27,3 +27,6 @@ LIVE_RATE_WINDOW = 2.0
 DISPLAY_MAX_WIDTH = 640
 #: Seconds one cell may run before the notebook export gives up.
 CELL_TIMEOUT = 300
+
+#: Largest file shown (bytes); a larger one is cut with a note.
+CODE_MAX_BYTES = 200_000
