@@ -25,7 +25,6 @@ from typing import Any
 import numpy as np
 
 from rosfpga_lab.msg.builtins import BYTE_ARRAY_TYPES, SCALARS, TIME_CLASS
-from rosfpga_lab.msg.decode import too_long
 from rosfpga_lab.msg.encode import _byte_array, _check_scalar, _numeric_array
 from rosfpga_lab.msg.errors import DeserializeError, SerializeError
 from rosfpga_lab.msg.layout import FieldSpan
@@ -192,12 +191,7 @@ class _Reader(SpanReader):
     def count(self, path: str, elem_min: int, limit: int, limit_name: str) -> int:
         start = self.pos
         n = self.scalar("uint32", path, ROLE_LENGTH)
-        if n > limit:
-            raise DeserializeError(f"field {path}: length at byte offset {start} declares {n}, "
-                                   f"more than {limit_name}={limit}", path, start)
-        if n * elem_min > self.left:
-            raise too_long(path, start, n, elem_min, self.left, limit_name)
-        return n
+        return self.check_length(path, start, n, elem_min, limit, limit_name)
 
     def string(self, path: str) -> str:
         at = self.pos

@@ -19,7 +19,7 @@ import struct
 from typing import Any
 
 from rosfpga_lab.msg.builtins import SCALARS, TIME_CLASS
-from rosfpga_lab.msg.decode import min_size, too_long
+from rosfpga_lab.msg.decode import min_size
 from rosfpga_lab.msg.errors import DeserializeError
 from rosfpga_lab.msg.limits import DEFAULT_LIMITS, LAYOUT_ELEMENT_SPANS, MsgLimits
 from rosfpga_lab.msg.parser import Field
@@ -49,12 +49,7 @@ class _Reader(SpanReader):
         start = self.pos
         (n,) = struct.unpack("<I", self._take(4, path, "the uint32 length prefix"))
         self._span(path, start, "uint32", n, ROLE_LENGTH)
-        if n > limit:
-            raise DeserializeError(f"field {path}: length prefix at byte offset {start} declares "
-                                   f"{n}, more than {limit_name}={limit}", path, start)
-        if n * elem_min > self.left:
-            raise too_long(path, start, n, elem_min, self.left, limit_name)
-        return n
+        return self.check_length(path, start, n, elem_min, limit, limit_name)
 
     def string(self, path: str) -> str:
         n = self.length(path, 1, self.limits.max_string_bytes, "max_string_bytes")

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from rosfpga_lab.msg.builtins import SCALARS
+from rosfpga_lab.msg.decode import too_long
 from rosfpga_lab.msg.errors import DeserializeError
 from rosfpga_lab.msg.limits import MsgLimits
 from rosfpga_lab.msg.registry import MsgRegistry
@@ -59,6 +60,17 @@ class SpanReader:
         chunk = self.data[self.pos:self.pos + size]
         self.pos += size
         return chunk
+
+    def check_length(self, path: str, start: int, n: int, elem_min: int, limit: int,
+                     limit_name: str) -> int:
+        """``n``, the length prefix read at ``start``; refused over ``limit`` or when ``n``
+        elements of at least ``elem_min`` bytes cannot fit in the bytes left."""
+        if n > limit:
+            raise DeserializeError(f"field {path}: length prefix at byte offset {start} declares "
+                                   f"{n}, more than {limit_name}={limit}", path, start)
+        if n * elem_min > self.left:
+            raise too_long(path, start, n, elem_min, self.left, limit_name)
+        return n
 
     def align(self, size: int, path: str) -> None:
         """Skip the padding before a ``size``-byte value (none in TCPROS)."""
