@@ -75,13 +75,15 @@ def test_loading_a_configuration_imports_neither_opencv_nor_jinja2() -> None:
 
 
 def test_limits_live_in_limits_modules() -> None:
-    """One convention: a layer's limits are in its ``limits.py``; ``errors.py`` holds errors (the
-    graph and tcpros errors modules only re-export their old limit names)."""
+    """One convention: a layer's limits are in its ``limits.py``; ``errors.py`` holds errors and
+    neither defines nor re-exports a limit."""
     import re
 
     for path in sorted(PACKAGE.rglob("errors.py")):
         own = re.findall(r"^([A-Z][A-Z0-9_]*)\s*(?::[^=]*)?=", path.read_text(), flags=re.M)
         assert own == [], f"{path.relative_to(PACKAGE)} defines limits {own}: move them to limits.py"
+        assert "limits import" not in path.read_text(), \
+            f"{path.relative_to(PACKAGE)} re-exports limits: import them from limits.py"
 
 
 def test_timeouts_and_maxima_live_in_limits_modules() -> None:

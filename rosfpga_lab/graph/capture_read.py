@@ -17,7 +17,8 @@ import bisect
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from rosfpga_lab.graph.errors import TRACE_EXCERPT_BYTES, GraphError, XmlRpcError
+from rosfpga_lab.graph.errors import GraphError, XmlRpcError
+from rosfpga_lab.graph.limits import TRACE_EXCERPT_BYTES
 from rosfpga_lab.graph.master import MASTER_ID
 from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.xmlrpc import _parse_head, parse_xmlrpc, split_uri

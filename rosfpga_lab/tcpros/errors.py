@@ -9,15 +9,6 @@ it refused *our* request with an ``error=`` header (:class:`RemoteError`).
 from __future__ import annotations
 
 from rosfpga_lab.errors import LabError
-# The limits live in limits.py; re-exported here for code written before the move.
-from rosfpga_lab.tcpros.limits import (  # noqa: F401
-    MAX_HEADER_BYTES,
-    MAX_FIELD_BYTES,
-    MAX_FRAME_BYTES,
-    FRAME_BUFFER_FIRST,
-    HISTORY_REPEATS,
-    HANDSHAKE_TIMEOUT,
-)
 
 
 class ProtocolError(LabError):
