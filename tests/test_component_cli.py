@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 import pytest
 
+from proctools import interruptible
 from rosfpga_lab.cli import main
 from rosfpga_lab.component import (
     Camera, ComponentConfigError, FpgaComponent, SourceError, Viewer, open_source, to_rgb,
@@ -207,7 +208,7 @@ def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
         proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(CONFIG),
                                  "--master-uri", master.uri, "--status-interval", "0.2"],
                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                cwd=tmp_path)
+                                cwd=tmp_path, preexec_fn=interruptible)
         try:
             deadline = time.monotonic() + 20
             while time.monotonic() < deadline:

@@ -18,6 +18,7 @@ import cv2
 import numpy as np
 import pytest
 
+from proctools import interruptible
 from realros import (
     ROS_PROGRAMS, ROS_PYTHON, build_roscpp_program, finish, free_port, require_ros, ros_env,
     stop_process, wait_for_master, wait_line,
@@ -137,7 +138,7 @@ def test_rostopic_sees_the_component_like_any_node(rosmaster_uri, tmp_path) -> N
         assert _tool(["rostopic", "type", "/image_dilated"], env).strip() == "sensor_msgs/Image"
         # rostopic hz: a real subscriber measuring the component's output rate
         hz = subprocess.Popen(["rostopic", "hz", "/image_dilated"], env=env, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True)
+                              stderr=subprocess.PIPE, text=True, preexec_fn=interruptible)
         time.sleep(6)
         hz.send_signal(signal.SIGINT)
         out, err = hz.communicate(timeout=15)

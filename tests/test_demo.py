@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
+from proctools import interruptible
 from rosfpga_lab.cli import main
 from rosfpga_lab.component import ComponentConfigError, run_demo
 
@@ -129,7 +130,8 @@ def test_demo_interrupted_says_so_and_exits_130(tmp_path) -> None:
 
     proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "demo", "--frames", "1000",
                              "--source", "synthetic", "--no-figure", "-v"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+                            stderr=subprocess.PIPE, text=True, cwd=tmp_path,
+                            preexec_fn=interruptible)
     try:
         for line in proc.stdout:                     # wait until the camera runs
             if line.startswith("camera:"):
