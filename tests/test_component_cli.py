@@ -245,6 +245,31 @@ def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
     assert not any("/fpga_dilate" in n for _t, n in state[0] + state[1])
 
 
+def test_node_command_stops_cleanly_on_sigterm(tmp_path) -> None:
+    """SIGTERM (what a service manager or a hub sends) ends the node as Ctrl-C does: report
+    printed, unregistered, exit 0; and soon, though the status loop ticks only every second."""
+    with EmbeddedMaster(port=0) as master:
+        proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(CONFIG),
+                                 "--master-uri", master.uri, "--quiet"],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                cwd=tmp_path)
+        try:
+            deadline = time.monotonic() + 20
+            while time.monotonic() < deadline and not any(
+                    "/fpga_dilate" in n for _t, n in master.getSystemState("/t")[2][1]):
+                time.sleep(0.05)
+            proc.send_signal(signal.SIGTERM)
+            out, err = proc.communicate(timeout=20)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
+        state = master.getSystemState("/t")[2]
+    assert proc.returncode == 0, err
+    assert "frames: received 0, processed 0, published 0" in out
+    assert not any("/fpga_dilate" in n for _t, n in state[0] + state[1])
+
+
 def test_node_command_without_a_master_says_what_to_do(capsys) -> None:
     uri = f"http://127.0.0.1:{free_port()}/"
     assert main(["node", str(CONFIG), "--master-uri", uri]) == 1

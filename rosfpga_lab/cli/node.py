@@ -74,10 +74,17 @@ def run(args: argparse.Namespace) -> int:
         host, port, _path = split_uri(component.master_uri)
         master = EmbeddedMaster(host=host, port=port).start()
         print(f"started the embedded master at {master.uri}", file=sys.stderr)
-    stop = threading.Event()
+    terminated = False
+
+    def on_sigterm(*_args: object) -> None:
+        # Only a flag: a handler runs between two steps of the main thread, which may hold any
+        # lock then (an Event's included), so taking one here could wait forever.
+        nonlocal terminated
+        terminated = True
+
     previous = signal.getsignal(signal.SIGTERM)
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, lambda *_: stop.set())
+        signal.signal(signal.SIGTERM, on_sigterm)
     component.start()
     tty = sys.stdout.isatty()
     print(f"{component.name}: {component.input_topic} -> {component.pipeline.op} "
@@ -87,9 +94,15 @@ def run(args: argparse.Namespace) -> int:
     interval = args.status_interval if args.status_interval > 0 and not args.quiet else 1.0
     last_print = 0.0
     exit_code = 0
+    period = min(interval, limits.WATCHDOG_PERIOD)
+    next_tick = time.monotonic() + period
     try:
-        while not stop.wait(min(interval, limits.WATCHDOG_PERIOD)):
+        while not terminated:
+            time.sleep(limits.SIGNAL_POLL)
             now = time.monotonic()
+            if now < next_tick:
+                continue
+            next_tick = now + period
             if t_end is not None and now >= t_end:
                 break
             if not component.running:

@@ -43,3 +43,5 @@ MAX_CAMERA_SIDE = 8192
 
 #: Pictures wider than this are shrunk before encoding (pixels).
 PAGE_IMAGE_MAX_WIDTH = 640
+#: Seconds between the ``node`` command's looks at its stop flag (how soon SIGTERM is obeyed).
+SIGNAL_POLL = 0.05
