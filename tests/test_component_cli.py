@@ -13,7 +13,7 @@ import cv2
 import numpy as np
 import pytest
 
-from proctools import interruptible
+from proctools import interruptible, kill_if_running, stop_with
 from rosfpga_lab.cli import main
 from rosfpga_lab.component import (
     Camera, ComponentConfigError, FpgaComponent, SourceError, Viewer, open_source, to_rgb,
@@ -203,19 +203,27 @@ def test_view_into_an_unwritable_directory_is_a_clear_error(tmp_path, capsys) ->
 
 
 # ------------------------------------------------------------------------------- node command
+def start_node_command(master: EmbeddedMaster, cwd: Path, *options: str) -> subprocess.Popen:
+    """``rosfpga-lab node`` on the shipped configuration, once it has subscribed to its input."""
+    proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(CONFIG),
+                             "--master-uri", master.uri, *options],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd,
+                            preexec_fn=interruptible)
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline and proc.poll() is None:
+        subscribers = master.getSystemState("/t")[2][1]
+        if any(t == "/image_raw" and "/fpga_dilate" in n for t, n in subscribers):
+            return proc
+        time.sleep(0.05)
+    proc.kill()
+    out, err = proc.communicate()
+    raise AssertionError(f"the node never subscribed to /image_raw:\n{out}{err}")
+
+
 def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
     with EmbeddedMaster(port=0) as master:
-        proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(CONFIG),
-                                 "--master-uri", master.uri, "--status-interval", "0.2"],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                cwd=tmp_path, preexec_fn=interruptible)
+        proc = start_node_command(master, tmp_path, "--status-interval", "0.2")
         try:
-            deadline = time.monotonic() + 20
-            while time.monotonic() < deadline:
-                state = master.getSystemState("/t")[2]
-                if any(t == "/image_raw" and "/fpga_dilate" in n for t, n in state[1]):
-                    break
-                time.sleep(0.05)
             cam = Camera("/image_raw", rate=30, master=master, source="synthetic")
             viewer = Viewer("/image_dilated", master=master, queue_size=20)
             try:
@@ -227,12 +235,9 @@ def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
             finally:
                 cam.stop()
                 viewer.stop()
-            proc.send_signal(signal.SIGINT)
-            out, err = proc.communicate(timeout=20)
+            out, err = stop_with(proc, signal.SIGINT)
         finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.communicate()
+            kill_if_running(proc)
         state = master.getSystemState("/t")[2]
     assert proc.returncode == 0, err
     assert "/image_raw -> dilate (fast model) -> /image_dilated" in out
@@ -247,23 +252,10 @@ def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
 
 def test_node_command_stops_cleanly_on_sigterm(tmp_path) -> None:
     """SIGTERM (what a service manager or a hub sends) ends the node as Ctrl-C does: report
-    printed, unregistered, exit 0; and soon, though the status loop ticks only every second."""
+    printed, unregistered, exit 0."""
     with EmbeddedMaster(port=0) as master:
-        proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(CONFIG),
-                                 "--master-uri", master.uri, "--quiet"],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                cwd=tmp_path)
-        try:
-            deadline = time.monotonic() + 20
-            while time.monotonic() < deadline and not any(
-                    "/fpga_dilate" in n for _t, n in master.getSystemState("/t")[2][1]):
-                time.sleep(0.05)
-            proc.send_signal(signal.SIGTERM)
-            out, err = proc.communicate(timeout=20)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
-                proc.communicate()
+        proc = start_node_command(master, tmp_path, "--quiet")
+        out, err = stop_with(proc, signal.SIGTERM)
         state = master.getSystemState("/t")[2]
     assert proc.returncode == 0, err
     assert "frames: received 0, processed 0, published 0" in out

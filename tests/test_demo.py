@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
-from proctools import interruptible
+from proctools import interruptible, kill_if_running, stop_with
 from rosfpga_lab.cli import main
 from rosfpga_lab.component import ComponentConfigError, run_demo
 
@@ -136,12 +136,9 @@ def test_demo_interrupted_says_so_and_exits_130(tmp_path) -> None:
         for line in proc.stdout:                     # wait until the camera runs
             if line.startswith("camera:"):
                 break
-        proc.send_signal(signal.SIGINT)
-        _out, err = proc.communicate(timeout=20)
+        _out, err = stop_with(proc, signal.SIGINT)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
+        kill_if_running(proc)
     assert proc.returncode == 130
     assert "rosfpga-lab demo: interrupted" in err and "Traceback" not in err
 
