@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from rosfpga_lab.cli._args import positive_float, positive_int
+from rosfpga_lab.config.vocabulary import MODELS
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -35,7 +36,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--scale", type=positive_float, default=1.0,
                    help="scale of the figure's panels (default: 1; 0.5 for a small file)")
     p.add_argument("--no-figure", action="store_true", help="do not write the figure")
-    p.add_argument("--model", choices=("fast", "reference"), default="fast",
+    p.add_argument("--model", choices=MODELS, default=MODELS[0],
                    help="circuit model (reference: byte at a time, about 0.3 s per 160x120 "
                    "frame; try --config data/fpga_passthrough_rgb8.yaml --frames 5)")
     p.add_argument("--input-queue", type=positive_int, metavar="N",

@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 from rosfpga_lab.cli._args import non_negative_float, positive_float, positive_int
+from rosfpga_lab.config.vocabulary import MODELS
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -28,7 +29,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "node.master_uri)")
     p.add_argument("--embedded-master", action="store_true",
                    help="start the lab's embedded master at that URI when none answers there")
-    p.add_argument("--model", choices=("fast", "reference"), default="fast",
+    p.add_argument("--model", choices=MODELS, default=MODELS[0],
                    help="circuit model: fast (numpy, default) or reference (byte at a time; "
                    "small images only)")
     p.add_argument("--input-queue", type=positive_int, default=None, metavar="N",

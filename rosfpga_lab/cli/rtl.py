@@ -12,28 +12,31 @@ import time
 from pathlib import Path
 
 from rosfpga_lab.cli._args import positive_int
+from rosfpga_lab.config.vocabulary import SIMULATORS
 
-PER_MILLE_HELP = "per mille of clocks (0..990)"
-#: Bytes of input above which Verilator's fast simulation repays its slow compilation.
-BIG_INPUT = 200_000
+PER_MILLE_HELP = "per mille of clocks"
 
 
 def _pick_simulator(chosen: str | None, input_bytes: int) -> str | None:
     """``chosen``, else Verilator for a big input when it is installed, else the default."""
     from rosfpga_lab.rtl import simulator_missing_reason
+    from rosfpga_lab.rtl.limits import VERILATOR_FROM_BYTES
 
-    if chosen is None and input_bytes > BIG_INPUT and simulator_missing_reason("verilator") is None:
+    if (chosen is None and input_bytes > VERILATOR_FROM_BYTES
+            and simulator_missing_reason("verilator") is None):
         return "verilator"
     return chosen
 
 
 def _per_mille(text: str) -> int:
+    from rosfpga_lab.rtl.limits import MAX_PER_MILLE  # imported when the option is given
+
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"want a whole number, got {text!r}") from None
-    if not 0 <= value <= 990:
-        raise argparse.ArgumentTypeError(f"want 0..990 (per mille), got {value}")
+    if not 0 <= value <= MAX_PER_MILLE:
+        raise argparse.ArgumentTypeError(f"want 0..{MAX_PER_MILLE} (per mille), got {value}")
     return value
 
 
@@ -52,10 +55,10 @@ def _common(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-cache", action="store_true",
                         help="compile afresh instead of reusing a build of the same sources "
                         "($XDG_CACHE_HOME/rosfpga-lab/rtl, ~/.cache by default)")
-    parser.add_argument("--simulator", choices=("iverilog", "verilator"),
-                        help="the simulator (default: Verilator for frames over "
-                        f"{BIG_INPUT // 1000} kB when installed, it compiles slowly but runs "
-                        "fast; else Icarus Verilog when installed, else Verilator)")
+    parser.add_argument("--simulator", choices=SIMULATORS,
+                        help="the simulator (default: Verilator for large inputs when installed, "
+                        "it compiles slowly but runs fast; else Icarus Verilog when installed, "
+                        "else Verilator)")
 
 
 def _register_sim(subparsers: argparse._SubParsersAction) -> None:

@@ -56,6 +56,10 @@ MODEL_OPS = ("dilate", "erode", PASSTHROUGH)
 OPS = (*MODEL_OPS, CUSTOM)
 
 _OP_ALIASES = {"copy": PASSTHROUGH}
+#: The circuit's Python models: ``fast`` (whole arrays) and ``reference`` (a byte at a time).
+MODELS = ("fast", "reference")
+#: The Verilog simulators the RTL flow runs (the first one found is the default).
+SIMULATORS = ("iverilog", "verilator")
 
 
 def canonical_op(op: str) -> str:

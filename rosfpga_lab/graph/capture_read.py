@@ -19,6 +19,7 @@ from pathlib import Path
 
 from rosfpga_lab.graph.errors import GraphError, XmlRpcError
 from rosfpga_lab.graph.limits import TRACE_EXCERPT_BYTES
+from rosfpga_lab.graph.limits import CAPTURE_MAX_STREAM_BYTES
 from rosfpga_lab.graph.master import MASTER_ID
 from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.xmlrpc import _parse_head, parse_xmlrpc, split_uri
@@ -28,8 +29,6 @@ from rosfpga_lab.tcpros import FrameDecoder, ProtocolError, decode_header
 DATA_DIR = Path(__file__).resolve().parents[2] / "data"
 ROS1_CAPTURE = DATA_DIR / "ros1_image.pcapng"
 RTPS_CAPTURE = DATA_DIR / "rtps_image.pcapng"
-#: Most bytes one direction of one connection may hold when read from a capture.
-MAX_STREAM_BYTES = 256 * 1024 * 1024
 #: Master API methods whose 4th parameter is the caller's XML-RPC URI.
 _CALLER_API_METHODS = ("registerPublisher", "registerSubscriber", "unregisterPublisher",
                        "unregisterSubscriber", "registerService")
@@ -108,7 +107,7 @@ def tcp_streams(path: str | Path) -> list[TcpStream]:
                 off = (seq - start) & 0xFFFF_FFFF
                 if off + wire <= len(buf):
                     continue                       # a repeat of bytes we have
-                if off > len(buf) or len(buf) + wire > MAX_STREAM_BYTES:
+                if off > len(buf) or len(buf) + wire > CAPTURE_MAX_STREAM_BYTES:
                     st.complete[from_client] = False   # a hole in the capture, or too much
                     break
                 marks.append((len(buf), t))

@@ -71,3 +71,9 @@ MAX_ARRAY_SHOWN = 64
 RATE_SAMPLES = 1000
 #: Seconds between two asks of the master while waiting for a topic to appear (rostopic: 0.1).
 TOPIC_POLL = 0.1
+
+#: Most bytes one direction of one connection may hold when read from a capture.
+CAPTURE_MAX_STREAM_BYTES = 256 * 1024 * 1024
+
+#: At most this many bytes of one table are read (a busy server lists thousands of sockets).
+OWNER_MAX_TABLE_BYTES = 8 * 2**20

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rosfpga_lab.graph.limits import OWNER_MAX_TABLE_BYTES
+
 #: The kernel's socket tables (IPv4, IPv6).
 PROC_NET_TCP = (Path("/proc/net/tcp"), Path("/proc/net/tcp6"))
 #: ``st`` of a listening socket in those tables.
 TCP_LISTEN = "0A"
-#: At most this many bytes of one table are read (a busy server lists thousands of sockets).
-MAX_TABLE_BYTES = 8 * 2**20
 
 
 def parse_tcp_table(text: str, port: int) -> set[int]:
@@ -48,7 +48,7 @@ def listener_uids(port: int, tables: tuple[Path, ...] = PROC_NET_TCP) -> set[int
     for table in tables:
         try:
             with open(table, encoding="ascii", errors="replace") as f:
-                text = f.read(MAX_TABLE_BYTES)
+                text = f.read(OWNER_MAX_TABLE_BYTES)
         except OSError:
             continue
         readable = True

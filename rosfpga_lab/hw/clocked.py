@@ -20,10 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from rosfpga_lab.hw.errors import PipelineConfigError
-
-#: Most clocks one call simulates (a window of a frame, not a whole frame: the beat viewer
-#: draws tens of beats; the RTL simulation covers whole frames).
-MAX_CLOCKS = 1 << 20
+from rosfpga_lab.hw.limits import CLOCKED_MAX_CLOCKS
 
 
 def fifo2axi_clocks(data: bytes | np.ndarray, width: int, bytes_per_pixel: int, *,
@@ -49,7 +46,7 @@ def fifo2axi_clocks(data: bytes | np.ndarray, width: int, bytes_per_pixel: int, 
         ``m_axis_tvalid``, ``m_axis_tready``: arrays of one value per clock.
 
     Raises:
-        PipelineConfigError: a bad geometry, or more than :data:`MAX_CLOCKS` clocks.
+        PipelineConfigError: a bad geometry, or more than :data:`CLOCKED_MAX_CLOCKS` clocks.
     """
     raw = np.frombuffer(bytes(data), np.uint8) if not isinstance(data, np.ndarray) else data.astype(np.uint8).ravel()
     b = int(bytes_per_pixel)
@@ -61,8 +58,9 @@ def fifo2axi_clocks(data: bytes | np.ndarray, width: int, bytes_per_pixel: int, 
     if in_valid is not None or out_ready is not None:
         given = [a.size for a in (in_valid, out_ready) if a is not None]
         n = clocks if clocks is not None else min(given)
-    if n > MAX_CLOCKS:
-        raise PipelineConfigError(f"{n} clocks is more than this model simulates ({MAX_CLOCKS}); "
+    if n > CLOCKED_MAX_CLOCKS:
+        raise PipelineConfigError(f"{n} clocks is more than this model simulates "
+                                  f"({CLOCKED_MAX_CLOCKS}); "
                                   "use the RTL simulation for whole frames")
     ivalid = np.ones(n, bool) if in_valid is None else np.asarray(in_valid, bool)[:n]
     oready = np.ones(n, bool) if out_ready is None else np.asarray(out_ready, bool)[:n]

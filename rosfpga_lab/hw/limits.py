@@ -36,3 +36,7 @@ DEFAULT_RX_BURST_BYTES = 1
 ETHERNET_MTU = 1500
 TCP_IP_HEADER_BYTES = 20 + 20 + 12
 ETHERNET_FRAMING_BYTES = 8 + 14 + 4 + 12
+
+#: Most clocks one call simulates (a window of a frame, not a whole frame: the beat viewer
+#: draws tens of beats; the RTL simulation covers whole frames).
+CLOCKED_MAX_CLOCKS = 1 << 20

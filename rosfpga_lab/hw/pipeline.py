@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rosfpga_lab.config import CUSTOM, DEFAULT_OP, NodeConfig, canonical_op, model_ksize
+from rosfpga_lab.config.vocabulary import MODELS
 from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference
 from rosfpga_lab.hw.cycles import CycleReport, account
@@ -41,7 +42,6 @@ from rosfpga_lab.hw.video import (
     status_names,
 )
 
-MODELS = ("fast", "reference")
 
 
 def wire_bytes(payload: int, mtu: int = limits.ETHERNET_MTU) -> int:

@@ -8,3 +8,18 @@ RUN_TIMEOUT = 900.0
 
 #: Seconds allowed for one synthesis.
 SYNTH_TIMEOUT = 1800.0
+
+#: Clocks without a handshake on any stream that end a run: the input ended inside a frame (or
+#: the circuit hangs). Even at 990 per mille gaps and backpressure, a stream moves every ~100
+#: clocks on average; 20,000 idle clocks in a row would happen with a chance below 1e-40.
+IDLE_LIMIT = 20_000
+#: Per mille: the largest input gap / backpressure share (1000 would never move).
+MAX_PER_MILLE = 990
+#: Bytes of input above which ``rtl sim`` picks Verilator when none is named (its fast
+#: simulation repays its slow compilation).
+VERILATOR_FROM_BYTES = 200_000
+
+#: Largest header (everything before ``$enddefinitions``) read.
+VCD_MAX_HEADER_BYTES = 16 << 20
+#: Widest signal kept (bits).
+VCD_MAX_SIGNAL_BITS = 1 << 16

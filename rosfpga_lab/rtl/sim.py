@@ -25,28 +25,21 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from rosfpga_lab.config.vocabulary import SIMULATORS
 from rosfpga_lab.hls.csim import read_beats
 from rosfpga_lab.hw import Beats
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
-from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, RUN_TIMEOUT
+from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, IDLE_LIMIT, MAX_PER_MILLE, RUN_TIMEOUT
 from rosfpga_lab.rtl.params import STATUS_HEADER, RtlParams, node_wrapper
 
 VERILOG_DIR = Path(__file__).resolve().parent / "verilog"
 TB_DIR = Path(__file__).resolve().parent / "tb"
 TB_TOP = "rfl_tb"
 NODE_FILE = "rfl_node.v"
-#: The simulators the runner knows, in the order it prefers them.
-SIMULATORS = ("iverilog", "verilator")
 #: The streams the testbench times, in its ``hs`` vector's bit order (bit 0 first).
 STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx",
            "axis_out")
-#: Clocks without a handshake on any stream that end a run: the input ended inside a frame (or
-#: the circuit hangs). Even at 990 per mille gaps and backpressure, a stream moves every ~100
-#: clocks on average; 20,000 idle clocks in a row would happen with a chance below 1e-40.
-IDLE_LIMIT = 20_000
-#: Per mille: the largest input gap / backpressure share (1000 would never move).
-MAX_PER_MILLE = 990
 
 
 def find_tool(name: str) -> str | None:

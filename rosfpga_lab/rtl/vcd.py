@@ -34,15 +34,12 @@ from typing import BinaryIO
 import numpy as np
 
 from rosfpga_lab.rtl.errors import VcdError
+from rosfpga_lab.rtl.limits import VCD_MAX_HEADER_BYTES, VCD_MAX_SIGNAL_BITS
 
 #: Bytes read from the file at a time.
 CHUNK_BYTES = 1 << 20
-#: Largest header (everything before ``$enddefinitions``) read.
-MAX_HEADER_BYTES = 16 << 20
-#: Widest signal kept (bits).
-MAX_SIGNAL_BITS = 1 << 16
 #: Longest single token (a value or a keyword).
-MAX_TOKEN_BYTES = MAX_SIGNAL_BITS + 16
+MAX_TOKEN_BYTES = VCD_MAX_SIGNAL_BITS + 16
 _UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9, "ps": 1e-12, "fs": 1e-15}
 _SCALAR = frozenset(b"01xXzZ")
 _UNKNOWN_BITS = bytes.maketrans(b"xXzZuUwW-", b"000000000")
@@ -210,8 +207,8 @@ def _read(stream: BinaryIO, clock: str, wanted: Iterable[str] | None, where: str
         except ValueError:
             header.extend(batch)
             header_bytes += sum(len(t) + 1 for t in batch)
-            if header_bytes > MAX_HEADER_BYTES:
-                raise VcdError(f"{where}: no $enddefinitions in the first {MAX_HEADER_BYTES} "
+            if header_bytes > VCD_MAX_HEADER_BYTES:
+                raise VcdError(f"{where}: no $enddefinitions in the first {VCD_MAX_HEADER_BYTES} "
                                "bytes: not a VCD dump?") from None
             continue
         header.extend(batch[:end])
@@ -271,9 +268,9 @@ def _parse_header(tokens: list[bytes], where: str) -> tuple[dict[bytes, _Var], f
                 width = int(size)
             except ValueError:
                 raise VcdError(f"{where}: $var {ref} has size {size!r}") from None
-            if not 1 <= width <= MAX_SIGNAL_BITS:
+            if not 1 <= width <= VCD_MAX_SIGNAL_BITS:
                 raise VcdError(f"{where}: $var {ref} is {width} bits wide; the reader keeps "
-                               f"1..{MAX_SIGNAL_BITS}")
+                               f"1..{VCD_MAX_SIGNAL_BITS}")
             real = kind in (b"real", b"realtime")
             name = ".".join(scopes + [ref])
             var = variables.get(code)

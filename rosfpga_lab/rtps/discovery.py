@@ -15,6 +15,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
+from rosfpga_lab.rtps.limits import MAX_PENDING_SAMPLES, MAX_SAMPLE_BYTES
 from rosfpga_lab.rtps.message import Data, DataFrag, RtpsMessage
 
 PID_SENTINEL = 0x0001
@@ -27,9 +28,6 @@ SPDP_WRITER = 0x000100C2
 SEDP_PUBLICATIONS_WRITER = 0x000003C2
 SEDP_SUBSCRIPTIONS_WRITER = 0x000004C2
 PL_CDR_BE, PL_CDR_LE = b"\x00\x02", b"\x00\x03"
-#: Largest sample :class:`FragmentAssembler` puts together, and most samples it holds at once.
-MAX_SAMPLE_BYTES = 64 * 1024 * 1024
-MAX_PENDING_SAMPLES = 16
 
 
 def parse_parameters(payload: bytes) -> dict[int, list[bytes]]:

@@ -30,3 +30,13 @@ CELL_TIMEOUT = 300
 
 #: Largest file shown (bytes); a larger one is cut with a note.
 CODE_MAX_BYTES = 200_000
+
+#: Widest panel drawn; a table needing more columns than fit narrows the columns.
+DIAGRAM_MAX_WIDTH = 900
+
+#: Changes per signal drawn one by one in a window; more become a hatched "busy" band.
+MAX_EDGES = 600
+#: Largest span (clocks) of one window (a whole frame can be seen at once, in summary).
+MAX_SPAN = 1 << 26
+#: Signals drawn at most in one picture.
+MAX_SIGNALS = 48

@@ -15,11 +15,10 @@ from collections.abc import Iterable, Sequence
 from typing import Any
 
 from rosfpga_lab.widgets._common import WidgetError, esc
+from rosfpga_lab.widgets.limits import DIAGRAM_MAX_WIDTH
 
 #: Drawing sizes (pixels): column step, row step, state box.
 COL, ROW, BOX_W, BOX_H = 215, 84, 128, 30
-#: Widest panel drawn; a table needing more columns than fit narrows the columns.
-MAX_WIDTH = 900
 
 
 def _states_by_depth(rows: Sequence[Any]) -> list[list[str]]:
@@ -48,7 +47,7 @@ def _states_by_depth(rows: Sequence[Any]) -> list[list[str]]:
 
 def _panel(role: str, rows: Sequence[Any], top: int, uid: str) -> tuple[list[str], int, int]:
     columns = _states_by_depth(rows)
-    col = min(COL, (MAX_WIDTH - BOX_W - 20) // max(len(columns) - 1, 1))
+    col = min(COL, (DIAGRAM_MAX_WIDTH - BOX_W - 20) // max(len(columns) - 1, 1))
     pos: dict[str, tuple[float, float]] = {}
     first = top + 70   # room for the panel's title and a loop above the first row
     for c, states in enumerate(columns):

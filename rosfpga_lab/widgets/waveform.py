@@ -28,15 +28,10 @@ import ipywidgets as w
 import numpy as np
 
 from rosfpga_lab.widgets._common import StaticFallback, WidgetError, esc
+from rosfpga_lab.widgets.limits import MAX_EDGES, MAX_SIGNALS, MAX_SPAN
 
 #: Clocks shown when a viewer opens, and the widest window one picture draws edge by edge.
 DEFAULT_SPAN = 64
-#: Changes per signal drawn one by one in a window; more become a hatched "busy" band.
-MAX_EDGES = 600
-#: Largest span (clocks) of one window (a whole frame can be seen at once, in summary).
-MAX_SPAN = 1 << 26
-#: Signals drawn at most in one picture.
-MAX_SIGNALS = 48
 #: Names drawn as a clock (one pulse per clock) rather than as their sampled value.
 CLOCK_NAMES = ("aclk", "clk", "ap_clk")
 
