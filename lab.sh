@@ -62,8 +62,13 @@ shift
 case "$cmd" in
   lab|open)
     setup ""
+    root=()   # a container or a root shell: JupyterLab refuses root unless told (loopback only here)
+    if [ "$(id -u)" = 0 ]; then
+      echo "lab.sh: running as root (a container?): starting JupyterLab with --allow-root" >&2
+      root=(--allow-root)
+    fi
     exec "$venv/bin/jupyter" lab --ServerApp.ip=127.0.0.1 --notebook-dir="$here/notebooks" \
-      --LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate "$@" ;;
+      --LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate "${root[@]}" "$@" ;;
   test)
     setup "[test]"
     exec "$venv/bin/python" -m pytest "$@" ;;
