@@ -68,7 +68,7 @@ def rostopic_pub(env: dict[str, str], topic: str, type_name: str, *values: str) 
 
 def rostopic_echo(env: dict[str, str], topic: str) -> str:
     proc = subprocess.run(["rostopic", "echo", "-n", "1", topic], env=env, capture_output=True,
-                          text=True, timeout=40)
+                          text=True, timeout=20)
     assert proc.returncode == 0, proc.stderr
     return proc.stdout
 
