@@ -120,8 +120,11 @@ class Camera:
         stop = stop or self._stop
         start = time.monotonic()
         k = 0
+        times = self.source.times  # a bag's recorded timing, repeated; else k / rate
+        span = (times[-1] * len(times) / (len(times) - 1) if len(times) > 1 and times[-1] > 0
+                else len(times) / self.rate) if times else 0.0
         while not stop.is_set() and (count is None or k < count):
-            due = start + k / self.rate
+            due = start + (k // len(times) * span + times[k % len(times)] if times else k / self.rate)
             if duration is not None and due - start >= duration:
                 break
             if stop.wait(max(0.0, due - time.monotonic())):

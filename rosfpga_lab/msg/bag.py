@@ -102,7 +102,8 @@ class BagWriter:
         conn = self._conns.get(key)
         try:
             if conn is None:
-                conn = self._writer.add_connection(topic, type_name, msgdef=definition,
+                pkg, _, name = type_name.rpartition("/")  # rosbags names types pkg/msg/Name
+                conn = self._writer.add_connection(topic, f"{pkg}/msg/{name}", msgdef=definition,
                                                    md5sum=md5sum, callerid=callerid)
                 self._conns[key] = conn
             self._writer.write(conn, int(time_ns), bytes(body))
