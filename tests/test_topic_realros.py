@@ -147,3 +147,41 @@ def test_pub_header_auto_and_stamp_now(lab_master) -> None:
         assert before - 1 <= stamp["secs"] + stamp["nsecs"] * 1e-9 <= time.time() + 1, stamp
     assert msg["pose"]["position"] == {"x": 4.0, "y": 0.0, "z": 0.0}
     assert msg["header"]["frame_id"] == "" and header["frame_id"] == "f"
+
+
+GENPY_STRIFY = r'''
+import base64, io, json, math
+import rospy
+from genpy.message import strify_message
+from geometry_msgs.msg import PoseArray, Pose
+from std_msgs.msg import Float32MultiArray, MultiArrayDimension, Header
+from sensor_msgs.msg import JointState
+pa = PoseArray(header=Header(seq=3, stamp=rospy.Time(12, 345), frame_id="map"), poses=[Pose(), Pose()])
+pa.poses[0].position.x = 1.5
+pa.poses[1].orientation.w = -0.25
+m = Float32MultiArray(data=[1, 2.5, -3])
+m.layout.dim = [MultiArrayDimension("rows", 2, 6), MultiArrayDimension('a "q"', 3, 3)]
+js = JointState(name=["j1", "it's"], position=[0.5, 1e-7], velocity=[], effort=[math.inf])
+out = []
+for msg in (pa, PoseArray(), m, js):
+    b = io.BytesIO()
+    msg.serialize(b)
+    back = type(msg)().deserialize(b.getvalue())   # what rostopic echo prints: a received message
+    out.append([msg._type, base64.b64encode(b.getvalue()).decode(), strify_message(back)])
+print(json.dumps(out))
+'''
+
+
+def test_format_message_is_genpys_strify_message_text() -> None:
+    """Item 11, byte for byte: the lab's echo text is what rostopic echo prints for the same bytes
+    (arrays of messages, an empty one, strings with quotes, a list of strings, inf)."""
+    import base64
+    import json
+
+    from realros import run_ros_python
+    from rosfpga_lab.graph.tools import format_message
+    from rosfpga_lab.msg import default_registry, deserialize
+
+    reg = default_registry()
+    for type_name, body, text in json.loads(run_ros_python(GENPY_STRIFY).stdout):
+        assert format_message(deserialize(reg, type_name, base64.b64decode(body))) == text, type_name
