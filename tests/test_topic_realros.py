@@ -162,8 +162,11 @@ pa.poses[1].orientation.w = -0.25
 m = Float32MultiArray(data=[1, 2.5, -3])
 m.layout.dim = [MultiArrayDimension("rows", 2, 6), MultiArrayDimension('a "q"', 3, 3)]
 js = JointState(name=["j1", "it's"], position=[0.5, 1e-7], velocity=[], effort=[math.inf])
+from sensor_msgs.msg import Image
+from std_msgs.msg import Bool
+img = Image(height=1, width=3, encoding="mono8", step=3, data=bytes([0, 7, 255]))
 out = []
-for msg in (pa, PoseArray(), m, js):
+for msg in (pa, PoseArray(), m, js, img, Bool(True)):
     b = io.BytesIO()
     msg.serialize(b)
     back = type(msg)().deserialize(b.getvalue())   # what rostopic echo prints: a received message
@@ -174,7 +177,7 @@ print(json.dumps(out))
 
 def test_format_message_is_genpys_strify_message_text() -> None:
     """Item 11, byte for byte: the lab's echo text is what rostopic echo prints for the same bytes
-    (arrays of messages, an empty one, strings with quotes, a list of strings, inf)."""
+    (arrays of messages, an empty one, strings with quotes, a list of strings, inf, uint8[], bool)."""
     import base64
     import json
 

@@ -157,3 +157,15 @@ def test_echo_counts_and_reports_dropped_messages() -> None:
     assert found, err
     dropped, received = int(found[1]), int(found[2])
     assert received == total and dropped > 0 and printed + dropped == total
+
+
+def test_new_message_completes_messages_inside_arrays() -> None:
+    """The library's new_message completed nested dicts only outside arrays; serialize then
+    failed with "missing ... y" for `poses=[{"position": {"x": 1}}]`."""
+    from rosfpga_lab.msg import SerializeError, new_message
+
+    v = new_message(REG, "geometry_msgs/PoseArray", poses=[{"position": {"x": 1.0}}])
+    back = deserialize(REG, "geometry_msgs/PoseArray", serialize(REG, "geometry_msgs/PoseArray", v))
+    assert back["poses"][0]["position"] == {"x": 1.0, "y": 0.0, "z": 0.0}
+    with pytest.raises(SerializeError, match=r"field poses\[0\]\.position\.q: geometry_msgs/Point has no such field"):
+        new_message(REG, "geometry_msgs/PoseArray", poses=[{"position": {"q": 1}}])
