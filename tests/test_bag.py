@@ -83,8 +83,10 @@ def test_camera_replays_a_bag_on_its_recorded_timing(tmp_path) -> None:
         arrivals: list[tuple[float, bytes]] = []
         sub = viewer.subscribe("/cam/image", IMAGE, lambda v: arrivals.append(
             (time.monotonic(), bytes(v["data"]))), queue_size=0)
+        sent: list[float] = []
         cam = Camera("/cam/image", width=8, height=6, encoding="rgb8", rate=1000.0,
-                     source=open_source(str(tmp_path / "x.bag"), 8, 6, "rgb8"), master=m)
+                     source=open_source(str(tmp_path / "x.bag"), 8, 6, "rgb8"), master=m,
+                     on_sent=lambda f: sent.append(f.sent))
         try:
             assert sub.wait_for_connection(1, 10)
             cam.run(count=len(images))
@@ -95,8 +97,10 @@ def test_camera_replays_a_bag_on_its_recorded_timing(tmp_path) -> None:
             cam.stop()
             viewer.shutdown()
     assert [a[1] for a in arrivals] == [img.tobytes() for img in images]
-    gaps = np.diff([a[0] for a in arrivals])
-    assert gaps == pytest.approx(np.diff(OFFSETS), abs=0.06)  # at 1000 fps they would be 1 ms
+    # on the recorded schedule (at the --rate of 1000 fps they would be 1 ms apart): never
+    # early, and late by no more than a loaded machine's scheduling delay
+    for got, want in zip([t - sent[0] for t in sent], OFFSETS):
+        assert want - 0.005 <= got <= want + 0.2, (sent, OFFSETS)
 
 
 def lab_env() -> dict[str, str]:

@@ -169,3 +169,22 @@ def test_new_message_completes_messages_inside_arrays() -> None:
     assert back["poses"][0]["position"] == {"x": 1.0, "y": 0.0, "z": 0.0}
     with pytest.raises(SerializeError, match=r"field poses\[0\]\.position\.q: geometry_msgs/Point has no such field"):
         new_message(REG, "geometry_msgs/PoseArray", poses=[{"position": {"q": 1}}])
+
+
+def test_pub_with_msg_path_publishes_an_unshipped_type(tmp_path) -> None:
+    reg = custom_registry(tmp_path)
+    with EmbeddedMaster(port=0) as m:
+        listener = Node("/listener", master=m, registry=reg)
+        sub = listener.subscribe("/reading", "lab_test_msgs/Reading")
+        proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "topic", "--master-uri", m.uri,
+                                 "--msg-path", str(tmp_path), "pub", "/reading", "lab_test_msgs/Reading",
+                                 "{samples: [{value: 2}, {where: [1, 2, 3]}], note: hi}"],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=lab_env())
+        try:
+            value, _info = sub.wait_for_message(20)
+        finally:
+            proc.terminate()
+            proc.wait(10)
+            listener.shutdown()
+    assert value["note"] == "hi" and [s["value"] for s in value["samples"]] == [2.0, 0.0]
+    assert value["samples"][1]["where"] == {"x": 1.0, "y": 2.0, "z": 3.0}
