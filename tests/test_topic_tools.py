@@ -156,9 +156,10 @@ def test_echo_counts_and_reports_dropped_messages() -> None:
                       r"and the queue of 5 was full \(a larger --queue-size", err)
     assert found, err
     dropped, received = int(found[1]), int(found[2])
-    # every message received is either printed or counted as dropped (on a loaded machine a
-    # few may still be on their way when --timeout ends)
-    assert dropped > 0 and printed + dropped == received and total // 2 < received <= total
+    # every message received is printed or counted as dropped, but for at most the queue (5)
+    # and one in hand still waiting when --timeout ends on a loaded machine
+    assert dropped > 0 and received - 6 <= printed + dropped <= received
+    assert total // 2 < received <= total
 
 
 def test_new_message_completes_messages_inside_arrays() -> None:
