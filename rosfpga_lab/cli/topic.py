@@ -7,8 +7,7 @@ import sys
 import threading
 import time
 
-from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
-from rosfpga_lab.graph.limits import ECHO_QUEUE
+from rosfpga_lab.config.limits import DEFAULT_MASTER_URI, ECHO_QUEUE
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

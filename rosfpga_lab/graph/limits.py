@@ -67,8 +67,6 @@ TRACE_EXCERPT_BYTES = 64 << 10
 MAX_CLOSED_LINKS_KEPT = 64
 #: Arrays longer than this are summarised by ``tools.format_message`` (rostopic echo --noarr style).
 MAX_ARRAY_SHOWN = 64
-#: Messages ``topic echo`` queues while printing falls behind (older ones are dropped and counted).
-ECHO_QUEUE = 100
 #: Arrival times a :class:`~rosfpga_lab.graph.rate.RateMeter` keeps unless told otherwise.
 RATE_SAMPLES = 1000
 #: Seconds between two asks of the master while waiting for a topic to appear (rostopic: 0.1).
