@@ -114,13 +114,13 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
         print(f"topic echo: {args.topic} was not published within {args.timeout} s",
               file=sys.stderr)
         return 1
+    bag = BagWriter(args.bag) if args.bag else None  # before the node: a refusal leaves nothing
     node = _node(uri, "echo", args.msg_path)
     done = threading.Event()
     count = [0]
     failed: list[str] = []
     known = type_name in node.registry
     decoders: dict[tuple[str, str], object] = {}  # (md5, definition) -> registry from a header
-    bag = BagWriter(args.bag) if args.bag else None
 
     def show(body, info) -> None:
         if done.is_set():
@@ -150,7 +150,7 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
         if args.n and count[0] >= args.n:
             done.set()
 
-    reported = 0
+    reported, last_report = 0, time.monotonic()
     sub = None
     try:
         sub = node.subscribe(args.topic, type_name if known else "*", show, raw=True,
@@ -159,8 +159,9 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
         while not done.is_set() and not _stopped_remotely(node):
             if end is not None and time.monotonic() >= end:
                 break
-            done.wait(0.5)
-            reported = _report_drops(sub, args.queue_size, reported)
+            done.wait(0.1)
+            if time.monotonic() - last_report >= 1.0:  # at most a line a second
+                reported, last_report = _report_drops(sub, args.queue_size, reported), time.monotonic()
     except KeyboardInterrupt:
         pass
     finally:
