@@ -2,7 +2,7 @@
 
 How this works: :class:`Camera` is a ROS node that publishes ``sensor_msgs/Image`` frames from
 an :class:`~rosfpga_lab.component.sources.ImageSource` on a fixed schedule (frame k is due at
-``start + k / rate``; a late frame is sent at once and the schedule is kept, so the average rate
+``start + k / rate``, or at its recorded offset for a bag source; a late frame is sent at once and the schedule is kept, so the average rate
 holds). Each frame's ``header.stamp`` is the wall-clock time it was published and
 ``header.seq`` its number: a subscriber computes latency from the stamp, and a checker finds
 the input frame an output came from by its stamp (the component carries stamps through).
