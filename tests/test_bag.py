@@ -131,6 +131,7 @@ def test_camera_cli_replays_a_bag(tmp_path) -> None:
     assert got and set(got) <= {img.tobytes() for img in images}
 
 
+@pytest.mark.ros
 def test_topic_echo_records_a_bag_that_rosbag_reads(tmp_path) -> None:
     require_ros()
     bag = tmp_path / "rec.bag"
