@@ -17,11 +17,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from realros import require_ros, ros_env
+from realros import require_ros, ros_env, skip_or_fail
 from rosfpga_lab.component import Camera
 from rosfpga_lab.component.errors import SourceError
 from rosfpga_lab.component.sources import open_source
 from rosfpga_lab.graph import EmbeddedMaster, Node
+from rosfpga_lab.graph.realros import ros_missing
 from rosfpga_lab.hw import image_frame
 from rosfpga_lab.msg import default_registry, deserialize, serialize
 from rosfpga_lab.msg.bag import BagWriter, bag_topics, read_bag
@@ -134,6 +135,9 @@ def test_camera_cli_replays_a_bag(tmp_path) -> None:
 @pytest.mark.ros
 def test_topic_echo_records_a_bag_that_rosbag_reads(tmp_path) -> None:
     require_ros()
+    reason = ros_missing(("rosbag",), modules=("rosbag",))
+    if reason:
+        skip_or_fail(f"Debian's rosbag is missing: {reason}", "ROSFPGA_REQUIRE_ROS")
     bag = tmp_path / "rec.bag"
     with EmbeddedMaster(port=0) as m:
         talker = Node("/talker", master=m)
