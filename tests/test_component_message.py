@@ -1,0 +1,219 @@
+"""The FPGA component for any message type (issue 19, items 5 and 6): LaserScan and lab_msgs/Samples.
+
+Outputs are compared with numpy written out here (a sliding min/max over the in-array window)
+and with the msg layer's deserializer; frames of the shipped examples also come from real
+genpy's dynamic classes (built from the .msg texts) under the system Python.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rosfpga_lab.component import FpgaComponent
+from rosfpga_lab.config import load_config
+from rosfpga_lab.graph import EmbeddedMaster, Node
+from rosfpga_lab.hw.errors import FrameFieldError
+from rosfpga_lab.hw.msgpipeline import MessagePipeline
+from rosfpga_lab.msg import deserialize, new_message, serialize
+
+from realros import require_ros, run_ros_python
+
+DATA = Path(__file__).resolve().parent.parent / "data"
+SCAN_CONFIG = DATA / "fpga_laserscan_min.yaml"
+SAMPLES_CONFIG = DATA / "fpga_samples_dilate.yaml"
+
+
+def sliding(values: np.ndarray, k: int, pick) -> np.ndarray:
+    r = k // 2
+    return np.array([pick(values[max(0, i - r):i + r + 1]) for i in range(len(values))],
+                    values.dtype)
+
+
+def scan(k: int, n: int = 360) -> dict:
+    rng = np.random.default_rng(k)
+    reg = load_config(SCAN_CONFIG).registry()
+    return {**new_message(reg, "sensor_msgs/LaserScan"),
+            "header": {"seq": k, "stamp": (100 + k, k), "frame_id": "laser"},
+            "angle_min": -1.5, "angle_increment": 0.01, "range_max": 30.0,
+            "ranges": rng.uniform(0.1, 30, n).astype(np.float32),
+            "intensities": rng.uniform(0, 1, 4).astype(np.float32)}
+
+
+class Collector:
+    def __init__(self, master: EmbeddedMaster, topic: str, type_name: str, registry) -> None:
+        self.bodies: list[bytes] = []
+        self.cond = threading.Condition()
+        self.node = Node("/collector", master=master, registry=registry)
+        self.sub = self.node.subscribe(topic, type_name, self._cb, raw=True, queue_size=0)
+
+    def _cb(self, body, info) -> None:
+        with self.cond:
+            self.bodies.append(bytes(body))
+            self.cond.notify_all()
+
+    def wait(self, n: int, timeout: float = 10.0) -> bool:
+        deadline = time.monotonic() + timeout
+        with self.cond:
+            while len(self.bodies) < n:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self.cond.wait(left)
+        return True
+
+
+@pytest.fixture
+def master():
+    with EmbeddedMaster(port=0) as m:
+        yield m
+
+
+def test_a_laserscan_component_publishes_the_minimum_filter_and_counts_refusals(master) -> None:
+    config = load_config(SCAN_CONFIG)
+    reg = config.registry()
+    comp = FpgaComponent.from_config(config, master=master, output_queue=64).start()
+    src = Node("/scanner", master=master, registry=reg)
+    pub = src.advertise("/scan", "sensor_msgs/LaserScan", queue_size=0)
+    out = Collector(master, "/scan_min", "sensor_msgs/LaserScan", reg)
+    try:
+        assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+        sent = [scan(k) for k in range(4)]
+        pub.publish(sent[0])
+        assert comp.wait_for(1, 10)
+        pub.publish(scan(9, n=359))                               # 359 beams: refused
+        assert comp.wait_for(2, 10)
+        pub.publish(dict(scan(8), range_max=5000.0))              # over the checked bound
+        assert comp.wait_for(3, 10)
+        for k, msg in enumerate(sent[1:], 1):
+            pub.publish(msg)
+            assert comp.wait_for(3 + k, 10)
+        assert out.wait(4), comp.stats.report()
+        for msg, body in zip(sent, out.bodies):
+            got = deserialize(reg, "sensor_msgs/LaserScan", body)
+            want = sliding(msg["ranges"], 5, np.min)
+            assert np.asarray(got["ranges"]).tobytes() == want.tobytes()
+            assert np.array_equal(got["intensities"], msg["intensities"])
+            assert got["header"]["frame_id"] == "laser"
+            assert tuple(got["header"]["stamp"]) == tuple(msg["header"]["stamp"])
+            assert got["header"]["seq"] == msg["header"]["seq"]
+            assert got["angle_increment"] == np.float32(0.01)
+        st = comp.stats
+        assert (st.published, st.refused) == (4, 2)
+        assert st.refused_reasons == {"ranges length: not what the circuit was built for": 1,
+                                      "range_max: over the limit": 1}
+        assert st.cycles["subscriber"] == 4 + len(serialize(reg, "sensor_msgs/LaserScan", sent[-1]))
+    finally:
+        out.node.shutdown()
+        src.shutdown()
+        comp.stop()
+
+
+def test_the_custom_message_component_dilates_samples_and_carries_the_rest(master) -> None:
+    config = load_config(SAMPLES_CONFIG)
+    reg = config.registry()
+    comp = FpgaComponent.from_config(config, master=master, model="reference").start()
+    src = Node("/sampler", master=master, registry=reg)
+    pub = src.advertise("/samples", "lab_msgs/Samples", queue_size=0)
+    out = Collector(master, "/samples_dilated", "lab_msgs/Samples", reg)
+    cal = {"sensor_name": "front", "offset": [0.5, -1.0, 2.0], "mode": 2}
+    samples = np.random.default_rng(1).integers(-2**31, 2**31, 64).astype(np.int32)
+    msg = {"header": {"seq": 3, "stamp": (1, 2), "frame_id": "array"}, "calibration": cal,
+           "label": "burst", "thresholds": [-5, 0, 5, 100], "samples": samples,
+           "period": (0, 1000), "history": [cal, dict(cal, mode=7, sensor_name="")],
+           "valid": True}
+    try:
+        assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+        pub.publish(dict(msg, calibration=dict(cal, mode=1)))     # checked mode: refused
+        assert comp.wait_for(1, 10)
+        pub.publish(msg)
+        assert comp.wait_for(2, 10) and out.wait(1), comp.stats.report()
+        got = deserialize(reg, "lab_msgs/Samples", out.bodies[0])
+        expected = deserialize(reg, "lab_msgs/Samples", serialize(
+            reg, "lab_msgs/Samples", dict(msg, samples=sliding(samples, 3, np.max))))
+        assert serialize(reg, "lab_msgs/Samples", got) == serialize(reg, "lab_msgs/Samples", expected)
+        assert comp.stats.refused_reasons == {
+            "calibration.mode: not what the circuit was built for": 1}
+    finally:
+        out.node.shutdown()
+        src.shutdown()
+        comp.stop()
+
+
+# -- frames from real genpy -------------------------------------------------------------------
+
+GENPY = r"""
+import json, sys, struct, io
+import genpy.dynamic
+spec = json.loads(sys.stdin.read())
+out = {}
+for name, full_text in spec["types"].items():
+    classes = genpy.dynamic.generate_dynamic(name, full_text)
+    cls = classes[name]
+    msg = cls()
+    for path, value in spec["values"][name]:
+        obj = msg
+        parts = path.split(".")
+        for p in parts[:-1]:
+            obj = getattr(obj, p)
+        setattr(obj, parts[-1], value)
+    if name == "lab_msgs/Samples":
+        cal = classes["lab_msgs/Calibration"]
+        msg.history = [cal(sensor_name="h%d" % i, offset=[i, 0.5, -i], mode=i) for i in range(3)]
+    buf = io.BytesIO()
+    msg.serialize(buf)
+    out[name] = {"md5": cls._md5sum, "body": buf.getvalue().hex()}
+print(json.dumps(out))
+"""
+
+
+def test_frames_from_real_genpy_through_the_shipped_examples() -> None:
+    require_ros()
+    scan_cfg, samples_cfg = load_config(SCAN_CONFIG), load_config(SAMPLES_CONFIG)
+    ranges = [float(x) for x in np.linspace(0.5, 20, 360, dtype=np.float32)]
+    ranges[100] = 0.25
+    samples = [(-1) ** i * i * 1000 for i in range(64)]
+    spec = {
+        "types": {"sensor_msgs/LaserScan": scan_cfg.registry().full_text("sensor_msgs/LaserScan"),
+                  "lab_msgs/Samples": samples_cfg.registry().full_text("lab_msgs/Samples")},
+        "values": {
+            "sensor_msgs/LaserScan": [["header.frame_id", "laser"], ["header.seq", 4],
+                                      ["angle_min", -1.0], ["range_max", 25.0],
+                                      ["ranges", ranges], ["intensities", [1.0, 2.0]]],
+            "lab_msgs/Samples": [["header.frame_id", "arr"], ["calibration.mode", 2],
+                                 ["calibration.sensor_name", "front"],
+                                 ["calibration.offset", [1.0, 2.0, 3.0]], ["label", "genpy"],
+                                 ["thresholds", [1, -2, 3, -4]], ["samples", samples],
+                                 ["valid", True]]},
+    }
+    proc = run_ros_python(GENPY, input=json.dumps(spec).encode())
+    got = json.loads(proc.stdout)
+    for cfg, type_name, stream, k, pick in (
+            (scan_cfg, "sensor_msgs/LaserScan", "ranges", 5, np.min),
+            (samples_cfg, "lab_msgs/Samples", "samples", 3, np.max)):
+        reg = cfg.registry()
+        assert got[type_name]["md5"] == reg.md5(type_name)
+        body = bytes.fromhex(got[type_name]["body"])
+        frame = struct.pack("<I", len(body)) + body
+        want_in = deserialize(reg, type_name, body)
+        for model in ("fast", "reference"):
+            res = MessagePipeline.from_config(cfg, model=model, reg=reg).process(frame)
+            src = np.asarray(want_in[stream])
+            assert res.input_stream.tobytes() == src.tobytes()
+            out = deserialize(reg, type_name, res.output_frame[4:])
+            assert np.asarray(out[stream]).tobytes() == sliding(src, k, pick).tobytes()
+            # everything else is carried: the output with the input's stream is genpy's body
+            restored = serialize(reg, type_name, dict(out, **{stream: src}))
+            assert restored == body
+    bad = bytearray(bytes.fromhex(got["lab_msgs/Samples"]["body"]))
+    with pytest.raises(FrameFieldError, match="calibration.mode"):
+        pipe = MessagePipeline.from_config(samples_cfg, reg=samples_cfg.registry())
+        mode_at = 12 + 4 + 3 + 4 + 5 + 24  # header (seq, stamp, "arr"), sensor_name, offset
+        bad[mode_at] = 9
+        pipe.process(struct.pack("<I", len(bad)) + bytes(bad))
