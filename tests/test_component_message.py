@@ -217,3 +217,37 @@ def test_frames_from_real_genpy_through_the_shipped_examples() -> None:
         mode_at = 12 + 4 + 3 + 4 + 5 + 24  # header (seq, stamp, "arr"), sensor_name, offset
         bad[mode_at] = 9
         pipe.process(struct.pack("<I", len(bad)) + bytes(bad))
+
+
+def test_the_node_and_topic_pub_commands_run_a_custom_type_end_to_end(master) -> None:
+    """``rosfpga-lab node CONFIG`` for lab_msgs/Samples, fed by ``rosfpga-lab topic pub
+    --msg-path`` (both real command lines, as subprocesses)."""
+    import os
+    import subprocess
+    import sys
+
+    reg = load_config(SAMPLES_CONFIG).registry()
+    out = Collector(master, "/samples_dilated", "lab_msgs/Samples", reg)
+    env = {k: v for k, v in os.environ.items() if not k.startswith("ROS_")}
+    cmd = [sys.executable, "-m", "rosfpga_lab"]
+    node = subprocess.Popen(cmd + ["node", str(SAMPLES_CONFIG), "--master-uri", master.uri,
+                                   "--duration", "8", "-q"], env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    samples = [(i * 37) % 101 - 50 for i in range(64)]
+    value = json.dumps({"calibration": {"mode": 2}, "label": "cli", "samples": samples})
+    try:
+        assert out.sub.wait_for_connection(1, 15), node.stderr.read() if node.poll() else "no node"
+        pub = subprocess.run(cmd + ["topic", "--master-uri", master.uri, "--msg-path",
+                                    str(DATA / "msg"), "pub", "-1", "/samples",
+                                    "lab_msgs/Samples", value],
+                             env=env, capture_output=True, text=True, timeout=30)
+        assert pub.returncode == 0, pub.stderr
+        assert out.wait(1, 10)
+    finally:
+        node.terminate()
+        node.communicate(timeout=15)
+        out.node.shutdown()
+    got = deserialize(reg, "lab_msgs/Samples", out.bodies[0])
+    want = sliding(np.array(samples, np.int32), 3, np.max)
+    assert np.asarray(got["samples"]).tolist() == want.tolist()
+    assert got["label"] == "cli" and got["calibration"]["mode"] == 2
