@@ -16,23 +16,25 @@ field's default). Every length prefix is checked too (its maximum, from the conf
 the HLS C++, the Verilog) walk ``layout.steps`` and never need to know a message type: every
 name, size, maximum and status code is in the steps.
 
-Worked example: ``pkg/Scan`` = ``Header header``, ``string[] names``, ``float32[] ranges``
-streamed with length 4, ``checks: {header.seq: 0}``; :func:`format_layout` prints::
+Worked example: ``pkg/Scan`` = ``Header header``, ``string[] names``, ``float32[] ranges``,
+``derive_layout(reg, "pkg/Scan", stream="ranges", stream_length=4, checks={"header.seq": 0})``;
+:func:`format_layout` prints (a test holds this text equal to its output)::
 
-    #   kind    ident                 label                   type     bytes      max  action  check
-    0   length  frame_length          frame length            uint32   4          -    check   SUB_BAD_FRAME_LENGTH: 20..
-    1   scalar  header_seq            header.seq              uint32   4          -    check   SUB_BAD_HEADER_SEQ: == 0
-    2   scalar  header_stamp_secs     header.stamp.secs       uint32   4          -    carry   -
-    3   scalar  header_stamp_nsecs    header.stamp.nsecs      uint32   4          -    carry   -
-    4   length  header_frame_id_len.. header.frame_id length  uint32   4          -    carry   SUB_BAD_HEADER_FRAME_ID_LENGTH: <= 256
-    5   string  header_frame_id       header.frame_id         string   1 x [4]    256  carry   -
-    6   length  names_length          names length            uint32   4          -    carry   SUB_BAD_NAMES_LENGTH: <= 64
-    7   loop    names                 names                   string   0 x [6]    64   carry   -
-    8   length  names_item_length     names[] length          uint32   4          -    carry   SUB_BAD_NAMES_ITEM_LENGTH: <= 256
-    9   string  names_item            names[]                 string   1 x [8]    256  carry   -
-    10  end     names                 names                   string   0          -    carry   -
-    11  length  ranges_length         ranges length           uint32   4          -    stream  SUB_BAD_RANGES_LENGTH: == 4
-    12  array   ranges                ranges                  float32  4 x [11]   4    stream  -
+    pkg/Scan (md5 115c5a6fcd20cb3c1c340cbd2d284ee1): stream ranges 4 x float32, body 24..16936 bytes
+    #   kind      ident                   label                   type     bytes     max  action  check
+    0   length    frame_length            frame length            uint32   4         -    check   SUB_BAD_FRAME_LENGTH: 24..67108864
+    1   scalar    header_seq              header.seq              uint32   4         -    check   SUB_BAD_HEADER_SEQ: == 0
+    2   scalar    header_stamp_secs       header.stamp.secs       uint32   4         -    carry   -
+    3   scalar    header_stamp_nsecs      header.stamp.nsecs      uint32   4         -    carry   -
+    4   length    header_frame_id_length  header.frame_id length  uint32   4         -    carry   SUB_BAD_HEADER_FRAME_ID_LENGTH: <= 256
+    5   string    header_frame_id         header.frame_id         string   1 x [4]   256  carry   -
+    6   length    names_length            names length            uint32   4         -    carry   SUB_BAD_NAMES_LENGTH: <= 64
+    7   loop      names                   names                   string   0 x [6]   64   carry   -
+    8     length  names_item_length       names[] length          uint32   4         -    carry   SUB_BAD_NAMES_ITEM_LENGTH: <= 256
+    9     string  names_item              names[]                 string   1 x [8]   256  carry   -
+    10  end       names                   names                   string   0         -    carry   -
+    11  length    ranges_length           ranges length           uint32   4         -    stream  SUB_BAD_RANGES_LENGTH: == 4
+    12  array     ranges                  ranges                  float32  4 x [11]  4    stream  -
 
 (``x [11]``: as many elements as step 11 says). A frame's byte offsets follow from its values
 (:func:`frame_geometry`); a refused field is named by its label with indices filled in
