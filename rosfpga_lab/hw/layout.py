@@ -41,6 +41,17 @@ Worked example: ``pkg/Scan`` = ``Header header``, ``string[] names``, ``float32[
 (``names[2] length``). Status codes: ``SUB_OK`` then one per checked step, in step order
 (:attr:`Layout.statuses`), exactly as ``hw.interpreter.SUBSCRIBER_STATUSES`` does for Image.
 
+Refusal order (what every renderer does, so models, C++ and RTL give the same status): when a
+step completes, (1) step 0, the frame length: below ``min_body`` or above
+``hw.limits.MAX_FRAME_BYTES`` -> ``SUB_BAD_FRAME_LENGTH``, nothing trusted, wait for the next
+frame; (2) the step's own check (``EQUAL``, ``RANGE`` -- a NaN fails it --, ``MAX``) -> its
+status; (3) a LENGTH step's :class:`LengthRule` (:func:`length_rules`): when only fixed-size
+data follows, the frame must end exactly there (else ``SUB_BAD_FRAME_LENGTH``), otherwise its
+elements must fit in the bytes left (else its own status); (4) on to the next step: LOOPs
+with no elements and empty strings/arrays are passed at once; reaching the frame's end before
+a step that has bytes, or inside one, refuses the frame (``SUB_BAD_FRAME_LENGTH``). After a
+refusal with a sane frame length the rest of the frame is skipped.
+
 :func:`tokens` lists a message's values in walk order (what the subscriber emits step by step)
 and :func:`marshal` writes tokens back into a frame (what the publisher does): the two are
 the layout's definition of the wire, tested against the ``msg`` layer.
@@ -554,6 +565,85 @@ def _with_max_body(layout: Layout) -> Layout:
     return replace(layout, max_body=size(1, len(layout.steps)))
 
 
+# -- how length prefixes are held against the frame ------------------------------------------
+
+def _min_bytes(layout: Layout, lo: int, hi: int) -> int:
+    """Fewest bytes steps ``lo..hi-1`` can take (variable parts empty)."""
+    total, i = 0, lo
+    while i < hi:
+        s = layout.steps[i]
+        if s.kind is StepKind.LOOP:
+            assert s.partner is not None
+            if s.count is not None:
+                total += s.count * _min_bytes(layout, i + 1, s.partner)
+            i = s.partner + 1
+            continue
+        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
+            total += s.size
+        elif s.count is not None:
+            total += s.size * s.count
+        i += 1
+    return total
+
+
+def _fixed_bytes(layout: Layout, lo: int, hi: int) -> int | None:
+    """Bytes of steps ``lo..hi-1`` if they are all fixed-size, else None."""
+    total, i = 0, lo
+    while i < hi:
+        s = layout.steps[i]
+        if s.is_variable or s.kind is StepKind.STRING:
+            return None
+        if s.kind is StepKind.LOOP:
+            assert s.partner is not None and s.count is not None
+            inner = _fixed_bytes(layout, i + 1, s.partner)
+            if inner is None:
+                return None
+            total += s.count * inner
+            i = s.partner + 1
+            continue
+        total += s.size * (s.count if s.count is not None else 1)
+        i += 1
+    return total
+
+
+class LengthRule(NamedTuple):
+    """How a LENGTH step's value is held against the frame length (after its own check).
+
+    Attributes:
+        element_min: fewest bytes one counted element takes (1 for a string's byte).
+        fixed_after: when the counted elements and everything after them are fixed-size (and
+            the step is in no loop): the bytes after the counted part, so the frame length must
+            equal ``offset + value * element_min + fixed_after`` exactly (else a
+            ``frame length`` refusal, as Image's ``data length``); otherwise ``None`` and only
+            ``value * element_min <= bytes left`` is required (else ``past the frame end``).
+    """
+
+    element_min: int
+    fixed_after: int | None
+
+
+def length_rules(layout: Layout) -> dict[int, LengthRule]:
+    """The :class:`LengthRule` of every LENGTH step but the frame length, by step index."""
+    rules: dict[int, LengthRule] = {}
+    steps = layout.steps
+    for s in steps:
+        if s.kind is not StepKind.LENGTH or s.partner is None:
+            continue
+        part = steps[s.partner]
+        exact = True
+        if part.kind is StepKind.LOOP:
+            assert part.partner is not None
+            element_min = _min_bytes(layout, part.index + 1, part.partner)
+            exact = _fixed_bytes(layout, part.index + 1, part.partner) is not None
+            end = part.partner + 1
+        else:
+            element_min = part.size
+            end = part.index + 1
+        rules[s.index] = LengthRule(element_min, _fixed_bytes(layout, end, len(steps))
+                                    if s.depth == 0 and exact else None)
+    return rules
+
+
 # -- values in walk order ----------------------------------------------------------------------
 
 class Token(NamedTuple):
@@ -679,7 +769,8 @@ def format_layout(layout: Layout) -> str:
 
 
 __all__ = [
-    "Action", "CheckOp", "FieldCheck", "FrameGeometry", "Layout", "Step", "StepKind", "Token",
+    "Action", "CheckOp", "FieldCheck", "FrameGeometry", "Layout", "LengthRule", "Step", "StepKind",
+    "Token", "length_rules",
     "VideoShape", "STREAM_ELEMENT_TYPES", "derive_layout", "encode_token", "format_layout",
     "frame_geometry", "marshal", "tokens",
 ]

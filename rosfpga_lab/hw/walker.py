@@ -35,7 +35,8 @@ import numpy as np
 
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
 from rosfpga_lab.hw.layout import (
-    Action, CheckOp, Layout, Step, StepKind, Token, encode_token, marshal,
+    Action, CheckOp, Layout, LengthRule, Step, StepKind, Token, encode_token, length_rules,
+    marshal,
 )
 from rosfpga_lab.msg.builtins import SCALARS
 
@@ -71,77 +72,6 @@ def _decode(step: Step, data: bytes | memoryview) -> Any:
     return np.frombuffer(data, np.dtype(step.dtype))  # a read-only view (fast model: of the frame)
 
 
-def _min_bytes(layout: Layout, lo: int, hi: int) -> int:
-    """Fewest bytes steps ``lo..hi-1`` can take (variable parts empty)."""
-    total, i = 0, lo
-    while i < hi:
-        s = layout.steps[i]
-        if s.kind is StepKind.LOOP:
-            assert s.partner is not None
-            if s.count is not None:
-                total += s.count * _min_bytes(layout, i + 1, s.partner)
-            i = s.partner + 1
-            continue
-        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
-            total += s.size
-        elif s.count is not None:
-            total += s.size * s.count
-        i += 1
-    return total
-
-
-def _fixed_bytes(layout: Layout, lo: int, hi: int) -> int | None:
-    """Bytes of steps ``lo..hi-1`` if they are all fixed-size, else None."""
-    total, i = 0, lo
-    while i < hi:
-        s = layout.steps[i]
-        if s.is_variable or s.kind is StepKind.STRING:
-            return None
-        if s.kind is StepKind.LOOP:
-            assert s.partner is not None and s.count is not None
-            inner = _fixed_bytes(layout, i + 1, s.partner)
-            if inner is None:
-                return None
-            total += s.count * inner
-            i = s.partner + 1
-            continue
-        total += s.size * (s.count if s.count is not None else 1)
-        i += 1
-    return total
-
-
-@dataclass(frozen=True)
-class _Plan:
-    """Per LENGTH step: minimum bytes of one counted element, and the exact bytes after the
-    counted part when its elements and everything after it are fixed-size (None otherwise, or
-    inside a loop): then the frame length must match exactly."""
-
-    element_min: dict[int, int]
-    fixed_after: dict[int, int | None]
-
-
-def _plan(layout: Layout) -> _Plan:
-    element_min: dict[int, int] = {}
-    fixed_after: dict[int, int | None] = {}
-    steps = layout.steps
-    for s in steps:
-        if s.kind is not StepKind.LENGTH or s.partner is None:
-            continue
-        part = steps[s.partner]
-        exact = True
-        if part.kind is StepKind.LOOP:
-            assert part.partner is not None
-            element_min[s.index] = _min_bytes(layout, part.index + 1, part.partner)
-            exact = _fixed_bytes(layout, part.index + 1, part.partner) is not None
-            end = part.partner + 1
-        else:
-            element_min[s.index] = part.size
-            end = part.index + 1
-        fixed_after[s.index] = (_fixed_bytes(layout, end, len(steps))
-                                if s.depth == 0 and exact else None)
-    return _Plan(element_min, fixed_after)
-
-
 @dataclass
 class LayoutInterpreter:
     """The subscriber circuit of ``layout`` (reference model: one byte per :meth:`push`).
@@ -156,10 +86,10 @@ class LayoutInterpreter:
     layout: Layout
     frames: int = 0
     last: Extracted | None = None
-    _plan: _Plan = field(init=False, repr=False)
+    _rules: dict[int, LengthRule] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self._plan = _plan(self.layout)
+        self._rules = length_rules(self.layout)
         self.reset()
 
     def reset(self) -> None:
@@ -361,8 +291,9 @@ class LayoutInterpreter:
 
     def _check_fits(self, s: Step, value: int) -> None:
         left = self._end - self.offset
-        need = value * self._plan.element_min[s.index]
-        fixed = self._plan.fixed_after[s.index]
+        rule = self._rules[s.index]
+        need = value * rule.element_min
+        fixed = rule.fixed_after
         if fixed is not None and need + fixed != left:
             self._fail(FrameLengthError(
                 f"{self._frame_length} announces {left} bytes after the {s.label} field, but "
