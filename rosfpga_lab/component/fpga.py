@@ -157,18 +157,16 @@ class FpgaComponent:
             raise ComponentConfigError(
                 f"subscriber.type is {config.subscriber.type!r} but image: is given: image: is "
                 f"for {IMAGE_TYPE} only")
+        if config.is_image and config.publisher.type != IMAGE_TYPE:
+            raise ComponentConfigError(
+                f"publisher.type is {config.publisher.type!r}: the video path publishes "
+                f"{IMAGE_TYPE} only")
         try:
             self.registry = config.registry()
             self.pipeline: Pipeline | MessagePipeline = (
                 Pipeline.from_config(config, model=model) if config.is_image
                 else MessagePipeline.from_config(config, model=model, reg=self.registry))
-            if config.publisher.type != config.subscriber.type:
-                raise ComponentConfigError(
-                    f"publisher.type {config.publisher.type!r} differs from subscriber.type "
-                    f"{config.subscriber.type!r}: the emulated node publishes the input's type")
         except LabError as exc:
-            if isinstance(exc, ComponentConfigError):
-                raise
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         if input_queue < 1 or output_queue < 1:
             raise ComponentConfigError("input_queue and output_queue must be at least 1")

@@ -783,7 +783,9 @@ def layout_from_config(config: NodeConfig, reg: MsgRegistry | None = None, *,
     ``sensor_msgs/Image``: stream ``data`` with the video shape of ``image:``, checks of
     ``height``, ``width``, ``encoding`` and ``step`` equal to it, ``encoding`` at most
     ``hw.limits.MAX_ENCODING_BYTES``. Every type: ``header.frame_id`` (when there is one) at most
-    ``frame_id_max`` unless ``limits:`` says otherwise.
+    ``frame_id_max`` unless ``limits:`` says otherwise. A publisher of another type than the
+    subscriber's has no checks and skips nothing (it writes what it carries, defaults for the
+    rest); its maxima are the ``limits:`` entries whose paths it has.
 
     Args:
         config: a loaded configuration.
@@ -793,7 +795,9 @@ def layout_from_config(config: NodeConfig, reg: MsgRegistry | None = None, *,
     reg = reg or config.registry()
     type_name = config.publisher.type if output else config.subscriber.type
     assert config.stream is not None
-    checks: dict[str, Any] = {c.path: c.spec for c in config.checks}
+    # the publisher's own type checks nothing; its maxima are those of the paths it has
+    other = output and type_name != config.subscriber.type
+    checks: dict[str, Any] = {} if other else {c.path: c.spec for c in config.checks}
     maxima: dict[str, int] = {}
     try:
         resolve_field(reg, type_name, _FRAME_ID)
@@ -808,10 +812,16 @@ def layout_from_config(config: NodeConfig, reg: MsgRegistry | None = None, *,
         maxima["encoding"] = limits.MAX_ENCODING_BYTES
         video = VideoShape(im.width, im.height, im.encoding, im.bytes_per_pixel)
         length = im.data_bytes
-    maxima.update(config.limits)
+    for path, value in config.limits:
+        if other:
+            try:
+                limit_field(reg, type_name, path.removesuffix("[]"))
+            except FieldPathError:
+                continue
+        maxima[path] = value
     return derive_layout(reg, type_name, stream=config.stream.field,
                          stream_length=length, checks=checks, limits_=maxima,
-                         skip=config.skip, video=video)
+                         skip=() if other else config.skip, video=video)
 
 
 _FRAME_ID = "header.frame_id"

@@ -82,16 +82,23 @@ class MessagePipeline:
         ksize: window of the 1-D application (odd).
         model: ``fast`` or ``reference``.
         clock_hz: the circuit's clock, for ``frame_time_s``.
+        out_layout: the publisher's layout when its type is not the subscriber's (fields carried
+            by path and type, see :func:`~rosfpga_lab.hw.walker.published_tokens`).
+        reg: the registry holding both types (with ``out_layout``).
     """
 
     def __init__(self, layout: Layout, op: str = "passthrough", ksize: int = 3,
-                 model: str = "fast", clock_hz: float = limits.DEFAULT_CLOCK_HZ) -> None:
+                 model: str = "fast", clock_hz: float = limits.DEFAULT_CLOCK_HZ,
+                 out_layout: Layout | None = None, reg: MsgRegistry | None = None) -> None:
         if model not in MODELS:
             raise PipelineConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
         if layout.video is not None:
             raise PipelineConfigError(f"{layout.type_name} streams video: use hw.Pipeline")
         self.op = check_op1d(op, ksize, np.dtype(layout.stream.dtype))
         self.layout, self.ksize, self.model, self.clock_hz = layout, ksize, model, clock_hz
+        self.out_layout, self.reg = out_layout, reg
+        if out_layout is not None and reg is None:
+            raise PipelineConfigError("a publisher of another type needs the registry")
         self._stamp = self._stamp_steps()
 
     @classmethod
@@ -105,9 +112,12 @@ class MessagePipeline:
         if canonical_op(config.application.op) == CUSTOM:
             raise PipelineConfigError("a custom application has no Python model; compare its C "
                                       "simulation against your own expectation")
+        reg = reg or config.registry()
         layout = layout_from_config(config, reg)
+        out_layout = (layout_from_config(config, reg, output=True)
+                      if config.publisher.type != config.subscriber.type else None)
         return cls(layout, config.application.op, config.application.ksize, model,
-                   config.clock_mhz * 1e6)
+                   config.clock_mhz * 1e6, out_layout, reg)
 
     def _stamp_steps(self) -> tuple[int, int] | None:
         idents = {s.ident: s.index for s in self.layout.steps}
@@ -125,8 +135,8 @@ class MessagePipeline:
         ex = (extract_reference if reference else extract_fast)(self.layout, frame)
         app = morph1d_reference if reference else morph1d_fast
         out_stream = app(np.asarray(ex.stream), self.op, self.ksize)
-        out = (publish_reference if reference else publish_fast)(self.layout, ex.tokens,
-                                                                 out_stream)
+        out = (publish_reference if reference else publish_fast)(
+            self.layout, ex.tokens, out_stream, self.out_layout, self.reg)
         n = len(out_stream)
         cycles = {"subscriber": len(frame), "application": n + (self.ksize // 2 if n else 0),
                   "publisher": len(out)}

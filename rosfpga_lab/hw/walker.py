@@ -36,8 +36,9 @@ import numpy as np
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
 from rosfpga_lab.hw.layout import (
     Action, CheckOp, Layout, LengthRule, Step, StepKind, Token, encode_token, length_rules,
-    marshal,
+    marshal, tokens,
 )
+from rosfpga_lab.msg import MsgRegistry, default_value, new_message
 from rosfpga_lab.msg.builtins import SCALARS
 
 STAGE = "subscriber"
@@ -428,15 +429,108 @@ def output_tokens(layout: Layout, toks: list[Token], stream: np.ndarray) -> list
     return out
 
 
-def publish_fast(layout: Layout, toks: list[Token], stream: np.ndarray) -> bytes:
+def _merge(skeleton: dict[str, Any], got: dict[str, Any]) -> dict[str, Any]:
+    for key, value in got.items():
+        if isinstance(value, dict) and isinstance(skeleton.get(key), dict):
+            _merge(skeleton[key], value)
+        else:
+            skeleton[key] = value
+    return skeleton
+
+
+def message_of(layout: Layout, toks: list[Token], reg: MsgRegistry) -> dict[str, Any]:
+    """The message (nested dicts and lists, ``msg.serialize`` takes it) whose walk gives
+    ``toks``: the inverse of :func:`~rosfpga_lab.hw.layout.tokens` (``reg`` fills nested
+    messages without fields, which have no steps)."""
+    steps = layout.steps
+    pos = 0
+
+    def put(obj: dict[str, Any], rel: tuple[str, ...], value: Any) -> None:
+        for name in rel[:-1]:
+            obj = obj.setdefault(name, {})
+        obj[rel[-1]] = value
+
+    def walk(lo: int, hi: int, obj: dict[str, Any]) -> None:
+        nonlocal pos
+        i = lo
+        while i < hi:
+            s = steps[i]
+            if s.kind is StepKind.LOOP:
+                assert s.partner is not None
+                n = s.count if s.count is not None else counts[s.length_step or 0]
+                items: list[Any] = []
+                for _ in range(n):
+                    element: dict[str, Any] = {}
+                    walk(i + 1, s.partner, element)
+                    if "" in element:
+                        items.append(element[""])
+                    elif s.type in reg:
+                        items.append(_merge(new_message(reg, s.type), element))
+                    else:
+                        items.append(element)
+                put(obj, s.rel, items)
+                i = s.partner + 1
+                continue
+            t = toks[pos]
+            assert t.step == i, f"token of step {t.step} where step {i} was expected"
+            pos += 1
+            if s.kind is StepKind.LENGTH:
+                counts[i] = t.value
+            else:
+                put(obj, s.rel or ("",), t.value)
+            i += 1
+
+    counts: dict[int, int] = {}
+    root: dict[str, Any] = {}
+    walk(1, len(steps), root)
+    return _merge(new_message(reg, layout.type_name), root)
+
+
+def _carry_into(reg: MsgRegistry, in_type: str, out_type: str, src: dict[str, Any]) -> dict:
+    """A value of ``out_type``: each field the input's field of the same name when the types
+    are equal (nested messages field by field), else its default."""
+    in_fields = {f.name: f for f in reg.check(in_type).fields}
+    out: dict[str, Any] = {}
+    for f in reg.check(out_type).fields:
+        g = in_fields.get(f.name)
+        if g is not None and g.type == f.type:
+            out[f.name] = src[f.name]
+        elif (g is not None and not f.is_array and not g.is_array and not f.is_builtin
+              and not g.is_builtin):
+            out[f.name] = _carry_into(reg, g.base_type, f.base_type, src[f.name])
+        else:
+            out[f.name] = default_value(reg, f)
+    return out
+
+
+def published_tokens(layout: Layout, toks: list[Token], stream: np.ndarray,
+                     out_layout: Layout | None = None, reg: MsgRegistry | None = None
+                     ) -> list[Token]:
+    """What the publisher writes, in its layout's walk order: :func:`output_tokens`, and for a
+    publisher of another type (``out_layout``, its registry ``reg``) every field of that type
+    taken from the input's field of the same path and type, else its default."""
+    same = output_tokens(layout, toks, stream)
+    if out_layout is None or out_layout.type_name == layout.type_name:
+        return same
+    if reg is None:
+        raise ValueError("a publisher of another type needs the registry holding both types")
+    message = _carry_into(reg, layout.type_name, out_layout.type_name,
+                          message_of(layout, same, reg))
+    return tokens(out_layout, message)
+
+
+def publish_fast(layout: Layout, toks: list[Token], stream: np.ndarray,
+                 out_layout: Layout | None = None, reg: MsgRegistry | None = None) -> bytes:
     """The output TCPROS frame (4-byte length + body), each field packed whole."""
-    return marshal(layout, output_tokens(layout, toks, stream))
+    return marshal(out_layout or layout, published_tokens(layout, toks, stream, out_layout, reg))
 
 
-def publish_reference(layout: Layout, toks: list[Token], stream: np.ndarray) -> bytes:
+def publish_reference(layout: Layout, toks: list[Token], stream: np.ndarray,
+                      out_layout: Layout | None = None, reg: MsgRegistry | None = None) -> bytes:
     """The output frame written a byte per clock: numbers shifted out little-endian, strings
     and arrays byte by byte, as the generated publisher does."""
-    out_toks = output_tokens(layout, toks, stream)
+    out_toks = published_tokens(layout, toks, stream, out_layout, reg)
+    layout = out_layout or layout
     length = sum(_size(layout.steps[t.step], t.value) for t in out_toks)
     out = bytearray()
     for k in range(4):
