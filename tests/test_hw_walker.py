@@ -27,7 +27,7 @@ from rosfpga_lab.hw.walker import (
     LayoutInterpreter, extract_fast, extract_reference, message_of, publish_fast,
     publish_reference,
 )
-from rosfpga_lab.msg import MsgRegistry, deserialize, serialize
+from rosfpga_lab.msg import MsgRegistry, deserialize, new_message, serialize
 from rosfpga_lab.msg.builtins import SCALARS
 from rosfpga_lab.msg.strategies import message
 
@@ -405,3 +405,14 @@ def test_a_publisher_of_another_type_carries_fields_by_path_and_type(tmp_path: P
     for model in ("fast", "reference"):
         res = MessagePipeline.from_config(config, model=model, reg=reg).process(frame)
         assert res.output_frame == want
+
+
+def test_thousands_of_empty_steps_in_a_row_need_no_recursion() -> None:
+    reg = MsgRegistry.with_defaults()
+    reg.add("e_msgs/E", "int32[0] nothing\nuint8[0] none")
+    reg.add("e_msgs/Many", "E[3000] empties\nint16[] values")
+    layout = derive_layout(reg, "e_msgs/Many", stream="values", stream_length=2)
+    frame = _frame(serialize(reg, "e_msgs/Many", new_message(reg, "e_msgs/Many", values=[5, -6])))
+    for extract in (extract_reference, extract_fast):
+        ex = extract(layout, frame)
+        assert ex.stream.tolist() == [5, -6] and len(ex.tokens) == 2 * 3000 + 2

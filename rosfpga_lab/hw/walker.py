@@ -184,6 +184,11 @@ class LayoutInterpreter:
 
     # -- steps ------------------------------------------------------------------------------------
     def _complete(self, s: Step, data: bytes | memoryview) -> None:
+        self._accept(s, data)
+        self._advance(s.index + 1)
+
+    def _accept(self, s: Step, data: bytes | memoryview) -> None:
+        """Decode a complete step, run its checks, record its token (no moving on)."""
         value = _decode(s, data)
         if s.index == 0:
             self._frame_length = value
@@ -197,7 +202,6 @@ class LayoutInterpreter:
             self._tokens.append(Token(s.index, value, self.indices))
         if s.index == self.layout.stream_index:
             self._stream = value
-        self._advance(s.index + 1)
 
     def _advance(self, pc: int) -> None:
         steps = self.layout.steps
@@ -227,10 +231,11 @@ class LayoutInterpreter:
             self.pc = pc
             if pc == self.layout.stream_index:
                 self._stream_offset = self.offset
-            if self.need(t) == 0:
+            if self.need(t) == 0:  # an empty string or array completes at once
                 self._field_start = self.offset
-                self._complete(t, b"")
-                return
+                self._accept(t, b"")
+                pc += 1
+                continue
             if self.offset == self._end:
                 self._fail(FrameLengthError(
                     f"the frame length ({self._frame_length}) ends before this field",
