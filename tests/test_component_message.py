@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rosfpga_lab.component import FpgaComponent
+from rosfpga_lab.component import FpgaComponent, MessageChecker
 from rosfpga_lab.config import load_config
 from rosfpga_lab.graph import EmbeddedMaster, Node
 from rosfpga_lab.hw.errors import FrameFieldError
@@ -82,8 +82,9 @@ def test_a_laserscan_component_publishes_the_minimum_filter_and_counts_refusals(
     src = Node("/scanner", master=master, registry=reg)
     pub = src.advertise("/scan", "sensor_msgs/LaserScan", queue_size=0)
     out = Collector(master, "/scan_min", "sensor_msgs/LaserScan", reg)
+    checker = MessageChecker(config, master=master)
     try:
-        assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+        assert pub.wait_for_subscribers(2, 10) and comp.wait_for_subscribers(2, 10)
         sent = [scan(k) for k in range(4)]
         pub.publish(sent[0])
         assert comp.wait_for(1, 10)
@@ -109,7 +110,16 @@ def test_a_laserscan_component_publishes_the_minimum_filter_and_counts_refusals(
         assert st.refused_reasons == {"ranges length: not what the circuit was built for": 1,
                                       "range_max: over the limit": 1}
         assert st.cycles["subscriber"] == 4 + len(serialize(reg, "sensor_msgs/LaserScan", sent[-1]))
+        assert checker.wait_for(4, 10), checker.mismatches
+        assert (checker.inputs, checker.outputs, checker.bit_exact) == (6, 4, 4)
+        # and the checker does catch a wrong output
+        pub2 = src.advertise("/scan_min", "sensor_msgs/LaserScan", queue_size=0)
+        assert pub2.wait_for_subscribers(2, 10)
+        pub2.publish(sent[0])  # the input itself, not its minimum filter
+        assert checker.wait_for(5, 10) and checker.bit_exact == 4
+        assert "expected output of no input" in checker.mismatches[-1]
     finally:
+        checker.stop()
         out.node.shutdown()
         src.shutdown()
         comp.stop()
