@@ -41,7 +41,7 @@ from rosfpga_lab.hw.layout import (
 from rosfpga_lab.msg import MsgRegistry, default_value, new_message
 from rosfpga_lab.msg.builtins import SCALARS
 
-STAGE = "subscriber"
+STAGE = "interpreter"  # as the Image interpreter: refusals read the same
 
 
 @dataclass
