@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import argparse
 import logging
-import signal
 import sys
-import threading
 import time
 from pathlib import Path
 
+from rosfpga_lab.cli._signals import StopSignals
 from rosfpga_lab.cli._args import non_negative_float, positive_float, positive_int
 from rosfpga_lab.config.vocabulary import MODELS
 
@@ -44,13 +43,21 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="seconds between status updates (default: 0.5; 0: no status line)")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no status line and no log lines, only the final summary")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, ros_node=True)
 
 
 def run(args: argparse.Namespace) -> int:
     """Start the component, show the status until interrupted, stop cleanly."""
+    # SIGINT and SIGTERM only set a flag the loops poll (a handler that takes a lock could wait
+    # forever on one the interrupted main thread holds), whatever disposition was inherited.
+    with StopSignals(raise_interrupt=False) as stop:
+        return _run(args, stop)
+
+
+def _run(args: argparse.Namespace, stop: StopSignals) -> int:
     from rosfpga_lab.component import FpgaComponent, limits, master_answers
     from rosfpga_lab.config import load_config, master_uri
+    from rosfpga_lab.config.rosargs import RosArgs, advertise_host, component_names
     from rosfpga_lab.graph import EmbeddedMaster
     from rosfpga_lab.graph.xmlrpc import split_uri
 
@@ -62,43 +69,40 @@ def run(args: argparse.Namespace) -> int:
         kw["input_queue"] = args.input_queue
     if args.output_queue is not None:
         kw["output_queue"] = args.output_queue
+    ros = getattr(args, "ros", None) or RosArgs()
     config = load_config(args.config)
-    component = FpgaComponent.from_config(config, master_uri=master_uri(args.master_uri, config),
-                                          model=args.model, **kw)
+    names = component_names(config, ros)
+    host = advertise_host(ros, config.node.ip_address)
+    component = FpgaComponent.from_config(
+        config, master_uri=master_uri(args.master_uri or ros.special.get("__master"), config),
+        model=args.model, name=names.node, host=host.host, input_topic=names.input,
+        output_topic=names.output, **kw)
+    t_end = None if args.duration is None else time.monotonic() + args.duration
     master = None
     if not master_answers(component.master_uri):
-        if not args.embedded_master:
-            print(f"rosfpga-lab node: error: no ROS master answers at {component.master_uri}; "
-                  "start one (roscore, or 'rosfpga-lab master') or add --embedded-master",
-                  file=sys.stderr)
-            return 1
-        host, port, _path = split_uri(component.master_uri)
-        master = EmbeddedMaster(host=host, port=port).start()
-        print(f"started the embedded master at {master.uri}", file=sys.stderr)
-    terminated = False
-
-    def on_sigterm(*_args: object) -> None:
-        # Only a flag: a handler runs between two steps of the main thread, which may hold any
-        # lock then (an Event's included), so taking one here could wait forever.
-        nonlocal terminated
-        terminated = True
-
-    previous = signal.getsignal(signal.SIGTERM)
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, on_sigterm)
-    component.start()
+        if args.embedded_master:
+            host_, port, _path = split_uri(component.master_uri)
+            master = EmbeddedMaster(host=host_, port=port).start()
+            print(f"started the embedded master at {master.uri}", file=sys.stderr)
+        elif not _wait_for_master(component.master_uri, stop, t_end):
+            return 0 if stop.fired is not None else 1
+    try:
+        component.start()
+    except BaseException:
+        if master is not None:
+            master.stop()
+        raise
     tty = sys.stdout.isatty()
     print(f"{component.name}: {component.input_topic} -> {component.pipeline.op} "
           f"({args.model} model) -> {component.output_topic}; master {component.master_uri}; "
-          "Ctrl-C to stop", flush=True)
-    t_end = None if args.duration is None else time.monotonic() + args.duration
+          f"address {component.host} (from {host.source}); Ctrl-C to stop", flush=True)
     interval = args.status_interval if args.status_interval > 0 and not args.quiet else 1.0
     last_print = 0.0
     exit_code = 0
     period = min(interval, limits.WATCHDOG_PERIOD)
     next_tick = time.monotonic() + period
     try:
-        while not terminated:
+        while stop.fired is None:
             time.sleep(limits.SIGNAL_POLL)
             now = time.monotonic()
             if now < next_tick:
@@ -107,9 +111,10 @@ def run(args: argparse.Namespace) -> int:
             if t_end is not None and now >= t_end:
                 break
             if not component.running:
-                print("\nthe node was shut down from outside (a 'shutdown' call: another node "
-                      "took its name, or rosnode kill)", file=sys.stderr, flush=True)
-                exit_code = 1
+                # rospy and roscpp end a node shut down this way normally (exit status 0)
+                reason = component.node.shutdown_reason if component.node is not None else ""
+                print(f"\nthe node was shut down from outside ({reason or 'a shutdown call'}: "
+                      "rosnode kill, or another node took its name)", file=sys.stderr, flush=True)
                 break
             if args.quiet or args.status_interval <= 0:
                 continue
@@ -119,7 +124,7 @@ def run(args: argparse.Namespace) -> int:
             elif now - last_print >= max(5.0, interval):
                 print(line, flush=True)
                 last_print = now
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:   # a Ctrl-C that came before the handlers were in place
         pass
     finally:
         if tty and not args.quiet:
@@ -128,7 +133,30 @@ def run(args: argparse.Namespace) -> int:
         component.stop()
         if master is not None:
             master.stop()
-        if threading.current_thread() is threading.main_thread():
-            signal.signal(signal.SIGTERM, previous)
     print(stats.report(), flush=True)
     return exit_code
+
+
+def _wait_for_master(uri: str, stop: StopSignals, t_end: float | None) -> bool:
+    """Wait until a master answers at ``uri``, as rospy and roscpp nodes do (a launch order race
+    is normal), saying so once; False when stopped by a signal or ``--duration`` first."""
+    from rosfpga_lab.component import limits, master_answers
+
+    print(f"rosfpga-lab node: no ROS master answers at {uri} yet; waiting for it and trying "
+          "again (start one: roscore, or 'rosfpga-lab master'; or add --embedded-master)",
+          file=sys.stderr, flush=True)
+    next_try = time.monotonic() + limits.MASTER_RETRY
+    while stop.fired is None:
+        now = time.monotonic()
+        if t_end is not None and now >= t_end:
+            print(f"rosfpga-lab node: error: no ROS master answered at {uri} within --duration",
+                  file=sys.stderr)
+            return False
+        if now >= next_try:
+            if master_answers(uri, timeout=limits.MASTER_RETRY):
+                print(f"rosfpga-lab node: the ROS master at {uri} answers now", file=sys.stderr,
+                      flush=True)
+                return True
+            next_try = time.monotonic() + limits.MASTER_RETRY
+        time.sleep(limits.SIGNAL_POLL)
+    return False
