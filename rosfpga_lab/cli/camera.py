@@ -19,6 +19,7 @@ from rosfpga_lab.config.vocabulary import DEFAULT_ENCODING, ENCODINGS
 
 if TYPE_CHECKING:
     from rosfpga_lab.config import NodeConfig
+    from rosfpga_lab.config.rosargs import RosArgs
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -60,7 +61,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="stop after N frames (default: run on)")
     p.add_argument("--frame-id", default="camera", help="header.frame_id (default: camera)")
     _common(p, with_config=True)
-    p.set_defaults(func=run_camera)
+    p.set_defaults(func=run_camera, ros_node=True)
 
     v = subparsers.add_parser(
         "view", help="receive sensor_msgs/Image frames: count, time and save them as PNG",
@@ -77,7 +78,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     v.add_argument("--timeout", type=positive_float, default=None, metavar="S",
                    help="give up after S seconds (exit code 1 if fewer than --count arrived)")
     _common(v, with_config=False)
-    v.set_defaults(func=run_view)
+    v.set_defaults(func=run_view, ros_node=True)
+
+
+def _ros(args: argparse.Namespace) -> RosArgs:
+    from rosfpga_lab.config.rosargs import RosArgs
+
+    return getattr(args, "ros", None) or RosArgs()
+
+
+def _identity(args: argparse.Namespace, default_name: str, topic: str,
+              config: NodeConfig | None = None) -> tuple[str, str, str]:
+    """Node name, topic and address after the ROS command line (``__name:=``, ``from:=to``,
+    ``__ip:=``) and the environment (``ROS_NAMESPACE``, ``ROS_HOSTNAME``, ``ROS_IP``)."""
+    from rosfpga_lab.config.rosargs import advertise_host, node_name, remap
+
+    ros = _ros(args)
+    name = node_name(args.name or default_name, ros)
+    host = advertise_host(ros, config.node.ip_address if config is not None else None)
+    return name, remap(topic, name, ros), host.host
 
 
 def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> str:
@@ -85,7 +104,7 @@ def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> s
     from rosfpga_lab.component import ComponentError, master_answers
     from rosfpga_lab.config import master_uri
 
-    uri = master_uri(args.master_uri, config)
+    uri = master_uri(args.master_uri or _ros(args).special.get("__master"), config)
     if not master_answers(uri):
         raise ComponentError(f"no ROS master answers at {uri}; start one (roscore, or "
                              "'rosfpga-lab master') or give --master-uri")
@@ -93,7 +112,14 @@ def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> s
 
 
 def run_camera(args: argparse.Namespace) -> int:
-    """Publish until Ctrl-C or --count."""
+    """Publish until Ctrl-C, SIGTERM or --count."""
+    from rosfpga_lab.cli._signals import StopSignals
+
+    with StopSignals():
+        return _run_camera(args)
+
+
+def _run_camera(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Camera
     from rosfpga_lab.config import load_config
 
@@ -104,9 +130,10 @@ def run_camera(args: argparse.Namespace) -> int:
     topic = args.topic or topic
     size = args.size or size
     encoding = args.encoding or encoding
+    name, topic, host = _identity(args, "/camera", topic, cfg)
     cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
-                 source=args.source, name=args.name or "/camera", master_uri=_master_uri(args, cfg),
-                 frame_id=args.frame_id)
+                 source=args.source, name=name, master_uri=_master_uri(args, cfg),
+                 frame_id=args.frame_id, host=host)
     print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on {topic} "
           f"at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop", flush=True)
     stop = threading.Event()
@@ -132,12 +159,20 @@ def run_camera(args: argparse.Namespace) -> int:
 
 
 def run_view(args: argparse.Namespace) -> int:
-    """Receive until Ctrl-C, --count or --timeout."""
+    """Receive until Ctrl-C, SIGTERM, --count or --timeout."""
+    from rosfpga_lab.cli._signals import StopSignals
+
+    with StopSignals():
+        return _run_view(args)
+
+
+def _run_view(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Viewer
 
-    viewer = Viewer(args.topic, save_dir=args.save, every=args.every, latest_only=args.latest,
-                    name=args.name or "/viewer", master_uri=_master_uri(args))
-    print(f"{viewer.node.name}: listening on {args.topic}; master {viewer.node.master_uri}"
+    name, topic, host = _identity(args, "/viewer", args.topic)
+    viewer = Viewer(topic, save_dir=args.save, every=args.every, latest_only=args.latest,
+                    name=name, master_uri=_master_uri(args), host=host)
+    print(f"{viewer.node.name}: listening on {topic}; master {viewer.node.master_uri}"
           + (f"; saving into {args.save}" if args.save else "") + "; Ctrl-C to stop", flush=True)
     tty = sys.stdout.isatty()
     deadline = None if args.timeout is None else time.monotonic() + args.timeout

@@ -141,15 +141,15 @@ def _put(table: dict[str, Any], key: str, value: Any, where: str) -> None:
 def _check_special(special: Mapping[str, str]) -> None:
     name = special.get("__name")
     if name is not None and (name_problem(name, node_name=True) or "/" in name or "~" in name):
-        raise ConfigError(f"ROS argument __name:={name}: a node name here is a base name "
+        raise ConfigError(f"ROS argument {'__name:=' + name!r}: a node name here is a base name "
                           "(a letter, then letters, digits and '_'; no '/' or '~'), as roscpp "
                           "requires")
     ns = special.get("__ns")
     if ns is not None and name_problem(ns) and ns != "/":
-        raise ConfigError(f"ROS argument __ns:={ns}: {name_problem(ns)}")
+        raise ConfigError(f"ROS argument {'__ns:=' + ns!r}: {name_problem(ns)}")
     master = special.get("__master")
     if master is not None and not master.startswith("http://"):
-        raise ConfigError(f"ROS argument __master:={master}: expected http://HOST:PORT/")
+        raise ConfigError(f"ROS argument {'__master:=' + master!r}: expected http://HOST:PORT/")
 
 
 def namespace_of(name: str) -> str:

@@ -64,16 +64,15 @@ def check_topic_name(name: str, caller_id: str = "/") -> str:
 
 
 def default_host() -> str:
-    """The address nodes bind to and advertise: ROS_IP, then ROS_HOSTNAME, else 127.0.0.1.
+    """The address nodes bind to and advertise: ROS_HOSTNAME, then ROS_IP (roscpp's and rospy's
+    order), else 127.0.0.1 (:func:`rosfpga_lab.config.rosargs.advertise_host` owns the rule).
 
     Unlike ROS (which defaults to the machine's hostname, reachable from the network), the lab
     defaults to loopback: a workshop network should not see students' nodes by accident.
     """
-    for var in ("ROS_IP", "ROS_HOSTNAME"):
-        value = os.environ.get(var, "").strip()
-        if value:
-            return value
-    return "127.0.0.1"
+    from rosfpga_lab.config.rosargs import RosArgs, advertise_host
+
+    return advertise_host(RosArgs(), None).host
 
 
 def bind_address(host: str) -> str:
