@@ -1,0 +1,155 @@
+"""Every lab command that registers with a master unregisters on SIGINT and SIGTERM (issue 23,
+items 3, 8, 9): ``topic pub/hz/echo``, ``camera``, ``view`` and ``node``, stopped by SIGTERM (what
+``timeout``, ``kill``, systemd and container stops send) and by SIGINT when started with SIGINT
+ignored (a shell's background job, ``cmd &``), on the lab's master and on Debian's rosmaster.
+Each command is named with ``__name:=`` (the ROS command line) so the test knows what to look for.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from proctools import interruptible, kill_if_running, stop_with
+from realros import real_rosmaster
+from rosfpga_lab.graph import EmbeddedMaster, Node
+from rosfpga_lab.graph.xmlrpc import call
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = ROOT / "data" / "fpga_dilate_rgba8.yaml"
+
+TOOLS = {
+    "pub": ["topic", "pub", "/sig_chatter", "std_msgs/String", "data: hi"],
+    "hz": ["topic", "hz", "/sig_chatter"],
+    "echo": ["topic", "echo", "/sig_chatter"],
+    "camera": ["camera", "--size", "16x8", "--rate", "5", "--topic", "/sig_image"],
+    "view": ["view", "/sig_image"],
+    "node": ["node", str(CONFIG), "-q"],
+}
+
+
+def ignore_sigint() -> None:
+    """What a shell does to a background job (``cmd &``): SIGINT ignored, inherited by exec."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def nodes_of(uri: str) -> set[str]:
+    pubs, subs, _srvs = call(uri, "getSystemState", "/t")[2]
+    return {n for _t, names in pubs + subs for n in names}
+
+
+def start_registered(uri: str, argv: list[str], name: str, *, background: bool,
+                     env: dict[str, str] | None = None, expect: str = "") -> subprocess.Popen:
+    """Start ``rosfpga-lab ARGV __name:=NAME`` and wait until the master lists it (as
+    ``expect``, default ``/NAME``)."""
+    expect = expect or f"/{name}"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rosfpga_lab", *argv, f"__name:={name}", f"__master:={uri}"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env={**os.environ, "ROS_MASTER_URI": uri, **(env or {})},
+        preexec_fn=ignore_sigint if background else interruptible)
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and proc.poll() is None:
+        if expect in nodes_of(uri):
+            return proc
+        time.sleep(0.05)
+    kill_if_running(proc)
+    out, err = proc.communicate()
+    raise AssertionError(f"{argv} never registered as {expect}:\n{out}{err}")
+
+
+def stop_and_check(uri: str, proc: subprocess.Popen, name: str, sig: int) -> None:
+    out, err = stop_with(proc, sig)
+    assert proc.returncode == 0, f"rc {proc.returncode}\n{out}\n{err}"
+    assert f"/{name}" not in nodes_of(uri), f"/{name} stayed registered:\n{err}"
+
+
+@pytest.fixture
+def lab_master():
+    with EmbeddedMaster(port=0) as master, \
+            Node("/sig_source", master=master) as source:
+        source.advertise("/sig_chatter", "std_msgs/String", latch=True).publish({"data": "x"})
+        yield master.uri
+
+
+@pytest.mark.parametrize("how", ["sigterm", "sigint_ignored_at_start"])
+@pytest.mark.parametrize("tool", list(TOOLS))
+def test_each_tool_unregisters_on_the_lab_master(lab_master, tool, how) -> None:
+    name = f"sig_{tool}"
+    background = how != "sigterm"
+    proc = start_registered(lab_master, TOOLS[tool], name, background=background)
+    stop_and_check(lab_master, proc, name, signal.SIGINT if background else signal.SIGTERM)
+
+
+@pytest.mark.parametrize("tool", ["pub", "camera", "node"])
+def test_tools_unregister_on_sigterm_on_real_rosmaster(tmp_path, tool) -> None:
+    with real_rosmaster(tmp_path) as uri:
+        name = f"sig_{tool}"
+        proc = start_registered(uri, TOOLS[tool], name, background=True)
+        stop_and_check(uri, proc, name, signal.SIGTERM)
+
+
+def test_node_command_waits_for_a_master_that_comes_later(tmp_path) -> None:
+    """A launch order race: the component starts first, says once that it waits, and registers
+    as soon as the master answers (rospy and roscpp do the same); before, it exited with 1."""
+    from realros import free_port
+
+    port = free_port()
+    uri = f"http://127.0.0.1:{port}/"
+    proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(CONFIG), "-q",
+                             "--master-uri", uri], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, preexec_fn=interruptible)
+    try:
+        time.sleep(1.5)
+        assert proc.poll() is None, proc.communicate()
+        with EmbeddedMaster(port=port) as master:
+            deadline = time.monotonic() + 20
+            while "/fpga_dilate" not in nodes_of(master.uri) and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert "/fpga_dilate" in nodes_of(master.uri)
+            _out, err = stop_with(proc, signal.SIGTERM)
+    finally:
+        kill_if_running(proc)
+    assert proc.returncode == 0
+    assert err.count("waiting for it and trying again") == 1, err
+    assert f"the ROS master at {uri} answers now" in err
+
+
+def test_node_command_exits_0_after_rosnode_kill(lab_master) -> None:
+    """A slave-API shutdown (rosnode kill) ends the component normally, as rospy nodes
+    (exit status 0; it was 1)."""
+    proc = start_registered(lab_master, TOOLS["node"], "killed", background=False)
+    try:
+        node_uri = call(lab_master, "lookupNode", "/t", "/killed")[2]
+        assert call(node_uri, "shutdown", "/rosnode", "kill")[0] == 1
+        out, err = proc.communicate(timeout=20)
+    finally:
+        kill_if_running(proc)
+    assert proc.returncode == 0, err
+    assert "shut down from outside (remote shutdown by /rosnode: kill" in err
+    assert "/killed" not in nodes_of(lab_master)
+
+
+def test_node_command_takes_remaps_name_and_namespace(lab_master, tmp_path) -> None:
+    """``node CONFIG image_raw:=/cam/image __name:=foo __log:=...`` under ROS_NAMESPACE (what
+    roslaunch runs for ``<node ns="ns1" name="foo"><remap .../></node>``); before: argparse
+    refused it with rc 2, and a relative config name ignored ROS_NAMESPACE."""
+    cfg = tmp_path / "rel.yaml"
+    cfg.write_text(CONFIG.read_text().replace("name: /fpga_dilate", "name: fpga_dilate")
+                   .replace("topic: /image_dilated", "topic: image_dilated"))
+    argv = ["node", str(cfg), "-q", "/image_raw:=/cam/image", f"__log:={tmp_path}/foo.log"]
+    proc = start_registered(lab_master, argv, "foo", background=False,
+                            env={"ROS_NAMESPACE": "ns1"}, expect="/ns1/foo")
+    try:
+        pubs, subs, _ = call(lab_master, "getSystemState", "/t")[2]
+    finally:
+        out, err = stop_with(proc, signal.SIGINT)
+    assert ["/cam/image", ["/ns1/foo"]] in subs, subs
+    assert ["/ns1/image_dilated", ["/ns1/foo"]] in pubs, pubs
+    assert proc.returncode == 0, err
