@@ -7,8 +7,10 @@ by :mod:`rosfpga_lab.config.names` (the lab's one validator); this module resolv
 
 from __future__ import annotations
 
+import ipaddress
 import os
 import re
+import socket
 import warnings
 
 from rosfpga_lab.config.master import master_uri_from_env  # noqa: F401  (re-exported; the rule's owner)
@@ -75,18 +77,40 @@ def default_host() -> str:
     return advertise_host(RosArgs(), None).host
 
 
+def is_ipv6_literal(host: str) -> bool:
+    """True for an IPv6 address such as ``::1`` (brackets allowed, as in a URI)."""
+    try:
+        return ipaddress.ip_address(host.strip("[]")).version == 6
+    except ValueError:
+        return False
+
+
+def address_family(bind: str) -> socket.AddressFamily:
+    """The socket family that binds ``bind`` (IPv6 for an IPv6 literal, else IPv4)."""
+    return socket.AF_INET6 if is_ipv6_literal(bind) else socket.AF_INET
+
+
+def uri_host(host: str) -> str:
+    """``host`` as written in a URI: an IPv6 literal in brackets (``[::1]``)."""
+    return f"[{host.strip('[]')}]" if is_ipv6_literal(host) else host
+
+
 def bind_address(host: str) -> str:
-    """The address to bind for an advertised ``host``; warn when it opens every interface."""
+    """The address to bind for an advertised ``host``: the address itself (IPv4 or IPv6, never
+    widened), or every interface with a warning when asked (``0.0.0.0``, ``::``) or when
+    ``host`` is a host name (it may resolve to any interface, as for roscpp)."""
     if host in ALL_INTERFACES:
         warnings.warn(
             "binding to all network interfaces: ROS 1 has no authentication, anyone who can "
             "reach this machine can publish, subscribe and stop nodes. Use 127.0.0.1 unless "
             "you need other machines.", OpenBindWarning, stacklevel=3)
-        return "0.0.0.0"
+        return "::" if host == "::" else "0.0.0.0"
     if host in ("localhost",):
         return "127.0.0.1"
     if re.fullmatch(r"[0-9.]+", host):
         return host
+    if is_ipv6_literal(host):
+        return host.strip("[]")
     # a hostname (ROS_HOSTNAME): bind every interface it may resolve to, like roscpp does
     warnings.warn(f"binding to all interfaces to serve the hostname {host!r}; ROS 1 has no "
                   "authentication", OpenBindWarning, stacklevel=3)

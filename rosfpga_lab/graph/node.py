@@ -36,6 +36,7 @@ from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MAX_PENDING_HANDSHAKES, MAX_P
 from rosfpga_lab.graph.master import MASTER_ID, EmbeddedMaster
 from rosfpga_lab.graph.names import (
     ALL_INTERFACES,
+    address_family,
     bind_address,
     check_node_name,
     check_topic_name,
@@ -183,7 +184,7 @@ class Node:
                                     trace=self.trace, name=self.name, advertise_host=self.host)
         self._xmlrpc.start()
         self._methods = api_methods(self)
-        self._tcp = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self._tcp = socket.socket(address_family(bind), socket.SOCK_STREAM)
         self._tcp.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             self._tcp.bind((bind, tcpros_port))
