@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 from rosfpga_lab.cli._signals import StopSignals
+from rosfpga_lab.config.params import ParamSource
 from rosfpga_lab.cli._args import non_negative_float, positive_float, positive_int
 from rosfpga_lab.config.vocabulary import MODELS
 
@@ -21,16 +22,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "file 'rosfpga-lab generate' reads): it registers with the ROS master, subscribes to "
         "the input topic, pushes every TCPROS frame through the modelled circuit and publishes "
         "the result. A status line shows frames, fps, drops and latency; Ctrl-C stops it "
-        "cleanly and prints a summary. Example: rosfpga-lab node data/fpga_dilate_rgba8.yaml")
+        "cleanly and prints a summary. It takes the ROS command line as rospy does (remappings "
+        "FROM:=TO, __name:=, __ns:=, __ip:=, __hostname:=, __master:=, private parameters "
+        "_NAME:=VALUE) and ROS_NAMESPACE, so rosrun and roslaunch can start it. Private "
+        "parameters (~model, ~input_queue, ~output_queue; ~op, ~ksize, ~width, ~height, "
+        "~encoding, ~clock_mhz must equal the configuration's: the YAML is the circuit) come "
+        "from the parameter server and the command line. "
+        "Example: rosfpga-lab node data/fpga_dilate_rgba8.yaml")
     p.add_argument("config", type=Path, metavar="CONFIG", help="the node configuration file (YAML)")
     p.add_argument("--master-uri", metavar="URI",
                    help="ROS master (default: ROS_MASTER_URI, else the configuration's "
                    "node.master_uri)")
     p.add_argument("--embedded-master", action="store_true",
                    help="start the lab's embedded master at that URI when none answers there")
-    p.add_argument("--model", choices=MODELS, default=MODELS[0],
+    p.add_argument("--model", choices=MODELS, default=None,
                    help="circuit model: fast (numpy, default) or reference (byte at a time; "
-                   "small images only)")
+                   "small images only); also the private parameter ~model")
     p.add_argument("--input-queue", type=positive_int, default=None, metavar="N",
                    help="frames waiting in front of the circuit before the oldest is dropped "
                    "(default: 2)")
@@ -57,36 +64,43 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace, stop: StopSignals) -> int:
     from rosfpga_lab.component import FpgaComponent, limits, master_answers
     from rosfpga_lab.config import load_config, master_uri
+    from rosfpga_lab.config.params import ParamSource, runtime_settings
     from rosfpga_lab.config.rosargs import RosArgs, advertise_host, component_names
     from rosfpga_lab.graph import EmbeddedMaster
-    from rosfpga_lab.graph.xmlrpc import split_uri
+    from rosfpga_lab.graph.xmlrpc import call, split_uri
 
     if not args.quiet:
         logging.basicConfig(level=logging.INFO, format="[%(levelname)s] %(message)s",
                             stream=sys.stderr)
-    kw = {}
-    if args.input_queue is not None:
-        kw["input_queue"] = args.input_queue
-    if args.output_queue is not None:
-        kw["output_queue"] = args.output_queue
     ros = getattr(args, "ros", None) or RosArgs()
     config = load_config(args.config)
     names = component_names(config, ros)
     host = advertise_host(ros, config.node.ip_address)
-    component = FpgaComponent.from_config(
-        config, master_uri=master_uri(args.master_uri or ros.special.get("__master"), config),
-        model=args.model, name=names.node, host=host.host, input_topic=names.input,
-        output_topic=names.output, **kw)
+    uri = master_uri(args.master_uri or ros.special.get("__master"), config)
+    cmdline = ParamSource(ros.params, "the command line", "_")
+    runtime_settings(config, cmdline)   # a wrong parameter is refused before any waiting
     t_end = None if args.duration is None else time.monotonic() + args.duration
     master = None
-    if not master_answers(component.master_uri):
+    if not master_answers(uri):
         if args.embedded_master:
-            host_, port, _path = split_uri(component.master_uri)
+            host_, port, _path = split_uri(uri)
             master = EmbeddedMaster(host=host_, port=port).start()
             print(f"started the embedded master at {master.uri}", file=sys.stderr)
-        elif not _wait_for_master(component.master_uri, stop, t_end):
+        elif not _wait_for_master(uri, stop, t_end):
             return 0 if stop.fired is not None else 1
     try:
+        settings = runtime_settings(config, _server_params(uri, names.node), cmdline)
+        for key, value in ros.params.items():   # as rospy: _x:=v lands on the server as ~x
+            call(uri, "setParam", names.node, f"{names.node}/{key}", value)
+        model = args.model or settings.get("model", MODELS[0])
+        kw = {k: v for k, v in settings.items() if k in ("input_queue", "output_queue")}
+        if args.input_queue is not None:
+            kw["input_queue"] = args.input_queue
+        if args.output_queue is not None:
+            kw["output_queue"] = args.output_queue
+        component = FpgaComponent.from_config(
+            config, master_uri=uri, model=model, name=names.node, host=host.host,
+            input_topic=names.input, output_topic=names.output, **kw)
         component.start()
     except BaseException:
         if master is not None:
@@ -94,7 +108,7 @@ def _run(args: argparse.Namespace, stop: StopSignals) -> int:
         raise
     tty = sys.stdout.isatty()
     print(f"{component.name}: {component.input_topic} -> {component.pipeline.op} "
-          f"({args.model} model) -> {component.output_topic}; master {component.master_uri}; "
+          f"({model} model) -> {component.output_topic}; master {component.master_uri}; "
           f"address {component.host} (from {host.source}); Ctrl-C to stop", flush=True)
     interval = args.status_interval if args.status_interval > 0 and not args.quiet else 1.0
     last_print = 0.0
@@ -135,6 +149,17 @@ def _run(args: argparse.Namespace, stop: StopSignals) -> int:
             master.stop()
     print(stats.report(), flush=True)
     return exit_code
+
+
+def _server_params(uri: str, node: str) -> ParamSource:
+    """The node's private parameters on the parameter server (``getParam`` of its own name)."""
+    from rosfpga_lab.config.params import ParamSource
+    from rosfpga_lab.graph.xmlrpc import call
+
+    reply = call(uri, "getParam", node, node, timeout=5.0)
+    values = reply[2] if isinstance(reply, list) and len(reply) == 3 and reply[0] == 1 else {}
+    return ParamSource(values if isinstance(values, dict) else {},
+                       "the parameter server", f"{node}/")
 
 
 def _wait_for_master(uri: str, stop: StopSignals, t_end: float | None) -> bool:
