@@ -104,3 +104,16 @@ def test_component_names_in_a_namespace_with_a_remap() -> None:
         "/ns1/fpga_dilate", "/cam/image", "/ns1/image_dilated")
     with pytest.raises(ConfigError, match="publish to the topic it subscribes"):
         component_names(cfg, split_ros_args(["image_raw:=image_dilated"])[1], {})
+
+
+def test_the_command_line_refuses_ros_words_where_no_node_runs(capsys) -> None:
+    from rosfpga_lab.cli import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(["msg", "md5", "std_msgs/String", "a:=b"])
+    assert exit_info.value.code == 2
+    assert "a:=b: ROS arguments (NAME:=VALUE) are for the commands that run a ROS node" in \
+        capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["node", "x.yaml", "__bad:=1"])
+    assert "unknown special key '__bad'" in capsys.readouterr().err
