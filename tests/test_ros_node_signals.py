@@ -2,7 +2,7 @@
 items 3, 8, 9): ``topic pub/hz/echo``, ``camera``, ``view`` and ``node``, stopped by SIGTERM (what
 ``timeout``, ``kill``, systemd and container stops send) and by SIGINT when started with SIGINT
 ignored (a shell's background job, ``cmd &``), on the lab's master and on Debian's rosmaster.
-Each command is named with ``__name:=`` (the ROS command line) so the test knows what to look for.
+The signal tests find the command's node as the one that appears on the master.
 """
 
 from __future__ import annotations
@@ -44,30 +44,34 @@ def nodes_of(uri: str) -> set[str]:
     return {n for _t, names in pubs + subs for n in names}
 
 
-def start_registered(uri: str, argv: list[str], name: str, *, background: bool,
-                     env: dict[str, str] | None = None, expect: str = "") -> subprocess.Popen:
-    """Start ``rosfpga-lab ARGV __name:=NAME`` and wait until the master lists it (as
-    ``expect``, default ``/NAME``)."""
-    expect = expect or f"/{name}"
+def start_registered(uri: str, argv: list[str], name: str = "", *, background: bool,
+                     env: dict[str, str] | None = None, expect: str = "") -> tuple[subprocess.Popen, str]:
+    """Start ``rosfpga-lab ARGV`` (with ``__name:=NAME`` when a name is given) and wait until the
+    master lists a new node (``expect``, else ``/NAME``, else any new one); return the process
+    and that node's name. The master comes from ROS_MASTER_URI only, so the signal tests do not
+    depend on the ROS command line."""
+    before = nodes_of(uri)
+    expect = expect or (f"/{name}" if name else "")
     proc = subprocess.Popen(
-        [sys.executable, "-m", "rosfpga_lab", *argv, f"__name:={name}", f"__master:={uri}"],
+        [sys.executable, "-m", "rosfpga_lab", *argv, *([f"__name:={name}"] if name else [])],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         env={**os.environ, "ROS_MASTER_URI": uri, **(env or {})},
         preexec_fn=ignore_sigint if background else interruptible)
     deadline = time.monotonic() + 30
     while time.monotonic() < deadline and proc.poll() is None:
-        if expect in nodes_of(uri):
-            return proc
+        new = nodes_of(uri) - before
+        if (expect in new) if expect else new:
+            return proc, expect or sorted(new)[0]
         time.sleep(0.05)
     kill_if_running(proc)
     out, err = proc.communicate()
-    raise AssertionError(f"{argv} never registered as {expect}:\n{out}{err}")
+    raise AssertionError(f"{argv} never registered as {expect or 'a new node'}:\n{out}{err}")
 
 
-def stop_and_check(uri: str, proc: subprocess.Popen, name: str, sig: int) -> None:
+def stop_and_check(uri: str, proc: subprocess.Popen, node: str, sig: int) -> None:
     out, err = stop_with(proc, sig)
     assert proc.returncode == 0, f"rc {proc.returncode}\n{out}\n{err}"
-    assert f"/{name}" not in nodes_of(uri), f"/{name} stayed registered:\n{err}"
+    assert node not in nodes_of(uri), f"{node} stayed registered:\n{err}"
 
 
 @pytest.fixture
@@ -81,18 +85,16 @@ def lab_master():
 @pytest.mark.parametrize("how", ["sigterm", "sigint_ignored_at_start"])
 @pytest.mark.parametrize("tool", list(TOOLS))
 def test_each_tool_unregisters_on_the_lab_master(lab_master, tool, how) -> None:
-    name = f"sig_{tool}"
     background = how != "sigterm"
-    proc = start_registered(lab_master, TOOLS[tool], name, background=background)
-    stop_and_check(lab_master, proc, name, signal.SIGINT if background else signal.SIGTERM)
+    proc, node = start_registered(lab_master, TOOLS[tool], background=background)
+    stop_and_check(lab_master, proc, node, signal.SIGINT if background else signal.SIGTERM)
 
 
 @pytest.mark.parametrize("tool", ["pub", "camera", "node"])
 def test_tools_unregister_on_sigterm_on_real_rosmaster(tmp_path, tool) -> None:
     with real_rosmaster(tmp_path) as uri:
-        name = f"sig_{tool}"
-        proc = start_registered(uri, TOOLS[tool], name, background=True)
-        stop_and_check(uri, proc, name, signal.SIGTERM)
+        proc, node = start_registered(uri, TOOLS[tool], background=True)
+        stop_and_check(uri, proc, node, signal.SIGTERM)
 
 
 def test_node_command_waits_for_a_master_that_comes_later(tmp_path) -> None:
@@ -124,7 +126,7 @@ def test_node_command_waits_for_a_master_that_comes_later(tmp_path) -> None:
 def test_node_command_exits_0_after_rosnode_kill(lab_master) -> None:
     """A slave-API shutdown (rosnode kill) ends the component normally, as rospy nodes
     (exit status 0; it was 1)."""
-    proc = start_registered(lab_master, TOOLS["node"], "killed", background=False)
+    proc, _node = start_registered(lab_master, TOOLS["node"], "killed", background=False)
     try:
         node_uri = call(lab_master, "lookupNode", "/t", "/killed")[2]
         assert call(node_uri, "shutdown", "/rosnode", "kill")[0] == 1
@@ -144,7 +146,7 @@ def test_node_command_takes_remaps_name_and_namespace(lab_master, tmp_path) -> N
     cfg.write_text(CONFIG.read_text().replace("name: /fpga_dilate", "name: fpga_dilate")
                    .replace("topic: /image_dilated", "topic: image_dilated"))
     argv = ["node", str(cfg), "-q", "/image_raw:=/cam/image", f"__log:={tmp_path}/foo.log"]
-    proc = start_registered(lab_master, argv, "foo", background=False,
+    proc, _node = start_registered(lab_master, argv, "foo", background=False,
                             env={"ROS_NAMESPACE": "ns1"}, expect="/ns1/foo")
     try:
         pubs, subs, _ = call(lab_master, "getSystemState", "/t")[2]

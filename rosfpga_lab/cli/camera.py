@@ -87,16 +87,15 @@ def _ros(args: argparse.Namespace) -> RosArgs:
     return getattr(args, "ros", None) or RosArgs()
 
 
-def _identity(args: argparse.Namespace, default_name: str, topic: str,
-              config: NodeConfig | None = None) -> tuple[str, str, str]:
+def _identity(args: argparse.Namespace, default_name: str, topic: str) -> tuple[str, str, str]:
     """Node name, topic and address after the ROS command line (``__name:=``, ``from:=to``,
-    ``__ip:=``) and the environment (``ROS_NAMESPACE``, ``ROS_HOSTNAME``, ``ROS_IP``)."""
+    ``__ip:=``) and the environment (``ROS_NAMESPACE``, ``ROS_HOSTNAME``, ``ROS_IP``). A
+    configuration's ``node.ip_address`` is the component's address, not the camera's: unused."""
     from rosfpga_lab.config.rosargs import advertise_host, node_name, remap
 
     ros = _ros(args)
     name = node_name(args.name or default_name, ros)
-    host = advertise_host(ros, config.node.ip_address if config is not None else None)
-    return name, remap(topic, name, ros), host.host
+    return name, remap(topic, name, ros), advertise_host(ros, None).host
 
 
 def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> str:
@@ -130,7 +129,7 @@ def _run_camera(args: argparse.Namespace) -> int:
     topic = args.topic or topic
     size = args.size or size
     encoding = args.encoding or encoding
-    name, topic, host = _identity(args, "/camera", topic, cfg)
+    name, topic, host = _identity(args, "/camera", topic)
     cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
                  source=args.source, name=name, master_uri=_master_uri(args, cfg),
                  frame_id=args.frame_id, host=host)
