@@ -155,3 +155,22 @@ def test_node_command_takes_remaps_name_and_namespace(lab_master, tmp_path) -> N
     assert ["/cam/image", ["/ns1/foo"]] in subs, subs
     assert ["/ns1/image_dilated", ["/ns1/foo"]] in pubs, pubs
     assert proc.returncode == 0, err
+
+
+@pytest.mark.parametrize("argv,expect,topic,kind", [
+    (["camera", "--size", "16x8", "--rate", "5", "--topic", "image", "image:=cam/raw"],
+     "/ns2/cam", "/ns2/cam/raw", 0),
+    (["view", "image", "image:=/elsewhere"], "/ns2/cam", "/elsewhere", 1),
+    (["topic", "hz", "chatter"], "/ns2/cam", "/ns2/chatter", 1),
+])
+def test_camera_view_and_topic_take_names_from_the_ros_command_line(lab_master, argv, expect,
+                                                                    topic, kind) -> None:
+    """Relative names land in ROS_NAMESPACE, remappings apply, __name names the node (before:
+    argparse refused the ROS words)."""
+    proc, _node = start_registered(lab_master, argv, "cam", background=False,
+                                   env={"ROS_NAMESPACE": "ns2"}, expect=expect)
+    try:
+        entries = call(lab_master, "getSystemState", "/t")[2][kind]
+    finally:
+        stop_with(proc, signal.SIGTERM)
+    assert [topic, [expect]] in entries, entries
