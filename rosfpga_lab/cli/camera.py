@@ -56,9 +56,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help=f"image encoding (default: {DEFAULT_ENCODING})")
     p.add_argument("--rate", type=float, default=30.0, help="frames per second (default: 30)")
     p.add_argument("--source", default="synthetic",
-                   help="synthetic (default), grace_hopper, an image file or a directory")
+                   help="synthetic (default), grace_hopper, an image file, a directory, or a ROS 1 "
+                   "bag (FILE.bag: its images replayed with their recorded timing, on --topic, "
+                   "which also names the bag topic read; the bag's only image topic otherwise)")
     p.add_argument("--count", type=positive_int, default=None,
-                   help="stop after N frames (default: run on)")
+                   help="stop after N frames (default: run on; a bag: its frames once)")
     p.add_argument("--frame-id", default="camera", help="header.frame_id (default: camera)")
     _common(p, with_config=True)
     p.set_defaults(func=run_camera, ros_node=True)
@@ -120,18 +122,24 @@ def run_camera(args: argparse.Namespace) -> int:
 
 def _run_camera(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Camera
+    from rosfpga_lab.component.sources import ImageSource, open_source
     from rosfpga_lab.config import load_config
 
     topic, size, encoding, cfg = "/image_raw", (640, 480), DEFAULT_ENCODING, None
     if args.config is not None:
         cfg = load_config(args.config)
         topic, size, encoding = cfg.subscriber.topic, (cfg.image.width, cfg.image.height), cfg.image.encoding
-    topic = args.topic or topic
     size = args.size or size
     encoding = args.encoding or encoding
+    source: str | ImageSource = args.source
+    if args.source.endswith(".bag"):  # a bag: its topic (named by --topic), once by default
+        source = open_source(args.source, size[0], size[1], encoding, topic=args.topic)
+        topic = args.topic or (topic if cfg is not None else source.bag_topic or topic)
+        args.count = args.count or source.period
+    topic = args.topic or topic
     name, topic, host = _identity(args, "/camera", topic)
     cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
-                 source=args.source, name=name, master_uri=_master_uri(args, cfg),
+                 source=source, name=name, master_uri=_master_uri(args, cfg),
                  frame_id=args.frame_id, host=host)
     print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on {topic} "
           f"at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop", flush=True)

@@ -40,6 +40,8 @@ MAX_REFUSAL_KINDS = 64
 #: Camera limits: frames per second and image side.
 MAX_CAMERA_RATE = 1000.0
 MAX_CAMERA_SIDE = 8192
+#: Bytes of decoded frames a bag source (``camera --source x.bag``) holds in memory.
+MAX_BAG_SOURCE_BYTES = 512 * 1024 * 1024
 
 #: Pictures wider than this are shrunk before encoding (pixels).
 PAGE_IMAGE_MAX_WIDTH = 640

@@ -37,3 +37,6 @@ IMAGE_TYPE = "sensor_msgs/Image"
 MAX_CONFIG_BYTES = 1 << 20
 #: FPGA part of the HLS project script (the Zynq-7020 of the paper's class of boards).
 DEFAULT_PART = "xc7z020clg400-1"
+#: Messages ``rosfpga-lab topic echo`` queues while printing falls behind (older ones are
+#: dropped and counted); ``--queue-size`` changes it.
+ECHO_QUEUE = 100
