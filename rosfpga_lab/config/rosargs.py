@@ -177,7 +177,7 @@ def node_namespace(ros: RosArgs, environ: Mapping[str, str] | None = None) -> st
     problem = name_problem(ns) if ns != "/" else None
     if problem:
         raise ConfigError(f"ROS_NAMESPACE={ns!r}: {problem}")
-    ns = canonical("/" + ns.lstrip("~"))
+    ns = canonical("/" + ns)
     return ns if ns.endswith("/") else ns + "/"
 
 

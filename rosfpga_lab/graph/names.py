@@ -8,13 +8,14 @@ by :mod:`rosfpga_lab.config.names` (the lab's one validator); this module resolv
 from __future__ import annotations
 
 import ipaddress
-import os
 import re
 import socket
 import warnings
 
 from rosfpga_lab.config.master import master_uri_from_env  # noqa: F401  (re-exported; the rule's owner)
 from rosfpga_lab.config.names import canonical, is_legal_name, name_problem  # noqa: F401  (re-exported)
+from rosfpga_lab.config.rosargs import RosArgs, advertise_host
+from rosfpga_lab.config.rosargs import namespace_of, resolve_name  # noqa: F401  (re-exported)
 from rosfpga_lab.graph.errors import ConfigError
 
 ALL_INTERFACES = ("0.0.0.0", "", "::")
@@ -24,21 +25,10 @@ class OpenBindWarning(UserWarning):
     """Binding to every network interface: ROS 1 has no authentication."""
 
 
-def namespace_of(name: str) -> str:
-    """``/a/b/c`` -> ``/a/b/``; ``/c`` -> ``/``."""
-    name = canonical(name)
-    return name[: name.rfind("/") + 1] if "/" in name else "/"
-
-
 def resolve(name: str, caller_id: str = "/") -> str:
-    """Resolve ``name`` against ``caller_id`` the way the master and rospy do."""
-    if not name:
-        return namespace_of(caller_id)
-    if name.startswith("/"):
-        return canonical(name)
-    if name.startswith("~"):
-        return canonical(canonical(caller_id) + "/" + name[1:])
-    return canonical(namespace_of(caller_id) + name)
+    """Resolve ``name`` against ``caller_id`` the way the master and rospy do (the rule's owner:
+    :func:`rosfpga_lab.config.rosargs.resolve_name`)."""
+    return resolve_name(name, caller_id)
 
 
 def check_node_name(name: str) -> str:
@@ -72,8 +62,6 @@ def default_host() -> str:
     Unlike ROS (which defaults to the machine's hostname, reachable from the network), the lab
     defaults to loopback: a workshop network should not see students' nodes by accident.
     """
-    from rosfpga_lab.config.rosargs import RosArgs, advertise_host
-
     return advertise_host(RosArgs(), None).host
 
 
