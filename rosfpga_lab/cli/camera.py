@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rosfpga_lab.cli._args import positive_float, positive_int
+from rosfpga_lab.cli._signals import deliver_held, holding
 from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
 from rosfpga_lab.config.vocabulary import DEFAULT_ENCODING, ENCODINGS
 
@@ -138,16 +139,19 @@ def _run_camera(args: argparse.Namespace) -> int:
         args.count = args.count or source.period
     topic = args.topic or topic
     name, topic, host = _identity(args, "/camera", topic)
-    cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
-                 source=source, name=name, master_uri=_master_uri(args, cfg),
-                 frame_id=args.frame_id, host=host)
-    print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on {topic} "
-          f"at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop", flush=True)
+    uri = _master_uri(args, cfg)
+    with holding(deliver=False):   # registering: a signal waits (delivered in the try below)
+        cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
+                     source=source, name=name, master_uri=uri, frame_id=args.frame_id, host=host)
     stop = threading.Event()
     tty = sys.stdout.isatty()
     worker = threading.Thread(target=cam.run, kwargs={"count": args.count, "stop": stop}, daemon=True)
-    worker.start()
     try:
+        deliver_held()
+        print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on "
+              f"{topic} at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop",
+              flush=True)
+        worker.start()
         while worker.is_alive():
             worker.join(0.5)
             if tty:
@@ -157,10 +161,12 @@ def _run_camera(args: argparse.Namespace) -> int:
         pass
     finally:
         stop.set()
-        worker.join(5.0)
+        if worker.is_alive():
+            worker.join(5.0)
         if tty:
             print()
-        cam.stop()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            cam.stop()
     print(f"sent {cam.sent} frames", flush=True)
     return 0
 
@@ -177,13 +183,17 @@ def _run_view(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Viewer
 
     name, topic, host = _identity(args, "/viewer", args.topic)
-    viewer = Viewer(topic, save_dir=args.save, every=args.every, latest_only=args.latest,
-                    name=name, master_uri=_master_uri(args), host=host)
-    print(f"{viewer.node.name}: listening on {topic}; master {viewer.node.master_uri}"
-          + (f"; saving into {args.save}" if args.save else "") + "; Ctrl-C to stop", flush=True)
+    uri = _master_uri(args)
+    with holding(deliver=False):   # registering: a signal waits (delivered in the try below)
+        viewer = Viewer(topic, save_dir=args.save, every=args.every, latest_only=args.latest,
+                        name=name, master_uri=uri, host=host)
     tty = sys.stdout.isatty()
     deadline = None if args.timeout is None else time.monotonic() + args.timeout
     try:
+        deliver_held()
+        print(f"{viewer.node.name}: listening on {topic}; master {viewer.node.master_uri}"
+              + (f"; saving into {args.save}" if args.save else "") + "; Ctrl-C to stop",
+              flush=True)
         while args.count is None or viewer.received < args.count:
             if deadline is not None and time.monotonic() >= deadline:
                 break
@@ -199,7 +209,8 @@ def _run_view(args: argparse.Namespace) -> int:
     finally:
         if tty:
             print()
-        viewer.stop()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            viewer.stop()
     lat = viewer.latency.summary()
     print(f"received {viewer.received} frames; latency (stamp -> arrival) {lat.ms()}"
           + (f"; saved {len(viewer.saved)} PNG files in {args.save}" if args.save else ""))

@@ -7,6 +7,7 @@ import sys
 import threading
 import time
 
+from rosfpga_lab.cli._signals import holding
 from rosfpga_lab.config.limits import DEFAULT_MASTER_URI, ECHO_QUEUE
 
 
@@ -183,7 +184,8 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
         if bag is not None:
             bag.close()
             print(f"topic echo: recorded {bag.count} messages to {args.bag}", file=sys.stderr)
@@ -233,7 +235,8 @@ def _pub(args: argparse.Namespace, uri: str) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
     return 0
 
 
@@ -256,5 +259,6 @@ def _hz(args: argparse.Namespace, uri: str) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
     return 0
