@@ -174,3 +174,23 @@ def test_camera_view_and_topic_take_names_from_the_ros_command_line(lab_master, 
     finally:
         stop_with(proc, signal.SIGTERM)
     assert [topic, [expect]] in entries, entries
+
+
+def test_stop_signals_hold_a_signal_while_registering_and_restore_the_old_handlers() -> None:
+    from rosfpga_lab.cli._signals import StopSignals, deliver_held
+
+    before = signal.getsignal(signal.SIGTERM)
+    with StopSignals() as stop:
+        with stop.holding(deliver=False):
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.05)            # the handler ran here, and raised nothing
+        assert stop.fired == signal.SIGTERM
+        with pytest.raises(KeyboardInterrupt):
+            deliver_held()
+        deliver_held()                  # delivered once only
+    assert signal.getsignal(signal.SIGTERM) == before
+    with pytest.raises(KeyboardInterrupt), StopSignals() as stop:
+        with stop.holding():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)
+        raise AssertionError("holding() should have raised at its end")
