@@ -135,6 +135,8 @@ class FpgaComponent:
         history: records kept in :attr:`recent`.
         name: node name instead of the configuration's ``node.name``.
         host: address to bind and advertise instead of ``node.ip_address``.
+        input_topic, output_topic: topic names instead of the configuration's (after a ROS
+            remapping: :func:`rosfpga_lab.config.rosargs.component_names`).
         trace: a :class:`~rosfpga_lab.graph.Trace` to record the conversation into.
         watchdog: check the master once a second and register again after a restart (the
             monitor thread runs either way, logging drops and connections).
@@ -152,7 +154,8 @@ class FpgaComponent:
                  input_queue: int = limits.DEFAULT_INPUT_QUEUE,
                  output_queue: int = limits.DEFAULT_OUTPUT_QUEUE,
                  history: int = limits.DEFAULT_HISTORY, name: str | None = None,
-                 host: str | None = None, trace: Any = None, watchdog: bool = True) -> None:
+                 host: str | None = None, trace: Any = None, watchdog: bool = True,
+                 input_topic: str | None = None, output_topic: str | None = None) -> None:
         if config.is_image != (config.subscriber.type == IMAGE_TYPE):
             raise ComponentConfigError(
                 f"subscriber.type is {config.subscriber.type!r} but image: is given: image: is "
@@ -178,8 +181,8 @@ class FpgaComponent:
             master_uri, config, environ={})
         self.name = name or config.node.global_name
         self.host = host or config.node.ip_address
-        self.input_topic = config.subscriber.topic
-        self.output_topic = config.publisher.topic
+        self.input_topic = input_topic or config.subscriber.topic
+        self.output_topic = output_topic or config.publisher.topic
         self.input_queue, self.output_queue = input_queue, output_queue
         self.trace = trace
         self.watchdog = watchdog
