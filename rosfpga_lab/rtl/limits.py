@@ -23,3 +23,6 @@ VERILATOR_FROM_BYTES = 200_000
 VCD_MAX_HEADER_BYTES = 16 << 20
 #: Widest signal kept (bits).
 VCD_MAX_SIGNAL_BITS = 1 << 16
+
+#: Seconds allowed for one formal check (SymbiYosys).
+FORMAL_TIMEOUT = 600.0
