@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 from rosfpga_lab.cli._args import non_negative_float, positive_float, positive_int
-from rosfpga_lab.config.vocabulary import MODELS
+from rosfpga_lab.config.vocabulary import MODELS, TIMINGS
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -30,8 +30,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--embedded-master", action="store_true",
                    help="start the lab's embedded master at that URI when none answers there")
     p.add_argument("--model", choices=MODELS, default=MODELS[0],
-                   help="circuit model: fast (numpy, default) or reference (byte at a time; "
-                   "small images only)")
+                   help="the data path: fast (numpy model, default), reference (byte at a time; "
+                   "small images only) or rtl (the Verilog itself, simulated by Verilator)")
+    p.add_argument("--timing", choices=TIMINGS, default=TIMINGS[0],
+                   help="host (default): publish as soon as the data path is done; fpga: hold "
+                   "each output for the circuit's clocks at clock_mhz and drop frames that come "
+                   "while it is busy, as the board would")
     p.add_argument("--input-queue", type=positive_int, default=None, metavar="N",
                    help="frames waiting in front of the circuit before the oldest is dropped "
                    "(default: 2)")
@@ -64,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
         kw["output_queue"] = args.output_queue
     config = load_config(args.config)
     component = FpgaComponent.from_config(config, master_uri=master_uri(args.master_uri, config),
-                                          model=args.model, **kw)
+                                          model=args.model, timing=args.timing, **kw)
     master = None
     if not master_answers(component.master_uri):
         if not args.embedded_master:
@@ -89,7 +93,8 @@ def run(args: argparse.Namespace) -> int:
     component.start()
     tty = sys.stdout.isatty()
     print(f"{component.name}: {component.input_topic} -> {component.pipeline.op} "
-          f"({args.model} model) -> {component.output_topic}; master {component.master_uri}; "
+          f"({args.model} model, {args.timing} timing) -> {component.output_topic}; "
+          f"master {component.master_uri}; "
           "Ctrl-C to stop", flush=True)
     t_end = None if args.duration is None else time.monotonic() + args.duration
     interval = args.status_interval if args.status_interval > 0 and not args.quiet else 1.0

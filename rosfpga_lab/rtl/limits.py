@@ -26,3 +26,6 @@ VCD_MAX_SIGNAL_BITS = 1 << 16
 
 #: Seconds allowed for one formal check (SymbiYosys).
 FORMAL_TIMEOUT = 600.0
+
+#: Largest request to the long-lived simulator of ``--model rtl`` (bytes).
+MAX_SERVE_FRAME = 64 << 20
