@@ -5,7 +5,7 @@
 * through the Python API: a refused frame carries the circuit's status code as its reason, the
   next frame comes out right, and the bytes equal the Python models';
 * ``timing="fpga"``: a flood at 200 frames/s of 640x480 ``rgba8`` comes out at no more than
-  the modelled rate (hw.cycles at clock_mhz), the rest counted as drops of a busy circuit.
+  the modelled rate (hw.cycles at clock_mhz), the rest counted as drops in front of it.
 """
 
 from __future__ import annotations
@@ -126,7 +126,7 @@ def test_rtl_model_without_a_simulator_says_so(monkeypatch) -> None:
 
 def test_fpga_timing_flood_comes_out_at_the_modelled_rate_excess_dropped() -> None:
     """200 frames/s of 640x480 rgba8 for 2 s: the circuit at 100 MHz takes hw.cycles' clocks
-    per frame, so at most 1 / (clocks / clock) frames/s come out, the rest are dropped."""
+    per frame, so 1 / (clocks / clock) frames/s (+-10 %) come out, the rest are dropped."""
     config = load_config(DATA / "fpga_dilate_rgba8.yaml")
     pipe = Pipeline.from_config(config)
     image = np.random.default_rng(1).integers(0, 256, (480, 640, 4), dtype=np.uint8)
@@ -153,7 +153,7 @@ def test_fpga_timing_flood_comes_out_at_the_modelled_rate_excess_dropped() -> No
             deadline = time.monotonic() + 10
             while time.monotonic() < deadline:      # until every frame read is accounted for
                 st = comp.stats
-                if st.received and st.published + st.dropped_busy + st.refused == st.received:
+                if st.received and st.published + st.dropped_input + st.refused == st.received:
                     break
                 time.sleep(0.05)
             print(f"sent {n} in {sent_for:.2f} s; {st.report()}")
@@ -163,7 +163,7 @@ def test_fpga_timing_flood_comes_out_at_the_modelled_rate_excess_dropped() -> No
             comp.stop()
     got_rate = st.published / sent_for
     assert got_rate <= modelled * 1.1, st.report()
-    assert got_rate >= modelled * 0.5, st.report()   # the circuit, not the host, set the pace
-    assert st.published + st.dropped_busy + st.dropped_input + st.refused == st.received
-    assert st.dropped_busy > 0 and st.received > n * 0.5, st.report()
+    assert got_rate >= modelled * 0.9, st.report()   # the circuit, not the host, set the pace
+    assert st.published + st.dropped_input + st.refused == st.received
+    assert st.dropped_input > 0 and st.received > n * 0.5, st.report()
     assert st.timing == "fpga" and "timing: fpga" in st.report()

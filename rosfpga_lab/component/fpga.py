@@ -132,8 +132,9 @@ class FpgaComponent:
             or ``"rtl"`` (the Verilog itself, in a long-lived simulator: :mod:`rosfpga_lab.rtl.server`).
         timing: ``"host"`` (publish as soon as the data path is done) or ``"fpga"`` (publish
             when the circuit's clocks for the frame at ``clock_mhz`` have passed since it
-            arrived; a frame that arrives while the circuit is busy is dropped, as the input
-            FIFO would make the sender drop it: :attr:`ComponentStats.dropped_busy`).
+            arrived, or since the circuit became free; the input queue is then 1 deep, as the
+            input FIFO and the socket hold one waiting frame: a newer frame replaces it and the
+            older one is counted in :attr:`ComponentStats.dropped_input`).
         input_queue: frames waiting in front of the circuit (see module docstring).
         output_queue: frames waiting per downstream subscriber.
         history: records kept in :attr:`recent`.
@@ -179,6 +180,8 @@ class FpgaComponent:
                 raise ComponentConfigError(f"cannot run the Verilog (--model rtl): {exc}") from None
         if input_queue < 1 or output_queue < 1:
             raise ComponentConfigError("input_queue and output_queue must be at least 1")
+        if timing == "fpga":   # what waits in front of the board: one frame (see above)
+            input_queue = 1
         self.config = config
         self.model = model
         self.master = master
@@ -205,7 +208,7 @@ class FpgaComponent:
         self._since_stamp = LatencyWindow(limits.LATENCY_WINDOW)
         self._published_rate = fps_meter()
         self._counts = {"seen": 0, "processed": 0, "published": 0, "refused": 0,
-                        "reregistered": 0, "observer_errors": 0, "dropped_busy": 0}
+                        "reregistered": 0, "observer_errors": 0}
         self._last_clocks = 0
         self._reasons: dict[str, int] = {}        # refusal kind -> count
         self._examples: dict[str, str] = {}       # refusal kind -> the first reason text seen
@@ -310,19 +313,6 @@ class FpgaComponent:
                 self._observers.remove(callback)
 
     # ------------------------------------------------------------------ the data path
-    def _circuit_free(self, info: MessageInfo) -> bool:
-        """Timing ``fpga``: False (and counted) when the frame came while the circuit was busy."""
-        if self.timing != "fpga" or info.received >= self._busy_until:
-            return True
-        with self._lock:
-            self._counts["dropped_busy"] += 1
-            n = self._counts["dropped_busy"]
-        if n <= limits.LOG_FIRST or n % limits.LOG_EVERY == 0:
-            log.info("%s: dropped frame #%d from %s: the circuit was busy for %.1f ms more "
-                     "(%d dropped so far)", self.name, info.index, info.publisher,
-                     (self._busy_until - info.received) * 1e3, n)
-        return False
-
     def _hold(self, info: MessageInfo, clocks: int) -> None:
         """Timing ``fpga``: wait until ``clocks`` at the circuit's clock have passed since the
         frame arrived (or since the circuit became free)."""
@@ -337,8 +327,6 @@ class FpgaComponent:
 
     def _on_frame(self, body: bytes | memoryview, info: MessageInfo) -> None:
         frame = len(body).to_bytes(4, "little") + body
-        if not self._circuit_free(info):
-            return
         if self._rtl is not None:
             self._on_frame_rtl(frame, info)
             return
@@ -536,7 +524,7 @@ class FpgaComponent:
                 circuit_time_s=(last.frame_time_s if last is not None and self._rtl is None
                                 else self._last_clocks / self._clock_hz if self._last_clocks
                                 else float("nan")),
-                dropped_busy=c["dropped_busy"], timing=self.timing, model=self.model,
+                timing=self.timing, model=self.model,
                 cycles=dict(last.cycles) if last is not None else {},
                 fifo_high_water=dict(self._high_water), fps=fps,
                 master_reregistrations=c["reregistered"], master_ok=self._master_ok,

@@ -114,8 +114,6 @@ class ComponentStats:
         last_error: the most recent refusal or problem, as text.
         connection_errors: the input side's recent connection problems (a publisher of another
             type on the input topic, a refused handshake, a publisher gone), newest last.
-        dropped_busy: frames dropped because they came while the circuit was busy (timing
-            ``fpga`` only: the input FIFO is full, the sender's queue drops them).
         timing: ``host`` or ``fpga`` (when outputs are published); ``model``: what ran the
             data path (``fast``, ``reference`` or ``rtl``).
     """
@@ -143,14 +141,13 @@ class ComponentStats:
     observer_errors: int = 0
     last_error: str = ""
     connection_errors: list[str] = field(default_factory=list)
-    dropped_busy: int = 0
     timing: str = "host"
     model: str = "fast"
 
     @property
     def dropped(self) -> int:
-        """All drops: in front of the circuit (queue full, or busy circuit) and behind it."""
-        return self.dropped_input + self.dropped_busy + self.dropped_output
+        """All drops: in front of and behind the circuit."""
+        return self.dropped_input + self.dropped_output
 
     def status_line(self) -> str:
         """One line for a terminal status display."""
@@ -167,11 +164,10 @@ class ComponentStats:
         lines = [
             f"frames: received {self.received}, processed {self.processed}, published "
             f"{self.published}, refused {self.refused}, dropped {self.dropped} "
-            f"(input queue {self.dropped_input}, busy circuit {self.dropped_busy}, output queues "
-            f"{self.dropped_output})",
+            f"(input queue {self.dropped_input}, output queues {self.dropped_output})",
             f"data path: {self.model} model; timing: {self.timing}" + (
-                " (each output held for the circuit's clocks at clock_mhz; frames arriving while "
-                "it is busy dropped)" if self.timing == "fpga" else
+                " (each output held for the circuit's clocks at clock_mhz; one frame waits while "
+                "it is busy, a newer one replaces it)" if self.timing == "fpga" else
                 " (outputs published as soon as the data path is done)"),
             f"latency (receive -> publish): {self.latency.ms()}; circuit model alone: "
             f"{self.process_time.ms()}",
@@ -193,9 +189,6 @@ class ComponentStats:
         for kind, n in sorted(self.refused_reasons.items(), key=lambda kv: -kv[1]):
             example = self.refused_examples.get(kind)
             lines.append(f"refused x{n}: {kind}" + (f" (first: {example})" if example else ""))
-        if self.dropped_busy:
-            lines.append(f"dropped x{self.dropped_busy}: came while the circuit was busy (timing "
-                         "fpga: the input FIFO is full, the sender drops them)")
         if self.dropped_input:
             lines.append(f"dropped x{self.dropped_input}: input queue full (the circuit was busy; "
                          "the oldest waiting frame goes)")
