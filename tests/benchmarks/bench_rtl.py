@@ -8,6 +8,10 @@
   the Verilog testbench (``verilator --binary --timing``) and the fast C++ harness side by side,
   on the same frame, with their outputs compared. Target of the harness: >= 20 M clocks/s.
 
+* the live node with ``--model rtl`` per shipped configuration: frames/s through the component
+  (embedded master, a lab publisher and subscriber, frames in lock step), each output checked
+  against the Python models.
+
 The build (compilation) time is printed apart: it is paid once per configuration.
 
 Usage: ``python tests/benchmarks/bench_rtl.py [--simulator verilator] [--full-icarus]``
@@ -45,6 +49,52 @@ def bench(stem: str, simulator: str, harness: bool | None = None) -> RtlResult:
     return result
 
 
+def bench_node(stem: str, frames: int = 5) -> None:
+    """Frames per second of the live component with the Verilog on its data path."""
+    import threading
+    import time
+
+    from rosfpga_lab.component import FpgaComponent
+    from rosfpga_lab.graph import EmbeddedMaster, Node
+
+    config = load_config(DATA / f"{stem}.yaml")
+    frame, _ = sample_frames(config)
+    expected = Pipeline.from_config(config).process(frame).output_frame
+    got: list[bytes] = []
+    cond = threading.Condition()
+
+    def collect(body: bytes | memoryview, info: object) -> None:
+        with cond:
+            got.append(bytes(body))
+            cond.notify_all()
+
+    with EmbeddedMaster(port=0) as master:
+        comp = FpgaComponent(config, master=master, model="rtl").start()
+        src, sink = Node("/bench_source", master=master), Node("/bench_sink", master=master)
+        try:
+            pub = src.advertise(config.subscriber.topic, "sensor_msgs/Image", queue_size=0)
+            sink.subscribe(config.publisher.topic, "sensor_msgs/Image", collect, raw=True,
+                           queue_size=0)
+            pub.wait_for_subscribers(1, 10)
+            comp.wait_for_subscribers(1, 10)
+            start = time.perf_counter()
+            for k in range(frames):
+                pub.publish_body(frame[4:])
+                with cond:
+                    cond.wait_for(lambda: len(got) > k, 60)
+            seconds = time.perf_counter() - start
+        finally:
+            sink.shutdown()
+            src.shutdown()
+            comp.stop()
+    # the circuit numbers its frames on: compare all but the seq field (bytes 4..7)
+    same = all(len(b) + 4 == len(expected) and b[4:] == expected[8:] for b in got)
+    img = config.image
+    print(f"node --model rtl  {stem:<24} {img.width}x{img.height} {img.encoding:<6} "
+          f"{len(got) / seconds:6.1f} frames/s   outputs {'equal to' if same else 'DIFFERENT from'} "
+          "the models (but seq)", flush=True)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -70,6 +120,9 @@ def main(argv: list[str] | None = None) -> int:
             bench("fpga_dilate_rgba8", simulator)
         else:
             bench("fpga_passthrough_rgb8", simulator)
+    if "verilator" in sims:
+        for stem in ("fpga_dilate_rgba8", "fpga_erode_mono8", "fpga_passthrough_rgb8"):
+            bench_node(stem)
     return 0
 
 
