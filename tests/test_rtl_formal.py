@@ -52,3 +52,18 @@ def test_a_planted_bug_fails_the_fifo_proof() -> None:
         result = prove(proof, replace={"rfl_fifo.v": buggy})
         assert result.status == "FAIL", format_results([result])
         assert any(f.startswith("fv_fifo.sv:") for f in result.failed), result.failed
+
+
+def test_cli_rtl_prove(capsys: pytest.CaptureFixture[str]) -> None:
+    from rosfpga_lab.cli import main
+
+    assert main(["rtl", "prove", "--only", "nosuch"]) == 1     # without the tools: 1 as well
+    err = capsys.readouterr().err
+    assert "error:" in err
+    require_formal()
+    assert "no check named nosuch" in err and "axi2fifo" in err
+    assert main(["rtl", "prove", "--only", "axi2fifo"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].split() == ["check", "mode", "depth", "result", "s", "claim"]
+    assert [line.split()[:4] for line in out[1:]] == [["axi2fifo", "prove", "8", "PASS"],
+                                                      ["axi2fifo", "bmc", "12", "PASS"]]

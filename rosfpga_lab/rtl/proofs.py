@@ -52,31 +52,32 @@ class Proof:
     defines: tuple[str, ...] = ()
 
 
-#: Every check, every module of the circuit at least once.
+#: Every check, every module of the circuit at least once. Inputs are assumed to keep the stream
+#: rules (what the neighbour's own proof shows); what a module drives is asserted.
 PROOFS: tuple[Proof, ...] = (
     Proof("fifo", ("rfl_fifo.v",), "prove", 8,
-          "rfl_fifo (depth 4): stream rules on both sides, level = beats in - beats out, "
+          "rfl_fifo (depth 4): output stream rules, level = beats in - beats out, "
           "no overflow/underflow, ready when there is room; all reachable states",
           ("FV_PROVE",)),
     Proof("fifo", ("rfl_fifo.v",), "bmc", 12,
           "rfl_fifo (depth 4): the n-th beat out is the n-th beat in (no beat lost, "
           "duplicated or reordered), any n, 12 clocks"),
     Proof("fifo2axi", ("rfl_fifo2axi.v",), "prove", 10,
-          "rfl_fifo2axi (3x2, 2 bytes/pixel): stream rules on both sides; all reachable states",
+          "rfl_fifo2axi (3x2, 2 bytes/pixel): output stream rules; all reachable states",
           ("FV_PROVE",)),
     Proof("fifo2axi", ("rfl_fifo2axi.v",), "bmc", 20,
           "rfl_fifo2axi (3x2, 2 bytes/pixel): TUSER on a frame's first pixel only, TLAST on a "
           "line's last pixel only, TKEEP, each beat = the bytes taken; 20 clocks"),
     Proof("axi2fifo", ("rfl_axi2fifo.v",), "prove", 8,
-          "rfl_axi2fifo: stream rules on both sides; all reachable states", ("FV_PROVE",)),
+          "rfl_axi2fifo: output stream rules; all reachable states", ("FV_PROVE",)),
     Proof("axi2fifo", ("rfl_axi2fifo.v",), "bmc", 12,
           "rfl_axi2fifo: one byte per kept lane in lane order, no beat overwritten; 12 clocks"),
     Proof("morph", ("rfl_morph.v",), "prove", 8,
-          "rfl_morph (3x2, 3x3 dilate): stream rules, TKEEP; all reachable states",
+          "rfl_morph (3x2, 3x3 dilate): output stream rules, TKEEP; all reachable states",
           ("FV_PROVE",)),
     Proof("morph", ("rfl_morph.v",), "bmc", 24,
           "rfl_morph (3x2, 3x3 dilate): TUSER/TLAST on the output where they belong; "
-          "24 clocks (two frames)"),
+          "24 clocks (two 3x2 frames at full rate)"),
     Proof("subscriber", ("rfl_subscriber.v",), "prove", 8,
           "rfl_subscriber (any input bytes): pixel stream rules, status codes of the table; "
           "all reachable states"),
