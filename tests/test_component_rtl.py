@@ -163,7 +163,8 @@ def test_fpga_timing_flood_comes_out_at_the_modelled_rate_excess_dropped() -> No
             comp.stop()
     got_rate = st.published / sent_for
     assert got_rate <= modelled * 1.1, st.report()
-    assert got_rate >= modelled * 0.9, st.report()   # the circuit, not the host, set the pace
+    # the circuit, not the host, set the pace (unless a loaded machine delivered fewer frames)
+    assert got_rate >= 0.9 * min(modelled, st.received / sent_for), st.report()
     assert st.published + st.dropped_input + st.refused == st.received
     assert st.dropped_input > 0 and st.received > n * 0.5, st.report()
     assert st.timing == "fpga" and "timing: fpga" in st.report()

@@ -319,8 +319,9 @@ class FpgaComponent:
         self._last_clocks = clocks
         if self.timing != "fpga":
             return
-        done = max(info.received, self._busy_until) + clocks / self._clock_hz
-        self._busy_until = done
+        with self._lock:   # one circuit, whichever connection the frame came on
+            done = max(info.received, self._busy_until) + clocks / self._clock_hz
+            self._busy_until = done
         left = done - time.time()
         if left > 0:
             time.sleep(left)
