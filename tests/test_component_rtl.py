@@ -10,6 +10,9 @@
 
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -17,13 +20,14 @@ import cv2
 import numpy as np
 import pytest
 
+from proctools import interruptible, kill_if_running, stop_with
 from realros import (
     ROS_PROGRAMS, ROS_PYTHON, finish, require_ros, require_rtl, stop_process,
 )
 from rosfpga_lab.component import FpgaComponent
 from rosfpga_lab.component.errors import ComponentConfigError
 from rosfpga_lab.config import load_config, parse_config
-from rosfpga_lab.graph import EmbeddedMaster, Node
+from rosfpga_lab.graph import EmbeddedMaster, Node, call
 from rosfpga_lab.hw import Pipeline, image_frame
 from rosfpga_lab.hw.cycles import account
 from test_component_node import Collector
@@ -40,45 +44,59 @@ def small_config_text(width: int = W, height: int = H) -> str:
 
 @pytest.mark.ros
 @pytest.mark.rtl
-def test_real_rospy_publisher_rtl_node_real_rospy_checker_exact(rosmaster_uri, tmp_path) -> None:
+def test_real_rospy_publisher_rtl_node_command_real_rospy_checker_exact(rosmaster_uri,
+                                                                       tmp_path) -> None:
+    """``rosfpga-lab node CONFIG --model rtl`` between a real rospy publisher and a real rospy
+    subscriber, on a real rosmaster: every frame out is OpenCV's dilation of one sent."""
     require_ros()
     require_rtl("verilator")
     count = 8
     cfg = tmp_path / "small.yaml"
     cfg.write_text(small_config_text())
-    comp = FpgaComponent.from_config(cfg, master_uri=rosmaster_uri, model="rtl",
-                                     input_queue=count, output_queue=count).start()
+    node = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(cfg), "--master-uri",
+                             rosmaster_uri, "--model", "rtl", "--input-queue", str(count),
+                             "--output-queue", str(count), "--status-interval", "0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=tmp_path, preexec_fn=interruptible)
     procs = []
     try:
+        deadline = time.monotonic() + 120       # the first run compiles the circuit
+        while time.monotonic() < deadline and node.poll() is None:
+            subscribers = call(rosmaster_uri, "getSystemState", "/t")[2][1]
+            if any(t == "/image_raw" and "/fpga_dilate" in n for t, n in subscribers):
+                break
+            time.sleep(0.1)
+        else:
+            raise AssertionError(f"the node never subscribed: {node.communicate(timeout=10)}")
         sent_file, got_file = tmp_path / "sent.bin", tmp_path / "got.bin"
         sub = start([ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "sub",
                      "/image_dilated", str(count), str(got_file), "60"], rosmaster_uri, tmp_path)
         procs.append(sub)
-        assert comp.wait_for_subscribers(1, 20), "the rospy subscriber never connected"
         pub = start([ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "pub", "/image_raw",
                      str(count), str(W), str(H), "rgba8", str(sent_file), "20", "60"],
                     rosmaster_uri, tmp_path)
         procs.append(pub)
         finish(pub)
         finish(sub)
-        stats = comp.stats
+        out, err = stop_with(node, signal.SIGINT)
     finally:
         for p in procs:
             stop_process(p)
-        comp.stop()
+        kill_if_running(node)
+    assert node.returncode == 0, err
     sent = {parse_image(b)["stamp"]: parse_image(b) for b in records(sent_file)}
     got = [parse_image(b) for b in records(got_file)]
-    assert len(sent) == count and len(got) == count, stats.report()
-    for out in got:
-        src = sent[out["stamp"]]
+    assert len(sent) == count and len(got) == count, out + err
+    for image_out in got:
+        src = sent[image_out["stamp"]]
         image = np.frombuffer(src["data"], np.uint8).reshape(H, W, 4)
         want = cv2.dilate(image, np.ones((3, 3), np.uint8))
-        assert out["data"] == want.tobytes(), f"frame with stamp {out['stamp']}"
+        assert image_out["data"] == want.tobytes(), f"frame with stamp {image_out['stamp']}"
         for key in ("frame_id", "height", "width", "encoding", "is_bigendian", "step"):
-            assert out[key] == src[key], key
+            assert image_out[key] == src[key], key
     assert sorted(o["seq"] for o in got) == list(range(1, count + 1))  # the circuit counts
-    assert stats.model == "rtl" and stats.published == count and stats.refused == 0
-    assert "data path: rtl model" in stats.report()
+    assert "(rtl model, host timing)" in out
+    assert f"published {count}, refused 0" in out and "data path: rtl model" in out
 
 
 @pytest.mark.rtl
