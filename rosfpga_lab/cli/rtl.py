@@ -214,7 +214,8 @@ def run_sim(args: argparse.Namespace) -> int:
     for offset, status in result.status:
         print(f"frame at byte {offset}: {status}")
     print(f"{len(result.status)} frame(s), {len(result.output):,} bytes out, {result.cycles:,} clocks "
-          f"in {result.seconds:.2f} s ({result.clocks_per_second:,.0f} clocks/s, {sim.simulator})")
+          f"in {result.seconds:.2f} s ({result.clocks_per_second:,.0f} clocks/s, {sim.simulator}"
+          f"{' fast harness' if sim.harness else ''})")
     if result.cut_short:
         print("the input ended inside a frame: the circuit waits for the rest of it")
     if args.output is not None:
