@@ -83,8 +83,9 @@ PROOFS: tuple[Proof, ...] = (
           "all reachable states"),
     # induction does not close here: the output byte is read from the subscriber's frame_id
     # memory, which the wrapper leaves free (the whole rfl_top below closes instead)
-    Proof("publisher", ("rfl_publisher.v",), "bmc", 16,
-          "rfl_publisher: output stream rules, releases only fields it holds; 16 clocks"),
+    Proof("publisher", ("rfl_publisher.v",), "bmc", 32,
+          "rfl_publisher (2x1 mono8): output stream rules, releases only fields it holds; 32 "
+          "clocks (through the header and frame_id)"),
     Proof("top", tuple(p.name for p in sorted(VERILOG_DIR.glob("*.v"))), "prove", 8,
           "rfl_top (2x1 mono8, FIFOs 4 deep, any input bytes): output stream rules, busy while "
           "output is pending; all reachable states"),

@@ -22,8 +22,9 @@ module fv_publisher (input clk, input rst_n, input [7:0] s_tdata, input s_tvalid
     always @(posedge clk) if (!fv_init && $past(rst_n)) begin
         if ($past(meta_valid && !meta_release)) assume(meta_valid && $stable(meta_secs)
             && $stable(meta_nsecs) && $stable(meta_bigendian) && $stable(meta_fid_len));
-        if ($past(!meta_valid || meta_release) && $past(rst_n)) assume(!meta_valid || !$past(meta_valid) || !$past(meta_release));
-        if ($past(fid_raddr) == fid_raddr && $past(meta_valid) && meta_valid) assume($stable(fid_rdata));
+        // the frame_id memory is read combinationally and not written while the fields are held
+        if ($past(fid_raddr) == fid_raddr && $past(meta_valid && !meta_release))
+            assume($stable(fid_rdata));
     end
     always @(*) if (!rst_n) assume(!meta_valid);
     always @(posedge clk) if (!fv_init && rst_n) begin
