@@ -43,11 +43,11 @@ def mixed_frames(config) -> tuple[list[bytes], list[str]]:
              image_frame(b, enc, frame_id="b")], ["SUB_OK", "SUB_BAD_WIDTH", "SUB_OK"])
 
 
-@pytest.mark.parametrize("encoding,gap,bp", [("mono8", 300, 500), ("rgba8", 0, 0),
-                                             ("rgb8", 100, 700)])
+@pytest.mark.parametrize("encoding,gap,bp", [("mono8", 300, 500), ("rgba8", 0, 0)])
 def test_harness_equals_the_testbench(encoding: str, gap: int, bp: int, tmp_path: Path) -> None:
-    """mono8: every refusal reason, each followed by a good frame; rgba8 and rgb8: good frames
-    around a refused one; with and without input gaps and backpressure."""
+    """mono8: every refusal reason, each followed by a good frame, with input gaps and
+    backpressure; rgba8: good frames around a refused one at full speed, then cut short.
+    (Each case compiles a Verilator model: two cases keep the file near a minute.)"""
     require_rtl("verilator")
     require_rtl("iverilog")
     if encoding == "mono8":
