@@ -104,6 +104,21 @@ def test_talker_contact_right_and_wrong():
             talker.shutdown()
 
 
+def test_a_whole_reply_passed_as_uri_is_named():
+    """Exercise 1.2's likeliest mistake: lookupNode's whole reply handed to call() as the URI
+    ended in a raw TypeError from urllib; split_uri now raises its documented ConfigError."""
+    from rosfpga_lab.errors import LabError
+    from rosfpga_lab.graph.xmlrpc import call, split_uri
+
+    reply = [1, "node api", "http://127.0.0.1:9/"]
+    with pytest.raises(LabError, match=r"whole \[code, statusMessage, value\].*reply\[2\]"):
+        call(reply, "requestTopic", "/student", "/chatter", [["TCPROS"]])   # before any socket
+    with pytest.raises(LabError, match="not int 5"):
+        split_uri(5)
+    with pytest.raises(LabError, match="not NoneType"):
+        split_uri(None)
+
+
 HTTP = b"POST / HTTP/1.1\r\nContent-Length: 5\r\n\r\nhello"
 
 
