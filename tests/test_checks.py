@@ -206,6 +206,35 @@ def test_data_offset():
     assert "inside field header.frame_id" in problems_of(C.check_data_offset, 22, frame)
 
 
+def test_data_offset_names_both_mistakes_that_give_want_minus_4():
+    frame = pack_str(image_body())
+    right = 4 + 12 + 4 + 6 + 8 + 4 + 5 + 1 + 4 + 4
+    msg = problems_of(C.check_data_offset, right - 4, frame)
+    # counted from the message body (no frame length) and stopped at data's length: both give it
+    assert "start of the message body" in msg and "uint32 length of 'data'" in msg
+    assert "both the frame's 4-byte length and the 4-byte length of 'data'" in \
+        problems_of(C.check_data_offset, right - 8, frame)
+    assert "still None" in problems_of(C.check_data_offset, None, frame)
+    assert "still Ellipsis" in problems_of(C.check_data_offset, ..., frame)
+
+
+def test_extract_frame_length_forgotten_is_not_called_a_swap():
+    """Every field read 4 bytes early (the frame's length left out): width then holds the
+    height, which the check used to call a swap of two right variables."""
+    frame = pack_str(image_body("left_camera", width=9, height=5, encoding="bgr8"))
+    u32 = lambda off: struct.unpack_from("<I", frame, off)[0]  # noqa: E731
+    height_at = 4 + 12 + 4 + len("left_camera")
+    early = {"height": u32(height_at - 4), "width": u32(height_at), "encoding": "bgr8", "step": 9}
+    assert early["width"] == 5                                  # the height's value ...
+    msg = problems_of(C.check_extract, early, frame)
+    assert "read 4 bytes too early" in msg and "frame's 4-byte length" in msg
+    assert "that is the height" not in msg                      # ... but no swap
+    swapped = {"height": 9, "width": 5, "encoding": "bgr8", "step": 9}
+    assert "that is the height; in sensor_msgs/Image height comes before width" in \
+        problems_of(C.check_extract, swapped, frame)
+    assert "still None" in problems_of(C.check_extract, None, frame)
+
+
 def test_marshal_right_and_the_brief_example():
     assert C.check_marshal(image_body("cam_one"), image_msg("cam_one")).ok
     bad = bytearray(image_body("cam_one"))
@@ -438,3 +467,22 @@ def test_marshal_native_alignment_is_named_not_big_endian():
     # a real big-endian step is still called big-endian
     swapped = image_body()[:-10] + struct.pack(">I", 2) + pack_str(b"\x01\x02")
     assert "big-endian" in problems_of(C.check_marshal, swapped, msg)
+
+
+def test_notebook_3_exercise_3_1_frame_is_not_the_printed_one():
+    """03 printed ``ImageFields(..., data_offset=52)`` for ``frame`` two cells above Exercise 3.1,
+    so ``fields.data_offset`` passed; the exercise now asks about a frame nothing prints."""
+    from pathlib import Path
+
+    from rosfpga_lab import hw
+    from rosfpga_lab.checks import nbbuild
+
+    path = Path(__file__).resolve().parents[1] / "notebooks" / "solutions" / "03_message_conversion.ipynb"
+    cells = nbbuild.load(path)["cells"]
+    source = next(nbbuild.cell_source(c) for c in cells if "check_data_offset(" in nbbuild.cell_source(c))
+    scope = {"hw": hw, "np": np}
+    exec(source.split(nbbuild.BEGIN)[0], scope)                   # the exercise's set-up lines
+    printed_frame = hw.image_frame(np.zeros((3, 4, 4), np.uint8), "rgba8", frame_id="camera")
+    printed = hw.interpret_fast(printed_frame)[0].data_offset      # what cell 14 prints: 52
+    assert "exercise_frame)" in source and printed == 52
+    assert "not right yet" in problems_of(C.check_data_offset, printed, scope["exercise_frame"])
