@@ -263,6 +263,16 @@ def test_tdata():
         problems_of(C.check_tdata, 0x44330011, (0x11, 0x22, 0x33, 0x44))
 
 
+def test_tdata_wrong_types_get_no_misleading_example():
+    """A str answer got "(an int, e.g. 0x11223344)": the example was the big-endian wrong answer."""
+    pixel = (0x11, 0x22, 0x33, 0x44)
+    msg = problems_of(C.check_tdata, "0x44332211", pixel)
+    assert "should be int, you gave str" in msg and "int(text, 16)" in msg
+    assert "0x11223344" not in msg and "11223344" not in msg.replace("'0x44332211'", "")
+    assert "0x11223344" not in problems_of(C.check_tdata, 1.5, pixel)
+    assert "still None" in problems_of(C.check_tdata, None, pixel)
+
+
 def test_markers():
     tuser = [i == 0 for i in range(6)]
     tlast = [i % 3 == 2 for i in range(6)]
