@@ -349,6 +349,26 @@ def test_dilate():
     assert "keep uint8" in problems_of(C.check_dilate, lambda im: good_dilate(im).astype(np.int32))
 
 
+def test_dilate_returning_none_says_so():
+    """5.1 returning None said "your output has shape ()"."""
+    def forgot_return(image):
+        out = image.copy()  # noqa: F841 - the mistake: no return
+    msg = problems_of(C.check_dilate, forgot_return)
+    assert "returned None: did you forget 'return out'" in msg and "shape ()" not in msg
+    assert "still None" in problems_of(C.check_dilate, None)
+
+
+def test_frame_timing_frame_time_instead_of_the_filters_is_named_and_rounded():
+    """5.2: the byte-wide stages' 12.28846 ms (the frame's time) in the filter's variable got
+    "frame_ms is 12.288459999999999, expected 3.0832" and no hint."""
+    msg = problems_of(C.check_frame_timing, 308_321, 1_228_846 / 100e6 * 1e3, "byte-wide stages")
+    assert "filter_ms is 12.2885: that is about the byte-wide stages' time" in msg
+    assert "12.288459999" not in msg
+    msg = problems_of(C.check_frame_timing, 308_321, 1 / 3, "byte-wide stages")
+    assert "filter_ms is 0.333333, expected 3.0832" in msg
+    assert "still None" in problems_of(C.check_frame_timing, 308_321, None, "byte-wide stages")
+
+
 def test_frame_timing():
     assert C.check_frame_timing(308_321, 3.08321, "byte-wide stages").ok
     msg = problems_of(C.check_frame_timing, 307_200, 3.072, "filter")

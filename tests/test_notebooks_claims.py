@@ -78,3 +78,26 @@ def test_clicking_is_only_mentioned_where_something_is_clickable(path: Path) -> 
 
     text = drop_live_only(markdown(path.name))
     assert not re.search(r"\b(click|hover)", text, re.I), re.search(r".{0,60}\b(click|hover).{0,60}", text, re.I)[0]
+
+
+def _numbers(phrase: str) -> set[int]:
+    """``"1 to 6, 8 and 9"`` -> {1, ..., 6, 8, 9}."""
+    out: set[int] = set()
+    for part in re.split(r",\s*|\s+and\s+", phrase.strip()):
+        lo, _, hi = part.partition(" to ")
+        out |= set(range(int(lo), int(hi or lo) + 1))
+    return out
+
+
+def test_one_place_says_which_notebooks_have_exercises() -> None:
+    """It was told three ways (00: "1 to 6", README: "1 to 6, 8 and 9", notebooks/README:
+    "1 to 6"). notebooks/README.md says it, from the notebooks' own exercise cells; the others
+    point there."""
+    with_exercises = {int(p.name[:2]) for p in NOTEBOOKS
+                      if any(nbbuild.is_exercise_cell(c) for c in nbbuild.load(p)["cells"])}
+    owner = (ROOT / "notebooks" / "README.md").read_text(encoding="utf-8")
+    said = re.findall(r"Notebooks ([\d ,toand]+?) end with exercises", owner)
+    assert len(said) == 1 and _numbers(said[0]) == with_exercises, (said, with_exercises)
+    for text in ((ROOT / "README.md").read_text(encoding="utf-8"), markdown("00_overview.ipynb")):
+        assert not re.search(r"Notebooks [\d ,toand]+ end with exercises", text)
+        assert "end with them" in text
