@@ -161,8 +161,8 @@ class ComponentStats:
             f"frames: received {self.received}, processed {self.processed}, published "
             f"{self.published}, refused {self.refused}, dropped {self.dropped} "
             f"(input queue {self.dropped_input}, output queues {self.dropped_output})",
-            f"latency (receive -> publish): {self.latency.ms()}; circuit model alone: "
-            f"{self.process_time.ms()}",
+            f"latency (receive -> publish, wall time here): {self.latency.ms()}; of it the "
+            f"Python circuit model's own run: {self.process_time.ms()}",
         ]
         if self.since_stamp.count:
             lines.append(f"latency since capture (input header.stamp -> publish): "
@@ -171,7 +171,8 @@ class ComponentStats:
             total = self.circuit_time_s * 1e3
             lines.append("cycles per stage (last frame): " + ", ".join(
                 f"{name} {n:,}" for name, n in self.cycles.items())
-                + f"; modelled circuit time {total:.2f} ms")
+                + f"; the real circuit would need {total:.2f} ms per frame at its clock "
+                "(cycles / clock, not measured here)")
         if self.fifo_high_water:
             lines.append("FIFO high water: " + ", ".join(
                 f"{name} {n}" for name, n in self.fifo_high_water.items()))
