@@ -123,3 +123,13 @@ def test_stats_report_says_which_time_is_which() -> None:
     assert "real circuit would need 12.31 ms per frame" in report and "not measured" in report
     prose = " ".join(markdown("00_overview.ipynb").split())
     assert "wall time" in prose and "not measured" in prose
+
+
+def test_workshop_notebook_says_when_the_stop_button_is_there_and_explains_resets() -> None:
+    """07 promised a Stop button that Run All never shows (the last cell closes the view), and
+    left real rospy's 'Connection reset by peer' line unexplained."""
+    text = " ".join(markdown("07_workshop_demo.ipynb").split())
+    assert "after *Run All* the cameras have already stopped" in text
+    assert "*Connection reset by peer*" in text and "not a damaged frame" in text
+    code = "\n".join("".join(c["source"]) for c in cells("07_workshop_demo.ipynb") if c["cell_type"] == "code")
+    assert "live.close()" in code        # what the prose says the last cell does
