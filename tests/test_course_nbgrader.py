@@ -259,3 +259,18 @@ def test_environment_tools_on_path_adds_only_what_is_missing(monkeypatch: pytest
     assert os.environ["PATH"] == f"{BIN}{os.pathsep}/usr/bin:/bin"
     assert grading.environment_tools_on_path() is None          # found now: PATH stays
     assert os.environ["PATH"] == f"{BIN}{os.pathsep}/usr/bin:/bin"
+
+
+def test_validate_fails_on_an_unanswered_assignment(nbgrader_cmd: list[str], tmp_path: Path) -> None:
+    """nbgrader's Validate said "Success" for an unanswered student notebook (it carries no
+    graded cells; the student lab hides the button, tests/test_lab_student_view.py). The version
+    students fetch on the course server has the checks as graded cells: there it fails."""
+    course = tmp_path / "course"
+    grading.write_course_source(SOLUTIONS, course, [GRADED])
+    run(nbgrader_cmd + ["generate_assignment", GRADED, "--force"], course)
+    released = course / "release" / GRADED / f"{GRADED}.ipynb"
+    env = dict(os.environ, PATH=f"{BIN}{os.pathsep}{os.environ.get('PATH', '')}")
+    proc = subprocess.run(nbgrader_cmd + ["validate", str(released)], cwd=course, env=env,
+                          capture_output=True, text=True, timeout=240)
+    out = proc.stdout + proc.stderr
+    assert "Success" not in out and "VALIDATION FAILED" in out, out[-2000:]
