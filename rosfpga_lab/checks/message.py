@@ -9,6 +9,7 @@ from rosfpga_lab.checks._core import (
     ByteField, CheckResult, as_bytes, describe_byte_difference, fail, field_at, require_answer,
     require_type,
 )
+from rosfpga_lab.checks.limits import MAX_READ_SHIFT
 from rosfpga_lab.msg import MsgRegistry, default_registry, field_layout, serialize
 from rosfpga_lab.tcpros import frame_spans
 
@@ -113,13 +114,9 @@ def _common_shift(frame: bytes, at: Mapping[str, int], wrong: Mapping[str, int])
     for key, value in wrong.items():
         shifts = {off - at[key] for off in range(0, len(frame) - 3)
                   if int.from_bytes(frame[off:off + 4], "little") == value
-                  and 0 < abs(off - at[key]) <= MAX_SHIFT_BYTES}
+                  and 0 < abs(off - at[key]) <= MAX_READ_SHIFT}
         found = shifts if found is None else found & shifts
     return min(found, key=abs) if found else None
-
-
-#: Exercise 3.3: how far from its field a wrongly read value is looked for.
-MAX_SHIFT_BYTES = 16
 
 
 def check_extract(answer: Any, frame: bytes) -> CheckResult:
