@@ -8,6 +8,7 @@ import threading
 from dataclasses import dataclass, field
 
 from rosfpga_lab.component import limits
+from rosfpga_lab.config.vocabulary import RTL_MODEL
 from rosfpga_lab.graph.rate import RateMeter
 
 
@@ -169,8 +170,9 @@ class ComponentStats:
                 " (each output held for the circuit's clocks at clock_mhz; one frame waits while "
                 "it is busy, a newer one replaces it)" if self.timing == "fpga" else
                 " (outputs published as soon as the data path is done)"),
-            f"latency (receive -> publish): {self.latency.ms()}; circuit model alone: "
-            f"{self.process_time.ms()}",
+            f"latency (receive -> publish, wall time here): {self.latency.ms()}; of it the "
+            f"{'simulated Verilog' if self.model == RTL_MODEL else 'Python circuit model'}'s own "
+            f"run: {self.process_time.ms()}",
         ]
         if self.since_stamp.count:
             lines.append(f"latency since capture (input header.stamp -> publish): "
@@ -182,7 +184,8 @@ class ComponentStats:
             total = self.circuit_time_s * 1e3
             lines.append("cycles per stage (last frame): " + ", ".join(
                 f"{name} {n:,}" for name, n in self.cycles.items())
-                + f"; modelled circuit time {total:.2f} ms")
+                + f"; the real circuit would need {total:.2f} ms per frame at its clock "
+                "(cycles / clock, not measured here)")
         if self.fifo_high_water:
             lines.append("FIFO high water: " + ", ".join(
                 f"{name} {n}" for name, n in self.fifo_high_water.items()))
