@@ -314,17 +314,23 @@ def cdr_bytes(cdr: CdrLayout, step: Step, value: Any) -> bytes:
 def cdr_marshal(cdr: CdrLayout, toks: Iterable[Token]) -> bytes:
     """The circuit's output record (4-byte sample length + CDR payload, options 0 and no
     trailing padding, as Cyclone DDS's ``serialize()`` writes) from CDR tokens in walk order."""
-    out = bytearray(CDR_LE)
+    parts = [b"", CDR_LE]
+    at = 4 + len(CDR_LE)            # offset in the record
     steps = cdr.layout.steps
     for t in toks:
         s = steps[t.step]
         data = encode_token(s, t.value)
         if data:
-            out += bytes(cdr.pad(t.step, len(out) + 4))
-        out += data
+            pad = cdr.pad(t.step, at)
+            if pad:
+                parts.append(bytes(pad))
+            parts.append(data)
+            at += pad + len(data)
         if s.kind is StepKind.STRING:
-            out += b"\x00"
-    return struct.pack("<I", len(out)) + bytes(out)
+            parts.append(b"\x00")
+            at += 1
+    parts[0] = struct.pack("<I", at - 4)
+    return b"".join(parts)
 
 
 def format_cdr_layout(cdr: CdrLayout) -> str:
