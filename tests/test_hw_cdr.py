@@ -400,3 +400,22 @@ def test_images_cyclone_dds_sent_over_rtps_through_the_cdr_circuit() -> None:
         image = np.asarray(value["data"]).reshape(480, 640, 3)
         want = dict(value, data=cv2.dilate(image, np.ones((3, 3), np.uint8)).tobytes())
         assert pipe.process(sample) == serialize_cdr(reg, "sensor_msgs/Image", want)
+
+
+def test_messages_without_fields_are_rosidls_one_byte_in_the_walk() -> None:
+    reg = MsgRegistry.with_defaults()
+    reg.add("h_msgs/E", "std_msgs/Empty e\nstd_msgs/Empty[] es\nfloat64[] stream\nstd_msgs/Empty z")
+    cdr = derive_cdr_layout(reg, "h_msgs/E", stream="stream", stream_length=2)
+    assert [s.label for s in cdr.layout.steps if s.kind is StepKind.SCALAR] == [
+        "e.structure_needs_at_least_one_member", "es[].structure_needs_at_least_one_member",
+        "z.structure_needs_at_least_one_member"]
+    r2 = ros2_registry(reg)
+    value = {"e": {}, "es": [{}, {}, {}], "stream": [1.5, -2.0], "z": {}}
+    payload = serialize_cdr(r2, "h_msgs/E", value)
+    # 1 byte, 4-byte count, 3 bytes, pad to 8, 4-byte count, 2 float64, 1 byte
+    assert len(payload) == 4 + 1 + 3 + 4 + 3 + 1 + 4 + 16 + 1
+    for extract in (extract_cdr_reference, extract_cdr_fast):
+        ex = extract(cdr, _record(payload))
+        assert ex.stream.tolist() == [1.5, -2.0]
+        assert publish_cdr_fast(cdr, ex.tokens, ex.stream[::-1].copy()) == _record(
+            serialize_cdr(r2, "h_msgs/E", dict(value, stream=[-2.0, 1.5])))

@@ -54,7 +54,9 @@ refusal with a sane frame length the rest of the frame is skipped.
 
 :func:`tokens` lists a message's values in walk order (what the subscriber emits step by step)
 and :func:`marshal` writes tokens back into a frame (what the publisher does): the two are
-the layout's definition of the wire, tested against the ``msg`` layer.
+the layout's definition of the wire, tested against the ``msg`` layer. CDR, the second wire
+format, is the same walk of the type's ROS 2 form with the kinds ``ENCAPSULATION`` and ``NUL``
+and each step's alignment added (:mod:`rosfpga_lab.hw.cdrlayout`).
 """
 
 from __future__ import annotations
