@@ -419,3 +419,26 @@ def test_messages_without_fields_are_rosidls_one_byte_in_the_walk() -> None:
         assert ex.stream.tolist() == [1.5, -2.0]
         assert publish_cdr_fast(cdr, ex.tokens, ex.stream[::-1].copy()) == _record(
             serialize_cdr(r2, "h_msgs/E", dict(value, stream=[-2.0, 1.5])))
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.binary(min_size=1, max_size=120), st.integers(0, 3))
+def test_any_bytes_are_walked_or_refused_by_name_and_both_models_agree(junk: bytes, mode: int) -> None:
+    cdr = _samples_pipeline().cdr
+    good = _record(serialize_cdr(cdr.registry, "lab_msgs/Samples", _samples_value(n=64)))
+    record = [junk, good[:8] + junk, good[:40] + junk, _record(b"\x00\x01\x00\x00" + junk)][mode]
+    outcome = _outcome(extract_cdr_reference, cdr, record)
+    assert outcome == _outcome(extract_cdr_fast, cdr, record)
+    # byte by byte after the junk, the next good sample still comes out right
+    interp = CdrInterpreter(cdr)
+    for byte in record:
+        try:
+            interp.push(byte)
+        except FrameFieldError:
+            pass
+    frames = interp.frames
+    if interp.pc != 0 or interp._buf:   # mid-sample: the junk's sample length still runs
+        return
+    for byte in good:
+        interp.push(byte)
+    assert interp.frames == frames + 1
