@@ -442,3 +442,46 @@ def test_any_bytes_are_walked_or_refused_by_name_and_both_models_agree(junk: byt
     for byte in good:
         interp.push(byte)
     assert interp.frames == frames + 1
+
+
+def test_skipped_fields_are_written_as_cdr_defaults_and_another_output_type_by_path(
+        tmp_path: Path) -> None:
+    r2 = ros2_registry()
+    c = parse_config("node: {name: n}\nsubscriber: {topic: /a, type: sensor_msgs/LaserScan}\n"
+                     "publisher: {topic: /b}\nstream: {field: ranges, length: 3}\n"
+                     "skip: [intensities, header.frame_id, scan_time]\n"
+                     "application: {op: dilate, ksize: 3}\n")
+    scan = {"header": {"stamp": {"sec": 5, "nanosec": 6}, "frame_id": "laser"},
+            "angle_min": -1.0, "angle_max": 1.0, "angle_increment": 0.5, "time_increment": 0.0,
+            "scan_time": 0.5, "range_min": 0.1, "range_max": 9.0, "ranges": [3.0, 1.0, 2.0],
+            "intensities": [9.0, 9.0, 9.0]}
+    # a skipped string is "" on the wire: length 1, its NUL (the alignment after it moves)
+    want = serialize_cdr(r2, "sensor_msgs/LaserScan", dict(
+        scan, header=dict(scan["header"], frame_id=""), scan_time=0.0, intensities=[],
+        ranges=[3.0, 3.0, 2.0]))
+    for model in ("fast", "reference"):
+        assert CdrPipeline(c, model).process(serialize_cdr(r2, "sensor_msgs/LaserScan", scan)) == want
+
+    msgs = tmp_path / "conv_msgs" / "msg"
+    msgs.mkdir(parents=True)
+    (msgs / "InnerA.msg").write_text("int32 a\nstring b\n")
+    (msgs / "InnerB.msg").write_text("string b\nint64 a\nuint8 c\n")
+    (msgs / "In.msg").write_text("Header header\nstring name\nint16[] values\nfloat64 gain\n"
+                                 "InnerA inner\nInnerA[] list\n")
+    (msgs / "Out.msg").write_text("Header header\nint16[] values\nstring name\nuint8 extra\n"
+                                  "InnerB inner\nInnerB[] list\n")
+    (tmp_path / "c.yaml").write_text(
+        "node: {name: n}\nsubscriber: {topic: /a, type: conv_msgs/In}\n"
+        "publisher: {topic: /b, type: conv_msgs/Out}\nmsg_path: [.]\n"
+        "stream: {field: values, length: 4}\napplication: {op: dilate, ksize: 3}\n"
+        "limits: {name: 8}\n")
+    config = load_config(tmp_path / "c.yaml")
+    reg2 = ros2_registry(config.registry())
+    msg = {"header": {"stamp": {"sec": 3, "nanosec": 4}, "frame_id": "x"}, "name": "nm",
+           "values": [1, -5, 3, 0], "gain": 2.5, "inner": {"a": 7, "b": "in"},
+           "list": [{"a": 1, "b": "z"}]}
+    want = serialize_cdr(reg2, "conv_msgs/Out", {
+        "header": msg["header"], "values": [1, 3, 3, 3], "name": "nm", "extra": 0,
+        "inner": {"b": "in", "a": 0, "c": 0}, "list": []})
+    for model in ("fast", "reference"):
+        assert CdrPipeline(config, model).process(serialize_cdr(reg2, "conv_msgs/In", msg)) == want
