@@ -17,6 +17,15 @@ MAX_KSIZE = 15
 #: Longest header.frame_id the circuit stores and the publisher re-sends.
 MAX_FRAME_ID_MAX = 256
 DEFAULT_FRAME_ID_MAX = MAX_FRAME_ID_MAX
+#: Maxima of the variable-length parts of a message other than the stream, when a configuration's
+#: ``limits:`` leaves them out: bytes of a string, elements of a variable-length array (a longer
+#: one is refused). ``header.frame_id`` keeps ``frame_id_max``.
+DEFAULT_STRING_MAX = 256
+DEFAULT_ARRAY_MAX = 64
+#: Largest value a ``limits:`` entry may give (bytes of a string, elements of an array).
+MAX_LIMIT = 1 << 20
+#: Most elements of the streamed array (``stream.length``).
+MAX_STREAM_LENGTH = 1 << 24
 #: FIFO depths (items) and their bounds.
 DEFAULT_INPUT_FIFO_DEPTH = 2048
 DEFAULT_OUTPUT_FIFO_DEPTH = 2048

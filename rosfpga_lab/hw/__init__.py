@@ -25,6 +25,9 @@ A bad frame raises a :class:`PipelineError` subclass naming the field and byte o
 has been reset and the next good frame comes out right. ``Pipeline(model="reference")`` runs
 the byte/beat-at-a-time models (small images: a 160x120 frame takes about half a second).
 
+The circuit's one layout (every field in wire order and what the circuit does with it) is
+derived from a ``.msg`` and the configuration by :func:`derive_layout` (module ``layout``).
+
 Stages (``reference`` / ``fast``), importable for notebooks:
 
 * receive FIFO: :func:`receive_reference` / :func:`receive_fast_check` (module ``rx``);
@@ -59,6 +62,7 @@ from rosfpga_lab.hw.interpreter import (
     interpret_fast,
     interpret_reference,
 )
+from rosfpga_lab.hw.layout import Layout, derive_layout, format_layout
 from rosfpga_lab.hw.morph import OPS, morph_fast, morph_reference
 from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame, wire_bytes
 from rosfpga_lab.hw.rx import receive_fast_check, receive_reference
@@ -80,4 +84,5 @@ __all__ = [
     "format_table", "frame_length", "generate_fast", "generate_reference", "image_frame", "interpret_fast",
     "interpret_reference", "mat2axivideo_fast", "mat2axivideo_reference", "morph_fast",
     "morph_reference", "pixel_format", "receive_fast_check", "receive_reference",
+    "Layout", "derive_layout", "format_layout",
 ]

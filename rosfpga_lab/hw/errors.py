@@ -106,3 +106,16 @@ class FifoOverflowError(PipelineError):
         self.depth = depth
         self.needed = needed
         super().__init__(message, stage)
+
+
+class LayoutError(PipelineConfigError):
+    """A circuit layout cannot be derived: a key names a missing field or one it cannot take.
+
+    Attributes:
+        key: the configuration key at fault, dotted (``stream.field``, ``checks.height``,
+            ``limits.points``), so a configuration loader can point at its line.
+    """
+
+    def __init__(self, message: str, key: str = "") -> None:
+        self.key = key
+        super().__init__(f"{key}: {message}" if key else message, "layout")
