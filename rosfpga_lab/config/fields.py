@@ -10,8 +10,11 @@ into its own error.
 
 from __future__ import annotations
 
+from typing import Any
+
 from rosfpga_lab.config.vocabulary import STREAM_ELEMENT_TYPES
 from rosfpga_lab.msg import BUILTIN_TYPES, Field, MsgRegistry
+from rosfpga_lab.msg.builtins import FLOAT_TYPES, integer_bounds
 
 
 class FieldPathError(ValueError):
@@ -98,3 +101,20 @@ def check_field(reg: MsgRegistry, type_name: str, path: str) -> Field:
         raise FieldPathError(f"{path} is a {f.type}: a check compares one number, bool or "
                              "string")
     return f
+
+
+def check_value_problem(type_: str, value: Any) -> str | None:
+    """Why ``value`` cannot be compared with a field of builtin ``type_``, or None."""
+    if type_ == "string":
+        ok = isinstance(value, str)
+    elif type_ == "bool":
+        ok = isinstance(value, bool)
+    elif type_ in FLOAT_TYPES:
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+    else:
+        ok = isinstance(value, int) and not isinstance(value, bool)
+        if ok:
+            lo, hi = integer_bounds(type_)
+            if not lo <= value <= hi:
+                return f"{value} does not fit a {type_} ({lo}..{hi})"
+    return None if ok else f"{value!r} is not a {type_} value"

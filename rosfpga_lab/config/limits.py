@@ -40,8 +40,13 @@ MAX_CLOCK_MHZ = 1000.0
 DEFAULT_MASTER_PORT = 11311
 DEFAULT_MASTER_URI = f"http://127.0.0.1:{DEFAULT_MASTER_PORT}/"
 DEFAULT_IP_ADDRESS = "127.0.0.1"
-#: The only message type that can stream through the circuit.
+#: The message type with a video stream (``image:`` gives its geometry), the default type.
 IMAGE_TYPE = "sensor_msgs/Image"
+#: Its streamed array, and the fields ``image:`` implies a check on (equal to the geometry).
+IMAGE_STREAM_FIELD = "data"
+IMAGE_IMPLIED_CHECKS = ("height", "width", "encoding", "step")
+#: Longest ``encoding`` string an Image circuit stores.
+IMAGE_MAX_ENCODING_BYTES = 32
 #: Largest configuration file read (bytes).
 MAX_CONFIG_BYTES = 1 << 20
 #: FPGA part of the HLS project script (the Zynq-7020 of the paper's class of boards).

@@ -54,15 +54,16 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config import limits as config_limits
 from rosfpga_lab.config.fields import (
-    FieldPathError, check_field, limit_field, resolve_field, stream_field,
+    FieldPathError, check_field, check_value_problem, limit_field, resolve_field, stream_field,
 )
 from rosfpga_lab.config.vocabulary import STREAM_ELEMENT_TYPES
 from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.errors import LayoutError
 from rosfpga_lab.msg import MsgRegistry
-from rosfpga_lab.msg.builtins import SCALARS, TIME_CLASS, integer_bounds
+from rosfpga_lab.msg.builtins import SCALARS, TIME_CLASS
 from rosfpga_lab.msg.decode import min_size
 
 
@@ -421,20 +422,9 @@ def _user_check(reg: MsgRegistry, type_name: str, path: str, spec: Any, status: 
 
 
 def _value_problem(base: str, value: Any, key: str) -> None:
-    if base == "string":
-        ok = isinstance(value, str)
-    elif base == "bool":
-        ok = isinstance(value, bool)
-    elif base in ("float32", "float64"):
-        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-    else:
-        ok = isinstance(value, int) and not isinstance(value, bool)
-        if ok:
-            lo, hi = integer_bounds(base)
-            if not lo <= value <= hi:
-                raise LayoutError(f"{value} does not fit a {base} ({lo}..{hi})", key)
-    if not ok:
-        raise LayoutError(f"{value!r} is not a {base} value", key)
+    problem = check_value_problem(base, value)
+    if problem:
+        raise LayoutError(problem, key)
 
 
 def derive_layout(reg: MsgRegistry, type_name: str, *, stream: str | None,
@@ -691,3 +681,45 @@ __all__ = [
     "VideoShape", "STREAM_ELEMENT_TYPES", "derive_layout", "encode_token", "format_layout",
     "frame_geometry", "marshal", "tokens",
 ]
+
+
+def layout_from_config(config: NodeConfig, reg: MsgRegistry | None = None, *,
+                       output: bool = False) -> Layout:
+    """The layout of a node configuration's subscribed (or, with ``output``, published) type.
+
+    ``sensor_msgs/Image``: stream ``data`` with the video shape of ``image:``, checks of
+    ``height``, ``width``, ``encoding`` and ``step`` equal to it, ``encoding`` at most
+    ``hw.limits.MAX_ENCODING_BYTES``. Every type: ``header.frame_id`` (when there is one) at most
+    ``frame_id_max`` unless ``limits:`` says otherwise.
+
+    Args:
+        config: a loaded configuration.
+        reg: its registry (default: ``config.registry()``).
+        output: the publisher's type instead of the subscriber's.
+    """
+    reg = reg or config.registry()
+    type_name = config.publisher.type if output else config.subscriber.type
+    assert config.stream is not None
+    checks: dict[str, Any] = {c.path: c.spec for c in config.checks}
+    maxima: dict[str, int] = {}
+    try:
+        resolve_field(reg, type_name, _FRAME_ID)
+        maxima[_FRAME_ID] = config.frame_id_max
+    except FieldPathError:
+        pass
+    video = None
+    length = config.stream.length
+    if config.is_image and type_name == config_limits.IMAGE_TYPE:
+        im = config.image  # (its data_bytes: a replaced image: keeps the stream in step)
+        checks.update(height=im.height, width=im.width, encoding=im.encoding, step=im.step)
+        maxima["encoding"] = limits.MAX_ENCODING_BYTES
+        video = VideoShape(im.width, im.height, im.encoding, im.bytes_per_pixel)
+        length = im.data_bytes
+    maxima.update(config.limits)
+    return derive_layout(reg, type_name, stream=config.stream.field,
+                         stream_length=length, checks=checks, limits_=maxima,
+                         skip=config.skip, video=video)
+
+
+_FRAME_ID = "header.frame_id"
+__all__ += ["layout_from_config"]
