@@ -37,7 +37,7 @@ def nested_program(length: int = 5) -> Program:
     """A custom walk with checks, constants, zeros, loops nested two deep and a stream in the middle."""
     instrs = [
         Instr(Op.FIXED, Sub.CHECK, Pub.CONST, 2, status=2, const=b"\x07\x00", name="version", type="uint16"),
-        Instr(Op.VAR, Sub.CHECK, Pub.CONST, 1, 8, status=3, const=b"abc", name="kind", type="string"),
+        Instr(Op.VAR, Sub.CHECK, Pub.CONST, 1, 8, status=3, status2=6, const=b"abc", name="kind", type="string"),
         Instr(Op.LOOP, Sub.CARRY, Pub.CARRY, 0, 3, variable=True, status=4, name="points", type="Point[]"),
         Instr(Op.FIXED, Sub.CARRY, Pub.CARRY, 8, name="points.x", type="float64"),
         Instr(Op.VAR, Sub.CARRY, Pub.CARRY, 1, 6, status=5, name="points.label", type="string"),

@@ -12,15 +12,20 @@ version, :mod:`rosfpga_lab.hls.generator`).
 
 from __future__ import annotations
 
+import struct
 from dataclasses import dataclass
 from pathlib import Path
 
 import jinja2
+import numpy as np
 
 from rosfpga_lab import __version__
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.generator import HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
-from rosfpga_lab.hls.program import MAX_LOOP_DEPTH, Op, Program, Pub, Sub
+from rosfpga_lab.config import NodeConfig
+from rosfpga_lab.hls.program import FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub
+from rosfpga_lab.hw.layout import Action, CheckOp, Layout, Step, StepKind
+from rosfpga_lab.msg.builtins import SCALARS
 
 GENERIC_DIR = TEMPLATES_DIR / "generic"
 #: Output file -> template of a generic project (``stream_filter.cpp`` is the user's for custom).
@@ -93,7 +98,8 @@ def _hex_rows(data: bytes) -> list[str]:
             for i in range(0, len(data), HEX_BYTES_PER_LINE)]
 
 
-_SUB_WORD = {Sub.SKIP: "skip", Sub.CARRY: "carry", Sub.CHECK: "check", Sub.STREAM: "stream"}
+_SUB_WORD = {Sub.SKIP: "skip", Sub.CARRY: "carry", Sub.CHECK: "check", Sub.STREAM: "stream",
+             Sub.RANGE: "carry, check bounds"}
 _PUB_WORD = {Pub.CARRY: "as received", Pub.CONST: "constant", Pub.COUNT: "message number",
              Pub.ZERO: "zero / empty", Pub.STREAM: "the application's output"}
 
@@ -118,6 +124,8 @@ def instruction_rows(prog: Program) -> list[dict[str, object]]:
             check = ""
             if ins.sub == Sub.CHECK:
                 check = f", must be {ins.const!r}"
+            elif ins.sub == Sub.RANGE:
+                check = f" {ins.const[:ins.size].hex()}..{ins.const[ins.size:].hex()} (LE hex)"
             comment = (f"{indent}{ins.name} ({ins.type}): {what}; {_SUB_WORD[ins.sub]}{check}; "
                        f"out: {_PUB_WORD[ins.pub]}")
         if ins.op == Op.LOOP:
@@ -126,7 +134,8 @@ def instruction_rows(prog: Program) -> list[dict[str, object]]:
             "pc": pc, "op_c": f"OP_{ins.op.name}", "sub_c": f"SUB_{ins.sub.name}",
             "pub_c": f"PUB_{ins.pub.name}", "op": int(ins.op), "sub": int(ins.sub),
             "pub": int(ins.pub), "size": ins.size, "count": ins.count,
-            "variable": ins.variable, "status": ins.status,
+            "variable": ins.variable, "status": ins.status, "status2": ins.status2,
+            "kind": ins.kind,
             "kaddr": prog.const_offsets[pc], "klen": len(ins.const), "jump": ins.jump,
             "comment": comment.replace("*/", "* /"), "name": ins.name, "type": ins.type,
             "sub_word": _SUB_WORD[ins.sub] if ins.op in (Op.FIXED, Op.VAR) else "-",
@@ -238,3 +247,177 @@ def render_generic(spec: GenericSpec) -> dict[str, str]:
             continue
         out[target] = env.get_template(template).render(ctx)
     return out
+
+
+# -- from the circuit layout (rosfpga_lab.hw.layout) to the walkers' program --------------------
+
+def _kind_of(dtype: str) -> int:
+    return {"u": 0, "b": 0, "i": 1, "f": 2}[np.dtype(dtype).kind]
+
+
+def _scalar_bytes(step: Step, value: object) -> bytes:
+    return struct.pack("<" + SCALARS[step.type].struct_char, value)
+
+
+def _bounds(step: Step, low: object, high: object) -> bytes:
+    dt = np.dtype(step.dtype)
+    if dt.kind == "f":
+        lo = -np.inf if low is None else low
+        hi = np.inf if high is None else high
+    else:
+        info = np.iinfo(dt) if dt.kind in "iu" else np.iinfo(np.uint8)
+        lo = info.min if low is None else low
+        hi = info.max if high is None else high
+    return _scalar_bytes(step, lo) + _scalar_bytes(step, hi)
+
+
+def _scalar_instr(step: Step, code: dict[str, int], label: str) -> Instr:
+    common = {"size": step.size, "name": label, "type": step.type}
+    if step.action is Action.SKIP:
+        return Instr(Op.FIXED, Sub.SKIP, Pub.ZERO, **common)  # type: ignore[arg-type]
+    if step.action is not Action.CHECK or step.check is None:
+        return Instr(Op.FIXED, Sub.CARRY, Pub.CARRY, **common)  # type: ignore[arg-type]
+    chk = step.check
+    status = code[chk.status]
+    kind = _kind_of(step.dtype)
+    if chk.op is CheckOp.EQUAL and kind != 2:
+        return Instr(Op.FIXED, Sub.CHECK, Pub.CONST, status=status,  # type: ignore[arg-type]
+                     const=_scalar_bytes(step, chk.value), **common)
+    # a float's equality is the range [v, v] (so -0.0 == +0.0 and NaN equals nothing)
+    low, high = (chk.value, chk.value) if chk.op is CheckOp.EQUAL else (chk.low, chk.high)
+    return Instr(Op.FIXED, Sub.RANGE, Pub.CARRY, status=status, kind=kind,  # type: ignore[arg-type]
+                 const=_bounds(step, low, high), **common)
+
+
+def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Program:
+    """The walkers' program of a circuit layout (one instruction per field, names from it).
+
+    A length prefix and the string or array it counts become one ``VAR`` instruction; an array
+    of messages, strings or times a ``LOOP``/``END`` pair; the checks, maxima and statuses are
+    the layout's. Skipped fields are written as zeros (empty strings and arrays).
+
+    Raises:
+        GenerateError: the layout has no stream, or a video stream (Image keeps its own project).
+    """
+    if layout.stream_index is None:
+        raise GenerateError(f"the layout of {layout.type_name} has no stream: nothing to generate")
+    if layout.video is not None:
+        raise GenerateError("a video stream (sensor_msgs/Image) has its own project "
+                            "(rosfpga_lab.hls.generator)")
+    code = {name: i for i, (name, _label) in enumerate(layout.statuses)}
+    steps = layout.steps
+    frame = steps[0]
+    assert frame.check is not None and code[frame.check.status] == FRAME_LENGTH_STATUS
+    instrs: list[Instr] = []
+    carry = 0
+    mult = [1]
+    i = 1
+    while i < len(steps):
+        s = steps[i]
+        if s.kind is StepKind.LENGTH:
+            target = steps[s.partner] if s.partner is not None else None
+            assert target is not None and s.check is not None
+            status = code[s.check.status]
+            keep = s.action in (Action.CARRY, Action.CHECK)
+            if target.kind is StepKind.LOOP:
+                instrs.append(Instr(Op.LOOP, Sub.CARRY if keep else Sub.SKIP,
+                                    Pub.CARRY if keep else Pub.ZERO, 0, target.max_count,
+                                    variable=True, status=status, name=target.label,
+                                    type=f"{target.type}[]"))
+                carry += 4 * mult[-1] if keep else 0
+                mult.append(mult[-1] * target.max_count)
+                i = target.index + 1
+                continue
+            n = layout.stream_length if target.action is Action.STREAM else target.max_count
+            if target.action is Action.STREAM:
+                sub, pub = Sub.STREAM, Pub.STREAM
+            elif target.action is Action.SKIP:
+                sub, pub = Sub.SKIP, Pub.ZERO
+            elif target.check is not None:
+                sub, pub = Sub.CHECK, Pub.CONST
+            else:
+                sub, pub = Sub.CARRY, Pub.CARRY
+            const = b""
+            status2 = 0
+            if sub == Sub.CHECK:
+                assert target.check is not None and target.check.op is CheckOp.EQUAL
+                const = str(target.check.value).encode("utf-8")
+                status2 = code[target.check.status]
+            if sub == Sub.CARRY:
+                carry += (4 + n * target.size) * mult[-1]
+            instrs.append(Instr(Op.VAR, sub, pub, target.size, n, status=status, status2=status2,
+                                const=const, name=target.label,
+                                type=target.type if target.kind is StepKind.STRING
+                                else f"{target.type}[]"))
+            i = target.index + 1
+            continue
+        if s.kind is StepKind.SCALAR:
+            ins = _scalar_instr(s, code, s.label)
+            carry += ins.size * mult[-1] if ins.sub in (Sub.CARRY, Sub.RANGE) else 0
+            instrs.append(ins)
+        elif s.kind is StepKind.ARRAY:  # a fixed-length array of numbers
+            assert s.count is not None
+            sub, pub = {Action.STREAM: (Sub.STREAM, Pub.STREAM), Action.SKIP: (Sub.SKIP, Pub.ZERO)
+                        }.get(s.action, (Sub.CARRY, Pub.CARRY))
+            carry += s.size * s.count * mult[-1] if sub == Sub.CARRY else 0
+            instrs.append(Instr(Op.FIXED, sub, pub, s.size * s.count, name=s.label,
+                                type=f"{s.type}[{s.count}]"))
+        elif s.kind is StepKind.LOOP:  # fixed count (a variable one starts at its LENGTH)
+            assert s.count is not None
+            instrs.append(Instr(Op.LOOP, Sub.SKIP, Pub.CARRY, 0, s.count, name=s.label,
+                                type=f"{s.type}[{s.count}]"))
+            mult.append(mult[-1] * s.count)
+        elif s.kind is StepKind.END:
+            instrs.append(Instr(Op.END, name=s.label))
+            mult.pop()
+        else:
+            raise GenerateError(f"step {i} ({s.kind} {s.label}) has no length step before it")
+        i += 1
+    instrs.append(Instr(Op.DONE, status=FRAME_LENGTH_STATUS, name="", type=""))
+    stream = layout.stream
+    return Program.build(
+        instrs, statuses=layout.statuses, min_body=int(frame.check.low),
+        max_frame=int(max_frame if max_frame is not None else frame.check.high),
+        seq_start=1, stream_bytes=stream.size, stream_length=layout.stream_length,
+        carry_bytes=carry, type_in=layout.type_name, type_out=layout.type_name)
+
+
+#: ``kind`` of :class:`GenericSpec` per numpy dtype kind of the stream's elements.
+_KIND_NAMES = {"u": "unsigned", "i": "signed", "f": "float"}
+
+
+def spec_from_config(config: NodeConfig) -> GenericSpec:
+    """The generic project of a node configuration (a type other than ``sensor_msgs/Image``).
+
+    Raises:
+        GenerateError: the configuration's types differ (the generic publisher re-sends the
+            subscribed type), or its layout cannot be rendered (see :func:`program_from_layout`).
+    """
+    from rosfpga_lab.hw.layout import layout_from_config
+    from rosfpga_lab.tcpros import TopicSpec, publisher_reply_fields, subscriber_request_fields
+
+    if config.publisher.type != config.subscriber.type:
+        raise GenerateError(f"publisher.type {config.publisher.type} differs from subscriber.type "
+                            f"{config.subscriber.type}: the generated circuit publishes the type "
+                            "it subscribes to")
+    reg = config.registry()
+    layout = layout_from_config(config, reg)
+    prog = program_from_layout(layout)
+    t = config.subscriber.type
+    stream = layout.stream
+    sub_header = subscriber_request_fields(
+        callerid=config.node.global_name, topic=config.subscriber.topic, md5sum=reg.md5(t),
+        type_name=t, message_definition=reg.full_text(t), tcp_nodelay=True)
+    pub_header = publisher_reply_fields(config.node.global_name, TopicSpec(
+        config.publisher.topic, t, reg.md5(t), reg.full_text(t)))
+    app = config.application
+    return GenericSpec(
+        program=prog, node_name=config.node.global_name, sub_topic=config.subscriber.topic,
+        pub_topic=config.publisher.topic, master_uri=config.node.master_uri,
+        ip_address=config.node.ip_address, input_depth=config.fifo.input_depth,
+        output_depth=config.fifo.output_depth, axis_depth=config.fifo.axis_depth,
+        part=config.part, clock_mhz=config.clock_mhz, op=app.op, ksize=app.ksize,
+        kind=_KIND_NAMES[np.dtype(stream.dtype).kind], stream_name=stream.label,
+        stream_type=f"{stream.type}[]" if stream.count is None else f"{stream.type}[{stream.count}]",
+        subscriber_header=sub_header, publisher_header=pub_header,
+        config_name=config.path.name if config.path else "<string>", custom_source=app.source)

@@ -53,6 +53,7 @@ class Sub(IntEnum):
     CARRY = 1
     CHECK = 2
     STREAM = 3
+    RANGE = 4
 
 
 class Pub(IntEnum):
@@ -75,7 +76,11 @@ class Instr:
         count: VAR: most elements accepted (for a stream: the exact count);
             LOOP: elements of a fixed array, or the most accepted of a variable one.
         variable: LOOP: the count is read from the frame (a uint32) rather than fixed.
-        status: the status code the subscriber refuses with at this field (0: it cannot fail).
+        status: the status code the subscriber refuses with at this field (0: it cannot fail);
+            for VAR, a bad count.
+        status2: VAR with CHECK: the status of contents unlike the constant.
+        kind: RANGE: how the value is ordered: 0 unsigned, 1 signed, 2 IEEE float (a NaN is out
+            of every range, -0.0 equals +0.0).
         const: CHECK/CONST: the bytes (VAR: the elements' bytes, count = len // size).
         name: the field's path in the message, e.g. ``header.frame_id``.
         type: its ROS type, e.g. ``string`` or ``float32[]``.
@@ -89,6 +94,8 @@ class Instr:
     count: int = 0
     variable: bool = False
     status: int = 0
+    status2: int = 0
+    kind: int = 0
     const: bytes = b""
     name: str = ""
     type: str = ""
@@ -169,6 +176,40 @@ class Refused(Exception):
         self.streamed = streamed
 
 
+#: The status of a frame whose length is refused, or which ends inside a field or after the last.
+FRAME_LENGTH_STATUS = 1
+
+
+def order_key(b: bytes, kind: int) -> int:
+    """The unsigned key a value's little-endian bytes order by (``kind`` as :attr:`Instr.kind`):
+    two's complement flips the sign bit, IEEE floats map by totalOrder with -0.0 taken as +0.0."""
+    v = int.from_bytes(b, "little")
+    sign = 1 << (8 * len(b) - 1)
+    if kind == 1:
+        return v ^ sign
+    if kind == 2:
+        if v == sign:
+            v = 0
+        return (~v & (2 * sign - 1)) if v & sign else v | sign
+    return v
+
+
+def is_nan(b: bytes) -> bool:
+    """The bytes of a float32/float64 hold a NaN."""
+    v = int.from_bytes(b, "little")
+    mant = 23 if len(b) == 4 else 52
+    exp = (v >> mant) & ((1 << (8 * len(b) - 1 - mant)) - 1)
+    return exp == (1 << (8 * len(b) - 1 - mant)) - 1 and v & ((1 << mant) - 1) != 0
+
+
+def in_range(b: bytes, bounds: bytes, kind: int) -> bool:
+    """``b`` is within ``bounds`` (low bytes then high bytes), ordered by ``kind``."""
+    n = len(b)
+    if kind == 2 and is_nan(b):
+        return False
+    return order_key(bounds[:n], kind) <= order_key(b, kind) <= order_key(bounds[n:], kind)
+
+
 def _u32(b: bytes) -> int:
     return int.from_bytes(b, "little")
 
@@ -196,7 +237,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
     def take(n: int, status: int) -> bytes:
         nonlocal pos
         if pos + n > end:
-            raise Refused(status, bool(stream))
+            raise Refused(FRAME_LENGTH_STATUS, bool(stream))
         b = frame[pos:pos + n]
         pos += n
         return b
@@ -211,9 +252,11 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
             return bytes(carry), bytes(stream), out_len
         if ins.op == Op.FIXED:
             b = take(ins.size, ins.status)
-            if ins.sub == Sub.CARRY:
+            if ins.sub in (Sub.CARRY, Sub.RANGE):
                 carry += b
-            elif ins.sub == Sub.CHECK and b != ins.const:
+            if ins.sub == Sub.CHECK and b != ins.const:
+                raise Refused(ins.status, bool(stream))
+            if ins.sub == Sub.RANGE and not in_range(b, ins.const, ins.kind):
                 raise Refused(ins.status, bool(stream))
             elif ins.sub == Sub.STREAM:
                 stream += b
@@ -229,7 +272,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
             if ins.sub == Sub.CARRY:
                 carry += lb + b
             elif ins.sub == Sub.CHECK and b != ins.const:
-                raise Refused(ins.status, bool(stream))
+                raise Refused(ins.status2, bool(stream))
             elif ins.sub == Sub.STREAM:
                 stream += b
             if not quiet:
