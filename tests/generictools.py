@@ -3,6 +3,8 @@ and a numpy oracle of the 1-D applications written independently of the circuit.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from rosfpga_lab.hls.generic import GenericSpec
@@ -70,17 +72,14 @@ def spec_for(prog: Program, op: str = "dilate", ksize: int = 3, kind: str = "flo
 
 
 def window_oracle(data: bytes, dtype: str, ksize: int, op: str) -> bytes:
-    """numpy's max/min over the in-array part of each window (two zeros: +0.0 wins max)."""
+    """numpy's maximum/minimum folded over the in-array part of each window, oldest first."""
     x = np.frombuffer(data, dtype=np.dtype(dtype))
     if op == "passthrough":
         return data
     half = ksize // 2
+    pick = np.maximum if op == "dilate" else np.minimum
     out = np.empty_like(x)
-    for i in range(len(x)):
-        win = x[max(0, i - half):i + half + 1]
-        v = win.max() if op == "dilate" else win.min()
-        if x.dtype.kind == "f" and v == 0:
-            signs = np.signbit(win[win == 0])
-            v = x.dtype.type(-0.0 if (signs.all() if op == "dilate" else signs.any()) else 0.0)
-        out[i] = v
+    with np.errstate(invalid="ignore"):
+        for i in range(len(x)):
+            out[i] = functools.reduce(pick, x[max(0, i - half):i + half + 1])
     return out.tobytes()

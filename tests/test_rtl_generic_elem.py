@@ -5,13 +5,15 @@ Each case compiles the file-based testbench ``rfl_elem_tb.v`` with its parameter
 whole arrays through it with random input gaps and output backpressure, and compares the bytes
 out with a numpy oracle written here: for every element, ``np.max``/``np.min`` over the in-array
 part of the window of ``ksize`` elements centred on it (OpenCV's border). Floats mix negatives,
-zeros of both signs, subnormals and infinities; where two zeros tie, the circuit's documented rule
-(max -> +0.0, min -> -0.0: IEEE totalOrder) decides the sign. TUSER/TLAST placement is checked by
+zeros of both signs, subnormals, infinities and (two cases) NaNs with payloads: the oracle folds
+numpy's own ``np.maximum``/``np.minimum`` over each window oldest first, the order
+``rosfpga_lab.hw.morph1d`` defines (of -0.0 and +0.0 the later wins; a NaN's bits spread). TUSER/TLAST placement is checked by
 the testbench itself. Verilator's ``--lint-only -Wall`` runs on every parameter set too.
 """
 
 from __future__ import annotations
 
+import functools
 import subprocess
 from pathlib import Path
 
@@ -39,6 +41,8 @@ CASES = {
     "f64-dilate-k5": ("f8", 20, 5, "dilate", 2, 200, 400),
     "f64-erode-k3": ("f8", 20, 3, "erode", 2, 200, 400),
     "f32-passthrough": ("f4", 6, 3, "passthrough", 2, 300, 300),
+    "f32-dilate-k5-nan": ("f4", 16, 5, "dilate", 2, 200, 200),
+    "f64-erode-k3-nan": ("f8", 16, 3, "erode", 2, 200, 200),
 }
 
 
@@ -46,33 +50,34 @@ def kind_of(dtype: np.dtype) -> str:
     return {"u": "unsigned", "i": "signed", "f": "float"}[dtype.kind]
 
 
-def values(dtype: np.dtype, n: int, rng: np.random.Generator) -> np.ndarray:
+def values(dtype: np.dtype, n: int, rng: np.random.Generator, with_nan: bool = False) -> np.ndarray:
     if dtype.kind == "f":
         special = np.array([0.0, -0.0, np.inf, -np.inf, 1e-40 if dtype.itemsize == 4 else 5e-324,
                             -1.5, 2.5, -1e30, 1e30], dtype=dtype)
+        nans = np.array([0x7fc00001, 0xffc00002, 0x7f800003] if dtype.itemsize == 4 else
+                        [0x7ff8000000000001, 0xfff8000000000002, 0x7ff0000000000003],
+                        dtype=np.uint32 if dtype.itemsize == 4 else np.uint64).view(dtype)
         x = (rng.standard_normal(n) * 100).astype(dtype)
         pick = rng.random(n) < 0.4
         x[pick] = rng.choice(special, pick.sum())
+        if with_nan:
+            x[rng.integers(0, n, 2)] = rng.choice(nans, 2)
         return x
     info = np.iinfo(dtype)
     return rng.integers(info.min, info.max, n, dtype=dtype, endpoint=True)
 
 
 def oracle(x: np.ndarray, ksize: int, op: str) -> np.ndarray:
-    """The expected elements: numpy's extreme over the in-array part of each window."""
+    """The expected elements: numpy's maximum/minimum folded over the in-array part of each
+    window, oldest element first (ties of -0.0/+0.0: the later; NaN: the first NaN)."""
     if op == "passthrough":
         return x.copy()
     half = ksize // 2
+    pick = np.maximum if op == "dilate" else np.minimum
     out = np.empty_like(x)
-    for i in range(len(x)):
-        win = x[max(0, i - half):i + half + 1]
-        v = win.max() if op == "dilate" else win.min()
-        if x.dtype.kind == "f" and v == 0:   # two zeros: totalOrder (+0.0 > -0.0)
-            zeros = win[win == 0]
-            signs = np.signbit(zeros)
-            neg = signs.all() if op == "dilate" else signs.any()
-            v = x.dtype.type(-0.0 if neg else 0.0)
-        out[i] = v
+    with np.errstate(invalid="ignore"):
+        for i in range(len(x)):
+            out[i] = functools.reduce(pick, x[max(0, i - half):i + half + 1])
     return out
 
 
@@ -93,7 +98,7 @@ def test_element_stream_equals_numpy(name: str, tmp_path: Path) -> None:
     code, length, ksize, op, arrays, gap, bp = CASES[name]
     dtype = np.dtype("<" + code)
     rng = np.random.default_rng(sum(map(ord, name)))
-    data = [values(dtype, length, rng) for _ in range(arrays)]
+    data = [values(dtype, length, rng, name.endswith("nan")) for _ in range(arrays)]
     params = {"EBYTES": dtype.itemsize, "LENGTH": length, "KSIZE": ksize,
               "OP": OP_CODES_1D[op], "KIND": KIND_CODES[kind_of(dtype)]}
     exe = compile_tb(tmp_path, params)

@@ -47,10 +47,10 @@ GENERIC_SOURCES = ("subscriber.cpp", "publisher.cpp", "stream_filter.cpp", "ros_
                    "connection_headers.cpp", "csim_testbench.cpp")
 #: How each element kind is ordered, said in the application's comment.
 KIND_NOTES = {
-    "unsigned": "unsigned integers.",
-    "signed": "two's-complement integers.",
-    "float": "IEEE totalOrder (-inf < negatives < -0.0 < +0.0 < positives < +inf; a NaN with "
-             "the sign clear ranks above +inf, one with it set below -inf).",
+    "unsigned": "unsigned integers",
+    "signed": "two's-complement integers",
+    "float": "IEEE floats by value: -0.0 equals +0.0, so of two zeros the later wins; a window "
+             "with a NaN gives its first NaN, bits unchanged",
 }
 
 

@@ -5,13 +5,11 @@
 // TLAST on its last; one beat per clock when the output is ready.
 //
 // Ordering (KIND): 0 unsigned integers, 1 two's-complement signed integers, 2 IEEE-754 floats
-// (EBYTES 4: float32, 8: float64). Floats are compared by IEEE totalOrder: each value maps to
-// an unsigned key (sign clear: the bits with the sign set; sign set: all bits inverted), so
-// -inf < negatives < -0.0 < +0.0 < positives < +inf, which is numpy's maximum/minimum on every
-// pair of non-NaN values that are not two zeros (numpy then returns either; here the max of
-// -0.0 and +0.0 is +0.0 and the min is -0.0). NaN: a NaN with the sign clear ranks above +inf,
-// one with the sign set below -inf, so a window's maximum is its positive NaN (bits kept) and
-// its minimum its negative NaN, if it has one; numpy would give NaN for both.
+// (EBYTES 4: float32, 8: float64). The window is folded oldest element first as numpy's
+// maximum/minimum fold it (rosfpga_lab.hw.morph1d): acc = max2(acc, x) is acc if acc is NaN,
+// else x if x is NaN, else (acc > x ? acc : x), compared by value (-0.0 equals +0.0, so of two
+// zeros the later one wins); min2 likewise with <. A window holding a NaN gives its first NaN,
+// bits unchanged.
 //
 // How it works: a shift register of KSIZE entries (element, valid, TUSER, TLAST), the newest
 // in entry 0. An element's result is ready once R = KSIZE/2 later elements are in, so it is
@@ -62,28 +60,44 @@ module rfl_window1d #(
     wire [K-1:0]    nw_user = (wuser << 1) | {{(K-1){1'b0}}, step_in && s_axis_tuser};
     wire [K-1:0]    nw_last = (wlast << 1) | {{(K-1){1'b0}}, step_in && s_axis_tlast};
 
-    // The order key of an element (see the header): larger key, larger value.
+    // The order key of an element by value (larger key, larger value; floats: -0.0 as +0.0).
     function [EW-1:0] order_key(input [EW-1:0] x);
         begin
-            if (KIND == 2) order_key = x[EW-1] ? ~x : (x | SIGN);
+            if (KIND == 2) order_key = (x == SIGN) ? SIGN : x[EW-1] ? ~x : (x | SIGN);
             else if (KIND == 1) order_key = x ^ SIGN;
             else order_key = x;
         end
     endfunction
 
-    // The extreme over the valid entries of the new window.
+    /* verilator lint_off UNUSEDSIGNAL */
+    function is_nan(input [EW-1:0] x);
+        reg [63:0] v;                           // x widened (the sign bit is not looked at)
+        begin
+            v = 64'd0;
+            v[EW-1:0] = x;
+            if (KIND != 2) is_nan = 1'b0;
+            else if (EBYTES == 4) is_nan = (v[30:23] == 8'hff) && (v[22:0] != 23'd0);
+            else is_nan = (v[62:52] == 11'h7ff) && (v[51:0] != 52'd0);
+        end
+    endfunction
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    // The fold over the valid entries of the new window, oldest (entry K-1) first.
     reg [EW-1:0] best, cand;
     reg          have;
     integer t;
     always @* begin
         best = {EW{1'b0}};
         have = 1'b0;
-        for (t = 0; t < K; t = t + 1) begin
+        for (t = K - 1; t >= 0; t = t - 1) begin
             cand = nw_data[t*EW +: EW];
             if (nw_val[t]) begin
                 if (!have) best = cand;
-                else if (OP == 1 ? (order_key(cand) < order_key(best))
-                                 : (order_key(cand) > order_key(best))) best = cand;
+                else if (!is_nan(best)) begin
+                    if (is_nan(cand)) best = cand;
+                    else if (OP == 1 ? !(order_key(best) < order_key(cand))
+                                     : !(order_key(best) > order_key(cand))) best = cand;
+                end
                 have = 1'b1;
             end
         end
