@@ -24,7 +24,7 @@ from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.generator import HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hls.program import FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub
-from rosfpga_lab.hw.layout import Action, CheckOp, Layout, Step, StepKind
+from rosfpga_lab.hw.layout import Action, CheckOp, Layout, Step, StepKind, Token, marshal
 from rosfpga_lab.msg.builtins import SCALARS
 
 GENERIC_DIR = TEMPLATES_DIR / "generic"
@@ -135,7 +135,7 @@ def instruction_rows(prog: Program) -> list[dict[str, object]]:
             "pub_c": f"PUB_{ins.pub.name}", "op": int(ins.op), "sub": int(ins.sub),
             "pub": int(ins.pub), "size": ins.size, "count": ins.count,
             "variable": ins.variable, "status": ins.status, "status2": ins.status2,
-            "kind": ins.kind,
+            "kind": ins.kind, "fixed_after": ins.fixed_after, "elem_min": ins.elem_min,
             "kaddr": prog.const_offsets[pc], "klen": len(ins.const), "jump": ins.jump,
             "comment": comment.replace("*/", "* /"), "name": ins.name, "type": ins.type,
             "sub_word": _SUB_WORD[ins.sub] if ins.op in (Op.FIXED, Op.VAR) else "-",
@@ -304,6 +304,9 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
     if layout.video is not None:
         raise GenerateError("a video stream (sensor_msgs/Image) has its own project "
                             "(rosfpga_lab.hls.generator)")
+    from rosfpga_lab.hw.walker import _plan  # the models' fit rule: one owner
+
+    plan = _plan(layout)
     code = {name: i for i, (name, _label) in enumerate(layout.statuses)}
     steps = layout.steps
     frame = steps[0]
@@ -319,11 +322,13 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
             assert target is not None and s.check is not None
             status = code[s.check.status]
             keep = s.action in (Action.CARRY, Action.CHECK)
+            fit = plan.fixed_after[s.index]
+            rule = {"fixed_after": -1 if fit is None else fit, "elem_min": plan.element_min[s.index]}
             if target.kind is StepKind.LOOP:
                 instrs.append(Instr(Op.LOOP, Sub.CARRY if keep else Sub.SKIP,
                                     Pub.CARRY if keep else Pub.ZERO, 0, target.max_count,
                                     variable=True, status=status, name=target.label,
-                                    type=f"{target.type}[]"))
+                                    type=f"{target.type}[]", **rule))
                 carry += 4 * mult[-1] if keep else 0
                 mult.append(mult[-1] * target.max_count)
                 i = target.index + 1
@@ -346,7 +351,7 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
             if sub == Sub.CARRY:
                 carry += (4 + n * target.size) * mult[-1]
             instrs.append(Instr(Op.VAR, sub, pub, target.size, n, status=status, status2=status2,
-                                const=const, name=target.label,
+                                const=const, name=target.label, **rule,
                                 type=target.type if target.kind is StepKind.STRING
                                 else f"{target.type}[]"))
             i = target.index + 1
@@ -421,3 +426,124 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
         stream_type=f"{stream.type}[]" if stream.count is None else f"{stream.type}[{stream.count}]",
         subscriber_header=sub_header, publisher_header=pub_header,
         config_name=config.path.name if config.path else "<string>", custom_source=app.source)
+
+
+# -- test frames and the models' output ----------------------------------------------------------
+
+def _random_value(step: Step, rng: np.random.Generator) -> object:
+    """A value of a SCALAR step that its check (if any) accepts."""
+    chk = step.check
+    if chk is not None and chk.op is CheckOp.EQUAL:
+        return chk.value
+    if step.type == "bool":
+        return bool(rng.integers(0, 2))
+    dt = np.dtype(step.dtype)
+    if dt.kind == "f":
+        if chk is not None and chk.op is CheckOp.RANGE:
+            lo = -1e3 if chk.low is None else float(chk.low)
+            hi = 1e3 if chk.high is None else float(chk.high)
+            return float(dt.type(lo + (hi - lo) * rng.random()))
+        return float(dt.type(rng.standard_normal() * 100))
+    info = np.iinfo(dt)
+    lo, hi = int(info.min), int(info.max)
+    if chk is not None and chk.op is CheckOp.RANGE:
+        lo = lo if chk.low is None else int(chk.low)
+        hi = hi if chk.high is None else int(chk.high)
+    return int(rng.integers(lo, hi, endpoint=True))
+
+
+def sample_tokens(layout: Layout, rng: np.random.Generator, *, stream_count: int | None = None,
+                  items: int = 2) -> list[Token]:
+    """Random values of a message in the layout's walk order, within its checks and maxima:
+    at most ``items`` elements per variable array or string of characters other than the stream
+    (``stream_count`` elements for it: default, the length the circuit was built for)."""
+    steps = layout.steps
+    toks: list[Token] = []
+    counts: dict[int, int] = {}
+
+    def walk(lo: int, hi: int, at: tuple[int, ...]) -> None:
+        i = lo
+        while i < hi:
+            s = steps[i]
+            if s.kind is StepKind.LOOP:
+                assert s.partner is not None
+                n = s.count if s.count is not None else counts[s.length_step or 0]
+                for k in range(n):
+                    walk(i + 1, s.partner, at + (k,))
+                i = s.partner + 1
+                continue
+            if s.kind is StepKind.LENGTH:
+                part = steps[s.partner] if s.partner is not None else s
+                if part.action is Action.STREAM:
+                    n = layout.stream_length if stream_count is None else stream_count
+                elif part.check is not None and part.check.op is CheckOp.EQUAL:
+                    n = len(str(part.check.value).encode("utf-8"))
+                else:
+                    n = int(rng.integers(0, min(items, part.max_count), endpoint=True))
+                counts[i] = n
+                toks.append(Token(i, n, at))
+            elif s.kind is StepKind.SCALAR:
+                toks.append(Token(i, _random_value(s, rng), at))
+            elif s.kind is StepKind.STRING:
+                n = counts[s.length_step or 0]
+                value = (str(s.check.value) if s.check is not None and s.check.op is CheckOp.EQUAL
+                         else "".join(chr(c) for c in rng.integers(97, 123, n)))
+                toks.append(Token(i, value, at))
+            elif s.kind is StepKind.ARRAY:
+                n = s.count if s.count is not None else counts[s.length_step or 0]
+                dt = np.dtype(s.dtype)
+                if dt.kind == "f":
+                    arr = (rng.standard_normal(n) * 10).astype(dt)
+                    arr[rng.random(n) < 0.1] = 0.0
+                elif dt.kind == "b":
+                    arr = rng.integers(0, 2, n).astype(dt)
+                else:
+                    info = np.iinfo(dt)
+                    arr = rng.integers(info.min, info.max, n, dtype=dt, endpoint=True)
+                toks.append(Token(i, arr, at))
+            i += 1
+
+    walk(1, len(steps), ())
+    return toks
+
+
+def model_output(layout: Layout, op: str, ksize: int, frames: list[bytes]) -> tuple[bytes, list[str]]:
+    """What the lab's Python models (``hw.walker`` fast model, ``hw.morph1d``) publish for
+    ``frames``, one whole frame each, and the refusal (``""`` for accepted) per frame."""
+    from rosfpga_lab.hw.errors import FrameFieldError
+    from rosfpga_lab.hw.morph1d import morph1d_fast
+    from rosfpga_lab.hw.walker import extract_fast, publish_fast
+
+    out = bytearray()
+    why = []
+    for frame in frames:
+        try:
+            ex = extract_fast(layout, frame)
+        except FrameFieldError as exc:
+            why.append(str(exc))
+            continue
+        why.append("")
+        out += publish_fast(layout, ex.tokens, morph1d_fast(np.asarray(ex.stream), op, ksize))
+    return bytes(out), why
+
+
+def sample_frames_generic(layout: Layout, op: str, ksize: int, *, seed: int = 20240606
+                          ) -> tuple[bytes, bytes]:
+    """The testbench's input (a good frame, a refused one, another good one) and what the
+    models publish for it (``op: custom``: no expected output).
+
+    The refused frame's stream has one element too few when the stream has a variable length,
+    else the frame has one byte too many; both are refused before anything is published.
+    """
+    rng = np.random.default_rng(seed)
+    good = [marshal(layout, sample_tokens(layout, rng)) for _ in range(2)]
+    if layout.stream.is_variable and layout.stream_length > 0:
+        bad = marshal(layout, sample_tokens(layout, rng, stream_count=layout.stream_length - 1))
+    else:
+        body = marshal(layout, sample_tokens(layout, rng))[4:] + b"\0"
+        bad = struct.pack("<I", len(body)) + body
+    frames = [good[0], bad, good[1]]
+    if op == "custom":
+        return b"".join(frames), b""
+    expected, _why = model_output(layout, op, ksize, frames)
+    return b"".join(frames), expected

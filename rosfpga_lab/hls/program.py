@@ -79,6 +79,9 @@ class Instr:
         status: the status code the subscriber refuses with at this field (0: it cannot fail);
             for VAR, a bad count.
         status2: VAR with CHECK: the status of contents unlike the constant.
+        fixed_after: VAR and variable LOOP: when only fixed-size fields follow the counted part,
+            their bytes (then the count must fill the frame exactly), else -1.
+        elem_min: VAR and variable LOOP: fewest bytes of one element (VAR: ``size``).
         kind: RANGE: how the value is ordered: 0 unsigned, 1 signed, 2 IEEE float (a NaN is out
             of every range, -0.0 equals +0.0).
         const: CHECK/CONST: the bytes (VAR: the elements' bytes, count = len // size).
@@ -96,6 +99,8 @@ class Instr:
     status: int = 0
     status2: int = 0
     kind: int = 0
+    fixed_after: int = -1
+    elem_min: int = 0
     const: bytes = b""
     name: str = ""
     type: str = ""
@@ -139,6 +144,8 @@ class Program:
         stack: list[int] = []
         fixed = list(instrs)
         for i, ins in enumerate(fixed):
+            if ins.op == Op.VAR and ins.elem_min == 0:
+                fixed[i] = ins = _replace(ins, elem_min=ins.size)
             if ins.op == Op.LOOP:
                 stack.append(i)
                 if len(stack) > MAX_LOOP_DEPTH:
@@ -236,11 +243,21 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
 
     def take(n: int, status: int) -> bytes:
         nonlocal pos
-        if pos + n > end:
-            raise Refused(FRAME_LENGTH_STATUS, bool(stream))
+        if pos + n > end:  # the frame ends inside (or before) this field
+            raise Refused(status or FRAME_LENGTH_STATUS, bool(stream))
         b = frame[pos:pos + n]
         pos += n
         return b
+
+    def fits(ins: Instr, n: int) -> None:
+        """A count's checks: its maximum (a stream's: exact), then the bytes left."""
+        if n != ins.count if ins.sub == Sub.STREAM else n > ins.count:
+            raise Refused(ins.status, bool(stream))
+        need = n * ins.elem_min
+        if ins.fixed_after >= 0 and need + ins.fixed_after != end - pos:
+            raise Refused(FRAME_LENGTH_STATUS, bool(stream))
+        if need > end - pos:
+            raise Refused(ins.status, bool(stream))
 
     suppressed = 0
     while True:
@@ -264,10 +281,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
         elif ins.op == Op.VAR:
             lb = take(4, ins.status)
             n = _u32(lb)
-            if n > ins.count or pos + n * ins.size > end:
-                raise Refused(ins.status, bool(stream))
-            if ins.sub == Sub.STREAM and n != ins.count:
-                raise Refused(ins.status, bool(stream))
+            fits(ins, n)
             b = take(n * ins.size, ins.status)
             if ins.sub == Sub.CARRY:
                 carry += lb + b
@@ -283,8 +297,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
             if ins.variable:
                 lb = take(4, ins.status)
                 n = _u32(lb)
-                if n > ins.count:
-                    raise Refused(ins.status, bool(stream))
+                fits(ins, n)
                 if ins.sub == Sub.CARRY:
                     carry += lb
                 out_len += 0 if quiet else 4

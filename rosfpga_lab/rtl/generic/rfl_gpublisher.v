@@ -41,16 +41,16 @@ module rfl_gpublisher #(
     reg [7:0]  depth;
 
     wire [IW-1:0] w = prog_word(pc);
-    wire [2:0]  op = w[139:137];
-    wire [2:0]  pub = w[133:131];
-    wire        variable = w[130];
-    wire [31:0] size = w[111:80];
-    wire [31:0] count = w[79:48];
-    wire [15:0] kaddr = w[47:32];
-    wire [15:0] klen = w[31:16];
-    wire [15:0] jump = w[15:0];
+    wire [2:0]  op = w[204:202];
+    wire [2:0]  pub = w[198:196];
+    wire        variable = w[195];
+    wire [31:0] size = w[176:145];
+    wire [31:0] count = w[144:113];
+    wire [15:0] kaddr = w[112:97];
+    wire [15:0] klen = w[96:81];
+    wire [15:0] jump = w[80:65];
     /* verilator lint_off UNUSEDSIGNAL */
-    wire [19:0] unused_fields = {w[136:134], w[129:112]};   // the subscriber's part
+    wire [84:0] unused_fields = {w[201:199], w[194:177], w[64:0]};  // the subscriber's part
     /* verilator lint_on UNUSEDSIGNAL */
 
     // The count an OP_VAR or variable OP_LOOP writes, when not carried.

@@ -55,18 +55,21 @@ module rfl_gsubscriber #(
 
     // The current instruction.
     wire [IW-1:0] w = prog_word(pc);
-    wire [2:0]  op = w[139:137];
-    wire [2:0]  sub = w[136:134];
-    wire [2:0]  pub = w[133:131];
-    wire        variable = w[130];
-    wire [1:0]  kind = w[129:128];
-    wire [7:0]  st = w[127:120];
-    wire [7:0]  st2 = w[119:112];
-    wire [31:0] size = w[111:80];
-    wire [31:0] count = w[79:48];
-    wire [15:0] kaddr = w[47:32];
-    wire [15:0] klen = w[31:16];
-    wire [15:0] jump = w[15:0];
+    wire [2:0]  op = w[204:202];
+    wire [2:0]  sub = w[201:199];
+    wire [2:0]  pub = w[198:196];
+    wire        variable = w[195];
+    wire [1:0]  kind = w[194:193];
+    wire [7:0]  st = w[192:185];
+    wire [7:0]  st2 = w[184:177];
+    wire [31:0] size = w[176:145];
+    wire [31:0] count = w[144:113];
+    wire [15:0] kaddr = w[112:97];
+    wire [15:0] klen = w[96:81];
+    wire [15:0] jump = w[80:65];
+    wire        fits = w[64];
+    wire [31:0] fixed_after = w[63:32];
+    wire [31:0] elem_min = w[31:0];
 
     // A new frame waits until the publisher has taken the previous frame's meta.
     wire stall = (state == S_FLEN) && (cnt == 0) && meta_valid;
@@ -85,6 +88,7 @@ module rfl_gsubscriber #(
     wire [31:0] pos_next = pos + 32'd1;
     wire [63:0] room = {32'd0, endp} - {32'd0, pos};  // bytes left in the frame
     wire [63:0] body = {32'd0, n} * {32'd0, size};
+    wire [63:0] least = {32'd0, n} * {32'd0, elem_min};  // fewest bytes of the counted elements
     wire        keep = (state == S_COUNT) ? (sub == SUB_CARRY)
                        : (sub == SUB_CARRY || sub == SUB_RANGE);
     wire [7:0]  expect = konst(kaddr + cnt[15:0]);
@@ -246,7 +250,7 @@ module rfl_gsubscriber #(
                             end
                         end
                         OP_FIXED: begin
-                            if ({32'd0, size} > room) refuse(SUB_BAD_FRAME_LENGTH, room == 64'd0);
+                            if ({32'd0, size} > room) refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, room == 64'd0);
                             else if (size == 32'd0) go(pc + 16'd1);
                             else begin
                                 need <= {32'd0, size};
@@ -270,9 +274,14 @@ module rfl_gsubscriber #(
                     end
                 end
                 S_COUNTED: begin
-                    if (op == OP_LOOP) begin
-                        if (n > count) refuse(st, room == 64'd0);
-                        else begin
+                    if ((sub == SUB_STREAM ? n != count : n > count))
+                        refuse(st, room == 64'd0);
+                    else if (fits && least + {32'd0, fixed_after} != room)
+                        refuse(SUB_BAD_FRAME_LENGTH, room == 64'd0);
+                    else if (least > room)
+                        refuse(st, room == 64'd0);
+                    else if (op == OP_LOOP) begin
+                        begin
                             if (variable && quiet == 8'd0) out_len <= out_len + 32'd4;
                             if (n == 32'd0) go(jump + 16'd1);
                             else begin
@@ -283,8 +292,6 @@ module rfl_gsubscriber #(
                                 go(pc + 16'd1);
                             end
                         end
-                    end else if (n > count || body > room || (sub == SUB_STREAM && n != count)) begin
-                        refuse(st, room == 64'd0);
                     end else if (body == 64'd0) begin
                         state <= S_FINISH;
                     end else begin
