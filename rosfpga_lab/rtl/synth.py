@@ -45,6 +45,13 @@ MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_publisher", "publisher"),
     ("rfl_fifo", "FIFOs (rfl_fifo)"),
     ("rfl_top", "top level (glue)"),
+    # a generated project for any other message type (rosfpga_lab.rtl.generic)
+    ("rfl_gsubscriber", "subscriber (generic walker)"),
+    ("rfl_elem_pack", "fifo2axi (elements)"),
+    ("rfl_window1d", "application (rfl_window1d)"),
+    ("rfl_elem_unpack", "axi2fifo (elements)"),
+    ("rfl_gpublisher", "publisher (generic walker)"),
+    ("rfl_gtop", "top level (glue, generic)"),
 )
 #: The module synthesized: rfl_top with the node's parameters.
 TOP = "rfl_node"
