@@ -25,7 +25,9 @@ from rosfpga_lab.hls.generator import HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hls.program import FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub
 from rosfpga_lab.hw.layout import Action, CheckOp, Layout, Step, StepKind, Token, marshal
+from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.msg.builtins import SCALARS
+from rosfpga_lab.tcpros import TopicSpec, publisher_reply_fields, subscriber_request_fields
 
 GENERIC_DIR = TEMPLATES_DIR / "generic"
 #: Output file -> template of a generic project (``stream_filter.cpp`` is the user's for custom).
@@ -304,6 +306,9 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
     if layout.video is not None:
         raise GenerateError("a video stream (sensor_msgs/Image) has its own project "
                             "(rosfpga_lab.hls.generator)")
+    if layout.stream_length < 1:
+        raise GenerateError(f"stream.length is {layout.stream_length}: the circuit streams at "
+                            "least one element")
     from rosfpga_lab.hw.walker import _plan  # the models' fit rule: one owner
 
     plan = _plan(layout)
@@ -391,6 +396,33 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
 _KIND_NAMES = {"u": "unsigned", "i": "signed", "f": "float"}
 
 
+def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpga",
+                     sub_topic: str = "/in", pub_topic: str = "/out",
+                     master_uri: str = "http://127.0.0.1:11311", ip_address: str = "127.0.0.1",
+                     input_depth: int = 2048, output_depth: int = 2048, axis_depth: int = 16,
+                     part: str = "xc7z020clg400-1", clock_mhz: float = 100.0, op: str = "dilate",
+                     ksize: int = 3, config_name: str = "<string>",
+                     custom_source: Path | None = None) -> GenericSpec:
+    """The generic project of a layout (its type in ``reg``), with the node's names and sizes."""
+    prog = program_from_layout(layout)
+    t = layout.type_name
+    stream = layout.stream
+    sub_header = subscriber_request_fields(
+        callerid=node_name, topic=sub_topic, md5sum=reg.md5(t), type_name=t,
+        message_definition=reg.full_text(t), tcp_nodelay=True)
+    pub_header = publisher_reply_fields(node_name, TopicSpec(pub_topic, t, reg.md5(t),
+                                                             reg.full_text(t)))
+    return GenericSpec(
+        program=prog, node_name=node_name, sub_topic=sub_topic, pub_topic=pub_topic,
+        master_uri=master_uri, ip_address=ip_address, input_depth=input_depth,
+        output_depth=output_depth, axis_depth=axis_depth, part=part, clock_mhz=clock_mhz,
+        op=op, ksize=ksize, kind=_KIND_NAMES[np.dtype(stream.dtype).kind],
+        stream_name=stream.label,
+        stream_type=f"{stream.type}[]" if stream.count is None else f"{stream.type}[{stream.count}]",
+        subscriber_header=sub_header, publisher_header=pub_header, config_name=config_name,
+        custom_source=custom_source)
+
+
 def spec_from_config(config: NodeConfig) -> GenericSpec:
     """The generic project of a node configuration (a type other than ``sensor_msgs/Image``).
 
@@ -399,33 +431,21 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
             subscribed type), or its layout cannot be rendered (see :func:`program_from_layout`).
     """
     from rosfpga_lab.hw.layout import layout_from_config
-    from rosfpga_lab.tcpros import TopicSpec, publisher_reply_fields, subscriber_request_fields
 
     if config.publisher.type != config.subscriber.type:
         raise GenerateError(f"publisher.type {config.publisher.type} differs from subscriber.type "
                             f"{config.subscriber.type}: the generated circuit publishes the type "
                             "it subscribes to")
     reg = config.registry()
-    layout = layout_from_config(config, reg)
-    prog = program_from_layout(layout)
-    t = config.subscriber.type
-    stream = layout.stream
-    sub_header = subscriber_request_fields(
-        callerid=config.node.global_name, topic=config.subscriber.topic, md5sum=reg.md5(t),
-        type_name=t, message_definition=reg.full_text(t), tcp_nodelay=True)
-    pub_header = publisher_reply_fields(config.node.global_name, TopicSpec(
-        config.publisher.topic, t, reg.md5(t), reg.full_text(t)))
     app = config.application
-    return GenericSpec(
-        program=prog, node_name=config.node.global_name, sub_topic=config.subscriber.topic,
-        pub_topic=config.publisher.topic, master_uri=config.node.master_uri,
-        ip_address=config.node.ip_address, input_depth=config.fifo.input_depth,
-        output_depth=config.fifo.output_depth, axis_depth=config.fifo.axis_depth,
-        part=config.part, clock_mhz=config.clock_mhz, op=app.op, ksize=app.ksize,
-        kind=_KIND_NAMES[np.dtype(stream.dtype).kind], stream_name=stream.label,
-        stream_type=f"{stream.type}[]" if stream.count is None else f"{stream.type}[{stream.count}]",
-        subscriber_header=sub_header, publisher_header=pub_header,
-        config_name=config.path.name if config.path else "<string>", custom_source=app.source)
+    return spec_from_layout(
+        layout_from_config(config, reg), reg, node_name=config.node.global_name,
+        sub_topic=config.subscriber.topic, pub_topic=config.publisher.topic,
+        master_uri=config.node.master_uri, ip_address=config.node.ip_address,
+        input_depth=config.fifo.input_depth, output_depth=config.fifo.output_depth,
+        axis_depth=config.fifo.axis_depth, part=config.part, clock_mhz=config.clock_mhz,
+        op=app.op, ksize=app.ksize, config_name=config.path.name if config.path else "<string>",
+        custom_source=app.source)
 
 
 # -- test frames and the models' output ----------------------------------------------------------

@@ -93,3 +93,17 @@ def generic_rtl_files(spec: GenericSpec) -> dict[str, bytes]:
     files[NODE_FILE] = node_wrapper(spec, str(ctx["generated_note"])).encode()
     files["rfl_tb.v"] = testbench().encode()
     return files
+
+
+def project_files(spec: GenericSpec) -> dict[str, bytes]:
+    """Every file of a generic project but the test frames: the HLS C++, ``hls_include/`` and
+    ``rtl/`` (what ``rosfpga-lab generate`` writes for a configuration, for a bare layout)."""
+    from rosfpga_lab.hls.generator import HLS_HEADERS, INCLUDE_DIR
+    from rosfpga_lab.hls.generic import render_generic
+
+    files = {name: text.encode() for name, text in render_generic(spec).items()}
+    for header in HLS_HEADERS:
+        files[f"hls_include/{header}"] = (INCLUDE_DIR / header).read_bytes()
+    for name, data in generic_rtl_files(spec).items():
+        files[f"rtl/{name}"] = data
+    return files
