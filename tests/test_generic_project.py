@@ -46,7 +46,7 @@ def write(files: dict[str, bytes], where: Path) -> Path:
 
 def make(project: Path, *args: str) -> str:
     proc = subprocess.run(["make", "-s", *args], cwd=project, capture_output=True, text=True,
-                          timeout=600)
+                          timeout=120)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     return proc.stdout
 
