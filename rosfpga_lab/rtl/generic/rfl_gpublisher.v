@@ -37,8 +37,8 @@ module rfl_gpublisher #(
     reg [63:0] need;                            // bytes of the current body
     reg [31:0] seq;
     reg [CW-1:0] raddr;
-    reg [31:0] left [0:LOOP_DEPTH-1];
-    reg [7:0]  depth;
+    reg [31:0] left [0:LOOPS-1];
+    reg [DB-1:0] depth;
 
     wire [IW-1:0] w = prog_word(pc);
     wire [2:0]  op = w[204:202];
@@ -50,7 +50,7 @@ module rfl_gpublisher #(
     wire [15:0] klen = w[96:81];
     wire [15:0] jump = w[80:65];
     /* verilator lint_off UNUSEDSIGNAL */
-    wire [84:0] unused_fields = {w[201:199], w[194:177], w[64:0]};  // the subscriber's part
+    wire [85:0] unused_fields = {w[201:199], w[194:177], w[64:0]};  // the subscriber's part
     /* verilator lint_on UNUSEDSIGNAL */
 
     // The count an OP_VAR or variable OP_LOOP writes, when not carried.
@@ -103,8 +103,8 @@ module rfl_gpublisher #(
             need <= 64'd0;
             seq <= SEQ_START;
             raddr <= {CW{1'b0}};
-            depth <= 8'd0;
-            for (d = 0; d < LOOP_DEPTH; d = d + 1) left[d] <= 32'd0;
+            depth <= {DB{1'b0}};
+            for (d = 0; d < LOOPS; d = d + 1) left[d] <= 32'd0;
         end else begin
             if (put) cnt <= cnt + 32'd1;
             if (put && carried) raddr <= raddr + 1'b1;
@@ -112,7 +112,7 @@ module rfl_gpublisher #(
                 P_IDLE: if (meta_valid) begin
                     cnt <= 32'd0;
                     raddr <= {CW{1'b0}};
-                    depth <= 8'd0;
+                    depth <= {DB{1'b0}};
                     pc <= 16'd0;
                     state <= meta_drop ? ((STREAM_DATA_BYTES == 0) ? P_DONE : P_DROP) : P_LEN;
                 end
@@ -127,11 +127,11 @@ module rfl_gpublisher #(
                         state <= P_DONE;
                     end
                     OP_END: begin
-                        if (left[depth - 8'd1] != 32'd1) begin
-                            left[depth - 8'd1] <= left[depth - 8'd1] - 32'd1;
+                        if (left[depth - 1'b1] != 32'd1) begin
+                            left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
                             go(jump + 16'd1);
                         end else begin
-                            depth <= depth - 8'd1;
+                            depth <= depth - 1'b1;
                             go(pc + 16'd1);
                         end
                     end
@@ -162,7 +162,7 @@ module rfl_gpublisher #(
                         if (n == 32'd0) go(jump + 16'd1);
                         else begin
                             left[depth] <= n;
-                            depth <= depth + 8'd1;
+                            depth <= depth + 1'b1;
                             go(pc + 16'd1);
                         end
                     end else if ({32'd0, n} * {32'd0, size} == 64'd0) begin

@@ -48,9 +48,10 @@ module rfl_gsubscriber #(
     reg        streamed;                        // the stream went out
     reg [31:0] out_len;
     reg [CW-1:0] waddr;
-    reg [31:0] left [0:LOOP_DEPTH-1];           // elements left of each open loop
-    reg [LOOP_DEPTH-1:0] quiet_of;              // that loop is written empty
-    reg [7:0]  depth, quiet;
+    reg [31:0] left [0:LOOPS-1];           // elements left of each open loop
+    reg [LOOPS-1:0] quiet_of;              // that loop is written empty
+    reg [DB-1:0] depth;
+    reg [7:0]  quiet;
     reg [7:0]  carry_mem [0:CARRY_BYTES-1];
 
     // The current instruction.
@@ -91,7 +92,7 @@ module rfl_gsubscriber #(
     wire [63:0] least = {32'd0, n} * {32'd0, elem_min};  // fewest bytes of the counted elements
     wire        keep = (state == S_COUNT) ? (sub == SUB_CARRY)
                        : (sub == SUB_CARRY || sub == SUB_RANGE);
-    wire [7:0]  expect = konst(kaddr + cnt[15:0]);
+    wire [7:0]  want_byte = konst(kaddr + cnt[15:0]);
 
     // Bounds of a SUB_RANGE field: low, then high, little-endian, `size` bytes each.
     function [63:0] bound(input [15:0] at, input [31:0] nbytes);
@@ -117,12 +118,14 @@ module rfl_gsubscriber #(
         end
     endfunction
 
+    /* verilator lint_off UNUSEDSIGNAL */
     function is_nan(input [63:0] v, input [31:0] nbytes);
         begin
             if (nbytes == 32'd4) is_nan = (v[30:23] == 8'hff) && (v[22:0] != 23'd0);
             else is_nan = (v[62:52] == 11'h7ff) && (v[51:0] != 52'd0);
         end
     endfunction
+    /* verilator lint_on UNUSEDSIGNAL */
 
     wire [63:0] vkey = order_key(value, size, kind);
     wire in_range = !(kind == 2'd2 && is_nan(value, size))
@@ -176,10 +179,10 @@ module rfl_gsubscriber #(
             streamed <= 1'b0;
             out_len <= 32'd0;
             waddr <= {CW{1'b0}};
-            depth <= 8'd0;
+            depth <= {DB{1'b0}};
             quiet <= 8'd0;
-            quiet_of <= {LOOP_DEPTH{1'b0}};
-            for (d = 0; d < LOOP_DEPTH; d = d + 1) left[d] <= 32'd0;
+            quiet_of <= {LOOPS{1'b0}};
+            for (d = 0; d < LOOPS; d = d + 1) left[d] <= 32'd0;
             meta_valid <= 1'b0;
             meta_out_len <= 32'd0;
             meta_drop <= 1'b0;
@@ -215,7 +218,7 @@ module rfl_gsubscriber #(
                             streamed <= 1'b0;
                             out_len <= 32'd0;
                             waddr <= {CW{1'b0}};
-                            depth <= 8'd0;
+                            depth <= {DB{1'b0}};
                             quiet <= 8'd0;
                             meta_drop <= 1'b0;
                             go(16'd0);
@@ -240,12 +243,12 @@ module rfl_gsubscriber #(
                             end
                         end
                         OP_END: begin
-                            if (left[depth - 8'd1] != 32'd1) begin
-                                left[depth - 8'd1] <= left[depth - 8'd1] - 32'd1;
+                            if (left[depth - 1'b1] != 32'd1) begin
+                                left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
                                 go(jump + 16'd1);
                             end else begin
-                                depth <= depth - 8'd1;
-                                if (quiet_of[depth - 8'd1]) quiet <= quiet - 8'd1;
+                                depth <= depth - 1'b1;
+                                if (quiet_of[depth - 1'b1]) quiet <= quiet - 8'd1;
                                 go(pc + 16'd1);
                             end
                         end
@@ -288,7 +291,7 @@ module rfl_gsubscriber #(
                                 left[depth] <= n;
                                 quiet_of[depth] <= variable && pub == PUB_ZERO;
                                 if (variable && pub == PUB_ZERO) quiet <= quiet + 8'd1;
-                                depth <= depth + 8'd1;
+                                depth <= depth + 1'b1;
                                 go(pc + 16'd1);
                             end
                         end
@@ -301,7 +304,7 @@ module rfl_gsubscriber #(
                 end
                 S_BODY: if (take) begin
                     if (cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
-                    if ({16'd0, cnt} >= {16'd0, klen} || s_tdata != expect) same <= 1'b0;
+                    if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
                     if (sub == SUB_STREAM) streamed <= 1'b1;
                     if ({32'd0, cnt} + 64'd1 == need) state <= S_FINISH;
                 end
