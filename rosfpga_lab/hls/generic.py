@@ -21,6 +21,7 @@ import numpy as np
 
 from rosfpga_lab import __version__
 from rosfpga_lab.hls.errors import GenerateError
+from rosfpga_lab.hls.limits import MAX_CARRY_BYTES
 from rosfpga_lab.hls.generator import HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hls.program import FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub
@@ -383,6 +384,11 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
         else:
             raise GenerateError(f"step {i} ({s.kind} {s.label}) has no length step before it")
         i += 1
+    if carry > MAX_CARRY_BYTES:
+        raise GenerateError(f"{layout.type_name} keeps up to {carry} bytes of a frame for the "
+                            f"publisher, over the {MAX_CARRY_BYTES} a generated circuit holds: "
+                            "lower the maxima of its strings and arrays (limits: in the "
+                            "configuration)")
     instrs.append(Instr(Op.DONE, status=FRAME_LENGTH_STATUS, name="", type=""))
     stream = layout.stream
     return Program.build(
