@@ -275,21 +275,21 @@ def _bounds(step: Step, low: object, high: object) -> bytes:
 
 
 def _scalar_instr(step: Step, code: dict[str, int], label: str) -> Instr:
-    common = {"size": step.size, "name": label, "type": step.type}
+    size, name, type_ = step.size, label, step.type
     if step.action is Action.SKIP:
-        return Instr(Op.FIXED, Sub.SKIP, Pub.ZERO, **common)  # type: ignore[arg-type]
+        return Instr(Op.FIXED, Sub.SKIP, Pub.ZERO, size, name=name, type=type_)
     if step.action is not Action.CHECK or step.check is None:
-        return Instr(Op.FIXED, Sub.CARRY, Pub.CARRY, **common)  # type: ignore[arg-type]
+        return Instr(Op.FIXED, Sub.CARRY, Pub.CARRY, size, name=name, type=type_)
     chk = step.check
     status = code[chk.status]
     kind = _kind_of(step.dtype)
     if chk.op is CheckOp.EQUAL and kind != 2:
-        return Instr(Op.FIXED, Sub.CHECK, Pub.CONST, status=status,  # type: ignore[arg-type]
-                     const=_scalar_bytes(step, chk.value), **common)
+        return Instr(Op.FIXED, Sub.CHECK, Pub.CONST, size, status=status,
+                     const=_scalar_bytes(step, chk.value), name=name, type=type_)
     # a float's equality is the range [v, v] (so -0.0 == +0.0 and NaN equals nothing)
     low, high = (chk.value, chk.value) if chk.op is CheckOp.EQUAL else (chk.low, chk.high)
-    return Instr(Op.FIXED, Sub.RANGE, Pub.CARRY, status=status, kind=kind,  # type: ignore[arg-type]
-                 const=_bounds(step, low, high), **common)
+    return Instr(Op.FIXED, Sub.RANGE, Pub.CARRY, size, status=status, kind=kind,
+                 const=_bounds(step, low, high), name=name, type=type_)
 
 
 def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Program:
@@ -329,12 +329,14 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
             status = code[s.check.status]
             keep = s.action in (Action.CARRY, Action.CHECK)
             fit = plan.fixed_after[s.index]
-            rule = {"fixed_after": -1 if fit is None else fit, "elem_min": plan.element_min[s.index]}
+            fixed_after = -1 if fit is None else fit
+            elem_min = plan.element_min[s.index]
             if target.kind is StepKind.LOOP:
                 instrs.append(Instr(Op.LOOP, Sub.CARRY if keep else Sub.SKIP,
                                     Pub.CARRY if keep else Pub.ZERO, 0, target.max_count,
                                     variable=True, status=status, name=target.label,
-                                    type=f"{target.type}[]", **rule))
+                                    type=f"{target.type}[]", fixed_after=fixed_after,
+                                    elem_min=elem_min))
                 carry += 4 * mult[-1] if keep else 0
                 mult.append(mult[-1] * target.max_count)
                 i = target.index + 1
@@ -357,7 +359,8 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
             if sub == Sub.CARRY:
                 carry += (4 + n * target.size) * mult[-1]
             instrs.append(Instr(Op.VAR, sub, pub, target.size, n, status=status, status2=status2,
-                                const=const, name=target.label, **rule,
+                                const=const, name=target.label, fixed_after=fixed_after,
+                                elem_min=elem_min,
                                 type=target.type if target.kind is StepKind.STRING
                                 else f"{target.type}[]"))
             i = target.index + 1

@@ -10,3 +10,5 @@ RUN_TIMEOUT = 300.0
 #: carried strings and arrays at their maxima). Beyond it the configuration's ``limits:`` must
 #: lower the maxima (a C simulation copies the memory by value; an FPGA has a few MB of RAM).
 MAX_CARRY_BYTES = 256 * 1024
+#: Deepest nesting of arrays of messages (loops) a generated walk may have (the walkers' stacks).
+MAX_LOOP_DEPTH = 8

@@ -32,8 +32,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
-#: Deepest nesting of arrays of messages a program may have.
-MAX_LOOP_DEPTH = 4
+from rosfpga_lab.hls.limits import MAX_LOOP_DEPTH
 
 
 class Op(IntEnum):
