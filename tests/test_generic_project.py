@@ -27,8 +27,10 @@ from rtltools import require_iverilog
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hls.generic import model_output, sample_tokens, spec_from_layout
 from rosfpga_lab.hls.program import run_program
-from rosfpga_lab.hw.layout import Action, StepKind, derive_layout, layout_from_config, marshal
-from rosfpga_lab.msg import serialize
+from rosfpga_lab.hw.layout import (
+    Action, StepKind, derive_layout, frame_geometry, layout_from_config, marshal,
+)
+from rosfpga_lab.msg import deserialize, serialize
 from rosfpga_lab.msg.strategies import message
 from rosfpga_lab.rtl.generic import project_files
 from test_hw_walker import definitions  # the models' strategy over message definitions
@@ -217,3 +219,46 @@ def test_generated_verilog_is_lint_clean_and_readable(name: str, tmp_path: Path)
     ours = [line for line in proc.stderr.splitlines()
             if line.startswith("%Warning") and "rfl_fifo.v" not in line]
     assert proc.returncode == 0 and not ours, proc.stderr
+
+
+def test_custom_application_runs_the_users_cpp(tmp_path: Path) -> None:
+    """``op: custom``: the user's stream_filter() (here: negate every float32 range) replaces the
+    application; the output is the models' pass-through output with every range negated."""
+    require_cxx()
+    source = tmp_path / "negate.cpp"
+    source.write_text('#include "ros_node.h"\n'
+                      "void stream_filter(elem_stream& in, elem_stream& out) {\n"
+                      "    for (int e = 0; e < STREAM_LENGTH; e++) {\n"
+                      "        elem_beat beat = in.read();\n"
+                      "        beat.data = beat.data.to_uint64() ^ 0x80000000ull;\n"
+                      "        out.write(beat);\n    }\n}\n")
+    text = (DATA / "fpga_laserscan_min.yaml").read_text().replace(
+        "application: {op: erode, ksize: 5}", "application: {op: custom, source: negate.cpp}")
+    (tmp_path / "scan.yaml").write_text(text)
+    out = tmp_path / "project"
+    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(tmp_path / "scan.yaml"),
+                           "-o", str(out), "-q"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert not (out / "rtl").exists() and not (out / "tb_expected.bin").exists()
+    make(out, "csim")
+    config = load_config(tmp_path / "scan.yaml")
+    layout = layout_from_config(config)
+    data = (out / "tb_input.bin").read_bytes()
+    frames, at = [], 0
+    while at < len(data):
+        size = 4 + struct.unpack_from("<I", data, at)[0]
+        frames.append(data[at:at + size])
+        at += size
+    expected, why = model_output(layout, "passthrough", 1, frames)
+    got = (out / "csim_out/output.bin").read_bytes()
+    assert len(got) == len(expected) > 0 and got != expected
+    flipped = bytearray(expected)
+    at = 0
+    for frame, refused in zip(frames, why):
+        if refused:
+            continue
+        geo = frame_geometry(layout, deserialize(config.registry(), layout.type_name, frame[4:]))
+        for k in range(geo.stream_offset + 3, geo.stream_offset + geo.stream_bytes, 4):
+            flipped[at + k] ^= 0x80
+        at += 4 + geo.frame_length
+    assert got == bytes(flipped)
