@@ -21,7 +21,7 @@ from pathlib import Path
 
 from rosfpga_lab.config import load_config
 from rosfpga_lab.rtl.project import generate_project
-from rosfpga_lab.rtl.sim import simulator_missing_reason
+from rosfpga_lab.rtl.sim import find_tool, simulator_missing_reason
 
 DATA = Path(__file__).resolve().parents[2] / "data"
 EXAMPLES = ("fpga_laserscan_min.yaml", "fpga_samples_dilate.yaml")
@@ -44,24 +44,26 @@ def main() -> int:
     args = parser.parse_args()
     sims = args.simulator or [s for s in ("iverilog", "verilator")
                               if simulator_missing_reason(s) is None]
-    print(f"{'example':<28}{'step':<28}{'seconds':>9}  result")
+    print(f"{'example':<28}{'step':<32}{'seconds':>9}  result")
     for name in EXAMPLES:
         config = load_config(DATA / name)
         with tempfile.TemporaryDirectory(prefix="bench-generic-") as tmp:
             project = Path(tmp) / "p"
             start = time.perf_counter()
             generate_project(config, project)
-            print(f"{name:<28}{'generate':<28}{time.perf_counter() - start:>9.2f}  "
+            print(f"{name:<28}{'generate':<32}{time.perf_counter() - start:>9.2f}  "
                   f"{len(list(project.rglob('*')))} paths")
             seconds, last = timed_make(project, "csim")
-            print(f"{'':<28}{'make csim (build + run)':<28}{seconds:>9.2f}  {last}")
+            print(f"{'':<28}{'make csim (build + run)':<32}{seconds:>9.2f}  {last}")
             seconds, last = timed_make(project, "csim")
-            print(f"{'':<28}{'make csim (run)':<28}{seconds:>9.2f}  {last}")
+            print(f"{'':<28}{'make csim (run)':<32}{seconds:>9.2f}  {last}")
             for sim in sims:
-                seconds, last = timed_make(project, "rtlsim", f"SIM={sim}", "GAP=200", "BP=300")
-                print(f"{'':<28}{f'make rtlsim {sim} (build+run)':<28}{seconds:>9.2f}  {last}")
-                seconds, last = timed_make(project, "rtlsim", f"SIM={sim}", "GAP=200", "BP=300")
-                print(f"{'':<28}{f'make rtlsim {sim} (run)':<28}{seconds:>9.2f}  {last}")
+                tool = [] if sim == "iverilog" else [
+                    f"VERILATOR={find_tool('verilator') or find_tool('verilator-cli')}"]
+                seconds, last = timed_make(project, "rtlsim", f"SIM={sim}", "GAP=200", "BP=300", *tool)
+                print(f"{'':<28}{f'make rtlsim {sim} (build+run)':<32}{seconds:>9.2f}  {last}")
+                seconds, last = timed_make(project, "rtlsim", f"SIM={sim}", "GAP=200", "BP=300", *tool)
+                print(f"{'':<28}{f'make rtlsim {sim} (run)':<32}{seconds:>9.2f}  {last}")
     return 0
 
 
