@@ -113,6 +113,16 @@ def test_refusals_then_good_frames_match_the_models(tmp_path: Path) -> None:
     csim, rtl = simulate(project, frames)
     assert csim == expected
     assert rtl == expected
+    # the status of each frame names the field the models refused it at
+    names = [name for name, _label in layout.statuses]
+    want = ["SUB_OK", "SUB_BAD_CALIBRATION_MODE", "SUB_OK", "SUB_BAD_LABEL_LENGTH", "SUB_OK",
+            "SUB_BAD_SAMPLES_LENGTH", "SUB_OK", "SUB_BAD_FRAME_LENGTH", "SUB_OK",
+            "SUB_BAD_FRAME_LENGTH", "SUB_OK"]
+    for refusal, status in zip(why, want):
+        label = dict((n, lbl) for n, lbl in layout.statuses)[status]
+        assert (refusal == "") == (status == "SUB_OK") and (not refusal or label in refusal), refusal
+    assert (project / "c_out/status.txt").read_text().split()[1::2] == want
+    assert [names[int(c)] for c in (project / "r_out/status.txt").read_text().split()[1::2]] == want
 
 
 def test_hand_written_walks_match_the_executor(tmp_path: Path) -> None:
