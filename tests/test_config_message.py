@@ -98,6 +98,8 @@ def test_refusals_name_file_line_and_key(old: str, new: str, key: str, line: int
     ("checks: {header.stamp: 1}", "checks.header.stamp", "a time"),
     ("checks: {header.seq: -1}", "checks.header.seq", "does not fit a uint32"),
     ("checks: {angle_min: fast}", "checks.angle_min", "is not a float32"),
+    ("checks: {angle_min: .nan}", "checks.angle_min", "NaN equals nothing"),
+    ("checks: {angle_min: {max: .nan}}", "checks.angle_min", "NaN equals nothing"),
     ("checks: {angle_min: {min: 2, max: 1}}", "checks.angle_min", "above max"),
     ("checks: {angle_min: {low: 2}}", "checks.angle_min", "{min: LOW, max: HIGH}"),
     ("checks: {header.frame_id: {max: 3}}", "checks.header.frame_id", "only be checked for equality"),

@@ -232,3 +232,16 @@ def _registry_of(defs: dict[str, str]):
     for name, text in defs.items():
         reg.add(f"t_msgs/{name}", text)
     return reg
+
+
+def test_the_module_docstrings_worked_example_is_format_layouts_output() -> None:
+    import rosfpga_lab.hw.layout as module
+
+    reg = _registry_of({})
+    reg.add("pkg/Scan", "Header header\nstring[] names\nfloat32[] ranges")
+    text = format_layout(derive_layout(reg, "pkg/Scan", stream="ranges", stream_length=4,
+                                       checks={"header.seq": 0}))
+    doc = module.__doc__ or ""
+    block = doc.split("prints (a test holds this text equal to its output)::\n\n")[1]
+    shown = "\n".join(line[4:] for line in block.split("\n\n")[0].splitlines())
+    assert shown == text

@@ -21,11 +21,13 @@ from rosfpga_lab.hw.layout import (
     Action, Layout, StepKind, derive_layout, encode_token, layout_from_config, tokens,
 )
 from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
+from rosfpga_lab.hw.msgpipeline import MessagePipeline
 from rosfpga_lab.hw.pipeline import image_frame
 from rosfpga_lab.hw.walker import (
-    LayoutInterpreter, extract_fast, extract_reference, publish_fast, publish_reference,
+    LayoutInterpreter, extract_fast, extract_reference, message_of, publish_fast,
+    publish_reference,
 )
-from rosfpga_lab.msg import MsgRegistry, deserialize, serialize
+from rosfpga_lab.msg import MsgRegistry, deserialize, new_message, serialize
 from rosfpga_lab.msg.builtins import SCALARS
 from rosfpga_lab.msg.strategies import message
 
@@ -112,6 +114,8 @@ def test_reference_fast_and_the_msg_layer_agree_on_every_field(case: Any) -> Non
     assert _wire(layout, ref.carried(layout)) == [
         w for w, t in zip(expected, tokens(layout, decoded))
         if layout.steps[t.step].action is not Action.STREAM]
+    # the tokens rebuild the message (the inverse walk)
+    assert serialize(reg, type_name, message_of(layout, ref.tokens, reg)) == frame[4:]
     # the publisher writes the same frame back (passthrough), in both models
     assert publish_fast(layout, ref.tokens, ref.stream) == frame
     assert publish_reference(layout, ref.tokens, ref.stream) == frame
@@ -373,3 +377,42 @@ def test_morph1d_nan_gives_the_first_nan_of_the_window_with_its_bits() -> None:
     big = np.array([2**64 - 1, 0, 2**63], np.uint64)
     assert morph1d_reference(big, "erode", 3).tolist() == [0, 0, 0]
     assert morph1d_fast(big, "dilate", 3).tolist() == [2**64 - 1, 2**64 - 1, 2**63]
+
+
+def test_a_publisher_of_another_type_carries_fields_by_path_and_type(tmp_path: Path) -> None:
+    msgs = tmp_path / "conv_msgs" / "msg"
+    msgs.mkdir(parents=True)
+    (msgs / "InnerA.msg").write_text("int32 a\nstring b\n")
+    (msgs / "InnerB.msg").write_text("string b\nint64 a\nuint8 c\n")
+    (msgs / "In.msg").write_text("Header header\nstring name\nint16[] values\nfloat64 gain\n"
+                                 "InnerA inner\nInnerA[] list\n")
+    (msgs / "Out.msg").write_text("Header header\nint16[] values\nstring name\nuint8 extra\n"
+                                  "InnerB inner\nInnerB[] list\n")
+    (tmp_path / "c.yaml").write_text(
+        "node: {name: n}\nsubscriber: {topic: /a, type: conv_msgs/In}\n"
+        "publisher: {topic: /b, type: conv_msgs/Out}\nmsg_path: [.]\n"
+        "stream: {field: values, length: 4}\napplication: {op: dilate, ksize: 3}\n"
+        "limits: {name: 8}\n")
+    config = load_config(tmp_path / "c.yaml")
+    reg = config.registry()
+    msg = {"header": {"seq": 2, "stamp": (3, 4), "frame_id": "x"}, "name": "nm",
+           "values": [1, -5, 3, 0], "gain": 2.5, "inner": {"a": 7, "b": "in"},
+           "list": [{"a": 1, "b": "z"}]}
+    frame = _frame(serialize(reg, "conv_msgs/In", msg))
+    want = _frame(serialize(reg, "conv_msgs/Out", {
+        "header": msg["header"], "values": [1, 3, 3, 3], "name": "nm", "extra": 0,
+        "inner": {"b": "in", "a": 0, "c": 0}, "list": []}))
+    for model in ("fast", "reference"):
+        res = MessagePipeline.from_config(config, model=model, reg=reg).process(frame)
+        assert res.output_frame == want
+
+
+def test_thousands_of_empty_steps_in_a_row_need_no_recursion() -> None:
+    reg = MsgRegistry.with_defaults()
+    reg.add("e_msgs/E", "int32[0] nothing\nuint8[0] none")
+    reg.add("e_msgs/Many", "E[3000] empties\nint16[] values")
+    layout = derive_layout(reg, "e_msgs/Many", stream="values", stream_length=2)
+    frame = _frame(serialize(reg, "e_msgs/Many", new_message(reg, "e_msgs/Many", values=[5, -6])))
+    for extract in (extract_reference, extract_fast):
+        ex = extract(layout, frame)
+        assert ex.stream.tolist() == [5, -6] and len(ex.tokens) == 2 * 3000 + 2

@@ -42,6 +42,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="stop by itself after S seconds (default: run until Ctrl-C)")
     p.add_argument("--status-interval", type=non_negative_float, default=0.5, metavar="S",
                    help="seconds between status updates (default: 0.5; 0: no status line)")
+    p.add_argument("--msg-path", action="append", metavar="DIR", default=[],
+                   help="folder of PKG/msg/NAME.msg packages (repeatable), after the "
+                   "configuration's msg_path")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no status line and no log lines, only the final summary")
     p.set_defaults(func=run)
@@ -62,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
         kw["input_queue"] = args.input_queue
     if args.output_queue is not None:
         kw["output_queue"] = args.output_queue
-    config = load_config(args.config)
+    config = load_config(args.config, msg_path=args.msg_path)
     component = FpgaComponent.from_config(config, master_uri=master_uri(args.master_uri, config),
                                           model=args.model, **kw)
     master = None

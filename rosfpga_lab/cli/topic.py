@@ -20,6 +20,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "own: start one with `rosfpga-lab master` or roscore).")
     p.add_argument("--master-uri", help="master to talk to (default: ROS_MASTER_URI or "
                    f"{DEFAULT_MASTER_URI})")
+    p.add_argument("--msg-path", action="append", metavar="DIR", default=[],
+                   help="folder of PKG/msg/NAME.msg packages (repeatable): your own types")
     sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     ls = sub.add_parser("list", help="list topics", description="List the topics the master knows.")
     ls.add_argument("-v", "--verbose", action="store_true", help="show types and counts")
@@ -53,10 +55,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _node(uri: str, kind: str):
+def _node(uri: str, kind: str, msg_path: list[str] | None = None):
     from rosfpga_lab.graph import Node
+    from rosfpga_lab.msg import registry_with
 
-    return Node(f"/rosfpga_lab_topic_{kind}_{int(time.time() * 1000) % 10**8}", master_uri=uri)
+    return Node(f"/rosfpga_lab_topic_{kind}_{int(time.time() * 1000) % 10**8}", master_uri=uri,
+                registry=registry_with(msg_path or []))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -103,7 +107,7 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
         print(f"topic echo: {args.topic} was not published within {args.timeout} s",
               file=sys.stderr)
         return 1
-    node = _node(uri, "echo")
+    node = _node(uri, "echo", args.msg_path)
     done = threading.Event()
     count = [0]
 
@@ -143,7 +147,7 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
 def _pub(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import tools
 
-    node = _node(uri, "pub")
+    node = _node(uri, "pub", args.msg_path)
     try:
         value = tools.parse_message_value(node.registry, args.type, args.values)
         pub = node.advertise(args.topic, args.type, latch=args.latch or args.once or not args.rate)

@@ -43,9 +43,11 @@ from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
 from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, fps_meter, since_stamp
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.config import master_uri as pick_master_uri
+from rosfpga_lab.config.limits import IMAGE_TYPE
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
 from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineResult
+from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
 
 log = logging.getLogger("rosfpga_lab.component")
 
@@ -57,9 +59,11 @@ class FrameRecord:
 
     Attributes:
         index: frames seen by the circuit so far, counting from 0 (refused ones included).
-        input_frame: the TCPROS frame received (4-byte length + ``sensor_msgs/Image`` body).
+        input_frame: the TCPROS frame received (4-byte length + message body).
         output_frame: the frame published (empty when refused).
-        result: the pipeline's :class:`~rosfpga_lab.hw.PipelineResult` (None when refused).
+        result: the pipeline's :class:`~rosfpga_lab.hw.PipelineResult` (Image) or
+            :class:`~rosfpga_lab.hw.msgpipeline.MessageResult` (any other type); None when
+            refused.
         error: the refusal reason (empty when the frame went through).
         publisher: callerid of the node that sent the frame.
         received: ``time.time()`` when the frame was complete on the input connection.
@@ -69,7 +73,7 @@ class FrameRecord:
     index: int
     input_frame: bytes
     output_frame: bytes
-    result: PipelineResult | None
+    result: PipelineResult | MessageResult | None
     error: str
     publisher: str
     received: float
@@ -136,7 +140,11 @@ class FpgaComponent:
             monitor thread runs either way, logging drops and connections).
 
     Raises:
-        ComponentConfigError: the configuration cannot be run (``op: custom``, wrong type).
+        ComponentConfigError: the configuration cannot be run (``op: custom``).
+
+    A ``sensor_msgs/Image`` configuration runs :class:`~rosfpga_lab.hw.Pipeline` (the video
+    path); any other type the circuit rendered from its layout,
+    :class:`~rosfpga_lab.hw.msgpipeline.MessagePipeline`.
     """
 
     def __init__(self, config: NodeConfig, *, master_uri: str | None = None,
@@ -145,12 +153,19 @@ class FpgaComponent:
                  output_queue: int = limits.DEFAULT_OUTPUT_QUEUE,
                  history: int = limits.DEFAULT_HISTORY, name: str | None = None,
                  host: str | None = None, trace: Any = None, watchdog: bool = True) -> None:
-        for section, topic in (("subscriber", config.subscriber), ("publisher", config.publisher)):
-            if topic.type != "sensor_msgs/Image":
-                raise ComponentConfigError(
-                    f"{section}.type is {topic.type!r}: the circuit streams sensor_msgs/Image only")
+        if config.is_image != (config.subscriber.type == IMAGE_TYPE):
+            raise ComponentConfigError(
+                f"subscriber.type is {config.subscriber.type!r} but image: is given: image: is "
+                f"for {IMAGE_TYPE} only")
+        if config.is_image and config.publisher.type != IMAGE_TYPE:
+            raise ComponentConfigError(
+                f"publisher.type is {config.publisher.type!r}: the video path publishes "
+                f"{IMAGE_TYPE} only")
         try:
-            self.pipeline = Pipeline.from_config(config, model=model)
+            self.registry = config.registry()
+            self.pipeline: Pipeline | MessagePipeline = (
+                Pipeline.from_config(config, model=model) if config.is_image
+                else MessagePipeline.from_config(config, model=model, reg=self.registry))
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         if input_queue < 1 or output_queue < 1:
@@ -168,7 +183,7 @@ class FpgaComponent:
         self.input_queue, self.output_queue = input_queue, output_queue
         self.trace = trace
         self.watchdog = watchdog
-        pixels = config.image.width * config.image.height
+        pixels = config.image.width * config.image.height if config.is_image else 0
         if model == "reference" and pixels > limits.REFERENCE_WARN_PIXELS:
             log.warning("reference model with %dx%d frames: expect seconds per frame; "
                         "use model='fast' for real-time rates", config.image.width,
@@ -185,7 +200,7 @@ class FpgaComponent:
         self._reasons: dict[str, int] = {}        # refusal kind -> count
         self._examples: dict[str, str] = {}       # refusal kind -> the first reason text seen
         self._high_water: dict[str, int] = {}
-        self._last: PipelineResult | None = None
+        self._last: PipelineResult | MessageResult | None = None
         self._last_error = ""
         self._master_ok = True
         self._name_taken = False
@@ -231,11 +246,11 @@ class FpgaComponent:
         if self.trace is not None:
             kw["trace"] = self.trace
         node = Node(self.name, host=self.host, xmlrpc_port=self.config.node.xmlrpc_port,
-                    tcpros_port=self.config.node.tcpros_port, **kw)
+                    tcpros_port=self.config.node.tcpros_port, registry=self.registry, **kw)
         try:
-            self._pub = node.advertise(self.output_topic, "sensor_msgs/Image",
+            self._pub = node.advertise(self.output_topic, self.config.publisher.type,
                                        queue_size=self.output_queue)
-            self._sub = node.subscribe(self.input_topic, "sensor_msgs/Image", self._on_frame,
+            self._sub = node.subscribe(self.input_topic, self.config.subscriber.type, self._on_frame,
                                        raw=True, queue_size=self.input_queue, tcp_nodelay=True)
         except BaseException:
             node.shutdown()
@@ -299,7 +314,9 @@ class FpgaComponent:
                         problem)
         self._latency.add(now - info.received)
         self._process.add(t1 - t0)
-        from_stamp = since_stamp(now, result.fields.stamp_secs, result.fields.stamp_nsecs)
+        stamp = (result.stamp if isinstance(result, MessageResult)
+                 else (result.fields.stamp_secs, result.fields.stamp_nsecs))
+        from_stamp = since_stamp(now, *stamp) if stamp is not None else None
         if from_stamp is not None:  # a wall-clock stamp (a camera's)
             self._since_stamp.add(from_stamp)
         with self._lock:

@@ -10,6 +10,7 @@ into its own error.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from rosfpga_lab.config.vocabulary import STREAM_ELEMENT_TYPES
@@ -111,6 +112,8 @@ def check_value_problem(type_: str, value: Any) -> str | None:
         ok = isinstance(value, bool)
     elif type_ in FLOAT_TYPES:
         ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if ok and math.isnan(value):
+            return "NaN equals nothing and bounds nothing: the circuit would refuse every frame"
     else:
         ok = isinstance(value, int) and not isinstance(value, bool)
         if ok:

@@ -29,7 +29,8 @@ The circuit's one layout (every field in wire order and what the circuit does wi
 derived from a ``.msg`` and the configuration by :func:`derive_layout` (module ``layout``);
 the subscriber and publisher of any type are rendered from it (module ``walker``:
 :class:`LayoutInterpreter`, :func:`extract_reference` / :func:`extract_fast`,
-:func:`publish_reference` / :func:`publish_fast`), the 1-D application in ``morph1d``.
+:func:`publish_reference` / :func:`publish_fast`), the 1-D application in ``morph1d``, the
+whole circuit of a non-Image type in :class:`MessagePipeline` (``msgpipeline``).
 
 Stages (``reference`` / ``fast``), importable for notebooks:
 
@@ -67,6 +68,7 @@ from rosfpga_lab.hw.interpreter import (
 )
 from rosfpga_lab.hw.layout import Layout, derive_layout, format_layout, layout_from_config
 from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
+from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
 from rosfpga_lab.hw.walker import (
     Extracted, LayoutInterpreter, extract_fast, extract_reference, publish_fast, publish_reference,
 )
@@ -93,5 +95,5 @@ __all__ = [
     "morph_reference", "pixel_format", "receive_fast_check", "receive_reference",
     "Layout", "derive_layout", "format_layout", "layout_from_config", "morph1d_fast",
     "morph1d_reference", "Extracted", "LayoutInterpreter", "extract_fast", "extract_reference",
-    "publish_fast", "publish_reference",
+    "publish_fast", "publish_reference", "MessagePipeline", "MessageResult",
 ]

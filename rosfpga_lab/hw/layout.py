@@ -16,28 +16,41 @@ field's default). Every length prefix is checked too (its maximum, from the conf
 the HLS C++, the Verilog) walk ``layout.steps`` and never need to know a message type: every
 name, size, maximum and status code is in the steps.
 
-Worked example: ``pkg/Scan`` = ``Header header``, ``string[] names``, ``float32[] ranges``
-streamed with length 4, ``checks: {header.seq: 0}``; :func:`format_layout` prints::
+Worked example: ``pkg/Scan`` = ``Header header``, ``string[] names``, ``float32[] ranges``,
+``derive_layout(reg, "pkg/Scan", stream="ranges", stream_length=4, checks={"header.seq": 0})``;
+:func:`format_layout` prints (a test holds this text equal to its output)::
 
-    #   kind    ident                 label                   type     bytes      max  action  check
-    0   length  frame_length          frame length            uint32   4          -    check   SUB_BAD_FRAME_LENGTH: 20..
-    1   scalar  header_seq            header.seq              uint32   4          -    check   SUB_BAD_HEADER_SEQ: == 0
-    2   scalar  header_stamp_secs     header.stamp.secs       uint32   4          -    carry   -
-    3   scalar  header_stamp_nsecs    header.stamp.nsecs      uint32   4          -    carry   -
-    4   length  header_frame_id_len.. header.frame_id length  uint32   4          -    carry   SUB_BAD_HEADER_FRAME_ID_LENGTH: <= 256
-    5   string  header_frame_id       header.frame_id         string   1 x [4]    256  carry   -
-    6   length  names_length          names length            uint32   4          -    carry   SUB_BAD_NAMES_LENGTH: <= 64
-    7   loop    names                 names                   string   0 x [6]    64   carry   -
-    8   length  names_item_length     names[] length          uint32   4          -    carry   SUB_BAD_NAMES_ITEM_LENGTH: <= 256
-    9   string  names_item            names[]                 string   1 x [8]    256  carry   -
-    10  end     names                 names                   string   0          -    carry   -
-    11  length  ranges_length         ranges length           uint32   4          -    stream  SUB_BAD_RANGES_LENGTH: == 4
-    12  array   ranges                ranges                  float32  4 x [11]   4    stream  -
+    pkg/Scan (md5 115c5a6fcd20cb3c1c340cbd2d284ee1): stream ranges 4 x float32, body 24..16936 bytes
+    #   kind      ident                   label                   type     bytes     max  action  check
+    0   length    frame_length            frame length            uint32   4         -    check   SUB_BAD_FRAME_LENGTH: 24..67108864
+    1   scalar    header_seq              header.seq              uint32   4         -    check   SUB_BAD_HEADER_SEQ: == 0
+    2   scalar    header_stamp_secs       header.stamp.secs       uint32   4         -    carry   -
+    3   scalar    header_stamp_nsecs      header.stamp.nsecs      uint32   4         -    carry   -
+    4   length    header_frame_id_length  header.frame_id length  uint32   4         -    carry   SUB_BAD_HEADER_FRAME_ID_LENGTH: <= 256
+    5   string    header_frame_id         header.frame_id         string   1 x [4]   256  carry   -
+    6   length    names_length            names length            uint32   4         -    carry   SUB_BAD_NAMES_LENGTH: <= 64
+    7   loop      names                   names                   string   0 x [6]   64   carry   -
+    8     length  names_item_length       names[] length          uint32   4         -    carry   SUB_BAD_NAMES_ITEM_LENGTH: <= 256
+    9     string  names_item              names[]                 string   1 x [8]   256  carry   -
+    10  end       names                   names                   string   0         -    carry   -
+    11  length    ranges_length           ranges length           uint32   4         -    stream  SUB_BAD_RANGES_LENGTH: == 4
+    12  array     ranges                  ranges                  float32  4 x [11]  4    stream  -
 
 (``x [11]``: as many elements as step 11 says). A frame's byte offsets follow from its values
 (:func:`frame_geometry`); a refused field is named by its label with indices filled in
 (``names[2] length``). Status codes: ``SUB_OK`` then one per checked step, in step order
 (:attr:`Layout.statuses`), exactly as ``hw.interpreter.SUBSCRIBER_STATUSES`` does for Image.
+
+Refusal order (what every renderer does, so models, C++ and RTL give the same status): when a
+step completes, (1) step 0, the frame length: below ``min_body`` or above
+``hw.limits.MAX_FRAME_BYTES`` -> ``SUB_BAD_FRAME_LENGTH``, nothing trusted, wait for the next
+frame; (2) the step's own check (``EQUAL``, ``RANGE`` -- a NaN fails it --, ``MAX``) -> its
+status; (3) a LENGTH step's :class:`LengthRule` (:func:`length_rules`): when only fixed-size
+data follows, the frame must end exactly there (else ``SUB_BAD_FRAME_LENGTH``), otherwise its
+elements must fit in the bytes left (else its own status); (4) on to the next step: LOOPs
+with no elements and empty strings/arrays are passed at once; reaching the frame's end before
+a step that has bytes, or inside one, refuses the frame (``SUB_BAD_FRAME_LENGTH``). After a
+refusal with a sane frame length the rest of the frame is skipped.
 
 :func:`tokens` lists a message's values in walk order (what the subscriber emits step by step)
 and :func:`marshal` writes tokens back into a frame (what the publisher does): the two are
@@ -552,6 +565,85 @@ def _with_max_body(layout: Layout) -> Layout:
     return replace(layout, max_body=size(1, len(layout.steps)))
 
 
+# -- how length prefixes are held against the frame ------------------------------------------
+
+def _min_bytes(layout: Layout, lo: int, hi: int) -> int:
+    """Fewest bytes steps ``lo..hi-1`` can take (variable parts empty)."""
+    total, i = 0, lo
+    while i < hi:
+        s = layout.steps[i]
+        if s.kind is StepKind.LOOP:
+            assert s.partner is not None
+            if s.count is not None:
+                total += s.count * _min_bytes(layout, i + 1, s.partner)
+            i = s.partner + 1
+            continue
+        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
+            total += s.size
+        elif s.count is not None:
+            total += s.size * s.count
+        i += 1
+    return total
+
+
+def _fixed_bytes(layout: Layout, lo: int, hi: int) -> int | None:
+    """Bytes of steps ``lo..hi-1`` if they are all fixed-size, else None."""
+    total, i = 0, lo
+    while i < hi:
+        s = layout.steps[i]
+        if s.is_variable or s.kind is StepKind.STRING:
+            return None
+        if s.kind is StepKind.LOOP:
+            assert s.partner is not None and s.count is not None
+            inner = _fixed_bytes(layout, i + 1, s.partner)
+            if inner is None:
+                return None
+            total += s.count * inner
+            i = s.partner + 1
+            continue
+        total += s.size * (s.count if s.count is not None else 1)
+        i += 1
+    return total
+
+
+class LengthRule(NamedTuple):
+    """How a LENGTH step's value is held against the frame length (after its own check).
+
+    Attributes:
+        element_min: fewest bytes one counted element takes (1 for a string's byte).
+        fixed_after: when the counted elements and everything after them are fixed-size (and
+            the step is in no loop): the bytes after the counted part, so the frame length must
+            equal ``offset + value * element_min + fixed_after`` exactly (else a
+            ``frame length`` refusal, as Image's ``data length``); otherwise ``None`` and only
+            ``value * element_min <= bytes left`` is required (else ``past the frame end``).
+    """
+
+    element_min: int
+    fixed_after: int | None
+
+
+def length_rules(layout: Layout) -> dict[int, LengthRule]:
+    """The :class:`LengthRule` of every LENGTH step but the frame length, by step index."""
+    rules: dict[int, LengthRule] = {}
+    steps = layout.steps
+    for s in steps:
+        if s.kind is not StepKind.LENGTH or s.partner is None:
+            continue
+        part = steps[s.partner]
+        exact = True
+        if part.kind is StepKind.LOOP:
+            assert part.partner is not None
+            element_min = _min_bytes(layout, part.index + 1, part.partner)
+            exact = _fixed_bytes(layout, part.index + 1, part.partner) is not None
+            end = part.partner + 1
+        else:
+            element_min = part.size
+            end = part.index + 1
+        rules[s.index] = LengthRule(element_min, _fixed_bytes(layout, end, len(steps))
+                                    if s.depth == 0 and exact else None)
+    return rules
+
+
 # -- values in walk order ----------------------------------------------------------------------
 
 class Token(NamedTuple):
@@ -677,7 +769,8 @@ def format_layout(layout: Layout) -> str:
 
 
 __all__ = [
-    "Action", "CheckOp", "FieldCheck", "FrameGeometry", "Layout", "Step", "StepKind", "Token",
+    "Action", "CheckOp", "FieldCheck", "FrameGeometry", "Layout", "LengthRule", "Step", "StepKind",
+    "Token", "length_rules",
     "VideoShape", "STREAM_ELEMENT_TYPES", "derive_layout", "encode_token", "format_layout",
     "frame_geometry", "marshal", "tokens",
 ]
@@ -690,7 +783,9 @@ def layout_from_config(config: NodeConfig, reg: MsgRegistry | None = None, *,
     ``sensor_msgs/Image``: stream ``data`` with the video shape of ``image:``, checks of
     ``height``, ``width``, ``encoding`` and ``step`` equal to it, ``encoding`` at most
     ``hw.limits.MAX_ENCODING_BYTES``. Every type: ``header.frame_id`` (when there is one) at most
-    ``frame_id_max`` unless ``limits:`` says otherwise.
+    ``frame_id_max`` unless ``limits:`` says otherwise. A publisher of another type than the
+    subscriber's has no checks and skips nothing (it writes what it carries, defaults for the
+    rest); its maxima are the ``limits:`` entries whose paths it has.
 
     Args:
         config: a loaded configuration.
@@ -700,7 +795,9 @@ def layout_from_config(config: NodeConfig, reg: MsgRegistry | None = None, *,
     reg = reg or config.registry()
     type_name = config.publisher.type if output else config.subscriber.type
     assert config.stream is not None
-    checks: dict[str, Any] = {c.path: c.spec for c in config.checks}
+    # the publisher's own type checks nothing; its maxima are those of the paths it has
+    other = output and type_name != config.subscriber.type
+    checks: dict[str, Any] = {} if other else {c.path: c.spec for c in config.checks}
     maxima: dict[str, int] = {}
     try:
         resolve_field(reg, type_name, _FRAME_ID)
@@ -715,10 +812,16 @@ def layout_from_config(config: NodeConfig, reg: MsgRegistry | None = None, *,
         maxima["encoding"] = limits.MAX_ENCODING_BYTES
         video = VideoShape(im.width, im.height, im.encoding, im.bytes_per_pixel)
         length = im.data_bytes
-    maxima.update(config.limits)
+    for path, value in config.limits:
+        if other:
+            try:
+                limit_field(reg, type_name, path.removesuffix("[]"))
+            except FieldPathError:
+                continue
+        maxima[path] = value
     return derive_layout(reg, type_name, stream=config.stream.field,
                          stream_length=length, checks=checks, limits_=maxima,
-                         skip=config.skip, video=video)
+                         skip=() if other else config.skip, video=video)
 
 
 _FRAME_ID = "header.frame_id"

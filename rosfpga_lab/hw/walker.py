@@ -35,11 +35,13 @@ import numpy as np
 
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
 from rosfpga_lab.hw.layout import (
-    Action, CheckOp, Layout, Step, StepKind, Token, encode_token, marshal,
+    Action, CheckOp, Layout, LengthRule, Step, StepKind, Token, encode_token, length_rules,
+    marshal, tokens,
 )
+from rosfpga_lab.msg import MsgRegistry, default_value, new_message
 from rosfpga_lab.msg.builtins import SCALARS
 
-STAGE = "subscriber"
+STAGE = "interpreter"  # as the Image interpreter: refusals read the same
 
 
 @dataclass
@@ -68,78 +70,7 @@ def _decode(step: Step, data: bytes | memoryview) -> Any:
         return struct.unpack("<" + SCALARS[step.type].struct_char, data)[0]
     if step.kind is StepKind.STRING:
         return bytes(data).decode("utf-8", "surrogateescape")
-    return np.frombuffer(bytes(data), np.dtype(step.dtype))
-
-
-def _min_bytes(layout: Layout, lo: int, hi: int) -> int:
-    """Fewest bytes steps ``lo..hi-1`` can take (variable parts empty)."""
-    total, i = 0, lo
-    while i < hi:
-        s = layout.steps[i]
-        if s.kind is StepKind.LOOP:
-            assert s.partner is not None
-            if s.count is not None:
-                total += s.count * _min_bytes(layout, i + 1, s.partner)
-            i = s.partner + 1
-            continue
-        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
-            total += s.size
-        elif s.count is not None:
-            total += s.size * s.count
-        i += 1
-    return total
-
-
-def _fixed_bytes(layout: Layout, lo: int, hi: int) -> int | None:
-    """Bytes of steps ``lo..hi-1`` if they are all fixed-size, else None."""
-    total, i = 0, lo
-    while i < hi:
-        s = layout.steps[i]
-        if s.is_variable or s.kind is StepKind.STRING:
-            return None
-        if s.kind is StepKind.LOOP:
-            assert s.partner is not None and s.count is not None
-            inner = _fixed_bytes(layout, i + 1, s.partner)
-            if inner is None:
-                return None
-            total += s.count * inner
-            i = s.partner + 1
-            continue
-        total += s.size * (s.count if s.count is not None else 1)
-        i += 1
-    return total
-
-
-@dataclass(frozen=True)
-class _Plan:
-    """Per LENGTH step: minimum bytes of one counted element, and the exact bytes after the
-    counted part when its elements and everything after it are fixed-size (None otherwise, or
-    inside a loop): then the frame length must match exactly."""
-
-    element_min: dict[int, int]
-    fixed_after: dict[int, int | None]
-
-
-def _plan(layout: Layout) -> _Plan:
-    element_min: dict[int, int] = {}
-    fixed_after: dict[int, int | None] = {}
-    steps = layout.steps
-    for s in steps:
-        if s.kind is not StepKind.LENGTH or s.partner is None:
-            continue
-        part = steps[s.partner]
-        exact = True
-        if part.kind is StepKind.LOOP:
-            assert part.partner is not None
-            element_min[s.index] = _min_bytes(layout, part.index + 1, part.partner)
-            exact = _fixed_bytes(layout, part.index + 1, part.partner) is not None
-            end = part.partner + 1
-        else:
-            element_min[s.index] = part.size
-            end = part.index + 1
-        fixed_after[s.index] = (_fixed_bytes(layout, end, len(steps))
-                                if s.depth == 0 and exact else None)
-    return _Plan(element_min, fixed_after)
+    return np.frombuffer(data, np.dtype(step.dtype))  # a read-only view (fast model: of the frame)
 
 
 @dataclass
@@ -156,10 +87,10 @@ class LayoutInterpreter:
     layout: Layout
     frames: int = 0
     last: Extracted | None = None
-    _plan: _Plan = field(init=False, repr=False)
+    _rules: dict[int, LengthRule] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self._plan = _plan(self.layout)
+        self._rules = length_rules(self.layout)
         self.reset()
 
     def reset(self) -> None:
@@ -253,6 +184,11 @@ class LayoutInterpreter:
 
     # -- steps ------------------------------------------------------------------------------------
     def _complete(self, s: Step, data: bytes | memoryview) -> None:
+        self._accept(s, data)
+        self._advance(s.index + 1)
+
+    def _accept(self, s: Step, data: bytes | memoryview) -> None:
+        """Decode a complete step, run its checks, record its token (no moving on)."""
         value = _decode(s, data)
         if s.index == 0:
             self._frame_length = value
@@ -266,7 +202,6 @@ class LayoutInterpreter:
             self._tokens.append(Token(s.index, value, self.indices))
         if s.index == self.layout.stream_index:
             self._stream = value
-        self._advance(s.index + 1)
 
     def _advance(self, pc: int) -> None:
         steps = self.layout.steps
@@ -296,10 +231,11 @@ class LayoutInterpreter:
             self.pc = pc
             if pc == self.layout.stream_index:
                 self._stream_offset = self.offset
-            if self.need(t) == 0:
+            if self.need(t) == 0:  # an empty string or array completes at once
                 self._field_start = self.offset
-                self._complete(t, b"")
-                return
+                self._accept(t, b"")
+                pc += 1
+                continue
             if self.offset == self._end:
                 self._fail(FrameLengthError(
                     f"the frame length ({self._frame_length}) ends before this field",
@@ -361,8 +297,9 @@ class LayoutInterpreter:
 
     def _check_fits(self, s: Step, value: int) -> None:
         left = self._end - self.offset
-        need = value * self._plan.element_min[s.index]
-        fixed = self._plan.fixed_after[s.index]
+        rule = self._rules[s.index]
+        need = value * rule.element_min
+        fixed = rule.fixed_after
         if fixed is not None and need + fixed != left:
             self._fail(FrameLengthError(
                 f"{self._frame_length} announces {left} bytes after the {s.label} field, but "
@@ -425,10 +362,6 @@ def extract_fast(layout: Layout, frame: bytes) -> Extracted:
             interp._stream_offset = pos
         interp._complete(s, view[pos:pos + n])
     assert interp.last is not None
-    if interp.last.stream.size and layout.stream_index is not None:
-        off = interp.last.stream_offset
-        interp.last.stream = np.frombuffer(frame, np.dtype(layout.stream.dtype),
-                                           layout.stream_length, off)
     _check_trailing(interp.last, len(frame))
     return interp.last
 
@@ -501,15 +434,108 @@ def output_tokens(layout: Layout, toks: list[Token], stream: np.ndarray) -> list
     return out
 
 
-def publish_fast(layout: Layout, toks: list[Token], stream: np.ndarray) -> bytes:
+def _merge(skeleton: dict[str, Any], got: dict[str, Any]) -> dict[str, Any]:
+    for key, value in got.items():
+        if isinstance(value, dict) and isinstance(skeleton.get(key), dict):
+            _merge(skeleton[key], value)
+        else:
+            skeleton[key] = value
+    return skeleton
+
+
+def message_of(layout: Layout, toks: list[Token], reg: MsgRegistry) -> dict[str, Any]:
+    """The message (nested dicts and lists, ``msg.serialize`` takes it) whose walk gives
+    ``toks``: the inverse of :func:`~rosfpga_lab.hw.layout.tokens` (``reg`` fills nested
+    messages without fields, which have no steps)."""
+    steps = layout.steps
+    pos = 0
+
+    def put(obj: dict[str, Any], rel: tuple[str, ...], value: Any) -> None:
+        for name in rel[:-1]:
+            obj = obj.setdefault(name, {})
+        obj[rel[-1]] = value
+
+    def walk(lo: int, hi: int, obj: dict[str, Any]) -> None:
+        nonlocal pos
+        i = lo
+        while i < hi:
+            s = steps[i]
+            if s.kind is StepKind.LOOP:
+                assert s.partner is not None
+                n = s.count if s.count is not None else counts[s.length_step or 0]
+                items: list[Any] = []
+                for _ in range(n):
+                    element: dict[str, Any] = {}
+                    walk(i + 1, s.partner, element)
+                    if "" in element:
+                        items.append(element[""])
+                    elif s.type in reg:
+                        items.append(_merge(new_message(reg, s.type), element))
+                    else:
+                        items.append(element)
+                put(obj, s.rel, items)
+                i = s.partner + 1
+                continue
+            t = toks[pos]
+            assert t.step == i, f"token of step {t.step} where step {i} was expected"
+            pos += 1
+            if s.kind is StepKind.LENGTH:
+                counts[i] = t.value
+            else:
+                put(obj, s.rel or ("",), t.value)
+            i += 1
+
+    counts: dict[int, int] = {}
+    root: dict[str, Any] = {}
+    walk(1, len(steps), root)
+    return _merge(new_message(reg, layout.type_name), root)
+
+
+def _carry_into(reg: MsgRegistry, in_type: str, out_type: str, src: dict[str, Any]) -> dict:
+    """A value of ``out_type``: each field the input's field of the same name when the types
+    are equal (nested messages field by field), else its default."""
+    in_fields = {f.name: f for f in reg.check(in_type).fields}
+    out: dict[str, Any] = {}
+    for f in reg.check(out_type).fields:
+        g = in_fields.get(f.name)
+        if g is not None and g.type == f.type:
+            out[f.name] = src[f.name]
+        elif (g is not None and not f.is_array and not g.is_array and not f.is_builtin
+              and not g.is_builtin):
+            out[f.name] = _carry_into(reg, g.base_type, f.base_type, src[f.name])
+        else:
+            out[f.name] = default_value(reg, f)
+    return out
+
+
+def published_tokens(layout: Layout, toks: list[Token], stream: np.ndarray,
+                     out_layout: Layout | None = None, reg: MsgRegistry | None = None
+                     ) -> list[Token]:
+    """What the publisher writes, in its layout's walk order: :func:`output_tokens`, and for a
+    publisher of another type (``out_layout``, its registry ``reg``) every field of that type
+    taken from the input's field of the same path and type, else its default."""
+    same = output_tokens(layout, toks, stream)
+    if out_layout is None or out_layout.type_name == layout.type_name:
+        return same
+    if reg is None:
+        raise ValueError("a publisher of another type needs the registry holding both types")
+    message = _carry_into(reg, layout.type_name, out_layout.type_name,
+                          message_of(layout, same, reg))
+    return tokens(out_layout, message)
+
+
+def publish_fast(layout: Layout, toks: list[Token], stream: np.ndarray,
+                 out_layout: Layout | None = None, reg: MsgRegistry | None = None) -> bytes:
     """The output TCPROS frame (4-byte length + body), each field packed whole."""
-    return marshal(layout, output_tokens(layout, toks, stream))
+    return marshal(out_layout or layout, published_tokens(layout, toks, stream, out_layout, reg))
 
 
-def publish_reference(layout: Layout, toks: list[Token], stream: np.ndarray) -> bytes:
+def publish_reference(layout: Layout, toks: list[Token], stream: np.ndarray,
+                      out_layout: Layout | None = None, reg: MsgRegistry | None = None) -> bytes:
     """The output frame written a byte per clock: numbers shifted out little-endian, strings
     and arrays byte by byte, as the generated publisher does."""
-    out_toks = output_tokens(layout, toks, stream)
+    out_toks = published_tokens(layout, toks, stream, out_layout, reg)
+    layout = out_layout or layout
     length = sum(_size(layout.steps[t.step], t.value) for t in out_toks)
     out = bytearray()
     for k in range(4):
