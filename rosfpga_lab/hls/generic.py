@@ -25,7 +25,9 @@ from rosfpga_lab.hls.limits import MAX_CARRY_BYTES
 from rosfpga_lab.hls.generator import HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hls.program import FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub
-from rosfpga_lab.hw.layout import Action, CheckOp, Layout, Step, StepKind, Token, marshal
+from rosfpga_lab.hw.layout import (
+    Action, CheckOp, Layout, Step, StepKind, Token, length_rules, marshal,
+)
 from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.msg.builtins import SCALARS
 from rosfpga_lab.tcpros import TopicSpec, publisher_reply_fields, subscriber_request_fields
@@ -310,9 +312,7 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
     if layout.stream_length < 1:
         raise GenerateError(f"stream.length is {layout.stream_length}: the circuit streams at "
                             "least one element")
-    from rosfpga_lab.hw.walker import _plan  # the models' fit rule: one owner
-
-    plan = _plan(layout)
+    rules = length_rules(layout)  # the models' fit rule: one owner
     code = {name: i for i, (name, _label) in enumerate(layout.statuses)}
     steps = layout.steps
     frame = steps[0]
@@ -328,9 +328,9 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
             assert target is not None and s.check is not None
             status = code[s.check.status]
             keep = s.action in (Action.CARRY, Action.CHECK)
-            fit = plan.fixed_after[s.index]
+            fit = rules[s.index].fixed_after
             fixed_after = -1 if fit is None else fit
-            elem_min = plan.element_min[s.index]
+            elem_min = rules[s.index].element_min
             if target.kind is StepKind.LOOP:
                 instrs.append(Instr(Op.LOOP, Sub.CARRY if keep else Sub.SKIP,
                                     Pub.CARRY if keep else Pub.ZERO, 0, target.max_count,
