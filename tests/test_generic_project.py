@@ -304,3 +304,42 @@ def test_yosys_synthesizes_a_generated_project(tmp_path: Path) -> None:
     assert report.row("rfl_gsubscriber").counts["FF"] > 0
     assert report.row("rfl_window1d").counts["LUT"] > 0
     assert report.total["LUT"] == sum(row.counts["LUT"] for row in report.rows)
+
+
+def test_the_generic_circuit_given_the_image_layout_publishes_as_the_image_project(
+        tmp_path: Path) -> None:
+    """sensor_msgs/Image through the generic renderer (pixels as a byte stream, a pass-through,
+    header.seq numbered by the publisher as the Image project's does): C simulation and RTL
+    simulation publish what the Image project's Python models publish, frame for frame,
+    including a frame of the wrong width refused between good ones."""
+    from rosfpga_lab.config import parse_config
+    from rosfpga_lab.hls.generic import program_from_layout
+    from rosfpga_lab.hw import Pipeline
+    from rosfpga_lab.hw.errors import PipelineError
+    from rosfpga_lab.hw.pipeline import image_frame
+
+    require_cxx()
+    require_iverilog()
+    text = (DATA / "fpga_passthrough_rgb8.yaml").read_text().replace(
+        "width: 160", "width: 6").replace("height: 120", "height: 4")
+    config = parse_config(text)
+    reg = config.registry()
+    layout = layout_from_config(config, reg)
+    prog = program_from_layout(layout, count="header.seq", video_as_bytes=True)
+    spec = spec_from_layout(layout, reg, op="passthrough", ksize=1, program=prog)
+    project = write(project_files(spec), tmp_path)
+    rng = np.random.default_rng(11)
+    frames = []
+    for k, (w, fid) in enumerate([(6, "cam"), (6, ""), (5, "cam"), (6, "x" * 40)]):
+        pic = rng.integers(0, 256, (4, w, 3), dtype=np.uint8)
+        frames.append(image_frame(pic, "rgb8", seq=100 + k, stamp=(7 + k, 9), frame_id=fid))
+    pipe = Pipeline.from_config(config)
+    expected = b""
+    refused = 0
+    for frame in frames:
+        try:
+            expected += pipe.process(frame).output_frame
+        except PipelineError:
+            refused += 1
+    assert refused == 1 and expected
+    assert simulate(project, frames) == (expected, expected)

@@ -294,19 +294,28 @@ def _scalar_instr(step: Step, code: dict[str, int], label: str) -> Instr:
                  const=_bounds(step, low, high), name=name, type=type_)
 
 
-def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Program:
+def program_from_layout(layout: Layout, *, max_frame: int | None = None,
+                        count: str | None = None, video_as_bytes: bool = False) -> Program:
     """The walkers' program of a circuit layout (one instruction per field, names from it).
 
     A length prefix and the string or array it counts become one ``VAR`` instruction; an array
     of messages, strings or times a ``LOOP``/``END`` pair; the checks, maxima and statuses are
     the layout's. Skipped fields are written as zeros (empty strings and arrays).
 
+    Args:
+        layout: the circuit layout.
+        max_frame: the longest frame length accepted (default: the layout's).
+        count: the label of a uint32 field the publisher numbers itself (1, 2, 3 ...) instead of
+            re-sending it (``header.seq`` of the Image project's publisher).
+        video_as_bytes: take a video stream (``sensor_msgs/Image``'s ``data``) as a plain array of
+            bytes (the Image project has its own; this is for comparing the two).
+
     Raises:
         GenerateError: the layout has no stream, or a video stream (Image keeps its own project).
     """
     if layout.stream_index is None:
         raise GenerateError(f"the layout of {layout.type_name} has no stream: nothing to generate")
-    if layout.video is not None:
+    if layout.video is not None and not video_as_bytes:
         raise GenerateError("a video stream (sensor_msgs/Image) has its own project "
                             "(rosfpga_lab.hls.generator)")
     if layout.stream_length < 1:
@@ -365,7 +374,9 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None) -> Prog
                                 else f"{target.type}[]"))
             i = target.index + 1
             continue
-        if s.kind is StepKind.SCALAR:
+        if s.kind is StepKind.SCALAR and s.label == count and s.type == "uint32":
+            instrs.append(Instr(Op.FIXED, Sub.SKIP, Pub.COUNT, 4, name=s.label, type=s.type))
+        elif s.kind is StepKind.SCALAR:
             ins = _scalar_instr(s, code, s.label)
             carry += ins.size * mult[-1] if ins.sub in (Sub.CARRY, Sub.RANGE) else 0
             instrs.append(ins)
@@ -411,9 +422,11 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
                      input_depth: int = 2048, output_depth: int = 2048, axis_depth: int = 16,
                      part: str = "xc7z020clg400-1", clock_mhz: float = 100.0, op: str = "dilate",
                      ksize: int = 3, config_name: str = "<string>",
-                     custom_source: Path | None = None) -> GenericSpec:
-    """The generic project of a layout (its type in ``reg``), with the node's names and sizes."""
-    prog = program_from_layout(layout)
+                     custom_source: Path | None = None,
+                     program: Program | None = None) -> GenericSpec:
+    """The generic project of a layout (its type in ``reg``), with the node's names and sizes
+    (``program``: the layout's walk when the caller derived it itself)."""
+    prog = program or program_from_layout(layout)
     t = layout.type_name
     stream = layout.stream
     sub_header = subscriber_request_fields(
