@@ -32,7 +32,7 @@ from rosfpga_lab.hw.layout import (
 )
 from rosfpga_lab.msg import deserialize, serialize
 from rosfpga_lab.msg.strategies import message
-from rosfpga_lab.rtl.generic import project_files
+from rosfpga_lab.rtl.generic import project_files, simulate_project
 from test_hw_walker import definitions  # the models' strategy over message definitions
 
 DATA = Path(__file__).resolve().parent.parent / "data"
@@ -123,6 +123,10 @@ def test_refusals_then_good_frames_match_the_models(tmp_path: Path) -> None:
         assert (refusal == "") == (status == "SUB_OK") and (not refusal or label in refusal), refusal
     assert (project / "c_out/status.txt").read_text().split()[1::2] == want
     assert [names[int(c)] for c in (project / "r_out/status.txt").read_text().split()[1::2]] == want
+    # the same through the Python entry point (what a notebook calls)
+    for target in ("csim", "rtlsim"):
+        assert simulate_project(project, b"".join(frames), target=target, simulator="iverilog",
+                                gap=100, bp=100) == (expected, want)
 
 
 def test_hand_written_walks_match_the_executor(tmp_path: Path) -> None:

@@ -107,3 +107,53 @@ def project_files(spec: GenericSpec) -> dict[str, bytes]:
     for name, data in generic_rtl_files(spec).items():
         files[f"rtl/{name}"] = data
     return files
+
+
+def simulate_project(project_dir: str | Path, frames: bytes, *, target: str = "rtlsim",
+                     simulator: str | None = None, gap: int = 0, bp: int = 0, seed: int = 1,
+                     out: str = "sim_out") -> tuple[bytes, list[str]]:
+    """Run a generic project's ``make csim`` or ``make rtlsim`` on ``frames`` (the real flow,
+    as a student types it) and read back its output bytes and a status name per frame.
+
+    Args:
+        project_dir: a project written by ``rosfpga-lab generate`` for a type other than Image.
+        frames: TCPROS frames.
+        target: ``csim`` or ``rtlsim``.
+        simulator: rtlsim: ``iverilog`` or ``verilator`` (default: the first installed).
+        gap, bp, seed: rtlsim: random input gaps and output backpressure (per mille), seed.
+        out: the output folder inside the project.
+
+    Raises:
+        RtlError: the build or the simulation failed, or no simulator is installed.
+    """
+    import re
+    import shutil
+    import subprocess
+
+    from rosfpga_lab.rtl.limits import RUN_TIMEOUT
+    from rosfpga_lab.rtl.sim import find_simulator, find_tool
+
+    project = Path(project_dir)
+    if shutil.which("make") is None:
+        raise RtlError("no make on this machine (apt-get install make)")
+    (project / out).mkdir(parents=True, exist_ok=True)
+    (project / out / "input.bin").write_bytes(frames)
+    cmd = ["make", "-s", target, f"INPUT={out}/input.bin", f"OUT={out}", "EXPECTED="]
+    if target == "rtlsim":
+        sim = find_simulator(simulator)
+        cmd += [f"SIM={sim}", f"GAP={gap}", f"BP={bp}", f"SEED={seed}"]
+        if sim == "verilator":
+            cmd.append(f"VERILATOR={find_tool('verilator') or find_tool('verilator-cli')}")
+    try:
+        proc = subprocess.run(cmd, cwd=project, capture_output=True, text=True,
+                              timeout=RUN_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        raise RtlError(f"make {target} ran longer than {RUN_TIMEOUT:g} s") from None
+    if proc.returncode != 0:
+        raise RtlError(f"make {target} in {project} failed:\n{proc.stdout}{proc.stderr}")
+    names = re.findall(r"localparam \[7:0\] (SUB_\w+) = 8'd(\d+)",
+                       (project / "rtl" / LAYOUT_INCLUDE).read_text()) if target == "rtlsim" else []
+    by_code = {"0": "SUB_OK", "1": "SUB_BAD_FRAME_LENGTH", **{c: n for n, c in names}}
+    statuses = [by_code.get(word, word) for word in
+                (project / out / "status.txt").read_text().split()[1::2]]
+    return (project / out / "output.bin").read_bytes(), statuses
