@@ -404,6 +404,13 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
                             "lower the maxima of its strings and arrays (limits: in the "
                             "configuration)")
     instrs.append(Instr(Op.DONE, status=FRAME_LENGTH_STATUS, name="", type=""))
+    consts = sum(len(ins.const) for ins in instrs)
+    for what, n, most in (("status codes", len(layout.statuses), 256),
+                          ("instructions", len(instrs), 1 << 16),
+                          ("constant bytes", consts, 1 << 16)):
+        if n > most:  # the walkers' 8-bit status, 16-bit program counter and constant address
+            raise GenerateError(f"the walk of {layout.type_name} needs {n} {what}; a generated "
+                                f"circuit holds {most}")
     stream = layout.stream
     return Program.build(
         instrs, statuses=layout.statuses, min_body=int(frame.check.low),
