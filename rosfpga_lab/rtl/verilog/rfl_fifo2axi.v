@@ -19,12 +19,14 @@ module rfl_fifo2axi #(
     output reg        m_axis_tvalid,
     input             m_axis_tready
 );
+    localparam [31:0] K_LAST_32 = BYTES - 1;
+    localparam [1:0] K_LAST = K_LAST_32[1:0];
     reg [31:0] acc;                             // the bytes of the pixel so far (lanes 0..BYTES-2)
     reg [1:0]  k;                               // the lane the next byte goes to
     reg [15:0] x, y;                            // the pixel the next beat carries
 
     wire out_free = !m_axis_tvalid || m_axis_tready;
-    wire last_byte = (k == BYTES - 1);
+    wire last_byte = (k == K_LAST);
     wire take = s_tvalid && s_tready;
 
     assign s_tready = !last_byte || out_free;

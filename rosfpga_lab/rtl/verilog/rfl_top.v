@@ -39,12 +39,14 @@ module rfl_top #(
     output       busy                           // something is in flight
 );
     localparam FIDW = $clog2(FRAME_ID_MAX + 1);
+    localparam FIDA = (FRAME_ID_MAX > 1) ? $clog2(FRAME_ID_MAX) : 1;
 
     // rx FIFO -> subscriber
     wire [7:0] rx_tdata;
     wire rx_tvalid, rx_tready;
     wire [$clog2(RX_DEPTH + 1)-1:0] rx_level;
-    rfl_fifo #(.WIDTH(8), .DEPTH(RX_DEPTH)) u_rx_fifo (
+    // OUTREG: the subscriber reads a register, not the block RAM's output (timing)
+    rfl_fifo #(.WIDTH(8), .DEPTH(RX_DEPTH), .OUTREG(RX_DEPTH > 2 ? 1 : 0)) u_rx_fifo (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(rx_tdata), .m_tvalid(rx_tvalid), .m_tready(rx_tready), .level(rx_level));
@@ -55,7 +57,8 @@ module rfl_top #(
     wire meta_valid, meta_release, sub_idle, pub_idle;
     wire [31:0] meta_secs, meta_nsecs;
     wire [7:0] meta_bigendian, fid_rdata;
-    wire [FIDW-1:0] meta_fid_len, fid_raddr;
+    wire [FIDW-1:0] meta_fid_len;
+    wire [FIDA-1:0] fid_raddr;
     rfl_subscriber #(
         .WIDTH(WIDTH), .HEIGHT(HEIGHT), .BYTES(BYTES), .ENC_LEN(ENC_LEN), .ENCODING(ENCODING),
         .FRAME_ID_MAX(FRAME_ID_MAX), .ENCODING_MAX(ENCODING_MAX), .MIN_BODY(MIN_BODY),
@@ -149,4 +152,9 @@ module rfl_top #(
     assign busy = rx_tvalid || meta_valid || pix_in_tvalid || axis_in_tvalid || app_in_tvalid
                   || app_out_tvalid || axis_out_tvalid || pix_out_tvalid || tx_tvalid
                   || m_tvalid || !sub_idle || !pub_idle;
+
+    // FIFO levels and the publisher's frame_done are for testbenches and waveforms; axi2fifo
+    // sends bytes, not beats, so TUSER/TLAST end at its input
+    wire unused_ok = &{1'b0, rx_level, axis_in_level, axis_out_level, tx_level, frame_done,
+                       axis_out_tuser, axis_out_tlast};
 endmodule
