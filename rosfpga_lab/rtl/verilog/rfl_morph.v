@@ -15,11 +15,11 @@
 // columns behind the scan takes the extreme of the entries that lie on its own line. The
 // window's right part of the last pixel needs D more steps without input (the flush). A frame
 // is (HEIGHT + D) * WIDTH + D steps; the first output leaves D * WIDTH + D steps after the first
-// input, plus the three pipeline registers. No input is taken during the flush, so the next
+// input, plus the four pipeline registers. No input is taken during the flush, so the next
 // frame's first pixel goes in (HEIGHT + D) * WIDTH + D clocks after this frame's first one.
 //
-// Handshake: the step pipeline (issue, line-memory read, shift register, output register)
-// advances as a whole when the output register is empty or being taken (adv); s_axis_tready is
+// Handshake: the step pipeline (issue, line-memory read, its register, shift register,
+// output register) advances as a whole when the output register is empty or being taken (adv); s_axis_tready is
 // adv while the step needs a pixel. Beats before a tuser beat are dropped (the HLS video
 // library's loop_wait_for_start); inside the frame the circuit counts WIDTH x HEIGHT pixels and
 // does not look at tuser or tlast again.
@@ -190,14 +190,54 @@ module rfl_morph #(
         end
     end
 
+    // ---- stage 1r: the line memories' outputs registered (a block RAM's clock-to-output is
+    // slow; the window's extremes start from flip-flops) ------------------------------------
+    reg           valid1r, pv1r, emit1r, first1r, eol1r;
+    reg [W-1:0]   p1r;
+    reg [NL-1:0]  mv1r;
+    reg [K-1:0]   hmask1r;
+    reg [NL*W-1:0] q1r;
+
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            valid1r <= 1'b0;
+        end else if (adv) begin
+            valid1r <= valid1;
+            p1r     <= p1;
+            pv1r    <= pv1;
+            mv1r    <= mv1;
+            q1r     <= qall;
+            emit1r  <= emit1;
+            first1r <= first1;
+            eol1r   <= eol1;
+            hmask1r <= hmask1;
+        end
+    end
+
+    // The extreme of up to N candidates (those not taken are the identity ID), as a balanced
+    // tree of pick: ceil(log2 N) comparisons deep, not N - 1.
+    function [W-1:0] tree(input [15*W-1:0] c, input integer n);
+        reg [15*W-1:0] t;
+        integer st, a;
+        begin
+            t = c;
+            for (st = 1; st < 16; st = st * 2)
+                for (a = 0; a + st < 16; a = a + 2 * st)
+                    if (a + st < n) t[a*W +: W] = pick(t[a*W +: W], t[(a+st)*W +: W]);
+            tree = t[W-1:0];
+        end
+    endfunction
+
     // vertical extreme of the column over the image rows of the window
-    reg [W-1:0] vext;
+    reg [15*W-1:0] vcand;
     integer i;
     always @* begin
-        vext = pv1 ? p1 : ID;
+        vcand = {15{ID}};
+        vcand[W-1:0] = pv1r ? p1r : ID;
         for (i = 0; i < NL; i = i + 1)
-            if (mv1[i]) vext = pick(vext, qall[i*W +: W]);
+            if (K > 1 && mv1r[i]) vcand[(i+1)*W +: W] = q1r[i*W +: W];
     end
+    wire [W-1:0] vext = tree(vcand, NL + 1);
 
     // ---- stage 2: horizontal shift register of vertical extremes -----------------------------
     reg           valid2, emit2, first2, eol2;
@@ -208,29 +248,30 @@ module rfl_morph #(
         if (!aresetn) begin
             valid2 <= 1'b0;
         end else if (adv) begin
-            valid2 <= valid1;
-            emit2  <= emit1;
-            first2 <= first1;
-            eol2   <= eol1;
-            hmask2 <= hmask1;
+            valid2 <= valid1r;
+            emit2  <= emit1r;
+            first2 <= first1r;
+            eol2   <= eol1r;
+            hmask2 <= hmask1r;
         end
     end
 
     generate
         if (K > 1) begin : shift
-            always @(posedge aclk) if (adv && valid1) sr <= {sr[K*W-W-1:0], vext};
+            always @(posedge aclk) if (adv && valid1r) sr <= {sr[K*W-W-1:0], vext};
         end else begin : noshift
-            always @(posedge aclk) if (adv && valid1) sr <= vext;
+            always @(posedge aclk) if (adv && valid1r) sr <= vext;
         end
     endgenerate
 
-    reg [W-1:0] hext;
+    reg [15*W-1:0] hcand;
     integer h;
     always @* begin
-        hext = ID;
+        hcand = {15{ID}};
         for (h = 0; h < K; h = h + 1)
-            if (hmask2[h]) hext = pick(hext, sr[h*W +: W]);
+            if (hmask2[h]) hcand[h*W +: W] = sr[h*W +: W];
     end
+    wire [W-1:0] hext = tree(hcand, K);
 
     // ---- stage 3: output register ------------------------------------------------------------
     assign m_axis_tkeep = KEEP;
