@@ -191,26 +191,26 @@ module rfl_morph #(
     end
 
     // ---- stage 1r: the line memories' outputs registered (a block RAM's clock-to-output is
-    // slow; the window's extremes start from flip-flops) ------------------------------------
-    reg           valid1r, pv1r, emit1r, first1r, eol1r;
-    reg [W-1:0]   p1r;
-    reg [NL-1:0]  mv1r;
+    // slow; the window's extremes start from flip-flops), those outside the image replaced by
+    // the identity of the extreme on the way ----------------------------------------------------
+    reg           valid1r, emit1r, first1r, eol1r;
     reg [K-1:0]   hmask1r;
-    reg [NL*W-1:0] q1r;
+    reg [15*W-1:0] vcand;      // candidates of the vertical extreme: the pixel, then the lines
 
+    integer i;
     always @(posedge aclk) begin
         if (!aresetn) begin
             valid1r <= 1'b0;
         end else if (adv) begin
             valid1r <= valid1;
-            p1r     <= p1;
-            pv1r    <= pv1;
-            mv1r    <= mv1;
-            q1r     <= qall;
             emit1r  <= emit1;
             first1r <= first1;
             eol1r   <= eol1;
             hmask1r <= hmask1;
+            vcand   <= {15{ID}};
+            vcand[W-1:0] <= pv1 ? p1 : ID;
+            for (i = 0; i < NL; i = i + 1)
+                if (K > 1 && mv1[i]) vcand[(i+1)*W +: W] <= qall[i*W +: W];
         end
     end
 
@@ -229,14 +229,6 @@ module rfl_morph #(
     endfunction
 
     // vertical extreme of the column over the image rows of the window
-    reg [15*W-1:0] vcand;
-    integer i;
-    always @* begin
-        vcand = {15{ID}};
-        vcand[W-1:0] = pv1r ? p1r : ID;
-        for (i = 0; i < NL; i = i + 1)
-            if (K > 1 && mv1r[i]) vcand[(i+1)*W +: W] = q1r[i*W +: W];
-    end
     wire [W-1:0] vext = tree(vcand, NL + 1);
 
     // ---- stage 2: horizontal shift register of vertical extremes -----------------------------

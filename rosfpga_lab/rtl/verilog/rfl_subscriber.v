@@ -63,6 +63,8 @@ module rfl_subscriber #(
     localparam [SUMW-1:0] AFTER_FID_S = AFTER_FRAME_ID;
     localparam [SUMW-1:0] AFTER_ENC_S = AFTER_ENCODING;
 
+    localparam [31:0] HEIGHT_32 = HEIGHT, WIDTH_32 = WIDTH, ENC_LEN_32 = ENC_LEN;
+
     localparam [3:0] S_FLEN = 4'd0, S_SEQ = 4'd1, S_SECS = 4'd2, S_NSECS = 4'd3,
                      S_FIDLEN = 4'd4, S_FID = 4'd5, S_HEIGHT = 4'd6, S_WIDTH = 4'd7,
                      S_ENCLEN = 4'd8, S_ENC = 4'd9, S_BIG = 4'd10, S_STEP = 4'd11,
@@ -75,7 +77,9 @@ module rfl_subscriber #(
     reg [23:0]   acc;                           // the bytes of a uint32 field so far
     reg [CW-1:0] flast;                         // last index of the current string field
     reg          same;                          // the encoding matches so far
-    reg [7:0]    fid_mem [0:FRAME_ID_MAX-1];
+    reg          one_left;                      // `left` is 1
+    // distributed RAM: a block RAM's clock-to-output would start the publisher's output path
+    (* ram_style = "distributed" *) reg [7:0] fid_mem [0:FRAME_ID_MAX-1];
 
     // A new frame waits until the publisher has taken the previous frame's fields.
     wire at_start = (state == S_FLEN) && (cnt == 0);
@@ -91,15 +95,46 @@ module rfl_subscriber #(
 
     wire [31:0] value = {s_tdata, acc};         // the uint32 completed by this byte
     wire        u32_done = (cnt == U32_LAST);
-    wire        last_byte = in_frame && (left == ONE);   // the frame's last byte is taken
-    // a length that fits its limit, at the width of the sums below
-    wire [SUMW-1:0] value_s = value[SUMW-1:0];
-    wire        left_big = |(left >> SUMW);
-    wire [SUMW-1:0] left_s = left[SUMW-1:0];
-    wire        fid_fits = (value <= FRAME_ID_MAX)
-                           && (left_big || value_s + AFTER_FID_S < left_s);
-    wire        enc_fits = (value <= ENCODING_MAX)
-                           && (left_big || value_s + AFTER_ENC_S < left_s);
+    wire        last_byte = in_frame && one_left;        // the frame's last byte is taken
+
+    // Every check of a uint32 field is split: its low three bytes are compared as the third
+    // byte is taken (into the registers pre_*), the fourth byte alone as it comes. The sums
+    // with the bytes left use `left` after the third byte (left - 1 then).
+    wire [23:0] low = value[31:8];              // the low three bytes, as the third comes
+    wire [LW-1:0] left3 = left - ONE;           // `left` as the fourth byte comes
+    wire [SUMW-1:0] low_s = low[SUMW-1:0];
+    wire        left3_big = |(left3 >> SUMW);
+    wire [SUMW-1:0] left3_s = left3[SUMW-1:0];
+    reg pre_fid, pre_enc, pre_zero, pre_one, pre_short, pre_long, pre_enclen,
+        pre_height, pre_width, pre_step, pre_dlen, pre_dleft;
+    always @(posedge clk) begin
+        if (take && cnt == U32_LAST - 1'b1) begin
+            pre_fid <= (low <= FRAME_ID_MAX) && (left3_big || low_s + AFTER_FID_S < left3_s);
+            pre_enc <= (low <= ENCODING_MAX) && (left3_big || low_s + AFTER_ENC_S < left3_s);
+            pre_zero <= (low == 24'd0);
+            pre_one <= (low == 24'd1);
+            pre_short <= (low < MIN_BODY);
+            pre_long <= (low > MAX_FRAME_32[23:0]);
+            pre_enclen <= (low == ENC_LEN_32[23:0]);
+            pre_height <= (low == HEIGHT_32[23:0]);
+            pre_width <= (low == WIDTH_32[23:0]);
+            pre_step <= (low == STEP[23:0]);
+            pre_dlen <= (low == DATA_BYTES[23:0]);
+            pre_dleft <= (left3 == DATA_LEFT);
+        end
+    end
+    wire top0 = (s_tdata == 8'd0);
+    wire fid_fits = top0 && pre_fid;            // FRAME_ID_MAX and ENCODING_MAX are < 2**24
+    wire enc_fits = top0 && pre_enc;
+    wire is_zero = top0 && pre_zero;
+    wire too_long = (s_tdata > MAX_FRAME_32[31:24])
+                    || (s_tdata == MAX_FRAME_32[31:24] && pre_long);
+    wire too_short = top0 && pre_short;          // MIN_BODY < 2**24
+    wire is_one = top0 && pre_one;
+    wire height_ok = (s_tdata == HEIGHT_32[31:24]) && pre_height;
+    wire width_ok = (s_tdata == WIDTH_32[31:24]) && pre_width;
+    wire step_ok = (s_tdata == STEP[31:24]) && pre_step;
+    wire dlen_ok = (s_tdata == DATA_BYTES[31:24]) && pre_dlen && pre_dleft;
 
     // the expected encoding byte at position n of the string
     function [7:0] enc_at(input [CW-1:0] n);
@@ -148,6 +183,7 @@ module rfl_subscriber #(
             acc <= 24'd0;
             flast <= {CW{1'b0}};
             same <= 1'b0;
+            one_left <= 1'b0;
             meta_valid <= 1'b0;
             meta_secs <= 32'd0;
             meta_nsecs <= 32'd0;
@@ -160,23 +196,25 @@ module rfl_subscriber #(
             if (meta_release) meta_valid <= 1'b0;
             if (take) begin
                 left <= left - ONE;
+                one_left <= (left == 2);
                 acc <= value[31:8];
                 cnt <= cnt + 1'b1;
                 case (state)
                     S_FLEN: if (u32_done) begin
                         cnt <= {CW{1'b0}};
-                        if (value > MAX_FRAME_32) begin
+                        if (too_long) begin
                             // Not to be trusted for skipping: wait for the next frame length.
                             status_valid <= 1'b1;
                             status <= SUB_BAD_FRAME_LENGTH;
                         end else begin
                             left <= value[LW-1:0];
-                            if (value < MIN_BODY) begin
+                            one_left <= is_one;
+                            if (too_short) begin
                                 // Too short for an Image, but framed: skip its bytes, as the
                                 // HLS subscriber and the Python interpreter do.
                                 status_valid <= 1'b1;
                                 status <= SUB_BAD_FRAME_LENGTH;
-                                if (value != 32'd0) begin
+                                if (!is_zero) begin
                                     state <= S_SKIP;
                                     in_frame <= 1'b1;
                                 end
@@ -201,26 +239,26 @@ module rfl_subscriber #(
                         end else begin
                             meta_fid_len <= value[FIDW-1:0];
                             flast <= value[CW-1:0] - 1'b1;
-                            advance(value == 32'd0 ? S_HEIGHT : S_FID);
+                            advance(is_zero ? S_HEIGHT : S_FID);
                         end
                     end
                     S_FID: if (cnt == flast) advance(S_HEIGHT);
                     S_HEIGHT: if (u32_done) begin
-                        if (value != HEIGHT) refuse(SUB_BAD_HEIGHT);
+                        if (!height_ok) refuse(SUB_BAD_HEIGHT);
                         else advance(S_WIDTH);
                     end
                     S_WIDTH: if (u32_done) begin
-                        if (value != WIDTH) refuse(SUB_BAD_WIDTH);
+                        if (!width_ok) refuse(SUB_BAD_WIDTH);
                         else advance(S_ENCLEN);
                     end
                     S_ENCLEN: if (u32_done) begin
                         if (!enc_fits) begin
                             refuse(SUB_BAD_ENCODING_LENGTH);
-                        end else if (value == 32'd0) begin
+                        end else if (is_zero) begin
                             refuse(SUB_BAD_ENCODING);   // an empty string matches no encoding
                         end else begin
                             flast <= value[CW-1:0] - 1'b1;
-                            same <= (value == ENC_LEN);
+                            same <= top0 && pre_enclen;
                             advance(S_ENC);
                         end
                     end
@@ -236,11 +274,11 @@ module rfl_subscriber #(
                         advance(S_STEP);
                     end
                     S_STEP: if (u32_done) begin
-                        if (value != STEP) refuse(SUB_BAD_STEP);
+                        if (!step_ok) refuse(SUB_BAD_STEP);
                         else advance(S_DLEN);
                     end
                     S_DLEN: if (u32_done) begin
-                        if (value != DATA_BYTES || left != DATA_LEFT) begin
+                        if (!dlen_ok) begin
                             refuse(SUB_BAD_DATA_LENGTH);
                         end else begin
                             status_valid <= 1'b1;
