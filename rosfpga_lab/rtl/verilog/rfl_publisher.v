@@ -48,6 +48,7 @@ module rfl_publisher #(
     localparam [IW-1:0] DATA_LAST = DATA_LAST_32[IW-1:0];
     localparam [IW-1:0] ENC_LAST = ENC_LAST_32[IW-1:0];
     localparam [IW-1:0] U32_LAST = 3;
+    localparam [FIDA-1:0] FID_ONE = 1;
 
     localparam [3:0] F_IDLE = 4'd0, F_LEN = 4'd1, F_SEQ = 4'd2, F_SECS = 4'd3, F_NSECS = 4'd4,
                      F_FIDLEN = 4'd5, F_FID = 4'd6, F_HEIGHT = 4'd7, F_WIDTH = 4'd8,
@@ -57,6 +58,7 @@ module rfl_publisher #(
     reg [3:0]    f;                             // the field being written
     reg [IW-1:0] i;                             // its byte being written
     reg [IW-1:0] ilast;                         // its last byte's index
+    reg [FIDA-1:0] fid_next;                    // i + 1, for the frame_id RAM's address
     reg [31:0]   seq;
     reg [31:0]   word;                          // the field's value, for uint32 fields
     reg [3:0]    fnext;                         // the field after this one
@@ -118,7 +120,8 @@ module rfl_publisher #(
     wire put = m_tvalid && m_tready;
     wire field_done = put && (i == ilast);
     wire [IW-1:0] i_next = i + 1'b1;
-    assign fid_raddr = (f != F_FID) ? {FIDA{1'b0}} : put ? i_next[FIDA-1:0] : i[FIDA-1:0];
+    // in F_FID m_tvalid is 1, so a byte goes when m_tready is 1
+    assign fid_raddr = (f != F_FID) ? {FIDA{1'b0}} : m_tready ? fid_next : i[FIDA-1:0];
     assign meta_release = field_done && (f == F_BIG);  // the last field taken from the subscriber
     assign frame_done = field_done && (f == F_DATA);
     assign idle = (f == F_IDLE);
@@ -128,6 +131,7 @@ module rfl_publisher #(
             f <= F_IDLE;
             i <= {IW{1'b0}};
             ilast <= U32_LAST;
+            fid_next <= FID_ONE;
             seq <= SEQ_START;
         end else if (f == F_IDLE) begin
             if (meta_valid) begin
@@ -136,11 +140,13 @@ module rfl_publisher #(
             end
         end else if (field_done) begin
             i <= {IW{1'b0}};
+            fid_next <= FID_ONE;
             f <= fnext;
             ilast <= last_of(fnext);
             if (f == F_DATA) seq <= seq + 32'd1;
         end else if (put) begin
             i <= i_next;
+            fid_next <= fid_next + 1'b1;
         end
     end
 endmodule
