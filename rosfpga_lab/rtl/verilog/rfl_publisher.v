@@ -58,7 +58,8 @@ module rfl_publisher #(
     reg [3:0]    f;                             // the field being written
     reg [IW-1:0] i;                             // its byte being written
     reg [IW-1:0] ilast;                         // its last byte's index
-    reg [FIDA-1:0] fid_next;                    // i + 1, for the frame_id RAM's address
+    reg          in_fid;                        // f is F_FID
+    reg [FIDA-1:0] fa, fa1;                     // frame_id byte shown, and the next one
     reg [31:0]   seq;
     reg [31:0]   word;                          // the field's value, for uint32 fields
     reg [3:0]    fnext;                         // the field after this one
@@ -120,8 +121,8 @@ module rfl_publisher #(
     wire put = m_tvalid && m_tready;
     wire field_done = put && (i == ilast);
     wire [IW-1:0] i_next = i + 1'b1;
-    // in F_FID m_tvalid is 1, so a byte goes when m_tready is 1
-    assign fid_raddr = (f != F_FID) ? {FIDA{1'b0}} : m_tready ? fid_next : i[FIDA-1:0];
+    // in F_FID m_tvalid is 1, so a byte goes when m_tready is 1: one LUT from registers
+    assign fid_raddr = (in_fid && m_tready) ? fa1 : fa;
     assign meta_release = field_done && (f == F_BIG);  // the last field taken from the subscriber
     assign frame_done = field_done && (f == F_DATA);
     assign idle = (f == F_IDLE);
@@ -131,22 +132,33 @@ module rfl_publisher #(
             f <= F_IDLE;
             i <= {IW{1'b0}};
             ilast <= U32_LAST;
-            fid_next <= FID_ONE;
+            in_fid <= 1'b0;
+            fa <= {FIDA{1'b0}};
+            fa1 <= FID_ONE;
             seq <= SEQ_START;
         end else if (f == F_IDLE) begin
             if (meta_valid) begin
                 f <= F_LEN;
+                fa <= {FIDA{1'b0}};
+                fa1 <= FID_ONE;
                 ilast <= U32_LAST;
             end
         end else if (field_done) begin
+            if (in_fid) begin
+                fa <= fa1;
+                fa1 <= fa1 + 1'b1;
+            end
             i <= {IW{1'b0}};
-            fid_next <= FID_ONE;
+            in_fid <= (fnext == F_FID);
             f <= fnext;
             ilast <= last_of(fnext);
             if (f == F_DATA) seq <= seq + 32'd1;
         end else if (put) begin
             i <= i_next;
-            fid_next <= fid_next + 1'b1;
+            if (in_fid) begin
+                fa <= fa1;
+                fa1 <= fa1 + 1'b1;
+            end
         end
     end
 endmodule
