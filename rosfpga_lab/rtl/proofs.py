@@ -87,8 +87,9 @@ PROOFS: tuple[Proof, ...] = (
     Proof("subscriber", ("rfl_subscriber.v",), "prove", 8,
           "rfl_subscriber (any input bytes): pixel stream rules, status codes of the table; "
           "all reachable states"),
-    # induction does not close here: the output byte is read from the subscriber's frame_id
-    # memory, which the wrapper leaves free (the whole rfl_top below closes instead)
+    # bounded: the publisher's place in the frame is not visible on its ports (the whole
+    # rfl_top below closes by induction instead); the wrapper reads frame_id from a RAM of any
+    # fixed contents with a clock, as rfl_top does
     Proof("publisher", ("rfl_publisher.v",), "bmc", 32,
           "rfl_publisher (2x1 mono8): output stream rules, releases only fields it holds; 32 "
           "clocks (through the header and frame_id)"),
