@@ -9,6 +9,9 @@ MAX_XMLRPC_BODY = 8 << 20
 #: graph (900 topics with long names pass 8 MiB) and rosmaster sets no limit, so replies get more
 #: room than requests; the cap only bounds what a broken or hostile server can make us hold.
 MAX_XMLRPC_REPLY = 64 << 20
+#: Calls one ``system.multicall`` may batch (roslaunch batches a handful, rospy one per
+#: registration at shutdown); a longer list is refused whole with a fault.
+MAX_XMLRPC_MULTICALL = 1000
 #: Largest HTTP head (request line + headers).
 MAX_HTTP_HEAD = 16 << 10
 #: Seconds an XML-RPC call (connect + request + reply) may take.

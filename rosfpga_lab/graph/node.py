@@ -47,7 +47,7 @@ from rosfpga_lab.graph.subscriber import Subscriber
 from rosfpga_lab.graph.topic import TopicContext
 from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close, socket_ends
-from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, split_uri
+from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call, split_uri, unsupported
 from rosfpga_lab.tcpros import (
     HANDSHAKE_TIMEOUT,
     MAX_FRAME_BYTES,
@@ -447,7 +447,7 @@ class Node:
     def _handle_xmlrpc(self, method: str, params: tuple) -> Any:
         f = self._methods.get(method)
         if f is None:
-            raise Fault(1, f'method "{method}" is not supported')
+            raise unsupported(method)
         return f(*params)
 
     @checked((), "")

@@ -34,6 +34,7 @@ from rosfpga_lab.graph.limits import (
     MAX_XMLRPC_BODY,
     MAX_XMLRPC_CONNECTIONS,
     MAX_XMLRPC_DEPTH,
+    MAX_XMLRPC_MULTICALL,
     MAX_XMLRPC_REPLY,
     XMLRPC_IDLE_TIMEOUT,
     XMLRPC_REQUEST_TIMEOUT,
@@ -479,7 +480,10 @@ class XmlRpcServer:
         if method is None:
             return _fault(-32600, "not an XML-RPC request (no methodName)"), "", params, "fault"
         try:
-            value = self.handler(method, params)
+            if method == "system.multicall":
+                value = multicall(self.handler, params)
+            else:
+                value = self.handler(method, params)
             return dump_response(value), method, params, value
         except Fault as fault:
             return _fault(fault.code, fault.message), method, params, f"fault: {fault.message}"
@@ -509,6 +513,47 @@ class XmlRpcServer:
             threads[0].join(max(0.0, deadline - time.monotonic()))
         if self._sock is not None:
             self._sock.close()
+
+
+def unsupported(method: str) -> Fault:
+    """The fault Python's dispatcher (rosmaster's, rospy's) answers for an unknown method."""
+    return Fault(1, f"<class 'Exception'>:method \"{method}\" is not supported")
+
+
+def multicall(handler: Handler, params: tuple) -> list:
+    """``system.multicall`` as Python's ``SimpleXMLRPCDispatcher`` answers it (rosmaster's and
+    rospy's servers): a list of ``{methodName, params}`` structs in, a list of ``[result]`` or
+    ``{faultCode, faultString}`` out, each call answered on its own; at most
+    :data:`MAX_XMLRPC_MULTICALL` calls, and no multicall inside a multicall (Python runs it;
+    here it is that call's fault).
+
+    Raises:
+        Fault: not one list of structs with ``methodName`` and ``params`` (Python's texts), or
+            more than :data:`MAX_XMLRPC_MULTICALL` calls: nothing is run then.
+    """
+    try:
+        (calls,) = params
+        if len(calls) > MAX_XMLRPC_MULTICALL:
+            raise Fault(1, f"system.multicall of {len(calls)} calls refused: at most "
+                           f"{MAX_XMLRPC_MULTICALL} (graph.limits.MAX_XMLRPC_MULTICALL)")
+        batch = [(one["methodName"], one["params"]) for one in calls]
+    except (TypeError, KeyError, ValueError) as exc:
+        raise Fault(1, f"{type(exc)}:{exc}") from None
+    results: list = []
+    for name, args in batch:
+        try:
+            if not isinstance(name, str):
+                raise unsupported(str(name))
+            if name == "system.multicall":
+                raise Fault(1, "system.multicall inside system.multicall is refused")
+            if not isinstance(args, list):
+                raise TypeError(f"params must be an array, not {type(args).__name__}")
+            results.append([handler(name, tuple(args))])
+        except Fault as fault:
+            results.append({"faultCode": fault.code, "faultString": fault.message})
+        except Exception as exc:  # what Python's dispatcher answers: "<class 'X'>:text"
+            results.append({"faultCode": 1, "faultString": f"{type(exc)}:{exc}"})
+    return results
 
 
 def _fault(code: int, message: str) -> bytes:
