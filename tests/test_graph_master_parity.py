@@ -249,3 +249,27 @@ def test_rostopic_pub_and_echo_leave_nothing_behind(tmp_path: Path, lab_master) 
     assert pub.returncode == 0, err
     assert lab_master.getSystemState("/x")[2] == [[], [], []]
     assert lab_master.nodes == {}
+
+
+# ---------------------------------------------------------------- item 14: full message_definition
+def test_lab_publisher_sends_genpys_full_text(lab_master) -> None:
+    """A lab publisher's connection header carries genpy's ``_full_text`` byte for byte,
+    comments included (pinned: tests/golden/sensor_msgs_Image.full_text, 2016 bytes)."""
+    import socket
+
+    from rosfpga_lab.graph import Node
+    from rosfpga_lab.tcpros import decode_header, encode_header
+
+    golden = (Path(__file__).resolve().parent / "golden" / "sensor_msgs_Image.full_text").read_bytes()
+    with Node("/full_text_pub", master=lab_master) as node:
+        node.advertise("/img", "sensor_msgs/Image")
+        with socket.create_connection(("127.0.0.1", node.tcpros_port), timeout=5) as sock:
+            sock.sendall(encode_header({"callerid": "/probe", "topic": "/img", "md5sum": "*",
+                                        "type": "sensor_msgs/Image"}))
+            data = b""
+            while len(data) < 4 or len(data) < 4 + int.from_bytes(data[:4], "little"):
+                chunk = sock.recv(65536)
+                assert chunk, "publisher closed before its header"
+                data += chunk
+    fields, _used = decode_header(data)
+    assert fields["message_definition"].encode() == golden
