@@ -47,6 +47,13 @@ CONNECT_TIMEOUT = 5.0
 RECONNECT_FIRST = 0.1
 RECONNECT_FACTOR = 2.0
 RECONNECT_MAX = 5.0
+#: Service connections a node's service port serves at once; a new one beyond this evicts the
+#: connection idle longest (a call in progress is never evicted).
+MAX_SERVICE_CONNECTIONS = 64
+#: Seconds a persistent service connection may wait for its next request.
+SERVICE_IDLE_TIMEOUT = 30.0
+#: Seconds one service call (connect, header, request, handler, response) may take by default.
+SERVICE_CALL_TIMEOUT = 10.0
 #: Seconds stop()/shutdown() waits for each worker thread.
 JOIN_TIMEOUT = 5.0
 #: Seconds the master waits on one publisherUpdate/paramUpdate/shutdown notification.

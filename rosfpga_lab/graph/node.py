@@ -43,6 +43,7 @@ from rosfpga_lab.graph.names import (
 )
 from rosfpga_lab.graph.owner import listener_uids
 from rosfpga_lab.graph.publisher import Publisher
+from rosfpga_lab.graph.service import ServiceServer
 from rosfpga_lab.graph.subscriber import Subscriber
 from rosfpga_lab.graph.topic import TopicContext
 from rosfpga_lab.graph.trace import Trace, new_connection_id
@@ -176,7 +177,11 @@ class Node:
         self.is_shutdown = False
         self.shutdown_reason = ""   # why it shut down (e.g. a remote slave-API shutdown's message)
         self._down = threading.Event()
+        self._service_port: ServiceServer | None = None   # started with the first service
+        self._logging: Any = None   # /rosout and logger services, from the first registration
+        self.ros_logging = True     # False: this node offers neither (before its first registration)
         bind = bind_address(self.host)
+        self._bind_host = self.host
         if self.host in ALL_INTERFACES:  # peers need a reachable name, not 0.0.0.0
             self.host = socket.gethostname()
         self._xmlrpc = XmlRpcServer(self._handle_xmlrpc, host=bind, port=xmlrpc_port,
@@ -253,6 +258,7 @@ class Node:
         """
         topic = check_topic_name(topic, self.name)
         md5, definition = self._type_info(type_name, md5sum, message_definition)
+        self._start_logging()
         with self._lock:
             if self.is_shutdown:
                 raise GraphError(f"node {self.name} is shut down")
@@ -318,6 +324,7 @@ class Node:
         md5, definition = self._type_info(type_name, md5sum, None)
         if type_name == "*" and not raw:
             raise GraphError("subscribing with type '*' needs raw=True (nothing to deserialize with)")
+        self._start_logging()
         with self._lock:
             if self.is_shutdown:
                 raise GraphError(f"node {self.name} is shut down")
@@ -339,6 +346,67 @@ class Node:
         sub.update_publishers([u for u in pubs if isinstance(u, str)])
         return sub
 
+    # ------------------------------------------------------------------ services
+    def _start_logging(self) -> None:
+        """At the first registration: ``/rosout`` and the logger services (see ``rosout``)."""
+        with self._lock:
+            if self._logging is not None or not self.ros_logging or self.is_shutdown:
+                return
+            self._logging = True   # taken: the calls below come back here
+        from rosfpga_lab.graph.rosout import start_node_logging
+
+        try:
+            self._logging = start_node_logging(self)
+        except Exception:
+            self._logging = None
+            raise
+
+    def advertise_service(self, service: str, srv_type: str, handler: Callable[[dict], dict]) -> str:
+        """Serve ``service`` (``~name`` is private to this node) of the shipped type
+        ``srv_type`` with ``handler(request) -> response`` (dicts); register it with the
+        master; return its global name. A handler that raises answers the caller ``ok=0``
+        with its text.
+
+        Raises:
+            UnknownTypeError: ``srv_type`` is not a shipped service type.
+            MasterError, XmlRpcError: the master refused or cannot be reached.
+        """
+        from rosfpga_lab.msg.srv import service_registry, srv_spec
+
+        name = check_topic_name(service, self.name)
+        srv = srv_spec(srv_type)
+        with self._lock:
+            if self.is_shutdown:
+                raise GraphError(f"node {self.name} is shut down")
+            if self._service_port is None:
+                self._service_port = ServiceServer(self.name, bind_address(self._bind_host),
+                                                   self.host, service_registry()[0], self.trace)
+            port = self._service_port
+        port.add(name, srv, handler)
+        self._master("registerService", name, port.uri, self.uri)
+        return name
+
+    def call_service(self, service: str, srv_type: str, request: dict | None = None, *,
+                     timeout: float | None = None) -> dict:
+        """Call ``service`` (looked up at the master) with ``request``; return the response.
+
+        Raises:
+            ServiceError: no provider, refused, ``ok=0`` (the provider's text) or time-out.
+            UnknownTypeError: ``srv_type`` is not a shipped service type.
+        """
+        from rosfpga_lab.graph.limits import SERVICE_CALL_TIMEOUT
+        from rosfpga_lab.graph.service import ServiceError, call_service
+        from rosfpga_lab.msg.srv import service_registry, srv_spec
+
+        name = check_topic_name(service, self.name)
+        srv = srv_spec(srv_type)
+        try:
+            uri = self._master("lookupService", name)
+        except MasterError as exc:
+            raise ServiceError(f"no provider of service [{name}]: {exc.status or exc}") from None
+        return call_service(uri, name, srv, request, callerid=self.name, registry=service_registry()[0],
+                            timeout=SERVICE_CALL_TIMEOUT if timeout is None else timeout, trace=self.trace)
+
     def register_again(self) -> None:
         """Register every publisher and subscriber of this node again, after the master
         restarted and forgot the graph.
@@ -354,6 +422,9 @@ class Node:
         with self._lock:
             pubs = list(self.publishers.values())
             subs = list(self.subscribers.values())
+        port = self._service_port
+        for name in port.names() if port is not None else []:
+            self._master("registerService", name, port.uri, self.uri)
         for pub in pubs:
             self._master("registerPublisher", pub.topic, pub.type_name, self.uri)
         for sub in subs:
@@ -544,6 +615,17 @@ class Node:
             subs = list(self.subscribers.values())
             self.publishers.clear()
             self.subscribers.clear()
+        from rosfpga_lab.graph.rosout import stop_node_logging
+
+        stop_node_logging(self._logging if self._logging is not True else None)
+        port = self._service_port
+        for name in port.names() if port is not None else []:
+            try:
+                self._master("unregisterService", name, port.uri)
+            except GraphError:
+                pass
+        if port is not None:
+            port.stop()
         topic_objects: list[Publisher | Subscriber] = [*subs, *pubs]
         for topic_object in topic_objects:
             self._leave(topic_object)
