@@ -277,7 +277,8 @@ def call_service(uri: str, service: str, srv: SrvSpec, request: dict | None, *, 
     t0 = time.time()
     try:
         with socket.create_connection((host, port), timeout=timeout) as sock:
-            sock.sendall(client.request_header + client.request(body))
+            sock.sendall(client.request_header)  # the request after the server's header, as
+            #                                      rospy's client does (rospy's server reads no further)
             while True:
                 left = deadline - time.monotonic()
                 if left <= 0:
@@ -286,6 +287,8 @@ def call_service(uri: str, service: str, srv: SrvSpec, request: dict | None, *, 
                 data = sock.recv(RECV_CHUNK)
                 events = client.receive_data(data) if data else client.receive_eof()
                 for ev in events:
+                    if isinstance(ev, ServiceHeader) and "error" not in ev.fields:
+                        sock.sendall(client.request(body))
                     if isinstance(ev, ServiceRejected):
                         raise ServiceError(f"service [{service}] at {uri} refused the call: {ev.error}")
                     if isinstance(ev, ServiceResponse):
