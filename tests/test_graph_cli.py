@@ -60,7 +60,7 @@ def test_master_cli_serves_and_stops() -> None:
         node = Node("/probe", master_uri=f"http://127.0.0.1:{port}/")
         node.advertise("/x", "std_msgs/String")
         out = cli("topic", "--master-uri", f"http://127.0.0.1:{port}/", "list")
-        assert out.stdout.split() == ["/x"]
+        assert out.stdout.split() == ["/rosout", "/x"]   # every node logs on /rosout, as in ROS
         node.shutdown()
     finally:
         stop_process(proc)

@@ -423,8 +423,9 @@ class Node:
             pubs = list(self.publishers.values())
             subs = list(self.subscribers.values())
         port = self._service_port
-        for name in port.names() if port is not None else []:
-            self._master("registerService", name, port.uri, self.uri)
+        if port is not None:
+            for name in port.names():
+                self._master("registerService", name, port.uri, self.uri)
         for pub in pubs:
             self._master("registerPublisher", pub.topic, pub.type_name, self.uri)
         for sub in subs:
@@ -619,12 +620,12 @@ class Node:
 
         stop_node_logging(self._logging if self._logging is not True else None)
         port = self._service_port
-        for name in port.names() if port is not None else []:
-            try:
-                self._master("unregisterService", name, port.uri)
-            except GraphError:
-                pass
         if port is not None:
+            for name in port.names():
+                try:
+                    self._master("unregisterService", name, port.uri)
+                except GraphError:
+                    pass
             port.stop()
         topic_objects: list[Publisher | Subscriber] = [*subs, *pubs]
         for topic_object in topic_objects:
