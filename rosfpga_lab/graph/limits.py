@@ -54,6 +54,10 @@ MAX_SERVICE_CONNECTIONS = 64
 SERVICE_IDLE_TIMEOUT = 30.0
 #: Seconds one service call (connect, header, request, handler, response) may take by default.
 SERVICE_CALL_TIMEOUT = 10.0
+#: Seconds between two checks that the master still knows a registered node (a node the master
+#: forgot, after a restart, registers again), and how long one check may take.
+MASTER_CHECK_PERIOD = 1.0
+MASTER_CHECK_TIMEOUT = 2.0
 #: Seconds stop()/shutdown() waits for each worker thread.
 JOIN_TIMEOUT = 5.0
 #: Seconds the master waits on one publisherUpdate/paramUpdate/shutdown notification.

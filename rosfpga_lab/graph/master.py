@@ -24,6 +24,7 @@ import logging
 import os
 import threading
 import uuid
+import weakref
 from typing import Any
 
 from rosfpga_lab.config.limits import DEFAULT_MASTER_PORT
@@ -49,6 +50,8 @@ from rosfpga_lab.graph.xmlrpc import (
 )
 
 MASTER_ID = "/master"
+#: Masters running in this process, by URI (a node's watchdog asks them directly, untraced).
+_local: weakref.WeakValueDictionary[str, EmbeddedMaster] = weakref.WeakValueDictionary()
 #: What roscore's launch file puts in ``/rosdistro`` and ``/rosversion`` (``rosversion -d`` and
 #: ``rosversion roslaunch``, each with its newline): the ROS release and the ros_comm version
 #: whose master replies this one matches (the golden tests pin them against that rosmaster).
@@ -221,6 +224,7 @@ class EmbeddedMaster:
         for t in self._notifiers:
             t.start()
         self.running = True
+        _local[self.uri] = self
         return self
 
     def stop(self) -> None:
@@ -228,6 +232,8 @@ class EmbeddedMaster:
         if not self.running:
             return
         self.running = False
+        if _local.get(self.uri) is self:
+            del _local[self.uri]
         self._server.stop()
         with self._notify_cond:
             self._stopping = True
@@ -595,3 +601,23 @@ def param_updates(subscribers: dict[str, dict[str, str]], key: str, value: Any,
             else:
                 out.extend((sub_key, api, ns_key, {}) for api in regs.values())
     return out
+
+
+def knows_node(master_uri: str, name: str, api: str, timeout: float) -> bool | None:
+    """Whether the master at ``master_uri`` has ``name`` registered with ``api`` (None: with
+    another API: someone took the name). A master running in this process is asked directly
+    (no XML-RPC, nothing in any trace); another one by an untraced ``lookupNode``.
+
+    Raises:
+        GraphError: the master cannot be reached.
+    """
+    local = _local.get(master_uri)
+    if local is not None and local.running:
+        with local._lock:
+            known = local.nodes.get(name)
+    else:
+        reply = call(master_uri, "lookupNode", name, name, timeout=timeout)
+        known = reply[2] if isinstance(reply, list) and len(reply) == 3 and reply[0] == 1 else None
+    if known is None:
+        return False
+    return True if known == api else None

@@ -180,6 +180,8 @@ class Node:
         self._service_port: ServiceServer | None = None   # started with the first service
         self._logging: Any = None   # /rosout and logger services, from the first registration
         self.ros_logging = True     # False: this node offers neither (before its first registration)
+        self.watch_master = True    # register again after a master restart (see ``watchdog``)
+        self._watch: Any = None
         bind = bind_address(self.host)
         self._bind_host = self.host
         if self.host in ALL_INTERFACES:  # peers need a reachable name, not 0.0.0.0
@@ -349,7 +351,11 @@ class Node:
     # ------------------------------------------------------------------ services
     def _start_logging(self) -> None:
         """At the first registration: ``/rosout`` and the logger services (see ``rosout``)."""
+        from rosfpga_lab.graph.watchdog import MasterWatch
+
         with self._lock:
+            if self._watch is None and not self.is_shutdown:
+                self._watch = MasterWatch(self)
             if self._logging is not None or not self.ros_logging or self.is_shutdown:
                 return
             self._logging = True   # taken: the calls below come back here
@@ -618,6 +624,8 @@ class Node:
             self.subscribers.clear()
         from rosfpga_lab.graph.rosout import stop_node_logging
 
+        if self._watch is not None:
+            self._watch.stop()
         stop_node_logging(self._logging if self._logging is not True else None)
         port = self._service_port
         if port is not None:
