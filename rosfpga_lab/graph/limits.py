@@ -5,6 +5,11 @@ from __future__ import annotations
 #: Largest HTTP request/response body accepted (XML-RPC payloads are small; 8 MiB leaves room
 #: for a big getSystemState or parameter tree).
 MAX_XMLRPC_BODY = 8 << 20
+#: Bytes of request bodies one XML-RPC server holds at once, all connections together: a
+#: request whose declared body would pass it is refused at once ("503", before its body is
+#: read), so 64 concurrent 8 MiB bodies cannot make a master hold half a gigabyte (each body
+#: also costs its parsed values). Legitimate calls are a few kilobytes.
+MAX_XMLRPC_BODIES_IN_FLIGHT = 64 << 20
 #: Largest XML-RPC reply body a client call accepts. A master's ``getSystemState`` grows with the
 #: graph (900 topics with long names pass 8 MiB) and rosmaster sets no limit, so replies get more
 #: room than requests; the cap only bounds what a broken or hostile server can make us hold.
@@ -12,6 +17,10 @@ MAX_XMLRPC_REPLY = 64 << 20
 #: Calls one ``system.multicall`` may batch (roslaunch batches a handful, rospy one per
 #: registration at shutdown); a longer list is refused whole with a fault.
 MAX_XMLRPC_MULTICALL = 1000
+#: Connections the kernel queues for a server socket before accept() takes them (the kernel
+#: caps it at net.core.somaxconn). A burst larger than the queue loses SYNs, and each lost SYN
+#: costs its client a 1 s retransmit: 64 made the slowest of 250 concurrent calls 1.1-1.3 s.
+LISTEN_BACKLOG = 1024
 #: Largest HTTP head (request line + headers).
 MAX_HTTP_HEAD = 16 << 10
 #: Seconds an XML-RPC call (connect + request + reply) may take.

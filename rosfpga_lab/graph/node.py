@@ -32,7 +32,12 @@ from rosfpga_lab.config import limits as config_limits
 from rosfpga_lab.config.master import master_uri_from_env
 from rosfpga_lab.graph.apicheck import api_methods, checked
 from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcError
-from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MAX_PENDING_HANDSHAKES, MAX_PUBLISHERS_PER_TOPIC
+from rosfpga_lab.graph.limits import (
+    JOIN_TIMEOUT,
+    LISTEN_BACKLOG,
+    MAX_PENDING_HANDSHAKES,
+    MAX_PUBLISHERS_PER_TOPIC,
+)
 from rosfpga_lab.graph.master import MASTER_ID, EmbeddedMaster
 from rosfpga_lab.graph.names import (
     ALL_INTERFACES,
@@ -198,7 +203,7 @@ class Node:
             self._tcp.close()
             self._xmlrpc.stop()
             raise XmlRpcError(f"cannot bind TCPROS port {bind}:{tcpros_port}: {exc}") from None
-        self._tcp.listen(64)
+        self._tcp.listen(LISTEN_BACKLOG)
         self.tcpros_port = self._tcp.getsockname()[1]
         self._accept = threading.Thread(target=self._accept_loop, daemon=True,
                                         name=f"rosfpga-tcpros-accept-{self.name}")

@@ -24,6 +24,7 @@ from typing import Any
 from rosfpga_lab.graph.errors import GraphError
 from rosfpga_lab.graph.limits import (
     JOIN_TIMEOUT,
+    LISTEN_BACKLOG,
     MAX_SERVICE_CONNECTIONS,
     SERVICE_CALL_TIMEOUT,
     SERVICE_IDLE_TIMEOUT,
@@ -94,7 +95,7 @@ class ServiceServer:
         except OSError as exc:
             self._sock.close()
             raise GraphError(f"cannot bind the service port of {name} on {bind}: {exc}") from None
-        self._sock.listen(128)
+        self._sock.listen(LISTEN_BACKLOG)
         self.port = self._sock.getsockname()[1]
         #: calls answered, and connections closed to make room for newer ones
         self.calls = 0
