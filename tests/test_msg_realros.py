@@ -33,7 +33,7 @@ from test_msg_parse import BAD, TRICKY
 
 pytestmark = pytest.mark.ros
 REG = default_registry()
-PACKAGES = ("std_msgs", "sensor_msgs", "geometry_msgs")
+PACKAGES = ("std_msgs", "sensor_msgs", "geometry_msgs", "rosgraph_msgs", "roscpp")
 
 
 def run_helper(name: str, argv: list[str] | None = None, stdin: Any = None) -> Any:
