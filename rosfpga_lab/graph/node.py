@@ -265,7 +265,6 @@ class Node:
         """
         topic = check_topic_name(topic, self.name)
         md5, definition = self._type_info(type_name, md5sum, message_definition)
-        self._start_logging()
         with self._lock:
             if self.is_shutdown:
                 raise GraphError(f"node {self.name} is shut down")
@@ -280,6 +279,7 @@ class Node:
             with self._lock:
                 self.publishers.pop(topic, None)
             raise
+        self._start_logging()
         return pub
 
     def _context(self) -> TopicContext:
@@ -331,7 +331,6 @@ class Node:
         md5, definition = self._type_info(type_name, md5sum, None)
         if type_name == "*" and not raw:
             raise GraphError("subscribing with type '*' needs raw=True (nothing to deserialize with)")
-        self._start_logging()
         with self._lock:
             if self.is_shutdown:
                 raise GraphError(f"node {self.name} is shut down")
@@ -350,12 +349,14 @@ class Node:
                 self.subscribers.pop(topic, None)
             sub.close()
             raise
+        self._start_logging()   # before connecting: a latched message comes after subscribe()
         sub.update_publishers([u for u in pubs if isinstance(u, str)])
         return sub
 
     # ------------------------------------------------------------------ services
     def _start_logging(self) -> None:
-        """At the first registration: ``/rosout`` and the logger services (see ``rosout``)."""
+        """After the first registration: ``/rosout`` and the logger services (see ``rosout``),
+        and the master watchdog; a master that refuses them costs a warning, not the topic."""
         from rosfpga_lab.graph.watchdog import MasterWatch
 
         with self._lock:
@@ -368,9 +369,10 @@ class Node:
 
         try:
             self._logging = start_node_logging(self)
-        except Exception:
+        except GraphError as exc:
             self._logging = None
-            raise
+            warnings.warn(f"{self.name}: no /rosout or logger services: {exc}", RuntimeWarning,
+                          stacklevel=3)
 
     def advertise_service(self, service: str, srv_type: str, handler: Callable[[dict], dict]) -> str:
         """Serve ``service`` (``~name`` is private to this node) of the shipped type
