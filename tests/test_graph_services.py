@@ -269,3 +269,34 @@ def test_rosout_agg_shows_lab_messages(any_master_uri, tmp_path: Path) -> None:
 
 
 __all__ = ["run_ros_python", "service_registry"]
+
+
+def test_the_component_answers_rosservice_and_reaches_rosout_agg(tmp_path: Path) -> None:
+    """The FPGA component is a lab node like the others: ``rosservice call /<component>/get_loggers``
+    answers, and its logger's records reach ``/rosout_agg`` through Debian's rosout."""
+    require_ros()
+    from rosfpga_lab.component import FpgaComponent
+
+    config = Path(__file__).resolve().parents[1] / "data" / "fpga_dilate_rgba8.yaml"
+    with EmbeddedMaster(port=0) as m:
+        env = _tool_env(m.uri, tmp_path)
+        comp = FpgaComponent.from_config(config, master=m).start()
+        agg = subprocess.Popen(["/usr/lib/rosout/rosout"], env=env, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+        try:
+            name = comp.name
+            out = subprocess.run(["rosservice", "call", f"{name}/get_loggers"], env=env,
+                                 capture_output=True, text=True, timeout=30)
+            assert out.returncode == 0 and 'name: "rosfpga_lab"' in out.stdout, out.stderr
+            with Node("/agg_watch", m.uri) as watch:
+                got: list[dict] = []
+                watch.subscribe("/rosout_agg", "rosgraph_msgs/Log", got.append)
+                deadline = time.monotonic() + 20
+                while time.monotonic() < deadline and not any(g["name"] == name for g in got):
+                    logging.getLogger("rosfpga_lab.component").warning("component says hi")
+                    time.sleep(0.2)
+                assert any(g["name"] == name and g["msg"] == "component says hi" for g in got)
+        finally:
+            agg.terminate()
+            agg.wait(10)
+            comp.stop()
