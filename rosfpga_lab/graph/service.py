@@ -180,9 +180,9 @@ class ServiceServer:
             for ev in events:
                 if isinstance(ev, ServiceHeader):
                     caller = ev.fields.get("callerid", peer)
-                    self._record("tcpros_header", role="in", src=caller, dst=self.name,
+                    self._record("service_call", role="in", src=caller, dst=self.name,
                                  method=ev.fields.get("service", ""), args=dict(ev.fields),
-                                 raw=ev.raw, size=len(ev.raw), **ends)
+                                 result="connection header", size=len(ev.raw), **ends)
                 elif isinstance(ev, ServiceRejected):
                     conn.settimeout(1.0)
                     conn.sendall(ev.reply)
