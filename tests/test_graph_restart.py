@@ -40,12 +40,13 @@ def test_library_nodes_register_again_after_a_restart(caplog: pytest.LogCaptureF
         listener = Node("/restart_listener", master_uri=first.uri)
         pub = talker.advertise("/restart_t", "std_msgs/String")
         sub = listener.subscribe("/restart_t", "std_msgs/String")
+        assert talker.logging_ready.wait(5) and listener.logging_ready.wait(5)
         first.stop()
         second = EmbeddedMaster(port=port).start()
         try:
             assert wait_for(lambda: "/restart_talker" in second.publishers.get("/restart_t", {})
-                            and "/restart_listener" in second.subscribers.get("/restart_t", {}))
-            assert "/restart_talker/get_loggers" in second.services
+                            and "/restart_listener" in second.subscribers.get("/restart_t", {})
+                            and "/restart_talker/get_loggers" in second.services)
             time.sleep(2.5)   # more checks pass: the node is known now, nothing more is said
             assert len(restarted_lines(caplog, "/restart_talker")) == 1
             assert len(restarted_lines(caplog, "/restart_listener")) == 1
@@ -78,6 +79,7 @@ def test_a_node_registers_again_with_a_restarted_rosmaster(tmp_path: Path,
     try:
         with Node("/restart_cam", master_uri=uri) as node:
             node.advertise("/image_raw", "sensor_msgs/Image")
+            assert node.logging_ready.wait(10)
             stop_process(proc)
             proc = rosmaster()
 

@@ -139,6 +139,7 @@ def test_node_serves_and_calls_and_unregisters(master) -> None:
 def test_every_node_has_logger_services_and_rosout(master) -> None:
     with Node("/log_a", master=master) as a, Node("/log_b", master=master) as b:
         a.advertise("/t", "std_msgs/String")
+        assert a.logging_ready.wait(5)
         services = dict(master.getSystemState("/x")[2][2])
         assert services == {"/log_a/get_loggers": ["/log_a"], "/log_a/set_logger_level": ["/log_a"]}
         names = {lg["name"] for lg in b.call_service("/log_a/get_loggers", "roscpp/GetLoggers")["loggers"]}
@@ -210,6 +211,7 @@ def test_rosservice_lists_and_calls_a_lab_node(any_master_uri, tmp_path: Path) -
 
     with Node("/lab_svc", any_master_uri) as node:
         node.advertise("/t", "std_msgs/String")
+        assert node.logging_ready.wait(10)
         assert {"/lab_svc/get_loggers", "/lab_svc/set_logger_level"} <= set(rosservice("list").split())
         assert rosservice("type", "/lab_svc/get_loggers").strip() == "roscpp/GetLoggers"
         assert 'name: "rosfpga_lab"' in rosservice("call", "/lab_svc/get_loggers")
@@ -286,6 +288,7 @@ def test_the_component_answers_rosservice_and_reaches_rosout_agg(tmp_path: Path)
                                stderr=subprocess.DEVNULL)
         try:
             name = comp.name
+            assert comp.node is not None and comp.node.logging_ready.wait(10)
             out = subprocess.run(["rosservice", "call", f"{name}/get_loggers"], env=env,
                                  capture_output=True, text=True, timeout=30)
             assert out.returncode == 0 and 'name: "rosfpga_lab"' in out.stdout, out.stderr
@@ -301,3 +304,23 @@ def test_the_component_answers_rosservice_and_reaches_rosout_agg(tmp_path: Path)
             agg.terminate()
             agg.wait(10)
             comp.stop()
+
+
+def test_random_bytes_only_raise_protocol_errors() -> None:
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    from rosfpga_lab.tcpros import ProtocolError
+
+    @settings(max_examples=200, deadline=None)
+    @given(st.binary(max_size=300), st.booleans())
+    def run(data: bytes, server_side: bool) -> None:
+        machine = (ServiceServerConnection("/n", lookup, max_frame=1000, max_header=200) if server_side
+                   else ServiceClientConnection("/c", "/n/svc", "*", max_frame=1000, max_header=200))
+        try:
+            machine.receive_data(data)
+            machine.receive_eof()
+        except ProtocolError:
+            pass
+
+    run()

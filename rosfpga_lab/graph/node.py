@@ -187,6 +187,9 @@ class Node:
         self.ros_logging = True     # False: this node offers neither (before its first registration)
         self.watch_master = True    # register again after a master restart (see ``watchdog``)
         self._watch: Any = None
+        self._logging_thread: threading.Thread | None = None
+        #: set once /rosout and the logger services are registered (or failed)
+        self.logging_ready = threading.Event()
         bind = bind_address(self.host)
         self._bind_host = self.host
         if self.host in ALL_INTERFACES:  # peers need a reachable name, not 0.0.0.0
@@ -349,14 +352,15 @@ class Node:
                 self.subscribers.pop(topic, None)
             sub.close()
             raise
-        self._start_logging()   # before connecting: a latched message comes after subscribe()
         sub.update_publishers([u for u in pubs if isinstance(u, str)])
+        self._start_logging()
         return sub
 
     # ------------------------------------------------------------------ services
     def _start_logging(self) -> None:
-        """After the first registration: ``/rosout`` and the logger services (see ``rosout``),
-        and the master watchdog; a master that refuses them costs a warning, not the topic."""
+        """After the first registration: the master watchdog, and (in a thread of its own, so
+        registering a topic takes no longer than before) ``/rosout`` and the logger services
+        (see ``rosout``); a master that refuses those costs a warning, not the topic."""
         from rosfpga_lab.graph.watchdog import MasterWatch
 
         with self._lock:
@@ -364,15 +368,23 @@ class Node:
                 self._watch = MasterWatch(self)
             if self._logging is not None or not self.ros_logging or self.is_shutdown:
                 return
-            self._logging = True   # taken: the calls below come back here
+            self._logging = True   # taken: the calls it makes come back here
+            self._logging_thread = threading.Thread(target=self._setup_logging, daemon=True,
+                                                    name=f"rosfpga-rosout-{self.name}")
+            self._logging_thread.start()
+
+    def _setup_logging(self) -> None:
+        from rosfpga_lab.graph.rosout import log as rosout_log
         from rosfpga_lab.graph.rosout import start_node_logging
 
         try:
             self._logging = start_node_logging(self)
         except GraphError as exc:
             self._logging = None
-            warnings.warn(f"{self.name}: no /rosout or logger services: {exc}", RuntimeWarning,
-                          stacklevel=3)
+            if not self.is_shutdown:
+                rosout_log.warning("%s: no /rosout or logger services: %s", self.name, exc)
+        finally:
+            self.logging_ready.set()
 
     def advertise_service(self, service: str, srv_type: str, handler: Callable[[dict], dict]) -> str:
         """Serve ``service`` (``~name`` is private to this node) of the shipped type
@@ -444,6 +456,8 @@ class Node:
         for sub in subs:
             uris = self._master("registerSubscriber", sub.topic, sub.type_name, self.uri)
             sub.update_publishers([u for u in uris if isinstance(u, str)], keep_live=True)
+        if self._logging is None:   # its setup failed while the master was away: again
+            self._start_logging()
 
     # ------------------------------------------------------------------ TCPROS server
     def _accept_loop(self) -> None:
@@ -631,6 +645,9 @@ class Node:
             self.subscribers.clear()
         from rosfpga_lab.graph.rosout import stop_node_logging
 
+        setup = self._logging_thread
+        if setup is not None and setup is not threading.current_thread():
+            setup.join(JOIN_TIMEOUT)   # its registrations are undone below
         if self._watch is not None:
             self._watch.stop()
         stop_node_logging(self._logging if self._logging is not True else None)

@@ -22,6 +22,8 @@ if TYPE_CHECKING:  # pragma: no cover
     from rosfpga_lab.graph.node import Node
     from rosfpga_lab.graph.publisher import Publisher
 
+log = logging.getLogger("rosfpga_lab.graph")
+
 #: The logger tree the lab's records come from (and the logger services act on).
 LAB_LOGGER = "rosfpga_lab"
 ROSOUT_TOPIC = "/rosout"

@@ -6,7 +6,8 @@ advertises. Each connection gets a thread running
 :class:`~rosfpga_lab.tcpros.service.ServiceServerConnection` (bytes in, events out): the client's
 header must be complete within ``HANDSHAKE_TIMEOUT``; a persistent connection may then sit idle
 for at most :data:`SERVICE_IDLE_TIMEOUT` between calls; at most :data:`MAX_SERVICE_CONNECTIONS`
-connections are served at once (a new one beyond that evicts the one idle longest). A request
+connections are served at once (a new one beyond that evicts the one idle longest, or is closed
+when every one is inside a call). A request
 is decoded with the service's request type, the handler's dict is encoded with the response
 type; a handler that raises answers ``ok=0`` with its text, as rospy does ("error processing
 request: ..."). :func:`call_service` is one call from a client: lookupService, connect, header,
@@ -97,9 +98,11 @@ class ServiceServer:
             raise GraphError(f"cannot bind the service port of {name} on {bind}: {exc}") from None
         self._sock.listen(LISTEN_BACKLOG)
         self.port = self._sock.getsockname()[1]
-        #: calls answered, and connections closed to make room for newer ones
+        #: calls answered, connections closed to make room for newer ones, and connections
+        #: refused because every one was inside a call
         self.calls = 0
         self.evicted = 0
+        self.refused = 0
         self._accept = threading.Thread(target=accept_loop, daemon=True,
                                         name=f"rosfpga-service-accept-{name}",
                                         args=(self._sock, lambda: self._running, self._admit,
@@ -134,7 +137,12 @@ class ServiceServer:
     def _admit(self, conn: socket.socket, peer: str) -> None:
         with self._lock:
             if len(self._conns) >= MAX_SERVICE_CONNECTIONS:
-                victim = min(self._conns, key=self._conns.__getitem__)
+                idle = [c for c, since in self._conns.items() if since != float("inf")]
+                if not idle:  # every connection is inside a call: this one waits for none
+                    self.refused += 1
+                    hard_close(conn)
+                    return
+                victim = min(idle, key=self._conns.__getitem__)
                 del self._conns[victim]
                 self.evicted += 1
                 try:  # wakes its thread, which closes it
