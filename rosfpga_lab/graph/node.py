@@ -187,7 +187,7 @@ class Node:
         self.ros_logging = True     # False: this node offers neither (before its first registration)
         self.watch_master = True    # register again after a master restart (see ``watchdog``)
         self._watch: Any = None
-        self._logging_thread: threading.Thread | None = None
+        self._updates: dict[str, int] = {}   # topic -> publisherUpdate calls received
         #: set once /rosout and the logger services are registered (or failed)
         self.logging_ready = threading.Event()
         bind = bind_address(self.host)
@@ -345,6 +345,7 @@ class Node:
                              message_definition=definition if send_definition else None,
                              max_frame=max_frame, max_publishers=max_publishers)
             self.subscribers[topic] = sub
+        updates = self._updates.get(topic, 0)
         try:
             pubs = self._master("registerSubscriber", topic, type_name, self.uri)
         except Exception:
@@ -352,15 +353,17 @@ class Node:
                 self.subscribers.pop(topic, None)
             sub.close()
             raise
-        sub.update_publishers([u for u in pubs if isinstance(u, str)])
-        self._start_logging()
+        self._start_logging()   # before connecting: a latched message comes after subscribe()
+        if self._updates.get(topic, 0) == updates:  # else a newer list came meanwhile: kept
+            sub.update_publishers([u for u in pubs if isinstance(u, str)])
         return sub
 
     # ------------------------------------------------------------------ services
     def _start_logging(self) -> None:
-        """After the first registration: the master watchdog, and (in a thread of its own, so
-        registering a topic takes no longer than before) ``/rosout`` and the logger services
-        (see ``rosout``); a master that refuses those costs a warning, not the topic."""
+        """After the first registration: the master watchdog, ``/rosout`` and the logger
+        services (see ``rosout``); a master that refuses those costs a warning, not the topic."""
+        from rosfpga_lab.graph.rosout import log as rosout_log
+        from rosfpga_lab.graph.rosout import start_node_logging
         from rosfpga_lab.graph.watchdog import MasterWatch
 
         with self._lock:
@@ -368,21 +371,12 @@ class Node:
                 self._watch = MasterWatch(self)
             if self._logging is not None or not self.ros_logging or self.is_shutdown:
                 return
-            self._logging = True   # taken: the calls it makes come back here
-            self._logging_thread = threading.Thread(target=self._setup_logging, daemon=True,
-                                                    name=f"rosfpga-rosout-{self.name}")
-            self._logging_thread.start()
-
-    def _setup_logging(self) -> None:
-        from rosfpga_lab.graph.rosout import log as rosout_log
-        from rosfpga_lab.graph.rosout import start_node_logging
-
+            self._logging = True   # taken: the calls below come back here
         try:
             self._logging = start_node_logging(self)
         except GraphError as exc:
             self._logging = None
-            if not self.is_shutdown:
-                rosout_log.warning("%s: no /rosout or logger services: %s", self.name, exc)
+            rosout_log.warning("%s: no /rosout or logger services: %s", self.name, exc)
         finally:
             self.logging_ready.set()
 
@@ -583,6 +577,7 @@ class Node:
         sub = self.subscribers.get(topic)
         if sub is None:
             return 1, f"not subscribed to {topic}", 0
+        self._updates[topic] = self._updates.get(topic, 0) + 1   # (one key per subscription)
         sub.update_publishers(publishers)
         return 1, "", 0
 
@@ -645,9 +640,6 @@ class Node:
             self.subscribers.clear()
         from rosfpga_lab.graph.rosout import stop_node_logging
 
-        setup = self._logging_thread
-        if setup is not None and setup is not threading.current_thread():
-            setup.join(JOIN_TIMEOUT)   # its registrations are undone below
         if self._watch is not None:
             self._watch.stop()
         stop_node_logging(self._logging if self._logging is not True else None)
