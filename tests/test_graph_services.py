@@ -324,3 +324,21 @@ def test_random_bytes_only_raise_protocol_errors() -> None:
             pass
 
     run()
+
+
+def test_a_publisher_update_during_subscribe_is_kept(master, monkeypatch) -> None:
+    """The first subscription also registers /rosout and the logger services; a publisherUpdate
+    that arrives meanwhile brings a newer list than registerSubscriber's: it is kept."""
+    with Node("/late_pub", master=master) as pub_node, Node("/early_sub", master=master) as sub_node:
+        original = sub_node._start_logging
+
+        def publisher_appears() -> None:
+            pub_node.advertise("/race", "std_msgs/String")   # the master's update comes now
+            deadline = time.monotonic() + 5
+            while time.monotonic() < deadline and not sub_node._updates.get("/race"):
+                time.sleep(0.01)
+            original()
+
+        monkeypatch.setattr(sub_node, "_start_logging", publisher_appears)
+        sub = sub_node.subscribe("/race", "std_msgs/String")
+        assert [uri for uri, _ in sub.publisher_links()] == [pub_node.uri]
