@@ -22,7 +22,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from rosfpga_lab.graph.errors import GraphError
+from rosfpga_lab.graph.errors import GraphError, ServiceError
 from rosfpga_lab.graph.limits import (
     JOIN_TIMEOUT,
     LISTEN_BACKLOG,
@@ -49,10 +49,6 @@ from rosfpga_lab.tcpros.service import (
 
 #: ``handler(request_dict) -> response_dict``
 ServiceHandler = Callable[[dict], dict]
-
-
-class ServiceError(GraphError):
-    """A service call failed: no provider, refused header, ``ok=0`` answer, or time-out."""
 
 
 def split_rosrpc(uri: str) -> tuple[str, int]:
