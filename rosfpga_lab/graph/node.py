@@ -191,7 +191,7 @@ class Node:
         #: set once /rosout and the logger services are registered (or failed)
         self.logging_ready = threading.Event()
         bind = bind_address(self.host)
-        self._bind_host = self.host
+        self._bind = bind   # (warned once, here, when it opens every interface)
         if self.host in ALL_INTERFACES:  # peers need a reachable name, not 0.0.0.0
             self.host = socket.gethostname()
         self._xmlrpc = XmlRpcServer(self._handle_xmlrpc, host=bind, port=xmlrpc_port,
@@ -398,7 +398,7 @@ class Node:
             if self.is_shutdown:
                 raise GraphError(f"node {self.name} is shut down")
             if self._service_port is None:
-                self._service_port = ServiceServer(self.name, bind_address(self._bind_host),
+                self._service_port = ServiceServer(self.name, self._bind,
                                                    self.host, service_registry()[0], self.trace)
             port = self._service_port
         port.add(name, srv, handler)
