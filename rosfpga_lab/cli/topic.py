@@ -7,7 +7,8 @@ import sys
 import threading
 import time
 
-from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
+from rosfpga_lab.cli._signals import holding
+from rosfpga_lab.config.limits import DEFAULT_MASTER_URI, ECHO_QUEUE
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -20,6 +21,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "own: start one with `rosfpga-lab master` or roscore).")
     p.add_argument("--master-uri", help="master to talk to (default: ROS_MASTER_URI or "
                    f"{DEFAULT_MASTER_URI})")
+    p.add_argument("--msg-path", action="append", metavar="DIR", default=[],
+                   help="also load message types from PKG/msg/NAME.msg files under DIR (repeatable)")
     sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
     ls = sub.add_parser("list", help="list topics", description="List the topics the master knows.")
     ls.add_argument("-v", "--verbose", action="store_true", help="show types and counts")
@@ -34,6 +37,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     echo.add_argument("--hex", action="store_true", help="print the raw body bytes in hex instead")
     echo.add_argument("--timeout", type=float, default=0.0,
                       help="give up after this many seconds, waiting included (default: never)")
+    echo.add_argument("--queue-size", type=int, default=ECHO_QUEUE, metavar="N",
+                      help="messages kept while printing falls behind; older ones are dropped and "
+                      f"counted (default: {ECHO_QUEUE}; 0: no limit)")
+    echo.add_argument("--bag", metavar="FILE", help="also record the messages to a new ROS 1 bag "
+                      "(rosbag info/play read it)")
     pub = sub.add_parser("pub", help="publish a message",
                          description="Publish a message, e.g.: topic pub /chatter std_msgs/String "
                          "'data: hello'. Arguments are YAML: one mapping, or field values in order.")
@@ -50,23 +58,41 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     hz.add_argument("-w", "--window", type=int, default=1000, help="window size in messages")
     hz.add_argument("--duration", type=float, default=0.0,
                     help="stop after this many seconds (default: Ctrl-C)")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, ros_node=True)
 
 
-def _node(uri: str, kind: str):
+def _node(uri: str, kind: str, args: argparse.Namespace | None = None):
     from rosfpga_lab.graph import Node
+    from rosfpga_lab.msg import registry_with
 
-    return Node(f"/rosfpga_lab_topic_{kind}_{int(time.time() * 1000) % 10**8}", master_uri=uri)
+    name, host = getattr(args, "identity", None) or (
+        f"/rosfpga_lab_topic_{kind}_{int(time.time() * 1000) % 10**8}", None)
+    return Node(name, master_uri=uri, host=host,
+                registry=registry_with(getattr(args, "msg_path", None) or []))
 
 
 def run(args: argparse.Namespace) -> int:
-    """Dispatch the action."""
-    from rosfpga_lab.graph import resolve, tools
+    """Dispatch the action; SIGINT and SIGTERM stop it cleanly (unregistered) whatever
+    disposition it inherited."""
+    from rosfpga_lab.cli._signals import StopSignals
 
-    uri = tools.pick_master_uri(args.master_uri)
+    with StopSignals():
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
+    from rosfpga_lab.config.rosargs import RosArgs, advertise_host, node_name, remap
+    from rosfpga_lab.graph import tools
+
+    ros = getattr(args, "ros", None) or RosArgs()
+    uri = tools.pick_master_uri(args.master_uri or ros.special.get("__master"))
     tools.check_master(uri)  # never end up alone: a clear error when no master answers
+    # rostopic's own node: anonymous, in ROS_NAMESPACE (or __ns), unless __name gives one
+    name = node_name(f"rosfpga_lab_topic_{args.action}_{int(time.time() * 1000) % 10**8}", ros)
+    args.identity = (name, advertise_host(ros, None).host)
     if getattr(args, "topic", None):
-        args.topic = resolve(args.topic)  # "chatter" means /chatter, as for rostopic
+        # "chatter" means /chatter (or /NS/chatter under ROS_NAMESPACE), then remapped, as for rostopic
+        args.topic = remap(args.topic, name, ros)
     if args.action == "list":
         print(tools.format_topic_list(uri, args.verbose))
         return 0
@@ -91,6 +117,8 @@ def _stopped_remotely(node) -> bool:
 
 def _echo(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import GraphError, tools
+    from rosfpga_lab.msg import MsgError, deserialize
+    from rosfpga_lab.msg.bag import BagWriter
 
     start = time.monotonic()
     try:
@@ -103,47 +131,89 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
         print(f"topic echo: {args.topic} was not published within {args.timeout} s",
               file=sys.stderr)
         return 1
-    node = _node(uri, "echo")
+    bag = BagWriter(args.bag) if args.bag else None  # before the node: a refusal leaves nothing
+    node = _node(uri, "echo", args)
     done = threading.Event()
     count = [0]
+    timed_out = False
+    failed: list[str] = []
+    known = type_name in node.registry
+    decoders: dict[tuple[str, str], object] = {}  # (md5, definition) -> registry from a header
 
     def show(body, info) -> None:
         if done.is_set():
             return
-        if args.hex:
-            print(bytes(body).hex(), flush=True)
-        else:
-            from rosfpga_lab.msg import deserialize
-
-            print(tools.format_message(deserialize(node.registry, type_name, body)), flush=True)
+        try:
+            if bag is not None:
+                ty = info.header.get("type", type_name)
+                md5 = info.header.get("md5sum") or node.registry.md5(ty)
+                definition = info.header.get("message_definition") or node.registry.full_text(ty)
+                bag.write(args.topic, ty, md5, definition, time.time_ns(), body, info.publisher)
+            if args.hex:
+                print(bytes(body).hex(), flush=True)
+            else:
+                reg = node.registry
+                if not known:
+                    key = (info.header.get("md5sum", ""), info.header.get("message_definition", ""))
+                    if key not in decoders:
+                        decoders[key] = tools.registry_from_header(type_name, info.header)
+                    reg = decoders[key]
+                print(tools.format_message(deserialize(reg, type_name, body)), flush=True)
+        except (GraphError, MsgError) as exc:
+            failed.append(str(exc))
+            done.set()
+            return
         print("---", flush=True)
         count[0] += 1
         if args.n and count[0] >= args.n:
             done.set()
 
+    reported, last_report = 0, time.monotonic()
+    sub = None
     try:
-        known = type_name in node.registry.types() if hasattr(node.registry, "types") else True
-        if not known and not args.hex:
-            raise GraphError(f"type {type_name} is not in the lab's registry; use --hex to see "
-                             "the raw bytes")
-        node.subscribe(args.topic, type_name if known else "*", show, raw=True, queue_size=100,
-                       md5sum=None if known else "*")
+        sub = node.subscribe(args.topic, type_name if known else "*", show, raw=True,
+                             queue_size=args.queue_size, md5sum=None if known else "*")
         end = start + args.timeout if args.timeout else None
         while not done.is_set() and not _stopped_remotely(node):
             if end is not None and time.monotonic() >= end:
+                timed_out = True
                 break
             done.wait(0.1)
+            if time.monotonic() - last_report >= 1.0:  # at most a line a second
+                reported, last_report = _report_drops(sub, args.queue_size, reported), time.monotonic()
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
+        if bag is not None:
+            bag.close()
+            print(f"topic echo: recorded {bag.count} messages to {args.bag}", file=sys.stderr)
+    if sub is not None:
+        _report_drops(sub, args.queue_size, reported, final=True)
+    if timed_out and args.n:
+        print(f"topic echo: timed out after {args.timeout:g} s: {count[0]} of {args.n} "
+              f"message(s) arrived on {args.topic}", file=sys.stderr)
+    if failed:
+        print(f"topic echo: {failed[0]}", file=sys.stderr)
+        return 1
     return 0 if (not args.n or count[0] >= args.n) else 1
+
+
+def _report_drops(sub, queue_size: int, reported: int, final: bool = False) -> int:
+    """Say on stderr how many messages were dropped since the last report; return the total."""
+    stats = sub.stats
+    if stats.drops > reported or final and stats.drops:
+        print(f"topic echo: {stats.drops} of {stats.frames} messages dropped "
+              f"{'in all' if final else 'so far'}: printing fell behind and the queue of {queue_size} "
+              "was full (a larger --queue-size keeps more; 0: no limit)", file=sys.stderr, flush=True)
+    return stats.drops
 
 
 def _pub(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import tools
 
-    node = _node(uri, "pub")
+    node = _node(uri, "pub", args)
     try:
         value = tools.parse_message_value(node.registry, args.type, args.values)
         pub = node.advertise(args.topic, args.type, latch=args.latch or args.once or not args.rate)
@@ -165,7 +235,8 @@ def _pub(args: argparse.Namespace, uri: str) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
     return 0
 
 
@@ -173,7 +244,7 @@ def _hz(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import tools
 
     meter = tools.RateMeter(samples=args.window + 1)  # the last N intervals, as rostopic hz -w N
-    node = _node(uri, "hz")
+    node = _node(uri, "hz", args)
     try:
         node.subscribe(args.topic, "*", lambda body, info: meter.tick(), raw=True, queue_size=0,
                        md5sum="*")
@@ -188,5 +259,6 @@ def _hz(args: argparse.Namespace, uri: str) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
     return 0

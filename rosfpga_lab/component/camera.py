@@ -2,7 +2,7 @@
 
 How this works: :class:`Camera` is a ROS node that publishes ``sensor_msgs/Image`` frames from
 an :class:`~rosfpga_lab.component.sources.ImageSource` on a fixed schedule (frame k is due at
-``start + k / rate``; a late frame is sent at once and the schedule is kept, so the average rate
+``start + k / rate``, or at its recorded offset for a bag source; a late frame is sent at once and the schedule is kept, so the average rate
 holds). Each frame's ``header.stamp`` is the wall-clock time it was published and
 ``header.seq`` its number: a subscriber computes latency from the stamp, and a checker finds
 the input frame an output came from by its stamp (the component carries stamps through).
@@ -120,8 +120,11 @@ class Camera:
         stop = stop or self._stop
         start = time.monotonic()
         k = 0
+        times = self.source.times  # a bag's recorded timing, repeated; else k / rate
+        span = (times[-1] * len(times) / (len(times) - 1) if len(times) > 1 and times[-1] > 0
+                else len(times) / self.rate) if times else 0.0
         while not stop.is_set() and (count is None or k < count):
-            due = start + k / self.rate
+            due = start + (k // len(times) * span + times[k % len(times)] if times else k / self.rate)
             if duration is not None and due - start >= duration:
                 break
             if stop.wait(max(0.0, due - time.monotonic())):

@@ -40,8 +40,13 @@ MAX_REFUSAL_KINDS = 64
 #: Camera limits: frames per second and image side.
 MAX_CAMERA_RATE = 1000.0
 MAX_CAMERA_SIDE = 8192
+#: Bytes of decoded frames a bag source (``camera --source x.bag``) holds in memory.
+MAX_BAG_SOURCE_BYTES = 512 * 1024 * 1024
 
 #: Pictures wider than this are shrunk before encoding (pixels).
 PAGE_IMAGE_MAX_WIDTH = 640
 #: Seconds between the ``node`` command's looks at its stop flag (how soon SIGTERM is obeyed).
 SIGNAL_POLL = 0.05
+#: Seconds between the ``node`` command's tries to reach a master that does not answer yet
+#: (rospy and roscpp nodes wait for it too: a launch order race is normal).
+MASTER_RETRY = 0.5

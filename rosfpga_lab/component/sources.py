@@ -9,7 +9,10 @@ frames differ (a frozen picture would hide a component that repeats its last out
   (single bright pixels make a dilation easy to see: each becomes a kernel-sized square);
 * ``grace_hopper``: the photo matplotlib ships (``matplotlib.cbook.get_sample_data``), panned
   slowly;
-* a file path: that picture, panned; a directory: its ``.png``/``.jpg`` files in turn.
+* a file path: that picture, panned; a directory: its ``.png``/``.jpg`` files in turn;
+* a ROS 1 bag (``.bag``, read with ``rosbags``, no ROS needed): its ``sensor_msgs/Image`` frames
+  of one topic as recorded (converted only when the size or encoding asked for differs), with
+  their recorded times in :attr:`ImageSource.times` so a camera replays them on that timing.
 
 Frames repeat with period :attr:`ImageSource.period`, so a camera can render each once.
 """
@@ -101,12 +104,19 @@ class ImageSource:
     """
 
     def __init__(self, name: str, width: int, height: int, encoding: str,
-                 period: int = DEFAULT_PERIOD) -> None:
+                 period: int = DEFAULT_PERIOD, topic: str | None = None) -> None:
         check_geometry(width, height, encoding)
         self.name, self.width, self.height, self.encoding = name, width, height, encoding
         self.period = max(1, int(period))
         self._pictures: list[np.ndarray] = []
+        #: A bag's frames as recorded, the bag topic read, and their times in seconds from the first.
+        self._frames: list[np.ndarray] = []
+        self.bag_topic: str | None = None
+        self.times: list[float] | None = None
         if name == "synthetic":
+            return
+        if name.endswith(".bag") and Path(name).is_file():
+            self._load_bag(Path(name), topic)
             return
         if name == "grace_hopper":
             self._pictures = [_grace_hopper()]
@@ -134,9 +144,59 @@ class ImageSource:
         size = (max(self.width + 2, round(w * scale)), max(self.height + 2, round(h * scale)))
         return cv2.resize(picture, size, interpolation=cv2.INTER_AREA)
 
+    def _load_bag(self, path: Path, topic: str | None) -> None:
+        from rosfpga_lab.msg import MsgError, default_registry, deserialize
+        from rosfpga_lab.msg.bag import bag_topics, read_bag
+
+        try:
+            images = sorted(t for t, ty in bag_topics(path).items() if ty == "sensor_msgs/Image")
+            if topic is None and len(images) == 1:
+                topic = images[0]
+            if topic not in images:
+                raise SourceError(f"{path}: {'no' if topic is None else f'no topic {topic} of'} "
+                                  f"sensor_msgs/Image to replay; its image topics: "
+                                  f"{', '.join(images) or 'none'} (choose one with --topic)")
+            reg, held, t0 = default_registry(), 0, None
+            self.times = []
+            for m in read_bag(path, [topic]):
+                frame = self._bag_frame(deserialize(reg, "sensor_msgs/Image", m.body), path)
+                held += frame.nbytes
+                if held > limits.MAX_BAG_SOURCE_BYTES:
+                    raise SourceError(f"{path}: the frames of {topic} need more than "
+                                      f"{limits.MAX_BAG_SOURCE_BYTES >> 20} MiB; cut the bag "
+                                      "(rosbag filter) or record fewer frames")
+                t0 = m.time_ns if t0 is None else t0
+                self.times.append((m.time_ns - t0) / 1e9)
+                self._frames.append(frame)
+        except MsgError as exc:
+            raise SourceError(f"{path}: {exc}") from None
+        if not self._frames:
+            raise SourceError(f"{path}: no messages on {topic}")
+        self.bag_topic, self.period = topic, len(self._frames)
+
+    def _bag_frame(self, msg: dict, path: Path) -> np.ndarray:
+        """A bag's Image as a frame of this source's size and encoding (as is when they match)."""
+        enc, w, h, step = msg["encoding"], msg["width"], msg["height"], msg["step"]
+        if enc not in PIXEL_FORMATS:
+            raise SourceError(f"{path}: frames in encoding {enc!r}; the lab reads "
+                              f"{', '.join(PIXEL_FORMATS)}")
+        bpp = PIXEL_FORMATS[enc].bytes_per_pixel
+        data = np.asarray(msg["data"], np.uint8)
+        if w * bpp > step or data.size < step * h or not w or not h:
+            raise SourceError(f"{path}: a frame's data does not match {w}x{h} {enc} step {step}")
+        image = data[:step * h].reshape(h, step)[:, :w * bpp].reshape(h, w, bpp)
+        if (w, h, enc) == (self.width, self.height, self.encoding):
+            return np.ascontiguousarray(image)
+        bgr = cv2.cvtColor(to_rgb(image, enc), cv2.COLOR_RGB2BGR)
+        if (w, h) != (self.width, self.height):
+            bgr = cv2.resize(bgr, (self.width, self.height), interpolation=cv2.INTER_AREA)
+        return from_bgr(bgr, self.encoding)
+
     def frame(self, k: int) -> np.ndarray:
         """The k-th frame, ``(height, width, channels)`` uint8 in :attr:`encoding`."""
         k %= self.period
+        if self._frames:
+            return self._frames[k]
         if not self._pictures:
             bgr = _synthetic(k, self.width, self.height, self.period)
         else:
@@ -150,9 +210,9 @@ class ImageSource:
 
 
 def open_source(name: str, width: int, height: int, encoding: str,
-                period: int = DEFAULT_PERIOD) -> ImageSource:
-    """Open an image source (see :class:`ImageSource`)."""
-    return ImageSource(name, width, height, encoding, period)
+                period: int = DEFAULT_PERIOD, topic: str | None = None) -> ImageSource:
+    """Open an image source (see :class:`ImageSource`; ``topic``: a bag's topic to read)."""
+    return ImageSource(name, width, height, encoding, period, topic)
 
 
 def _read(path: Path) -> np.ndarray:

@@ -11,8 +11,11 @@ stalls the socket. When a connection drops, the link retries with exponential ba
 (0.1 s doubling up to ``RECONNECT_MAX``) for as long as the master still lists that
 publisher; a refused handshake (md5 mismatch, ``error=`` reply) is not retried.
 
-Across a master restart (:meth:`Node.register_again`) established links are kept, as roscpp keeps
-them: the new master does not list their publishers until those register again (rospy and
+A publisher list without a connected publisher (its ``unregisterPublisher``, or a spoofed
+``publisherUpdate`` with an empty list) does not close the link: like rospy, the subscriber keeps
+it until the connection ends (a publisher that unregisters closes its connections), then does
+not retry. Across a master restart (:meth:`Node.register_again`) established links are kept the
+same way, as roscpp keeps them: the new master does not list their publishers until those register again (rospy and
 roscpp never do), so such a link is *kept* rather than confirmed. Later publisher lists never
 remove a kept link; one that lists its publisher confirms it; when its publisher closes the
 connection, it ends without retrying.
@@ -95,6 +98,9 @@ class _PublisherLink:
         self.connected = False
         self.kept = False   # kept across a master restart, not (yet) listed by the master
         self.permanent_error: str | None = None
+        self.conn = 0              # connection id of the current (or last) TCPROS connection
+        self.frames = 0            # frames and body bytes received on it (getBusStats)
+        self.bytes = 0
         self.thread = threading.Thread(target=self._run, daemon=True,
                                        name=f"rosfpga-sub-link-{sub.topic}")
 
@@ -147,6 +153,7 @@ class _PublisherLink:
         if sub.tcp_nodelay:
             set_nodelay(sock)
         conn = new_connection_id()
+        self.conn, self.frames, self.bytes = conn, 0, 0
         peer = f"{host}:{port}"
         ends = socket_ends(sock)
         node.trace.names[ends["local"]] = node.name
@@ -194,6 +201,8 @@ class _PublisherLink:
                 events, failure = exc.partial, exc
             for ev in events:
                 if isinstance(ev, Frame):
+                    self.frames += 1
+                    self.bytes += len(ev.body)
                     sub._deliver(ev.body, MessageInfo(sub.topic, publisher, conn, ev.index,
                                                       len(ev.body), time.time(), header), ev.offset, ends)
                 elif isinstance(ev, HeaderReceived):
@@ -262,10 +271,13 @@ class Subscriber:
     # ----------------------------------------------------------------- publishers
     def update_publishers(self, uris: list[str], *, keep_live: bool = False) -> None:
         """Make the links follow the master's publisher list ``uris`` (``registerSubscriber``'s
-        reply, ``publisherUpdate``): new ones are connected, vanished ones closed.
+        reply, ``publisherUpdate``): new ones are connected; an unlisted one still trying to
+        connect is closed, a connected one is *kept* until its connection ends (a publisher that
+        unregisters closes it), as rospy keeps it: a spoofed ``publisherUpdate`` with an empty
+        list cannot cut a live link.
 
-        With ``keep_live`` (a restarted master's first list), a connected link whose publisher
-        is not listed is kept (see the module docstring) instead of closed.
+        ``keep_live`` (a restarted master's first list) is accepted for the callers; every list
+        now keeps live links (see the module docstring).
         """
         with self._lock:
             if self.closed:
@@ -283,7 +295,7 @@ class Subscriber:
                 wanted = [u for u in wanted if u in keep]
             for uri in [u for u in self._links if u not in wanted]:
                 stale = self._links[uri]
-                if stale.kept or keep_live and stale.connected:
+                if stale.kept or stale.connected:  # live: kept until it fails (as rospy)
                     stale.kept = True
                     continue
                 self._links.pop(uri).close()
@@ -380,6 +392,13 @@ class Subscriber:
         """``(publisher XML-RPC URI, connected)`` of every publisher linked to now."""
         with self._lock:
             return [(uri, link.connected) for uri, link in self._links.items()]
+
+    def link_stats(self) -> list[tuple[int, int, int, bool]]:
+        """``(connection id, bytes, frames, connected)`` of every publisher link now (the
+        current connection of each; getBusStats)."""
+        with self._lock:
+            return [(link.conn, link.bytes, link.frames, link.connected)
+                    for link in self._links.values()]
 
     def get_num_connections(self) -> int:
         """Publishers connected right now."""

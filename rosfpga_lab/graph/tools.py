@@ -5,7 +5,6 @@ The CLI modules stay thin and call these; notebooks can call them too.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from typing import Any
@@ -17,6 +16,7 @@ from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcTooLargeErro
 from rosfpga_lab.graph.limits import MAX_ARRAY_SHOWN, TOPIC_POLL
 from rosfpga_lab.graph.rate import RateMeter  # noqa: F401  (rostopic hz's meter, re-exported)
 from rosfpga_lab.graph.xmlrpc import call
+from rosfpga_lab.msg.builtins import BUILTIN_TYPES, TIME_CLASS
 
 TOOL_ID = "/rosfpga_lab_topic"
 
@@ -142,84 +142,161 @@ def format_topic_info(uri: str, topic: str) -> str:
 
 
 def format_message(value: Any, indent: int = 0, max_array: int = MAX_ARRAY_SHOWN) -> str:
-    """Format a message dict like ``rostopic echo`` (YAML-ish); long arrays are summarised."""
-    pad = "  " * indent
-    lines: list[str] = []
-    for key, v in value.items():
-        if isinstance(v, dict):
-            lines.append(f"{pad}{key}: ")
-            lines.append(format_message(v, indent + 1, max_array))
-        elif hasattr(v, "secs") and hasattr(v, "nsecs"):
-            lines.append(f"{pad}{key}: ")
-            lines.append(f"{pad}  secs: {v.secs}")
-            lines.append(f"{pad}  nsecs: {v.nsecs:>9}")
-        elif isinstance(v, (np.ndarray, list, tuple, bytes, bytearray, memoryview)):
-            n = len(v)
-            if n > max_array:
-                dtype = getattr(v, "dtype", type(v[0]).__name__ if n else "?")
-                lines.append(f"{pad}{key}: \"<array type: {dtype}, length: {n}>\"")
-            elif n and isinstance(v[0], dict):
-                lines.append(f"{pad}{key}: ")
-                for item in v:
-                    body = format_message(item, indent + 1, max_array).split("\n")
-                    body[0] = f"{pad}  - " + body[0].lstrip()
-                    lines.extend(body)
-            else:
-                items = [_scalar(x) for x in (list(v) if not isinstance(v, np.ndarray) else v.tolist())]
-                lines.append(f"{pad}{key}: [{', '.join(items)}]")
-        else:
-            lines.append(f"{pad}{key}: {_scalar(v)}")
-    return "\n".join(lines)
+    """Format a message dict as ``rostopic echo`` does (genpy's ``strify_message``: valid YAML,
+    arrays of messages as block lists); arrays longer than ``max_array`` are summarised."""
+    return _strify_fields(value, "  " * indent, max_array)
 
 
-def _scalar(v: Any) -> str:
+def _strify_fields(value: Any, indent: str, max_array: int) -> str:
+    inner = "  " + indent
+    return "\n".join(f"{indent}{key}: {_strify(v, inner, max_array)}" for key, v in value.items())
+
+
+def _strify(v: Any, indent: str, max_array: int) -> str:
+    """One value as genpy's strify_message writes it at ``indent``."""
+    import yaml
+
+    if isinstance(v, np.generic):
+        v = v.item()
+    if isinstance(v, dict):
+        return "\n" + _strify_fields(v, indent, max_array)
+    if hasattr(v, "secs") and hasattr(v, "nsecs"):
+        return f"\n{indent}secs: {v.secs}\n{indent}nsecs: {v.nsecs:9d}"
     if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"' if v else "''"
-    if isinstance(v, bool):
-        return "True" if v else "False"
-    if isinstance(v, float):
-        return repr(v) if math.isfinite(v) else ("nan" if math.isnan(v) else ("inf" if v > 0 else "-inf"))
+        return yaml.dump(v, default_style='"').rstrip("\n") if v else "''"
+    if isinstance(v, (bool, int, float)):
+        return str(v)
+    if isinstance(v, (np.ndarray, list, tuple, bytes, bytearray, memoryview)):
+        n = len(v)
+        if n == 0:
+            return "[]"
+        if n > max_array:
+            dtype = getattr(v, "dtype", type(v[0]).__name__)
+            return f'"<array type: {dtype}, length: {n}>"'
+        items = v.tolist() if isinstance(v, np.ndarray) else list(v)
+        if isinstance(items[0], (bool, int, float)):
+            return str(items)
+        if isinstance(items[0], str):
+            return "\n" + "\n".join(indent + line for line in
+                                     yaml.dump(items).rstrip("\n").splitlines())
+        deeper = indent + "  "
+        return "\n" + "\n".join(f"{indent}- {_strify(x, deeper, max_array)}" for x in items)
     return str(v)
 
 
 def parse_message_value(registry: Any, type_name: str, args: list[str]) -> dict[str, Any]:
-    """Build a message from ``rostopic pub`` style arguments.
+    """Build a message from ``rostopic pub`` style arguments (genpy's ``fill_message_args``).
 
     One argument that is a YAML mapping (``"data: hi"`` or ``"{data: hi}"``) sets those
     fields; otherwise the arguments (each parsed as YAML) fill the top-level fields in order.
-    Unset fields keep their defaults.
+    Below the top, a mapping sets fields by name and a list fills a message's fields in order
+    (``geometry_msgs/Twist '[0.1, 0, 0]' '[0, 0, 1]'``), also inside arrays of messages. A
+    time field takes ``now`` or integer nanoseconds, a Header field ``auto`` (stamp now),
+    as for rostopic. Fields not given keep their defaults.
 
     Raises:
-        GraphError: YAML that does not parse, unknown fields, too many arguments.
+        GraphError: YAML that does not parse, unknown fields, too many values, a wrong shape.
     """
     import yaml
 
-    from rosfpga_lab.msg import new_message
+    from rosfpga_lab.msg import Time, new_message
 
     value = new_message(registry, type_name)
     try:
         parsed = [yaml.safe_load(a) for a in args]
     except yaml.YAMLError as exc:
         raise GraphError(f"cannot parse the message arguments as YAML: {exc}") from None
-    if len(parsed) == 1 and isinstance(parsed[0], dict):
-        _merge(value, parsed[0], type_name)
-        return value
-    names = registry.get(type_name).field_names
-    if len(parsed) > len(names):
-        raise GraphError(f"{type_name} has {len(names)} fields ({', '.join(names)}); got {len(parsed)} values")
-    for name, v in zip(names, parsed):
-        if isinstance(value[name], dict) and isinstance(v, dict):
-            _merge(value[name], v, f"{type_name}.{name}")
-        else:
-            value[name] = v
+    now = Time.from_sec(time.time())
+    keys = {"now": now, "auto": {**new_message(registry, "std_msgs/Header"), "stamp": now}}
+    _fill(registry, type_name, value, parsed[0] if len(parsed) == 1 and isinstance(parsed[0], dict)
+          else parsed, type_name, keys)
     return value
 
 
-def _merge(into: dict, new: dict, where: str) -> None:
-    for k, v in new.items():
-        if k not in into:
-            raise GraphError(f"{where} has no field {k!r} (fields: {', '.join(into)})")
-        if isinstance(into[k], dict) and isinstance(v, dict):
-            _merge(into[k], v, f"{where}.{k}")
+def _fill(registry: Any, type_name: str, into: dict, given: Any, where: str,
+          keys: dict[str, Any]) -> None:
+    """Set the fields of ``into`` (a message of ``type_name``) from a mapping or a list."""
+    spec = registry.get(type_name)
+    fields = {f.name: f for f in spec.fields}
+    if isinstance(given, dict):
+        pairs = list(given.items())
+    elif isinstance(given, (list, tuple)):
+        if len(given) > len(spec.fields):
+            raise GraphError(f"{where} has {len(spec.fields)} fields "
+                             f"({', '.join(fields)}); got {len(given)} values")
+        pairs = [(f.name, v) for f, v in zip(spec.fields, given)]
+    else:
+        raise GraphError(f"{where} is a {type_name} message: give a mapping or a list of its "
+                         f"fields ({', '.join(fields)}), not {given!r}")
+    for name, v in pairs:
+        f = fields.get(name) if isinstance(name, str) else None
+        if f is None:
+            raise GraphError(f"{where} has no field {name!r} (fields: {', '.join(fields)})")
+        at = f"{where}.{name}"
+        v = "" if v is None else v
+        if f.is_array and not f.is_builtin or f.is_array and f.base_type in TIME_CLASS:
+            if not isinstance(v, (list, tuple)):
+                raise GraphError(f"{at} is an array: give a list, not {v!r}")
+            if f.array_length is not None and len(v) != f.array_length:
+                raise GraphError(f"{at} has {f.array_length} elements; got {len(v)}")
+            into[name] = [_element(registry, f.base_type, x, f"{at}[{i}]", keys)
+                          for i, x in enumerate(v)]
+        elif f.is_array:
+            into[name] = v
         else:
-            into[k] = v
+            into[name] = _element(registry, f.base_type, v, at, keys, into[name])
+
+
+def _element(registry: Any, base: str, v: Any, where: str, keys: dict[str, Any],
+             current: Any = None) -> Any:
+    """One value of type ``base``: a message filled from ``v`` (over ``current`` or defaults),
+    a time from ``now``/nanoseconds, or ``v`` itself for a builtin."""
+    from rosfpga_lab.msg import new_message
+
+    if base in TIME_CLASS:
+        if isinstance(v, str):
+            if v not in keys or not hasattr(keys[v], "secs"):
+                raise GraphError(f"{where} is a {base}: give now, integer nanoseconds or "
+                                 f"{{secs: S, nsecs: N}}, not {v!r}")
+            return TIME_CLASS[base](keys[v].secs, keys[v].nsecs)
+        if isinstance(v, int) and not isinstance(v, bool):
+            return TIME_CLASS[base](*divmod(v, 10**9))
+        return v
+    if base in BUILTIN_TYPES:
+        return v
+    if isinstance(v, str):
+        if v not in keys or not isinstance(keys[v], dict) or registry.resolve(base) != "std_msgs/Header":
+            raise GraphError(f"{where} is a {base} message: {v!r} is no key (rostopic's keys: "
+                             "now for a time, auto for a Header)")
+        return dict(keys[v])
+    out = current if isinstance(current, dict) else new_message(registry, base)
+    _fill(registry, base, out, v, where, keys)
+    return out
+
+
+def registry_from_header(type_name: str, header: dict[str, str]) -> Any:
+    """A registry holding ``type_name`` as a publisher's connection header defines it (its
+    ``message_definition``), checked against the header's ``md5sum``, as rostopic and rosbag
+    decode types they have no package for.
+
+    Raises:
+        GraphError: the header has no definition, it does not parse, or its md5 differs.
+    """
+    from rosfpga_lab.msg import MsgError, MsgRegistry
+
+    who = header.get("callerid", "the publisher")
+    definition = header.get("message_definition", "")
+    if not definition.strip():
+        raise GraphError(f"{type_name} is not in the lab's registry and {who} sent no "
+                         "message_definition; add its package with --msg-path DIR or use --hex")
+    reg = MsgRegistry()
+    try:
+        reg.add_full_text(type_name, definition, f"message_definition from {who}")
+        md5 = reg.md5(type_name)
+    except MsgError as exc:
+        raise GraphError(f"cannot use the message_definition of {type_name} sent by {who}: "
+                         f"{exc}") from None
+    if header.get("md5sum", md5) not in (md5, "*"):
+        raise GraphError(f"the message_definition of {type_name} sent by {who} has md5 {md5}, "
+                         f"but its header says {header['md5sum']}: not decoding")
+    return reg

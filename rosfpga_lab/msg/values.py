@@ -39,7 +39,8 @@ def _default_element(reg: MsgRegistry, base: str) -> Any:
 def new_message(reg: MsgRegistry, type_name: str, **fields: Any) -> dict:
     """A message value with every field set: given ``fields`` plus defaults for the rest.
 
-    A dict given for a nested message field is completed with defaults too.
+    A dict given for a nested message field, or inside an array of messages, is completed
+    with defaults too.
 
     Args:
         reg: the registry holding the type.
@@ -65,10 +66,17 @@ def new_message(reg: MsgRegistry, type_name: str, **fields: Any) -> dict:
             continue
         value = fields[f.name]
         if not f.is_array and not f.is_builtin and isinstance(value, Mapping):
-            try:
-                value = new_message(reg, f.base_type, **value)
-            except SerializeError as exc:
-                raise SerializeError(str(exc).replace("field ", f"field {f.name}.", 1),
-                                     f"{f.name}.{exc.path}", exc.expected) from None
+            value = _completed(reg, f.base_type, value, f.name)
+        elif f.is_array and not f.is_builtin and isinstance(value, (list, tuple)):
+            value = [_completed(reg, f.base_type, v, f"{f.name}[{i}]") if isinstance(v, Mapping)
+                     else v for i, v in enumerate(value)]  # messages in arrays too, as genpy
         out[f.name] = value
     return out
+
+
+def _completed(reg: MsgRegistry, type_name: str, value: Mapping, where: str) -> dict:
+    try:
+        return new_message(reg, type_name, **value)
+    except SerializeError as exc:
+        raise SerializeError(str(exc).replace("field ", f"field {where}.", 1),
+                             f"{where}.{exc.path}", exc.expected) from None
