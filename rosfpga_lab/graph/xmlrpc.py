@@ -522,10 +522,10 @@ class XmlRpcServer:
                 finally:
                     self._release(reserved)
                 reply = _http_response("200 OK", reply_body, keep)
+                conn.settimeout(self.request_timeout)
+                conn.sendall(reply)   # still "busy": stop() lets a reply go out (a "shutdown" call's)
                 if not self._set_busy(conn, False):
                     return
-                conn.settimeout(self.request_timeout)
-                conn.sendall(reply)
                 self.requests += 1
                 if self.trace is not None:
                     caller = params[0] if params and isinstance(params[0], str) else peer
@@ -572,7 +572,9 @@ class XmlRpcServer:
             except OSError:
                 pass
         with self._lock:  # a connection's thread takes it out of _conns before closing it
-            for c in self._conns:
+            for c, st in self._conns.items():
+                if st.busy:   # answering a call: its thread sends the reply, then sees the stop
+                    continue
                 try:
                     c.shutdown(socket.SHUT_RDWR)
                 except OSError:
