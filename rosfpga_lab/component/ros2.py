@@ -1,0 +1,155 @@
+"""The FPGA component as a ROS 2 node (first step): RTPS in software, the circuit on the data path.
+
+How this works: a :class:`~rosfpga_lab.graph.ros2.Ros2Node` discovers and matches the peers
+in software (SPDP/SEDP, as the ROS 1 side does XML-RPC); every sample that arrives on the
+input topic is a CDR payload, which goes through the circuit model and out through the RTPS
+writer on the output topic.
+
+SOFTWARE STAND-IN FOR THE CDR CIRCUIT. The circuit the paper's flow renders (a CDR interpreter
+from the generic layout -> fifo2axi -> application -> axi2fifo -> CDR generator) does not exist
+yet. Until it does, :func:`cdr_to_ros1_frame` converts the CDR sample to values and to the
+TCPROS frame the existing ROS 1 circuit model reads, the ROS 1 model processes it, and
+:func:`ros1_frame_to_cdr` converts its output frame back to CDR. The application stage and
+its result are the circuit's; the two conversions are software, and are replaced when the CDR
+interpreter and generator are rendered from ``hw.layout``.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from pathlib import Path
+
+from rosfpga_lab.component.errors import ComponentConfigError
+from rosfpga_lab.config import NodeConfig, load_config
+from rosfpga_lab.errors import LabError
+from rosfpga_lab.graph.ros2 import Ros2Node, Ros2Publisher
+from rosfpga_lab.hw import Pipeline, PipelineError
+from rosfpga_lab.msg import default_registry, deserialize, deserialize_cdr, serialize, serialize_cdr
+from rosfpga_lab.msg import to_ros2_value
+from rosfpga_lab.rtps.participant import Qos, Sample
+
+log = logging.getLogger(__name__)
+IMAGE = "sensor_msgs/Image"
+
+
+def cdr_to_ros1_frame(payload: bytes, seq: int = 0) -> bytes:
+    """A ROS 2 Image (CDR payload) as the TCPROS frame (length + body) of the ROS 1 circuit.
+
+    Software stand-in for the CDR interpreter (see the module docstring).
+    """
+    v = deserialize_cdr(None, IMAGE, payload)
+    stamp = v["header"]["stamp"]
+    if stamp["sec"] < 0:
+        raise PipelineError(f"header.stamp.sec is {stamp['sec']}: ROS 1 time has no negative "
+                            f"seconds")
+    v["header"] = {"seq": seq & 0xFFFFFFFF, "stamp": (stamp["sec"], stamp["nanosec"]),
+                   "frame_id": v["header"]["frame_id"]}
+    body = serialize(default_registry(), IMAGE, v)
+    return len(body).to_bytes(4, "little") + body
+
+
+def ros1_frame_to_cdr(frame: bytes) -> bytes:
+    """The ROS 1 circuit's output frame as a ROS 2 Image CDR payload (stand-in for the CDR generator)."""
+    v = deserialize(default_registry(), IMAGE, frame[4:])
+    return serialize_cdr(None, IMAGE, to_ros2_value(default_registry(), IMAGE, v))
+
+
+class Ros2Component:
+    """The FPGA component on ROS 2: ``config``'s topics, DDS domain ``domain``.
+
+    Samples are processed on the node's receive thread, one at a time (the circuit is one
+    stream); KEEP_LAST ``qos.depth`` bounds what waits in the reader meanwhile.
+    """
+
+    def __init__(self, config: NodeConfig | str | Path, *, domain: int = 0, model: str = "fast",
+                 qos_in: Qos = Qos(), qos_out: Qos = Qos(), name: str | None = None) -> None:
+        if not isinstance(config, NodeConfig):
+            config = load_config(config)
+        for section, topic in (("subscriber", config.subscriber), ("publisher", config.publisher)):
+            if topic.type != IMAGE:
+                raise ComponentConfigError(
+                    f"{section}.type is {topic.type!r}: the circuit streams sensor_msgs/Image only")
+        try:
+            self.pipeline = Pipeline.from_config(config, model=model)
+        except LabError as exc:
+            raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
+        self.config, self.domain, self.qos_in, self.qos_out = config, domain, qos_in, qos_out
+        self.name = (name or config.node.global_name).strip("/").replace("/", "_") or "fpga"
+        self.input_topic, self.output_topic = config.subscriber.topic, config.publisher.topic
+        self.counts = {"seen": 0, "published": 0, "refused": 0}
+        self.latencies: list[float] = []
+        self._cond = threading.Condition()
+        self.node: Ros2Node | None = None
+        self._pub: Ros2Publisher | None = None
+
+    def start(self) -> Ros2Component:
+        self.node = Ros2Node(self.name, self.domain)
+        self._pub = self.node.create_publisher(self.output_topic, IMAGE, self.qos_out)
+        self.node.create_subscriber(self.input_topic, IMAGE, self._on_sample, self.qos_in)
+        log.info("%s: ROS 2 node in DDS domain %d (participant index %d): %s -> %s -> %s",
+                 self.name, self.domain, self.node.index, self.input_topic, self.pipeline.op,
+                 self.output_topic)
+        return self
+
+    def _on_sample(self, payload: bytes, sample: Sample) -> None:
+        t0 = time.perf_counter()
+        with self._cond:
+            index = self.counts["seen"]
+            self.counts["seen"] += 1
+        try:
+            result = self.pipeline.process(cdr_to_ros1_frame(payload, index))
+            out = ros1_frame_to_cdr(result.output_frame)
+        except LabError as exc:
+            with self._cond:
+                self.counts["refused"] += 1
+                n = self.counts["refused"]
+                self._cond.notify_all()
+            if n <= 3:
+                log.warning("%s: refused sample %d from %s: %s", self.name, sample.seq,
+                            sample.writer_guid.hex(), exc)
+            return
+        assert self._pub is not None
+        self._pub.publish(out)
+        with self._cond:
+            self.counts["published"] += 1
+            if len(self.latencies) < 10000:
+                self.latencies.append(time.perf_counter() - t0)
+            self._cond.notify_all()
+
+    def wait_for_peers(self, timeout: float = 10.0) -> bool:
+        """Until the input has a matched writer and the output a matched reader."""
+        assert self.node is not None and self._pub is not None
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            subs = self.node._subs.values()
+            if self._pub.matched() and all(s.matched() for s in subs):
+                return True
+            time.sleep(0.01)
+        return False
+
+    def wait_for(self, frames: int, timeout: float = 10.0) -> bool:
+        """Until ``frames`` samples were published or refused."""
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            while self.counts["published"] + self.counts["refused"] < frames:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self._cond.wait(left)
+        return True
+
+    def notes(self) -> list[str]:
+        return self.node.notes() if self.node else []
+
+    def stop(self) -> None:
+        if self.node is not None:
+            self.node.close()
+            self.node = None
+
+    def __enter__(self) -> Ros2Component:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
