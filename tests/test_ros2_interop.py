@@ -1,0 +1,98 @@
+"""The FPGA component as a ROS 2 node against real Cyclone DDS peers (PyPI ``cyclonedds``).
+
+A Cyclone writer of ``sensor_msgs::msg::dds_::Image_`` -> the lab's component -> a Cyclone reader
+with ROS 2's default QoS (RELIABLE KEEP_LAST 10). Every output is compared with OpenCV run on
+the input (never with the lab's own models). Skips without cyclonedds; fails under
+ROSFPGA_REQUIRE_WIRE=1 (CI).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import cv2
+import numpy as np
+import pytest
+
+from rosfpga_lab.component.ros2 import Ros2Component
+from rosfpga_lab.config import parse_config
+from rosfpga_lab.rtps.participant import Qos
+from ros2tools import DOMAIN, cyclone, image, qos, wait
+
+pytestmark = pytest.mark.timeout(60)
+
+CONFIG = """\
+node: {{name: /fpga_ros2}}
+subscriber: {{topic: /cam, type: sensor_msgs/Image}}
+publisher: {{topic: /cam_out, type: sensor_msgs/Image}}
+image: {{width: {w}, height: {h}, encoding: rgba8}}
+application: {{op: dilate, ksize: 3}}
+"""
+
+
+def picture(k: int, h: int = 48, w: int = 64) -> np.ndarray:
+    return np.random.default_rng(k).integers(0, 256, (h, w, 4), dtype=np.uint8)
+
+
+def cv2_dilate(img: np.ndarray) -> np.ndarray:
+    return cv2.dilate(img, np.ones((3, 3), np.uint8)).reshape(img.shape)
+
+
+def run_through(n: int, h: int, w: int, writer_reliable: bool, qos_in: Qos) -> list:
+    """n pictures from a Cyclone writer through the component; the Cyclone reader's samples."""
+    dds = cyclone()
+    comp = Ros2Component(parse_config(CONFIG.format(w=w, h=h)), domain=DOMAIN, qos_in=qos_in)
+    with comp:
+        dp = dds.DomainParticipant(DOMAIN)
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds, writer_reliable))
+        reader = dds.DataReader(dp, dds.Topic(dp, "rt/cam_out", dds.Image_), qos=qos(dds))
+        assert comp.wait_for_peers(10), comp.notes()
+        assert wait(lambda: writer.get_matched_subscriptions() and reader.get_matched_publications())
+        for k in range(n):
+            writer.write(image(dds, picture(k, h, w), "rgba8", sec=1700000000 + k))
+        assert comp.wait_for(n, 20), (comp.counts, comp.notes())
+        got: list = []
+        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= n, 20), len(got)
+        assert comp.counts == {"seen": n, "published": n, "refused": 0}
+        return got
+
+
+@pytest.mark.parametrize("writer_reliable,reader_reliable", [(True, True), (True, False),
+                                                             (False, False)])
+def test_cyclone_images_through_the_component_exact(writer_reliable: bool,
+                                                    reader_reliable: bool) -> None:
+    got = run_through(5, 48, 64, writer_reliable, Qos(reader_reliable, 10))
+    for k, s in enumerate(got):
+        assert (s.width, s.height, s.encoding, s.step) == (64, 48, "rgba8", 256)
+        assert (s.header.stamp.sec, s.header.stamp.nanosec, s.header.frame_id) == \
+            (1700000000 + k, 500, "camera")
+        out = np.frombuffer(bytes(s.data), np.uint8).reshape(48, 64, 4)
+        assert np.array_equal(out, cv2_dilate(picture(k, 48, 64))), f"sample {k}"
+
+
+def test_a_640x480_frame_fragmented_both_ways_exact() -> None:
+    got = run_through(1, 480, 640, True, Qos(True, 10))
+    out = np.frombuffer(bytes(got[0].data), np.uint8).reshape(480, 640, 4)
+    assert np.array_equal(out, cv2_dilate(picture(0, 480, 640)))
+
+
+def test_best_effort_writer_never_matches_reliable_reader(caplog: pytest.LogCaptureFixture) -> None:
+    dds = cyclone()
+    caplog.set_level(logging.INFO, logger="rosfpga_lab.graph.ros2")
+    comp = Ros2Component(parse_config(CONFIG.format(w=64, h=48)), domain=DOMAIN,
+                         qos_in=Qos(True, 10), qos_out=Qos(False, 10))
+    with comp:
+        dp = dds.DomainParticipant(DOMAIN)
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds, False))
+        reader = dds.DataReader(dp, dds.Topic(dp, "rt/cam_out", dds.Image_), qos=qos(dds, True))
+        why = "a BEST_EFFORT writer never matches a RELIABLE reader"
+        assert wait(lambda: any(why in n and "reader /cam" not in n and "rt/cam " in n
+                                for n in comp.notes()), 10), comp.notes()
+        # the lab's best-effort writer and Cyclone's reliable reader: Cyclone refuses it too
+        assert wait(lambda: any(why in n and "rt/cam_out" in n for n in comp.notes()), 10)
+        writer.write(image(dds, picture(0), "rgba8"))
+        assert not wait(lambda: comp.counts["seen"] > 0, 0.5)
+        assert reader.get_matched_publications() == []
+        assert writer.get_matched_subscriptions() == []
+    logged = [r.getMessage() for r in caplog.records if why in r.getMessage()]
+    assert len(logged) == 2, logged       # once each, however often SEDP repeats
