@@ -96,3 +96,46 @@ def test_best_effort_writer_never_matches_reliable_reader(caplog: pytest.LogCapt
         assert writer.get_matched_subscriptions() == []
     logged = [r.getMessage() for r in caplog.records if why in r.getMessage()]
     assert len(logged) == 2, logged       # once each, however often SEDP repeats
+
+
+def test_a_late_reader_and_a_peer_that_leaves_and_comes_back() -> None:
+    dds = cyclone()
+    comp = Ros2Component(parse_config(CONFIG.format(w=16, h=8)), domain=DOMAIN)
+    with comp:
+        dp = dds.DomainParticipant(DOMAIN)
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds))
+        early = dds.DataReader(dp, dds.Topic(dp, "rt/cam_out", dds.Image_), qos=qos(dds))
+        assert comp.wait_for_peers(10)
+        assert wait(lambda: writer.get_matched_subscriptions() and early.get_matched_publications())
+        for k in range(2):
+            writer.write(image(dds, picture(k, 8, 16), "rgba8", sec=k))
+        assert comp.wait_for(2, 10)
+        dp2 = dds.DomainParticipant(DOMAIN)
+        late = dds.DataReader(dp2, dds.Topic(dp2, "rt/cam_out", dds.Image_), qos=qos(dds))
+        assert wait(lambda: late.get_matched_publications() and len(comp._pub.node.participant
+                                                                     .matched(comp._pub.writer_id)) == 2)
+        for k in range(2, 4):
+            writer.write(image(dds, picture(k, 8, 16), "rgba8", sec=k))
+        assert comp.wait_for(4, 10)
+        got_early: list = []
+        got_late: list = []
+        assert wait(lambda: got_early.extend(early.take(10)) or len(got_early) >= 4)
+        assert wait(lambda: got_late.extend(late.take(10)) or len(got_late) >= 2)
+        assert [s.header.stamp.sec for s in got_early] == [0, 1, 2, 3]
+        assert [s.header.stamp.sec for s in got_late] == [2, 3]     # VOLATILE: only what came after
+        # the first peer leaves (its participant is deleted): the lab forgets it
+        prefix_count = len(comp.node.participant.participants)
+        dp.__del__()
+        assert wait(lambda: len(comp.node.participant.participants) == prefix_count - 1, 10), \
+            comp.notes()
+        assert wait(lambda: not comp.node._subs[next(iter(comp.node._subs))].matched())
+        # ... and comes back as a new participant: matched again, frames flow again
+        dp3 = dds.DomainParticipant(DOMAIN)
+        writer3 = dds.DataWriter(dp3, dds.Topic(dp3, "rt/cam", dds.Image_), qos=qos(dds))
+        assert wait(lambda: writer3.get_matched_subscriptions())
+        writer3.write(image(dds, picture(9, 8, 16), "rgba8", sec=9))
+        assert comp.wait_for(5, 10)
+        assert wait(lambda: got_late.extend(late.take(10)) or len(got_late) >= 3)
+        out = np.frombuffer(bytes(got_late[2].data), np.uint8).reshape(8, 16, 4)
+        assert got_late[2].header.stamp.sec == 9
+        assert np.array_equal(out, cv2_dilate(picture(9, 8, 16)))
