@@ -109,6 +109,26 @@ def _bitmap(base: int, members: Iterable[int], num_bits: int) -> bytes:
     return struct.pack(f"<I{len(words)}I", num_bits, *words)
 
 
+def pad_payload(payload: bytes) -> bytes:
+    """A serialized payload padded to 4 bytes, the count in its encapsulation options' low
+    2 bits (XTypes 7.6.3.1.2; what Cyclone DDS does); :func:`unpad_payload` undoes it."""
+    pad = -len(payload) % 4
+    if not pad or len(payload) < 4:
+        return payload
+    return payload[:3] + bytes([(payload[3] & 0xFC) | pad]) + payload[4:] + bytes(pad)
+
+
+def unpad_payload(payload: bytes) -> bytes:
+    """The payload without the padding its encapsulation options declare (bytes as they came
+    when it declares none or more than it has)."""
+    if len(payload) < 4 or payload[0] != 0:
+        return payload
+    pad = payload[3] & 0x03
+    if not pad or len(payload) < 4 + pad:
+        return payload
+    return payload[:3] + bytes([payload[3] & 0xFC]) + payload[4:len(payload) - pad]
+
+
 def info_dst(guid_prefix: bytes) -> bytes:
     return _sub(INFO_DST, 0, guid_prefix)
 
@@ -220,7 +240,7 @@ def spdp_payload(guid_prefix: bytes, meta: Locator, user: Locator, lease: float,
 
 
 def sedp_payload(guid: bytes, topic: str, type_name: str, reliable: bool, depth: int,
-                 locator: Locator) -> bytes:
+                 locator: Locator, transient_local: bool = False) -> bytes:
     """SEDP data of one of the lab's endpoints (publication or subscription)."""
     return param_list([
         (PID_ENDPOINT_GUID, guid),
@@ -228,7 +248,7 @@ def sedp_payload(guid: bytes, topic: str, type_name: str, reliable: bool, depth:
         (PID_TOPIC_NAME, cdr_string(topic)),
         (PID_TYPE_NAME, cdr_string(type_name)),
         (PID_RELIABILITY, struct.pack("<I", RELIABLE if reliable else BEST_EFFORT) + duration(0.1)),
-        (PID_DURABILITY, struct.pack("<I", VOLATILE)),
+        (PID_DURABILITY, struct.pack("<I", TRANSIENT_LOCAL if transient_local else VOLATILE)),
         (PID_HISTORY, struct.pack("<Ii", KEEP_LAST, depth)),
         (PID_DATA_REPRESENTATION, struct.pack("<Ih", 1, XCDR)),
         (PID_UNICAST_LOCATOR, locator.encode()),

@@ -236,7 +236,7 @@ class Participant:
         sedp.seq += 1
         sedp.history[sedp.seq] = b.sedp_payload(self.guid_prefix + ep.guid_tail, ep.topic,
                                                 ep.type_name, ep.qos.reliable, ep.qos.depth,
-                                                b.Locator(*self.user))
+                                                b.Locator(*self.user), ep.qos.transient_local)
         for rem in list(self.remote.values()):
             self._try_match(ep, rem)
 
@@ -262,6 +262,7 @@ class Participant:
     def _sample_subs(self, reader_id: int, writer_id: int, seq: int, payload: bytes,
                      frags: list[int] | None = None) -> list[bytes]:
         """DATA, or DATA_FRAGs (all, or those numbered in ``frags``), of one sample."""
+        payload = b.pad_payload(payload)
         room = MAX_MESSAGE_BYTES - 20 - 16 - 32 - 4
         if len(payload) <= room and frags is None:
             return [b.data(reader_id, writer_id, seq, payload)]
@@ -573,7 +574,7 @@ class Participant:
         if ep.entity_id in (PUB_READER, SUB_READER):
             return   # SEDP samples are handled on arrival
         self.samples.append(Sample(ep.entity_id, wp.prefix + wp.writer_id.to_bytes(4, "big"),
-                                   seq, payload))
+                                   seq, b.unpad_payload(payload)))
         mine = sum(1 for s in self.samples if s.reader_id == ep.entity_id)
         if mine > ep.qos.depth:
             for i, s in enumerate(self.samples):
@@ -722,11 +723,9 @@ class Participant:
                 self._on_sample(prefix, sub.reader_id, sub.writer_id, sub.seq, sub.payload,
                                 sub.inline_qos, sub.little_endian)
         elif isinstance(sub, DataFrag):
-            if not self._readers_of(prefix, sub.writer_id, sub.reader_id):
-                return []
             readers = self._readers_of(prefix, sub.writer_id, sub.reader_id)
-            if all(sub.seq < wp.next for _, wp in readers if wp.next):
-                return []     # already delivered
+            if not readers or all(wp.next and sub.seq < wp.next for _, wp in readers):
+                return []     # no reader for it, or already delivered
             sample = self.assembler.add(prefix, sub)
             if sample is not None:
                 self._on_sample(prefix, sub.reader_id, sub.writer_id, sub.seq, sample,
