@@ -139,3 +139,38 @@ def test_a_late_reader_and_a_peer_that_leaves_and_comes_back() -> None:
         out = np.frombuffer(bytes(got_late[2].data), np.uint8).reshape(8, 16, 4)
         assert got_late[2].header.stamp.sec == 9
         assert np.array_equal(out, cv2_dilate(picture(9, 8, 16)))
+
+
+def test_cli_node_ros2_serves_cyclone_peers(tmp_path) -> None:
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    dds = cyclone()
+    cfg = tmp_path / "node.yaml"
+    cfg.write_text(CONFIG.format(w=32, h=16))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(cfg), "--ros2",
+                             "--domain", str(DOMAIN), "--duration", "30"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        dp = dds.DomainParticipant(DOMAIN)
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds))
+        reader = dds.DataReader(dp, dds.Topic(dp, "rt/cam_out", dds.Image_), qos=qos(dds))
+        assert wait(lambda: writer.get_matched_subscriptions() and reader.get_matched_publications(), 8)
+        for k in range(3):
+            writer.write(image(dds, picture(k, 16, 32), "rgba8", sec=k))
+        got: list = []
+        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= 3, 8)
+        for k, s in enumerate(got):
+            out = np.frombuffer(bytes(s.data), np.uint8).reshape(16, 32, 4)
+            assert np.array_equal(out, cv2_dilate(picture(k, 16, 32)))
+        proc.send_signal(signal.SIGINT)          # Ctrl-C: stops cleanly with a summary
+        out_text, err = proc.communicate(timeout=15)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 0, err
+    assert "DDS domain" in out_text and "3 samples seen, 3 published, 0 refused" in out_text

@@ -44,11 +44,50 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="seconds between status updates (default: 0.5; 0: no status line)")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no status line and no log lines, only the final summary")
+    p.add_argument("--ros2", action="store_true",
+                   help="run as a ROS 2 node (DDS/RTPS on 127.0.0.1, no master) instead of ROS 1")
+    p.add_argument("--domain", type=int, default=None, metavar="N",
+                   help="with --ros2: the DDS domain (default: ROS_DOMAIN_ID, else 0)")
     p.set_defaults(func=run)
+
+
+def run_ros2(args: argparse.Namespace) -> int:
+    """``node --ros2``: the component as a ROS 2 participant until Ctrl-C or --duration."""
+    import os
+
+    from rosfpga_lab.component.ros2 import Ros2Component
+    from rosfpga_lab.errors import LabError
+
+    if not args.quiet:
+        logging.basicConfig(level=logging.INFO, format="[%(levelname)s] %(message)s",
+                            stream=sys.stderr)
+    raw = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID", "0") or "0"
+    try:
+        domain = int(raw)
+        comp = Ros2Component(args.config, domain=domain, model=args.model).start()
+    except (ValueError, LabError) as exc:
+        print(f"rosfpga-lab node: error: {exc}", file=sys.stderr)
+        return 1
+    print(f"{comp.name}: ROS 2 (DDS domain {domain}, participant index {comp.node.index if comp.node else '?'}) "
+          f"{comp.input_topic} -> {comp.pipeline.op} ({args.model} model) -> {comp.output_topic}; "
+          "Ctrl-C to stop", flush=True)
+    t_end = None if args.duration is None else time.monotonic() + args.duration
+    try:
+        while t_end is None or time.monotonic() < t_end:
+            time.sleep(0.1)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        comp.stop()
+    c = comp.counts
+    print(f"{c['seen']} samples seen, {c['published']} published, {c['refused']} refused", flush=True)
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
     """Start the component, show the status until interrupted, stop cleanly."""
+    if args.ros2:
+        return run_ros2(args)
     from rosfpga_lab.component import FpgaComponent, limits, master_answers
     from rosfpga_lab.config import load_config, master_uri
     from rosfpga_lab.graph import EmbeddedMaster
