@@ -21,14 +21,12 @@ import time
 from collections.abc import Callable
 
 from rosfpga_lab.graph.errors import GraphError
+from rosfpga_lab.graph.limits import ROS2_SOCKET_BUFFER_BYTES, ROS2_TICK_SECONDS
 from rosfpga_lab.rtps.build import dds_topic, dds_type
 from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX
 from rosfpga_lab.rtps.participant import Participant, Qos, Sample, discovery_port, user_port
 
 log = logging.getLogger(__name__)
-#: Socket buffer sizes asked for (a 640x480 frame is ~1.2 MB of fragments).
-SOCKET_BUFFER_BYTES = 8 << 20
-TICK_SECONDS = 0.01
 
 
 class Ros2Publisher:
@@ -105,7 +103,7 @@ class Ros2Node:
                     s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
                     socks.append(s)
                     for opt in (socket.SO_RCVBUF, socket.SO_SNDBUF):
-                        s.setsockopt(socket.SOL_SOCKET, opt, SOCKET_BUFFER_BYTES)
+                        s.setsockopt(socket.SOL_SOCKET, opt, ROS2_SOCKET_BUFFER_BYTES)
                     s.bind((address, port))
                 return socks[0], socks[1], index
             except OSError:
@@ -164,7 +162,7 @@ class Ros2Node:
                 with self._lock:
                     out = self.participant.tick(now)
                 self._send(out)
-                next_tick = now + TICK_SECONDS
+                next_tick = now + ROS2_TICK_SECONDS
             try:
                 ready, _, _ = select.select(socks, [], [], max(0.0, next_tick - time.monotonic()))
             except (OSError, ValueError):
