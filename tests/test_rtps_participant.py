@@ -168,9 +168,14 @@ def test_lease_expiry_forgets_a_silent_peer() -> None:
     net = Net(a, c)
     net.run([], steps=20)
     assert c.participants
+    # half a fragmented sample arrives, then a falls silent: the fragments go with it
+    half = [d for _, _, d in a.write(w, b"\x00\x01\x00\x00" + bytes(30000), net.now)][:1]
+    c.receive(half[0], a.user, net.now)
+    assert c.assembler.held > 0
     net.parts = (c,)                              # a falls silent
     net.run([], steps=int(a.lease / 0.01) + 50)
     assert not c.participants and c.matched(r) == []
+    assert c.assembler.held == 0
     assert any("lease" in n for n in c.notes)
 
 

@@ -318,17 +318,16 @@ class Participant:
 
     def _forget(self, prefix: bytes) -> None:
         self.participants.pop(prefix, None)
+        writers = {k[1] for ep in self.local.values() if ep.kind == "reader"
+                   for k in ep.proxies if k[0] == prefix}
         for guid in [g for g in self.remote if g[:12] == prefix]:
             self._forget_endpoint(guid)
         for ep in self.local.values():
             for key in [k for k in ep.proxies if k[0] == prefix]:
                 del ep.proxies[key]
-        for seqs in [(prefix, w) for (p, w) in list(self._writer_keys()) if p == prefix]:
-            for s in self.assembler.partial(*seqs):
-                self.assembler.discard(seqs[0], seqs[1], s)
-
-    def _writer_keys(self) -> set[tuple[bytes, int]]:
-        return {k for ep in self.local.values() if ep.kind == "reader" for k in ep.proxies}
+        for writer_id in writers:       # its partly received samples go too
+            for seq in self.assembler.partial(prefix, writer_id):
+                self.assembler.discard(prefix, writer_id, seq)
 
     def _forget_endpoint(self, guid: bytes) -> None:
         rem = self.remote.pop(guid, None)
