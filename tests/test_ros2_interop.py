@@ -174,3 +174,34 @@ def test_cli_node_ros2_serves_cyclone_peers(tmp_path) -> None:
             proc.wait()
     assert proc.returncode == 0, err
     assert "DDS domain" in out_text and "3 samples seen, 3 published, 0 refused" in out_text
+
+
+def test_transient_local_writer_serves_a_late_cyclone_reader_its_history() -> None:
+    from rosfpga_lab.graph.ros2 import Ros2Node
+    from rosfpga_lab.msg import serialize_cdr
+
+    dds = cyclone()
+
+    def sample(k: int) -> bytes:
+        return serialize_cdr(None, "sensor_msgs/Image", {
+            "header": {"stamp": {"sec": k, "nanosec": 0}, "frame_id": "f"}, "height": 1,
+            "width": 2, "encoding": "mono8", "is_bigendian": 0, "step": 2, "data": bytes([k, k])})
+
+    with Ros2Node("latched", DOMAIN) as node:
+        pub = node.create_publisher("/latched", "sensor_msgs/Image", Qos(True, 3, transient_local=True))
+        for k in range(5):
+            pub.publish(sample(k))
+        dp = dds.DomainParticipant(DOMAIN)
+        P = dds.Policy
+        tl = dds.Qos(P.Reliability.Reliable(1_000_000_000), P.History.KeepLast(10),
+                     P.Durability.TransientLocal, P.DataRepresentation(use_cdrv0_representation=True))
+        late = dds.DataReader(dp, dds.Topic(dp, "rt/latched", dds.Image_), qos=tl)
+        volatile = dds.DataReader(dp, dds.Topic(dp, "rt/latched", dds.Image_), qos=qos(dds))
+        got: list = []
+        assert wait(lambda: got.extend(late.take(10)) or len(got) >= 3, 10)
+        assert [s.header.stamp.sec for s in got] == [2, 3, 4]      # KEEP_LAST 3 of 5
+        assert wait(lambda: volatile.get_matched_publications(), 5)
+        pub.publish(sample(5))
+        more: list = []
+        assert wait(lambda: more.extend(volatile.take(10)) or len(more) >= 1, 5)
+        assert [s.header.stamp.sec for s in more] == [5]           # VOLATILE: only the new one

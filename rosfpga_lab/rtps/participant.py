@@ -14,7 +14,8 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
   the peers' ones come in the same way; a remote endpoint on the same topic and type is matched
   when its QoS is compatible (RxO: offered reliability and durability at least what is
   requested), else the reason is logged once.
-* User data: a writer keeps the last ``depth`` samples (KEEP_LAST, VOLATILE), sends each as DATA
+* User data: a writer keeps the last ``depth`` samples (KEEP_LAST; VOLATILE, or TRANSIENT_LOCAL:
+  a reader that joins late gets them), sends each as DATA
   or DATA_FRAG; reliable ones HEARTBEAT until acknowledged, resend on ACKNACK/NACK_FRAG and GAP
   what left the history. A reader puts fragments together (memory follows bytes received),
   delivers in order when reliable, asks again with ACKNACK/NACK_FRAG.
@@ -191,6 +192,7 @@ class Participant:
         self._next_key = 1
         self._last_announce = -1e9
         self.assembler = FragmentAssembler()
+        self._outbox: list[Send] = []     # what matching produced (sent with the next result)
         # built-in SEDP writers and readers (reliable, KEEP_ALL of the lab's own endpoints)
         for eid, kind in ((PUB_WRITER, "writer"), (SUB_WRITER, "writer"),
                           (PUB_READER, "reader"), (SUB_READER, "reader")):
@@ -218,7 +220,8 @@ class Participant:
     def add_writer(self, topic: str, type_name: str, qos: Qos = Qos()) -> int:
         """A user writer on DDS topic ``topic`` (``rt/...`` for ROS 2); returns its entity id."""
         ep = LocalEndpoint(self._new_entity(WRITER_KIND), "writer", topic, type_name,
-                           Qos(qos.reliable, max(1, min(qos.depth, MAX_HISTORY_DEPTH)), False))
+                           Qos(qos.reliable, max(1, min(qos.depth, MAX_HISTORY_DEPTH)),
+                               qos.transient_local))
         self.local[ep.entity_id] = ep
         self._announce_endpoint(ep)
         return ep.entity_id
@@ -292,7 +295,7 @@ class Participant:
 
     def tick(self, now: float) -> list[Send]:
         """Periodic work: SPDP announcements, lease expiry, HEARTBEATs of reliable writers."""
-        out: list[Send] = []
+        out: list[Send] = self._take_outbox()
         if now - self._last_announce >= self.announce_period:
             self._last_announce = now
             out += self.announce()
@@ -469,7 +472,18 @@ class Participant:
         if why:
             self.note(f"qos-{rem.guid.hex()}-{ep.entity_id}", f"not matched: {what}: {why}")
             return
-        if ep.kind == "writer":
+        if ep.kind == "writer" and ep.qos.transient_local and ep.history:
+            # TRANSIENT_LOCAL: a reader that joins late gets the history (KEEP_LAST depth)
+            first = next(iter(ep.history))
+            proxy = ReaderProxy(key[0], key[1], rem.locator, rem.qos.reliable, first, acked=first)
+            ep.proxies[key] = proxy
+            subs: list[bytes] = []
+            for seq, payload in ep.history.items():
+                subs += self._sample_subs(proxy.reader_id, ep.entity_id, seq, payload)
+            if ep.qos.reliable and proxy.reliable:
+                subs.append(self._heartbeat(ep, proxy))
+            self._outbox += self._msg(proxy.locator, proxy.prefix, subs)
+        elif ep.kind == "writer":
             ep.proxies[key] = ReaderProxy(key[0], key[1], rem.locator, rem.qos.reliable, ep.seq + 1,
                                           acked=ep.seq + 1)
         else:
@@ -711,6 +725,10 @@ class Participant:
                 out += self._on_submessage(prefix, sub, source, now)
             except RtpsError as exc:
                 self.note(f"bad-{sub.name}", f"{sub.name} from {prefix.hex()} ignored ({exc})")
+        return out + self._take_outbox()
+
+    def _take_outbox(self) -> list[Send]:
+        out, self._outbox = self._outbox, []
         return out
 
     def _on_submessage(self, prefix: bytes, sub: object, source: tuple[str, int],
