@@ -205,3 +205,23 @@ def test_transient_local_writer_serves_a_late_cyclone_reader_its_history() -> No
         more: list = []
         assert wait(lambda: more.extend(volatile.take(10)) or len(more) >= 1, 5)
         assert [s.header.stamp.sec for s in more] == [5]           # VOLATILE: only the new one
+
+
+def test_camera_component_viewer_all_on_ros2() -> None:
+    """The one-command pieces on ROS 2 (no Cyclone needed): camera -> component -> viewer."""
+    import time
+
+    from rosfpga_lab.component import Camera, Viewer
+
+    domain = (DOMAIN + 7) % 233
+    with Ros2Component(parse_config(CONFIG.format(w=32, h=16)), domain=domain) as comp, \
+            Viewer("/cam_out", name="/viewer", domain=domain) as viewer, \
+            Camera("/cam", width=32, height=16, encoding="rgba8", rate=50, name="/camera",
+                   domain=domain) as cam:
+        assert wait(lambda: cam.publisher.get_num_connections() == 1 and comp.wait_for_peers(0.1))
+        sent = [cam.publish_one() for _ in range(3)]
+        assert viewer.wait_for(3, 10), comp.notes()
+        time.sleep(0.1)
+        assert viewer.received == 3
+        assert viewer.last is not None and viewer.last.header["frame_id"] == "camera"
+        assert np.array_equal(viewer.last.image, cv2_dilate(sent[-1].image))

@@ -34,6 +34,25 @@ def _common(p: argparse.ArgumentParser, *, with_config: bool) -> None:
     p.add_argument("--master-uri", metavar="URI",
                    help=f"ROS master (default: ROS_MASTER_URI, else {from_config}{DEFAULT_MASTER_URI})")
     p.add_argument("--name", metavar="NODE", help="node name")
+    p.add_argument("--ros2", action="store_true",
+                   help="ROS 2 instead of ROS 1: a DDS participant on 127.0.0.1, no master")
+    p.add_argument("--domain", type=int, default=None, metavar="N",
+                   help="with --ros2: the DDS domain (default: ROS_DOMAIN_ID, else 0)")
+
+
+def _domain(args: argparse.Namespace) -> int | None:
+    """The DDS domain with --ros2 (None: ROS 1)."""
+    import os
+
+    from rosfpga_lab.component import ComponentError
+
+    if not args.ros2:
+        return None
+    raw = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID") or "0"
+    try:
+        return int(raw)
+    except ValueError:
+        raise ComponentError(f"ROS_DOMAIN_ID={raw!r} is not a number; give --domain N") from None
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -113,8 +132,8 @@ def run_camera(args: argparse.Namespace) -> int:
         args.count = args.count or source.period
     topic = args.topic or topic
     cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
-                 source=source, name=args.name or "/camera", master_uri=_master_uri(args, cfg),
-                 frame_id=args.frame_id)
+                 source=source, name=args.name or "/camera", frame_id=args.frame_id,
+                 master_uri=None if args.ros2 else _master_uri(args, cfg), domain=_domain(args))
     print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on {topic} "
           f"at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop", flush=True)
     stop = threading.Event()
@@ -144,7 +163,8 @@ def run_view(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Viewer
 
     viewer = Viewer(args.topic, save_dir=args.save, every=args.every, latest_only=args.latest,
-                    name=args.name or "/viewer", master_uri=_master_uri(args))
+                    name=args.name or "/viewer", domain=_domain(args),
+                    master_uri=None if args.ros2 else _master_uri(args))
     print(f"{viewer.node.name}: listening on {args.topic}; master {viewer.node.master_uri}"
           + (f"; saving into {args.save}" if args.save else "") + "; Ctrl-C to stop", flush=True)
     tty = sys.stdout.isatty()

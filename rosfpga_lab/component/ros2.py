@@ -19,11 +19,13 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 from rosfpga_lab.component.errors import ComponentConfigError
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.errors import LabError
+from rosfpga_lab.graph import MessageInfo
 from rosfpga_lab.graph.ros2 import Ros2Node, Ros2Publisher
 from rosfpga_lab.hw import Pipeline, PipelineError
 from rosfpga_lab.msg import default_registry, deserialize, deserialize_cdr, serialize, serialize_cdr
@@ -54,6 +56,33 @@ def ros1_frame_to_cdr(frame: bytes) -> bytes:
     """The ROS 1 circuit's output frame as a ROS 2 Image CDR payload (stand-in for the CDR generator)."""
     v = deserialize(default_registry(), IMAGE, frame[4:])
     return serialize_cdr(None, IMAGE, to_ros2_value(default_registry(), IMAGE, v))
+
+
+class Ros2ImagePublisher:
+    """A ROS 2 image publisher that takes ROS 1 bodies, as the graph's publisher does
+    (``publish_body``, ``get_num_connections``): what lets the camera publish on ROS 2."""
+
+    def __init__(self, node: Ros2Node, topic: str, qos: Qos = Qos()) -> None:
+        self.pub = node.create_publisher(topic, IMAGE, qos)
+
+    def publish_body(self, body: bytes | memoryview) -> None:
+        self.pub.publish(ros1_frame_to_cdr(len(body).to_bytes(4, "little") + bytes(body)))
+
+    def get_num_connections(self) -> int:
+        return self.pub.matched()
+
+
+def subscribe_ros1_bodies(node: Ros2Node, topic: str,
+                          callback: Callable[[bytes, MessageInfo], None], qos: Qos = Qos()) -> None:
+    """Subscribe to a ROS 2 image topic; ``callback`` gets each sample as a ROS 1 body and a
+    :class:`~rosfpga_lab.graph.MessageInfo` (publisher: the writer's GUID), as a raw ROS 1
+    subscriber's callback does (what lets the viewer read ROS 2)."""
+    def on_sample(payload: bytes, sample: Sample) -> None:
+        body = cdr_to_ros1_frame(payload, sample.seq)[4:]
+        callback(body, MessageInfo(topic, sample.writer_guid.hex(), 0, sample.seq, len(body),
+                                   time.time()))
+
+    node.create_subscriber(topic, IMAGE, on_sample, qos)
 
 
 class Ros2Component:

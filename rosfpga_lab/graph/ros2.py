@@ -84,6 +84,7 @@ class Ros2Node:
 
     def __init__(self, name: str = "rosfpga_lab", domain: int = 0, address: str = "127.0.0.1",
                  lease: float | None = None, announce: float | None = None) -> None:
+        self.name, self.domain = name, domain
         self._meta, self._user, index = self._bind(domain, address)
         kw = {k: v for k, v in (("lease", lease), ("announce", announce)) if v is not None}
         self.participant = Participant(domain, index, address, name, **kw)  # type: ignore[arg-type]
@@ -194,6 +195,13 @@ class Ros2Node:
         self._thread.join(timeout=2.0)
         self._meta.close()
         self._user.close()
+
+    shutdown = close
+
+    @property
+    def master_uri(self) -> str:
+        """What stands for the master in ROS 2: the DDS domain (status lines print it)."""
+        return f"none (DDS domain {self.domain})"
 
     def __enter__(self) -> Ros2Node:
         return self
