@@ -296,3 +296,13 @@ def test_acknack_storm_is_paced_and_duplicates_ignored() -> None:
     dup = b.header(c.guid_prefix) + b.acknack(r, w, 1, range(1, 11), 5)
     assert a.receive(dup, c.user, 9.0) == []
     assert any("paced" in n for n in a.notes)
+
+
+def test_notes_and_counts_stay_bounded_under_random_prefixes() -> None:
+    p = fresh()
+    rng = random.Random(3)
+    for _ in range(3000):
+        prefix = bytes(rng.randrange(256) for _ in range(12))
+        p.receive(b.header(prefix) + b.heartbeat(0, 0x103, 1, 5, 1), ("127.0.0.1", 7999), 0.0)
+    assert len(p.notes) <= MAX_NOTES + 1 and len(p.counts) <= MAX_NOTES + 1
+    assert sum(p.counts.values()) == 3000

@@ -200,14 +200,13 @@ class Participant:
 
     # ---- notes ---------------------------------------------------------------------------
     def note(self, key: str, text: str) -> None:
-        """Log ``text`` once per ``key`` (bounded); every call is counted in :attr:`counts`."""
+        """Log ``text`` once per ``key``; every call is counted in :attr:`counts`. Both are
+        bounded: past MAX_NOTES distinct keys, new ones are counted under ``notes-full``."""
+        if key not in self._noted and len(self._noted) >= MAX_NOTES:
+            key, text = "notes-full", f"more than {MAX_NOTES} distinct notes; further ones are counted only"
         self.counts[key] = self.counts.get(key, 0) + 1
         if key in self._noted:
             return
-        if len(self._noted) >= MAX_NOTES:
-            key, text = "notes-full", f"more than {MAX_NOTES} distinct notes; further ones are counted only"
-            if key in self._noted:
-                return
         self._noted.add(key)
         self.notes.append(text)
 
