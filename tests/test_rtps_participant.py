@@ -306,3 +306,17 @@ def test_notes_and_counts_stay_bounded_under_random_prefixes() -> None:
         p.receive(b.header(prefix) + b.heartbeat(0, 0x103, 1, 5, 1), ("127.0.0.1", 7999), 0.0)
     assert len(p.notes) <= MAX_NOTES + 1 and len(p.counts) <= MAX_NOTES + 1
     assert sum(p.counts.values()) == 3000
+
+
+def test_acknack_for_samples_not_yet_written_never_gaps_them() -> None:
+    """A (spoofed) ACKNACK asking for numbers past the last written used to GAP them, so the
+    real reader skipped every later sample."""
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    evil = b.header(c.guid_prefix) + b.acknack(r, w, 1, range(1, 100), 10_000)
+    out = a.receive(evil, c.user, net.now)
+    assert not any(isinstance(s, Gap) for _, _, d in out for s in parse_message(d).submessages)
+    net.run(out, steps=2)
+    net.run(a.write(w, b"\x00\x01\x00\x00late", net.now), steps=20)
+    assert [s.payload for s in c.take(r)] == [b"\x00\x01\x00\x00late"]

@@ -529,12 +529,19 @@ class Participant:
             self.note(f"acknack-unknown-{prefix.hex()}", f"ACKNACK from {prefix.hex()} for no "
                       f"matched reader of writer 0x{sub.writer_id:08x}: ignored")
             return []
+        proxy.acked = min(max(proxy.acked, sub.base), ep.seq + 1)
         if sub.count <= proxy.last_count:
-            self.note("acknack-dup", "ACKNACK with a count already seen: ignored (RTPS 8.4.15.8)")
+            # a count already seen (RTPS 8.4.15.8): no retransmission. Its acknowledgement
+            # still counts, so a spoofed high count cannot silence the real reader for good.
+            self.note("acknack-dup", "ACKNACK with a count already seen: no retransmission")
             return []
         proxy.last_count = sub.count
-        proxy.acked = min(max(proxy.acked, sub.base), ep.seq + 1)
-        if not sub.missing:
+        # only what was written can be missing: later numbers are ignored, never GAPped
+        missing = [s for s in sub.missing if s <= ep.seq]
+        if len(missing) < len(sub.missing):
+            self.note(f"acknack-future-{prefix.hex()}", f"ACKNACK from {prefix.hex()} asks for "
+                      f"samples past {ep.seq}, the last written: those ignored")
+        if not missing:
             return []
         if now - proxy.last_resend < MIN_RESEND_SECONDS:
             self.note("acknack-storm", f"ACKNACKs from {prefix.hex()} faster than one per "
@@ -542,8 +549,8 @@ class Participant:
             return []
         proxy.last_resend = now
         subs: list[bytes] = []
-        gone = [s for s in sub.missing if s not in ep.history]
-        for s in sub.missing:
+        gone = [s for s in missing if s not in ep.history]
+        for s in missing:
             if s in ep.history:
                 subs += self._sample_subs(proxy.reader_id, ep.entity_id, s, ep.history[s])
         if gone:
@@ -562,6 +569,8 @@ class Participant:
             return []
         proxy.last_frag_count = sub.count
         payload = ep.history.get(sub.seq)
+        if sub.seq > ep.seq or sub.seq < 1:
+            return []          # never written: nothing to resend, nothing to GAP
         if payload is None:
             return self._msg(proxy.locator, proxy.prefix,
                              [b.gap(proxy.reader_id, ep.entity_id, sub.seq, sub.seq + 1)])
