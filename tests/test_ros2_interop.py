@@ -113,7 +113,7 @@ def test_a_late_reader_and_a_peer_that_leaves_and_comes_back() -> None:
         dp2 = dds.DomainParticipant(DOMAIN)
         late = dds.DataReader(dp2, dds.Topic(dp2, "rt/cam_out", dds.Image_), qos=qos(dds))
         assert wait(lambda: late.get_matched_publications() and len(comp._pub.node.participant
-                                                                     .matched(comp._pub.writer_id)) == 2)
+                                                                     .matched(comp._pub.writer_id)) >= 2)
         for k in range(2, 4):
             writer.write(image(dds, picture(k, 8, 16), "rgba8", sec=k))
         assert comp.wait_for(4, 10)

@@ -320,3 +320,18 @@ def test_acknack_for_samples_not_yet_written_never_gaps_them() -> None:
     net.run(out, steps=2)
     net.run(a.write(w, b"\x00\x01\x00\x00late", net.now), steps=20)
     assert [s.payload for s in c.take(r)] == [b"\x00\x01\x00\x00late"]
+
+
+def test_transient_local_history_goes_only_to_transient_local_readers() -> None:
+    a, c, w, r = pair(Qos(True, 3, transient_local=True), Qos(True))
+    for k in range(5):
+        a.write(w, b"\x00\x01\x00\x00" + bytes([k]), 0.0)
+    r_tl = c._new_entity(0x04)      # a TRANSIENT_LOCAL reader (the lab's own are VOLATILE)
+    c.local[r_tl] = type(c.local[r])(r_tl, "reader", TOPIC, TYPE, Qos(True, 10, True))
+    c._announce_endpoint(c.local[r_tl])
+    net = Net(a, c)
+    net.run([], steps=40)
+    assert [s.payload[-1] for s in c.take(r_tl)] == [2, 3, 4]
+    assert c.take(r) == []                      # the VOLATILE reader: nothing from before
+    net.run(a.write(w, b"\x00\x01\x00\x00\x05", net.now), steps=5)
+    assert [s.payload[-1] for s in c.take(r)] == [5]

@@ -471,8 +471,9 @@ class Participant:
         if why:
             self.note(f"qos-{rem.guid.hex()}-{ep.entity_id}", f"not matched: {what}: {why}")
             return
-        if ep.kind == "writer" and ep.qos.transient_local and ep.history:
-            # TRANSIENT_LOCAL: a reader that joins late gets the history (KEEP_LAST depth)
+        if ep.kind == "writer" and ep.qos.transient_local and rem.qos.transient_local and ep.history:
+            # TRANSIENT_LOCAL both sides: a reader that joins late gets the history (KEEP_LAST
+            # depth); a VOLATILE reader gets only what is written after it matched
             first = next(iter(ep.history))
             proxy = ReaderProxy(key[0], key[1], rem.locator, rem.qos.reliable, first, acked=first)
             ep.proxies[key] = proxy
