@@ -57,11 +57,29 @@ def cyclone() -> Any:
         step: t.uint32
         data: t.sequence[t.uint8]
 
+    @dataclass
+    class Gid_(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):
+        data: t.array[t.uint8, 16]       # char[16] data (rmw_dds_common 2.0+)
+
+    @dataclass
+    class NodeEntitiesInfo_(IdlStruct, typename="rmw_dds_common::msg::dds_::NodeEntitiesInfo_"):
+        node_namespace: t.bounded_str[256]
+        node_name: t.bounded_str[256]
+        reader_gid_seq: t.sequence[Gid_]
+        writer_gid_seq: t.sequence[Gid_]
+
+    @dataclass
+    class ParticipantEntitiesInfo_(IdlStruct,
+                                   typename="rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_"):
+        gid: Gid_
+        node_entities_info_seq: t.sequence[NodeEntitiesInfo_]
+
     class Ns:
         pass
 
     ns = Ns()
     ns.__dict__.update(Time_=Time_, Header_=Header_, Image_=Image_, Policy=Policy, Qos=Qos,
+                       ParticipantEntitiesInfo_=ParticipantEntitiesInfo_,
                        DomainParticipant=DomainParticipant, DataWriter=DataWriter,
                        DataReader=DataReader, Topic=Topic)
     return ns

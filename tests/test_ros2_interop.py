@@ -210,10 +210,13 @@ def test_transient_local_writer_serves_a_late_cyclone_reader_its_history() -> No
         tl = dds.Qos(P.Reliability.Reliable(1_000_000_000), P.History.KeepLast(10),
                      P.Durability.TransientLocal, P.DataRepresentation(use_cdrv0_representation=True))
         late = dds.DataReader(dp, dds.Topic(dp, "rt/latched", dds.Image_), qos=tl)
-        volatile = dds.DataReader(dp, dds.Topic(dp, "rt/latched", dds.Image_), qos=qos(dds))
         got: list = []
         assert wait(lambda: got.extend(late.take(10)) or len(got) >= 3, 10)
         assert [s.header.stamp.sec for s in got] == [2, 3, 4]      # KEEP_LAST 3 of 5
+        # the VOLATILE reader only after that: Cyclone (one network stack per domain and
+        # process) hands a writer's samples to all its in-sync readers there, so history sent
+        # for a TRANSIENT_LOCAL reader meanwhile would reach it too
+        volatile = dds.DataReader(dp, dds.Topic(dp, "rt/latched", dds.Image_), qos=qos(dds))
         assert wait(lambda: volatile.get_matched_publications(), 5)
         pub.publish(sample(5))
         more: list = []
@@ -239,3 +242,31 @@ def test_camera_component_viewer_all_on_ros2() -> None:
         assert viewer.received == 3
         assert viewer.last is not None and viewer.last.header["frame_id"] == "camera"
         assert np.array_equal(viewer.last.image, cv2_dilate(sent[-1].image))
+
+
+def test_ros_discovery_info_names_the_node_and_its_endpoints() -> None:
+    """What ``ros2 node list`` reads: rmw_dds_common/ParticipantEntitiesInfo on ros_discovery_info
+    (TRANSIENT_LOCAL), here read by a Cyclone reader typed from rmw_dds_common's .msg files."""
+    dds = cyclone()
+    comp = Ros2Component(parse_config(CONFIG.format(w=8, h=4)), domain=DOMAIN,
+                         name="/lab/fpga_ros2")
+    with comp:
+        dp = dds.DomainParticipant(DOMAIN)
+        P = dds.Policy
+        tl = dds.Qos(P.Reliability.Reliable(1_000_000_000), P.History.KeepLast(1),
+                     P.Durability.TransientLocal, P.DataRepresentation(use_cdrv0_representation=True))
+        reader = dds.DataReader(dp, dds.Topic(dp, "ros_discovery_info", dds.ParticipantEntitiesInfo_),
+                                qos=tl)
+        got: list = []
+        assert wait(lambda: got.extend(s for s in reader.take(10)
+                                       if isinstance(s, dds.ParticipantEntitiesInfo_)) or got, 10)
+        info = got[-1]
+        prefix = comp.node.participant.guid_prefix if comp.node else b""
+        assert bytes(info.gid.data) == prefix + b"\x00\x00\x01\xc1"
+        (node,) = info.node_entities_info_seq
+        assert (node.node_namespace, node.node_name) == ("/lab", "fpga_ros2")
+        readers = [bytes(g.data) for g in node.reader_gid_seq]
+        writers = [bytes(g.data) for g in node.writer_gid_seq]
+        assert len(readers) == len(writers) == 1
+        assert readers[0][:12] == writers[0][:12] == prefix
+        assert comp._pub is not None and writers[0][12:] == comp._pub.writer_id.to_bytes(4, "big")

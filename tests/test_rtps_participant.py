@@ -335,3 +335,17 @@ def test_transient_local_history_goes_only_to_transient_local_readers() -> None:
     assert c.take(r) == []                      # the VOLATILE reader: nothing from before
     net.run(a.write(w, b"\x00\x01\x00\x00\x05", net.now), steps=5)
     assert [s.payload[-1] for s in c.take(r)] == [5]
+
+
+def test_a_volatile_reader_asking_for_older_samples_gets_a_gap_not_the_samples() -> None:
+    """Cyclone's first ACKNACK asks for everything from 1: the writer used to resend its
+    history to a VOLATILE reader that matched after it was written."""
+    a, c, w, r = pair(Qos(True, 5))
+    net = Net(a, c)
+    for k in range(3):
+        a.write(w, b"\x00\x01\x00\x00" + bytes([k]), 0.0)   # before anyone matched
+    net.run([], steps=20)
+    out = a.receive(b.header(c.guid_prefix) + b.acknack(r, w, 1, [1, 2, 3], 50), c.user, net.now)
+    subs = [s for _, _, d in out for s in parse_message(d).submessages]
+    assert not any(isinstance(s, Data) and s.writer_id == w for s in subs)
+    assert any(isinstance(s, Gap) and (s.start, s.list_base) == (1, 4) for s in subs)

@@ -105,7 +105,8 @@ class Ros2Component:
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         self.config, self.domain, self.qos_in, self.qos_out = config, domain, qos_in, qos_out
-        self.name = (name or config.node.global_name).strip("/").replace("/", "_") or "fpga"
+        namespace, _, base = (name or config.node.global_name).rpartition("/")
+        self.name, self.namespace = base or "fpga", namespace or "/"
         self.input_topic, self.output_topic = config.subscriber.topic, config.publisher.topic
         self.counts = {"seen": 0, "published": 0, "refused": 0}
         self.latencies: list[float] = []
@@ -114,7 +115,7 @@ class Ros2Component:
         self._pub: Ros2Publisher | None = None
 
     def start(self) -> Ros2Component:
-        self.node = Ros2Node(self.name, self.domain)
+        self.node = Ros2Node(self.name, self.domain, namespace=self.namespace)
         self._pub = self.node.create_publisher(self.output_topic, IMAGE, self.qos_out)
         self.node.create_subscriber(self.input_topic, IMAGE, self._on_sample, self.qos_in)
         log.info("%s: ROS 2 node in DDS domain %d (participant index %d): %s -> %s -> %s",

@@ -22,7 +22,9 @@ from collections.abc import Callable
 
 from rosfpga_lab.graph.errors import GraphError
 from rosfpga_lab.graph.limits import ROS2_SOCKET_BUFFER_BYTES, ROS2_TICK_SECONDS
-from rosfpga_lab.rtps.build import dds_topic, dds_type
+from rosfpga_lab.rtps.build import (
+    ROS_DISCOVERY_TOPIC, ROS_DISCOVERY_TYPE, dds_topic, dds_type, participant_entities_info,
+)
 from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX
 from rosfpga_lab.rtps.participant import Participant, Qos, Sample, discovery_port, user_port
 
@@ -83,8 +85,9 @@ class Ros2Node:
     """
 
     def __init__(self, name: str = "rosfpga_lab", domain: int = 0, address: str = "127.0.0.1",
-                 lease: float | None = None, announce: float | None = None) -> None:
-        self.name, self.domain = name, domain
+                 lease: float | None = None, announce: float | None = None,
+                 namespace: str = "/") -> None:
+        self.name, self.domain, self.namespace = name, domain, namespace
         self._meta, self._user, index = self._bind(domain, address)
         kw = {k: v for k, v in (("lease", lease), ("announce", announce)) if v is not None}
         self.participant = Participant(domain, index, address, name, **kw)  # type: ignore[arg-type]
@@ -92,6 +95,13 @@ class Ros2Node:
         self._subs: dict[int, Ros2Subscriber] = {}
         self._logged = 0
         self._stop = threading.Event()
+        # the ROS 2 graph learns the node's name and endpoints from ros_discovery_info
+        # (RELIABLE TRANSIENT_LOCAL KEEP_LAST 1, as rmw publishes it)
+        self._graph_writer = self.participant.add_writer(
+            ROS_DISCOVERY_TOPIC, ROS_DISCOVERY_TYPE, Qos(True, 1, transient_local=True))
+        self._readers: list[bytes] = []
+        self._writers: list[bytes] = []
+        self._announce_graph()
         self._thread = threading.Thread(target=self._run, name=f"ros2-{name}", daemon=True)
         self._thread.start()
 
@@ -119,10 +129,24 @@ class Ros2Node:
     def index(self) -> int:
         return self.participant.index
 
+    def _guid(self, entity_id: int) -> bytes:
+        return self.participant.guid_prefix + entity_id.to_bytes(4, "big")
+
+    def _announce_graph(self) -> None:
+        """Publish this node's name and endpoints on ros_discovery_info (a ROS 2 node list sees it)."""
+        p = self.participant
+        payload = participant_entities_info(
+            self._guid(0x000001C1), [(self.namespace, self.name, self._readers, self._writers)])
+        with self._lock:
+            out = p.write(self._graph_writer, payload, time.monotonic(), time.time())
+        self._send(out)
+
     def create_publisher(self, topic: str, type_name: str, qos: Qos = Qos()) -> Ros2Publisher:
         """A writer of ROS 2 topic ``topic`` (``/image``) of ROS type ``type_name``."""
         with self._lock:
             wid = self.participant.add_writer(dds_topic(topic), dds_type(type_name), qos)
+            self._writers.append(self._guid(wid))
+        self._announce_graph()
         return Ros2Publisher(self, wid, topic)
 
     def create_subscriber(self, topic: str, type_name: str,
@@ -130,6 +154,8 @@ class Ros2Node:
         with self._lock:
             rid = self.participant.add_reader(dds_topic(topic), dds_type(type_name), qos)
             sub = self._subs[rid] = Ros2Subscriber(self, rid, topic, callback)
+            self._readers.append(self._guid(rid))
+        self._announce_graph()
         return sub
 
     def notes(self) -> list[str]:

@@ -273,3 +273,33 @@ def dds_type(ros_type: str) -> str:
     parts = ros_type.split("/")
     pkg, name = parts[0], parts[-1]
     return f"{pkg}::msg::dds_::{name}_"
+
+
+# ---- the ROS 2 graph: which nodes a participant holds (rmw_dds_common) ------------------------
+
+#: The DDS topic and type on which rmw tells the ROS 2 graph a participant's nodes (rmw_dds_common).
+ROS_DISCOVERY_TOPIC = "ros_discovery_info"
+ROS_DISCOVERY_TYPE = "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_"
+#: Bytes of rmw_dds_common/Gid (``char[16] data`` since rmw_dds_common 2.0: Iron, Jazzy and later;
+#: Humble's 1.x used 24). rmw_cyclonedds puts the 16-byte DDS GUID there.
+GID_BYTES = 16
+
+
+def participant_entities_info(participant_guid: bytes,
+                              nodes: Iterable[tuple[str, str, list[bytes], list[bytes]]]) -> bytes:
+    """The CDR payload of rmw_dds_common/ParticipantEntitiesInfo: the participant's GID, then per
+    node (namespace, name, reader GIDs, writer GIDs), in the field order of the .msg files."""
+    def gid(g: bytes) -> bytes:
+        return g[:GID_BYTES].ljust(GID_BYTES, b"\0")
+
+    out = bytearray(CDR_LE) + gid(participant_guid)
+    nodes = list(nodes)
+    out += struct.pack("<I", len(nodes))
+    for ns, name, readers, writers in nodes:
+        for text in (ns, name):
+            out += bytes(-(len(out) - 4) % 4)
+            out += cdr_string(text)
+        for gids in (readers, writers):
+            out += bytes(-(len(out) - 4) % 4)
+            out += struct.pack("<I", len(gids)) + b"".join(gid(g) for g in gids)
+    return bytes(out)

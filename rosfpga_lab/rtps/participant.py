@@ -542,6 +542,13 @@ class Participant:
         if len(missing) < len(sub.missing):
             self.note(f"acknack-future-{prefix.hex()}", f"ACKNACK from {prefix.hex()} asks for "
                       f"samples past {ep.seq}, the last written: those ignored")
+        # what was written before a VOLATILE reader matched is not for it: GAP, never resend
+        early = [s for s in missing if s < proxy.first_relevant]
+        missing = [s for s in missing if s >= proxy.first_relevant]
+        if early and not missing:
+            return self._msg(proxy.locator, proxy.prefix,
+                             [b.gap(proxy.reader_id, ep.entity_id, min(early), proxy.first_relevant),
+                              self._heartbeat(ep, proxy)])
         if not missing:
             return []
         if now - proxy.last_resend < MIN_RESEND_SECONDS:
@@ -560,6 +567,8 @@ class Participant:
                         if len(gone) == max(gone) - min(gone) + 1 else
                         b.gap(proxy.reader_id, ep.entity_id, min(gone),
                               next(iter(ep.history), ep.seq + 1)))
+        if early:
+            subs.insert(0, b.gap(proxy.reader_id, ep.entity_id, min(early), proxy.first_relevant))
         subs.append(self._heartbeat(ep, proxy))
         return self._msg(proxy.locator, proxy.prefix, subs)
 
