@@ -349,3 +349,21 @@ def test_a_volatile_reader_asking_for_older_samples_gets_a_gap_not_the_samples()
     subs = [s for _, _, d in out for s in parse_message(d).submessages]
     assert not any(isinstance(s, Data) and s.writer_id == w for s in subs)
     assert any(isinstance(s, Gap) and (s.start, s.list_base) == (1, 4) for s in subs)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from([b.PID_RELIABILITY, b.PID_DURABILITY, b.PID_HISTORY,
+                                           b.PID_TOPIC_NAME, b.PID_TYPE_NAME, b.PID_UNICAST_LOCATOR,
+                                           b.PID_ENDPOINT_GUID, 0x0071]),
+                          st.binary(max_size=24)), max_size=8))
+def test_sedp_with_odd_parameter_values_never_raises(params: list) -> None:
+    """Short or odd QoS values (a 2-byte PID_RELIABILITY, ...) used to raise struct.error out of
+    the receive path, which stops the node's thread."""
+    p = fresh()
+    prefix = b"P" * 12
+    p.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    guid = prefix + (0x103).to_bytes(4, "big")
+    payload = b.param_list([(b.PID_ENDPOINT_GUID, guid), (b.PID_TOPIC_NAME, b.cdr_string(TOPIC))]
+                           + params)
+    p.receive(b.header(prefix) + b.data(0x3C7, PUB_WRITER, 1, payload), ("127.0.0.1", 7999), 0.0)
+    assert not any(k.startswith("unexpected") for k in p.counts), p.notes

@@ -94,6 +94,8 @@ class Ros2Node:
         self._lock = threading.RLock()
         self._subs: dict[int, Ros2Subscriber] = {}
         self._logged = 0
+        #: Datagrams whose handling raised (a bug: logged the first time, counted after).
+        self._failures = 0
         self._stop = threading.Event()
         # the ROS 2 graph learns the node's name and endpoints from ros_discovery_info
         # (RELIABLE TRANSIENT_LOCAL KEEP_LAST 1, as rmw publishes it)
@@ -203,7 +205,14 @@ class Ros2Node:
                     except OSError:
                         return
                     with self._lock:
-                        out = self.participant.receive(data, src, time.monotonic())
+                        try:
+                            out = self.participant.receive(data, src, time.monotonic())
+                        except Exception:     # never let one datagram stop the node's thread
+                            self._failures += 1
+                            if self._failures == 1:
+                                log.exception("datagram from %s:%d dropped (further ones counted "
+                                              "in failures)", src[0], src[1])
+                            out = []
                         samples = self.participant.take() if self.participant.samples else []
                         self._flush_notes()
                     self._send(out)

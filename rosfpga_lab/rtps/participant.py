@@ -434,13 +434,15 @@ class Participant:
                       f"new ones are ignored")
             return
         order = "<" if little else ">"
-        rel = params.get(b.PID_RELIABILITY)
-        reliable = (struct.unpack(order + "I", rel[0][:4])[0] == b.RELIABLE) if rel \
-            else kind == "writer"
-        dur = params.get(b.PID_DURABILITY)
-        durability = struct.unpack(order + "I", dur[0][:4])[0] if dur else b.VOLATILE
-        hist = params.get(b.PID_HISTORY)
-        depth = struct.unpack(order + "Ii", hist[0][:8])[1] if hist and len(hist[0]) >= 8 else 1
+
+        def u32(pid: int, at: int = 0) -> int | None:   # None: absent or too short
+            value = (params.get(pid) or [b""])[0]
+            return struct.unpack(order + "I", value[at:at + 4])[0] if len(value) >= at + 4 else None
+
+        rel = u32(b.PID_RELIABILITY)
+        reliable = rel == b.RELIABLE if rel is not None else kind == "writer"
+        durability = u32(b.PID_DURABILITY) or b.VOLATILE
+        depth = u32(b.PID_HISTORY, 4) or 1
         owner = self.participants.get(prefix)
         loc = self._locator(params.get(b.PID_UNICAST_LOCATOR), little, (self.address, 0)) \
             or (owner.user if owner else None)
@@ -743,6 +745,12 @@ class Participant:
                 out += self._on_submessage(prefix, sub, source, now)
             except RtpsError as exc:
                 self.note(f"bad-{sub.name}", f"{sub.name} from {prefix.hex()} ignored ({exc})")
+            except (struct.error, ValueError, IndexError, KeyError, UnicodeError) as exc:
+                # a field this code did not expect in that shape: the submessage is dropped,
+                # the participant goes on (a bug to report, never a way to stop the node)
+                self.note(f"unexpected-{sub.name}-{type(exc).__name__}",
+                          f"{sub.name} from {prefix.hex()} dropped: unexpected {type(exc).__name__}: "
+                          f"{exc}")
         return out + self._take_outbox()
 
     def _take_outbox(self) -> list[Send]:
