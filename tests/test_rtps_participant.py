@@ -367,3 +367,16 @@ def test_sedp_with_odd_parameter_values_never_raises(params: list) -> None:
                            + params)
     p.receive(b.header(prefix) + b.data(0x3C7, PUB_WRITER, 1, payload), ("127.0.0.1", 7999), 0.0)
     assert not any(k.startswith("unexpected") for k in p.counts), p.notes
+
+
+def test_invalid_heartbeat_and_gap_are_ignored_and_delivery_goes_on() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    net.run(a.write(w, b"\x00\x01\x00\x00one", net.now), steps=3)
+    bad = (b.header(a.guid_prefix) + b.heartbeat(r, w, 0, -5, 99)       # first < 1, last < first-1
+           + b.gap(r, w, -3, 1 << 40) + b.gap(r, w, 5, 2))               # start < 1; base < start
+    c.receive(bad, a.user, net.now)
+    net.run(a.write(w, b"\x00\x01\x00\x00two", net.now), steps=3)
+    assert [s.payload[4:] for s in c.take(r)] == [b"one", b"two"]
+    assert sum("RTPS 2.3 8.3.7" in n for n in c.notes) == 2     # one note per kind

@@ -757,8 +757,26 @@ class Participant:
         out, self._outbox = self._outbox, []
         return out
 
+    @staticmethod
+    def _invalid(sub: object) -> str:
+        """Why a submessage is invalid by RTPS 2.3 8.3.7 (then it is ignored), or ''."""
+        if isinstance(sub, Heartbeat) and (sub.first < 1 or sub.last < sub.first - 1):
+            return f"HEARTBEAT first {sub.first} last {sub.last}"
+        if isinstance(sub, Gap) and (sub.start < 1 or sub.list_base < sub.start):
+            return f"GAP start {sub.start} base {sub.list_base}"
+        if isinstance(sub, AckNack) and sub.base < 1:
+            return f"ACKNACK base {sub.base}"
+        if isinstance(sub, (Data, DataFrag)) and sub.seq < 1:
+            return f"{'DATA' if isinstance(sub, Data) else 'DATA_FRAG'} sequence number {sub.seq}"
+        return ""
+
     def _on_submessage(self, prefix: bytes, sub: object, source: tuple[str, int],
                        now: float) -> list[Send]:
+        why = self._invalid(sub)
+        if why:
+            self.note(f"invalid-{type(sub).__name__}", f"invalid submessage from {prefix.hex()} "
+                      f"ignored: {why} (RTPS 2.3 8.3.7)")
+            return []
         if isinstance(sub, Data):
             if sub.writer_id == SPDP_WRITER:
                 return self._on_spdp(prefix, sub, source, now)
