@@ -25,147 +25,30 @@ from __future__ import annotations
 
 import os
 import struct
-from collections import OrderedDict, deque
-from dataclasses import dataclass, field
+from collections import deque
 
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.discovery import PL_CDR_BE, PL_CDR_LE, FragmentAssembler, parse_parameters
+from rosfpga_lab.rtps.entities import (
+    PUB_READER, PUB_WRITER, READER_KIND, SPDP_READER, SPDP_WRITER, SUB_READER, SUB_WRITER,
+    WRITER_KIND, LocalEndpoint, Qos, ReaderProxy, RemoteEndpoint, RemoteParticipant, Sample, Send,
+    WriterProxy, check_domain, discovery_port, incompatibility, user_port,
+)
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import (
-    ANNOUNCE_SECONDS, DOMAIN_GAIN, FRAGMENT_BYTES, HEARTBEAT_SECONDS, LEASE_SECONDS,
-    MAX_DOMAIN_ID, MAX_HISTORY_DEPTH, MAX_LEASE_SECONDS, MAX_MESSAGE_BYTES, MAX_NOTES,
-    MAX_OUT_OF_ORDER, MAX_OUT_OF_ORDER_BYTES, MAX_PARTICIPANT_INDEX, MAX_REMOTE_ENDPOINTS,
-    MAX_REMOTE_PARTICIPANTS, MIN_RESEND_SECONDS, OFFSET_DISCOVERY_UNICAST, OFFSET_USER_UNICAST,
-    PARTICIPANT_GAIN, PORT_BASE,
+    ANNOUNCE_SECONDS, FRAGMENT_BYTES, HEARTBEAT_SECONDS, LEASE_SECONDS, MAX_HISTORY_DEPTH,
+    MAX_LEASE_SECONDS, MAX_MESSAGE_BYTES, MAX_NOTES, MAX_OUT_OF_ORDER, MAX_OUT_OF_ORDER_BYTES,
+    MAX_PARTICIPANT_INDEX, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS, MIN_RESEND_SECONDS,
 )
 from rosfpga_lab.rtps.message import (
     AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, InfoDst, NackFrag, parse_message,
 )
 
-SPDP_WRITER, SPDP_READER = 0x000100C2, 0x000100C7
-PUB_WRITER, PUB_READER = 0x000003C2, 0x000003C7
-SUB_WRITER, SUB_READER = 0x000004C2, 0x000004C7
-PARTICIPANT_ENTITY = 0x000001C1
-#: User entity kinds: writer and reader without key (ROS 2 topics have no key).
-WRITER_KIND, READER_KIND = 0x03, 0x04
-
-Send = tuple[str, int, bytes]
-
-
-def discovery_port(domain: int, index: int) -> int:
-    """The unicast discovery (metatraffic) port of participant ``index`` in ``domain``."""
-    return PORT_BASE + DOMAIN_GAIN * domain + OFFSET_DISCOVERY_UNICAST + PARTICIPANT_GAIN * index
-
-
-def user_port(domain: int, index: int) -> int:
-    """The unicast user-data port of participant ``index`` in ``domain``."""
-    return PORT_BASE + DOMAIN_GAIN * domain + OFFSET_USER_UNICAST + PARTICIPANT_GAIN * index
-
-
-def check_domain(domain: int) -> None:
-    if not 0 <= domain <= MAX_DOMAIN_ID:
-        raise RtpsError(f"DDS domain {domain} out of range: use 0..{MAX_DOMAIN_ID} (the RTPS "
-                        f"port mapping puts larger ids past port 65535)")
-
-
-@dataclass(frozen=True)
-class Qos:
-    """The QoS the lab's endpoints use and compare: reliability, durability, history depth."""
-
-    reliable: bool = True
-    depth: int = 10
-    transient_local: bool = False
-
-    def describe(self) -> str:
-        return (f"{'RELIABLE' if self.reliable else 'BEST_EFFORT'} KEEP_LAST {self.depth} "
-                f"{'TRANSIENT_LOCAL' if self.transient_local else 'VOLATILE'}")
-
-
-def incompatibility(offered: Qos, requested: Qos) -> str:
-    """Why a writer offering ``offered`` cannot serve a reader requesting ``requested`` ('' if it can)."""
-    if requested.reliable and not offered.reliable:
-        return "a BEST_EFFORT writer never matches a RELIABLE reader (RELIABILITY offered < requested)"
-    if requested.transient_local and not offered.transient_local:
-        return "a VOLATILE writer never matches a TRANSIENT_LOCAL reader (DURABILITY offered < requested)"
-    return ""
-
-
-@dataclass
-class RemoteParticipant:
-    prefix: bytes
-    meta: tuple[str, int]
-    user: tuple[str, int]
-    lease: float
-    last_seen: float
-    name: str = ""
-
-
-@dataclass
-class RemoteEndpoint:
-    guid: bytes
-    kind: str                     # "writer" | "reader"
-    topic: str
-    type_name: str
-    qos: Qos
-    locator: tuple[str, int]
-
-
-@dataclass
-class ReaderProxy:
-    """A remote reader as one of the lab's writers sees it."""
-
-    prefix: bytes
-    reader_id: int
-    locator: tuple[str, int]
-    reliable: bool
-    first_relevant: int
-    acked: int = 1                # every sample before it is acknowledged
-    last_count: int = 0
-    last_frag_count: int = 0
-    last_resend: float = -1.0
-    last_heartbeat: float = -1.0
-
-
-@dataclass
-class WriterProxy:
-    """A remote writer as one of the lab's readers sees it."""
-
-    prefix: bytes
-    writer_id: int
-    reliable: bool
-    next: int = 0                 # 0: nothing known yet
-    pending: dict[int, bytes | None] = field(default_factory=dict)
-    pending_bytes: int = 0
-    last_hb_count: int = -(1 << 31)
-    acknack_count: int = 0
-    nackfrag_count: int = 0
-
-
-@dataclass
-class LocalEndpoint:
-    entity_id: int
-    kind: str
-    topic: str
-    type_name: str
-    qos: Qos
-    seq: int = 0                                  # writer: last sequence number written
-    history: OrderedDict[int, bytes] = field(default_factory=OrderedDict)
-    proxies: dict[tuple[bytes, int], ReaderProxy | WriterProxy] = field(default_factory=dict)
-    hb_count: int = 0
-
-    @property
-    def guid_tail(self) -> bytes:
-        return self.entity_id.to_bytes(4, "big")
-
-
-@dataclass(frozen=True)
-class Sample:
-    """A user sample delivered to one of the lab's readers."""
-
-    reader_id: int
-    writer_guid: bytes
-    seq: int
-    payload: bytes
+__all__ = [
+    "PUB_READER", "PUB_WRITER", "Participant", "Qos", "SPDP_READER", "SPDP_WRITER", "SUB_READER",
+    "SUB_WRITER", "Sample", "Send", "check_domain", "discovery_port", "incompatibility",
+    "user_port",
+]
 
 
 class Participant:
