@@ -38,6 +38,7 @@ class Net:
         self.drop = drop
         self.now = 0.0
         self.sent = 0
+        self.kinds: set[str] = set()      # submessage kinds that went over the network
 
     def port_owner(self, port: int) -> Participant | None:
         for p in self.parts:
@@ -53,6 +54,7 @@ class Net:
             while queue:
                 host, port, data = queue.pop(0)
                 self.sent += 1
+                self.kinds |= {sub.name for sub in parse_message(data).submessages}
                 dst = self.port_owner(port)
                 if dst is None or self.drop(data):
                     continue
@@ -118,6 +120,7 @@ def test_reliable_recovers_lost_datagrams_and_fragments() -> None:
     net.run(out, steps=300)
     assert [s.payload for s in c.take(r)] == [small[0], big, *small[1:]]
     assert c.assembler.held == 0
+    assert {"DATA", "DATA_FRAG", "HEARTBEAT", "ACKNACK", "NACK_FRAG"} <= net.kinds, net.kinds
 
 
 def test_keep_last_history_gaps_what_left_it() -> None:
