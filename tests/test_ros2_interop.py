@@ -166,11 +166,12 @@ def test_cli_node_ros2_serves_cyclone_peers(tmp_path) -> None:
     cfg.write_text(CONFIG.format(w=32, h=16))
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(cfg), "--ros2",
-                             "--domain", str(DOMAIN), "--duration", "30"],
+                             "--domain", str(DOMAIN), "--duration", "30", "--best-effort-input"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
         dp = dds.DomainParticipant(DOMAIN)
-        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds))
+        # a best-effort camera (sensor-data QoS): only --best-effort-input matches it
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds, False))
         reader = dds.DataReader(dp, dds.Topic(dp, "rt/cam_out", dds.Image_), qos=qos(dds))
         assert wait(lambda: writer.get_matched_subscriptions() and reader.get_matched_publications(), 8)
         for k in range(3):
@@ -187,7 +188,8 @@ def test_cli_node_ros2_serves_cyclone_peers(tmp_path) -> None:
             proc.kill()
             proc.wait()
     assert proc.returncode == 0, err
-    assert "DDS domain" in out_text and "3 samples seen, 3 published, 0 refused" in out_text
+    assert "DDS domain" in out_text and "input BEST_EFFORT" in out_text
+    assert "3 samples seen, 3 published, 0 refused" in out_text
 
 
 def test_transient_local_writer_serves_a_late_cyclone_reader_its_history() -> None:

@@ -48,6 +48,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="run as a ROS 2 node (DDS/RTPS on 127.0.0.1, no master) instead of ROS 1")
     p.add_argument("--domain", type=int, default=None, metavar="N",
                    help="with --ros2: the DDS domain (default: ROS_DOMAIN_ID, else 0)")
+    p.add_argument("--best-effort-input", action="store_true",
+                   help="with --ros2: subscribe BEST_EFFORT (matches best-effort cameras, e.g. "
+                   "ROS 2's sensor-data QoS, as well as reliable ones); default RELIABLE, ROS 2's "
+                   "default, which a best-effort writer never matches")
     p.set_defaults(func=run)
 
 
@@ -57,6 +61,7 @@ def run_ros2(args: argparse.Namespace) -> int:
 
     from rosfpga_lab.component.ros2 import Ros2Component
     from rosfpga_lab.errors import LabError
+    from rosfpga_lab.rtps.participant import Qos
 
     if not args.quiet:
         logging.basicConfig(level=logging.INFO, format="[%(levelname)s] %(message)s",
@@ -64,11 +69,13 @@ def run_ros2(args: argparse.Namespace) -> int:
     raw = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID", "0") or "0"
     try:
         domain = int(raw)
-        comp = Ros2Component(args.config, domain=domain, model=args.model).start()
+        qos_in = Qos(reliable=not args.best_effort_input)
+        comp = Ros2Component(args.config, domain=domain, model=args.model, qos_in=qos_in).start()
     except (ValueError, LabError) as exc:
         print(f"rosfpga-lab node: error: {exc}", file=sys.stderr)
         return 1
-    print(f"{comp.name}: ROS 2 (DDS domain {domain}, participant index {comp.node.index if comp.node else '?'}) "
+    print(f"{comp.name}: ROS 2 (DDS domain {domain}, participant index "
+          f"{comp.node.index if comp.node else '?'}, input {comp.qos_in.describe()}) "
           f"{comp.input_topic} -> {comp.pipeline.op} ({args.model} model) -> {comp.output_topic}; "
           "Ctrl-C to stop", flush=True)
     t_end = None if args.duration is None else time.monotonic() + args.duration
