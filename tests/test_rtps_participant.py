@@ -383,3 +383,15 @@ def test_invalid_heartbeat_and_gap_are_ignored_and_delivery_goes_on() -> None:
     net.run(a.write(w, b"\x00\x01\x00\x00two", net.now), steps=3)
     assert [s.payload[4:] for s in c.take(r)] == [b"one", b"two"]
     assert sum("RTPS 2.3 8.3.7" in n for n in c.notes) == 2     # one note per kind
+
+
+def test_heartbeats_to_a_reader_that_never_answers_back_off() -> None:
+    a = Participant(domain=7, index=0, announce=100.0)
+    a.add_writer(TOPIC, TYPE)
+    a.receive(spdp(b"Z" * 12), ("127.0.0.1", 7999), 0.0)       # a peer that will never ACK
+    beats = 0
+    for k in range(1000):                                        # 10 s of ticks
+        for _, _, d in a.tick(k * 0.01):
+            beats += sum(isinstance(s, Heartbeat) for s in parse_message(d).submessages)
+    # 2 SEDP writers; at a fixed 50 ms period that would be 400 HEARTBEATs
+    assert 2 <= beats <= 2 * 16, beats

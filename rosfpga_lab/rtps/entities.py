@@ -96,6 +96,7 @@ class ReaderProxy:
     last_frag_count: int = 0
     last_resend: float = -1.0
     last_heartbeat: float = -1.0
+    heartbeat_period: float = 0.0     # 0: the first period; doubles while unanswered
 
 
 @dataclass

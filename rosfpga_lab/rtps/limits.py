@@ -25,6 +25,8 @@ ANNOUNCE_SECONDS = 1.0
 MAX_LEASE_SECONDS = 300.0
 #: Period of a reliable writer's HEARTBEATs while a reader has not acknowledged everything.
 HEARTBEAT_SECONDS = 0.05
+#: ... doubling while the reader does not answer, up to this (readers that are gone or fake).
+MAX_HEARTBEAT_SECONDS = 1.0
 #: A reader proxy's retransmissions are at least this far apart (ACKNACK storms).
 MIN_RESEND_SECONDS = 0.005
 #: Remote participants and endpoints the participant keeps (SPDP/SEDP floods).

@@ -36,7 +36,8 @@ from rosfpga_lab.rtps.entities import (
 )
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import (
-    ANNOUNCE_SECONDS, FRAGMENT_BYTES, HEARTBEAT_SECONDS, LEASE_SECONDS, MAX_HISTORY_DEPTH,
+    ANNOUNCE_SECONDS, FRAGMENT_BYTES, HEARTBEAT_SECONDS, LEASE_SECONDS, MAX_HEARTBEAT_SECONDS,
+    MAX_HISTORY_DEPTH,
     MAX_LEASE_SECONDS, MAX_MESSAGE_BYTES, MAX_NOTES, MAX_OUT_OF_ORDER, MAX_OUT_OF_ORDER_BYTES,
     MAX_PARTICIPANT_INDEX, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS, MIN_RESEND_SECONDS,
 )
@@ -191,8 +192,10 @@ class Participant:
                 continue
             for key, proxy in ep.proxies.items():
                 assert isinstance(proxy, ReaderProxy)
-                if proxy.acked <= ep.seq and now - proxy.last_heartbeat >= HEARTBEAT_SECONDS:
+                period = proxy.heartbeat_period or HEARTBEAT_SECONDS
+                if proxy.acked <= ep.seq and now - proxy.last_heartbeat >= period:
                     proxy.last_heartbeat = now
+                    proxy.heartbeat_period = min(period * 2, MAX_HEARTBEAT_SECONDS)
                     out += self._msg(proxy.locator, proxy.prefix, [self._heartbeat(ep, proxy)])
         return out
 
@@ -416,6 +419,7 @@ class Participant:
                       f"matched reader of writer 0x{sub.writer_id:08x}: ignored")
             return []
         proxy.acked = min(max(proxy.acked, sub.base), ep.seq + 1)
+        proxy.heartbeat_period = 0.0     # it answers: back to the short period
         if sub.count <= proxy.last_count:
             # a count already seen (RTPS 8.4.15.8): no retransmission. Its acknowledgement
             # still counts, so a spoofed high count cannot silence the real reader for good.
