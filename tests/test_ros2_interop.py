@@ -17,7 +17,7 @@ import pytest
 from rosfpga_lab.component.ros2 import Ros2Component
 from rosfpga_lab.config import parse_config
 from rosfpga_lab.rtps.participant import Qos
-from ros2tools import DOMAIN, cyclone, image, qos, wait
+from ros2tools import CYCLONE_CONFIG, DOMAIN, cyclone, image, qos, wait
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -272,3 +272,38 @@ def test_ros_discovery_info_names_the_node_and_its_endpoints() -> None:
         assert len(readers) == len(writers) == 1
         assert readers[0][:12] == writers[0][:12] == prefix
         assert comp._pub is not None and writers[0][12:] == comp._pub.writer_id.to_bytes(4, "big")
+
+
+def test_a_cyclone_peer_that_dies_is_forgotten_when_its_lease_runs_out(tmp_path) -> None:
+    """SIGKILL: no goodbye on the wire; only the lease (1 s here) tells."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    cyclone()
+    cfg = CYCLONE_CONFIG.replace("</Discovery>", "<LeaseDuration>1s</LeaseDuration></Discovery>")
+    code = ("import time\nfrom cyclonedds.domain import DomainParticipant\n"
+            f"dp = DomainParticipant({DOMAIN})\nprint('up', flush=True)\ntime.sleep(60)\n")
+    with Ros2Component(parse_config(CONFIG.format(w=8, h=4)), domain=DOMAIN) as comp:
+        assert comp.node is not None
+        before = set(comp.node.participant.participants)
+        proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True,
+                                env=dict(os.environ, CYCLONEDDS_URI=cfg))
+        try:
+            assert proc.stdout is not None and proc.stdout.readline().strip() == "up"
+            assert wait(lambda: set(comp.node.participant.participants) - before, 10)
+            (peer,) = set(comp.node.participant.participants) - before
+            lease = comp.node.participant.participants[peer].lease
+            assert lease == pytest.approx(1.0)
+            proc.send_signal(signal.SIGKILL)
+            proc.wait(5)
+            t0 = time.monotonic()
+            assert wait(lambda: peer not in comp.node.participant.participants, 10)
+            assert time.monotonic() - t0 < lease + 1.0
+            assert any("lease" in n and peer.hex() in n for n in comp.notes())
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
