@@ -54,3 +54,12 @@ def require_yosys() -> None:
     reason = yosys_missing_reason()
     if reason:
         skip_or_fail(reason, REQUIRE)
+
+
+def require_formal() -> None:
+    """Skip (or fail under CI) unless SymbiYosys, Yosys and Yices are installed."""
+    from rosfpga_lab.rtl.proofs import formal_missing_reason
+
+    reason = formal_missing_reason()
+    if reason:
+        skip_or_fail(reason, REQUIRE)

@@ -240,7 +240,8 @@ def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
             kill_if_running(proc)
         state = master.getSystemState("/t")[2]
     assert proc.returncode == 0, err
-    assert "/image_raw -> dilate (fast model) -> /image_dilated" in out
+    assert "/image_raw -> dilate (fast model, host timing) -> /image_dilated" in out
+    assert "data path: fast model; timing: host" in out
     assert "frames: received 15, processed 15, published 15, refused 0, dropped 0" in out
     assert "cycles per stage (last frame): interpreter 1,228,8" in out
     assert "FIFO high water: rx 1" in out
@@ -263,10 +264,13 @@ def test_node_command_stops_cleanly_on_sigterm(tmp_path) -> None:
 
 
 def test_node_command_without_a_master_says_what_to_do(capsys) -> None:
+    """It waits for the master as rospy nodes do (issue 23, item 8), saying so once;
+    --duration bounds the wait."""
     uri = f"http://127.0.0.1:{free_port()}/"
-    assert main(["node", str(CONFIG), "--master-uri", uri]) == 1
+    assert main(["node", str(CONFIG), "--master-uri", uri, "--duration", "1.2"]) == 1
     err = capsys.readouterr().err
-    assert f"no ROS master answers at {uri}" in err and "--embedded-master" in err
+    assert err.count(f"no ROS master answers at {uri} yet; waiting for it") == 1
+    assert "--embedded-master" in err and "no ROS master answered" in err
 
 
 def test_node_command_embedded_master_and_duration(capsys) -> None:

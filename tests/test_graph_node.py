@@ -458,6 +458,8 @@ def test_ros_ip_and_hostname_are_honoured(monkeypatch) -> None:
     monkeypatch.setenv("ROS_HOSTNAME", "localhost")
     assert default_host() == "localhost"
     monkeypatch.setenv("ROS_IP", "127.0.0.1")
+    assert default_host() == "localhost"   # ROS_HOSTNAME wins over ROS_IP, as in rospy and roscpp
+    monkeypatch.delenv("ROS_HOSTNAME")
     assert default_host() == "127.0.0.1"
 
 

@@ -37,8 +37,18 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; return the process exit code."""
+    from rosfpga_lab.config.rosargs import split_ros_args
+
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:  # the ROS words (from:=to, __name:=x, _param:=v), as rosgraph's myargv drops them
+        own, ros = split_ros_args(sys.argv[1:] if argv is None else list(argv))
+    except LabError as exc:
+        parser.error(str(exc))
+    args = parser.parse_args(own)
+    if ros and not getattr(args, "ros_node", False):
+        parser.error(f"{' '.join(ros.words)}: ROS arguments (NAME:=VALUE) are for the commands "
+                     "that run a ROS node (node, camera, view, topic)")
+    args.ros = ros
     if getattr(args, "func", None) is None:
         parser.print_help()
         return 2

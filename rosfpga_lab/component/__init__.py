@@ -31,10 +31,12 @@ from rosfpga_lab.component.demo import (
 )
 from rosfpga_lab.component.errors import ComponentConfigError, ComponentError, SourceError
 from rosfpga_lab.component.fpga import FpgaComponent, FrameRecord, master_answers
+from rosfpga_lab.component.msgchecker import MessageChecker
 from rosfpga_lab.component.sources import SOURCES, ImageSource, open_source, to_rgb
 from rosfpga_lab.component.stats import ComponentStats, LatencySummary, LatencyWindow
 
 __all__ = [
+    "MessageChecker",
     "SOURCES", "Camera", "CheckReport", "Checker", "ComponentConfigError", "ComponentError",
     "ComponentStats", "DemoResult", "DemoRig", "FpgaComponent", "FrameRecord", "ImageSource",
     "LatencySummary", "LatencyWindow", "SentFrame", "SourceError", "ViewedFrame", "Viewer",

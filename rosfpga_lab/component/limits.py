@@ -47,3 +47,6 @@ MAX_BAG_SOURCE_BYTES = 512 * 1024 * 1024
 PAGE_IMAGE_MAX_WIDTH = 640
 #: Seconds between the ``node`` command's looks at its stop flag (how soon SIGTERM is obeyed).
 SIGNAL_POLL = 0.05
+#: Seconds between the ``node`` command's tries to reach a master that does not answer yet
+#: (rospy and roscpp nodes wait for it too: a launch order race is normal).
+MASTER_RETRY = 0.5

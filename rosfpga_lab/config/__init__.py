@@ -21,6 +21,7 @@ from rosfpga_lab.config.node import (
     ApplicationConfig, FifoConfig, ImageConfig, NodeConfig, NodeSection, TopicConfig,
     load_config, parse_config, ros_name_problem,
 )
+from rosfpga_lab.config.node import CheckConfig, NoImage, StreamConfig
 from rosfpga_lab.config.vocabulary import (
     CUSTOM, DEFAULT_ENCODING, DEFAULT_OP, ENCODINGS, MODEL_OPS, OPS, PASSTHROUGH, PIXEL_FORMATS, PixelFormat,
     canonical_op, model_ksize,
@@ -30,5 +31,5 @@ __all__ = [
     "CUSTOM", "DEFAULT_ENCODING", "DEFAULT_OP", "ENCODINGS", "MODEL_OPS", "OPS", "PASSTHROUGH", "PIXEL_FORMATS", "ApplicationConfig", "ConfigError", "FifoConfig",
     "ImageConfig", "NodeConfig", "NodeSection", "PixelFormat", "TopicConfig", "load_config",
     "parse_config", "ros_name_problem", "canonical_op", "master_uri", "master_uri_from_env",
-    "model_ksize",
+    "model_ksize", "CheckConfig", "NoImage", "StreamConfig",
 ]

@@ -17,6 +17,15 @@ MAX_KSIZE = 15
 #: Longest header.frame_id the circuit stores and the publisher re-sends.
 MAX_FRAME_ID_MAX = 256
 DEFAULT_FRAME_ID_MAX = MAX_FRAME_ID_MAX
+#: Maxima of the variable-length parts of a message other than the stream, when a configuration's
+#: ``limits:`` leaves them out: bytes of a string, elements of a variable-length array (a longer
+#: one is refused). ``header.frame_id`` keeps ``frame_id_max``.
+DEFAULT_STRING_MAX = 256
+DEFAULT_ARRAY_MAX = 64
+#: Largest value a ``limits:`` entry may give (bytes of a string, elements of an array).
+MAX_LIMIT = 1 << 20
+#: Most elements of the streamed array (``stream.length``).
+MAX_STREAM_LENGTH = 1 << 24
 #: FIFO depths (items) and their bounds.
 DEFAULT_INPUT_FIFO_DEPTH = 2048
 DEFAULT_OUTPUT_FIFO_DEPTH = 2048
@@ -31,8 +40,13 @@ MAX_CLOCK_MHZ = 1000.0
 DEFAULT_MASTER_PORT = 11311
 DEFAULT_MASTER_URI = f"http://127.0.0.1:{DEFAULT_MASTER_PORT}/"
 DEFAULT_IP_ADDRESS = "127.0.0.1"
-#: The only message type that can stream through the circuit.
+#: The message type with a video stream (``image:`` gives its geometry), the default type.
 IMAGE_TYPE = "sensor_msgs/Image"
+#: Its streamed array, and the fields ``image:`` implies a check on (equal to the geometry).
+IMAGE_STREAM_FIELD = "data"
+IMAGE_IMPLIED_CHECKS = ("height", "width", "encoding", "step")
+#: Longest ``encoding`` string an Image circuit stores.
+IMAGE_MAX_ENCODING_BYTES = 32
 #: Largest configuration file read (bytes).
 MAX_CONFIG_BYTES = 1 << 20
 #: FPGA part of the HLS project script (the Zynq-7020 of the paper's class of boards).

@@ -17,8 +17,8 @@ encoding, the application, FIFO depths and the clock. Example (every key but ``n
       type: sensor_msgs/Image
     publisher:
       topic: /image_dilated
-      type: sensor_msgs/Image
-    image: {width: 640, height: 480, encoding: rgba8}
+      type: sensor_msgs/Image           # default: the subscriber's type
+    image: {width: 640, height: 480, encoding: rgba8}   # sensor_msgs/Image only
     application:
       op: dilate          # dilate | erode | passthrough | custom
       ksize: 3            # odd, 1..15 (dilate and erode)
@@ -27,6 +27,23 @@ encoding, the application, FIFO depths and the clock. Example (every key but ``n
     clock_mhz: 100
     frame_id_max: 256     # longest header.frame_id the circuit keeps
     part: xc7z020clg400-1 # FPGA part for the HLS project script (Zynq-7020)
+
+Any other message type names the array the application processes and, if it likes, checks,
+maxima and fields to drop (paths are dotted field names; ``msg_path`` folders, relative to this
+file, hold the user's ``PKG/msg/NAME.msg`` files)::
+
+    subscriber: {topic: /scan, type: sensor_msgs/LaserScan}
+    publisher: {topic: /scan_min}                # same type
+    msg_path: [msg]                              # optional
+    stream: {field: ranges, length: 360}         # the array and its element count
+    checks: {angle_min: -3.14, range_max: {max: 100}}   # equal, or {min, max} bounds
+    limits: {header.frame_id: 64, intensities: 360}     # default: DEFAULT_STRING_MAX bytes,
+                                                        # DEFAULT_ARRAY_MAX elements
+    skip: [intensities]                          # dropped; the output gets the default
+    application: {op: erode, ksize: 5}           # 1-D: min over 5 elements
+
+For ``sensor_msgs/Image`` the stream is ``data`` with ``image:``'s size (a ``stream:`` may say
+so, and must agree) and the image checks are implied.
 
 How this works: the YAML is *composed* (not just loaded) so every key and value keeps its line
 number; a small walker checks each section against a schema table (key -> type, default),
@@ -42,17 +59,23 @@ import difflib
 import ipaddress
 import re
 import urllib.parse
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import yaml
 
 from rosfpga_lab.config import limits
 from rosfpga_lab.config.errors import ConfigError
+from rosfpga_lab.config.fields import (
+    FieldPathError, check_field, check_value_problem, limit_field, resolve_field, stream_field,
+)
 from rosfpga_lab.config.names import canonical, name_problem
 from rosfpga_lab.config.vocabulary import CUSTOM, DEFAULT_OP, ENCODINGS, OPS
+
+if TYPE_CHECKING:
+    from rosfpga_lab.msg import MsgRegistry
 
 @dataclass(frozen=True)
 class NodeSection:
@@ -84,8 +107,7 @@ class TopicConfig:
 
     Attributes:
         topic: topic name, e.g. ``/image_raw``.
-        type: message type, ``package/Name`` (only ``sensor_msgs/Image`` streams through the
-            circuit).
+        type: message type, ``package/Name`` (the shipped types or the ``msg_path`` ones).
     """
 
     topic: str
@@ -136,6 +158,62 @@ class ApplicationConfig:
     source: Path | None = None
 
 
+class NoImage(ImageConfig):
+    """The ``image`` of a configuration whose type is not ``sensor_msgs/Image``.
+
+    Every public attribute raises :class:`ConfigError` naming the type, so code that only knows
+    images fails with a clear message instead of using made-up geometry.
+    """
+
+    def __init__(self, type_name: str) -> None:  # no dataclass fields set on purpose
+        object.__setattr__(self, "_type_name", type_name)
+
+    def __getattribute__(self, name: str) -> Any:
+        if name.startswith("_"):
+            return object.__getattribute__(self, name)
+        type_name = object.__getattribute__(self, "_type_name")
+        raise ConfigError(f"{type_name} has no image geometry (image.{name}): this needs a "
+                          f"{limits.IMAGE_TYPE} configuration", key="image")
+
+    def __repr__(self) -> str:
+        return f"NoImage({object.__getattribute__(self, '_type_name')!r})"
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, NoImage) and repr(self) == repr(other)
+
+    def __hash__(self) -> int:
+        return hash(repr(self))
+
+
+@dataclass(frozen=True)
+class StreamConfig:
+    """The one array the application processes.
+
+    Attributes:
+        field: its dotted path in the subscribed message (``data``, ``ranges``).
+        length: its element count, fixed at synthesis time.
+    """
+
+    field: str
+    length: int
+
+
+class CheckConfig(NamedTuple):
+    """One ``checks:`` entry: ``value`` (equality) or the bounds ``low``/``high`` (``None``: open)."""
+
+    path: str
+    value: Any = None
+    low: Any = None
+    high: Any = None
+
+    @property
+    def spec(self) -> Any:
+        """As the layout takes it: the value, or ``{"min": low, "max": high}``."""
+        if self.value is not None:
+            return self.value
+        return {k: v for k, v in (("min", self.low), ("max", self.high)) if v is not None}
+
+
 @dataclass(frozen=True)
 class FifoConfig:
     """FIFO depths of the circuit (items).
@@ -159,13 +237,20 @@ class NodeConfig:
         node: the ROS node (name, master, address, ports).
         subscriber: the topic the circuit consumes (its subscriber, paper's (d)).
         publisher: the topic the circuit produces (its publisher, paper's (e)).
-        image: geometry and encoding.
+        image: geometry and encoding. A configuration of another type holds a stand-in
+            (:class:`NoImage`) whose every attribute raises :class:`ConfigError`: Image-only
+            code refuses it clearly; :attr:`is_image` tells them apart.
         application: what the circuit does to the image.
         fifo: FIFO depths.
         clock_mhz: the circuit's clock (MHz).
         frame_id_max: longest ``header.frame_id`` kept (longer frames are refused).
         part: the FPGA part named in the HLS project script.
         path: the file it was read from (None when parsed from a string).
+        msg_path: folders of the user's ``.msg`` packages (absolute).
+        stream: the streamed array (for Image: ``data``, ``image.data_bytes`` elements).
+        checks: ``checks:`` entries, in file order (Image's implied ones not included).
+        limits: ``limits:`` entries ``(path, max)``, in file order.
+        skip: fields the circuit drops.
     """
 
     node: NodeSection
@@ -178,6 +263,22 @@ class NodeConfig:
     frame_id_max: int = limits.DEFAULT_FRAME_ID_MAX
     part: str = limits.DEFAULT_PART
     path: Path | None = None
+    msg_path: tuple[Path, ...] = ()
+    stream: StreamConfig | None = None
+    checks: tuple[CheckConfig, ...] = ()
+    limits: tuple[tuple[str, int], ...] = ()
+    skip: tuple[str, ...] = ()
+
+    @property
+    def is_image(self) -> bool:
+        """True when the circuit subscribes to ``sensor_msgs/Image`` (the video path)."""
+        return not isinstance(self.image, NoImage)
+
+    def registry(self) -> "MsgRegistry":
+        """The message registry of this configuration: the shipped types plus ``msg_path``."""
+        from rosfpga_lab.msg import registry_with
+
+        return registry_with(self.msg_path)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -189,19 +290,24 @@ _SCHEMA: dict[str, dict[str, tuple[type | tuple[type, ...], Any]]] = {
              "ip_address": (str, limits.DEFAULT_IP_ADDRESS), "xmlrpc_port": (int, 0),
              "tcpros_port": (int, 0)},
     "subscriber": {"topic": (str, _REQUIRED), "type": (str, limits.IMAGE_TYPE)},
-    "publisher": {"topic": (str, _REQUIRED), "type": (str, limits.IMAGE_TYPE)},
+    "publisher": {"topic": (str, _REQUIRED), "type": ((str, type(None)), None)},
     "image": {"width": (int, _REQUIRED), "height": (int, _REQUIRED), "encoding": (str, _REQUIRED)},
     "application": {"op": (str, DEFAULT_OP), "ksize": (int, 3), "source": ((str, type(None)), None)},
     "fifo": {"input_depth": (int, limits.DEFAULT_INPUT_FIFO_DEPTH),
              "output_depth": (int, limits.DEFAULT_OUTPUT_FIFO_DEPTH),
              "axis_depth": (int, limits.DEFAULT_AXIS_FIFO_DEPTH)},
+    "stream": {"field": (str, _REQUIRED), "length": ((int, type(None)), None)},
 }
+#: Top-level keys read by their own code (lists and free mappings of field paths).
+_FREE_KEYS = ("msg_path", "checks", "limits", "skip")
 _TOP_SCALARS: dict[str, tuple[type | tuple[type, ...], Any]] = {
     "clock_mhz": ((int, float), limits.DEFAULT_CLOCK_MHZ),
     "frame_id_max": (int, limits.DEFAULT_FRAME_ID_MAX),
     "part": (str, limits.DEFAULT_PART),
 }
-_REQUIRED_SECTIONS = ("node", "subscriber", "publisher", "image")
+_REQUIRED_SECTIONS = ("node", "subscriber", "publisher")
+#: Sections that are left out unless given (no defaults to fill).
+_OPTIONAL_SECTIONS = ("image", "stream")
 
 
 class _Ctx:
@@ -258,6 +364,8 @@ def _section(ctx: _Ctx, top: dict[str, tuple[yaml.Node, yaml.Node]], name: str,
              ) -> tuple[dict[str, Any], dict[str, yaml.Node]]:
     """Values of one section with defaults filled in, and the node of each given value."""
     schema = _SCHEMA[name]
+    if name not in top and name in _OPTIONAL_SECTIONS:
+        return {}, {}
     if name not in top:
         if name in _REQUIRED_SECTIONS:
             raise ctx.error(f"missing section '{name}:' (keys: {', '.join(schema)})", None, name)
@@ -306,12 +414,8 @@ def ros_name_problem(name: str, *, node_name: bool = False) -> str | None:
 def _check_type(ctx: _Ctx, type_name: str, nodes: dict[str, yaml.Node], section: str,
                 known: Callable[[str], bool]) -> None:
     if not known(type_name):
-        raise ctx.error(f"unknown message type {type_name!r} (not in the lab's message registry)",
-                        nodes.get("type"), f"{section}.type")
-    if type_name != limits.IMAGE_TYPE:
-        raise ctx.error(f"message type {type_name!r} cannot stream through the circuit: the "
-                        f"templates serve {limits.IMAGE_TYPE} only", nodes.get("type"),
-                        f"{section}.type")
+        raise ctx.error(f"unknown message type {type_name!r} (not in the lab's message registry "
+                        "nor under msg_path)", nodes.get("type"), f"{section}.type")
 
 
 def _known_type(type_name: str) -> bool:
@@ -320,15 +424,197 @@ def _known_type(type_name: str) -> bool:
     return type_name in default_registry()
 
 
+def _free_mapping(ctx: _Ctx, top: dict[str, tuple[yaml.Node, yaml.Node]], name: str
+                  ) -> list[tuple[str, yaml.Node, Any]]:
+    """``(key, value node, value)`` of a top-level mapping whose keys are field paths."""
+    if name not in top:
+        return []
+    vnode = top[name][1]
+    if isinstance(vnode, yaml.ScalarNode) and vnode.tag.endswith(":null"):
+        return []
+    if not isinstance(vnode, yaml.MappingNode):
+        raise ctx.error("must be a mapping of 'field: value' lines", vnode, name)
+    out: list[tuple[str, yaml.Node, Any]] = []
+    seen: dict[str, int] = {}
+    for knode, node in vnode.value:
+        key = knode.value if isinstance(knode, yaml.ScalarNode) else None
+        if not isinstance(key, str) or not key:
+            raise ctx.error("keys must be field paths like header.frame_id", knode, name)
+        dotted = f"{name}.{key}"
+        if key in seen:
+            raise ctx.error(f"duplicate key (first given on line {seen[key]})", knode, dotted)
+        seen[key] = knode.start_mark.line + 1
+        if isinstance(node, yaml.MappingNode):
+            value: Any = {}
+            for bk, bv in node.value:
+                bname = bk.value if isinstance(bk, yaml.ScalarNode) else None
+                if bname not in ("min", "max") or bname in value:
+                    raise ctx.error("a bound is {min: LOW, max: HIGH} (either may be left out)",
+                                    bk, dotted)
+                value[bname] = _scalar(ctx, bv, dotted)
+        else:
+            value = _scalar(ctx, node, dotted)
+        out.append((key, node, value))
+    return out
+
+
+def _string_list(ctx: _Ctx, top: dict[str, tuple[yaml.Node, yaml.Node]], name: str
+                 ) -> list[tuple[str, yaml.Node]]:
+    if name not in top:
+        return []
+    vnode = top[name][1]
+    if isinstance(vnode, yaml.ScalarNode) and vnode.tag.endswith(":null"):
+        return []
+    if not isinstance(vnode, yaml.SequenceNode):
+        raise ctx.error("must be a list, e.g. [a, b]", vnode, name)
+    out = []
+    for item in vnode.value:
+        value = _scalar(ctx, item, name)
+        if not isinstance(value, str) or not value:
+            raise ctx.error(f"expected a name, got {value!r}", item, name)
+        out.append((value, item))
+    return out
+
+
+def _registry(ctx: _Ctx, folders: list[Path], nodes: list[yaml.Node | None]) -> "MsgRegistry":
+    from rosfpga_lab.msg import MsgError, MsgRegistry, default_registry
+
+    if not folders:
+        return default_registry()
+    reg = MsgRegistry.with_defaults()
+    for folder, node in zip(folders, nodes):
+        try:
+            reg.load_path(folder)
+        except MsgError as exc:
+            raise ctx.error(str(exc), node, "msg_path") from None
+    return reg
+
+
+def _message_keys(ctx: _Ctx, reg: "MsgRegistry", type_name: str, top: dict[str, Any],
+                  sec: dict[str, tuple[dict[str, Any], dict[str, yaml.Node]]],
+                  image: ImageConfig | None) -> tuple[StreamConfig, tuple[CheckConfig, ...],
+                                                      tuple[tuple[str, int], ...], tuple[str, ...]]:
+    """``stream``, ``checks``, ``limits`` and ``skip``, each field path checked against the type."""
+    st, stn = sec["stream"]
+    if image is not None:
+        default = StreamConfig(limits.IMAGE_STREAM_FIELD, image.data_bytes)
+        if st and (st["field"] != default.field or st["length"] not in (None, default.length)):
+            raise ctx.error(f"a {limits.IMAGE_TYPE} streams {default.field!r} with "
+                            f"image.width x height x bytes per pixel = {default.length} elements",
+                            stn.get("field"), "stream.field")
+        stream = default
+    else:
+        if not st:
+            raise ctx.error(f"missing section 'stream:' ({{field: ARRAY, length: N}}): which "
+                            f"array of {type_name} the application processes", None, "stream")
+        try:
+            f = stream_field(reg, type_name, st["field"])
+        except FieldPathError as exc:
+            raise ctx.error(str(exc), stn.get("field"), "stream.field") from None
+        length = st["length"]
+        if f.array_length is not None:
+            if length not in (None, f.array_length):
+                raise ctx.error(f"{st['field']} is a {f.type}: its length is "
+                                f"{f.array_length}", stn.get("length"), "stream.length")
+            length = f.array_length
+        if length is None or not 1 <= length <= limits.MAX_STREAM_LENGTH:
+            raise ctx.error(f"give the element count of {st['field']}, 1.."
+                            f"{limits.MAX_STREAM_LENGTH}", stn.get("length") or stn.get("field"),
+                            "stream.length")
+        stream = StreamConfig(st["field"], length)
+    checks = []
+    for path, node, value in _free_mapping(ctx, top, "checks"):
+        key = f"checks.{path}"
+        if image is not None and path in limits.IMAGE_IMPLIED_CHECKS:
+            raise ctx.error(f"{path} is checked against image: already", node, key)
+        if path == stream.field:
+            raise ctx.error("is the stream: its length is stream.length", node, key)
+        try:
+            f = check_field(reg, type_name, path)
+        except FieldPathError as exc:
+            raise ctx.error(str(exc), node, key) from None
+        bounds = value if isinstance(value, dict) else None
+        if bounds is not None and f.base_type in ("string", "bool"):
+            raise ctx.error(f"a {f.base_type} can only be checked for equality", node, key)
+        for v in (bounds or {"value": value}).values():
+            problem = check_value_problem(f.base_type, v)
+            if problem:
+                raise ctx.error(problem, node, key)
+        if bounds is not None:
+            if not bounds:
+                raise ctx.error("a bound needs min or max", node, key)
+            low, high = bounds.get("min"), bounds.get("max")
+            if low is not None and high is not None and low > high:
+                raise ctx.error(f"min {low} is above max {high}", node, key)
+            checks.append(CheckConfig(path, low=low, high=high))
+        else:
+            checks.append(CheckConfig(path, value=value))
+    maxima = []
+    for path, node, value in _free_mapping(ctx, top, "limits"):
+        key = f"limits.{path}"
+        try:
+            limit_field(reg, type_name, path.removesuffix("[]"))
+        except FieldPathError as exc:
+            raise ctx.error(str(exc), node, key) from None
+        if path == stream.field:
+            raise ctx.error("is the stream: its length is stream.length", node, key)
+        if isinstance(value, bool) or not isinstance(value, int) or \
+                not 0 <= value <= limits.MAX_LIMIT:
+            raise ctx.error(f"expected 0..{limits.MAX_LIMIT}, got {value!r}", node, key)
+        maxima.append((path, value))
+    skip = []
+    for path, node in _string_list(ctx, top, "skip"):
+        try:
+            resolve_field(reg, type_name, path)
+        except FieldPathError as exc:
+            raise ctx.error(str(exc), node, "skip") from None
+        if path == stream.field or stream.field.startswith(path + "."):
+            raise ctx.error(f"{path}: the stream cannot be skipped", node, "skip")
+        skip.append(path)
+    return stream, tuple(checks), tuple(maxima), tuple(skip)
+
+
+def _check_image(ctx: _Ctx, im: dict[str, Any], imn: dict[str, yaml.Node]) -> None:
+    _check(ctx, limits.MIN_WIDTH <= im["width"] <= limits.MAX_WIDTH,
+           f"width must be {limits.MIN_WIDTH}..{limits.MAX_WIDTH}, got {im['width']}",
+           imn, "width", "image")
+    _check(ctx, limits.MIN_HEIGHT <= im["height"] <= limits.MAX_HEIGHT,
+           f"height must be {limits.MIN_HEIGHT}..{limits.MAX_HEIGHT}, got {im['height']}",
+           imn, "height", "image")
+    _check(ctx, im["encoding"] in ENCODINGS,
+           f"encoding {im['encoding']!r} is not one the circuit can pack (supported: "
+           f"{', '.join(ENCODINGS)})", imn, "encoding", "image")
+
+
+def _check_output_type(ctx: _Ctx, reg: "MsgRegistry", in_type: str, out_type: str,
+                       stream: StreamConfig, nodes: dict[str, yaml.Node]) -> None:
+    """The publisher's type must have the stream's array, of the same element type."""
+    if out_type == in_type:
+        return
+    try:
+        f = stream_field(reg, out_type, stream.field)
+        g = stream_field(reg, in_type, stream.field)
+    except FieldPathError as exc:
+        raise ctx.error(f"{out_type} cannot stream the output: {exc}", nodes.get("type"),
+                        "publisher.type") from None
+    if f.base_type != g.base_type or f.array_length not in (None, stream.length):
+        raise ctx.error(f"{out_type} cannot stream the output: its {stream.field} is a {f.type}, "
+                        f"the input's a {g.type}", nodes.get("type"), "publisher.type")
+
+
 def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None = None,
-                 known_type: Callable[[str], bool] | None = None) -> NodeConfig:
+                 known_type: Callable[[str], bool] | None = None,
+                 msg_path: Iterable[str | Path] = ()) -> NodeConfig:
     """Parse and validate configuration text.
 
     Args:
         text: the YAML text.
         source: file name used in error messages.
         base_dir: directory that ``application.source`` is relative to (default: cwd).
-        known_type: predicate "is this message type known" (default: the lab's registry).
+        known_type: predicate "is this message type known" (default: the lab's registry
+            with ``msg_path:`` and ``msg_path``).
+        msg_path: more folders of ``.msg`` packages (the command line's ``--msg-path``), after
+            the file's ``msg_path:``.
 
     Returns:
         The validated configuration (``path`` is None; :func:`load_config` sets it).
@@ -346,7 +632,7 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
         raise ConfigError(f"not valid YAML: {problem}", path=source, line=line) from None
     if root is None:
         raise ConfigError("the configuration is empty", path=source)
-    allowed = {**{k: None for k in _SCHEMA}, **_TOP_SCALARS}
+    allowed = {**{k: None for k in _SCHEMA}, **_TOP_SCALARS, **{k: None for k in _FREE_KEYS}}
     top = _mapping(ctx, root, "", allowed)
     sec = {name: _section(ctx, top, name) for name in _SCHEMA}
     scalars: dict[str, Any] = {}
@@ -378,8 +664,23 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
     _check(ctx, n["xmlrpc_port"] == 0 or n["xmlrpc_port"] != n["tcpros_port"],
            "the XML-RPC and TCPROS ports must differ", nn, "tcpros_port", "node")
 
-    # topics
-    known = known_type or _known_type
+    # message path, topics
+    root_dir = base_dir or Path.cwd()
+    folders: list[Path] = []
+    folder_nodes: list[yaml.Node | None] = []
+    for name, node in _string_list(ctx, top, "msg_path"):
+        folder = (root_dir / name).resolve()
+        if not folder.is_dir():
+            raise ctx.error(f"message folder not found: {folder} (PKG/msg/NAME.msg files go "
+                            "under it; relative to the configuration file)", node, "msg_path")
+        folders.append(folder)
+        folder_nodes.append(node)
+    for extra in msg_path:
+        folders.append(Path(extra).resolve())
+        folder_nodes.append(None)
+    reg = _registry(ctx, folders, folder_nodes)
+    known = known_type or (reg.__contains__ if folders else _known_type)
+    sec["publisher"][0]["type"] = sec["publisher"][0]["type"] or sec["subscriber"][0]["type"]
     for section in ("subscriber", "publisher"):
         t, tn = sec[section]
         problem = ros_name_problem(t["topic"])
@@ -388,18 +689,25 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
     if sec["subscriber"][0]["topic"] == sec["publisher"][0]["topic"]:
         raise ctx.error("the node would publish to the topic it subscribes to",
                         sec["publisher"][1].get("topic"), "publisher.topic")
+    in_type, out_type = sec["subscriber"][0]["type"], sec["publisher"][0]["type"]
+    is_image = in_type == limits.IMAGE_TYPE
 
     # image
     im, imn = sec["image"]
-    _check(ctx, limits.MIN_WIDTH <= im["width"] <= limits.MAX_WIDTH,
-           f"width must be {limits.MIN_WIDTH}..{limits.MAX_WIDTH}, got {im['width']}",
-           imn, "width", "image")
-    _check(ctx, limits.MIN_HEIGHT <= im["height"] <= limits.MAX_HEIGHT,
-           f"height must be {limits.MIN_HEIGHT}..{limits.MAX_HEIGHT}, got {im['height']}",
-           imn, "height", "image")
-    _check(ctx, im["encoding"] in ENCODINGS,
-           f"encoding {im['encoding']!r} is not one the circuit can pack (supported: "
-           f"{', '.join(ENCODINGS)})", imn, "encoding", "image")
+    if not is_image and im:
+        raise ctx.error(f"image: is the geometry of {limits.IMAGE_TYPE} only; for "
+                        f"{in_type} say stream: {{field: ARRAY, length: N}}",
+                        top["image"][0], "image")
+    if is_image and not im:
+        raise ctx.error("missing section 'image:' (keys: width, height, encoding)", None, "image")
+    if is_image:
+        _check_image(ctx, im, imn)
+    image = ImageConfig(**im) if is_image else None
+    if in_type in reg:
+        stream, checks, maxima, skip = _message_keys(ctx, reg, in_type, top, sec, image)
+        _check_output_type(ctx, reg, in_type, out_type, stream, sec["publisher"][1])
+    else:  # a caller's known_type accepted a type the registry lacks: no field to check
+        stream, checks, maxima, skip = StreamConfig(limits.IMAGE_STREAM_FIELD, 0), (), (), ()
 
     # application
     ap, apn = sec["application"]
@@ -438,20 +746,27 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
         node=NodeSection(**n),
         subscriber=TopicConfig(**sec["subscriber"][0]),
         publisher=TopicConfig(**sec["publisher"][0]),
-        image=ImageConfig(**im),
+        image=image if image is not None else NoImage(in_type),
         application=ApplicationConfig(op=ap["op"], ksize=ap["ksize"], source=source_path),
         fifo=FifoConfig(**f),
         clock_mhz=float(scalars["clock_mhz"]),
         frame_id_max=scalars["frame_id_max"],
         part=scalars["part"],
+        msg_path=tuple(folders),
+        stream=stream,
+        checks=checks,
+        limits=maxima,
+        skip=skip,
     )
 
 
-def load_config(path: str | Path) -> NodeConfig:
+def load_config(path: str | Path, *, msg_path: Iterable[str | Path] = ()) -> NodeConfig:
     """Read and validate a node configuration file.
 
     Args:
-        path: the YAML file. ``application.source`` is relative to its directory.
+        path: the YAML file. ``application.source`` and ``msg_path:`` are relative to its
+            directory.
+        msg_path: more folders of ``.msg`` packages (``--msg-path``).
 
     Returns:
         The validated, frozen :class:`NodeConfig` (its ``path`` set).
@@ -470,7 +785,7 @@ def load_config(path: str | Path) -> NodeConfig:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise ConfigError(f"not UTF-8 text (byte {exc.start})", path=str(p)) from None
-    config = parse_config(text, source=str(p), base_dir=p.resolve().parent)
+    config = parse_config(text, source=str(p), base_dir=p.resolve().parent, msg_path=msg_path)
     return _with_path(config, p.resolve())
 
 

@@ -56,8 +56,21 @@ MODEL_OPS = ("dilate", "erode", PASSTHROUGH)
 OPS = (*MODEL_OPS, CUSTOM)
 
 _OP_ALIASES = {"copy": PASSTHROUGH}
+#: Element types of the one array a circuit streams to its application (``stream.field`` of a
+#: node configuration): the numeric builtins, one AXI4-Stream beat of the element's width each
+#: (``byte`` is genmsg's signed 8-bit alias, ``char`` its unsigned one). ``bool``, ``time``,
+#: ``duration``, ``string`` and messages cannot stream.
+STREAM_ELEMENT_TYPES = ("int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
+                        "float32", "float64", "byte", "char")
 #: The circuit's Python models: ``fast`` (whole arrays) and ``reference`` (a byte at a time).
-MODELS = ("fast", "reference")
+PIPELINE_MODELS = ("fast", "reference")
+#: The simulated Verilog itself (a long-lived RTL simulator on the data path).
+RTL_MODEL = "rtl"
+#: What a component's data path can run: the Python models, or the Verilog.
+MODELS = (*PIPELINE_MODELS, RTL_MODEL)
+#: When a component publishes: ``host`` as soon as the model is done; ``fpga`` after the
+#: circuit's clocks for the frame at ``clock_mhz`` (frames that come while it is busy dropped).
+TIMINGS = ("host", "fpga")
 #: The Verilog simulators the RTL flow runs (the first one found is the default).
 SIMULATORS = ("iverilog", "verilator")
 

@@ -7,12 +7,15 @@ by :mod:`rosfpga_lab.config.names` (the lab's one validator); this module resolv
 
 from __future__ import annotations
 
-import os
+import ipaddress
 import re
+import socket
 import warnings
 
 from rosfpga_lab.config.master import master_uri_from_env  # noqa: F401  (re-exported; the rule's owner)
 from rosfpga_lab.config.names import canonical, is_legal_name, name_problem  # noqa: F401  (re-exported)
+from rosfpga_lab.config.rosargs import RosArgs, advertise_host
+from rosfpga_lab.config.rosargs import namespace_of, resolve_name  # noqa: F401  (re-exported)
 from rosfpga_lab.graph.errors import ConfigError
 
 ALL_INTERFACES = ("0.0.0.0", "", "::")
@@ -22,21 +25,10 @@ class OpenBindWarning(UserWarning):
     """Binding to every network interface: ROS 1 has no authentication."""
 
 
-def namespace_of(name: str) -> str:
-    """``/a/b/c`` -> ``/a/b/``; ``/c`` -> ``/``."""
-    name = canonical(name)
-    return name[: name.rfind("/") + 1] if "/" in name else "/"
-
-
 def resolve(name: str, caller_id: str = "/") -> str:
-    """Resolve ``name`` against ``caller_id`` the way the master and rospy do."""
-    if not name:
-        return namespace_of(caller_id)
-    if name.startswith("/"):
-        return canonical(name)
-    if name.startswith("~"):
-        return canonical(canonical(caller_id) + "/" + name[1:])
-    return canonical(namespace_of(caller_id) + name)
+    """Resolve ``name`` against ``caller_id`` the way the master and rospy do (the rule's owner:
+    :func:`rosfpga_lab.config.rosargs.resolve_name`)."""
+    return resolve_name(name, caller_id)
 
 
 def check_node_name(name: str) -> str:
@@ -64,30 +56,49 @@ def check_topic_name(name: str, caller_id: str = "/") -> str:
 
 
 def default_host() -> str:
-    """The address nodes bind to and advertise: ROS_IP, then ROS_HOSTNAME, else 127.0.0.1.
+    """The address nodes bind to and advertise: ROS_HOSTNAME, then ROS_IP (roscpp's and rospy's
+    order), else 127.0.0.1 (:func:`rosfpga_lab.config.rosargs.advertise_host` owns the rule).
 
     Unlike ROS (which defaults to the machine's hostname, reachable from the network), the lab
     defaults to loopback: a workshop network should not see students' nodes by accident.
     """
-    for var in ("ROS_IP", "ROS_HOSTNAME"):
-        value = os.environ.get(var, "").strip()
-        if value:
-            return value
-    return "127.0.0.1"
+    return advertise_host(RosArgs(), None).host
+
+
+def is_ipv6_literal(host: str) -> bool:
+    """True for an IPv6 address such as ``::1`` (brackets allowed, as in a URI)."""
+    try:
+        return ipaddress.ip_address(host.strip("[]")).version == 6
+    except ValueError:
+        return False
+
+
+def address_family(bind: str) -> socket.AddressFamily:
+    """The socket family that binds ``bind`` (IPv6 for an IPv6 literal, else IPv4)."""
+    return socket.AF_INET6 if is_ipv6_literal(bind) else socket.AF_INET
+
+
+def uri_host(host: str) -> str:
+    """``host`` as written in a URI: an IPv6 literal in brackets (``[::1]``)."""
+    return f"[{host.strip('[]')}]" if is_ipv6_literal(host) else host
 
 
 def bind_address(host: str) -> str:
-    """The address to bind for an advertised ``host``; warn when it opens every interface."""
+    """The address to bind for an advertised ``host``: the address itself (IPv4 or IPv6, never
+    widened), or every interface with a warning when asked (``0.0.0.0``, ``::``) or when
+    ``host`` is a host name (it may resolve to any interface, as for roscpp)."""
     if host in ALL_INTERFACES:
         warnings.warn(
             "binding to all network interfaces: ROS 1 has no authentication, anyone who can "
             "reach this machine can publish, subscribe and stop nodes. Use 127.0.0.1 unless "
             "you need other machines.", OpenBindWarning, stacklevel=3)
-        return "0.0.0.0"
+        return "::" if host == "::" else "0.0.0.0"
     if host in ("localhost",):
         return "127.0.0.1"
     if re.fullmatch(r"[0-9.]+", host):
         return host
+    if is_ipv6_literal(host):
+        return host.strip("[]")
     # a hostname (ROS_HOSTNAME): bind every interface it may resolve to, like roscpp does
     warnings.warn(f"binding to all interfaces to serve the hostname {host!r}; ROS 1 has no "
                   "authentication", OpenBindWarning, stacklevel=3)

@@ -36,6 +36,7 @@ from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MAX_PENDING_HANDSHAKES, MAX_P
 from rosfpga_lab.graph.master import MASTER_ID, EmbeddedMaster
 from rosfpga_lab.graph.names import (
     ALL_INTERFACES,
+    address_family,
     bind_address,
     check_node_name,
     check_topic_name,
@@ -183,7 +184,7 @@ class Node:
                                     trace=self.trace, name=self.name, advertise_host=self.host)
         self._xmlrpc.start()
         self._methods = api_methods(self)
-        self._tcp = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        self._tcp = socket.socket(address_family(bind), socket.SOCK_STREAM)
         self._tcp.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             self._tcp.bind((bind, tcpros_port))
@@ -512,14 +513,20 @@ class Node:
 
     @checked((), [[], [], []])
     def getBusStats(self, caller_id: str) -> tuple:
+        # rospy's and roscpp's shapes: a publisher lists its open connections only
+        # ([conn_id, bytes_sent, num_sent, connected]); a subscriber one entry per publisher
+        # link ([conn_id, bytes_received, num_received, drop_estimate, connected]; the drop
+        # estimate is -1 as rospy's: drops happen in the subscription's shared queue, counted
+        # by Subscriber.stats, not per connection)
         pubs = []
         for pub in list(self.publishers.values()):
             st = pub.stats
-            pubs.append([pub.topic, st.bytes, [[l.conn, l.bytes, l.frames, l.connected] for l in st.links]])
+            pubs.append([pub.topic, st.bytes, [[l.conn, l.bytes, l.frames, True]
+                                               for l in st.links if l.connected]])
         subs = []
         for sub in list(self.subscribers.values()):
-            sub_st = sub.stats
-            subs.append([sub.topic, [[0, sub_st.bytes, sub_st.drops, sub_st.connections > 0]]])
+            subs.append([sub.topic, [[conn, nbytes, frames, -1, connected]
+                                     for conn, nbytes, frames, connected in sub.link_stats()]])
         return 1, "", [pubs, subs, []]
 
     # ------------------------------------------------------------------ shutdown

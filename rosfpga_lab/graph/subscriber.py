@@ -98,6 +98,9 @@ class _PublisherLink:
         self.connected = False
         self.kept = False   # kept across a master restart, not (yet) listed by the master
         self.permanent_error: str | None = None
+        self.conn = 0              # connection id of the current (or last) TCPROS connection
+        self.frames = 0            # frames and body bytes received on it (getBusStats)
+        self.bytes = 0
         self.thread = threading.Thread(target=self._run, daemon=True,
                                        name=f"rosfpga-sub-link-{sub.topic}")
 
@@ -150,6 +153,7 @@ class _PublisherLink:
         if sub.tcp_nodelay:
             set_nodelay(sock)
         conn = new_connection_id()
+        self.conn, self.frames, self.bytes = conn, 0, 0
         peer = f"{host}:{port}"
         ends = socket_ends(sock)
         node.trace.names[ends["local"]] = node.name
@@ -197,6 +201,8 @@ class _PublisherLink:
                 events, failure = exc.partial, exc
             for ev in events:
                 if isinstance(ev, Frame):
+                    self.frames += 1
+                    self.bytes += len(ev.body)
                     sub._deliver(ev.body, MessageInfo(sub.topic, publisher, conn, ev.index,
                                                       len(ev.body), time.time(), header), ev.offset, ends)
                 elif isinstance(ev, HeaderReceived):
@@ -386,6 +392,13 @@ class Subscriber:
         """``(publisher XML-RPC URI, connected)`` of every publisher linked to now."""
         with self._lock:
             return [(uri, link.connected) for uri, link in self._links.items()]
+
+    def link_stats(self) -> list[tuple[int, int, int, bool]]:
+        """``(connection id, bytes, frames, connected)`` of every publisher link now (the
+        current connection of each; getBusStats)."""
+        with self._lock:
+            return [(link.conn, link.bytes, link.frames, link.connected)
+                    for link in self._links.values()]
 
     def get_num_connections(self) -> int:
         """Publishers connected right now."""

@@ -39,6 +39,7 @@ from rosfpga_lab.graph.limits import (
     XMLRPC_REQUEST_TIMEOUT,
     XMLRPC_TIMEOUT,
 )
+from rosfpga_lab.graph.names import address_family, uri_host
 from rosfpga_lab.graph.trace import Trace
 from rosfpga_lab.graph.wire import accept_loop, hard_close, socket_ends
 
@@ -144,8 +145,16 @@ def split_uri(uri: str) -> tuple[str, int, str]:
     """``http://host:port/path`` -> (host, port, path).
 
     Raises:
-        ConfigError: not an http URI with a host and port.
+        ConfigError: not an http URI with a host and port (also when ``uri`` is no str,
+            e.g. a whole ``[code, statusMessage, value]`` reply instead of its value).
     """
+    if not isinstance(uri, str):
+        reply = (isinstance(uri, (list, tuple)) and len(uri) == 3
+                 and isinstance(uri[0], int) and isinstance(uri[2], str))
+        hint = (": that is a whole [code, statusMessage, value] XML-RPC reply (of lookupNode, "
+                "say); its value, reply[2], is the URI" if reply else "")
+        raise ConfigError(f"an XML-RPC URI is a str like 'http://host:port/', not "
+                          f"{type(uri).__name__} {uri!r:.120}{hint}")
     parts = urllib.parse.urlsplit(uri)
     try:
         port = parts.port
@@ -331,16 +340,16 @@ class XmlRpcServer:
     def uri(self) -> str:
         """``http://host:port/`` of this server."""
         host = self.advertise_host
-        if host in ("0.0.0.0", ""):
+        if host in ("0.0.0.0", "", "::"):
             host = socket.gethostname()
-        return f"http://{host}:{self.port}/"
+        return f"http://{uri_host(host)}:{self.port}/"
 
     def start(self) -> None:
         """Bind, listen and start the accept thread."""
-        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock = socket.socket(address_family(self.host), socket.SOCK_STREAM)
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
-            sock.bind((self.host, self.port))
+            sock.bind((self.host.strip("[]"), self.port))
         except (OSError, OverflowError) as exc:  # OverflowError: a port outside 0..65535
             sock.close()
             raise XmlRpcError(f"cannot bind XML-RPC server to {self.host}:{self.port}: {exc}") from None
@@ -533,7 +542,8 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
     host, port, path = split_uri(uri)
     check_int_range(params)
     body = xmlrpc.client.dumps(tuple(params), methodname=method, allow_none=False).encode()
-    head = (f"POST {path} HTTP/1.1\r\nHost: {host}:{port}\r\nUser-Agent: rosfpga-lab\r\n"
+    head = (f"POST {path} HTTP/1.1\r\nHost: {uri_host(host)}:{port}\r\n"
+            "User-Agent: rosfpga-lab\r\n"
             f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\nConnection: close\r\n\r\n")
     request = head.encode("latin-1") + body
     t0 = time.time()

@@ -25,6 +25,15 @@ A bad frame raises a :class:`PipelineError` subclass naming the field and byte o
 has been reset and the next good frame comes out right. ``Pipeline(model="reference")`` runs
 the byte/beat-at-a-time models (small images: a 160x120 frame takes about half a second).
 
+The circuit's one layout (every field in wire order and what the circuit does with it) is
+derived from a ``.msg`` and the configuration by :func:`derive_layout` (module ``layout``);
+the subscriber and publisher of any type are rendered from it (module ``walker``:
+:class:`LayoutInterpreter`, :func:`extract_reference` / :func:`extract_fast`,
+:func:`publish_reference` / :func:`publish_fast`), the 1-D application in ``morph1d``, the
+whole circuit of a non-Image type in :class:`MessagePipeline` (``msgpipeline``). CDR (ROS 2)
+is the second wire format of the same layout (``cdrlayout``, ``cdrwalker``), the whole circuit
+on CDR samples, Image included, :class:`CdrPipeline` (``cdrpipeline``).
+
 Stages (``reference`` / ``fast``), importable for notebooks:
 
 * receive FIFO: :func:`receive_reference` / :func:`receive_fast_check` (module ``rx``);
@@ -59,6 +68,13 @@ from rosfpga_lab.hw.interpreter import (
     interpret_fast,
     interpret_reference,
 )
+from rosfpga_lab.hw.layout import Layout, derive_layout, format_layout, layout_from_config
+from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
+from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
+from rosfpga_lab.hw.cdrpipeline import CdrPipeline, CdrResult
+from rosfpga_lab.hw.walker import (
+    Extracted, LayoutInterpreter, extract_fast, extract_reference, publish_fast, publish_reference,
+)
 from rosfpga_lab.hw.morph import OPS, morph_fast, morph_reference
 from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame, wire_bytes
 from rosfpga_lab.hw.rx import receive_fast_check, receive_reference
@@ -80,4 +96,8 @@ __all__ = [
     "format_table", "frame_length", "generate_fast", "generate_reference", "image_frame", "interpret_fast",
     "interpret_reference", "mat2axivideo_fast", "mat2axivideo_reference", "morph_fast",
     "morph_reference", "pixel_format", "receive_fast_check", "receive_reference",
+    "Layout", "derive_layout", "format_layout", "layout_from_config", "morph1d_fast",
+    "morph1d_reference", "Extracted", "LayoutInterpreter", "extract_fast", "extract_reference",
+    "publish_fast", "publish_reference", "MessagePipeline", "MessageResult",
+    "CdrPipeline", "CdrResult",
 ]

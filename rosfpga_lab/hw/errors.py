@@ -1,7 +1,8 @@
 """Typed errors of the hardware-model layer, all under :class:`rosfpga_lab.errors.LabError`.
 
-Every error names the stage that found it; frame errors also name the ``sensor_msgs/Image``
-field and the byte offset in the TCPROS frame (offset 0 is the first byte of the 4-byte frame
+Every error names the stage that found it; frame errors also name the field (of
+``sensor_msgs/Image`` or of any type's layout, e.g. ``history[1].sensor_name length``) and the
+byte offset in the TCPROS frame (offset 0 is the first byte of the 4-byte frame
 length). After any of these errors the stage (and the :class:`~rosfpga_lab.hw.Pipeline`) has
 reset itself: the next good frame comes out right.
 """
@@ -33,7 +34,7 @@ class PipelineConfigError(PipelineError):
 
 
 class FrameFieldError(PipelineError):
-    """A field of the incoming ``sensor_msgs/Image`` frame has a value the circuit refuses.
+    """A field of the incoming frame has a value the circuit refuses.
 
     Attributes:
         field: the field name (``"height"``, ``"encoding"``, ``"data length"`` ...).
@@ -106,3 +107,16 @@ class FifoOverflowError(PipelineError):
         self.depth = depth
         self.needed = needed
         super().__init__(message, stage)
+
+
+class LayoutError(PipelineConfigError):
+    """A circuit layout cannot be derived: a key names a missing field or one it cannot take.
+
+    Attributes:
+        key: the configuration key at fault, dotted (``stream.field``, ``checks.height``,
+            ``limits.points``), so a configuration loader can point at its line.
+    """
+
+    def __init__(self, message: str, key: str = "") -> None:
+        self.key = key
+        super().__init__(f"{key}: {message}" if key else message, "layout")

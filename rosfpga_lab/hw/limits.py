@@ -14,7 +14,7 @@ MAX_WIDTH = _config.MAX_WIDTH
 MAX_HEIGHT = _config.MAX_HEIGHT
 #: Longest ``header.frame_id`` and ``encoding`` strings the interpreter stores.
 MAX_FRAME_ID_BYTES = _config.MAX_FRAME_ID_MAX
-MAX_ENCODING_BYTES = 32
+MAX_ENCODING_BYTES = _config.IMAGE_MAX_ENCODING_BYTES
 #: Largest TCPROS frame (4-byte length excluded) the interpreter accepts: the TCPROS layer's.
 MAX_FRAME_BYTES = _tcpros_max_frame_bytes
 #: Width of the AXI4-Stream data bus between fifo2axi and the application, in bits.

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rosfpga_lab.config import CUSTOM, DEFAULT_OP, NodeConfig, canonical_op, model_ksize
-from rosfpga_lab.config.vocabulary import MODELS
+from rosfpga_lab.config.vocabulary import PIPELINE_MODELS
 from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference
 from rosfpga_lab.hw.cycles import CycleReport, account
@@ -194,8 +194,9 @@ class Pipeline:
                  stamp: tuple[int, int] | None = None, frame_id: str | None = None,
                  max_frame_id_bytes: int = limits.MAX_FRAME_ID_BYTES,
                  faults: Sequence[Fault] = ()) -> None:
-        if model not in MODELS:
-            raise PipelineConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        if model not in PIPELINE_MODELS:
+            raise PipelineConfigError(
+                f"model must be one of {', '.join(PIPELINE_MODELS)}, got {model!r}")
         if seq not in SEQ_MODES:
             raise PipelineConfigError(f"seq must be one of {', '.join(SEQ_MODES)}, got {seq!r}")
         if encoding is not None:

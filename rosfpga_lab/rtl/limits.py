@@ -23,3 +23,9 @@ VERILATOR_FROM_BYTES = 200_000
 VCD_MAX_HEADER_BYTES = 16 << 20
 #: Widest signal kept (bits).
 VCD_MAX_SIGNAL_BITS = 1 << 16
+
+#: Seconds allowed for one formal check (SymbiYosys).
+FORMAL_TIMEOUT = 600.0
+
+#: Largest request to the long-lived simulator of ``--model rtl`` (bytes).
+MAX_SERVE_FRAME = 64 << 20

@@ -1,0 +1,560 @@
+"""Subscriber and publisher models of any message type, rendered from its circuit layout.
+
+How this works: the subscriber is a program counter over ``layout.steps`` plus a stack of
+loop counters, as the generated circuit is. :class:`LayoutInterpreter` (the reference model)
+takes one byte per :meth:`~LayoutInterpreter.push`, collects the current step's bytes, and when
+the step is complete decodes it little-endian, runs the step's check, records a
+:class:`~rosfpga_lab.hw.layout.Token` and moves on: past a LOOP whose count is 0, back to the
+loop body at an END while elements remain, through zero-length strings and arrays at once.
+:func:`extract_fast` runs the same machine a whole step at a time (the stream as one numpy
+slice). Both raise the same :class:`~rosfpga_lab.hw.errors.FrameFieldError` naming the field
+(``history[1].sensor_name length``) and its byte offset, then resynchronise: a sane frame
+length lets the reference skip the rest of the refused frame, so the next good frame comes out
+right.
+
+The frame length is checked against the type's smallest body and the lab's limit; each length
+prefix against its maximum and against the bytes left (when only fixed-size fields follow, the
+frame length must match exactly, as the Image interpreter checks ``data length``). Refusal
+kinds (``FrameFieldError.rule``): ``below the minimum``, ``over the limit``,
+``past the frame end``, ``not what the circuit was built for``, ``not a number`` (a NaN in a
+range check), ``frame length disagrees``, ``cut short``.
+
+The publisher (:func:`publish_reference`, :func:`publish_fast`) writes the output frame: the
+carried and checked values as received, the application's stream, and the default of every
+skipped field (0, ``""``, an empty variable array, zeros for a fixed one).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
+from rosfpga_lab.hw.layout import (
+    Action, CheckOp, Layout, LengthRule, Step, StepKind, Token, encode_token, length_rules,
+    marshal, tokens,
+)
+from rosfpga_lab.msg import MsgRegistry, default_value, new_message
+from rosfpga_lab.msg.builtins import SCALARS
+
+STAGE = "interpreter"  # as the Image interpreter: refusals read the same
+
+
+@dataclass
+class Extracted:
+    """What the subscriber circuit took from one frame.
+
+    Attributes:
+        tokens: every value in walk order (``tokens(layout, deserialize(body))`` equals it).
+        stream: the streamed array's elements (the element dtype).
+        frame_length: the 4-byte frame length.
+        stream_offset: byte offset of the stream's first element in the frame.
+    """
+
+    tokens: list[Token]
+    stream: np.ndarray
+    frame_length: int
+    stream_offset: int
+
+    def carried(self, layout: Layout) -> list[Token]:
+        """The tokens the circuit keeps (everything but skipped fields and the stream)."""
+        return [t for t in self.tokens if layout.steps[t.step].action in (Action.CARRY, Action.CHECK)]
+
+
+def _decode(step: Step, data: bytes | memoryview) -> Any:
+    if step.kind in (StepKind.SCALAR, StepKind.LENGTH):
+        return struct.unpack("<" + SCALARS[step.type].struct_char, data)[0]
+    if step.kind is StepKind.STRING:
+        return bytes(data).decode("utf-8", "surrogateescape")
+    return np.frombuffer(data, np.dtype(step.dtype))  # a read-only view (fast model: of the frame)
+
+
+@dataclass
+class LayoutInterpreter:
+    """The subscriber circuit of ``layout`` (reference model: one byte per :meth:`push`).
+
+    Attributes:
+        pc: index of the step being read (``-1``: skipping the rest of a refused frame).
+        offset: byte offset in the current frame of the next byte.
+        frames: frames completed since construction.
+        last: what the last complete frame gave.
+    """
+
+    layout: Layout
+    frames: int = 0
+    last: Extracted | None = None
+    _rules: dict[int, LengthRule] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._rules = length_rules(self.layout)
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to waiting for a frame length."""
+        self.pc = 0
+        self.offset = 0
+        self._buf = bytearray()
+        self._field_start = 0
+        self._loops: list[list[int]] = []     # [loop step, count, element index]
+        self._counts: dict[int, int] = {}     # LENGTH step -> its last value
+        self._tokens: list[Token] = []
+        self._frame_length: int | None = None
+        self._stream_offset = 0
+        self._stream: np.ndarray | None = None
+        self._skip = 0
+
+    # -- geometry -------------------------------------------------------------------------------
+    @property
+    def step(self) -> Step | None:
+        """The step being read (``None`` while skipping)."""
+        return self.layout.steps[self.pc] if self.pc >= 0 else None
+
+    @property
+    def indices(self) -> tuple[int, ...]:
+        """Element indices of the enclosing loops."""
+        return tuple(k for _s, _n, k in self._loops)
+
+    def need(self, s: Step) -> int:
+        """Bytes of step ``s`` in this frame."""
+        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
+            return s.size
+        n = s.count if s.count is not None else self._counts[s.length_step or 0]
+        return s.size * n
+
+    @property
+    def _end(self) -> int:
+        assert self._frame_length is not None
+        return 4 + self._frame_length
+
+    # -- the byte path --------------------------------------------------------------------------
+    def push(self, byte: int) -> None:
+        """Consume one byte (one clock).
+
+        Raises:
+            FrameFieldError: (or a subclass) the circuit refuses the frame; it has resynchronised.
+        """
+        if self.pc < 0:
+            self._skip -= 1
+            if self._skip == 0:
+                self.reset()
+            return
+        s = self.layout.steps[self.pc]
+        if not self._buf:
+            self._field_start = self.offset
+        self.offset += 1
+        self._buf.append(byte)
+        if len(self._buf) == self.need(s):
+            data, self._buf = bytes(self._buf), bytearray()
+            self._complete(s, data)
+        elif self.pc > 0 and self.offset == self._end:
+            self._fail(FrameLengthError(
+                f"the frame length ({self._frame_length}) ends inside this field",
+                s.label_at(self.indices), self._field_start, self._frame_length))
+
+    def feed(self, data: bytes) -> None:
+        """Push every byte of ``data`` (the first error propagates)."""
+        for byte in data:
+            self.push(byte)
+
+    def trace(self, data: bytes) -> list[tuple[int, int, str, str]]:
+        """Push bytes, recording ``(offset, byte, step ident, field label)`` before each."""
+        rows = []
+        for byte in data:
+            s = self.step
+            rows.append((self.offset, byte, s.ident if s else "(skip)",
+                         s.label_at(self.indices) if s else "(skipping)"))
+            self.push(byte)
+        return rows
+
+    def finish(self) -> None:
+        """End of input: raise :class:`FrameTruncatedError` if a frame was left incomplete."""
+        if self.pc == 0 and not self._buf:
+            return
+        s = self.step
+        label = s.label_at(self.indices) if s else "frame"
+        start = self._field_start if self._buf else self.offset
+        got = len(self._buf)
+        self.reset()
+        raise FrameTruncatedError(f"the frame was cut short: {got} of this field's bytes had "
+                                  "arrived", label, start)
+
+    # -- steps ------------------------------------------------------------------------------------
+    def _complete(self, s: Step, data: bytes | memoryview) -> None:
+        self._accept(s, data)
+        self._advance(s.index + 1)
+
+    def _accept(self, s: Step, data: bytes | memoryview) -> None:
+        """Decode a complete step, run its checks, record its token (no moving on)."""
+        value = _decode(s, data)
+        if s.index == 0:
+            self._frame_length = value
+        if s.kind is StepKind.LENGTH:
+            self._counts[s.index] = value
+        if s.check is not None:
+            self._check(s, value)
+        if s.kind is StepKind.LENGTH and s.index > 0:
+            self._check_fits(s, value)
+        if s.index > 0:
+            self._tokens.append(Token(s.index, value, self.indices))
+        if s.index == self.layout.stream_index:
+            self._stream = value
+
+    def _advance(self, pc: int) -> None:
+        steps = self.layout.steps
+        while True:
+            if pc == len(steps):
+                self._frame_done()
+                return
+            t = steps[pc]
+            if t.kind is StepKind.LOOP:
+                n = t.count if t.count is not None else self._counts[t.length_step or 0]
+                assert t.partner is not None
+                if n == 0:
+                    pc = t.partner + 1
+                    continue
+                self._loops.append([pc, n, 0])
+                pc += 1
+                continue
+            if t.kind is StepKind.END:
+                top = self._loops[-1]
+                top[2] += 1
+                if top[2] < top[1]:
+                    pc = top[0] + 1
+                else:
+                    self._loops.pop()
+                    pc += 1
+                continue
+            self.pc = pc
+            if pc == self.layout.stream_index:
+                self._stream_offset = self.offset
+            if self.need(t) == 0:  # an empty string or array completes at once
+                self._field_start = self.offset
+                self._accept(t, b"")
+                pc += 1
+                continue
+            if self.offset == self._end:
+                self._fail(FrameLengthError(
+                    f"the frame length ({self._frame_length}) ends before this field",
+                    t.label_at(self.indices), self.offset, self._frame_length))
+            return
+
+    def _frame_done(self) -> None:
+        if self.offset != self._end:
+            left = self._end - self.offset
+            self._fail(FrameLengthError(
+                f"{self._frame_length} announces {left} bytes after the last field",
+                "frame length", 0, self._frame_length))
+        stream = self._stream if self._stream is not None else np.zeros(0, np.uint8)
+        assert self._frame_length is not None
+        self.last = Extracted(self._tokens, stream, self._frame_length, self._stream_offset)
+        self.frames += 1
+        self.reset()
+
+    def _fail(self, error: FrameFieldError) -> None:
+        remaining = self._end - self.offset if self._frame_length is not None else 0
+        self.reset()
+        if remaining > 0:
+            self.pc, self._skip = -1, remaining
+        raise error
+
+    def _refuse(self, s: Step, message: str, value: Any, rule: str,
+                cls: type[FrameFieldError] = FrameFieldError) -> None:
+        self._fail(cls(message, s.label_at(self.indices), self._field_start, value, STAGE,
+                       rule=rule))
+
+    def _check(self, s: Step, value: Any) -> None:
+        c = s.check
+        assert c is not None
+        if s.index == 0:
+            if value < c.low:
+                self._refuse(s, f"{value} is shorter than the smallest {self.layout.type_name} "
+                                f"({c.low} bytes)", value, "below the minimum", FrameLengthError)
+            if value > c.high:
+                self._refuse(s, f"{value} exceeds the limit of {c.high} bytes "
+                                "(hw.limits.MAX_FRAME_BYTES)", value, "over the limit",
+                             FrameLengthError)
+            return
+        if c.op is CheckOp.MAX:
+            if value > c.high:
+                self._refuse(s, f"{value} exceeds the limit of {c.high} (limits: {s.path})",
+                             value, "over the limit")
+        elif c.op is CheckOp.EQUAL:
+            if value != c.value:
+                self._refuse(s, f"{value!r} but the circuit was built for {c.value!r}", value,
+                             "not what the circuit was built for")
+        else:
+            if isinstance(value, float) and math.isnan(value):
+                self._refuse(s, f"NaN is outside {c.describe()}", value, "not a number")
+            if c.low is not None and value < c.low:
+                self._refuse(s, f"{value} is below the minimum {c.low}", value,
+                             "below the minimum")
+            if c.high is not None and value > c.high:
+                self._refuse(s, f"{value} exceeds the maximum {c.high}", value, "over the limit")
+
+    def _check_fits(self, s: Step, value: int) -> None:
+        left = self._end - self.offset
+        rule = self._rules[s.index]
+        need = value * rule.element_min
+        fixed = rule.fixed_after
+        if fixed is not None and need + fixed != left:
+            self._fail(FrameLengthError(
+                f"{self._frame_length} announces {left} bytes after the {s.label} field, but "
+                f"{value} elements and the fields after them take {need + fixed}",
+                "frame length", 0, self._frame_length))
+        if need > left:
+            self._refuse(s, f"{value} elements ({need} bytes at least) announced but the frame "
+                            f"length leaves only {left}", value, "past the frame end",
+                         FrameLengthError)
+
+
+def extract_reference(layout: Layout, frame: bytes) -> Extracted:
+    """Push ``frame`` (one TCPROS frame) a byte at a time.
+
+    Raises:
+        FrameFieldError: as the circuit refuses it; a frame cut short; bytes after the frame.
+    """
+    interp = LayoutInterpreter(layout)
+    for byte in frame:
+        interp.push(byte)
+        if interp.frames:
+            break
+    if not interp.frames:
+        if not frame:
+            raise FrameTruncatedError("the input held no bytes at all", "frame length", 0)
+        interp.finish()
+    assert interp.last is not None
+    _check_trailing(interp.last, len(frame))
+    return interp.last
+
+
+def extract_fast(layout: Layout, frame: bytes) -> Extracted:
+    """The same machine a whole step at a time (the stream as a numpy view of ``frame``).
+
+    Raises:
+        FrameFieldError: exactly as :func:`extract_reference` would.
+    """
+    interp = LayoutInterpreter(layout)
+    view = memoryview(frame)
+    if not frame:
+        raise FrameTruncatedError("the input held no bytes at all", "frame length", 0)
+    while not interp.frames:
+        s = interp.layout.steps[interp.pc]
+        n = interp.need(s)
+        pos = interp.offset
+        if interp.pc > 0 and pos + n > interp._end and interp._end <= len(view):
+            interp._field_start = pos
+            interp.offset = interp._end
+            interp._fail(FrameLengthError(
+                f"the frame length ({interp._frame_length}) ends inside this field",
+                s.label_at(interp.indices), pos, interp._frame_length))
+        if pos + n > len(view):
+            got = len(view) - pos
+            interp.reset()
+            raise FrameTruncatedError(f"the frame was cut short: {got} of this field's bytes "
+                                      "had arrived", s.label_at(interp.indices), pos)
+        interp._field_start = pos
+        interp.offset = pos + n
+        if s.index == layout.stream_index:
+            interp._stream_offset = pos
+        interp._complete(s, view[pos:pos + n])
+    assert interp.last is not None
+    _check_trailing(interp.last, len(frame))
+    return interp.last
+
+
+def _check_trailing(ex: Extracted, given: int) -> None:
+    left = given - 4 - ex.frame_length
+    if left:
+        raise FrameLengthError(
+            f"the frame length ({ex.frame_length}) ends the frame at byte {4 + ex.frame_length}, "
+            f"but {left} more bytes were given; pass one frame at a time", "frame length", 0,
+            ex.frame_length)
+
+
+# -- publisher ------------------------------------------------------------------------------------
+
+def _default(step: Step, count: int) -> Any:
+    if step.kind is StepKind.LENGTH:
+        return 0
+    if step.kind is StepKind.STRING:
+        return ""
+    if step.kind is StepKind.ARRAY:
+        return np.zeros(count, np.dtype(step.dtype))
+    return False if step.type == "bool" else 0.0 if step.type.startswith("float") else 0
+
+
+def output_tokens(layout: Layout, toks: list[Token], stream: np.ndarray) -> list[Token]:
+    """The publisher's values: ``toks`` (a subscriber's, walk order) with the stream replaced
+    by ``stream`` and every skipped field at its default."""
+    steps = layout.steps
+    queue = [t for t in toks if steps[t.step].action is not Action.SKIP]
+    out: list[Token] = []
+    pos = 0
+    counts: dict[int, int] = {}
+
+    def take(i: int, at: tuple[int, ...]) -> Any:
+        nonlocal pos
+        t = queue[pos]
+        assert t.step == i, f"token of step {t.step} where step {i} was expected"
+        pos += 1
+        return t.value
+
+    def walk(lo: int, hi: int, at: tuple[int, ...]) -> None:
+        i = lo
+        while i < hi:
+            s = steps[i]
+            if s.kind is StepKind.LOOP:
+                assert s.partner is not None
+                n = s.count if s.count is not None else counts[s.length_step or 0]
+                for k in range(n):
+                    walk(i + 1, s.partner, at + (k,))
+                i = s.partner + 1
+                continue
+            n = s.count if s.count is not None else counts.get(s.length_step or 0, 0)
+            if i == layout.stream_index:
+                take(i, at)
+                value: Any = np.asarray(stream)
+            elif s.kind is StepKind.LENGTH and s.partner == layout.stream_index:
+                take(i, at)
+                value = len(stream)
+            elif s.action is Action.SKIP:
+                value = _default(s, n if s.kind is StepKind.ARRAY else 0)
+            else:
+                value = take(i, at)
+            if s.kind is StepKind.LENGTH:
+                counts[i] = value
+            out.append(Token(i, value, at))
+            i += 1
+
+    walk(1, len(steps), ())
+    return out
+
+
+def _merge(skeleton: dict[str, Any], got: dict[str, Any]) -> dict[str, Any]:
+    for key, value in got.items():
+        if isinstance(value, dict) and isinstance(skeleton.get(key), dict):
+            _merge(skeleton[key], value)
+        else:
+            skeleton[key] = value
+    return skeleton
+
+
+def message_of(layout: Layout, toks: list[Token], reg: MsgRegistry) -> dict[str, Any]:
+    """The message (nested dicts and lists, ``msg.serialize`` takes it) whose walk gives
+    ``toks``: the inverse of :func:`~rosfpga_lab.hw.layout.tokens` (``reg`` fills nested
+    messages without fields, which have no steps)."""
+    steps = layout.steps
+    pos = 0
+
+    def put(obj: dict[str, Any], rel: tuple[str, ...], value: Any) -> None:
+        for name in rel[:-1]:
+            obj = obj.setdefault(name, {})
+        obj[rel[-1]] = value
+
+    def walk(lo: int, hi: int, obj: dict[str, Any]) -> None:
+        nonlocal pos
+        i = lo
+        while i < hi:
+            s = steps[i]
+            if s.kind is StepKind.LOOP:
+                assert s.partner is not None
+                n = s.count if s.count is not None else counts[s.length_step or 0]
+                items: list[Any] = []
+                for _ in range(n):
+                    element: dict[str, Any] = {}
+                    walk(i + 1, s.partner, element)
+                    if "" in element:
+                        items.append(element[""])
+                    elif s.type in reg:
+                        items.append(_merge(new_message(reg, s.type), element))
+                    else:
+                        items.append(element)
+                put(obj, s.rel, items)
+                i = s.partner + 1
+                continue
+            t = toks[pos]
+            assert t.step == i, f"token of step {t.step} where step {i} was expected"
+            pos += 1
+            if s.kind is StepKind.LENGTH:
+                counts[i] = t.value
+            else:
+                put(obj, s.rel or ("",), t.value)
+            i += 1
+
+    counts: dict[int, int] = {}
+    root: dict[str, Any] = {}
+    walk(1, len(steps), root)
+    return _merge(new_message(reg, layout.type_name), root)
+
+
+def _carry_into(reg: MsgRegistry, in_type: str, out_type: str, src: dict[str, Any]) -> dict:
+    """A value of ``out_type``: each field the input's field of the same name when the types
+    are equal (nested messages field by field), else its default."""
+    in_fields = {f.name: f for f in reg.check(in_type).fields}
+    out: dict[str, Any] = {}
+    for f in reg.check(out_type).fields:
+        g = in_fields.get(f.name)
+        if g is not None and g.type == f.type:
+            out[f.name] = src[f.name]
+        elif (g is not None and not f.is_array and not g.is_array and not f.is_builtin
+              and not g.is_builtin):
+            out[f.name] = _carry_into(reg, g.base_type, f.base_type, src[f.name])
+        else:
+            out[f.name] = default_value(reg, f)
+    return out
+
+
+def published_tokens(layout: Layout, toks: list[Token], stream: np.ndarray,
+                     out_layout: Layout | None = None, reg: MsgRegistry | None = None
+                     ) -> list[Token]:
+    """What the publisher writes, in its layout's walk order: :func:`output_tokens`, and for a
+    publisher of another type (``out_layout``, its registry ``reg``) every field of that type
+    taken from the input's field of the same path and type, else its default."""
+    same = output_tokens(layout, toks, stream)
+    if out_layout is None or out_layout.type_name == layout.type_name:
+        return same
+    if reg is None:
+        raise ValueError("a publisher of another type needs the registry holding both types")
+    message = _carry_into(reg, layout.type_name, out_layout.type_name,
+                          message_of(layout, same, reg))
+    return tokens(out_layout, message)
+
+
+def publish_fast(layout: Layout, toks: list[Token], stream: np.ndarray,
+                 out_layout: Layout | None = None, reg: MsgRegistry | None = None) -> bytes:
+    """The output TCPROS frame (4-byte length + body), each field packed whole."""
+    return marshal(out_layout or layout, published_tokens(layout, toks, stream, out_layout, reg))
+
+
+def publish_reference(layout: Layout, toks: list[Token], stream: np.ndarray,
+                      out_layout: Layout | None = None, reg: MsgRegistry | None = None) -> bytes:
+    """The output frame written a byte per clock: numbers shifted out little-endian, strings
+    and arrays byte by byte, as the generated publisher does."""
+    out_toks = published_tokens(layout, toks, stream, out_layout, reg)
+    layout = out_layout or layout
+    length = sum(_size(layout.steps[t.step], t.value) for t in out_toks)
+    out = bytearray()
+    for k in range(4):
+        out.append((length >> (8 * k)) & 0xFF)
+    for t in out_toks:
+        s = layout.steps[t.step]
+        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
+            bits = int.from_bytes(encode_token(s, t.value), "little")  # the register's bits
+            for k in range(s.size):
+                out.append((bits >> (8 * k)) & 0xFF)
+        else:
+            for byte in encode_token(s, t.value):
+                out.append(byte)
+    return bytes(out)
+
+
+def _size(step: Step, value: Any) -> int:
+    if step.kind in (StepKind.SCALAR, StepKind.LENGTH):
+        return step.size
+    if step.kind is StepKind.STRING:
+        return len(value.encode("utf-8", "surrogateescape"))
+    return step.size * len(value)
