@@ -84,13 +84,15 @@ def run_ros2(args: argparse.Namespace) -> int:
     try:
         domain = int(raw)
         qos_in = Qos(reliable=not args.best_effort_input)
-        comp = Ros2Component(args.config, domain=domain, model=args.model, qos_in=qos_in).start()
+        model = args.model or MODELS[0]
+        comp = Ros2Component(args.config, domain=domain, model=model, qos_in=qos_in).start()
     except (ValueError, LabError) as exc:
         print(f"rosfpga-lab node: error: {exc}", file=sys.stderr)
         return 1
     print(f"{comp.name}: ROS 2 (DDS domain {domain}, participant index "
           f"{comp.node.index if comp.node else '?'}, input {comp.qos_in.describe()}) "
-          f"{comp.input_topic} -> {comp.pipeline.op} ({args.model} model) -> {comp.output_topic}; "
+          f"{comp.input_topic} -> {comp.pipeline.op} ({model} CDR circuit model) -> "
+          f"{comp.output_topic}; "
           "Ctrl-C to stop", flush=True)
     t_end = None if args.duration is None else time.monotonic() + args.duration
     try:

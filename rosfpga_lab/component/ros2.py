@@ -1,17 +1,16 @@
-"""The FPGA component as a ROS 2 node (first step): RTPS in software, the circuit on the data path.
+"""The FPGA component as a ROS 2 node: RTPS in software, the CDR circuit on the data path.
 
 How this works: a :class:`~rosfpga_lab.graph.ros2.Ros2Node` discovers and matches the peers
 in software (SPDP/SEDP, as the ROS 1 side does XML-RPC); every sample that arrives on the
-input topic is a CDR payload, which goes through the circuit model and out through the RTPS
-writer on the output topic.
+input topic is a CDR payload, which goes through the CDR circuit model
+(:class:`~rosfpga_lab.hw.CdrPipeline`: CDR subscriber from the layout -> application -> CDR
+publisher, the bytes never deserialized in software) and out through the RTPS writer on the
+output topic. Any type the layout accepts works, ``sensor_msgs/Image`` included.
 
-SOFTWARE STAND-IN FOR THE CDR CIRCUIT. The circuit the paper's flow renders (a CDR interpreter
-from the generic layout -> fifo2axi -> application -> axi2fifo -> CDR generator) does not exist
-yet. Until it does, :func:`cdr_to_ros1_frame` converts the CDR sample to values and to the
-TCPROS frame the existing ROS 1 circuit model reads, the ROS 1 model processes it, and
-:func:`ros1_frame_to_cdr` converts its output frame back to CDR. The application stage and
-its result are the circuit's; the two conversions are software, and are replaced when the CDR
-interpreter and generator are rendered from ``hw.layout``.
+The camera and the viewer on ROS 2 (:class:`Ros2ImagePublisher`, :func:`subscribe_ros1_bodies`)
+are software peers, not the circuit: they convert between the ROS 1 image bodies the lab's
+camera and viewer use and CDR (:func:`ros1_frame_to_cdr`, :func:`cdr_to_ros1_frame`), as a
+ROS 2 camera driver serializes its images in software.
 """
 
 from __future__ import annotations
@@ -27,7 +26,7 @@ from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import MessageInfo
 from rosfpga_lab.graph.ros2 import Ros2Node, Ros2Publisher
-from rosfpga_lab.hw import Pipeline, PipelineError
+from rosfpga_lab.hw import CdrPipeline, PipelineError
 from rosfpga_lab.msg import default_registry, deserialize, deserialize_cdr, serialize, serialize_cdr
 from rosfpga_lab.msg import to_ros2_value
 from rosfpga_lab.rtps.participant import Qos, Sample
@@ -37,10 +36,7 @@ IMAGE = "sensor_msgs/Image"
 
 
 def cdr_to_ros1_frame(payload: bytes, seq: int = 0) -> bytes:
-    """A ROS 2 Image (CDR payload) as the TCPROS frame (length + body) of the ROS 1 circuit.
-
-    Software stand-in for the CDR interpreter (see the module docstring).
-    """
+    """A ROS 2 Image (CDR payload) as a TCPROS frame (length + body): the viewer's conversion."""
     v = deserialize_cdr(None, IMAGE, payload)
     stamp = v["header"]["stamp"]
     if stamp["sec"] < 0:
@@ -53,7 +49,7 @@ def cdr_to_ros1_frame(payload: bytes, seq: int = 0) -> bytes:
 
 
 def ros1_frame_to_cdr(frame: bytes) -> bytes:
-    """The ROS 1 circuit's output frame as a ROS 2 Image CDR payload (stand-in for the CDR generator)."""
+    """A ROS 1 Image frame (length + body) as a ROS 2 CDR payload: the camera's conversion."""
     v = deserialize(default_registry(), IMAGE, frame[4:])
     return serialize_cdr(None, IMAGE, to_ros2_value(default_registry(), IMAGE, v))
 
@@ -96,12 +92,8 @@ class Ros2Component:
                  qos_in: Qos = Qos(), qos_out: Qos = Qos(), name: str | None = None) -> None:
         if not isinstance(config, NodeConfig):
             config = load_config(config)
-        for section, topic in (("subscriber", config.subscriber), ("publisher", config.publisher)):
-            if topic.type != IMAGE:
-                raise ComponentConfigError(
-                    f"{section}.type is {topic.type!r}: the circuit streams sensor_msgs/Image only")
         try:
-            self.pipeline = Pipeline.from_config(config, model=model)
+            self.pipeline = CdrPipeline(config, model)
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         self.config, self.domain, self.qos_in, self.qos_out = config, domain, qos_in, qos_out
@@ -116,8 +108,10 @@ class Ros2Component:
 
     def start(self) -> Ros2Component:
         self.node = Ros2Node(self.name, self.domain, namespace=self.namespace)
-        self._pub = self.node.create_publisher(self.output_topic, IMAGE, self.qos_out)
-        self.node.create_subscriber(self.input_topic, IMAGE, self._on_sample, self.qos_in)
+        self._pub = self.node.create_publisher(self.output_topic, self.config.publisher.type,
+                                               self.qos_out)
+        self.node.create_subscriber(self.input_topic, self.config.subscriber.type,
+                                    self._on_sample, self.qos_in)
         log.info("%s: ROS 2 node in DDS domain %d (participant index %d): %s -> %s -> %s",
                  self.name, self.domain, self.node.index, self.input_topic, self.pipeline.op,
                  self.output_topic)
@@ -126,11 +120,9 @@ class Ros2Component:
     def _on_sample(self, payload: bytes, sample: Sample) -> None:
         t0 = time.perf_counter()
         with self._cond:
-            index = self.counts["seen"]
             self.counts["seen"] += 1
         try:
-            result = self.pipeline.process(cdr_to_ros1_frame(payload, index))
-            out = ros1_frame_to_cdr(result.output_frame)
+            out = self.pipeline.process(payload)
         except LabError as exc:
             with self._cond:
                 self.counts["refused"] += 1
