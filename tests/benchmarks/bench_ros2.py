@@ -6,7 +6,7 @@ samples (RELIABLE KEEP_LAST 10, rmw's QoS) and a Cyclone sink reads them after o
 * relay:     a Cyclone participant that takes each sample and writes it again (no processing);
 * direct:    no hop (the sink reads the source's topic), the cost of the two ends;
 * component: the lab's ROS 2 component (its RTPS participant in Python, the 3x3 dilation through
-             the fast circuit model, the CDR <-> ROS 1 frame stand-in conversions).
+             the fast model of the CDR circuit, hw.CdrPipeline).
 
 Figures: frames/s with the source writing as fast as the hop keeps up (KEEP_LAST 10, the
 output counted at the sink), and latency (source write -> sink take, one frame at a time)
@@ -132,7 +132,7 @@ def main() -> int:
           f"{(statistics.median(c_lat) - statistics.median(d_lat)) * 1e3:.2f} ms; "
           "(the relay is Cyclone's Python binding: it turns each frame into Python objects)")
     print(f"component minus relay (median): {(statistics.median(c_lat) - statistics.median(r_lat)) * 1e3:.2f} ms; "
-          f"component time per frame in the circuit model + CDR stand-in: "
+          f"component time per frame in the CDR circuit model (fast): "
           f"{statistics.median(comp.latencies) * 1e3:.2f} ms")
     return 0
 
