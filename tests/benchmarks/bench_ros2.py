@@ -1,9 +1,13 @@
 """Benchmark: the lab's ROS 2 component next to a Cyclone DDS relay, 640x480 rgba8 (issue 20).
 
-In one process, a Cyclone DDS source writes 640x480 rgba8 ``sensor_msgs::msg::dds_::Image_``
-samples (RELIABLE KEEP_LAST 10, rmw's QoS) and a Cyclone sink reads them after one hop:
+In one process, a source writes 640x480 rgba8 ``sensor_msgs::msg::dds_::Image_`` samples
+(RELIABLE KEEP_LAST 10, rmw's QoS) and a sink reads them after one hop; source and sink are
+the lab's participants moving raw CDR (Cyclone's Python binding would turn every pixel into a
+Python object at both ends and hide the hop):
 
-* relay:     a Cyclone participant that takes each sample and writes it again (no processing);
+* relay:     a Cyclone DDS participant that takes each sample and writes it again (no processing;
+             through Cyclone's Python binding, the only Cyclone API installed, which converts
+             each sample to Python objects and back);
 * direct:    no hop (the sink reads the source's topic), the cost of the two ends;
 * component: the lab's ROS 2 component (its RTPS participant in Python, the 3x3 dilation through
              the fast model of the CDR circuit, hw.CdrPipeline).
@@ -29,7 +33,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from ros2tools import cyclone, image, qos  # noqa: E402
+from ros2tools import cyclone, qos  # noqa: E402
 
 CONFIG = """\
 node: {name: /fpga_bench}
@@ -57,46 +61,56 @@ def relay(dds, domain: int, stop: threading.Event) -> threading.Thread:
     return t
 
 
-def measure(dds, domain: int, frames: int, out: str = "rt/cam_out") -> tuple[float, list[float]]:
-    dp = dds.DomainParticipant(domain)
-    src = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds))
-    dp2 = dds.DomainParticipant(domain)       # the sink in a participant of its own
-    sink = dds.DataReader(dp2, dds.Topic(dp2, out, dds.Image_), qos=qos(dds))
-    deadline = time.monotonic() + 15
-    while not (src.get_matched_subscriptions() and sink.get_matched_publications()):
-        if time.monotonic() > deadline:
-            raise SystemExit("peers did not match in 15 s")
-        time.sleep(0.01)
-    time.sleep(0.3)
+def measure(domain: int, frames: int, out: str = "/cam_out") -> tuple[float, list[float]]:
+    """Source and sink are the lab's own participants, moving raw CDR bytes (no Python objects
+    per pixel), so what differs between the rows is the hop."""
+    from rosfpga_lab.graph.ros2 import Ros2Node
+    from rosfpga_lab.msg import serialize_cdr
+
     pixels = np.random.default_rng(0).integers(0, 256, (480, 640, 4), dtype=np.uint8)
-    msg = image(dds, pixels, "rgba8")
-    # latency: one frame at a time
-    lat = []
-    for _ in range(frames):
-        t0 = time.perf_counter()
-        src.write(msg)
-        got = []
-        while not got and time.perf_counter() - t0 < 5:
-            got = sink.take(1)
-            time.sleep(0.0002)
-        if got:
-            lat.append(time.perf_counter() - t0)
-    # throughput: the source writes every frame at once (its KEEP_LAST 10 history may replace
-    # frames the hop did not take yet); frames/s = frames at the sink / time to the last one
-    n, last = 0, 0.0
-    t0 = time.perf_counter()
-    for k in range(frames):
-        src.write(image(dds, pixels, "rgba8", sec=k + 1))
-    while time.perf_counter() - t0 < 20:
-        got = [s for s in sink.take(10) if isinstance(s, dds.Image_)]
-        if got:
-            n += len(got)
-            last = time.perf_counter()
-            if got[-1].header.stamp.sec == frames:
-                break
-        time.sleep(0.001)
-    fps = n / (last - t0) if n else 0.0
-    return fps, lat
+
+    def sample(k: int) -> bytes:
+        return serialize_cdr(None, "sensor_msgs/Image", {
+            "header": {"stamp": {"sec": k, "nanosec": 0}, "frame_id": "camera"}, "height": 480,
+            "width": 640, "encoding": "rgba8", "is_bigendian": 0, "step": 2560,
+            "data": pixels.tobytes()})
+
+    arrived: dict[int, float] = {}
+    cond = threading.Condition()
+
+    def on_sample(payload: bytes, _info: object) -> None:
+        k = int.from_bytes(payload[4:8], "little")        # header.stamp.sec
+        with cond:
+            arrived[k] = time.perf_counter()
+            cond.notify_all()
+
+    src_node, sink_node = Ros2Node("bench_source", domain), Ros2Node("bench_sink", domain)
+    try:
+        src = src_node.create_publisher("/cam", "sensor_msgs/Image")
+        sink_node.create_subscriber(out, "sensor_msgs/Image", on_sample)
+        if not src.wait_for_subscribers(1, 15):
+            raise SystemExit("the hop did not match in 15 s")
+        time.sleep(1.0)
+        samples = [sample(k) for k in range(1, 2 * frames + 1)]
+        lat = []
+        for k in range(1, frames + 1):          # latency: one frame at a time
+            t0 = time.perf_counter()
+            src.publish(samples[k - 1])
+            with cond:
+                cond.wait_for(lambda: k in arrived, 5)
+            if k in arrived:
+                lat.append(arrived[k] - t0)
+        t0 = time.perf_counter()                # throughput: all at once (KEEP_LAST 10)
+        for k in range(frames + 1, 2 * frames + 1):
+            src.publish(samples[k - 1])
+        with cond:
+            cond.wait_for(lambda: 2 * frames in arrived, 20)
+        got = [t for k, t in arrived.items() if k > frames]
+        fps = len(got) / (max(got) - t0) if got else 0.0
+        return fps, lat
+    finally:
+        src_node.close()
+        sink_node.close()
 
 
 def main() -> int:
@@ -108,14 +122,14 @@ def main() -> int:
     from rosfpga_lab.component.ros2 import Ros2Component
     from rosfpga_lab.config import parse_config
 
-    d_fps, d_lat = measure(dds, args.domain + 2, args.frames, out="rt/cam")
+    d_fps, d_lat = measure(args.domain + 2, args.frames, out="/cam")
     stop = threading.Event()
     relay(dds, args.domain, stop)
-    r_fps, r_lat = measure(dds, args.domain, args.frames)
+    r_fps, r_lat = measure(args.domain, args.frames)
     stop.set()
     comp = Ros2Component(parse_config(CONFIG), domain=args.domain + 1).start()
     try:
-        c_fps, c_lat = measure(dds, args.domain + 1, args.frames)
+        c_fps, c_lat = measure(args.domain + 1, args.frames)
     finally:
         comp.stop()
 
@@ -129,8 +143,7 @@ def main() -> int:
     print(f"{'component':<10} {c_fps:9.1f} {statistics.median(c_lat) * 1e3:11.2f} {p(c_lat, .9):11.2f}")
     print(f"added latency over direct (median): relay "
           f"{(statistics.median(r_lat) - statistics.median(d_lat)) * 1e3:.2f} ms, component "
-          f"{(statistics.median(c_lat) - statistics.median(d_lat)) * 1e3:.2f} ms; "
-          "(the relay is Cyclone's Python binding: it turns each frame into Python objects)")
+          f"{(statistics.median(c_lat) - statistics.median(d_lat)) * 1e3:.2f} ms")
     print(f"component minus relay (median): {(statistics.median(c_lat) - statistics.median(r_lat)) * 1e3:.2f} ms; "
           f"component time per frame in the CDR circuit model (fast): "
           f"{statistics.median(comp.latencies) * 1e3:.2f} ms")
