@@ -312,3 +312,40 @@ def test_a_cyclone_peer_that_dies_is_forgotten_when_its_lease_runs_out(tmp_path)
             if proc.poll() is None:
                 proc.kill()
                 proc.wait()
+
+
+def test_the_labs_own_message_through_the_ros2_component() -> None:
+    """lab_msgs/Samples (a nested message, a float64 array: 8-byte CDR alignment, a sequence of
+    messages) from a Cyclone writer through the component's CDR circuit: the int32 array dilated
+    (sliding maximum over 3), every other field carried as the writer sent it."""
+    from pathlib import Path
+
+    from rosfpga_lab.config import load_config
+
+    cyclone()
+    import cdrtypes as T
+
+    dds = cyclone()
+    cfg = load_config(Path(__file__).resolve().parent.parent / "data" / "fpga_samples_dilate.yaml")
+    rng = np.random.default_rng(4)
+    values = rng.integers(-2**31, 2**31, 64, dtype=np.int64).astype(np.int32)
+    cal = T.Calibration_("lidar", [0.5, -1.25, 3.0], 2)
+    msg = T.Samples_(T.Header_(T.Time_(7, 9), "array"), cal, "burst", [1, -2, 3, -4],
+                     values.tolist(), T.Duration_(0, 500), [cal, T.Calibration_("x", [0, 0, 1], 2)],
+                     True)
+    with Ros2Component(cfg, domain=DOMAIN) as comp:
+        dp = dds.DomainParticipant(DOMAIN)
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/samples", T.Samples_), qos=qos(dds))
+        reader = dds.DataReader(dp, dds.Topic(dp, "rt/samples_dilated", T.Samples_), qos=qos(dds))
+        assert comp.wait_for_peers(10), comp.notes()
+        assert wait(lambda: writer.get_matched_subscriptions() and reader.get_matched_publications())
+        writer.write(msg)
+        got: list = []
+        assert wait(lambda: got.extend(reader.take(10)) or got, 10), (comp.counts, comp.notes())
+    out = got[0]
+    padded = np.concatenate(([np.iinfo(np.int32).min], values, [np.iinfo(np.int32).min]))
+    want = np.maximum(np.maximum(padded[:-2], padded[1:-1]), padded[2:])
+    assert list(out.samples) == want.tolist()
+    assert (out.label, list(out.thresholds), out.valid, out.period.nanosec) == ("burst", [1, -2, 3, -4], True, 500)
+    assert out.calibration == cal and list(out.history) == list(msg.history)
+    assert (out.header.stamp.sec, out.header.frame_id) == (7, "array")
