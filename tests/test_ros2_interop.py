@@ -349,3 +349,19 @@ def test_the_labs_own_message_through_the_ros2_component() -> None:
     assert (out.label, list(out.thresholds), out.valid, out.period.nanosec) == ("burst", [1, -2, 3, -4], True, 500)
     assert out.calibration == cal and list(out.history) == list(msg.history)
     assert (out.header.stamp.sec, out.header.frame_id) == (7, "array")
+
+
+def test_demo_ros2_command_is_bit_exact(tmp_path) -> None:
+    import os
+    import subprocess
+    import sys
+
+    cfg = tmp_path / "node.yaml"
+    cfg.write_text(CONFIG.format(w=32, h=16))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    run = subprocess.run([sys.executable, "-m", "rosfpga_lab", "demo", "--ros2", "--config",
+                          str(cfg), "--domain", str((DOMAIN + 21) % 233), "--frames", "6",
+                          "--source", "synthetic", "--rate", "50"],
+                         capture_output=True, text=True, timeout=60, env=env)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "frames sent 6, received 6, bit-exact against OpenCV 6" in run.stdout
