@@ -8,6 +8,7 @@ Each test process uses its own DDS domain (from its pid) so parallel runs do not
 
 # no "from __future__ import annotations": cyclonedds reads the field types at class creation
 
+import functools
 import os
 import time
 from dataclasses import dataclass
@@ -29,6 +30,12 @@ def cyclone() -> Any:
     """The cyclonedds modules and ROS 2 Image types, with CYCLONEDDS_URI set (skip without it)."""
     require_cyclonedds()
     os.environ["CYCLONEDDS_URI"] = CYCLONE_CONFIG
+    return _types()
+
+
+@functools.cache
+def _types() -> Any:
+    """Built once per process: one Python class per DDS type name."""
     import cyclonedds.idl.types as t
     from cyclonedds.core import Policy, Qos
     from cyclonedds.domain import DomainParticipant
