@@ -395,3 +395,23 @@ def test_heartbeats_to_a_reader_that_never_answers_back_off() -> None:
             beats += sum(isinstance(s, Heartbeat) for s in parse_message(d).submessages)
     # 2 SEDP writers; at a fixed 50 ms period that would be 400 HEARTBEATs
     assert 2 <= beats <= 2 * 16, beats
+
+
+def test_heartbeat_after_absurd_fragments_costs_no_more_than_what_came() -> None:
+    """A sample declaring 60 M one-byte fragments, then HEARTBEAT/HEARTBEAT_FRAG: listing the
+    missing fragments used to walk all 60 M numbers (seconds per heartbeat)."""
+    import time
+
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    head = b.header(a.guid_prefix) + b.info_dst(c.guid_prefix)
+    c.receive(head + b.data_frag(r, w, 1, 1, 1, 60_000_000, b"x" * 100, 100), a.user, 1.0)
+    hbf = struct.pack("<BBH", 0x13, 1, 24) + r.to_bytes(4, "big") + w.to_bytes(4, "big") \
+        + struct.pack("<iIIi", 0, 1, 60_000_000, 1)
+    t0 = time.perf_counter()
+    out = c.receive(head + b.heartbeat(r, w, 1, 1, 500), a.user, 1.1)
+    out += c.receive(head + hbf, a.user, 1.2)
+    assert time.perf_counter() - t0 < 0.5
+    nacks = [s for _, _, d in out for s in parse_message(d).submessages if isinstance(s, NackFrag)]
+    assert nacks and all(len(n.missing) <= 256 and n.missing[0] == 101 for n in nacks)

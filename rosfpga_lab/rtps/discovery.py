@@ -137,15 +137,23 @@ class FragmentAssembler:
         """Forget a partly received sample (it was delivered whole, or will never come)."""
         self._drop((guid_prefix, writer_id, seq))
 
-    def missing(self, guid_prefix: bytes, writer_id: int, seq: int, last: int = 0) -> list[int]:
-        """Fragment numbers of a partly received sample not yet here (up to ``last`` if given);
-        [] for a sample with no fragment here."""
+    def missing(self, guid_prefix: bytes, writer_id: int, seq: int, last: int = 0,
+                limit: int = 256) -> list[int]:
+        """The first ``limit`` fragment numbers of a partly received sample not yet here (up to
+        ``last`` if given); [] for a sample with no fragment here. The work is bounded by the
+        fragments received plus ``limit``, never by the count the sample declares."""
         key = (guid_prefix, writer_id, seq)
         if key not in self._pending:
             return []
         total = self._total[key] if not last else min(last, self._total[key])
         parts = self._pending[key]
-        return [n for n in range(1, total + 1) if n not in parts]
+        out: list[int] = []
+        n = 1
+        while n <= total and len(out) < limit:
+            if n not in parts:
+                out.append(n)
+            n += 1
+        return out
 
     def partial(self, guid_prefix: bytes, writer_id: int) -> list[int]:
         """Sequence numbers of ``writer_id``'s partly received samples."""
