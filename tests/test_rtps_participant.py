@@ -415,3 +415,19 @@ def test_heartbeat_after_absurd_fragments_costs_no_more_than_what_came() -> None
     assert time.perf_counter() - t0 < 0.5
     nacks = [s for _, _, d in out for s in parse_message(d).submessages if isinstance(s, NackFrag)]
     assert nacks and all(len(n.missing) <= 256 and n.missing[0] == 101 for n in nacks)
+
+
+def test_fake_readers_cannot_multiply_a_frame_without_bound() -> None:
+    from rosfpga_lab.rtps.limits import MAX_MATCHED_PER_ENDPOINT
+
+    a = fresh()
+    w = a.add_writer(TOPIC, TYPE, Qos(False))
+    prefix = b"R" * 12
+    a.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    for k in range(200):           # 200 readers on the topic from one participant
+        guid = prefix + ((k << 8) | 0x04).to_bytes(4, "big")
+        sedp = b.sedp_payload(guid, TOPIC, TYPE, False, 1, b.Locator("127.0.0.1", 9))
+        a.receive(b.header(prefix) + b.data(0x4C7, 0x4C2, k + 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert len(a.matched(w)) == MAX_MATCHED_PER_ENDPOINT
+    assert len(a.write(w, b"\x00\x01\x00\x00" + bytes(100), 1.0)) == MAX_MATCHED_PER_ENDPOINT
+    assert sum("already has" in n for n in a.notes) == 1

@@ -39,3 +39,6 @@ MAX_OUT_OF_ORDER_BYTES = 32 * 1024 * 1024
 MAX_HISTORY_DEPTH = 1000
 #: Distinct log notes kept (each is logged once).
 MAX_NOTES = 256
+#: Remote endpoints one local writer or reader is matched with (a writer sends each sample to
+#: every matched reader: fake readers must not multiply a frame without bound).
+MAX_MATCHED_PER_ENDPOINT = 32

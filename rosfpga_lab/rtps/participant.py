@@ -37,9 +37,9 @@ from rosfpga_lab.rtps.entities import (
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import (
     ANNOUNCE_SECONDS, FRAGMENT_BYTES, HEARTBEAT_SECONDS, LEASE_SECONDS, MAX_HEARTBEAT_SECONDS,
-    MAX_HISTORY_DEPTH,
-    MAX_LEASE_SECONDS, MAX_MESSAGE_BYTES, MAX_NOTES, MAX_OUT_OF_ORDER, MAX_OUT_OF_ORDER_BYTES,
-    MAX_PARTICIPANT_INDEX, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS, MIN_RESEND_SECONDS,
+    MAX_HISTORY_DEPTH, MAX_LEASE_SECONDS, MAX_MATCHED_PER_ENDPOINT, MAX_MESSAGE_BYTES, MAX_NOTES,
+    MAX_OUT_OF_ORDER, MAX_OUT_OF_ORDER_BYTES, MAX_PARTICIPANT_INDEX, MAX_REMOTE_ENDPOINTS,
+    MAX_REMOTE_PARTICIPANTS, MIN_RESEND_SECONDS,
 )
 from rosfpga_lab.rtps.message import (
     AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, InfoDst, NackFrag, parse_message,
@@ -353,6 +353,10 @@ class Participant:
         if ep.type_name != rem.type_name:
             self.note(f"type-{rem.guid.hex()}-{ep.entity_id}", f"not matched: {what}: type "
                       f"{rem.type_name} is not {ep.type_name}")
+            return
+        if len(ep.proxies) >= MAX_MATCHED_PER_ENDPOINT:
+            self.note(f"matched-full-{ep.entity_id}", f"not matched: {what}: {ep.kind} {ep.topic} "
+                      f"already has {MAX_MATCHED_PER_ENDPOINT} matched remote endpoints")
             return
         offered, requested = (ep.qos, rem.qos) if ep.kind == "writer" else (rem.qos, ep.qos)
         why = incompatibility(offered, requested)
