@@ -365,3 +365,19 @@ def test_demo_ros2_command_is_bit_exact(tmp_path) -> None:
                          capture_output=True, text=True, timeout=60, env=env)
     assert run.returncode == 0, run.stdout + run.stderr
     assert "frames sent 6, received 6, bit-exact against OpenCV 6" in run.stdout
+
+
+def test_cyclone_forgets_the_lab_node_at_once_when_it_stops() -> None:
+    """The node says goodbye (SPDP disposed/unregistered): Cyclone unmatches at once, not when
+    the 10 s lease runs out."""
+    import time
+
+    dds = cyclone()
+    comp = Ros2Component(parse_config(CONFIG.format(w=8, h=4)), domain=DOMAIN).start()
+    dp = dds.DomainParticipant(DOMAIN)
+    writer = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds))
+    assert wait(lambda: writer.get_matched_subscriptions(), 10)
+    comp.stop()
+    t0 = time.monotonic()
+    assert wait(lambda: not writer.get_matched_subscriptions(), 5)
+    assert time.monotonic() - t0 < 2.0

@@ -225,9 +225,12 @@ class Ros2Node:
                                 log.exception("subscriber callback of %s failed", sub.topic)
 
     def close(self) -> None:
-        """Stop the thread and close the sockets (peers forget the node when its lease ends)."""
+        """Stop the thread, tell the peers goodbye (SPDP dispose), close the sockets."""
         self._stop.set()
         self._thread.join(timeout=2.0)
+        with self._lock:
+            bye = self.participant.goodbye()
+        self._send(bye)
         self._meta.close()
         self._user.close()
 

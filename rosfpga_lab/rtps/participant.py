@@ -30,7 +30,7 @@ from collections import deque
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.discovery import PL_CDR_BE, PL_CDR_LE, FragmentAssembler, parse_parameters
 from rosfpga_lab.rtps.entities import (
-    PUB_READER, PUB_WRITER, READER_KIND, SPDP_READER, SPDP_WRITER, SUB_READER, SUB_WRITER,
+    PARTICIPANT_ENTITY, PUB_READER, PUB_WRITER, READER_KIND, SPDP_READER, SPDP_WRITER, SUB_READER, SUB_WRITER,
     WRITER_KIND, LocalEndpoint, Qos, ReaderProxy, RemoteEndpoint, RemoteParticipant, Sample, Send,
     WriterProxy, check_domain, discovery_port, incompatibility, user_port,
 )
@@ -175,6 +175,16 @@ class Participant:
         dsts.discard(self.meta)
         dsts |= {p.meta for p in self.participants.values()}
         return [self._spdp(d) for d in sorted(dsts)]
+
+    def goodbye(self) -> list[Send]:
+        """SPDP "disposed and unregistered" to every known participant: they forget this one
+        now instead of when its lease runs out (send it before closing the sockets)."""
+        guid = self.guid_prefix + PARTICIPANT_ENTITY.to_bytes(4, "big")
+        qos = b.inline_qos([(b.PID_KEY_HASH, guid), (b.PID_STATUS_INFO, b"\x00\x00\x00\x03")])
+        key = b.param_list([(b.PID_PARTICIPANT_GUID, guid)])
+        msg = (b.header(self.guid_prefix) + b.info_ts(0.0)
+               + b.data(SPDP_READER, SPDP_WRITER, 2, key, qos))
+        return [(p.meta[0], p.meta[1], msg) for p in self.participants.values()]
 
     def tick(self, now: float) -> list[Send]:
         """Periodic work: SPDP announcements, lease expiry, HEARTBEATs of reliable writers."""
