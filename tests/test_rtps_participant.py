@@ -431,3 +431,13 @@ def test_fake_readers_cannot_multiply_a_frame_without_bound() -> None:
     assert len(a.matched(w)) == MAX_MATCHED_PER_ENDPOINT
     assert len(a.write(w, b"\x00\x01\x00\x00" + bytes(100), 1.0)) == MAX_MATCHED_PER_ENDPOINT
     assert sum("already has" in n for n in a.notes) == 1
+
+
+def test_goodbye_makes_the_peer_forget_at_once() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    assert a.guid_prefix in c.participants and c.matched(r)
+    for _, _, d in a.goodbye():
+        c.receive(d, a.meta, net.now)
+    assert a.guid_prefix not in c.participants and c.matched(r) == []

@@ -250,7 +250,9 @@ class Participant:
         return None
 
     def _on_spdp(self, prefix: bytes, sub: Data, source: tuple[str, int], now: float) -> list[Send]:
-        if not sub.payload or sub.key:
+        if not sub.payload or sub.key or self._status(sub.inline_qos, sub.little_endian) & 0x3:
+            if prefix in self.participants:
+                self.note(f"left-{prefix.hex()}", f"participant {prefix.hex()} said goodbye")
             self._forget(prefix)
             return []
         params, little = self._params(sub.payload, "SPDP")
