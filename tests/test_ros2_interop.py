@@ -166,18 +166,18 @@ def test_cli_node_ros2_serves_cyclone_peers(tmp_path) -> None:
     cfg.write_text(CONFIG.format(w=32, h=16))
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(cfg), "--ros2",
-                             "--domain", str(DOMAIN), "--duration", "30", "--best-effort-input"],
+                             "--domain", str(DOMAIN), "--duration", "60", "--best-effort-input"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
         dp = dds.DomainParticipant(DOMAIN)
         # a best-effort camera (sensor-data QoS): only --best-effort-input matches it
         writer = dds.DataWriter(dp, dds.Topic(dp, "rt/cam", dds.Image_), qos=qos(dds, False))
         reader = dds.DataReader(dp, dds.Topic(dp, "rt/cam_out", dds.Image_), qos=qos(dds))
-        assert wait(lambda: writer.get_matched_subscriptions() and reader.get_matched_publications(), 8)
+        assert wait(lambda: writer.get_matched_subscriptions() and reader.get_matched_publications(), 30)
         for k in range(3):
             writer.write(image(dds, picture(k, 16, 32), "rgba8", sec=k))
         got: list = []
-        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= 3, 8)
+        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= 3, 20)
         for k, s in enumerate(got):
             out = np.frombuffer(bytes(s.data), np.uint8).reshape(16, 32, 4)
             assert np.array_equal(out, cv2_dilate(picture(k, 16, 32)))
@@ -379,5 +379,5 @@ def test_cyclone_forgets_the_lab_node_at_once_when_it_stops() -> None:
     assert wait(lambda: writer.get_matched_subscriptions(), 10)
     comp.stop()
     t0 = time.monotonic()
-    assert wait(lambda: not writer.get_matched_subscriptions(), 5)
-    assert time.monotonic() - t0 < 2.0
+    assert wait(lambda: not writer.get_matched_subscriptions(), 6)
+    assert time.monotonic() - t0 < 6.0     # the lease is 10 s: only the goodbye is this quick
