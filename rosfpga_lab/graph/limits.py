@@ -100,3 +100,9 @@ CAPTURE_MAX_STREAM_BYTES = 256 * 1024 * 1024
 
 #: At most this many bytes of one table are read (a busy server lists thousands of sockets).
 OWNER_MAX_TABLE_BYTES = 8 * 2**20
+
+# ---- the ROS 2 node (graph.ros2) ----
+#: Socket buffer sizes a ROS 2 node asks for (a 640x480 frame is ~1.2 MB of fragments).
+ROS2_SOCKET_BUFFER_BYTES = 8 << 20
+#: Longest wait between two ticks of the participant (SPDP, HEARTBEATs, leases).
+ROS2_TICK_SECONDS = 0.01
