@@ -106,3 +106,7 @@ OWNER_MAX_TABLE_BYTES = 8 * 2**20
 ROS2_SOCKET_BUFFER_BYTES = 8 << 20
 #: Longest wait between two ticks of the participant (SPDP, HEARTBEATs, leases).
 ROS2_TICK_SECONDS = 0.01
+#: What a ROS 2 node's recording (``Ros2Node.record``) keeps at most: datagrams and their bytes
+#: (the discovery of a run and a few small samples fit; past either, datagrams are counted only).
+ROS2_RECORD_DATAGRAMS = 600
+ROS2_RECORD_BYTES = 4 << 20

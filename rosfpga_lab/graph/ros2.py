@@ -8,7 +8,9 @@ both sockets: each datagram goes to the participant, what it returns is sent, an
 to the subscriber callbacks on that thread, outside the participant's lock. Samples are raw
 CDR payloads (encapsulation header first): ``rosfpga_lab.msg.serialize_cdr`` makes them.
 Each note the participant logs (matches, QoS mismatches, hostile input) goes once to the
-``rosfpga_lab.graph.ros2`` logger.
+``rosfpga_lab.graph.ros2`` logger. :meth:`Ros2Node.record` keeps what the node sends and
+receives (a bounded :class:`Ros2Recording`: datagrams as ``udp_datagrams`` of a capture gives
+them, and the notes with their times), which ``widgets.events_from_rtps`` draws.
 """
 
 from __future__ import annotations
@@ -19,9 +21,12 @@ import socket
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 from rosfpga_lab.graph.errors import GraphError
-from rosfpga_lab.graph.limits import ROS2_SOCKET_BUFFER_BYTES, ROS2_TICK_SECONDS
+from rosfpga_lab.graph.limits import (
+    ROS2_RECORD_BYTES, ROS2_RECORD_DATAGRAMS, ROS2_SOCKET_BUFFER_BYTES, ROS2_TICK_SECONDS,
+)
 from rosfpga_lab.rtps.build import (
     ROS_DISCOVERY_TOPIC, ROS_DISCOVERY_TYPE, dds_topic, dds_type, participant_entities_info,
 )
@@ -29,6 +34,36 @@ from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX
 from rosfpga_lab.rtps.participant import Participant, Qos, Sample, discovery_port, user_port
 
 log = logging.getLogger(__name__)
+
+
+@dataclass
+class Ros2Recording:
+    """What one node sent and received while recording, bounded.
+
+    Attributes:
+        datagrams: ``(time, "src:port", "dst:port", payload)`` in order, as
+            ``rosfpga_lab.graph.capture_read.udp_datagrams`` gives a capture's (``time.time()``).
+        notes: ``(time, text)`` of each participant note (matches, QoS mismatches) as logged.
+        names: participant names by GUID prefix (this node's and those it discovered).
+        dropped: datagrams not kept (past ``max_datagrams`` or ``max_bytes``), counted only.
+    """
+
+    max_datagrams: int = ROS2_RECORD_DATAGRAMS
+    max_bytes: int = ROS2_RECORD_BYTES
+    datagrams: list[tuple[float, str, str, bytes]] = field(default_factory=list)
+    notes: list[tuple[float, str]] = field(default_factory=list)
+    names: dict[bytes, str] = field(default_factory=dict)
+    dropped: int = 0
+    kept_bytes: int = 0
+
+    def add(self, src: tuple[str, int], dst: tuple[str, int], data: bytes) -> None:
+        if len(self.datagrams) >= self.max_datagrams or \
+                self.kept_bytes + len(data) > self.max_bytes:
+            self.dropped += 1
+            return
+        self.kept_bytes += len(data)
+        self.datagrams.append((time.time(), f"{src[0]}:{src[1]}", f"{dst[0]}:{dst[1]}",
+                               bytes(data)))
 
 
 class Ros2Publisher:
@@ -97,6 +132,7 @@ class Ros2Node:
         #: Datagrams whose handling raised (a bug: logged the first time, counted after).
         self._failures = 0
         self._stop = threading.Event()
+        self._recording: Ros2Recording | None = None
         # the ROS 2 graph learns the node's name and endpoints from ros_discovery_info
         # (RELIABLE TRANSIENT_LOCAL KEEP_LAST 1, as rmw publishes it)
         self._graph_writer = self.participant.add_writer(
@@ -164,12 +200,43 @@ class Ros2Node:
         with self._lock:
             return list(self.participant.notes)
 
+    def record(self, max_datagrams: int = ROS2_RECORD_DATAGRAMS,
+               max_bytes: int = ROS2_RECORD_BYTES) -> Ros2Recording:
+        """Start keeping what this node sends and receives (at most ``max_datagrams``
+        datagrams and ``max_bytes`` bytes; later ones are counted in ``dropped``). Call it
+        before the peers start to get the whole discovery. Returns the recording, which fills
+        while the node runs (read it under :meth:`recorded` for a consistent copy)."""
+        with self._lock:
+            self._recording = Ros2Recording(max(0, max_datagrams), max(0, max_bytes))
+            self._recording.names[self.participant.guid_prefix] = self.name
+            return self._recording
+
+    def recorded(self) -> Ros2Recording:
+        """A copy of the recording so far, with the names of the participants discovered.
+
+        Raises:
+            GraphError: :meth:`record` was not called.
+        """
+        with self._lock:
+            rec = self._recording
+            if rec is None:
+                raise GraphError(f"ROS 2 node {self.name} is not recording: call record() first")
+            for prefix, p in self.participant.participants.items():
+                rec.names.setdefault(prefix, p.name or f"participant {prefix[:4].hex()}..")
+            return Ros2Recording(rec.max_datagrams, rec.max_bytes, list(rec.datagrams),
+                                 list(rec.notes), dict(rec.names), rec.dropped, rec.kept_bytes)
+
     def _write(self, writer_id: int, payload: bytes) -> None:
         with self._lock:
             out = self.participant.write(writer_id, payload, time.monotonic(), time.time())
         self._send(out)
 
     def _send(self, out: list[tuple[str, int, bytes]]) -> None:
+        rec = self._recording
+        if rec is not None and out:
+            with self._lock:
+                for host, port, data in out:
+                    rec.add(self.participant.user, (host, port), data)
         for host, port, data in out:
             try:
                 self._user.sendto(data, (host, port))
@@ -180,6 +247,9 @@ class Ros2Node:
         notes = self.participant.notes
         while self._logged < len(notes):
             log.info("%s", notes[self._logged])
+            if self._recording is not None and \
+                    len(self._recording.notes) < self._recording.max_datagrams:
+                self._recording.notes.append((time.time(), notes[self._logged]))
             self._logged += 1
 
     def _run(self) -> None:
@@ -205,6 +275,8 @@ class Ros2Node:
                     except OSError:
                         return
                     with self._lock:
+                        if self._recording is not None:
+                            self._recording.add(src, s.getsockname(), data)
                         try:
                             out = self.participant.receive(data, src, time.monotonic())
                         except Exception:     # never let one datagram stop the node's thread

@@ -44,7 +44,7 @@ from rosfpga_lab.widgets.live import LiveView, RateMeter, Throttle
 from rosfpga_lab.widgets.progress import Progress, in_notebook, track
 from rosfpga_lab.widgets.waveform import Marker, Signal, WaveformViewer, Waves
 from rosfpga_lab.widgets.wire import (
-    capture_viewer, cdr_spans, cdr_viewer, events_from_rtps, rtps_spans,
+    capture_viewer, cdr_spans, cdr_viewer, events_from_recording, events_from_rtps, rtps_spans,
 )
 from rosfpga_lab.widgets.sequence import (
     SeqEvent,
@@ -69,5 +69,6 @@ __all__ = [
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
     "spans_from_http", "spans_from_tcpros_stream", "track", "view_bytes",
     "Marker", "Signal", "WaveformViewer", "Waves",
-    "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_rtps", "rtps_spans",
+    "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_recording", "events_from_rtps",
+    "rtps_spans",
 ]

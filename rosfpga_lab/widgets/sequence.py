@@ -52,6 +52,7 @@ KIND_STYLE = {
     "tcpros_header": ("#c46200", ""),
     "tcpros_frame": ("#1b8a3a", ""),
     "error": ("#cc0000", ""),
+    "rtps_match": ("#7b3fa0", "2 3"),
 }
 
 

@@ -83,19 +83,21 @@ def _who(prefix: bytes, names: dict[bytes, str]) -> str:
     return names[prefix]
 
 
-def events_from_rtps(datagrams: Any, *, max_events: int = 60) -> list[SeqEvent]:
+def events_from_rtps(datagrams: Any, *, max_events: int = 60,
+                     names: dict[bytes, str] | None = None) -> list[SeqEvent]:
     """Sequence-diagram events of RTPS datagrams.
 
     Args:
         datagrams: a capture file path, or ``(time, src, dst, payload)`` tuples as
             ``rosfpga_lab.graph.capture_read.udp_datagrams`` gives.
         max_events: arrows drawn at most (the rest summarised in one).
+        names: lifeline names by GUID prefix (others are numbered ``participant N``).
     """
     if isinstance(datagrams, (str, Path)):
         from rosfpga_lab.graph.capture_read import udp_datagrams
 
         datagrams = udp_datagrams(datagrams)
-    names: dict[bytes, str] = {}
+    names = dict(names or {})
     out: list[SeqEvent] = []
     seen_frag: set[tuple[bytes, int, int]] = set()
     seen: set[bytes] = set()
@@ -145,5 +147,24 @@ def events_from_rtps(datagrams: Any, *, max_events: int = 60) -> list[SeqEvent]:
     return out
 
 
-__all__ = ["ALIGNMENT_ROLE", "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_rtps",
-           "rtps_spans"]
+def events_from_recording(recording: Any, *, max_events: int = 60) -> list[SeqEvent]:
+    """Sequence-diagram events of a ROS 2 node's recording (``Ros2Node.recorded()``): its
+    RTPS messages (as :func:`events_from_rtps`, lifelines named after the participants) and,
+    as arrows of the node to itself at the time it logged them, its matching decisions
+    ("matched", "not matched" with the reason)."""
+    events = events_from_rtps(recording.datagrams, max_events=max_events, names=recording.names)
+    more = events.pop() if events and events[-1].label.startswith("\u2026") else None
+    me = recording.names.get(next(iter(recording.names), b""), "") if recording.names else ""
+    if me and events:
+        last = events[-1].t or 0.0
+        for t, text in recording.notes:
+            if text.startswith(("matched", "not matched")) and t <= last:
+                topic = next((w for w in text.split() if w.startswith("rt/")), "")
+                events.append(SeqEvent(me, me, f"{text.split(':')[0]} {topic}".strip(), b"", t,
+                                       "rtps_match", detail=text))
+        events.sort(key=lambda e: e.t or 0.0)
+    return events + ([more] if more else [])
+
+
+__all__ = ["ALIGNMENT_ROLE", "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_recording",
+           "events_from_rtps", "rtps_spans"]
