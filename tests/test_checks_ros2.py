@@ -114,3 +114,93 @@ def _ok(answer: int, payload: bytes) -> bool:
         return check_cdr_data_offset(answer, payload).ok
     except ExerciseError:
         return False
+
+
+# ---- notebook 11: the component live on ROS 2 ------------------------------------------------
+
+from rosfpga_lab.checks import check_discovery_port, check_pixel_offsets, check_qos_mismatch  # noqa: E402
+from rosfpga_lab.rtps.participant import Qos  # noqa: E402
+
+
+def test_discovery_port_right_and_each_usual_mistake() -> None:
+    # by hand: 7400 + 250*42 + 10 + 2*3 = 17916 (user data 17917)
+    assert check_discovery_port(17916, 42, 3).ok
+    assert check_discovery_port(7410, 0, 0).ok
+    assert check_discovery_port(7412, 0, 1).ok      # the lab's second participant in domain 0
+    for wrong, why in ((17917, "user-data port"), (17900, "multicast discovery port"),
+                       (17901, "multicast user-data port"), (17913, "participant gain is 2"),
+                       (7416, "domain gain"), (17906, "offset d1 = 10"),
+                       (17918, "one index too many"), (17914, "one index too few"),
+                       (1234, "PB \\+ DG\\*domain")):
+        with pytest.raises(ExerciseError, match=why):
+            check_discovery_port(wrong, 42, 3)
+    for blank in (None, ...):
+        with pytest.raises(ExerciseError, match="still"):
+            check_discovery_port(blank, 42, 3)
+    with pytest.raises(ExerciseError, match="should be int"):
+        check_discovery_port("17916", 42, 3)
+
+
+def _both(frame_id: str) -> tuple[bytes, bytes]:
+    img = new_message(REG, "sensor_msgs/Image", header={"frame_id": frame_id}, height=2, width=2,
+                      encoding="rgba8", step=8, data=bytes(16))
+    message = serialize(REG, "sensor_msgs/Image", img)
+    cdr = serialize_cdr(None, "sensor_msgs/Image", to_ros2_value(REG, "sensor_msgs/Image", img))
+    return len(message).to_bytes(4, "little") + message, cdr
+
+
+def test_pixel_offsets_right_wrong_and_blank() -> None:
+    frame, cdr = _both("camera_link")
+    # by hand, TCPROS: 4 length + 4 seq + 8 stamp + 4+11 "camera_link" -> 31, height, width
+    # -> 39, 4+5 "rgba8" -> 48, is_bigendian -> 49, step -> 53, count -> 57.
+    # CDR: 4 header + 8 stamp + 4+12 "camera_link\0" -> 28, height, width -> 36, 4+6 "rgba8\0"
+    # -> 46, is_bigendian -> 47, pad 1 -> 48, step -> 52, count -> 56.
+    assert frame[53:57] == (16).to_bytes(4, "little") and cdr[52:56] == (16).to_bytes(4, "little")
+    result = check_pixel_offsets((57, 56), frame, cdr)
+    assert result.ok and "byte 57 of the TCPROS frame and at byte 56 of the CDR payload (-1)" \
+        in str(result)
+    assert check_pixel_offsets([57, 56], frame, cdr).ok
+    with pytest.raises(ExerciseError, match="tcpros_offset 53.*message body"):
+        check_pixel_offsets((53, 56), frame, cdr)
+    with pytest.raises(ExerciseError, match="encapsulation header") as info:
+        check_pixel_offsets((57, 52), frame, cdr)
+    assert "tcpros_offset" not in str(info.value)          # only the wrong one is named
+    with pytest.raises(ExerciseError) as info:             # the two swapped: both named
+        check_pixel_offsets((56, 57), frame, cdr)
+    assert "that is the CDR offset" in str(info.value) and "that is the TCPROS offset" \
+        in str(info.value)
+    with pytest.raises(ExerciseError, match="header.seq"):
+        check_pixel_offsets((57, 60), frame, cdr)
+    with pytest.raises(ExerciseError, match="1 item"):
+        check_pixel_offsets((57,), frame, cdr)
+    with pytest.raises(ExerciseError, match="still None"):
+        check_pixel_offsets(None, frame, cdr)
+    # "camera": the same offset on both wires (52), a coincidence the check follows
+    frame, cdr = _both("camera")
+    assert check_pixel_offsets((52, 52), frame, cdr).ok
+
+
+PAIRS = [(Qos(True, 10), Qos(False, 5)),                  # matches: RELIABLE serves BEST_EFFORT
+         (Qos(False, 10), Qos(False, 1)),                 # matches
+         (Qos(True, 1), Qos(True, 1, transient_local=True)),  # DURABILITY: VOLATILE < T_LOCAL
+         (Qos(True, 1, transient_local=True), Qos(True, 100))]  # matches: depth is not compared
+
+
+def test_qos_mismatch_right_wrong_and_blank() -> None:
+    result = check_qos_mismatch((2, "DURABILITY"), PAIRS)
+    assert result.ok and "VOLATILE" in str(result)
+    assert check_qos_mismatch([2, " durability "], PAIRS).ok
+    with pytest.raises(ExerciseError, match="pair 3 matches.*history depth is not compared"):
+        check_qos_mismatch((3, "HISTORY"), PAIRS)
+    with pytest.raises(ExerciseError, match="pair 0 matches"):
+        check_qos_mismatch((0, "RELIABILITY"), PAIRS)
+    with pytest.raises(ExerciseError, match="on DURABILITY, not 'RELIABILITY'"):
+        check_qos_mismatch((2, "RELIABILITY"), PAIRS)
+    with pytest.raises(ExerciseError, match="index 4 is not a pair"):
+        check_qos_mismatch((4, "DURABILITY"), PAIRS)
+    with pytest.raises(ExerciseError, match="still Ellipsis"):
+        check_qos_mismatch(..., PAIRS)
+    with pytest.raises(ExerciseError, match="policy should be str"):
+        check_qos_mismatch((2, 1), PAIRS)
+    # a best-effort writer and a reliable reader: RELIABILITY
+    assert check_qos_mismatch((1, "RELIABILITY"), [PAIRS[0], (Qos(False), Qos(True))]).ok

@@ -38,7 +38,10 @@ from rosfpga_lab.checks.handshake import (
 from rosfpga_lab.checks.message import (
     check_data_offset, check_extract, check_marshal, frame_fields, message_fields,
 )
-from rosfpga_lab.checks.ros2 import check_cdr_data_offset, check_fragment_count
+from rosfpga_lab.checks.ros2 import (
+    check_cdr_data_offset, check_discovery_port, check_fragment_count, check_pixel_offsets,
+    check_qos_mismatch,
+)
 from rosfpga_lab.checks.stream import check_fifo2axi, check_markers, check_tdata
 from rosfpga_lab.checks.tcpros import (
     check_connection_header, check_frame_split, check_md5, header_fields,
@@ -51,4 +54,5 @@ __all__ = [
     "check_http_body", "check_markers", "check_marshal", "check_md5", "check_node_config",
     "check_sloc", "check_talker_contact", "check_tdata", "describe_byte_difference", "field_at",
     "frame_fields", "header_fields", "message_fields",
+    "check_discovery_port", "check_pixel_offsets", "check_qos_mismatch",
 ]
