@@ -45,6 +45,7 @@ class Ros2Recording:
             ``rosfpga_lab.graph.capture_read.udp_datagrams`` gives a capture's (``time.time()``).
         notes: ``(time, text)`` of each participant note (matches, QoS mismatches) as logged.
         names: participant names by GUID prefix (this node's and those it discovered).
+        prefix: this node's GUID prefix (what it sent carries it in the RTPS header).
         dropped: datagrams not kept (past ``max_datagrams`` or ``max_bytes``), counted only.
     """
 
@@ -53,6 +54,7 @@ class Ros2Recording:
     datagrams: list[tuple[float, str, str, bytes]] = field(default_factory=list)
     notes: list[tuple[float, str]] = field(default_factory=list)
     names: dict[bytes, str] = field(default_factory=dict)
+    prefix: bytes = b""
     dropped: int = 0
     kept_bytes: int = 0
 
@@ -208,6 +210,7 @@ class Ros2Node:
         while the node runs (read it under :meth:`recorded` for a consistent copy)."""
         with self._lock:
             self._recording = Ros2Recording(max(0, max_datagrams), max(0, max_bytes))
+            self._recording.prefix = self.participant.guid_prefix
             self._recording.names[self.participant.guid_prefix] = self.name
             return self._recording
 
@@ -224,7 +227,8 @@ class Ros2Node:
             for prefix, p in self.participant.participants.items():
                 rec.names.setdefault(prefix, p.name or f"participant {prefix[:4].hex()}..")
             return Ros2Recording(rec.max_datagrams, rec.max_bytes, list(rec.datagrams),
-                                 list(rec.notes), dict(rec.names), rec.dropped, rec.kept_bytes)
+                                 list(rec.notes), dict(rec.names), rec.prefix, rec.dropped,
+                                 rec.kept_bytes)
 
     def _write(self, writer_id: int, payload: bytes) -> None:
         with self._lock:

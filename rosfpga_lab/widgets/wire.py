@@ -151,12 +151,12 @@ def events_from_recording(recording: Any, *, max_events: int = 60) -> list[SeqEv
     """Sequence-diagram events of a ROS 2 node's recording (``Ros2Node.recorded()``): its
     RTPS messages (as :func:`events_from_rtps`, lifelines named after the participants) and,
     as arrows of the node to itself at the time it logged them, its matching decisions
-    ("matched", "not matched" with the reason). The recording's first name is the node's own;
-    a message it received without INFO_DST is drawn to it (it was sent to its port), one it
-    sent without INFO_DST to ``peers`` (every probed port)."""
+    ("matched", "not matched" with the reason). A message it received without INFO_DST is
+    drawn to it (it was sent to its port), one it sent without INFO_DST to ``peers`` (every
+    probed port)."""
     events = events_from_rtps(recording.datagrams, max_events=max_events, names=recording.names)
     more = events.pop() if events and events[-1].label.startswith("\u2026") else None
-    me = recording.names.get(next(iter(recording.names), b""), "") if recording.names else ""
+    me = recording.names.get(recording.prefix, "")
     for e in events:     # what the node received was sent to it, INFO_DST or not
         if me and e.src != me and e.dst == "peers":
             e.dst = me
