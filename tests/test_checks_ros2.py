@@ -204,3 +204,25 @@ def test_qos_mismatch_right_wrong_and_blank() -> None:
         check_qos_mismatch((2, 1), PAIRS)
     # a best-effort writer and a reliable reader: RELIABILITY
     assert check_qos_mismatch((1, "RELIABILITY"), [PAIRS[0], (Qos(False), Qos(True))]).ok
+
+
+def test_notebook_11_exercises_come_last_and_11_2_tells_the_wires_apart() -> None:
+    from pathlib import Path
+
+    from rosfpga_lab.checks import nbbuild
+
+    path = Path(__file__).resolve().parents[1] / "notebooks" / "solutions" / "11_ros2_live.ipynb"
+    cells = nbbuild.load(path)["cells"]
+    exercise = [i for i, c in enumerate(cells) if nbbuild.is_exercise_cell(c)]
+    heading = next(i for i, c in enumerate(cells) if nbbuild.cell_source(c).startswith("## Exercises"))
+    assert len(exercise) == 3 and min(exercise) > heading
+    assert not any(nbbuild.cell_source(c).startswith("## ") for c in cells[heading + 1:])
+    text = "".join(nbbuild.cell_source(c) for c in cells)
+    frame_id = re.search(r'header=\{"seq": 0, "stamp": \(STAMP, 500\), "frame_id": "([^"]+)"\}',
+                         text[text.index("exercise_msg"):]).group(1)
+    assert frame_id == "left_camera_optical"
+    frame, cdr = _both(frame_id)
+    # by hand, TCPROS: 4 + 4 seq + 8 stamp + 4+19 -> 39, height, width -> 47, 4+5 -> 56,
+    # is_bigendian -> 57, step -> 61, count -> 65. CDR: 4 + 8 + 4+20 -> 36 (aligned), height,
+    # width -> 44, 4+6 -> 54, is_bigendian -> 55, pad 1 -> 56, step -> 60, count -> 64.
+    assert check_pixel_offsets((65, 64), frame, cdr).ok
