@@ -57,13 +57,13 @@ from rosfpga_lab.widgets.sequence import (
     sequence_svg,
 )
 from rosfpga_lab.widgets.code import CodeFiles, code_html
-from rosfpga_lab.widgets.statemachine import StateDiagram, state_diagram_svg
+from rosfpga_lab.widgets.statemachine import StateDiagram, layout_transitions, state_diagram_svg
 
 __all__ = [
     "STATIC_EXPORT_PRIORITY", "show_static",
     "BeatMap", "BeatViewer", "ByteMap", "CodeFiles", "code_html", "ByteViewer", "FrameDiff", "ImageDiffViewer", "LiveView",
     "MarkerMismatch", "Progress", "RateMeter", "SeqEvent", "SequenceDiagram", "Span", "StateDiagram",
-    "SvgPane", "state_diagram_svg",
+    "SvgPane", "layout_transitions", "state_diagram_svg",
     "Throttle", "WidgetError", "as_span", "events_from_capture", "events_from_trace", "in_notebook", "message_spans",
     "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
