@@ -291,7 +291,9 @@ def _clean(out_dir: Path, manifest: dict) -> list[str]:
 
 def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
              progress: Progress | None = None,
-             extra_files: Mapping[str, bytes] | None = None) -> GenerationResult:
+             extra_files: Mapping[str, bytes] | None = None,
+             texts: Mapping[str, str] | None = None,
+             frames: tuple[bytes, bytes] | None = None) -> GenerationResult:
     """Write the HLS C++ project of ``config`` into ``out_dir``.
 
     Args:
@@ -302,6 +304,9 @@ def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
         progress: called with a short message before each long step.
         extra_files: more files to write (``{relative path: bytes}``) under the same manifest:
             a layer above adds its own (``rosfpga_lab.rtl`` adds ``rtl/``, the Verilog).
+        texts: the rendered files, when a caller rendered them (a message type other than
+            Image: :func:`rosfpga_lab.hls.generic.render_generic`); default :func:`render`.
+        frames: ``(tb_input, tb_expected)`` with ``texts``; default :func:`sample_frames`.
 
     Returns:
         What was written, removed and kept.
@@ -325,10 +330,14 @@ def generate(config: NodeConfig, out_dir: str | Path, *, force: bool = False,
             raise GenerateError(f"{out} is not empty and was not written by rosfpga-lab "
                                 f"({len(present)} files); choose an empty or new directory")
     say("rendering templates")
-    texts = render(config)
-    say(f"computing the test frame and the Python models' output "
-        f"({config.image.width}x{config.image.height} {config.image.encoding})")
-    tb_input, tb_expected = sample_frames(config)
+    if texts is None:
+        texts = render(config)
+        say(f"computing the test frame and the Python models' output "
+            f"({config.image.width}x{config.image.height} {config.image.encoding})")
+        tb_input, tb_expected = sample_frames(config)
+    else:
+        assert frames is not None, "generate(texts=...) needs frames=(tb_input, tb_expected)"
+        tb_input, tb_expected = frames
 
     blobs: dict[str, bytes] = {name: text.encode("utf-8") for name, text in texts.items()}
     for header in HLS_HEADERS:

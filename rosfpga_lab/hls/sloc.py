@@ -22,7 +22,11 @@ PAPER_TABLE1 = {"subscriber": (57, 415), "publisher": (70, 445), "total": (127, 
 COUNTED = {"subscriber": ("subscriber.cpp",), "publisher": ("publisher.cpp",)}
 #: Other generated C/C++ files, listed beside the table (not in the paper's count).
 OTHERS = ("connection_headers.cpp", "ros_node.h", "image_filter.cpp", "ros_fpga_node.cpp",
-          "csim_testbench.cpp")
+          "csim_testbench.cpp", "stream_filter.cpp")
+#: A generated project of any other message type (:mod:`rosfpga_lab.hls.generic`): its walk,
+#: ``layout.h``, is the per-message part of the subscriber and publisher, counted with the
+#: subscriber (as ``rfl_layout.vh`` is on the Verilog side).
+GENERIC_COUNTED = {"subscriber": ("subscriber.cpp", "layout.h"), "publisher": ("publisher.cpp",)}
 
 
 def sloc(text: str, char_literals: bool = True) -> int:
@@ -116,7 +120,8 @@ def count_sloc(project_dir: str | Path) -> SlocTable:
         HlsError: the directory lacks subscriber.cpp or publisher.cpp.
     """
     root = Path(project_dir)
-    return count_files(root, COUNTED, OTHERS, sloc, lambda path: HlsError(
+    counted = GENERIC_COUNTED if (root / GENERIC_COUNTED["subscriber"][1]).is_file() else COUNTED
+    return count_files(root, counted, OTHERS, sloc, lambda path: HlsError(
         f"{path} not found: is {root} a directory written by 'rosfpga-lab generate'?"))
 
 

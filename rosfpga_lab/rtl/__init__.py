@@ -13,7 +13,9 @@ Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
 
 :mod:`rosfpga_lab.rtl.vcd` reads waveform dumps into per-clock arrays,
 :mod:`rosfpga_lab.rtl.synth` synthesizes the modules with Yosys and
-:mod:`rosfpga_lab.rtl.sloc` counts their lines for the paper's Table 1.
+:mod:`rosfpga_lab.rtl.sloc` counts their lines for the paper's Table 1. A message type other
+than ``sensor_msgs/Image`` gets the generic circuit of :mod:`rosfpga_lab.rtl.generic` (walkers
+stepping through a generated program, one instruction per field of the message).
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError

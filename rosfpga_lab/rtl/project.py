@@ -14,6 +14,9 @@ from rosfpga_lab import __version__
 from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.hls import GenerationResult, generate
 from rosfpga_lab.hls.generator import Progress
+from rosfpga_lab.hls.generic import render_generic, sample_frames_generic, spec_from_config
+from rosfpga_lab.hw.layout import layout_from_config
+from rosfpga_lab.rtl.generic import generic_rtl_files
 from rosfpga_lab.rtl.params import rtl_params
 from rosfpga_lab.rtl.sim import source_files
 
@@ -34,7 +37,23 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
                      progress: Progress | None = None) -> GenerationResult:
     """The HLS C++ project of ``config`` with its RTL in ``rtl/`` (see the module docstring).
 
+    ``sensor_msgs/Image`` gets the hand-written teaching project (its own templates and the lab's
+    ``rfl_*.v``); every other type the generic one, rendered from its circuit layout
+    (:mod:`rosfpga_lab.hls.generic`, :mod:`rosfpga_lab.rtl.generic`).
+
     Raises:
         GenerateError: as :func:`rosfpga_lab.hls.generate`.
     """
-    return generate(config, out_dir, force=force, progress=progress, extra_files=rtl_files(config))
+    if config.is_image:
+        return generate(config, out_dir, force=force, progress=progress,
+                        extra_files=rtl_files(config))
+    say = progress or (lambda _msg: None)
+    spec = spec_from_config(config)
+    say(f"rendering the walk of {spec.program.type_in}: {len(spec.program.instrs)} instructions")
+    texts = render_generic(spec)
+    rtl = {f"{RTL_DIR}/{k}": v for k, v in generic_rtl_files(spec).items()}
+    say("computing the test frames and the Python models' output")
+    layout = layout_from_config(config)
+    frames = sample_frames_generic(layout, spec.op, spec.ksize)
+    return generate(config, out_dir, force=force, progress=progress, extra_files=rtl,
+                    texts=texts, frames=frames)

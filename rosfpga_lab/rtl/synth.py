@@ -46,6 +46,16 @@ MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_fifo", "FIFOs (rfl_fifo)"),
     ("rfl_top", "top level (glue)"),
 )
+#: The same for a generated project of any other message type (rosfpga_lab.rtl.generic).
+GENERIC_MODULES: tuple[tuple[str, str], ...] = (
+    ("rfl_gsubscriber", "subscriber (generic walker)"),
+    ("rfl_elem_pack", "fifo2axi (elements)"),
+    ("rfl_window1d", "application (rfl_window1d)"),
+    ("rfl_elem_unpack", "axi2fifo (elements)"),
+    ("rfl_gpublisher", "publisher (generic walker)"),
+    ("rfl_gtop", "top level (glue, generic)"),
+    ("rfl_fifo", "FIFOs (rfl_fifo)"),
+)
 #: The module synthesized: rfl_top with the node's parameters.
 TOP = "rfl_node"
 #: Yosys programs tried, in order.
@@ -325,8 +335,10 @@ def _report(stat: str, part: str, family: str, version: str, seconds: float,
                 cells[cell] = cells.get(cell, 0) + k * times
         by_base[base] = (n + times, cells)
     rows = []
-    known = {module for module, _ in MODULES}
-    for module, label in MODULES:
+    generic = "rfl_gtop" in by_base
+    order = GENERIC_MODULES if generic else MODULES
+    known = {module for module, _ in MODULES + GENERIC_MODULES}
+    for module, label in order:
         if module in by_base:
             n, cells = by_base[module]
             rows.append(SynthRow(label, module, n, _columns(cells), cells))

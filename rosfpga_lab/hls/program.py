@@ -1,0 +1,399 @@
+"""The generated circuit's walk over a frame as a small program (the microcode of any layout).
+
+How this works: the generated subscriber and publisher of a message other than
+``sensor_msgs/Image`` are two small walkers (the same in HLS C++ and in Verilog) that step
+through one table, :class:`Program`, rendered into the generated files with a comment per field
+naming it. One instruction per field in wire order:
+
+* ``FIXED`` -- ``size`` bytes (a number, a time, a fixed array of numbers);
+* ``VAR`` -- a uint32 count, then count x ``size`` bytes (a string, a variable array);
+* ``LOOP`` -- an array of messages: ``count`` elements (fixed) or a uint32 count read from the
+  frame (``size`` 0 ... see :attr:`Instr.variable`), then the instructions up to its ``END``
+  once per element;
+* ``END`` -- the end of a loop's body; ``DONE`` -- the end of the message.
+
+What the subscriber does with the bytes (:class:`Sub`): skip them, carry them (into the carry
+memory, in order, lengths included), check them (equal to ``const`` bytes from the constant
+table) or stream them (to the application; a ``VAR`` stream's count must equal ``count``).
+What the publisher writes (:class:`Pub`): the carried bytes, the constant bytes, its own
+message counter (``COUNT``: a uint32 from ``seq_start``), zeros (``ZERO``; an empty string or
+array for ``VAR``) or the application's output (``STREAM``).
+
+The subscriber adds up the publisher's output length as it walks, so the publisher can write
+the frame length first; it starts once the subscriber has read (and accepted) the whole frame.
+A frame refused after its stream went to the application is dropped by the publisher (it reads
+the application's output and writes nothing). :func:`run_program` is the Python executor of the
+same program: the specification the C++ and Verilog walkers are tested against.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from enum import IntEnum
+
+from rosfpga_lab.hls.limits import MAX_LOOP_DEPTH
+
+
+class Op(IntEnum):
+    """Instruction kinds (their codes are the C++ and Verilog ones)."""
+
+    FIXED = 0
+    VAR = 1
+    LOOP = 2
+    END = 3
+    DONE = 4
+
+
+class Sub(IntEnum):
+    """What the subscriber does with a field's bytes."""
+
+    SKIP = 0
+    CARRY = 1
+    CHECK = 2
+    STREAM = 3
+    RANGE = 4
+
+
+class Pub(IntEnum):
+    """What the publisher writes for a field."""
+
+    CARRY = 0
+    CONST = 1
+    COUNT = 2
+    ZERO = 3
+    STREAM = 4
+
+
+@dataclass(frozen=True)
+class Instr:
+    """One instruction (one field of the message, in wire order).
+
+    Attributes:
+        op, sub, pub: see the module docstring.
+        size: FIXED: bytes; VAR: bytes per element; LOOP: 0.
+        count: VAR: most elements accepted (for a stream: the exact count);
+            LOOP: elements of a fixed array, or the most accepted of a variable one.
+        variable: LOOP: the count is read from the frame (a uint32) rather than fixed.
+        status: the status code the subscriber refuses with at this field (0: it cannot fail);
+            for VAR, a bad count.
+        status2: VAR with CHECK: the status of contents unlike the constant.
+        fixed_after: VAR and variable LOOP: when only fixed-size fields follow the counted part,
+            their bytes (then the count must fill the frame exactly), else -1.
+        elem_min: VAR and variable LOOP: fewest bytes of one element (VAR: ``size``).
+        kind: RANGE: how the value is ordered: 0 unsigned, 1 signed, 2 IEEE float (a NaN is out
+            of every range, -0.0 equals +0.0).
+        const: CHECK/CONST: the bytes (VAR: the elements' bytes, count = len // size).
+        name: the field's path in the message, e.g. ``header.frame_id``.
+        type: its ROS type, e.g. ``string`` or ``float32[]``.
+        jump: LOOP: the index of its END; END: the index of its LOOP (filled by :class:`Program`).
+    """
+
+    op: Op
+    sub: Sub = Sub.SKIP
+    pub: Pub = Pub.CARRY
+    size: int = 0
+    count: int = 0
+    variable: bool = False
+    status: int = 0
+    status2: int = 0
+    kind: int = 0
+    fixed_after: int = -1
+    elem_min: int = 0
+    const: bytes = b""
+    name: str = ""
+    type: str = ""
+    jump: int = 0
+
+
+@dataclass(frozen=True)
+class Program:
+    """A message's walk: the instructions, the constant table and the statuses.
+
+    Attributes:
+        instrs: the instructions, the last one ``DONE``.
+        statuses: ``(name, label)`` per status code, code 0 first (accepted), code 1 the frame
+            length's.
+        min_body, max_frame: the frame lengths accepted are min_body..max_frame.
+        seq_start: the publisher's first ``COUNT`` value.
+        stream_bytes: bytes of one element of the streamed array; stream_length its elements.
+        carry_bytes: size of the carry memory (the most carried bytes of one frame).
+        type_in, type_out: the message types.
+    """
+
+    instrs: tuple[Instr, ...]
+    statuses: tuple[tuple[str, str], ...]
+    min_body: int
+    max_frame: int
+    seq_start: int
+    stream_bytes: int
+    stream_length: int
+    carry_bytes: int
+    type_in: str = ""
+    type_out: str = ""
+    const_offsets: tuple[int, ...] = field(default=(), compare=False)
+
+    @staticmethod
+    def build(instrs: list[Instr], **kwargs: object) -> "Program":
+        """Fill each LOOP's and END's ``jump``, the constant offsets, and check nesting.
+
+        Raises:
+            ValueError: unbalanced loops, nesting deeper than :data:`MAX_LOOP_DEPTH`, no DONE last.
+        """
+        stack: list[int] = []
+        fixed = list(instrs)
+        for i, ins in enumerate(fixed):
+            if ins.op == Op.VAR and ins.elem_min == 0:
+                fixed[i] = ins = _replace(ins, elem_min=ins.size)
+            if ins.op == Op.LOOP:
+                stack.append(i)
+                if len(stack) > MAX_LOOP_DEPTH:
+                    raise ValueError(f"arrays of messages nest deeper than {MAX_LOOP_DEPTH} at {ins.name}")
+            elif ins.op == Op.END:
+                if not stack:
+                    raise ValueError(f"END without LOOP at instruction {i}")
+                j = stack.pop()
+                fixed[j] = _replace(fixed[j], jump=i)
+                fixed[i] = _replace(ins, jump=j)
+        if stack or not fixed or fixed[-1].op != Op.DONE:
+            raise ValueError("the program must close every loop and end with DONE")
+        offsets, at = [], 0
+        for ins in fixed:
+            offsets.append(at)
+            at += len(ins.const)
+        return Program(tuple(fixed), const_offsets=tuple(offsets), **kwargs)  # type: ignore[arg-type]
+
+    @property
+    def const_table(self) -> bytes:
+        """Every instruction's constant bytes, one after the other."""
+        return b"".join(ins.const for ins in self.instrs)
+
+
+def _replace(ins: Instr, **changes: object) -> Instr:
+    return replace(ins, **changes)  # type: ignore[arg-type]
+
+
+class Refused(Exception):
+    """The subscriber refused a frame (``status``); ``streamed``: its stream had gone out."""
+
+    def __init__(self, status: int, streamed: bool) -> None:
+        super().__init__(status)
+        self.status = status
+        self.streamed = streamed
+
+
+#: The status of a frame whose length is refused, or which ends inside a field or after the last.
+FRAME_LENGTH_STATUS = 1
+
+
+def order_key(b: bytes, kind: int) -> int:
+    """The unsigned key a value's little-endian bytes order by (``kind`` as :attr:`Instr.kind`):
+    two's complement flips the sign bit, IEEE floats map by totalOrder with -0.0 taken as +0.0."""
+    v = int.from_bytes(b, "little")
+    sign = 1 << (8 * len(b) - 1)
+    if kind == 1:
+        return v ^ sign
+    if kind == 2:
+        if v == sign:
+            v = 0
+        return (~v & (2 * sign - 1)) if v & sign else v | sign
+    return v
+
+
+def is_nan(b: bytes) -> bool:
+    """The bytes of a float32/float64 hold a NaN."""
+    v = int.from_bytes(b, "little")
+    mant = 23 if len(b) == 4 else 52
+    exp = (v >> mant) & ((1 << (8 * len(b) - 1 - mant)) - 1)
+    return exp == (1 << (8 * len(b) - 1 - mant)) - 1 and v & ((1 << mant) - 1) != 0
+
+
+def in_range(b: bytes, bounds: bytes, kind: int) -> bool:
+    """``b`` is within ``bounds`` (low bytes then high bytes), ordered by ``kind``."""
+    n = len(b)
+    if kind == 2 and is_nan(b):
+        return False
+    return order_key(bounds[:n], kind) <= order_key(b, kind) <= order_key(bounds[n:], kind)
+
+
+def _u32(b: bytes) -> int:
+    return int.from_bytes(b, "little")
+
+
+def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
+    """Walk one whole frame as the subscriber does.
+
+    Returns:
+        ``(carried bytes, streamed bytes, output body length)``.
+
+    Raises:
+        Refused: a field failed (status code), with whether the stream had gone out.
+    """
+    flen = _u32(frame[:4])
+    if not prog.min_body <= flen <= prog.max_frame or len(frame) != 4 + flen:
+        raise Refused(1, False)
+    end = 4 + flen
+    pos = 4
+    carry = bytearray()
+    stream = bytearray()
+    out_len = 0
+    loops: list[list[int]] = []  # [elements left, suppressed]
+    pc = 0
+
+    def take(n: int, status: int) -> bytes:
+        nonlocal pos
+        if pos + n > end:  # the frame ends inside (or before) this field
+            raise Refused(status or FRAME_LENGTH_STATUS, bool(stream))
+        b = frame[pos:pos + n]
+        pos += n
+        return b
+
+    def fits(ins: Instr, n: int) -> None:
+        """A count's checks: its maximum (a stream's: exact), then the bytes left."""
+        if n != ins.count if ins.sub == Sub.STREAM else n > ins.count:
+            raise Refused(ins.status, bool(stream))
+        need = n * ins.elem_min
+        if ins.fixed_after >= 0 and need + ins.fixed_after != end - pos:
+            raise Refused(FRAME_LENGTH_STATUS, bool(stream))
+        if need > end - pos:
+            raise Refused(ins.status, bool(stream))
+
+    suppressed = 0
+    while True:
+        ins = prog.instrs[pc]
+        quiet = suppressed > 0
+        if ins.op == Op.DONE:
+            if pos != end:
+                raise Refused(ins.status, bool(stream))
+            return bytes(carry), bytes(stream), out_len
+        if ins.op == Op.FIXED:
+            b = take(ins.size, ins.status)
+            if ins.sub in (Sub.CARRY, Sub.RANGE):
+                carry += b
+            if ins.sub == Sub.CHECK and b != ins.const:
+                raise Refused(ins.status, bool(stream))
+            if ins.sub == Sub.RANGE and not in_range(b, ins.const, ins.kind):
+                raise Refused(ins.status, bool(stream))
+            elif ins.sub == Sub.STREAM:
+                stream += b
+            out_len += 0 if quiet else ins.size
+        elif ins.op == Op.VAR:
+            lb = take(4, ins.status)
+            n = _u32(lb)
+            fits(ins, n)
+            b = take(n * ins.size, ins.status)
+            if ins.sub == Sub.CARRY:
+                carry += lb + b
+            elif ins.sub == Sub.CHECK and b != ins.const:
+                raise Refused(ins.status2, bool(stream))
+            elif ins.sub == Sub.STREAM:
+                stream += b
+            if not quiet:
+                out_len += 4 + {Pub.CARRY: n * ins.size, Pub.CONST: len(ins.const),
+                                Pub.ZERO: 0, Pub.STREAM: n * ins.size, Pub.COUNT: 0}[ins.pub]
+        elif ins.op == Op.LOOP:
+            n = ins.count
+            if ins.variable:
+                lb = take(4, ins.status)
+                n = _u32(lb)
+                fits(ins, n)
+                if ins.sub == Sub.CARRY:
+                    carry += lb
+                out_len += 0 if quiet else 4
+            zero = ins.variable and ins.pub == Pub.ZERO
+            if n == 0:
+                pc = ins.jump + 1
+                continue
+            loops.append([n, int(zero)])
+            suppressed += int(zero)
+        elif ins.op == Op.END:
+            top = loops[-1]
+            top[0] -= 1
+            if top[0] > 0:
+                pc = ins.jump + 1
+                continue
+            suppressed -= top[1]
+            loops.pop()
+        pc += 1
+
+
+def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int) -> bytes:
+    """The frame the publisher writes for an accepted frame (see the module docstring)."""
+    out = bytearray(out_len.to_bytes(4, "little"))
+    ci = 0
+    si = 0
+    loops: list[int] = []
+    pc = 0
+    while True:
+        ins = prog.instrs[pc]
+        if ins.op == Op.DONE:
+            assert len(out) == 4 + out_len, (len(out), out_len)
+            return bytes(out)
+        if ins.op == Op.FIXED:
+            if ins.pub == Pub.CARRY:
+                out += carry[ci:ci + ins.size]
+                ci += ins.size
+            elif ins.pub == Pub.CONST:
+                out += ins.const
+            elif ins.pub == Pub.COUNT:
+                out += (seq & 0xFFFFFFFF).to_bytes(4, "little") + bytes(ins.size - 4)
+            elif ins.pub == Pub.ZERO:
+                out += bytes(ins.size)
+            else:
+                out += stream[si:si + ins.size]
+                si += ins.size
+        elif ins.op == Op.VAR:
+            if ins.pub == Pub.CARRY:
+                n = _u32(carry[ci:ci + 4])
+                out += carry[ci:ci + 4 + n * ins.size]
+                ci += 4 + n * ins.size
+            elif ins.pub == Pub.CONST:
+                out += (len(ins.const) // ins.size).to_bytes(4, "little") + ins.const
+            elif ins.pub == Pub.ZERO:
+                out += bytes(4)
+            else:
+                out += ins.count.to_bytes(4, "little") + stream[si:si + ins.count * ins.size]
+                si += ins.count * ins.size
+        elif ins.op == Op.LOOP:
+            n = ins.count
+            if ins.variable:
+                if ins.pub == Pub.ZERO:
+                    out += bytes(4)
+                    pc = ins.jump + 1
+                    continue
+                n = _u32(carry[ci:ci + 4])
+                ci += 4
+                out += n.to_bytes(4, "little")
+            if n == 0:
+                pc = ins.jump + 1
+                continue
+            loops.append(n)
+        elif ins.op == Op.END:
+            loops[-1] -= 1
+            if loops[-1] > 0:
+                pc = ins.jump + 1
+                continue
+            loops.pop()
+        pc += 1
+
+
+def run_program(prog: Program, frames: list[bytes], apply: Callable[[bytes], bytes]) -> tuple[bytes, list[int]]:
+    """Frames through subscriber, application (``apply``: stream bytes -> bytes) and publisher.
+
+    Returns:
+        ``(output bytes, status code per frame)``.
+    """
+    out = bytearray()
+    statuses = []
+    seq = prog.seq_start
+    for frame in frames:
+        try:
+            carry, stream, out_len = subscribe(prog, frame)
+        except Refused as exc:
+            statuses.append(exc.status)
+            continue
+        statuses.append(0)
+        out += publish(prog, carry, apply(stream), out_len, seq)
+        seq += 1
+    return bytes(out), statuses
+

@@ -1,0 +1,159 @@
+"""Verilog of generated projects for any message type (not ``sensor_msgs/Image``).
+
+How this works: the modules of ``generic/`` are written once and parameterized:
+``rfl_gsubscriber`` and ``rfl_gpublisher`` walk a frame by stepping through a program, one
+instruction per field, that is generated for each configuration into ``rfl_layout.vh`` (from
+:class:`rosfpga_lab.hls.program.Program`, the same program as the HLS C++'s ``layout.h``, with a
+comment per field naming it); ``rfl_elem_pack`` turns the streamed array's bytes into AXI4-Stream
+beats of one element (TUSER first, TLAST last), ``rfl_window1d`` is the 1-D application (sliding
+max/min over KSIZE elements, pass-through) and ``rfl_elem_unpack`` turns beats back into bytes;
+``rfl_gtop`` joins them with the lab's ``rfl_fifo``. ``rfl_node.v`` sets the parameters of one
+configuration; the testbench is the lab's ``rfl_tb.v`` (with an 8-bit status).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import jinja2
+
+from rosfpga_lab.hls.generic import GenericSpec, context, environment
+from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, VERILOG_DIR
+
+GENERIC_VERILOG_DIR = Path(__file__).resolve().parent / "generic"
+#: ``rfl_window1d``'s OP parameter per operation.
+OP_CODES_1D = {"dilate": 0, "erode": 1, "passthrough": 2}
+#: ``rfl_window1d``'s KIND parameter per element kind (how elements are ordered).
+KIND_CODES = {"unsigned": 0, "signed": 1, "float": 2}
+#: The static Verilog of every generic project (``generic/``), in data-path order.
+GENERIC_MODULES = ("rfl_gsubscriber.v", "rfl_elem_pack.v", "rfl_window1d.v", "rfl_elem_unpack.v",
+                   "rfl_gpublisher.v", "rfl_gtop.v")
+#: The generated include holding the walk (one instruction per field).
+LAYOUT_INCLUDE = "rfl_layout.vh"
+TEMPLATES = Path(__file__).resolve().parent / "templates"
+
+
+def generic_params(spec: GenericSpec) -> dict[str, int]:
+    """``rfl_gtop``'s parameters for a generic project."""
+    prog = spec.program
+    carry = max(1, prog.carry_bytes)
+    return {
+        "EBYTES": prog.stream_bytes, "LENGTH": prog.stream_length,
+        "KSIZE": spec.ksize if spec.op in ("dilate", "erode") else 1,
+        "OP": OP_CODES_1D[spec.op], "KIND": KIND_CODES[spec.kind],
+        "CARRY_BYTES": carry, "CW": max(1, (carry - 1).bit_length()),
+        "MIN_BODY": prog.min_body, "MAX_FRAME": prog.max_frame,
+        "RX_DEPTH": spec.input_depth, "TX_DEPTH": spec.output_depth,
+        "AXIS_DEPTH": spec.axis_depth, "OUT_DEPTH": max(spec.axis_depth, prog.stream_length + 2),
+        "SEQ_START": prog.seq_start,
+    }
+
+
+def node_wrapper(spec: GenericSpec, note: str) -> str:
+    """``rfl_node.v``: ``rfl_gtop`` with the configuration's parameters (the testbench's DUT)."""
+    params = generic_params(spec)
+    body = ",\n".join(f"        .{k}({v})" for k, v in params.items())
+    return (f"// rfl_node -- rfl_gtop with the parameters of one node configuration "
+            f"({spec.program.type_in}, stream {spec.stream_name}).\n// {note}\n"
+            "module rfl_node (\n"
+            "    input clk, input rst_n,\n"
+            "    input [7:0] s_tdata, input s_tvalid, output s_tready,\n"
+            "    output [7:0] m_tdata, output m_tvalid, input m_tready,\n"
+            "    output frame_start, output status_valid, output [7:0] status, output busy);\n"
+            f"    rfl_gtop #(\n{body}\n    ) u_top (\n"
+            "        .clk(clk), .rst_n(rst_n),\n"
+            "        .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),\n"
+            "        .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),\n"
+            "        .frame_start(frame_start), .status_valid(status_valid), .status(status),\n"
+            "        .busy(busy));\nendmodule\n")
+
+
+def testbench() -> str:
+    """The lab's file-based testbench ``rfl_tb.v``, with the generic circuit's 8-bit status."""
+    text = (TB_DIR / "rfl_tb.v").read_text(encoding="utf-8")
+    old = "wire [3:0] status;"
+    if old not in text:
+        raise RtlError(f"{TB_DIR / 'rfl_tb.v'} no longer declares '{old}': update "
+                       "rosfpga_lab.rtl.generic.testbench()")
+    return text.replace(old, "wire [7:0] status;")
+
+
+def generic_rtl_files(spec: GenericSpec) -> dict[str, bytes]:
+    """``{file name: bytes}`` of a generic project's ``rtl/`` (empty for ``op: custom``)."""
+    if spec.op == "custom":
+        return {}
+    ctx = context(spec)
+    env = environment()
+    env.loader = jinja2.FileSystemLoader(str(TEMPLATES))
+    files = {LAYOUT_INCLUDE: env.get_template(f"{LAYOUT_INCLUDE}.j2").render(ctx).encode()}
+    for name in GENERIC_MODULES:
+        files[name] = (GENERIC_VERILOG_DIR / name).read_bytes()
+    files["rfl_fifo.v"] = (VERILOG_DIR / "rfl_fifo.v").read_bytes()
+    files[NODE_FILE] = node_wrapper(spec, str(ctx["generated_note"])).encode()
+    files["rfl_tb.v"] = testbench().encode()
+    return files
+
+
+def project_files(spec: GenericSpec) -> dict[str, bytes]:
+    """Every file of a generic project but the test frames: the HLS C++, ``hls_include/`` and
+    ``rtl/`` (what ``rosfpga-lab generate`` writes for a configuration, for a bare layout)."""
+    from rosfpga_lab.hls.generator import HLS_HEADERS, INCLUDE_DIR
+    from rosfpga_lab.hls.generic import render_generic
+
+    files = {name: text.encode() for name, text in render_generic(spec).items()}
+    for header in HLS_HEADERS:
+        files[f"hls_include/{header}"] = (INCLUDE_DIR / header).read_bytes()
+    for name, data in generic_rtl_files(spec).items():
+        files[f"rtl/{name}"] = data
+    return files
+
+
+def simulate_project(project_dir: str | Path, frames: bytes, *, target: str = "rtlsim",
+                     simulator: str | None = None, gap: int = 0, bp: int = 0, seed: int = 1,
+                     out: str = "sim_out") -> tuple[bytes, list[str]]:
+    """Run a generic project's ``make csim`` or ``make rtlsim`` on ``frames`` (the real flow,
+    as a student types it) and read back its output bytes and a status name per frame.
+
+    Args:
+        project_dir: a project written by ``rosfpga-lab generate`` for a type other than Image.
+        frames: TCPROS frames.
+        target: ``csim`` or ``rtlsim``.
+        simulator: rtlsim: ``iverilog`` or ``verilator`` (default: the first installed).
+        gap, bp, seed: rtlsim: random input gaps and output backpressure (per mille), seed.
+        out: the output folder inside the project.
+
+    Raises:
+        RtlError: the build or the simulation failed, or no simulator is installed.
+    """
+    import re
+    import shutil
+    import subprocess
+
+    from rosfpga_lab.rtl.limits import RUN_TIMEOUT
+    from rosfpga_lab.rtl.sim import find_simulator, find_tool
+
+    project = Path(project_dir)
+    if shutil.which("make") is None:
+        raise RtlError("no make on this machine (apt-get install make)")
+    (project / out).mkdir(parents=True, exist_ok=True)
+    (project / out / "input.bin").write_bytes(frames)
+    cmd = ["make", "-s", target, f"INPUT={out}/input.bin", f"OUT={out}", "EXPECTED="]
+    if target == "rtlsim":
+        sim = find_simulator(simulator)
+        cmd += [f"SIM={sim}", f"GAP={gap}", f"BP={bp}", f"SEED={seed}"]
+        if sim == "verilator":
+            cmd.append(f"VERILATOR={find_tool('verilator') or find_tool('verilator-cli')}")
+    try:
+        proc = subprocess.run(cmd, cwd=project, capture_output=True, text=True,
+                              timeout=RUN_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        raise RtlError(f"make {target} ran longer than {RUN_TIMEOUT:g} s") from None
+    if proc.returncode != 0:
+        raise RtlError(f"make {target} in {project} failed:\n{proc.stdout}{proc.stderr}")
+    names = re.findall(r"localparam \[7:0\] (SUB_\w+) = 8'd(\d+)",
+                       (project / "rtl" / LAYOUT_INCLUDE).read_text()) if target == "rtlsim" else []
+    by_code = {"0": "SUB_OK", "1": "SUB_BAD_FRAME_LENGTH", **{c: n for n, c in names}}
+    statuses = [by_code.get(word, word) for word in
+                (project / out / "status.txt").read_text().split()[1::2]]
+    return (project / out / "output.bin").read_bytes(), statuses

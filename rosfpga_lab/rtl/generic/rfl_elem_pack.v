@@ -1,0 +1,65 @@
+// rfl_elem_pack -- the streamed array's bytes (8-bit valid/ready, little-endian, as on the
+// wire) become AXI4-Stream beats of one element each: element byte i in TDATA bits 8i+7..8i,
+// TUSER on the array's first element, TLAST on its last (LENGTH elements per array). One byte
+// is taken per clock, so a beat of EBYTES bytes takes EBYTES clocks.
+module rfl_elem_pack #(
+    parameter EBYTES = 4,                       // bytes per element: 1, 2, 4 or 8
+    parameter LENGTH = 256                      // elements per array (at least 1)
+) (
+    input                       clk,
+    input                       rst_n,
+    input      [7:0]            s_tdata,
+    input                       s_tvalid,
+    output                      s_tready,
+    output reg [8*EBYTES-1:0]   m_axis_tdata,
+    output     [EBYTES-1:0]     m_axis_tkeep,
+    output reg                  m_axis_tuser,
+    output reg                  m_axis_tlast,
+    output reg                  m_axis_tvalid,
+    input                       m_axis_tready
+);
+    localparam EW = 8 * EBYTES;
+    localparam NB = EBYTES - 1;
+    localparam [3:0] LAST_LANE = NB[3:0];
+    localparam LN = LENGTH - 1;
+    localparam [31:0] LAST_N = LN[31:0];
+    reg [EW-1:0] acc;                           // the element's bytes so far
+    reg [3:0]    k;                             // the byte lane the next byte goes to
+    reg [31:0]   n;                             // the element the next beat carries
+
+    wire out_free = !m_axis_tvalid || m_axis_tready;
+    wire last_byte = (k == LAST_LANE);
+    wire take = s_tvalid && s_tready;
+    wire [EW-1:0] byte_in = {{(EW-8){1'b0}}, s_tdata};
+
+    assign s_tready = !last_byte || out_free;
+    assign m_axis_tkeep = {EBYTES{1'b1}};
+
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            acc <= {EW{1'b0}};
+            k <= 4'd0;
+            n <= 32'd0;
+            m_axis_tdata <= {EW{1'b0}};
+            m_axis_tuser <= 1'b0;
+            m_axis_tlast <= 1'b0;
+            m_axis_tvalid <= 1'b0;
+        end else begin
+            if (m_axis_tvalid && m_axis_tready) m_axis_tvalid <= 1'b0;
+            if (take) begin
+                if (last_byte) begin
+                    m_axis_tdata <= acc | (byte_in << (8 * LAST_LANE));
+                    m_axis_tuser <= (n == 32'd0);
+                    m_axis_tlast <= (n == LAST_N);
+                    m_axis_tvalid <= 1'b1;
+                    acc <= {EW{1'b0}};
+                    k <= 4'd0;
+                    n <= (n == LAST_N) ? 32'd0 : n + 32'd1;
+                end else begin
+                    acc <= acc | (byte_in << (8 * k));
+                    k <= k + 4'd1;
+                end
+            end
+        end
+    end
+endmodule

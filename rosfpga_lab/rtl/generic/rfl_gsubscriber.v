@@ -1,0 +1,334 @@
+// rfl_gsubscriber -- the subscriber circuit of any message: reads one TCPROS frame from an 8-bit
+// valid/ready byte stream, one byte per clock, stepping through the program of rfl_layout.vh
+// (one instruction per field, in wire order). Each field's bytes are skipped, carried (written
+// into the carry memory, in order, lengths included, for the publisher), checked (against the
+// program's constants or bounds) or streamed (out on m_*, to the element packer). It adds up
+// the length of the message the publisher will write (out_len). When it has read a whole frame
+// (or refused one after its stream went out) it raises meta_valid until the publisher's
+// meta_release; a new frame waits for that. A refused frame is skipped to its end. Each frame
+// ends in a one-clock status_valid pulse with the status code (0: accepted).
+module rfl_gsubscriber #(
+    parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
+    parameter CW = 6,                           // its address bits
+    parameter MIN_BODY = 0,                     // shortest frame length accepted
+    parameter MAX_FRAME = 67108864              // longest frame length accepted
+) (
+    input              clk,
+    input              rst_n,
+    input      [7:0]   s_tdata,
+    input              s_tvalid,
+    output             s_tready,
+    output     [7:0]   m_tdata,                 // streamed bytes
+    output             m_tvalid,
+    input              m_tready,
+    output reg         meta_valid,
+    input              meta_release,
+    output reg [31:0]  meta_out_len,            // the publisher's frame length
+    output reg         meta_drop,               // refused after its stream: drop the stream
+    input      [CW-1:0] carry_raddr,
+    output     [7:0]   carry_rdata,
+    output             frame_start,
+    output reg         status_valid,
+    output reg [7:0]   status,
+    output             idle                     // between frames
+);
+`include "rfl_layout.vh"
+    localparam [3:0] S_FLEN = 4'd0, S_DECODE = 4'd1, S_COUNT = 4'd2, S_COUNTED = 4'd3,
+                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6;
+
+    reg [3:0]  state;
+    reg [15:0] pc;
+    reg [31:0] pos;                             // bytes of this frame taken so far
+    reg [31:0] endp;                            // 4 + frame length
+    reg [31:0] cnt;                             // bytes of the current part taken so far
+    reg [31:0] n;                               // a count, shifted in little-endian
+    reg [63:0] need;                            // bytes of the current body
+    reg [63:0] value;                           // a SUB_RANGE field, little-endian
+    reg        same;                            // a SUB_CHECK field equals its constant so far
+    reg        streamed;                        // the stream went out
+    reg [31:0] out_len;
+    reg [CW-1:0] waddr;
+    reg [31:0] left [0:LOOPS-1];           // elements left of each open loop
+    reg [LOOPS-1:0] quiet_of;              // that loop is written empty
+    reg [DB-1:0] depth;
+    reg [7:0]  quiet;
+    reg [7:0]  carry_mem [0:CARRY_BYTES-1];
+
+    // The current instruction.
+    wire [IW-1:0] w = prog_word(pc);
+    wire [2:0]  op = w[204:202];
+    wire [2:0]  sub = w[201:199];
+    wire [2:0]  pub = w[198:196];
+    wire        variable = w[195];
+    wire [1:0]  kind = w[194:193];
+    wire [7:0]  st = w[192:185];
+    wire [7:0]  st2 = w[184:177];
+    wire [31:0] size = w[176:145];
+    wire [31:0] count = w[144:113];
+    wire [15:0] kaddr = w[112:97];
+    wire [15:0] klen = w[96:81];
+    wire [15:0] jump = w[80:65];
+    wire        fits = w[64];
+    wire [31:0] fixed_after = w[63:32];
+    wire [31:0] elem_min = w[31:0];
+
+    // A new frame waits until the publisher has taken the previous frame's meta.
+    wire stall = (state == S_FLEN) && (cnt == 0) && meta_valid;
+    wire streaming = (state == S_BODY) && (sub == SUB_STREAM);
+    wire reading = (state == S_FLEN && !stall) || state == S_COUNT || state == S_BODY
+                   || state == S_SKIP;
+    assign s_tready = streaming ? m_tready : reading;
+    assign m_tvalid = streaming && s_tvalid;
+    assign m_tdata = s_tdata;
+    wire take = s_tvalid && s_tready;
+    assign frame_start = take && (state == S_FLEN) && (cnt == 0);
+    assign idle = (state == S_FLEN) && (cnt == 0);
+    assign carry_rdata = carry_mem[carry_raddr];
+
+    wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
+    wire [31:0] pos_next = pos + 32'd1;
+    wire [63:0] room = {32'd0, endp} - {32'd0, pos};  // bytes left in the frame
+    wire [63:0] body = {32'd0, n} * {32'd0, size};
+    wire [63:0] least = {32'd0, n} * {32'd0, elem_min};  // fewest bytes of the counted elements
+    wire        keep = (state == S_COUNT) ? (sub == SUB_CARRY)
+                       : (sub == SUB_CARRY || sub == SUB_RANGE);
+    wire [7:0]  want_byte = konst(kaddr + cnt[15:0]);
+
+    // Bounds of a SUB_RANGE field: low, then high, little-endian, `size` bytes each.
+    function [63:0] bound(input [15:0] at, input [31:0] nbytes);
+        integer b;
+        begin
+            bound = 64'd0;
+            for (b = 0; b < 8; b = b + 1)
+                if (b < nbytes) bound[8*b +: 8] = konst(at + b[15:0]);
+        end
+    endfunction
+
+    // The order key of a value (larger key, larger value); floats: -0.0 counts as +0.0.
+    function [63:0] order_key(input [63:0] v, input [31:0] nbytes, input [1:0] k);
+        reg [63:0] sign, all, x;
+        begin
+            sign = 64'd1 << (8 * nbytes - 1);
+            all = sign | (sign - 64'd1);
+            x = v;
+            if (k == 2'd2 && x == sign) x = 64'd0;
+            if (k == 2'd1) order_key = x ^ sign;
+            else if (k == 2'd2) order_key = x[8*nbytes-1] ? (~x & all) : (x | sign);
+            else order_key = x;
+        end
+    endfunction
+
+    /* verilator lint_off UNUSEDSIGNAL */
+    function is_nan(input [63:0] v, input [31:0] nbytes);
+        begin
+            if (nbytes == 32'd4) is_nan = (v[30:23] == 8'hff) && (v[22:0] != 23'd0);
+            else is_nan = (v[62:52] == 11'h7ff) && (v[51:0] != 52'd0);
+        end
+    endfunction
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    wire [63:0] vkey = order_key(value, size, kind);
+    wire in_range = !(kind == 2'd2 && is_nan(value, size))
+                    && order_key(bound(kaddr, size), size, kind) <= vkey
+                    && vkey <= order_key(bound(kaddr + size[15:0], size), size, kind);
+
+    always @(posedge clk) begin
+        if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
+    end
+
+    // Refuse the frame with status `code`; skip what is left of it (`at_end`: nothing is).
+    task refuse(input [7:0] code, input at_end);
+        begin
+            status_valid <= 1'b1;
+            status <= code;
+            cnt <= 32'd0;
+            if (streamed) begin
+                meta_valid <= 1'b1;
+                meta_drop <= 1'b1;
+            end
+            if (at_end) begin
+                state <= S_FLEN;
+                pos <= 32'd0;
+            end else begin
+                state <= S_SKIP;
+            end
+        end
+    endtask
+
+    // Go on with instruction `next`.
+    task go(input [15:0] next);
+        begin
+            pc <= next;
+            state <= S_DECODE;
+            cnt <= 32'd0;
+        end
+    endtask
+
+    integer d;
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            state <= S_FLEN;
+            pc <= 16'd0;
+            pos <= 32'd0;
+            endp <= 32'd0;
+            cnt <= 32'd0;
+            n <= 32'd0;
+            need <= 64'd0;
+            value <= 64'd0;
+            same <= 1'b0;
+            streamed <= 1'b0;
+            out_len <= 32'd0;
+            waddr <= {CW{1'b0}};
+            depth <= {DB{1'b0}};
+            quiet <= 8'd0;
+            quiet_of <= {LOOPS{1'b0}};
+            for (d = 0; d < LOOPS; d = d + 1) left[d] <= 32'd0;
+            meta_valid <= 1'b0;
+            meta_out_len <= 32'd0;
+            meta_drop <= 1'b0;
+            status_valid <= 1'b0;
+            status <= SUB_OK;
+        end else begin
+            status_valid <= 1'b0;
+            if (meta_release) meta_valid <= 1'b0;
+            if (take) begin
+                pos <= pos_next;
+                cnt <= cnt + 32'd1;
+                if (keep && (state == S_COUNT || state == S_BODY)) waddr <= waddr + 1'b1;
+            end
+            case (state)
+                S_FLEN: if (take) begin
+                    n <= n_next;
+                    if (cnt == 32'd3) begin
+                        if (n_next > MAX_FRAME) begin
+                            // Not to be trusted for skipping: wait for the next frame length.
+                            status_valid <= 1'b1;
+                            status <= SUB_BAD_FRAME_LENGTH;
+                            cnt <= 32'd0;
+                            pos <= 32'd0;
+                        end else if (n_next < MIN_BODY) begin
+                            status_valid <= 1'b1;
+                            status <= SUB_BAD_FRAME_LENGTH;
+                            cnt <= 32'd0;
+                            endp <= n_next + 32'd4;
+                            if (n_next == 32'd0) pos <= 32'd0;
+                            else state <= S_SKIP;
+                        end else begin
+                            endp <= n_next + 32'd4;
+                            streamed <= 1'b0;
+                            out_len <= 32'd0;
+                            waddr <= {CW{1'b0}};
+                            depth <= {DB{1'b0}};
+                            quiet <= 8'd0;
+                            meta_drop <= 1'b0;
+                            go(16'd0);
+                        end
+                    end
+                end
+                S_DECODE: begin
+                    cnt <= 32'd0;
+                    same <= 1'b1;
+                    value <= 64'd0;
+                    case (op)
+                        OP_DONE: begin
+                            if (pos != endp) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
+                            else begin
+                                status_valid <= 1'b1;
+                                status <= SUB_OK;
+                                meta_valid <= 1'b1;
+                                meta_drop <= 1'b0;
+                                meta_out_len <= out_len;
+                                state <= S_FLEN;
+                                pos <= 32'd0;
+                            end
+                        end
+                        OP_END: begin
+                            if (left[depth - 1'b1] != 32'd1) begin
+                                left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
+                                go(jump + 16'd1);
+                            end else begin
+                                depth <= depth - 1'b1;
+                                if (quiet_of[depth - 1'b1]) quiet <= quiet - 8'd1;
+                                go(pc + 16'd1);
+                            end
+                        end
+                        OP_FIXED: begin
+                            if ({32'd0, size} > room) refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, room == 64'd0);
+                            else if (size == 32'd0) go(pc + 16'd1);
+                            else begin
+                                need <= {32'd0, size};
+                                state <= S_BODY;
+                            end
+                        end
+                        default: begin  // OP_VAR, OP_LOOP
+                            if (op == OP_LOOP && !variable) begin
+                                n <= count;
+                                state <= S_COUNTED;
+                            end else if (room < 64'd4) refuse(SUB_BAD_FRAME_LENGTH, room == 64'd0);
+                            else state <= S_COUNT;
+                        end
+                    endcase
+                end
+                S_COUNT: if (take) begin
+                    n <= n_next;
+                    if (cnt == 32'd3) begin
+                        state <= S_COUNTED;
+                        cnt <= 32'd0;
+                    end
+                end
+                S_COUNTED: begin
+                    if ((sub == SUB_STREAM ? n != count : n > count))
+                        refuse(st, room == 64'd0);
+                    else if (fits && least + {32'd0, fixed_after} != room)
+                        refuse(SUB_BAD_FRAME_LENGTH, room == 64'd0);
+                    else if (least > room)
+                        refuse(st, room == 64'd0);
+                    else if (op == OP_LOOP) begin
+                        begin
+                            if (variable && quiet == 8'd0) out_len <= out_len + 32'd4;
+                            if (n == 32'd0) go(jump + 16'd1);
+                            else begin
+                                left[depth] <= n;
+                                quiet_of[depth] <= variable && pub == PUB_ZERO;
+                                if (variable && pub == PUB_ZERO) quiet <= quiet + 8'd1;
+                                depth <= depth + 1'b1;
+                                go(pc + 16'd1);
+                            end
+                        end
+                    end else if (body == 64'd0) begin
+                        state <= S_FINISH;
+                    end else begin
+                        need <= body;
+                        state <= S_BODY;
+                    end
+                end
+                S_BODY: if (take) begin
+                    if (cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
+                    if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
+                    if (sub == SUB_STREAM) streamed <= 1'b1;
+                    if ({32'd0, cnt} + 64'd1 == need) state <= S_FINISH;
+                end
+                S_FINISH: begin
+                    if (sub == SUB_CHECK && (!same || (op == OP_VAR ? body : {32'd0, size}) != {48'd0, klen}))
+                        refuse(op == OP_VAR ? st2 : st, pos == endp);
+                    else if (sub == SUB_RANGE && !in_range) refuse(st, pos == endp);
+                    else begin
+                        if (quiet == 8'd0) begin
+                            if (op == OP_FIXED) out_len <= out_len + size;
+                            else if (pub == PUB_CARRY || pub == PUB_STREAM) out_len <= out_len + 32'd4 + body[31:0];
+                            else if (pub == PUB_CONST) out_len <= out_len + 32'd4 + {16'd0, klen};
+                            else out_len <= out_len + 32'd4;
+                        end
+                        go(pc + 16'd1);
+                    end
+                end
+                S_SKIP: if (take && pos_next == endp) begin
+                    state <= S_FLEN;
+                    cnt <= 32'd0;
+                    pos <= 32'd0;
+                end
+                default: state <= S_FLEN;
+            endcase
+        end
+    end
+endmodule

@@ -1,0 +1,139 @@
+// rfl_gtop -- the whole data path of a generated component for any message type:
+//
+//   s_* (8-bit, from TCP/IP) -> [rx FIFO] -> rfl_gsubscriber -> rfl_elem_pack -> [axis FIFO]
+//     -> rfl_window1d -> [axis FIFO, OUT_DEPTH] -> rfl_elem_unpack -> rfl_gpublisher
+//     -> [tx FIFO] -> m_* (8-bit, to TCP/IP)
+//
+// The publisher starts a frame once the subscriber has read all of it (the frame length comes
+// first and depends on every field), so the FIFO after the application holds a whole stream:
+// OUT_DEPTH >= LENGTH + 2. The carry memory lives in the subscriber; the publisher reads it.
+module rfl_gtop #(
+    parameter EBYTES = 4,                       // bytes per streamed element
+    parameter LENGTH = 16,                      // elements of the streamed array
+    parameter KSIZE = 3,
+    parameter OP = 0,                           // 0 dilate, 1 erode, 2 passthrough
+    parameter KIND = 0,                         // 0 unsigned, 1 signed, 2 float
+    parameter CARRY_BYTES = 64,
+    parameter CW = 6,
+    parameter MIN_BODY = 0,
+    parameter MAX_FRAME = 67108864,
+    parameter RX_DEPTH = 2048,
+    parameter TX_DEPTH = 2048,
+    parameter AXIS_DEPTH = 16,
+    parameter OUT_DEPTH = 18,
+    parameter [31:0] SEQ_START = 1
+) (
+    input        clk,
+    input        rst_n,
+    input  [7:0] s_tdata,
+    input        s_tvalid,
+    output       s_tready,
+    output [7:0] m_tdata,
+    output       m_tvalid,
+    input        m_tready,
+    output       frame_start,                   // the subscriber took a frame's first byte
+    output       status_valid,                  // the subscriber decided on a frame
+    output [7:0] status,
+    output       busy                           // something is in flight
+);
+    localparam EW = 8 * EBYTES;
+    localparam BW = EW + EBYTES + 2;            // a beat in the FIFOs: tlast, tuser, tkeep, tdata
+
+    // rx FIFO -> subscriber
+    wire [7:0] rx_tdata;
+    wire rx_tvalid, rx_tready;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [$clog2(RX_DEPTH + 1)-1:0] rx_level;
+    wire [$clog2(TX_DEPTH + 1)-1:0] tx_level;
+    wire [$clog2(AXIS_DEPTH + 1)-1:0] axis_in_level;
+    wire [$clog2(OUT_DEPTH + 1)-1:0] axis_out_level;
+    wire [EBYTES-1:0] axis_out_tkeep;
+    wire axis_out_tuser, axis_out_tlast;
+    /* verilator lint_on UNUSEDSIGNAL */
+    rfl_fifo #(.WIDTH(8), .DEPTH(RX_DEPTH)) u_rx_fifo (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
+        .m_tdata(rx_tdata), .m_tvalid(rx_tvalid), .m_tready(rx_tready), .level(rx_level));
+
+    // subscriber -> element packer (streamed bytes), subscriber <-> publisher (meta, carry)
+    wire [7:0] pix_in_tdata, carry_rdata;
+    wire pix_in_tvalid, pix_in_tready;
+    wire meta_valid, meta_release, meta_drop, sub_idle, pub_idle;
+    wire [31:0] meta_out_len;
+    wire [CW-1:0] carry_raddr;
+    rfl_gsubscriber #(.CARRY_BYTES(CARRY_BYTES), .CW(CW), .MIN_BODY(MIN_BODY),
+                      .MAX_FRAME(MAX_FRAME)) u_subscriber (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(rx_tdata), .s_tvalid(rx_tvalid), .s_tready(rx_tready),
+        .m_tdata(pix_in_tdata), .m_tvalid(pix_in_tvalid), .m_tready(pix_in_tready),
+        .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
+        .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
+        .frame_start(frame_start), .status_valid(status_valid), .status(status),
+        .idle(sub_idle));
+
+    // element packer -> axis FIFO -> application
+    wire [EW-1:0] axis_in_tdata, app_in_tdata, app_out_tdata, axis_out_tdata;
+    wire [EBYTES-1:0] axis_in_tkeep, app_in_tkeep, app_out_tkeep;
+    wire axis_in_tuser, axis_in_tlast, axis_in_tvalid, axis_in_tready;
+    wire app_in_tuser, app_in_tlast, app_in_tvalid, app_in_tready;
+    wire app_out_tuser, app_out_tlast, app_out_tvalid, app_out_tready;
+    wire axis_out_tvalid, axis_out_tready;
+    rfl_elem_pack #(.EBYTES(EBYTES), .LENGTH(LENGTH)) u_fifo2axi (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(pix_in_tdata), .s_tvalid(pix_in_tvalid), .s_tready(pix_in_tready),
+        .m_axis_tdata(axis_in_tdata), .m_axis_tkeep(axis_in_tkeep), .m_axis_tuser(axis_in_tuser),
+        .m_axis_tlast(axis_in_tlast), .m_axis_tvalid(axis_in_tvalid),
+        .m_axis_tready(axis_in_tready));
+    rfl_fifo #(.WIDTH(BW), .DEPTH(AXIS_DEPTH)) u_axis_in_fifo (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata({axis_in_tlast, axis_in_tuser, axis_in_tkeep, axis_in_tdata}),
+        .s_tvalid(axis_in_tvalid), .s_tready(axis_in_tready),
+        .m_tdata({app_in_tlast, app_in_tuser, app_in_tkeep, app_in_tdata}),
+        .m_tvalid(app_in_tvalid), .m_tready(app_in_tready), .level(axis_in_level));
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [EBYTES-1:0] unused_keep = app_in_tkeep;
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    rfl_window1d #(.EBYTES(EBYTES), .KSIZE(KSIZE), .OP(OP), .KIND(KIND)) u_app (
+        .aclk(clk), .aresetn(rst_n),
+        .s_axis_tdata(app_in_tdata), .s_axis_tuser(app_in_tuser), .s_axis_tlast(app_in_tlast),
+        .s_axis_tvalid(app_in_tvalid), .s_axis_tready(app_in_tready),
+        .m_axis_tdata(app_out_tdata), .m_axis_tkeep(app_out_tkeep), .m_axis_tuser(app_out_tuser),
+        .m_axis_tlast(app_out_tlast), .m_axis_tvalid(app_out_tvalid),
+        .m_axis_tready(app_out_tready));
+
+    // application -> axis FIFO (a whole stream) -> element unpacker -> publisher
+    rfl_fifo #(.WIDTH(BW), .DEPTH(OUT_DEPTH)) u_axis_out_fifo (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata({app_out_tlast, app_out_tuser, app_out_tkeep, app_out_tdata}),
+        .s_tvalid(app_out_tvalid), .s_tready(app_out_tready),
+        .m_tdata({axis_out_tlast, axis_out_tuser, axis_out_tkeep, axis_out_tdata}),
+        .m_tvalid(axis_out_tvalid), .m_tready(axis_out_tready), .level(axis_out_level));
+
+    wire [7:0] pix_out_tdata;
+    wire pix_out_tvalid, pix_out_tready;
+    rfl_elem_unpack #(.EBYTES(EBYTES)) u_axi2fifo (
+        .clk(clk), .rst_n(rst_n),
+        .s_axis_tdata(axis_out_tdata), .s_axis_tvalid(axis_out_tvalid),
+        .s_axis_tready(axis_out_tready),
+        .m_tdata(pix_out_tdata), .m_tvalid(pix_out_tvalid), .m_tready(pix_out_tready));
+
+    wire [7:0] tx_tdata;
+    wire tx_tvalid, tx_tready;
+    rfl_gpublisher #(.CW(CW), .STREAM_DATA_BYTES(LENGTH * EBYTES), .SEQ_START(SEQ_START)) u_publisher (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(pix_out_tdata), .s_tvalid(pix_out_tvalid), .s_tready(pix_out_tready),
+        .m_tdata(tx_tdata), .m_tvalid(tx_tvalid), .m_tready(tx_tready),
+        .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
+        .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
+        .idle(pub_idle));
+
+    rfl_fifo #(.WIDTH(8), .DEPTH(TX_DEPTH)) u_tx_fifo (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(tx_tdata), .s_tvalid(tx_tvalid), .s_tready(tx_tready),
+        .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready), .level(tx_level));
+
+    assign busy = rx_tvalid || meta_valid || pix_in_tvalid || axis_in_tvalid || app_in_tvalid
+                  || app_out_tvalid || axis_out_tvalid || pix_out_tvalid || tx_tvalid
+                  || m_tvalid || !sub_idle || !pub_idle;
+endmodule

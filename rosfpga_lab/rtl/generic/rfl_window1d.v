@@ -1,0 +1,135 @@
+// rfl_window1d -- the 1-D application: every element of the streamed array is replaced by the
+// maximum (OP 0, dilate) or the minimum (OP 1, erode) over the KSIZE elements centred on it,
+// counting only the elements inside the array (OpenCV's border rule for dilate/erode); OP 2
+// passes the elements through. One element per AXI4-Stream beat, TUSER on the array's first,
+// TLAST on its last; one beat per clock when the output is ready.
+//
+// Ordering (KIND): 0 unsigned integers, 1 two's-complement signed integers, 2 IEEE-754 floats
+// (EBYTES 4: float32, 8: float64). The window is folded oldest element first as numpy's
+// maximum/minimum fold it (rosfpga_lab.hw.morph1d): acc = max2(acc, x) is acc if acc is NaN,
+// else x if x is NaN, else (acc > x ? acc : x), compared by value (-0.0 equals +0.0, so of two
+// zeros the later one wins); min2 likewise with <. A window holding a NaN gives its first NaN,
+// bits unchanged.
+//
+// How it works: a shift register of KSIZE entries (element, valid, TUSER, TLAST), the newest
+// in entry 0. An element's result is ready once R = KSIZE/2 later elements are in, so it is
+// computed when the element reaches entry R; after an array's TLAST, R empty entries are
+// shifted in (the input waits meanwhile) to finish its last R elements. Those R empties also
+// keep the next array's window clear of this one.
+module rfl_window1d #(
+    parameter EBYTES = 4,                       // bytes per element: 1, 2, 4 or 8
+    parameter KSIZE = 3,                        // odd, 1..15
+    parameter OP = 0,                           // 0 max (dilate), 1 min (erode), 2 passthrough
+    parameter KIND = 0                          // 0 unsigned, 1 signed, 2 float
+) (
+    input                       aclk,
+    input                       aresetn,
+    input      [8*EBYTES-1:0]   s_axis_tdata,
+    input                       s_axis_tuser,
+    input                       s_axis_tlast,
+    input                       s_axis_tvalid,
+    output                      s_axis_tready,
+    output reg [8*EBYTES-1:0]   m_axis_tdata,
+    output     [EBYTES-1:0]     m_axis_tkeep,
+    output reg                  m_axis_tuser,
+    output reg                  m_axis_tlast,
+    output reg                  m_axis_tvalid,
+    input                       m_axis_tready
+);
+    localparam EW = 8 * EBYTES;
+    localparam K = (OP == 2) ? 1 : KSIZE;       // a pass-through has a window of one
+    localparam R = K / 2;
+    localparam [3:0] RFLUSH = R[3:0];
+    localparam [EW-1:0] SIGN = {1'b1, {(EW-1){1'b0}}};
+
+    reg [K*EW-1:0] wdata;                       // the window, entry 0 newest
+    reg [K-1:0]    wval, wuser, wlast;
+    reg [3:0]      flush;                       // empty entries still to shift in
+
+    wire out_free = !m_axis_tvalid || m_axis_tready;
+    wire step_in = out_free && (flush == 4'd0) && s_axis_tvalid;
+    wire step_empty = out_free && (flush != 4'd0);
+    wire step = step_in || step_empty;
+
+    assign s_axis_tready = out_free && (flush == 4'd0);
+    assign m_axis_tkeep = {EBYTES{1'b1}};
+
+    // The window after this step: the new element (or an empty entry) shifted in.
+    wire [K*EW-1:0] nw_data = (wdata << EW) | {{((K-1)*EW){1'b0}}, step_in ? s_axis_tdata : {EW{1'b0}}};
+    wire [K-1:0]    nw_val = (wval << 1) | {{(K-1){1'b0}}, step_in};
+    wire [K-1:0]    nw_user = (wuser << 1) | {{(K-1){1'b0}}, step_in && s_axis_tuser};
+    wire [K-1:0]    nw_last = (wlast << 1) | {{(K-1){1'b0}}, step_in && s_axis_tlast};
+
+    // The order key of an element by value (larger key, larger value; floats: -0.0 as +0.0).
+    function [EW-1:0] order_key(input [EW-1:0] x);
+        begin
+            if (KIND == 2) order_key = (x == SIGN) ? SIGN : x[EW-1] ? ~x : (x | SIGN);
+            else if (KIND == 1) order_key = x ^ SIGN;
+            else order_key = x;
+        end
+    endfunction
+
+    /* verilator lint_off UNUSEDSIGNAL */
+    function is_nan(input [EW-1:0] x);
+        reg [63:0] v;                           // x widened (the sign bit is not looked at)
+        begin
+            v = 64'd0;
+            v[EW-1:0] = x;
+            if (KIND != 2) is_nan = 1'b0;
+            else if (EBYTES == 4) is_nan = (v[30:23] == 8'hff) && (v[22:0] != 23'd0);
+            else is_nan = (v[62:52] == 11'h7ff) && (v[51:0] != 52'd0);
+        end
+    endfunction
+    /* verilator lint_on UNUSEDSIGNAL */
+
+    // The fold over the valid entries of the new window, oldest (entry K-1) first.
+    reg [EW-1:0] best, cand;
+    reg          have;
+    integer t;
+    always @* begin
+        best = {EW{1'b0}};
+        have = 1'b0;
+        for (t = K - 1; t >= 0; t = t - 1) begin
+            cand = nw_data[t*EW +: EW];
+            if (nw_val[t]) begin
+                if (!have) best = cand;
+                else if (!is_nan(best)) begin
+                    if (is_nan(cand)) best = cand;
+                    else if (OP == 1 ? !(order_key(best) < order_key(cand))
+                                     : !(order_key(best) > order_key(cand))) best = cand;
+                end
+                have = 1'b1;
+            end
+        end
+    end
+
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            wdata <= {(K*EW){1'b0}};
+            wval <= {K{1'b0}};
+            wuser <= {K{1'b0}};
+            wlast <= {K{1'b0}};
+            flush <= 4'd0;
+            m_axis_tdata <= {EW{1'b0}};
+            m_axis_tuser <= 1'b0;
+            m_axis_tlast <= 1'b0;
+            m_axis_tvalid <= 1'b0;
+        end else begin
+            if (m_axis_tvalid && m_axis_tready) m_axis_tvalid <= 1'b0;
+            if (step) begin
+                wdata <= nw_data;
+                wval <= nw_val;
+                wuser <= nw_user;
+                wlast <= nw_last;
+                if (step_in) flush <= s_axis_tlast ? RFLUSH : 4'd0;
+                else flush <= flush - 4'd1;
+                if (nw_val[R]) begin
+                    m_axis_tdata <= best;
+                    m_axis_tuser <= nw_user[R];
+                    m_axis_tlast <= nw_last[R];
+                    m_axis_tvalid <= 1'b1;
+                end
+            end
+        end
+    end
+endmodule
