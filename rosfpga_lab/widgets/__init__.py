@@ -35,6 +35,7 @@ from rosfpga_lab.widgets.byte_sources import (
     spans_from_field_layout,
     spans_from_frame,
     spans_from_http,
+    spans_from_layout,
     spans_from_tcpros_stream,
     view_bytes,
 )
@@ -67,7 +68,7 @@ __all__ = [
     "Throttle", "WidgetError", "as_span", "events_from_capture", "events_from_trace", "in_notebook", "message_spans",
     "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
-    "spans_from_http", "spans_from_tcpros_stream", "track", "view_bytes",
+    "spans_from_http", "spans_from_layout", "spans_from_tcpros_stream", "track", "view_bytes",
     "Marker", "Signal", "WaveformViewer", "Waves",
     "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_rtps", "rtps_spans",
 ]
