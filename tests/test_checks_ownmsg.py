@@ -149,3 +149,22 @@ def test_refused_field_right_wrong_blank(setup) -> None:
     # only the gain wrong: named by the gain's own check
     assert "at gain (byte 31" in str(check_refused_field("gain", frame_of(reg, message(gain=5)),
                                                          layout, reg))
+
+
+def test_the_byte_viewer_names_the_walk_as_the_check_does(setup) -> None:
+    """widgets.spans_from_layout (notebook 10's byte viewer) and the check's spans agree, and
+    each byte's role is what the circuit does with it (set by hand from the configuration)."""
+    from rosfpga_lab.widgets import spans_from_layout
+
+    _config, layout, reg = setup
+    msg = message()
+    spans = spans_from_layout(layout, msg)
+    assert [(s.offset, s.size, s.path) for s in spans] == walk_spans(layout, msg)
+    roles = {s.path: s.role for s in spans}
+    assert roles == {"frame length": "length", "header.seq": "carry", "header.stamp.secs": "carry",
+                     "header.stamp.nsecs": "carry", "header.frame_id length": "length",
+                     "header.frame_id": "carry", "sensor length": "length", "sensor": "carry",
+                     "gain": "check", "window": "carry", "values length": "length",
+                     "values": "stream"}
+    assert spans[0].value == 56 and spans[-1].type == "uint16[8]"
+    assert sum(s.size for s in spans) == len(frame_of(reg, msg))
