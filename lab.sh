@@ -51,6 +51,20 @@ setup() {
     mkdir -p "$settings"
     cp "$here/data/jupyterlab_overrides.json" "$settings/overrides.json"
   fi
+  # The student's lab: no nbgrader panels or Validate button (nbgrader belongs to the course
+  # server, where each assignment carries graded checks; here Validate would pass an unanswered
+  # notebook), and notebooks/solutions/ out of the file browser (still open on purpose:
+  # File > Open from Path..., solutions/01_xmlrpc_handshake.ipynb). Jupyter reads both from the
+  # environment's etc/jupyter.
+  local etc="$venv/etc/jupyter"
+  if ! cmp -s "$here/data/jupyterlab_page_config.json" "$etc/labconfig/page_config.json"; then
+    mkdir -p "$etc/labconfig"
+    cp "$here/data/jupyterlab_page_config.json" "$etc/labconfig/page_config.json"
+  fi
+  if ! cmp -s "$here/data/jupyter_lab_config.json" "$etc/jupyter_lab_config.json"; then
+    mkdir -p "$etc"
+    cp "$here/data/jupyter_lab_config.json" "$etc/jupyter_lab_config.json"
+  fi
 }
 
 # No command, or only options for JupyterLab (./lab.sh --port 8889): open the lab.

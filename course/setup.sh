@@ -52,9 +52,12 @@ mkdir -p "$PREFIX"
 "$PREFIX/venv/bin/python" -m pip install --quiet --no-deps --force-reinstall "$repo"
 
 # Students see nbgrader's Assignments list (fetch, validate, submit); the teacher's panels stay
-# hidden, as the teacher grades from the command line (README).
+# hidden, as the teacher grades from the command line (README). So does the notebook toolbar's
+# Validate button: on the copies in ~/rosfpga-lab, which carry no graded cells, it said "Success"
+# for an unanswered notebook (the Assignments list validates the fetched, graded versions).
 "$PREFIX/venv/bin/jupyter" labextension disable --level=sys_prefix @jupyter/nbgrader:formgrader \
-    @jupyter/nbgrader:create-assignment @jupyter/nbgrader:course-list >/dev/null 2>&1
+    @jupyter/nbgrader:create-assignment @jupyter/nbgrader:course-list \
+    @jupyter/nbgrader:validate-assignment >/dev/null 2>&1
 "$PREFIX/venv/bin/jupyter" server extension disable --sys-prefix \
     nbgrader.server_extensions.formgrader nbgrader.server_extensions.course_list >/dev/null 2>&1
 

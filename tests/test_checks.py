@@ -104,6 +104,21 @@ def test_talker_contact_right_and_wrong():
             talker.shutdown()
 
 
+def test_a_whole_reply_passed_as_uri_is_named():
+    """Exercise 1.2's likeliest mistake: lookupNode's whole reply handed to call() as the URI
+    ended in a raw TypeError from urllib; split_uri now raises its documented ConfigError."""
+    from rosfpga_lab.errors import LabError
+    from rosfpga_lab.graph.xmlrpc import call, split_uri
+
+    reply = [1, "node api", "http://127.0.0.1:9/"]
+    with pytest.raises(LabError, match=r"whole \[code, statusMessage, value\].*reply\[2\]"):
+        call(reply, "requestTopic", "/student", "/chatter", [["TCPROS"]])   # before any socket
+    with pytest.raises(LabError, match="not int 5"):
+        split_uri(5)
+    with pytest.raises(LabError, match="not NoneType"):
+        split_uri(None)
+
+
 HTTP = b"POST / HTTP/1.1\r\nContent-Length: 5\r\n\r\nhello"
 
 
@@ -191,6 +206,35 @@ def test_data_offset():
     assert "inside field header.frame_id" in problems_of(C.check_data_offset, 22, frame)
 
 
+def test_data_offset_names_both_mistakes_that_give_want_minus_4():
+    frame = pack_str(image_body())
+    right = 4 + 12 + 4 + 6 + 8 + 4 + 5 + 1 + 4 + 4
+    msg = problems_of(C.check_data_offset, right - 4, frame)
+    # counted from the message body (no frame length) and stopped at data's length: both give it
+    assert "start of the message body" in msg and "uint32 length of 'data'" in msg
+    assert "both the frame's 4-byte length and the 4-byte length of 'data'" in \
+        problems_of(C.check_data_offset, right - 8, frame)
+    assert "still None" in problems_of(C.check_data_offset, None, frame)
+    assert "still Ellipsis" in problems_of(C.check_data_offset, ..., frame)
+
+
+def test_extract_frame_length_forgotten_is_not_called_a_swap():
+    """Every field read 4 bytes early (the frame's length left out): width then holds the
+    height, which the check used to call a swap of two right variables."""
+    frame = pack_str(image_body("left_camera", width=9, height=5, encoding="bgr8"))
+    u32 = lambda off: struct.unpack_from("<I", frame, off)[0]  # noqa: E731
+    height_at = 4 + 12 + 4 + len("left_camera")
+    early = {"height": u32(height_at - 4), "width": u32(height_at), "encoding": "bgr8", "step": 9}
+    assert early["width"] == 5                                  # the height's value ...
+    msg = problems_of(C.check_extract, early, frame)
+    assert "read 4 bytes too early" in msg and "frame's 4-byte length" in msg
+    assert "that is the height" not in msg                      # ... but no swap
+    swapped = {"height": 9, "width": 5, "encoding": "bgr8", "step": 9}
+    assert "that is the height; in sensor_msgs/Image height comes before width" in \
+        problems_of(C.check_extract, swapped, frame)
+    assert "still None" in problems_of(C.check_extract, None, frame)
+
+
 def test_marshal_right_and_the_brief_example():
     assert C.check_marshal(image_body("cam_one"), image_msg("cam_one")).ok
     bad = bytearray(image_body("cam_one"))
@@ -217,6 +261,16 @@ def test_tdata():
     assert "puts byte 0 (0x11) in the high bits" in problems_of(C.check_tdata, 0x11223344, (0x11, 0x22, 0x33, 0x44))
     assert "bits 15..8 hold 0x00, expected 0x22 (byte 1, G)" in \
         problems_of(C.check_tdata, 0x44330011, (0x11, 0x22, 0x33, 0x44))
+
+
+def test_tdata_wrong_types_get_no_misleading_example():
+    """A str answer got "(an int, e.g. 0x11223344)": the example was the big-endian wrong answer."""
+    pixel = (0x11, 0x22, 0x33, 0x44)
+    msg = problems_of(C.check_tdata, "0x44332211", pixel)
+    assert "should be int, you gave str" in msg and "int(text, 16)" in msg
+    assert "0x11223344" not in msg and "11223344" not in msg.replace("'0x44332211'", "")
+    assert "0x11223344" not in problems_of(C.check_tdata, 1.5, pixel)
+    assert "still None" in problems_of(C.check_tdata, None, pixel)
 
 
 def test_markers():
@@ -293,6 +347,26 @@ def test_dilate():
 
     assert "looks shifted" in problems_of(C.check_dilate, anchored)
     assert "keep uint8" in problems_of(C.check_dilate, lambda im: good_dilate(im).astype(np.int32))
+
+
+def test_dilate_returning_none_says_so():
+    """5.1 returning None said "your output has shape ()"."""
+    def forgot_return(image):
+        out = image.copy()  # noqa: F841 - the mistake: no return
+    msg = problems_of(C.check_dilate, forgot_return)
+    assert "returned None: did you forget 'return out'" in msg and "shape ()" not in msg
+    assert "still None" in problems_of(C.check_dilate, None)
+
+
+def test_frame_timing_frame_time_instead_of_the_filters_is_named_and_rounded():
+    """5.2: the byte-wide stages' 12.28846 ms (the frame's time) in the filter's variable got
+    "frame_ms is 12.288459999999999, expected 3.0832" and no hint."""
+    msg = problems_of(C.check_frame_timing, 308_321, 1_228_846 / 100e6 * 1e3, "byte-wide stages")
+    assert "filter_ms is 12.2885: that is about the byte-wide stages' time" in msg
+    assert "12.288459999" not in msg
+    msg = problems_of(C.check_frame_timing, 308_321, 1 / 3, "byte-wide stages")
+    assert "filter_ms is 0.333333, expected 3.0832" in msg
+    assert "still None" in problems_of(C.check_frame_timing, 308_321, None, "byte-wide stages")
 
 
 def test_frame_timing():
@@ -423,3 +497,22 @@ def test_marshal_native_alignment_is_named_not_big_endian():
     # a real big-endian step is still called big-endian
     swapped = image_body()[:-10] + struct.pack(">I", 2) + pack_str(b"\x01\x02")
     assert "big-endian" in problems_of(C.check_marshal, swapped, msg)
+
+
+def test_notebook_3_exercise_3_1_frame_is_not_the_printed_one():
+    """03 printed ``ImageFields(..., data_offset=52)`` for ``frame`` two cells above Exercise 3.1,
+    so ``fields.data_offset`` passed; the exercise now asks about a frame nothing prints."""
+    from pathlib import Path
+
+    from rosfpga_lab import hw
+    from rosfpga_lab.checks import nbbuild
+
+    path = Path(__file__).resolve().parents[1] / "notebooks" / "solutions" / "03_message_conversion.ipynb"
+    cells = nbbuild.load(path)["cells"]
+    source = next(nbbuild.cell_source(c) for c in cells if "check_data_offset(" in nbbuild.cell_source(c))
+    scope = {"hw": hw, "np": np}
+    exec(source.split(nbbuild.BEGIN)[0], scope)                   # the exercise's set-up lines
+    printed_frame = hw.image_frame(np.zeros((3, 4, 4), np.uint8), "rgba8", frame_id="camera")
+    printed = hw.interpret_fast(printed_frame)[0].data_offset      # what cell 14 prints: 52
+    assert "exercise_frame)" in source and printed == 52
+    assert "not right yet" in problems_of(C.check_data_offset, printed, scope["exercise_frame"])

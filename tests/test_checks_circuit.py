@@ -48,6 +48,29 @@ def test_frame_clocks() -> None:
         check_frame_clocks(129, 257, 1025)
 
 
+@pytest.mark.parametrize("mono_half, rgba_half, says", [
+    (256, 513, ["mono_half is 256, too few", "one short"]),                # the +1 forgotten
+    (200, 513, ["mono_half is 200, too few", "2 x 128 clocks"]),
+    (300, 513, ["mono_half is 300, too many", "next even clock"]),
+    (257, 512, ["rgba_half is 512, too few", "one short"]),
+    (257, 257, ["rgba_half is 257, too few", "4 x 128 clocks"]),          # rgba8 paced as mono8
+    (257, 1025, ["rgba_half is 1025, too many", "costs nothing for rgba8"]),
+])
+def test_frame_clocks_wrong_halves_get_a_direction_and_a_hint(mono_half: int, rgba_half: int,
+                                                              says: list[str]) -> None:
+    """8.2's hardest part got only its value echoed ("mono_half is 256")."""
+    with pytest.raises(ExerciseError) as err:
+        check_frame_clocks(129, mono_half, rgba_half)
+    for text in says:
+        assert text in str(err.value), str(err.value)
+
+
+def test_frame_clocks_blank_answers() -> None:
+    for blank in (None, ...):
+        with pytest.raises(ExerciseError, match="still"):
+            check_frame_clocks(129, blank, 513)
+
+
 def test_ksize_rerun_checks_the_parameters_and_reruns_the_circuit() -> None:
     from rosfpga_lab.rtl import simulator_missing_reason
 

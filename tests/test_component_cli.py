@@ -240,7 +240,8 @@ def test_node_command_runs_reports_and_stops_on_sigint(tmp_path) -> None:
             kill_if_running(proc)
         state = master.getSystemState("/t")[2]
     assert proc.returncode == 0, err
-    assert "/image_raw -> dilate (fast model) -> /image_dilated" in out
+    assert "/image_raw -> dilate (fast model, host timing) -> /image_dilated" in out
+    assert "data path: fast model; timing: host" in out
     assert "frames: received 15, processed 15, published 15, refused 0, dropped 0" in out
     assert "cycles per stage (last frame): interpreter 1,228,8" in out
     assert "FIFO high water: rx 1" in out

@@ -67,5 +67,5 @@ def test_node_command_reads_the_parameter_server_and_puts_command_line_params_th
         assert main(["node", str(CONFIG), "--master-uri", master.uri, "--duration", "0.3",
                      "-q"]) == 1
     out, err = capsys.readouterr()
-    assert "/image_raw -> dilate (reference model) -> /image_dilated" in out
+    assert "/image_raw -> dilate (reference model, host timing) -> /image_dilated" in out
     assert "parameter /fpga_dilate/ksize is 7 in the parameter server" in err

@@ -17,6 +17,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -181,3 +182,95 @@ def test_autograde_scores_solution_untouched_and_half_done(nbgrader_cmd: list[st
     run(nbgrader_cmd + ["generate_feedback", GRADED, "--student=half", "--force"], course)
     page = (course / "feedback" / "half" / GRADED / f"{GRADED}.html").read_text(encoding="utf-8")
     assert "not right yet" in page and "Score: 1.0 / 3.0" in page     # what the student gets back
+
+
+# The orders the help and the README show: options first (the usage line), options between the
+# course and the notebooks (README), options last.
+CLI_ORDERS = [
+    ["--source", "{src}", "{course}", "02_tcpros", "04_fifo_to_axi_stream"],
+    ["{course}", "--source", "{src}", "02_tcpros", "04_fifo_to_axi_stream"],
+    ["{course}", "02_tcpros", "--source", "{src}", "04_fifo_to_axi_stream"],
+    ["{course}", "02_tcpros", "04_fifo_to_axi_stream", "--source", "{src}"],
+]
+
+
+@pytest.mark.parametrize("order", CLI_ORDERS, ids=["options-first", "readme", "between", "last"])
+def test_nbgrader_command_takes_options_between_positionals(order: list[str], tmp_path: Path) -> None:
+    from rosfpga_lab.cli import main
+
+    course = tmp_path / "course"
+    argv = [a.format(src=SOLUTIONS, course=course) for a in order]
+    assert main(["notebooks", "nbgrader", *argv]) == 0
+    written = sorted(p.relative_to(course).as_posix() for p in course.glob("source/*/*.ipynb"))
+    assert written == ["source/02_tcpros/02_tcpros.ipynb",
+                       "source/04_fifo_to_axi_stream/04_fifo_to_axi_stream.ipynb"]
+
+
+def _readme_grading_block() -> str:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("**Grading with nbgrader.**", 1)[1]
+    return section.split("```bash\n", 1)[1].split("```", 1)[0]
+
+
+def test_readme_grading_commands_run_as_written_in_a_new_shell(nbgrader_cmd: list[str],
+                                                               tmp_path: Path) -> None:
+    """The README's commands, one script in a fresh /bin/sh whose PATH has no environment on it
+    (a teacher's new shell, script or cron job): only the install places are swapped for this
+    machine's. Before the fix nbgrader failed there: it runs ``alembic`` by name."""
+    block = _readme_grading_block()
+    assert "/opt/rosfpga-lab/venv/bin/nbgrader generate_assignment" in block
+    script = (block.replace("/opt/rosfpga-lab/venv/bin", str(BIN))
+              .replace("/path/to/checkout", str(ROOT)))
+    etc = tmp_path / "etc"       # what course/setup.sh writes to /etc/jupyter/nbgrader_config.py
+    etc.mkdir()
+    exchange = tmp_path / "exchange"
+    exchange.mkdir()
+    (etc / "nbgrader_config.py").write_text(
+        f'c = get_config()\nc.CourseDirectory.course_id = "test-course"\n'
+        f'c.Exchange.root = "{exchange}"\n', encoding="utf-8")
+    env = {"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), "JUPYTER_CONFIG_PATH": str(etc),
+           "TMPDIR": os.environ.get("TMPDIR", "/tmp"), "LANG": "C.UTF-8"}
+    if os.environ.get("PYTHONPATH"):      # a worktree run: the lab under test, not the installed one
+        env["PYTHONPATH"] = os.environ["PYTHONPATH"]
+    assert shutil.which("alembic", path=env["PATH"]) is None
+    teacher, collect = script.split(f"{BIN}/nbgrader collect", 1)
+    student = tmp_path / "student"      # between release and collect, a student hands one in
+    student.mkdir()
+    student_script = (f"cd {student}\n{BIN}/nbgrader fetch_assignment 02_tcpros\n"
+                      f"{BIN}/nbgrader submit 02_tcpros\n")
+    for part in (teacher, student_script, f"cd ~/course\n{BIN}/nbgrader collect{collect}"):
+        proc = subprocess.run(["/bin/sh", "-e", "-c", part], cwd=tmp_path, env=env,
+                              capture_output=True, text=True, timeout=240)
+        assert proc.returncode == 0, f"{part}\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+    course = tmp_path / "course"
+    assert (course / "release" / "02_tcpros" / "02_tcpros.ipynb").is_file()
+    assert (exchange / "test-course" / "outbound" / "02_tcpros" / "02_tcpros.ipynb").is_file()
+    with open(course / "grades.csv", newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert [(r["assignment"], float(r["score"]), float(r["max_score"])) for r in rows] == [
+        ("02_tcpros", 0.0, 3.0)]                            # the untouched copy, graded
+
+
+def test_environment_tools_on_path_adds_only_what_is_missing(monkeypatch: pytest.MonkeyPatch) -> None:
+    if shutil.which("alembic", path=str(BIN)) is None:
+        skip_or_fail("alembic not installed (pip install -e '.[course]')", "ROSFPGA_REQUIRE_COURSE")
+    monkeypatch.setenv("PATH", "/usr/bin:/bin")
+    assert grading.environment_tools_on_path() == str(BIN)
+    assert os.environ["PATH"] == f"{BIN}{os.pathsep}/usr/bin:/bin"
+    assert grading.environment_tools_on_path() is None          # found now: PATH stays
+    assert os.environ["PATH"] == f"{BIN}{os.pathsep}/usr/bin:/bin"
+
+
+def test_validate_fails_on_an_unanswered_assignment(nbgrader_cmd: list[str], tmp_path: Path) -> None:
+    """nbgrader's Validate said "Success" for an unanswered student notebook (it carries no
+    graded cells; the student lab hides the button, tests/test_lab_student_view.py). The version
+    students fetch on the course server has the checks as graded cells: there it fails."""
+    course = tmp_path / "course"
+    grading.write_course_source(SOLUTIONS, course, [GRADED])
+    run(nbgrader_cmd + ["generate_assignment", GRADED, "--force"], course)
+    released = course / "release" / GRADED / f"{GRADED}.ipynb"
+    env = dict(os.environ, PATH=f"{BIN}{os.pathsep}{os.environ.get('PATH', '')}")
+    proc = subprocess.run(nbgrader_cmd + ["validate", str(released)], cwd=course, env=env,
+                          capture_output=True, text=True, timeout=240)
+    out = proc.stdout + proc.stderr
+    assert "Success" not in out and "VALIDATION FAILED" in out, out[-2000:]

@@ -32,7 +32,13 @@ def test_table_1_ratio_is_computed_not_written() -> None:
     assert "order of magnitude" not in text            # 860 / 163 is 5.3x, the paper's own 6.8x
     assert not re.search(r"\d(\.\d)?\s*x\b|\d+ times", text), "a ratio written into the text"
     code = "\n".join("".join(c["source"]) for c in cells("06_design_flow.ipynb") if c["cell_type"] == "code")
-    assert "paper_verilog / table.total" in code and "hls.PAPER_TABLE1" in code
+    assert "hls.PAPER_TABLE1" in code
+    # like for like (06 printed the paper's Verilog over the lab's C++, 08 the lab's over the lab's)
+    assert "paper_verilog / table.total" not in code
+    assert "verilog.total / table.total" in code and "paper_verilog / paper_hls" in code
+    rtl_code = "\n".join("".join(c["source"]) for c in cells("08_rtl.ipynb") if c["cell_type"] == "code")
+    assert "verilog.total / hls.count_sloc(project).total" in rtl_code
+    assert "paper_verilog / paper_cpp" in rtl_code
 
 
 def test_workshop_notebook_names_the_packages_the_readme_installs() -> None:
@@ -78,3 +84,52 @@ def test_clicking_is_only_mentioned_where_something_is_clickable(path: Path) -> 
 
     text = drop_live_only(markdown(path.name))
     assert not re.search(r"\b(click|hover)", text, re.I), re.search(r".{0,60}\b(click|hover).{0,60}", text, re.I)[0]
+
+
+def _numbers(phrase: str) -> set[int]:
+    """``"1 to 6, 8 and 9"`` -> {1, ..., 6, 8, 9}."""
+    out: set[int] = set()
+    for part in re.split(r",\s*|\s+and\s+", phrase.strip()):
+        lo, _, hi = part.partition(" to ")
+        out |= set(range(int(lo), int(hi or lo) + 1))
+    return out
+
+
+def test_one_place_says_which_notebooks_have_exercises() -> None:
+    """It was told three ways (00: "1 to 6", README: "1 to 6, 8 and 9", notebooks/README:
+    "1 to 6"). notebooks/README.md says it, from the notebooks' own exercise cells; the others
+    point there."""
+    with_exercises = {int(p.name[:2]) for p in NOTEBOOKS
+                      if any(nbbuild.is_exercise_cell(c) for c in nbbuild.load(p)["cells"])}
+    owner = (ROOT / "notebooks" / "README.md").read_text(encoding="utf-8")
+    said = re.findall(r"Notebooks ([\d ,toand]+?) end with exercises", owner)
+    assert len(said) == 1 and _numbers(said[0]) == with_exercises, (said, with_exercises)
+    for text in ((ROOT / "README.md").read_text(encoding="utf-8"), markdown("00_overview.ipynb")):
+        assert not re.search(r"Notebooks [\d ,toand]+ end with exercises", text)
+        assert "end with them" in text
+
+
+def test_stats_report_says_which_time_is_which() -> None:
+    """00 printed "circuit model alone: median 1.1 ms" (the Python model's wall time) and
+    "modelled circuit time 12.31 ms" (the circuit at 100 MHz) beside an end-to-end latency of
+    2.7 ms, with nothing saying which time is which."""
+    from rosfpga_lab.component.stats import ComponentStats, LatencySummary
+
+    stats = ComponentStats(latency=LatencySummary(3, 2.7e-3, 2.7e-3, 2.9e-3),
+                           process_time=LatencySummary(3, 1.1e-3, 1.1e-3, 1.2e-3),
+                           circuit_time_s=12.31e-3, cycles={"interpreter": 1_228_846})
+    report = stats.report()
+    assert "wall time" in report and "Python circuit model's own run" in report
+    assert "real circuit would need 12.31 ms per frame" in report and "not measured" in report
+    prose = " ".join(markdown("00_overview.ipynb").split())
+    assert "wall time" in prose and "not measured" in prose
+
+
+def test_workshop_notebook_says_when_the_stop_button_is_there_and_explains_resets() -> None:
+    """07 promised a Stop button that Run All never shows (the last cell closes the view), and
+    left real rospy's 'Connection reset by peer' line unexplained."""
+    text = " ".join(markdown("07_workshop_demo.ipynb").split())
+    assert "after *Run All* the cameras have already stopped" in text
+    assert "*Connection reset by peer*" in text and "not a damaged frame" in text
+    code = "\n".join("".join(c["source"]) for c in cells("07_workshop_demo.ipynb") if c["cell_type"] == "code")
+    assert "live.close()" in code        # what the prose says the last cell does

@@ -152,7 +152,7 @@ def test_rosrun_runs_the_component_with_ros_arguments(tmp_path) -> None:
              "__name:=by_rosrun", "/image_raw:=/cam/image"],
             env=package_env(master.uri, tmp_path), capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.startswith("/by_rosrun: /cam/image -> dilate (fast model) -> "
+    assert proc.stdout.startswith("/by_rosrun: /cam/image -> dilate (fast model, host timing) -> "
                                   "/image_dilated;"), proc.stdout
 
 

@@ -375,3 +375,30 @@ def test_image_pixel_bytes_are_named_by_pixel_and_channel() -> None:
     # rgb8, 2 pixels (6 bytes) in a row of step 8: bytes 6 and 7 pad the row
     assert pixel_label(6, 2, 8, "rgb8") == "data[6] = row 0 padding"
     assert pixel_label(11, 2, 8, "bgr8") == "data[11] = pixel (x 1, y 1) B"
+
+
+def test_no_field_colour_looks_like_cdr_padding() -> None:
+    """09's CDR viewer gave frame_id, height, encoding and step pinks and a salmon beside the
+    red padding bytes; every field colour's hue now stays 60 degrees away from that red."""
+    import colorsys
+
+    def hue(colour: str) -> float:
+        r, g, b = (int(colour[i:i + 2], 16) / 255 for i in (1, 3, 5))
+        return colorsys.rgb_to_hls(r, g, b)[0] * 360
+
+    red = hue(ROLE_COLOURS["alignment"])
+    for colour in PALETTE:
+        gap = abs(hue(colour) - red) % 360
+        assert min(gap, 360 - gap) >= 60, colour
+    assert len(set(PALETTE)) == len(PALETTE)
+
+
+def test_field_list_breaks_between_words_only() -> None:
+    """The live viewer's field list wrapped names mid-word ('overflow-wrap: anywhere')."""
+    from pathlib import Path
+
+    import rosfpga_lab.widgets as widgets
+
+    css = (Path(widgets.__file__).parent / "static" / "byteviewer.css").read_text()
+    rule = next(line for line in css.splitlines() if line.startswith(".rfl-bv-list td"))
+    assert "overflow-wrap: break-word" in rule and "anywhere" not in rule

@@ -160,3 +160,15 @@ def test_trace_parties_are_named_retries_folded_and_the_diagram_fits() -> None:
     labels = re.findall(r'stroke-linejoin="round">([^<]*)</text>', svg)
     assert len(labels) == 7 and all(t.endswith("\u2026") and len(t) < 40 for t in labels), labels  # cut
     assert "a rather long label for one arrow a rather long label for one arrow" in svg  # whole in the tooltip
+
+
+def test_cut_labels_keep_their_number_and_byte_count() -> None:
+    """01 and 09 showed "10. TCPROS header /chatter [12…": the byte count was cut away."""
+    events = [SeqEvent(f"/node_{i}", f"/node_{i + 1}", "TCPROS header /chatter callerid=/listener",
+                       bytes(123), kind="tcpros_header") for i in range(7)]
+    svg = sequence_svg(events)
+    labels = re.findall(r'stroke-linejoin="round">([^<]*)</text>', svg)
+    assert len(labels) == 7
+    for k, label in enumerate(labels):
+        assert label.startswith(f"{k + 1}. TCPROS") and label.endswith(" [123 B]"), label
+        assert "\u2026" in label                                   # the middle was cut

@@ -191,3 +191,19 @@ def test_a_chosen_set_of_signals_draws_only_its_streams_markers_and_the_static_f
     viewer.set_cursor(5)
     static = viewer.to_html()
     assert "m_axis_tvalid" in static and "s_axis_tdata" not in static and 'stroke="#d00"' in static
+
+
+def test_cursor_panel_lists_the_drawn_signals_first_and_folds_the_rest() -> None:
+    """Notebook 8's cursor panel dumped all 63 signals; the drawn ones come first now."""
+    arrays = _stream(6, 3, width=3)
+    arrays.update({k.replace("s_axis", "m_axis"): v for k, v in _stream(6, 3, width=2).items() if k != "aclk"})
+    viewer = WaveformViewer(Waves.from_arrays(arrays), names=["m_axis_tvalid", "aclk"], span=20)
+    viewer.set_cursor(5)
+    panel = viewer.values.value
+    visible, folded = panel.split('<details class="rfl-wave-others">')
+    assert visible.index('data-signal="m_axis_tvalid"') < visible.index('data-signal="aclk"')
+    assert "s_axis_tdata" not in visible and 'data-signal="s_axis_tdata"' in folded
+    assert f"the other {len(arrays) - 2} signals" in folded
+    everything = WaveformViewer(Waves.from_arrays(_stream(6, 3, width=3)), span=20)
+    everything.set_cursor(5)
+    assert "<details" not in everything.values.value      # all drawn: nothing folded

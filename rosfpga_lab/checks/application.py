@@ -41,6 +41,9 @@ def check_dilate(fn: Callable[[np.ndarray], Any]) -> CheckResult:
             got = fn(image.copy())
         except Exception as exc:  # the reader's code
             raise fail(ex, f"on {case} your function raised {type(exc).__name__}: {exc}") from None
+        if got is None:
+            raise fail(ex, f"on {case} your function returned None: did you forget "
+                           "'return out' at its end?")
         got = np.asarray(got)
         if got.shape != want.shape and got.size == want.size:
             got = got.reshape(want.shape)
@@ -74,7 +77,7 @@ def check_dilate(fn: Callable[[np.ndarray], Any]) -> CheckResult:
                             f"{len(DILATE_CASES)} random images, borders included"])
 
 
-def check_frame_timing(filter_cycles: Any, frame_ms: Any, bottleneck: Any, *, width: int = 640,
+def check_frame_timing(filter_cycles: Any, filter_ms: Any, bottleneck: Any, *, width: int = 640,
                        height: int = 480, bytes_per_pixel: int = 4,
                        clock_hz: float = 100e6) -> CheckResult:
     """Exercise 5.2: cycles of the 3x3 filter, its time per frame, and the slowest stage.
@@ -82,7 +85,8 @@ def check_frame_timing(filter_cycles: Any, frame_ms: Any, bottleneck: Any, *, wi
     Args:
         filter_cycles: cycles the filter needs for one frame (one pixel per clock, plus the
             flush: one more row and one more column for a 3x3 window).
-        frame_ms: ``filter_cycles`` at ``clock_hz``, in milliseconds.
+        filter_ms: ``filter_cycles`` at ``clock_hz``, in milliseconds (the filter's time per
+            frame, not the frame's: that is the byte-wide stages').
         bottleneck: ``"filter"`` or ``"byte-wide stages"`` (the 8-bit FIFO side).
 
     Raises:
@@ -90,10 +94,11 @@ def check_frame_timing(filter_cycles: Any, frame_ms: Any, bottleneck: Any, *, wi
     """
     ex = "5.2 (cycles and time per frame)"
     require_type(ex, "filter_cycles", filter_cycles, int)
-    require_type(ex, "frame_ms", frame_ms, (int, float))
+    require_type(ex, "filter_ms", filter_ms, (int, float))
     require_type(ex, "bottleneck", bottleneck, str)
     want_cycles = (height + 1) * (width + 1)
     want_ms = want_cycles / clock_hz * 1e3
+    byte_ms = width * height * bytes_per_pixel / clock_hz * 1e3
     problems = []
     if filter_cycles != want_cycles:
         if filter_cycles == width * height:
@@ -104,16 +109,20 @@ def check_frame_timing(filter_cycles: Any, frame_ms: Any, bottleneck: Any, *, wi
                             "pixel (all 4 bytes on the 32-bit bus) per clock")
         else:
             problems.append(f"filter_cycles is {filter_cycles}, expected (rows + 1) x (cols + 1)")
-    if abs(float(frame_ms) - want_ms) > 1e-3 * want_ms:
-        if abs(float(frame_ms) - want_ms * 1e3) < 1e-3 * want_ms * 1e3:
-            problems.append("frame_ms is in microseconds: divide by 1000")
-        elif abs(float(frame_ms) * 1e3 - want_ms) < 1e-3 * want_ms:
-            problems.append("frame_ms is in seconds: multiply by 1000")
-        elif abs(float(frame_ms) - filter_cycles / clock_hz * 1e3) < 1e-6 and filter_cycles != want_cycles:
+    if abs(float(filter_ms) - want_ms) > 1e-3 * want_ms:
+        if abs(float(filter_ms) - want_ms * 1e3) < 1e-3 * want_ms * 1e3:
+            problems.append("filter_ms is in microseconds: divide by 1000")
+        elif abs(float(filter_ms) * 1e3 - want_ms) < 1e-3 * want_ms:
+            problems.append("filter_ms is in seconds: multiply by 1000")
+        elif abs(float(filter_ms) - filter_cycles / clock_hz * 1e3) < 1e-6 and filter_cycles != want_cycles:
             pass  # follows from the wrong cycle count, already reported
+        elif abs(float(filter_ms) - byte_ms) < 0.01 * byte_ms:
+            problems.append(f"filter_ms is {float(filter_ms):.6g}: that is about the byte-wide "
+                            f"stages' time, the frame's ({byte_ms:.3f} ms); filter_ms asks for the "
+                            "filter's alone: filter_cycles / clock, in ms")
         else:
-            problems.append(f"frame_ms is {frame_ms}, expected {want_ms:.4f} (cycles / {clock_hz:g} Hz, "
-                            "times 1000)")
+            problems.append(f"filter_ms is {float(filter_ms):.6g}, expected {want_ms:.4f} (cycles / "
+                            f"{clock_hz / 1e6:g} MHz, in ms)")
     norm = bottleneck.strip().lower().replace("_", " ").replace("-", " ")
     if "byte" not in norm and "fifo" not in norm and "interpreter" not in norm:
         problems.append(f"bottleneck {bottleneck!r}: the byte-wide stages move one byte per clock, "

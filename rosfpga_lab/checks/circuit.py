@@ -108,19 +108,43 @@ def check_frame_clocks(mono_free: Any, mono_half: Any, rgba_half: Any) -> CheckR
             problems.append(f"mono_free is {mono_free}: one byte per clock and one pixel per byte; "
                             "the last beat is taken the clock after the last byte")
     if mono_half != want["mono_half"]:
-        hint = (" (that is the rate without backpressure: with TREADY only every other clock a "
-                "1-byte pixel can leave only every other clock)" if mono_half == want["mono_free"] else "")
-        problems.append(f"mono_half is {mono_half}{hint}")
+        problems.append(_half_hint("mono_half", mono_half, want["mono_half"], want["mono_free"],
+                                   bytes_per_beat=1))
     if rgba_half != want["rgba_half"]:
-        hint = (" (an rgba8 beat needs 4 clocks of bytes, so TREADY on every other clock is "
-                "always there in time: the backpressure costs nothing)" if rgba_half > want["rgba_half"] else "")
-        problems.append(f"rgba_half is {rgba_half}{hint}")
+        problems.append(_half_hint("rgba_half", rgba_half, want["rgba_half"], want["mono_free"],
+                                   bytes_per_beat=4))
     if problems:
         raise fail(ex, *problems)
     return CheckResult(ex, [f"mono8: {want['mono_free']} clocks free, {want['mono_half']} with TREADY every "
                             "other clock: backpressure halves a byte-per-beat stream",
                             f"rgba8: {want['rgba_half']} clocks either way: the 8-bit FIFO, not the "
                             "stream, limits it"])
+
+
+def _half_hint(name: str, value: int, want: int, free: int, *, bytes_per_beat: int) -> str:
+    """What a wrong 16x8-frame clock count with TREADY on every other clock probably missed."""
+    beats = 16 * 8
+    direction = "too few" if value < want else "too many"
+    if value == want - 1:
+        why = ("one short: clock 0 is the clock the first byte is taken, and the count ends the "
+               "clock after the last handshake (its clock + 1)")
+    elif bytes_per_beat == 1 and value == free:
+        why = ("that is the count without backpressure: with TREADY only on even clocks a "
+               "1-byte pixel can leave only every other clock, so the beats, not the bytes, "
+               "set the pace")
+    elif bytes_per_beat == 1 and value < want:
+        why = (f"with TREADY 1 only every other clock at most one beat leaves per 2 clocks: "
+               f"{beats} beats need about 2 x {beats} clocks")
+    elif bytes_per_beat == 4 and value < want:
+        why = (f"an rgba8 beat needs 4 bytes, one per clock: {beats} beats need about "
+               f"4 x {beats} clocks whatever TREADY does")
+    elif bytes_per_beat == 4:
+        why = ("backpressure costs nothing for rgba8 here: a beat is ready only every 4th "
+               "clock, and TREADY, 1 every other clock, is back in time for each")
+    else:
+        why = ("a byte arrives on every clock and its beat leaves at the next even clock: count "
+               "when the last beat can be taken")
+    return f"{name} is {value}, {direction}: {why}"
 
 
 def check_ksize_rerun(params: Any, base: Any, frame: bytes) -> CheckResult:

@@ -28,6 +28,9 @@ so its findings stand in the graded notebook and in nbgrader's feedback.
 from __future__ import annotations
 
 import copy
+import os
+import shutil
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -149,7 +152,7 @@ NBGRADER_CONFIG = """\
 from rosfpga_lab.checks.grading import configure
 
 c = get_config()  # noqa: F821 (nbgrader defines it)
-configure(c)
+configure(c)   # also finds nbgrader's alembic when the environment is not activated
 """
 
 
@@ -220,7 +223,27 @@ def configure(c: Any) -> None:
     Call it from an ``nbgrader_config.py``: ``from rosfpga_lab.checks.grading import
     configure; configure(get_config())``.
     """
+    environment_tools_on_path()
     c.ClearSolutions.code_stub = {"python": f"{PLACEHOLDER}\n{RAISE}"}
     c.ClearSolutions.text_stub = MD_PLACEHOLDER
     c.ClearSolutions.begin_solution_delimeter = BEGIN.removeprefix("# ")
     c.ClearSolutions.end_solution_delimeter = END.removeprefix("# ")
+
+
+def environment_tools_on_path() -> str | None:
+    """Put the running environment's ``bin/`` first on ``PATH`` when nbgrader's tools are not there.
+
+    nbgrader runs ``alembic`` (its database migrations) as a program found on ``PATH``. A
+    teacher's script or cron job that runs ``/opt/rosfpga-lab/venv/bin/nbgrader`` without
+    activating the environment has no ``alembic`` on ``PATH``, and nbgrader fails with
+    ``FileNotFoundError: 'alembic'``. Called from ``nbgrader_config.py`` (:func:`configure`), so
+    every nbgrader command of a course finds the ``alembic`` installed beside it.
+
+    Returns:
+        The directory added, or ``None`` when ``alembic`` was already found (``PATH`` unchanged).
+    """
+    here = os.path.dirname(sys.executable)
+    if shutil.which("alembic") is not None or shutil.which("alembic", path=here) is None:
+        return None
+    os.environ["PATH"] = here + os.pathsep + os.environ.get("PATH", "")
+    return here

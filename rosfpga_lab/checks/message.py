@@ -9,6 +9,7 @@ from rosfpga_lab.checks._core import (
     ByteField, CheckResult, as_bytes, describe_byte_difference, fail, field_at, require_answer,
     require_type,
 )
+from rosfpga_lab.checks.limits import MAX_READ_SHIFT
 from rosfpga_lab.msg import MsgRegistry, default_registry, field_layout, serialize
 from rosfpga_lab.tcpros import frame_spans
 
@@ -48,12 +49,15 @@ def check_data_offset(answer: Any, frame: bytes) -> CheckResult:
         return CheckResult(ex, [f"pixels start at byte {want}: 4 (frame length) + "
                                 f"{want - 4} bytes of message before 'data'"])
     if answer == want - 4:
-        hint = ("that is where the uint32 length of 'data' starts; the pixels begin 4 bytes later"
-                if _name_at(fields, answer) == "data length" else
-                "you counted from the start of the message body; the frame's 4-byte length comes "
-                "first")
+        # two different mistakes land here; name both
+        hint = ("either you counted from the start of the message body (the frame's 4-byte "
+                "length comes first) - or you stopped where the uint32 length of 'data' starts "
+                "(the pixels begin 4 bytes after it)")
     elif answer == want - 8:
-        hint = "off by 8: count the frame length and the data length prefix"
+        hint = ("off by 8: you left out both the frame's 4-byte length and the 4-byte length "
+                "of 'data'")
+    elif answer == want + 4:
+        hint = "off by 4 too many: the frame length and each length prefix count once"
     else:
         f = _name_at(fields, answer)
         hint = (f"byte {answer} is inside field {f}" if f else
@@ -96,6 +100,25 @@ def check_marshal(answer: Any, message: Mapping[str, Any]) -> CheckResult:
 EXTRACTED = ("width", "height", "encoding", "step")
 
 
+def _common_shift(frame: bytes, at: Mapping[str, int], wrong: Mapping[str, int]) -> int | None:
+    """The one offset error (in bytes, negative: read too early) that explains every wrong
+    number at once, when at least two are wrong; the smallest such, or None.
+
+    A value read a fixed distance from its field (the frame length forgotten: 4 bytes early)
+    can look like a swap (width read 4 bytes early *is* the height); the shift is tested
+    first, so the hint points at the cause.
+    """
+    if len(wrong) < 2:
+        return None
+    found: set[int] | None = None
+    for key, value in wrong.items():
+        shifts = {off - at[key] for off in range(0, len(frame) - 3)
+                  if int.from_bytes(frame[off:off + 4], "little") == value
+                  and 0 < abs(off - at[key]) <= MAX_READ_SHIFT}
+        found = shifts if found is None else found & shifts
+    return min(found, key=abs) if found else None
+
+
 def check_extract(answer: Any, frame: bytes) -> CheckResult:
     """Exercise 3.3: fields extracted from a TCPROS Image frame (what the interpreter does).
 
@@ -117,9 +140,22 @@ def check_extract(answer: Any, frame: bytes) -> CheckResult:
     spans = {s.path: s for s in field_layout(default_registry(), IMAGE, frame[4:])}
     want = {"width": spans["width"].value, "height": spans["height"].value,
             "encoding": spans["encoding"].value, "step": spans["step"].value}
+    at = {k: spans[k].offset + 4 for k in ("width", "height", "step")}   # frame offsets
+    wrong = {k: answer[k] for k in at if isinstance(answer[k], int) and answer[k] != want[k]}
+    shift = _common_shift(frame, at, wrong)
     problems = []
+    if shift is not None:
+        where = "early" if shift < 0 else "late"
+        cause = (": did you leave out the frame's 4-byte length? Offsets in `mystery` count from "
+                 "its first byte, and the message starts at byte 4" if shift == -4 else
+                 ": count the bytes before each field again")
+        problems.append(f"{' and '.join(sorted(wrong))} read {abs(shift)} bytes too {where} "
+                        f"(each value is the uint32 {abs(shift)} bytes {'before' if shift < 0 else 'after'} "
+                        f"its field){cause}")
     for key in EXTRACTED:
         have = answer[key]
+        if shift is not None and key in wrong:
+            continue
         if isinstance(have, bytes) and key == "encoding":
             problems.append(f"encoding is bytes {have!r}: decode it to str (.decode())")
             continue

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from itertools import combinations
 from typing import Any
 
 from rosfpga_lab.checks._core import CheckResult, fail, require_type
@@ -34,15 +35,43 @@ def check_cdr_data_offset(answer: Any, payload: bytes) -> CheckResult:
         return CheckResult(ex, [f"pixels start at byte {want}: {ENCAPSULATION_SIZE} bytes of "
                                 f"encapsulation header, {nuls} string NULs and {padding} "
                                 f"padding byte(s) included"])
-    hints = [(want - ENCAPSULATION_SIZE, "you left out the 4-byte encapsulation header"),
-             (want - padding, f"you left out the {padding} alignment padding byte(s)"),
-             (want - nuls, f"CDR strings end with a NUL that the length counts ({nuls} strings)"),
-             (want - ENCAPSULATION_SIZE - padding, "no encapsulation header and no padding"),
-             (want - 4, "that is where the uint32 count of 'data' starts; the pixels follow it")]
-    hint = " - or ".join(dict.fromkeys(text for value, text in hints if value == answer)) or (
-        "count again: header (sec, nanosec, frame_id), height, width, encoding, is_bigendian, "
-        "padding to 4, step, count of data")
-    raise fail(ex, f"cdr_data_offset {answer}, expected another value: {hint}")
+    raise fail(ex, f"cdr_data_offset {answer}, expected another value: "
+                   f"{_cdr_offset_hint(answer, want, nuls, padding)}")
+
+
+def _cdr_offset_hint(answer: int, want: int, nuls: int, padding: int) -> str:
+    """What an offset ``answer`` instead of ``want`` probably left out or added.
+
+    Each usual mistake moves the answer by a fixed amount; the hint names the fewest mistakes
+    that together give ``answer`` (all such sets, when several do), so a TCPROS-style sum (ROS
+    1's ``seq`` kept, no NULs, no padding) is named as such instead of as one missing piece.
+    """
+    mistakes = [  # (delta, what the student did)
+        (-ENCAPSULATION_SIZE, f"left out the {ENCAPSULATION_SIZE}-byte encapsulation header"),
+        (+4, "counted ROS 1's header.seq (ROS 2's std_msgs/Header has no seq)"),
+        (-nuls, f"left out the NUL that ends each CDR string ({nuls} strings; the length "
+                "counts it)"),
+        (-padding, f"left out the {padding} alignment padding byte(s) (red in the CDR viewer)"),
+        (-4, "stopped at the uint32 count of 'data'; the pixels follow it"),
+    ]
+    found: list[str] = []
+    for size in range(1, len(mistakes) + 1):
+        for subset in combinations(mistakes, size):
+            if all(delta for delta, _ in subset) and want + sum(d for d, _ in subset) == answer:
+                found.append(" and ".join(text for _, text in subset))
+        if found:
+            break
+    if not found:
+        return ("count again: encapsulation header, header (sec, nanosec, frame_id with its NUL), "
+                "padding to 4, height, width, encoding with its NUL, is_bigendian, padding to 4, "
+                "step, count of data")
+    tcpros_message = want - ENCAPSULATION_SIZE + 4 - nuls - padding
+    lead = {tcpros_message: "that is where the pixels start in the TCPROS message (notebook 3), "
+                            "not in CDR: ",
+            tcpros_message + 4: "that is where the pixels start in the TCPROS frame (notebook 3; "
+                                "its 4-byte frame length is not CDR's encapsulation header), "
+                                "not in CDR: "}.get(answer, "")
+    return lead + "you " + " - or you ".join(dict.fromkeys(found))
 
 
 def fragment_count(sample_size: int, fragment_size: int) -> int:

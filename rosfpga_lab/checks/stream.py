@@ -25,7 +25,9 @@ def check_tdata(answer: Any, pixel: Sequence[int]) -> CheckResult:
         ExerciseError: the wrong lane order (big-endian) or wrong lanes (named by bits).
     """
     ex = "4.1 (one pixel into tdata)"
-    require_type(ex, "tdata", answer, int, "an int, e.g. 0x11223344")
+    require_type(ex, "tdata", answer, int,
+                 "a number, not text: write a hex literal without quotes, or convert with "
+                 "int(text, 16)" if isinstance(answer, str) else "a number such as 0xCAFE")
     answer = int(answer)
     pix = [int(b) for b in pixel]
     want = sum(b << (8 * i) for i, b in enumerate(pix))

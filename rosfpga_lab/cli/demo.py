@@ -38,7 +38,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--no-figure", action="store_true", help="do not write the figure")
     p.add_argument("--model", choices=MODELS, default=MODELS[0],
                    help="circuit model (reference: byte at a time, about 0.3 s per 160x120 "
-                   "frame; try --config data/fpga_passthrough_rgb8.yaml --frames 5)")
+                   "frame; try --config data/fpga_passthrough_rgb8.yaml --frames 5; rtl: the "
+                   "Verilog itself on Verilator, about 0.1-0.3 s per 640x480 frame)")
     p.add_argument("--input-queue", type=positive_int, metavar="N",
                    help="frames waiting in front of the circuit (default: 2, as a camera "
                    "driver's queue; every frame with --model reference). A circuit slower than "

@@ -11,7 +11,7 @@ from pathlib import Path
 from rosfpga_lab.cli._signals import StopSignals
 from rosfpga_lab.config.params import ParamSource
 from rosfpga_lab.cli._args import non_negative_float, positive_float, positive_int
-from rosfpga_lab.config.vocabulary import MODELS
+from rosfpga_lab.config.vocabulary import MODELS, TIMINGS
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -36,8 +36,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--embedded-master", action="store_true",
                    help="start the lab's embedded master at that URI when none answers there")
     p.add_argument("--model", choices=MODELS, default=None,
-                   help="circuit model: fast (numpy, default) or reference (byte at a time; "
-                   "small images only); also the private parameter ~model")
+                   help="the data path: fast (numpy model, default), reference (byte at a time; "
+                   "small images only) or rtl (the Verilog itself, simulated by Verilator); "
+                   "also the private parameter ~model")
+    p.add_argument("--timing", choices=TIMINGS, default=TIMINGS[0],
+                   help="host (default): publish as soon as the data path is done; fpga: hold "
+                   "each output for the circuit's clocks at clock_mhz and drop frames that come "
+                   "while it is busy, as the board would")
     p.add_argument("--input-queue", type=positive_int, default=None, metavar="N",
                    help="frames waiting in front of the circuit before the oldest is dropped "
                    "(default: 2)")
@@ -102,8 +107,8 @@ def _run(args: argparse.Namespace, stop: StopSignals) -> int:
         if args.output_queue is not None:
             kw["output_queue"] = args.output_queue
         component = FpgaComponent.from_config(
-            config, master_uri=uri, model=model, name=names.node, host=host.host,
-            input_topic=names.input, output_topic=names.output, **kw)
+            config, master_uri=uri, model=model, timing=args.timing, name=names.node,
+            host=host.host, input_topic=names.input, output_topic=names.output, **kw)
         component.start()
     except BaseException:
         if master is not None:
@@ -111,7 +116,8 @@ def _run(args: argparse.Namespace, stop: StopSignals) -> int:
         raise
     tty = sys.stdout.isatty()
     print(f"{component.name}: {component.input_topic} -> {component.pipeline.op} "
-          f"({model} model) -> {component.output_topic}; master {component.master_uri}; "
+          f"({model} model, {args.timing} timing) -> {component.output_topic}; "
+          f"master {component.master_uri}; "
           f"address {component.host} (from {host.source}); Ctrl-C to stop", flush=True)
     interval = args.status_interval if args.status_interval > 0 and not args.quiet else 1.0
     last_print = 0.0

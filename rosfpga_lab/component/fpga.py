@@ -44,9 +44,11 @@ from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, fps_meter
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.config import master_uri as pick_master_uri
 from rosfpga_lab.config.limits import IMAGE_TYPE
+from rosfpga_lab.config.vocabulary import MODELS, RTL_MODEL, TIMINGS
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
 from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineResult
+from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
 
 log = logging.getLogger("rosfpga_lab.component")
@@ -81,8 +83,9 @@ class FrameRecord:
 
     @property
     def ok(self) -> bool:
-        """True when the circuit took the frame (False: refused, see :attr:`error`)."""
-        return self.result is not None
+        """True when the circuit took the frame (False: refused, see :attr:`error`). With
+        ``model="rtl"`` :attr:`result` is None either way: the Verilog, not a model, ran."""
+        return not self.error
 
     @property
     def latency(self) -> float:
@@ -129,7 +132,13 @@ class FpgaComponent:
         config: the node configuration (as :func:`rosfpga_lab.config.load_config` returns it).
         master_uri: the master to use instead of the configuration's ``node.master_uri``.
         master: an :class:`~rosfpga_lab.graph.EmbeddedMaster` to use (overrides both).
-        model: ``"fast"`` (numpy) or ``"reference"`` (one byte or beat at a time; small images).
+        model: ``"fast"`` (numpy), ``"reference"`` (one byte or beat at a time; small images)
+            or ``"rtl"`` (the Verilog itself, in a long-lived simulator: :mod:`rosfpga_lab.rtl.server`).
+        timing: ``"host"`` (publish as soon as the data path is done) or ``"fpga"`` (publish
+            when the circuit's clocks for the frame at ``clock_mhz`` have passed since it
+            arrived, or since the circuit became free; the input queue is then 1 deep, as the
+            input FIFO and the socket hold one waiting frame: a newer frame replaces it and the
+            older one is counted in :attr:`ComponentStats.dropped_input`).
         input_queue: frames waiting in front of the circuit (see module docstring).
         output_queue: frames waiting per downstream subscriber.
         history: records kept in :attr:`recent`.
@@ -151,7 +160,7 @@ class FpgaComponent:
 
     def __init__(self, config: NodeConfig, *, master_uri: str | None = None,
                  master: EmbeddedMaster | None = None, model: str = "fast",
-                 input_queue: int = limits.DEFAULT_INPUT_QUEUE,
+                 timing: str = "host", input_queue: int = limits.DEFAULT_INPUT_QUEUE,
                  output_queue: int = limits.DEFAULT_OUTPUT_QUEUE,
                  history: int = limits.DEFAULT_HISTORY, name: str | None = None,
                  host: str | None = None, trace: Any = None, watchdog: bool = True,
@@ -164,15 +173,38 @@ class FpgaComponent:
             raise ComponentConfigError(
                 f"publisher.type is {config.publisher.type!r}: the video path publishes "
                 f"{IMAGE_TYPE} only")
-        try:
+        if model not in MODELS:
+            raise ComponentConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        if timing not in TIMINGS:
+            raise ComponentConfigError(f"timing must be one of {', '.join(TIMINGS)}, got {timing!r}")
+        if model == RTL_MODEL and not config.is_image:
+            raise ComponentConfigError(
+                f"--model rtl runs the {IMAGE_TYPE} Verilog only; {config.subscriber.type} runs "
+                "on the fast or reference model (its generated Verilog: rosfpga-lab generate, "
+                "make rtlsim)")
+        try:   # with model="rtl" the fast model still names the operation and sets its limits
             self.registry = config.registry()
+            pmodel = "fast" if model == RTL_MODEL else model
             self.pipeline: Pipeline | MessagePipeline = (
-                Pipeline.from_config(config, model=model) if config.is_image
-                else MessagePipeline.from_config(config, model=model, reg=self.registry))
+                Pipeline.from_config(config, model=pmodel) if config.is_image
+                else MessagePipeline.from_config(config, model=pmodel, reg=self.registry))
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
+        self.timing = timing
+        self._clock_hz = config.clock_mhz * 1e6
+        self._busy_until = 0.0      # time.time() when the circuit is free again (timing fpga)
+        self._rtl: Any = None
+        if model == RTL_MODEL:
+            from rosfpga_lab.rtl.server import RtlServer
+
+            try:
+                self._rtl = RtlServer(config)
+            except LabError as exc:
+                raise ComponentConfigError(f"cannot run the Verilog (--model rtl): {exc}") from None
         if input_queue < 1 or output_queue < 1:
             raise ComponentConfigError("input_queue and output_queue must be at least 1")
+        if timing == "fpga":   # what waits in front of the board: one frame (see above)
+            input_queue = 1
         self.config = config
         self.model = model
         self.master = master
@@ -200,6 +232,7 @@ class FpgaComponent:
         self._published_rate = fps_meter()
         self._counts = {"seen": 0, "processed": 0, "published": 0, "refused": 0,
                         "reregistered": 0, "observer_errors": 0}
+        self._last_clocks = 0
         self._reasons: dict[str, int] = {}        # refusal kind -> count
         self._examples: dict[str, str] = {}       # refusal kind -> the first reason text seen
         self._high_water: dict[str, int] = {}
@@ -274,6 +307,8 @@ class FpgaComponent:
             self._watch.join(5.0)
         if self.node is not None:
             self.node.shutdown("component stopped")
+        if self._rtl is not None:
+            self._rtl.close()
 
     def __enter__(self) -> FpgaComponent:
         if self.node is None:
@@ -301,15 +336,33 @@ class FpgaComponent:
                 self._observers.remove(callback)
 
     # ------------------------------------------------------------------ the data path
+    def _hold(self, info: MessageInfo, clocks: int) -> None:
+        """Timing ``fpga``: wait until ``clocks`` at the circuit's clock have passed since the
+        frame arrived (or since the circuit became free)."""
+        self._last_clocks = clocks
+        if self.timing != "fpga":
+            return
+        with self._lock:   # one circuit, whichever connection the frame came on
+            done = max(info.received, self._busy_until) + clocks / self._clock_hz
+            self._busy_until = done
+        left = done - time.time()
+        if left > 0:
+            time.sleep(left)
+
     def _on_frame(self, body: bytes | memoryview, info: MessageInfo) -> None:
         frame = len(body).to_bytes(4, "little") + body
+        if self._rtl is not None:
+            self._on_frame_rtl(frame, info)
+            return
         t0 = time.perf_counter()
         try:
             result = self.pipeline.process(frame)
         except PipelineError as exc:
+            self._hold(info, 0)
             self._refuse(exc, frame, info)
             return
         t1 = time.perf_counter()
+        self._hold(info, result.total_cycles)
         self._pub.publish_body(memoryview(result.output_frame)[4:])
         now = time.time()
         for problem in result.status:
@@ -335,9 +388,43 @@ class FpgaComponent:
         self._observe(FrameRecord(index, frame, result.output_frame, result, "", info.publisher,
                                   info.received, now))
 
+    def _on_frame_rtl(self, frame: bytes, info: MessageInfo) -> None:
+        """The simulated Verilog on the data path: its bytes are published, its status codes
+        are the refusal reasons."""
+        t0 = time.perf_counter()
+        got = self._rtl.process(frame)
+        t1 = time.perf_counter()
+        refused = [code for _, code in got.status if code]
+        if refused or not got.output:
+            self._hold(info, got.clocks)
+            code = refused[0] if refused else -1
+            if code >= 0:
+                name, field = SUBSCRIBER_STATUSES[code]
+                self._count_refusal(f"circuit status {code} ({name}): bad {field}",
+                                    f"circuit status {code}: {name}", frame, info)
+            else:
+                self._count_refusal("the circuit sent nothing (the frame was cut short)",
+                                    "circuit: no output", frame, info)
+            return
+        self._hold(info, got.span)
+        self._pub.publish_body(memoryview(got.output)[4:])
+        now = time.time()
+        self._latency.add(now - info.received)
+        self._process.add(t1 - t0)
+        with self._lock:
+            index = self._counts["seen"]
+            self._counts["seen"] += 1
+            self._counts["processed"] += 1
+            self._counts["published"] += 1
+            self._published_rate.tick()
+            self._done.notify_all()
+        self._observe(FrameRecord(index, frame, got.output, None, "", info.publisher,
+                                  info.received, now))
+
     def _refuse(self, exc: PipelineError, frame: bytes, info: MessageInfo) -> None:
-        reason = _reason(exc)
-        kind = refusal_kind(exc)
+        self._count_refusal(_reason(exc), refusal_kind(exc), frame, info)
+
+    def _count_refusal(self, reason: str, kind: str, frame: bytes, info: MessageInfo) -> None:
         with self._lock:
             self._counts["seen"] += 1
             self._counts["refused"] += 1
@@ -460,7 +547,10 @@ class FpgaComponent:
                 publishers=sub_stats.connections if sub_stats else 0,
                 latency=self._latency.summary(), process_time=self._process.summary(),
                 since_stamp=self._since_stamp.summary(),
-                circuit_time_s=last.frame_time_s if last is not None else float("nan"),
+                circuit_time_s=(last.frame_time_s if last is not None and self._rtl is None
+                                else self._last_clocks / self._clock_hz if self._last_clocks
+                                else float("nan")),
+                timing=self.timing, model=self.model,
                 cycles=dict(last.cycles) if last is not None else {},
                 fifo_high_water=dict(self._high_water), fps=fps,
                 master_reregistrations=c["reregistered"], master_ok=self._master_ok,

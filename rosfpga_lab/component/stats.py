@@ -8,6 +8,7 @@ import threading
 from dataclasses import dataclass, field
 
 from rosfpga_lab.component import limits
+from rosfpga_lab.config.vocabulary import RTL_MODEL
 from rosfpga_lab.graph.rate import RateMeter
 
 
@@ -114,6 +115,8 @@ class ComponentStats:
         last_error: the most recent refusal or problem, as text.
         connection_errors: the input side's recent connection problems (a publisher of another
             type on the input topic, a refused handshake, a publisher gone), newest last.
+        timing: ``host`` or ``fpga`` (when outputs are published); ``model``: what ran the
+            data path (``fast``, ``reference`` or ``rtl``).
     """
 
     received: int = 0
@@ -139,6 +142,8 @@ class ComponentStats:
     observer_errors: int = 0
     last_error: str = ""
     connection_errors: list[str] = field(default_factory=list)
+    timing: str = "host"
+    model: str = "fast"
 
     @property
     def dropped(self) -> int:
@@ -161,17 +166,26 @@ class ComponentStats:
             f"frames: received {self.received}, processed {self.processed}, published "
             f"{self.published}, refused {self.refused}, dropped {self.dropped} "
             f"(input queue {self.dropped_input}, output queues {self.dropped_output})",
-            f"latency (receive -> publish): {self.latency.ms()}; circuit model alone: "
-            f"{self.process_time.ms()}",
+            f"data path: {self.model} model; timing: {self.timing}" + (
+                " (each output held for the circuit's clocks at clock_mhz; one frame waits while "
+                "it is busy, a newer one replaces it)" if self.timing == "fpga" else
+                " (outputs published as soon as the data path is done)"),
+            f"latency (receive -> publish, wall time here): {self.latency.ms()}; of it the "
+            f"{'simulated Verilog' if self.model == RTL_MODEL else 'Python circuit model'}'s own "
+            f"run: {self.process_time.ms()}",
         ]
         if self.since_stamp.count:
             lines.append(f"latency since capture (input header.stamp -> publish): "
                          f"{self.since_stamp.ms()} over {self.since_stamp.count} frames")
+        if not self.cycles and self.circuit_time_s == self.circuit_time_s:   # rtl: no stages
+            lines.append(f"circuit time of the last frame: {self.circuit_time_s * 1e3:.2f} ms "
+                         "(its simulated clocks)")
         if self.cycles:
             total = self.circuit_time_s * 1e3
             lines.append("cycles per stage (last frame): " + ", ".join(
                 f"{name} {n:,}" for name, n in self.cycles.items())
-                + f"; modelled circuit time {total:.2f} ms")
+                + f"; the real circuit would need {total:.2f} ms per frame at its clock "
+                "(cycles / clock, not measured here)")
         if self.fifo_high_water:
             lines.append("FIFO high water: " + ", ".join(
                 f"{name} {n}" for name, n in self.fifo_high_water.items()))

@@ -63,7 +63,14 @@ _OP_ALIASES = {"copy": PASSTHROUGH}
 STREAM_ELEMENT_TYPES = ("int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
                         "float32", "float64", "byte", "char")
 #: The circuit's Python models: ``fast`` (whole arrays) and ``reference`` (a byte at a time).
-MODELS = ("fast", "reference")
+PIPELINE_MODELS = ("fast", "reference")
+#: The simulated Verilog itself (a long-lived RTL simulator on the data path).
+RTL_MODEL = "rtl"
+#: What a component's data path can run: the Python models, or the Verilog.
+MODELS = (*PIPELINE_MODELS, RTL_MODEL)
+#: When a component publishes: ``host`` as soon as the model is done; ``fpga`` after the
+#: circuit's clocks for the frame at ``clock_mhz`` (frames that come while it is busy dropped).
+TIMINGS = ("host", "fpga")
 #: The Verilog simulators the RTL flow runs (the first one found is the default).
 SIMULATORS = ("iverilog", "verilator")
 

@@ -145,8 +145,16 @@ def split_uri(uri: str) -> tuple[str, int, str]:
     """``http://host:port/path`` -> (host, port, path).
 
     Raises:
-        ConfigError: not an http URI with a host and port.
+        ConfigError: not an http URI with a host and port (also when ``uri`` is no str,
+            e.g. a whole ``[code, statusMessage, value]`` reply instead of its value).
     """
+    if not isinstance(uri, str):
+        reply = (isinstance(uri, (list, tuple)) and len(uri) == 3
+                 and isinstance(uri[0], int) and isinstance(uri[2], str))
+        hint = (": that is a whole [code, statusMessage, value] XML-RPC reply (of lookupNode, "
+                "say); its value, reply[2], is the URI" if reply else "")
+        raise ConfigError(f"an XML-RPC URI is a str like 'http://host:port/', not "
+                          f"{type(uri).__name__} {uri!r:.120}{hint}")
     parts = urllib.parse.urlsplit(uri)
     try:
         port = parts.port

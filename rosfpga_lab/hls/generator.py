@@ -58,7 +58,8 @@ TB_INPUT = "tb_input.bin"
 TB_EXPECTED = "tb_expected.bin"
 #: What ``make csim`` and ``vivado_hls -f run_hls.tcl`` leave behind; --force removes these too.
 BUILD_PRODUCTS = ("csim_testbench", "csim_out", "hls_subscriber", "hls_image_filter",
-                  "hls_publisher", "vivado_hls.log", "rtlsim_out", "rtl/rfl_sim.vvp", "rtl/obj_dir")
+                  "hls_publisher", "vivado_hls.log", "rtlsim_out", "rtl/rfl_sim.vvp", "rtl/obj_dir",
+                  "rtl/obj_fast")
 #: Bytes per line of the hexadecimal arrays in connection_headers.cpp.
 HEX_BYTES_PER_LINE = 16
 _OP_CPP = {"dilate": "Dilate", "erode": "Erode"}

@@ -30,7 +30,9 @@ derived from a ``.msg`` and the configuration by :func:`derive_layout` (module `
 the subscriber and publisher of any type are rendered from it (module ``walker``:
 :class:`LayoutInterpreter`, :func:`extract_reference` / :func:`extract_fast`,
 :func:`publish_reference` / :func:`publish_fast`), the 1-D application in ``morph1d``, the
-whole circuit of a non-Image type in :class:`MessagePipeline` (``msgpipeline``).
+whole circuit of a non-Image type in :class:`MessagePipeline` (``msgpipeline``). CDR (ROS 2)
+is the second wire format of the same layout (``cdrlayout``, ``cdrwalker``), the whole circuit
+on CDR samples, Image included, :class:`CdrPipeline` (``cdrpipeline``).
 
 Stages (``reference`` / ``fast``), importable for notebooks:
 
@@ -69,6 +71,7 @@ from rosfpga_lab.hw.interpreter import (
 from rosfpga_lab.hw.layout import Layout, derive_layout, format_layout, layout_from_config
 from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
 from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
+from rosfpga_lab.hw.cdrpipeline import CdrPipeline, CdrResult
 from rosfpga_lab.hw.walker import (
     Extracted, LayoutInterpreter, extract_fast, extract_reference, publish_fast, publish_reference,
 )
@@ -96,4 +99,5 @@ __all__ = [
     "Layout", "derive_layout", "format_layout", "layout_from_config", "morph1d_fast",
     "morph1d_reference", "Extracted", "LayoutInterpreter", "extract_fast", "extract_reference",
     "publish_fast", "publish_reference", "MessagePipeline", "MessageResult",
+    "CdrPipeline", "CdrResult",
 ]

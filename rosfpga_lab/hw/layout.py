@@ -54,7 +54,9 @@ refusal with a sane frame length the rest of the frame is skipped.
 
 :func:`tokens` lists a message's values in walk order (what the subscriber emits step by step)
 and :func:`marshal` writes tokens back into a frame (what the publisher does): the two are
-the layout's definition of the wire, tested against the ``msg`` layer.
+the layout's definition of the wire, tested against the ``msg`` layer. CDR, the second wire
+format, is the same walk of the type's ROS 2 form with the kinds ``ENCAPSULATION`` and ``NUL``
+and each step's alignment added (:mod:`rosfpga_lab.hw.cdrlayout`).
 """
 
 from __future__ import annotations
@@ -94,6 +96,9 @@ class StepKind(_Name):
     ARRAY = "array"     # an array of numbers as one block of ``count`` x ``size`` bytes
     LOOP = "loop"       # the start of an array of messages/strings/times, walked per element
     END = "end"         # the end of one element of that array (back to the LOOP's body)
+    # CDR only (hw.cdrlayout: the second wire format of the same walk)
+    ENCAPSULATION = "encapsulation"  # the 4-byte encapsulation header (representation, options)
+    NUL = "nul"         # the NUL that ends a CDR string (its length counts it)
 
 
 class Action(_Name):
@@ -748,7 +753,7 @@ def format_layout(layout: Layout) -> str:
     """The walk as aligned text: one row per step (what notebooks print before drawing it)."""
     rows = [("#", "kind", "ident", "label", "type", "bytes", "max", "action", "check")]
     for s in layout.steps:
-        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
+        if s.kind in (StepKind.SCALAR, StepKind.LENGTH, StepKind.ENCAPSULATION, StepKind.NUL):
             size = str(s.size)
         elif s.kind is StepKind.END:
             size = str(s.size)
@@ -756,7 +761,8 @@ def format_layout(layout: Layout) -> str:
             size = f"{s.size} x {s.count}"
         else:
             size = f"{s.size} x [{s.length_step}]"
-        top = "-" if s.kind in (StepKind.SCALAR, StepKind.LENGTH, StepKind.END) else str(s.max_count)
+        top = "-" if s.kind in (StepKind.SCALAR, StepKind.LENGTH, StepKind.END,
+                                StepKind.ENCAPSULATION, StepKind.NUL) else str(s.max_count)
         check = f"{s.check.status}: {s.check.describe()}" if s.check else "-"
         rows.append((str(s.index), "  " * s.depth + s.kind, s.ident, s.label, s.type, size, top,
                      s.action, check))

@@ -1,4 +1,4 @@
-"""Simulating the RTL: Icarus Verilog or Verilator runs the file-based testbench.
+"""Simulating the RTL: the fast C++ harness on Verilator, or the file-based testbench.
 
 How this works: :func:`write_sources` copies the Verilog of ``verilog/`` and the testbench
 ``tb/rfl_tb.v`` into a directory and writes ``rfl_node.v`` (``rfl_top`` with the node
@@ -8,7 +8,14 @@ runs the simulation and reads back what the testbench wrote: the output bytes, t
 subscriber's status per frame and, per stream, the clocks of its first and last handshake.
 The testbench drives the input with random gaps and the output with random backpressure
 (``gap`` and ``bp`` in per mille of clocks, from a seeded xorshift generator), so no Python
-runs per clock and a 640x480 frame takes seconds.
+runs per clock.
+
+With Verilator and a C++ compiler (and no waveform wanted), :func:`build` compiles the fast
+harness instead (``harness/rfl_harness.cpp`` around ``harness/rfl_harness.v``): a plain
+``eval`` loop without ``--timing`` that keeps the frames in memory and does clock for clock what
+the testbench does (same reset, same random draws, same outputs and files), at 10-20 M clocks/s
+where the testbench on ``verilator --binary --timing`` does about 2 M. Its serve mode is the
+long-lived simulator of ``--model rtl`` (:mod:`rosfpga_lab.rtl.server`).
 """
 
 from __future__ import annotations
@@ -35,7 +42,11 @@ from rosfpga_lab.rtl.params import STATUS_HEADER, RtlParams, node_wrapper
 
 VERILOG_DIR = Path(__file__).resolve().parent / "verilog"
 TB_DIR = Path(__file__).resolve().parent / "tb"
+HARNESS_DIR = Path(__file__).resolve().parent / "harness"
 TB_TOP = "rfl_tb"
+HARNESS_TOP = "rfl_harness"
+#: The fast harness's sources (written beside the testbench; never part of a synthesis).
+HARNESS_FILES = ("rfl_harness.v", "rfl_harness.cpp")
 NODE_FILE = "rfl_node.v"
 #: The streams the testbench times, in its ``hs`` vector's bit order (bit 0 first).
 STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx",
@@ -113,6 +124,7 @@ def source_files(params: RtlParams, *, note: str = "",
     have = {p.name for p in verilog_sources()}
     files = {}
     for src in [*verilog_sources(), VERILOG_DIR / STATUS_HEADER, *sorted(TB_DIR.glob("*.v")),
+                *(HARNESS_DIR / name for name in HARNESS_FILES),
                 *(Path(p) for p in extra_sources if Path(p).name not in have)]:
         files[src.name] = src.read_bytes()
     files[NODE_FILE] = node_wrapper(params, note).encode("utf-8")
@@ -145,6 +157,7 @@ class RtlBuild:
         params: the parameters it was built with.
         seconds: how long the build took.
         trace: it can write a VCD (always with Icarus; Verilator only when built with trace).
+        harness: the fast C++ harness (Verilator without trace), not the Verilog testbench.
     """
 
     simulator: str
@@ -153,6 +166,7 @@ class RtlBuild:
     params: RtlParams
     seconds: float
     trace: bool = True
+    harness: bool = False
 
 
 def cache_root() -> Path:
@@ -161,13 +175,33 @@ def cache_root() -> Path:
     return Path(base) / "rosfpga-lab" / "rtl"
 
 
-def _run_command(sim: str, where: Path) -> tuple[str, ...]:
+def _run_command(sim: str, where: Path, harness: bool = False) -> tuple[str, ...]:
     if sim == "iverilog":
         return (find_tool("vvp") or "vvp", "-n", str(where / "rfl_sim"))
-    return (str(where / "obj_dir" / "rfl_sim"),)
+    return (str(where / "obj_dir" / ("rfl_fast" if harness else "rfl_sim")),)
 
 
-def _compile(sim: str, where: Path, files: list[str], trace: bool) -> None:
+def harness_command(where: str | Path = ".", obj_dir: str = "obj_dir",
+                    plain_eval: bool = False) -> list[str]:
+    """The Verilator command that builds the fast harness from the sources in ``where``."""
+    rtl = sorted(p.name for p in Path(where).glob("*.v")
+                 if p.name not in (*HARNESS_FILES, f"{TB_TOP}.v"))
+    return [_verilator() or "verilator", "--cc", "--exe", "--build", "-O3", "--x-assign", "fast",
+            "--x-initial", "fast", "--noassert", "-Wno-fatal", "-Wno-lint", "-Wno-style", "-I.",
+            "--top-module", HARNESS_TOP, "-Mdir", obj_dir, "-o", "rfl_fast", "-j", "2",
+            "-CFLAGS", "-O3" + (" -DRFL_PLAIN_EVAL" if plain_eval else ""),
+            "-MAKEFLAGS", "OPT_FAST=-O3 OPT_GLOBAL=-O2", *HARNESS_FILES, *rtl]
+
+
+def _compile(sim: str, where: Path, files: list[str], trace: bool, harness: bool = False) -> None:
+    if harness:
+        try:
+            _run_build(harness_command(where), where)
+        except RtlError:   # a Verilator whose model lacks the inner eval: its plain eval()
+            shutil.rmtree(where / "obj_dir", ignore_errors=True)
+            _run_build(harness_command(where, plain_eval=True), where)
+        return
+    files = [f for f in files if f not in HARNESS_FILES]
     if sim == "iverilog":
         cmd = [find_tool("iverilog") or "iverilog", "-g2005", "-I", ".", "-s", TB_TOP, "-o", "rfl_sim",
                *files]
@@ -175,6 +209,10 @@ def _compile(sim: str, where: Path, files: list[str], trace: bool) -> None:
         cmd = [_verilator() or "verilator", "--binary", "--timing", "-O3", "-Wno-fatal",
                "-Wno-lint", "-Wno-style", "-I.", "--top-module", TB_TOP, "-Mdir", "obj_dir",
                "-o", "rfl_sim", *(["--trace", "--trace-depth", "3"] if trace else []), *files]
+    _run_build(cmd, where)
+
+
+def _run_build(cmd: list[str], where: Path) -> None:
     try:
         proc = subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
     except subprocess.TimeoutExpired:
@@ -186,8 +224,8 @@ def _compile(sim: str, where: Path, files: list[str], trace: bool) -> None:
 
 def build(params: RtlParams, directory: str | Path | None = None, *,
           simulator: str | None = None, extra_sources: Sequence[str | Path] = (),
-          trace: bool = False, cache: bool = False) -> RtlBuild:
-    """Write the sources and compile the testbench.
+          trace: bool = False, cache: bool = False, harness: bool | None = None) -> RtlBuild:
+    """Write the sources and compile the fast harness or the testbench.
 
     Args:
         params: the configuration's parameters.
@@ -197,6 +235,8 @@ def build(params: RtlParams, directory: str | Path | None = None, *,
         trace: Verilator only: compile in VCD tracing (Icarus can always dump).
         cache: without ``directory``: reuse a build of the same sources, simulator and tracing
             from :func:`cache_root` (Verilator takes 20-60 s to compile), or leave this one there.
+        harness: Verilator only: the fast C++ harness (default: yes unless ``trace``); False
+            builds the Verilog testbench on ``verilator --binary --timing``.
 
     Raises:
         SimulatorMissingError: no simulator.
@@ -204,37 +244,40 @@ def build(params: RtlParams, directory: str | Path | None = None, *,
     """
     sim = find_simulator(simulator)
     trace = trace or sim == "iverilog"
+    if harness and (sim != "verilator" or trace):
+        raise RtlError("the fast harness runs on Verilator without waveform tracing")
+    fast = sim == "verilator" and not trace if harness is None else harness
     sources = source_files(params, extra_sources=extra_sources)
     files = sorted(f for f in sources if f.endswith(".v"))
     start = time.perf_counter()
     if cache and directory is None:
-        digest = hashlib.sha256(f"{sim} {trace} {simulator_version(sim)}".encode())
+        digest = hashlib.sha256(f"{sim} {trace} {fast} {simulator_version(sim)}".encode())
         for name in sorted(sources):
             digest.update(name.encode() + b"\0" + sources[name] + b"\0")
         target = cache_root() / f"{sim}-{digest.hexdigest()[:20]}"
         if (target / "BUILT").exists():
-            return RtlBuild(sim, _run_command(sim, target), target, params, 0.0, trace)
+            return RtlBuild(sim, _run_command(sim, target, fast), target, params, 0.0, trace, fast)
         cache_root().mkdir(parents=True, exist_ok=True)
         where = Path(tempfile.mkdtemp(prefix=".building-", dir=cache_root()))
         write_sources(params, where, extra_sources=extra_sources)
-        _compile(sim, where, files, trace)
+        _compile(sim, where, files, trace, fast)
         (where / "BUILT").write_text("ok\n")
         try:
             os.replace(where, target)   # another process may have finished first: keep its
         except OSError:
             shutil.rmtree(where, ignore_errors=True)
-        return RtlBuild(sim, _run_command(sim, target), target, params,
-                        time.perf_counter() - start, trace)
+        return RtlBuild(sim, _run_command(sim, target, fast), target, params,
+                        time.perf_counter() - start, trace, fast)
     where = Path(directory) if directory else Path(tempfile.mkdtemp(prefix="rosfpga-rtl-"))
     try:
         write_sources(params, where, extra_sources=extra_sources)
-        _compile(sim, where, files, trace)
+        _compile(sim, where, files, trace, fast)
     except BaseException:
         if directory is None:
             shutil.rmtree(where, ignore_errors=True)
         raise
-    built = RtlBuild(sim, _run_command(sim, where), where, params, time.perf_counter() - start,
-                     trace)
+    built = RtlBuild(sim, _run_command(sim, where, fast), where, params,
+                     time.perf_counter() - start, trace, fast)
     if directory is None:  # a temporary build goes when its RtlBuild does (or at exit)
         weakref.finalize(built, shutil.rmtree, where, True)
     return built
@@ -320,7 +363,8 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
         work_dir: where the files go (default: a temporary directory, removed after).
         idle_limit: clocks without any handshake that end the run (default :data:`IDLE_LIMIT`).
         beats: also record the AXI4-Stream beats into and out of the application.
-        plusargs: further testbench options (``+clocks_f2a=FILE``: fifo2axi's ports per clock).
+        plusargs: further testbench options (``+clocks_f2a=FILE``: fifo2axi's ports per clock;
+            the testbench only: build with ``harness=False``).
 
     Raises:
         RtlError: bad settings, the simulation failed, stalled or ran out of time.
@@ -328,6 +372,9 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
     gap, bp = _per_mille("gap", gap), _per_mille("bp", bp)
     if vcd is not None and not sim.trace:
         raise RtlError("this Verilator build cannot write a VCD: build it with trace=True")
+    if plusargs and sim.harness:
+        raise RtlError(f"the fast harness takes no testbench options ({' '.join(plusargs)}): "
+                       "build the testbench with harness=False")
     if not 1 <= seed < 2**31:
         raise RtlError(f"seed must be in 1..2**31-1, got {seed}")
     limit = idle_limit or IDLE_LIMIT

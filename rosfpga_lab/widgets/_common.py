@@ -67,10 +67,12 @@ class StaticFallback:
         return dict(data, **{"text/html": self.to_html()}), meta
 
 
-# Pastel colours that keep black text readable; adjacent fields get different ones.
+# Pastel colours that keep black text readable; adjacent fields get different ones. None is
+# reddish (every hue at least 60 degrees from the alignment red below), so a field beside CDR
+# padding never looks like padding.
 PALETTE = (
-    "#ffd6a5", "#caffbf", "#9bf6ff", "#bdb2ff", "#ffc6ff", "#fdffb6",
-    "#ffadad", "#a0c4ff", "#d0f4de", "#f1c0e8", "#cfbaf0", "#b9fbc0",
+    "#fdffb6", "#caffbf", "#9bf6ff", "#bdb2ff", "#e4c1f9", "#eeffa8",
+    "#b8e0d2", "#a0c4ff", "#d0f4de", "#cfbaf0", "#bde0fe", "#b9fbc0",
 )
 #: Fixed colours for bytes whose role matters more than which field they belong to.
 ROLE_COLOURS = {

@@ -238,6 +238,13 @@ def _fit(text: str, px: float) -> str:
     return text if len(text) <= n else text[: n - 1] + "\u2026"
 
 
+def _fit_label(number: str, text: str, size: str, px: float) -> str:
+    """An arrow's label cut to about ``px`` pixels in its middle: the arrow's number and its
+    byte count (``[123 B]``) always stay whole, the text between gets the ellipsis."""
+    n = max(4, int(px / CHAR_PX)) - len(number) - len(size)
+    return number + (text if len(text) <= n else text[: max(n - 1, 3)] + "\u2026") + size
+
+
 def events_from_capture(path: str | Path, **options: Any) -> list[SeqEvent]:
     """Events of the ROS 1 conversation in a capture file (pcap/pcapng of real traffic), via
     ``rosfpga_lab.graph.capture_read.trace_from_capture``; options as :func:`events_from_trace`."""
@@ -300,7 +307,7 @@ def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None 
             # a label may run past a short arrow's ends: its white halo keeps it readable
             tx, anchor, room = (x1 + x2) / 2, "middle", max(abs(x2 - x1) - 16, min(2.2 * col, LABEL_MIN_PX))
         size = f" [{len(e.raw)} B]" if e.raw and e.kind != "tcpros_frame" else ""
-        label = _fit(f"{k + 1}. {e.label}{size}", room)
+        label = _fit_label(f"{k + 1}. ", e.label, size, room)
         out.append(f'<text x="{tx}" y="{y - 5}" text-anchor="{anchor}" fill="{colour}" '
                    f'paint-order="stroke" stroke="#fff" stroke-width="4" stroke-linejoin="round">'
                    f'{esc(label)}</text>')

@@ -317,6 +317,12 @@ class Waves:
         return firsts + start, lengths, values
 
     # --- drawing ---------------------------------------------------------------------------------
+    def drawn_names(self, names: Sequence[str] | None = None) -> list[str]:
+        """The full names of the signals a picture of ``names`` draws (default: the first
+        ``MAX_SIGNALS``), in drawing order."""
+        return ([self.signal(n).name for n in names] if names
+                else [s.name for s in self.signals[:MAX_SIGNALS]])
+
     def svg(self, start: int = 0, span: int = DEFAULT_SPAN, cursor: int | None = None,
             names: Sequence[str] | None = None) -> str:
         """An SVG of clocks ``start .. start+span-1``: one row per signal, markers on top.
@@ -325,7 +331,7 @@ class Waves:
         viewer); the cursor is a red line with every value written beside its row.
         """
         start, span = self.clamp_window(start, span)
-        chosen = [self.signal(n) for n in names] if names else self.signals[:MAX_SIGNALS]
+        chosen = [self.signal(n) for n in self.drawn_names(names)]
         px = _PLOT / span
         height = _ROW * (len(chosen) + 2) + 8
         width = _LEFT + _PLOT + 70
@@ -635,11 +641,19 @@ class WaveformViewer(StaticFallback, w.VBox):
             self.values.value = ""
             return
         vals = self.waves.values_at(self.cursor)
-        items = "".join(f'<span data-signal="{esc(k)}">{esc(k)} = <b>{esc(v)}</b></span>'
-                        for k, v in vals.items())
+        drawn = [k for k in self.waves.drawn_names(self.names) if k in vals]
+        rest = [k for k in vals if k not in drawn]
+
+        def items(keys: list[str]) -> str:
+            return (f'<div style="display:flex;flex-wrap:wrap;gap:2px 18px">'
+                    + "".join(f'<span data-signal="{esc(k)}">{esc(k)} = <b>{esc(vals[k])}</b></span>'
+                              for k in keys) + "</div>")
+
+        others = (f'<details class="rfl-wave-others"><summary>the other {len(rest)} signals</summary>'
+                  f'{items(rest)}</details>' if rest else "")
         self.values.value = (f'<div class="rfl-wave-values" style="font-family:monospace;font-size:12px">'
-                             f'<b>clock {self.cursor}</b><div style="display:flex;flex-wrap:wrap;'
-                             f'gap:2px 18px">{items}</div></div>')
+                             f'<b>clock {self.cursor}</b>, the signals drawn above:{items(drawn)}'
+                             f'{others}</div>')
 
     def to_html(self) -> str:
         return self.waves.to_html(self.start, self.span, self.cursor, self.names)

@@ -1,0 +1,245 @@
+// rfl_harness.cpp -- the fast simulation of the whole circuit: a plain eval loop around the
+// Verilated rfl_harness (rfl_node plus read-only stream taps), no --timing, frames in and out
+// through memory. It does clock for clock what rfl_tb.v does (same reset, same xorshift
+// draws in the same order, same sampling before each rising edge), so the bytes, statuses
+// and cycle counts are those of the Verilog testbench.
+//
+// Batch mode (the testbench's plus-arguments):
+//   rfl_harness +input=FILE [+output=FILE +status=FILE +stats=FILE +seed=N +gap=P +bp=P
+//               +idle_limit=N +beats_in=FILE +beats_out=FILE]
+// Serve mode (a long-lived process; the circuit keeps its state between requests):
+//   rfl_harness --serve [+seed=N +gap=P +bp=P +idle_limit=N]
+//   request on stdin:  "RFLQ" u32 length, then length bytes (one or more TCPROS frames)
+//   reply on stdout:   "RFLR" u32 flags (1 input ended inside a frame, 2 stalled)
+//                      u64 clocks (this request)  u64 span (first byte into the subscriber
+//                      to last byte out, 0 without output)  u32 statuses  u32 output bytes,
+//                      then per status u32 offset (in the request) u32 code, then the bytes.
+//   A request of length 0 (or end of input) ends the process.
+#include "Vrfl_harness.h"
+#include "Vrfl_harness___024root.h"
+#include "verilated.h"
+
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+static const int NS = 9;
+
+// Once initialised, the model's own evaluation function is called per edge: Verilator's eval()
+// adds a garbage sweep and a message-queue flush (four mutex operations) that cost a third
+// of the time here. Build with -DRFL_PLAIN_EVAL to use eval() (a Verilator without it).
+#ifdef RFL_PLAIN_EVAL
+#define RFL_EVAL(t) (t)->eval()
+#else
+void Vrfl_harness___024root___eval(Vrfl_harness___024root* vlSelf);
+#define RFL_EVAL(t) Vrfl_harness___024root___eval((t)->rootp)
+#endif
+
+static uint32_t xorshift(uint32_t x) {
+    uint32_t y = x ^ (x << 13);
+    y = y ^ (y >> 17);
+    return y ^ (y << 5);
+}
+
+static bool plusarg(int argc, char** argv, const char* name, std::string& out) {
+    size_t n = strlen(name);
+    for (int i = 1; i < argc; ++i) {
+        if (argv[i][0] == '+' && strncmp(argv[i] + 1, name, n) == 0 && argv[i][n + 1] == '=') {
+            out = argv[i] + n + 2;
+            return true;
+        }
+    }
+    return false;
+}
+
+static long long plusint(int argc, char** argv, const char* name, long long dflt) {
+    std::string v;
+    return plusarg(argc, argv, name, v) ? atoll(v.c_str()) : dflt;
+}
+
+struct Sim {
+    Vrfl_harness* top;
+    uint32_t rnd;
+    uint32_t gap, bp;
+    uint64_t idle_limit;
+    uint64_t cycle = 0, idle = 0, done_for = 0, in_bytes = 0, sub_bytes = 0, frame_off = 0;
+    uint64_t first[NS] = {0}, last[NS] = {0}, count[NS] = {0};
+    long frames = 0, refused = 0;
+    // the input of the current run
+    const uint8_t* in = nullptr;
+    size_t in_len = 0, in_pos = 0;
+    bool eof = false;
+    std::vector<uint8_t> out;   // reserved to the input's size: a frame out is as long as in
+    std::vector<std::pair<uint64_t, int>> statuses;
+    uint64_t req_first = 0, req_last = 0;   // this run's first rx and last tx handshake
+    FILE* fbin = nullptr;
+    FILE* fbout = nullptr;
+
+    Sim(uint32_t seed, uint32_t gap_, uint32_t bp_, uint64_t limit)
+        : top(new Vrfl_harness), rnd(seed == 0 ? 0x12345678u : seed), gap(gap_), bp(bp_),
+          idle_limit(limit) {
+        top->clk = 0; top->rst_n = 0; top->s_tvalid = 0; top->s_tdata = 0; top->m_tready = 0;
+        top->eval();
+        for (int i = 0; i < 4; ++i) {
+            top->clk = 1; top->eval();
+            top->clk = 0; top->eval();
+        }
+        top->rst_n = 1;
+        top->eval();
+    }
+    ~Sim() { top->final(); delete top; }
+
+    static void beat(FILE* f, uint64_t w) {
+        // {tlast, tuser, tkeep[3:0], tdata[31:0]}: "%08x %x %x %x" as rfl_tb.v writes it
+        const unsigned hi = (unsigned)(w >> 32);
+        fprintf(f, "%08x %x %x %x\n", (unsigned)(w & 0xffffffffu), hi & 0xf, (hi >> 4) & 1,
+                (hi >> 5) & 1);
+    }
+
+    // Run until the input is used up and the circuit idle for 8 clocks (0), the input ended
+    // inside a frame (1) or nothing moved for idle_limit clocks with input left (2).
+    int run() {
+        eof = false;
+        out.reserve(out.size() + in_len + 64);
+        req_first = req_last = 0;
+        done_for = 0;
+        idle = 0;
+        for (;;) {
+            const bool s_tvalid = top->s_tvalid, s_tready = top->s_tready;
+            const bool m_tvalid = top->m_tvalid, m_tready = top->m_tready;
+            const uint32_t hs = top->hs;
+            ++cycle;
+            if (s_tvalid && s_tready) ++in_bytes;
+            bool nv = s_tvalid;
+            uint8_t nd = top->s_tdata;
+            if ((!s_tvalid || s_tready) && !eof) {
+                rnd = xorshift(rnd);
+                if ((rnd % 1000) >= gap) {
+                    if (in_pos >= in_len) { eof = true; nv = false; }
+                    else { nd = in[in_pos++]; nv = true; }
+                } else {
+                    nv = false;
+                }
+            }
+            if (m_tvalid && m_tready) out.push_back(top->m_tdata);
+            rnd = xorshift(rnd);
+            const bool nr = (rnd % 1000) >= bp;
+            if (top->frame_start) frame_off = sub_bytes;
+            if (hs & 1) ++sub_bytes;
+            if (top->status_valid) {
+                statuses.emplace_back(frame_off, top->status);
+                ++frames;
+                if (top->status != 0) ++refused;
+            }
+            if (fbin && (hs & 4)) beat(fbin, top->beat_in);
+            if (fbout && (hs & 16)) beat(fbout, top->beat_out);
+            if (hs) {
+                for (int i = 0; i < NS; ++i) if (hs & (1u << i)) {
+                    if (count[i] == 0) first[i] = cycle;
+                    last[i] = cycle;
+                    ++count[i];
+                }
+                if ((hs & 1) && !req_first) req_first = cycle;
+                if (hs & 128) req_last = cycle;
+                idle = 0;
+            } else {
+                ++idle;
+            }
+            done_for = (eof && !top->busy && !s_tvalid) ? done_for + 1 : 0;
+            top->clk = 1; RFL_EVAL(top);
+            top->s_tvalid = nv; top->s_tdata = nd; top->m_tready = nr;
+            top->clk = 0; RFL_EVAL(top);
+            if (done_for == 8) return 0;
+            if (idle >= idle_limit) return eof ? 1 : 2;
+        }
+    }
+};
+
+static bool read_all(FILE* f, void* buf, size_t n) {
+    return n == 0 || fread(buf, 1, n, f) == n;
+}
+
+static int serve(Sim& sim) {
+    std::vector<uint8_t> buf;
+    for (;;) {
+        uint8_t head[8];
+        if (!read_all(stdin, head, 8)) return 0;
+        if (memcmp(head, "RFLQ", 4) != 0) { fprintf(stderr, "rtlsim: ERROR: bad request\n"); return 1; }
+        uint32_t len;
+        memcpy(&len, head + 4, 4);
+        if (len == 0) return 0;
+        buf.resize(len);
+        if (!read_all(stdin, buf.data(), len)) { fprintf(stderr, "rtlsim: ERROR: short request\n"); return 1; }
+        sim.in = buf.data(); sim.in_len = len; sim.in_pos = 0;
+        sim.out.clear(); sim.statuses.clear();
+        const uint64_t c0 = sim.cycle, sub0 = sim.sub_bytes;
+        const int rc = sim.run();
+        uint32_t flags = rc == 1 ? 1u : rc == 2 ? 2u : 0u;
+        uint64_t clocks = sim.cycle - c0;
+        uint64_t span = (sim.req_first && sim.req_last) ? sim.req_last - sim.req_first + 1 : 0;
+        uint32_t ns = (uint32_t)sim.statuses.size(), no = (uint32_t)sim.out.size();
+        fwrite("RFLR", 1, 4, stdout);
+        fwrite(&flags, 4, 1, stdout);
+        fwrite(&clocks, 8, 1, stdout);
+        fwrite(&span, 8, 1, stdout);
+        fwrite(&ns, 4, 1, stdout);
+        fwrite(&no, 4, 1, stdout);
+        for (auto& s : sim.statuses) {
+            uint32_t off = (uint32_t)(s.first - sub0), code = (uint32_t)s.second;
+            fwrite(&off, 4, 1, stdout);
+            fwrite(&code, 4, 1, stdout);
+        }
+        if (no) fwrite(sim.out.data(), 1, no, stdout);
+        fflush(stdout);
+        if (rc == 2) return 2;
+    }
+}
+
+int main(int argc, char** argv) {
+    Verilated::commandArgs(argc, argv);
+    const long long seed = plusint(argc, argv, "seed", 1);
+    const long long gap = plusint(argc, argv, "gap", 0), bp = plusint(argc, argv, "bp", 0);
+    const long long limit = plusint(argc, argv, "idle_limit", 1000000);
+    Sim sim((uint32_t)seed, (uint32_t)gap, (uint32_t)bp, (uint64_t)limit);
+    for (int i = 1; i < argc; ++i) if (strcmp(argv[i], "--serve") == 0) return serve(sim);
+
+    std::string path;
+    if (!plusarg(argc, argv, "input", path)) { fprintf(stderr, "rtlsim: ERROR: no +input=FILE\n"); return 1; }
+    FILE* fin = fopen(path.c_str(), "rb");
+    if (!fin) { fprintf(stderr, "rtlsim: ERROR: cannot open the input %s\n", path.c_str()); return 1; }
+    std::vector<uint8_t> input;
+    uint8_t chunk[1 << 16];
+    size_t got;
+    while ((got = fread(chunk, 1, sizeof chunk, fin)) > 0) input.insert(input.end(), chunk, chunk + got);
+    fclose(fin);
+    std::string out_path = "output.bin", status_path = "status.txt", stats_path = "stats.txt";
+    plusarg(argc, argv, "output", out_path);
+    plusarg(argc, argv, "status", status_path);
+    plusarg(argc, argv, "stats", stats_path);
+    FILE* fout = fopen(out_path.c_str(), "wb");
+    FILE* fstatus = fopen(status_path.c_str(), "w");
+    FILE* fstats = fopen(stats_path.c_str(), "w");
+    if (!fout || !fstatus || !fstats) { fprintf(stderr, "rtlsim: ERROR: cannot open an output file\n"); return 1; }
+    if (plusarg(argc, argv, "beats_in", path)) sim.fbin = fopen(path.c_str(), "w");
+    if (plusarg(argc, argv, "beats_out", path)) sim.fbout = fopen(path.c_str(), "w");
+    sim.in = input.data(); sim.in_len = input.size(); sim.in_pos = 0;
+    const int rc = sim.run();
+    for (int i = 0; i < NS; ++i)
+        fprintf(fstats, "%d %llu %llu %llu\n", i, (unsigned long long)sim.first[i],
+                (unsigned long long)sim.last[i], (unsigned long long)sim.count[i]);
+    fprintf(fstats, "cycles %llu\n", (unsigned long long)sim.cycle);
+    for (auto& s : sim.statuses) fprintf(fstatus, "%llu %d\n", (unsigned long long)s.first, s.second);
+    if (!sim.out.empty()) fwrite(sim.out.data(), 1, sim.out.size(), fout);
+    fclose(fout); fclose(fstatus); fclose(fstats);
+    if (sim.fbin) fclose(sim.fbin);
+    if (sim.fbout) fclose(sim.fbout);
+    printf("rtlsim: %ld frame(s) in, %ld refused, %llu bytes in, %llu bytes out, %llu clocks\n",
+           sim.frames, sim.refused, (unsigned long long)sim.in_bytes,
+           (unsigned long long)sim.out.size(), (unsigned long long)sim.cycle);
+    if (rc == 2) { printf("rtlsim: ERROR: stalled: no handshake for +idle_limit clocks\n"); return 1; }
+    if (rc == 1) printf("rtlsim: the input ended inside a frame (the circuit waits for the rest)\n");
+    return 0;
+}

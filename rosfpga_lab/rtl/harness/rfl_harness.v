@@ -1,0 +1,43 @@
+// rfl_harness -- the top of the fast C++ simulation (rfl_harness.cpp): rfl_node, whose ports
+// the C++ drives and reads, plus read-only taps of the streams between the stages (the same
+// nets rfl_tb.v times), so that per-stage cycle spans and the application's beats can be
+// recorded. The taps are the only place the harness names a net inside rfl_top.
+module rfl_harness (
+    input         clk,
+    input         rst_n,
+    input  [7:0]  s_tdata,
+    input         s_tvalid,
+    output        s_tready,
+    output [7:0]  m_tdata,
+    output        m_tvalid,
+    input         m_tready,
+    output        frame_start,
+    output        status_valid,
+    output [3:0]  status,
+    output        busy,
+    output [8:0]  hs,            // handshake per stream (sim.STREAMS order, bit 0 first)
+    output [37:0] beat_in,       // {tlast, tuser, tkeep, tdata} into the application
+    output [37:0] beat_out       // ... and out of it
+);
+    rfl_node dut (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
+        .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
+        .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy));
+
+    assign hs = {
+        dut.u_top.axis_out_tvalid && dut.u_top.axis_out_tready,
+        m_tvalid && m_tready,
+        dut.u_top.tx_tvalid && dut.u_top.tx_tready,
+        dut.u_top.pix_out_tvalid && dut.u_top.pix_out_tready,
+        dut.u_top.app_out_tvalid && dut.u_top.app_out_tready,
+        dut.u_top.app_in_tvalid && dut.u_top.app_in_tready,
+        dut.u_top.axis_in_tvalid && dut.u_top.axis_in_tready,
+        dut.u_top.pix_in_tvalid && dut.u_top.pix_in_tready,
+        dut.u_top.rx_tvalid && dut.u_top.rx_tready
+    };
+    assign beat_in = {dut.u_top.axis_in_tlast, dut.u_top.axis_in_tuser, dut.u_top.axis_in_tkeep,
+                      dut.u_top.axis_in_tdata};
+    assign beat_out = {dut.u_top.app_out_tlast, dut.u_top.app_out_tuser,
+                       dut.u_top.app_out_tkeep, dut.u_top.app_out_tdata};
+endmodule

@@ -1,0 +1,106 @@
+"""The fast C++ harness (``rosfpga_lab/rtl/harness``) against today's Verilog testbench.
+
+The harness does on Verilator, without ``--timing``, what ``rtl/tb/rfl_tb.v`` does; here both
+run the same frames with the same seed, gaps and backpressure, and must give the same output
+bytes, the same status per frame, the same first/last clock and count of every stream between
+the stages (the cycle counts of ``rtl cycles``), the same total clocks and the same beats into
+and out of the application. The testbench runs on Icarus Verilog (quick to build for small
+images); both are also checked against the Python models.
+"""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from realros import require_rtl
+from rosfpga_lab.rtl import RtlError, build, rtl_params, run
+from rosfpga_lab.hw import image_frame
+from rosfpga_lab.rtl.project import generate_project
+from rosfpga_lab.rtl.sim import RtlBuild, RtlResult
+from rosfpga_lab.rtl.sim import find_tool as tool
+from test_rtl_sim import model_output, random_image, refusal_frames, small_config
+
+pytestmark = pytest.mark.rtl
+
+
+def assert_same_run(fast: RtlResult, tb: RtlResult) -> None:
+    assert fast.output == tb.output
+    assert fast.status == tb.status
+    assert fast.streams == tb.streams          # every stage's first/last handshake clock
+    assert fast.cycles == tb.cycles
+    assert fast.input_beats == tb.input_beats and fast.output_beats == tb.output_beats
+    assert fast.cut_short == tb.cut_short
+
+
+def mixed_frames(config) -> tuple[list[bytes], list[str]]:
+    """Two good frames around one a column too narrow (refused: width)."""
+    enc = config.image.encoding
+    a, b = random_image(config, 21), random_image(config, 22)
+    return ([image_frame(a, enc, frame_id="a"), image_frame(b[:, :-1], enc, frame_id="narrow"),
+             image_frame(b, enc, frame_id="b")], ["SUB_OK", "SUB_BAD_WIDTH", "SUB_OK"])
+
+
+@pytest.mark.parametrize("encoding,gap,bp", [("mono8", 300, 500), ("rgba8", 0, 0)])
+def test_harness_equals_the_testbench(encoding: str, gap: int, bp: int, tmp_path: Path) -> None:
+    """mono8: every refusal reason, each followed by a good frame, with input gaps and
+    backpressure; rgba8: good frames around a refused one at full speed, then cut short.
+    (Each case compiles a Verilator model: two cases keep the file near a minute.)"""
+    require_rtl("verilator")
+    require_rtl("iverilog")
+    if encoding == "mono8":
+        config = small_config(encoding, frame_id_max=16)
+        frames, names = refusal_frames(config)
+    else:
+        config = small_config(encoding)
+        frames, names = mixed_frames(config)
+    data = b"".join(frames)
+    fast_build = build(rtl_params(config), tmp_path / "fast", simulator="verilator")
+    tb_build = build(rtl_params(config), tmp_path / "tb", simulator="iverilog")
+    assert fast_build.harness and not tb_build.harness
+    fast = run(fast_build, data, seed=29, gap=gap, bp=bp, beats=True)
+    tb = run(tb_build, data, seed=29, gap=gap, bp=bp, beats=True)
+    assert_same_run(fast, tb)
+    expected, verdicts = model_output(config, frames)
+    assert fast.output == expected
+    assert [s if s == "SUB_OK" else "refused" for _, s in fast.status] == verdicts
+    assert [s for _, s in fast.status] == names
+    assert fast.cycles > 0 and fast.input_beats is not None and len(fast.input_beats) > 0
+    if encoding == "rgba8":   # and when the input ends inside a frame (the circuit waits)
+        cut = data + frames[0][: len(frames[0]) // 2]
+        fast = run(fast_build, cut, seed=3, gap=200, bp=200, idle_limit=2000)
+        tb = run(tb_build, cut, seed=3, gap=200, bp=200, idle_limit=2000)
+        assert fast.cut_short and tb.cut_short
+        assert_same_run(fast, tb)
+
+
+def test_make_rtlsim_on_verilator_runs_the_fast_harness(tmp_path: Path) -> None:
+    """The generated project's ``make rtlsim`` builds the harness and checks its output."""
+    require_rtl("verilator")
+    config = small_config("rgb8")
+    result = generate_project(config, tmp_path / "proj")
+    assert "rtl/rfl_harness.cpp" in result.files and "rtl/rfl_harness.v" in result.files
+    proj = tmp_path / "proj"
+    verilator = tool("verilator") or tool("verilator-cli")
+    proc = subprocess.run(["make", "-s", "rtlsim", "SIM=verilator", f"VERILATOR={verilator}",
+                           "GAP=100", "BP=200"], cwd=proj,
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "rtlsim: PASS: output equals tb_expected.bin" in proc.stdout
+    assert (proj / "rtl" / "obj_fast" / "rfl_fast").exists()
+    assert not (proj / "rtl" / "obj_dir").exists()     # the testbench was not built
+
+
+def test_harness_refuses_testbench_only_options(tmp_path: Path) -> None:
+    require_rtl("verilator")
+    config = small_config("mono8")
+    # the options are checked before anything runs: a build that was never compiled will do
+    sim = RtlBuild("verilator", ("false",), tmp_path, rtl_params(config), 0.0, False, True)
+    with pytest.raises(RtlError, match="harness=False"):
+        run(sim, b"", plusargs=["+clocks_f2a=x.txt"])
+    with pytest.raises(RtlError, match="trace=True"):
+        run(sim, b"", vcd=tmp_path / "w.vcd")
+    with pytest.raises(RtlError, match="Verilator without waveform"):
+        build(rtl_params(config), tmp_path / "x", simulator="verilator", trace=True, harness=True)
