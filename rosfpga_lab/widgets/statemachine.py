@@ -68,9 +68,9 @@ def _panel(role: str, rows: Sequence[Any], top: int, uid: str,
     for c, states in enumerate(columns):
         # the end states' column starts a row lower, so arrows into it pass beside the others
         shift = 1 if c == len(columns) - 1 and len(columns) > 1 else 0
-        band, x = (c // per_band, c % per_band) if bands > 1 else (0, c)
+        band, slot = (c // per_band, c % per_band) if bands > 1 else (0, c)
         for k, s in enumerate(states):
-            pos[s] = (20 + BOX_W / 2 + x * col, first + (band * band_rows + k + shift) * ROW)
+            pos[s] = (20 + BOX_W / 2 + slot * col, first + (band * band_rows + k + shift) * ROW)
     height = 70 + ROW * max(len(c) + (1 if i == len(columns) - 1 else 0)
                             + (i // per_band * band_rows if bands > 1 else 0)
                             for i, c in enumerate(columns)) - ROW + 30
@@ -207,7 +207,7 @@ def layout_transitions(layout: Any) -> list[WalkTransition]:
 
     def after(i: int) -> int:
         s = steps[i]
-        return (s.partner if str(s.kind) == "loop" else i) + 1   # type: ignore[operator]
+        return (s.partner if str(s.kind) == "loop" else i) + 1
 
     def size(s: Any) -> str:   # the trigger: short, the tooltip says more
         if str(s.kind) in ("scalar", "length"):
