@@ -62,7 +62,9 @@ def test_a_message_layout_is_drawn_as_its_subscriber_state_machine(tmp_path) -> 
     arrows = _arrows(svg)
     role = "t_msgs/Scan subscriber"
     assert "not == 2: refuse: SUB_BAD_GAIN" in arrows[(role, "GAIN", "SKIP")]
-    assert "0: names is empty" in arrows[(role, "NAMES_LENGTH", "GAIN")]
+    assert "no elements: names is empty" in arrows[(role, "NAMES_LOOP", "GAIN")]
+    assert "0: ranges is empty" in arrows[(role, "RANGES_LENGTH", "FRAME_LENGTH")]
+    assert (role, "NAMES_LENGTH", "GAIN") not in arrows   # the loop's own state says it
     assert "more elements: next element of names" in arrows[(role, "NAMES_END", "NAMES_ITEM_LENGTH")]
     assert "last element: names done" in arrows[(role, "NAMES_END", "GAIN")]
     assert "n x 4 bytes: stream ranges (float32), n = ranges length as AXI4-Stream beats" \

@@ -243,7 +243,9 @@ def layout_transitions(layout: Any) -> list[WalkTransition]:
             back = state(0) if i == 0 else SKIP_STATE
             rows.append(WalkTransition(role, state(i), f"not {s.check.describe()}", back,
                                        f"refuse: {s.check.status}"))
-        if kind == "length" and i > 0 and s.partner is not None and steps[s.partner].count is None:
+        # a zero count passes a string or array at once (a loop's own state says "no elements")
+        if (kind == "length" and i > 0 and s.partner is not None
+                and str(steps[s.partner].kind) != "loop" and steps[s.partner].count is None):
             rows.append(WalkTransition(role, state(i), "0", state(after(s.partner)),
                                        f"{steps[s.partner].label} is empty"))
     rows.append(WalkTransition(role, SKIP_STATE, "rest of the frame", state(0),
