@@ -181,7 +181,9 @@ def check_refused_field(answer: Any, frame: bytes, layout: Layout, reg: MsgRegis
                                 f"{refused.rule}), status {status or 'SUB_BAD_FRAME_LENGTH'}",
                                 f"it stops there: nothing after byte {refused.offset} is checked"])
     spans = walk_spans(layout, deserialize(reg, layout.type_name, frame[4:]))
-    where = {lab: off for off, _n, lab in spans}
+    where: dict[str, int] = {}
+    for off, _n, lab in spans:
+        where.setdefault(lab, off)
     named = [s for s in layout.steps if s.check is not None and s.check.status == given]
     if named:
         given = named[0].label
