@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.generic import GENERIC_MODULES, GENERIC_VERILOG_DIR, LAYOUT_INCLUDE
 from rosfpga_lab.rtl.limits import FORMAL_TIMEOUT
 from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 
@@ -37,11 +38,13 @@ class Proof:
 
     Attributes:
         name: the wrapper is ``formal/fv_<name>.sv``, top module ``fv_<name>``.
-        design: the files of ``verilog/`` it needs.
+        design: the files of ``verilog/`` or ``generic/`` it needs.
         mode: ``"prove"`` (BMC + k-induction) or ``"bmc"``.
         depth: clocks of the bounded check (and of the induction in prove mode).
         defines: Verilog macros for the wrapper (``FV_PROVE`` leaves out what only holds bounded).
         claim: what it shows, in words.
+        layout: the design includes the generated walk ``rfl_layout.vh``: prove against the one
+            of :func:`formal_program` (a small message type).
     """
 
     name: str
@@ -50,6 +53,7 @@ class Proof:
     depth: int
     claim: str
     defines: tuple[str, ...] = ()
+    layout: bool = False
 
 
 #: Every check, every module of the circuit at least once. Inputs are assumed to keep the stream
@@ -89,6 +93,27 @@ PROOFS: tuple[Proof, ...] = (
     Proof("top", tuple(p.name for p in sorted(VERILOG_DIR.glob("*.v"))), "prove", 8,
           "rfl_top (2x1 mono8, FIFOs 4 deep, any input bytes): output stream rules, busy while "
           "output is pending; all reachable states"),
+    # the generic element-stream modules (generic/)
+    Proof("elem_pack", ("rfl_elem_pack.v",), "prove", 8,
+          "rfl_elem_pack (2-byte elements, arrays of 3): output stream rules, TKEEP; all "
+          "reachable states", ("FV_PROVE",)),
+    Proof("elem_pack", ("rfl_elem_pack.v",), "bmc", 20,
+          "rfl_elem_pack (2-byte elements, arrays of 3): TUSER on an array's first element only, "
+          "TLAST on its last only, each beat = the bytes taken, lane 0 first; 20 clocks"),
+    Proof("elem_unpack", ("rfl_elem_unpack.v",), "prove", 8,
+          "rfl_elem_unpack (2-byte elements): output stream rules; all reachable states",
+          ("FV_PROVE",)),
+    Proof("elem_unpack", ("rfl_elem_unpack.v",), "bmc", 12,
+          "rfl_elem_unpack (2-byte elements): at most one element held, valid while a byte is "
+          "owed, the bytes of the n-th element are bytes 2n, 2n+1 out, byte 0 first (none lost, "
+          "duplicated or reordered), any n; 12 clocks"),
+    Proof("window1d", ("rfl_window1d.v",), "prove", 8,
+          "rfl_window1d (1-byte unsigned, arrays of 3, dilate over 3): output stream rules, "
+          "TKEEP; all reachable states", ("FV_PROVE",)),
+    Proof("window1d", ("rfl_window1d.v",), "bmc", 16,
+          "rfl_window1d (1-byte unsigned, arrays of 3, dilate over 3): TUSER/TLAST on an "
+          "array's first/last element only, each element = the maximum of its in-array "
+          "neighbours; 16 clocks (three arrays at full rate)"),
 )
 
 
@@ -133,8 +158,14 @@ def _tools() -> list[str]:
     return [find_tool("sby") or "sby"]
 
 
-def sby_text(proof: Proof, design_files: Sequence[Path]) -> str:
-    """The ``.sby`` file of ``proof`` over ``design_files``."""
+def design_path(name: str) -> Path:
+    """Where the design file ``name`` of a :class:`Proof` lives (``generic/`` or ``verilog/``)."""
+    return (GENERIC_VERILOG_DIR if name in GENERIC_MODULES else VERILOG_DIR) / name
+
+
+def sby_text(proof: Proof, design_files: Sequence[Path], includes: Sequence[Path] = ()) -> str:
+    """The ``.sby`` file of ``proof`` over ``design_files`` (``includes``: more included files,
+    such as a generated ``rfl_layout.vh``)."""
     defines = " ".join(f"-D{d}" for d in proof.defines)
     wrapper = FORMAL_DIR / f"fv_{proof.name}.sv"
     lines = ["[options]", f"mode {proof.mode}", f"depth {proof.depth}", "",
@@ -143,7 +174,9 @@ def sby_text(proof: Proof, design_files: Sequence[Path]) -> str:
     lines += [f"read_verilog -formal -sv {defines} {wrapper.name}".replace("  ", " "),
               f"prep -top fv_{proof.name}", "memory_map", "opt -fast", "", "[files]"]
     lines += [str(p) for p in design_files]
-    lines += [str(wrapper), str(FORMAL_DIR / ENV_INCLUDE), str(VERILOG_DIR / "rfl_status.vh"), ""]
+    lines += [str(wrapper), str(FORMAL_DIR / ENV_INCLUDE), str(VERILOG_DIR / "rfl_status.vh")]
+    lines += [str(p) for p in includes]
+    lines.append("")
     return "\n".join(lines)
 
 
@@ -164,7 +197,7 @@ def prove(proof: Proof, *, work_dir: str | Path | None = None,
     if reason:
         raise RtlError(reason)
     replace = replace or {}
-    design = [replace.get(name, VERILOG_DIR / name) for name in proof.design]
+    design = [replace.get(name, design_path(name)) for name in proof.design]
     env = dict(os.environ)
     tools_dir = str(Path(find_tool("yices-smt2") or "yices-smt2").parent)
     env["PATH"] = tools_dir + os.pathsep + env.get("PATH", "")
@@ -172,7 +205,11 @@ def prove(proof: Proof, *, work_dir: str | Path | None = None,
         work = Path(work_dir) if work_dir else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         sby = work / f"fv_{proof.name}_{proof.mode}.sby"
-        sby.write_text(sby_text(proof, design))
+        includes = []
+        if proof.layout:
+            includes.append(work / LAYOUT_INCLUDE)
+            includes[-1].write_text(formal_layout())
+        sby.write_text(sby_text(proof, design, includes))
         start = time.perf_counter()
         try:
             proc = subprocess.run([*_tools(), "-f", sby.name], cwd=work, capture_output=True,
