@@ -24,7 +24,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosfpga_lab.rtl.errors import RtlError
-from rosfpga_lab.rtl.generic import GENERIC_MODULES, GENERIC_VERILOG_DIR, LAYOUT_INCLUDE
+from rosfpga_lab.hls.generic import GenericSpec
+from rosfpga_lab.hls.program import Instr, Op, Program, Pub, Sub
+from rosfpga_lab.rtl.generic import (
+    GENERIC_MODULES, GENERIC_VERILOG_DIR, LAYOUT_INCLUDE, generic_rtl_files,
+)
 from rosfpga_lab.rtl.limits import FORMAL_TIMEOUT
 from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 
@@ -114,7 +118,50 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_window1d (1-byte unsigned, arrays of 3, dilate over 3): TUSER/TLAST on an "
           "array's first/last element only, each element = the maximum of its in-array "
           "neighbours; 16 clocks (three arrays at full rate)"),
+    # the walkers of generated projects, on the small walk of formal_program()
+    Proof("gsubscriber", ("rfl_gsubscriber.v",), "prove", 4,
+          "rfl_gsubscriber (formal_program, any input bytes): stream rules, status codes of the "
+          "table; all reachable states", ("FV_PROVE",), True),
+    Proof("gsubscriber", ("rfl_gsubscriber.v",), "bmc", 28,
+          "rfl_gsubscriber (formal_program, any input bytes): fields held unchanged until "
+          "released, each frame handed over streamed exactly the array's 2 bytes, never more, "
+          "accepted: the answer's length in range; 28 clocks (the shortest frame, 15 bytes, "
+          "takes 26)", (), True),
 )
+
+
+def formal_program() -> Program:
+    """The walk the program walkers are proven against: a small message of every part the
+    subscriber checks (a constant, a carried string of at most 2 bytes, a streamed array of
+    exactly 2 one-byte elements), frames of 15 to 17 bytes."""
+    instrs = [
+        Instr(Op.FIXED, Sub.CHECK, Pub.CONST, 1, status=2, const=b"\x02", name="mode",
+              type="uint8"),
+        Instr(Op.VAR, Sub.CARRY, Pub.CARRY, 1, 2, status=3, name="label", type="string"),
+        Instr(Op.VAR, Sub.STREAM, Pub.STREAM, 1, 2, status=4, fixed_after=0, name="samples",
+              type="uint8[]"),
+        Instr(Op.DONE, status=1),
+    ]
+    statuses = (("SUB_OK", "frame accepted"), ("SUB_BAD_FRAME_LENGTH", "frame length"),
+                ("SUB_BAD_MODE", "mode"), ("SUB_BAD_LABEL", "label"),
+                ("SUB_BAD_SAMPLES", "samples"))
+    return Program.build(instrs, statuses=statuses, min_body=1 + 4 + 4 + 2,
+                         max_frame=1 + 4 + 2 + 4 + 2, seq_start=1, stream_bytes=1,
+                         stream_length=2, carry_bytes=4 + 2, type_in="lab_msgs/FormalTiny",
+                         type_out="lab_msgs/FormalTiny")
+
+
+def formal_layout() -> str:
+    """``rfl_layout.vh`` of :func:`formal_program`, rendered by the project generator."""
+    hdr = {"callerid": "/fpga", "md5sum": "0" * 32, "type": "lab_msgs/FormalTiny",
+           "topic": "/in", "message_definition": "", "tcp_nodelay": "1"}
+    spec = GenericSpec(program=formal_program(), node_name="/fpga", sub_topic="/in",
+                       pub_topic="/out", master_uri="http://127.0.0.1:11311",
+                       ip_address="127.0.0.1", input_depth=4, output_depth=4, axis_depth=4,
+                       part="xc7z020clg400-1", clock_mhz=100.0, op="dilate", ksize=3,
+                       kind="unsigned", stream_name="samples", stream_type="uint8[]",
+                       subscriber_header=hdr, publisher_header=hdr, config_name="rtl/proofs.py")
+    return generic_rtl_files(spec)[LAYOUT_INCLUDE].decode()
 
 
 def formal_missing_reason() -> str | None:
