@@ -127,6 +127,14 @@ PROOFS: tuple[Proof, ...] = (
           "released, each frame handed over streamed exactly the array's 2 bytes, never more, "
           "accepted: the answer's length in range; 28 clocks (the shortest frame, 15 bytes, "
           "takes 26)", (), True),
+    Proof("gpublisher", ("rfl_gpublisher.v",), "prove", 4,
+          "rfl_gpublisher (formal_program, fields held until released): output stream rules; "
+          "all reachable states", ("FV_PROVE",), True),
+    Proof("gpublisher", ("rfl_gpublisher.v",), "bmc", 26,
+          "rfl_gpublisher (formal_program, fields held until released): releases only fields it "
+          "holds, a frame starts with its length then the constant, takes exactly the array's 2 "
+          "bytes per frame, writes nothing for a dropped one; 26 clocks (a whole frame)",
+          (), True),
 )
 
 
