@@ -135,7 +135,8 @@ def _register_prove(subparsers: argparse._SubParsersAction) -> None:
     )
     prove.add_argument("--only", metavar="NAME", action="append",
                        help="only this check (fifo, fifo2axi, axi2fifo, morph, subscriber, "
-                       "publisher, top; repeatable)")
+                       "publisher, top; the generic modules: elem_pack, elem_unpack, window1d, "
+                       "gsubscriber, gpublisher, gtop; repeatable)")
     prove.set_defaults(func=run_prove)
 
 
