@@ -59,8 +59,9 @@ def test_master_cli_serves_and_stops() -> None:
         wait_for_master(f"http://127.0.0.1:{port}/", timeout=10)
         node = Node("/probe", master_uri=f"http://127.0.0.1:{port}/")
         node.advertise("/x", "std_msgs/String")
+        assert node.logging_ready.wait(5)
         out = cli("topic", "--master-uri", f"http://127.0.0.1:{port}/", "list")
-        assert out.stdout.split() == ["/x"]
+        assert out.stdout.split() == ["/rosout", "/x"]   # every node logs on /rosout, as in ROS
         node.shutdown()
     finally:
         stop_process(proc)

@@ -224,9 +224,10 @@ def test_slave_api(nodes, master) -> None:
     a.advertise("/o", "std_msgs/String")
     a.subscribe("/i", "std_msgs/String")
     p = xmlrpc.client.ServerProxy(a.uri)
+    assert a.logging_ready.wait(5)   # /rosout comes in its own thread after the first registration
     assert p.getPid("/x") == [1, "", os.getpid()]
     assert p.getMasterUri("/x") == [1, "", master.uri]
-    assert p.getPublications("/x")[2] == [["/o", "std_msgs/String"]]
+    assert p.getPublications("/x")[2] == [["/o", "std_msgs/String"], ["/rosout", "rosgraph_msgs/Log"]]
     assert p.getSubscriptions("/x")[2] == [["/i", "std_msgs/String"]]
     assert p.requestTopic("/x", "/o", [["UDPROS"]]) == [0, "no supported protocol implementations", []]
     assert p.requestTopic("/x", "/none", [["TCPROS"]]) == [-1, "Not a publisher of [/none]", []]

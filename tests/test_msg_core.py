@@ -7,6 +7,7 @@ Every md5 pinned here was read from Debian's genpy classes (``sensor_msgs.msg.Im
 from __future__ import annotations
 
 import struct
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -39,12 +40,9 @@ GOLDEN_MD5 = {
     "sensor_msgs/LaserScan": "90c7ef2dc6895d81024acba2ac42f369",
 }
 
-# genpy's Image._full_text with the comments stripped (the lab's documented rule).
-IMAGE_FULL_TEXT = (
-    "Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\n"
-    "uint32 step\nuint8[] data\n\n" + "=" * 80 + "\nMSG: std_msgs/Header\n"
-    "uint32 seq\ntime stamp\nstring frame_id\n"
-)
+# genpy's sensor_msgs/Image._full_text (Debian's Noetic), comments included: what roscpp and
+# rospy send as message_definition (2016 bytes); pinned from genpy.
+IMAGE_FULL_TEXT = (Path(__file__).resolve().parent / "golden" / "sensor_msgs_Image.full_text").read_text()
 
 
 @pytest.fixture(scope="module")
@@ -74,6 +72,7 @@ def test_shipped_packages_complete(reg: MsgRegistry) -> None:
 
 
 def test_image_full_text(reg: MsgRegistry) -> None:
+    assert len(IMAGE_FULL_TEXT.encode()) == 2016
     assert reg.full_text("sensor_msgs/Image") == IMAGE_FULL_TEXT
 
 

@@ -5,7 +5,7 @@ the system Python once per test and compares in bulk:
 
 * every message type of Debian's std_msgs, sensor_msgs and geometry_msgs: the lab's md5 and
   full text against genpy's ``_md5sum`` and ``_full_text`` (a) with genpy's own commented texts
-  loaded and (b) with the lab's shipped, comment-stripped definitions; fields and constants;
+  loaded and (b) with the lab's shipped definitions (the same commented texts); fields and constants;
 * the tricky definitions of test_msg_parse.py against genmsg itself;
 * serialized bytes against genpy on hypothesis-generated values of every type, both ways, and a
   640x480 rgba8 sensor_msgs/Image.
@@ -25,8 +25,7 @@ from hypothesis import strategies as st
 
 from realros import ROS_PROGRAMS, require_ros, run_ros_python
 from rosfpga_lab.msg import (
-    MsgRegistry, default_registry, deserialize, new_message, serialize, split_full_text,
-    strip_comments,
+    MsgRegistry, default_registry, deserialize, new_message, serialize,
 )
 from rosfpga_lab.msg.builtins import SCALARS
 from rosfpga_lab.msg.strategies import message, normalize
@@ -34,7 +33,7 @@ from test_msg_parse import BAD, TRICKY
 
 pytestmark = pytest.mark.ros
 REG = default_registry()
-PACKAGES = ("std_msgs", "sensor_msgs", "geometry_msgs")
+PACKAGES = ("std_msgs", "sensor_msgs", "geometry_msgs", "rosgraph_msgs", "roscpp")
 
 
 def run_helper(name: str, argv: list[str] | None = None, stdin: Any = None) -> Any:
@@ -71,22 +70,13 @@ def test_genpy_commented_texts_reproduce_full_text_and_md5(genpy: dict[str, dict
     assert not bad, f"(a) differs from genpy for {bad}"
 
 
-def stripped_full_text(genpy_full_text: str) -> str:
-    """genpy's full text with each section's comments stripped (the lab's documented rule)."""
-    sections = split_full_text(genpy_full_text)
-    out = strip_comments(sections[0][1]) + "\n"
-    for dep, text in sections[1:]:
-        out += "=" * 80 + "\n" + f"MSG: {dep}\n" + strip_comments(text) + "\n"
-    return out[:-1]
-
-
 def test_shipped_definitions_match_genpy(genpy: dict[str, dict]) -> None:
     md5_bad, text_bad, field_bad, const_bad = [], [], [], []
     for name, info in genpy.items():
         spec = REG.get(name)
         if REG.md5(name) != info["md5"]:
             md5_bad.append(name)
-        if REG.full_text(name) != stripped_full_text(info["full_text"]):
+        if REG.full_text(name) != info["full_text"]:  # byte for byte, comments included
             text_bad.append(name)
         if (spec.field_names, spec.field_types) != (info["slots"], info["slot_types"]):
             field_bad.append(name)

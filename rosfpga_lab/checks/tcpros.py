@@ -11,7 +11,7 @@ from typing import Any
 from rosfpga_lab.checks._core import (
     ByteField, CheckResult, as_bytes, describe_byte_difference, fail, require_answer,
 )
-from rosfpga_lab.msg import MsgRegistry, default_registry
+from rosfpga_lab.msg import MsgRegistry, default_registry, strip_comments
 from rosfpga_lab.tcpros import FrameDecoder, encode_header, parse_fields
 
 
@@ -96,6 +96,10 @@ def check_md5(type_name: str, answer: Any, registry: MsgRegistry | None = None) 
                         "replaced by their own md5 sums",
         md5(spec.text.strip()): "that is the md5 of the .msg text; nested types must be replaced "
                                 "by their own md5 sums",
+        md5(strip_comments(spec.text)): "that is the md5 of the .msg fields as written; nested "
+                                        "types must be replaced by their own md5 sums",
+        md5(strip_comments(spec.text).strip()): "that is the md5 of the .msg fields; nested types "
+                                                "must be replaced by their own md5 sums",
         md5(plain): "that hashes the full type names of the nested types; replace each by its "
                     "md5 sum",
         md5(short): "that hashes the nested type names; replace each by its md5 sum",

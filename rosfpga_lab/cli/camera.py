@@ -36,6 +36,25 @@ def _common(p: argparse.ArgumentParser, *, with_config: bool) -> None:
     p.add_argument("--master-uri", metavar="URI",
                    help=f"ROS master (default: ROS_MASTER_URI, else {from_config}{DEFAULT_MASTER_URI})")
     p.add_argument("--name", metavar="NODE", help="node name")
+    p.add_argument("--ros2", action="store_true",
+                   help="ROS 2 instead of ROS 1: a DDS participant on 127.0.0.1, no master")
+    p.add_argument("--domain", type=int, default=None, metavar="N",
+                   help="with --ros2: the DDS domain (default: ROS_DOMAIN_ID, else 0)")
+
+
+def _domain(args: argparse.Namespace) -> int | None:
+    """The DDS domain with --ros2 (None: ROS 1)."""
+    import os
+
+    from rosfpga_lab.component import ComponentError
+
+    if not args.ros2:
+        return None
+    raw = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID") or "0"
+    try:
+        return int(raw)
+    except ValueError:
+        raise ComponentError(f"ROS_DOMAIN_ID={raw!r} is not a number; give --domain N") from None
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -139,10 +158,12 @@ def _run_camera(args: argparse.Namespace) -> int:
         args.count = args.count or source.period
     topic = args.topic or topic
     name, topic, host = _identity(args, "/camera", topic)
-    uri = _master_uri(args, cfg)
+    uri = None if args.ros2 else _master_uri(args, cfg)   # ROS 2: a DDS participant, no master
     with holding(deliver=False):   # registering: a signal waits (delivered in the try below)
         cam = Camera(topic, width=size[0], height=size[1], encoding=encoding, rate=args.rate,
-                     source=source, name=name, master_uri=uri, frame_id=args.frame_id, host=host)
+                     source=source, name=name, master_uri=uri, frame_id=args.frame_id,
+                     host=None if args.ros2 else host,
+                     domain=_domain(args))
     stop = threading.Event()
     tty = sys.stdout.isatty()
     worker = threading.Thread(target=cam.run, kwargs={"count": args.count, "stop": stop}, daemon=True)
@@ -183,10 +204,11 @@ def _run_view(args: argparse.Namespace) -> int:
     from rosfpga_lab.component import Viewer
 
     name, topic, host = _identity(args, "/viewer", args.topic)
-    uri = _master_uri(args)
+    uri = None if args.ros2 else _master_uri(args)   # ROS 2: a DDS participant, no master
     with holding(deliver=False):   # registering: a signal waits (delivered in the try below)
         viewer = Viewer(topic, save_dir=args.save, every=args.every, latest_only=args.latest,
-                        name=name, master_uri=uri, host=host)
+                        name=name, master_uri=uri, host=None if args.ros2 else host,
+                        domain=_domain(args))
     tty = sys.stdout.isatty()
     deadline = None if args.timeout is None else time.monotonic() + args.timeout
     try:

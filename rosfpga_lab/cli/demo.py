@@ -61,6 +61,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "the traces are bounded in bytes: past that the oldest events go, and the "
                    "capture says so)")
     p.add_argument("-v", "--verbose", action="store_true", help="print each step")
+    p.add_argument("--ros2", action="store_true",
+                   help="the same on ROS 2: camera, component and viewer as DDS participants on "
+                   "127.0.0.1, no master (no figure, live view or capture yet)")
+    p.add_argument("--domain", type=int, default=None, metavar="N",
+                   help="with --ros2: the DDS domain (default: ROS_DOMAIN_ID, else 0)")
     p.set_defaults(func=run)
 
 
@@ -72,6 +77,9 @@ def run(args: argparse.Namespace) -> int:
     """Run the demo; 0 when every output came back bit-exact and no frame was lost."""
     from rosfpga_lab.component import run_demo
 
+    if args.ros2:
+        return run_ros2(args)
+
     try:
         result = run_demo(args.config, frames=args.frames, rate=args.rate, source=args.source,
                           png=None if args.no_figure else args.output, model=args.model,
@@ -79,6 +87,29 @@ def run(args: argparse.Namespace) -> int:
                           progress=print if args.verbose else None,
                           view=_announce if args.view else None, pcap=args.pcap,
                           pcap_frame_bytes=args.pcap_frame_bytes, input_queue=args.input_queue)
+    except KeyboardInterrupt:
+        print("rosfpga-lab demo: interrupted (everything it started is stopped); no verdict",
+              file=sys.stderr)
+        return 130
+    print("\n".join(result.lines()), flush=True)
+    return 0 if result.ok else 1
+
+
+def run_ros2(args: argparse.Namespace) -> int:
+    """``demo --ros2``: 0 when every frame came back bit-exact."""
+    import os
+
+    from rosfpga_lab.component.ros2 import run_demo_ros2
+    from rosfpga_lab.errors import LabError
+
+    raw = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID") or "0"
+    try:
+        result = run_demo_ros2(args.config, frames=args.frames, rate=args.rate,
+                               source=args.source, domain=int(raw), model=args.model or "fast",
+                               timeout=args.timeout)
+    except (ValueError, LabError) as exc:
+        print(f"rosfpga-lab demo: error: {exc}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("rosfpga-lab demo: interrupted (everything it started is stopped); no verdict",
               file=sys.stderr)

@@ -58,11 +58,59 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "configuration's msg_path")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no status line and no log lines, only the final summary")
+    p.add_argument("--ros2", action="store_true",
+                   help="run as a ROS 2 node (DDS/RTPS on 127.0.0.1, no master) instead of ROS 1")
+    p.add_argument("--domain", type=int, default=None, metavar="N",
+                   help="with --ros2: the DDS domain (default: ROS_DOMAIN_ID, else 0)")
+    p.add_argument("--best-effort-input", action="store_true",
+                   help="with --ros2: subscribe BEST_EFFORT (matches best-effort cameras, e.g. "
+                   "ROS 2's sensor-data QoS, as well as reliable ones); default RELIABLE, ROS 2's "
+                   "default, which a best-effort writer never matches")
     p.set_defaults(func=run, ros_node=True)
+
+
+def run_ros2(args: argparse.Namespace) -> int:
+    """``node --ros2``: the component as a ROS 2 participant until Ctrl-C or --duration."""
+    import os
+
+    from rosfpga_lab.component.ros2 import Ros2Component
+    from rosfpga_lab.errors import LabError
+    from rosfpga_lab.rtps.participant import Qos
+
+    if not args.quiet:
+        logging.basicConfig(level=logging.INFO, format="[%(levelname)s] %(message)s",
+                            stream=sys.stderr)
+    raw = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID", "0") or "0"
+    try:
+        domain = int(raw)
+        qos_in = Qos(reliable=not args.best_effort_input)
+        model = args.model or MODELS[0]
+        comp = Ros2Component(args.config, domain=domain, model=model, qos_in=qos_in).start()
+    except (ValueError, LabError) as exc:
+        print(f"rosfpga-lab node: error: {exc}", file=sys.stderr)
+        return 1
+    print(f"{comp.name}: ROS 2 (DDS domain {domain}, participant index "
+          f"{comp.node.index if comp.node else '?'}, input {comp.qos_in.describe()}) "
+          f"{comp.input_topic} -> {comp.pipeline.op} ({model} CDR circuit model) -> "
+          f"{comp.output_topic}; "
+          "Ctrl-C to stop", flush=True)
+    t_end = None if args.duration is None else time.monotonic() + args.duration
+    try:
+        while t_end is None or time.monotonic() < t_end:
+            time.sleep(0.1)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        comp.stop()
+    c = comp.counts
+    print(f"{c['seen']} samples seen, {c['published']} published, {c['refused']} refused", flush=True)
+    return 0
 
 
 def run(args: argparse.Namespace) -> int:
     """Start the component, show the status until interrupted, stop cleanly."""
+    if args.ros2:
+        return run_ros2(args)
     # SIGINT and SIGTERM only set a flag the loops poll (a handler that takes a lock could wait
     # forever on one the interrupted main thread holds), whatever disposition was inherited.
     with StopSignals(raise_interrupt=False) as stop:

@@ -63,6 +63,7 @@ class Camera:
         name: node name. master, master_uri, host: as for :class:`rosfpga_lab.graph.Node`.
         frame_id: ``header.frame_id`` of every frame.
         queue_size: frames queued per subscriber (oldest dropped when full).
+        domain: publish on ROS 2 in this DDS domain instead (a DDS participant, no master).
         on_sent: ``on_sent(SentFrame)`` just before each publish (e.g. a checker remembering
             inputs).
 
@@ -74,7 +75,8 @@ class Camera:
                  encoding: str = DEFAULT_ENCODING, rate: float = 30.0, source: str | ImageSource = "synthetic",
                  name: str = "/camera", master: EmbeddedMaster | None = None,
                  master_uri: str | None = None, host: str | None = None, frame_id: str = "camera",
-                 queue_size: int = 2, on_sent: Callable[[SentFrame], Any] | None = None) -> None:
+                 queue_size: int = 2, on_sent: Callable[[SentFrame], Any] | None = None,
+                 domain: int | None = None) -> None:
         if not 0 < rate <= limits.MAX_CAMERA_RATE:
             raise SourceError(f"rate {rate} is outside (0, {limits.MAX_CAMERA_RATE:g}] frames/s")
         self.source = source if isinstance(source, ImageSource) else open_source(
@@ -82,12 +84,22 @@ class Camera:
         self.topic, self.rate, self.frame_id = topic, float(rate), frame_id
         self.on_sent = on_sent
         self._images = [self.source.frame(k) for k in range(self.source.period)]
-        self.node = Node(name, master_uri, host, master=master)
-        try:
-            self.publisher = self.node.advertise(topic, "sensor_msgs/Image", queue_size=queue_size)
-        except BaseException:
-            self.node.shutdown()
-            raise
+        self.node: Any
+        self.publisher: Any
+        if domain is not None:     # ROS 2: a DDS participant instead of a ROS 1 node
+            from rosfpga_lab.component.ros2 import Ros2ImagePublisher
+            from rosfpga_lab.graph.ros2 import Ros2Node
+
+            self.node = Ros2Node(name.strip("/") or "camera", domain, host or "127.0.0.1")
+            self.publisher = Ros2ImagePublisher(self.node, topic)
+        else:
+            self.node = Node(name, master_uri, host, master=master)
+            try:
+                self.publisher = self.node.advertise(topic, "sensor_msgs/Image",
+                                                     queue_size=queue_size)
+            except BaseException:
+                self.node.shutdown()
+                raise
         self.sent = 0
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -186,13 +198,14 @@ class Viewer:
         latest_only: overwrite ``latest.png`` instead of numbering files.
         name, master, master_uri, host: as for :class:`rosfpga_lab.graph.Node`.
         on_frame: ``on_frame(ViewedFrame)`` after each frame.
+        domain: subscribe on ROS 2 in this DDS domain instead (a DDS participant, no master).
     """
 
     def __init__(self, topic: str, *, save_dir: str | Path | None = None, every: int = 1,
                  latest_only: bool = False, name: str = "/viewer",
                  master: EmbeddedMaster | None = None, master_uri: str | None = None,
                  host: str | None = None, on_frame: Callable[[ViewedFrame], Any] | None = None,
-                 queue_size: int = 2) -> None:
+                 queue_size: int = 2, domain: int | None = None) -> None:
         self.topic = topic
         self.save_dir = Path(save_dir) if save_dir is not None else None
         if self.save_dir is not None:
@@ -209,6 +222,14 @@ class Viewer:
         self.last: ViewedFrame | None = None
         self._rate = fps_meter()
         self._lock = threading.Lock()
+        self.node: Any
+        if domain is not None:     # ROS 2: a DDS participant instead of a ROS 1 node
+            from rosfpga_lab.component.ros2 import subscribe_ros1_bodies
+            from rosfpga_lab.graph.ros2 import Ros2Node
+
+            self.node = Ros2Node(name.strip("/") or "viewer", domain, host or "127.0.0.1")
+            subscribe_ros1_bodies(self.node, topic, self._on_body)
+            return
         self.node = Node(name, master_uri, host, master=master)
         try:
             self.subscriber = self.node.subscribe(topic, "sensor_msgs/Image", self._on_body,

@@ -283,6 +283,7 @@ class FpgaComponent:
             kw["trace"] = self.trace
         node = Node(self.name, host=self.host, xmlrpc_port=self.config.node.xmlrpc_port,
                     tcpros_port=self.config.node.tcpros_port, registry=self.registry, **kw)
+        node.watch_master = False   # check_master below watches (and reports) for the component
         try:
             self._pub = node.advertise(self.output_topic, self.config.publisher.type,
                                        queue_size=self.output_queue)

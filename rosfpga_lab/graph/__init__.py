@@ -27,7 +27,8 @@ with an error and a hint when no master answers there).
 Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``master`` (EmbeddedMaster),
 ``node`` (Node, Slave API, TCPROS server), ``publisher``, ``subscriber``, ``trace`` (the recorded
 conversation; its docstring documents the format), ``names`` (names, ROS_* environment),
-``owner`` (which Unix user listens on a port), ``rate`` (RateMeter, every events-per-second
+``owner`` (which Unix user listens on a port), ``service`` (TCPROS services), ``rosout``
+(/rosout and the logger services), ``watchdog`` (registering again after a master restart), ``rate`` (RateMeter, every events-per-second
 figure), ``errors`` (errors), ``limits`` (limits).
 """
 
@@ -36,6 +37,7 @@ from rosfpga_lab.graph.errors import (
     ConfigError,
     GraphError,
     MasterError,
+    ServiceError,
     XmlRpcError,
     XmlRpcTooLargeError,
 )
@@ -63,5 +65,5 @@ __all__ = [
     "GraphError", "LinkStats", "MasterError", "MessageInfo", "Node", "OpenBindWarning",
     "ParamTree", "Publisher", "PublisherStats", "RateMeter", "Subscriber", "SubscriberStats", "Trace",
     "TraceEvent", "XmlRpcError", "XmlRpcTooLargeError", "XmlRpcServer", "call", "default_host", "default_master_uri", "master_uri_from_env",
-    "parse_xmlrpc", "resolve", "shared_master", "stop_shared_master",
+    "parse_xmlrpc", "resolve", "shared_master", "stop_shared_master", "ServiceError",
 ]

@@ -34,5 +34,9 @@ class ApiArgumentError(GraphError):
     """An XML-RPC API call had the wrong number or types of arguments."""
 
 
+class ServiceError(GraphError):
+    """A service call failed: no provider, refused header, ``ok=0`` answer, or time-out."""
+
+
 class ConfigError(GraphError):
     """Bad configuration: a malformed ROS_MASTER_URI, host or name."""

@@ -5,10 +5,22 @@ from __future__ import annotations
 #: Largest HTTP request/response body accepted (XML-RPC payloads are small; 8 MiB leaves room
 #: for a big getSystemState or parameter tree).
 MAX_XMLRPC_BODY = 8 << 20
+#: Bytes of request bodies one XML-RPC server holds at once, all connections together: a
+#: request whose declared body would pass it is refused at once ("503", before its body is
+#: read), so 64 concurrent 8 MiB bodies cannot make a master hold half a gigabyte (each body
+#: also costs its parsed values). Legitimate calls are a few kilobytes.
+MAX_XMLRPC_BODIES_IN_FLIGHT = 64 << 20
 #: Largest XML-RPC reply body a client call accepts. A master's ``getSystemState`` grows with the
 #: graph (900 topics with long names pass 8 MiB) and rosmaster sets no limit, so replies get more
 #: room than requests; the cap only bounds what a broken or hostile server can make us hold.
 MAX_XMLRPC_REPLY = 64 << 20
+#: Calls one ``system.multicall`` may batch (roslaunch batches a handful, rospy one per
+#: registration at shutdown); a longer list is refused whole with a fault.
+MAX_XMLRPC_MULTICALL = 1000
+#: Connections the kernel queues for a server socket before accept() takes them (the kernel
+#: caps it at net.core.somaxconn). A burst larger than the queue loses SYNs, and each lost SYN
+#: costs its client a 1 s retransmit: 64 made the slowest of 250 concurrent calls 1.1-1.3 s.
+LISTEN_BACKLOG = 1024
 #: Largest HTTP head (request line + headers).
 MAX_HTTP_HEAD = 16 << 10
 #: Seconds an XML-RPC call (connect + request + reply) may take.
@@ -44,6 +56,17 @@ CONNECT_TIMEOUT = 5.0
 RECONNECT_FIRST = 0.1
 RECONNECT_FACTOR = 2.0
 RECONNECT_MAX = 5.0
+#: Service connections a node's service port serves at once; a new one beyond this evicts the
+#: connection idle longest (a call in progress is never evicted).
+MAX_SERVICE_CONNECTIONS = 64
+#: Seconds a persistent service connection may wait for its next request.
+SERVICE_IDLE_TIMEOUT = 30.0
+#: Seconds one service call (connect, header, request, handler, response) may take by default.
+SERVICE_CALL_TIMEOUT = 10.0
+#: Seconds between two checks that the master still knows a registered node (a node the master
+#: forgot, after a restart, registers again), and how long one check may take.
+MASTER_CHECK_PERIOD = 1.0
+MASTER_CHECK_TIMEOUT = 2.0
 #: Seconds stop()/shutdown() waits for each worker thread.
 JOIN_TIMEOUT = 5.0
 #: Seconds the master waits on one publisherUpdate/paramUpdate/shutdown notification.
@@ -77,3 +100,9 @@ CAPTURE_MAX_STREAM_BYTES = 256 * 1024 * 1024
 
 #: At most this many bytes of one table are read (a busy server lists thousands of sockets).
 OWNER_MAX_TABLE_BYTES = 8 * 2**20
+
+# ---- the ROS 2 node (graph.ros2) ----
+#: Socket buffer sizes a ROS 2 node asks for (a 640x480 frame is ~1.2 MB of fragments).
+ROS2_SOCKET_BUFFER_BYTES = 8 << 20
+#: Longest wait between two ticks of the participant (SPDP, HEARTBEATs, leases).
+ROS2_TICK_SECONDS = 0.01

@@ -24,6 +24,7 @@ import logging
 import os
 import threading
 import uuid
+import weakref
 from typing import Any
 
 from rosfpga_lab.config.limits import DEFAULT_MASTER_PORT
@@ -39,9 +40,23 @@ from rosfpga_lab.graph.limits import (
 )
 from rosfpga_lab.graph.names import bind_address, canonical, namespace_of, resolve
 from rosfpga_lab.graph.trace import Trace
-from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, check_int_range, request_peer, value_depth
+from rosfpga_lab.graph.xmlrpc import (
+    XmlRpcServer,
+    call,
+    check_int_range,
+    request_peer,
+    unsupported,
+    value_depth,
+)
 
 MASTER_ID = "/master"
+#: Masters running in this process, by URI (a node's watchdog asks them directly, untraced).
+_local: weakref.WeakValueDictionary[str, EmbeddedMaster] = weakref.WeakValueDictionary()
+#: What roscore's launch file puts in ``/rosdistro`` and ``/rosversion`` (``rosversion -d`` and
+#: ``rosversion roslaunch``, each with its newline): the ROS release and the ros_comm version
+#: whose master replies this one matches (the golden tests pin them against that rosmaster).
+ROS_DISTRO = "noetic"
+ROS_COMM_VERSION = "1.15.15"
 log = logging.getLogger("rosfpga_lab.graph.master")
 
 
@@ -128,7 +143,7 @@ class ParamTree:
 
         def walk(prefix: str, node: dict) -> None:
             for k, v in node.items():
-                if isinstance(v, dict) and v:
+                if isinstance(v, dict):  # an empty dict is no name (rosmaster)
                     walk(prefix + k + "/", v)
                 else:
                     out.append(prefix + k)
@@ -172,8 +187,8 @@ class EmbeddedMaster:
         self.nodes: dict[str, str] = {}                   # caller_id -> api
         self.params = ParamTree()
         self.params.set("/run_id", str(uuid.uuid1()))
-        self.params.set("/rosdistro", "noetic\n")
-        self.params.set("/rosversion", "1.16.0\n")
+        self.params.set("/rosdistro", ROS_DISTRO + "\n")
+        self.params.set("/rosversion", ROS_COMM_VERSION + "\n")
         # api -> {(method, topic or key): args}, waiting; _ready: apis no worker serves yet
         self._pending: dict[str, dict[tuple[str, str], tuple]] = {}
         self._pending_count = 0
@@ -209,6 +224,7 @@ class EmbeddedMaster:
         for t in self._notifiers:
             t.start()
         self.running = True
+        _local[self.uri] = self
         return self
 
     def stop(self) -> None:
@@ -216,6 +232,8 @@ class EmbeddedMaster:
         if not self.running:
             return
         self.running = False
+        if _local.get(self.uri) is self:
+            del _local[self.uri]
         self._server.stop()
         with self._notify_cond:
             self._stopping = True
@@ -232,7 +250,7 @@ class EmbeddedMaster:
     def _handle(self, method: str, params: tuple) -> Any:
         f = self._methods.get(method)
         if f is None:
-            raise Fault(1, f'method "{method}" is not supported')
+            raise unsupported(method)
         return f(*params)
 
     # ------------------------------------------------------------------ notifications
@@ -397,10 +415,13 @@ class EmbeddedMaster:
     @checked((("service", "topic"), ("service_api", "api")), 0)
     def unregisterService(self, caller_id: str, service: str, service_api: str) -> tuple:
         with self._lock:
+            if caller_id not in self.nodes:  # rosmaster's two texts, same codes
+                self._log("-SERVICE", service, caller_id, service_api, "not a registered node")
+                return 1, f"[{caller_id}] is not a registered node", 0
             regs = self.services.get(service, {})
             if caller_id not in regs or regs[caller_id][0] != service_api:
                 self._log("-SERVICE", service, caller_id, service_api, "not its provider")
-                return 1, f"[{caller_id}] is not a registered provider of [{service}]", 0
+                return 1, f"[{service_api}] is no longer the current service api handle for [{service}]", 0
             self._log("-SERVICE", service, caller_id, service_api)
             del self.services[service]
             self._forget_if_idle(caller_id)
@@ -471,7 +492,7 @@ class EmbeddedMaster:
                 self.params.set(key, value)
             except ValueError as exc:
                 return -1, str(exc), 0
-            self._notify_params(key, value)
+            self._notify_params(key, value, ignore=caller_id)
         log.info("+PARAM [%s] by %s (from %s)", key, caller_id, request_peer() or "this process")
         return 1, f"parameter {key} set", 0
 
@@ -535,13 +556,68 @@ class EmbeddedMaster:
         with self._lock:
             return 1, "Parameter names", self.params.names()
 
-    def _notify_params(self, key: str, value: Any) -> None:
-        for sub_key, regs in self.param_subscribers.items():
-            if sub_key == key or sub_key.startswith(key.rstrip("/") + "/") or key.startswith(sub_key.rstrip("/") + "/"):
-                try:
-                    sub_value = self.params.get(sub_key)
-                except KeyError:
-                    sub_value = {}
-                for api in regs.values():
-                    self._notify(api, "paramUpdate", sub_key,
-                                 (sub_key + "/" if sub_key != "/" else "/", sub_value))
+    def _notify_params(self, key: str, value: Any, ignore: str | None = None) -> None:
+        """Queue ``paramUpdate`` for every subscriber the change of ``key`` concerns, with the
+        key and value rosmaster's ``compute_param_updates`` sends (``ignore``: the setter's
+        caller_id, not told of its own change by the first rule, as rosmaster does)."""
+        for _sub, api, update_key, update_value in param_updates(
+                self.param_subscribers, key, value, ignore):
+            self._notify(api, "paramUpdate", update_key, (update_key, update_value))
+
+
+def _all_keys(prefix: str, tree: dict, out: list[str]) -> list[str]:
+    """Every key under ``prefix`` in ``tree``, each ending in "/" (rosmaster's _compute_all_keys)."""
+    stack = [(prefix, tree)]
+    while stack:
+        p, d = stack.pop()
+        for k, v in d.items():
+            key = p.rstrip("/") + "/" + k + "/"
+            out.append(key)
+            if isinstance(v, dict):
+                stack.append((key, v))
+    return out
+
+
+def param_updates(subscribers: dict[str, dict[str, str]], key: str, value: Any,
+                  ignore: str | None = None) -> list[tuple[str, str, str, Any]]:
+    """``(subscribed key, api, key sent, value sent)`` for each paramUpdate that setting (or,
+    with ``value == {}``, deleting) ``key`` causes: rosmaster 1.15's rules. A subscriber of the
+    key or of a namespace above it gets the changed key (with a trailing "/") and its new
+    value; when a dict is set, a subscriber below it gets its own key with the value found
+    there, or ``{}`` when the new dict no longer holds it."""
+    param_key = key if key == "/" else canonical(key).rstrip("/") + "/"
+    all_keys = set(_all_keys(param_key, value, [])) if isinstance(value, dict) else None
+    out: list[tuple[str, str, str, Any]] = []
+    for sub_key, regs in subscribers.items():
+        ns_key = sub_key if sub_key.endswith("/") else sub_key + "/"
+        if param_key.startswith(ns_key):
+            out.extend((sub_key, api, param_key, value) for cid, api in regs.items() if cid != ignore)
+        elif all_keys is not None and ns_key.startswith(param_key):
+            if ns_key in all_keys:
+                found: Any = value
+                for part in [x for x in ns_key[len(param_key):].split("/") if x]:
+                    found = found[part]
+                out.extend((sub_key, api, ns_key, _copy(found)) for api in regs.values())
+            else:
+                out.extend((sub_key, api, ns_key, {}) for api in regs.values())
+    return out
+
+
+def knows_node(master_uri: str, name: str, api: str, timeout: float) -> bool | None:
+    """Whether the master at ``master_uri`` has ``name`` registered with ``api`` (None: with
+    another API: someone took the name). A master running in this process is asked directly
+    (no XML-RPC, nothing in any trace); another one by an untraced ``lookupNode``.
+
+    Raises:
+        GraphError: the master cannot be reached.
+    """
+    local = _local.get(master_uri)
+    if local is not None and local.running:
+        with local._lock:
+            known = local.nodes.get(name)
+    else:
+        reply = call(master_uri, "lookupNode", name, name, timeout=timeout)
+        known = reply[2] if isinstance(reply, list) and len(reply) == 3 and reply[0] == 1 else None
+    if known is None:
+        return False
+    return True if known == api else None

@@ -32,7 +32,12 @@ from rosfpga_lab.config import limits as config_limits
 from rosfpga_lab.config.master import master_uri_from_env
 from rosfpga_lab.graph.apicheck import api_methods, checked
 from rosfpga_lab.graph.errors import GraphError, MasterError, XmlRpcError
-from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MAX_PENDING_HANDSHAKES, MAX_PUBLISHERS_PER_TOPIC
+from rosfpga_lab.graph.limits import (
+    JOIN_TIMEOUT,
+    LISTEN_BACKLOG,
+    MAX_PENDING_HANDSHAKES,
+    MAX_PUBLISHERS_PER_TOPIC,
+)
 from rosfpga_lab.graph.master import MASTER_ID, EmbeddedMaster
 from rosfpga_lab.graph.names import (
     ALL_INTERFACES,
@@ -44,11 +49,12 @@ from rosfpga_lab.graph.names import (
 )
 from rosfpga_lab.graph.owner import listener_uids
 from rosfpga_lab.graph.publisher import Publisher
+from rosfpga_lab.graph.service import ServiceServer
 from rosfpga_lab.graph.subscriber import Subscriber
 from rosfpga_lab.graph.topic import TopicContext
 from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close, socket_ends
-from rosfpga_lab.graph.xmlrpc import Fault, XmlRpcServer, call, split_uri
+from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call, split_uri, unsupported
 from rosfpga_lab.tcpros import (
     HANDSHAKE_TIMEOUT,
     MAX_FRAME_BYTES,
@@ -177,7 +183,16 @@ class Node:
         self.is_shutdown = False
         self.shutdown_reason = ""   # why it shut down (e.g. a remote slave-API shutdown's message)
         self._down = threading.Event()
+        self._service_port: ServiceServer | None = None   # started with the first service
+        self._logging: Any = None   # /rosout and logger services, from the first registration
+        self.ros_logging = True     # False: this node offers neither (before its first registration)
+        self.watch_master = True    # register again after a master restart (see ``watchdog``)
+        self._watch: Any = None
+        self._updates: dict[str, int] = {}   # topic -> publisherUpdate calls received
+        #: set once /rosout and the logger services are registered (or failed)
+        self.logging_ready = threading.Event()
         bind = bind_address(self.host)
+        self._bind = bind   # (warned once, here, when it opens every interface)
         if self.host in ALL_INTERFACES:  # peers need a reachable name, not 0.0.0.0
             self.host = socket.gethostname()
         self._xmlrpc = XmlRpcServer(self._handle_xmlrpc, host=bind, port=xmlrpc_port,
@@ -192,7 +207,7 @@ class Node:
             self._tcp.close()
             self._xmlrpc.stop()
             raise XmlRpcError(f"cannot bind TCPROS port {bind}:{tcpros_port}: {exc}") from None
-        self._tcp.listen(64)
+        self._tcp.listen(LISTEN_BACKLOG)
         self.tcpros_port = self._tcp.getsockname()[1]
         self._accept = threading.Thread(target=self._accept_loop, daemon=True,
                                         name=f"rosfpga-tcpros-accept-{self.name}")
@@ -268,6 +283,7 @@ class Node:
             with self._lock:
                 self.publishers.pop(topic, None)
             raise
+        self._start_logging()
         return pub
 
     def _context(self) -> TopicContext:
@@ -330,6 +346,7 @@ class Node:
                              message_definition=definition if send_definition else None,
                              max_frame=max_frame, max_publishers=max_publishers)
             self.subscribers[topic] = sub
+        updates = self._updates.get(topic, 0)
         try:
             pubs = self._master("registerSubscriber", topic, type_name, self.uri)
         except Exception:
@@ -337,8 +354,78 @@ class Node:
                 self.subscribers.pop(topic, None)
             sub.close()
             raise
-        sub.update_publishers([u for u in pubs if isinstance(u, str)])
+        self._start_logging()   # before connecting: a latched message comes after subscribe()
+        if self._updates.get(topic, 0) == updates:  # else a newer list came meanwhile: kept
+            sub.update_publishers([u for u in pubs if isinstance(u, str)])
         return sub
+
+    # ------------------------------------------------------------------ services
+    def _start_logging(self) -> None:
+        """After the first registration: the master watchdog, ``/rosout`` and the logger
+        services (see ``rosout``); a master that refuses those costs a warning, not the topic."""
+        from rosfpga_lab.graph.rosout import log as rosout_log
+        from rosfpga_lab.graph.rosout import start_node_logging
+        from rosfpga_lab.graph.watchdog import MasterWatch
+
+        with self._lock:
+            if self._watch is None and not self.is_shutdown:
+                self._watch = MasterWatch(self)
+            if self._logging is not None or not self.ros_logging or self.is_shutdown:
+                return
+            self._logging = True   # taken: the calls below come back here
+        try:
+            self._logging = start_node_logging(self)
+        except GraphError as exc:
+            self._logging = None
+            rosout_log.warning("%s: no /rosout or logger services: %s", self.name, exc)
+        finally:
+            self.logging_ready.set()
+
+    def advertise_service(self, service: str, srv_type: str, handler: Callable[[dict], dict]) -> str:
+        """Serve ``service`` (``~name`` is private to this node) of the shipped type
+        ``srv_type`` with ``handler(request) -> response`` (dicts); register it with the
+        master; return its global name. A handler that raises answers the caller ``ok=0``
+        with its text.
+
+        Raises:
+            UnknownTypeError: ``srv_type`` is not a shipped service type.
+            MasterError, XmlRpcError: the master refused or cannot be reached.
+        """
+        from rosfpga_lab.msg.srv import service_registry, srv_spec
+
+        name = check_topic_name(service, self.name)
+        srv = srv_spec(srv_type)
+        with self._lock:
+            if self.is_shutdown:
+                raise GraphError(f"node {self.name} is shut down")
+            if self._service_port is None:
+                self._service_port = ServiceServer(self.name, self._bind,
+                                                   self.host, service_registry()[0], self.trace)
+            port = self._service_port
+        port.add(name, srv, handler)
+        self._master("registerService", name, port.uri, self.uri)
+        return name
+
+    def call_service(self, service: str, srv_type: str, request: dict | None = None, *,
+                     timeout: float | None = None) -> dict:
+        """Call ``service`` (looked up at the master) with ``request``; return the response.
+
+        Raises:
+            ServiceError: no provider, refused, ``ok=0`` (the provider's text) or time-out.
+            UnknownTypeError: ``srv_type`` is not a shipped service type.
+        """
+        from rosfpga_lab.graph.limits import SERVICE_CALL_TIMEOUT
+        from rosfpga_lab.graph.service import ServiceError, call_service
+        from rosfpga_lab.msg.srv import service_registry, srv_spec
+
+        name = check_topic_name(service, self.name)
+        srv = srv_spec(srv_type)
+        try:
+            uri = self._master("lookupService", name)
+        except MasterError as exc:
+            raise ServiceError(f"no provider of service [{name}]: {exc.status or exc}") from None
+        return call_service(uri, name, srv, request, callerid=self.name, registry=service_registry()[0],
+                            timeout=SERVICE_CALL_TIMEOUT if timeout is None else timeout, trace=self.trace)
 
     def register_again(self) -> None:
         """Register every publisher and subscriber of this node again, after the master
@@ -355,11 +442,17 @@ class Node:
         with self._lock:
             pubs = list(self.publishers.values())
             subs = list(self.subscribers.values())
+        port = self._service_port
+        if port is not None:
+            for name in port.names():
+                self._master("registerService", name, port.uri, self.uri)
         for pub in pubs:
             self._master("registerPublisher", pub.topic, pub.type_name, self.uri)
         for sub in subs:
             uris = self._master("registerSubscriber", sub.topic, sub.type_name, self.uri)
             sub.update_publishers([u for u in uris if isinstance(u, str)], keep_live=True)
+        if self._logging is None:   # its setup failed while the master was away: again
+            self._start_logging()
 
     # ------------------------------------------------------------------ TCPROS server
     def _accept_loop(self) -> None:
@@ -448,7 +541,7 @@ class Node:
     def _handle_xmlrpc(self, method: str, params: tuple) -> Any:
         f = self._methods.get(method)
         if f is None:
-            raise Fault(1, f'method "{method}" is not supported')
+            raise unsupported(method)
         return f(*params)
 
     @checked((), "")
@@ -485,6 +578,7 @@ class Node:
         sub = self.subscribers.get(topic)
         if sub is None:
             return 1, f"not subscribed to {topic}", 0
+        self._updates[topic] = self._updates.get(topic, 0) + 1   # (one key per subscription)
         sub.update_publishers(publishers)
         return 1, "", 0
 
@@ -551,6 +645,19 @@ class Node:
             subs = list(self.subscribers.values())
             self.publishers.clear()
             self.subscribers.clear()
+        from rosfpga_lab.graph.rosout import stop_node_logging
+
+        if self._watch is not None:
+            self._watch.stop()
+        stop_node_logging(self._logging if self._logging is not True else None)
+        port = self._service_port
+        if port is not None:
+            for name in port.names():
+                try:
+                    self._master("unregisterService", name, port.uri)
+                except GraphError:
+                    pass
+            port.stop()
         topic_objects: list[Publisher | Subscriber] = [*subs, *pubs]
         for topic_object in topic_objects:
             self._leave(topic_object)

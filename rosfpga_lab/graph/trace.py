@@ -58,7 +58,8 @@ from typing import Any
 
 from rosfpga_lab.graph.limits import TRACE_EXCERPT_BYTES, TRACE_MAX_BYTES, TRACE_MAX_EVENTS
 
-KINDS = ("xmlrpc", "tcp_connect", "tcpros_header", "tcpros_frame", "tcp_close", "error")
+#: (``service_call``: a TCPROS service header or call, by its service name; no bytes kept)
+KINDS = ("xmlrpc", "tcp_connect", "tcpros_header", "tcpros_frame", "tcp_close", "error", "service_call")
 
 _conn_ids = itertools.count(1)
 

@@ -30,10 +30,13 @@ from defusedxml.xmlrpc import DefusedExpatParser
 from rosfpga_lab.graph.errors import ConfigError, XmlRpcError, XmlRpcTooLargeError
 from rosfpga_lab.graph.limits import (
     JOIN_TIMEOUT,
+    LISTEN_BACKLOG,
     MAX_HTTP_HEAD,
+    MAX_XMLRPC_BODIES_IN_FLIGHT,
     MAX_XMLRPC_BODY,
     MAX_XMLRPC_CONNECTIONS,
     MAX_XMLRPC_DEPTH,
+    MAX_XMLRPC_MULTICALL,
     MAX_XMLRPC_REPLY,
     XMLRPC_IDLE_TIMEOUT,
     XMLRPC_REQUEST_TIMEOUT,
@@ -275,6 +278,24 @@ def _read_body(sock: socket.socket, buf: bytearray, headers: dict[str, str],
     return body
 
 
+def _discard(sock: socket.socket, n: int, deadline: _Deadline) -> None:
+    """Receive and drop up to ``n`` bytes (a refused body) within ``deadline``; keeps nothing."""
+    sock.shutdown(socket.SHUT_WR)
+    scratch = bytearray(65536)
+    try:
+        while n > 0:
+            left = deadline.at - time.monotonic()
+            if left <= 0:
+                return
+            sock.settimeout(left)
+            got = sock.recv_into(scratch, min(n, len(scratch)))
+            if not got:
+                return
+            n -= got
+    except OSError:
+        return
+
+
 def _http_response(status: str, body: bytes, keep_alive: bool) -> bytes:
     head = (f"HTTP/1.1 {status}\r\nServer: rosfpga-lab/XMLRPC\r\n"
             f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\n"
@@ -311,13 +332,20 @@ class XmlRpcServer:
         advertise_host: host written in :attr:`uri` (defaults to ``host``).
         request_timeout: seconds for a whole request once its first byte arrived.
         max_connections: connections kept open at once (see the module docstring).
+        body_budget: bytes of request bodies held at once, all connections together; a request
+            whose declared length would pass it is answered "503" before its body is read.
     """
 
     def __init__(self, handler: Handler, *, host: str = "127.0.0.1", port: int = 0,
                  trace: Trace | None = None, name: str = "", advertise_host: str | None = None,
                  request_timeout: float = XMLRPC_REQUEST_TIMEOUT,
-                 max_connections: int = MAX_XMLRPC_CONNECTIONS) -> None:
+                 max_connections: int = MAX_XMLRPC_CONNECTIONS,
+                 body_budget: int = MAX_XMLRPC_BODIES_IN_FLIGHT) -> None:
         self.handler = handler
+        self.body_budget = body_budget
+        #: bytes of request bodies reserved now, and requests refused for the budget
+        self.bodies_in_flight = 0
+        self.over_budget = 0
         self.host = host
         self.port = port
         self.trace = trace
@@ -353,7 +381,7 @@ class XmlRpcServer:
         except (OSError, OverflowError) as exc:  # OverflowError: a port outside 0..65535
             sock.close()
             raise XmlRpcError(f"cannot bind XML-RPC server to {self.host}:{self.port}: {exc}") from None
-        sock.listen(64)
+        sock.listen(LISTEN_BACKLOG)
         self._sock = sock
         self.port = sock.getsockname()[1]
         self._running = True
@@ -405,6 +433,27 @@ class XmlRpcServer:
             return
         self._spawn(self._serve_connection, "xmlrpc-conn", conn, peer)
 
+    def _reserve(self, headers: dict[str, str]) -> int:
+        """Reserve the declared body length in the budget: the bytes reserved, or -1 when it
+        would pass the budget (bad or oversized lengths reserve 0: they are refused anyway)."""
+        try:
+            length = int(headers.get("content-length", "0"))
+        except ValueError:
+            return 0
+        if length <= 0 or length > MAX_XMLRPC_BODY:
+            return 0
+        with self._lock:
+            if self.bodies_in_flight + length > self.body_budget:
+                self.over_budget += 1
+                return -1
+            self.bodies_in_flight += length
+        return length
+
+    def _release(self, reserved: int) -> None:
+        if reserved:
+            with self._lock:
+                self.bodies_in_flight -= reserved
+
     def _set_busy(self, conn: socket.socket, busy: bool) -> bool:
         """Mark ``conn`` busy (in a handler) or waiting again; False when it was evicted."""
         with self._lock:
@@ -441,26 +490,42 @@ class XmlRpcServer:
                 if len(parts) != 3 or parts[0] != "POST":
                     conn.sendall(_http_response("405 Method Not Allowed", b"", False))
                     return
+                reserved = self._reserve(headers)
+                if reserved < 0:  # refuse, and read the body into nothing so the client
+                    conn.settimeout(1.0)  # finishes sending and reads the refusal
+                    conn.sendall(_http_response("503 Service Unavailable", (
+                        f"request bodies in flight would pass this server's budget of "
+                        f"{self.body_budget} bytes (graph.limits.MAX_XMLRPC_BODIES_IN_FLIGHT); "
+                        "retry later").encode(), False))
+                    _discard(conn, int(headers["content-length"]) - len(buf), deadline)
+                    return
                 try:
                     body = _read_body(conn, buf, headers, deadline)
-                except XmlRpcError as exc:
-                    status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
-                              else "400 Bad Request")
-                    conn.sendall(_http_response(status, str(exc).encode(), False))
-                    return
-                except TimeoutError:
-                    conn.settimeout(1.0)
-                    conn.sendall(_http_response("408 Request Timeout", (
-                        f"request not complete within {self.request_timeout} s").encode(), False))
-                    return
+                except BaseException as exc:
+                    self._release(reserved)
+                    if isinstance(exc, XmlRpcError):
+                        status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
+                                  else "400 Bad Request")
+                        conn.sendall(_http_response(status, str(exc).encode(), False))
+                        return
+                    if isinstance(exc, TimeoutError):
+                        conn.settimeout(1.0)
+                        conn.sendall(_http_response("408 Request Timeout", (
+                            f"request not complete within {self.request_timeout} s").encode(), False))
+                        return
+                    raise
                 if not self._set_busy(conn, True):
+                    self._release(reserved)
                     return
-                reply_body, method, params, result = self._dispatch(body)
+                try:
+                    reply_body, method, params, result = self._dispatch(body)
+                finally:
+                    self._release(reserved)
                 reply = _http_response("200 OK", reply_body, keep)
+                conn.settimeout(self.request_timeout)
+                conn.sendall(reply)   # still "busy": stop() lets a reply go out (a "shutdown" call's)
                 if not self._set_busy(conn, False):
                     return
-                conn.settimeout(self.request_timeout)
-                conn.sendall(reply)
                 self.requests += 1
                 if self.trace is not None:
                     caller = params[0] if params and isinstance(params[0], str) else peer
@@ -488,7 +553,10 @@ class XmlRpcServer:
         if method is None:
             return _fault(-32600, "not an XML-RPC request (no methodName)"), "", params, "fault"
         try:
-            value = self.handler(method, params)
+            if method == "system.multicall":
+                value = multicall(self.handler, params)
+            else:
+                value = self.handler(method, params)
             return dump_response(value), method, params, value
         except Fault as fault:
             return _fault(fault.code, fault.message), method, params, f"fault: {fault.message}"
@@ -504,7 +572,9 @@ class XmlRpcServer:
             except OSError:
                 pass
         with self._lock:  # a connection's thread takes it out of _conns before closing it
-            for c in self._conns:
+            for c, st in self._conns.items():
+                if st.busy:   # answering a call: its thread sends the reply, then sees the stop
+                    continue
                 try:
                     c.shutdown(socket.SHUT_RDWR)
                 except OSError:
@@ -518,6 +588,47 @@ class XmlRpcServer:
             threads[0].join(max(0.0, deadline - time.monotonic()))
         if self._sock is not None:
             self._sock.close()
+
+
+def unsupported(method: str) -> Fault:
+    """The fault Python's dispatcher (rosmaster's, rospy's) answers for an unknown method."""
+    return Fault(1, f"<class 'Exception'>:method \"{method}\" is not supported")
+
+
+def multicall(handler: Handler, params: tuple) -> list:
+    """``system.multicall`` as Python's ``SimpleXMLRPCDispatcher`` answers it (rosmaster's and
+    rospy's servers): a list of ``{methodName, params}`` structs in, a list of ``[result]`` or
+    ``{faultCode, faultString}`` out, each call answered on its own; at most
+    :data:`MAX_XMLRPC_MULTICALL` calls, and no multicall inside a multicall (Python runs it;
+    here it is that call's fault).
+
+    Raises:
+        Fault: not one list of structs with ``methodName`` and ``params`` (Python's texts), or
+            more than :data:`MAX_XMLRPC_MULTICALL` calls: nothing is run then.
+    """
+    try:
+        (calls,) = params
+        if len(calls) > MAX_XMLRPC_MULTICALL:
+            raise Fault(1, f"system.multicall of {len(calls)} calls refused: at most "
+                           f"{MAX_XMLRPC_MULTICALL} (graph.limits.MAX_XMLRPC_MULTICALL)")
+        batch = [(one["methodName"], one["params"]) for one in calls]
+    except (TypeError, KeyError, ValueError) as exc:
+        raise Fault(1, f"{type(exc)}:{exc}") from None
+    results: list = []
+    for name, args in batch:
+        try:
+            if not isinstance(name, str):
+                raise unsupported(str(name))
+            if name == "system.multicall":
+                raise Fault(1, "system.multicall inside system.multicall is refused")
+            if not isinstance(args, list):
+                raise TypeError(f"params must be an array, not {type(args).__name__}")
+            results.append([handler(name, tuple(args))])
+        except Fault as fault:
+            results.append({"faultCode": fault.code, "faultString": fault.message})
+        except Exception as exc:  # what Python's dispatcher answers: "<class 'X'>:text"
+            results.append({"faultCode": 1, "faultString": f"{type(exc)}:{exc}"})
+    return results
 
 
 def _fault(code: int, message: str) -> bytes:

@@ -31,7 +31,7 @@ from rosfpga_lab.msg.parser import MsgSpec, bare_type, is_legal_base_name, parse
 
 #: Folder of the definitions the lab ships (``PKG/msg/NAME.msg``).
 DEFINITIONS_DIR = Path(__file__).resolve().parent / "definitions"
-SHIPPED_PACKAGES = ("std_msgs", "sensor_msgs", "geometry_msgs")
+SHIPPED_PACKAGES = ("std_msgs", "sensor_msgs", "geometry_msgs", "rosgraph_msgs", "roscpp")
 FULL_TEXT_SEPARATOR = "=" * 80
 
 
@@ -53,7 +53,7 @@ class MsgRegistry:
     # -- building ---------------------------------------------------------------------
     @classmethod
     def with_defaults(cls) -> "MsgRegistry":
-        """A new registry holding the shipped std_msgs, sensor_msgs and geometry_msgs."""
+        """A new registry holding the shipped packages (:data:`SHIPPED_PACKAGES`)."""
         reg = cls()
         reg.load_path(DEFINITIONS_DIR, label="the lab's shipped definitions")
         return reg

@@ -44,6 +44,7 @@ MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_axi2fifo", "axi2fifo"),
     ("rfl_publisher", "publisher"),
     ("rfl_fifo", "FIFOs (rfl_fifo)"),
+    ("rfl_slice", "register slice"),
     ("rfl_top", "top level (glue)"),
 )
 #: The same for a generated project of any other message type (rosfpga_lab.rtl.generic).

@@ -6,6 +6,12 @@ DATA_FRAG, HEARTBEAT, HEARTBEAT_FRAG, ACKNACK, NACK_FRAG, GAP; others as ``Unkno
 :func:`parse_parameters` reads SPDP/SEDP parameter lists, :func:`discovery` names participants,
 topics and types from them, and :class:`FragmentAssembler` puts DATA_FRAG fragments back
 together into the serialized sample (a CDR payload for ``rosfpga_lab.msg.deserialize_cdr``).
+
+The other way, :mod:`rosfpga_lab.rtps.build` writes RTPS messages, SPDP/SEDP parameter lists
+and the ROS 2 names (``rt/...``, ``pkg::msg::dds_::Type_``), and
+:class:`rosfpga_lab.rtps.participant.Participant` is a whole DDS participant as a sans-IO state
+machine (discovery, matching, reliable and best-effort writers and readers; its entities in
+:mod:`rosfpga_lab.rtps.entities`); ``rosfpga_lab.graph.ros2`` runs it on sockets.
 """
 
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError

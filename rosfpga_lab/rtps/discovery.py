@@ -15,7 +15,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
-from rosfpga_lab.rtps.limits import MAX_PENDING_SAMPLES, MAX_SAMPLE_BYTES
+from rosfpga_lab.rtps.limits import MAX_PENDING_BYTES, MAX_PENDING_SAMPLES, MAX_SAMPLE_BYTES
 from rosfpga_lab.rtps.message import Data, DataFrag, RtpsMessage
 
 PID_SENTINEL = 0x0001
@@ -117,11 +117,47 @@ class FragmentAssembler:
     """
 
     def __init__(self, max_sample_bytes: int = MAX_SAMPLE_BYTES,
-                 max_pending: int = MAX_PENDING_SAMPLES) -> None:
+                 max_pending: int = MAX_PENDING_SAMPLES,
+                 max_pending_bytes: int = MAX_PENDING_BYTES) -> None:
         self.max_sample_bytes = max_sample_bytes
         self.max_pending = max_pending
+        self.max_pending_bytes = max_pending_bytes
         self.dropped = 0
+        #: Bytes of fragments held now (what was received, never what a sample declares).
+        self.held = 0
         self._pending: dict[tuple[bytes, int, int], dict[int, bytes]] = {}
+        self._total: dict[tuple[bytes, int, int], int] = {}
+
+    def _drop(self, key: tuple[bytes, int, int]) -> None:
+        parts = self._pending.pop(key, {})
+        self._total.pop(key, None)
+        self.held -= sum(len(p) for p in parts.values())
+
+    def discard(self, guid_prefix: bytes, writer_id: int, seq: int) -> None:
+        """Forget a partly received sample (it was delivered whole, or will never come)."""
+        self._drop((guid_prefix, writer_id, seq))
+
+    def missing(self, guid_prefix: bytes, writer_id: int, seq: int, last: int = 0,
+                limit: int = 256) -> list[int]:
+        """The first ``limit`` fragment numbers of a partly received sample not yet here (up to
+        ``last`` if given); [] for a sample with no fragment here. The work is bounded by the
+        fragments received plus ``limit``, never by the count the sample declares."""
+        key = (guid_prefix, writer_id, seq)
+        if key not in self._pending:
+            return []
+        total = self._total[key] if not last else min(last, self._total[key])
+        parts = self._pending[key]
+        out: list[int] = []
+        n = 1
+        while n <= total and len(out) < limit:
+            if n not in parts:
+                out.append(n)
+            n += 1
+        return out
+
+    def partial(self, guid_prefix: bytes, writer_id: int) -> list[int]:
+        """Sequence numbers of ``writer_id``'s partly received samples."""
+        return [k[2] for k in self._pending if k[0] == guid_prefix and k[1] == writer_id]
 
     def add(self, guid_prefix: bytes, frag: DataFrag) -> bytes | None:
         """Add one DATA_FRAG; return the whole sample once its last missing fragment came."""
@@ -133,17 +169,28 @@ class FragmentAssembler:
             raise RtpsError(f"DATA_FRAG at byte {frag.offset} has fragment size 0", frag.offset)
         total = -(-frag.sample_size // frag.frag_size)
         key = (guid_prefix, frag.writer_id, frag.seq)
+        if key in self._total and self._total[key] != total:
+            self._drop(key)                # the sample changed shape: start again
         parts = self._pending.setdefault(key, {})
-        if len(self._pending) > self.max_pending:
-            self._pending.pop(next(iter(self._pending)))
+        self._total[key] = total
+        while len(self._pending) > self.max_pending:
+            self._drop(next(iter(self._pending)))
             self.dropped += 1
-        for i in range(frag.frag_count):
+        for i in range(min(frag.frag_count, -(-len(frag.payload) // frag.frag_size))):
             number = frag.frag_start + i
-            if 1 <= number <= total:       # numbers past the sample's end are ignored
-                parts[number] = frag.payload[i * frag.frag_size:(i + 1) * frag.frag_size]
-        if len(parts) < total:
+            if 1 <= number <= total and number not in parts:   # numbers past the end ignored
+                chunk = frag.payload[i * frag.frag_size:(i + 1) * frag.frag_size]
+                parts[number] = chunk
+                self.held += len(chunk)
+        while self.held > self.max_pending_bytes and self._pending:
+            oldest = next(iter(self._pending))
+            self._drop(oldest)
+            self.dropped += 1
+            if oldest == key:
+                return None
+        if key not in self._pending or len(parts) < total:
             return None
-        del self._pending[key]
+        self._drop(key)
         sample = b"".join(parts[n] for n in range(1, total + 1))[:frag.sample_size]
         if len(sample) != frag.sample_size:
             raise RtpsError(f"sample {frag.seq} reassembled to {len(sample)} bytes, it declared "

@@ -5,3 +5,40 @@ from __future__ import annotations
 #: Largest sample :class:`FragmentAssembler` puts together, and most samples it holds at once.
 MAX_SAMPLE_BYTES = 64 * 1024 * 1024
 MAX_PENDING_SAMPLES = 16
+#: Bytes all partly reassembled samples of one assembler may hold together (fragments received).
+MAX_PENDING_BYTES = 64 * 1024 * 1024
+
+# ---- the participant (rosfpga_lab.rtps.participant) ----
+#: RTPS port mapping (RTPS 2.3, 9.6.1.1): PB + DG * domain + offset + PG * index.
+PORT_BASE, DOMAIN_GAIN, PARTICIPANT_GAIN = 7400, 250, 2
+OFFSET_DISCOVERY_UNICAST, OFFSET_USER_UNICAST = 10, 11
+#: Largest domain id whose ports still fit in 16 bits (7400 + 250 * 232 + 11 + 2 * 119 < 65536).
+MAX_DOMAIN_ID = 232
+#: Participant indices probed (and tried when binding), as Cyclone DDS's MaxAutoParticipantIndex.
+MAX_PARTICIPANT_INDEX = 9
+#: Largest datagram the participant sends, and the DATA_FRAG fragment size (Cyclone DDS defaults).
+MAX_MESSAGE_BYTES = 14720
+FRAGMENT_BYTES = 1344
+#: Lease the lab announces, period of its SPDP announcements, and the longest lease it believes.
+LEASE_SECONDS = 10.0
+ANNOUNCE_SECONDS = 1.0
+MAX_LEASE_SECONDS = 300.0
+#: Period of a reliable writer's HEARTBEATs while a reader has not acknowledged everything.
+HEARTBEAT_SECONDS = 0.05
+#: ... doubling while the reader does not answer, up to this (readers that are gone or fake).
+MAX_HEARTBEAT_SECONDS = 1.0
+#: A reader proxy's retransmissions are at least this far apart (ACKNACK storms).
+MIN_RESEND_SECONDS = 0.005
+#: Remote participants and endpoints the participant keeps (SPDP/SEDP floods).
+MAX_REMOTE_PARTICIPANTS = 64
+MAX_REMOTE_ENDPOINTS = 512
+#: Out-of-order samples a reliable reader holds per remote writer, and in bytes.
+MAX_OUT_OF_ORDER = 64
+MAX_OUT_OF_ORDER_BYTES = 32 * 1024 * 1024
+#: Received samples kept for the application per reader beyond its history depth (never more).
+MAX_HISTORY_DEPTH = 1000
+#: Distinct log notes kept (each is logged once).
+MAX_NOTES = 256
+#: Remote endpoints one local writer or reader is matched with (a writer sends each sample to
+#: every matched reader: fake readers must not multiply a frame without bound).
+MAX_MATCHED_PER_ENDPOINT = 32

@@ -42,6 +42,11 @@ from rosfpga_lab.tcpros.handshake import (
     publisher_reply_fields,
     subscriber_request_fields,
 )
+from rosfpga_lab.tcpros.service import (
+    ServiceClientConnection,
+    ServiceServerConnection,
+    ServiceSpec,
+)
 from rosfpga_lab.tcpros.header import (
     HeaderDecoder,
     decode_header,
@@ -56,7 +61,7 @@ __all__ = [
     "STATES", "TRANSITIONS", "Closed", "Connected", "Frame", "FrameDecoder", "FrameError",
     "HandshakeRejected", "HandshakeTimeout", "HeaderDecoder", "HeaderFormatError",
     "HeaderReceived", "IncompleteError", "ProtocolError", "PublisherHandshake", "Rejected",
-    "RemoteError", "Role", "State", "StateError", "SubscriberHandshake", "TopicSpec", "Transition",
+    "RemoteError", "Role", "ServiceClientConnection", "ServiceServerConnection", "ServiceSpec", "State", "StateError", "SubscriberHandshake", "TopicSpec", "Transition",
     "Trigger",
     "check_publisher_header", "check_subscriber_header", "decode_header", "encode_error_header",
     "encode_frame", "encode_header", "frame_prefix", "frame_spans", "header_spans", "parse_fields", "publisher_reply_fields",

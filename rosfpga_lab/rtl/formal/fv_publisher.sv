@@ -4,10 +4,14 @@
 module fv_publisher (input clk, input rst_n, input [7:0] s_tdata, input s_tvalid,
                      input m_tready, input meta_valid, input [31:0] meta_secs,
                      input [31:0] meta_nsecs, input [7:0] meta_bigendian,
-                     input [2:0] meta_fid_len, input [7:0] fid_rdata);
+                     input [2:0] meta_fid_len);
     wire s_tready, m_tvalid, meta_release, frame_done, idle;
     wire [7:0] m_tdata;
-    wire [2:0] fid_raddr;
+    wire [1:0] fid_raddr;
+    // the subscriber's frame_id RAM, read with a clock as in rfl_top: any contents, fixed
+    (* anyconst *) reg [31:0] fid_mem;
+    reg [7:0] fid_rdata;
+    always @(posedge clk) fid_rdata <= fid_mem[8 * fid_raddr +: 8];
     rfl_publisher #(.WIDTH(2), .HEIGHT(1), .BYTES(1), .ENC_LEN(5), .ENCODING("mono8"),
                     .FRAME_ID_MAX(4), .MIN_BODY(37)) dut (
         .clk(clk), .rst_n(rst_n), .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
@@ -22,9 +26,6 @@ module fv_publisher (input clk, input rst_n, input [7:0] s_tdata, input s_tvalid
     always @(posedge clk) if (!fv_init && $past(rst_n)) begin
         if ($past(meta_valid && !meta_release)) assume(meta_valid && $stable(meta_secs)
             && $stable(meta_nsecs) && $stable(meta_bigendian) && $stable(meta_fid_len));
-        // the frame_id memory is read combinationally and not written while the fields are held
-        if ($past(fid_raddr) == fid_raddr && $past(meta_valid && !meta_release))
-            assume($stable(fid_rdata));
     end
     always @(*) if (!rst_n) assume(!meta_valid);
     always @(posedge clk) if (!fv_init && rst_n) begin

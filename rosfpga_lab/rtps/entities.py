@@ -1,0 +1,141 @@
+"""The entities of a DDS participant as data: built-in entity ids, the RTPS port mapping, the
+QoS the lab compares (and why two endpoints do not match), remote participants and endpoints,
+and the proxies a writer keeps per matched reader and a reader per matched writer
+(:mod:`rosfpga_lab.rtps.participant` runs them)."""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from dataclasses import dataclass, field
+
+from rosfpga_lab.rtps.errors import RtpsError
+from rosfpga_lab.rtps.limits import (
+    DOMAIN_GAIN, MAX_DOMAIN_ID, OFFSET_DISCOVERY_UNICAST, OFFSET_USER_UNICAST, PARTICIPANT_GAIN,
+    PORT_BASE,
+)
+
+SPDP_WRITER, SPDP_READER = 0x000100C2, 0x000100C7
+PUB_WRITER, PUB_READER = 0x000003C2, 0x000003C7
+SUB_WRITER, SUB_READER = 0x000004C2, 0x000004C7
+PARTICIPANT_ENTITY = 0x000001C1
+#: User entity kinds: writer and reader without key (ROS 2 topics have no key).
+WRITER_KIND, READER_KIND = 0x03, 0x04
+
+Send = tuple[str, int, bytes]
+
+
+def discovery_port(domain: int, index: int) -> int:
+    """The unicast discovery (metatraffic) port of participant ``index`` in ``domain``."""
+    return PORT_BASE + DOMAIN_GAIN * domain + OFFSET_DISCOVERY_UNICAST + PARTICIPANT_GAIN * index
+
+
+def user_port(domain: int, index: int) -> int:
+    """The unicast user-data port of participant ``index`` in ``domain``."""
+    return PORT_BASE + DOMAIN_GAIN * domain + OFFSET_USER_UNICAST + PARTICIPANT_GAIN * index
+
+
+def check_domain(domain: int) -> None:
+    if not 0 <= domain <= MAX_DOMAIN_ID:
+        raise RtpsError(f"DDS domain {domain} out of range: use 0..{MAX_DOMAIN_ID} (the RTPS "
+                        f"port mapping puts larger ids past port 65535)")
+
+
+@dataclass(frozen=True)
+class Qos:
+    """The QoS the lab's endpoints use and compare: reliability, durability, history depth."""
+
+    reliable: bool = True
+    depth: int = 10
+    transient_local: bool = False
+
+    def describe(self) -> str:
+        return (f"{'RELIABLE' if self.reliable else 'BEST_EFFORT'} KEEP_LAST {self.depth} "
+                f"{'TRANSIENT_LOCAL' if self.transient_local else 'VOLATILE'}")
+
+
+def incompatibility(offered: Qos, requested: Qos) -> str:
+    """Why a writer offering ``offered`` cannot serve a reader requesting ``requested`` ('' if it can)."""
+    if requested.reliable and not offered.reliable:
+        return "a BEST_EFFORT writer never matches a RELIABLE reader (RELIABILITY offered < requested)"
+    if requested.transient_local and not offered.transient_local:
+        return "a VOLATILE writer never matches a TRANSIENT_LOCAL reader (DURABILITY offered < requested)"
+    return ""
+
+
+@dataclass
+class RemoteParticipant:
+    prefix: bytes
+    meta: tuple[str, int]
+    user: tuple[str, int]
+    lease: float
+    last_seen: float
+    name: str = ""
+
+
+@dataclass
+class RemoteEndpoint:
+    guid: bytes
+    kind: str                     # "writer" | "reader"
+    topic: str
+    type_name: str
+    qos: Qos
+    locator: tuple[str, int]
+
+
+@dataclass
+class ReaderProxy:
+    """A remote reader as one of the lab's writers sees it."""
+
+    prefix: bytes
+    reader_id: int
+    locator: tuple[str, int]
+    reliable: bool
+    first_relevant: int
+    acked: int = 1                # every sample before it is acknowledged
+    last_count: int = 0
+    last_frag_count: int = 0
+    last_resend: float = -1.0
+    last_heartbeat: float = -1.0
+    heartbeat_period: float = 0.0     # 0: the first period; doubles while unanswered
+
+
+@dataclass
+class WriterProxy:
+    """A remote writer as one of the lab's readers sees it."""
+
+    prefix: bytes
+    writer_id: int
+    reliable: bool
+    next: int = 0                 # 0: nothing known yet
+    pending: dict[int, bytes | None] = field(default_factory=dict)
+    pending_bytes: int = 0
+    last_hb_count: int = -(1 << 31)
+    acknack_count: int = 0
+    nackfrag_count: int = 0
+
+
+@dataclass
+class LocalEndpoint:
+    entity_id: int
+    kind: str
+    topic: str
+    type_name: str
+    qos: Qos
+    seq: int = 0                                  # writer: last sequence number written
+    history: OrderedDict[int, bytes] = field(default_factory=OrderedDict)
+    proxies: dict[tuple[bytes, int], ReaderProxy | WriterProxy] = field(default_factory=dict)
+    hb_count: int = 0
+
+    @property
+    def guid_tail(self) -> bytes:
+        return self.entity_id.to_bytes(4, "big")
+
+
+@dataclass(frozen=True)
+class Sample:
+    """A user sample delivered to one of the lab's readers."""
+
+    reader_id: int
+    writer_guid: bytes
+    seq: int
+    payload: bytes

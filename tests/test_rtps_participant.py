@@ -1,0 +1,443 @@
+"""The sans-IO DDS participant: two lab participants over an in-memory network (with loss),
+the real Cyclone DDS capture replayed whole, byte by byte and with trailing bytes, and hostile
+peers (spoofed GUIDs, absurd fragments, SPDP floods, ACKNACK storms): nothing crashes, stalls or
+grows past its limit, and each problem is logged once."""
+
+from __future__ import annotations
+
+import random
+import struct
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rosfpga_lab.graph.capture_read import udp_datagrams
+from rosfpga_lab.rtps import build as b
+from rosfpga_lab.rtps import parse_message
+from rosfpga_lab.rtps.limits import (
+    MAX_NOTES, MAX_PENDING_BYTES, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS,
+)
+from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, NackFrag
+from rosfpga_lab.rtps.participant import (
+    PUB_WRITER, SPDP_READER, SPDP_WRITER, Participant, Qos, discovery_port, incompatibility,
+    user_port,
+)
+
+CAPTURE = Path(__file__).resolve().parent.parent / "data" / "rtps_image.pcapng"
+DATAGRAMS = [d[3] for d in udp_datagrams(CAPTURE)]
+TOPIC, TYPE = "rt/cam", "sensor_msgs::msg::dds_::Image_"
+
+
+class Net:
+    """Delivers what participants send, by destination port; ``drop(datagram)`` loses some."""
+
+    def __init__(self, *parts: Participant, drop=lambda d: False) -> None:
+        self.parts = parts
+        self.drop = drop
+        self.now = 0.0
+        self.sent = 0
+        self.kinds: set[str] = set()      # submessage kinds that went over the network
+
+    def port_owner(self, port: int) -> Participant | None:
+        for p in self.parts:
+            if port in (p.meta[1], p.user[1]):
+                return p
+        return None
+
+    def run(self, out: list, steps: int = 200, dt: float = 0.01) -> None:
+        queue = list(out)
+        for _ in range(steps):
+            for p in self.parts:
+                queue += p.tick(self.now)
+            while queue:
+                host, port, data = queue.pop(0)
+                self.sent += 1
+                self.kinds |= {sub.name for sub in parse_message(data).submessages}
+                dst = self.port_owner(port)
+                if dst is None or self.drop(data):
+                    continue
+                src = next(p for p in self.parts if p is not dst)
+                queue += dst.receive(data, src.user, self.now)
+            self.now += dt
+
+
+def pair(qw: Qos = Qos(), qr: Qos = Qos()) -> tuple[Participant, Participant, int, int]:
+    a = Participant(domain=7, index=0, announce=0.1)
+    c = Participant(domain=7, index=1, announce=0.1)
+    w = a.add_writer(TOPIC, TYPE, qw)
+    r = c.add_reader(TOPIC, TYPE, qr)
+    return a, c, w, r
+
+
+def test_port_mapping_is_the_rtps_standard() -> None:
+    assert (discovery_port(0, 0), user_port(0, 0)) == (7410, 7411)
+    assert (discovery_port(1, 2), user_port(1, 2)) == (7400 + 250 + 10 + 4, 7400 + 250 + 11 + 4)
+
+
+def test_encoders_decode_back() -> None:
+    prefix = bytes(range(12))
+    msg = (b.header(prefix) + b.info_dst(bytes(12)) + b.data(1, 0x103, 5, b"\x00\x01\x00\x00abc")
+           + b.heartbeat(4, 0x103, 2, 9, 3) + b.acknack(0x104, 0x103, 4, [4, 6], 2)
+           + b.gap(4, 0x103, 2, 4) + b.nack_frag(4, 0x103, 7, [3, 5], 1)
+           + b.data_frag(4, 0x103, 8, 3, 4, 10, b"abcd", 1))
+    m = parse_message(msg)
+    assert m.header.guid_prefix == prefix
+    d, hb, an, gap, nf, df = m.submessages[1:]
+    assert isinstance(d, Data) and (d.writer_id, d.seq, d.payload[:7]) == (0x103, 5, b"\x00\x01\x00\x00abc")
+    assert isinstance(hb, Heartbeat) and (hb.first, hb.last, hb.count) == (2, 9, 3)
+    assert isinstance(an, AckNack) and (an.base, an.missing, an.count) == (4, (4, 6), 2)
+    assert isinstance(gap, Gap) and (gap.start, gap.list_base) == (2, 4)
+    assert isinstance(nf, NackFrag) and (nf.seq, nf.missing) == (7, (3, 5))
+    assert isinstance(df, DataFrag) and (df.frag_start, df.frag_size, df.sample_size) == (3, 4, 10)
+
+
+def test_two_participants_discover_match_and_deliver_in_order() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    assert len(a.matched(w)) == 1 and len(c.matched(r)) == 1
+    payloads = [b"\x00\x01\x00\x00" + bytes([k]) * (k + 1) for k in range(5)]
+    out = []
+    for p in payloads:
+        out += a.write(w, p, net.now)
+    net.run(out, steps=5)
+    assert [s.payload for s in c.take(r)] == payloads
+
+
+def test_reliable_recovers_lost_datagrams_and_fragments() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    rng = random.Random(1)
+    big = b"\x00\x01\x00\x00" + bytes(rng.randrange(256) for _ in range(40000))   # 30 fragments
+    small = [b"\x00\x01\x00\x00" + bytes([k]) * 8 for k in range(4)]
+    net.drop = lambda d: rng.random() < 0.3           # lose 30% of everything, both ways
+    out = a.write(w, small[0], net.now) + a.write(w, big, net.now)
+    for s in small[1:]:
+        out += a.write(w, s, net.now)
+    net.run(out, steps=300)
+    assert [s.payload for s in c.take(r)] == [small[0], big, *small[1:]]
+    assert c.assembler.held == 0
+    assert {"DATA", "DATA_FRAG", "HEARTBEAT", "ACKNACK", "NACK_FRAG"} <= net.kinds, net.kinds
+
+
+def test_keep_last_history_gaps_what_left_it() -> None:
+    a, c, w, r = pair(Qos(True, 2))
+    net = Net(a, c)
+    net.run([], steps=20)
+    lost = True
+    net.drop = lambda d: lost and any(isinstance(s, Data) and s.writer_id == w
+                                      for s in parse_message(d).submessages)
+    out = []
+    for k in range(5):
+        out += a.write(w, b"\x00\x01\x00\x00" + bytes([k]), net.now)
+    net.run(out, steps=1)
+    lost = False
+    net.run([], steps=50)
+    # only the last 2 stayed in the writer's history; 1..3 were GAPped, the reader moved on
+    assert [s.payload[-1] for s in c.take(r)] == [3, 4]
+
+
+@pytest.mark.parametrize("qw,qr,why", [
+    (Qos(False), Qos(True), "BEST_EFFORT writer never matches a RELIABLE reader"),
+    (Qos(True), Qos(True, transient_local=True), "VOLATILE writer never matches a TRANSIENT_LOCAL"),
+])
+def test_incompatible_qos_is_not_matched_and_said_once(qw: Qos, qr: Qos, why: str) -> None:
+    assert why in incompatibility(qw, qr)
+    a, c, w, r = pair(qw, Qos(qr.reliable))
+    if qr.transient_local:   # the lab's readers are VOLATILE; announce a TRANSIENT_LOCAL one
+        c.local[r] = type(c.local[r])(r, "reader", TOPIC, TYPE, qr)
+        c.local[0x4C2].history.clear()
+        c._announce_endpoint(c.local[r])
+    net = Net(a, c)
+    net.run([], steps=40)
+    assert a.matched(w) == [] and c.matched(r) == []
+    side = a if qw.reliable else c
+    assert sum(why in n for n in side.notes) == 1, side.notes
+
+
+def test_best_effort_reader_matches_a_reliable_writer() -> None:
+    a, c, w, r = pair(Qos(True), Qos(False))
+    net = Net(a, c)
+    net.run([], steps=20)
+    net.run(a.write(w, b"\x00\x01\x00\x00x", net.now), steps=3)
+    assert [s.payload for s in c.take(r)] == [b"\x00\x01\x00\x00x"]
+
+
+def test_lease_expiry_forgets_a_silent_peer() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    assert c.participants
+    # half a fragmented sample arrives, then a falls silent: the fragments go with it
+    half = [d for _, _, d in a.write(w, b"\x00\x01\x00\x00" + bytes(30000), net.now)][:1]
+    c.receive(half[0], a.user, net.now)
+    assert c.assembler.held > 0
+    net.parts = (c,)                              # a falls silent
+    net.run([], steps=int(a.lease / 0.01) + 50)
+    assert not c.participants and c.matched(r) == []
+    assert c.assembler.held == 0
+    assert any("lease" in n for n in c.notes)
+
+
+# ---- the real Cyclone capture, whole / byte by byte / with trailing bytes ------------------
+
+def fresh() -> Participant:
+    return Participant(domain=0, index=5)
+
+
+def test_replaying_cyclone_capture_learns_its_participants() -> None:
+    p = fresh()
+    for d in DATAGRAMS:
+        p.receive(d, ("127.0.0.1", 7411), 0.0)
+    assert len(p.participants) == 2
+    # SEDP samples addressed (INFO_DST) to the other participant are not for this one
+    found = {(e.kind, e.topic, e.type_name) for e in p.remote.values()}
+    assert found and found <= {("writer", "rt/image_raw", TYPE), ("reader", "rt/image_raw", TYPE)}
+
+
+def test_every_prefix_and_trailing_bytes_of_every_datagram_is_handled() -> None:
+    p = fresh()
+    for d in DATAGRAMS[:60]:
+        for n in range(0, min(len(d), 400)):
+            p.receive(d[:n], ("127.0.0.1", 7411), 0.0)
+        p.receive(d + b"\x00\x01\x02", ("127.0.0.1", 7411), 0.0)
+        p.receive(d + b"\xff" * 7, ("127.0.0.1", 7411), 0.0)
+    assert len(p.notes) <= MAX_NOTES + 1
+    assert any("malformed" in n for n in p.notes)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from(DATAGRAMS[:80]), st.integers(0, 2000), st.binary(min_size=1, max_size=8))
+def test_mutated_datagrams_never_raise(d: bytes, at: int, junk: bytes) -> None:
+    p = fresh()
+    at %= len(d)
+    p.receive(d[:at] + junk + d[at + len(junk):], ("127.0.0.1", 7411), 0.0)
+
+
+# ---- hostile peers ---------------------------------------------------------------------------
+
+def spdp(prefix: bytes, guid_prefix: bytes | None = None, port: int = 7999) -> bytes:
+    payload = b.spdp_payload(guid_prefix or prefix, b.Locator("127.0.0.1", port),
+                             b.Locator("127.0.0.1", port + 1), 10.0, "evil", b"", 0)
+    return b.header(prefix) + b.data(SPDP_READER, SPDP_WRITER, 1, payload)
+
+
+def test_spoofed_spdp_guid_is_ignored_and_logged_once() -> None:
+    p = fresh()
+    for k in range(50):
+        p.receive(spdp(b"E" * 12, guid_prefix=bytes([k]) * 12), ("127.0.0.1", 7999), 0.0)
+    assert p.participants == {}
+    assert sum("announces only itself" in n for n in p.notes) == 1
+    assert p.counts["spdp-spoof"] == 50
+
+
+def test_spoofed_sedp_endpoint_of_another_participant_is_ignored() -> None:
+    p = fresh()
+    p.add_reader(TOPIC, TYPE)
+    p.receive(spdp(b"E" * 12), ("127.0.0.1", 7999), 0.0)
+    victim = b"V" * 12 + (0x103).to_bytes(4, "big")
+    sedp = b.sedp_payload(victim, TOPIC, TYPE, True, 10, b.Locator("127.0.0.1", 8000))
+    p.receive(b.header(b"E" * 12) + b.data(0x3C7, PUB_WRITER, 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert p.remote == {}
+    assert sum("announces only its own endpoints" in n for n in p.notes) == 1
+
+
+def test_spdp_flood_is_bounded() -> None:
+    p = fresh()
+    for k in range(MAX_REMOTE_PARTICIPANTS * 4):
+        p.receive(spdp(struct.pack(">I", k) + b"F" * 8), ("127.0.0.1", 7999), 0.0)
+    assert len(p.participants) == MAX_REMOTE_PARTICIPANTS
+    assert sum("new ones are ignored" in n for n in p.notes) == 1
+    assert len(p.notes) <= MAX_REMOTE_PARTICIPANTS + 2
+
+
+def test_sedp_flood_is_bounded() -> None:
+    p = fresh()
+    prefix = b"S" * 12
+    p.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    for k in range(MAX_REMOTE_ENDPOINTS + 100):
+        guid = prefix + ((k << 8) | 0x03).to_bytes(4, "big")
+        sedp = b.sedp_payload(guid, f"rt/t{k}", TYPE, True, 10, b.Locator("127.0.0.1", 8000))
+        p.receive(b.header(prefix) + b.data(0x3C7, PUB_WRITER, k + 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert len(p.remote) == MAX_REMOTE_ENDPOINTS
+
+
+def test_absurd_fragments_hold_only_bytes_received() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    # a matched writer declares a 60 MB sample in 1-byte fragments, 65535 per submessage
+    frag = b.data_frag(r, w, 1, 1, 1, 60_000_000, b"x" * 100, 65535)
+    evil = b.header(a.guid_prefix) + b.info_dst(c.guid_prefix) + frag
+    for _ in range(20):
+        c.receive(evil, a.user, 1.0)
+    assert c.assembler.held == 100      # the bytes that came, never the declared size
+    frag = b.data_frag(r, w, 2, 1, 64000, MAX_PENDING_BYTES * 4, b"y" * 64000, 1)
+    for k in range(2, 40):
+        sub = b.data_frag(r, w, k, 1, 64000, 60_000_000, b"y" * 12000, 1)
+        c.receive(b.header(a.guid_prefix) + sub, a.user, 1.0)
+    assert c.assembler.held <= MAX_PENDING_BYTES
+    assert len(c.assembler._pending) <= c.assembler.max_pending
+
+
+def test_acknack_storm_is_paced_and_duplicates_ignored() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    for k in range(10):
+        a.write(w, b"\x00\x01\x00\x00" + bytes(5000), net.now)
+    reader_guid_eid = r
+    sent_bytes = 0
+    for k in range(2000):       # 2000 ACKNACKs asking for all 10 samples, within 10 ms
+        msg = b.header(c.guid_prefix) + b.acknack(reader_guid_eid, w, 1, range(1, 11), 100 + k)
+        sent_bytes += sum(len(d) for _, _, d in a.receive(msg, c.user, 5.0 + k * 0.000005))
+    # paced: at most one retransmission per MIN_RESEND_SECONDS, not 2000 of them
+    assert sent_bytes < 4 * 10 * 5100
+    dup = b.header(c.guid_prefix) + b.acknack(r, w, 1, range(1, 11), 5)
+    assert a.receive(dup, c.user, 9.0) == []
+    assert any("paced" in n for n in a.notes)
+
+
+def test_notes_and_counts_stay_bounded_under_random_prefixes() -> None:
+    p = fresh()
+    rng = random.Random(3)
+    for _ in range(3000):
+        prefix = bytes(rng.randrange(256) for _ in range(12))
+        p.receive(b.header(prefix) + b.heartbeat(0, 0x103, 1, 5, 1), ("127.0.0.1", 7999), 0.0)
+    assert len(p.notes) <= MAX_NOTES + 1 and len(p.counts) <= MAX_NOTES + 1
+    assert sum(p.counts.values()) == 3000
+
+
+def test_acknack_for_samples_not_yet_written_never_gaps_them() -> None:
+    """A (spoofed) ACKNACK asking for numbers past the last written used to GAP them, so the
+    real reader skipped every later sample."""
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    evil = b.header(c.guid_prefix) + b.acknack(r, w, 1, range(1, 100), 10_000)
+    out = a.receive(evil, c.user, net.now)
+    assert not any(isinstance(s, Gap) for _, _, d in out for s in parse_message(d).submessages)
+    net.run(out, steps=2)
+    net.run(a.write(w, b"\x00\x01\x00\x00late", net.now), steps=20)
+    assert [s.payload for s in c.take(r)] == [b"\x00\x01\x00\x00late"]
+
+
+def test_transient_local_history_goes_only_to_transient_local_readers() -> None:
+    a, c, w, r = pair(Qos(True, 3, transient_local=True), Qos(True))
+    for k in range(5):
+        a.write(w, b"\x00\x01\x00\x00" + bytes([k]), 0.0)
+    r_tl = c._new_entity(0x04)      # a TRANSIENT_LOCAL reader (the lab's own are VOLATILE)
+    c.local[r_tl] = type(c.local[r])(r_tl, "reader", TOPIC, TYPE, Qos(True, 10, True))
+    c._announce_endpoint(c.local[r_tl])
+    net = Net(a, c)
+    net.run([], steps=40)
+    assert [s.payload[-1] for s in c.take(r_tl)] == [2, 3, 4]
+    assert c.take(r) == []                      # the VOLATILE reader: nothing from before
+    net.run(a.write(w, b"\x00\x01\x00\x00\x05", net.now), steps=5)
+    assert [s.payload[-1] for s in c.take(r)] == [5]
+
+
+def test_a_volatile_reader_asking_for_older_samples_gets_a_gap_not_the_samples() -> None:
+    """Cyclone's first ACKNACK asks for everything from 1: the writer used to resend its
+    history to a VOLATILE reader that matched after it was written."""
+    a, c, w, r = pair(Qos(True, 5))
+    net = Net(a, c)
+    for k in range(3):
+        a.write(w, b"\x00\x01\x00\x00" + bytes([k]), 0.0)   # before anyone matched
+    net.run([], steps=20)
+    out = a.receive(b.header(c.guid_prefix) + b.acknack(r, w, 1, [1, 2, 3], 50), c.user, net.now)
+    subs = [s for _, _, d in out for s in parse_message(d).submessages]
+    assert not any(isinstance(s, Data) and s.writer_id == w for s in subs)
+    assert any(isinstance(s, Gap) and (s.start, s.list_base) == (1, 4) for s in subs)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.tuples(st.sampled_from([b.PID_RELIABILITY, b.PID_DURABILITY, b.PID_HISTORY,
+                                           b.PID_TOPIC_NAME, b.PID_TYPE_NAME, b.PID_UNICAST_LOCATOR,
+                                           b.PID_ENDPOINT_GUID, 0x0071]),
+                          st.binary(max_size=24)), max_size=8))
+def test_sedp_with_odd_parameter_values_never_raises(params: list) -> None:
+    """Short or odd QoS values (a 2-byte PID_RELIABILITY, ...) used to raise struct.error out of
+    the receive path, which stops the node's thread."""
+    p = fresh()
+    prefix = b"P" * 12
+    p.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    guid = prefix + (0x103).to_bytes(4, "big")
+    payload = b.param_list([(b.PID_ENDPOINT_GUID, guid), (b.PID_TOPIC_NAME, b.cdr_string(TOPIC))]
+                           + params)
+    p.receive(b.header(prefix) + b.data(0x3C7, PUB_WRITER, 1, payload), ("127.0.0.1", 7999), 0.0)
+    assert not any(k.startswith("unexpected") for k in p.counts), p.notes
+
+
+def test_invalid_heartbeat_and_gap_are_ignored_and_delivery_goes_on() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    net.run(a.write(w, b"\x00\x01\x00\x00one", net.now), steps=3)
+    bad = (b.header(a.guid_prefix) + b.heartbeat(r, w, 0, -5, 99)       # first < 1, last < first-1
+           + b.gap(r, w, -3, 1 << 40) + b.gap(r, w, 5, 2))               # start < 1; base < start
+    c.receive(bad, a.user, net.now)
+    net.run(a.write(w, b"\x00\x01\x00\x00two", net.now), steps=3)
+    assert [s.payload[4:] for s in c.take(r)] == [b"one", b"two"]
+    assert sum("RTPS 2.3 8.3.7" in n for n in c.notes) == 2     # one note per kind
+
+
+def test_heartbeats_to_a_reader_that_never_answers_back_off() -> None:
+    a = Participant(domain=7, index=0, announce=100.0)
+    a.add_writer(TOPIC, TYPE)
+    a.receive(spdp(b"Z" * 12), ("127.0.0.1", 7999), 0.0)       # a peer that will never ACK
+    beats = 0
+    for k in range(1000):                                        # 10 s of ticks
+        for _, _, d in a.tick(k * 0.01):
+            beats += sum(isinstance(s, Heartbeat) for s in parse_message(d).submessages)
+    # 2 SEDP writers; at a fixed 50 ms period that would be 400 HEARTBEATs
+    assert 2 <= beats <= 2 * 16, beats
+
+
+def test_heartbeat_after_absurd_fragments_costs_no_more_than_what_came() -> None:
+    """A sample declaring 60 M one-byte fragments, then HEARTBEAT/HEARTBEAT_FRAG: listing the
+    missing fragments used to walk all 60 M numbers (seconds per heartbeat)."""
+    import time
+
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    head = b.header(a.guid_prefix) + b.info_dst(c.guid_prefix)
+    c.receive(head + b.data_frag(r, w, 1, 1, 1, 60_000_000, b"x" * 100, 100), a.user, 1.0)
+    hbf = struct.pack("<BBH", 0x13, 1, 24) + r.to_bytes(4, "big") + w.to_bytes(4, "big") \
+        + struct.pack("<iIIi", 0, 1, 60_000_000, 1)
+    t0 = time.perf_counter()
+    out = c.receive(head + b.heartbeat(r, w, 1, 1, 500), a.user, 1.1)
+    out += c.receive(head + hbf, a.user, 1.2)
+    assert time.perf_counter() - t0 < 0.5
+    nacks = [s for _, _, d in out for s in parse_message(d).submessages if isinstance(s, NackFrag)]
+    assert nacks and all(len(n.missing) <= 256 and n.missing[0] == 101 for n in nacks)
+
+
+def test_fake_readers_cannot_multiply_a_frame_without_bound() -> None:
+    from rosfpga_lab.rtps.limits import MAX_MATCHED_PER_ENDPOINT
+
+    a = fresh()
+    w = a.add_writer(TOPIC, TYPE, Qos(False))
+    prefix = b"R" * 12
+    a.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    for k in range(200):           # 200 readers on the topic from one participant
+        guid = prefix + ((k << 8) | 0x04).to_bytes(4, "big")
+        sedp = b.sedp_payload(guid, TOPIC, TYPE, False, 1, b.Locator("127.0.0.1", 9))
+        a.receive(b.header(prefix) + b.data(0x4C7, 0x4C2, k + 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert len(a.matched(w)) == MAX_MATCHED_PER_ENDPOINT
+    assert len(a.write(w, b"\x00\x01\x00\x00" + bytes(100), 1.0)) == MAX_MATCHED_PER_ENDPOINT
+    assert sum("already has" in n for n in a.notes) == 1
+
+
+def test_goodbye_makes_the_peer_forget_at_once() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    assert a.guid_prefix in c.participants and c.matched(r)
+    for _, _, d in a.goodbye():
+        c.receive(d, a.meta, net.now)
+    assert a.guid_prefix not in c.participants and c.matched(r) == []
