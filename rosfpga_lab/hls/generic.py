@@ -27,7 +27,7 @@ from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config.vocabulary import CDR_WIRE, TCPROS_WIRE
 from rosfpga_lab.hls.program import _replace
 from rosfpga_lab.hls.program import (
-    ENCAP_BYTES, FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub,
+    ALIGN_ORIGIN, ENCAP_BYTES, ENCAP_PAD_MASK, FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub,
 )
 from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_length_rules
 from rosfpga_lab.hw.layout import (
@@ -213,6 +213,7 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "pub": {"topic": spec.pub_topic, "type": prog.type_out},
         "prog": prog, "instrs": instruction_rows(prog),
         "cdr": spec.wire == CDR_WIRE, "wire": spec.wire,
+        "align_origin": ALIGN_ORIGIN, "encap_pad_mask": ENCAP_PAD_MASK,
         "frame": "CDR sample" if spec.wire == CDR_WIRE else "TCPROS frame", "statuses": list(prog.statuses),
         "consts": prog.const_table, "const_rows": _hex_rows(prog.const_table),
         "loop_depth": loop_depth(prog), "max_instr_steps": max_steps(prog),
