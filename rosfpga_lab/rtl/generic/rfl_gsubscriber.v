@@ -174,8 +174,8 @@ module rfl_gsubscriber #(
         end
     endtask
 
-    // Refuse the frame with status `code`; skip what is left of it (`at_end`: nothing is).
-    task refuse(input [7:0] code, input at_end);
+    // Refuse the frame with status `code`; skip what is left of it (`to_end`: nothing is).
+    task refuse(input [7:0] code, input to_end);
         begin
             status_valid <= 1'b1;
             status <= code;
@@ -184,7 +184,7 @@ module rfl_gsubscriber #(
                 meta_valid <= 1'b1;
                 meta_drop <= 1'b1;
             end
-            if (at_end) begin
+            if (to_end) begin
                 state <= S_FLEN;
                 pos <= 32'd0;
             end else begin
@@ -324,7 +324,7 @@ module rfl_gsubscriber #(
                                 state <= S_COUNTED;
                             end else if (pad_f != 32'd0 && {32'd0, pad_f} >= room)
                                 refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                            else if (room_f < 64'd4) refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                            else if (room_f < 64'd4) refuse(st, at_end);  // cut short in its count
                             else begin
                                 if (quiet == 8'd0) out_len <= out_len + pad_at(out_len + 32'd4, align);
                                 pad_then(pad_f, S_COUNT);
