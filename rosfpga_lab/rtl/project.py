@@ -13,6 +13,7 @@ from pathlib import Path
 from rosfpga_lab import __version__
 from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.hls import GenerationResult, generate
+from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.generator import Progress
 from rosfpga_lab.config.vocabulary import CDR_WIRE
 from rosfpga_lab.hls.generic import (
@@ -46,8 +47,12 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
     (:mod:`rosfpga_lab.hls.generic`, :mod:`rosfpga_lab.rtl.generic`).
 
     Raises:
-        GenerateError: as :func:`rosfpga_lab.hls.generate`.
+        GenerateError: as :func:`rosfpga_lab.hls.generate`; ``wire: cdr`` for Image.
     """
+    if config.is_image and config.wire == CDR_WIRE:
+        raise GenerateError("wire: cdr is not generated for sensor_msgs/Image (its project is the "
+                            "hand-written TCPROS one; the generic walkers refuse video streams): "
+                            "use wire: tcpros, or the Python CDR model (hw.cdrpipeline)")
     if config.is_image:
         return generate(config, out_dir, force=force, progress=progress,
                         extra_files=rtl_files(config))
