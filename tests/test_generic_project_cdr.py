@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from generictools import window_oracle
 from realros import require_cxx
@@ -30,10 +32,15 @@ from wiretools import require_cyclonedds
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hls.generic import model_output_cdr, program_from_cdr
 from rosfpga_lab.hls.program import run_program
-from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_layout_from_config
+from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_layout_from_config, derive_cdr_layout
 from rosfpga_lab.hw.cdrwalker import extract_cdr_fast
 from rosfpga_lab.hw.errors import FrameFieldError
+from rosfpga_lab.hw.layout import Action, StepKind
+from rosfpga_lab.msg.cdr import serialize_cdr
+from rosfpga_lab.msg.ros2 import ros2_registry
+from rosfpga_lab.msg.strategies import message
 from rosfpga_lab.rtl.generic import simulate_project
+from test_hw_walker import definitions  # the models' strategy over message definitions
 
 DATA = Path(__file__).resolve().parent.parent / "data"
 SAMPLES = "fpga_samples_dilate_cdr.yaml"
@@ -274,3 +281,67 @@ def test_image_with_wire_cdr_is_refused_by_name(tmp_path: Path) -> None:
                           timeout=120)
     assert proc.returncode != 0 and "wire: cdr is not generated for sensor_msgs/Image" in proc.stderr
     assert not (tmp_path / "p" / "subscriber.cpp").exists()
+
+
+def _random_case(data: st.DataObject) -> tuple[CdrLayout, list[bytes], str]:
+    """A random message definition (the models' strategy), small maxima, two samples serialized
+    by the msg layer's CDR codec (held equal to Cyclone's bytes in test_hw_cdr.py) with end
+    padding of 0..3 bytes, a damaged copy of the first, and an application."""
+    reg, type_name, stream = data.draw(definitions())
+    r2 = ros2_registry(reg)
+    values = [data.draw(message(r2, type_name)) for _ in range(2)]
+    n = max(1, len(values[0][stream]))
+    values = [v for v in values if len(v[stream]) == n] or values[:1]
+    cdr = derive_cdr_layout(reg, type_name, stream=stream, stream_length=n)
+    small = {s.path: 3 for s in cdr.base.steps[1:] if s.kind is StepKind.LENGTH
+             and s.action is not Action.STREAM and not s.label.endswith("[] length")}
+    cdr = derive_cdr_layout(reg, type_name, stream=stream, stream_length=n, limits_=small)
+    records = [record(pad_tail(serialize_cdr(r2, type_name, v), data.draw(st.integers(0, 3))))
+               for v in values]
+    damaged = bytearray(records[0])
+    at = data.draw(st.integers(4, len(damaged) - 1))
+    damaged[at] ^= data.draw(st.integers(1, 255))
+    records += [bytes(damaged), records[-1]]
+    return cdr, records, data.draw(st.sampled_from(["dilate", "erode", "passthrough"]))
+
+
+QUIET = [HealthCheck.too_slow, HealthCheck.function_scoped_fixture]
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=QUIET)
+@given(data=st.data())
+def test_the_program_executor_equals_the_cdr_models_on_random_definitions(
+        data: st.DataObject) -> None:
+    """The walkers' specification (hls.program.run_program) publishes and refuses exactly as
+    hw.cdrwalker does, status for status, on random types and damaged samples."""
+    cdr, records, op = _random_case(data)
+    expected, _why = model_output_cdr(cdr, op, 3, records)
+    dtype = np.dtype(cdr.layout.stream.dtype)
+    out, codes = run_program(program_from_cdr(cdr), records,
+                             lambda b: window_oracle(b, dtype.str, 3, op))
+    names = [n for n, _label in cdr.layout.statuses]
+    assert (out, [names[c] for c in codes]) == (expected, statuses_of(cdr, records))
+
+
+@settings(max_examples=2, deadline=None, derandomize=True, suppress_health_check=QUIET)
+@given(data=st.data())
+def test_random_definitions_simulate_as_the_cdr_models(data: st.DataObject,
+                                                       tmp_path_factory: pytest.TempPathFactory
+                                                       ) -> None:
+    require_cxx()
+    require_iverilog()
+    from rosfpga_lab.hls.generic import spec_from_layout
+    from rosfpga_lab.rtl.generic import project_files
+
+    cdr, records, op = _random_case(data)
+    expected, _why = model_output_cdr(cdr, op, 3, records)
+    spec = spec_from_layout(cdr.layout, cdr.registry, op=op, ksize=3,
+                            program=program_from_cdr(cdr), wire="cdr")
+    where = tmp_path_factory.mktemp("random_cdr")
+    for name, blob in project_files(spec).items():
+        (where / name).parent.mkdir(parents=True, exist_ok=True)
+        (where / name).write_bytes(blob)
+    want = statuses_of(cdr, records)
+    csim, rtl = both_simulations(where, records)
+    assert csim == (expected, want)
+    assert rtl == (expected, want)
