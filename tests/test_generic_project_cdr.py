@@ -34,7 +34,7 @@ from rosfpga_lab.hls.generic import model_output_cdr, program_from_cdr
 from rosfpga_lab.hls.program import run_program
 from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_layout_from_config, derive_cdr_layout
 from rosfpga_lab.hw.cdrwalker import extract_cdr_fast
-from rosfpga_lab.hw.errors import FrameFieldError
+from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError
 from rosfpga_lab.hw.layout import Action, StepKind
 from rosfpga_lab.msg.cdr import serialize_cdr
 from rosfpga_lab.msg.ros2 import ros2_registry
@@ -92,7 +92,9 @@ def statuses_of(cdr: CdrLayout, records: list[bytes]) -> list[str]:
         except FrameFieldError as exc:
             label = "sample length" if exc.field == "frame length" else \
                 re.sub(r"\[\d+\]", "[]", exc.field)
-            names.append(by_label[label])
+            # a sample that ends inside a field the circuit checks nothing of: its length's status
+            names.append(by_label.get(label, "SUB_BAD_FRAME_LENGTH")
+                         if isinstance(exc, FrameLengthError) else by_label[label])
             continue
         names.append("SUB_OK")
     return names
@@ -308,7 +310,7 @@ def _random_case(data: st.DataObject) -> tuple[CdrLayout, list[bytes], str]:
 QUIET = [HealthCheck.too_slow, HealthCheck.function_scoped_fixture]
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=QUIET)
+@settings(max_examples=100, deadline=None, suppress_health_check=QUIET)
 @given(data=st.data())
 def test_the_program_executor_equals_the_cdr_models_on_random_definitions(
         data: st.DataObject) -> None:
