@@ -347,3 +347,32 @@ def test_random_definitions_simulate_as_the_cdr_models(data: st.DataObject,
     csim, rtl = both_simulations(where, records)
     assert csim == (expected, want)
     assert rtl == (expected, want)
+
+
+def test_a_tcpros_frame_cut_short_in_a_count_is_refused_by_that_count_in_verilog_too(
+        tmp_path: Path) -> None:
+    """Regression (the Verilog walker said SUB_BAD_FRAME_LENGTH where the C++ and the models name
+    the count): a LaserScan frame whose length ends inside ``intensities``' count."""
+    require_cxx()
+    require_iverilog()
+    from rosfpga_lab.hls.generic import model_output, sample_tokens, spec_from_config
+    from rosfpga_lab.hw.layout import layout_from_config, marshal
+    from rosfpga_lab.rtl.generic import project_files
+
+    config = load_config(DATA / "fpga_laserscan_min.yaml")
+    layout = layout_from_config(config)
+    toks = []
+    for t in sample_tokens(layout, np.random.default_rng(1)):
+        label = layout.steps[t.step].label
+        toks.append(t._replace(value=0) if label == "intensities length" else
+                    t._replace(value=np.zeros(0, np.float32)) if label == "intensities" else t)
+    good = marshal(layout, toks)
+    body = good[4:-2]
+    frames = [struct.pack("<I", len(body)) + body, good]
+    expected, why = model_output(layout, "erode", 5, frames)
+    assert "'intensities length'" in why[0] and why[1] == ""
+    for name, blob in project_files(spec_from_config(config)).items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_bytes(blob)
+    want = ["SUB_BAD_INTENSITIES_LENGTH", "SUB_OK"]
+    assert both_simulations(tmp_path, frames) == ((expected, want), (expected, want))
