@@ -276,7 +276,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
     pc = 0
 
     def take(n: int, status: int, align: int = 1) -> bytes:
-        nonlocal pos, out_len
+        nonlocal pos
         if n and align > 1:
             if pos + pad(pos, align) >= fend:  # the frame ends before this field
                 raise Refused(FRAME_LENGTH_STATUS, bool(stream))
