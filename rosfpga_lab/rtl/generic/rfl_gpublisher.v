@@ -46,9 +46,10 @@ module rfl_gpublisher #(
     reg [DB-1:0] depth;
 
     wire [IW-1:0] w = prog_word(pc);
-    wire [3:0]  align = w[221:218];
-    wire [3:0]  elem_align = w[217:214];
-    wire        nul = w[213];
+    // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
+    wire [3:0]  align = CDR ? w[221:218] : 4'd1;
+    wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
+    wire        nul = CDR ? w[213] : 1'b0;
     wire [2:0]  op = w[204:202];
     wire [2:0]  pub = w[198:196];
     wire        variable = w[195];

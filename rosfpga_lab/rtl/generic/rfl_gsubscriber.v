@@ -64,9 +64,10 @@ module rfl_gsubscriber #(
 
     // The current instruction.
     wire [IW-1:0] w = prog_word(pc);
-    wire [3:0]  align = w[221:218];
-    wire [3:0]  elem_align = w[217:214];
-    wire        nul = w[213];
+    // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
+    wire [3:0]  align = CDR ? w[221:218] : 4'd1;
+    wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
+    wire        nul = CDR ? w[213] : 1'b0;
     wire [7:0]  st3 = w[212:205];
     wire [2:0]  op = w[204:202];
     wire [2:0]  sub = w[201:199];
@@ -99,7 +100,8 @@ module rfl_gsubscriber #(
 
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
     wire [31:0] pos_next = pos + 32'd1;
-    wire [63:0] room = {32'd0, fendp} - {32'd0, pos};  // bytes left for the fields
+    wire [31:0] fields_end = CDR ? fendp : endp;
+    wire [63:0] room = {32'd0, fields_end} - {32'd0, pos};  // bytes left for the fields
     wire        at_end = (pos == endp);             // nothing left of the frame to skip
     wire [31:0] pad_f = pad_at(pos, align);         // before a field or a count
     wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
@@ -275,7 +277,7 @@ module rfl_gsubscriber #(
                     value <= 64'd0;
                     case (op)
                         OP_DONE: begin
-                            if (pos != fendp) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
+                            if (pos != fields_end) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
                             else begin
                                 status_valid <= 1'b1;
                                 status <= SUB_OK;
@@ -381,7 +383,7 @@ module rfl_gsubscriber #(
                     if ({32'd0, cnt} + 64'd1 == need) state <= S_FINISH;
                 end
                 S_FINISH: begin
-                    if (op == OP_ENCAP) begin  // CDR little-endian, then the end padding
+                    if (CDR && op == OP_ENCAP) begin  // CDR little-endian, then the end padding
                         if (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1))
                             refuse(st, at_end);
                         else if ({56'd0, value[31:24] & ENCAP_PAD_MASK} > room)
