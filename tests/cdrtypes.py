@@ -57,3 +57,17 @@ class Samples_(IdlStruct, typename="lab_msgs::msg::dds_::Samples_"):
     period: Duration_
     history: t.sequence[Calibration_]
     valid: bool
+
+
+@dataclass
+class LaserScan_(IdlStruct, typename="sensor_msgs::msg::dds_::LaserScan_"):
+    header: Header_
+    angle_min: t.float32
+    angle_max: t.float32
+    angle_increment: t.float32
+    time_increment: t.float32
+    scan_time: t.float32
+    range_min: t.float32
+    range_max: t.float32
+    ranges: t.sequence[t.float32]
+    intensities: t.sequence[t.float32]

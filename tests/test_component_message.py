@@ -2,7 +2,9 @@
 
 Outputs are compared with numpy written out here (a sliding min/max over the in-array window)
 and with the msg layer's deserializer; frames of the shipped examples also come from real
-genpy's dynamic classes (built from the .msg texts) under the system Python.
+genpy's dynamic classes (built from the .msg texts) under the system Python, and a real roscpp
+program (Debian's sensor_msgs/LaserScan.h) publishes scans to the LaserScan component and
+receives its output on a real rosmaster.
 """
 
 from __future__ import annotations
@@ -322,3 +324,73 @@ def test_real_rospy_with_genpys_dynamic_classes_talks_to_the_custom_component(
     for k, g in enumerate(got):
         assert g["samples"] == sliding(np.array(bursts[k], np.int32), 3, np.max).tolist()
         assert (g["label"], g["mode"], g["history"]) == (f"burst {k}", 2, [f"h{i}" for i in range(k)])
+
+
+def _laserscan_by_hand(body: bytes) -> dict:
+    """A sensor_msgs/LaserScan body decoded with struct (independent of the lab's decoders)."""
+    seq, secs, nsecs, n = struct.unpack_from("<IIII", body, 0)
+    pos = 16
+    frame_id = body[pos:pos + n].decode()
+    pos += n
+    floats = struct.unpack_from("<7f", body, pos)
+    pos += 28
+    (n,) = struct.unpack_from("<I", body, pos)
+    ranges = body[pos + 4:pos + 4 + 4 * n]
+    pos += 4 + 4 * n
+    (n,) = struct.unpack_from("<I", body, pos)
+    intensities = struct.unpack_from(f"<{n}f", body, pos + 4)
+    assert pos + 4 + 4 * n == len(body)
+    return {"seq": seq, "stamp": (secs, nsecs), "frame_id": frame_id, "floats": floats,
+            "ranges": ranges, "intensities": intensities}
+
+
+@pytest.mark.ros
+def test_real_roscpp_laserscans_through_the_component_come_out_min_filtered_exactly(
+        rosmaster_uri, tmp_path) -> None:
+    """Issue 19 item 5: a real roscpp program (Debian's sensor_msgs/LaserScan.h) publishes to
+    the LaserScan component on a real rosmaster and receives its output: a 359-beam scan is
+    refused by name, every good one comes out as numpy's sliding minimum, the rest carried."""
+    import subprocess
+
+    from realros import ROS_PROGRAMS, build_roscpp_program, finish, ros_env, stop_process
+
+    require_ros()
+    binary = build_roscpp_program(ROS_PROGRAMS / "scan_roscpp_pubsub.cpp")
+    rng = np.random.default_rng(19)
+    scans = [rng.uniform(0.1, 30, 359).astype(np.float32)]            # refused: 359 beams
+    scans += [rng.uniform(0.1, 30, 360).astype(np.float32) for _ in range(3)]
+    scans[2][[0, 100, 359]] = [-np.inf, 0.0, np.inf]                   # the extremes too
+    infile, outfile = tmp_path / "scans.bin", tmp_path / "out.bin"
+    infile.write_bytes(b"".join(struct.pack("<I", len(s)) + s.tobytes() for s in scans))
+    good = len(scans) - 1
+    comp = FpgaComponent.from_config(SCAN_CONFIG, master_uri=rosmaster_uri, input_queue=8,
+                                     output_queue=8).start()
+    proc = subprocess.Popen([str(binary), "/scan", "/scan_min", str(infile), str(good),
+                             str(outfile), "20"], env=ros_env(rosmaster_uri, tmp_path),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        finish(proc, 40)
+        stats = comp.stats
+    finally:
+        stop_process(proc)
+        comp.stop()
+    data = outfile.read_bytes()
+    bodies, pos = [], 0
+    while pos < len(data):
+        (n,) = struct.unpack_from("<I", data, pos)
+        bodies.append(data[pos + 4:pos + 4 + n])
+        pos += 4 + n
+    assert len(bodies) == good, stats.report()
+    assert (stats.published, stats.refused) == (good, 1)
+    assert stats.refused_reasons == {"ranges length: not what the circuit was built for": 1}
+    for body in bodies:
+        got = _laserscan_by_hand(body)
+        k = got["stamp"][1]                       # the program stamps scan k with (100 + k, k)
+        assert got["stamp"] == (100 + k, k) and 1 <= k <= good
+        want = sliding(scans[k], 5, np.min)
+        assert got["ranges"] == want.tobytes(), f"scan {k}"
+        assert got["frame_id"] == "laser" and got["intensities"] == (float(k), 0.5)
+        assert got["floats"] == struct.unpack("<7f", struct.pack(
+            "<7f", -1.5, 1.5, 0.01, 0.0, 0.0, 0.05, 30.0))
+        assert got["seq"] == k      # roscpp numbers from 0 (the refused scan); the circuit carries it
+    assert sorted(_laserscan_by_hand(b)["stamp"][1] for b in bodies) == list(range(1, good + 1))

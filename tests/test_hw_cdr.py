@@ -82,7 +82,8 @@ def test_reference_fast_and_the_cdr_codec_agree_on_every_field(case: Any, pad: i
     decoded = deserialize_cdr(r2, type_name, payload)
     expected = _wire(cdr, cdr_tokens(cdr, decoded))
     record = _record(payload)
-    for given_record in (record, _record(_pad_tail(payload, pad))):
+    cyclone = _record(payload + bytes(-len(payload) % 4))   # padded to 4, options 00 00
+    for given_record in (record, _record(_pad_tail(payload, pad)), cyclone):
         ref = extract_cdr_reference(cdr, given_record)
         fast = extract_cdr_fast(cdr, given_record)
         assert _wire(cdr, ref.tokens) == expected
@@ -273,6 +274,70 @@ def test_end_padding_announced_by_the_options_is_skipped() -> None:
     with pytest.raises(FrameFieldError) as exc:
         interp.finish()
     assert exc.value.field == TAIL_LABEL
+
+
+@pytest.mark.parametrize("model", ["reference", "fast"])
+def test_unannounced_zero_padding_to_4_is_taken_when_the_options_announce_fewer(model: str) -> None:
+    """Issue 20: Cyclone DDS pads an XCDR1 payload to a multiple of 4 (counted from the
+    encapsulation header's first byte) with options 00 00; a 398-byte Samples arrives as 400."""
+    pipe = _samples_pipeline(model)
+    creg = pipe.cdr.registry
+    extract = extract_cdr_reference if model == "reference" else extract_cdr_fast
+    good = serialize_cdr(creg, "lab_msgs/Samples", _samples_value())
+    shorter = serialize_cdr(creg, "lab_msgs/Samples", dict(_samples_value(), history=[]))
+    assert (len(good) % 4, len(shorter) % 4) == (2, 1)   # they need 2 and 3 bytes
+    out = pipe.process(good)
+    out_shorter = pipe.process(shorter)
+    for payload, want in ((good, out), (shorter, out_shorter)):
+        fill = -len(payload) % 4
+        padded = payload + bytes(fill)                      # options 00 00: unannounced
+        assert len(padded) % 4 == 0 and padded[2:4] == b"\x00\x00"
+        assert pipe.process(padded) == want
+        # options announcing fewer bytes do not stop it; announcing more than there are
+        # claims the last field's bytes as padding and is refused, as before
+        for options in range(1, 4):
+            record = _record(padded[:2] + struct.pack(">H", options) + padded[4:])
+            if options < fill:
+                assert pipe.process(record[4:]) == want
+            elif options > fill:
+                with pytest.raises(FrameLengthError):
+                    extract(pipe.cdr, record)
+                assert _outcome(extract_cdr_reference, pipe.cdr, record) == \
+                    _outcome(extract_cdr_fast, pipe.cdr, record)
+        # announced by the options and also aligning: taken as before
+        assert pipe.process(_pad_tail(payload, fill)) == want
+        # one byte short of alignment, one zero too many, four more zeros: not padding
+        for bad in (payload + bytes(fill - 1) if fill > 1 else None, padded + b"\x00",
+                    padded + bytes(4)):
+            if bad is None:
+                continue
+            with pytest.raises(FrameLengthError) as exc:
+                extract(pipe.cdr, _record(bad))
+            assert exc.value.field == "frame length"
+            assert pipe.process(padded) == want
+        # a non-zero byte in the padding: refused by name, at its offset, both models alike
+        for k in range(fill):
+            bad = bytearray(padded)
+            bad[len(payload) + k] = 0x5A
+            with pytest.raises(FrameFieldError) as exc:
+                extract(pipe.cdr, _record(bytes(bad)))
+            assert (exc.value.field, exc.value.rule, exc.value.offset, exc.value.value) == \
+                (TAIL_LABEL, "not zero", 4 + len(payload) + k, 0x5A)
+            assert _outcome(extract_cdr_reference, pipe.cdr, _record(bytes(bad))) == \
+                _outcome(extract_cdr_fast, pipe.cdr, _record(bytes(bad)))
+            assert pipe.process(padded) == want
+    # byte by byte: a bad padding byte, then the next sample comes out right
+    bad = bytearray(good + bytes(2))
+    bad[-2] = 1
+    interp = CdrInterpreter(pipe.cdr)
+    refusals = []
+    for byte in _record(bytes(bad)) + _record(good + bytes(2)) + _record(shorter + bytes(3)):
+        try:
+            interp.push(byte)
+        except FrameFieldError as exc:
+            refusals.append((exc.field, exc.offset))
+    assert refusals == [(TAIL_LABEL, 4 + len(good))] and interp.frames == 2
+    assert interp.pc == 0 and not interp._buf
 
 
 def test_the_samples_pipeline_agrees_with_the_codec_and_a_sliding_max() -> None:

@@ -133,3 +133,36 @@ def test_workshop_notebook_says_when_the_stop_button_is_there_and_explains_reset
     assert "*Connection reset by peer*" in text and "not a damaged frame" in text
     code = "\n".join("".join(c["source"]) for c in cells("07_workshop_demo.ipynb") if c["cell_type"] == "code")
     assert "live.close()" in code        # what the prose says the last cell does
+
+
+def test_notebook_08_shows_a_shipped_timing_report_that_meets_the_clock() -> None:
+    """Issue 21 item 4: notebook 08 shows the place-and-route report shipped in data/ (made by
+    data/make_timing_report.py) and says what its text claims about it."""
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.rtl.timing import (
+        SHIPPED_CONFIG, SHIPPED_REPORT, format_timing, report_from_dict, shipped_report,
+    )
+
+    data = json.loads((ROOT / "data" / SHIPPED_REPORT).read_text(encoding="utf-8"))
+    report = report_from_dict(data)
+    config = load_config(ROOT / "data" / SHIPPED_CONFIG)
+    # the clock is met, at the configuration's clock, and the stored verdict agrees
+    assert report.clock_mhz == config.clock_mhz == 100
+    assert report.fmax_mhz >= report.clock_mhz and report.met and data["met"] is True
+    assert report.utilization["TRELLIS_COMB"][0] > 0 and report.path
+    # the text beside it is what `rosfpga-lab rtl timing` prints for it
+    text = (ROOT / "data" / SHIPPED_REPORT).with_suffix(".txt").read_text(encoding="utf-8")
+    assert text.rstrip("\n") == format_timing(report, title=f"Timing of data/{SHIPPED_CONFIG}")
+    assert ": met (" in text
+    assert shipped_report() == report
+    # what the notebook says of it
+    text08 = markdown("08_rtl.ipynb")
+    code08 = "\n".join("".join(c["source"]) for c in cells("08_rtl.ipynb")
+                       if c["cell_type"] == "code")
+    assert "rosfpga-lab rtl timing data/fpga_dilate_rgba8.yaml" in text08
+    assert f"data/{SHIPPED_REPORT}" in text08 and "shipped_report()" in code08
+    assert (ROOT / "data" / "make_timing_report.py").is_file()
+    routing = sum(s.delay_ns for s in report.path if s.kind == "routing")
+    assert "Most of\nits delay is routing" in text08 and routing > report.path_ns / 2
+    assert "valid/ready handshakes" in text08
+    assert any("tvalid" in s.sink or "tready" in s.sink for s in report.path)

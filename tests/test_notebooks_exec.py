@@ -114,6 +114,42 @@ def check_claims(stem: str, nb: nbformat.NotebookNode) -> None:
         if "No g++" not in text:
             assert "subscriber status: SUB_OK (the frame at byte 0 of the input)" in text
         assert "<details open><summary><code>subscriber.cpp</code>" in html
+    if stem == "10_your_own_message":
+        check_own_message(text, html)
+
+
+def check_own_message(text: str, html: str) -> None:
+    """Notebook 10: the walk drawn and shown over the frame, both simulations (or the shipped
+    result) equal to the models, Table 1, the live graph, and real rospy when it is here."""
+    assert 'class="rfl-state" data-state="VALUES"' in html and 'data-state="SKIP"' in html
+    assert "values [stream]" in html and "gain [check]" in html   # the byte viewer's roles
+    assert "field 'gain' at byte 34: 5 but the circuit was built for 4 (status SUB_BAD_GAIN)" in text
+    for run in ("C simulation", "RTL simulation"):
+        if "the shipped result" not in text:
+            assert re.search(rf"{run} output equals the models':\s+True", text), text[-2000:]
+    if "the shipped result" in text:
+        assert "made for this project" in text and text.count("output equals the models': True") == 2
+    assert re.search(r"Table 1 for my_msgs/LineScan\n.*\ntotal\s+\d+\s+\d+\s+127\s+860", text, re.S)
+    assert "checker: 5 outputs, 5 bit-exact" in text and "refused 1" in text
+    reason = ros_missing_reason()
+    if reason is None:
+        found = re.search(r"frames from the rospy node: (\d+), bit-exact: (\d+)", text)
+        assert found and int(found[1]) > 0 and found[1] == found[2], found and found[0]
+    elif os.environ.get("ROSFPGA_REQUIRE_ROS", "") not in ("", "0", "false", "no"):
+        pytest.fail(f"notebook 10 ran without real ROS ({reason}) and ROSFPGA_REQUIRE_ROS=1")
+
+
+def test_own_message_notebook_shows_the_shipped_simulation_without_tools(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Notebook 10 on a machine without g++, make or Icarus Verilog: the shipped result."""
+    monkeypatch.setenv("PATH", str(Path(sys.executable).parent))
+    client, nb = client_for(SOLUTIONS / "10_your_own_message.ipynb")
+    client.execute()
+    text = "\n".join(text_of(c) for c in nb.cells if c.cell_type == "code")
+    assert "the shipped result (data/notebook10_sim.json, made for this project)" in text
+    assert "csim statuses: ['SUB_OK', 'SUB_BAD_VALUES_LENGTH', 'SUB_OK']; output equals the models': True" in text
+    assert "rtlsim statuses: ['SUB_OK', 'SUB_BAD_VALUES_LENGTH', 'SUB_OK']; output equals the models': True" in text
+    assert "real ROS 1: " in text   # rospy is found by its own interpreter's path, not PATH
 
 
 def cyclone_imports() -> bool:

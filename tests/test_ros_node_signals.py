@@ -39,9 +39,22 @@ def ignore_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def nodes_of(uri: str) -> set[str]:
+def nodes_of(uri: str, *, beside_rosout: bool = False) -> set[str]:
+    """Nodes the master lists; with ``beside_rosout`` only those with a topic other than
+    ``/rosout`` (every lab node advertises ``/rosout`` first, before its own topics)."""
     pubs, subs, _srvs = call(uri, "getSystemState", "/t")[2]
-    return {n for _t, names in pubs + subs for n in names}
+    return {n for t, names in pubs + subs for n in names if not (beside_rosout and t == "/rosout")}
+
+
+def wait_for_entry(uri: str, kind: int, entry: list, timeout: float = 10.0) -> list:
+    """getSystemState's publishers (0) or subscribers (1) once ``entry`` is among them (or at
+    the time-out)."""
+    deadline = time.monotonic() + timeout
+    while True:
+        entries = call(uri, "getSystemState", "/t")[2][kind]
+        if entry in entries or time.monotonic() > deadline:
+            return entries
+        time.sleep(0.05)
 
 
 def start_registered(uri: str, argv: list[str], name: str = "", *, background: bool,
@@ -59,7 +72,7 @@ def start_registered(uri: str, argv: list[str], name: str = "", *, background: b
         preexec_fn=ignore_sigint if background else interruptible)
     deadline = time.monotonic() + 30
     while time.monotonic() < deadline and proc.poll() is None:
-        new = nodes_of(uri) - before
+        new = nodes_of(uri, beside_rosout=True) - before
         if (expect in new) if expect else new:
             return proc, expect or sorted(new)[0]
         time.sleep(0.05)
@@ -149,7 +162,8 @@ def test_node_command_takes_remaps_name_and_namespace(lab_master, tmp_path) -> N
     proc, _node = start_registered(lab_master, argv, "foo", background=False,
                             env={"ROS_NAMESPACE": "ns1"}, expect="/ns1/foo")
     try:
-        pubs, subs, _ = call(lab_master, "getSystemState", "/t")[2]
+        subs = wait_for_entry(lab_master, 1, ["/cam/image", ["/ns1/foo"]])
+        pubs = wait_for_entry(lab_master, 0, ["/ns1/image_dilated", ["/ns1/foo"]])
     finally:
         out, err = stop_with(proc, signal.SIGINT)
     assert ["/cam/image", ["/ns1/foo"]] in subs, subs
@@ -170,7 +184,7 @@ def test_camera_view_and_topic_take_names_from_the_ros_command_line(lab_master, 
     proc, _node = start_registered(lab_master, argv, "cam", background=False,
                                    env={"ROS_NAMESPACE": "ns2"}, expect=expect)
     try:
-        entries = call(lab_master, "getSystemState", "/t")[2][kind]
+        entries = wait_for_entry(lab_master, kind, [topic, [expect]])
     finally:
         stop_with(proc, signal.SIGTERM)
     assert [topic, [expect]] in entries, entries

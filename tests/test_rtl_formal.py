@@ -2,8 +2,10 @@
 
 Every check of :data:`PROOFS` must pass (``prove``: bounded check plus k-induction, so true in
 every reachable state; ``bmc``: true in the first ``depth`` clocks), every module of the circuit
-must be covered, and a copy of the FIFO with a planted bug (a word written into an empty FIFO
-is lost) must make the FIFO's proof fail: the properties are not vacuous.
+must be covered, the generic element-stream modules and program walkers (``generic/``) too,
+and copies with planted bugs must make the proofs fail: the properties are not vacuous (a FIFO
+that loses a word written into it when empty; a 1-D window whose output changes while stalled;
+an element packer that drops TLAST).
 """
 
 from __future__ import annotations
@@ -13,7 +15,13 @@ from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
-from rosfpga_lab.rtl.proofs import FORMAL_DIR, PROOFS, format_results, prove, sby_text
+from pathlib import Path
+
+from rosfpga_lab.rtl.generic import GENERIC_MODULES, GENERIC_VERILOG_DIR, LAYOUT_INCLUDE
+from rosfpga_lab.rtl.proofs import (
+    FORMAL_DIR, PROOFS, Proof, ProofResult, format_results, formal_layout, formal_program, prove,
+    sby_text,
+)
 from rosfpga_lab.rtl.sim import VERILOG_DIR
 from rtltools import TB_DIR, require_formal
 
@@ -21,10 +29,17 @@ pytestmark = pytest.mark.rtl
 
 
 def test_every_module_has_a_proof() -> None:
-    modules = {m for p in VERILOG_DIR.glob("*.v")
-               for m in re.findall(r"^\s*module\s+(\w+)", p.read_text(), re.M)}
+    """Every module of verilog/ and of generic/ (the generic projects' static Verilog) has one."""
+    files = [*VERILOG_DIR.glob("*.v"), *GENERIC_VERILOG_DIR.glob("*.v")]
+    assert sorted(p.name for p in GENERIC_VERILOG_DIR.glob("*.v")) == sorted(GENERIC_MODULES)
+    modules = {m for p in files for m in re.findall(r"^\s*module\s+(\w+)", p.read_text(), re.M)}
     proven = {f"rfl_{p.name}" for p in PROOFS}
     assert modules == proven
+    # a walker's proof runs against the generated walk, the others do not need it
+    for p in PROOFS:
+        walks = any(LAYOUT_INCLUDE in (GENERIC_VERILOG_DIR / f).read_text()
+                    for f in p.design if f in GENERIC_MODULES)
+        assert p.layout == walks, p
     for p in PROOFS:
         assert (FORMAL_DIR / f"fv_{p.name}.sv").exists()
         assert p.mode in ("prove", "bmc") and p.depth > 0
@@ -74,3 +89,64 @@ def test_cli_rtl_prove(capsys: pytest.CaptureFixture[str]) -> None:
     assert out[0].split() == ["check", "mode", "depth", "result", "s", "claim"]
     assert [line.split()[:4] for line in out[1:]] == [["axi2fifo", "prove", "8", "PASS"],
                                                       ["axi2fifo", "bmc", "12", "PASS"]]
+
+
+def test_the_walkers_are_proven_on_a_generated_walk() -> None:
+    """rfl_layout.vh of the proofs is the project generator's, for the program it names, and the
+    walkers' wrappers are set for that program (frame lengths, carry memory, stream)."""
+    prog = formal_program()
+    text = formal_layout()
+    assert "function [IW-1:0] prog_word" in text and prog.type_in in text
+    assert text.count("prog_word = {") == len(prog.instrs) + 1         # + the default word
+    for ins in prog.instrs[:-1]:
+        assert f"// {ins.name} ({ins.type})" in text
+    sub = (FORMAL_DIR / "fv_gsubscriber.sv").read_text()
+    assert f".CARRY_BYTES({prog.carry_bytes})" in sub
+    assert f".MIN_BODY({prog.min_body}), .MAX_FRAME({prog.max_frame})" in sub
+    pub = (FORMAL_DIR / "fv_gpublisher.sv").read_text()
+    assert f".STREAM_DATA_BYTES({prog.stream_length * prog.stream_bytes})" in pub
+    top = (FORMAL_DIR / "fv_gtop.sv").read_text()
+    assert f".EBYTES({prog.stream_bytes}), .LENGTH({prog.stream_length})" in top
+
+
+def plant(tmp: Path, name: str, old: str, new: str) -> Path:
+    """A copy of generic/``name`` with the line ``old`` replaced by the bug ``new``."""
+    text = (GENERIC_VERILOG_DIR / name).read_text()
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp / name
+    buggy.write_text(text.replace(old, new + "   // PLANTED BUG"))
+    return buggy
+
+
+def failures(proof: Proof, name: str, buggy: Path) -> ProofResult:
+    result = prove(proof, replace={name: buggy})
+    assert result.status == "FAIL", format_results([result])
+    assert all(f.startswith(f"fv_{proof.name}.sv:") for f in result.failed), result.failed
+    return result
+
+
+def failed_lines(proof: Proof, result: ProofResult) -> list[str]:
+    """The wrapper's source lines of the failed assertions."""
+    wrapper = (FORMAL_DIR / f"fv_{proof.name}.sv").read_text().splitlines()
+    lines = sorted({int(f.split(":")[1].split(".")[0]) for f in result.failed})
+    return [wrapper[n - 1].strip() for n in lines]
+
+
+def test_planted_bugs_fail_the_generic_proofs(tmp_path: Path) -> None:
+    """A window that steps while its output is stalled (the beat it holds is overwritten) fails
+    the induction proof's data-stable rule; a packer that never sets TLAST fails the bounded
+    check of TLAST on an array's last element."""
+    require_formal()
+    name = "rfl_window1d.v"
+    buggy = plant(tmp_path, name, "wire out_free = !m_axis_tvalid || m_axis_tready;",
+                  "wire out_free = 1'b1;")
+    proof = next(p for p in PROOFS if p.name == "window1d" and p.mode == "prove")
+    result = failures(proof, name, buggy)
+    assert failed_lines(proof, result) == ["`FV_SINK(m_tvalid, m_axis_tready, {m_tuser, m_tlast, "
+                                           "m_tkeep, m_tdata})"]
+    name = "rfl_elem_pack.v"
+    buggy = plant(tmp_path, name, "m_axis_tlast <= (n == LAST_N);", "m_axis_tlast <= 1'b0;")
+    proof = next(p for p in PROOFS if p.name == "elem_pack" and p.mode == "bmc")
+    result = failures(proof, name, buggy)
+    assert any(line.startswith("assert(m_tlast == (idx == LENGTH - 1));")
+               for line in failed_lines(proof, result)), result.failed

@@ -78,3 +78,25 @@ def test_a_report_below_the_clock_is_not_met_and_names_the_path() -> None:
 def test_a_folder_without_the_node_is_refused(tmp_path: Path) -> None:
     with pytest.raises(TimingError, match="rfl_node.v not found"):
         place_and_route_dir(tmp_path, 100)
+
+
+def test_a_report_written_for_shipping_reads_back_equal_and_a_damaged_one_is_refused() -> None:
+    """report_to_dict / report_from_dict (data/make_timing_report.py, notebook 08)."""
+    from rosfpga_lab.rtl.timing import report_from_dict, report_to_dict
+
+    report = parse_report({
+        "fmax": {"clk": {"achieved": 123.5}},
+        "critical_paths": [{"from": "clk", "to": "clk", "path": [
+            {"type": "clk-to-q", "delay": 0.5, "from": {"cell": "a", "port": "Q"},
+             "to": {"cell": "a", "port": "Q"}},
+            {"type": "routing", "delay": 3.25, "from": {"cell": "a", "port": "Q"},
+             "to": {"cell": "b", "port": "D"}}]}],
+        "utilization": {"TRELLIS_COMB": {"used": 10, "available": 24288}}}, 100,
+        "LFE5U-25K CABGA256", (1.5, 2.5))
+    data = json.loads(json.dumps(report_to_dict(report)))
+    assert data["met"] is True and data["fmax_mhz"] == 123.5
+    assert report_from_dict(data) == report
+    for damaged in ({k: v for k, v in data.items() if k != "path"},
+                    dict(data, fmax_mhz="fast"), dict(data, utilization=[1, 2])):
+        with pytest.raises(TimingError, match="make_timing_report.py"):
+            report_from_dict(damaged)

@@ -43,3 +43,33 @@ def test_the_picture_follows_the_table() -> None:
     assert "PAUSED" in _states(svg) and "pause: a made-up move" in _arrows(svg)[("subscriber", "STREAMING", "PAUSED")]
     with pytest.raises(WidgetError):
         state_diagram_svg([])
+
+
+def test_a_message_layout_is_drawn_as_its_subscriber_state_machine(tmp_path) -> None:
+    """Every step of a derived layout is a state; loops, empty arrays and refusals are moves."""
+    from rosfpga_lab.hw.layout import derive_layout
+    from rosfpga_lab.msg import registry_with
+    from rosfpga_lab.widgets import layout_transitions
+
+    (tmp_path / "t_msgs/msg").mkdir(parents=True)
+    (tmp_path / "t_msgs/msg/Scan.msg").write_text("string[] names\nuint8 gain\nfloat32[] ranges\n")
+    layout = derive_layout(registry_with([tmp_path]), "t_msgs/Scan", stream="ranges",
+                           stream_length=4, checks={"gain": 2})
+    rows = layout_transitions(layout)
+    svg = state_diagram_svg(rows, in_order=True)
+    assert _states(svg) == ["FRAME_LENGTH", "NAMES_LENGTH", "NAMES_LOOP", "NAMES_ITEM_LENGTH",
+                            "NAMES_ITEM", "NAMES_END", "GAIN", "RANGES_LENGTH", "RANGES", "SKIP"]
+    arrows = _arrows(svg)
+    role = "t_msgs/Scan subscriber"
+    assert "not == 2: refuse: SUB_BAD_GAIN" in arrows[(role, "GAIN", "SKIP")]
+    assert "no elements: names is empty" in arrows[(role, "NAMES_LOOP", "GAIN")]
+    assert "0: ranges is empty" in arrows[(role, "RANGES_LENGTH", "FRAME_LENGTH")]
+    assert (role, "NAMES_LENGTH", "GAIN") not in arrows   # the loop's own state says it
+    assert "more elements: next element of names" in arrows[(role, "NAMES_END", "NAMES_ITEM_LENGTH")]
+    assert "last element: names done" in arrows[(role, "NAMES_END", "GAIN")]
+    assert "n x 4 bytes: stream ranges (float32), n = ranges length as AXI4-Stream beats" \
+        in arrows[(role, "RANGES", "FRAME_LENGTH")]
+    assert "rest of the frame" in arrows[(role, "SKIP", "FRAME_LENGTH")]
+    # the walk folds into bands that fit a notebook; the handshake's picture is not folded
+    assert int(re.search(r'width="(\d+)"', svg)[1]) <= 940
+    assert state_diagram_svg(tcpros.TRANSITIONS) == state_diagram_svg(tcpros.TRANSITIONS, in_order=False)

@@ -21,6 +21,8 @@ notebook  checks
 5         :func:`check_dilate`, :func:`check_frame_timing`
 6         :func:`check_node_config`, :func:`check_sloc`
 9         :func:`check_cdr_data_offset`, :func:`check_fragment_count`
+10        :func:`check_stream_offset`, :func:`check_frame_clocks`, :func:`check_refused_field`
+11        :func:`check_discovery_port`, :func:`check_pixel_offsets`, :func:`check_qos_mismatch`
 ========  ======================================================================
 
 :mod:`rosfpga_lab.checks.nbbuild` makes the student notebooks from the instructor notebooks
@@ -38,6 +40,7 @@ from rosfpga_lab.checks.handshake import (
 from rosfpga_lab.checks.message import (
     check_data_offset, check_extract, check_marshal, frame_fields, message_fields,
 )
+from rosfpga_lab.checks.ownmsg import check_frame_clocks, check_refused_field, check_stream_offset
 from rosfpga_lab.checks.ros2 import (
     check_cdr_data_offset, check_discovery_port, check_fragment_count, check_pixel_offsets,
     check_qos_mismatch,
@@ -54,5 +57,6 @@ __all__ = [
     "check_http_body", "check_markers", "check_marshal", "check_md5", "check_node_config",
     "check_sloc", "check_talker_contact", "check_tdata", "describe_byte_difference", "field_at",
     "frame_fields", "header_fields", "message_fields",
+    "check_frame_clocks", "check_refused_field", "check_stream_offset",
     "check_discovery_port", "check_pixel_offsets", "check_qos_mismatch",
 ]

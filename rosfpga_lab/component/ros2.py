@@ -30,7 +30,7 @@ from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import MessageInfo
 from rosfpga_lab.graph.ros2 import Ros2Node, Ros2Publisher
-from rosfpga_lab.hw import CdrPipeline, FrameLengthError, PipelineError
+from rosfpga_lab.hw import CdrPipeline, PipelineError
 from rosfpga_lab.msg import default_registry, deserialize, deserialize_cdr, serialize, serialize_cdr
 from rosfpga_lab.msg import to_ros2_value
 from rosfpga_lab.rtps.participant import Qos, Sample
@@ -145,18 +145,9 @@ class Ros2Component:
             self._cond.notify_all()
 
     def _process(self, payload: bytes) -> bytes:
-        """The sample through the CDR circuit. Cyclone DDS pads an XCDR1 payload to 4 bytes
-        without saying so in the encapsulation options (a 398-byte Samples arrives as 400 bytes,
-        options 00 00), and the circuit's CDR subscriber refuses bytes after the last field:
-        the RTPS software cuts 1 to 3 zero bytes when the circuit names exactly that."""
-        try:
-            return self.pipeline.process(payload)
-        except FrameLengthError as exc:
-            for cut in (1, 2, 3):
-                if f"announces {cut} bytes after the last field" in str(exc) and \
-                        len(payload) % 4 == 0 and not any(payload[-cut:]):
-                    return self.pipeline.process(payload[:-cut])
-            raise
+        """The sample through the CDR circuit (whose subscriber takes the zero bytes Cyclone DDS
+        pads an XCDR1 payload with to a multiple of 4, announced or not)."""
+        return self.pipeline.process(payload)
 
     def wait_for_peers(self, timeout: float = 10.0) -> bool:
         """Until the input has a matched writer and the output a matched reader."""

@@ -27,6 +27,7 @@ encoding, the application, FIFO depths and the clock. Example (every key but ``n
     clock_mhz: 100
     frame_id_max: 256     # longest header.frame_id the circuit keeps
     part: xc7z020clg400-1 # FPGA part for the HLS project script (Zynq-7020)
+    wire: tcpros          # tcpros | cdr: the generated circuit reads ROS 1 frames or ROS 2 samples
 
 Any other message type names the array the application processes and, if it likes, checks,
 maxima and fields to drop (paths are dotted field names; ``msg_path`` folders, relative to this
@@ -72,7 +73,7 @@ from rosfpga_lab.config.fields import (
     FieldPathError, check_field, check_value_problem, limit_field, resolve_field, stream_field,
 )
 from rosfpga_lab.config.names import canonical, name_problem
-from rosfpga_lab.config.vocabulary import CUSTOM, DEFAULT_OP, ENCODINGS, OPS
+from rosfpga_lab.config.vocabulary import CUSTOM, DEFAULT_OP, DEFAULT_WIRE, ENCODINGS, OPS, WIRES
 
 if TYPE_CHECKING:
     from rosfpga_lab.msg import MsgRegistry
@@ -245,6 +246,7 @@ class NodeConfig:
         clock_mhz: the circuit's clock (MHz).
         frame_id_max: longest ``header.frame_id`` kept (longer frames are refused).
         part: the FPGA part named in the HLS project script.
+        wire: the wire format the circuit reads and writes (``tcpros`` or ``cdr``).
         path: the file it was read from (None when parsed from a string).
         msg_path: folders of the user's ``.msg`` packages (absolute).
         stream: the streamed array (for Image: ``data``, ``image.data_bytes`` elements).
@@ -262,6 +264,7 @@ class NodeConfig:
     clock_mhz: float = limits.DEFAULT_CLOCK_MHZ
     frame_id_max: int = limits.DEFAULT_FRAME_ID_MAX
     part: str = limits.DEFAULT_PART
+    wire: str = DEFAULT_WIRE
     path: Path | None = None
     msg_path: tuple[Path, ...] = ()
     stream: StreamConfig | None = None
@@ -304,6 +307,7 @@ _TOP_SCALARS: dict[str, tuple[type | tuple[type, ...], Any]] = {
     "clock_mhz": ((int, float), limits.DEFAULT_CLOCK_MHZ),
     "frame_id_max": (int, limits.DEFAULT_FRAME_ID_MAX),
     "part": (str, limits.DEFAULT_PART),
+    "wire": (str, DEFAULT_WIRE),
 }
 _REQUIRED_SECTIONS = ("node", "subscriber", "publisher")
 #: Sections that are left out unless given (no defaults to fill).
@@ -741,6 +745,9 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
     if not re.fullmatch(r"[A-Za-z0-9_.-]+", scalars["part"]):
         raise ctx.error(f"expected an FPGA part name like xc7z020clg400-1, got {scalars['part']!r}",
                         top_nodes.get("part"), "part")
+    if scalars["wire"] not in WIRES:
+        raise ctx.error(f"wire must be one of {', '.join(WIRES)}, got {scalars['wire']!r}",
+                        top_nodes.get("wire"), "wire")
 
     return NodeConfig(
         node=NodeSection(**n),
@@ -752,6 +759,7 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
         clock_mhz=float(scalars["clock_mhz"]),
         frame_id_max=scalars["frame_id_max"],
         part=scalars["part"],
+        wire=scalars["wire"],
         msg_path=tuple(folders),
         stream=stream,
         checks=checks,

@@ -71,6 +71,12 @@ MODELS = (*PIPELINE_MODELS, RTL_MODEL)
 #: When a component publishes: ``host`` as soon as the model is done; ``fpga`` after the
 #: circuit's clocks for the frame at ``clock_mhz`` (frames that come while it is busy dropped).
 TIMINGS = ("host", "fpga")
+#: The wire formats a circuit reads and writes: ROS 1's TCPROS frames, or ROS 2's CDR samples
+#: (each behind a 4-byte sample length the RTPS reader writes into the byte FIFO).
+TCPROS_WIRE = "tcpros"
+CDR_WIRE = "cdr"
+WIRES = (TCPROS_WIRE, CDR_WIRE)
+DEFAULT_WIRE = TCPROS_WIRE
 #: The Verilog simulators the RTL flow runs (the first one found is the default).
 SIMULATORS = ("iverilog", "verilator")
 

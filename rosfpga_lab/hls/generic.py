@@ -24,7 +24,12 @@ from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.limits import MAX_CARRY_BYTES
 from rosfpga_lab.hls.generator import HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
 from rosfpga_lab.config import NodeConfig
-from rosfpga_lab.hls.program import FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub
+from rosfpga_lab.config.vocabulary import CDR_WIRE, TCPROS_WIRE
+from rosfpga_lab.hls.program import _replace
+from rosfpga_lab.hls.program import (
+    ALIGN_ORIGIN, ENCAP_BYTES, ENCAP_PAD_MASK, FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub,
+)
+from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_length_rules
 from rosfpga_lab.hw.layout import (
     Action, CheckOp, Layout, Step, StepKind, Token, length_rules, marshal,
 )
@@ -74,6 +79,7 @@ class GenericSpec:
         subscriber_header, publisher_header: the connection-header fields of both sides.
         config_name: the configuration's file name (in the generated-file note).
         custom_source: ``op: custom``: the user's C++ file (its ``stream_filter()``).
+        wire: ``tcpros`` (frames) or ``cdr`` (ROS 2 samples, each behind a sample length).
     """
 
     program: Program
@@ -96,6 +102,7 @@ class GenericSpec:
     publisher_header: dict[str, str]
     config_name: str = "<string>"
     custom_source: Path | None = None
+    wire: str = TCPROS_WIRE
 
 
 def _hex_rows(data: bytes) -> list[str]:
@@ -119,6 +126,9 @@ def instruction_rows(prog: Program) -> list[dict[str, object]]:
         indent = "  " * depth
         if ins.op == Op.DONE:
             comment = "end of the message: the frame must end here"
+        elif ins.op == Op.ENCAP:
+            comment = ("CDR encapsulation header: must start 00 01 (CDR little-endian); options & 3: "
+                       "padding bytes at the end of the payload; out: 00 01 00 00")
         elif ins.op == Op.END:
             comment = f"{indent}end of each element of {ins.name}"
         else:
@@ -131,8 +141,12 @@ def instruction_rows(prog: Program) -> list[dict[str, object]]:
                 check = f", must be {ins.const!r}"
             elif ins.sub == Sub.RANGE:
                 check = f" {ins.const[:ins.size].hex()}..{ins.const[ins.size:].hex()} (LE hex)"
+            if ins.nul:
+                what += ", NUL counted and checked"
+            aligned = "".join(f"; align {a}{' (elements)' if k else ''}" for k, a in
+                              enumerate((ins.align, ins.elem_align)) if a > 1)
             comment = (f"{indent}{ins.name} ({ins.type}): {what}; {_SUB_WORD[ins.sub]}{check}; "
-                       f"out: {_PUB_WORD[ins.pub]}")
+                       f"out: {_PUB_WORD[ins.pub]}{aligned}")
         if ins.op == Op.LOOP:
             depth += 1
         rows.append({
@@ -142,6 +156,8 @@ def instruction_rows(prog: Program) -> list[dict[str, object]]:
             "variable": ins.variable, "status": ins.status, "status2": ins.status2,
             "kind": ins.kind, "fixed_after": ins.fixed_after, "elem_min": ins.elem_min,
             "kaddr": prog.const_offsets[pc], "klen": len(ins.const), "jump": ins.jump,
+            "align": ins.align, "elem_align": ins.elem_align, "nul": ins.nul,
+            "status3": ins.status3,
             "comment": comment.replace("*/", "* /"), "name": ins.name, "type": ins.type,
             "sub_word": _SUB_WORD[ins.sub] if ins.op in (Op.FIXED, Op.VAR) else "-",
             "pub_word": _PUB_WORD[ins.pub] if ins.op in (Op.FIXED, Op.VAR) else "-",
@@ -195,7 +211,10 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "generated_note": note, "node": node,
         "sub": {"topic": spec.sub_topic, "type": prog.type_in},
         "pub": {"topic": spec.pub_topic, "type": prog.type_out},
-        "prog": prog, "instrs": instruction_rows(prog), "statuses": list(prog.statuses),
+        "prog": prog, "instrs": instruction_rows(prog),
+        "cdr": spec.wire == CDR_WIRE, "wire": spec.wire,
+        "align_origin": ALIGN_ORIGIN, "encap_pad_mask": ENCAP_PAD_MASK,
+        "frame": "CDR sample" if spec.wire == CDR_WIRE else "TCPROS frame", "statuses": list(prog.statuses),
         "consts": prog.const_table, "const_rows": _hex_rows(prog.const_table),
         "loop_depth": loop_depth(prog), "max_instr_steps": max_steps(prog),
         "carry_bytes": max(1, prog.carry_bytes),
@@ -295,7 +314,8 @@ def _scalar_instr(step: Step, code: dict[str, int], label: str) -> Instr:
 
 
 def program_from_layout(layout: Layout, *, max_frame: int | None = None,
-                        count: str | None = None, video_as_bytes: bool = False) -> Program:
+                        count: str | None = None, video_as_bytes: bool = False,
+                        cdr: CdrLayout | None = None) -> Program:
     """The walkers' program of a circuit layout (one instruction per field, names from it).
 
     A length prefix and the string or array it counts become one ``VAR`` instruction; an array
@@ -309,6 +329,8 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
             re-sending it (``header.seq`` of the Image project's publisher).
         video_as_bytes: take a video stream (``sensor_msgs/Image``'s ``data``) as a plain array of
             bytes (the Image project has its own; this is for comparing the two).
+        cdr: the CDR walk whose ``layout`` this is (:func:`program_from_cdr`): the program
+            reads and writes CDR samples (alignment, strings with their NUL, the header).
 
     Raises:
         GenerateError: the layout has no stream, or a video stream (Image keeps its own project).
@@ -321,7 +343,11 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
     if layout.stream_length < 1:
         raise GenerateError(f"stream.length is {layout.stream_length}: the circuit streams at "
                             "least one element")
-    rules = length_rules(layout)  # the models' fit rule: one owner
+    rules = cdr_length_rules(cdr) if cdr is not None else length_rules(layout)  # the models' rule
+
+    def align(step: int) -> int:
+        return cdr.align[step] if cdr is not None else 1
+
     code = {name: i for i, (name, _label) in enumerate(layout.statuses)}
     steps = layout.steps
     frame = steps[0]
@@ -332,6 +358,13 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
     i = 1
     while i < len(steps):
         s = steps[i]
+        if s.kind is StepKind.ENCAPSULATION:
+            assert s.check is not None
+            instrs.append(Instr(Op.ENCAP, Sub.CHECK, Pub.CONST, len(ENCAP_BYTES),
+                                status=code[s.check.status], const=ENCAP_BYTES, name=s.label,
+                                type="uint8[4]"))
+            i += 1
+            continue
         if s.kind is StepKind.LENGTH:
             target = steps[s.partner] if s.partner is not None else None
             assert target is not None and s.check is not None
@@ -345,7 +378,7 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
                                     Pub.CARRY if keep else Pub.ZERO, 0, target.max_count,
                                     variable=True, status=status, name=target.label,
                                     type=f"{target.type}[]", fixed_after=fixed_after,
-                                    elem_min=elem_min))
+                                    elem_min=elem_min, align=align(s.index)))
                 carry += 4 * mult[-1] if keep else 0
                 mult.append(mult[-1] * target.max_count)
                 i = target.index + 1
@@ -365,19 +398,28 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
                 assert target.check is not None and target.check.op is CheckOp.EQUAL
                 const = str(target.check.value).encode("utf-8")
                 status2 = code[target.check.status]
+            # CDR: a string's count includes its NUL, checked by the NUL step after it
+            nul = cdr is not None and target.kind is StepKind.STRING
+            status3 = 0
+            if nul:
+                after = steps[target.index + 1]
+                assert after.kind is StepKind.NUL and after.check is not None
+                status3 = code[after.check.status]
+                n += 1
             if sub == Sub.CARRY:
                 carry += (4 + n * target.size) * mult[-1]
             instrs.append(Instr(Op.VAR, sub, pub, target.size, n, status=status, status2=status2,
                                 const=const, name=target.label, fixed_after=fixed_after,
-                                elem_min=elem_min,
+                                elem_min=elem_min, align=align(s.index),
+                                elem_align=align(target.index), nul=nul, status3=status3,
                                 type=target.type if target.kind is StepKind.STRING
                                 else f"{target.type}[]"))
-            i = target.index + 1
+            i = target.index + (2 if nul else 1)
             continue
         if s.kind is StepKind.SCALAR and s.label == count and s.type == "uint32":
             instrs.append(Instr(Op.FIXED, Sub.SKIP, Pub.COUNT, 4, name=s.label, type=s.type))
         elif s.kind is StepKind.SCALAR:
-            ins = _scalar_instr(s, code, s.label)
+            ins = _replace(_scalar_instr(s, code, s.label), align=align(i))
             carry += ins.size * mult[-1] if ins.sub in (Sub.CARRY, Sub.RANGE) else 0
             instrs.append(ins)
         elif s.kind is StepKind.ARRAY:  # a fixed-length array of numbers
@@ -386,7 +428,7 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
                         }.get(s.action, (Sub.CARRY, Pub.CARRY))
             carry += s.size * s.count * mult[-1] if sub == Sub.CARRY else 0
             instrs.append(Instr(Op.FIXED, sub, pub, s.size * s.count, name=s.label,
-                                type=f"{s.type}[{s.count}]"))
+                                type=f"{s.type}[{s.count}]", align=align(i)))
         elif s.kind is StepKind.LOOP:  # fixed count (a variable one starts at its LENGTH)
             assert s.count is not None
             instrs.append(Instr(Op.LOOP, Sub.SKIP, Pub.CARRY, 0, s.count, name=s.label,
@@ -419,6 +461,17 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
         carry_bytes=carry, type_in=layout.type_name, type_out=layout.type_name)
 
 
+def program_from_cdr(cdr: CdrLayout, *, max_frame: int | None = None) -> Program:
+    """The walkers' program of a CDR walk (:mod:`rosfpga_lab.hw.cdrlayout`): an ``ENCAP``
+    first, each field's alignment, strings with their NUL, no exact fit (see
+    :mod:`rosfpga_lab.hls.program`).
+
+    Raises:
+        GenerateError: as :func:`program_from_layout`.
+    """
+    return program_from_layout(cdr.layout, max_frame=max_frame, cdr=cdr)
+
+
 #: ``kind`` of :class:`GenericSpec` per numpy dtype kind of the stream's elements.
 _KIND_NAMES = {"u": "unsigned", "i": "signed", "f": "float"}
 
@@ -430,9 +483,10 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
                      part: str = "xc7z020clg400-1", clock_mhz: float = 100.0, op: str = "dilate",
                      ksize: int = 3, config_name: str = "<string>",
                      custom_source: Path | None = None,
-                     program: Program | None = None) -> GenericSpec:
+                     program: Program | None = None, wire: str = TCPROS_WIRE) -> GenericSpec:
     """The generic project of a layout (its type in ``reg``), with the node's names and sizes
-    (``program``: the layout's walk when the caller derived it itself)."""
+    (``program``: the layout's walk when the caller derived it itself; ``wire``: ``cdr`` for a
+    CDR walk's ``layout`` with its ``program_from_cdr``)."""
     prog = program or program_from_layout(layout)
     t = layout.type_name
     stream = layout.stream
@@ -449,7 +503,7 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
         stream_name=stream.label,
         stream_type=f"{stream.type}[]" if stream.count is None else f"{stream.type}[{stream.count}]",
         subscriber_header=sub_header, publisher_header=pub_header, config_name=config_name,
-        custom_source=custom_source)
+        custom_source=custom_source, wire=wire)
 
 
 def spec_from_config(config: NodeConfig) -> GenericSpec:
@@ -467,8 +521,15 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
                             "it subscribes to")
     reg = config.registry()
     app = config.application
+    layout = layout_from_config(config, reg)
+    program = None
+    if config.wire == CDR_WIRE:
+        from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
+
+        cdr = cdr_layout_from_config(config, reg)
+        layout, program = cdr.layout, program_from_cdr(cdr)
     return spec_from_layout(
-        layout_from_config(config, reg), reg, node_name=config.node.global_name,
+        layout, reg, node_name=config.node.global_name, program=program, wire=config.wire,
         sub_topic=config.subscriber.topic, pub_topic=config.publisher.topic,
         master_uri=config.node.master_uri, ip_address=config.node.ip_address,
         input_depth=config.fifo.input_depth, output_depth=config.fifo.output_depth,
@@ -596,3 +657,44 @@ def sample_frames_generic(layout: Layout, op: str, ksize: int, *, seed: int = 20
         return b"".join(frames), b""
     expected, _why = model_output(layout, op, ksize, frames)
     return b"".join(frames), expected
+
+
+# -- CDR: test samples and the models' output ----------------------------------------------------
+
+def model_output_cdr(cdr: CdrLayout, op: str, ksize: int, records: list[bytes]
+                     ) -> tuple[bytes, list[str]]:
+    """What the lab's CDR models (``hw.cdrwalker`` fast model, ``hw.morph1d``) publish for
+    ``records`` (each a 4-byte sample length + CDR payload), and the refusal per record."""
+    from rosfpga_lab.hw.cdrwalker import extract_cdr_fast, publish_cdr_fast
+    from rosfpga_lab.hw.errors import FrameFieldError
+    from rosfpga_lab.hw.morph1d import morph1d_fast
+
+    out = bytearray()
+    why = []
+    for record in records:
+        try:
+            ex = extract_cdr_fast(cdr, record)
+        except FrameFieldError as exc:
+            why.append(str(exc))
+            continue
+        why.append("")
+        out += publish_cdr_fast(cdr, ex.tokens, morph1d_fast(np.asarray(ex.stream), op, ksize))
+    return bytes(out), why
+
+
+def sample_records_cdr(cdr: CdrLayout, op: str, ksize: int, *, seed: int = 20240606
+                       ) -> tuple[bytes, bytes]:
+    """The CDR testbench's input (a good sample, one with a bad encapsulation header, another
+    good one padded at its end as Cyclone DDS pads, options 3 and three zeros) and what the
+    models publish for it (``op: custom``: no expected output)."""
+    from rosfpga_lab.hw.cdrlayout import cdr_marshal, to_cdr_tokens
+
+    rng = np.random.default_rng(seed)
+    good = [cdr_marshal(cdr, to_cdr_tokens(cdr, sample_tokens(cdr.base, rng))) for _ in range(2)]
+    bad = good[0][:4] + b"\x01\x00" + good[0][6:]           # CDR big-endian: refused
+    body = good[1][4:6] + b"\x00\x03" + good[1][8:] + bytes(3)
+    records = [good[0], bad, struct.pack("<I", len(body)) + body]
+    if op == "custom":
+        return b"".join(records), b""
+    expected, _why = model_output_cdr(cdr, op, ksize, records)
+    return b"".join(records), expected

@@ -10,7 +10,8 @@ naming it. One instruction per field in wire order:
 * ``LOOP`` -- an array of messages: ``count`` elements (fixed) or a uint32 count read from the
   frame (``size`` 0 ... see :attr:`Instr.variable`), then the instructions up to its ``END``
   once per element;
-* ``END`` -- the end of a loop's body; ``DONE`` -- the end of the message.
+* ``END`` -- the end of a loop's body; ``DONE`` -- the end of the message;
+* ``ENCAP`` -- CDR's 4-byte encapsulation header (see below).
 
 What the subscriber does with the bytes (:class:`Sub`): skip them, carry them (into the carry
 memory, in order, lengths included), check them (equal to ``const`` bytes from the constant
@@ -24,6 +25,17 @@ the frame length first; it starts once the subscriber has read (and accepted) th
 A frame refused after its stream went to the application is dropped by the publisher (it reads
 the application's output and writes nothing). :func:`run_program` is the Python executor of the
 same program: the specification the C++ and Verilog walkers are tested against.
+
+CDR (ROS 2's samples, :mod:`rosfpga_lab.hw.cdrlayout`) is the same program with four more
+things, all no-ops for TCPROS: each instruction's ``align`` (padding before its first byte:
+the subscriber skips ``-(pos - 8) % align`` bytes, counted from byte 8 of its input, after the
+sample length and the encapsulation header; the publisher writes zeros counted from its own
+output position, because skipped or re-sized fields change where its fields fall), a ``VAR``'s
+``elem_align`` (padding before its elements, only when it has some), a ``VAR``'s ``nul``
+(a string whose count includes its NUL: at least 1, the last byte 0, else ``status3``), and
+``ENCAP``: the subscriber checks ``00 01`` (CDR little-endian) and takes the padding that ends
+the payload from the options' two low bits (skipped after ``DONE``); the publisher writes its
+constant ``00 01 00 00``. No count is held to an exact fit in CDR (``fixed_after`` -1).
 """
 
 from __future__ import annotations
@@ -43,6 +55,7 @@ class Op(IntEnum):
     LOOP = 2
     END = 3
     DONE = 4
+    ENCAP = 5
 
 
 class Sub(IntEnum):
@@ -87,6 +100,10 @@ class Instr:
         name: the field's path in the message, e.g. ``header.frame_id``.
         type: its ROS type, e.g. ``string`` or ``float32[]``.
         jump: LOOP: the index of its END; END: the index of its LOOP (filled by :class:`Program`).
+        align: CDR: alignment of the field's first byte (a count's, for VAR and variable LOOP).
+        elem_align: CDR VAR: alignment of its first element (applied when the count is > 0).
+        nul: CDR VAR: a string whose count includes its NUL (at least 1, last byte 0).
+        status3: a ``nul`` VAR: the status of a last byte that is not 0.
     """
 
     op: Op
@@ -104,6 +121,10 @@ class Instr:
     name: str = ""
     type: str = ""
     jump: int = 0
+    align: int = 1
+    elem_align: int = 1
+    nul: bool = False
+    status3: int = 0
 
 
 @dataclass(frozen=True)
@@ -184,6 +205,19 @@ class Refused(Exception):
 
 #: The status of a frame whose length is refused, or which ends inside a field or after the last.
 FRAME_LENGTH_STATUS = 1
+#: CDR: where alignment counts from in the subscriber's input and the publisher's output (the
+#: 4-byte sample length, then the 4-byte encapsulation header).
+ALIGN_ORIGIN = 8
+#: CDR: the representation the circuit reads (``00 01``, CDR little-endian) and the header the
+#: publisher writes (options 0).
+ENCAP_BYTES = b"\x00\x01\x00\x00"
+#: CDR: the bits of the encapsulation options that count the payload's end padding.
+ENCAP_PAD_MASK = 3
+
+
+def pad(pos: int, align: int) -> int:
+    """Padding bytes before a field of alignment ``align`` at byte ``pos`` (see ALIGN_ORIGIN)."""
+    return -(pos - ALIGN_ORIGIN) % align
 
 
 def order_key(b: bytes, kind: int) -> int:
@@ -233,6 +267,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
     if not prog.min_body <= flen <= prog.max_frame or len(frame) != 4 + flen:
         raise Refused(1, False)
     end = 4 + flen
+    fend = end               # where the fields end (CDR: less the payload's end padding)
     pos = 4
     carry = bytearray()
     stream = bytearray()
@@ -240,22 +275,34 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
     loops: list[list[int]] = []  # [elements left, suppressed]
     pc = 0
 
-    def take(n: int, status: int) -> bytes:
+    def take(n: int, status: int, align: int = 1) -> bytes:
         nonlocal pos
-        if pos + n > end:  # the frame ends inside (or before) this field
+        if n and align > 1:
+            if pos + pad(pos, align) >= fend:  # the frame ends before this field
+                raise Refused(FRAME_LENGTH_STATUS, bool(stream))
+            pos += pad(pos, align)
+        if pos + n > fend:  # the frame ends inside (or before) this field
             raise Refused(status or FRAME_LENGTH_STATUS, bool(stream))
         b = frame[pos:pos + n]
         pos += n
         return b
 
+    def out_pad(n: int, align: int) -> None:
+        """The publisher's padding before a part of ``n`` bytes (its position: 4 + out_len)."""
+        nonlocal out_len
+        if n and not quiet:
+            out_len += pad(4 + out_len, align)
+
     def fits(ins: Instr, n: int) -> None:
         """A count's checks: its maximum (a stream's: exact), then the bytes left."""
         if n != ins.count if ins.sub == Sub.STREAM else n > ins.count:
             raise Refused(ins.status, bool(stream))
+        if ins.nul and n == 0:
+            raise Refused(ins.status, bool(stream))
         need = n * ins.elem_min
-        if ins.fixed_after >= 0 and need + ins.fixed_after != end - pos:
+        if ins.fixed_after >= 0 and need + ins.fixed_after != fend - pos:
             raise Refused(FRAME_LENGTH_STATUS, bool(stream))
-        if need > end - pos:
+        if need > fend - pos:
             raise Refused(ins.status, bool(stream))
 
     suppressed = 0
@@ -263,11 +310,21 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
         ins = prog.instrs[pc]
         quiet = suppressed > 0
         if ins.op == Op.DONE:
-            if pos != end:
+            if pos != fend:
                 raise Refused(ins.status, bool(stream))
             return bytes(carry), bytes(stream), out_len
-        if ins.op == Op.FIXED:
-            b = take(ins.size, ins.status)
+        if ins.op == Op.ENCAP:
+            b = take(4, ins.status)
+            if b[:2] != ins.const[:2]:
+                raise Refused(ins.status, bool(stream))
+            tail = b[3] & ENCAP_PAD_MASK
+            if tail > fend - pos:
+                raise Refused(FRAME_LENGTH_STATUS, bool(stream))
+            fend -= tail
+            out_len += len(ins.const)
+        elif ins.op == Op.FIXED:
+            b = take(ins.size, ins.status, ins.align)
+            out_pad(ins.size, ins.align)
             if ins.sub in (Sub.CARRY, Sub.RANGE):
                 carry += b
             if ins.sub == Sub.CHECK and b != ins.const:
@@ -278,27 +335,36 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
                 stream += b
             out_len += 0 if quiet else ins.size
         elif ins.op == Op.VAR:
-            lb = take(4, ins.status)
+            lb = take(4, ins.status, ins.align)
             n = _u32(lb)
             fits(ins, n)
-            b = take(n * ins.size, ins.status)
+            b = take(n * ins.size, ins.status, ins.elem_align)
+            text = b[:-1] if ins.nul else b
             if ins.sub == Sub.CARRY:
                 carry += lb + b
-            elif ins.sub == Sub.CHECK and b != ins.const:
+            elif ins.sub == Sub.CHECK and text != ins.const:
                 raise Refused(ins.status2, bool(stream))
             elif ins.sub == Sub.STREAM:
                 stream += b
+            if ins.nul and b[-1] != 0:
+                raise Refused(ins.status3, bool(stream))
+            out_pad(4, ins.align)
             if not quiet:
-                out_len += 4 + {Pub.CARRY: n * ins.size, Pub.CONST: len(ins.const),
-                                Pub.ZERO: 0, Pub.STREAM: n * ins.size, Pub.COUNT: 0}[ins.pub]
+                out_len += 4
+            body = {Pub.CARRY: n * ins.size, Pub.CONST: len(ins.const) + ins.nul,
+                    Pub.ZERO: int(ins.nul), Pub.STREAM: n * ins.size, Pub.COUNT: 0}[ins.pub]
+            out_pad(body, ins.elem_align)
+            if not quiet:
+                out_len += body
         elif ins.op == Op.LOOP:
             n = ins.count
             if ins.variable:
-                lb = take(4, ins.status)
+                lb = take(4, ins.status, ins.align)
                 n = _u32(lb)
                 fits(ins, n)
                 if ins.sub == Sub.CARRY:
                     carry += lb
+                out_pad(4, ins.align)
                 out_len += 0 if quiet else 4
             zero = ins.variable and ins.pub == Pub.ZERO
             if n == 0:
@@ -329,7 +395,11 @@ def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int) 
         if ins.op == Op.DONE:
             assert len(out) == 4 + out_len, (len(out), out_len)
             return bytes(out)
-        if ins.op == Op.FIXED:
+        if ins.op == Op.ENCAP:
+            out += ins.const
+        elif ins.op == Op.FIXED:
+            if ins.size:
+                out += bytes(pad(len(out), ins.align))
             if ins.pub == Pub.CARRY:
                 out += carry[ci:ci + ins.size]
                 ci += ins.size
@@ -343,20 +413,27 @@ def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int) 
                 out += stream[si:si + ins.size]
                 si += ins.size
         elif ins.op == Op.VAR:
+            out += bytes(pad(len(out), ins.align))
             if ins.pub == Pub.CARRY:
                 n = _u32(carry[ci:ci + 4])
-                out += carry[ci:ci + 4 + n * ins.size]
+                body = carry[ci + 4:ci + 4 + n * ins.size]
                 ci += 4 + n * ins.size
             elif ins.pub == Pub.CONST:
-                out += (len(ins.const) // ins.size).to_bytes(4, "little") + ins.const
+                body = ins.const + bytes(int(ins.nul))
+                n = len(body) // ins.size
             elif ins.pub == Pub.ZERO:
-                out += bytes(4)
+                n, body = int(ins.nul), bytes(int(ins.nul))
             else:
-                out += ins.count.to_bytes(4, "little") + stream[si:si + ins.count * ins.size]
+                n, body = ins.count, stream[si:si + ins.count * ins.size]
                 si += ins.count * ins.size
+            out += n.to_bytes(4, "little")
+            if body:
+                out += bytes(pad(len(out), ins.elem_align))
+            out += body
         elif ins.op == Op.LOOP:
             n = ins.count
             if ins.variable:
+                out += bytes(pad(len(out), ins.align))
                 if ins.pub == Pub.ZERO:
                     out += bytes(4)
                     pc = ins.jump + 1

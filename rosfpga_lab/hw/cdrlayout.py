@@ -13,7 +13,12 @@ zero byte CDR sends for it) and then rewrites that walk for the CDR wire:
 * step 1 (``ENCAPSULATION``) reads the 4-byte encapsulation header: representation
   ``00 01`` (CDR little-endian, :data:`rosfpga_lab.msg.cdr.CDR_LE`) or the frame is refused;
   the options' two low bits say how many padding bytes end the payload (DDS-XTypes 1.3
-  7.6.3.1.2; Cyclone DDS pads its payloads to a multiple of 4 this way);
+  7.6.3.1.2); after the last field the circuit takes exactly those bytes (not looked at) or,
+  when the options announce fewer (or none), the 1 to 3 bytes that bring the payload (header
+  included) to a multiple of 4 when they are zero: Cyclone DDS pads its XCDR1 payloads to 4
+  with options ``00 00`` (a 398-byte ``lab_msgs/Samples`` arrives as 400 bytes). Any other bytes after the
+  last field are refused: ``frame length`` (bytes the sample length announces beyond that), or
+  ``payload end padding`` (a non-zero byte in the unannounced padding, at its offset);
 * every step has an *alignment* (:attr:`CdrLayout.align`): a scalar its size, a length prefix 4,
   a numeric array its element size (only when it has elements), everything else 1; before a step
   the circuit skips ``-(offset - 8) % align`` padding bytes (offset 8: after the sample length

@@ -5,7 +5,11 @@ How this works: :class:`CdrInterpreter` is :class:`~rosfpga_lab.hw.walker.Layout
 steps with CDR's three additions: before a step it skips the step's alignment padding (counted
 from after the encapsulation header), it checks the encapsulation header (representation
 CDR little-endian; the options' low bits give the padding that ends the payload, skipped after
-the last field) and a string's NUL, and a string takes ``length - 1`` bytes. Refusals and
+the last field) and a string's NUL, and a string takes ``length - 1`` bytes. After the last
+field it also takes, when the options announce fewer (Cyclone DDS: none), the 1 to 3 *zero* bytes that bring the serialized
+payload (header included) to a multiple of 4: RTPS 2.5 9.4.2.11 and DDS-XTypes 1.3 7.6.3.1.2
+ask for that padding, and Cyclone DDS sends it with options ``00 00`` (a 398-byte
+``lab_msgs/Samples`` arrives as 400 bytes); a non-zero byte there, or more bytes, is refused. Refusals and
 resynchronisation are the walker's: the field, its byte offset (in the input, 0 = the first
 byte of the sample length) and the rule; a refused sample is skipped to its end.
 :func:`extract_cdr_fast` runs the same machine a whole step at a time.
@@ -23,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from rosfpga_lab.hw.cdrlayout import (
-    OPTIONS_PADDING_MASK, CdrLayout, cdr_length_rules, cdr_marshal, to_base_tokens,
+    ALIGN_ORIGIN, OPTIONS_PADDING_MASK, CdrLayout, cdr_length_rules, cdr_marshal, to_base_tokens,
     to_cdr_tokens,
 )
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
@@ -31,8 +35,11 @@ from rosfpga_lab.hw.layout import Step, StepKind, Token, encode_token
 from rosfpga_lab.hw.walker import STAGE, Extracted, LayoutInterpreter, published_tokens
 from rosfpga_lab.msg.cdr import CDR_BE
 
-#: Label of the padding bytes that end a payload (the encapsulation options count them).
+#: Label of the padding bytes that end a payload (the encapsulation options count them, or they
+#: align the payload to :data:`END_ALIGN` unannounced).
 TAIL_LABEL = "payload end padding"
+#: The serialized payload (header included) may end with zeros up to a multiple of this.
+END_ALIGN = 4
 
 
 def _representation(value: int) -> str:
@@ -60,6 +67,7 @@ class CdrInterpreter(LayoutInterpreter):
         self._pad = 0
         self._tail = 0
         self._tail_left = 0
+        self._tail_zero = False     # the end padding is unannounced: its bytes must be zero
         self._done: Extracted | None = None
 
     @property
@@ -89,6 +97,8 @@ class CdrInterpreter(LayoutInterpreter):
         if self._tail_left:
             self.offset += 1
             self._tail_left -= 1
+            if self._tail_zero and byte:
+                self._nonzero_tail(self.offset - 1, byte)
             if not self._tail_left:
                 self._publish_done()
             return
@@ -183,6 +193,11 @@ class CdrInterpreter(LayoutInterpreter):
             return
 
     def _frame_done(self) -> None:
+        assert self._frame_length is not None
+        after = 4 + self._frame_length - self.offset   # bytes after the last field
+        if after != self._tail and 0 < after < END_ALIGN and \
+                after == -(self.offset - ALIGN_ORIGIN) % END_ALIGN:
+            self._tail, self._tail_zero = after, True   # unannounced alignment to 4: zeros
         if self.offset != self._end:
             left = self._end - self.offset
             self._fail(FrameLengthError(
@@ -196,6 +211,12 @@ class CdrInterpreter(LayoutInterpreter):
             self.pc = -1
             return
         self._publish_done()
+
+    def _nonzero_tail(self, at: int, byte: int) -> None:
+        self._fail(FrameFieldError(
+            f"byte 0x{byte:02x} after the last field, where only zero bytes may pad the payload "
+            f"to a multiple of {END_ALIGN} (the encapsulation options announce no end padding)",
+            TAIL_LABEL, at, byte, STAGE, rule="not zero"))
 
     def _publish_done(self) -> None:
         assert self._done is not None
@@ -251,6 +272,12 @@ def extract_cdr_fast(cdr: CdrLayout, frame: bytes) -> Extracted:
             if interp.offset + interp._tail_left > len(view):
                 raise FrameTruncatedError("the sample was cut short in its end padding",
                                           TAIL_LABEL, len(view))
+            if interp._tail_zero:
+                tail = view[interp.offset:interp.offset + interp._tail_left]
+                for k, byte in enumerate(tail):
+                    if byte:
+                        interp.offset += k + 1
+                        interp._nonzero_tail(interp.offset - 1, byte)
             interp.offset += interp._tail_left
             interp._tail_left = 0
             interp._publish_done()
@@ -354,6 +381,6 @@ def _size(step: Step, value: Any) -> int:
 
 
 __all__ = [
-    "CdrInterpreter", "TAIL_LABEL", "extract_cdr_fast", "extract_cdr_reference",
+    "CdrInterpreter", "END_ALIGN", "TAIL_LABEL", "extract_cdr_fast", "extract_cdr_reference",
     "publish_cdr_fast", "publish_cdr_reference", "published_cdr_tokens",
 ]

@@ -8,7 +8,9 @@ comment per field naming it); ``rfl_elem_pack`` turns the streamed array's bytes
 beats of one element (TUSER first, TLAST last), ``rfl_window1d`` is the 1-D application (sliding
 max/min over KSIZE elements, pass-through) and ``rfl_elem_unpack`` turns beats back into bytes;
 ``rfl_gtop`` joins them with the lab's ``rfl_fifo``. ``rfl_node.v`` sets the parameters of one
-configuration; the testbench is the lab's ``rfl_tb.v`` (with an 8-bit status).
+configuration; the testbench is the lab's ``rfl_tb.v`` (with an 8-bit status). The same
+walkers read and write CDR (``wire: cdr``): the program's alignment, ``OP_ENCAP`` and strings
+with their NUL (:mod:`rosfpga_lab.hls.program`).
 """
 
 from __future__ import annotations
@@ -117,7 +119,8 @@ def simulate_project(project_dir: str | Path, frames: bytes, *, target: str = "r
 
     Args:
         project_dir: a project written by ``rosfpga-lab generate`` for a type other than Image.
-        frames: TCPROS frames.
+        frames: TCPROS frames, or for a ``wire: cdr`` project CDR records (each a 4-byte sample
+            length and the payload).
         target: ``csim`` or ``rtlsim``.
         simulator: rtlsim: ``iverilog`` or ``verilator`` (default: the first installed).
         gap, bp, seed: rtlsim: random input gaps and output backpressure (per mille), seed.

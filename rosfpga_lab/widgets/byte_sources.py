@@ -223,3 +223,26 @@ def view_bytes(raw: bytes, kind: str = "", type_name: str | None = None, *, titl
     "sensor_msgs/Image")``, ``view_bytes(http_request)`` (HTTP is recognised by itself).
     """
     return ByteViewer(raw, spans_for(raw, kind, type_name), title=title, **kwargs)
+
+
+def spans_from_layout(layout: Any, message: Any) -> list[Span]:
+    """Spans of a TCPROS frame as the circuit of ``layout`` (``rosfpga_lab.hw.layout.Layout``)
+    walks it: one per field read, named by its label with indices filled in, its role what the
+    circuit does with it (``stream``, ``check``, ``carry``, ``skip``; ``length`` for a length
+    prefix). ``message`` holds the frame's values (``rosfpga_lab.msg.deserialize`` of its body).
+    """
+    from rosfpga_lab.hw.layout import StepKind, encode_token, tokens
+
+    first = layout.steps[0]
+    out = [Span(0, 4, first.label, first.type, None, "length")]
+    offset = 4
+    for t in tokens(layout, message):
+        step = layout.steps[t.step]
+        n = len(encode_token(step, t.value))
+        kind = str(step.kind)
+        role = "length" if step.kind is StepKind.LENGTH else str(step.action)
+        type_ = f"{step.type}[{len(t.value)}]" if kind == "array" else step.type
+        out.append(Span(offset, n, step.label_at(t.at), type_, t.value, role))
+        offset += n
+    out[0] = Span(0, 4, first.label, first.type, offset - 4, "length")
+    return out

@@ -12,16 +12,20 @@ table and the picture follows.
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 from rosfpga_lab.widgets._common import WidgetError, esc
 from rosfpga_lab.widgets.limits import DIAGRAM_MAX_WIDTH
 
 #: Drawing sizes (pixels): column step, row step, state box.
 COL, ROW, BOX_W, BOX_H = 215, 84, 128, 30
+#: Narrowest column step; a table with more columns than fit at it folds into bands.
+MIN_COL = BOX_W + 40
 
 
-def _states_by_depth(rows: Sequence[Any]) -> list[list[str]]:
+def _states_by_depth(rows: Sequence[Any], in_order: bool = False) -> list[list[str]]:
+    if in_order:   # a walk: one column per state, in the order the table's rows leave them
+        return [[s] for s in dict.fromkeys([r.source for r in rows] + [r.target for r in rows])]
     start = rows[0].source
     depth = {start: 0}
     queue = [start]
@@ -45,19 +49,32 @@ def _states_by_depth(rows: Sequence[Any]) -> list[list[str]]:
     return columns
 
 
-def _panel(role: str, rows: Sequence[Any], top: int, uid: str) -> tuple[list[str], int, int]:
-    columns = _states_by_depth(rows)
-    col = min(COL, (DIAGRAM_MAX_WIDTH - BOX_W - 20) // max(len(columns) - 1, 1))
+def _font(name: str) -> str:
+    """Font size of a state's name: 12, smaller for a long name so it stays in its box."""
+    return "12" if len(name) <= 15 else f"{max(7.0, 12 * 15 / len(name)):.1f}"
+
+
+def _panel(role: str, rows: Sequence[Any], top: int, uid: str,
+           in_order: bool = False) -> tuple[list[str], int, int]:
+    columns = _states_by_depth(rows, in_order)
+    # a long walk (a message's fields) folds into bands of as many columns as fit side by side
+    per_band = max(1, (DIAGRAM_MAX_WIDTH - BOX_W - 20) // MIN_COL + 1)
+    bands = -(-len(columns) // per_band) if len(columns) > per_band else 1
+    across = per_band if bands > 1 else len(columns)
+    col = min(COL, (DIAGRAM_MAX_WIDTH - BOX_W - 20) // max(across - 1, 1))
+    band_rows = max(len(c) for c in columns) + 1
     pos: dict[str, tuple[float, float]] = {}
     first = top + 70   # room for the panel's title and a loop above the first row
     for c, states in enumerate(columns):
         # the end states' column starts a row lower, so arrows into it pass beside the others
         shift = 1 if c == len(columns) - 1 and len(columns) > 1 else 0
+        band, slot = (c // per_band, c % per_band) if bands > 1 else (0, c)
         for k, s in enumerate(states):
-            pos[s] = (20 + BOX_W / 2 + c * col, first + (k + shift) * ROW)
+            pos[s] = (20 + BOX_W / 2 + slot * col, first + (band * band_rows + k + shift) * ROW)
     height = 70 + ROW * max(len(c) + (1 if i == len(columns) - 1 else 0)
+                            + (i // per_band * band_rows if bands > 1 else 0)
                             for i, c in enumerate(columns)) - ROW + 30
-    width = int(20 + BOX_W + col * (len(columns) - 1) + 20)
+    width = int(20 + BOX_W + col * (across - 1) + 20)
     out = [f'<text x="8" y="{top + 18}" font-weight="bold" font-size="13">{esc(role)}</text>']
     legend: list[str] = []
     edges: dict[tuple[str, str], list[Any]] = {}
@@ -100,19 +117,24 @@ def _panel(role: str, rows: Sequence[Any], top: int, uid: str) -> tuple[list[str
         fill = "#f4f4f4" if end else "#e8f0fb"
         out.append(f'<g class="rfl-state" data-state="{esc(s)}"><rect x="{x - BOX_W / 2}" y="{y - BOX_H / 2}" '
                    f'width="{BOX_W}" height="{BOX_H}" rx="{BOX_H / 2 if end else 6}" fill="{fill}" '
-                   f'stroke="#333"/><text x="{x}" y="{y + 4}" text-anchor="middle" font-size="12">{esc(s)}</text></g>')
+                   f'stroke="#333"/><text x="{x}" y="{y + 4}" text-anchor="middle" '
+                   f'font-size="{_font(s)}">{esc(s)}</text></g>')
     for k, line in enumerate(legend):
         out.append(f'<text x="20" y="{top + height + 4 + 15 * k}" font-size="11" fill="#333">'
                    f'<tspan fill="#1f5fbf" font-weight="bold">{k + 1}</tspan>  {esc(line)}</text>')
     return out, width, height + 15 * len(legend) + 12
 
 
-def state_diagram_svg(transitions: Iterable[Any], roles: Sequence[str] | None = None) -> str:
+def state_diagram_svg(transitions: Iterable[Any], roles: Sequence[str] | None = None,
+                      in_order: bool = False) -> str:
     """An SVG of the state machine(s) in ``transitions``, one panel per role.
 
     Args:
         transitions: rows with ``role``, ``source``, ``trigger``, ``target``, ``action``.
         roles: which roles, in which order (default: order of appearance).
+        in_order: place the states one per column in the order the table's rows leave them, folded
+            into bands (a walk over a message's fields, :func:`layout_transitions`), instead
+            of by their distance from the first state.
 
     Raises:
         WidgetError: no transitions, or a role with none.
@@ -126,7 +148,7 @@ def state_diagram_svg(transitions: Iterable[Any], roles: Sequence[str] | None = 
         mine = [r for r in rows if r.role == role]
         if not mine:
             raise WidgetError(f"no transitions for role {role!r}")
-        body, w, h = _panel(role, mine, top, "rfl-sm-ah")
+        body, w, h = _panel(role, mine, top, "rfl-sm-ah", in_order)
         parts += body
         width, top = max(width, w), top + h
     return (f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{top}" '
@@ -142,9 +164,90 @@ class StateDiagram:
     Hover an arrow for the actions of its transitions.
     """
 
-    def __init__(self, transitions: Iterable[Any], roles: Sequence[str] | None = None) -> None:
+    def __init__(self, transitions: Iterable[Any], roles: Sequence[str] | None = None,
+                 in_order: bool = False) -> None:
         self.transitions = list(transitions)
-        self.svg = state_diagram_svg(self.transitions, roles)
+        self.svg = state_diagram_svg(self.transitions, roles, in_order)
 
     def _repr_html_(self) -> str:
         return f"<div>{self.svg}</div>"
+
+
+class WalkTransition(NamedTuple):
+    """One move of a message walk's state machine (a row :func:`state_diagram_svg` draws)."""
+
+    role: str
+    source: str
+    trigger: str
+    target: str
+    action: str
+
+
+#: The state a refused frame's remaining bytes are read in (as the Image interpreter's SKIP).
+SKIP_STATE = "SKIP"
+
+
+def layout_transitions(layout: Any) -> list[WalkTransition]:
+    """The subscriber circuit of a circuit layout (``rosfpga_lab.hw.layout.Layout``) as the
+    rows of a state machine: one state per step (``HEADER_SEQ``, a loop's ``<IDENT>_LOOP`` and
+    ``<IDENT>_END``), each moving on when its bytes are in; a zero count passes the counted
+    part; a failed check goes to ``SKIP`` (the frame length's back to ``FRAME_LENGTH``); the last
+    step goes back to ``FRAME_LENGTH`` for the next frame. Triggers and actions come from the
+    steps (sizes, maxima, checks and status codes), so the picture follows the ``.msg``.
+    """
+    steps = layout.steps
+    role = f"{layout.type_name} subscriber"
+
+    def state(i: int) -> str:
+        if i >= len(steps):
+            return steps[0].ident.upper()
+        s = steps[i]
+        suffix = {"loop": "_LOOP", "end": "_END"}.get(str(s.kind), "")
+        return s.ident.upper() + suffix
+
+    def after(i: int) -> int:
+        s = steps[i]
+        return (s.partner if str(s.kind) == "loop" else i) + 1
+
+    def size(s: Any) -> str:   # the trigger: short, the tooltip says more
+        if str(s.kind) in ("scalar", "length"):
+            return f"{s.size} bytes"
+        if s.count is None:
+            return "n bytes" if str(s.kind) == "string" else f"n x {s.size} bytes"
+        return f"{s.count} x {s.size} bytes"
+
+    def count_of(s: Any) -> str:
+        return "" if s.length_step is None else f", n = {steps[s.length_step].label}"
+
+    rows: list[WalkTransition] = []
+    for i, s in enumerate(steps):
+        kind = str(s.kind)
+        what = f"{s.action} {s.label} ({s.type})"
+        if kind == "loop":
+            rows.append(WalkTransition(role, state(i), "an element left", state(i + 1),
+                                       f"walk one element of {s.label}"))
+            if s.count is None:
+                rows.append(WalkTransition(role, state(i), "no elements", state(after(i)),
+                                           f"{s.label} is empty"))
+            continue
+        if kind == "end":
+            rows.append(WalkTransition(role, state(i), "more elements", state(s.partner + 1),
+                                       f"next element of {s.label}"))
+            rows.append(WalkTransition(role, state(i), "last element", state(i + 1),
+                                       f"{s.label} done"))
+            continue
+        rows.append(WalkTransition(role, state(i), size(s), state(i + 1),
+                                   what + count_of(s) + (" as AXI4-Stream beats"
+                                                         if str(s.action) == "stream" else "")))
+        if s.check is not None:
+            back = state(0) if i == 0 else SKIP_STATE
+            rows.append(WalkTransition(role, state(i), f"not {s.check.describe()}", back,
+                                       f"refuse: {s.check.status}"))
+        # a zero count passes a string or array at once (a loop's own state says "no elements")
+        if (kind == "length" and i > 0 and s.partner is not None
+                and str(steps[s.partner].kind) != "loop" and steps[s.partner].count is None):
+            rows.append(WalkTransition(role, state(i), "0", state(after(s.partner)),
+                                       f"{steps[s.partner].label} is empty"))
+    rows.append(WalkTransition(role, SKIP_STATE, "rest of the frame", state(0),
+                               "drop the refused frame's bytes"))
+    return rows

@@ -4,7 +4,9 @@
 // program of rfl_layout.vh says (carried bytes from the carry memory, constants, its message
 // number, zeros, or the application's bytes from s_*). For a frame refused after its stream
 // went out (meta_drop) it reads the STREAM_DATA_BYTES bytes of the application's output and
-// writes nothing. meta_release ends the frame.
+// writes nothing. meta_release ends the frame. CDR: before each field the zeros that align it,
+// counted from its own output position (P_PAD); a string's count includes its NUL (written
+// after a constant; an empty string for a skipped one); OP_ENCAP writes its 4 constant bytes.
 module rfl_gpublisher #(
     parameter CW = 6,                           // carry memory address bits
     parameter STREAM_DATA_BYTES = 4,            // bytes of the stream, for a dropped frame
@@ -27,10 +29,13 @@ module rfl_gpublisher #(
     output             idle                     // no frame being written
 );
 `include "rfl_layout.vh"
-    localparam [2:0] P_IDLE = 3'd0, P_LEN = 3'd1, P_DECODE = 3'd2, P_COUNT = 3'd3,
-                     P_COUNTED = 3'd4, P_BODY = 3'd5, P_DROP = 3'd6, P_DONE = 3'd7;
+    localparam [3:0] P_IDLE = 4'd0, P_LEN = 4'd1, P_DECODE = 4'd2, P_COUNT = 4'd3,
+                     P_COUNTED = 4'd4, P_BODY = 4'd5, P_DROP = 4'd6, P_DONE = 4'd7, P_PAD = 4'd8;
 
-    reg [2:0]  state;
+    reg [3:0]  state;
+    reg [31:0] opos;                            // bytes of this frame written so far
+    reg [31:0] padn;                            // zeros to write (P_PAD)
+    reg [3:0]  pad_ret;                         // the state after them
     reg [15:0] pc;
     reg [31:0] cnt;                             // bytes of the current part written so far
     reg [31:0] n;                               // the count being written
@@ -41,6 +46,10 @@ module rfl_gpublisher #(
     reg [DB-1:0] depth;
 
     wire [IW-1:0] w = prog_word(pc);
+    // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
+    wire [3:0]  align = CDR ? w[221:218] : 4'd1;
+    wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
+    wire        nul = CDR ? w[213] : 1'b0;
     wire [2:0]  op = w[204:202];
     wire [2:0]  pub = w[198:196];
     wire        variable = w[195];
@@ -50,12 +59,12 @@ module rfl_gpublisher #(
     wire [15:0] klen = w[96:81];
     wire [15:0] jump = w[80:65];
     /* verilator lint_off UNUSEDSIGNAL */
-    wire [85:0] unused_fields = {w[201:199], w[194:177], w[64:0]};  // the subscriber's part
+    wire [93:0] unused_fields = {w[212:205], w[201:199], w[194:177], w[64:0]};  // the subscriber's
     /* verilator lint_on UNUSEDSIGNAL */
 
     // The count an OP_VAR or variable OP_LOOP writes, when not carried.
-    wire [31:0] own_count = (pub == PUB_CONST) ? {16'd0, klen}  // strings: one byte per element
-                            : (pub == PUB_STREAM) ? count : 32'd0;
+    wire [31:0] own_count = (pub == PUB_CONST) ? {16'd0, klen} + {31'd0, nul}  // strings: a byte each
+                            : (pub == PUB_STREAM) ? count : {31'd0, nul};
     wire from_stream = (state == P_BODY) && (pub == PUB_STREAM);
     wire [7:0] len_byte = meta_out_len[8 * cnt[1:0] +: 8];
     wire [7:0] cnt_byte = own_count[8 * cnt[1:0] +: 8];
@@ -67,7 +76,7 @@ module rfl_gpublisher #(
             P_COUNT: m_tdata = (pub == PUB_CARRY) ? carry_rdata : cnt_byte;
             P_BODY: case (pub)
                 PUB_CARRY: m_tdata = carry_rdata;
-                PUB_CONST: m_tdata = konst(kaddr + cnt[15:0]);
+                PUB_CONST: m_tdata = (cnt < {16'd0, klen}) ? konst(kaddr + cnt[15:0]) : 8'd0;  // then a NUL
                 PUB_COUNT: m_tdata = (cnt < 32'd4) ? seq_byte : 8'd0;
                 PUB_STREAM: m_tdata = s_tdata;
                 default: m_tdata = 8'd0;
@@ -76,7 +85,8 @@ module rfl_gpublisher #(
         endcase
     end
 
-    assign m_tvalid = (state == P_LEN) || (state == P_COUNT) || (state == P_BODY && (!from_stream || s_tvalid));
+    assign m_tvalid = (state == P_LEN) || (state == P_COUNT) || (state == P_PAD)
+                      || (state == P_BODY && (!from_stream || s_tvalid));
     assign s_tready = (from_stream && m_tready) || (state == P_DROP);
     assign carry_raddr = raddr;
     assign meta_release = (state == P_DONE);
@@ -84,6 +94,20 @@ module rfl_gpublisher #(
     wire put = m_tvalid && m_tready;
     wire carried = (state == P_COUNT || state == P_BODY) && (pub == PUB_CARRY);
     wire [31:0] n_next = {carry_rdata, n[31:8]};
+
+    // Write `p` alignment zeros (if any), then go to state `next`.
+    task pad_then(input [31:0] p, input [3:0] next);
+        begin
+            cnt <= 32'd0;
+            if (p != 32'd0) begin
+                padn <= p;
+                pad_ret <= next;
+                state <= P_PAD;
+            end else begin
+                state <= next;
+            end
+        end
+    endtask
 
     task go(input [15:0] next);
         begin
@@ -102,15 +126,20 @@ module rfl_gpublisher #(
             n <= 32'd0;
             need <= 64'd0;
             seq <= SEQ_START;
+            opos <= 32'd0;
+            padn <= 32'd0;
+            pad_ret <= P_IDLE;
             raddr <= {CW{1'b0}};
             depth <= {DB{1'b0}};
             for (d = 0; d < LOOPS; d = d + 1) left[d] <= 32'd0;
         end else begin
             if (put) cnt <= cnt + 32'd1;
+            if (put) opos <= opos + 32'd1;
             if (put && carried) raddr <= raddr + 1'b1;
             case (state)
                 P_IDLE: if (meta_valid) begin
                     cnt <= 32'd0;
+                    opos <= 32'd0;
                     raddr <= {CW{1'b0}};
                     depth <= {DB{1'b0}};
                     pc <= 16'd0;
@@ -135,10 +164,10 @@ module rfl_gpublisher #(
                             go(pc + 16'd1);
                         end
                     end
-                    OP_FIXED: begin
+                    OP_FIXED, OP_ENCAP: begin
                         need <= {32'd0, size};
-                        state <= (size == 32'd0) ? P_DECODE : P_BODY;
                         if (size == 32'd0) pc <= pc + 16'd1;
+                        else pad_then(pad_at(opos, align), P_BODY);
                     end
                     default: begin  // OP_VAR, OP_LOOP
                         if (op == OP_LOOP && !variable) begin
@@ -146,7 +175,7 @@ module rfl_gpublisher #(
                             state <= P_COUNTED;
                         end else begin
                             n <= own_count;
-                            state <= P_COUNT;
+                            pad_then(pad_at(opos, align), P_COUNT);
                         end
                     end
                 endcase
@@ -169,8 +198,12 @@ module rfl_gpublisher #(
                         go(pc + 16'd1);
                     end else begin
                         need <= {32'd0, n} * {32'd0, size};
-                        state <= P_BODY;
+                        pad_then(pad_at(opos, elem_align), P_BODY);
                     end
+                end
+                P_PAD: if (put && cnt + 32'd1 == padn) begin
+                    state <= pad_ret;
+                    cnt <= 32'd0;
                 end
                 P_BODY: if (put && {32'd0, cnt} + 64'd1 == need) go(pc + 16'd1);
                 P_DONE: state <= P_IDLE;

@@ -7,6 +7,10 @@
 // (or refused one after its stream went out) it raises meta_valid until the publisher's
 // meta_release; a new frame waits for that. A refused frame is skipped to its end. Each frame
 // ends in a one-clock status_valid pulse with the status code (0: accepted).
+// CDR samples (a sample length, then the payload): OP_ENCAP checks the encapsulation header and
+// takes the payload's end padding from its options (skipped after the last field); before each
+// field the bytes that align it are skipped (S_PAD); a string's count includes its NUL, which
+// must be 0; out_len includes the padding the publisher will write.
 module rfl_gsubscriber #(
     parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
     parameter CW = 6,                           // its address bits
@@ -34,12 +38,16 @@ module rfl_gsubscriber #(
 );
 `include "rfl_layout.vh"
     localparam [3:0] S_FLEN = 4'd0, S_DECODE = 4'd1, S_COUNT = 4'd2, S_COUNTED = 4'd3,
-                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6;
+                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7;
 
     reg [3:0]  state;
     reg [15:0] pc;
     reg [31:0] pos;                             // bytes of this frame taken so far
     reg [31:0] endp;                            // 4 + frame length
+    reg [31:0] fendp;                           // where the fields end (CDR: less the end padding)
+    reg [31:0] padn;                            // alignment bytes to skip (S_PAD)
+    reg [3:0]  pad_ret;                         // the state after them
+    reg        nul_bad;                         // a string's last byte was not 0
     reg [31:0] cnt;                             // bytes of the current part taken so far
     reg [31:0] n;                               // a count, shifted in little-endian
     reg [63:0] need;                            // bytes of the current body
@@ -56,6 +64,11 @@ module rfl_gsubscriber #(
 
     // The current instruction.
     wire [IW-1:0] w = prog_word(pc);
+    // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
+    wire [3:0]  align = CDR ? w[221:218] : 4'd1;
+    wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
+    wire        nul = CDR ? w[213] : 1'b0;
+    wire [7:0]  st3 = w[212:205];
     wire [2:0]  op = w[204:202];
     wire [2:0]  sub = w[201:199];
     wire [2:0]  pub = w[198:196];
@@ -76,7 +89,7 @@ module rfl_gsubscriber #(
     wire stall = (state == S_FLEN) && (cnt == 0) && meta_valid;
     wire streaming = (state == S_BODY) && (sub == SUB_STREAM);
     wire reading = (state == S_FLEN && !stall) || state == S_COUNT || state == S_BODY
-                   || state == S_SKIP;
+                   || state == S_SKIP || state == S_PAD;
     assign s_tready = streaming ? m_tready : reading;
     assign m_tvalid = streaming && s_tvalid;
     assign m_tdata = s_tdata;
@@ -87,7 +100,20 @@ module rfl_gsubscriber #(
 
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
     wire [31:0] pos_next = pos + 32'd1;
-    wire [63:0] room = {32'd0, endp} - {32'd0, pos};  // bytes left in the frame
+    wire [31:0] fields_end = CDR ? fendp : endp;
+    wire [63:0] room = {32'd0, fields_end} - {32'd0, pos};  // bytes left for the fields
+    wire        at_end = (pos == endp);             // nothing left of the frame to skip
+    wire [31:0] pad_f = pad_at(pos, align);         // before a field or a count
+    wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
+    wire [63:0] room_f = room - {32'd0, pad_f};     // bytes left after that padding
+    wire [63:0] room_e = room - {32'd0, pad_e};
+    // what the publisher writes for this OP_FIXED / OP_VAR: its bytes, and where they start
+    wire [31:0] written = (op == OP_FIXED) ? size
+                          : (pub == PUB_CARRY || pub == PUB_STREAM) ? body[31:0]
+                          : (pub == PUB_CONST) ? {16'd0, klen} + {31'd0, nul} : {31'd0, nul};
+    wire [31:0] out_base = (op == OP_FIXED) ? out_len : out_len + 32'd4;
+    wire [31:0] out_pad = (written == 32'd0) ? 32'd0
+                          : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
     wire [63:0] body = {32'd0, n} * {32'd0, size};
     wire [63:0] least = {32'd0, n} * {32'd0, elem_min};  // fewest bytes of the counted elements
     wire        keep = (state == S_COUNT) ? (sub == SUB_CARRY)
@@ -136,8 +162,22 @@ module rfl_gsubscriber #(
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
     end
 
-    // Refuse the frame with status `code`; skip what is left of it (`at_end`: nothing is).
-    task refuse(input [7:0] code, input at_end);
+    // Skip `p` alignment bytes (if any), then go to state `next`.
+    task pad_then(input [31:0] p, input [3:0] next);
+        begin
+            cnt <= 32'd0;
+            if (p != 32'd0) begin
+                padn <= p;
+                pad_ret <= next;
+                state <= S_PAD;
+            end else begin
+                state <= next;
+            end
+        end
+    endtask
+
+    // Refuse the frame with status `code`; skip what is left of it (`to_end`: nothing is).
+    task refuse(input [7:0] code, input to_end);
         begin
             status_valid <= 1'b1;
             status <= code;
@@ -146,7 +186,7 @@ module rfl_gsubscriber #(
                 meta_valid <= 1'b1;
                 meta_drop <= 1'b1;
             end
-            if (at_end) begin
+            if (to_end) begin
                 state <= S_FLEN;
                 pos <= 32'd0;
             end else begin
@@ -171,6 +211,10 @@ module rfl_gsubscriber #(
             pc <= 16'd0;
             pos <= 32'd0;
             endp <= 32'd0;
+            fendp <= 32'd0;
+            padn <= 32'd0;
+            pad_ret <= S_FLEN;
+            nul_bad <= 1'b0;
             cnt <= 32'd0;
             n <= 32'd0;
             need <= 64'd0;
@@ -215,6 +259,7 @@ module rfl_gsubscriber #(
                             else state <= S_SKIP;
                         end else begin
                             endp <= n_next + 32'd4;
+                            fendp <= n_next + 32'd4;
                             streamed <= 1'b0;
                             out_len <= 32'd0;
                             waddr <= {CW{1'b0}};
@@ -228,18 +273,30 @@ module rfl_gsubscriber #(
                 S_DECODE: begin
                     cnt <= 32'd0;
                     same <= 1'b1;
+                    nul_bad <= 1'b0;
                     value <= 64'd0;
                     case (op)
                         OP_DONE: begin
-                            if (pos != endp) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
+                            if (pos != fields_end) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
                             else begin
                                 status_valid <= 1'b1;
                                 status <= SUB_OK;
                                 meta_valid <= 1'b1;
                                 meta_drop <= 1'b0;
                                 meta_out_len <= out_len;
-                                state <= S_FLEN;
-                                pos <= 32'd0;
+                                if (at_end) begin
+                                    state <= S_FLEN;
+                                    pos <= 32'd0;
+                                end else begin
+                                    state <= S_SKIP;  // CDR: the payload's end padding
+                                end
+                            end
+                        end
+                        OP_ENCAP: begin
+                            if (room < 64'd4) refuse(st, at_end);
+                            else begin
+                                need <= 64'd4;
+                                state <= S_BODY;
                             end
                         end
                         OP_END: begin
@@ -253,19 +310,27 @@ module rfl_gsubscriber #(
                             end
                         end
                         OP_FIXED: begin
-                            if ({32'd0, size} > room) refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, room == 64'd0);
-                            else if (size == 32'd0) go(pc + 16'd1);
+                            if (size == 32'd0) go(pc + 16'd1);
+                            else if (pad_f != 32'd0 && {32'd0, pad_f} >= room)
+                                refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                            else if ({32'd0, size} > room_f)
+                                refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
                             else begin
                                 need <= {32'd0, size};
-                                state <= S_BODY;
+                                pad_then(pad_f, S_BODY);
                             end
                         end
                         default: begin  // OP_VAR, OP_LOOP
                             if (op == OP_LOOP && !variable) begin
                                 n <= count;
                                 state <= S_COUNTED;
-                            end else if (room < 64'd4) refuse(SUB_BAD_FRAME_LENGTH, room == 64'd0);
-                            else state <= S_COUNT;
+                            end else if (pad_f != 32'd0 && {32'd0, pad_f} >= room)
+                                refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                            else if (room_f < 64'd4) refuse(st, at_end);  // cut short in its count
+                            else begin
+                                if (quiet == 8'd0) out_len <= out_len + pad_at(out_len + 32'd4, align);
+                                pad_then(pad_f, S_COUNT);
+                            end
                         end
                     endcase
                 end
@@ -277,12 +342,12 @@ module rfl_gsubscriber #(
                     end
                 end
                 S_COUNTED: begin
-                    if ((sub == SUB_STREAM ? n != count : n > count))
-                        refuse(st, room == 64'd0);
+                    if ((sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0))
+                        refuse(st, at_end);
                     else if (fits && least + {32'd0, fixed_after} != room)
-                        refuse(SUB_BAD_FRAME_LENGTH, room == 64'd0);
+                        refuse(SUB_BAD_FRAME_LENGTH, at_end);
                     else if (least > room)
-                        refuse(st, room == 64'd0);
+                        refuse(st, at_end);
                     else if (op == OP_LOOP) begin
                         begin
                             if (variable && quiet == 8'd0) out_len <= out_len + 32'd4;
@@ -297,28 +362,44 @@ module rfl_gsubscriber #(
                         end
                     end else if (body == 64'd0) begin
                         state <= S_FINISH;
+                    end else if (pad_e != 32'd0 && {32'd0, pad_e} >= room) begin
+                        refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                    end else if (body > room_e) begin
+                        refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
                     end else begin
                         need <= body;
-                        state <= S_BODY;
+                        pad_then(pad_e, S_BODY);
                     end
+                end
+                S_PAD: if (take && cnt + 32'd1 == padn) begin
+                    state <= pad_ret;
+                    cnt <= 32'd0;
                 end
                 S_BODY: if (take) begin
                     if (cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
-                    if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
+                    if (nul && {32'd0, cnt} + 64'd1 == need) nul_bad <= (s_tdata != 8'd0);
+                    else if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
                     if (sub == SUB_STREAM) streamed <= 1'b1;
                     if ({32'd0, cnt} + 64'd1 == need) state <= S_FINISH;
                 end
                 S_FINISH: begin
-                    if (sub == SUB_CHECK && (!same || (op == OP_VAR ? body : {32'd0, size}) != {48'd0, klen}))
-                        refuse(op == OP_VAR ? st2 : st, pos == endp);
-                    else if (sub == SUB_RANGE && !in_range) refuse(st, pos == endp);
-                    else begin
-                        if (quiet == 8'd0) begin
-                            if (op == OP_FIXED) out_len <= out_len + size;
-                            else if (pub == PUB_CARRY || pub == PUB_STREAM) out_len <= out_len + 32'd4 + body[31:0];
-                            else if (pub == PUB_CONST) out_len <= out_len + 32'd4 + {16'd0, klen};
-                            else out_len <= out_len + 32'd4;
+                    if (CDR && op == OP_ENCAP) begin  // CDR little-endian, then the end padding
+                        if (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1))
+                            refuse(st, at_end);
+                        else if ({56'd0, value[31:24] & ENCAP_PAD_MASK} > room)
+                            refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                        else begin
+                            fendp <= fendp - {24'd0, value[31:24] & ENCAP_PAD_MASK};
+                            out_len <= out_len + {16'd0, klen};
+                            go(pc + 16'd1);
                         end
+                    end
+                    else if (sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {63'd0, nul} : {32'd0, size}) != {48'd0, klen}))
+                        refuse(op == OP_VAR ? st2 : st, at_end);
+                    else if (sub == SUB_RANGE && !in_range) refuse(st, at_end);
+                    else if (nul_bad) refuse(st3, at_end);
+                    else begin
+                        if (quiet == 8'd0) out_len <= out_base + out_pad + written;
                         go(pc + 16'd1);
                     end
                 end

@@ -1,0 +1,62 @@
+// fv_gpublisher -- rfl_gpublisher on its ports, walking the small program of
+// rosfpga_lab.rtl.proofs.formal_program (a constant byte, a carried string, a stream of 2
+// bytes). Given a frame's fields held until it releases them (as rfl_gsubscriber's proof shows),
+// a carry memory not written while it writes a frame, and the application's bytes by the stream
+// rules: its output keeps the rules, it releases only fields it holds, a frame starts with the
+// frame length it was given (little-endian) and then the constant, it takes exactly the
+// array's 2 bytes of the application per frame (a dropped frame too), and writes nothing for a
+// dropped frame.
+module fv_gpublisher #(parameter CW = 3) (
+    input clk, input rst_n, input [7:0] s_tdata, input s_tvalid, input m_tready,
+    input meta_valid, input [31:0] meta_out_len, input meta_drop, input [7:0] carry_rdata
+);
+    wire s_tready, m_tvalid, meta_release, idle;
+    wire [7:0] m_tdata;
+    wire [CW-1:0] carry_raddr;
+    rfl_gpublisher #(.CW(CW), .STREAM_DATA_BYTES(2), .SEQ_START(1)) dut (
+        .clk(clk), .rst_n(rst_n), .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
+        .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
+        .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
+        .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
+        .idle(idle));
+`include "fv_env.vh"
+    `FV_SOURCE(s_tvalid, s_tready, s_tdata)
+    `FV_SINK(m_tvalid, m_tready, m_tdata)
+    // the subscriber's side: the fields are held, unchanged, from meta_valid until released,
+    // dropped the clock after, and set only as meta_valid rises; the carry memory is read
+    // combinationally and not written while a frame is being written (not idle)
+    always @(*) if (!rst_n) assume(!meta_valid);
+    always @(posedge clk) if (!fv_init && $past(rst_n)) begin
+        if ($past(meta_valid && !meta_release) || $past(!idle && !meta_release))
+            assume(meta_valid && $stable(meta_out_len) && $stable(meta_drop));
+        if ($past(meta_release)) assume(!meta_valid);
+        if (!(meta_valid && !$past(meta_valid))) assume($stable(meta_out_len));
+        if ($past(!idle) && $past(carry_raddr) == carry_raddr) assume($stable(carry_rdata));
+    end
+
+    // per frame (from one release to the next): bytes written, application bytes taken
+    reg [7:0] n_out, n_in;
+    wire put = m_tvalid && m_tready, take = s_tvalid && s_tready;
+    always @(posedge clk) begin
+        if (!rst_n || meta_release) begin
+            n_out <= 0;
+            n_in <= 0;
+        end else begin
+            n_out <= n_out + put;
+            n_in <= n_in + take;
+        end
+    end
+
+    always @(posedge clk) if (!fv_init && rst_n) begin
+`ifndef FV_PROVE   // bounded only: which part of a frame it is writing is not visible on the ports
+        if (meta_release) assert(meta_valid);               // releases only what it holds
+        assert(n_in <= 8'd2);                               // never more than the array
+        if (meta_release) assert(n_in == 8'd2);             // the whole array, dropped or not
+        if (put) begin
+            assert(!meta_drop && meta_valid);               // nothing for a dropped frame
+            if (n_out < 4) assert(m_tdata == meta_out_len[8 * n_out[1:0] +: 8]);  // the length
+            if (n_out == 4) assert(m_tdata == 8'h02);       // then the constant
+        end
+`endif
+    end
+endmodule

@@ -1,0 +1,49 @@
+// fv_gsubscriber -- rfl_gsubscriber on its ports, walking the small program of
+// rosfpga_lab.rtl.proofs.formal_program (a checked byte, a carried string of at most 2 bytes, a
+// stream of exactly 2 bytes), fed any bytes by the stream rules: its stream keeps the rules, a
+// frame's fields (meta_*) are held unchanged until the publisher releases them, every status is
+// a code of the table, and each frame whose fields it hands over (accepted, or refused after
+// its stream went out) streamed exactly the array's 2 bytes.
+module fv_gsubscriber #(parameter CW = 3) (
+    input clk, input rst_n, input [7:0] s_tdata, input s_tvalid, input m_tready,
+    input meta_release, input [CW-1:0] carry_raddr
+);
+    wire s_tready, m_tvalid, meta_valid, meta_drop, frame_start, status_valid, idle;
+    wire [7:0] m_tdata, carry_rdata, status;
+    wire [31:0] meta_out_len;
+    rfl_gsubscriber #(.CARRY_BYTES(6), .CW(CW), .MIN_BODY(11), .MAX_FRAME(13)) dut (
+        .clk(clk), .rst_n(rst_n), .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
+        .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
+        .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
+        .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
+        .frame_start(frame_start), .status_valid(status_valid), .status(status), .idle(idle));
+`include "fv_env.vh"
+    `FV_SOURCE(s_tvalid, s_tready, s_tdata)
+    `FV_SINK(m_tvalid, m_tready, m_tdata)
+    // the publisher releases the fields only while they are held
+    always @(*) if (!meta_valid) assume(!meta_release);
+
+    // stream bytes out since the frame's first byte
+    reg [7:0] streamed;
+    always @(posedge clk) begin
+        if (!rst_n) streamed <= 0;
+        else if (frame_start) streamed <= 0;
+        else if (m_tvalid && m_tready) streamed <= streamed + 8'd1;
+    end
+
+    always @(posedge clk) if (!fv_init && rst_n) begin
+        if (status_valid) assert(status <= 8'd4);           // a code of the table
+`ifndef FV_PROVE   // bounded only: whether a frame is in progress and what it streamed are not
+                   // visible on the ports, so induction cannot close on these
+        // the fields are held, unchanged, until released
+        if ($past(rst_n) && $past(meta_valid && !meta_release)) begin
+            assert(meta_valid);
+            assert($stable(meta_out_len) && $stable(meta_drop));
+        end
+        assert(streamed <= 8'd2);                            // never more than the array
+        if (meta_valid && !$past(meta_valid)) assert(streamed == 8'd2);   // the whole array
+        if (meta_valid && !meta_drop && !$past(meta_valid))  // the answer's length: 4 + label
+            assert(meta_out_len >= 1 + 4 + 4 + 2 && meta_out_len <= 1 + 4 + 2 + 4 + 2);
+`endif
+    end
+endmodule
