@@ -82,6 +82,15 @@ def pad_tail(payload: bytes, pad: int) -> bytes:
     return payload[:2] + struct.pack(">H", pad) + payload[4:] + bytes(pad)
 
 
+def pad_to_4(payload: bytes, options: int = 0, fill: bytes | None = None) -> bytes:
+    """The payload as Cyclone DDS's core sends it: padded to a multiple of 4 (counted from the
+    encapsulation header) with ``fill`` (default zeros), the options saying ``options``."""
+    n = -len(payload) % 4
+    fill = bytes(n) if fill is None else fill
+    assert len(fill) == n
+    return payload[:2] + struct.pack(">H", options) + payload[4:] + fill
+
+
 def statuses_of(cdr: CdrLayout, records: list[bytes]) -> list[str]:
     """The status name the circuit must report per record: the field the models refused it at."""
     by_label = {label: name for name, label in cdr.layout.statuses}
@@ -236,6 +245,56 @@ def test_cyclone_dds_laser_scans_through_the_generated_circuit(projects: dict[st
     check_against_models(SCAN, projects[SCAN], records, oracle)
 
 
+def test_unannounced_end_padding_through_the_generated_circuit(projects: dict[str, Path]) -> None:
+    """Issue 20: Cyclone DDS pads lab_msgs/Samples to a multiple of 4 with options 00 00 (or
+    options announcing fewer): 2 and 3 zeros are taken; a non-zero pad byte is refused with
+    SUB_BAD_PAYLOAD_END_PADDING (mid-padding and its last byte), bytes beyond the multiple or
+    short of it with SUB_BAD_FRAME_LENGTH; each refusal then a good sample, which comes out
+    right. C simulation, RTL simulation (gaps, backpressure) and the executor equal the models."""
+    require_cxx()
+    require_iverilog()
+    T = cyclone()
+    rng = np.random.default_rng(22)
+
+    def sample(values: np.ndarray, history: int) -> bytes:
+        calib = T.Calibration_("imu", [0.25, -1.5, 3.0], 2)
+        hist = [T.Calibration_("a" * k, [1.0, 2.0, 3.0], k) for k in range(history)]
+        return T.Samples_(T.Header_(T.Time_(5, 6), "array"), calib, "hi", [1, 2, 3, 4],
+                          [int(v) for v in values], T.Duration_(3, 1000), hist,
+                          True).serialize()
+
+    by_fill: dict[int, tuple[bytes, bytes]] = {}
+    for history in (1, 0):   # they leave 2 and 3 bytes to pad
+        x = rng.integers(-2**31, 2**31, 64, dtype=np.int32)
+        payload = sample(x, history)
+        dilated = np.frombuffer(window_oracle(x.tobytes(), "<i4", 3, "dilate"), "<i4")
+        by_fill[-len(payload) % 4] = (payload, record(sample(dilated, history)))
+    (p2, out2), (p3, out3) = by_fill[2], by_fill[3]
+    cases = [  # (record, what the circuit publishes for it: b"" when refused)
+        (record(pad_to_4(p2)), out2),                           # options 00 00, 2 zeros
+        (record(pad_to_4(p3)), out3),                           # options 00 00, 3 zeros
+        (record(pad_to_4(p2, options=1)), out2),                # options announce 1 of 2
+        (record(pad_to_4(p3, options=2)), out3),                # options announce 2 of 3
+        (record(pad_to_4(p3, fill=b"\x00\x07\x00")), b""),      # non-zero mid-padding
+        (record(pad_to_4(p2)), out2),
+        (record(pad_to_4(p2, options=1, fill=b"\x00\x80")), b""),  # non-zero last byte
+        (record(pad_to_4(p3)), out3),
+        (record(pad_to_4(p3, fill=b"\x09\x00\x00")), b""),      # non-zero first byte
+        (record(pad_to_4(p2)), out2),
+        (record(pad_to_4(p2) + bytes(4)), b""),                # beyond the multiple of 4
+        (record(pad_to_4(p3)), out3),
+        (record(p3 + bytes(2)), b""),                          # short of it
+        (record(pad_to_4(p2)), out2),
+    ]
+    records = [r for r, _out in cases]
+    oracle = b"".join(out for _r, out in cases)
+    assert statuses_of(cdr_of(SAMPLES), records) == [
+        "SUB_OK", "SUB_OK", "SUB_OK", "SUB_OK", "SUB_BAD_PAYLOAD_END_PADDING", "SUB_OK",
+        "SUB_BAD_PAYLOAD_END_PADDING", "SUB_OK", "SUB_BAD_PAYLOAD_END_PADDING", "SUB_OK",
+        "SUB_BAD_FRAME_LENGTH", "SUB_OK", "SUB_BAD_FRAME_LENGTH", "SUB_OK"]
+    check_against_models(SAMPLES, projects[SAMPLES], records, oracle)
+
+
 @pytest.mark.parametrize("name", [SAMPLES, SCAN])
 def test_generated_cdr_verilog_is_lint_clean(name: str, projects: dict[str, Path]) -> None:
     """Verilator -Wall and iverilog -Wall find nothing in the walkers with CDR's parts and the
@@ -288,7 +347,8 @@ def test_image_with_wire_cdr_is_refused_by_name(tmp_path: Path) -> None:
 def _random_case(data: st.DataObject) -> tuple[CdrLayout, list[bytes], str]:
     """A random message definition (the models' strategy), small maxima, two samples serialized
     by the msg layer's CDR codec (held equal to Cyclone's bytes in test_hw_cdr.py) with end
-    padding of 0..3 bytes, a damaged copy of the first, and an application."""
+    padding of 0..3 bytes announced, or Cyclone's unannounced padding to 4 (zeros, or with a
+    non-zero byte), a damaged copy of the first, and an application."""
     reg, type_name, stream = data.draw(definitions())
     r2 = ros2_registry(reg)
     values = [data.draw(message(r2, type_name)) for _ in range(2)]
@@ -298,8 +358,19 @@ def _random_case(data: st.DataObject) -> tuple[CdrLayout, list[bytes], str]:
     small = {s.path: 3 for s in cdr.base.steps[1:] if s.kind is StepKind.LENGTH
              and s.action is not Action.STREAM and not s.label.endswith("[] length")}
     cdr = derive_cdr_layout(reg, type_name, stream=stream, stream_length=n, limits_=small)
-    records = [record(pad_tail(serialize_cdr(r2, type_name, v), data.draw(st.integers(0, 3))))
-               for v in values]
+
+    def wire(payload: bytes) -> bytes:
+        """Padded as announced (0..3), or to 4 unannounced (options fewer), maybe not zero."""
+        fill = -len(payload) % 4
+        how = data.draw(st.sampled_from(["announced", "unannounced", "not zero"]))
+        if how == "announced" or fill == 0:
+            return pad_tail(payload, data.draw(st.integers(0, 3)))
+        pad = bytearray(fill)
+        if how == "not zero":
+            pad[data.draw(st.integers(0, fill - 1))] = data.draw(st.integers(1, 255))
+        return pad_to_4(payload, data.draw(st.integers(0, fill - 1)), bytes(pad))
+
+    records = [record(wire(serialize_cdr(r2, type_name, v))) for v in values]
     damaged = bytearray(records[0])
     at = data.draw(st.integers(4, len(damaged) - 1))
     damaged[at] ^= data.draw(st.integers(1, 255))

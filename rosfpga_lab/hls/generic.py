@@ -29,7 +29,7 @@ from rosfpga_lab.hls.program import _replace
 from rosfpga_lab.hls.program import (
     ALIGN_ORIGIN, ENCAP_BYTES, ENCAP_PAD_MASK, FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub,
 )
-from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_length_rules
+from rosfpga_lab.hw.cdrlayout import END_ALIGN, TAIL_LABEL, CdrLayout, cdr_length_rules
 from rosfpga_lab.hw.layout import (
     Action, CheckOp, Layout, Step, StepKind, Token, length_rules, marshal,
 )
@@ -213,7 +213,7 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "pub": {"topic": spec.pub_topic, "type": prog.type_out},
         "prog": prog, "instrs": instruction_rows(prog),
         "cdr": spec.wire == CDR_WIRE, "wire": spec.wire,
-        "align_origin": ALIGN_ORIGIN, "encap_pad_mask": ENCAP_PAD_MASK,
+        "align_origin": ALIGN_ORIGIN, "encap_pad_mask": ENCAP_PAD_MASK, "end_align": END_ALIGN,
         "frame": "CDR sample" if spec.wire == CDR_WIRE else "TCPROS frame", "statuses": list(prog.statuses),
         "consts": prog.const_table, "const_rows": _hex_rows(prog.const_table),
         "loop_depth": loop_depth(prog), "max_instr_steps": max_steps(prog),
@@ -445,7 +445,10 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
                             f"publisher, over the {MAX_CARRY_BYTES} a generated circuit holds: "
                             "lower the maxima of its strings and arrays (limits: in the "
                             "configuration)")
-    instrs.append(Instr(Op.DONE, status=FRAME_LENGTH_STATUS, name="", type=""))
+    # CDR: the status of a non-zero byte in the unannounced end padding (the walk's own)
+    tail = {label: c for c, (_name, label) in enumerate(layout.statuses)}.get(TAIL_LABEL, 0) \
+        if cdr is not None else 0
+    instrs.append(Instr(Op.DONE, status=FRAME_LENGTH_STATUS, status2=tail, name="", type=""))
     consts = sum(len(ins.const) for ins in instrs)
     for what, n, most in (("status codes", len(layout.statuses), 256),
                           ("instructions", len(instrs), 1 << 16),

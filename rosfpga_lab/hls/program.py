@@ -35,7 +35,11 @@ output position, because skipped or re-sized fields change where its fields fall
 (a string whose count includes its NUL: at least 1, the last byte 0, else ``status3``), and
 ``ENCAP``: the subscriber checks ``00 01`` (CDR little-endian) and takes the padding that ends
 the payload from the options' two low bits (skipped after ``DONE``); the publisher writes its
-constant ``00 01 00 00``. No count is held to an exact fit in CDR (``fixed_after`` -1).
+constant ``00 01 00 00``. At ``DONE``, when the options announce fewer bytes than are left and
+those are the 1 to :data:`END_ALIGN` - 1 that bring the payload (header included) to a multiple of
+:data:`END_ALIGN` (Cyclone DDS pads so with options ``00 00``), the subscriber takes them when
+they are zero, and refuses the first non-zero one with ``DONE``'s ``status2`` (the models'
+``payload end padding``); any other bytes left refuse the frame with the frame length's status. No count is held to an exact fit in CDR (``fixed_after`` -1).
 """
 
 from __future__ import annotations
@@ -45,6 +49,7 @@ from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
 from rosfpga_lab.hls.limits import MAX_LOOP_DEPTH
+from rosfpga_lab.hw.cdrlayout import END_ALIGN
 
 
 class Op(IntEnum):
@@ -90,7 +95,8 @@ class Instr:
         variable: LOOP: the count is read from the frame (a uint32) rather than fixed.
         status: the status code the subscriber refuses with at this field (0: it cannot fail);
             for VAR, a bad count.
-        status2: VAR with CHECK: the status of contents unlike the constant.
+        status2: VAR with CHECK: the status of contents unlike the constant; CDR's DONE: the
+            status of a non-zero byte in the unannounced end padding (0: TCPROS, none taken).
         fixed_after: VAR and variable LOOP: when only fixed-size fields follow the counted part,
             their bytes (then the count must fill the frame exactly), else -1.
         elem_min: VAR and variable LOOP: fewest bytes of one element (VAR: ``size``).
@@ -310,7 +316,12 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
         ins = prog.instrs[pc]
         quiet = suppressed > 0
         if ins.op == Op.DONE:
-            if pos != fend:
+            after = end - pos  # CDR: Cyclone's unannounced zeros up to a multiple of END_ALIGN
+            if ins.status2 and pos != fend and 0 < after < END_ALIGN and \
+                    after == -(pos - ALIGN_ORIGIN) % END_ALIGN:
+                if any(frame[pos:end]):
+                    raise Refused(ins.status2, bool(stream))
+            elif pos != fend:
                 raise Refused(ins.status, bool(stream))
             return bytes(carry), bytes(stream), out_len
         if ins.op == Op.ENCAP:

@@ -58,6 +58,11 @@ REPRESENTATION = int.from_bytes(CDR_LE[:2], "big")
 OPTIONS_PADDING_MASK = 0x3
 #: Byte offset in the circuit's input of CDR's alignment origin (sample length + header).
 ALIGN_ORIGIN = 4 + ENCAPSULATION_SIZE
+#: Label of the padding bytes that end a payload (the encapsulation options count them, or they
+#: align the payload to :data:`END_ALIGN` unannounced); its status is the walk's last.
+TAIL_LABEL = "payload end padding"
+#: The serialized payload (header included) may end with zeros up to a multiple of this.
+END_ALIGN = 4
 
 
 def cdr_registry(reg: MsgRegistry | None = None) -> MsgRegistry:
@@ -183,8 +188,10 @@ def to_cdr(base: Layout, reg: MsgRegistry) -> CdrLayout:
             align.append(1)
             base_index.append(None)
     stream_index = remap(base.stream_index)
+    tail_ident = _unique("payload_end_padding", taken)
     statuses = (base.statuses[0],) + tuple((s.check.status, s.label) for s in out
-                                           if s.check is not None)
+                                           if s.check is not None) + \
+        ((f"SUB_BAD_{tail_ident.upper()}", TAIL_LABEL),)  # a non-zero unannounced pad byte
     layout = Layout(type_name=base.type_name, md5=base.md5, steps=tuple(out),
                     stream_index=stream_index, stream_length=base.stream_length,
                     min_body=0, max_body=0, statuses=statuses, video=base.video)
@@ -352,7 +359,8 @@ def format_cdr_layout(cdr: CdrLayout) -> str:
 
 
 __all__ = [
-    "ALIGN_ORIGIN", "CdrLayout", "OPTIONS_PADDING_MASK", "PLACEHOLDER", "REPRESENTATION",
+    "ALIGN_ORIGIN", "CdrLayout", "END_ALIGN", "OPTIONS_PADDING_MASK", "PLACEHOLDER",
+    "REPRESENTATION", "TAIL_LABEL",
     "cdr_bytes", "cdr_layout_from_config", "cdr_length_rules", "cdr_marshal", "cdr_registry",
     "cdr_tokens", "derive_cdr_layout", "format_cdr_layout", "to_base_tokens", "to_cdr",
     "to_cdr_tokens", "with_placeholders",

@@ -27,19 +27,13 @@ from typing import Any
 import numpy as np
 
 from rosfpga_lab.hw.cdrlayout import (
-    ALIGN_ORIGIN, OPTIONS_PADDING_MASK, CdrLayout, cdr_length_rules, cdr_marshal, to_base_tokens,
-    to_cdr_tokens,
+    ALIGN_ORIGIN, END_ALIGN, OPTIONS_PADDING_MASK, TAIL_LABEL, CdrLayout, cdr_length_rules,
+    cdr_marshal, to_base_tokens, to_cdr_tokens,
 )
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
 from rosfpga_lab.hw.layout import Step, StepKind, Token, encode_token
 from rosfpga_lab.hw.walker import STAGE, Extracted, LayoutInterpreter, published_tokens
 from rosfpga_lab.msg.cdr import CDR_BE
-
-#: Label of the padding bytes that end a payload (the encapsulation options count them, or they
-#: align the payload to :data:`END_ALIGN` unannounced).
-TAIL_LABEL = "payload end padding"
-#: The serialized payload (header included) may end with zeros up to a multiple of this.
-END_ALIGN = 4
 
 
 def _representation(value: int) -> str:

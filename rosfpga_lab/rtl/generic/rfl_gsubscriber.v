@@ -10,7 +10,10 @@
 // CDR samples (a sample length, then the payload): OP_ENCAP checks the encapsulation header and
 // takes the payload's end padding from its options (skipped after the last field); before each
 // field the bytes that align it are skipped (S_PAD); a string's count includes its NUL, which
-// must be 0; out_len includes the padding the publisher will write.
+// must be 0; out_len includes the padding the publisher will write. After the last field, the
+// bytes the options do not announce that pad the payload to a multiple of END_ALIGN (Cyclone DDS
+// pads so with options 00 00) are taken when they are zero (S_TAIL); the first non-zero one
+// refuses the sample with OP_DONE's status2.
 module rfl_gsubscriber #(
     parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
     parameter CW = 6,                           // its address bits
@@ -38,7 +41,7 @@ module rfl_gsubscriber #(
 );
 `include "rfl_layout.vh"
     localparam [3:0] S_FLEN = 4'd0, S_DECODE = 4'd1, S_COUNT = 4'd2, S_COUNTED = 4'd3,
-                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7;
+                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7, S_TAIL = 4'd8;
 
     reg [3:0]  state;
     reg [15:0] pc;
@@ -89,7 +92,7 @@ module rfl_gsubscriber #(
     wire stall = (state == S_FLEN) && (cnt == 0) && meta_valid;
     wire streaming = (state == S_BODY) && (sub == SUB_STREAM);
     wire reading = (state == S_FLEN && !stall) || state == S_COUNT || state == S_BODY
-                   || state == S_SKIP || state == S_PAD;
+                   || state == S_SKIP || state == S_PAD || state == S_TAIL;
     assign s_tready = streaming ? m_tready : reading;
     assign m_tvalid = streaming && s_tvalid;
     assign m_tdata = s_tdata;
@@ -103,6 +106,10 @@ module rfl_gsubscriber #(
     wire [31:0] fields_end = CDR ? fendp : endp;
     wire [63:0] room = {32'd0, fields_end} - {32'd0, pos};  // bytes left for the fields
     wire        at_end = (pos == endp);             // nothing left of the frame to skip
+    wire [31:0] after = endp - pos;                 // bytes left after the last field
+    // CDR: they are the unannounced zeros up to a multiple of END_ALIGN (OP_DONE's st2 != 0)
+    wire        tail_zero = CDR && st2 != 8'd0 && pos != fields_end && after != 32'd0
+                            && after < {28'd0, END_ALIGN} && after == pad_at(pos, END_ALIGN);
     wire [31:0] pad_f = pad_at(pos, align);         // before a field or a count
     wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
     wire [63:0] room_f = room - {32'd0, pad_f};     // bytes left after that padding
@@ -195,6 +202,24 @@ module rfl_gsubscriber #(
         end
     endtask
 
+    // Accept the frame: hand its fields over; skip what is left of it (`to_end`: nothing is).
+    task accept(input to_end);
+        begin
+            status_valid <= 1'b1;
+            status <= SUB_OK;
+            meta_valid <= 1'b1;
+            meta_drop <= 1'b0;
+            meta_out_len <= out_len;
+            cnt <= 32'd0;
+            if (to_end) begin
+                state <= S_FLEN;
+                pos <= 32'd0;
+            end else begin
+                state <= S_SKIP;  // CDR: the payload's end padding
+            end
+        end
+    endtask
+
     // Go on with instruction `next`.
     task go(input [15:0] next);
         begin
@@ -277,20 +302,9 @@ module rfl_gsubscriber #(
                     value <= 64'd0;
                     case (op)
                         OP_DONE: begin
-                            if (pos != fields_end) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
-                            else begin
-                                status_valid <= 1'b1;
-                                status <= SUB_OK;
-                                meta_valid <= 1'b1;
-                                meta_drop <= 1'b0;
-                                meta_out_len <= out_len;
-                                if (at_end) begin
-                                    state <= S_FLEN;
-                                    pos <= 32'd0;
-                                end else begin
-                                    state <= S_SKIP;  // CDR: the payload's end padding
-                                end
-                            end
+                            if (tail_zero) state <= S_TAIL;
+                            else if (pos != fields_end) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
+                            else accept(at_end);
                         end
                         OP_ENCAP: begin
                             if (room < 64'd4) refuse(st, at_end);
@@ -402,6 +416,10 @@ module rfl_gsubscriber #(
                         if (quiet == 8'd0) out_len <= out_base + out_pad + written;
                         go(pc + 16'd1);
                     end
+                end
+                S_TAIL: if (take) begin  // CDR: an unannounced end pad byte, which must be 0
+                    if (s_tdata != 8'd0) refuse(st2, pos_next == endp);
+                    else if (pos_next == endp) accept(1'b1);
                 end
                 S_SKIP: if (take && pos_next == endp) begin
                     state <= S_FLEN;
