@@ -49,7 +49,8 @@ from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
 from rosfpga_lab.hls.limits import MAX_LOOP_DEPTH
-from rosfpga_lab.hw.cdrlayout import END_ALIGN
+from rosfpga_lab.hw.cdrlayout import ALIGN_ORIGIN, END_ALIGN, OPTIONS_PADDING_MASK
+from rosfpga_lab.msg.cdr import CDR_LE
 
 
 class Op(IntEnum):
@@ -211,14 +212,11 @@ class Refused(Exception):
 
 #: The status of a frame whose length is refused, or which ends inside a field or after the last.
 FRAME_LENGTH_STATUS = 1
-#: CDR: where alignment counts from in the subscriber's input and the publisher's output (the
-#: 4-byte sample length, then the 4-byte encapsulation header).
-ALIGN_ORIGIN = 8
-#: CDR: the representation the circuit reads (``00 01``, CDR little-endian) and the header the
-#: publisher writes (options 0).
-ENCAP_BYTES = b"\x00\x01\x00\x00"
-#: CDR: the bits of the encapsulation options that count the payload's end padding.
-ENCAP_PAD_MASK = 3
+# CDR: where alignment counts from (after the 4-byte sample length and the encapsulation
+# header), the header the circuit reads and the publisher writes (CDR little-endian, options
+# 0), and the options' end-padding bits: each owned by the CDR layout and the codec below.
+ENCAP_BYTES = CDR_LE
+ENCAP_PAD_MASK = OPTIONS_PADDING_MASK
 
 
 def pad(pos: int, align: int) -> int:
