@@ -1,7 +1,7 @@
 """The component with the Verilog on its data path (``model="rtl"``) and FPGA-true timing.
 
-* a real rospy publisher -> the component running the simulated circuit -> a real rospy
-  subscriber: every frame received is OpenCV's dilation of a frame sent, byte for byte;
+* a real rospy or roscpp publisher -> the component running the simulated circuit -> a real
+  rospy subscriber: every frame received is OpenCV's dilation of a frame sent, byte for byte;
 * through the Python API: a refused frame carries the circuit's status code as its reason, the
   next frame comes out right, and the bytes equal the Python models';
 * ``timing="fpga"``: a flood at 200 frames/s of 640x480 ``rgba8`` comes out at no more than
@@ -22,7 +22,8 @@ import pytest
 
 from proctools import interruptible, kill_if_running, stop_with
 from realros import (
-    ROS_PROGRAMS, ROS_PYTHON, finish, require_ros, require_rtl, stop_process,
+    ROS_PROGRAMS, ROS_PYTHON, build_roscpp_program, finish, require_ros, require_rtl,
+    stop_process,
 )
 from rosfpga_lab.component import FpgaComponent
 from rosfpga_lab.component.errors import ComponentConfigError
@@ -44,12 +45,15 @@ def small_config_text(width: int = W, height: int = H) -> str:
 
 @pytest.mark.ros
 @pytest.mark.rtl
-def test_real_rospy_publisher_rtl_node_command_real_rospy_checker_exact(rosmaster_uri,
-                                                                       tmp_path) -> None:
-    """``rosfpga-lab node CONFIG --model rtl`` between a real rospy publisher and a real rospy
-    subscriber, on a real rosmaster: every frame out is OpenCV's dilation of one sent."""
+@pytest.mark.parametrize("publisher", ["rospy", "roscpp"])
+def test_real_publisher_rtl_node_command_real_rospy_checker_exact(publisher, rosmaster_uri,
+                                                                  tmp_path) -> None:
+    """``rosfpga-lab node CONFIG --model rtl`` between a real rospy or roscpp publisher and a
+    real rospy subscriber, on a real rosmaster: every frame out is OpenCV's dilation of one sent."""
     require_ros()
     require_rtl("verilator")
+    if publisher == "roscpp":      # compiled (and cached) before the node starts its clock
+        pub_cmd = [str(build_roscpp_program(ROS_PROGRAMS / "wire_roscpp_node.cpp")), "pub"]
     count = 8
     cfg = tmp_path / "small.yaml"
     cfg.write_text(small_config_text())
@@ -72,9 +76,13 @@ def test_real_rospy_publisher_rtl_node_command_real_rospy_checker_exact(rosmaste
         sub = start([ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "sub",
                      "/image_dilated", str(count), str(got_file), "60"], rosmaster_uri, tmp_path)
         procs.append(sub)
-        pub = start([ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "pub", "/image_raw",
-                     str(count), str(W), str(H), "rgba8", str(sent_file), "20", "60"],
-                    rosmaster_uri, tmp_path)
+        if publisher == "roscpp":   # rgba8 frames of W x H, 20 per second
+            pub_args = [*pub_cmd, "Image", "/image_raw", str(count), str(sent_file), "60",
+                        str(W), str(H)]
+        else:
+            pub_args = [ROS_PYTHON, str(ROS_PROGRAMS / "component_rospy.py"), "pub", "/image_raw",
+                        str(count), str(W), str(H), "rgba8", str(sent_file), "20", "60"]
+        pub = start(pub_args, rosmaster_uri, tmp_path)
         procs.append(pub)
         finish(pub)
         finish(sub)

@@ -1,8 +1,9 @@
 // roscpp side of the lab's TCPROS interop tests.
 //   wire_roscpp_node sub TYPE TOPIC COUNT OUTFILE [TIMEOUT]
-//   wire_roscpp_node pub TYPE TOPIC COUNT OUTFILE [TIMEOUT]
+//   wire_roscpp_node pub TYPE TOPIC COUNT OUTFILE [TIMEOUT [WIDTH HEIGHT]]
 // Same contract as wire_rospy_node.py: the subscriber writes each received message
 // re-serialized by roscpp (uint32 length + bytes); the publisher writes what it sent.
+// Image frames are rgba8, 640x480 unless WIDTH HEIGHT are given.
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 #include <std_msgs/Int32.h>
@@ -15,6 +16,7 @@
 
 static FILE* out = nullptr;
 static int received = 0;
+static uint32_t image_width = 640, image_height = 480;
 
 template <class M>
 static void write_msg(const M& m) {
@@ -50,12 +52,12 @@ static sensor_msgs::Image make_image(int k) {
   m.header.seq = k;
   m.header.frame_id = "roscpp";
   m.header.stamp = ros::Time(1000 + k, 17);
-  m.height = 480;
-  m.width = 640;
+  m.height = image_height;
+  m.width = image_width;
   m.encoding = "rgba8";
   m.is_bigendian = 0;
-  m.step = 2560;
-  m.data.resize(640 * 480 * 4);
+  m.step = image_width * 4;
+  m.data.resize((size_t)image_width * image_height * 4);
   for (size_t i = 0; i < m.data.size(); ++i) m.data[i] = (uint8_t)((i * 7 + k * 13) & 0xFF);
   return m;
 }
@@ -95,12 +97,16 @@ static int run(ros::NodeHandle& nh, const std::string& mode, const std::string& 
 
 int main(int argc, char** argv) {
   if (argc < 6) {
-    fprintf(stderr, "usage: %s sub|pub String|Int32|Image TOPIC COUNT OUTFILE [TIMEOUT]\n", argv[0]);
+    fprintf(stderr, "usage: %s sub|pub String|Int32|Image TOPIC COUNT OUTFILE [TIMEOUT [WIDTH HEIGHT]]\n", argv[0]);
     return 2;
   }
   std::string mode = argv[1], kind = argv[2], topic = argv[3];
   int count = atoi(argv[4]);
   double timeout = argc > 6 ? atof(argv[6]) : 30.0;
+  if (argc > 8) {
+    image_width = (uint32_t)atoi(argv[7]);
+    image_height = (uint32_t)atoi(argv[8]);
+  }
   ros::init(argc, argv, "wire_roscpp_" + mode, ros::init_options::NoSigintHandler);
   ros::NodeHandle nh;
   out = fopen(argv[5], "wb");

@@ -77,6 +77,7 @@ struct Sim {
     uint64_t req_first = 0, req_last = 0;   // this run's first rx and last tx handshake
     FILE* fbin = nullptr;
     FILE* fbout = nullptr;
+    bool stats = false;         // keep the per-stream spans (first, last, count)
 
     Sim(uint32_t seed, uint32_t gap_, uint32_t bp_, uint64_t limit)
         : top(new Vrfl_harness), rnd(seed == 0 ? 0x12345678u : seed), gap(gap_), bp(bp_),
@@ -107,6 +108,15 @@ struct Sim {
         req_first = req_last = 0;
         done_for = 0;
         idle = 0;
+        // The loop is specialised: without gaps or backpressure no random number is drawn (the
+        // draws then decide nothing), and the per-stream spans and beat files only when asked.
+        const bool random = gap != 0 || bp != 0, taps = stats || fbin || fbout;
+        if (random) return taps ? loop<true, true>() : loop<true, false>();
+        return taps ? loop<false, true>() : loop<false, false>();
+    }
+
+    template <bool Random, bool Taps>
+    int loop() {
         for (;;) {
             const bool s_tvalid = top->s_tvalid, s_tready = top->s_tready;
             const bool m_tvalid = top->m_tvalid, m_tready = top->m_tready;
@@ -116,8 +126,12 @@ struct Sim {
             bool nv = s_tvalid;
             uint8_t nd = top->s_tdata;
             if ((!s_tvalid || s_tready) && !eof) {
-                rnd = xorshift(rnd);
-                if ((rnd % 1000) >= gap) {
+                bool take = true;
+                if (Random) {
+                    rnd = xorshift(rnd);
+                    take = (rnd % 1000) >= gap;
+                }
+                if (take) {
                     if (in_pos >= in_len) { eof = true; nv = false; }
                     else { nd = in[in_pos++]; nv = true; }
                 } else {
@@ -125,8 +139,11 @@ struct Sim {
                 }
             }
             if (m_tvalid && m_tready) out.push_back(top->m_tdata);
-            rnd = xorshift(rnd);
-            const bool nr = (rnd % 1000) >= bp;
+            bool nr = true;
+            if (Random) {
+                rnd = xorshift(rnd);
+                nr = (rnd % 1000) >= bp;
+            }
             if (top->frame_start) frame_off = sub_bytes;
             if (hs & 1) ++sub_bytes;
             if (top->status_valid) {
@@ -134,13 +151,15 @@ struct Sim {
                 ++frames;
                 if (top->status != 0) ++refused;
             }
-            if (fbin && (hs & 4)) beat(fbin, top->beat_in);
-            if (fbout && (hs & 16)) beat(fbout, top->beat_out);
             if (hs) {
-                for (int i = 0; i < NS; ++i) if (hs & (1u << i)) {
-                    if (count[i] == 0) first[i] = cycle;
-                    last[i] = cycle;
-                    ++count[i];
+                if (Taps) {
+                    if (fbin && (hs & 4)) beat(fbin, top->beat_in);
+                    if (fbout && (hs & 16)) beat(fbout, top->beat_out);
+                    for (int i = 0; i < NS; ++i) if (hs & (1u << i)) {
+                        if (count[i] == 0) first[i] = cycle;
+                        last[i] = cycle;
+                        ++count[i];
+                    }
                 }
                 if ((hs & 1) && !req_first) req_first = cycle;
                 if (hs & 128) req_last = cycle;
@@ -225,6 +244,7 @@ int main(int argc, char** argv) {
     if (!fout || !fstatus || !fstats) { fprintf(stderr, "rtlsim: ERROR: cannot open an output file\n"); return 1; }
     if (plusarg(argc, argv, "beats_in", path)) sim.fbin = fopen(path.c_str(), "w");
     if (plusarg(argc, argv, "beats_out", path)) sim.fbout = fopen(path.c_str(), "w");
+    sim.stats = true;
     sim.in = input.data(); sim.in_len = input.size(); sim.in_pos = 0;
     const int rc = sim.run();
     for (int i = 0; i < NS; ++i)
