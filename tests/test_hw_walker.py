@@ -271,6 +271,15 @@ def test_refusals_inside_arrays_of_messages_name_the_element_and_resync() -> Non
             extract(layout, good[:-1])
         with pytest.raises(FrameLengthError, match="more bytes were given"):
             extract(layout, good + b"\0")
+    # cut short inside an element: both models name the element (the fast one used to lose
+    # the loop indices, naming "history[].offset")
+    two = _frame(serialize(reg, "lab_msgs/Samples", dict(msg, history=[cal, cal])))
+    cut = []
+    for extract in (extract_reference, extract_fast):
+        with pytest.raises(FrameTruncatedError) as trunc:
+            extract(layout, two[:-3])
+        cut.append((trunc.value.field, trunc.value.offset))
+    assert cut[0] == cut[1] and cut[0][0].startswith("history[1]."), cut
     wrong_mode = _frame(serialize(reg, "lab_msgs/Samples", dict(msg, calibration=dict(cal, mode=3))))
     with pytest.raises(FrameFieldError, match="built for 2") as exc:
         extract_fast(layout, wrong_mode)
