@@ -28,25 +28,22 @@ from rosfpga_lab.hw.cdrwalker import (
     publish_cdr_reference,
 )
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, LayoutError
-from rosfpga_lab.hw.layout import StepKind, encode_token
+from rosfpga_lab.hw.layout import StepKind
 from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.msg.builtins import SCALARS
 from rosfpga_lab.msg.cdr import deserialize_cdr, serialize_cdr
 from rosfpga_lab.msg.ros2 import ros2_registry
 from rosfpga_lab.msg.strategies import message
-from test_hw_walker import definitions
+from test_hw_walker import _frame as _record  # 4-byte length + payload, as TCPROS
+from test_hw_walker import _wire as _layout_wire, definitions
 from wiretools import require_cyclonedds
 
 DATA = Path(__file__).resolve().parent.parent / "data"
 
 
-def _record(payload: bytes) -> bytes:
-    return struct.pack("<I", len(payload)) + payload
-
-
 def _wire(cdr: Any, toks: list) -> list[tuple[int, tuple[int, ...], bytes]]:
-    steps = cdr.layout.steps
-    return [(t.step, t.at, encode_token(steps[t.step], t.value)) for t in toks]
+    """Tokens as comparable (step, indices, wire bytes), as the TCPROS walker's tests do."""
+    return _layout_wire(cdr.layout, toks)
 
 
 def _pad_tail(payload: bytes, pad: int) -> bytes:
