@@ -35,7 +35,7 @@ from rosfpga_lab.msg.cdr import deserialize_cdr, serialize_cdr
 from rosfpga_lab.msg.ros2 import ros2_registry
 from rosfpga_lab.msg.strategies import message
 from test_hw_walker import _frame as _record  # 4-byte length + payload, as TCPROS
-from test_hw_walker import _wire as _layout_wire, definitions
+from test_hw_walker import _wire as _layout_wire, conversion_config, definitions
 from wiretools import require_cyclonedds
 
 DATA = Path(__file__).resolve().parent.parent / "data"
@@ -524,20 +524,7 @@ def test_skipped_fields_are_written_as_cdr_defaults_and_another_output_type_by_p
     for model in ("fast", "reference"):
         assert CdrPipeline(c, model).process(serialize_cdr(r2, "sensor_msgs/LaserScan", scan)) == want
 
-    msgs = tmp_path / "conv_msgs" / "msg"
-    msgs.mkdir(parents=True)
-    (msgs / "InnerA.msg").write_text("int32 a\nstring b\n")
-    (msgs / "InnerB.msg").write_text("string b\nint64 a\nuint8 c\n")
-    (msgs / "In.msg").write_text("Header header\nstring name\nint16[] values\nfloat64 gain\n"
-                                 "InnerA inner\nInnerA[] list\n")
-    (msgs / "Out.msg").write_text("Header header\nint16[] values\nstring name\nuint8 extra\n"
-                                  "InnerB inner\nInnerB[] list\n")
-    (tmp_path / "c.yaml").write_text(
-        "node: {name: n}\nsubscriber: {topic: /a, type: conv_msgs/In}\n"
-        "publisher: {topic: /b, type: conv_msgs/Out}\nmsg_path: [.]\n"
-        "stream: {field: values, length: 4}\napplication: {op: dilate, ksize: 3}\n"
-        "limits: {name: 8}\n")
-    config = load_config(tmp_path / "c.yaml")
+    config = conversion_config(tmp_path)
     reg2 = ros2_registry(config.registry())
     msg = {"header": {"stamp": {"sec": 3, "nanosec": 4}, "frame_id": "x"}, "name": "nm",
            "values": [1, -5, 3, 0], "gain": 2.5, "inner": {"a": 7, "b": "in"},

@@ -388,7 +388,9 @@ def test_morph1d_nan_gives_the_first_nan_of_the_window_with_its_bits() -> None:
     assert morph1d_fast(big, "dilate", 3).tolist() == [2**64 - 1, 2**64 - 1, 2**63]
 
 
-def test_a_publisher_of_another_type_carries_fields_by_path_and_type(tmp_path: Path) -> None:
+def conversion_config(tmp_path: Path) -> Any:
+    """A node from conv_msgs/In to conv_msgs/Out (written under ``tmp_path``): fields of the same
+    path and type carried (nested ones too), the others at their defaults."""
     msgs = tmp_path / "conv_msgs" / "msg"
     msgs.mkdir(parents=True)
     (msgs / "InnerA.msg").write_text("int32 a\nstring b\n")
@@ -403,6 +405,11 @@ def test_a_publisher_of_another_type_carries_fields_by_path_and_type(tmp_path: P
         "stream: {field: values, length: 4}\napplication: {op: dilate, ksize: 3}\n"
         "limits: {name: 8}\n")
     config = load_config(tmp_path / "c.yaml")
+    return config
+
+
+def test_a_publisher_of_another_type_carries_fields_by_path_and_type(tmp_path: Path) -> None:
+    config = conversion_config(tmp_path)
     reg = config.registry()
     msg = {"header": {"seq": 2, "stamp": (3, 4), "frame_id": "x"}, "name": "nm",
            "values": [1, -5, 3, 0], "gain": 2.5, "inner": {"a": 7, "b": "in"},
