@@ -35,7 +35,9 @@ from rosfpga_lab.msg.cdr import deserialize_cdr, serialize_cdr
 from rosfpga_lab.msg.ros2 import ros2_registry
 from rosfpga_lab.msg.strategies import message
 from test_hw_walker import _frame as _record  # 4-byte length + payload, as TCPROS
-from test_hw_walker import _wire as _layout_wire, conversion_config, definitions
+from test_hw_walker import (
+    _wire as _layout_wire, conversion_config, definitions, push_counting_refusals,
+)
 from wiretools import require_cyclonedds
 
 DATA = Path(__file__).resolve().parent.parent / "data"
@@ -150,13 +152,8 @@ def test_a_refused_check_names_its_field_and_the_next_good_sample_comes_out_righ
             extract(cdr, bad_record)
         assert exc.value.field == label and exc.value.rule == "not what the circuit was built for"
     interp = CdrInterpreter(cdr)
-    refused = 0
-    for byte in bad_record + good_record:
-        try:
-            interp.push(byte)
-        except FrameFieldError:
-            refused += 1
-    assert refused == 1 and interp.frames == 1 and interp.last is not None
+    assert push_counting_refusals(interp, bad_record + good_record) == 1
+    assert interp.frames == 1 and interp.last is not None
     expected = _wire(cdr, cdr_tokens(cdr, deserialize_cdr(r2, type_name, good_record[4:])))
     assert _wire(cdr, interp.last.tokens) == expected
 

@@ -45,6 +45,17 @@ def _wire(layout: Layout, toks: list) -> list[tuple[int, tuple[int, ...], bytes]
     return [(t.step, t.at, encode_token(layout.steps[t.step], t.value)) for t in toks]
 
 
+def push_counting_refusals(interp: LayoutInterpreter, data: bytes) -> int:
+    """Push ``data`` a byte at a time; how many frames the circuit refused on the way."""
+    refused = 0
+    for byte in data:
+        try:
+            interp.push(byte)
+        except FrameFieldError:
+            refused += 1
+    return refused
+
+
 # -- a strategy over message definitions -------------------------------------------------------
 
 PRIMS = ["bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
@@ -154,13 +165,8 @@ def test_a_refused_check_names_its_field_and_the_next_good_frame_comes_out_right
             extract(layout, bad_frame)
         assert exc.value.field == label and exc.value.rule == words
     interp = LayoutInterpreter(layout)
-    refused = 0
-    for byte in bad_frame + good_frame:
-        try:
-            interp.push(byte)
-        except FrameFieldError:
-            refused += 1
-    assert refused == 1 and interp.frames == 1 and interp.last is not None
+    assert push_counting_refusals(interp, bad_frame + good_frame) == 1
+    assert interp.frames == 1 and interp.last is not None
     expected = _wire(layout, tokens(layout, deserialize(reg, type_name, good_frame[4:])))
     assert _wire(layout, interp.last.tokens) == expected
 
