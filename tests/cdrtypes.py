@@ -1,43 +1,43 @@
 """rosidl's IDL of the types the CDR tests send, as PyPI cyclonedds' IDL dataclasses.
 
 Written by hand from the ``.msg`` files (independently of the lab's registry), as rosidl and
-rmw_cyclonedds_cpp name them. No ``from __future__ import annotations`` here: cyclonedds
+rmw_cyclonedds_cpp name them; Time_, Header_ and Image_ come from the shipped capture script's
+own IDL (one owner: tests/ros2tools.py imports them from here). No ``from __future__ import annotations`` here: cyclonedds
 resolves the annotations of module-level classes. Import only after ``require_cyclonedds()``.
 """
 
+import importlib.util
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 import cyclonedds.idl.types as t
 from cyclonedds.idl import IdlStruct
 
 
-@dataclass
-class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-    sec: t.int32
-    nanosec: t.uint32
+# Time_, Header_ and Image_ are the shipped capture script's (data/capture_rtps_image.py, which
+# must stay runnable on its own and hands them to its Cyclone DDS processes as source text).
+def _capture_types() -> dict[str, Any]:
+    path = Path(__file__).resolve().parent.parent / "data" / "capture_rtps_image.py"
+    spec = importlib.util.spec_from_file_location("capture_rtps_image", path)
+    assert spec is not None and spec.loader is not None
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    names: dict[str, Any] = {"__name__": __name__}
+    exec(script.TYPES, names)
+    return names
+
+
+_CAPTURE = _capture_types()
+Time_ = _CAPTURE["Time_"]
+Header_ = _CAPTURE["Header_"]
+Image_ = _CAPTURE["Image_"]
 
 
 @dataclass
 class Duration_(IdlStruct, typename="builtin_interfaces::msg::dds_::Duration_"):
     sec: t.int32
     nanosec: t.uint32
-
-
-@dataclass
-class Header_(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
-    stamp: Time_
-    frame_id: str
-
-
-@dataclass
-class Image_(IdlStruct, typename="sensor_msgs::msg::dds_::Image_"):
-    header: Header_
-    height: t.uint32
-    width: t.uint32
-    encoding: str
-    is_bigendian: t.uint8
-    step: t.uint32
-    data: t.sequence[t.uint8]
 
 
 @dataclass

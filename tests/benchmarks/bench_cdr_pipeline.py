@@ -11,10 +11,11 @@ Run:  .venv/bin/python tests/benchmarks/bench_cdr_pipeline.py [--samples N]
 from __future__ import annotations
 
 import argparse
-import time
 from pathlib import Path
 
 import numpy as np
+
+from benchtools import per_call
 
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hw import Pipeline, image_frame
@@ -24,13 +25,6 @@ from rosfpga_lab.msg import new_message
 from rosfpga_lab.msg.cdr import serialize_cdr
 
 DATA = Path(__file__).resolve().parents[2] / "data"
-
-
-def _time(fn, n: int) -> float:
-    t0 = time.perf_counter()
-    for _ in range(n):
-        fn()
-    return (time.perf_counter() - t0) / n
 
 
 def main() -> None:
@@ -48,9 +42,9 @@ def main() -> None:
     value["calibration"]["mode"] = 2
     sample = serialize_cdr(creg, "lab_msgs/Samples", value)
     print(f"lab_msgs/Samples, {len(sample)}-byte sample:")
-    print(f"  derive the CDR walk   {_time(lambda: cdr_layout_from_config(config), 5) * 1e3:8.2f} ms")
-    print(f"  reference per sample  {_time(lambda: ref.process(sample), max(1, n // 4)) * 1e3:8.2f} ms")
-    print(f"  fast per sample       {_time(lambda: fast.process(sample), n) * 1e3:8.2f} ms")
+    print(f"  derive the CDR walk   {per_call(lambda: cdr_layout_from_config(config), 5) * 1e3:8.2f} ms")
+    print(f"  reference per sample  {per_call(lambda: ref.process(sample), max(1, n // 4)) * 1e3:8.2f} ms")
+    print(f"  fast per sample       {per_call(lambda: fast.process(sample), n) * 1e3:8.2f} ms")
     print(f"  modelled cycles       {sum(fast.run(sample).cycles.values()):8d}")
 
     image_config = load_config(DATA / "fpga_dilate_rgba8.yaml")
@@ -64,8 +58,8 @@ def main() -> None:
     cdr_sample = serialize_cdr(cdr_image.cdr.registry, "sensor_msgs/Image", img)
     tcpros = Pipeline.from_config(image_config)
     frame = image_frame(pixels, im.encoding, frame_id="camera")
-    t_cdr = _time(lambda: cdr_image.process(cdr_sample), n)
-    t_tcp = _time(lambda: tcpros.process(frame), n)
+    t_cdr = per_call(lambda: cdr_image.process(cdr_sample), n)
+    t_tcp = per_call(lambda: tcpros.process(frame), n)
     print(f"sensor_msgs/Image {im.width}x{im.height} {im.encoding}, 3x3 dilate (fast models):")
     print(f"  CDR    {t_cdr * 1e3:8.2f} ms/sample  ({1 / t_cdr:6.1f} samples/s)")
     print(f"  TCPROS {t_tcp * 1e3:8.2f} ms/frame   ({1 / t_tcp:6.1f} frames/s)")

@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import argparse
 import struct
-import time
 from pathlib import Path
 
 import numpy as np
+
+from benchtools import per_call
 
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hw import image_frame, interpret_fast
@@ -47,13 +48,6 @@ def _frame(config_name: str) -> tuple[object, bytes]:
     return config, struct.pack("<I", len(body)) + body
 
 
-def _time(fn, n: int) -> float:
-    t0 = time.perf_counter()
-    for _ in range(n):
-        fn()
-    return (time.perf_counter() - t0) / n
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--frames", type=int, default=20, help="frames per figure (default 20)")
@@ -62,21 +56,21 @@ def main() -> None:
           f"{'fast ms/frame':>13} {'cycles':>7}")
     for name in EXAMPLES:
         config, frame = _frame(name)
-        t_layout = _time(lambda: layout_from_config(config), 5)
+        t_layout = per_call(lambda: layout_from_config(config), 5)
         ref = MessagePipeline.from_config(config, model="reference")
         fast = MessagePipeline.from_config(config, model="fast")
         cycles = fast.process(frame).total_cycles
-        t_ref = _time(lambda: ref.process(frame), max(1, args.frames // 4))
-        t_fast = _time(lambda: fast.process(frame), args.frames)
+        t_ref = per_call(lambda: ref.process(frame), max(1, args.frames // 4))
+        t_fast = per_call(lambda: fast.process(frame), args.frames)
         print(f"{name:28} {len(frame):6} {t_layout * 1e3:9.2f} {t_ref * 1e3:12.2f} "
               f"{t_fast * 1e3:13.3f} {cycles:7}")
     config = load_config(DATA / "fpga_dilate_rgba8.yaml")
     layout = layout_from_config(config)
     pic = np.random.default_rng(0).integers(0, 256, (480, 640, 4), np.uint8)
     frame = image_frame(pic, "rgba8", frame_id="cam")
-    t_image = _time(lambda: interpret_fast(frame, width=640, height=480, encoding="rgba8"),
+    t_image = per_call(lambda: interpret_fast(frame, width=640, height=480, encoding="rgba8"),
                     args.frames)
-    t_layout_sub = _time(lambda: extract_fast(layout, frame), args.frames)
+    t_layout_sub = per_call(lambda: extract_fast(layout, frame), args.frames)
     print(f"640x480 rgba8 subscriber, fast: Image interpreter {t_image * 1e3:.3f} ms, "
           f"layout walker {t_layout_sub * 1e3:.3f} ms per frame")
 
