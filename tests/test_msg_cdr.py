@@ -19,6 +19,7 @@ from rosfpga_lab.msg.builtins import SCALARS
 from rosfpga_lab.msg.cdr import (
     CDR_LE, ROLE_ENCAPSULATION, ROLE_PADDING, cdr_layout, deserialize_cdr, serialize_cdr,
 )
+from rosfpga_lab.msg.registry import MsgRegistry
 from rosfpga_lab.msg.ros2 import NOT_IN_ROS2, ros2_registry, to_ros2_value
 from rosfpga_lab.msg.strategies import message, normalize
 
@@ -118,6 +119,23 @@ def test_image_padding_before_step_and_data_count() -> None:
 def test_empty_message_is_one_byte() -> None:
     assert serialize_cdr(None, "std_msgs/Empty", {}) == CDR_LE + b"\x00"
     assert deserialize_cdr(None, "std_msgs/Empty", CDR_LE + b"\x00") == {}
+
+
+def test_a_message_of_zero_length_arrays_is_zero_bytes_and_reads_back() -> None:
+    """A message whose only field is a zero-length fixed array is no bytes in CDR (it has a
+    field, so no placeholder byte); an array of such messages has a count and nothing else.
+    The reader held each element to 1 byte at least and refused what the writer wrote (found
+    by hypothesis)."""
+    reg = MsgRegistry.with_defaults()
+    reg.add("h_msgs/T1", "time[0] f0\n")
+    reg.add("h_msgs/T0", "uint8[] data\nh_msgs/T1[] f3\n")
+    value = {"data": b"", "f3": [{"f0": []}]}
+    wire = serialize_cdr(reg, "h_msgs/T0", value)
+    assert wire == CDR_LE + b"\x00" * 4 + b"\x01\x00\x00\x00"
+    back = deserialize_cdr(reg, "h_msgs/T0", wire)
+    assert len(back["f3"]) == 1 and list(back["f3"][0]["f0"]) == []
+    with pytest.raises(DeserializeError):   # a count of 2 with one element's bytes missing
+        deserialize_cdr(reg, "h_msgs/T0", CDR_LE + b"\x00" * 4 + b"\x02\x00\x00")
 
 
 def test_truncated_payloads_raise_typed_errors() -> None:

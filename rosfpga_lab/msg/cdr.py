@@ -156,6 +156,26 @@ def serialize_cdr(reg: MsgRegistry | None, type_name: str, value: Any) -> bytes:
     return bytes(w.out)
 
 
+def _may_be_empty(reg: MsgRegistry, type_name: str) -> bool:
+    """Whether a message can serialize to no bytes in CDR: only when every field is a
+    zero-length fixed array (or such a message); a message with no fields gets ROS 2's one-byte
+    placeholder."""
+    spec = reg.check(type_name)
+    if not spec.fields:
+        return False
+    for f in spec.fields:
+        if f.is_array and f.array_length == 0:
+            continue
+        if f.is_array and f.array_length is None:
+            return False
+        base = f.base_type
+        if base in SCALARS or base == "string" or base in TIME_CLASS:
+            return False
+        if not _may_be_empty(reg, base):
+            return False
+    return True
+
+
 class _Reader(SpanReader):
     """Plain field-by-field CDR reader that records spans (the decoder and the layout)."""
 
@@ -221,7 +241,9 @@ class _Reader(SpanReader):
         base = f.base_type
         if not f.is_array:
             return self.element(base, path)
-        elem_min = SCALARS[base].size if base in SCALARS else 1
+        elem_min = (SCALARS[base].size if base in SCALARS
+                    else 0 if base not in ("string", *TIME_CLASS) and _may_be_empty(self.reg, base)
+                    else 1)
         if f.array_length is None:
             n = self.count(path, elem_min, self.limits.max_array_length, "max_array_length")
         else:
