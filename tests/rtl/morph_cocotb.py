@@ -194,6 +194,7 @@ async def morph_frames(dut) -> None:
     for img in frames:
         for _ in range(case.get("junk", 0) and prng.randint(0, case["junk"])):
             beats_in.append((prng.getrandbits(32), fmt.tkeep, 0, prng.getrandbits(1)))
+            want_flags = 8      # sof_missing: junk dropped before a TUSER (hw.framing)
         rows, cols = img.shape[:2]
         tdata = pack_lanes(img.reshape(rows * cols, -1))
         tuser, tlast = _flags(rows, cols)
