@@ -186,3 +186,83 @@ def reframe_fast(beats: Beats, rows: int, cols: int) -> Reframed:
         per_frame.append(flags & ~mark)
         mark = flags
     return Reframed(frames, per_frame, flags, i)
+
+
+def reframe_bytes_reference(data: bytes | np.ndarray, marks: np.ndarray,
+                            frame_bytes: int) -> Reframed:
+    """Byte-at-a-time model of ``rfl_fifo2axi``'s start-of-frame re-sync.
+
+    ``marks[i]`` is the subscriber's start-of-frame marker on byte ``i``. Bytes before a marked
+    byte are dropped (``sof_missing``); a marked byte inside a frame ends it, the rest of the
+    frame being zero bytes, and starts the next (``sof_early``). ``frames`` holds each
+    completed frame's ``frame_bytes`` bytes (uint8).
+    """
+    raw = np.frombuffer(bytes(data), np.uint8) if not isinstance(data, np.ndarray) else data
+    mk = np.asarray(marks, bool)
+    if frame_bytes < 1 or mk.size != raw.size:
+        raise PipelineConfigError(f"need frame_bytes >= 1 and one marker per byte, got "
+                                  f"{frame_bytes}, {mk.size} markers for {raw.size} bytes")
+    n = raw.size
+    i, flags, mark = 0, 0, 0
+    frames: list[np.ndarray] = []
+    per_frame: list[int] = []
+    while True:
+        while i < n and not mk[i]:
+            flags |= SOF_MISSING
+            i += 1
+        if i >= n:
+            break
+        buf = np.zeros(frame_bytes, np.uint8)
+        j = 0
+        while j < frame_bytes and i < n:
+            if mk[i] and j > 0:
+                flags |= SOF_EARLY
+                break
+            buf[j] = raw[i]
+            i, j = i + 1, j + 1
+        if j < frame_bytes and i >= n:
+            break                           # the stream ran out inside the frame
+        frames.append(buf)
+        per_frame.append(flags & ~mark)
+        mark = flags
+    return Reframed(frames, per_frame, flags, i)
+
+
+def reframe_bytes_fast(data: bytes | np.ndarray, marks: np.ndarray, frame_bytes: int) -> Reframed:
+    """Fast model of :func:`reframe_bytes_reference` (a slice per frame)."""
+    raw = np.frombuffer(bytes(data), np.uint8) if not isinstance(data, np.ndarray) else data
+    mk = np.asarray(marks, bool)
+    if frame_bytes < 1 or mk.size != raw.size:
+        raise PipelineConfigError(f"need frame_bytes >= 1 and one marker per byte, got "
+                                  f"{frame_bytes}, {mk.size} markers for {raw.size} bytes")
+    n = raw.size
+    starts = np.flatnonzero(mk)
+    i, flags, mark, s = 0, 0, 0, 0
+    frames: list[np.ndarray] = []
+    per_frame: list[int] = []
+    while True:
+        while s < len(starts) and starts[s] < i:
+            s += 1
+        k = int(starts[s]) if s < len(starts) else n
+        if k > i:
+            flags |= SOF_MISSING
+        if k >= n:
+            i = n
+            break
+        nxt = int(starts[s + 1]) if s + 1 < len(starts) else n
+        avail = nxt - k
+        if avail >= frame_bytes:
+            frames.append(raw[k:k + frame_bytes].astype(np.uint8, copy=True))
+            i = k + frame_bytes
+        elif nxt < n:
+            buf = np.zeros(frame_bytes, np.uint8)
+            buf[:avail] = raw[k:nxt]
+            frames.append(buf)
+            flags |= SOF_EARLY
+            i = nxt
+        else:
+            i = n                           # the stream ran out inside the frame
+            break
+        per_frame.append(flags & ~mark)
+        mark = flags
+    return Reframed(frames, per_frame, flags, i)
