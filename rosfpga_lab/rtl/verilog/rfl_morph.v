@@ -73,10 +73,10 @@ module rfl_morph #(
     localparam SW   = (NL > 1) ? $clog2(NL) : 1;
     localparam [W-1:0] ID = (OP == 1) ? {W{1'b1}} : {W{1'b0}};  // identity of max / min
     // the same constants at the widths of the counters they are compared with
-    localparam [31:0] VROWS_32 = VROWS, HEIGHT_32 = HEIGHT, LAST_ROW_32 = HEIGHT - 1,
+    localparam [31:0] LAST_VROW_32 = VROWS - 1, LAST_ROW_32 = HEIGHT - 1,
                       LAST_COL_32 = WIDTH - 1, LEAD_32 = LEAD, LAST_LINE_32 = NL - 1;
-    localparam [RW-1:0] VROWS_R   = VROWS_32[RW-1:0];
-    localparam [RW-1:0] HEIGHT_R  = HEIGHT_32[RW-1:0];
+    localparam [RW-1:0] LAST_VROW = LAST_VROW_32[RW-1:0];
+    localparam [RW-1:0] LAST_IROW = LAST_ROW_32[RW-1:0];
     localparam [OW-1:0] LAST_ROW  = LAST_ROW_32[OW-1:0];
     localparam [CW-1:0] LAST_COL  = LAST_COL_32[CW-1:0];
     localparam [LW-1:0] LEAD_R    = LEAD_32[LW-1:0];
@@ -106,13 +106,15 @@ module rfl_morph #(
     reg [NL-1:0]  mvalid;      // line memory m holds a row of this frame's image
     reg [SW-1:0]  wsel;        // line memory the current scan row is written to
 
+    reg           vact_r;      // vrow < VROWS: the scan is inside the extended image
+    reg           inrow_r;     // vrow < HEIGHT: the scan row takes input pixels
     reg           padl;        // an early TLAST: the rest of this line is zero pixels
     reg           padf;        // an early TUSER: the rest of this frame is zero pixels
     reg           drop;        // no TLAST at the line end: drop beats up to the next TLAST
 
     wire adv     = !m_axis_tvalid || m_axis_tready;
-    wire vact    = (vrow < VROWS_R);
-    wire in_row  = (vrow < HEIGHT_R);
+    wire vact    = vact_r;                         // registered: no compare before fire
+    wire in_row  = inrow_r;
     wire need_in = run && vact && in_row;          // the step takes a pixel of the frame
     wire sof_in  = s_axis_tvalid && s_axis_tuser;
     wire dropping = drop && !sof_in;               // a TUSER beat is never dropped here
@@ -140,7 +142,7 @@ module rfl_morph #(
         if (!aresetn) begin
             run <= 1'b0;
             vrow <= 0; vcol <= 0; lead <= LEAD_R; orow <= 0; ocol <= 0;
-            mvalid <= 0; wsel <= 0;
+            mvalid <= 0; wsel <= 0; vact_r <= 1'b1; inrow_r <= 1'b1;
             padl <= 1'b0; padf <= 1'b0; drop <= 1'b0; framing <= 4'd0;
         end else begin
           if (skip) begin                              // a beat dropped
@@ -169,6 +171,8 @@ module rfl_morph #(
                     padl <= 1'b0;
                     vcol <= 0;
                     vrow <= vrow + 1'b1;
+                    vact_r <= (vrow != LAST_VROW);
+                    inrow_r <= inrow_r && (vrow != LAST_IROW);
                     mvalid[wsel] <= in_row;
                     wsel <= (wsel == LAST_LINE) ? {SW{1'b0}} : wsel + 1'b1;
                 end else begin
@@ -186,7 +190,7 @@ module rfl_morph #(
             if (last_px) begin       // frame done: back to waiting for the next tuser
                 run <= 1'b0;
                 vrow <= 0; vcol <= 0; lead <= LEAD_R; orow <= 0; ocol <= 0;
-                mvalid <= 0; wsel <= 0;
+                mvalid <= 0; wsel <= 0; vact_r <= 1'b1; inrow_r <= 1'b1;
                 padl <= 1'b0; padf <= 1'b0;
             end
           end
