@@ -113,7 +113,7 @@ module rfl_morph #(
     reg           drop;        // no TLAST at the line end: drop beats up to the next TLAST
 
     wire adv     = !m_axis_tvalid || m_axis_tready;
-    wire vact    = vact_r;                         // registered: no compare before fire
+    wire vact    = (D > 0) ? vact_r : inrow_r;     // registered: no compare before fire
     wire in_row  = inrow_r;
     wire need_in = run && vact && in_row;          // the step takes a pixel of the frame
     wire sof_in  = s_axis_tvalid && s_axis_tuser;
@@ -124,7 +124,8 @@ module rfl_morph #(
     wire fire    = run ? adv && (!need_in || pad || take_px) : take_px;
     wire emit    = (lead == 0);
     wire last_px = emit && (orow == LAST_ROW) && (ocol == LAST_COL);
-    wire [W-1:0] pix = (run && pad) ? {W{1'b0}} : s_axis_tdata[W-1:0];
+    wire         pz  = run && pad;                 // the step's pixel is a zero (padding)
+    wire [W-1:0] pix = pz ? {W{1'b0}} : s_axis_tdata[W-1:0];    // into the line memories
     wire skip    = s_axis_tvalid && (dropping || (!run && adv && !s_axis_tuser));
 
     assign s_axis_tready = dropping || (run ? adv && need_in && !pad : adv);
@@ -201,6 +202,7 @@ module rfl_morph #(
     reg           valid1;
     reg [W-1:0]   p1;
     reg           pv1;         // p1 is an image pixel
+    reg           pz1;         // ... and a zero of padding
     reg [NL-1:0]  mv1;         // line memory outputs that are image pixels
     reg           emit1, first1, eol1;
     reg [K-1:0]   hmask1;
@@ -231,7 +233,8 @@ module rfl_morph #(
             valid1 <= 1'b0;
         end else if (adv) begin
             valid1 <= fire;
-            p1     <= pix;
+            p1     <= s_axis_tdata[W-1:0];
+            pz1    <= pz;
             pv1    <= vact && in_row;
             mv1    <= vact ? mvalid : {NL{1'b0}};
             emit1  <= emit;
@@ -259,7 +262,7 @@ module rfl_morph #(
             eol1r   <= eol1;
             hmask1r <= hmask1;
             vcand   <= {16{ID}};
-            vcand[W-1:0] <= pv1 ? p1 : ID;
+            vcand[W-1:0] <= pv1 ? (pz1 ? {W{1'b0}} : p1) : ID;
             for (i = 0; i < NL; i = i + 1)
                 if (K > 1 && mv1[i]) vcand[(i+1)*W +: W] <= qall[i*W +: W];
         end
@@ -379,7 +382,7 @@ module rfl_morph #(
     end
 
     // tkeep and the unused lanes of the input are not needed
-    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata};
+    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata, pix};   // pix: K == 1 has no lines
 
 endmodule
 
