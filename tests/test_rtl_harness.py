@@ -33,6 +33,7 @@ def assert_same_run(fast: RtlResult, tb: RtlResult) -> None:
     assert fast.cycles == tb.cycles
     assert fast.input_beats == tb.input_beats and fast.output_beats == tb.output_beats
     assert fast.cut_short == tb.cut_short
+    assert fast.framing == tb.framing == 0     # no stage saw a damaged frame (hw.framing)
 
 
 def mixed_frames(config) -> tuple[list[bytes], list[str]]:

@@ -30,6 +30,15 @@ CASES = {
     "dilate-k5-rgba8-no-stalls": (11, 7, 5, 0, 4, 2, 0, 0, 0),
     "erode-k3-mono8-heavy-backpressure": (10, 6, 3, 1, 1, 2, 0, 900, 0),
 }
+# damaged input streams (early/late TLAST, TUSER inside a frame, junk before TUSER), then a
+# clean frame: the same fields, the frames damaged in turn
+DAMAGED = {
+    "damaged-dilate-k3-rgba8": (6, 4, 3, 0, 4, 11, 200, 300, 0),
+    "damaged-erode-k5-mono8": (5, 5, 5, 1, 1, 11, 0, 0, 0),
+    "damaged-passthrough-rgb8": (4, 3, 3, 2, 3, 11, 300, 300, 0),
+    "damaged-dilate-k3-mono8-one-row": (5, 1, 3, 0, 1, 6, 200, 200, 0),
+}
+CASES.update(DAMAGED)
 
 
 @pytest.mark.parametrize("name", list(CASES))
@@ -40,7 +49,7 @@ def test_morph_cocotb(name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
     width, height, ksize, op, nbytes, frames, gap, bp, junk = CASES[name]
     case = {"width": width, "height": height, "ksize": ksize, "op": op, "bytes": nbytes,
             "frames": frames, "gap": gap, "bp": bp, "junk": junk,
-            "seed": sum(map(ord, name))}
+            "seed": sum(map(ord, name)), "damaged": name in DAMAGED}
     runner = get_runner(sim)
     runner.build(sources=[VERILOG_DIR / "rfl_morph.v"], hdl_toplevel="rfl_morph",
                  parameters={"WIDTH": width, "HEIGHT": height, "KSIZE": ksize, "OP": op,

@@ -155,6 +155,8 @@ def test_every_refusal_reason_then_a_good_frame(tmp_path: Path) -> None:
     got = run(sim, b"".join(frames), seed=3, gap=200, bp=300)
     offsets = np.cumsum([0] + [len(f) for f in frames])[:-1]
     assert got.status == tuple((int(o), n) for o, n in zip(offsets, names))
+    # the refused frames never reach fifo2axi or the application: no framing flag is raised
+    assert got.framing == 0
     expected, verdicts = model_output(config, frames)
     assert verdicts == ["refused" if n != "SUB_OK" else "SUB_OK" for n in names]
     assert got.output == expected

@@ -80,7 +80,9 @@ def test_make_synth_prints_the_table(tmp_path: Path) -> None:
     # passthrough: no window, no line buffer (LUTRAM: at most the SRLs that carry the pixel
     # through the pipeline registers, 1 per data bit and flag)
     assert counts["RAMB36"] == counts["RAMB18"] == 0 and counts["LUTRAM"] <= 40
-    assert counts["LUT"] < 100
+    # counters, handshake and the input's framing re-sync (hw.framing: padding, dropping,
+    # four sticky flags, about 15 LUTs): 97 LUTs before the re-sync, 110 with it
+    assert counts["LUT"] < 130
     assert any(line.startswith("total") for line in lines)
     assert f"{config.part} (synth_xilinx -family xc7)" in done.stdout
 

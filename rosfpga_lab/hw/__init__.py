@@ -45,6 +45,9 @@ Stages (``reference`` / ``fast``), importable for notebooks:
 * ``AXIvideo2Mat`` / ``Mat2AXIvideo``: :func:`axivideo2mat_reference`, :func:`axivideo2mat_fast`,
   :func:`mat2axivideo_reference`, :func:`mat2axivideo_fast` with :class:`Mat`;
 * application: :func:`morph_reference` / :func:`morph_fast` (``dilate``, ``erode``, ``copy``);
+  on a beat stream, damaged or not, as ``rfl_morph.v``: :func:`morph_stream_reference` /
+  :func:`morph_stream_fast` (framing rules and flags :data:`FRAMING_FLAGS`, module ``framing``;
+  ``fifo2axi``'s start-of-frame re-sync: ``axis.fifo2axi_stream_reference`` / ``_fast``);
 * message generator: :func:`generate_reference` / :func:`generate_fast` (:data:`GENERATOR_TABLE`).
 
 Streams: :class:`Fifo`, :class:`ByteFIFO`, :class:`Beat`, :class:`Beats`. Faults:
@@ -75,7 +78,10 @@ from rosfpga_lab.hw.cdrpipeline import CdrPipeline, CdrResult
 from rosfpga_lab.hw.walker import (
     Extracted, LayoutInterpreter, extract_fast, extract_reference, publish_fast, publish_reference,
 )
-from rosfpga_lab.hw.morph import OPS, morph_fast, morph_reference
+from rosfpga_lab.hw.framing import FRAMING_FLAGS
+from rosfpga_lab.hw.morph import (
+    OPS, morph_fast, morph_reference, morph_stream_fast, morph_stream_reference,
+)
 from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame, wire_bytes
 from rosfpga_lab.hw.rx import receive_fast_check, receive_reference
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
@@ -99,5 +105,5 @@ __all__ = [
     "Layout", "derive_layout", "format_layout", "layout_from_config", "morph1d_fast",
     "morph1d_reference", "Extracted", "LayoutInterpreter", "extract_fast", "extract_reference",
     "publish_fast", "publish_reference", "MessagePipeline", "MessageResult",
-    "CdrPipeline", "CdrResult",
+    "CdrPipeline", "CdrResult", "FRAMING_FLAGS", "morph_stream_fast", "morph_stream_reference",
 ]

@@ -13,6 +13,11 @@ are what a simulator's dump shows at every rising edge of ``aclk``:
 
 Without gaps or backpressure, beat ``j`` is taken at clock ``(j + 1) * B``: one pixel every
 ``B`` clocks, the rate ``hw.cycles`` counts for the byte-wide stages.
+
+The bytes are one clean frame (or a window of one), the first carrying the subscriber's
+start-of-frame marker; the RTL's re-sync on a damaged byte stream (``hw.framing``) changes
+nothing in that case and is modelled beat by beat, not clock by clock, by
+``hw.axis.fifo2axi_stream_reference`` / ``_fast``.
 """
 
 from __future__ import annotations

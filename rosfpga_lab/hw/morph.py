@@ -25,7 +25,10 @@ import numpy as np
 from rosfpga_lab.config.vocabulary import MODEL_OPS, PASSTHROUGH, canonical_op
 from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.errors import PipelineConfigError
-from rosfpga_lab.hw.video import Mat
+from rosfpga_lab.hw.encodings import PixelFormat, unpack_lanes
+from rosfpga_lab.hw.framing import Reframed, reframe_fast, reframe_reference
+from rosfpga_lab.hw.streams import Beat, Beats, Fifo
+from rosfpga_lab.hw.video import Mat, mat2axivideo_fast, mat2axivideo_reference
 
 #: Operations the models run (the configuration vocabulary's :data:`~rosfpga_lab.config.vocabulary.MODEL_OPS`).
 OPS = MODEL_OPS
@@ -118,3 +121,39 @@ def morph_fast(image: np.ndarray, op: str, ksize: tuple[int, int],
 @functools.lru_cache(maxsize=32)
 def _kernel(kw: int, kh: int) -> np.ndarray:
     return np.ones((kh, kw), np.uint8)
+
+
+def morph_stream_reference(beats: Beats, rows: int, cols: int, fmt: PixelFormat, op: str,
+                           ksize: tuple[int, int]) -> tuple[Beats, Reframed]:
+    """The application circuit on a beat stream, damaged or not (``rfl_morph.v``).
+
+    The stream is framed by :func:`~rosfpga_lab.hw.framing.reframe_reference` (a damaged frame
+    is padded or cut to ``rows x cols`` and flagged), each frame is filtered by
+    :func:`morph_reference` and sent as well-formed beats.
+
+    Returns:
+        ``(beats out, framing)``: every completed frame's output beats, and what the framing did.
+    """
+    framed = reframe_reference(beats, rows, cols)
+    out: Fifo[Beat] = Fifo(None, "morph_out")
+    for pixels in framed.frames:
+        src = Mat.from_numpy(unpack_lanes(pixels, fmt.bytes_per_pixel).reshape(rows, cols, -1))
+        dst = Mat(rows, cols, src.channels)
+        morph_reference(src, dst, op, ksize)
+        mat2axivideo_reference(dst, out, fmt)
+    return Beats.from_list(out.drain()), framed
+
+
+def morph_stream_fast(beats: Beats, rows: int, cols: int, fmt: PixelFormat, op: str,
+                      ksize: tuple[int, int]) -> tuple[Beats, Reframed]:
+    """Fast model of :func:`morph_stream_reference` (numpy framing, OpenCV filter)."""
+    framed = reframe_fast(beats, rows, cols)
+    parts = []
+    for pixels in framed.frames:
+        image = unpack_lanes(pixels, fmt.bytes_per_pixel).reshape(rows, cols, -1)
+        parts.append(mat2axivideo_fast(morph_fast(image, op, ksize), fmt))
+    if not parts:
+        return Beats.empty(), framed
+    return Beats(np.concatenate([p.tdata for p in parts]), np.concatenate([p.tkeep for p in parts]),
+                 np.concatenate([p.tuser for p in parts]),
+                 np.concatenate([p.tlast for p in parts])), framed

@@ -90,8 +90,8 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_morph (3x2, 3x3 dilate): output stream rules, TKEEP; all reachable states",
           ("FV_PROVE",)),
     Proof("morph", ("rfl_morph.v",), "bmc", 24,
-          "rfl_morph (3x2, 3x3 dilate): TUSER/TLAST on the output where they belong; "
-          "24 clocks (two 3x2 frames at full rate)"),
+          "rfl_morph (3x2, 3x3 dilate): TUSER/TLAST on the output where they belong, no "
+          "framing flag on a clean stream; 24 clocks (two 3x2 frames at full rate)"),
     Proof("subscriber", ("rfl_subscriber.v",), "prove", 8,
           "rfl_subscriber (any input bytes): pixel stream rules, status codes of the table; "
           "all reachable states"),

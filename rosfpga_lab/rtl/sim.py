@@ -318,6 +318,9 @@ class RtlResult:
         seconds: wall-clock time of the run.
         input_beats, output_beats: the beats into and out of the application, all frames
             (``run(..., beats=True)``; else None).
+        framing: the stages' framing flags at the end (``rfl_top``'s ``framing`` port: bits
+            7..4 fifo2axi's, 3..0 the application's, each in ``hw.framing.FRAMING_FLAGS``
+            order); 0 when every frame came through whole.
     """
 
     output: bytes
@@ -328,6 +331,7 @@ class RtlResult:
     seconds: float
     input_beats: Beats | None = None
     output_beats: Beats | None = None
+    framing: int = 0
 
     @property
     def cut_short(self) -> bool:
@@ -409,17 +413,19 @@ def _read_result(work: Path, log: str, seconds: float) -> RtlResult:
         offset, code = line.split()
         status.append((int(offset), SUBSCRIBER_STATUSES[int(code)][0]))
     streams: dict[str, StreamTiming] = {}
-    cycles = 0
+    cycles = framing = 0
     for line in (work / "stats.txt").read_text().splitlines():
         parts = line.split()
         if parts[0] == "cycles":
             cycles = int(parts[1])
+        elif parts[0] == "framing":
+            framing = int(parts[1])
         else:
             streams[STREAMS[int(parts[0])]] = StreamTiming(*(int(v) for v in parts[1:]))
     beats = [read_beats(work / f"{side}_beats.txt") if (work / f"{side}_beats.txt").exists()
              else None for side in ("input", "output")]
     return RtlResult((work / "output.bin").read_bytes(), tuple(status), streams, cycles, log,
-                     seconds, beats[0], beats[1])
+                     seconds, beats[0], beats[1], framing)
 
 
 def env_required() -> bool:

@@ -7,6 +7,8 @@ Random images go in as beats with random junk in the unused byte lanes and a few
 ``cv2.dilate``/``cv2.erode`` of the image, and the output must keep AXI4-Stream's rule (a
 beat once valid stays valid and unchanged until taken). With no gaps and no backpressure the
 input must flow one pixel per clock and the frame take the cycles rfl_morph.v states.
+A ``damaged`` case damages the frames in turn (hw.framing's rules); the output must equal the
+hw models' beats and the ``framing`` port the flags of the damage done.
 """
 
 from __future__ import annotations
@@ -63,6 +65,60 @@ def _expected(case: dict, img: np.ndarray) -> Beats:
                     np.ones((k, k), np.uint8)).reshape(img.shape)
         assert np.array_equal(out, direct), "hw model differs from cv2"
     return mat2axivideo_fast(out, fmt)
+
+
+def _damaged(case: dict, frames: list[np.ndarray], fmt, prng: random.Random
+             ) -> tuple[list[tuple[int, int, int, int]], list[tuple[int, int, int, int]], int]:
+    """A stream of frames, each but the last damaged in turn (early TLAST, late TLAST, TUSER
+    inside the frame, junk before TUSER: after a whole frame, else it is that frame's pixels);
+    the expected output beats from both hw models of
+    the framing rules (held equal here), and the flags the damage must raise (by hand)."""
+    from rosfpga_lab.hw.framing import EOL_EARLY, EOL_LATE, SOF_EARLY, SOF_MISSING
+    from rosfpga_lab.hw.morph import morph_stream_fast, morph_stream_reference
+    rows, cols = case["height"], case["width"]
+    beats: list[list[int]] = []
+    flags = 0
+    for n, img in enumerate(frames):
+        tdata = pack_lanes(img.reshape(rows * cols, -1))
+        tuser, tlast = _flags(rows, cols)
+        lines = [[[int(tdata[r * cols + c]), fmt.tkeep, int(tuser[r * cols + c]),
+                   int(tlast[r * cols + c])] for c in range(cols)] for r in range(rows)]
+        kind = n % 5 if n < len(frames) - 1 else 0
+        r = prng.randrange(rows)
+        if kind == 1 and cols > 1:                  # early TLAST: a line cut short
+            lines[r] = lines[r][:prng.randint(1, cols - 1)]
+            lines[r][-1][3] = 1
+            lines[r][0][2] = int(r == 0)
+            flags |= EOL_EARLY
+        elif kind == 2:                             # late TLAST: a line too long
+            lines[r][-1][3] = 0
+            lines[r] += [[prng.getrandbits(32), fmt.tkeep, 0, 0]
+                         for _ in range(prng.randint(1, 3))]
+            lines[r][-1][3] = 1
+            flags |= EOL_LATE
+        elif kind == 4 and rows * cols > 1:         # the next TUSER inside this frame
+            keep = prng.randint(1, rows * cols - 1)
+            flat = [b for line in lines for b in line][:keep]
+            lines = [flat]
+            flags |= SOF_EARLY
+        elif kind == 3:                             # junk before the TUSER (after a whole frame)
+            beats += [[prng.getrandbits(32), fmt.tkeep, 0, prng.getrandbits(1)]
+                      for _ in range(prng.randint(1, 4))]
+            flags |= SOF_MISSING
+        beats += [b for line in lines for b in line]
+    stream = Beats(np.array([b[0] for b in beats], np.uint32), np.array([b[1] for b in beats]),
+                   np.array([b[2] for b in beats], bool), np.array([b[3] for b in beats], bool))
+    op, k = OPS[case["op"]], case["ksize"]
+    ksize = (k, k) if op != "copy" else (1, 1)
+    out, framed = morph_stream_fast(stream, rows, cols, fmt, op, ksize)
+    ref, ref_framed = morph_stream_reference(stream, rows, cols, fmt, op, ksize)
+    assert out == ref and ref_framed.flags == framed.flags, "fast and reference models differ"
+    assert framed.flags == flags, f"model flags {framed.flags:#06b}, by hand {flags:#06b}"
+    assert len(framed.frames) == len(frames) and framed.used == len(beats)
+    assert framed.frame_flags[-1] == 0, "the last, clean frame was flagged"
+    expected = [(int(out.tdata[i]), int(out.tkeep[i]), int(out.tuser[i]), int(out.tlast[i]))
+                for i in range(len(out))]
+    return [(b[0], b[1], b[2], b[3]) for b in beats], expected, flags
 
 
 def _flags(rows: int, cols: int) -> tuple[np.ndarray, np.ndarray]:
@@ -131,9 +187,14 @@ async def morph_frames(dut) -> None:
     frames = _frames(case, rng)
     beats_in: list[tuple[int, int, int, int]] = []
     expected: list[tuple[int, int, int, int]] = []
+    want_flags = 0
+    if case.get("damaged"):
+        beats_in, expected, want_flags = _damaged(case, frames, fmt, prng)
+        frames = []
     for img in frames:
         for _ in range(case.get("junk", 0) and prng.randint(0, case["junk"])):
             beats_in.append((prng.getrandbits(32), fmt.tkeep, 0, prng.getrandbits(1)))
+            want_flags = 8      # sof_missing: junk dropped before a TUSER (hw.framing)
         rows, cols = img.shape[:2]
         tdata = pack_lanes(img.reshape(rows * cols, -1))
         tuser, tlast = _flags(rows, cols)
@@ -164,13 +225,16 @@ async def morph_frames(dut) -> None:
         assert int(dut.m_axis_tvalid.value) == 0, "rfl_morph sent more beats than pixels"
         await RisingEdge(dut.aclk)
 
+    flags = int(dut.framing.value)
+    assert flags == want_flags, f"framing flags {flags:#06b}, expected {want_flags:#06b}"
+
     for n, (g, e) in enumerate(zip(got, expected)):
         assert g == e, (f"beat {n} (frame {n // (case['width'] * case['height'])}): "
                         f"got tdata={g[0]:#010x} tkeep={g[1]:#x} tuser={g[2]} tlast={g[3]}, "
                         f"expected tdata={e[0]:#010x} tkeep={e[1]:#x} tuser={e[2]} tlast={e[3]}")
     assert len(got) == len(expected)
 
-    if case["gap"] == 0 and case["bp"] == 0 and not case.get("junk"):
+    if case["gap"] == 0 and case["bp"] == 0 and not case.get("junk") and not case.get("damaged"):
         w, h, k = case["width"], case["height"], case["ksize"] if case["op"] != 2 else 1
         d = k // 2
         pixels = w * h

@@ -1,13 +1,13 @@
 // fv_morph -- rfl_morph on its ports: fed frames whose TUSER/TLAST are where they belong, its
 // output keeps the stream rules, has TUSER on the first pixel of every frame only, TLAST on the
-// last pixel of every line only, and the pixel's lanes in TKEEP.
+// last pixel of every line only, and the pixel's lanes in TKEEP; no framing flag is raised.
 module fv_morph #(parameter WIDTH = 3, parameter HEIGHT = 2, parameter KSIZE = 3,
                   parameter OP = 0, parameter BYTES = 1) (
     input clk, input rst_n, input [31:0] s_tdata, input s_tvalid, input m_tready
 );
     wire s_tready, m_tuser, m_tlast, m_tvalid;
     wire [31:0] m_tdata;
-    wire [3:0] m_tkeep;
+    wire [3:0] m_tkeep, framing;
     reg [7:0] icol, irow, ocol, orow;
     wire s_tuser = (icol == 0 && irow == 0), s_tlast = (icol == WIDTH - 1);
     wire [3:0] s_tkeep = (4'b0001 << BYTES) - 4'b0001;
@@ -16,7 +16,7 @@ module fv_morph #(parameter WIDTH = 3, parameter HEIGHT = 2, parameter KSIZE = 3
         .s_axis_tuser(s_tuser), .s_axis_tlast(s_tlast), .s_axis_tvalid(s_tvalid),
         .s_axis_tready(s_tready), .m_axis_tdata(m_tdata), .m_axis_tkeep(m_tkeep),
         .m_axis_tuser(m_tuser), .m_axis_tlast(m_tlast), .m_axis_tvalid(m_tvalid),
-        .m_axis_tready(m_tready));
+        .m_axis_tready(m_tready), .framing(framing));
 `include "fv_env.vh"
     `FV_SOURCE(s_tvalid, s_tready, s_tdata)
     `FV_SINK(m_tvalid, m_tready, {m_tuser, m_tlast, m_tkeep, m_tdata})
@@ -41,6 +41,7 @@ module fv_morph #(parameter WIDTH = 3, parameter HEIGHT = 2, parameter KSIZE = 3
 `ifndef FV_PROVE   // bounded only: the position counted here is not visible on the ports
         assert(m_tuser == (ocol == 0 && orow == 0));
         assert(m_tlast == (ocol == WIDTH - 1));
+        assert(framing == 4'd0);        // a clean stream is never flagged
 `endif
     end
 endmodule

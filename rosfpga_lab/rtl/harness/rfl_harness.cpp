@@ -251,6 +251,7 @@ int main(int argc, char** argv) {
         fprintf(fstats, "%d %llu %llu %llu\n", i, (unsigned long long)sim.first[i],
                 (unsigned long long)sim.last[i], (unsigned long long)sim.count[i]);
     fprintf(fstats, "cycles %llu\n", (unsigned long long)sim.cycle);
+    fprintf(fstats, "framing %u\n", (unsigned)sim.top->framing);
     for (auto& s : sim.statuses) fprintf(fstatus, "%llu %d\n", (unsigned long long)s.first, s.second);
     if (!sim.out.empty()) fwrite(sim.out.data(), 1, sim.out.size(), fout);
     fclose(fout); fclose(fstatus); fclose(fstats);

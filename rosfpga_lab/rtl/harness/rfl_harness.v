@@ -15,6 +15,7 @@ module rfl_harness (
     output        status_valid,
     output [3:0]  status,
     output        busy,
+    output [7:0]  framing,       // the stages' framing flags (rfl_top)
     output [8:0]  hs,            // handshake per stream (sim.STREAMS order, bit 0 first)
     output [37:0] beat_in,       // {tlast, tuser, tkeep, tdata} into the application
     output [37:0] beat_out       // ... and out of it
@@ -23,7 +24,8 @@ module rfl_harness (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
-        .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy));
+        .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy),
+        .framing(framing));
 
     assign hs = {
         dut.u_top.axis_out_tvalid && dut.u_top.axis_out_tready,

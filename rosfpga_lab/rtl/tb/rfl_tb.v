@@ -21,12 +21,14 @@ module rfl_tb;
     reg m_tready = 1'b0;
     wire frame_start, status_valid, busy;
     wire [3:0] status;
+    wire [7:0] framing;
 
     rfl_node dut (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
-        .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy));
+        .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy),
+        .framing(framing));
 
     always #5 clk = ~clk;
 
@@ -188,6 +190,7 @@ module rfl_tb;
             for (i = 0; i < NS; i = i + 1)
                 $fwrite(fstats, "%0d %0d %0d %0d\n", i, first[i], last[i], count[i]);
             $fwrite(fstats, "cycles %0d\n", cycle);
+            $fwrite(fstats, "framing %0d\n", framing);
             $fclose(fout);
             $fclose(fstatus);
             $fclose(fstats);

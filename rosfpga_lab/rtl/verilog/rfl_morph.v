@@ -20,9 +20,20 @@
 //
 // Handshake: the step pipeline (issue, line-memory read, its register, the column's pairs,
 // shift register, the row's pairs, output register) advances as a whole when the output register is empty or being taken (adv); s_axis_tready is
-// adv while the step needs a pixel. Beats before a tuser beat are dropped (the HLS video
-// library's loop_wait_for_start); inside the frame the circuit counts WIDTH x HEIGHT pixels and
-// does not look at tuser or tlast again.
+// adv while the step needs a pixel.
+//
+// Framing (as Xilinx's AXI4-Stream video IP): every frame the circuit starts comes out whole,
+// WIDTH x HEIGHT beats with TUSER on the first and TLAST at each line end, whatever the input
+// did, so the stages after it keep their byte count; a damaged frame is repaired and flagged
+// and the next clean frame comes out right. The rules, beat by beat (hw.framing models them):
+//   - beats before a TUSER beat are dropped (wait for the start of frame): sof_missing;
+//   - TLAST before the line's last pixel: the rest of the line is zero pixels: eol_early;
+//   - no TLAST on the line's last pixel: the beats after it are dropped up to and with the next
+//     TLAST (a TUSER beat ends the dropping): eol_late;
+//   - TUSER inside a frame: the rest of the frame is zero pixels, and the TUSER beat starts
+//     the next frame: sof_early.
+// framing holds these flags since reset: bit 0 sof_early, 1 eol_early, 2 eol_late,
+// 3 sof_missing (the order of hw.framing.FRAMING_FLAGS).
 `default_nettype none
 
 module rfl_morph #(
@@ -45,7 +56,8 @@ module rfl_morph #(
     output reg         m_axis_tuser,
     output reg         m_axis_tlast,
     output reg         m_axis_tvalid,
-    input  wire        m_axis_tready
+    input  wire        m_axis_tready,
+    output reg  [3:0]  framing      // sticky since reset: sof_missing, eol_late, eol_early, sof_early
 );
 
     localparam K    = (OP == 2) ? 1 : KSIZE;
@@ -61,10 +73,10 @@ module rfl_morph #(
     localparam SW   = (NL > 1) ? $clog2(NL) : 1;
     localparam [W-1:0] ID = (OP == 1) ? {W{1'b1}} : {W{1'b0}};  // identity of max / min
     // the same constants at the widths of the counters they are compared with
-    localparam [31:0] VROWS_32 = VROWS, HEIGHT_32 = HEIGHT, LAST_ROW_32 = HEIGHT - 1,
+    localparam [31:0] LAST_VROW_32 = VROWS - 1, LAST_ROW_32 = HEIGHT - 1,
                       LAST_COL_32 = WIDTH - 1, LEAD_32 = LEAD, LAST_LINE_32 = NL - 1;
-    localparam [RW-1:0] VROWS_R   = VROWS_32[RW-1:0];
-    localparam [RW-1:0] HEIGHT_R  = HEIGHT_32[RW-1:0];
+    localparam [RW-1:0] LAST_VROW = LAST_VROW_32[RW-1:0];
+    localparam [RW-1:0] LAST_IROW = LAST_ROW_32[RW-1:0];
     localparam [OW-1:0] LAST_ROW  = LAST_ROW_32[OW-1:0];
     localparam [CW-1:0] LAST_COL  = LAST_COL_32[CW-1:0];
     localparam [LW-1:0] LEAD_R    = LEAD_32[LW-1:0];
@@ -94,15 +106,29 @@ module rfl_morph #(
     reg [NL-1:0]  mvalid;      // line memory m holds a row of this frame's image
     reg [SW-1:0]  wsel;        // line memory the current scan row is written to
 
+    reg           vact_r;      // vrow < VROWS: the scan is inside the extended image
+    reg           inrow_r;     // vrow < HEIGHT: the scan row takes input pixels
+    reg           padl;        // an early TLAST: the rest of this line is zero pixels
+    reg           padf;        // an early TUSER: the rest of this frame is zero pixels
+    reg           drop;        // no TLAST at the line end: drop beats up to the next TLAST
+
     wire adv     = !m_axis_tvalid || m_axis_tready;
-    wire vact    = (vrow < VROWS_R);
-    wire in_row  = (vrow < HEIGHT_R);
-    wire need_in = !run || (vact && in_row);
-    wire fire    = adv && (run ? (!need_in || s_axis_tvalid) : (s_axis_tvalid && s_axis_tuser));
+    wire vact    = (D > 0) ? vact_r : inrow_r;     // registered: no compare before fire
+    wire in_row  = inrow_r;
+    wire need_in = run && vact && in_row;          // the step takes a pixel of the frame
+    wire sof_in  = s_axis_tvalid && s_axis_tuser;
+    wire dropping = drop && !sof_in;               // a TUSER beat is never dropped here
+    wire pad     = padl || padf || sof_in;         // the step's pixel is zero, no beat taken
+    wire take_px = adv && (run ? (need_in && !pad && !dropping && s_axis_tvalid)
+                               : (sof_in && !dropping));
+    wire fire    = run ? adv && (!need_in || pad || take_px) : take_px;
     wire emit    = (lead == 0);
     wire last_px = emit && (orow == LAST_ROW) && (ocol == LAST_COL);
+    wire         pz  = run && pad;                 // the step's pixel is a zero (padding)
+    wire [W-1:0] pix = pz ? {W{1'b0}} : s_axis_tdata[W-1:0];    // into the line memories
+    wire skip    = s_axis_tvalid && (dropping || (!run && adv && !s_axis_tuser));
 
-    assign s_axis_tready = adv && need_in;
+    assign s_axis_tready = dropping || (run ? adv && need_in && !pad : adv);
 
     // which shift-register entries lie on the output pixel's line (entry j is column ocol+D-j)
     reg [K-1:0] hmask_n;
@@ -117,13 +143,37 @@ module rfl_morph #(
         if (!aresetn) begin
             run <= 1'b0;
             vrow <= 0; vcol <= 0; lead <= LEAD_R; orow <= 0; ocol <= 0;
-            mvalid <= 0; wsel <= 0;
-        end else if (fire) begin
+            mvalid <= 0; wsel <= 0; vact_r <= 1'b1; inrow_r <= 1'b1;
+            padl <= 1'b0; padf <= 1'b0; drop <= 1'b0; framing <= 4'd0;
+        end else begin
+          if (skip) begin                              // a beat dropped
+            if (!dropping) framing[3] <= 1'b1;         // before the start of frame
+            if (dropping && s_axis_tlast) drop <= 1'b0;
+          end
+          if (drop && sof_in) drop <= 1'b0;
+          if (fire && run && need_in && pad && !padl && !padf) begin
+            padf <= 1'b1;                              // TUSER inside the frame
+            framing[0] <= 1'b1;
+          end
+          if (take_px) begin
+            if (s_axis_tlast && vcol != LAST_COL) begin
+                padl <= 1'b1;                          // line too short
+                framing[1] <= 1'b1;
+            end
+            if (!s_axis_tlast && vcol == LAST_COL) begin
+                drop <= 1'b1;                          // line too long
+                framing[2] <= 1'b1;
+            end
+          end
+          if (fire) begin
             run <= 1'b1;
             if (vact) begin
                 if (vcol == LAST_COL) begin
+                    padl <= 1'b0;
                     vcol <= 0;
                     vrow <= vrow + 1'b1;
+                    vact_r <= (vrow != LAST_VROW);
+                    inrow_r <= inrow_r && (vrow != LAST_IROW);
                     mvalid[wsel] <= in_row;
                     wsel <= (wsel == LAST_LINE) ? {SW{1'b0}} : wsel + 1'b1;
                 end else begin
@@ -141,8 +191,10 @@ module rfl_morph #(
             if (last_px) begin       // frame done: back to waiting for the next tuser
                 run <= 1'b0;
                 vrow <= 0; vcol <= 0; lead <= LEAD_R; orow <= 0; ocol <= 0;
-                mvalid <= 0; wsel <= 0;
+                mvalid <= 0; wsel <= 0; vact_r <= 1'b1; inrow_r <= 1'b1;
+                padl <= 1'b0; padf <= 1'b0;
             end
+          end
         end
     end
 
@@ -150,6 +202,7 @@ module rfl_morph #(
     reg           valid1;
     reg [W-1:0]   p1;
     reg           pv1;         // p1 is an image pixel
+    reg           pz1;         // ... and a zero of padding
     reg [NL-1:0]  mv1;         // line memory outputs that are image pixels
     reg           emit1, first1, eol1;
     reg [K-1:0]   hmask1;
@@ -164,7 +217,7 @@ module rfl_morph #(
                 reg [W-1:0] q;
                 always @(posedge aclk) begin
                     if (fire && vact) begin
-                        if (wsel == SEL) mem[vcol] <= s_axis_tdata[W-1:0];
+                        if (wsel == SEL) mem[vcol] <= pix;
                         q <= mem[vcol];          // read-first: the row written KSIZE-1 rows ago
                     end
                 end
@@ -181,6 +234,7 @@ module rfl_morph #(
         end else if (adv) begin
             valid1 <= fire;
             p1     <= s_axis_tdata[W-1:0];
+            pz1    <= pz;
             pv1    <= vact && in_row;
             mv1    <= vact ? mvalid : {NL{1'b0}};
             emit1  <= emit;
@@ -208,7 +262,7 @@ module rfl_morph #(
             eol1r   <= eol1;
             hmask1r <= hmask1;
             vcand   <= {16{ID}};
-            vcand[W-1:0] <= pv1 ? p1 : ID;
+            vcand[W-1:0] <= pv1 ? (pz1 ? {W{1'b0}} : p1) : ID;
             for (i = 0; i < NL; i = i + 1)
                 if (K > 1 && mv1[i]) vcand[(i+1)*W +: W] <= qall[i*W +: W];
         end
@@ -327,8 +381,8 @@ module rfl_morph #(
         end
     end
 
-    // tkeep, tlast and the unused lanes of the input are not needed: the frame is counted
-    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tlast, s_axis_tdata};
+    // tkeep and the unused lanes of the input are not needed
+    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata, pix};   // pix: K == 1 has no lines
 
 endmodule
 

@@ -31,6 +31,7 @@ module rfl_subscriber #(
     input                 s_tvalid,
     output                s_tready,
     output     [7:0]      m_tdata,
+    output reg            m_tuser,              // the frame's first pixel byte (fifo2axi re-syncs)
     output                m_tvalid,
     input                 m_tready,
     output reg            meta_valid,
@@ -191,6 +192,7 @@ module rfl_subscriber #(
             meta_fid_len <= {FIDW{1'b0}};
             status_valid <= 1'b0;
             status <= SUB_OK;
+            m_tuser <= 1'b0;
         end else begin
             status_valid <= 1'b0;
             if (meta_release) meta_valid <= 1'b0;
@@ -284,12 +286,16 @@ module rfl_subscriber #(
                             status_valid <= 1'b1;
                             status <= SUB_OK;
                             meta_valid <= 1'b1;
+                            m_tuser <= 1'b1;
                             advance(S_DATA);
                         end
                     end
-                    S_DATA, S_SKIP: if (last_byte) begin
-                        advance(S_FLEN);
-                        in_frame <= 1'b0;
+                    S_DATA, S_SKIP: begin
+                        m_tuser <= 1'b0;                // the first pixel byte is taken
+                        if (last_byte) begin
+                            advance(S_FLEN);
+                            in_frame <= 1'b0;
+                        end
                     end
                     default: begin
                         advance(S_FLEN);

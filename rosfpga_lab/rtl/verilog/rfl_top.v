@@ -36,7 +36,10 @@ module rfl_top #(
     output       frame_start,                   // the subscriber took a frame's first byte
     output       status_valid,                  // the subscriber decided on a frame
     output [3:0] status,
-    output       busy                           // something is in flight
+    output       busy,                          // something is in flight
+    // framing flags since reset (hw.framing.FRAMING_FLAGS order): fifo2axi's in 7..4,
+    // the application's in 3..0
+    output [7:0] framing
 );
     localparam FIDW = $clog2(FRAME_ID_MAX + 1);
     localparam FIDA = (FRAME_ID_MAX > 1) ? $clog2(FRAME_ID_MAX) : 1;
@@ -53,7 +56,7 @@ module rfl_top #(
 
     // subscriber -> fifo2axi (pixel bytes), subscriber <-> publisher (carried-over fields)
     wire [7:0] pix_in_tdata;
-    wire pix_in_tvalid, pix_in_tready;
+    wire pix_in_tvalid, pix_in_tready, pix_in_tuser;
     wire meta_valid, meta_release, sub_idle, pub_idle;
     wire [31:0] meta_secs, meta_nsecs;
     wire [7:0] meta_bigendian, fid_rdata;
@@ -66,8 +69,8 @@ module rfl_top #(
     ) u_subscriber (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(rx_tdata), .s_tvalid(rx_tvalid), .s_tready(rx_tready),
-        .m_tdata(pix_in_tdata), .m_tvalid(pix_in_tvalid), .m_tready(pix_in_tready),
-        .meta_valid(meta_valid), .meta_release(meta_release), .meta_secs(meta_secs),
+        .m_tdata(pix_in_tdata), .m_tuser(pix_in_tuser), .m_tvalid(pix_in_tvalid),
+        .m_tready(pix_in_tready), .meta_valid(meta_valid), .meta_release(meta_release), .meta_secs(meta_secs),
         .meta_nsecs(meta_nsecs), .meta_bigendian(meta_bigendian), .meta_fid_len(meta_fid_len),
         .fid_raddr(fid_raddr), .fid_rdata(fid_rdata),
         .frame_start(frame_start), .status_valid(status_valid), .status(status),
@@ -79,7 +82,8 @@ module rfl_top #(
     wire axis_in_tuser, axis_in_tlast, axis_in_tvalid, axis_in_tready;
     rfl_fifo2axi #(.WIDTH(WIDTH), .HEIGHT(HEIGHT), .BYTES(BYTES)) u_fifo2axi (
         .clk(clk), .rst_n(rst_n),
-        .s_tdata(pix_in_tdata), .s_tvalid(pix_in_tvalid), .s_tready(pix_in_tready),
+        .s_tdata(pix_in_tdata), .s_tuser(pix_in_tuser), .s_tvalid(pix_in_tvalid),
+        .s_tready(pix_in_tready), .framing(framing[7:4]),
         .m_axis_tdata(axis_in_tdata), .m_axis_tkeep(axis_in_tkeep), .m_axis_tuser(axis_in_tuser),
         .m_axis_tlast(axis_in_tlast), .m_axis_tvalid(axis_in_tvalid),
         .m_axis_tready(axis_in_tready));
@@ -106,7 +110,7 @@ module rfl_top #(
         .s_axis_tlast(app_in_tlast), .s_axis_tvalid(app_in_tvalid), .s_axis_tready(app_in_tready),
         .m_axis_tdata(app_out_tdata), .m_axis_tkeep(app_out_tkeep), .m_axis_tuser(app_out_tuser),
         .m_axis_tlast(app_out_tlast), .m_axis_tvalid(app_out_tvalid),
-        .m_axis_tready(app_out_tready));
+        .m_axis_tready(app_out_tready), .framing(framing[3:0]));
 
     wire [31:0] axis_out_tdata;
     wire [3:0] axis_out_tkeep;
