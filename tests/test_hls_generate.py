@@ -175,7 +175,7 @@ def test_cli_generate_and_sloc(tmp_path: Path) -> None:
            "-o", str(out)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
-    assert "rendering templates" in proc.stderr and "writing 28 files" in proc.stderr  # 16 HLS + 12 RTL (rtl/: + the fast harness)
+    assert "rendering templates" in proc.stderr and "writing 29 files" in proc.stderr  # 16 HLS + 13 RTL (rtl/: + the fast harness, rfl_slice.v)
     assert f"make -C {out} csim" in proc.stdout
     again = subprocess.run(cmd, capture_output=True, text=True)
     assert again.returncode == 1 and "--force" in again.stderr
@@ -183,7 +183,7 @@ def test_cli_generate_and_sloc(tmp_path: Path) -> None:
     assert forced.returncode == 0 and forced.stdout == "" and forced.stderr == ""
     loud = subprocess.run(cmd + ["--force"], capture_output=True, text=True)
     assert loud.returncode == 0
-    assert loud.stderr.index("removed 29 files") < loud.stderr.index("writing 28 files")
+    assert loud.stderr.index("removed 30 files") < loud.stderr.index("writing 29 files")
     unwritable = subprocess.run(cmd[:-1] + [str(out / "Makefile" / "below")], capture_output=True,
                                 text=True)
     assert unwritable.returncode == 1 and "Traceback" not in unwritable.stderr

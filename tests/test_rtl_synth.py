@@ -46,8 +46,12 @@ def test_every_module_is_counted_and_the_rows_add_up_to_yosys_totals(dilate_repo
 
 def test_resource_counts_keep_their_order_of_magnitude(dilate_report) -> None:
     morph = dilate_report.row("rfl_morph").counts
-    # two line buffers of 640 x 32 bits: one 36 Kb block RAM each, no LUTs as memory
-    assert morph["RAMB36"] * 2 + morph["RAMB18"] == 4 and morph["LUTRAM"] == 0
+    cells = dilate_report.row("rfl_morph").cells
+    # two line buffers of 640 x 32 bits: one 36 Kb block RAM each, no LUTs as memory; the
+    # LUTRAM column holds only shift registers (SRLs: flags through the pipeline registers)
+    assert morph["RAMB36"] * 2 + morph["RAMB18"] == 4
+    assert all(c.startswith(("SRL", "SRLC")) for c in cells if c in RESOURCES["LUTRAM"])
+    assert morph["LUTRAM"] <= 40
     assert 100 <= morph["LUT"] <= 2000 and 100 <= morph["FF"] <= 1000
     assert dilate_report.total["DSP"] == 0               # nothing multiplies
     for row in dilate_report.rows:
@@ -73,8 +77,9 @@ def test_make_synth_prints_the_table(tmp_path: Path) -> None:
     morph = next(line for line in lines if line.startswith("application"))
     values = [int(v) for v in morph.split()[-len(COLUMNS) - 1:]]
     counts = dict(zip(COLUMNS, values[1:]))
-    # passthrough: no window, no line buffer
-    assert counts["RAMB36"] == counts["RAMB18"] == counts["LUTRAM"] == 0
+    # passthrough: no window, no line buffer (LUTRAM: at most the SRLs that carry the pixel
+    # through the pipeline registers, 1 per data bit and flag)
+    assert counts["RAMB36"] == counts["RAMB18"] == 0 and counts["LUTRAM"] <= 40
     assert counts["LUT"] < 100
     assert any(line.startswith("total") for line in lines)
     assert f"{config.part} (synth_xilinx -family xc7)" in done.stdout

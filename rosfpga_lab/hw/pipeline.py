@@ -30,10 +30,10 @@ from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference
 from rosfpga_lab.hw.cycles import CycleReport, account
 from rosfpga_lab.hw.encodings import PIXEL_FORMATS, pixel_format
-from rosfpga_lab.hw.errors import PipelineConfigError, PipelineError
+from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, PipelineConfigError, PipelineError
 from rosfpga_lab.hw.faults import BeatFault, ByteFault, Fault, ShallowFifo
 from rosfpga_lab.hw.generator import frame_length, generate_fast, generate_reference
-from rosfpga_lab.hw.interpreter import ImageFields, Interpreter, interpret_fast
+from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES, ImageFields, Interpreter, interpret_fast
 from rosfpga_lab.hw.morph import check_op, morph_fast, morph_reference
 from rosfpga_lab.hw.rx import check_rx, receive_fast_check, receive_reference
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
@@ -52,6 +52,39 @@ def wire_bytes(payload: int, mtu: int = limits.ETHERNET_MTU) -> int:
     segments = -(-payload // per_segment)
     return payload + segments * (limits.TCP_IP_HEADER_BYTES + limits.ETHERNET_FRAMING_BYTES)
 SEQ_MODES = ("count", "carry")
+
+
+#: A refused field's label (``FrameFieldError.field``) -> the subscriber's status name.
+_STATUS_OF_LABEL = {label: name for name, label in SUBSCRIBER_STATUSES[1:]}
+
+
+def _circuit_status(exc: FrameFieldError) -> str:
+    """The subscriber circuit's status for a refused field.
+
+    The models name the frame length where it disagrees with the message (data length not
+    ending at the frame's end); the circuit finds that as it checks the data length.
+    """
+    if isinstance(exc, FrameLengthError) and exc.field == "frame length" \
+            and exc.rule == FrameLengthError.default_rule:
+        return _STATUS_OF_LABEL["data length"]
+    if exc.field not in _STATUS_OF_LABEL:
+        raise exc
+    return _STATUS_OF_LABEL[exc.field]
+
+
+@dataclass(frozen=True)
+class StreamResult:
+    """What :meth:`Pipeline.process_stream` made of a byte stream.
+
+    Attributes:
+        output: the bytes the publisher sent.
+        status: per frame the circuit read, its byte offset and the subscriber's status name.
+        unread: bytes at the end left unread (a frame cut short).
+    """
+
+    output: bytes
+    status: tuple[tuple[int, str], ...]
+    unread: int
 
 
 @dataclass
@@ -286,6 +319,41 @@ class Pipeline:
             raise
         self.frames_out += 1
         return result
+
+    def process_stream(self, data: bytes) -> StreamResult:
+        """Run a continuous byte stream of TCPROS frames through, as the circuit reads it.
+
+        The subscriber circuit (HLS and Verilog) reads a frame length; one above
+        ``hw.limits.MAX_FRAME_BYTES`` cannot be trusted for skipping, so it takes only those 4
+        bytes and reads the next 4 as a new frame length; any other frame (a short one too) is
+        read or skipped to its end. A frame cut short by the end of ``data`` is left unread.
+
+        Returns:
+            The bytes sent, the subscriber's status per frame (byte offset, name as in
+            :data:`~rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES`) and the bytes left unread.
+
+        Raises:
+            PipelineError: an error other than a refused field (a fault, a FIFO overflow).
+        """
+        out = bytearray()
+        status: list[tuple[int, str]] = []
+        offset, n = 0, len(data)
+        while offset + 4 <= n:
+            length = int.from_bytes(data[offset:offset + 4], "little")
+            if length > limits.MAX_FRAME_BYTES:
+                status.append((offset, _STATUS_OF_LABEL["frame length"]))
+                self.errors += 1
+                offset += 4
+                continue
+            if 4 + length > n - offset:
+                break
+            try:
+                out += self.process(data[offset:offset + 4 + length]).output_frame
+                status.append((offset, SUBSCRIBER_STATUSES[0][0]))
+            except FrameFieldError as exc:
+                status.append((offset, _circuit_status(exc)))
+            offset += 4 + length
+        return StreamResult(bytes(out), tuple(status), n - offset)
 
     # -- helpers shared by both models --------------------------------------------------------
     def _faults(self, tap: str) -> list[Fault]:

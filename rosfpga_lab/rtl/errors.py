@@ -19,3 +19,7 @@ class VcdError(RtlError):
 
 class SynthError(RtlError):
     """Synthesis could not run (no Yosys) or Yosys refused the RTL (the message quotes it)."""
+
+
+class TimingError(RtlError):
+    """Place and route could not run (no Yosys or nextpnr) or failed (the message quotes it)."""

@@ -29,3 +29,12 @@ FORMAL_TIMEOUT = 600.0
 
 #: Largest request to the long-lived simulator of ``--model rtl`` (bytes).
 MAX_SERVE_FRAME = 64 << 20
+
+#: Seconds allowed for one place and route (nextpnr).
+PNR_TIMEOUT = 1800.0
+#: The open FPGA ``rtl timing`` places and routes for: nextpnr-ecp5's device and package
+#: (a Lattice ECP5 LFE5U-25F in a 256-ball BGA: 24k LUTs, 56 block RAMs, 197 I/Os).
+ECP5_DEVICE = "25k"
+ECP5_PACKAGE = "CABGA256"
+#: Longest critical path kept in a timing report (steps).
+MAX_PATH_STEPS = 400

@@ -44,6 +44,7 @@ MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_axi2fifo", "axi2fifo"),
     ("rfl_publisher", "publisher"),
     ("rfl_fifo", "FIFOs (rfl_fifo)"),
+    ("rfl_slice", "register slice"),
     ("rfl_top", "top level (glue)"),
 )
 #: The module synthesized: rfl_top with the node's parameters.

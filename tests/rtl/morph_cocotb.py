@@ -178,7 +178,7 @@ async def morph_frames(dut) -> None:
         assert first == list(range(first[0], first[0] + pixels)), "input not one pixel per clock"
         outs = out_log[:pixels]
         lead = outs[0] - first[0]
-        assert lead == d * w + d + 3, f"first output {lead} clocks after the first input"
+        assert lead == d * w + d + 6, f"first output {lead} clocks after the first input"
         assert outs == list(range(outs[0], outs[0] + pixels)), "output not one pixel per clock"
         # the next frame's first pixel is taken the clock after the last step of this one
         second = in_log[pixels] - first[0]

@@ -144,14 +144,15 @@ module rfl_tb;
         end
         rnd = xorshift(rnd);
         m_tready <= ((rnd % 1000) >= bp);
-        // the subscriber's frames
-        if (frame_start) frame_off = sub_bytes;
-        if (dut.u_top.rx_tvalid && dut.u_top.rx_tready) sub_bytes = sub_bytes + 1;
+        // the subscriber's frames (a status comes a clock after its frame's deciding byte, when
+        // the next frame may already start: write it before frame_off moves on)
         if (status_valid) begin
             $fwrite(fstatus, "%0d %0d\n", frame_off, status);
             frames = frames + 1;
             if (status != 0) refused = refused + 1;
         end
+        if (frame_start) frame_off = sub_bytes;
+        if (dut.u_top.rx_tvalid && dut.u_top.rx_tready) sub_bytes = sub_bytes + 1;
         // fifo2axi's ports at every clock from its first byte offered (+clocks_f2a): s_tvalid
         // s_tready s_tdata m_axis_tvalid m_axis_tready m_axis_tdata m_axis_tuser m_axis_tlast
         if (ff2a != 0 && dut.u_top.pix_in_tvalid) f2a_on = 1'b1;

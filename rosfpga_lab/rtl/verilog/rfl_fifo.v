@@ -1,10 +1,14 @@
 // rfl_fifo -- a synchronous first-word-fall-through FIFO of DEPTH entries, valid/ready on both
-// sides. DEPTH-1 entries live in a RAM with a registered read (block or distributed RAM after
-// synthesis); the last one is the output register that m_tdata shows. A word written into an
-// empty FIFO appears at the output two clocks later.
+// sides. The entries live in a RAM with a registered read (block or distributed RAM after
+// synthesis) and in the output register that m_tdata shows: DEPTH-1 in the RAM and a word
+// written into an empty FIFO appears at the output two clocks later. With OUTREG = 1 the RAM's
+// read register is followed by one more register in the fabric, so that what reads m_tdata
+// does not start from a block RAM's slow clock-to-output (100 MHz timing on an ECP5): DEPTH-2
+// entries in the RAM, and three clocks from an empty FIFO's input to its output.
 module rfl_fifo #(
     parameter WIDTH = 8,
-    parameter DEPTH = 16,                       // entries, at least 2
+    parameter DEPTH = 16,                       // entries, at least 2 (3 with OUTREG)
+    parameter OUTREG = 0,                       // 1: register the RAM's output once more
     parameter LEVEL_BITS = $clog2(DEPTH + 1)
 ) (
     input                       clk,
@@ -17,43 +21,78 @@ module rfl_fifo #(
     input                       m_tready,
     output     [LEVEL_BITS-1:0] level
 );
-    localparam MEMD = DEPTH - 1;
+    localparam MEMD = DEPTH - 1 - OUTREG;       // entries in the RAM
     localparam AW = (MEMD > 1) ? $clog2(MEMD) : 1;
-    localparam [AW-1:0] LAST = MEMD - 1;        // the RAM's last address
+    localparam [31:0] LAST_32 = MEMD - 1;
+    localparam [AW-1:0] LAST = LAST_32[AW-1:0];  // the RAM's last address
+    localparam [31:0] MEMD_32 = MEMD;
+    localparam [LEVEL_BITS-1:0] FULL = MEMD_32[LEVEL_BITS-1:0];
 
     reg [WIDTH-1:0] mem [0:MEMD-1];
     reg [AW-1:0] wptr, rptr;
     reg [LEVEL_BITS-1:0] cnt;                   // entries in the RAM
-    reg [WIDTH-1:0] dout;
-    reg dvalid;
+    reg [WIDTH-1:0] q;                          // the RAM's read register
+    reg qvalid;
+    wire [WIDTH-1:0] dout;
+    wire dvalid;
 
     wire wr = s_tvalid && s_tready;
     wire pop = dvalid && m_tready;
-    wire load = (cnt != 0) && (!dvalid || pop);
+    wire load;                                  // RAM -> q
 
-    assign s_tready = (cnt != MEMD);
+    assign s_tready = (cnt != FULL);
     assign m_tdata = dout;
     assign m_tvalid = dvalid;
-    assign level = cnt + {{(LEVEL_BITS-1){1'b0}}, dvalid};
 
     always @(posedge clk) begin
         if (wr) mem[wptr] <= s_tdata;
-        if (load) dout <= mem[rptr];
+        if (load) q <= mem[rptr];
     end
+
+    generate
+        if (OUTREG != 0) begin : outreg
+            reg [WIDTH-1:0] r;
+            reg rvalid;
+            wire move = qvalid && (!rvalid || pop);   // q -> r
+            assign load = (cnt != 0) && (!qvalid || move);
+            assign dout = r;
+            assign dvalid = rvalid;
+            assign level = cnt + {{(LEVEL_BITS-1){1'b0}}, qvalid}
+                           + {{(LEVEL_BITS-1){1'b0}}, rvalid};
+            always @(posedge clk) begin
+                if (move) r <= q;
+                if (!rst_n) rvalid <= 1'b0;
+                else if (move) rvalid <= 1'b1;
+                else if (pop) rvalid <= 1'b0;
+            end
+            always @(posedge clk) begin
+                if (!rst_n) qvalid <= 1'b0;
+                else if (load) qvalid <= 1'b1;
+                else if (move) qvalid <= 1'b0;
+            end
+        end else begin : direct
+            assign load = (cnt != 0) && (!qvalid || pop);
+            assign dout = q;
+            assign dvalid = qvalid;
+            assign level = cnt + {{(LEVEL_BITS-1){1'b0}}, qvalid};
+            always @(posedge clk) begin
+                if (!rst_n) qvalid <= 1'b0;
+                else if (load) qvalid <= 1'b1;
+                else if (pop) qvalid <= 1'b0;
+            end
+        end
+    endgenerate
 
     always @(posedge clk) begin
         if (!rst_n) begin
             wptr <= 0;
             rptr <= 0;
             cnt <= 0;
-            dvalid <= 1'b0;
         end else begin
             if (wr) wptr <= (wptr == LAST) ? {AW{1'b0}} : wptr + 1'b1;
             if (load) rptr <= (rptr == LAST) ? {AW{1'b0}} : rptr + 1'b1;
             if (wr && !load) cnt <= cnt + 1'b1;
             else if (load && !wr) cnt <= cnt - 1'b1;
-            if (load) dvalid <= 1'b1;
-            else if (pop) dvalid <= 1'b0;
         end
     end
 endmodule

@@ -19,12 +19,14 @@ module rfl_fifo2axi #(
     output reg        m_axis_tvalid,
     input             m_axis_tready
 );
-    reg [31:0] acc;                             // the bytes of the pixel so far (lanes 0..BYTES-2)
+    localparam [31:0] K_LAST_32 = BYTES - 1;
+    localparam [1:0] K_LAST = K_LAST_32[1:0];
+    reg [23:0] acc;                             // the pixel's bytes so far, shifted in from the top
     reg [1:0]  k;                               // the lane the next byte goes to
     reg [15:0] x, y;                            // the pixel the next beat carries
 
     wire out_free = !m_axis_tvalid || m_axis_tready;
-    wire last_byte = (k == BYTES - 1);
+    wire last_byte = (k == K_LAST);
     wire take = s_tvalid && s_tready;
 
     assign s_tready = !last_byte || out_free;
@@ -32,7 +34,7 @@ module rfl_fifo2axi #(
 
     always @(posedge clk) begin
         if (!rst_n) begin
-            acc <= 32'd0;
+            acc <= 24'd0;
             k <= 2'd0;
             x <= 16'd0;
             y <= 16'd0;
@@ -44,7 +46,7 @@ module rfl_fifo2axi #(
             if (m_axis_tvalid && m_axis_tready) m_axis_tvalid <= 1'b0;
             if (take) begin
                 if (last_byte) begin
-                    m_axis_tdata <= acc | ({24'd0, s_tdata} << (8 * (BYTES - 1)));
+                    m_axis_tdata <= {s_tdata, acc} >> (8 * (4 - BYTES));
                     m_axis_tuser <= (x == 0) && (y == 0);
                     m_axis_tlast <= (x == WIDTH - 1);
                     m_axis_tvalid <= 1'b1;
@@ -56,7 +58,7 @@ module rfl_fifo2axi #(
                         x <= x + 16'd1;
                     end
                 end else begin
-                    acc[8 * k +: 8] <= s_tdata;
+                    acc <= {s_tdata, acc[23:8]};
                     k <= k + 2'd1;
                 end
             end

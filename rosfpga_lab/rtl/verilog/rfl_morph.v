@@ -15,11 +15,11 @@
 // columns behind the scan takes the extreme of the entries that lie on its own line. The
 // window's right part of the last pixel needs D more steps without input (the flush). A frame
 // is (HEIGHT + D) * WIDTH + D steps; the first output leaves D * WIDTH + D steps after the first
-// input, plus the three pipeline registers. No input is taken during the flush, so the next
+// input, plus the six pipeline registers. No input is taken during the flush, so the next
 // frame's first pixel goes in (HEIGHT + D) * WIDTH + D clocks after this frame's first one.
 //
-// Handshake: the step pipeline (issue, line-memory read, shift register, output register)
-// advances as a whole when the output register is empty or being taken (adv); s_axis_tready is
+// Handshake: the step pipeline (issue, line-memory read, its register, the column's pairs,
+// shift register, the row's pairs, output register) advances as a whole when the output register is empty or being taken (adv); s_axis_tready is
 // adv while the step needs a pixel. Beats before a tuser beat are dropped (the HLS video
 // library's loop_wait_for_start); inside the frame the circuit counts WIDTH x HEIGHT pixels and
 // does not look at tuser or tlast again.
@@ -190,14 +190,67 @@ module rfl_morph #(
         end
     end
 
-    // vertical extreme of the column over the image rows of the window
-    reg [W-1:0] vext;
+    // ---- stage 1r: the line memories' outputs registered (a block RAM's clock-to-output is
+    // slow; the window's extremes start from flip-flops), those outside the image replaced by
+    // the identity of the extreme on the way ----------------------------------------------------
+    reg           valid1r, emit1r, first1r, eol1r;
+    reg [K-1:0]   hmask1r;
+    reg [16*W-1:0] vcand;      // candidates of the vertical extreme: the pixel, then the lines
+
     integer i;
-    always @* begin
-        vext = pv1 ? p1 : ID;
-        for (i = 0; i < NL; i = i + 1)
-            if (mv1[i]) vext = pick(vext, qall[i*W +: W]);
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            valid1r <= 1'b0;
+        end else if (adv) begin
+            valid1r <= valid1;
+            emit1r  <= emit1;
+            first1r <= first1;
+            eol1r   <= eol1;
+            hmask1r <= hmask1;
+            vcand   <= {16{ID}};
+            vcand[W-1:0] <= pv1 ? p1 : ID;
+            for (i = 0; i < NL; i = i + 1)
+                if (K > 1 && mv1[i]) vcand[(i+1)*W +: W] <= qall[i*W +: W];
+        end
     end
+
+    // The extreme of up to N candidates (those not taken are the identity ID), as a balanced
+    // tree of pick: ceil(log2 N) comparisons deep, not N - 1.
+    function [W-1:0] tree(input [15*W-1:0] c, input integer n);
+        reg [15*W-1:0] t;
+        integer st, a;
+        begin
+            t = c;
+            for (st = 1; st < 16; st = st * 2)
+                for (a = 0; a + st < 16; a = a + 2 * st)
+                    if (a + st < n) t[a*W +: W] = pick(t[a*W +: W], t[(a+st)*W +: W]);
+            tree = t[W-1:0];
+        end
+    endfunction
+
+    // ---- stage 1v: the vertical candidates paired (the tree's first level) and registered ----
+    localparam VP = (NL + 2) / 2;              // pairs of the NL + 1 candidates
+    reg           valid1v, emit1v, first1v, eol1v;
+    reg [K-1:0]   hmask1v;
+    reg [15*W-1:0] vpair;
+    integer v;
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            valid1v <= 1'b0;
+        end else if (adv) begin
+            valid1v <= valid1r;
+            emit1v  <= emit1r;
+            first1v <= first1r;
+            eol1v   <= eol1r;
+            hmask1v <= hmask1r;
+            vpair   <= {15{ID}};
+            for (v = 0; v < VP; v = v + 1)
+                vpair[v*W +: W] <= pick(vcand[2*v*W +: W], vcand[(2*v+1)*W +: W]);
+        end
+    end
+
+    // vertical extreme of the column over the image rows of the window
+    wire [W-1:0] vext = tree(vpair, VP);
 
     // ---- stage 2: horizontal shift register of vertical extremes -----------------------------
     reg           valid2, emit2, first2, eol2;
@@ -208,29 +261,53 @@ module rfl_morph #(
         if (!aresetn) begin
             valid2 <= 1'b0;
         end else if (adv) begin
-            valid2 <= valid1;
-            emit2  <= emit1;
-            first2 <= first1;
-            eol2   <= eol1;
-            hmask2 <= hmask1;
+            valid2 <= valid1v;
+            emit2  <= emit1v;
+            first2 <= first1v;
+            eol2   <= eol1v;
+            hmask2 <= hmask1v;
         end
     end
 
     generate
         if (K > 1) begin : shift
-            always @(posedge aclk) if (adv && valid1) sr <= {sr[K*W-W-1:0], vext};
+            always @(posedge aclk) if (adv && valid1v) sr <= {sr[K*W-W-1:0], vext};
         end else begin : noshift
-            always @(posedge aclk) if (adv && valid1) sr <= vext;
+            always @(posedge aclk) if (adv && valid1v) sr <= vext;
         end
     endgenerate
 
-    reg [W-1:0] hext;
+    // the entries on the output pixel's line (else the identity), paired: the first level of
+    // the horizontal tree
+    localparam HP = (K + 1) / 2;
+    reg [16*W-1:0] hcand;
+    reg [8*W-1:0]  hpair;
     integer h;
     always @* begin
-        hext = ID;
+        hcand = {16{ID}};
         for (h = 0; h < K; h = h + 1)
-            if (hmask2[h]) hext = pick(hext, sr[h*W +: W]);
+            if (hmask2[h]) hcand[h*W +: W] = sr[h*W +: W];
+        hpair = {8{ID}};
+        for (h = 0; h < HP; h = h + 1)
+            hpair[h*W +: W] = pick(hcand[2*h*W +: W], hcand[(2*h+1)*W +: W]);
     end
+
+    // ---- stage 2b: the pairs registered; the rest of the tree after them --------------------
+    reg           valid2b, emit2b, first2b, eol2b;
+    reg [8*W-1:0] hpair2b;
+    always @(posedge aclk) begin
+        if (!aresetn) begin
+            valid2b <= 1'b0;
+        end else if (adv) begin
+            valid2b <= valid2;
+            emit2b  <= emit2;
+            first2b <= first2;
+            eol2b   <= eol2;
+            hpair2b <= hpair;
+        end
+    end
+    wire [15*W-1:0] hpair_wide = {{(7*W){1'b0}}, hpair2b};
+    wire [W-1:0] hext = tree(hpair_wide, HP);
 
     // ---- stage 3: output register ------------------------------------------------------------
     assign m_axis_tkeep = KEEP;
@@ -242,11 +319,11 @@ module rfl_morph #(
             m_axis_tuser  <= 1'b0;
             m_axis_tlast  <= 1'b0;
         end else if (adv) begin
-            m_axis_tvalid <= valid2 && emit2;
+            m_axis_tvalid <= valid2b && emit2b;
             m_axis_tdata  <= 32'd0;
             m_axis_tdata[W-1:0] <= hext;
-            m_axis_tuser  <= first2;
-            m_axis_tlast  <= eol2;
+            m_axis_tuser  <= first2b;
+            m_axis_tlast  <= eol2b;
         end
     end
 

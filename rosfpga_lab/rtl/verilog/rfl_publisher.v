@@ -3,7 +3,10 @@
 // the frame length first (computed from sizes the circuit knows), then every field in wire
 // order: header.seq (counting from SEQ_START, as a rospy publisher does), the stamp and
 // frame_id carried over from the subscriber, the image's fixed fields, and the pixel bytes
-// from axi2fifo last, passed straight through.
+// from axi2fifo last, passed straight through. Timing: each field's last byte index is set as
+// the field starts (no subtraction on the way to the handshake), the byte counter has the
+// width of the longest field, and frame_id comes from the subscriber's RAM one clock after its
+// address (fid_raddr is the byte the next clock shows).
 module rfl_publisher #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,
@@ -13,7 +16,8 @@ module rfl_publisher #(
     parameter FRAME_ID_MAX = 256,
     parameter MIN_BODY = 37,
     parameter [31:0] SEQ_START = 1,
-    parameter FIDW = $clog2(FRAME_ID_MAX + 1)
+    parameter FIDW = $clog2(FRAME_ID_MAX + 1),
+    parameter FIDA = (FRAME_ID_MAX > 1) ? $clog2(FRAME_ID_MAX) : 1
 ) (
     input                 clk,
     input                 rst_n,
@@ -29,7 +33,7 @@ module rfl_publisher #(
     input      [31:0]     meta_nsecs,
     input      [7:0]      meta_bigendian,
     input      [FIDW-1:0] meta_fid_len,
-    output     [FIDW-1:0] fid_raddr,
+    output     [FIDA-1:0] fid_raddr,
     input      [7:0]      fid_rdata,
     output                frame_done,
     output                idle                  // no frame being written
@@ -37,22 +41,54 @@ module rfl_publisher #(
     localparam [31:0] STEP = WIDTH * BYTES;
     localparam [31:0] DATA_BYTES = WIDTH * HEIGHT * BYTES;
     localparam [31:0] BODY = MIN_BODY + ENC_LEN + DATA_BYTES;  // all but frame_id
+    // the byte counter holds the last index of the longest field
+    localparam LONGEST = (DATA_BYTES > FRAME_ID_MAX) ? DATA_BYTES : FRAME_ID_MAX;
+    localparam IW = $clog2(LONGEST + 1);
+    localparam [31:0] DATA_LAST_32 = DATA_BYTES - 1, ENC_LAST_32 = ENC_LEN - 1;
+    localparam [IW-1:0] DATA_LAST = DATA_LAST_32[IW-1:0];
+    localparam [IW-1:0] ENC_LAST = ENC_LAST_32[IW-1:0];
+    localparam [IW-1:0] U32_LAST = 3;
+    localparam [FIDA-1:0] FID_ONE = 1;
 
     localparam [3:0] F_IDLE = 4'd0, F_LEN = 4'd1, F_SEQ = 4'd2, F_SECS = 4'd3, F_NSECS = 4'd4,
                      F_FIDLEN = 4'd5, F_FID = 4'd6, F_HEIGHT = 4'd7, F_WIDTH = 4'd8,
                      F_ENCLEN = 4'd9, F_ENC = 4'd10, F_BIG = 4'd11, F_STEP = 4'd12,
                      F_DLEN = 4'd13, F_DATA = 4'd14;
 
-    reg [3:0]  f;                               // the field being written
-    reg [31:0] i;                               // its byte being written
-    reg [31:0] seq;
-    reg [31:0] word;                            // the field's value, for uint32 fields
-    reg [31:0] flen;                            // the field's length in bytes
+    reg [3:0]    f;                             // the field being written
+    reg [IW-1:0] i;                             // its byte being written
+    reg [IW-1:0] ilast;                         // its last byte's index
+    reg          in_fid;                        // f is F_FID
+    reg [FIDA-1:0] fa, fa1;                     // frame_id byte shown, and the next one
+    reg [31:0]   seq;
+    reg [31:0]   word;                          // the field's value, for uint32 fields
+    reg [3:0]    fnext;                         // the field after this one
 
     wire [31:0] fid_len = {{(32-FIDW){1'b0}}, meta_fid_len};
-    wire [31:0] enc_index = ENC_LEN - 1 - i;
-    wire [8*32-1:0] enc_shifted = ENCODING >> (8 * enc_index);
-    wire [7:0]  enc_byte = enc_shifted[7:0];
+    wire [IW-1:0] fid_last = fid_len[IW-1:0] - 1'b1;
+
+    // the encoding's byte at position n
+    function [7:0] enc_at(input [IW-1:0] n);
+        integer b;
+        begin
+            enc_at = 8'd0;
+            for (b = 0; b < ENC_LEN; b = b + 1)
+                if (n == b[IW-1:0]) enc_at = ENCODING[8 * (ENC_LEN - 1 - b) +: 8];
+        end
+    endfunction
+
+    // the last byte index of field `g`
+    function [IW-1:0] last_of(input [3:0] g);
+        begin
+            case (g)
+                F_FID:   last_of = fid_last;
+                F_ENC:   last_of = ENC_LAST;
+                F_BIG:   last_of = {IW{1'b0}};
+                F_DATA:  last_of = DATA_LAST;
+                default: last_of = U32_LAST;
+            endcase
+        end
+    endfunction
 
     always @* begin
         case (f)
@@ -69,26 +105,24 @@ module rfl_publisher #(
             default:  word = 32'd0;
         endcase
         case (f)
-            F_FID:   flen = fid_len;
-            F_ENC:   flen = ENC_LEN;
-            F_BIG:   flen = 32'd1;
-            F_DATA:  flen = DATA_BYTES;
-            default: flen = 32'd4;
-        endcase
-        case (f)
             F_FID:   m_tdata = fid_rdata;
-            F_ENC:   m_tdata = enc_byte;
+            F_ENC:   m_tdata = enc_at(i);
             F_BIG:   m_tdata = meta_bigendian;
             F_DATA:  m_tdata = s_tdata;
             default: m_tdata = word[8 * i[1:0] +: 8];
         endcase
+        if (f == F_FIDLEN) fnext = (fid_len == 0) ? F_HEIGHT : F_FID;
+        else if (f == F_DATA) fnext = F_IDLE;
+        else fnext = f + 4'd1;
     end
 
     assign m_tvalid = (f != F_IDLE) && (f != F_DATA || s_tvalid);
     assign s_tready = (f == F_DATA) && m_tready;
-    assign fid_raddr = i[FIDW-1:0];
     wire put = m_tvalid && m_tready;
-    wire field_done = put && (i == flen - 1);
+    wire field_done = put && (i == ilast);
+    wire [IW-1:0] i_next = i + 1'b1;
+    // in F_FID m_tvalid is 1, so a byte goes when m_tready is 1: one LUT from registers
+    assign fid_raddr = (in_fid && m_tready) ? fa1 : fa;
     assign meta_release = field_done && (f == F_BIG);  // the last field taken from the subscriber
     assign frame_done = field_done && (f == F_DATA);
     assign idle = (f == F_IDLE);
@@ -96,22 +130,35 @@ module rfl_publisher #(
     always @(posedge clk) begin
         if (!rst_n) begin
             f <= F_IDLE;
-            i <= 32'd0;
+            i <= {IW{1'b0}};
+            ilast <= U32_LAST;
+            in_fid <= 1'b0;
+            fa <= {FIDA{1'b0}};
+            fa1 <= FID_ONE;
             seq <= SEQ_START;
         end else if (f == F_IDLE) begin
-            if (meta_valid) f <= F_LEN;
+            if (meta_valid) begin
+                f <= F_LEN;
+                fa <= {FIDA{1'b0}};
+                fa1 <= FID_ONE;
+                ilast <= U32_LAST;
+            end
         end else if (field_done) begin
-            i <= 32'd0;
-            case (f)
-                F_FIDLEN: f <= (fid_len == 0) ? F_HEIGHT : F_FID;
-                F_DATA: begin
-                    f <= F_IDLE;
-                    seq <= seq + 32'd1;
-                end
-                default: f <= f + 4'd1;
-            endcase
+            if (in_fid) begin
+                fa <= fa1;
+                fa1 <= fa1 + 1'b1;
+            end
+            i <= {IW{1'b0}};
+            in_fid <= (fnext == F_FID);
+            f <= fnext;
+            ilast <= last_of(fnext);
+            if (f == F_DATA) seq <= seq + 32'd1;
         end else if (put) begin
-            i <= i + 32'd1;
+            i <= i_next;
+            if (in_fid) begin
+                fa <= fa1;
+                fa1 <= fa1 + 1'b1;
+            end
         end
     end
 endmodule

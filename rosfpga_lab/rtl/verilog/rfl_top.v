@@ -2,7 +2,7 @@
 // conventional design:
 //
 //   s_* (8-bit, from TCP/IP) -> [rx FIFO] -> subscriber -> fifo2axi -> [axis FIFO] -> rfl_morph
-//     -> [axis FIFO] -> axi2fifo -> publisher -> [tx FIFO] -> m_* (8-bit, to TCP/IP)
+//     -> [axis FIFO] -> axi2fifo -> publisher -> [slice] -> [tx FIFO] -> m_* (8-bit, to TCP/IP)
 //
 // The subscriber holds the carried-over fields (stamp, frame_id) of an accepted frame until
 // the publisher has written them. OP: 0 dilate, 1 erode, 2 passthrough.
@@ -39,12 +39,14 @@ module rfl_top #(
     output       busy                           // something is in flight
 );
     localparam FIDW = $clog2(FRAME_ID_MAX + 1);
+    localparam FIDA = (FRAME_ID_MAX > 1) ? $clog2(FRAME_ID_MAX) : 1;
 
     // rx FIFO -> subscriber
     wire [7:0] rx_tdata;
     wire rx_tvalid, rx_tready;
     wire [$clog2(RX_DEPTH + 1)-1:0] rx_level;
-    rfl_fifo #(.WIDTH(8), .DEPTH(RX_DEPTH)) u_rx_fifo (
+    // OUTREG: the subscriber reads a register, not the block RAM's output (timing)
+    rfl_fifo #(.WIDTH(8), .DEPTH(RX_DEPTH), .OUTREG(RX_DEPTH > 2 ? 1 : 0)) u_rx_fifo (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(rx_tdata), .m_tvalid(rx_tvalid), .m_tready(rx_tready), .level(rx_level));
@@ -55,7 +57,8 @@ module rfl_top #(
     wire meta_valid, meta_release, sub_idle, pub_idle;
     wire [31:0] meta_secs, meta_nsecs;
     wire [7:0] meta_bigendian, fid_rdata;
-    wire [FIDW-1:0] meta_fid_len, fid_raddr;
+    wire [FIDW-1:0] meta_fid_len;
+    wire [FIDA-1:0] fid_raddr;
     rfl_subscriber #(
         .WIDTH(WIDTH), .HEIGHT(HEIGHT), .BYTES(BYTES), .ENC_LEN(ENC_LEN), .ENCODING(ENCODING),
         .FRAME_ID_MAX(FRAME_ID_MAX), .ENCODING_MAX(ENCODING_MAX), .MIN_BODY(MIN_BODY),
@@ -124,9 +127,9 @@ module rfl_top #(
         .s_axis_tvalid(axis_out_tvalid), .s_axis_tready(axis_out_tready),
         .m_tdata(pix_out_tdata), .m_tvalid(pix_out_tvalid), .m_tready(pix_out_tready));
 
-    // publisher -> tx FIFO
-    wire [7:0] tx_tdata;
-    wire tx_tvalid, tx_tready, frame_done;
+    // publisher -> register slice -> tx FIFO
+    wire [7:0] pub_tdata, tx_tdata;
+    wire pub_tvalid, pub_tready, tx_tvalid, tx_tready, frame_done;
     wire [$clog2(TX_DEPTH + 1)-1:0] tx_level;
     rfl_publisher #(
         .WIDTH(WIDTH), .HEIGHT(HEIGHT), .BYTES(BYTES), .ENC_LEN(ENC_LEN), .ENCODING(ENCODING),
@@ -134,10 +137,16 @@ module rfl_top #(
     ) u_publisher (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(pix_out_tdata), .s_tvalid(pix_out_tvalid), .s_tready(pix_out_tready),
-        .m_tdata(tx_tdata), .m_tvalid(tx_tvalid), .m_tready(tx_tready),
+        .m_tdata(pub_tdata), .m_tvalid(pub_tvalid), .m_tready(pub_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_secs(meta_secs),
         .meta_nsecs(meta_nsecs), .meta_bigendian(meta_bigendian), .meta_fid_len(meta_fid_len),
         .fid_raddr(fid_raddr), .fid_rdata(fid_rdata), .frame_done(frame_done), .idle(pub_idle));
+
+    // the publisher's output multiplexer and the tx FIFO's fullness meet in registers (timing)
+    rfl_slice #(.WIDTH(8)) u_tx_slice (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(pub_tdata), .s_tvalid(pub_tvalid), .s_tready(pub_tready),
+        .m_tdata(tx_tdata), .m_tvalid(tx_tvalid), .m_tready(tx_tready));
 
     rfl_fifo #(.WIDTH(8), .DEPTH(TX_DEPTH)) u_tx_fifo (
         .clk(clk), .rst_n(rst_n),
@@ -147,6 +156,11 @@ module rfl_top #(
     // The publisher is busy from an accepted frame until its last byte, so an accepted frame
     // (and every pixel of it inside the application) counts as in flight.
     assign busy = rx_tvalid || meta_valid || pix_in_tvalid || axis_in_tvalid || app_in_tvalid
-                  || app_out_tvalid || axis_out_tvalid || pix_out_tvalid || tx_tvalid
+                  || app_out_tvalid || axis_out_tvalid || pix_out_tvalid || pub_tvalid || tx_tvalid
                   || m_tvalid || !sub_idle || !pub_idle;
+
+    // FIFO levels and the publisher's frame_done are for testbenches and waveforms; axi2fifo
+    // sends bytes, not beats, so TUSER/TLAST end at its input
+    wire unused_ok = &{1'b0, rx_level, axis_in_level, axis_out_level, tx_level, frame_done,
+                       axis_out_tuser, axis_out_tlast};
 endmodule

@@ -64,12 +64,16 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
 
     // frame length (uint32): bytes of the serialized message that follow.
     ap_uint<32> frame_length = read_u32(in, pos);
-    if (frame_length < MIN_BODY_BYTES || frame_length > MAX_FRAME_BYTES) {
+    if (frame_length > MAX_FRAME_BYTES) {
         return SUB_BAD_FRAME_LENGTH;  // not to be trusted for skipping: wait for the next frame
     }
     const ap_uint<32> end = frame_length + 4;
     int status = SUB_OK;
     do {  // the fields in wire order; a refused one breaks out to the skip below
+        if (frame_length < MIN_BODY_BYTES) {
+            status = SUB_BAD_FRAME_LENGTH;  // too short for an Image, but framed: skip its bytes
+            break;
+        }
         // header.seq (uint32): not kept; the publisher numbers its own messages.
         read_u32(in, pos);
         // header.stamp.secs (uint32): carried over.
