@@ -53,7 +53,8 @@ static bool match_string(byte_stream& in, ap_uint<32>& pos, ap_uint<32> length,
 }
 
 // Interpret one frame. Returns SUB_OK (the pixels went to `out`, the carried-over fields to
-// `meta_out`, frame_id's bytes to `frame_id_out`) or the subscriber_status of the field that made it refuse the frame.
+// `meta_out`, frame_id's bytes to `frame_id_out`) or the subscriber_status of the field that
+// made it refuse the frame.
 int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out, byte_stream& frame_id_out) {
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
     HLS_PRAGMA(HLS INTERFACE axis port = out)
