@@ -16,7 +16,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "FPGA component: subscriber, publisher, connection headers, application, top level, "
         "a C-simulation testbench with a test frame and the Python models' expected output, a "
         "Makefile ('make csim' builds and runs it with g++; 'make rtlsim' simulates the same "
-        "circuit's Verilog, written into DIR/rtl/) and a Vivado HLS Tcl script. "
+        "circuit's Verilog, written into DIR/rtl/) and an HLS Tcl script (vitis_hls -f "
+        "run_hls.tcl; the paper's vivado_hls with 'hls: {flavour: vivado}' in CONFIG). "
         "Examples: data/fpga_dilate_rgba8.yaml, data/fpga_erode_mono8.yaml, "
         "data/fpga_passthrough_rgb8.yaml.",
     )
