@@ -1,11 +1,12 @@
 """The generator: golden files, determinism, the manifest and --force, the CLI, the SLOC table.
 
-Golden files live in ``tests/golden/hls/<config>/``: every text file the generator writes for
-the three shipped configurations. A template change shows up here as a diff. To accept a
+Golden files live in ``tests/golden/hls/<config>/`` (the default flavour, Vitis HLS) and
+``tests/golden/hls-vivado/<config>/`` (``hls: {flavour: vivado}``): every text file the generator
+writes for the three shipped configurations. A template change shows up here as a diff. To accept a
 change on purpose, regenerate them and review the diff before committing::
 
     ROSFPGA_UPDATE_GOLDEN=1 .venv/bin/python -m pytest tests/test_hls_generate.py -k golden
-    git diff tests/golden/hls
+    git diff tests/golden/hls tests/golden/hls-vivado
 """
 
 from __future__ import annotations
