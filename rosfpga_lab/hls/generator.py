@@ -69,16 +69,16 @@ class HlsTool:
 #: Flavour (:data:`rosfpga_lab.config.vocabulary.HLS_FLAVOURS`) -> its tool.
 HLS_TOOLS: dict[str, HlsTool] = {
     "vitis": HlsTool(
-        "Vitis HLS", "Vitis HLS 2020.2 and later (AMD Vitis / Vivado ML editions)",
+        "Vitis HLS", "Vitis HLS 2020.2 and later",
         "vitis_hls -f run_hls.tcl", "HLS aggregate", True,
         ("ap_int.h", "ap_axi_sdata.h", "hls_stream.h"),
         "The application's own line buffer and window (no hls_video.h), `#pragma HLS aggregate` "
         "on the metadata FIFO, `ap_ctrl_none` on the free-running AXI4-Stream cores."),
     "vivado": HlsTool(
-        "Vivado HLS", "Vivado HLS 2016.x to 2019.2 (the paper's tool)",
+        "Vivado HLS", "Vivado HLS 2016.x to 2019.2",
         "vivado_hls -f run_hls.tcl", "HLS DATA_PACK", False, HLS_HEADERS,
-        "The HLS video library (`hls_video.h`: `AXIvideo2Mat`, `hls::Dilate`/`hls::Erode`, "
-        "`Mat2AXIvideo`) and `DATA_PACK`, both removed in Vitis HLS."),
+        "The paper's tool. The HLS video library (`hls_video.h`: `AXIvideo2Mat`, "
+        "`hls::Dilate`/`hls::Erode`, `Mat2AXIvideo`) and `DATA_PACK`, both removed in Vitis HLS."),
 }
 
 
@@ -108,10 +108,11 @@ TEMPLATE_FILES = {
 MANIFEST = ".rosfpga-lab-manifest.json"
 TB_INPUT = "tb_input.bin"
 TB_EXPECTED = "tb_expected.bin"
-#: What ``make csim`` and ``vitis_hls``/``vivado_hls -f run_hls.tcl`` leave behind; --force removes these too.
+#: What ``make csim`` and ``vitis_hls``/``vivado_hls -f run_hls.tcl`` leave behind; --force
+#: removes these too.
 BUILD_PRODUCTS = ("csim_testbench", "csim_out", "hls_subscriber", "hls_image_filter",
-                  "hls_publisher", "vivado_hls.log", "vitis_hls.log", "rtlsim_out", "rtl/rfl_sim.vvp", "rtl/obj_dir",
-                  "rtl/obj_fast")
+                  "hls_publisher", "vivado_hls.log", "vitis_hls.log", "rtlsim_out",
+                  "rtl/rfl_sim.vvp", "rtl/obj_dir", "rtl/obj_fast")
 #: Bytes per line of the hexadecimal arrays in connection_headers.cpp.
 HEX_BYTES_PER_LINE = 16
 _OP_CPP = {"dilate": "Dilate", "erode": "Erode"}
