@@ -17,6 +17,7 @@ import struct
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from realros import cxx_missing_reason, require_rtl
 from rosfpga_lab.hls import generate, run_csim
@@ -60,6 +61,7 @@ def test_the_models_read_a_continuous_stream_as_the_circuit_does() -> None:
     assert cut.unread == 20 and cut.status == tuple(status)
 
 
+@pytest.mark.rtl
 def test_csim_rtl_and_models_agree_byte_for_byte(tmp_path: Path) -> None:
     config = small_config("rgb8", width=5, height=3)
     data, status = _stream(config)

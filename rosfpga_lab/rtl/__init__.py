@@ -12,7 +12,8 @@ Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
     result = run(sim, frames, gap=100, bp=500)   # result.output: the frames sent
 
 :mod:`rosfpga_lab.rtl.vcd` reads waveform dumps into per-clock arrays,
-:mod:`rosfpga_lab.rtl.synth` synthesizes the modules with Yosys and
+:mod:`rosfpga_lab.rtl.synth` synthesizes the modules with Yosys,
+:mod:`rosfpga_lab.rtl.timing` places and routes them with nextpnr-ecp5 (Fmax against the clock) and
 :mod:`rosfpga_lab.rtl.sloc` counts their lines for the paper's Table 1.
 """
 
