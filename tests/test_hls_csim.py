@@ -11,9 +11,11 @@ skip (with ROSFPGA_REQUIRE_CXX=1, as in CI, they fail).
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import struct
 import subprocess
+import re
 from pathlib import Path
 
 import cv2
@@ -21,7 +23,8 @@ import numpy as np
 import pytest
 
 from realros import require_cxx, ros_missing_reason, run_ros_python
-from rosfpga_lab.config import load_config
+from rosfpga_lab.config import HlsConfig, load_config, parse_config
+from rosfpga_lab.config.vocabulary import DEFAULT_HLS_FLAVOUR, HLS_FLAVOURS
 from rosfpga_lab.hls import CsimError, build_csim, generate, run_csim
 from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.hls.csim import CsimResult
@@ -95,12 +98,17 @@ def projects(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Project]:
     cache: dict[str, Project] = {}
 
     class Lazy(dict):
-        def __missing__(self, stem: str) -> Project:
+        def __missing__(self, key: str) -> Project:
+            # "STEM" (the default flavour) or "STEM:FLAVOUR".
+            stem, _, flavour = key.partition(":")
             out = tmp_path_factory.mktemp(stem)
-            generate(load_config(DATA / f"{stem}.yaml"), out / "proj")
-            cache[stem] = Project(out / "proj", build_csim(out / "proj"))
-            self[stem] = cache[stem]
-            return cache[stem]
+            config = load_config(DATA / f"{stem}.yaml")
+            if flavour:
+                config = dataclasses.replace(config, hls=HlsConfig(flavour))
+            generate(config, out / "proj")
+            cache[key] = Project(out / "proj", build_csim(out / "proj"))
+            self[key] = cache[key]
+            return cache[key]
 
     return Lazy()
 
@@ -111,11 +119,17 @@ def _decode(frame: bytes) -> dict:
     return deserialize(default_registry(), "sensor_msgs/Image", frame[4:])
 
 
+@pytest.mark.parametrize("flavour", HLS_FLAVOURS)
 @pytest.mark.parametrize("stem", CONFIGS)
-def test_csim_equals_python_models_and_opencv(projects: dict[str, Project], stem: str) -> None:
+def test_csim_equals_python_models_and_opencv(projects: dict[str, Project], stem: str,
+                                               flavour: str) -> None:
+    """Both flavours of the generated C++ (Vitis HLS's own line buffer, Vivado HLS's
+    hls_video.h), each with g++ alone, give the models' bytes and beats."""
     image, encoding = random_image(stem)
     frame = ros_frame(image, encoding)
-    got = projects[stem].run(frame)
+    project = projects[stem if flavour == DEFAULT_HLS_FLAVOUR else f"{stem}:{flavour}"]
+    assert ("hls_video.h" in os.listdir(project.path / "hls_include")) == (flavour == "vivado")
+    got = project.run(frame)
     config = load_config(DATA / f"{stem}.yaml")
     model = Pipeline.from_config(config).process(frame)
     assert got.status == ((0, "SUB_OK"),)
@@ -362,3 +376,44 @@ def test_frame_id_max_is_the_same_limit_in_the_circuit_and_the_models(tmp_path: 
             expected += pipe.process(frame).output_frame
     assert got.output == expected
     assert "WARNING" not in got.log, got.log
+
+
+@pytest.mark.parametrize("op, ksize, encoding, width, height", [
+    ("dilate", 7, "rgb8", 9, 5),   # the window taller than the image
+    ("erode", 5, "bgra8", 4, 3),   # and wider
+    ("dilate", 1, "mono8", 6, 4),  # a 1x1 window: the pixels pass
+])
+def test_vitis_line_buffer_on_small_images_and_kernels(tmp_path: Path, op: str, ksize: int,
+                                                       encoding: str, width: int, height: int) -> None:
+    """The Vitis flavour's own line buffer and window at the edges: kernels as large as or
+    larger than the image, and the static line buffer carrying nothing from one frame into the
+    next (three frames in one run); the models and OpenCV agree, beat for beat."""
+    require_cxx()
+    text = (DATA / "fpga_passthrough_rgb8.yaml").read_text()
+    text = text.replace("  op: passthrough\n", f"  op: {op}\n  ksize: {ksize}\n")
+    text = re.sub(r"image: .*|image:\n(  .*\n)+",
+                  f"image: {{width: {width}, height: {height}, encoding: {encoding}}}\n", text)
+    config = parse_config(text, source="small.yaml")
+    assert (config.application.op, config.application.ksize, config.image.width) == (op, ksize, width)
+    assert config.hls.flavour == "vitis"
+    generate(config, tmp_path / "proj")
+    rng = np.random.default_rng(ksize)
+    channels = config.image.bytes_per_pixel
+    images = [rng.integers(0, 256, (height, width, channels), dtype=np.uint8) for _ in range(3)]
+    images[1][:] = 255 if op == "erode" else 0  # a flat frame after a busy one: no leftovers
+    frames = [image_frame(im, encoding, seq=i, frame_id=f"f{i}") for i, im in enumerate(images)]
+    got = run_csim(tmp_path / "proj", b"".join(frames))
+    assert "WARNING" not in got.log, got.log
+    pipe = Pipeline.from_config(config)
+    results = [pipe.process(f) for f in frames]
+    assert got.output == b"".join(r.output_frame for r in results)
+    n = width * height
+    for i, res in enumerate(results):
+        part = Beats(got.output_beats.tdata[i * n:(i + 1) * n], got.output_beats.tkeep[i * n:(i + 1) * n],
+                     got.output_beats.tuser[i * n:(i + 1) * n], got.output_beats.tlast[i * n:(i + 1) * n])
+        assert part == res.output_beats, f"frame {i}: first differing beat {part.first_difference(res.output_beats)}"
+        kernel = np.ones((ksize, ksize), np.uint8)
+        morph = cv2.dilate if op == "dilate" else cv2.erode
+        expected = morph(images[i], kernel).reshape(images[i].shape)
+        published = np.frombuffer(bytes(_decode(res.output_frame)["data"]), np.uint8)
+        assert np.array_equal(published.reshape(images[i].shape), expected)

@@ -1,28 +1,32 @@
 """The generator: golden files, determinism, the manifest and --force, the CLI, the SLOC table.
 
-Golden files live in ``tests/golden/hls/<config>/``: every text file the generator writes for
-the three shipped configurations. A template change shows up here as a diff. To accept a
+Golden files live in ``tests/golden/hls/<config>/`` (the default flavour, Vitis HLS) and
+``tests/golden/hls-vivado/<config>/`` (``hls: {flavour: vivado}``): every text file the generator
+writes for the three shipped configurations. A template change shows up here as a diff. To accept a
 change on purpose, regenerate them and review the diff before committing::
 
     ROSFPGA_UPDATE_GOLDEN=1 .venv/bin/python -m pytest tests/test_hls_generate.py -k golden
-    git diff tests/golden/hls
+    git diff tests/golden/hls tests/golden/hls-vivado
 """
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import hashlib
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
-from rosfpga_lab.config import load_config
+from rosfpga_lab.config import ConfigError, HlsConfig, NodeConfig, load_config, parse_config
+from rosfpga_lab.config.vocabulary import DEFAULT_HLS_FLAVOUR, HLS_FLAVOURS
 from rosfpga_lab.hls import GenerateError, HlsError, count_sloc, format_table, generate, render
-from rosfpga_lab.hls.generator import MANIFEST, TEMPLATE_FILES
+from rosfpga_lab.hls.generator import HLS_TOOLS, MANIFEST, TEMPLATE_FILES, meta_fields
 from rosfpga_lab.hls.sloc import PAPER_TABLE1, sloc
 from rosfpga_lab.rtl.sloc import count_verilog, verilog_sloc
 
@@ -38,11 +42,33 @@ def _tree(root: Path) -> dict[str, str]:
             for p in sorted(root.rglob("*")) if p.is_file()}
 
 
+def _config(stem: str, flavour: str = DEFAULT_HLS_FLAVOUR) -> NodeConfig:
+    """A shipped configuration, with ``hls.flavour`` set (its file name unchanged)."""
+    return dataclasses.replace(load_config(DATA / f"{stem}.yaml"), hls=HlsConfig(flavour))
+
+
+def _meta_bits(header: str) -> int:
+    """Bits of ``struct image_meta`` in a generated ros_node.h, read from its declarations
+    (``ap_uint<N>``, ``byte_t name[N]``; N a number or a #define of the header)."""
+    defines = dict(re.findall(r"^#define (\w+) (\d+)", header, re.M))
+    body = re.search(r"struct image_meta \{(.*?)\};", header, re.S)
+    assert body, "no struct image_meta"
+    value = lambda token: int(defines.get(token, token))  # noqa: E731
+    bits = 0
+    for line in body.group(1).strip().splitlines():
+        m = re.fullmatch(r"\s*(?:ap_uint<(\w+)>|byte_t) (\w+)(?:\[(\w+)\])?;", line)
+        assert m, f"unexpected member {line!r}"
+        bits += (value(m.group(1)) if m.group(1) else 8) * (value(m.group(3)) if m.group(3) else 1)
+    return bits
+
+
+@pytest.mark.parametrize("flavour", HLS_FLAVOURS)
 @pytest.mark.parametrize("stem", CONFIGS)
-def test_golden_files(stem: str) -> None:
-    texts = render(load_config(DATA / f"{stem}.yaml"))
+def test_golden_files(stem: str, flavour: str) -> None:
+    texts = render(_config(stem, flavour))
     assert set(texts) == set(TEMPLATE_FILES)
-    folder = GOLDEN / stem
+    # The default flavour's files in golden/hls/, the others' in golden/hls-<flavour>/.
+    folder = (GOLDEN if flavour == DEFAULT_HLS_FLAVOUR else GOLDEN.with_name(f"hls-{flavour}")) / stem
     if UPDATE:
         folder.mkdir(parents=True, exist_ok=True)
         for name, text in texts.items():
@@ -67,7 +93,7 @@ def test_generation_is_deterministic(tmp_path: Path) -> None:
     generate(config, tmp_path / "b")
     a, b = _tree(tmp_path / "a"), _tree(tmp_path / "b")
     assert a == b
-    assert len(a) == 17  # 10 rendered + 4 headers + input + expected + manifest
+    assert len(a) == 16  # 10 rendered + 3 headers (Vitis: no hls_video.h) + input + expected + manifest
     # The same file elsewhere generates the same bytes (only its name appears in the output).
     moved = tmp_path / "elsewhere" / "fpga_erode_mono8.yaml"
     moved.parent.mkdir()
@@ -81,7 +107,7 @@ def test_generated_code_names_the_configuration() -> None:
     texts = render(config)
     assert '#define IMG_WIDTH 640' in texts["ros_node.h"]
     assert '"rgba8"' in texts["ros_node.h"]
-    assert "hls::Dilate(src, dst)" in texts["image_filter.cpp"]
+    assert "#define KSIZE 3" in texts["image_filter.cpp"]  # Vitis HLS: its own window
     assert "md5sum=060021388200f6f0f447d0fcd9c64743" in texts["connection_headers.cpp"]
     assert "topic=/image_raw" in texts["connection_headers.cpp"]
     assert "topic=/image_dilated" in texts["connection_headers.cpp"]
@@ -93,23 +119,49 @@ def test_generated_code_names_the_configuration() -> None:
         assert top in texts["run_hls.tcl"]
     assert "-std=c++14 -Wall -Werror" in texts["Makefile"]
     erode = render(load_config(DATA / "fpga_erode_mono8.yaml"))
+    assert "#define KSIZE 5" in erode["image_filter.cpp"] and "(u < v) ? u : v" in erode["image_filter.cpp"]
+    assert "vitis_hls -f run_hls.tcl" in erode["run_hls.tcl"]
+    # The paper's flavour: the HLS video library.
+    vivado = render(_config("fpga_dilate_rgba8", "vivado"))
+    assert "hls::Dilate(src, dst)" in vivado["image_filter.cpp"]
+    assert "vivado_hls -f run_hls.tcl" in vivado["run_hls.tcl"]
+    erode = render(_config("fpga_erode_mono8", "vivado"))
     assert "hls::Erode<hls::MORPH_RECT, 1>(src, dst, kernel)" in erode["image_filter.cpp"]
     assert "hls::Window<5, 5, unsigned char>" in erode["image_filter.cpp"]
 
 
+@pytest.mark.parametrize("flavour", HLS_FLAVOURS)
 @pytest.mark.parametrize("stem, bpp", [("fpga_dilate_rgba8", 4), ("fpga_erode_mono8", 1),
                                        ("fpga_passthrough_rgb8", 3)])
-def test_hls_directives_where_vivado_hls_needs_them(stem: str, bpp: int) -> None:
-    texts = render(load_config(DATA / f"{stem}.yaml"))
+def test_hls_directives_where_the_hls_tool_needs_them(stem: str, bpp: int, flavour: str) -> None:
+    texts = render(_config(stem, flavour))
     sub, pub, app = texts["subscriber.cpp"], texts["publisher.cpp"], texts["image_filter.cpp"]
-    for text, ports in ((sub, ("ap_fifo port = in", "axis port = out", "ap_fifo port = meta_out")),
-                        (pub, ("axis port = in", "ap_fifo port = meta_in", "ap_fifo port = out")),
+    for text, ports in ((sub, ("ap_fifo port = in", "axis port = out", "ap_fifo port = meta_out",
+                               "ap_fifo port = frame_id_out")),
+                        (pub, ("axis port = in", "ap_fifo port = meta_in", "ap_fifo port = frame_id_in",
+                               "ap_fifo port = out")),
                         (app, ("axis port = in", "axis port = out"))):
         for port in ports:
             assert f"HLS_PRAGMA(HLS INTERFACE {port})" in text
-    assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_out)" in sub
-    assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_in)" in pub
-    assert "HLS_PRAGMA(HLS DATAFLOW)" in app
+    # The C++ without its comments (which may say what the other flavour does).
+    every = "".join(re.sub(r"//.*", "", text) for name, text in texts.items()
+                    if name.endswith((".cpp", ".h")))
+    if flavour == "vivado":
+        assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_out)" in sub
+        assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_in)" in pub
+        assert "HLS_PRAGMA(HLS DATAFLOW)" in app and "#include <hls_video.h>" in app
+        assert "ap_ctrl_none" not in every
+    else:
+        # Vitis HLS has neither DATA_PACK nor hls_video.h; its free-running cores need no start.
+        assert "HLS_PRAGMA(HLS aggregate variable = meta_out)" in sub
+        assert "HLS_PRAGMA(HLS aggregate variable = meta_in)" in pub
+        for gone in ("DATA_PACK", "hls_video.h", "hls::Mat", "AXIvideo2Mat", "Mat2AXIvideo", "hls::Window"):
+            assert gone not in every, gone
+        assert "HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)" in app
+        assert "HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)" in pub
+        assert "ap_ctrl_none" not in re.sub(r"//.*", "", sub)  # it returns a status (ap_ctrl_hs)
+        assert "open_solution -reset solution1 -flow_target vivado" in texts["run_hls.tcl"]
+        assert "HLS_PRAGMA(HLS PIPELINE II = 1)" in app
     # Every loop over a variable number of bytes moves one byte per clock.
     for text in (sub, pub):
         lines = text.splitlines()
@@ -147,6 +199,47 @@ def test_regenerating_refuses_then_force_replaces(tmp_path: Path) -> None:
     assert "IMG_ENCODING_LENGTH 5" in (out / "ros_node.h").read_text()  # mono8, not rgb8
 
 
+@pytest.mark.parametrize("flavour", HLS_FLAVOURS)
+def test_the_metadata_word_is_narrow(flavour: str) -> None:
+    """The subscriber passes the publisher one FIFO word per frame: stamps, frame_id's length and
+    is_bigendian (81 bits with frame_id_max 256); frame_id's bytes go on an 8-bit FIFO of their
+    own. (Before, the word held frame_id itself: 2,152 bits.)"""
+    config = _config("fpga_dilate_rgba8", flavour)
+    header = render(config)["ros_node.h"]
+    assert _meta_bits(header) == sum(bits for _name, bits in meta_fields(config)) == 81
+    assert "one FIFO word per frame, 81 bits of fields" in header
+    small = dataclasses.replace(config, frame_id_max=16)
+    assert _meta_bits(render(small)["ros_node.h"]) == 32 + 32 + 5 + 8
+    assert "depth = FRAME_ID_MAX" in render(config)["ros_fpga_node.cpp"]
+
+
+def test_meta_width_parser_reads_the_old_wide_word() -> None:
+    """The parser above, on the word as it was (frame_id inside): 2,152 bits."""
+    old = ("#define FRAME_ID_MAX 256\nstruct image_meta {\n    ap_uint<32> stamp_secs;\n"
+           "    ap_uint<32> stamp_nsecs;\n    ap_uint<32> frame_id_length;\n"
+           "    byte_t frame_id[FRAME_ID_MAX];\n    ap_uint<8> is_bigendian;\n};\n")
+    assert _meta_bits(old) == 2152
+
+
+def test_hls_flavour_is_a_configuration_key_and_the_readme_names_the_tools() -> None:
+    assert set(HLS_TOOLS) == set(HLS_FLAVOURS)
+    text = (DATA / "fpga_passthrough_rgb8.yaml").read_text()
+    assert parse_config(text).hls.flavour == "vitis"
+    assert parse_config(text + "hls: {flavour: vivado}\n").hls.flavour == "vivado"
+    with pytest.raises(ConfigError, match=r"hls\.flavour.*one of vitis, vivado.*got 'vitis_hls'"):
+        parse_config(text + "hls: {flavour: vitis_hls}\n")
+    with pytest.raises(ConfigError, match="unknown key"):
+        parse_config(text + "hls: {tool: vitis}\n")
+    for flavour in HLS_FLAVOURS:
+        readme = render(_config("fpga_passthrough_rgb8", flavour))["README.md"]
+        assert f"This project is the `{flavour}` flavour" in readme
+        assert HLS_TOOLS[flavour].command in readme
+        for tool in HLS_TOOLS.values():  # both flavours and their tool versions, in each README
+            assert tool.versions in readme
+    assert "Vivado HLS 2016.x to 2019.2" in HLS_TOOLS["vivado"].versions
+    assert "Vitis HLS 2020.2 and later" in HLS_TOOLS["vitis"].versions
+
+
 def test_refuses_foreign_directory_even_with_nothing_generated(tmp_path: Path) -> None:
     (tmp_path / "main.c").write_text("int main(){}")
     with pytest.raises(GenerateError, match="not written by rosfpga-lab"):
@@ -175,7 +268,7 @@ def test_cli_generate_and_sloc(tmp_path: Path) -> None:
            "-o", str(out)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
-    assert "rendering templates" in proc.stderr and "writing 29 files" in proc.stderr  # 16 HLS + 13 RTL (rtl/: the fast harness, the register slice)
+    assert "rendering templates" in proc.stderr and "writing 28 files" in proc.stderr  # 15 HLS (Vitis) + 13 RTL (rtl/: + the fast harness, rfl_slice.v)
     assert f"make -C {out} csim" in proc.stdout
     again = subprocess.run(cmd, capture_output=True, text=True)
     assert again.returncode == 1 and "--force" in again.stderr
@@ -183,7 +276,7 @@ def test_cli_generate_and_sloc(tmp_path: Path) -> None:
     assert forced.returncode == 0 and forced.stdout == "" and forced.stderr == ""
     loud = subprocess.run(cmd + ["--force"], capture_output=True, text=True)
     assert loud.returncode == 0
-    assert loud.stderr.index("removed 30 files") < loud.stderr.index("writing 29 files")
+    assert loud.stderr.index("removed 29 files") < loud.stderr.index("writing 28 files")
     unwritable = subprocess.run(cmd[:-1] + [str(out / "Makefile" / "below")], capture_output=True,
                                 text=True)
     assert unwritable.returncode == 1 and "Traceback" not in unwritable.stderr

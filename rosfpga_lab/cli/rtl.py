@@ -160,7 +160,6 @@ def run_prove(args: argparse.Namespace) -> int:
     return 0 if all(r.passed for r in results) else 1
 
 
-
 def _register_timing(subparsers: argparse._SubParsersAction) -> None:
     timing = subparsers.add_parser(
         "timing",

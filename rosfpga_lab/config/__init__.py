@@ -18,7 +18,7 @@ schema, its checker and the dataclasses).
 from rosfpga_lab.config.errors import ConfigError
 from rosfpga_lab.config.master import master_uri, master_uri_from_env
 from rosfpga_lab.config.node import (
-    ApplicationConfig, FifoConfig, ImageConfig, NodeConfig, NodeSection, TopicConfig,
+    ApplicationConfig, FifoConfig, HlsConfig, ImageConfig, NodeConfig, NodeSection, TopicConfig,
     load_config, parse_config, ros_name_problem,
 )
 from rosfpga_lab.config.node import CheckConfig, NoImage, StreamConfig
@@ -28,7 +28,7 @@ from rosfpga_lab.config.vocabulary import (
 )
 
 __all__ = [
-    "CUSTOM", "DEFAULT_ENCODING", "DEFAULT_OP", "ENCODINGS", "MODEL_OPS", "OPS", "PASSTHROUGH", "PIXEL_FORMATS", "ApplicationConfig", "ConfigError", "FifoConfig",
+    "CUSTOM", "DEFAULT_ENCODING", "DEFAULT_OP", "ENCODINGS", "MODEL_OPS", "OPS", "PASSTHROUGH", "PIXEL_FORMATS", "ApplicationConfig", "ConfigError", "FifoConfig", "HlsConfig",
     "ImageConfig", "NodeConfig", "NodeSection", "PixelFormat", "TopicConfig", "load_config",
     "parse_config", "ros_name_problem", "canonical_op", "master_uri", "master_uri_from_env",
     "model_ksize", "CheckConfig", "NoImage", "StreamConfig",

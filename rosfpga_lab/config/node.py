@@ -28,6 +28,7 @@ encoding, the application, FIFO depths and the clock. Example (every key but ``n
     frame_id_max: 256     # longest header.frame_id the circuit keeps
     part: xc7z020clg400-1 # FPGA part for the HLS project script (Zynq-7020)
     wire: tcpros          # tcpros | cdr: the generated circuit reads ROS 1 frames or ROS 2 samples
+    hls: {flavour: vitis} # vitis (Vitis HLS 2020.2 on) | vivado (the paper's Vivado HLS <= 2019.2)
 
 Any other message type names the array the application processes and, if it likes, checks,
 maxima and fields to drop (paths are dotted field names; ``msg_path`` folders, relative to this
@@ -73,7 +74,9 @@ from rosfpga_lab.config.fields import (
     FieldPathError, check_field, check_value_problem, limit_field, resolve_field, stream_field,
 )
 from rosfpga_lab.config.names import canonical, name_problem
-from rosfpga_lab.config.vocabulary import CUSTOM, DEFAULT_OP, DEFAULT_WIRE, ENCODINGS, OPS, WIRES
+from rosfpga_lab.config.vocabulary import (
+    CUSTOM, DEFAULT_HLS_FLAVOUR, DEFAULT_OP, DEFAULT_WIRE, ENCODINGS, HLS_FLAVOURS, OPS, WIRES,
+)
 
 if TYPE_CHECKING:
     from rosfpga_lab.msg import MsgRegistry
@@ -231,6 +234,18 @@ class FifoConfig:
 
 
 @dataclass(frozen=True)
+class HlsConfig:
+    """What the generated HLS C++ is written for.
+
+    Attributes:
+        flavour: ``vitis`` (Vitis HLS) or ``vivado`` (Vivado HLS up to 2019.2, the paper's);
+            :data:`rosfpga_lab.config.vocabulary.HLS_FLAVOURS`.
+    """
+
+    flavour: str = DEFAULT_HLS_FLAVOUR
+
+
+@dataclass(frozen=True)
 class NodeConfig:
     """One ROS-compliant FPGA component, as read from its YAML file.
 
@@ -247,6 +262,7 @@ class NodeConfig:
         frame_id_max: longest ``header.frame_id`` kept (longer frames are refused).
         part: the FPGA part named in the HLS project script.
         wire: the wire format the circuit reads and writes (``tcpros`` or ``cdr``).
+        hls: the HLS tool the generated C++ is written for.
         path: the file it was read from (None when parsed from a string).
         msg_path: folders of the user's ``.msg`` packages (absolute).
         stream: the streamed array (for Image: ``data``, ``image.data_bytes`` elements).
@@ -265,6 +281,7 @@ class NodeConfig:
     frame_id_max: int = limits.DEFAULT_FRAME_ID_MAX
     part: str = limits.DEFAULT_PART
     wire: str = DEFAULT_WIRE
+    hls: HlsConfig = HlsConfig()
     path: Path | None = None
     msg_path: tuple[Path, ...] = ()
     stream: StreamConfig | None = None
@@ -300,6 +317,7 @@ _SCHEMA: dict[str, dict[str, tuple[type | tuple[type, ...], Any]]] = {
              "output_depth": (int, limits.DEFAULT_OUTPUT_FIFO_DEPTH),
              "axis_depth": (int, limits.DEFAULT_AXIS_FIFO_DEPTH)},
     "stream": {"field": (str, _REQUIRED), "length": ((int, type(None)), None)},
+    "hls": {"flavour": (str, DEFAULT_HLS_FLAVOUR)},
 }
 #: Top-level keys read by their own code (lists and free mappings of field paths).
 _FREE_KEYS = ("msg_path", "checks", "limits", "skip")
@@ -742,6 +760,10 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
     if not 1 <= scalars["frame_id_max"] <= limits.MAX_FRAME_ID_MAX:
         raise ctx.error(f"must be 1..{limits.MAX_FRAME_ID_MAX}, got {scalars['frame_id_max']}",
                         top_nodes.get("frame_id_max"), "frame_id_max")
+    hl, hln = sec["hls"]
+    _check(ctx, hl["flavour"] in HLS_FLAVOURS, f"flavour must be one of "
+           f"{', '.join(HLS_FLAVOURS)} (vitis: Vitis HLS 2020.2 on; vivado: Vivado HLS up to "
+           f"2019.2), got {hl['flavour']!r}", hln, "flavour", "hls")
     if not re.fullmatch(r"[A-Za-z0-9_.-]+", scalars["part"]):
         raise ctx.error(f"expected an FPGA part name like xc7z020clg400-1, got {scalars['part']!r}",
                         top_nodes.get("part"), "part")
@@ -760,6 +782,7 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
         frame_id_max=scalars["frame_id_max"],
         part=scalars["part"],
         wire=scalars["wire"],
+        hls=HlsConfig(**hl),
         msg_path=tuple(folders),
         stream=stream,
         checks=checks,

@@ -79,6 +79,13 @@ WIRES = (TCPROS_WIRE, CDR_WIRE)
 DEFAULT_WIRE = TCPROS_WIRE
 #: The Verilog simulators the RTL flow runs (the first one found is the default).
 SIMULATORS = ("iverilog", "verilator")
+#: The HLS tool the generated C++ is written for (``hls.flavour`` of a node configuration):
+#: ``vitis`` (Vitis HLS 2020.2 on: its own line buffer, ``#pragma HLS aggregate``,
+#: ``ap_ctrl_none``, a ``vitis_hls`` script) or ``vivado`` (the paper's Vivado HLS up to 2019.2:
+#: ``hls_video.h``, ``DATA_PACK``, a ``vivado_hls`` script). Both run ``make csim`` with g++.
+HLS_FLAVOURS = ("vitis", "vivado")
+#: The flavour a configuration without ``hls.flavour`` gets: the tool a course installs today.
+DEFAULT_HLS_FLAVOUR = "vitis"
 
 
 def canonical_op(op: str) -> str:

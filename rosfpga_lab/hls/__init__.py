@@ -4,7 +4,8 @@ The developer provides (a) the ROS message definition (from :mod:`rosfpga_lab.ms
 node configuration (a YAML file, :func:`rosfpga_lab.config.load_config`) and (c) the application; the generator
 emits (d) the subscriber and (e) the publisher in HLS C++, with the application top, the top
 level, a testbench, a Makefile for C simulation with g++ (against the lab's stand-ins for
-Xilinx's HLS headers, ``include/``) and a Vivado HLS project script::
+Xilinx's HLS headers, ``include/``) and an HLS project script: for Vitis HLS by default, for
+the paper's Vivado HLS with ``hls: {flavour: vivado}`` (:data:`generator.HLS_TOOLS`)::
 
     from rosfpga_lab.config import load_config
     from rosfpga_lab.hls import generate, run_csim, count_sloc

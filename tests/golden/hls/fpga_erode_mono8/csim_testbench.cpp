@@ -130,9 +130,11 @@ int main(int argc, char** argv) {
         pixel_stream beats_in("beats_in"), filter_in("filter_in"), beats_out("beats_out"),
             sink("sink");
         meta_stream meta("tap_meta");
+        byte_stream frame_id("tap_frame_id");
         for (std::size_t i = 0; i < taken; i++) tap_in.write(bytes[offset + i]);
-        if (subscriber(tap_in, beats_in, meta) == SUB_OK) {
+        if (subscriber(tap_in, beats_in, meta, frame_id) == SUB_OK) {
             meta.read();
+            drain(frame_id);
             tap(beats_in, filter_in, in_log);
             image_filter(filter_in, beats_out);
             tap(beats_out, sink, out_log);

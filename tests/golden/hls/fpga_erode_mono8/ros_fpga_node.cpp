@@ -5,6 +5,7 @@
 //   in  (8-bit FIFO, TCP payload of /camera/image_mono)
 //    -> subscriber  -> [AXI4-Stream, depth 16] -> image_filter -> [AXI4-Stream, depth 16]
 //    -> publisher   -> out (8-bit FIFO, TCP payload for /camera/image_eroded)
+//   subscriber -> [meta FIFO: 81 bits per frame] and [8-bit FIFO: frame_id, depth 256] -> publisher
 //
 // In the FPGA the three stages are separate IP cores (run_hls.tcl synthesises each) working
 // concurrently on the stream. This function is their C-level model for C simulation: it
@@ -15,11 +16,13 @@ int ros_fpga_node(byte_stream& in, byte_stream& out) {
     static pixel_stream to_filter("to_filter");
     static pixel_stream from_filter("from_filter");
     static meta_stream meta("meta");
+    static byte_stream frame_id("frame_id");
     HLS_PRAGMA(HLS STREAM variable = to_filter depth = AXIS_FIFO_DEPTH)
     HLS_PRAGMA(HLS STREAM variable = from_filter depth = AXIS_FIFO_DEPTH)
-    int status = subscriber(in, to_filter, meta);
+    HLS_PRAGMA(HLS STREAM variable = frame_id depth = FRAME_ID_MAX)
+    int status = subscriber(in, to_filter, meta, frame_id);
     if (status != SUB_OK) return status;
     image_filter(to_filter, from_filter);
-    publisher(from_filter, meta, out);
+    publisher(from_filter, meta, frame_id, out);
     return SUB_OK;
 }

@@ -32,8 +32,9 @@ static const char IMG_ENCODING[IMG_ENCODING_LENGTH + 1] = "mono8";
 #define ENCODING_MAX 32
 
 // HLS directives. HLS_PRAGMA(HLS PIPELINE II = 1) is "#pragma HLS PIPELINE II = 1" for
-// Vivado HLS synthesis (the _Pragma idiom of UG902, which also lets macros into directives);
-// in C simulation it is nothing, so g++ -Wall -Werror has no unknown pragma to complain of.
+// Vitis HLS synthesis (the _Pragma idiom of UG902 and UG1399, which also lets macros
+// into directives); in C simulation it is nothing, so g++ -Wall -Werror has no unknown pragma
+// to complain of.
 #ifdef __SYNTHESIS__
 #define HLS_PRAGMA_TEXT(x) _Pragma(#x)
 #define HLS_PRAGMA(x) HLS_PRAGMA_TEXT(x)
@@ -53,12 +54,14 @@ typedef ap_axiu<32, 1, 1, 1> pixel_beat;     // TDATA, TKEEP, TSTRB, TUSER, TLAS
 typedef hls::stream<pixel_beat> pixel_stream;
 
 // The fields of the received message that the publisher carries over to the one it sends
-// (it numbers its messages itself: header.seq counts 1, 2, 3 ... as a rospy publisher does).
+// (it numbers its messages itself: header.seq counts 1, 2, 3 ... as a rospy publisher does):
+// one FIFO word per frame, 81 bits of fields. frame_id's bytes follow on their own
+// 8-bit FIFO (depth FRAME_ID_MAX), not inside the word.
+#define FRAME_ID_LENGTH_BITS 9  // 0..FRAME_ID_MAX
 struct image_meta {
     ap_uint<32> stamp_secs;
     ap_uint<32> stamp_nsecs;
-    ap_uint<32> frame_id_length;
-    byte_t frame_id[FRAME_ID_MAX];
+    ap_uint<FRAME_ID_LENGTH_BITS> frame_id_length;
     ap_uint<8> is_bigendian;
 };
 typedef hls::stream<image_meta> meta_stream;
@@ -81,11 +84,11 @@ void subscriber_connection_header(byte_stream& out);
 void publisher_connection_header(byte_stream& out);
 
 // The circuit (subscriber.cpp, image_filter.cpp, publisher.cpp, ros_fpga_node.cpp).
-int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out);
+int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out, byte_stream& frame_id_out);
 void fifo2axi(byte_stream& in, pixel_stream& out);
 void image_filter(pixel_stream& in, pixel_stream& out);
 void axi2fifo(pixel_stream& in, byte_stream& out);
-void publisher(pixel_stream& in, meta_stream& meta_in, byte_stream& out);
+void publisher(pixel_stream& in, meta_stream& meta_in, byte_stream& frame_id_in, byte_stream& out);
 int ros_fpga_node(byte_stream& in, byte_stream& out);
 
 #endif  // ROS_NODE_H

@@ -29,12 +29,14 @@ void axi2fifo(pixel_stream& in, byte_stream& out) {
     }
 }
 
-// Write one message: the carried-over fields from meta_in, the pixels from `in`.
-void publisher(pixel_stream& in, meta_stream& meta_in, byte_stream& out) {
+// Write one message: the carried-over fields from meta_in and frame_id_in, the pixels from `in`.
+void publisher(pixel_stream& in, meta_stream& meta_in, byte_stream& frame_id_in, byte_stream& out) {
     HLS_PRAGMA(HLS INTERFACE axis port = in)
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_in)
-    HLS_PRAGMA(HLS DATA_PACK variable = meta_in)  // one wide FIFO word per frame
+    HLS_PRAGMA(HLS aggregate variable = meta_in)  // one FIFO word per frame
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = frame_id_in)
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = out)
+    HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one message per meta word
     static ap_uint<32> seq = 0;  // messages published so far
     image_meta meta = meta_in.read();
     seq++;
@@ -48,10 +50,10 @@ void publisher(pixel_stream& in, meta_stream& meta_in, byte_stream& out) {
     write_u32(out, meta.stamp_nsecs);
     // header.frame_id (string): as received
     write_u32(out, meta.frame_id_length);
-    for (ap_uint<32> i = 0; i < meta.frame_id_length; i++) {
+    for (ap_uint<FRAME_ID_LENGTH_BITS> i = 0; i < meta.frame_id_length; i++) {
         HLS_PRAGMA(HLS PIPELINE II = 1)
         HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 256)
-        out.write(meta.frame_id[i]);
+        out.write(frame_id_in.read());
     }
     // height (uint32)
     write_u32(out, IMG_HEIGHT);

@@ -53,13 +53,18 @@ static bool match_string(byte_stream& in, ap_uint<32>& pos, ap_uint<32> length,
 }
 
 // Interpret one frame. Returns SUB_OK (the pixels went to `out`, the carried-over fields to
-// `meta_out`) or the subscriber_status of the field that made it refuse the frame.
-int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
+// `meta_out`, frame_id's bytes to `frame_id_out`) or the subscriber_status of the field that
+// made it refuse the frame.
+int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out, byte_stream& frame_id_out) {
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
     HLS_PRAGMA(HLS INTERFACE axis port = out)
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_out)
-    HLS_PRAGMA(HLS DATA_PACK variable = meta_out)  // one wide FIFO word per frame
+    HLS_PRAGMA(HLS aggregate variable = meta_out)  // one FIFO word per frame
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = frame_id_out)
+    // Block protocol ap_ctrl_hs kept (not ap_ctrl_none): the status is the ap_return port,
+    // valid with ap_done. Tie ap_start high and the core reads frame after frame.
     image_meta meta;
+    byte_t frame_id[FRAME_ID_MAX];  // kept until the frame is accepted
     ap_uint<32> pos = 0;  // offset in the frame; 0 is the first byte of the frame length
 
     // frame length (uint32): bytes of the serialized message that follow.
@@ -87,7 +92,7 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
             break;
         }
         // header.frame_id (string bytes): carried over.
-        read_string(in, pos, meta.frame_id, frame_id_length);
+        read_string(in, pos, frame_id, frame_id_length);
         meta.frame_id_length = frame_id_length;
         // height (uint32): must be IMG_HEIGHT.
         ap_uint<32> height = read_u32(in, pos);
@@ -129,6 +134,11 @@ int subscriber(byte_stream& in, pixel_stream& out, meta_stream& meta_out) {
 
         // data (uint8[]): the pixels, through fifo2axi into the AXI4-Stream.
         meta_out.write(meta);
+        for (ap_uint<FRAME_ID_LENGTH_BITS> i = 0; i < meta.frame_id_length; i++) {
+            HLS_PRAGMA(HLS PIPELINE II = 1)
+            HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 256)
+            frame_id_out.write(frame_id[i]);
+        }
         fifo2axi(in, out);
         return SUB_OK;
     } while (false);
