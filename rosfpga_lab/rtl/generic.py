@@ -71,14 +71,24 @@ def node_wrapper(spec: GenericSpec, note: str) -> str:
             "        .busy(busy));\nendmodule\n")
 
 
+#: What the generic testbench changes in the lab's ``rfl_tb.v``: an 8-bit status, and no
+#: framing flags (the generic walkers frame each array themselves; the flags read 0).
+_TB_EDITS = (
+    ("wire [3:0] status;", "wire [7:0] status;"),
+    ("wire [7:0] framing;", "wire [7:0] framing = 8'd0;   // no framing flags in this circuit"),
+    (".busy(busy),\n        .framing(framing));", ".busy(busy));"),
+)
+
+
 def testbench() -> str:
-    """The lab's file-based testbench ``rfl_tb.v``, with the generic circuit's 8-bit status."""
+    """The lab's file-based testbench ``rfl_tb.v``, for the generic circuit (see _TB_EDITS)."""
     text = (TB_DIR / "rfl_tb.v").read_text(encoding="utf-8")
-    old = "wire [3:0] status;"
-    if old not in text:
-        raise RtlError(f"{TB_DIR / 'rfl_tb.v'} no longer declares '{old}': update "
-                       "rosfpga_lab.rtl.generic.testbench()")
-    return text.replace(old, "wire [7:0] status;")
+    for old, new in _TB_EDITS:
+        if old not in text:
+            raise RtlError(f"{TB_DIR / 'rfl_tb.v'} no longer has '{old}': update "
+                           "rosfpga_lab.rtl.generic.testbench()")
+        text = text.replace(old, new)
+    return text
 
 
 def generic_rtl_files(spec: GenericSpec) -> dict[str, bytes]:
