@@ -61,3 +61,19 @@ def test_every_subcommand_has_help() -> None:
         text = subparser.format_help()
         assert text.startswith("usage: rosfpga-lab " + name), name
         assert subparser.description, f"sub-command {name} has no description"
+
+
+def test_every_data_file_of_the_package_is_installed() -> None:
+    """A non-editable install (the course server's) ships every file the library reads: each
+    file under rosfpga_lab/ matches pyproject's package-data globs. The .srv files were missing,
+    and every lab node failed on the course server ("service type 'roscpp/GetLoggers' is not
+    shipped")."""
+    from fnmatch import fnmatch
+
+    globs = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"][
+        "package-data"]["*"]
+    code = {".py", ".pyc"}
+    left_out = [str(p.relative_to(ROOT)) for p in (ROOT / "rosfpga_lab").rglob("*")
+                if p.is_file() and p.suffix not in code and "__pycache__" not in p.parts
+                and p.name != "README.md" and not any(fnmatch(p.name, g) for g in globs)]
+    assert left_out == [], f"add their patterns to [tool.setuptools.package-data]: {left_out}"
