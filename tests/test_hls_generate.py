@@ -1,8 +1,8 @@
 """The generator: golden files, determinism, the manifest and --force, the CLI, the SLOC table.
 
 Golden files live in ``tests/golden/hls/<config>/`` (the default flavour, Vitis HLS) and
-``tests/golden/hls-vivado/<config>/`` (``hls: {flavour: vivado}``): every text file the generator
-writes for the three shipped configurations. A template change shows up here as a diff. To accept a
+``tests/golden/hls-vivado/<config>/`` (``hls: {flavour: vivado}``, only the files that differ from
+the default's): every text file the generator writes for the three shipped configurations. A template change shows up here as a diff. To accept a
 change on purpose, regenerate them and review the diff before committing::
 
     ROSFPGA_UPDATE_GOLDEN=1 .venv/bin/python -m pytest tests/test_hls_generate.py -k golden
@@ -67,22 +67,30 @@ def _meta_bits(header: str) -> int:
 def test_golden_files(stem: str, flavour: str) -> None:
     texts = render(_config(stem, flavour))
     assert set(texts) == set(TEMPLATE_FILES)
-    # The default flavour's files in golden/hls/, the others' in golden/hls-<flavour>/.
-    folder = (GOLDEN if flavour == DEFAULT_HLS_FLAVOUR else GOLDEN.with_name(f"hls-{flavour}")) / stem
+    # The default flavour's files in golden/hls/; another flavour's golden/hls-<flavour>/ holds
+    # only the files that differ from the default's (a file absent there equals the default's).
+    default = GOLDEN / stem
+    folder = default if flavour == DEFAULT_HLS_FLAVOUR else GOLDEN.with_name(f"hls-{flavour}") / stem
     if UPDATE:
         folder.mkdir(parents=True, exist_ok=True)
         for name, text in texts.items():
-            (folder / name).write_text(text, encoding="utf-8")
+            own = folder / name
+            if folder != default and (default / name).exists() \
+                    and (default / name).read_text(encoding="utf-8") == text:
+                own.unlink(missing_ok=True)
+            else:
+                own.write_text(text, encoding="utf-8")
     problems = []
     for name, text in sorted(texts.items()):
-        golden = folder / name
+        golden = folder / name if (folder / name).exists() else default / name
         if not golden.exists():
             problems.append(f"{golden} missing (regenerate: see this module's docstring)")
             continue
         expected = golden.read_text(encoding="utf-8")
         if expected != text:
             diff = "".join(difflib.unified_diff(expected.splitlines(True), text.splitlines(True),
-                                                f"golden/{stem}/{name}", f"generated/{name}", n=2))
+                                                f"{golden.relative_to(GOLDEN.parent)}",
+                                                f"generated/{name}", n=2))
             problems.append(diff)
     assert not problems, "generated code differs from the golden files:\n" + "\n".join(problems)
 
