@@ -40,20 +40,42 @@ pytestmark = [pytest.mark.slow, pytest.mark.timeout(600)]
 def client_for(path: Path) -> tuple[NotebookClient, nbformat.NotebookNode]:
     nb = nbformat.read(path, as_version=4)
     client = NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3",
-                            resources={"metadata": {"path": str(path.parent)}})
+                            resources={"metadata": {"path": str(path.parent)}},
+                            iopub_timeout=30, raise_on_iopub_timeout=True)
     return client, nb
 
 
 def text_of(cell: nbformat.NotebookNode) -> str:
-    parts = []
+    """A cell's text outputs; one print may arrive as several stream messages (the kernel
+    flushes on a timer, so a loaded machine splits lines), so consecutive chunks of one stream
+    are joined as they were written."""
+    parts: list[str] = []
+    stream = None
     for out in cell.get("outputs", []):
         if out.get("output_type") == "stream":
-            parts.append(out.get("text", ""))
-        elif out.get("output_type") in ("execute_result", "display_data"):
+            if stream == out.get("name"):
+                parts[-1] += out.get("text", "")
+            else:
+                parts.append(out.get("text", ""))
+            stream = out.get("name")
+            continue
+        stream = None
+        if out.get("output_type") in ("execute_result", "display_data"):
             parts.append(out.get("data", {}).get("text/plain", ""))
         elif out.get("output_type") == "error":
             parts.append(f"{out.get('ename')}: {out.get('evalue')}")
     return "\n".join(parts)
+
+
+def test_text_of_joins_a_print_the_kernel_sent_in_pieces():
+    """The kernel flushes stdout on a timer: one print can arrive as two stream messages."""
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(
+        'import sys, time\nsys.stdout.write("real ROS 1:")\nsys.stdout.flush()\n'
+        'time.sleep(0.5)\nprint(" NOT available")\nsys.stderr.write("warn\\n")\n1 + 1')])
+    NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3").execute()
+    outputs = nb.cells[0].outputs
+    assert [o.get("name") for o in outputs[:2]] == ["stdout", "stdout"]   # the split happened
+    assert text_of(nb.cells[0]) == "real ROS 1: NOT available\n\nwarn\n\n2"
 
 
 @pytest.mark.parametrize("path", sorted(SOLUTIONS.glob(nbbuild.NOTEBOOK_GLOB)), ids=lambda p: p.stem)
