@@ -48,10 +48,9 @@ from rosfpga_lab.hw.layout import (
 )
 from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.msg.cdr import CDR_LE, ENCAPSULATION_SIZE
-from rosfpga_lab.msg.ros2 import ros2_registry
+from rosfpga_lab.msg.ros2 import PLACEHOLDER_MEMBER as PLACEHOLDER
+from rosfpga_lab.msg.ros2 import PLACEHOLDER_TYPE, ros2_registry
 
-#: The member rosidl gives a message without fields (CDR sends it as one zero byte).
-PLACEHOLDER = "structure_needs_at_least_one_member"
 #: The representation id the circuit takes (CDR little-endian), big-endian as sent.
 REPRESENTATION = int.from_bytes(CDR_LE[:2], "big")
 #: Mask of the options' bits that count the padding bytes at the end of the payload.
@@ -72,7 +71,7 @@ def cdr_registry(reg: MsgRegistry | None = None) -> MsgRegistry:
     out = MsgRegistry()
     for name in r2.types():
         spec = r2.get(name)
-        text = spec.text if spec.fields else spec.text.rstrip("\n") + f"\nuint8 {PLACEHOLDER}\n"
+        text = spec.text if spec.fields else spec.text.rstrip("\n") + f"\n{PLACEHOLDER_TYPE} {PLACEHOLDER}\n"
         out.add(name, text.lstrip("\n"), source=spec.source)
     return out
 

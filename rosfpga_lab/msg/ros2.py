@@ -41,6 +41,9 @@ RENAMED_FIELDS: dict[str, dict[str, str]] = {
 }
 #: Shipped ROS 1 types that have no ROS 2 form.
 NOT_IN_ROS2: tuple[str, ...] = ("std_msgs/Time", "std_msgs/Duration")
+#: The member rosidl gives a message without fields (its type and name): CDR sends it as one
+#: zero byte and the type description lists it.
+PLACEHOLDER_TYPE, PLACEHOLDER_MEMBER = "uint8", "structure_needs_at_least_one_member"
 #: ROS 1 time value fields -> ROS 2 Time/Duration fields.
 TIME_FIELDS = ("sec", "nanosec")
 
