@@ -207,8 +207,39 @@ def build_roscpp_program(source: Path) -> Path:
     return binary
 
 
+# ---- real ROS 2 Python packages (the ros-jazzy-* wheels from PyPI) ------------------------------
+
+def ros2_share() -> Path:
+    """Where the ROS 2 wheels install their share/ folders (``<prefix>/share/PKG/msg/*.json``)."""
+    import sysconfig
+
+    return Path(sysconfig.get_path("data")) / "share"
+
+
+@functools.cache
+def ros2_python_missing_reason() -> str | None:
+    """Why the real ROS 2 Python packages cannot be used here, or None when they can."""
+    import importlib.util
+
+    if importlib.util.find_spec("rosidl_generator_type_description") is None:
+        return ("real ROS 2 Python packages not installed (rosidl_generator_type_description from "
+                "the ros-jazzy-* wheels; there are none for macOS)")
+    probe = ros2_share() / "std_msgs" / "msg" / "Header.json"
+    if not probe.is_file():
+        return f"real ROS 2 type descriptions not installed (no {probe})"
+    return None
+
+
+def require_ros2_python() -> None:
+    """Skip (or fail under CI: ROSFPGA_REQUIRE_ROS2=1) unless the ROS 2 Python packages are usable."""
+    reason = ros2_python_missing_reason()
+    if reason:
+        skip_or_fail(reason, "ROSFPGA_REQUIRE_ROS2")
+
+
 __all__ = [
     "ROS_PYTHON", "ROS_PROGRAMS", "build_roscpp_program", "cxx_missing_reason", "finish", "free_port",
-    "real_rosmaster", "require_cxx", "require_ros", "ros_env", "ros_missing_reason",
+    "real_rosmaster", "require_cxx", "require_ros", "require_ros2_python", "ros2_python_missing_reason",
+    "ros2_share", "ros_env", "ros_missing_reason",
     "run_ros_python", "skip_or_fail", "stop_process", "wait_for_master", "wait_line",
 ]

@@ -112,10 +112,11 @@ class Ros2Component:
 
     def start(self) -> Ros2Component:
         self.node = Ros2Node(self.name, self.domain, namespace=self.namespace)
+        reg = self.config.registry()
         self._pub = self.node.create_publisher(self.output_topic, self.config.publisher.type,
-                                               self.qos_out)
+                                               self.qos_out, reg)
         self.node.create_subscriber(self.input_topic, self.config.subscriber.type,
-                                    self._on_sample, self.qos_in)
+                                    self._on_sample, self.qos_in, reg)
         log.info("%s: ROS 2 node in DDS domain %d (participant index %d): %s -> %s -> %s",
                  self.name, self.domain, self.node.index, self.input_topic, self.pipeline.op,
                  self.output_topic)

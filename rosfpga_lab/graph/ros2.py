@@ -27,6 +27,9 @@ from rosfpga_lab.graph.errors import GraphError
 from rosfpga_lab.graph.limits import (
     ROS2_RECORD_BYTES, ROS2_RECORD_DATAGRAMS, ROS2_SOCKET_BUFFER_BYTES, ROS2_TICK_SECONDS,
 )
+from rosfpga_lab.msg.errors import MsgError
+from rosfpga_lab.msg.registry import MsgRegistry
+from rosfpga_lab.msg.typehash import type_hash as ros2_type_hash
 from rosfpga_lab.rtps.build import (
     ROS_DISCOVERY_TOPIC, ROS_DISCOVERY_TYPE, dds_topic, dds_type, participant_entities_info,
 )
@@ -181,18 +184,32 @@ class Ros2Node:
             out = p.write(self._graph_writer, payload, time.monotonic(), time.time())
         self._send(out)
 
-    def create_publisher(self, topic: str, type_name: str, qos: Qos = Qos()) -> Ros2Publisher:
-        """A writer of ROS 2 topic ``topic`` (``/image``) of ROS type ``type_name``."""
+    @staticmethod
+    def type_hash(type_name: str, registry: MsgRegistry | None = None) -> str:
+        """The ROS 2 type hash the node announces for ``type_name`` (its definition in
+        ``registry``, default the shipped types); '' for a type it cannot load (no hash sent)."""
+        try:
+            return ros2_type_hash(type_name, registry)
+        except MsgError:
+            return ""
+
+    def create_publisher(self, topic: str, type_name: str, qos: Qos = Qos(),
+                         registry: MsgRegistry | None = None) -> Ros2Publisher:
+        """A writer of ROS 2 topic ``topic`` (``/image``) of ROS type ``type_name`` (defined in
+        ``registry``, default the shipped types: its type hash goes out with it)."""
         with self._lock:
-            wid = self.participant.add_writer(dds_topic(topic), dds_type(type_name), qos)
+            wid = self.participant.add_writer(dds_topic(topic), dds_type(type_name), qos,
+                                              self.type_hash(type_name, registry))
             self._writers.append(self._guid(wid))
         self._announce_graph()
         return Ros2Publisher(self, wid, topic)
 
     def create_subscriber(self, topic: str, type_name: str,
-                          callback: Callable[[bytes, Sample], None], qos: Qos = Qos()) -> Ros2Subscriber:
+                          callback: Callable[[bytes, Sample], None], qos: Qos = Qos(),
+                          registry: MsgRegistry | None = None) -> Ros2Subscriber:
         with self._lock:
-            rid = self.participant.add_reader(dds_topic(topic), dds_type(type_name), qos)
+            rid = self.participant.add_reader(dds_topic(topic), dds_type(type_name), qos,
+                                              self.type_hash(type_name, registry))
             sub = self._subs[rid] = Ros2Subscriber(self, rid, topic, callback)
             self._readers.append(self._guid(rid))
         self._announce_graph()

@@ -217,6 +217,11 @@ def inline_qos(params: Iterable[tuple[int, bytes]]) -> bytes:
     return param_list(params)[len(PL_CDR_LE):]
 
 
+def octet_sequence(value: bytes) -> bytes:
+    """A CDR ``sequence<octet>`` (uint32 count, the bytes), as USER_DATA's value is."""
+    return struct.pack("<I", len(value)) + value
+
+
 def duration(seconds: float) -> bytes:
     sec = int(seconds)
     return struct.pack("<iI", sec, int((seconds - sec) * 2**32) & 0xFFFFFFFF)
@@ -235,13 +240,16 @@ def spdp_payload(guid_prefix: bytes, meta: Locator, user: Locator, lease: float,
         (PID_DEFAULT_UNICAST_LOCATOR, user.encode()),
         (PID_PARTICIPANT_LEASE_DURATION, duration(lease)),
         (PID_ENTITY_NAME, cdr_string(name)),
-        (PID_USER_DATA, struct.pack("<I", len(user_data)) + user_data),
+        (PID_USER_DATA, octet_sequence(user_data)),
     ])
 
 
 def sedp_payload(guid: bytes, topic: str, type_name: str, reliable: bool, depth: int,
-                 locator: Locator, transient_local: bool = False) -> bytes:
-    """SEDP data of one of the lab's endpoints (publication or subscription)."""
+                 locator: Locator, transient_local: bool = False, type_hash: str = "") -> bytes:
+    """SEDP data of one of the lab's endpoints (publication or subscription); with a
+    ``type_hash``, its USER_DATA says ``typehash=RIHS01_...;`` as ROS 2's rmw does."""
+    user = ([(PID_USER_DATA, octet_sequence(type_hash_user_data(type_hash)))] if type_hash
+            else [])
     return param_list([
         (PID_ENDPOINT_GUID, guid),
         (PID_PARTICIPANT_GUID, guid[:12] + _eid(0x000001C1)),
@@ -251,6 +259,7 @@ def sedp_payload(guid: bytes, topic: str, type_name: str, reliable: bool, depth:
         (PID_DURABILITY, struct.pack("<I", TRANSIENT_LOCAL if transient_local else VOLATILE)),
         (PID_HISTORY, struct.pack("<Ii", KEEP_LAST, depth)),
         (PID_DATA_REPRESENTATION, struct.pack("<Ih", 1, XCDR)),
+        *user,
         (PID_UNICAST_LOCATOR, locator.encode()),
         (PID_PROTOCOL_VERSION, bytes(PROTOCOL_VERSION)),
         (PID_VENDORID, VENDOR_ID.to_bytes(2, "big")),
@@ -273,6 +282,18 @@ def dds_type(ros_type: str) -> str:
     parts = ros_type.split("/")
     pkg, name = parts[0], parts[-1]
     return f"{pkg}::msg::dds_::{name}_"
+
+
+#: rmw's USER_DATA of an endpoint is ``key=value;`` pairs (rmw_dds_common); Iron and later
+#: put the type hash under this key (``encode_type_hash_for_user_data_qos``).
+TYPEHASH_KEY = "typehash"
+#: Separators of those pairs.
+USER_DATA_PAIR_END, USER_DATA_KEY_END = ";", "="
+
+
+def type_hash_user_data(type_hash: str) -> bytes:
+    """``RIHS01_...`` -> ``b"typehash=RIHS01_...;"`` (no NUL), the USER_DATA rmw sends."""
+    return f"{TYPEHASH_KEY}{USER_DATA_KEY_END}{type_hash}{USER_DATA_PAIR_END}".encode("ascii")
 
 
 # ---- the ROS 2 graph: which nodes a participant holds (rmw_dds_common) ------------------------

@@ -14,6 +14,10 @@ import struct
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from rosfpga_lab.msg.typehash import RIHS_PATTERN
+from rosfpga_lab.rtps.build import (
+    PID_USER_DATA, TYPEHASH_KEY, USER_DATA_KEY_END, USER_DATA_PAIR_END,
+)
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
 from rosfpga_lab.rtps.limits import MAX_PENDING_BYTES, MAX_PENDING_SAMPLES, MAX_SAMPLE_BYTES
 from rosfpga_lab.rtps.message import Data, DataFrag, RtpsMessage
@@ -62,6 +66,29 @@ def _string(value: bytes, little: bool) -> str:
     return value[4:4 + n].rstrip(b"\x00").decode("utf-8", "replace")
 
 
+def user_data_pairs(value: bytes, little: bool = True) -> dict[str, str]:
+    """The ``key=value;`` pairs of a USER_DATA parameter value (a ``sequence<octet>``), as
+    rmw's ``parse_key_value`` reads them: an item without ``=`` or with an empty key is skipped,
+    a count past the value's end is cut to the bytes there; {} when it is no such text."""
+    if len(value) < 4:
+        return {}
+    (n,) = struct.unpack("<I" if little else ">I", value[:4])
+    text = value[4:4 + n].decode("utf-8", "replace")
+    out: dict[str, str] = {}
+    for item in text.split(USER_DATA_PAIR_END):
+        key, sep, val = item.partition(USER_DATA_KEY_END)
+        if sep and key:
+            out[key] = val
+    return out
+
+
+def user_data_type_hash(value: bytes, little: bool = True) -> str:
+    """The ROS 2 type hash (``RIHS01_...``) an endpoint's USER_DATA announces; '' when it
+    announces none (Humble, plain DDS) or a malformed one."""
+    found = user_data_pairs(value, little).get(TYPEHASH_KEY, "")
+    return found if RIHS_PATTERN.fullmatch(found) else ""
+
+
 @dataclass(frozen=True)
 class Participant:
     """A participant announced by SPDP: GUID prefix (12 bytes) and name when it gave one."""
@@ -78,6 +105,7 @@ class Endpoint:
     kind: str            # "writer" or "reader"
     topic: str
     type_name: str
+    type_hash: str = ""      # ROS 2 (Iron and later): RIHS01_... from USER_DATA, else ''
 
 
 def discovery(messages: Iterable[RtpsMessage]) -> tuple[list[Participant], list[Endpoint]]:
@@ -104,7 +132,9 @@ def discovery(messages: Iterable[RtpsMessage]) -> tuple[list[Participant], list[
                 kind = "writer" if sub.writer_id == SEDP_PUBLICATIONS_WRITER else "reader"
                 endpoints[guid] = Endpoint(guid, kind, _string(params[PID_TOPIC_NAME][0], little),
                                            _string(params[PID_TYPE_NAME][0], little)
-                                           if PID_TYPE_NAME in params else "")
+                                           if PID_TYPE_NAME in params else "",
+                                           user_data_type_hash(params[PID_USER_DATA][0], little)
+                                           if PID_USER_DATA in params else "")
     return list(participants.values()), list(endpoints.values())
 
 

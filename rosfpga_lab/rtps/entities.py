@@ -80,6 +80,7 @@ class RemoteEndpoint:
     type_name: str
     qos: Qos
     locator: tuple[str, int]
+    type_hash: str = ""           # RIHS01_... its USER_DATA announced ('' if none)
 
 
 @dataclass
@@ -125,6 +126,7 @@ class LocalEndpoint:
     history: OrderedDict[int, bytes] = field(default_factory=OrderedDict)
     proxies: dict[tuple[bytes, int], ReaderProxy | WriterProxy] = field(default_factory=dict)
     hb_count: int = 0
+    type_hash: str = ""                           # RIHS01_... announced in its USER_DATA
 
     @property
     def guid_tail(self) -> bytes:

@@ -13,7 +13,9 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
 * SEDP: its writers and readers go out as reliable built-in samples (DATA, HEARTBEAT, ACKNACK),
   the peers' ones come in the same way; a remote endpoint on the same topic and type is matched
   when its QoS is compatible (RxO: offered reliability and durability at least what is
-  requested), else the reason is logged once.
+  requested), else the reason is logged once. An endpoint given a ROS 2 type hash announces it
+  (USER_DATA ``typehash=RIHS01_...;``, as rmw does); a matched remote endpoint whose announced
+  hash differs is logged once and matched all the same (rmw matches on the type name).
 * User data: a writer keeps the last ``depth`` samples (KEEP_LAST; VOLATILE, or TRANSIENT_LOCAL:
   a reader that joins late gets them), sends each as DATA
   or DATA_FRAG; reliable ones HEARTBEAT until acknowledged, resend on ACKNACK/NACK_FRAG and GAP
@@ -28,7 +30,10 @@ import struct
 from collections import deque
 
 from rosfpga_lab.rtps import build as b
-from rosfpga_lab.rtps.discovery import PL_CDR_BE, PL_CDR_LE, FragmentAssembler, parse_parameters
+from rosfpga_lab.msg.typehash import RIHS_PATTERN
+from rosfpga_lab.rtps.discovery import (
+    PL_CDR_BE, PL_CDR_LE, FragmentAssembler, parse_parameters, user_data_type_hash,
+)
 from rosfpga_lab.rtps.entities import (
     PARTICIPANT_ENTITY, PUB_READER, PUB_WRITER, READER_KIND, SPDP_READER, SPDP_WRITER, SUB_READER, SUB_WRITER,
     WRITER_KIND, LocalEndpoint, Qos, ReaderProxy, RemoteEndpoint, RemoteParticipant, Sample, Send,
@@ -100,19 +105,28 @@ class Participant:
         self._next_key += 1
         return eid
 
-    def add_writer(self, topic: str, type_name: str, qos: Qos = Qos()) -> int:
-        """A user writer on DDS topic ``topic`` (``rt/...`` for ROS 2); returns its entity id."""
+    @staticmethod
+    def _check_hash(type_hash: str) -> str:
+        if type_hash and not RIHS_PATTERN.fullmatch(type_hash):
+            raise RtpsError(f"type hash {type_hash[:80]!r} is not RIHS01_ and 64 lowercase hex "
+                            f"digits: pass rosfpga_lab.msg.typehash.type_hash(type), or ''")
+        return type_hash
+
+    def add_writer(self, topic: str, type_name: str, qos: Qos = Qos(), type_hash: str = "") -> int:
+        """A user writer on DDS topic ``topic`` (``rt/...`` for ROS 2); returns its entity id.
+        ``type_hash`` (``RIHS01_...``, '' for none) goes out in its SEDP USER_DATA."""
         ep = LocalEndpoint(self._new_entity(WRITER_KIND), "writer", topic, type_name,
                            Qos(qos.reliable, max(1, min(qos.depth, MAX_HISTORY_DEPTH)),
-                               qos.transient_local))
+                               qos.transient_local), type_hash=self._check_hash(type_hash))
         self.local[ep.entity_id] = ep
         self._announce_endpoint(ep)
         return ep.entity_id
 
-    def add_reader(self, topic: str, type_name: str, qos: Qos = Qos()) -> int:
+    def add_reader(self, topic: str, type_name: str, qos: Qos = Qos(), type_hash: str = "") -> int:
         """A user reader; returns its entity id (its samples arrive in :attr:`samples`)."""
         ep = LocalEndpoint(self._new_entity(READER_KIND), "reader", topic, type_name,
-                           Qos(qos.reliable, max(1, min(qos.depth, MAX_HISTORY_DEPTH)), False))
+                           Qos(qos.reliable, max(1, min(qos.depth, MAX_HISTORY_DEPTH)), False),
+                           type_hash=self._check_hash(type_hash))
         self.local[ep.entity_id] = ep
         self._announce_endpoint(ep)
         return ep.entity_id
@@ -122,7 +136,8 @@ class Participant:
         sedp.seq += 1
         sedp.history[sedp.seq] = b.sedp_payload(self.guid_prefix + ep.guid_tail, ep.topic,
                                                 ep.type_name, ep.qos.reliable, ep.qos.depth,
-                                                b.Locator(*self.user), ep.qos.transient_local)
+                                                b.Locator(*self.user), ep.qos.transient_local,
+                                                ep.type_hash)
         for rem in list(self.remote.values()):
             self._try_match(ep, rem)
 
@@ -348,7 +363,8 @@ class Participant:
             return
         rem = RemoteEndpoint(guid, kind, b.cdr_string_value(params[b.PID_TOPIC_NAME][0], little),
                              b.cdr_string_value((params.get(b.PID_TYPE_NAME) or [b""])[0], little),
-                             Qos(reliable, depth, durability >= b.TRANSIENT_LOCAL), loc)
+                             Qos(reliable, depth, durability >= b.TRANSIENT_LOCAL), loc,
+                             user_data_type_hash((params.get(b.PID_USER_DATA) or [b""])[0], little))
         self.remote[guid] = rem
         for ep in list(self.local.values()):
             if ep.topic:
@@ -375,6 +391,13 @@ class Participant:
         if why:
             self.note(f"qos-{rem.guid.hex()}-{ep.entity_id}", f"not matched: {what}: {why}")
             return
+        if ep.type_hash and rem.type_hash and ep.type_hash != rem.type_hash:
+            # rmw matches on the type name alone and only tells; so does the lab
+            self.note(f"typehash-{rem.guid.hex()}-{ep.entity_id}",
+                      f"type hash differs: {what}: remote {rem.type_name} announces "
+                      f"{rem.type_hash}, ours is {ep.type_hash} (matched anyway, as ROS 2's rmw "
+                      f"does; the two definitions of {rem.type_name} differ, e.g. another ROS 2 "
+                      f"distribution's)")
         if ep.kind == "writer" and ep.qos.transient_local and rem.qos.transient_local and ep.history:
             # TRANSIENT_LOCAL both sides: a reader that joins late gets the history (KEEP_LAST
             # depth); a VOLATILE reader gets only what is written after it matched
