@@ -240,3 +240,87 @@ def test_field_type_ids_are_rosidls() -> None:
         assert value + ARRAY_OFFSET == ids[name + "_ARRAY"]
         assert value + UNBOUNDED_SEQUENCE_OFFSET == ids[name + "_UNBOUNDED_SEQUENCE"]
     assert NESTED_TYPE_ID == ids["FIELD_TYPE_NESTED_TYPE"]
+
+
+# ---- real rmw (rclpy on Fast DDS) and the lab's node, both ways ---------------------------------
+
+FASTDDS_LOOPBACK = """<?xml version="1.0" encoding="UTF-8" ?>
+<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
+  <transport_descriptors><transport_descriptor><transport_id>loopback</transport_id>
+    <type>UDPv4</type><interfaceWhiteList><address>127.0.0.1</address></interfaceWhiteList>
+  </transport_descriptor></transport_descriptors>
+  <participant profile_name="loopback_only" is_default_profile="true"><rtps>
+    <userTransports><transport_id>loopback</transport_id></userTransports>
+    <useBuiltinTransports>false</useBuiltinTransports>
+  </rtps></participant>
+</profiles>
+"""
+#: rclpy subscribes to the lab's /hash_cam and publishes /hash_back; prints the type hash its rmw
+#: read from the lab's publisher, then stays a while so the lab sees its endpoints.
+RCLPY_PROBE = """
+import json, sys, time
+import rclpy
+from rclpy.node import Node
+from sensor_msgs.msg import Image
+rclpy.init()
+node = Node("hash_probe")
+node.create_subscription(Image, "/hash_cam", lambda m: None, 10)
+node.create_publisher(Image, "/hash_back", 10)
+end, seen = time.time() + 20, []
+while time.time() < end and not seen:
+    rclpy.spin_once(node, timeout_sec=0.1)
+    seen = [str(i.topic_type_hash) for i in node.get_publishers_info_by_topic("/hash_cam")]
+print(json.dumps(seen), flush=True)
+end = time.time() + 20
+while time.time() < end and not sys.stdin.readline():
+    pass
+node.destroy_node()
+rclpy.shutdown()
+"""
+
+
+def test_real_rmw_reads_the_labs_hash_and_the_lab_reads_rmws(tmp_path: Path) -> None:
+    require_ros2_python()
+    import importlib.util
+    import os
+    import subprocess
+    import sys
+    import time
+
+    from realros import skip_or_fail
+    from ros2tools import DOMAIN
+    from rosfpga_lab.graph.ros2 import Ros2Node
+
+    if importlib.util.find_spec("rclpy") is None:
+        skip_or_fail("rclpy not installed (ros-jazzy-rclpy[fastrtps] wheels)", "ROSFPGA_REQUIRE_ROS2")
+    (tmp_path / "fastdds.xml").write_text(FASTDDS_LOOPBACK)
+    env = {**os.environ, "ROS_DOMAIN_ID": str(DOMAIN),
+           "FASTRTPS_DEFAULT_PROFILES_FILE": str(tmp_path / "fastdds.xml")}
+    image = GOLDEN["sensor_msgs/Image"]
+    with Ros2Node("hash_lab", DOMAIN) as node:
+        node.create_publisher("/hash_cam", "sensor_msgs/Image")
+        probe = subprocess.Popen([sys.executable, "-c", RCLPY_PROBE], env=env, text=True,
+                                 stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE)
+        try:
+            assert probe.stdout is not None and probe.stdin is not None
+            line = probe.stdout.readline()
+            seen: dict[tuple[str, str], str] = {}
+            deadline = time.monotonic() + 10
+            while len(seen) < 2 and time.monotonic() < deadline:
+                with node._lock:
+                    seen = {(r.kind, r.topic): r.type_hash for r in node.participant.remote.values()
+                            if r.topic in ("rt/hash_cam", "rt/hash_back")}
+                time.sleep(0.05)
+            probe.stdin.write("done\n")
+            probe.stdin.flush()
+        finally:
+            try:
+                _, err = probe.communicate(timeout=20)
+            except subprocess.TimeoutExpired:
+                probe.kill()
+                _, err = probe.communicate()
+    # rmw_fastrtps parsed the lab's USER_DATA: the hash it reports is Jazzy's own for Image
+    assert json.loads(line or "null") == [image], (line, err[-2000:])
+    # and the lab read what Jazzy's rmw announces for its reader and writer
+    assert seen == {("reader", "rt/hash_cam"): image, ("writer", "rt/hash_back"): image}, seen
