@@ -109,7 +109,7 @@ def individual_description(spec: MsgSpec) -> dict[str, Any]:
 def _ros2(reg: MsgRegistry | None) -> MsgRegistry:
     if reg is None:
         return ros2_registry()
-    return reg.cached("ros2-form", "", lambda: ros2_registry(reg))  # type: ignore[no-any-return]
+    return reg.cached("ros2-form", "", lambda: ros2_registry(reg))
 
 
 def type_description(type_name: str, reg: MsgRegistry | None = None) -> dict[str, Any]:
@@ -158,6 +158,6 @@ def type_hash(type_name: str, reg: MsgRegistry | None = None) -> str:
     """
     r2 = _ros2(reg)
     name = r2.check(lab_type_name(type_name)).full_name
-    return r2.cached(  # type: ignore[no-any-return]
+    return r2.cached(
         "rihs01", name, lambda: RIHS01_PREFIX + hashlib.sha256(
             _hashed_text(r2, name).encode("utf-8")).hexdigest())
