@@ -32,7 +32,8 @@ arrays of strings, times, messages     lists
 Modules: ``parser`` (text -> MsgSpec), ``registry`` (types, md5, full text), ``decode`` and
 ``encode`` (the fast wire codecs), ``layout`` (byte spans, and the plain reference decoder),
 ``values`` (defaults, new_message), ``builtins`` (types, Time, Duration), ``limits``, ``errors``,
-``describe`` (text views), ``ros2`` (the ROS 2 forms of the types) and ``cdr`` (the ROS 2
+``describe`` (text views), ``ros2`` (the ROS 2 forms of the types), ``typehash`` (their ROS 2
+type hash, RIHS01) and ``cdr`` (the ROS 2
 wire format: ``serialize_cdr``, ``deserialize_cdr``, ``cdr_layout``), ``strategies`` (hypothesis strategies, for tests), ``bench``.
 """
 
