@@ -54,6 +54,13 @@ GOLDEN = {
     "geometry_msgs/PoseWithCovariance":
         "RIHS01_9a7c0fd234b7f45c6098745ecccd773ca1085670e64107135397aee31c02e1bb",
 }
+#: What rosidl's generator writes for the hand-written ROS 2 forms of data/msg/lab_msgs (no
+#: installed file holds them; test_lab_msgs_hash_as_rosidl_generates_it derives them again).
+LAB_GOLDEN = {
+    "lab_msgs/Samples": "RIHS01_66141d0aaf67694542693aa6499d50ee641b99b3d30b3453e8037dbc06becffa",
+    "lab_msgs/Calibration":
+        "RIHS01_e57fb46cb30dd9375c3c31095f8a36fb1cf601f7d89ef3df55b1778a5e4f0a08",
+}
 #: Installed types whose Jazzy definition is not the lab's ROS 2 form, and why. The lab's forms
 #: follow Humble's (tests/test_msg_cdr.py checks them against rosbags' Humble store).
 JAZZY_CHANGED = {
@@ -205,7 +212,8 @@ def test_lab_msgs_hash_as_rosidl_generates_it(tmp_path: Path) -> None:
     reg = registry_with([LAB_MSGS])
     for name in ("Calibration", "Samples"):
         real = theirs[name]
-        assert type_hash(f"lab_msgs/{name}", reg) == real["type_hashes"][0]["hash_string"]
+        assert real["type_hashes"][0]["hash_string"] == LAB_GOLDEN[f"lab_msgs/{name}"]
+        assert type_hash(f"lab_msgs/{name}", reg) == LAB_GOLDEN[f"lab_msgs/{name}"]
         assert type_description(f"lab_msgs/{name}", reg) == real["type_description_msg"]
 
 
@@ -240,6 +248,30 @@ def test_field_type_ids_are_rosidls() -> None:
         assert value + ARRAY_OFFSET == ids[name + "_ARRAY"]
         assert value + UNBOUNDED_SEQUENCE_OFFSET == ids[name + "_UNBOUNDED_SEQUENCE"]
     assert NESTED_TYPE_ID == ids["FIELD_TYPE_NESTED_TYPE"]
+
+
+def test_component_announces_the_hash_of_its_configured_type() -> None:
+    """A lab_msgs component (its msg_path types) sends rosidl's hash of them in SEDP."""
+    from ros2tools import DOMAIN
+    from rosfpga_lab.component.ros2 import Ros2Component
+    from rosfpga_lab.rtps.build import PID_TOPIC_NAME, PID_USER_DATA, cdr_string_value
+    from rosfpga_lab.rtps.discovery import parse_parameters, user_data_type_hash
+    from rosfpga_lab.rtps.participant import PUB_WRITER, SUB_WRITER
+
+    comp = Ros2Component(LAB_MSGS.parent / "fpga_samples_dilate.yaml", domain=DOMAIN).start()
+    try:
+        assert comp.node is not None
+        with comp.node._lock:                      # the SEDP samples it sends
+            p = comp.node.participant
+            sedp = [params for eid in (PUB_WRITER, SUB_WRITER)
+                    for params in map(parse_parameters, p.local[eid].history.values())]
+    finally:
+        comp.stop()
+    announced = {cdr_string_value(params[PID_TOPIC_NAME][0]):
+                 user_data_type_hash(params[PID_USER_DATA][0]) for params in sedp
+                 if PID_USER_DATA in params}
+    assert announced == {"rt/samples": LAB_GOLDEN["lab_msgs/Samples"],
+                         "rt/samples_dilated": LAB_GOLDEN["lab_msgs/Samples"]}
 
 
 # ---- real rmw (rclpy on Fast DDS) and the lab's node, both ways ---------------------------------
