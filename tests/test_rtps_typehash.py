@@ -7,13 +7,16 @@ from __future__ import annotations
 import struct
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+from rosfpga_lab.msg.typehash import RIHS_PATTERN
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps import parse_message
 from rosfpga_lab.rtps.discovery import discovery, parse_parameters, user_data_type_hash
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.participant import PUB_READER, PUB_WRITER, Participant
-from test_rtps_participant import TOPIC, TYPE, Net
+from test_rtps_participant import TOPIC, TYPE, Net, fresh, spdp
 
 # sensor_msgs/msg/Image and std_msgs/msg/Header of ROS 2 Jazzy (share/*/msg/*.json)
 IMAGE = "RIHS01_d31d41a9a4c4bc8eae9be757b0beed306564f7526c88ea6a4588fb9582527d47"
@@ -95,3 +98,32 @@ def test_a_malformed_local_hash_is_refused() -> None:
     p = Participant(domain=7, index=0)
     with pytest.raises(RtpsError, match="RIHS01_"):
         p.add_writer(TOPIC, TYPE, type_hash="RIHS01_dead")
+
+
+def test_type_hash_decoder_byte_by_byte_and_with_trailing_bytes() -> None:
+    text = b"enclave=/;typehash=" + IMAGE.encode() + b";"
+    value = struct.pack("<I", len(text)) + text
+    for n in range(len(value)):                   # every prefix: nothing, or the whole hash
+        got = user_data_type_hash(value[:n])
+        assert got in ("", IMAGE), n
+        assert (got == IMAGE) == (n >= len(value) - 1), n      # only the ';' may be missing
+    assert user_data_type_hash(value + b"typehash=junk;" + bytes(7)) == IMAGE  # past the count
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.one_of(st.binary(max_size=200),
+                 st.lists(st.sampled_from([b"typehash=", IMAGE.encode(), b";", b"=", b"\xff",
+                                           b"RIHS01_", b"0" * 64]), max_size=8).map(b"".join)
+                 .map(lambda t: struct.pack("<I", len(t)) + t)))
+def test_any_user_data_never_raises(value: bytes) -> None:
+    got = user_data_type_hash(value)
+    assert got == "" or RIHS_PATTERN.fullmatch(got)
+    p = fresh()
+    prefix = b"Q" * 12
+    p.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    payload = b.param_list([(b.PID_ENDPOINT_GUID, prefix + bytes([0, 0, 1, 3])),
+                            (b.PID_TOPIC_NAME, b.cdr_string(TOPIC)),
+                            (b.PID_TYPE_NAME, b.cdr_string(TYPE)),
+                            (b.PID_UNICAST_LOCATOR, LOCATOR.encode()), (b.PID_USER_DATA, value)])
+    p.receive(b.header(prefix) + b.data(PUB_READER, PUB_WRITER, 1, payload), ("127.0.0.1", 7999), 0.0)
+    assert [r.type_hash for r in p.remote.values()] == [got]
