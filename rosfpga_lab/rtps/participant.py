@@ -239,12 +239,22 @@ class Participant:
 
     def _locator(self, value: list[bytes] | None, little: bool,
                  source: tuple[str, int]) -> tuple[str, int] | None:
-        for raw in value or []:
-            loc = b.Locator.decode(raw, little)
-            if loc is None:
-                continue
+        """Where to reach a peer: a loopback locator, or one at the sender's own address; else,
+        when the sender is on this host (a loopback source), its locator's port at the sender's
+        address (Fast DDS, rmw_fastrtps_cpp's DDS, announces only the host's LAN addresses and
+        listens on all of them, loopback included, as it does for its own peers on one host)."""
+        found = [loc for loc in (b.Locator.decode(raw, little) for raw in value or [])
+                 if loc is not None]
+        for loc in found:
             if loc.address.startswith("127.") or loc.address == source[0]:
                 return (loc.address, loc.port)
+        if found and source[0].startswith("127."):
+            loc = found[0]
+            self.note(f"locator-local-{loc.address}", f"locator {loc.address}:{loc.port} of a "
+                      f"peer on this host (it spoke from {source[0]}): reached at "
+                      f"{source[0]}:{loc.port}")
+            return (source[0], loc.port)
+        for loc in found:
             self.note(f"locator-{loc.address}", f"locator {loc.address}:{loc.port} ignored: the "
                       f"lab sends only to loopback or to the sender's own address")
         return None
@@ -342,7 +352,8 @@ class Participant:
         durability = u32(b.PID_DURABILITY) or b.VOLATILE
         depth = u32(b.PID_HISTORY, 4) or 1
         owner = self.participants.get(prefix)
-        loc = self._locator(params.get(b.PID_UNICAST_LOCATOR), little, (self.address, 0)) \
+        loc = self._locator(params.get(b.PID_UNICAST_LOCATOR), little,
+                            owner.meta if owner else (self.address, 0)) \
             or (owner.user if owner else None)
         if loc is None:
             return
