@@ -305,10 +305,15 @@ class Participant:
             for seq, payload in ep.history.items():
                 subs += self._sample_subs(rid, wid, seq, payload)
             subs.append(self._heartbeat(ep, proxy))
+        # Fast DDS answers a preemptive ACKNACK at once (a HEARTBEAT, then what we lack) only
+        # in its own form, base 0 (which Cyclone DDS refuses from other vendors): without it,
+        # SEDP data it sent before it knew us waits for its next periodic HEARTBEAT (~1 s)
+        vendor = (params.get(b.PID_VENDORID) or [b""])[0][:2]
+        base = 0 if vendor == b.VENDOR_EPROSIMA.to_bytes(2, "big") else 1
         for rid, wid in ((PUB_READER, PUB_WRITER), (SUB_READER, SUB_WRITER)):
             wp = WriterProxy(prefix, wid, True, 1)
             self.local[rid].proxies[(prefix, wid)] = wp
-            subs.append(b.acknack(rid, wid, 1, [], 1))
+            subs.append(b.acknack(rid, wid, base, [], 1))
         out += self._msg(meta, prefix, subs)
         return out
 
@@ -453,6 +458,9 @@ class Participant:
             self.note("acknack-dup", "ACKNACK with a count already seen: no retransmission")
             return []
         proxy.last_count = sub.count
+        if sub.base == 0:
+            # a preemptive ACKNACK (base 0, no bits: Fast DDS's form) asks for a HEARTBEAT
+            return self._msg(proxy.locator, proxy.prefix, [self._heartbeat(ep, proxy)])
         # only what was written can be missing: later numbers are ignored, never GAPped
         missing = [s for s in sub.missing if s <= ep.seq]
         if len(missing) < len(sub.missing):
@@ -678,7 +686,7 @@ class Participant:
             return f"HEARTBEAT first {sub.first} last {sub.last}"
         if isinstance(sub, Gap) and (sub.start < 1 or sub.list_base < sub.start):
             return f"GAP start {sub.start} base {sub.list_base}"
-        if isinstance(sub, AckNack) and sub.base < 1:
+        if isinstance(sub, AckNack) and sub.base < 1 and (sub.base, sub.num_bits) != (0, 0):
             return f"ACKNACK base {sub.base}"
         if isinstance(sub, (Data, DataFrag)) and sub.seq < 1:
             return f"{'DATA' if isinstance(sub, Data) else 'DATA_FRAG'} sequence number {sub.seq}"

@@ -82,6 +82,7 @@ def main() -> int:
             report["matched"] = spin_until(
                 node, lambda: pub.get_subscription_count() >= 1 and
                 sink.sub.get_publisher_count() >= 1, opt.timeout)
+            spin_until(node, lambda: False, 0.3)   # the lab matches our writer (SEDP) too
             for k in range(n):
                 pub.publish(image(k, h, w))
                 spin_until(node, lambda: len(sink.got) > k, 2.0)   # paced: one at a time
@@ -96,7 +97,7 @@ def main() -> int:
             pub = node.create_publisher(Image, topic, 10)
             report["matched"] = spin_until(node, lambda: pub.get_subscription_count() >= 1,
                                            opt.timeout)
-            time.sleep(0.2)    # the lab's reader has matched too (it learns of us by SEDP)
+            spin_until(node, lambda: False, 0.3)   # the lab matches our writer (SEDP) too
             for k in range(n):
                 pub.publish(image(k, h, w))
                 spin_until(node, lambda: False, 0.1)
