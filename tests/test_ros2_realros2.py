@@ -15,7 +15,7 @@ import json
 import os
 import subprocess
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import cv2
@@ -62,15 +62,28 @@ def ros2_env(tmp: Path) -> dict[str, str]:
     return env
 
 
-def rclpy_peer(tmp: Path, mode: str, *args: object, timeout: float = 15.0) -> tuple[dict, Path]:
-    """Run rclpy_peer.py MODE ARGS; its JSON report and the folder of the frames it received."""
+def rclpy_peer(tmp: Path, mode: str, *args: object, timeout: float = 15.0,
+               matched: Callable[[], bool] | None = None) -> tuple[dict, Path]:
+    """Run rclpy_peer.py MODE ARGS; its JSON report and the folder of the frames it received.
+    ``matched``: the relay's go-ahead, once it says true (the lab has matched its writer)."""
     out = tmp / f"rclpy-{mode}"
     out.mkdir(exist_ok=True)
-    proc = subprocess.run([sys.executable, str(PEER), mode, *map(str, args), "--out", str(out),
-                           "--timeout", str(timeout)],
-                          capture_output=True, text=True, timeout=timeout + 30, env=ros2_env(tmp))
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1]), out
+    proc = subprocess.Popen([sys.executable, str(PEER), mode, *map(str, args), "--out", str(out),
+                             "--timeout", str(timeout)], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=ros2_env(tmp))
+    try:
+        if matched is not None:
+            assert proc.stdout is not None and proc.stdin is not None
+            first = proc.stdout.readline()      # within the peer's own timeout
+            assert first.strip() == "matched" and wait(matched, 10), first
+            proc.stdin.write("go\n")
+            proc.stdin.flush()
+        stdout, stderr = proc.communicate(timeout=timeout + 30)
+    finally:
+        stop_process(proc)
+    assert proc.returncode == 0, stderr[-3000:]
+    return json.loads(stdout.strip().splitlines()[-1]), out
 
 
 class Labs:
@@ -99,7 +112,15 @@ def test_rclpy_images_through_the_component_exact(labs: Labs, tmp_path: Path, wh
     """rclpy publisher (RELIABLE KEEP_LAST 10) -> component -> rclpy subscriber (the same)."""
     comp = getattr(labs, which)
     before = dict(comp.counts)
-    report, out = rclpy_peer(tmp_path, "relay", topic, f"{topic}_out", w, h, n)
+    (reader_id,) = comp.node._subs
+
+    def writers() -> set[bytes]:     # remote writers the lab's input reader is matched with
+        with comp.node._lock:
+            return set(comp.node.participant.matched(reader_id))
+
+    earlier = writers()
+    report, out = rclpy_peer(tmp_path, "relay", topic, f"{topic}_out", w, h, n,
+                             matched=lambda: bool(writers() - earlier))
     assert report["matched"], comp.notes()
     got = report["got"]
     assert len(got) == n, (got, comp.counts, comp.notes())

@@ -6,6 +6,7 @@ Each mode ends by itself (bounded by --timeout) and prints one JSON line on stdo
 last line; frames received are written as raw files into --out.
 
   relay IN OUT W H N      publish N random rgba8 W x H pictures (numpy seed k) on IN, receive on OUT
+                          (prints "matched", then waits for a line on stdin before publishing)
   listen TOPIC N          receive N images
   talk TOPIC W H N        publish N pictures once a subscriber is matched
   graph NODE NS TOPIC...  what the ROS 2 graph API says about node NS/NODE and the topics
@@ -82,7 +83,9 @@ def main() -> int:
             report["matched"] = spin_until(
                 node, lambda: pub.get_subscription_count() >= 1 and
                 sink.sub.get_publisher_count() >= 1, opt.timeout)
-            spin_until(node, lambda: False, 0.3)   # the lab matches our writer (SEDP) too
+            # the test says when the lab has matched our writer too (rclpy cannot see that)
+            print("matched" if report["matched"] else "unmatched", flush=True)
+            sys.stdin.readline()
             for k in range(n):
                 pub.publish(image(k, h, w))
                 spin_until(node, lambda: len(sink.got) > k, 2.0)   # paced: one at a time
@@ -97,7 +100,7 @@ def main() -> int:
             pub = node.create_publisher(Image, topic, 10)
             report["matched"] = spin_until(node, lambda: pub.get_subscription_count() >= 1,
                                            opt.timeout)
-            spin_until(node, lambda: False, 0.3)   # the lab matches our writer (SEDP) too
+            spin_until(node, lambda: False, 0.5)   # the lab matches our writer (SEDP) too
             for k in range(n):
                 pub.publish(image(k, h, w))
                 spin_until(node, lambda: False, 0.1)
