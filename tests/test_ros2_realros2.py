@@ -63,13 +63,14 @@ def ros2_env(tmp: Path) -> dict[str, str]:
 
 
 def rclpy_peer(tmp: Path, mode: str, *args: object, timeout: float = 15.0,
-               matched: Callable[[], bool] | None = None) -> tuple[dict, Path]:
+               matched: Callable[[], bool] | None = None,
+               options: tuple[str, ...] = ()) -> tuple[dict, Path]:
     """Run rclpy_peer.py MODE ARGS; its JSON report and the folder of the frames it received.
     ``matched``: the relay's go-ahead, once it says true (the lab has matched its writer)."""
     out = tmp / f"rclpy-{mode}"
     out.mkdir(exist_ok=True)
     proc = subprocess.Popen([sys.executable, str(PEER), mode, *map(str, args), "--out", str(out),
-                             "--timeout", str(timeout)], stdin=subprocess.PIPE,
+                             "--timeout", str(timeout), *options], stdin=subprocess.PIPE,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=ros2_env(tmp))
     try:
@@ -136,8 +137,8 @@ def test_rclpy_images_through_the_component_exact(labs: Labs, tmp_path: Path, wh
 def test_rclpy_sees_the_component_in_the_ros2_graph(labs: Labs, tmp_path: Path) -> None:
     """What ``ros2 node list`` / ``ros2 node info`` / ``ros2 topic list -t`` read: the node
     from ros_discovery_info, its endpoints from SEDP, matched by GID."""
-    report, _ = rclpy_peer(tmp_path, "graph", "fpga_ros2", "/lab", "/cam", "/cam_out",
-                           timeout=10)
+    report, _ = rclpy_peer(tmp_path, "graph", "fpga_ros2", "/lab", "/cam", "/cam_out", "/big",
+                           timeout=10, options=("--node", "/fpga_big"))
     nodes = {tuple(x) for x in report["nodes"]}
     assert {("fpga_ros2", "/lab"), ("fpga_big", "/")} <= nodes, nodes
     image = ["sensor_msgs/msg/Image"]

@@ -70,6 +70,8 @@ def main() -> int:
     ap.add_argument("args", nargs="*")
     ap.add_argument("--out", type=Path, default=Path("."))
     ap.add_argument("--timeout", type=float, default=20.0)
+    ap.add_argument("--node", action="append", default=[],
+                    help="graph: NS/NAME of another node to wait for too")
     opt = ap.parse_args()
     rclpy.init()
     node = rclpy.create_node("rclpy_peer")
@@ -108,7 +110,9 @@ def main() -> int:
             spin_until(node, lambda: False, 1.0)   # RELIABLE: answer the reader's ACKNACKs
         elif opt.mode == "graph":
             name, ns, topics = a[0], a[1], a[2:]
-            spin_until(node, lambda: (name, ns) in node.get_node_names_and_namespaces()
+            others = [tuple(reversed(n.rsplit("/", 1))) for n in opt.node]   # (name, ns)
+            others = [(n, ns or "/") for n, ns in others]
+            spin_until(node, lambda: {(name, ns), *others} <= set(node.get_node_names_and_namespaces())
                        and all(node.count_publishers(t) + node.count_subscribers(t) for t in topics),
                        opt.timeout)
             report["nodes"] = node.get_node_names_and_namespaces()
