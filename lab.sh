@@ -42,6 +42,10 @@ setup() {
     echo "lab.sh: installing rosfpga-lab$extras into .venv (editable)"
     "$venv/bin/python" -m pip install --quiet --upgrade pip
     "$venv/bin/python" -m pip install --quiet -e ".$extras"
+    if [ "$extras" = "[test]" ]; then   # real ROS 2's wheels: optional (Linux x86_64 only)
+      "$venv/bin/python" -m pip install --quiet -e ".[test,ros2]" || echo "lab.sh: note: real" \
+        "ROS 2 Jazzy's wheels (the [ros2] extra) do not install here; their tests will skip" >&2
+    fi
     echo "$want" >> "$stamp"
   fi
   # JupyterLab's own defaults for this lab: no "get news?" pop-up over the outputs, no update

@@ -19,6 +19,7 @@ import os
 import shutil
 import socket
 import subprocess
+import sys
 import threading
 import time
 import xmlrpc.client
@@ -60,6 +61,31 @@ def require_ros() -> None:
     reason = ros_missing_reason()
     if reason:
         skip_or_fail(reason, "ROSFPGA_REQUIRE_ROS")
+
+
+@functools.cache
+@functools.cache
+def ros2_missing_reason() -> str | None:
+    """Why real ROS 2 Jazzy (rclpy on Fast DDS, the ``[ros2]`` extra's PyPI wheels) cannot be
+    used here, or None when it can. Probed in a subprocess of this Python: rclpy is never
+    imported into the test process."""
+    try:
+        proc = subprocess.run([sys.executable, "-c", "import rclpy, sensor_msgs.msg"],
+                              capture_output=True, text=True, timeout=60)
+    except (OSError, subprocess.TimeoutExpired) as exc:
+        return f"real ROS 2 (rclpy) not usable: {exc}"
+    if proc.returncode == 0:
+        return None
+    last = (proc.stderr.strip().splitlines() or ["import failed"])[-1]
+    return (f"real ROS 2 (rclpy) not importable: {last} (pip install -e '.[ros2]'; wheels for "
+            f"Linux x86_64 only)")
+
+
+def require_ros2() -> None:
+    """Skip (or fail under CI: ROSFPGA_REQUIRE_ROS2=1) unless rclpy imports in this Python."""
+    reason = ros2_missing_reason()
+    if reason:
+        skip_or_fail(reason, "ROSFPGA_REQUIRE_ROS2")
 
 
 @functools.cache
@@ -239,7 +265,7 @@ def require_ros2_python() -> None:
 
 __all__ = [
     "ROS_PYTHON", "ROS_PROGRAMS", "build_roscpp_program", "cxx_missing_reason", "finish", "free_port",
-    "real_rosmaster", "require_cxx", "require_ros", "require_ros2_python", "ros2_python_missing_reason",
-    "ros2_share", "ros_env", "ros_missing_reason",
+    "real_rosmaster", "require_cxx", "require_ros", "require_ros2", "require_ros2_python",
+    "ros2_missing_reason", "ros2_python_missing_reason", "ros2_share", "ros_env", "ros_missing_reason",
     "run_ros_python", "skip_or_fail", "stop_process", "wait_for_master", "wait_line",
 ]

@@ -441,3 +441,58 @@ def test_goodbye_makes_the_peer_forget_at_once() -> None:
     for _, _, d in a.goodbye():
         c.receive(d, a.meta, net.now)
     assert a.guid_prefix not in c.participants and c.matched(r) == []
+
+
+# ---- Fast DDS (ROS 2 Jazzy's rmw_fastrtps_cpp): what tests/test_ros2_realros2.py found ----------
+#: One SPDP datagram of a real rclpy node (ROS 2 Jazzy, Fast DDS 2.14, PyPI wheels) sent to the
+#: lab's discovery port over loopback: its UDP locators name only the host's LAN address
+#: (192.0.2.2, ports 29162/29163) and its vendor is eProsima (01 0f).
+FASTDDS_SPDP = Path(__file__).resolve().parent.parent / "data" / "fastdds_jazzy_spdp.bin"
+
+
+def test_a_fast_dds_peer_on_this_host_is_reached_over_loopback() -> None:
+    dg = FASTDDS_SPDP.read_bytes()
+    prefix = parse_message(dg).header.guid_prefix
+    p = fresh()
+    out = p.receive(dg, ("127.0.0.1", 40000), 0.0)
+    # the old code ignored it: "SPDP ... has no usable unicast locator"
+    assert p.participants[prefix].meta == ("127.0.0.1", 29162), p.notes
+    assert p.participants[prefix].user == ("127.0.0.1", 29163)
+    assert out and {(host, port) for host, port, _ in out} == {("127.0.0.1", 29162)}
+    assert sum("of a peer on this host" in n for n in p.notes) == 1
+    # its endpoints' locators (LAN too) are reached over loopback as well
+    guid = prefix + (0x1303).to_bytes(4, "big")
+    sedp = b.sedp_payload(guid, TOPIC, TYPE, True, 10, b.Locator("192.0.2.2", 29163))
+    p.receive(b.header(prefix) + b.data(0x3C7, PUB_WRITER, 1, sedp), ("127.0.0.1", 40000), 0.1)
+    assert p.remote[guid].locator == ("127.0.0.1", 29163)
+    # the same datagram from another host: 192.0.2.2 is not where it came from, so not reachable
+    q = fresh()
+    q.receive(dg, ("198.51.100.7", 40000), 0.0)
+    assert q.participants == {} and any("ignored" in n for n in q.notes)
+
+
+def test_preemptive_acknack_in_fast_dds_form_only_to_fast_dds() -> None:
+    """Fast DDS answers at once (HEARTBEAT, then the SEDP data it sent before it knew us) only a
+    preemptive ACKNACK of base 0; Cyclone DDS refuses base 0 from other vendors: base 1 there."""
+    def preemptive_bases(dg: bytes, source: tuple[str, int]) -> set[int]:
+        p = fresh()
+        return {s.base for _, _, d in p.receive(dg, source, 0.0)
+                for s in parse_message(d).submessages if isinstance(s, AckNack)}
+
+    assert preemptive_bases(FASTDDS_SPDP.read_bytes(), ("127.0.0.1", 40000)) == {0}
+    assert preemptive_bases(spdp(b"C" * 12), ("127.0.0.1", 7999)) == {1}
+
+
+def test_a_preemptive_acknack_gets_a_heartbeat_and_is_not_invalid() -> None:
+    a = fresh()
+    w = a.add_writer(TOPIC, TYPE)
+    prefix = b"F" * 12
+    a.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    rguid = prefix + (0x1404).to_bytes(4, "big")
+    sedp = b.sedp_payload(rguid, TOPIC, TYPE, True, 10, b.Locator("127.0.0.1", 8000))
+    a.receive(b.header(prefix) + b.data(0x4C7, 0x4C2, 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert a.matched(w) == [rguid]
+    out = a.receive(b.header(prefix) + b.acknack(0x1404, w, 0, [], 7), ("127.0.0.1", 8000), 0.1)
+    beats = [s for _, _, d in out for s in parse_message(d).submessages if isinstance(s, Heartbeat)]
+    assert [(s.writer_id, s.reader_id) for s in beats] == [(w, 0x1404)]
+    assert not any("8.3.7" in n for n in a.notes), a.notes

@@ -17,6 +17,8 @@ from rosfpga_lab.rtps.message import MAGIC
 PROTOCOL_VERSION = (2, 3)
 #: The lab announces "unknown vendor" (0x0000): it has no OMG-assigned vendor id.
 VENDOR_ID = 0x0000
+#: eProsima's vendor id (Fast DDS, under rmw_fastrtps_cpp, ROS 2's default middleware).
+VENDOR_EPROSIMA = 0x010F
 
 # submessage ids
 PAD, ACKNACK, HEARTBEAT, GAP, INFO_TS, INFO_DST = 0x01, 0x06, 0x07, 0x08, 0x09, 0x0E

@@ -254,12 +254,22 @@ class Participant:
 
     def _locator(self, value: list[bytes] | None, little: bool,
                  source: tuple[str, int]) -> tuple[str, int] | None:
-        for raw in value or []:
-            loc = b.Locator.decode(raw, little)
-            if loc is None:
-                continue
+        """Where to reach a peer: a loopback locator, or one at the sender's own address; else,
+        when the sender is on this host (a loopback source), its locator's port at the sender's
+        address (Fast DDS, rmw_fastrtps_cpp's DDS, announces only the host's LAN addresses and
+        listens on all of them, loopback included, as it does for its own peers on one host)."""
+        found = [loc for loc in (b.Locator.decode(raw, little) for raw in value or [])
+                 if loc is not None]
+        for loc in found:
             if loc.address.startswith("127.") or loc.address == source[0]:
                 return (loc.address, loc.port)
+        if found and source[0].startswith("127."):
+            loc = found[0]
+            self.note(f"locator-local-{loc.address}", f"locator {loc.address}:{loc.port} of a "
+                      f"peer on this host (it spoke from {source[0]}): reached at "
+                      f"{source[0]}:{loc.port}")
+            return (source[0], loc.port)
+        for loc in found:
             self.note(f"locator-{loc.address}", f"locator {loc.address}:{loc.port} ignored: the "
                       f"lab sends only to loopback or to the sender's own address")
         return None
@@ -310,10 +320,15 @@ class Participant:
             for seq, payload in ep.history.items():
                 subs += self._sample_subs(rid, wid, seq, payload)
             subs.append(self._heartbeat(ep, proxy))
+        # Fast DDS answers a preemptive ACKNACK at once (a HEARTBEAT, then what we lack) only
+        # in its own form, base 0 (which Cyclone DDS refuses from other vendors): without it,
+        # SEDP data it sent before it knew us waits for its next periodic HEARTBEAT (~1 s)
+        vendor = (params.get(b.PID_VENDORID) or [b""])[0][:2]
+        base = 0 if vendor == b.VENDOR_EPROSIMA.to_bytes(2, "big") else 1
         for rid, wid in ((PUB_READER, PUB_WRITER), (SUB_READER, SUB_WRITER)):
             wp = WriterProxy(prefix, wid, True, 1)
             self.local[rid].proxies[(prefix, wid)] = wp
-            subs.append(b.acknack(rid, wid, 1, [], 1))
+            subs.append(b.acknack(rid, wid, base, [], 1))
         out += self._msg(meta, prefix, subs)
         return out
 
@@ -357,7 +372,8 @@ class Participant:
         durability = u32(b.PID_DURABILITY) or b.VOLATILE
         depth = u32(b.PID_HISTORY, 4) or 1
         owner = self.participants.get(prefix)
-        loc = self._locator(params.get(b.PID_UNICAST_LOCATOR), little, (self.address, 0)) \
+        loc = self._locator(params.get(b.PID_UNICAST_LOCATOR), little,
+                            owner.meta if owner else (self.address, 0)) \
             or (owner.user if owner else None)
         if loc is None:
             return
@@ -465,6 +481,9 @@ class Participant:
             self.note("acknack-dup", "ACKNACK with a count already seen: no retransmission")
             return []
         proxy.last_count = sub.count
+        if sub.base == 0:
+            # a preemptive ACKNACK (base 0, no bits: Fast DDS's form) asks for a HEARTBEAT
+            return self._msg(proxy.locator, proxy.prefix, [self._heartbeat(ep, proxy)])
         # only what was written can be missing: later numbers are ignored, never GAPped
         missing = [s for s in sub.missing if s <= ep.seq]
         if len(missing) < len(sub.missing):
@@ -690,7 +709,7 @@ class Participant:
             return f"HEARTBEAT first {sub.first} last {sub.last}"
         if isinstance(sub, Gap) and (sub.start < 1 or sub.list_base < sub.start):
             return f"GAP start {sub.start} base {sub.list_base}"
-        if isinstance(sub, AckNack) and sub.base < 1:
+        if isinstance(sub, AckNack) and sub.base < 1 and (sub.base, sub.num_bits) != (0, 0):
             return f"ACKNACK base {sub.base}"
         if isinstance(sub, (Data, DataFrag)) and sub.seq < 1:
             return f"{'DATA' if isinstance(sub, Data) else 'DATA_FRAG'} sequence number {sub.seq}"
