@@ -446,7 +446,8 @@ def test_goodbye_makes_the_peer_forget_at_once() -> None:
 # ---- Fast DDS (ROS 2 Jazzy's rmw_fastrtps_cpp): what tests/test_ros2_realros2.py found ----------
 #: One SPDP datagram of a real rclpy node (ROS 2 Jazzy, Fast DDS 2.14, PyPI wheels) sent to the
 #: lab's discovery port over loopback: its UDP locators name only the host's LAN address
-#: (192.0.2.2, ports 29162/29163) and its vendor is eProsima (01 0f).
+#: (192.0.2.2, ports 29162/29163) and its vendor is eProsima (01 0f). Made by
+#: data/capture_fastdds_spdp.py.
 FASTDDS_SPDP = Path(__file__).resolve().parent.parent / "data" / "fastdds_jazzy_spdp.bin"
 
 
