@@ -19,7 +19,7 @@ from pathlib import Path
 
 import jinja2
 
-from rosfpga_lab.hls.generic import GenericSpec, context, environment
+from rosfpga_lab.hls.generic import GenericSpec, beat_shape, context, environment
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, VERILOG_DIR
 
@@ -31,24 +31,30 @@ KIND_CODES = {"unsigned": 0, "signed": 1, "float": 2}
 #: The static Verilog of every generic project (``generic/``), in data-path order.
 GENERIC_MODULES = ("rfl_gsubscriber.v", "rfl_elem_pack.v", "rfl_window1d.v", "rfl_elem_unpack.v",
                    "rfl_gpublisher.v", "rfl_gtop.v")
+#: The application of a video stream (the video project's), beside ``GENERIC_MODULES``.
+VIDEO_APP = "rfl_morph.v"
 #: The generated include holding the walk (one instruction per field).
 LAYOUT_INCLUDE = "rfl_layout.vh"
 TEMPLATES = Path(__file__).resolve().parent / "templates"
 
 
 def generic_params(spec: GenericSpec) -> dict[str, int]:
-    """``rfl_gtop``'s parameters for a generic project."""
+    """``rfl_gtop``'s parameters for a generic project (with a video stream: a beat per pixel,
+    ``VIDEO``, ``WIDTH`` and ``HEIGHT``; :func:`rosfpga_lab.hls.generic.beat_shape`)."""
     prog = spec.program
+    beat = beat_shape(spec)
     carry = max(1, prog.carry_bytes)
+    video = {} if spec.video is None else {"VIDEO": 1, "WIDTH": spec.video.width,
+                                           "HEIGHT": spec.video.height}
     return {
-        "EBYTES": prog.stream_bytes, "LENGTH": prog.stream_length,
+        "EBYTES": beat["bytes"], "LENGTH": beat["count"],
         "KSIZE": spec.ksize if spec.op in ("dilate", "erode") else 1,
         "OP": OP_CODES_1D[spec.op], "KIND": KIND_CODES[spec.kind],
         "CARRY_BYTES": carry, "CW": max(1, (carry - 1).bit_length()),
         "MIN_BODY": prog.min_body, "MAX_FRAME": prog.max_frame,
         "RX_DEPTH": spec.input_depth, "TX_DEPTH": spec.output_depth,
-        "AXIS_DEPTH": spec.axis_depth, "OUT_DEPTH": max(spec.axis_depth, prog.stream_length + 2),
-        "SEQ_START": prog.seq_start,
+        "AXIS_DEPTH": spec.axis_depth, "OUT_DEPTH": max(spec.axis_depth, beat["count"] + 2),
+        "SEQ_START": prog.seq_start, **video,
     }
 
 
@@ -101,6 +107,8 @@ def generic_rtl_files(spec: GenericSpec) -> dict[str, bytes]:
     files = {LAYOUT_INCLUDE: env.get_template(f"{LAYOUT_INCLUDE}.j2").render(ctx).encode()}
     for name in GENERIC_MODULES:
         files[name] = (GENERIC_VERILOG_DIR / name).read_bytes()
+    if spec.video is not None:  # the video project's 2-D application
+        files[VIDEO_APP] = (VERILOG_DIR / VIDEO_APP).read_bytes()
     files["rfl_fifo.v"] = (VERILOG_DIR / "rfl_fifo.v").read_bytes()
     files[NODE_FILE] = node_wrapper(spec, str(ctx["generated_note"])).encode()
     files["rfl_tb.v"] = testbench().encode()
