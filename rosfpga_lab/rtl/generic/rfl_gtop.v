@@ -28,7 +28,9 @@ module rfl_gtop #(
     parameter [31:0] SEQ_START = 1,
     parameter VIDEO = 0,                        // 1: frame the stream as video (rfl_morph)
     parameter WIDTH = LENGTH,                   // VIDEO: pixels per line
-    parameter HEIGHT = 1                        // VIDEO: lines
+    /* verilator lint_off UNUSEDPARAM */
+    parameter HEIGHT = 1                        // VIDEO: lines (unused without VIDEO)
+    /* verilator lint_on UNUSEDPARAM */
 ) (
     input        clk,
     input        rst_n,
