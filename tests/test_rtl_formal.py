@@ -145,7 +145,7 @@ def test_planted_bugs_fail_the_generic_proofs(tmp_path: Path) -> None:
     assert failed_lines(proof, result) == ["`FV_SINK(m_tvalid, m_axis_tready, {m_tuser, m_tlast, "
                                            "m_tkeep, m_tdata})"]
     name = "rfl_elem_pack.v"
-    buggy = plant(tmp_path, name, "m_axis_tlast <= (n == LAST_N);", "m_axis_tlast <= 1'b0;")
+    buggy = plant(tmp_path, name, "m_axis_tlast <= line_end;", "m_axis_tlast <= 1'b0;")
     proof = next(p for p in PROOFS if p.name == "elem_pack" and p.mode == "bmc")
     result = failures(proof, name, buggy)
     assert any(line.startswith("assert(m_tlast == (idx == LENGTH - 1));")
