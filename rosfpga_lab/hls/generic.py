@@ -6,7 +6,10 @@ Image project's ``connection_headers.cpp.j2``, which knows no field) from one
 (:class:`~rosfpga_lab.hls.program.Program`, one instruction per field with its name and type)
 and the application (operation, window, how elements are ordered). No template names a field
 of any message type: every field-specific line comes from the program's instructions, with a
-comment naming the field. The Image project keeps its own templates (the hand-written teaching
+comment naming the field. A stream with a video shape (``GenericSpec.video``, from the layout:
+no field named) travels as pixels, TUSER on the first and TLAST ending each line, into the video
+application the Image project also renders (``video_filter.cpp.j2``): that is how Image on CDR is
+generated. On TCPROS the Image project keeps its own templates (the hand-written teaching
 version, :mod:`rosfpga_lab.hls.generator`).
 """
 
@@ -22,7 +25,8 @@ import numpy as np
 from rosfpga_lab import __version__
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.limits import MAX_CARRY_BYTES
-from rosfpga_lab.hls.generator import HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
+from rosfpga_lab.hw import limits as hw_limits
+from rosfpga_lab.hls.generator import _OP_CPP, HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config.vocabulary import CDR_WIRE, TCPROS_WIRE
 from rosfpga_lab.hls.program import _replace
@@ -225,7 +229,7 @@ def beat_shape(spec: GenericSpec) -> dict[str, int]:
                             f"not the {v.width}x{v.height} pixels of {v.bytes_per_pixel} bytes "
                             "of its video shape")
     return {"bytes": v.bytes_per_pixel, "count": v.width * v.height, "line": v.width,
-            "bits": 32}
+            "bits": hw_limits.TDATA_BITS}
 
 
 def context(spec: GenericSpec) -> dict[str, object]:
@@ -262,7 +266,7 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "app_summary": app_summary(spec),
         "beat": beat_shape(spec), "video": video, "filter_name": "stream_filter",
         "app": {"op": spec.op, "ksize": spec.ksize},
-        "op_cpp": {"dilate": "Dilate", "erode": "Erode"}.get(spec.op, ""),
+        "op_cpp": _OP_CPP.get(spec.op, ""),
         "tb_input": "tb_input.bin", "tb_expected": "tb_expected.bin" if spec.op != "custom" else "",
         "cxxflags": ("-std=c++14", "-Wall", "-Werror", "-O2"), "rtl": spec.op != "custom",
         "csim_sources": GENERIC_SOURCES,

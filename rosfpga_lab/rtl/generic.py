@@ -1,4 +1,5 @@
-"""Verilog of generated projects for any message type (not ``sensor_msgs/Image``).
+"""Verilog of generated projects for any message type (``sensor_msgs/Image`` only on CDR: on
+TCPROS it has the hand-written project).
 
 How this works: the modules of ``generic/`` are written once and parameterized:
 ``rfl_gsubscriber`` and ``rfl_gpublisher`` walk a frame by stepping through a program, one
@@ -10,7 +11,9 @@ max/min over KSIZE elements, pass-through) and ``rfl_elem_unpack`` turns beats b
 ``rfl_gtop`` joins them with the lab's ``rfl_fifo``. ``rfl_node.v`` sets the parameters of one
 configuration; the testbench is the lab's ``rfl_tb.v`` (with an 8-bit status). The same
 walkers read and write CDR (``wire: cdr``): the program's alignment, ``OP_ENCAP`` and strings
-with their NUL (:mod:`rosfpga_lab.hls.program`).
+with their NUL (:mod:`rosfpga_lab.hls.program`). A stream with a video shape
+(:attr:`GenericSpec.video`) is packed a pixel per beat with TLAST ending each line, and
+``rfl_gtop`` (``VIDEO``) runs the video project's 2-D ``rfl_morph`` instead of ``rfl_window1d``.
 """
 
 from __future__ import annotations
@@ -136,7 +139,7 @@ def simulate_project(project_dir: str | Path, frames: bytes, *, target: str = "r
     as a student types it) and read back its output bytes and a status name per frame.
 
     Args:
-        project_dir: a project written by ``rosfpga-lab generate`` for a type other than Image.
+        project_dir: a project written by ``rosfpga-lab generate`` (not TCPROS Image's).
         frames: TCPROS frames, or for a ``wire: cdr`` project CDR records (each a 4-byte sample
             length and the payload).
         target: ``csim`` or ``rtlsim``.
