@@ -296,3 +296,16 @@ def test_generated_image_cdr_verilog_is_lint_clean(name: str, projects: dict[str
     from generictools import assert_rtl_lint_clean
 
     assert_rtl_lint_clean(projects[name] / "rtl")
+
+
+def test_the_tcpros_image_circuits_tools_refuse_a_cdr_configuration() -> None:
+    """rtl sim/cycles/synth/timing and --model rtl build the TCPROS Image circuit from
+    ``rtl_params``; for the shipped CDR configuration that would be the wrong circuit, so it is
+    refused with where the CDR circuit's Verilog is."""
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.rtl import rtl_params
+    from rosfpga_lab.rtl.errors import RtlError
+
+    with pytest.raises(RtlError, match="wire: cdr.*rosfpga-lab generate CONFIG -o DIR"):
+        rtl_params(load_config(DATA / SHIPPED))
+    assert rtl_params(load_config(DATA / "fpga_dilate_rgba8.yaml")).WIDTH == 640
