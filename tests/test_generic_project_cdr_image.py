@@ -309,3 +309,17 @@ def test_the_tcpros_image_circuits_tools_refuse_a_cdr_configuration() -> None:
     with pytest.raises(RtlError, match="wire: cdr.*rosfpga-lab generate CONFIG -o DIR"):
         rtl_params(load_config(DATA / SHIPPED))
     assert rtl_params(load_config(DATA / "fpga_dilate_rgba8.yaml")).WIDTH == 640
+
+
+def test_make_synth_reports_every_module_of_the_video_project(projects: dict[str, Path]) -> None:
+    """``make synth``'s table has a row for every module of the project's Verilog (rfl_morph's
+    resources were left out of the rows and the total)."""
+    import re
+
+    from rosfpga_lab.rtl.synth import GENERIC_MODULES
+
+    rtl = projects["rgba8"] / "rtl"
+    modules = {m for p in rtl.glob("*.v") if p.name != "rfl_tb.v"
+               for m in re.findall(r"^\s*module\s+(\w+)", p.read_text(), re.M)}
+    assert "rfl_morph" in modules
+    assert modules - {"rfl_node"} <= {m for m, _row in GENERIC_MODULES}
