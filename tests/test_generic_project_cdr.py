@@ -317,18 +317,6 @@ def test_wire_key_is_checked_and_defaults_to_tcpros() -> None:
     assert "wire must be one of tcpros, cdr" in str(exc.value)
 
 
-def test_image_with_wire_cdr_is_refused_by_name(tmp_path: Path) -> None:
-    """CDR for sensor_msgs/Image is not generated (the generic walkers refuse video streams):
-    ``rosfpga-lab generate`` says so rather than write a TCPROS project for a CDR node."""
-    text = (DATA / "fpga_passthrough_rgb8.yaml").read_text() + "wire: cdr\n"
-    (tmp_path / "img.yaml").write_text(text)
-    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(tmp_path / "img.yaml"),
-                           "-o", str(tmp_path / "p"), "-q"], capture_output=True, text=True,
-                          timeout=120)
-    assert proc.returncode != 0 and "wire: cdr is not generated for sensor_msgs/Image" in proc.stderr
-    assert not (tmp_path / "p" / "subscriber.cpp").exists()
-
-
 def _random_case(data: st.DataObject) -> tuple[CdrLayout, list[bytes], str]:
     """A random message definition (the models' strategy), small maxima, two samples serialized
     by the msg layer's CDR codec (held equal to Cyclone's bytes in test_hw_cdr.py) with end

@@ -135,7 +135,8 @@ def failed_lines(proof: Proof, result: ProofResult) -> list[str]:
 def test_planted_bugs_fail_the_generic_proofs(tmp_path: Path) -> None:
     """A window that steps while its output is stalled (the beat it holds is overwritten) fails
     the induction proof's data-stable rule; a packer that never sets TLAST fails the bounded
-    check of TLAST on an array's last element."""
+    check of TLAST on an array's last element, and one that ends only the array, not each line of
+    a video stream, the check of TLAST on each line's last element."""
     require_formal()
     name = "rfl_window1d.v"
     buggy = plant(tmp_path, name, "wire out_free = !m_axis_tvalid || m_axis_tready;",
@@ -145,8 +146,15 @@ def test_planted_bugs_fail_the_generic_proofs(tmp_path: Path) -> None:
     assert failed_lines(proof, result) == ["`FV_SINK(m_tvalid, m_axis_tready, {m_tuser, m_tlast, "
                                            "m_tkeep, m_tdata})"]
     name = "rfl_elem_pack.v"
-    buggy = plant(tmp_path, name, "m_axis_tlast <= (n == LAST_N);", "m_axis_tlast <= 1'b0;")
+    buggy = plant(tmp_path, name, "m_axis_tlast <= line_end;", "m_axis_tlast <= 1'b0;")
     proof = next(p for p in PROOFS if p.name == "elem_pack" and p.mode == "bmc")
     result = failures(proof, name, buggy)
-    assert any(line.startswith("assert(m_tlast == (idx == LENGTH - 1));")
+    assert any(line.startswith("assert(m_tlast == (idx % LINE == LINE - 1));")
+               for line in failed_lines(proof, result)), result.failed
+    # a packer that ends only the array, not each line of a video stream, fails the lines check
+    buggy = plant(tmp_path, name, "assign line_end = (c == LAST_C);",
+                  "assign line_end = (n == LAST_N);")
+    proof = next(p for p in PROOFS if p.name == "elem_pack" and "FV_LINES" in p.defines)
+    result = failures(proof, name, buggy)
+    assert any(line.startswith("assert(m_tlast == (idx % LINE == LINE - 1));")
                for line in failed_lines(proof, result)), result.failed

@@ -112,6 +112,31 @@ def test_element_stream_equals_numpy(name: str, tmp_path: Path) -> None:
     assert got.tobytes() == want.tobytes(), (got, want)
 
 
+@pytest.mark.parametrize("ebytes,length,line", [(4, 12, 4), (2, 15, 5), (1, 6, 1)])
+def test_element_pack_ends_every_line_with_tlast(ebytes: int, length: int, line: int,
+                                                 tmp_path: Path) -> None:
+    """rfl_elem_pack with LINE (a video stream's pixels per line): TLAST on the last element of
+    every line (checked beat by beat by the testbench), so the window, which ends its window at
+    TLAST, works line by line: the output equals numpy's per line."""
+    rng = np.random.default_rng(length * 100 + line)
+    data = rng.integers(0, 256, (2, length // line, line, ebytes), dtype=np.uint8)
+    exe = compile_tb(tmp_path, {"EBYTES": ebytes, "LENGTH": length, "KSIZE": 3, "OP": 0,
+                                "KIND": 0, "LINE": line})
+    (tmp_path / "in.bin").write_bytes(data.tobytes())
+    proc = subprocess.run([tool("vvp") or "vvp", "-n", str(exe), f"+input={tmp_path / 'in.bin'}",
+                           f"+output={tmp_path / 'out.bin'}", "+gap=300", "+bp=300", "+seed=5"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and "ERROR" not in proc.stdout, proc.stdout + proc.stderr
+    got = (tmp_path / "out.bin").read_bytes()
+    want = b""
+    for arr in data:
+        for row in arr:                                  # one line: ebytes-byte unsigned elements
+            keys = [int.from_bytes(bytes(e), "little") for e in row]
+            out = [max(keys[max(0, i - 1):i + 2]) for i in range(len(keys))]
+            want += b"".join(v.to_bytes(ebytes, "little") for v in out)
+    assert len(got) == data.size and got == want
+
+
 @pytest.mark.parametrize("ebytes,ksize,op,kind", [(1, 1, 0, 0), (2, 3, 1, 1), (4, 5, 0, 2),
                                                   (8, 15, 1, 2), (8, 3, 2, 0)])
 def test_element_modules_lint_clean(ebytes: int, ksize: int, op: int, kind: int) -> None:

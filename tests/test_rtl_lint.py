@@ -32,9 +32,10 @@ from test_rtl_sim import small_config
 pytestmark = pytest.mark.rtl
 
 DATA = Path(__file__).resolve().parent.parent / "data"
-# the sensor_msgs/Image configurations (other types get the generic circuit, linted by
-# tests/test_generic_project.py)
-SHIPPED = sorted(p.stem for p in DATA.glob("fpga_*.yaml") if load_config(p).is_image)
+# the sensor_msgs/Image configurations on TCPROS (other types, and Image on CDR, get the generic
+# circuit, linted by tests/test_generic_project.py and tests/test_generic_project_cdr_image.py)
+SHIPPED = sorted(p.stem for p in DATA.glob("fpga_*.yaml")
+                 if load_config(p).is_image and load_config(p).wire != "cdr")
 # (encoding, width, height, frame_id_max): small_config picks op and ksize per encoding
 SMALL = [("rgba8", 11, 7, 256), ("rgb8", 9, 5, 3), ("mono8", 13, 6, 1), ("bgr8", 5, 4, 100),
          ("bgra8", 7, 3, 17)]

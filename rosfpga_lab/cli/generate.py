@@ -22,8 +22,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "data/fpga_passthrough_rgb8.yaml (sensor_msgs/Image: the hand-written teaching project); "
         "data/fpga_laserscan_min.yaml, data/fpga_samples_dilate.yaml (any other type: a project "
         "rendered from the message's circuit layout, one instruction per field); "
-        "data/fpga_laserscan_min_cdr.yaml, data/fpga_samples_dilate_cdr.yaml (wire: cdr: the "
-        "same circuits on ROS 2's CDR samples).",
+        "data/fpga_laserscan_min_cdr.yaml, data/fpga_samples_dilate_cdr.yaml, "
+        "data/fpga_dilate_rgba8_cdr.yaml (wire: cdr: the same circuits on ROS 2's CDR samples; "
+        "Image's pixels framed as video for its 2-D application).",
     )
     parser.add_argument("config", type=Path, metavar="CONFIG", help="the node configuration file (YAML)")
     parser.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",

@@ -263,6 +263,7 @@ def render(config: NodeConfig) -> dict[str, str]:
         "pixel_mask": (1 << (8 * fmt.bytes_per_pixel)) - 1,
         "hls_type": _HLS_TYPE[fmt.bytes_per_pixel], "app": config.application,
         "op_cpp": _OP_CPP.get(config.application.op, ""), "app_summary": _app_summary(config),
+        "filter_name": "image_filter",
         "fifo": config.fifo, "clock_mhz": f"{config.clock_mhz:g}",
         "clock_period_ns": f"{1000.0 / config.clock_mhz:g}", "part": config.part,
         "frame_id_max": config.frame_id_max, "max_encoding_bytes": hw_limits.MAX_ENCODING_BYTES,

@@ -6,7 +6,10 @@ Image project's ``connection_headers.cpp.j2``, which knows no field) from one
 (:class:`~rosfpga_lab.hls.program.Program`, one instruction per field with its name and type)
 and the application (operation, window, how elements are ordered). No template names a field
 of any message type: every field-specific line comes from the program's instructions, with a
-comment naming the field. The Image project keeps its own templates (the hand-written teaching
+comment naming the field. A stream with a video shape (``GenericSpec.video``, from the layout:
+no field named) travels as pixels, TUSER on the first and TLAST ending each line, into the video
+application the Image project also renders (``video_filter.cpp.j2``): that is how Image on CDR is
+generated. On TCPROS the Image project keeps its own templates (the hand-written teaching
 version, :mod:`rosfpga_lab.hls.generator`).
 """
 
@@ -22,7 +25,8 @@ import numpy as np
 from rosfpga_lab import __version__
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.limits import MAX_CARRY_BYTES
-from rosfpga_lab.hls.generator import HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
+from rosfpga_lab.hw import limits as hw_limits
+from rosfpga_lab.hls.generator import _OP_CPP, HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config.vocabulary import CDR_WIRE, TCPROS_WIRE
 from rosfpga_lab.hls.program import _replace
@@ -31,7 +35,7 @@ from rosfpga_lab.hls.program import (
 )
 from rosfpga_lab.hw.cdrlayout import END_ALIGN, TAIL_LABEL, CdrLayout, cdr_length_rules
 from rosfpga_lab.hw.layout import (
-    Action, CheckOp, Layout, Step, StepKind, Token, length_rules, marshal,
+    Action, CheckOp, Layout, Step, StepKind, Token, VideoShape, length_rules, marshal,
 )
 from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.msg.builtins import SCALARS
@@ -80,6 +84,10 @@ class GenericSpec:
         config_name: the configuration's file name (in the generated-file note).
         custom_source: ``op: custom``: the user's C++ file (its ``stream_filter()``).
         wire: ``tcpros`` (frames) or ``cdr`` (ROS 2 samples, each behind a sample length).
+        video: the stream's video shape, or ``None``: with one, the streamed bytes go to the
+            application as pixels of ``bytes_per_pixel`` bytes (TUSER on the first, TLAST ending
+            each line of ``width``) and the application is the 2-D window over ``height``
+            lines (the video project's ``video_filter.cpp.j2``, ``rfl_morph.v``).
     """
 
     program: Program
@@ -103,6 +111,7 @@ class GenericSpec:
     config_name: str = "<string>"
     custom_source: Path | None = None
     wire: str = TCPROS_WIRE
+    video: VideoShape | None = None
 
 
 def _hex_rows(data: bytes) -> list[str]:
@@ -198,12 +207,42 @@ def app_summary(spec: GenericSpec) -> str:
                 f"{spec.custom_source.name if spec.custom_source else '?'}")
     if spec.op == "passthrough":
         return "pass-through, no processing"
+    if spec.video is not None:
+        v = spec.video
+        return (f"{spec.op} over {spec.ksize}x{spec.ksize} pixels of {v.width}x{v.height} "
+                f"{v.encoding} video")
     return f"{spec.op} over {spec.ksize} elements"
+
+
+def beat_shape(spec: GenericSpec) -> dict[str, int]:
+    """How the streamed bytes travel as AXI4-Stream beats: ``bytes`` per beat, ``count`` beats
+    per array, ``line`` beats per line (TLAST), ``bits`` of TDATA. Without a video shape a beat
+    is one element and the array one line; with one, a beat is a pixel (32-bit TDATA, unused
+    lanes zero, as the video project packs it) and a line ``width`` pixels."""
+    prog = spec.program
+    if spec.video is None:
+        return {"bytes": prog.stream_bytes, "count": prog.stream_length,
+                "line": prog.stream_length, "bits": 8 * prog.stream_bytes}
+    v = spec.video
+    if prog.stream_bytes * prog.stream_length != v.width * v.height * v.bytes_per_pixel:
+        raise GenerateError(f"the stream has {prog.stream_bytes * prog.stream_length} bytes, "
+                            f"not the {v.width}x{v.height} pixels of {v.bytes_per_pixel} bytes "
+                            "of its video shape")
+    return {"bytes": v.bytes_per_pixel, "count": v.width * v.height, "line": v.width,
+            "bits": hw_limits.TDATA_BITS}
 
 
 def context(spec: GenericSpec) -> dict[str, object]:
     """The template context of ``spec`` (shared with the Verilog renderer)."""
+    from rosfpga_lab.hw.encodings import PIXEL_FORMATS
+
     prog = spec.program
+    video = None
+    if spec.video is not None:
+        fmt = PIXEL_FORMATS[spec.video.encoding]
+        video = {"width": spec.video.width, "height": spec.video.height,
+                 "encoding": spec.video.encoding, "bpp": fmt.bytes_per_pixel,
+                 "tkeep": fmt.tkeep, "pixel_mask": (1 << (8 * fmt.bytes_per_pixel)) - 1}
     note = f"Generated by rosfpga-lab {__version__} from {spec.config_name} (do not edit: regenerate)."
     node = {"global_name": spec.node_name, "master_uri": spec.master_uri,
             "ip_address": spec.ip_address}
@@ -225,6 +264,9 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "kind": spec.kind, "kind_note": KIND_NOTES[spec.kind],
         "stream_name": spec.stream_name, "stream_type": spec.stream_type,
         "app_summary": app_summary(spec),
+        "beat": beat_shape(spec), "video": video, "filter_name": "stream_filter",
+        "app": {"op": spec.op, "ksize": spec.ksize},
+        "op_cpp": _OP_CPP.get(spec.op, ""),
         "tb_input": "tb_input.bin", "tb_expected": "tb_expected.bin" if spec.op != "custom" else "",
         "cxxflags": ("-std=c++14", "-Wall", "-Werror", "-O2"), "rtl": spec.op != "custom",
         "csim_sources": GENERIC_SOURCES,
@@ -328,7 +370,8 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
         count: the label of a uint32 field the publisher numbers itself (1, 2, 3 ...) instead of
             re-sending it (``header.seq`` of the Image project's publisher).
         video_as_bytes: take a video stream (``sensor_msgs/Image``'s ``data``) as a plain array of
-            bytes (the Image project has its own; this is for comparing the two).
+            bytes (the TCPROS Image project has its own; this is for comparing the two). A CDR
+            walk always does: its project frames the bytes as video (``GenericSpec.video``).
         cdr: the CDR walk whose ``layout`` this is (:func:`program_from_cdr`): the program
             reads and writes CDR samples (alignment, strings with their NUL, the header).
 
@@ -337,7 +380,7 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
     """
     if layout.stream_index is None:
         raise GenerateError(f"the layout of {layout.type_name} has no stream: nothing to generate")
-    if layout.video is not None and not video_as_bytes:
+    if layout.video is not None and not video_as_bytes and cdr is None:
         raise GenerateError("a video stream (sensor_msgs/Image) has its own project "
                             "(rosfpga_lab.hls.generator)")
     if layout.stream_length < 1:
@@ -486,10 +529,12 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
                      part: str = "xc7z020clg400-1", clock_mhz: float = 100.0, op: str = "dilate",
                      ksize: int = 3, config_name: str = "<string>",
                      custom_source: Path | None = None,
-                     program: Program | None = None, wire: str = TCPROS_WIRE) -> GenericSpec:
+                     program: Program | None = None, wire: str = TCPROS_WIRE,
+                     video: VideoShape | None = None) -> GenericSpec:
     """The generic project of a layout (its type in ``reg``), with the node's names and sizes
     (``program``: the layout's walk when the caller derived it itself; ``wire``: ``cdr`` for a
-    CDR walk's ``layout`` with its ``program_from_cdr``)."""
+    CDR walk's ``layout`` with its ``program_from_cdr``; ``video``: the stream's video shape,
+    to frame it as pixels and lines for a 2-D application, see :class:`GenericSpec`)."""
     prog = program or program_from_layout(layout)
     t = layout.type_name
     stream = layout.stream
@@ -506,11 +551,13 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
         stream_name=stream.label,
         stream_type=f"{stream.type}[]" if stream.count is None else f"{stream.type}[{stream.count}]",
         subscriber_header=sub_header, publisher_header=pub_header, config_name=config_name,
-        custom_source=custom_source, wire=wire)
+        custom_source=custom_source, wire=wire, video=video)
 
 
 def spec_from_config(config: NodeConfig) -> GenericSpec:
-    """The generic project of a node configuration (a type other than ``sensor_msgs/Image``).
+    """The generic project of a node configuration (any type but a video stream on TCPROS,
+    whose project is :mod:`rosfpga_lab.hls.generator`'s; a video stream on CDR is framed as
+    video, :class:`GenericSpec`).
 
     Raises:
         GenerateError: the configuration's types differ (the generic publisher re-sends the
@@ -531,6 +578,10 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
 
         cdr = cdr_layout_from_config(config, reg)
         layout, program = cdr.layout, program_from_cdr(cdr)
+    elif layout.video is not None:
+        raise GenerateError(f"{config.subscriber.type} streams video: on TCPROS its project is "
+                            "rosfpga_lab.hls.generator's (rosfpga_lab.rtl.project.generate_project "
+                            "picks it)")
     return spec_from_layout(
         layout, reg, node_name=config.node.global_name, program=program, wire=config.wire,
         sub_topic=config.subscriber.topic, pub_topic=config.publisher.topic,
@@ -538,7 +589,7 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
         input_depth=config.fifo.input_depth, output_depth=config.fifo.output_depth,
         axis_depth=config.fifo.axis_depth, part=config.part, clock_mhz=config.clock_mhz,
         op=app.op, ksize=app.ksize, config_name=config.path.name if config.path else "<string>",
-        custom_source=app.source)
+        custom_source=app.source, video=layout.video)
 
 
 # -- test frames and the models' output ----------------------------------------------------------
@@ -666,11 +717,12 @@ def sample_frames_generic(layout: Layout, op: str, ksize: int, *, seed: int = 20
 
 def model_output_cdr(cdr: CdrLayout, op: str, ksize: int, records: list[bytes]
                      ) -> tuple[bytes, list[str]]:
-    """What the lab's CDR models (``hw.cdrwalker`` fast model, ``hw.morph1d``) publish for
+    """What the lab's CDR models (``hw.cdrwalker`` fast model, the application of
+    ``hw.cdrpipeline``: ``hw.morph1d``, or ``hw.morph`` on a video stream) publish for
     ``records`` (each a 4-byte sample length + CDR payload), and the refusal per record."""
+    from rosfpga_lab.hw.cdrpipeline import apply_application
     from rosfpga_lab.hw.cdrwalker import extract_cdr_fast, publish_cdr_fast
     from rosfpga_lab.hw.errors import FrameFieldError
-    from rosfpga_lab.hw.morph1d import morph1d_fast
 
     out = bytearray()
     why = []
@@ -681,7 +733,8 @@ def model_output_cdr(cdr: CdrLayout, op: str, ksize: int, records: list[bytes]
             why.append(str(exc))
             continue
         why.append("")
-        out += publish_cdr_fast(cdr, ex.tokens, morph1d_fast(np.asarray(ex.stream), op, ksize))
+        out += publish_cdr_fast(cdr, ex.tokens, apply_application(
+            cdr.layout.video, op, ksize, np.asarray(ex.stream)))
     return bytes(out), why
 
 

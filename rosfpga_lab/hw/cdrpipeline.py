@@ -30,6 +30,7 @@ from rosfpga_lab.hw.errors import FrameTruncatedError, PipelineConfigError
 from rosfpga_lab.hw.morph import check_op, morph_fast, morph_reference
 from rosfpga_lab.hw.morph1d import check_op1d, morph1d_fast, morph1d_reference
 from rosfpga_lab.hw.video import Mat
+from rosfpga_lab.hw.layout import VideoShape
 from rosfpga_lab.hw.walker import Extracted
 from rosfpga_lab.msg import MsgRegistry
 
@@ -141,16 +142,31 @@ class CdrPipeline:
         return CdrResult(out[4:], out, ex, out_stream, cycles, self.model, stamp)
 
     def _apply(self, stream: np.ndarray, reference: bool) -> np.ndarray:
-        video = self.cdr.layout.video
-        if video is None:
-            return (morph1d_reference if reference else morph1d_fast)(stream, self.op, self.ksize)
-        image = stream.reshape(video.height, video.width, video.bytes_per_pixel)
-        if reference:
-            src, dst = Mat.from_numpy(image, "src"), Mat(video.height, video.width,
-                                                         video.bytes_per_pixel, "dst")
-            morph_reference(src, dst, self.op, self.ksize2)
-            return dst.to_numpy().reshape(-1)
-        return morph_fast(image, self.op, self.ksize2).reshape(-1)
+        return apply_application(self.cdr.layout.video, self.op, self.ksize, stream,
+                                 reference=reference)
 
 
-__all__ = ["CdrPipeline", "CdrResult"]
+def apply_application(video: VideoShape | None, op: str, ksize: int, stream: np.ndarray, *,
+                      reference: bool = False) -> np.ndarray:
+    """The application on one streamed array (flat): with a video shape the 2-D dilate/erode of
+    :mod:`~rosfpga_lab.hw.morph` on its ``height x width`` pixels, else the 1-D window of
+    :mod:`~rosfpga_lab.hw.morph1d` (``reference``: the one-element-at-a-time model).
+
+    Raises:
+        PipelineConfigError: an unknown ``op`` or a bad ``ksize``.
+    """
+    if video is None:
+        name = check_op1d(op, ksize, np.dtype(stream.dtype))
+        return (morph1d_reference if reference else morph1d_fast)(stream, name, ksize)
+    name = canonical_op(op)
+    ksize2 = check_op(name, model_ksize(op, ksize))
+    image = stream.reshape(video.height, video.width, video.bytes_per_pixel)
+    if reference:
+        src, dst = Mat.from_numpy(image, "src"), Mat(video.height, video.width,
+                                                     video.bytes_per_pixel, "dst")
+        morph_reference(src, dst, name, ksize2)
+        return dst.to_numpy().reshape(-1)
+    return morph_fast(image, name, ksize2).reshape(-1)
+
+
+__all__ = ["CdrPipeline", "CdrResult", "apply_application"]

@@ -1,4 +1,5 @@
-"""Verilog of generated projects for any message type (not ``sensor_msgs/Image``).
+"""Verilog of generated projects for any message type (``sensor_msgs/Image`` only on CDR: on
+TCPROS it has the hand-written project).
 
 How this works: the modules of ``generic/`` are written once and parameterized:
 ``rfl_gsubscriber`` and ``rfl_gpublisher`` walk a frame by stepping through a program, one
@@ -10,7 +11,9 @@ max/min over KSIZE elements, pass-through) and ``rfl_elem_unpack`` turns beats b
 ``rfl_gtop`` joins them with the lab's ``rfl_fifo``. ``rfl_node.v`` sets the parameters of one
 configuration; the testbench is the lab's ``rfl_tb.v`` (with an 8-bit status). The same
 walkers read and write CDR (``wire: cdr``): the program's alignment, ``OP_ENCAP`` and strings
-with their NUL (:mod:`rosfpga_lab.hls.program`).
+with their NUL (:mod:`rosfpga_lab.hls.program`). A stream with a video shape
+(:attr:`GenericSpec.video`) is packed a pixel per beat with TLAST ending each line, and
+``rfl_gtop`` (``VIDEO``) runs the video project's 2-D ``rfl_morph`` instead of ``rfl_window1d``.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from pathlib import Path
 
 import jinja2
 
-from rosfpga_lab.hls.generic import GenericSpec, context, environment
+from rosfpga_lab.hls.generic import GenericSpec, beat_shape, context, environment
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, VERILOG_DIR
 
@@ -31,24 +34,30 @@ KIND_CODES = {"unsigned": 0, "signed": 1, "float": 2}
 #: The static Verilog of every generic project (``generic/``), in data-path order.
 GENERIC_MODULES = ("rfl_gsubscriber.v", "rfl_elem_pack.v", "rfl_window1d.v", "rfl_elem_unpack.v",
                    "rfl_gpublisher.v", "rfl_gtop.v")
+#: The application of a video stream (the video project's), beside ``GENERIC_MODULES``.
+VIDEO_APP = "rfl_morph.v"
 #: The generated include holding the walk (one instruction per field).
 LAYOUT_INCLUDE = "rfl_layout.vh"
 TEMPLATES = Path(__file__).resolve().parent / "templates"
 
 
 def generic_params(spec: GenericSpec) -> dict[str, int]:
-    """``rfl_gtop``'s parameters for a generic project."""
+    """``rfl_gtop``'s parameters for a generic project (with a video stream: a beat per pixel,
+    ``VIDEO``, ``WIDTH`` and ``HEIGHT``; :func:`rosfpga_lab.hls.generic.beat_shape`)."""
     prog = spec.program
+    beat = beat_shape(spec)
     carry = max(1, prog.carry_bytes)
+    video = {} if spec.video is None else {"VIDEO": 1, "WIDTH": spec.video.width,
+                                           "HEIGHT": spec.video.height}
     return {
-        "EBYTES": prog.stream_bytes, "LENGTH": prog.stream_length,
+        "EBYTES": beat["bytes"], "LENGTH": beat["count"],
         "KSIZE": spec.ksize if spec.op in ("dilate", "erode") else 1,
         "OP": OP_CODES_1D[spec.op], "KIND": KIND_CODES[spec.kind],
         "CARRY_BYTES": carry, "CW": max(1, (carry - 1).bit_length()),
         "MIN_BODY": prog.min_body, "MAX_FRAME": prog.max_frame,
         "RX_DEPTH": spec.input_depth, "TX_DEPTH": spec.output_depth,
-        "AXIS_DEPTH": spec.axis_depth, "OUT_DEPTH": max(spec.axis_depth, prog.stream_length + 2),
-        "SEQ_START": prog.seq_start,
+        "AXIS_DEPTH": spec.axis_depth, "OUT_DEPTH": max(spec.axis_depth, beat["count"] + 2),
+        "SEQ_START": prog.seq_start, **video,
     }
 
 
@@ -101,6 +110,8 @@ def generic_rtl_files(spec: GenericSpec) -> dict[str, bytes]:
     files = {LAYOUT_INCLUDE: env.get_template(f"{LAYOUT_INCLUDE}.j2").render(ctx).encode()}
     for name in GENERIC_MODULES:
         files[name] = (GENERIC_VERILOG_DIR / name).read_bytes()
+    if spec.video is not None:  # the video project's 2-D application
+        files[VIDEO_APP] = (VERILOG_DIR / VIDEO_APP).read_bytes()
     files["rfl_fifo.v"] = (VERILOG_DIR / "rfl_fifo.v").read_bytes()
     files[NODE_FILE] = node_wrapper(spec, str(ctx["generated_note"])).encode()
     files["rfl_tb.v"] = testbench().encode()
@@ -128,7 +139,7 @@ def simulate_project(project_dir: str | Path, frames: bytes, *, target: str = "r
     as a student types it) and read back its output bytes and a status name per frame.
 
     Args:
-        project_dir: a project written by ``rosfpga-lab generate`` for a type other than Image.
+        project_dir: a project written by ``rosfpga-lab generate`` (not TCPROS Image's).
         frames: TCPROS frames, or for a ``wire: cdr`` project CDR records (each a 4-byte sample
             length and the payload).
         target: ``csim`` or ``rtlsim``.

@@ -15,6 +15,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 
 from rosfpga_lab.config import CUSTOM, MODEL_OPS, PASSTHROUGH, NodeConfig, load_config
+from rosfpga_lab.config.vocabulary import CDR_WIRE
 from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.encodings import PIXEL_FORMATS
@@ -69,8 +70,14 @@ def rtl_params(config: NodeConfig) -> RtlParams:
     """The RTL parameters of ``config``.
 
     Raises:
-        RtlError: ``op: custom`` (the RTL has no user application), or a FIFO shallower than 2.
+        RtlError: ``op: custom`` (the RTL has no user application), a FIFO shallower than 2, or
+            ``wire: cdr`` (these parameters are the TCPROS Image circuit's).
     """
+    if config.wire == CDR_WIRE:
+        raise RtlError("wire: cdr: the lab's Image circuit (rtl sim, cycles, synth, timing, "
+                       "--model rtl) reads TCPROS frames; the CDR circuit's Verilog is a generated "
+                       "project's: rosfpga-lab generate CONFIG -o DIR, then make -C DIR rtlsim "
+                       "(or synth)")
     if config.application.op == CUSTOM:
         raise RtlError("a custom application has no RTL: the lab's Verilog holds dilate, erode "
                        "and passthrough only")

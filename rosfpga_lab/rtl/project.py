@@ -13,7 +13,6 @@ from pathlib import Path
 from rosfpga_lab import __version__
 from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.hls import GenerationResult, generate
-from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.generator import Progress
 from rosfpga_lab.config.vocabulary import CDR_WIRE
 from rosfpga_lab.hls.generic import (
@@ -42,18 +41,15 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
                      progress: Progress | None = None) -> GenerationResult:
     """The HLS C++ project of ``config`` with its RTL in ``rtl/`` (see the module docstring).
 
-    ``sensor_msgs/Image`` gets the hand-written teaching project (its own templates and the lab's
-    ``rfl_*.v``); every other type the generic one, rendered from its circuit layout
-    (:mod:`rosfpga_lab.hls.generic`, :mod:`rosfpga_lab.rtl.generic`).
+    ``sensor_msgs/Image`` on TCPROS gets the hand-written teaching project (its own templates
+    and the lab's ``rfl_*.v``); every other type, and Image on CDR, the generic one, rendered
+    from its circuit layout (:mod:`rosfpga_lab.hls.generic`, :mod:`rosfpga_lab.rtl.generic`;
+    a video stream framed as video for the video project's 2-D application).
 
     Raises:
-        GenerateError: as :func:`rosfpga_lab.hls.generate`; ``wire: cdr`` for Image.
+        GenerateError: as :func:`rosfpga_lab.hls.generate`.
     """
-    if config.is_image and config.wire == CDR_WIRE:
-        raise GenerateError("wire: cdr is not generated for sensor_msgs/Image (its project is the "
-                            "hand-written TCPROS one; the generic walkers refuse video streams): "
-                            "use wire: tcpros, or the Python CDR model (hw.cdrpipeline)")
-    if config.is_image:
+    if config.is_image and config.wire != CDR_WIRE:
         return generate(config, out_dir, force=force, progress=progress,
                         extra_files=rtl_files(config))
     say = progress or (lambda _msg: None)

@@ -111,6 +111,10 @@ PROOFS: tuple[Proof, ...] = (
     Proof("elem_pack", ("rfl_elem_pack.v",), "bmc", 20,
           "rfl_elem_pack (2-byte elements, arrays of 3): TUSER on an array's first element only, "
           "TLAST on its last only, each beat = the bytes taken, lane 0 first; 20 clocks"),
+    Proof("elem_pack", ("rfl_elem_pack.v",), "bmc", 24,
+          "rfl_elem_pack (2-byte elements, arrays of 4 in lines of 2: a video stream): TUSER on "
+          "an array's first element only, TLAST on each line's last only, each beat = the bytes "
+          "taken; 24 clocks", ("FV_LINES",)),
     Proof("elem_unpack", ("rfl_elem_unpack.v",), "prove", 8,
           "rfl_elem_unpack (2-byte elements): output stream rules; all reachable states",
           ("FV_PROVE",)),

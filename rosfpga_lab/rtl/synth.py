@@ -52,6 +52,7 @@ GENERIC_MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_gsubscriber", "subscriber (generic walker)"),
     ("rfl_elem_pack", "fifo2axi (elements)"),
     ("rfl_window1d", "application (rfl_window1d)"),
+    ("rfl_morph", "application (rfl_morph)"),   # a video stream's (Image on CDR)
     ("rfl_elem_unpack", "axi2fifo (elements)"),
     ("rfl_gpublisher", "publisher (generic walker)"),
     ("rfl_gtop", "top level (glue, generic)"),

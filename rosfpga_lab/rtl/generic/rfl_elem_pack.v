@@ -1,10 +1,12 @@
 // rfl_elem_pack -- the streamed array's bytes (8-bit valid/ready, little-endian, as on the
 // wire) become AXI4-Stream beats of one element each: element byte i in TDATA bits 8i+7..8i,
-// TUSER on the array's first element, TLAST on its last (LENGTH elements per array). One byte
-// is taken per clock, so a beat of EBYTES bytes takes EBYTES clocks.
+// TUSER on the array's first element, TLAST on its last (LENGTH elements per array) or, for
+// video, on the last of every line of LINE elements (pixels). One byte is taken per clock, so a
+// beat of EBYTES bytes takes EBYTES clocks.
 module rfl_elem_pack #(
     parameter EBYTES = 4,                       // bytes per element: 1, 2, 4 or 8
-    parameter LENGTH = 256                      // elements per array (at least 1)
+    parameter LENGTH = 256,                     // elements per array (at least 1)
+    parameter LINE = LENGTH                     // elements per line (TLAST); divides LENGTH
 ) (
     input                       clk,
     input                       rst_n,
@@ -31,6 +33,22 @@ module rfl_elem_pack #(
     wire last_byte = (k == LAST_LANE);
     wire take = s_tvalid && s_tready;
     wire [EW-1:0] byte_in = {{(EW-8){1'b0}}, s_tdata};
+    wire line_end;                              // the next beat ends a line
+
+    generate
+        if (LINE == LENGTH) begin : g_one_line
+            assign line_end = (n == LAST_N);
+        end else begin : g_lines
+            localparam LC = LINE - 1;
+            localparam [31:0] LAST_C = LC[31:0];
+            reg [31:0] c;                       // the next beat's element within its line
+            always @(posedge clk) begin
+                if (!rst_n) c <= 32'd0;
+                else if (take && last_byte) c <= (c == LAST_C || n == LAST_N) ? 32'd0 : c + 32'd1;
+            end
+            assign line_end = (c == LAST_C);
+        end
+    endgenerate
 
     assign s_tready = !last_byte || out_free;
     assign m_axis_tkeep = {EBYTES{1'b1}};
@@ -50,7 +68,7 @@ module rfl_elem_pack #(
                 if (last_byte) begin
                     m_axis_tdata <= acc | (byte_in << (8 * LAST_LANE));
                     m_axis_tuser <= (n == 32'd0);
-                    m_axis_tlast <= (n == LAST_N);
+                    m_axis_tlast <= line_end;
                     m_axis_tvalid <= 1'b1;
                     acc <= {EW{1'b0}};
                     k <= 4'd0;

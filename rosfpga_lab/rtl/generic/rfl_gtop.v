@@ -4,6 +4,10 @@
 //     -> rfl_window1d -> [axis FIFO, OUT_DEPTH] -> rfl_elem_unpack -> rfl_gpublisher
 //     -> [tx FIFO] -> m_* (8-bit, to TCP/IP)
 //
+// VIDEO = 1: the streamed array is HEIGHT lines of WIDTH pixels of EBYTES bytes; the packer ends
+// every line with TLAST and the application is the video project's 2-D rfl_morph (32-bit TDATA,
+// unused lanes zero) instead of rfl_window1d.
+//
 // The publisher starts a frame once the subscriber has read all of it (the frame length comes
 // first and depends on every field), so the FIFO after the application holds a whole stream:
 // OUT_DEPTH >= LENGTH + 2. The carry memory lives in the subscriber; the publisher reads it.
@@ -21,7 +25,12 @@ module rfl_gtop #(
     parameter TX_DEPTH = 2048,
     parameter AXIS_DEPTH = 16,
     parameter OUT_DEPTH = 18,
-    parameter [31:0] SEQ_START = 1
+    parameter [31:0] SEQ_START = 1,
+    parameter VIDEO = 0,                        // 1: frame the stream as video (rfl_morph)
+    parameter WIDTH = LENGTH,                   // VIDEO: pixels per line
+    /* verilator lint_off UNUSEDPARAM */
+    parameter HEIGHT = 1                        // VIDEO: lines (unused without VIDEO)
+    /* verilator lint_on UNUSEDPARAM */
 ) (
     input        clk,
     input        rst_n,
@@ -78,7 +87,7 @@ module rfl_gtop #(
     wire app_in_tuser, app_in_tlast, app_in_tvalid, app_in_tready;
     wire app_out_tuser, app_out_tlast, app_out_tvalid, app_out_tready;
     wire axis_out_tvalid, axis_out_tready;
-    rfl_elem_pack #(.EBYTES(EBYTES), .LENGTH(LENGTH)) u_fifo2axi (
+    rfl_elem_pack #(.EBYTES(EBYTES), .LENGTH(LENGTH), .LINE(VIDEO ? WIDTH : LENGTH)) u_fifo2axi (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(pix_in_tdata), .s_tvalid(pix_in_tvalid), .s_tready(pix_in_tready),
         .m_axis_tdata(axis_in_tdata), .m_axis_tkeep(axis_in_tkeep), .m_axis_tuser(axis_in_tuser),
@@ -90,17 +99,46 @@ module rfl_gtop #(
         .s_tvalid(axis_in_tvalid), .s_tready(axis_in_tready),
         .m_tdata({app_in_tlast, app_in_tuser, app_in_tkeep, app_in_tdata}),
         .m_tvalid(app_in_tvalid), .m_tready(app_in_tready), .level(axis_in_level));
-    /* verilator lint_off UNUSEDSIGNAL */
-    wire [EBYTES-1:0] unused_keep = app_in_tkeep;
-    /* verilator lint_on UNUSEDSIGNAL */
-
-    rfl_window1d #(.EBYTES(EBYTES), .KSIZE(KSIZE), .OP(OP), .KIND(KIND)) u_app (
-        .aclk(clk), .aresetn(rst_n),
-        .s_axis_tdata(app_in_tdata), .s_axis_tuser(app_in_tuser), .s_axis_tlast(app_in_tlast),
-        .s_axis_tvalid(app_in_tvalid), .s_axis_tready(app_in_tready),
-        .m_axis_tdata(app_out_tdata), .m_axis_tkeep(app_out_tkeep), .m_axis_tuser(app_out_tuser),
-        .m_axis_tlast(app_out_tlast), .m_axis_tvalid(app_out_tvalid),
-        .m_axis_tready(app_out_tready));
+    generate
+        if (VIDEO) begin : g_video
+            // the video application: one pixel per 32-bit beat, lanes above EBYTES zero
+            wire [31:0] v_in_tdata, v_out_tdata;
+            wire [3:0] v_in_tkeep, v_out_tkeep;
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire [3:0] v_framing;               // framing flags: the packer frames every array
+            wire [31:0] v_out_all = v_out_tdata;
+            wire [3:0] v_keep_all = v_out_tkeep;
+            /* verilator lint_on UNUSEDSIGNAL */
+            if (EW < 32) begin : g_pad
+                assign v_in_tdata = {{(32 - EW){1'b0}}, app_in_tdata};
+                assign v_in_tkeep = {{(4 - EBYTES){1'b0}}, app_in_tkeep};
+            end else begin : g_full
+                assign v_in_tdata = app_in_tdata;
+                assign v_in_tkeep = app_in_tkeep;
+            end
+            rfl_morph #(.WIDTH(WIDTH), .HEIGHT(HEIGHT), .KSIZE(KSIZE), .OP(OP), .BYTES(EBYTES)) u_app (
+                .aclk(clk), .aresetn(rst_n),
+                .s_axis_tdata(v_in_tdata), .s_axis_tkeep(v_in_tkeep), .s_axis_tuser(app_in_tuser),
+                .s_axis_tlast(app_in_tlast), .s_axis_tvalid(app_in_tvalid),
+                .s_axis_tready(app_in_tready),
+                .m_axis_tdata(v_out_tdata), .m_axis_tkeep(v_out_tkeep), .m_axis_tuser(app_out_tuser),
+                .m_axis_tlast(app_out_tlast), .m_axis_tvalid(app_out_tvalid),
+                .m_axis_tready(app_out_tready), .framing(v_framing));
+            assign app_out_tdata = v_out_all[EW-1:0];
+            assign app_out_tkeep = v_keep_all[EBYTES-1:0];
+        end else begin : g_window
+            /* verilator lint_off UNUSEDSIGNAL */
+            wire [EBYTES-1:0] unused_keep = app_in_tkeep;
+            /* verilator lint_on UNUSEDSIGNAL */
+            rfl_window1d #(.EBYTES(EBYTES), .KSIZE(KSIZE), .OP(OP), .KIND(KIND)) u_app (
+                .aclk(clk), .aresetn(rst_n),
+                .s_axis_tdata(app_in_tdata), .s_axis_tuser(app_in_tuser), .s_axis_tlast(app_in_tlast),
+                .s_axis_tvalid(app_in_tvalid), .s_axis_tready(app_in_tready),
+                .m_axis_tdata(app_out_tdata), .m_axis_tkeep(app_out_tkeep), .m_axis_tuser(app_out_tuser),
+                .m_axis_tlast(app_out_tlast), .m_axis_tvalid(app_out_tvalid),
+                .m_axis_tready(app_out_tready));
+        end
+    endgenerate
 
     // application -> axis FIFO (a whole stream) -> element unpacker -> publisher
     rfl_fifo #(.WIDTH(BW), .DEPTH(OUT_DEPTH)) u_axis_out_fifo (

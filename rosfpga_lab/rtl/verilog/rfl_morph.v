@@ -68,6 +68,7 @@ module rfl_morph #(
     localparam VROWS = HEIGHT + D;                   // scan rows
     localparam RW   = $clog2(VROWS + 1);
     localparam CW   = $clog2(WIDTH + 1);
+    localparam AW   = (WIDTH > 1) ? $clog2(WIDTH) : 1;  // a line memory's address (< CW when WIDTH is 2^n)
     localparam OW   = $clog2(HEIGHT + 1);
     localparam LW   = (LEAD > 0) ? $clog2(LEAD + 1) : 1;
     localparam SW   = (NL > 1) ? $clog2(NL) : 1;
@@ -217,8 +218,8 @@ module rfl_morph #(
                 reg [W-1:0] q;
                 always @(posedge aclk) begin
                     if (fire && vact) begin
-                        if (wsel == SEL) mem[vcol] <= pix;
-                        q <= mem[vcol];          // read-first: the row written KSIZE-1 rows ago
+                        if (wsel == SEL) mem[vcol[AW-1:0]] <= pix;
+                        q <= mem[vcol[AW-1:0]];  // read-first: the row written KSIZE-1 rows ago
                     end
                 end
                 assign qall[m*W +: W] = q;

@@ -2,13 +2,15 @@
 // (whole arrays of LENGTH elements of EBYTES bytes, little-endian) go through rfl_elem_pack,
 // rfl_window1d and rfl_elem_unpack; the bytes out go to +output=FILE. Random input gaps and
 // output backpressure (+gap=P +bp=P, per mille of clocks; +seed=N). A TUSER or TLAST in the
-// wrong place is reported as "rtlsim: ERROR".
+// wrong place (TLAST: the last element of every LINE, the packer's video framing) is reported
+// as "rtlsim: ERROR".
 module rfl_elem_tb;
     parameter EBYTES = 4;
     parameter LENGTH = 16;
     parameter KSIZE = 3;
     parameter OP = 0;
     parameter KIND = 0;
+    parameter LINE = LENGTH;
     localparam EW = 8 * EBYTES;
 
     reg clk = 1'b0;
@@ -24,7 +26,7 @@ module rfl_elem_tb;
     wire [EBYTES-1:0] a_tkeep, b_tkeep;
     wire a_tuser, a_tlast, a_tvalid, a_tready, b_tuser, b_tlast, b_tvalid, b_tready;
 
-    rfl_elem_pack #(.EBYTES(EBYTES), .LENGTH(LENGTH)) u_pack (
+    rfl_elem_pack #(.EBYTES(EBYTES), .LENGTH(LENGTH), .LINE(LINE)) u_pack (
         .clk(clk), .rst_n(rst_n), .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_axis_tdata(a_tdata), .m_axis_tkeep(a_tkeep), .m_axis_tuser(a_tuser),
         .m_axis_tlast(a_tlast), .m_axis_tvalid(a_tvalid), .m_axis_tready(a_tready));
@@ -90,12 +92,12 @@ module rfl_elem_tb;
         rnd = xorshift(rnd);
         m_tready <= ((rnd % 1000) >= bp);
         if (b_tvalid && b_tready) begin
-            if (b_tuser != (nout == 0) || b_tlast != (nout == LENGTH - 1))
+            if (b_tuser != (nout == 0) || b_tlast != (nout % LINE == LINE - 1))
                 $display("rtlsim: ERROR: element %0d out has TUSER %0d TLAST %0d", nout, b_tuser, b_tlast);
             nout = (nout == LENGTH - 1) ? 0 : nout + 1;
         end
         if (a_tvalid && a_tready) begin
-            if (a_tuser != (nin == 0) || a_tlast != (nin == LENGTH - 1))
+            if (a_tuser != (nin == 0) || a_tlast != (nin % LINE == LINE - 1))
                 $display("rtlsim: ERROR: element %0d in has TUSER %0d TLAST %0d", nin, a_tuser, a_tlast);
             nin = (nin == LENGTH - 1) ? 0 : nin + 1;
         end
