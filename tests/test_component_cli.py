@@ -333,3 +333,12 @@ def test_camera_and_view_without_a_master_say_what_to_do(capsys) -> None:
     assert main(["view", "/x", "--master-uri", uri, "--count", "1"]) == 1
     err = capsys.readouterr().err
     assert err.count(f"no ROS master answers at {uri}") == 2 and "rosfpga-lab master" in err
+
+
+def test_node_ros2_with_the_rtl_model_says_where_the_cdr_verilog_runs(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """It once served with the Python model while saying nothing; now it stops before any socket."""
+    config = Path(__file__).resolve().parent.parent / "data" / "fpga_dilate_rgba8.yaml"
+    assert main(["node", str(config), "--ros2", "--model", "rtl", "--duration", "1"]) == 1
+    err = capsys.readouterr().err
+    assert "rosfpga-lab node: error:" in err and "make rtlsim" in err

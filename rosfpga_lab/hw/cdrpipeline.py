@@ -21,7 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from rosfpga_lab.config import NodeConfig
-from rosfpga_lab.config.vocabulary import CUSTOM, MODELS, canonical_op, model_ksize
+from rosfpga_lab.config.vocabulary import (CUSTOM, PIPELINE_MODELS, RTL_MODEL, canonical_op,
+                                           model_ksize)
 from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_layout_from_config
 from rosfpga_lab.hw.cdrwalker import (
     extract_cdr_fast, extract_cdr_reference, publish_cdr_fast, publish_cdr_reference,
@@ -82,8 +83,14 @@ class CdrPipeline:
 
     def __init__(self, config: NodeConfig, model: str = "fast",
                  reg: MsgRegistry | None = None) -> None:
-        if model not in MODELS:
-            raise PipelineConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        if model == RTL_MODEL:
+            raise PipelineConfigError(
+                "the CDR circuit has no live RTL model: run its Verilog with `rosfpga-lab generate "
+                "CONFIG -o DIR` then `make rtlsim` in DIR; live, use --model "
+                f"{' or '.join(PIPELINE_MODELS)}")
+        if model not in PIPELINE_MODELS:
+            raise PipelineConfigError(
+                f"model must be one of {', '.join(PIPELINE_MODELS)}, got {model!r}")
         app = config.application
         if canonical_op(app.op) == CUSTOM:
             raise PipelineConfigError("a custom application has no Python model; compare its C "
