@@ -35,6 +35,7 @@ from rosfpga_lab.hw.layout import (
 from rosfpga_lab.msg import deserialize, serialize
 from rosfpga_lab.msg.strategies import message
 from rosfpga_lab.rtl.generic import project_files, simulate_project
+from rosfpga_lab.rtl.project import generate_project
 from test_hw_walker import definitions  # the models' strategy over message definitions
 
 DATA = Path(__file__).resolve().parent.parent / "data"
@@ -336,3 +337,15 @@ def test_the_generic_circuit_given_the_image_layout_publishes_as_the_image_proje
             refused += 1
     assert refused == 1 and expected
     assert simulate(project, frames) == (expected, expected)
+
+
+def test_a_vivado_flavour_is_refused_for_a_generic_project(tmp_path: Path) -> None:
+    """The generic project is Vitis HLS C++ only; hls.flavour: vivado was once ignored quietly."""
+    from rosfpga_lab.config import parse_config
+    from rosfpga_lab.hls import GenerateError
+
+    text = (DATA / "fpga_samples_dilate.yaml").read_text(encoding="utf-8")
+    vivado = parse_config(text + "\nhls: {flavour: vivado}\n", base_dir=DATA)
+    with pytest.raises(GenerateError, match="hls.flavour: vivado .* written for vitis only"):
+        generate_project(vivado, tmp_path / "out")
+    assert not (tmp_path / "out").exists()

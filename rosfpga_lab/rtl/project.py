@@ -12,9 +12,9 @@ from pathlib import Path
 
 from rosfpga_lab import __version__
 from rosfpga_lab.config import CUSTOM, NodeConfig
-from rosfpga_lab.hls import GenerationResult, generate
+from rosfpga_lab.hls import GenerateError, GenerationResult, generate
 from rosfpga_lab.hls.generator import Progress
-from rosfpga_lab.config.vocabulary import CDR_WIRE
+from rosfpga_lab.config.vocabulary import CDR_WIRE, DEFAULT_HLS_FLAVOUR
 from rosfpga_lab.hls.generic import (
     render_generic, sample_frames_generic, sample_records_cdr, spec_from_config,
 )
@@ -47,11 +47,17 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
     a video stream framed as video for the video project's 2-D application).
 
     Raises:
-        GenerateError: as :func:`rosfpga_lab.hls.generate`.
+        GenerateError: as :func:`rosfpga_lab.hls.generate`; also ``hls.flavour`` other than
+            the default for a generic project (it is written for that tool only).
     """
     if config.is_image and config.wire != CDR_WIRE:
         return generate(config, out_dir, force=force, progress=progress,
                         extra_files=rtl_files(config))
+    if config.hls.flavour != DEFAULT_HLS_FLAVOUR:
+        raise GenerateError(
+            f"hls.flavour: {config.hls.flavour} is for the sensor_msgs/Image project on TCPROS; "
+            f"the generic project ({config.subscriber.type}, wire {config.wire}) is written for "
+            f"{DEFAULT_HLS_FLAVOUR} only: remove hls.flavour from {config.path or 'the configuration'}")
     say = progress or (lambda _msg: None)
     spec = spec_from_config(config)
     say(f"rendering the walk of {spec.program.type_in}: {len(spec.program.instrs)} instructions")
