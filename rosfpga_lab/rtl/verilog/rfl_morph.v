@@ -249,7 +249,10 @@ module rfl_morph #(
     // the identity of the extreme on the way ----------------------------------------------------
     // The candidates, pairs and tree nodes below are one W-bit word per generate block, indexed
     // by constants, not wide vectors walked by functions: the same logic, and a Verilated
-    // model that evaluates only the words that exist (the simulation's speed).
+    // model that evaluates only the words that exist (the simulation's speed). These data
+    // registers load only with a step (their stage's valid): a bubble leaves them as they
+    // were, which nothing reads, and the simulation skips their comparisons then (a pixel
+    // comes every BYTES clocks from the byte stream).
     reg           valid1r, emit1r, first1r, eol1r;
     reg [K-1:0]   hmask1r;
 
@@ -280,7 +283,7 @@ module rfl_morph #(
             end else begin : pad
                 assign src = ID;
             end
-            always @(posedge aclk) if (aresetn && adv) v <= src;
+            always @(posedge aclk) if (aresetn && adv && valid1) v <= src;
         end
     endgenerate
 
@@ -310,7 +313,7 @@ module rfl_morph #(
             if (c >= VT && c - VT < VP) begin : pair
                 reg [W-1:0] r;
                 always @(posedge aclk)
-                    if (aresetn && adv) r <= pick(vc[2*(c-VT)].v, vc[2*(c-VT)+1].v);
+                    if (aresetn && adv && valid1r) r <= pick(vc[2*(c-VT)].v, vc[2*(c-VT)+1].v);
                 assign w = r;
             end else if (c >= VT) begin : pad
                 assign w = ID;
@@ -378,7 +381,7 @@ module rfl_morph #(
             if (c >= HT && c - HT < HP) begin : pair
                 reg [W-1:0] r;
                 always @(posedge aclk)
-                    if (aresetn && adv) r <= pick(hc[2*(c-HT)].w, hc[2*(c-HT)+1].w);
+                    if (aresetn && adv && valid2) r <= pick(hc[2*(c-HT)].w, hc[2*(c-HT)+1].w);
                 assign w = r;
             end else if (c >= HT) begin : pad
                 assign w = ID;
@@ -400,8 +403,10 @@ module rfl_morph #(
             m_axis_tlast  <= 1'b0;
         end else if (adv) begin
             m_axis_tvalid <= valid2b && emit2b;
-            m_axis_tdata  <= 32'd0;
-            m_axis_tdata[W-1:0] <= hext;
+            if (valid2b) begin
+                m_axis_tdata  <= 32'd0;
+                m_axis_tdata[W-1:0] <= hext;
+            end
             m_axis_tuser  <= first2b;
             m_axis_tlast  <= eol2b;
         end
