@@ -233,6 +233,8 @@ module rfl_morph #(
             valid1 <= 1'b0;
         end else if (adv) begin
             valid1 <= fire;
+        end
+        if (aresetn && adv && fire) begin      // the step's payload (see stage 1r)
             p1     <= s_axis_tdata[W-1:0];
             pz1    <= pz;
             pv1    <= vact && in_row;
@@ -261,6 +263,8 @@ module rfl_morph #(
             valid1r <= 1'b0;
         end else if (adv) begin
             valid1r <= valid1;
+        end
+        if (aresetn && adv && valid1) begin
             emit1r  <= emit1;
             first1r <= first1;
             eol1r   <= eol1;
@@ -297,6 +301,8 @@ module rfl_morph #(
             valid1v <= 1'b0;
         end else if (adv) begin
             valid1v <= valid1r;
+        end
+        if (aresetn && adv && valid1r) begin
             emit1v  <= emit1r;
             first1v <= first1r;
             eol1v   <= eol1r;
@@ -336,6 +342,8 @@ module rfl_morph #(
             valid2 <= 1'b0;
         end else if (adv) begin
             valid2 <= valid1v;
+        end
+        if (aresetn && adv && valid1v) begin
             emit2  <= emit1v;
             first2 <= first1v;
             eol2   <= eol1v;
@@ -362,6 +370,8 @@ module rfl_morph #(
             valid2b <= 1'b0;
         end else if (adv) begin
             valid2b <= valid2;
+        end
+        if (aresetn && adv && valid2) begin
             emit2b  <= emit2;
             first2b <= first2;
             eol2b   <= eol2;
@@ -406,9 +416,9 @@ module rfl_morph #(
             if (valid2b) begin
                 m_axis_tdata  <= 32'd0;
                 m_axis_tdata[W-1:0] <= hext;
+                m_axis_tuser  <= first2b;
+                m_axis_tlast  <= eol2b;
             end
-            m_axis_tuser  <= first2b;
-            m_axis_tlast  <= eol2b;
         end
     end
 
