@@ -105,3 +105,28 @@ def test_harness_refuses_testbench_only_options(tmp_path: Path) -> None:
         run(sim, b"", vcd=tmp_path / "w.vcd")
     with pytest.raises(RtlError, match="Verilator without waveform"):
         build(rtl_params(config), tmp_path / "x", simulator="verilator", trace=True, harness=True)
+
+
+def test_the_plain_eval_fallback_equals_the_testbench(tmp_path: Path) -> None:
+    """The harness evaluates the model once per clock (the rising edge; the falling edge is
+    only told to the edge detector, hs bit 7 computed in C++: the test above holds that to
+    the testbench). Built with RFL_PLAIN_EVAL (the fallback for a Verilator without the inner
+    eval) it evaluates both edges with eval(), and must give the same bytes, statuses, stream
+    spans, clocks and beats, with gaps and backpressure."""
+    require_rtl("verilator")
+    require_rtl("iverilog")
+    from rosfpga_lab.rtl.sim import _run_command, harness_command, write_sources
+
+    config = small_config("mono8", frame_id_max=16)
+    frames, _ = refusal_frames(config)
+    data = b"".join(frames)
+    plain_dir = tmp_path / "plain"
+    write_sources(rtl_params(config), plain_dir)
+    done = subprocess.run(harness_command(plain_dir, plain_eval=True), cwd=plain_dir,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    plain = RtlBuild("verilator", _run_command("verilator", plain_dir, True), plain_dir,
+                     rtl_params(config), 0.0, False, True)
+    tb = build(rtl_params(config), tmp_path / "tb", simulator="iverilog")
+    assert_same_run(run(plain, data, seed=6, gap=100, bp=700, beats=True),
+                    run(tb, data, seed=6, gap=100, bp=700, beats=True))

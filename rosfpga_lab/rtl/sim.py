@@ -13,7 +13,7 @@ runs per clock.
 With Verilator and a C++ compiler (and no waveform wanted), :func:`build` compiles the fast
 harness instead (``harness/rfl_harness.cpp`` around ``harness/rfl_harness.v``): a plain
 ``eval`` loop without ``--timing`` that keeps the frames in memory and does clock for clock what
-the testbench does (same reset, same random draws, same outputs and files), at 10-20 M clocks/s
+the testbench does (same reset, same random draws, same outputs and files), at about 17 M clocks/s
 where the testbench on ``verilator --binary --timing`` does about 2 M. Its serve mode is the
 long-lived simulator of ``--model rtl`` (:mod:`rosfpga_lab.rtl.server`).
 """

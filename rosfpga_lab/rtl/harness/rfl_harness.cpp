@@ -37,6 +37,18 @@ static const int NS = 9;
 void Vrfl_harness___024root___eval(Vrfl_harness___024root* vlSelf);
 #define RFL_EVAL(t) Vrfl_harness___024root___eval((t)->rootp)
 #endif
+// The falling edge changes no register, and of the ports read before the next rising edge only
+// hs bit 7 (m_tvalid && m_tready) follows an input without a register between: so the model
+// is evaluated once per clock, at the rising edge (with the inputs set after the last one, as
+// the testbench's nonblocking drives do), the edge detector is told the clock went low, and bit
+// 7 is computed here from the same two signals. RFL_PLAIN_EVAL keeps both evaluations.
+#ifdef RFL_PLAIN_EVAL
+#define RFL_FALL(t) RFL_EVAL(t)
+#define RFL_HS(t) ((t)->hs)
+#else
+#define RFL_FALL(t) ((t)->rootp->__Vtrigprevexpr___TOP__clk__0 = 0)
+#define RFL_HS(t) (((t)->hs & ~128u) | (((t)->m_tvalid && (t)->m_tready) ? 128u : 0u))
+#endif
 
 static uint32_t xorshift(uint32_t x) {
     uint32_t y = x ^ (x << 13);
@@ -120,7 +132,7 @@ struct Sim {
         for (;;) {
             const bool s_tvalid = top->s_tvalid, s_tready = top->s_tready;
             const bool m_tvalid = top->m_tvalid, m_tready = top->m_tready;
-            const uint32_t hs = top->hs;
+            const uint32_t hs = RFL_HS(top);
             ++cycle;
             if (s_tvalid && s_tready) ++in_bytes;
             bool nv = s_tvalid;
@@ -170,7 +182,7 @@ struct Sim {
             done_for = (eof && !top->busy && !s_tvalid) ? done_for + 1 : 0;
             top->clk = 1; RFL_EVAL(top);
             top->s_tvalid = nv; top->s_tdata = nd; top->m_tready = nr;
-            top->clk = 0; RFL_EVAL(top);
+            top->clk = 0; RFL_FALL(top);
             if (done_for == 8) return 0;
             if (idle >= idle_limit) return eof ? 1 : 2;
         }

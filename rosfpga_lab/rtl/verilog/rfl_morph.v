@@ -234,6 +234,8 @@ module rfl_morph #(
             valid1 <= 1'b0;
         end else if (adv) begin
             valid1 <= fire;
+        end
+        if (aresetn && adv && fire) begin      // the step's payload (see stage 1r)
             p1     <= s_axis_tdata[W-1:0];
             pz1    <= pz;
             pv1    <= vact && in_row;
@@ -248,64 +250,88 @@ module rfl_morph #(
     // ---- stage 1r: the line memories' outputs registered (a block RAM's clock-to-output is
     // slow; the window's extremes start from flip-flops), those outside the image replaced by
     // the identity of the extreme on the way ----------------------------------------------------
+    // The candidates, pairs and tree nodes below are one W-bit word per generate block, indexed
+    // by constants, not wide vectors walked by functions: the same logic, and a Verilated
+    // model that evaluates only the words that exist (the simulation's speed). These data
+    // registers load only with a step (their stage's valid): a bubble leaves them as they
+    // were, which nothing reads, and the simulation skips their comparisons then (a pixel
+    // comes every BYTES clocks from the byte stream).
     reg           valid1r, emit1r, first1r, eol1r;
     reg [K-1:0]   hmask1r;
-    reg [16*W-1:0] vcand;      // candidates of the vertical extreme: the pixel, then the lines
 
-    integer i;
     always @(posedge aclk) begin
         if (!aresetn) begin
             valid1r <= 1'b0;
         end else if (adv) begin
             valid1r <= valid1;
+        end
+        if (aresetn && adv && valid1) begin
             emit1r  <= emit1;
             first1r <= first1;
             eol1r   <= eol1;
             hmask1r <= hmask1;
-            vcand   <= {16{ID}};
-            vcand[W-1:0] <= pv1 ? (pz1 ? {W{1'b0}} : p1) : ID;
-            for (i = 0; i < NL; i = i + 1)
-                if (K > 1 && mv1[i]) vcand[(i+1)*W +: W] <= qall[i*W +: W];
         end
     end
 
-    // The extreme of up to N candidates (those not taken are the identity ID), as a balanced
-    // tree of pick: ceil(log2 N) comparisons deep, not N - 1.
-    function [W-1:0] tree(input [15*W-1:0] c, input integer n);
-        reg [15*W-1:0] t;
-        integer st, a;
-        begin
-            t = c;
-            for (st = 1; st < 16; st = st * 2)
-                for (a = 0; a + st < 16; a = a + 2 * st)
-                    if (a + st < n) t[a*W +: W] = pick(t[a*W +: W], t[(a+st)*W +: W]);
-            tree = t[W-1:0];
+    // candidates of the vertical extreme, vc[c].v: the pixel (c = 0), then the lines; one more
+    // (the identity) when their count is odd, so that every pair below has two
+    localparam NC = NL + 1 + ((NL + 1) % 2);
+    genvar c;
+    generate
+        for (c = 0; c < NC; c = c + 1) begin : vc
+            reg  [W-1:0] v;
+            wire [W-1:0] src;
+            if (c == 0) begin : pixel
+                assign src = pv1 ? (pz1 ? {W{1'b0}} : p1) : ID;
+            end else if (K > 1 && c <= NL) begin : line
+                assign src = mv1[c-1] ? qall[(c-1)*W +: W] : ID;
+            end else begin : pad
+                assign src = ID;
+            end
+            always @(posedge aclk) if (aresetn && adv && valid1) v <= src;
         end
-    endfunction
+    endgenerate
 
     // ---- stage 1v: the vertical candidates paired (the tree's first level) and registered ----
-    localparam VP = (NL + 2) / 2;              // pairs of the NL + 1 candidates
+    localparam VP = NC / 2;                    // pairs of the NL + 1 candidates
+    localparam VT = 1 << $clog2(VP);           // leaves of the tree: VP, rounded up to 2**n
     reg           valid1v, emit1v, first1v, eol1v;
     reg [K-1:0]   hmask1v;
-    reg [15*W-1:0] vpair;
-    integer v;
     always @(posedge aclk) begin
         if (!aresetn) begin
             valid1v <= 1'b0;
         end else if (adv) begin
             valid1v <= valid1r;
+        end
+        if (aresetn && adv && valid1r) begin
             emit1v  <= emit1r;
             first1v <= first1r;
             eol1v   <= eol1r;
             hmask1v <= hmask1r;
-            vpair   <= {15{ID}};
-            for (v = 0; v < VP; v = v + 1)
-                vpair[v*W +: W] <= pick(vcand[2*v*W +: W], vcand[(2*v+1)*W +: W]);
         end
     end
 
+    // The extreme of the VP pairs as a balanced tree of pick (ceil(log2 VP) comparisons deep),
+    // numbered as a heap: node n (1 <= n < VT) picks from nodes 2n and 2n+1, node VT + p is
+    // pair p (registered; the identity past VP), the root is node 1.
+    generate
+        for (c = 1; c < 2 * VT; c = c + 1) begin : vt
+            wire [W-1:0] w;
+            if (c >= VT && c - VT < VP) begin : pair
+                reg [W-1:0] r;
+                always @(posedge aclk)
+                    if (aresetn && adv && valid1r) r <= pick(vc[2*(c-VT)].v, vc[2*(c-VT)+1].v);
+                assign w = r;
+            end else if (c >= VT) begin : pad
+                assign w = ID;
+            end else begin : node
+                assign w = pick(vt[2*c].w, vt[2*c+1].w);
+            end
+        end
+    endgenerate
+
     // vertical extreme of the column over the image rows of the window
-    wire [W-1:0] vext = tree(vpair, VP);
+    wire [W-1:0] vext = vt[1].w;
 
     // ---- stage 2: horizontal shift register of vertical extremes -----------------------------
     reg           valid2, emit2, first2, eol2;
@@ -317,6 +343,8 @@ module rfl_morph #(
             valid2 <= 1'b0;
         end else if (adv) begin
             valid2 <= valid1v;
+        end
+        if (aresetn && adv && valid1v) begin
             emit2  <= emit1v;
             first2 <= first1v;
             eol2   <= eol1v;
@@ -332,37 +360,48 @@ module rfl_morph #(
         end
     endgenerate
 
-    // the entries on the output pixel's line (else the identity), paired: the first level of
-    // the horizontal tree
+    // ---- stage 2b: the entries on the output pixel's line (else the identity), paired (the
+    // first level of the horizontal tree; K is odd, the last pair's second word is the
+    // identity) and registered; the rest of the tree after them, numbered as vt ---------------
     localparam HP = (K + 1) / 2;
-    reg [16*W-1:0] hcand;
-    reg [8*W-1:0]  hpair;
-    integer h;
-    always @* begin
-        hcand = {16{ID}};
-        for (h = 0; h < K; h = h + 1)
-            if (hmask2[h]) hcand[h*W +: W] = sr[h*W +: W];
-        hpair = {8{ID}};
-        for (h = 0; h < HP; h = h + 1)
-            hpair[h*W +: W] = pick(hcand[2*h*W +: W], hcand[(2*h+1)*W +: W]);
-    end
-
-    // ---- stage 2b: the pairs registered; the rest of the tree after them --------------------
+    localparam HT = 1 << $clog2(HP);
     reg           valid2b, emit2b, first2b, eol2b;
-    reg [8*W-1:0] hpair2b;
     always @(posedge aclk) begin
         if (!aresetn) begin
             valid2b <= 1'b0;
         end else if (adv) begin
             valid2b <= valid2;
+        end
+        if (aresetn && adv && valid2) begin
             emit2b  <= emit2;
             first2b <= first2;
             eol2b   <= eol2;
-            hpair2b <= hpair;
         end
     end
-    wire [15*W-1:0] hpair_wide = {{(7*W){1'b0}}, hpair2b};
-    wire [W-1:0] hext = tree(hpair_wide, HP);
+    generate
+        for (c = 0; c < 2 * HP; c = c + 1) begin : hc
+            wire [W-1:0] w;
+            if (c < K) begin : entry
+                assign w = hmask2[c] ? sr[c*W +: W] : ID;
+            end else begin : pad
+                assign w = ID;
+            end
+        end
+        for (c = 1; c < 2 * HT; c = c + 1) begin : ht
+            wire [W-1:0] w;
+            if (c >= HT && c - HT < HP) begin : pair
+                reg [W-1:0] r;
+                always @(posedge aclk)
+                    if (aresetn && adv && valid2) r <= pick(hc[2*(c-HT)].w, hc[2*(c-HT)+1].w);
+                assign w = r;
+            end else if (c >= HT) begin : pad
+                assign w = ID;
+            end else begin : node
+                assign w = pick(ht[2*c].w, ht[2*c+1].w);
+            end
+        end
+    endgenerate
+    wire [W-1:0] hext = ht[1].w;
 
     // ---- stage 3: output register ------------------------------------------------------------
     assign m_axis_tkeep = KEEP;
@@ -375,15 +414,18 @@ module rfl_morph #(
             m_axis_tlast  <= 1'b0;
         end else if (adv) begin
             m_axis_tvalid <= valid2b && emit2b;
-            m_axis_tdata  <= 32'd0;
-            m_axis_tdata[W-1:0] <= hext;
-            m_axis_tuser  <= first2b;
-            m_axis_tlast  <= eol2b;
+            if (valid2b) begin
+                m_axis_tdata  <= 32'd0;
+                m_axis_tdata[W-1:0] <= hext;
+                m_axis_tuser  <= first2b;
+                m_axis_tlast  <= eol2b;
+            end
         end
     end
 
     // tkeep and the unused lanes of the input are not needed
-    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata, pix};   // pix: K == 1 has no lines
+    // pix, mv1, qall: K == 1 has no lines
+    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata, pix, mv1, qall};
 
 endmodule
 
