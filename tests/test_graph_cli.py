@@ -341,3 +341,31 @@ def test_one_rate_meter_windowed_stale_overall_and_bounded() -> None:
     assert m.report() is not None
     f = fps_meter()
     assert (f.window_s, f.stale_s) == (2.0, 1.0)
+
+
+def test_two_tools_started_in_the_same_millisecond_get_different_names(monkeypatch) -> None:
+    """CI saw two `topic pub` tools register one name (the millisecond alone made it unique), so
+    the master shut one down. Names are rospy's anonymous form, base_PID_MS."""
+    from rosfpga_lab.graph import names
+
+    monkeypatch.setattr(names.time, "time", lambda: 1764000000.1234)
+    monkeypatch.setattr(names.os, "getpid", lambda: 4242)
+    first = names.anonymous_name("/rosfpga_lab_topic_pub")
+    monkeypatch.setattr(names.os, "getpid", lambda: 4243)
+    second = names.anonymous_name("/rosfpga_lab_topic_pub")
+    assert (first, second) == ("/rosfpga_lab_topic_pub_4242_1764000000123",
+                               "/rosfpga_lab_topic_pub_4243_1764000000123")
+
+
+def test_two_topic_pub_tools_at_once_both_stay_registered() -> None:
+    with EmbeddedMaster(port=0) as m:
+        procs = [popen_cli("topic", "--master-uri", m.uri, "pub", f"/twin{k}", "std_msgs/String",
+                           "{data: x}") for k in range(2)]
+        try:
+            first, second = tool_node(m, "/twin0"), tool_node(m, "/twin1")
+            assert first != second
+            time.sleep(0.5)          # a duplicate name would have shut the first one down by now
+            assert all(p.poll() is None for p in procs), [p.stderr.read() for p in procs if p.poll() is not None]
+        finally:
+            for p in procs:
+                stop_process(p)

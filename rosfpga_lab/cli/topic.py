@@ -65,8 +65,10 @@ def _node(uri: str, kind: str, args: argparse.Namespace | None = None):
     from rosfpga_lab.graph import Node
     from rosfpga_lab.msg import registry_with
 
+    from rosfpga_lab.graph.names import anonymous_name
+
     name, host = getattr(args, "identity", None) or (
-        f"/rosfpga_lab_topic_{kind}_{int(time.time() * 1000) % 10**8}", None)
+        anonymous_name(f"/rosfpga_lab_topic_{kind}"), None)
     return Node(name, master_uri=uri, host=host,
                 registry=registry_with(getattr(args, "msg_path", None) or []))
 
@@ -83,12 +85,13 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from rosfpga_lab.config.rosargs import RosArgs, advertise_host, node_name, remap
     from rosfpga_lab.graph import tools
+    from rosfpga_lab.graph.names import anonymous_name
 
     ros = getattr(args, "ros", None) or RosArgs()
     uri = tools.pick_master_uri(args.master_uri or ros.special.get("__master"))
     tools.check_master(uri)  # never end up alone: a clear error when no master answers
     # rostopic's own node: anonymous, in ROS_NAMESPACE (or __ns), unless __name gives one
-    name = node_name(f"rosfpga_lab_topic_{args.action}_{int(time.time() * 1000) % 10**8}", ros)
+    name = node_name(anonymous_name(f"rosfpga_lab_topic_{args.action}"), ros)
     args.identity = (name, advertise_host(ros, None).host)
     if getattr(args, "topic", None):
         # "chatter" means /chatter (or /NS/chatter under ROS_NAMESPACE), then remapped, as for rostopic

@@ -8,8 +8,10 @@ by :mod:`rosfpga_lab.config.names` (the lab's one validator); this module resolv
 from __future__ import annotations
 
 import ipaddress
+import os
 import re
 import socket
+import time
 import warnings
 
 from rosfpga_lab.config.master import master_uri_from_env  # noqa: F401  (re-exported; the rule's owner)
@@ -19,6 +21,14 @@ from rosfpga_lab.config.rosargs import namespace_of, resolve_name  # noqa: F401 
 from rosfpga_lab.graph.errors import ConfigError
 
 ALL_INTERFACES = ("0.0.0.0", "", "::")
+
+
+def anonymous_name(base: str) -> str:
+    """``base`` made unique as rospy's ``init_node(anonymous=True)`` does: ``base_PID_MS``.
+
+    The process id keeps two tools started in the same millisecond apart (a name registered
+    twice makes the master shut the first node down)."""
+    return f"{base}_{os.getpid()}_{int(time.time() * 1000)}"
 
 
 class OpenBindWarning(UserWarning):
