@@ -525,3 +525,26 @@ def test_other_circuits_match_opencv(master, enc, channels, op, k) -> None:
         out.node.shutdown()
         src.shutdown()
         comp.stop()
+
+
+def test_a_remote_shutdown_while_starting_is_a_typed_ending_and_leaves_nothing(
+        master, monkeypatch: pytest.MonkeyPatch) -> None:
+    """`rosnode kill` between the component's registrations (its output advertised, its input
+    not yet subscribed) made start() raise a bare GraphError and `node` exit 1 with a
+    traceback; now it is ComponentShutDown with the reason, and nothing stays registered."""
+    from rosfpga_lab.component import ComponentShutDown
+    from rosfpga_lab.graph import call
+
+    real_subscribe = Node.subscribe
+
+    def killed_first(self, *args, **kw):           # the slave API's shutdown, as rosnode sends
+        call(self.uri, "shutdown", "/rosnode", "kill")
+        return real_subscribe(self, *args, **kw)
+
+    monkeypatch.setattr(Node, "subscribe", killed_first)
+    comp = FpgaComponent.from_config(config(), master=master)
+    with pytest.raises(ComponentShutDown, match="shut down from outside") as info:
+        comp.start()
+    assert "kill" in info.value.reason
+    state = call(master.uri, "getSystemState", "/t")[2]
+    assert not [n for _topic, nodes in state[0] + state[1] for n in nodes if n == comp.name], state

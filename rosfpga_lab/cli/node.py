@@ -117,8 +117,13 @@ def run(args: argparse.Namespace) -> int:
         return _run(args, stop)
 
 
+def _say_shut_down(reason: str) -> None:
+    print(f"\nthe node was shut down from outside ({reason or 'a shutdown call'}: rosnode kill, "
+          "or another node took its name)", file=sys.stderr, flush=True)
+
+
 def _run(args: argparse.Namespace, stop: StopSignals) -> int:
-    from rosfpga_lab.component import FpgaComponent, limits, master_answers
+    from rosfpga_lab.component import ComponentShutDown, FpgaComponent, limits, master_answers
     from rosfpga_lab.config import load_config, master_uri
     from rosfpga_lab.config.params import ParamSource, runtime_settings
     from rosfpga_lab.config.rosargs import RosArgs, advertise_host, component_names
@@ -158,6 +163,12 @@ def _run(args: argparse.Namespace, stop: StopSignals) -> int:
             config, master_uri=uri, model=model, timing=args.timing, name=names.node,
             host=host.host, input_topic=names.input, output_topic=names.output, **kw)
         component.start()
+    except ComponentShutDown as exc:
+        # rosnode kill between its registrations: an ending as normal as one after them
+        if master is not None:
+            master.stop()
+        _say_shut_down(exc.reason + ", while it was starting")
+        return 0
     except BaseException:
         if master is not None:
             master.stop()
@@ -184,8 +195,7 @@ def _run(args: argparse.Namespace, stop: StopSignals) -> int:
             if not component.running:
                 # rospy and roscpp end a node shut down this way normally (exit status 0)
                 reason = component.node.shutdown_reason if component.node is not None else ""
-                print(f"\nthe node was shut down from outside ({reason or 'a shutdown call'}: "
-                      "rosnode kill, or another node took its name)", file=sys.stderr, flush=True)
+                _say_shut_down(reason)
                 break
             if args.quiet or args.status_interval <= 0:
                 continue

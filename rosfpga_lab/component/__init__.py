@@ -29,7 +29,8 @@ from rosfpga_lab.component.checker import CheckReport, Checker, expected_output
 from rosfpga_lab.component.demo import (
     DemoResult, DemoRig, default_config, run_demo, write_figure,
 )
-from rosfpga_lab.component.errors import ComponentConfigError, ComponentError, SourceError
+from rosfpga_lab.component.errors import (ComponentConfigError, ComponentError, ComponentShutDown,
+                                          SourceError)
 from rosfpga_lab.component.fpga import FpgaComponent, FrameRecord, master_answers
 from rosfpga_lab.component.msgchecker import MessageChecker
 from rosfpga_lab.component.sources import SOURCES, ImageSource, open_source, to_rgb
@@ -38,6 +39,7 @@ from rosfpga_lab.component.stats import ComponentStats, LatencySummary, LatencyW
 __all__ = [
     "MessageChecker",
     "SOURCES", "Camera", "CheckReport", "Checker", "ComponentConfigError", "ComponentError",
+    "ComponentShutDown",
     "ComponentStats", "DemoResult", "DemoRig", "FpgaComponent", "FrameRecord", "ImageSource",
     "LatencySummary", "LatencyWindow", "SentFrame", "SourceError", "ViewedFrame", "Viewer",
     "default_config", "expected_output", "master_answers", "open_source", "run_demo", "stamp_of",

@@ -15,3 +15,12 @@ class ComponentConfigError(ComponentError):
 
 class SourceError(ComponentError):
     """An image source (file, photo, size or encoding for the camera) is unusable."""
+
+
+class ComponentShutDown(ComponentError):
+    """The component's node was shut down from outside (``rosnode kill``, another node taking its
+    name) while it was still starting; :attr:`reason` is the shutdown's message."""
+
+    def __init__(self, message: str, reason: str) -> None:
+        super().__init__(message)
+        self.reason = reason

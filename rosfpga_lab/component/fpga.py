@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from rosfpga_lab.component import limits
-from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
+from rosfpga_lab.component.errors import ComponentConfigError, ComponentError, ComponentShutDown
 from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, fps_meter, since_stamp
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.config import master_uri as pick_master_uri
@@ -274,6 +274,7 @@ class FpgaComponent:
 
         Raises:
             GraphError: the master cannot be reached or refused (nothing is left running).
+            ComponentShutDown: a remote ``shutdown`` came while it was registering.
         """
         if self.node is not None:
             raise ComponentError(f"component {self.name} was already started")
@@ -290,7 +291,12 @@ class FpgaComponent:
             self._sub = node.subscribe(self.input_topic, self.config.subscriber.type, self._on_frame,
                                        raw=True, queue_size=self.input_queue, tcp_nodelay=True)
         except BaseException:
+            remote = node.is_shutdown and node.shutdown_reason   # shut down while starting
             node.shutdown()
+            node.wait_for_shutdown(limits.SHUTDOWN_WAIT)   # a remote one unregisters in a thread
+            if remote:
+                raise ComponentShutDown(f"{self.name} was shut down from outside while it started "
+                                        f"({remote})", remote) from None
             raise
         self.node = node
         self._stop.clear()

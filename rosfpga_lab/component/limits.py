@@ -50,3 +50,6 @@ SIGNAL_POLL = 0.05
 #: Seconds between the ``node`` command's tries to reach a master that does not answer yet
 #: (rospy and roscpp nodes wait for it too: a launch order race is normal).
 MASTER_RETRY = 0.5
+#: Seconds a component that was shut down from outside while starting waits for that shutdown to
+#: finish unregistering (it runs in the slave API's thread) before it reports it.
+SHUTDOWN_WAIT = 5.0
