@@ -8,10 +8,10 @@ within its bounds, and ``widgets.events_from_recording`` draws it with the nodes
 from __future__ import annotations
 
 import os
-import time
 
 import pytest
 
+from ros2tools import wait  # the ROS 2 tests' one polling helper
 from rosfpga_lab.graph.errors import GraphError
 from rosfpga_lab.graph.ros2 import Ros2Node
 from rosfpga_lab.rtps import parse_message
@@ -23,15 +23,6 @@ pytestmark = pytest.mark.timeout(60)
 #: A DDS domain of this test process's own, apart from the other ROS 2 tests' (100..219).
 DOMAIN = 10 + os.getpid() % 80
 PAYLOAD = b"\x00\x01\x00\x00" + (5).to_bytes(4, "little") + b"hello\x00\x00\x00"
-
-
-def _until(cond, timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while not cond():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.01)
-    return True
 
 
 def test_the_recording_holds_discovery_matching_and_data_both_ways() -> None:
@@ -47,7 +38,7 @@ def test_the_recording_holds_discovery_matching_and_data_both_ways() -> None:
                                        lambda payload, sample: got.append(payload), Qos(True, 10))
             assert pub.wait_for_subscribers(1, 10)
             pub.publish(PAYLOAD)
-            assert _until(lambda: got and pub.unacknowledged() == 0)
+            assert wait(lambda: got and pub.unacknowledged() == 0)
             run = talker.recorded()
             me, other = talker.participant.guid_prefix, listener.participant.guid_prefix
     assert got == [PAYLOAD]
@@ -90,11 +81,11 @@ def test_the_recording_is_bounded_and_counts_what_it_leaves_out() -> None:
     with Ros2Node("talker", DOMAIN + 1) as talker:
         rec = talker.record(max_datagrams=3, max_bytes=1 << 20)
         with Ros2Node("listener", DOMAIN + 1):
-            assert _until(lambda: talker.recorded().dropped > 0)
+            assert wait(lambda: talker.recorded().dropped > 0)
         run = talker.recorded()
     assert len(run.datagrams) == 3 and run.dropped > 0
     assert rec is not run                       # recorded() is a copy
     with Ros2Node("small", DOMAIN + 1) as node:
         node.record(max_datagrams=100, max_bytes=10)   # no datagram is that small
-        assert _until(lambda: node.recorded().dropped > 0)
+        assert wait(lambda: node.recorded().dropped > 0)
         assert node.recorded().datagrams == [] and node.recorded().kept_bytes == 0
