@@ -31,23 +31,17 @@ static const int NS = 9;
 // Once initialised, the model's own evaluation function is called per edge: Verilator's eval()
 // adds a garbage sweep and a message-queue flush (four mutex operations) that cost a third
 // of the time here. Build with -DRFL_PLAIN_EVAL to use eval() (a Verilator without it).
+// The inputs are registered in rfl_harness.v and the falling edge changes no register: so the
+// model is evaluated once per clock, at the rising edge, with the next clock's inputs set just
+// before it, and the edge detector is told the clock went low. RFL_PLAIN_EVAL evaluates both
+// edges.
 #ifdef RFL_PLAIN_EVAL
 #define RFL_EVAL(t) (t)->eval()
+#define RFL_FALL(t) RFL_EVAL(t)
 #else
 void Vrfl_harness___024root___eval(Vrfl_harness___024root* vlSelf);
 #define RFL_EVAL(t) Vrfl_harness___024root___eval((t)->rootp)
-#endif
-// The falling edge changes no register, and of the ports read before the next rising edge only
-// hs bit 7 (m_tvalid && m_tready) follows an input without a register between: so the model
-// is evaluated once per clock, at the rising edge (with the inputs set after the last one, as
-// the testbench's nonblocking drives do), the edge detector is told the clock went low, and bit
-// 7 is computed here from the same two signals. RFL_PLAIN_EVAL keeps both evaluations.
-#ifdef RFL_PLAIN_EVAL
-#define RFL_FALL(t) RFL_EVAL(t)
-#define RFL_HS(t) ((t)->hs)
-#else
 #define RFL_FALL(t) ((t)->rootp->__Vtrigprevexpr___TOP__clk__0 = 0)
-#define RFL_HS(t) (((t)->hs & ~128u) | (((t)->m_tvalid && (t)->m_tready) ? 128u : 0u))
 #endif
 
 static uint32_t xorshift(uint32_t x) {
@@ -78,7 +72,12 @@ struct Sim {
     uint32_t gap, bp;
     uint64_t idle_limit;
     uint64_t cycle = 0, idle = 0, done_for = 0, in_bytes = 0, sub_bytes = 0, frame_off = 0;
-    uint64_t first[NS] = {0}, last[NS] = {0}, count[NS] = {0};
+    // Per stream: the first and last clock of a handshake and their count. They are kept per
+    // run of clocks with the handshake (it changes far less often than every clock): since[i]
+    // is where stream i's current run started, `on` the streams in a run, `seen` those that
+    // had one; span() adds the runs still open.
+    uint64_t first[NS] = {0}, last[NS] = {0}, count[NS] = {0}, since[NS] = {0};
+    uint32_t on = 0, seen = 0;
     long frames = 0, refused = 0;
     // the input of the current run
     const uint8_t* in = nullptr;
@@ -90,6 +89,9 @@ struct Sim {
     FILE* fbin = nullptr;
     FILE* fbout = nullptr;
     bool stats = false;         // keep the per-stream spans (first, last, count)
+    // the input rfl_node sees in the current clock (the ports hold that of the next one)
+    bool in_valid = false;
+    uint8_t in_data = 0;
 
     Sim(uint32_t seed, uint32_t gap_, uint32_t bp_, uint64_t limit)
         : top(new Vrfl_harness), rnd(seed == 0 ? 0x12345678u : seed), gap(gap_), bp(bp_),
@@ -112,6 +114,30 @@ struct Sim {
                 (hi >> 5) & 1);
     }
 
+    // The streams whose handshake started or stopped in this clock (hs: those with one now).
+    void runs(uint32_t hs) {
+        for (uint32_t m = hs ^ on; m; m &= m - 1) {
+            const int i = __builtin_ctz(m);
+            if (hs & (1u << i)) {
+                since[i] = cycle;
+                if (!(seen & (1u << i))) first[i] = cycle;
+            } else {
+                count[i] += cycle - since[i];
+                last[i] = cycle - 1;
+            }
+        }
+        seen |= hs;
+        on = hs;
+    }
+
+    // Stream i's (first, last, count) up to the current clock.
+    void span(int i, uint64_t& f, uint64_t& l, uint64_t& n) const {
+        const bool open = on & (1u << i);
+        f = first[i];
+        l = open ? cycle : last[i];
+        n = count[i] + (open ? cycle - since[i] + 1 : 0);
+    }
+
     // Run until the input is used up and the circuit idle for 8 clocks (0), the input ended
     // inside a frame (1) or nothing moved for idle_limit clocks with input left (2).
     int run() {
@@ -129,15 +155,20 @@ struct Sim {
 
     template <bool Random, bool Taps>
     int loop() {
+        Vrfl_harness* const t = top;
+        bool sv = in_valid;
+        uint8_t sd = in_data;
+        int rc;
         for (;;) {
-            const bool s_tvalid = top->s_tvalid, s_tready = top->s_tready;
-            const bool m_tvalid = top->m_tvalid, m_tready = top->m_tready;
-            const uint32_t hs = RFL_HS(top);
+            // the circuit's outputs in this clock, before its rising edge
+            const uint32_t hs = t->hs;
+            const bool s_tready = t->s_tready;
             ++cycle;
-            if (s_tvalid && s_tready) ++in_bytes;
-            bool nv = s_tvalid;
-            uint8_t nd = top->s_tdata;
-            if ((!s_tvalid || s_tready) && !eof) {
+            if (sv && s_tready) ++in_bytes;
+            // the inputs of the next clock, as rfl_tb.v's nonblocking drives decide them
+            bool nv = sv;
+            uint8_t nd = sd;
+            if ((!sv || s_tready) && !eof) {
                 bool take = true;
                 if (Random) {
                     rnd = xorshift(rnd);
@@ -150,42 +181,42 @@ struct Sim {
                     nv = false;
                 }
             }
-            if (m_tvalid && m_tready) out.push_back(top->m_tdata);
+            if (hs & 128) out.push_back(t->m_tdata);
             bool nr = true;
             if (Random) {
                 rnd = xorshift(rnd);
                 nr = (rnd % 1000) >= bp;
             }
-            if (top->frame_start) frame_off = sub_bytes;
+            if (t->frame_start) frame_off = sub_bytes;
             if (hs & 1) ++sub_bytes;
-            if (top->status_valid) {
-                statuses.emplace_back(frame_off, top->status);
+            if (t->status_valid) {
+                statuses.emplace_back(frame_off, t->status);
                 ++frames;
-                if (top->status != 0) ++refused;
+                if (t->status != 0) ++refused;
             }
             if (hs) {
                 if (Taps) {
-                    if (fbin && (hs & 4)) beat(fbin, top->beat_in);
-                    if (fbout && (hs & 16)) beat(fbout, top->beat_out);
-                    for (int i = 0; i < NS; ++i) if (hs & (1u << i)) {
-                        if (count[i] == 0) first[i] = cycle;
-                        last[i] = cycle;
-                        ++count[i];
-                    }
+                    if (fbin && (hs & 4)) beat(fbin, t->beat_in);
+                    if (fbout && (hs & 16)) beat(fbout, t->beat_out);
+                    if (hs != on) runs(hs);
                 }
                 if ((hs & 1) && !req_first) req_first = cycle;
                 if (hs & 128) req_last = cycle;
                 idle = 0;
             } else {
+                if (Taps && on) runs(0);
                 ++idle;
             }
-            done_for = (eof && !top->busy && !s_tvalid) ? done_for + 1 : 0;
-            top->clk = 1; RFL_EVAL(top);
-            top->s_tvalid = nv; top->s_tdata = nd; top->m_tready = nr;
-            top->clk = 0; RFL_FALL(top);
-            if (done_for == 8) return 0;
-            if (idle >= idle_limit) return eof ? 1 : 2;
+            done_for = (eof && !t->busy && !sv) ? done_for + 1 : 0;
+            t->s_tvalid = nv; t->s_tdata = nd; t->m_tready = nr;
+            t->clk = 1; RFL_EVAL(t);
+            t->clk = 0; RFL_FALL(t);
+            sv = nv; sd = nd;
+            if (done_for == 8) { rc = 0; break; }
+            if (idle >= idle_limit) { rc = eof ? 1 : 2; break; }
         }
+        in_valid = sv; in_data = sd;
+        return rc;
     }
 };
 
@@ -259,9 +290,12 @@ int main(int argc, char** argv) {
     sim.stats = true;
     sim.in = input.data(); sim.in_len = input.size(); sim.in_pos = 0;
     const int rc = sim.run();
-    for (int i = 0; i < NS; ++i)
-        fprintf(fstats, "%d %llu %llu %llu\n", i, (unsigned long long)sim.first[i],
-                (unsigned long long)sim.last[i], (unsigned long long)sim.count[i]);
+    for (int i = 0; i < NS; ++i) {
+        uint64_t f, l, n;
+        sim.span(i, f, l, n);
+        fprintf(fstats, "%d %llu %llu %llu\n", i, (unsigned long long)f, (unsigned long long)l,
+                (unsigned long long)n);
+    }
     fprintf(fstats, "cycles %llu\n", (unsigned long long)sim.cycle);
     fprintf(fstats, "framing %u\n", (unsigned)sim.top->framing);
     for (auto& s : sim.statuses) fprintf(fstatus, "%llu %d\n", (unsigned long long)s.first, s.second);

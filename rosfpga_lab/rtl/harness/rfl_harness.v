@@ -2,6 +2,10 @@
 // the C++ drives and reads, plus read-only taps of the streams between the stages (the same
 // nets rfl_tb.v times), so that per-stage cycle spans and the application's beats can be
 // recorded. The taps are the only place the harness names a net inside rfl_top.
+// The inputs the C++ drives (s_tvalid, s_tdata, m_tready) are the values for the next clock:
+// registered here at the rising edge, they reach rfl_node as the testbench's nonblocking
+// drives do. So no input reaches logic without a register between, and the Verilated model
+// has nothing to evaluate when an input changes: one evaluation per clock, at the edge.
 module rfl_harness (
     input         clk,
     input         rst_n,
@@ -20,16 +24,24 @@ module rfl_harness (
     output [37:0] beat_in,       // {tlast, tuser, tkeep, tdata} into the application
     output [37:0] beat_out       // ... and out of it
 );
+    reg [7:0] s_tdata_r;
+    reg       s_tvalid_r, m_tready_r;
+    always @(posedge clk) begin
+        s_tdata_r <= s_tdata;
+        s_tvalid_r <= s_tvalid;
+        m_tready_r <= m_tready;
+    end
+
     rfl_node dut (
         .clk(clk), .rst_n(rst_n),
-        .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
-        .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
+        .s_tdata(s_tdata_r), .s_tvalid(s_tvalid_r), .s_tready(s_tready),
+        .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready_r),
         .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy),
         .framing(framing));
 
     assign hs = {
         dut.u_top.axis_out_tvalid && dut.u_top.axis_out_tready,
-        m_tvalid && m_tready,
+        m_tvalid && m_tready_r,
         dut.u_top.tx_tvalid && dut.u_top.tx_tready,
         dut.u_top.pix_out_tvalid && dut.u_top.pix_out_tready,
         dut.u_top.app_out_tvalid && dut.u_top.app_out_tready,
