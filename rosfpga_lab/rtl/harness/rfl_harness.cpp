@@ -71,7 +71,7 @@ struct Sim {
     uint32_t rnd;
     uint32_t gap, bp;
     uint64_t idle_limit;
-    uint64_t cycle = 0, idle = 0, done_for = 0, in_bytes = 0, sub_bytes = 0, frame_off = 0;
+    uint64_t cycle = 0, idle = 0, done_for = 0, sub_bytes = 0, frame_off = 0;
     // Per stream: the first and last clock of a handshake and their count. They are kept per
     // run of clocks with the handshake (it changes far less often than every clock): since[i]
     // is where stream i's current run started, `on` the streams in a run, `seen` those that
@@ -130,6 +130,9 @@ struct Sim {
         on = hs;
     }
 
+    // Bytes of the input the circuit took (a byte offered is held until it is taken).
+    uint64_t taken() const { return in_pos - (in_valid ? 1 : 0); }
+
     // Stream i's (first, last, count) up to the current clock.
     void span(int i, uint64_t& f, uint64_t& l, uint64_t& n) const {
         const bool open = on & (1u << i);
@@ -164,7 +167,6 @@ struct Sim {
             const uint32_t hs = t->hs;
             const bool s_tready = t->s_tready;
             ++cycle;
-            if (sv && s_tready) ++in_bytes;
             // the inputs of the next clock, as rfl_tb.v's nonblocking drives decide them
             bool nv = sv;
             uint8_t nd = sd;
@@ -195,11 +197,7 @@ struct Sim {
                 if (t->status != 0) ++refused;
             }
             if (hs) {
-                if (Taps) {
-                    if (fbin && (hs & 4)) beat(fbin, t->beat_in);
-                    if (fbout && (hs & 16)) beat(fbout, t->beat_out);
-                    if (hs != on) runs(hs);
-                }
+                if (Taps && hs != on) runs(hs);
                 if ((hs & 1) && !req_first) req_first = cycle;
                 if (hs & 128) req_last = cycle;
                 idle = 0;
@@ -211,6 +209,10 @@ struct Sim {
             t->s_tvalid = nv; t->s_tdata = nd; t->m_tready = nr;
             t->clk = 1; RFL_EVAL(t);
             t->clk = 0; RFL_FALL(t);
+            if (Taps) {     // the beats of the clock just ended, held by rfl_harness.v
+                if (fbin && (hs & 4)) beat(fbin, t->beat_in);
+                if (fbout && (hs & 16)) beat(fbout, t->beat_out);
+            }
             sv = nv; sd = nd;
             if (done_for == 8) { rc = 0; break; }
             if (idle >= idle_limit) { rc = eof ? 1 : 2; break; }
@@ -304,7 +306,7 @@ int main(int argc, char** argv) {
     if (sim.fbin) fclose(sim.fbin);
     if (sim.fbout) fclose(sim.fbout);
     printf("rtlsim: %ld frame(s) in, %ld refused, %llu bytes in, %llu bytes out, %llu clocks\n",
-           sim.frames, sim.refused, (unsigned long long)sim.in_bytes,
+           sim.frames, sim.refused, (unsigned long long)sim.taken(),
            (unsigned long long)sim.out.size(), (unsigned long long)sim.cycle);
     if (rc == 2) { printf("rtlsim: ERROR: stalled: no handshake for +idle_limit clocks\n"); return 1; }
     if (rc == 1) printf("rtlsim: the input ended inside a frame (the circuit waits for the rest)\n");

@@ -21,8 +21,8 @@ module rfl_harness (
     output        busy,
     output [7:0]  framing,       // the stages' framing flags (rfl_top)
     output [8:0]  hs,            // handshake per stream (sim.STREAMS order, bit 0 first)
-    output [37:0] beat_in,       // {tlast, tuser, tkeep, tdata} into the application
-    output [37:0] beat_out       // ... and out of it
+    output reg [37:0] beat_in,   // {tlast, tuser, tkeep, tdata} into the application
+    output reg [37:0] beat_out   // ... and out of it (each the last beat, after its clock)
 );
     reg [7:0] s_tdata_r;
     reg       s_tvalid_r, m_tready_r;
@@ -50,8 +50,12 @@ module rfl_harness (
         dut.u_top.pix_in_tvalid && dut.u_top.pix_in_tready,
         dut.u_top.rx_tvalid && dut.u_top.rx_tready
     };
-    assign beat_in = {dut.u_top.axis_in_tlast, dut.u_top.axis_in_tuser, dut.u_top.axis_in_tkeep,
-                      dut.u_top.axis_in_tdata};
-    assign beat_out = {dut.u_top.app_out_tlast, dut.u_top.app_out_tuser,
-                       dut.u_top.app_out_tkeep, dut.u_top.app_out_tdata};
+    // Held from the clock of each beat's handshake: the C++ reads a beat after that clock's
+    // edge, and the model assembles the 38 bits once per beat, not every clock.
+    always @(posedge clk) begin
+        if (hs[2]) beat_in <= {dut.u_top.axis_in_tlast, dut.u_top.axis_in_tuser,
+                               dut.u_top.axis_in_tkeep, dut.u_top.axis_in_tdata};
+        if (hs[4]) beat_out <= {dut.u_top.app_out_tlast, dut.u_top.app_out_tuser,
+                                dut.u_top.app_out_tkeep, dut.u_top.app_out_tdata};
+    end
 endmodule
