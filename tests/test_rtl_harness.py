@@ -19,7 +19,7 @@ from realros import require_rtl
 from rosfpga_lab.rtl import RtlError, build, rtl_params, run
 from rosfpga_lab.hw import image_frame
 from rosfpga_lab.rtl.project import generate_project
-from rosfpga_lab.rtl.sim import RtlBuild, RtlResult
+from rosfpga_lab.rtl.sim import EVAL_MODES, RtlBuild, RtlResult, harness_command, nba_only
 from rosfpga_lab.rtl.sim import find_tool as tool
 from test_rtl_sim import model_output, random_image, refusal_frames, small_config
 
@@ -107,12 +107,13 @@ def test_harness_refuses_testbench_only_options(tmp_path: Path) -> None:
         build(rtl_params(config), tmp_path / "x", simulator="verilator", trace=True, harness=True)
 
 
-def test_the_plain_eval_fallback_equals_the_testbench(tmp_path: Path) -> None:
-    """The harness evaluates the model once per clock (the rising edge; the falling edge is
-    only told to the edge detector, hs bit 7 computed in C++: the test above holds that to
-    the testbench). Built with RFL_PLAIN_EVAL (the fallback for a Verilator without the inner
-    eval) it evaluates both edges with eval(), and must give the same bytes, statuses, stream
-    spans, clocks and beats, with gaps and backpressure."""
+@pytest.mark.parametrize("mode", EVAL_MODES[1:])
+def test_the_eval_fallbacks_equal_the_testbench(tmp_path: Path, mode: str) -> None:
+    """By default the harness runs only the model's nonblocking region once per clock (the
+    test above holds that to the testbench). Built for a Verilator whose model lacks what
+    that calls, it falls back to the model's inner eval of the rising edge ("root") or to
+    eval() of both edges ("plain"): each must give the same bytes, statuses, stream spans,
+    clocks and beats, with gaps and backpressure."""
     require_rtl("verilator")
     require_rtl("iverilog")
     from rosfpga_lab.rtl.sim import _run_command, harness_command, write_sources
@@ -120,9 +121,9 @@ def test_the_plain_eval_fallback_equals_the_testbench(tmp_path: Path) -> None:
     config = small_config("mono8", frame_id_max=16)
     frames, _ = refusal_frames(config)
     data = b"".join(frames)
-    plain_dir = tmp_path / "plain"
+    plain_dir = tmp_path / mode
     write_sources(rtl_params(config), plain_dir)
-    done = subprocess.run(harness_command(plain_dir, plain_eval=True), cwd=plain_dir,
+    done = subprocess.run(harness_command(plain_dir, eval_mode=mode), cwd=plain_dir,
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr
     plain = RtlBuild("verilator", _run_command("verilator", plain_dir, True), plain_dir,
@@ -130,3 +131,22 @@ def test_the_plain_eval_fallback_equals_the_testbench(tmp_path: Path) -> None:
     tb = build(rtl_params(config), tmp_path / "tb", simulator="iverilog")
     assert_same_run(run(plain, data, seed=6, gap=100, bp=700, beats=True),
                     run(tb, data, seed=6, gap=100, bp=700, beats=True))
+
+
+def test_the_shipped_design_runs_in_the_nonblocking_region_alone(tmp_path: Path) -> None:
+    """The harness registers its inputs, so the Verilated model of the shipped node has no input
+    region and no active region: the default build takes the fastest mode, and the check that
+    guards it tells a model with such a region apart."""
+    require_rtl("verilator")
+    built = build(rtl_params(small_config("rgb8")), tmp_path / "fast", simulator="verilator")
+    obj_dir = built.directory / "obj_dir"
+    assert nba_only(obj_dir)
+    assert "-DRFL_EVAL_NBA" in (obj_dir / "Vrfl_harness.mk").read_text()
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "Vx___024root__0.cpp").write_text(
+        "void Vx___024root___eval_ico(Vx___024root* vlSelf) {}\n"
+        "void Vx___024root___eval_nba(Vx___024root* vlSelf) {}\n")
+    assert not nba_only(other)
+    with pytest.raises(RtlError, match="eval_mode must be one of nba, root, plain"):
+        harness_command(tmp_path, eval_mode="fast")

@@ -181,25 +181,52 @@ def _run_command(sim: str, where: Path, harness: bool = False) -> tuple[str, ...
     return (str(where / "obj_dir" / ("rfl_fast" if harness else "rfl_sim")),)
 
 
+#: How the harness evaluates the model per clock (``rfl_harness.cpp``), fastest first: the
+#: model's nonblocking region alone, its inner eval, Verilator's public eval() of both edges.
+EVAL_MODES = ("nba", "root", "plain")
+#: Functions of a Verilated model whose logic runs outside the nonblocking region: with any of
+#: them, the "nba" mode would skip it.
+_OUTSIDE_NBA = ("___eval_ico(", "___eval_act(")
+
+
 def harness_command(where: str | Path = ".", obj_dir: str = "obj_dir",
-                    plain_eval: bool = False) -> list[str]:
+                    eval_mode: str = EVAL_MODES[0]) -> list[str]:
     """The Verilator command that builds the fast harness from the sources in ``where``."""
+    if eval_mode not in EVAL_MODES:
+        raise RtlError(f"eval_mode must be one of {', '.join(EVAL_MODES)}, got {eval_mode!r}")
     rtl = sorted(p.name for p in Path(where).glob("*.v")
                  if p.name not in (*HARNESS_FILES, f"{TB_TOP}.v"))
     return [_verilator() or "verilator", "--cc", "--exe", "--build", "-O3", "--x-assign", "fast",
             "--x-initial", "fast", "--noassert", "-Wno-fatal", "-Wno-lint", "-Wno-style", "-I.",
             "--top-module", HARNESS_TOP, "-Mdir", obj_dir, "-o", "rfl_fast", "-j", "2",
-            "-CFLAGS", "-O3" + (" -DRFL_PLAIN_EVAL" if plain_eval else ""),
+            "-CFLAGS", f"-O3 -DRFL_EVAL_{eval_mode.upper()}",
             "-MAKEFLAGS", "OPT_FAST=-O3 OPT_GLOBAL=-O2", *HARNESS_FILES, *rtl]
+
+
+def nba_only(obj_dir: Path) -> bool:
+    """The Verilated model in ``obj_dir`` does all its work in the nonblocking region."""
+    text = "".join(p.read_text(errors="replace") for p in obj_dir.glob("*___024root*.cpp"))
+    return "___eval_nba(" in text and not any(name in text for name in _OUTSIDE_NBA)
+
+
+def _compile_harness(where: Path) -> str:
+    """Build the harness in the first of :data:`EVAL_MODES` this Verilator's model allows."""
+    for mode in EVAL_MODES:
+        shutil.rmtree(where / "obj_dir", ignore_errors=True)
+        try:
+            _run_build(harness_command(where, eval_mode=mode), where)
+        except RtlError as error:   # the harness's C++ may not compile against this model
+            if mode == EVAL_MODES[-1] or HARNESS_FILES[1] not in str(error):
+                raise
+            continue
+        if mode != "nba" or nba_only(where / "obj_dir"):
+            return mode
+    raise AssertionError("unreachable: the last mode returns or raises")
 
 
 def _compile(sim: str, where: Path, files: list[str], trace: bool, harness: bool = False) -> None:
     if harness:
-        try:
-            _run_build(harness_command(where), where)
-        except RtlError:   # a Verilator whose model lacks the inner eval: its plain eval()
-            shutil.rmtree(where / "obj_dir", ignore_errors=True)
-            _run_build(harness_command(where, plain_eval=True), where)
+        _compile_harness(where)
         return
     files = [f for f in files if f not in HARNESS_FILES]
     if sim == "iverilog":
