@@ -28,7 +28,7 @@ module rfl_fifo #(
     localparam [31:0] MEMD_32 = MEMD;
     localparam [LEVEL_BITS-1:0] FULL = MEMD_32[LEVEL_BITS-1:0];
 
-    reg [WIDTH-1:0] mem [0:MEMD-1];
+    reg [WIDTH-1:0] mem [0:(1 << AW)-1];
     reg [AW-1:0] wptr, rptr;
     reg [LEVEL_BITS-1:0] cnt;                   // entries in the RAM
     reg [WIDTH-1:0] q;                          // the RAM's read register
@@ -44,10 +44,6 @@ module rfl_fifo #(
     assign m_tdata = dout;
     assign m_tvalid = dvalid;
 
-    always @(posedge clk) begin
-        if (wr) mem[wptr] <= s_tdata;
-        if (load) q <= mem[rptr];
-    end
 
     generate
         if (OUTREG != 0) begin : outreg
@@ -84,6 +80,8 @@ module rfl_fifo #(
     endgenerate
 
     always @(posedge clk) begin
+        if (wr) mem[wptr] <= s_tdata;
+        if (load) q <= mem[rptr];
         if (!rst_n) begin
             wptr <= 0;
             rptr <= 0;

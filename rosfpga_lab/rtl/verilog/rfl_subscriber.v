@@ -146,7 +146,11 @@ module rfl_subscriber #(
                 if (n == b[CW-1:0]) enc_at = ENCODING[8 * (ENC_LEN - 1 - b) +: 8];
         end
     endfunction
-    wire        enc_ok = same && (s_tdata == enc_at(cnt));
+    // the encoding matches up to and with byte b at position n (a function, not a wire: the
+    // simulation compares only in S_ENC)
+    function enc_ok(input [7:0] b, input [CW-1:0] n);
+        enc_ok = same && (b == enc_at(n));
+    endfunction
 
     always @(posedge clk) begin
         if (take && state == S_FID) fid_mem[cnt[FIDA-1:0]] <= s_tdata;
@@ -265,11 +269,11 @@ module rfl_subscriber #(
                         end
                     end
                     S_ENC: begin
-                        same <= enc_ok;
                         if (cnt == flast) begin
-                            if (!enc_ok) refuse(SUB_BAD_ENCODING);
+                            if (!enc_ok(s_tdata, cnt)) refuse(SUB_BAD_ENCODING);
                             else advance(S_BIG);
                         end
+                        same <= enc_ok(s_tdata, cnt);
                     end
                     S_BIG: begin
                         meta_bigendian <= s_tdata;
