@@ -62,7 +62,6 @@ module rfl_publisher #(
     reg [FIDA-1:0] fa, fa1;                     // frame_id byte shown, and the next one
     reg [31:0]   seq;
     reg [31:0]   word;                          // the field's value, for uint32 fields
-    reg [3:0]    fnext;                         // the field after this one
 
     wire [31:0] fid_len = {{(32-FIDW){1'b0}}, meta_fid_len};
     wire [IW-1:0] fid_last = fid_len[IW-1:0] - 1'b1;
@@ -74,6 +73,16 @@ module rfl_publisher #(
             enc_at = 8'd0;
             for (b = 0; b < ENC_LEN; b = b + 1)
                 if (n == b[IW-1:0]) enc_at = ENCODING[8 * (ENC_LEN - 1 - b) +: 8];
+        end
+    endfunction
+
+    // the field after field `g` (a function, not a wire: the simulation computes it only as a
+    // field ends)
+    function [3:0] next_of(input [3:0] g);
+        begin
+            if (g == F_FIDLEN) next_of = (fid_len == 0) ? F_HEIGHT : F_FID;
+            else if (g == F_DATA) next_of = F_IDLE;
+            else next_of = g + 4'd1;
         end
     endfunction
 
@@ -111,9 +120,6 @@ module rfl_publisher #(
             F_DATA:  m_tdata = s_tdata;
             default: m_tdata = word[8 * i[1:0] +: 8];
         endcase
-        if (f == F_FIDLEN) fnext = (fid_len == 0) ? F_HEIGHT : F_FID;
-        else if (f == F_DATA) fnext = F_IDLE;
-        else fnext = f + 4'd1;
     end
 
     assign m_tvalid = (f != F_IDLE) && (f != F_DATA || s_tvalid);
@@ -149,9 +155,9 @@ module rfl_publisher #(
                 fa1 <= fa1 + 1'b1;
             end
             i <= {IW{1'b0}};
-            in_fid <= (fnext == F_FID);
-            f <= fnext;
-            ilast <= last_of(fnext);
+            in_fid <= (next_of(f) == F_FID);
+            f <= next_of(f);
+            ilast <= last_of(next_of(f));
             if (f == F_DATA) seq <= seq + 32'd1;
         end else if (put) begin
             i <= i_next;
