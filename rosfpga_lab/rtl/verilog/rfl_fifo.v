@@ -89,8 +89,7 @@ module rfl_fifo #(
         end else begin
             if (wr) wptr <= (wptr == LAST) ? {AW{1'b0}} : wptr + 1'b1;
             if (load) rptr <= (rptr == LAST) ? {AW{1'b0}} : rptr + 1'b1;
-            if (wr && !load) cnt <= cnt + 1'b1;
-            else if (load && !wr) cnt <= cnt - 1'b1;
+            if (wr != load) cnt <= wr ? cnt + 1'b1 : cnt - 1'b1;
         end
     end
 endmodule
