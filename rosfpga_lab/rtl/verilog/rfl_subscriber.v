@@ -152,9 +152,6 @@ module rfl_subscriber #(
         enc_ok = same && (b == enc_at(n));
     endfunction
 
-    always @(posedge clk) begin
-        if (take && state == S_FID) fid_mem[cnt[FIDA-1:0]] <= s_tdata;
-    end
 
     // Enter state `next` at the start of a field.
     task advance(input [3:0] next);
@@ -180,6 +177,7 @@ module rfl_subscriber #(
     endtask
 
     always @(posedge clk) begin
+        if (take && state == S_FID) fid_mem[cnt[FIDA-1:0]] <= s_tdata;
         if (!rst_n) begin
             state <= S_FLEN;
             in_frame <= 1'b0;
