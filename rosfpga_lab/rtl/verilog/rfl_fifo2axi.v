@@ -81,17 +81,12 @@ module rfl_fifo2axi #(
                     m_axis_tuser <= (x == 0) && (y == 0);
                     m_axis_tlast <= (x == X_LAST);
                     m_axis_tvalid <= 1'b1;
-                    k <= 2'd0;
-                    if (x == X_LAST) begin
-                        x <= 16'd0;
-                        y <= (y == Y_LAST) ? 16'd0 : y + 16'd1;
-                    end else begin
-                        x <= x + 16'd1;
-                    end
+                    if (x == X_LAST) y <= (y == Y_LAST) ? 16'd0 : y + 16'd1;
+                    x <= (x == X_LAST) ? 16'd0 : x + 16'd1;
                 end else begin
                     acc <= {byte_in, acc[23:8]};
-                    k <= k + 2'd1;
                 end
+                k <= last_byte ? 2'd0 : k + 2'd1;
                 if (frame_end) begin
                     run <= 1'b0;
                     padf <= 1'b0;

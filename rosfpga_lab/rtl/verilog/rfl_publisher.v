@@ -142,29 +142,23 @@ module rfl_publisher #(
             fa <= {FIDA{1'b0}};
             fa1 <= FID_ONE;
             seq <= SEQ_START;
-        end else if (f == F_IDLE) begin
-            if (meta_valid) begin
-                f <= F_LEN;
-                fa <= {FIDA{1'b0}};
-                fa1 <= FID_ONE;
-                ilast <= U32_LAST;
-            end
-        end else if (field_done) begin
+        end else if (put) begin                 // a byte goes (never in F_IDLE)
             if (in_fid) begin
                 fa <= fa1;
                 fa1 <= fa1 + 1'b1;
             end
-            i <= {IW{1'b0}};
-            in_fid <= (next_of(f) == F_FID);
-            f <= next_of(f);
-            ilast <= last_of(next_of(f));
-            if (f == F_DATA) seq <= seq + 32'd1;
-        end else if (put) begin
-            i <= i_next;
-            if (in_fid) begin
-                fa <= fa1;
-                fa1 <= fa1 + 1'b1;
+            if (field_done) begin
+                if (f == F_DATA) seq <= seq + 32'd1;
+                in_fid <= (next_of(f) == F_FID);
+                ilast <= last_of(next_of(f));
+                f <= next_of(f);
             end
+            i <= field_done ? {IW{1'b0}} : i_next;
+        end else if (f == F_IDLE && meta_valid) begin
+            f <= F_LEN;
+            fa <= {FIDA{1'b0}};
+            fa1 <= FID_ONE;
+            ilast <= U32_LAST;
         end
     end
 endmodule
