@@ -61,7 +61,6 @@ module rfl_publisher #(
     reg          in_fid;                        // f is F_FID
     reg [FIDA-1:0] fa, fa1;                     // frame_id byte shown, and the next one
     reg [31:0]   seq;
-    reg [31:0]   word;                          // the field's value, for uint32 fields
 
     wire [31:0] fid_len = {{(32-FIDW){1'b0}}, meta_fid_len};
     wire [IW-1:0] fid_last = fid_len[IW-1:0] - 1'b1;
@@ -99,27 +98,42 @@ module rfl_publisher #(
         end
     endfunction
 
+    // the value of the uint32 field `g`
+    function [31:0] word_of(input [3:0] g);
+        begin
+            case (g)
+                F_LEN:    word_of = BODY + fid_len;
+                F_SEQ:    word_of = seq;
+                F_SECS:   word_of = meta_secs;
+                F_NSECS:  word_of = meta_nsecs;
+                F_FIDLEN: word_of = fid_len;
+                F_HEIGHT: word_of = HEIGHT;
+                F_WIDTH:  word_of = WIDTH;
+                F_ENCLEN: word_of = ENC_LEN;
+                F_STEP:   word_of = STEP;
+                F_DLEN:   word_of = DATA_BYTES;
+                default:  word_of = 32'd0;
+            endcase
+        end
+    endfunction
+
+    // byte n (little-endian) of the word w
+    function [7:0] byte_of(input [31:0] w, input [1:0] n);
+        byte_of = w[8 * n +: 8];
+    endfunction
+
+    // the pixel bytes first: the simulation then looks at no header field most of the frame
     always @* begin
-        case (f)
-            F_LEN:    word = BODY + fid_len;
-            F_SEQ:    word = seq;
-            F_SECS:   word = meta_secs;
-            F_NSECS:  word = meta_nsecs;
-            F_FIDLEN: word = fid_len;
-            F_HEIGHT: word = HEIGHT;
-            F_WIDTH:  word = WIDTH;
-            F_ENCLEN: word = ENC_LEN;
-            F_STEP:   word = STEP;
-            F_DLEN:   word = DATA_BYTES;
-            default:  word = 32'd0;
-        endcase
-        case (f)
-            F_FID:   m_tdata = fid_rdata;
-            F_ENC:   m_tdata = enc_at(i);
-            F_BIG:   m_tdata = meta_bigendian;
-            F_DATA:  m_tdata = s_tdata;
-            default: m_tdata = word[8 * i[1:0] +: 8];
-        endcase
+        if (f == F_DATA) begin
+            m_tdata = s_tdata;
+        end else begin
+            case (f)
+                F_FID:   m_tdata = fid_rdata;
+                F_ENC:   m_tdata = enc_at(i);
+                F_BIG:   m_tdata = meta_bigendian;
+                default: m_tdata = byte_of(word_of(f), i[1:0]);
+            endcase
+        end
     end
 
     assign m_tvalid = (f != F_IDLE) && (f != F_DATA || s_tvalid);
