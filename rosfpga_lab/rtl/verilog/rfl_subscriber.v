@@ -203,7 +203,14 @@ module rfl_subscriber #(
                 one_left <= (left == 2);
                 acc <= value[31:8];
                 cnt <= cnt + 1'b1;
-                case (state)
+                // the pixel bytes (or the rest of a refused frame) first: most of the stream
+                if (state == S_DATA || state == S_SKIP) begin
+                    m_tuser <= 1'b0;                    // the first pixel byte is taken
+                    if (last_byte) begin
+                        advance(S_FLEN);
+                        in_frame <= 1'b0;
+                    end
+                end else case (state)
                     S_FLEN: if (u32_done) begin
                         cnt <= {CW{1'b0}};
                         if (too_long) begin
@@ -290,13 +297,6 @@ module rfl_subscriber #(
                             meta_valid <= 1'b1;
                             m_tuser <= 1'b1;
                             advance(S_DATA);
-                        end
-                    end
-                    S_DATA, S_SKIP: begin
-                        m_tuser <= 1'b0;                // the first pixel byte is taken
-                        if (last_byte) begin
-                            advance(S_FLEN);
-                            in_frame <= 1'b0;
                         end
                     end
                     default: begin
