@@ -336,7 +336,6 @@ module rfl_morph #(
     // ---- stage 2: horizontal shift register of vertical extremes -----------------------------
     reg           valid2, emit2, first2, eol2;
     reg [K-1:0]   hmask2;
-    reg [K*W-1:0] sr;          // entry 0 newest
 
     always @(posedge aclk) begin
         if (!aresetn) begin
@@ -352,11 +351,15 @@ module rfl_morph #(
         end
     end
 
+    // the shift register, one word per entry (sr[0].e newest)
     generate
-        if (K > 1) begin : shift
-            always @(posedge aclk) if (adv && valid1v) sr <= {sr[K*W-W-1:0], vext};
-        end else begin : noshift
-            always @(posedge aclk) if (adv && valid1v) sr <= vext;
+        for (c = 0; c < K; c = c + 1) begin : sr
+            reg [W-1:0] e;
+            if (c == 0) begin : newest
+                always @(posedge aclk) if (adv && valid1v) e <= vext;
+            end else begin : older
+                always @(posedge aclk) if (adv && valid1v) e <= sr[c-1].e;
+            end
         end
     endgenerate
 
@@ -382,7 +385,7 @@ module rfl_morph #(
         for (c = 0; c < 2 * HP; c = c + 1) begin : hc
             wire [W-1:0] w;
             if (c < K) begin : entry
-                assign w = hmask2[c] ? sr[c*W +: W] : ID;
+                assign w = hmask2[c] ? sr[c].e : ID;
             end else begin : pad
                 assign w = ID;
             end
