@@ -136,7 +136,7 @@ module rfl_publisher #(
         end
     end
 
-    assign m_tvalid = (f != F_IDLE) && (f != F_DATA || s_tvalid);
+    assign m_tvalid = (f == F_DATA) ? s_tvalid : (f != F_IDLE);
     assign s_tready = (f == F_DATA) && m_tready;
     wire put = m_tvalid && m_tready;
     wire field_done = put && (i == ilast);
