@@ -351,15 +351,18 @@ module rfl_morph #(
         end
     end
 
-    // the shift register, one word per entry (sr[0].e newest)
+    // the shift register, one word per entry (sh[0].e newest), as the trees are; sr shows the
+    // whole register as one bus in waveforms (nothing reads it)
+    wire [K*W-1:0] sr;
     generate
-        for (c = 0; c < K; c = c + 1) begin : sr
+        for (c = 0; c < K; c = c + 1) begin : sh
             reg [W-1:0] e;
             if (c == 0) begin : newest
                 always @(posedge aclk) if (adv && valid1v) e <= vext;
             end else begin : older
-                always @(posedge aclk) if (adv && valid1v) e <= sr[c-1].e;
+                always @(posedge aclk) if (adv && valid1v) e <= sh[c-1].e;
             end
+            assign sr[c*W +: W] = e;
         end
     endgenerate
 
@@ -385,7 +388,7 @@ module rfl_morph #(
         for (c = 0; c < 2 * HP; c = c + 1) begin : hc
             wire [W-1:0] w;
             if (c < K) begin : entry
-                assign w = hmask2[c] ? sr[c].e : ID;
+                assign w = hmask2[c] ? sh[c].e : ID;
             end else begin : pad
                 assign w = ID;
             end
@@ -426,9 +429,9 @@ module rfl_morph #(
         end
     end
 
-    // tkeep and the unused lanes of the input are not needed
+    // tkeep and the unused lanes of the input are not needed; sr is for waveforms
     // pix, mv1, qall: K == 1 has no lines
-    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata, pix, mv1, qall};
+    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata, pix, mv1, qall, sr};
 
 endmodule
 
