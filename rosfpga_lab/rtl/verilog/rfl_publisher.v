@@ -6,7 +6,10 @@
 // from axi2fifo last, passed straight through. Timing: each field's last byte index is set as
 // the field starts (no subtraction on the way to the handshake), the byte counter has the
 // width of the longest field, and frame_id comes from the subscriber's RAM one clock after its
-// address (fid_raddr is the byte the next clock shows).
+// address (fid_raddr is the byte the next clock shows). For the Verilated simulation, where
+// the pixel bytes are most clocks: the output multiplexer tests F_DATA first, and what only a
+// header field or a field's end needs (its uint32 value, the next field) are functions called
+// there, not wires evaluated on every clock; the same logic after synthesis.
 module rfl_publisher #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,

@@ -10,6 +10,9 @@
 // end compare against `left`, the bytes of the frame still to come, kept as a down-counter, so
 // no check adds three 32-bit numbers; a field's byte counter has the width of the longest
 // string field; frame_id is read by the publisher from a RAM with a registered read port.
+// For the Verilated simulation, where the pixel bytes are most clocks: the state machine tests
+// S_DATA first, and the encoding compare is a function called in S_ENC, not a wire evaluated
+// on every clock; the same logic after synthesis.
 module rfl_subscriber #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,
