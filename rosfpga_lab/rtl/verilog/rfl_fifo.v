@@ -8,8 +8,8 @@
 // For the Verilated simulation (four of these FIFOs move a byte or a beat on almost every clock):
 // the RAM is declared with 2**AW words (the same RAM after synthesis; the pointers wrap before
 // the words past the last entry) so that no address needs a range check, and the RAM, the
-// pointers and the level counter are written in one block, each register once, so that
-// Verilator keeps no copy of their old values.
+// pointers and the level counter are written in one block, each register once, so that the
+// model keeps no copy of their old values.
 module rfl_fifo #(
     parameter WIDTH = 8,
     parameter DEPTH = 16,                       // entries, at least 2 (3 with OUTREG)
