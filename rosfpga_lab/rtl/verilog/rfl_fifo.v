@@ -5,6 +5,11 @@
 // read register is followed by one more register in the fabric, so that what reads m_tdata
 // does not start from a block RAM's slow clock-to-output (100 MHz timing on an ECP5): DEPTH-2
 // entries in the RAM, and three clocks from an empty FIFO's input to its output.
+// For the Verilated simulation (four of these FIFOs move a byte or a beat on almost every clock):
+// the RAM is declared with 2**AW words (the same RAM after synthesis; the pointers wrap before
+// the words past the last entry) so that no address needs a range check, and the RAM, the
+// pointers and the level counter are written in one block, each register once, so that the
+// model keeps no copy of their old values.
 module rfl_fifo #(
     parameter WIDTH = 8,
     parameter DEPTH = 16,                       // entries, at least 2 (3 with OUTREG)
@@ -28,7 +33,7 @@ module rfl_fifo #(
     localparam [31:0] MEMD_32 = MEMD;
     localparam [LEVEL_BITS-1:0] FULL = MEMD_32[LEVEL_BITS-1:0];
 
-    reg [WIDTH-1:0] mem [0:MEMD-1];
+    reg [WIDTH-1:0] mem [0:(1 << AW)-1];        // MEMD entries used
     reg [AW-1:0] wptr, rptr;
     reg [LEVEL_BITS-1:0] cnt;                   // entries in the RAM
     reg [WIDTH-1:0] q;                          // the RAM's read register
@@ -43,11 +48,6 @@ module rfl_fifo #(
     assign s_tready = (cnt != FULL);
     assign m_tdata = dout;
     assign m_tvalid = dvalid;
-
-    always @(posedge clk) begin
-        if (wr) mem[wptr] <= s_tdata;
-        if (load) q <= mem[rptr];
-    end
 
     generate
         if (OUTREG != 0) begin : outreg
@@ -84,6 +84,8 @@ module rfl_fifo #(
     endgenerate
 
     always @(posedge clk) begin
+        if (wr) mem[wptr] <= s_tdata;
+        if (load) q <= mem[rptr];
         if (!rst_n) begin
             wptr <= 0;
             rptr <= 0;
@@ -91,8 +93,7 @@ module rfl_fifo #(
         end else begin
             if (wr) wptr <= (wptr == LAST) ? {AW{1'b0}} : wptr + 1'b1;
             if (load) rptr <= (rptr == LAST) ? {AW{1'b0}} : rptr + 1'b1;
-            if (wr && !load) cnt <= cnt + 1'b1;
-            else if (load && !wr) cnt <= cnt - 1'b1;
+            if (wr != load) cnt <= wr ? cnt + 1'b1 : cnt - 1'b1;
         end
     end
 endmodule

@@ -46,7 +46,11 @@ module rfl_fifo2axi #(
     wire start = s_tvalid && s_tuser;
     wire pad = run && (padf || start);          // this clock's byte is a zero, none taken
     wire step = slot && (pad || (s_tvalid && (run || s_tuser)));
-    wire [7:0] byte_in = pad ? 8'd0 : s_tdata;
+    // the byte that goes into the pixel: a zero while padding (a function, not a wire: the
+    // simulation evaluates it only as a byte goes in)
+    function [7:0] byte_in(input zero, input [7:0] b);
+        byte_in = zero ? 8'd0 : b;
+    endfunction
     wire frame_end = last_byte && (x == X_LAST) && (y == Y_LAST);
 
     assign s_tready = run ? (slot && !padf && !s_tuser) : (!s_tuser || slot);
@@ -77,21 +81,16 @@ module rfl_fifo2axi #(
             if (step) begin
                 run <= 1'b1;
                 if (last_byte) begin
-                    m_axis_tdata <= {byte_in, acc} >> (8 * (4 - BYTES));
+                    m_axis_tdata <= {byte_in(pad, s_tdata), acc} >> (8 * (4 - BYTES));
                     m_axis_tuser <= (x == 0) && (y == 0);
                     m_axis_tlast <= (x == X_LAST);
                     m_axis_tvalid <= 1'b1;
-                    k <= 2'd0;
-                    if (x == X_LAST) begin
-                        x <= 16'd0;
-                        y <= (y == Y_LAST) ? 16'd0 : y + 16'd1;
-                    end else begin
-                        x <= x + 16'd1;
-                    end
+                    if (x == X_LAST) y <= (y == Y_LAST) ? 16'd0 : y + 16'd1;
+                    x <= (x == X_LAST) ? 16'd0 : x + 16'd1;
                 end else begin
-                    acc <= {byte_in, acc[23:8]};
-                    k <= k + 2'd1;
+                    acc <= {byte_in(pad, s_tdata), acc[23:8]};
                 end
+                k <= last_byte ? 2'd0 : k + 2'd1;
                 if (frame_end) begin
                     run <= 1'b0;
                     padf <= 1'b0;

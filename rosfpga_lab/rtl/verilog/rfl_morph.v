@@ -336,7 +336,6 @@ module rfl_morph #(
     // ---- stage 2: horizontal shift register of vertical extremes -----------------------------
     reg           valid2, emit2, first2, eol2;
     reg [K-1:0]   hmask2;
-    reg [K*W-1:0] sr;          // entry 0 newest
 
     always @(posedge aclk) begin
         if (!aresetn) begin
@@ -352,11 +351,18 @@ module rfl_morph #(
         end
     end
 
+    // the shift register, one word per entry (sh[0].e newest), as the trees are; sr shows the
+    // whole register as one bus in waveforms (nothing reads it)
+    wire [K*W-1:0] sr;
     generate
-        if (K > 1) begin : shift
-            always @(posedge aclk) if (adv && valid1v) sr <= {sr[K*W-W-1:0], vext};
-        end else begin : noshift
-            always @(posedge aclk) if (adv && valid1v) sr <= vext;
+        for (c = 0; c < K; c = c + 1) begin : sh
+            reg [W-1:0] e;
+            if (c == 0) begin : newest
+                always @(posedge aclk) if (adv && valid1v) e <= vext;
+            end else begin : older
+                always @(posedge aclk) if (adv && valid1v) e <= sh[c-1].e;
+            end
+            assign sr[c*W +: W] = e;
         end
     endgenerate
 
@@ -382,7 +388,7 @@ module rfl_morph #(
         for (c = 0; c < 2 * HP; c = c + 1) begin : hc
             wire [W-1:0] w;
             if (c < K) begin : entry
-                assign w = hmask2[c] ? sr[c*W +: W] : ID;
+                assign w = hmask2[c] ? sh[c].e : ID;
             end else begin : pad
                 assign w = ID;
             end
@@ -423,9 +429,9 @@ module rfl_morph #(
         end
     end
 
-    // tkeep and the unused lanes of the input are not needed
+    // tkeep and the unused lanes of the input are not needed; sr is for waveforms
     // pix, mv1, qall: K == 1 has no lines
-    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata, pix, mv1, qall};
+    wire unused_ok = &{1'b0, s_axis_tkeep, s_axis_tdata, pix, mv1, qall, sr};
 
 endmodule
 

@@ -6,7 +6,10 @@
 // from axi2fifo last, passed straight through. Timing: each field's last byte index is set as
 // the field starts (no subtraction on the way to the handshake), the byte counter has the
 // width of the longest field, and frame_id comes from the subscriber's RAM one clock after its
-// address (fid_raddr is the byte the next clock shows).
+// address (fid_raddr is the byte the next clock shows). For the Verilated simulation, where
+// the pixel bytes are most clocks: the output multiplexer tests F_DATA first, and what only a
+// header field or a field's end needs (its uint32 value, the next field) are functions called
+// there, not wires evaluated on every clock; the same logic after synthesis.
 module rfl_publisher #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,
@@ -61,8 +64,6 @@ module rfl_publisher #(
     reg          in_fid;                        // f is F_FID
     reg [FIDA-1:0] fa, fa1;                     // frame_id byte shown, and the next one
     reg [31:0]   seq;
-    reg [31:0]   word;                          // the field's value, for uint32 fields
-    reg [3:0]    fnext;                         // the field after this one
 
     wire [31:0] fid_len = {{(32-FIDW){1'b0}}, meta_fid_len};
     wire [IW-1:0] fid_last = fid_len[IW-1:0] - 1'b1;
@@ -74,6 +75,16 @@ module rfl_publisher #(
             enc_at = 8'd0;
             for (b = 0; b < ENC_LEN; b = b + 1)
                 if (n == b[IW-1:0]) enc_at = ENCODING[8 * (ENC_LEN - 1 - b) +: 8];
+        end
+    endfunction
+
+    // the field after field `g` (a function, not a wire: the simulation computes it only as a
+    // field ends)
+    function [3:0] next_of(input [3:0] g);
+        begin
+            if (g == F_FIDLEN) next_of = (fid_len == 0) ? F_HEIGHT : F_FID;
+            else if (g == F_DATA) next_of = F_IDLE;
+            else next_of = g + 4'd1;
         end
     endfunction
 
@@ -90,33 +101,45 @@ module rfl_publisher #(
         end
     endfunction
 
+    // the value of the uint32 field `g`
+    function [31:0] word_of(input [3:0] g);
+        begin
+            case (g)
+                F_LEN:    word_of = BODY + fid_len;
+                F_SEQ:    word_of = seq;
+                F_SECS:   word_of = meta_secs;
+                F_NSECS:  word_of = meta_nsecs;
+                F_FIDLEN: word_of = fid_len;
+                F_HEIGHT: word_of = HEIGHT;
+                F_WIDTH:  word_of = WIDTH;
+                F_ENCLEN: word_of = ENC_LEN;
+                F_STEP:   word_of = STEP;
+                F_DLEN:   word_of = DATA_BYTES;
+                default:  word_of = 32'd0;
+            endcase
+        end
+    endfunction
+
+    // byte n (little-endian) of the word w
+    function [7:0] byte_of(input [31:0] w, input [1:0] n);
+        byte_of = w[8 * n +: 8];
+    endfunction
+
+    // the pixel bytes first: the simulation then looks at no header field most of the frame
     always @* begin
-        case (f)
-            F_LEN:    word = BODY + fid_len;
-            F_SEQ:    word = seq;
-            F_SECS:   word = meta_secs;
-            F_NSECS:  word = meta_nsecs;
-            F_FIDLEN: word = fid_len;
-            F_HEIGHT: word = HEIGHT;
-            F_WIDTH:  word = WIDTH;
-            F_ENCLEN: word = ENC_LEN;
-            F_STEP:   word = STEP;
-            F_DLEN:   word = DATA_BYTES;
-            default:  word = 32'd0;
-        endcase
-        case (f)
-            F_FID:   m_tdata = fid_rdata;
-            F_ENC:   m_tdata = enc_at(i);
-            F_BIG:   m_tdata = meta_bigendian;
-            F_DATA:  m_tdata = s_tdata;
-            default: m_tdata = word[8 * i[1:0] +: 8];
-        endcase
-        if (f == F_FIDLEN) fnext = (fid_len == 0) ? F_HEIGHT : F_FID;
-        else if (f == F_DATA) fnext = F_IDLE;
-        else fnext = f + 4'd1;
+        if (f == F_DATA) begin
+            m_tdata = s_tdata;
+        end else begin
+            case (f)
+                F_FID:   m_tdata = fid_rdata;
+                F_ENC:   m_tdata = enc_at(i);
+                F_BIG:   m_tdata = meta_bigendian;
+                default: m_tdata = byte_of(word_of(f), i[1:0]);
+            endcase
+        end
     end
 
-    assign m_tvalid = (f != F_IDLE) && (f != F_DATA || s_tvalid);
+    assign m_tvalid = (f == F_DATA) ? s_tvalid : (f != F_IDLE);
     assign s_tready = (f == F_DATA) && m_tready;
     wire put = m_tvalid && m_tready;
     wire field_done = put && (i == ilast);
@@ -136,29 +159,23 @@ module rfl_publisher #(
             fa <= {FIDA{1'b0}};
             fa1 <= FID_ONE;
             seq <= SEQ_START;
-        end else if (f == F_IDLE) begin
-            if (meta_valid) begin
-                f <= F_LEN;
-                fa <= {FIDA{1'b0}};
-                fa1 <= FID_ONE;
-                ilast <= U32_LAST;
-            end
-        end else if (field_done) begin
+        end else if (put) begin                 // a byte goes (never in F_IDLE)
             if (in_fid) begin
                 fa <= fa1;
                 fa1 <= fa1 + 1'b1;
             end
-            i <= {IW{1'b0}};
-            in_fid <= (fnext == F_FID);
-            f <= fnext;
-            ilast <= last_of(fnext);
-            if (f == F_DATA) seq <= seq + 32'd1;
-        end else if (put) begin
-            i <= i_next;
-            if (in_fid) begin
-                fa <= fa1;
-                fa1 <= fa1 + 1'b1;
+            if (field_done) begin
+                if (f == F_DATA) seq <= seq + 32'd1;
+                in_fid <= (next_of(f) == F_FID);
+                ilast <= last_of(next_of(f));
+                f <= next_of(f);
             end
+            i <= field_done ? {IW{1'b0}} : i_next;
+        end else if (f == F_IDLE && meta_valid) begin
+            f <= F_LEN;
+            fa <= {FIDA{1'b0}};
+            fa1 <= FID_ONE;
+            ilast <= U32_LAST;
         end
     end
 endmodule

@@ -10,6 +10,9 @@
 // end compare against `left`, the bytes of the frame still to come, kept as a down-counter, so
 // no check adds three 32-bit numbers; a field's byte counter has the width of the longest
 // string field; frame_id is read by the publisher from a RAM with a registered read port.
+// For the Verilated simulation, where the pixel bytes are most clocks: the state machine tests
+// S_DATA first, and the encoding compare is a function called in S_ENC, not a wire evaluated
+// on every clock; the same logic after synthesis.
 module rfl_subscriber #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,
@@ -146,11 +149,12 @@ module rfl_subscriber #(
                 if (n == b[CW-1:0]) enc_at = ENCODING[8 * (ENC_LEN - 1 - b) +: 8];
         end
     endfunction
-    wire        enc_ok = same && (s_tdata == enc_at(cnt));
+    // the encoding matches up to and with byte b at position n (a function, not a wire: the
+    // simulation compares only in S_ENC)
+    function enc_ok(input [7:0] b, input [CW-1:0] n);
+        enc_ok = same && (b == enc_at(n));
+    endfunction
 
-    always @(posedge clk) begin
-        if (take && state == S_FID) fid_mem[cnt[FIDA-1:0]] <= s_tdata;
-    end
 
     // Enter state `next` at the start of a field.
     task advance(input [3:0] next);
@@ -176,6 +180,7 @@ module rfl_subscriber #(
     endtask
 
     always @(posedge clk) begin
+        if (take && state == S_FID) fid_mem[cnt[FIDA-1:0]] <= s_tdata;
         if (!rst_n) begin
             state <= S_FLEN;
             in_frame <= 1'b0;
@@ -201,7 +206,14 @@ module rfl_subscriber #(
                 one_left <= (left == 2);
                 acc <= value[31:8];
                 cnt <= cnt + 1'b1;
-                case (state)
+                // the pixel bytes (or the rest of a refused frame) first: most of the stream
+                if (state == S_DATA || state == S_SKIP) begin
+                    m_tuser <= 1'b0;                    // the first pixel byte is taken
+                    if (last_byte) begin
+                        advance(S_FLEN);
+                        in_frame <= 1'b0;
+                    end
+                end else case (state)
                     S_FLEN: if (u32_done) begin
                         cnt <= {CW{1'b0}};
                         if (too_long) begin
@@ -265,11 +277,11 @@ module rfl_subscriber #(
                         end
                     end
                     S_ENC: begin
-                        same <= enc_ok;
                         if (cnt == flast) begin
-                            if (!enc_ok) refuse(SUB_BAD_ENCODING);
+                            if (!enc_ok(s_tdata, cnt)) refuse(SUB_BAD_ENCODING);
                             else advance(S_BIG);
                         end
+                        same <= enc_ok(s_tdata, cnt);
                     end
                     S_BIG: begin
                         meta_bigendian <= s_tdata;
@@ -288,13 +300,6 @@ module rfl_subscriber #(
                             meta_valid <= 1'b1;
                             m_tuser <= 1'b1;
                             advance(S_DATA);
-                        end
-                    end
-                    S_DATA, S_SKIP: begin
-                        m_tuser <= 1'b0;                // the first pixel byte is taken
-                        if (last_byte) begin
-                            advance(S_FLEN);
-                            in_frame <= 1'b0;
                         end
                     end
                     default: begin
