@@ -11,10 +11,11 @@ The testbench drives the input with random gaps and the output with random backp
 runs per clock.
 
 With Verilator and a C++ compiler (and no waveform wanted), :func:`build` compiles the fast
-harness instead (``harness/rfl_harness.cpp`` around ``harness/rfl_harness.v``): a plain
-``eval`` loop without ``--timing`` that keeps the frames in memory and does clock for clock what
-the testbench does (same reset, same random draws, same outputs and files), at about 17 M clocks/s
-where the testbench on ``verilator --binary --timing`` does about 2 M. Its serve mode is the
+harness instead (``harness/rfl_harness.cpp`` around ``harness/rfl_harness.v``): a loop without
+``--timing`` that keeps the frames in memory, evaluates the model once per clock (its nonblocking
+region alone where :func:`nba_only` allows, see :data:`EVAL_MODES`) and does clock for clock what
+the testbench does (same reset, same random draws, same outputs and files), at about 22 M clocks/s
+where the testbench on ``verilator --binary --timing`` does about 3 M. Its serve mode is the
 long-lived simulator of ``--model rtl`` (:mod:`rosfpga_lab.rtl.server`).
 """
 

@@ -6,7 +6,10 @@
 * simulated clocks per second, per simulator installed (Icarus Verilog is timed on a
   160x120 ``rgb8`` frame unless --full-icarus: it is far slower than Verilator). On Verilator,
   the Verilog testbench (``verilator --binary --timing``) and the fast C++ harness side by side,
-  on the same frame, with their outputs compared. Target of the harness: >= 20 M clocks/s.
+  on the same frame, with their outputs compared. Target of the harness: >= 20 M clocks/s,
+  judged by the median of --builds K builds (each a new file: on this virtual machine an
+  identical binary runs at 55 to 120 ms a frame depending on where its pages land in memory;
+  dropping the page cache turns a slow copy into a fast one).
 
 * the live node with ``--model rtl`` per shipped configuration: frames/s through the component
   (embedded master, a lab publisher and subscriber, frames in lock step), each output checked
@@ -14,7 +17,8 @@
 
 The build (compilation) time is printed apart: it is paid once per configuration.
 
-Usage: ``python tests/benchmarks/bench_rtl.py [--simulator verilator] [--repeat N] [--full-icarus]``
+Usage: ``python tests/benchmarks/bench_rtl.py [--simulator verilator] [--repeat N] [--builds K]
+[--full-icarus]``
 """
 
 from __future__ import annotations
@@ -110,6 +114,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=5, metavar="N",
                         help="Verilator: simulate the frame N times per build, print the fastest "
                              "(default 5)")
+    parser.add_argument("--builds", type=int, default=3, metavar="K",
+                        help="Verilator: build the harness K times, each in a new directory, and "
+                             "judge the target by the median (default 3): on a virtual machine "
+                             "the same binary can run up to twice as slow from one file to "
+                             "another, as its pages land in memory")
     parser.add_argument("--full-icarus", action="store_true",
                         help="time Icarus Verilog on the 640x480 frame too (minutes)")
     args = parser.parse_args(argv)
@@ -121,15 +130,17 @@ def main(argv: list[str] | None = None) -> int:
     for simulator in sims:
         if simulator == "verilator":
             old = bench("fpga_dilate_rgba8", simulator, harness=False, repeat=args.repeat)
-            new = bench("fpga_dilate_rgba8", simulator, harness=True, repeat=args.repeat)
-            same = (new.output, new.status, new.streams, new.cycles) == (
-                old.output, old.status, old.streams, old.cycles)
+            news = [bench("fpga_dilate_rgba8", simulator, harness=True, repeat=args.repeat)
+                    for _ in range(max(1, args.builds))]
+            new = sorted(news, key=lambda r: r.clocks_per_second)[len(news) // 2]
+            same = all((r.output, r.status, r.streams, r.cycles) == (
+                old.output, old.status, old.streams, old.cycles) for r in news)
             print(f"harness / testbench: {new.clocks_per_second / old.clocks_per_second:.1f}x the "
                   f"clocks/s; bytes, statuses and cycle counts {'the same' if same else 'DIFFERENT'}")
             met = new.clocks_per_second >= HARNESS_TARGET
             print(f"harness target >= {HARNESS_TARGET / 1e6:g} M clocks/s: "
-                  f"{'met' if met else 'NOT met'} (a shared machine: take the median of several "
-                  "runs of this script)")
+                  f"{'met' if met else 'NOT met'} by the median of {len(news)} build(s): "
+                  f"{new.clocks_per_second / 1e6:.1f} M clocks/s")
         elif args.full_icarus:
             bench("fpga_dilate_rgba8", simulator)
         else:

@@ -1,4 +1,4 @@
-// rfl_harness.cpp -- the fast simulation of the whole circuit: a plain eval loop around the
+// rfl_harness.cpp -- the fast simulation of the whole circuit: one evaluation per clock of the
 // Verilated rfl_harness (rfl_node plus read-only stream taps), no --timing, frames in and out
 // through memory. It does clock for clock what rfl_tb.v does (same reset, same xorshift
 // draws in the same order, same sampling before each rising edge), so the bytes, statuses
