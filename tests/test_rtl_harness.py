@@ -150,3 +150,70 @@ def test_the_shipped_design_runs_in_the_nonblocking_region_alone(tmp_path: Path)
     assert not nba_only(other)
     with pytest.raises(RtlError, match="eval_mode must be one of nba, root, plain"):
         harness_command(tmp_path, eval_mode="fast")
+
+
+def _code_mappings(pid: int) -> list[tuple[str, int]]:
+    """(what is mapped, AnonHugePages in kB) per executable mapping of a process."""
+    found: list[tuple[str, int]] = []
+    code = False                     # the fields that follow belong to an executable mapping
+    for line in Path(f"/proc/{pid}/smaps").read_text().splitlines():
+        parts = line.split()
+        if len(parts) >= 5 and "-" in parts[0] and not parts[0].endswith(":"):
+            code = parts[1] == "r-xp"
+            if code:
+                found.append((parts[5] if len(parts) > 5 else "", 0))
+        elif code and line.startswith("AnonHugePages:"):
+            found[-1] = (found[-1][0], int(parts[1]))
+    return found
+
+
+def _thp_fallbacks() -> int:
+    """How often the kernel gave small pages where a huge page was asked for."""
+    for line in Path("/proc/vmstat").read_text().splitlines():
+        if line.startswith("thp_fault_fallback "):
+            return int(line.split()[1])
+    return 0
+
+
+@pytest.mark.parametrize("huge", [True, False])
+def test_the_harness_runs_its_code_from_a_huge_page(tmp_path: Path, huge: bool) -> None:
+    """Linux: the harness moves its machine code onto a 2 MiB transparent huge page as it
+    starts (an anonymous mapping where the loader had mapped the file); RFL_NO_HUGE_TEXT=1
+    leaves it on the file's pages. Either way it serves the same bytes."""
+    import os
+    import sys
+    import time
+
+    require_rtl("verilator")
+    if not sys.platform.startswith("linux"):
+        pytest.skip("the huge code page is Linux only")
+    thp = Path("/sys/kernel/mm/transparent_hugepage/enabled")
+    if not thp.exists() or "[never]" in thp.read_text():
+        pytest.skip("transparent huge pages are off on this machine")
+    config = small_config("rgb8")
+    built = build(rtl_params(config), tmp_path / "fast", simulator="verilator")
+    env = {**os.environ, "RFL_NO_HUGE_TEXT": "" if huge else "1"}
+    fallbacks = _thp_fallbacks()
+    proc = subprocess.Popen([*built.command, "--serve"], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, env=env)
+    try:
+        binary = str(Path(built.command[0]).resolve())
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            maps = _code_mappings(proc.pid)
+            ours = [m for m in maps if m[0] in ("", binary)]
+            if huge and any(kb == 2048 and name == "" for name, kb in ours):
+                break
+            if not huge and any(name == binary for name, _ in ours):
+                break
+            time.sleep(0.05)
+        if huge:
+            assert not any(name == binary for name, _ in ours), maps   # the code was moved
+            if _thp_fallbacks() == fallbacks:    # unless the kernel had no huge page to give
+                assert any(kb == 2048 and name == "" for name, kb in ours), maps
+        else:
+            assert any(name == binary for name, _ in ours), maps
+    finally:
+        proc.stdin.close()    # end of input ends the serve loop
+        proc.wait(timeout=30)
+    assert proc.returncode == 0

@@ -190,6 +190,11 @@ EVAL_MODES = ("nba", "root", "plain")
 _OUTSIDE_NBA = ("___eval_ico(", "___eval_act(")
 
 
+#: Linux: link the harness with its segments on 2 MiB boundaries, so that it can move its
+#: machine code onto a transparent huge page as it starts (``rfl_harness.cpp``).
+HUGE_TEXT_LDFLAGS = "-Wl,-z,max-page-size=0x200000 -Wl,-z,common-page-size=0x200000"
+
+
 def harness_command(where: str | Path = ".", obj_dir: str = "obj_dir",
                     eval_mode: str = EVAL_MODES[0]) -> list[str]:
     """The Verilator command that builds the fast harness from the sources in ``where``."""
@@ -197,10 +202,11 @@ def harness_command(where: str | Path = ".", obj_dir: str = "obj_dir",
         raise RtlError(f"eval_mode must be one of {', '.join(EVAL_MODES)}, got {eval_mode!r}")
     rtl = sorted(p.name for p in Path(where).glob("*.v")
                  if p.name not in (*HARNESS_FILES, f"{TB_TOP}.v"))
+    link = ["-LDFLAGS", HUGE_TEXT_LDFLAGS] if sys.platform.startswith("linux") else []
     return [_verilator() or "verilator", "--cc", "--exe", "--build", "-O3", "--x-assign", "fast",
             "--x-initial", "fast", "--noassert", "-Wno-fatal", "-Wno-lint", "-Wno-style", "-I.",
             "--top-module", HARNESS_TOP, "-Mdir", obj_dir, "-o", "rfl_fast", "-j", "2",
-            "-CFLAGS", f"-O3 -DRFL_EVAL_{eval_mode.upper()}",
+            "-CFLAGS", f"-O3 -DRFL_EVAL_{eval_mode.upper()}", *link,
             "-MAKEFLAGS", "OPT_FAST=-O3 OPT_GLOBAL=-O2", *HARNESS_FILES, *rtl]
 
 
