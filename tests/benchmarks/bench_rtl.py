@@ -8,8 +8,9 @@
   the Verilog testbench (``verilator --binary --timing``) and the fast C++ harness side by side,
   on the same frame, with their outputs compared. Target of the harness: >= 20 M clocks/s,
   judged by the median of --builds K builds (each a new file: on this virtual machine an
-  identical binary runs at 55 to 120 ms a frame depending on where its pages land in memory;
-  dropping the page cache turns a slow copy into a fast one).
+  identical binary ran at 55 to 133 ms a frame from its file's pages, depending on where they
+  landed in memory, which is why the harness moves its code onto a huge page as it starts;
+  RFL_NO_HUGE_TEXT=1 in the environment turns that off, to compare).
 
 * the live node with ``--model rtl`` per shipped configuration: frames/s through the component
   (embedded master, a lab publisher and subscriber, frames in lock step), each output checked
@@ -116,9 +117,7 @@ def main(argv: list[str] | None = None) -> int:
                              "(default 5)")
     parser.add_argument("--builds", type=int, default=3, metavar="K",
                         help="Verilator: build the harness K times, each in a new directory, and "
-                             "judge the target by the median (default 3): on a virtual machine "
-                             "the same binary can run up to twice as slow from one file to "
-                             "another, as its pages land in memory")
+                             "judge the target by the median (default 3)")
     parser.add_argument("--full-icarus", action="store_true",
                         help="time Icarus Verilog on the 640x480 frame too (minutes)")
     args = parser.parse_args(argv)
