@@ -28,7 +28,7 @@ from pathlib import Path
 
 import pytest
 
-from rosfpga_lab.graph.realros import ROS_PYTHON, ros_env, ros_missing, user_temp_dir
+from rosfpga_lab.graph.realros import ROS_PYTHON, import_problem, ros_env, ros_missing, user_temp_dir
 
 HERE = Path(__file__).resolve().parent
 ROS_PROGRAMS = HERE / "ros_programs"
@@ -64,21 +64,13 @@ def require_ros() -> None:
 
 
 @functools.cache
-@functools.cache
 def ros2_missing_reason() -> str | None:
     """Why real ROS 2 Jazzy (rclpy on Fast DDS, the ``[ros2]`` extra's PyPI wheels) cannot be
     used here, or None when it can. Probed in a subprocess of this Python: rclpy is never
     imported into the test process."""
-    try:
-        proc = subprocess.run([sys.executable, "-c", "import rclpy, sensor_msgs.msg"],
-                              capture_output=True, text=True, timeout=60)
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        return f"real ROS 2 (rclpy) not usable: {exc}"
-    if proc.returncode == 0:
-        return None
-    last = (proc.stderr.strip().splitlines() or ["import failed"])[-1]
-    return (f"real ROS 2 (rclpy) not importable: {last} (pip install -e '.[ros2]'; wheels for "
-            f"Linux x86_64 only)")
+    reason = import_problem(sys.executable, ("rclpy", "sensor_msgs.msg"),
+                            "pip install -e '.[ros2]'; wheels for Linux x86_64 only")
+    return None if reason is None else f"real ROS 2 (rclpy) not usable: {reason}"
 
 
 def require_ros2() -> None:

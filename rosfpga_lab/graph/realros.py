@@ -105,7 +105,10 @@ def ros_env(master_uri: str, home: Path | str | None = None) -> dict[str, str]:
 
 
 @functools.lru_cache(maxsize=16)
-def _import_problem(python: str, modules: tuple[str, ...]) -> str | None:
+def import_problem(python: str, modules: tuple[str, ...], hint: str) -> str | None:
+    """Why ``python`` cannot import ``modules``, in one line ending with ``hint`` (what to
+    install); None when it can. Probed in a subprocess without this process's ``PYTHON*``
+    variables, remembered per process."""
     env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
     try:
         probe = subprocess.run([python, "-c", f"import {', '.join(modules)}"], env=env,
@@ -115,8 +118,7 @@ def _import_problem(python: str, modules: tuple[str, ...]) -> str | None:
     if probe.returncode == 0:
         return None
     last = (probe.stderr.strip().splitlines() or ["no error text"])[-1]
-    return (f"{python} cannot import {', '.join(modules)} ({last}); Debian's packages: "
-            f"{' '.join(ROS_PACKAGES)}")
+    return f"{python} cannot import {', '.join(modules)} ({last}); {hint}"
 
 
 def ros_missing(tools: Sequence[str] = (), *, modules: Sequence[str] = ROS_MODULES,
@@ -137,8 +139,10 @@ def ros_missing(tools: Sequence[str] = (), *, modules: Sequence[str] = ROS_MODUL
             return f"{tool} is not on PATH"
     if not Path(python).exists():
         return f"{python} not found"
-    return _import_problem(python, tuple(modules)) if modules else None
+    if not modules:
+        return None
+    return import_problem(python, tuple(modules), f"Debian's packages: {' '.join(ROS_PACKAGES)}")
 
 
-__all__ = ["PROBE_TIMEOUT", "ROS_MODULES", "ROS_PACKAGES", "ROS_PYTHON", "ros_env", "ros_missing",
-           "user_temp_dir"]
+__all__ = ["PROBE_TIMEOUT", "ROS_MODULES", "ROS_PACKAGES", "ROS_PYTHON", "import_problem", "ros_env",
+           "ros_missing", "user_temp_dir"]

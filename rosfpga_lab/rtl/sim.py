@@ -226,7 +226,7 @@ def _compile_harness(where: Path) -> str:
             if mode == EVAL_MODES[-1] or HARNESS_FILES[1] not in str(error):
                 raise
             continue
-        if mode != "nba" or nba_only(where / "obj_dir"):
+        if mode != EVAL_MODES[0] or nba_only(where / "obj_dir"):
             return mode
     raise AssertionError("unreachable: the last mode returns or raises")
 

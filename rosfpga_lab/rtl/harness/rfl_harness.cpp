@@ -156,9 +156,6 @@ struct Sim {
     FILE* fbin = nullptr;
     FILE* fbout = nullptr;
     bool stats = false;         // keep the per-stream spans (first, last, count)
-    // the input rfl_node sees in the current clock (the ports hold that of the next one)
-    bool in_valid = false;
-    uint8_t in_data = 0;
 
     Sim(uint32_t seed, uint32_t gap_, uint32_t bp_, uint64_t limit)
         : top(new Vrfl_harness), rnd(seed == 0 ? 0x12345678u : seed), gap(gap_), bp(bp_),
@@ -198,7 +195,7 @@ struct Sim {
     }
 
     // Bytes of the input the circuit took (a byte offered is held until it is taken).
-    uint64_t taken() const { return in_pos - (in_valid ? 1 : 0); }
+    uint64_t taken() const { return in_pos - (top->s_tvalid ? 1 : 0); }
 
     // Stream i's (first, last, count) up to the current clock.
     void span(int i, uint64_t& f, uint64_t& l, uint64_t& n) const {
@@ -226,8 +223,9 @@ struct Sim {
     template <bool Random, bool Taps>
     int loop() {
         Vrfl_harness* const t = top;
-        bool sv = in_valid;
-        uint8_t sd = in_data;
+        // the input rfl_node sees in this clock: the ports hold what was set before its edge
+        bool sv = t->s_tvalid;
+        uint8_t sd = t->s_tdata;
         int rc;
         for (;;) {
             // the circuit's outputs in this clock, before its rising edge
@@ -284,7 +282,6 @@ struct Sim {
             if (done_for == 8) { rc = 0; break; }
             if (idle >= idle_limit) { rc = eof ? 1 : 2; break; }
         }
-        in_valid = sv; in_data = sd;
         return rc;
     }
 };
