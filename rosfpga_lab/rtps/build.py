@@ -12,6 +12,8 @@ import struct
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from rosfpga_lab.msg.parser import SEP
+from rosfpga_lab.msg.typehash import MSG_NAMESPACE
 from rosfpga_lab.rtps.message import MAGIC
 
 PROTOCOL_VERSION = (2, 3)
@@ -281,9 +283,8 @@ def dds_topic(ros_name: str) -> str:
 
 def dds_type(ros_type: str) -> str:
     """``sensor_msgs/Image`` (or ``sensor_msgs/msg/Image``) -> ``sensor_msgs::msg::dds_::Image_``."""
-    parts = ros_type.split("/")
-    pkg, name = parts[0], parts[-1]
-    return f"{pkg}::msg::dds_::{name}_"
+    parts = ros_type.split(SEP)
+    return f"{parts[0]}::{MSG_NAMESPACE}::dds_::{parts[-1]}_"
 
 
 #: rmw's USER_DATA of an endpoint is ``key=value;`` pairs (rmw_dds_common); Iron and later
