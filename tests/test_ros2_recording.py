@@ -89,3 +89,21 @@ def test_the_recording_is_bounded_and_counts_what_it_leaves_out() -> None:
         node.record(max_datagrams=100, max_bytes=10)   # no datagram is that small
         assert wait(lambda: node.recorded().dropped > 0)
         assert node.recorded().datagrams == [] and node.recorded().kept_bytes == 0
+
+
+def test_a_datagram_of_two_participants_is_drawn_as_an_arrow_from_each() -> None:
+    """Cyclone DDS packs the submessages of a process's participants into one datagram, the
+    second after INFO_SRC (data/capture_cyclone_info_src.py made this one): one arrow each."""
+    from pathlib import Path
+
+    from rosfpga_lab.widgets.wire import events_from_rtps
+
+    dg = (Path(__file__).resolve().parent.parent / "data" / "cyclone_info_src_spdp.bin").read_bytes()
+    first, second = parse_message(dg).header.guid_prefix, bytes.fromhex("0110972927d126a60dd1d6af")
+    names = {first: "camera", second: "viewer", bytes.fromhex("010fb4edbcfd6003fa1936d9"): "component"}
+    events = events_from_rtps([(0.0, "127.0.0.1:7410", "127.0.0.1:7412", dg)], names=names)
+    # one arrow per sender and destination, in the order each first speaks
+    assert [(e.src, e.dst, e.label) for e in events] == [
+        ("camera", "component", "ACKNACK, HEARTBEAT, SPDP participant"),
+        ("viewer", "component", "SPDP participant")]
+    assert all(e.raw == dg for e in events)

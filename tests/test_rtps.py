@@ -12,10 +12,10 @@ import pytest
 from rosfpga_lab.graph.capture_read import udp_datagrams
 from rosfpga_lab.msg import deserialize_cdr
 from rosfpga_lab.rtps import (
-    AckNack, DataFrag, FragmentAssembler, Gap, RtpsError, RtpsTruncatedError,
-    discovery, parse_message, parse_parameters,
+    ANY_PARTICIPANT, AckNack, DataFrag, FragmentAssembler, Gap, InfoSrc, RtpsError,
+    RtpsTruncatedError, discovery, parse_message, parse_parameters,
 )
-from wiretools import assert_rtps_agrees_with_tshark
+from wiretools import assert_rtps_agrees_with_tshark, tshark_fields
 
 CAPTURE = Path(__file__).resolve().parent.parent / "data" / "rtps_image.pcapng"
 DATAGRAMS = [d[3] for d in udp_datagrams(CAPTURE)]
@@ -123,3 +123,60 @@ def test_assembler_ignores_fragment_numbers_past_the_sample() -> None:
     assert asm.add(b"p" * 12, DataFrag(**common, frag_start=9, frag_count=1, payload=b"zzzz")) is None
     assert asm.add(b"p" * 12, DataFrag(**common, frag_start=2, frag_count=1, payload=b"ef")) is None
     assert asm.add(b"p" * 12, DataFrag(**common, frag_start=1, frag_count=1, payload=b"abcd")) == b"abcdef"
+
+
+# ---- INFO_SRC: two participants of one process in one datagram ----------------------------------
+#: A real datagram of Cyclone DDS (PyPI cyclonedds 0.10) with two participants in one process,
+#: sent to a lab participant (010fb4ed..): the header names one participant, INFO_SRC switches
+#: to the other for its SPDP, a second INFO_SRC switches back. Made by
+#: data/capture_cyclone_info_src.py.
+INFO_SRC_DATAGRAM = (CAPTURE.parent / "cyclone_info_src_spdp.bin").read_bytes()
+FIRST, SECOND = bytes.fromhex("01109729d515b1b1edabb6b4"), bytes.fromhex("0110972927d126a60dd1d6af")
+LAB = bytes.fromhex("010fb4edbcfd6003fa1936d9")
+
+
+def test_info_src_sets_the_source_of_the_submessages_after_it() -> None:
+    msg = parse_message(INFO_SRC_DATAGRAM)
+    assert msg.header.guid_prefix == FIRST
+    infos = [s for s in msg.submessages if isinstance(s, InfoSrc)]
+    assert [(s.guid_prefix, s.version, s.vendor_id) for s in infos] == [
+        (SECOND, (2, 5), 0x0110), (FIRST, (2, 5), 0x0110)]
+    routed = [(src, dst, s.name) for src, dst, s in msg.routed()]
+    assert routed == [(FIRST, LAB, "INFO_DST"), (FIRST, LAB, "ACKNACK"), (FIRST, LAB, "ACKNACK"),
+                      (FIRST, LAB, "HEARTBEAT"), (FIRST, LAB, "HEARTBEAT"),
+                      (SECOND, LAB, "INFO_SRC"), (SECOND, LAB, "INFO_TS"), (SECOND, LAB, "DATA"),
+                      (FIRST, LAB, "INFO_SRC"), (FIRST, LAB, "INFO_TS"), (FIRST, LAB, "DATA")]
+    # each SPDP announces the participant INFO_SRC named, which discovery() reports
+    participants, _ = discovery([msg])
+    assert {p.guid_prefix for p in participants} == {FIRST, SECOND}
+
+
+def test_routed_starts_from_the_header_and_any_participant() -> None:
+    msg = parse_message(HEADER + struct.pack("<BBH", 0x09, 0x03, 0))
+    assert [(src, dst) for src, dst, _ in msg.routed()] == [(HEADER[8:20], ANY_PARTICIPANT)]
+
+
+def test_info_src_agrees_with_tshark(tmp_path: Path) -> None:
+    from scapy.all import IP, UDP, Ether, Raw, wrpcap
+
+    capture = tmp_path / "info_src.pcap"
+    wrpcap(str(capture), [Ether() / IP(src="127.0.0.1", dst="127.0.0.1")
+                          / UDP(sport=7410, dport=7412) / Raw(INFO_SRC_DATAGRAM)])
+    assert assert_rtps_agrees_with_tshark(capture) == 1
+    [[sources]] = tshark_fields(capture, ["rtps.guidPrefix.src"], display_filter="rtps")
+    msg = parse_message(INFO_SRC_DATAGRAM)
+    ours = [msg.header.guid_prefix] + [s.guid_prefix for s in msg.submessages if isinstance(s, InfoSrc)]
+    assert sources.split("|") == [p.hex() for p in ours]
+
+
+@pytest.mark.parametrize("cut", range(1, 24))
+def test_a_datagram_cut_inside_info_src_is_a_typed_error(cut: int) -> None:
+    at = next(s.offset for s in parse_message(INFO_SRC_DATAGRAM).submessages if isinstance(s, InfoSrc))
+    with pytest.raises(RtpsTruncatedError):
+        parse_message(INFO_SRC_DATAGRAM[:at + cut])
+
+
+@pytest.mark.parametrize("length", range(20))
+def test_an_info_src_body_shorter_than_20_bytes_is_a_typed_error(length: int) -> None:
+    with pytest.raises(RtpsTruncatedError, match="INFO_SRC at byte 20"):
+        parse_message(HEADER + struct.pack("<BBH", 0x0C, 0x01, length) + bytes(length))

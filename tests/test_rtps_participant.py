@@ -21,7 +21,7 @@ from rosfpga_lab.rtps.limits import (
 )
 from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, NackFrag
 from rosfpga_lab.rtps.participant import (
-    PUB_WRITER, SPDP_READER, SPDP_WRITER, Participant, Qos, discovery_port, incompatibility,
+    PUB_READER, PUB_WRITER, SPDP_READER, SPDP_WRITER, Participant, Qos, discovery_port, incompatibility,
     user_port,
 )
 
@@ -232,6 +232,52 @@ def test_spoofed_spdp_guid_is_ignored_and_logged_once() -> None:
     assert p.participants == {}
     assert sum("announces only itself" in n for n in p.notes) == 1
     assert p.counts["spdp-spoof"] == 50
+
+
+# ---- INFO_SRC: several participants of one process in one datagram (Cyclone DDS does it) -------
+#: Made by data/capture_cyclone_info_src.py: Cyclone's header names one participant, INFO_SRC
+#: the other, whose SPDP follows; all of it is addressed (INFO_DST) to the lab's participant LAB.
+CYCLONE_INFO_SRC = Path(__file__).resolve().parent.parent / "data" / "cyclone_info_src_spdp.bin"
+LAB = bytes.fromhex("010fb4edbcfd6003fa1936d9")
+
+
+def test_both_participants_of_a_cyclone_datagram_with_info_src_are_learned() -> None:
+    dg = CYCLONE_INFO_SRC.read_bytes()
+    msg = parse_message(dg)
+    first, second = msg.header.guid_prefix, bytes.fromhex("0110972927d126a60dd1d6af")
+    p = Participant(domain=0, index=5, guid_prefix=LAB)
+    p.receive(dg, ("127.0.0.1", 7410), 0.0)
+    # before INFO_SRC was read, the second SPDP was "SPDP from <first> announces <second>"
+    assert set(p.participants) == {first, second}, p.notes
+    assert not any("announces only itself" in n for n in p.notes)
+    # the same datagram addressed (INFO_DST) to another participant is not for this one
+    q = Participant(domain=0, index=5, guid_prefix=b"Q" * 12)
+    q.receive(dg, ("127.0.0.1", 7410), 0.0)
+    assert q.participants == {}
+
+
+def test_info_src_is_held_to_what_its_participant_may_say() -> None:
+    p = fresh()
+    # INFO_SRC naming this participant: its own submessages, ignored as if sent by itself
+    own = b.header(b"E" * 12) + b.info_src(p.guid_prefix) + spdp(p.guid_prefix)[20:]
+    p.receive(own, ("127.0.0.1", 7999), 0.0)
+    assert p.participants == {}
+    # after INFO_SRC F, an SPDP announcing G is a spoof (of F, not of the header's E)
+    payload = b.spdp_payload(b"G" * 12, b.Locator("127.0.0.1", 7999), b.Locator("127.0.0.1", 8000),
+                             10.0, "evil", b"", 0)
+    p.receive(b.header(b"E" * 12) + b.info_src(b"F" * 12) + b.data(SPDP_READER, SPDP_WRITER, 1, payload),
+              ("127.0.0.1", 7999), 0.0)
+    assert p.participants == {}
+    assert any(f"SPDP from {(b'F' * 12).hex()} announces" in n for n in p.notes)
+    # an SEDP endpoint after INFO_SRC is the INFO_SRC participant's, held to its GUID prefix
+    p.add_reader(TOPIC, TYPE)
+    p.receive(spdp(b"E" * 12), ("127.0.0.1", 7999), 0.0)
+    p.receive(spdp(b"F" * 12, port=8001), ("127.0.0.1", 8001), 0.0)
+    guid = b"F" * 12 + (0x1203).to_bytes(4, "big")
+    sedp = b.sedp_payload(guid, TOPIC, TYPE, True, 10, b.Locator("127.0.0.1", 8002))
+    p.receive(b.header(b"E" * 12) + b.info_src(b"F" * 12) + b.data(PUB_READER, PUB_WRITER, 1, sedp),
+              ("127.0.0.1", 7999), 0.1)
+    assert guid in p.remote and p.remote[guid].locator == ("127.0.0.1", 8002)
 
 
 def test_spoofed_sedp_endpoint_of_another_participant_is_ignored() -> None:

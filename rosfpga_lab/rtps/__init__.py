@@ -16,17 +16,18 @@ machine (discovery, matching, reliable and best-effort writers and readers; its 
 
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
 from rosfpga_lab.rtps.message import (
-    ENTITY_NAMES, SUBMESSAGE_NAMES, AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag,
-    InfoDst, InfoTs, NackFrag, RtpsHeader, RtpsMessage, Submessage, Unknown, entity_name,
-    parse_message,
+    ANY_PARTICIPANT, ENTITY_NAMES, SUBMESSAGE_NAMES, AckNack, Data, DataFrag, Gap, Heartbeat,
+    HeartbeatFrag, InfoDst, InfoSrc, InfoTs, NackFrag, RtpsHeader, RtpsMessage, Submessage,
+    Unknown, entity_name, parse_message,
 )
 from rosfpga_lab.rtps.discovery import (
     Endpoint, FragmentAssembler, Participant, discovery, parse_parameters,
 )
 
 __all__ = [
-    "AckNack", "Data", "DataFrag", "ENTITY_NAMES", "Endpoint", "FragmentAssembler", "Gap",
-    "Heartbeat", "HeartbeatFrag", "InfoDst", "InfoTs", "NackFrag", "Participant", "RtpsError",
+    "ANY_PARTICIPANT", "AckNack", "Data", "DataFrag", "ENTITY_NAMES", "Endpoint",
+    "FragmentAssembler", "Gap", "Heartbeat", "HeartbeatFrag", "InfoDst", "InfoSrc", "InfoTs",
+    "NackFrag", "Participant", "RtpsError",
     "RtpsHeader", "RtpsMessage", "RtpsTruncatedError", "SUBMESSAGE_NAMES", "Submessage",
     "Unknown", "discovery", "entity_name", "parse_message", "parse_parameters",
 ]

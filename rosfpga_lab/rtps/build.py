@@ -23,7 +23,7 @@ VENDOR_ID = 0x0000
 VENDOR_EPROSIMA = 0x010F
 
 # submessage ids
-PAD, ACKNACK, HEARTBEAT, GAP, INFO_TS, INFO_DST = 0x01, 0x06, 0x07, 0x08, 0x09, 0x0E
+PAD, ACKNACK, HEARTBEAT, GAP, INFO_TS, INFO_SRC, INFO_DST = 0x01, 0x06, 0x07, 0x08, 0x09, 0x0C, 0x0E
 NACK_FRAG, HEARTBEAT_FRAG, DATA, DATA_FRAG = 0x12, 0x13, 0x15, 0x16
 FLAG_LE = 0x01
 
@@ -135,6 +135,12 @@ def unpad_payload(payload: bytes) -> bytes:
 
 def info_dst(guid_prefix: bytes) -> bytes:
     return _sub(INFO_DST, 0, guid_prefix)
+
+
+def info_src(guid_prefix: bytes) -> bytes:
+    """INFO_SRC: the submessages after it come from participant ``guid_prefix``."""
+    return _sub(INFO_SRC, 0, bytes(4) + bytes(PROTOCOL_VERSION) + VENDOR_ID.to_bytes(2, "big")
+                + guid_prefix)
 
 
 def info_ts(seconds: float) -> bytes:

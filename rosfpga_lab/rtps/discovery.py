@@ -16,21 +16,15 @@ from dataclasses import dataclass
 
 from rosfpga_lab.msg.typehash import RIHS_PATTERN
 from rosfpga_lab.rtps.build import (
-    PID_USER_DATA, TYPEHASH_KEY, USER_DATA_KEY_END, USER_DATA_PAIR_END,
+    PID_ENDPOINT_GUID, PID_ENTITY_NAME, PID_PARTICIPANT_GUID, PID_SENTINEL, PID_TOPIC_NAME,
+    PID_TYPE_NAME, PID_USER_DATA, TYPEHASH_KEY, USER_DATA_KEY_END, USER_DATA_PAIR_END,
 )
+from rosfpga_lab.rtps.entities import PUB_WRITER, SPDP_WRITER, SUB_WRITER
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
 from rosfpga_lab.rtps.limits import MAX_PENDING_BYTES, MAX_PENDING_SAMPLES, MAX_SAMPLE_BYTES
 from rosfpga_lab.rtps.message import Data, DataFrag, RtpsMessage
 
-PID_SENTINEL = 0x0001
-PID_TOPIC_NAME = 0x0005
-PID_TYPE_NAME = 0x0007
-PID_PARTICIPANT_GUID = 0x0050
-PID_ENDPOINT_GUID = 0x005A
-PID_ENTITY_NAME = 0x0062
-SPDP_WRITER = 0x000100C2
-SEDP_PUBLICATIONS_WRITER = 0x000003C2
-SEDP_SUBSCRIPTIONS_WRITER = 0x000004C2
+SEDP_PUBLICATIONS_WRITER, SEDP_SUBSCRIPTIONS_WRITER = PUB_WRITER, SUB_WRITER
 PL_CDR_BE, PL_CDR_LE = b"\x00\x02", b"\x00\x03"
 
 
@@ -113,7 +107,7 @@ def discovery(messages: Iterable[RtpsMessage]) -> tuple[list[Participant], list[
     participants: dict[bytes, Participant] = {}
     endpoints: dict[bytes, Endpoint] = {}
     for msg in messages:
-        for sub in msg.submessages:
+        for source, _destination, sub in msg.routed():
             if not isinstance(sub, Data) or not sub.payload or sub.key:
                 continue
             if sub.writer_id not in (SPDP_WRITER, SEDP_PUBLICATIONS_WRITER, SEDP_SUBSCRIPTIONS_WRITER):
@@ -124,7 +118,7 @@ def discovery(messages: Iterable[RtpsMessage]) -> tuple[list[Participant], list[
                 continue
             little = sub.payload[:2] == PL_CDR_LE
             if sub.writer_id == SPDP_WRITER:
-                guid = (params.get(PID_PARTICIPANT_GUID) or [msg.header.guid_prefix])[0][:12]
+                guid = (params.get(PID_PARTICIPANT_GUID) or [source])[0][:12]
                 name = params.get(PID_ENTITY_NAME)
                 participants[guid] = Participant(guid, _string(name[0], little) if name else "")
             elif PID_TOPIC_NAME in params and PID_ENDPOINT_GUID in params:

@@ -11,6 +11,7 @@ numbers are 64-bit (a signed high and an unsigned low 32-bit half); entity ids a
 from __future__ import annotations
 
 import struct
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
@@ -87,6 +88,17 @@ class InfoTs(Submessage):
 class InfoDst(Submessage):
     """INFO_DST: the GUID prefix of the participant the following submessages are for."""
 
+    guid_prefix: bytes = b""
+
+
+@dataclass(frozen=True)
+class InfoSrc(Submessage):
+    """INFO_SRC: the participant (GUID prefix), protocol version and vendor the following
+    submessages come from. A DDS that runs several participants in one process (Cyclone DDS
+    does) packs their submessages into one datagram this way."""
+
+    version: tuple[int, int] = (0, 0)
+    vendor_id: int = 0
     guid_prefix: bytes = b""
 
 
@@ -182,12 +194,32 @@ class Unknown(Submessage):
     body: bytes = b""
 
 
+#: The destination of submessages before any INFO_DST: every participant that receives them.
+ANY_PARTICIPANT = bytes(12)
+
+
 @dataclass(frozen=True)
 class RtpsMessage:
     """One RTPS message: header and submessages in order."""
 
     header: RtpsHeader
     submessages: list[Submessage] = field(default_factory=list)
+
+    def routed(self) -> Iterator[tuple[bytes, bytes, Submessage]]:
+        """Each submessage with the participant it comes from and the one it is for.
+
+        This is the receiver state of RTPS 2.3 8.3.4: the source starts as the header's GUID
+        prefix and the destination as ``ANY_PARTICIPANT``; INFO_SRC sets the source and
+        INFO_DST the destination of the submessages after them (both are yielded too, with
+        the state they set).
+        """
+        source, destination = self.header.guid_prefix, ANY_PARTICIPANT
+        for sub in self.submessages:
+            if isinstance(sub, InfoSrc):
+                source = sub.guid_prefix
+            elif isinstance(sub, InfoDst):
+                destination = sub.guid_prefix
+            yield source, destination, sub
 
 
 class _Body:
@@ -259,6 +291,12 @@ def _submessage(data: bytes, kind: int, flags: int, offset: int, end: int) -> Su
             return InfoTs(**common, timestamp=None)
         sec, frac = b.unpack("iI", "timestamp")
         return InfoTs(**common, timestamp=sec + frac / 2**32)
+    if kind == 0x0C:
+        b.take(4, "unused")
+        major, minor = b.take(2, "protocolVersion")
+        vendor = int.from_bytes(b.take(2, "vendorId"), "big")    # octets, as in the header
+        return InfoSrc(**common, version=(major, minor), vendor_id=vendor,
+                       guid_prefix=b.take(12, "guidPrefix"))
     if kind == 0x0E:
         return InfoDst(**common, guid_prefix=b.take(12, "guidPrefix"))
     if kind == 0x15:  # DATA: Q=0x02 D=0x04 K=0x08

@@ -47,7 +47,8 @@ from rosfpga_lab.rtps.limits import (
     MAX_REMOTE_PARTICIPANTS, MIN_RESEND_SECONDS,
 )
 from rosfpga_lab.rtps.message import (
-    AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, InfoDst, NackFrag, parse_message,
+    ANY_PARTICIPANT, AckNack, Data, DataFrag, Gap, Heartbeat, HeartbeatFrag, InfoDst, InfoSrc,
+    NackFrag, parse_message,
 )
 
 __all__ = [
@@ -670,16 +671,12 @@ class Participant:
             self.note(f"malformed-{type(exc).__name__}", f"malformed datagram from "
                       f"{source[0]}:{source[1]} ignored ({exc}); further ones are counted")
             return []
-        prefix = msg.header.guid_prefix
-        if prefix == self.guid_prefix:
+        if msg.header.guid_prefix == self.guid_prefix:
             return []
         out: list[Send] = []
-        for_us = True
-        for sub in msg.submessages:
-            if isinstance(sub, InfoDst):
-                for_us = sub.guid_prefix in (self.guid_prefix, bytes(12))
-                continue
-            if not for_us:
+        for prefix, destination, sub in msg.routed():
+            if isinstance(sub, (InfoDst, InfoSrc)) or prefix == self.guid_prefix or \
+                    destination not in (self.guid_prefix, ANY_PARTICIPANT):
                 continue
             if prefix not in self.participants and not (
                     isinstance(sub, Data) and sub.writer_id == SPDP_WRITER):

@@ -15,8 +15,12 @@ from pathlib import Path
 from typing import Any
 
 from rosfpga_lab.msg import cdr_layout
-from rosfpga_lab.rtps import Data, DataFrag, InfoDst, RtpsError, parse_message, parse_parameters
-from rosfpga_lab.rtps.discovery import PID_TOPIC_NAME, SEDP_PUBLICATIONS_WRITER, SEDP_SUBSCRIPTIONS_WRITER
+from rosfpga_lab.rtps import (
+    ANY_PARTICIPANT, Data, DataFrag, InfoDst, InfoSrc, RtpsError, parse_message, parse_parameters,
+)
+from rosfpga_lab.rtps.discovery import (
+    PID_TOPIC_NAME, SEDP_PUBLICATIONS_WRITER, SEDP_SUBSCRIPTIONS_WRITER, SPDP_WRITER,
+)
 from rosfpga_lab.widgets._common import WidgetError
 from rosfpga_lab.widgets.byteview import ByteViewer, Span
 from rosfpga_lab.widgets.sequence import SeqEvent, events_from_capture
@@ -111,16 +115,16 @@ def events_from_rtps(datagrams: Any, *, max_events: int = 60,
             msg = parse_message(payload)
         except RtpsError:
             continue
-        src = _who(msg.header.guid_prefix, names)
-        dst = "peers"
-        labels: list[str] = []
+        # one arrow per sender and destination: INFO_SRC lets one datagram carry the
+        # submessages of several participants of one process (Cyclone DDS does this)
+        groups: dict[tuple[bytes, bytes], list[str]] = {}
         fold = False
-        for s in msg.submessages:
-            if isinstance(s, InfoDst):
-                dst = _who(s.guid_prefix, names) if any(s.guid_prefix) else "peers"
+        for source, destination, s in msg.routed():
+            if isinstance(s, (InfoDst, InfoSrc)) or s.name == "INFO_TS":
                 continue
+            labels = groups.setdefault((source, destination), [])
             if isinstance(s, DataFrag):
-                key = (msg.header.guid_prefix, s.writer_id, s.seq)
+                key = (source, s.writer_id, s.seq)
                 fold = fold or key in seen_frag
                 seen_frag.add(key)
                 labels.append(f"DATA_FRAG seq {s.seq} frags {s.frag_start}..{s.frag_start + s.frag_count - 1}")
@@ -131,16 +135,22 @@ def events_from_rtps(datagrams: Any, *, max_events: int = 60,
                                   f"{topic.decode(errors='replace')}")
                 except RtpsError:
                     labels.append("SEDP")
-            elif isinstance(s, Data) and s.writer_id == 0x000100C2:
+            elif isinstance(s, Data) and s.writer_id == SPDP_WRITER:
                 labels.append("SPDP participant")
-            elif s.name != "INFO_TS":
+            else:
                 labels.append(s.name)
-        if fold or len(out) >= max_events:
+        if fold:
             skipped += 1
             continue
-        label = ", ".join(dict.fromkeys(labels)) or "INFO_TS"
-        out.append(SeqEvent(src, dst, label[:70], bytes(payload), t, "rtps", detail=label[:300],
-                            spans=rtps_spans(payload)))
+        for (source, destination), labels in (groups or {(msg.header.guid_prefix, ANY_PARTICIPANT): []}).items():
+            if len(out) >= max_events:
+                skipped += 1
+                continue
+            src = _who(source, names)
+            dst = _who(destination, names) if destination != ANY_PARTICIPANT else "peers"
+            label = ", ".join(dict.fromkeys(labels)) or "INFO_TS"
+            out.append(SeqEvent(src, dst, label[:70], bytes(payload), t, "rtps", detail=label[:300],
+                                spans=rtps_spans(payload)))
     if skipped and out:
         out.append(SeqEvent(out[-1].src, out[-1].dst, f"\u2026 {skipped} more RTPS messages", b"",
                             (out[-1].t or 0.0) + 1e-9, "rtps"))
