@@ -127,9 +127,10 @@ def test_a_late_reader_and_a_peer_that_leaves_and_comes_back() -> None:
         assert comp.wait_for(2, 10)
         got_early: list = []
         got_late: list = []
-        # Cyclone's participants of one process share the proxy of the component's writer: a
-        # reader created before the early one has taken a sample may still get it (a race of
-        # Cyclone's receive thread, not of the component). The late reader comes after.
+        # Cyclone's participants of one process share their proxy of the component's writer: a
+        # reader made there matches at once and is handed what that proxy has not delivered
+        # yet (a race of Cyclone's receive thread, not the component's). The late reader comes
+        # only after the early one has its samples.
         assert wait(lambda: got_early.extend(early.take(10)) or len(got_early) >= 2)
         dp2 = dds.DomainParticipant(DOMAIN)
         late = dds.DataReader(dp2, dds.Topic(dp2, "rt/cam_out", dds.Image_), qos=qos(dds))
