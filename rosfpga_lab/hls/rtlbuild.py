@@ -21,7 +21,8 @@ from pathlib import Path
 
 from rosfpga_lab.hls.errors import HlsError
 
-#: The harness's top module and its two sources, in Verilator's command-line order.
+#: The harness's top module and its two sources, in Verilator's command-line order (written
+#: beside the testbench; never part of a synthesis).
 HARNESS_TOP = "rfl_harness"
 HARNESS_FILES = ("rfl_harness.v", "rfl_harness.cpp")
 #: The program Verilator links, and the directory it builds it in inside a project's ``rtl/``.

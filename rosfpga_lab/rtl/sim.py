@@ -13,11 +13,12 @@ runs per clock.
 With Verilator and a C++ compiler (and no waveform wanted), :func:`build` compiles the fast
 harness instead (``harness/rfl_harness.cpp`` around ``harness/rfl_harness.v``): a loop without
 ``--timing`` that keeps the frames in memory, evaluates the model once per clock (its nonblocking
-region alone where :func:`nba_only` allows, see :data:`EVAL_MODES`; the recipe is
-:mod:`rosfpga_lab.hls.rtlbuild`'s, which a generated project's Makefile renders too) and does clock for clock what
+region alone where :func:`nba_only` allows, see :data:`EVAL_MODES`) and does clock for clock what
 the testbench does (same reset, same random draws, same outputs and files), at about 22 M clocks/s
 where the testbench on ``verilator --binary --timing`` does about 3 M. Its serve mode is the
-long-lived simulator of ``--model rtl`` (:mod:`rosfpga_lab.rtl.server`).
+long-lived simulator of ``--model rtl`` (:mod:`rosfpga_lab.rtl.server`). How it is built (the
+Verilator options, the eval modes and their fallback, the huge-page link flags) is
+:mod:`rosfpga_lab.hls.rtlbuild`'s, which a generated project's Makefile renders too.
 """
 
 from __future__ import annotations
