@@ -29,6 +29,7 @@ import numpy as np
 from rosfpga_lab import __version__
 from rosfpga_lab.config import CUSTOM, PASSTHROUGH, NodeConfig
 from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, SOURCES
+from rosfpga_lab.hls import rtlbuild
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hw import GENERATOR_TABLE, INTERPRETER_TABLE, PIXEL_FORMATS, Pipeline, image_frame
 from rosfpga_lab.hw import limits as hw_limits
@@ -112,7 +113,8 @@ TB_EXPECTED = "tb_expected.bin"
 #: removes these too.
 BUILD_PRODUCTS = ("csim_testbench", "csim_out", "hls_subscriber", "hls_image_filter",
                   "hls_publisher", "vivado_hls.log", "vitis_hls.log", "rtlsim_out",
-                  "rtl/rfl_sim.vvp", "rtl/obj_dir", "rtl/obj_fast")
+                  "rtl/rfl_sim.vvp", "rtl/obj_dir", f"rtl/{rtlbuild.PROJECT_OBJ_DIR}",
+                  f"rtl/{rtlbuild.PROJECT_BUILD_LOG}")
 #: Bytes per line of the hexadecimal arrays in connection_headers.cpp.
 HEX_BYTES_PER_LINE = 16
 _OP_CPP = {"dilate": "Dilate", "erode": "Erode"}
@@ -270,6 +272,7 @@ def render(config: NodeConfig) -> dict[str, str]:
         "max_frame_bytes": hw_limits.MAX_FRAME_BYTES, "min_body_bytes": MIN_BODY_BYTES,
         "checked": checked, "interp_table": interp, "gen_table": GENERATOR_TABLE,
         "after_frame_id": fixed_after("frame_id"), "after_encoding": fixed_after("encoding"),
+        "harness": rtlbuild.makefile_context(),
         "tb_input": TB_INPUT, "cxxflags": CXXFLAGS, "rtl": config.application.op != "custom", "csim_sources": SOURCES,
         "design_sources": [src for src in SOURCES if src != f"{BINARY}.cpp"],
         "tb_expected": TB_EXPECTED if config.application.op != CUSTOM else "",

@@ -16,13 +16,16 @@ harness instead (``harness/rfl_harness.cpp`` around ``harness/rfl_harness.v``): 
 region alone where :func:`nba_only` allows, see :data:`EVAL_MODES`) and does clock for clock what
 the testbench does (same reset, same random draws, same outputs and files), at about 22 M clocks/s
 where the testbench on ``verilator --binary --timing`` does about 3 M. Its serve mode is the
-long-lived simulator of ``--model rtl`` (:mod:`rosfpga_lab.rtl.server`).
+long-lived simulator of ``--model rtl`` (:mod:`rosfpga_lab.rtl.server`). How it is built (the
+Verilator options, the eval modes and their fallback, the huge-page link flags) is
+:mod:`rosfpga_lab.hls.rtlbuild`'s, which a generated project's Makefile renders too.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -35,6 +38,10 @@ from pathlib import Path
 
 from rosfpga_lab.config.vocabulary import SIMULATORS
 from rosfpga_lab.hls.csim import read_beats
+from rosfpga_lab.hls.rtlbuild import (  # the harness's build recipe, shared with the Makefile
+    EVAL_MODES, HARNESS_BINARY, HARNESS_CXX_DIAGNOSTIC, HARNESS_FILES, HARNESS_TOP,
+    HUGE_TEXT_LDFLAGS, eval_define, harness_options, huge_text_here, nba_only,
+)
 from rosfpga_lab.hw import Beats
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
@@ -45,9 +52,6 @@ VERILOG_DIR = Path(__file__).resolve().parent / "verilog"
 TB_DIR = Path(__file__).resolve().parent / "tb"
 HARNESS_DIR = Path(__file__).resolve().parent / "harness"
 TB_TOP = "rfl_tb"
-HARNESS_TOP = "rfl_harness"
-#: The fast harness's sources (written beside the testbench; never part of a synthesis).
-HARNESS_FILES = ("rfl_harness.v", "rfl_harness.cpp")
 NODE_FILE = "rfl_node.v"
 #: The streams the testbench times, in its ``hs`` vector's bit order (bit 0 first).
 STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx",
@@ -179,41 +183,25 @@ def cache_root() -> Path:
 def _run_command(sim: str, where: Path, harness: bool = False) -> tuple[str, ...]:
     if sim == "iverilog":
         return (find_tool("vvp") or "vvp", "-n", str(where / "rfl_sim"))
-    return (str(where / "obj_dir" / ("rfl_fast" if harness else "rfl_sim")),)
-
-
-#: How the harness evaluates the model per clock (``rfl_harness.cpp``), fastest first: the
-#: model's nonblocking region alone, its inner eval, Verilator's public eval() of both edges.
-EVAL_MODES = ("nba", "root", "plain")
-#: Functions of a Verilated model whose logic runs outside the nonblocking region: with any of
-#: them, the "nba" mode would skip it.
-_OUTSIDE_NBA = ("___eval_ico(", "___eval_act(")
-
-
-#: Linux: link the harness with its segments on 2 MiB boundaries, so that it can move its
-#: machine code onto a transparent huge page as it starts (``rfl_harness.cpp``).
-HUGE_TEXT_LDFLAGS = "-Wl,-z,max-page-size=0x200000 -Wl,-z,common-page-size=0x200000"
+    return (str(where / "obj_dir" / (HARNESS_BINARY if harness else "rfl_sim")),)
 
 
 def harness_command(where: str | Path = ".", obj_dir: str = "obj_dir",
-                    eval_mode: str = EVAL_MODES[0]) -> list[str]:
-    """The Verilator command that builds the fast harness from the sources in ``where``."""
+                    eval_mode: str = EVAL_MODES[0], *, waivers: bool = True) -> list[str]:
+    """The Verilator command that builds the fast harness from the sources in ``where``.
+
+    The options are :func:`rosfpga_lab.hls.rtlbuild.harness_options` (a generated project's
+    Makefile renders the same; ``waivers=False`` gives its command), linked with the huge-page
+    flags on Linux.
+    """
     if eval_mode not in EVAL_MODES:
         raise RtlError(f"eval_mode must be one of {', '.join(EVAL_MODES)}, got {eval_mode!r}")
     rtl = sorted(p.name for p in Path(where).glob("*.v")
                  if p.name not in (*HARNESS_FILES, f"{TB_TOP}.v"))
-    link = ["-LDFLAGS", HUGE_TEXT_LDFLAGS] if sys.platform.startswith("linux") else []
-    return [_verilator() or "verilator", "--cc", "--exe", "--build", "-O3", "--x-assign", "fast",
-            "--x-initial", "fast", "--noassert", "-Wno-fatal", "-Wno-lint", "-Wno-style", "-I.",
-            "--top-module", HARNESS_TOP, "-Mdir", obj_dir, "-o", "rfl_fast", "-j", "2",
-            "-CFLAGS", f"-O3 -DRFL_EVAL_{eval_mode.upper()}", *link,
-            "-MAKEFLAGS", "OPT_FAST=-O3 OPT_GLOBAL=-O2", *HARNESS_FILES, *rtl]
-
-
-def nba_only(obj_dir: Path) -> bool:
-    """The Verilated model in ``obj_dir`` does all its work in the nonblocking region."""
-    text = "".join(p.read_text(errors="replace") for p in obj_dir.glob("*___024root*.cpp"))
-    return "___eval_nba(" in text and not any(name in text for name in _OUTSIDE_NBA)
+    return [_verilator() or "verilator",
+            *harness_options(eval_define(eval_mode), obj_dir, waivers=waivers,
+                             huge_text=huge_text_here()),
+            *HARNESS_FILES, *rtl]
 
 
 def _compile_harness(where: Path) -> str:
@@ -223,7 +211,7 @@ def _compile_harness(where: Path) -> str:
         try:
             _run_build(harness_command(where, eval_mode=mode), where)
         except RtlError as error:   # the harness's C++ may not compile against this model
-            if mode == EVAL_MODES[-1] or HARNESS_FILES[1] not in str(error):
+            if mode == EVAL_MODES[-1] or not re.search(HARNESS_CXX_DIAGNOSTIC, str(error)):
                 raise
             continue
         if mode != EVAL_MODES[0] or nba_only(where / "obj_dir"):

@@ -39,9 +39,10 @@ static const int NS = 9;
 // the trigger loops, a garbage sweep and a message-queue flush (four mutex operations): a
 // third of the time here. So by default (RFL_EVAL_NBA) the harness marks the clock's edge
 // and runs the model's nonblocking region, all there is to a clock of this single-clock
-// design (sim.py builds it so only when the generated model has no input or active region);
+// design (sim.py and a generated project's Makefile build it so only when the generated model
+// has no input or active region; the recipe: rosfpga_lab/hls/rtlbuild.py);
 // RFL_EVAL_ROOT calls the model's inner eval and tells the edge detector the clock went low;
-// RFL_EVAL_PLAIN evaluates both edges with eval(). sim.py falls back in that order when a
+// RFL_EVAL_PLAIN evaluates both edges with eval(). Both fall back in that order when a
 // Verilator's model lacks what a mode calls.
 #if defined(RFL_EVAL_PLAIN)
 #define RFL_EVAL(t) (t)->eval()
@@ -59,9 +60,9 @@ void Vrfl_harness___024root___eval_nba(Vrfl_harness___024root* vlSelf);
 // The program's machine code on one 2 MiB page. On a virtual machine, the same binary ran at
 // 55 ms or at 110 ms a frame depending on the physical pages its code was read into (dropping
 // the page cache turned a slow copy into a fast one). Linked with 2 MiB segment alignment
-// (sim.py's HUGE_TEXT_LDFLAGS), the code segment starts on a 2 MiB boundary: it is copied
-// into an anonymous transparent huge page, which then replaces the file's pages at the same
-// addresses. Without that alignment, without transparent huge pages, or when a step fails,
+// (HUGE_TEXT_LDFLAGS of rosfpga_lab/hls/rtlbuild.py), the code segment starts on a 2 MiB
+// boundary: it is copied into an anonymous transparent huge page, which then replaces the
+// file's pages at the same addresses. Without that alignment, without transparent huge pages, or when a step fails,
 // the code stays where the loader put it. RFL_NO_HUGE_TEXT=1 in the environment skips it.
 #ifdef __linux__
 static const uintptr_t HUGE_PAGE = (uintptr_t)2 << 20;
