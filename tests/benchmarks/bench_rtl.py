@@ -8,9 +8,9 @@
   the Verilog testbench (``verilator --binary --timing``) and the fast C++ harness side by side,
   on the same frame, with their outputs compared. Target of the harness: >= 20 M clocks/s,
   judged by the median of --builds K builds (each a new file: on this virtual machine an
-  identical binary ran at 55 to 133 ms a frame from its file's pages, depending on where they
-  landed in memory, which is why the harness moves its code onto a huge page as it starts;
-  RFL_NO_HUGE_TEXT=1 in the environment turns that off, to compare).
+  identical binary runs a frame in 54 ms or up to 2.7 times that, depending on where its pages
+  landed in memory, from its file's pages and from the huge page the harness moves its code to
+  alike; RFL_NO_HUGE_TEXT=1 in the environment keeps the file's pages, to compare).
 
 * the live node with ``--model rtl`` per shipped configuration: frames/s through the component
   (embedded master, a lab publisher and subscriber, frames in lock step), each output checked
