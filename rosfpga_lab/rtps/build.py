@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from rosfpga_lab.msg.parser import SEP
 from rosfpga_lab.msg.typehash import MSG_NAMESPACE
-from rosfpga_lab.rtps.message import MAGIC
+from rosfpga_lab.rtps.message import HEARTBEAT_FINAL, HEARTBEAT_LIVELINESS, MAGIC
 
 PROTOCOL_VERSION = (2, 3)
 #: The lab announces "unknown vendor" (0x0000): it has no OMG-assigned vendor id.
@@ -164,8 +164,9 @@ def data_frag(reader_id: int, writer_id: int, seq: int, frag_start: int, frag_si
 
 
 def heartbeat(reader_id: int, writer_id: int, first: int, last: int, count: int,
-              final: bool = False) -> bytes:
-    return _sub(HEARTBEAT, 0x02 if final else 0,
+              final: bool = False, liveliness: bool = False) -> bytes:
+    flags = (HEARTBEAT_FINAL if final else 0) | (HEARTBEAT_LIVELINESS if liveliness else 0)
+    return _sub(HEARTBEAT, flags,
                 _eid(reader_id) + _eid(writer_id) + _seq(first) + _seq(last) + struct.pack("<i", count))
 
 
