@@ -246,3 +246,10 @@ def test_keep_valid_keeps_the_submessages_before_a_malformed_one() -> None:
     assert parse_message(HEADER + SPDP_DATA, keep_valid=True).error is None
     with pytest.raises(RtpsError, match="not an RTPS message"):
         parse_message(b"RTPX" + data[4:], keep_valid=True)       # a bad header raises either way
+
+
+def test_the_sedp_dispose_capture_agrees_with_tshark() -> None:
+    capture = CAPTURE.parent / "cyclone_sedp_dispose.pcapng"
+    assert assert_rtps_agrees_with_tshark(capture) == len(udp_datagrams(capture))
+    [*_, [status]] = tshark_fields(capture, ["rtps.param.status_info"], display_filter="rtps")
+    assert int(status, 0) == 3          # the last datagram: disposed and unregistered

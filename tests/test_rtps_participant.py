@@ -19,7 +19,7 @@ from rosfpga_lab.rtps import parse_message
 from rosfpga_lab.rtps.limits import (
     MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS,
 )
-from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, NackFrag
+from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, InfoDst, NackFrag
 from rosfpga_lab.rtps.participant import (
     PUB_READER, PUB_WRITER, SPDP_READER, SPDP_WRITER, Participant, Qos, discovery_port, incompatibility,
     user_port,
@@ -655,3 +655,27 @@ def test_a_gap_ahead_of_delivery_is_remembered() -> None:
     assert len(wp.gaps) <= MAX_OUT_OF_ORDER and c.counts[f"gaps-full-{r}"] > 0
     (ack,) = acknacks(send(b.heartbeat(r, w, 1, 12, 1001)), w)
     assert (ack.base, ack.missing) == (6, (6, 7, 8, 9, 11))
+
+
+#: Made by data/capture_cyclone_sedp_dispose.py: what a lab participant received from Cyclone DDS
+#: while a Cyclone writer of rt/chatter appeared, was matched with the lab's reader and was
+#: deleted (its last datagram: the SEDP DATA with K flag and PID_STATUS_INFO "disposed and
+#: unregistered"), all addressed (INFO_DST) to the lab participant that recorded it.
+SEDP_DISPOSE = [d[3] for d in udp_datagrams(CAPTURE.parent / "cyclone_sedp_dispose.pcapng")]
+
+
+def test_a_cyclone_writer_deleted_is_unmatched_at_once() -> None:
+    (lab,) = {s.guid_prefix for s in parse_message(SEDP_DISPOSE[0]).submessages
+              if isinstance(s, InfoDst)}
+    p = Participant(domain=79, index=0, guid_prefix=lab)
+    r = p.add_reader("rt/chatter", "std_msgs::msg::dds_::String_")
+    for d in SEDP_DISPOSE[:-1]:
+        p.receive(d, ("127.0.0.1", 7410), 0.0)
+    (writer,) = p.matched(r)
+    assert p.remote[writer].kind == "writer"
+    (dispose,) = [s for s in parse_message(SEDP_DISPOSE[-1]).submessages if isinstance(s, Data)]
+    assert dispose.key and dispose.writer_id == PUB_WRITER and dispose.inline_qos
+    p.receive(SEDP_DISPOSE[-1], ("127.0.0.1", 7410), 1.0)
+    # the endpoint goes, not only when its participant's lease runs out
+    assert p.matched(r) == [] and writer not in p.remote and len(p.participants) == 1
+    assert any(writer.hex() in n and "left" in n for n in p.notes)
