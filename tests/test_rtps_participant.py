@@ -679,3 +679,19 @@ def test_a_cyclone_writer_deleted_is_unmatched_at_once() -> None:
     # the endpoint goes, not only when its participant's lease runs out
     assert p.matched(r) == [] and writer not in p.remote and len(p.participants) == 1
     assert any(writer.hex() in n and "left" in n for n in p.notes)
+
+
+def test_the_lease_a_peer_announced_is_the_one_that_runs_out() -> None:
+    p = fresh()                                    # its own lease: 10 s
+    for prefix, lease in ((b"S" * 12, 2.0), (b"L" * 12, 30.0)):
+        payload = b.spdp_payload(prefix, b.Locator("127.0.0.1", 7999), b.Locator("127.0.0.1", 8000),
+                                 lease, "peer", b"", 0)
+        p.receive(b.header(prefix) + b.data(SPDP_READER, SPDP_WRITER, 1, payload),
+                  ("127.0.0.1", 7999), 0.0)
+    assert {k: v.lease for k, v in p.participants.items()} == {b"S" * 12: 2.0, b"L" * 12: 30.0}
+    p.tick(2.5)
+    assert set(p.participants) == {b"L" * 12}
+    p.tick(20.0)
+    assert set(p.participants) == {b"L" * 12}
+    p.tick(30.5)
+    assert p.participants == {}
