@@ -21,6 +21,11 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
   or DATA_FRAG; reliable ones HEARTBEAT until acknowledged, resend on ACKNACK/NACK_FRAG and GAP
   what left the history. A reader puts fragments together (memory follows bytes received),
   delivers in order when reliable, asks again with ACKNACK/NACK_FRAG.
+* The receiver's rules (RTPS 2.3 8.3.4, 8.3.6.3, 8.4.12.2, as Cyclone DDS's receiver follows
+  them): INFO_SRC/INFO_DST set source and destination; a message of another major version is
+  ignored; a malformed submessage drops itself and the rest of its datagram, not what came
+  before; a final HEARTBEAT is answered only when samples are missing, a final liveliness one
+  never; a GAP ahead of delivery is remembered until delivery gets there.
 """
 
 from __future__ import annotations
