@@ -695,3 +695,22 @@ def test_the_lease_a_peer_announced_is_the_one_that_runs_out() -> None:
     assert set(p.participants) == {b"L" * 12}
     p.tick(30.5)
     assert p.participants == {}
+
+
+def test_a_peer_whose_endpoints_speak_is_alive_between_its_announcements() -> None:
+    a, c, w, r = pair(Qos(False), Qos(False))      # best effort: DATA only, no HEARTBEAT
+    a.lease = 2.0                                   # what a announces
+    net = Net(a, c)
+    net.run([], steps=20)
+    assert c.participants[a.guid_prefix].lease == 2.0 and c.matched(r)
+    a.announce_period = 1000.0                      # its SPDP stops (lost, or late) ...
+    net.parts = (c,)
+    for k in range(8):                              # ... while its writer goes on for 4 s
+        for d in a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * 4, net.now) + a.tick(net.now):
+            c.receive(d[2], a.user, net.now)
+        net.run([], steps=50)                       # 0.5 s
+    # before: forgotten 2 s after its last SPDP, its samples still arriving (only SPDP and
+    # HEARTBEAT renewed a lease)
+    assert a.guid_prefix in c.participants and len(c.take(r)) == 8
+    net.run([], steps=250)                          # silent for 2.5 s: its lease runs out
+    assert a.guid_prefix not in c.participants

@@ -25,7 +25,8 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
   them): INFO_SRC/INFO_DST set source and destination; a message of another major version is
   ignored; a malformed submessage drops itself and the rest of its datagram, not what came
   before; a final HEARTBEAT is answered only when samples are missing, a final liveliness one
-  never; a GAP ahead of delivery is remembered until delivery gets there.
+  never; a GAP ahead of delivery is remembered until delivery gets there; whatever a known
+  peer's endpoints send renews its lease, as SPDP does.
 """
 
 from __future__ import annotations
@@ -771,6 +772,12 @@ class Participant:
             self.note(f"invalid-{type(sub).__name__}", f"invalid submessage from {prefix.hex()} "
                       f"ignored: {why} (RTPS 2.3 8.3.7)")
             return []
+        known = self.participants.get(prefix)
+        if known is not None and not (isinstance(sub, Data) and sub.writer_id == SPDP_WRITER):
+            # its endpoints speak: it is alive (Cyclone DDS renews a peer's lease on its
+            # DATA, HEARTBEAT, GAP, ACKNACK and NACK_FRAG too), so a lost or late SPDP
+            # announcement does not drop a peer that is sending
+            known.last_seen = max(known.last_seen, now)
         if isinstance(sub, Data):
             if sub.writer_id == SPDP_WRITER:
                 return self._on_spdp(prefix, sub, source, now)
@@ -786,8 +793,6 @@ class Participant:
                 self._on_sample(prefix, sub.reader_id, sub.writer_id, sub.seq, sample,
                                 sub.inline_qos, sub.little_endian)
         elif isinstance(sub, Heartbeat):
-            if prefix in self.participants:
-                self.participants[prefix].last_seen = now
             return self._on_heartbeat(prefix, sub)
         elif isinstance(sub, HeartbeatFrag):
             return self._on_heartbeat_frag(prefix, sub)
