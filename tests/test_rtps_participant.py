@@ -714,3 +714,16 @@ def test_a_peer_whose_endpoints_speak_is_alive_between_its_announcements() -> No
     assert a.guid_prefix in c.participants and len(c.take(r)) == 8
     net.run([], steps=250)                          # silent for 2.5 s: its lease runs out
     assert a.guid_prefix not in c.participants
+
+
+def test_an_acknack_from_reader_unknown_is_ignored() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    net.run(a.write(w, b"\x00\x01\x00\x00one!", net.now), steps=3)
+    for reader_id in (0, r):                          # ENTITYID_UNKNOWN, then the real reader
+        ask = b.header(c.guid_prefix) + b.acknack(reader_id, w, 1, [1], 500 + reader_id)
+        out = a.receive(ask, c.user, net.now + 1.0)
+        sent = [s for _, _, d in out for s in parse_message(d).submessages if isinstance(s, Data)]
+        assert [s.seq for s in sent] == ([] if reader_id == 0 else [1])
+    assert a.counts[f"acknack-unknown-{c.guid_prefix.hex()}"] == 1
