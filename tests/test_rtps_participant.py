@@ -727,3 +727,18 @@ def test_an_acknack_from_reader_unknown_is_ignored() -> None:
         sent = [s for _, _, d in out for s in parse_message(d).submessages if isinstance(s, Data)]
         assert [s.seq for s in sent] == ([] if reader_id == 0 else [1])
     assert a.counts[f"acknack-unknown-{c.guid_prefix.hex()}"] == 1
+
+
+def test_a_gap_whose_list_starts_before_its_range_still_counts_its_list() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    one, four = b"\x00\x01\x00\x00" + b"1" * 4, b"\x00\x01\x00\x00" + b"4" * 4
+    c.receive(b.header(a.guid_prefix) + b.data(r, w, 1, one), a.user, net.now)
+    # gapList.base (2) below gapStart (9): an empty range, and 2 and 3 listed (valid: RTPS 2.3
+    # 8.3.7.4.3 lists only gapStart < 1 and an invalid gapList; Cyclone DDS reads it so)
+    c.receive(b.header(a.guid_prefix) + b.gap(r, w, 9, 2, [2, 3]) + b.data(r, w, 4, four),
+              a.user, net.now)
+    # before: refused as invalid, so 4 waited for 2 and 3
+    assert [s.payload for s in c.take(r)] == [one, four]
+    assert not any("invalid" in n for n in c.notes)

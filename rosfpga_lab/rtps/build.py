@@ -188,10 +188,14 @@ def nack_frag(reader_id: int, writer_id: int, seq: int, missing: Iterable[int], 
                 + struct.pack("<I", base) + _bitmap(base, missing, num_bits) + struct.pack("<i", count))
 
 
-def gap(reader_id: int, writer_id: int, start: int, list_base: int) -> bytes:
-    """GAP: samples ``start`` .. ``list_base - 1`` will never come (empty list)."""
+def gap(reader_id: int, writer_id: int, start: int, list_base: int,
+        listed: Iterable[int] = ()) -> bytes:
+    """GAP: samples ``start`` .. ``list_base - 1`` will never come, nor those in ``listed``
+    (within 256 of ``list_base``)."""
+    listed = sorted(m for m in listed if list_base <= m < list_base + 256)
+    num_bits = (listed[-1] - list_base + 1) if listed else 0
     return _sub(GAP, 0, _eid(reader_id) + _eid(writer_id) + _seq(start) + _seq(list_base)
-                + struct.pack("<I", 0))
+                + _bitmap(list_base, listed, num_bits))
 
 
 # ---- parameter lists -------------------------------------------------------------------------

@@ -757,7 +757,9 @@ class Participant:
         """Why a submessage is invalid by RTPS 2.3 8.3.7 (then it is ignored), or ''."""
         if isinstance(sub, Heartbeat) and (sub.first < 1 or sub.last < sub.first - 1):
             return f"HEARTBEAT first {sub.first} last {sub.last}"
-        if isinstance(sub, Gap) and (sub.start < 1 or sub.list_base < sub.start):
+        if isinstance(sub, Gap) and (sub.start < 1 or sub.list_base < 1):
+            # gapList.base below gapStart is valid (8.3.7.4.3): the range is empty, the
+            # listed samples still count (Cyclone DDS reads it so too)
             return f"GAP start {sub.start} base {sub.list_base}"
         if isinstance(sub, AckNack) and sub.base < 1 and (sub.base, sub.num_bits) != (0, 0):
             return f"ACKNACK base {sub.base}"
