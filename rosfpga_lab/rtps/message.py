@@ -320,7 +320,7 @@ def _submessage(data: bytes, kind: int, flags: int, offset: int, end: int) -> Su
     if kind == 0x15:  # DATA: Q=0x02 D=0x04 K=0x08
         if flags & 0x0C == 0x0C:
             raise RtpsError(f"DATA at byte {offset} has both the D (data) and K (key) flags: "
-                            f"invalid in RTPS 2.x (8.3.7.2.2)", offset)
+                            f"invalid in RTPS 2.x (8.3.7.2)", offset)
         qos_at, reader, writer, seq = _data_common(b)
         b.take(max(0, qos_at - b.pos), "the bytes before the inline QoS")
         qos = _inline_qos(b, data) if flags & 0x02 else b""
