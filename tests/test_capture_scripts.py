@@ -45,3 +45,19 @@ def test_rtps_capture_script_reruns(tmp_path: Path) -> None:
                          capture_output=True, text=True, timeout=200)
     assert run.returncode == 0, run.stderr[-2000:]
     assert assert_rtps_agrees_with_tshark(out) > 0
+
+
+def test_cyclone_sedp_dispose_capture_script_reruns(tmp_path: Path) -> None:
+    require_cyclonedds()
+    from ros2tools import DOMAIN
+
+    out = tmp_path / "dispose.pcapng"
+    run = subprocess.run([sys.executable, str(DATA_DIR / "capture_cyclone_sedp_dispose.py"),
+                          "--domain", str((DOMAIN + 3) % 233), "-o", str(out)],
+                         capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0, run.stderr[-2000:]
+    from rosfpga_lab.graph.capture_read import udp_datagrams
+    from rosfpga_lab.rtps import Data, parse_message
+
+    last = parse_message(udp_datagrams(out)[-1][3]).submessages
+    assert any(isinstance(s, Data) and s.key and s.inline_qos for s in last)

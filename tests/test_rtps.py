@@ -11,6 +11,7 @@ import pytest
 
 from rosfpga_lab.graph.capture_read import udp_datagrams
 from rosfpga_lab.msg import deserialize_cdr
+from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps import (
     ANY_PARTICIPANT, AckNack, DataFrag, FragmentAssembler, Gap, InfoSrc, RtpsError,
     RtpsTruncatedError, discovery, parse_message, parse_parameters,
@@ -180,3 +181,75 @@ def test_a_datagram_cut_inside_info_src_is_a_typed_error(cut: int) -> None:
 def test_an_info_src_body_shorter_than_20_bytes_is_a_typed_error(length: int) -> None:
     with pytest.raises(RtpsTruncatedError, match="INFO_SRC at byte 20"):
         parse_message(HEADER + struct.pack("<BBH", 0x0C, 0x01, length) + bytes(length))
+
+
+# ---- the receiver's rules (RTPS 2.3 8.3.4.1, 9.4.1; what Cyclone DDS's ddsi_receive.c does) ----
+SPDP_DATA = b.data(0x000100C7, 0x000100C2, 1, b"\x00\x03\x00\x00\x01\x00\x00\x00")  # empty list
+
+
+def test_pad_info_reply_vendor_and_unknown_submessages_are_skipped() -> None:
+    skipped = (b"\x01\x01\x00\x00"                                       # PAD, empty
+               + b"\x01\x01\x04\x00" + bytes(4)                         # PAD with 4 bytes
+               + b"\x09\x03\x00\x00"                                    # INFO_TS, I flag: no time
+               + b"\x0f\x01\x04\x00" + struct.pack("<I", 0)          # INFO_REPLY, no locators
+               + b"\x0d\x01\x08\x00" + bytes(8)                         # INFO_REPLY_IP4
+               + b"\x80\x01\x04\x00abcd"                                # vendor-specific id
+               + b"\x7e\x00\x00\x04wxyz")                               # an id RTPS 2.3 lacks
+    msg = parse_message(HEADER + skipped + SPDP_DATA)
+    assert [s.name for s in msg.submessages] == ["PAD", "PAD", "INFO_TS", "INFO_REPLY",
+                                                 "INFO_REPLY_IP4", "0x80", "0x7e", "DATA"]
+    assert msg.submessages[2].timestamp is None
+    assert msg.submessages[-1].payload == SPDP_DATA[24:]
+
+
+def test_octets_to_inline_qos_past_16_skips_the_extra_fields() -> None:
+    # a later RTPS minor version may add fields before the inline QoS: octetsToInlineQos says
+    # where the QoS (and then the payload) starts, 8 bytes further here
+    body = (struct.pack("<HH", 0, 24) + bytes.fromhex("00000104") + bytes.fromhex("00000103")
+            + struct.pack("<iI", 0, 7) + b"EXTRAEXT" + b"\x00\x01\x00\x00data")
+    (sub,) = parse_message(HEADER + b"\x15\x05" + struct.pack("<H", len(body)) + body).submessages
+    assert (sub.seq, sub.writer_id, sub.payload) == (7, 0x103, b"\x00\x01\x00\x00data")
+
+
+def test_a_data_frag_with_two_fragments_reassembles() -> None:
+    sample = b"\x00\x01\x00\x00" + bytes(range(60))          # 64 bytes in 16-byte fragments
+    first = b.data_frag(0x104, 0x103, 1, 1, 16, len(sample), sample[:32], 2)
+    rest = b.data_frag(0x104, 0x103, 1, 3, 16, len(sample), sample[32:], 2)
+    asm = FragmentAssembler()
+    frags = [parse_message(HEADER + sm).submessages[0] for sm in (first, rest)]
+    assert [(f.frag_start, f.frag_count) for f in frags] == [(1, 2), (3, 2)]
+    assert asm.add(b"p" * 12, frags[0]) is None
+    assert asm.add(b"p" * 12, frags[1]) == sample
+
+
+def test_data_with_both_data_and_key_flags_is_malformed() -> None:
+    dk = bytes([SPDP_DATA[0], SPDP_DATA[1] | 0x08]) + SPDP_DATA[2:]
+    with pytest.raises(RtpsError, match="both the D .data. and K .key. flags"):
+        parse_message(HEADER + dk)
+
+
+def test_a_misaligned_submessage_is_malformed_unless_it_is_the_last() -> None:
+    odd = b"\x80\x01\x03\x00abc"                              # 3 bytes: the next would start unaligned
+    assert parse_message(HEADER + odd).submessages[0].size == 7     # last: up to the end
+    with pytest.raises(RtpsError, match="not a multiple of 4"):
+        parse_message(HEADER + odd + SPDP_DATA)
+
+
+def test_keep_valid_keeps_the_submessages_before_a_malformed_one() -> None:
+    bad_hb = b"\x07\x01\x08\x00" + bytes(8)                   # a HEARTBEAT needs 28 bytes
+    data = HEADER + SPDP_DATA + bad_hb + SPDP_DATA
+    with pytest.raises(RtpsTruncatedError):
+        parse_message(data)
+    msg = parse_message(data, keep_valid=True)
+    assert [s.name for s in msg.submessages] == ["DATA"]
+    assert isinstance(msg.error, RtpsTruncatedError) and msg.error.offset >= 20 + len(SPDP_DATA)
+    assert parse_message(HEADER + SPDP_DATA, keep_valid=True).error is None
+    with pytest.raises(RtpsError, match="not an RTPS message"):
+        parse_message(b"RTPX" + data[4:], keep_valid=True)       # a bad header raises either way
+
+
+def test_the_sedp_dispose_capture_agrees_with_tshark() -> None:
+    capture = CAPTURE.parent / "cyclone_sedp_dispose.pcapng"
+    assert assert_rtps_agrees_with_tshark(capture) == len(udp_datagrams(capture))
+    [*_, [status]] = tshark_fields(capture, ["rtps.param.status_info"], display_filter="rtps")
+    assert int(status, 0) == 3          # the last datagram: disposed and unregistered

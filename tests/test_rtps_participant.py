@@ -17,9 +17,9 @@ from rosfpga_lab.graph.capture_read import udp_datagrams
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps import parse_message
 from rosfpga_lab.rtps.limits import (
-    MAX_NOTES, MAX_PENDING_BYTES, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS,
+    MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS,
 )
-from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, NackFrag
+from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, InfoDst, NackFrag
 from rosfpga_lab.rtps.participant import (
     PUB_READER, PUB_WRITER, SPDP_READER, SPDP_WRITER, Participant, Qos, discovery_port, incompatibility,
     user_port,
@@ -543,3 +543,202 @@ def test_a_preemptive_acknack_gets_a_heartbeat_and_is_not_invalid() -> None:
     beats = [s for _, _, d in out for s in parse_message(d).submessages if isinstance(s, Heartbeat)]
     assert [(s.writer_id, s.reader_id) for s in beats] == [(w, 0x1404)]
     assert not any("8.3.7" in n for n in a.notes), a.notes
+
+
+# ---- the receiver's rules (RTPS 2.3 8.3.4.1, 8.3.6.3, 8.4.12.2; Cyclone DDS's ddsi_receive.c) ----
+
+def spdp_data(prefix: bytes, port: int = 7999) -> bytes:
+    """The SPDP DATA submessage of ``spdp(prefix)`` alone."""
+    return spdp(prefix, port=port)[20:]
+
+
+def with_version(datagram: bytes, major: int, minor: int) -> bytes:
+    return datagram[:4] + bytes([major, minor]) + datagram[6:]
+
+
+def test_a_message_of_another_major_version_is_ignored_whole() -> None:
+    p = fresh()
+    for major, minor in ((3, 0), (1, 0), (255, 1)):
+        p.receive(with_version(spdp(b"V" * 12), major, minor), ("127.0.0.1", 7999), 0.0)
+    assert p.participants == {}
+    assert sum("RTPS 3.0 message" in n for n in p.notes) == 1 and p.counts["version-3"] == 1
+    p.receive(with_version(spdp(b"V" * 12), 2, 5), ("127.0.0.1", 7999), 0.0)   # newer minor: read
+    assert set(p.participants) == {b"V" * 12}
+
+
+def test_a_malformed_submessage_drops_itself_and_the_rest_not_what_came_before() -> None:
+    bad_heartbeat = b"\x07\x01\x08\x00" + bytes(8)            # declares 8 bytes; it needs 28
+    dg = (spdp(b"A" * 12) + bad_heartbeat + b.info_src(b"B" * 12) + spdp_data(b"B" * 12, 7997))
+    p = fresh()
+    p.receive(dg, ("127.0.0.1", 7999), 0.0)
+    assert set(p.participants) == {b"A" * 12}, p.notes          # before: nothing was learned
+    assert p.counts["malformed-rest-RtpsTruncatedError"] == 1
+    # a submessage that is not the last and whose length is not a multiple of 4 is malformed
+    # too (RTPS 2.3 9.4.1; Cyclone DDS refuses it): what follows it is not read
+    misaligned = b"\x80\x01\x03\x00abc"
+    q = fresh()
+    q.receive(spdp(b"A" * 12) + misaligned + b.info_src(b"B" * 12) + spdp_data(b"B" * 12, 7997),
+              ("127.0.0.1", 7999), 0.0)
+    assert set(q.participants) == {b"A" * 12}, q.notes
+
+
+def test_spdp_data_with_both_data_and_key_flags_does_not_make_the_peer_leave() -> None:
+    p = fresh()
+    p.receive(spdp(b"K" * 12), ("127.0.0.1", 7999), 0.0)
+    assert b"K" * 12 in p.participants
+    dk = bytearray(spdp(b"K" * 12))
+    dk[21] |= 0x08                     # DATA flags: D and K (RTPS 2.3 8.3.7.2: invalid)
+    p.receive(bytes(dk), ("127.0.0.1", 7999), 1.0)
+    # before: read as a key-only DATA, i.e. "disposed": the peer was forgotten
+    assert b"K" * 12 in p.participants, p.notes
+    assert not any("said goodbye" in n for n in p.notes)
+
+
+def test_pad_info_reply_and_vendor_submessages_do_not_stop_the_datagram() -> None:
+    p = fresh()
+    skipped = (b"\x01\x01\x00\x00" + b"\x0f\x01\x04\x00" + bytes(4) + b"\x0d\x01\x08\x00" + bytes(8)
+               + b"\x09\x03\x00\x00" + b"\x81\x01\x04\x00abcd")
+    p.receive(b.header(b"S" * 12) + skipped + spdp_data(b"S" * 12), ("127.0.0.1", 7999), 0.0)
+    assert set(p.participants) == {b"S" * 12}, p.notes
+
+
+def acknacks(out: list, writer_id: int) -> list[AckNack]:
+    return [s for _, _, d in out for s in parse_message(d).submessages
+            if isinstance(s, AckNack) and s.writer_id == writer_id]
+
+
+def test_final_and_liveliness_heartbeats_get_an_acknack_only_when_the_rules_ask() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    net.run(a.write(w, b"\x00\x01\x00\x00one", net.now), steps=3)
+    assert [s.payload[4:] for s in c.take(r)] == [b"one"]
+
+    def hb(first: int, last: int, count: int, **flags: bool) -> list:
+        return c.receive(b.header(a.guid_prefix) + b.heartbeat(r, w, first, last, count, **flags),
+                         a.user, net.now)
+
+    # F set, nothing missing: no ACKNACK (Cyclone DDS piggybacks such HEARTBEATs on its data;
+    # before, every one of them was answered)
+    assert acknacks(hb(1, 1, 1000, final=True), w) == []
+    (ack,) = acknacks(hb(1, 1, 1001), w)                     # F not set: must answer
+    assert (ack.base, ack.missing) == (2, ())
+    # F and L set (a liveliness assertion): no ACKNACK, even with samples missing
+    assert acknacks(hb(1, 3, 1002, final=True, liveliness=True), w) == []
+    (ack,) = acknacks(hb(1, 3, 1003, final=True), w)         # F set, samples missing: ask
+    assert (ack.base, ack.missing) == (2, (2, 3))
+    assert acknacks(hb(1, 3, 1003), w) == []                 # a count already seen: ignored
+
+
+def test_a_gap_ahead_of_delivery_is_remembered() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+
+    def send(*subs: bytes) -> list:
+        return c.receive(b.header(a.guid_prefix) + b"".join(subs), a.user, net.now)
+
+    def sample(k: int) -> bytes:
+        return b"\x00\x01\x00\x00" + bytes([k]) * 4
+
+    send(b.data(r, w, 1, sample(1)))
+    send(b.gap(r, w, 3, 5))                 # 3 and 4 will never come; 2 is still on its way
+    send(b.data(r, w, 2, sample(2)), b.data(r, w, 5, sample(5)))
+    # before: the GAP was dropped (it did not start at the next sample): 5 waited for 3 and 4
+    assert [s.payload for s in c.take(r)] == [sample(1), sample(2), sample(5)]
+    (ack,) = acknacks(send(b.heartbeat(r, w, 1, 5, 1000)), w)
+    assert (ack.base, ack.missing) == (6, ())
+    # GAP ranges ahead are bounded; past the bound they are asked for again, never lost
+    for k in range(200):
+        send(b.gap(r, w, 10 + 2 * k, 11 + 2 * k))
+    wp = c.local[r].proxies[(a.guid_prefix, w)]
+    assert len(wp.gaps) <= MAX_OUT_OF_ORDER and c.counts[f"gaps-full-{r}"] > 0
+    (ack,) = acknacks(send(b.heartbeat(r, w, 1, 12, 1001)), w)
+    assert (ack.base, ack.missing) == (6, (6, 7, 8, 9, 11))
+
+
+#: Made by data/capture_cyclone_sedp_dispose.py: what a lab participant received from Cyclone DDS
+#: while a Cyclone writer of rt/chatter appeared, was matched with the lab's reader and was
+#: deleted (its last datagram: the SEDP DATA with K flag and PID_STATUS_INFO "disposed and
+#: unregistered"), all addressed (INFO_DST) to the lab participant that recorded it.
+SEDP_DISPOSE = [d[3] for d in udp_datagrams(CAPTURE.parent / "cyclone_sedp_dispose.pcapng")]
+
+
+def test_a_cyclone_writer_deleted_is_unmatched_at_once() -> None:
+    (lab,) = {s.guid_prefix for s in parse_message(SEDP_DISPOSE[0]).submessages
+              if isinstance(s, InfoDst)}
+    p = Participant(domain=79, index=0, guid_prefix=lab)
+    r = p.add_reader("rt/chatter", "std_msgs::msg::dds_::String_")
+    for d in SEDP_DISPOSE[:-1]:
+        p.receive(d, ("127.0.0.1", 7410), 0.0)
+    (writer,) = p.matched(r)
+    assert p.remote[writer].kind == "writer"
+    (dispose,) = [s for s in parse_message(SEDP_DISPOSE[-1]).submessages if isinstance(s, Data)]
+    assert dispose.key and dispose.writer_id == PUB_WRITER and dispose.inline_qos
+    p.receive(SEDP_DISPOSE[-1], ("127.0.0.1", 7410), 1.0)
+    # the endpoint goes, not only when its participant's lease runs out
+    assert p.matched(r) == [] and writer not in p.remote and len(p.participants) == 1
+    assert any(writer.hex() in n and "left" in n for n in p.notes)
+
+
+def test_the_lease_a_peer_announced_is_the_one_that_runs_out() -> None:
+    p = fresh()                                    # its own lease: 10 s
+    for prefix, lease in ((b"S" * 12, 2.0), (b"L" * 12, 30.0)):
+        payload = b.spdp_payload(prefix, b.Locator("127.0.0.1", 7999), b.Locator("127.0.0.1", 8000),
+                                 lease, "peer", b"", 0)
+        p.receive(b.header(prefix) + b.data(SPDP_READER, SPDP_WRITER, 1, payload),
+                  ("127.0.0.1", 7999), 0.0)
+    assert {k: v.lease for k, v in p.participants.items()} == {b"S" * 12: 2.0, b"L" * 12: 30.0}
+    p.tick(2.5)
+    assert set(p.participants) == {b"L" * 12}
+    p.tick(20.0)
+    assert set(p.participants) == {b"L" * 12}
+    p.tick(30.5)
+    assert p.participants == {}
+
+
+def test_a_peer_whose_endpoints_speak_is_alive_between_its_announcements() -> None:
+    a, c, w, r = pair(Qos(False), Qos(False))      # best effort: DATA only, no HEARTBEAT
+    a.lease = 2.0                                   # what a announces
+    net = Net(a, c)
+    net.run([], steps=20)
+    assert c.participants[a.guid_prefix].lease == 2.0 and c.matched(r)
+    a.announce_period = 1000.0                      # its SPDP stops (lost, or late) ...
+    net.parts = (c,)
+    for k in range(8):                              # ... while its writer goes on for 4 s
+        for d in a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * 4, net.now) + a.tick(net.now):
+            c.receive(d[2], a.user, net.now)
+        net.run([], steps=50)                       # 0.5 s
+    # before: forgotten 2 s after its last SPDP, its samples still arriving (only SPDP and
+    # HEARTBEAT renewed a lease)
+    assert a.guid_prefix in c.participants and len(c.take(r)) == 8
+    net.run([], steps=250)                          # silent for 2.5 s: its lease runs out
+    assert a.guid_prefix not in c.participants
+
+
+def test_an_acknack_from_reader_unknown_is_ignored() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    net.run(a.write(w, b"\x00\x01\x00\x00one!", net.now), steps=3)
+    for reader_id in (0, r):                          # ENTITYID_UNKNOWN, then the real reader
+        ask = b.header(c.guid_prefix) + b.acknack(reader_id, w, 1, [1], 500 + reader_id)
+        out = a.receive(ask, c.user, net.now + 1.0)
+        sent = [s for _, _, d in out for s in parse_message(d).submessages if isinstance(s, Data)]
+        assert [s.seq for s in sent] == ([] if reader_id == 0 else [1])
+    assert a.counts[f"acknack-unknown-{c.guid_prefix.hex()}"] == 1
+
+
+def test_a_gap_whose_list_starts_before_its_range_still_counts_its_list() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    one, four = b"\x00\x01\x00\x00" + b"1" * 4, b"\x00\x01\x00\x00" + b"4" * 4
+    c.receive(b.header(a.guid_prefix) + b.data(r, w, 1, one), a.user, net.now)
+    # gapList.base (2) below gapStart (9): an empty range, and 2 and 3 listed (valid: RTPS 2.3
+    # 8.3.7.4.3 lists only gapStart < 1 and an invalid gapList; Cyclone DDS reads it so)
+    c.receive(b.header(a.guid_prefix) + b.gap(r, w, 9, 2, [2, 3]) + b.data(r, w, 4, four),
+              a.user, net.now)
+    # before: refused as invalid, so 4 waited for 2 and 3
+    assert [s.payload for s in c.take(r)] == [one, four]
+    assert not any("invalid" in n for n in c.notes)

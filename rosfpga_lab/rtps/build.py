@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from rosfpga_lab.msg.parser import SEP
 from rosfpga_lab.msg.typehash import MSG_NAMESPACE
-from rosfpga_lab.rtps.message import MAGIC
+from rosfpga_lab.rtps.message import HEARTBEAT_FINAL, HEARTBEAT_LIVELINESS, MAGIC
 
 PROTOCOL_VERSION = (2, 3)
 #: The lab announces "unknown vendor" (0x0000): it has no OMG-assigned vendor id.
@@ -164,8 +164,9 @@ def data_frag(reader_id: int, writer_id: int, seq: int, frag_start: int, frag_si
 
 
 def heartbeat(reader_id: int, writer_id: int, first: int, last: int, count: int,
-              final: bool = False) -> bytes:
-    return _sub(HEARTBEAT, 0x02 if final else 0,
+              final: bool = False, liveliness: bool = False) -> bytes:
+    flags = (HEARTBEAT_FINAL if final else 0) | (HEARTBEAT_LIVELINESS if liveliness else 0)
+    return _sub(HEARTBEAT, flags,
                 _eid(reader_id) + _eid(writer_id) + _seq(first) + _seq(last) + struct.pack("<i", count))
 
 
@@ -187,10 +188,14 @@ def nack_frag(reader_id: int, writer_id: int, seq: int, missing: Iterable[int], 
                 + struct.pack("<I", base) + _bitmap(base, missing, num_bits) + struct.pack("<i", count))
 
 
-def gap(reader_id: int, writer_id: int, start: int, list_base: int) -> bytes:
-    """GAP: samples ``start`` .. ``list_base - 1`` will never come (empty list)."""
+def gap(reader_id: int, writer_id: int, start: int, list_base: int,
+        listed: Iterable[int] = ()) -> bytes:
+    """GAP: samples ``start`` .. ``list_base - 1`` will never come, nor those in ``listed``
+    (within 256 of ``list_base``)."""
+    listed = sorted(m for m in listed if list_base <= m < list_base + 256)
+    num_bits = (listed[-1] - list_base + 1) if listed else 0
     return _sub(GAP, 0, _eid(reader_id) + _eid(writer_id) + _seq(start) + _seq(list_base)
-                + struct.pack("<I", 0))
+                + _bitmap(list_base, listed, num_bits))
 
 
 # ---- parameter lists -------------------------------------------------------------------------

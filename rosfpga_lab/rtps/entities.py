@@ -110,6 +110,7 @@ class WriterProxy:
     next: int = 0                 # 0: nothing known yet
     pending: dict[int, bytes | None] = field(default_factory=dict)
     pending_bytes: int = 0
+    gaps: dict[int, int] = field(default_factory=dict)   # GAP ranges start -> end ahead of next
     last_hb_count: int = -(1 << 31)
     acknack_count: int = 0
     nackfrag_count: int = 0

@@ -19,6 +19,8 @@ from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError
 MAGIC = b"RTPS"
 HEADER_SIZE = 20
 SUBMESSAGE_HEADER_SIZE = 4
+#: HEARTBEAT flags besides E (RTPS 2.3 9.4.5.7): F (final) and L (liveliness).
+HEARTBEAT_FINAL, HEARTBEAT_LIVELINESS = 0x02, 0x04
 
 SUBMESSAGE_NAMES: dict[int, str] = {
     0x01: "PAD", 0x06: "ACKNACK", 0x07: "HEARTBEAT", 0x08: "GAP", 0x09: "INFO_TS",
@@ -140,6 +142,16 @@ class Heartbeat(Submessage):
     last: int = 0
     count: int = 0
 
+    @property
+    def final(self) -> bool:
+        """The F flag: no ACKNACK is asked for (the reader answers only if it lacks samples)."""
+        return bool(self.flags & HEARTBEAT_FINAL)
+
+    @property
+    def liveliness(self) -> bool:
+        """The L flag: the writer asserts its liveliness (with F: nothing is asked for)."""
+        return bool(self.flags & HEARTBEAT_LIVELINESS)
+
 
 @dataclass(frozen=True)
 class HeartbeatFrag(Submessage):
@@ -200,10 +212,16 @@ ANY_PARTICIPANT = bytes(12)
 
 @dataclass(frozen=True)
 class RtpsMessage:
-    """One RTPS message: header and submessages in order."""
+    """One RTPS message: header and submessages in order.
+
+    ``error``: set only by ``parse_message(..., keep_valid=True)``: the submessage at
+    ``error.offset`` is malformed, so it and the rest of the message are left out (RTPS 2.3
+    8.3.4.1: a known but invalid submessage invalidates the rest of the message, not what came
+    before it)."""
 
     header: RtpsHeader
     submessages: list[Submessage] = field(default_factory=list)
+    error: RtpsError | None = None
 
     def routed(self) -> Iterator[tuple[bytes, bytes, Submessage]]:
         """Each submessage with the participant it comes from and the one it is for.
@@ -300,6 +318,9 @@ def _submessage(data: bytes, kind: int, flags: int, offset: int, end: int) -> Su
     if kind == 0x0E:
         return InfoDst(**common, guid_prefix=b.take(12, "guidPrefix"))
     if kind == 0x15:  # DATA: Q=0x02 D=0x04 K=0x08
+        if flags & 0x0C == 0x0C:
+            raise RtpsError(f"DATA at byte {offset} has both the D (data) and K (key) flags: "
+                            f"invalid in RTPS 2.x (8.3.7.2)", offset)
         qos_at, reader, writer, seq = _data_common(b)
         b.take(max(0, qos_at - b.pos), "the bytes before the inline QoS")
         qos = _inline_qos(b, data) if flags & 0x02 else b""
@@ -349,11 +370,17 @@ def _submessage(data: bytes, kind: int, flags: int, offset: int, end: int) -> Su
     return Unknown(**common, body=b.rest())
 
 
-def parse_message(data: bytes | bytearray | memoryview) -> RtpsMessage:
+def parse_message(data: bytes | bytearray | memoryview, keep_valid: bool = False) -> RtpsMessage:
     """Decode one RTPS message (a whole UDP datagram).
 
+    With ``keep_valid`` a malformed submessage does not raise: the message keeps the
+    submessages before it and says why in ``error`` (what a DDS receiver does, RTPS 2.3
+    8.3.4.1). A bad header raises either way.
+
     Raises:
-        RtpsError: not RTPS (bad magic), or a malformed field.
+        RtpsError: not RTPS (bad magic), or a malformed field; a submessage that is not the
+            last one and whose length is not a multiple of 4 (RTPS 2.3 9.4.1: every submessage
+            starts on a 4-byte boundary; Cyclone DDS refuses it too).
         RtpsTruncatedError: the datagram ends inside the header or a submessage (a prefix of
             a message that ends between two submessages is itself a valid, shorter message).
     """
@@ -367,6 +394,17 @@ def parse_message(data: bytes | bytearray | memoryview) -> RtpsMessage:
         raise RtpsError(f"not an RTPS message: starts with {data[:4]!r}, not {MAGIC!r}", 0)
     header = RtpsHeader((data[4], data[5]), int.from_bytes(data[6:8], "big"), data[8:20])
     subs: list[Submessage] = []
+    try:
+        _submessages(data, subs)
+    except RtpsError as exc:
+        if not keep_valid:
+            raise
+        return RtpsMessage(header, subs, exc)
+    return RtpsMessage(header, subs)
+
+
+def _submessages(data: bytes, subs: list[Submessage]) -> None:
+    """Append the submessages of ``data`` (after the header) to ``subs``, in order."""
     pos = HEADER_SIZE
     while pos < len(data):
         if pos + SUBMESSAGE_HEADER_SIZE > len(data):
@@ -380,6 +418,9 @@ def parse_message(data: bytes | bytearray | memoryview) -> RtpsMessage:
             raise RtpsTruncatedError(
                 f"{SUBMESSAGE_NAMES.get(kind, hex(kind))} at byte {pos} declares {length} bytes, "
                 f"only {len(data) - pos - 4} left", pos)
+        if length % 4 and end != len(data):
+            raise RtpsError(f"{SUBMESSAGE_NAMES.get(kind, hex(kind))} at byte {pos} declares "
+                            f"{length} bytes, not a multiple of 4, and is not the last submessage "
+                            f"(RTPS 2.3 9.4.1: submessages start on 4-byte boundaries)", pos)
         subs.append(_submessage(data, kind, flags, pos, end))
         pos = end
-    return RtpsMessage(header, subs)

@@ -21,6 +21,12 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
   or DATA_FRAG; reliable ones HEARTBEAT until acknowledged, resend on ACKNACK/NACK_FRAG and GAP
   what left the history. A reader puts fragments together (memory follows bytes received),
   delivers in order when reliable, asks again with ACKNACK/NACK_FRAG.
+* The receiver's rules (RTPS 2.3 8.3.4, 8.3.6.3, 8.4.12.2, as Cyclone DDS's receiver follows
+  them): INFO_SRC/INFO_DST set source and destination; a message of another major version is
+  ignored; a malformed submessage drops itself and the rest of its datagram, not what came
+  before; a final HEARTBEAT is answered only when samples are missing, a final liveliness one
+  never; a GAP ahead of delivery is remembered until delivery gets there; whatever a known
+  peer's endpoints send renews its lease, as SPDP does.
 """
 
 from __future__ import annotations
@@ -595,22 +601,38 @@ class Participant:
                           f"samples beyond {MAX_OUT_OF_ORDER}: later ones asked again")
 
     def _drain(self, ep: LocalEndpoint, wp: WriterProxy) -> None:
-        while wp.next in wp.pending:
-            payload = wp.pending.pop(wp.next)
-            wp.pending_bytes -= len(payload or b"")
-            self._deliver(ep, wp, wp.next, payload)
-            wp.next += 1
+        while True:
+            if wp.next in wp.pending:
+                payload = wp.pending.pop(wp.next)
+                wp.pending_bytes -= len(payload or b"")
+                self._deliver(ep, wp, wp.next, payload)
+                wp.next += 1
+                continue
+            end = max((e for s, e in wp.gaps.items() if s <= wp.next < e), default=0)
+            for s in [s for s, e in wp.gaps.items() if e <= max(end, wp.next + 1)]:
+                del wp.gaps[s]           # reached (or passed): forgotten
+            if not end:
+                return
+            self._advance(wp, end)
 
-    def _skip_to(self, ep: LocalEndpoint, wp: WriterProxy, first: int) -> None:
-        """Samples before ``first`` will never come."""
-        if first <= wp.next:
-            return
+    def _advance(self, wp: WriterProxy, first: int) -> None:
+        """Samples from ``wp.next`` to before ``first`` will never come: drop what is held."""
         for s in [s for s in wp.pending if s < first]:
             wp.pending_bytes -= len(wp.pending.pop(s) or b"")
         for s in range(wp.next, min(first, wp.next + 256)):
             self.assembler.discard(wp.prefix, wp.writer_id, s)
         wp.next = first
+
+    def _skip_to(self, ep: LocalEndpoint, wp: WriterProxy, first: int) -> None:
+        """Samples before ``first`` will never come."""
+        if first <= wp.next:
+            return
+        self._advance(wp, first)
         self._drain(ep, wp)
+
+    @staticmethod
+    def _gapped(wp: WriterProxy, seq: int) -> bool:
+        return any(s <= seq < e for s, e in wp.gaps.items())
 
     def _on_gap(self, prefix: bytes, sub: Gap) -> None:
         for ep, wp in self._readers_of(prefix, sub.writer_id, sub.reader_id):
@@ -618,6 +640,15 @@ class Participant:
                 continue
             if sub.start <= wp.next < sub.list_base:
                 self._skip_to(ep, wp, sub.list_base)
+            elif wp.next < sub.start < sub.list_base:
+                # a later range (RTPS 2.3 8.3.7.4: gapStart .. gapList.base - 1 are irrelevant):
+                # remembered until delivery gets there, never asked for again
+                if sub.start in wp.gaps or len(wp.gaps) < MAX_OUT_OF_ORDER:
+                    wp.gaps[sub.start] = max(sub.list_base, wp.gaps.get(sub.start, 0))
+                else:
+                    self.note(f"gaps-full-{ep.entity_id}", f"reader {ep.topic or 'SEDP'}: more "
+                              f"than {MAX_OUT_OF_ORDER} GAP ranges ahead of delivery: later ones "
+                              f"asked again")
             for s in sub.listed:
                 if s >= wp.next and s not in wp.pending and len(wp.pending) < MAX_OUT_OF_ORDER:
                     wp.pending[s] = None
@@ -634,7 +665,14 @@ class Participant:
             if sub.first > wp.next:
                 self._skip_to(ep, wp, sub.first)
             top = min(sub.last, wp.next + 255)
-            missing = [s for s in range(wp.next, top + 1) if s not in wp.pending]
+            missing = [s for s in range(wp.next, top + 1)
+                       if s not in wp.pending and not self._gapped(wp, s)]
+            # RTPS 2.3 8.4.12.2 (the reliable reader's HEARTBEAT transitions): F (final) not set:
+            # an ACKNACK must go; F set: only when something is missing; F and L (liveliness)
+            # both set: none (a liveliness assertion asks for nothing). Cyclone DDS piggybacks
+            # final HEARTBEATs on its data and answers only those without F itself.
+            if sub.final and (sub.liveliness or not missing):
+                continue
             partial = set(self.assembler.partial(prefix, sub.writer_id))
             subs: list[bytes] = []
             wp.acknack_count += 1
@@ -664,15 +702,30 @@ class Participant:
 
     # ---- the datagram entry point ------------------------------------------------------
     def receive(self, datagram: bytes, source: tuple[str, int], now: float) -> list[Send]:
-        """Handle one UDP datagram from ``source``; return the datagrams to send."""
+        """Handle one UDP datagram from ``source``; return the datagrams to send.
+
+        As RTPS 2.3 8.3.4.1 and 8.3.6.3 say: a message of another major protocol version is
+        ignored whole; a malformed submessage is ignored with the rest of the message, and
+        the submessages before it are handled."""
         try:
-            msg = parse_message(datagram)
+            msg = parse_message(datagram, keep_valid=True)
         except RtpsError as exc:
             self.note(f"malformed-{type(exc).__name__}", f"malformed datagram from "
                       f"{source[0]}:{source[1]} ignored ({exc}); further ones are counted")
             return []
         if msg.header.guid_prefix == self.guid_prefix:
             return []
+        if msg.header.version[0] != b.PROTOCOL_VERSION[0]:
+            major, minor = msg.header.version
+            self.note(f"version-{major}", f"RTPS {major}.{minor} message from {source[0]}:"
+                      f"{source[1]} ignored (this participant speaks RTPS "
+                      f"{b.PROTOCOL_VERSION[0]}.x; RTPS 2.3 8.3.6.3)")
+            return []
+        if msg.error is not None:
+            self.note(f"malformed-rest-{type(msg.error).__name__}", f"malformed submessage in a "
+                      f"datagram from {source[0]}:{source[1]}: the {len(msg.submessages)} "
+                      f"before it handled, it and the rest ignored ({msg.error}); further ones "
+                      f"are counted")
         out: list[Send] = []
         for prefix, destination, sub in msg.routed():
             if isinstance(sub, (InfoDst, InfoSrc)) or prefix == self.guid_prefix or \
@@ -704,7 +757,9 @@ class Participant:
         """Why a submessage is invalid by RTPS 2.3 8.3.7 (then it is ignored), or ''."""
         if isinstance(sub, Heartbeat) and (sub.first < 1 or sub.last < sub.first - 1):
             return f"HEARTBEAT first {sub.first} last {sub.last}"
-        if isinstance(sub, Gap) and (sub.start < 1 or sub.list_base < sub.start):
+        if isinstance(sub, Gap) and (sub.start < 1 or sub.list_base < 1):
+            # gapList.base below gapStart is valid (8.3.7.4.3): the range is empty, the
+            # listed samples still count (Cyclone DDS reads it so too)
             return f"GAP start {sub.start} base {sub.list_base}"
         if isinstance(sub, AckNack) and sub.base < 1 and (sub.base, sub.num_bits) != (0, 0):
             return f"ACKNACK base {sub.base}"
@@ -719,6 +774,12 @@ class Participant:
             self.note(f"invalid-{type(sub).__name__}", f"invalid submessage from {prefix.hex()} "
                       f"ignored: {why} (RTPS 2.3 8.3.7)")
             return []
+        known = self.participants.get(prefix)
+        if known is not None and not (isinstance(sub, Data) and sub.writer_id == SPDP_WRITER):
+            # its endpoints speak: it is alive (Cyclone DDS renews a peer's lease on its
+            # DATA, HEARTBEAT, GAP, ACKNACK and NACK_FRAG too), so a lost or late SPDP
+            # announcement does not drop a peer that is sending
+            known.last_seen = max(known.last_seen, now)
         if isinstance(sub, Data):
             if sub.writer_id == SPDP_WRITER:
                 return self._on_spdp(prefix, sub, source, now)
@@ -734,8 +795,6 @@ class Participant:
                 self._on_sample(prefix, sub.reader_id, sub.writer_id, sub.seq, sample,
                                 sub.inline_qos, sub.little_endian)
         elif isinstance(sub, Heartbeat):
-            if prefix in self.participants:
-                self.participants[prefix].last_seen = now
             return self._on_heartbeat(prefix, sub)
         elif isinstance(sub, HeartbeatFrag):
             return self._on_heartbeat_frag(prefix, sub)
