@@ -21,10 +21,6 @@ import sys
 import time
 from pathlib import Path
 
-CONFIG = ('<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
-          '</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers>'
-          '<Peer address="localhost"/></Peers><ParticipantIndex>auto</ParticipantIndex>'
-          '<MaxAutoParticipantIndex>9</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>')
 
 
 def spdp_after_info_src(datagram: bytes) -> bool:
@@ -48,7 +44,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("-o", "--output", type=Path,
                     default=Path(__file__).resolve().parent / "cyclone_info_src_spdp.bin")
     args = ap.parse_args(argv)
-    os.environ["CYCLONEDDS_URI"] = CONFIG
+    from rosfpga_lab.rtps.cyclone import cyclone_loopback_uri
+
+    os.environ["CYCLONEDDS_URI"] = cyclone_loopback_uri()
     from cyclonedds.domain import DomainParticipant
 
     from rosfpga_lab.graph.ros2 import Ros2Node

@@ -22,10 +22,6 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-CONFIG = ('<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
-          '</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers>'
-          '<Peer address="localhost"/></Peers><ParticipantIndex>auto</ParticipantIndex>'
-          '<MaxAutoParticipantIndex>9</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>')
 TOPIC, ROS_TYPE = "/chatter", "std_msgs/String"
 
 
@@ -58,7 +54,9 @@ def main(argv: "list[str] | None" = None) -> int:
     ap.add_argument("-o", "--output", type=Path,
                     default=Path(__file__).resolve().parent / "cyclone_sedp_dispose.pcapng")
     args = ap.parse_args(argv)
-    os.environ["CYCLONEDDS_URI"] = CONFIG
+    from rosfpga_lab.rtps.cyclone import cyclone_loopback_uri
+
+    os.environ["CYCLONEDDS_URI"] = cyclone_loopback_uri()
     from cyclonedds.domain import DomainParticipant
     from cyclonedds.idl import IdlStruct
     from cyclonedds.pub import DataWriter

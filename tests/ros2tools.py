@@ -14,14 +14,11 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
+from rosfpga_lab.rtps.cyclone import cyclone_loopback_uri
 from wiretools import require_cyclonedds
 
-CYCLONE_CONFIG = (
-    '<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
-    '</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers>'
-    '<Peer address="localhost"/></Peers><ParticipantIndex>auto</ParticipantIndex>'
-    '<MaxAutoParticipantIndex>9</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>'
-)
+#: What a ROS 2 user sets in CYCLONEDDS_URI for a graph on 127.0.0.1 (rosfpga_lab.rtps.cyclone).
+CYCLONE_CONFIG = cyclone_loopback_uri()
 #: A DDS domain of this test process's own (0..232 keep every port under 65536).
 DOMAIN = 100 + os.getpid() % 120
 

@@ -17,8 +17,9 @@ import pytest
 
 from rosfpga_lab.component.ros2 import Ros2Component
 from rosfpga_lab.config import parse_config
+from rosfpga_lab.rtps.cyclone import cyclone_loopback_uri
 from rosfpga_lab.rtps.participant import Qos
-from ros2tools import CYCLONE_CONFIG, DOMAIN, cyclone, image, qos, wait
+from ros2tools import DOMAIN, cyclone, image, qos, wait
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -311,7 +312,7 @@ def test_a_cyclone_peer_that_dies_is_forgotten_when_its_lease_runs_out(tmp_path)
     import time
 
     cyclone()
-    cfg = CYCLONE_CONFIG.replace("</Discovery>", "<LeaseDuration>1s</LeaseDuration></Discovery>")
+    cfg = cyclone_loopback_uri(lease_seconds=1)
     code = ("import time\nfrom cyclonedds.domain import DomainParticipant\n"
             f"dp = DomainParticipant({DOMAIN})\nprint('up', flush=True)\ntime.sleep(60)\n")
     with Ros2Component(parse_config(CONFIG.format(w=8, h=4)), domain=DOMAIN) as comp:

@@ -253,3 +253,20 @@ def test_the_sedp_dispose_capture_agrees_with_tshark() -> None:
     assert assert_rtps_agrees_with_tshark(capture) == len(udp_datagrams(capture))
     [*_, [status]] = tshark_fields(capture, ["rtps.param.status_info"], display_filter="rtps")
     assert int(status, 0) == 3          # the last datagram: disposed and unregistered
+
+
+def test_the_cyclone_configuration_probes_the_indices_the_lab_probes() -> None:
+    """Cyclone sends SPDP to participant indices 0..MaxAutoParticipantIndex, the lab probes
+    0..MAX_PARTICIPANT_INDEX: the two must be one number (the ROS 2 tests run real Cyclone
+    under this configuration)."""
+    import xml.etree.ElementTree as ET
+
+    from rosfpga_lab.rtps.cyclone import cyclone_loopback_uri
+    from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX
+
+    root = ET.fromstring(cyclone_loopback_uri())
+    assert root.findtext("Domain/Discovery/MaxAutoParticipantIndex") == str(MAX_PARTICIPANT_INDEX)
+    assert root.findtext("Domain/General/AllowMulticast") == "false"
+    assert root.find("Domain/General/Interfaces/NetworkInterface").get("address") == "127.0.0.1"
+    assert root.find("Domain/Discovery/LeaseDuration") is None
+    assert ET.fromstring(cyclone_loopback_uri(1.5)).findtext("Domain/Discovery/LeaseDuration") == "1.5s"
