@@ -23,6 +23,10 @@ FRAGMENT_BYTES = 1344
 LEASE_SECONDS = 10.0
 ANNOUNCE_SECONDS = 1.0
 MAX_LEASE_SECONDS = 300.0
+#: ... the shortest one it believes, and the lease of a peer that announces none (RTPS's default
+#: PID_PARTICIPANT_LEASE_DURATION, as Cyclone DDS takes it).
+MIN_LEASE_SECONDS = 0.1
+DEFAULT_LEASE_SECONDS = 100.0
 #: Period of a reliable writer's HEARTBEATs while a reader has not acknowledged everything.
 HEARTBEAT_SECONDS = 0.05
 #: ... doubling while the reader does not answer, up to this (readers that are gone or fake).

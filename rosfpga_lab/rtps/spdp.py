@@ -9,10 +9,11 @@ participant whose lease ran out. ``_on_spdp`` learns a new participant (reached 
 locator or at its own address: ``_locator``), answers with its own SPDP sample and starts SEDP
 with it: the built-in SEDP writers send it their history and a HEARTBEAT, the built-in SEDP
 readers a preemptive ACKNACK (base 0 for Fast DDS, which answers only that form at once). A known
-participant's SPDP sample renews its lease. One that says goodbye (:meth:`goodbye` sends ours: an
-SPDP sample disposed and unregistered) or whose lease runs out is forgotten with its endpoints,
-its proxies and its partly received samples (``_forget``). An SPDP sample about another
-participant than its sender is ignored.
+participant's SPDP sample renews its lease (one that announces none gets RTPS's default,
+DEFAULT_LEASE_SECONDS; any is held within MIN_LEASE_SECONDS..MAX_LEASE_SECONDS). One that says
+goodbye (:meth:`goodbye` sends ours: an SPDP sample disposed and unregistered) or whose lease runs
+out is forgotten with its endpoints, its proxies and its partly received samples (``_forget``).
+An SPDP sample about another participant than its sender is ignored.
 """
 
 from __future__ import annotations
@@ -24,7 +25,10 @@ from rosfpga_lab.rtps.entities import (
     PARTICIPANT_ENTITY, PUB_READER, PUB_WRITER, SPDP_READER, SPDP_WRITER, SUB_READER, SUB_WRITER,
     ReaderProxy, RemoteParticipant, Send, WriterProxy, discovery_port,
 )
-from rosfpga_lab.rtps.limits import MAX_LEASE_SECONDS, MAX_PARTICIPANT_INDEX, MAX_REMOTE_PARTICIPANTS
+from rosfpga_lab.rtps.limits import (
+    DEFAULT_LEASE_SECONDS, MAX_LEASE_SECONDS, MAX_PARTICIPANT_INDEX, MAX_REMOTE_PARTICIPANTS,
+    MIN_LEASE_SECONDS,
+)
 from rosfpga_lab.rtps.message import Data
 from rosfpga_lab.rtps.sedp import EndpointDiscovery
 
@@ -87,9 +91,13 @@ class ParticipantDiscovery(EndpointDiscovery):
                       f"{guid[:12].hex()}: ignored (a participant announces only itself)")
             return []
         known = self.participants.get(prefix)
-        lease_raw = (params.get(b.PID_PARTICIPANT_LEASE_DURATION) or [struct.pack("<iI", 100, 0)])[0]
-        sec, frac = struct.unpack("<iI" if little else ">iI", lease_raw[:8].ljust(8, b"\0"))
-        lease = min(max(sec + frac / 2**32, 0.1), MAX_LEASE_SECONDS)
+        lease_raw = params.get(b.PID_PARTICIPANT_LEASE_DURATION)
+        if lease_raw:
+            sec, frac = struct.unpack("<iI" if little else ">iI", lease_raw[0][:8].ljust(8, b"\0"))
+            announced = sec + frac / 2**32
+        else:
+            announced = DEFAULT_LEASE_SECONDS    # a value, so either byte order gets it
+        lease = min(max(announced, MIN_LEASE_SECONDS), MAX_LEASE_SECONDS)
         if known is not None:
             known.last_seen, known.lease = now, lease
             return []
