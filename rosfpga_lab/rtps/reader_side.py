@@ -11,8 +11,11 @@ up to gapList.base, and the listed ones), and a range ahead of delivery is remem
 ``wp.gaps`` until delivery gets there (``_drain``). ``_on_heartbeat`` answers a writer's HEARTBEAT
 with an ACKNACK naming what is missing and NACK_FRAGs for partly received samples (RTPS 2.3
 8.4.12.2: a final HEARTBEAT only when something is missing, a final liveliness one never);
-``_on_heartbeat_frag`` asks for the missing fragments. Delivered samples queue in ``samples``,
-at most KEEP_LAST ``depth`` per reader not taken (the oldest dropped).
+``_on_heartbeat_frag`` asks for the missing fragments of one sample with a NACK_FRAG. Both follow
+one set of rules (``_heard``, ``_answer``): only a reliable reader of a reliable writer answers, a
+count already seen (each kind its own) is not answered again, and a built-in SEDP reader answers
+on the peer's metatraffic port, a user reader on its user port. Delivered samples queue in
+``samples``, at most KEEP_LAST ``depth`` per reader not taken (the oldest dropped).
 """
 
 from __future__ import annotations
@@ -140,12 +143,48 @@ class ReaderSide(EndpointDiscovery):
                     wp.pending[s] = None
             self._drain(ep, wp)
 
+    def _heard(self, prefix: bytes, writer_id: int, reader_id: int, count: int,
+               frag: bool) -> list[tuple[LocalEndpoint, WriterProxy]]:
+        """The local readers that answer a HEARTBEAT (a HEARTBEAT_FRAG when ``frag``) of
+        ``count`` from ``writer_id``: reliable ones matched with a reliable writer (a best-effort
+        reader asks for nothing), for which the count is new. A count not greater than the last
+        one seen is a duplicate and is ignored (RTPS 2.3 8.3.7.5 and 8.3.7.6; HEARTBEAT and
+        HEARTBEAT_FRAG count apart); a new one is remembered."""
+        found = []
+        for ep, wp in self._readers_of(prefix, writer_id, reader_id):
+            if not wp.reliable or not ep.qos.reliable:
+                continue
+            if count <= (wp.last_hbfrag_count if frag else wp.last_hb_count):
+                continue
+            if frag:
+                wp.last_hbfrag_count = count
+            else:
+                wp.last_hb_count = count
+            found.append((ep, wp))
+        return found
+
+    def _answer(self, prefix: bytes, ep: LocalEndpoint, subs: list[bytes]) -> list[Send]:
+        """Datagrams of reader ``ep``'s answer (ACKNACK, NACK_FRAG) to participant ``prefix``'s
+        writer: a built-in SEDP reader answers on its metatraffic port, a user reader on its
+        user port."""
+        owner = self.participants.get(prefix)
+        if owner is None or not subs:
+            return []
+        return self._msg(owner.meta if not ep.topic else owner.user, prefix, subs)
+
+    def _nack_frag(self, prefix: bytes, ep: LocalEndpoint, wp: WriterProxy, seq: int,
+                   last: int = 0) -> list[bytes]:
+        """A NACK_FRAG naming the first 256 fragments of sample ``seq`` not here (up to fragment
+        ``last`` if given), or none when none is missing or no fragment of it is here."""
+        frags = self.assembler.missing(prefix, wp.writer_id, seq, last)[:256]
+        if not frags:
+            return []
+        wp.nackfrag_count += 1
+        return [b.nack_frag(ep.entity_id, wp.writer_id, seq, frags, wp.nackfrag_count)]
+
     def _on_heartbeat(self, prefix: bytes, sub: Heartbeat) -> list[Send]:
         out: list[Send] = []
-        for ep, wp in self._readers_of(prefix, sub.writer_id, sub.reader_id):
-            if not wp.reliable or not ep.qos.reliable or sub.count <= wp.last_hb_count:
-                continue
-            wp.last_hb_count = sub.count
+        for ep, wp in self._heard(prefix, sub.writer_id, sub.reader_id, sub.count, frag=False):
             if wp.next == 0:
                 wp.next = sub.first if ep.topic == "" else max(sub.first, 1)
             if sub.first > wp.next:
@@ -166,22 +205,12 @@ class ReaderSide(EndpointDiscovery):
                                   [s for s in missing if s not in partial], wp.acknack_count,
                                   final=not missing))
             for s in sorted(partial & set(missing))[:8]:
-                frags = self.assembler.missing(prefix, sub.writer_id, s)[:256]
-                if frags:
-                    wp.nackfrag_count += 1
-                    subs.append(b.nack_frag(ep.entity_id, sub.writer_id, s, frags, wp.nackfrag_count))
-            owner = self.participants.get(prefix)
-            if owner is not None:
-                out += self._msg(owner.meta if not ep.topic else owner.user, prefix, subs)
+                subs += self._nack_frag(prefix, ep, wp, s)
+            out += self._answer(prefix, ep, subs)
         return out
 
     def _on_heartbeat_frag(self, prefix: bytes, sub: HeartbeatFrag) -> list[Send]:
         out: list[Send] = []
-        for ep, wp in self._readers_of(prefix, sub.writer_id, sub.reader_id):
-            frags = self.assembler.missing(prefix, sub.writer_id, sub.seq, sub.last_frag)[:256]
-            owner = self.participants.get(prefix)
-            if frags and owner is not None and wp.reliable:
-                wp.nackfrag_count += 1
-                out += self._msg(owner.user, prefix, [b.nack_frag(ep.entity_id, sub.writer_id,
-                                                                  sub.seq, frags, wp.nackfrag_count)])
+        for ep, wp in self._heard(prefix, sub.writer_id, sub.reader_id, sub.count, frag=True):
+            out += self._answer(prefix, ep, self._nack_frag(prefix, ep, wp, sub.seq, sub.last_frag))
         return out
