@@ -6,9 +6,10 @@ reader, with a HEARTBEAT (the first and last sequence numbers held) to the relia
 reliable reader answers with an ACKNACK: its base acknowledges everything before it, its bits name
 the samples it lacks. ``_on_acknack`` resends those still in the history, GAPs those that left it
 (and those written before a VOLATILE reader matched), ignores numbers never written, and paces
-resends (MIN_RESEND_SECONDS); an ACKNACK count already seen is not answered again (RTPS 2.3
-8.4.15.8), and a preemptive ACKNACK (base 0, Fast DDS's form) gets a HEARTBEAT. ``_on_nackfrag``
-resends the fragments a NACK_FRAG names, or GAPs a sample no longer held. The periodic HEARTBEATs
+resends; an ACKNACK count already seen is not answered again (RTPS 2.3 8.4.15.8), and a
+preemptive ACKNACK (base 0, Fast DDS's form) gets a HEARTBEAT. ``_on_nackfrag`` resends the
+fragments a NACK_FRAG names (a count already seen: none), or GAPs a sample no longer held. Both
+pace their resends per reader proxy (``_paced``: MIN_RESEND_SECONDS apart). The periodic HEARTBEATs
 (their period doubling up to MAX_HEARTBEAT_SECONDS until the reader answers) go out from
 ``Participant.tick``.
 """
@@ -44,6 +45,27 @@ class WriterSide(ParticipantBase):
             out += self._msg(proxy.locator, proxy.prefix, subs)
         return out
 
+    def _paced(self, proxy: ReaderProxy, frag: bool, now: float) -> bool:
+        """Whether a retransmission an ACKNACK (a NACK_FRAG when ``frag``) asks of ``proxy``
+        must wait: those of each kind are at least MIN_RESEND_SECONDS apart per reader proxy,
+        else a peer raising its count gets every resend it asks for (a request of a few bytes in,
+        whole samples or fragments out); paced ones are counted, logged once per kind. The kinds
+        are paced apart: a reader asks for both in one datagram (Cyclone DDS: an ACKNACK for the
+        whole samples it lacks, a NACK_FRAG for the first partly received one). A retransmission
+        let through sets the time of its kind's last one."""
+        last = proxy.last_frag_resend if frag else proxy.last_resend
+        if now - last < MIN_RESEND_SECONDS:
+            kind = "NACK_FRAG" if frag else "ACKNACK"
+            self.note(f"{kind.replace('_', '').lower()}-storm", f"{kind}s from "
+                      f"{proxy.prefix.hex()} faster than one per {MIN_RESEND_SECONDS} s: "
+                      f"retransmissions paced")
+            return True
+        if frag:
+            proxy.last_frag_resend = now
+        else:
+            proxy.last_resend = now
+        return False
+
     def _on_acknack(self, prefix: bytes, sub: AckNack, now: float) -> list[Send]:
         ep = self.local.get(sub.writer_id)
         proxy = ep.proxies.get((prefix, sub.reader_id)) if ep and ep.kind == "writer" else None
@@ -74,13 +96,8 @@ class WriterSide(ParticipantBase):
             return self._msg(proxy.locator, proxy.prefix,
                              [b.gap(proxy.reader_id, ep.entity_id, min(early), proxy.first_relevant),
                               self._heartbeat(ep, proxy)])
-        if not missing:
+        if not missing or self._paced(proxy, False, now):
             return []
-        if now - proxy.last_resend < MIN_RESEND_SECONDS:
-            self.note("acknack-storm", f"ACKNACKs from {prefix.hex()} faster than one per "
-                      f"{MIN_RESEND_SECONDS} s: retransmissions paced")
-            return []
-        proxy.last_resend = now
         subs: list[bytes] = []
         gone = [s for s in missing if s not in ep.history]
         for s in missing:
@@ -109,6 +126,8 @@ class WriterSide(ParticipantBase):
         if payload is None:
             return self._msg(proxy.locator, proxy.prefix,
                              [b.gap(proxy.reader_id, ep.entity_id, sub.seq, sub.seq + 1)])
+        if not sub.missing or self._paced(proxy, True, now):
+            return []
         return self._msg(proxy.locator, proxy.prefix,
                          self._sample_subs(proxy.reader_id, ep.entity_id, sub.seq, payload,
                                            list(sub.missing)))
