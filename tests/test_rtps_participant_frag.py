@@ -149,8 +149,9 @@ def spdp_without_lease(prefix: bytes, little: bool) -> bytes:
     params = [(b.PID_PARTICIPANT_GUID, prefix + (0x1C1).to_bytes(4, "big")),
               (b.PID_METATRAFFIC_UNICAST_LOCATOR, loc(7999)),
               (b.PID_DEFAULT_UNICAST_LOCATOR, loc(8000))]
-    payload = (b"\x00\x03\x00\x00" if little else b"\x00\x02\x00\x00") + b"".join(
-        struct.pack(o + "HH", pid, len(v)) + v for pid, v in params) + struct.pack(o + "HH", b.PID_SENTINEL, 0)
+    encapsulation = b"\x00\x03\x00\x00" if little else b"\x00\x02\x00\x00"   # PL_CDR_LE / _BE
+    payload = (encapsulation + b"".join(struct.pack(o + "HH", pid, len(v)) + v for pid, v in params)
+               + struct.pack(o + "HH", b.PID_SENTINEL, 0))
     return b.header(prefix) + b.data(SPDP_READER, SPDP_WRITER, 1, payload)
 
 
