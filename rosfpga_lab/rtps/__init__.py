@@ -11,7 +11,8 @@ The other way, :mod:`rosfpga_lab.rtps.build` writes RTPS messages, SPDP/SEDP par
 and the ROS 2 names (``rt/...``, ``pkg::msg::dds_::Type_``), and
 :class:`rosfpga_lab.rtps.participant.Participant` is a whole DDS participant as a sans-IO state
 machine (discovery, matching, reliable and best-effort writers and readers; its entities in
-:mod:`rosfpga_lab.rtps.entities`); ``rosfpga_lab.graph.ros2`` runs it on sockets.
+:mod:`rosfpga_lab.rtps.entities`, its parts in ``participant_base``, ``spdp``, ``sedp``,
+``writer_side`` and ``reader_side``); ``rosfpga_lab.graph.ros2`` runs it on sockets.
 """
 
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError

@@ -95,7 +95,8 @@ class ReaderProxy:
     acked: int = 1                # every sample before it is acknowledged
     last_count: int = 0
     last_frag_count: int = 0
-    last_resend: float = -1.0
+    last_resend: float = -1.0         # of what an ACKNACK asked for
+    last_frag_resend: float = -1.0    # of what a NACK_FRAG asked for
     last_heartbeat: float = -1.0
     heartbeat_period: float = 0.0     # 0: the first period; doubles while unanswered
 
@@ -112,6 +113,7 @@ class WriterProxy:
     pending_bytes: int = 0
     gaps: dict[int, int] = field(default_factory=dict)   # GAP ranges start -> end ahead of next
     last_hb_count: int = -(1 << 31)
+    last_hbfrag_count: int = -(1 << 31)   # HEARTBEAT_FRAG counts on their own (RTPS 2.3 8.3.7.6)
     acknack_count: int = 0
     nackfrag_count: int = 0
 

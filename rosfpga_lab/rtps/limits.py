@@ -23,11 +23,16 @@ FRAGMENT_BYTES = 1344
 LEASE_SECONDS = 10.0
 ANNOUNCE_SECONDS = 1.0
 MAX_LEASE_SECONDS = 300.0
+#: ... the shortest one it believes, and the lease of a peer that announces none (RTPS's default
+#: PID_PARTICIPANT_LEASE_DURATION, as Cyclone DDS takes it).
+MIN_LEASE_SECONDS = 0.1
+DEFAULT_LEASE_SECONDS = 100.0
 #: Period of a reliable writer's HEARTBEATs while a reader has not acknowledged everything.
 HEARTBEAT_SECONDS = 0.05
 #: ... doubling while the reader does not answer, up to this (readers that are gone or fake).
 MAX_HEARTBEAT_SECONDS = 1.0
-#: A reader proxy's retransmissions are at least this far apart (ACKNACK storms).
+#: A reader proxy's retransmissions are at least this far apart (ACKNACK and NACK_FRAG storms;
+#: those each kind asks for are paced apart).
 MIN_RESEND_SECONDS = 0.005
 #: Remote participants and endpoints the participant keeps (SPDP/SEDP floods).
 MAX_REMOTE_PARTICIPANTS = 64
