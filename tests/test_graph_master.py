@@ -90,7 +90,14 @@ def test_parameter_server(master: EmbeddedMaster) -> None:
     assert p.getParam("/x", "/cfg") == [1, "Parameter [/cfg]", {"a": 1, "b": {"c": "s"}}]
     assert p.getParam("/x", "/cfg/b/c")[2] == "s"
     assert p.getParam("/x", "/nope") == [-1, "Parameter [/nope] is not set", 0]
-    assert p.searchParam("/ns/node", "gain") == [-1, "Cannot find parameter [gain] in an upwards search", ""]
+    # rosmaster 1.15.15 looks in the caller's own namespace first (ns_join(caller_id, key))
+    assert p.searchParam("/ns/node", "gain") == [1, "Found [/ns/node/gain]", "/ns/node/gain"]
+    assert p.searchParam("/ns/node", "gain/x") == [1, "Found [/ns/node/gain/x]", "/ns/node/gain/x"]
+    assert p.searchParam("/ns/other", "gain") == [-1, "Cannot find parameter [gain] in an upwards search", ""]
+    assert p.searchParam("/ns/node", "~gain") == [0, "Internal failure: invalid key", 0]
+    assert p.searchParam("node", "gain") == [0, "Internal failure: namespace must be global", 0]
+    assert p.setParam("/x", "/", 5) == \
+        [-1, "Error: invalid arguments: cannot set root of parameter tree to non-dictionary", 0]
     assert p.searchParam("/cfg/node", "b") == [1, "Found [/cfg/b]", "/cfg/b"]
     p.setParam("/x", "/ns/gain", 1)
     assert p.searchParam("/ns/sub/node", "gain") == [1, "Found [/ns/gain]", "/ns/gain"]

@@ -283,6 +283,11 @@ MASTER_CALLS = [
     ("getTopicTypes", 3), ("getSystemState", 3), ("hasParam", "/x", ""), ("getParam", "/x", ""),
     ("lookupService", "/x", ""), ("subscribeParam", "/x", "nope", "/d"),
     ("unregisterSubscriber", "/l", "x y", API),
+    # searchParam starts in the caller's own namespace; a '~' key or a relative caller is code 0
+    ("setParam", "/x", "/a/b/node/q", 1), ("searchParam", "/a/b/node", "q"),
+    ("searchParam", "/a/b/node", "q/z"), ("searchParam", "/a/b/other", "q"),
+    ("setParam", "/x", "/top", 1), ("searchParam", "/a/b/node", "top/"),
+    ("searchParam", "/a/b/node", "~q"), ("searchParam", "node", "top"), ("setParam", "/x", "/", 5),
 ]
 ROSCORE_PARAMS = {"/run_id", "/rosdistro", "/rosversion"}  # set by roscore (roslaunch), not rosmaster --core
 

@@ -38,7 +38,7 @@ from rosfpga_lab.graph.limits import (
     NOTIFY_TIMEOUT,
     NOTIFY_WORKERS,
 )
-from rosfpga_lab.graph.names import bind_address, canonical, namespace_of, resolve
+from rosfpga_lab.graph.names import bind_address, canonical, resolve
 from rosfpga_lab.graph.trace import Trace
 from rosfpga_lab.graph.xmlrpc import (
     XmlRpcServer,
@@ -100,7 +100,7 @@ class ParamTree:
         parts = self._parts(key)
         if not parts:
             if not isinstance(value, dict):
-                raise ValueError("cannot set the root namespace to a non-dictionary")
+                raise ValueError("cannot set root of parameter tree to non-dictionary")
             self.root = _copy(value)
             return
         node = self.root
@@ -491,7 +491,7 @@ class EmbeddedMaster:
             try:
                 self.params.set(key, value)
             except ValueError as exc:
-                return -1, str(exc), 0
+                return -1, f"Error: invalid arguments: {exc}", 0
             self._notify_params(key, value, ignore=caller_id)
         log.info("+PARAM [%s] by %s (from %s)", key, caller_id, request_peer() or "this process")
         return 1, f"parameter {key} set", 0
@@ -507,23 +507,26 @@ class EmbeddedMaster:
 
     @checked((("key", "key"),), 0)
     def searchParam(self, caller_id: str, key: str) -> tuple:
+        """rosmaster's search: a relative key's first part is looked for in ``caller_id`` itself
+        (the node's private namespace: roscpp's ``NodeHandle("~").searchParam`` relies on it),
+        then in each namespace above it; the answer joins the found namespace and the key as
+        given. A ``~`` key or a relative caller is rosmaster's code-0 internal failure."""
+        if key.startswith("~"):
+            return 0, "Internal failure: invalid key", 0
+        if not caller_id.startswith("/"):
+            return 0, "Internal failure: namespace must be global", 0
         if key.startswith("/"):
             with self._lock:
                 found = self.params.has(key)
             return (1, f"Found [{key}]", key) if found else \
                 (-1, f"Cannot find parameter [{key}] in an upwards search", "")
-        first = key.lstrip("~").split("/")[0]
-        rest = key.lstrip("~")[len(first):]
-        ns = namespace_of(caller_id)
+        first = next((p for p in key.split("/") if p), key)
+        parts = [p for p in caller_id.split("/") if p]
         with self._lock:
-            while True:
-                candidate = canonical(ns + first)
-                if self.params.has(candidate):
-                    full = canonical(candidate + rest)
-                    return 1, f"Found [{full}]", full
-                if ns == "/":
-                    break
-                ns = namespace_of(ns.rstrip("/"))
+            for depth in range(len(parts), -1, -1):
+                ns = "/" + "".join(p + "/" for p in parts[:depth])
+                if self.params.has(ns + first):
+                    return 1, f"Found [{ns + key}]", ns + key
         return -1, f"Cannot find parameter [{key}] in an upwards search", ""
 
     @checked((("caller_api", "api"), ("key", "key")), 0)
