@@ -80,6 +80,14 @@ def test_server_refuses_wrong_md5_unknown_service_and_answers_probes() -> None:
     probe = ServiceServerConnection("/n", lookup).receive_data(
         encode_header({"callerid": "/c", "md5sum": "*", "service": "/n/svc", "probe": "1"}))
     assert isinstance(probe[-1], ServiceAccepted) and probe[-1].probe
+    # rospy's rules (test_service_server_header_rules_are_rospys checks them against rospy)
+    kept = ServiceServerConnection("/n", lookup).receive_data(
+        encode_header({"callerid": "/c", "md5sum": "*", "service": "/n/svc", "persistent": "True"}))
+    assert isinstance(kept[-1], ServiceAccepted) and kept[-1].persistent
+    anonymous = ServiceServerConnection("/n", lookup).receive_data(
+        encode_header({"md5sum": "*", "service": "/n/svc"}))
+    assert isinstance(anonymous[-1], ServiceRejected)
+    assert anonymous[-1].error == "Missing required 'callerid' field"
 
 
 def test_request_and_response_bodies_are_bounded() -> None:
@@ -342,3 +350,78 @@ def test_a_publisher_update_during_subscribe_is_kept(master, monkeypatch) -> Non
         monkeypatch.setattr(sub_node, "_start_logging", publisher_appears)
         sub = sub_node.subscribe("/race", "std_msgs/String")
         assert [uri for uri, _ in sub.publisher_links()] == [pub_node.uri]
+
+
+# ---------------------------------------------------------------- the server's header rules, against rospy
+def _recv_exact(sock: socket.socket, n: int) -> bytes:
+    data = b""
+    while len(data) < n:
+        chunk = sock.recv(n - len(data))
+        if not chunk:
+            return data
+        data += chunk
+    return data
+
+
+def _read_reply_header(sock: socket.socket) -> dict[str, str]:
+    size = _recv_exact(sock, 4)
+    body = _recv_exact(sock, int.from_bytes(size, "little")) if len(size) == 4 else b""
+    return decode_header(size + body)[0] if body else {}
+
+
+def server_header_story(rosrpc: str, service: str) -> list:
+    """What a service server does with ``persistent=true`` (two calls on one connection) and
+    with headers missing a required field (its refusal text, or '' when it accepts)."""
+    host, port = rosrpc.removeprefix("rosrpc://").rstrip("/").rsplit(":", 1)
+    md5 = GOLDEN_SRV_MD5["roscpp/GetLoggers"]
+    out: list = []
+    with socket.create_connection((host, int(port)), timeout=5) as sock:
+        sock.sendall(encode_header({"callerid": "/story", "md5sum": md5, "service": service,
+                                    "persistent": "true"}))
+        out.append("error" in _read_reply_header(sock))
+        for _ in range(2):
+            try:
+                sock.sendall((0).to_bytes(4, "little"))  # GetLoggers' request is empty
+                ok_and_size = _recv_exact(sock, 5)
+            except OSError:
+                ok_and_size = b""
+            out.append(ok_and_size[:1])
+            if len(ok_and_size) == 5:
+                _recv_exact(sock, int.from_bytes(ok_and_size[1:], "little"))
+    full = {"callerid": "/story", "md5sum": md5, "service": service}
+    for missing in ("md5sum", "callerid"):
+        with socket.create_connection((host, int(port)), timeout=5) as sock:
+            sock.sendall(encode_header({k: v for k, v in full.items() if k != missing}))
+            out.append(_read_reply_header(sock).get("error", ""))
+    return out
+
+
+def test_service_server_header_rules_are_rospys(tmp_path: Path) -> None:
+    """``persistent=true`` keeps the connection (rospy: ``'1'``/``'true'``; before, the lab
+    closed after one call) and a header without md5sum or callerid is refused with rospy's text
+    (before, a missing callerid was accepted and a missing md5sum called a mismatch)."""
+    want = [False, b"\x01", b"\x01", "Missing required 'md5sum' field",
+            "Missing required 'callerid' field"]
+    with real_rosmaster(tmp_path) as uri:
+        code = ("import rospy\nrospy.init_node('py_srv')\nprint('READY', flush=True)\n"
+                "rospy.sleep(20)\n")
+        proc = subprocess.Popen([ROS_PYTHON, "-c", code], env=ros_env(uri, tmp_path),
+                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+        try:
+            assert proc.stdout is not None and proc.stdout.readline().strip() == b"READY"
+            import xmlrpc.client
+            master = xmlrpc.client.ServerProxy(uri)
+            deadline = time.monotonic() + 20
+            while (found := master.lookupService("/t", "/py_srv/get_loggers"))[0] != 1:
+                assert time.monotonic() < deadline, found
+                time.sleep(0.1)
+            assert server_header_story(found[2], "/py_srv/get_loggers") == want
+        finally:
+            proc.kill()
+            proc.wait()
+        with Node("/lab_srv", uri) as node:
+            node.advertise("/t", "std_msgs/String")  # a node serves its logger services once it has a topic
+            assert node.logging_ready.wait(5)
+            found = xmlrpc.client.ServerProxy(uri).lookupService("/t", "/lab_srv/get_loggers")
+            assert found[0] == 1, found
+            assert server_header_story(found[2], "/lab_srv/get_loggers") == want

@@ -22,6 +22,14 @@ from rosfpga_lab.tcpros.header import HeaderDecoder, encode_error_header, encode
 from rosfpga_lab.tcpros.limits import MAX_FIELD_BYTES, MAX_FRAME_BYTES, MAX_HEADER_BYTES
 
 
+#: what a client's ``persistent`` field may say to keep the connection (lower-cased): rospy's
+#: ``ServiceImpl.handle`` takes ``'1'`` and ``'true'`` in any case, roscpp ``"1"`` and ``"true"``
+PERSISTENT_VALUES = ("1", "true")
+#: the fields a client's header must have, in the order rospy's ``service_connection_handler``
+#: checks them (its refusal names the first one missing)
+REQUIRED_CLIENT_FIELDS = ("service", "md5sum", "callerid")
+
+
 @dataclass(frozen=True)
 class ServiceSpec:
     """What a service server answers a client's header with."""
@@ -150,7 +158,7 @@ class ServiceServerConnection:
             assert self.spec is not None
             probe = fields.get("probe") == "1"
             events.append(ServiceAccepted(encode_header(service_reply_fields(self.callerid, self.spec)),
-                                          probe, fields.get("persistent") == "1"))
+                                          probe, fields.get("persistent", "").lower() in PERSISTENT_VALUES))
             if probe:
                 self.done = True
                 return events
@@ -159,9 +167,10 @@ class ServiceServerConnection:
         return events
 
     def _check(self, fields: dict[str, str]) -> str:
-        service = fields.get("service", "")
-        if not service:
-            return "Missing required 'service' field in header"
+        for required in REQUIRED_CLIENT_FIELDS:
+            if required not in fields:
+                return f"Missing required '{required}' field"
+        service = fields["service"]
         spec = self.lookup(service)
         if spec is None:
             return f"no provider for service [{service}] in {self.callerid}"
