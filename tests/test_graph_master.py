@@ -112,6 +112,11 @@ def test_new_node_with_same_name_replaces_old(master: EmbeddedMaster) -> None:
     p.registerPublisher("/t", "/a", "std_msgs/String", "http://127.0.0.1:1/")
     p.registerPublisher("/t", "/a", "std_msgs/String", "http://127.0.0.1:2/")
     assert p.lookupNode("/x", "/t")[2] == "http://127.0.0.1:2/"
+    # rosmaster drops every registration of the old instance, its services included
+    p.registerService("/t", "/t/svc", "rosrpc://127.0.0.1:5", "http://127.0.0.1:2/")
+    p.registerSubscriber("/t", "/b", "std_msgs/String", "http://127.0.0.1:3/")
+    assert p.lookupService("/x", "/t/svc") == [-1, "no provider", ""]
+    assert p.getSystemState("/x")[2] == [[], [["/b", ["/t"]]], []]
 
 
 # ----------------------------------------------------------------------------- XML-RPC safety

@@ -288,6 +288,11 @@ MASTER_CALLS = [
     ("searchParam", "/a/b/node", "q/z"), ("searchParam", "/a/b/other", "q"),
     ("setParam", "/x", "/top", 1), ("searchParam", "/a/b/node", "top/"),
     ("searchParam", "/a/b/node", "~q"), ("searchParam", "node", "top"), ("setParam", "/x", "/", 5),
+    # a node that registers again from a new API (a restart) loses its old services too
+    ("registerService", "/rs", "/rs/svc", "rosrpc://127.0.0.1:1", "http://127.0.0.1:2/"),
+    ("registerPublisher", "/rs", "/rs/t", "std_msgs/String", "http://127.0.0.1:3/"),
+    ("lookupService", "/x", "/rs/svc"), ("getSystemState", "/x"),
+    ("unregisterService", "/rs", "/rs/svc", "rosrpc://127.0.0.1:1"),
 ]
 ROSCORE_PARAMS = {"/run_id", "/rosdistro", "/rosversion"}  # set by roscore (roslaunch), not rosmaster --core
 
