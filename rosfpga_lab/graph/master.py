@@ -319,8 +319,8 @@ class EmbeddedMaster:
                         del regs[caller_id]
             # its services go too (rosmaster's unregister_all): a restarted node that no longer
             # offers one must not leave the dead process's rosrpc:// URI in lookupService
-            for service, regs in list(self.services.items()):
-                if caller_id in regs and regs[caller_id][1] == old:
+            for service, providers in list(self.services.items()):
+                if caller_id in providers and providers[caller_id][1] == old:
                     del self.services[service]
         self.nodes[caller_id] = api
         self.trace.names[api] = caller_id
