@@ -137,6 +137,28 @@ def test_an_acknack_and_a_nack_frag_in_one_datagram_are_both_answered() -> None:
     assert resent_fragments(out, w) == [3, 4]
 
 
+def test_nack_frags_for_several_samples_in_one_datagram_are_all_answered() -> None:
+    """The lab's own reader asks for the fragments of up to 8 partly received samples in one
+    datagram: each sample is paced on its own, so all are resent (before: only the first
+    within MIN_RESEND_SECONDS), and the same sample asked again at once is still paced."""
+    a, c, w, r = pair(Qos(True, 5))
+    net = Net(a, c)
+    net.run([], steps=20)
+    for k in range(3):
+        a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * 40000, net.now)
+    t = net.now + 1.0
+    ask = b.header(c.guid_prefix) + b"".join(b.nack_frag(r, w, seq, [2, 5], 60 + seq)
+                                             for seq in (1, 2, 3))
+    out = a.receive(ask, c.user, t)
+    frags = [(s.seq, s.frag_start) for _, _, d in out for s in parse_message(d).submessages
+             if isinstance(s, DataFrag) and s.writer_id == w]
+    assert frags == [(1, 2), (1, 5), (2, 2), (2, 5), (3, 2), (3, 5)]
+    again = b.header(c.guid_prefix) + b.nack_frag(r, w, 2, [2], 70)
+    assert resent_fragments(a.receive(again, c.user, t + MIN_RESEND_SECONDS / 2), w) == []
+    assert resent_fragments(a.receive(again[:20] + b.nack_frag(r, w, 2, [2], 71), c.user,
+                                      t + MIN_RESEND_SECONDS * 1.5), w) == [2]
+
+
 # ---- SPDP without PID_PARTICIPANT_LEASE_DURATION ------------------------------------------------
 
 def spdp_without_lease(prefix: bytes, little: bool) -> bytes:

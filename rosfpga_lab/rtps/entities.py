@@ -95,8 +95,9 @@ class ReaderProxy:
     acked: int = 1                # every sample before it is acknowledged
     last_count: int = 0
     last_frag_count: int = 0
-    last_resend: float = -1.0         # of what an ACKNACK asked for
-    last_frag_resend: float = -1.0    # of what a NACK_FRAG asked for
+    #: When retransmissions were last let through: key 0 for an ACKNACK's, a sample's sequence
+    #: number for a NACK_FRAG's of that sample (only samples still in the history are kept).
+    resent: dict[int, float] = field(default_factory=dict)
     last_heartbeat: float = -1.0
     heartbeat_period: float = 0.0     # 0: the first period; doubles while unanswered
 

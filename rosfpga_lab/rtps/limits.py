@@ -32,7 +32,7 @@ HEARTBEAT_SECONDS = 0.05
 #: ... doubling while the reader does not answer, up to this (readers that are gone or fake).
 MAX_HEARTBEAT_SECONDS = 1.0
 #: A reader proxy's retransmissions are at least this far apart (ACKNACK and NACK_FRAG storms;
-#: those each kind asks for are paced apart).
+#: an ACKNACK's and each sample's NACK_FRAG's are paced apart).
 MIN_RESEND_SECONDS = 0.005
 #: Remote participants and endpoints the participant keeps (SPDP/SEDP floods).
 MAX_REMOTE_PARTICIPANTS = 64

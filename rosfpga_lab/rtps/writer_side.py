@@ -9,7 +9,8 @@ the samples it lacks. ``_on_acknack`` resends those still in the history, GAPs t
 resends; an ACKNACK count already seen is not answered again (RTPS 2.3 8.4.15.8), and a
 preemptive ACKNACK (base 0, Fast DDS's form) gets a HEARTBEAT. ``_on_nackfrag`` resends the
 fragments a NACK_FRAG names (a count already seen: none), or GAPs a sample no longer held. Both
-pace their resends per reader proxy (``_paced``: MIN_RESEND_SECONDS apart). The periodic HEARTBEATs
+pace their resends per reader proxy (``_paced``: MIN_RESEND_SECONDS apart, each sample's
+fragments apart from the others'). The periodic HEARTBEATs
 (their period doubling up to MAX_HEARTBEAT_SECONDS until the reader answers) go out from
 ``Participant.tick``.
 """
@@ -45,25 +46,27 @@ class WriterSide(ParticipantBase):
             out += self._msg(proxy.locator, proxy.prefix, subs)
         return out
 
-    def _paced(self, proxy: ReaderProxy, frag: bool, now: float) -> bool:
-        """Whether a retransmission an ACKNACK (a NACK_FRAG when ``frag``) asks of ``proxy``
-        must wait: those of each kind are at least MIN_RESEND_SECONDS apart per reader proxy,
-        else a peer raising its count gets every resend it asks for (a request of a few bytes in,
-        whole samples or fragments out); paced ones are counted, logged once per kind. The kinds
-        are paced apart: a reader asks for both in one datagram (Cyclone DDS: an ACKNACK for the
-        whole samples it lacks, a NACK_FRAG for the first partly received one). A retransmission
-        let through sets the time of its kind's last one."""
-        last = proxy.last_frag_resend if frag else proxy.last_resend
-        if now - last < MIN_RESEND_SECONDS:
-            kind = "NACK_FRAG" if frag else "ACKNACK"
+    def _paced(self, proxy: ReaderProxy, seq: int, now: float, oldest: int = 0) -> bool:
+        """Whether a retransmission asked of ``proxy`` must wait: ``seq`` 0 for what an ACKNACK
+        asks, else the fragments of sample ``seq`` a NACK_FRAG asks.
+
+        Each is let through at most once per MIN_RESEND_SECONDS, else a peer raising its count
+        gets every resend it asks for (a request of a few bytes in, whole samples or fragments
+        out); paced ones are counted, logged once per kind. ACKNACK and each sample's NACK_FRAG
+        are paced apart: a reader asks for several in one datagram (Cyclone DDS: an ACKNACK for
+        the whole samples it lacks and a NACK_FRAG for the first partly received one; the lab's
+        reader: NACK_FRAGs for up to 8 samples), and what it may get per interval stays bounded
+        by the history, as an ACKNACK's resend is. Samples before ``oldest`` (no longer held)
+        are forgotten."""
+        if now - proxy.resent.get(seq, -1.0) < MIN_RESEND_SECONDS:
+            kind = "NACK_FRAG" if seq else "ACKNACK"
             self.note(f"{kind.replace('_', '').lower()}-storm", f"{kind}s from "
                       f"{proxy.prefix.hex()} faster than one per {MIN_RESEND_SECONDS} s: "
                       f"retransmissions paced")
             return True
-        if frag:
-            proxy.last_frag_resend = now
-        else:
-            proxy.last_resend = now
+        for gone in [s for s in proxy.resent if 0 < s < oldest]:
+            del proxy.resent[gone]
+        proxy.resent[seq] = now
         return False
 
     def _on_acknack(self, prefix: bytes, sub: AckNack, now: float) -> list[Send]:
@@ -96,7 +99,7 @@ class WriterSide(ParticipantBase):
             return self._msg(proxy.locator, proxy.prefix,
                              [b.gap(proxy.reader_id, ep.entity_id, min(early), proxy.first_relevant),
                               self._heartbeat(ep, proxy)])
-        if not missing or self._paced(proxy, False, now):
+        if not missing or self._paced(proxy, 0, now):
             return []
         subs: list[bytes] = []
         gone = [s for s in missing if s not in ep.history]
@@ -126,7 +129,7 @@ class WriterSide(ParticipantBase):
         if payload is None:
             return self._msg(proxy.locator, proxy.prefix,
                              [b.gap(proxy.reader_id, ep.entity_id, sub.seq, sub.seq + 1)])
-        if not sub.missing or self._paced(proxy, True, now):
+        if not sub.missing or self._paced(proxy, sub.seq, now, next(iter(ep.history))):
             return []
         return self._msg(proxy.locator, proxy.prefix,
                          self._sample_subs(proxy.reader_id, ep.entity_id, sub.seq, payload,
