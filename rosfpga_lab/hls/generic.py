@@ -15,6 +15,7 @@ version, :mod:`rosfpga_lab.hls.generator`).
 
 from __future__ import annotations
 
+import math
 import struct
 from dataclasses import dataclass
 from pathlib import Path
@@ -594,6 +595,9 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
 
 # -- test frames and the models' output ----------------------------------------------------------
 
+_INT64_MAX = int(np.iinfo(np.int64).max)
+
+
 def _random_value(step: Step, rng: np.random.Generator) -> object:
     """A value of a SCALAR step that its check (if any) accepts."""
     chk = step.check
@@ -606,6 +610,10 @@ def _random_value(step: Step, rng: np.random.Generator) -> object:
         if chk is not None and chk.op is CheckOp.RANGE:
             lo = -1e3 if chk.low is None else float(chk.low)
             hi = 1e3 if chk.high is None else float(chk.high)
+            if not math.isfinite(hi - lo):  # an infinite bound, or a span beyond a float's
+                a, b = max(lo, -1e3), min(hi, 1e3)
+                # (-1e3..1e3 inside the range, else its finite end: the draw is never NaN)
+                lo, hi = (a, b) if a <= b else ((lo, lo) if math.isfinite(lo) else (hi, hi))
             return float(dt.type(lo + (hi - lo) * rng.random()))
         return float(dt.type(rng.standard_normal() * 100))
     info = np.iinfo(dt)
@@ -613,6 +621,10 @@ def _random_value(step: Step, rng: np.random.Generator) -> object:
     if chk is not None and chk.op is CheckOp.RANGE:
         lo = lo if chk.low is None else int(chk.low)
         hi = hi if chk.high is None else int(chk.high)
+    # drawn in the field's own integer type: numpy's default (int64) cannot hold a uint64's
+    # upper half; every other type keeps the default's draws (and the shipped test frames)
+    if hi > _INT64_MAX:
+        return int(rng.integers(lo, hi, endpoint=True, dtype=np.uint64))
     return int(rng.integers(lo, hi, endpoint=True))
 
 
