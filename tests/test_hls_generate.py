@@ -2,8 +2,16 @@
 
 Golden files live in ``tests/golden/hls/<config>/`` (the default flavour, Vitis HLS) and
 ``tests/golden/hls-vivado/<config>/`` (``hls: {flavour: vivado}``, only the files that differ from
-the default's): every text file the generator writes for the three shipped configurations. A template change shows up here as a diff. To accept a
-change on purpose, regenerate them and review the diff before committing::
+the default's): every text file the generator writes for the three shipped Image configurations.
+The generated projects of the other examples, LaserScan and the lab's own message on both wires
+(``rosfpga-lab generate``: the HLS C++, ``rtl/`` and the test frames), have theirs in
+``tests/golden/hls/<config>/`` too: every file rendered for the configuration (``rtl/`` holds the
+walk ``rfl_layout.vh``, the wrapper ``rfl_node.v`` and the testbench ``rfl_tb.v``), the SHA-256
+of the test frames (``tb_frames.sha256``); the files copied from the library (``hls_include/``,
+``rtl/rfl_fifo.v`` and the generic modules of ``rosfpga_lab/rtl/generic/``) are held equal to
+their sources instead, so a change to those needs no new golden file. A template change shows
+up here as a diff. To accept a change on purpose, regenerate them all (one command) and review
+the diff before committing::
 
     ROSFPGA_UPDATE_GOLDEN=1 .venv/bin/python -m pytest tests/test_hls_generate.py -k golden
     git diff tests/golden/hls tests/golden/hls-vivado
@@ -62,19 +70,15 @@ def _meta_bits(header: str) -> int:
     return bits
 
 
-@pytest.mark.parametrize("flavour", HLS_FLAVOURS)
-@pytest.mark.parametrize("stem", CONFIGS)
-def test_golden_files(stem: str, flavour: str) -> None:
-    texts = render(_config(stem, flavour))
-    assert set(texts) == set(TEMPLATE_FILES)
-    # The default flavour's files in golden/hls/; another flavour's golden/hls-<flavour>/ holds
-    # only the files that differ from the default's (a file absent there equals the default's).
-    default = GOLDEN / stem
-    folder = default if flavour == DEFAULT_HLS_FLAVOUR else GOLDEN.with_name(f"hls-{flavour}") / stem
+def _check_golden(folder: Path, texts: dict[str, str], default: Path | None = None) -> None:
+    """``texts`` equal the golden files in ``folder`` (a file absent there: ``default``'s, when
+    given); under ROSFPGA_UPDATE_GOLDEN, write them first (only those differing from
+    ``default``'s)."""
+    default = default or folder
     if UPDATE:
-        folder.mkdir(parents=True, exist_ok=True)
         for name, text in texts.items():
             own = folder / name
+            own.parent.mkdir(parents=True, exist_ok=True)
             if folder != default and (default / name).exists() \
                     and (default / name).read_text(encoding="utf-8") == text:
                 own.unlink(missing_ok=True)
@@ -93,6 +97,68 @@ def test_golden_files(stem: str, flavour: str) -> None:
                                                 f"generated/{name}", n=2))
             problems.append(diff)
     assert not problems, "generated code differs from the golden files:\n" + "\n".join(problems)
+
+
+@pytest.mark.parametrize("flavour", HLS_FLAVOURS)
+@pytest.mark.parametrize("stem", CONFIGS)
+def test_golden_files(stem: str, flavour: str) -> None:
+    texts = render(_config(stem, flavour))
+    assert set(texts) == set(TEMPLATE_FILES)
+    # The default flavour's files in golden/hls/; another flavour's golden/hls-<flavour>/ holds
+    # only the files that differ from the default's (a file absent there equals the default's).
+    default = GOLDEN / stem
+    folder = default if flavour == DEFAULT_HLS_FLAVOUR else GOLDEN.with_name(f"hls-{flavour}") / stem
+    _check_golden(folder, texts, default)
+
+
+#: The other shipped examples (generic projects), each on both wires.
+GENERIC_CONFIGS = ["fpga_laserscan_min", "fpga_laserscan_min_cdr", "fpga_samples_dilate",
+                   "fpga_samples_dilate_cdr"]
+#: The golden file holding the SHA-256 of a generic project's test frames.
+FRAMES_GOLDEN = "tb_frames.sha256"
+
+
+def _library_copies() -> dict[str, Path]:
+    """Files a generic project copies from the library unchanged: project path -> source."""
+    from rosfpga_lab.hls.generator import HLS_HEADERS, INCLUDE_DIR
+    from rosfpga_lab.rtl.generic import GENERIC_MODULES, GENERIC_VERILOG_DIR, VIDEO_APP
+    from rosfpga_lab.rtl.sim import VERILOG_DIR
+
+    copies = {f"hls_include/{h}": INCLUDE_DIR / h for h in HLS_HEADERS}
+    copies.update({f"rtl/{m}": GENERIC_VERILOG_DIR / m for m in GENERIC_MODULES})
+    copies.update({f"rtl/{m}": VERILOG_DIR / m for m in ("rfl_fifo.v", VIDEO_APP)})
+    return copies
+
+
+@pytest.mark.parametrize("stem", GENERIC_CONFIGS)
+def test_golden_files_of_generated_projects(stem: str, tmp_path: Path) -> None:
+    """Every file ``rosfpga-lab generate`` writes for the example: rendered ones equal their
+    golden files, the test frames their golden SHA-256, copies of the library their sources."""
+    from rosfpga_lab.rtl.project import generate_project
+
+    generate_project(load_config(DATA / f"{stem}.yaml"), tmp_path)
+    written = {str(p.relative_to(tmp_path)): p.read_bytes()
+               for p in sorted(tmp_path.rglob("*")) if p.is_file() and p.name != MANIFEST}
+    copies = _library_copies()
+    texts, frames = {}, []
+    for name, data in written.items():
+        if name in copies:
+            assert data == copies[name].read_bytes(), f"{name} is not a copy of {copies[name]}"
+        elif name.endswith(".bin"):
+            frames.append(f"{hashlib.sha256(data).hexdigest()}  {name}\n")
+        else:
+            texts[name] = data.decode("utf-8")
+    assert {"rtl/rfl_layout.vh", "rtl/rfl_node.v", "rtl/rfl_tb.v", "layout.h"} <= set(texts)
+    assert len(frames) == 2 and any(n.startswith("rtl/rfl_g") for n in written)
+    texts[FRAMES_GOLDEN] = "".join(frames)
+    folder = GOLDEN / stem
+    if UPDATE:  # a file the generator no longer writes goes too
+        for old in folder.rglob("*"):
+            if old.is_file() and str(old.relative_to(folder)) not in texts:
+                old.unlink()
+    _check_golden(folder, texts)
+    assert sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()) == \
+        sorted(texts), f"{folder} holds files the generator no longer writes (regenerate)"
 
 
 def test_generation_is_deterministic(tmp_path: Path) -> None:
