@@ -20,15 +20,30 @@ Tolerances, and why:
 from __future__ import annotations
 
 import math
+import struct
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from realros import require_rtl
+from rtltools import require_iverilog
+from rosfpga_lab.hls.generic import program_from_cdr, spec_from_layout
+from rosfpga_lab.hls.program import frame_clocks
 from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, image_frame
+from rosfpga_lab.hw.cdrlayout import derive_cdr_layout
+from rosfpga_lab.hw.layout import Action, StepKind, derive_layout
+from rosfpga_lab.msg import serialize
+from rosfpga_lab.msg.cdr import serialize_cdr
+from rosfpga_lab.msg.ros2 import ros2_registry
+from rosfpga_lab.msg.strategies import message
 from rosfpga_lab.rtl import build, rtl_params, run
-from rosfpga_lab.rtl.cycles import compare, format_rows, model_report
+from rosfpga_lab.rtl.cycles import compare, format_rows, model_report, read_stats
+from rosfpga_lab.rtl.generic import project_files, simulate_project
+from test_hw_walker import definitions  # the models' strategy over message definitions
 from test_rtl_sim import random_image, small_config
 
 pytestmark = pytest.mark.rtl
@@ -98,3 +113,81 @@ def test_the_clocked_fifo2axi_model_matches_the_rtl_clock_by_clock(encoding: str
         bad = np.nonzero(got != want)[0]
         assert bad.size == 0, f"{name} differs first at clock {bad[0]}: RTL {got[bad[0]]}, model {want[bad[0]]}"
     assert (rtl["m_axis_tready"] == 0).any() and (rtl["s_tvalid"] == 0).any()  # both were exercised
+
+
+# -- generated circuits (any message type): the walk's cycle model equals the RTL ----------------
+
+def _small_limits(steps: Any) -> dict[str, int]:
+    return {s.path + ("[]" if s.label.endswith("[] length") else ""): 3 for s in steps[1:]
+            if s.kind is StepKind.LENGTH and s.action is not Action.STREAM}
+
+
+@settings(max_examples=6, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_the_generated_circuits_clocks_equal_the_walks_model(
+        data: st.DataObject, tmp_path_factory: pytest.TempPathFactory) -> None:
+    """Random message definitions (the models' strategy: every field kind, nesting, arrays of
+    messages), each on TCPROS or CDR: every accepted frame's clocks in the RTL (``make rtlsim``,
+    no backpressure), first byte in to last byte out, and the publisher's span, equal
+    ``hls.program.frame_clocks``'s (the RTL is the oracle; Icarus Verilog only, no C++)."""
+    require_iverilog()
+    reg, type_name, stream = data.draw(definitions())
+    cdr = data.draw(st.booleans())
+    values = [data.draw(message(ros2_registry(reg) if cdr else reg, type_name))
+              for _ in range(2)]
+    n = max(1, len(values[0][stream]))  # (the circuit streams at least one element)
+    values = [v if len(v[stream]) == n else {**v, stream: [0] * n} for v in values]
+    if cdr:
+        walk = derive_cdr_layout(reg, type_name, stream=stream, stream_length=n)
+        walk = derive_cdr_layout(reg, type_name, stream=stream, stream_length=n,
+                                 limits_=_small_limits(walk.base.steps))
+        prog = program_from_cdr(walk)
+        spec = spec_from_layout(walk.layout, walk.registry, program=prog, wire="cdr",
+                                op="dilate", ksize=3)
+        bodies = [serialize_cdr(ros2_registry(reg), type_name, v) for v in values]
+    else:
+        layout = derive_layout(reg, type_name, stream=stream, stream_length=n)
+        layout = derive_layout(reg, type_name, stream=stream, stream_length=n,
+                               limits_=_small_limits(layout.steps))
+        spec = spec_from_layout(layout, reg, op="erode", ksize=3)
+        prog = spec.program
+        bodies = [serialize(reg, type_name, v) for v in values]
+    frames = [struct.pack("<I", len(b)) + b for b in bodies]
+    where = tmp_path_factory.mktemp("cycles")
+    for name, blob in project_files(spec).items():
+        (where / name).parent.mkdir(parents=True, exist_ok=True)
+        (where / name).write_bytes(blob)
+    for frame in frames:
+        model = frame_clocks(prog, frame)
+        _out, statuses = simulate_project(where, frame, target="rtlsim", simulator="iverilog",
+                                          out="c")
+        assert statuses == ["SUB_OK"]
+        rtl = read_stats(where / "c" / "stats.txt")
+        assert rtl["tx"].last - rtl["rx"].first + 1 == model.total
+        assert rtl["publisher_out"].last - rtl["publisher_out"].first + 1 == model.publisher
+        assert rtl["tx"].count == model.out_bytes and rtl["rx"].count >= model.in_bytes - 3
+
+
+def test_cli_rtl_cycles_of_a_generated_circuit(capsys: pytest.CaptureFixture[str]) -> None:
+    """``rtl cycles CONFIG`` of the custom-message example on CDR: each test frame without
+    backpressure exactly as the model says, with 50 % within four standard deviations."""
+    from rosfpga_lab.cli import main
+
+    require_iverilog()
+    data = Path(__file__).resolve().parent.parent / "data"
+    assert main(["rtl", "cycles", str(data / "fpga_samples_dilate_cdr.yaml"), "--simulator",
+                 "iverilog"]) == 0
+    captured = capsys.readouterr()
+    rows = [line.split() for line in captured.out.splitlines()
+            if line.startswith("frame ") and line.split()[1].isdigit()]
+    assert len(rows) == 4 and "generating the project" in captured.err
+    for row in rows:
+        out_bytes, bp, model, rtl = (int(row[3].replace(",", "")), row[4],
+                                     int(row[5].replace(",", "")), int(row[6].replace(",", "")))
+        if bp == "0%":
+            assert model == rtl and row[7] == "+0.00%" and row[8] == row[9]
+        else:
+            assert abs(rtl - model) <= 4 * math.sqrt(out_bytes * 0.5) / 0.5 + 16
+    assert main(["rtl", "cycles", str(data / "fpga_samples_dilate.yaml"), "--size", "4x4"]) == 1
+    assert "--size are for the Image circuit on TCPROS" in capsys.readouterr().err

@@ -332,6 +332,8 @@ def run_cycles(args: argparse.Namespace) -> int:
     from rosfpga_lab.rtl.cycles import compare, format_rows
 
     config = load_config(args.config)
+    if not config.is_image or config.wire == "cdr":
+        return _generic_cycles(args, config)
     encodings = args.encoding or list(PIXEL_FORMATS)
     unknown = [e for e in encodings if e not in PIXEL_FORMATS]
     if unknown:
@@ -357,6 +359,29 @@ def run_cycles(args: argparse.Namespace) -> int:
     print(format_rows(rows))
     _say(f"done in {time.perf_counter() - start:.1f} s")
     return 0
+
+
+def _generic_cycles(args: argparse.Namespace, config: object) -> int:
+    """``rtl cycles`` of a generated circuit: its test frames, RTL beside the walk's model."""
+    from rosfpga_lab.config import NodeConfig
+    from rosfpga_lab.rtl.cycles import format_generic_rows, generic_rows
+
+    assert isinstance(config, NodeConfig)
+    image_only = [flag for flag, given in (("--size", args.size), ("--encoding", args.encoding))
+                  if given]
+    if image_only:
+        print(f"rosfpga-lab rtl cycles: error: {', '.join(image_only)} are for the Image "
+              f"circuit on TCPROS; {config.subscriber.type} on {config.wire} is a generated "
+              "circuit (its test frames are measured)", file=sys.stderr)
+        return 1
+    start = time.perf_counter()
+    rows = generic_rows(config, bp=args.bp, simulator=args.simulator, progress=_say)
+    print(f"Clocks per frame of the generated {config.subscriber.type} circuit on {config.wire}, "
+          f"first byte in to last byte out ({config.application.op}); model: the walk's "
+          "cycle model (hls.program.frame_clocks), exact without backpressure")
+    print(format_generic_rows(rows))
+    _say(f"done in {time.perf_counter() - start:.1f} s")
+    return 0 if all(r.model == r.rtl for r in rows if r.bp == 0) else 1
 
 
 def run_synth(args: argparse.Namespace) -> int:

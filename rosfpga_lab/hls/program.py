@@ -258,8 +258,13 @@ def _u32(b: bytes) -> int:
     return int.from_bytes(b, "little")
 
 
-def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
+def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
+              ) -> tuple[bytes, bytes, int]:
     """Walk one whole frame as the subscriber does.
+
+    ``timeline``: appended a 1 per clock the Verilog walker takes a byte and a 0 per clock it
+    does not, from the frame length's first byte to the clock it accepts the frame (see
+    :func:`frame_clocks`).
 
     Returns:
         ``(carried bytes, streamed bytes, output body length)``.
@@ -278,9 +283,12 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
     out_len = 0
     loops: list[list[int]] = []  # [elements left, suppressed]
     pc = 0
+    tl = timeline if timeline is not None else bytearray()
+    tl += b"\1" * 4                                   # the frame length
 
     def take(n: int, status: int, align: int = 1) -> bytes:
         nonlocal pos
+        start = pos
         if n and align > 1:
             if pos + pad(pos, align) >= fend:  # the frame ends before this field
                 raise Refused(FRAME_LENGTH_STATUS, bool(stream))
@@ -289,6 +297,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
             raise Refused(status or FRAME_LENGTH_STATUS, bool(stream))
         b = frame[pos:pos + n]
         pos += n
+        tl.extend(b"\1" * (pos - start))               # a byte per clock, padding included
         return b
 
     def out_pad(n: int, align: int) -> None:
@@ -313,17 +322,20 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
     while True:
         ins = prog.instrs[pc]
         quiet = suppressed > 0
+        tl.append(0)  # a clock to decode each instruction (then one after each count and field)
         if ins.op == Op.DONE:
             after = end - pos  # CDR: Cyclone's unannounced zeros up to a multiple of END_ALIGN
             if ins.status2 and pos != fend and 0 < after < END_ALIGN and \
                     after == -(pos - ALIGN_ORIGIN) % END_ALIGN:
                 if any(frame[pos:end]):
                     raise Refused(ins.status2, bool(stream))
+                tl.extend(b"\1" * after)  # taken before the frame is accepted
             elif pos != fend:
                 raise Refused(ins.status, bool(stream))
             return bytes(carry), bytes(stream), out_len
         if ins.op == Op.ENCAP:
             b = take(4, ins.status)
+            tl.append(0)
             if b[:2] != ins.const[:2]:
                 raise Refused(ins.status, bool(stream))
             tail = b[3] & ENCAP_PAD_MASK
@@ -333,6 +345,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
             out_len += len(ins.const)
         elif ins.op == Op.FIXED:
             b = take(ins.size, ins.status, ins.align)
+            tl += b"\0" if ins.size else b""
             out_pad(ins.size, ins.align)
             if ins.sub in (Sub.CARRY, Sub.RANGE):
                 carry += b
@@ -345,9 +358,11 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
             out_len += 0 if quiet else ins.size
         elif ins.op == Op.VAR:
             lb = take(4, ins.status, ins.align)
+            tl.append(0)
             n = _u32(lb)
             fits(ins, n)
             b = take(n * ins.size, ins.status, ins.elem_align)
+            tl.append(0)
             text = b[:-1] if ins.nul else b
             if ins.sub == Sub.CARRY:
                 carry += lb + b
@@ -375,6 +390,7 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
                     carry += lb
                 out_pad(4, ins.align)
                 out_len += 0 if quiet else 4
+            tl.append(0)
             zero = ins.variable and ins.pub == Pub.ZERO
             if n == 0:
                 pc = ins.jump + 1
@@ -392,15 +408,30 @@ def subscribe(prog: Program, frame: bytes) -> tuple[bytes, bytes, int]:
         pc += 1
 
 
-def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int) -> bytes:
-    """The frame the publisher writes for an accepted frame (see the module docstring)."""
+def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int,
+            timeline: bytearray | None = None) -> bytes:
+    """The frame the publisher writes for an accepted frame (see the module docstring).
+
+    ``timeline``: appended a 1 per clock the Verilog walker writes a byte and a 0 per clock it
+    does not, from its first byte (output always ready, the stream's bytes there in time)."""
     out = bytearray(out_len.to_bytes(4, "little"))
+    tl = timeline if timeline is not None else bytearray()
+    written = 0
+
+    def moved() -> None:
+        """A clock per byte written since the last call."""
+        nonlocal written
+        tl.extend(b"\1" * (len(out) - written))
+        written = len(out)
+
     ci = 0
     si = 0
     loops: list[int] = []
     pc = 0
     while True:
         ins = prog.instrs[pc]
+        moved()
+        tl.append(0)  # a clock to decode each instruction (then one after each count)
         if ins.op == Op.DONE:
             assert len(out) == 4 + out_len, (len(out), out_len)
             return bytes(out)
@@ -436,6 +467,8 @@ def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int) 
                 n, body = ins.count, stream[si:si + ins.count * ins.size]
                 si += ins.count * ins.size
             out += n.to_bytes(4, "little")
+            moved()
+            tl.append(0)
             if body:
                 out += bytes(pad(len(out), ins.elem_align))
             out += body
@@ -445,11 +478,15 @@ def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int) 
                 out += bytes(pad(len(out), ins.align))
                 if ins.pub == Pub.ZERO:
                     out += bytes(4)
+                    moved()
+                    tl.append(0)
                     pc = ins.jump + 1
                     continue
                 n = _u32(carry[ci:ci + 4])
                 ci += 4
                 out += n.to_bytes(4, "little")
+                moved()
+            tl.append(0)
             if n == 0:
                 pc = ins.jump + 1
                 continue
@@ -483,3 +520,54 @@ def run_program(prog: Program, frames: list[bytes], apply: Callable[[bytes], byt
         seq += 1
     return bytes(out), statuses
 
+
+
+#: Clocks from the subscriber accepting a frame to the publisher's first byte (its fields are
+#: handed over on a register; the publisher leaves its idle state on the next clock).
+ACCEPT_TO_PUBLISH = 2
+#: Clocks through the output FIFO (the publisher's byte to the node's output).
+TX_LATENCY = 2
+
+
+@dataclass(frozen=True)
+class FrameClocks:
+    """Clocks of one accepted frame in the generated Verilog (``rfl_gtop``), from the walkers'
+    timelines (:func:`subscribe`, :func:`publish`: a byte per clock, a clock to decode each
+    instruction, one after each count and each field the subscriber takes).
+
+    Attributes:
+        subscriber: from the frame length's first byte in to the clock the frame is accepted.
+        publisher: from the publisher's first byte out to its last.
+        total: from the first byte into the subscriber to the last byte out of the node,
+            ``subscriber + ACCEPT_TO_PUBLISH - 1 + publisher + TX_LATENCY`` with the output
+            always ready; with ``ready`` < 1 at least the output bytes at that share after the
+            publisher starts.
+        in_bytes, out_bytes: the frames' sizes.
+    """
+
+    subscriber: int
+    publisher: int
+    total: int
+    in_bytes: int
+    out_bytes: int
+
+
+def frame_clocks(prog: Program, frame: bytes, ready: float = 1.0) -> FrameClocks:
+    """The clocks of ``frame`` through the generated circuit (see :class:`FrameClocks`), the
+    output ready ``ready`` of the clocks.
+
+    Raises:
+        Refused: the circuit refuses the frame (its clocks are not modelled).
+        ValueError: ``ready`` is not in (0, 1].
+    """
+    if not 0 < ready <= 1:
+        raise ValueError(f"ready must be in (0, 1], got {ready}")
+    sub_tl, pub_tl = bytearray(), bytearray()
+    carry, stream, out_len = subscribe(prog, frame, sub_tl)
+    out = publish(prog, carry, stream, out_len, prog.seq_start, pub_tl)
+    pub = pub_tl.rindex(1) + 1
+    total = len(sub_tl) + ACCEPT_TO_PUBLISH - 1 + pub + TX_LATENCY
+    if ready < 1:
+        total = max(total, len(sub_tl) + ACCEPT_TO_PUBLISH + TX_LATENCY - 1
+                    + -(-len(out) * 1000 // round(ready * 1000)))
+    return FrameClocks(len(sub_tl), pub, total, len(frame), len(out))

@@ -6,15 +6,28 @@ stages, the clock of its first and last handshake (the testbench records them). 
 from the first byte into the subscriber to the last byte out of the node (the output FIFO
 included, so that backpressure on the output counts). :func:`compare` sets the spans
 beside :func:`rosfpga_lab.hw.cycles.account`'s figures for the same frame.
+
+A generated circuit (any other message type, and Image on CDR) is measured the same way
+through its generated project's ``make rtlsim`` (:func:`generic_rows`) and set beside the walk's
+cycle model, :func:`rosfpga_lab.hls.program.frame_clocks`: a byte per clock through subscriber
+and publisher, a clock to decode each instruction and one after each count and field; equal to
+the RTL without backpressure, an estimate with it (the output's random ready share).
 """
 
 from __future__ import annotations
 
+import struct
+import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
+from rosfpga_lab.config import CUSTOM, NodeConfig
+from rosfpga_lab.hls.program import Program, Refused, frame_clocks
 from rosfpga_lab.hw import Pipeline
 from rosfpga_lab.hw.cycles import CycleReport, account
-from rosfpga_lab.rtl.sim import RtlBuild, RtlResult, run
+from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.sim import STREAMS, RtlBuild, RtlResult, StreamTiming, run
 
 #: Stage -> (stream of its first input, stream of its last output).
 STAGES: dict[str, tuple[str, str]] = {
@@ -96,4 +109,110 @@ def format_rows(rows: list[CycleRow]) -> str:
     for r in rows:
         lines.append(f"{r.label:<22}{r.bp / 10:>7.0f}%{r.model:>10,}{r.rtl:>10,}"
                      f"{r.error * 100:>+7.2f}%  " + "".join(f"{r.spans[s]:>12,}" for s in stages))
+    return "\n".join(lines)
+
+
+# -- generated (generic) circuits: any message type ----------------------------------------------
+
+@dataclass(frozen=True)
+class GenericCycleRow:
+    """One frame of a generated circuit: the model's clocks (``hls.program.frame_clocks``) and
+    the RTL's, first byte into the subscriber to last byte out of the node, and the
+    publisher's span (first byte out to last)."""
+
+    label: str
+    bp: int
+    in_bytes: int
+    out_bytes: int
+    model: int
+    rtl: int
+    model_publisher: int
+    rtl_publisher: int
+
+    @property
+    def error(self) -> float:
+        """(RTL - model) / model."""
+        return (self.rtl - self.model) / self.model
+
+
+def read_stats(path: Path) -> dict[str, StreamTiming]:
+    """The per-stream first/last handshake clocks and counts of a testbench's ``stats.txt``."""
+    out = {}
+    for line in path.read_text().splitlines():
+        parts = line.split()
+        if parts and parts[0].isdigit():
+            out[STREAMS[int(parts[0])]] = StreamTiming(*(int(v) for v in parts[1:]))
+    return out
+
+
+def good_frames(frames: bytes, prog: Program) -> list[bytes]:
+    """The frames of ``frames`` (back to back, each behind its 4-byte length) the circuit
+    accepts."""
+    out, at = [], 0
+    while at + 4 <= len(frames):
+        frame = frames[at:at + 4 + struct.unpack_from("<I", frames, at)[0]]
+        at += len(frame)
+        try:
+            frame_clocks(prog, frame)
+        except Refused:
+            continue
+        out.append(frame)
+    return out
+
+
+def generic_rows(config: NodeConfig, *, bp: int = 500, simulator: str | None = None,
+                 frames: list[bytes] | None = None, work_dir: Path | None = None,
+                 progress: Callable[[str], None] | None = None) -> list[GenericCycleRow]:
+    """Each accepted frame (default: the generated project's test frames) through the generated
+    project's RTL (``make rtlsim``) without and with ``bp`` per mille output backpressure, beside
+    the cycle model.
+
+    Raises:
+        RtlError: the configuration has no generated circuit (Image on TCPROS: its own
+            ``rtl cycles``; ``op: custom``), or the simulation failed.
+    """
+    from rosfpga_lab.hls.errors import GenerateError
+    from rosfpga_lab.hls.generic import spec_from_config
+    from rosfpga_lab.rtl.generic import simulate_project
+    from rosfpga_lab.rtl.project import generate_project
+
+    say = progress or (lambda _line: None)
+    try:
+        prog = spec_from_config(config).program
+    except GenerateError as exc:
+        raise RtlError(f"no generated circuit to count: {exc}") from None
+    if config.application.op == CUSTOM:
+        raise RtlError("application.op is custom: the generated project has no RTL")
+    with tempfile.TemporaryDirectory(prefix="rosfpga-cycles-") as tmp:
+        project = Path(work_dir or tmp) / "project"
+        say(f"generating the project of {prog.type_in} on {config.wire} in {project} ...")
+        generate_project(config, project, force=True)
+        if frames is None:
+            frames = good_frames((project / "tb_input.bin").read_bytes(), prog)
+        rows = []
+        for k, frame in enumerate(frames):
+            for share in sorted({0, bp}):
+                say(f"frame {k} ({len(frame):,} bytes), backpressure {share / 10:g} % ...")
+                out, statuses = simulate_project(project, frame, target="rtlsim",
+                                                 simulator=simulator, bp=share, out="cycles")
+                if statuses != ["SUB_OK"]:
+                    raise RtlError(f"frame {k}: the RTL said {statuses}, the model accepts it")
+                rtl = read_stats(project / "cycles" / "stats.txt")
+                model = frame_clocks(prog, frame, 1 - share / 1000)
+                rows.append(GenericCycleRow(
+                    f"frame {k}", share, len(frame), len(out), model.total,
+                    rtl["tx"].last - rtl["rx"].first + 1, model.publisher,
+                    rtl["publisher_out"].last - rtl["publisher_out"].first + 1))
+        return rows
+
+
+def format_generic_rows(rows: list[GenericCycleRow]) -> str:
+    """The rows as an aligned text table."""
+    head = (f"{'frame':<10}{'in B':>8}{'out B':>8}{'backpr.':>8}{'model':>10}{'RTL':>10}"
+            f"{'diff':>8}  {'publisher: model':>16}{'RTL':>8}")
+    lines = [head, "-" * len(head)]
+    for r in rows:
+        lines.append(f"{r.label:<10}{r.in_bytes:>8,}{r.out_bytes:>8,}{r.bp / 10:>7.0f}%"
+                     f"{r.model:>10,}{r.rtl:>10,}{r.error * 100:>+7.2f}%  "
+                     f"{r.model_publisher:>16,}{r.rtl_publisher:>8,}")
     return "\n".join(lines)
