@@ -234,8 +234,9 @@ def test_a_planted_bug_inside_the_generated_top_fails_its_proof(tmp_path: Path) 
 
 def test_rtl_prove_config_names_what_it_cannot_prove(tmp_path: Path,
                                                      capsys: pytest.CaptureFixture[str]) -> None:
-    """Image on TCPROS (the hand-written circuit) and op: custom have no generated top; a
-    module check's option is refused with a configuration (no tools needed to say so)."""
+    """Image on TCPROS (the hand-written circuit) and op: custom have no generated top, a top
+    with megabits of FIFO is refused before the tools run; a module check's option is refused
+    with a configuration."""
     from rosfpga_lab.cli import main
     from rosfpga_lab.config import load_config, parse_config
     from rosfpga_lab.rtl.errors import RtlError
@@ -248,6 +249,12 @@ def test_rtl_prove_config_names_what_it_cannot_prove(tmp_path: Path,
     custom = CHANNEL.replace("{op: dilate, ksize: 3}", "{op: custom, source: neg.cpp}")
     with pytest.raises(RtlError, match="application.op is custom"):
         node_files(parse_config(custom, base_dir=tmp_path))
+    # a 640x480 rgba8 stream: its FIFO alone is 11.7 Mbit (PyPI's Yosys gave up after 90 s)
+    from rosfpga_lab.rtl.nodeproof import prove_config
+
+    with pytest.raises(RtlError, match=r"holds 11,\d{3},\d{3} bits of memory \(the FIFO after "
+                       r"the application \(a whole stream\): 11,673,\d{3}\), over the 262,144"):
+        prove_config(load_config(data / "fpga_dilate_rgba8_cdr.yaml"))
     require_formal()
     (tmp_path / "ch.yaml").write_text(CHANNEL)
     assert main(["rtl", "prove", str(tmp_path / "ch.yaml"), "--only", "fifo"]) == 1

@@ -13,7 +13,9 @@ wire (``connect -set fv_rx_tvalid dut.u_top.rx_tvalid``). Every status must be a
 walk's table and the node busy while output is pending. SymbiYosys proves it by k-induction
 (``mode prove``: true in every reachable state) with Yices, at the configuration's sizes: FIFO
 depths, carry memory, stream length and walk are the ones the configuration generates (large
-FIFOs make the proof slower, not different; :data:`NODE_PROOF_DEPTH` clocks of induction).
+FIFOs make the proof slower, not different; :data:`NODE_PROOF_DEPTH` clocks of induction). A
+top with more memory than ``rtl.limits.FORMAL_MAX_MEMORY_BITS`` is refused before the tools run
+(:func:`check_size`): prove a copy of the configuration with smaller FIFOs or stream.
 
 Only generated (generic) tops: ``sensor_msgs/Image`` on TCPROS has the hand-written circuit,
 whose modules and top ``rtl prove`` without a configuration proves (:mod:`rosfpga_lab.rtl.proofs`).
@@ -42,6 +44,7 @@ from rosfpga_lab.rtl.generic import (
 from rosfpga_lab.rtl.proofs import (
     ENV_INCLUDE, FORMAL_DIR, Proof, ProofResult, formal_missing_reason, run_sby, sby_command,
 )
+from rosfpga_lab.rtl.limits import FORMAL_MAX_MEMORY_BITS
 from rosfpga_lab.rtl.sim import NODE_FILE, VERILOG_DIR, find_tool
 
 #: The streams inside ``rfl_gtop`` the proof watches: its wire prefix, in data-path order,
@@ -106,6 +109,34 @@ def node_files(config: NodeConfig) -> tuple[GenericSpec, dict[str, bytes]]:
     return spec, files
 
 
+def memory_bits(spec: GenericSpec) -> dict[str, int]:
+    """The bits of each memory of the generated top (what the proof maps to flip-flops)."""
+    p = generic_params(spec)
+    beat = 9 * p["EBYTES"] + 2                 # a FIFO's beat: TDATA, TKEEP, TUSER, TLAST
+    return {"input FIFO": 8 * p["RX_DEPTH"], "output FIFO": 8 * p["TX_DEPTH"],
+            "FIFO to the application": beat * p["AXIS_DEPTH"],
+            "FIFO after the application (a whole stream)": beat * p["OUT_DEPTH"],
+            "carry memory": 8 * p["CARRY_BYTES"]}
+
+
+def check_size(config: NodeConfig, spec: GenericSpec) -> None:
+    """Refuse a top whose memories are over :data:`~rosfpga_lab.rtl.limits.FORMAL_MAX_MEMORY_BITS`.
+
+    Raises:
+        RtlError: naming the memories and what to do.
+    """
+    bits = memory_bits(spec)
+    total = sum(bits.values())
+    if total > FORMAL_MAX_MEMORY_BITS:
+        largest = max(bits, key=bits.__getitem__)
+        raise RtlError(
+            f"the generated top of {config.path or 'the configuration'} holds {total:,} bits of "
+            f"memory (the {largest}: {bits[largest]:,}), over the {FORMAL_MAX_MEMORY_BITS:,} a "
+            "proof takes on (rosfpga_lab.rtl.limits.FORMAL_MAX_MEMORY_BITS: it maps every "
+            "memory to flip-flops); prove a copy of the configuration with smaller fifo depths, "
+            "stream length or image size: the walk and the modules are the same")
+
+
 def node_sby_text(spec: GenericSpec, mode: str = "prove", depth: int = NODE_PROOF_DEPTH) -> str:
     """The ``.sby`` file of the proof (its files in the work directory, see :func:`node_files`):
     ``prove`` (k-induction) or ``bmc`` (bounded, every stream of :data:`NODE_STREAMS`)."""
@@ -162,10 +193,11 @@ def prove_config(config: NodeConfig, *, depth: int = NODE_PROOF_DEPTH, bmc_depth
             SymbiYosys could not run.
     """
     say = progress or (lambda _line: None)
+    spec, files = node_files(config)
+    check_size(config, spec)
     reason = formal_missing_reason()
     if reason:
         raise RtlError(reason)
-    spec, files = node_files(config)
     for name, path in (replace or {}).items():
         if name not in files:
             raise RtlError(f"{name} is not a file of the generated top ({', '.join(files)})")
