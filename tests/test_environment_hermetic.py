@@ -56,7 +56,8 @@ def test_a_variable_a_test_sets_is_seen(monkeypatch: pytest.MonkeyPatch) -> None
 def test_a_sample_of_the_suite_passes_in_a_ros_users_shell(tmp_path: Path) -> None:
     env = {**os.environ, **USER_SHELL}
     run = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--rootdir", str(HERE.parent),
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+         "--rootdir", str(HERE.parent),
          *(str(HERE / test) for test in SAMPLE)],
         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
