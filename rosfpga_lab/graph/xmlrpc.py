@@ -446,24 +446,14 @@ class XmlRpcServer:
                         "retry later").encode(), False))
                     _discard(conn, http.missing, deadline)
                     return
+                body = None
                 try:
-                    event = _next_event(conn, http, deadline)
-                    if not isinstance(event, Body):   # the decoder gives a body after a head
-                        raise XmlRpcError("connection closed before the request's body")
-                    body = event.data
-                except BaseException as exc:
-                    self._release(reserved)
-                    if isinstance(exc, XmlRpcError):
-                        status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
-                                  else "400 Bad Request")
-                        conn.sendall(_http_response(status, str(exc).encode(), False))
-                        return
-                    if isinstance(exc, TimeoutError):
-                        conn.settimeout(1.0)
-                        conn.sendall(_http_response("408 Request Timeout", (
-                            f"request not complete within {self.request_timeout} s").encode(), False))
-                        return
-                    raise
+                    body = self._request_body(conn, http, deadline)
+                finally:
+                    if body is None:
+                        self._release(reserved)
+                if body is None:
+                    return
                 if not self._set_busy(conn, True):
                     self._release(reserved)
                     return
@@ -494,6 +484,25 @@ class XmlRpcServer:
             with self._lock:
                 self._conns.pop(conn, None)
             hard_close(conn)
+
+    def _request_body(self, conn: socket.socket, http: HttpDecoder,
+                      deadline: _Deadline) -> bytes | None:
+        """The body of the request whose head ``http`` gave; None after answering 400, 413 or
+        408 (the caller then closes the connection)."""
+        try:
+            event = _next_event(conn, http, deadline)
+            if not isinstance(event, Body):   # the decoder gives a body after a head
+                raise XmlRpcError("connection closed before the request's body")
+            return event.data
+        except XmlRpcError as exc:
+            status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
+                      else "400 Bad Request")
+            conn.sendall(_http_response(status, str(exc).encode(), False))
+        except TimeoutError:
+            conn.settimeout(1.0)
+            conn.sendall(_http_response("408 Request Timeout", (
+                f"request not complete within {self.request_timeout} s").encode(), False))
+        return None
 
     def _dispatch(self, body: bytes) -> tuple[bytes, str, tuple, Any]:
         try:
