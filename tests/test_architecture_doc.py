@@ -26,7 +26,7 @@ def _table_rows(section: str) -> list[list[str]]:
 
 def _levels_of_test_layers() -> list[set[str]]:
     """``LEVELS`` as tests/test_layers.py writes it, read from its source (not imported)."""
-    tree = ast.parse((ROOT / "tests" / "test_layers.py").read_text(encoding="utf-8"))
+    tree = ast.parse(Path(__file__).with_name("test_layers.py").read_text(encoding="utf-8"))
     for node in tree.body:
         if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "LEVELS"
                                                 for t in node.targets):
