@@ -40,3 +40,15 @@ def test_quick_start_commands_are_lab_sh_s() -> None:
     assert commands == ["./lab.sh", "./lab.sh test"]
     usage = (ROOT / "lab.sh").read_text(encoding="utf-8")
     assert "#   ./lab.sh          set up" in usage and "#   ./lab.sh test     set up" in usage
+
+
+def test_the_notebook_table_names_every_notebook_and_real_packages() -> None:
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme.split("## The notebooks", 1)[1].split("\n## ", 1)[0]
+    rows = [line.strip("|").split("|") for line in section.splitlines() if line.startswith("| `")]
+    assert {row[0].strip(" `") for row in rows} == {
+        p.stem for p in (ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")}
+    packages = {p.name for p in (ROOT / "rosfpga_lab").iterdir() if (p / "__init__.py").exists()}
+    for row in rows:
+        drives = set(re.findall(r"`([a-z_]+)`", row[2]))
+        assert drives and drives <= packages, row
