@@ -18,6 +18,7 @@ from realros import real_rosmaster, require_cxx, require_ros  # noqa: E402
 #: and ROS 2 (``ROS_DOMAIN_ID``, the RMW and DDS vendors' settings) variables, the RTL harness's
 #: and benches' ``RFL_*`` files and switches, and the lab's own switches that are not CI's
 #: ``ROSFPGA_REQUIRE_*`` (those say what a run must have; CI sets them on purpose).
+#: ``XDG_CACHE_HOME`` stays: it says where the user keeps caches (RTL builds), not what they hold.
 CALLER_PREFIXES = ("ROS_", "RMW_", "CYCLONEDDS_", "FASTRTPS_", "FASTDDS_", "ROSCONSOLE_", "RFL_")
 CALLER_NAMES = ("ROSFPGA_HIDE_CYCLONE", "ROSFPGA_LAB_PYTHON")
 
