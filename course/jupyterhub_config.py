@@ -1,4 +1,4 @@
-# JupyterHub for a rosfpga_lab course: one server, many Unix users (README: Teaching a course).
+# JupyterHub for a rosfpga_lab course: one server, many Unix users (course/README.md).
 #
 # Run as root from the hub's state directory (it keeps jupyterhub.sqlite and the cookie secret
 # there), with the shared environment that course/setup.sh made:

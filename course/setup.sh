@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Set up a course server for rosfpga_lab (README: Teaching a course). Run as root, once, from a
+# Set up a course server for rosfpga_lab (course/README.md). Run as root, once, from a
 # checkout of the lab (again after `git pull` to update it):
 #   sudo course/setup.sh
 # What it does:
@@ -52,7 +52,7 @@ mkdir -p "$PREFIX"
 "$PREFIX/venv/bin/python" -m pip install --quiet --no-deps --force-reinstall "$repo"
 
 # Students see nbgrader's Assignments list (fetch, validate, submit); the teacher's panels stay
-# hidden, as the teacher grades from the command line (README). So does the notebook toolbar's
+# hidden, as the teacher grades from the command line (course/README.md). So does the notebook toolbar's
 # Validate button: on the copies in ~/rosfpga-lab, which carry no graded cells, it said "Success"
 # for an unanswered notebook (the Assignments list validates the fetched, graded versions).
 "$PREFIX/venv/bin/jupyter" labextension disable --level=sys_prefix @jupyter/nbgrader:formgrader \

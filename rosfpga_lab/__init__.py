@@ -1,8 +1,9 @@
 """rosfpga_lab: rebuild a ROS-compliant FPGA component, byte for byte, in Python.
 
-The package is layered (see ``DESIGN.md`` in the course material and the README):
-``msg`` -> ``tcpros`` -> ``config`` -> ``graph`` -> ``hw`` -> ``hls`` -> ``component`` -> ``widgets``/``checks``
--> ``cli``. A layer imports only the layers below it.
+The package is layered (``ARCHITECTURE.md`` in the repository: the layers, the conventions, the
+commands): ``errors`` -> ``msg`` -> ``tcpros``/``rtps`` -> ``config`` -> ``graph`` -> ``hw`` ->
+``hls`` -> ``rtl`` -> ``component`` -> ``widgets``/``checks`` -> ``bench`` -> ``cli``. A layer
+imports only the layers below it (``tests/test_layers.py``).
 """
 
 from rosfpga_lab.errors import LabError

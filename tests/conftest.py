@@ -13,6 +13,39 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from realros import real_rosmaster, require_cxx, require_ros  # noqa: E402
 
+#: What a caller's shell may hold that changes what the lab, or a program a test starts, does:
+#: ROS 1 (``ROS_MASTER_URI``, ``ROS_HOSTNAME``, ``ROS_IP``, ``ROS_NAMESPACE``, ``ROS_IPV6``, ...)
+#: and ROS 2 (``ROS_DOMAIN_ID``, the RMW and DDS vendors' settings) variables, the RTL harness's
+#: and benches' ``RFL_*`` files and switches, and the lab's own switches that are not CI's
+#: ``ROSFPGA_REQUIRE_*`` (those say what a run must have; CI sets them on purpose).
+#: ``XDG_CACHE_HOME`` stays: it says where the user keeps caches (RTL builds), not what they hold.
+CALLER_PREFIXES = ("ROS_", "RMW_", "CYCLONEDDS_", "FASTRTPS_", "FASTDDS_", "ROSCONSOLE_", "RFL_")
+CALLER_NAMES = ("ROSFPGA_HIDE_CYCLONE", "ROSFPGA_LAB_PYTHON")
+
+
+def _caller_variables() -> list[str]:
+    return sorted(k for k in os.environ if k.startswith(CALLER_PREFIXES) or k in CALLER_NAMES)
+
+
+@pytest.fixture(autouse=True, scope="session")
+def no_caller_ros_environment_for_the_session() -> Iterator[None]:
+    """The suite runs as in a clean shell: the caller's ``ROS_*`` (and :data:`CALLER_PREFIXES`)
+    variables are gone for the whole session, so module and session fixtures do not see them
+    either; they are restored at the end."""
+    with pytest.MonkeyPatch.context() as patch:
+        for name in _caller_variables():
+            patch.delenv(name)
+        yield
+
+
+@pytest.fixture(autouse=True)
+def no_caller_ros_environment(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each test starts without those variables too (a test, or a fixture it asks for, sets
+    what it needs with ``monkeypatch.setenv`` or a subprocess's ``env=``; ``monkeypatch`` undoes
+    it after the test)."""
+    for name in _caller_variables():
+        monkeypatch.delenv(name)
+
 
 @pytest.fixture(autouse=True, scope="session")
 def dev_null_stays_writable() -> Iterator[None]:

@@ -184,8 +184,8 @@ def test_autograde_scores_solution_untouched_and_half_done(nbgrader_cmd: list[st
     assert "not right yet" in page and "Score: 1.0 / 3.0" in page     # what the student gets back
 
 
-# The orders the help and the README show: options first (the usage line), options between the
-# course and the notebooks (README), options last.
+# The orders the help and course/README.md show: options first (the usage line), options between
+# the course and the notebooks (course/README.md), options last.
 CLI_ORDERS = [
     ["--source", "{src}", "{course}", "02_tcpros", "04_fifo_to_axi_stream"],
     ["{course}", "--source", "{src}", "02_tcpros", "04_fifo_to_axi_stream"],
@@ -207,14 +207,14 @@ def test_nbgrader_command_takes_options_between_positionals(order: list[str], tm
 
 
 def _readme_grading_block() -> str:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = (ROOT / "course" / "README.md").read_text(encoding="utf-8")
     section = text.split("**Grading with nbgrader.**", 1)[1]
     return section.split("```bash\n", 1)[1].split("```", 1)[0]
 
 
 def test_readme_grading_commands_run_as_written_in_a_new_shell(nbgrader_cmd: list[str],
                                                                tmp_path: Path) -> None:
-    """The README's commands, one script in a fresh /bin/sh whose PATH has no environment on it
+    """course/README.md's commands, one script in a fresh /bin/sh whose PATH has no environment on it
     (a teacher's new shell, script or cron job): only the install places are swapped for this
     machine's. Before the fix nbgrader failed there: it runs ``alembic`` by name."""
     block = _readme_grading_block()

@@ -99,7 +99,7 @@ def run_ros2(args: argparse.Namespace) -> int:
     """``demo --ros2``: 0 when every frame came back bit-exact."""
     import os
 
-    from rosfpga_lab.component.ros2 import run_demo_ros2
+    from rosfpga_lab.component.demo import run_demo_ros2
     from rosfpga_lab.errors import LabError
 
     raw = args.domain if args.domain is not None else os.environ.get("ROS_DOMAIN_ID") or "0"

@@ -60,8 +60,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "an autograded answer cell (the part up to '# END SOLUTION') and a locked autograder "
         "test cell (the check call after it, worth one point). Also writes "
         "COURSE_DIR/nbgrader_config.py when missing. Then, in COURSE_DIR: nbgrader "
-        "generate_assignment NAME, release_assignment, collect, autograde (README: Teaching a "
-        "course). Needs no nbgrader itself; the course server has it (pip install -e '.[course]'). "
+        "generate_assignment NAME, release_assignment, collect, autograde (course/README.md). "
+        "Needs no nbgrader itself; the course server has it (pip install -e '.[course]'). "
         "Options may stand anywhere, e.g. rosfpga-lab notebooks nbgrader ~/course --source "
         "notebooks/solutions 02_tcpros.")
     grading.add_argument("course_dir", type=Path, metavar="COURSE_DIR",

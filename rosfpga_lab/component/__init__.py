@@ -21,13 +21,14 @@ Quick use::
 Modules: ``fpga`` (:class:`FpgaComponent`, :class:`FrameRecord`), ``stats``
 (:class:`ComponentStats`), ``sources`` (pictures: synthetic, grace_hopper, files), ``camera``
 (:class:`Camera`, :class:`Viewer`), ``checker`` (:class:`Checker`, OpenCV as the oracle),
-``demo`` (:func:`run_demo`), ``limits``, ``errors``.
+``demo`` (:func:`run_demo`, :func:`run_demo_ros2`), ``ros2`` (:class:`Ros2Component`: the node on
+ROS 2, and the camera's and viewer's ROS 2 adapters), ``limits``, ``errors``.
 """
 
 from rosfpga_lab.component.camera import Camera, SentFrame, ViewedFrame, Viewer, stamp_of
 from rosfpga_lab.component.checker import CheckReport, Checker, expected_output
 from rosfpga_lab.component.demo import (
-    DemoResult, DemoRig, default_config, run_demo, write_figure,
+    DemoResult, DemoRig, Ros2DemoResult, default_config, run_demo, run_demo_ros2, write_figure,
 )
 from rosfpga_lab.component.errors import (ComponentConfigError, ComponentError, ComponentShutDown,
                                           SourceError)
@@ -41,7 +42,7 @@ __all__ = [
     "SOURCES", "Camera", "CheckReport", "Checker", "ComponentConfigError", "ComponentError",
     "ComponentShutDown",
     "ComponentStats", "DemoResult", "DemoRig", "FpgaComponent", "FrameRecord", "ImageSource",
-    "LatencySummary", "LatencyWindow", "SentFrame", "SourceError", "ViewedFrame", "Viewer",
-    "default_config", "expected_output", "master_answers", "open_source", "run_demo", "stamp_of",
-    "to_rgb", "write_figure",
+    "LatencySummary", "LatencyWindow", "Ros2DemoResult", "SentFrame", "SourceError", "ViewedFrame",
+    "Viewer", "default_config", "expected_output", "master_answers", "open_source", "run_demo",
+    "run_demo_ros2", "stamp_of", "to_rgb", "write_figure",
 ]

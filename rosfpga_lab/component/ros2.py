@@ -19,13 +19,10 @@ import logging
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from rosfpga_lab.component.errors import ComponentConfigError, ComponentError
+from rosfpga_lab.component.errors import ComponentConfigError
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import MessageInfo
@@ -185,86 +182,3 @@ class Ros2Component:
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
-
-
-@dataclass
-class Ros2DemoResult:
-    """What :func:`run_demo_ros2` saw: frames sent, received, bit-exact against OpenCV."""
-
-    domain: int
-    sent: int
-    received: int
-    exact: int
-    mismatched: list[int] = field(default_factory=list)
-    counts: dict[str, int] = field(default_factory=dict)
-    notes: list[str] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return self.sent > 0 and self.exact == self.sent and not self.mismatched
-
-    def lines(self) -> list[str]:
-        out = [f"ROS 2, DDS domain {self.domain}: camera -> component (CDR circuit) -> viewer",
-               f"frames sent {self.sent}, received {self.received}, bit-exact against OpenCV "
-               f"{self.exact}" + (f", mismatched {self.mismatched[:10]}" if self.mismatched else ""),
-               f"component: {self.counts}"]
-        return out + [f"  {n}" for n in self.notes if n.startswith("not matched")]
-
-
-def run_demo_ros2(config: NodeConfig | str | Path | None = None, *, frames: int = 30,
-                  rate: float = 30.0, source: str = "grace_hopper", domain: int = 0,
-                  model: str = "fast", timeout: float = 30.0) -> Ros2DemoResult:
-    """The demo on ROS 2: the component, a viewer on its output and a camera on its input, each
-    its own DDS participant on 127.0.0.1 in ``domain``; every output compared with OpenCV run
-    on its input (matched by header.stamp)."""
-    from rosfpga_lab.component.camera import Camera, Viewer
-    from rosfpga_lab.component.checker import expected_output
-    from rosfpga_lab.component.demo import default_config
-
-    cfg = default_config() if config is None else (
-        config if isinstance(config, NodeConfig) else load_config(config))
-    img = cfg.image
-    comp = Ros2Component(cfg, domain=domain, model=model).start()
-    try:
-        with Viewer(cfg.publisher.topic, name="/viewer", domain=domain) as viewer, \
-                Camera(cfg.subscriber.topic, width=img.width, height=img.height,
-                       encoding=img.encoding, rate=rate, source=source, name="/camera",
-                       domain=domain) as cam:
-            outputs: dict[tuple[int, int], np.ndarray] = {}
-            lock = threading.Lock()
-
-            def keep(frame: Any) -> None:
-                stamp = frame.header["stamp"]
-                key = (stamp["secs"], stamp["nsecs"]) if isinstance(stamp, dict) else tuple(stamp)
-                if frame.image is not None:
-                    with lock:
-                        outputs[key] = frame.image
-
-            viewer.on_frame = keep
-            deadline = time.monotonic() + timeout
-            while not (comp.wait_for_peers(0.1) and cam.publisher.get_num_connections()):
-                if time.monotonic() > deadline:
-                    raise ComponentError(f"the camera, component and viewer did not find each "
-                                         f"other in {timeout:g} s in DDS domain {domain}")
-            sent: list[Any] = []
-            cam.on_sent = sent.append
-            cam.run(count=frames)
-            while viewer.received < len(sent) and time.monotonic() < deadline:
-                time.sleep(0.02)
-            time.sleep(0.1)
-            ksize = (cfg.application.ksize, cfg.application.ksize)
-            exact, bad = 0, []
-            with lock:
-                for s in sent:
-                    got = outputs.get(tuple(s.stamp))
-                    if got is None:
-                        continue
-                    want = expected_output(s.image, cfg.application.op, ksize)
-                    if np.array_equal(got, want.reshape(got.shape)):
-                        exact += 1
-                    else:
-                        bad.append(s.seq)
-            return Ros2DemoResult(domain, len(sent), viewer.received, exact, bad,
-                                  dict(comp.counts), comp.notes())
-    finally:
-        comp.stop()

@@ -11,17 +11,22 @@ Jinja2 (a test holds that)::
 
 Owners: :mod:`~rosfpga_lab.config.vocabulary` (encodings and operations),
 :mod:`~rosfpga_lab.config.limits` (limits and defaults), :mod:`~rosfpga_lab.config.master` (which
-ROS master a program talks to), :mod:`~rosfpga_lab.config.node` (the
-schema, its checker and the dataclasses).
+ROS master a program talks to), :mod:`~rosfpga_lab.config.names` (ROS names),
+:mod:`~rosfpga_lab.config.node` (the file's format and its records, the dataclasses),
+:mod:`~rosfpga_lab.config.parse` (:func:`parse_config`, :func:`load_config`),
+:mod:`~rosfpga_lab.config.schema` (sections, keys, types, defaults),
+:mod:`~rosfpga_lab.config.sections` (one parser per section),
+:mod:`~rosfpga_lab.config.yamlwalk` (the composed YAML, with line numbers).
 """
 
 from rosfpga_lab.config.errors import ConfigError
 from rosfpga_lab.config.master import master_uri, master_uri_from_env
+from rosfpga_lab.config.names import ros_name_problem
 from rosfpga_lab.config.node import (
     ApplicationConfig, FifoConfig, HlsConfig, ImageConfig, NodeConfig, NodeSection, TopicConfig,
-    load_config, parse_config, ros_name_problem,
 )
 from rosfpga_lab.config.node import CheckConfig, NoImage, StreamConfig
+from rosfpga_lab.config.parse import load_config, parse_config
 from rosfpga_lab.config.vocabulary import (
     CUSTOM, DEFAULT_ENCODING, DEFAULT_OP, ENCODINGS, MODEL_OPS, OPS, PASSTHROUGH, PIXEL_FORMATS, PixelFormat,
     canonical_op, model_ksize,

@@ -3,7 +3,7 @@
 A configuration names fields of its message by dotted path without indices: ``ranges``,
 ``header.frame_id``, ``info.samples``. A path walks nested messages; only ``limits:`` may walk
 into the elements of an array of messages (``points.name``: the ``name`` of every element).
-The rules live here once; the configuration checker (:mod:`~rosfpga_lab.config.node`) turns a
+The rules live here once; the configuration checker (:mod:`~rosfpga_lab.config.sections`) turns a
 problem into ``file:line: key: problem`` and the circuit layout (:mod:`rosfpga_lab.hw.layout`)
 into its own error.
 """

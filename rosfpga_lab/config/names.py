@@ -73,3 +73,20 @@ def name_problem(name: str, *, node_name: bool = False) -> str | None:
         if not is_legal_base_name(base):
             return f"a node's base name must start with a letter, got {base!r}"
     return None
+
+
+def ros_name_problem(name: str, *, node_name: bool = False) -> str | None:
+    """Why ``name`` cannot be a topic (or node) name in a configuration, or None.
+
+    The ROS rules of :func:`rosfpga_lab.config.names.name_problem`, plus one of the configuration:
+    the name is written in canonical form (no trailing ``/``), as the circuit sends it verbatim
+    in its connection headers.
+
+    Args:
+        name: a graph resource name (topic or node).
+        node_name: apply the extra rules of node names (not private, base name legal).
+    """
+    problem = name_problem(name, node_name=node_name)
+    if problem is None and name != canonical(name):
+        return f"write the name in canonical form, {canonical(name)!r} (no trailing '/')"
+    return problem

@@ -24,7 +24,8 @@ Programs that must join an existing graph pass ``master_uri`` explicitly instead
 ``rosfpga-lab topic`` does (``--master-uri``, else ``ROS_MASTER_URI``, else 11311; it stops
 with an error and a hint when no master answers there).
 
-Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``master`` (EmbeddedMaster),
+Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``http`` (its sans-IO HTTP
+decoder), ``master`` (EmbeddedMaster),
 ``node`` (Node, Slave API, TCPROS server), ``publisher``, ``subscriber``, ``trace`` (the recorded
 conversation; its docstring documents the format), ``names`` (names, ROS_* environment),
 ``owner`` (which Unix user listens on a port), ``service`` (TCPROS services), ``rosout``

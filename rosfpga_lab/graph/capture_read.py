@@ -22,7 +22,8 @@ from rosfpga_lab.graph.limits import TRACE_EXCERPT_BYTES
 from rosfpga_lab.graph.limits import CAPTURE_MAX_STREAM_BYTES
 from rosfpga_lab.graph.master import MASTER_ID
 from rosfpga_lab.graph.trace import Trace, new_connection_id
-from rosfpga_lab.graph.xmlrpc import _parse_head, parse_xmlrpc, split_uri
+from rosfpga_lab.graph.http import Body, Head, HttpDecoder
+from rosfpga_lab.graph.xmlrpc import parse_xmlrpc, split_uri
 from rosfpga_lab.tcpros import FrameDecoder, ProtocolError, decode_header
 
 #: The lab's data/ folder and the real captures shipped in it (each made by the script beside it).
@@ -120,22 +121,24 @@ def tcp_streams(path: str | Path) -> list[TcpStream]:
 
 
 def _http_messages(data: bytes) -> list[tuple[int, bytes, bytes]]:
-    """``(offset, head, body)`` of each complete HTTP message in one direction's bytes."""
-    out, pos = [], 0
-    while pos < len(data):
-        end = data.find(b"\r\n\r\n", pos)
-        if end < 0:
-            break
-        head = data[pos:end + 4]
-        try:
-            _line, headers = _parse_head(head[:-4])
-            length = int(headers.get("content-length", "-1"))
-        except (XmlRpcError, ValueError):
-            break
-        if length < 0 or end + 4 + length > len(data):
-            break
-        out.append((pos, head, data[end + 4:end + 4 + length]))
-        pos = end + 4 + length
+    """``(offset, head, body)`` of each complete HTTP message in one direction's bytes (up to
+    the first that is cut short or malformed, or has no ``Content-Length``)."""
+    http = HttpDecoder(max_head=len(data) + 1, max_body=len(data))
+    http.receive(data)
+    http.receive(b"")
+    out = []
+    try:
+        while True:
+            start = http.consumed
+            head = http.next_event()
+            if not isinstance(head, Head):
+                break
+            body = http.next_event()
+            if not isinstance(body, Body):
+                break
+            out.append((start, head.raw, body.data))
+    except XmlRpcError:
+        pass
     return out
 
 

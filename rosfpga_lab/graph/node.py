@@ -49,10 +49,13 @@ from rosfpga_lab.graph.names import (
 )
 from rosfpga_lab.graph.owner import listener_uids
 from rosfpga_lab.graph.publisher import Publisher
+from rosfpga_lab.graph.rosout import log as rosout_log
+from rosfpga_lab.graph.rosout import start_node_logging, stop_node_logging
 from rosfpga_lab.graph.service import ServiceServer
 from rosfpga_lab.graph.subscriber import Subscriber
 from rosfpga_lab.graph.topic import TopicContext
 from rosfpga_lab.graph.trace import Trace, new_connection_id
+from rosfpga_lab.graph.watchdog import MasterWatch
 from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close, socket_ends
 from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call, split_uri, unsupported
 from rosfpga_lab.tcpros import (
@@ -187,7 +190,7 @@ class Node:
         self._logging: Any = None   # /rosout and logger services, from the first registration
         self.ros_logging = True     # False: this node offers neither (before its first registration)
         self.watch_master = True    # register again after a master restart (see ``watchdog``)
-        self._watch: Any = None
+        self._watch: MasterWatch | None = None
         self._updates: dict[str, int] = {}   # topic -> publisherUpdate calls received
         #: set once /rosout and the logger services are registered (or failed)
         self.logging_ready = threading.Event()
@@ -363,10 +366,6 @@ class Node:
     def _start_logging(self) -> None:
         """After the first registration: the master watchdog, ``/rosout`` and the logger
         services (see ``rosout``); a master that refuses those costs a warning, not the topic."""
-        from rosfpga_lab.graph.rosout import log as rosout_log
-        from rosfpga_lab.graph.rosout import start_node_logging
-        from rosfpga_lab.graph.watchdog import MasterWatch
-
         with self._lock:
             if self._watch is None and not self.is_shutdown:
                 self._watch = MasterWatch(self)
@@ -645,8 +644,6 @@ class Node:
             subs = list(self.subscribers.values())
             self.publishers.clear()
             self.subscribers.clear()
-        from rosfpga_lab.graph.rosout import stop_node_logging
-
         if self._watch is not None:
             self._watch.stop()
         stop_node_logging(self._logging if self._logging is not True else None)

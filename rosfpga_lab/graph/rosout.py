@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import logging
 import threading
-from typing import TYPE_CHECKING, Any
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any, Protocol
 
 from rosfpga_lab.graph.errors import GraphError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from rosfpga_lab.graph.node import Node
     from rosfpga_lab.graph.publisher import Publisher
 
 log = logging.getLogger("rosfpga_lab.graph")
@@ -109,7 +109,23 @@ def set_logger_level(request: dict) -> dict:
     return {}
 
 
-def start_node_logging(node: Node) -> RosoutHandler:
+class LoggingNode(Protocol):
+    """What :func:`start_node_logging` needs of a node (a :class:`~rosfpga_lab.graph.node.Node`
+    is one; this module does not import it, so the node can import this one)."""
+
+    name: str
+
+    @property
+    def publishers(self) -> Mapping[str, Publisher]: ...
+
+    def advertise(self, topic: str, type_name: str, queue_size: int = ...,
+                  latch: bool = ...) -> Publisher: ...
+
+    def advertise_service(self, service: str, srv_type: str,
+                          handler: Callable[[dict], dict]) -> str: ...
+
+
+def start_node_logging(node: LoggingNode) -> RosoutHandler:
     """Advertise ``/rosout`` and the two logger services for ``node``; return the handler
     attached to the lab's logger (the node removes it when it shuts down)."""
     node.advertise_service("~get_loggers", "roscpp/GetLoggers", get_loggers)
@@ -126,5 +142,5 @@ def stop_node_logging(handler: RosoutHandler | None) -> None:
         logging.getLogger(LAB_LOGGER).removeHandler(handler)
 
 
-__all__ = ["LAB_LOGGER", "ROS_LEVELS", "RosoutHandler", "get_loggers", "log_message",
+__all__ = ["LAB_LOGGER", "ROS_LEVELS", "LoggingNode", "RosoutHandler", "get_loggers", "log_message",
            "set_logger_level", "start_node_logging", "stop_node_logging"]

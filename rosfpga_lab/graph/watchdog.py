@@ -16,22 +16,34 @@ from __future__ import annotations
 
 import logging
 import threading
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from rosfpga_lab.graph.errors import GraphError
 from rosfpga_lab.graph.limits import JOIN_TIMEOUT, MASTER_CHECK_PERIOD, MASTER_CHECK_TIMEOUT
 from rosfpga_lab.graph.master import knows_node
 
-if TYPE_CHECKING:  # pragma: no cover
-    from rosfpga_lab.graph.node import Node
-
 log = logging.getLogger("rosfpga_lab.graph")
+
+
+class WatchedNode(Protocol):
+    """What :class:`MasterWatch` needs of a node (a :class:`~rosfpga_lab.graph.node.Node` is
+    one; this module does not import it, so the node can import this one)."""
+
+    name: str
+    master_uri: str
+    watch_master: bool
+    is_shutdown: bool
+
+    @property
+    def uri(self) -> str: ...
+
+    def register_again(self) -> None: ...
 
 
 class MasterWatch:
     """The watchdog thread of one node (see the module docstring)."""
 
-    def __init__(self, node: Node, period: float = MASTER_CHECK_PERIOD) -> None:
+    def __init__(self, node: WatchedNode, period: float = MASTER_CHECK_PERIOD) -> None:
         self.node = node
         self.period = period
         self.reachable = True

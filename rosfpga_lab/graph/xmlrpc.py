@@ -1,8 +1,9 @@
 """XML-RPC over HTTP/1.1, small and safe, recording the exact bytes.
 
 How it works: the server accepts connections on a loopback socket (unless told otherwise),
-gives each connection a thread, reads the HTTP head (capped at :data:`MAX_HTTP_HEAD`) and a
-``Content-Length`` body (capped at :data:`MAX_XMLRPC_BODY`), parses it with defusedxml's
+gives each connection a thread, feeds its bytes to a sans-IO decoder
+(:class:`~rosfpga_lab.graph.http.HttpDecoder`: the HTTP head capped at :data:`MAX_HTTP_HEAD`, a
+``Content-Length`` body capped at :data:`MAX_XMLRPC_BODY`), parses the body with defusedxml's
 expat parser (no entity expansion, no DTDs, no external references; nesting capped at
 :data:`MAX_XMLRPC_DEPTH`), calls the handler and writes the reply; keep-alive is honoured as
 rospy's and roscpp's clients expect. A request must be complete within
@@ -28,6 +29,7 @@ from typing import Any
 from defusedxml.xmlrpc import DefusedExpatParser
 
 from rosfpga_lab.graph.errors import ConfigError, XmlRpcError, XmlRpcTooLargeError
+from rosfpga_lab.graph.http import Body, EndOfStream, Head, HttpDecoder
 from rosfpga_lab.graph.limits import (
     JOIN_TIMEOUT,
     LISTEN_BACKLOG,
@@ -44,7 +46,7 @@ from rosfpga_lab.graph.limits import (
 )
 from rosfpga_lab.graph.names import address_family, uri_host
 from rosfpga_lab.graph.trace import Trace
-from rosfpga_lab.graph.wire import accept_loop, hard_close, socket_ends
+from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close, socket_ends
 
 #: XML-RPC's <int>/<i4> range (ROS's XmlRpcValue and rospy's marshaller refuse anything else).
 INT32_MIN, INT32_MAX = -(2**31), 2**31 - 1
@@ -204,78 +206,22 @@ class _Deadline:
         return chunk
 
 
-def _read_head(sock: socket.socket, buf: bytearray, deadline: _Deadline) -> bytes | None:
-    """Read until the end of an HTTP head; return it (buf keeps the rest). None on clean EOF.
+def _next_event(sock: socket.socket, http: HttpDecoder, deadline: _Deadline) -> Head | Body | None:
+    """Feed ``sock``'s bytes to ``http`` until it has an event; None when the stream ended
+    cleanly between messages.
 
     Raises:
-        XmlRpcError: the head is longer than :data:`MAX_HTTP_HEAD` (however it was chunked),
-            or the connection closed inside it.
+        XmlRpcError: what the decoder refuses (sizes, format, a stream cut inside a message).
         TimeoutError: ``deadline`` passed.
     """
     while True:
-        end = buf.find(b"\r\n\r\n", 0, MAX_HTTP_HEAD)
-        if end >= 0:
-            head = bytes(buf[:end + 4])
-            del buf[:end + 4]
-            return head
-        if len(buf) >= MAX_HTTP_HEAD:
-            raise XmlRpcError(f"HTTP head longer than {MAX_HTTP_HEAD} bytes")
-        chunk = deadline.recv(sock, 65536)
-        if not chunk:
-            if buf:
-                raise XmlRpcError(f"connection closed inside an HTTP head ({len(buf)} bytes)")
+        event = http.next_event()
+        if isinstance(event, (Head, Body)):
+            return event
+        if isinstance(event, EndOfStream):
             return None
-        buf += chunk
-
-
-def _parse_head(head: bytes) -> tuple[str, dict[str, str]]:
-    lines = head.decode("latin-1").split("\r\n")
-    headers: dict[str, str] = {}
-    for line in lines[1:]:
-        if not line:
-            continue
-        name, sep, value = line.partition(":")
-        if not sep:
-            raise XmlRpcError(f"malformed HTTP header line: {line[:80]!r}")
-        headers[name.strip().lower()] = value.strip()
-    return lines[0], headers
-
-
-def _read_body(sock: socket.socket, buf: bytearray, headers: dict[str, str],
-               deadline: _Deadline, *, until_eof: bool = False,
-               limit: int = MAX_XMLRPC_BODY) -> bytes:
-    length_text = headers.get("content-length")
-    if length_text is None:
-        if not until_eof:
-            raise XmlRpcError("HTTP message without Content-Length")
-        while len(buf) <= limit:
-            chunk = deadline.recv(sock, 65536)
-            if not chunk:
-                body = bytes(buf)
-                buf.clear()
-                return body
-            buf += chunk
-        raise XmlRpcTooLargeError(f"HTTP body over the limit of {limit} bytes")
-    try:
-        length = int(length_text)
-    except ValueError:
-        raise XmlRpcError(f"bad Content-Length {length_text!r}") from None
-    if length < 0:
-        raise XmlRpcError(f"bad Content-Length {length_text!r}")
-    if length > limit:
-        raise XmlRpcTooLargeError(f"HTTP body of {length} bytes, over the limit of {limit}")
-    while len(buf) < length:
-        chunk = deadline.recv(sock, min(max(65536, length - len(buf)), 1 << 20))
-        if not chunk:
-            raise XmlRpcError(f"connection closed after {len(buf)} of {length} body bytes")
-        buf += chunk
-    if len(buf) == length:  # the usual case: one copy, not a slice and then a copy
-        body = bytes(buf)
-        buf.clear()
-        return body
-    body = bytes(memoryview(buf)[:length])
-    del buf[:length]
-    return body
+        want = min(max(RECV_CHUNK, http.missing), 1 << 20)   # a big body in big pieces
+        http.receive(deadline.recv(sock, want))
 
 
 def _discard(sock: socket.socket, n: int, deadline: _Deadline) -> None:
@@ -466,19 +412,20 @@ class XmlRpcServer:
             return True
 
     def _serve_connection(self, conn: socket.socket, peer: str) -> None:
-        buf = bytearray()
+        http = HttpDecoder(max_head=MAX_HTTP_HEAD, max_body=MAX_XMLRPC_BODY)
         _context.peer = peer
         ends = socket_ends(conn)
         try:
             while self._running:
                 deadline = _Deadline(XMLRPC_IDLE_TIMEOUT, self.request_timeout)
                 try:
-                    if buf:
+                    if http.in_message:
                         deadline.started()
-                    head = _read_head(conn, buf, deadline)
-                    if head is None:
+                    event = _next_event(conn, http, deadline)
+                    if event is None:
                         return
-                    request_line, headers = _parse_head(head)
+                    assert isinstance(event, Head)
+                    head, request_line, headers = event.raw, event.start_line, event.headers
                 except XmlRpcError as exc:
                     conn.sendall(_http_response("400 Bad Request", str(exc).encode(), False))
                     return
@@ -497,23 +444,16 @@ class XmlRpcServer:
                         f"request bodies in flight would pass this server's budget of "
                         f"{self.body_budget} bytes (graph.limits.MAX_XMLRPC_BODIES_IN_FLIGHT); "
                         "retry later").encode(), False))
-                    _discard(conn, int(headers["content-length"]) - len(buf), deadline)
+                    _discard(conn, http.missing, deadline)
                     return
+                body = None
                 try:
-                    body = _read_body(conn, buf, headers, deadline)
-                except BaseException as exc:
-                    self._release(reserved)
-                    if isinstance(exc, XmlRpcError):
-                        status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
-                                  else "400 Bad Request")
-                        conn.sendall(_http_response(status, str(exc).encode(), False))
-                        return
-                    if isinstance(exc, TimeoutError):
-                        conn.settimeout(1.0)
-                        conn.sendall(_http_response("408 Request Timeout", (
-                            f"request not complete within {self.request_timeout} s").encode(), False))
-                        return
-                    raise
+                    body = self._request_body(conn, http, deadline)
+                finally:
+                    if body is None:
+                        self._release(reserved)
+                if body is None:
+                    return
                 if not self._set_busy(conn, True):
                     self._release(reserved)
                     return
@@ -544,6 +484,25 @@ class XmlRpcServer:
             with self._lock:
                 self._conns.pop(conn, None)
             hard_close(conn)
+
+    def _request_body(self, conn: socket.socket, http: HttpDecoder,
+                      deadline: _Deadline) -> bytes | None:
+        """The body of the request whose head ``http`` gave; None after answering 400, 413 or
+        408 (the caller then closes the connection)."""
+        try:
+            event = _next_event(conn, http, deadline)
+            if not isinstance(event, Body):   # the decoder gives a body after a head
+                raise XmlRpcError("connection closed before the request's body")
+            return event.data
+        except XmlRpcError as exc:
+            status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
+                      else "400 Bad Request")
+            conn.sendall(_http_response(status, str(exc).encode(), False))
+        except TimeoutError:
+            conn.settimeout(1.0)
+            conn.sendall(_http_response("408 Request Timeout", (
+                f"request not complete within {self.request_timeout} s").encode(), False))
+        return None
 
     def _dispatch(self, body: bytes) -> tuple[bytes, str, tuple, Any]:
         try:
@@ -658,7 +617,7 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
             f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\nConnection: close\r\n\r\n")
     request = head.encode("latin-1") + body
     t0 = time.time()
-    buf = bytearray()
+    http = HttpDecoder(max_head=MAX_HTTP_HEAD, max_body=MAX_XMLRPC_REPLY, eof_ends_body=True)
     deadline = _Deadline(timeout)
     ends: dict[str, str] = {}
     try:
@@ -666,12 +625,12 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
             ends = socket_ends(sock)
             sock.settimeout(max(0.001, deadline.at - time.monotonic()))
             sock.sendall(request)
-            reply_head = _read_head(sock, buf, deadline)
-            if reply_head is None:
+            head_event = _next_event(sock, http, deadline)
+            if not isinstance(head_event, Head):
                 raise XmlRpcError("connection closed before any reply")
-            status_line, headers = _parse_head(reply_head)
-            reply_body = _read_body(sock, buf, headers, deadline, until_eof=True,
-                                    limit=MAX_XMLRPC_REPLY)
+            body_event = _next_event(sock, http, deadline)
+            assert isinstance(body_event, Body)   # or the decoder raised
+            reply_head, status_line, reply_body = head_event.raw, head_event.start_line, body_event.data
     except (OSError, XmlRpcError) as exc:
         if trace is not None:
             trace.record("xmlrpc", caller, role="client", src=caller, dst=callee or uri,

@@ -1,0 +1,54 @@
+"""The README stays short and its links lead somewhere: at most 250 lines of at most 110
+characters; every relative link of the README, ARCHITECTURE.md, docs/, course/ and data/
+pages names a file that exists; the Quick start is what lab.sh says it does."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PAGES = [ROOT / "README.md", ROOT / "ARCHITECTURE.md", ROOT / "course" / "README.md",
+         ROOT / "data" / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+
+
+def test_readme_is_short_with_short_lines() -> None:
+    lines = (ROOT / "README.md").read_text(encoding="utf-8").splitlines()
+    assert len(lines) <= 250
+    assert [n for n, line in enumerate(lines, 1) if len(line) > 110] == []
+
+
+def test_relative_links_lead_to_files() -> None:
+    broken = []
+    for page in PAGES:
+        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", page.read_text(encoding="utf-8")):
+            if "://" not in target and not (page.parent / target).exists():
+                broken.append(f"{page.relative_to(ROOT)}: {target}")
+    assert broken == []
+
+
+def test_every_docs_page_is_in_the_index() -> None:
+    index = (ROOT / "docs" / "README.md").read_text(encoding="utf-8")
+    pages = {p.name for p in (ROOT / "docs").glob("*.md")} - {"README.md"}
+    assert {name for name in pages if f"]({name})" not in index} == set()
+
+
+def test_quick_start_commands_are_lab_sh_s() -> None:
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    block = readme.split("## Quick start", 1)[1].split("```bash\n", 1)[1].split("```", 1)[0]
+    commands = [line.split("#", 1)[0].strip() for line in block.splitlines()]
+    assert commands == ["./lab.sh", "./lab.sh test"]
+    usage = (ROOT / "lab.sh").read_text(encoding="utf-8")
+    assert "#   ./lab.sh          set up" in usage and "#   ./lab.sh test     set up" in usage
+
+
+def test_the_notebook_table_names_every_notebook_and_real_packages() -> None:
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme.split("## The notebooks", 1)[1].split("\n## ", 1)[0]
+    rows = [line.strip("|").split("|") for line in section.splitlines() if line.startswith("| `")]
+    assert {row[0].strip(" `") for row in rows} == {
+        p.stem for p in (ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")}
+    packages = {p.name for p in (ROOT / "rosfpga_lab").iterdir() if (p / "__init__.py").exists()}
+    for row in rows:
+        drives = set(re.findall(r"`([a-z_]+)`", row[2]))
+        assert drives and drives <= packages, row
