@@ -440,6 +440,20 @@ def _check_type(ctx: _Ctx, type_name: str, nodes: dict[str, yaml.Node], section:
                         "nor under msg_path)", nodes.get("type"), f"{section}.type")
 
 
+def _check_definition(ctx: _Ctx, reg: "MsgRegistry", type_name: str,
+                      nodes: dict[str, yaml.Node], section: str) -> None:
+    """Every type the definition of ``type_name`` uses is known (a misspelt field type,
+    ``flaot32``, names its ``.msg`` file and line, and the primitive it is close to)."""
+    from rosfpga_lab.msg import MsgError
+
+    if type_name not in reg:
+        return
+    try:
+        reg.md5(type_name)
+    except MsgError as exc:
+        raise ctx.error(str(exc), nodes.get("type"), f"{section}.type") from None
+
+
 def _known_type(type_name: str) -> bool:
     from rosfpga_lab.msg import default_registry
 
@@ -708,6 +722,7 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
         problem = ros_name_problem(t["topic"])
         _check(ctx, problem is None, f"{problem}: {t['topic']!r}", tn, "topic", section)
         _check_type(ctx, t["type"], tn, section, known)
+        _check_definition(ctx, reg, t["type"], tn, section)
     if sec["subscriber"][0]["topic"] == sec["publisher"][0]["topic"]:
         raise ctx.error("the node would publish to the topic it subscribes to",
                         sec["publisher"][1].get("topic"), "publisher.topic")
