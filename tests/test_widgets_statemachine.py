@@ -63,7 +63,14 @@ def test_a_message_layout_is_drawn_as_its_subscriber_state_machine(tmp_path) -> 
     role = "t_msgs/Scan subscriber"
     assert "not == 2: refuse: SUB_BAD_GAIN" in arrows[(role, "GAIN", "SKIP")]
     assert "no elements: names is empty" in arrows[(role, "NAMES_LOOP", "GAIN")]
-    assert "0: ranges is empty" in arrows[(role, "RANGES_LENGTH", "FRAME_LENGTH")]
+    # the stream's length must be 4: no "0" arrow past it (notebook 10 drew one; a frame with
+    # no values is refused)
+    assert (role, "RANGES_LENGTH", "FRAME_LENGTH") not in arrows
+    assert "not == 4: refuse: SUB_BAD_RANGES_LENGTH" in arrows[(role, "RANGES_LENGTH", "SKIP")]
+    empty = derive_layout(registry_with([tmp_path]), "t_msgs/Scan", stream="ranges",
+                          stream_length=0, checks={"gain": 2})
+    assert "0: ranges is empty" in _arrows(state_diagram_svg(layout_transitions(empty), in_order=True)
+                                           )[(role, "RANGES_LENGTH", "FRAME_LENGTH")]
     assert (role, "NAMES_LENGTH", "GAIN") not in arrows   # the loop's own state says it
     assert "more elements: next element of names" in arrows[(role, "NAMES_END", "NAMES_ITEM_LENGTH")]
     assert "last element: names done" in arrows[(role, "NAMES_END", "GAIN")]

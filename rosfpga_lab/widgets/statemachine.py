@@ -243,8 +243,10 @@ def layout_transitions(layout: Any) -> list[WalkTransition]:
             back = state(0) if i == 0 else SKIP_STATE
             rows.append(WalkTransition(role, state(i), f"not {s.check.describe()}", back,
                                        f"refuse: {s.check.status}"))
-        # a zero count passes a string or array at once (a loop's own state says "no elements")
-        if (kind == "length" and i > 0 and s.partner is not None
+        # a zero count passes a string or array at once (a loop's own state says "no elements"),
+        # unless the count is checked for another value (the stream's fixed length)
+        fixed = s.check is not None and str(s.check.op) == "equal" and s.check.value != 0
+        if (kind == "length" and i > 0 and s.partner is not None and not fixed
                 and str(steps[s.partner].kind) != "loop" and steps[s.partner].count is None):
             rows.append(WalkTransition(role, state(i), "0", state(after(s.partner)),
                                        f"{steps[s.partner].label} is empty"))
