@@ -145,7 +145,10 @@ def check_own_message(text: str, html: str) -> None:
     result) equal to the models, Table 1, the live graph, and real rospy when it is here."""
     assert 'class="rfl-state" data-state="VALUES"' in html and 'data-state="SKIP"' in html
     assert "values [stream]" in html and "gain [check]" in html   # the byte viewer's roles
-    assert "field 'gain' at byte 34: 5 but the circuit was built for 4 (status SUB_BAD_GAIN)" in text
+    # the sample message made from the layout: frame_id "frame_id", sensor "sensor"; by hand
+    # the gain is at 4 + 4 + 8 + (4 + 8) + (4 + 6) = 38
+    assert "field 'gain' at byte 38: 5 but the circuit was built for 4 (status SUB_BAD_GAIN)" in text
+    assert "real circuit would need" in text and " ms per frame" not in text   # 2.x us, shown so
     for run in ("C simulation", "RTL simulation"):
         if "the shipped result" not in text:
             assert re.search(rf"{run} output equals the models':\s+True", text), text[-2000:]

@@ -772,8 +772,10 @@ def frame_geometry(layout: Layout, message: Any) -> FrameGeometry:
 
 # -- text ---------------------------------------------------------------------------------------
 
-def format_layout(layout: Layout) -> str:
-    """The walk as aligned text: one row per step (what notebooks print before drawing it)."""
+def format_layout(layout: Layout, *, idents: bool = True) -> str:
+    """The walk as aligned text: one row per step (what notebooks print before drawing it);
+    without ``idents``, no ``ident`` column (narrower: the state names are the idents in
+    capitals)."""
     rows = [("#", "kind", "ident", "label", "type", "bytes", "max", "action", "check")]
     for s in layout.steps:
         if s.kind in (StepKind.SCALAR, StepKind.LENGTH, StepKind.ENCAPSULATION, StepKind.NUL):
@@ -789,6 +791,8 @@ def format_layout(layout: Layout) -> str:
         check = f"{s.check.status}: {s.check.describe()}" if s.check else "-"
         rows.append((str(s.index), "  " * s.depth + s.kind, s.ident, s.label, s.type, size, top,
                      s.action, check))
+    if not idents:
+        rows = [r[:2] + r[3:] for r in rows]
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     text = "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
     what = (f"stream {layout.stream.label} {layout.stream_length} x {layout.stream.type}"
