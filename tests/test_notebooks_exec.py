@@ -238,6 +238,13 @@ def check_ros2_live(text: str, html: str, cyclone: bool) -> None:
     assert "and the same as the live run's first output: True" in text
     sample = 4 + 4 + 4 + 4 + len("camera") + 1 + 1 + 4 + 4 + 4 + len("rgba8") + 1 + 1 + 1 + 4 + 4 + 64 * 48 * 4
     assert f"{3 * sample:,} bytes of samples went through the circuit" in text, text[-600:]
+    # the applications' clocks in their own units (by hand: 64 x 48 pixels; 64 x 48 x 4 bytes
+    # + ksize // 2 = 1), and whether the run cut samples into DATA_FRAG, as counted
+    assert re.search(r"ROS 1 dilate [\d,]+ clocks for 3,072 pixels; ROS 2 application 12,289 "
+                     r"clocks for 12,288 bytes", text), text[-1500:]
+    frag_line = re.search(r"user samples received whole in one DATA: (\d+); DATA_FRAG fragments "
+                          r"received: (\d+)", text)
+    assert frag_line and int(frag_line[1]) + int(frag_line[2]) >= 3, text[-800:]
     assert "<svg" in html
     for label in ("SPDP participant", "SEDP writer rt/cam", "SEDP reader rt/cam_out", "HEARTBEAT",
                   "ACKNACK", "matched rt/cam", "not matched rt/cam", "DATA"):
