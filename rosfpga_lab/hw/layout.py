@@ -776,7 +776,8 @@ def format_layout(layout: Layout, *, idents: bool = True) -> str:
     """The walk as aligned text: one row per step (what notebooks print before drawing it);
     without ``idents``, no ``ident`` column (narrower: the state names are the idents in
     capitals)."""
-    rows = [("#", "kind", "ident", "label", "type", "bytes", "max", "action", "check")]
+    rows: list[tuple[str, ...]] = [("#", "kind", "ident", "label", "type", "bytes", "max", "action",
+                                    "check")]
     for s in layout.steps:
         if s.kind in (StepKind.SCALAR, StepKind.LENGTH, StepKind.ENCAPSULATION, StepKind.NUL):
             size = str(s.size)
