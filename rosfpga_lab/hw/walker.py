@@ -13,8 +13,9 @@ length lets the reference skip the rest of the refused frame, so the next good f
 right.
 
 The frame length is checked against the shortest body accepted (``Layout.min_body``) and the
-lab's limit; each length prefix against its maximum and against the bytes left (when only fixed-size fields follow, the
-frame length must match exactly, as the Image interpreter checks ``data length``). Refusal
+lab's limit; each length prefix against its maximum and against the bytes left (when only
+fixed-size fields follow, the frame length must match exactly, as the Image interpreter checks
+``data length``). Refusal
 kinds (``FrameFieldError.rule``): ``below the minimum``, ``over the limit``,
 ``past the frame end``, ``not what the circuit was built for``, ``not a number`` (a NaN in a
 range check), ``frame length disagrees``, ``cut short``.
