@@ -178,6 +178,12 @@ def test_cut_labels_keep_their_number_and_byte_count() -> None:
         assert f"{first} {second}" == f"{k + 1}. TCPROS header /chatter callerid=/listener [123 B]"
     lines = re.findall(r'<text x="[\d.]+" y="([\d.]+)"[^>]*stroke-linejoin="round">', svg)
     assert float(lines[1]) - float(lines[0]) == 17            # the second under the arrow
+    # the byte count is never split between the lines
+    short = [SeqEvent("/a", "/b", "TCPROS header /chatter", bytes(128), kind="tcpros_header"),
+             SeqEvent("/b", "/c", "x", bytes(1)), SeqEvent("/c", "/d", "x", bytes(1)),
+             SeqEvent("/d", "/e", "x", bytes(1)), SeqEvent("/e", "/f", "x", bytes(1))]
+    two = re.findall(r'stroke-linejoin="round">([^<]*)</text>', sequence_svg(short, col=110))
+    assert "[128 B]" in " ".join(two) and not any(t.endswith("[128") for t in two), two
     # text longer than two lines keeps its number and byte count, the middle cut
     long = [SeqEvent(f"/node_{i}", f"/node_{i + 1}", "TCPROS header /chatter " * 6, bytes(99),
                      kind="tcpros_header") for i in range(7)]

@@ -256,20 +256,19 @@ def _fit_label(number: str, text: str, size: str, px: float) -> str:
 
 def _label_lines(number: str, text: str, size: str, px: float) -> list[str]:
     """An arrow's label in one line of about ``px`` pixels, or two (the second drawn under the
-    arrow), broken between words; only text longer than two lines is cut (its middle, as
-    :func:`_fit_label` does), the number and the byte count always stay whole."""
+    arrow), broken between words of the text; the byte count stays whole at the end, and only
+    text longer than two lines is cut (its middle, as :func:`_fit_label` does)."""
     n = max(4, int(px / CHAR_PX))
-    whole = number + text + size
-    if len(whole) <= n:
-        return [whole]
-    cut = whole.rfind(" ", 0, n + 1)
+    head = number + text
+    if len(head) + len(size) <= n:
+        return [head + size]
+    cut = head.rfind(" ", 0, n + 1)
     if cut <= len(number):
         cut = n
-    first, rest = whole[:cut].rstrip(), whole[cut:].lstrip()
-    if len(rest) <= n:
-        return [first, rest]
-    body = rest[: len(rest) - len(size)] if size else rest
-    return [first, _fit_label("", body, size, px)]
+    first, rest = head[:cut].rstrip(), head[cut:].lstrip()
+    if len(rest) + len(size) <= n:
+        return [first, rest + size]
+    return [first, _fit_label("", rest, size, px)]
 
 
 def events_from_capture(path: str | Path, **options: Any) -> list[SeqEvent]:
