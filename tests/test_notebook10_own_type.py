@@ -84,3 +84,20 @@ def test_notebook_10_runs_to_the_end_with_another_message() -> None:
         assert "frames from the rospy node: 10, bit-exact: 10" in text
     # the exercises still use the example and pass
     assert text.count("\u2714 Exercise") == 3
+
+
+def test_a_failing_rospy_node_shows_its_own_error() -> None:
+    """Cell 28 printed only "rospy exited with 1", swallowing rospy's traceback."""
+    reason = ros_missing_reason()
+    if reason is not None:
+        pytest.skip(f"real ROS 1 not available: {reason}")
+    nb = nbformat.read(SOLUTIONS / "10_your_own_message.ipynb", as_version=4)
+    cell = next(c for c in nb.cells if c.cell_type == "code" and 'ROSPY_SENSOR = """' in c.source)
+    cell.source = cell.source.replace('ROSPY_SENSOR = """\n',
+                                      'ROSPY_SENSOR = """\nraise RuntimeError("no such sensor")\n')
+    NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3",
+                   resources={"metadata": {"path": str(SOLUTIONS)}}).execute()
+    text = text_of(cell)
+    assert "rospy exited with 1" in text
+    assert "rospy's error output:" in text and "RuntimeError: no such sensor" in text
+    assert "frames from the rospy node: 0, bit-exact: 0" in text
