@@ -73,20 +73,21 @@ def check_stream_offset(answer: Any, frame: bytes, layout: Layout, reg: MsgRegis
         hint = (f"that is where the uint32 '{stream} length' starts; the elements begin 4 bytes "
                 "later (and did you count the frame's own 4-byte length?)")
     elif answer == shown_at:
-        strings = [f"{label} {n} bytes" for off, n, label in spans
-                   if off < want and f"{label} length" in {lab for _o, _n, lab in spans}]
+        labels = {lab for _o, _n, lab in spans}
+        counted = [f"{label} {n} bytes" for off, n, label in spans
+                   if off < want and f"{label} length" in labels]
         hint = (f"{answer} is where the stream starts in the frame shown above, not in this one: "
-                f"its strings have other lengths here ({', '.join(strings)})")
+                f"its strings have other lengths here ({', '.join(counted)})")
     elif 0 < short and (short % 4 == 0 and short // 4 <= len(prefixes) or
                         any(n == short for o, n, _l in spans if o < want)):
         k = short // 4
-        same = [label for off, n, label in spans if off < want and n == short]
+        same = [label for off, n, label in spans
+                if off < want and n == short and label not in prefixes]
         ways = ([f"as many as {' or '.join(same)}"] if same else []) + (
             [f"{k} of the {len(prefixes)} four-byte length prefixes before the stream "
              f"({', '.join(prefixes)})"] if short % 4 == 0 and k <= len(prefixes) else [])
         hint = (f"{short} byte{'s' if short > 1 else ''} short: {', or '.join(ways)}; count "
-                "every field and every "
-                "length prefix once")
+                "every field and every length prefix once")
     elif hit is None:
         hint = f"byte {answer} is outside the {len(frame)}-byte frame"
     else:
@@ -96,8 +97,8 @@ def check_stream_offset(answer: Any, frame: bytes, layout: Layout, reg: MsgRegis
             hint += ", not where a field begins"
         if answer < want:
             after = [lab for o, n, lab in spans if off < o < want]
-            hint += (f"; the elements begin after it" + (f" and {', '.join(after)}" if after
-                                                          else ""))
+            hint += "; the elements begin after it" + (f" and {', '.join(after)}" if after
+                                                        else "")
     raise fail(ex, f"stream_offset {answer}, expected another value: {hint}")
 
 
