@@ -9,6 +9,7 @@ hand from the message and the sample the notebook prints (strings = their field 
 from __future__ import annotations
 
 import re
+import time
 
 import nbformat
 import pytest
@@ -101,3 +102,28 @@ def test_a_failing_rospy_node_shows_its_own_error() -> None:
     assert "rospy exited with 1" in text
     assert "rospy's error output:" in text and "RuntimeError: no such sensor" in text
     assert "frames from the rospy node: 0, bit-exact: 0" in text
+
+
+def test_a_wait_that_runs_out_stops_the_cell_saying_what() -> None:
+    """With its publisher on another topic than the component's (what the literal "/line" did
+    to a student's own topic), the live cell waited about 80 s and printed "received 0"."""
+    from nbclient.exceptions import CellExecutionError
+
+    nb = nbformat.read(SOLUTIONS / "10_your_own_message.ipynb", as_version=4)
+    index, cell = next((i, c) for i, c in enumerate(nb.cells)
+                       if c.cell_type == "code" and "sensor.advertise(IN_TOPIC" in c.source)
+    cell.source = cell.source.replace("sensor.advertise(IN_TOPIC", 'sensor.advertise("/elsewhere"')
+    client = NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3",
+                            resources={"metadata": {"path": str(SOLUTIONS)}})
+    with client.setup_kernel():
+        for i, c in enumerate(nb.cells[:index]):
+            if c.cell_type == "code":
+                client.execute_cell(c, i)
+        start = time.monotonic()
+        with pytest.raises(CellExecutionError) as info:
+            client.execute_cell(cell, index)
+        took = time.monotonic() - start
+        client.execute_cell(nb.cells[index + 4], index + 4)   # the clean-up cell still runs
+    assert info.value.ename == "TimeoutError"
+    assert info.value.evalue == "timed out waiting for the component and the checker on /line"
+    assert took < 30
