@@ -57,18 +57,23 @@ setup() {
   fi
   # The student's lab: no nbgrader panels or Validate button (nbgrader belongs to the course
   # server, where each assignment carries graded checks; here Validate would pass an unanswered
-  # notebook), and notebooks/solutions/ out of the file browser (still open on purpose:
-  # File > Open from Path..., solutions/01_xmlrpc_handshake.ipynb). Jupyter reads both from the
-  # environment's etc/jupyter.
+  # notebook), none of nbgrader's server pages either (its teacher page /formgrader), and
+  # notebooks/solutions/ out of the file browser (still open on purpose: File > Open from
+  # Path..., solutions/01_xmlrpc_handshake.ipynb). Jupyter reads them from the environment's
+  # etc/jupyter (jupyter_server_config.json wins over the jupyter_server_config.d/nbgrader.json
+  # that nbgrader installs beside it).
   local etc="$venv/etc/jupyter"
   if ! cmp -s "$here/data/jupyterlab_page_config.json" "$etc/labconfig/page_config.json"; then
     mkdir -p "$etc/labconfig"
     cp "$here/data/jupyterlab_page_config.json" "$etc/labconfig/page_config.json"
   fi
-  if ! cmp -s "$here/data/jupyter_lab_config.json" "$etc/jupyter_lab_config.json"; then
-    mkdir -p "$etc"
-    cp "$here/data/jupyter_lab_config.json" "$etc/jupyter_lab_config.json"
-  fi
+  local name
+  for name in jupyter_lab_config.json jupyter_server_config.json; do
+    if ! cmp -s "$here/data/$name" "$etc/$name"; then
+      mkdir -p "$etc"
+      cp "$here/data/$name" "$etc/$name"
+    fi
+  done
 }
 
 # No command, or only options for JupyterLab (./lab.sh --port 8889): open the lab.

@@ -5,8 +5,10 @@ Run from the repository root with the lab installed and g++, make and iverilog o
 
     python data/make_notebook10_sim.py
 
-The message and the configuration are the notebook's own (``MSG_TEXT`` and ``CONFIG_TEXT`` in
-notebooks/solutions/10_your_own_message.ipynb, read here, one owner); the project is what
+The message and the configuration are the notebook's example (``EXAMPLE_MSG_TEXT`` and
+``EXAMPLE_CONFIG_TEXT`` in notebooks/solutions/10_your_own_message.ipynb, read here, one owner;
+returned as ``MSG_TEXT`` and ``CONFIG_TEXT``, the texts the notebook runs unless a student
+changes them); the project is what
 ``rosfpga-lab generate`` writes for them and the frames are its testbench's (``tb_input.bin``:
 a good frame, a refused one, a good one). tests/test_notebook10_shipped.py checks that the file
 belongs to the notebook's texts and, with the tools, makes it again and compares.
@@ -31,8 +33,13 @@ MSG_FILE = "msg/my_msgs/msg/LineScan.msg"
 GAP, BP, SEED = 300, 300, 1
 
 
+#: The notebook's variables read here, and the keys they are returned under.
+NAMES = {"EXAMPLE_MSG_TEXT": "MSG_TEXT", "EXAMPLE_CONFIG_TEXT": "CONFIG_TEXT"}
+
+
 def notebook_texts(path: Path = NOTEBOOK) -> dict[str, str]:
-    """``MSG_TEXT`` and ``CONFIG_TEXT`` as the notebook's cells assign them."""
+    """``MSG_TEXT`` and ``CONFIG_TEXT``: the example's texts as the notebook's cells assign
+    them (``EXAMPLE_MSG_TEXT``, ``EXAMPLE_CONFIG_TEXT``)."""
     found: dict[str, str] = {}
     for cell in json.loads(path.read_text(encoding="utf-8"))["cells"]:
         if cell["cell_type"] != "code":
@@ -45,10 +52,10 @@ def notebook_texts(path: Path = NOTEBOOK) -> dict[str, str]:
         for node in tree.body:
             if (isinstance(node, ast.Assign) and len(node.targets) == 1
                     and isinstance(node.targets[0], ast.Name)
-                    and node.targets[0].id in ("MSG_TEXT", "CONFIG_TEXT")
+                    and node.targets[0].id in NAMES
                     and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)):
-                found[node.targets[0].id] = node.value.value
-    missing = {"MSG_TEXT", "CONFIG_TEXT"} - set(found)
+                found[NAMES[node.targets[0].id]] = node.value.value
+    missing = {name for name, key in NAMES.items() if key not in found}
     if missing:
         raise SystemExit(f"{path}: no cell assigns {', '.join(sorted(missing))} a string")
     return found

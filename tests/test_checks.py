@@ -235,6 +235,34 @@ def test_extract_frame_length_forgotten_is_not_called_a_swap():
     assert "still None" in problems_of(C.check_extract, None, frame)
 
 
+def test_extract_from_27_names_the_shift_of_height_and_width_whatever_step_is():
+    """Issue 32: ``height, width = unpack_from("<II", mystery, 27)`` (the frame length left out),
+    the walk then going on from there, was told "that is the height; height comes before
+    width": the shift was named only when every wrong number had it."""
+    import numpy as np
+
+    from rosfpga_lab import hw
+
+    mystery = hw.image_frame(np.zeros((5, 9, 3), np.uint8), "bgr8", seq=42, frame_id="left_camera")
+    pos = 27                                   # 4 + 8 + 4 + 11: the frame's length forgotten
+    height, width = struct.unpack_from("<II", mystery, pos)
+    pos += 8
+    (n,) = struct.unpack_from("<I", mystery, pos)
+    encoding = mystery[pos + 4:pos + 4 + n].decode(errors="replace")
+    pos += 4 + n + 1
+    (step,) = struct.unpack_from("<I", mystery, pos)
+    assert width == 5 and step != 27                    # the height's value, a wrong step
+    msg = problems_of(C.check_extract, {"width": width, "height": height, "encoding": encoding,
+                                        "step": step}, mystery)
+    assert "height and width read 4 bytes too early" in msg and "frame's 4-byte length" in msg
+    assert "that is the height" not in msg
+    assert f"step is {step}, expected 27" in msg
+    # the same with encoding and step right: the shift alone
+    msg = problems_of(C.check_extract, {"width": width, "height": height, "encoding": "bgr8",
+                                        "step": 27}, mystery)
+    assert "height and width read 4 bytes too early" in msg and "step" not in msg
+
+
 def test_marshal_right_and_the_brief_example():
     assert C.check_marshal(image_body("cam_one"), image_msg("cam_one")).ok
     bad = bytearray(image_body("cam_one"))

@@ -66,11 +66,30 @@ def test_stream_offset_right_wrong_blank(setup) -> None:
     assert "start at byte 44" in str(check_stream_offset(OFFSET, frame, layout, reg))
     with pytest.raises(ExerciseError, match="uint32 'values length' starts; the elements begin 4"):
         check_stream_offset(OFFSET - 4, frame, layout, reg)
-    with pytest.raises(ExerciseError, match="off by 8"):
+    # both string length prefixes forgotten (or the frame length and values length, or the
+    # window): the hint names every way to be 8 short, not one guess
+    with pytest.raises(ExerciseError, match=r"stream_offset 36, expected another value: 8 bytes "
+                                            r"short: as many as window, or 2 of the 4 four-byte "
+                                            r"length prefixes before the stream \(frame length, "
+                                            r"header.frame_id length, sensor length, values "
+                                            r"length\); count every field and every length "
+                                            r"prefix once"):
         check_stream_offset(OFFSET - 8, frame, layout, reg)
-    # window counted as 4 + 3 bytes: lands inside the window
-    with pytest.raises(ExerciseError, match=r"byte 35 is inside field window \(bytes 32..39\); "
-                                            r"between it and the stream: values length"):
+    with pytest.raises(ExerciseError, match=r"1 byte short: as many as gain;"):
+        check_stream_offset(OFFSET - 1, frame, layout, reg)
+    # the offset copied from another frame of the type (the one the notebook shows)
+    longer = frame_of(reg, {**message(), "sensor": "left_more"})     # 5 bytes more sensor
+    with pytest.raises(ExerciseError, match=r"44 is where the stream starts in the frame shown "
+                                            r"above, not in this one: its strings have other "
+                                            r"lengths here \(header.frame_id 3 bytes, sensor 9 "
+                                            r"bytes\)"):
+        check_stream_offset(OFFSET, longer, layout, reg, shown=frame)
+    assert "start at byte 49" in str(check_stream_offset(OFFSET + 5, longer, layout, reg,
+                                                         shown=frame))
+    # window counted as 4 + 3 bytes: lands inside the window, not at a field's start
+    with pytest.raises(ExerciseError, match=r"byte 35 is inside field window \(bytes 32..39\), "
+                                            r"not where a field begins; the elements begin after "
+                                            r"it and values length"):
         check_stream_offset(35, frame, layout, reg)
     with pytest.raises(ExerciseError, match="outside the 60-byte frame"):
         check_stream_offset(500, frame, layout, reg)
@@ -121,6 +140,10 @@ def test_frame_clocks_right_wrong_blank(setup) -> None:
         check_frame_clocks(lambda n: 1 // 0, config, message())
     with pytest.raises(ExerciseError, match="should be a function of n"):
         check_frame_clocks(119, config, message())
+    def no_return(n: int) -> None:
+        4 + body_bytes(n)
+    with pytest.raises(ExerciseError, match=r"clocks\(8\) returned None: did you forget `return`\?"):
+        check_frame_clocks(no_return, config, message())
     with pytest.raises(ExerciseError, match="replace it with your answer"):
         check_frame_clocks(None, config, message())
 
@@ -140,6 +163,12 @@ def test_refused_field_right_wrong_blank(setup) -> None:
     with pytest.raises(ExerciseError, match=r"header.frame_id length is 3 in this frame and the "
                                             r"circuit accepts it \(<= 256\)"):
         check_refused_field("header.frame_id length", suspect, layout, reg)
+    # the frame length's value is printed (it was "frame length is None in this frame"):
+    # 56 bytes of body with frame_id "cam", 17 bytes of sensor and 7 elements, by hand
+    body = OFFSET - 4 + 2 * 7 - 4 + 17
+    with pytest.raises(ExerciseError, match=rf"frame length is {body} in this frame and the "
+                                            r"circuit accepts it \(\d+\.\.\d+\); look further on"):
+        check_refused_field("frame length", suspect, layout, reg)
     with pytest.raises(ExerciseError, match="no field 'sensor_length' in this frame's walk"):
         check_refused_field("sensor_length", suspect, layout, reg)
     with pytest.raises(ExerciseError, match="replace it with your answer"):
@@ -168,3 +197,26 @@ def test_the_byte_viewer_names_the_walk_as_the_check_does(setup) -> None:
                      "values": "stream"}
     assert spans[0].value == 56 and spans[-1].type == "uint16[8]"
     assert sum(s.size for s in spans) == len(frame_of(reg, msg))
+
+
+def test_the_issues_two_wrong_answers_in_notebook_10s_own_frames(setup) -> None:
+    """Notebook 10's exercise frame (frame_id "line_camera", sensor "rear": the stream at
+    4 + 4 + 8 + 4 + 11 + 4 + 4 + 1 + 8 + 4 = 52) and the frame shown above it ("camera",
+    "left": at 47). 44 (both string prefixes forgotten) was told to count the frame length and
+    the values length (counted already); 47 (copied from the viewer) was sent to 51."""
+    _config, layout, reg = setup
+    exercise = frame_of(reg, {**message(), "header": {"seq": 9, "stamp": {"secs": 3, "nsecs": 4},
+                                                      "frame_id": "line_camera"},
+                              "sensor": "rear"})
+    shown = frame_of(reg, {**message(), "header": {"seq": 1, "stamp": {"secs": 1, "nsecs": 0},
+                                                   "frame_id": "camera"}, "sensor": "left"})
+    assert "start at byte 52" in str(check_stream_offset(52, exercise, layout, reg, shown=shown))
+    with pytest.raises(ExerciseError) as info:
+        check_stream_offset(44, exercise, layout, reg, shown=shown)
+    assert "8 bytes short" in str(info.value) and "header.frame_id length, sensor length" \
+        in str(info.value)
+    with pytest.raises(ExerciseError, match=r"47 is where the stream starts in the frame shown "
+                                            r"above, not in this one: its strings have other "
+                                            r"lengths here \(header.frame_id 11 bytes, sensor 4 "
+                                            r"bytes\)"):
+        check_stream_offset(47, exercise, layout, reg, shown=shown)

@@ -131,6 +131,8 @@ def test_discovery_port_right_and_each_usual_mistake() -> None:
                        (17901, "multicast user-data port"), (17913, "participant gain is 2"),
                        (7416, "domain gain"), (17906, "offset d1 = 10"),
                        (17918, "one index too many"), (17914, "one index too few"),
+                       (17910, r"participant 0's port: left out the participant term "
+                               r"PG\*index = 2\*3"),
                        (1234, "PB \\+ DG\\*domain")):
         with pytest.raises(ExerciseError, match=why):
             check_discovery_port(wrong, 42, 3)

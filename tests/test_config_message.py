@@ -150,3 +150,41 @@ def test_image_configs_keep_their_shape_and_imply_the_image_checks() -> None:
          "image: already")
     _bad(text.replace("image:\n  width: 320\n  height: 240\n  encoding: mono8\n", ""),
          "image", 0, "missing section 'image:'")
+
+
+OWN = """\
+node: {name: /fpga_linescan}
+subscriber: {topic: /line, type: my_msgs/LineScan}
+publisher: {topic: /line_eroded}
+msg_path: [msg]
+stream: {field: values, length: 32}
+application: {op: erode, ksize: 3}
+"""
+
+
+@pytest.mark.parametrize("typo, meant", [("flaot32", "float32"), ("unit8", "uint8"),
+                                         ("strng", "string"), ("Float64", "float64")])
+def test_a_misspelt_primitive_is_a_config_error_with_its_line_and_the_primitive(
+        tmp_path: Path, typo: str, meant: str) -> None:
+    """Notebook 10: ``flaot32[] values`` gave a raw UnknownTypeError traceback where other
+    .msg mistakes give a ConfigError with the line."""
+    (tmp_path / "msg/my_msgs/msg").mkdir(parents=True)
+    msg = tmp_path / "msg/my_msgs/msg/LineScan.msg"
+    msg.write_text(f"Header header\nuint8 gain\n{typo}[] values\n")
+    with pytest.raises(ConfigError) as info:
+        parse_config(OWN, source="notebook config", base_dir=tmp_path)
+    text = str(info.value)
+    assert text.startswith("notebook config:2: subscriber.type: unknown message type "
+                           f"'my_msgs/{typo}', used by field 'values' of my_msgs/LineScan "
+                           f"({msg.resolve()}:3) -- did you mean the primitive '{meant}'?"), text
+
+
+def test_an_unknown_message_type_far_from_any_primitive_gets_no_primitive_hint(
+        tmp_path: Path) -> None:
+    (tmp_path / "msg/my_msgs/msg").mkdir(parents=True)
+    (tmp_path / "msg/my_msgs/msg/LineScan.msg").write_text("Pose pose\nuint16[] values\n")
+    with pytest.raises(ConfigError, match=r"unknown message type 'my_msgs/Pose', used by field "
+                                          r"'pose' of my_msgs/LineScan \(.*LineScan.msg:1\); "
+                                          r"searched") as info:
+        parse_config(OWN, source="notebook config", base_dir=tmp_path)
+    assert "did you mean" not in str(info.value)

@@ -86,7 +86,8 @@ def test_shipped_example_generates_and_simulates_exactly(name: str, tmp_path: Pa
 
 
 def test_refusals_then_good_frames_match_the_models(tmp_path: Path) -> None:
-    """lab_msgs/Samples: a failed check, a string over its maximum, a bad stream length, bytes
+    """lab_msgs/Samples: a failed check, a string over its maximum, a bad stream length (one
+    element too many: one too few can be below the shortest body accepted), bytes
     after the last field and a frame length below the minimum, each followed by a good frame."""
     require_cxx()
     require_iverilog()
@@ -106,7 +107,7 @@ def test_refusals_then_good_frames_match_the_models(tmp_path: Path) -> None:
     body = good[0][4:] + b"\x00"
     frames = [good[0], with_value("calibration_mode", 3), good[1],
               with_value("label_length", 33), good[2],
-              marshal(layout, sample_tokens(layout, rng, stream_count=63)), good[3],
+              marshal(layout, sample_tokens(layout, rng, stream_count=65)), good[3],
               struct.pack("<I", len(body)) + body, good[4],
               struct.pack("<I", 3) + b"abc", good[5]]
     # the two refusals whose bytes were altered after marshal's length keep a consistent frame:

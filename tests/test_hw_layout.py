@@ -117,7 +117,9 @@ def test_the_image_layout_names_the_image_interpreters_statuses() -> None:
     assert [label for _n, label in layout.statuses] == [label for _n, label in SUBSCRIBER_STATUSES]
     assert [n.replace("HEADER_", "") for n, _l in layout.statuses] == \
         [n for n, _l in SUBSCRIBER_STATUSES]
-    assert layout.min_body == 37 and layout.stream.ident == "data"
+    # Image's 37 bytes with empty strings and no pixels, plus what the checks fix: "rgb8" and
+    # the 12 data bytes (the shortest body accepted)
+    assert layout.min_body == 37 + 4 + 12 and layout.stream.ident == "data"
     assert layout.step("encoding").check.value == "rgb8"
 
 
@@ -168,7 +170,8 @@ def test_actions_checks_and_statuses() -> None:
     assert layout.step("ranges_length").check.value == 360
     assert layout.step("range_max").check.op is CheckOp.RANGE
     assert layout.step("range_max").check.high == 100
-    assert layout.step("frame_length").check.low == 52  # genpy: 13 x 4 bytes for an empty scan
+    # genpy: 13 x 4 bytes for an empty scan, plus the 360 float32 ranges the circuit is built for
+    assert layout.step("frame_length").check.low == 52 + 360 * 4 == layout.min_body
     assert layout.beat_bits == 32 and layout.stream.dtype == "<f4"
     assert [n for n, _l in layout.statuses] == [
         "SUB_OK", "SUB_BAD_FRAME_LENGTH", "SUB_BAD_HEADER_FRAME_ID_LENGTH", "SUB_BAD_ANGLE_MIN",

@@ -15,6 +15,7 @@ import os
 import shutil
 import subprocess
 import sys
+import urllib.error
 import urllib.request
 from pathlib import Path
 
@@ -68,6 +69,9 @@ def test_lab_sh_installs_the_student_configuration(lab_dir: Path) -> None:
     assert page["disabledExtensions"]["@jupyter/nbgrader"] is True
     server = json.loads((etc / "jupyter_lab_config.json").read_text())
     assert "solutions" in server["ContentsManager"]["hide_globs"]
+    extensions = json.loads((etc / "jupyter_server_config.json").read_text())
+    assert extensions["ServerApp"]["jpserver_extensions"][
+        "nbgrader.server_extensions.formgrader"] is False
     settings = lab_dir / ".venv" / "share" / "jupyter" / "lab" / "settings" / "overrides.json"
     assert settings.read_text() == (ROOT / "data" / "jupyterlab_overrides.json").read_text()
 
@@ -124,5 +128,12 @@ def test_solutions_are_out_of_the_file_browser_but_open_by_path(lab_dir: Path, t
         url = f"{base}api/contents/solutions/01_xmlrpc_handshake.ipynb?content=0&token={TOKEN}"
         with urllib.request.urlopen(url, timeout=10) as resp:   # ... but open on purpose
             assert json.load(resp)["type"] == "notebook"
+        # nbgrader's teacher pages are not served ("Manage Assignments" at /formgrader)
+        for page in ("formgrader", "formgrader/manage_assignments"):
+            with pytest.raises(urllib.error.HTTPError) as info:
+                urllib.request.urlopen(f"{base}{page}?token={TOKEN}", timeout=10)
+            assert info.value.code == 404, page
+        with urllib.request.urlopen(f"{base}lab?token={TOKEN}", timeout=10) as resp:
+            assert resp.status == 200                            # the lab itself is
     finally:
         _stop_server(server, base)

@@ -60,7 +60,7 @@ def test_the_script_makes_the_same_result_with_the_tools() -> None:
 
 
 def test_the_script_names_a_missing_text(tmp_path: Path) -> None:
-    nb = {"cells": [{"cell_type": "code", "source": ["MSG_TEXT = 'Header header\\n'\n"]}]}
+    nb = {"cells": [{"cell_type": "code", "source": ["EXAMPLE_MSG_TEXT = 'Header header\\n'\n"]}]}
     (tmp_path / "nb.ipynb").write_text(json.dumps(nb))
-    with pytest.raises(SystemExit, match="no cell assigns CONFIG_TEXT a string"):
+    with pytest.raises(SystemExit, match="no cell assigns EXAMPLE_CONFIG_TEXT a string"):
         script().notebook_texts(tmp_path / "nb.ipynb")

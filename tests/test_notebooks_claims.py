@@ -125,6 +125,20 @@ def test_stats_report_says_which_time_is_which() -> None:
     assert "wall time" in prose and "not measured" in prose
 
 
+def test_stats_report_shows_a_short_circuit_time_in_microseconds() -> None:
+    """10 printed "the real circuit would need 0.00 ms per frame" for a 2.55 us frame."""
+    from rosfpga_lab.component.stats import ComponentStats, LatencySummary
+
+    stats = ComponentStats(latency=LatencySummary(3, 2.7e-3, 2.7e-3, 2.9e-3),
+                           process_time=LatencySummary(3, 1.1e-3, 1.1e-3, 1.2e-3),
+                           circuit_time_s=255 / 100e6, cycles={"subscriber": 100})
+    report = stats.report()
+    assert "real circuit would need 2.55 \u00b5s per frame" in report
+    assert "0.00 ms" not in report
+    short = ComponentStats(circuit_time_s=4e-8, cycles={"subscriber": 4}).report()
+    assert "real circuit would need 40 ns per frame" in short
+
+
 def test_workshop_notebook_says_when_the_stop_button_is_there_and_explains_resets() -> None:
     """07 promised a Stop button that Run All never shows (the last cell closes the view), and
     left real rospy's 'Connection reset by peer' line unexplained."""

@@ -138,6 +138,41 @@ def check_claims(stem: str, nb: nbformat.NotebookNode) -> None:
         assert "<details open><summary><code>subscriber.cpp</code>" in html
     if stem == "10_your_own_message":
         check_own_message(text, html)
+    if stem == "01_xmlrpc_handshake":
+        check_handshake_claims(nb, ros_logging=False)
+
+
+def check_handshake_claims(nb: nbformat.NotebookNode, ros_logging: bool) -> None:
+    """Notebook 01: each sentence about a trace entry is true of the entry printed under it
+    ("the talker's registerPublisher request", "the value is the list of the topic's
+    subscribers: the listener's", "requestTopic goes from the subscriber to the publisher")."""
+    def output_of(marker: str) -> str:
+        cell = next(c for c in nb.cells if c.cell_type == "code" and marker in c.source)
+        return text_of(cell)
+
+    summary = output_of("trace.summary()")
+    request = output_of("print(reg_pub.raw.decode())")
+    assert request.startswith("POST ") and "<methodName>registerPublisher</methodName>" in request
+    params = re.findall(r"<string>([^<]*)</string>", request)
+    assert params[:3] == ["/talker", "/chatter", "std_msgs/String"], params
+    result = " ".join(output_of("reg_pub.result").split())   # as one line (pretty-printed)
+    listener = re.search(r"'(http://127\.0\.0\.1:\d+/)'\)$", result.strip())
+    assert listener, result
+    assert f"[1, 'Registered [/talker] as publisher of [/chatter]', ['{listener[1]}']]" in result
+    request_topic = " ".join(output_of("req.args, req.result").split())
+    assert request_topic.startswith("(['/listener', '/chatter', [['TCPROS']]], [1, ")
+    assert "'TCPROS', '127.0.0.1'" in request_topic
+    lines = summary.splitlines()
+    first = [re.sub(r"^\s*[\d.]+s ", "", line) for line in lines]
+    if ros_logging:   # the plumbing the switch shows, besides the paper's calls
+        assert "/talker -> /master: registerService" in first and \
+            sum("registerPublisher" in line for line in first) == 3, summary
+    else:             # the paper's Figure 2: four calls, then TCPROS
+        assert first[:4] == ["/listener -> /master: registerSubscriber",
+                             "/talker -> /master: registerPublisher",
+                             "/master -> /listener: publisherUpdate",
+                             "/listener -> /talker: requestTopic"], summary
+        assert "registerService" not in summary and "/rosout" not in summary
 
 
 def check_own_message(text: str, html: str) -> None:
@@ -145,7 +180,10 @@ def check_own_message(text: str, html: str) -> None:
     result) equal to the models, Table 1, the live graph, and real rospy when it is here."""
     assert 'class="rfl-state" data-state="VALUES"' in html and 'data-state="SKIP"' in html
     assert "values [stream]" in html and "gain [check]" in html   # the byte viewer's roles
-    assert "field 'gain' at byte 34: 5 but the circuit was built for 4 (status SUB_BAD_GAIN)" in text
+    # the sample message made from the layout: frame_id "frame_id", sensor "sensor"; by hand
+    # the gain is at 4 + 4 + 8 + (4 + 8) + (4 + 6) = 38
+    assert "field 'gain' at byte 38: 5 but the circuit was built for 4 (status SUB_BAD_GAIN)" in text
+    assert "real circuit would need" in text and " ms per frame" not in text   # 2.x us, shown so
     for run in ("C simulation", "RTL simulation"):
         if "the shipped result" not in text:
             assert re.search(rf"{run} output equals the models':\s+True", text), text[-2000:]
@@ -200,6 +238,13 @@ def check_ros2_live(text: str, html: str, cyclone: bool) -> None:
     assert "and the same as the live run's first output: True" in text
     sample = 4 + 4 + 4 + 4 + len("camera") + 1 + 1 + 4 + 4 + 4 + len("rgba8") + 1 + 1 + 1 + 4 + 4 + 64 * 48 * 4
     assert f"{3 * sample:,} bytes of samples went through the circuit" in text, text[-600:]
+    # the applications' clocks in their own units (by hand: 64 x 48 pixels; 64 x 48 x 4 bytes
+    # + ksize // 2 = 1), and whether the run cut samples into DATA_FRAG, as counted
+    assert re.search(r"ROS 1 dilate [\d,]+ clocks for 3,072 pixels; ROS 2 application 12,289 "
+                     r"clocks for 12,288 bytes", text), text[-1500:]
+    frag_line = re.search(r"user samples received whole in one DATA: (\d+); DATA_FRAG fragments "
+                          r"received: (\d+)", text)
+    assert frag_line and int(frag_line[1]) + int(frag_line[2]) >= 3, text[-800:]
     assert "<svg" in html
     for label in ("SPDP participant", "SEDP writer rt/cam", "SEDP reader rt/cam_out", "HEARTBEAT",
                   "ACKNACK", "matched rt/cam", "not matched rt/cam", "DATA"):
@@ -244,6 +289,16 @@ def test_student_notebook_runs_with_only_the_placeholders_failing(path: Path):
             else:
                 client.execute_cell(cell, index)
     assert placeholders >= 2
+
+
+def test_handshake_notebook_with_the_ros_logging_switch_on():
+    """Notebook 01 with ``ROS_LOGGING = True`` (its visible switch): the nodes add /rosout and
+    the logger services, and every sentence still names the /chatter entry it prints."""
+    client, nb = client_for(SOLUTIONS / "01_xmlrpc_handshake.ipynb")
+    switch = next(c for c in nb.cells if c.cell_type == "code" and "ROS_LOGGING = False" in c.source)
+    switch.source = switch.source.replace("ROS_LOGGING = False", "ROS_LOGGING = True")
+    client.execute()
+    check_handshake_claims(nb, ros_logging=True)
 
 
 def test_workshop_demo_explains_itself_without_real_ros(monkeypatch: pytest.MonkeyPatch):

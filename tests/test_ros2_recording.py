@@ -107,3 +107,9 @@ def test_a_datagram_of_two_participants_is_drawn_as_an_arrow_from_each() -> None
         ("camera", "component", "ACKNACK, HEARTBEAT, SPDP participant"),
         ("viewer", "component", "SPDP participant")]
     assert all(e.raw == dg for e in events)
+    # each arrow its own submessages' bytes (issue 32: both said the whole 836), counted from
+    # the datagram's submessage table: the camera's INFO_DST 16, ACKNACK 28 + 28, HEARTBEAT
+    # 32 + 32 and, after its INFO_SRC 24 and INFO_TS 12, DATA 304; the viewer's INFO_SRC 24,
+    # INFO_TS 12, DATA 304 (the 20-byte RTPS header is neither's)
+    assert len(dg) == 836
+    assert [e.bytes_drawn for e in events] == [16 + 28 + 28 + 32 + 32 + 24 + 12 + 304, 24 + 12 + 304]

@@ -158,7 +158,9 @@ def test_trace_parties_are_named_retries_folded_and_the_diagram_fits() -> None:
     width = int(re.search(r'<svg [^>]*width="(\d+)"', svg)[1])
     assert width <= FIT_WIDTH + 100 and 'style="max-width:100%;height:auto"' in svg
     labels = re.findall(r'stroke-linejoin="round">([^<]*)</text>', svg)
-    assert len(labels) == 7 and all(t.endswith("\u2026") and len(t) < 40 for t in labels), labels  # cut
+    # two lines each (above and under the arrow); longer than two lines: the second is cut
+    assert len(labels) == 14 and all(len(t) < 40 for t in labels), labels
+    assert all(t.endswith("\u2026") for t in labels[1::2]), labels
     assert "a rather long label for one arrow a rather long label for one arrow" in svg  # whole in the tooltip
 
 
@@ -168,7 +170,35 @@ def test_cut_labels_keep_their_number_and_byte_count() -> None:
                        bytes(123), kind="tcpros_header") for i in range(7)]
     svg = sequence_svg(events)
     labels = re.findall(r'stroke-linejoin="round">([^<]*)</text>', svg)
-    assert len(labels) == 7
-    for k, label in enumerate(labels):
-        assert label.startswith(f"{k + 1}. TCPROS") and label.endswith(" [123 B]"), label
-        assert "\u2026" in label                                   # the middle was cut
+    # issue 32: the text was still cut; it now goes on in a second line under the arrow
+    assert len(labels) == 14
+    for k in range(7):
+        first, second = labels[2 * k], labels[2 * k + 1]
+        assert first.startswith(f"{k + 1}. TCPROS") and second.endswith(" [123 B]"), (first, second)
+        assert f"{first} {second}" == f"{k + 1}. TCPROS header /chatter callerid=/listener [123 B]"
+    lines = re.findall(r'<text x="[\d.]+" y="([\d.]+)"[^>]*stroke-linejoin="round">', svg)
+    assert float(lines[1]) - float(lines[0]) == 17            # the second under the arrow
+    # the byte count is never split between the lines
+    short = [SeqEvent("/a", "/b", "TCPROS header /chatter", bytes(128), kind="tcpros_header"),
+             SeqEvent("/b", "/c", "x", bytes(1)), SeqEvent("/c", "/d", "x", bytes(1)),
+             SeqEvent("/d", "/e", "x", bytes(1)), SeqEvent("/e", "/f", "x", bytes(1))]
+    two = re.findall(r'stroke-linejoin="round">([^<]*)</text>', sequence_svg(short, col=110))
+    assert "[128 B]" in " ".join(two) and not any(t.endswith("[128") for t in two), two
+    # text longer than two lines keeps its number and byte count, the middle cut
+    long = [SeqEvent(f"/node_{i}", f"/node_{i + 1}", "TCPROS header /chatter " * 6, bytes(99),
+                     kind="tcpros_header") for i in range(7)]
+    cut = re.findall(r'stroke-linejoin="round">([^<]*)</text>', sequence_svg(long))
+    assert cut[0].startswith("1. TCPROS") and cut[1].endswith("\u2026 [99 B]"), cut[:2]
+
+
+def test_a_packed_datagrams_arrows_each_carry_their_own_bytes() -> None:
+    """11: a 692-byte datagram packing two senders' submessages was drawn as two arrows of
+    692 B each; each now says its own submessages' bytes, the tooltip the datagram's."""
+    events = [SeqEvent("camera", "component", "HEARTBEAT", bytes(692), kind="rtps", size=52),
+              SeqEvent("viewer", "component", "ACKNACK", bytes(692), kind="rtps", size=620),
+              SeqEvent("component", "viewer", "DATA", bytes(100), kind="rtps")]
+    svg = sequence_svg(events)
+    labels = re.findall(r'stroke-linejoin="round">([^<]*)</text>', svg)
+    assert labels == ["1. HEARTBEAT [52 B]", "2. ACKNACK [620 B]", "3. DATA [100 B]"], labels
+    assert "(52 of the datagram&#x27;s 692 bytes)" in svg or "(52 of the datagram's 692 bytes)" in svg
+    assert "3. component \u2192 viewer: DATA (100 bytes)" in svg

@@ -100,9 +100,12 @@ def check_marshal(answer: Any, message: Mapping[str, Any]) -> CheckResult:
 EXTRACTED = ("width", "height", "encoding", "step")
 
 
-def _common_shift(frame: bytes, at: Mapping[str, int], wrong: Mapping[str, int]) -> int | None:
-    """The one offset error (in bytes, negative: read too early) that explains every wrong
-    number at once, when at least two are wrong; the smallest such, or None.
+def _common_shift(frame: bytes, at: Mapping[str, int], wrong: Mapping[str, int]
+                  ) -> tuple[int, frozenset[str]] | None:
+    """The one offset error (in bytes, negative: read too early) that explains at least two
+    wrong numbers, and which: the shift explaining the most of them (the smallest such on a
+    tie), or None. Other wrong numbers may have other causes (``unpack_from("<II", mystery,
+    27)`` shifts height and width; a step read after them from a wrong position is not).
 
     A value read a fixed distance from its field (the frame length forgotten: 4 bytes early)
     can look like a swap (width read 4 bytes early *is* the height); the shift is tested
@@ -110,13 +113,17 @@ def _common_shift(frame: bytes, at: Mapping[str, int], wrong: Mapping[str, int])
     """
     if len(wrong) < 2:
         return None
-    found: set[int] | None = None
+    explains: dict[int, set[str]] = {}
     for key, value in wrong.items():
-        shifts = {off - at[key] for off in range(0, len(frame) - 3)
-                  if int.from_bytes(frame[off:off + 4], "little") == value
-                  and 0 < abs(off - at[key]) <= MAX_READ_SHIFT}
-        found = shifts if found is None else found & shifts
-    return min(found, key=abs) if found else None
+        for off in range(0, len(frame) - 3):
+            if int.from_bytes(frame[off:off + 4], "little") == value and \
+                    0 < abs(off - at[key]) <= MAX_READ_SHIFT:
+                explains.setdefault(off - at[key], set()).add(key)
+    best = sorted(((-len(keys), abs(d), d) for d, keys in explains.items() if len(keys) >= 2))
+    if not best:
+        return None
+    shift = best[0][2]
+    return shift, frozenset(explains[shift])
 
 
 def check_extract(answer: Any, frame: bytes) -> CheckResult:
@@ -142,19 +149,21 @@ def check_extract(answer: Any, frame: bytes) -> CheckResult:
             "encoding": spans["encoding"].value, "step": spans["step"].value}
     at = {k: spans[k].offset + 4 for k in ("width", "height", "step")}   # frame offsets
     wrong = {k: answer[k] for k in at if isinstance(answer[k], int) and answer[k] != want[k]}
-    shift = _common_shift(frame, at, wrong)
+    found = _common_shift(frame, at, wrong)
+    shifted: frozenset[str] = frozenset() if found is None else found[1]
     problems = []
-    if shift is not None:
+    if found is not None:
+        shift = found[0]
         where = "early" if shift < 0 else "late"
         cause = (": did you leave out the frame's 4-byte length? Offsets in `mystery` count from "
                  "its first byte, and the message starts at byte 4" if shift == -4 else
                  ": count the bytes before each field again")
-        problems.append(f"{' and '.join(sorted(wrong))} read {abs(shift)} bytes too {where} "
+        problems.append(f"{' and '.join(sorted(shifted))} read {abs(shift)} bytes too {where} "
                         f"(each value is the uint32 {abs(shift)} bytes {'before' if shift < 0 else 'after'} "
                         f"its field){cause}")
     for key in EXTRACTED:
         have = answer[key]
-        if shift is not None and key in wrong:
+        if key in shifted:
             continue
         if isinstance(have, bytes) and key == "encoding":
             problems.append(f"encoding is bytes {have!r}: decode it to str (.decode())")

@@ -47,8 +47,10 @@ def _at(spans: list[tuple[int, int, str]], offset: int) -> tuple[int, int, str] 
     return next((s for s in spans if s[0] <= offset < s[0] + s[1]), None)
 
 
-def check_stream_offset(answer: Any, frame: bytes, layout: Layout, reg: MsgRegistry) -> CheckResult:
-    """Exercise 10.1: the byte offset in a TCPROS frame of the streamed array's first element.
+def check_stream_offset(answer: Any, frame: bytes, layout: Layout, reg: MsgRegistry, *,
+                        shown: bytes | None = None) -> CheckResult:
+    """Exercise 10.1: the byte offset in a TCPROS frame of the streamed array's first element
+    (``shown``: another frame of the type the notebook showed, whose offset a reader may copy).
 
     Raises:
         ExerciseError: a wrong offset (the field it points into is named).
@@ -63,19 +65,40 @@ def check_stream_offset(answer: Any, frame: bytes, layout: Layout, reg: MsgRegis
                                 f"{want - 4} bytes of message before them"])
     spans = walk_spans(layout, deserialize(reg, layout.type_name, frame[4:]))
     hit = _at(spans, int(answer))
+    prefixes = [label for off, n, label in spans
+                if off < want and n == 4 and (label.endswith(" length") or off == 0)]
+    short = want - int(answer)
+    shown_at = None if shown is None else extract_fast(layout, bytes(shown)).stream_offset
     if answer == want - 4 and hit is not None and hit[2] == f"{stream} length":
         hint = (f"that is where the uint32 '{stream} length' starts; the elements begin 4 bytes "
                 "later (and did you count the frame's own 4-byte length?)")
-    elif answer == want - 8:
-        hint = f"off by 8: count both the frame length and the '{stream} length' prefix"
+    elif answer == shown_at:
+        labels = {lab for _o, _n, lab in spans}
+        counted = [f"{label} {n} bytes" for off, n, label in spans
+                   if off < want and f"{label} length" in labels]
+        hint = (f"{answer} is where the stream starts in the frame shown above, not in this one: "
+                f"its strings have other lengths here ({', '.join(counted)})")
+    elif 0 < short and (short % 4 == 0 and short // 4 <= len(prefixes) or
+                        any(n == short for o, n, _l in spans if o < want)):
+        k = short // 4
+        same = [label for off, n, label in spans
+                if off < want and n == short and label not in prefixes]
+        ways = ([f"as many as {' or '.join(same)}"] if same else []) + (
+            [f"{k} of the {len(prefixes)} four-byte length prefixes before the stream "
+             f"({', '.join(prefixes)})"] if short % 4 == 0 and k <= len(prefixes) else [])
+        hint = (f"{short} byte{'s' if short > 1 else ''} short: {', or '.join(ways)}; count "
+                "every field and every length prefix once")
     elif hit is None:
         hint = f"byte {answer} is outside the {len(frame)}-byte frame"
     else:
         off, size, label = hit
         hint = f"byte {answer} is inside field {label} (bytes {off}..{off + size - 1})"
+        if answer != off:
+            hint += ", not where a field begins"
         if answer < want:
-            skipped = [label for o, n, label in spans if answer <= o < want]
-            hint += f"; between it and the stream: {', '.join(skipped)}"
+            after = [lab for o, n, lab in spans if off < o < want]
+            hint += "; the elements begin after it" + (f" and {', '.join(after)}" if after
+                                                        else "")
     raise fail(ex, f"stream_offset {answer}, expected another value: {hint}")
 
 
@@ -123,6 +146,8 @@ def check_frame_clocks(answer: Any, config: NodeConfig, message: Mapping[str, An
             got = fn(n)
         except Exception as exc:  # the reader's code: say what it raised
             raise fail(ex, f"clocks({n}) raised {type(exc).__name__}: {exc}") from None
+        if got is None:
+            raise fail(ex, f"clocks({n}) returned None: did you forget `return`?")
         require_type(ex, f"clocks({n})", got, int)
         frame = c["subscriber"]
         if got == want:
@@ -191,9 +216,10 @@ def check_refused_field(answer: Any, frame: bytes, layout: Layout, reg: MsgRegis
         known = ", ".join(dict.fromkeys(lab for _o, _n, lab in spans))
         raise fail(ex, f"no field {answer!r} in this frame's walk; its fields are: {known}")
     off = where[given]
-    value = next((t.value for t in tokens(layout, deserialize(reg, layout.type_name, frame[4:]))
-                  if layout.steps[t.step].label_at(t.at) == given and
-                  layout.steps[t.step].kind is not StepKind.LOOP), None)
+    value = struct.unpack_from("<I", frame)[0] if given == layout.steps[0].label else next(
+        (t.value for t in tokens(layout, deserialize(reg, layout.type_name, frame[4:]))
+         if layout.steps[t.step].label_at(t.at) == given and
+         layout.steps[t.step].kind is not StepKind.LOOP), None)
     if off > refused.offset:
         raise fail(ex, f"{given} (byte {off}) comes after the refused field: the circuit stops at "
                        f"the first field it refuses, an earlier one")

@@ -137,6 +137,8 @@ def check_discovery_port(answer: Any, domain: int, index: int) -> CheckResult:
             f"the domain moves every port by {DOMAIN_GAIN} (domain gain) times its id",
         base + PARTICIPANT_GAIN * index: f"left out the offset d1 = {OFFSET_DISCOVERY_UNICAST} "
                                          f"of unicast discovery",
+        base + OFFSET_DISCOVERY_UNICAST: f"that is participant 0's port: left out the "
+                                         f"participant term PG*index = {PARTICIPANT_GAIN}*{index}",
         want + PARTICIPANT_GAIN: "one index too many: participant indices count from 0",
         want - PARTICIPANT_GAIN: "one index too few: participant indices count from 0",
     }

@@ -29,7 +29,7 @@ from rosfpga_lab.component.fpga import FpgaComponent
 from rosfpga_lab.component.limits import DEFAULT_INPUT_QUEUE, DEFAULT_OUTPUT_QUEUE
 from rosfpga_lab.component.ros2 import Ros2Component
 from rosfpga_lab.component.sources import to_rgb
-from rosfpga_lab.component.stats import ComponentStats, LatencySummary
+from rosfpga_lab.component.stats import ComponentStats, LatencySummary, format_duration
 from rosfpga_lab.component.webview import DemoPage
 from rosfpga_lab.config import CUSTOM, PASSTHROUGH, NodeConfig, load_config, parse_config
 from rosfpga_lab.graph import EmbeddedMaster
@@ -114,7 +114,7 @@ class DemoResult:
             f"(receive -> publish): {c.latency.ms()}",
         ]
         if c.cycles:
-            out.append(f"modelled circuit: {c.circuit_time_s * 1e3:.2f} ms per frame at "
+            out.append(f"modelled circuit: {format_duration(c.circuit_time_s)} per frame at "
                        f"{cfg.clock_mhz:g} MHz; FIFO high water {c.fifo_high_water}")
         out.append(f"bit-exact: {self.check.bit_exact}/{self.received}")
         if c.dropped:

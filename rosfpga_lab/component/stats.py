@@ -84,6 +84,16 @@ class LatencySummary:
         return f"median {self.median * 1e3:.1f} ms, p95 {self.p95 * 1e3:.1f} ms"
 
 
+def format_duration(seconds: float) -> str:
+    """A circuit's time in a unit that shows it: ``"12.31 ms"``, ``"2.55 \u00b5s"`` (below
+    1 ms), ``"40 ns"`` (below 1 \u00b5s)."""
+    if seconds >= 1e-3:
+        return f"{seconds * 1e3:.2f} ms"
+    if seconds >= 1e-6:
+        return f"{seconds * 1e6:.2f} \u00b5s"
+    return f"{seconds * 1e9:.0f} ns"
+
+
 @dataclass(frozen=True)
 class ComponentStats:
     """What the component did so far.
@@ -178,13 +188,13 @@ class ComponentStats:
             lines.append(f"latency since capture (input header.stamp -> publish): "
                          f"{self.since_stamp.ms()} over {self.since_stamp.count} frames")
         if not self.cycles and self.circuit_time_s == self.circuit_time_s:   # rtl: no stages
-            lines.append(f"circuit time of the last frame: {self.circuit_time_s * 1e3:.2f} ms "
+            lines.append(f"circuit time of the last frame: {format_duration(self.circuit_time_s)} "
                          "(its simulated clocks)")
         if self.cycles:
-            total = self.circuit_time_s * 1e3
             lines.append("cycles per stage (last frame): " + ", ".join(
                 f"{name} {n:,}" for name, n in self.cycles.items())
-                + f"; the real circuit would need {total:.2f} ms per frame at its clock "
+                + f"; the real circuit would need {format_duration(self.circuit_time_s)} per "
+                "frame at its clock "
                 "(cycles / clock, not measured here)")
         if self.fifo_high_water:
             lines.append("FIFO high water: " + ", ".join(

@@ -69,6 +69,7 @@ def parse_config(text: str, *, source: str = "<string>", base_dir: Path | None =
     reg = s.registry(ctx, folders, folder_nodes)
     known = known_type or (reg.__contains__ if folders else s.known_type)
     subscriber, publisher = s.topics(ctx, sec["subscriber"], sec["publisher"], known)
+    s.check_definitions(ctx, reg, sec["subscriber"], sec["publisher"])
     in_type = subscriber.type
     image = s.image_section(ctx, top, sec["image"], in_type)
     if in_type in reg:

@@ -122,6 +122,20 @@ def topics(ctx: Ctx, sub: Section, pub: Section,
     return TopicConfig(**sub[0]), TopicConfig(**pub[0])
 
 
+def check_definitions(ctx: Ctx, reg: MsgRegistry, sub: Section, pub: Section) -> None:
+    """Every type the definitions of the two topics use is known (a misspelt field type,
+    ``flaot32``, names its ``.msg`` file and line, and the primitive it is close to)."""
+    from rosfpga_lab.msg import MsgError
+
+    for section, (t, tn) in (("subscriber", sub), ("publisher", pub)):
+        if t["type"] not in reg:
+            continue
+        try:
+            reg.md5(t["type"])
+        except MsgError as exc:
+            raise ctx.error(str(exc), tn.get("type"), f"{section}.type") from None
+
+
 def image_section(ctx: Ctx, top: Nodes, sec: Section, in_type: str) -> ImageConfig | None:
     """``image:``, which ``sensor_msgs/Image`` needs and no other type may have."""
     im, imn = sec
@@ -323,7 +337,8 @@ def check_top_values(ctx: Ctx, top: Nodes, values: dict[str, Any]) -> None:
                         nodes.get("wire"), "wire")
 
 
-__all__ = ["application_section", "check_output_type", "checks_section", "fifo_section",
-           "hls_section", "image_section", "known_type", "limits_section", "message_folders",
+__all__ = ["application_section", "check_definitions", "check_output_type",
+           "check_top_values", "checks_section", "fifo_section", "hls_section",
+           "image_section", "known_type", "limits_section", "message_folders",
            "node_section", "registry", "skip_section", "stream_section", "top_values",
-           "check_top_values", "topics"]
+           "topics"]

@@ -20,9 +20,9 @@ Worked example: ``pkg/Scan`` = ``Header header``, ``string[] names``, ``float32[
 ``derive_layout(reg, "pkg/Scan", stream="ranges", stream_length=4, checks={"header.seq": 0})``;
 :func:`format_layout` prints (a test holds this text equal to its output)::
 
-    pkg/Scan (md5 115c5a6fcd20cb3c1c340cbd2d284ee1): stream ranges 4 x float32, body 24..16936 bytes
+    pkg/Scan (md5 115c5a6fcd20cb3c1c340cbd2d284ee1): stream ranges 4 x float32, body 40..16936 bytes
     #   kind      ident                   label                   type     bytes     max  action  check
-    0   length    frame_length            frame length            uint32   4         -    check   SUB_BAD_FRAME_LENGTH: 24..67108864
+    0   length    frame_length            frame length            uint32   4         -    check   SUB_BAD_FRAME_LENGTH: 40..67108864
     1   scalar    header_seq              header.seq              uint32   4         -    check   SUB_BAD_HEADER_SEQ: == 0
     2   scalar    header_stamp_secs       header.stamp.secs       uint32   4         -    carry   -
     3   scalar    header_stamp_nsecs      header.stamp.nsecs      uint32   4         -    carry   -
@@ -79,7 +79,6 @@ from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.errors import LayoutError
 from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.msg.builtins import SCALARS, TIME_CLASS
-from rosfpga_lab.msg.decode import min_size
 
 
 class _Name(StrEnum):
@@ -224,7 +223,10 @@ class Layout:
         steps: the walk, step 0 the frame length.
         stream_index: index of the streamed ARRAY step (``None``: a walk without a stream).
         stream_length: elements of the streamed array the circuit was built for.
-        min_body: the smallest body of the type (empty strings and arrays), bytes.
+        min_body: the shortest body the circuit accepts, bytes: strings and arrays empty but
+            the stream (its ``stream_length`` elements) and a string checked for one value
+            (its bytes); a shorter body is refused at the frame length. (A video stream:
+            the type's smallest body, as the Image interpreter's.)
         max_body: the largest body the circuit accepts (every maximum reached), bytes.
         statuses: ``(name, label)`` of each status code, ``SUB_OK`` first.
         video: the stream's video shape (Image), or ``None`` (a plain 1-D stream).
@@ -529,7 +531,7 @@ def derive_layout(reg: MsgRegistry, type_name: str, *, stream: str | None,
         if spec_check is not None:
             what, arg = spec_check
             if what == "frame":
-                check = FieldCheck(CheckOp.RANGE, status, low=min_size(reg, type_name),
+                check = FieldCheck(CheckOp.RANGE, status, low=0,   # set below: min_body
                                    high=limits.MAX_FRAME_BYTES)
             elif what == "user":
                 check = _user_check(reg, type_name, arg, checks[arg], status)
@@ -545,9 +547,23 @@ def derive_layout(reg: MsgRegistry, type_name: str, *, stream: str | None,
         (s.check.status, s.label) for s in steps if s.check is not None)
     layout = Layout(type_name=type_name, md5=reg.md5(type_name), steps=tuple(steps),
                     stream_index=stream_index, stream_length=stream_length,
-                    min_body=min_size(reg, type_name), max_body=0, statuses=statuses,
-                    video=video)
-    return _with_max_body(layout)
+                    min_body=0, max_body=0, statuses=statuses, video=video)
+    return _with_min_body(_with_max_body(layout))
+
+
+def _with_min_body(layout: Layout) -> Layout:
+    """The layout with ``min_body`` (and the frame length's lower bound) the shortest body its
+    checks accept: the type's smallest body plus the stream's elements and the bytes of any
+    string checked for one value. A video stream (Image) keeps the type's smallest body, as
+    the Image interpreter's ``MIN_BODY_BYTES`` does: a frame of another geometry is refused
+    by the field that differs (``width``), not by its length."""
+    from dataclasses import replace
+
+    low = _min_bytes(layout, 1, len(layout.steps), accepted=layout.video is None)
+    frame = layout.steps[0]
+    assert frame.check is not None
+    first = replace(frame, check=replace(frame.check, low=low))
+    return replace(layout, steps=(first,) + layout.steps[1:], min_body=low)
 
 
 def _with_max_body(layout: Layout) -> Layout:
@@ -572,21 +588,28 @@ def _with_max_body(layout: Layout) -> Layout:
 
 # -- how length prefixes are held against the frame ------------------------------------------
 
-def _min_bytes(layout: Layout, lo: int, hi: int) -> int:
-    """Fewest bytes steps ``lo..hi-1`` can take (variable parts empty)."""
+def _min_bytes(layout: Layout, lo: int, hi: int, *, accepted: bool = False) -> int:
+    """Fewest bytes steps ``lo..hi-1`` can take (variable parts empty); with ``accepted``, the
+    fewest the checks accept (the stream holds ``stream_length`` elements, a string checked
+    for one value holds it)."""
     total, i = 0, lo
     while i < hi:
         s = layout.steps[i]
         if s.kind is StepKind.LOOP:
             assert s.partner is not None
             if s.count is not None:
-                total += s.count * _min_bytes(layout, i + 1, s.partner)
+                total += s.count * _min_bytes(layout, i + 1, s.partner, accepted=accepted)
             i = s.partner + 1
             continue
         if s.kind in (StepKind.SCALAR, StepKind.LENGTH):
             total += s.size
         elif s.count is not None:
             total += s.size * s.count
+        elif accepted and s.index == layout.stream_index:
+            total += s.size * layout.stream_length
+        elif accepted and s.kind is StepKind.STRING and s.check is not None \
+                and s.check.op is CheckOp.EQUAL:
+            total += len(str(s.check.value).encode("utf-8"))
         i += 1
     return total
 
@@ -749,9 +772,12 @@ def frame_geometry(layout: Layout, message: Any) -> FrameGeometry:
 
 # -- text ---------------------------------------------------------------------------------------
 
-def format_layout(layout: Layout) -> str:
-    """The walk as aligned text: one row per step (what notebooks print before drawing it)."""
-    rows = [("#", "kind", "ident", "label", "type", "bytes", "max", "action", "check")]
+def format_layout(layout: Layout, *, idents: bool = True) -> str:
+    """The walk as aligned text: one row per step (what notebooks print before drawing it);
+    without ``idents``, no ``ident`` column (narrower: the state names are the idents in
+    capitals)."""
+    rows: list[tuple[str, ...]] = [("#", "kind", "ident", "label", "type", "bytes", "max", "action",
+                                    "check")]
     for s in layout.steps:
         if s.kind in (StepKind.SCALAR, StepKind.LENGTH, StepKind.ENCAPSULATION, StepKind.NUL):
             size = str(s.size)
@@ -766,6 +792,8 @@ def format_layout(layout: Layout) -> str:
         check = f"{s.check.status}: {s.check.describe()}" if s.check else "-"
         rows.append((str(s.index), "  " * s.depth + s.kind, s.ident, s.label, s.type, size, top,
                      s.action, check))
+    if not idents:
+        rows = [r[:2] + r[3:] for r in rows]
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     text = "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
     what = (f"stream {layout.stream.label} {layout.stream_length} x {layout.stream.type}"

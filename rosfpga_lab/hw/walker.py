@@ -12,9 +12,10 @@ slice). Both raise the same :class:`~rosfpga_lab.hw.errors.FrameFieldError` nami
 length lets the reference skip the rest of the refused frame, so the next good frame comes out
 right.
 
-The frame length is checked against the type's smallest body and the lab's limit; each length
-prefix against its maximum and against the bytes left (when only fixed-size fields follow, the
-frame length must match exactly, as the Image interpreter checks ``data length``). Refusal
+The frame length is checked against the shortest body accepted (``Layout.min_body``) and the
+lab's limit; each length prefix against its maximum and against the bytes left (when only
+fixed-size fields follow, the frame length must match exactly, as the Image interpreter checks
+``data length``). Refusal
 kinds (``FrameFieldError.rule``): ``below the minimum``, ``over the limit``,
 ``past the frame end``, ``not what the circuit was built for``, ``not a number`` (a NaN in a
 range check), ``frame length disagrees``, ``cut short``.
@@ -297,8 +298,9 @@ class LayoutInterpreter:
         assert c is not None
         if s.index == 0:
             if value < c.low:
-                self._refuse(s, f"{value} is shorter than the smallest {self.layout.type_name} "
-                                f"({c.low} bytes)", value, "below the minimum", FrameLengthError)
+                self._refuse(s, f"{value} is shorter than the shortest {self.layout.type_name} "
+                                f"the circuit accepts ({c.low} bytes)", value, "below the minimum",
+                             FrameLengthError)
             if value > c.high:
                 self._refuse(s, f"{value} exceeds the limit of {c.high} bytes "
                                 "(hw.limits.MAX_FRAME_BYTES)", value, "over the limit",

@@ -16,6 +16,7 @@ Sums and derived codecs are cached and the caches are cleared whenever a definit
 
 from __future__ import annotations
 
+import difflib
 import functools
 import hashlib
 from collections.abc import Callable, Iterable
@@ -34,6 +35,14 @@ DEFINITIONS_DIR = Path(__file__).resolve().parent / "definitions"
 SHIPPED_PACKAGES = ("std_msgs", "sensor_msgs", "geometry_msgs", "rosgraph_msgs", "roscpp")
 FULL_TEXT_SEPARATOR = "=" * 80
 
+
+
+def _primitive_hint(base_type: str) -> str:
+    """``" -- did you mean the primitive 'float32'?"`` when a type's bare name is a likely
+    misspelling of one (``flaot32`` is read as the message type ``my_msgs/flaot32``)."""
+    bare = base_type.rsplit("/", 1)[-1]
+    near = difflib.get_close_matches(bare.lower(), BUILTIN_TYPES, n=1, cutoff=0.7)
+    return f" -- did you mean the primitive {near[0]!r}?" if near else ""
 
 class MsgRegistry:
     """Message types by name, with genmsg-exact md5 sums and full texts.
@@ -220,7 +229,8 @@ class MsgRegistry:
         where = f"{spec.source}:{f.line}" if spec.source else f"line {f.line}"
         raise UnknownTypeError(
             f"unknown message type {f.base_type!r}, used by field {f.name!r} of {spec.full_name} "
-            f"({where}); searched: {self._where()}", f.base_type, tuple(self._searched))
+            f"({where}){_primitive_hint(f.base_type)}; searched: {self._where()}", f.base_type,
+            tuple(self._searched))
 
     def nested(self, spec: MsgSpec) -> list[tuple[int, MsgSpec]]:
         """(field index, spec) of every message-typed field of ``spec``.

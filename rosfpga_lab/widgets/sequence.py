@@ -70,6 +70,7 @@ class SeqEvent:
         detail: tooltip text.
         type_name: message type of a ``tcpros_frame`` (so its body is shown field by field).
         spans: explicit byte fields for ``raw`` (default: worked out from ``kind``).
+        size: the bytes the arrow stands for when they are part of ``raw`` (``None``: all).
     """
 
     src: str
@@ -81,6 +82,13 @@ class SeqEvent:
     detail: str = ""
     type_name: str | None = None
     spans: list[Any] | None = field(default=None, repr=False)
+    size: int | None = None
+
+    @property
+    def bytes_drawn(self) -> int:
+        """The bytes this arrow stands for: :attr:`size` when it is a share of :attr:`raw` (the
+        submessages of one sender in a datagram packing several), else all of ``raw``."""
+        return len(self.raw) if self.size is None else self.size
 
     def byte_spans(self) -> list[Span]:
         """The fields of :attr:`raw` for the byte viewer."""
@@ -246,6 +254,23 @@ def _fit_label(number: str, text: str, size: str, px: float) -> str:
     return number + (text if len(text) <= n else text[: max(n - 1, 3)] + "\u2026") + size
 
 
+def _label_lines(number: str, text: str, size: str, px: float) -> list[str]:
+    """An arrow's label in one line of about ``px`` pixels, or two (the second drawn under the
+    arrow), broken between words of the text; the byte count stays whole at the end, and only
+    text longer than two lines is cut (its middle, as :func:`_fit_label` does)."""
+    n = max(4, int(px / CHAR_PX))
+    head = number + text
+    if len(head) + len(size) <= n:
+        return [head + size]
+    cut = head.rfind(" ", 0, n + 1)
+    if cut <= len(number):
+        cut = n
+    first, rest = head[:cut].rstrip(), head[cut:].lstrip()
+    if len(rest) + len(size) <= n:
+        return [first, rest + size]
+    return [first, _fit_label("", rest, size, px)]
+
+
 def events_from_capture(path: str | Path, **options: Any) -> list[SeqEvent]:
     """Events of the ROS 1 conversation in a capture file (pcap/pcapng of real traffic), via
     ``rosfpga_lab.graph.capture_read.trace_from_capture``; options as :func:`events_from_trace`."""
@@ -290,7 +315,9 @@ def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None 
         colour, dash = KIND_STYLE.get(e.kind, ("#333333", ""))
         dash_attr = f' stroke-dasharray="{dash}"' if dash else ""
         sel = " sel" if k == selected else ""
-        tip = esc(f"{k + 1}. {e.src} \u2192 {e.dst}: {e.label}" + (f" ({len(e.raw)} bytes)" if e.raw else "")
+        tip = esc(f"{k + 1}. {e.src} \u2192 {e.dst}: {e.label}" + (
+            f" ({e.bytes_drawn} bytes)" if e.raw and e.bytes_drawn == len(e.raw) else
+            f" ({e.bytes_drawn} of the datagram's {len(e.raw)} bytes)" if e.raw else "")
                   + (f"\n{e.detail}" if e.detail else ""))
         out.append(f'<g class="rfl-arrow{sel}" data-index="{k}"><title>{tip}</title>')
         x1, x2 = xs[e.src], xs[e.dst]
@@ -307,11 +334,11 @@ def sequence_svg(events: Sequence[SeqEvent], participants: Sequence[str] | None 
                        f'stroke-width="1.5"{dash_attr} marker-end="url(#rfl-ah)"/>')
             # a label may run past a short arrow's ends: its white halo keeps it readable
             tx, anchor, room = (x1 + x2) / 2, "middle", max(abs(x2 - x1) - 16, min(2.2 * col, LABEL_MIN_PX))
-        size = f" [{len(e.raw)} B]" if e.raw and e.kind != "tcpros_frame" else ""
-        label = _fit_label(f"{k + 1}. ", e.label, size, room)
-        out.append(f'<text x="{tx}" y="{y - 5}" text-anchor="{anchor}" fill="{colour}" '
-                   f'paint-order="stroke" stroke="#fff" stroke-width="4" stroke-linejoin="round">'
-                   f'{esc(label)}</text>')
+        size = f" [{e.bytes_drawn} B]" if e.raw and e.kind != "tcpros_frame" else ""
+        for j, line in enumerate(_label_lines(f"{k + 1}. ", e.label, size, room)):
+            out.append(f'<text x="{tx}" y="{y - 5 + 17 * j}" text-anchor="{anchor}" fill="{colour}" '
+                       f'paint-order="stroke" stroke="#fff" stroke-width="4" stroke-linejoin="round">'
+                       f'{esc(line)}</text>')
         if e.t is not None and t0 is not None:
             out.append(f'<text x="4" y="{y + 4}" fill="#777" font-size="10">+{(e.t - t0) * 1000:.1f} ms</text>')
         out.append("</g>")

@@ -64,14 +64,15 @@ def _panel(role: str, rows: Sequence[Any], top: int, uid: str,
     col = min(COL, (DIAGRAM_MAX_WIDTH - BOX_W - 20) // max(across - 1, 1))
     band_rows = max(len(c) for c in columns) + 1
     pos: dict[str, tuple[float, float]] = {}
-    first = top + 70   # room for the panel's title and a loop above the first row
+    # room for the panel's title and a loop above the first row (its trigger above the loop)
+    first = top + (86 if any(r.source == r.target for r in rows) else 70)
     for c, states in enumerate(columns):
         # the end states' column starts a row lower, so arrows into it pass beside the others
         shift = 1 if c == len(columns) - 1 and len(columns) > 1 else 0
         band, slot = (c // per_band, c % per_band) if bands > 1 else (0, c)
         for k, s in enumerate(states):
             pos[s] = (20 + BOX_W / 2 + slot * col, first + (band * band_rows + k + shift) * ROW)
-    height = 70 + ROW * max(len(c) + (1 if i == len(columns) - 1 else 0)
+    height = first - top + ROW * max(len(c) + (1 if i == len(columns) - 1 else 0)
                             + (i // per_band * band_rows if bands > 1 else 0)
                             for i, c in enumerate(columns)) - ROW + 30
     width = int(20 + BOX_W + col * (across - 1) + 20)
@@ -87,9 +88,13 @@ def _panel(role: str, rows: Sequence[Any], top: int, uid: str,
         (x1, y1), (x2, y2) = pos[a], pos[b]
         tip = esc("\n".join(f"{r.trigger}: {r.action}" for r in group))
         out.append(f'<g class="rfl-transition" data-role="{esc(role)}" data-source="{esc(a)}" data-target="{esc(b)}"><title>{tip}</title>')
+        routed = in_order and a != b and not (y1 == y2 and abs(x2 - x1) <= col + 1)
         if a == b:  # a loop above the box
             d = f"M{x1 - 18},{y1 - BOX_H / 2} C{x1 - 30},{y1 - 48} {x1 + 30},{y1 - 48} {x1 + 18},{y1 - BOX_H / 2}"
             lx, ly, anchor = x1, y1 - 44, "middle"
+        elif routed:  # a walk's longer arrow: along the free lanes between rows and columns
+            d, lx, ly = _route(x1, y1, x2, y2, col, len(legend))
+            anchor = "middle"
         else:
             sx = x1 + (BOX_W / 2 if x2 > x1 else -BOX_W / 2 if x2 < x1 else 0)
             ex = x2 - (BOX_W / 2 if x2 > x1 else -BOX_W / 2 if x2 < x1 else 0)
@@ -101,7 +106,7 @@ def _panel(role: str, rows: Sequence[Any], top: int, uid: str,
             lx, ly, anchor = sx + (ex - sx) * f, sy + (ey - sy) * f - 5, "middle"
         out.append(f'<path d="{d}" fill="none" stroke="#555" stroke-width="1.4" marker-end="url(#{uid})"/>')
         triggers = ", ".join(dict.fromkeys(r.trigger for r in group))
-        if a == b or y1 == y2:   # loops and level arrows carry their triggers
+        if a == b or (y1 == y2 and not routed):   # loops and level arrows carry their triggers
             out.append(f'<text x="{lx:.0f}" y="{ly:.0f}" text-anchor="{anchor}" font-size="11" fill="#1f5fbf" '
                        f'paint-order="stroke" stroke="#fff" stroke-width="4" stroke-linejoin="round">'
                        f'{esc(triggers)}</text>')
@@ -123,6 +128,32 @@ def _panel(role: str, rows: Sequence[Any], top: int, uid: str,
         out.append(f'<text x="20" y="{top + height + 4 + 15 * k}" font-size="11" fill="#333">'
                    f'<tspan fill="#1f5fbf" font-weight="bold">{k + 1}</tspan>  {esc(line)}</text>')
     return out, width, height + 15 * len(legend) + 12
+
+
+def _route(x1: float, y1: float, x2: float, y2: float, col: float, k: int
+           ) -> tuple[str, float, float]:
+    """An arrow between two states of a folded walk that never crosses a box: out of the source
+    box's bottom (top, when the target is higher) into the lane between rows, along it to the
+    lane between columns beside the target, along that to the lane beside the target's row,
+    and into the target box. ``k`` shifts the lanes a little so arrows sharing them stay
+    apart. Returns the path and where its numbered tag goes (on its first lane)."""
+    lane = (k % 7 - 3) * 5.0
+    up = y2 < y1
+    out_y = y1 - BOX_H / 2 if up else y1 + BOX_H / 2
+    row_lane = y1 + (-ROW / 2 if up else ROW / 2) + lane
+    if y2 == y1:    # the same row: along the lane under it
+        end_y = y2 + BOX_H / 2
+        d = (f"M{x1 + lane},{out_y} L{x1 + lane},{row_lane} L{x2 + lane},{row_lane} "
+             f"L{x2 + lane},{end_y}")
+        return d, (x1 + x2) / 2, row_lane - 5
+    gutter = x2 + (-col / 2 if x1 <= x2 else col / 2) + lane
+    gutter = max(gutter, 6.0)
+    near = y2 + (ROW / 2 if up else -ROW / 2) + lane
+    end_y = y2 + BOX_H / 2 if up else y2 - BOX_H / 2
+    d = (f"M{x1 + lane},{out_y} L{x1 + lane},{row_lane} L{gutter},{row_lane} L{gutter},{near} "
+         f"L{x2 + lane},{near} L{x2 + lane},{end_y}")
+    return d, (x1 + gutter) / 2 if abs(gutter - x1) > 30 else gutter, (
+        row_lane - 5 if abs(gutter - x1) > 30 else (row_lane + near) / 2)
 
 
 def state_diagram_svg(transitions: Iterable[Any], roles: Sequence[str] | None = None,
@@ -211,7 +242,7 @@ def layout_transitions(layout: Any) -> list[WalkTransition]:
 
     def size(s: Any) -> str:   # the trigger: short, the tooltip says more
         if str(s.kind) in ("scalar", "length"):
-            return f"{s.size} bytes"
+            return f"{s.size} byte{'s' if s.size != 1 else ''}"
         if s.count is None:
             return "n bytes" if str(s.kind) == "string" else f"n x {s.size} bytes"
         return f"{s.count} x {s.size} bytes"
@@ -243,8 +274,10 @@ def layout_transitions(layout: Any) -> list[WalkTransition]:
             back = state(0) if i == 0 else SKIP_STATE
             rows.append(WalkTransition(role, state(i), f"not {s.check.describe()}", back,
                                        f"refuse: {s.check.status}"))
-        # a zero count passes a string or array at once (a loop's own state says "no elements")
-        if (kind == "length" and i > 0 and s.partner is not None
+        # a zero count passes a string or array at once (a loop's own state says "no elements"),
+        # unless the count is checked for another value (the stream's fixed length)
+        fixed = s.check is not None and str(s.check.op) == "equal" and s.check.value != 0
+        if (kind == "length" and i > 0 and s.partner is not None and not fixed
                 and str(steps[s.partner].kind) != "loop" and steps[s.partner].count is None):
             rows.append(WalkTransition(role, state(i), "0", state(after(s.partner)),
                                        f"{steps[s.partner].label} is empty"))

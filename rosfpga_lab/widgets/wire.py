@@ -118,8 +118,11 @@ def events_from_rtps(datagrams: Any, *, max_events: int = 60,
         # one arrow per sender and destination: INFO_SRC lets one datagram carry the
         # submessages of several participants of one process (Cyclone DDS does this)
         groups: dict[tuple[bytes, bytes], list[str]] = {}
+        sizes: dict[tuple[bytes, bytes], int] = {}
         fold = False
         for source, destination, s in msg.routed():
+            # each submessage's bytes (INFO_* too) count to the sender it is routed from
+            sizes[(source, destination)] = sizes.get((source, destination), 0) + s.size
             if isinstance(s, (InfoDst, InfoSrc)) or s.name == "INFO_TS":
                 continue
             labels = groups.setdefault((source, destination), [])
@@ -149,8 +152,10 @@ def events_from_rtps(datagrams: Any, *, max_events: int = 60,
             src = _who(source, names)
             dst = _who(destination, names) if destination != ANY_PARTICIPANT else "peers"
             label = ", ".join(dict.fromkeys(labels)) or "INFO_TS"
+            # a datagram packing several senders' submessages: each arrow its own share
+            share = sizes.get((source, destination)) if len(groups) > 1 else None
             out.append(SeqEvent(src, dst, label[:70], bytes(payload), t, "rtps", detail=label[:300],
-                                spans=rtps_spans(payload)))
+                                spans=rtps_spans(payload), size=share))
     if skipped and out:
         out.append(SeqEvent(out[-1].src, out[-1].dst, f"\u2026 {skipped} more RTPS messages", b"",
                             (out[-1].t or 0.0) + 1e-9, "rtps"))
