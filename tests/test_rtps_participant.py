@@ -642,18 +642,21 @@ def test_a_gap_ahead_of_delivery_is_remembered() -> None:
         return b"\x00\x01\x00\x00" + bytes([k]) * 4
 
     send(b.data(r, w, 1, sample(1)))
-    send(b.gap(r, w, 3, 5))                 # 3 and 4 will never come; 2 is still on its way
+    # 3 and 4 will never come; 2 is still on its way (the writer announced 5: a GAP past what
+    # it announced is ignored, test_a_gap_past_what_the_writer_announced_is_ignored)
+    send(b.heartbeat(r, w, 1, 5, 999, final=True), b.gap(r, w, 3, 5))
     send(b.data(r, w, 2, sample(2)), b.data(r, w, 5, sample(5)))
     # before: the GAP was dropped (it did not start at the next sample): 5 waited for 3 and 4
     assert [s.payload for s in c.take(r)] == [sample(1), sample(2), sample(5)]
     (ack,) = acknacks(send(b.heartbeat(r, w, 1, 5, 1000)), w)
     assert (ack.base, ack.missing) == (6, ())
     # GAP ranges ahead are bounded; past the bound they are asked for again, never lost
+    send(b.heartbeat(r, w, 1, 420, 1001, final=True))
     for k in range(200):
         send(b.gap(r, w, 10 + 2 * k, 11 + 2 * k))
     wp = c.local[r].proxies[(a.guid_prefix, w)]
     assert len(wp.gaps) <= MAX_OUT_OF_ORDER and c.counts[f"gaps-full-{r}"] > 0
-    (ack,) = acknacks(send(b.heartbeat(r, w, 1, 12, 1001)), w)
+    (ack,) = acknacks(send(b.heartbeat(r, w, 1, 12, 1002)), w)
     assert (ack.base, ack.missing) == (6, (6, 7, 8, 9, 11))
 
 
@@ -742,3 +745,33 @@ def test_a_gap_whose_list_starts_before_its_range_still_counts_its_list() -> Non
     # before: refused as invalid, so 4 waited for 2 and 3
     assert [s.payload for s in c.take(r)] == [one, four]
     assert not any("invalid" in n for n in c.notes)
+
+
+def test_a_gap_past_what_the_writer_announced_is_ignored() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+
+    def send(*subs: bytes) -> None:
+        c.receive(b.header(a.guid_prefix) + b"".join(subs), a.user, net.now)
+
+    def sample(k: int) -> bytes:
+        return b"\x00\x01\x00\x00" + bytes([k]) * 4
+
+    send(b.data(r, w, 1, sample(1)), b.heartbeat(r, w, 1, 1, 900, final=True))
+    # a spoofed GAP for the next 30 samples, none written yet, and a listed one past them
+    send(b.gap(r, w, 2, 32, [40]))
+    for k in range(2, 6):
+        send(b.data(r, w, k, sample(k)))
+    # before: delivery jumped to 32, so 2..5 were dropped as already gapped
+    assert [s.payload for s in c.take(r)] == [sample(k) for k in range(1, 6)]
+    assert c.counts[f"gap-ahead-{r}"] == 1
+    # a GAP within what the HEARTBEAT announced still counts (7 and 8 never come) ...
+    send(b.heartbeat(r, w, 1, 9, 901, final=True), b.gap(r, w, 7, 9), b.data(r, w, 6, sample(6)),
+         b.data(r, w, 9, sample(9)))
+    assert [s.payload for s in c.take(r)] == [sample(6), sample(9)]
+    # ... and one that reaches past it counts up to what was announced, not beyond
+    send(b.gap(r, w, 10, 20))
+    send(b.heartbeat(r, w, 1, 12, 902, final=True), b.gap(r, w, 10, 12))
+    send(b.data(r, w, 12, sample(12)), b.data(r, w, 13, sample(13)))
+    assert [s.payload for s in c.take(r)] == [sample(12), sample(13)]

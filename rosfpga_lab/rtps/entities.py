@@ -110,6 +110,7 @@ class WriterProxy:
     writer_id: int
     reliable: bool
     next: int = 0                 # 0: nothing known yet
+    announced: int = 0            # highest number the writer announced (HEARTBEAT last, data)
     pending: dict[int, bytes | None] = field(default_factory=dict)
     pending_bytes: int = 0
     gaps: dict[int, int] = field(default_factory=dict)   # GAP ranges start -> end ahead of next

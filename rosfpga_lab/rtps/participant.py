@@ -25,7 +25,8 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
   them): INFO_SRC/INFO_DST set source and destination; a message of another major version is
   ignored; a malformed submessage drops itself and the rest of its datagram, not what came
   before; a final HEARTBEAT is answered only when samples are missing, a final liveliness one
-  never; a GAP ahead of delivery is remembered until delivery gets there; whatever a known
+  never; a GAP ahead of delivery is remembered until delivery gets there, one past what its
+  writer announced (HEARTBEAT's last, data seen) is ignored there; whatever a known
   peer's endpoints send renews its lease, as SPDP does.
 
 Where each part lives: :class:`Participant` is one class built from one class per part, each in
@@ -157,7 +158,16 @@ class Participant(ParticipantDiscovery, ReaderSide, WriterSide):
                       f"before it handled, it and the rest ignored ({msg.error}); further ones "
                       f"are counted")
         out: list[Send] = []
-        for prefix, destination, sub in msg.routed():
+        routed = list(msg.routed())
+        for prefix, destination, sub in routed:
+            # what the datagram's writers announce counts for its GAPs wherever it stands in it
+            # (a writer may send a GAP before the DATA that follows the samples it skips)
+            if prefix in self.participants and destination in (self.guid_prefix, ANY_PARTICIPANT) \
+                    and isinstance(sub, (Data, DataFrag, Heartbeat, HeartbeatFrag)) \
+                    and not self._invalid(sub):
+                last = sub.last if isinstance(sub, Heartbeat) else sub.seq
+                self._written_up_to(prefix, sub.writer_id, sub.reader_id, last)
+        for prefix, destination, sub in routed:
             if isinstance(sub, (InfoDst, InfoSrc)) or prefix == self.guid_prefix or \
                     destination not in (self.guid_prefix, ANY_PARTICIPANT):
                 continue
