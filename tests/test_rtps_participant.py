@@ -723,7 +723,7 @@ def test_an_acknack_from_reader_unknown_is_ignored() -> None:
     a, c, w, r = pair()
     net = Net(a, c)
     net.run([], steps=20)
-    net.run(a.write(w, b"\x00\x01\x00\x00one!", net.now), steps=3)
+    a.write(w, b"\x00\x01\x00\x00one!", net.now)           # lost on its way
     for reader_id in (0, r):                          # ENTITYID_UNKNOWN, then the real reader
         ask = b.header(c.guid_prefix) + b.acknack(reader_id, w, 1, [1], 500 + reader_id)
         out = a.receive(ask, c.user, net.now + 1.0)
@@ -775,3 +775,57 @@ def test_a_gap_past_what_the_writer_announced_is_ignored() -> None:
     send(b.heartbeat(r, w, 1, 12, 902, final=True), b.gap(r, w, 10, 12))
     send(b.data(r, w, 12, sample(12)), b.data(r, w, 13, sample(13)))
     assert [s.payload for s in c.take(r)] == [sample(12), sample(13)]
+
+
+# ---- the resend budget (issue 30 row 1: 10,000 ACKNACKs pulled 218 MB) -------------------------
+
+def resent_data_bytes(out: list) -> int:
+    return sum(len(s.payload) for _, _, d in out for s in parse_message(d).submessages
+               if isinstance(s, Data))
+
+
+def test_acknacks_in_the_real_readers_name_for_samples_it_acknowledged_get_gaps() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    sample = b"\x00\x01\x00\x00" + bytes(5000)
+    out = []
+    for _ in range(10):
+        out += a.write(w, sample, net.now)
+    net.run(out, steps=5)
+    assert len(c.take(r)) == 10                      # delivered and acknowledged
+    bytes_in = bytes_out = data = 0
+    for k in range(2000):       # one every 6 ms: each one past MIN_RESEND_SECONDS's pacing
+        ask = b.header(c.guid_prefix) + b.acknack(r, w, 1, range(1, 11), 100 + k)
+        got = a.receive(ask, c.user, net.now + 0.006 * k)
+        bytes_in += len(ask)
+        bytes_out += sum(len(d) for _, _, d in got)
+        data += resent_data_bytes(got)
+    # before: every one of them resent all 10 samples (50 KB out per 60-byte ACKNACK)
+    assert data == 0 and bytes_out <= 2 * bytes_in, (data, bytes_out, bytes_in)
+    assert any("acknowledged: GAP" in n for n in a.notes)
+    net.run(a.write(w, sample[:-1] + b"!", net.now + 13.0), steps=5)
+    assert [s.payload[-1:] for s in c.take(r)] == [b"!"]
+
+
+def test_a_reader_that_never_acknowledges_is_resent_no_more_than_was_written() -> None:
+    a = fresh()
+    w = a.add_writer(TOPIC, TYPE)
+    prefix = b"R" * 12                  # a fake reader, its locator a victim's port
+    a.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    guid = prefix + (0x1404).to_bytes(4, "big")
+    sedp = b.sedp_payload(guid, TOPIC, TYPE, True, 10, b.Locator("127.0.0.1", 9))
+    a.receive(b.header(prefix) + b.data(0x4C7, 0x4C2, 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert a.matched(w) == [guid]
+    sample = b"\x00\x01\x00\x00" + bytes(5000)
+    written = resent = 0
+    for round_ in range(3):
+        for _ in range(10):
+            a.write(w, sample, 1.0 + round_)
+            written += len(sample)
+        for k in range(500):             # ACKNACKs asking for everything, never acknowledging
+            ask = b.header(prefix) + b.acknack(0x1404, w, 1, range(1, 31), 1000 * round_ + k + 1)
+            resent += resent_data_bytes(a.receive(ask, ("127.0.0.1", 9), 1.0 + round_ + 0.0019 * k))
+        # before: 500 * 10 samples resent per round (about 25 MB for 50 KB written)
+        assert 0 < resent <= written, (round_, resent, written)
+    assert any("budget" in n for n in a.notes)

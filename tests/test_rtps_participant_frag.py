@@ -112,10 +112,14 @@ def test_nack_frags_with_rising_counts_are_paced() -> None:
     # every NACK_FRAG of 40 bytes a peer sends)
     assert nack(11, t + MIN_RESEND_SECONDS / 2) == []
     assert sum("paced" in n and "NACK_FRAG" in n for n in a.notes) == 1
-    assert nack(12, t + MIN_RESEND_SECONDS * 1.5) == list(range(1, 31))    # after it: again
+    # after it: again, once the writer has written again (the resend budget: each byte written
+    # pays for one byte resent, RESEND_PER_BYTE_WRITTEN)
+    assert nack(12, t + MIN_RESEND_SECONDS * 1.5) == []
+    a.write(w, b"\x00\x01\x00\x00" + bytes(40000), net.now)
+    assert nack(13, t + MIN_RESEND_SECONDS * 3) == list(range(1, 31))
     # a storm is counted, logged once
     for k in range(200):
-        nack(100 + k, t + MIN_RESEND_SECONDS * 1.6)
+        nack(100 + k, t + MIN_RESEND_SECONDS * 3.1)
     assert sum("paced" in n and "NACK_FRAG" in n for n in a.notes) == 1
     assert a.counts["nackfrag-storm"] == 201
 

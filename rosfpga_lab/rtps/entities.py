@@ -100,6 +100,9 @@ class ReaderProxy:
     resent: dict[int, float] = field(default_factory=dict)
     last_heartbeat: float = -1.0
     heartbeat_period: float = 0.0     # 0: the first period; doubles while unanswered
+    #: Bytes it may still be resent (``WriterSide._afford``): each sample written adds its size
+    #: (times RESEND_PER_BYTE_WRITTEN), up to the history's bytes; it starts at those.
+    credit: float = 0.0
 
 
 @dataclass
@@ -129,6 +132,7 @@ class LocalEndpoint:
     qos: Qos
     seq: int = 0                                  # writer: last sequence number written
     history: OrderedDict[int, bytes] = field(default_factory=OrderedDict)
+    history_bytes: int = 0                        # writer: bytes of the samples in history
     proxies: dict[tuple[bytes, int], ReaderProxy | WriterProxy] = field(default_factory=dict)
     hb_count: int = 0
     type_hash: str = ""                           # RIHS01_... announced in its USER_DATA

@@ -34,6 +34,14 @@ MAX_HEARTBEAT_SECONDS = 1.0
 #: A reader proxy's retransmissions are at least this far apart (ACKNACK and NACK_FRAG storms;
 #: an ACKNACK's and each sample's NACK_FRAG's are paced apart).
 MIN_RESEND_SECONDS = 0.005
+#: The resend budget of a reader proxy (rosfpga_lab.rtps.writer_side): what ACKNACKs and
+#: NACK_FRAGs make a writer send again, over any time, is at most this many bytes per byte it
+#: wrote to the history since the reader matched, plus the history's bytes at that time (the
+#: budget starts at those and never holds more than the history). A sample the reader already
+#: acknowledged is never resent to it (a GAP says so), so a storm of ACKNACKs in the real
+#: reader's name gets GAPs, a few bytes per ACKNACK, and a fake reader that never acknowledges
+#: gets at most this share of the stream it is sent anyway.
+RESEND_PER_BYTE_WRITTEN = 1.0
 #: Remote participants and endpoints the participant keeps (SPDP/SEDP floods).
 MAX_REMOTE_PARTICIPANTS = 64
 MAX_REMOTE_ENDPOINTS = 512

@@ -29,7 +29,7 @@ from rosfpga_lab.rtps.entities import (
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import (
     ANNOUNCE_SECONDS, FRAGMENT_BYTES, LEASE_SECONDS, MAX_MESSAGE_BYTES, MAX_NOTES,
-    MAX_REMOTE_ENDPOINTS,
+    MAX_REMOTE_ENDPOINTS, RESEND_PER_BYTE_WRITTEN,
 )
 
 
@@ -102,6 +102,20 @@ class ParticipantBase:
         return [b.data_frag(reader_id, writer_id, seq, n, FRAGMENT_BYTES, len(payload),
                             payload[(n - 1) * FRAGMENT_BYTES:n * FRAGMENT_BYTES], 1)
                 for n in numbers]
+
+    def _keep(self, ep: LocalEndpoint, payload: bytes) -> int:
+        """Put the next sample of writer ``ep`` in its history (KEEP_LAST depth: the oldest
+        go); each matched reader proxy earns its resend budget. Returns its sequence number."""
+        ep.seq += 1
+        ep.history[ep.seq] = payload
+        ep.history_bytes += len(payload)
+        while len(ep.history) > ep.qos.depth:
+            ep.history_bytes -= len(ep.history.popitem(last=False)[1])
+        for proxy in ep.proxies.values():
+            if isinstance(proxy, ReaderProxy):
+                proxy.credit = min(proxy.credit + len(payload) * RESEND_PER_BYTE_WRITTEN,
+                                   ep.history_bytes)
+        return ep.seq
 
     def _heartbeat(self, ep: LocalEndpoint, proxy: ReaderProxy) -> bytes:
         ep.hb_count += 1

@@ -121,7 +121,7 @@ class ParticipantDiscovery(EndpointDiscovery):
         subs: list[bytes] = []
         for wid, rid in ((PUB_WRITER, PUB_READER), (SUB_WRITER, SUB_READER)):
             ep = self.local[wid]
-            proxy = ReaderProxy(prefix, rid, meta, True, 1)
+            proxy = ReaderProxy(prefix, rid, meta, True, 1, credit=ep.history_bytes)
             ep.proxies[(prefix, rid)] = proxy
             for seq, payload in ep.history.items():
                 subs += self._sample_subs(rid, wid, seq, payload)
