@@ -296,7 +296,7 @@ def test_spdp_flood_is_bounded() -> None:
     for k in range(MAX_REMOTE_PARTICIPANTS * 4):
         p.receive(spdp(struct.pack(">I", k) + b"F" * 8), ("127.0.0.1", 7999), 0.0)
     assert len(p.participants) == MAX_REMOTE_PARTICIPANTS
-    assert sum("new ones are ignored" in n for n in p.notes) == 1
+    assert sum("makes room" in n for n in p.notes) == 1
     assert len(p.notes) <= MAX_REMOTE_PARTICIPANTS + 2
 
 
@@ -829,3 +829,39 @@ def test_a_reader_that_never_acknowledges_is_resent_no_more_than_was_written() -
         # before: 500 * 10 samples resent per round (about 25 MB for 50 KB written)
         assert 0 < resent <= written, (round_, resent, written)
     assert any("budget" in n for n in a.notes)
+
+
+# ---- the participant table under an SPDP flood (issue 30 row 2: locked at 64, a late peer never
+# discovered) ---------------------------------------------------------------------------------
+
+def test_an_spdp_flood_cannot_lock_the_table_and_matched_peers_stay() -> None:
+    p = fresh()
+    r = p.add_reader(TOPIC, TYPE)
+    cam, talker = b"C" * 12, b"T" * 12
+    p.receive(spdp(cam), ("127.0.0.1", 7999), 0.0)
+    sedp = b.sedp_payload(cam + (0x103).to_bytes(4, "big"), TOPIC, TYPE, True, 10,
+                          b.Locator("127.0.0.1", 8000))
+    p.receive(b.header(cam) + b.data(PUB_READER, PUB_WRITER, 1, sedp), ("127.0.0.1", 7999), 0.0)
+    p.receive(spdp(talker, port=7997), ("127.0.0.1", 7997), 0.0)
+    p.receive(b.header(talker) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 0, 1), ("127.0.0.1", 7997), 0.0)
+    rng = random.Random(30)
+    for k in range(MAX_REMOTE_PARTICIPANTS * 10):     # random GUID prefixes, 10 s leases
+        p.receive(spdp(bytes(rng.randrange(256) for _ in range(12))), ("127.0.0.1", 7999), k * 1e-3)
+    assert len(p.participants) == MAX_REMOTE_PARTICIPANTS
+    # the matched camera and the peer that spoke (SEDP HEARTBEAT) stayed; the flood made room
+    # for itself among the ones that sent nothing but SPDP
+    assert cam in p.participants and talker in p.participants and len(p.matched(r)) == 1
+    # a late peer is discovered (before: "new ones are ignored until a lease runs out") ...
+    late = b"L" * 12
+    out = p.receive(spdp(late, port=7995), ("127.0.0.1", 7995), 1.0)
+    assert late in p.participants and ("127.0.0.1", 7995) in {(h, port) for h, port, _ in out}
+    # ... and it has MAX_REMOTE_PARTICIPANTS - 2 more new prefixes' time to speak: the oldest
+    # silent ones go first, whatever the flood re-announces
+    for k in range(MAX_REMOTE_PARTICIPANTS - 3):
+        p.receive(spdp(bytes(rng.randrange(256) for _ in range(12))), ("127.0.0.1", 7999), 1.1)
+    for prefix in list(p.participants):
+        p.receive(spdp(prefix), ("127.0.0.1", 7999), 1.2)        # re-announced: no standing
+    assert late in p.participants
+    p.receive(spdp(b"N" * 12), ("127.0.0.1", 7999), 1.3)
+    assert late not in p.participants and {cam, talker, b"N" * 12} <= set(p.participants)
+    assert p.counts["participants-evict"] == MAX_REMOTE_PARTICIPANTS * 10 - 62 + 1 + 61 + 1

@@ -70,6 +70,8 @@ class RemoteParticipant:
     lease: float
     last_seen: float
     name: str = ""
+    learned: float = 0.0          # when its SPDP was first taken
+    spoke: bool = False           # it sent something besides SPDP (SEDP, HEARTBEAT, ...)
 
 
 @dataclass

@@ -42,7 +42,8 @@ MIN_RESEND_SECONDS = 0.005
 #: reader's name gets GAPs, a few bytes per ACKNACK, and a fake reader that never acknowledges
 #: gets at most this share of the stream it is sent anyway.
 RESEND_PER_BYTE_WRITTEN = 1.0
-#: Remote participants and endpoints the participant keeps (SPDP/SEDP floods).
+#: Remote participants and endpoints the participant keeps (SPDP/SEDP floods; a full
+#: participant table makes room for each new one: rosfpga_lab.rtps.spdp says which goes).
 MAX_REMOTE_PARTICIPANTS = 64
 MAX_REMOTE_ENDPOINTS = 512
 #: Out-of-order samples a reliable reader holds per remote writer, and in bytes.

@@ -14,6 +14,20 @@ DEFAULT_LEASE_SECONDS; any is held within MIN_LEASE_SECONDS..MAX_LEASE_SECONDS).
 goodbye (:meth:`goodbye` sends ours: an SPDP sample disposed and unregistered) or whose lease runs
 out is forgotten with its endpoints, its proxies and its partly received samples (``_forget``).
 An SPDP sample about another participant than its sender is ignored.
+
+The table holds MAX_REMOTE_PARTICIPANTS and never stops learning: a new participant in a full
+table takes the place of the one of lowest standing (``_standing``, ``_evict``): first those that
+sent nothing but SPDP, the one learned first going first (re-announcing does not help it); then
+those that spoke (SEDP, HEARTBEATs, ...) but have no endpoint matched with a local one, then
+matched ones, each the one heard from least recently going first. What an SPDP flood from random
+GUID prefixes can still do, at R announcements a second: make the table forget a new peer that
+has not spoken within MAX_REMOTE_PARTICIPANTS - (peers that spoke) new prefixes, i.e. about
+64 / R s (a ROS 2 peer answers our SPDP with SEDP within milliseconds on one host; one forgotten
+is learned again at its next SPDP); keep every learned fake's lease (up to MAX_LEASE_SECONDS);
+and make the participant answer each new fake with its SPDP and SEDP data (a few KB) sent to a
+locator on loopback or at the sender's own address (``_locator``). To evict a peer that spoke
+or is matched it must make MAX_REMOTE_PARTICIPANTS fakes speak (or match the lab's topics) and
+keep them heard from more recently than that peer.
 """
 
 from __future__ import annotations
@@ -76,6 +90,22 @@ class ParticipantDiscovery(EndpointDiscovery):
             for seq in self.assembler.partial(prefix, writer_id):
                 self.assembler.discard(prefix, writer_id, seq)
 
+    def _standing(self, p: RemoteParticipant) -> tuple[int, float]:
+        """What keeps ``p`` in a full table, lowest first: 0 and when it was learned, if it
+        sent nothing but SPDP; 1 and when it was last heard, if it spoke but none of its
+        endpoints is matched with a local user endpoint; 2 and when it was last heard, if one is."""
+        if any(key[0] == p.prefix for ep in self.local.values() if ep.topic for key in ep.proxies):
+            return (2, p.last_seen)
+        return (1, p.last_seen) if p.spoke else (0, p.learned)
+
+    def _evict(self) -> None:
+        """Make room for a new participant in a full table: forget the one of lowest standing."""
+        victim = min(self.participants.values(), key=self._standing)
+        self.note("participants-evict", f"more than {MAX_REMOTE_PARTICIPANTS} remote "
+                  f"participants: the one of lowest standing makes room for each new one (first "
+                  f"{victim.prefix.hex()}, {'matched' if self._standing(victim)[0] == 2 else 'unmatched'})")
+        self._forget(victim.prefix)
+
     def _on_spdp(self, prefix: bytes, sub: Data, source: tuple[str, int], now: float) -> list[Send]:
         if not sub.payload or sub.key or self._status(sub.inline_qos, sub.little_endian) & 0x3:
             if prefix in self.participants:
@@ -101,21 +131,21 @@ class ParticipantDiscovery(EndpointDiscovery):
         if known is not None:
             known.last_seen, known.lease = now, lease
             return []
-        if len(self.participants) >= MAX_REMOTE_PARTICIPANTS:
-            self.note("participants-full", f"more than {MAX_REMOTE_PARTICIPANTS} remote "
-                      f"participants: new ones are ignored until a lease runs out")
-            return []
         meta = self._locator(params.get(b.PID_METATRAFFIC_UNICAST_LOCATOR), little, source)
         user = self._locator(params.get(b.PID_DEFAULT_UNICAST_LOCATOR), little, source)
         if meta is None or user is None:
             self.note(f"spdp-nolocator-{prefix.hex()}", f"SPDP of {prefix.hex()} has no usable "
                       f"unicast locator: ignored")
             return []
+        full = len(self.participants) >= MAX_REMOTE_PARTICIPANTS
+        if full:
+            self._evict()      # its note stands for the new one's (a flood fills no notes)
         name_raw = params.get(b.PID_ENTITY_NAME)
         name = b.cdr_string_value(name_raw[0], little) if name_raw else ""
-        self.participants[prefix] = RemoteParticipant(prefix, meta, user, lease, now, name)
-        self.note(f"participant-{prefix.hex()}", f"participant {prefix.hex()} ({name}) at "
-                  f"{meta[0]}:{meta[1]}, lease {lease:g} s")
+        self.participants[prefix] = RemoteParticipant(prefix, meta, user, lease, now, name, now)
+        if not full:
+            self.note(f"participant-{prefix.hex()}", f"participant {prefix.hex()} ({name}) at "
+                      f"{meta[0]}:{meta[1]}, lease {lease:g} s")
         out = [self._spdp(meta)]
         # the built-in SEDP endpoints: send ours, ask for theirs (preemptive ACKNACK)
         subs: list[bytes] = []
