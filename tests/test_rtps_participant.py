@@ -17,7 +17,8 @@ from rosfpga_lab.graph.capture_read import udp_datagrams
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps import parse_message
 from rosfpga_lab.rtps.limits import (
-    MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS,
+    GOODBYE_GRACE_SECONDS, MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES, MAX_REMOTE_ENDPOINTS,
+    MAX_REMOTE_PARTICIPANTS, SUSPECT_GOODBYE_LEASE_SECONDS,
 )
 from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, InfoDst, NackFrag
 from rosfpga_lab.rtps.participant import (
@@ -865,3 +866,46 @@ def test_an_spdp_flood_cannot_lock_the_table_and_matched_peers_stay() -> None:
     p.receive(spdp(b"N" * 12), ("127.0.0.1", 7999), 1.3)
     assert late not in p.participants and {cam, talker, b"N" * 12} <= set(p.participants)
     assert p.counts["participants-evict"] == MAX_REMOTE_PARTICIPANTS * 10 - 62 + 1 + 61 + 1
+
+
+# ---- a spoofed goodbye (issue 30 row 3: a live camera forgotten, no recovery in 45 s) ------------
+
+def test_a_goodbye_from_elsewhere_is_suspect_and_one_whose_traffic_goes_on_is_learned_again() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    a.announce_period = c.announce_period = 1000.0        # no SPDP comes to the rescue
+    (bye,) = [d for host, port, d in a.goodbye() if port == c.meta[1]]
+
+    def frame(k: int) -> list[int]:
+        """a writes sample k; what c delivers then."""
+        for _, _, d in a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * 4, net.now):
+            c.receive(d, a.user, net.now)
+        return [s.payload[-1] for s in c.take(r)]
+
+    assert frame(1) == [1]
+    # a goodbye in a's name from another port: suspect, a stays (before: forgotten, unmatched,
+    # its samples ignored until its next SPDP)
+    c.receive(bye, ("127.0.0.1", 6666), net.now)
+    assert a.guid_prefix in c.participants and c.matched(r), c.notes
+    assert c.participants[a.guid_prefix].lease == SUSPECT_GOODBYE_LEASE_SECONDS
+    assert frame(2) == [2]
+    # from where a speaks (a spoofed source port, or a real goodbye): forgotten at once ...
+    c.receive(bye, a.user, net.now)
+    assert a.guid_prefix not in c.participants and c.matched(r) == []
+    net.now += GOODBYE_GRACE_SECONDS / 2
+    assert frame(3) == []                # ... what was in flight does not bring it back ...
+    net.now += GOODBYE_GRACE_SECONDS
+    out = []
+    for _, _, d in a.write(w, b"\x00\x01\x00\x00" + bytes([4]) * 4, net.now):
+        out += c.receive(d, a.user, net.now)
+    # ... but traffic after that learns it again: matched at once, our SPDP sent to it
+    assert a.guid_prefix in c.participants and len(c.matched(r)) == 1
+    assert any(port == a.meta[1] and SPDP_WRITER.to_bytes(4, "big") in d for _, port, d in out)
+    net.run(out, steps=30)
+    assert [s.payload[-1] for s in c.take(r)][-1:] == [4] and frame(5) == [5]
+    # a silent participant that said goodbye stays gone
+    c.receive(bye, a.user, net.now)
+    net.parts = (c,)
+    net.run([], steps=int(a.lease / 0.01) + 10)
+    assert a.guid_prefix not in c.participants and not c.departed

@@ -72,6 +72,8 @@ class RemoteParticipant:
     name: str = ""
     learned: float = 0.0          # when its SPDP was first taken
     spoke: bool = False           # it sent something besides SPDP (SEDP, HEARTBEAT, ...)
+    source: tuple[str, int] = ("", 0)     # where the SPDP that taught it came from
+    preemptive_base: int = 1      # its SEDP readers' preemptive ACKNACK base (Fast DDS: 0)
 
 
 @dataclass
@@ -123,6 +125,19 @@ class WriterProxy:
     last_hbfrag_count: int = -(1 << 31)   # HEARTBEAT_FRAG counts on their own (RTPS 2.3 8.3.7.6)
     acknack_count: int = 0
     nackfrag_count: int = 0
+
+
+@dataclass
+class Departed:
+    """What a participant that said goodbye or was evicted leaves behind, to learn it again when
+    its traffic goes on (``spdp._relearn``): its record, its endpoints, our SEDP readers' proxies
+    of its SEDP writers (where they were), from when and until when its traffic counts."""
+
+    participant: RemoteParticipant
+    endpoints: list[RemoteEndpoint]
+    sedp: dict[tuple[bytes, int], WriterProxy]
+    relearn_from: float
+    until: float
 
 
 @dataclass

@@ -46,6 +46,12 @@ RESEND_PER_BYTE_WRITTEN = 1.0
 #: participant table makes room for each new one: rosfpga_lab.rtps.spdp says which goes).
 MAX_REMOTE_PARTICIPANTS = 64
 MAX_REMOTE_ENDPOINTS = 512
+#: A goodbye (SPDP dispose) from a source that is neither where the participant's first SPDP came
+#: from nor one of its locators is suspect: its lease becomes this (its traffic keeps it alive).
+#: One from there forgets it, and traffic from it later than GOODBYE_GRACE_SECONDS after the
+#: goodbye learns it again (rosfpga_lab.rtps.spdp).
+SUSPECT_GOODBYE_LEASE_SECONDS = 1.0
+GOODBYE_GRACE_SECONDS = 0.1
 #: Out-of-order samples a reliable reader holds per remote writer, and in bytes.
 MAX_OUT_OF_ORDER = 64
 MAX_OUT_OF_ORDER_BYTES = 32 * 1024 * 1024

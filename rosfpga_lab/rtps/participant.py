@@ -114,6 +114,8 @@ class Participant(ParticipantDiscovery, ReaderSide, WriterSide):
         if now - self._last_announce >= self.announce_period:
             self._last_announce = now
             out += self.announce()
+        for prefix in [k for k, d in self.departed.items() if now > d.until]:
+            del self.departed[prefix]
         for prefix, p in list(self.participants.items()):
             if now - p.last_seen > p.lease:
                 self.note(f"lease-{prefix.hex()}", f"participant {prefix.hex()} ({p.name}) lease "
@@ -173,9 +175,12 @@ class Participant(ParticipantDiscovery, ReaderSide, WriterSide):
                 continue
             if prefix not in self.participants and not (
                     isinstance(sub, Data) and sub.writer_id == SPDP_WRITER):
-                self.note(f"unknown-{prefix.hex()}", f"submessages from participant "
-                          f"{prefix.hex()} before its SPDP: ignored")
-                continue
+                back = self._relearn(prefix, now)     # one that left, still speaking
+                if not back:
+                    self.note(f"unknown-{prefix.hex()}", f"submessages from participant "
+                              f"{prefix.hex()} before its SPDP: ignored")
+                    continue
+                out += back
             try:
                 out += self._on_submessage(prefix, sub, source, now)
             except RtpsError as exc:

@@ -18,13 +18,13 @@ none: they wait in ``_outbox`` until the next ``receive`` or ``tick``.
 from __future__ import annotations
 
 import os
-from collections import deque
+from collections import OrderedDict, deque
 
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.discovery import PL_CDR_BE, PL_CDR_LE, FragmentAssembler, parse_parameters
 from rosfpga_lab.rtps.entities import (
-    PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, LocalEndpoint, Qos, ReaderProxy, RemoteEndpoint,
-    RemoteParticipant, Sample, Send, check_domain, discovery_port, user_port,
+    PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, Departed, LocalEndpoint, Qos, ReaderProxy,
+    RemoteEndpoint, RemoteParticipant, Sample, Send, check_domain, discovery_port, user_port,
 )
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import (
@@ -48,6 +48,9 @@ class ParticipantBase:
         self.meta = (address, discovery_port(domain, index))
         self.user = (address, user_port(domain, index))
         self.participants: dict[bytes, RemoteParticipant] = {}
+        #: Participants that said goodbye or were evicted, by prefix (``spdp._depart``).
+        self.departed: OrderedDict[bytes, Departed] = OrderedDict()
+        self._count = 0                   # the last ACKNACK / NACK_FRAG count sent
         self.remote: dict[bytes, RemoteEndpoint] = {}
         self.local: dict[int, LocalEndpoint] = {}
         self.samples: deque[Sample] = deque()
@@ -62,6 +65,13 @@ class ParticipantBase:
         for eid, kind in ((PUB_WRITER, "writer"), (SUB_WRITER, "writer"),
                           (PUB_READER, "reader"), (SUB_READER, "reader")):
             self.local[eid] = LocalEndpoint(eid, kind, "", "", Qos(True, MAX_REMOTE_ENDPOINTS))
+
+    def _next_count(self) -> int:
+        """The count of the next ACKNACK or NACK_FRAG: one counter for all of them, so the
+        counts a remote writer sees from a reader only rise, even after the participant forgot
+        and learned that writer again (a count already seen is ignored: RTPS 2.3 8.4.15.8)."""
+        self._count += 1
+        return self._count
 
     # ---- notes ---------------------------------------------------------------------------
     def note(self, key: str, text: str) -> None:

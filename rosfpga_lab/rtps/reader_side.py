@@ -197,7 +197,7 @@ class ReaderSide(EndpointDiscovery):
         frags = self.assembler.missing(prefix, wp.writer_id, seq, last)[:256]
         if not frags:
             return []
-        wp.nackfrag_count += 1
+        wp.nackfrag_count = self._next_count()
         return [b.nack_frag(ep.entity_id, wp.writer_id, seq, frags, wp.nackfrag_count)]
 
     def _on_heartbeat(self, prefix: bytes, sub: Heartbeat) -> list[Send]:
@@ -218,7 +218,7 @@ class ReaderSide(EndpointDiscovery):
                 continue
             partial = set(self.assembler.partial(prefix, sub.writer_id))
             subs: list[bytes] = []
-            wp.acknack_count += 1
+            wp.acknack_count = self._next_count()
             subs.append(b.acknack(ep.entity_id, sub.writer_id, wp.next,
                                   [s for s in missing if s not in partial], wp.acknack_count,
                                   final=not missing))
