@@ -17,8 +17,8 @@ from rosfpga_lab.graph.capture_read import udp_datagrams
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps import parse_message
 from rosfpga_lab.rtps.limits import (
-    GOODBYE_GRACE_SECONDS, MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES, MAX_REMOTE_ENDPOINTS,
-    MAX_REMOTE_PARTICIPANTS, SUSPECT_GOODBYE_LEASE_SECONDS,
+    GOODBYE_GRACE_SECONDS, MAX_HISTORY_BYTES, MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES,
+    MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS, SUSPECT_GOODBYE_LEASE_SECONDS,
 )
 from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, InfoDst, NackFrag
 from rosfpga_lab.rtps.participant import (
@@ -909,3 +909,31 @@ def test_a_goodbye_from_elsewhere_is_suspect_and_one_whose_traffic_goes_on_is_le
     net.parts = (c,)
     net.run([], steps=int(a.lease / 0.01) + 10)
     assert a.guid_prefix not in c.participants and not c.departed
+
+
+# ---- a RELIABLE (KEEP_ALL) reader that consumes slowly (issue 30 row 5) --------------------------
+
+def test_a_reader_that_never_acknowledges_leaves_the_writer_bounded_and_unblocked() -> None:
+    a = fresh()
+    w = a.add_writer(TOPIC, TYPE, Qos(True, 1000))              # KEEP_LAST 1000 (the most)
+    prefix = b"K" * 12                  # a KEEP_ALL RELIABLE reader that never acknowledges
+    a.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    guid = prefix + (0x1404).to_bytes(4, "big")
+    sedp = b.sedp_payload(guid, TOPIC, TYPE, True, 0, b.Locator("127.0.0.1", 9))
+    a.receive(b.header(prefix) + b.data(0x4C7, 0x4C2, 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert a.matched(w) == [guid]
+    size = 1 << 20
+    sent = 0
+    for k in range(80):                 # 80 MiB written, no write waits for the reader
+        sent += len(a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * (size - 4), 1.0 + k * 0.01))
+        a.tick(1.0 + k * 0.01)
+    ep = a.local[w]
+    # before: all 80 samples kept (the history was bounded by depth alone)
+    assert ep.history_bytes == sum(map(len, ep.history.values())) <= MAX_HISTORY_BYTES
+    assert list(ep.history) == list(range(81 - MAX_HISTORY_BYTES // size, 81))
+    assert sent >= 80 and sum("MAX_HISTORY_BYTES" in n for n in a.notes) == 1
+    # what it asks for that left the history is GAPped; what is held, resent within its budget
+    out = a.receive(b.header(prefix) + b.acknack(0x1404, w, 1, [1, 2, 80], 1), ("127.0.0.1", 9), 2.0)
+    subs = [s for _, _, d in out for s in parse_message(d).submessages]
+    assert [(g.start, g.list_base) for g in subs if isinstance(g, Gap)] == [(1, 81 - MAX_HISTORY_BYTES // size)]
+    assert {s.seq for s in subs if isinstance(s, DataFrag)} == {80}

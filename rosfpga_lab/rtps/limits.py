@@ -55,8 +55,16 @@ GOODBYE_GRACE_SECONDS = 0.1
 #: Out-of-order samples a reliable reader holds per remote writer, and in bytes.
 MAX_OUT_OF_ORDER = 64
 MAX_OUT_OF_ORDER_BYTES = 32 * 1024 * 1024
-#: Received samples kept for the application per reader beyond its history depth (never more).
+#: Received samples kept for the application per reader beyond its history depth (never more),
+#: and the deepest history a writer keeps (KEEP_LAST).
 MAX_HISTORY_DEPTH = 1000
+#: Bytes a writer's history holds at most: past them the oldest samples go before KEEP_LAST
+#: depth says (one sample always stays). With MAX_HISTORY_DEPTH, what bounds a writer whatever
+#: its readers do: the lab's writer is KEEP_LAST and never blocks; a RELIABLE reader, KEEP_ALL
+#: included (history kind is not requested-vs-offered), that consumes slowly or never
+#: acknowledges is sent each sample once, resent within its budget, and GAPped what left the
+#: history (rosfpga_lab.rtps.writer_side); nothing is buffered per reader.
+MAX_HISTORY_BYTES = 64 * 1024 * 1024
 #: Distinct log notes kept (each is logged once).
 MAX_NOTES = 256
 #: Remote endpoints one local writer or reader is matched with (a writer sends each sample to

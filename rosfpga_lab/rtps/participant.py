@@ -16,10 +16,11 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
   requested), else the reason is logged once. An endpoint given a ROS 2 type hash announces it
   (USER_DATA ``typehash=RIHS01_...;``, as rmw does); a matched remote endpoint whose announced
   hash differs is logged once and matched all the same (rmw matches on the type name).
-* User data: a writer keeps the last ``depth`` samples (KEEP_LAST; VOLATILE, or TRANSIENT_LOCAL:
-  a reader that joins late gets them), sends each as DATA
-  or DATA_FRAG; reliable ones HEARTBEAT until acknowledged, resend on ACKNACK/NACK_FRAG and GAP
-  what left the history. A reader puts fragments together (memory follows bytes received),
+* User data: a writer keeps the last ``depth`` samples (KEEP_LAST, at most MAX_HISTORY_BYTES;
+  VOLATILE, or TRANSIENT_LOCAL: a reader that joins late gets them), sends each as DATA
+  or DATA_FRAG; reliable ones HEARTBEAT until acknowledged, resend on ACKNACK/NACK_FRAG within
+  a budget and GAP what left the history or was acknowledged. It never blocks: a slow reader,
+  KEEP_ALL or not, loses what left the history (rosfpga_lab.rtps.limits.MAX_HISTORY_BYTES). A reader puts fragments together (memory follows bytes received),
   delivers in order when reliable, asks again with ACKNACK/NACK_FRAG.
 * The receiver's rules (RTPS 2.3 8.3.4, 8.3.6.3, 8.4.12.2, as Cyclone DDS's receiver follows
   them): INFO_SRC/INFO_DST set source and destination; a message of another major version is

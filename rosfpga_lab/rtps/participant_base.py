@@ -28,8 +28,8 @@ from rosfpga_lab.rtps.entities import (
 )
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import (
-    ANNOUNCE_SECONDS, FRAGMENT_BYTES, LEASE_SECONDS, MAX_MESSAGE_BYTES, MAX_NOTES,
-    MAX_REMOTE_ENDPOINTS, RESEND_PER_BYTE_WRITTEN,
+    ANNOUNCE_SECONDS, FRAGMENT_BYTES, LEASE_SECONDS, MAX_HISTORY_BYTES, MAX_MESSAGE_BYTES,
+    MAX_NOTES, MAX_REMOTE_ENDPOINTS, RESEND_PER_BYTE_WRITTEN,
 )
 
 
@@ -114,12 +114,18 @@ class ParticipantBase:
                 for n in numbers]
 
     def _keep(self, ep: LocalEndpoint, payload: bytes) -> int:
-        """Put the next sample of writer ``ep`` in its history (KEEP_LAST depth: the oldest
-        go); each matched reader proxy earns its resend budget. Returns its sequence number."""
+        """Put the next sample of writer ``ep`` in its history (KEEP_LAST depth, and at most
+        MAX_HISTORY_BYTES: the oldest go); each matched reader proxy earns its resend budget.
+        Returns its sequence number."""
         ep.seq += 1
         ep.history[ep.seq] = payload
         ep.history_bytes += len(payload)
-        while len(ep.history) > ep.qos.depth:
+        while len(ep.history) > ep.qos.depth or \
+                (ep.history_bytes > MAX_HISTORY_BYTES and len(ep.history) > 1):
+            if len(ep.history) <= ep.qos.depth:
+                self.note(f"history-bytes-{ep.entity_id}", f"writer {ep.topic or 'SEDP'}: its "
+                          f"last {ep.qos.depth} samples exceed MAX_HISTORY_BYTES "
+                          f"({MAX_HISTORY_BYTES} bytes): the oldest go first")
             ep.history_bytes -= len(ep.history.popitem(last=False)[1])
         for proxy in ep.proxies.values():
             if isinstance(proxy, ReaderProxy):
