@@ -18,7 +18,8 @@ from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps import parse_message
 from rosfpga_lab.rtps.limits import (
     GOODBYE_GRACE_SECONDS, MAX_HISTORY_BYTES, MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES,
-    MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS, SUSPECT_GOODBYE_LEASE_SECONDS,
+    MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS, NACK_SUPPRESSION_SECONDS,
+    SUSPECT_GOODBYE_LEASE_SECONDS,
 )
 from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, InfoDst, NackFrag
 from rosfpga_lab.rtps.participant import (
@@ -937,3 +938,20 @@ def test_a_reader_that_never_acknowledges_leaves_the_writer_bounded_and_unblocke
     subs = [s for _, _, d in out for s in parse_message(d).submessages]
     assert [(g.start, g.list_base) for g in subs if isinstance(g, Gap)] == [(1, 81 - MAX_HISTORY_BYTES // size)]
     assert {s.seq for s in subs if isinstance(s, DataFrag)} == {80}
+
+
+def test_a_sample_on_its_way_is_not_resent_within_the_nack_suppression_time() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    t = net.now
+    data = 0
+    for k in range(20):          # each sample asked for by ACKNACKs in c's name while on its way
+        a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * 5000, t + k * 0.1)
+        for j in range(1, 8):    # 6 ms apart: past MIN_RESEND_SECONDS's pacing, within 50 ms
+            ask = b.header(c.guid_prefix) + b.acknack(r, w, k + 1, [k + 1], 100 * k + j)
+            data += resent_data_bytes(a.receive(ask, c.user, t + k * 0.1 + 0.006 * j))
+    # before: resent as often as the pacing let (and then within the budget: once per sample)
+    assert data == 0 and a.counts[f"nack-suppressed-{c.guid_prefix.hex()}"] == 20 * 7
+    ask = b.header(c.guid_prefix) + b.acknack(r, w, 20, [20], 5000)     # later: resent
+    assert resent_data_bytes(a.receive(ask, c.user, t + 1.9 + 1.5 * NACK_SUPPRESSION_SECONDS)) == 5004

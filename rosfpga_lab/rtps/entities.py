@@ -104,6 +104,9 @@ class ReaderProxy:
     resent: dict[int, float] = field(default_factory=dict)
     last_heartbeat: float = -1.0
     heartbeat_period: float = 0.0     # 0: the first period; doubles while unanswered
+    #: When each sample still in the history was last sent to it (written or resent): not
+    #: again within NACK_SUPPRESSION_SECONDS (``WriterSide._suppressed``).
+    sent: dict[int, float] = field(default_factory=dict)
     #: Bytes it may still be resent (``WriterSide._afford``): each sample written adds its size
     #: (times RESEND_PER_BYTE_WRITTEN), up to the history's bytes; it starts at those.
     credit: float = 0.0

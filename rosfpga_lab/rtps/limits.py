@@ -34,6 +34,11 @@ MAX_HEARTBEAT_SECONDS = 1.0
 #: A reader proxy's retransmissions are at least this far apart (ACKNACK and NACK_FRAG storms;
 #: an ACKNACK's and each sample's NACK_FRAG's are paced apart).
 MIN_RESEND_SECONDS = 0.005
+#: A sample is not sent to one reader again within this of its last sending (written or
+#: resent): RTPS's nackSuppressionDuration. A reader that lost it asks again at the next
+#: HEARTBEAT; ACKNACKs in its name cannot pull a sample while it is on its way (each sample at
+#: most once per heartbeat period per reader).
+NACK_SUPPRESSION_SECONDS = 0.05
 #: The resend budget of a reader proxy (rosfpga_lab.rtps.writer_side): what ACKNACKs and
 #: NACK_FRAGs make a writer send again, over any time, is at most this many bytes per byte it
 #: wrote to the history since the reader matched, plus the history's bytes at that time (the

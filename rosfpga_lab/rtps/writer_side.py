@@ -16,6 +16,10 @@ bits name the samples it lacks. ``_on_acknack`` resends those it may get and GAP
   one the reader already acknowledged (below the highest ACKNACK base it sent) are never resent:
   one GAP names them. So ACKNACKs in the real reader's name, asking again for what it has, get a
   GAP of a few bytes each, never the samples (issue 30: 10,000 of them pulled 218 MB);
+* NACK suppression (``_suppressed``, NACK_SUPPRESSION_SECONDS, RTPS's nackSuppressionDuration):
+  a sample is not sent to a reader again within that of its last sending, so ACKNACKs in its
+  name cannot pull a sample while it is on its way (a reader that lost it asks again at the next
+  HEARTBEAT);
 * the resend budget (``_afford``, RESEND_PER_BYTE_WRITTEN): a reader proxy is resent at most
   what was written to the history since it matched (plus the history then); what it cannot
   afford waits for the writer's next samples. A fake reader that never acknowledges, its
@@ -32,7 +36,7 @@ from __future__ import annotations
 
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import LocalEndpoint, ReaderProxy, Send
-from rosfpga_lab.rtps.limits import FRAGMENT_BYTES, MIN_RESEND_SECONDS
+from rosfpga_lab.rtps.limits import FRAGMENT_BYTES, MIN_RESEND_SECONDS, NACK_SUPPRESSION_SECONDS
 from rosfpga_lab.rtps.message import AckNack, NackFrag
 from rosfpga_lab.rtps.participant_base import ParticipantBase
 
@@ -47,8 +51,12 @@ class WriterSide(ParticipantBase):
         ep = self.local[writer_id]
         self._keep(ep, bytes(payload))
         out: list[Send] = []
+        oldest = next(iter(ep.history))
         for proxy in ep.proxies.values():
             assert isinstance(proxy, ReaderProxy)
+            while proxy.sent and next(iter(proxy.sent)) < oldest:
+                del proxy.sent[next(iter(proxy.sent))]      # left the history
+            proxy.sent[ep.seq] = now
             subs = [b.info_ts(now if stamp is None else stamp)] + self._sample_subs(proxy.reader_id, ep.entity_id, ep.seq, payload)
             if ep.qos.reliable and proxy.reliable:
                 subs.append(self._heartbeat(ep, proxy))
@@ -91,6 +99,18 @@ class WriterSide(ParticipantBase):
             return False
         proxy.credit -= cost
         return True
+
+    def _suppressed(self, proxy: ReaderProxy, seq: int, now: float) -> bool:
+        """Whether sample ``seq`` went to ``proxy`` less than NACK_SUPPRESSION_SECONDS ago
+        (then it is not sent again: counted, logged once); if not, it goes now."""
+        if now - proxy.sent.get(seq, -1e9) < NACK_SUPPRESSION_SECONDS:
+            self.note(f"nack-suppressed-{proxy.prefix.hex()}", f"reader {proxy.prefix.hex()}:"
+                      f"{proxy.reader_id:08x} asked again for a sample sent to it less than "
+                      f"{NACK_SUPPRESSION_SECONDS} s ago: not resent yet (NACK suppression)")
+            return True
+        if seq in proxy.sent:
+            proxy.sent[seq] = now
+        return False
 
     @staticmethod
     def _floor(ep: LocalEndpoint, proxy: ReaderProxy) -> int:
@@ -135,10 +155,11 @@ class WriterSide(ParticipantBase):
                 self.note(f"acknack-acked-{prefix.hex()}", f"ACKNACK from {prefix.hex()} asks "
                           f"again for samples it acknowledged: GAP, not the samples")
         for s in missing:
-            if s >= floor:
-                if not self._afford(proxy, len(ep.history[s])):
-                    break
-                subs += self._sample_subs(proxy.reader_id, ep.entity_id, s, ep.history[s])
+            if s < floor or self._suppressed(proxy, s, now):
+                continue
+            if not self._afford(proxy, len(ep.history[s])):
+                break
+            subs += self._sample_subs(proxy.reader_id, ep.entity_id, s, ep.history[s])
         if not subs:
             return []
         subs.append(self._heartbeat(ep, proxy))
@@ -157,6 +178,8 @@ class WriterSide(ParticipantBase):
         if sub.seq < self._floor(ep, proxy):
             return self._msg(proxy.locator, proxy.prefix,
                              [b.gap(proxy.reader_id, ep.entity_id, sub.seq, sub.seq + 1)])
+        if self._suppressed(proxy, sub.seq, now):
+            return []
         payload = ep.history[sub.seq]
         frags: list[int] = []
         for n in sub.missing:     # each fragment costs the sample bytes it carries
