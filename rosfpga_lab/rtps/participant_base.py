@@ -61,6 +61,7 @@ class ParticipantBase:
         self._last_announce = -1e9
         self.assembler = FragmentAssembler()
         self._outbox: list[Send] = []     # what matching produced (sent with the next result)
+        self._spdp_msg: tuple[object, bytes] = (None, b"")     # our SPDP datagram, once built
         # built-in SEDP writers and readers (reliable, KEEP_ALL of the lab's own endpoints)
         for eid, kind in ((PUB_WRITER, "writer"), (SUB_WRITER, "writer"),
                           (PUB_READER, "reader"), (SUB_READER, "reader")):

@@ -47,6 +47,7 @@ keep them heard from more recently than that peer.
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
@@ -69,9 +70,11 @@ class ParticipantDiscovery(EndpointDiscovery):
                               self.lease, self.name, b"enclave=/;", self.domain)
 
     def _spdp(self, dst: tuple[str, int]) -> Send:
-        msg = (b.header(self.guid_prefix) + b.info_ts(0.0)
-               + b.data(SPDP_READER, SPDP_WRITER, 1, self.spdp_payload()))
-        return (dst[0], dst[1], msg)
+        key = (self.guid_prefix, self.lease, self.name, self.meta, self.user, self.domain)
+        if self._spdp_msg[0] != key:       # built once (it is sent to every peer, every period)
+            self._spdp_msg = (key, b.header(self.guid_prefix) + b.info_ts(0.0)
+                              + b.data(SPDP_READER, SPDP_WRITER, 1, self.spdp_payload()))
+        return (dst[0], dst[1], self._spdp_msg[1])
 
     def announce(self) -> list[Send]:
         """SPDP to the probed discovery ports of every peer address and to every known participant."""
@@ -104,20 +107,25 @@ class ParticipantDiscovery(EndpointDiscovery):
             for seq in self.assembler.partial(prefix, writer_id):
                 self.assembler.discard(prefix, writer_id, seq)
 
-    def _standing(self, p: RemoteParticipant) -> tuple[int, float]:
-        """What keeps ``p`` in a full table, lowest first: 0 and when it was learned, if it
-        sent nothing but SPDP; 1 and when it was last heard, if it spoke but none of its
+    def _standing(self) -> Callable[[RemoteParticipant], tuple[int, float]]:
+        """What keeps a participant in a full table, lowest first: 0 and when it was learned, if
+        it sent nothing but SPDP; 1 and when it was last heard, if it spoke but none of its
         endpoints is matched with a local user endpoint; 2 and when it was last heard, if one is."""
-        if any(key[0] == p.prefix for ep in self.local.values() if ep.topic for key in ep.proxies):
-            return (2, p.last_seen)
-        return (1, p.last_seen) if p.spoke else (0, p.learned)
+        matched = {key[0] for ep in self.local.values() if ep.topic for key in ep.proxies}
+
+        def standing(p: RemoteParticipant) -> tuple[int, float]:
+            if p.prefix in matched:
+                return (2, p.last_seen)
+            return (1, p.last_seen) if p.spoke else (0, p.learned)
+        return standing
 
     def _evict(self) -> None:
         """Make room for a new participant in a full table: forget the one of lowest standing."""
-        victim = min(self.participants.values(), key=self._standing)
+        standing = self._standing()
+        victim = min(self.participants.values(), key=standing)
         self.note("participants-evict", f"more than {MAX_REMOTE_PARTICIPANTS} remote "
                   f"participants: the one of lowest standing makes room for each new one (first "
-                  f"{victim.prefix.hex()}, {'matched' if self._standing(victim)[0] == 2 else 'unmatched'})")
+                  f"{victim.prefix.hex()}, {'matched' if standing(victim)[0] == 2 else 'unmatched'})")
         self._depart(victim, -1e9, victim.last_seen + victim.lease)
 
     def _depart(self, p: RemoteParticipant, relearn_from: float, until: float) -> None:
