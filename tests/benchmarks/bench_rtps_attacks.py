@@ -16,6 +16,9 @@ the sans-IO ``rtps.participant`` on sockets) and once against a Cyclone DDS part
 * goodbye:  a Cyclone camera sends 30 Hz frames to the side's reader; one SPDP dispose in the
             camera's name (from the attacker's own socket) goes to the side's discovery port.
             Figures: the longest time without a frame after it (recovery), frames lost.
+* goodbye2: as goodbye, but the camera is a lab participant and the goodbye comes from its own
+            socket while it goes on sending (what a spoofer of the source address too, with a
+            raw socket, sends): the goodbye looks real.
 * gap:      as goodbye, but the attack is a GAP in the camera writer's name for its next 30
             samples, not yet written. Figures: frames lost.
 * slow:     the side's writer (RELIABLE KEEP_LAST 10) sends 30 Hz frames to a Cyclone KEEP_ALL
@@ -25,7 +28,7 @@ the sans-IO ``rtps.participant`` on sockets) and once against a Cyclone DDS part
 Every row runs in a child process of its own (``--child ROW SIDE``) in a DDS domain of its own
 (from the pid), on 127.0.0.1 only, bounded in datagrams and seconds; no files are written. The
 side's participant is the first of its domain (participant index 0: the attacker knows its
-ports). The Cyclone camera, late peer and slow reader run in a process of their own
+ports). The cameras, late peers and slow reader run in a process of their own
 (``--peer``): Cyclone DDS joins the participants of one process into one instance that matches
 them without the network. The lab's participant runs in Python threads of the child, sharing
 its GIL with the attacker. Times are from the attack (or the late peer's creation) to the
@@ -50,7 +53,7 @@ from typing import Any
 HERE = Path(__file__).resolve()
 sys.path.insert(0, str(HERE.parent.parent))
 
-ROWS = ("acknack", "flood", "goodbye", "gap", "slow")
+ROWS = ("acknack", "flood", "goodbye", "goodbye2", "gap", "slow")
 SIDES = ("lab", "cyclone")
 TOPIC, ROS_TOPIC, ROS_TYPE = "rt/bench", "/bench", "sensor_msgs/Image"
 PERIOD = 1 / 30
@@ -278,12 +281,18 @@ def peer_main(role: str, args: argparse.Namespace) -> None:
                 late = CycloneWriter(world)
                 print(f"{late.prefix.hex()} {late.eid}", flush=True)
         os._exit(0)
-    writer = CycloneWriter(world)
+    writer: Any = LabWriter(world) if role == "labcamera" else CycloneWriter(world)
     print(f"READY {writer.prefix.hex()} {writer.eid}", flush=True)
     cam: Camera | None = None
     for line in sys.stdin:
         command = line.strip()
-        if command == "start":
+        if command.startswith("bye ") and role == "labcamera":
+            # its own goodbye, from its own socket, while it goes on: what a spoofer of both
+            # GUID prefix and source address (a raw socket) sends
+            host, port = command.split()[1:]
+            writer.node._user.sendto(goodbye_datagram(writer.prefix), (host, int(port)))
+            print("sent", flush=True)
+        elif command == "start":
             cam = Camera(writer, 120.0)
             print("started", flush=True)
         elif command == "count":
@@ -425,11 +434,12 @@ def row_flood(world: World, side: str) -> dict:
     return out
 
 
-def camera_and_target(world: World, side: str) -> tuple[Any, Peer]:
-    """The side's reader (first in the domain: index 0) and a Cyclone camera peer, matched."""
+def camera_and_target(world: World, side: str, role: str = "camera") -> tuple[Any, Peer]:
+    """The side's reader (first in the domain: index 0) and a camera peer (Cyclone's, or the
+    lab's for ``labcamera``), matched."""
     target: Any = LabReader(world, "target") if side == "lab" else CycloneReader(world)
     time.sleep(0.3)
-    camera = Peer(world, "camera")
+    camera = Peer(world, role)
     if wait(lambda: target.matched(), 15) is None:
         camera.stop()
         raise RuntimeError("camera and target never matched")
@@ -437,13 +447,16 @@ def camera_and_target(world: World, side: str) -> tuple[Any, Peer]:
     return target, camera
 
 
-def row_goodbye(world: World, side: str) -> dict:
+def row_goodbye(world: World, side: str, from_camera: bool = False) -> dict:
     args = world.args
-    target, camera = camera_and_target(world, side)
+    target, camera = camera_and_target(world, side, "labcamera" if from_camera else "camera")
     time.sleep(1.0)
     tg = time.monotonic()
     first = int(camera.ask("count"))
-    world.send(goodbye_datagram(camera.prefix), world.meta0())
+    if from_camera:
+        camera.ask("bye %s %d" % world.meta0())
+    else:
+        world.send(goodbye_datagram(camera.prefix), world.meta0())
     # until frames have flowed for 1.5 s after the longest outage so far, or --wait
     while time.monotonic() - tg < args.wait:
         time.sleep(0.1)
@@ -459,6 +472,8 @@ def row_goodbye(world: World, side: str) -> dict:
     forgotten = None
     if side == "lab":
         forgotten = any("said goodbye" in n for n in target.node.notes())
+    elif gap > 0.5:
+        forgotten = True
     target.close()
     return {"longest_gap_s": gap, "recovered": back < 1e9, "frames": f"{good}/{due}",
             "forgotten": forgotten}
@@ -521,7 +536,8 @@ def row_slow(world: World, side: str) -> dict:
 
 def child_main(row: str, side: str, args: argparse.Namespace) -> None:
     world = World(args)
-    fn = {"acknack": row_acknack, "flood": row_flood, "goodbye": row_goodbye, "gap": row_gap,
+    fn = {"acknack": row_acknack, "flood": row_flood, "goodbye": row_goodbye,
+          "goodbye2": lambda w, s: row_goodbye(w, s, from_camera=True), "gap": row_gap,
           "slow": row_slow}[row]
     try:
         out = fn(world, side)
@@ -565,7 +581,7 @@ def cells(row: str, r: dict, args: argparse.Namespace) -> list[tuple[str, str]]:
                 ("discovery time of a late peer, median (max)", disc(r["discovery_s"], args.wait)),
                 ("RSS growth during the flood", f"{r['rss_growth'] / 2**20:.1f} MiB"),
                 ("participant table after it", "-" if r["table"] is None else str(r["table"]))]
-    if row == "goodbye":
+    if row in ("goodbye", "goodbye2"):
         rec = f"{r['longest_gap_s']:.3f} s" if r["recovered"] else f"none in {args.wait:g} s"
         return [("longest time without a frame (recovery)", rec),
                 ("legitimate frames exact", r["frames"]),
