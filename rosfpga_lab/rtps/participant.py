@@ -9,7 +9,11 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
 
 * SPDP: the participant announces itself (lease, locators, ``enclave=/;`` user data) to the
   discovery ports of indices 0..MAX_PARTICIPANT_INDEX of its domain and to every participant it
-  knows; a participant whose lease runs out is forgotten with its endpoints.
+  knows; a participant whose lease runs out is forgotten with its endpoints. A full table makes
+  room for each new participant (those that sent nothing but SPDP go first); a goodbye from
+  another source than the peer's is suspect, and a peer forgotten by a goodbye (or evicted) whose
+  traffic goes on is learned again (:mod:`~rosfpga_lab.rtps.spdp` says what an attacker can
+  still do).
 * SEDP: its writers and readers go out as reliable built-in samples (DATA, HEARTBEAT, ACKNACK),
   the peers' ones come in the same way; a remote endpoint on the same topic and type is matched
   when its QoS is compatible (RxO: offered reliability and durability at least what is
