@@ -849,20 +849,25 @@ def test_an_spdp_flood_cannot_lock_the_table_and_matched_peers_stay() -> None:
     rng = random.Random(30)
     for k in range(MAX_REMOTE_PARTICIPANTS * 10):     # random GUID prefixes, 10 s leases
         p.receive(spdp(bytes(rng.randrange(256) for _ in range(12))), ("127.0.0.1", 7999), k * 1e-3)
+        if k % 20 == 0:                                # the talker goes on speaking
+            p.receive(b.header(talker) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 0, 2 + k),
+                      ("127.0.0.1", 7997), k * 1e-3)
     assert len(p.participants) == MAX_REMOTE_PARTICIPANTS
-    # the matched camera and the peer that spoke (SEDP HEARTBEAT) stayed; the flood made room
+    # the matched camera and the peer that speaks (SEDP HEARTBEATs) stayed; the flood made room
     # for itself among the ones that sent nothing but SPDP
     assert cam in p.participants and talker in p.participants and len(p.matched(r)) == 1
     # a late peer is discovered (before: "new ones are ignored until a lease runs out") ...
     late = b"L" * 12
     out = p.receive(spdp(late, port=7995), ("127.0.0.1", 7995), 1.0)
     assert late in p.participants and ("127.0.0.1", 7995) in {(h, port) for h, port, _ in out}
-    # ... and it has MAX_REMOTE_PARTICIPANTS - 2 more new prefixes' time to speak: the oldest
-    # silent ones go first, whatever the flood re-announces
+    # ... and it has MAX_REMOTE_PARTICIPANTS - 2 more new prefixes' time to speak (the talker
+    # speaking meanwhile): the oldest silent ones go first, whatever the flood re-announces
+    p.receive(b.header(talker) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 0, 4000), ("127.0.0.1", 7997), 1.05)
     for k in range(MAX_REMOTE_PARTICIPANTS - 3):
         p.receive(spdp(bytes(rng.randrange(256) for _ in range(12))), ("127.0.0.1", 7999), 1.1)
     for prefix in list(p.participants):
         p.receive(spdp(prefix), ("127.0.0.1", 7999), 1.2)        # re-announced: no standing
+    p.receive(b.header(talker) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 0, 5000), ("127.0.0.1", 7997), 1.2)
     assert late in p.participants
     p.receive(spdp(b"N" * 12), ("127.0.0.1", 7999), 1.3)
     assert late not in p.participants and {cam, talker, b"N" * 12} <= set(p.participants)
@@ -955,3 +960,24 @@ def test_a_sample_on_its_way_is_not_resent_within_the_nack_suppression_time() ->
     assert data == 0 and a.counts[f"nack-suppressed-{c.guid_prefix.hex()}"] == 20 * 7
     ask = b.header(c.guid_prefix) + b.acknack(r, w, 20, [20], 5000)     # later: resent
     assert resent_data_bytes(a.receive(ask, c.user, t + 1.9 + 1.5 * NACK_SUPPRESSION_SECONDS)) == 5004
+
+
+def test_a_peer_evicted_while_silent_is_back_with_its_endpoints_when_it_speaks() -> None:
+    p = fresh()
+    peer = b"E" * 12
+    p.receive(spdp(peer), ("127.0.0.1", 7999), 0.0)
+    guid = peer + (0x1103).to_bytes(4, "big")
+    sedp = b.sedp_payload(guid, "rt/other", TYPE, True, 10, b.Locator("127.0.0.1", 8000))
+    p.receive(b.header(peer) + b.data(PUB_READER, PUB_WRITER, 1, sedp), ("127.0.0.1", 7999), 0.1)
+    assert guid in p.remote
+    rng = random.Random(31)
+    for k in range(MAX_REMOTE_PARTICIPANTS):          # newer than its last word: it goes
+        p.receive(spdp(bytes(rng.randrange(256) for _ in range(12))), ("127.0.0.1", 7999), 1.0)
+    assert peer not in p.participants and guid not in p.remote
+    out = p.receive(b.header(peer) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 1, 9), ("127.0.0.1", 7999), 2.0)
+    # before: never evicted (the table was locked); now back at once, its endpoint with it, and
+    # its SEDP writer not asked for sample 1 again (our reader is where it was)
+    assert peer in p.participants and p.remote[guid].topic == "rt/other"
+    assert len(p.participants) == MAX_REMOTE_PARTICIPANTS
+    assert not any(isinstance(s, AckNack) and s.writer_id == PUB_WRITER and 1 in s.missing
+                   for _, _, d in out for s in parse_message(d).submessages)

@@ -71,7 +71,7 @@ class RemoteParticipant:
     last_seen: float
     name: str = ""
     learned: float = 0.0          # when its SPDP was first taken
-    spoke: bool = False           # it sent something besides SPDP (SEDP, HEARTBEAT, ...)
+    spoke: float = -1e9           # when it last sent something besides SPDP (SEDP, HEARTBEAT...)
     source: tuple[str, int] = ("", 0)     # where the SPDP that taught it came from
     preemptive_base: int = 1      # its SEDP readers' preemptive ACKNACK base (Fast DDS: 0)
 

@@ -226,7 +226,7 @@ class Participant(ParticipantDiscovery, ReaderSide, WriterSide):
             # DATA, HEARTBEAT, GAP, ACKNACK and NACK_FRAG too), so a lost or late SPDP
             # announcement does not drop a peer that is sending
             known.last_seen = max(known.last_seen, now)
-            known.spoke = True
+            known.spoke = now
         if isinstance(sub, Data):
             if sub.writer_id == SPDP_WRITER:
                 return self._on_spdp(prefix, sub, source, now)

@@ -30,18 +30,20 @@ forget a peer for GOODBYE_GRACE_SECONDS plus the time to its next datagram, as o
 goodbyes.
 
 The table holds MAX_REMOTE_PARTICIPANTS and never stops learning: a new participant in a full
-table takes the place of the one of lowest standing (``_standing``, ``_evict``): first those that
-sent nothing but SPDP, the one learned first going first (re-announcing does not help it); then
-those that spoke (SEDP, HEARTBEATs, ...) but have no endpoint matched with a local one, then
-matched ones, each the one heard from least recently going first. What an SPDP flood from random
-GUID prefixes can still do, at R announcements a second: make the table forget a new peer that
-has not spoken within MAX_REMOTE_PARTICIPANTS - (peers that spoke) new prefixes, i.e. about
-64 / R s (a ROS 2 peer answers our SPDP with SEDP within milliseconds on one host; one forgotten
-is learned again at its next SPDP); keep every learned fake's lease (up to MAX_LEASE_SECONDS);
-and make the participant answer each new fake with its SPDP and SEDP data (a few KB) sent to a
-locator on loopback or at the sender's own address (``_locator``). To evict a peer that spoke
-or is matched it must make MAX_REMOTE_PARTICIPANTS fakes speak (or match the lab's topics) and
-keep them heard from more recently than that peer.
+table takes the place of the one of lowest standing (``_standing``, ``_evict``): first those with
+no endpoint matched with a local one, the one whose last sign of life other than an SPDP
+re-announcement (being learned, or sending SEDP, HEARTBEATs, data...) is oldest going first;
+then matched ones, the one heard from least recently going first. What an SPDP flood from random
+GUID prefixes can still do, at R new prefixes a second: make the table forget a new peer that
+has not spoken within MAX_REMOTE_PARTICIPANTS - (matched peers) new prefixes, about 64 / R s (a
+ROS 2 peer answers our SPDP with SEDP within milliseconds on one host, and one evicted that
+speaks is learned again at once: ``_relearn``); shorten that by making its fakes speak too, one
+datagram per fake after the newcomer arrived; keep each fake's lease (up to MAX_LEASE_SECONDS)
+while the table is not full; and make the participant answer each new fake with its SPDP and
+SEDP data (a few KB) sent to a locator on loopback or at the sender's own address
+(``_locator``). Each flood SPDP costs about 60 us. To evict a matched peer it must match
+MAX_REMOTE_PARTICIPANTS fakes with the lab's topics and keep them heard from more recently than
+that peer.
 """
 
 from __future__ import annotations
@@ -108,15 +110,14 @@ class ParticipantDiscovery(EndpointDiscovery):
                 self.assembler.discard(prefix, writer_id, seq)
 
     def _standing(self) -> Callable[[RemoteParticipant], tuple[int, float]]:
-        """What keeps a participant in a full table, lowest first: 0 and when it was learned, if
-        it sent nothing but SPDP; 1 and when it was last heard, if it spoke but none of its
-        endpoints is matched with a local user endpoint; 2 and when it was last heard, if one is."""
+        """What keeps a participant in a full table, lowest first: 0 and the later of when it
+        was learned and when it last sent something besides SPDP, if none of its endpoints is
+        matched with a local user endpoint (re-announcing its SPDP does not help it); 1 and when
+        it was last heard, if one is."""
         matched = {key[0] for ep in self.local.values() if ep.topic for key in ep.proxies}
 
         def standing(p: RemoteParticipant) -> tuple[int, float]:
-            if p.prefix in matched:
-                return (2, p.last_seen)
-            return (1, p.last_seen) if p.spoke else (0, p.learned)
+            return (1, p.last_seen) if p.prefix in matched else (0, max(p.learned, p.spoke))
         return standing
 
     def _evict(self) -> None:
@@ -125,7 +126,7 @@ class ParticipantDiscovery(EndpointDiscovery):
         victim = min(self.participants.values(), key=standing)
         self.note("participants-evict", f"more than {MAX_REMOTE_PARTICIPANTS} remote "
                   f"participants: the one of lowest standing makes room for each new one (first "
-                  f"{victim.prefix.hex()}, {'matched' if standing(victim)[0] == 2 else 'unmatched'})")
+                  f"{victim.prefix.hex()}, {'matched' if standing(victim)[0] else 'unmatched'})")
         self._depart(victim, -1e9, victim.last_seen + victim.lease)
 
     def _depart(self, p: RemoteParticipant, relearn_from: float, until: float) -> None:
@@ -156,7 +157,7 @@ class ParticipantDiscovery(EndpointDiscovery):
             self._evict()
         p = d.participant
         self.participants[prefix] = RemoteParticipant(prefix, p.meta, p.user, p.lease, now, p.name,
-                                                      now, True, p.source, p.preemptive_base)
+                                                      now, now, p.source, p.preemptive_base)
         self.note(f"back-{prefix.hex()}", f"participant {prefix.hex()} ({p.name}) left but its "
                   f"traffic goes on: learned again, our SPDP sent to {p.meta[0]}:{p.meta[1]}")
         out = self._greet(self.participants[prefix])
@@ -227,7 +228,7 @@ class ParticipantDiscovery(EndpointDiscovery):
         vendor = (params.get(b.PID_VENDORID) or [b""])[0][:2]
         base = 0 if vendor == b.VENDOR_EPROSIMA.to_bytes(2, "big") else 1
         p = self.participants[prefix] = RemoteParticipant(prefix, meta, user, lease, now, name, now,
-                                                          False, source, base)
+                                                          -1e9, source, base)
         if not full:
             self.note(f"participant-{prefix.hex()}", f"participant {prefix.hex()} ({name}) at "
                       f"{meta[0]}:{meta[1]}, lease {lease:g} s")
