@@ -10,8 +10,9 @@ MAX_OUT_OF_ORDER_BYTES, 256 numbers ahead); a GAP says which samples will never 
 up to gapList.base, and the listed ones), and a range ahead of delivery is remembered in
 ``wp.gaps`` until delivery gets there (``_drain``). A GAP counts only up to what its writer
 announced (``wp.announced``: its HEARTBEATs' last, the DATA/DATA_FRAGs seen, in that datagram or
-before; ``_written_up_to``): past that it is ignored, as Cyclone DDS ignores it, so a spoofed GAP
-cannot skip samples not yet written. ``_on_heartbeat`` answers a writer's HEARTBEAT
+before; ``_written_up_to``): past that it is ignored, so a spoofed GAP cannot skip samples not
+yet written (Cyclone DDS 11.0.1, PyPI, skips them: tests/benchmarks/bench_rtps_attacks.py, row
+gap). ``_on_heartbeat`` answers a writer's HEARTBEAT
 with an ACKNACK naming what is missing and NACK_FRAGs for partly received samples (RTPS 2.3
 8.4.12.2: a final HEARTBEAT only when something is missing, a final liveliness one never);
 ``_on_heartbeat_frag`` asks for the missing fragments of one sample with a NACK_FRAG. Both follow
@@ -137,8 +138,8 @@ class ReaderSide(EndpointDiscovery):
             if wp.next == 0:
                 continue
             # only samples the writer announced can be irrelevant: a GAP past its HEARTBEAT's
-            # last and past the data seen is cut there (Cyclone DDS ignores it too), else one
-            # spoofed GAP skips samples not yet written
+            # last and past the data seen is cut there, else one spoofed GAP skips samples
+            # not yet written
             end = min(sub.list_base, wp.announced + 1)
             listed = [s for s in sub.listed if s <= wp.announced]
             if end < sub.list_base or len(listed) < len(sub.listed):
