@@ -17,7 +17,9 @@ from rosfpga_lab.graph.capture_read import udp_datagrams
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps import parse_message
 from rosfpga_lab.rtps.limits import (
-    MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES, MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS,
+    GOODBYE_GRACE_SECONDS, MAX_HISTORY_BYTES, MAX_NOTES, MAX_OUT_OF_ORDER, MAX_PENDING_BYTES,
+    MAX_REMOTE_ENDPOINTS, MAX_REMOTE_PARTICIPANTS, NACK_SUPPRESSION_SECONDS,
+    SUSPECT_GOODBYE_LEASE_SECONDS,
 )
 from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Gap, Heartbeat, InfoDst, NackFrag
 from rosfpga_lab.rtps.participant import (
@@ -296,7 +298,7 @@ def test_spdp_flood_is_bounded() -> None:
     for k in range(MAX_REMOTE_PARTICIPANTS * 4):
         p.receive(spdp(struct.pack(">I", k) + b"F" * 8), ("127.0.0.1", 7999), 0.0)
     assert len(p.participants) == MAX_REMOTE_PARTICIPANTS
-    assert sum("new ones are ignored" in n for n in p.notes) == 1
+    assert sum("makes room" in n for n in p.notes) == 1
     assert len(p.notes) <= MAX_REMOTE_PARTICIPANTS + 2
 
 
@@ -642,18 +644,21 @@ def test_a_gap_ahead_of_delivery_is_remembered() -> None:
         return b"\x00\x01\x00\x00" + bytes([k]) * 4
 
     send(b.data(r, w, 1, sample(1)))
-    send(b.gap(r, w, 3, 5))                 # 3 and 4 will never come; 2 is still on its way
+    # 3 and 4 will never come; 2 is still on its way (the writer announced 5: a GAP past what
+    # it announced is ignored, test_a_gap_past_what_the_writer_announced_is_ignored)
+    send(b.heartbeat(r, w, 1, 5, 999, final=True), b.gap(r, w, 3, 5))
     send(b.data(r, w, 2, sample(2)), b.data(r, w, 5, sample(5)))
     # before: the GAP was dropped (it did not start at the next sample): 5 waited for 3 and 4
     assert [s.payload for s in c.take(r)] == [sample(1), sample(2), sample(5)]
     (ack,) = acknacks(send(b.heartbeat(r, w, 1, 5, 1000)), w)
     assert (ack.base, ack.missing) == (6, ())
     # GAP ranges ahead are bounded; past the bound they are asked for again, never lost
+    send(b.heartbeat(r, w, 1, 420, 1001, final=True))
     for k in range(200):
         send(b.gap(r, w, 10 + 2 * k, 11 + 2 * k))
     wp = c.local[r].proxies[(a.guid_prefix, w)]
     assert len(wp.gaps) <= MAX_OUT_OF_ORDER and c.counts[f"gaps-full-{r}"] > 0
-    (ack,) = acknacks(send(b.heartbeat(r, w, 1, 12, 1001)), w)
+    (ack,) = acknacks(send(b.heartbeat(r, w, 1, 12, 1002)), w)
     assert (ack.base, ack.missing) == (6, (6, 7, 8, 9, 11))
 
 
@@ -720,7 +725,7 @@ def test_an_acknack_from_reader_unknown_is_ignored() -> None:
     a, c, w, r = pair()
     net = Net(a, c)
     net.run([], steps=20)
-    net.run(a.write(w, b"\x00\x01\x00\x00one!", net.now), steps=3)
+    a.write(w, b"\x00\x01\x00\x00one!", net.now)           # lost on its way
     for reader_id in (0, r):                          # ENTITYID_UNKNOWN, then the real reader
         ask = b.header(c.guid_prefix) + b.acknack(reader_id, w, 1, [1], 500 + reader_id)
         out = a.receive(ask, c.user, net.now + 1.0)
@@ -742,3 +747,237 @@ def test_a_gap_whose_list_starts_before_its_range_still_counts_its_list() -> Non
     # before: refused as invalid, so 4 waited for 2 and 3
     assert [s.payload for s in c.take(r)] == [one, four]
     assert not any("invalid" in n for n in c.notes)
+
+
+def test_a_gap_past_what_the_writer_announced_is_ignored() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+
+    def send(*subs: bytes) -> None:
+        c.receive(b.header(a.guid_prefix) + b"".join(subs), a.user, net.now)
+
+    def sample(k: int) -> bytes:
+        return b"\x00\x01\x00\x00" + bytes([k]) * 4
+
+    send(b.data(r, w, 1, sample(1)), b.heartbeat(r, w, 1, 1, 900, final=True))
+    # a spoofed GAP for the next 30 samples, none written yet, and a listed one past them
+    send(b.gap(r, w, 2, 32, [40]))
+    for k in range(2, 6):
+        send(b.data(r, w, k, sample(k)))
+    # before: delivery jumped to 32, so 2..5 were dropped as already gapped
+    assert [s.payload for s in c.take(r)] == [sample(k) for k in range(1, 6)]
+    assert c.counts[f"gap-ahead-{r}"] == 1
+    # a GAP within what the HEARTBEAT announced still counts (7 and 8 never come) ...
+    send(b.heartbeat(r, w, 1, 9, 901, final=True), b.gap(r, w, 7, 9), b.data(r, w, 6, sample(6)),
+         b.data(r, w, 9, sample(9)))
+    assert [s.payload for s in c.take(r)] == [sample(6), sample(9)]
+    # ... and one that reaches past it counts up to what was announced, not beyond
+    send(b.gap(r, w, 10, 20))
+    send(b.heartbeat(r, w, 1, 12, 902, final=True), b.gap(r, w, 10, 12))
+    send(b.data(r, w, 12, sample(12)), b.data(r, w, 13, sample(13)))
+    assert [s.payload for s in c.take(r)] == [sample(12), sample(13)]
+
+
+# ---- the resend budget (issue 30 row 1: 10,000 ACKNACKs pulled 218 MB) -------------------------
+
+def resent_data_bytes(out: list) -> int:
+    return sum(len(s.payload) for _, _, d in out for s in parse_message(d).submessages
+               if isinstance(s, Data))
+
+
+def test_acknacks_in_the_real_readers_name_for_samples_it_acknowledged_get_gaps() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    sample = b"\x00\x01\x00\x00" + bytes(5000)
+    out = []
+    for _ in range(10):
+        out += a.write(w, sample, net.now)
+    net.run(out, steps=5)
+    assert len(c.take(r)) == 10                      # delivered and acknowledged
+    bytes_in = bytes_out = data = 0
+    for k in range(2000):       # one every 6 ms: each one past MIN_RESEND_SECONDS's pacing
+        ask = b.header(c.guid_prefix) + b.acknack(r, w, 1, range(1, 11), 100 + k)
+        got = a.receive(ask, c.user, net.now + 0.006 * k)
+        bytes_in += len(ask)
+        bytes_out += sum(len(d) for _, _, d in got)
+        data += resent_data_bytes(got)
+    # before: every one of them resent all 10 samples (50 KB out per 60-byte ACKNACK)
+    assert data == 0 and bytes_out <= 2 * bytes_in, (data, bytes_out, bytes_in)
+    assert any("acknowledged: GAP" in n for n in a.notes)
+    net.run(a.write(w, sample[:-1] + b"!", net.now + 13.0), steps=5)
+    assert [s.payload[-1:] for s in c.take(r)] == [b"!"]
+
+
+def test_a_reader_that_never_acknowledges_is_resent_no_more_than_was_written() -> None:
+    a = fresh()
+    w = a.add_writer(TOPIC, TYPE)
+    prefix = b"R" * 12                  # a fake reader, its locator a victim's port
+    a.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    guid = prefix + (0x1404).to_bytes(4, "big")
+    sedp = b.sedp_payload(guid, TOPIC, TYPE, True, 10, b.Locator("127.0.0.1", 9))
+    a.receive(b.header(prefix) + b.data(0x4C7, 0x4C2, 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert a.matched(w) == [guid]
+    sample = b"\x00\x01\x00\x00" + bytes(5000)
+    written = resent = 0
+    for round_ in range(3):
+        for _ in range(10):
+            a.write(w, sample, 1.0 + round_)
+            written += len(sample)
+        for k in range(500):             # ACKNACKs asking for everything, never acknowledging
+            ask = b.header(prefix) + b.acknack(0x1404, w, 1, range(1, 31), 1000 * round_ + k + 1)
+            resent += resent_data_bytes(a.receive(ask, ("127.0.0.1", 9), 1.0 + round_ + 0.0019 * k))
+        # before: 500 * 10 samples resent per round (about 25 MB for 50 KB written)
+        assert 0 < resent <= written, (round_, resent, written)
+    assert any("budget" in n for n in a.notes)
+
+
+# ---- the participant table under an SPDP flood (issue 30 row 2: locked at 64, a late peer never
+# discovered) ---------------------------------------------------------------------------------
+
+def test_an_spdp_flood_cannot_lock_the_table_and_matched_peers_stay() -> None:
+    p = fresh()
+    r = p.add_reader(TOPIC, TYPE)
+    cam, talker = b"C" * 12, b"T" * 12
+    p.receive(spdp(cam), ("127.0.0.1", 7999), 0.0)
+    sedp = b.sedp_payload(cam + (0x103).to_bytes(4, "big"), TOPIC, TYPE, True, 10,
+                          b.Locator("127.0.0.1", 8000))
+    p.receive(b.header(cam) + b.data(PUB_READER, PUB_WRITER, 1, sedp), ("127.0.0.1", 7999), 0.0)
+    p.receive(spdp(talker, port=7997), ("127.0.0.1", 7997), 0.0)
+    p.receive(b.header(talker) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 0, 1), ("127.0.0.1", 7997), 0.0)
+    rng = random.Random(30)
+    for k in range(MAX_REMOTE_PARTICIPANTS * 10):     # random GUID prefixes, 10 s leases
+        p.receive(spdp(bytes(rng.randrange(256) for _ in range(12))), ("127.0.0.1", 7999), k * 1e-3)
+        if k % 20 == 0:                                # the talker goes on speaking
+            p.receive(b.header(talker) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 0, 2 + k),
+                      ("127.0.0.1", 7997), k * 1e-3)
+    assert len(p.participants) == MAX_REMOTE_PARTICIPANTS
+    # the matched camera and the peer that speaks (SEDP HEARTBEATs) stayed; the flood made room
+    # for itself among the ones that sent nothing but SPDP
+    assert cam in p.participants and talker in p.participants and len(p.matched(r)) == 1
+    # a late peer is discovered (before: "new ones are ignored until a lease runs out") ...
+    late = b"L" * 12
+    out = p.receive(spdp(late, port=7995), ("127.0.0.1", 7995), 1.0)
+    assert late in p.participants and ("127.0.0.1", 7995) in {(h, port) for h, port, _ in out}
+    # ... and it has MAX_REMOTE_PARTICIPANTS - 2 more new prefixes' time to speak (the talker
+    # speaking meanwhile): the oldest silent ones go first, whatever the flood re-announces
+    p.receive(b.header(talker) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 0, 4000), ("127.0.0.1", 7997), 1.05)
+    for k in range(MAX_REMOTE_PARTICIPANTS - 3):
+        p.receive(spdp(bytes(rng.randrange(256) for _ in range(12))), ("127.0.0.1", 7999), 1.1)
+    for prefix in list(p.participants):
+        p.receive(spdp(prefix), ("127.0.0.1", 7999), 1.2)        # re-announced: no standing
+    p.receive(b.header(talker) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 0, 5000), ("127.0.0.1", 7997), 1.2)
+    assert late in p.participants
+    p.receive(spdp(b"N" * 12), ("127.0.0.1", 7999), 1.3)
+    assert late not in p.participants and {cam, talker, b"N" * 12} <= set(p.participants)
+    assert p.counts["participants-evict"] == MAX_REMOTE_PARTICIPANTS * 10 - 62 + 1 + 61 + 1
+
+
+# ---- a spoofed goodbye (issue 30 row 3: a live camera forgotten, no recovery in 45 s) ------------
+
+def test_a_goodbye_from_elsewhere_is_suspect_and_one_whose_traffic_goes_on_is_learned_again() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    a.announce_period = c.announce_period = 1000.0        # no SPDP comes to the rescue
+    (bye,) = [d for host, port, d in a.goodbye() if port == c.meta[1]]
+
+    def frame(k: int) -> list[int]:
+        """a writes sample k; what c delivers then."""
+        for _, _, d in a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * 4, net.now):
+            c.receive(d, a.user, net.now)
+        return [s.payload[-1] for s in c.take(r)]
+
+    assert frame(1) == [1]
+    # a goodbye in a's name from another port: suspect, a stays (before: forgotten, unmatched,
+    # its samples ignored until its next SPDP)
+    c.receive(bye, ("127.0.0.1", 6666), net.now)
+    assert a.guid_prefix in c.participants and c.matched(r), c.notes
+    assert c.participants[a.guid_prefix].lease == SUSPECT_GOODBYE_LEASE_SECONDS
+    assert frame(2) == [2]
+    # from where a speaks (a spoofed source port, or a real goodbye): forgotten at once ...
+    c.receive(bye, a.user, net.now)
+    assert a.guid_prefix not in c.participants and c.matched(r) == []
+    net.now += GOODBYE_GRACE_SECONDS / 2
+    assert frame(3) == []                # ... what was in flight does not bring it back ...
+    net.now += GOODBYE_GRACE_SECONDS
+    out = []
+    for _, _, d in a.write(w, b"\x00\x01\x00\x00" + bytes([4]) * 4, net.now):
+        out += c.receive(d, a.user, net.now)
+    # ... but traffic after that learns it again: matched at once, our SPDP sent to it
+    assert a.guid_prefix in c.participants and len(c.matched(r)) == 1
+    assert any(port == a.meta[1] and SPDP_WRITER.to_bytes(4, "big") in d for _, port, d in out)
+    net.run(out, steps=30)
+    assert [s.payload[-1] for s in c.take(r)][-1:] == [4] and frame(5) == [5]
+    # a silent participant that said goodbye stays gone
+    c.receive(bye, a.user, net.now)
+    net.parts = (c,)
+    net.run([], steps=int(a.lease / 0.01) + 10)
+    assert a.guid_prefix not in c.participants and not c.departed
+
+
+# ---- a RELIABLE (KEEP_ALL) reader that consumes slowly (issue 30 row 5) --------------------------
+
+def test_a_reader_that_never_acknowledges_leaves_the_writer_bounded_and_unblocked() -> None:
+    a = fresh()
+    w = a.add_writer(TOPIC, TYPE, Qos(True, 1000))              # KEEP_LAST 1000 (the most)
+    prefix = b"K" * 12                  # a KEEP_ALL RELIABLE reader that never acknowledges
+    a.receive(spdp(prefix), ("127.0.0.1", 7999), 0.0)
+    guid = prefix + (0x1404).to_bytes(4, "big")
+    sedp = b.sedp_payload(guid, TOPIC, TYPE, True, 0, b.Locator("127.0.0.1", 9))
+    a.receive(b.header(prefix) + b.data(0x4C7, 0x4C2, 1, sedp), ("127.0.0.1", 7999), 0.0)
+    assert a.matched(w) == [guid]
+    size = 1 << 20
+    sent = 0
+    for k in range(80):                 # 80 MiB written, no write waits for the reader
+        sent += len(a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * (size - 4), 1.0 + k * 0.01))
+        a.tick(1.0 + k * 0.01)
+    ep = a.local[w]
+    # before: all 80 samples kept (the history was bounded by depth alone)
+    assert ep.history_bytes == sum(map(len, ep.history.values())) <= MAX_HISTORY_BYTES
+    assert list(ep.history) == list(range(81 - MAX_HISTORY_BYTES // size, 81))
+    assert sent >= 80 and sum("MAX_HISTORY_BYTES" in n for n in a.notes) == 1
+    # what it asks for that left the history is GAPped; what is held, resent within its budget
+    out = a.receive(b.header(prefix) + b.acknack(0x1404, w, 1, [1, 2, 80], 1), ("127.0.0.1", 9), 2.0)
+    subs = [s for _, _, d in out for s in parse_message(d).submessages]
+    assert [(g.start, g.list_base) for g in subs if isinstance(g, Gap)] == [(1, 81 - MAX_HISTORY_BYTES // size)]
+    assert {s.seq for s in subs if isinstance(s, DataFrag)} == {80}
+
+
+def test_a_sample_on_its_way_is_not_resent_within_the_nack_suppression_time() -> None:
+    a, c, w, r = pair()
+    net = Net(a, c)
+    net.run([], steps=20)
+    t = net.now
+    data = 0
+    for k in range(20):          # each sample asked for by ACKNACKs in c's name while on its way
+        a.write(w, b"\x00\x01\x00\x00" + bytes([k]) * 5000, t + k * 0.1)
+        for j in range(1, 8):    # 6 ms apart: past MIN_RESEND_SECONDS's pacing, within 50 ms
+            ask = b.header(c.guid_prefix) + b.acknack(r, w, k + 1, [k + 1], 100 * k + j)
+            data += resent_data_bytes(a.receive(ask, c.user, t + k * 0.1 + 0.006 * j))
+    # before: resent as often as the pacing let (and then within the budget: once per sample)
+    assert data == 0 and a.counts[f"nack-suppressed-{c.guid_prefix.hex()}"] == 20 * 7
+    ask = b.header(c.guid_prefix) + b.acknack(r, w, 20, [20], 5000)     # later: resent
+    assert resent_data_bytes(a.receive(ask, c.user, t + 1.9 + 1.5 * NACK_SUPPRESSION_SECONDS)) == 5004
+
+
+def test_a_peer_evicted_while_silent_is_back_with_its_endpoints_when_it_speaks() -> None:
+    p = fresh()
+    peer = b"E" * 12
+    p.receive(spdp(peer), ("127.0.0.1", 7999), 0.0)
+    guid = peer + (0x1103).to_bytes(4, "big")
+    sedp = b.sedp_payload(guid, "rt/other", TYPE, True, 10, b.Locator("127.0.0.1", 8000))
+    p.receive(b.header(peer) + b.data(PUB_READER, PUB_WRITER, 1, sedp), ("127.0.0.1", 7999), 0.1)
+    assert guid in p.remote
+    rng = random.Random(31)
+    for k in range(MAX_REMOTE_PARTICIPANTS):          # newer than its last word: it goes
+        p.receive(spdp(bytes(rng.randrange(256) for _ in range(12))), ("127.0.0.1", 7999), 1.0)
+    assert peer not in p.participants and guid not in p.remote
+    out = p.receive(b.header(peer) + b.heartbeat(PUB_READER, PUB_WRITER, 1, 1, 9), ("127.0.0.1", 7999), 2.0)
+    # before: never evicted (the table was locked); now back at once, its endpoint with it, and
+    # its SEDP writer not asked for sample 1 again (our reader is where it was)
+    assert peer in p.participants and p.remote[guid].topic == "rt/other"
+    assert len(p.participants) == MAX_REMOTE_PARTICIPANTS
+    assert not any(isinstance(s, AckNack) and s.writer_id == PUB_WRITER and 1 in s.missing
+                   for _, _, d in out for s in parse_message(d).submessages)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps import parse_message
-from rosfpga_lab.rtps.limits import MIN_RESEND_SECONDS
+from rosfpga_lab.rtps.limits import MIN_RESEND_SECONDS, NACK_SUPPRESSION_SECONDS
 from rosfpga_lab.rtps.message import DataFrag, NackFrag
 from rosfpga_lab.rtps.participant import PUB_READER, PUB_WRITER, SPDP_READER, SPDP_WRITER, Participant, Qos
 
@@ -112,10 +112,17 @@ def test_nack_frags_with_rising_counts_are_paced() -> None:
     # every NACK_FRAG of 40 bytes a peer sends)
     assert nack(11, t + MIN_RESEND_SECONDS / 2) == []
     assert sum("paced" in n and "NACK_FRAG" in n for n in a.notes) == 1
-    assert nack(12, t + MIN_RESEND_SECONDS * 1.5) == list(range(1, 31))    # after it: again
+    # after it: again, once the writer has written again (the resend budget: each byte written
+    # pays for one byte resent, RESEND_PER_BYTE_WRITTEN)
+    assert nack(12, t + MIN_RESEND_SECONDS * 1.5) == []
+    # (and NACK suppression: a sample is not sent to a reader again within
+    # NACK_SUPPRESSION_SECONDS of its last sending)
+    a.write(w, b"\x00\x01\x00\x00" + bytes(40000), net.now)
+    assert nack(13, t + NACK_SUPPRESSION_SECONDS / 2) == []
+    assert nack(14, t + NACK_SUPPRESSION_SECONDS * 1.5) == list(range(1, 31))
     # a storm is counted, logged once
     for k in range(200):
-        nack(100 + k, t + MIN_RESEND_SECONDS * 1.6)
+        nack(100 + k, t + NACK_SUPPRESSION_SECONDS * 1.5 + MIN_RESEND_SECONDS * 0.1)
     assert sum("paced" in n and "NACK_FRAG" in n for n in a.notes) == 1
     assert a.counts["nackfrag-storm"] == 201
 
@@ -156,7 +163,7 @@ def test_nack_frags_for_several_samples_in_one_datagram_are_all_answered() -> No
     again = b.header(c.guid_prefix) + b.nack_frag(r, w, 2, [2], 70)
     assert resent_fragments(a.receive(again, c.user, t + MIN_RESEND_SECONDS / 2), w) == []
     assert resent_fragments(a.receive(again[:20] + b.nack_frag(r, w, 2, [2], 71), c.user,
-                                      t + MIN_RESEND_SECONDS * 1.5), w) == [2]
+                                      t + NACK_SUPPRESSION_SECONDS * 1.5), w) == [2]
 
 
 # ---- SPDP without PID_PARTICIPANT_LEASE_DURATION ------------------------------------------------

@@ -70,6 +70,10 @@ class RemoteParticipant:
     lease: float
     last_seen: float
     name: str = ""
+    learned: float = 0.0          # when its SPDP was first taken
+    spoke: float = -1e9           # when it last sent something besides SPDP (SEDP, HEARTBEAT...)
+    source: tuple[str, int] = ("", 0)     # where the SPDP that taught it came from
+    preemptive_base: int = 1      # its SEDP readers' preemptive ACKNACK base (Fast DDS: 0)
 
 
 @dataclass
@@ -100,6 +104,12 @@ class ReaderProxy:
     resent: dict[int, float] = field(default_factory=dict)
     last_heartbeat: float = -1.0
     heartbeat_period: float = 0.0     # 0: the first period; doubles while unanswered
+    #: When each sample still in the history was last sent to it (written or resent): not
+    #: again within NACK_SUPPRESSION_SECONDS (``WriterSide._suppressed``).
+    sent: dict[int, float] = field(default_factory=dict)
+    #: Bytes it may still be resent (``WriterSide._afford``): each sample written adds its size
+    #: (times RESEND_PER_BYTE_WRITTEN), up to the history's bytes; it starts at those.
+    credit: float = 0.0
 
 
 @dataclass
@@ -110,6 +120,7 @@ class WriterProxy:
     writer_id: int
     reliable: bool
     next: int = 0                 # 0: nothing known yet
+    announced: int = 0            # highest number the writer announced (HEARTBEAT last, data)
     pending: dict[int, bytes | None] = field(default_factory=dict)
     pending_bytes: int = 0
     gaps: dict[int, int] = field(default_factory=dict)   # GAP ranges start -> end ahead of next
@@ -117,6 +128,19 @@ class WriterProxy:
     last_hbfrag_count: int = -(1 << 31)   # HEARTBEAT_FRAG counts on their own (RTPS 2.3 8.3.7.6)
     acknack_count: int = 0
     nackfrag_count: int = 0
+
+
+@dataclass
+class Departed:
+    """What a participant that said goodbye or was evicted leaves behind, to learn it again when
+    its traffic goes on (``spdp._relearn``): its record, its endpoints, our SEDP readers' proxies
+    of its SEDP writers (where they were), from when and until when its traffic counts."""
+
+    participant: RemoteParticipant
+    endpoints: list[RemoteEndpoint]
+    sedp: dict[tuple[bytes, int], WriterProxy]
+    relearn_from: float
+    until: float
 
 
 @dataclass
@@ -128,6 +152,7 @@ class LocalEndpoint:
     qos: Qos
     seq: int = 0                                  # writer: last sequence number written
     history: OrderedDict[int, bytes] = field(default_factory=OrderedDict)
+    history_bytes: int = 0                        # writer: bytes of the samples in history
     proxies: dict[tuple[bytes, int], ReaderProxy | WriterProxy] = field(default_factory=dict)
     hb_count: int = 0
     type_hash: str = ""                           # RIHS01_... announced in its USER_DATA

@@ -34,14 +34,42 @@ MAX_HEARTBEAT_SECONDS = 1.0
 #: A reader proxy's retransmissions are at least this far apart (ACKNACK and NACK_FRAG storms;
 #: an ACKNACK's and each sample's NACK_FRAG's are paced apart).
 MIN_RESEND_SECONDS = 0.005
-#: Remote participants and endpoints the participant keeps (SPDP/SEDP floods).
+#: A sample is not sent to one reader again within this of its last sending (written or
+#: resent): RTPS's nackSuppressionDuration. A reader that lost it asks again at the next
+#: HEARTBEAT; ACKNACKs in its name cannot pull a sample while it is on its way (each sample at
+#: most once per heartbeat period per reader).
+NACK_SUPPRESSION_SECONDS = 0.05
+#: The resend budget of a reader proxy (rosfpga_lab.rtps.writer_side): what ACKNACKs and
+#: NACK_FRAGs make a writer send again, over any time, is at most this many bytes per byte it
+#: wrote to the history since the reader matched, plus the history's bytes at that time (the
+#: budget starts at those and never holds more than the history). A sample the reader already
+#: acknowledged is never resent to it (a GAP says so), so a storm of ACKNACKs in the real
+#: reader's name gets GAPs, a few bytes per ACKNACK, and a fake reader that never acknowledges
+#: gets at most this share of the stream it is sent anyway.
+RESEND_PER_BYTE_WRITTEN = 1.0
+#: Remote participants and endpoints the participant keeps (SPDP/SEDP floods; a full
+#: participant table makes room for each new one: rosfpga_lab.rtps.spdp says which goes).
 MAX_REMOTE_PARTICIPANTS = 64
 MAX_REMOTE_ENDPOINTS = 512
+#: A goodbye (SPDP dispose) from a source that is neither where the participant's first SPDP came
+#: from nor one of its locators is suspect: its lease becomes this (its traffic keeps it alive).
+#: One from there forgets it, and traffic from it later than GOODBYE_GRACE_SECONDS after the
+#: goodbye learns it again (rosfpga_lab.rtps.spdp).
+SUSPECT_GOODBYE_LEASE_SECONDS = 1.0
+GOODBYE_GRACE_SECONDS = 0.1
 #: Out-of-order samples a reliable reader holds per remote writer, and in bytes.
 MAX_OUT_OF_ORDER = 64
 MAX_OUT_OF_ORDER_BYTES = 32 * 1024 * 1024
-#: Received samples kept for the application per reader beyond its history depth (never more).
+#: Received samples kept for the application per reader beyond its history depth (never more),
+#: and the deepest history a writer keeps (KEEP_LAST).
 MAX_HISTORY_DEPTH = 1000
+#: Bytes a writer's history holds at most: past them the oldest samples go before KEEP_LAST
+#: depth says (one sample always stays). With MAX_HISTORY_DEPTH, what bounds a writer whatever
+#: its readers do: the lab's writer is KEEP_LAST and never blocks; a RELIABLE reader, KEEP_ALL
+#: included (history kind is not requested-vs-offered), that consumes slowly or never
+#: acknowledges is sent each sample once, resent within its budget, and GAPped what left the
+#: history (rosfpga_lab.rtps.writer_side); nothing is buffered per reader.
+MAX_HISTORY_BYTES = 64 * 1024 * 1024
 #: Distinct log notes kept (each is logged once).
 MAX_NOTES = 256
 #: Remote endpoints one local writer or reader is matched with (a writer sends each sample to

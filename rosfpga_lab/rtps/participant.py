@@ -9,23 +9,29 @@ to send as ``(address, port, bytes)``. Received user samples queue up in
 
 * SPDP: the participant announces itself (lease, locators, ``enclave=/;`` user data) to the
   discovery ports of indices 0..MAX_PARTICIPANT_INDEX of its domain and to every participant it
-  knows; a participant whose lease runs out is forgotten with its endpoints.
+  knows; a participant whose lease runs out is forgotten with its endpoints. A full table makes
+  room for each new participant (those that sent nothing but SPDP go first); a goodbye from
+  another source than the peer's is suspect, and a peer forgotten by a goodbye (or evicted) whose
+  traffic goes on is learned again (:mod:`~rosfpga_lab.rtps.spdp` says what an attacker can
+  still do).
 * SEDP: its writers and readers go out as reliable built-in samples (DATA, HEARTBEAT, ACKNACK),
   the peers' ones come in the same way; a remote endpoint on the same topic and type is matched
   when its QoS is compatible (RxO: offered reliability and durability at least what is
   requested), else the reason is logged once. An endpoint given a ROS 2 type hash announces it
   (USER_DATA ``typehash=RIHS01_...;``, as rmw does); a matched remote endpoint whose announced
   hash differs is logged once and matched all the same (rmw matches on the type name).
-* User data: a writer keeps the last ``depth`` samples (KEEP_LAST; VOLATILE, or TRANSIENT_LOCAL:
-  a reader that joins late gets them), sends each as DATA
-  or DATA_FRAG; reliable ones HEARTBEAT until acknowledged, resend on ACKNACK/NACK_FRAG and GAP
-  what left the history. A reader puts fragments together (memory follows bytes received),
+* User data: a writer keeps the last ``depth`` samples (KEEP_LAST, at most MAX_HISTORY_BYTES;
+  VOLATILE, or TRANSIENT_LOCAL: a reader that joins late gets them), sends each as DATA
+  or DATA_FRAG; reliable ones HEARTBEAT until acknowledged, resend on ACKNACK/NACK_FRAG within
+  a budget and GAP what left the history or was acknowledged. It never blocks: a slow reader,
+  KEEP_ALL or not, loses what left the history (rosfpga_lab.rtps.limits.MAX_HISTORY_BYTES). A reader puts fragments together (memory follows bytes received),
   delivers in order when reliable, asks again with ACKNACK/NACK_FRAG.
 * The receiver's rules (RTPS 2.3 8.3.4, 8.3.6.3, 8.4.12.2, as Cyclone DDS's receiver follows
   them): INFO_SRC/INFO_DST set source and destination; a message of another major version is
   ignored; a malformed submessage drops itself and the rest of its datagram, not what came
   before; a final HEARTBEAT is answered only when samples are missing, a final liveliness one
-  never; a GAP ahead of delivery is remembered until delivery gets there; whatever a known
+  never; a GAP ahead of delivery is remembered until delivery gets there, one past what its
+  writer announced (HEARTBEAT's last, data seen) is ignored there; whatever a known
   peer's endpoints send renews its lease, as SPDP does.
 
 Where each part lives: :class:`Participant` is one class built from one class per part, each in
@@ -113,6 +119,8 @@ class Participant(ParticipantDiscovery, ReaderSide, WriterSide):
         if now - self._last_announce >= self.announce_period:
             self._last_announce = now
             out += self.announce()
+        for prefix in [k for k, d in self.departed.items() if now > d.until]:
+            del self.departed[prefix]
         for prefix, p in list(self.participants.items()):
             if now - p.last_seen > p.lease:
                 self.note(f"lease-{prefix.hex()}", f"participant {prefix.hex()} ({p.name}) lease "
@@ -157,15 +165,27 @@ class Participant(ParticipantDiscovery, ReaderSide, WriterSide):
                       f"before it handled, it and the rest ignored ({msg.error}); further ones "
                       f"are counted")
         out: list[Send] = []
-        for prefix, destination, sub in msg.routed():
+        routed = list(msg.routed())
+        for prefix, destination, sub in routed:
+            # what the datagram's writers announce counts for its GAPs wherever it stands in it
+            # (a writer may send a GAP before the DATA that follows the samples it skips)
+            if prefix in self.participants and destination in (self.guid_prefix, ANY_PARTICIPANT) \
+                    and isinstance(sub, (Data, DataFrag, Heartbeat, HeartbeatFrag)) \
+                    and not self._invalid(sub):
+                last = sub.last if isinstance(sub, Heartbeat) else sub.seq
+                self._written_up_to(prefix, sub.writer_id, sub.reader_id, last)
+        for prefix, destination, sub in routed:
             if isinstance(sub, (InfoDst, InfoSrc)) or prefix == self.guid_prefix or \
                     destination not in (self.guid_prefix, ANY_PARTICIPANT):
                 continue
             if prefix not in self.participants and not (
                     isinstance(sub, Data) and sub.writer_id == SPDP_WRITER):
-                self.note(f"unknown-{prefix.hex()}", f"submessages from participant "
-                          f"{prefix.hex()} before its SPDP: ignored")
-                continue
+                back = self._relearn(prefix, now)     # one that left, still speaking
+                if not back:
+                    self.note(f"unknown-{prefix.hex()}", f"submessages from participant "
+                              f"{prefix.hex()} before its SPDP: ignored")
+                    continue
+                out += back
             try:
                 out += self._on_submessage(prefix, sub, source, now)
             except RtpsError as exc:
@@ -206,6 +226,7 @@ class Participant(ParticipantDiscovery, ReaderSide, WriterSide):
             # DATA, HEARTBEAT, GAP, ACKNACK and NACK_FRAG too), so a lost or late SPDP
             # announcement does not drop a peer that is sending
             known.last_seen = max(known.last_seen, now)
+            known.spoke = now
         if isinstance(sub, Data):
             if sub.writer_id == SPDP_WRITER:
                 return self._on_spdp(prefix, sub, source, now)

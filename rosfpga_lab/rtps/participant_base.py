@@ -18,18 +18,18 @@ none: they wait in ``_outbox`` until the next ``receive`` or ``tick``.
 from __future__ import annotations
 
 import os
-from collections import deque
+from collections import OrderedDict, deque
 
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.discovery import PL_CDR_BE, PL_CDR_LE, FragmentAssembler, parse_parameters
 from rosfpga_lab.rtps.entities import (
-    PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, LocalEndpoint, Qos, ReaderProxy, RemoteEndpoint,
-    RemoteParticipant, Sample, Send, check_domain, discovery_port, user_port,
+    PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, Departed, LocalEndpoint, Qos, ReaderProxy,
+    RemoteEndpoint, RemoteParticipant, Sample, Send, check_domain, discovery_port, user_port,
 )
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import (
-    ANNOUNCE_SECONDS, FRAGMENT_BYTES, LEASE_SECONDS, MAX_MESSAGE_BYTES, MAX_NOTES,
-    MAX_REMOTE_ENDPOINTS,
+    ANNOUNCE_SECONDS, FRAGMENT_BYTES, LEASE_SECONDS, MAX_HISTORY_BYTES, MAX_MESSAGE_BYTES,
+    MAX_NOTES, MAX_REMOTE_ENDPOINTS, RESEND_PER_BYTE_WRITTEN,
 )
 
 
@@ -48,6 +48,9 @@ class ParticipantBase:
         self.meta = (address, discovery_port(domain, index))
         self.user = (address, user_port(domain, index))
         self.participants: dict[bytes, RemoteParticipant] = {}
+        #: Participants that said goodbye or were evicted, by prefix (``spdp._depart``).
+        self.departed: OrderedDict[bytes, Departed] = OrderedDict()
+        self._count = 0                   # the last ACKNACK / NACK_FRAG count sent
         self.remote: dict[bytes, RemoteEndpoint] = {}
         self.local: dict[int, LocalEndpoint] = {}
         self.samples: deque[Sample] = deque()
@@ -58,10 +61,18 @@ class ParticipantBase:
         self._last_announce = -1e9
         self.assembler = FragmentAssembler()
         self._outbox: list[Send] = []     # what matching produced (sent with the next result)
+        self._spdp_msg: tuple[object, bytes] = (None, b"")     # our SPDP datagram, once built
         # built-in SEDP writers and readers (reliable, KEEP_ALL of the lab's own endpoints)
         for eid, kind in ((PUB_WRITER, "writer"), (SUB_WRITER, "writer"),
                           (PUB_READER, "reader"), (SUB_READER, "reader")):
             self.local[eid] = LocalEndpoint(eid, kind, "", "", Qos(True, MAX_REMOTE_ENDPOINTS))
+
+    def _next_count(self) -> int:
+        """The count of the next ACKNACK or NACK_FRAG: one counter for all of them, so the
+        counts a remote writer sees from a reader only rise, even after the participant forgot
+        and learned that writer again (a count already seen is ignored: RTPS 2.3 8.4.15.8)."""
+        self._count += 1
+        return self._count
 
     # ---- notes ---------------------------------------------------------------------------
     def note(self, key: str, text: str) -> None:
@@ -102,6 +113,26 @@ class ParticipantBase:
         return [b.data_frag(reader_id, writer_id, seq, n, FRAGMENT_BYTES, len(payload),
                             payload[(n - 1) * FRAGMENT_BYTES:n * FRAGMENT_BYTES], 1)
                 for n in numbers]
+
+    def _keep(self, ep: LocalEndpoint, payload: bytes) -> int:
+        """Put the next sample of writer ``ep`` in its history (KEEP_LAST depth, and at most
+        MAX_HISTORY_BYTES: the oldest go); each matched reader proxy earns its resend budget.
+        Returns its sequence number."""
+        ep.seq += 1
+        ep.history[ep.seq] = payload
+        ep.history_bytes += len(payload)
+        while len(ep.history) > ep.qos.depth or \
+                (ep.history_bytes > MAX_HISTORY_BYTES and len(ep.history) > 1):
+            if len(ep.history) <= ep.qos.depth:
+                self.note(f"history-bytes-{ep.entity_id}", f"writer {ep.topic or 'SEDP'}: its "
+                          f"last {ep.qos.depth} samples exceed MAX_HISTORY_BYTES "
+                          f"({MAX_HISTORY_BYTES} bytes): the oldest go first")
+            ep.history_bytes -= len(ep.history.popitem(last=False)[1])
+        for proxy in ep.proxies.values():
+            if isinstance(proxy, ReaderProxy):
+                proxy.credit = min(proxy.credit + len(payload) * RESEND_PER_BYTE_WRITTEN,
+                                   ep.history_bytes)
+        return ep.seq
 
     def _heartbeat(self, ep: LocalEndpoint, proxy: ReaderProxy) -> bytes:
         ep.hb_count += 1

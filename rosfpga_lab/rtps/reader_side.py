@@ -8,7 +8,11 @@ it has, in arrival order. A reliable one delivers in sequence order: ``wp.next``
 waits for; samples ahead of it wait in ``wp.pending`` (bounded: MAX_OUT_OF_ORDER samples,
 MAX_OUT_OF_ORDER_BYTES, 256 numbers ahead); a GAP says which samples will never come (its range
 up to gapList.base, and the listed ones), and a range ahead of delivery is remembered in
-``wp.gaps`` until delivery gets there (``_drain``). ``_on_heartbeat`` answers a writer's HEARTBEAT
+``wp.gaps`` until delivery gets there (``_drain``). A GAP counts only up to what its writer
+announced (``wp.announced``: its HEARTBEATs' last, the DATA/DATA_FRAGs seen, in that datagram or
+before; ``_written_up_to``): past that it is ignored, so a spoofed GAP cannot skip samples not
+yet written (Cyclone DDS 11.0.1, PyPI, skips them: tests/benchmarks/bench_rtps_attacks.py, row
+gap). ``_on_heartbeat`` answers a writer's HEARTBEAT
 with an ACKNACK naming what is missing and NACK_FRAGs for partly received samples (RTPS 2.3
 8.4.12.2: a final HEARTBEAT only when something is missing, a final liveliness one never);
 ``_on_heartbeat_frag`` asks for the missing fragments of one sample with a NACK_FRAG. Both follow
@@ -123,22 +127,37 @@ class ReaderSide(EndpointDiscovery):
     def _gapped(wp: WriterProxy, seq: int) -> bool:
         return any(s <= seq < e for s, e in wp.gaps.items())
 
+    def _written_up_to(self, prefix: bytes, writer_id: int, reader_id: int, seq: int) -> None:
+        """Remote writer ``writer_id`` announced sample ``seq`` (its HEARTBEAT's last, or a
+        DATA/DATA_FRAG of it): a GAP may name it from now on."""
+        for _, wp in self._readers_of(prefix, writer_id, reader_id):
+            wp.announced = max(wp.announced, seq)
+
     def _on_gap(self, prefix: bytes, sub: Gap) -> None:
         for ep, wp in self._readers_of(prefix, sub.writer_id, sub.reader_id):
             if wp.next == 0:
                 continue
-            if sub.start <= wp.next < sub.list_base:
-                self._skip_to(ep, wp, sub.list_base)
-            elif wp.next < sub.start < sub.list_base:
+            # only samples the writer announced can be irrelevant: a GAP past its HEARTBEAT's
+            # last and past the data seen is cut there, else one spoofed GAP skips samples
+            # not yet written
+            end = min(sub.list_base, wp.announced + 1)
+            listed = [s for s in sub.listed if s <= wp.announced]
+            if end < sub.list_base or len(listed) < len(sub.listed):
+                self.note(f"gap-ahead-{ep.entity_id}", f"reader {ep.topic or 'SEDP'}: GAP from "
+                          f"{prefix.hex()} names samples past {wp.announced}, the last its writer "
+                          f"announced: those ignored")
+            if sub.start <= wp.next < end:
+                self._skip_to(ep, wp, end)
+            elif wp.next < sub.start < end:
                 # a later range (RTPS 2.3 8.3.7.4: gapStart .. gapList.base - 1 are irrelevant):
                 # remembered until delivery gets there, never asked for again
                 if sub.start in wp.gaps or len(wp.gaps) < MAX_OUT_OF_ORDER:
-                    wp.gaps[sub.start] = max(sub.list_base, wp.gaps.get(sub.start, 0))
+                    wp.gaps[sub.start] = max(end, wp.gaps.get(sub.start, 0))
                 else:
                     self.note(f"gaps-full-{ep.entity_id}", f"reader {ep.topic or 'SEDP'}: more "
                               f"than {MAX_OUT_OF_ORDER} GAP ranges ahead of delivery: later ones "
                               f"asked again")
-            for s in sub.listed:
+            for s in listed:
                 if s >= wp.next and s not in wp.pending and len(wp.pending) < MAX_OUT_OF_ORDER:
                     wp.pending[s] = None
             self._drain(ep, wp)
@@ -179,7 +198,7 @@ class ReaderSide(EndpointDiscovery):
         frags = self.assembler.missing(prefix, wp.writer_id, seq, last)[:256]
         if not frags:
             return []
-        wp.nackfrag_count += 1
+        wp.nackfrag_count = self._next_count()
         return [b.nack_frag(ep.entity_id, wp.writer_id, seq, frags, wp.nackfrag_count)]
 
     def _on_heartbeat(self, prefix: bytes, sub: Heartbeat) -> list[Send]:
@@ -200,7 +219,7 @@ class ReaderSide(EndpointDiscovery):
                 continue
             partial = set(self.assembler.partial(prefix, sub.writer_id))
             subs: list[bytes] = []
-            wp.acknack_count += 1
+            wp.acknack_count = self._next_count()
             subs.append(b.acknack(ep.entity_id, sub.writer_id, wp.next,
                                   [s for s in missing if s not in partial], wp.acknack_count,
                                   final=not missing))

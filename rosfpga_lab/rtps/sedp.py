@@ -35,11 +35,9 @@ class EndpointDiscovery(ParticipantBase):
 
     def _announce_endpoint(self, ep: LocalEndpoint) -> None:
         sedp = self.local[PUB_WRITER if ep.kind == "writer" else SUB_WRITER]
-        sedp.seq += 1
-        sedp.history[sedp.seq] = b.sedp_payload(self.guid_prefix + ep.guid_tail, ep.topic,
-                                                ep.type_name, ep.qos.reliable, ep.qos.depth,
-                                                b.Locator(*self.user), ep.qos.transient_local,
-                                                ep.type_hash)
+        self._keep(sedp, b.sedp_payload(self.guid_prefix + ep.guid_tail, ep.topic, ep.type_name,
+                                        ep.qos.reliable, ep.qos.depth, b.Locator(*self.user),
+                                        ep.qos.transient_local, ep.type_hash))
         for rem in list(self.remote.values()):
             self._try_match(ep, rem)
 
@@ -131,7 +129,8 @@ class EndpointDiscovery(ParticipantBase):
             # TRANSIENT_LOCAL both sides: a reader that joins late gets the history (KEEP_LAST
             # depth); a VOLATILE reader gets only what is written after it matched
             first = next(iter(ep.history))
-            proxy = ReaderProxy(key[0], key[1], rem.locator, rem.qos.reliable, first, acked=first)
+            proxy = ReaderProxy(key[0], key[1], rem.locator, rem.qos.reliable, first, acked=first,
+                                credit=ep.history_bytes)
             ep.proxies[key] = proxy
             subs: list[bytes] = []
             for seq, payload in ep.history.items():
@@ -141,7 +140,7 @@ class EndpointDiscovery(ParticipantBase):
             self._outbox += self._msg(proxy.locator, proxy.prefix, subs)
         elif ep.kind == "writer":
             ep.proxies[key] = ReaderProxy(key[0], key[1], rem.locator, rem.qos.reliable, ep.seq + 1,
-                                          acked=ep.seq + 1)
+                                          acked=ep.seq + 1, credit=ep.history_bytes)
         else:
             ep.proxies[key] = WriterProxy(key[0], key[1], rem.qos.reliable)
         self.note(f"match-{rem.guid.hex()}-{ep.entity_id}", f"matched: {what}")
