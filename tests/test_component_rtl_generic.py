@@ -1,0 +1,136 @@
+"""``--model rtl`` and ``--timing fpga`` for a generated circuit (issue 28 item 3): the LaserScan
+component with its generated top (the ``rtl/`` ``rosfpga-lab generate`` writes) simulated by the
+fast harness on the data path.
+
+* ``rosfpga-lab node data/fpga_laserscan_min.yaml --model rtl`` between a lab publisher and a
+  lab subscriber on loopback: every output body equals the Python model's output for one input,
+  byte for byte, and the refused scan (359 beams) is counted under the walk's status name;
+* ``timing="fpga"`` on the fast model: the circuit time the stats give is the RTL's own span of
+  the same frame (first byte in to last out, measured by the harness) at ``clock_mhz``, and
+  each output is held at least that long;
+* the configurations ``--model rtl`` cannot run are refused with a typed error that names them.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from proctools import interruptible, kill_if_running, stop_with
+from realros import require_rtl
+from rosfpga_lab.component import FpgaComponent
+from rosfpga_lab.component.errors import ComponentConfigError
+from rosfpga_lab.config import load_config
+from rosfpga_lab.graph import EmbeddedMaster, Node, call
+from rosfpga_lab.hw.msgpipeline import MessagePipeline
+from rosfpga_lab.msg import deserialize, serialize
+from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.sim import design_from_config
+from test_component_message import Collector, scan, sliding
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+SCAN = DATA / "fpga_laserscan_min.yaml"
+
+
+def _frame(reg, msg: dict) -> bytes:
+    body = serialize(reg, "sensor_msgs/LaserScan", msg)
+    return len(body).to_bytes(4, "little") + body
+
+
+@pytest.mark.rtl
+def test_laserscan_node_command_with_the_generated_verilog_is_exact(tmp_path) -> None:
+    require_rtl("verilator")
+    config = load_config(SCAN)
+    reg = config.registry()
+    pipe = MessagePipeline.from_config(config)
+    good = [scan(k) for k in range(6)]
+    with EmbeddedMaster(port=0) as master:
+        node = subprocess.Popen(
+            [sys.executable, "-m", "rosfpga_lab", "node", str(SCAN), "--master-uri", master.uri,
+             "--model", "rtl", "--input-queue", "16", "--output-queue", "16",
+             "--status-interval", "0"],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path,
+            preexec_fn=interruptible)
+        src = Node("/scanner", master=master, registry=reg)
+        out = Collector(master, "/scan_min", "sensor_msgs/LaserScan", reg)
+        try:
+            pub = src.advertise("/scan", "sensor_msgs/LaserScan", queue_size=0)
+            deadline = time.monotonic() + 120          # the first run compiles the circuit
+            while time.monotonic() < deadline and node.poll() is None:
+                subscribers = call(master.uri, "getSystemState", "/t")[2][1]
+                if any(t == "/scan_min" and len(n) for t, n in subscribers) and \
+                        pub.wait_for_subscribers(1, 0.1):
+                    break
+                time.sleep(0.1)
+            else:
+                raise AssertionError(f"the node never came up: {node.communicate(timeout=10)}")
+            sent = [good[0], scan(9, n=359), *good[1:]]   # the second: 359 beams, refused
+            for msg in sent:
+                pub.publish(msg)
+                time.sleep(0.02)
+            assert out.wait(len(good), 30), node.poll()
+            stdout, stderr = stop_with(node, signal.SIGINT)
+        finally:
+            out.node.shutdown()
+            src.shutdown()
+            kill_if_running(node)
+    assert node.returncode == 0, stderr
+    assert len(out.bodies) == len(good)
+    for msg, body in zip(good, out.bodies):
+        assert body == pipe.process(_frame(reg, msg)).output_frame[4:]      # every byte
+        got = np.asarray(deserialize(reg, "sensor_msgs/LaserScan", body)["ranges"])
+        assert got.tobytes() == sliding(msg["ranges"], 5, np.min).tobytes()  # numpy's minimum
+    assert "(rtl model, host timing)" in stdout
+    assert f"published {len(good)}, refused 1" in stdout, stdout
+    assert "SUB_BAD_RANGES_LENGTH" in stdout, stdout
+
+
+@pytest.mark.rtl
+def test_fpga_timing_of_a_generated_circuit_is_the_rtl_span_at_its_clock() -> None:
+    require_rtl("verilator")
+    from rosfpga_lab.rtl.server import RtlServer
+
+    config = replace(load_config(SCAN), clock_mhz=1.0)    # 1 MHz: a few ms a scan
+    reg = config.registry()
+    frame = _frame(reg, scan(3))
+    with RtlServer(config) as server:
+        span = server.process(frame).span                  # the Verilog's clocks, measured
+    assert span > len(frame)
+    with EmbeddedMaster(port=0) as master:
+        comp = FpgaComponent(config, master=master, timing="fpga", output_queue=8).start()
+        src = Node("/scanner", master=master, registry=reg)
+        pub = src.advertise("/scan", "sensor_msgs/LaserScan", queue_size=0)
+        out = Collector(master, "/scan_min", "sensor_msgs/LaserScan", reg)
+        try:
+            assert pub.wait_for_subscribers(1, 10) and comp.wait_for_subscribers(1, 10)
+            pub.publish_body(frame[4:])
+            assert out.wait(1, 10)
+            st = comp.stats
+        finally:
+            out.node.shutdown()
+            src.shutdown()
+            comp.stop()
+    assert st.circuit_time_s == pytest.approx(span / 1e6, rel=1e-9), st.report()
+    assert st.latency.count == 1 and min(comp.latency_samples()) >= span / 1e6
+    assert "timing: fpga" in st.report()
+
+
+def test_model_rtl_refuses_a_cdr_configuration_and_a_custom_application(tmp_path) -> None:
+    cdr = load_config(DATA / "fpga_laserscan_min_cdr.yaml")
+    with pytest.raises(ComponentConfigError, match=r"fpga_laserscan_min_cdr.yaml has wire: cdr.*"
+                                                   r"wire: tcpros"):
+        FpgaComponent(cdr, model="rtl")
+    text = SCAN.read_text().replace("application: {op: erode, ksize: 5}",
+                                    "application: {op: custom, source: mine.cpp}")
+    (tmp_path / "mine.cpp").write_text("// the user's application\n")
+    (tmp_path / "custom_scan.yaml").write_text(text)
+    custom = load_config(tmp_path / "custom_scan.yaml")
+    with pytest.raises(RtlError, match="custom_scan.yaml: application.op is custom.*fast"):
+        design_from_config(custom)
