@@ -134,3 +134,41 @@ def test_model_rtl_refuses_a_cdr_configuration_and_a_custom_application(tmp_path
     custom = load_config(tmp_path / "custom_scan.yaml")
     with pytest.raises(RtlError, match="custom_scan.yaml: application.op is custom.*fast"):
         design_from_config(custom)
+
+
+@pytest.mark.rtl
+def test_rtl_sim_of_generated_tops_is_exact_and_fails_on_a_wrong_byte(
+        tmp_path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``rosfpga-lab rtl sim CONFIG`` runs the generated top on generate's test frames (TCPROS
+    frames or CDR records) and compares with the models; a byte off is a FAIL naming it."""
+    from rosfpga_lab.cli import main
+    from rosfpga_lab.rtl.project import test_frames
+
+    sim = require_rtl("iverilog")
+    for name in ("fpga_laserscan_min", "fpga_samples_dilate_cdr"):
+        assert main(["rtl", "sim", str(DATA / f"{name}.yaml"), "--simulator", sim,
+                     "--bp", "300", "--gap", "100"]) == 0
+        out = capsys.readouterr().out
+        assert "PASS: the output equals the Python models' output" in out, out
+        assert out.count(": SUB_OK") == 2 and "clocks" in out, out
+    assert "frame at byte 386: SUB_BAD_ENCAPSULATION" in out      # the walk's own status names
+    frames, expected = test_frames(load_config(SCAN))
+    wrong = bytearray(expected)
+    wrong[100] ^= 1
+    (tmp_path / "wrong.bin").write_bytes(bytes(wrong))
+    assert main(["rtl", "sim", str(SCAN), "--simulator", sim, "--expected",
+                 str(tmp_path / "wrong.bin")]) == 1
+    assert "FAIL: the output differs from the expected bytes at byte 100" in capsys.readouterr().out
+
+
+def test_rtl_sim_of_a_custom_application_is_a_clear_error(tmp_path, capsys) -> None:
+    from rosfpga_lab.cli import main
+
+    text = SCAN.read_text().replace("application: {op: erode, ksize: 5}",
+                                    "application: {op: custom, source: mine.cpp}")
+    (tmp_path / "mine.cpp").write_text("// the user's application\n")
+    (tmp_path / "custom_scan.yaml").write_text(text)
+    assert main(["rtl", "sim", str(tmp_path / "custom_scan.yaml")]) == 1
+    err = capsys.readouterr().err
+    assert "rosfpga-lab rtl: error:" in err and "custom_scan.yaml: application.op is custom" in err
+    assert "Traceback" not in err

@@ -259,12 +259,12 @@ def run_sim(args: argparse.Namespace) -> int:
     """Simulate, compare, report."""
     from rosfpga_lab.errors import LabError
     from rosfpga_lab.config import load_config
-    from rosfpga_lab.hls import sample_frames
-    from rosfpga_lab.hw import Pipeline, PipelineError
-    from rosfpga_lab.rtl import build, rtl_params, run
+    from rosfpga_lab.rtl import RtlParams, build, run
+    from rosfpga_lab.rtl.project import model_output, test_frames
+    from rosfpga_lab.rtl.sim import design_from_config
 
     config = load_config(args.config)
-    params = rtl_params(config)
+    params = design_from_config(config)     # Image on TCPROS: the hand circuit; else generated
     if args.input is not None:
         try:
             frames = args.input.read_bytes()
@@ -272,15 +272,17 @@ def run_sim(args: argparse.Namespace) -> int:
             raise LabError(f"cannot read {args.input}: {exc.strerror}") from None
         expected = None
     else:
-        frames, expected = sample_frames(config)
+        frames, expected = test_frames(config)
     if args.expected is not None:
         try:
             expected = args.expected.read_bytes()
         except OSError as exc:
             raise LabError(f"cannot read {args.expected}: {exc.strerror}") from None
     if expected is None:
-        expected = _model_output(Pipeline.from_config(config), frames, PipelineError)
-    _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ...")
+        expected = model_output(config, frames)
+    _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ..."
+         if isinstance(params, RtlParams) else f"building the generated {config.subscriber.type} "
+         f"circuit on {config.wire} ({params.op}) ...")
     sim = build(params, simulator=_pick_simulator(args.simulator, len(frames)),
                 trace=args.vcd is not None, cache=not args.no_cache)
     how = f"built with {sim.simulator} in {sim.seconds:.1f} s" if sim.seconds else \
@@ -306,19 +308,6 @@ def run_sim(args: argparse.Namespace) -> int:
     print(f"FAIL: the output differs from the expected bytes at byte {diff} "
           f"({len(result.output):,} bytes out, {len(expected):,} expected)")
     return 1
-
-
-def _model_output(pipe, frames: bytes, error: type[BaseException]) -> bytes:
-    """The Python models' output for a stream of frames (refused ones give nothing)."""
-    out, pos = b"", 0
-    while pos + 4 <= len(frames):
-        size = 4 + int.from_bytes(frames[pos:pos + 4], "little")
-        try:
-            out += pipe.process(frames[pos:pos + size]).output_frame
-        except error:
-            pass
-        pos += size
-    return out
 
 
 def run_cycles(args: argparse.Namespace) -> int:
