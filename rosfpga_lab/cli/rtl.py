@@ -65,12 +65,15 @@ def _register_sim(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "sim", help="simulate the RTL on TCPROS frames and compare with the Python models",
         description="Simulate the Verilog of the component CONFIG describes (subscriber, "
-        "fifo2axi, application, axi2fifo, publisher and FIFOs) on TCPROS frames, with random "
+        "fifo2axi, application, axi2fifo, publisher and FIFOs; for any type but "
+        "sensor_msgs/Image on TCPROS the generated top that 'rosfpga-lab generate' writes) on "
+        "its test frames (TCPROS frames, or CDR records for wire: cdr), with random "
         "input gaps and output backpressure if asked, and compare every output byte with the "
         "Python models' output (or --expected). Exit status 1 on any difference.")
     _common(parser)
     parser.add_argument("--input", type=Path, metavar="FRAMES",
-                        help="TCPROS frames (default: the configuration's test frame)")
+                        help="TCPROS frames or CDR records (default: the configuration's test "
+                        "frames, generate's tb_input.bin)")
     parser.add_argument("--expected", type=Path, metavar="FILE",
                         help="the bytes the output must equal (default: the Python models' output)")
     parser.add_argument("-o", "--output", type=Path, metavar="FILE", help="write the output bytes here")

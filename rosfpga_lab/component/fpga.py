@@ -132,10 +132,14 @@ class FpgaComponent:
         master_uri: the master to use instead of the configuration's ``node.master_uri``.
         master: an :class:`~rosfpga_lab.graph.EmbeddedMaster` to use (overrides both).
         model: ``"fast"`` (numpy), ``"reference"`` (one byte or beat at a time; small images)
-            or ``"rtl"`` (the Verilog itself, in a long-lived simulator: :mod:`rosfpga_lab.rtl.server`).
+            or ``"rtl"`` (the Verilog itself, in a long-lived simulator: :mod:`rosfpga_lab.rtl.server`;
+            for any type but Image the generated top ``rosfpga-lab generate`` writes; TCPROS
+            configurations only: ``wire: cdr`` is refused).
         timing: ``"host"`` (publish as soon as the data path is done) or ``"fpga"`` (publish
             when the circuit's clocks for the frame at ``clock_mhz`` have passed since it
-            arrived, or since the circuit became free; the input queue is then 1 deep, as the
+            arrived, or since the circuit became free -- Image's cycle model, any other type's
+            generated walk (:func:`rosfpga_lab.hls.program.frame_clocks`), or with ``"rtl"`` the
+            simulated clocks; the input queue is then 1 deep, as the
             input FIFO and the socket hold one waiting frame: a newer frame replaces it and the
             older one is counted in :attr:`ComponentStats.dropped_input`).
         input_queue: frames waiting in front of the circuit (see module docstring).

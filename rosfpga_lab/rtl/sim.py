@@ -2,7 +2,9 @@
 
 How this works: :func:`write_sources` copies the Verilog of ``verilog/`` and the testbench
 ``tb/rfl_tb.v`` into a directory and writes ``rfl_node.v`` (``rfl_top`` with the node
-configuration's parameters). :func:`build` compiles them once (``iverilog -g2005`` to a ``vvp``
+configuration's parameters); for any other type than ``sensor_msgs/Image`` on TCPROS it writes
+the generated top instead, the ``rtl/`` of ``rosfpga-lab generate`` (:data:`Design`,
+:func:`design_from_config`), with the same testbench and harness. :func:`build` compiles them once (``iverilog -g2005`` to a ``vvp``
 program, or ``verilator --binary`` to a native one); :func:`run` writes the frames to a file,
 runs the simulation and reads back what the testbench wrote: the output bytes, the
 subscriber's status per frame and, per stream, the clocks of its first and last handshake.
