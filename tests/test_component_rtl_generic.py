@@ -93,7 +93,9 @@ def test_laserscan_node_command_with_the_generated_verilog_is_exact(tmp_path) ->
 
 
 @pytest.mark.rtl
-def test_fpga_timing_of_a_generated_circuit_is_the_rtl_span_at_its_clock() -> None:
+@pytest.mark.parametrize("model", ["fast", "rtl"])
+def test_fpga_timing_of_a_generated_circuit_is_the_rtl_span_at_its_clock(model) -> None:
+    """The fast model's clocks (the walk's cycle model) and the simulated Verilog's agree."""
     require_rtl("verilator")
     from rosfpga_lab.rtl.server import RtlServer
 
@@ -104,7 +106,8 @@ def test_fpga_timing_of_a_generated_circuit_is_the_rtl_span_at_its_clock() -> No
         span = server.process(frame).span                  # the Verilog's clocks, measured
     assert span > len(frame)
     with EmbeddedMaster(port=0) as master:
-        comp = FpgaComponent(config, master=master, timing="fpga", output_queue=8).start()
+        comp = FpgaComponent(config, master=master, timing="fpga", output_queue=8,
+                             model=model).start()
         src = Node("/scanner", master=master, registry=reg)
         pub = src.advertise("/scan", "sensor_msgs/LaserScan", queue_size=0)
         out = Collector(master, "/scan_min", "sensor_msgs/LaserScan", reg)
