@@ -132,9 +132,10 @@ class FpgaComponent:
         master_uri: the master to use instead of the configuration's ``node.master_uri``.
         master: an :class:`~rosfpga_lab.graph.EmbeddedMaster` to use (overrides both).
         model: ``"fast"`` (numpy), ``"reference"`` (one byte or beat at a time; small images)
-            or ``"rtl"`` (the Verilog itself, in a long-lived simulator: :mod:`rosfpga_lab.rtl.server`;
-            for any type but Image the generated top ``rosfpga-lab generate`` writes; TCPROS
-            configurations only: ``wire: cdr`` is refused).
+            or ``"rtl"`` (the Verilog itself, in a long-lived simulator:
+            :mod:`rosfpga_lab.rtl.server`; for any type but Image the generated top
+            ``rosfpga-lab generate`` writes; TCPROS configurations only: ``wire: cdr`` is
+            refused).
         timing: ``"host"`` (publish as soon as the data path is done) or ``"fpga"`` (publish
             when the circuit's clocks for the frame at ``clock_mhz`` have passed since it
             arrived, or since the circuit became free -- Image's cycle model, any other type's
@@ -211,6 +212,8 @@ class FpgaComponent:
         if model == RTL_MODEL:
             from rosfpga_lab.rtl.server import RtlServer
 
+            log.info("building the Verilog of %s's circuit on Verilator (seconds the first "
+                     "time, then cached) ...", config.subscriber.type)
             try:
                 self._rtl = RtlServer(config)
             except LabError as exc:

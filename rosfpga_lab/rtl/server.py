@@ -3,11 +3,12 @@
 How this works: :class:`RtlServer` builds (or takes from the cache) the fast harness of
 :mod:`rosfpga_lab.rtl.sim` for a node configuration -- the hand-written Image circuit, or for
 any other type the generated top, the same ``rtl/`` ``rosfpga-lab generate`` writes and its
-``make rtlsim`` runs (:func:`rosfpga_lab.rtl.sim.design_from_config`) -- and starts it once in serve mode
-(``rfl_fast --serve``). Each :meth:`RtlServer.process` call writes one request (``RFLQ``, the
-length, the TCPROS frame) to its standard input and reads the reply (``RFLR``: flags, clocks,
-span, the statuses the subscriber decided and the bytes the circuit sent). The circuit keeps
-its state between frames, as the board does (the publisher's sequence number counts on).
+``make rtlsim`` runs (:func:`rosfpga_lab.rtl.sim.design_from_config`) -- and starts it once in
+serve mode (``rfl_fast --serve``). Each :meth:`RtlServer.process` call writes one request
+(``RFLQ``, the length, the TCPROS frame) to its standard input and reads the reply (``RFLR``:
+flags, clocks, span, the statuses the subscriber decided and the bytes the circuit sent). The
+circuit keeps its state between frames, as the board does (the publisher's sequence number
+counts on).
 """
 
 from __future__ import annotations

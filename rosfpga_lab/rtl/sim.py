@@ -4,8 +4,9 @@ How this works: :func:`write_sources` copies the Verilog of ``verilog/`` and the
 ``tb/rfl_tb.v`` into a directory and writes ``rfl_node.v`` (``rfl_top`` with the node
 configuration's parameters); for any other type than ``sensor_msgs/Image`` on TCPROS it writes
 the generated top instead, the ``rtl/`` of ``rosfpga-lab generate`` (:data:`Design`,
-:func:`design_from_config`), with the same testbench and harness. :func:`build` compiles them once (``iverilog -g2005`` to a ``vvp``
-program, or ``verilator --binary`` to a native one); :func:`run` writes the frames to a file,
+:func:`design_from_config`), with the same testbench and harness. :func:`build` compiles them
+once (``iverilog -g2005`` to a ``vvp`` program, or ``verilator --binary`` to a native one);
+:func:`run` writes the frames to a file,
 runs the simulation and reads back what the testbench wrote: the output bytes, the
 subscriber's status per frame and, per stream, the clocks of its first and last handshake.
 The testbench drives the input with random gaps and the output with random backpressure
@@ -162,7 +163,7 @@ def source_files(params: Design, *, note: str = "",
         params: the configuration's parameters, or a generated top's spec.
         note: a comment line for ``rfl_node.v`` (the hand circuit's; a generated top's names
             its configuration).
-        extra_sources: further Verilog files (a module the package lacks).
+        extra_sources: further Verilog files (a module the package lacks; the hand circuit's).
 
     Returns:
         ``{file name: bytes}``.
