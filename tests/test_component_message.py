@@ -297,17 +297,25 @@ rospy.signal_shutdown("done")
 """
 
 
+#: The component's data path in the real-ROS tests: the Python model, and the generated circuit's
+#: Verilog in the fast harness (``--model rtl``, issue 28 item 3).
+MODELS = ["fast", pytest.param("rtl", marks=pytest.mark.rtl)]
+
+
 @pytest.mark.ros
+@pytest.mark.parametrize("model", MODELS)
 def test_real_rospy_with_genpys_dynamic_classes_talks_to_the_custom_component(
-        rosmaster_uri, tmp_path) -> None:
+        model, rosmaster_uri, tmp_path) -> None:
     import subprocess
 
-    from realros import ROS_PYTHON, ros_env
+    from realros import ROS_PYTHON, require_rtl, ros_env
 
+    if model == "rtl":
+        require_rtl("verilator")
     config = load_config(SAMPLES_CONFIG)
     # queues as deep as the run: this test is about every message coming out right
     comp = FpgaComponent.from_config(config, master_uri=rosmaster_uri, input_queue=16,
-                                     output_queue=16).start()
+                                     output_queue=16, model=model).start()
     rng = np.random.default_rng(5)
     bursts = [rng.integers(-1000, 1000, 64).tolist() for _ in range(3)]
     spec = {"full_text": config.registry().full_text("lab_msgs/Samples"), "bursts": bursts}
@@ -345,16 +353,21 @@ def _laserscan_by_hand(body: bytes) -> dict:
 
 
 @pytest.mark.ros
+@pytest.mark.parametrize("model", MODELS)
 def test_real_roscpp_laserscans_through_the_component_come_out_min_filtered_exactly(
-        rosmaster_uri, tmp_path) -> None:
+        model, rosmaster_uri, tmp_path) -> None:
     """Issue 19 item 5: a real roscpp program (Debian's sensor_msgs/LaserScan.h) publishes to
     the LaserScan component on a real rosmaster and receives its output: a 359-beam scan is
     refused by name, every good one comes out as numpy's sliding minimum, the rest carried."""
     import subprocess
 
-    from realros import ROS_PROGRAMS, build_roscpp_program, finish, ros_env, stop_process
+    from realros import (
+        ROS_PROGRAMS, build_roscpp_program, finish, require_rtl, ros_env, stop_process,
+    )
 
     require_ros()
+    if model == "rtl":
+        require_rtl("verilator")
     binary = build_roscpp_program(ROS_PROGRAMS / "scan_roscpp_pubsub.cpp")
     rng = np.random.default_rng(19)
     scans = [rng.uniform(0.1, 30, 359).astype(np.float32)]            # refused: 359 beams
@@ -364,7 +377,7 @@ def test_real_roscpp_laserscans_through_the_component_come_out_min_filtered_exac
     infile.write_bytes(b"".join(struct.pack("<I", len(s)) + s.tobytes() for s in scans))
     good = len(scans) - 1
     comp = FpgaComponent.from_config(SCAN_CONFIG, master_uri=rosmaster_uri, input_queue=8,
-                                     output_queue=8).start()
+                                     output_queue=8, model=model).start()
     proc = subprocess.Popen([str(binary), "/scan", "/scan_min", str(infile), str(good),
                              str(outfile), "20"], env=ros_env(rosmaster_uri, tmp_path),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
@@ -382,7 +395,9 @@ def test_real_roscpp_laserscans_through_the_component_come_out_min_filtered_exac
         pos += 4 + n
     assert len(bodies) == good, stats.report()
     assert (stats.published, stats.refused) == (good, 1)
-    assert stats.refused_reasons == {"ranges length: not what the circuit was built for": 1}
+    assert stats.refused_reasons == {
+        "fast": {"ranges length: not what the circuit was built for": 1},
+        "rtl": {"circuit status 4: SUB_BAD_RANGES_LENGTH": 1}}[model]
     for body in bodies:
         got = _laserscan_by_hand(body)
         k = got["stamp"][1]                       # the program stamps scan k with (100 + k, k)

@@ -65,12 +65,15 @@ def _register_sim(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "sim", help="simulate the RTL on TCPROS frames and compare with the Python models",
         description="Simulate the Verilog of the component CONFIG describes (subscriber, "
-        "fifo2axi, application, axi2fifo, publisher and FIFOs) on TCPROS frames, with random "
+        "fifo2axi, application, axi2fifo, publisher and FIFOs; for any type but "
+        "sensor_msgs/Image on TCPROS the generated top that 'rosfpga-lab generate' writes) on "
+        "its test frames (TCPROS frames, or CDR records for wire: cdr), with random "
         "input gaps and output backpressure if asked, and compare every output byte with the "
         "Python models' output (or --expected). Exit status 1 on any difference.")
     _common(parser)
     parser.add_argument("--input", type=Path, metavar="FRAMES",
-                        help="TCPROS frames (default: the configuration's test frame)")
+                        help="TCPROS frames or CDR records (default: the configuration's test "
+                        "frames, generate's tb_input.bin)")
     parser.add_argument("--expected", type=Path, metavar="FILE",
                         help="the bytes the output must equal (default: the Python models' output)")
     parser.add_argument("-o", "--output", type=Path, metavar="FILE", help="write the output bytes here")
@@ -259,12 +262,12 @@ def run_sim(args: argparse.Namespace) -> int:
     """Simulate, compare, report."""
     from rosfpga_lab.errors import LabError
     from rosfpga_lab.config import load_config
-    from rosfpga_lab.hls import sample_frames
-    from rosfpga_lab.hw import Pipeline, PipelineError
-    from rosfpga_lab.rtl import build, rtl_params, run
+    from rosfpga_lab.rtl import RtlParams, build, run
+    from rosfpga_lab.rtl.project import model_output, test_frames
+    from rosfpga_lab.rtl.sim import design_from_config
 
     config = load_config(args.config)
-    params = rtl_params(config)
+    params = design_from_config(config)     # Image on TCPROS: the hand circuit; else generated
     if args.input is not None:
         try:
             frames = args.input.read_bytes()
@@ -272,15 +275,17 @@ def run_sim(args: argparse.Namespace) -> int:
             raise LabError(f"cannot read {args.input}: {exc.strerror}") from None
         expected = None
     else:
-        frames, expected = sample_frames(config)
+        frames, expected = test_frames(config)
     if args.expected is not None:
         try:
             expected = args.expected.read_bytes()
         except OSError as exc:
             raise LabError(f"cannot read {args.expected}: {exc.strerror}") from None
     if expected is None:
-        expected = _model_output(Pipeline.from_config(config), frames, PipelineError)
-    _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ...")
+        expected = model_output(config, frames)
+    _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ..."
+         if isinstance(params, RtlParams) else f"building the generated {config.subscriber.type} "
+         f"circuit on {config.wire} ({params.op}) ...")
     sim = build(params, simulator=_pick_simulator(args.simulator, len(frames)),
                 trace=args.vcd is not None, cache=not args.no_cache)
     how = f"built with {sim.simulator} in {sim.seconds:.1f} s" if sim.seconds else \
@@ -306,19 +311,6 @@ def run_sim(args: argparse.Namespace) -> int:
     print(f"FAIL: the output differs from the expected bytes at byte {diff} "
           f"({len(result.output):,} bytes out, {len(expected):,} expected)")
     return 1
-
-
-def _model_output(pipe, frames: bytes, error: type[BaseException]) -> bytes:
-    """The Python models' output for a stream of frames (refused ones give nothing)."""
-    out, pos = b"", 0
-    while pos + 4 <= len(frames):
-        size = 4 + int.from_bytes(frames[pos:pos + 4], "little")
-        try:
-            out += pipe.process(frames[pos:pos + size]).output_frame
-        except error:
-            pass
-        pos += size
-    return out
 
 
 def run_cycles(args: argparse.Namespace) -> int:

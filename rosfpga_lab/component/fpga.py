@@ -44,11 +44,10 @@ from rosfpga_lab.component.stats import ComponentStats, LatencyWindow, fps_meter
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.config import master_uri as pick_master_uri
 from rosfpga_lab.config.limits import IMAGE_TYPE
-from rosfpga_lab.config.vocabulary import MODELS, RTL_MODEL, TIMINGS
+from rosfpga_lab.config.vocabulary import CDR_WIRE, MODELS, RTL_MODEL, TIMINGS
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
 from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineResult
-from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
 
 log = logging.getLogger("rosfpga_lab.component")
@@ -133,10 +132,15 @@ class FpgaComponent:
         master_uri: the master to use instead of the configuration's ``node.master_uri``.
         master: an :class:`~rosfpga_lab.graph.EmbeddedMaster` to use (overrides both).
         model: ``"fast"`` (numpy), ``"reference"`` (one byte or beat at a time; small images)
-            or ``"rtl"`` (the Verilog itself, in a long-lived simulator: :mod:`rosfpga_lab.rtl.server`).
+            or ``"rtl"`` (the Verilog itself, in a long-lived simulator:
+            :mod:`rosfpga_lab.rtl.server`; for any type but Image the generated top
+            ``rosfpga-lab generate`` writes; TCPROS configurations only: ``wire: cdr`` is
+            refused).
         timing: ``"host"`` (publish as soon as the data path is done) or ``"fpga"`` (publish
             when the circuit's clocks for the frame at ``clock_mhz`` have passed since it
-            arrived, or since the circuit became free; the input queue is then 1 deep, as the
+            arrived, or since the circuit became free -- Image's cycle model, any other type's
+            generated walk (:func:`rosfpga_lab.hls.program.frame_clocks`), or with ``"rtl"`` the
+            simulated clocks; the input queue is then 1 deep, as the
             input FIFO and the socket hold one waiting frame: a newer frame replaces it and the
             older one is counted in :attr:`ComponentStats.dropped_input`).
         input_queue: frames waiting in front of the circuit (see module docstring).
@@ -177,11 +181,12 @@ class FpgaComponent:
             raise ComponentConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
         if timing not in TIMINGS:
             raise ComponentConfigError(f"timing must be one of {', '.join(TIMINGS)}, got {timing!r}")
-        if model == RTL_MODEL and not config.is_image:
+        if model == RTL_MODEL and config.wire == CDR_WIRE:
             raise ComponentConfigError(
-                f"--model rtl runs the {IMAGE_TYPE} Verilog only; {config.subscriber.type} runs "
-                "on the fast or reference model (its generated Verilog: rosfpga-lab generate, "
-                "make rtlsim)")
+                f"{config.path or 'the configuration'} has wire: cdr, whose circuit reads CDR "
+                "samples (ROS 2); this ROS 1 node feeds its circuit TCPROS frames: for --model "
+                "rtl use a copy with wire: tcpros (or leave wire out), or run this one with "
+                "--model fast")
         try:   # with model="rtl" the fast model still names the operation and sets its limits
             self.registry = config.registry()
             pmodel = "fast" if model == RTL_MODEL else model
@@ -194,9 +199,21 @@ class FpgaComponent:
         self._clock_hz = config.clock_mhz * 1e6
         self._busy_until = 0.0      # time.time() when the circuit is free again (timing fpga)
         self._rtl: Any = None
+        # any type but Image: the generated walk, whose clocks per frame are the timing (a
+        # configuration the generator refuses, e.g. another publisher type, keeps the model's)
+        self._program: Any = None
+        if not config.is_image:
+            from rosfpga_lab.hls.generic import spec_from_config
+
+            try:
+                self._program = spec_from_config(config).program
+            except LabError:
+                pass
         if model == RTL_MODEL:
             from rosfpga_lab.rtl.server import RtlServer
 
+            log.info("building the Verilog of %s's circuit on Verilator (seconds the first "
+                     "time, then cached) ...", config.subscriber.type)
             try:
                 self._rtl = RtlServer(config)
             except LabError as exc:
@@ -343,10 +360,24 @@ class FpgaComponent:
                 self._observers.remove(callback)
 
     # ------------------------------------------------------------------ the data path
+    def _clocks(self, frame: bytes, result: PipelineResult | MessageResult) -> int:
+        """The circuit's clocks for ``frame``: Image's cycle model (``hw.cycles``), any other
+        type's generated walk, first byte in to last byte out
+        (:func:`rosfpga_lab.hls.program.frame_clocks`, equal to the RTL's clock for clock)."""
+        if self._program is None:
+            return result.total_cycles
+        from rosfpga_lab.hls.program import Refused, frame_clocks
+
+        try:
+            return frame_clocks(self._program, frame).total
+        except Refused:     # the walk and the model disagree: keep the model's stages' sum
+            return result.total_cycles
+
     def _hold(self, info: MessageInfo, clocks: int) -> None:
         """Timing ``fpga``: wait until ``clocks`` at the circuit's clock have passed since the
         frame arrived (or since the circuit became free)."""
-        self._last_clocks = clocks
+        if clocks:
+            self._last_clocks = clocks
         if self.timing != "fpga":
             return
         with self._lock:   # one circuit, whichever connection the frame came on
@@ -369,7 +400,7 @@ class FpgaComponent:
             self._refuse(exc, frame, info)
             return
         t1 = time.perf_counter()
-        self._hold(info, result.total_cycles)
+        self._hold(info, self._clocks(frame, result))
         self._pub.publish_body(memoryview(result.output_frame)[4:])
         now = time.time()
         for problem in result.status:
@@ -406,7 +437,7 @@ class FpgaComponent:
             self._hold(info, got.clocks)
             code = refused[0] if refused else -1
             if code >= 0:
-                name, field = SUBSCRIBER_STATUSES[code]
+                name, field = got.name(code)
                 self._count_refusal(f"circuit status {code} ({name}): bad {field}",
                                     f"circuit status {code}: {name}", frame, info)
             else:
@@ -554,8 +585,7 @@ class FpgaComponent:
                 publishers=sub_stats.connections if sub_stats else 0,
                 latency=self._latency.summary(), process_time=self._process.summary(),
                 since_stamp=self._since_stamp.summary(),
-                circuit_time_s=(last.frame_time_s if last is not None and self._rtl is None
-                                else self._last_clocks / self._clock_hz if self._last_clocks
+                circuit_time_s=(self._last_clocks / self._clock_hz if self._last_clocks
                                 else float("nan")),
                 timing=self.timing, model=self.model,
                 cycles=dict(last.cycles) if last is not None else {},

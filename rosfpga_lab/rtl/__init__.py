@@ -16,19 +16,20 @@ Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
 :mod:`rosfpga_lab.rtl.timing` places and routes them with nextpnr-ecp5 (Fmax against the clock) and
 :mod:`rosfpga_lab.rtl.sloc` counts their lines for the paper's Table 1. A message type other
 than ``sensor_msgs/Image`` gets the generic circuit of :mod:`rosfpga_lab.rtl.generic` (walkers
-stepping through a generated program, one instruction per field of the message).
+stepping through a generated program, one instruction per field of the message), which
+:func:`build` and :func:`run` simulate the same way (``build(design_from_config(config))``).
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
 from rosfpga_lab.rtl.params import OP_CODES, RtlParams, load_config, node_wrapper, rtl_params, status_header
 from rosfpga_lab.rtl.sim import (
-    SIMULATORS, STREAMS, RtlBuild, RtlResult, StreamTiming, build, find_simulator, run,
-    simulator_missing_reason, verilog_sources, write_sources,
+    SIMULATORS, STREAMS, Design, RtlBuild, RtlResult, StreamTiming, build, design_from_config,
+    find_simulator, run, simulator_missing_reason, verilog_sources, write_sources,
 )
 
 __all__ = [
-    "OP_CODES", "SIMULATORS", "STREAMS", "RtlBuild", "RtlError", "RtlParams", "RtlResult",
-    "SimulatorMissingError", "StreamTiming", "build", "find_simulator", "load_config",
-    "node_wrapper", "rtl_params", "run", "simulator_missing_reason", "status_header",
-    "verilog_sources", "write_sources",
+    "OP_CODES", "SIMULATORS", "STREAMS", "Design", "RtlBuild", "RtlError", "RtlParams",
+    "RtlResult", "SimulatorMissingError", "StreamTiming", "build", "design_from_config",
+    "find_simulator", "load_config", "node_wrapper", "rtl_params", "run",
+    "simulator_missing_reason", "status_header", "verilog_sources", "write_sources",
 ]

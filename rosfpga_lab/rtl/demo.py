@@ -7,6 +7,11 @@ first refused for its width, the second good), the simulator settings (random in
 notebook runs this live; without one it reads the shipped dump, made by Icarus Verilog::
 
     python data/make_rtl_demo_dump.py            # rewrites data/rtl_demo.vcd (needs iverilog)
+
+:func:`run_demo` takes any other configuration too: its circuit is
+:func:`~rosfpga_lab.rtl.sim.design_from_config`'s (a generated top for any type but Image on
+TCPROS) and its frames generate's test frames (a good one, a refused one, another good one),
+with the same testbench and dump.
 """
 
 from __future__ import annotations
@@ -16,8 +21,8 @@ from pathlib import Path
 from rosfpga_lab.config import NodeConfig, parse_config
 from rosfpga_lab.hls import sample_image
 from rosfpga_lab.hw import image_frame
-from rosfpga_lab.rtl.params import rtl_params
-from rosfpga_lab.rtl.sim import RtlResult, build, run
+from rosfpga_lab.rtl.params import RtlParams
+from rosfpga_lab.rtl.sim import RtlResult, build, design_from_config, run
 
 #: The circuit of the demo: the paper's dilate on a frame small enough to read clock by clock.
 DEMO_YAML = """\
@@ -57,15 +62,24 @@ def demo_frames(config: NodeConfig | None = None) -> tuple[bytes, bytes]:
 def run_demo(vcd: str | Path | None = None, *, simulator: str | None = None,
              config: NodeConfig | None = None, gap: int = DEMO_GAP, bp: int = DEMO_BP,
              seed: int = DEMO_SEED) -> RtlResult:
-    """Build and simulate the demo circuit on :func:`demo_frames`, optionally dumping a VCD.
+    """Build and simulate the demo circuit on :func:`demo_frames` (another configuration's
+    circuit on its test frames, see the module docstring), optionally dumping a VCD.
 
     Raises:
-        SimulatorMissingError: no simulator; RtlError: the simulation failed.
+        SimulatorMissingError: no simulator; RtlError: the configuration has no RTL
+        (:func:`~rosfpga_lab.rtl.sim.design_from_config`) or the simulation failed.
     """
+    from rosfpga_lab.rtl.project import test_frames
+
     config = config or demo_config()
-    sim = build(rtl_params(config), simulator=simulator, trace=vcd is not None)
-    refused, good = demo_frames(config)
-    return run(sim, refused + good, gap=gap, bp=bp, seed=seed, vcd=vcd)
+    design = design_from_config(config)
+    sim = build(design, simulator=simulator, trace=vcd is not None)
+    if isinstance(design, RtlParams):
+        refused, good = demo_frames(config)
+        frames = refused + good
+    else:
+        frames = test_frames(config)[0]
+    return run(sim, frames, gap=gap, bp=bp, seed=seed, vcd=vcd)
 
 
 def shipped_dump() -> Path | None:

@@ -13,7 +13,7 @@ from pathlib import Path
 from rosfpga_lab import __version__
 from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.hls import GenerateError, GenerationResult, generate
-from rosfpga_lab.hls.generator import Progress
+from rosfpga_lab.hls.generator import Progress, sample_frames
 from rosfpga_lab.config.vocabulary import CDR_WIRE, DEFAULT_HLS_FLAVOUR
 from rosfpga_lab.hls.generic import (
     render_generic, sample_frames_generic, sample_records_cdr, spec_from_config,
@@ -64,9 +64,50 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
     texts = render_generic(spec)
     rtl = {f"{RTL_DIR}/{k}": v for k, v in generic_rtl_files(spec).items()}
     say("computing the test frames and the Python models' output")
-    if spec.wire == CDR_WIRE:
-        frames = sample_records_cdr(cdr_layout_from_config(config), spec.op, spec.ksize)
-    else:
-        frames = sample_frames_generic(layout_from_config(config), spec.op, spec.ksize)
     return generate(config, out_dir, force=force, progress=progress, extra_files=rtl,
-                    texts=texts, frames=frames)
+                    texts=texts, frames=test_frames(config))
+
+
+def test_frames(config: NodeConfig) -> tuple[bytes, bytes]:
+    """A configuration's test frames and the Python models' output for them: what ``generate``
+    writes as ``tb_input.bin`` and ``tb_expected.bin`` (``rtl sim`` runs them too). TCPROS frames,
+    or for ``wire: cdr`` records (a 4-byte sample length, the payload); for ``op: custom`` no
+    expected output."""
+    if config.is_image and config.wire != CDR_WIRE:
+        return sample_frames(config)
+    spec = spec_from_config(config)
+    if spec.wire == CDR_WIRE:
+        return sample_records_cdr(cdr_layout_from_config(config), spec.op, spec.ksize)
+    return sample_frames_generic(layout_from_config(config), spec.op, spec.ksize)
+
+
+def model_output(config: NodeConfig, frames: bytes) -> bytes:
+    """What the Python models publish for ``frames`` (back to back, each behind its 4-byte
+    length; a refused one gives nothing): ``hw.Pipeline`` for Image on TCPROS, else the
+    configuration's layout walked by ``MessagePipeline`` (TCPROS) or ``CdrPipeline`` (CDR).
+
+    Raises:
+        PipelineConfigError: ``op: custom`` (no model of the user's C++).
+    """
+    import struct
+
+    from rosfpga_lab.hw import Pipeline, PipelineError
+    from rosfpga_lab.hw.cdrpipeline import CdrPipeline
+    from rosfpga_lab.hw.msgpipeline import MessagePipeline
+
+    if config.wire == CDR_WIRE:
+        cdr = CdrPipeline(config)
+        run = lambda frame: cdr.run_record(frame).output_record   # noqa: E731
+    else:
+        pipe = (Pipeline.from_config(config) if config.is_image
+                else MessagePipeline.from_config(config))
+        run = lambda frame: pipe.process(frame).output_frame      # noqa: E731
+    out, at = bytearray(), 0
+    while at + 4 <= len(frames):
+        frame = frames[at:at + 4 + struct.unpack_from("<I", frames, at)[0]]
+        at += len(frame)
+        try:
+            out += run(frame)
+        except PipelineError:
+            pass
+    return bytes(out)

@@ -1,11 +1,14 @@
 """The Verilog on a live data path: one long-lived simulator process fed whole frames.
 
 How this works: :class:`RtlServer` builds (or takes from the cache) the fast harness of
-:mod:`rosfpga_lab.rtl.sim` for a node configuration and starts it once in serve mode
-(``rfl_fast --serve``). Each :meth:`RtlServer.process` call writes one request (``RFLQ``, the
-length, the TCPROS frame) to its standard input and reads the reply (``RFLR``: flags, clocks,
-span, the statuses the subscriber decided and the bytes the circuit sent). The circuit keeps
-its state between frames, as the board does (the publisher's sequence number counts on).
+:mod:`rosfpga_lab.rtl.sim` for a node configuration -- the hand-written Image circuit, or for
+any other type the generated top, the same ``rtl/`` ``rosfpga-lab generate`` writes and its
+``make rtlsim`` runs (:func:`rosfpga_lab.rtl.sim.design_from_config`) -- and starts it once in
+serve mode (``rfl_fast --serve``). Each :meth:`RtlServer.process` call writes one request
+(``RFLQ``, the length, the TCPROS frame) to its standard input and reads the reply (``RFLR``:
+flags, clocks, span, the statuses the subscriber decided and the bytes the circuit sent). The
+circuit keeps its state between frames, as the board does (the publisher's sequence number
+counts on).
 """
 
 from __future__ import annotations
@@ -13,15 +16,13 @@ from __future__ import annotations
 import struct
 import subprocess
 import threading
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import IO
 
 from rosfpga_lab.config import NodeConfig
-from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
 from rosfpga_lab.rtl.limits import IDLE_LIMIT, MAX_SERVE_FRAME
-from rosfpga_lab.rtl.params import rtl_params
-from rosfpga_lab.rtl.sim import RtlBuild, build, simulator_missing_reason
+from rosfpga_lab.rtl.sim import RtlBuild, build, design_from_config, simulator_missing_reason
 
 _REPLY = struct.Struct("<4sIQQII")
 
@@ -37,6 +38,7 @@ class RtlFrame:
         span: clocks from the first byte into the subscriber to the last byte out (0 without
             output): the frame's time on the board at ``clock_mhz``.
         cut_short: the request ended inside a frame (the circuit waits for the rest).
+        table: ``(name, field)`` per status code of this circuit (:attr:`RtlBuild.statuses`).
     """
 
     output: bytes
@@ -44,11 +46,16 @@ class RtlFrame:
     clocks: int
     span: int
     cut_short: bool
+    table: tuple[tuple[str, str], ...] = field(default=(), compare=False, repr=False)
 
     @property
     def refused(self) -> tuple[tuple[int, str, str], ...]:
         """``(code, name, field)`` per refused frame (status not 0)."""
-        return tuple((code, *SUBSCRIBER_STATUSES[code]) for _, code in self.status if code)
+        return tuple((code, *self.name(code)) for _, code in self.status if code)
+
+    def name(self, code: int) -> tuple[str, str]:
+        """``(name, field)`` of a status code (a code outside the table is named as such)."""
+        return self.table[code] if 0 <= code < len(self.table) else (f"status {code}", "?")
 
 
 def _read_exact(stream: IO[bytes], n: int) -> bytes:
@@ -70,16 +77,16 @@ class RtlServer:
 
     Raises:
         SimulatorMissingError: no Verilator or no C++ compiler (the fast harness needs both).
-        RtlError: the build failed.
+        RtlError: the configuration has no RTL (:func:`design_from_config`), or the build failed.
     """
 
     def __init__(self, config: NodeConfig, *, cache: bool = True) -> None:
+        design = design_from_config(config)
         reason = simulator_missing_reason("verilator")
         if reason:
             raise SimulatorMissingError(
                 f"--model rtl runs the Verilog on Verilator's fast harness: {reason}")
-        self.build: RtlBuild = build(rtl_params(config), simulator="verilator", harness=True,
-                                     cache=cache)
+        self.build: RtlBuild = build(design, simulator="verilator", harness=True, cache=cache)
         self._lock = threading.Lock()
         self._proc: subprocess.Popen[bytes] | None = subprocess.Popen(
             [*self.build.command, "--serve", f"+idle_limit={IDLE_LIMIT}"],
@@ -113,7 +120,7 @@ class RtlServer:
             raise RtlError("the RTL simulation stalled: no handshake for "
                            f"{IDLE_LIMIT} clocks with input left")
         status = tuple(struct.unpack_from("<II", raw, 8 * i) for i in range(n_status))
-        return RtlFrame(output, status, clocks, span, bool(flags & 1))
+        return RtlFrame(output, status, clocks, span, bool(flags & 1), self.build.statuses)
 
     def close(self) -> None:
         """End the simulator process (idempotent)."""

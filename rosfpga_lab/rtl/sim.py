@@ -2,8 +2,11 @@
 
 How this works: :func:`write_sources` copies the Verilog of ``verilog/`` and the testbench
 ``tb/rfl_tb.v`` into a directory and writes ``rfl_node.v`` (``rfl_top`` with the node
-configuration's parameters). :func:`build` compiles them once (``iverilog -g2005`` to a ``vvp``
-program, or ``verilator --binary`` to a native one); :func:`run` writes the frames to a file,
+configuration's parameters); for any other type than ``sensor_msgs/Image`` on TCPROS it writes
+the generated top instead, the ``rtl/`` of ``rosfpga-lab generate`` (:data:`Design`,
+:func:`design_from_config`), with the same testbench and harness. :func:`build` compiles them
+once (``iverilog -g2005`` to a ``vvp`` program, or ``verilator --binary`` to a native one);
+:func:`run` writes the frames to a file,
 runs the simulation and reads back what the testbench wrote: the output bytes, the
 subscriber's status per frame and, per stream, the clocks of its first and last handshake.
 The testbench drives the input with random gaps and the output with random backpressure
@@ -37,9 +40,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from rosfpga_lab.config.vocabulary import SIMULATORS
+from rosfpga_lab.config import CUSTOM, NodeConfig
+from rosfpga_lab.config.vocabulary import CDR_WIRE, SIMULATORS
 from rosfpga_lab.hls.csim import read_beats
 from rosfpga_lab.hls.errors import HlsError
+from rosfpga_lab.hls.generic import GenericSpec
 from rosfpga_lab.hls.rtlbuild import (  # the harness's build recipe, shared with the Makefile
     EVAL_MODES, HARNESS_BINARY, HARNESS_CXX_DIAGNOSTIC, HARNESS_FILES, HARNESS_TOP,
     HUGE_TEXT_LDFLAGS, eval_define, harness_options, huge_text_here, nba_only,
@@ -55,9 +60,41 @@ TB_DIR = Path(__file__).resolve().parent / "tb"
 HARNESS_DIR = Path(__file__).resolve().parent / "harness"
 TB_TOP = "rfl_tb"
 NODE_FILE = "rfl_node.v"
+#: What a simulation is built from: the hand-written Image circuit's parameters, or a generated
+#: top's spec (:func:`rosfpga_lab.rtl.generic.generic_rtl_files`: the ``rtl/`` that ``rosfpga-lab
+#: generate`` writes). Both tops have the same ``rfl_node`` ports and stream nets, so the
+#: testbench, the fast harness and its serve mode run either.
+Design = RtlParams | GenericSpec
 #: The streams the testbench times, in its ``hs`` vector's bit order (bit 0 first).
 STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx",
            "axis_out")
+
+
+def design_from_config(config: NodeConfig) -> Design:
+    """The circuit a configuration simulates: ``sensor_msgs/Image`` on TCPROS the hand-written
+    one (:func:`~rosfpga_lab.rtl.params.rtl_params`), any other type, and Image on CDR, the
+    generated top (:func:`rosfpga_lab.hls.generic.spec_from_config`, what ``rosfpga-lab
+    generate`` renders).
+
+    Raises:
+        RtlError: ``op: custom`` (no RTL of the user's C++) or a configuration the generator
+            refuses; the message names the configuration and what to do.
+    """
+    from rosfpga_lab.hls.errors import GenerateError
+    from rosfpga_lab.hls.generic import spec_from_config
+    from rosfpga_lab.rtl.params import rtl_params
+
+    where = str(config.path) if config.path else "the configuration"
+    if config.application.op == CUSTOM:
+        raise RtlError(f"{where}: application.op is custom, so there is no RTL to simulate (the "
+                       "application is your C++): run it on the fast or reference model, or "
+                       "simulate the generated project's C++ (rosfpga-lab generate, make csim)")
+    if config.is_image and config.wire != CDR_WIRE:
+        return rtl_params(config)
+    try:
+        return spec_from_config(config)
+    except GenerateError as exc:
+        raise RtlError(f"{where}: no generated circuit to simulate: {exc}") from None
 
 
 def find_tool(name: str) -> str | None:
@@ -116,18 +153,34 @@ def verilog_sources() -> list[Path]:
     return sorted(VERILOG_DIR.glob("*.v"))
 
 
-def source_files(params: RtlParams, *, note: str = "",
+def source_files(params: Design, *, note: str = "",
                  extra_sources: Sequence[str | Path] = ()) -> dict[str, bytes]:
-    """The simulation's files: the lab's Verilog, the status include, the testbench, ``rfl_node.v``.
+    """The simulation's files: the lab's Verilog, the status include, the testbench, ``rfl_node.v``
+    and the fast harness; for a generated top (a :class:`GenericSpec`) the generated project's
+    ``rtl/`` and the same harness.
 
     Args:
-        params: the configuration's parameters.
-        note: a comment line for ``rfl_node.v``.
-        extra_sources: further Verilog files (a module the package lacks).
+        params: the configuration's parameters, or a generated top's spec.
+        note: a comment line for ``rfl_node.v`` (the hand circuit's; a generated top's names
+            its configuration).
+        extra_sources: further Verilog files (a module the package lacks; the hand circuit's).
 
     Returns:
         ``{file name: bytes}``.
+
+    Raises:
+        RtlError: a generated top with ``op: custom`` (its application is the user's C++).
     """
+    if isinstance(params, GenericSpec):
+        from rosfpga_lab.rtl.generic import generic_rtl_files   # it imports this module
+
+        files = generic_rtl_files(params)
+        if not files:
+            raise RtlError("application.op is custom: the generated project has no RTL to "
+                           "simulate (its application is your C++)")
+        for name in HARNESS_FILES:
+            files[name] = (HARNESS_DIR / name).read_bytes()
+        return files
     have = {p.name for p in verilog_sources()}
     files = {}
     for src in [*verilog_sources(), VERILOG_DIR / STATUS_HEADER, *sorted(TB_DIR.glob("*.v")),
@@ -138,7 +191,7 @@ def source_files(params: RtlParams, *, note: str = "",
     return files
 
 
-def write_sources(params: RtlParams, dest: str | Path, *, note: str = "",
+def write_sources(params: Design, dest: str | Path, *, note: str = "",
                   extra_sources: Sequence[str | Path] = ()) -> list[str]:
     """Write :func:`source_files` into ``dest`` (created when missing).
 
@@ -161,7 +214,7 @@ class RtlBuild:
         simulator: ``"iverilog"`` or ``"verilator"``.
         command: what runs it (plus-arguments are appended).
         directory: where its sources and products are.
-        params: the parameters it was built with.
+        params: the parameters (or generated top's spec) it was built with.
         seconds: how long the build took.
         trace: it can write a VCD (always with Icarus; Verilator only when built with trace).
         harness: the fast C++ harness (Verilator without trace), not the Verilog testbench.
@@ -170,10 +223,23 @@ class RtlBuild:
     simulator: str
     command: tuple[str, ...]
     directory: Path
-    params: RtlParams
+    params: Design
     seconds: float
     trace: bool = True
     harness: bool = False
+
+    @property
+    def statuses(self) -> tuple[tuple[str, str], ...]:
+        """``(name, field)`` per status code of its subscriber, code 0 (accepted) first."""
+        return status_table(self.params)
+
+
+def status_table(params: Design) -> tuple[tuple[str, str], ...]:
+    """The subscriber's status codes: the walk's table of a generated top, or the hand
+    circuit's :data:`~rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES`."""
+    if isinstance(params, GenericSpec):
+        return tuple(params.program.statuses)
+    return tuple(SUBSCRIBER_STATUSES)
 
 
 def cache_root() -> Path:
@@ -248,13 +314,13 @@ def _run_build(cmd: list[str], where: Path) -> None:
                        f"{proc.stdout}{proc.stderr}")
 
 
-def build(params: RtlParams, directory: str | Path | None = None, *,
+def build(params: Design, directory: str | Path | None = None, *,
           simulator: str | None = None, extra_sources: Sequence[str | Path] = (),
           trace: bool = False, cache: bool = False, harness: bool | None = None) -> RtlBuild:
     """Write the sources and compile the fast harness or the testbench.
 
     Args:
-        params: the configuration's parameters.
+        params: the configuration's parameters, or a generated top's spec.
         directory: the build directory (default: a new temporary one).
         simulator: ``"iverilog"`` or ``"verilator"`` (default: the first found).
         extra_sources: further Verilog files (see :func:`write_sources`).
@@ -430,14 +496,15 @@ def run(sim: RtlBuild, frames: bytes, *, seed: int = 1, gap: int = 0, bp: int = 
         log = proc.stdout + proc.stderr
         if proc.returncode != 0 or "rtlsim: ERROR" in log or not (work / "stats.txt").exists():
             raise RtlError(f"the RTL simulation failed (exit {proc.returncode}):\n{log}")
-        return _read_result(work, log, seconds)
+        return _read_result(work, log, seconds, sim.statuses)
 
 
-def _read_result(work: Path, log: str, seconds: float) -> RtlResult:
+def _read_result(work: Path, log: str, seconds: float,
+                 table: tuple[tuple[str, str], ...]) -> RtlResult:
     status = []
     for line in (work / "status.txt").read_text().splitlines():
         offset, code = line.split()
-        status.append((int(offset), SUBSCRIBER_STATUSES[int(code)][0]))
+        status.append((int(offset), table[int(code)][0]))
     streams: dict[str, StreamTiming] = {}
     cycles = framing = 0
     for line in (work / "stats.txt").read_text().splitlines():

@@ -12,14 +12,15 @@
   landed in memory, from its file's pages and from the huge page the harness moves its code to
   alike; RFL_NO_HUGE_TEXT=1 in the environment keeps the file's pages, to compare).
 
-* the live node with ``--model rtl`` per shipped configuration: frames/s through the component
-  (embedded master, a lab publisher and subscriber, frames in lock step), each output checked
-  against the Python models.
+* the live node with ``--model rtl`` per shipped configuration on TCPROS, the generated
+  LaserScan and lab_msgs/Samples circuits too: frames/s through the component (embedded master,
+  a lab publisher and subscriber, frames in lock step: one in flight, so the figure is one over
+  the round trip), each output checked against the Python models.
 
 The build (compilation) time is printed apart: it is paid once per configuration.
 
 Usage: ``python tests/benchmarks/bench_rtl.py [--simulator verilator] [--repeat N] [--builds K]
-[--full-icarus]``
+[--full-icarus] [--node STEM --frames N]`` (``--node``: only that node benchmark, repeatable)
 """
 
 from __future__ import annotations
@@ -63,15 +64,19 @@ def bench(stem: str, simulator: str, harness: bool | None = None, repeat: int = 
 
 def bench_node(stem: str, frames: int = 5) -> None:
     """Frames per second of the live component with the Verilog on its data path."""
+    import struct
     import threading
     import time
 
     from rosfpga_lab.component import FpgaComponent
     from rosfpga_lab.graph import EmbeddedMaster, Node
+    from rosfpga_lab.rtl.project import model_output, test_frames
 
     config = load_config(DATA / f"{stem}.yaml")
-    frame, _ = sample_frames(config)
-    expected = Pipeline.from_config(config).process(frame).output_frame
+    first, _ = test_frames(config)
+    frame = first[:4 + struct.unpack_from("<I", first)[0]]      # the first test frame (good)
+    expected = model_output(config, frame)
+    kind, reg = config.subscriber.type, config.registry()
     got: list[bytes] = []
     cond = threading.Condition()
 
@@ -82,11 +87,12 @@ def bench_node(stem: str, frames: int = 5) -> None:
 
     with EmbeddedMaster(port=0) as master:
         comp = FpgaComponent(config, master=master, model="rtl").start()
-        src, sink = Node("/bench_source", master=master), Node("/bench_sink", master=master)
+        src = Node("/bench_source", master=master, registry=reg)
+        sink = Node("/bench_sink", master=master, registry=reg)
         try:
-            pub = src.advertise(config.subscriber.topic, "sensor_msgs/Image", queue_size=0)
-            sink.subscribe(config.publisher.topic, "sensor_msgs/Image", collect, raw=True,
-                           queue_size=0)
+            pub = src.advertise(config.subscriber.topic, kind, queue_size=0)
+            sink.subscribe(config.publisher.topic, kind, collect, raw=True, queue_size=0,
+                           tcp_nodelay=True)
             pub.wait_for_subscribers(1, 10)
             comp.wait_for_subscribers(1, 10)
             start = time.perf_counter()
@@ -99,12 +105,15 @@ def bench_node(stem: str, frames: int = 5) -> None:
             sink.shutdown()
             src.shutdown()
             comp.stop()
-    # the circuit numbers its frames on: compare all but the seq field (bytes 4..7)
-    same = all(len(b) + 4 == len(expected) and b[4:] == expected[8:] for b in got)
-    img = config.image
-    print(f"node --model rtl  {stem:<24} {img.width}x{img.height} {img.encoding:<6} "
-          f"{len(got) / seconds:6.1f} frames/s   outputs {'equal to' if same else 'DIFFERENT from'} "
-          "the models (but seq)", flush=True)
+    if config.is_image:  # the circuit numbers its frames on: compare all but seq (bytes 4..7)
+        same = all(len(b) + 4 == len(expected) and b[4:] == expected[8:] for b in got)
+        what = f"{config.image.width}x{config.image.height} {config.image.encoding:<6}"
+    else:                # a generated circuit carries header.seq: every byte
+        same = all(b == expected[4:] for b in got)
+        what = f"{kind} {len(frame):,} B"
+    print(f"node --model rtl  {stem:<24} {what} {len(got) / seconds:8.1f} frames/s   outputs "
+          f"{'equal to' if same else 'DIFFERENT from'} the models"
+          f"{' (but seq)' if config.is_image else ''} ({len(got)} frames)", flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -120,7 +129,15 @@ def main(argv: list[str] | None = None) -> int:
                              "judge the target by the median (default 3)")
     parser.add_argument("--full-icarus", action="store_true",
                         help="time Icarus Verilog on the 640x480 frame too (minutes)")
+    parser.add_argument("--node", action="append", metavar="STEM",
+                        help="only the live node benchmark of data/STEM.yaml (repeatable)")
+    parser.add_argument("--frames", type=int, default=0, metavar="N",
+                        help="frames per node benchmark (default 5 for Image, 500 for others)")
     args = parser.parse_args(argv)
+    if args.node:
+        for stem in args.node:
+            bench_node(stem, args.frames or 500)
+        return 0
     sims = [s for s in (args.simulator or ["verilator", "iverilog"])
             if simulator_missing_reason(s) is None]
     if not sims:
@@ -146,7 +163,9 @@ def main(argv: list[str] | None = None) -> int:
             bench("fpga_passthrough_rgb8", simulator)
     if "verilator" in sims:
         for stem in ("fpga_dilate_rgba8", "fpga_erode_mono8", "fpga_passthrough_rgb8"):
-            bench_node(stem)
+            bench_node(stem, args.frames or 5)
+        for stem in ("fpga_laserscan_min", "fpga_samples_dilate"):
+            bench_node(stem, args.frames or 500)
     return 0
 
 

@@ -17,7 +17,7 @@ module rfl_harness (
     input         m_tready,
     output        frame_start,
     output        status_valid,
-    output [3:0]  status,
+    output [7:0]  status,        // a code of the walk's table (the hand circuit's: 4 bits, zero-extended)
     output        busy,
     output [7:0]  framing,       // the stages' framing flags (rfl_top)
     output [8:0]  hs,            // handshake per stream (sim.STREAMS order, bit 0 first)

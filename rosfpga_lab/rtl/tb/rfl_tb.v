@@ -1,5 +1,7 @@
-// rfl_tb -- a file-based testbench of the whole circuit (rfl_node: rfl_top with the node
-// configuration's parameters). It streams TCPROS frames from a file into the 8-bit input,
+// rfl_tb -- a file-based testbench of the whole circuit (rfl_node: rfl_top, or a generated
+// project's rfl_gtop, with the node configuration's parameters; both have the same ports, an
+// 8-bit status of the subscriber's table and the framing flags, which rfl_gtop ties to 0, and
+// the stream nets timed below; rfl_harness.v taps the same). It streams TCPROS frames from a file into the 8-bit input,
 // with random input gaps and random output backpressure from a seeded xorshift generator,
 // writes every output byte to a file, and records per frame the subscriber's status and per
 // stream the first and last handshake clocks. No Python runs per clock.
@@ -20,7 +22,7 @@ module rfl_tb;
     wire m_tvalid;
     reg m_tready = 1'b0;
     wire frame_start, status_valid, busy;
-    wire [3:0] status;
+    wire [7:0] status;
     wire [7:0] framing;
 
     rfl_node dut (

@@ -1,5 +1,7 @@
-// rfl_tb -- a file-based testbench of the whole circuit (rfl_node: rfl_top with the node
-// configuration's parameters). It streams TCPROS frames from a file into the 8-bit input,
+// rfl_tb -- a file-based testbench of the whole circuit (rfl_node: rfl_top, or a generated
+// project's rfl_gtop, with the node configuration's parameters; both have the same ports, an
+// 8-bit status of the subscriber's table and the framing flags, which rfl_gtop ties to 0, and
+// the stream nets timed below; rfl_harness.v taps the same). It streams TCPROS frames from a file into the 8-bit input,
 // with random input gaps and random output backpressure from a seeded xorshift generator,
 // writes every output byte to a file, and records per frame the subscriber's status and per
 // stream the first and last handshake clocks. No Python runs per clock.
@@ -21,13 +23,14 @@ module rfl_tb;
     reg m_tready = 1'b0;
     wire frame_start, status_valid, busy;
     wire [7:0] status;
-    wire [7:0] framing = 8'd0;   // no framing flags in this circuit
+    wire [7:0] framing;
 
     rfl_node dut (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
-        .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy));
+        .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy),
+        .framing(framing));
 
     always #5 clk = ~clk;
 
