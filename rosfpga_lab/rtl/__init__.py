@@ -22,8 +22,9 @@ stepping through a generated program, one instruction per field of the message),
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
 from rosfpga_lab.rtl.params import OP_CODES, RtlParams, load_config, node_wrapper, rtl_params, status_header
+from rosfpga_lab.config.vocabulary import SIMULATORS
 from rosfpga_lab.rtl.sim import (
-    SIMULATORS, STREAMS, Design, RtlBuild, RtlResult, StreamTiming, build, design_from_config,
+    STREAMS, Design, RtlBuild, RtlResult, StreamTiming, build, design_from_config,
     find_simulator, run, simulator_missing_reason, verilog_sources, write_sources,
 )
 

@@ -25,7 +25,7 @@ import jinja2
 
 from rosfpga_lab.hls.generic import GenericSpec, beat_shape, context, environment
 from rosfpga_lab.rtl.errors import RtlError
-from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, VERILOG_DIR
+from rosfpga_lab.rtl.tools import NODE_FILE, TB_DIR, VERILOG_DIR
 
 GENERIC_VERILOG_DIR = Path(__file__).resolve().parent / "generic"
 #: ``rfl_window1d``'s OP parameter per operation.
@@ -146,7 +146,7 @@ def simulate_project(project_dir: str | Path, frames: bytes, *, target: str = "r
     import subprocess
 
     from rosfpga_lab.rtl.limits import RUN_TIMEOUT
-    from rosfpga_lab.rtl.sim import find_simulator, find_tool
+    from rosfpga_lab.rtl.tools import find_simulator, find_tool
 
     project = Path(project_dir)
     if shutil.which("make") is None:

