@@ -180,6 +180,10 @@ void publisher(byte_stream& in, byte_stream& carry_in, meta_stream& meta_in, byt
         }
         return;
     }
+    // The walk and its constants are ROMs read every clock (a range check reads both bounds at
+    // once): constants in logic, so no block-RAM port limits the loop's II.
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = PROGRAM complete)
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = CONSTS complete)
     pub_walk w;
     HLS_PRAGMA(HLS ARRAY_PARTITION variable = w.left complete)
     w.st = PT_LEN;
