@@ -27,9 +27,9 @@ from rosfpga_lab import __version__
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.limits import MAX_CARRY_BYTES
 from rosfpga_lab.hw import limits as hw_limits
-from rosfpga_lab.hls.generator import _OP_CPP, HEX_BYTES_PER_LINE, TEMPLATES_DIR, _header_context
+from rosfpga_lab.hls.generator import _OP_CPP, HEX_BYTES_PER_LINE, HLS_TOOLS, TEMPLATES_DIR, _header_context
 from rosfpga_lab.config import NodeConfig
-from rosfpga_lab.config.vocabulary import CDR_WIRE, TCPROS_WIRE
+from rosfpga_lab.config.vocabulary import CDR_WIRE, DEFAULT_HLS_FLAVOUR, TCPROS_WIRE
 from rosfpga_lab.hls.program import _replace
 from rosfpga_lab.hls.program import (
     ALIGN_ORIGIN, ENCAP_BYTES, ENCAP_PAD_MASK, FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub,
@@ -89,6 +89,7 @@ class GenericSpec:
             application as pixels of ``bytes_per_pixel`` bytes (TUSER on the first, TLAST ending
             each line of ``width``) and the application is the 2-D window over ``height``
             lines (the video project's ``video_filter.cpp.j2``, ``rfl_morph.v``).
+        flavour: ``hls.flavour``, the HLS tool ``run_hls.tcl`` and the directives are for.
     """
 
     program: Program
@@ -113,6 +114,16 @@ class GenericSpec:
     custom_source: Path | None = None
     wire: str = TCPROS_WIRE
     video: VideoShape | None = None
+    flavour: str = DEFAULT_HLS_FLAVOUR
+
+
+def meta_fields(prog: Program) -> tuple[tuple[str, int, str], ...]:
+    """The fields of the subscriber's one metadata FIFO word per frame (``struct frame_meta``),
+    with their widths in bits and what each holds; the carried bytes go on a byte FIFO."""
+    return (("out_len", 32, "the publisher's frame length"),
+            ("carried", max(1, prog.carry_bytes).bit_length(), "bytes this frame put on the carry FIFO"),
+            ("streamed", 1, "the stream went to the application"),
+            ("drop", 1, "refused after that: the publisher drops the frame"))
 
 
 def _hex_rows(data: bytes) -> list[str]:
@@ -258,6 +269,11 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "consts": prog.const_table, "const_rows": _hex_rows(prog.const_table),
         "loop_depth": loop_depth(prog), "max_instr_steps": max_steps(prog),
         "carry_bytes": max(1, prog.carry_bytes),
+        "meta_fields": meta_fields(prog), "meta_bits": sum(f[1] for f in meta_fields(prog)),
+        "carry_count_bits": meta_fields(prog)[1][1],
+        "flavour": spec.flavour, "tool": HLS_TOOLS[spec.flavour],
+        "other_tools": [(key, tool) for key, tool in HLS_TOOLS.items() if key != spec.flavour],
+        "cores": ("subscriber", "fifo2axi", "stream_filter", "axi2fifo", "publisher"),
         "fifo": {"input_depth": spec.input_depth, "output_depth": spec.output_depth},
         "axis_depth": spec.axis_depth, "part": spec.part, "clock_mhz": f"{spec.clock_mhz:g}",
         "clock_period_ns": f"{1000.0 / spec.clock_mhz:g}",
@@ -531,7 +547,7 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
                      ksize: int = 3, config_name: str = "<string>",
                      custom_source: Path | None = None,
                      program: Program | None = None, wire: str = TCPROS_WIRE,
-                     video: VideoShape | None = None) -> GenericSpec:
+                     video: VideoShape | None = None, flavour: str = DEFAULT_HLS_FLAVOUR) -> GenericSpec:
     """The generic project of a layout (its type in ``reg``), with the node's names and sizes
     (``program``: the layout's walk when the caller derived it itself; ``wire``: ``cdr`` for a
     CDR walk's ``layout`` with its ``program_from_cdr``; ``video``: the stream's video shape,
@@ -552,7 +568,7 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
         stream_name=stream.label,
         stream_type=f"{stream.type}[]" if stream.count is None else f"{stream.type}[{stream.count}]",
         subscriber_header=sub_header, publisher_header=pub_header, config_name=config_name,
-        custom_source=custom_source, wire=wire, video=video)
+        custom_source=custom_source, wire=wire, video=video, flavour=flavour)
 
 
 def spec_from_config(config: NodeConfig) -> GenericSpec:
@@ -590,7 +606,7 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
         input_depth=config.fifo.input_depth, output_depth=config.fifo.output_depth,
         axis_depth=config.fifo.axis_depth, part=config.part, clock_mhz=config.clock_mhz,
         op=app.op, ksize=app.ksize, config_name=config.path.name if config.path else "<string>",
-        custom_source=app.source, video=layout.video)
+        custom_source=app.source, video=layout.video, flavour=config.hls.flavour)
 
 
 # -- test frames and the models' output ----------------------------------------------------------

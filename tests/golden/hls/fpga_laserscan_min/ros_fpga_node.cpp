@@ -12,16 +12,19 @@
 #include "ros_node.h"
 
 int ros_fpga_node(byte_stream& in, byte_stream& out) {
-    static byte_stream stream_bytes("stream_bytes"), result_bytes("result_bytes");
+    static byte_stream stream_bytes("stream_bytes"), result_bytes("result_bytes"), carry("carry");
     static elem_stream to_filter("to_filter"), from_filter("from_filter");
     static meta_stream meta("meta");
     HLS_PRAGMA(HLS STREAM variable = to_filter depth = AXIS_FIFO_DEPTH)
     HLS_PRAGMA(HLS STREAM variable = from_filter depth = AXIS_FIFO_DEPTH)
-    int status = subscriber(in, stream_bytes, meta);
-    if (meta.empty()) return status;
-    fifo2axi(stream_bytes, to_filter);
-    stream_filter(to_filter, from_filter);
-    axi2fifo(from_filter, result_bytes);
-    publisher(result_bytes, meta, out);
-    return status;
+    HLS_PRAGMA(HLS STREAM variable = carry depth = CARRY_FIFO_DEPTH)
+    ap_uint<8> status = 0;
+    subscriber(in, stream_bytes, carry, meta, status);
+    if (!stream_bytes.empty()) {  // the stream went out: through the application
+        fifo2axi(stream_bytes, to_filter);
+        stream_filter(to_filter, from_filter);
+        axi2fifo(from_filter, result_bytes);
+    }
+    if (!meta.empty()) publisher(result_bytes, carry, meta, out);
+    return static_cast<int>(status.to_uint());
 }

@@ -35,6 +35,7 @@ static unsigned long long pick(unsigned long long acc, unsigned long long x) {
 void stream_filter(elem_stream& in, elem_stream& out) {
     HLS_PRAGMA(HLS INTERFACE axis port = in)
     HLS_PRAGMA(HLS INTERFACE axis port = out)
+    HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one array per call
     // The window: entry 0 the newest element; an element's result is ready once HALF later
     // ones are in; after the last element, HALF empty entries finish the last results.
     elem_beat window[KSIZE];

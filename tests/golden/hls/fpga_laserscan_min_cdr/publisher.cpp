@@ -12,6 +12,9 @@
 
 // axi2fifo: every element beat's bytes, byte 0 first, one per clock into the 8-bit FIFO.
 void axi2fifo(elem_stream& in, byte_stream& out) {
+    HLS_PRAGMA(HLS INTERFACE axis port = in)
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = out)
+    HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one array per call
     for (int e = 0; e < STREAM_LENGTH; e++) {
         HLS_PRAGMA(HLS PIPELINE II = 4)
         elem_beat beat = in.read();
@@ -19,82 +22,189 @@ void axi2fifo(elem_stream& in, byte_stream& out) {
     }
 }
 
-// Write one byte and count it.
-static void put(byte_stream& out, byte_t b, unsigned& opos) {
-    out.write(b);
-    opos++;
-}
+// The walk is a state machine stepped by one loop, pipelined at II=1, as the subscriber's:
+// every iteration writes at most one byte, and the iteration that decodes an instruction also
+// writes that field's first byte, so lengths, counts, padding and fields move one byte per
+// clock whatever the mix; only steps with no byte of their own (the end of each element of an
+// array of messages, entering one, an empty field, the end) take a clock without one.
+enum { PT_LEN, PT_DECODE, PT_PAD, PT_COUNT, PT_BYTES, PT_FINISH };
 
-// Write `n` zeros (the padding that aligns the next field).
-static void put_zeros(byte_stream& out, unsigned n, unsigned& opos) {
-    for (unsigned i = 0; i < n; i++) put(out, 0, opos);
-}
+// The registers of the walk over one message.
+struct pub_walk {
+    unsigned char st, next;  // the state; after PT_PAD: the state it leads to
+    instr_t ins;             // the instruction being walked
+    unsigned pc;
+    unsigned opos;           // bytes written of this frame (alignment counts from byte 8)
+    ap_uint<32> n, bytes, i;  // the count; the field's bytes; bytes of it written so far
+    unsigned k;              // PT_LEN, PT_COUNT: bytes written; PT_PAD: zeros left
+    ap_uint<32> left[LOOP_DEPTH];
+    int depth;
+};
 
-// Write one message for an accepted frame (or drop the stream of a refused one).
-void publisher(byte_stream& in, meta_stream& meta_in, byte_stream& out) {
-    HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
-    HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_in)
-    HLS_PRAGMA(HLS INTERFACE ap_fifo port = out)
-    static ap_uint<32> seq = SEQ_START;  // the next message number
-    static frame_meta meta;
-    meta = meta_in.read();
-    if (meta.drop) {
-        for (int i = 0; i < STREAM_DATA_BYTES; i++) in.read();
+// A field of w.bytes bytes starts (after the zeros that align it).
+static void pub_start_field(pub_walk& w) {
+    w.i = 0;
+    if (w.bytes == 0) {
+        w.pc++;
+        w.st = PT_DECODE;
         return;
     }
-    unsigned opos = 0;             // bytes written of this frame (alignment counts from byte 8)
-    for (int i = 0; i < 4; i++) put(out, meta.out_len.range(8 * i + 7, 8 * i), opos);
-    unsigned carried = 0;          // bytes of meta.carry written so far
-    ap_uint<32> left[LOOP_DEPTH];
-    int depth = 0;
-    for (int d = 0; d < LOOP_DEPTH; d++) left[d] = 0;
-    unsigned pc = 0;
-    while (PROGRAM[pc].op != OP_DONE) {
-        HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 14)
-        const instr_t ins = PROGRAM[pc];
-        if (ins.op == OP_END) {
-            if (--left[depth - 1] != 0) {
-                pc = ins.jump + 1;
+    const unsigned p = pad(w.opos, w.ins.op == OP_VAR ? w.ins.elem_align : w.ins.align);
+    if (p != 0) {
+        w.k = p;
+        w.st = PT_PAD;
+        w.next = PT_BYTES;
+        return;
+    }
+    w.st = PT_BYTES;
+}
+
+// Decode PROGRAM[pc] (no byte written). Returns whether the state it leaves writes a byte now.
+static bool pub_decode(pub_walk& w) {
+    w.ins = PROGRAM[w.pc];
+    const instr_t& ins = w.ins;
+    if (ins.op == OP_DONE) {
+        w.st = PT_FINISH;
+        return false;
+    }
+    if (ins.op == OP_END) {
+        if (--w.left[w.depth - 1] != 0) {
+            w.pc = ins.jump + 1;
+        } else {
+            w.depth--;
+            w.pc++;
+        }
+        return false;
+    }
+    if (ins.op == OP_VAR || (ins.op == OP_LOOP && ins.variable)) {
+        // the count: as received (read with its bytes), the constant's, the stream's or zero (a string's NUL counted)
+        if (ins.pub == PUB_CONST) w.n = ins.klen / ins.size + (ins.nul ? 1 : 0);
+        else if (ins.pub == PUB_ZERO) w.n = ins.nul ? 1 : 0;
+        else w.n = ins.count;
+        w.k = 0;
+        const unsigned p = pad(w.opos, ins.align);
+        if (p != 0) {
+            w.k = p;
+            w.st = PT_PAD;
+            w.next = PT_COUNT;
+            return true;
+        }
+        w.st = PT_COUNT;
+        return true;
+    }
+    if (ins.op == OP_LOOP) {
+        if (ins.count == 0) {
+            w.pc = ins.jump + 1;
+        } else {
+            w.left[w.depth++] = ins.count;
+            w.pc++;
+        }
+        return false;
+    }
+    w.bytes = ins.size;  // OP_FIXED
+    pub_start_field(w);
+    return w.st != PT_DECODE;
+}
+
+// The byte the current state writes (and what it moves on to).
+static byte_t give(pub_walk& w, const ap_uint<32>& out_len, const ap_uint<32>& seq, byte_stream& in,
+                   byte_stream& carry_in) {
+    const instr_t& ins = w.ins;
+    byte_t b = 0;
+    w.opos++;  // counted first: a field started after this byte aligns from the next one
+    switch (w.st) {
+    case PT_LEN:
+        b = out_len.range(8 * w.k + 7, 8 * w.k);
+        if (++w.k == 4) w.st = PT_DECODE;
+        break;
+    case PT_PAD:  // zeros aligning the next field
+        if (--w.k == 0) w.st = w.next;
+        break;
+    case PT_COUNT:
+        if (ins.pub == PUB_CARRY) {
+            b = carry_in.read();
+            w.n.range(8 * w.k + 7, 8 * w.k) = b;
+        } else {
+            b = w.n.range(8 * w.k + 7, 8 * w.k);
+        }
+        if (++w.k == 4) {
+            if (ins.op == OP_LOOP) {
+                if (w.n == 0) {
+                    w.pc = ins.jump + 1;
+                } else {
+                    w.left[w.depth++] = w.n;
+                    w.pc++;
+                }
+                w.st = PT_DECODE;
             } else {
-                depth--;
-                pc++;
+                w.bytes = w.n * ins.size;
+                pub_start_field(w);
             }
-            continue;
         }
-        ap_uint<32> n = ins.count;
-        if (ins.op == OP_VAR || (ins.op == OP_LOOP && ins.variable)) {
-            // the count: as received, the constant's, the stream's or zero (a string's NUL counted)
-            if (ins.pub == PUB_CARRY) {
-                for (int i = 0; i < 4; i++) n.range(8 * i + 7, 8 * i) = meta.carry[carried++];
-            } else if (ins.pub == PUB_CONST) {
-                n = ins.klen / ins.size + (ins.nul ? 1 : 0);
-            } else if (ins.pub == PUB_ZERO) {
-                n = ins.nul ? 1 : 0;
-            }
-            put_zeros(out, pad(opos, ins.align), opos);
-            for (int i = 0; i < 4; i++) put(out, n.range(8 * i + 7, 8 * i), opos);
+        break;
+    default:  // PT_BYTES
+        if (ins.pub == PUB_CARRY) b = carry_in.read();
+        else if (ins.pub == PUB_CONST) b = (w.i < ins.klen) ? byte_t(CONSTS[ins.kaddr + w.i]) : byte_t(0);
+        else if (ins.pub == PUB_COUNT) b = (w.i < 4) ? byte_t(seq.range(8 * w.i + 7, 8 * w.i)) : byte_t(0);
+        else if (ins.pub == PUB_STREAM) b = in.read();
+        if (++w.i == w.bytes) {
+            w.pc++;
+            w.st = PT_DECODE;
         }
-        if (ins.op == OP_LOOP) {
-            if (n == 0) {
-                pc = ins.jump + 1;
-                continue;
-            }
-            left[depth++] = n;
-            pc++;
-            continue;
-        }
-        ap_uint<32> bytes = ins.op == OP_VAR ? ap_uint<32>(n * ins.size) : ap_uint<32>(ins.size);
-        if (bytes != 0) put_zeros(out, pad(opos, ins.op == OP_VAR ? ins.elem_align : ins.align), opos);
-        for (ap_uint<32> i = 0; i < bytes; i++) {
+        break;
+    }
+    return b;
+}
+
+// Write one message for an accepted frame (or drop the stream and carried bytes of a refused one).
+void publisher(byte_stream& in, byte_stream& carry_in, meta_stream& meta_in, byte_stream& out) {
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = carry_in)
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_in)
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = out)
+    HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one message per meta word
+    HLS_PRAGMA(HLS HLS aggregate variable = meta_in)
+    static ap_uint<32> seq = SEQ_START;  // the next message number
+    const frame_meta meta = meta_in.read();
+    if (meta.drop) {
+        for (ap_uint<11> c = 0; c < meta.carried; c++) {
             HLS_PRAGMA(HLS PIPELINE II = 1)
-            byte_t b = 0;
-            if (ins.pub == PUB_CARRY) b = meta.carry[carried++];
-            else if (ins.pub == PUB_CONST) b = (i < ins.klen) ? byte_t(CONSTS[ins.kaddr + i]) : byte_t(0);
-            else if (ins.pub == PUB_COUNT) b = (i < 4) ? byte_t(seq.range(8 * i + 7, 8 * i)) : byte_t(0);
-            else if (ins.pub == PUB_STREAM) b = in.read();
-            put(out, b, opos);
+            HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = CARRY_BYTES)
+            carry_in.read();
         }
-        pc++;
+        if (meta.streamed) {
+            for (int i = 0; i < STREAM_DATA_BYTES; i++) {
+                HLS_PRAGMA(HLS PIPELINE II = 1)
+                in.read();
+            }
+        }
+        return;
+    }
+    // The walk and its constants are ROMs read every clock (a range check reads both bounds at
+    // once): constants in logic, so no block-RAM port limits the loop's II.
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = PROGRAM complete)
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = CONSTS complete)
+    pub_walk w;
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = w.left complete)
+    w.st = PT_LEN;
+    w.next = PT_DECODE;
+    w.ins = PROGRAM[0];
+    w.pc = 0;
+    w.opos = 0;
+    w.n = 0;
+    w.bytes = 0;
+    w.i = 0;
+    w.k = 0;
+    w.depth = 0;
+    for (int d = 0; d < LOOP_DEPTH; d++) {
+        HLS_PRAGMA(HLS UNROLL)
+        w.left[d] = 0;
+    }
+    while (w.st != PT_FINISH) {
+        HLS_PRAGMA(HLS PIPELINE II = 1)
+        HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 67108878)
+        if (w.st == PT_DECODE && !pub_decode(w)) continue;  // a step with no byte of its own
+        out.write(give(w, meta.out_len, seq, in, carry_in));
     }
     seq++;
 }

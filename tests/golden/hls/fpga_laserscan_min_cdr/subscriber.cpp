@@ -16,16 +16,13 @@
 // to the output length.
 #include "ros_node.h"
 
-// Read one byte; pos counts the bytes of the frame read so far.
-static byte_t read_u8(byte_stream& in, ap_uint<32>& pos) {
-    pos++;
-    return in.read();
-}
-
-// Skip `n` bytes (alignment padding; their values are not looked at).
-static void skip_bytes(byte_stream& in, ap_uint<32>& pos, unsigned n) {
-    for (unsigned i = 0; i < n; i++) read_u8(in, pos);
-}
+// The walk is a state machine (wstate) stepped by one loop, pipelined at II=1: every iteration
+// takes at most one byte from `in`, and the iteration that decodes an instruction also takes
+// that field's first byte, so the bytes of fields, counts, padding and skipped frames move one
+// per clock whatever the mix of fields; only steps with no byte of their own take a clock
+// without one (the end of each element of an array of messages, entering such an array, an
+// empty field, the end of the walk).
+enum { ST_LEN, ST_DECODE, ST_PAD, ST_COUNT, ST_BYTES, ST_ENCAP, ST_ENDPAD, ST_SKIP, ST_FINISH };
 
 // The order key of a value of `bytes` bytes (see layout.h: kind 0 unsigned, 1 signed, 2 float
 // with -0.0 taken as +0.0): a larger key is a larger value.
@@ -43,9 +40,12 @@ static unsigned long long order_key(unsigned long long v, unsigned bytes, unsign
 // A SUB_RANGE field's value is within its bounds (CONSTS: low, then high); a NaN never is.
 static bool in_range(unsigned long long v, const instr_t& ins) {
     unsigned long long low = 0, high = 0;
-    for (unsigned i = 0; i < ins.size; i++) {
-        low |= (unsigned long long)CONSTS[ins.kaddr + i] << (8 * i);
-        high |= (unsigned long long)CONSTS[ins.kaddr + ins.size + i] << (8 * i);
+    for (unsigned i = 0; i < 8; i++) {
+        HLS_PRAGMA(HLS UNROLL)
+        if (i < ins.size) {
+            low |= (unsigned long long)CONSTS[ins.kaddr + i] << (8 * i);
+            high |= (unsigned long long)CONSTS[ins.kaddr + ins.size + i] << (8 * i);
+        }
     }
     if (ins.kind == 2) {
         const unsigned mant = ins.size == 4 ? 23 : 52;
@@ -56,182 +56,315 @@ static bool in_range(unsigned long long v, const instr_t& ins) {
     return order_key(low, ins.size, ins.kind) <= k && k <= order_key(high, ins.size, ins.kind);
 }
 
-// Interpret one frame. Returns SUB_OK or the status of the field that made it refuse the
-// frame. The streamed bytes go to stream_out; when they did, meta_out gets the frame's meta
-// (drop set if the frame was refused after them).
-int subscriber(byte_stream& in, byte_stream& stream_out, meta_stream& meta_out) {
-    HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
-    HLS_PRAGMA(HLS INTERFACE ap_fifo port = stream_out)
-    HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_out)
-    static frame_meta meta;
-    ap_uint<32> pos = 0;
-    ap_uint<32> frame_length = 0;
-    for (int i = 0; i < 4; i++) frame_length.range(8 * i + 7, 8 * i) = read_u8(in, pos);
-    if (frame_length < MIN_BODY_BYTES || frame_length > MAX_FRAME_BYTES) {
-        return SUB_BAD_FRAME_LENGTH;  // not to be trusted for skipping: wait for the next frame
-    }
-    const ap_uint<32> end = frame_length + 4;
-    ap_uint<32> fend = end;        // where the fields end: less the payload's end padding
-    ap_uint<32> out_len = 0;       // bytes of the message the publisher will write
-    unsigned carried = 0;          // bytes in meta.carry
-    bool streamed = false;         // the stream went to the application
-    int status = SUB_OK;
+// The registers of the walk over one frame.
+struct sub_walk {
+    unsigned char st, next;  // the state; after ST_PAD: the state it leads to
+    instr_t ins;             // the instruction being walked
+    unsigned pc;
+    ap_uint<32> pos, end, fend;  // bytes read of the frame; its end; where its fields end
+    ap_uint<32> out_len;     // bytes of the message the publisher will write
+    ap_uint<32> n, bytes, i;  // the count read; the field's bytes; bytes of it taken so far
+    unsigned k;              // ST_LEN, ST_COUNT, ST_ENCAP: bytes taken; ST_PAD, ST_ENDPAD: bytes left
+    unsigned long long value;  // a SUB_RANGE field, little-endian
+    bool same;               // a SUB_CHECK field equals its constant so far
+    bool nul_ok;             // a string's last byte is its NUL
+    bool hdr_ok;             // the encapsulation header's kind is CDR little-endian
+    ap_uint<11> carried;  // bytes put on the carry FIFO
+    bool streamed;
+    int status;
     ap_uint<32> left[LOOP_DEPTH];  // elements left of each open array of messages
     bool quiet_of[LOOP_DEPTH];     // that array is written empty: count none of its fields
-    int depth = 0, quiet = 0;
+    int depth, quiet;
+};
+
+// Refuse the frame: skip what is left of it (one byte per clock).
+static void refuse(sub_walk& w, int status) {
+    w.status = status;
+    w.st = w.pos < w.end ? ST_SKIP : ST_FINISH;
+}
+
+// Enter an array of messages of w.n elements (its count, if variable, read).
+static void enter_loop(sub_walk& w) {
+    bool zero = w.ins.variable && w.ins.pub == PUB_ZERO;
+    if (w.ins.variable && w.quiet == 0) w.out_len += 4;
+    if (w.n == 0) {
+        w.pc = w.ins.jump + 1;
+    } else {
+        w.left[w.depth] = w.n;
+        w.quiet_of[w.depth] = zero;
+        w.depth++;
+        if (zero) w.quiet++;
+        w.pc++;
+    }
+    w.st = ST_DECODE;
+}
+
+// A field's bytes are all taken (or it has none): check it, count what the publisher writes.
+static void finish_field(sub_walk& w) {
+    const instr_t& ins = w.ins;
+    if (ins.sub == SUB_STREAM) w.streamed = true;
+    if (!w.same) { refuse(w, ins.op == OP_VAR ? ins.status2 : ins.status); return; }
+    if (ins.sub == SUB_RANGE && !in_range(w.value, ins)) { refuse(w, ins.status); return; }
+    if (!w.nul_ok) { refuse(w, ins.status3); return; }
+    if (w.quiet == 0) {  // what the publisher writes: its count, its padding, its bytes
+        unsigned written = ins.size;
+        if (ins.op == OP_VAR) {
+            w.out_len += 4;
+            if (ins.pub == PUB_CARRY || ins.pub == PUB_STREAM) written = w.bytes.to_uint();
+            else if (ins.pub == PUB_CONST) written = ins.klen + (ins.nul ? 1 : 0);
+            else written = ins.nul ? 1 : 0;
+        }
+        if (written != 0)
+            w.out_len += pad(4 + w.out_len.to_uint(), ins.op == OP_VAR ? ins.elem_align : ins.align);
+        w.out_len += written;
+    }
+    w.pc++;
+    w.st = ST_DECODE;
+}
+
+// A field of w.bytes bytes starts: check that it fits in the frame, skip its padding.
+static void start_field(sub_walk& w) {
+    const instr_t& ins = w.ins;
+    unsigned p = 0;
+    if (w.bytes != 0) {  // the padding before the field's bytes
+        p = pad(w.pos.to_uint(), ins.op == OP_VAR ? ins.elem_align : ins.align);
+        if (p != 0 && w.pos + p >= w.fend) { refuse(w, SUB_BAD_FRAME_LENGTH); return; }
+    }
+    const ap_uint<32> text = ins.nul ? ap_uint<32>(w.bytes - 1) : w.bytes;  // a string's bytes
+    w.same = (ins.sub != SUB_CHECK) || (text == ins.klen);
+    w.nul_ok = true;
+    if (w.pos + p + w.bytes > w.fend) {  // the frame ends inside this field
+        refuse(w, ins.status != 0 ? int(ins.status) : int(SUB_BAD_FRAME_LENGTH));
+        return;
+    }
+    w.value = 0;
+    w.i = 0;
+    if (w.bytes == 0) {
+        finish_field(w);
+    } else if (p != 0) {
+        w.k = p;
+        w.st = ST_PAD;
+        w.next = ST_BYTES;
+    } else {
+        w.st = ST_BYTES;
+    }
+}
+
+// A count's four bytes are read: check it, then enter the array or start its bytes.
+static void count_read(sub_walk& w) {
+    const instr_t& ins = w.ins;
+    // its maximum (a stream's: exact), then the bytes left in the frame
+    if (ins.sub == SUB_STREAM ? w.n != ins.count : w.n > ins.count) { refuse(w, ins.status); return; }
+    if (ins.nul && w.n == 0) { refuse(w, ins.status); return; }  // a string counts its NUL
+    unsigned long long need = (unsigned long long)w.n.to_uint64() * ins.elem_min;
+    unsigned long long room = w.fend.to_uint64() - w.pos.to_uint64();
+    if (ins.fixed_after >= 0 && need + (unsigned long long)ins.fixed_after != room) {
+        refuse(w, SUB_BAD_FRAME_LENGTH);  // only fixed-size fields follow: exact fit
+        return;
+    }
+    if (need > room) { refuse(w, ins.status); return; }
+    if (ins.op == OP_LOOP) {
+        enter_loop(w);
+    } else {
+        w.bytes = w.n * ins.size;
+        start_field(w);
+    }
+}
+
+// Decode PROGRAM[pc] (no byte taken). Returns whether the state it leaves takes a byte now.
+static bool decode(sub_walk& w) {
+    w.ins = PROGRAM[w.pc];
+    const instr_t& ins = w.ins;
+    if (ins.op == OP_DONE) {
+        // Bytes the options do not announce, that bring the payload to a multiple of
+        // END_ALIGN (Cyclone DDS pads so with options 00 00): taken when they are zero.
+        const unsigned after = w.end.to_uint() - w.pos.to_uint();
+        if (ins.status2 != 0 && w.pos != w.fend && after != 0 && after < END_ALIGN &&
+            after == pad(w.pos.to_uint(), END_ALIGN)) {
+            w.k = after;
+            w.st = ST_ENDPAD;
+            return true;
+        }
+        if (w.pos != w.fend) refuse(w, ins.status);  // bytes left over
+        else w.st = w.pos < w.end ? ST_SKIP : ST_FINISH;  // the padding the options announce
+        return w.st == ST_SKIP;
+    }
+    if (ins.op == OP_ENCAP) {  // CDR's encapsulation header
+        if (w.pos + 4 > w.fend) { refuse(w, ins.status); return w.st == ST_SKIP; }
+        w.k = 0;
+        w.st = ST_ENCAP;
+        return true;
+    }
+    if (ins.op == OP_END) {
+        if (--w.left[w.depth - 1] != 0) {
+            w.pc = ins.jump + 1;
+        } else {
+            w.depth--;
+            if (w.quiet_of[w.depth]) w.quiet--;
+            w.pc++;
+        }
+        return false;
+    }
+    if (ins.op == OP_VAR || (ins.op == OP_LOOP && ins.variable)) {  // a count first
+        unsigned p = 0;
+        p = pad(w.pos.to_uint(), ins.align);
+        if (p != 0 && w.pos + p >= w.fend) { refuse(w, SUB_BAD_FRAME_LENGTH); return w.st == ST_SKIP; }
+        if (w.quiet == 0) w.out_len += pad(4 + w.out_len.to_uint(), ins.align);
+        if (w.pos + p + 4 > w.fend) { refuse(w, ins.status); return w.st == ST_SKIP; }
+        w.n = 0;
+        w.k = 0;
+        if (p != 0) {
+            w.k = p;
+            w.st = ST_PAD;
+            w.next = ST_COUNT;
+        } else {
+            w.st = ST_COUNT;
+        }
+        return true;
+    }
+    if (ins.op == OP_LOOP) {
+        w.n = ins.count;
+        enter_loop(w);
+        return false;
+    }
+    w.bytes = ins.size;  // OP_FIXED
+    start_field(w);
+    return w.st == ST_PAD || w.st == ST_BYTES || w.st == ST_SKIP;
+}
+
+// Take one byte `b` of the frame in the current state.
+static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& carry_out) {
+    const instr_t& ins = w.ins;
+    w.pos++;
+    switch (w.st) {
+    case ST_LEN:
+        w.end.range(8 * w.k + 7, 8 * w.k) = b;
+        if (++w.k == 4) {
+            const ap_uint<32> frame_length = w.end;
+            if (frame_length < MIN_BODY_BYTES || frame_length > MAX_FRAME_BYTES) {
+                w.status = SUB_BAD_FRAME_LENGTH;  // not to be trusted for skipping: wait for the next frame
+                w.st = ST_FINISH;
+                return;
+            }
+            w.end = frame_length + 4;
+            w.fend = w.end;
+            w.st = ST_DECODE;
+        }
+        break;
+    case ST_PAD:  // alignment padding (its values are not looked at)
+        if (--w.k == 0) w.st = w.next;
+        break;
+    case ST_COUNT:
+        w.n.range(8 * w.k + 7, 8 * w.k) = b;
+        if (ins.sub == SUB_CARRY) {
+            carry_out.write(b);
+            w.carried++;
+        }
+        if (++w.k == 4) count_read(w);
+        break;
+    case ST_BYTES:
+        if (ins.sub == SUB_CARRY || ins.sub == SUB_RANGE) {
+            carry_out.write(b);
+            w.carried++;
+        }
+        if (w.i < 8) w.value |= (unsigned long long)b.to_uint() << (8 * w.i.to_uint());
+        if (ins.sub == SUB_STREAM) stream_out.write(b);
+        if (ins.nul && w.i + 1 == w.bytes) w.nul_ok = (b == 0);
+        else
+        if (ins.sub == SUB_CHECK && (w.i >= ins.klen || b != CONSTS[ins.kaddr + w.i])) w.same = false;
+        if (++w.i == w.bytes) finish_field(w);
+        break;
+    case ST_ENCAP:
+        if (w.k < 2 && b != CONSTS[ins.kaddr + w.k]) w.hdr_ok = false;
+        if (++w.k == 4) {
+            if (!w.hdr_ok) { refuse(w, ins.status); break; }
+            const unsigned tail = b.to_uint() & ENCAP_PAD_MASK;
+            if (w.pos + tail > w.fend) { refuse(w, SUB_BAD_FRAME_LENGTH); break; }
+            w.fend -= tail;
+            w.out_len += ins.klen;
+            w.pc++;
+            w.st = ST_DECODE;
+        }
+        break;
+    case ST_ENDPAD:
+        if (b != 0) refuse(w, ins.status2);  // the rest is skipped
+        else if (--w.k == 0) w.st = ST_FINISH;
+        break;
+    default:  // ST_SKIP: a refused frame, to its end (or an accepted one's announced end padding)
+        if (w.pos == w.end) w.st = ST_FINISH;
+        break;
+    }
+}
+
+// Interpret one frame. `status` gets SUB_OK or the status of the field that made it refuse the
+// frame. The streamed bytes go to stream_out, the carried ones to carry_out; when either did,
+// meta_out gets the frame's meta (drop set if the frame was refused after them).
+void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out,
+                meta_stream& meta_out, ap_uint<8>& status) {
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = stream_out)
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = carry_out)
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_out)
+    HLS_PRAGMA(HLS INTERFACE ap_vld port = status)
+    HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one frame per call
+    HLS_PRAGMA(HLS HLS aggregate variable = meta_out)
+    // The walk and its constants are ROMs read every clock (a range check reads both bounds at
+    // once): constants in logic, so no block-RAM port limits the loop's II.
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = PROGRAM complete)
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = CONSTS complete)
+    sub_walk w;
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = w.left complete)
+    HLS_PRAGMA(HLS ARRAY_PARTITION variable = w.quiet_of complete)
+    w.st = ST_LEN;
+    w.next = ST_DECODE;
+    w.ins = PROGRAM[0];
+    w.pc = 0;
+    w.pos = 0;
+    w.end = 0;
+    w.fend = 0;
+    w.nul_ok = true;
+    w.hdr_ok = true;
+    w.out_len = 0;
+    w.n = 0;
+    w.bytes = 0;
+    w.i = 0;
+    w.k = 0;
+    w.value = 0;
+    w.same = true;
+    w.carried = 0;
+    w.streamed = false;
+    w.status = SUB_OK;
+    w.depth = 0;
+    w.quiet = 0;
     for (int d = 0; d < LOOP_DEPTH; d++) {
-        left[d] = 0;
-        quiet_of[d] = false;
+        HLS_PRAGMA(HLS UNROLL)
+        w.left[d] = 0;
+        w.quiet_of[d] = false;
     }
-    unsigned pc = 0;
-    while (true) {
-        HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 14)
-        const instr_t ins = PROGRAM[pc];
-        if (ins.op == OP_DONE) {
-            // Bytes the options do not announce, that bring the payload to a multiple of
-            // END_ALIGN (Cyclone DDS pads so with options 00 00): taken when they are zero.
-            const unsigned after = end.to_uint() - pos.to_uint();
-            if (ins.status2 != 0 && pos != fend && after != 0 && after < END_ALIGN &&
-                after == pad(pos.to_uint(), END_ALIGN)) {
-                for (unsigned i = 0; i < after; i++) {
-                    if (read_u8(in, pos) != 0) {
-                        status = ins.status2;  // the rest is skipped below
-                        break;
-                    }
-                }
-                break;
-            }
-            if (pos != fend) status = ins.status;  // bytes left over
-            break;
-        }
-        if (ins.op == OP_ENCAP) {  // CDR's encapsulation header
-            if (pos + 4 > fend) { status = ins.status; break; }
-            byte_t h[4];
-            for (int i = 0; i < 4; i++) h[i] = read_u8(in, pos);
-            if (h[0] != CONSTS[ins.kaddr] || h[1] != CONSTS[ins.kaddr + 1]) { status = ins.status; break; }
-            unsigned tail = h[3].to_uint() & ENCAP_PAD_MASK;
-            if (pos + tail > fend) { status = SUB_BAD_FRAME_LENGTH; break; }
-            fend -= tail;
-            out_len += ins.klen;
-            pc++;
-            continue;
-        }
-        if (ins.op == OP_END) {
-            if (--left[depth - 1] != 0) {
-                pc = ins.jump + 1;
-                continue;
-            }
-            depth--;
-            if (quiet_of[depth]) quiet--;
-            pc++;
-            continue;
-        }
-        ap_uint<32> n = ins.count;  // OP_VAR and variable OP_LOOP: the count read below
-        if (ins.op == OP_VAR || (ins.op == OP_LOOP && ins.variable)) {
-            const unsigned p = pad(pos.to_uint(), ins.align);
-            if (p != 0 && pos + p >= fend) { status = SUB_BAD_FRAME_LENGTH; break; }
-            skip_bytes(in, pos, p);
-            if (quiet == 0) out_len += pad(4 + out_len.to_uint(), ins.align);
-            if (pos + 4 > fend) { status = ins.status; break; }
-            for (int i = 0; i < 4; i++) {
-                byte_t b = read_u8(in, pos);
-                n.range(8 * i + 7, 8 * i) = b;
-                if (ins.sub == SUB_CARRY) meta.carry[carried++] = b;
-            }
-            // its maximum (a stream's: exact), then the bytes left in the frame
-            if (ins.sub == SUB_STREAM ? n != ins.count : n > ins.count) { status = ins.status; break; }
-            if (ins.nul && n == 0) { status = ins.status; break; }  // a string counts its NUL
-            unsigned long long need = (unsigned long long)n.to_uint64() * ins.elem_min;
-            unsigned long long room = fend.to_uint64() - pos.to_uint64();
-            if (ins.fixed_after >= 0 && need + (unsigned long long)ins.fixed_after != room) {
-                status = SUB_BAD_FRAME_LENGTH;  // only fixed-size fields follow: exact fit
-                break;
-            }
-            if (need > room) { status = ins.status; break; }
-        }
-        if (ins.op == OP_LOOP) {
-            bool zero = ins.variable && ins.pub == PUB_ZERO;
-            if (ins.variable && quiet == 0) out_len += 4;
-            if (n == 0) {
-                pc = ins.jump + 1;
-                continue;
-            }
-            left[depth] = n;
-            quiet_of[depth] = zero;
-            depth++;
-            if (zero) quiet++;
-            pc++;
-            continue;
-        }
-        // OP_FIXED or OP_VAR: the bytes
-        ap_uint<32> bytes = ins.op == OP_FIXED ? ap_uint<32>(ins.size) : ap_uint<32>(n * ins.size);
-        if (bytes != 0) {  // the padding before the field's bytes
-            const unsigned p = pad(pos.to_uint(), ins.op == OP_VAR ? ins.elem_align : ins.align);
-            if (p != 0 && pos + p >= fend) { status = SUB_BAD_FRAME_LENGTH; break; }
-            skip_bytes(in, pos, p);
-        }
-        if (pos + bytes > fend) {  // the frame ends inside this field
-            status = ins.status != 0 ? int(ins.status) : int(SUB_BAD_FRAME_LENGTH);
-            break;
-        }
-        const ap_uint<32> text = ins.nul ? ap_uint<32>(bytes - 1) : bytes;  // a string's bytes
-        bool same = (ins.sub != SUB_CHECK) || (text == ins.klen);
-        bool nul_ok = true;
-        unsigned long long value = 0;  // a SUB_RANGE field, little-endian
-        for (ap_uint<32> i = 0; i < bytes; i++) {
-            HLS_PRAGMA(HLS PIPELINE II = 1)
-            byte_t b = read_u8(in, pos);
-            if (ins.sub == SUB_CARRY || ins.sub == SUB_RANGE) meta.carry[carried++] = b;
-            if (i < 8) value |= (unsigned long long)b.to_uint() << (8 * i);
-            if (ins.sub == SUB_STREAM) stream_out.write(b);
-            if (ins.nul && i + 1 == bytes) nul_ok = (b == 0);
-            else
-            if (ins.sub == SUB_CHECK && (i >= ins.klen || b != CONSTS[ins.kaddr + i])) same = false;
-        }
-        if (ins.sub == SUB_STREAM) streamed = true;
-        if (!same) {
-            status = ins.op == OP_VAR ? ins.status2 : ins.status;
-            break;
-        }
-        if (ins.sub == SUB_RANGE && !in_range(value, ins)) {
-            status = ins.status;
-            break;
-        }
-        if (!nul_ok) {
-            status = ins.status3;
-            break;
-        }
-        if (quiet == 0) {  // what the publisher writes: its count, its padding, its bytes
-            unsigned written = ins.size;
-            if (ins.op == OP_VAR) {
-                out_len += 4;
-                if (ins.pub == PUB_CARRY || ins.pub == PUB_STREAM) written = bytes.to_uint();
-                else if (ins.pub == PUB_CONST) written = ins.klen + (ins.nul ? 1 : 0);
-                else written = ins.nul ? 1 : 0;
-            }
-            if (written != 0)
-                out_len += pad(4 + out_len.to_uint(), ins.op == OP_VAR ? ins.elem_align : ins.align);
-            out_len += written;
-        }
-        pc++;
-    }
-    // Refused: skip the rest of the frame.
-    while (pos < end) {
+    while (w.st != ST_FINISH) {
         HLS_PRAGMA(HLS PIPELINE II = 1)
-        HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 67108864)
-        read_u8(in, pos);
+        HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 67108878)
+        if (w.st == ST_DECODE && !decode(w)) continue;  // a step with no byte of its own
+        if (w.st == ST_FINISH) break;
+        take(w, in.read(), stream_out, carry_out);
     }
-    if (streamed) {
-        meta.out_len = out_len;
-        meta.drop = (status != SUB_OK);
+    if (w.streamed || w.carried != 0) {
+        frame_meta meta;
+        meta.out_len = w.out_len;
+        meta.carried = w.carried;
+        meta.streamed = w.streamed;
+        meta.drop = (w.status != SUB_OK);
         meta_out.write(meta);
     }
-    return status;
+    status = w.status;
 }
 
 // fifo2axi: the streamed bytes become AXI4-Stream beats of one element each, byte i of the
 // element in TDATA bits 8i+7..8i, TUSER on the first element, TLAST on the last.
 void fifo2axi(byte_stream& in, elem_stream& out) {
+    HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
+    HLS_PRAGMA(HLS INTERFACE axis port = out)
+    HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one array per call
     for (int e = 0; e < STREAM_LENGTH; e++) {
         HLS_PRAGMA(HLS PIPELINE II = 4)
         elem_beat beat;

@@ -36,24 +36,30 @@ typedef hls::stream<byte_t> byte_stream;
 typedef ap_axiu<32, 1, 1, 1> elem_beat;  // one element of the stream
 typedef hls::stream<elem_beat> elem_stream;
 
-// What the subscriber hands the publisher per frame whose stream went to the application:
-// the publisher's frame length, the carried bytes (in wire order, lengths included) and
-// whether the frame was refused after its stream had gone out (then the publisher drops it).
+// What the subscriber hands the publisher per frame whose stream or carried bytes went out: one
+// narrow FIFO word (45 bits of fields). The carried bytes themselves (in wire order,
+// lengths included) travel on a byte FIFO of their own, carry (depth CARRY_BYTES), as the
+// stream's bytes do on theirs.
 struct frame_meta {
-    ap_uint<32> out_len;
-    bool drop;
-    byte_t carry[CARRY_BYTES + 8];  // (+8: g++ cannot see that no walk reads past CARRY_BYTES)
+    ap_uint<32> out_len;  // the publisher's frame length
+    ap_uint<11> carried;  // bytes this frame put on the carry FIFO
+    bool streamed;  // the stream went to the application
+    bool drop;  // refused after that: the publisher drops the frame
 };
 typedef hls::stream<frame_meta> meta_stream;
+#define CARRY_FIFO_DEPTH CARRY_BYTES
 
 void subscriber_connection_header(byte_stream& out);
 void publisher_connection_header(byte_stream& out);
 
-int subscriber(byte_stream& in, byte_stream& stream_out, meta_stream& meta_out);
+// The block design's cores, each a top function of its own (run_hls.tcl), free-running
+// (ap_ctrl_none); their stream types chain: bytes -> beats -> beats -> bytes.
+void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out,
+                meta_stream& meta_out, ap_uint<8>& status);
 void fifo2axi(byte_stream& in, elem_stream& out);
 void stream_filter(elem_stream& in, elem_stream& out);
 void axi2fifo(elem_stream& in, byte_stream& out);
-void publisher(byte_stream& in, meta_stream& meta_in, byte_stream& out);
+void publisher(byte_stream& in, byte_stream& carry_in, meta_stream& meta_in, byte_stream& out);
 int ros_fpga_node(byte_stream& in, byte_stream& out);
 
 #endif  // ROS_NODE_H
