@@ -92,3 +92,18 @@ def test_docs_keeps_only_guides() -> None:
     for page in sorted((ROOT / "docs").glob("*.md")):
         if page.name != "README.md":
             assert page.read_text(encoding="utf-8").startswith("# Guide"), page.name
+
+
+def test_constants_the_guides_name_are_defined() -> None:
+    """A guide names a limit's constant instead of restating its value: each such name is
+    defined at the top level of a module of the library or the tests (environment variables,
+    which the code reads by their quoted name, are not constants)."""
+    sources = [p.read_text(encoding="utf-8")
+               for p in [*(ROOT / "rosfpga_lab").rglob("*.py"), *(ROOT / "tests").rglob("*.py")]]
+    defined = {name for text in sources
+               for name in re.findall(r"^([A-Z][A-Z0-9_]+)\b[^=\n]*=", text, re.M)}
+    quoted = {name for text in sources for name in re.findall(r"[\"']([A-Z][A-Z0-9_]+)[\"']", text)}
+    named = {(page.name, name) for page in (ROOT / "docs").glob("*.md")
+             for name in re.findall(r"`(?:[a-z_.]+\.)?([A-Z][A-Z0-9_]{3,})`",
+                                    page.read_text(encoding="utf-8"))}
+    assert sorted(pair for pair in named if pair[1] not in defined | quoted) == []
