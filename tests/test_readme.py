@@ -1,9 +1,12 @@
 """The README stays short and its links lead somewhere: at most 250 lines of at most 110
 characters; every relative link of the README, ARCHITECTURE.md, docs/, course/ and data/
-pages names a file that exists; the Quick start is what lab.sh says it does."""
+pages names a file that exists; the Quick start is what lab.sh says it does. The library
+reference is the package docstrings: every package has one, every file a docstring names
+exists, and docs/ holds only guides."""
 
 from __future__ import annotations
 
+import ast
 import re
 from pathlib import Path
 
@@ -52,3 +55,55 @@ def test_the_notebook_table_names_every_notebook_and_real_packages() -> None:
     for row in rows:
         drives = set(re.findall(r"`([a-z_]+)`", row[2]))
         assert drives and drives <= packages, row
+
+
+PACKAGES = sorted(p.parent for p in (ROOT / "rosfpga_lab").glob("*/__init__.py"))
+
+
+def _docstring_paths(path: Path) -> list[str]:
+    """The file paths a module's docstring names in backquotes (``a/b.ext`` or ``b/``...)."""
+    doc = ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or ""
+    return re.findall(r"``([\w./-]+/[\w.-]+\.(?:py|md|yaml|v|vh|sv|cpp|json|pcapng|bin|png))``", doc)
+
+
+def test_every_package_has_its_reference_docstring() -> None:
+    """The library reference is the package docstrings: none is missing or a one-liner."""
+    thin = [p.name for p in PACKAGES
+            if len((ast.get_docstring(ast.parse((p / "__init__.py").read_text())) or "")
+                   .splitlines()) < 5]
+    assert thin == []
+
+
+def test_files_the_docstrings_name_exist() -> None:
+    """Every file a package's or module's docstring names is there: relative to the repository,
+    to the package or to the module's own folder."""
+    broken = []
+    for module in sorted((ROOT / "rosfpga_lab").rglob("*.py")):
+        package = ROOT / "rosfpga_lab" / module.relative_to(ROOT / "rosfpga_lab").parts[0]
+        for name in _docstring_paths(module):
+            if not any((base / name).exists() for base in (ROOT, package, module.parent)):
+                broken.append(f"{module.relative_to(ROOT)}: {name}")
+    assert broken == []
+
+
+def test_docs_keeps_only_guides() -> None:
+    """docs/ is no second library reference: every page there says it is a guide, and the
+    index says why each one is not a docstring."""
+    for page in sorted((ROOT / "docs").glob("*.md")):
+        if page.name != "README.md":
+            assert page.read_text(encoding="utf-8").startswith("# Guide"), page.name
+
+
+def test_constants_the_guides_name_are_defined() -> None:
+    """A guide names a limit's constant instead of restating its value: each such name is
+    defined at the top level of a module of the library or the tests (environment variables,
+    which the code reads by their quoted name, are not constants)."""
+    sources = [p.read_text(encoding="utf-8")
+               for p in [*(ROOT / "rosfpga_lab").rglob("*.py"), *(ROOT / "tests").rglob("*.py")]]
+    defined = {name for text in sources
+               for name in re.findall(r"^([A-Z][A-Z0-9_]+)\b[^=\n]*=", text, re.M)}
+    quoted = {name for text in sources for name in re.findall(r"[\"']([A-Z][A-Z0-9_]+)[\"']", text)}
+    named = {(page.name, name) for page in (ROOT / "docs").glob("*.md")
+             for name in re.findall(r"`(?:[a-z_.]+\.)?([A-Z][A-Z0-9_]{3,})`",
+                                    page.read_text(encoding="utf-8"))}
+    assert sorted(pair for pair in named if pair[1] not in defined | quoted) == []

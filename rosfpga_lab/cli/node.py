@@ -7,11 +7,18 @@ import logging
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rosfpga_lab.cli._signals import StopSignals
 from rosfpga_lab.config.params import ParamSource
 from rosfpga_lab.cli._args import non_negative_float, positive_float, positive_int
 from rosfpga_lab.config.vocabulary import MODELS, TIMINGS
+
+if TYPE_CHECKING:
+    from rosfpga_lab.component import FpgaComponent
+    from rosfpga_lab.config import NodeConfig
+    from rosfpga_lab.config.rosargs import NodeNames, RosArgs
+    from rosfpga_lab.graph import EmbeddedMaster
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -122,13 +129,47 @@ def _say_shut_down(reason: str) -> None:
           "or another node took its name)", file=sys.stderr, flush=True)
 
 
-def _run(args: argparse.Namespace, stop: StopSignals) -> int:
-    from rosfpga_lab.component import ComponentShutDown, FpgaComponent, limits, master_answers
-    from rosfpga_lab.config import load_config, master_uri
-    from rosfpga_lab.config.params import ParamSource, runtime_settings
-    from rosfpga_lab.config.rosargs import RosArgs, advertise_host, component_names
+def _start_component(args: argparse.Namespace, config: NodeConfig, ros: RosArgs,
+                     names: NodeNames, host: str, uri: str,
+                     cmdline: ParamSource) -> tuple[FpgaComponent, str]:
+    """The component started with its parameters (the server's ~params, the command line's,
+    which also land on the server as rospy puts them) and the model it runs."""
+    from rosfpga_lab.component import FpgaComponent
+    from rosfpga_lab.config.params import runtime_settings
+    from rosfpga_lab.graph.xmlrpc import call
+
+    settings = runtime_settings(config, _server_params(uri, names.node), cmdline)
+    for key, value in ros.params.items():   # as rospy: _x:=v lands on the server as ~x
+        call(uri, "setParam", names.node, f"{names.node}/{key}", value)
+    model = args.model or settings.get("model", MODELS[0])
+    kw = {k: v for k, v in settings.items() if k in ("input_queue", "output_queue")}
+    if args.input_queue is not None:
+        kw["input_queue"] = args.input_queue
+    if args.output_queue is not None:
+        kw["output_queue"] = args.output_queue
+    component = FpgaComponent.from_config(
+        config, master_uri=uri, model=model, timing=args.timing, name=names.node,
+        host=host, input_topic=names.input, output_topic=names.output, **kw)
+    component.start()
+    return component, model
+
+
+def _start_embedded_master(uri: str) -> EmbeddedMaster:
+    """``--embedded-master``: a master of this process's own, at the URI no master answered."""
     from rosfpga_lab.graph import EmbeddedMaster
-    from rosfpga_lab.graph.xmlrpc import call, split_uri
+    from rosfpga_lab.graph.xmlrpc import split_uri
+
+    host, port, _path = split_uri(uri)
+    master = EmbeddedMaster(host=host, port=port).start()
+    print(f"started the embedded master at {master.uri}", file=sys.stderr)
+    return master
+
+
+def _run(args: argparse.Namespace, stop: StopSignals) -> int:
+    from rosfpga_lab.component import ComponentShutDown, limits, master_answers
+    from rosfpga_lab.config import load_config, master_uri
+    from rosfpga_lab.config.params import runtime_settings
+    from rosfpga_lab.config.rosargs import RosArgs, advertise_host, component_names
 
     if not args.quiet:
         logging.basicConfig(level=logging.INFO, format="[%(levelname)s] %(message)s",
@@ -144,25 +185,11 @@ def _run(args: argparse.Namespace, stop: StopSignals) -> int:
     master = None
     if not master_answers(uri):
         if args.embedded_master:
-            host_, port, _path = split_uri(uri)
-            master = EmbeddedMaster(host=host_, port=port).start()
-            print(f"started the embedded master at {master.uri}", file=sys.stderr)
+            master = _start_embedded_master(uri)
         elif not _wait_for_master(uri, stop, t_end):
             return 0 if stop.fired is not None else 1
     try:
-        settings = runtime_settings(config, _server_params(uri, names.node), cmdline)
-        for key, value in ros.params.items():   # as rospy: _x:=v lands on the server as ~x
-            call(uri, "setParam", names.node, f"{names.node}/{key}", value)
-        model = args.model or settings.get("model", MODELS[0])
-        kw = {k: v for k, v in settings.items() if k in ("input_queue", "output_queue")}
-        if args.input_queue is not None:
-            kw["input_queue"] = args.input_queue
-        if args.output_queue is not None:
-            kw["output_queue"] = args.output_queue
-        component = FpgaComponent.from_config(
-            config, master_uri=uri, model=model, timing=args.timing, name=names.node,
-            host=host.host, input_topic=names.input, output_topic=names.output, **kw)
-        component.start()
+        component, model = _start_component(args, config, ros, names, host.host, uri, cmdline)
     except ComponentShutDown as exc:
         # rosnode kill between its registrations: an ending as normal as one after them
         if master is not None:

@@ -1,5 +1,14 @@
 """``rosfpga-lab notebooks build|nbgrader|html``: student notebooks from the solutions, an nbgrader
-course's source, offline HTML pages."""
+course's source, offline HTML pages.
+
+``notebooks html notebooks/solutions/*.ipynb --output-dir site`` runs each notebook in a fresh
+kernel (in its own directory) and writes ``site/NN_*.html``. Every widget shows its static form
+(``rosfpga_lab.widgets``): the pages need no JavaScript and no network, and sentences about
+clicking (marked ``<span class="rfl-live-only">`` in the notebooks) are left out. (``jupyter
+nbconvert --execute --to html`` leaves every widget an empty box offline: it fetches the widgets'
+JavaScript from the network.) ``--no-execute`` exports stored outputs; ``--allow-errors`` exports
+student notebooks, which stop at each exercise.
+"""
 
 from __future__ import annotations
 

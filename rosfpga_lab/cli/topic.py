@@ -1,4 +1,16 @@
-"""``rosfpga-lab topic``: list, info, echo, pub and hz, like ``rostopic``."""
+"""``rosfpga-lab topic``: list, info, echo, pub and hz, like ``rostopic``.
+
+It never starts a master (see the parser's description). As rostopic's: ``echo`` of a topic not
+published yet warns and waits (``--timeout`` bounds it) and prints genpy's YAML, decoding a type
+the lab ships no definition for from the publisher's ``message_definition`` (md5 checked; or
+``--msg-path DIR``), says how many messages it dropped when printing fell behind
+(``--queue-size``), and ``--bag FILE`` records a ROS 1 bag (``rosfpga_lab.msg.bag``); ``hz``
+prints "no new messages" when none arrived since its last line; ``pub`` takes rostopic's forms
+(partial messages inside arrays, positional values, ``stamp: now``, ``header: auto``); a slave-API
+``shutdown`` from another node ends ``echo``, ``hz`` and ``pub`` with its reason. A master reply
+over ``graph.limits.MAX_XMLRPC_REPLY`` is reported with its size, never as "cannot reach the ROS
+master".
+"""
 
 from __future__ import annotations
 
@@ -118,6 +130,8 @@ def _stopped_remotely(node) -> bool:
     return False
 
 
+# Long (about 80 lines) on purpose: the callback ``show`` and the waiting loop share the echo's
+# state (the bag, decoders per publisher header, counts, the failure); a class would only move it.
 def _echo(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import GraphError, tools
     from rosfpga_lab.msg import MsgError, deserialize

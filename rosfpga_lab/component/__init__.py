@@ -18,6 +18,20 @@ Quick use::
         rig.start_camera()
         ...
 
+The component is an ordinary ROS 1 node whose data path is the modelled circuit, started from
+the YAML file ``rosfpga-lab generate`` reads: it pushes every received TCPROS frame (the raw
+bytes, never deserialized in software) through the circuit model and publishes the frame the
+circuit's message generator writes. Frames wait in front of the circuit in one queue and behind
+it in one queue per subscriber (sizes in module ``limits``; ``--input-queue``,
+``--output-queue``); when one is full the oldest frame is dropped, counted and logged. A frame of
+the wrong size or encoding is refused with its reason (field and byte offset), counted by kind
+and logged, and the next good frame comes out right. The component survives its input
+publisher dying and coming back, a master restart (it registers again and keeps its
+established input connections, as roscpp does) and a subscriber too slow for the rate (only
+that subscriber loses frames). Commands: ``rosfpga-lab demo`` (``--view`` for a live page on
+127.0.0.1), ``node CONFIG``, ``camera``, ``view`` (ARCHITECTURE.md's command table); the
+measured figures are printed by ``rosfpga-lab demo`` and ``rosfpga-lab bench`` (:mod:`rosfpga_lab.bench`).
+
 Modules: ``fpga`` (:class:`FpgaComponent`, :class:`FrameRecord`), ``stats``
 (:class:`ComponentStats`), ``sources`` (pictures: synthetic, grace_hopper, files), ``camera``
 (:class:`Camera`, :class:`Viewer`), ``checker`` (:class:`Checker`, OpenCV as the oracle),

@@ -9,6 +9,10 @@ Jinja2 (a test holds that)::
     config = load_config("data/fpga_dilate_rgba8.yaml")
     config.image.width, config.application.op, config.node.master_uri
 
+The same package owns what every layer shares: the encodings and operations (``dilate``,
+``erode``, ``passthrough``, ``custom``), the ROS name rules (rosgraph's, ASCII letters only, as
+roscpp) and the one rule for which master a command talks to (:func:`master_uri`).
+
 Owners: :mod:`~rosfpga_lab.config.vocabulary` (encodings and operations),
 :mod:`~rosfpga_lab.config.limits` (limits and defaults), :mod:`~rosfpga_lab.config.master` (which
 ROS master a program talks to), :mod:`~rosfpga_lab.config.names` (ROS names),

@@ -24,6 +24,21 @@ Programs that must join an existing graph pass ``master_uri`` explicitly instead
 ``rosfpga-lab topic`` does (``--master-uri``, else ``ROS_MASTER_URI``, else 11311; it stops
 with an error and a hint when no master answers there).
 
+``Trace`` records the whole conversation (``Node(..., trace=trace)``, ``EmbeddedMaster(...,
+trace=trace)``); ``trace.summary()`` is the paper's Figure 2 from a real run. Real rospy, roscpp
+and rostopic work against the lab's master, and lab nodes with a real roscore. Like rospy and
+roscpp nodes, every lab node publishes ``rosgraph_msgs/Log`` on ``/rosout`` and serves
+``~get_loggers`` and ``~set_logger_level``; services are TCPROS on the node's own service port
+(``node.advertise_service(name, type, handler)``, ``node.call_service(name, type, request)``;
+codec ``tcpros.service``, shipped types ``msg.srv``). After a master restart every lab node
+registers again and says so once. The master answers ``system.multicall`` and matches rosmaster
+1.15's replies (golden-tested). The XML-RPC limits (backlog, body sizes, bodies in flight, reply
+cap) are the constants of module ``limits``; ``tests/benchmarks/bench_master_load.py`` measures
+them beside rosmaster. Deliberate differences from real ROS: no UDPROS; the lab's publisher
+answers a malformed header with an ``error=`` header where roscpp just drops the connection; the
+lab's subscriber also checks the publisher's md5; both sides time the handshake out
+(``tcpros.limits``); the default host is 127.0.0.1 rather than the machine's hostname.
+
 Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``http`` (its sans-IO HTTP
 decoder), ``master`` (EmbeddedMaster),
 ``node`` (Node, Slave API, TCPROS server), ``publisher``, ``subscriber``, ``trace`` (the recorded

@@ -133,7 +133,8 @@ class _PublisherLink:
             hard_close(self.sock)
             self.sock = None
 
-    def _connect_once(self) -> bool:
+    def _request_topic(self) -> tuple[str, int]:
+        """Ask the publisher's slave API for a TCPROS address: (host, port)."""
         sub, node = self.sub, self.sub.context
         reply = call(self.pub_uri, "requestTopic", node.name, sub.topic, [["TCPROS"]],
                      trace=node.trace, caller=node.name, timeout=CONNECT_TIMEOUT)
@@ -143,7 +144,27 @@ class _PublisherLink:
         if not (isinstance(proto, list) and len(proto) >= 3 and proto[0] == "TCPROS"
                 and isinstance(proto[1], str) and isinstance(proto[2], int)):
             raise GraphError(f"requestTopic gave an unusable protocol description: {proto!r}")
-        host, port = proto[1], proto[2]
+        return proto[1], proto[2]
+
+    def _send_header(self, sock: socket.socket, conn: int,
+                     ends: dict[str, str]) -> SubscriberHandshake:
+        """Start the handshake: send the subscriber's connection header, recorded in the trace."""
+        sub, node = self.sub, self.sub.context
+        hs = SubscriberHandshake(callerid=node.name, topic=sub.topic, md5sum=sub.md5sum,
+                                 type_name=sub.type_name, message_definition=sub.message_definition,
+                                 tcp_nodelay=sub.tcp_nodelay, max_frame=sub.max_frame)
+        request = hs.initiate()
+        t0 = time.time()
+        sock.sendall(request)
+        node.trace.record("tcpros_header", node.name, role="out", src=node.name,
+                          dst=node.trace.name_of(self.pub_uri), method=sub.topic,
+                          args=dict(hs.fields), raw=request, size=len(request), conn=conn, t0=t0,
+                          **ends)
+        return hs
+
+    def _connect_once(self) -> bool:
+        sub, node = self.sub, self.sub.context
+        host, port = self._request_topic()
         if self.stop.is_set():
             return False
         sock = socket.create_connection((host, port), timeout=CONNECT_TIMEOUT)
@@ -159,16 +180,7 @@ class _PublisherLink:
         node.trace.names[ends["local"]] = node.name
         node.trace.record("tcp_connect", node.name, role="out", src=node.name,
                           dst=node.trace.name_of(self.pub_uri), method=sub.topic, conn=conn, **ends)
-        hs = SubscriberHandshake(callerid=node.name, topic=sub.topic, md5sum=sub.md5sum,
-                                 type_name=sub.type_name, message_definition=sub.message_definition,
-                                 tcp_nodelay=sub.tcp_nodelay, max_frame=sub.max_frame)
-        request = hs.initiate()
-        t0 = time.time()
-        sock.sendall(request)
-        node.trace.record("tcpros_header", node.name, role="out", src=node.name,
-                          dst=node.trace.name_of(self.pub_uri), method=sub.topic,
-                          args=dict(hs.fields), raw=request, size=len(request), conn=conn, t0=t0,
-                          **ends)
+        hs = self._send_header(sock, conn, ends)
         deadline = time.monotonic() + HANDSHAKE_TIMEOUT
         publisher, header = peer, dict[str, str]()
         got = False

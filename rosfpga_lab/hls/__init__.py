@@ -13,6 +13,29 @@ the paper's Vivado HLS with ``hls: {flavour: vivado}`` (:data:`generator.HLS_TOO
     generate(config, "build/fpga_dilate")             # rosfpga-lab generate CONFIG -o DIR
     result = run_csim("build/fpga_dilate", frames)    # make + run the testbench
     count_sloc("build/fpga_dilate")                   # rosfpga-lab sloc DIR (Table 1)
+
+On the shell: ``rosfpga-lab generate CONFIG -o DIR``, then ``make -C DIR csim`` (g++:
+"csim: PASS: output equals tb_expected.bin"; ``make csim INPUT=frames.bin [EXPECTED=file]``
+writes output bytes and AXI4-Stream beats to ``csim_out/``), ``make -C DIR rtlsim``, ``synth``,
+``lint`` (:mod:`rosfpga_lab.rtl`). A bad configuration is refused with ``file:line: key:
+problem`` before anything is written; regenerating into a used directory needs ``--force``,
+which deletes only what the previous generation wrote. The application is the lab's dilate /
+erode (its own line buffer and window) or your ``image_filter()`` with ``application: {op:
+custom, source: my_filter.cpp}``. ``include/`` holds the lab's g++ stand-ins for ``ap_int.h``,
+``ap_axi_sdata.h``, ``hls_stream.h`` (and ``hls_video.h`` for the Vivado flavour); the tool
+versions each flavour is for are :data:`generator.HLS_TOOLS` (neither tried here: the lab has no
+Xilinx tools).
+
+Any message type becomes a circuit (issue 19): the configuration names the type, the array the
+application processes and, optionally, checks, maxima and the user's ``.msg`` folders (the keys:
+:mod:`rosfpga_lab.config.schema`); ``hw.layout.layout_from_config(config)`` derives the one walk
+over the frame, and module ``generic`` renders it and compiles it to the walkers' program
+(``program``). ``wire: cdr`` writes the same walkers for ROS 2's CDR samples; on TCPROS,
+``sensor_msgs/Image`` keeps its hand-written project (ARCHITECTURE.md says why). The shipped
+examples are mapped in ``data/README.md``. Golden files of the generated code are in
+``tests/golden/hls/``; after a deliberate template change run
+``ROSFPGA_UPDATE_GOLDEN=1 python -m pytest tests/test_hls_generate.py -k golden`` and review
+``git diff tests/golden/hls``.
 """
 
 from rosfpga_lab.hls.csim import CsimResult, build_csim, run_csim

@@ -52,7 +52,20 @@ Stages (``reference`` / ``fast``), importable for notebooks:
 
 Streams: :class:`Fifo`, :class:`ByteFIFO`, :class:`Beat`, :class:`Beats`. Faults:
 :class:`DropByte`, :class:`DuplicateByte`, :class:`SwapByteOrder`, :class:`LoseTlast`,
-:class:`LoseTuser`, :class:`ShallowFifo`. Errors: :class:`PipelineError` and subclasses.
+:class:`LoseTuser`, :class:`ShallowFifo` (module ``faults``): a fault gives a wrong image, a
+status flag or a typed :class:`PipelineError`, never a hang. Errors: :class:`PipelineError` and
+subclasses. The packing rule (the generalised Figure 7: which bytes of a pixel go where in
+``tdata``, and ``tkeep``) is module ``encodings``'s docstring and :data:`PIXEL_FORMATS`.
+
+Cycles at II=1 (module ``cycles``): ``res.summary()`` prints each stage's cycles, the frame time
+and the payload's time on gigabit Ethernet; for a 640x480 rgba8 frame the byte-wide input FIFO
+(one byte per clock), not the application (one pixel per clock), limits the circuit.
+
+When (module ``clocked``): ``clocked.fifo2axi_clocks(data, width, bytes_per_pixel, in_valid=...,
+out_ready=...)`` follows ``rfl_fifo2axi.v`` register for register and returns every signal at
+every clock (one byte taken per clock, a beat the clock after a pixel's last byte, backpressure
+holding back only a pixel's last byte); a test feeds it a real RTL simulation's offers and
+readiness and requires the RTL's beats at the RTL's clocks.
 """
 
 from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference

@@ -29,6 +29,18 @@ other numeric and ``bool`` arrays      read-only numpy array of the little-endia
 arrays of strings, times, messages     lists
 =====================================  =========================================================
 
+Your own types: ``reg = MsgRegistry.with_defaults(); reg.load_path("my_ws/src")`` (finds
+``PKG/msg/NAME.msg``); ``new_message(reg, TYPE, **fields)`` fills the rest with defaults. Errors
+are typed (``MsgDefinitionError`` with file:line, ``UnknownTypeError``, ``SerializeError`` /
+``DeserializeError`` with field path and byte offset); limits live in module ``limits``. The
+shipped definitions, their versions and why ``message_definition`` is genpy's ``_full_text``
+byte for byte: ``definitions/README.md``. On the command line (``rosfpga_lab.cli.msg``)::
+
+    rosfpga-lab msg show sensor_msgs/Image             # fields (like rosmsg show), md5, full text
+    rosfpga-lab msg md5 [--msg-path DIR]... TYPE...    # one "TYPE MD5" line per type
+    rosfpga-lab msg list [PKG]
+    rosfpga-lab msg layout std_msgs/String --hex "02000000 6869"   # byte layout table
+
 Modules: ``parser`` (text -> MsgSpec), ``registry`` (types, md5, full text), ``decode`` and
 ``encode`` (the fast wire codecs), ``layout`` (byte spans, and the plain reference decoder),
 ``values`` (defaults, new_message), ``builtins`` (types, Time, Duration), ``limits``, ``errors``,

@@ -18,6 +18,33 @@ Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
 than ``sensor_msgs/Image`` gets the generic circuit of :mod:`rosfpga_lab.rtl.generic` (walkers
 stepping through a generated program, one instruction per field of the message), which
 :func:`build` and :func:`run` simulate the same way (``build(design_from_config(config))``).
+
+From the shell (ARCHITECTURE.md's command table; each sub-command's ``--help``)::
+
+    rosfpga-lab generate data/fpga_erode_mono8.yaml -o build/erode   # the RTL goes to build/erode/rtl/
+    make -C build/erode rtlsim        # "rtlsim: PASS: output equals tb_expected.bin"
+    make -C build/erode rtlsim INPUT=frames.bin EXPECTED=expected.bin OUT=out GAP=200 BP=500 VCD=1
+    make -C build/erode lint          # Verilator --lint-only -Wall on rtl/ (0 warnings)
+    rosfpga-lab rtl sim CONFIG --bp 500 --vcd wave.vcd      # against the Python models
+    rosfpga-lab rtl cycles CONFIG     # the cycle model against the RTL (module ``cycles``)
+    rosfpga-lab rtl prove|synth|timing CONFIG
+    rosfpga-lab node CONFIG --model rtl --timing fpga       # the live node runs the Verilog
+
+Simulation (module ``sim``): the testbench streams frames with random input gaps (``GAP``) and
+output backpressure (``BP``, per mille of clocks) and writes ``output.bin``, ``status.txt`` and
+``stats.txt``; with Verilator and a C++ compiler the fast harness ``harness/`` runs instead,
+clock for clock the same (built by ``rosfpga_lab/hls/rtlbuild.py``); Icarus Verilog is the slow fallback;
+``SIM=`` picks one and builds are cached (module ``sim``). Speeds are measured, never asserted:
+``tests/benchmarks/bench_rtl.py``. Without a simulator the RTL tests skip; with
+``ROSFPGA_REQUIRE_RTL=1`` (CI) they fail. ``hw.cycles`` is held to the RTL (module ``cycles``).
+The live node on the RTL (``--model rtl``, ``FpgaComponent(config, model="rtl")``): one
+long-lived simulator, module ``server``; ``--timing fpga`` holds each output until the circuit's
+clocks have passed at ``clock_mhz``. Formal proofs of the stream handshakes (``formal/``, run by
+module ``proofs`` with SymbiYosys; which check, mode and claim: ``rosfpga-lab rtl prove``, limits
+in module ``limits``). The application ``rfl_morph.v``'s clocks and latency are its header
+comment's; synthesis (``synth``: Yosys, the part's family, hierarchy kept, latches refused),
+place and route (``timing``: nextpnr-ecp5) and Table 1's counting rule (``sloc.COUNTED``) are
+their modules' docstrings.
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError

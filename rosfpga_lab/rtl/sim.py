@@ -17,9 +17,9 @@ With Verilator and a C++ compiler (and no waveform wanted), :func:`build` compil
 harness instead (``harness/rfl_harness.cpp`` around ``harness/rfl_harness.v``): a loop without
 ``--timing`` that keeps the frames in memory, evaluates the model once per clock (its nonblocking
 region alone where :func:`nba_only` allows, see :data:`EVAL_MODES`) and does clock for clock what
-the testbench does (same reset, same random draws, same outputs and files), at 18 to 23 M
-clocks/s here (docs/rtl.md: the fast harness) where the testbench on ``verilator --binary --timing``
-does about 3 M. Its serve mode is the
+the testbench does (same reset, same random draws, same outputs and files), several times
+faster than the testbench on ``verilator --binary --timing`` (measured, beside it, by
+``tests/benchmarks/bench_rtl.py``). Its serve mode is the
 long-lived simulator of ``--model rtl`` (:mod:`rosfpga_lab.rtl.server`). How it is built (the
 Verilator options, the eval modes and their fallback, the huge-page link flags) is
 :mod:`rosfpga_lab.hls.rtlbuild`'s, which a generated project's Makefile renders too.

@@ -2,6 +2,10 @@
 
 Nothing here touches a socket or a thread: feed bytes, get events (see ``handshake``); the
 ``graph`` layer does the I/O. Byte layouts match rospy and roscpp exactly (fields sorted by key).
+The handshake is two state machines, publisher and subscriber, driven by one table,
+:data:`TRANSITIONS`, which the notebooks draw (``widgets.StateDiagram(tcpros.TRANSITIONS)``).
+Sizes and the handshake's time-out are the constants of module ``limits``; services (request
+and response over TCPROS) are module ``service``.
 """
 
 from rosfpga_lab.tcpros.errors import (

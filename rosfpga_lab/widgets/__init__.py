@@ -23,6 +23,9 @@ reference::
     W.SequenceDiagram(W.events_from_rtps("data/rtps_image.pcapng"))   # RTPS (DDS) traffic
     live = W.LiveView(max_fps=10); live.update(frame, stamp=t)   # from any thread
     with W.Progress(total, "dilate") as p: p.update()  # or W.track(iterable, desc=...)
+
+What each widget shows and how it stays fast (paged bytes, windowed waveforms) is its module's
+docstring. Notebooks as offline pages: ``rosfpga-lab notebooks html`` (``rosfpga_lab.cli.notebooks``).
 """
 
 from rosfpga_lab.widgets._common import STATIC_EXPORT_PRIORITY, WidgetError, show_static

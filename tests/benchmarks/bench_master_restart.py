@@ -9,6 +9,10 @@ round: output frames while the master was down, seconds from the master's return
 component's re-registration, seconds from the re-registration to the next output frame, and
 the longest gap between two output frames over the whole round.
 
+Measured (20 frames/s): the next output comes 0.02-0.05 s after the component registers again,
+the longest gap is 0.12-0.17 s; before issue 10, no output at all until the camera registered
+again.
+
 Usage: ``python tests/benchmarks/bench_master_restart.py [--rounds 3] [--rate 20] [--down 1.0]``
 """
 

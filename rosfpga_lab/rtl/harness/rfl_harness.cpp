@@ -60,7 +60,8 @@ void Vrfl_harness___024root___eval_nba(Vrfl_harness___024root* vlSelf);
 // The program's machine code on one 2 MiB page. On a virtual machine, the same binary ran at
 // 55 ms or at 110 ms a frame depending on the physical pages its code was read into (dropping
 // the page cache turned a slow copy into a fast one); the huge page is placed by chance too, so
-// it helps on some machines and days, not all (docs/rtl.md: the fast harness). Linked with 2 MiB segment alignment
+// it helps on some machines and days, not all (tests/benchmarks/bench_rtl.py measures it).
+// Linked with 2 MiB segment alignment
 // (HUGE_TEXT_LDFLAGS of rosfpga_lab/hls/rtlbuild.py), the code segment starts on a 2 MiB
 // boundary: it is copied into an anonymous transparent huge page, which then replaces the
 // file's pages at the same addresses. Without that alignment, without transparent huge pages, or when a step fails,
