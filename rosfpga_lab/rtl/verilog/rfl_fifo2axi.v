@@ -35,8 +35,10 @@ module rfl_fifo2axi #(
     // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
 `ifdef __ICARUS__
     initial begin
-        if (BYTES < 1 || BYTES > 4) $fatal(1, "rfl_fifo2axi: BYTES must be 1..4 (one pixel per 32-bit beat)");
-        if (WIDTH < 1 || WIDTH > 65536 || HEIGHT < 1 || HEIGHT > 65536) $fatal(1, "rfl_fifo2axi: WIDTH and HEIGHT must be 1..65536 (16-bit counters)");
+        if (BYTES < 1 || BYTES > 4)
+            $fatal(1, "rfl_fifo2axi: BYTES must be 1..4 (one pixel per 32-bit beat)");
+        if (WIDTH < 1 || WIDTH > 65536 || HEIGHT < 1 || HEIGHT > 65536)
+            $fatal(1, "rfl_fifo2axi: WIDTH and HEIGHT must be 1..65536 (16-bit counters)");
     end
 `else
     if (BYTES < 1 || BYTES > 4) begin : g_bad_bytes

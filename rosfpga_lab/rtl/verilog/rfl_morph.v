@@ -64,9 +64,12 @@ module rfl_morph #(
     // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
 `ifdef __ICARUS__
     initial begin
-        if (BYTES < 1 || BYTES > 4) $fatal(1, "rfl_morph: BYTES must be 1..4 (one pixel per 32-bit beat)");
-        if (OP < 0 || OP > 2) $fatal(1, "rfl_morph: OP must be 0 (dilate), 1 (erode) or 2 (passthrough)");
-        if (OP != 2 && (KSIZE < 1 || KSIZE % 2 == 0)) $fatal(1, "rfl_morph: KSIZE must be odd and at least 1");
+        if (BYTES < 1 || BYTES > 4)
+            $fatal(1, "rfl_morph: BYTES must be 1..4 (one pixel per 32-bit beat)");
+        if (OP < 0 || OP > 2)
+            $fatal(1, "rfl_morph: OP must be 0 (dilate), 1 (erode) or 2 (passthrough)");
+        if (OP != 2 && (KSIZE < 1 || KSIZE % 2 == 0))
+            $fatal(1, "rfl_morph: KSIZE must be odd and at least 1");
         if (WIDTH < 1 || HEIGHT < 1) $fatal(1, "rfl_morph: WIDTH and HEIGHT must be at least 1");
     end
 `else

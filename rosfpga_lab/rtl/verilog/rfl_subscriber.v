@@ -56,9 +56,12 @@ module rfl_subscriber #(
     // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
 `ifdef __ICARUS__
     initial begin
-        if (ENC_LEN < 1 || ENC_LEN > 32 || ENC_LEN > ENCODING_MAX) $fatal(1, "rfl_subscriber: ENC_LEN must be 1..32 and at most ENCODING_MAX");
-        if (FRAME_ID_MAX < 1 || FRAME_ID_MAX >= 16777216 || ENCODING_MAX >= 16777216) $fatal(1, "rfl_subscriber: FRAME_ID_MAX must be 1..2**24-1 and ENCODING_MAX below 2**24");
-        if (MIN_BODY >= 16777216 || MAX_FRAME < MIN_BODY) $fatal(1, "rfl_subscriber: MIN_BODY must be below 2**24 and at most MAX_FRAME");
+        if (ENC_LEN < 1 || ENC_LEN > 32 || ENC_LEN > ENCODING_MAX)
+            $fatal(1, "rfl_subscriber: ENC_LEN must be 1..32 and at most ENCODING_MAX");
+        if (FRAME_ID_MAX < 1 || FRAME_ID_MAX >= 16777216 || ENCODING_MAX >= 16777216)
+            $fatal(1, "rfl_subscriber: FRAME_ID_MAX must be 1..2**24-1 and ENCODING_MAX below 2**24");
+        if (MIN_BODY >= 16777216 || MAX_FRAME < MIN_BODY)
+            $fatal(1, "rfl_subscriber: MIN_BODY must be below 2**24 and at most MAX_FRAME");
     end
 `else
     if (ENC_LEN < 1 || ENC_LEN > 32 || ENC_LEN > ENCODING_MAX) begin : g_bad_enc_len
