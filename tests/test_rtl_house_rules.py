@@ -159,7 +159,7 @@ def test_verilator_refuses_an_illegal_parameter(module: str, params: dict[str, i
     done = subprocess.run([verilator, "--lint-only", f"-I{VERILOG_DIR}", "--top-module", module,
                            *sets, _source(module)], cwd=tmp_path, capture_output=True, text=True,
                           timeout=120)
-    assert done.returncode != 0 and f"USERERROR" in done.stderr and message in done.stderr, \
+    assert done.returncode != 0 and "USERERROR" in done.stderr and message in done.stderr, \
         done.stderr[-3000:]
 
 
@@ -178,7 +178,7 @@ def test_icarus_refuses_an_illegal_parameter(module: str, params: dict[str, int]
     assert done.returncode == 0, done.stdout + done.stderr
     run = subprocess.run(["vvp", "-n", "m.vvp"], cwd=tmp_path, capture_output=True, text=True,
                          timeout=120)
-    assert run.returncode != 0 and f"FATAL" in run.stdout + run.stderr, run.stdout + run.stderr
+    assert run.returncode != 0 and "FATAL" in run.stdout + run.stderr, run.stdout + run.stderr
     assert message in run.stdout + run.stderr
 
 
@@ -219,6 +219,7 @@ def test_legal_defaults_pass_every_contract(module: str, tmp_path: Path) -> None
     assert run.returncode == 0 and "FATAL" not in run.stdout + run.stderr, run.stdout
 
 
+@pytest.mark.rtl
 def test_fifo_edge_depths_are_legal(tmp_path: Path) -> None:
     """DEPTH 2 (and 3 with OUTREG) is the smallest FIFO: accepted."""
     verilator = require_verilator()
