@@ -228,3 +228,16 @@ def test_fifo_edge_depths_are_legal(tmp_path: Path) -> None:
                                *sets, _source("rfl_fifo")], cwd=tmp_path, capture_output=True,
                               text=True, timeout=120)
         assert done.returncode == 0 and "USERERROR" not in done.stderr, done.stderr[-3000:]
+
+
+def test_the_generated_node_wrapper_follows_the_rules(tmp_path: Path) -> None:
+    """rfl_node.v (rtl.params.node_wrapper, the Image top of every configuration) too."""
+    from rosfpga_lab.rtl import rtl_params
+    from rosfpga_lab.rtl.params import node_wrapper
+    from test_rtl_sim import small_config
+
+    path = tmp_path / "rfl_node.v"
+    path.write_text(node_wrapper(rtl_params(small_config("rgba8", width=5, height=3))))
+    lines = _code_lines(path)
+    assert lines[0] == "`default_nettype none" and lines[-1] == "`default_nettype wire"
+    assert stream_problems(ports(path)) == []
