@@ -6,23 +6,25 @@
 // registered here at the rising edge, they reach rfl_node as the testbench's nonblocking
 // drives do. So no input reaches logic without a register between, and the Verilated model
 // has nothing to evaluate when an input changes: one evaluation per clock, at the edge.
+`default_nettype none
+
 module rfl_harness (
-    input         clk,
-    input         rst_n,
-    input  [7:0]  s_tdata,
-    input         s_tvalid,
-    output        s_tready,
-    output [7:0]  m_tdata,
-    output        m_tvalid,
-    input         m_tready,
-    output        frame_start,
-    output        status_valid,
-    output [7:0]  status,        // a code of the walk's table (the hand circuit's: 4 bits, zero-extended)
-    output        busy,
-    output [7:0]  framing,       // the stages' framing flags (rfl_top)
-    output [8:0]  hs,            // handshake per stream (sim.STREAMS order, bit 0 first)
-    output reg [37:0] beat_in,   // {tlast, tuser, tkeep, tdata} into the application
-    output reg [37:0] beat_out   // ... and out of it (each the last beat, after its clock)
+    input  wire        clk,
+    input  wire        rst_n,
+    input  wire [7:0]  s_tdata,
+    input  wire        s_tvalid,
+    output wire        s_tready,
+    output wire [7:0]  m_tdata,
+    output wire        m_tvalid,
+    input  wire        m_tready,
+    output wire        frame_start,
+    output wire        status_valid,
+    output wire [7:0]  status,   // a code of the walk's table (the hand circuit's: 4 bits, zero-extended)
+    output wire        busy,
+    output wire [7:0]  framing,  // the stages' framing flags (rfl_top)
+    output wire [8:0]  hs,       // handshake per stream (sim.STREAMS order, bit 0 first)
+    output reg  [37:0] beat_in,  // {tlast, tuser, tkeep, tdata} into the application
+    output reg  [37:0] beat_out  // ... and out of it (each the last beat, after its clock)
 );
     reg [7:0] s_tdata_r;
     reg       s_tvalid_r, m_tready_r;
@@ -59,3 +61,5 @@ module rfl_harness (
                                 dut.u_top.app_out_tkeep, dut.u_top.app_out_tdata};
     end
 endmodule
+
+`default_nettype wire

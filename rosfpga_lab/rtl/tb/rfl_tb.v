@@ -12,6 +12,8 @@
 //   +vcd=FILE      dump the stream and FIFO       is idle / the output is not ready
 //                  signals                     +idle_limit=N  clocks without progress = stall
 `timescale 1ns / 1ps
+`default_nettype none
+
 module rfl_tb;
     reg clk = 1'b0;
     reg rst_n = 1'b0;
@@ -207,3 +209,5 @@ module rfl_tb;
         end
     endtask
 endmodule
+
+`default_nettype wire

@@ -1,15 +1,17 @@
 // rfl_axi2fifo -- AXI4-Stream video beats back to bytes: for every beat, the bytes of the lanes
 // whose TKEEP bit is set, lane 0 first, one byte per clock onto the 8-bit stream.
+`default_nettype none
+
 module rfl_axi2fifo (
-    input         clk,
-    input         rst_n,
-    input  [31:0] s_axis_tdata,
-    input  [3:0]  s_axis_tkeep,
-    input         s_axis_tvalid,
-    output        s_axis_tready,
-    output [7:0]  m_tdata,
-    output        m_tvalid,
-    input         m_tready
+    input  wire        clk,
+    input  wire        rst_n,
+    input  wire [31:0] s_axis_tdata,
+    input  wire [3:0]  s_axis_tkeep,
+    input  wire        s_axis_tvalid,
+    output wire        s_axis_tready,
+    output wire [7:0]  m_tdata,
+    output wire        m_tvalid,
+    input  wire        m_tready
 );
     reg [31:0] d;                               // the beat being unpacked
     reg [3:0]  left;                            // its lanes not yet sent
@@ -33,3 +35,5 @@ module rfl_axi2fifo (
         end
     end
 endmodule
+
+`default_nettype wire

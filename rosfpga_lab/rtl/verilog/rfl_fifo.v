@@ -10,22 +10,44 @@
 // the words past the last entry) so that no address needs a range check, and the RAM, the
 // pointers and the level counter are written in one block, each register once, so that the
 // model keeps no copy of their old values.
+`default_nettype none
+
 module rfl_fifo #(
     parameter WIDTH = 8,
-    parameter DEPTH = 16,                       // entries, at least 2 (3 with OUTREG)
+    parameter DEPTH = 16,                       // entries, at least 2 (3 with OUTREG): checked
     parameter OUTREG = 0,                       // 1: register the RAM's output once more
     parameter LEVEL_BITS = $clog2(DEPTH + 1)
 ) (
-    input                       clk,
-    input                       rst_n,
-    input      [WIDTH-1:0]      s_tdata,
-    input                       s_tvalid,
-    output                      s_tready,
-    output     [WIDTH-1:0]      m_tdata,
-    output                      m_tvalid,
-    input                       m_tready,
-    output     [LEVEL_BITS-1:0] level
+    input  wire                  clk,
+    input  wire                  rst_n,
+    input  wire [WIDTH-1:0]      s_tdata,
+    input  wire                  s_tvalid,
+    output wire                  s_tready,
+    output wire [WIDTH-1:0]      m_tdata,
+    output wire                  m_tvalid,
+    input  wire                  m_tready,
+    output wire [LEVEL_BITS-1:0] level
 );
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (WIDTH < 1) $fatal(1, "rfl_fifo: WIDTH must be at least 1");
+        if (OUTREG != 0 && OUTREG != 1) $fatal(1, "rfl_fifo: OUTREG must be 0 or 1");
+        if (DEPTH < 2 + OUTREG) $fatal(1, "rfl_fifo: DEPTH must be at least 2 (3 with OUTREG = 1)");
+    end
+`else
+    if (WIDTH < 1) begin : g_bad_width
+        $error("rfl_fifo: WIDTH must be at least 1");
+    end
+    if (OUTREG != 0 && OUTREG != 1) begin : g_bad_outreg
+        $error("rfl_fifo: OUTREG must be 0 or 1");
+    end
+    if (DEPTH < 2 + OUTREG) begin : g_bad_depth
+        $error("rfl_fifo: DEPTH must be at least 2 (3 with OUTREG = 1)");
+    end
+`endif
+
     localparam MEMD = DEPTH - 1 - OUTREG;       // entries in the RAM
     localparam AW = (MEMD > 1) ? $clog2(MEMD) : 1;
     localparam [31:0] LAST_32 = MEMD - 1;
@@ -97,3 +119,5 @@ module rfl_fifo #(
         end
     end
 endmodule
+
+`default_nettype wire

@@ -10,25 +10,45 @@
 // going out as zero bytes, and starts the next (sof_early). framing holds the flags since
 // reset in hw.framing.FRAMING_FLAGS order (bit 0 sof_early, 3 sof_missing; a byte stream has
 // no lines, so bits 1 and 2 stay 0).
+`default_nettype none
+
 module rfl_fifo2axi #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,
     parameter BYTES = 4                         // bytes per pixel: 1..4
 ) (
-    input             clk,
-    input             rst_n,
-    input      [7:0]  s_tdata,
-    input             s_tuser,                  // the frame's first pixel byte
-    input             s_tvalid,
-    output            s_tready,
-    output reg [31:0] m_axis_tdata,
-    output     [3:0]  m_axis_tkeep,
-    output reg        m_axis_tuser,
-    output reg        m_axis_tlast,
-    output reg        m_axis_tvalid,
-    input             m_axis_tready,
-    output     [3:0]  framing
+    input  wire        clk,
+    input  wire        rst_n,
+    input  wire [7:0]  s_tdata,
+    input  wire        s_tuser,                 // the frame's first pixel byte
+    input  wire        s_tvalid,
+    output wire        s_tready,
+    output reg  [31:0] m_axis_tdata,
+    output wire [3:0]  m_axis_tkeep,
+    output reg         m_axis_tuser,
+    output reg         m_axis_tlast,
+    output reg         m_axis_tvalid,
+    input  wire        m_axis_tready,
+    output wire [3:0]  framing
 );
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (BYTES < 1 || BYTES > 4)
+            $fatal(1, "rfl_fifo2axi: BYTES must be 1..4 (one pixel per 32-bit beat)");
+        if (WIDTH < 1 || WIDTH > 65536 || HEIGHT < 1 || HEIGHT > 65536)
+            $fatal(1, "rfl_fifo2axi: WIDTH and HEIGHT must be 1..65536 (16-bit counters)");
+    end
+`else
+    if (BYTES < 1 || BYTES > 4) begin : g_bad_bytes
+        $error("rfl_fifo2axi: BYTES must be 1..4 (one pixel per 32-bit beat)");
+    end
+    if (WIDTH < 1 || WIDTH > 65536 || HEIGHT < 1 || HEIGHT > 65536) begin : g_bad_size
+        $error("rfl_fifo2axi: WIDTH and HEIGHT must be 1..65536 (16-bit counters)");
+    end
+`endif
+
     localparam [31:0] K_LAST_32 = BYTES - 1;
     localparam [1:0] K_LAST = K_LAST_32[1:0];
     localparam [31:0] X_LAST_32 = WIDTH - 1, Y_LAST_32 = HEIGHT - 1;
@@ -99,3 +119,5 @@ module rfl_fifo2axi #(
         end
     end
 endmodule
+
+`default_nettype wire

@@ -60,6 +60,33 @@ module rfl_morph #(
     output reg  [3:0]  framing      // sticky since reset: sof_missing, eol_late, eol_early, sof_early
 );
 
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (BYTES < 1 || BYTES > 4)
+            $fatal(1, "rfl_morph: BYTES must be 1..4 (one pixel per 32-bit beat)");
+        if (OP < 0 || OP > 2)
+            $fatal(1, "rfl_morph: OP must be 0 (dilate), 1 (erode) or 2 (passthrough)");
+        if (OP != 2 && (KSIZE < 1 || KSIZE % 2 == 0))
+            $fatal(1, "rfl_morph: KSIZE must be odd and at least 1");
+        if (WIDTH < 1 || HEIGHT < 1) $fatal(1, "rfl_morph: WIDTH and HEIGHT must be at least 1");
+    end
+`else
+    if (BYTES < 1 || BYTES > 4) begin : g_bad_bytes
+        $error("rfl_morph: BYTES must be 1..4 (one pixel per 32-bit beat)");
+    end
+    if (OP < 0 || OP > 2) begin : g_bad_op
+        $error("rfl_morph: OP must be 0 (dilate), 1 (erode) or 2 (passthrough)");
+    end
+    if (OP != 2 && (KSIZE < 1 || KSIZE % 2 == 0)) begin : g_bad_ksize
+        $error("rfl_morph: KSIZE must be odd and at least 1");
+    end
+    if (WIDTH < 1 || HEIGHT < 1) begin : g_bad_size
+        $error("rfl_morph: WIDTH and HEIGHT must be at least 1");
+    end
+`endif
+
     localparam K    = (OP == 2) ? 1 : KSIZE;
     localparam D    = K / 2;
     localparam W    = 8 * BYTES;

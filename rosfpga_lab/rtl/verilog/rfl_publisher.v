@@ -10,6 +10,8 @@
 // the pixel bytes are most clocks: the output multiplexer tests F_DATA first, and what only a
 // header field or a field's end needs (its uint32 value, the next field) are functions called
 // there, not wires evaluated on every clock; the same logic after synthesis.
+`default_nettype none
+
 module rfl_publisher #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,
@@ -22,25 +24,41 @@ module rfl_publisher #(
     parameter FIDW = $clog2(FRAME_ID_MAX + 1),
     parameter FIDA = (FRAME_ID_MAX > 1) ? $clog2(FRAME_ID_MAX) : 1
 ) (
-    input                 clk,
-    input                 rst_n,
-    input      [7:0]      s_tdata,              // pixel bytes from axi2fifo
-    input                 s_tvalid,
-    output                s_tready,
-    output reg [7:0]      m_tdata,              // the outgoing frame (combinational)
-    output                m_tvalid,
-    input                 m_tready,
-    input                 meta_valid,
-    output                meta_release,
-    input      [31:0]     meta_secs,
-    input      [31:0]     meta_nsecs,
-    input      [7:0]      meta_bigendian,
-    input      [FIDW-1:0] meta_fid_len,
-    output     [FIDA-1:0] fid_raddr,
-    input      [7:0]      fid_rdata,
-    output                frame_done,
-    output                idle                  // no frame being written
+    input  wire            clk,
+    input  wire            rst_n,
+    input  wire [7:0]      s_tdata,             // pixel bytes from axi2fifo
+    input  wire            s_tvalid,
+    output wire            s_tready,
+    output reg  [7:0]      m_tdata,             // the outgoing frame (combinational)
+    output wire            m_tvalid,
+    input  wire            m_tready,
+    input  wire            meta_valid,
+    output wire            meta_release,
+    input  wire [31:0]     meta_secs,
+    input  wire [31:0]     meta_nsecs,
+    input  wire [7:0]      meta_bigendian,
+    input  wire [FIDW-1:0] meta_fid_len,
+    output wire [FIDA-1:0] fid_raddr,
+    input  wire [7:0]      fid_rdata,
+    output wire            frame_done,
+    output wire            idle                 // no frame being written
 );
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (ENC_LEN < 1 || ENC_LEN > 32) $fatal(1, "rfl_publisher: ENC_LEN must be 1..32");
+        if (FRAME_ID_MAX < 1) $fatal(1, "rfl_publisher: FRAME_ID_MAX must be at least 1");
+    end
+`else
+    if (ENC_LEN < 1 || ENC_LEN > 32) begin : g_bad_enc_len
+        $error("rfl_publisher: ENC_LEN must be 1..32");
+    end
+    if (FRAME_ID_MAX < 1) begin : g_bad_fid_max
+        $error("rfl_publisher: FRAME_ID_MAX must be at least 1");
+    end
+`endif
+
     localparam [31:0] STEP = WIDTH * BYTES;
     localparam [31:0] DATA_BYTES = WIDTH * HEIGHT * BYTES;
     localparam [31:0] BODY = MIN_BODY + ENC_LEN + DATA_BYTES;  // all but frame_id
@@ -179,3 +197,5 @@ module rfl_publisher #(
         end
     end
 endmodule
+
+`default_nettype wire

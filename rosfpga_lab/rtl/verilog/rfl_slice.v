@@ -3,18 +3,32 @@
 // it combinationally (100 MHz timing), at full throughput. Two registers: the output, and a
 // skid register that takes the word arriving while the output is stalled. A word appears at
 // the output one clock after it was taken.
+`default_nettype none
+
 module rfl_slice #(
     parameter WIDTH = 8
 ) (
-    input                  clk,
-    input                  rst_n,
-    input      [WIDTH-1:0] s_tdata,
-    input                  s_tvalid,
-    output reg             s_tready,
-    output reg [WIDTH-1:0] m_tdata,
-    output reg             m_tvalid,
-    input                  m_tready
+    input  wire             clk,
+    input  wire             rst_n,
+    input  wire [WIDTH-1:0] s_tdata,
+    input  wire             s_tvalid,
+    output reg              s_tready,
+    output reg  [WIDTH-1:0] m_tdata,
+    output reg              m_tvalid,
+    input  wire             m_tready
 );
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (WIDTH < 1) $fatal(1, "rfl_slice: WIDTH must be at least 1");
+    end
+`else
+    if (WIDTH < 1) begin : g_bad_width
+        $error("rfl_slice: WIDTH must be at least 1");
+    end
+`endif
+
     reg [WIDTH-1:0] skid;
 
     wire take = s_tvalid && s_tready;
@@ -38,3 +52,5 @@ module rfl_slice #(
         end
     end
 endmodule
+
+`default_nettype wire

@@ -13,6 +13,8 @@
 // For the Verilated simulation, where the pixel bytes are most clocks: the state machine tests
 // S_DATA first, and the encoding compare is a function called in S_ENC, not a wire evaluated
 // on every clock; the same logic after synthesis.
+`default_nettype none
+
 module rfl_subscriber #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,
@@ -28,28 +30,51 @@ module rfl_subscriber #(
     parameter FIDW = $clog2(FRAME_ID_MAX + 1),  // bits of a frame_id length
     parameter FIDA = (FRAME_ID_MAX > 1) ? $clog2(FRAME_ID_MAX) : 1  // bits of a frame_id address
 ) (
-    input                 clk,
-    input                 rst_n,
-    input      [7:0]      s_tdata,
-    input                 s_tvalid,
-    output                s_tready,
-    output     [7:0]      m_tdata,
-    output reg            m_tuser,              // the frame's first pixel byte (fifo2axi re-syncs)
-    output                m_tvalid,
-    input                 m_tready,
-    output reg            meta_valid,
-    input                 meta_release,
-    output reg [31:0]     meta_secs,
-    output reg [31:0]     meta_nsecs,
-    output reg [7:0]      meta_bigendian,
-    output reg [FIDW-1:0] meta_fid_len,
-    input      [FIDA-1:0] fid_raddr,            // read port: fid_rdata is fid_mem[fid_raddr]
-    output reg [7:0]      fid_rdata,            //   one clock after fid_raddr
-    output                frame_start,
-    output reg            status_valid,
-    output reg [3:0]      status,
-    output                idle                  // between frames
+    input  wire            clk,
+    input  wire            rst_n,
+    input  wire [7:0]      s_tdata,
+    input  wire            s_tvalid,
+    output wire            s_tready,
+    output wire [7:0]      m_tdata,
+    output reg             m_tuser,             // the frame's first pixel byte (fifo2axi re-syncs)
+    output wire            m_tvalid,
+    input  wire            m_tready,
+    output reg             meta_valid,
+    input  wire            meta_release,
+    output reg  [31:0]     meta_secs,
+    output reg  [31:0]     meta_nsecs,
+    output reg  [7:0]      meta_bigendian,
+    output reg  [FIDW-1:0] meta_fid_len,
+    input  wire [FIDA-1:0] fid_raddr,           // read port: fid_rdata is fid_mem[fid_raddr]
+    output reg  [7:0]      fid_rdata,           //   one clock after fid_raddr
+    output wire            frame_start,
+    output reg             status_valid,
+    output reg  [3:0]      status,
+    output wire            idle                 // between frames
 );
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (ENC_LEN < 1 || ENC_LEN > 32 || ENC_LEN > ENCODING_MAX)
+            $fatal(1, "rfl_subscriber: ENC_LEN must be 1..32 and at most ENCODING_MAX");
+        if (FRAME_ID_MAX < 1 || FRAME_ID_MAX >= 16777216 || ENCODING_MAX >= 16777216)
+            $fatal(1, "rfl_subscriber: FRAME_ID_MAX must be 1..2**24-1 and ENCODING_MAX below 2**24");
+        if (MIN_BODY >= 16777216 || MAX_FRAME < MIN_BODY)
+            $fatal(1, "rfl_subscriber: MIN_BODY must be below 2**24 and at most MAX_FRAME");
+    end
+`else
+    if (ENC_LEN < 1 || ENC_LEN > 32 || ENC_LEN > ENCODING_MAX) begin : g_bad_enc_len
+        $error("rfl_subscriber: ENC_LEN must be 1..32 and at most ENCODING_MAX");
+    end
+    if (FRAME_ID_MAX < 1 || FRAME_ID_MAX >= 16777216 || ENCODING_MAX >= 16777216) begin : g_bad_str_max
+        $error("rfl_subscriber: FRAME_ID_MAX must be 1..2**24-1 and ENCODING_MAX below 2**24");
+    end
+    if (MIN_BODY >= 16777216 || MAX_FRAME < MIN_BODY) begin : g_bad_body
+        $error("rfl_subscriber: MIN_BODY must be below 2**24 and at most MAX_FRAME");
+    end
+`endif
+
 `include "rfl_status.vh"
     localparam [31:0] STEP = WIDTH * BYTES;
     localparam [31:0] DATA_BYTES = WIDTH * HEIGHT * BYTES;
@@ -311,3 +336,5 @@ module rfl_subscriber #(
         end
     end
 endmodule
+
+`default_nettype wire

@@ -6,6 +6,8 @@
 //
 // The subscriber holds the carried-over fields (stamp, frame_id) of an accepted frame until
 // the publisher has written them. OP: 0 dilate, 1 erode, 2 passthrough.
+`default_nettype none
+
 module rfl_top #(
     parameter WIDTH = 640,
     parameter HEIGHT = 480,
@@ -25,21 +27,21 @@ module rfl_top #(
     parameter AXIS_DEPTH = 16,
     parameter [31:0] SEQ_START = 1
 ) (
-    input        clk,
-    input        rst_n,
-    input  [7:0] s_tdata,
-    input        s_tvalid,
-    output       s_tready,
-    output [7:0] m_tdata,
-    output       m_tvalid,
-    input        m_tready,
-    output       frame_start,                   // the subscriber took a frame's first byte
-    output       status_valid,                  // the subscriber decided on a frame
-    output [3:0] status,
-    output       busy,                          // something is in flight
+    input  wire       clk,
+    input  wire       rst_n,
+    input  wire [7:0] s_tdata,
+    input  wire       s_tvalid,
+    output wire       s_tready,
+    output wire [7:0] m_tdata,
+    output wire       m_tvalid,
+    input  wire       m_tready,
+    output wire       frame_start,              // the subscriber took a frame's first byte
+    output wire       status_valid,             // the subscriber decided on a frame
+    output wire [3:0] status,
+    output wire       busy,                     // something is in flight
     // framing flags since reset (hw.framing.FRAMING_FLAGS order): fifo2axi's in 7..4,
     // the application's in 3..0
-    output [7:0] framing
+    output wire [7:0] framing
 );
     localparam FIDW = $clog2(FRAME_ID_MAX + 1);
     localparam FIDA = (FRAME_ID_MAX > 1) ? $clog2(FRAME_ID_MAX) : 1;
@@ -168,3 +170,5 @@ module rfl_top #(
     wire unused_ok = &{1'b0, rx_level, axis_in_level, axis_out_level, tx_level, frame_done,
                        axis_out_tuser, axis_out_tlast};
 endmodule
+
+`default_nettype wire
