@@ -14,6 +14,11 @@
 // bytes the options do not announce that pad the payload to a multiple of END_ALIGN (Cyclone DDS
 // pads so with options 00 00) are taken when they are zero (S_TAIL); the first non-zero one
 // refuses the sample with OP_DONE's status2.
+// No multiplier (100 MHz on an ECP5 with no DSP): an OP_VAR's bytes are its count shifted by
+// lsize; an OP_LOOP's fewest bytes (count x elem_min) are added up in S_LEAST, one bit of
+// elem_min per clock, before S_COUNTED checks them. The bytes left for the fields (room) are a
+// register kept with pos, and a body's last byte is found by a count down (left_b), so that no
+// clock adds and compares in a row.
 module rfl_gsubscriber #(
     parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
     parameter CW = 6,                           // its address bits
@@ -41,7 +46,8 @@ module rfl_gsubscriber #(
 );
 `include "rfl_layout.vh"
     localparam [3:0] S_FLEN = 4'd0, S_DECODE = 4'd1, S_COUNT = 4'd2, S_COUNTED = 4'd3,
-                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7, S_TAIL = 4'd8;
+                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7, S_TAIL = 4'd8,
+                     S_LEAST = 4'd9;
 
     reg [3:0]  state;
     reg [15:0] pc;
@@ -53,7 +59,11 @@ module rfl_gsubscriber #(
     reg        nul_bad;                         // a string's last byte was not 0
     reg [31:0] cnt;                             // bytes of the current part taken so far
     reg [31:0] n;                               // a count, shifted in little-endian
-    reg [63:0] need;                            // bytes of the current body
+    reg [34:0] left_b;                          // bytes of the current body still to take
+    reg [31:0] room;                            // bytes left for the fields: fields_end - pos
+    reg [63:0] least_r;                         // OP_LOOP: count x elem_min, added up (S_LEAST)
+    reg [63:0] nsh;                             // the count shifted by the elem_min bits done
+    reg [31:0] mrem;                            // elem_min's bits still to add
     reg [63:0] value;                           // a SUB_RANGE field, little-endian
     reg        same;                            // a SUB_CHECK field equals its constant so far
     reg        streamed;                        // the stream went out
@@ -66,7 +76,7 @@ module rfl_gsubscriber #(
     reg [7:0]  carry_mem [0:CARRY_BYTES-1];
 
     // The current instruction.
-    wire [IW-1:0] w = prog_word(pc);
+    reg [IW-1:0] w;                             // the current instruction: prog_word(pc)
     // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
     wire [3:0]  align = CDR ? w[221:218] : 4'd1;
     wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
@@ -87,6 +97,7 @@ module rfl_gsubscriber #(
     wire        fits = w[64];
     wire [31:0] fixed_after = w[63:32];
     wire [31:0] elem_min = w[31:0];
+    wire [1:0]  lsize = w[223:222];
 
     // A new frame waits until the publisher has taken the previous frame's meta.
     wire stall = (state == S_FLEN) && (cnt == 0) && meta_valid;
@@ -104,7 +115,6 @@ module rfl_gsubscriber #(
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
     wire [31:0] pos_next = pos + 32'd1;
     wire [31:0] fields_end = CDR ? fendp : endp;
-    wire [63:0] room = {32'd0, fields_end} - {32'd0, pos};  // bytes left for the fields
     wire        at_end = (pos == endp);             // nothing left of the frame to skip
     wire [31:0] after = endp - pos;                 // bytes left after the last field
     // CDR: they are the unannounced zeros up to a multiple of END_ALIGN (OP_DONE's st2 != 0)
@@ -112,8 +122,8 @@ module rfl_gsubscriber #(
                             && after < {28'd0, END_ALIGN} && after == pad_at(pos, END_ALIGN);
     wire [31:0] pad_f = pad_at(pos, align);         // before a field or a count
     wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
-    wire [63:0] room_f = room - {32'd0, pad_f};     // bytes left after that padding
-    wire [63:0] room_e = room - {32'd0, pad_e};
+    wire [31:0] room_f = room - pad_f;              // bytes left after that padding
+    wire [31:0] room_e = room - pad_e;              // (each used only when the padding fits)
     // what the publisher writes for this OP_FIXED / OP_VAR: its bytes, and where they start
     wire [31:0] written = (op == OP_FIXED) ? size
                           : (pub == PUB_CARRY || pub == PUB_STREAM) ? body[31:0]
@@ -121,8 +131,9 @@ module rfl_gsubscriber #(
     wire [31:0] out_base = (op == OP_FIXED) ? out_len : out_len + 32'd4;
     wire [31:0] out_pad = (written == 32'd0) ? 32'd0
                           : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
-    wire [63:0] body = {32'd0, n} * {32'd0, size};
-    wire [63:0] least = {32'd0, n} * {32'd0, elem_min};  // fewest bytes of the counted elements
+    wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
+    // fewest bytes of the counted elements (OP_VAR: its elements' bytes)
+    wire [63:0] least = (op == OP_VAR) ? {29'd0, body} : least_r;
     wire        keep = (state == S_COUNT) ? (sub == SUB_CARRY)
                        : (sub == SUB_CARRY || sub == SUB_RANGE);
     wire [7:0]  want_byte = konst(kaddr + cnt[15:0]);
@@ -160,10 +171,15 @@ module rfl_gsubscriber #(
     endfunction
     /* verilator lint_on UNUSEDSIGNAL */
 
+    // The bounds' keys, registered: they depend on the instruction only, which holds from
+    // S_DECODE through S_BODY to S_FINISH (two clocks at least), where in_range is read.
+    reg [63:0] lo_key, hi_key;
+    always @(posedge clk) begin
+        lo_key <= order_key(bound(kaddr, size), size, kind);
+        hi_key <= order_key(bound(kaddr + size[15:0], size), size, kind);
+    end
     wire [63:0] vkey = order_key(value, size, kind);
-    wire in_range = !(kind == 2'd2 && is_nan(value, size))
-                    && order_key(bound(kaddr, size), size, kind) <= vkey
-                    && vkey <= order_key(bound(kaddr + size[15:0], size), size, kind);
+    wire in_range = !(kind == 2'd2 && is_nan(value, size)) && lo_key <= vkey && vkey <= hi_key;
 
     always @(posedge clk) begin
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
@@ -221,9 +237,11 @@ module rfl_gsubscriber #(
     endtask
 
     // Go on with instruction `next`.
-    task go(input [15:0] next);
+    // (w follows pc: `word` is prog_word(next), from a look-up by the current pc.)
+    task go(input [15:0] next, input [IW-1:0] word);
         begin
             pc <= next;
+            w <= word;
             state <= S_DECODE;
             cnt <= 32'd0;
         end
@@ -234,6 +252,7 @@ module rfl_gsubscriber #(
         if (!rst_n) begin
             state <= S_FLEN;
             pc <= 16'd0;
+            w <= prog_word(16'd0);
             pos <= 32'd0;
             endp <= 32'd0;
             fendp <= 32'd0;
@@ -242,7 +261,11 @@ module rfl_gsubscriber #(
             nul_bad <= 1'b0;
             cnt <= 32'd0;
             n <= 32'd0;
-            need <= 64'd0;
+            left_b <= 35'd0;
+            room <= 32'd0;
+            least_r <= 64'd0;
+            nsh <= 64'd0;
+            mrem <= 32'd0;
             value <= 64'd0;
             same <= 1'b0;
             streamed <= 1'b0;
@@ -262,6 +285,7 @@ module rfl_gsubscriber #(
             if (meta_release) meta_valid <= 1'b0;
             if (take) begin
                 pos <= pos_next;
+                room <= room - 32'd1;
                 cnt <= cnt + 32'd1;
                 if (keep && (state == S_COUNT || state == S_BODY)) waddr <= waddr + 1'b1;
             end
@@ -285,13 +309,14 @@ module rfl_gsubscriber #(
                         end else begin
                             endp <= n_next + 32'd4;
                             fendp <= n_next + 32'd4;
+                            room <= n_next;                     // pos is 4 after this byte
                             streamed <= 1'b0;
                             out_len <= 32'd0;
                             waddr <= {CW{1'b0}};
                             depth <= {DB{1'b0}};
                             quiet <= 8'd0;
                             meta_drop <= 1'b0;
-                            go(16'd0);
+                            go(16'd0, prog_word(16'd0));
                         end
                     end
                 end
@@ -307,40 +332,43 @@ module rfl_gsubscriber #(
                             else accept(at_end);
                         end
                         OP_ENCAP: begin
-                            if (room < 64'd4) refuse(st, at_end);
+                            if (room < 32'd4) refuse(st, at_end);
                             else begin
-                                need <= 64'd4;
+                                left_b <= 35'd4;
                                 state <= S_BODY;
                             end
                         end
                         OP_END: begin
                             if (left[depth - 1'b1] != 32'd1) begin
                                 left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
-                                go(jump + 16'd1);
+                                go(jump + 16'd1, prog_jump(pc));
                             end else begin
                                 depth <= depth - 1'b1;
                                 if (quiet_of[depth - 1'b1]) quiet <= quiet - 8'd1;
-                                go(pc + 16'd1);
+                                go(pc + 16'd1, prog_next(pc));
                             end
                         end
                         OP_FIXED: begin
-                            if (size == 32'd0) go(pc + 16'd1);
-                            else if (pad_f != 32'd0 && {32'd0, pad_f} >= room)
+                            if (size == 32'd0) go(pc + 16'd1, prog_next(pc));
+                            else if (pad_f != 32'd0 && pad_f >= room)
                                 refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                            else if ({32'd0, size} > room_f)
+                            else if (size > room_f)
                                 refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
                             else begin
-                                need <= {32'd0, size};
+                                left_b <= {3'd0, size};
                                 pad_then(pad_f, S_BODY);
                             end
                         end
                         default: begin  // OP_VAR, OP_LOOP
                             if (op == OP_LOOP && !variable) begin
                                 n <= count;
-                                state <= S_COUNTED;
-                            end else if (pad_f != 32'd0 && {32'd0, pad_f} >= room)
+                                nsh <= {32'd0, count};
+                                least_r <= 64'd0;
+                                mrem <= elem_min;
+                                state <= S_LEAST;
+                            end else if (pad_f != 32'd0 && pad_f >= room)
                                 refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                            else if (room_f < 64'd4) refuse(st, at_end);  // cut short in its count
+                            else if (room_f < 32'd4) refuse(st, at_end);  // cut short in its count
                             else begin
                                 if (quiet == 8'd0) out_len <= out_len + pad_at(out_len + 32'd4, align);
                                 pad_then(pad_f, S_COUNT);
@@ -351,37 +379,48 @@ module rfl_gsubscriber #(
                 S_COUNT: if (take) begin
                     n <= n_next;
                     if (cnt == 32'd3) begin
-                        state <= S_COUNTED;
+                        state <= (op == OP_LOOP) ? S_LEAST : S_COUNTED;
+                        nsh <= {32'd0, n_next};
+                        least_r <= 64'd0;
+                        mrem <= elem_min;
                         cnt <= 32'd0;
+                    end
+                end
+                S_LEAST: begin  // OP_LOOP: least_r = n x elem_min, a bit of elem_min per clock
+                    if (mrem == 32'd0) state <= S_COUNTED;
+                    else begin
+                        if (mrem[0]) least_r <= least_r + nsh;
+                        nsh <= nsh << 1;
+                        mrem <= mrem >> 1;
                     end
                 end
                 S_COUNTED: begin
                     if ((sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0))
                         refuse(st, at_end);
-                    else if (fits && least + {32'd0, fixed_after} != room)
+                    else if (fits && least + {32'd0, fixed_after} != {32'd0, room})
                         refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                    else if (least > room)
+                    else if (least > {32'd0, room})
                         refuse(st, at_end);
                     else if (op == OP_LOOP) begin
                         begin
                             if (variable && quiet == 8'd0) out_len <= out_len + 32'd4;
-                            if (n == 32'd0) go(jump + 16'd1);
+                            if (n == 32'd0) go(jump + 16'd1, prog_jump(pc));
                             else begin
                                 left[depth] <= n;
                                 quiet_of[depth] <= variable && pub == PUB_ZERO;
                                 if (variable && pub == PUB_ZERO) quiet <= quiet + 8'd1;
                                 depth <= depth + 1'b1;
-                                go(pc + 16'd1);
+                                go(pc + 16'd1, prog_next(pc));
                             end
                         end
-                    end else if (body == 64'd0) begin
+                    end else if (body == 35'd0) begin
                         state <= S_FINISH;
-                    end else if (pad_e != 32'd0 && {32'd0, pad_e} >= room) begin
+                    end else if (pad_e != 32'd0 && pad_e >= room) begin
                         refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                    end else if (body > room_e) begin
+                    end else if (body > {3'd0, room_e}) begin
                         refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
                     end else begin
-                        need <= body;
+                        left_b <= body;
                         pad_then(pad_e, S_BODY);
                     end
                 end
@@ -391,30 +430,32 @@ module rfl_gsubscriber #(
                 end
                 S_BODY: if (take) begin
                     if (cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
-                    if (nul && {32'd0, cnt} + 64'd1 == need) nul_bad <= (s_tdata != 8'd0);
+                    left_b <= left_b - 35'd1;
+                    if (nul && left_b == 35'd1) nul_bad <= (s_tdata != 8'd0);
                     else if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
                     if (sub == SUB_STREAM) streamed <= 1'b1;
-                    if ({32'd0, cnt} + 64'd1 == need) state <= S_FINISH;
+                    if (left_b == 35'd1) state <= S_FINISH;
                 end
                 S_FINISH: begin
                     if (CDR && op == OP_ENCAP) begin  // CDR little-endian, then the end padding
                         if (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1))
                             refuse(st, at_end);
-                        else if ({56'd0, value[31:24] & ENCAP_PAD_MASK} > room)
+                        else if ({24'd0, value[31:24] & ENCAP_PAD_MASK} > room)
                             refuse(SUB_BAD_FRAME_LENGTH, at_end);
                         else begin
                             fendp <= fendp - {24'd0, value[31:24] & ENCAP_PAD_MASK};
+                            room <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
                             out_len <= out_len + {16'd0, klen};
-                            go(pc + 16'd1);
+                            go(pc + 16'd1, prog_next(pc));
                         end
                     end
-                    else if (sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {63'd0, nul} : {32'd0, size}) != {48'd0, klen}))
+                    else if (sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {34'd0, nul} : {3'd0, size}) != {19'd0, klen}))
                         refuse(op == OP_VAR ? st2 : st, at_end);
                     else if (sub == SUB_RANGE && !in_range) refuse(st, at_end);
                     else if (nul_bad) refuse(st3, at_end);
                     else begin
                         if (quiet == 8'd0) out_len <= out_base + out_pad + written;
-                        go(pc + 16'd1);
+                        go(pc + 16'd1, prog_next(pc));
                     end
                 end
                 S_TAIL: if (take) begin  // CDR: an unannounced end pad byte, which must be 0
@@ -430,4 +471,8 @@ module rfl_gsubscriber #(
             endcase
         end
     end
+`ifdef FORMAL
+    // the instruction register holds the word of pc (an invariant the proofs carry)
+    always @(*) if (rst_n) assert(w == prog_word(pc));
+`endif
 endmodule
