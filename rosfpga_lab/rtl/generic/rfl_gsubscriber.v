@@ -16,9 +16,9 @@
 // refuses the sample with OP_DONE's status2.
 // No multiplier (100 MHz on an ECP5 with no DSP): an OP_VAR's bytes are its count shifted by
 // lsize; an OP_LOOP's fewest bytes (count x elem_min) are added up in S_LEAST, one bit of
-// elem_min per clock, before S_COUNTED checks them. The bytes left for the fields (room) are a
-// register kept with pos, and a body's last byte is found by a count down (left_b), so that no
-// clock adds and compares in a row.
+// elem_min per clock, before S_COUNTED checks them. The bytes left for the fields (room: CDR
+// less the end padding) and in the frame (left_f) are registers kept with pos, and a body's
+// last byte is found by a count down (left_b), so that no clock subtracts and compares in a row.
 module rfl_gsubscriber #(
     parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
     parameter CW = 6,                           // its address bits
@@ -52,15 +52,14 @@ module rfl_gsubscriber #(
     reg [3:0]  state;
     reg [15:0] pc;
     reg [31:0] pos;                             // bytes of this frame taken so far
-    reg [31:0] endp;                            // 4 + frame length
-    reg [31:0] fendp;                           // where the fields end (CDR: less the end padding)
+    reg [31:0] left_f;                          // bytes of the frame left: 4 + frame length - pos
     reg [31:0] padn;                            // alignment bytes to skip (S_PAD)
     reg [3:0]  pad_ret;                         // the state after them
     reg        nul_bad;                         // a string's last byte was not 0
     reg [31:0] cnt;                             // bytes of the current part taken so far
     reg [31:0] n;                               // a count, shifted in little-endian
     reg [34:0] left_b;                          // bytes of the current body still to take
-    reg [31:0] room;                            // bytes left for the fields: fields_end - pos
+    reg [31:0] room;                            // bytes left for the fields (CDR: before the end padding)
     reg [63:0] least_r;                         // OP_LOOP: count x elem_min, added up (S_LEAST)
     reg [63:0] nsh;                             // the count shifted by the elem_min bits done
     reg [31:0] mrem;                            // elem_min's bits still to add
@@ -114,12 +113,11 @@ module rfl_gsubscriber #(
 
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
     wire [31:0] pos_next = pos + 32'd1;
-    wire [31:0] fields_end = CDR ? fendp : endp;
-    wire        at_end = (pos == endp);             // nothing left of the frame to skip
-    wire [31:0] after = endp - pos;                 // bytes left after the last field
-    // CDR: they are the unannounced zeros up to a multiple of END_ALIGN (OP_DONE's st2 != 0)
-    wire        tail_zero = CDR && st2 != 8'd0 && pos != fields_end && after != 32'd0
-                            && after < {28'd0, END_ALIGN} && after == pad_at(pos, END_ALIGN);
+    wire        at_end = (left_f == 32'd0);         // nothing left of the frame to skip
+    // CDR: the bytes left after the last field are the unannounced zeros up to a multiple of
+    // END_ALIGN (OP_DONE's st2 != 0)
+    wire        tail_zero = CDR && st2 != 8'd0 && room != 32'd0 && left_f != 32'd0
+                            && left_f < {28'd0, END_ALIGN} && left_f == pad_at(pos, END_ALIGN);
     wire [31:0] pad_f = pad_at(pos, align);         // before a field or a count
     wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
     wire [31:0] room_f = room - pad_f;              // bytes left after that padding
@@ -254,8 +252,7 @@ module rfl_gsubscriber #(
             pc <= 16'd0;
             w <= prog_word(16'd0);
             pos <= 32'd0;
-            endp <= 32'd0;
-            fendp <= 32'd0;
+            left_f <= 32'd0;
             padn <= 32'd0;
             pad_ret <= S_FLEN;
             nul_bad <= 1'b0;
@@ -286,6 +283,7 @@ module rfl_gsubscriber #(
             if (take) begin
                 pos <= pos_next;
                 room <= room - 32'd1;
+                left_f <= left_f - 32'd1;
                 cnt <= cnt + 32'd1;
                 if (keep && (state == S_COUNT || state == S_BODY)) waddr <= waddr + 1'b1;
             end
@@ -303,13 +301,12 @@ module rfl_gsubscriber #(
                             status_valid <= 1'b1;
                             status <= SUB_BAD_FRAME_LENGTH;
                             cnt <= 32'd0;
-                            endp <= n_next + 32'd4;
+                            left_f <= n_next;                   // pos is 4 after this byte
                             if (n_next == 32'd0) pos <= 32'd0;
                             else state <= S_SKIP;
                         end else begin
-                            endp <= n_next + 32'd4;
-                            fendp <= n_next + 32'd4;
-                            room <= n_next;                     // pos is 4 after this byte
+                            left_f <= n_next;                   // pos is 4 after this byte
+                            room <= n_next;
                             streamed <= 1'b0;
                             out_len <= 32'd0;
                             waddr <= {CW{1'b0}};
@@ -328,7 +325,7 @@ module rfl_gsubscriber #(
                     case (op)
                         OP_DONE: begin
                             if (tail_zero) state <= S_TAIL;
-                            else if (pos != fields_end) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
+                            else if (room != 32'd0) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
                             else accept(at_end);
                         end
                         OP_ENCAP: begin
@@ -443,7 +440,6 @@ module rfl_gsubscriber #(
                         else if ({24'd0, value[31:24] & ENCAP_PAD_MASK} > room)
                             refuse(SUB_BAD_FRAME_LENGTH, at_end);
                         else begin
-                            fendp <= fendp - {24'd0, value[31:24] & ENCAP_PAD_MASK};
                             room <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
                             out_len <= out_len + {16'd0, klen};
                             go(pc + 16'd1, prog_next(pc));
@@ -459,10 +455,10 @@ module rfl_gsubscriber #(
                     end
                 end
                 S_TAIL: if (take) begin  // CDR: an unannounced end pad byte, which must be 0
-                    if (s_tdata != 8'd0) refuse(st2, pos_next == endp);
-                    else if (pos_next == endp) accept(1'b1);
+                    if (s_tdata != 8'd0) refuse(st2, left_f == 32'd1);
+                    else if (left_f == 32'd1) accept(1'b1);
                 end
-                S_SKIP: if (take && pos_next == endp) begin
+                S_SKIP: if (take && left_f == 32'd1) begin
                     state <= S_FLEN;
                     cnt <= 32'd0;
                     pos <= 32'd0;
