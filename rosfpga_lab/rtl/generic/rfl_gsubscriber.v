@@ -183,6 +183,33 @@ module rfl_gsubscriber #(
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
     end
 
+    // The decisions' arithmetic, registered (c_*): S_DECODE, S_COUNTED and S_FINISH take two
+    // clocks, the first (settled 0) with nothing changing but these registers, so that the
+    // second decides from flip-flops (100 MHz on an ECP5) as the same expressions would.
+    reg settled;
+    reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
+        c_body0, c_pade_bad, c_body_gt, c_encap_bad, c_encap_pad_gt, c_check_bad, c_range_bad;
+    reg [31:0] c_out_len;                          // S_FINISH: out_len after the field
+    always @(posedge clk) begin
+        c_tail <= tail_zero;
+        c_left1 <= (left[depth - 1'b1] != 32'd1);
+        c_padf_bad <= (pad_f != 32'd0 && pad_f >= room);
+        c_size_gt <= (size > room_f);
+        c_roomf_lt4 <= (room_f < 32'd4);
+        c_count_bad <= (sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0);
+        c_fit_bad <= fits && least + {32'd0, fixed_after} != {32'd0, room};
+        c_least_gt <= (least > {32'd0, room});
+        c_body0 <= (body == 35'd0);
+        c_pade_bad <= (pad_e != 32'd0 && pad_e >= room);
+        c_body_gt <= (body > {3'd0, room_e});
+        c_encap_bad <= (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1));
+        c_encap_pad_gt <= ({24'd0, value[31:24] & ENCAP_PAD_MASK} > room);
+        c_check_bad <= sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {34'd0, nul}
+                                                      : {3'd0, size}) != {19'd0, klen});
+        c_range_bad <= (sub == SUB_RANGE && !in_range);
+        c_out_len <= out_base + out_pad + written;
+    end
+
     // Skip `p` alignment bytes (if any), then go to state `next`.
     task pad_then(input [31:0] p, input [3:0] next);
         begin
@@ -259,6 +286,7 @@ module rfl_gsubscriber #(
             cnt <= 32'd0;
             n <= 32'd0;
             left_b <= 35'd0;
+            settled <= 1'b0;
             room <= 32'd0;
             least_r <= 64'd0;
             nsh <= 64'd0;
@@ -317,14 +345,15 @@ module rfl_gsubscriber #(
                         end
                     end
                 end
-                S_DECODE: begin
+                S_DECODE: if (!settled) settled <= 1'b1; else begin
+                    settled <= 1'b0;
                     cnt <= 32'd0;
                     same <= 1'b1;
                     nul_bad <= 1'b0;
                     value <= 64'd0;
                     case (op)
                         OP_DONE: begin
-                            if (tail_zero) state <= S_TAIL;
+                            if (c_tail) state <= S_TAIL;
                             else if (room != 32'd0) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
                             else accept(at_end);
                         end
@@ -336,7 +365,7 @@ module rfl_gsubscriber #(
                             end
                         end
                         OP_END: begin
-                            if (left[depth - 1'b1] != 32'd1) begin
+                            if (c_left1) begin
                                 left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
                                 go(jump + 16'd1, prog_jump(pc));
                             end else begin
@@ -347,9 +376,9 @@ module rfl_gsubscriber #(
                         end
                         OP_FIXED: begin
                             if (size == 32'd0) go(pc + 16'd1, prog_next(pc));
-                            else if (pad_f != 32'd0 && pad_f >= room)
+                            else if (c_padf_bad)
                                 refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                            else if (size > room_f)
+                            else if (c_size_gt)
                                 refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
                             else begin
                                 left_b <= {3'd0, size};
@@ -363,9 +392,9 @@ module rfl_gsubscriber #(
                                 least_r <= 64'd0;
                                 mrem <= elem_min;
                                 state <= S_LEAST;
-                            end else if (pad_f != 32'd0 && pad_f >= room)
+                            end else if (c_padf_bad)
                                 refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                            else if (room_f < 32'd4) refuse(st, at_end);  // cut short in its count
+                            else if (c_roomf_lt4) refuse(st, at_end);  // cut short in its count
                             else begin
                                 if (quiet == 8'd0) out_len <= out_len + pad_at(out_len + 32'd4, align);
                                 pad_then(pad_f, S_COUNT);
@@ -391,12 +420,13 @@ module rfl_gsubscriber #(
                         mrem <= mrem >> 1;
                     end
                 end
-                S_COUNTED: begin
-                    if ((sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0))
+                S_COUNTED: if (!settled) settled <= 1'b1; else begin
+                    settled <= 1'b0;
+                    if (c_count_bad)
                         refuse(st, at_end);
-                    else if (fits && least + {32'd0, fixed_after} != {32'd0, room})
+                    else if (c_fit_bad)
                         refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                    else if (least > {32'd0, room})
+                    else if (c_least_gt)
                         refuse(st, at_end);
                     else if (op == OP_LOOP) begin
                         begin
@@ -410,11 +440,11 @@ module rfl_gsubscriber #(
                                 go(pc + 16'd1, prog_next(pc));
                             end
                         end
-                    end else if (body == 35'd0) begin
+                    end else if (c_body0) begin
                         state <= S_FINISH;
-                    end else if (pad_e != 32'd0 && pad_e >= room) begin
+                    end else if (c_pade_bad) begin
                         refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                    end else if (body > {3'd0, room_e}) begin
+                    end else if (c_body_gt) begin
                         refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
                     end else begin
                         left_b <= body;
@@ -433,11 +463,12 @@ module rfl_gsubscriber #(
                     if (sub == SUB_STREAM) streamed <= 1'b1;
                     if (left_b == 35'd1) state <= S_FINISH;
                 end
-                S_FINISH: begin
+                S_FINISH: if (!settled) settled <= 1'b1; else begin
+                    settled <= 1'b0;
                     if (CDR && op == OP_ENCAP) begin  // CDR little-endian, then the end padding
-                        if (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1))
+                        if (c_encap_bad)
                             refuse(st, at_end);
-                        else if ({24'd0, value[31:24] & ENCAP_PAD_MASK} > room)
+                        else if (c_encap_pad_gt)
                             refuse(SUB_BAD_FRAME_LENGTH, at_end);
                         else begin
                             room <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
@@ -445,12 +476,12 @@ module rfl_gsubscriber #(
                             go(pc + 16'd1, prog_next(pc));
                         end
                     end
-                    else if (sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {34'd0, nul} : {3'd0, size}) != {19'd0, klen}))
+                    else if (c_check_bad)
                         refuse(op == OP_VAR ? st2 : st, at_end);
-                    else if (sub == SUB_RANGE && !in_range) refuse(st, at_end);
+                    else if (c_range_bad) refuse(st, at_end);
                     else if (nul_bad) refuse(st3, at_end);
                     else begin
-                        if (quiet == 8'd0) out_len <= out_base + out_pad + written;
+                        if (quiet == 8'd0) out_len <= c_out_len;
                         go(pc + 16'd1, prog_next(pc));
                     end
                 end
