@@ -146,7 +146,7 @@ PROOFS: tuple[Proof, ...] = (
           "holds, a frame starts with its length then the constant, takes exactly the array's 2 "
           "bytes per frame, writes nothing for a dropped one; 26 clocks (a whole frame)",
           (), True),
-    Proof("gtop", ("rfl_fifo.v", *GENERIC_MODULES), "prove", 4,
+    Proof("gtop", ("rfl_fifo.v", "rfl_slice.v", *GENERIC_MODULES), "prove", 4,
           "rfl_gtop (formal_program, 1-byte elements, FIFOs 2 and 4 deep, any input bytes): "
           "output stream rules, status codes of the table, busy while output is pending; all "
           "reachable states", (), True),

@@ -57,6 +57,7 @@ GENERIC_MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_gpublisher", "publisher (generic walker)"),
     ("rfl_gtop", "top level (glue, generic)"),
     ("rfl_fifo", "FIFOs (rfl_fifo)"),
+    ("rfl_slice", "register slice"),
 )
 #: The module synthesized: rfl_top with the node's parameters.
 TOP = "rfl_node"

@@ -146,16 +146,16 @@ module rfl_gsubscriber #(
         end
     endfunction
 
-    // The order key of a value (larger key, larger value); floats: -0.0 counts as +0.0.
-    function [63:0] order_key(input [63:0] v, input [31:0] nbytes, input [1:0] k);
-        reg [63:0] sign, all, x;
+    // The order key of a value (larger key, larger value); floats: -0.0 counts as +0.0. `sign`
+    // is the value's sign bit (1 << (8 x bytes - 1)), `all` its bits (registered below).
+    function [63:0] order_key(input [63:0] v, input [63:0] sign, input [63:0] all,
+                              input [1:0] k);
+        reg [63:0] x;
         begin
-            sign = 64'd1 << (8 * nbytes - 1);
-            all = sign | (sign - 64'd1);
             x = v;
             if (k == 2'd2 && x == sign) x = 64'd0;
             if (k == 2'd1) order_key = x ^ sign;
-            else if (k == 2'd2) order_key = x[8*nbytes-1] ? (~x & all) : (x | sign);
+            else if (k == 2'd2) order_key = ((x & sign) != 64'd0) ? (~x & all) : (x | sign);
             else order_key = x;
         end
     endfunction
@@ -170,43 +170,62 @@ module rfl_gsubscriber #(
     /* verilator lint_on UNUSEDSIGNAL */
 
     // The bounds' keys, registered: they depend on the instruction only, which holds from
-    // S_DECODE through S_BODY to S_FINISH (two clocks at least), where in_range is read.
-    reg [63:0] lo_key, hi_key;
+    // S_DECODE (three clocks) through S_BODY to S_FINISH, where in_range is read (the masks
+    // are registered one clock after the instruction, the keys one clock after the masks).
+    // The sign and all-bits masks of the field's size (1, 2, 4 or 8 bytes) the same way.
+    reg [63:0] lo_key, hi_key, sign_m, all_m;
     always @(posedge clk) begin
-        lo_key <= order_key(bound(kaddr, size), size, kind);
-        hi_key <= order_key(bound(kaddr + size[15:0], size), size, kind);
+        sign_m <= 64'd1 << (8 * size[3:0] - 1);
+        all_m <= (64'd1 << (8 * size[3:0] - 1)) | ((64'd1 << (8 * size[3:0] - 1)) - 64'd1);
+        lo_key <= order_key(bound(kaddr, size), sign_m, all_m, kind);
+        hi_key <= order_key(bound(kaddr + size[15:0], size), sign_m, all_m, kind);
     end
-    wire [63:0] vkey = order_key(value, size, kind);
-    wire in_range = !(kind == 2'd2 && is_nan(value, size)) && lo_key <= vkey && vkey <= hi_key;
+    wire [63:0] vkey = order_key(value, sign_m, all_m, kind);
 
     always @(posedge clk) begin
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
     end
 
-    // The decisions' arithmetic, registered (c_*): S_DECODE, S_COUNTED and S_FINISH take two
-    // clocks, the first (settled 0) with nothing changing but these registers, so that the
-    // second decides from flip-flops (100 MHz on an ECP5) as the same expressions would.
-    reg settled;
+    // The decisions' arithmetic, registered: S_DECODE, S_COUNTED and S_FINISH take three
+    // clocks, the first two (settled 0, 1) with nothing changing but these registers (p_*: the
+    // subtractions and the value's key; c_*: the comparisons, from p_*), so that the third
+    // decides from flip-flops (100 MHz on an ECP5) as the same expressions would.
+    reg [1:0] settled;
+    reg [31:0] p_room_f, p_room_e;
+    reg [63:0] p_vkey, p_least_fa;
+    reg        p_vnan;
+    wire in_range = !p_vnan && lo_key <= p_vkey && p_vkey <= hi_key;
     reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
-        c_body0, c_pade_bad, c_body_gt, c_encap_bad, c_encap_pad_gt, c_check_bad, c_range_bad;
+        c_body0, c_pade_bad, c_body_gt, c_encap_bad, c_encap_pad_gt, c_check_bad, c_range_bad,
+        c_at_end, c_room0, c_room_lt4, c_size0, c_n0;
     reg [31:0] c_out_len;                          // S_FINISH: out_len after the field
     always @(posedge clk) begin
         c_tail <= tail_zero;
+        c_at_end <= at_end;
+        c_room0 <= (room == 32'd0);
+        c_room_lt4 <= (room < 32'd4);
+        c_size0 <= (size == 32'd0);
+        c_n0 <= (n == 32'd0);
         c_left1 <= (left[depth - 1'b1] != 32'd1);
         c_padf_bad <= (pad_f != 32'd0 && pad_f >= room);
-        c_size_gt <= (size > room_f);
-        c_roomf_lt4 <= (room_f < 32'd4);
+        p_room_f <= room_f;
+        p_room_e <= room_e;
+        p_vkey <= vkey;
+        p_vnan <= (kind == 2'd2 && is_nan(value, size));
+        p_least_fa <= least + {32'd0, fixed_after};
+        c_size_gt <= (size > p_room_f);
+        c_roomf_lt4 <= (p_room_f < 32'd4);
         c_count_bad <= (sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0);
-        c_fit_bad <= fits && least + {32'd0, fixed_after} != {32'd0, room};
+        c_fit_bad <= fits && p_least_fa != {32'd0, room};
         c_least_gt <= (least > {32'd0, room});
         c_body0 <= (body == 35'd0);
         c_pade_bad <= (pad_e != 32'd0 && pad_e >= room);
-        c_body_gt <= (body > {3'd0, room_e});
+        c_body_gt <= (body > {3'd0, p_room_e});
         c_encap_bad <= (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1));
         c_encap_pad_gt <= ({24'd0, value[31:24] & ENCAP_PAD_MASK} > room);
         c_check_bad <= sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {34'd0, nul}
                                                       : {3'd0, size}) != {19'd0, klen});
-        c_range_bad <= (sub == SUB_RANGE && !in_range);
+        c_range_bad <= (sub == SUB_RANGE && !in_range);  // from p_vkey, p_vnan
         c_out_len <= out_base + out_pad + written;
     end
 
@@ -286,7 +305,7 @@ module rfl_gsubscriber #(
             cnt <= 32'd0;
             n <= 32'd0;
             left_b <= 35'd0;
-            settled <= 1'b0;
+            settled <= 2'd0;
             room <= 32'd0;
             least_r <= 64'd0;
             nsh <= 64'd0;
@@ -345,8 +364,8 @@ module rfl_gsubscriber #(
                         end
                     end
                 end
-                S_DECODE: if (!settled) settled <= 1'b1; else begin
-                    settled <= 1'b0;
+                S_DECODE: if (settled != 2'd2) settled <= settled + 2'd1; else begin
+                    settled <= 2'd0;
                     cnt <= 32'd0;
                     same <= 1'b1;
                     nul_bad <= 1'b0;
@@ -354,11 +373,11 @@ module rfl_gsubscriber #(
                     case (op)
                         OP_DONE: begin
                             if (c_tail) state <= S_TAIL;
-                            else if (room != 32'd0) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
-                            else accept(at_end);
+                            else if (!c_room0) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
+                            else accept(c_at_end);
                         end
                         OP_ENCAP: begin
-                            if (room < 32'd4) refuse(st, at_end);
+                            if (c_room_lt4) refuse(st, c_at_end);
                             else begin
                                 left_b <= 35'd4;
                                 state <= S_BODY;
@@ -375,11 +394,11 @@ module rfl_gsubscriber #(
                             end
                         end
                         OP_FIXED: begin
-                            if (size == 32'd0) go(pc + 16'd1, prog_next(pc));
+                            if (c_size0) go(pc + 16'd1, prog_next(pc));
                             else if (c_padf_bad)
-                                refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                                refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                             else if (c_size_gt)
-                                refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
+                                refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
                             else begin
                                 left_b <= {3'd0, size};
                                 pad_then(pad_f, S_BODY);
@@ -393,8 +412,8 @@ module rfl_gsubscriber #(
                                 mrem <= elem_min;
                                 state <= S_LEAST;
                             end else if (c_padf_bad)
-                                refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                            else if (c_roomf_lt4) refuse(st, at_end);  // cut short in its count
+                                refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
+                            else if (c_roomf_lt4) refuse(st, c_at_end);  // cut short in its count
                             else begin
                                 if (quiet == 8'd0) out_len <= out_len + pad_at(out_len + 32'd4, align);
                                 pad_then(pad_f, S_COUNT);
@@ -420,18 +439,18 @@ module rfl_gsubscriber #(
                         mrem <= mrem >> 1;
                     end
                 end
-                S_COUNTED: if (!settled) settled <= 1'b1; else begin
-                    settled <= 1'b0;
+                S_COUNTED: if (settled != 2'd2) settled <= settled + 2'd1; else begin
+                    settled <= 2'd0;
                     if (c_count_bad)
-                        refuse(st, at_end);
+                        refuse(st, c_at_end);
                     else if (c_fit_bad)
-                        refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                        refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                     else if (c_least_gt)
-                        refuse(st, at_end);
+                        refuse(st, c_at_end);
                     else if (op == OP_LOOP) begin
                         begin
                             if (variable && quiet == 8'd0) out_len <= out_len + 32'd4;
-                            if (n == 32'd0) go(jump + 16'd1, prog_jump(pc));
+                            if (c_n0) go(jump + 16'd1, prog_jump(pc));
                             else begin
                                 left[depth] <= n;
                                 quiet_of[depth] <= variable && pub == PUB_ZERO;
@@ -443,9 +462,9 @@ module rfl_gsubscriber #(
                     end else if (c_body0) begin
                         state <= S_FINISH;
                     end else if (c_pade_bad) begin
-                        refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                        refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                     end else if (c_body_gt) begin
-                        refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
+                        refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
                     end else begin
                         left_b <= body;
                         pad_then(pad_e, S_BODY);
@@ -463,13 +482,13 @@ module rfl_gsubscriber #(
                     if (sub == SUB_STREAM) streamed <= 1'b1;
                     if (left_b == 35'd1) state <= S_FINISH;
                 end
-                S_FINISH: if (!settled) settled <= 1'b1; else begin
-                    settled <= 1'b0;
+                S_FINISH: if (settled != 2'd2) settled <= settled + 2'd1; else begin
+                    settled <= 2'd0;
                     if (CDR && op == OP_ENCAP) begin  // CDR little-endian, then the end padding
                         if (c_encap_bad)
-                            refuse(st, at_end);
+                            refuse(st, c_at_end);
                         else if (c_encap_pad_gt)
-                            refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                            refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                         else begin
                             room <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
                             out_len <= out_len + {16'd0, klen};
@@ -477,9 +496,9 @@ module rfl_gsubscriber #(
                         end
                     end
                     else if (c_check_bad)
-                        refuse(op == OP_VAR ? st2 : st, at_end);
-                    else if (c_range_bad) refuse(st, at_end);
-                    else if (nul_bad) refuse(st3, at_end);
+                        refuse(op == OP_VAR ? st2 : st, c_at_end);
+                    else if (c_range_bad) refuse(st, c_at_end);
+                    else if (nul_bad) refuse(st3, c_at_end);
                     else begin
                         if (quiet == 8'd0) out_len <= c_out_len;
                         go(pc + 16'd1, prog_next(pc));
