@@ -98,8 +98,9 @@ module rfl_gsubscriber #(
     wire [31:0] elem_min = w[31:0];
     wire [1:0]  lsize = w[223:222];
 
-    // A new frame waits until the publisher has taken the previous frame's meta.
-    wire stall = (state == S_FLEN) && (cnt == 0) && meta_valid;
+    // A new frame waits until the publisher has taken the previous frame's meta. (In S_FLEN,
+    // as in S_COUNT, cnt counts the length's bytes, 0..3.)
+    wire stall = (state == S_FLEN) && (cnt[1:0] == 2'd0) && meta_valid;
     wire streaming = (state == S_BODY) && (sub == SUB_STREAM);
     wire reading = (state == S_FLEN && !stall) || state == S_COUNT || state == S_BODY
                    || state == S_SKIP || state == S_PAD || state == S_TAIL;
@@ -107,8 +108,8 @@ module rfl_gsubscriber #(
     assign m_tvalid = streaming && s_tvalid;
     assign m_tdata = s_tdata;
     wire take = s_tvalid && s_tready;
-    assign frame_start = take && (state == S_FLEN) && (cnt == 0);
-    assign idle = (state == S_FLEN) && (cnt == 0);
+    assign frame_start = take && (state == S_FLEN) && (cnt[1:0] == 2'd0);
+    assign idle = (state == S_FLEN) && (cnt[1:0] == 2'd0);
     assign carry_rdata = carry_mem[carry_raddr];
 
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
@@ -337,7 +338,7 @@ module rfl_gsubscriber #(
             case (state)
                 S_FLEN: if (take) begin
                     n <= n_next;
-                    if (cnt == 32'd3) begin
+                    if (cnt[1:0] == 2'd3) begin  // (cnt counts 0..3 here)
                         if (n_next > MAX_FRAME) begin
                             // Not to be trusted for skipping: wait for the next frame length.
                             status_valid <= 1'b1;
@@ -421,14 +422,17 @@ module rfl_gsubscriber #(
                         end
                     endcase
                 end
-                S_COUNT: if (take) begin
-                    n <= n_next;
-                    if (cnt == 32'd3) begin
-                        state <= (op == OP_LOOP) ? S_LEAST : S_COUNTED;
-                        nsh <= {32'd0, n_next};
-                        least_r <= 64'd0;
-                        mrem <= elem_min;
-                        cnt <= 32'd0;
+                S_COUNT: begin
+                    // S_LEAST's start, set on every clock here (the last is the count's last byte)
+                    nsh <= {32'd0, n_next};
+                    least_r <= 64'd0;
+                    mrem <= elem_min;
+                    if (take) begin
+                        n <= n_next;
+                        if (cnt[1:0] == 2'd3) begin  // (cnt counts 0..3 here)
+                            state <= (op == OP_LOOP) ? S_LEAST : S_COUNTED;
+                            cnt <= 32'd0;
+                        end
                     end
                 end
                 S_LEAST: begin  // OP_LOOP: least_r = n x elem_min, a bit of elem_min per clock

@@ -90,22 +90,26 @@ module rfl_window1d #(
     endfunction
     /* verilator lint_on UNUSEDSIGNAL */
 
-    // the new entry
+    // the new entry; its key is compared as xkey_raw (a LUT from the FIFO's output), or as
+    // -0.0's key SIGN, chosen after the comparison (xnegz, found beside it)
     wire [EW-1:0] x = s_axis_tdata;
     wire [EW-1:0] xkey = order_key(s_axis_tdata);
+    wire          xnegz = (KIND == 2) && (s_axis_tdata == SIGN);
+    wire [EW-1:0] xkey_raw = (KIND == 2) ? (x[EW-1] ? ~x : (x | SIGN)) : xkey;
     wire          xnan = is_nan(s_axis_tdata);
 
     // The older fold keeps its element against the new one: it is the only one valid, or it
     // holds a NaN (the first NaN wins), or the new one is no NaN and is smaller (larger for OP
     // 1): of equal keys the later element wins, as numpy's fold gives it.
     function keeps(input oval, input onan, input [EW-1:0] okey,
-                   input nval, input nnan, input [EW-1:0] nkey);
+                   input nval, input nnan, input [EW-1:0] nkey_raw, input nnegz);
         begin
             if (!oval) keeps = 1'b0;
             else if (!nval) keeps = 1'b1;
             else if (onan) keeps = 1'b1;
             else if (nnan) keeps = 1'b0;
-            else keeps = (OP == 1) ? (okey < nkey) : (okey > nkey);
+            else if (nnegz) keeps = (OP == 1) ? (okey < SIGN) : (okey > SIGN);
+            else keeps = (OP == 1) ? (okey < nkey_raw) : (okey > nkey_raw);
         end
     endfunction
 
@@ -125,7 +129,7 @@ module rfl_window1d #(
         nfnan[0] = step_in && xnan;
         nfval[0] = step_in;
         for (t = 1; t < G; t = t + 1) begin
-            if (keeps(gval[t-1], gnan[t-1], gkey[(t-1)*EW +: EW], step_in, xnan, xkey)) begin
+            if (keeps(gval[t-1], gnan[t-1], gkey[(t-1)*EW +: EW], step_in, xnan, xkey_raw, xnegz)) begin
                 nfdata[t*EW +: EW] = gdata[(t-1)*EW +: EW];
                 nfkey[t*EW +: EW] = gkey[(t-1)*EW +: EW];
                 nfnan[t] = gnan[t-1];
@@ -137,7 +141,7 @@ module rfl_window1d #(
             nfval[t] = gval[t-1] || step_in;
         end
         if (K == 1) best = x;
-        else if (keeps(gval[G-1], gnan[G-1], gkey[(G-1)*EW +: EW], step_in, xnan, xkey))
+        else if (keeps(gval[G-1], gnan[G-1], gkey[(G-1)*EW +: EW], step_in, xnan, xkey_raw, xnegz))
             best = gdata[(G-1)*EW +: EW];
         else best = x;
     end
