@@ -73,19 +73,23 @@ module rfl_gpublisher #(
     wire [7:0] cnt_byte = own_count[8 * cnt[1:0] +: 8];
     wire [7:0] seq_byte = seq[8 * cnt[1:0] +: 8];
 
+    wire carried = (state == P_COUNT || state == P_BODY) && (pub == PUB_CARRY);
+    // A carried byte comes from the carry memory (a block RAM: late), so it is chosen last,
+    // against every other byte (`other`, from flip-flops).
+    reg [7:0] other;
     always @* begin
         case (state)
-            P_LEN: m_tdata = len_byte;
-            P_COUNT: m_tdata = (pub == PUB_CARRY) ? carry_rdata : cnt_byte;
+            P_LEN: other = len_byte;
+            P_COUNT: other = cnt_byte;
             P_BODY: case (pub)
-                PUB_CARRY: m_tdata = carry_rdata;
-                PUB_CONST: m_tdata = (cnt < {16'd0, klen}) ? konst(kaddr + cnt[15:0]) : 8'd0;  // then a NUL
-                PUB_COUNT: m_tdata = (cnt < 32'd4) ? seq_byte : 8'd0;
-                PUB_STREAM: m_tdata = s_tdata;
-                default: m_tdata = 8'd0;
+                PUB_CONST: other = (cnt < {16'd0, klen}) ? konst(kaddr + cnt[15:0]) : 8'd0;  // then a NUL
+                PUB_COUNT: other = (cnt < 32'd4) ? seq_byte : 8'd0;
+                PUB_STREAM: other = s_tdata;
+                default: other = 8'd0;
             endcase
-            default: m_tdata = 8'd0;
+            default: other = 8'd0;
         endcase
+        m_tdata = carried ? carry_rdata : other;
     end
 
     assign m_tvalid = (state == P_LEN) || (state == P_COUNT) || (state == P_PAD)
@@ -95,7 +99,6 @@ module rfl_gpublisher #(
     assign meta_release = (state == P_DONE);
     assign idle = (state == P_IDLE);
     wire put = m_tvalid && m_tready;
-    wire carried = (state == P_COUNT || state == P_BODY) && (pub == PUB_CARRY);
     wire [31:0] n_next = {carry_rdata, n[31:8]};
     wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
 

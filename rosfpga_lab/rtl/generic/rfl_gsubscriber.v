@@ -47,7 +47,7 @@ module rfl_gsubscriber #(
 `include "rfl_layout.vh"
     localparam [3:0] S_FLEN = 4'd0, S_DECODE = 4'd1, S_COUNT = 4'd2, S_COUNTED = 4'd3,
                      S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7, S_TAIL = 4'd8,
-                     S_LEAST = 4'd9;
+                     S_LEAST = 4'd9, S_FCHK = 4'd10;
 
     reg [3:0]  state;
     reg [15:0] pc;
@@ -198,7 +198,7 @@ module rfl_gsubscriber #(
     wire in_range = !p_vnan && lo_key <= p_vkey && p_vkey <= hi_key;
     reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
         c_body0, c_pade_bad, c_body_gt, c_encap_bad, c_encap_pad_gt, c_check_bad, c_range_bad,
-        c_at_end, c_room0, c_room_lt4, c_size0, c_n0;
+        c_at_end, c_room0, c_room_lt4, c_size0, c_n0, c_flen_long, c_flen_short;
     reg [31:0] c_out_len;                          // S_FINISH: out_len after the field
     always @(posedge clk) begin
         c_tail <= tail_zero;
@@ -207,6 +207,8 @@ module rfl_gsubscriber #(
         c_room_lt4 <= (room < 32'd4);
         c_size0 <= (size == 32'd0);
         c_n0 <= (n == 32'd0);
+        c_flen_long <= (n > MAX_FRAME);
+        c_flen_short <= (n < MIN_BODY);
         c_left1 <= (left[depth - 1'b1] != 32'd1);
         c_padf_bad <= (pad_f != 32'd0 && pad_f >= room);
         p_room_f <= room_f;
@@ -339,22 +341,31 @@ module rfl_gsubscriber #(
                 S_FLEN: if (take) begin
                     n <= n_next;
                     if (cnt[1:0] == 2'd3) begin  // (cnt counts 0..3 here)
-                        if (n_next > MAX_FRAME) begin
+                        cnt <= 32'd0;
+                        state <= S_FCHK;
+                    end
+                end
+                S_FCHK: if (settled != 2'd2) settled <= settled + 2'd1; else begin
+                    // the frame length n, settled as S_DECODE's decisions are (c_flen_*)
+                    settled <= 2'd0;
+                    begin
+                        if (c_flen_long) begin
                             // Not to be trusted for skipping: wait for the next frame length.
                             status_valid <= 1'b1;
                             status <= SUB_BAD_FRAME_LENGTH;
-                            cnt <= 32'd0;
                             pos <= 32'd0;
-                        end else if (n_next < MIN_BODY) begin
+                            state <= S_FLEN;
+                        end else if (c_flen_short) begin
                             status_valid <= 1'b1;
                             status <= SUB_BAD_FRAME_LENGTH;
-                            cnt <= 32'd0;
-                            left_f <= n_next;                   // pos is 4 after this byte
-                            if (n_next == 32'd0) pos <= 32'd0;
-                            else state <= S_SKIP;
+                            left_f <= n;                        // pos is 4
+                            if (c_n0) begin
+                                pos <= 32'd0;
+                                state <= S_FLEN;
+                            end else state <= S_SKIP;
                         end else begin
-                            left_f <= n_next;                   // pos is 4 after this byte
-                            room <= n_next;
+                            left_f <= n;                        // pos is 4
+                            room <= n;
                             streamed <= 1'b0;
                             out_len <= 32'd0;
                             waddr <= {CW{1'b0}};
