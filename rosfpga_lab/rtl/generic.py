@@ -19,10 +19,11 @@ Timing (``rosfpga-lab rtl timing`` places and routes the generated top for an EC
 configuration's clock): the walkers have no multiplier (an array's bytes are its count shifted
 by log2 of its element size, which the program word carries; an array of messages' fewest
 bytes are added up bit by bit), hold the current instruction in a register, keep the bytes left
-as registers and settle each decision's arithmetic into registers a clock before deciding;
-``rfl_window1d`` keeps its fold as it goes (one comparison per clock). Bodies still move a byte
-per clock; a field costs a few clocks more than before (S_DECODE, S_COUNTED and S_FINISH take
-two clocks each, an array of messages 1 + bits(elem_min) more).
+as registers and settle each decision's arithmetic into registers for two clocks before
+deciding; ``rfl_window1d`` keeps its fold as it goes (one comparison per clock); a register
+slice sits between the publisher and the tx FIFO. Bodies still move a byte per clock; a field
+costs a few clocks more than before (S_FCHK, S_DECODE, S_COUNTED and S_FINISH take three clocks
+each, one before; an array of messages 1 + bits(elem_min) more).
 """
 
 from __future__ import annotations

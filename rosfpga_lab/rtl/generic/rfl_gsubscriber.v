@@ -53,6 +53,7 @@ module rfl_gsubscriber #(
     reg [15:0] pc;
     reg [31:0] pos;                             // bytes of this frame taken so far
     reg [31:0] left_f;                          // bytes of the frame left: 4 + frame length - pos
+    reg        last_f;                          // left_f == 1 (kept with it: S_SKIP, S_TAIL)
     reg [31:0] padn;                            // alignment bytes to skip (S_PAD)
     reg [3:0]  pad_ret;                         // the state after them
     reg        nul_bad;                         // a string's last byte was not 0
@@ -187,8 +188,8 @@ module rfl_gsubscriber #(
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
     end
 
-    // The decisions' arithmetic, registered: S_DECODE, S_COUNTED and S_FINISH take three
-    // clocks, the first two (settled 0, 1) with nothing changing but these registers (p_*: the
+    // The decisions' arithmetic, registered: S_FCHK, S_DECODE, S_COUNTED and S_FINISH take
+    // three clocks, the first two (settled 0, 1) with nothing changing but these registers (p_*: the
     // subtractions and the value's key; c_*: the comparisons, from p_*), so that the third
     // decides from flip-flops (100 MHz on an ECP5) as the same expressions would.
     reg [1:0] settled;
@@ -198,7 +199,7 @@ module rfl_gsubscriber #(
     wire in_range = !p_vnan && lo_key <= p_vkey && p_vkey <= hi_key;
     reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
         c_body0, c_pade_bad, c_body_gt, c_encap_bad, c_encap_pad_gt, c_check_bad, c_range_bad,
-        c_at_end, c_room0, c_room_lt4, c_size0, c_n0, c_flen_long, c_flen_short;
+        c_at_end, c_room0, c_room_lt4, c_size0, c_n0, c_n1, c_flen_long, c_flen_short;
     reg [31:0] c_out_len;                          // S_FINISH: out_len after the field
     always @(posedge clk) begin
         c_tail <= tail_zero;
@@ -207,6 +208,7 @@ module rfl_gsubscriber #(
         c_room_lt4 <= (room < 32'd4);
         c_size0 <= (size == 32'd0);
         c_n0 <= (n == 32'd0);
+        c_n1 <= (n == 32'd1);
         c_flen_long <= (n > MAX_FRAME);
         c_flen_short <= (n < MIN_BODY);
         c_left1 <= (left[depth - 1'b1] != 32'd1);
@@ -302,6 +304,7 @@ module rfl_gsubscriber #(
             w <= prog_word(16'd0);
             pos <= 32'd0;
             left_f <= 32'd0;
+            last_f <= 1'b0;
             padn <= 32'd0;
             pad_ret <= S_FLEN;
             nul_bad <= 1'b0;
@@ -334,6 +337,7 @@ module rfl_gsubscriber #(
                 pos <= pos_next;
                 room <= room - 32'd1;
                 left_f <= left_f - 32'd1;
+                last_f <= (left_f == 32'd2);
                 cnt <= cnt + 32'd1;
                 if (keep && (state == S_COUNT || state == S_BODY)) waddr <= waddr + 1'b1;
             end
@@ -359,12 +363,14 @@ module rfl_gsubscriber #(
                             status_valid <= 1'b1;
                             status <= SUB_BAD_FRAME_LENGTH;
                             left_f <= n;                        // pos is 4
+                            last_f <= c_n1;
                             if (c_n0) begin
                                 pos <= 32'd0;
                                 state <= S_FLEN;
                             end else state <= S_SKIP;
                         end else begin
                             left_f <= n;                        // pos is 4
+                            last_f <= c_n1;
                             room <= n;
                             streamed <= 1'b0;
                             out_len <= 32'd0;
@@ -520,10 +526,10 @@ module rfl_gsubscriber #(
                     end
                 end
                 S_TAIL: if (take) begin  // CDR: an unannounced end pad byte, which must be 0
-                    if (s_tdata != 8'd0) refuse(st2, left_f == 32'd1);
-                    else if (left_f == 32'd1) accept(1'b1);
+                    if (s_tdata != 8'd0) refuse(st2, last_f);
+                    else if (last_f) accept(1'b1);
                 end
-                S_SKIP: if (take && left_f == 32'd1) begin
+                S_SKIP: if (take && last_f) begin
                     state <= S_FLEN;
                     cnt <= 32'd0;
                     pos <= 32'd0;
