@@ -19,6 +19,7 @@ from rosfpga_lab.cli import main
 from rosfpga_lab.rtl.errors import TimingError
 from rosfpga_lab.rtl.timing import parse_report, place_and_route_dir
 from rtltools import require_nextpnr
+from test_hw_walker import definitions  # the models' strategy over message definitions
 from test_rtl_sim import small_config
 
 pytestmark = pytest.mark.rtl
@@ -178,7 +179,6 @@ def test_generated_tops_of_random_message_types_use_no_multiplier(
     from rosfpga_lab.rtl.generic import generic_rtl_files
     from rosfpga_lab.rtl.timing import ecp5_cells
     from rtltools import require_yosys
-    from test_hw_walker import definitions
 
     require_yosys()
     reg, type_name, stream = data.draw(definitions())
