@@ -194,7 +194,7 @@ module rfl_gsubscriber #(
     // decides from flip-flops (100 MHz on an ECP5) as the same expressions would.
     reg [1:0] settled;
     reg [31:0] p_room_f, p_room_e;
-    reg [63:0] p_vkey, p_least_fa;
+    reg [63:0] p_vkey, p_least, p_least_fa;
     reg        p_vnan;
     wire in_range = !p_vnan && lo_key <= p_vkey && p_vkey <= hi_key;
     reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
@@ -217,12 +217,13 @@ module rfl_gsubscriber #(
         p_room_e <= room_e;
         p_vkey <= vkey;
         p_vnan <= (kind == 2'd2 && is_nan(value, size));
+        p_least <= least;
         p_least_fa <= least + {32'd0, fixed_after};
         c_size_gt <= (size > p_room_f);
         c_roomf_lt4 <= (p_room_f < 32'd4);
         c_count_bad <= (sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0);
         c_fit_bad <= fits && p_least_fa != {32'd0, room};
-        c_least_gt <= (least > {32'd0, room});
+        c_least_gt <= (p_least > {32'd0, room});
         c_body0 <= (body == 35'd0);
         c_pade_bad <= (pad_e != 32'd0 && pad_e >= room);
         c_body_gt <= (body > {3'd0, p_room_e});
