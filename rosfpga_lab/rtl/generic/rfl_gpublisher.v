@@ -36,7 +36,7 @@ module rfl_gpublisher #(
 
     reg [3:0]  state;
     reg [31:0] opos;                            // bytes of this frame written so far
-    reg [31:0] padn;                            // zeros to write (P_PAD)
+    reg [2:0]  padn;                            // zeros to write (P_PAD; fewer than 8)
     reg [3:0]  pad_ret;                         // the state after them
     reg [15:0] pc;
     reg [31:0] cnt;                             // bytes of the current part written so far
@@ -107,7 +107,7 @@ module rfl_gpublisher #(
         begin
             cnt <= 32'd0;
             if (p != 32'd0) begin
-                padn <= p;
+                padn <= p[2:0];
                 pad_ret <= next;
                 state <= P_PAD;
             end else begin
@@ -137,7 +137,7 @@ module rfl_gpublisher #(
             left_b <= 35'd0;
             seq <= SEQ_START;
             opos <= 32'd0;
-            padn <= 32'd0;
+            padn <= 3'd0;
             pad_ret <= P_IDLE;
             raddr <= {CW{1'b0}};
             depth <= {DB{1'b0}};
@@ -215,7 +215,7 @@ module rfl_gpublisher #(
                         pad_then(pad_at(opos, elem_align), P_BODY);
                     end
                 end
-                P_PAD: if (put && cnt + 32'd1 == padn) begin
+                P_PAD: if (put && cnt[2:0] + 3'd1 == padn) begin
                     state <= pad_ret;
                     cnt <= 32'd0;
                 end

@@ -54,7 +54,7 @@ module rfl_gsubscriber #(
     reg [31:0] pos;                             // bytes of this frame taken so far
     reg [31:0] left_f;                          // bytes of the frame left: 4 + frame length - pos
     reg        last_f;                          // left_f == 1 (kept with it: S_SKIP, S_TAIL)
-    reg [31:0] padn;                            // alignment bytes to skip (S_PAD)
+    reg [2:0]  padn;                            // alignment bytes to skip (S_PAD; fewer than 8)
     reg [3:0]  pad_ret;                         // the state after them
     reg        nul_bad;                         // a string's last byte was not 0
     reg [31:0] cnt;                             // bytes of the current part taken so far
@@ -240,7 +240,7 @@ module rfl_gsubscriber #(
         begin
             cnt <= 32'd0;
             if (p != 32'd0) begin
-                padn <= p;
+                padn <= p[2:0];
                 pad_ret <= next;
                 state <= S_PAD;
             end else begin
@@ -306,7 +306,7 @@ module rfl_gsubscriber #(
             pos <= 32'd0;
             left_f <= 32'd0;
             last_f <= 1'b0;
-            padn <= 32'd0;
+            padn <= 3'd0;
             pad_ret <= S_FLEN;
             nul_bad <= 1'b0;
             cnt <= 32'd0;
@@ -492,7 +492,7 @@ module rfl_gsubscriber #(
                         pad_then(pad_e, S_BODY);
                     end
                 end
-                S_PAD: if (take && cnt + 32'd1 == padn) begin
+                S_PAD: if (take && cnt[2:0] + 3'd1 == padn) begin
                     state <= pad_ret;
                     cnt <= 32'd0;
                 end
