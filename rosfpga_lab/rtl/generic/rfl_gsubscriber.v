@@ -195,6 +195,7 @@ module rfl_gsubscriber #(
     reg [1:0] settled;
     reg [31:0] p_room_f, p_room_e;
     reg [63:0] p_vkey, p_least, p_least_fa;
+    reg [31:0] p_out_at, p_written;                // S_FINISH: where the field's bytes start, and how many
     reg        p_vnan;
     wire in_range = !p_vnan && lo_key <= p_vkey && p_vkey <= hi_key;
     reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
@@ -218,6 +219,8 @@ module rfl_gsubscriber #(
         p_vkey <= vkey;
         p_vnan <= (kind == 2'd2 && is_nan(value, size));
         p_least <= least;
+        p_out_at <= out_base + out_pad;
+        p_written <= written;
         p_least_fa <= least + {32'd0, fixed_after};
         c_size_gt <= (size > p_room_f);
         c_roomf_lt4 <= (p_room_f < 32'd4);
@@ -232,7 +235,7 @@ module rfl_gsubscriber #(
         c_check_bad <= sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {34'd0, nul}
                                                       : {3'd0, size}) != {19'd0, klen});
         c_range_bad <= (sub == SUB_RANGE && !in_range);  // from p_vkey, p_vnan
-        c_out_len <= out_base + out_pad + written;
+        c_out_len <= p_out_at + p_written;
     end
 
     // Skip `p` alignment bytes (if any), then go to state `next`.
