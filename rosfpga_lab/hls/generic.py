@@ -176,6 +176,7 @@ def instruction_rows(prog: Program) -> list[dict[str, object]]:
             "pub": int(ins.pub), "size": ins.size, "count": ins.count,
             "variable": ins.variable, "status": ins.status, "status2": ins.status2,
             "kind": ins.kind, "fixed_after": ins.fixed_after, "elem_min": ins.elem_min,
+            "lsize": ins.size.bit_length() - 1 if ins.op == Op.VAR else 0,
             "kaddr": prog.const_offsets[pc], "klen": len(ins.const), "jump": ins.jump,
             "align": ins.align, "elem_align": ins.elem_align, "nul": ins.nul,
             "status3": ins.status3,

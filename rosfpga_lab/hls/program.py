@@ -53,6 +53,10 @@ from rosfpga_lab.hw.cdrlayout import ALIGN_ORIGIN, END_ALIGN, OPTIONS_PADDING_MA
 from rosfpga_lab.msg.cdr import CDR_LE
 
 
+#: Bytes of one element of a ``VAR`` (a number): the walkers shift a count by their log2.
+VAR_SIZES = (1, 2, 4, 8)
+
+
 class Op(IntEnum):
     """Instruction kinds (their codes are the C++ and Verilog ones)."""
 
@@ -166,13 +170,18 @@ class Program:
         """Fill each LOOP's and END's ``jump``, the constant offsets, and check nesting.
 
         Raises:
-            ValueError: unbalanced loops, nesting deeper than :data:`MAX_LOOP_DEPTH`, no DONE last.
+            ValueError: unbalanced loops, nesting deeper than :data:`MAX_LOOP_DEPTH`, no DONE last,
+                a ``VAR`` whose elements are not :data:`VAR_SIZES` bytes (its ``elem_min``).
         """
         stack: list[int] = []
         fixed = list(instrs)
         for i, ins in enumerate(fixed):
             if ins.op == Op.VAR and ins.elem_min == 0:
                 fixed[i] = ins = _replace(ins, elem_min=ins.size)
+            if ins.op == Op.VAR and (ins.size not in VAR_SIZES or ins.elem_min != ins.size):
+                # the walkers shift a count by log2(size) (no multiplier in the circuit)
+                raise ValueError(f"{ins.name}: an array of {ins.size}-byte elements (fewest "
+                                 f"{ins.elem_min}); a VAR's elements are 1, 2, 4 or 8 bytes")
             if ins.op == Op.LOOP:
                 stack.append(i)
                 if len(stack) > MAX_LOOP_DEPTH:

@@ -8,13 +8,23 @@ instruction per field, that is generated for each configuration into ``rfl_layou
 comment per field naming it); ``rfl_elem_pack`` turns the streamed array's bytes into AXI4-Stream
 beats of one element (TUSER first, TLAST last), ``rfl_window1d`` is the 1-D application (sliding
 max/min over KSIZE elements, pass-through) and ``rfl_elem_unpack`` turns beats back into bytes;
-``rfl_gtop`` joins them with the lab's ``rfl_fifo``. ``rfl_node.v`` sets the parameters of one
-configuration, with the ports of the hand circuit's ``rfl_node`` (so the lab's testbench
-``rfl_tb.v`` and its fast harness run either top unchanged). The same
+``rfl_gtop`` joins them with the lab's ``rfl_fifo`` and ``rfl_slice``. ``rfl_node.v`` sets the
+parameters of one configuration, with the ports of the hand circuit's ``rfl_node`` (so the lab's
+testbench ``rfl_tb.v`` and its fast harness run either top unchanged). The same
 walkers read and write CDR (``wire: cdr``): the program's alignment, ``OP_ENCAP`` and strings
 with their NUL (:mod:`rosfpga_lab.hls.program`). A stream with a video shape
 (:attr:`GenericSpec.video`) is packed a pixel per beat with TLAST ending each line, and
 ``rfl_gtop`` (``VIDEO``) runs the video project's 2-D ``rfl_morph`` instead of ``rfl_window1d``.
+
+Timing (``rosfpga-lab rtl timing`` places and routes the generated top for an ECP5 at the
+configuration's clock): the walkers have no multiplier (an array's bytes are its count shifted
+by log2 of its element size, which the program word carries; an array of messages' fewest
+bytes are added up bit by bit), hold the current instruction in a register, keep the bytes left
+as registers and settle each decision's arithmetic into registers for two clocks before
+deciding; ``rfl_window1d`` keeps its fold as it goes (one comparison per clock); a register
+slice sits between the publisher and the tx FIFO. Bodies still move a byte per clock; a field
+costs a few clocks more than before (S_FCHK, S_DECODE, S_COUNTED and S_FINISH take three clocks
+each, one before; an array of messages 1 + bits(elem_min) more).
 """
 
 from __future__ import annotations
@@ -35,6 +45,8 @@ KIND_CODES = {"unsigned": 0, "signed": 1, "float": 2}
 #: The static Verilog of every generic project (``generic/``), in data-path order.
 GENERIC_MODULES = ("rfl_gsubscriber.v", "rfl_elem_pack.v", "rfl_window1d.v", "rfl_elem_unpack.v",
                    "rfl_gpublisher.v", "rfl_gtop.v")
+#: The lab's modules every generic project takes from ``verilog/`` (FIFO, register slice).
+LAB_MODULES = ("rfl_fifo.v", "rfl_slice.v")
 #: The application of a video stream (the video project's), beside ``GENERIC_MODULES``.
 VIDEO_APP = "rfl_morph.v"
 #: The generated include holding the walk (one instruction per field).
@@ -103,7 +115,8 @@ def generic_rtl_files(spec: GenericSpec) -> dict[str, bytes]:
         files[name] = (GENERIC_VERILOG_DIR / name).read_bytes()
     if spec.video is not None:  # the video project's 2-D application
         files[VIDEO_APP] = (VERILOG_DIR / VIDEO_APP).read_bytes()
-    files["rfl_fifo.v"] = (VERILOG_DIR / "rfl_fifo.v").read_bytes()
+    for name in LAB_MODULES:
+        files[name] = (VERILOG_DIR / name).read_bytes()
     files[NODE_FILE] = node_wrapper(spec, str(ctx["generated_note"])).encode()
     files["rfl_tb.v"] = testbench().encode()
     return files

@@ -36,6 +36,10 @@ PNR_TIMEOUT = 1800.0
 #: (a Lattice ECP5 LFE5U-25F in a 256-ball BGA: 24k LUTs, 56 block RAMs, 197 I/Os).
 ECP5_DEVICE = "25k"
 ECP5_PACKAGE = "CABGA256"
+#: Seconds between progress lines while Yosys or nextpnr runs (``rtl timing``).
+PROGRESS_SECONDS = 30.0
+#: Seconds allowed for a tool to say its version (a WebAssembly build compiles on first run).
+VERSION_TIMEOUT = 120.0
 #: Longest critical path kept in a timing report (steps).
 MAX_PATH_STEPS = 400
 

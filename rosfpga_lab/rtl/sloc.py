@@ -26,7 +26,8 @@ OTHERS = ("rfl_morph.v", "rfl_fifo.v", "rfl_top.v", "rfl_node.v")
 #: the per-message part), and the element packer/unpacker as fifo2axi/axi2fifo.
 GENERIC_COUNTED = {"subscriber": ("rfl_gsubscriber.v", "rfl_layout.vh", "rfl_elem_pack.v"),
                    "publisher": ("rfl_gpublisher.v", "rfl_elem_unpack.v")}
-GENERIC_OTHERS = ("rfl_window1d.v", "rfl_morph.v", "rfl_fifo.v", "rfl_gtop.v", "rfl_node.v")
+GENERIC_OTHERS = ("rfl_window1d.v", "rfl_morph.v", "rfl_fifo.v", "rfl_slice.v", "rfl_gtop.v",
+                  "rfl_node.v")
 
 
 def verilog_sloc(text: str) -> int:

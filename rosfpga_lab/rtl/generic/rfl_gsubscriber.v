@@ -14,6 +14,11 @@
 // bytes the options do not announce that pad the payload to a multiple of END_ALIGN (Cyclone DDS
 // pads so with options 00 00) are taken when they are zero (S_TAIL); the first non-zero one
 // refuses the sample with OP_DONE's status2.
+// No multiplier (100 MHz on an ECP5 with no DSP): an OP_VAR's bytes are its count shifted by
+// lsize; an OP_LOOP's fewest bytes (count x elem_min) are added up in S_LEAST, one bit of
+// elem_min per clock, before S_COUNTED checks them. The bytes left for the fields (room: CDR
+// less the end padding) and in the frame (left_f) are registers kept with pos, and a body's
+// last byte is found by a count down (left_b), so that no clock subtracts and compares in a row.
 module rfl_gsubscriber #(
     parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
     parameter CW = 6,                           // its address bits
@@ -41,19 +46,24 @@ module rfl_gsubscriber #(
 );
 `include "rfl_layout.vh"
     localparam [3:0] S_FLEN = 4'd0, S_DECODE = 4'd1, S_COUNT = 4'd2, S_COUNTED = 4'd3,
-                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7, S_TAIL = 4'd8;
+                     S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7, S_TAIL = 4'd8,
+                     S_LEAST = 4'd9, S_FCHK = 4'd10;
 
     reg [3:0]  state;
     reg [15:0] pc;
     reg [31:0] pos;                             // bytes of this frame taken so far
-    reg [31:0] endp;                            // 4 + frame length
-    reg [31:0] fendp;                           // where the fields end (CDR: less the end padding)
-    reg [31:0] padn;                            // alignment bytes to skip (S_PAD)
+    reg [31:0] left_f;                          // bytes of the frame left: 4 + frame length - pos
+    reg        last_f;                          // left_f == 1 (kept with it: S_SKIP, S_TAIL)
+    reg [2:0]  padn;                            // alignment bytes to skip (S_PAD; fewer than 8)
     reg [3:0]  pad_ret;                         // the state after them
     reg        nul_bad;                         // a string's last byte was not 0
     reg [31:0] cnt;                             // bytes of the current part taken so far
     reg [31:0] n;                               // a count, shifted in little-endian
-    reg [63:0] need;                            // bytes of the current body
+    reg [34:0] left_b;                          // bytes of the current body still to take
+    reg [31:0] room;                            // bytes left for the fields (CDR: before the end padding)
+    reg [63:0] least_r;                         // OP_LOOP: count x elem_min, added up (S_LEAST)
+    reg [63:0] nsh;                             // the count shifted by the elem_min bits done
+    reg [31:0] mrem;                            // elem_min's bits still to add
     reg [63:0] value;                           // a SUB_RANGE field, little-endian
     reg        same;                            // a SUB_CHECK field equals its constant so far
     reg        streamed;                        // the stream went out
@@ -66,7 +76,7 @@ module rfl_gsubscriber #(
     reg [7:0]  carry_mem [0:CARRY_BYTES-1];
 
     // The current instruction.
-    wire [IW-1:0] w = prog_word(pc);
+    reg [IW-1:0] w;                             // the current instruction: prog_word(pc)
     // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
     wire [3:0]  align = CDR ? w[221:218] : 4'd1;
     wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
@@ -87,9 +97,11 @@ module rfl_gsubscriber #(
     wire        fits = w[64];
     wire [31:0] fixed_after = w[63:32];
     wire [31:0] elem_min = w[31:0];
+    wire [1:0]  lsize = w[223:222];
 
-    // A new frame waits until the publisher has taken the previous frame's meta.
-    wire stall = (state == S_FLEN) && (cnt == 0) && meta_valid;
+    // A new frame waits until the publisher has taken the previous frame's meta. (In S_FLEN,
+    // as in S_COUNT, cnt counts the length's bytes, 0..3.)
+    wire stall = (state == S_FLEN) && (cnt[1:0] == 2'd0) && meta_valid;
     wire streaming = (state == S_BODY) && (sub == SUB_STREAM);
     wire reading = (state == S_FLEN && !stall) || state == S_COUNT || state == S_BODY
                    || state == S_SKIP || state == S_PAD || state == S_TAIL;
@@ -97,23 +109,21 @@ module rfl_gsubscriber #(
     assign m_tvalid = streaming && s_tvalid;
     assign m_tdata = s_tdata;
     wire take = s_tvalid && s_tready;
-    assign frame_start = take && (state == S_FLEN) && (cnt == 0);
-    assign idle = (state == S_FLEN) && (cnt == 0);
+    assign frame_start = take && (state == S_FLEN) && (cnt[1:0] == 2'd0);
+    assign idle = (state == S_FLEN) && (cnt[1:0] == 2'd0);
     assign carry_rdata = carry_mem[carry_raddr];
 
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
     wire [31:0] pos_next = pos + 32'd1;
-    wire [31:0] fields_end = CDR ? fendp : endp;
-    wire [63:0] room = {32'd0, fields_end} - {32'd0, pos};  // bytes left for the fields
-    wire        at_end = (pos == endp);             // nothing left of the frame to skip
-    wire [31:0] after = endp - pos;                 // bytes left after the last field
-    // CDR: they are the unannounced zeros up to a multiple of END_ALIGN (OP_DONE's st2 != 0)
-    wire        tail_zero = CDR && st2 != 8'd0 && pos != fields_end && after != 32'd0
-                            && after < {28'd0, END_ALIGN} && after == pad_at(pos, END_ALIGN);
+    wire        at_end = (left_f == 32'd0);         // nothing left of the frame to skip
+    // CDR: the bytes left after the last field are the unannounced zeros up to a multiple of
+    // END_ALIGN (OP_DONE's st2 != 0)
+    wire        tail_zero = CDR && st2 != 8'd0 && room != 32'd0 && left_f != 32'd0
+                            && left_f < {28'd0, END_ALIGN} && left_f == pad_at(pos, END_ALIGN);
     wire [31:0] pad_f = pad_at(pos, align);         // before a field or a count
     wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
-    wire [63:0] room_f = room - {32'd0, pad_f};     // bytes left after that padding
-    wire [63:0] room_e = room - {32'd0, pad_e};
+    wire [31:0] room_f = room - pad_f;              // bytes left after that padding
+    wire [31:0] room_e = room - pad_e;              // (each used only when the padding fits)
     // what the publisher writes for this OP_FIXED / OP_VAR: its bytes, and where they start
     wire [31:0] written = (op == OP_FIXED) ? size
                           : (pub == PUB_CARRY || pub == PUB_STREAM) ? body[31:0]
@@ -121,8 +131,9 @@ module rfl_gsubscriber #(
     wire [31:0] out_base = (op == OP_FIXED) ? out_len : out_len + 32'd4;
     wire [31:0] out_pad = (written == 32'd0) ? 32'd0
                           : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
-    wire [63:0] body = {32'd0, n} * {32'd0, size};
-    wire [63:0] least = {32'd0, n} * {32'd0, elem_min};  // fewest bytes of the counted elements
+    wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
+    // fewest bytes of the counted elements (OP_VAR: its elements' bytes)
+    wire [63:0] least = (op == OP_VAR) ? {29'd0, body} : least_r;
     wire        keep = (state == S_COUNT) ? (sub == SUB_CARRY)
                        : (sub == SUB_CARRY || sub == SUB_RANGE);
     wire [7:0]  want_byte = konst(kaddr + cnt[15:0]);
@@ -137,16 +148,16 @@ module rfl_gsubscriber #(
         end
     endfunction
 
-    // The order key of a value (larger key, larger value); floats: -0.0 counts as +0.0.
-    function [63:0] order_key(input [63:0] v, input [31:0] nbytes, input [1:0] k);
-        reg [63:0] sign, all, x;
+    // The order key of a value (larger key, larger value); floats: -0.0 counts as +0.0. `sign`
+    // is the value's sign bit (1 << (8 x bytes - 1)), `all` its bits (registered below).
+    function [63:0] order_key(input [63:0] v, input [63:0] sign, input [63:0] all,
+                              input [1:0] k);
+        reg [63:0] x;
         begin
-            sign = 64'd1 << (8 * nbytes - 1);
-            all = sign | (sign - 64'd1);
             x = v;
             if (k == 2'd2 && x == sign) x = 64'd0;
             if (k == 2'd1) order_key = x ^ sign;
-            else if (k == 2'd2) order_key = x[8*nbytes-1] ? (~x & all) : (x | sign);
+            else if (k == 2'd2) order_key = ((x & sign) != 64'd0) ? (~x & all) : (x | sign);
             else order_key = x;
         end
     endfunction
@@ -160,13 +171,71 @@ module rfl_gsubscriber #(
     endfunction
     /* verilator lint_on UNUSEDSIGNAL */
 
-    wire [63:0] vkey = order_key(value, size, kind);
-    wire in_range = !(kind == 2'd2 && is_nan(value, size))
-                    && order_key(bound(kaddr, size), size, kind) <= vkey
-                    && vkey <= order_key(bound(kaddr + size[15:0], size), size, kind);
+    // The bounds' keys, registered: they depend on the instruction only, which holds from
+    // S_DECODE (three clocks) through S_BODY to S_FINISH, where in_range is read (the masks
+    // are registered one clock after the instruction, the keys one clock after the masks).
+    // The sign and all-bits masks of the field's size (1, 2, 4 or 8 bytes) the same way.
+    reg [63:0] lo_key, hi_key, sign_m, all_m;
+    always @(posedge clk) begin
+        sign_m <= 64'd1 << (8 * size[3:0] - 1);
+        all_m <= (64'd1 << (8 * size[3:0] - 1)) | ((64'd1 << (8 * size[3:0] - 1)) - 64'd1);
+        lo_key <= order_key(bound(kaddr, size), sign_m, all_m, kind);
+        hi_key <= order_key(bound(kaddr + size[15:0], size), sign_m, all_m, kind);
+    end
+    wire [63:0] vkey = order_key(value, sign_m, all_m, kind);
 
     always @(posedge clk) begin
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
+    end
+
+    // The decisions' arithmetic, registered: S_FCHK, S_DECODE, S_COUNTED and S_FINISH take
+    // three clocks, the first two (settled 0, 1) with nothing changing but these registers (p_*: the
+    // subtractions and the value's key; c_*: the comparisons, from p_*), so that the third
+    // decides from flip-flops (100 MHz on an ECP5) as the same expressions would.
+    reg [1:0] settled;
+    reg [31:0] p_room_f, p_room_e;
+    reg [63:0] p_vkey, p_least, p_least_fa;
+    reg [31:0] p_out_at, p_written;                // S_FINISH: where the field's bytes start, and how many
+    reg        p_vnan;
+    wire in_range = !p_vnan && lo_key <= p_vkey && p_vkey <= hi_key;
+    reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
+        c_body0, c_pade_bad, c_body_gt, c_encap_bad, c_encap_pad_gt, c_check_bad, c_range_bad,
+        c_at_end, c_room0, c_room_lt4, c_size0, c_n0, c_n1, c_flen_long, c_flen_short;
+    reg [31:0] c_out_len;                          // S_FINISH: out_len after the field
+    always @(posedge clk) begin
+        c_tail <= tail_zero;
+        c_at_end <= at_end;
+        c_room0 <= (room == 32'd0);
+        c_room_lt4 <= (room < 32'd4);
+        c_size0 <= (size == 32'd0);
+        c_n0 <= (n == 32'd0);
+        c_n1 <= (n == 32'd1);
+        c_flen_long <= (n > MAX_FRAME);
+        c_flen_short <= (n < MIN_BODY);
+        c_left1 <= (left[depth - 1'b1] != 32'd1);
+        c_padf_bad <= (pad_f != 32'd0 && pad_f >= room);
+        p_room_f <= room_f;
+        p_room_e <= room_e;
+        p_vkey <= vkey;
+        p_vnan <= (kind == 2'd2 && is_nan(value, size));
+        p_least <= least;
+        p_out_at <= out_base + out_pad;
+        p_written <= written;
+        p_least_fa <= least + {32'd0, fixed_after};
+        c_size_gt <= (size > p_room_f);
+        c_roomf_lt4 <= (p_room_f < 32'd4);
+        c_count_bad <= (sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0);
+        c_fit_bad <= fits && p_least_fa != {32'd0, room};
+        c_least_gt <= (p_least > {32'd0, room});
+        c_body0 <= (body == 35'd0);
+        c_pade_bad <= (pad_e != 32'd0 && pad_e >= room);
+        c_body_gt <= (body > {3'd0, p_room_e});
+        c_encap_bad <= (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1));
+        c_encap_pad_gt <= ({24'd0, value[31:24] & ENCAP_PAD_MASK} > room);
+        c_check_bad <= sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {34'd0, nul}
+                                                      : {3'd0, size}) != {19'd0, klen});
+        c_range_bad <= (sub == SUB_RANGE && !in_range);  // from p_vkey, p_vnan
+        c_out_len <= p_out_at + p_written;
     end
 
     // Skip `p` alignment bytes (if any), then go to state `next`.
@@ -174,7 +243,7 @@ module rfl_gsubscriber #(
         begin
             cnt <= 32'd0;
             if (p != 32'd0) begin
-                padn <= p;
+                padn <= p[2:0];
                 pad_ret <= next;
                 state <= S_PAD;
             end else begin
@@ -221,9 +290,11 @@ module rfl_gsubscriber #(
     endtask
 
     // Go on with instruction `next`.
-    task go(input [15:0] next);
+    // (w follows pc: `word` is prog_word(next), from a look-up by the current pc.)
+    task go(input [15:0] next, input [IW-1:0] word);
         begin
             pc <= next;
+            w <= word;
             state <= S_DECODE;
             cnt <= 32'd0;
         end
@@ -234,15 +305,21 @@ module rfl_gsubscriber #(
         if (!rst_n) begin
             state <= S_FLEN;
             pc <= 16'd0;
+            w <= prog_word(16'd0);
             pos <= 32'd0;
-            endp <= 32'd0;
-            fendp <= 32'd0;
-            padn <= 32'd0;
+            left_f <= 32'd0;
+            last_f <= 1'b0;
+            padn <= 3'd0;
             pad_ret <= S_FLEN;
             nul_bad <= 1'b0;
             cnt <= 32'd0;
             n <= 32'd0;
-            need <= 64'd0;
+            left_b <= 35'd0;
+            settled <= 2'd0;
+            room <= 32'd0;
+            least_r <= 64'd0;
+            nsh <= 64'd0;
+            mrem <= 32'd0;
             value <= 64'd0;
             same <= 1'b0;
             streamed <= 1'b0;
@@ -262,85 +339,103 @@ module rfl_gsubscriber #(
             if (meta_release) meta_valid <= 1'b0;
             if (take) begin
                 pos <= pos_next;
+                room <= room - 32'd1;
+                left_f <= left_f - 32'd1;
+                last_f <= (left_f == 32'd2);
                 cnt <= cnt + 32'd1;
                 if (keep && (state == S_COUNT || state == S_BODY)) waddr <= waddr + 1'b1;
             end
             case (state)
                 S_FLEN: if (take) begin
                     n <= n_next;
-                    if (cnt == 32'd3) begin
-                        if (n_next > MAX_FRAME) begin
+                    if (cnt[1:0] == 2'd3) begin  // (cnt counts 0..3 here)
+                        cnt <= 32'd0;
+                        state <= S_FCHK;
+                    end
+                end
+                S_FCHK: if (settled != 2'd2) settled <= settled + 2'd1; else begin
+                    // the frame length n, settled as S_DECODE's decisions are (c_flen_*)
+                    settled <= 2'd0;
+                    begin
+                        if (c_flen_long) begin
                             // Not to be trusted for skipping: wait for the next frame length.
                             status_valid <= 1'b1;
                             status <= SUB_BAD_FRAME_LENGTH;
-                            cnt <= 32'd0;
                             pos <= 32'd0;
-                        end else if (n_next < MIN_BODY) begin
+                            state <= S_FLEN;
+                        end else if (c_flen_short) begin
                             status_valid <= 1'b1;
                             status <= SUB_BAD_FRAME_LENGTH;
-                            cnt <= 32'd0;
-                            endp <= n_next + 32'd4;
-                            if (n_next == 32'd0) pos <= 32'd0;
-                            else state <= S_SKIP;
+                            left_f <= n;                        // pos is 4
+                            last_f <= c_n1;
+                            if (c_n0) begin
+                                pos <= 32'd0;
+                                state <= S_FLEN;
+                            end else state <= S_SKIP;
                         end else begin
-                            endp <= n_next + 32'd4;
-                            fendp <= n_next + 32'd4;
+                            left_f <= n;                        // pos is 4
+                            last_f <= c_n1;
+                            room <= n;
                             streamed <= 1'b0;
                             out_len <= 32'd0;
                             waddr <= {CW{1'b0}};
                             depth <= {DB{1'b0}};
                             quiet <= 8'd0;
                             meta_drop <= 1'b0;
-                            go(16'd0);
+                            go(16'd0, prog_word(16'd0));
                         end
                     end
                 end
-                S_DECODE: begin
+                S_DECODE: if (settled != 2'd2) settled <= settled + 2'd1; else begin
+                    settled <= 2'd0;
                     cnt <= 32'd0;
                     same <= 1'b1;
                     nul_bad <= 1'b0;
                     value <= 64'd0;
                     case (op)
                         OP_DONE: begin
-                            if (tail_zero) state <= S_TAIL;
-                            else if (pos != fields_end) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
-                            else accept(at_end);
+                            if (c_tail) state <= S_TAIL;
+                            else if (!c_room0) refuse(SUB_BAD_FRAME_LENGTH, 1'b0);
+                            else accept(c_at_end);
                         end
                         OP_ENCAP: begin
-                            if (room < 64'd4) refuse(st, at_end);
+                            if (c_room_lt4) refuse(st, c_at_end);
                             else begin
-                                need <= 64'd4;
+                                left_b <= 35'd4;
                                 state <= S_BODY;
                             end
                         end
                         OP_END: begin
-                            if (left[depth - 1'b1] != 32'd1) begin
+                            if (c_left1) begin
                                 left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
-                                go(jump + 16'd1);
+                                go(jump + 16'd1, prog_jump(pc));
                             end else begin
                                 depth <= depth - 1'b1;
                                 if (quiet_of[depth - 1'b1]) quiet <= quiet - 8'd1;
-                                go(pc + 16'd1);
+                                go(pc + 16'd1, prog_next(pc));
                             end
                         end
                         OP_FIXED: begin
-                            if (size == 32'd0) go(pc + 16'd1);
-                            else if (pad_f != 32'd0 && {32'd0, pad_f} >= room)
-                                refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                            else if ({32'd0, size} > room_f)
-                                refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
+                            if (c_size0) go(pc + 16'd1, prog_next(pc));
+                            else if (c_padf_bad)
+                                refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
+                            else if (c_size_gt)
+                                refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
                             else begin
-                                need <= {32'd0, size};
+                                left_b <= {3'd0, size};
                                 pad_then(pad_f, S_BODY);
                             end
                         end
                         default: begin  // OP_VAR, OP_LOOP
                             if (op == OP_LOOP && !variable) begin
                                 n <= count;
-                                state <= S_COUNTED;
-                            end else if (pad_f != 32'd0 && {32'd0, pad_f} >= room)
-                                refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                            else if (room_f < 64'd4) refuse(st, at_end);  // cut short in its count
+                                nsh <= {32'd0, count};
+                                least_r <= 64'd0;
+                                mrem <= elem_min;
+                                state <= S_LEAST;
+                            end else if (c_padf_bad)
+                                refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
+                            else if (c_roomf_lt4) refuse(st, c_at_end);  // cut short in its count
                             else begin
                                 if (quiet == 8'd0) out_len <= out_len + pad_at(out_len + 32'd4, align);
                                 pad_then(pad_f, S_COUNT);
@@ -348,80 +443,97 @@ module rfl_gsubscriber #(
                         end
                     endcase
                 end
-                S_COUNT: if (take) begin
-                    n <= n_next;
-                    if (cnt == 32'd3) begin
-                        state <= S_COUNTED;
-                        cnt <= 32'd0;
+                S_COUNT: begin
+                    // S_LEAST's start, set on every clock here (the last is the count's last byte)
+                    nsh <= {32'd0, n_next};
+                    least_r <= 64'd0;
+                    mrem <= elem_min;
+                    if (take) begin
+                        n <= n_next;
+                        if (cnt[1:0] == 2'd3) begin  // (cnt counts 0..3 here)
+                            state <= (op == OP_LOOP) ? S_LEAST : S_COUNTED;
+                            cnt <= 32'd0;
+                        end
                     end
                 end
-                S_COUNTED: begin
-                    if ((sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0))
-                        refuse(st, at_end);
-                    else if (fits && least + {32'd0, fixed_after} != room)
-                        refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                    else if (least > room)
-                        refuse(st, at_end);
+                S_LEAST: begin  // OP_LOOP: least_r = n x elem_min, a bit of elem_min per clock
+                    if (mrem == 32'd0) state <= S_COUNTED;
+                    else begin
+                        if (mrem[0]) least_r <= least_r + nsh;
+                        nsh <= nsh << 1;
+                        mrem <= mrem >> 1;
+                    end
+                end
+                S_COUNTED: if (settled != 2'd2) settled <= settled + 2'd1; else begin
+                    settled <= 2'd0;
+                    if (c_count_bad)
+                        refuse(st, c_at_end);
+                    else if (c_fit_bad)
+                        refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
+                    else if (c_least_gt)
+                        refuse(st, c_at_end);
                     else if (op == OP_LOOP) begin
                         begin
                             if (variable && quiet == 8'd0) out_len <= out_len + 32'd4;
-                            if (n == 32'd0) go(jump + 16'd1);
+                            if (c_n0) go(jump + 16'd1, prog_jump(pc));
                             else begin
                                 left[depth] <= n;
                                 quiet_of[depth] <= variable && pub == PUB_ZERO;
                                 if (variable && pub == PUB_ZERO) quiet <= quiet + 8'd1;
                                 depth <= depth + 1'b1;
-                                go(pc + 16'd1);
+                                go(pc + 16'd1, prog_next(pc));
                             end
                         end
-                    end else if (body == 64'd0) begin
+                    end else if (c_body0) begin
                         state <= S_FINISH;
-                    end else if (pad_e != 32'd0 && {32'd0, pad_e} >= room) begin
-                        refuse(SUB_BAD_FRAME_LENGTH, at_end);
-                    end else if (body > room_e) begin
-                        refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, at_end);
+                    end else if (c_pade_bad) begin
+                        refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
+                    end else if (c_body_gt) begin
+                        refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
                     end else begin
-                        need <= body;
+                        left_b <= body;
                         pad_then(pad_e, S_BODY);
                     end
                 end
-                S_PAD: if (take && cnt + 32'd1 == padn) begin
+                S_PAD: if (take && cnt[2:0] + 3'd1 == padn) begin
                     state <= pad_ret;
                     cnt <= 32'd0;
                 end
                 S_BODY: if (take) begin
                     if (cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
-                    if (nul && {32'd0, cnt} + 64'd1 == need) nul_bad <= (s_tdata != 8'd0);
+                    left_b <= left_b - 35'd1;
+                    if (nul && left_b == 35'd1) nul_bad <= (s_tdata != 8'd0);
                     else if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
                     if (sub == SUB_STREAM) streamed <= 1'b1;
-                    if ({32'd0, cnt} + 64'd1 == need) state <= S_FINISH;
+                    if (left_b == 35'd1) state <= S_FINISH;
                 end
-                S_FINISH: begin
+                S_FINISH: if (settled != 2'd2) settled <= settled + 2'd1; else begin
+                    settled <= 2'd0;
                     if (CDR && op == OP_ENCAP) begin  // CDR little-endian, then the end padding
-                        if (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1))
-                            refuse(st, at_end);
-                        else if ({56'd0, value[31:24] & ENCAP_PAD_MASK} > room)
-                            refuse(SUB_BAD_FRAME_LENGTH, at_end);
+                        if (c_encap_bad)
+                            refuse(st, c_at_end);
+                        else if (c_encap_pad_gt)
+                            refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                         else begin
-                            fendp <= fendp - {24'd0, value[31:24] & ENCAP_PAD_MASK};
+                            room <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
                             out_len <= out_len + {16'd0, klen};
-                            go(pc + 16'd1);
+                            go(pc + 16'd1, prog_next(pc));
                         end
                     end
-                    else if (sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {63'd0, nul} : {32'd0, size}) != {48'd0, klen}))
-                        refuse(op == OP_VAR ? st2 : st, at_end);
-                    else if (sub == SUB_RANGE && !in_range) refuse(st, at_end);
-                    else if (nul_bad) refuse(st3, at_end);
+                    else if (c_check_bad)
+                        refuse(op == OP_VAR ? st2 : st, c_at_end);
+                    else if (c_range_bad) refuse(st, c_at_end);
+                    else if (nul_bad) refuse(st3, c_at_end);
                     else begin
-                        if (quiet == 8'd0) out_len <= out_base + out_pad + written;
-                        go(pc + 16'd1);
+                        if (quiet == 8'd0) out_len <= c_out_len;
+                        go(pc + 16'd1, prog_next(pc));
                     end
                 end
                 S_TAIL: if (take) begin  // CDR: an unannounced end pad byte, which must be 0
-                    if (s_tdata != 8'd0) refuse(st2, pos_next == endp);
-                    else if (pos_next == endp) accept(1'b1);
+                    if (s_tdata != 8'd0) refuse(st2, last_f);
+                    else if (last_f) accept(1'b1);
                 end
-                S_SKIP: if (take && pos_next == endp) begin
+                S_SKIP: if (take && last_f) begin
                     state <= S_FLEN;
                     cnt <= 32'd0;
                     pos <= 32'd0;
@@ -430,4 +542,8 @@ module rfl_gsubscriber #(
             endcase
         end
     end
+`ifdef FORMAL
+    // the instruction register holds the word of pc (an invariant the proofs carry)
+    always @(*) if (rst_n) assert(w == prog_word(pc));
+`endif
 endmodule

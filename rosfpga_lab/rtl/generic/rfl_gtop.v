@@ -2,7 +2,7 @@
 //
 //   s_* (8-bit, from TCP/IP) -> [rx FIFO] -> rfl_gsubscriber -> rfl_elem_pack -> [axis FIFO]
 //     -> rfl_window1d -> [axis FIFO, OUT_DEPTH] -> rfl_elem_unpack -> rfl_gpublisher
-//     -> [tx FIFO] -> m_* (8-bit, to TCP/IP)
+//     -> [register slice] -> [tx FIFO] -> m_* (8-bit, to TCP/IP)
 //
 // VIDEO = 1: the streamed array is HEIGHT lines of WIDTH pixels of EBYTES bytes; the packer ends
 // every line with TLAST and the application is the video project's 2-D rfl_morph (32-bit TDATA,
@@ -11,6 +11,9 @@
 // The publisher starts a frame once the subscriber has read all of it (the frame length comes
 // first and depends on every field), so the FIFO after the application holds a whole stream:
 // OUT_DEPTH >= LENGTH + 2. The carry memory lives in the subscriber; the publisher reads it.
+// The FIFOs that feed logic (rx, axis in, axis out) register their RAM's output once more
+// (rfl_fifo's OUTREG, when at least 3 deep): what reads them does not start from a block RAM's
+// slow clock-to-output (100 MHz timing on an ECP5); same entries, two more clocks of latency.
 module rfl_gtop #(
     parameter EBYTES = 4,                       // bytes per streamed element
     parameter LENGTH = 16,                      // elements of the streamed array
@@ -59,7 +62,7 @@ module rfl_gtop #(
     wire [EBYTES-1:0] axis_out_tkeep;
     wire axis_out_tuser, axis_out_tlast;
     /* verilator lint_on UNUSEDSIGNAL */
-    rfl_fifo #(.WIDTH(8), .DEPTH(RX_DEPTH)) u_rx_fifo (
+    rfl_fifo #(.WIDTH(8), .DEPTH(RX_DEPTH), .OUTREG(RX_DEPTH > 2 ? 1 : 0)) u_rx_fifo (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(rx_tdata), .m_tvalid(rx_tvalid), .m_tready(rx_tready), .level(rx_level));
@@ -93,7 +96,7 @@ module rfl_gtop #(
         .m_axis_tdata(axis_in_tdata), .m_axis_tkeep(axis_in_tkeep), .m_axis_tuser(axis_in_tuser),
         .m_axis_tlast(axis_in_tlast), .m_axis_tvalid(axis_in_tvalid),
         .m_axis_tready(axis_in_tready));
-    rfl_fifo #(.WIDTH(BW), .DEPTH(AXIS_DEPTH)) u_axis_in_fifo (
+    rfl_fifo #(.WIDTH(BW), .DEPTH(AXIS_DEPTH), .OUTREG(AXIS_DEPTH > 2 ? 1 : 0)) u_axis_in_fifo (
         .clk(clk), .rst_n(rst_n),
         .s_tdata({axis_in_tlast, axis_in_tuser, axis_in_tkeep, axis_in_tdata}),
         .s_tvalid(axis_in_tvalid), .s_tready(axis_in_tready),
@@ -141,7 +144,7 @@ module rfl_gtop #(
     endgenerate
 
     // application -> axis FIFO (a whole stream) -> element unpacker -> publisher
-    rfl_fifo #(.WIDTH(BW), .DEPTH(OUT_DEPTH)) u_axis_out_fifo (
+    rfl_fifo #(.WIDTH(BW), .DEPTH(OUT_DEPTH), .OUTREG(OUT_DEPTH > 2 ? 1 : 0)) u_axis_out_fifo (
         .clk(clk), .rst_n(rst_n),
         .s_tdata({app_out_tlast, app_out_tuser, app_out_tkeep, app_out_tdata}),
         .s_tvalid(app_out_tvalid), .s_tready(app_out_tready),
@@ -156,15 +159,22 @@ module rfl_gtop #(
         .s_axis_tready(axis_out_tready),
         .m_tdata(pix_out_tdata), .m_tvalid(pix_out_tvalid), .m_tready(pix_out_tready));
 
-    wire [7:0] tx_tdata;
-    wire tx_tvalid, tx_tready;
+    wire [7:0] pub_tdata, tx_tdata;
+    wire pub_tvalid, pub_tready, tx_tvalid, tx_tready;
     rfl_gpublisher #(.CW(CW), .STREAM_DATA_BYTES(LENGTH * EBYTES), .SEQ_START(SEQ_START)) u_publisher (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(pix_out_tdata), .s_tvalid(pix_out_tvalid), .s_tready(pix_out_tready),
-        .m_tdata(tx_tdata), .m_tvalid(tx_tvalid), .m_tready(tx_tready),
+        .m_tdata(pub_tdata), .m_tvalid(pub_tvalid), .m_tready(pub_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
         .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
         .idle(pub_idle));
+
+    // a register slice: the publisher's bytes (a carried one straight from the carry memory's
+    // block RAM) reach a flip-flop before the tx FIFO's RAM (100 MHz timing on an ECP5)
+    rfl_slice #(.WIDTH(8)) u_tx_slice (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(pub_tdata), .s_tvalid(pub_tvalid), .s_tready(pub_tready),
+        .m_tdata(tx_tdata), .m_tvalid(tx_tvalid), .m_tready(tx_tready));
 
     rfl_fifo #(.WIDTH(8), .DEPTH(TX_DEPTH)) u_tx_fifo (
         .clk(clk), .rst_n(rst_n),
@@ -172,6 +182,6 @@ module rfl_gtop #(
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready), .level(tx_level));
 
     assign busy = rx_tvalid || meta_valid || pix_in_tvalid || axis_in_tvalid || app_in_tvalid
-                  || app_out_tvalid || axis_out_tvalid || pix_out_tvalid || tx_tvalid
+                  || app_out_tvalid || axis_out_tvalid || pix_out_tvalid || pub_tvalid || tx_tvalid
                   || m_tvalid || !sub_idle || !pub_idle;
 endmodule

@@ -11,11 +11,17 @@
 // zeros the later one wins); min2 likewise with <. A window holding a NaN gives its first NaN,
 // bits unchanged.
 //
-// How it works: a shift register of KSIZE entries (element, valid, TUSER, TLAST), the newest
-// in entry 0. An element's result is ready once R = KSIZE/2 later elements are in, so it is
-// computed when the element reaches entry R; after an array's TLAST, R empty entries are
-// shifted in (the input waits meanwhile) to finish its last R elements. Those R empties also
-// keep the next array's window clear of this one.
+// How it works: a shift register of KSIZE entries (valid, TUSER, TLAST), the newest in entry 0.
+// An element's result is ready once R = KSIZE/2 later elements are in, so it is computed when
+// the element reaches entry R; after an array's TLAST, R empty entries are shifted in (the
+// input waits meanwhile) to finish its last R elements. Those R empties also keep the next
+// array's window clear of this one. The fold is kept as it goes (100 MHz on an ECP5: one
+// comparison per clock, not KSIZE - 1 in a row): for g = 1 .. KSIZE-1 a register holds the
+// fold of the newest g entries (element, order key, NaN flag, whether any entry is valid), and
+// a step folds the new element into each (the fold of g entries becomes that of g + 1). The
+// window's result is the fold of the newest KSIZE-1 entries with the new element. The rule
+// folded (the first NaN, else the last of the largest, or smallest, keys) picks the same
+// element however the entries are grouped, so this equals numpy's left fold.
 module rfl_window1d #(
     parameter EBYTES = 4,                       // bytes per element: 1, 2, 4 or 8
     parameter KSIZE = 3,                        // odd, 1..15
@@ -42,8 +48,11 @@ module rfl_window1d #(
     localparam [3:0] RFLUSH = R[3:0];
     localparam [EW-1:0] SIGN = {1'b1, {(EW-1){1'b0}}};
 
-    reg [K*EW-1:0] wdata;                       // the window, entry 0 newest
-    reg [K-1:0]    wval, wuser, wlast;
+    localparam G = (K > 1) ? K - 1 : 1;         // folds kept (one unused for a window of one)
+
+    reg [K-1:0]    wval, wuser, wlast;          // the window, entry 0 newest
+    reg [G*EW-1:0] gdata, gkey;                 // fold of the newest g+1 entries: its element, key
+    reg [G-1:0]    gnan, gval;                  // its NaN flag; whether it holds an element
     reg [3:0]      flush;                       // empty entries still to shift in
 
     wire out_free = !m_axis_tvalid || m_axis_tready;
@@ -55,7 +64,6 @@ module rfl_window1d #(
     assign m_axis_tkeep = {EBYTES{1'b1}};
 
     // The window after this step: the new element (or an empty entry) shifted in.
-    wire [K*EW-1:0] nw_data = (wdata << EW) | {{((K-1)*EW){1'b0}}, step_in ? s_axis_tdata : {EW{1'b0}}};
     wire [K-1:0]    nw_val = (wval << 1) | {{(K-1){1'b0}}, step_in};
     wire [K-1:0]    nw_user = (wuser << 1) | {{(K-1){1'b0}}, step_in && s_axis_tuser};
     wire [K-1:0]    nw_last = (wlast << 1) | {{(K-1){1'b0}}, step_in && s_axis_tlast};
@@ -82,33 +90,71 @@ module rfl_window1d #(
     endfunction
     /* verilator lint_on UNUSEDSIGNAL */
 
-    // The fold over the valid entries of the new window, oldest (entry K-1) first.
-    reg [EW-1:0] best, cand;
-    reg          have;
+    // the new entry; its key is compared as xkey_raw (a LUT from the FIFO's output), or as
+    // -0.0's key SIGN, chosen after the comparison (xnegz, found beside it)
+    wire [EW-1:0] x = s_axis_tdata;
+    wire [EW-1:0] xkey = order_key(s_axis_tdata);
+    wire          xnegz = (KIND == 2) && (s_axis_tdata == SIGN);
+    wire [EW-1:0] xkey_raw = (KIND == 2) ? (x[EW-1] ? ~x : (x | SIGN)) : xkey;
+    wire          xnan = is_nan(s_axis_tdata);
+
+    // The older fold keeps its element against the new one: it is the only one valid, or it
+    // holds a NaN (the first NaN wins), or the new one is no NaN and is smaller (larger for OP
+    // 1): of equal keys the later element wins, as numpy's fold gives it.
+    function keeps(input oval, input onan, input [EW-1:0] okey,
+                   input nval, input nnan, input [EW-1:0] nkey_raw, input nnegz);
+        begin
+            if (!oval) keeps = 1'b0;
+            else if (!nval) keeps = 1'b1;
+            else if (onan) keeps = 1'b1;
+            else if (nnan) keeps = 1'b0;
+            else if (nnegz) keeps = (OP == 1) ? (okey < SIGN) : (okey > SIGN);
+            else keeps = (OP == 1) ? (okey < nkey_raw) : (okey > nkey_raw);
+        end
+    endfunction
+
+    // the folds after this step (nf*), and the window's result (best)
+    reg [G*EW-1:0] nfdata, nfkey;
+    reg [G-1:0]    nfnan, nfval;
+    reg [EW-1:0]   best;
     integer t;
     always @* begin
-        best = {EW{1'b0}};
-        have = 1'b0;
-        for (t = K - 1; t >= 0; t = t - 1) begin
-            cand = nw_data[t*EW +: EW];
-            if (nw_val[t]) begin
-                if (!have) best = cand;
-                else if (!is_nan(best)) begin
-                    if (is_nan(cand)) best = cand;
-                    else if (OP == 1 ? !(order_key(best) < order_key(cand))
-                                     : !(order_key(best) > order_key(cand))) best = cand;
-                end
-                have = 1'b1;
+        nfdata = gdata;
+        nfkey = gkey;
+        nfnan = gnan;
+        nfval = gval;
+        // the fold of the newest entry alone: the new one
+        nfdata[EW-1:0] = step_in ? x : {EW{1'b0}};
+        nfkey[EW-1:0] = step_in ? xkey : {EW{1'b0}};
+        nfnan[0] = step_in && xnan;
+        nfval[0] = step_in;
+        for (t = 1; t < G; t = t + 1) begin
+            if (keeps(gval[t-1], gnan[t-1], gkey[(t-1)*EW +: EW], step_in, xnan, xkey_raw, xnegz)) begin
+                nfdata[t*EW +: EW] = gdata[(t-1)*EW +: EW];
+                nfkey[t*EW +: EW] = gkey[(t-1)*EW +: EW];
+                nfnan[t] = gnan[t-1];
+            end else begin
+                nfdata[t*EW +: EW] = x;
+                nfkey[t*EW +: EW] = xkey;
+                nfnan[t] = xnan;
             end
+            nfval[t] = gval[t-1] || step_in;
         end
+        if (K == 1) best = x;
+        else if (keeps(gval[G-1], gnan[G-1], gkey[(G-1)*EW +: EW], step_in, xnan, xkey_raw, xnegz))
+            best = gdata[(G-1)*EW +: EW];
+        else best = x;
     end
 
     always @(posedge aclk) begin
         if (!aresetn) begin
-            wdata <= {(K*EW){1'b0}};
             wval <= {K{1'b0}};
             wuser <= {K{1'b0}};
             wlast <= {K{1'b0}};
+            gdata <= {(G*EW){1'b0}};
+            gkey <= {(G*EW){1'b0}};
+            gnan <= {G{1'b0}};
+            gval <= {G{1'b0}};
             flush <= 4'd0;
             m_axis_tdata <= {EW{1'b0}};
             m_axis_tuser <= 1'b0;
@@ -117,10 +163,13 @@ module rfl_window1d #(
         end else begin
             if (m_axis_tvalid && m_axis_tready) m_axis_tvalid <= 1'b0;
             if (step) begin
-                wdata <= nw_data;
                 wval <= nw_val;
                 wuser <= nw_user;
                 wlast <= nw_last;
+                gdata <= nfdata;
+                gkey <= nfkey;
+                gnan <= nfnan;
+                gval <= nfval;
                 if (step_in) flush <= s_axis_tlast ? RFLUSH : 4'd0;
                 else flush <= flush - 4'd1;
                 if (nw_val[R]) begin
