@@ -267,13 +267,27 @@ def _u32(b: bytes) -> int:
     return int.from_bytes(b, "little")
 
 
+#: Clocks of each of the subscriber's decisions (S_FCHK, S_DECODE, S_COUNTED, S_FINISH): two
+#: that settle its arithmetic into registers, then the one that acts.
+DECIDE_CLOCKS = 3
+
+
+def least_clocks(elem_min: int) -> int:
+    """Clocks of the subscriber's S_LEAST for an array of messages whose elements take at least
+    ``elem_min`` bytes: a bit of ``elem_min`` per clock (count x elem_min with no multiplier),
+    then one that finds none left."""
+    return 1 + elem_min.bit_length()
+
+
 def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
               ) -> tuple[bytes, bytes, int]:
     """Walk one whole frame as the subscriber does.
 
     ``timeline``: appended a 1 per clock the Verilog walker takes a byte and a 0 per clock it
     does not, from the frame length's first byte to the clock it accepts the frame (see
-    :func:`frame_clocks`).
+    :func:`frame_clocks`): :data:`DECIDE_CLOCKS` for each decision (the frame length's checks,
+    each instruction's decode, a count's checks, each field's end), ``1 + bits(elem_min)`` for
+    an array of messages' fewest bytes (:func:`least_clocks`), a byte per clock.
 
     Returns:
         ``(carried bytes, streamed bytes, output body length)``.
@@ -294,6 +308,8 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
     pc = 0
     tl = timeline if timeline is not None else bytearray()
     tl += b"\1" * 4                                   # the frame length
+    decide = b"\0" * DECIDE_CLOCKS
+    tl += decide                                      # its checks (S_FCHK)
 
     def take(n: int, status: int, align: int = 1) -> bytes:
         nonlocal pos
@@ -331,7 +347,7 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
     while True:
         ins = prog.instrs[pc]
         quiet = suppressed > 0
-        tl.append(0)  # a clock to decode each instruction (then one after each count and field)
+        tl += decide  # each instruction's decode (S_DECODE); S_COUNTED, S_FINISH below
         if ins.op == Op.DONE:
             after = end - pos  # CDR: Cyclone's unannounced zeros up to a multiple of END_ALIGN
             if ins.status2 and pos != fend and 0 < after < END_ALIGN and \
@@ -344,7 +360,7 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
             return bytes(carry), bytes(stream), out_len
         if ins.op == Op.ENCAP:
             b = take(4, ins.status)
-            tl.append(0)
+            tl += decide                                # S_FINISH
             if b[:2] != ins.const[:2]:
                 raise Refused(ins.status, bool(stream))
             tail = b[3] & ENCAP_PAD_MASK
@@ -354,7 +370,7 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
             out_len += len(ins.const)
         elif ins.op == Op.FIXED:
             b = take(ins.size, ins.status, ins.align)
-            tl += b"\0" if ins.size else b""
+            tl += decide if ins.size else b""          # S_FINISH
             out_pad(ins.size, ins.align)
             if ins.sub in (Sub.CARRY, Sub.RANGE):
                 carry += b
@@ -367,11 +383,11 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
             out_len += 0 if quiet else ins.size
         elif ins.op == Op.VAR:
             lb = take(4, ins.status, ins.align)
-            tl.append(0)
+            tl += decide                                # S_COUNTED
             n = _u32(lb)
             fits(ins, n)
             b = take(n * ins.size, ins.status, ins.elem_align)
-            tl.append(0)
+            tl += decide                                # S_FINISH
             text = b[:-1] if ins.nul else b
             if ins.sub == Sub.CARRY:
                 carry += lb + b
@@ -399,7 +415,8 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
                     carry += lb
                 out_pad(4, ins.align)
                 out_len += 0 if quiet else 4
-            tl.append(0)
+            tl += b"\0" * least_clocks(ins.elem_min)   # S_LEAST
+            tl += decide                                # S_COUNTED
             zero = ins.variable and ins.pub == Pub.ZERO
             if n == 0:
                 pc = ins.jump + 1
@@ -422,7 +439,8 @@ def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int,
     """The frame the publisher writes for an accepted frame (see the module docstring).
 
     ``timeline``: appended a 1 per clock the Verilog walker writes a byte and a 0 per clock it
-    does not, from its first byte (output always ready, the stream's bytes there in time)."""
+    does not, from its first byte (output always ready, the stream's bytes there in time): a
+    clock to decode each instruction (P_DECODE) and one after each count (P_COUNTED)."""
     out = bytearray(out_len.to_bytes(4, "little"))
     tl = timeline if timeline is not None else bytearray()
     written = 0
@@ -534,15 +552,15 @@ def run_program(prog: Program, frames: list[bytes], apply: Callable[[bytes], byt
 #: Clocks from the subscriber accepting a frame to the publisher's first byte (its fields are
 #: handed over on a register; the publisher leaves its idle state on the next clock).
 ACCEPT_TO_PUBLISH = 2
-#: Clocks through the output FIFO (the publisher's byte to the node's output).
-TX_LATENCY = 2
+#: Clocks from the publisher's byte to the node's output: the register slice before the tx
+#: FIFO (one), then the FIFO (two).
+TX_LATENCY = 3
 
 
 @dataclass(frozen=True)
 class FrameClocks:
     """Clocks of one accepted frame in the generated Verilog (``rfl_gtop``), from the walkers'
-    timelines (:func:`subscribe`, :func:`publish`: a byte per clock, a clock to decode each
-    instruction, one after each count and each field the subscriber takes).
+    timelines (:func:`subscribe`, :func:`publish`: each says the clocks of its walker's states).
 
     Attributes:
         subscriber: from the frame length's first byte in to the clock the frame is accepted.

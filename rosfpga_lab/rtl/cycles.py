@@ -10,8 +10,9 @@ beside :func:`rosfpga_lab.hw.cycles.account`'s figures for the same frame.
 A generated circuit (any other message type, and Image on CDR) is measured the same way
 through its generated project's ``make rtlsim`` (:func:`generic_rows`) and set beside the walk's
 cycle model, :func:`rosfpga_lab.hls.program.frame_clocks`: a byte per clock through subscriber
-and publisher, a clock to decode each instruction and one after each count and field; equal to
-the RTL without backpressure, an estimate with it (the output's random ready share).
+and publisher and the clocks of each walker's decisions (per state, as
+:func:`rosfpga_lab.hls.program.subscribe` and :func:`~rosfpga_lab.hls.program.publish` say);
+equal to the RTL without backpressure, an estimate with it (the output's random ready share).
 """
 
 from __future__ import annotations
