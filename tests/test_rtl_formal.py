@@ -11,12 +11,14 @@ an element packer that drops TLAST).
 from __future__ import annotations
 
 import re
+import struct
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
 
 from pathlib import Path
 
+from rosfpga_lab.hls.program import frame_clocks
 from rosfpga_lab.rtl.generic import GENERIC_MODULES, GENERIC_VERILOG_DIR, LAYOUT_INCLUDE
 from rosfpga_lab.rtl.proofs import (
     FORMAL_DIR, PROOFS, Proof, ProofResult, format_results, formal_layout, formal_program, prove,
@@ -108,6 +110,23 @@ def test_the_walkers_are_proven_on_a_generated_walk() -> None:
     assert f".STREAM_DATA_BYTES({prog.stream_length * prog.stream_bytes})" in pub
     top = (FORMAL_DIR / "fv_gtop.sv").read_text()
     assert f".EBYTES({prog.stream_bytes}), .LENGTH({prog.stream_length})" in top
+
+
+def test_the_subscribers_bounded_check_sees_every_frame_length_handed_over() -> None:
+    """The gsubscriber bmc is deep enough for a frame of formal_program of each accepted length
+    (a label of 0 to 2 bytes) to be handed over and held: the reset clock, the frame's clocks to
+    its acceptance (the walk's cycle model, equal to the RTL's clock for clock:
+    test_rtl_cycles.py), the clock meta_valid rises (the handover's checks: the answer's length
+    in range) and one more (the fields held unchanged). 48 would see the shortest frame only."""
+    prog = formal_program()
+    bmc = next(p for p in PROOFS if p.name == "gsubscriber" and p.mode == "bmc")
+    clocks = []
+    for label in (b"", b"a", b"ab"):
+        body = b"\x02" + struct.pack("<I", len(label)) + label + struct.pack("<I", 2) + b"\0\0"
+        clocks.append(frame_clocks(prog, struct.pack("<I", len(body)) + body).subscriber)
+    assert len(clocks) == prog.max_frame - prog.min_body + 1
+    assert bmc.depth >= 1 + max(clocks) + 2, (bmc.depth, clocks)
+    assert f"{min(clocks)} to {max(clocks)} clocks to acceptance" in bmc.claim
 
 
 def plant(tmp: Path, name: str, old: str, new: str) -> Path:

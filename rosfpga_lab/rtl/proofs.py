@@ -139,8 +139,9 @@ PROOFS: tuple[Proof, ...] = (
     Proof("gsubscriber", ("rfl_gsubscriber.v",), "bmc", 50,
           "rfl_gsubscriber (formal_program, any input bytes): fields held unchanged until "
           "released, each frame handed over streamed exactly the array's 2 bytes, never more, "
-          "accepted: the answer's length in range; 50 clocks (the shortest frame, 15 bytes, "
-          "takes 47: each decision settles for two clocks)", (), True),
+          "accepted: the answer's length in range; 50 clocks: every frame length (15 to 17 "
+          "bytes, 45 to 47 clocks to acceptance) handed over and held a clock after the reset "
+          "clock", (), True),
     Proof("gpublisher", ("rfl_gpublisher.v",), "prove", 4,
           "rfl_gpublisher (formal_program, fields held until released): output stream rules; "
           "all reachable states", ("FV_PROVE",), True),
