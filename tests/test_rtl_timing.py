@@ -165,7 +165,7 @@ def test_the_newest_yosys_found_is_run_and_named(tmp_path: Path,
 
 
 @pytest.mark.slow
-@settings(max_examples=2, deadline=None, derandomize=True,
+@settings(max_examples=1, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 def test_generated_tops_of_random_message_types_use_no_multiplier(
