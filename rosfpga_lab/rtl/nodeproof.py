@@ -39,7 +39,8 @@ from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.generic import GenericSpec, environment, spec_from_config
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.generic import (
-    GENERIC_MODULES, LAYOUT_INCLUDE, TEMPLATES, VIDEO_APP, generic_params, generic_rtl_files,
+    GENERIC_MODULES, LAB_MODULES, LAYOUT_INCLUDE, TEMPLATES, VIDEO_APP, generic_params,
+    generic_rtl_files,
 )
 from rosfpga_lab.rtl.proofs import (
     ENV_INCLUDE, FORMAL_DIR, Proof, ProofResult, formal_missing_reason, run_sby, sby_command,
@@ -74,7 +75,7 @@ def _spec(config: NodeConfig) -> GenericSpec:
 
 def design_order(spec: GenericSpec) -> list[str]:
     """The Verilog files of the generated top, each read once, modules before their users."""
-    return ["rfl_fifo.v", *GENERIC_MODULES, *([VIDEO_APP] if spec.video is not None else []),
+    return [*LAB_MODULES, *GENERIC_MODULES, *([VIDEO_APP] if spec.video is not None else []),
             NODE_FILE]
 
 
