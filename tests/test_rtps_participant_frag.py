@@ -113,7 +113,7 @@ def test_nack_frags_with_rising_counts_are_paced() -> None:
     assert nack(11, t + MIN_RESEND_SECONDS / 2) == []
     assert sum("paced" in n and "NACK_FRAG" in n for n in a.notes) == 1
     # after it: again, once the writer has written again (the resend budget: each byte written
-    # pays for one byte resent, RESEND_PER_BYTE_WRITTEN)
+    # pays for RESEND_PER_BYTE_WRITTEN bytes resent; NACK suppression holds this one back)
     assert nack(12, t + MIN_RESEND_SECONDS * 1.5) == []
     # (and NACK suppression: a sample is not sent to a reader again within
     # NACK_SUPPRESSION_SECONDS of its last sending)

@@ -108,7 +108,7 @@ class ReaderProxy:
     #: again within NACK_SUPPRESSION_SECONDS (``WriterSide._suppressed``).
     sent: dict[int, float] = field(default_factory=dict)
     #: Bytes it may still be resent (``WriterSide._afford``): each sample written adds its size
-    #: (times RESEND_PER_BYTE_WRITTEN), up to the history's bytes; it starts at those.
+    #: (times RESEND_PER_BYTE_WRITTEN), up to as many times the history's bytes; it starts at those.
     credit: float = 0.0
 
 

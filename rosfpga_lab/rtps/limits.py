@@ -42,11 +42,14 @@ NACK_SUPPRESSION_SECONDS = 0.05
 #: The resend budget of a reader proxy (rosfpga_lab.rtps.writer_side): what ACKNACKs and
 #: NACK_FRAGs make a writer send again, over any time, is at most this many bytes per byte it
 #: wrote to the history since the reader matched, plus the history's bytes at that time (the
-#: budget starts at those and never holds more than the history). A sample the reader already
+#: budget starts at those and never holds more than this many histories). Four, not one: a
+#: single large sample whose fragments a loaded receiver drops round after round (rclpy on Fast
+#: DDS taking a 1.2 MB image on two busy cores) needs more than one copy resent, and a budget of
+#: one left it incomplete for good. A sample the reader already
 #: acknowledged is never resent to it (a GAP says so), so a storm of ACKNACKs in the real
 #: reader's name gets GAPs, a few bytes per ACKNACK, and a fake reader that never acknowledges
 #: gets at most this share of the stream it is sent anyway.
-RESEND_PER_BYTE_WRITTEN = 1.0
+RESEND_PER_BYTE_WRITTEN = 4.0
 #: Remote participants and endpoints the participant keeps (SPDP/SEDP floods; a full
 #: participant table makes room for each new one: rosfpga_lab.rtps.spdp says which goes).
 MAX_REMOTE_PARTICIPANTS = 64

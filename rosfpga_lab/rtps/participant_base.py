@@ -131,7 +131,7 @@ class ParticipantBase:
         for proxy in ep.proxies.values():
             if isinstance(proxy, ReaderProxy):
                 proxy.credit = min(proxy.credit + len(payload) * RESEND_PER_BYTE_WRITTEN,
-                                   ep.history_bytes)
+                                   ep.history_bytes * RESEND_PER_BYTE_WRITTEN)
         return ep.seq
 
     def _heartbeat(self, ep: LocalEndpoint, proxy: ReaderProxy) -> bytes:

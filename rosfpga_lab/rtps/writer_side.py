@@ -21,9 +21,10 @@ bits name the samples it lacks. ``_on_acknack`` resends those it may get and GAP
   name cannot pull a sample while it is on its way (a reader that lost it asks again at the next
   HEARTBEAT);
 * the resend budget (``_afford``, RESEND_PER_BYTE_WRITTEN): a reader proxy is resent at most
-  what was written to the history since it matched (plus the history then); what it cannot
-  afford waits for the writer's next samples. A fake reader that never acknowledges, its
-  locator a victim's, gets at most that share of the stream it is sent anyway.
+  RESEND_PER_BYTE_WRITTEN times what was written to the history since it matched (plus the
+  history then); what it cannot afford waits for the writer's next samples. A fake reader that
+  never acknowledges, its locator a victim's, gets at most that multiple of the stream it is
+  sent anyway.
 
 What an attacker who knows a reader's GUID can still do: acknowledge samples in its name (a
 sample the real reader lost is then GAPped to it, or waits until it leaves the history) and spend
