@@ -26,10 +26,13 @@ has been reset and the next good frame comes out right. ``Pipeline(model="refere
 the byte/beat-at-a-time models (small images: a 160x120 frame takes about half a second).
 
 The circuit's one layout (every field in wire order and what the circuit does with it) is
-derived from a ``.msg`` and the configuration by :func:`derive_layout` (module ``layout``);
-the subscriber and publisher of any type are rendered from it (module ``walker``:
-:class:`LayoutInterpreter`, :func:`extract_reference` / :func:`extract_fast`,
-:func:`publish_reference` / :func:`publish_fast`), the 1-D application in ``morph1d``, the
+derived from a ``.msg`` and the configuration by :func:`derive_layout` (module ``layout``
+tells it and gathers the names of ``layoutsteps``, the types, ``layoutderive``, the
+derivation, ``layoutlengths``, the length rules, and ``layouttokens``, values in walk order);
+the subscriber and publisher of any type are rendered from it (module ``walker`` gathers
+``subscriberwalker``: :class:`LayoutInterpreter`, :func:`extract_reference` /
+:func:`extract_fast`, and ``publisherwalker``: :func:`publish_reference` /
+:func:`publish_fast`), the 1-D application in ``morph1d``, the
 whole circuit of a non-Image type in :class:`MessagePipeline` (``msgpipeline``). CDR (ROS 2)
 is the second wire format of the same layout (``cdrlayout``, ``cdrwalker``), the whole circuit
 on CDR samples, Image included, :class:`CdrPipeline` (``cdrpipeline``).
@@ -84,12 +87,14 @@ from rosfpga_lab.hw.interpreter import (
     interpret_fast,
     interpret_reference,
 )
-from rosfpga_lab.hw.layout import Layout, derive_layout, format_layout, layout_from_config
+from rosfpga_lab.hw.layoutderive import derive_layout, layout_from_config
+from rosfpga_lab.hw.layoutsteps import Layout, format_layout
 from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
 from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline, CdrResult
-from rosfpga_lab.hw.walker import (
-    Extracted, LayoutInterpreter, extract_fast, extract_reference, publish_fast, publish_reference,
+from rosfpga_lab.hw.publisherwalker import publish_fast, publish_reference
+from rosfpga_lab.hw.subscriberwalker import (
+    Extracted, LayoutInterpreter, extract_fast, extract_reference,
 )
 from rosfpga_lab.hw.framing import FRAMING_FLAGS
 from rosfpga_lab.hw.morph import (

@@ -42,10 +42,12 @@ from typing import Any
 
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hw import limits
-from rosfpga_lab.hw.layout import (
-    Action, CheckOp, FieldCheck, Layout, LengthRule, Step, StepKind, Token, derive_layout,
-    encode_token, layout_from_config, length_rules, tokens,
+from rosfpga_lab.hw.layoutderive import derive_layout, layout_from_config
+from rosfpga_lab.hw.layoutlengths import LengthRule, length_rules
+from rosfpga_lab.hw.layoutsteps import (
+    Action, CheckOp, FieldCheck, Layout, Step, StepKind, format_layout,
 )
+from rosfpga_lab.hw.layouttokens import Token, encode_token, tokens
 from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.msg.cdr import CDR_LE, ENCAPSULATION_SIZE
 from rosfpga_lab.msg.ros2 import PLACEHOLDER_MEMBER as PLACEHOLDER
@@ -347,8 +349,6 @@ def cdr_marshal(cdr: CdrLayout, toks: Iterable[Token]) -> bytes:
 def format_cdr_layout(cdr: CdrLayout) -> str:
     """The CDR walk as text: :func:`~rosfpga_lab.hw.layout.format_layout`'s rows with each
     step's alignment."""
-    from rosfpga_lab.hw.layout import format_layout
-
     lines = format_layout(cdr.layout).split("\n")
     head, rows = lines[:2], lines[2:]
     width = max(len(r) for r in lines[1:])

@@ -31,8 +31,8 @@ from rosfpga_lab.hw.errors import FrameTruncatedError, PipelineConfigError
 from rosfpga_lab.hw.morph import check_op, morph_fast, morph_reference
 from rosfpga_lab.hw.morph1d import check_op1d, morph1d_fast, morph1d_reference
 from rosfpga_lab.hw.video import Mat
-from rosfpga_lab.hw.layout import VideoShape
-from rosfpga_lab.hw.walker import Extracted
+from rosfpga_lab.hw.layoutsteps import VideoShape
+from rosfpga_lab.hw.subscriberwalker import Extracted
 from rosfpga_lab.msg import MsgRegistry
 
 

@@ -31,10 +31,11 @@ from rosfpga_lab.hw.cdrlayout import (
     cdr_marshal, to_base_tokens, to_cdr_tokens,
 )
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
-from rosfpga_lab.hw.layout import Step, StepKind, Token
-from rosfpga_lab.hw.walker import (
-    STAGE, Extracted, LayoutInterpreter, published_tokens, run_fast, run_reference, shift_out,
-    value_size, write_value,
+from rosfpga_lab.hw.layoutsteps import Step, StepKind
+from rosfpga_lab.hw.layouttokens import Token
+from rosfpga_lab.hw.publisherwalker import published_tokens, shift_out, value_size, write_value
+from rosfpga_lab.hw.subscriberwalker import (
+    STAGE, Extracted, LayoutInterpreter, run_fast, run_reference,
 )
 from rosfpga_lab.msg.cdr import CDR_BE
 

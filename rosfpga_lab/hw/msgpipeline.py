@@ -20,11 +20,11 @@ from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config.vocabulary import CUSTOM, MODELS, canonical_op
 from rosfpga_lab.hw import limits
 from rosfpga_lab.hw.errors import PipelineConfigError
-from rosfpga_lab.hw.layout import Layout, layout_from_config
+from rosfpga_lab.hw.layoutderive import layout_from_config
+from rosfpga_lab.hw.layoutsteps import Layout
 from rosfpga_lab.hw.morph1d import check_op1d, morph1d_fast, morph1d_reference
-from rosfpga_lab.hw.walker import (
-    Extracted, extract_fast, extract_reference, publish_fast, publish_reference,
-)
+from rosfpga_lab.hw.publisherwalker import publish_fast, publish_reference
+from rosfpga_lab.hw.subscriberwalker import Extracted, extract_fast, extract_reference
 from rosfpga_lab.msg import MsgRegistry
 
 

@@ -17,9 +17,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from rosfpga_lab.hw.layout import (
-    Action, CheckOp, Layout, Step, StepKind, Token, marshal, tokens,
-)
+from rosfpga_lab.hw.layoutsteps import Action, CheckOp, Layout, Step, StepKind
+from rosfpga_lab.hw.layouttokens import Token, marshal, tokens
 from rosfpga_lab.msg import MsgRegistry, deserialize
 
 #: Elements of a variable array (or loop) other than the stream, in an example message.
