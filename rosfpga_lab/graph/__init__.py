@@ -39,8 +39,9 @@ answers a malformed header with an ``error=`` header where roscpp just drops the
 lab's subscriber also checks the publisher's md5; both sides time the handshake out
 (``tcpros.limits``); the default host is 127.0.0.1 rather than the machine's hostname.
 
-Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server), ``http`` (its sans-IO HTTP
-decoder), ``master`` (EmbeddedMaster),
+Modules: ``xmlrpc`` (safe HTTP/XML-RPC client and server: the sockets), ``xmlrpccodec``
+(its sans-IO XML-RPC documents: parse, marshal, faults, int32), ``http`` (its sans-IO HTTP
+messages: the decoder, the request and the reply), ``master`` (EmbeddedMaster),
 ``node`` (Node, Slave API, TCPROS server), ``publisher``, ``subscriber``, ``trace`` (the recorded
 conversation; its docstring documents the format), ``names`` (names, ROS_* environment),
 ``owner`` (which Unix user listens on a port), ``service`` (TCPROS services), ``rosout``
@@ -73,7 +74,8 @@ from rosfpga_lab.graph.publisher import LinkStats, Publisher, PublisherStats
 from rosfpga_lab.graph.rate import RateMeter
 from rosfpga_lab.graph.subscriber import MessageInfo, Subscriber, SubscriberStats
 from rosfpga_lab.graph.trace import KINDS, Trace, TraceEvent
-from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call, parse_xmlrpc
+from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call
+from rosfpga_lab.graph.xmlrpccodec import parse_xmlrpc
 
 __all__ = [
     "CONNECT_TIMEOUT", "KINDS", "MAX_HTTP_HEAD", "MAX_XMLRPC_BODY", "MAX_XMLRPC_REPLY", "RECONNECT_FIRST",

@@ -23,7 +23,8 @@ from rosfpga_lab.graph.limits import CAPTURE_MAX_STREAM_BYTES
 from rosfpga_lab.graph.master import MASTER_ID
 from rosfpga_lab.graph.trace import Trace, new_connection_id
 from rosfpga_lab.graph.http import Body, Head, HttpDecoder
-from rosfpga_lab.graph.xmlrpc import parse_xmlrpc, split_uri
+from rosfpga_lab.graph.xmlrpc import split_uri
+from rosfpga_lab.graph.xmlrpccodec import parse_xmlrpc
 from rosfpga_lab.tcpros import FrameDecoder, ProtocolError, decode_header
 
 #: The lab's data/ folder and the real captures shipped in it (each made by the script beside it).

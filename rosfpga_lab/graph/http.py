@@ -13,8 +13,11 @@ when the head is asked for; a missing or bad ``Content-Length`` or one over ``ma
 the body is asked for, before more of it is read; a body that grows over ``max_body`` and a
 stream that ends inside a message raise :class:`~rosfpga_lab.graph.errors.XmlRpcError`
 (:class:`~rosfpga_lab.graph.errors.XmlRpcTooLargeError` for a body's size). Memory follows the
-bytes received, never a declared length.
-The socket side (deadlines, refusals) is :mod:`rosfpga_lab.graph.xmlrpc`'s.
+bytes received, never a declared length. The other way, :func:`request_message` and
+:func:`response_message` write the two messages XML-RPC sends, and :func:`keeps_alive` reads
+whether a request's client keeps its connection.
+The socket side (deadlines, refusals) is :mod:`rosfpga_lab.graph.xmlrpc`'s, the XML in the
+bodies :mod:`rosfpga_lab.graph.xmlrpccodec`'s.
 """
 
 from __future__ import annotations
@@ -102,6 +105,34 @@ def content_length(headers: dict[str, str], max_body: int) -> int | None:
     if length > max_body:
         raise XmlRpcTooLargeError(f"HTTP body of {length} bytes, over the limit of {max_body}")
     return length
+
+
+def request_message(host: str, port: int, path: str, body: bytes) -> bytes:
+    """The client's ``POST`` of an XML-RPC ``body`` to ``http://host:port/path``, on a
+    connection it closes after the reply (``host`` as a URI writes it: IPv6 in brackets)."""
+    head = (f"POST {path} HTTP/1.1\r\nHost: {host}:{port}\r\n"
+            "User-Agent: rosfpga-lab\r\n"
+            f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\nConnection: close\r\n\r\n")
+    return head.encode("latin-1") + body
+
+
+def response_message(status: str, body: bytes, keep_alive: bool) -> bytes:
+    """The server's reply: ``status`` (``200 OK``) and ``body``; ``keep_alive`` says whether the
+    connection stays open for another request."""
+    head = (f"HTTP/1.1 {status}\r\nServer: rosfpga-lab/XMLRPC\r\n"
+            f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\n"
+            f"Connection: {'keep-alive' if keep_alive else 'close'}\r\n\r\n")
+    return head.encode("latin-1") + body
+
+
+def keeps_alive(request: Head) -> bool:
+    """Whether the client of ``request`` keeps the connection for another request, as rospy's
+    and roscpp's clients expect: HTTP/1.1 unless it says ``Connection: close``, an older
+    version only when it says ``Connection: keep-alive``."""
+    parts = request.start_line.split()
+    version = parts[2] if len(parts) == 3 else "HTTP/1.0"
+    connection = request.headers.get("connection", "").lower()
+    return (version == "HTTP/1.1" and connection != "close") or connection == "keep-alive"
 
 
 class HttpDecoder:
@@ -206,4 +237,4 @@ class HttpDecoder:
 
 
 __all__ = ["Body", "EndOfStream", "Event", "HEAD_END", "Head", "HttpDecoder", "content_length",
-           "parse_head"]
+           "keeps_alive", "parse_head", "request_message", "response_message"]

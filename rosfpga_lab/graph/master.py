@@ -40,14 +40,8 @@ from rosfpga_lab.graph.limits import (
 )
 from rosfpga_lab.graph.names import bind_address, canonical, resolve
 from rosfpga_lab.graph.trace import Trace
-from rosfpga_lab.graph.xmlrpc import (
-    XmlRpcServer,
-    call,
-    check_int_range,
-    request_peer,
-    unsupported,
-    value_depth,
-)
+from rosfpga_lab.graph.xmlrpc import XmlRpcServer, call, request_peer, unsupported
+from rosfpga_lab.graph.xmlrpccodec import check_int_range, value_depth
 
 MASTER_ID = "/master"
 #: Masters running in this process, by URI (a node's watchdog asks them directly, untraced).

@@ -1,18 +1,18 @@
-"""XML-RPC over HTTP/1.1, small and safe, recording the exact bytes.
+"""XML-RPC over HTTP/1.1, small and safe, recording the exact bytes: the sockets.
 
 How it works: the server accepts connections on a loopback socket (unless told otherwise),
 gives each connection a thread, feeds its bytes to a sans-IO decoder
 (:class:`~rosfpga_lab.graph.http.HttpDecoder`: the HTTP head capped at :data:`MAX_HTTP_HEAD`, a
-``Content-Length`` body capped at :data:`MAX_XMLRPC_BODY`), parses the body with defusedxml's
-expat parser (no entity expansion, no DTDs, no external references; nesting capped at
-:data:`MAX_XMLRPC_DEPTH`), calls the handler and writes the reply; keep-alive is honoured as
+``Content-Length`` body capped at :data:`MAX_XMLRPC_BODY`), parses the body
+(:func:`~rosfpga_lab.graph.xmlrpccodec.parse_xmlrpc`: defusedxml, nesting capped at
+``graph.limits.MAX_XMLRPC_DEPTH``), calls the handler and writes the reply; keep-alive is honoured as
 rospy's and roscpp's clients expect. A request must be complete within
 :data:`XMLRPC_REQUEST_TIMEOUT` of its first byte (a deadline for the whole request, not per
 ``recv``); at :data:`MAX_XMLRPC_CONNECTIONS` a new connection evicts the one that has waited
 longest for request bytes, so peers holding sockets open cannot lock others out. The client
-opens one connection per call, and its ``timeout`` bounds the whole call. Both sides record request and response bytes in a
-:class:`~rosfpga_lab.graph.trace.Trace`. The stdlib ``xmlrpc.client`` is used only to
-marshal (build XML), never to parse.
+opens one connection per call, and its ``timeout`` bounds the whole call. Both sides record
+request and response bytes in a :class:`~rosfpga_lab.graph.trace.Trace`. The XML documents are
+:mod:`rosfpga_lab.graph.xmlrpccodec`'s, the HTTP messages :mod:`rosfpga_lab.graph.http`'s.
 """
 
 from __future__ import annotations
@@ -22,14 +22,13 @@ import threading
 import time
 from dataclasses import dataclass
 import urllib.parse
-import xmlrpc.client
 from collections.abc import Callable
 from typing import Any
 
-from defusedxml.xmlrpc import DefusedExpatParser
-
 from rosfpga_lab.graph.errors import ConfigError, XmlRpcError, XmlRpcTooLargeError
-from rosfpga_lab.graph.http import Body, EndOfStream, Head, HttpDecoder
+from rosfpga_lab.graph.http import (
+    Body, EndOfStream, Head, HttpDecoder, keeps_alive, request_message, response_message,
+)
 from rosfpga_lab.graph.limits import (
     JOIN_TIMEOUT,
     LISTEN_BACKLOG,
@@ -37,7 +36,6 @@ from rosfpga_lab.graph.limits import (
     MAX_XMLRPC_BODIES_IN_FLIGHT,
     MAX_XMLRPC_BODY,
     MAX_XMLRPC_CONNECTIONS,
-    MAX_XMLRPC_DEPTH,
     MAX_XMLRPC_MULTICALL,
     MAX_XMLRPC_REPLY,
     XMLRPC_IDLE_TIMEOUT,
@@ -47,103 +45,11 @@ from rosfpga_lab.graph.limits import (
 from rosfpga_lab.graph.names import address_family, uri_host
 from rosfpga_lab.graph.trace import Trace
 from rosfpga_lab.graph.wire import RECV_CHUNK, accept_loop, hard_close, socket_ends
-
-#: XML-RPC's <int>/<i4> range (ROS's XmlRpcValue and rospy's marshaller refuse anything else).
-INT32_MIN, INT32_MAX = -(2**31), 2**31 - 1
+from rosfpga_lab.graph.xmlrpccodec import (
+    Fault, check_int_range, dump_fault, dump_request, dump_response, parse_xmlrpc,
+)
 
 Handler = Callable[[str, tuple], Any]
-
-
-class Fault(Exception):
-    """Raise from a handler to answer with an XML-RPC fault (not a LabError: it is a reply)."""
-
-    def __init__(self, code: int, message: str) -> None:
-        super().__init__(message)
-        self.code = code
-        self.message = message
-
-
-def parse_xmlrpc(data: bytes) -> tuple[tuple, str | None]:
-    """Parse an XML-RPC request or response safely.
-
-    Returns:
-        ``(params, method_name)``; method_name is None for responses.
-
-    Raises:
-        XmlRpcError: malformed XML, forbidden XML constructs, not XML-RPC, nested deeper than
-            :data:`MAX_XMLRPC_DEPTH`, or a fault reply.
-    """
-    unmarshaller = xmlrpc.client.Unmarshaller(use_builtin_types=True)
-    parser = DefusedExpatParser(unmarshaller)
-    try:
-        parser.feed(data)
-        parser.close()
-        params = unmarshaller.close()
-    except xmlrpc.client.Fault as fault:
-        raise XmlRpcError(f"XML-RPC fault {fault.faultCode}: {fault.faultString}") from None
-    except Exception as exc:  # expat, defusedxml, ResponseError, bad int/float/base64 text
-        raise XmlRpcError(f"malformed XML-RPC document: {type(exc).__name__}: {exc}") from None
-    depth = value_depth(params, MAX_XMLRPC_DEPTH + 1)
-    if depth > MAX_XMLRPC_DEPTH:
-        raise XmlRpcError(f"XML-RPC values nested deeper than {MAX_XMLRPC_DEPTH} levels are refused")
-    return params, unmarshaller.getmethodname()
-
-
-def value_depth(value: Any, stop: int | None = None) -> int:
-    """Nesting depth of lists/tuples/dicts in ``value`` (a scalar is 0), without recursion.
-
-    Args:
-        stop: return as soon as the depth reaches this (enough to know a limit is passed).
-    """
-    deepest = 0
-    stack = [(value, 0)]
-    while stack:
-        v, d = stack.pop()
-        if isinstance(v, (list, tuple, dict)):
-            d += 1
-            deepest = max(deepest, d)
-            if stop is not None and deepest >= stop:
-                return deepest
-            stack.extend((x, d) for x in (v.values() if isinstance(v, dict) else v))
-    return deepest
-
-
-def check_int_range(value: Any) -> None:
-    """Refuse ints XML-RPC cannot carry (outside int32), anywhere in ``value``, without recursion.
-
-    Raises:
-        XmlRpcError: naming the first such integer.
-    """
-    stack = [value]
-    while stack:
-        v = stack.pop()
-        if isinstance(v, bool):
-            continue
-        if isinstance(v, int):
-            if not INT32_MIN <= v <= INT32_MAX:
-                raise XmlRpcError(f"integer {v} is outside XML-RPC's 32-bit range "
-                                  f"[{INT32_MIN}, {INT32_MAX}]")
-        elif isinstance(v, (list, tuple)):
-            stack.extend(v)
-        elif isinstance(v, dict):
-            stack.extend(v.values())
-
-
-def dump_response(value: Any) -> bytes:
-    """Marshal a handler's return value (ints clamped to int32 as ROS expects)."""
-    return xmlrpc.client.dumps((_clamp(value),), methodresponse=True, allow_none=False).encode()
-
-
-def _clamp(v: Any) -> Any:
-    if isinstance(v, bool):
-        return v
-    if isinstance(v, int):
-        return max(INT32_MIN, min(INT32_MAX, v))
-    if isinstance(v, (list, tuple)):
-        return [_clamp(x) for x in v]
-    if isinstance(v, dict):
-        return {k: _clamp(x) for k, x in v.items()}
-    return v
 
 
 def split_uri(uri: str) -> tuple[str, int, str]:
@@ -240,13 +146,6 @@ def _discard(sock: socket.socket, n: int, deadline: _Deadline) -> None:
             n -= got
     except OSError:
         return
-
-
-def _http_response(status: str, body: bytes, keep_alive: bool) -> bytes:
-    head = (f"HTTP/1.1 {status}\r\nServer: rosfpga-lab/XMLRPC\r\n"
-            f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\n"
-            f"Connection: {'keep-alive' if keep_alive else 'close'}\r\n\r\n")
-    return head.encode("latin-1") + body
 
 
 _context = threading.local()
@@ -372,7 +271,7 @@ class XmlRpcServer:
             self.refused += 1
             try:
                 conn.settimeout(1.0)
-                conn.sendall(_http_response("503 Service Unavailable", b"too many connections", False))
+                conn.sendall(response_message("503 Service Unavailable", b"too many connections", False))
             except OSError:
                 pass
             hard_close(conn)
@@ -416,67 +315,8 @@ class XmlRpcServer:
         _context.peer = peer
         ends = socket_ends(conn)
         try:
-            while self._running:
-                deadline = _Deadline(XMLRPC_IDLE_TIMEOUT, self.request_timeout)
-                try:
-                    if http.in_message:
-                        deadline.started()
-                    event = _next_event(conn, http, deadline)
-                    if event is None:
-                        return
-                    assert isinstance(event, Head)
-                    head, request_line, headers = event.raw, event.start_line, event.headers
-                except XmlRpcError as exc:
-                    conn.sendall(_http_response("400 Bad Request", str(exc).encode(), False))
-                    return
-                t0 = time.time()
-                parts = request_line.split()
-                version = parts[2] if len(parts) == 3 else "HTTP/1.0"
-                keep = (version == "HTTP/1.1" and headers.get("connection", "").lower() != "close") or \
-                       headers.get("connection", "").lower() == "keep-alive"
-                if len(parts) != 3 or parts[0] != "POST":
-                    conn.sendall(_http_response("405 Method Not Allowed", b"", False))
-                    return
-                reserved = self._reserve(headers)
-                if reserved < 0:  # refuse, and read the body into nothing so the client
-                    conn.settimeout(1.0)  # finishes sending and reads the refusal
-                    conn.sendall(_http_response("503 Service Unavailable", (
-                        f"request bodies in flight would pass this server's budget of "
-                        f"{self.body_budget} bytes (graph.limits.MAX_XMLRPC_BODIES_IN_FLIGHT); "
-                        "retry later").encode(), False))
-                    _discard(conn, http.missing, deadline)
-                    return
-                body = None
-                try:
-                    body = self._request_body(conn, http, deadline)
-                finally:
-                    if body is None:
-                        self._release(reserved)
-                if body is None:
-                    return
-                if not self._set_busy(conn, True):
-                    self._release(reserved)
-                    return
-                try:
-                    reply_body, method, params, result = self._dispatch(body)
-                finally:
-                    self._release(reserved)
-                reply = _http_response("200 OK", reply_body, keep)
-                conn.settimeout(self.request_timeout)
-                conn.sendall(reply)   # still "busy": stop() lets a reply go out (a "shutdown" call's)
-                if not self._set_busy(conn, False):
-                    return
-                self.requests += 1
-                if self.trace is not None:
-                    caller = params[0] if params and isinstance(params[0], str) else peer
-                    self.trace.record("xmlrpc", self.name, role="server", src=caller,
-                                      dst=self.name, method=method, args=list(params),
-                                      result=result, raw=self.trace.excerpt(head, body),
-                                      raw_reply=self.trace.excerpt(reply),
-                                      size=len(head) + len(body) + len(reply), t0=t0, **ends)
-                del body, reply, reply_body, params, result
-                if not keep:
-                    return
+            while self._running and self._serve_request(conn, peer, http, ends):
+                pass
         except OSError:
             return
         finally:
@@ -484,6 +324,66 @@ class XmlRpcServer:
             with self._lock:
                 self._conns.pop(conn, None)
             hard_close(conn)
+
+    def _serve_request(self, conn: socket.socket, peer: str, http: HttpDecoder,
+                       ends: dict[str, str]) -> bool:
+        """Read one request from ``conn``, answer it and record it; True when the connection
+        stays open for the next (keep-alive), False once it is to be closed."""
+        deadline = _Deadline(XMLRPC_IDLE_TIMEOUT, self.request_timeout)
+        try:
+            if http.in_message:
+                deadline.started()
+            head = _next_event(conn, http, deadline)
+            if head is None:
+                return False
+            assert isinstance(head, Head)
+        except XmlRpcError as exc:
+            conn.sendall(response_message("400 Bad Request", str(exc).encode(), False))
+            return False
+        t0 = time.time()
+        parts = head.start_line.split()
+        if len(parts) != 3 or parts[0] != "POST":
+            conn.sendall(response_message("405 Method Not Allowed", b"", False))
+            return False
+        reserved = self._reserve(head.headers)
+        if reserved < 0:  # refuse, and read the body into nothing so the client
+            conn.settimeout(1.0)  # finishes sending and reads the refusal
+            conn.sendall(response_message("503 Service Unavailable", (
+                f"request bodies in flight would pass this server's budget of "
+                f"{self.body_budget} bytes (graph.limits.MAX_XMLRPC_BODIES_IN_FLIGHT); "
+                "retry later").encode(), False))
+            _discard(conn, http.missing, deadline)
+            return False
+        body = None
+        try:
+            body = self._request_body(conn, http, deadline)
+        finally:
+            if body is None:
+                self._release(reserved)
+        if body is None:
+            return False
+        if not self._set_busy(conn, True):
+            self._release(reserved)
+            return False
+        try:
+            reply_body, method, params, result = self._dispatch(body)
+        finally:
+            self._release(reserved)
+        keep = keeps_alive(head)
+        reply = response_message("200 OK", reply_body, keep)
+        conn.settimeout(self.request_timeout)
+        conn.sendall(reply)   # still "busy": stop() lets a reply go out (a "shutdown" call's)
+        if not self._set_busy(conn, False):
+            return False
+        self.requests += 1
+        if self.trace is not None:
+            caller = params[0] if params and isinstance(params[0], str) else peer
+            self.trace.record("xmlrpc", self.name, role="server", src=caller,
+                              dst=self.name, method=method, args=list(params),
+                              result=result, raw=self.trace.excerpt(head.raw, body),
+                              raw_reply=self.trace.excerpt(reply),
+                              size=len(head.raw) + len(body) + len(reply), t0=t0, **ends)
+        return keep
 
     def _request_body(self, conn: socket.socket, http: HttpDecoder,
                       deadline: _Deadline) -> bytes | None:
@@ -497,10 +397,10 @@ class XmlRpcServer:
         except XmlRpcError as exc:
             status = ("413 Payload Too Large" if isinstance(exc, XmlRpcTooLargeError)
                       else "400 Bad Request")
-            conn.sendall(_http_response(status, str(exc).encode(), False))
+            conn.sendall(response_message(status, str(exc).encode(), False))
         except TimeoutError:
             conn.settimeout(1.0)
-            conn.sendall(_http_response("408 Request Timeout", (
+            conn.sendall(response_message("408 Request Timeout", (
                 f"request not complete within {self.request_timeout} s").encode(), False))
         return None
 
@@ -508,9 +408,9 @@ class XmlRpcServer:
         try:
             params, method = parse_xmlrpc(body)
         except XmlRpcError as exc:
-            return _fault(-32700, f"parse error: {exc}"), "", (), f"fault: {exc}"
+            return dump_fault(-32700, f"parse error: {exc}"), "", (), f"fault: {exc}"
         if method is None:
-            return _fault(-32600, "not an XML-RPC request (no methodName)"), "", params, "fault"
+            return dump_fault(-32600, "not an XML-RPC request (no methodName)"), "", params, "fault"
         try:
             if method == "system.multicall":
                 value = multicall(self.handler, params)
@@ -518,9 +418,9 @@ class XmlRpcServer:
                 value = self.handler(method, params)
             return dump_response(value), method, params, value
         except Fault as fault:
-            return _fault(fault.code, fault.message), method, params, f"fault: {fault.message}"
+            return dump_fault(fault.code, fault.message), method, params, f"fault: {fault.message}"
         except Exception as exc:  # a bug in a handler must not kill the server thread
-            return _fault(1, f"internal error: {type(exc).__name__}: {exc}"), method, params, "fault"
+            return dump_fault(1, f"internal error: {type(exc).__name__}: {exc}"), method, params, "fault"
 
     def stop(self) -> None:
         """Stop accepting, close every connection, join every thread."""
@@ -590,10 +490,6 @@ def multicall(handler: Handler, params: tuple) -> list:
     return results
 
 
-def _fault(code: int, message: str) -> bytes:
-    return xmlrpc.client.dumps(xmlrpc.client.Fault(code, message), methodresponse=True).encode()
-
-
 def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller: str = "",
          callee: str = "", timeout: float = XMLRPC_TIMEOUT) -> Any:
     """Call ``method(*params)`` at ``uri``; return the result.
@@ -611,11 +507,7 @@ def call(uri: str, method: str, *params: Any, trace: Trace | None = None, caller
     """
     host, port, path = split_uri(uri)
     check_int_range(params)
-    body = xmlrpc.client.dumps(tuple(params), methodname=method, allow_none=False).encode()
-    head = (f"POST {path} HTTP/1.1\r\nHost: {uri_host(host)}:{port}\r\n"
-            "User-Agent: rosfpga-lab\r\n"
-            f"Content-Type: text/xml\r\nContent-Length: {len(body)}\r\nConnection: close\r\n\r\n")
-    request = head.encode("latin-1") + body
+    request = request_message(uri_host(host), port, path, dump_request(method, params))
     t0 = time.time()
     http = HttpDecoder(max_head=MAX_HTTP_HEAD, max_body=MAX_XMLRPC_REPLY, eof_ends_body=True)
     deadline = _Deadline(timeout)
