@@ -130,7 +130,7 @@ def _stopped_remotely(node) -> bool:
     return False
 
 
-# Long (about 80 lines) on purpose: the callback ``show`` and the waiting loop share the echo's
+# long: the callback ``show`` and the waiting loop share the echo's
 # state (the bag, decoders per publisher header, counts, the failure); a class would only move it.
 def _echo(args: argparse.Namespace, uri: str) -> int:
     from rosfpga_lab.graph import GraphError, tools

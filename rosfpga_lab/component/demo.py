@@ -220,7 +220,7 @@ class DemoRig:
         self.stop()
 
 
-# Long (over 80 lines) on purpose: a third of it is the Args list of its docstring, and the rest
+# long: a third of it is the Args list of its docstring, and the rest
 # is one story (start, stream, wait, check, stop) whose every step the DemoResult reports.
 def run_demo(config: NodeConfig | str | Path | None = None, *, frames: int = 60,
              rate: float = 30.0, source: str = "grace_hopper", png: str | Path | None = "demo.png",

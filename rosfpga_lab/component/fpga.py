@@ -124,6 +124,37 @@ def refusal_kind(exc: PipelineError) -> str:
     return f"{exc.stage or 'pipeline'}: {type(exc).__name__}"
 
 
+def _check_arguments(config: NodeConfig, model: str, timing: str, input_queue: int,
+                     output_queue: int) -> None:
+    """Refuse what the component cannot run, before anything is built.
+
+    Raises:
+        ComponentConfigError: ``image:`` with another type than Image (or an Image subscriber
+            publishing another type), an unknown model or timing, ``--model rtl`` on a CDR
+            configuration, a queue shorter than one.
+    """
+    if config.is_image != (config.subscriber.type == IMAGE_TYPE):
+        raise ComponentConfigError(
+            f"subscriber.type is {config.subscriber.type!r} but image: is given: image: is "
+            f"for {IMAGE_TYPE} only")
+    if config.is_image and config.publisher.type != IMAGE_TYPE:
+        raise ComponentConfigError(
+            f"publisher.type is {config.publisher.type!r}: the video path publishes "
+            f"{IMAGE_TYPE} only")
+    if model not in MODELS:
+        raise ComponentConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+    if timing not in TIMINGS:
+        raise ComponentConfigError(f"timing must be one of {', '.join(TIMINGS)}, got {timing!r}")
+    if model == RTL_MODEL and config.wire == CDR_WIRE:
+        raise ComponentConfigError(
+            f"{config.path or 'the configuration'} has wire: cdr, whose circuit reads CDR "
+            "samples (ROS 2); this ROS 1 node feeds its circuit TCPROS frames: for --model "
+            "rtl use a copy with wire: tcpros (or leave wire out), or run this one with "
+            "--model fast")
+    if input_queue < 1 or output_queue < 1:
+        raise ComponentConfigError("input_queue and output_queue must be at least 1")
+
+
 class FpgaComponent:
     """The FPGA node: software registration and handshakes, the modelled circuit on the data path.
 
@@ -169,57 +200,11 @@ class FpgaComponent:
                  history: int = limits.DEFAULT_HISTORY, name: str | None = None,
                  host: str | None = None, trace: Any = None, watchdog: bool = True,
                  input_topic: str | None = None, output_topic: str | None = None) -> None:
-        if config.is_image != (config.subscriber.type == IMAGE_TYPE):
-            raise ComponentConfigError(
-                f"subscriber.type is {config.subscriber.type!r} but image: is given: image: is "
-                f"for {IMAGE_TYPE} only")
-        if config.is_image and config.publisher.type != IMAGE_TYPE:
-            raise ComponentConfigError(
-                f"publisher.type is {config.publisher.type!r}: the video path publishes "
-                f"{IMAGE_TYPE} only")
-        if model not in MODELS:
-            raise ComponentConfigError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
-        if timing not in TIMINGS:
-            raise ComponentConfigError(f"timing must be one of {', '.join(TIMINGS)}, got {timing!r}")
-        if model == RTL_MODEL and config.wire == CDR_WIRE:
-            raise ComponentConfigError(
-                f"{config.path or 'the configuration'} has wire: cdr, whose circuit reads CDR "
-                "samples (ROS 2); this ROS 1 node feeds its circuit TCPROS frames: for --model "
-                "rtl use a copy with wire: tcpros (or leave wire out), or run this one with "
-                "--model fast")
-        try:   # with model="rtl" the fast model still names the operation and sets its limits
-            self.registry = config.registry()
-            pmodel = "fast" if model == RTL_MODEL else model
-            self.pipeline: Pipeline | MessagePipeline = (
-                Pipeline.from_config(config, model=pmodel) if config.is_image
-                else MessagePipeline.from_config(config, model=pmodel, reg=self.registry))
-        except LabError as exc:
-            raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
+        _check_arguments(config, model, timing, input_queue, output_queue)
+        self._build_circuit(config, model)
         self.timing = timing
         self._clock_hz = config.clock_mhz * 1e6
         self._busy_until = 0.0      # time.time() when the circuit is free again (timing fpga)
-        self._rtl: Any = None
-        # any type but Image: the generated walk, whose clocks per frame are the timing (a
-        # configuration the generator refuses, e.g. another publisher type, keeps the model's)
-        self._program: Any = None
-        if not config.is_image:
-            from rosfpga_lab.hls.generic import spec_from_config
-
-            try:
-                self._program = spec_from_config(config).program
-            except LabError:
-                pass
-        if model == RTL_MODEL:
-            from rosfpga_lab.rtl.server import RtlServer
-
-            log.info("building the Verilog of %s's circuit on Verilator (seconds the first "
-                     "time, then cached) ...", config.subscriber.type)
-            try:
-                self._rtl = RtlServer(config)
-            except LabError as exc:
-                raise ComponentConfigError(f"cannot run the Verilog (--model rtl): {exc}") from None
-        if input_queue < 1 or output_queue < 1:
-            raise ComponentConfigError("input_queue and output_queue must be at least 1")
         if timing == "fpga":   # what waits in front of the board: one frame (see above)
             input_queue = 1
         self.config = config
@@ -263,6 +248,38 @@ class FpgaComponent:
         self.node: Node | None = None
         self._pub: Any = None
         self._sub: Any = None
+
+    def _build_circuit(self, config: NodeConfig, model: str) -> None:
+        """The circuit's models: the Python pipeline (with ``model="rtl"`` the fast model still
+        names the operation and sets its limits), for any type but Image the generated walk,
+        whose clocks per frame are the timing (a configuration the generator refuses, e.g.
+        another publisher type, keeps the model's), and with ``model="rtl"`` the Verilog."""
+        try:
+            self.registry = config.registry()
+            pmodel = "fast" if model == RTL_MODEL else model
+            self.pipeline: Pipeline | MessagePipeline = (
+                Pipeline.from_config(config, model=pmodel) if config.is_image
+                else MessagePipeline.from_config(config, model=pmodel, reg=self.registry))
+        except LabError as exc:
+            raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
+        self._program: Any = None
+        if not config.is_image:
+            from rosfpga_lab.hls.generic import spec_from_config
+
+            try:
+                self._program = spec_from_config(config).program
+            except LabError:
+                pass
+        self._rtl: Any = None
+        if model == RTL_MODEL:
+            from rosfpga_lab.rtl.server import RtlServer
+
+            log.info("building the Verilog of %s's circuit on Verilator (seconds the first "
+                     "time, then cached) ...", config.subscriber.type)
+            try:
+                self._rtl = RtlServer(config)
+            except LabError as exc:
+                raise ComponentConfigError(f"cannot run the Verilog (--model rtl): {exc}") from None
 
     @classmethod
     def from_config(cls, config: str | Path | NodeConfig, master_uri: str | None = None,

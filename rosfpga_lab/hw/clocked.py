@@ -28,6 +28,35 @@ from rosfpga_lab.hw.errors import PipelineConfigError
 from rosfpga_lab.hw.limits import CLOCKED_MAX_CLOCKS
 
 
+def _stimulus(size: int, width: int, b: int, first_pixel: int, in_valid: np.ndarray | None,
+              out_ready: np.ndarray | None, clocks: int | None) -> tuple[np.ndarray, np.ndarray]:
+    """Per clock, whether a byte is offered and whether the beat is taken, for ``size`` bytes
+    of pixels of ``b`` bytes: as many clocks as asked, else as the arrays given hold, else
+    ``(size + 2) * 4 + 8`` (more than the data takes when nothing holds it back).
+
+    Raises:
+        PipelineConfigError: a bad geometry, arrays too short, or more than
+            :data:`CLOCKED_MAX_CLOCKS` clocks.
+    """
+    if not 1 <= b <= 4 or width < 1 or first_pixel < 0:
+        raise PipelineConfigError(f"bad geometry: width={width}, bytes_per_pixel={b}, first_pixel={first_pixel}")
+    if size % b:
+        raise PipelineConfigError(f"{size} bytes are not whole pixels of {b} bytes")
+    n = clocks if clocks is not None else (size + 2) * 4 + 8
+    if in_valid is not None or out_ready is not None:
+        given = [a.size for a in (in_valid, out_ready) if a is not None]
+        n = clocks if clocks is not None else min(given)
+    if n > CLOCKED_MAX_CLOCKS:
+        raise PipelineConfigError(f"{n} clocks is more than this model simulates "
+                                  f"({CLOCKED_MAX_CLOCKS}); "
+                                  "use the RTL simulation for whole frames")
+    ivalid = np.ones(n, bool) if in_valid is None else np.asarray(in_valid, bool)[:n]
+    oready = np.ones(n, bool) if out_ready is None else np.asarray(out_ready, bool)[:n]
+    if ivalid.size < n or oready.size < n:
+        raise PipelineConfigError("in_valid and out_ready need a value for every clock")
+    return ivalid, oready
+
+
 def fifo2axi_clocks(data: bytes | np.ndarray, width: int, bytes_per_pixel: int, *,
                     first_pixel: int = 0, in_valid: np.ndarray | None = None,
                     out_ready: np.ndarray | None = None, clocks: int | None = None,
@@ -55,22 +84,8 @@ def fifo2axi_clocks(data: bytes | np.ndarray, width: int, bytes_per_pixel: int, 
     """
     raw = np.frombuffer(bytes(data), np.uint8) if not isinstance(data, np.ndarray) else data.astype(np.uint8).ravel()
     b = int(bytes_per_pixel)
-    if not 1 <= b <= 4 or width < 1 or first_pixel < 0:
-        raise PipelineConfigError(f"bad geometry: width={width}, bytes_per_pixel={b}, first_pixel={first_pixel}")
-    if raw.size % b:
-        raise PipelineConfigError(f"{raw.size} bytes are not whole pixels of {b} bytes")
-    n = clocks if clocks is not None else (raw.size + 2) * 4 + 8
-    if in_valid is not None or out_ready is not None:
-        given = [a.size for a in (in_valid, out_ready) if a is not None]
-        n = clocks if clocks is not None else min(given)
-    if n > CLOCKED_MAX_CLOCKS:
-        raise PipelineConfigError(f"{n} clocks is more than this model simulates "
-                                  f"({CLOCKED_MAX_CLOCKS}); "
-                                  "use the RTL simulation for whole frames")
-    ivalid = np.ones(n, bool) if in_valid is None else np.asarray(in_valid, bool)[:n]
-    oready = np.ones(n, bool) if out_ready is None else np.asarray(out_ready, bool)[:n]
-    if ivalid.size < n or oready.size < n:
-        raise PipelineConfigError("in_valid and out_ready need a value for every clock")
+    ivalid, oready = _stimulus(raw.size, width, b, first_pixel, in_valid, out_ready, clocks)
+    n = ivalid.size
     sig = {name: np.zeros(n, np.uint64) for name in (
         "s_tdata", "s_tvalid", "s_tready", "m_axis_tdata", "m_axis_tuser", "m_axis_tlast",
         "m_axis_tvalid", "m_axis_tready")}

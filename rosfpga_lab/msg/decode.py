@@ -149,7 +149,7 @@ def _decode_string(buf: memoryview, pos: int, path: str, limits: MsgLimits) -> t
     return str(buf[pos:pos + n], "utf-8", _STR_ERRORS), pos + n
 
 
-# Long (about 90 lines) on purpose: one branch per kind of field, each returning the closure the
+# long: one branch per kind of field, each returning the closure the
 # compiled decoder calls per message (the fast path: the kind is decided once, here); encode.py's
 # _field_encoder is its mirror, branch for branch, so the two read side by side.
 def _field_decoder(reg: MsgRegistry, f: Field) -> Callable:

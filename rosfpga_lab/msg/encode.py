@@ -224,7 +224,7 @@ def _numeric_array(value: Any, path: str, base: str, type_name: str) -> np.ndarr
     return arr.astype(target)
 
 
-# Long (about 90 lines) on purpose: one branch per kind of field, each returning the closure the
+# long: one branch per kind of field, each returning the closure the
 # compiled encoder calls per message (the fast path: the kind is decided once, here); decode.py's
 # _field_decoder is its mirror, branch for branch, so the two read side by side.
 def _field_encoder(reg: MsgRegistry, f: Field) -> Callable:
