@@ -186,8 +186,8 @@ def _subs(dg: bytes) -> list[tuple[int, int, bool]]:
         le = bool(dg[pos + 1] & 1)
         (length,) = struct.unpack("<H" if le else ">H", dg[pos + 2:pos + 4])
         found.append((pos, length, le))
-        if length == 0:
-            break
+        if length == 0 and dg[pos] not in (b.PAD, b.INFO_TS):
+            break                                  # to the end of the message
         pos += 4 + length
     return found
 
@@ -206,12 +206,12 @@ def _damage(rng: random.Random, dg: bytes) -> bytes:
     elif kind == 1:
         out[4] = rng.choice([1, 3])                             # another major version
     elif kind == 2:
-        return bytes(out[:rng.randrange(HEADER_SIZE)])          # shorter than a header
+        return bytes(out[:rng.randrange(1, HEADER_SIZE)])       # shorter than a header
     elif kind in (3, 4) and len(out) > HEADER_SIZE + 1:
         return bytes(out[:rng.randrange(HEADER_SIZE + 1, len(out))])   # cut short
     elif kind == 5 and subs:
         at, length, le = rng.choice(subs)
-        _set_length(out, at, le, length + 4 * rng.randint(1, 40))      # beyond the packet
+        _set_length(out, at, le, len(dg) - at + 4 * rng.randint(0, 40))  # beyond the packet
     elif kind == 6 and len(subs) > 1:
         at, length, le = rng.choice(subs[:-1])
         _set_length(out, at, le, length + rng.choice([1, 2, 3]))       # not a multiple of 4

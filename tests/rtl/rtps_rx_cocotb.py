@@ -86,7 +86,9 @@ async def rtps_rx_walk(dut) -> None:
         idle = idle + 1 if (i == len(stream) and not valid) else 0
         await RisingEdge(dut.clk)
     assert i == len(stream), f"{len(stream) - i} input bytes never taken"
-    assert cur is None, "a packet without TLAST at the end"
+    if cur is not None:            # a fragmented sample still waiting for its fragments
+        cur["drop"] = 1
+        packets.append(cur)
     good = [p for p in packets if not p["drop"]]
     if os.environ.get("RTPS_RX_OUT"):                 # for a look after a failure
         with open(os.environ["RTPS_RX_OUT"], "w") as f:
