@@ -122,20 +122,20 @@ module rfl_rtps_rx #(
     reg [3:0] sm_flags;                         // E, Q (INFO_TS: I), D, K
     reg [15:0] sub_left;                        // body bytes left (not with to_end)
     reg to_end, mis;
+    reg sl1;                                    // sub_left == 1, registered (timing)
     reg [31:0] acc_e;                           // the last four bytes, in E order
     reg [23:0] acc_b;                           // the last three bytes, as they came
     wire le = sm_flags[0];
     wire [31:0] acc_e_n = le ? {b, acc_e[31:8]} : {acc_e[23:0], b};
     wire [31:0] acc_b_n = {acc_b, b};
     wire [15:0] e16 = le ? acc_e_n[31:16] : acc_e_n[15:0];      // a 16-bit field ending here
-    wire [15:0] pid_n = le ? acc_e_n[15:0] : acc_e_n[31:16];    // parameter id before it
     wire is_frag = (sm_id == ID_DATA_FRAG);
     wire empty_kind = (sm_id == ID_PAD) || (sm_id == ID_INFO_TS);
     wire fields_kind = (sm_id == ID_DATA) || is_frag || (sm_id == ID_INFO_DST) ||
                        (sm_id == ID_INFO_SRC) || ((sm_id == ID_INFO_TS) && !sm_flags[1]);
     wire [5:0] fields_last = (sm_id == ID_INFO_TS) ? 6'd7 : (sm_id == ID_INFO_DST) ? 6'd11 :
                              (sm_id == ID_DATA) ? 6'd19 : is_frag ? 6'd31 : 6'd19;
-    wire body_last = to_end ? tl : (sub_left == 16'd1);
+    wire body_last = to_end ? tl : sl1;
     wire body_end = body_last || tl;            // the submessage's last byte in this packet
     wire trunc = tl && !body_last;
     wire end_bad = trunc || (body_last && mis && !tl);   // cut short; misaligned, not last
@@ -146,13 +146,14 @@ module rfl_rtps_rx #(
     reg [63:0] seq;
     reg [15:0] frag_count, frag_size;
     reg [15:0] q_left;
-    reg q_sent;
+    reg q_sent, ql1, q_pid1, q_z2, g1;         // ql1: q_left == 1; g1: gap == 1
     wire gap_pos = !gap[16] && (gap != 17'd0);
-    wire q_done = ((idx == 6'd3) && (e16 == 16'd0) && (pid_n == 16'h0001)) ||
-                  ((idx == 6'd4) && (q_left == 16'd1) && q_sent);
+    wire q_len0 = q_z2 && (b == 8'h00);        // the parameter's length is 0
+    wire q_done = ((idx == 6'd3) && q_len0 && q_pid1) || ((idx == 6'd4) && ql1 && q_sent);
 
     // the sample being streamed
     reg act, act_frag, beats, pay_on, hold, sm_acc;
+    reg al1, fl1, fc1, afs1;                    // a_left, f_left, f_cnt, a_fsize == 1
     reg [7:0] hold_data;
     reg [31:0] next_frag, a_ssize, a_left;
     reg [15:0] a_fsize, f_left, f_cnt;
@@ -160,8 +161,8 @@ module rfl_rtps_rx #(
     reg [31:0] meta_writer;
     reg [63:0] meta_seq, meta_ts;
     reg meta_ts_valid;
-    wire fin = act_frag ? (a_left == 32'd1) : body_last;        // the sample's last byte
-    wire fset_end = act_frag && (f_left == 16'd1) && (f_cnt == 16'd1);
+    wire fin = act_frag ? al1 : body_last;      // the sample's last byte
+    wire fset_end = act_frag && fl1 && fc1;
 
     // the decision (S_D1 registers, S_D2 reads)
     reg d_body_end, d_pkt_end, d_bad;
@@ -251,8 +252,10 @@ module rfl_rtps_rx #(
             acc_e <= acc_e_n;
             acc_b <= acc_b_n[23:0];
             if (!to_end && (st == S_FIELDS || st == S_GAP || st == S_QOS || st == S_PAY ||
-                            st == S_SKIP))
+                            st == S_SKIP)) begin
                 sub_left <= sub_left - 16'd1;
+                sl1 <= (sub_left == 16'd2);
+            end
         end
         if (!rst_n) begin
             st <= S_HDR;
@@ -296,6 +299,7 @@ module rfl_rtps_rx #(
                 if (idx == 6'd3) begin
                     idx <= 6'd0;
                     sub_left <= e16;
+                    sl1 <= (e16 == 16'd1);
                     mis <= (e16[1:0] != 2'd0);
                     to_end <= (e16 == 16'd0) && !empty_kind;
                     if (sm_id == ID_INFO_TS && sm_flags[1]) ts_valid <= 1'b0;
@@ -340,7 +344,10 @@ module rfl_rtps_rx #(
                 end
                 ID_INFO_SRC: if (idx >= 6'd8) src_prefix <= {src_prefix[87:0], b};
                 default: begin                  // DATA, DATA_FRAG
-                    if (idx == 6'd3) gap <= {1'b0, e16} - (is_frag ? 17'd28 : 17'd16);
+                    if (idx == 6'd3) begin
+                        gap <= {1'b0, e16} - (is_frag ? 17'd28 : 17'd16);
+                        g1 <= (e16 == (is_frag ? 16'd29 : 16'd17));
+                    end
                     if (idx == 6'd7) reader <= acc_b_n;
                     if (idx == 6'd11) writer <= acc_b_n;
                     if (idx == 6'd15) seq[63:32] <= acc_e_n;
@@ -383,7 +390,9 @@ module rfl_rtps_rx #(
                         sm_acc <= 1'b1;
                         pay_on <= 1'b1;
                         f_left <= frag_size;
+                        fl1 <= (frag_size == 16'd1);
                         f_cnt <= frag_count;
+                        fc1 <= (frag_count == 16'd1);
                     end
                     if (start_now) begin
                         load_meta;
@@ -392,8 +401,10 @@ module rfl_rtps_rx #(
                         beats <= 1'b0;
                         next_frag <= 32'd1;
                         a_fsize <= frag_size;
+                        afs1 <= (frag_size == 16'd1);
                         a_ssize <= sample_size;
                         a_left <= sample_size;
+                        al1 <= (sample_size == 32'd1);
                     end else if (f_matched && !cont_now) p_drop <= 1'b1;  // out of order
                     if (d_body_end) begin       // nothing after the fields
                         if (!d_ok) p_mal <= 1'b1;
@@ -415,7 +426,8 @@ module rfl_rtps_rx #(
             end
             S_GAP: if (take) begin
                 gap <= gap - 17'd1;
-                if (gap == 17'd1) begin
+                g1 <= (gap == 17'd2);
+                if (g1) begin
                     if (body_end) begin
                         if (sm_flags[1]) malformed(tl);     // the inline QoS is missing
                         else end_no_payload;
@@ -425,12 +437,16 @@ module rfl_rtps_rx #(
             S_QOS: if (take) begin
                 if (idx == 6'd4) begin          // in a parameter's value
                     q_left <= q_left - 16'd1;
-                    if (q_left == 16'd1) idx <= 6'd0;
+                    ql1 <= (q_left == 16'd2);
+                    if (ql1) idx <= 6'd0;
                 end else if (idx == 6'd3) begin
                     q_left <= e16;
-                    q_sent <= (pid_n == 16'h0001);
-                    idx <= (e16 == 16'd0) ? 6'd0 : 6'd4;
+                    ql1 <= (e16 == 16'd1);
+                    q_sent <= q_pid1;
+                    idx <= q_len0 ? 6'd0 : 6'd4;
                 end else idx <= idx + 6'd1;
+                if (idx == 6'd1) q_pid1 <= (e16 == 16'h0001);   // the parameter id
+                if (idx == 6'd2) q_z2 <= (b == 8'h00);
                 if (body_end) begin
                     if (q_done) end_no_payload;
                     else malformed(tl);
@@ -443,11 +459,17 @@ module rfl_rtps_rx #(
                 if (pay_on) begin
                     if (act_frag) begin
                         a_left <= a_left - 32'd1;
-                        if (f_left == 16'd1) begin
+                        al1 <= (a_left == 32'd2);
+                        if (fl1) begin
                             f_left <= a_fsize;
+                            fl1 <= afs1;
                             f_cnt <= f_cnt - 16'd1;
+                            fc1 <= (f_cnt == 16'd2);
                             next_frag <= next_frag + 32'd1;
-                        end else f_left <= f_left - 16'd1;
+                        end else begin
+                            f_left <= f_left - 16'd1;
+                            fl1 <= (f_left == 16'd2);
+                        end
                     end
                     if (fin) begin
                         pay_on <= 1'b0;
