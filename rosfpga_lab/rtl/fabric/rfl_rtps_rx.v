@@ -33,7 +33,7 @@
 // the sample is dropped, discard the packet (a fragment missing, out of order or malformed, a
 // truncated or malformed submessage). A packet with TUSER may end with a byte 0 that is not
 // the sample's. m_sample_* (writer GUID = source prefix + writerId, writerSN, the INFO_TS time
-// {seconds, fraction} and whether there was one) hold for every beat of the sample's packet.
+// {seconds, fraction}, meaningful with m_sample_ts_valid) hold for every beat of its packet.
 // The payload is as on the wire: padding declared in the encapsulation options (and a
 // DATA_FRAG sample's bytes past sampleSize) are left to the CDR stage / not sent.
 // Refused and counted (cnt_malformed, the rest of the packet dropped, RTPS 2.3 8.3.4.1): a
@@ -118,7 +118,7 @@ module rfl_rtps_rx #(
     wire own_n = ((idx == 6'd8) || own_eq) && cmp_eq;
 
     // the submessage
-    reg [7:0] sm_id;
+    reg k_ts, k_dst, k_src, k_data, k_frag, k_pad;   // the submessage id, decoded once
     reg [3:0] sm_flags;                         // E, Q (INFO_TS: I), D, K
     reg [15:0] sub_left;                        // body bytes left (not with to_end)
     reg to_end, mis;
@@ -129,12 +129,10 @@ module rfl_rtps_rx #(
     wire [31:0] acc_e_n = le ? {b, acc_e[31:8]} : {acc_e[23:0], b};
     wire [31:0] acc_b_n = {acc_b, b};
     wire [15:0] e16 = le ? acc_e_n[31:16] : acc_e_n[15:0];      // a 16-bit field ending here
-    wire is_frag = (sm_id == ID_DATA_FRAG);
-    wire empty_kind = (sm_id == ID_PAD) || (sm_id == ID_INFO_TS);
-    wire fields_kind = (sm_id == ID_DATA) || is_frag || (sm_id == ID_INFO_DST) ||
-                       (sm_id == ID_INFO_SRC) || ((sm_id == ID_INFO_TS) && !sm_flags[1]);
-    wire [5:0] fields_last = (sm_id == ID_INFO_TS) ? 6'd7 : (sm_id == ID_INFO_DST) ? 6'd11 :
-                             (sm_id == ID_DATA) ? 6'd19 : is_frag ? 6'd31 : 6'd19;
+    wire is_frag = k_frag;
+    wire empty_kind = k_pad || k_ts;
+    wire fields_kind = k_data || k_frag || k_dst || k_src || (k_ts && !sm_flags[1]);
+    wire [5:0] fields_last = k_ts ? 6'd7 : k_dst ? 6'd11 : k_frag ? 6'd31 : 6'd19;
     wire body_last = to_end ? tl : sl1;
     wire body_end = body_last || tl;            // the submessage's last byte in this packet
     wire trunc = tl && !body_last;
@@ -236,7 +234,7 @@ module rfl_rtps_rx #(
             meta_prefix <= src_prefix;
             meta_writer <= writer;
             meta_seq <= seq;
-            meta_ts <= ts_valid ? ts : 64'd0;
+            meta_ts <= ts;
             meta_ts_valid <= ts_valid;
         end
     endtask
@@ -292,7 +290,12 @@ module rfl_rtps_rx #(
             S_SUBHDR: if (take) begin
                 idx <= idx + 6'd1;
                 if (idx == 6'd0) begin
-                    sm_id <= b;
+                    k_ts <= (b == ID_INFO_TS);
+                    k_dst <= (b == ID_INFO_DST);
+                    k_src <= (b == ID_INFO_SRC);
+                    k_data <= (b == ID_DATA);
+                    k_frag <= (b == ID_DATA_FRAG);
+                    k_pad <= (b == ID_PAD);
                     sm_acc <= 1'b0;
                 end
                 if (idx == 6'd1) sm_flags <= b[3:0];
@@ -302,8 +305,8 @@ module rfl_rtps_rx #(
                     sl1 <= (e16 == 16'd1);
                     mis <= (e16[1:0] != 2'd0);
                     to_end <= (e16 == 16'd0) && !empty_kind;
-                    if (sm_id == ID_INFO_TS && sm_flags[1]) ts_valid <= 1'b0;
-                    if (sm_id == ID_INFO_DST) begin
+                    if (k_ts && sm_flags[1]) ts_valid <= 1'b0;
+                    if (k_dst) begin
                         cmp_sh <= cfg_prefix;
                         dst_cfg <= 1'b1;
                         dst_zero <= 1'b1;
@@ -311,7 +314,7 @@ module rfl_rtps_rx #(
                     if (tl) begin               // no body in this packet
                         if (e16 != 16'd0 || fields_kind) p_mal <= 1'b1;
                         st <= S_HDR;
-                    end else if (sm_id == ID_DATA && sm_flags[3:2] == 2'b11) begin
+                    end else if (k_data && sm_flags[3:2] == 2'b11) begin
                         p_mal <= 1'b1;          // D and K: invalid (RTPS 2.3 8.3.7.2)
                         st <= S_DROP;
                     end else if (e16 == 16'd0 && empty_kind) begin
@@ -328,22 +331,20 @@ module rfl_rtps_rx #(
             end
             S_FIELDS: if (take) begin
                 idx <= idx + 6'd1;
-                case (sm_id)
-                ID_INFO_TS: begin
+                if (k_ts) begin
                     if (idx == 6'd3) ts_sec <= acc_e_n;
                     if (idx == 6'd7) begin
                         ts <= {ts_sec, acc_e_n};
                         ts_valid <= 1'b1;
                     end
-                end
-                ID_INFO_DST: begin
+                end else if (k_dst) begin
                     dst_cfg <= dst_cfg && cmp_eq;
                     dst_zero <= dst_zero && (b == 8'h00);
                     cmp_sh <= {cmp_sh[87:0], 8'h00};
                     if (idx == 6'd11) dst_ok <= (dst_cfg && cmp_eq) || (dst_zero && b == 8'h00);
-                end
-                ID_INFO_SRC: if (idx >= 6'd8) src_prefix <= {src_prefix[87:0], b};
-                default: begin                  // DATA, DATA_FRAG
+                end else if (k_src) begin
+                    if (idx >= 6'd8) src_prefix <= {src_prefix[87:0], b};
+                end else begin                  // DATA, DATA_FRAG
                     if (idx == 6'd3) begin
                         gap <= {1'b0, e16} - (is_frag ? 17'd28 : 17'd16);
                         g1 <= (e16 == (is_frag ? 16'd29 : 16'd17));
@@ -357,9 +358,8 @@ module rfl_rtps_rx #(
                     if (idx == 6'd27) frag_size <= e16;
                     if (idx == 6'd31) sample_size <= acc_e_n;
                 end
-                endcase
                 if (idx == fields_last) begin
-                    if (sm_id == ID_DATA || is_frag) begin
+                    if (k_data || k_frag) begin
                         d_body_end <= body_end;
                         d_pkt_end <= tl;
                         d_bad <= end_bad;
