@@ -31,7 +31,9 @@ from rosfpga_lab.rtps.message import (
     ANY_PARTICIPANT, HEADER_SIZE, Data, DataFrag, InfoTs, parse_message,
 )
 from rosfpga_lab.rtl.proofs import PROOFS, prove
-from rtltools import TB_DIR, require_cocotb, require_formal, require_verilator
+from rtltools import (
+    TB_DIR, require_cocotb, require_formal, require_iverilog, require_verilator, require_yosys,
+)
 
 pytestmark = pytest.mark.rtl
 
@@ -414,6 +416,25 @@ def test_verilator_wall_has_no_warning(tmp_path: Path) -> None:
     done = subprocess.run([verilator, "--lint-only", "-Wall", str(SOURCE)], cwd=tmp_path,
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-3000:]
+
+
+def test_iverilog_wall_and_yosys_check_are_silent(tmp_path: Path) -> None:
+    """Icarus -Wall says nothing; Yosys finds no latch, loop, multiple or missing driver."""
+    iverilog = require_iverilog()
+    done = subprocess.run([iverilog, "-g2005", "-Wall", "-o", "m.vvp", str(SOURCE)],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
+    require_yosys()
+    from rosfpga_lab.rtl.synth import yosys_command
+
+    yosys = yosys_command()
+    assert yosys is not None
+    (tmp_path / "check.ys").write_text(
+        f"read_verilog {SOURCE}\nhierarchy -check -top rfl_rtps_rx\nproc\n"
+        "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
+    done = subprocess.run([*yosys, "-q", "check.ys"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0, (done.stdout + done.stderr)[-3000:]
 
 
 def test_a_planted_bug_fails_the_proof(tmp_path: Path) -> None:
