@@ -16,7 +16,7 @@
 //             next INFO_DST or the end of the message), INFO_SRC (source prefix), DATA
 //             (readerId, writerId, writerSN) and DATA_FRAG (+ fragmentStartingNum, count,
 //             size, sampleSize).
-//   S_D1/S_D2 two clocks without input: the comparisons are registered (D1), then the
+//   S_D1/S_D2 two clocks without input (dwait): the comparisons are registered (D1), then the
 //             decision (D2): a DATA (flag D, not K) or DATA_FRAG is taken when it is for us
 //             (destination), for cfg_reader or ENTITYID_UNKNOWN, from cfg_writer (0: any) and
 //             writerSN >= 1. A DATA_FRAG continues the sample being streamed when it has the
@@ -91,13 +91,14 @@ module rfl_rtps_rx #(
                      ID_INFO_DST = 8'h0E, ID_DATA = 8'h15, ID_DATA_FRAG = 8'h16;
 
     reg [3:0] st;
+    reg dwait;                                  // in S_D1 or S_D2 (timing: no state decode)
     reg [5:0] idx;                              // byte of the header / fields / parameter
 
     // the output register
     reg [7:0] o_data;
     reg o_valid, o_last, o_user;
     wire o_free = !o_valid || m_axis_tready;
-    assign s_axis_tready = (st != S_D1) && (st != S_D2) && o_free;
+    assign s_axis_tready = !dwait && o_free;
     wire take = s_axis_tvalid && s_axis_tready;
     wire [7:0] b = s_axis_tdata;
     wire tl = s_axis_tlast;
@@ -164,6 +165,7 @@ module rfl_rtps_rx #(
 
     // the decision (S_D1 registers, S_D2 reads)
     reg d_body_end, d_pkt_end, d_bad;
+    reg eq_pfx, eq_wr, eq_seq;                  // registered every clock (timing)
     reg f_k_eq, f_start_eq, f_start1, f_fsz_eq, f_ssz_eq, f_valid, f_matched;
     wire cont_now = f_matched && act && act_frag && f_k_eq && f_start_eq && f_fsz_eq &&
                     f_ssz_eq && f_valid;
@@ -240,6 +242,9 @@ module rfl_rtps_rx #(
     endtask
 
     always @(posedge clk) begin
+        eq_pfx <= (src_prefix == meta_prefix);
+        eq_wr <= (writer == meta_writer);
+        eq_seq <= (seq == meta_seq);
         p_pkt <= 1'b0;
         p_badhdr <= 1'b0;
         p_mal <= 1'b0;
@@ -257,6 +262,7 @@ module rfl_rtps_rx #(
         end
         if (!rst_n) begin
             st <= S_HDR;
+            dwait <= 1'b0;
             idx <= 6'd0;
             o_valid <= 1'b0;
             act <= 1'b0;
@@ -363,6 +369,7 @@ module rfl_rtps_rx #(
                         d_body_end <= body_end;
                         d_pkt_end <= tl;
                         d_bad <= end_bad;
+                        dwait <= 1'b1;
                         st <= S_D1;
                     end else if (end_bad) malformed(tl);
                     else if (body_end) next_sub(tl);
@@ -370,8 +377,7 @@ module rfl_rtps_rx #(
                 end else if (body_end) malformed(tl);    // fields missing
             end
             S_D1: begin
-                f_k_eq <= (src_prefix == meta_prefix) && (writer == meta_writer) &&
-                          (seq == meta_seq);
+                f_k_eq <= eq_pfx && eq_wr && eq_seq;    // DATA_FRAG: writerSN is 12 bytes old
                 f_start_eq <= (frag_start == next_frag);
                 f_start1 <= (frag_start == 32'd1);
                 f_fsz_eq <= (frag_size == a_fsize);
@@ -386,6 +392,7 @@ module rfl_rtps_rx #(
             S_D2: if (o_free) begin
                 if (need_abort) abort_act;      // then decide again, without it
                 else begin
+                    dwait <= 1'b0;
                     if (start_now || cont_now) begin
                         sm_acc <= 1'b1;
                         pay_on <= 1'b1;
