@@ -27,7 +27,7 @@ from rosfpga_lab.rtl.sim import VERILOG_DIR
 from rtltools import require_iverilog, require_verilator, require_yosys
 
 RTL = Path(VERILOG_DIR).parent
-FILES = ["verilog/rfl_*.v", "harness/rfl_*.v", "tb/rfl_*.v"]
+FILES = ["verilog/rfl_*.v", "harness/rfl_*.v", "tb/rfl_*.v", "fabric/rfl_*.v"]
 MODULE_FILES = sorted(p for pattern in FILES for p in RTL.glob(pattern))
 
 _COMMENT = re.compile(r"//.*?$|/\*.*?\*/", re.S | re.M)
@@ -139,6 +139,7 @@ CONTRACTS = [
      "rfl_subscriber: MIN_BODY must be below 2**24 and at most MAX_FRAME"),
     ("rfl_publisher", {"ENC_LEN": 0}, "rfl_publisher: ENC_LEN must be 1..32"),
     ("rfl_publisher", {"FRAME_ID_MAX": 0}, "rfl_publisher: FRAME_ID_MAX must be at least 1"),
+    ("rfl_rtps_rx", {"COUNT_BITS": 33}, "rfl_rtps_rx: COUNT_BITS must be 1..32"),
 ]
 # Icarus cannot elaborate these at all (a part select [-1:0] before the check runs): refused,
 # though with its own message
@@ -147,7 +148,8 @@ _IDS = [f"{m}-{'-'.join(f'{k}{v}' for k, v in p.items())}" for m, p, _ in CONTRA
 
 
 def _source(module: str) -> str:
-    return str(Path(VERILOG_DIR) / f"{module}.v")
+    path = Path(VERILOG_DIR) / f"{module}.v"
+    return str(path if path.exists() else RTL / "fabric" / f"{module}.v")
 
 
 @pytest.mark.rtl

@@ -45,6 +45,12 @@ in module ``limits``). The application ``rfl_morph.v``'s clocks and latency are 
 comment's; synthesis (``synth``: Yosys, the part's family, hierarchy kept, latches refused),
 place and route (``timing``: nextpnr-ecp5) and Table 1's counting rule (``sloc.COUNTED``) are
 their modules' docstrings.
+
+The network side of a ROS 2 node in the fabric (issue #31) starts in ``fabric/``:
+``rfl_rtps_rx`` walks RTPS datagrams (one UDP payload per AXI4-Stream packet) and streams one
+writer's DATA / DATA_FRAG samples out (its header comment is the design note; proof
+``rtps_rx``; tested against :func:`rosfpga_lab.rtps.parse_message` in
+``tests/test_rtl_rtps_rx.py``).
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError

@@ -36,6 +36,9 @@ from rosfpga_lab.rtl.limits import FORMAL_TIMEOUT
 from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 
 FORMAL_DIR = Path(__file__).resolve().parent / "formal"
+#: The network side of the node in the fabric (issue #31): modules proven here, not in a project.
+FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
+FABRIC_MODULES = ("rfl_rtps_rx.v",)
 ENV_INCLUDE = "fv_env.vh"
 
 
@@ -150,6 +153,11 @@ PROOFS: tuple[Proof, ...] = (
           "holds, a frame starts with its length then the constant, takes exactly the array's 2 "
           "bytes per frame, writes nothing for a dropped one; 26 clocks (a whole frame)",
           (), True),
+    # the fabric's network side (rtl/fabric, issue #31)
+    Proof("rtps_rx", ("rfl_rtps_rx.v",), "prove", 3,
+          "rfl_rtps_rx (any input bytes, any configuration): output stream rules with TLAST, "
+          "TUSER and the sample's sideband, TUSER only with TLAST, input taken only when the "
+          "output register is free; all reachable states", ("FV_PROVE",)),
     Proof("gtop", ("rfl_fifo.v", "rfl_slice.v", *GENERIC_MODULES), "prove", 4,
           "rfl_gtop (formal_program, 1-byte elements, FIFOs 2 and 4 deep, any input bytes): "
           "output stream rules, status codes of the table, busy while output is pending; all "
@@ -235,7 +243,10 @@ def sby_command() -> list[str]:
 
 
 def design_path(name: str) -> Path:
-    """Where the design file ``name`` of a :class:`Proof` lives (``generic/`` or ``verilog/``)."""
+    """Where the design file ``name`` of a :class:`Proof` lives (``generic/``, ``fabric/`` or
+    ``verilog/``)."""
+    if name in FABRIC_MODULES:
+        return FABRIC_DIR / name
     return (GENERIC_VERILOG_DIR if name in GENERIC_MODULES else VERILOG_DIR) / name
 
 
