@@ -46,6 +46,7 @@ from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.limits import MAX_DISC_ROM_BYTES
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
     PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, Qos, discovery_multicast_port,
@@ -62,8 +63,6 @@ DEST_SPDP, DEST_META, DEST_USER = 0, 1, 2
 DEST_NAMES = {DEST_SPDP: "spdp", DEST_META: "metatraffic", DEST_USER: "user"}
 #: Bits of a message table entry: destination (8), offset (16), length (16).
 TABLE_BITS = 40
-#: Largest ROM image the table addresses (16-bit offsets).
-MAX_ROM_BYTES = 1 << 16
 #: The GUID prefix of a ROM rendered without one: "rosfpga" and the fabric's mark, 12 bytes.
 DEFAULT_FABRIC_PREFIX = b"\x01\x0frflFABRIC\x00"
 #: The file names :func:`write_rom` writes (the Verilog's default ROM_FILE/TABLE_FILE).
@@ -150,7 +149,7 @@ def fabric_participant(config: NodeConfig, *, domain: int = 0, index: int = 0,
     entities, in the same order): the participant, its node entities, the output writer's and
     the input reader's entity ids."""
     if config.wire != "cdr":
-        raise RtlError(f"{config.path or "configuration"}: wire is {config.wire!r}: the "
+        raise RtlError(f"{config.path or 'configuration'}: wire is {config.wire!r}: the "
                        f"fabric's discovery ROM is for a ROS 2 node (set wire: cdr)")
     if len(guid_prefix) != 12:
         raise RtlError(f"GUID prefix of {len(guid_prefix)} bytes: it has 12")
@@ -224,9 +223,9 @@ def render_rom(config: NodeConfig | str | Path, *, domain: int = 0, index: int =
                            f"datagram ({MAX_MESSAGE_BYTES})")
     rom = DiscoveryRom(messages, p.guid_prefix, domain, index, address,
                        {"ros_discovery_info": node.graph_writer, "writer": wid, "reader": rid})
-    if len(rom.image()) > MAX_ROM_BYTES:
+    if len(rom.image()) > MAX_DISC_ROM_BYTES:
         raise RtlError(f"discovery ROM of {len(rom.image())} bytes: the table addresses "
-                       f"{MAX_ROM_BYTES}")
+                       f"{MAX_DISC_ROM_BYTES}")
     return rom
 
 
