@@ -13,8 +13,11 @@
 // The bytes are the ROM's as they are: the patch points the index names (INFO_DST, HEARTBEAT
 // counts, INFO_TS) hold their build-time values (rosfpga_lab.rtl.discrom says why they are
 // accepted as they are).
+// The ROM is read on the clock into the register TDATA shows (a block RAM's read port): a
+// datagram's first byte is offered the clock after it starts, then one byte per clock taken;
+// a datagram waiting starts on the clock its predecessor's TLAST is taken (no idle clock).
 // Stream rules: TDATA, TLAST and TDEST change only after a beat is taken, and TVALID does not
-// fall before (formal/fv_rtps_disc_rom.sv proves it).
+// fall before (formal/fv_rtps_disc_rom.sv proves it, for any ROM contents).
 `default_nettype none
 
 module rfl_rtps_disc_rom #(
@@ -89,7 +92,8 @@ module rfl_rtps_disc_rom #(
     reg sedp_wait;                              // a send_sedp request waits
     reg [MW-1:0] next_msg;                      // next message of a SEDP burst (0: none)
     reg sending;
-    reg [AW-1:0] addr;                          // the byte TDATA shows
+    reg [AW-1:0] addr;                          // the byte after the one offered
+    reg [7:0] q;                                // the byte offered (the ROM's read register)
     reg [15:0] left;                            // bytes of the datagram from addr on
     reg [DEST_BITS-1:0] dest;
 
@@ -105,9 +109,23 @@ module rfl_rtps_disc_rom #(
                       && (MESSAGES > 1);
     wire start = start_spdp || start_burst || start_sedp;
     wire [MW-1:0] msg = start_spdp ? MSG_SPDP : (start_burst ? next_msg : MSG_ONE);
-    wire [39:0] entry = table_mem[msg];
+    wire [39:0] entry;                          // the table's entry of msg
+    wire [7:0] rom_q;                           // the ROM's byte at raddr
 
-    assign m_axis_tdata = rom[addr];
+    wire [AW-1:0] first = entry[16 +: AW];
+    wire [AW-1:0] raddr = start ? first : addr;
+`ifdef FORMAL
+    // the proofs hold for any ROM and table: every read returns any value
+    (* anyseq *) wire [39:0] fv_entry;
+    (* anyseq *) wire [7:0] fv_byte;
+    assign entry = fv_entry;
+    assign rom_q = fv_byte;
+`else
+    assign entry = table_mem[msg];
+    assign rom_q = rom[raddr];
+`endif
+
+    assign m_axis_tdata = q;
     assign m_axis_tvalid = sending;
     assign m_axis_tlast = sending && last;
     assign m_axis_tdest = dest;
@@ -124,6 +142,7 @@ module rfl_rtps_disc_rom #(
             next_msg <= MSG_SPDP;
             sending <= 1'b0;
             addr <= {AW{1'b0}};
+            q <= 8'd0;
             left <= 16'd0;
             dest <= {DEST_BITS{1'b0}};
         end else begin
@@ -139,15 +158,19 @@ module rfl_rtps_disc_rom #(
             else if (start_sedp) sedp_wait <= 1'b0;
             if (start_sedp || start_burst)
                 next_msg <= (msg == LAST_MSG) ? MSG_SPDP : msg + 1'b1;
+            // the ROM is read on the clock (a block RAM's read port): the first byte as a
+            // datagram starts, the next one as a beat is taken
+            if (start || (take && !last)) begin
+                q <= rom_q;
+                addr <= raddr + 1'b1;
+            end
             if (start) begin
                 sending <= 1'b1;
-                addr <= entry[16 +: AW];
                 left <= entry[15:0];
                 dest <= entry[32 +: DEST_BITS];
             end else if (done) begin
                 sending <= 1'b0;
             end else if (take) begin
-                addr <= addr + 1'b1;
                 left <= left - 1'b1;
             end
         end
