@@ -79,16 +79,15 @@ def test_announcements_repeat_every_period(tmp_path: Path) -> None:
 
 
 def test_the_proof_catches_a_byte_that_moves_while_stalled(tmp_path: Path) -> None:
-    """The formal check of rfl_rtps_disc_rom (rtl.proofs: any ROM contents) passes, and fails
-    on a planted bug: the ROM read on every clock of a datagram, taken or not."""
+    """The formal check of rfl_rtps_disc_rom (rtl.proofs: any ROM contents; that it passes is
+    tests/test_rtl_formal.py's) fails on a planted bug: the ROM read on every clock of a
+    datagram, taken or not."""
     from rtltools import require_formal
-    from rosfpga_lab.rtl.proofs import FABRIC_VERILOG_DIR, PROOFS, prove
+    from rosfpga_lab.rtl.proofs import FABRIC_DIR, PROOFS, prove
 
     require_formal()
     proof = next(p for p in PROOFS if p.name == "rtps_disc_rom")
-    good = prove(proof)
-    assert good.passed and "successful proof by k-induction" in good.log, good.log[-2000:]
-    src = (FABRIC_VERILOG_DIR / "rfl_rtps_disc_rom.v").read_text()
+    src = (FABRIC_DIR / "rfl_rtps_disc_rom.v").read_text()
     planted = src.replace("if (start || (take && !last)) begin", "if (start || !last) begin")
     assert planted != src
     (tmp_path / "rfl_rtps_disc_rom.v").write_text(planted)

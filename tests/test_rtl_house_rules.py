@@ -27,7 +27,7 @@ from rosfpga_lab.rtl.sim import VERILOG_DIR
 from rtltools import require_iverilog, require_verilator, require_yosys
 
 RTL = Path(VERILOG_DIR).parent
-FILES = ["verilog/rfl_*.v", "harness/rfl_*.v", "tb/rfl_*.v", "fabric/rfl_rtps_disc_rom.v"]
+FILES = ["verilog/rfl_*.v", "harness/rfl_*.v", "tb/rfl_*.v", "fabric/rfl_*.v"]
 MODULE_FILES = sorted(p for pattern in FILES for p in RTL.glob(pattern))
 
 _COMMENT = re.compile(r"//.*?$|/\*.*?\*/", re.S | re.M)
@@ -153,7 +153,8 @@ _IDS = [f"{m}-{'-'.join(f'{k}{v}' for k, v in p.items())}" for m, p, _ in CONTRA
 
 
 def _source(module: str) -> str:
-    return str(next(p for p in MODULE_FILES if p.name == f"{module}.v"))
+    path = Path(VERILOG_DIR) / f"{module}.v"
+    return str(path if path.exists() else RTL / "fabric" / f"{module}.v")
 
 
 @pytest.mark.rtl
