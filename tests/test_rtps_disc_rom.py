@@ -108,8 +108,12 @@ def test_rom_equals_what_the_software_participant_sends() -> None:
 
 
 def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
-    rom = render_rom(CONFIG)
-    write_rom(rom, tmp_path)
+    """``rosfpga-lab generate CONFIG -o DIR --target fabric`` writes the ROM and its table."""
+    from rosfpga_lab.cli import main
+
+    assert main(["generate", str(CONFIG), "-o", str(tmp_path), "-q", "--target", "fabric",
+                 "--domain", "9", "--participant-index", "1"]) == 0
+    rom = render_rom(CONFIG, domain=9, index=1)
     image = bytes(int(x, 16) for x in (tmp_path / ROM_FILE).read_text().split())
     assert image == b"".join(m.data for m in rom.messages)
     table = [int(x, 16) for x in (tmp_path / TABLE_FILE).read_text().split()]
@@ -117,6 +121,8 @@ def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
     for entry, m in zip(table, rom.messages, strict=True):
         assert (entry >> 32, (entry >> 16) & 0xFFFF, entry & 0xFFFF) == (m.dest, at, len(m.data))
         assert image[at:at + len(m.data)] == m.data
+        one = bytes(int(x, 16) for x in (tmp_path / f"rfl_rtps_disc_{m.name}.hex").read_text().split())
+        assert one == m.data
         at += len(m.data)
 
 

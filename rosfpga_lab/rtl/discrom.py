@@ -34,7 +34,7 @@ counts (1 and 2: a new participant has seen none) too.
 
 :func:`write_rom` writes one ``$readmemh`` file per message, the concatenated image
 ``rfl_rtps_disc_rom.hex`` and its message table ``rfl_rtps_disc_rom_table.hex`` (what
-``rtl/fabric/rfl_rtps_disc_rom.v`` reads) and an index ``rfl_rtps_disc_rom.json`` (offsets,
+``fabric/rfl_rtps_disc_rom.v`` reads) and an index ``rfl_rtps_disc_rom.json`` (offsets,
 lengths, destinations, patch points).
 """
 
