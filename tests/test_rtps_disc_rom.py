@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import socket
 import struct
+import threading
 import time
 from pathlib import Path
 
@@ -26,7 +27,7 @@ from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.participant import Participant
 from rosfpga_lab.rtps.rosnode import RosNodeEntities
 from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX
-from ros2tools import CYCLONE_CONFIG, DOMAIN
+from ros2tools import CYCLONE_CONFIG, DOMAIN, cyclone, wait
 
 DATA = Path(__file__).resolve().parent.parent / "data"
 CONFIG = DATA / "fpga_samples_dilate_cdr.yaml"
@@ -79,10 +80,16 @@ def test_rom_messages_parse_into_spdp_sedp_and_graph() -> None:
     gdata = graph.submessages[2]
     assert gdata.payload[4:16] == PREFIX and b"fpga_samples" in gdata.payload
     # each patch point lies on what it names
+    assert sorted(p.name for m in rom.messages for p in m.patches) == sorted([
+        "info_dst", "hb_count_publications", "hb_count_subscriptions",
+        "acknack_base_publications", "acknack_base_subscriptions",
+        "info_dst", "info_ts", "hb_count_ros_discovery_info"])
     for m in rom.messages:
         for p in m.patches:
             field = m.data[p.offset:p.offset + p.width]
-            expect = {"info_dst": bytes(12), "info_ts": bytes(8)}.get(p.name, struct.pack("<i", 1))
+            expect = {"info_dst": bytes(12), "info_ts": bytes(8)}.get(
+                p.name, struct.pack("<iI", 0, 1) if p.name.startswith("acknack_base")
+                else struct.pack("<i", 1))
             assert field == expect, (m.name, p)
 
 
@@ -159,7 +166,8 @@ def _bind_free_index(domain: int) -> tuple[int, socket.socket, socket.socket]:
 
 
 def _peer_locators(datagram: bytes) -> tuple[int, int] | None:
-    """The metatraffic and user ports a peer's SPDP announces (None: not an SPDP)."""
+    """The metatraffic and user ports a peer's SPDP announces (None: not an SPDP with both;
+    Fast DDS announces its LAN addresses: the port is what counts on one host)."""
     try:
         msg = parse_message(datagram)
     except Exception:
@@ -167,69 +175,114 @@ def _peer_locators(datagram: bytes) -> tuple[int, int] | None:
     for s in msg.submessages:
         if isinstance(s, Data) and s.writer_id == 0x000100C2 and s.payload:
             p = parse_parameters(s.payload)
-            meta = b.Locator.decode(p[b.PID_METATRAFFIC_UNICAST_LOCATOR][0])
-            user = b.Locator.decode(p[b.PID_DEFAULT_UNICAST_LOCATOR][0])
-            return meta.port, user.port
+            little = s.payload[:2] == b.PL_CDR_LE[:2]
+            ports = []
+            for pid in (b.PID_METATRAFFIC_UNICAST_LOCATOR, b.PID_DEFAULT_UNICAST_LOCATOR):
+                locs = [b.Locator.decode(v, little) for v in p.get(pid, [])]
+                ports += [loc.port for loc in locs if loc is not None][:1]
+            if len(ports) == 2:
+                return ports[0], ports[1]
     return None
+
+
+class RomSender:
+    """The circuit's side on a UDP socket: SPDP to the discovery ports a loopback graph probes,
+    every PERIOD seconds; on a new peer's SPDP (send_sedp), the SEDP datagram to its metatraffic
+    port and the ros_discovery_info one to its user port, again every period (the circuit has
+    no ACKNACK handling yet: a peer that dropped them, as Cyclone sometimes does with SEDP data
+    that comes right after our first SPDP, gets them then). Runs on a thread until closed."""
+
+    PERIOD = 0.5
+
+    def __init__(self, domain: int) -> None:
+        self.index, self.meta, self.user = _bind_free_index(domain)
+        self.rom = render_rom(CONFIG, domain=domain, index=self.index, guid_prefix=PREFIX)
+        self.peers: set[tuple[int, int]] = set()
+        self.meta.settimeout(0.05)
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _send(self, name: str, port: int) -> None:
+        self.meta.sendto(self.rom.message(name).data, ("127.0.0.1", port))
+
+    def _run(self) -> None:
+        last = -1.0
+        while not self._stop.is_set():
+            if time.monotonic() - last > self.PERIOD:          # the period tick
+                last = time.monotonic()
+                for port in self.rom.ports()["spdp_unicast"]:
+                    self._send("spdp", port)
+                for meta, user in list(self.peers):
+                    self._send("sedp", meta)
+                    self._send("graph", user)
+            try:
+                datagram, _ = self.meta.recvfrom(65536)
+            except (socket.timeout, OSError):
+                continue
+            ports = _peer_locators(datagram)
+            if ports is not None and ports not in self.peers:     # send_sedp: a new participant
+                self.peers.add(ports)
+                self._send("sedp", ports[0])
+                self._send("graph", ports[1])
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=2.0)
+        self.meta.close()
+        self.user.close()
 
 
 @pytest.mark.timeout(30)
 def test_cyclone_discovers_the_rom_participant_and_its_topics() -> None:
-    """The ROM's bytes from a UDP socket, as the circuit sends them (SPDP to the discovery ports a
-    loopback graph probes, every period; on a peer's SPDP, the SEDP and ros_discovery_info
-    datagrams to its unicast ports, again every period), and Cyclone DDS's built-in topics
-    show the participant, its publication and its subscription with their type names."""
+    """The ROM's bytes from a UDP socket, as the circuit sends them (RomSender), and Cyclone
+    DDS's built-in topics show the participant, its publication and its subscription with their
+    type names and the ROM's GUIDs, and a Cyclone reader of ros_discovery_info (rmw's QoS) takes
+    the node's ParticipantEntitiesInfo."""
     builtin, dds = _require_cyclonedds()
-    index, meta_sock, user_sock = _bind_free_index(DOMAIN)
+    types = cyclone()
+    sender = RomSender(DOMAIN)
     try:
-        rom = render_rom(CONFIG, domain=DOMAIN, index=index, guid_prefix=PREFIX)
         dp = dds.DomainParticipant(DOMAIN)
+        P = types.Policy
+        graph = types.DataReader(dp, types.Topic(dp, "ros_discovery_info",
+                                                 types.ParticipantEntitiesInfo_),
+                                 qos=types.Qos(P.Reliability.Reliable(1_000_000_000),
+                                               P.Durability.TransientLocal, P.History.KeepLast(1)))
+        infos: list = []
         readers = {name: builtin.BuiltinDataReader(dp, topic) for name, topic in (
             ("participant", builtin.BuiltinTopicDcpsParticipant),
             ("publication", builtin.BuiltinTopicDcpsPublication),
             ("subscription", builtin.BuiltinTopicDcpsSubscription))}
         seen: dict[str, list] = {name: [] for name in readers}
-        meta_sock.settimeout(0.05)
-        peers: set[tuple[int, int]] = set()
         ours = {"publication": ("rt/samples_dilated", "lab_msgs::msg::dds_::Samples_"),
                 "subscription": ("rt/samples", "lab_msgs::msg::dds_::Samples_")}
 
         def found() -> bool:
             for name, r in readers.items():
                 seen[name] += r.take(N=64)
-            return any(s.key.bytes[:12] == PREFIX for s in seen["participant"]) and all(
+            infos.extend(graph.take(N=8))
+            return bool(infos) and any(s.key.bytes[:12] == PREFIX for s in seen["participant"]) and all(
                 any(s.key.bytes[:12] == PREFIX and (s.topic_name, s.type_name) == ours[name]
                     for s in seen[name]) for name in ours)
 
-        deadline, last_spdp = time.monotonic() + 10.0, -1.0
-        while not found():
-            assert time.monotonic() < deadline, (peers, {k: len(v) for k, v in seen.items()})
-            if time.monotonic() - last_spdp > 0.5:          # the period tick
-                last_spdp = time.monotonic()
-                for port in rom.ports()["spdp_unicast"]:
-                    meta_sock.sendto(rom.message("spdp").data, ("127.0.0.1", port))
-                # and send_sedp again to the peers known: the circuit has no ACKNACK handling
-                # yet, and Cyclone sometimes drops SEDP data that comes right after our first
-                # SPDP (about 1 run in 6 here; it asks again by ACKNACK, which the ROM leaves
-                # unanswered)
-                for meta, user in peers:
-                    meta_sock.sendto(rom.message("sedp").data, ("127.0.0.1", meta))
-                    meta_sock.sendto(rom.message("graph").data, ("127.0.0.1", user))
-            try:
-                datagram, _ = meta_sock.recvfrom(65536)
-            except socket.timeout:
-                continue
-            ports = _peer_locators(datagram)
-            if ports is not None and ports not in peers:       # send_sedp: a new participant
-                peers.add(ports)
-                meta_sock.sendto(rom.message("sedp").data, ("127.0.0.1", ports[0]))
-                meta_sock.sendto(rom.message("graph").data, ("127.0.0.1", ports[1]))
-        pub = next(s for s in seen["publication"] if s.topic_name == "rt/samples_dilated")
-        assert pub.key.bytes == PREFIX + rom.entity_ids["writer"].to_bytes(4, "big")
+        assert wait(found, 10.0), (sender.peers, {k: len(v) for k, v in seen.items()})
+        ids = sender.rom.entity_ids
+        for name, eid in (("publication", ids["writer"]), ("subscription", ids["reader"])):
+            (ep,) = [s for s in seen[name] if s.topic_name == ours[name][0]]
+            assert ep.key.bytes == PREFIX + eid.to_bytes(4, "big")
+            assert ep.participant_key.bytes == PREFIX + bytes.fromhex("000001c1")
+        # ros_discovery_info: the node, its reader and writer by GID (what ros2 node list reads)
+        (info,) = infos
+        gid = lambda g: bytes(g.data)  # noqa: E731
+        assert gid(info.gid) == PREFIX + bytes.fromhex("000001c1")
+        (node,) = info.node_entities_info_seq
+        assert (node.node_namespace, node.node_name) == ("/", "fpga_samples")
+        assert [gid(g) for g in node.reader_gid_seq] == [PREFIX + ids["reader"].to_bytes(4, "big")]
+        assert [gid(g) for g in node.writer_gid_seq] == [PREFIX + ids["writer"].to_bytes(4, "big")]
         dp = None
     finally:
-        meta_sock.close()
-        user_sock.close()
+        sender.close()
 
 
 def test_rom_sedp_equals_the_software_component_s() -> None:

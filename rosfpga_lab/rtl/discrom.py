@@ -19,14 +19,19 @@ runs, with the same entities (:class:`~rosfpga_lab.rtps.rosnode.RosNodeEntities`
   built-in readers' preemptive ACKNACKs (destination :data:`DEST_META`: that participant's
   metatraffic unicast port);
 * ``graph``: the ``ros_discovery_info`` sample (ParticipantEntitiesInfo: the node's name and its
-  endpoints' GIDs) with its HEARTBEAT, to any reader of that participant (destination
-  :data:`DEST_USER`: its user-data unicast port).
+  endpoints' GIDs) with its HEARTBEAT, to any reader of that participant (reader
+  ENTITYID_UNKNOWN; destination :data:`DEST_USER`: its user-data unicast port; Fast DDS's
+  readers announce a port of their own in their SEDP data, which the software participant sends
+  to and the fabric's receive side must learn).
 
 Run-time fields (each message's :class:`PatchPoint`): ``sedp`` and ``graph`` name their
 destination in INFO_DST; the ROM holds GUIDPREFIX_UNKNOWN (zeros: any participant, which RTPS
 readers accept), where the circuit may write the new participant's prefix. A HEARTBEAT's count
 must rise for the same reader to act on it again: the ROM holds 1 (what a participant learned
-for the first time gets), where the circuit writes its counter when it sends again. The
+for the first time gets), where the circuit writes its counter when it sends again. The built-in
+readers' preemptive ACKNACKs hold base 1 (Cyclone DDS's form); Fast DDS answers only base 0 at
+once (the software participant picks by the peer's vendor id), so their base is a patch point
+too. The
 ``graph`` sample's INFO_TS (source time) holds 0 (as the SPDP's does: constant by design) where
 the circuit may write its clock. Everything else is constant: sequence numbers (each built-in
 writer's history is fixed at build time), lease, locators, QoS, names, hashes; the ACKNACK
@@ -206,9 +211,13 @@ def render_rom(config: NodeConfig | str | Path, *, domain: int = 0, index: int =
         for seq, payload in ep.history.items():
             sedp.add(b.data(reader, writer, seq, b.pad_payload(payload)))
         _heartbeat(sedp, reader, writer, ep.seq, what)
-    for count, (reader, writer) in enumerate(((PUB_READER, PUB_WRITER),
-                                              (SUB_READER, SUB_WRITER)), 1):
-        sedp.add(b.acknack(reader, writer, 1, [], count))
+    for count, (reader, writer, what) in enumerate(((PUB_READER, PUB_WRITER, "publications"),
+                                                    (SUB_READER, SUB_WRITER, "subscriptions")),
+                                                   1):
+        sedp.add(b.acknack(reader, writer, 1, [], count),
+                 (f"acknack_base_{what}", 4 + 8, 8, f"the preemptive ACKNACK's base to the "
+                  f"peer's {what} writer: 1, or 0 for Fast DDS (vendor 0x010F), which answers "
+                  f"only that form at once (as spdp._on_spdp picks)"))
     graph = _Message(p.guid_prefix)
     _dst(graph)
     graph.add(b.info_ts(0.0), ("info_ts", 4, 8, "the source time (0: none, as the SPDP's)"))
