@@ -48,6 +48,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--address", default="127.0.0.1", metavar="IPV4",
                         help="--target fabric: the address the node announces (default "
                         "127.0.0.1)")
+    parser.add_argument("--guid-prefix", metavar="HEX",
+                        help="--target fabric: the participant's GUID prefix, 24 hex digits "
+                        "(default: the lab's fixed fabric prefix; give each board of one DDS "
+                        "domain its own)")
     parser.set_defaults(func=run)
 
 
@@ -76,10 +80,17 @@ def run(args: argparse.Namespace) -> int:
 
 def _fabric(args: argparse.Namespace, config: object) -> int:
     """``--target fabric``: the discovery ROM's files into the output directory."""
-    from rosfpga_lab.rtl.discrom import render_rom, write_rom
+    from rosfpga_lab.rtl.discrom import DEFAULT_FABRIC_PREFIX, render_rom, write_rom
+    from rosfpga_lab.rtl.errors import RtlError
 
+    prefix = DEFAULT_FABRIC_PREFIX
+    if args.guid_prefix is not None:
+        try:
+            prefix = bytes.fromhex(args.guid_prefix)
+        except ValueError:
+            raise RtlError(f"--guid-prefix {args.guid_prefix!r} is not hex digits") from None
     rom = render_rom(config, domain=args.domain, index=args.participant_index,  # type: ignore[arg-type]
-                     address=args.address)
+                     address=args.address, guid_prefix=prefix)
     paths = write_rom(rom, args.output)
     if not args.quiet:
         sizes = ", ".join(f"{m.name} {len(m.data)}" for m in rom.messages)

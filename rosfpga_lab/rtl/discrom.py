@@ -45,6 +45,7 @@ lengths, destinations, patch points).
 
 from __future__ import annotations
 
+import ipaddress
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -158,6 +159,11 @@ def fabric_participant(config: NodeConfig, *, domain: int = 0, index: int = 0,
                        f"fabric's discovery ROM is for a ROS 2 node (set wire: cdr)")
     if len(guid_prefix) != 12:
         raise RtlError(f"GUID prefix of {len(guid_prefix)} bytes: it has 12")
+    try:
+        ipaddress.IPv4Address(address)
+    except ValueError:
+        raise RtlError(f"address {address!r} is not an IPv4 address (the locators are UDPv4)") \
+            from None
     namespace, name = split_node_name(config.node.global_name)
     p = Participant(domain, index, address, name, guid_prefix=guid_prefix)
     node = RosNodeEntities(p, name, namespace)

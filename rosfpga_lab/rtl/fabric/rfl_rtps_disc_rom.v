@@ -5,14 +5,15 @@
 //   1 = the new participant's metatraffic unicast port, 2 = its user-data unicast port.
 // The ROM and its message table come from rosfpga_lab.rtl.discrom (render_rom, write_rom):
 // ROM_FILE holds the messages back to back, one byte a line; TABLE_FILE one entry a line per
-// message, {dest[7:0], offset[15:0], length[15:0]}. Message 0 is the SPDP announcement, sent
-// right after reset and then every PERIOD clocks; a pulse on send_sedp (the receive side saw a
-// new participant) sends messages 1 .. MESSAGES-1 in order (SEDP, ros_discovery_info). A tick or
-// a request that comes while a datagram is on its way waits for its end (a datagram is never cut
+// message, {dest[7:0], offset[15:0], length[15:0]} (a length of at least 1: write_rom writes no
+// empty message). Message 0 is the SPDP announcement, sent right after reset and then every
+// PERIOD clocks; a pulse on send_sedp (the receive side saw a new participant) sends messages
+// 1 .. MESSAGES-1 in order (SEDP, ros_discovery_info; none when MESSAGES = 1). A tick or a
+// request that comes while a datagram is on its way waits for its end (a datagram is never cut
 // or interleaved); requests that come while one waits are one request.
 // The bytes are the ROM's as they are: the patch points the index names (INFO_DST, HEARTBEAT
-// counts, INFO_TS) hold their build-time values (rosfpga_lab.rtl.discrom says why they are
-// accepted as they are).
+// counts, preemptive ACKNACK bases, INFO_TS) hold their build-time values (rosfpga_lab.rtl.discrom
+// says why a peer accepts them as they are, and which peer needs another value).
 // The ROM is read on the clock into the register TDATA shows (a block RAM's read port): a
 // datagram's first byte is offered the clock after it starts, then one byte per clock taken;
 // a datagram waiting starts on the clock its predecessor's TLAST is taken (no idle clock).
@@ -94,7 +95,7 @@ module rfl_rtps_disc_rom #(
     reg sending;
     reg [AW-1:0] addr;                          // the byte after the one offered
     reg [7:0] q;                                // the byte offered (the ROM's read register)
-    reg [15:0] left;                            // bytes of the datagram from addr on
+    reg [15:0] left;                            // bytes of the datagram from q on
     reg [DEST_BITS-1:0] dest;
 
     wire take = sending && m_axis_tready;
@@ -154,7 +155,7 @@ module rfl_rtps_disc_rom #(
                 ticks <= ticks - 1'b1;
                 if (start_spdp) spdp_wait <= 1'b0;
             end
-            if (send_sedp) sedp_wait <= 1'b1;
+            if (send_sedp && MESSAGES > 1) sedp_wait <= 1'b1;
             else if (start_sedp) sedp_wait <= 1'b0;
             if (start_sedp || start_burst)
                 next_msg <= (msg == LAST_MSG) ? MSG_SPDP : msg + 1'b1;
