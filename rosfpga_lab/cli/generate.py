@@ -34,6 +34,24 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="replace an earlier generation in DIR: delete the files its "
                         "manifest lists (and 'make csim' output) first; other files are kept")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    parser.add_argument("--target", choices=("project", "fabric"), default="project",
+                        help="what to write: 'project' (default) the HLS C++ and Verilog project; "
+                        "'fabric' the discovery ROM of the ROS 2 node in the fabric (wire: cdr "
+                        "only): its SPDP, SEDP and ros_discovery_info datagrams as $readmemh "
+                        "files, the ROM and message table rtl/fabric/rfl_rtps_disc_rom.v reads, "
+                        "and an index (offsets, lengths, destinations, run-time patch points)")
+    parser.add_argument("--domain", type=int, default=0, metavar="ID",
+                        help="--target fabric: the DDS domain (ROS_DOMAIN_ID; default 0)")
+    parser.add_argument("--participant-index", type=int, default=0, metavar="N",
+                        help="--target fabric: the participant index, which sets the node's "
+                        "UDP ports (RTPS port mapping; default 0)")
+    parser.add_argument("--address", default="127.0.0.1", metavar="IPV4",
+                        help="--target fabric: the address the node announces (default "
+                        "127.0.0.1)")
+    parser.add_argument("--guid-prefix", metavar="HEX",
+                        help="--target fabric: the participant's GUID prefix, 24 hex digits "
+                        "(default: the lab's fixed fabric prefix; give each board of one DDS "
+                        "domain its own)")
     parser.set_defaults(func=run)
 
 
@@ -47,6 +65,8 @@ def run(args: argparse.Namespace) -> int:
             print(f"generate: {message}", file=sys.stderr)
 
     config = load_config(args.config)
+    if args.target == "fabric":
+        return _fabric(args, config)
     result = generate_project(config, args.output, force=args.force, progress=say)
     if result.kept:
         say(f"left alone {len(result.kept)} files not written by the generator: "
@@ -55,4 +75,25 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {len(result.files)} files into {result.out_dir}; "
               f"next: make -C {result.out_dir} csim"
               + (f" (or rtlsim)" if config.application.op != "custom" else ""))
+    return 0
+
+
+def _fabric(args: argparse.Namespace, config: object) -> int:
+    """``--target fabric``: the discovery ROM's files into the output directory."""
+    from rosfpga_lab.rtl.discrom import DEFAULT_FABRIC_PREFIX, render_rom, write_rom
+    from rosfpga_lab.rtl.errors import RtlError
+
+    prefix = DEFAULT_FABRIC_PREFIX
+    if args.guid_prefix is not None:
+        try:
+            prefix = bytes.fromhex(args.guid_prefix)
+        except ValueError:
+            raise RtlError(f"--guid-prefix {args.guid_prefix!r} is not hex digits") from None
+    rom = render_rom(config, domain=args.domain, index=args.participant_index,  # type: ignore[arg-type]
+                     address=args.address, guid_prefix=prefix)
+    paths = write_rom(rom, args.output)
+    if not args.quiet:
+        sizes = ", ".join(f"{m.name} {len(m.data)}" for m in rom.messages)
+        print(f"wrote {len(paths)} files into {args.output}: discovery ROM of "
+              f"{len(rom.image())} bytes ({sizes})")
     return 0

@@ -31,6 +31,7 @@ from rosfpga_lab.hw import CdrPipeline, PipelineError
 from rosfpga_lab.msg import default_registry, deserialize, deserialize_cdr, serialize, serialize_cdr
 from rosfpga_lab.msg import to_ros2_value
 from rosfpga_lab.rtps.participant import Qos, Sample
+from rosfpga_lab.rtps.rosnode import split_node_name
 
 log = logging.getLogger(__name__)
 IMAGE = "sensor_msgs/Image"
@@ -98,8 +99,7 @@ class Ros2Component:
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         self.config, self.domain, self.qos_in, self.qos_out = config, domain, qos_in, qos_out
-        namespace, _, base = (name or config.node.global_name).rpartition("/")
-        self.name, self.namespace = base or "fpga", namespace or "/"
+        self.namespace, self.name = split_node_name(name or config.node.global_name)
         self.input_topic, self.output_topic = config.subscriber.topic, config.publisher.topic
         self.counts = {"seen": 0, "published": 0, "refused": 0}
         self.latencies: list[float] = []

@@ -27,14 +27,10 @@ from rosfpga_lab.graph.errors import GraphError
 from rosfpga_lab.graph.limits import (
     ROS2_RECORD_BYTES, ROS2_RECORD_DATAGRAMS, ROS2_SOCKET_BUFFER_BYTES, ROS2_TICK_SECONDS,
 )
-from rosfpga_lab.msg.errors import MsgError
 from rosfpga_lab.msg.registry import MsgRegistry
-from rosfpga_lab.msg.typehash import type_hash as ros2_type_hash
-from rosfpga_lab.rtps.build import (
-    ROS_DISCOVERY_TOPIC, ROS_DISCOVERY_TYPE, dds_topic, dds_type, participant_entities_info,
-)
 from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX
 from rosfpga_lab.rtps.participant import Participant, Qos, Sample, discovery_port, user_port
+from rosfpga_lab.rtps.rosnode import RosNodeEntities, node_type_hash
 
 log = logging.getLogger(__name__)
 
@@ -139,11 +135,7 @@ class Ros2Node:
         self._stop = threading.Event()
         self._recording: Ros2Recording | None = None
         # the ROS 2 graph learns the node's name and endpoints from ros_discovery_info
-        # (RELIABLE TRANSIENT_LOCAL KEEP_LAST 1, as rmw publishes it)
-        self._graph_writer = self.participant.add_writer(
-            ROS_DISCOVERY_TOPIC, ROS_DISCOVERY_TYPE, Qos(True, 1, transient_local=True))
-        self._readers: list[bytes] = []
-        self._writers: list[bytes] = []
+        self.entities = RosNodeEntities(self.participant, name, namespace)
         self._announce_graph()
         self._thread = threading.Thread(target=self._run, name=f"ros2-{name}", daemon=True)
         self._thread.start()
@@ -172,35 +164,25 @@ class Ros2Node:
     def index(self) -> int:
         return self.participant.index
 
-    def _guid(self, entity_id: int) -> bytes:
-        return self.participant.guid_prefix + entity_id.to_bytes(4, "big")
-
     def _announce_graph(self) -> None:
         """Publish this node's name and endpoints on ros_discovery_info (a ROS 2 node list sees it)."""
-        p = self.participant
-        payload = participant_entities_info(
-            self._guid(0x000001C1), [(self.namespace, self.name, self._readers, self._writers)])
         with self._lock:
-            out = p.write(self._graph_writer, payload, time.monotonic(), time.time())
+            out = self.participant.write(self.entities.graph_writer, self.entities.entities_info(),
+                                         time.monotonic(), time.time())
         self._send(out)
 
     @staticmethod
     def type_hash(type_name: str, registry: MsgRegistry | None = None) -> str:
         """The ROS 2 type hash the node announces for ``type_name`` (its definition in
         ``registry``, default the shipped types); '' for a type it cannot load (no hash sent)."""
-        try:
-            return ros2_type_hash(type_name, registry)
-        except MsgError:
-            return ""
+        return node_type_hash(type_name, registry)
 
     def create_publisher(self, topic: str, type_name: str, qos: Qos = Qos(),
                          registry: MsgRegistry | None = None) -> Ros2Publisher:
         """A writer of ROS 2 topic ``topic`` (``/image``) of ROS type ``type_name`` (defined in
         ``registry``, default the shipped types: its type hash goes out with it)."""
         with self._lock:
-            wid = self.participant.add_writer(dds_topic(topic), dds_type(type_name), qos,
-                                              self.type_hash(type_name, registry))
-            self._writers.append(self._guid(wid))
+            wid = self.entities.add_publisher(topic, type_name, qos, registry)
         self._announce_graph()
         return Ros2Publisher(self, wid, topic)
 
@@ -208,10 +190,8 @@ class Ros2Node:
                           callback: Callable[[bytes, Sample], None], qos: Qos = Qos(),
                           registry: MsgRegistry | None = None) -> Ros2Subscriber:
         with self._lock:
-            rid = self.participant.add_reader(dds_topic(topic), dds_type(type_name), qos,
-                                              self.type_hash(type_name, registry))
+            rid = self.entities.add_subscriber(topic, type_name, qos, registry)
             sub = self._subs[rid] = Ros2Subscriber(self, rid, topic, callback)
-            self._readers.append(self._guid(rid))
         self._announce_graph()
         return sub
 

@@ -19,6 +19,11 @@ than ``sensor_msgs/Image`` gets the generic circuit of :mod:`rosfpga_lab.rtl.gen
 stepping through a generated program, one instruction per field of the message), which
 :func:`build` and :func:`run` simulate the same way (``build(design_from_config(config))``).
 
+The ROS 2 node in the fabric (issue #31) announces itself from a ROM built at build time:
+:mod:`rosfpga_lab.rtl.discrom` renders the software participant's SPDP, SEDP and
+``ros_discovery_info`` datagrams for a ``wire: cdr`` configuration, ``fabric/rfl_rtps_disc_rom.v``
+streams them out (proof ``rtps_disc_rom``; ``rosfpga-lab generate CONFIG -o DIR --target fabric``).
+
 From the shell (ARCHITECTURE.md's command table; each sub-command's ``--help``)::
 
     rosfpga-lab generate data/fpga_erode_mono8.yaml -o build/erode   # the RTL goes to build/erode/rtl/

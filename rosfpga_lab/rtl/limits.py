@@ -48,3 +48,6 @@ MAX_PATH_STEPS = 400
 #: shipped generic examples (50-60 kbit) took 19-33 s on a shared machine; a 640x480 rgba8
 #: stream's FIFO (11.7 Mbit) stopped PyPI's Yosys (WebAssembly) after 90 s.
 FORMAL_MAX_MEMORY_BITS = 256 * 1024
+
+#: Largest discovery ROM image (``rtl.discrom``): its message table holds 16-bit offsets.
+MAX_DISC_ROM_BYTES = 1 << 16

@@ -38,7 +38,7 @@ from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 #: The network side of the node in the fabric (issue #31): modules proven here, not in a project.
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
-FABRIC_MODULES = ("rfl_rtps_rx.v",)
+FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v")
 ENV_INCLUDE = "fv_env.vh"
 
 
@@ -162,6 +162,10 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_gtop (formal_program, 1-byte elements, FIFOs 2 and 4 deep, any input bytes): "
           "output stream rules, status codes of the table, busy while output is pending; all "
           "reachable states", (), True),
+    # the fabric's network side (rtl/fabric, issue #31)
+    Proof("rtps_disc_rom", ("rfl_rtps_disc_rom.v",), "prove", 8,
+          "rfl_rtps_disc_rom (16-byte ROM, 4 messages, any contents, any requests): output "
+          "stream rules, TDEST constant and no gap inside a datagram; all reachable states"),
 )
 
 

@@ -12,7 +12,9 @@ and the ROS 2 names (``rt/...``, ``pkg::msg::dds_::Type_``), and
 :class:`rosfpga_lab.rtps.participant.Participant` is a whole DDS participant as a sans-IO state
 machine (discovery, matching, reliable and best-effort writers and readers; its entities in
 :mod:`rosfpga_lab.rtps.entities`, its parts in ``participant_base``, ``spdp``, ``sedp``,
-``writer_side`` and ``reader_side``); ``rosfpga_lab.graph.ros2`` runs it on sockets.
+``writer_side`` and ``reader_side``); ``rosfpga_lab.graph.ros2`` runs it on sockets, with a
+ROS 2 node's entities from :mod:`rosfpga_lab.rtps.rosnode` (which the fabric's discovery ROM,
+``rosfpga_lab.rtl.discrom``, renders too).
 Checked against Cyclone DDS (``tests/test_ros2_interop.py``) and rclpy on Fast DDS
 (``tests/test_ros2_realros2.py``); the same by hand, and captures in Wireshark: ``docs/ros2.md``.
 """

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import (
-    DOMAIN_GAIN, MAX_DOMAIN_ID, OFFSET_DISCOVERY_UNICAST, OFFSET_USER_UNICAST, PARTICIPANT_GAIN,
-    PORT_BASE,
+    DOMAIN_GAIN, MAX_DOMAIN_ID, OFFSET_DISCOVERY_MULTICAST, OFFSET_DISCOVERY_UNICAST,
+    OFFSET_USER_UNICAST, PARTICIPANT_GAIN, PORT_BASE,
 )
 
 SPDP_WRITER, SPDP_READER = 0x000100C2, 0x000100C7
@@ -27,6 +27,12 @@ Send = tuple[str, int, bytes]
 def discovery_port(domain: int, index: int) -> int:
     """The unicast discovery (metatraffic) port of participant ``index`` in ``domain``."""
     return PORT_BASE + DOMAIN_GAIN * domain + OFFSET_DISCOVERY_UNICAST + PARTICIPANT_GAIN * index
+
+
+def discovery_multicast_port(domain: int) -> int:
+    """The SPDP multicast port of ``domain`` (every participant's announcements, when the
+    network has multicast)."""
+    return PORT_BASE + DOMAIN_GAIN * domain + OFFSET_DISCOVERY_MULTICAST
 
 
 def user_port(domain: int, index: int) -> int:

@@ -12,6 +12,10 @@ MAX_PENDING_BYTES = 64 * 1024 * 1024
 #: RTPS port mapping (RTPS 2.3, 9.6.1.1): PB + DG * domain + offset + PG * index.
 PORT_BASE, DOMAIN_GAIN, PARTICIPANT_GAIN = 7400, 250, 2
 OFFSET_DISCOVERY_UNICAST, OFFSET_USER_UNICAST = 10, 11
+#: ... the SPDP multicast port's offset (d0) and its group (RTPS 2.3 9.6.1.4.1: the default
+#: multicast locator); a loopback graph has no multicast and probes the unicast ports instead.
+OFFSET_DISCOVERY_MULTICAST = 0
+SPDP_MULTICAST_ADDRESS = "239.255.0.1"
 #: Largest domain id whose ports still fit in 16 bits (7400 + 250 * 232 + 11 + 2 * 119 < 65536).
 MAX_DOMAIN_ID = 232
 #: Participant indices probed (and tried when binding), as Cyclone DDS's MaxAutoParticipantIndex.

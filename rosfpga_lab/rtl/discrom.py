@@ -1,0 +1,270 @@
+"""The fabric participant's discovery ROM: what is known at build time is built at build time.
+
+How this works: as the paper splits XML-RPC (the node's registration known at build time, the
+data path in the circuit), the ROS 2 node in the fabric splits discovery. A configuration with
+``wire: cdr`` fixes everything the node's SPDP and SEDP say: its GUID prefix, domain, participant
+index (ports), address, node name, topics, DDS type names and type hashes. :func:`render_rom`
+builds the same sans-IO :class:`~rosfpga_lab.rtps.participant.Participant` the software node
+runs, with the same entities (:class:`~rosfpga_lab.rtps.rosnode.RosNodeEntities`: the
+``ros_discovery_info`` writer, then the output topic's writer and the input topic's reader, in
+``component.ros2.Ros2Component.start``'s order) and writes, with the lab's RTPS builders
+(:mod:`rosfpga_lab.rtps.build`), the UDP payloads the circuit sends:
+
+* ``spdp``: the participant's SPDP announcement, the bytes ``Participant.announce`` sends
+  (destination :data:`DEST_SPDP`: the SPDP multicast port, or on a loopback graph the unicast
+  discovery ports of indices 0..MAX_PARTICIPANT_INDEX, as the software participant probes);
+* ``sedp``: what ``Participant`` sends a participant it has just learned (``spdp._greet``): the
+  SEDP publications writer's DATA(w) (``ros_discovery_info``'s writer and the output topic's)
+  and HEARTBEAT, the subscriptions writer's DATA(r) (the input topic's) and HEARTBEAT, and the
+  built-in readers' preemptive ACKNACKs (destination :data:`DEST_META`: that participant's
+  metatraffic unicast port);
+* ``graph``: the ``ros_discovery_info`` sample (ParticipantEntitiesInfo: the node's name and its
+  endpoints' GIDs) with its HEARTBEAT, to any reader of that participant (reader
+  ENTITYID_UNKNOWN; destination :data:`DEST_USER`: its user-data unicast port; Fast DDS's
+  readers announce a port of their own in their SEDP data, which the software participant sends
+  to and the fabric's receive side must learn).
+
+Run-time fields (each message's :class:`PatchPoint`): ``sedp`` and ``graph`` name their
+destination in INFO_DST; the ROM holds GUIDPREFIX_UNKNOWN (zeros: any participant, which RTPS
+readers accept), where the circuit may write the new participant's prefix. A HEARTBEAT's count
+must rise for the same reader to act on it again: the ROM holds 1 (what a participant learned
+for the first time gets), where the circuit writes its counter when it sends again. The built-in
+readers' preemptive ACKNACKs hold base 1 (Cyclone DDS's form); Fast DDS answers only base 0 at
+once (the software participant picks by the peer's vendor id), so their base is a patch point
+too. The
+``graph`` sample's INFO_TS (source time) holds 0 (as the SPDP's does: constant by design) where
+the circuit may write its clock. Everything else is constant: sequence numbers (each built-in
+writer's history is fixed at build time), lease, locators, QoS, names, hashes; the ACKNACK
+counts (1 and 2: a new participant has seen none) too.
+
+:func:`write_rom` writes one ``$readmemh`` file per message, the concatenated image
+``rfl_rtps_disc_rom.hex`` and its message table ``rfl_rtps_disc_rom_table.hex`` (what
+``fabric/rfl_rtps_disc_rom.v`` reads) and an index ``rfl_rtps_disc_rom.json`` (offsets,
+lengths, destinations, patch points).
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rosfpga_lab.config import NodeConfig, load_config
+from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.limits import MAX_DISC_ROM_BYTES
+from rosfpga_lab.rtps import build as b
+from rosfpga_lab.rtps.entities import (
+    PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, Qos, discovery_multicast_port,
+    discovery_port, user_port,
+)
+from rosfpga_lab.rtps.limits import MAX_MESSAGE_BYTES, SPDP_MULTICAST_ADDRESS
+from rosfpga_lab.rtps.message import ANY_PARTICIPANT
+from rosfpga_lab.rtps.participant import Participant
+from rosfpga_lab.rtps.rosnode import RosNodeEntities, split_node_name
+
+#: Destination codes (the stream's ``tdest``): the SPDP discovery port(s), the new participant's
+#: metatraffic unicast port, its user-data unicast port.
+DEST_SPDP, DEST_META, DEST_USER = 0, 1, 2
+DEST_NAMES = {DEST_SPDP: "spdp", DEST_META: "metatraffic", DEST_USER: "user"}
+#: Bits of a message table entry: destination (8), offset (16), length (16).
+TABLE_BITS = 40
+#: The GUID prefix of a ROM rendered without one: "rosfpga" and the fabric's mark, 12 bytes.
+DEFAULT_FABRIC_PREFIX = b"\x01\x0frflFABRIC\x00"
+#: The file names :func:`write_rom` writes (the Verilog's default ROM_FILE/TABLE_FILE).
+ROM_FILE, TABLE_FILE, INDEX_FILE = ("rfl_rtps_disc_rom.hex", "rfl_rtps_disc_rom_table.hex",
+                                    "rfl_rtps_disc_rom.json")
+
+
+@dataclass(frozen=True)
+class PatchPoint:
+    """A field of a ROM message the circuit may overwrite when it sends: ``width`` bytes at
+    ``offset`` in the message, and what goes there."""
+
+    name: str
+    offset: int
+    width: int
+    what: str
+
+
+@dataclass(frozen=True)
+class RomMessage:
+    """One UDP payload of the ROM and where it goes (``dest``: a DEST_* code)."""
+
+    name: str
+    data: bytes
+    dest: int
+    patches: tuple[PatchPoint, ...] = ()
+
+
+@dataclass(frozen=True)
+class DiscoveryRom:
+    """The fabric participant's discovery messages and the facts they were built from."""
+
+    messages: tuple[RomMessage, ...]
+    guid_prefix: bytes
+    domain: int
+    index: int
+    address: str
+    entity_ids: dict[str, int] = field(default_factory=dict)
+
+    def message(self, name: str) -> RomMessage:
+        return next(m for m in self.messages if m.name == name)
+
+    def image(self) -> bytes:
+        """The messages one after the other, as the ROM holds them."""
+        return b"".join(m.data for m in self.messages)
+
+    def offsets(self) -> list[int]:
+        out, at = [], 0
+        for m in self.messages:
+            out.append(at)
+            at += len(m.data)
+        return out
+
+    def ports(self) -> dict[str, object]:
+        """The destinations' ports: the SPDP multicast group and port, the unicast discovery
+        ports a loopback graph probes, this participant's own metatraffic and user ports."""
+        return {"spdp_multicast": [SPDP_MULTICAST_ADDRESS, discovery_multicast_port(self.domain)],
+                "spdp_unicast": sorted({d[1] for d in _announce_ports(self)}),
+                "own_metatraffic": discovery_port(self.domain, self.index),
+                "own_user": user_port(self.domain, self.index)}
+
+    def index_json(self) -> dict[str, object]:
+        return {"guid_prefix": self.guid_prefix.hex(), "domain": self.domain, "index": self.index,
+                "address": self.address, "ports": self.ports(), "entity_ids": {
+                    k: f"{v:08x}" for k, v in self.entity_ids.items()},
+                "rom_file": ROM_FILE, "table_file": TABLE_FILE,
+                "rom_bytes": len(self.image()),
+                "messages": [{"name": m.name, "offset": off, "length": len(m.data),
+                              "dest": m.dest, "dest_name": DEST_NAMES[m.dest],
+                              "patches": [{"name": p.name, "offset": p.offset, "width": p.width,
+                                           "what": p.what} for p in m.patches]}
+                             for m, off in zip(self.messages, self.offsets())]}
+
+
+def _announce_ports(rom: DiscoveryRom) -> list[tuple[str, int, bytes]]:
+    return Participant(rom.domain, rom.index, rom.address, guid_prefix=rom.guid_prefix).announce()
+
+
+def fabric_participant(config: NodeConfig, *, domain: int = 0, index: int = 0,
+                       address: str = "127.0.0.1", guid_prefix: bytes = DEFAULT_FABRIC_PREFIX,
+                       qos_in: Qos = Qos(), qos_out: Qos = Qos()
+                       ) -> tuple[Participant, RosNodeEntities, int, int]:
+    """The sans-IO participant of ``config``'s node as the software node builds it (the same
+    entities, in the same order): the participant, its node entities, the output writer's and
+    the input reader's entity ids."""
+    if config.wire != "cdr":
+        raise RtlError(f"{config.path or 'configuration'}: wire is {config.wire!r}: the "
+                       f"fabric's discovery ROM is for a ROS 2 node (set wire: cdr)")
+    if len(guid_prefix) != 12:
+        raise RtlError(f"GUID prefix of {len(guid_prefix)} bytes: it has 12")
+    try:
+        ipaddress.IPv4Address(address)
+    except ValueError:
+        raise RtlError(f"address {address!r} is not an IPv4 address (the locators are UDPv4)") \
+            from None
+    namespace, name = split_node_name(config.node.global_name)
+    p = Participant(domain, index, address, name, guid_prefix=guid_prefix)
+    node = RosNodeEntities(p, name, namespace)
+    reg = config.registry()
+    wid = node.add_publisher(config.publisher.topic, config.publisher.type, qos_out, reg)
+    rid = node.add_subscriber(config.subscriber.topic, config.subscriber.type, qos_in, reg)
+    return p, node, wid, rid
+
+
+class _Message:
+    """A message being written: its submessages and where each field the circuit patches is."""
+
+    def __init__(self, prefix: bytes) -> None:
+        self.data = bytearray(b.header(prefix))
+        self.patches: list[PatchPoint] = []
+
+    def add(self, sub: bytes, patch: tuple[str, int, int, str] | None = None) -> None:
+        if patch is not None:
+            name, at, width, what = patch
+            self.patches.append(PatchPoint(name, len(self.data) + at, width, what))
+        self.data += sub
+
+
+def _dst(msg: _Message) -> None:
+    msg.add(b.info_dst(ANY_PARTICIPANT), ("info_dst", 4, 12, "the destination participant's "
+                                          "GUID prefix (zeros: any participant)"))
+
+
+def _heartbeat(msg: _Message, reader: int, writer: int, last: int, what: str) -> None:
+    msg.add(b.heartbeat(reader, writer, 1, last, 1),
+            (f"hb_count_{what}", 4 + 24, 4, f"the HEARTBEAT count of {what} (1: first sent; must "
+             f"rise for a reader to act on a HEARTBEAT again)"))
+
+
+def render_rom(config: NodeConfig | str | Path, *, domain: int = 0, index: int = 0,
+               address: str = "127.0.0.1", guid_prefix: bytes = DEFAULT_FABRIC_PREFIX,
+               qos_in: Qos = Qos(), qos_out: Qos = Qos()) -> DiscoveryRom:
+    """The discovery ROM of ``config``'s ROS 2 node in the fabric (participant ``index`` of DDS
+    ``domain`` at ``address``, GUID prefix ``guid_prefix``: all fixed at build time)."""
+    if not isinstance(config, NodeConfig):
+        config = load_config(config)
+    p, node, wid, rid = fabric_participant(config, domain=domain, index=index, address=address,
+                                           guid_prefix=guid_prefix, qos_in=qos_in,
+                                           qos_out=qos_out)
+    spdp = p.announce()[0][2]
+    sedp = _Message(p.guid_prefix)
+    _dst(sedp)
+    for writer, reader, what in ((PUB_WRITER, PUB_READER, "publications"),
+                                 (SUB_WRITER, SUB_READER, "subscriptions")):
+        ep = p.local[writer]
+        for seq, payload in ep.history.items():
+            sedp.add(b.data(reader, writer, seq, b.pad_payload(payload)))
+        _heartbeat(sedp, reader, writer, ep.seq, what)
+    for count, (reader, writer, what) in enumerate(((PUB_READER, PUB_WRITER, "publications"),
+                                                    (SUB_READER, SUB_WRITER, "subscriptions")),
+                                                   1):
+        sedp.add(b.acknack(reader, writer, 1, [], count),
+                 (f"acknack_base_{what}", 4 + 8, 8, f"the preemptive ACKNACK's base to the "
+                  f"peer's {what} writer: 1, or 0 for Fast DDS (vendor 0x010F), which answers "
+                  f"only that form at once (as spdp._on_spdp picks)"))
+    graph = _Message(p.guid_prefix)
+    _dst(graph)
+    graph.add(b.info_ts(0.0), ("info_ts", 4, 8, "the source time (0: none, as the SPDP's)"))
+    graph.add(b.data(0, node.graph_writer, 1, b.pad_payload(node.entities_info())))
+    _heartbeat(graph, 0, node.graph_writer, 1, "ros_discovery_info")
+    messages = (RomMessage("spdp", spdp, DEST_SPDP),
+                RomMessage("sedp", bytes(sedp.data), DEST_META, tuple(sedp.patches)),
+                RomMessage("graph", bytes(graph.data), DEST_USER, tuple(graph.patches)))
+    for m in messages:
+        if len(m.data) > MAX_MESSAGE_BYTES:
+            raise RtlError(f"discovery message {m.name} of {len(m.data)} bytes: more than one "
+                           f"datagram ({MAX_MESSAGE_BYTES})")
+    rom = DiscoveryRom(messages, p.guid_prefix, domain, index, address,
+                       {"ros_discovery_info": node.graph_writer, "writer": wid, "reader": rid})
+    if len(rom.image()) > MAX_DISC_ROM_BYTES:
+        raise RtlError(f"discovery ROM of {len(rom.image())} bytes: the table addresses "
+                       f"{MAX_DISC_ROM_BYTES}")
+    return rom
+
+
+def readmemh(data: bytes) -> str:
+    """Bytes as a ``$readmemh`` file: one byte (two hex digits) a line."""
+    return "".join(f"{x:02x}\n" for x in data)
+
+
+def table_readmemh(rom: DiscoveryRom) -> str:
+    """The message table: one entry a line, {dest[7:0], offset[15:0], length[15:0]}."""
+    return "".join(f"{m.dest:02x}{off:04x}{len(m.data):04x}\n"
+                   for m, off in zip(rom.messages, rom.offsets()))
+
+
+def write_rom(rom: DiscoveryRom, out_dir: str | Path) -> list[Path]:
+    """Write the ROM files into ``out_dir``; returns their paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    files = {ROM_FILE: readmemh(rom.image()), TABLE_FILE: table_readmemh(rom),
+             INDEX_FILE: json.dumps(rom.index_json(), indent=1) + "\n"}
+    for m in rom.messages:
+        files[f"rfl_rtps_disc_{m.name}.hex"] = readmemh(m.data)
+    paths = []
+    for name, text in files.items():
+        (out / name).write_text(text)
+        paths.append(out / name)
+    return paths
