@@ -38,7 +38,7 @@ from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 #: The network side of the node in the fabric (issue #31): modules proven here, not in a project.
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
-FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v")
+FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v")
 ENV_INCLUDE = "fv_env.vh"
 
 
@@ -166,6 +166,13 @@ PROOFS: tuple[Proof, ...] = (
     Proof("rtps_disc_rom", ("rfl_rtps_disc_rom.v",), "prove", 8,
           "rfl_rtps_disc_rom (16-byte ROM, 4 messages, any contents, any requests): output "
           "stream rules, TDEST constant and no gap inside a datagram; all reachable states"),
+    Proof("rtps_to_cdr", ("rfl_rtps_to_cdr.v",), "prove", 4,
+          "rfl_rtps_to_cdr (4-byte buffer, any input packets): output stream rules, no input "
+          "taken while a record goes out; all reachable states", ("FV_PROVE",)),
+    Proof("rtps_to_cdr", ("rfl_rtps_to_cdr.v",), "bmc", 16,
+          "rfl_rtps_to_cdr (4-byte buffer, any input packets): a record only for a packet "
+          "without TUSER that fitted, its length (LE32) that packet's byte count, its body that "
+          "packet's bytes in order; 16 clocks (a 4-byte packet's whole record)"),
 )
 
 
