@@ -82,7 +82,7 @@ def test_the_rules_cover_every_module_file_in_scope() -> None:
     names = {p.name for p in MODULE_FILES}
     assert {"rfl_fifo.v", "rfl_fifo2axi.v", "rfl_axi2fifo.v", "rfl_slice.v", "rfl_subscriber.v",
             "rfl_publisher.v", "rfl_top.v", "rfl_morph.v", "rfl_harness.v", "rfl_tb.v",
-            "rfl_rtps_disc_rom.v"} <= names
+            "rfl_rtps_disc_rom.v", "rfl_rtps_rx.v", "rfl_rtps_to_cdr.v"} <= names
 
 
 @pytest.mark.parametrize("path", MODULE_FILES, ids=[p.name for p in MODULE_FILES])
@@ -146,6 +146,8 @@ CONTRACTS = [
     ("rfl_rtps_disc_rom", {"MESSAGES": 0}, "rfl_rtps_disc_rom: MESSAGES must be 1..256"),
     ("rfl_rtps_disc_rom", {"PERIOD": 0}, "rfl_rtps_disc_rom: PERIOD must be at least 1"),
     ("rfl_rtps_disc_rom", {"DEST_BITS": 9}, "rfl_rtps_disc_rom: DEST_BITS must be 1..8"),
+    ("rfl_rtps_to_cdr", {"MAX_BYTES": 3}, "rfl_rtps_to_cdr: MAX_BYTES must be 4..2**24"),
+    ("rfl_rtps_to_cdr", {"COUNT_BITS": 33}, "rfl_rtps_to_cdr: COUNT_BITS must be 1..32"),
 ]
 # Icarus cannot elaborate these at all (a part select [-1:0] before the check runs): refused,
 # though with its own message

@@ -172,3 +172,32 @@ def test_disc_rom_is_clean_under_three_linters(name: str, tmp_path: Path) -> Non
     done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]
+
+
+# the fabric's seam to a generated CDR circuit (rtl/fabric/rfl_rtps_to_cdr.v): its buffer and
+# counter widths follow the parameters (a power of two, another size, the smallest)
+@pytest.mark.parametrize("max_bytes,count_bits", [(4, 1), (2048, 32), (3000, 16)])
+def test_rtps_to_cdr_is_clean_under_three_linters(max_bytes: int, count_bits: int,
+                                                  tmp_path: Path) -> None:
+    from rosfpga_lab.rtl.sim import VERILOG_DIR
+    from rosfpga_lab.rtl.synth import yosys_command
+
+    source = str(Path(VERILOG_DIR).parent / "fabric" / "rfl_rtps_to_cdr.v")
+    top = "rfl_rtps_to_cdr"
+    params = {"MAX_BYTES": max_bytes, "COUNT_BITS": count_bits}
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall",
+                           *(f"-G{k}={v}" for k, v in params.items()), source], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
+    require_yosys()
+    sets = " ".join(f"-set {k} {v}" for k, v in params.items())
+    (tmp_path / "check.ys").write_text(
+        f"read_verilog -defer {source}\nchparam {sets} {top}\nhierarchy -check -top {top}\nproc\n"
+        "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
+    done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]

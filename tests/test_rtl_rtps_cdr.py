@@ -33,7 +33,8 @@ from rosfpga_lab.hls.generic import model_output_cdr
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.msg.cdr import serialize_cdr
 from rosfpga_lab.rtps import build as b
-from rtltools import TB_DIR, require_cocotb
+from rosfpga_lab.rtl.proofs import PROOFS, prove
+from rtltools import TB_DIR, require_cocotb, require_formal
 from test_generic_project_cdr import statuses_of
 from test_rtl_rtps_rx import LOCAL, OTHER_READER, READER, REMOTES, WRITER, reference
 
@@ -174,3 +175,17 @@ def test_rtps_datagrams_through_the_seam_publish_the_models_records(
         total, failed = 1, 1
     log = (tmp_path / "sim.log").read_text(errors="replace")
     assert total == 1 and failed == 0, log[-4000:]
+
+
+def test_a_seam_that_forwards_a_dropped_sample_fails_its_proof(tmp_path: Path) -> None:
+    """The bounded proof (tests/test_rtl_formal.py runs it) sees a record go out for a packet
+    that ended with TUSER once the seam forgets to look at it; the stream rules still hold."""
+    require_formal()
+    good = (FABRIC / "rfl_rtps_to_cdr.v").read_text()
+    check = "                        if (s_axis_tuser) begin\n"
+    assert good.count(check) == 1
+    buggy = tmp_path / "rfl_rtps_to_cdr.v"
+    buggy.write_text(good.replace(check, check.replace("s_axis_tuser", "1'b0")))
+    by_mode = {p.mode: p for p in PROOFS if p.name == "rtps_to_cdr"}
+    assert prove(by_mode["bmc"], replace={"rfl_rtps_to_cdr.v": buggy}).status == "FAIL"
+    assert prove(by_mode["prove"], replace={"rfl_rtps_to_cdr.v": buggy}).passed
