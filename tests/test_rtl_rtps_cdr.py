@@ -52,7 +52,8 @@ def scan(ranges: np.ndarray, intensities: int, frame_id: str, range_max: float =
         "header": {"stamp": {"sec": 12, "nanosec": 34}, "frame_id": frame_id},
         "angle_min": -1.5, "angle_max": 1.5, "angle_increment": 0.01, "time_increment": 0.0,
         "scan_time": 0.1, "range_min": 0.05, "range_max": range_max,
-        "ranges": [float(r) for r in ranges], "intensities": [float(k) for k in range(intensities)]})
+        "ranges": [float(r) for r in ranges],
+        "intensities": [float(k) for k in range(intensities)]})
 
 
 def frags(seq: int, sample: bytes, fsize: int, numbers: list[int], per: int = 2) -> list[bytes]:
