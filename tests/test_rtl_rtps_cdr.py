@@ -5,7 +5,8 @@ input gaps and output backpressure (tests/rtl/rtps_cdr_top.v, tests/rtl/rtps_cdr
 
 The datagrams are the lab's RTPS builders' (``rtps.build``: DATA, DATA_FRAG, INFO_TS, a DATA for
 another reader) around sensor_msgs/LaserScan samples the lab's CDR writer serialized
-(``msg.cdr``): whole samples, fragmented ones, one with a fragment missing (dropped by the
+(``msg.cdr``): whole samples, fragmented ones (one with end padding its encapsulation options
+declare, which the subscriber skips), one with a fragment missing (dropped by the
 walker, so the seam must discard it) followed by a good one, one the subscriber refuses
 (range_max over its bound), one longer than the seam's buffer (refused and counted) and a good
 one after each. Expected: the lab's decoder picks the samples the walker sends whole
@@ -72,7 +73,8 @@ def frags(seq: int, sample: bytes, fsize: int, numbers: list[int], per: int = 2)
 
 
 def case_of(seed: int) -> tuple[list[bytes], bytes, list[bytes]]:
-    """The datagrams, the numpy oracle of the good samples' output, and the scans sent."""
+    """The datagrams, the numpy oracle of the good samples' output, and the payloads the
+    walker must send whole, in order."""
     rng = np.random.default_rng(seed)
     specials = np.array([0.0, -0.0, np.inf, -np.inf, np.nan, 1.0, 2.5], np.float32)
     ranges = [rng.standard_normal(360).astype(np.float32) for _ in range(4)]
@@ -86,6 +88,7 @@ def case_of(seed: int) -> tuple[list[bytes], bytes, list[bytes]]:
     assert len(too_long) > MAX_BYTES >= max(len(s) for s in good.values())
     hdr = b.header(REMOTES[0])
     s1, s2, s4 = b.pad_payload(good[1]), good[2], good[4]
+    s9 = _padded(good[9], 3)            # end padding the options declare (sampleSize includes it)
     f2 = frags(2, s2, 512, [1, 2, 3, 4])
     datagrams = [
         hdr + b.info_ts(1.5e9) + b.data(READER, WRITER, 1, s1),
@@ -96,11 +99,11 @@ def case_of(seed: int) -> tuple[list[bytes], bytes, list[bytes]]:
         hdr + b.data(READER, WRITER, 5, refused),
         hdr + b.data(READER, WRITER, 6, too_long),
         hdr + b.data(OTHER_READER, WRITER, 7, lost) + b.data(0, WRITER, 7, good[7]),
-        hdr + b"".join(frags(9, good[9], 700, [1, 2, 3], per=3)),
+        hdr + b"".join(frags(9, s9, 700, [1, 2, 3], per=3)),
     ]
     oracle = b"".join(_record(_eroded(good[k], r)) for k, r in
                       zip(sorted(good), [ranges[0], ranges[1], ranges[4], ranges[2], ranges[3]]))
-    return datagrams, oracle, [s1, s2, s4, refused, too_long, good[7], good[9]]
+    return datagrams, oracle, [s1, s2, s4, refused, too_long, good[7], s9]
 
 
 def _eroded(sample: bytes, ranges: np.ndarray) -> bytes:
@@ -110,6 +113,14 @@ def _eroded(sample: bytes, ranges: np.ndarray) -> bytes:
     assert at > 0 and sample.find(raw, at + 5) < 0
     eroded = window_oracle(raw, "<f4", 5, "erode")
     return sample[:at + 4] + eroded + sample[at + 4 + len(raw):]
+
+
+def _padded(payload: bytes, pad: int) -> bytes:
+    """The payload with ``pad`` zeros at its end, declared in the encapsulation options' low
+    bits (``rtps.build.unpad_payload`` takes them off)."""
+    out = payload[:3] + bytes([payload[3] | pad]) + payload[4:] + bytes(pad)
+    assert b.unpad_payload(out) == payload
+    return out
 
 
 def _record(payload: bytes) -> bytes:
