@@ -247,7 +247,7 @@ void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_out)
     HLS_PRAGMA(HLS INTERFACE ap_vld port = status)
     HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one frame per call
-    HLS_PRAGMA(HLS HLS aggregate variable = meta_out)
+    HLS_PRAGMA(HLS aggregate variable = meta_out)
     // The walk and its constants are ROMs read every clock (a range check reads both bounds at
     // once): constants in logic, so no block-RAM port limits the loop's II.
     HLS_PRAGMA(HLS ARRAY_PARTITION variable = PROGRAM complete)

@@ -6,7 +6,9 @@
 //             message: the CDR encapsulation header and body), one after the other.
 //   OUTDIR    receives output.bin (the bytes the publisher wrote: CDR samples for
 //             /scan_min), status.txt (per input frame: its byte offset and the subscriber's
-//             status) and subscriber_header.bin, publisher_header.bin (the connection headers).
+//             status), input_beats.txt and output_beats.txt (the AXI4-Stream beats into and out
+//             of the application, one "TDATA TKEEP TUSER TLAST" line each in hexadecimal) and
+//             subscriber_header.bin, publisher_header.bin (the connection headers).
 //   EXPECTED  optional: bytes output.bin must equal (the exit status says whether it does).
 #include <cstdio>
 #include <fstream>
@@ -16,6 +18,9 @@
 #include <vector>
 
 #include "ros_node.h"
+
+extern std::FILE* csim_beats_in;   // ros_fpga_node.cpp's taps
+extern std::FILE* csim_beats_out;
 
 static const char* status_name(int status) {
     switch (status) {
@@ -63,7 +68,9 @@ int main(int argc, char** argv) {
     publisher_connection_header(header);
     ok = write_file(outdir + "/publisher_header.bin", drain(header)) && ok;
     std::FILE* status_log = std::fopen((outdir + "/status.txt").c_str(), "w");
-    if (!ok || !status_log) {
+    csim_beats_in = std::fopen((outdir + "/input_beats.txt").c_str(), "w");
+    csim_beats_out = std::fopen((outdir + "/output_beats.txt").c_str(), "w");
+    if (!ok || !status_log || !csim_beats_in || !csim_beats_out) {
         std::cerr << "cannot write into " << outdir << "\n";
         return 2;
     }
@@ -94,6 +101,9 @@ int main(int argc, char** argv) {
         offset += size;
     }
     std::fclose(status_log);
+    std::fclose(csim_beats_in);
+    std::fclose(csim_beats_out);
+    csim_beats_in = csim_beats_out = 0;
     ok = write_file(outdir + "/output.bin", output);
     std::cout << "csim: " << frames << " frame(s) in, " << refused << " refused, " << output.size()
               << " bytes out -> " << outdir << "/output.bin\n";
