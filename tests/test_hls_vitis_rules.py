@@ -164,7 +164,7 @@ def check_rules(texts: dict[str, str], flavour: str) -> None:
     else:
         assert "-flow_target" not in tcl and "config_interface" not in tcl and "vitis" not in tcl
         assert "open_solution -reset solution1\n" in tcl
-    assert f"HLS_PRAGMA(HLS {HLS_TOOLS[flavour].pack} variable = meta_out)" in texts["subscriber.cpp"]
+    assert f"HLS_PRAGMA({HLS_TOOLS[flavour].pack} variable = meta_out)" in texts["subscriber.cpp"]
     # the cores' stream types chain: each one's data output is the next one's input
     for a, b in zip(CHAIN, CHAIN[1:]):
         out_type = next(t for t, n in params[a] if n in ("out", "stream_out"))
