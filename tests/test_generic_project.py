@@ -341,13 +341,16 @@ def test_the_generic_circuit_given_the_image_layout_publishes_as_the_image_proje
     assert simulate(project, frames) == (expected, expected)
 
 
-def test_a_vivado_flavour_is_refused_for_a_generic_project(tmp_path: Path) -> None:
-    """The generic project is Vitis HLS C++ only; hls.flavour: vivado was once ignored quietly."""
+def test_a_vivado_flavour_of_a_generic_project(tmp_path: Path) -> None:
+    """hls.flavour: vivado (once refused for a generic project, before that ignored quietly)
+    writes Vivado HLS's script and packing directive into the same project."""
     from rosfpga_lab.config import parse_config
-    from rosfpga_lab.hls import GenerateError
 
     text = (DATA / "fpga_samples_dilate.yaml").read_text(encoding="utf-8")
     vivado = parse_config(text + "\nhls: {flavour: vivado}\n", base_dir=DATA)
-    with pytest.raises(GenerateError, match="hls.flavour: vivado .* written for vitis only"):
-        generate_project(vivado, tmp_path / "out")
-    assert not (tmp_path / "out").exists()
+    generate_project(vivado, tmp_path / "out")
+    out = tmp_path / "out"
+    assert "vivado_hls -f run_hls.tcl" in (out / "run_hls.tcl").read_text()
+    assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_out)" in (out / "subscriber.cpp").read_text()
+    assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_in)" in (out / "publisher.cpp").read_text()
+    assert "This project is the `vivado` flavour" in (out / "README.md").read_text()
