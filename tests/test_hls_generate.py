@@ -103,11 +103,14 @@ FRAMES_GOLDEN = "tb_frames.sha256"
 
 def _library_copies() -> dict[str, Path]:
     """Files a generic project copies from the library unchanged: project path -> source."""
-    from rosfpga_lab.hls.generator import HLS_HEADERS, INCLUDE_DIR
+    from rosfpga_lab.hls.csim import HLS_HEADERS, INCLUDE_DIR
+    from rosfpga_lab.hls.rtlbuild import HARNESS_FILES
     from rosfpga_lab.rtl.generic import GENERIC_MODULES, GENERIC_VERILOG_DIR, VIDEO_APP
     from rosfpga_lab.rtl.sim import VERILOG_DIR
+    from rosfpga_lab.rtl.tools import HARNESS_DIR
 
     copies = {f"hls_include/{h}": INCLUDE_DIR / h for h in HLS_HEADERS}
+    copies.update({f"rtl/{h}": HARNESS_DIR / h for h in HARNESS_FILES})
     copies.update({f"rtl/{m}": GENERIC_VERILOG_DIR / m for m in GENERIC_MODULES})
     copies.update({f"rtl/{m}": VERILOG_DIR / m for m in ("rfl_fifo.v", VIDEO_APP)})
     return copies
@@ -278,7 +281,7 @@ def test_cli_generate_and_sloc(tmp_path: Path) -> None:
            "-o", str(out)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
-    assert "rendering templates" in proc.stderr and "writing 28 files" in proc.stderr  # 16 HLS + 12 RTL (rtl/: the walkers, the walk, the 2-D application)
+    assert "rendering templates" in proc.stderr and "writing 30 files" in proc.stderr  # 16 HLS + 14 RTL (rtl/: the walkers, the walk, the 2-D application, the fast harness)
     assert f"make -C {out} csim" in proc.stdout
     again = subprocess.run(cmd, capture_output=True, text=True)
     assert again.returncode == 1 and "--force" in again.stderr
@@ -286,7 +289,7 @@ def test_cli_generate_and_sloc(tmp_path: Path) -> None:
     assert forced.returncode == 0 and forced.stdout == "" and forced.stderr == ""
     loud = subprocess.run(cmd + ["--force"], capture_output=True, text=True)
     assert loud.returncode == 0
-    assert loud.stderr.index("removed 29 files") < loud.stderr.index("writing 28 files")
+    assert loud.stderr.index("removed 31 files") < loud.stderr.index("writing 30 files")
     unwritable = subprocess.run(cmd[:-1] + [str(out / "Makefile" / "below")], capture_output=True,
                                 text=True)
     assert unwritable.returncode == 1 and "Traceback" not in unwritable.stderr

@@ -27,6 +27,10 @@ CXXFLAGS = ("-std=c++14", "-Wall", "-Werror", "-O2")
 SOURCES = ("subscriber.cpp", "publisher.cpp", "stream_filter.cpp", "ros_fpga_node.cpp",
            "connection_headers.cpp", "csim_testbench.cpp")
 BINARY = "csim_testbench"
+#: The lab's g++ stand-ins for Xilinx's headers (``include/``), copied to a project's
+#: ``hls_include/`` (both flavours).
+INCLUDE_DIR = Path(__file__).resolve().parent / "include"
+HLS_HEADERS = ("ap_int.h", "ap_axi_sdata.h", "hls_stream.h")
 #: The test frames a generated project ships and what the Python models publish for them.
 TB_INPUT = "tb_input.bin"
 TB_EXPECTED = "tb_expected.bin"

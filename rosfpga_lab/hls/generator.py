@@ -25,14 +25,11 @@ from pathlib import Path
 from rosfpga_lab import __version__
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hls import rtlbuild
-from rosfpga_lab.hls.csim import BINARY, TB_EXPECTED, TB_INPUT
+from rosfpga_lab.hls.csim import BINARY, HLS_HEADERS, INCLUDE_DIR, TB_EXPECTED, TB_INPUT
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.generic import render
 from rosfpga_lab.hls.vectors import sample_frames
 
-INCLUDE_DIR = Path(__file__).resolve().parent / "include"
-#: The lab's g++ stand-ins for Xilinx's headers, copied to ``hls_include/`` (both flavours).
-HLS_HEADERS = ("ap_int.h", "ap_axi_sdata.h", "hls_stream.h")
 MANIFEST = ".rosfpga-lab-manifest.json"
 #: What ``make csim``, ``make rtlsim`` and ``vitis_hls``/``vivado_hls -f run_hls.tcl`` leave
 #: behind; --force removes these too.

@@ -30,7 +30,8 @@ import numpy as np
 from rosfpga_lab import __version__
 from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.config.vocabulary import CDR_WIRE, DEFAULT_HLS_FLAVOUR, TCPROS_WIRE
-from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, SOURCES, TB_EXPECTED, TB_INPUT
+from rosfpga_lab.hls import rtlbuild
+from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, HLS_HEADERS, SOURCES, TB_EXPECTED, TB_INPUT
 from rosfpga_lab.hls.compiler import program_from_cdr, program_from_layout
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.program import ALIGN_ORIGIN, ENCAP_PAD_MASK, MAX_LOOP_DEPTH, Op, Program, Pub, Sub
@@ -331,7 +332,8 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "meta_fields": meta_fields(prog), "meta_bits": sum(f[1] for f in meta_fields(prog)),
         "carry_count_bits": meta_fields(prog)[1][1],
         "flavour": spec.flavour, "tool": HLS_TOOLS[spec.flavour],
-        "flavours": list(HLS_TOOLS.items()),
+        "flavours": list(HLS_TOOLS.items()), "hls_headers": HLS_HEADERS,
+        "harness": rtlbuild.makefile_context(),
         "cores": ("subscriber", "fifo2axi", "stream_filter", "axi2fifo", "publisher"),
         "fifo": {"input_depth": spec.input_depth, "output_depth": spec.output_depth},
         "axis_depth": spec.axis_depth, "part": spec.part, "clock_mhz": f"{spec.clock_mhz:g}",

@@ -61,7 +61,8 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
     spec = spec_from_config(config)
     say(f"rendering the walk of {spec.program.type_in}: {len(spec.program.instrs)} instructions")
     texts = render_generic(spec)
-    rtl = {f"{RTL_DIR}/{k}": v for k, v in generic_rtl_files(spec).items()}
+    # the generated Verilog and the lab's fast harness around it (make rtlsim on Verilator)
+    rtl = {f"{RTL_DIR}/{k}": v for k, v in source_files(spec).items()} if spec.op != CUSTOM else {}
     say("computing the test frames and the Python models' output")
     return generate(config, out_dir, force=force, progress=progress, extra_files=rtl,
                     texts=texts, frames=sample_frames(config))
