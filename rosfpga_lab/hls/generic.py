@@ -114,7 +114,7 @@ KIND_NOTES = {
 
 @dataclass(frozen=True)
 class GenericSpec:
-    """Everything a generic project is rendered from.
+    """Everything a project is rendered from (any message type, either wire).
 
     Attributes:
         program: the walk (one instruction per field).
@@ -131,7 +131,7 @@ class GenericSpec:
         video: the stream's video shape, or ``None``: with one, the streamed bytes go to the
             application as pixels of ``bytes_per_pixel`` bytes (TUSER on the first, TLAST ending
             each line of ``width``) and the application is the 2-D window over ``height``
-            lines (the video project's ``video_filter.cpp.j2``, ``rfl_morph.v``).
+            lines (``video_filter.cpp.j2``, ``rfl_morph.v``).
         flavour: ``hls.flavour``, the HLS tool ``run_hls.tcl`` and the directives are for.
     """
 
