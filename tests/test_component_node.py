@@ -432,7 +432,7 @@ def test_started_from_the_generator_config_file(master) -> None:
 
 def test_custom_application_cannot_be_emulated(tmp_path) -> None:
     src = tmp_path / "f.cpp"
-    src.write_text("void image_filter() {}\n")
+    src.write_text("void stream_filter() {}\n")
     cfg = parse_config(CONFIG.format(w=8, h=8, enc="mono8", op="custom", k=3).replace(
         "ksize: 3}", f"ksize: 3, source: {src}}}"), base_dir=tmp_path)
     with pytest.raises(ComponentConfigError, match="custom"):

@@ -145,7 +145,7 @@ def test_rtl_sim_of_generated_tops_is_exact_and_fails_on_a_wrong_byte(
     """``rosfpga-lab rtl sim CONFIG`` runs the generated top on generate's test frames (TCPROS
     frames or CDR records) and compares with the models; a byte off is a FAIL naming it."""
     from rosfpga_lab.cli import main
-    from rosfpga_lab.rtl.project import test_frames
+    from rosfpga_lab.hls import sample_frames
 
     sim = require_rtl("iverilog")
     for name in ("fpga_laserscan_min", "fpga_samples_dilate_cdr"):
@@ -155,7 +155,7 @@ def test_rtl_sim_of_generated_tops_is_exact_and_fails_on_a_wrong_byte(
         assert "PASS: the output equals the Python models' output" in out, out
         assert out.count(": SUB_OK") == 2 and "clocks" in out, out
     assert "frame at byte 386: SUB_BAD_ENCAPSULATION" in out      # the walk's own status names
-    frames, expected = test_frames(load_config(SCAN))
+    frames, expected = sample_frames(load_config(SCAN))
     wrong = bytearray(expected)
     wrong[100] ^= 1
     (tmp_path / "wrong.bin").write_bytes(bytes(wrong))
@@ -183,13 +183,14 @@ def test_rtl_demo_runs_a_generated_top_with_its_waveform(tmp_path) -> None:
     three test frames through the generated top with gaps and backpressure, the output the
     models', the refused one by the walk's name, and a readable dump of the streams."""
     from rosfpga_lab.rtl.demo import run_demo
-    from rosfpga_lab.rtl.project import model_output, test_frames
+    from rosfpga_lab.rtl.project import model_output
+    from rosfpga_lab.hls import sample_frames
     from rosfpga_lab.rtl.vcd import read_vcd
 
     sim = require_rtl("iverilog")
     config = load_config(DATA / "fpga_samples_dilate.yaml")
     result = run_demo(tmp_path / "demo.vcd", simulator=sim, config=config)
-    assert result.output == model_output(config, test_frames(config)[0])
+    assert result.output == model_output(config, sample_frames(config)[0])
     assert [name for _, name in result.status] == ["SUB_OK", "SUB_BAD_SAMPLES_LENGTH", "SUB_OK"]
     wave = read_vcd(tmp_path / "demo.vcd", clock="clk", signals=["m_tvalid", "m_tready"])
     handshakes = int(np.sum(wave.values("m_tvalid") & wave.values("m_tready")))

@@ -18,7 +18,7 @@ MARKER = "# long:"
 EXCEPTIONS = {
     "hls/program.py:subscribe": "being rewritten with the generic walkers' cycle model (issue 29)",
     "hls/program.py:publish": "being rewritten with the generic walkers' cycle model (issue 29)",
-    "hls/generic.py:program_from_layout": "being rewritten with the generic walkers (issue 29)",
+    "hls/compiler.py:program_from_layout": "being rewritten with the generic walkers (issue 29)",
 }
 
 

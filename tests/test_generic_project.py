@@ -27,7 +27,8 @@ from generictools import (
 from realros import require_cxx
 from rtltools import require_iverilog
 from rosfpga_lab.config import load_config
-from rosfpga_lab.hls.generic import model_output, sample_tokens, spec_from_layout
+from rosfpga_lab.hls.vectors import model_output, sample_tokens
+from rosfpga_lab.hls.generic import spec_from_layout
 from rosfpga_lab.hls.program import run_program
 from rosfpga_lab.hw.layout import (
     Action, StepKind, derive_layout, frame_geometry, layout_from_config, marshal,
@@ -308,7 +309,7 @@ def test_the_generic_circuit_given_the_image_layout_publishes_as_the_image_proje
     simulation publish what the Image project's Python models publish, frame for frame,
     including a frame of the wrong width refused between good ones."""
     from rosfpga_lab.config import parse_config
-    from rosfpga_lab.hls.generic import program_from_layout
+    from rosfpga_lab.hls.compiler import program_from_layout
     from rosfpga_lab.hw import Pipeline
     from rosfpga_lab.hw.errors import PipelineError
     from rosfpga_lab.hw.pipeline import image_frame
@@ -320,7 +321,7 @@ def test_the_generic_circuit_given_the_image_layout_publishes_as_the_image_proje
     config = parse_config(text)
     reg = config.registry()
     layout = layout_from_config(config, reg)
-    prog = program_from_layout(layout, count="header.seq", video_as_bytes=True)
+    prog = program_from_layout(layout, count="header.seq")
     spec = spec_from_layout(layout, reg, op="passthrough", ksize=1, program=prog)
     project = write(project_files(spec), tmp_path)
     rng = np.random.default_rng(11)
@@ -340,13 +341,16 @@ def test_the_generic_circuit_given_the_image_layout_publishes_as_the_image_proje
     assert simulate(project, frames) == (expected, expected)
 
 
-def test_a_vivado_flavour_is_refused_for_a_generic_project(tmp_path: Path) -> None:
-    """The generic project is Vitis HLS C++ only; hls.flavour: vivado was once ignored quietly."""
+def test_a_vivado_flavour_of_a_generic_project(tmp_path: Path) -> None:
+    """hls.flavour: vivado (once refused for a generic project, before that ignored quietly)
+    writes Vivado HLS's script and packing directive into the same project."""
     from rosfpga_lab.config import parse_config
-    from rosfpga_lab.hls import GenerateError
 
     text = (DATA / "fpga_samples_dilate.yaml").read_text(encoding="utf-8")
     vivado = parse_config(text + "\nhls: {flavour: vivado}\n", base_dir=DATA)
-    with pytest.raises(GenerateError, match="hls.flavour: vivado .* written for vitis only"):
-        generate_project(vivado, tmp_path / "out")
-    assert not (tmp_path / "out").exists()
+    generate_project(vivado, tmp_path / "out")
+    out = tmp_path / "out"
+    assert "vivado_hls -f run_hls.tcl" in (out / "run_hls.tcl").read_text()
+    assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_out)" in (out / "subscriber.cpp").read_text()
+    assert "HLS_PRAGMA(HLS DATA_PACK variable = meta_in)" in (out / "publisher.cpp").read_text()
+    assert "This project is the `vivado` flavour" in (out / "README.md").read_text()

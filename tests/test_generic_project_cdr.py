@@ -30,7 +30,8 @@ from realros import require_cxx
 from rtltools import require_iverilog
 from wiretools import require_cyclonedds
 from rosfpga_lab.config import load_config
-from rosfpga_lab.hls.generic import model_output_cdr, program_from_cdr
+from rosfpga_lab.hls.vectors import model_output_cdr
+from rosfpga_lab.hls.compiler import program_from_cdr
 from rosfpga_lab.hls.program import run_program
 from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_layout_from_config, derive_cdr_layout
 from rosfpga_lab.hw.cdrwalker import extract_cdr_fast
@@ -412,7 +413,8 @@ def test_a_tcpros_frame_cut_short_in_a_count_is_refused_by_that_count_in_verilog
     the count): a LaserScan frame whose length ends inside ``intensities``' count."""
     require_cxx()
     require_iverilog()
-    from rosfpga_lab.hls.generic import model_output, sample_tokens, spec_from_config
+    from rosfpga_lab.hls.vectors import model_output, sample_tokens
+    from rosfpga_lab.hls.generic import spec_from_config
     from rosfpga_lab.hw.layout import layout_from_config, marshal
     from rosfpga_lab.rtl.generic import project_files
 

@@ -270,15 +270,29 @@ def test_generated_fifo2axi_frames_pixels_as_the_image_project(
     assert int(got[:, 3].sum()) == h                  # one TLAST per line
 
 
-def test_image_on_tcpros_keeps_its_own_project() -> None:
-    """The generic renderer still refuses a video stream on TCPROS (the hand-written Image
-    project is that one's); ``generate`` routes it there."""
-    from rosfpga_lab.hls.errors import GenerateError
+@pytest.mark.parametrize("name", list(SMALL))
+def test_image_on_tcpros_is_the_same_project(name: str, tmp_path: Path) -> None:
+    """Image on TCPROS goes through the same renderer (issue 28): its data framed as video, its
+    header.seq numbered by the publisher as the Image model (hw.Pipeline) numbers it; the
+    generated project's make csim and make rtlsim both publish exactly what the model publishes
+    for the shipped test frame."""
     from rosfpga_lab.hls.generic import spec_from_config
+    from rosfpga_lab.hls.program import Pub
+    from rosfpga_lab.rtl.project import generate_project
 
-    text = config_text("rgba8").replace("wire: cdr", "wire: tcpros")
-    with pytest.raises(GenerateError, match="streams video: on TCPROS"):
-        spec_from_config(parse_config(text))
+    require_cxx()
+    require_iverilog()
+    config = parse_config(config_text(name).replace("wire: cdr", "wire: tcpros"),
+                          source="small_tcpros.yaml")
+    spec = spec_from_config(config)
+    assert spec.video is not None and spec.wire == "tcpros"
+    assert [i.pub for i in spec.program.instrs if i.name == "header.seq"] == [Pub.COUNT]
+    generate_project(config, tmp_path / "proj")
+    for target, extra in (("csim", []), ("rtlsim", ["SIM=iverilog", "GAP=100", "BP=200"])):
+        proc = subprocess.run(["make", "-s", target, *extra], cwd=tmp_path / "proj",
+                              capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+        assert f"{target}: PASS: output equals tb_expected.bin" in proc.stdout
 
 
 @pytest.mark.parametrize("name", list(SMALL))
@@ -308,10 +322,11 @@ def test_make_synth_reports_every_module_of_the_video_project(projects: dict[str
     resources were left out of the rows and the total)."""
     import re
 
+    from rosfpga_lab.hls.rtlbuild import HARNESS_FILES
     from rosfpga_lab.rtl.synth import GENERIC_MODULES
 
     rtl = projects["rgba8"] / "rtl"
-    modules = {m for p in rtl.glob("*.v") if p.name != "rfl_tb.v"
+    modules = {m for p in rtl.glob("*.v") if p.name not in ("rfl_tb.v", *HARNESS_FILES)
                for m in re.findall(r"^\s*module\s+(\w+)", p.read_text(), re.M)}
     assert "rfl_morph" in modules
     assert modules - {"rfl_node"} <= {m for m, _row in GENERIC_MODULES}

@@ -34,9 +34,7 @@ from generictools import window_oracle
 from realros import require_cxx
 from rtltools import require_iverilog
 from rosfpga_lab.config import NodeConfig, parse_config
-from rosfpga_lab.hls.generic import (
-    model_output, model_output_cdr, sample_frames_generic, sample_records_cdr,
-)
+from rosfpga_lab.hls.vectors import model_output, model_output_cdr, sample_frames_generic, sample_records_cdr
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config, derive_cdr_layout
 from rosfpga_lab.hw.layout import Action, StepKind, derive_layout, layout_from_config
 from rosfpga_lab.msg import MsgRegistry, Time, Duration, deserialize, serialize

@@ -123,12 +123,12 @@ def _decode(frame: bytes) -> dict:
 @pytest.mark.parametrize("stem", CONFIGS)
 def test_csim_equals_python_models_and_opencv(projects: dict[str, Project], stem: str,
                                                flavour: str) -> None:
-    """Both flavours of the generated C++ (Vitis HLS's own line buffer, Vivado HLS's
-    hls_video.h), each with g++ alone, give the models' bytes and beats."""
+    """Both flavours of the generated C++ (the same application, its own line buffer; the
+    flavours differ in one directive), each with g++ alone, give the models' bytes and beats."""
     image, encoding = random_image(stem)
     frame = ros_frame(image, encoding)
     project = projects[stem if flavour == DEFAULT_HLS_FLAVOUR else f"{stem}:{flavour}"]
-    assert ("hls_video.h" in os.listdir(project.path / "hls_include")) == (flavour == "vivado")
+    assert "hls_video.h" not in os.listdir(project.path / "hls_include")
     got = project.run(frame)
     config = load_config(DATA / f"{stem}.yaml")
     model = Pipeline.from_config(config).process(frame)
@@ -208,7 +208,9 @@ def test_refused_frames_are_skipped_and_the_next_good_frame_comes_out_right(
     image, encoding = random_image(stem, seed=5)
     other, _ = random_image(stem, seed=6)
     # Frames whose strings fit the frame length but whose fixed fields after them do not: the
-    # circuit must refuse them without reading past the frame's end (into the next frame).
+    # circuit must refuse them without reading past the frame's end (into the next frame), at
+    # the first field that runs past it (the walk knows no fixed size after frame_id: the
+    # encoding and data that follow vary).
     stamp = struct.pack("<III", 1, 2, 3)
     fid_overrun = _frame(stamp + struct.pack("<I", 30) + b"f" * 30 + struct.pack("<I", 240) + b"\x40")
     enc_overrun = _frame(stamp + struct.pack("<I", 3) + b"cam" + struct.pack("<III", 240, 320, 5)
@@ -218,10 +220,10 @@ def test_refused_frames_are_skipped_and_the_next_good_frame_comes_out_right(
         ("wrong height", image_frame(image[:-1], encoding), "SUB_BAD_HEIGHT"),
         ("wrong encoding", image_frame(np.repeat(image, 3, axis=2), "rgb8"), "SUB_BAD_ENCODING"),
         ("good", ros_frame(image, encoding, seq=10), "SUB_OK"),
-        ("frame_id too long", image_frame(image, encoding, frame_id="f" * 300), "SUB_BAD_FRAME_ID_LENGTH"),
+        ("frame_id too long", image_frame(image, encoding, frame_id="f" * 300), "SUB_BAD_HEADER_FRAME_ID_LENGTH"),
         ("frame length too short", struct.pack("<I", 10) + bytes(10), "SUB_BAD_FRAME_LENGTH"),
-        ("frame ends after frame_id", fid_overrun, "SUB_BAD_FRAME_ID_LENGTH"),
-        ("frame ends after encoding", enc_overrun, "SUB_BAD_ENCODING_LENGTH"),
+        ("frame ends after frame_id", fid_overrun, "SUB_BAD_WIDTH"),
+        ("frame ends after encoding", enc_overrun, "SUB_BAD_STEP"),
         ("data length differs from step x height",
          _frame(image_frame(image, encoding)[4:-4 - image.size] + struct.pack("<I", image.size - 1)
                 + image.tobytes()[:-1]), "SUB_BAD_DATA_LENGTH"),
@@ -264,7 +266,7 @@ CUSTOM_FILTER = r"""
 // A user's application: invert every channel (the paper's input (c), written by hand).
 #include "ros_node.h"
 
-void image_filter(pixel_stream& in, pixel_stream& out) {
+void stream_filter(pixel_stream& in, pixel_stream& out) {
     for (int p = 0; p < IMG_HEIGHT * IMG_WIDTH; p++) {
         pixel_beat beat = in.read();
         beat.data = (~beat.data.to_uint()) & PIXEL_MASK;
@@ -283,7 +285,7 @@ def test_custom_application_file(tmp_path: Path) -> None:
     config = load_config(tmp_path / "node.yaml")
     result = generate(config, tmp_path / "proj")
     assert "tb_expected.bin" not in result.files
-    assert (tmp_path / "proj" / "image_filter.cpp").read_text() == CUSTOM_FILTER
+    assert (tmp_path / "proj" / "stream_filter.cpp").read_text() == CUSTOM_FILTER
     image, encoding = random_image("fpga_erode_mono8", seed=9)
     got = run_csim(tmp_path / "proj", image_frame(image, encoding, frame_id="x"))
     out = _decode(got.output)
@@ -293,7 +295,7 @@ def test_custom_application_file(tmp_path: Path) -> None:
 
 def test_build_failure_quotes_the_compiler(tmp_path: Path) -> None:
     require_cxx()
-    (tmp_path / "broken.cpp").write_text('#include "ros_node.h"\nvoid image_filter(pixel_stream& in) {}\n')
+    (tmp_path / "broken.cpp").write_text('#include "ros_node.h"\nvoid stream_filter(pixel_stream& in) {}\n')
     text = (DATA / "fpga_erode_mono8.yaml").read_text().replace(
         "  op: erode\n  ksize: 5\n", "  op: custom\n  source: broken.cpp\n")
     (tmp_path / "node.yaml").write_text(text)
@@ -365,7 +367,7 @@ def test_frame_id_max_is_the_same_limit_in_the_circuit_and_the_models(tmp_path: 
     image, encoding = random_image("fpga_passthrough_rgb8", seed=3)
     frames = [image_frame(image, encoding, frame_id="f" * n) for n in (15, 16, 17, 0)]
     got = run_csim(tmp_path / "proj", b"".join(frames))
-    assert [s for _, s in got.status] == ["SUB_OK", "SUB_OK", "SUB_BAD_FRAME_ID_LENGTH", "SUB_OK"]
+    assert [s for _, s in got.status] == ["SUB_OK", "SUB_OK", "SUB_BAD_HEADER_FRAME_ID_LENGTH", "SUB_OK"]
     pipe = Pipeline.from_config(config)
     expected = b""
     for n, frame in zip((15, 16, 17, 0), frames):

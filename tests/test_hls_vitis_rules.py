@@ -1,7 +1,7 @@
 """The generic HLS C++ keeps the rules a Xilinx flow (Vitis HLS 2020.2+, Vivado HLS) needs, read
 from the generated text, since no Xilinx tool runs here (issue 28 item 6).
 
-For the shipped generic examples (both wires, Image on CDR) and random message definitions:
+For the shipped examples (both wires, Image on TCPROS and CDR) and random message definitions:
 every core of the run script is a top function with an INTERFACE pragma per port and
 ``ap_ctrl_none``; every stream word is narrow (``hls::stream<T>``: T's bits from its declaration,
 struct members summed); no register array longer than a small bound (so none indexed by a
@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 
 from rosfpga_lab.config import load_config
 from rosfpga_lab.config.vocabulary import HLS_FLAVOURS
-from rosfpga_lab.hls.generator import HLS_TOOLS
+from rosfpga_lab.hls.generic import HLS_TOOLS
 from rosfpga_lab.hls.generic import meta_fields, render_generic, spec_from_config, spec_from_layout
 from rosfpga_lab.hw.errors import LayoutError
 from rosfpga_lab.hw.layout import Action, StepKind, derive_layout
@@ -31,7 +31,8 @@ from test_hw_walker import definitions  # the models' strategy over message defi
 
 DATA = Path(__file__).resolve().parent.parent / "data"
 CONFIGS = ("fpga_laserscan_min", "fpga_laserscan_min_cdr", "fpga_samples_dilate",
-           "fpga_samples_dilate_cdr", "fpga_dilate_rgba8_cdr")
+           "fpga_samples_dilate_cdr", "fpga_dilate_rgba8_cdr", "fpga_dilate_rgba8",
+           "fpga_erode_mono8", "fpga_passthrough_rgb8")
 #: "A few hundred bits": the widest FIFO word a core may pass.
 MAX_WORD_BITS = 256
 #: The longest register array (elements) a core may hold: the window, the loop stack.
@@ -163,7 +164,7 @@ def check_rules(texts: dict[str, str], flavour: str) -> None:
     else:
         assert "-flow_target" not in tcl and "config_interface" not in tcl and "vitis" not in tcl
         assert "open_solution -reset solution1\n" in tcl
-    assert f"HLS_PRAGMA(HLS {HLS_TOOLS[flavour].pack} variable = meta_out)" in texts["subscriber.cpp"]
+    assert f"HLS_PRAGMA({HLS_TOOLS[flavour].pack} variable = meta_out)" in texts["subscriber.cpp"]
     # the cores' stream types chain: each one's data output is the next one's input
     for a, b in zip(CHAIN, CHAIN[1:]):
         out_type = next(t for t, n in params[a] if n in ("out", "stream_out"))

@@ -75,7 +75,8 @@ def test_min_body_is_the_shortest_accepted_body(linescan) -> None:
 
 def test_the_generated_program_and_layout_h_say_the_same(linescan, tmp_path: Path) -> None:
     from rosfpga_lab.hls import program
-    from rosfpga_lab.hls.generic import program_from_layout, render_generic, spec_from_config
+    from rosfpga_lab.hls.compiler import program_from_layout
+    from rosfpga_lab.hls.generic import render_generic, spec_from_config
 
     config, layout, reg = linescan
     prog = program_from_layout(layout)

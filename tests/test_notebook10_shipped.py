@@ -15,7 +15,7 @@ import pytest
 from realros import require_cxx
 from rtltools import require_iverilog
 from rosfpga_lab.config import parse_config
-from rosfpga_lab.hls.generic import sample_frames_generic
+from rosfpga_lab.hls.vectors import sample_frames_generic
 from rosfpga_lab.hw.layout import layout_from_config
 
 DATA = Path(__file__).resolve().parent.parent / "data"

@@ -31,7 +31,8 @@ from hypothesis import strategies as st
 
 from realros import require_rtl
 from rtltools import require_iverilog
-from rosfpga_lab.hls.generic import program_from_cdr, spec_from_layout
+from rosfpga_lab.hls.compiler import program_from_cdr
+from rosfpga_lab.hls.generic import spec_from_layout
 from rosfpga_lab.hls.program import frame_clocks
 from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, image_frame
 from rosfpga_lab.hw.cdrlayout import derive_cdr_layout

@@ -30,7 +30,7 @@ import pytest
 
 from generictools import window_oracle
 from rosfpga_lab.config import load_config
-from rosfpga_lab.hls.generic import model_output_cdr
+from rosfpga_lab.hls.vectors import model_output_cdr
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.msg.cdr import serialize_cdr
 from rosfpga_lab.rtps import build as b

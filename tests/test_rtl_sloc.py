@@ -56,12 +56,12 @@ def test_table_has_both_columns() -> None:
 
 
 def test_cli_without_rtl_counts_the_lab_verilog(tmp_path: Path) -> None:
-    for name in ("subscriber.cpp", "publisher.cpp"):
+    for name in ("subscriber.cpp", "layout.h", "publisher.cpp"):
         (tmp_path / name).write_text("int x;\n// c\nint y;\n")
     done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "sloc", str(tmp_path)],
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     verilog = count_verilog()
     row = next(line.split() for line in done.stdout.splitlines() if line.startswith("total"))
-    assert row == ["total", "4", str(verilog.total), "127", "860"]
+    assert row == ["total", "6", str(verilog.total), "127", "860"]
     assert "the lab's rosfpga_lab/rtl/verilog" in done.stdout

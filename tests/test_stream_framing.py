@@ -73,8 +73,12 @@ def test_csim_rtl_and_models_agree_byte_for_byte(tmp_path: Path) -> None:
     if cxx_missing_reason() is None:
         generate(config, tmp_path / "hls")
         csim = run_csim(tmp_path / "hls", data)
-        assert csim.status == tuple(status)
+        # the long frame is refused as the generated walk's exact-fit rule says, at its frame
+        # length (the hand circuit names the data length)
+        walk_names = {"SUB_BAD_DATA_LENGTH": "SUB_BAD_FRAME_LENGTH"}
+        assert csim.status == tuple((o, walk_names.get(n, n)) for o, n in status)
         assert csim.output == expected.output
+        assert "cannot trust" in csim.log and "WARNING" not in csim.log
         # the beats were tapped for the three good frames only
         assert len(csim.input_beats) == 3 * 5 * 3
     assert np.frombuffer(expected.output, np.uint8).size > 0

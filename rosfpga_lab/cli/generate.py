@@ -19,9 +19,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "circuit's Verilog, written into DIR/rtl/) and an HLS Tcl script (vitis_hls -f "
         "run_hls.tcl; the paper's vivado_hls with 'hls: {flavour: vivado}' in CONFIG). "
         "Examples: data/fpga_dilate_rgba8.yaml, data/fpga_erode_mono8.yaml, "
-        "data/fpga_passthrough_rgb8.yaml (sensor_msgs/Image: the hand-written teaching project); "
-        "data/fpga_laserscan_min.yaml, data/fpga_samples_dilate.yaml (any other type: a project "
-        "rendered from the message's circuit layout, one instruction per field); "
+        "data/fpga_passthrough_rgb8.yaml (sensor_msgs/Image), data/fpga_laserscan_min.yaml, "
+        "data/fpga_samples_dilate.yaml (every type: a project rendered from the message's "
+        "circuit layout, one instruction per field); "
         "data/fpga_laserscan_min_cdr.yaml, data/fpga_samples_dilate_cdr.yaml, "
         "data/fpga_dilate_rgba8_cdr.yaml (wire: cdr: the same circuits on ROS 2's CDR samples; "
         "Image's pixels framed as video for its 2-D application).",

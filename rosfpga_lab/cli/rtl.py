@@ -269,7 +269,8 @@ def run_sim(args: argparse.Namespace) -> int:
     from rosfpga_lab.errors import LabError
     from rosfpga_lab.config import load_config
     from rosfpga_lab.rtl import RtlParams, build, run
-    from rosfpga_lab.rtl.project import model_output, test_frames
+    from rosfpga_lab.rtl.project import model_output
+    from rosfpga_lab.hls import sample_frames
     from rosfpga_lab.rtl.sim import design_from_config
 
     config = load_config(args.config)
@@ -281,7 +282,7 @@ def run_sim(args: argparse.Namespace) -> int:
             raise LabError(f"cannot read {args.input}: {exc.strerror}") from None
         expected = None
     else:
-        frames, expected = test_frames(config)
+        frames, expected = sample_frames(config)
     if args.expected is not None:
         try:
             expected = args.expected.read_bytes()
@@ -324,7 +325,7 @@ def run_cycles(args: argparse.Namespace) -> int:
     import dataclasses
 
     from rosfpga_lab.config import load_config
-    from rosfpga_lab.hls.generator import sample_image
+    from rosfpga_lab.hls import sample_image
     from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, image_frame
     from rosfpga_lab.rtl import build, rtl_params
     from rosfpga_lab.rtl.cycles import compare, format_rows

@@ -22,7 +22,7 @@ encoding, the application, FIFO depths and the clock. Example (every key but ``n
     application:
       op: dilate          # dilate | erode | passthrough | custom
       ksize: 3            # odd, 1..15 (dilate and erode)
-      source: null        # C++ file of image_filter(), relative to this file (op: custom)
+      source: null        # C++ file of stream_filter(), relative to this file (op: custom)
     fifo: {input_depth: 2048, output_depth: 2048, axis_depth: 16}
     clock_mhz: 100
     frame_id_max: 256     # longest header.frame_id the circuit keeps
@@ -140,7 +140,7 @@ class ApplicationConfig:
     Attributes:
         op: ``dilate`` | ``erode`` | ``passthrough`` | ``custom``.
         ksize: side of the square structuring element (dilate, erode).
-        source: for ``custom``, the C++ file defining ``image_filter()`` (absolute path).
+        source: for ``custom``, the C++ file defining ``stream_filter()`` (absolute path).
     """
 
     op: str = DEFAULT_OP

@@ -286,7 +286,7 @@ def application_section(ctx: Ctx, sec: Section, base_dir: Path) -> ApplicationCo
     source_path: Path | None = None
     if ap["op"] == CUSTOM:
         check(ctx, bool(ap["source"]), "op 'custom' needs 'source: FILE.cpp' (the C++ file "
-              "defining image_filter)", apn, "op", "application")
+              "defining stream_filter)", apn, "op", "application")
         source_path = (base_dir / ap["source"]).resolve()
         check(ctx, source_path.is_file(), f"application file not found: {source_path}",
               apn, "source", "application")

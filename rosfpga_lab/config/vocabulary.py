@@ -46,7 +46,7 @@ DEFAULT_ENCODING = "rgba8"
 #: ``passthrough`` in every layer (configuration, models, generator, oracle); the hardware models
 #: once called it ``copy``, a name :func:`canonical_op` still accepts.
 PASSTHROUGH = "passthrough"
-#: The user's own C++ ``image_filter()`` (no Python model, no OpenCV oracle).
+#: The user's own C++ ``stream_filter()`` (no Python model, no OpenCV oracle).
 CUSTOM = "custom"
 #: The operation a configuration without ``application.op`` gets (the paper's).
 DEFAULT_OP = "dilate"
@@ -80,9 +80,9 @@ DEFAULT_WIRE = TCPROS_WIRE
 #: The Verilog simulators the RTL flow runs (the first one found is the default).
 SIMULATORS = ("iverilog", "verilator")
 #: The HLS tool the generated C++ is written for (``hls.flavour`` of a node configuration):
-#: ``vitis`` (Vitis HLS 2020.2 on: its own line buffer, ``#pragma HLS aggregate``,
-#: ``ap_ctrl_none``, a ``vitis_hls`` script) or ``vivado`` (the paper's Vivado HLS up to 2019.2:
-#: ``hls_video.h``, ``DATA_PACK``, a ``vivado_hls`` script). Both run ``make csim`` with g++.
+#: ``vitis`` (Vitis HLS 2020.2 on: ``#pragma HLS aggregate``, a ``vitis_hls`` script) or
+#: ``vivado`` (the paper's Vivado HLS up to 2019.2: ``DATA_PACK``, a ``vivado_hls`` script); the
+#: same C++ otherwise. Both run ``make csim`` with g++.
 HLS_FLAVOURS = ("vitis", "vivado")
 #: The flavour a configuration without ``hls.flavour`` gets: the tool a course installs today.
 DEFAULT_HLS_FLAVOUR = "vitis"

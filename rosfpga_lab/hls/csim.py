@@ -24,9 +24,16 @@ from rosfpga_lab.hw import Beats
 
 #: The flags and sources of the generated Makefile (also used directly when make is missing).
 CXXFLAGS = ("-std=c++14", "-Wall", "-Werror", "-O2")
-SOURCES = ("subscriber.cpp", "publisher.cpp", "image_filter.cpp", "ros_fpga_node.cpp",
+SOURCES = ("subscriber.cpp", "publisher.cpp", "stream_filter.cpp", "ros_fpga_node.cpp",
            "connection_headers.cpp", "csim_testbench.cpp")
 BINARY = "csim_testbench"
+#: The lab's g++ stand-ins for Xilinx's headers (``include/``), copied to a project's
+#: ``hls_include/`` (both flavours).
+INCLUDE_DIR = Path(__file__).resolve().parent / "include"
+HLS_HEADERS = ("ap_int.h", "ap_axi_sdata.h", "hls_stream.h")
+#: The test frames a generated project ships and what the Python models publish for them.
+TB_INPUT = "tb_input.bin"
+TB_EXPECTED = "tb_expected.bin"
 
 
 @dataclass(frozen=True)
@@ -35,8 +42,8 @@ class CsimResult:
 
     Attributes:
         output: the bytes the publisher wrote (TCPROS frames).
-        input_beats: the beats fifo2axi produced (into image_filter), all frames.
-        output_beats: the beats image_filter produced, all frames.
+        input_beats: the beats fifo2axi produced (into the application), all frames.
+        output_beats: the beats the application produced, all frames.
         status: ``(byte offset, subscriber status)`` per input frame, e.g. ``(0, "SUB_OK")``.
         subscriber_header, publisher_header: the connection-header bytes.
         log: the testbench's standard output and error.

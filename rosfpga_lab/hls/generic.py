@@ -1,22 +1,26 @@
-"""The generator of Figure 4 for any message layout: HLS C++ rendered from a :class:`Program`.
+"""Render a node's HLS C++ project from its walk: every message type, both wires, both HLS tools.
 
-How this works: :func:`render_generic` renders the templates of ``templates/generic/`` (and the
-Image project's ``connection_headers.cpp.j2``, which knows no field) from one
-:class:`GenericSpec`: the node configuration's names, FIFO depths, part and clock, the walk
-(:class:`~rosfpga_lab.hls.program.Program`, one instruction per field with its name and type)
-and the application (operation, window, how elements are ordered). No template names a field
-of any message type: every field-specific line comes from the program's instructions, with a
-comment naming the field. A stream with a video shape (``GenericSpec.video``, from the layout:
-no field named) travels as pixels, TUSER on the first and TLAST ending each line, into the video
-application the Image project also renders (``video_filter.cpp.j2``): that is how Image on CDR is
-generated. On TCPROS the Image project keeps its own templates (the hand-written teaching
-version, :mod:`rosfpga_lab.hls.generator`).
+How this works: a configuration gives one :class:`GenericSpec` (:func:`spec_from_config`): the
+node's names, FIFO depths, part and clock, the walk (:class:`~rosfpga_lab.hls.program.Program`,
+one instruction per field with its name and type, compiled by :mod:`rosfpga_lab.hls.compiler`),
+the application (operation, window, how elements are ordered), the wire and the HLS flavour.
+:func:`context` turns it into one template context (shared with the Verilog renderer,
+:mod:`rosfpga_lab.rtl.generic`) and :func:`render_generic` renders every template of
+``templates/`` into ``{file name: text}``; :func:`render` does both for a configuration. No
+template names a field of any message type: every field-specific line comes from the program's
+instructions, with a comment naming the field. A stream with a video shape (``sensor_msgs/Image``'s
+``data``, from the layout: no field named) travels as pixels, TUSER on the first and TLAST ending
+each line, into the 2-D application (``video_filter.cpp.j2``), on TCPROS as on CDR.
+
+The two flavours (``hls.flavour``, :data:`HLS_TOOLS`) are the same C++ but for the directive that
+packs the metadata word, and their own ``run_hls.tcl``. The paper's Vivado HLS flavour once used
+the HLS video library (``hls_video.h``); the application's own line buffer is plain C++ both tools
+synthesize, so the library (and the lab's g++ stand-in for it) is gone.
 """
 
 from __future__ import annotations
 
-import math
-import struct
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,42 +28,81 @@ import jinja2
 import numpy as np
 
 from rosfpga_lab import __version__
-from rosfpga_lab.hls.errors import GenerateError
-from rosfpga_lab.hls.limits import MAX_CARRY_BYTES
-from rosfpga_lab.hw import limits as hw_limits
-from rosfpga_lab.hls.generator import _OP_CPP, HEX_BYTES_PER_LINE, HLS_TOOLS, TEMPLATES_DIR, _header_context
-from rosfpga_lab.config import NodeConfig
+from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.config.vocabulary import CDR_WIRE, DEFAULT_HLS_FLAVOUR, TCPROS_WIRE
-from rosfpga_lab.hls.program import _replace
-from rosfpga_lab.hls.program import (
-    ALIGN_ORIGIN, ENCAP_BYTES, ENCAP_PAD_MASK, FRAME_LENGTH_STATUS, MAX_LOOP_DEPTH, Instr, Op, Program, Pub, Sub,
-)
-from rosfpga_lab.hw.cdrlayout import END_ALIGN, TAIL_LABEL, CdrLayout, cdr_length_rules
-from rosfpga_lab.hw.layout import (
-    Action, CheckOp, Layout, Step, StepKind, Token, VideoShape, length_rules, marshal,
-)
+from rosfpga_lab.hls import rtlbuild
+from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, HLS_HEADERS, SOURCES, TB_EXPECTED, TB_INPUT
+from rosfpga_lab.hls.compiler import program_from_cdr, program_from_layout
+from rosfpga_lab.hls.errors import GenerateError
+from rosfpga_lab.hls.program import ALIGN_ORIGIN, ENCAP_PAD_MASK, MAX_LOOP_DEPTH, Op, Program, Pub, Sub
+from rosfpga_lab.hw import limits as hw_limits
+from rosfpga_lab.hw.cdrlayout import END_ALIGN
+from rosfpga_lab.hw.layout import Layout, VideoShape
 from rosfpga_lab.msg import MsgRegistry
-from rosfpga_lab.msg.builtins import SCALARS
-from rosfpga_lab.tcpros import TopicSpec, publisher_reply_fields, subscriber_request_fields
+from rosfpga_lab.tcpros import TopicSpec, encode_header, publisher_reply_fields, subscriber_request_fields
 
-GENERIC_DIR = TEMPLATES_DIR / "generic"
-#: Output file -> template of a generic project (``stream_filter.cpp`` is the user's for custom).
+#: The templates of a project (Jinja2, strict: an unknown name is an error).
+TEMPLATES_DIR = Path(__file__).resolve().parent / "templates"
+#: Output file -> template (``stream_filter.cpp`` is the user's file for ``op: custom``).
 GENERIC_FILES = {
-    "layout.h": "generic/layout.h.j2",
-    "ros_node.h": "generic/ros_node.h.j2",
-    "subscriber.cpp": "generic/subscriber.cpp.j2",
-    "publisher.cpp": "generic/publisher.cpp.j2",
+    "layout.h": "layout.h.j2",
+    "ros_node.h": "ros_node.h.j2",
+    "subscriber.cpp": "subscriber.cpp.j2",
+    "publisher.cpp": "publisher.cpp.j2",
     "connection_headers.cpp": "connection_headers.cpp.j2",
-    "stream_filter.cpp": "generic/stream_filter.cpp.j2",
-    "ros_fpga_node.cpp": "generic/ros_fpga_node.cpp.j2",
-    "csim_testbench.cpp": "generic/csim_testbench.cpp.j2",
-    "Makefile": "generic/Makefile.j2",
-    "run_hls.tcl": "generic/run_hls.tcl.j2",
-    "README.md": "generic/README.md.j2",
+    "stream_filter.cpp": "stream_filter.cpp.j2",
+    "ros_fpga_node.cpp": "ros_fpga_node.cpp.j2",
+    "csim_testbench.cpp": "csim_testbench.cpp.j2",
+    "Makefile": "Makefile.j2",
+    "run_hls.tcl": "run_hls.tcl.j2",
+    "README.md": "README.md.j2",
 }
-#: The C++ sources of a generic project's testbench, in the Makefile's order.
-GENERIC_SOURCES = ("subscriber.cpp", "publisher.cpp", "stream_filter.cpp", "ros_fpga_node.cpp",
-                   "connection_headers.cpp", "csim_testbench.cpp")
+#: The file the user writes for ``op: custom`` (its function ``stream_filter()``).
+CUSTOM_FILE = "stream_filter.cpp"
+#: Bytes per line of the hexadecimal arrays in connection_headers.cpp.
+HEX_BYTES_PER_LINE = 16
+#: The field a TCPROS ``sensor_msgs/Image`` publisher numbers itself (1, 2, 3 ...) instead of
+#: re-sending it, as rospy does and as the Image model (``hw.Pipeline``, the live node's) does;
+#: every other type re-sends its ``header.seq``. (The one Image rule left in the renderer: a
+#: configuration key for it, for every type, is issue 28's.)
+NUMBERED_FIELD = "header.seq"
+#: The C++ name of a morphological operation (the application's comment).
+_OP_CPP = {"dilate": "Dilate", "erode": "Erode"}
+
+
+@dataclass(frozen=True)
+class HlsTool:
+    """What one flavour of the generated C++ (``hls.flavour``) is written for.
+
+    Attributes:
+        name: the tool's name.
+        versions: the releases the flavour is for (said in the generated README and scripts).
+        command: how to run ``run_hls.tcl`` with it.
+        pack: the directive that makes the metadata struct one FIFO word.
+        what: one line on how the flavour's C++ and script differ.
+    """
+
+    name: str
+    versions: str
+    command: str
+    pack: str
+    what: str
+
+
+#: Flavour (:data:`rosfpga_lab.config.vocabulary.HLS_FLAVOURS`) -> its tool.
+HLS_TOOLS: dict[str, HlsTool] = {
+    "vitis": HlsTool(
+        "Vitis HLS", "Vitis HLS 2020.2 and later", "vitis_hls -f run_hls.tcl", "HLS aggregate",
+        "`#pragma HLS aggregate` on the metadata FIFO; each solution opened with `-flow_target "
+        "vivado` and no AXI4-Lite adapter by default."),
+    "vivado": HlsTool(
+        "Vivado HLS", "Vivado HLS 2016.x to 2019.2", "vivado_hls -f run_hls.tcl", "HLS DATA_PACK",
+        "The paper's tool. `#pragma HLS DATA_PACK` on the metadata FIFO (Vitis HLS removed it); "
+        "the same C++ otherwise: the application's own line buffer, not the HLS video library "
+        "(`hls_video.h`, which Vitis HLS no longer ships), so one application serves both tools."),
+}
+
+
 #: How each element kind is ordered, said in the application's comment.
 KIND_NOTES = {
     "unsigned": "unsigned integers",
@@ -71,7 +114,7 @@ KIND_NOTES = {
 
 @dataclass(frozen=True)
 class GenericSpec:
-    """Everything a generic project is rendered from.
+    """Everything a project is rendered from (any message type, either wire).
 
     Attributes:
         program: the walk (one instruction per field).
@@ -88,7 +131,7 @@ class GenericSpec:
         video: the stream's video shape, or ``None``: with one, the streamed bytes go to the
             application as pixels of ``bytes_per_pixel`` bytes (TUSER on the first, TLAST ending
             each line of ``width``) and the application is the 2-D window over ``height``
-            lines (the video project's ``video_filter.cpp.j2``, ``rfl_morph.v``).
+            lines (``video_filter.cpp.j2``, ``rfl_morph.v``).
         flavour: ``hls.flavour``, the HLS tool ``run_hls.tcl`` and the directives are for.
     """
 
@@ -127,8 +170,24 @@ def meta_fields(prog: Program) -> tuple[tuple[str, int, str], ...]:
 
 
 def _hex_rows(data: bytes) -> list[str]:
+    """``data`` as rows of a C array initializer, :data:`HEX_BYTES_PER_LINE` bytes a row."""
     return [", ".join(f"0x{b:02x}" for b in data[i:i + HEX_BYTES_PER_LINE]) + ","
             for i in range(0, len(data), HEX_BYTES_PER_LINE)]
+
+
+def _header_context(title: str, array: str, function: str,
+                    fields: Mapping[str, str]) -> dict[str, object]:
+    """One connection header of ``connection_headers.cpp``: its bytes as C rows and its fields
+    as a comment (a long or multi-line value, the message definition, shown by its length)."""
+    data = encode_header(dict(fields))
+    shown = []
+    for key in sorted(fields):
+        value = fields[key]
+        if "\n" in value or len(value) > 60:
+            value = f"<{len(value.encode())} bytes: the full text of the message definition>"
+        shown.append((key, value))
+    return {"title": title, "array": array, "function": function, "length": len(data),
+            "rows": _hex_rows(data), "fields": shown}
 
 
 _SUB_WORD = {Sub.SKIP: "skip", Sub.CARRY: "carry", Sub.CHECK: "check", Sub.STREAM: "stream",
@@ -273,7 +332,8 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "meta_fields": meta_fields(prog), "meta_bits": sum(f[1] for f in meta_fields(prog)),
         "carry_count_bits": meta_fields(prog)[1][1],
         "flavour": spec.flavour, "tool": HLS_TOOLS[spec.flavour],
-        "other_tools": [(key, tool) for key, tool in HLS_TOOLS.items() if key != spec.flavour],
+        "flavours": list(HLS_TOOLS.items()), "hls_headers": HLS_HEADERS,
+        "harness": rtlbuild.makefile_context(),
         "cores": ("subscriber", "fifo2axi", "stream_filter", "axi2fifo", "publisher"),
         "fifo": {"input_depth": spec.input_depth, "output_depth": spec.output_depth},
         "axis_depth": spec.axis_depth, "part": spec.part, "clock_mhz": f"{spec.clock_mhz:g}",
@@ -285,10 +345,9 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "beat": beat_shape(spec), "video": video, "filter_name": "stream_filter",
         "app": {"op": spec.op, "ksize": spec.ksize},
         "op_cpp": _OP_CPP.get(spec.op, ""),
-        "tb_input": "tb_input.bin", "tb_expected": "tb_expected.bin" if spec.op != "custom" else "",
-        "cxxflags": ("-std=c++14", "-Wall", "-Werror", "-O2"), "rtl": spec.op != "custom",
-        "csim_sources": GENERIC_SOURCES,
-        "design_sources": [s for s in GENERIC_SOURCES if s != "csim_testbench.cpp"],
+        "tb_input": TB_INPUT, "tb_expected": TB_EXPECTED if spec.op != CUSTOM else "",
+        "cxxflags": CXXFLAGS, "rtl": spec.op != CUSTOM, "csim_sources": SOURCES,
+        "design_sources": [s for s in SOURCES if s != f"{BINARY}.cpp"],
         "headers": [
             _header_context(f"Subscriber: sent to each publisher of {spec.sub_topic}",
                             "SUBSCRIBER_HEADER", "subscriber_connection_header",
@@ -307,8 +366,30 @@ def environment() -> jinja2.Environment:
         trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True, autoescape=False)
 
 
+def render(config: NodeConfig) -> dict[str, str]:
+    """Render every text file of the HLS project of ``config`` (nothing is written):
+    :func:`render_generic` of :func:`spec_from_config`.
+
+    Raises:
+        GenerateError: as :func:`spec_from_config` and :func:`render_generic`.
+    """
+    return render_generic(spec_from_config(config))
+
+
+def subscriber_header_fields(config: NodeConfig) -> dict[str, str]:
+    """Connection-header fields the node's subscriber sends to a publisher (sorted on the wire):
+    callerid, md5sum, message_definition, tcp_nodelay, topic, type."""
+    return dict(spec_from_config(config).subscriber_header)
+
+
+def publisher_header_fields(config: NodeConfig) -> dict[str, str]:
+    """Connection-header fields the node's publisher answers a subscriber with: callerid,
+    latching, md5sum, message_definition, topic, type."""
+    return dict(spec_from_config(config).publisher_header)
+
+
 def render_generic(spec: GenericSpec) -> dict[str, str]:
-    """Render every HLS C++ file of a generic project (nothing is written).
+    """Render every HLS C++ file of a project (nothing is written).
 
     Returns:
         ``{file name: text}``.
@@ -320,7 +401,7 @@ def render_generic(spec: GenericSpec) -> dict[str, str]:
     env = environment()
     out: dict[str, str] = {}
     for target, template in GENERIC_FILES.items():
-        if target == "stream_filter.cpp" and spec.op == "custom":
+        if target == CUSTOM_FILE and spec.op == CUSTOM:
             if spec.custom_source is None:
                 raise GenerateError("application.op is custom but no source file is named")
             try:
@@ -331,209 +412,6 @@ def render_generic(spec: GenericSpec) -> dict[str, str]:
             continue
         out[target] = env.get_template(template).render(ctx)
     return out
-
-
-# -- from the circuit layout (rosfpga_lab.hw.layout) to the walkers' program --------------------
-
-def _kind_of(dtype: str) -> int:
-    return {"u": 0, "b": 0, "i": 1, "f": 2}[np.dtype(dtype).kind]
-
-
-def _scalar_bytes(step: Step, value: object) -> bytes:
-    return struct.pack("<" + SCALARS[step.type].struct_char, value)
-
-
-def _bounds(step: Step, low: object, high: object) -> bytes:
-    dt = np.dtype(step.dtype)
-    if dt.kind == "f":
-        lo = -np.inf if low is None else low
-        hi = np.inf if high is None else high
-    else:
-        info = np.iinfo(dt) if dt.kind in "iu" else np.iinfo(np.uint8)
-        lo = info.min if low is None else low
-        hi = info.max if high is None else high
-    return _scalar_bytes(step, lo) + _scalar_bytes(step, hi)
-
-
-def _scalar_instr(step: Step, code: dict[str, int], label: str) -> Instr:
-    size, name, type_ = step.size, label, step.type
-    if step.action is Action.SKIP:
-        return Instr(Op.FIXED, Sub.SKIP, Pub.ZERO, size, name=name, type=type_)
-    if step.action is not Action.CHECK or step.check is None:
-        return Instr(Op.FIXED, Sub.CARRY, Pub.CARRY, size, name=name, type=type_)
-    chk = step.check
-    status = code[chk.status]
-    kind = _kind_of(step.dtype)
-    if chk.op is CheckOp.EQUAL and kind != 2:
-        return Instr(Op.FIXED, Sub.CHECK, Pub.CONST, size, status=status,
-                     const=_scalar_bytes(step, chk.value), name=name, type=type_)
-    # a float's equality is the range [v, v] (so -0.0 == +0.0 and NaN equals nothing)
-    low, high = (chk.value, chk.value) if chk.op is CheckOp.EQUAL else (chk.low, chk.high)
-    return Instr(Op.FIXED, Sub.RANGE, Pub.CARRY, size, status=status, kind=kind,
-                 const=_bounds(step, low, high), name=name, type=type_)
-
-
-def program_from_layout(layout: Layout, *, max_frame: int | None = None,
-                        count: str | None = None, video_as_bytes: bool = False,
-                        cdr: CdrLayout | None = None) -> Program:
-    """The walkers' program of a circuit layout (one instruction per field, names from it).
-
-    A length prefix and the string or array it counts become one ``VAR`` instruction; an array
-    of messages, strings or times a ``LOOP``/``END`` pair; the checks, maxima and statuses are
-    the layout's. Skipped fields are written as zeros (empty strings and arrays).
-
-    Args:
-        layout: the circuit layout.
-        max_frame: the longest frame length accepted (default: the layout's).
-        count: the label of a uint32 field the publisher numbers itself (1, 2, 3 ...) instead of
-            re-sending it (``header.seq`` of the Image project's publisher).
-        video_as_bytes: take a video stream (``sensor_msgs/Image``'s ``data``) as a plain array of
-            bytes (the TCPROS Image project has its own; this is for comparing the two). A CDR
-            walk always does: its project frames the bytes as video (``GenericSpec.video``).
-        cdr: the CDR walk whose ``layout`` this is (:func:`program_from_cdr`): the program
-            reads and writes CDR samples (alignment, strings with their NUL, the header).
-
-    Raises:
-        GenerateError: the layout has no stream, or a video stream (Image keeps its own project).
-    """
-    if layout.stream_index is None:
-        raise GenerateError(f"the layout of {layout.type_name} has no stream: nothing to generate")
-    if layout.video is not None and not video_as_bytes and cdr is None:
-        raise GenerateError("a video stream (sensor_msgs/Image) has its own project "
-                            "(rosfpga_lab.hls.generator)")
-    if layout.stream_length < 1:
-        raise GenerateError(f"stream.length is {layout.stream_length}: the circuit streams at "
-                            "least one element")
-    rules = cdr_length_rules(cdr) if cdr is not None else length_rules(layout)  # the models' rule
-
-    def align(step: int) -> int:
-        return cdr.align[step] if cdr is not None else 1
-
-    code = {name: i for i, (name, _label) in enumerate(layout.statuses)}
-    steps = layout.steps
-    frame = steps[0]
-    assert frame.check is not None and code[frame.check.status] == FRAME_LENGTH_STATUS
-    instrs: list[Instr] = []
-    carry = 0
-    mult = [1]
-    i = 1
-    while i < len(steps):
-        s = steps[i]
-        if s.kind is StepKind.ENCAPSULATION:
-            assert s.check is not None
-            instrs.append(Instr(Op.ENCAP, Sub.CHECK, Pub.CONST, len(ENCAP_BYTES),
-                                status=code[s.check.status], const=ENCAP_BYTES, name=s.label,
-                                type="uint8[4]"))
-            i += 1
-            continue
-        if s.kind is StepKind.LENGTH:
-            target = steps[s.partner] if s.partner is not None else None
-            assert target is not None and s.check is not None
-            status = code[s.check.status]
-            keep = s.action in (Action.CARRY, Action.CHECK)
-            fit = rules[s.index].fixed_after
-            fixed_after = -1 if fit is None else fit
-            elem_min = rules[s.index].element_min
-            if target.kind is StepKind.LOOP:
-                instrs.append(Instr(Op.LOOP, Sub.CARRY if keep else Sub.SKIP,
-                                    Pub.CARRY if keep else Pub.ZERO, 0, target.max_count,
-                                    variable=True, status=status, name=target.label,
-                                    type=f"{target.type}[]", fixed_after=fixed_after,
-                                    elem_min=elem_min, align=align(s.index)))
-                carry += 4 * mult[-1] if keep else 0
-                mult.append(mult[-1] * target.max_count)
-                i = target.index + 1
-                continue
-            n = layout.stream_length if target.action is Action.STREAM else target.max_count
-            if target.action is Action.STREAM:
-                sub, pub = Sub.STREAM, Pub.STREAM
-            elif target.action is Action.SKIP:
-                sub, pub = Sub.SKIP, Pub.ZERO
-            elif target.check is not None:
-                sub, pub = Sub.CHECK, Pub.CONST
-            else:
-                sub, pub = Sub.CARRY, Pub.CARRY
-            const = b""
-            status2 = 0
-            if sub == Sub.CHECK:
-                assert target.check is not None and target.check.op is CheckOp.EQUAL
-                const = str(target.check.value).encode("utf-8")
-                status2 = code[target.check.status]
-            # CDR: a string's count includes its NUL, checked by the NUL step after it
-            nul = cdr is not None and target.kind is StepKind.STRING
-            status3 = 0
-            if nul:
-                after = steps[target.index + 1]
-                assert after.kind is StepKind.NUL and after.check is not None
-                status3 = code[after.check.status]
-                n += 1
-            if sub == Sub.CARRY:
-                carry += (4 + n * target.size) * mult[-1]
-            instrs.append(Instr(Op.VAR, sub, pub, target.size, n, status=status, status2=status2,
-                                const=const, name=target.label, fixed_after=fixed_after,
-                                elem_min=elem_min, align=align(s.index),
-                                elem_align=align(target.index), nul=nul, status3=status3,
-                                type=target.type if target.kind is StepKind.STRING
-                                else f"{target.type}[]"))
-            i = target.index + (2 if nul else 1)
-            continue
-        if s.kind is StepKind.SCALAR and s.label == count and s.type == "uint32":
-            instrs.append(Instr(Op.FIXED, Sub.SKIP, Pub.COUNT, 4, name=s.label, type=s.type))
-        elif s.kind is StepKind.SCALAR:
-            ins = _replace(_scalar_instr(s, code, s.label), align=align(i))
-            carry += ins.size * mult[-1] if ins.sub in (Sub.CARRY, Sub.RANGE) else 0
-            instrs.append(ins)
-        elif s.kind is StepKind.ARRAY:  # a fixed-length array of numbers
-            assert s.count is not None
-            sub, pub = {Action.STREAM: (Sub.STREAM, Pub.STREAM), Action.SKIP: (Sub.SKIP, Pub.ZERO)
-                        }.get(s.action, (Sub.CARRY, Pub.CARRY))
-            carry += s.size * s.count * mult[-1] if sub == Sub.CARRY else 0
-            instrs.append(Instr(Op.FIXED, sub, pub, s.size * s.count, name=s.label,
-                                type=f"{s.type}[{s.count}]", align=align(i)))
-        elif s.kind is StepKind.LOOP:  # fixed count (a variable one starts at its LENGTH)
-            assert s.count is not None
-            instrs.append(Instr(Op.LOOP, Sub.SKIP, Pub.CARRY, 0, s.count, name=s.label,
-                                type=f"{s.type}[{s.count}]"))
-            mult.append(mult[-1] * s.count)
-        elif s.kind is StepKind.END:
-            instrs.append(Instr(Op.END, name=s.label))
-            mult.pop()
-        else:
-            raise GenerateError(f"step {i} ({s.kind} {s.label}) has no length step before it")
-        i += 1
-    if carry > MAX_CARRY_BYTES:
-        raise GenerateError(f"{layout.type_name} keeps up to {carry} bytes of a frame for the "
-                            f"publisher, over the {MAX_CARRY_BYTES} a generated circuit holds: "
-                            "lower the maxima of its strings and arrays (limits: in the "
-                            "configuration)")
-    # CDR: the status of a non-zero byte in the unannounced end padding (the walk's own)
-    tail = {label: c for c, (_name, label) in enumerate(layout.statuses)}.get(TAIL_LABEL, 0) \
-        if cdr is not None else 0
-    instrs.append(Instr(Op.DONE, status=FRAME_LENGTH_STATUS, status2=tail, name="", type=""))
-    consts = sum(len(ins.const) for ins in instrs)
-    for what, n, most in (("status codes", len(layout.statuses), 256),
-                          ("instructions", len(instrs), 1 << 16),
-                          ("constant bytes", consts, 1 << 16)):
-        if n > most:  # the walkers' 8-bit status, 16-bit program counter and constant address
-            raise GenerateError(f"the walk of {layout.type_name} needs {n} {what}; a generated "
-                                f"circuit holds {most}")
-    stream = layout.stream
-    return Program.build(
-        instrs, statuses=layout.statuses, min_body=int(frame.check.low),
-        max_frame=int(max_frame if max_frame is not None else frame.check.high),
-        seq_start=1, stream_bytes=stream.size, stream_length=layout.stream_length,
-        carry_bytes=carry, type_in=layout.type_name, type_out=layout.type_name)
-
-
-def program_from_cdr(cdr: CdrLayout, *, max_frame: int | None = None) -> Program:
-    """The walkers' program of a CDR walk (:mod:`rosfpga_lab.hw.cdrlayout`): an ``ENCAP``
-    first, each field's alignment, strings with their NUL, no exact fit (see
-    :mod:`rosfpga_lab.hls.program`).
-
-    Raises:
-        GenerateError: as :func:`program_from_layout`.
-    """
-    return program_from_layout(cdr.layout, max_frame=max_frame, cdr=cdr)
 
 
 #: ``kind`` of :class:`GenericSpec` per numpy dtype kind of the stream's elements.
@@ -573,13 +451,14 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
 
 
 def spec_from_config(config: NodeConfig) -> GenericSpec:
-    """The generic project of a node configuration (any type but a video stream on TCPROS,
-    whose project is :mod:`rosfpga_lab.hls.generator`'s; a video stream on CDR is framed as
-    video, :class:`GenericSpec`).
+    """The project of a node configuration: any type, either wire (a video stream, Image's
+    ``data``, framed as video: :class:`GenericSpec`; a TCPROS Image's publisher numbers
+    :data:`NUMBERED_FIELD`).
 
     Raises:
-        GenerateError: the configuration's types differ (the generic publisher re-sends the
-            subscribed type), or its layout cannot be rendered (see :func:`program_from_layout`).
+        GenerateError: the configuration's types differ (the generated publisher re-sends the
+            subscribed type), or its layout cannot be compiled
+            (:func:`~rosfpga_lab.hls.compiler.program_from_layout`).
     """
     from rosfpga_lab.hw.layout import layout_from_config
 
@@ -596,10 +475,8 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
 
         cdr = cdr_layout_from_config(config, reg)
         layout, program = cdr.layout, program_from_cdr(cdr)
-    elif layout.video is not None:
-        raise GenerateError(f"{config.subscriber.type} streams video: on TCPROS its project is "
-                            "rosfpga_lab.hls.generator's (rosfpga_lab.rtl.project.generate_project "
-                            "picks it)")
+    elif config.is_image:  # the Image model's publisher numbers its messages (NUMBERED_FIELD)
+        program = program_from_layout(layout, count=NUMBERED_FIELD)
     return spec_from_layout(
         layout, reg, node_name=config.node.global_name, program=program, wire=config.wire,
         sub_topic=config.subscriber.topic, pub_topic=config.publisher.topic,
@@ -609,177 +486,3 @@ def spec_from_config(config: NodeConfig) -> GenericSpec:
         op=app.op, ksize=app.ksize, config_name=config.path.name if config.path else "<string>",
         custom_source=app.source, video=layout.video, flavour=config.hls.flavour)
 
-
-# -- test frames and the models' output ----------------------------------------------------------
-
-_INT64_MAX = int(np.iinfo(np.int64).max)
-
-
-def _random_value(step: Step, rng: np.random.Generator) -> object:
-    """A value of a SCALAR step that its check (if any) accepts."""
-    chk = step.check
-    if chk is not None and chk.op is CheckOp.EQUAL:
-        return chk.value
-    if step.type == "bool":
-        return bool(rng.integers(0, 2))
-    dt = np.dtype(step.dtype)
-    if dt.kind == "f":
-        if chk is not None and chk.op is CheckOp.RANGE:
-            lo = -1e3 if chk.low is None else float(chk.low)
-            hi = 1e3 if chk.high is None else float(chk.high)
-            if not math.isfinite(hi - lo):  # an infinite bound, or a span beyond a float's
-                a, b = max(lo, -1e3), min(hi, 1e3)
-                # (-1e3..1e3 inside the range, else its finite end: the draw is never NaN)
-                lo, hi = (a, b) if a <= b else ((lo, lo) if math.isfinite(lo) else (hi, hi))
-            return float(dt.type(lo + (hi - lo) * rng.random()))
-        return float(dt.type(rng.standard_normal() * 100))
-    info = np.iinfo(dt)
-    lo, hi = int(info.min), int(info.max)
-    if chk is not None and chk.op is CheckOp.RANGE:
-        lo = lo if chk.low is None else int(chk.low)
-        hi = hi if chk.high is None else int(chk.high)
-    # drawn in the field's own integer type: numpy's default (int64) cannot hold a uint64's
-    # upper half; every other type keeps the default's draws (and the shipped test frames)
-    if hi > _INT64_MAX:
-        return int(rng.integers(lo, hi, endpoint=True, dtype=np.uint64))
-    return int(rng.integers(lo, hi, endpoint=True))
-
-
-def sample_tokens(layout: Layout, rng: np.random.Generator, *, stream_count: int | None = None,
-                  items: int = 2) -> list[Token]:
-    """Random values of a message in the layout's walk order, within its checks and maxima:
-    at most ``items`` elements per variable array or string of characters other than the stream
-    (``stream_count`` elements for it: default, the length the circuit was built for)."""
-    steps = layout.steps
-    toks: list[Token] = []
-    counts: dict[int, int] = {}
-
-    def walk(lo: int, hi: int, at: tuple[int, ...]) -> None:
-        i = lo
-        while i < hi:
-            s = steps[i]
-            if s.kind is StepKind.LOOP:
-                assert s.partner is not None
-                n = s.count if s.count is not None else counts[s.length_step or 0]
-                for k in range(n):
-                    walk(i + 1, s.partner, at + (k,))
-                i = s.partner + 1
-                continue
-            if s.kind is StepKind.LENGTH:
-                part = steps[s.partner] if s.partner is not None else s
-                if part.action is Action.STREAM:
-                    n = layout.stream_length if stream_count is None else stream_count
-                elif part.check is not None and part.check.op is CheckOp.EQUAL:
-                    n = len(str(part.check.value).encode("utf-8"))
-                else:
-                    n = int(rng.integers(0, min(items, part.max_count), endpoint=True))
-                counts[i] = n
-                toks.append(Token(i, n, at))
-            elif s.kind is StepKind.SCALAR:
-                toks.append(Token(i, _random_value(s, rng), at))
-            elif s.kind is StepKind.STRING:
-                n = counts[s.length_step or 0]
-                value = (str(s.check.value) if s.check is not None and s.check.op is CheckOp.EQUAL
-                         else "".join(chr(c) for c in rng.integers(97, 123, n)))
-                toks.append(Token(i, value, at))
-            elif s.kind is StepKind.ARRAY:
-                n = s.count if s.count is not None else counts[s.length_step or 0]
-                dt = np.dtype(s.dtype)
-                if dt.kind == "f":
-                    arr = (rng.standard_normal(n) * 10).astype(dt)
-                    arr[rng.random(n) < 0.1] = 0.0
-                elif dt.kind == "b":
-                    arr = rng.integers(0, 2, n).astype(dt)
-                else:
-                    info = np.iinfo(dt)
-                    arr = rng.integers(info.min, info.max, n, dtype=dt, endpoint=True)
-                toks.append(Token(i, arr, at))
-            i += 1
-
-    walk(1, len(steps), ())
-    return toks
-
-
-def model_output(layout: Layout, op: str, ksize: int, frames: list[bytes]) -> tuple[bytes, list[str]]:
-    """What the lab's Python models (``hw.walker`` fast model, ``hw.morph1d``) publish for
-    ``frames``, one whole frame each, and the refusal (``""`` for accepted) per frame."""
-    from rosfpga_lab.hw.errors import FrameFieldError
-    from rosfpga_lab.hw.morph1d import morph1d_fast
-    from rosfpga_lab.hw.walker import extract_fast, publish_fast
-
-    out = bytearray()
-    why = []
-    for frame in frames:
-        try:
-            ex = extract_fast(layout, frame)
-        except FrameFieldError as exc:
-            why.append(str(exc))
-            continue
-        why.append("")
-        out += publish_fast(layout, ex.tokens, morph1d_fast(np.asarray(ex.stream), op, ksize))
-    return bytes(out), why
-
-
-def sample_frames_generic(layout: Layout, op: str, ksize: int, *, seed: int = 20240606
-                          ) -> tuple[bytes, bytes]:
-    """The testbench's input (a good frame, a refused one, another good one) and what the
-    models publish for it (``op: custom``: no expected output).
-
-    The refused frame's stream has one element too few when the stream has a variable length,
-    else the frame has one byte too many; both are refused before anything is published.
-    """
-    rng = np.random.default_rng(seed)
-    good = [marshal(layout, sample_tokens(layout, rng)) for _ in range(2)]
-    if layout.stream.is_variable and layout.stream_length > 0:
-        bad = marshal(layout, sample_tokens(layout, rng, stream_count=layout.stream_length - 1))
-    else:
-        body = marshal(layout, sample_tokens(layout, rng))[4:] + b"\0"
-        bad = struct.pack("<I", len(body)) + body
-    frames = [good[0], bad, good[1]]
-    if op == "custom":
-        return b"".join(frames), b""
-    expected, _why = model_output(layout, op, ksize, frames)
-    return b"".join(frames), expected
-
-
-# -- CDR: test samples and the models' output ----------------------------------------------------
-
-def model_output_cdr(cdr: CdrLayout, op: str, ksize: int, records: list[bytes]
-                     ) -> tuple[bytes, list[str]]:
-    """What the lab's CDR models (``hw.cdrwalker`` fast model, the application of
-    ``hw.cdrpipeline``: ``hw.morph1d``, or ``hw.morph`` on a video stream) publish for
-    ``records`` (each a 4-byte sample length + CDR payload), and the refusal per record."""
-    from rosfpga_lab.hw.cdrpipeline import apply_application
-    from rosfpga_lab.hw.cdrwalker import extract_cdr_fast, publish_cdr_fast
-    from rosfpga_lab.hw.errors import FrameFieldError
-
-    out = bytearray()
-    why = []
-    for record in records:
-        try:
-            ex = extract_cdr_fast(cdr, record)
-        except FrameFieldError as exc:
-            why.append(str(exc))
-            continue
-        why.append("")
-        out += publish_cdr_fast(cdr, ex.tokens, apply_application(
-            cdr.layout.video, op, ksize, np.asarray(ex.stream)))
-    return bytes(out), why
-
-
-def sample_records_cdr(cdr: CdrLayout, op: str, ksize: int, *, seed: int = 20240606
-                       ) -> tuple[bytes, bytes]:
-    """The CDR testbench's input (a good sample, one with a bad encapsulation header, another
-    good one padded at its end as Cyclone DDS pads, options 3 and three zeros) and what the
-    models publish for it (``op: custom``: no expected output)."""
-    from rosfpga_lab.hw.cdrlayout import cdr_marshal, to_cdr_tokens
-
-    rng = np.random.default_rng(seed)
-    good = [cdr_marshal(cdr, to_cdr_tokens(cdr, sample_tokens(cdr.base, rng))) for _ in range(2)]
-    bad = good[0][:4] + b"\x01\x00" + good[0][6:]           # CDR big-endian: refused
-    body = good[1][4:6] + b"\x00\x03" + good[1][8:] + bytes(3)
-    records = [good[0], bad, struct.pack("<I", len(body)) + body]
-    if op == "custom":
-        return b"".join(records), b""
-    expected, _why = model_output_cdr(cdr, op, ksize, records)
-    return b"".join(records), expected

@@ -18,15 +18,13 @@ from rosfpga_lab.hls.errors import HlsError
 
 #: The paper's Table 1: lines of the subscriber and publisher, HLS C/C++ and hand-written Verilog.
 PAPER_TABLE1 = {"subscriber": (57, 415), "publisher": (70, 445), "total": (127, 860)}
-#: Generated files counted as the subscriber and the publisher.
-COUNTED = {"subscriber": ("subscriber.cpp",), "publisher": ("publisher.cpp",)}
+#: Generated files counted as the subscriber and the publisher: the walkers, and the walk they
+#: both step through (``layout.h``, the per-message part), counted with the subscriber (as
+#: ``rfl_layout.vh`` is on the Verilog side, :mod:`rosfpga_lab.rtl.sloc`).
+COUNTED = {"subscriber": ("subscriber.cpp", "layout.h"), "publisher": ("publisher.cpp",)}
 #: Other generated C/C++ files, listed beside the table (not in the paper's count).
-OTHERS = ("connection_headers.cpp", "ros_node.h", "image_filter.cpp", "ros_fpga_node.cpp",
-          "csim_testbench.cpp", "stream_filter.cpp")
-#: A generated project of any other message type (:mod:`rosfpga_lab.hls.generic`): its walk,
-#: ``layout.h``, is the per-message part of the subscriber and publisher, counted with the
-#: subscriber (as ``rfl_layout.vh`` is on the Verilog side).
-GENERIC_COUNTED = {"subscriber": ("subscriber.cpp", "layout.h"), "publisher": ("publisher.cpp",)}
+OTHERS = ("connection_headers.cpp", "ros_node.h", "stream_filter.cpp", "ros_fpga_node.cpp",
+          "csim_testbench.cpp")
 
 
 def sloc(text: str, char_literals: bool = True) -> int:
@@ -117,11 +115,10 @@ def count_sloc(project_dir: str | Path) -> SlocTable:
     """Count the lines of a generated project.
 
     Raises:
-        HlsError: the directory lacks subscriber.cpp or publisher.cpp.
+        HlsError: the directory lacks a counted file (subscriber.cpp, layout.h, publisher.cpp).
     """
     root = Path(project_dir)
-    counted = GENERIC_COUNTED if (root / GENERIC_COUNTED["subscriber"][1]).is_file() else COUNTED
-    return count_files(root, counted, OTHERS, sloc, lambda path: HlsError(
+    return count_files(root, COUNTED, OTHERS, sloc, lambda path: HlsError(
         f"{path} not found: is {root} a directory written by 'rosfpga-lab generate'?"))
 
 

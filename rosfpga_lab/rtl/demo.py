@@ -69,7 +69,7 @@ def run_demo(vcd: str | Path | None = None, *, simulator: str | None = None,
         SimulatorMissingError: no simulator; RtlError: the configuration has no RTL
         (:func:`~rosfpga_lab.rtl.sim.design_from_config`) or the simulation failed.
     """
-    from rosfpga_lab.rtl.project import test_frames
+    from rosfpga_lab.hls import sample_frames
 
     config = config or demo_config()
     design = design_from_config(config)
@@ -78,7 +78,7 @@ def run_demo(vcd: str | Path | None = None, *, simulator: str | None = None,
         refused, good = demo_frames(config)
         frames = refused + good
     else:
-        frames = test_frames(config)[0]
+        frames = sample_frames(config)[0]
     return run(sim, frames, gap=gap, bp=bp, seed=seed, vcd=vcd)
 
 

@@ -1,5 +1,5 @@
-"""Verilog of generated projects for any message type (``sensor_msgs/Image`` only on CDR: on
-TCPROS it has the hand-written project).
+"""Verilog of generated projects for any message type, ``sensor_msgs/Image`` included (on TCPROS
+its hand-written circuit, ``verilog/``, is the exhibit beside Table 1).
 
 How this works: the modules of ``generic/`` are written once and parameterized:
 ``rfl_gsubscriber`` and ``rfl_gpublisher`` walk a frame by stepping through a program, one
@@ -124,15 +124,21 @@ def generic_rtl_files(spec: GenericSpec) -> dict[str, bytes]:
 
 def project_files(spec: GenericSpec) -> dict[str, bytes]:
     """Every file of a generic project but the test frames: the HLS C++, ``hls_include/`` and
-    ``rtl/`` (what ``rosfpga-lab generate`` writes for a configuration, for a bare layout)."""
-    from rosfpga_lab.hls.generator import HLS_HEADERS, INCLUDE_DIR
+    ``rtl/`` with the lab's fast harness (what ``rosfpga-lab generate`` writes for a
+    configuration, for a bare layout)."""
+    from rosfpga_lab.hls.csim import HLS_HEADERS, INCLUDE_DIR
     from rosfpga_lab.hls.generic import render_generic
+    from rosfpga_lab.hls.rtlbuild import HARNESS_FILES
+    from rosfpga_lab.rtl.tools import HARNESS_DIR
 
     files = {name: text.encode() for name, text in render_generic(spec).items()}
     for header in HLS_HEADERS:
         files[f"hls_include/{header}"] = (INCLUDE_DIR / header).read_bytes()
-    for name, data in generic_rtl_files(spec).items():
+    rtl = generic_rtl_files(spec)
+    for name, data in rtl.items():
         files[f"rtl/{name}"] = data
+    for name in HARNESS_FILES if rtl else ():
+        files[f"rtl/{name}"] = (HARNESS_DIR / name).read_bytes()
     return files
 
 

@@ -70,10 +70,11 @@ def bench_node(stem: str, frames: int = 5) -> None:
 
     from rosfpga_lab.component import FpgaComponent
     from rosfpga_lab.graph import EmbeddedMaster, Node
-    from rosfpga_lab.rtl.project import model_output, test_frames
+    from rosfpga_lab.rtl.project import model_output
+    from rosfpga_lab.hls import sample_frames
 
     config = load_config(DATA / f"{stem}.yaml")
-    first, _ = test_frames(config)
+    first, _ = sample_frames(config)
     frame = first[:4 + struct.unpack_from("<I", first)[0]]      # the first test frame (good)
     expected = model_output(config, frame)
     kind, reg = config.subscriber.type, config.registry()

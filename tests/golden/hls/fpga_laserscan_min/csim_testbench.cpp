@@ -6,7 +6,9 @@
 //             message), one after the other.
 //   OUTDIR    receives output.bin (the bytes the publisher wrote: TCPROS frames for
 //             /scan_min), status.txt (per input frame: its byte offset and the subscriber's
-//             status) and subscriber_header.bin, publisher_header.bin (the connection headers).
+//             status), input_beats.txt and output_beats.txt (the AXI4-Stream beats into and out
+//             of the application, one "TDATA TKEEP TUSER TLAST" line each in hexadecimal) and
+//             subscriber_header.bin, publisher_header.bin (the connection headers).
 //   EXPECTED  optional: bytes output.bin must equal (the exit status says whether it does).
 #include <cstdio>
 #include <fstream>
@@ -16,6 +18,9 @@
 #include <vector>
 
 #include "ros_node.h"
+
+extern std::FILE* csim_beats_in;   // ros_fpga_node.cpp's taps
+extern std::FILE* csim_beats_out;
 
 static const char* status_name(int status) {
     switch (status) {
@@ -60,40 +65,59 @@ int main(int argc, char** argv) {
     publisher_connection_header(header);
     ok = write_file(outdir + "/publisher_header.bin", drain(header)) && ok;
     std::FILE* status_log = std::fopen((outdir + "/status.txt").c_str(), "w");
-    if (!ok || !status_log) {
+    csim_beats_in = std::fopen((outdir + "/input_beats.txt").c_str(), "w");
+    csim_beats_out = std::fopen((outdir + "/output_beats.txt").c_str(), "w");
+    if (!ok || !status_log || !csim_beats_in || !csim_beats_out) {
         std::cerr << "cannot write into " << outdir << "\n";
         return 2;
     }
     std::vector<unsigned char> output;
     std::size_t offset = 0, frames = 0, refused = 0;
+    // The whole input is one continuous byte stream, as the circuit gets it from TCP: each
+    // call of ros_fpga_node() reads what the circuit reads of it (a frame, a refused frame's
+    // bytes skipped, or only a frame length it cannot trust), and the next call goes on from
+    // there. The testbench only looks ahead so as not to start a frame that is cut short.
+    byte_stream in("in");
+    for (std::size_t i = 0; i < bytes.size(); i++) in.write(bytes[i]);
     while (offset + 4 <= bytes.size()) {
         std::size_t length = bytes[offset] | (bytes[offset + 1] << 8) | (bytes[offset + 2] << 16) |
                              (static_cast<std::size_t>(bytes[offset + 3]) << 24);
         std::size_t size = 4 + length;
-        if (size > bytes.size() - offset) {
+        if (length <= MAX_FRAME_BYTES && size > bytes.size() - offset) {
+            // The circuit would wait for the missing bytes for ever: stop here.
             std::cout << "csim: the frame at byte " << offset << " is cut short ("
                       << bytes.size() - offset << " of " << size << " bytes); not simulated\n";
             break;
         }
-        byte_stream in("in"), out("out");
-        for (std::size_t i = 0; i < size; i++) in.write(bytes[offset + i]);
+        byte_stream out("out");
+        const std::size_t before = in.size();
         int status = ros_fpga_node(in, out);
+        const std::size_t taken = before - in.size();
         std::vector<unsigned char> published = drain(out);
         output.insert(output.end(), published.begin(), published.end());
         std::fprintf(status_log, "%zu %s\n", offset, status_name(status));
-        std::size_t unread = drain(in).size();
-        if (status != SUB_BAD_FRAME_LENGTH && unread != 0) {
-            std::cout << "csim: WARNING: the subscriber left " << unread << " byte(s) of the frame"
-                      << " at byte " << offset << " unread\n";
+        if (status == SUB_BAD_FRAME_LENGTH && taken == 4) {
+            std::cout << "csim: the frame at byte " << offset << " has a frame length the circuit"
+                      << " cannot trust; it reads the next 4 bytes as a new frame length\n";
+        } else if (taken != size) {
+            std::cout << "csim: WARNING: the subscriber read " << taken << " byte(s) of the "
+                      << size << "-byte frame at byte " << offset << "\n";
         }
         frames++;
         if (status != SUB_OK) refused++;
-        offset += size;
+        offset += taken;
     }
+    drain(in);
     std::fclose(status_log);
+    std::fclose(csim_beats_in);
+    std::fclose(csim_beats_out);
+    csim_beats_in = csim_beats_out = 0;
     ok = write_file(outdir + "/output.bin", output);
     std::cout << "csim: " << frames << " frame(s) in, " << refused << " refused, " << output.size()
               << " bytes out -> " << outdir << "/output.bin\n";
+    if (offset != bytes.size()) {
+        std::cout << "csim: " << bytes.size() - offset << " trailing byte(s) ignored\n";
+    }
     if (argc == 4) {
         std::ifstream expected_file(argv[3], std::ios::binary);
         std::vector<unsigned char> expected((std::istreambuf_iterator<char>(expected_file)),

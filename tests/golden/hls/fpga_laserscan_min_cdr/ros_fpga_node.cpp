@@ -9,11 +9,32 @@
 // In the FPGA the stages work concurrently on the stream; this function is their C-level
 // model for C simulation: one frame per call, the stages in turn. A frame refused before its
 // stream went out goes no further; one refused after it is dropped by the publisher.
+// The beats into and out of the application are tapped on the way (csim_testbench logs them).
+#include <cstdio>
+
 #include "ros_node.h"
+
+// C simulation: the files the beats into and out of the application are logged to, one
+// "TDATA TKEEP TUSER TLAST" line per beat in hexadecimal (csim_testbench opens them; null: none).
+std::FILE* csim_beats_in = 0;
+std::FILE* csim_beats_out = 0;
+
+// Move every beat from `from` to `to`, logging it to `log` when there is one.
+static void tap(elem_stream& from, elem_stream& to, std::FILE* log) {
+    while (!from.empty()) {
+        elem_beat beat = from.read();
+        if (log) {
+            std::fprintf(log, "%llx %x %x %x\n", beat.data.to_uint64(), beat.keep.to_uint(),
+                         beat.user.to_uint(), beat.last.to_uint());
+        }
+        to.write(beat);
+    }
+}
 
 int ros_fpga_node(byte_stream& in, byte_stream& out) {
     static byte_stream stream_bytes("stream_bytes"), result_bytes("result_bytes"), carry("carry");
-    static elem_stream to_filter("to_filter"), from_filter("from_filter");
+    static elem_stream beats_in("beats_in"), to_filter("to_filter"), beats_out("beats_out"),
+        from_filter("from_filter");
     static meta_stream meta("meta");
     HLS_PRAGMA(HLS STREAM variable = to_filter depth = AXIS_FIFO_DEPTH)
     HLS_PRAGMA(HLS STREAM variable = from_filter depth = AXIS_FIFO_DEPTH)
@@ -21,8 +42,10 @@ int ros_fpga_node(byte_stream& in, byte_stream& out) {
     ap_uint<8> status = 0;
     subscriber(in, stream_bytes, carry, meta, status);
     if (!stream_bytes.empty()) {  // the stream went out: through the application
-        fifo2axi(stream_bytes, to_filter);
-        stream_filter(to_filter, from_filter);
+        fifo2axi(stream_bytes, beats_in);
+        tap(beats_in, to_filter, csim_beats_in);
+        stream_filter(to_filter, beats_out);
+        tap(beats_out, from_filter, csim_beats_out);
         axi2fifo(from_filter, result_bytes);
     }
     if (!meta.empty()) publisher(result_bytes, carry, meta, out);

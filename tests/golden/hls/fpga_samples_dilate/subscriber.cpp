@@ -200,12 +200,16 @@ static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& ca
         w.end.range(8 * w.k + 7, 8 * w.k) = b;
         if (++w.k == 4) {
             const ap_uint<32> frame_length = w.end;
-            if (frame_length < MIN_BODY_BYTES || frame_length > MAX_FRAME_BYTES) {
+            if (frame_length > MAX_FRAME_BYTES) {
                 w.status = SUB_BAD_FRAME_LENGTH;  // not to be trusted for skipping: wait for the next frame
                 w.st = ST_FINISH;
                 return;
             }
             w.end = frame_length + 4;
+            if (frame_length < MIN_BODY_BYTES) {  // too short for the message: skipped to its end
+                refuse(w, SUB_BAD_FRAME_LENGTH);
+                return;
+            }
             w.st = ST_DECODE;
         }
         break;
@@ -247,7 +251,7 @@ void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_out)
     HLS_PRAGMA(HLS INTERFACE ap_vld port = status)
     HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one frame per call
-    HLS_PRAGMA(HLS HLS aggregate variable = meta_out)
+    HLS_PRAGMA(HLS aggregate variable = meta_out)
     // The walk and its constants are ROMs read every clock (a range check reads both bounds at
     // once): constants in logic, so no block-RAM port limits the loop's II.
     HLS_PRAGMA(HLS ARRAY_PARTITION variable = PROGRAM complete)

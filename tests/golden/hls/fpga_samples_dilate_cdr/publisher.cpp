@@ -163,7 +163,7 @@ void publisher(byte_stream& in, byte_stream& carry_in, meta_stream& meta_in, byt
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = meta_in)
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = out)
     HLS_PRAGMA(HLS INTERFACE ap_ctrl_none port = return)  // free-running: one message per meta word
-    HLS_PRAGMA(HLS HLS aggregate variable = meta_in)
+    HLS_PRAGMA(HLS aggregate variable = meta_in)
     static ap_uint<32> seq = SEQ_START;  // the next message number
     const frame_meta meta = meta_in.read();
     if (meta.drop) {
