@@ -435,3 +435,22 @@ def test_a_tcpros_frame_cut_short_in_a_count_is_refused_by_that_count_in_verilog
         (tmp_path / name).write_bytes(blob)
     want = ["SUB_BAD_INTENSITIES_LENGTH", "SUB_OK"]
     assert both_simulations(tmp_path, frames) == ((expected, want), (expected, want))
+
+
+def test_a_bool_is_carried_as_its_byte_by_the_models_as_by_the_walkers() -> None:
+    """A bool's byte goes through as received (0x02 stays 0x02), in the models as in the walkers'
+    program (and so the RTL): a damaged copy's bool once came out 0x01 from the models only
+    (Hypothesis found it: h_msgs/T0, a carried bool after the stream, XORed with 2)."""
+    from rosfpga_lab.msg.registry import MsgRegistry
+
+    reg = MsgRegistry()
+    reg.add("h_msgs/T1", "char[2] f0\nbool f1\n")
+    reg.add("h_msgs/T0", "h_msgs/T1 f0\nint8[] stream\nbool f1\n")
+    cdr = derive_cdr_layout(reg, "h_msgs/T0", stream="stream", stream_length=3)
+    # length 16, CDR_LE, f0.f0 = 00 00, f0.f1 = 01, stream [0, 0, 0] aligned to 4, f1 = 0x02
+    record = bytes.fromhex("10000000" "00010000" "0000" "01" "00" "03000000" "000000" "02")
+    expected, why = model_output_cdr(cdr, "passthrough", 3, [record])
+    assert why == [""] and expected == record
+    out, codes = run_program(program_from_cdr(cdr), [record],
+                             lambda b: window_oracle(b, "|i1", 3, "passthrough"))
+    assert (out, codes) == (expected, [0])

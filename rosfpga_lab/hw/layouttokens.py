@@ -72,10 +72,16 @@ def tokens(layout: Layout, message: Any) -> list[Token]:
     return out
 
 
+def scalar_format(type_name: str) -> str:
+    """The struct format of a scalar as the circuit carries it: a ``bool`` is its byte, kept as
+    received (the walkers copy bytes, as roscpp's ``uint8_t`` bool does), not folded to 0/1."""
+    return "<" + ("B" if type_name == "bool" else SCALARS[type_name].struct_char)
+
+
 def encode_token(step: Step, value: Any) -> bytes:
     """The wire bytes of one token."""
     if step.kind in (StepKind.SCALAR, StepKind.LENGTH):
-        return struct.pack("<" + (SCALARS[step.type].struct_char), value)
+        return struct.pack(scalar_format(step.type), value)
     if step.kind is StepKind.STRING:
         return value.encode("utf-8", "surrogateescape") if isinstance(value, str) else bytes(value)
     if step.kind is StepKind.ARRAY:

@@ -35,8 +35,7 @@ import numpy as np
 from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
 from rosfpga_lab.hw.layoutlengths import LengthRule, length_rules
 from rosfpga_lab.hw.layoutsteps import Action, CheckOp, Layout, Step, StepKind
-from rosfpga_lab.hw.layouttokens import Token
-from rosfpga_lab.msg.builtins import SCALARS
+from rosfpga_lab.hw.layouttokens import Token, scalar_format
 
 STAGE = "interpreter"  # as the Image interpreter: refusals read the same
 
@@ -64,7 +63,7 @@ class Extracted:
 
 def _decode(step: Step, data: bytes | memoryview) -> Any:
     if step.kind in (StepKind.SCALAR, StepKind.LENGTH):
-        return struct.unpack("<" + SCALARS[step.type].struct_char, data)[0]
+        return struct.unpack(scalar_format(step.type), data)[0]
     if step.kind is StepKind.STRING:
         return bytes(data).decode("utf-8", "surrogateescape")
     return np.frombuffer(data, np.dtype(step.dtype))  # a read-only view (fast model: of the frame)
