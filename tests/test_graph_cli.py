@@ -271,6 +271,35 @@ def test_topic_tools_exit_after_a_remote_shutdown(graph, action: list[str]) -> N
     assert "Traceback" not in err
 
 
+def test_topic_pub_shut_down_before_its_first_publish_exits_as_stopped_remotely(
+        monkeypatch, capsys) -> None:
+    """The race the [pub] case above lost under load: the shutdown landed between advertise and
+    the first publish, which found its publisher closed; the tool said "publisher of /latched is
+    closed; advertise again" and exited 1. Made certain here: the first publish waits for the
+    remote shutdown to close it."""
+    from rosfpga_lab.cli import main
+    from rosfpga_lab.graph.publisher import Publisher
+
+    publish = Publisher.publish
+
+    def shut_down_first(self, value) -> None:
+        api = call(m.uri, "lookupNode", "/test", tool_node(m, "/latched"))[2]
+        assert call(api, "shutdown", "/killer", "go away")[0] == 1
+        deadline = time.monotonic() + 10
+        while not self.closed and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert self.closed
+        publish(self, value)
+
+    monkeypatch.setattr(Publisher, "publish", shut_down_first)
+    with EmbeddedMaster(port=0) as m:
+        assert main(["topic", "--master-uri", m.uri, "pub", "-l", "/latched", "std_msgs/String",
+                     "data: x"]) == 0
+    err = capsys.readouterr().err
+    assert "shutdown request: remote shutdown by /killer: go away" in err
+    assert "closed" not in err
+
+
 def test_topic_tools_handle_a_large_graph() -> None:
     """900 topics with long names: getSystemState is over 8 MiB. rostopic lists them; the lab's
     tools said "cannot reach the ROS master"."""

