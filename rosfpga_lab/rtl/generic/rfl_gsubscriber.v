@@ -19,32 +19,54 @@
 // elem_min per clock, before S_COUNTED checks them. The bytes left for the fields (room: CDR
 // less the end padding) and in the frame (left_f) are registers kept with pos, and a body's
 // last byte is found by a count down (left_b), so that no clock subtracts and compares in a row.
+`default_nettype none
+
 module rfl_gsubscriber #(
     parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
     parameter CW = 6,                           // its address bits
     parameter MIN_BODY = 0,                     // shortest frame length accepted
     parameter MAX_FRAME = 67108864              // longest frame length accepted
 ) (
-    input              clk,
-    input              rst_n,
-    input      [7:0]   s_tdata,
-    input              s_tvalid,
-    output             s_tready,
-    output     [7:0]   m_tdata,                 // streamed bytes
-    output             m_tvalid,
-    input              m_tready,
+    input  wire        clk,
+    input  wire        rst_n,
+    input  wire [7:0]  s_tdata,
+    input  wire        s_tvalid,
+    output wire        s_tready,
+    output wire [7:0]  m_tdata,                 // streamed bytes
+    output wire        m_tvalid,
+    input  wire        m_tready,
     output reg         meta_valid,
-    input              meta_release,
-    output reg [31:0]  meta_out_len,            // the publisher's frame length
+    input  wire        meta_release,
+    output reg  [31:0] meta_out_len,            // the publisher's frame length
     output reg         meta_drop,               // refused after its stream: drop the stream
-    input      [CW-1:0] carry_raddr,
-    output     [7:0]   carry_rdata,
-    output             frame_start,
+    input  wire        carry_restart,           // the publisher reads them from the first
+    input  wire        carry_pop,               // ... has taken carry_rdata: the next
+    output reg  [7:0]  carry_rdata,             // the carried byte at hand (a register)
+    output wire        frame_start,
     output reg         status_valid,
-    output reg [7:0]   status,
-    output             idle                     // between frames
+    output reg  [7:0]  status,
+    output wire        idle                     // between frames
 );
 `include "rfl_layout.vh"
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (CARRY_BYTES < 1 || CW < 1 || CW > 16 || (1 << CW) < CARRY_BYTES)
+            $fatal(1,
+                   "rfl_gsubscriber: CARRY_BYTES must be at least 1 and at most 2**CW (CW 1..16)");
+        if (MIN_BODY < 0 || MIN_BODY > MAX_FRAME)
+            $fatal(1, "rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME");
+    end
+`else
+    if (CARRY_BYTES < 1 || CW < 1 || CW > 16 || (1 << CW) < CARRY_BYTES) begin : g_bad_carry
+        $error("rfl_gsubscriber: CARRY_BYTES must be at least 1 and at most 2**CW (CW 1..16)");
+    end
+    if (MIN_BODY < 0 || MIN_BODY > MAX_FRAME) begin : g_bad_frame
+        $error("rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME");
+    end
+`endif
+
     localparam [3:0] S_FLEN = 4'd0, S_DECODE = 4'd1, S_COUNT = 4'd2, S_COUNTED = 4'd3,
                      S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7, S_TAIL = 4'd8,
                      S_LEAST = 4'd9, S_FCHK = 4'd10;
@@ -111,7 +133,6 @@ module rfl_gsubscriber #(
     wire take = s_tvalid && s_tready;
     assign frame_start = take && (state == S_FLEN) && (cnt[1:0] == 2'd0);
     assign idle = (state == S_FLEN) && (cnt[1:0] == 2'd0);
-    assign carry_rdata = carry_mem[carry_raddr];
 
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
     wire [31:0] pos_next = pos + 32'd1;
@@ -186,6 +207,30 @@ module rfl_gsubscriber #(
 
     always @(posedge clk) begin
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
+    end
+
+    // The carry memory's read side: the publisher takes the carried bytes in order, from the
+    // first, once per frame (carry_restart, then carry_pop for each), while nothing is written
+    // (it writes while meta_valid holds, and a new frame waits for meta_release). They are read
+    // ahead into two registers, as rfl_fifo's OUTREG does: the block RAM's read register (cq),
+    // then carry_rdata in the fabric, so that the publisher's byte does not start from a block
+    // RAM's slow clock-to-output (100 MHz timing on an ECP5). Two clocks after carry_restart the
+    // first byte is in carry_rdata (the publisher's first carried byte comes after the frame
+    // length's 4 bytes and a decode); from then on each carry_pop moves the next one in.
+    reg [CW-1:0] craddr;                        // the next byte to read
+    reg [7:0]  cq;                              // the byte after carry_rdata
+    reg [1:0]  cfill;                           // registers filled since carry_restart (0..2)
+    wire       cadv = (cfill != 2'd2) || carry_pop;
+    always @(posedge clk) begin
+        if (cadv) cq <= carry_mem[craddr];
+        if (cadv && cfill != 2'd0) carry_rdata <= cq;
+        if (!rst_n || carry_restart) begin
+            craddr <= {CW{1'b0}};
+            cfill <= 2'd0;
+        end else if (cadv) begin
+            craddr <= craddr + 1'b1;
+            if (cfill != 2'd2) cfill <= cfill + 2'd1;
+        end
     end
 
     // The decisions' arithmetic, registered: S_FCHK, S_DECODE, S_COUNTED and S_FINISH take
@@ -547,3 +592,5 @@ module rfl_gsubscriber #(
     always @(*) if (rst_n) assert(w == prog_word(pc));
 `endif
 endmodule
+
+`default_nettype wire
