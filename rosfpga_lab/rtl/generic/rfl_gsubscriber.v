@@ -82,6 +82,7 @@ module rfl_gsubscriber #(
     reg [31:0] cnt;                             // bytes of the current part taken so far
     reg [31:0] n;                               // a count, shifted in little-endian
     reg [34:0] left_b;                          // bytes of the current body still to take
+    reg        last_b;                          // left_b == 1 (kept with it: S_BODY's end)
     reg [31:0] room;                            // bytes left for the fields (CDR: before the end padding)
     reg [63:0] least_r;                         // OP_LOOP: count x elem_min, added up (S_LEAST)
     reg [63:0] nsh;                             // the count shifted by the elem_min bits done
@@ -245,8 +246,28 @@ module rfl_gsubscriber #(
     wire in_range = !p_vnan && lo_key <= p_vkey && p_vkey <= hi_key;
     reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
         c_body0, c_pade_bad, c_body_gt, c_encap_bad, c_encap_pad_gt, c_check_bad, c_range_bad,
-        c_at_end, c_room0, c_room_lt4, c_size0, c_n0, c_n1, c_flen_long, c_flen_short;
+        c_at_end, c_room0, c_room_lt4, c_size0, c_n0, c_n1, c_flen_long, c_flen_short, c_body1,
+        c_size1;
     reg [31:0] c_out_len;                          // S_FINISH: out_len after the field
+    // out_len and room after a decision's additions, settled the same way (each decision acts
+    // on flip-flops only): an OP_VAR's count padding, a variable OP_LOOP's count, OP_ENCAP's
+    // header and end padding
+    reg [31:0] p_out_var, p_out4, p_out_klen, p_room_encap;
+    // The next instructions, registered (the ROM look-up and the adders are not on the
+    // decision's path): pc holds from one go() through the two settling clocks of the decision
+    // that does the next, so by then these are prog_next(pc), prog_jump(pc) and their pcs.
+    reg [IW-1:0] w_nx, w_jp;
+    reg [15:0] pc_nx, pc_jp;
+    always @(posedge clk) begin
+        w_nx <= prog_next(pc);
+        w_jp <= prog_jump(pc);
+        pc_nx <= pc + 16'd1;
+        pc_jp <= jump + 16'd1;
+        p_out_var <= out_len + pad_at(out_len + 32'd4, align);
+        p_out4 <= out_len + 32'd4;
+        p_out_klen <= out_len + {16'd0, klen};
+        p_room_encap <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
+    end
     always @(posedge clk) begin
         c_tail <= tail_zero;
         c_at_end <= at_end;
@@ -273,6 +294,8 @@ module rfl_gsubscriber #(
         c_fit_bad <= fits && p_least_fa != {32'd0, room};
         c_least_gt <= (p_least > {32'd0, room});
         c_body0 <= (body == 35'd0);
+        c_body1 <= (body == 35'd1);
+        c_size1 <= (size == 32'd1);
         c_pade_bad <= (pad_e != 32'd0 && pad_e >= room);
         c_body_gt <= (body > {3'd0, p_room_e});
         c_encap_bad <= (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1));
@@ -360,6 +383,7 @@ module rfl_gsubscriber #(
             cnt <= 32'd0;
             n <= 32'd0;
             left_b <= 35'd0;
+            last_b <= 1'b0;
             settled <= 2'd0;
             room <= 32'd0;
             least_r <= 64'd0;
@@ -447,27 +471,29 @@ module rfl_gsubscriber #(
                             if (c_room_lt4) refuse(st, c_at_end);
                             else begin
                                 left_b <= 35'd4;
+                                last_b <= 1'b0;
                                 state <= S_BODY;
                             end
                         end
                         OP_END: begin
                             if (c_left1) begin
                                 left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
-                                go(jump + 16'd1, prog_jump(pc));
+                                go(pc_jp, w_jp);
                             end else begin
                                 depth <= depth - 1'b1;
                                 if (quiet_of[depth - 1'b1]) quiet <= quiet - 8'd1;
-                                go(pc + 16'd1, prog_next(pc));
+                                go(pc_nx, w_nx);
                             end
                         end
                         OP_FIXED: begin
-                            if (c_size0) go(pc + 16'd1, prog_next(pc));
+                            if (c_size0) go(pc_nx, w_nx);
                             else if (c_padf_bad)
                                 refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                             else if (c_size_gt)
                                 refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
                             else begin
                                 left_b <= {3'd0, size};
+                                last_b <= c_size1;
                                 pad_then(pad_f, S_BODY);
                             end
                         end
@@ -482,7 +508,7 @@ module rfl_gsubscriber #(
                                 refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                             else if (c_roomf_lt4) refuse(st, c_at_end);  // cut short in its count
                             else begin
-                                if (quiet == 8'd0) out_len <= out_len + pad_at(out_len + 32'd4, align);
+                                if (quiet == 8'd0) out_len <= p_out_var;
                                 pad_then(pad_f, S_COUNT);
                             end
                         end
@@ -519,14 +545,14 @@ module rfl_gsubscriber #(
                         refuse(st, c_at_end);
                     else if (op == OP_LOOP) begin
                         begin
-                            if (variable && quiet == 8'd0) out_len <= out_len + 32'd4;
-                            if (c_n0) go(jump + 16'd1, prog_jump(pc));
+                            if (variable && quiet == 8'd0) out_len <= p_out4;
+                            if (c_n0) go(pc_jp, w_jp);
                             else begin
                                 left[depth] <= n;
                                 quiet_of[depth] <= variable && pub == PUB_ZERO;
                                 if (variable && pub == PUB_ZERO) quiet <= quiet + 8'd1;
                                 depth <= depth + 1'b1;
-                                go(pc + 16'd1, prog_next(pc));
+                                go(pc_nx, w_nx);
                             end
                         end
                     end else if (c_body0) begin
@@ -537,6 +563,7 @@ module rfl_gsubscriber #(
                         refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
                     end else begin
                         left_b <= body;
+                        last_b <= c_body1;
                         pad_then(pad_e, S_BODY);
                     end
                 end
@@ -547,10 +574,11 @@ module rfl_gsubscriber #(
                 S_BODY: if (take) begin
                     if (cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
                     left_b <= left_b - 35'd1;
-                    if (nul && left_b == 35'd1) nul_bad <= (s_tdata != 8'd0);
+                    last_b <= (left_b == 35'd2);
+                    if (nul && last_b) nul_bad <= (s_tdata != 8'd0);
                     else if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
                     if (sub == SUB_STREAM) streamed <= 1'b1;
-                    if (left_b == 35'd1) state <= S_FINISH;
+                    if (last_b) state <= S_FINISH;
                 end
                 S_FINISH: if (settled != 2'd2) settled <= settled + 2'd1; else begin
                     settled <= 2'd0;
@@ -560,9 +588,9 @@ module rfl_gsubscriber #(
                         else if (c_encap_pad_gt)
                             refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                         else begin
-                            room <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
-                            out_len <= out_len + {16'd0, klen};
-                            go(pc + 16'd1, prog_next(pc));
+                            room <= p_room_encap;
+                            out_len <= p_out_klen;
+                            go(pc_nx, w_nx);
                         end
                     end
                     else if (c_check_bad)
@@ -571,7 +599,7 @@ module rfl_gsubscriber #(
                     else if (nul_bad) refuse(st3, c_at_end);
                     else begin
                         if (quiet == 8'd0) out_len <= c_out_len;
-                        go(pc + 16'd1, prog_next(pc));
+                        go(pc_nx, w_nx);
                     end
                 end
                 S_TAIL: if (take) begin  // CDR: an unannounced end pad byte, which must be 0
@@ -590,6 +618,11 @@ module rfl_gsubscriber #(
 `ifdef FORMAL
     // the instruction register holds the word of pc (an invariant the proofs carry)
     always @(*) if (rst_n) assert(w == prog_word(pc));
+    always @(*) if (rst_n) assert(last_b == (left_b == 35'd1));
+    // ... and, once a clock has settled, the next instructions are those of pc
+    always @(*) if (rst_n && settled != 2'd0)
+        assert(w_nx == prog_next(pc) && w_jp == prog_jump(pc) && pc_nx == pc + 16'd1
+               && pc_jp == jump + 16'd1);
 `endif
 endmodule
 
