@@ -619,6 +619,10 @@ module rfl_gsubscriber #(
     // the instruction register holds the word of pc (an invariant the proofs carry)
     always @(*) if (rst_n) assert(w == prog_word(pc));
     always @(*) if (rst_n) assert(last_b == (left_b == 35'd1));
+    // a decision settles only in its own state, from 0 (each decision ends at 2 with 0)
+    always @(*) if (rst_n)
+        assert(settled == 2'd0 || (settled != 2'd3 && (state == S_FCHK || state == S_DECODE
+                                                       || state == S_COUNTED || state == S_FINISH)));
     // ... and, once a clock has settled, the next instructions are those of pc
     always @(*) if (rst_n && settled != 2'd0)
         assert(w_nx == prog_next(pc) && w_jp == prog_jump(pc) && pc_nx == pc + 16'd1
