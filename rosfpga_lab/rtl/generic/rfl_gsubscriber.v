@@ -151,8 +151,14 @@ module rfl_gsubscriber #(
                           : (pub == PUB_CARRY || pub == PUB_STREAM) ? body[31:0]
                           : (pub == PUB_CONST) ? {16'd0, klen} + {31'd0, nul} : {31'd0, nul};
     wire [31:0] out_base = (op == OP_FIXED) ? out_len : out_len + 32'd4;
-    wire [31:0] out_pad = (written == 32'd0) ? 32'd0
-                          : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
+    // (registered on every clock: out_len, n and the instruction hold from S_COUNTED, or the
+    // field's last byte, to S_FINISH, whose first settling clock adds them up into p_out_at)
+    reg [31:0]  r_out_base, r_out_pad;
+    always @(posedge clk) begin
+        r_out_base <= out_base;
+        r_out_pad <= (written == 32'd0) ? 32'd0
+                     : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
+    end
     wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
     // fewest bytes of the counted elements (OP_VAR: its elements' bytes)
     wire [63:0] least = (op == OP_VAR) ? {29'd0, body} : least_r;
@@ -285,7 +291,7 @@ module rfl_gsubscriber #(
         p_vkey <= vkey;
         p_vnan <= (kind == 2'd2 && is_nan(value, size));
         p_least <= least;
-        p_out_at <= out_base + out_pad;
+        p_out_at <= r_out_base + r_out_pad;
         p_written <= written;
         p_least_fa <= least + {32'd0, fixed_after};
         c_size_gt <= (size > p_room_f);
@@ -414,6 +420,10 @@ module rfl_gsubscriber #(
                 cnt <= cnt + 32'd1;
                 if (keep && (state == S_COUNT || state == S_BODY)) waddr <= waddr + 1'b1;
             end
+            // a SUB_RANGE or OP_ENCAP field's bytes: taken whenever offered (the same byte again
+            // until it is taken; only a streamed one waits for m_tready), so that take's fan-out
+            // does not reach these 64 enables (S_DECODE clears value after this)
+            if (state == S_BODY && s_tvalid && cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
             case (state)
                 S_FLEN: if (take) begin
                     n <= n_next;
@@ -572,7 +582,6 @@ module rfl_gsubscriber #(
                     cnt <= 32'd0;
                 end
                 S_BODY: if (take) begin
-                    if (cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
                     left_b <= left_b - 35'd1;
                     last_b <= (left_b == 35'd2);
                     if (nul && last_b) nul_bad <= (s_tdata != 8'd0);
