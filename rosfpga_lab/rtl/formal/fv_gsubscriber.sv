@@ -6,7 +6,7 @@
 // its stream went out) streamed exactly the array's 2 bytes.
 module fv_gsubscriber #(parameter CW = 3) (
     input clk, input rst_n, input [7:0] s_tdata, input s_tvalid, input m_tready,
-    input meta_release, input [CW-1:0] carry_raddr
+    input meta_release, input carry_restart, input carry_pop
 );
     wire s_tready, m_tvalid, meta_valid, meta_drop, frame_start, status_valid, idle;
     wire [7:0] m_tdata, carry_rdata, status;
@@ -15,7 +15,8 @@ module fv_gsubscriber #(parameter CW = 3) (
         .clk(clk), .rst_n(rst_n), .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
-        .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
+        .meta_drop(meta_drop), .carry_restart(carry_restart), .carry_pop(carry_pop),
+        .carry_rdata(carry_rdata),
         .frame_start(frame_start), .status_valid(status_valid), .status(status), .idle(idle));
 `include "fv_env.vh"
     `FV_SOURCE(s_tvalid, s_tready, s_tdata)

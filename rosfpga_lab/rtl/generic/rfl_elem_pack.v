@@ -3,23 +3,46 @@
 // TUSER on the array's first element, TLAST on its last (LENGTH elements per array) or, for
 // video, on the last of every line of LINE elements (pixels). One byte is taken per clock, so a
 // beat of EBYTES bytes takes EBYTES clocks.
+`default_nettype none
+
 module rfl_elem_pack #(
-    parameter EBYTES = 4,                       // bytes per element: 1, 2, 4 or 8
+    parameter EBYTES = 4,                       // bytes per element (beat): 1..8
     parameter LENGTH = 256,                     // elements per array (at least 1)
-    parameter LINE = LENGTH                     // elements per line (TLAST); divides LENGTH
+    parameter LINE = LENGTH                     // elements per line (TLAST): divides LENGTH
 ) (
-    input                       clk,
-    input                       rst_n,
-    input      [7:0]            s_tdata,
-    input                       s_tvalid,
-    output                      s_tready,
-    output reg [8*EBYTES-1:0]   m_axis_tdata,
-    output     [EBYTES-1:0]     m_axis_tkeep,
-    output reg                  m_axis_tuser,
-    output reg                  m_axis_tlast,
-    output reg                  m_axis_tvalid,
-    input                       m_axis_tready
+    input  wire                clk,
+    input  wire                rst_n,
+    input  wire [7:0]          s_tdata,
+    input  wire                s_tvalid,
+    output wire                s_tready,
+    output reg  [8*EBYTES-1:0] m_axis_tdata,
+    output wire [EBYTES-1:0]   m_axis_tkeep,
+    output reg                 m_axis_tuser,
+    output reg                 m_axis_tlast,
+    output reg                 m_axis_tvalid,
+    input  wire                m_axis_tready
 );
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (EBYTES < 1 || EBYTES > 8) $fatal(1, "rfl_elem_pack: EBYTES must be 1..8");
+        if (LENGTH < 1) $fatal(1, "rfl_elem_pack: LENGTH must be at least 1");
+        if (LINE < 1 || LENGTH % LINE != 0)
+            $fatal(1, "rfl_elem_pack: LINE must be at least 1 and divide LENGTH");
+    end
+`else
+    if (EBYTES < 1 || EBYTES > 8) begin : g_bad_ebytes
+        $error("rfl_elem_pack: EBYTES must be 1..8");
+    end
+    if (LENGTH < 1) begin : g_bad_length
+        $error("rfl_elem_pack: LENGTH must be at least 1");
+    end
+    if (LINE < 1 || LENGTH % LINE != 0) begin : g_bad_line
+        $error("rfl_elem_pack: LINE must be at least 1 and divide LENGTH");
+    end
+`endif
+
     localparam EW = 8 * EBYTES;
     localparam NB = EBYTES - 1;
     localparam [3:0] LAST_LANE = NB[3:0];
@@ -81,3 +104,5 @@ module rfl_elem_pack #(
         end
     end
 endmodule
+
+`default_nettype wire

@@ -9,28 +9,43 @@
 // after a constant; an empty string for a skipped one); OP_ENCAP writes its 4 constant bytes.
 // No multiplier (100 MHz on an ECP5 with no DSP): an OP_VAR's bytes are its count shifted by
 // lsize, and a body's last byte is found by a count down (left_b).
+`default_nettype none
+
 module rfl_gpublisher #(
-    parameter CW = 6,                           // carry memory address bits
     parameter STREAM_DATA_BYTES = 4,            // bytes of the stream, for a dropped frame
     parameter [31:0] SEQ_START = 1              // the first message number (PUB_COUNT)
 ) (
-    input              clk,
-    input              rst_n,
-    input      [7:0]   s_tdata,                 // the application's bytes
-    input              s_tvalid,
-    output             s_tready,
-    output reg [7:0]   m_tdata,                 // the outgoing frame (combinational)
-    output             m_tvalid,
-    input              m_tready,
-    input              meta_valid,
-    output             meta_release,
-    input      [31:0]  meta_out_len,
-    input              meta_drop,
-    output     [CW-1:0] carry_raddr,
-    input      [7:0]   carry_rdata,
-    output             idle                     // no frame being written
+    input  wire        clk,
+    input  wire        rst_n,
+    input  wire [7:0]  s_tdata,                 // the application's bytes
+    input  wire        s_tvalid,
+    output wire        s_tready,
+    output reg  [7:0]  m_tdata,                 // the outgoing frame (combinational)
+    output wire        m_tvalid,
+    input  wire        m_tready,
+    input  wire        meta_valid,
+    output wire        meta_release,
+    input  wire [31:0] meta_out_len,
+    input  wire        meta_drop,
+    output wire        carry_restart,           // read the carried bytes from the first
+    output wire        carry_pop,               // carry_rdata taken: the next carried byte
+    input  wire [7:0]  carry_rdata,             // the carried byte at hand (a register)
+    output wire        idle                     // no frame being written
 );
 `include "rfl_layout.vh"
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (STREAM_DATA_BYTES < 0)
+            $fatal(1, "rfl_gpublisher: STREAM_DATA_BYTES must be at least 0");
+    end
+`else
+    if (STREAM_DATA_BYTES < 0) begin : g_bad_stream
+        $error("rfl_gpublisher: STREAM_DATA_BYTES must be at least 0");
+    end
+`endif
+
     localparam [3:0] P_IDLE = 4'd0, P_LEN = 4'd1, P_DECODE = 4'd2, P_COUNT = 4'd3,
                      P_COUNTED = 4'd4, P_BODY = 4'd5, P_DROP = 4'd6, P_DONE = 4'd7, P_PAD = 4'd8;
 
@@ -43,8 +58,12 @@ module rfl_gpublisher #(
     reg [31:0] n;                               // the count being written
     reg [34:0] left_b;                          // bytes of the current body still to write
     reg [31:0] seq;
-    reg [CW-1:0] raddr;
     reg [31:0] left [0:LOOPS-1];
+    // Flags kept with the registers they test, so that no decision of P_DECODE or P_COUNTED
+    // compares 32 bits before choosing the next instruction (100 MHz on an ECP5): n is zero
+    // (OP_VAR: so is its body, n << lsize), and each open loop's last element.
+    reg        n_zero;
+    reg [LOOPS-1:0] last_of;                    // left[d] == 1
     reg [DB-1:0] depth;
 
     reg [IW-1:0] w;                             // the current instruction: prog_word(pc)
@@ -74,8 +93,8 @@ module rfl_gpublisher #(
     wire [7:0] seq_byte = seq[8 * cnt[1:0] +: 8];
 
     wire carried = (state == P_COUNT || state == P_BODY) && (pub == PUB_CARRY);
-    // A carried byte comes from the carry memory (a block RAM: late), so it is chosen last,
-    // against every other byte (`other`, from flip-flops).
+    // A carried byte comes from the subscriber's carry_rdata register (read ahead of the carry
+    // memory's block RAM); every other byte is `other`.
     reg [7:0] other;
     always @* begin
         case (state)
@@ -95,10 +114,11 @@ module rfl_gpublisher #(
     assign m_tvalid = (state == P_LEN) || (state == P_COUNT) || (state == P_PAD)
                       || (state == P_BODY && (!from_stream || s_tvalid));
     assign s_tready = (from_stream && m_tready) || (state == P_DROP);
-    assign carry_raddr = raddr;
+    assign carry_restart = (state == P_IDLE) && meta_valid;
     assign meta_release = (state == P_DONE);
     assign idle = (state == P_IDLE);
     wire put = m_tvalid && m_tready;
+    assign carry_pop = put && carried;
     wire [31:0] n_next = {carry_rdata, n[31:8]};
     wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
 
@@ -134,23 +154,22 @@ module rfl_gpublisher #(
             w <= prog_word(16'd0);
             cnt <= 32'd0;
             n <= 32'd0;
+            n_zero <= 1'b1;
+            last_of <= {LOOPS{1'b0}};
             left_b <= 35'd0;
             seq <= SEQ_START;
             opos <= 32'd0;
             padn <= 3'd0;
             pad_ret <= P_IDLE;
-            raddr <= {CW{1'b0}};
             depth <= {DB{1'b0}};
             for (d = 0; d < LOOPS; d = d + 1) left[d] <= 32'd0;
         end else begin
             if (put) cnt <= cnt + 32'd1;
             if (put) opos <= opos + 32'd1;
-            if (put && carried) raddr <= raddr + 1'b1;
             case (state)
                 P_IDLE: if (meta_valid) begin
                     cnt <= 32'd0;
                     opos <= 32'd0;
-                    raddr <= {CW{1'b0}};
                     depth <= {DB{1'b0}};
                     pc <= 16'd0;
                     w <= prog_word(16'd0);
@@ -167,8 +186,9 @@ module rfl_gpublisher #(
                         state <= P_DONE;
                     end
                     OP_END: begin
-                        if (left[depth - 1'b1] != 32'd1) begin
+                        if (!last_of[depth - 1'b1]) begin
                             left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
+                            last_of[depth - 1'b1] <= (left[depth - 1'b1] == 32'd2);
                             go(jump + 16'd1, prog_jump(pc));
                         end else begin
                             depth <= depth - 1'b1;
@@ -186,15 +206,20 @@ module rfl_gpublisher #(
                     default: begin  // OP_VAR, OP_LOOP
                         if (op == OP_LOOP && !variable) begin
                             n <= count;
+                            n_zero <= (count == 32'd0);
                             state <= P_COUNTED;
                         end else begin
                             n <= own_count;
+                            n_zero <= (own_count == 32'd0);
                             pad_then(pad_at(opos, align), P_COUNT);
                         end
                     end
                 endcase
                 P_COUNT: if (put) begin
-                    if (pub == PUB_CARRY) n <= n_next;
+                    if (pub == PUB_CARRY) begin
+                        n <= n_next;
+                        n_zero <= (n_next == 32'd0);
+                    end
                     if (cnt == 32'd3) begin
                         state <= P_COUNTED;
                         cnt <= 32'd0;
@@ -202,13 +227,14 @@ module rfl_gpublisher #(
                 end
                 P_COUNTED: begin
                     if (op == OP_LOOP) begin
-                        if (n == 32'd0) go(jump + 16'd1, prog_jump(pc));
+                        if (n_zero) go(jump + 16'd1, prog_jump(pc));
                         else begin
                             left[depth] <= n;
+                            last_of[depth] <= (n == 32'd1);
                             depth <= depth + 1'b1;
                             go(pc + 16'd1, prog_next(pc));
                         end
-                    end else if (body == 35'd0) begin
+                    end else if (n_zero) begin  // body == 0
                         go(pc + 16'd1, prog_next(pc));
                     end else begin
                         left_b <= body;
@@ -231,5 +257,13 @@ module rfl_gpublisher #(
 `ifdef FORMAL
     // the instruction register holds the word of pc (an invariant the proofs carry)
     always @(*) if (rst_n) assert(w == prog_word(pc));
+    // ... and the flags their registers (invariants too)
+    integer fd;
+    always @(*) if (rst_n) begin
+        assert(n_zero == (n == 32'd0));
+        for (fd = 0; fd < LOOPS; fd = fd + 1) assert(last_of[fd] == (left[fd] == 32'd1));
+    end
 `endif
 endmodule
+
+`default_nettype wire

@@ -19,32 +19,54 @@
 // elem_min per clock, before S_COUNTED checks them. The bytes left for the fields (room: CDR
 // less the end padding) and in the frame (left_f) are registers kept with pos, and a body's
 // last byte is found by a count down (left_b), so that no clock subtracts and compares in a row.
+`default_nettype none
+
 module rfl_gsubscriber #(
     parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
     parameter CW = 6,                           // its address bits
     parameter MIN_BODY = 0,                     // shortest frame length accepted
     parameter MAX_FRAME = 67108864              // longest frame length accepted
 ) (
-    input              clk,
-    input              rst_n,
-    input      [7:0]   s_tdata,
-    input              s_tvalid,
-    output             s_tready,
-    output     [7:0]   m_tdata,                 // streamed bytes
-    output             m_tvalid,
-    input              m_tready,
+    input  wire        clk,
+    input  wire        rst_n,
+    input  wire [7:0]  s_tdata,
+    input  wire        s_tvalid,
+    output wire        s_tready,
+    output wire [7:0]  m_tdata,                 // streamed bytes
+    output wire        m_tvalid,
+    input  wire        m_tready,
     output reg         meta_valid,
-    input              meta_release,
-    output reg [31:0]  meta_out_len,            // the publisher's frame length
+    input  wire        meta_release,
+    output reg  [31:0] meta_out_len,            // the publisher's frame length
     output reg         meta_drop,               // refused after its stream: drop the stream
-    input      [CW-1:0] carry_raddr,
-    output     [7:0]   carry_rdata,
-    output             frame_start,
+    input  wire        carry_restart,           // the publisher reads them from the first
+    input  wire        carry_pop,               // ... has taken carry_rdata: the next
+    output reg  [7:0]  carry_rdata,             // the carried byte at hand (a register)
+    output wire        frame_start,
     output reg         status_valid,
-    output reg [7:0]   status,
-    output             idle                     // between frames
+    output reg  [7:0]  status,
+    output wire        idle                     // between frames
 );
 `include "rfl_layout.vh"
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (CARRY_BYTES < 1 || CW < 1 || CW > 16 || (1 << CW) < CARRY_BYTES)
+            $fatal(1,
+                   "rfl_gsubscriber: CARRY_BYTES must be at least 1 and at most 2**CW (CW 1..16)");
+        if (MIN_BODY < 0 || MIN_BODY > MAX_FRAME)
+            $fatal(1, "rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME");
+    end
+`else
+    if (CARRY_BYTES < 1 || CW < 1 || CW > 16 || (1 << CW) < CARRY_BYTES) begin : g_bad_carry
+        $error("rfl_gsubscriber: CARRY_BYTES must be at least 1 and at most 2**CW (CW 1..16)");
+    end
+    if (MIN_BODY < 0 || MIN_BODY > MAX_FRAME) begin : g_bad_frame
+        $error("rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME");
+    end
+`endif
+
     localparam [3:0] S_FLEN = 4'd0, S_DECODE = 4'd1, S_COUNT = 4'd2, S_COUNTED = 4'd3,
                      S_BODY = 4'd4, S_FINISH = 4'd5, S_SKIP = 4'd6, S_PAD = 4'd7, S_TAIL = 4'd8,
                      S_LEAST = 4'd9, S_FCHK = 4'd10;
@@ -60,6 +82,7 @@ module rfl_gsubscriber #(
     reg [31:0] cnt;                             // bytes of the current part taken so far
     reg [31:0] n;                               // a count, shifted in little-endian
     reg [34:0] left_b;                          // bytes of the current body still to take
+    reg        last_b;                          // left_b == 1 (kept with it: S_BODY's end)
     reg [31:0] room;                            // bytes left for the fields (CDR: before the end padding)
     reg [63:0] least_r;                         // OP_LOOP: count x elem_min, added up (S_LEAST)
     reg [63:0] nsh;                             // the count shifted by the elem_min bits done
@@ -111,7 +134,6 @@ module rfl_gsubscriber #(
     wire take = s_tvalid && s_tready;
     assign frame_start = take && (state == S_FLEN) && (cnt[1:0] == 2'd0);
     assign idle = (state == S_FLEN) && (cnt[1:0] == 2'd0);
-    assign carry_rdata = carry_mem[carry_raddr];
 
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
     wire [31:0] pos_next = pos + 32'd1;
@@ -129,8 +151,14 @@ module rfl_gsubscriber #(
                           : (pub == PUB_CARRY || pub == PUB_STREAM) ? body[31:0]
                           : (pub == PUB_CONST) ? {16'd0, klen} + {31'd0, nul} : {31'd0, nul};
     wire [31:0] out_base = (op == OP_FIXED) ? out_len : out_len + 32'd4;
-    wire [31:0] out_pad = (written == 32'd0) ? 32'd0
-                          : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
+    // (registered on every clock: out_len, n and the instruction hold from S_COUNTED, or the
+    // field's last byte, to S_FINISH, whose first settling clock adds them up into p_out_at)
+    reg [31:0]  r_out_base, r_out_pad;
+    always @(posedge clk) begin
+        r_out_base <= out_base;
+        r_out_pad <= (written == 32'd0) ? 32'd0
+                     : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
+    end
     wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
     // fewest bytes of the counted elements (OP_VAR: its elements' bytes)
     wire [63:0] least = (op == OP_VAR) ? {29'd0, body} : least_r;
@@ -188,6 +216,30 @@ module rfl_gsubscriber #(
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
     end
 
+    // The carry memory's read side: the publisher takes the carried bytes in order, from the
+    // first, once per frame (carry_restart, then carry_pop for each), while nothing is written
+    // (it writes while meta_valid holds, and a new frame waits for meta_release). They are read
+    // ahead into two registers, as rfl_fifo's OUTREG does: the block RAM's read register (cq),
+    // then carry_rdata in the fabric, so that the publisher's byte does not start from a block
+    // RAM's slow clock-to-output (100 MHz timing on an ECP5). Two clocks after carry_restart the
+    // first byte is in carry_rdata (the publisher's first carried byte comes after the frame
+    // length's 4 bytes and a decode); from then on each carry_pop moves the next one in.
+    reg [CW-1:0] craddr;                        // the next byte to read
+    reg [7:0]  cq;                              // the byte after carry_rdata
+    reg [1:0]  cfill;                           // registers filled since carry_restart (0..2)
+    wire       cadv = (cfill != 2'd2) || carry_pop;
+    always @(posedge clk) begin
+        if (cadv) cq <= carry_mem[craddr];
+        if (cadv && cfill != 2'd0) carry_rdata <= cq;
+        if (!rst_n || carry_restart) begin
+            craddr <= {CW{1'b0}};
+            cfill <= 2'd0;
+        end else if (cadv) begin
+            craddr <= craddr + 1'b1;
+            if (cfill != 2'd2) cfill <= cfill + 2'd1;
+        end
+    end
+
     // The decisions' arithmetic, registered: S_FCHK, S_DECODE, S_COUNTED and S_FINISH take
     // three clocks, the first two (settled 0, 1) with nothing changing but these registers (p_*: the
     // subtractions and the value's key; c_*: the comparisons, from p_*), so that the third
@@ -200,8 +252,28 @@ module rfl_gsubscriber #(
     wire in_range = !p_vnan && lo_key <= p_vkey && p_vkey <= hi_key;
     reg c_tail, c_left1, c_padf_bad, c_size_gt, c_roomf_lt4, c_count_bad, c_fit_bad, c_least_gt,
         c_body0, c_pade_bad, c_body_gt, c_encap_bad, c_encap_pad_gt, c_check_bad, c_range_bad,
-        c_at_end, c_room0, c_room_lt4, c_size0, c_n0, c_n1, c_flen_long, c_flen_short;
+        c_at_end, c_room0, c_room_lt4, c_size0, c_n0, c_n1, c_flen_long, c_flen_short, c_body1,
+        c_size1;
     reg [31:0] c_out_len;                          // S_FINISH: out_len after the field
+    // out_len and room after a decision's additions, settled the same way (each decision acts
+    // on flip-flops only): an OP_VAR's count padding, a variable OP_LOOP's count, OP_ENCAP's
+    // header and end padding
+    reg [31:0] p_out_var, p_out4, p_out_klen, p_room_encap;
+    // The next instructions, registered (the ROM look-up and the adders are not on the
+    // decision's path): pc holds from one go() through the two settling clocks of the decision
+    // that does the next, so by then these are prog_next(pc), prog_jump(pc) and their pcs.
+    reg [IW-1:0] w_nx, w_jp;
+    reg [15:0] pc_nx, pc_jp;
+    always @(posedge clk) begin
+        w_nx <= prog_next(pc);
+        w_jp <= prog_jump(pc);
+        pc_nx <= pc + 16'd1;
+        pc_jp <= jump + 16'd1;
+        p_out_var <= out_len + pad_at(out_len + 32'd4, align);
+        p_out4 <= out_len + 32'd4;
+        p_out_klen <= out_len + {16'd0, klen};
+        p_room_encap <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
+    end
     always @(posedge clk) begin
         c_tail <= tail_zero;
         c_at_end <= at_end;
@@ -219,7 +291,7 @@ module rfl_gsubscriber #(
         p_vkey <= vkey;
         p_vnan <= (kind == 2'd2 && is_nan(value, size));
         p_least <= least;
-        p_out_at <= out_base + out_pad;
+        p_out_at <= r_out_base + r_out_pad;
         p_written <= written;
         p_least_fa <= least + {32'd0, fixed_after};
         c_size_gt <= (size > p_room_f);
@@ -228,6 +300,8 @@ module rfl_gsubscriber #(
         c_fit_bad <= fits && p_least_fa != {32'd0, room};
         c_least_gt <= (p_least > {32'd0, room});
         c_body0 <= (body == 35'd0);
+        c_body1 <= (body == 35'd1);
+        c_size1 <= (size == 32'd1);
         c_pade_bad <= (pad_e != 32'd0 && pad_e >= room);
         c_body_gt <= (body > {3'd0, p_room_e});
         c_encap_bad <= (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1));
@@ -315,6 +389,7 @@ module rfl_gsubscriber #(
             cnt <= 32'd0;
             n <= 32'd0;
             left_b <= 35'd0;
+            last_b <= 1'b0;
             settled <= 2'd0;
             room <= 32'd0;
             least_r <= 64'd0;
@@ -345,6 +420,10 @@ module rfl_gsubscriber #(
                 cnt <= cnt + 32'd1;
                 if (keep && (state == S_COUNT || state == S_BODY)) waddr <= waddr + 1'b1;
             end
+            // a SUB_RANGE or OP_ENCAP field's bytes: taken whenever offered (the same byte again
+            // until it is taken; only a streamed one waits for m_tready), so that take's fan-out
+            // does not reach these 64 enables (S_DECODE clears value after this)
+            if (state == S_BODY && s_tvalid && cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
             case (state)
                 S_FLEN: if (take) begin
                     n <= n_next;
@@ -402,27 +481,29 @@ module rfl_gsubscriber #(
                             if (c_room_lt4) refuse(st, c_at_end);
                             else begin
                                 left_b <= 35'd4;
+                                last_b <= 1'b0;
                                 state <= S_BODY;
                             end
                         end
                         OP_END: begin
                             if (c_left1) begin
                                 left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
-                                go(jump + 16'd1, prog_jump(pc));
+                                go(pc_jp, w_jp);
                             end else begin
                                 depth <= depth - 1'b1;
                                 if (quiet_of[depth - 1'b1]) quiet <= quiet - 8'd1;
-                                go(pc + 16'd1, prog_next(pc));
+                                go(pc_nx, w_nx);
                             end
                         end
                         OP_FIXED: begin
-                            if (c_size0) go(pc + 16'd1, prog_next(pc));
+                            if (c_size0) go(pc_nx, w_nx);
                             else if (c_padf_bad)
                                 refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                             else if (c_size_gt)
                                 refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
                             else begin
                                 left_b <= {3'd0, size};
+                                last_b <= c_size1;
                                 pad_then(pad_f, S_BODY);
                             end
                         end
@@ -437,7 +518,7 @@ module rfl_gsubscriber #(
                                 refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                             else if (c_roomf_lt4) refuse(st, c_at_end);  // cut short in its count
                             else begin
-                                if (quiet == 8'd0) out_len <= out_len + pad_at(out_len + 32'd4, align);
+                                if (quiet == 8'd0) out_len <= p_out_var;
                                 pad_then(pad_f, S_COUNT);
                             end
                         end
@@ -474,14 +555,14 @@ module rfl_gsubscriber #(
                         refuse(st, c_at_end);
                     else if (op == OP_LOOP) begin
                         begin
-                            if (variable && quiet == 8'd0) out_len <= out_len + 32'd4;
-                            if (c_n0) go(jump + 16'd1, prog_jump(pc));
+                            if (variable && quiet == 8'd0) out_len <= p_out4;
+                            if (c_n0) go(pc_jp, w_jp);
                             else begin
                                 left[depth] <= n;
                                 quiet_of[depth] <= variable && pub == PUB_ZERO;
                                 if (variable && pub == PUB_ZERO) quiet <= quiet + 8'd1;
                                 depth <= depth + 1'b1;
-                                go(pc + 16'd1, prog_next(pc));
+                                go(pc_nx, w_nx);
                             end
                         end
                     end else if (c_body0) begin
@@ -492,6 +573,7 @@ module rfl_gsubscriber #(
                         refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
                     end else begin
                         left_b <= body;
+                        last_b <= c_body1;
                         pad_then(pad_e, S_BODY);
                     end
                 end
@@ -500,12 +582,12 @@ module rfl_gsubscriber #(
                     cnt <= 32'd0;
                 end
                 S_BODY: if (take) begin
-                    if (cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
                     left_b <= left_b - 35'd1;
-                    if (nul && left_b == 35'd1) nul_bad <= (s_tdata != 8'd0);
+                    last_b <= (left_b == 35'd2);
+                    if (nul && last_b) nul_bad <= (s_tdata != 8'd0);
                     else if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
                     if (sub == SUB_STREAM) streamed <= 1'b1;
-                    if (left_b == 35'd1) state <= S_FINISH;
+                    if (last_b) state <= S_FINISH;
                 end
                 S_FINISH: if (settled != 2'd2) settled <= settled + 2'd1; else begin
                     settled <= 2'd0;
@@ -515,9 +597,9 @@ module rfl_gsubscriber #(
                         else if (c_encap_pad_gt)
                             refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                         else begin
-                            room <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
-                            out_len <= out_len + {16'd0, klen};
-                            go(pc + 16'd1, prog_next(pc));
+                            room <= p_room_encap;
+                            out_len <= p_out_klen;
+                            go(pc_nx, w_nx);
                         end
                     end
                     else if (c_check_bad)
@@ -526,7 +608,7 @@ module rfl_gsubscriber #(
                     else if (nul_bad) refuse(st3, c_at_end);
                     else begin
                         if (quiet == 8'd0) out_len <= c_out_len;
-                        go(pc + 16'd1, prog_next(pc));
+                        go(pc_nx, w_nx);
                     end
                 end
                 S_TAIL: if (take) begin  // CDR: an unannounced end pad byte, which must be 0
@@ -545,5 +627,16 @@ module rfl_gsubscriber #(
 `ifdef FORMAL
     // the instruction register holds the word of pc (an invariant the proofs carry)
     always @(*) if (rst_n) assert(w == prog_word(pc));
+    always @(*) if (rst_n) assert(last_b == (left_b == 35'd1));
+    // a decision settles only in its own state, from 0 (each decision ends at 2 with 0)
+    always @(*) if (rst_n)
+        assert(settled == 2'd0 || (settled != 2'd3 && (state == S_FCHK || state == S_DECODE
+                                                       || state == S_COUNTED || state == S_FINISH)));
+    // ... and, once a clock has settled, the next instructions are those of pc
+    always @(*) if (rst_n && settled != 2'd0)
+        assert(w_nx == prog_next(pc) && w_jp == prog_jump(pc) && pc_nx == pc + 16'd1
+               && pc_jp == jump + 16'd1);
 `endif
 endmodule
+
+`default_nettype wire

@@ -1,6 +1,7 @@
 // rfl_gtop -- the whole data path of a generated component for any message type:
 //
-//   s_* (8-bit, from TCP/IP) -> [rx FIFO] -> rfl_gsubscriber -> rfl_elem_pack -> [axis FIFO]
+//   s_* (8-bit, from TCP/IP) -> [rx FIFO] -> [slice] -> rfl_gsubscriber -> [slice]
+//     -> rfl_elem_pack -> [axis FIFO]
 //     -> rfl_window1d -> [axis FIFO, OUT_DEPTH] -> rfl_elem_unpack -> rfl_gpublisher
 //     -> [register slice] -> [tx FIFO] -> m_* (8-bit, to TCP/IP)
 //
@@ -10,10 +11,13 @@
 //
 // The publisher starts a frame once the subscriber has read all of it (the frame length comes
 // first and depends on every field), so the FIFO after the application holds a whole stream:
-// OUT_DEPTH >= LENGTH + 2. The carry memory lives in the subscriber; the publisher reads it.
+// OUT_DEPTH >= LENGTH + 2 (checked). The carry memory lives in the subscriber; the publisher
+// reads it in order (the subscriber reads it ahead into registers).
 // The FIFOs that feed logic (rx, axis in, axis out) register their RAM's output once more
 // (rfl_fifo's OUTREG, when at least 3 deep): what reads them does not start from a block RAM's
 // slow clock-to-output (100 MHz timing on an ECP5); same entries, two more clocks of latency.
+`default_nettype none
+
 module rfl_gtop #(
     parameter EBYTES = 4,                       // bytes per streamed element
     parameter LENGTH = 16,                      // elements of the streamed array
@@ -35,19 +39,43 @@ module rfl_gtop #(
     parameter HEIGHT = 1                        // VIDEO: lines (unused without VIDEO)
     /* verilator lint_on UNUSEDPARAM */
 ) (
-    input        clk,
-    input        rst_n,
-    input  [7:0] s_tdata,
-    input        s_tvalid,
-    output       s_tready,
-    output [7:0] m_tdata,
-    output       m_tvalid,
-    input        m_tready,
-    output       frame_start,                   // the subscriber took a frame's first byte
-    output       status_valid,                  // the subscriber decided on a frame
-    output [7:0] status,
-    output       busy                           // something is in flight
+    input  wire       clk,
+    input  wire       rst_n,
+    input  wire [7:0] s_tdata,
+    input  wire       s_tvalid,
+    output wire       s_tready,
+    output wire [7:0] m_tdata,
+    output wire       m_tvalid,
+    input  wire       m_tready,
+    output wire       frame_start,              // the subscriber took a frame's first byte
+    output wire       status_valid,             // the subscriber decided on a frame
+    output wire [7:0] status,
+    output wire       busy                      // something is in flight
 );
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (VIDEO ? (EBYTES < 1 || EBYTES > 4) : !(EBYTES == 1 || EBYTES == 2 || EBYTES == 4
+                                                  || EBYTES == 8))
+            $fatal(1, "rfl_gtop: EBYTES must be 1, 2, 4 or 8 (VIDEO: 1..4)");
+        if (LENGTH < 1) $fatal(1, "rfl_gtop: LENGTH must be at least 1");
+        if (OUT_DEPTH < LENGTH + 2)
+            $fatal(1, "rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream)");
+    end
+`else
+    if (VIDEO ? (EBYTES < 1 || EBYTES > 4) : !(EBYTES == 1 || EBYTES == 2 || EBYTES == 4
+                                              || EBYTES == 8)) begin : g_bad_ebytes
+        $error("rfl_gtop: EBYTES must be 1, 2, 4 or 8 (VIDEO: 1..4)");
+    end
+    if (LENGTH < 1) begin : g_bad_length
+        $error("rfl_gtop: LENGTH must be at least 1");
+    end
+    if (OUT_DEPTH < LENGTH + 2) begin : g_bad_out_depth
+        $error("rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream)");
+    end
+`endif
+
     localparam EW = 8 * EBYTES;
     localparam BW = EW + EBYTES + 2;            // a beat in the FIFOs: tlast, tuser, tkeep, tdata
 
@@ -62,26 +90,33 @@ module rfl_gtop #(
     wire [EBYTES-1:0] axis_out_tkeep;
     wire axis_out_tuser, axis_out_tlast;
     /* verilator lint_on UNUSEDSIGNAL */
+    wire [7:0] rxf_tdata;
+    wire rxf_tvalid, rxf_tready;
     rfl_fifo #(.WIDTH(8), .DEPTH(RX_DEPTH), .OUTREG(RX_DEPTH > 2 ? 1 : 0)) u_rx_fifo (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
-        .m_tdata(rx_tdata), .m_tvalid(rx_tvalid), .m_tready(rx_tready), .level(rx_level));
+        .m_tdata(rxf_tdata), .m_tvalid(rxf_tvalid), .m_tready(rxf_tready), .level(rx_level));
+    // a register slice: the subscriber's ready (which every one of its registers' enables
+    // follows) reaches the rx FIFO's read side through a flip-flop (100 MHz timing on an ECP5)
+    rfl_slice #(.WIDTH(8)) u_rx_slice (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(rxf_tdata), .s_tvalid(rxf_tvalid), .s_tready(rxf_tready),
+        .m_tdata(rx_tdata), .m_tvalid(rx_tvalid), .m_tready(rx_tready));
 
     // subscriber -> element packer (streamed bytes), subscriber <-> publisher (meta, carry)
     wire [7:0] pix_in_tdata, carry_rdata;
     wire pix_in_tvalid, pix_in_tready;
-    wire meta_valid, meta_release, meta_drop, sub_idle, pub_idle;
+    wire meta_valid, meta_release, meta_drop, sub_idle, pub_idle, carry_restart, carry_pop;
     wire [31:0] meta_out_len;
-    wire [CW-1:0] carry_raddr;
     rfl_gsubscriber #(.CARRY_BYTES(CARRY_BYTES), .CW(CW), .MIN_BODY(MIN_BODY),
                       .MAX_FRAME(MAX_FRAME)) u_subscriber (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(rx_tdata), .s_tvalid(rx_tvalid), .s_tready(rx_tready),
         .m_tdata(pix_in_tdata), .m_tvalid(pix_in_tvalid), .m_tready(pix_in_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
-        .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
-        .frame_start(frame_start), .status_valid(status_valid), .status(status),
-        .idle(sub_idle));
+        .meta_drop(meta_drop), .carry_restart(carry_restart), .carry_pop(carry_pop),
+        .carry_rdata(carry_rdata), .frame_start(frame_start), .status_valid(status_valid),
+        .status(status), .idle(sub_idle));
 
     // element packer -> axis FIFO -> application
     wire [EW-1:0] axis_in_tdata, app_in_tdata, app_out_tdata, axis_out_tdata;
@@ -90,9 +125,17 @@ module rfl_gtop #(
     wire app_in_tuser, app_in_tlast, app_in_tvalid, app_in_tready;
     wire app_out_tuser, app_out_tlast, app_out_tvalid, app_out_tready;
     wire axis_out_tvalid, axis_out_tready;
-    rfl_elem_pack #(.EBYTES(EBYTES), .LENGTH(LENGTH), .LINE(VIDEO ? WIDTH : LENGTH)) u_fifo2axi (
+    // a register slice: the packer's ready (from the axis FIFO's level) reaches the
+    // subscriber through a flip-flop, not on to the rx side (100 MHz timing on an ECP5)
+    wire [7:0] pk_tdata;
+    wire pk_tvalid, pk_tready;
+    rfl_slice #(.WIDTH(8)) u_pack_slice (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(pix_in_tdata), .s_tvalid(pix_in_tvalid), .s_tready(pix_in_tready),
+        .m_tdata(pk_tdata), .m_tvalid(pk_tvalid), .m_tready(pk_tready));
+    rfl_elem_pack #(.EBYTES(EBYTES), .LENGTH(LENGTH), .LINE(VIDEO ? WIDTH : LENGTH)) u_fifo2axi (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(pk_tdata), .s_tvalid(pk_tvalid), .s_tready(pk_tready),
         .m_axis_tdata(axis_in_tdata), .m_axis_tkeep(axis_in_tkeep), .m_axis_tuser(axis_in_tuser),
         .m_axis_tlast(axis_in_tlast), .m_axis_tvalid(axis_in_tvalid),
         .m_axis_tready(axis_in_tready));
@@ -161,13 +204,13 @@ module rfl_gtop #(
 
     wire [7:0] pub_tdata, tx_tdata;
     wire pub_tvalid, pub_tready, tx_tvalid, tx_tready;
-    rfl_gpublisher #(.CW(CW), .STREAM_DATA_BYTES(LENGTH * EBYTES), .SEQ_START(SEQ_START)) u_publisher (
+    rfl_gpublisher #(.STREAM_DATA_BYTES(LENGTH * EBYTES), .SEQ_START(SEQ_START)) u_publisher (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(pix_out_tdata), .s_tvalid(pix_out_tvalid), .s_tready(pix_out_tready),
         .m_tdata(pub_tdata), .m_tvalid(pub_tvalid), .m_tready(pub_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
-        .meta_drop(meta_drop), .carry_raddr(carry_raddr), .carry_rdata(carry_rdata),
-        .idle(pub_idle));
+        .meta_drop(meta_drop), .carry_restart(carry_restart), .carry_pop(carry_pop),
+        .carry_rdata(carry_rdata), .idle(pub_idle));
 
     // a register slice: the publisher's bytes (a carried one straight from the carry memory's
     // block RAM) reach a flip-flop before the tx FIFO's RAM (100 MHz timing on an ECP5)
@@ -181,7 +224,10 @@ module rfl_gtop #(
         .s_tdata(tx_tdata), .s_tvalid(tx_tvalid), .s_tready(tx_tready),
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready), .level(tx_level));
 
-    assign busy = rx_tvalid || meta_valid || pix_in_tvalid || axis_in_tvalid || app_in_tvalid
+    assign busy = rxf_tvalid || rx_tvalid || meta_valid || pix_in_tvalid || pk_tvalid
+                  || axis_in_tvalid || app_in_tvalid
                   || app_out_tvalid || axis_out_tvalid || pix_out_tvalid || pub_tvalid || tx_tvalid
                   || m_tvalid || !sub_idle || !pub_idle;
 endmodule
+
+`default_nettype wire

@@ -22,26 +22,56 @@
 // window's result is the fold of the newest KSIZE-1 entries with the new element. The rule
 // folded (the first NaN, else the last of the largest, or smallest, keys) picks the same
 // element however the entries are grouped, so this equals numpy's left fold.
+`default_nettype none
+
 module rfl_window1d #(
     parameter EBYTES = 4,                       // bytes per element: 1, 2, 4 or 8
     parameter KSIZE = 3,                        // odd, 1..15
     parameter OP = 0,                           // 0 max (dilate), 1 min (erode), 2 passthrough
     parameter KIND = 0                          // 0 unsigned, 1 signed, 2 float
 ) (
-    input                       aclk,
-    input                       aresetn,
-    input      [8*EBYTES-1:0]   s_axis_tdata,
-    input                       s_axis_tuser,
-    input                       s_axis_tlast,
-    input                       s_axis_tvalid,
-    output                      s_axis_tready,
-    output reg [8*EBYTES-1:0]   m_axis_tdata,
-    output     [EBYTES-1:0]     m_axis_tkeep,
-    output reg                  m_axis_tuser,
-    output reg                  m_axis_tlast,
-    output reg                  m_axis_tvalid,
-    input                       m_axis_tready
+    input  wire                aclk,
+    input  wire                aresetn,
+    input  wire [8*EBYTES-1:0] s_axis_tdata,
+    input  wire                s_axis_tuser,
+    input  wire                s_axis_tlast,
+    input  wire                s_axis_tvalid,
+    output wire                s_axis_tready,
+    output reg  [8*EBYTES-1:0] m_axis_tdata,
+    output wire [EBYTES-1:0]   m_axis_tkeep,
+    output reg                 m_axis_tuser,
+    output reg                 m_axis_tlast,
+    output reg                 m_axis_tvalid,
+    input  wire                m_axis_tready
 );
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    initial begin
+        if (EBYTES != 1 && EBYTES != 2 && EBYTES != 4 && EBYTES != 8)
+            $fatal(1, "rfl_window1d: EBYTES must be 1, 2, 4 or 8");
+        if (KSIZE < 1 || KSIZE > 15 || KSIZE % 2 != 1)
+            $fatal(1, "rfl_window1d: KSIZE must be odd, 1..15");
+        if (OP < 0 || OP > 2)
+            $fatal(1, "rfl_window1d: OP must be 0 (dilate), 1 (erode) or 2 (passthrough)");
+        if (KIND < 0 || KIND > 2)
+            $fatal(1, "rfl_window1d: KIND must be 0 (unsigned), 1 (signed) or 2 (float)");
+    end
+`else
+    if (EBYTES != 1 && EBYTES != 2 && EBYTES != 4 && EBYTES != 8) begin : g_bad_ebytes
+        $error("rfl_window1d: EBYTES must be 1, 2, 4 or 8");
+    end
+    if (KSIZE < 1 || KSIZE > 15 || KSIZE % 2 != 1) begin : g_bad_ksize
+        $error("rfl_window1d: KSIZE must be odd, 1..15");
+    end
+    if (OP < 0 || OP > 2) begin : g_bad_op
+        $error("rfl_window1d: OP must be 0 (dilate), 1 (erode) or 2 (passthrough)");
+    end
+    if (KIND < 0 || KIND > 2) begin : g_bad_kind
+        $error("rfl_window1d: KIND must be 0 (unsigned), 1 (signed) or 2 (float)");
+    end
+`endif
+
     localparam EW = 8 * EBYTES;
     localparam K = (OP == 2) ? 1 : KSIZE;       // a pass-through has a window of one
     localparam R = K / 2;
@@ -182,3 +212,5 @@ module rfl_window1d #(
         end
     end
 endmodule
+
+`default_nettype wire

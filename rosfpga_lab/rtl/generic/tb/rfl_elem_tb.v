@@ -4,6 +4,8 @@
 // output backpressure (+gap=P +bp=P, per mille of clocks; +seed=N). A TUSER or TLAST in the
 // wrong place (TLAST: the last element of every LINE, the packer's video framing) is reported
 // as "rtlsim: ERROR".
+`default_nettype none
+
 module rfl_elem_tb;
     parameter EBYTES = 4;
     parameter LENGTH = 16;
@@ -108,3 +110,5 @@ module rfl_elem_tb;
         end
     end
 endmodule
+
+`default_nettype wire
