@@ -10,7 +10,7 @@ The message and the configuration are the notebook's example (``EXAMPLE_MSG_TEXT
 returned as ``MSG_TEXT`` and ``CONFIG_TEXT``, the texts the notebook runs unless a student
 changes them); the project is what
 ``rosfpga-lab generate`` writes for them and the frames are its testbench's (``tb_input.bin``:
-a good frame, a refused one, a good one). tests/test_notebook10_shipped.py checks that the file
+a good frame, a refused one, a good one). tests/flow/test_notebook10_shipped.py checks that the file
 belongs to the notebook's texts and, with the tools, makes it again and compares.
 """
 

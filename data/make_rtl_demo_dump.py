@@ -5,7 +5,7 @@ Run from the repository root with the lab installed and Icarus Verilog on PATH:
     python data/make_rtl_demo_dump.py
 
 The circuit, the frames and the simulator settings are rosfpga_lab.rtl.demo's (one owner);
-tests/test_rtl_demo.py regenerates the dump the same way and fails when it drifts.
+tests/rtl/test_demo.py regenerates the dump the same way and fails when it drifts.
 """
 
 from __future__ import annotations

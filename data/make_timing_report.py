@@ -11,7 +11,7 @@ It does what ``rosfpga-lab rtl timing data/fpga_dilate_rgba8.yaml`` does (synth_
 nextpnr-ecp5 at the configuration's clock_mhz, seed 1) and writes the report beside this
 script: the JSON (rosfpga_lab.rtl.timing.report_to_dict, read back by report_from_dict) and the
 text that command prints. Notebook 08 shows the shipped report, since place and route takes
-minutes; tests/test_notebook_claims.py checks that the shipped report says the clock is met.
+minutes; tests/flow/test_notebooks_claims.py checks that the shipped report says the clock is met.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 The package is layered (``ARCHITECTURE.md`` in the repository: the layers, the conventions, the
 commands): ``errors`` -> ``msg`` -> ``tcpros``/``rtps`` -> ``config`` -> ``graph`` -> ``hw`` ->
 ``hls`` -> ``rtl`` -> ``component`` -> ``widgets``/``checks`` -> ``bench`` -> ``cli``. A layer
-imports only the layers below it (``tests/test_layers.py``).
+imports only the layers below it (``tests/flow/test_layers.py``).
 """
 
 from rosfpga_lab.errors import LabError

@@ -1,17 +1,15 @@
-"""Shared fixtures. Real-ROS helpers live in ``realros.py`` beside this file."""
+"""Shared fixtures. The helpers live in the package ``tests/support/`` (real ROS:
+``tests/support/realros.py``)."""
 
 from __future__ import annotations
 
 import os
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from realros import real_rosmaster, require_cxx, require_ros  # noqa: E402
+from tests.support.realros import real_rosmaster, require_cxx, require_ros  # noqa: E402
 
 #: What a caller's shell may hold that changes what the lab, or a program a test starts, does:
 #: ROS 1 (``ROS_MASTER_URI``, ``ROS_HOSTNAME``, ``ROS_IP``, ``ROS_NAMESPACE``, ``ROS_IPV6``, ...)

@@ -14,7 +14,7 @@ hand: the metadata is derived here on every build, so it can never drift from th
 :func:`configure` points nbgrader's own ``ClearSolutions`` preprocessor at the lab's
 placeholders (:mod:`rosfpga_lab.checks.nbbuild`), so ``nbgrader generate_assignment`` writes
 the same student cells as ``rosfpga-lab notebooks build`` (the answer and check cells joined
-again give the lab's exercise cell); ``tests/test_course_nbgrader.py`` holds them equal. One
+again give the lab's exercise cell); ``tests/flow/test_course_nbgrader.py`` holds them equal. One
 mechanism makes the committed student notebooks (the lab's build, which every student has);
 nbgrader, on the course server only, is configured to agree with it. In Markdown, nbgrader
 replaces whole lines, so there the two agree when ``<!-- BEGIN SOLUTION -->`` and

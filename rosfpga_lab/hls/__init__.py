@@ -36,7 +36,7 @@ same walkers for ROS 2's CDR samples; ``sensor_msgs/Image`` is one type among th
 ``data`` framed as video for the 2-D application. The shipped examples are mapped in
 ``data/README.md``. Golden files of the generated code are in ``tests/golden/hls/``; after a
 deliberate template change run ``ROSFPGA_UPDATE_GOLDEN=1 python -m pytest
-tests/test_hls_generate.py -k golden`` and review ``git diff tests/golden/hls``.
+tests/hls/test_generate.py -k golden`` and review ``git diff tests/golden/hls``.
 """
 
 from rosfpga_lab.hls.csim import CsimResult, build_csim, run_csim

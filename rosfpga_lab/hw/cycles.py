@@ -19,7 +19,7 @@ The stages run concurrently, so a frame takes (``total``, first byte in to last 
                                                     clock the output is ready (share ``ready``)
 
 The RTL simulation confirms this within a few clocks per frame plus, under random
-backpressure, its randomness (``tests/test_rtl_cycles.py`` states the tolerance).
+backpressure, its randomness (``tests/rtl/test_cycles.py`` states the tolerance).
 ``sequential`` (the sum of all cycles) is what it would take without overlap. For 640x480
 ``rgba8`` at 100 MHz the byte-wide stages need 1.23 M cycles (12.3 ms) while the filter needs
 0.31 M (3.1 ms): the 8-bit FIFO, not the filter, sets the frame rate, and it is slower than

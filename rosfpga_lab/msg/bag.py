@@ -3,7 +3,7 @@
 The lab keeps its own codecs: a bag holds serialized bodies, and each connection of a bag holds
 the type, md5 sum and full definition text (what a TCPROS header carries), so reading gives
 raw bodies with that information and writing takes them. Debian's ``rosbag info``/``play``
-read what :class:`BagWriter` writes (tests/test_bag_realros.py).
+read what :class:`BagWriter` writes (tests/msg/test_bag.py).
 """
 
 from __future__ import annotations

@@ -55,10 +55,10 @@ The network side of a ROS 2 node in the fabric (issue #31) starts in ``fabric/``
 ``rfl_rtps_rx`` walks RTPS datagrams (one UDP payload per AXI4-Stream packet) and streams one
 writer's DATA / DATA_FRAG samples out (its header comment is the design note; proof
 ``rtps_rx``; tested against :func:`rosfpga_lab.rtps.parse_message` in
-``tests/test_rtl_rtps_rx.py``); ``rfl_rtps_to_cdr`` turns its sample packets into the
+``tests/rtl/test_fabric_rtps_rx.py``); ``rfl_rtps_to_cdr`` turns its sample packets into the
 records a generated ``wire: cdr`` circuit's subscriber reads (the length, then the payload),
 forwarding a sample only once it ended good (proof ``rtps_to_cdr``; datagrams through both into
-a generated top in ``tests/test_rtl_rtps_cdr.py``).
+a generated top in ``tests/rtl/test_fabric_rtps_cdr.py``).
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError

@@ -15,8 +15,8 @@ machine (discovery, matching, reliable and best-effort writers and readers; its 
 ``writer_side`` and ``reader_side``); ``rosfpga_lab.graph.ros2`` runs it on sockets, with a
 ROS 2 node's entities from :mod:`rosfpga_lab.rtps.rosnode` (which the fabric's discovery ROM,
 ``rosfpga_lab.rtl.discrom``, renders too).
-Checked against Cyclone DDS (``tests/test_ros2_interop.py``) and rclpy on Fast DDS
-(``tests/test_ros2_realros2.py``); the same by hand, and captures in Wireshark: ``docs/ros2.md``.
+Checked against Cyclone DDS (``tests/flow/test_ros2_interop.py``) and rclpy on Fast DDS
+(``tests/flow/test_ros2_realros2.py``); the same by hand, and captures in Wireshark: ``docs/ros2.md``.
 """
 
 from rosfpga_lab.rtps.errors import RtpsError, RtpsTruncatedError

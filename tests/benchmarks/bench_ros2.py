@@ -31,9 +31,9 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))   # the root: tests.support
 
-from ros2tools import cyclone, qos  # noqa: E402
+from tests.support.ros2tools import cyclone, qos  # noqa: E402
 
 CONFIG = """\
 node: {name: /fpga_bench}

@@ -51,7 +51,7 @@ from pathlib import Path
 from typing import Any
 
 HERE = Path(__file__).resolve()
-sys.path.insert(0, str(HERE.parent.parent))
+sys.path.insert(0, str(HERE.parents[2]))   # the root: tests.support
 
 ROWS = ("acknack", "flood", "goodbye", "goodbye2", "gap", "slow")
 SIDES = ("lab", "cyclone")
@@ -64,7 +64,7 @@ class World:
     """What one child row shares: the domain, Cyclone's types, frames and where they went."""
 
     def __init__(self, args: argparse.Namespace) -> None:
-        from ros2tools import cyclone, qos
+        from tests.support.ros2tools import cyclone, qos
 
         self.dds = cyclone()              # sets CYCLONEDDS_URI (loopback, no multicast)
         self.qos = qos

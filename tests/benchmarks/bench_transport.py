@@ -29,7 +29,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT))   # tests.support
 
 from rosfpga_lab.graph import EmbeddedMaster, Node  # noqa: E402
 from rosfpga_lab.msg import Time, default_registry, serialize  # noqa: E402
@@ -126,7 +126,7 @@ def command(impl: str, role: str, master_uri: str, nlat: int, nthr: int) -> list
     if impl == "lab":
         return [sys.executable, __file__, "--role", role, "--master", master_uri,
                 "--lat-frames", str(nlat), "--frames", str(nthr)]
-    from realros import ROS_PROGRAMS, ROS_PYTHON, build_roscpp_program
+    from tests.support.realros import ROS_PROGRAMS, ROS_PYTHON, build_roscpp_program
 
     if impl == "rospy":
         return [ROS_PYTHON, str(ROS_PROGRAMS / "wire_bench_rospy.py"), role, TOPIC, str(nlat), str(nthr)]
@@ -142,7 +142,7 @@ def _wait_ready(proc: subprocess.Popen) -> None:
 
 
 def run_pair(pub_impl: str, sub_impl: str, master_uri: str, nlat: int, nthr: int) -> dict:
-    from realros import ros_env, stop_process
+    from tests.support.realros import ros_env, stop_process
 
     env = ros_env(master_uri)  # loopback only; the lab's roles run from the installed package
     procs = []
@@ -202,7 +202,7 @@ def main() -> int:
     if args.role:
         role_main(args.role, args.master, args.lat_frames, args.frames)
         return 0
-    from realros import ros_missing_reason
+    from tests.support.realros import ros_missing_reason
 
     pairs = [("lab", "lab")]
     reason = None if not args.no_ros else "--no-ros"

@@ -1,4 +1,4 @@
-"""A real ROS 2 Jazzy peer (rclpy, rmw_fastrtps_cpp) for tests/test_ros2_realros2.py.
+"""A real ROS 2 Jazzy peer (rclpy, rmw_fastrtps_cpp) for tests/flow/test_ros2_realros2.py.
 
 Run by the tests as a subprocess of the venv's Python (never rclpy.init in pytest's process),
 with ROS_DOMAIN_ID, ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST and ROS_LOG_DIR set by the test.

@@ -1,4 +1,4 @@
-// A plain testbench that dumps rfl_morph's signals to a VCD (tests/test_rtl_vcd.py reads it).
+// A plain testbench that dumps rfl_morph's signals to a VCD (tests/rtl/test_vcd.py reads it).
 // Pixels come from pixels.hex (one 32-bit word per line, written by the test); the input
 // pauses every third clock and the output refuses every fourth, from fixed patterns.
 `timescale 1ns / 1ps

