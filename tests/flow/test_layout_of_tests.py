@@ -20,7 +20,7 @@ def test_every_test_file_sits_in_a_package_folder_or_flow() -> None:
                  if "__pycache__" not in p.parts
                  and (len(p.relative_to(TESTS).parts) != 2
                       or p.parent.name not in PACKAGES | {"flow"})]
-    assert misplaced == [], "tests/<package>/test_<module>.py or tests/flow/ (tools/relayout_tests.py)"
+    assert misplaced == [], "tests/<package>/test_<module>.py or tests/flow/ (ARCHITECTURE.md, where the tests live)"
 
 
 def test_tests_holds_only_conftest_and_known_folders() -> None:
