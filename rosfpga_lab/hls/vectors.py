@@ -23,6 +23,7 @@ from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.config.vocabulary import CDR_WIRE
 from rosfpga_lab.hw.cdrlayout import CdrLayout
 from rosfpga_lab.hw.layout import Action, CheckOp, Layout, Step, StepKind, Token, marshal
+from rosfpga_lab.hw.layoutsteps import walk_order
 
 
 def sample_image(config: NodeConfig) -> np.ndarray:
@@ -107,49 +108,37 @@ def sample_tokens(layout: Layout, rng: np.random.Generator, *, stream_count: int
     toks: list[Token] = []
     counts: dict[int, int] = {}
 
-    def walk(lo: int, hi: int, at: tuple[int, ...]) -> None:
-        i = lo
-        while i < hi:
-            s = steps[i]
-            if s.kind is StepKind.LOOP:
-                assert s.partner is not None
-                n = s.count if s.count is not None else counts[s.length_step or 0]
-                for k in range(n):
-                    walk(i + 1, s.partner, at + (k,))
-                i = s.partner + 1
-                continue
-            if s.kind is StepKind.LENGTH:
-                part = steps[s.partner] if s.partner is not None else s
-                if part.action is Action.STREAM:
-                    n = layout.stream_length if stream_count is None else stream_count
-                elif part.check is not None and part.check.op is CheckOp.EQUAL:
-                    n = len(str(part.check.value).encode("utf-8"))
-                else:
-                    n = int(rng.integers(0, min(items, part.max_count), endpoint=True))
-                counts[i] = n
-                toks.append(Token(i, n, at))
-            elif s.kind is StepKind.SCALAR:
-                toks.append(Token(i, _random_value(s, rng), at))
-            elif s.kind is StepKind.STRING:
-                n = counts[s.length_step or 0]
-                value = (str(s.check.value) if s.check is not None and s.check.op is CheckOp.EQUAL
-                         else "".join(chr(c) for c in rng.integers(97, 123, n)))
-                toks.append(Token(i, value, at))
-            elif s.kind is StepKind.ARRAY:
-                n = s.count if s.count is not None else counts[s.length_step or 0]
-                dt = np.dtype(s.dtype)
-                if dt.kind == "f":
-                    arr = (rng.standard_normal(n) * 10).astype(dt)
-                    arr[rng.random(n) < 0.1] = 0.0
-                elif dt.kind == "b":
-                    arr = rng.integers(0, 2, n).astype(dt)
-                else:
-                    info = np.iinfo(dt)
-                    arr = rng.integers(info.min, info.max, n, dtype=dt, endpoint=True)
-                toks.append(Token(i, arr, at))
-            i += 1
-
-    walk(1, len(steps), ())
+    for i, at in walk_order(steps, counts.__getitem__):
+        s = steps[i]
+        if s.kind is StepKind.LENGTH:
+            part = steps[s.partner] if s.partner is not None else s
+            if part.action is Action.STREAM:
+                n = layout.stream_length if stream_count is None else stream_count
+            elif part.check is not None and part.check.op is CheckOp.EQUAL:
+                n = len(str(part.check.value).encode("utf-8"))
+            else:
+                n = int(rng.integers(0, min(items, part.max_count), endpoint=True))
+            counts[i] = n
+            toks.append(Token(i, n, at))
+        elif s.kind is StepKind.SCALAR:
+            toks.append(Token(i, _random_value(s, rng), at))
+        elif s.kind is StepKind.STRING:
+            n = counts[s.length_step or 0]
+            value = (str(s.check.value) if s.check is not None and s.check.op is CheckOp.EQUAL
+                     else "".join(chr(c) for c in rng.integers(97, 123, n)))
+            toks.append(Token(i, value, at))
+        elif s.kind is StepKind.ARRAY:
+            n = s.count if s.count is not None else counts[s.length_step or 0]
+            dt = np.dtype(s.dtype)
+            if dt.kind == "f":
+                arr = (rng.standard_normal(n) * 10).astype(dt)
+                arr[rng.random(n) < 0.1] = 0.0
+            elif dt.kind == "b":
+                arr = rng.integers(0, 2, n).astype(dt)
+            else:
+                info = np.iinfo(dt)
+                arr = rng.integers(info.min, info.max, n, dtype=dt, endpoint=True)
+            toks.append(Token(i, arr, at))
     return toks
 
 

@@ -11,7 +11,7 @@ public names.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any, NamedTuple
@@ -208,6 +208,25 @@ class Layout:
     def checked(self) -> tuple[Step, ...]:
         """Steps with a check, in status order (``statuses[i + 1]`` is ``checked()[i]``'s)."""
         return tuple(s for s in self.steps if s.check is not None)
+
+
+def walk_order(steps: Sequence[Step], count_of: Callable[[int], int], lo: int = 1,
+               hi: int | None = None, at: tuple[int, ...] = ()) -> Iterator[tuple[int, tuple[int, ...]]]:
+    """The steps of one message in wire order, each with the element indices of the loops around
+    it: a LOOP step's body comes ``count`` times, or ``count_of(its length step)`` times, asked
+    only when the loop is reached (so a walker sets a length's count before its loop needs it)."""
+    i, end = lo, len(steps) if hi is None else hi
+    while i < end:
+        s = steps[i]
+        if s.kind is StepKind.LOOP:
+            assert s.partner is not None
+            n = s.count if s.count is not None else count_of(s.length_step or 0)
+            for k in range(n):
+                yield from walk_order(steps, count_of, i + 1, s.partner, at + (k,))
+            i = s.partner + 1
+            continue
+        yield i, at
+        i += 1
 
 
 def format_layout(layout: Layout, *, idents: bool = True) -> str:

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from rosfpga_lab.hw.layoutsteps import Action, Layout, Step, StepKind
+from rosfpga_lab.hw.layoutsteps import Action, Layout, Step, StepKind, walk_order
 from rosfpga_lab.hw.layouttokens import Token, encode_token, marshal, tokens
 from rosfpga_lab.msg import MsgRegistry, default_value, new_message
 
@@ -47,34 +47,22 @@ def output_tokens(layout: Layout, toks: list[Token], stream: np.ndarray) -> list
         pos += 1
         return t.value
 
-    def walk(lo: int, hi: int, at: tuple[int, ...]) -> None:
-        i = lo
-        while i < hi:
-            s = steps[i]
-            if s.kind is StepKind.LOOP:
-                assert s.partner is not None
-                n = s.count if s.count is not None else counts[s.length_step or 0]
-                for k in range(n):
-                    walk(i + 1, s.partner, at + (k,))
-                i = s.partner + 1
-                continue
-            n = s.count if s.count is not None else counts.get(s.length_step or 0, 0)
-            if i == layout.stream_index:
-                take(i, at)
-                value: Any = np.asarray(stream)
-            elif s.kind is StepKind.LENGTH and s.partner == layout.stream_index:
-                take(i, at)
-                value = len(stream)
-            elif s.action is Action.SKIP:
-                value = _default(s, n if s.kind is StepKind.ARRAY else 0)
-            else:
-                value = take(i, at)
-            if s.kind is StepKind.LENGTH:
-                counts[i] = value
-            out.append(Token(i, value, at))
-            i += 1
-
-    walk(1, len(steps), ())
+    for i, at in walk_order(steps, counts.__getitem__):
+        s = steps[i]
+        n = s.count if s.count is not None else counts.get(s.length_step or 0, 0)
+        if i == layout.stream_index:
+            take(i, at)
+            value: Any = np.asarray(stream)
+        elif s.kind is StepKind.LENGTH and s.partner == layout.stream_index:
+            take(i, at)
+            value = len(stream)
+        elif s.action is Action.SKIP:
+            value = _default(s, n if s.kind is StepKind.ARRAY else 0)
+        else:
+            value = take(i, at)
+        if s.kind is StepKind.LENGTH:
+            counts[i] = value
+        out.append(Token(i, value, at))
     return out
 
 

@@ -17,7 +17,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from rosfpga_lab.hw.layoutsteps import Action, CheckOp, Layout, Step, StepKind
+from rosfpga_lab.hw.layoutsteps import Action, CheckOp, Layout, Step, StepKind, walk_order
 from rosfpga_lab.hw.layouttokens import Token, marshal, tokens
 from rosfpga_lab.msg import MsgRegistry, deserialize
 
@@ -68,40 +68,28 @@ def example_tokens(layout: Layout, *, stream: np.ndarray | None = None) -> list[
     toks: list[Token] = []
     counts: dict[int, int] = {}
 
-    def walk(lo: int, hi: int, at: tuple[int, ...]) -> None:
-        i = lo
-        while i < hi:
-            s = steps[i]
-            if s.kind is StepKind.LOOP:
-                assert s.partner is not None
-                n = s.count if s.count is not None else counts[s.length_step or 0]
-                for k in range(n):
-                    walk(i + 1, s.partner, at + (k,))
-                i = s.partner + 1
-                continue
-            if s.kind is StepKind.LENGTH:
-                part = steps[s.partner] if s.partner is not None else s
-                if part.action is Action.STREAM:
-                    n = layout.stream_length if stream is None else len(stream)
-                elif part.kind is StepKind.STRING:
-                    n = len(_text(part).encode("utf-8"))
-                else:
-                    n = min(EXAMPLE_ITEMS, part.max_count)
-                counts[i] = n
-                toks.append(Token(i, n, at))
-            elif s.kind is StepKind.SCALAR:
-                toks.append(Token(i, _scalar(s), at))
-            elif s.kind is StepKind.STRING:
-                toks.append(Token(i, _text(s), at))
-            elif s.kind is StepKind.ARRAY:
-                n = s.count if s.count is not None else counts[s.length_step or 0]
-                if s.index == layout.stream_index and stream is not None:
-                    toks.append(Token(i, np.asarray(stream, np.dtype(s.dtype)), at))
-                else:
-                    toks.append(Token(i, _array(s, n, s.index == layout.stream_index), at))
-            i += 1
-
-    walk(1, len(steps), ())
+    for i, at in walk_order(steps, counts.__getitem__):
+        s = steps[i]
+        if s.kind is StepKind.LENGTH:
+            part = steps[s.partner] if s.partner is not None else s
+            if part.action is Action.STREAM:
+                n = layout.stream_length if stream is None else len(stream)
+            elif part.kind is StepKind.STRING:
+                n = len(_text(part).encode("utf-8"))
+            else:
+                n = min(EXAMPLE_ITEMS, part.max_count)
+            counts[i] = n
+            toks.append(Token(i, n, at))
+        elif s.kind is StepKind.SCALAR:
+            toks.append(Token(i, _scalar(s), at))
+        elif s.kind is StepKind.STRING:
+            toks.append(Token(i, _text(s), at))
+        elif s.kind is StepKind.ARRAY:
+            n = s.count if s.count is not None else counts[s.length_step or 0]
+            if s.index == layout.stream_index and stream is not None:
+                toks.append(Token(i, np.asarray(stream, np.dtype(s.dtype)), at))
+            else:
+                toks.append(Token(i, _array(s, n, s.index == layout.stream_index), at))
     return toks
 
 
