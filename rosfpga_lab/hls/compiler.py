@@ -67,6 +67,8 @@ def _scalar_instr(step: Step, code: dict[str, int], label: str) -> Instr:
                  const=_bounds(step, low, high), name=name, type=type_)
 
 
+# long: one pass over the layout's steps building the instruction list, its budget checks
+# (carried bytes, status codes, instructions, constant bytes) reading the same state
 def program_from_layout(layout: Layout, *, max_frame: int | None = None,
                         count: str | None = None, cdr: CdrLayout | None = None) -> Program:
     """The walkers' program of a circuit layout (one instruction per field, names from it).

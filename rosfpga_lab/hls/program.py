@@ -279,6 +279,8 @@ def least_clocks(elem_min: int) -> int:
     return 1 + elem_min.bit_length()
 
 
+# long: one dispatch of the subscriber's state machine, whose closures (take, out_pad, fits)
+# share one walk's state (position, frame end, streamed bytes, output length) and its timeline
 def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
               ) -> tuple[bytes, bytes, int]:
     """Walk one whole frame as the subscriber does.
@@ -434,6 +436,36 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
         pc += 1
 
 
+def _fixed_bytes(ins: Instr, carry: bytes, ci: int, stream: bytes, si: int, seq: int
+                 ) -> tuple[bytes, int, int]:
+    """The bytes the publisher writes for a ``FIXED`` field (after its padding), with the
+    carried and streamed bytes' next positions."""
+    if ins.pub == Pub.CARRY:
+        return carry[ci:ci + ins.size], ci + ins.size, si
+    if ins.pub == Pub.CONST:
+        return ins.const, ci, si
+    if ins.pub == Pub.COUNT:
+        return (seq & 0xFFFFFFFF).to_bytes(4, "little") + bytes(ins.size - 4), ci, si
+    if ins.pub == Pub.ZERO:
+        return bytes(ins.size), ci, si
+    return stream[si:si + ins.size], ci, si + ins.size
+
+
+def _var_body(ins: Instr, carry: bytes, ci: int, stream: bytes, si: int
+              ) -> tuple[int, bytes, int, int]:
+    """A ``VAR`` field's count and body as the publisher writes them, with the carried and
+    streamed bytes' next positions."""
+    if ins.pub == Pub.CARRY:
+        n = _u32(carry[ci:ci + 4])
+        return n, carry[ci + 4:ci + 4 + n * ins.size], ci + 4 + n * ins.size, si
+    if ins.pub == Pub.CONST:
+        body = ins.const + bytes(int(ins.nul))
+        return len(body) // ins.size, body, ci, si
+    if ins.pub == Pub.ZERO:
+        return int(ins.nul), bytes(int(ins.nul)), ci, si
+    return ins.count, stream[si:si + ins.count * ins.size], ci, si + ins.count * ins.size
+
+
 def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int,
             timeline: bytearray | None = None) -> bytes:
     """The frame the publisher writes for an accepted frame (see the module docstring).
@@ -467,32 +499,11 @@ def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int,
         elif ins.op == Op.FIXED:
             if ins.size:
                 out += bytes(pad(len(out), ins.align))
-            if ins.pub == Pub.CARRY:
-                out += carry[ci:ci + ins.size]
-                ci += ins.size
-            elif ins.pub == Pub.CONST:
-                out += ins.const
-            elif ins.pub == Pub.COUNT:
-                out += (seq & 0xFFFFFFFF).to_bytes(4, "little") + bytes(ins.size - 4)
-            elif ins.pub == Pub.ZERO:
-                out += bytes(ins.size)
-            else:
-                out += stream[si:si + ins.size]
-                si += ins.size
+            b, ci, si = _fixed_bytes(ins, carry, ci, stream, si, seq)
+            out += b
         elif ins.op == Op.VAR:
             out += bytes(pad(len(out), ins.align))
-            if ins.pub == Pub.CARRY:
-                n = _u32(carry[ci:ci + 4])
-                body = carry[ci + 4:ci + 4 + n * ins.size]
-                ci += 4 + n * ins.size
-            elif ins.pub == Pub.CONST:
-                body = ins.const + bytes(int(ins.nul))
-                n = len(body) // ins.size
-            elif ins.pub == Pub.ZERO:
-                n, body = int(ins.nul), bytes(int(ins.nul))
-            else:
-                n, body = ins.count, stream[si:si + ins.count * ins.size]
-                si += ins.count * ins.size
+            n, body, ci, si = _var_body(ins, carry, ci, stream, si)
             out += n.to_bytes(4, "little")
             moved()
             tl.append(0)

@@ -15,11 +15,7 @@ LIMIT = 80
 MARKER = "# long:"
 #: ``path:qualified name`` -> why it is over the limit without a marker. An entry goes when its
 #: function is cut or marked (``test_every_exception_is_still_long_and_unmarked`` says which).
-EXCEPTIONS = {
-    "hls/program.py:subscribe": "being rewritten with the generic walkers' cycle model (issue 29)",
-    "hls/program.py:publish": "being rewritten with the generic walkers' cycle model (issue 29)",
-    "hls/compiler.py:program_from_layout": "being rewritten with the generic walkers (issue 29)",
-}
+EXCEPTIONS: dict[str, str] = {}
 
 
 def _comment_above(lines: list[str], first: int) -> list[str]:
