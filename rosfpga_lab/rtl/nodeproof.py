@@ -17,8 +17,9 @@ FIFOs make the proof slower, not different; :data:`NODE_PROOF_DEPTH` clocks of i
 top with more memory than ``rtl.limits.FORMAL_MAX_MEMORY_BITS`` is refused before the tools run
 (:func:`check_size`): prove a copy of the configuration with smaller FIFOs or stream.
 
-Only generated (generic) tops: ``sensor_msgs/Image`` on TCPROS has the hand-written circuit,
-whose modules and top ``rtl prove`` without a configuration proves (:mod:`rosfpga_lab.rtl.proofs`).
+Every configuration's generated top, ``sensor_msgs/Image`` on TCPROS included (its 640x480
+examples are over the memory limit: prove a smaller image); the hand-written Image circuit's modules
+and top are what ``rtl prove`` without a configuration proves (:mod:`rosfpga_lab.rtl.proofs`).
 """
 
 from __future__ import annotations
@@ -84,8 +85,8 @@ def node_files(config: NodeConfig) -> tuple[GenericSpec, dict[str, bytes]]:
     testbench) and the proof wrapper :data:`WRAPPER`.
 
     Raises:
-        RtlError: the configuration has no generated top (Image on TCPROS, ``op: custom``), or
-            its layout cannot be generated.
+        RtlError: the configuration has no generated RTL (``op: custom``), or its layout
+            cannot be generated.
     """
     spec = _spec(config)
     if spec.op == "custom":
@@ -178,7 +179,7 @@ def prove_config(config: NodeConfig, *, depth: int = NODE_PROOF_DEPTH, bmc_depth
     """Prove the stream rules on the configuration's generated top (see the module docstring).
 
     Args:
-        config: the node configuration (any generated top: not Image on TCPROS).
+        config: the node configuration (any type, either wire).
         depth: clocks of the base case and of the induction.
         bmc_depth: also a bounded check of every stream, ``tx`` too, for this many clocks
             (0: none; it grows fast: 40 clocks of a small top take about a minute).
