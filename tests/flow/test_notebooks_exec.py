@@ -253,10 +253,18 @@ def check_ros2_live(text: str, html: str, cyclone: bool) -> None:
     assert "and the same as the live run's first output: True" in text
     sample = 4 + 4 + 4 + 4 + len("camera") + 1 + 1 + 4 + 4 + 4 + len("rgba8") + 1 + 1 + 1 + 4 + 4 + 64 * 48 * 4
     assert f"{3 * sample:,} bytes of samples went through the circuit" in text, text[-600:]
-    # the applications' clocks in their own units (by hand: 64 x 48 pixels; 64 x 48 x 4 bytes
+    # the subscribers' clocks (by hand: the TCPROS frame is its 4-byte length, seq, stamp,
+    # frame_id "camera", height, width, "rgba8", is_bigendian, step and the data's length and
+    # bytes; the generated walker takes at most a byte per clock; the CDR model reads the sample
+    # and its 4-byte length a byte per clock), the CDR application's (64 x 48 x 4 bytes
     # + ksize // 2 = 1), and whether the run cut samples into DATA_FRAG, as counted
-    assert re.search(r"ROS 1 dilate [\d,]+ clocks for 3,072 pixels; ROS 2 application 12,289 "
-                     r"clocks for 12,288 bytes", text), text[-1500:]
+    frame = 4 + 4 + 8 + 4 + len("camera") + 4 + 4 + 4 + len("rgba8") + 1 + 4 + 4 + 64 * 48 * 4
+    clocks = re.search(r"the subscriber in each: ROS 1 ([\d,]+) clocks for ([\d,]+) bytes; ROS 2 "
+                       r"([\d,]+) clocks for ([\d,]+) bytes; ROS 2 application 12,289 clocks for "
+                       r"12,288 bytes", text)
+    assert clocks, text[-1500:]
+    ros1, ros1_bytes, ros2, ros2_bytes = (int(v.replace(",", "")) for v in clocks.groups())
+    assert ros1_bytes == frame and ros1 >= frame and ros2 == ros2_bytes == sample + 4
     frag_line = re.search(r"user samples received whole in one DATA: (\d+); DATA_FRAG fragments "
                           r"received: (\d+)", text)
     assert frag_line and int(frag_line[1]) + int(frag_line[2]) >= 3, text[-800:]
