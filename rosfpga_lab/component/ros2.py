@@ -130,12 +130,15 @@ class Ros2Component:
         if model not in MODELS or timing not in TIMINGS:
             raise ComponentConfigError(f"model must be one of {', '.join(MODELS)} and timing one "
                                        f"of {', '.join(TIMINGS)}, got {model!r} and {timing!r}")
+        # the Verilog first: its refusals (op: custom, no Verilator) name --model rtl
+        self._rtl: Any = self._start_rtl(config) if model == RTL_MODEL else None
         try:   # with "rtl" the fast model still names the operation and refuses what it cannot
             self.pipeline = CdrPipeline(config, "fast" if model == RTL_MODEL else model)
         except LabError as exc:
+            if self._rtl is not None:
+                self._rtl.close()
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         self.model, self.timing = model, timing
-        self._rtl: Any = self._start_rtl(config) if model == RTL_MODEL else None
         self._program: Any = self._walk(config) if timing == "fpga" and self._rtl is None else None
         self._clock_hz = config.clock_mhz * 1e6
         self._busy_until = 0.0      # time.time() when the circuit is free again (timing fpga)

@@ -76,9 +76,11 @@ def _record(payload: bytes) -> bytes:
 
 
 @pytest.mark.parametrize("model", ["rtl", "fast"])
-def test_ros2_node_with_the_generated_cdr_verilog_serves_cyclone_exactly(model: str) -> None:
-    """Five scans from a Cyclone writer (the third refused: range_max over its bound) through the
-    component to a Cyclone reader; with timing fpga at 1 MHz each output waits its clocks."""
+def test_ros2_node_with_the_generated_cdr_verilog_serves_cyclone_exactly(
+        model: str, caplog: pytest.LogCaptureFixture) -> None:
+    """Five scans from a Cyclone writer (the third refused: range_max over its bound, logged by
+    the walk's status name or the model's field) through the component to a Cyclone reader; with
+    timing fpga at 1 MHz each output waits its clocks."""
     if model == "rtl":
         require_rtl("verilator")
     dds = cyclone()
@@ -101,6 +103,10 @@ def test_ros2_node_with_the_generated_cdr_verilog_serves_cyclone_exactly(model: 
         assert comp.counts == {"seen": 5, "published": 4, "refused": 1}
         clocks, latencies = list(comp.clocks), list(comp.latencies)
         assert (comp._rtl is not None) == (model == "rtl")      # the Verilog ran, or not
+    refusals = [r.getMessage() for r in caplog.records if "refused sample" in r.getMessage()]
+    assert len(refusals) == 1 and "range_max" in refusals[0], refusals
+    if model == "rtl":
+        assert "(SUB_BAD_RANGE_MAX): bad range_max" in refusals[0], refusals
     good = [m for k, m in enumerate(sent) if k != 2]
     pipe = CdrPipeline(load_config(SCAN_CDR))
     for msg, out in zip(good, got, strict=True):
