@@ -87,7 +87,8 @@ def demo_inputs(config: NodeConfig | None = None) -> list[bytes]:
 def split_records(data: bytes) -> list[bytes]:
     """``data`` cut into its length-prefixed frames (4-byte little-endian length, then that many
     bytes); a cut-short last frame is kept as it is."""
-    out, at = [], 0
+    out: list[bytes] = []
+    at = 0
     while at < len(data):
         size = struct.unpack_from("<I", data, at)[0] if at + 4 <= len(data) else 0
         out.append(data[at:at + 4 + size])
@@ -171,7 +172,8 @@ def demo_report(config: NodeConfig, frames: list[bytes], result: RtlResult) -> l
     fields = dict(status_table(demo_design(config)))
     decided = dict(result.status)
     sent = iter(split_records(result.output))
-    report, offset, before = [], 0, b""
+    report: list[DemoFrame] = []
+    offset, before = 0, b""
     for frame in frames:
         status = decided.get(offset, "")
         upto = model_output(config, b"".join(frames[:len(report) + 1]))
