@@ -22,7 +22,6 @@ layout's ``MessagePipeline`` or ``CdrPipeline``, Image's ``Pipeline`` on TCPROS)
 
 from __future__ import annotations
 
-import struct
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -85,15 +84,11 @@ def demo_inputs(config: NodeConfig | None = None) -> list[bytes]:
 
 
 def split_records(data: bytes) -> list[bytes]:
-    """``data`` cut into its length-prefixed frames (4-byte little-endian length, then that many
-    bytes); a cut-short last frame is kept as it is."""
-    out: list[bytes] = []
-    at = 0
-    while at < len(data):
-        size = struct.unpack_from("<I", data, at)[0] if at + 4 <= len(data) else 0
-        out.append(data[at:at + 4 + size])
-        at += len(out[-1])
-    return out
+    """``data`` cut into its whole length-prefixed frames (TCPROS frames and CDR records are
+    framed alike: a 4-byte little-endian length, then that many bytes), prefixes kept."""
+    from rosfpga_lab.tcpros.frame import FrameDecoder, encode_frame
+
+    return [encode_frame(body) for body in FrameDecoder().feed(data)]
 
 
 def demo_design(config: NodeConfig | None = None) -> GenericSpec:
