@@ -399,6 +399,9 @@ def test_frame_timing_frame_time_instead_of_the_filters_is_named_and_rounded():
 
 def test_frame_timing():
     assert C.check_frame_timing(308_321, 3.08321, "byte-wide stages").ok
+    assert C.check_frame_timing(308_321, 3.08321, "the walkers").ok     # notebook 5 names them
+    assert C.check_frame_timing(308_321, 3.08321, "subscriber and publisher").ok
+    assert "bottleneck 'dilate'" in problems_of(C.check_frame_timing, 308_321, 3.08321, "dilate")
     msg = problems_of(C.check_frame_timing, 307_200, 3.072, "filter")
     assert "one clock per pixel" in msg and "bottleneck 'filter'" in msg
     assert "counts bytes" in problems_of(C.check_frame_timing, 1_228_800, 12.288, "byte-wide stages")
