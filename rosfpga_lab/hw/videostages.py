@@ -86,27 +86,33 @@ def video_stages(video: VideoShape, stream: np.ndarray, op: str, ksize: int = 3,
             raise PipelineConfigError(f"{type(fault).__name__} at tap {fault.tap!r}: the video "
                                       f"stages have the taps {', '.join(sorted(taps))}")
 
-    def at(tap: str, items: np.ndarray | Beats) -> np.ndarray | Beats:
+    def bytes_at(tap: str, data: np.ndarray) -> np.ndarray:
         for fault in faults:
-            if fault.tap == tap:
-                assert isinstance(fault, ByteFault | BeatFault)
-                items = fault.apply(items)  # type: ignore[arg-type]
-        return items
+            if fault.tap == tap and isinstance(fault, ByteFault):
+                data = fault.apply(data)
+        return data
+
+    def beats_at(tap: str, beats: Beats) -> Beats:
+        for fault in faults:
+            if fault.tap == tap and isinstance(fault, BeatFault):
+                beats = fault.apply(beats)
+        return beats
 
     fmt = pixel_format(video.encoding)
-    rows, cols, status = video.height, video.width, []
-    pixels_in = at("pixels_in", np.asarray(stream, np.uint8).reshape(-1))
+    rows, cols = video.height, video.width
+    status: list[str] = []
+    pixels_in = bytes_at("pixels_in", np.asarray(stream, np.uint8).reshape(-1))
     beats, left = fifo2axi_fast(pixels_in, rows, cols, fmt)
     _left(status, "pixels_in", left, "byte")
-    axis_in = at("axis_in", beats)
+    axis_in = beats_at("axis_in", beats)
     image_in, flags, left = axivideo2mat_fast(axis_in, rows, cols, fmt)
     status += [f"AXIvideo2Mat: {flag}" for flag in status_names(flags)]
     _left(status, "axis_in", left, "beat")
     image_out = morph_fast(image_in, name, window)
-    axis_out = at("axis_out", mat2axivideo_fast(image_out, fmt))
+    axis_out = beats_at("axis_out", mat2axivideo_fast(image_out, fmt))
     data, left = axi2fifo_fast(axis_out, rows * cols)
     _left(status, "axis_out", left, "beat")
-    pixels_out = at("pixels_out", data)
+    pixels_out = bytes_at("pixels_out", data)
     return VideoStages(pixels_in, axis_in, image_in, image_out, axis_out, pixels_out, status)
 
 
