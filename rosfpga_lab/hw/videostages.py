@@ -14,6 +14,9 @@ one pixel per beat (TUSER on the first pixel, TLAST ending each line: :mod:`~ros
 the application's input as the HLS video library frames it (:mod:`~rosfpga_lab.hw.video`: a
 frame starts at TUSER; a lost TUSER or TLAST makes it wait for ever, which the model reports as
 :class:`~rosfpga_lab.hw.errors.StreamStarvedError` with what it had made as ``partial``).
+Of the generated application's inputs, the HLS C++ (``video_filter.cpp.j2``) waits for TUSER
+the same way but does not check TLAST, and the Verilog's ``rfl_morph`` re-frames a damaged
+stream without waiting (:mod:`~rosfpga_lab.hw.framing`); on a well-formed stream all three agree.
 Faults (:mod:`~rosfpga_lab.hw.faults`) act on the bytes and beats of the bracketed taps.
 These are the fast (numpy) models; the stages' reference models are the modules named above.
 """
