@@ -117,7 +117,8 @@ def check_claims(stem: str, nb: nbformat.NotebookNode) -> None:
         assert re.search(r"tlast lost on line 60.*?in x \d+\.\.\d+, y 61\.\.119", html, re.S), \
             "the lost-TLAST frame is not compared with what AXIvideo2Mat should have made"
     if stem == "05_application":
-        payload = 640 * 480 * 4 + 4 + 4 + 8 + 4 + 4 + 4 + 4 + len("rgba8") + 1 + 4 + 4  # frame of the table
+        # the table's frame: the layout's example message (frame_id its own field name)
+        payload = 640 * 480 * 4 + 4 + 4 + 8 + 4 + len("frame_id") + 4 + 4 + 4 + len("rgba8") + 1 + 4 + 4
         segments = -(-payload // 1448)
         wire_ms = 8 * (payload + 90 * segments) / 1e9 * 1e3
         assert re.search(rf"640x480 rgba8\s+{payload:,}\s+\S+\s+{8 * payload / 1e6:.2f}\s+{wire_ms:.2f}", text), \
