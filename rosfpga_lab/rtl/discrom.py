@@ -52,13 +52,13 @@ from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.rtl.errors import RtlError
-from rosfpga_lab.rtl.limits import MAX_DISC_ROM_BYTES
+from rosfpga_lab.rtl.limits import FABRIC_MAX_DATAGRAM, MAX_DISC_ROM_BYTES
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
     PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, Qos, discovery_multicast_port,
     discovery_port, user_port,
 )
-from rosfpga_lab.rtps.limits import MAX_MESSAGE_BYTES, SPDP_MULTICAST_ADDRESS
+from rosfpga_lab.rtps.limits import FRAGMENT_BYTES, MAX_MESSAGE_BYTES, SPDP_MULTICAST_ADDRESS
 from rosfpga_lab.rtps.message import ANY_PARTICIPANT
 from rosfpga_lab.rtps.participant import Participant
 from rosfpga_lab.rtps.rosnode import RosNodeEntities, split_node_name
@@ -268,3 +268,16 @@ def write_rom(rom: DiscoveryRom, out_dir: str | Path) -> list[Path]:
         (out / name).write_text(text)
         paths.append(out / name)
     return paths
+
+
+def tx_parameters(rom: DiscoveryRom, *, frag_bytes: int = FRAGMENT_BYTES,
+                  max_datagram: int = FABRIC_MAX_DATAGRAM, info_ts: bool = True,
+                  reader_id: int = 0) -> dict[str, int]:
+    """The Verilog parameters of ``fabric/rfl_rtps_tx.v`` (the transmit path) for the participant
+    ``rom`` was rendered for: its GUID prefix and its data writer's entity id (one owner: the
+    same :func:`fabric_participant` the ROM announces), the DATA_FRAG fragment size (default the
+    software participant's), the largest datagram, INFO_TS on or off and the reader id
+    (0: ENTITYID_UNKNOWN, every reader of the topic)."""
+    return {"GUID_PREFIX": int.from_bytes(rom.guid_prefix, "big"),
+            "WRITER_ID": rom.entity_ids["writer"], "READER_ID": reader_id,
+            "FRAG_BYTES": frag_bytes, "MAX_DATAGRAM": max_datagram, "INFO_TS": int(info_ts)}
