@@ -226,3 +226,34 @@ def test_rtps_tx_sends_the_builders_datagrams(seed: int, frag: int, info_ts: boo
             for dg, sub in zip(dgs, own):
                 start = len(b.header(prefix)) + (len(b.info_ts(0.0)) if info_ts else 0)
                 assert dg[start:start + len(sub)] == sub
+
+
+def test_the_verilog_defaults_are_the_participants() -> None:
+    """One owner: the module's default parameters are tx_parameters of every shipped ROS 2
+    configuration (the lab's fabric prefix, the output writer's id, the software participant's
+    fragment size, the Ethernet-sized datagram), so the Verilog restates no fact of its own."""
+    text = SOURCE.read_text()
+    found = {m.group(1): int(m.group(3).replace("_", ""), 16 if m.group(2) == "h" else 10)
+             for m in re.finditer(r"parameter (?:\[\d+:0\] )?(\w+) = (?:\d+'([hd]))?"
+                                  r"([0-9a-fA-F_]+)", text)}
+    for config in sorted((ROOT / "data").glob("fpga_*_cdr.yaml")):
+        given = tx_parameters(render_rom(config))
+        assert {k: found[k] for k in given} == given, config.name
+
+
+def test_a_planted_bug_fails_the_proof(tmp_path: Path) -> None:
+    """The proofs are not vacuous: an output beat dropped while the sink stalls fails the stream
+    rules; a header with the version's bytes swapped fails the bounded header check."""
+    require_formal()
+    text = SOURCE.read_text()
+    for good, bad, mode in (("if (m_axis_tready) o_valid <= 1'b0;", "o_valid <= 1'b0;", "prove"),
+                            ("8'h02, 8'h03, 8'h00, 8'h00, GUID_PREFIX",
+                             "8'h03, 8'h02, 8'h00, 8'h00, GUID_PREFIX", "bmc")):
+        assert text.count(good) == 1
+        buggy = tmp_path / mode / "rfl_rtps_tx.v"
+        buggy.parent.mkdir()
+        buggy.write_text(text.replace(good, bad))
+        proof = next(p for p in PROOFS if p.name == "rtps_tx" and p.mode == mode)
+        result = prove(proof, replace={"rfl_rtps_tx.v": buggy})
+        assert result.status in ("FAIL", "UNKNOWN"), result.log[-3000:]
+        assert re.search(r"Assert(ion)? failed.*fv_rtps_tx\.sv", result.log), result.log[-3000:]

@@ -43,8 +43,10 @@
 `default_nettype none
 
 module rfl_rtps_tx #(
-    parameter [95:0] GUID_PREFIX = 96'd0,       // the participant's (rtl.discrom.tx_parameters)
-    parameter [31:0] WRITER_ID = 32'd0,         // the data writer's entity id (a writer kind)
+    // the defaults are rtl.discrom.tx_parameters of a shipped wire: cdr configuration (the
+    // lab's fabric GUID prefix, the output topic's writer); a project passes its own
+    parameter [95:0] GUID_PREFIX = 96'h010f_7266_6c46_4142_5249_4300,
+    parameter [31:0] WRITER_ID = 32'h00000203,  // the data writer's entity id (a writer kind)
     parameter [31:0] READER_ID = 32'd0,         // 0 (ENTITYID_UNKNOWN) or a reader's entity id
     parameter FRAG_BYTES = 1344,                // DATA_FRAG fragment size: 4..65532, 4 | it
     parameter MAX_DATAGRAM = 1472,              // largest UDP payload sent: at most 65507
