@@ -176,7 +176,9 @@ PROOFS: tuple[Proof, ...] = (
           "packet's bytes in order; 16 clocks (a 4-byte packet's whole record)"),
     Proof("rtps_tx", ("rfl_rtps_tx.v",), "prove", 4,
           "rfl_rtps_tx (4-byte fragments, samples of at most 16 bytes, INFO_TS, any records, "
-          "any time): output stream rules with TLAST; all reachable states", ("FV_PROVE",)),
+          "any time): output stream rules with TLAST; every datagram opens with the magic's R "
+          "and ends with TLAST within MAX_DATAGRAM (104) bytes; all reachable states",
+          ("FV_PROVE",)),
     Proof("rtps_tx", ("rfl_rtps_tx.v",), "bmc", 32,
           "rfl_rtps_tx (4-byte fragments, samples of at most 16 bytes, INFO_TS, any records): the "
           "first datagram opens with the RTPS header (magic, version 2.3, vendor 0, the GUID "

@@ -310,6 +310,50 @@ module rfl_rtps_tx #(
         end
     end
 
+`ifdef FORMAL
+    // Framing on the ports, with the invariants that make it inductive (fv_rtps_tx proves
+    // them): f_pos counts the bytes of the current datagram the sink has taken; every datagram
+    // opens with the magic's "R" and is at most MAX_DATAGRAM bytes, TLAST on its last byte.
+    // f_fresh: between datagrams (nothing of one out, or its TLAST beat still offered).
+    reg [15:0] f_pos;
+    always @(posedge clk) begin
+        if (!rst_n) f_pos <= 16'd0;
+        else if (m_axis_tvalid && m_axis_tready) f_pos <= m_axis_tlast ? 16'd0 : f_pos + 16'd1;
+    end
+    localparam [15:0] F_MAX = MAX_DATAGRAM;
+    wire [15:0] f_h = {9'd0, frag ? N_FRAG : N_DATA};
+    wire [15:0] f_e = f_pos + {15'd0, o_valid};
+    wire f_fresh = (!o_valid && f_pos == 16'd0) ||
+                   (o_valid && o_last && f_pos != 16'd0 && f_pos < F_MAX);
+    wire f_fb = fb != 16'd0 && fb <= FRAG_32[15:0] &&
+                (last_dg || (frag && fb == FRAG_32[15:0] && rem > FRAG_32));
+    always @(*) if (rst_n) begin
+        assert(f_e <= F_MAX);                                   // no datagram longer
+        if (o_valid && f_pos == 16'd0) assert(o_data == 8'h52); // each opens with "RTPS"
+        assert(st <= S_SKIP);
+        case (st)
+        S_P2: assert(f_fresh && (zero || big || w4 != 32'd0));
+        S_P3: assert(f_fresh && rem != 32'd0 && (frag || rem <= FRAG_32));
+        S_P4: assert(f_fresh && f_fb);
+        S_HDR: begin
+            assert(f_fb && hcnt != 7'd0 && {9'd0, hcnt} <= f_h && h1 == (hcnt == 7'd1));
+            assert(pay_left == fb && pl1 == (fb == 16'd1));
+            if ({9'd0, hcnt} == f_h) assert(f_fresh && sh[SHW-1 -: 8] == 8'h52);
+            else assert(!(o_valid && o_last) && f_e == f_h - {9'd0, hcnt});
+        end
+        S_PAY: begin
+            assert(f_fb && pay_left != 16'd0 && pay_left <= fb && pl1 == (pay_left == 16'd1));
+            assert(!(o_valid && o_last) && f_e == f_h + fb - pay_left);
+        end
+        S_HB: begin
+            assert(f_fb && hcnt != 7'd0 && hcnt <= N_HB && h1 == (hcnt == 7'd1));
+            assert(!(o_valid && o_last) && f_e == f_h + fb + {9'd0, N_HB - hcnt});
+        end
+        default: assert(f_fresh);                               // S_LEN, S_P1, S_SKIP
+        endcase
+    end
+`endif
+
     assign m_axis_tdata = o_data;
     assign m_axis_tvalid = o_valid;
     assign m_axis_tlast = o_last;
