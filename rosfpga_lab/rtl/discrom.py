@@ -40,7 +40,9 @@ counts (1 and 2: a new participant has seen none) too.
 :func:`write_rom` writes one ``$readmemh`` file per message, the concatenated image
 ``rfl_rtps_disc_rom.hex`` and its message table ``rfl_rtps_disc_rom_table.hex`` (what
 ``fabric/rfl_rtps_disc_rom.v`` reads) and an index ``rfl_rtps_disc_rom.json`` (offsets,
-lengths, destinations, patch points).
+lengths, destinations, patch points). :func:`tx_parameters` gives the transmit path
+(``fabric/rfl_rtps_tx.v``) the same participant's GUID prefix and data writer id, so the data
+comes from the writer the ROM announces.
 """
 
 from __future__ import annotations
