@@ -158,9 +158,10 @@ def check_parsed(datagrams: list[bytes], payloads: list[bytes], max_sample: int,
     for dg in datagrams:
         msg = parse_message(dg)
         assert msg.header.guid_prefix == prefix and msg.header.version == b.PROTOCOL_VERSION
-        kinds = [type(s) for s in msg.submessages]
-        assert kinds[:1] == ([InfoTs] if info_ts else kinds[:1]) and \
-            kinds[int(info_ts)] in (Data, DataFrag), kinds
+        kinds = [type(s) for s in msg.submessages]       # [INFO_TS], DATA(_FRAG), [HEARTBEAT]
+        assert kinds[:int(info_ts)] == [InfoTs] * int(info_ts), kinds
+        assert kinds[int(info_ts)] in (Data, DataFrag) and kinds[int(info_ts) + 1:] in \
+            ([], [Heartbeat]), kinds
         for sub in msg.submessages:
             if isinstance(sub, (Data, DataFrag, Heartbeat)):
                 assert (sub.writer_id, sub.reader_id) == (writer, reader)
