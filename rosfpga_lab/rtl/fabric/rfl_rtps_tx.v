@@ -34,9 +34,10 @@
 // padding zeros), S_HB the HEARTBEAT from the same shift register.
 // Bounded: a sample of L bytes (4 + L in) sends L rounded up to 4, plus per datagram the header
 // (20), INFO_TS (12 * INFO_TS) and DATA (24) or DATA_FRAG (36), plus one HEARTBEAT (32): at most
-// 91 + 12 * INFO_TS bytes for 5 in (L = 1), 1 + (68 + 12 * INFO_TS) / FRAG_BYTES per byte for a
-// large one; a dropped record sends nothing. The input waits only on the output's TREADY and
-// the clocks between datagrams (4 per datagram, 2 per sample).
+// 80 + 12 * INFO_TS bytes for 5 in (L = 1), 1 + (56 + 12 * INFO_TS) / FRAG_BYTES per byte for a
+// large one; a dropped record sends nothing. The input waits only on the output's TREADY, while
+// the header and HEARTBEAT go out, and the clocks without output (2 per datagram: S_P3, S_P4;
+// 2 more per sample: S_P1, S_P2).
 // Timing: the output register is the register slice (m_axis_* from flip-flops); the fields are
 // registered a state before the shift register loads them; 32/16-bit counters count down with
 // their "last" flags registered.
