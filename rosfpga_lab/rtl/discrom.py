@@ -40,9 +40,9 @@ counts (1 and 2: a new participant has seen none) too.
 :func:`write_rom` writes one ``$readmemh`` file per message, the concatenated image
 ``rfl_rtps_disc_rom.hex`` and its message table ``rfl_rtps_disc_rom_table.hex`` (what
 ``fabric/rfl_rtps_disc_rom.v`` reads) and an index ``rfl_rtps_disc_rom.json`` (offsets,
-lengths, destinations, patch points). :func:`tx_parameters` gives the transmit path
-(``fabric/rfl_rtps_tx.v``) the same participant's GUID prefix and data writer id, so the data
-comes from the writer the ROM announces.
+lengths, destinations, patch points, and ``rfl_rtps_tx``: the transmit path's parameters).
+:func:`tx_parameters` gives the transmit path (``fabric/rfl_rtps_tx.v``) the same participant's
+GUID prefix and data writer id, so the data comes from the writer the ROM announces.
 """
 
 from __future__ import annotations
@@ -136,6 +136,7 @@ class DiscoveryRom:
         return {"guid_prefix": self.guid_prefix.hex(), "domain": self.domain, "index": self.index,
                 "address": self.address, "ports": self.ports(), "entity_ids": {
                     k: f"{v:08x}" for k, v in self.entity_ids.items()},
+                "rfl_rtps_tx": verilog_parameters(tx_parameters(self)),
                 "rom_file": ROM_FILE, "table_file": TABLE_FILE,
                 "rom_bytes": len(self.image()),
                 "messages": [{"name": m.name, "offset": off, "length": len(m.data),
@@ -283,3 +284,14 @@ def tx_parameters(rom: DiscoveryRom, *, frag_bytes: int = FRAGMENT_BYTES,
     return {"GUID_PREFIX": int.from_bytes(rom.guid_prefix, "big"),
             "WRITER_ID": rom.entity_ids["writer"], "READER_ID": reader_id,
             "FRAG_BYTES": frag_bytes, "MAX_DATAGRAM": max_datagram, "INFO_TS": int(info_ts)}
+
+
+#: Bits of the parameters of :func:`tx_parameters` that are not Verilog integers.
+TX_PARAMETER_BITS = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32}
+
+
+def verilog_parameters(params: dict[str, int]) -> dict[str, str]:
+    """Parameters as Verilog literals (``-G``/``-P``/``chparam`` values): the GUID prefix and
+    the entity ids sized hex (96 bits do not fit an integer), the others decimal."""
+    return {k: f"{TX_PARAMETER_BITS[k]}'h{v:x}" if k in TX_PARAMETER_BITS else str(v)
+            for k, v in params.items()}

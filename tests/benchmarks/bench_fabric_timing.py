@@ -25,7 +25,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from rosfpga_lab.rtl.discrom import render_rom, tx_parameters
+from rosfpga_lab.rtl.discrom import render_rom, tx_parameters, verilog_parameters
 from rosfpga_lab.rtl.limits import ECP5_DEVICE, ECP5_PACKAGE
 from rosfpga_lab.rtl.proofs import FABRIC_DIR
 from rosfpga_lab.rtl.limits import PNR_TIMEOUT, SYNTH_TIMEOUT
@@ -33,15 +33,14 @@ from rosfpga_lab.rtl.timing import choose_tools, parse_report
 
 ROOT = Path(__file__).resolve().parents[2]
 CLOCK_MHZ = 125.0
-WIDTHS = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32}
 
 
 def module_parameters(module: str) -> dict[str, str]:
     """The parameters a module is timed with (Yosys ``chparam`` values)."""
     if module != "rfl_rtps_tx":
         return {}
-    given = tx_parameters(render_rom(ROOT / "data" / "fpga_laserscan_min_cdr.yaml"))
-    return {k: f"{WIDTHS[k]}'h{v:x}" if k in WIDTHS else str(v) for k, v in given.items()}
+    return verilog_parameters(tx_parameters(render_rom(ROOT / "data" /
+                                                       "fpga_laserscan_min_cdr.yaml")))
 
 
 def place(module: str, seeds: list[int]) -> list[str]:

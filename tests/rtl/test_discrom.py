@@ -7,6 +7,7 @@ from the ROM's bytes alone, sent from a plain UDP socket as the circuit sends th
 
 from __future__ import annotations
 
+import json
 import os
 import socket
 import struct
@@ -20,7 +21,8 @@ from tests.support.realros import skip_or_fail
 from rosfpga_lab.config import load_config
 from rosfpga_lab.msg.typehash import type_hash
 from rosfpga_lab.rtl.discrom import (
-    DEST_META, DEST_SPDP, DEST_USER, ROM_FILE, TABLE_FILE, render_rom, write_rom,
+    DEST_META, DEST_SPDP, DEST_USER, INDEX_FILE, ROM_FILE, TABLE_FILE, render_rom, tx_parameters,
+    verilog_parameters, write_rom,
 )
 from rosfpga_lab.rtps import Data, Heartbeat, parse_message, parse_parameters
 from rosfpga_lab.rtps import build as b
@@ -115,7 +117,8 @@ def test_rom_equals_what_the_software_participant_sends() -> None:
 
 
 def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
-    """``rosfpga-lab generate CONFIG -o DIR --target fabric`` writes the ROM and its table."""
+    """``rosfpga-lab generate CONFIG -o DIR --target fabric`` writes the ROM and its table, and
+    its index names the transmit path's parameters (the same participant's)."""
     from rosfpga_lab.cli import main
 
     assert main(["generate", str(CONFIG), "-o", str(tmp_path), "-q", "--target", "fabric",
@@ -131,6 +134,9 @@ def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
         one = bytes(int(x, 16) for x in (tmp_path / f"rfl_rtps_disc_{m.name}.hex").read_text().split())
         assert one == m.data
         at += len(m.data)
+    index = json.loads((tmp_path / INDEX_FILE).read_text())
+    assert index["rfl_rtps_tx"] == verilog_parameters(tx_parameters(rom))
+    assert index["rfl_rtps_tx"]["GUID_PREFIX"] == f"96'h{rom.guid_prefix.hex().lstrip('0')}"
 
 
 def _require_cyclonedds():

@@ -26,11 +26,13 @@ import pytest
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hls.vectors import model_output_cdr
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
-from rosfpga_lab.rtl.discrom import fabric_participant, render_rom, tx_parameters
+from rosfpga_lab.rtl.discrom import (
+    fabric_participant, render_rom, tx_parameters, verilog_parameters,
+)
 from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
 from tests.rtl.test_fabric_rtps_cdr import CONFIG, FABRIC, MAX_BYTES, _record, case_of
 from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER, reference
-from tests.rtl.test_fabric_rtps_tx import check_parsed, expected, verilog_values
+from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
 from tests.support.rtltools import TB_DIR, require_cocotb
 
 pytestmark = pytest.mark.rtl
@@ -84,7 +86,7 @@ def test_rtps_in_rtps_out_is_the_models_output_as_the_builders_send_it(
                *rtl, TB_DIR / "rtps_loop_top.v"]
     runner = get_runner(sim)
     runner.build(sources=sources, includes=[gen / "rtl"], hdl_toplevel="rtps_loop_top",
-                 parameters=dict(verilog_values(p), MAX_BYTES=str(MAX_BYTES)),
+                 parameters=dict(verilog_parameters(p), MAX_BYTES=str(MAX_BYTES)),
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
     try:

@@ -30,7 +30,9 @@ from pathlib import Path
 import pytest
 
 from rosfpga_lab.config import load_config
-from rosfpga_lab.rtl.discrom import fabric_participant, render_rom, tx_parameters
+from rosfpga_lab.rtl.discrom import (
+    fabric_participant, render_rom, tx_parameters, verilog_parameters,
+)
 from rosfpga_lab.rtl.limits import FABRIC_MAX_DATAGRAM
 from rosfpga_lab.rtl.proofs import PROOFS, prove
 from rosfpga_lab.rtps import build as b
@@ -54,12 +56,6 @@ def params(frag: int, info_ts: bool, max_sample: int) -> dict[str, int]:
     size, INFO_TS, the longest record."""
     out = tx_parameters(render_rom(CONFIG), frag_bytes=frag, info_ts=info_ts)
     return dict(out, MAX_SAMPLE=max_sample)
-
-
-def verilog_values(p: dict[str, int]) -> dict[str, str]:
-    """The parameters as sized Verilog literals (the 96-bit prefix does not fit an integer)."""
-    width = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32}
-    return {k: f"{width[k]}'h{v:x}" if k in width else str(v) for k, v in p.items()}
 
 
 def head_bytes(info_ts: bool) -> int:
@@ -131,7 +127,7 @@ def run(tmp_path: Path, seed: int, frag: int, info_ts: bool, max_sample: int, ga
     (tmp_path / "case.json").write_text(json.dumps(case))
     runner = get_runner(sim)
     runner.build(sources=[SOURCE], hdl_toplevel="rfl_rtps_tx", build_dir=tmp_path / "build",
-                 parameters=verilog_values(p), timescale=("1ns", "1ps"),
+                 parameters=verilog_parameters(p), timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
     try:
         xml = runner.test(test_module="bench_rfl_rtps_tx", hdl_toplevel="rfl_rtps_tx",

@@ -209,7 +209,7 @@ def test_rtps_to_cdr_is_clean_under_three_linters(max_bytes: int, count_bits: in
 @pytest.mark.parametrize("info_ts,frag", [(True, None), (False, 4)])
 def test_rtps_tx_is_clean_under_three_linters(name: str, info_ts: bool, frag: int | None,
                                               tmp_path: Path) -> None:
-    from rosfpga_lab.rtl.discrom import render_rom, tx_parameters
+    from rosfpga_lab.rtl.discrom import render_rom, tx_parameters, verilog_parameters
     from rosfpga_lab.rtl.sim import VERILOG_DIR
     from rosfpga_lab.rtl.synth import yosys_command
 
@@ -217,8 +217,7 @@ def test_rtps_tx_is_clean_under_three_linters(name: str, info_ts: bool, frag: in
     top = "rfl_rtps_tx"
     given = tx_parameters(render_rom(DATA / f"{name}.yaml"), info_ts=info_ts,
                           **({"frag_bytes": frag} if frag else {}))
-    width = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32}
-    params = {k: f"{width[k]}'h{v:x}" if k in width else str(v) for k, v in given.items()}
+    params = verilog_parameters(given)
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall",
                            *(f"-G{k}={v}" for k, v in params.items()), source], cwd=tmp_path,
                           capture_output=True, text=True, timeout=120)
