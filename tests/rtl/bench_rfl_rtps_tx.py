@@ -1,4 +1,5 @@
-"""cocotb testbench of ``rfl_rtps_tx`` alone (run by tests/rtl/test_fabric_rtps_tx.py, not by pytest).
+"""cocotb testbench of ``rfl_rtps_tx`` alone (run by tests/rtl/test_fabric_rtps_tx.py, not by
+pytest).
 
 The case comes in a JSON file (``RTPS_TX_CASE``): the records (hex: a length, LE32, then the
 payload), per-mille input gaps and output backpressure. One coroutine offers a byte a clock

@@ -240,9 +240,9 @@ def test_the_verilog_defaults_are_the_participants() -> None:
 
 def test_a_planted_bug_fails_the_proof(tmp_path: Path) -> None:
     """The proofs are not vacuous: an output beat dropped while the sink stalls fails the stream
-    rules or the framing invariants (a beat lost breaks the byte count); a HEARTBEAT that forgets TLAST fails the framing (the datagram runs
-    past MAX_DATAGRAM: the module's FORMAL block); a header with the version's bytes swapped
-    fails the bounded header check."""
+    rules or the framing invariants (a beat lost breaks the byte count); a HEARTBEAT that
+    forgets TLAST fails the framing (the datagram runs past MAX_DATAGRAM: the module's FORMAL
+    block); a header with the version's bytes swapped fails the bounded header check."""
     require_formal()
     text = SOURCE.read_text()
     for k, (good, bad, mode, where) in enumerate((

@@ -86,7 +86,8 @@ module rfl_rtps_tx #(
         if (FRAG_BYTES < 4 || FRAG_BYTES > 65532 || FRAG_BYTES % 4 != 0)
             $fatal(1, "rfl_rtps_tx: FRAG_BYTES must be 4..65532 and a multiple of 4");
         if (MAX_DATAGRAM > 65507 || MAX_DATAGRAM < MIN_DATAGRAM)
-            $fatal(1, "rfl_rtps_tx: MAX_DATAGRAM must be at most 65507 and hold a DATA_FRAG's datagram");
+            $fatal(1, {"rfl_rtps_tx: MAX_DATAGRAM must be at most 65507 and hold a ",
+                       "DATA_FRAG's datagram"});
         if (MAX_SAMPLE < 1 || MAX_SAMPLE > 2147483647)
             $fatal(1, "rfl_rtps_tx: MAX_SAMPLE must be 1..2**31-1");
         if (INFO_TS != 0 && INFO_TS != 1) $fatal(1, "rfl_rtps_tx: INFO_TS must be 0 or 1");

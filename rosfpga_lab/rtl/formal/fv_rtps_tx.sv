@@ -1,10 +1,11 @@
 // fv_rtps_tx -- rfl_rtps_tx (rtl/fabric) with 4-byte fragments, samples of at most 16 bytes and
 // INFO_TS on its ports: any records (any lengths, any bytes) under the stream rules, any time.
 // Always (prove): the output keeps the stream rules (a valid beat, its byte and TLAST held until
-// taken), and the framing the module's FORMAL block asserts with its invariants: every
-// datagram opens with "R" and ends with TLAST within MAX_DATAGRAM bytes (here the smallest
-// legal, 104: header 20, INFO_TS 12, DATA_FRAG 36, a 4-byte fragment, HEARTBEAT 32). Bounded (bmc, not FV_PROVE): the first datagram starts with the RTPS header: "RTPS",
-// version 2.3, vendor 0, the GUID prefix, in that order, whatever the input and backpressure.
+// taken), and the framing the module's FORMAL block asserts with its invariants: every datagram
+// opens with "R" and ends with TLAST within MAX_DATAGRAM bytes (here the smallest legal, 104:
+// header 20, INFO_TS 12, DATA_FRAG 36, a 4-byte fragment, HEARTBEAT 32). Bounded (bmc, not
+// FV_PROVE): the first datagram starts with the RTPS header: "RTPS", version 2.3, vendor 0, the
+// GUID prefix, in that order, whatever the input and backpressure.
 module fv_rtps_tx (
     input clk, input rst_n, input [63:0] cfg_time, input [7:0] s_tdata, input s_tvalid,
     input m_axis_tready
