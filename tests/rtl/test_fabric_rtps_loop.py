@@ -10,7 +10,11 @@ models' published records (``hls.generic.model_output_cdr``, also held against n
 each sent as the lab's RTPS builders send it from the fabric participant's writer
 (tests/rtl/test_fabric_rtps_tx.py's ``expected``: writerSN 1, 2, .., fragments of the software
 participant's size, a HEARTBEAT each), byte for byte; and the decoder's view of what came out
-(``rtps.parse_message``, ``FragmentAssembler``) is every record's payload.
+(``rtps.parse_message``, ``FragmentAssembler``) is every record's payload. Last, the lab's
+software ROS 2 subscriber (``rtps.participant.Participant`` with ``RosNodeEntities``, a RELIABLE
+reader of the output topic) learns the fabric participant from its discovery ROM
+(``rtl.discrom.render_rom``: SPDP, SEDP), matches its writer and takes every sample from the
+circuit's datagrams, in order; its ACKNACKs to the HEARTBEATs (an empty history) ask for none.
 """
 
 from __future__ import annotations
@@ -23,13 +27,16 @@ from pathlib import Path
 
 import pytest
 
-from rosfpga_lab.config import load_config
+from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.hls.vectors import model_output_cdr
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.rtl.discrom import (
     fabric_participant, render_rom, tx_parameters, verilog_parameters,
 )
 from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
+from rosfpga_lab.rtps.message import AckNack, parse_message
+from rosfpga_lab.rtps.participant import Participant
+from rosfpga_lab.rtps.rosnode import RosNodeEntities
 from tests.rtl.test_fabric_rtps_cdr import CONFIG, FABRIC, MAX_BYTES, _record, case_of
 from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER, reference
 from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
@@ -37,6 +44,7 @@ from tests.support.rtltools import TB_DIR, require_cocotb
 
 pytestmark = pytest.mark.rtl
 
+LISTENER = bytes.fromhex("010f0000000000000000abcd")   # the software subscriber's GUID prefix
 TIME = (1_700_000 << 32) | 0x8000_0000          # cfg_time: seconds below 2**21, exact as a float
 
 
@@ -49,6 +57,25 @@ def split_records(stream: bytes) -> list[bytes]:
         at += 4 + n
     assert at == len(stream)
     return out
+
+
+def software_subscriber(config: NodeConfig, datagrams: list[bytes]) -> tuple[list, list]:
+    """A software ROS 2 node subscribed to the configuration's output topic, told of the fabric
+    participant by its discovery ROM only, given ``datagrams``: the samples it takes and the
+    ACKNACKs it answers with."""
+    sub = Participant(0, 5, "127.0.0.1", "listener", guid_prefix=LISTENER)
+    node = RosNodeEntities(sub, "listener", "/")
+    rid = node.add_subscriber(config.publisher.topic, config.publisher.type,
+                              registry=config.registry())
+    rom = render_rom(config)
+    for m in rom.messages:
+        sub.receive(m.data, ("127.0.0.1", 7410), 0.0)
+    assert sub.matched(rid), sub.notes
+    acks = []
+    for k, dg in enumerate(datagrams):
+        for _host, _port, reply in sub.receive(dg, ("127.0.0.1", 7411), 0.1 + k / 1000):
+            acks += [s for s in parse_message(reply).submessages if isinstance(s, AckNack)]
+    return sub.take(rid), acks
 
 
 @pytest.mark.parametrize("seed,gap,bp", [(5, 200, 300)])
@@ -105,3 +132,8 @@ def test_rtps_in_rtps_out_is_the_models_output_as_the_builders_send_it(
     check_parsed(got, payloads, MAX_BYTES, part.guid_prefix, wid, p["READER_ID"], True)
     assert got == [d for dgs in want for d in dgs]
     assert out["counts"] == {"samples": 5, "datagrams": 10, "dropped": 0}
+    taken, acks = software_subscriber(config, got)
+    writer_guid = part.guid_prefix + wid.to_bytes(4, "big")
+    assert [(s.writer_guid, s.seq, s.payload) for s in taken] == \
+        [(writer_guid, n, pay) for n, pay in enumerate(payloads, 1)]
+    assert acks and all(a.writer_id == wid and a.missing == () for a in acks), acks
