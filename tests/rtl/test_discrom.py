@@ -200,9 +200,9 @@ class RomSender:
 
     PERIOD = 0.5
 
-    def __init__(self, domain: int) -> None:
+    def __init__(self, domain: int, config: Path = CONFIG, guid_prefix: bytes = PREFIX) -> None:
         self.index, self.meta, self.user = _bind_free_index(domain)
-        self.rom = render_rom(CONFIG, domain=domain, index=self.index, guid_prefix=PREFIX)
+        self.rom = render_rom(config, domain=domain, index=self.index, guid_prefix=guid_prefix)
         self.peers: set[tuple[int, int]] = set()
         self.meta.settimeout(0.05)
         self._stop = threading.Event()
@@ -211,6 +211,11 @@ class RomSender:
 
     def _send(self, name: str, port: int) -> None:
         self.meta.sendto(self.rom.message(name).data, ("127.0.0.1", port))
+
+    def send_data(self, datagram: bytes) -> None:
+        """A datagram of the circuit's data writer to every peer's user-data port."""
+        for _meta, user in list(self.peers):
+            self.user.sendto(datagram, ("127.0.0.1", user))
 
     def _run(self) -> None:
         last = -1.0

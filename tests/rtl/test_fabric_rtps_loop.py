@@ -23,6 +23,7 @@ import json
 import struct
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -33,6 +34,7 @@ from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.rtl.discrom import (
     fabric_participant, render_rom, tx_parameters, verilog_parameters,
 )
+from rosfpga_lab.rtps.build import dds_topic
 from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
 from rosfpga_lab.rtps.message import AckNack, parse_message
 from rosfpga_lab.rtps.participant import Participant
@@ -57,6 +59,20 @@ def split_records(stream: bytes) -> list[bytes]:
         at += 4 + n
     assert at == len(stream)
     return out
+
+
+def published(seed: int) -> tuple[list[bytes], list[bytes]]:
+    """tests/rtl/test_fabric_rtps_cdr.py's datagrams of ``seed`` and the payloads the CDR models
+    publish for them (each record's, in order)."""
+    datagrams, oracle, _ = case_of(seed)
+    walked, _counts = reference(datagrams)
+    kept = [r for r in (_record(bytes.fromhex(s["data"])) for s in walked)
+            if len(r) - 4 <= MAX_BYTES]
+    config = load_config(CONFIG)
+    out_records, _why = model_output_cdr(cdr_layout_from_config(config),
+                                         config.application.op, config.application.ksize, kept)
+    assert out_records == oracle
+    return datagrams, split_records(out_records)
 
 
 def software_subscriber(config: NodeConfig, datagrams: list[bytes]) -> tuple[list, list]:
@@ -89,15 +105,8 @@ def test_rtps_in_rtps_out_is_the_models_output_as_the_builders_send_it(
     proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
                            str(gen), "-q"], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
-    datagrams, oracle, _ = case_of(seed)
-    walked, _counts = reference(datagrams)
-    kept = [r for r in (_record(bytes.fromhex(s["data"])) for s in walked)
-            if len(r) - 4 <= MAX_BYTES]
+    datagrams, payloads = published(seed)
     config = load_config(CONFIG)
-    out_records, _why = model_output_cdr(cdr_layout_from_config(config),
-                                         config.application.op, config.application.ksize, kept)
-    assert out_records == oracle
-    payloads = split_records(out_records)
     part, _node, wid, _rid = fabric_participant(config)
     p = tx_parameters(render_rom(config))
     assert p["FRAG_BYTES"] == FRAGMENT_BYTES and p["INFO_TS"] == 1
@@ -137,3 +146,56 @@ def test_rtps_in_rtps_out_is_the_models_output_as_the_builders_send_it(
     assert [(s.writer_guid, s.seq, s.payload) for s in taken] == \
         [(writer_guid, n, pay) for n, pay in enumerate(payloads, 1)]
     assert acks and all(a.writer_id == wid and a.missing == () for a in acks), acks
+
+
+@pytest.mark.timeout(60)
+def test_cyclone_dds_takes_what_the_circuit_sends() -> None:
+    """PyPI Cyclone DDS (configured as rmw_cyclonedds_cpp would be) with a default-QoS ROS 2
+    reader (RELIABLE, VOLATILE, KEEP_LAST 10) of the output topic learns the fabric participant
+    from its discovery ROM sent from a UDP socket as the circuit sends it
+    (tests/rtl/test_discrom.py's RomSender), then takes every sample of the datagrams the
+    circuit sends for the models' output (the builders' bytes: the test above holds the
+    circuit's equal to them), DATA_FRAGs and empty-history HEARTBEATs included."""
+    from tests.rtl.test_discrom import RomSender, _require_cyclonedds
+    from tests.support.ros2tools import DOMAIN, cyclone, wait
+
+    builtin, dds = _require_cyclonedds()
+    types = cyclone()
+    from tests.support.cdrtypes import LaserScan_
+
+    config = load_config(CONFIG)
+    _datagrams, payloads = published(5)
+    part, _node, wid, _rid = fabric_participant(config)
+    sender = RomSender(DOMAIN, CONFIG, part.guid_prefix)
+    try:
+        dp = dds.DomainParticipant(DOMAIN)
+        P = types.Policy
+        topic = types.Topic(dp, dds_topic(config.publisher.topic), LaserScan_)
+        reader = types.DataReader(dp, topic, qos=types.Qos(
+            P.Reliability.Reliable(100_000_000), P.Durability.Volatile, P.History.KeepLast(10)))
+        pubs = builtin.BuiltinDataReader(dp, builtin.BuiltinTopicDcpsPublication)
+        seen: list = []
+        writer_key = part.guid_prefix + wid.to_bytes(4, "big")
+
+        def matched() -> bool:
+            seen.extend(pubs.take(N=64))
+            return bool(sender.peers) and any(s.key.bytes == writer_key for s in seen)
+
+        assert wait(matched, 10.0), (sender.peers, len(seen))
+        time.sleep(0.3)              # Cyclone's reader matches the writer it learned
+        want = expected(payloads, [TIME] * len(payloads), FRAGMENT_BYTES, True, MAX_BYTES,
+                        part.guid_prefix, wid, 0)
+        for dg in (d for dgs in want for d in dgs):
+            sender.send_data(dg)
+        got: list = []
+
+        def taken() -> bool:
+            got.extend(reader.take(N=16))
+            return len(got) >= len(payloads)
+
+        assert wait(taken, 10.0), f"{len(got)} of {len(payloads)} samples taken"
+        assert [g.serialize() for g in got] == \
+            [LaserScan_.deserialize(p).serialize() for p in payloads]
+        dp = None
+    finally:
+        sender.close()
