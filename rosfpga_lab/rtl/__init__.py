@@ -64,7 +64,7 @@ streamed without a sample buffer, and a HEARTBEAT), its GUID prefix and writer i
 :func:`rosfpga_lab.rtl.discrom.tx_parameters` of the participant the discovery ROM announces
 (proof ``rtps_tx``; byte for byte against the lab's RTPS builders in
 ``tests/rtl/test_fabric_rtps_tx.py``, RTPS in to RTPS out through a generated top in
-``tests/rtl/test_fabric_rtps_loop.py``).
+``tests/rtl/test_fabric_rtps_loop.py``, where Cyclone DDS takes what it sends).
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
