@@ -60,7 +60,13 @@ writer's DATA / DATA_FRAG samples out (its header comment is the design note; pr
 ``tests/rtl/test_fabric_rtps_rx.py``); ``rfl_rtps_to_cdr`` turns its sample packets into the
 records a generated ``wire: cdr`` circuit's subscriber reads (the length, then the payload),
 forwarding a sample only once it ended good (proof ``rtps_to_cdr``; datagrams through both into
-a generated top in ``tests/rtl/test_fabric_rtps_cdr.py``).
+a generated top in ``tests/rtl/test_fabric_rtps_cdr.py``). ``rfl_rtps_tx`` is the way back: the
+generated publisher's records become the data writer's RTPS datagrams (DATA, or DATA_FRAGs
+streamed without a sample buffer, and a HEARTBEAT), its GUID prefix and writer id
+:func:`rosfpga_lab.rtl.discrom.tx_parameters` of the participant the discovery ROM announces
+(proof ``rtps_tx``; byte for byte against the lab's RTPS builders in
+``tests/rtl/test_fabric_rtps_tx.py``, RTPS in to RTPS out through a generated top in
+``tests/rtl/test_fabric_rtps_loop.py``, where Cyclone DDS takes what it sends).
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError

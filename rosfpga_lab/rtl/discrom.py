@@ -40,7 +40,9 @@ counts (1 and 2: a new participant has seen none) too.
 :func:`write_rom` writes one ``$readmemh`` file per message, the concatenated image
 ``rfl_rtps_disc_rom.hex`` and its message table ``rfl_rtps_disc_rom_table.hex`` (what
 ``fabric/rfl_rtps_disc_rom.v`` reads) and an index ``rfl_rtps_disc_rom.json`` (offsets,
-lengths, destinations, patch points).
+lengths, destinations, patch points, and ``rfl_rtps_tx``: the transmit path's parameters).
+:func:`tx_parameters` gives the transmit path (``fabric/rfl_rtps_tx.v``) the same participant's
+GUID prefix and data writer id, so the data comes from the writer the ROM announces.
 """
 
 from __future__ import annotations
@@ -52,13 +54,13 @@ from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.rtl.errors import RtlError
-from rosfpga_lab.rtl.limits import MAX_DISC_ROM_BYTES
+from rosfpga_lab.rtl.limits import FABRIC_MAX_DATAGRAM, MAX_DISC_ROM_BYTES
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
     PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, Qos, discovery_multicast_port,
     discovery_port, user_port,
 )
-from rosfpga_lab.rtps.limits import MAX_MESSAGE_BYTES, SPDP_MULTICAST_ADDRESS
+from rosfpga_lab.rtps.limits import FRAGMENT_BYTES, MAX_MESSAGE_BYTES, SPDP_MULTICAST_ADDRESS
 from rosfpga_lab.rtps.message import ANY_PARTICIPANT
 from rosfpga_lab.rtps.participant import Participant
 from rosfpga_lab.rtps.rosnode import RosNodeEntities, split_node_name
@@ -134,6 +136,7 @@ class DiscoveryRom:
         return {"guid_prefix": self.guid_prefix.hex(), "domain": self.domain, "index": self.index,
                 "address": self.address, "ports": self.ports(), "entity_ids": {
                     k: f"{v:08x}" for k, v in self.entity_ids.items()},
+                "rfl_rtps_tx": verilog_parameters(tx_parameters(self)),
                 "rom_file": ROM_FILE, "table_file": TABLE_FILE,
                 "rom_bytes": len(self.image()),
                 "messages": [{"name": m.name, "offset": off, "length": len(m.data),
@@ -268,3 +271,27 @@ def write_rom(rom: DiscoveryRom, out_dir: str | Path) -> list[Path]:
         (out / name).write_text(text)
         paths.append(out / name)
     return paths
+
+
+def tx_parameters(rom: DiscoveryRom, *, frag_bytes: int = FRAGMENT_BYTES,
+                  max_datagram: int = FABRIC_MAX_DATAGRAM, info_ts: bool = True,
+                  reader_id: int = 0) -> dict[str, int]:
+    """The Verilog parameters of ``fabric/rfl_rtps_tx.v`` (the transmit path) for the participant
+    ``rom`` was rendered for: its GUID prefix and its data writer's entity id (one owner: the
+    same :func:`fabric_participant` the ROM announces), the DATA_FRAG fragment size (default the
+    software participant's), the largest datagram, INFO_TS on or off and the reader id
+    (0: ENTITYID_UNKNOWN, every reader of the topic)."""
+    return {"GUID_PREFIX": int.from_bytes(rom.guid_prefix, "big"),
+            "WRITER_ID": rom.entity_ids["writer"], "READER_ID": reader_id,
+            "FRAG_BYTES": frag_bytes, "MAX_DATAGRAM": max_datagram, "INFO_TS": int(info_ts)}
+
+
+#: Bits of the parameters of :func:`tx_parameters` that are not Verilog integers.
+TX_PARAMETER_BITS = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32}
+
+
+def verilog_parameters(params: dict[str, int]) -> dict[str, str]:
+    """Parameters as Verilog literals (``-G``/``-P``/``chparam`` values): the GUID prefix and
+    the entity ids sized hex (96 bits do not fit an integer), the others decimal."""
+    return {k: f"{TX_PARAMETER_BITS[k]}'h{v:x}" if k in TX_PARAMETER_BITS else str(v)
+            for k, v in params.items()}

@@ -51,3 +51,9 @@ FORMAL_MAX_MEMORY_BITS = 256 * 1024
 
 #: Largest discovery ROM image (``rtl.discrom``): its message table holds 16-bit offsets.
 MAX_DISC_ROM_BYTES = 1 << 16
+
+#: Largest UDP payload the fabric's transmit path (``fabric/rfl_rtps_tx.v``) sends: an Ethernet
+#: frame's 1500-byte MTU less the IPv4 (20) and UDP (8) headers, so no datagram is IP-fragmented
+#: (a MAC without IP fragmentation sends it as one frame). The fragment size is the software
+#: participant's (``rtps.limits.FRAGMENT_BYTES``), whose DATA_FRAG datagram fits in it.
+FABRIC_MAX_DATAGRAM = 1500 - 20 - 8

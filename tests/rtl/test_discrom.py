@@ -7,6 +7,7 @@ from the ROM's bytes alone, sent from a plain UDP socket as the circuit sends th
 
 from __future__ import annotations
 
+import json
 import os
 import socket
 import struct
@@ -20,7 +21,8 @@ from tests.support.realros import skip_or_fail
 from rosfpga_lab.config import load_config
 from rosfpga_lab.msg.typehash import type_hash
 from rosfpga_lab.rtl.discrom import (
-    DEST_META, DEST_SPDP, DEST_USER, ROM_FILE, TABLE_FILE, render_rom, write_rom,
+    DEST_META, DEST_SPDP, DEST_USER, INDEX_FILE, ROM_FILE, TABLE_FILE, render_rom, tx_parameters,
+    verilog_parameters, write_rom,
 )
 from rosfpga_lab.rtps import Data, Heartbeat, parse_message, parse_parameters
 from rosfpga_lab.rtps import build as b
@@ -115,7 +117,8 @@ def test_rom_equals_what_the_software_participant_sends() -> None:
 
 
 def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
-    """``rosfpga-lab generate CONFIG -o DIR --target fabric`` writes the ROM and its table."""
+    """``rosfpga-lab generate CONFIG -o DIR --target fabric`` writes the ROM and its table, and
+    its index names the transmit path's parameters (the same participant's)."""
     from rosfpga_lab.cli import main
 
     assert main(["generate", str(CONFIG), "-o", str(tmp_path), "-q", "--target", "fabric",
@@ -131,6 +134,9 @@ def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
         one = bytes(int(x, 16) for x in (tmp_path / f"rfl_rtps_disc_{m.name}.hex").read_text().split())
         assert one == m.data
         at += len(m.data)
+    index = json.loads((tmp_path / INDEX_FILE).read_text())
+    assert index["rfl_rtps_tx"] == verilog_parameters(tx_parameters(rom))
+    assert index["rfl_rtps_tx"]["GUID_PREFIX"] == f"96'h{rom.guid_prefix.hex().lstrip('0')}"
 
 
 def _require_cyclonedds():
@@ -194,9 +200,9 @@ class RomSender:
 
     PERIOD = 0.5
 
-    def __init__(self, domain: int) -> None:
+    def __init__(self, domain: int, config: Path = CONFIG, guid_prefix: bytes = PREFIX) -> None:
         self.index, self.meta, self.user = _bind_free_index(domain)
-        self.rom = render_rom(CONFIG, domain=domain, index=self.index, guid_prefix=PREFIX)
+        self.rom = render_rom(config, domain=domain, index=self.index, guid_prefix=guid_prefix)
         self.peers: set[tuple[int, int]] = set()
         self.meta.settimeout(0.05)
         self._stop = threading.Event()
@@ -205,6 +211,11 @@ class RomSender:
 
     def _send(self, name: str, port: int) -> None:
         self.meta.sendto(self.rom.message(name).data, ("127.0.0.1", port))
+
+    def send_data(self, datagram: bytes) -> None:
+        """A datagram of the circuit's data writer to every peer's user-data port."""
+        for _meta, user in list(self.peers):
+            self.user.sendto(datagram, ("127.0.0.1", user))
 
     def _run(self) -> None:
         last = -1.0

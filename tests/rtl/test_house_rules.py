@@ -83,7 +83,7 @@ def test_the_rules_cover_every_module_file_in_scope() -> None:
     names = {p.name for p in MODULE_FILES}
     assert {"rfl_fifo.v", "rfl_fifo2axi.v", "rfl_axi2fifo.v", "rfl_slice.v", "rfl_subscriber.v",
             "rfl_publisher.v", "rfl_top.v", "rfl_morph.v", "rfl_harness.v", "rfl_tb.v",
-            "rfl_rtps_disc_rom.v", "rfl_rtps_rx.v", "rfl_rtps_to_cdr.v",
+            "rfl_rtps_disc_rom.v", "rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
             "rfl_gsubscriber.v", "rfl_gpublisher.v", "rfl_gtop.v", "rfl_elem_pack.v",
             "rfl_elem_unpack.v", "rfl_window1d.v", "rfl_elem_tb.v"} <= names
 
@@ -152,6 +152,19 @@ CONTRACTS = [
     ("rfl_rtps_disc_rom", {"DEST_BITS": 9}, "rfl_rtps_disc_rom: DEST_BITS must be 1..8"),
     ("rfl_rtps_to_cdr", {"MAX_BYTES": 3}, "rfl_rtps_to_cdr: MAX_BYTES must be 4..2**24"),
     ("rfl_rtps_to_cdr", {"COUNT_BITS": 33}, "rfl_rtps_to_cdr: COUNT_BITS must be 1..32"),
+    ("rfl_rtps_tx", {"GUID_PREFIX": 0},
+     "rfl_rtps_tx: GUID_PREFIX must be the participant's, not 0"),
+    ("rfl_rtps_tx", {"WRITER_ID": 0x204},
+     "rfl_rtps_tx: WRITER_ID must be a writer's entity id (kind 0x02/0x03)"),
+    ("rfl_rtps_tx", {"READER_ID": 0x203},
+     "rfl_rtps_tx: READER_ID must be 0 or a reader's entity id (kind 0x04/0x07)"),
+    ("rfl_rtps_tx", {"FRAG_BYTES": 1346},
+     "rfl_rtps_tx: FRAG_BYTES must be 4..65532 and a multiple of 4"),
+    ("rfl_rtps_tx", {"MAX_DATAGRAM": 1443},
+     "rfl_rtps_tx: MAX_DATAGRAM must be at most 65507 and hold a DATA_FRAG's datagram"),
+    ("rfl_rtps_tx", {"MAX_SAMPLE": 0}, "rfl_rtps_tx: MAX_SAMPLE must be 1..2**31-1"),
+    ("rfl_rtps_tx", {"INFO_TS": 2}, "rfl_rtps_tx: INFO_TS must be 0 or 1"),
+    ("rfl_rtps_tx", {"COUNT_BITS": 33}, "rfl_rtps_tx: COUNT_BITS must be 1..32"),
     # the generated projects' element modules (the walkers and rfl_gtop need a project's
     # rfl_layout.vh: their contracts are elaborated in hls/test_generic_project.py's lint)
     ("rfl_elem_pack", {"EBYTES": 9}, "rfl_elem_pack: EBYTES must be 1..8"),
