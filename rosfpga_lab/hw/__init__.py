@@ -100,7 +100,8 @@ from rosfpga_lab.hw.framing import FRAMING_FLAGS
 from rosfpga_lab.hw.morph import (
     OPS, morph_fast, morph_reference, morph_stream_fast, morph_stream_reference,
 )
-from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame, wire_bytes
+from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, wire_bytes
+from rosfpga_lab.hw.sample import image_frame
 from rosfpga_lab.hw.rx import receive_fast_check, receive_reference
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
 from rosfpga_lab.hw.video import (
