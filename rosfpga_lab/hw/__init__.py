@@ -33,7 +33,9 @@ the subscriber and publisher of any type are rendered from it (module ``walker``
 ``subscriberwalker``: :class:`LayoutInterpreter`, :func:`extract_reference` /
 :func:`extract_fast`, and ``publisherwalker``: :func:`publish_reference` /
 :func:`publish_fast`), the 1-D application in ``morph1d``, the
-whole circuit of a non-Image type in :class:`MessagePipeline` (``msgpipeline``). CDR (ROS 2)
+whole circuit of any type, ``sensor_msgs/Image`` included (its video stream through the 2-D
+application), in :class:`MessagePipeline` (``msgpipeline``), from a configuration's layouts
+derived once (``circuit``: :func:`~rosfpga_lab.hw.circuit.circuit_layouts`). CDR (ROS 2)
 is the second wire format of the same layout (``cdrlayout``, ``cdrwalker``), the whole circuit
 on CDR samples, Image included, :class:`CdrPipeline` (``cdrpipeline``).
 

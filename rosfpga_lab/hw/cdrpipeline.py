@@ -24,7 +24,7 @@ from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config.vocabulary import (CUSTOM, PIPELINE_MODELS, RTL_MODEL, canonical_op,
                                            model_ksize)
 from rosfpga_lab.hw.cdrlayout import CdrLayout
-from rosfpga_lab.hw.circuit import circuit_layouts
+from rosfpga_lab.hw.circuit import CircuitLayouts, circuit_layouts
 from rosfpga_lab.hw.cdrwalker import (
     extract_cdr_fast, extract_cdr_reference, publish_cdr_fast, publish_cdr_reference,
 )
@@ -75,6 +75,9 @@ class CdrPipeline:
             types' ROS 2 forms (a check of ``header.seq`` is refused: ROS 2 has none).
         model: ``fast`` or ``reference``.
         reg: the registry of ROS 1 definitions (default: ``config.registry()``).
+        layouts: the configuration's layouts when the caller holds them
+            (:func:`~rosfpga_lab.hw.circuit.circuit_layouts`; default: derived, or the ones
+            kept for ``config``).
 
     Raises:
         PipelineConfigError: ``op: custom`` (no Python model of the user's C++), a bad model,
@@ -82,7 +85,8 @@ class CdrPipeline:
     """
 
     def __init__(self, config: NodeConfig, model: str = "fast",
-                 reg: MsgRegistry | None = None) -> None:
+                 reg: MsgRegistry | None = None, *,
+                 layouts: CircuitLayouts | None = None) -> None:
         if model == RTL_MODEL:
             raise PipelineConfigError(
                 "the CDR circuit has no live RTL model: run its Verilog with `rosfpga-lab generate "
@@ -95,7 +99,7 @@ class CdrPipeline:
         if canonical_op(app.op) == CUSTOM:
             raise PipelineConfigError("a custom application has no Python model; compare its C "
                                       "simulation against your own expectation")
-        layouts = circuit_layouts(config, reg)
+        layouts = layouts or circuit_layouts(config, reg)
         self.cdr: CdrLayout = layouts.cdr
         self.out_cdr: CdrLayout | None = layouts.out_cdr
         self.model = model

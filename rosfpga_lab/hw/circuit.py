@@ -17,8 +17,10 @@ from __future__ import annotations
 
 import threading
 import weakref
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Generic, TypeVar
 
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config.limits import IMAGE_TYPE
@@ -85,8 +87,37 @@ class CircuitLayouts:
         return cdr_layout_from_config(self.config, self.reg, output=True)
 
 
-_records: dict[int, tuple[weakref.ref[NodeConfig], CircuitLayouts]] = {}
-_lock = threading.Lock()
+T = TypeVar("T")
+
+
+class ConfigCache(Generic[T]):
+    """One value per configuration object, built on first use: the same object asked again gets
+    the same value; a configuration loaded again (a ``.msg`` edited in between) a new one. The
+    newest ``kept`` are kept (a notebook loads a few).
+    """
+
+    def __init__(self, kept: int = _KEPT) -> None:
+        self._kept = kept
+        self._values: dict[int, tuple[weakref.ref[NodeConfig], T]] = {}
+        self._lock = threading.Lock()
+
+    def get(self, config: NodeConfig, build: Callable[[], T]) -> T:
+        """The value of ``config``, ``build()`` when it has none yet (errors propagate; nothing
+        is kept then)."""
+        with self._lock:
+            kept = self._values.get(id(config))
+            if kept is not None and kept[0]() is config:
+                return kept[1]
+        value = build()
+        with self._lock:
+            self._values.pop(id(config), None)
+            while len(self._values) >= self._kept:
+                self._values.pop(next(iter(self._values)))
+            self._values[id(config)] = (weakref.ref(config), value)
+        return value
+
+
+_records: ConfigCache[CircuitLayouts] = ConfigCache()
 
 
 def circuit_layouts(config: NodeConfig, reg: MsgRegistry | None = None) -> CircuitLayouts:
@@ -100,22 +131,16 @@ def circuit_layouts(config: NodeConfig, reg: MsgRegistry | None = None) -> Circu
     Raises:
         LayoutError: a key of the configuration the type cannot take.
     """
-    if reg is None:
-        with _lock:
-            kept = _records.get(id(config))
-            if kept is not None and kept[0]() is config:
-                return kept[1]
-    own = reg or config.registry()
-    layout = layout_from_config(config, own)
-    out_layout = (layout_from_config(config, own, output=True)
+    if reg is not None:
+        return _derive(config, reg)
+    return _records.get(config, lambda: _derive(config, config.registry()))
+
+
+def _derive(config: NodeConfig, reg: MsgRegistry) -> CircuitLayouts:
+    layout = layout_from_config(config, reg)
+    out_layout = (layout_from_config(config, reg, output=True)
                   if config.publisher.type != config.subscriber.type else None)
-    record = CircuitLayouts(config, own, layout, out_layout, numbered_field(config))
-    if reg is None:
-        with _lock:
-            while len(_records) >= _KEPT:
-                _records.pop(next(iter(_records)))
-            _records[id(config)] = (weakref.ref(config), record)
-    return record
+    return CircuitLayouts(config, reg, layout, out_layout, numbered_field(config))
 
 
-__all__ = ["NUMBERED_FIELD", "CircuitLayouts", "circuit_layouts", "numbered_field"]
+__all__ = ["NUMBERED_FIELD", "CircuitLayouts", "ConfigCache", "circuit_layouts", "numbered_field"]
