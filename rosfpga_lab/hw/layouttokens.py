@@ -93,7 +93,7 @@ def _token_buffer(step: Step, value: Any) -> bytes | memoryview:
     """The wire bytes of one token; an array's as a view of its memory (no copy when it is
     contiguous and of the step's type already)."""
     if step.kind is StepKind.ARRAY:
-        return memoryview(np.ascontiguousarray(value, dtype=np.dtype(step.dtype))).cast("B")
+        return np.ascontiguousarray(value, dtype=np.dtype(step.dtype)).data.cast("B")
     return encode_token(step, value)
 
 
