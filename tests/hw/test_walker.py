@@ -244,6 +244,46 @@ def test_the_layout_models_give_the_image_paths_outputs_and_refusals(name: str) 
     assert ("ok", 5) in outcomes and sum(o[0] == "refused" for o in outcomes) >= 10
 
 
+@pytest.mark.parametrize("name", ["fpga_dilate_rgba8.yaml", "fpga_erode_mono8.yaml",
+                                  "fpga_passthrough_rgb8.yaml"])
+@pytest.mark.parametrize("model", ["fast", "reference"])
+def test_the_walkers_circuit_publishes_what_the_image_model_publishes(name: str,
+                                                                       model: str) -> None:
+    """MessagePipeline (the live node's model since issue 28) against hw.Pipeline (its model
+    before), frame for frame on one stream of good and refused Image frames: the same output
+    bytes (the picture filtered, header.seq numbered 1, 2, ... over the published frames), the
+    same refusals (field, byte offset and kind; two rules the layout words as its checks do),
+    and the next good frame right after each refusal."""
+    from rosfpga_lab.component.fpga import refusal_kind
+    from rosfpga_lab.hw import Pipeline
+    from rosfpga_lab.hw.errors import FrameFieldError
+
+    built_for = "not what the circuit was built for"    # the layout's EQUAL check
+    worded = {"step: not width x bytes per pixel": f"step: {built_for}",
+              "data length: not step x height": f"data length: {built_for}"}
+
+    text = (DATA / name).read_text()
+    for a, b in (("width: 320", "width: 8"), ("height: 240", "height: 6"),
+                 ("width: 640", "width: 8"), ("height: 480", "height: 6")):
+        text = text.replace(a, b)
+    config = parse_config(text)
+    old, new = Pipeline.from_config(config, model=model), MessagePipeline.from_config(config, model)
+    frames = _image_frames(config)
+    good = frames[0]
+    published = 0
+    for frame in [f for bad in frames[1:] for f in (bad, good)]:
+        outcome = []
+        for pipe in (old, new):
+            try:
+                outcome.append(pipe.process(frame).output_frame)
+            except FrameFieldError as exc:
+                kind = refusal_kind(exc)
+                outcome.append((exc.field, exc.offset, worded.get(kind, kind)))
+        assert outcome[0] == outcome[1], frame[:40].hex()
+        published += isinstance(outcome[0], bytes)
+    assert published >= len(frames) and new.next_seq == published + 1
+
+
 # -- specific refusals ---------------------------------------------------------------------------
 
 def test_refusals_inside_arrays_of_messages_name_the_element_and_resync() -> None:
