@@ -50,6 +50,7 @@ from rosfpga_lab.config.vocabulary import CDR_WIRE, MODELS, RTL_MODEL, TIMINGS
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
 from rosfpga_lab.hls.circuit import Circuit, circuit_of
+from rosfpga_lab.hls.program import Refused
 from rosfpga_lab.hw.errors import FrameFieldError, PipelineError
 from rosfpga_lab.hw.layoutsteps import StepKind
 from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
@@ -265,12 +266,8 @@ class FpgaComponent:
             self.pipeline: MessagePipeline = self.circuit.model(pmodel)
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
-        self._timed = True
+        self._timed = self._has_generated_walk()
         self._shape_clocks: dict[tuple[int, ...], int] = {}
-        try:
-            self.circuit.program
-        except LabError:
-            self._timed = False
         self._rtl: Any = None
         if model == RTL_MODEL:
             from rosfpga_lab.rtl.server import RtlServer
@@ -281,6 +278,13 @@ class FpgaComponent:
                 self._rtl = RtlServer(config)
             except LabError as exc:
                 raise ComponentConfigError(f"cannot run the Verilog (--model rtl): {exc}") from None
+
+    def _has_generated_walk(self) -> bool:
+        """Whether the generator renders this configuration (its walk then times the frames)."""
+        try:
+            return self.circuit.program is not None
+        except LabError:
+            return False
 
     @classmethod
     def from_config(cls, config: str | Path | NodeConfig, master_uri: str | None = None,
@@ -390,8 +394,6 @@ class FpgaComponent:
         """
         if not self._timed:
             return result.total_cycles
-        from rosfpga_lab.hls.program import Refused
-
         shape = (len(frame), *(t.value for t in result.extracted.tokens
                                if self.pipeline.layout.steps[t.step].kind is StepKind.LENGTH))
         clocks = self._shape_clocks.get(shape)
