@@ -92,7 +92,7 @@ from rosfpga_lab.hw.interpreter import (
 from rosfpga_lab.hw.layoutderive import derive_layout, layout_from_config
 from rosfpga_lab.hw.layoutsteps import Layout, format_layout
 from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
-from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
+from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult, wire_bytes
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline, CdrResult
 from rosfpga_lab.hw.publisherwalker import publish_fast, publish_reference
 from rosfpga_lab.hw.subscriberwalker import (
@@ -102,7 +102,7 @@ from rosfpga_lab.hw.framing import FRAMING_FLAGS
 from rosfpga_lab.hw.morph import (
     OPS, morph_fast, morph_reference, morph_stream_fast, morph_stream_reference,
 )
-from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, wire_bytes
+from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult
 from rosfpga_lab.hw.sample import image_frame
 from rosfpga_lab.hw.rx import receive_fast_check, receive_reference
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo

@@ -51,6 +51,7 @@ class MessageResult:
         model: ``"fast"`` or ``"reference"``.
         stamp: ``(secs, nsecs)`` of ``header.stamp`` when the type has one.
         video: the stream's video shape (Image), else None.
+        line_rate_bps: the network's line rate, for ``network_time_s`` and ``wire_time_s``.
     """
 
     output_frame: bytes
@@ -63,6 +64,17 @@ class MessageResult:
     model: str = "fast"
     stamp: tuple[int, int] | None = None
     video: VideoShape | None = None
+    line_rate_bps: float = limits.DEFAULT_LINE_RATE_BPS
+
+    @property
+    def network_time_s(self) -> float:
+        """The input frame's bytes (4-byte length + body) at ``line_rate_bps`` (payload only)."""
+        return 8 * (4 + self.extracted.frame_length) / self.line_rate_bps
+
+    @property
+    def wire_time_s(self) -> float:
+        """The same bytes as TCP over Ethernet (:func:`wire_bytes`) at ``line_rate_bps``."""
+        return 8 * wire_bytes(4 + self.extracted.frame_length) / self.line_rate_bps
 
     @property
     def input_stream(self) -> np.ndarray:
@@ -89,6 +101,15 @@ class MessageResult:
     def output_image(self) -> np.ndarray | None:
         """The published picture (a view), or None without a video shape."""
         return _picture(self.video, self.output_stream)
+
+
+def wire_bytes(payload: int, mtu: int = limits.ETHERNET_MTU) -> int:
+    """Bytes on the Ethernet line for ``payload`` bytes of one TCP stream, sent in full-size
+    segments: each carries ``mtu - TCP_IP_HEADER_BYTES`` payload bytes and costs ``mtu +
+    ETHERNET_FRAMING_BYTES`` on the line (acknowledgements travel the other way)."""
+    per_segment = mtu - limits.TCP_IP_HEADER_BYTES
+    segments = -(-payload // per_segment)
+    return payload + segments * (limits.TCP_IP_HEADER_BYTES + limits.ETHERNET_FRAMING_BYTES)
 
 
 def _picture(video: VideoShape | None, stream: Any) -> np.ndarray | None:
@@ -262,5 +283,5 @@ class MessagePipeline:
                              stamp=stamp, video=video)
 
 
-__all__ = ["MessagePipeline", "MessageResult", "apply_application",
+__all__ = ["wire_bytes", "MessagePipeline", "MessageResult", "apply_application",
            "application_clocks"]

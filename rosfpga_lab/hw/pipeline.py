@@ -36,6 +36,7 @@ from rosfpga_lab.hw.generator import frame_length, generate_fast, generate_refer
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES, ImageFields, Interpreter, interpret_fast
 from rosfpga_lab.hw.morph import check_op, morph_fast, morph_reference
 from rosfpga_lab.hw.rx import check_rx, receive_fast_check, receive_reference
+from rosfpga_lab.hw.msgpipeline import wire_bytes  # noqa: F401  (its home now)
 from rosfpga_lab.hw.sample import image_frame  # noqa: F401  (its home now; imported from here)
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
 from rosfpga_lab.hw.video import (
@@ -43,15 +44,6 @@ from rosfpga_lab.hw.video import (
     status_names,
 )
 
-
-
-def wire_bytes(payload: int, mtu: int = limits.ETHERNET_MTU) -> int:
-    """Bytes on the Ethernet line for ``payload`` bytes of one TCP stream, sent in full-size
-    segments: each carries ``mtu - TCP_IP_HEADER_BYTES`` payload bytes and costs ``mtu +
-    ETHERNET_FRAMING_BYTES`` on the line (acknowledgements travel the other way)."""
-    per_segment = mtu - limits.TCP_IP_HEADER_BYTES
-    segments = -(-payload // per_segment)
-    return payload + segments * (limits.TCP_IP_HEADER_BYTES + limits.ETHERNET_FRAMING_BYTES)
 SEQ_MODES = ("count", "carry")
 
 

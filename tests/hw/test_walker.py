@@ -21,8 +21,8 @@ from rosfpga_lab.hw.layout import (
     Action, Layout, StepKind, derive_layout, encode_token, layout_from_config, tokens,
 )
 from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
-from rosfpga_lab.hw.msgpipeline import MessagePipeline
-from rosfpga_lab.hw.pipeline import image_frame
+from rosfpga_lab.hw.msgpipeline import MessagePipeline, wire_bytes
+from rosfpga_lab.hw.sample import example_message, image_frame
 from rosfpga_lab.hw.walker import (
     LayoutInterpreter, extract_fast, extract_reference, message_of, publish_fast,
     publish_reference,
@@ -282,6 +282,21 @@ def test_the_walkers_circuit_publishes_what_the_image_model_publishes(name: str,
         assert outcome[0] == outcome[1], frame[:40].hex()
         published += isinstance(outcome[0], bytes)
     assert published >= len(frames) and new.next_seq == published + 1
+
+
+def test_a_results_network_times_count_the_frame_and_its_tcp_segments() -> None:
+    """network_time_s: the frame's bytes at 1 Gb/s; wire_time_s: with 90 bytes of TCP/IP and
+    Ethernet per segment of 1,448 payload bytes (a 3,000-byte frame: three segments)."""
+    config = load_config(DATA / "fpga_samples_dilate.yaml")
+    pipe = MessagePipeline.from_config(config)
+    layout = pipe.layout
+    frame = _frame(serialize(config.registry(), layout.type_name,
+                             example_message(layout, config.registry())))
+    res = pipe.process(frame)
+    assert res.network_time_s == pytest.approx(len(frame) * 8 / 1e9)
+    segments = -(-len(frame) // 1448)
+    assert res.wire_time_s == pytest.approx((len(frame) + 90 * segments) * 8 / 1e9)
+    assert wire_bytes(3000) == 3000 + 3 * 90
 
 
 # -- specific refusals ---------------------------------------------------------------------------
