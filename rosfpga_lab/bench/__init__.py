@@ -24,9 +24,9 @@ rospy relay (``AnyMsg``)       449      545      1.76 ms   90/90  2.6 ms   +1.9 
 
 The component, computing the dilation, beats roscpp's relay, which only copies (it receives each
 frame straight into its buffer and never deserializes it in software); with other programs busy
-on the same cores earlier runs put the two about level. In the real FPGA the 8-bit FIFOs (one
-byte per clock) would cap the component below gigabit Ethernet (``hw.cycles``; the demo's
-"modelled circuit" line). Other scripts (figures printed, never asserted):
+on the same cores earlier runs put the two about level. In the real FPGA the byte-wide walkers
+(one byte per clock in, then out) would cap the component below gigabit Ethernet (the generated
+circuit's clocks, ``hls.circuit.Circuit.frame_clocks``; the demo's "modelled circuit" line). Other scripts (figures printed, never asserted):
 ``python -m rosfpga_lab.msg.bench``, ``python -m rosfpga_lab.widgets.bench`` and
 ``tests/benchmarks/bench_*.py``, each saying what it measures in its docstring.
 """

@@ -39,7 +39,7 @@ from rosfpga_lab.bench.limits import (
 )
 from rosfpga_lab.component import LatencySummary, open_source
 from rosfpga_lab.graph import EmbeddedMaster, GraphError, MessageInfo, Node, call
-from rosfpga_lab.hw import image_frame
+from rosfpga_lab.hw.sample import image_frame
 
 RELAY_FALLBACK = "/usr/lib/topic_tools/relay"
 PROGRAMS = Path(__file__).resolve().parent / "ros_programs"

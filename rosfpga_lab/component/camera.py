@@ -6,7 +6,7 @@ an :class:`~rosfpga_lab.component.sources.ImageSource` on a fixed schedule (fram
 holds). Each frame's ``header.stamp`` is the wall-clock time it was published and
 ``header.seq`` its number: a subscriber computes latency from the stamp, and a checker finds
 the input frame an output came from by its stamp (the component carries stamps through).
-Frames are serialized by the lab's own generator (:func:`rosfpga_lab.hw.image_frame`) and sent
+Frames are written by the lab's own serializer of the layout (:func:`rosfpga_lab.hw.sample.image_frame`) and sent
 as raw bytes.
 
 :class:`Viewer` subscribes to an image topic, decodes every frame with the message layer, and
@@ -31,7 +31,7 @@ from rosfpga_lab.component.sources import ImageSource, open_source, to_rgb
 from rosfpga_lab.component.stats import LatencyWindow, fps_meter, since_stamp
 from rosfpga_lab.config import DEFAULT_ENCODING, PIXEL_FORMATS
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node
-from rosfpga_lab.hw import image_frame
+from rosfpga_lab.hw.sample import image_frame
 
 
 @dataclass(frozen=True)

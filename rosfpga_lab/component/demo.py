@@ -122,7 +122,8 @@ class DemoResult:
         ]
         if c.cycles:
             out.append(f"modelled circuit: {format_duration(c.circuit_time_s)} per frame at "
-                       f"{cfg.clock_mhz:g} MHz; FIFO high water {c.fifo_high_water}")
+                       f"{cfg.clock_mhz:g} MHz" + (f"; FIFO high water {c.fifo_high_water}"
+                                                   if c.fifo_high_water else ""))
         out.append(f"bit-exact: {self.check.bit_exact}/{self.received}")
         if c.dropped:
             out.append(f"  dropped {c.dropped} of {self.sent}: the circuit model was slower than "

@@ -5,9 +5,11 @@ How this works (Figure 3 of the paper): the *software* side is an ordinary
 subscriber of the input topic and publisher of the output topic, answers the Slave API and
 runs the TCPROS handshakes. The *hardware* side is the data path: every complete TCPROS frame
 the subscriber reads (the raw bytes, never deserialized in software) goes through the
-modelled circuit -- :class:`rosfpga_lab.hw.Pipeline` built by
-:meth:`rosfpga_lab.hw.Pipeline.from_config` from the same node configuration the generator reads --
-and the frame the circuit's message generator writes is sent, as bytes, to every subscriber.
+modelled circuit -- :class:`rosfpga_lab.hw.msgpipeline.MessagePipeline`, the walkers rendered
+from the circuit record the generator renders too (:func:`rosfpga_lab.hls.circuit.circuit_of`
+of the same node configuration; ``sensor_msgs/Image`` is one type among the others, its
+``data`` filtered as a picture) -- and the frame the circuit's publisher writes is sent, as
+bytes, to every subscriber.
 
 Queues (drop policy, as roscpp's): frames wait in front of the circuit in the subscriber's
 queue (``input_queue`` deep; when the circuit is busy and it is full, the oldest waiting frame
@@ -47,7 +49,10 @@ from rosfpga_lab.config.limits import IMAGE_TYPE
 from rosfpga_lab.config.vocabulary import CDR_WIRE, MODELS, RTL_MODEL, TIMINGS
 from rosfpga_lab.errors import LabError
 from rosfpga_lab.graph import EmbeddedMaster, MessageInfo, Node, call
-from rosfpga_lab.hw import FrameFieldError, Pipeline, PipelineError, PipelineResult
+from rosfpga_lab.hls.circuit import Circuit, circuit_of
+from rosfpga_lab.hls.program import Refused
+from rosfpga_lab.hw.errors import FrameFieldError, PipelineError
+from rosfpga_lab.hw.layoutsteps import StepKind
 from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
 
 log = logging.getLogger("rosfpga_lab.component")
@@ -62,9 +67,8 @@ class FrameRecord:
         index: frames seen by the circuit so far, counting from 0 (refused ones included).
         input_frame: the TCPROS frame received (4-byte length + message body).
         output_frame: the frame published (empty when refused).
-        result: the pipeline's :class:`~rosfpga_lab.hw.PipelineResult` (Image) or
-            :class:`~rosfpga_lab.hw.msgpipeline.MessageResult` (any other type); None when
-            refused.
+        result: the model's :class:`~rosfpga_lab.hw.msgpipeline.MessageResult` (its
+            ``input_image``/``output_image`` for Image); None when refused.
         error: the refusal reason (empty when the frame went through).
         publisher: callerid of the node that sent the frame.
         received: ``time.time()`` when the frame was complete on the input connection.
@@ -74,7 +78,7 @@ class FrameRecord:
     index: int
     input_frame: bytes
     output_frame: bytes
-    result: PipelineResult | MessageResult | None
+    result: MessageResult | None
     error: str
     publisher: str
     received: float
@@ -169,8 +173,8 @@ class FpgaComponent:
             refused).
         timing: ``"host"`` (publish as soon as the data path is done) or ``"fpga"`` (publish
             when the circuit's clocks for the frame at ``clock_mhz`` have passed since it
-            arrived, or since the circuit became free -- Image's cycle model, any other type's
-            generated walk (:func:`rosfpga_lab.hls.program.frame_clocks`), or with ``"rtl"`` the
+            arrived, or since the circuit became free -- the generated circuit's walk
+            (:meth:`rosfpga_lab.hls.circuit.Circuit.frame_clocks`), or with ``"rtl"`` the
             simulated clocks; the input queue is then 1 deep, as the
             input FIFO and the socket hold one waiting frame: a newer frame replaces it and the
             older one is counted in :attr:`ComponentStats.dropped_input`).
@@ -188,9 +192,9 @@ class FpgaComponent:
     Raises:
         ComponentConfigError: the configuration cannot be run (``op: custom``).
 
-    A ``sensor_msgs/Image`` configuration runs :class:`~rosfpga_lab.hw.Pipeline` (the video
-    path); any other type the circuit rendered from its layout,
-    :class:`~rosfpga_lab.hw.msgpipeline.MessagePipeline`.
+    Every type, ``sensor_msgs/Image`` included, runs the circuit rendered from its layout,
+    :class:`~rosfpga_lab.hw.msgpipeline.MessagePipeline` (an Image's ``data`` through the 2-D
+    application, ``header.seq`` numbered by the publisher).
     """
 
     def __init__(self, config: NodeConfig, *, master_uri: str | None = None,
@@ -238,7 +242,7 @@ class FpgaComponent:
         self._reasons: dict[str, int] = {}        # refusal kind -> count
         self._examples: dict[str, str] = {}       # refusal kind -> the first reason text seen
         self._high_water: dict[str, int] = {}
-        self._last: PipelineResult | MessageResult | None = None
+        self._last: MessageResult | None = None
         self._last_error = ""
         self._master_ok = True
         self._name_taken = False
@@ -250,26 +254,20 @@ class FpgaComponent:
         self._sub: Any = None
 
     def _build_circuit(self, config: NodeConfig, model: str) -> None:
-        """The circuit's models: the Python pipeline (with ``model="rtl"`` the fast model still
-        names the operation and sets its limits), for any type but Image the generated walk,
-        whose clocks per frame are the timing (a configuration the generator refuses, e.g.
-        another publisher type, keeps the model's), and with ``model="rtl"`` the Verilog."""
+        """The circuit's models, from its record (:func:`~rosfpga_lab.hls.circuit.circuit_of`):
+        the Python model (with ``model="rtl"`` the fast model still names the operation and
+        sets its limits), the generated walk, whose clocks per frame are the timing (a
+        configuration the generator refuses, e.g. another publisher type, keeps the model's
+        stages' sum), and with ``model="rtl"`` the Verilog."""
         try:
-            self.registry = config.registry()
+            self.circuit: Circuit = circuit_of(config)
+            self.registry = self.circuit.reg
             pmodel = "fast" if model == RTL_MODEL else model
-            self.pipeline: Pipeline | MessagePipeline = (
-                Pipeline.from_config(config, model=pmodel) if config.is_image
-                else MessagePipeline.from_config(config, model=pmodel, reg=self.registry))
+            self.pipeline: MessagePipeline = self.circuit.model(pmodel)
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
-        self._program: Any = None
-        if not config.is_image:
-            from rosfpga_lab.hls.generic import spec_from_config
-
-            try:
-                self._program = spec_from_config(config).program
-            except LabError:
-                pass
+        self._timed = self._has_generated_walk()
+        self._shape_clocks: dict[tuple[int, ...], int] = {}
         self._rtl: Any = None
         if model == RTL_MODEL:
             from rosfpga_lab.rtl.server import RtlServer
@@ -280,6 +278,13 @@ class FpgaComponent:
                 self._rtl = RtlServer(config)
             except LabError as exc:
                 raise ComponentConfigError(f"cannot run the Verilog (--model rtl): {exc}") from None
+
+    def _has_generated_walk(self) -> bool:
+        """Whether the generator renders this configuration (its walk then times the frames)."""
+        try:
+            return self.circuit.program is not None
+        except LabError:
+            return False
 
     @classmethod
     def from_config(cls, config: str | Path | NodeConfig, master_uri: str | None = None,
@@ -377,18 +382,31 @@ class FpgaComponent:
                 self._observers.remove(callback)
 
     # ------------------------------------------------------------------ the data path
-    def _clocks(self, frame: bytes, result: PipelineResult | MessageResult) -> int:
-        """The circuit's clocks for ``frame``: Image's cycle model (``hw.cycles``), any other
-        type's generated walk, first byte in to last byte out
-        (:func:`rosfpga_lab.hls.program.frame_clocks`, equal to the RTL's clock for clock)."""
-        if self._program is None:
-            return result.total_cycles
-        from rosfpga_lab.hls.program import Refused, frame_clocks
+    def _clocks(self, frame: bytes, result: MessageResult) -> int:
+        """The circuit's clocks for ``frame``: the generated walk's, first byte in to last byte
+        out (:meth:`~rosfpga_lab.hls.circuit.Circuit.frame_clocks`, equal to the RTL's clock
+        for clock); without a generated walk the model's stages' sum.
 
+        The walk takes a byte per clock and a fixed number of clocks per decision, so a frame's
+        clocks follow from its shape (the counts of its strings and arrays: where each field
+        lies), never from its values: they are computed once per shape (a 640x480 frame's walk
+        takes milliseconds in Python; the board's frame time is what ``--timing fpga`` waits).
+        """
+        if not self._timed:
+            return result.total_cycles
+        shape = (len(frame), *(t.value for t in result.extracted.tokens
+                               if self.pipeline.layout.steps[t.step].kind is StepKind.LENGTH))
+        clocks = self._shape_clocks.get(shape)
+        if clocks is not None:
+            return clocks
         try:
-            return frame_clocks(self._program, frame).total
+            clocks = self.circuit.frame_clocks(frame).total
         except Refused:     # the walk and the model disagree: keep the model's stages' sum
             return result.total_cycles
+        if len(self._shape_clocks) >= limits.MAX_TIMED_SHAPES:
+            self._shape_clocks.clear()
+        self._shape_clocks[shape] = clocks
+        return clocks
 
     def _hold(self, info: MessageInfo, clocks: int) -> None:
         """Timing ``fpga``: wait until ``clocks`` at the circuit's clock have passed since the
@@ -425,8 +443,7 @@ class FpgaComponent:
                         problem)
         self._latency.add(now - info.received)
         self._process.add(t1 - t0)
-        stamp = (result.stamp if isinstance(result, MessageResult)
-                 else (result.fields.stamp_secs, result.fields.stamp_nsecs))
+        stamp = result.stamp
         from_stamp = since_stamp(now, *stamp) if stamp is not None else None
         if from_stamp is not None:  # a wall-clock stamp (a camera's)
             self._since_stamp.add(from_stamp)

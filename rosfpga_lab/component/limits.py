@@ -37,6 +37,9 @@ DEFAULT_SOURCE_PERIOD = 60
 #: Refusal kinds counted separately (kinds are field + rule, a few dozen at most; any beyond
 #: this count under "other").
 MAX_REFUSAL_KINDS = 64
+#: Frame shapes (the counts of a frame's strings and arrays) whose clocks ``--timing fpga``
+#: keeps: a camera sends one shape, so the generated walk is timed once, not per frame.
+MAX_TIMED_SHAPES = 64
 #: Camera limits: frames per second and image side.
 MAX_CAMERA_RATE = 1000.0
 MAX_CAMERA_SIDE = 8192

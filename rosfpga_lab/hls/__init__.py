@@ -30,7 +30,9 @@ the application processes and, optionally, checks, maxima and the user's ``.msg`
 keys: :mod:`rosfpga_lab.config.schema`); ``hw.layout.layout_from_config(config)`` derives the
 one walk over the frame. The modules, in the flow's order: ``compiler`` compiles the layout to
 the walkers' program (``program``); ``generic`` renders the project from it (the templates of
-``templates/``); ``vectors`` makes the test frames and the models' output; ``generator`` writes
+``templates/``); ``circuit`` keeps one record per configuration (``circuit_of(config)``: its
+layouts, spec, program, clocks and Python models, derived once, what the component and the
+tools take); ``vectors`` makes the test frames and the models' output; ``generator`` writes
 it all; ``csim`` builds and runs the testbench; ``sloc`` counts lines. ``wire: cdr`` writes the
 same walkers for ROS 2's CDR samples; ``sensor_msgs/Image`` is one type among the others, its
 ``data`` framed as video for the 2-D application. The shipped examples are mapped in

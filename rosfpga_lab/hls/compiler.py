@@ -81,7 +81,7 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
         layout: the circuit layout.
         max_frame: the longest frame length accepted (default: the layout's).
         count: the label of a uint32 field the publisher numbers itself (1, 2, 3 ...) instead of
-            re-sending it (:data:`rosfpga_lab.hls.generic.NUMBERED_FIELD` on TCPROS Image).
+            re-sending it (:data:`rosfpga_lab.hw.circuit.NUMBERED_FIELD` on TCPROS Image).
             A video stream's bytes are a plain array here either way: how they travel to the
             application (as pixels and lines) is the project's (``GenericSpec.video``).
         cdr: the CDR walk whose ``layout`` this is (:func:`program_from_cdr`): the program

@@ -37,6 +37,10 @@ from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.program import ALIGN_ORIGIN, ENCAP_PAD_MASK, MAX_LOOP_DEPTH, Op, Program, Pub, Sub
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.cdrlayout import END_ALIGN
+# NUMBERED_FIELD: the field a TCPROS Image's publisher numbers itself (1, 2, 3 ...), as rospy and
+# the live node's model do; its owner is hw.circuit (numbered_field says for which
+# configurations). (The one Image rule left: a configuration key for it is issue 28's.)
+from rosfpga_lab.hw.circuit import NUMBERED_FIELD, CircuitLayouts, circuit_layouts
 from rosfpga_lab.hw.layout import Layout, VideoShape
 from rosfpga_lab.msg import MsgRegistry
 from rosfpga_lab.tcpros import TopicSpec, encode_header, publisher_reply_fields, subscriber_request_fields
@@ -61,11 +65,6 @@ GENERIC_FILES = {
 CUSTOM_FILE = "stream_filter.cpp"
 #: Bytes per line of the hexadecimal arrays in connection_headers.cpp.
 HEX_BYTES_PER_LINE = 16
-#: The field a TCPROS ``sensor_msgs/Image`` publisher numbers itself (1, 2, 3 ...) instead of
-#: re-sending it, as rospy does and as the Image model (``hw.Pipeline``, the live node's) does;
-#: every other type re-sends its ``header.seq``. (The one Image rule left in the renderer: a
-#: configuration key for it, for every type, is issue 28's.)
-NUMBERED_FIELD = "header.seq"
 #: The C++ name of a morphological operation (the application's comment).
 _OP_CPP = {"dilate": "Dilate", "erode": "Erode"}
 
@@ -453,32 +452,43 @@ def spec_from_layout(layout: Layout, reg: MsgRegistry, *, node_name: str = "/fpg
 def spec_from_config(config: NodeConfig) -> GenericSpec:
     """The project of a node configuration: any type, either wire (a video stream, Image's
     ``data``, framed as video: :class:`GenericSpec`; a TCPROS Image's publisher numbers
-    :data:`NUMBERED_FIELD`).
+    :data:`NUMBERED_FIELD`). Its layouts are derived once per configuration
+    (:func:`~rosfpga_lab.hw.circuit.circuit_layouts`); the spec itself once per configuration
+    with :func:`rosfpga_lab.hls.circuit.circuit_of` (``.spec``).
 
     Raises:
         GenerateError: the configuration's types differ (the generated publisher re-sends the
             subscribed type), or its layout cannot be compiled
             (:func:`~rosfpga_lab.hls.compiler.program_from_layout`).
     """
-    from rosfpga_lab.hw.layout import layout_from_config
+    _check_same_types(config)
+    return spec_from_layouts(circuit_layouts(config))
 
+
+def _check_same_types(config: NodeConfig) -> None:
     if config.publisher.type != config.subscriber.type:
         raise GenerateError(f"publisher.type {config.publisher.type} differs from subscriber.type "
                             f"{config.subscriber.type}: the generated circuit publishes the type "
                             "it subscribes to")
-    reg = config.registry()
+
+
+def spec_from_layouts(parts: CircuitLayouts) -> GenericSpec:
+    """The project of a configuration's derived layouts (see :func:`spec_from_config`).
+
+    Raises:
+        GenerateError: as :func:`spec_from_config`.
+    """
+    config = parts.config
+    _check_same_types(config)
     app = config.application
-    layout = layout_from_config(config, reg)
+    layout = parts.layout
     program = None
     if config.wire == CDR_WIRE:
-        from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
-
-        cdr = cdr_layout_from_config(config, reg)
-        layout, program = cdr.layout, program_from_cdr(cdr)
-    elif config.is_image:  # the Image model's publisher numbers its messages (NUMBERED_FIELD)
-        program = program_from_layout(layout, count=NUMBERED_FIELD)
+        layout, program = parts.cdr.layout, program_from_cdr(parts.cdr)
+    elif parts.numbered is not None:  # the publisher numbers its messages (NUMBERED_FIELD)
+        program = program_from_layout(layout, count=parts.numbered)
     return spec_from_layout(
-        layout, reg, node_name=config.node.global_name, program=program, wire=config.wire,
+        layout, parts.reg, node_name=config.node.global_name, program=program, wire=config.wire,
         sub_topic=config.subscriber.topic, pub_topic=config.publisher.topic,
         master_uri=config.node.master_uri, ip_address=config.node.ip_address,
         input_depth=config.fifo.input_depth, output_depth=config.fifo.output_depth,

@@ -2,8 +2,10 @@
 models publish for them (``tb_input.bin``, ``tb_expected.bin``).
 
 How this works: :func:`sample_frames` picks by configuration. ``sensor_msgs/Image`` on TCPROS
-gets a picture (:func:`sample_image`: gradients, a grid, bright dots) in one frame and the Image
-model's output for it (``hw.Pipeline``, the live node's model: it numbers ``header.seq``). Any
+gets a picture (:func:`sample_image`: gradients, a grid, bright dots) in one frame and the
+live node's model's output for it (the circuit record's
+:class:`~rosfpga_lab.hw.msgpipeline.MessagePipeline`: the 2-D application on the picture, its
+publisher numbering ``header.seq``). Any
 other type on TCPROS gets random messages within the layout's checks and maxima
 (:func:`sample_tokens`): a good frame, a refused one, another good one
 (:func:`sample_frames_generic`), published by the walker's fast model and the 1-D application
@@ -49,21 +51,20 @@ def sample_frames(config: NodeConfig) -> tuple[bytes, bytes]:
     writes as ``tb_input.bin`` and ``tb_expected.bin`` (``rtl sim`` runs them too). TCPROS
     frames, or for ``wire: cdr`` records (a 4-byte sample length, the payload); for ``op:
     custom`` no expected output (see the module docstring for which frames)."""
-    from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
-    from rosfpga_lab.hw.layout import layout_from_config
+    from rosfpga_lab.hls.circuit import circuit_of
+    from rosfpga_lab.hw.sample import image_frame
 
     app = config.application
+    circuit = circuit_of(config)
     if config.wire == CDR_WIRE:
-        return sample_records_cdr(cdr_layout_from_config(config), app.op, app.ksize)
+        return sample_records_cdr(circuit.cdr, app.op, app.ksize)
     if config.is_image:
-        from rosfpga_lab.hw import Pipeline, image_frame
-
         frame = image_frame(sample_image(config), config.image.encoding, seq=7,
                             stamp=(1_700_000_000, 123_456_789), frame_id="camera")
         if app.op == CUSTOM:
             return frame, b""
-        return frame, Pipeline.from_config(config).process(frame).output_frame
-    return sample_frames_generic(layout_from_config(config), app.op, app.ksize)
+        return frame, circuit.model().process(frame).output_frame
+    return sample_frames_generic(circuit.layout, app.op, app.ksize)
 
 
 _INT64_MAX = int(np.iinfo(np.int64).max)
@@ -191,7 +192,7 @@ def model_output_cdr(cdr: CdrLayout, op: str, ksize: int, records: list[bytes]
     """What the lab's CDR models (``hw.cdrwalker`` fast model, the application of
     ``hw.cdrpipeline``: ``hw.morph1d``, or ``hw.morph`` on a video stream) publish for
     ``records`` (each a 4-byte sample length + CDR payload), and the refusal per record."""
-    from rosfpga_lab.hw.cdrpipeline import apply_application
+    from rosfpga_lab.hw.msgpipeline import apply_application
     from rosfpga_lab.hw.cdrwalker import extract_cdr_fast, publish_cdr_fast
     from rosfpga_lab.hw.errors import FrameFieldError
 

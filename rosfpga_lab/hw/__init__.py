@@ -33,7 +33,9 @@ the subscriber and publisher of any type are rendered from it (module ``walker``
 ``subscriberwalker``: :class:`LayoutInterpreter`, :func:`extract_reference` /
 :func:`extract_fast`, and ``publisherwalker``: :func:`publish_reference` /
 :func:`publish_fast`), the 1-D application in ``morph1d``, the
-whole circuit of a non-Image type in :class:`MessagePipeline` (``msgpipeline``). CDR (ROS 2)
+whole circuit of any type, ``sensor_msgs/Image`` included (its video stream through the 2-D
+application), in :class:`MessagePipeline` (``msgpipeline``), from a configuration's layouts
+derived once (``circuit``: :func:`~rosfpga_lab.hw.circuit.circuit_layouts`). CDR (ROS 2)
 is the second wire format of the same layout (``cdrlayout``, ``cdrwalker``), the whole circuit
 on CDR samples, Image included, :class:`CdrPipeline` (``cdrpipeline``).
 
@@ -90,7 +92,7 @@ from rosfpga_lab.hw.interpreter import (
 from rosfpga_lab.hw.layoutderive import derive_layout, layout_from_config
 from rosfpga_lab.hw.layoutsteps import Layout, format_layout
 from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
-from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult
+from rosfpga_lab.hw.msgpipeline import MessagePipeline, MessageResult, wire_bytes
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline, CdrResult
 from rosfpga_lab.hw.publisherwalker import publish_fast, publish_reference
 from rosfpga_lab.hw.subscriberwalker import (
@@ -100,7 +102,8 @@ from rosfpga_lab.hw.framing import FRAMING_FLAGS
 from rosfpga_lab.hw.morph import (
     OPS, morph_fast, morph_reference, morph_stream_fast, morph_stream_reference,
 )
-from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult, image_frame, wire_bytes
+from rosfpga_lab.hw.pipeline import Pipeline, PipelineResult
+from rosfpga_lab.hw.sample import image_frame
 from rosfpga_lab.hw.rx import receive_fast_check, receive_reference
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
 from rosfpga_lab.hw.video import (

@@ -23,15 +23,15 @@ import numpy as np
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config.vocabulary import (CUSTOM, PIPELINE_MODELS, RTL_MODEL, canonical_op,
                                            model_ksize)
-from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_layout_from_config
+from rosfpga_lab.hw.cdrlayout import CdrLayout
+from rosfpga_lab.hw.circuit import CircuitLayouts, circuit_layouts
 from rosfpga_lab.hw.cdrwalker import (
     extract_cdr_fast, extract_cdr_reference, publish_cdr_fast, publish_cdr_reference,
 )
 from rosfpga_lab.hw.errors import FrameTruncatedError, PipelineConfigError
-from rosfpga_lab.hw.morph import check_op, morph_fast, morph_reference
-from rosfpga_lab.hw.morph1d import check_op1d, morph1d_fast, morph1d_reference
-from rosfpga_lab.hw.video import Mat
-from rosfpga_lab.hw.layoutsteps import VideoShape
+from rosfpga_lab.hw.morph import check_op
+from rosfpga_lab.hw.morph1d import check_op1d
+from rosfpga_lab.hw.msgpipeline import apply_application
 from rosfpga_lab.hw.subscriberwalker import Extracted
 from rosfpga_lab.msg import MsgRegistry
 
@@ -75,6 +75,9 @@ class CdrPipeline:
             types' ROS 2 forms (a check of ``header.seq`` is refused: ROS 2 has none).
         model: ``fast`` or ``reference``.
         reg: the registry of ROS 1 definitions (default: ``config.registry()``).
+        layouts: the configuration's layouts when the caller holds them
+            (:func:`~rosfpga_lab.hw.circuit.circuit_layouts`; default: derived, or the ones
+            kept for ``config``).
 
     Raises:
         PipelineConfigError: ``op: custom`` (no Python model of the user's C++), a bad model,
@@ -82,7 +85,8 @@ class CdrPipeline:
     """
 
     def __init__(self, config: NodeConfig, model: str = "fast",
-                 reg: MsgRegistry | None = None) -> None:
+                 reg: MsgRegistry | None = None, *,
+                 layouts: CircuitLayouts | None = None) -> None:
         if model == RTL_MODEL:
             raise PipelineConfigError(
                 "the CDR circuit has no live RTL model: run its Verilog with `rosfpga-lab generate "
@@ -95,11 +99,9 @@ class CdrPipeline:
         if canonical_op(app.op) == CUSTOM:
             raise PipelineConfigError("a custom application has no Python model; compare its C "
                                       "simulation against your own expectation")
-        reg = reg or config.registry()
-        self.cdr: CdrLayout = cdr_layout_from_config(config, reg)
-        self.out_cdr: CdrLayout | None = (
-            cdr_layout_from_config(config, reg, output=True)
-            if config.publisher.type != config.subscriber.type else None)
+        layouts = layouts or circuit_layouts(config, reg)
+        self.cdr: CdrLayout = layouts.cdr
+        self.out_cdr: CdrLayout | None = layouts.out_cdr
         self.model = model
         self.clock_hz = config.clock_mhz * 1e6
         video = self.cdr.layout.video
@@ -151,29 +153,6 @@ class CdrPipeline:
     def _apply(self, stream: np.ndarray, reference: bool) -> np.ndarray:
         return apply_application(self.cdr.layout.video, self.op, self.ksize, stream,
                                  reference=reference)
-
-
-def apply_application(video: VideoShape | None, op: str, ksize: int, stream: np.ndarray, *,
-                      reference: bool = False) -> np.ndarray:
-    """The application on one streamed array (flat): with a video shape the 2-D dilate/erode of
-    :mod:`~rosfpga_lab.hw.morph` on its ``height x width`` pixels, else the 1-D window of
-    :mod:`~rosfpga_lab.hw.morph1d` (``reference``: the one-element-at-a-time model).
-
-    Raises:
-        PipelineConfigError: an unknown ``op`` or a bad ``ksize``.
-    """
-    if video is None:
-        name = check_op1d(op, ksize, np.dtype(stream.dtype))
-        return (morph1d_reference if reference else morph1d_fast)(stream, name, ksize)
-    name = canonical_op(op)
-    ksize2 = check_op(name, model_ksize(op, ksize))
-    image = stream.reshape(video.height, video.width, video.bytes_per_pixel)
-    if reference:
-        src, dst = Mat.from_numpy(image, "src"), Mat(video.height, video.width,
-                                                     video.bytes_per_pixel, "dst")
-        morph_reference(src, dst, name, ksize2)
-        return dst.to_numpy().reshape(-1)
-    return morph_fast(image, name, ksize2).reshape(-1)
 
 
 __all__ = ["CdrPipeline", "CdrResult", "apply_application"]

@@ -89,10 +89,21 @@ def encode_token(step: Step, value: Any) -> bytes:
     raise ValueError(f"step {step.index} ({step.kind}) has no bytes")
 
 
+def _token_buffer(step: Step, value: Any) -> bytes | memoryview:
+    """The wire bytes of one token; an array's as a view of its memory (no copy when it is
+    contiguous and of the step's type already)."""
+    if step.kind is StepKind.ARRAY:
+        return np.ascontiguousarray(value, dtype=np.dtype(step.dtype)).data.cast("B")
+    return encode_token(step, value)
+
+
 def marshal(layout: Layout, toks: Iterable[Token]) -> bytes:
-    """A TCPROS frame (4-byte length + body) from tokens in walk order (the publisher)."""
-    body = b"".join(encode_token(layout.steps[t.step], t.value) for t in toks)
-    return struct.pack("<I", len(body)) + body
+    """A TCPROS frame (4-byte length + body) from tokens in walk order (the publisher): the
+    frame is joined once, so a large stream's bytes are copied once."""
+    parts: list[bytes | memoryview] = [b""]
+    parts += (_token_buffer(layout.steps[t.step], t.value) for t in toks)
+    parts[0] = struct.pack("<I", sum(len(p) for p in parts))
+    return b"".join(parts)
 
 
 class FrameGeometry(NamedTuple):

@@ -29,7 +29,7 @@ DEFAULT_LINE_RATE_BPS = 1e9
 DEFAULT_RX_FIFO_DEPTH = _config.DEFAULT_INPUT_FIFO_DEPTH
 DEFAULT_RX_BURST_BYTES = 1
 
-#: What a TCP byte stream costs on (gigabit) Ethernet, for ``PipelineResult.wire_time_s``:
+#: What a TCP byte stream costs on (gigabit) Ethernet, for ``MessageResult.wire_time_s`` (``hw.msgpipeline.wire_bytes``):
 #: IPv4 (20) + TCP (20) headers plus the 12-byte timestamp option Linux sends, inside a
 #: 1,500-byte MTU, and per Ethernet frame the preamble and start delimiter (8), MAC header
 #: (14), FCS (4) and the inter-frame gap (12).

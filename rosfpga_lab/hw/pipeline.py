@@ -36,21 +36,14 @@ from rosfpga_lab.hw.generator import frame_length, generate_fast, generate_refer
 from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES, ImageFields, Interpreter, interpret_fast
 from rosfpga_lab.hw.morph import check_op, morph_fast, morph_reference
 from rosfpga_lab.hw.rx import check_rx, receive_fast_check, receive_reference
+from rosfpga_lab.hw.msgpipeline import wire_bytes  # noqa: F401  (its home now)
+from rosfpga_lab.hw.sample import image_frame  # noqa: F401  (its home now; imported from here)
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo
 from rosfpga_lab.hw.video import (
     Mat, axivideo2mat_fast, axivideo2mat_reference, mat2axivideo_fast, mat2axivideo_reference,
     status_names,
 )
 
-
-
-def wire_bytes(payload: int, mtu: int = limits.ETHERNET_MTU) -> int:
-    """Bytes on the Ethernet line for ``payload`` bytes of one TCP stream, sent in full-size
-    segments: each carries ``mtu - TCP_IP_HEADER_BYTES`` payload bytes and costs ``mtu +
-    ETHERNET_FRAMING_BYTES`` on the line (acknowledgements travel the other way)."""
-    per_segment = mtu - limits.TCP_IP_HEADER_BYTES
-    segments = -(-payload // per_segment)
-    return payload + segments * (limits.TCP_IP_HEADER_BYTES + limits.ETHERNET_FRAMING_BYTES)
 SEQ_MODES = ("count", "carry")
 
 
@@ -496,22 +489,3 @@ class Pipeline:
         return self._finish(frame, fields, out_fields, tx.to_bytes(), (image_in, image_out),
                             (beats_in, beats_out), high_water, status,
                             (pixels_in_bytes, pixels_out_bytes))
-
-
-def image_frame(image: np.ndarray, encoding: str, *, seq: int = 0, stamp: tuple[int, int] = (0, 0),
-                frame_id: str = "", is_bigendian: int = 0) -> bytes:
-    """A TCPROS ``sensor_msgs/Image`` frame holding ``image`` (for notebooks and benchmarks).
-
-    Written with the generator's fast model; the tests check it against the message layer's
-    ``serialize`` and real genpy.
-    """
-    fmt = pixel_format(encoding)
-    img = np.ascontiguousarray(image, dtype=np.uint8)
-    rows, cols = img.shape[:2]
-    if img.size != rows * cols * fmt.bytes_per_pixel:
-        raise PipelineConfigError(
-            f"image of shape {img.shape} does not hold {fmt.bytes_per_pixel} bytes per pixel ({encoding})")
-    fields = ImageFields(seq, stamp[0], stamp[1], frame_id, rows, cols, encoding, is_bigendian,
-                         cols * fmt.bytes_per_pixel, img.size)
-    fields = dataclasses.replace(fields, frame_length=frame_length(fields))
-    return generate_fast(fields, img.reshape(-1))

@@ -7,19 +7,26 @@ count the circuit was built for (a ramp). :func:`example_message` turns the toke
 ``msg`` layer's dict (through the frame :func:`~rosfpga_lab.hw.layout.marshal` writes), so a
 notebook can show, publish and edit a message of a type it has never seen
 (notebook 10 with a student's own ``.msg``). :func:`refused_frame` makes the first checked
-field of a message wrong (else the stream one element too long).
+field of a message wrong (else the stream one element too long). :func:`image_frame` frames a
+picture as a ``sensor_msgs/Image`` (the camera's, the benchmarks' and the tests' frames),
+written by the same :func:`~rosfpga_lab.hw.layout.marshal` as the publisher's.
 """
 
 from __future__ import annotations
 
+import functools
 import struct
 from typing import Any, NamedTuple
 
 import numpy as np
 
+from rosfpga_lab.config.limits import IMAGE_TYPE
+from rosfpga_lab.hw.encodings import pixel_format
+from rosfpga_lab.hw.errors import PipelineConfigError
+from rosfpga_lab.hw.layoutderive import derive_layout
 from rosfpga_lab.hw.layoutsteps import Action, CheckOp, Layout, Step, StepKind, walk_order
 from rosfpga_lab.hw.layouttokens import Token, marshal, tokens
-from rosfpga_lab.msg import MsgRegistry, deserialize
+from rosfpga_lab.msg import MsgRegistry, default_registry, deserialize
 
 #: Elements of a variable array (or loop) other than the stream, in an example message.
 EXAMPLE_ITEMS = 2
@@ -170,5 +177,36 @@ def framed(body: bytes) -> bytes:
     return struct.pack("<I", len(body)) + body
 
 
+@functools.cache
+def _image_walk() -> Layout:
+    """``sensor_msgs/Image``'s walk with no stream and no checks (what a camera writes)."""
+    return derive_layout(default_registry(), IMAGE_TYPE, stream=None)
+
+
+def image_frame(image: np.ndarray, encoding: str, *, seq: int = 0, stamp: tuple[int, int] = (0, 0),
+                frame_id: str = "", is_bigendian: int = 0) -> bytes:
+    """A TCPROS ``sensor_msgs/Image`` frame (4-byte length + body) holding ``image``, ``(rows,
+    cols[, channels])`` uint8 in ``encoding``, its ``step`` a row's bytes (the pixel bytes
+    copied once).
+
+    Raises:
+        PipelineConfigError: ``image`` does not hold the encoding's bytes per pixel, or the
+            encoding is not one the lab frames (:data:`~rosfpga_lab.hw.encodings.PIXEL_FORMATS`).
+    """
+    fmt = pixel_format(encoding)
+    img = np.ascontiguousarray(image, dtype=np.uint8)
+    rows, cols = img.shape[:2]
+    if img.size != rows * cols * fmt.bytes_per_pixel:
+        raise PipelineConfigError(
+            f"image of shape {img.shape} does not hold {fmt.bytes_per_pixel} bytes per pixel ({encoding})")
+    message = {"header": {"seq": seq, "stamp": {"secs": stamp[0], "nsecs": stamp[1]},
+                          "frame_id": frame_id},
+               "height": rows, "width": cols, "encoding": encoding,
+               "is_bigendian": is_bigendian & 0xFF, "step": cols * fmt.bytes_per_pixel,
+               "data": img.reshape(-1)}
+    walk = _image_walk()
+    return marshal(walk, tokens(walk, message))
+
+
 __all__ = ["EXAMPLE_ITEMS", "Refusal", "example_message", "example_tokens", "framed",
-           "random_stream", "refused_frame"]
+           "image_frame", "random_stream", "refused_frame"]

@@ -70,24 +70,24 @@ def generate_project(config: NodeConfig, out_dir: str | Path, *, force: bool = F
 
 def model_output(config: NodeConfig, frames: bytes) -> bytes:
     """What the Python models publish for ``frames`` (back to back, each behind its 4-byte
-    length; a refused one gives nothing): ``hw.Pipeline`` for Image on TCPROS, else the
-    configuration's layout walked by ``MessagePipeline`` (TCPROS) or ``CdrPipeline`` (CDR).
+    length; a refused one gives nothing): the configuration's circuit record
+    (:func:`~rosfpga_lab.hls.circuit.circuit_of`) walked by ``MessagePipeline`` (TCPROS, Image
+    included) or ``CdrPipeline`` (CDR).
 
     Raises:
         PipelineConfigError: ``op: custom`` (no model of the user's C++).
     """
     import struct
 
-    from rosfpga_lab.hw import Pipeline, PipelineError
-    from rosfpga_lab.hw.cdrpipeline import CdrPipeline
-    from rosfpga_lab.hw.msgpipeline import MessagePipeline
+    from rosfpga_lab.hls.circuit import circuit_of
+    from rosfpga_lab.hw.errors import PipelineError
 
+    circuit = circuit_of(config)
     if config.wire == CDR_WIRE:
-        cdr = CdrPipeline(config)
+        cdr = circuit.cdr_model()
         run = lambda frame: cdr.run_record(frame).output_record   # noqa: E731
     else:
-        pipe = (Pipeline.from_config(config) if config.is_image
-                else MessagePipeline.from_config(config))
+        pipe = circuit.model()
         run = lambda frame: pipe.process(frame).output_frame      # noqa: E731
     out, at = bytearray(), 0
     while at + 4 <= len(frames):

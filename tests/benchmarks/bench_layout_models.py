@@ -4,7 +4,9 @@ For each shipped non-Image configuration: the time to derive its layout, and per
 reference (byte at a time) and fast (numpy) subscriber + application + publisher
 (``hw.msgpipeline.MessagePipeline``), plus the frame's bytes and the circuit's modelled cycles.
 For ``sensor_msgs/Image`` the fast layout subscriber is timed against the hand-written Image
-interpreter on one 640x480 rgba8 frame. Figures are printed, not asserted.
+interpreter on one 640x480 rgba8 frame, and the whole circuit the live node runs, before issue
+28 (``hw.Pipeline``) beside now (``MessagePipeline`` of the circuit record). Figures are
+printed, not asserted.
 
 Run:  .venv/bin/python tests/benchmarks/bench_layout_models.py [--frames N]
 """
@@ -20,7 +22,8 @@ import numpy as np
 from benchtools import per_call
 
 from rosfpga_lab.config import load_config
-from rosfpga_lab.hw import image_frame, interpret_fast
+from rosfpga_lab.hls.circuit import circuit_of
+from rosfpga_lab.hw import Pipeline, image_frame, interpret_fast
 from rosfpga_lab.hw.layout import layout_from_config
 from rosfpga_lab.hw.msgpipeline import MessagePipeline
 from rosfpga_lab.hw.walker import extract_fast
@@ -73,6 +76,14 @@ def main() -> None:
     t_layout_sub = per_call(lambda: extract_fast(layout, frame), args.frames)
     print(f"640x480 rgba8 subscriber, fast: Image interpreter {t_image * 1e3:.3f} ms, "
           f"layout walker {t_layout_sub * 1e3:.3f} ms per frame")
+    # the whole circuit, the live node's model before (hw.Pipeline) and since issue 28
+    old = Pipeline.from_config(config)
+    new = circuit_of(config).model()
+    assert old.process(frame).output_frame == new.process(frame).output_frame
+    t_old = per_call(lambda: old.process(frame), args.frames)
+    t_new = per_call(lambda: new.process(frame), args.frames)
+    print(f"640x480 rgba8 dilate 3x3, whole circuit, fast: hw.Pipeline (old) {t_old * 1e3:.3f} ms, "
+          f"MessagePipeline (new) {t_new * 1e3:.3f} ms per frame")
 
 
 if __name__ == "__main__":

@@ -95,3 +95,22 @@ def test_random_streams_fit_the_element_type() -> None:
     msg = example_message(layout, reg, stream=values)
     out = extract_fast(layout, framed(serialize(reg, "lab_msgs/Samples", msg)))
     assert np.array_equal(out.stream, values)
+
+
+@pytest.mark.parametrize("encoding, channels", [("bgr8", 3), ("mono8", 1), ("rgba8", 4)])
+def test_image_frame_is_the_message_layers_image(encoding: str, channels: int) -> None:
+    """hw.sample.image_frame (the camera's and the benchmarks' frames) writes what the msg
+    layer's serializer writes for the same Image; a picture of the wrong depth is refused."""
+    from rosfpga_lab.hw.errors import PipelineConfigError
+    from rosfpga_lab.hw.sample import image_frame
+    from rosfpga_lab.msg import default_registry
+
+    image = np.random.default_rng(5).integers(0, 256, (4, 5, channels), dtype=np.uint8)
+    msg = {"header": {"seq": 2, "stamp": (3, 4), "frame_id": "f"}, "height": 4, "width": 5,
+           "encoding": encoding, "is_bigendian": 1, "step": 5 * channels,
+           "data": image.tobytes()}
+    body = serialize(default_registry(), "sensor_msgs/Image", msg)
+    assert image_frame(image, encoding, seq=2, stamp=(3, 4), frame_id="f",
+                       is_bigendian=1) == struct.pack("<I", len(body)) + body
+    with pytest.raises(PipelineConfigError, match="bytes per pixel"):
+        image_frame(image, "rgba8" if channels != 4 else "mono8")

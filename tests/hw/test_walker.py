@@ -21,8 +21,8 @@ from rosfpga_lab.hw.layout import (
     Action, Layout, StepKind, derive_layout, encode_token, layout_from_config, tokens,
 )
 from rosfpga_lab.hw.morph1d import morph1d_fast, morph1d_reference
-from rosfpga_lab.hw.msgpipeline import MessagePipeline
-from rosfpga_lab.hw.pipeline import image_frame
+from rosfpga_lab.hw.msgpipeline import MessagePipeline, wire_bytes
+from rosfpga_lab.hw.sample import example_message, image_frame
 from rosfpga_lab.hw.walker import (
     LayoutInterpreter, extract_fast, extract_reference, message_of, publish_fast,
     publish_reference,
@@ -242,6 +242,61 @@ def test_the_layout_models_give_the_image_paths_outputs_and_refusals(name: str) 
             assert status_of[expected[1]].replace("HEADER_", "") == image_status[expected[1]]
         outcomes.append(expected[:2])
     assert ("ok", 5) in outcomes and sum(o[0] == "refused" for o in outcomes) >= 10
+
+
+@pytest.mark.parametrize("name", ["fpga_dilate_rgba8.yaml", "fpga_erode_mono8.yaml",
+                                  "fpga_passthrough_rgb8.yaml"])
+@pytest.mark.parametrize("model", ["fast", "reference"])
+def test_the_walkers_circuit_publishes_what_the_image_model_publishes(name: str,
+                                                                       model: str) -> None:
+    """MessagePipeline (the live node's model since issue 28) against hw.Pipeline (its model
+    before), frame for frame on one stream of good and refused Image frames: the same output
+    bytes (the picture filtered, header.seq numbered 1, 2, ... over the published frames), the
+    same refusals (field, byte offset and kind; two rules the layout words as its checks do),
+    and the next good frame right after each refusal."""
+    from rosfpga_lab.component.fpga import refusal_kind
+    from rosfpga_lab.hw import Pipeline
+    from rosfpga_lab.hw.errors import FrameFieldError
+
+    built_for = "not what the circuit was built for"    # the layout's EQUAL check
+    worded = {"step: not width x bytes per pixel": f"step: {built_for}",
+              "data length: not step x height": f"data length: {built_for}"}
+
+    text = (DATA / name).read_text()
+    for a, b in (("width: 320", "width: 8"), ("height: 240", "height: 6"),
+                 ("width: 640", "width: 8"), ("height: 480", "height: 6")):
+        text = text.replace(a, b)
+    config = parse_config(text)
+    old, new = Pipeline.from_config(config, model=model), MessagePipeline.from_config(config, model)
+    frames = _image_frames(config)
+    good = frames[0]
+    published = 0
+    for frame in [f for bad in frames[1:] for f in (bad, good)]:
+        outcome = []
+        for pipe in (old, new):
+            try:
+                outcome.append(pipe.process(frame).output_frame)
+            except FrameFieldError as exc:
+                kind = refusal_kind(exc)
+                outcome.append((exc.field, exc.offset, worded.get(kind, kind)))
+        assert outcome[0] == outcome[1], frame[:40].hex()
+        published += isinstance(outcome[0], bytes)
+    assert published >= len(frames) and new.next_seq == published + 1
+
+
+def test_a_results_network_times_count_the_frame_and_its_tcp_segments() -> None:
+    """network_time_s: the frame's bytes at 1 Gb/s; wire_time_s: with 90 bytes of TCP/IP and
+    Ethernet per segment of 1,448 payload bytes (a 3,000-byte frame: three segments)."""
+    config = load_config(DATA / "fpga_samples_dilate.yaml")
+    pipe = MessagePipeline.from_config(config)
+    layout = pipe.layout
+    frame = _frame(serialize(config.registry(), layout.type_name,
+                             example_message(layout, config.registry())))
+    res = pipe.process(frame)
+    assert res.network_time_s == pytest.approx(len(frame) * 8 / 1e9)
+    segments = -(-len(frame) // 1448)
+    assert res.wire_time_s == pytest.approx((len(frame) + 90 * segments) * 8 / 1e9)
+    assert wire_bytes(3000) == 3000 + 3 * 90
 
 
 # -- specific refusals ---------------------------------------------------------------------------
