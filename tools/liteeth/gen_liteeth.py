@@ -10,7 +10,7 @@ Run it in a virtual environment of its own (LiteX and Migen are not lab dependen
 
 It builds what LiteEth's own ``liteeth_gen`` builds for ``core: udp`` (PHY, MAC, ARP, IPv4,
 ICMP, UDP), from the same LiteEth classes, with three differences ``liteeth_gen`` has no
-configuration key for (so this script, not a YAML file for ``liteeth_gen``):
+configuration key for (so this script, not a YAML file for ``liteeth_gen``), and one fix:
 
 * the node's MAC address, IP address and UDP port are inputs of the core (``mac_address``,
   ``ip_address``, ``udp_rx_port``), so one vendored file serves every configuration;
@@ -19,6 +19,10 @@ configuration key for (so this script, not a YAML file for ``liteeth_gen``):
 * received frames are filtered by destination MAC (ours, broadcast, IPv4 multicast) before the
   EtherType dispatch (LiteEth's crossbar MAC takes every frame; only its ``hybrid`` MAC filters)
   and by destination IP (``with_ip_broadcast=False``: LiteEth's default takes every IPv4 frame);
+* the PHY's receive stream gets ``last_be`` = ``last`` (without it LiteEth 2024.12's 8-bit
+  receive path never flags a bad FCS: its CRC checker looks at the lanes ``last_be`` enables);
+* the UDP receiver holds a payload's last byte until its frame ends (``HoldingUDPRX``), so a
+  padded frame's bad FCS is not lost with the padding LiteEth's own receiver drops;
 * ``phy: gmii_model`` is LiteEth's GMII PHY in its ``model`` mode (RX and TX clocked by the
   core's clock, no vendor clock buffers): the simulation variant; ``phy: ecp5_rgmii`` is
   ``LiteEthECP5PHYRGMII`` (DELAYG, IDDRX1F, ODDRX1F), the board variant.
@@ -32,9 +36,13 @@ from importlib.metadata import version
 from pathlib import Path
 
 import yaml
-from migen import If, Signal
+from migen import FSM, If, NextState, NextValue, Signal
 
+import liteeth.core.udp
 import liteeth.mac
+from liteeth.common import eth_ipv4_user_description, eth_udp_user_description, udp_header, \
+    udp_protocol
+from liteeth.core.udp import LiteEthUDPDepacketizer
 from liteeth import phy as liteeth_phys
 from liteeth.core import LiteEthUDPIPCore
 from liteeth.gen import _io, get_udp_raw_port_ios
@@ -42,6 +50,8 @@ from liteeth.mac.common import LiteEthMACCrossbar
 from litex.build.generic_platform import Pins, Subsignal
 from litex.build.io import CRG
 from litex.build.lattice.platform import LatticePlatform
+from litex.gen import LiteXModule
+from litex.soc.interconnect import stream
 from litex.soc.integration.builder import Builder
 from litex.soc.integration.soc_core import SoCMini
 
@@ -82,6 +92,60 @@ class FilteringMACCrossbar(LiteEthMACCrossbar):
         self.comb += If(~ours, self.dispatcher.sel.eq(0))
 
 
+class HoldingUDPRX(LiteXModule):
+    """LiteEth's UDP receiver (8 bits), but a payload shorter than its frame (Ethernet padding,
+    trailing bytes) keeps its last byte until the frame ends, so that the frame's error (a bad
+    FCS, known at its end) comes with it. LiteEth's own ends the payload at the UDP length and
+    drops the rest, error included: a padded frame with a bad FCS would pass as good.
+    """
+
+    def __init__(self, ip_address: object, dw: int = 8) -> None:
+        assert dw == 8
+        self.sink = sink = stream.Endpoint(eth_ipv4_user_description(dw))
+        self.source = source = stream.Endpoint(eth_udp_user_description(dw))
+        self.depacketizer = dep = LiteEthUDPDepacketizer(dw)
+        self.comb += sink.connect(dep.sink)
+        d = dep.source
+        count = Signal(16)
+        err = Signal()
+        held = Signal(8)
+        sport, dport, length, ip = Signal(16), Signal(16), Signal(16), Signal(32)
+        payload_len = Signal(16)
+        self.comb += payload_len.eq(d.length - udp_header.length)
+        self.fsm = fsm = FSM(reset_state="IDLE")
+        fsm.act("IDLE",
+            NextValue(count, 1), NextValue(err, 0),
+            If(d.valid, NextState("DROP"), If(sink.protocol == udp_protocol, NextState("RECEIVE"))))
+        fsm.act("RECEIVE",
+            source.src_port.eq(d.src_port), source.dst_port.eq(d.dst_port),
+            source.length.eq(payload_len), source.ip_address.eq(sink.ip_address),
+            source.data.eq(d.data),
+            If(d.last | (count < payload_len),
+                source.valid.eq(d.valid), d.ready.eq(source.ready),
+                source.last.eq(d.last), source.error.eq(d.error | err),
+                If(d.valid & source.ready,
+                    NextValue(count, count + 1), NextValue(err, err | d.error),
+                    If(d.last, NextState("IDLE"))),
+            ).Else(                              # the payload's last byte, the frame goes on
+                d.ready.eq(1),
+                If(d.valid,
+                    NextValue(held, d.data), NextValue(err, err | d.error),
+                    NextValue(sport, d.src_port), NextValue(dport, d.dst_port),
+                    NextValue(length, payload_len), NextValue(ip, sink.ip_address),
+                    NextState("HOLD"))))
+        fsm.act("HOLD",
+            d.ready.eq(1),
+            If(d.valid, NextValue(err, err | d.error), If(d.last, NextState("EMIT"))))
+        fsm.act("EMIT",
+            source.valid.eq(1), source.last.eq(1), source.data.eq(held), source.error.eq(err),
+            source.src_port.eq(sport), source.dst_port.eq(dport), source.length.eq(length),
+            source.ip_address.eq(ip),
+            If(source.ready, NextState("IDLE")))
+        fsm.act("DROP",
+            d.ready.eq(1),
+            If(d.valid & d.last, NextState("IDLE")))
+
+
 class UDPPortCore(SoCMini):
     """PHY + LiteEthUDPIPCore + one raw UDP port (8-bit) with run-time addresses and port."""
 
@@ -102,6 +166,11 @@ class UDPPortCore(SoCMini):
         else:
             raise ValueError(f"phy: {phy!r}: gmii_model or ecp5_rgmii")
         self.ethphy = ethphy
+        # LiteEth 2024.12's receive path with an 8-bit PHY and an 8-bit core never drives
+        # last_be (LiteEthMACRXLastBE, which sets it from last, is only added when the core is
+        # wider), and its CRC checker flags an error only on a byte lane last_be enables: a frame
+        # with a bad FCS would pass as good. The PHY's last byte is its last lane.
+        self.comb += ethphy.source.last_be.eq(ethphy.source.last)
 
         mac_address = platform.request("mac_address")
         ip_address = platform.request("ip_address")
@@ -144,7 +213,8 @@ def main() -> None:
     args = ap.parse_args()
     cfg = yaml.safe_load(Path(args.config).read_text())
     name = cfg["name"]
-    liteeth.mac.LiteEthMACCrossbar = FilteringMACCrossbar   # before the MAC is built
+    liteeth.mac.LiteEthMACCrossbar = FilteringMACCrossbar   # before the core is built
+    liteeth.core.udp.LiteEthUDPRX = HoldingUDPRX
     platform = LatticePlatform(cfg["device"], io=[], toolchain="trellis")
     platform.add_extension(_io)
     platform.add_extension(PADS)

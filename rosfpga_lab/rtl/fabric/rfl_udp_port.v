@@ -6,7 +6,7 @@
 // Received (m_axis_*, m_udp_* hold for every beat of a packet): the payloads of the UDP datagrams
 // LiteEth passes up (for our MAC, broadcast or IPv4 multicast; for our IP; a good IPv4 header;
 // to the core's udp_rx_port), each only once it ended good (rfl_udp_store): LiteEth marks a
-// frame with a bad FCS only on its last byte (le_rx_error), and cuts a payload to its UDP
+// frame with a bad FCS only at its end (le_rx_error), and cuts a payload to its UDP
 // length without saying when the frame was shorter. Dropped and counted here: le_rx_error
 // (cnt_rx_error), a payload whose bytes are not its UDP length (cnt_rx_length: a truncated
 // datagram, or an empty one, which LiteEth passes as one padding byte), no room in the
@@ -81,15 +81,23 @@ module rfl_udp_port #(
     // RX_BITS, TX_BITS and QUEUE_BITS are checked by rfl_udp_store.
 
     // ---- receive ------------------------------------------------------------------------------
+    // LiteEth's error flag is taken from whichever beat of the payload carries it.
     reg [15:0] rx_n;                            // bytes of this payload so far
+    reg rx_err_seen;
     wire rx_take = le_rx_valid && le_rx_ready;
     wire [15:0] rx_n_next = rx_n + 16'd1;
     wire rx_short = (rx_n_next != le_rx_length);
-    wire rx_bad = le_rx_error || rx_short;
+    wire rx_err = le_rx_error || rx_err_seen;
+    wire rx_bad = rx_err || rx_short;
     wire rx_keep, rx_drop, rx_user;
     always @(posedge clk) begin
-        if (!rst_n) rx_n <= 16'd0;
-        else if (rx_take) rx_n <= le_rx_last ? 16'd0 : rx_n_next;
+        if (!rst_n) begin
+            rx_n <= 16'd0;
+            rx_err_seen <= 1'b0;
+        end else if (rx_take) begin
+            rx_n <= le_rx_last ? 16'd0 : rx_n_next;
+            rx_err_seen <= !le_rx_last && rx_err;
+        end
     end
 
     rfl_udp_store #(.ADDR_BITS(RX_BITS), .QUEUE_BITS(QUEUE_BITS), .META_W(64), .WAIT(0)) u_rx (
@@ -127,8 +135,8 @@ module rfl_udp_port #(
             c_tovf <= {COUNT_BITS{1'b0}};
         end else begin
             if (rx_keep && c_rx != top) c_rx <= c_rx + 1'b1;
-            if (rx_fin && le_rx_error && c_err != top) c_err <= c_err + 1'b1;
-            if (rx_fin && !le_rx_error && rx_short && c_len != top) c_len <= c_len + 1'b1;
+            if (rx_fin && rx_err && c_err != top) c_err <= c_err + 1'b1;
+            if (rx_fin && !rx_err && rx_short && c_len != top) c_len <= c_len + 1'b1;
             if (rx_drop && !rx_user && c_ovf != top) c_ovf <= c_ovf + 1'b1;
             if (tx_keep && c_tx != top) c_tx <= c_tx + 1'b1;
             if (tx_drop && !tx_user && c_tovf != top) c_tovf <= c_tovf + 1'b1;

@@ -201,7 +201,7 @@ UDPPortCore
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
 │    │    │    └─── fsm (FSM)
-│    │    └─── rx (LiteEthUDPRX)
+│    │    └─── rx (HoldingUDPRX)
 │    │    │    └─── depacketizer (LiteEthUDPDepacketizer)
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
@@ -229,21 +229,21 @@ UDPPortCore
 │    │    └─── csrstorage_0* (CSRStorage)
 │    │    └─── csrstatus_0* (CSRStatus)
 └─── csr_interconnect (InterconnectShared)
-└─── [IDDRX1F]
-└─── [IDDRX1F]
-└─── [IDDRX1F]
-└─── [IDDRX1F]
-└─── [IDDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
 └─── [ODDRX1F]
 └─── [FD1S3BX]
 └─── [FD1S3BX]
 └─── [FD1S3BX]
 └─── [FD1S3BX]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [IDDRX1F]
+└─── [IDDRX1F]
+└─── [IDDRX1F]
+└─── [IDDRX1F]
+└─── [IDDRX1F]
 * : Generated name.
 []: BlackBox.
 */
@@ -565,7 +565,7 @@ reg           ethphy_source_first = 1'd0;
 wire          ethphy_source_last;
 reg     [7:0] ethphy_source_payload_data = 8'd0;
 reg           ethphy_source_payload_error = 1'd0;
-reg           ethphy_source_payload_last_be = 1'd0;
+wire          ethphy_source_payload_last_be;
 wire          ethphy_source_ready;
 reg           ethphy_source_valid = 1'd0;
 reg     [3:0] ethphy_status = 4'd0;
@@ -574,6 +574,94 @@ wire    [3:0] ethphy_tx_data_oddrx1f;
 wire          ethphy_we;
 reg     [2:0] fsm_next_state = 3'd0;
 reg     [2:0] fsm_state = 3'd0;
+reg    [15:0] holdingudprx0 = 16'd0;
+reg    [15:0] holdingudprx0_liteethudp_next_value3 = 16'd0;
+reg           holdingudprx0_liteethudp_next_value_ce3 = 1'd0;
+reg    [15:0] holdingudprx1 = 16'd0;
+reg    [15:0] holdingudprx1_liteethudp_next_value4 = 16'd0;
+reg           holdingudprx1_liteethudp_next_value_ce4 = 1'd0;
+reg    [15:0] holdingudprx2 = 16'd0;
+reg    [15:0] holdingudprx2_liteethudp_next_value5 = 16'd0;
+reg           holdingudprx2_liteethudp_next_value_ce5 = 1'd0;
+reg    [31:0] holdingudprx3 = 32'd0;
+reg    [31:0] holdingudprx3_liteethudp_next_value6 = 32'd0;
+reg           holdingudprx3_liteethudp_next_value_ce6 = 1'd0;
+reg    [15:0] holdingudprx_count = 16'd0;
+reg    [15:0] holdingudprx_count_liteethudp_next_value0 = 16'd0;
+reg           holdingudprx_count_liteethudp_next_value_ce0 = 1'd0;
+reg     [2:0] holdingudprx_depacketizer_count = 3'd0;
+reg     [2:0] holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
+reg           holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
+reg           holdingudprx_depacketizer_delayed_last_be = 1'd0;
+reg           holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
+reg           holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
+reg           holdingudprx_depacketizer_fsm_from_idle = 1'd0;
+reg           holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
+reg           holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
+wire   [63:0] holdingudprx_depacketizer_header;
+wire          holdingudprx_depacketizer_is_in_copy;
+reg           holdingudprx_depacketizer_is_ongoing0 = 1'd0;
+reg           holdingudprx_depacketizer_is_ongoing1 = 1'd0;
+reg           holdingudprx_depacketizer_is_ongoing2 = 1'd0;
+reg           holdingudprx_depacketizer_is_ongoing3 = 1'd0;
+wire          holdingudprx_depacketizer_new_last_be;
+reg           holdingudprx_depacketizer_sink_d_last = 1'd0;
+wire          holdingudprx_depacketizer_sink_first;
+wire          holdingudprx_depacketizer_sink_last;
+wire          holdingudprx_depacketizer_sink_last_be;
+wire   [31:0] holdingudprx_depacketizer_sink_param_ip_address;
+wire   [15:0] holdingudprx_depacketizer_sink_param_length;
+wire    [7:0] holdingudprx_depacketizer_sink_param_protocol;
+wire    [7:0] holdingudprx_depacketizer_sink_payload_data;
+wire          holdingudprx_depacketizer_sink_payload_error;
+wire          holdingudprx_depacketizer_sink_payload_last_be;
+reg           holdingudprx_depacketizer_sink_ready = 1'd0;
+wire          holdingudprx_depacketizer_sink_valid;
+reg           holdingudprx_depacketizer_source_last = 1'd0;
+reg           holdingudprx_depacketizer_source_last_a = 1'd0;
+reg           holdingudprx_depacketizer_source_last_b = 1'd0;
+reg           holdingudprx_depacketizer_source_last_s = 1'd0;
+wire   [15:0] holdingudprx_depacketizer_source_param_checksum;
+wire   [15:0] holdingudprx_depacketizer_source_param_dst_port;
+wire   [15:0] holdingudprx_depacketizer_source_param_length;
+wire   [15:0] holdingudprx_depacketizer_source_param_src_port;
+reg     [7:0] holdingudprx_depacketizer_source_payload_data = 8'd0;
+wire          holdingudprx_depacketizer_source_payload_error;
+reg           holdingudprx_depacketizer_source_payload_last_be = 1'd0;
+reg           holdingudprx_depacketizer_source_ready = 1'd0;
+reg           holdingudprx_depacketizer_source_valid = 1'd0;
+reg    [63:0] holdingudprx_depacketizer_sr = 64'd0;
+reg           holdingudprx_depacketizer_sr_shift = 1'd0;
+reg           holdingudprx_depacketizer_sr_shift_leftover = 1'd0;
+reg           holdingudprx_depacketizer_was_in_copy = 1'd0;
+reg           holdingudprx_err = 1'd0;
+reg           holdingudprx_err_liteethudp_next_value1 = 1'd0;
+reg           holdingudprx_err_liteethudp_next_value_ce1 = 1'd0;
+reg     [7:0] holdingudprx_held = 8'd0;
+reg     [7:0] holdingudprx_held_liteethudp_next_value2 = 8'd0;
+reg           holdingudprx_held_liteethudp_next_value_ce2 = 1'd0;
+wire   [15:0] holdingudprx_payload_len;
+wire          holdingudprx_sink_sink_first;
+wire          holdingudprx_sink_sink_last;
+wire   [31:0] holdingudprx_sink_sink_param_ip_address;
+wire   [15:0] holdingudprx_sink_sink_param_length;
+wire    [7:0] holdingudprx_sink_sink_param_protocol;
+wire    [7:0] holdingudprx_sink_sink_payload_data;
+wire          holdingudprx_sink_sink_payload_error;
+wire          holdingudprx_sink_sink_payload_last_be;
+wire          holdingudprx_sink_sink_ready;
+wire          holdingudprx_sink_sink_valid;
+reg           holdingudprx_source_source_first = 1'd0;
+reg           holdingudprx_source_source_last = 1'd0;
+reg    [15:0] holdingudprx_source_source_param_dst_port = 16'd0;
+reg    [31:0] holdingudprx_source_source_param_ip_address = 32'd0;
+reg    [15:0] holdingudprx_source_source_param_length = 16'd0;
+reg    [15:0] holdingudprx_source_source_param_src_port = 16'd0;
+reg     [7:0] holdingudprx_source_source_payload_data = 8'd0;
+reg           holdingudprx_source_source_payload_error = 1'd0;
+reg           holdingudprx_source_source_payload_last_be = 1'd0;
+wire          holdingudprx_source_source_ready;
+reg           holdingudprx_source_source_valid = 1'd0;
 reg           icmp_echo_param_fifo_consume = 1'd0;
 wire          icmp_echo_param_fifo_do_read;
 wire          icmp_echo_param_fifo_fifo_in_first;
@@ -1334,13 +1422,13 @@ reg           liteethmac_txdatapath_liteethmacpaddinginserter_state = 1'd0;
 reg     [1:0] liteethmac_txdatapath_liteethmacpreambleinserter_next_state = 2'd0;
 reg     [1:0] liteethmac_txdatapath_liteethmacpreambleinserter_state = 2'd0;
 reg           liteethudp_first = 1'd1;
+reg     [1:0] liteethudp_holdingudprx_fsm0_next_state = 2'd0;
+reg     [1:0] liteethudp_holdingudprx_fsm0_state = 2'd0;
+reg           liteethudp_holdingudprx_fsm1_next_state = 1'd0;
+reg           liteethudp_holdingudprx_fsm1_state = 1'd0;
+reg     [2:0] liteethudp_holdingudprx_next_state = 3'd0;
+reg     [2:0] liteethudp_holdingudprx_state = 3'd0;
 wire          liteethudp_last;
-reg     [1:0] liteethudp_liteethudprx_fsm0_next_state = 2'd0;
-reg     [1:0] liteethudp_liteethudprx_fsm0_state = 2'd0;
-reg           liteethudp_liteethudprx_fsm1_next_state = 1'd0;
-reg           liteethudp_liteethudprx_fsm1_state = 1'd0;
-reg     [1:0] liteethudp_liteethudprx_next_state = 2'd0;
-reg     [1:0] liteethudp_liteethudprx_state = 2'd0;
 reg     [1:0] liteethudp_liteethudptx_fsm0_next_state = 2'd0;
 reg     [1:0] liteethudp_liteethudptx_fsm0_state = 2'd0;
 reg           liteethudp_liteethudptx_fsm1_next_state = 1'd0;
@@ -1865,6 +1953,48 @@ reg     [5:0] multiregimpl4_regs1 = 6'd0;
 reg     [5:0] multiregimpl5_regs0 = 6'd0;
 reg     [5:0] multiregimpl5_regs1 = 6'd0;
 reg           next_state = 1'd0;
+reg     [2:0] packetizer_count = 3'd0;
+reg     [2:0] packetizer_count_liteethudp_fsm0_next_value0 = 3'd0;
+reg           packetizer_count_liteethudp_fsm0_next_value_ce0 = 1'd0;
+reg           packetizer_delayed_last_be = 1'd0;
+reg           packetizer_delayed_last_be_liteethudp_fsm1_next_value0 = 1'd0;
+reg           packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 = 1'd0;
+reg           packetizer_fsm_from_idle = 1'd0;
+reg           packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 = 1'd0;
+reg           packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 = 1'd0;
+reg    [63:0] packetizer_header = 64'd0;
+wire          packetizer_in_data_copy;
+reg           packetizer_is_ongoing0 = 1'd0;
+reg           packetizer_is_ongoing1 = 1'd0;
+reg           packetizer_is_ongoing2 = 1'd0;
+wire          packetizer_new_last_be;
+wire          packetizer_sink_last;
+wire          packetizer_sink_last_be;
+wire   [15:0] packetizer_sink_param_checksum;
+wire   [15:0] packetizer_sink_param_dst_port;
+wire   [15:0] packetizer_sink_param_length;
+wire   [15:0] packetizer_sink_param_src_port;
+wire    [7:0] packetizer_sink_payload_data;
+reg           packetizer_sink_payload_error = 1'd0;
+wire          packetizer_sink_payload_last_be;
+reg           packetizer_sink_ready = 1'd0;
+wire          packetizer_sink_valid;
+reg           packetizer_source_first = 1'd0;
+reg           packetizer_source_last = 1'd0;
+reg           packetizer_source_last_a = 1'd0;
+reg           packetizer_source_last_b = 1'd0;
+reg           packetizer_source_last_s = 1'd0;
+reg    [31:0] packetizer_source_param_ip_address = 32'd0;
+reg    [15:0] packetizer_source_param_length = 16'd0;
+reg     [7:0] packetizer_source_param_protocol = 8'd0;
+reg     [7:0] packetizer_source_payload_data = 8'd0;
+wire          packetizer_source_payload_error;
+reg           packetizer_source_payload_last_be = 1'd0;
+reg           packetizer_source_ready = 1'd0;
+reg           packetizer_source_valid = 1'd0;
+reg    [63:0] packetizer_sr = 64'd0;
+reg           packetizer_sr_load = 1'd0;
+reg           packetizer_sr_shift = 1'd0;
 wire          por_clk;
 wire          re;
 wire   [15:0] rhs_slice_proxy0;
@@ -2005,75 +2135,27 @@ wire    [9:0] rx_converter_source_source_payload_data;
 wire          rx_converter_source_source_ready;
 wire          rx_converter_source_source_valid;
 wire          rx_converter_source_valid;
-reg    [15:0] rx_count = 16'd0;
-reg    [15:0] rx_count_liteethudp_next_value = 16'd0;
-reg           rx_count_liteethudp_next_value_ce = 1'd0;
-reg     [2:0] rx_depacketizer_count = 3'd0;
-reg     [2:0] rx_depacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
-reg           rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
-reg           rx_depacketizer_delayed_last_be = 1'd0;
-reg           rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
-reg           rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
-reg           rx_depacketizer_fsm_from_idle = 1'd0;
-reg           rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
-reg           rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
-wire   [63:0] rx_depacketizer_header;
-wire          rx_depacketizer_is_in_copy;
-reg           rx_depacketizer_is_ongoing0 = 1'd0;
-reg           rx_depacketizer_is_ongoing1 = 1'd0;
-reg           rx_depacketizer_is_ongoing2 = 1'd0;
-reg           rx_depacketizer_is_ongoing3 = 1'd0;
-wire          rx_depacketizer_new_last_be;
-reg           rx_depacketizer_sink_d_last = 1'd0;
-wire          rx_depacketizer_sink_first;
-wire          rx_depacketizer_sink_last;
-wire          rx_depacketizer_sink_last_be;
-wire   [31:0] rx_depacketizer_sink_param_ip_address;
-wire   [15:0] rx_depacketizer_sink_param_length;
-wire    [7:0] rx_depacketizer_sink_param_protocol;
-wire    [7:0] rx_depacketizer_sink_payload_data;
-wire          rx_depacketizer_sink_payload_error;
-wire          rx_depacketizer_sink_payload_last_be;
-reg           rx_depacketizer_sink_ready = 1'd0;
-wire          rx_depacketizer_sink_valid;
-reg           rx_depacketizer_source_last = 1'd0;
-reg           rx_depacketizer_source_last_a = 1'd0;
-reg           rx_depacketizer_source_last_b = 1'd0;
-reg           rx_depacketizer_source_last_s = 1'd0;
-wire   [15:0] rx_depacketizer_source_param_checksum;
-wire   [15:0] rx_depacketizer_source_param_dst_port;
-wire   [15:0] rx_depacketizer_source_param_length;
-wire   [15:0] rx_depacketizer_source_param_src_port;
-reg     [7:0] rx_depacketizer_source_payload_data = 8'd0;
-wire          rx_depacketizer_source_payload_error;
-reg           rx_depacketizer_source_payload_last_be = 1'd0;
-reg           rx_depacketizer_source_ready = 1'd0;
-reg           rx_depacketizer_source_valid = 1'd0;
-reg    [63:0] rx_depacketizer_sr = 64'd0;
-reg           rx_depacketizer_sr_shift = 1'd0;
-reg           rx_depacketizer_sr_shift_leftover = 1'd0;
-reg           rx_depacketizer_was_in_copy = 1'd0;
-wire          rx_sink_sink_first;
-wire          rx_sink_sink_last;
-wire   [31:0] rx_sink_sink_param_ip_address;
-wire   [15:0] rx_sink_sink_param_length;
-wire    [7:0] rx_sink_sink_param_protocol;
-wire    [7:0] rx_sink_sink_payload_data;
-wire          rx_sink_sink_payload_error;
-wire          rx_sink_sink_payload_last_be;
-wire          rx_sink_sink_ready;
-wire          rx_sink_sink_valid;
-reg           rx_source_source_first = 1'd0;
-reg           rx_source_source_last = 1'd0;
-wire   [15:0] rx_source_source_param_dst_port;
-wire   [31:0] rx_source_source_param_ip_address;
-wire   [15:0] rx_source_source_param_length;
-wire   [15:0] rx_source_source_param_src_port;
-wire    [7:0] rx_source_source_payload_data;
-wire          rx_source_source_payload_error;
-reg           rx_source_source_payload_last_be = 1'd0;
-wire          rx_source_source_ready;
-reg           rx_source_source_valid = 1'd0;
+wire          sink_sink_first;
+wire          sink_sink_last;
+wire   [15:0] sink_sink_param_dst_port;
+wire   [31:0] sink_sink_param_ip_address;
+wire   [15:0] sink_sink_param_length;
+wire   [15:0] sink_sink_param_src_port;
+wire    [7:0] sink_sink_payload_data;
+wire          sink_sink_payload_error;
+wire          sink_sink_payload_last_be;
+wire          sink_sink_ready;
+wire          sink_sink_valid;
+reg           source_source_first = 1'd0;
+reg           source_source_last = 1'd0;
+reg    [31:0] source_source_param_ip_address = 32'd0;
+reg    [15:0] source_source_param_length = 16'd0;
+reg     [7:0] source_source_param_protocol = 8'd0;
+reg     [7:0] source_source_payload_data = 8'd0;
+reg           source_source_payload_error = 1'd0;
+reg           source_source_payload_last_be = 1'd0;
+wire          source_source_ready;
+reg           source_source_valid = 1'd0;
 reg           state = 1'd0;
 wire          sys_clk;
 wire          sys_rst;
@@ -2137,69 +2219,6 @@ wire    [9:0] tx_converter_source_source_payload_data;
 wire          tx_converter_source_source_ready;
 wire          tx_converter_source_source_valid;
 wire          tx_converter_source_valid;
-reg     [2:0] tx_packetizer_count = 3'd0;
-reg     [2:0] tx_packetizer_count_liteethudp_fsm0_next_value0 = 3'd0;
-reg           tx_packetizer_count_liteethudp_fsm0_next_value_ce0 = 1'd0;
-reg           tx_packetizer_delayed_last_be = 1'd0;
-reg           tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 = 1'd0;
-reg           tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 = 1'd0;
-reg           tx_packetizer_fsm_from_idle = 1'd0;
-reg           tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 = 1'd0;
-reg           tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 = 1'd0;
-reg    [63:0] tx_packetizer_header = 64'd0;
-wire          tx_packetizer_in_data_copy;
-reg           tx_packetizer_is_ongoing0 = 1'd0;
-reg           tx_packetizer_is_ongoing1 = 1'd0;
-reg           tx_packetizer_is_ongoing2 = 1'd0;
-wire          tx_packetizer_new_last_be;
-wire          tx_packetizer_sink_last;
-wire          tx_packetizer_sink_last_be;
-wire   [15:0] tx_packetizer_sink_param_checksum;
-wire   [15:0] tx_packetizer_sink_param_dst_port;
-wire   [15:0] tx_packetizer_sink_param_length;
-wire   [15:0] tx_packetizer_sink_param_src_port;
-wire    [7:0] tx_packetizer_sink_payload_data;
-reg           tx_packetizer_sink_payload_error = 1'd0;
-wire          tx_packetizer_sink_payload_last_be;
-reg           tx_packetizer_sink_ready = 1'd0;
-wire          tx_packetizer_sink_valid;
-reg           tx_packetizer_source_first = 1'd0;
-reg           tx_packetizer_source_last = 1'd0;
-reg           tx_packetizer_source_last_a = 1'd0;
-reg           tx_packetizer_source_last_b = 1'd0;
-reg           tx_packetizer_source_last_s = 1'd0;
-reg    [31:0] tx_packetizer_source_param_ip_address = 32'd0;
-reg    [15:0] tx_packetizer_source_param_length = 16'd0;
-reg     [7:0] tx_packetizer_source_param_protocol = 8'd0;
-reg     [7:0] tx_packetizer_source_payload_data = 8'd0;
-wire          tx_packetizer_source_payload_error;
-reg           tx_packetizer_source_payload_last_be = 1'd0;
-reg           tx_packetizer_source_ready = 1'd0;
-reg           tx_packetizer_source_valid = 1'd0;
-reg    [63:0] tx_packetizer_sr = 64'd0;
-reg           tx_packetizer_sr_load = 1'd0;
-reg           tx_packetizer_sr_shift = 1'd0;
-wire          tx_sink_sink_first;
-wire          tx_sink_sink_last;
-wire   [15:0] tx_sink_sink_param_dst_port;
-wire   [31:0] tx_sink_sink_param_ip_address;
-wire   [15:0] tx_sink_sink_param_length;
-wire   [15:0] tx_sink_sink_param_src_port;
-wire    [7:0] tx_sink_sink_payload_data;
-wire          tx_sink_sink_payload_error;
-wire          tx_sink_sink_payload_last_be;
-wire          tx_sink_sink_ready;
-wire          tx_sink_sink_valid;
-reg           tx_source_source_first = 1'd0;
-reg           tx_source_source_last = 1'd0;
-reg    [31:0] tx_source_source_param_ip_address = 32'd0;
-reg    [15:0] tx_source_source_param_length = 16'd0;
-reg     [7:0] tx_source_source_param_protocol = 8'd0;
-reg     [7:0] tx_source_source_payload_data = 8'd0;
-reg           tx_source_source_payload_error = 1'd0;
-reg           tx_source_source_payload_last_be = 1'd0;
-wire          tx_source_source_ready;
-reg           tx_source_source_valid = 1'd0;
 reg           udpportcore_bus_error = 1'd0;
 reg    [31:0] udpportcore_bus_errors = 32'd0;
 reg           udpportcore_bus_errors_re = 1'd0;
@@ -2239,6 +2258,7 @@ wire          we;
 // Combinatorial Logic
 //------------------------------------------------------------------------------
 
+assign ethphy_source_payload_last_be = ethphy_source_last;
 assign user_port_sink_valid = udp_sink_valid;
 assign user_port_sink_last = udp_sink_last;
 assign user_port_sink_param_dst_port = udp_sink_dst_port;
@@ -5285,144 +5305,144 @@ assign icmp_echo_param_fifo_syncfifo_dout = icmp_echo_param_fifo_rdport_dat_r;
 assign icmp_echo_param_fifo_rdport_re = icmp_echo_param_fifo_do_read;
 assign icmp_echo_param_fifo_syncfifo_writable = (icmp_echo_param_fifo_level0 != 2'd2);
 assign icmp_echo_param_fifo_syncfifo_readable = (icmp_echo_param_fifo_level0 != 1'd0);
-assign ip_port_sink_valid = tx_source_source_valid;
-assign tx_source_source_ready = ip_port_sink_ready;
-assign ip_port_sink_first = tx_source_source_first;
-assign ip_port_sink_last = tx_source_source_last;
-assign ip_port_sink_payload_data = tx_source_source_payload_data;
-assign ip_port_sink_payload_last_be = tx_source_source_payload_last_be;
-assign ip_port_sink_payload_error = tx_source_source_payload_error;
-assign ip_port_sink_param_length = tx_source_source_param_length;
-assign ip_port_sink_param_protocol = tx_source_source_param_protocol;
-assign ip_port_sink_param_ip_address = tx_source_source_param_ip_address;
-assign rx_sink_sink_valid = ip_port_source_valid;
-assign ip_port_source_ready = rx_sink_sink_ready;
-assign rx_sink_sink_first = ip_port_source_first;
-assign rx_sink_sink_last = ip_port_source_last;
-assign rx_sink_sink_payload_data = ip_port_source_payload_data;
-assign rx_sink_sink_payload_last_be = ip_port_source_payload_last_be;
-assign rx_sink_sink_payload_error = ip_port_source_payload_error;
-assign rx_sink_sink_param_length = ip_port_source_param_length;
-assign rx_sink_sink_param_protocol = ip_port_source_param_protocol;
-assign rx_sink_sink_param_ip_address = ip_port_source_param_ip_address;
-assign tx_sink_sink_valid = crossbar_source_valid;
-assign crossbar_source_ready = tx_sink_sink_ready;
-assign tx_sink_sink_first = crossbar_source_first;
-assign tx_sink_sink_last = crossbar_source_last;
-assign tx_sink_sink_payload_data = crossbar_source_payload_data;
-assign tx_sink_sink_payload_last_be = crossbar_source_payload_last_be;
-assign tx_sink_sink_payload_error = crossbar_source_payload_error;
-assign tx_sink_sink_param_src_port = crossbar_source_param_src_port;
-assign tx_sink_sink_param_dst_port = crossbar_source_param_dst_port;
-assign tx_sink_sink_param_ip_address = crossbar_source_param_ip_address;
-assign tx_sink_sink_param_length = crossbar_source_param_length;
-assign crossbar_sink_valid = rx_source_source_valid;
-assign rx_source_source_ready = crossbar_sink_ready;
-assign crossbar_sink_first = rx_source_source_first;
-assign crossbar_sink_last = rx_source_source_last;
-assign crossbar_sink_payload_data = rx_source_source_payload_data;
-assign crossbar_sink_payload_last_be = rx_source_source_payload_last_be;
-assign crossbar_sink_payload_error = rx_source_source_payload_error;
-assign crossbar_sink_param_src_port = rx_source_source_param_src_port;
-assign crossbar_sink_param_dst_port = rx_source_source_param_dst_port;
-assign crossbar_sink_param_ip_address = rx_source_source_param_ip_address;
-assign crossbar_sink_param_length = rx_source_source_param_length;
-assign tx_packetizer_sink_valid = tx_sink_sink_valid;
-assign tx_sink_sink_ready = tx_packetizer_sink_ready;
-assign tx_packetizer_sink_last = tx_sink_sink_last;
-assign tx_packetizer_sink_payload_data = tx_sink_sink_payload_data;
-assign tx_packetizer_sink_payload_last_be = tx_sink_sink_payload_last_be;
-assign tx_packetizer_sink_param_src_port = tx_sink_sink_param_src_port;
-assign tx_packetizer_sink_param_dst_port = tx_sink_sink_param_dst_port;
-assign tx_packetizer_sink_param_length = (tx_sink_sink_param_length + 4'd8);
-assign tx_packetizer_sink_param_checksum = 1'd0;
+assign ip_port_sink_valid = source_source_valid;
+assign source_source_ready = ip_port_sink_ready;
+assign ip_port_sink_first = source_source_first;
+assign ip_port_sink_last = source_source_last;
+assign ip_port_sink_payload_data = source_source_payload_data;
+assign ip_port_sink_payload_last_be = source_source_payload_last_be;
+assign ip_port_sink_payload_error = source_source_payload_error;
+assign ip_port_sink_param_length = source_source_param_length;
+assign ip_port_sink_param_protocol = source_source_param_protocol;
+assign ip_port_sink_param_ip_address = source_source_param_ip_address;
+assign holdingudprx_sink_sink_valid = ip_port_source_valid;
+assign ip_port_source_ready = holdingudprx_sink_sink_ready;
+assign holdingudprx_sink_sink_first = ip_port_source_first;
+assign holdingudprx_sink_sink_last = ip_port_source_last;
+assign holdingudprx_sink_sink_payload_data = ip_port_source_payload_data;
+assign holdingudprx_sink_sink_payload_last_be = ip_port_source_payload_last_be;
+assign holdingudprx_sink_sink_payload_error = ip_port_source_payload_error;
+assign holdingudprx_sink_sink_param_length = ip_port_source_param_length;
+assign holdingudprx_sink_sink_param_protocol = ip_port_source_param_protocol;
+assign holdingudprx_sink_sink_param_ip_address = ip_port_source_param_ip_address;
+assign sink_sink_valid = crossbar_source_valid;
+assign crossbar_source_ready = sink_sink_ready;
+assign sink_sink_first = crossbar_source_first;
+assign sink_sink_last = crossbar_source_last;
+assign sink_sink_payload_data = crossbar_source_payload_data;
+assign sink_sink_payload_last_be = crossbar_source_payload_last_be;
+assign sink_sink_payload_error = crossbar_source_payload_error;
+assign sink_sink_param_src_port = crossbar_source_param_src_port;
+assign sink_sink_param_dst_port = crossbar_source_param_dst_port;
+assign sink_sink_param_ip_address = crossbar_source_param_ip_address;
+assign sink_sink_param_length = crossbar_source_param_length;
+assign crossbar_sink_valid = holdingudprx_source_source_valid;
+assign holdingudprx_source_source_ready = crossbar_sink_ready;
+assign crossbar_sink_first = holdingudprx_source_source_first;
+assign crossbar_sink_last = holdingudprx_source_source_last;
+assign crossbar_sink_payload_data = holdingudprx_source_source_payload_data;
+assign crossbar_sink_payload_last_be = holdingudprx_source_source_payload_last_be;
+assign crossbar_sink_payload_error = holdingudprx_source_source_payload_error;
+assign crossbar_sink_param_src_port = holdingudprx_source_source_param_src_port;
+assign crossbar_sink_param_dst_port = holdingudprx_source_source_param_dst_port;
+assign crossbar_sink_param_ip_address = holdingudprx_source_source_param_ip_address;
+assign crossbar_sink_param_length = holdingudprx_source_source_param_length;
+assign packetizer_sink_valid = sink_sink_valid;
+assign sink_sink_ready = packetizer_sink_ready;
+assign packetizer_sink_last = sink_sink_last;
+assign packetizer_sink_payload_data = sink_sink_payload_data;
+assign packetizer_sink_payload_last_be = sink_sink_payload_last_be;
+assign packetizer_sink_param_src_port = sink_sink_param_src_port;
+assign packetizer_sink_param_dst_port = sink_sink_param_dst_port;
+assign packetizer_sink_param_length = (sink_sink_param_length + 4'd8);
+assign packetizer_sink_param_checksum = 1'd0;
 always @(*) begin
-    tx_packetizer_header <= 64'd0;
-    tx_packetizer_header[63:48] <= {tx_packetizer_sink_param_checksum[7:0], tx_packetizer_sink_param_checksum[15:8]};
-    tx_packetizer_header[31:16] <= {tx_packetizer_sink_param_dst_port[7:0], tx_packetizer_sink_param_dst_port[15:8]};
-    tx_packetizer_header[47:32] <= {tx_packetizer_sink_param_length[7:0], tx_packetizer_sink_param_length[15:8]};
-    tx_packetizer_header[15:0] <= {tx_packetizer_sink_param_src_port[7:0], tx_packetizer_sink_param_src_port[15:8]};
+    packetizer_header <= 64'd0;
+    packetizer_header[63:48] <= {packetizer_sink_param_checksum[7:0], packetizer_sink_param_checksum[15:8]};
+    packetizer_header[31:16] <= {packetizer_sink_param_dst_port[7:0], packetizer_sink_param_dst_port[15:8]};
+    packetizer_header[47:32] <= {packetizer_sink_param_length[7:0], packetizer_sink_param_length[15:8]};
+    packetizer_header[15:0] <= {packetizer_sink_param_src_port[7:0], packetizer_sink_param_src_port[15:8]};
 end
-assign tx_packetizer_sink_last_be = tx_packetizer_sink_last;
-assign tx_packetizer_new_last_be = {tx_packetizer_sink_last_be};
-assign tx_packetizer_in_data_copy = (tx_packetizer_is_ongoing0 | tx_packetizer_is_ongoing1);
+assign packetizer_sink_last_be = packetizer_sink_last;
+assign packetizer_new_last_be = {packetizer_sink_last_be};
+assign packetizer_in_data_copy = (packetizer_is_ongoing0 | packetizer_is_ongoing1);
 always @(*) begin
-    tx_packetizer_source_last <= 1'd0;
-    if (tx_packetizer_source_last_s) begin
-        tx_packetizer_source_last <= tx_packetizer_source_last_b;
+    packetizer_source_last <= 1'd0;
+    if (packetizer_source_last_s) begin
+        packetizer_source_last <= packetizer_source_last_b;
     end else begin
-        tx_packetizer_source_last <= tx_packetizer_source_last_a;
+        packetizer_source_last <= packetizer_source_last_a;
     end
 end
-assign tx_packetizer_source_payload_error = tx_packetizer_sink_payload_error;
+assign packetizer_source_payload_error = packetizer_sink_payload_error;
 always @(*) begin
     liteethudp_liteethudptx_fsm0_next_state <= 2'd0;
     liteethudp_liteethudptx_fsm1_next_state <= 1'd0;
-    tx_packetizer_count_liteethudp_fsm0_next_value0 <= 3'd0;
-    tx_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd0;
-    tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= 1'd0;
-    tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd0;
-    tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd0;
-    tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd0;
-    tx_packetizer_is_ongoing0 <= 1'd0;
-    tx_packetizer_is_ongoing1 <= 1'd0;
-    tx_packetizer_is_ongoing2 <= 1'd0;
-    tx_packetizer_sink_ready <= 1'd0;
-    tx_packetizer_source_last_a <= 1'd0;
-    tx_packetizer_source_last_b <= 1'd0;
-    tx_packetizer_source_last_s <= 1'd0;
-    tx_packetizer_source_payload_data <= 8'd0;
-    tx_packetizer_source_payload_last_be <= 1'd0;
-    tx_packetizer_source_valid <= 1'd0;
-    tx_packetizer_sr_load <= 1'd0;
-    tx_packetizer_sr_shift <= 1'd0;
+    packetizer_count_liteethudp_fsm0_next_value0 <= 3'd0;
+    packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd0;
+    packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= 1'd0;
+    packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd0;
+    packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd0;
+    packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd0;
+    packetizer_is_ongoing0 <= 1'd0;
+    packetizer_is_ongoing1 <= 1'd0;
+    packetizer_is_ongoing2 <= 1'd0;
+    packetizer_sink_ready <= 1'd0;
+    packetizer_source_last_a <= 1'd0;
+    packetizer_source_last_b <= 1'd0;
+    packetizer_source_last_s <= 1'd0;
+    packetizer_source_payload_data <= 8'd0;
+    packetizer_source_payload_last_be <= 1'd0;
+    packetizer_source_valid <= 1'd0;
+    packetizer_sr_load <= 1'd0;
+    packetizer_sr_shift <= 1'd0;
     liteethudp_liteethudptx_fsm0_next_state <= liteethudp_liteethudptx_fsm0_state;
     case (liteethudp_liteethudptx_fsm0_state)
         1'd1: begin
-            tx_packetizer_source_valid <= 1'd1;
-            tx_packetizer_source_last_a <= 1'd0;
-            tx_packetizer_source_payload_data <= tx_packetizer_sr[63:8];
-            if ((tx_packetizer_source_valid & tx_packetizer_source_ready)) begin
-                tx_packetizer_sr_shift <= 1'd1;
-                if ((tx_packetizer_count == 3'd7)) begin
-                    tx_packetizer_sr_shift <= 1'd0;
+            packetizer_source_valid <= 1'd1;
+            packetizer_source_last_a <= 1'd0;
+            packetizer_source_payload_data <= packetizer_sr[63:8];
+            if ((packetizer_source_valid & packetizer_source_ready)) begin
+                packetizer_sr_shift <= 1'd1;
+                if ((packetizer_count == 3'd7)) begin
+                    packetizer_sr_shift <= 1'd0;
                     liteethudp_liteethudptx_fsm0_next_state <= 2'd2;
-                    tx_packetizer_count_liteethudp_fsm0_next_value0 <= (tx_packetizer_count + 1'd1);
-                    tx_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
+                    packetizer_count_liteethudp_fsm0_next_value0 <= (packetizer_count + 1'd1);
+                    packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
                 end else begin
-                    tx_packetizer_count_liteethudp_fsm0_next_value0 <= (tx_packetizer_count + 1'd1);
-                    tx_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
+                    packetizer_count_liteethudp_fsm0_next_value0 <= (packetizer_count + 1'd1);
+                    packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
                 end
             end
         end
         2'd2: begin
-            tx_packetizer_source_valid <= tx_packetizer_sink_valid;
-            tx_packetizer_source_last_a <= tx_packetizer_sink_last;
-            tx_packetizer_source_payload_data <= tx_packetizer_sink_payload_data;
-            if ((tx_packetizer_source_valid & tx_packetizer_source_ready)) begin
-                tx_packetizer_sink_ready <= 1'd1;
-                if (tx_packetizer_source_last) begin
+            packetizer_source_valid <= packetizer_sink_valid;
+            packetizer_source_last_a <= packetizer_sink_last;
+            packetizer_source_payload_data <= packetizer_sink_payload_data;
+            if ((packetizer_source_valid & packetizer_source_ready)) begin
+                packetizer_sink_ready <= 1'd1;
+                if (packetizer_source_last) begin
                     liteethudp_liteethudptx_fsm0_next_state <= 1'd0;
                 end
             end
-            tx_packetizer_is_ongoing0 <= 1'd1;
+            packetizer_is_ongoing0 <= 1'd1;
         end
         2'd3: begin
-            tx_packetizer_is_ongoing1 <= 1'd1;
+            packetizer_is_ongoing1 <= 1'd1;
         end
         default: begin
-            tx_packetizer_sink_ready <= 1'd1;
-            tx_packetizer_count_liteethudp_fsm0_next_value0 <= 1'd1;
-            tx_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
-            if (tx_packetizer_sink_valid) begin
-                tx_packetizer_sink_ready <= 1'd0;
-                tx_packetizer_source_valid <= 1'd1;
-                tx_packetizer_source_last_a <= 1'd0;
-                tx_packetizer_source_payload_data <= tx_packetizer_header[7:0];
-                if ((tx_packetizer_source_valid & tx_packetizer_source_ready)) begin
-                    tx_packetizer_sr_load <= 1'd1;
-                    tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd1;
-                    tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd1;
+            packetizer_sink_ready <= 1'd1;
+            packetizer_count_liteethudp_fsm0_next_value0 <= 1'd1;
+            packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
+            if (packetizer_sink_valid) begin
+                packetizer_sink_ready <= 1'd0;
+                packetizer_source_valid <= 1'd1;
+                packetizer_source_last_a <= 1'd0;
+                packetizer_source_payload_data <= packetizer_header[7:0];
+                if ((packetizer_source_valid & packetizer_source_ready)) begin
+                    packetizer_sr_load <= 1'd1;
+                    packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd1;
+                    packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd1;
                     if (1'd0) begin
                         liteethudp_liteethudptx_fsm0_next_state <= 2'd2;
                     end else begin
@@ -5430,42 +5450,42 @@ always @(*) begin
                     end
                 end
             end
-            tx_packetizer_is_ongoing2 <= 1'd1;
+            packetizer_is_ongoing2 <= 1'd1;
         end
     endcase
     liteethudp_liteethudptx_fsm1_next_state <= liteethudp_liteethudptx_fsm1_state;
     case (liteethudp_liteethudptx_fsm1_state)
         1'd1: begin
-            tx_packetizer_source_last_b <= 1'd1;
-            tx_packetizer_source_last_s <= 1'd1;
-            tx_packetizer_source_payload_last_be <= tx_packetizer_delayed_last_be;
-            tx_packetizer_sink_ready <= 1'd0;
-            if (tx_packetizer_source_ready) begin
+            packetizer_source_last_b <= 1'd1;
+            packetizer_source_last_s <= 1'd1;
+            packetizer_source_payload_last_be <= packetizer_delayed_last_be;
+            packetizer_sink_ready <= 1'd0;
+            if (packetizer_source_ready) begin
                 liteethudp_liteethudptx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((tx_packetizer_in_data_copy & tx_packetizer_sink_last) & (tx_packetizer_sink_last_be > tx_packetizer_new_last_be))) begin
-                tx_packetizer_source_last_b <= 1'd0;
-                tx_packetizer_source_last_s <= 1'd1;
-                tx_packetizer_source_payload_last_be <= 1'd0;
-                if ((tx_packetizer_source_ready & tx_packetizer_source_valid)) begin
-                    tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= tx_packetizer_new_last_be;
-                    tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd1;
+            if (((packetizer_in_data_copy & packetizer_sink_last) & (packetizer_sink_last_be > packetizer_new_last_be))) begin
+                packetizer_source_last_b <= 1'd0;
+                packetizer_source_last_s <= 1'd1;
+                packetizer_source_payload_last_be <= 1'd0;
+                if ((packetizer_source_ready & packetizer_source_valid)) begin
+                    packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= packetizer_new_last_be;
+                    packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd1;
                     liteethudp_liteethudptx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (tx_packetizer_in_data_copy) begin
-                    tx_packetizer_source_last_b <= tx_packetizer_sink_last;
-                    tx_packetizer_source_last_s <= 1'd1;
-                    tx_packetizer_source_payload_last_be <= tx_packetizer_new_last_be;
+                if (packetizer_in_data_copy) begin
+                    packetizer_source_last_b <= packetizer_sink_last;
+                    packetizer_source_last_s <= 1'd1;
+                    packetizer_source_payload_last_be <= packetizer_new_last_be;
                 end
             end
-            if (tx_packetizer_in_data_copy) begin
-                tx_packetizer_sink_ready <= tx_packetizer_source_ready;
+            if (packetizer_in_data_copy) begin
+                packetizer_sink_ready <= packetizer_source_ready;
             end else begin
-                if (tx_packetizer_is_ongoing2) begin
-                    tx_packetizer_sink_ready <= (~tx_packetizer_sink_valid);
+                if (packetizer_is_ongoing2) begin
+                    packetizer_sink_ready <= (~packetizer_sink_valid);
                 end
             end
         end
@@ -5473,254 +5493,282 @@ always @(*) begin
 end
 always @(*) begin
     liteethudp_liteethudptx_next_state <= 1'd0;
-    tx_packetizer_source_ready <= 1'd0;
-    tx_source_source_first <= 1'd0;
-    tx_source_source_last <= 1'd0;
-    tx_source_source_param_ip_address <= 32'd0;
-    tx_source_source_param_length <= 16'd0;
-    tx_source_source_param_protocol <= 8'd0;
-    tx_source_source_payload_data <= 8'd0;
-    tx_source_source_payload_error <= 1'd0;
-    tx_source_source_payload_last_be <= 1'd0;
-    tx_source_source_valid <= 1'd0;
+    packetizer_source_ready <= 1'd0;
+    source_source_first <= 1'd0;
+    source_source_last <= 1'd0;
+    source_source_param_ip_address <= 32'd0;
+    source_source_param_length <= 16'd0;
+    source_source_param_protocol <= 8'd0;
+    source_source_payload_data <= 8'd0;
+    source_source_payload_error <= 1'd0;
+    source_source_payload_last_be <= 1'd0;
+    source_source_valid <= 1'd0;
     liteethudp_liteethudptx_next_state <= liteethudp_liteethudptx_state;
     case (liteethudp_liteethudptx_state)
         1'd1: begin
-            tx_source_source_valid <= tx_packetizer_source_valid;
-            tx_packetizer_source_ready <= tx_source_source_ready;
-            tx_source_source_first <= tx_packetizer_source_first;
-            tx_source_source_last <= tx_packetizer_source_last;
-            tx_source_source_payload_data <= tx_packetizer_source_payload_data;
-            tx_source_source_payload_last_be <= tx_packetizer_source_payload_last_be;
-            tx_source_source_payload_error <= tx_packetizer_source_payload_error;
-            tx_source_source_param_length <= tx_packetizer_source_param_length;
-            tx_source_source_param_protocol <= tx_packetizer_source_param_protocol;
-            tx_source_source_param_ip_address <= tx_packetizer_source_param_ip_address;
-            tx_source_source_param_length <= tx_packetizer_sink_param_length;
-            tx_source_source_param_protocol <= 5'd17;
-            tx_source_source_param_ip_address <= tx_sink_sink_param_ip_address;
-            if ((tx_source_source_valid & tx_source_source_ready)) begin
-                if (tx_source_source_last) begin
+            source_source_valid <= packetizer_source_valid;
+            packetizer_source_ready <= source_source_ready;
+            source_source_first <= packetizer_source_first;
+            source_source_last <= packetizer_source_last;
+            source_source_payload_data <= packetizer_source_payload_data;
+            source_source_payload_last_be <= packetizer_source_payload_last_be;
+            source_source_payload_error <= packetizer_source_payload_error;
+            source_source_param_length <= packetizer_source_param_length;
+            source_source_param_protocol <= packetizer_source_param_protocol;
+            source_source_param_ip_address <= packetizer_source_param_ip_address;
+            source_source_param_length <= packetizer_sink_param_length;
+            source_source_param_protocol <= 5'd17;
+            source_source_param_ip_address <= sink_sink_param_ip_address;
+            if ((source_source_valid & source_source_ready)) begin
+                if (source_source_last) begin
                     liteethudp_liteethudptx_next_state <= 1'd0;
                 end
             end
         end
         default: begin
-            if (tx_packetizer_source_valid) begin
+            if (packetizer_source_valid) begin
                 liteethudp_liteethudptx_next_state <= 1'd1;
             end
         end
     endcase
 end
-assign rx_depacketizer_sink_valid = rx_sink_sink_valid;
-assign rx_sink_sink_ready = rx_depacketizer_sink_ready;
-assign rx_depacketizer_sink_first = rx_sink_sink_first;
-assign rx_depacketizer_sink_last = rx_sink_sink_last;
-assign rx_depacketizer_sink_payload_data = rx_sink_sink_payload_data;
-assign rx_depacketizer_sink_payload_last_be = rx_sink_sink_payload_last_be;
-assign rx_depacketizer_sink_payload_error = rx_sink_sink_payload_error;
-assign rx_depacketizer_sink_param_length = rx_sink_sink_param_length;
-assign rx_depacketizer_sink_param_protocol = rx_sink_sink_param_protocol;
-assign rx_depacketizer_sink_param_ip_address = rx_sink_sink_param_ip_address;
-assign rx_source_source_payload_data = rx_depacketizer_source_payload_data;
-assign rx_source_source_payload_error = rx_depacketizer_source_payload_error;
-assign rx_source_source_param_dst_port = rx_depacketizer_source_param_dst_port;
-assign rx_source_source_param_src_port = rx_depacketizer_source_param_src_port;
-assign rx_source_source_param_ip_address = rx_sink_sink_param_ip_address;
-assign rx_source_source_param_length = (rx_depacketizer_source_param_length - 4'd8);
-assign rx_depacketizer_header = rx_depacketizer_sr;
-assign rx_depacketizer_source_param_checksum = {rhs_slice_proxy69[7:0], rhs_slice_proxy68[15:8]};
-assign rx_depacketizer_source_param_dst_port = {rhs_slice_proxy71[7:0], rhs_slice_proxy70[15:8]};
-assign rx_depacketizer_source_param_length = {rhs_slice_proxy73[7:0], rhs_slice_proxy72[15:8]};
-assign rx_depacketizer_source_param_src_port = {rhs_slice_proxy75[7:0], rhs_slice_proxy74[15:8]};
-assign rx_depacketizer_source_payload_error = rx_depacketizer_sink_payload_error;
-assign rx_depacketizer_sink_last_be = rx_depacketizer_sink_last;
-assign rx_depacketizer_new_last_be = {rx_depacketizer_sink_last_be};
-assign rx_depacketizer_is_in_copy = (rx_depacketizer_is_ongoing0 | rx_depacketizer_is_ongoing1);
+assign holdingudprx_depacketizer_sink_valid = holdingudprx_sink_sink_valid;
+assign holdingudprx_sink_sink_ready = holdingudprx_depacketizer_sink_ready;
+assign holdingudprx_depacketizer_sink_first = holdingudprx_sink_sink_first;
+assign holdingudprx_depacketizer_sink_last = holdingudprx_sink_sink_last;
+assign holdingudprx_depacketizer_sink_payload_data = holdingudprx_sink_sink_payload_data;
+assign holdingudprx_depacketizer_sink_payload_last_be = holdingudprx_sink_sink_payload_last_be;
+assign holdingudprx_depacketizer_sink_payload_error = holdingudprx_sink_sink_payload_error;
+assign holdingudprx_depacketizer_sink_param_length = holdingudprx_sink_sink_param_length;
+assign holdingudprx_depacketizer_sink_param_protocol = holdingudprx_sink_sink_param_protocol;
+assign holdingudprx_depacketizer_sink_param_ip_address = holdingudprx_sink_sink_param_ip_address;
+assign holdingudprx_payload_len = (holdingudprx_depacketizer_source_param_length - 4'd8);
+assign holdingudprx_depacketizer_header = holdingudprx_depacketizer_sr;
+assign holdingudprx_depacketizer_source_param_checksum = {rhs_slice_proxy69[7:0], rhs_slice_proxy68[15:8]};
+assign holdingudprx_depacketizer_source_param_dst_port = {rhs_slice_proxy71[7:0], rhs_slice_proxy70[15:8]};
+assign holdingudprx_depacketizer_source_param_length = {rhs_slice_proxy73[7:0], rhs_slice_proxy72[15:8]};
+assign holdingudprx_depacketizer_source_param_src_port = {rhs_slice_proxy75[7:0], rhs_slice_proxy74[15:8]};
+assign holdingudprx_depacketizer_source_payload_error = holdingudprx_depacketizer_sink_payload_error;
+assign holdingudprx_depacketizer_sink_last_be = holdingudprx_depacketizer_sink_last;
+assign holdingudprx_depacketizer_new_last_be = {holdingudprx_depacketizer_sink_last_be};
+assign holdingudprx_depacketizer_is_in_copy = (holdingudprx_depacketizer_is_ongoing0 | holdingudprx_depacketizer_is_ongoing1);
 always @(*) begin
-    rx_depacketizer_source_last <= 1'd0;
-    if (rx_depacketizer_source_last_s) begin
-        rx_depacketizer_source_last <= rx_depacketizer_source_last_b;
+    holdingudprx_depacketizer_source_last <= 1'd0;
+    if (holdingudprx_depacketizer_source_last_s) begin
+        holdingudprx_depacketizer_source_last <= holdingudprx_depacketizer_source_last_b;
     end else begin
-        rx_depacketizer_source_last <= rx_depacketizer_source_last_a;
+        holdingudprx_depacketizer_source_last <= holdingudprx_depacketizer_source_last_a;
     end
 end
 always @(*) begin
-    liteethudp_liteethudprx_fsm0_next_state <= 2'd0;
-    liteethudp_liteethudprx_fsm1_next_state <= 1'd0;
-    rx_depacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
-    rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
-    rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
-    rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
-    rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
-    rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
-    rx_depacketizer_is_ongoing0 <= 1'd0;
-    rx_depacketizer_is_ongoing1 <= 1'd0;
-    rx_depacketizer_is_ongoing2 <= 1'd0;
-    rx_depacketizer_is_ongoing3 <= 1'd0;
-    rx_depacketizer_sink_ready <= 1'd0;
-    rx_depacketizer_source_last_a <= 1'd0;
-    rx_depacketizer_source_last_b <= 1'd0;
-    rx_depacketizer_source_last_s <= 1'd0;
-    rx_depacketizer_source_payload_data <= 8'd0;
-    rx_depacketizer_source_payload_last_be <= 1'd0;
-    rx_depacketizer_source_valid <= 1'd0;
-    rx_depacketizer_sr_shift <= 1'd0;
-    liteethudp_liteethudprx_fsm0_next_state <= liteethudp_liteethudprx_fsm0_state;
-    case (liteethudp_liteethudprx_fsm0_state)
+    holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
+    holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
+    holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
+    holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
+    holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
+    holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
+    holdingudprx_depacketizer_is_ongoing0 <= 1'd0;
+    holdingudprx_depacketizer_is_ongoing1 <= 1'd0;
+    holdingudprx_depacketizer_is_ongoing2 <= 1'd0;
+    holdingudprx_depacketizer_is_ongoing3 <= 1'd0;
+    holdingudprx_depacketizer_sink_ready <= 1'd0;
+    holdingudprx_depacketizer_source_last_a <= 1'd0;
+    holdingudprx_depacketizer_source_last_b <= 1'd0;
+    holdingudprx_depacketizer_source_last_s <= 1'd0;
+    holdingudprx_depacketizer_source_payload_data <= 8'd0;
+    holdingudprx_depacketizer_source_payload_last_be <= 1'd0;
+    holdingudprx_depacketizer_source_valid <= 1'd0;
+    holdingudprx_depacketizer_sr_shift <= 1'd0;
+    liteethudp_holdingudprx_fsm0_next_state <= 2'd0;
+    liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
+    liteethudp_holdingudprx_fsm0_next_state <= liteethudp_holdingudprx_fsm0_state;
+    case (liteethudp_holdingudprx_fsm0_state)
         1'd1: begin
-            rx_depacketizer_sink_ready <= 1'd1;
-            if (rx_depacketizer_sink_valid) begin
-                rx_depacketizer_count_liteethudp_fsm0_next_value2 <= (rx_depacketizer_count + 1'd1);
-                rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-                rx_depacketizer_sr_shift <= 1'd1;
-                if ((rx_depacketizer_count == 3'd7)) begin
-                    liteethudp_liteethudprx_fsm0_next_state <= 2'd2;
-                    rx_depacketizer_count_liteethudp_fsm0_next_value2 <= (rx_depacketizer_count + 1'd1);
-                    rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+            holdingudprx_depacketizer_sink_ready <= 1'd1;
+            if (holdingudprx_depacketizer_sink_valid) begin
+                holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= (holdingudprx_depacketizer_count + 1'd1);
+                holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+                holdingudprx_depacketizer_sr_shift <= 1'd1;
+                if ((holdingudprx_depacketizer_count == 3'd7)) begin
+                    liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
+                    holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= (holdingudprx_depacketizer_count + 1'd1);
+                    holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
                 end
             end
         end
         2'd2: begin
-            rx_depacketizer_source_valid <= (rx_depacketizer_sink_valid | rx_depacketizer_sink_d_last);
-            rx_depacketizer_source_last_a <= (rx_depacketizer_sink_last | rx_depacketizer_sink_d_last);
-            rx_depacketizer_sink_ready <= rx_depacketizer_source_ready;
-            rx_depacketizer_source_payload_data <= rx_depacketizer_sink_payload_data;
-            if ((rx_depacketizer_source_valid & rx_depacketizer_source_ready)) begin
-                if (rx_depacketizer_source_last) begin
-                    liteethudp_liteethudprx_fsm0_next_state <= 1'd0;
+            holdingudprx_depacketizer_source_valid <= (holdingudprx_depacketizer_sink_valid | holdingudprx_depacketizer_sink_d_last);
+            holdingudprx_depacketizer_source_last_a <= (holdingudprx_depacketizer_sink_last | holdingudprx_depacketizer_sink_d_last);
+            holdingudprx_depacketizer_sink_ready <= holdingudprx_depacketizer_source_ready;
+            holdingudprx_depacketizer_source_payload_data <= holdingudprx_depacketizer_sink_payload_data;
+            if ((holdingudprx_depacketizer_source_valid & holdingudprx_depacketizer_source_ready)) begin
+                if (holdingudprx_depacketizer_source_last) begin
+                    liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
                 end
             end
-            rx_depacketizer_is_ongoing0 <= 1'd1;
-            rx_depacketizer_is_ongoing2 <= 1'd1;
+            holdingudprx_depacketizer_is_ongoing0 <= 1'd1;
+            holdingudprx_depacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            rx_depacketizer_is_ongoing1 <= 1'd1;
-            rx_depacketizer_is_ongoing3 <= 1'd1;
+            holdingudprx_depacketizer_is_ongoing1 <= 1'd1;
+            holdingudprx_depacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            rx_depacketizer_sink_ready <= 1'd1;
-            rx_depacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
-            rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-            if (rx_depacketizer_sink_valid) begin
-                rx_depacketizer_sr_shift <= 1'd1;
-                rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
-                rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
+            holdingudprx_depacketizer_sink_ready <= 1'd1;
+            holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
+            holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+            if (holdingudprx_depacketizer_sink_valid) begin
+                holdingudprx_depacketizer_sr_shift <= 1'd1;
+                holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
+                holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
-                    liteethudp_liteethudprx_fsm0_next_state <= 2'd2;
+                    liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
                 end else begin
-                    liteethudp_liteethudprx_fsm0_next_state <= 1'd1;
+                    liteethudp_holdingudprx_fsm0_next_state <= 1'd1;
                 end
             end
         end
     endcase
-    liteethudp_liteethudprx_fsm1_next_state <= liteethudp_liteethudprx_fsm1_state;
-    case (liteethudp_liteethudprx_fsm1_state)
+    liteethudp_holdingudprx_fsm1_next_state <= liteethudp_holdingudprx_fsm1_state;
+    case (liteethudp_holdingudprx_fsm1_state)
         1'd1: begin
-            rx_depacketizer_source_last_b <= 1'd1;
-            rx_depacketizer_source_last_s <= 1'd1;
-            rx_depacketizer_source_payload_last_be <= rx_depacketizer_delayed_last_be;
-            rx_depacketizer_sink_ready <= 1'd0;
-            if ((rx_depacketizer_source_ready & rx_depacketizer_source_valid)) begin
-                liteethudp_liteethudprx_fsm1_next_state <= 1'd0;
+            holdingudprx_depacketizer_source_last_b <= 1'd1;
+            holdingudprx_depacketizer_source_last_s <= 1'd1;
+            holdingudprx_depacketizer_source_payload_last_be <= holdingudprx_depacketizer_delayed_last_be;
+            holdingudprx_depacketizer_sink_ready <= 1'd0;
+            if ((holdingudprx_depacketizer_source_ready & holdingudprx_depacketizer_source_valid)) begin
+                liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((rx_depacketizer_sink_valid & rx_depacketizer_sink_last) & (rx_depacketizer_sink_last_be > rx_depacketizer_new_last_be))) begin
-                rx_depacketizer_source_last_b <= 1'd0;
-                rx_depacketizer_source_last_s <= 1'd1;
-                rx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((rx_depacketizer_source_ready & rx_depacketizer_source_valid) | ((~rx_depacketizer_was_in_copy) & rx_depacketizer_is_in_copy))) begin
-                    rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= rx_depacketizer_new_last_be;
-                    rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
-                    liteethudp_liteethudprx_fsm1_next_state <= 1'd1;
+            if (((holdingudprx_depacketizer_sink_valid & holdingudprx_depacketizer_sink_last) & (holdingudprx_depacketizer_sink_last_be > holdingudprx_depacketizer_new_last_be))) begin
+                holdingudprx_depacketizer_source_last_b <= 1'd0;
+                holdingudprx_depacketizer_source_last_s <= 1'd1;
+                holdingudprx_depacketizer_source_payload_last_be <= 1'd0;
+                if (((holdingudprx_depacketizer_source_ready & holdingudprx_depacketizer_source_valid) | ((~holdingudprx_depacketizer_was_in_copy) & holdingudprx_depacketizer_is_in_copy))) begin
+                    holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= holdingudprx_depacketizer_new_last_be;
+                    holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
+                    liteethudp_holdingudprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (rx_depacketizer_sink_last) begin
-                    rx_depacketizer_source_last_b <= 1'd1;
-                    rx_depacketizer_source_last_s <= 1'd1;
-                    rx_depacketizer_source_payload_last_be <= rx_depacketizer_new_last_be;
+                if (holdingudprx_depacketizer_sink_last) begin
+                    holdingudprx_depacketizer_source_last_b <= 1'd1;
+                    holdingudprx_depacketizer_source_last_s <= 1'd1;
+                    holdingudprx_depacketizer_source_payload_last_be <= holdingudprx_depacketizer_new_last_be;
                 end
             end
-            if ((rx_depacketizer_is_ongoing2 | (rx_depacketizer_is_ongoing3 & (~rx_depacketizer_fsm_from_idle)))) begin
-                rx_depacketizer_sink_ready <= rx_depacketizer_source_ready;
+            if ((holdingudprx_depacketizer_is_ongoing2 | (holdingudprx_depacketizer_is_ongoing3 & (~holdingudprx_depacketizer_fsm_from_idle)))) begin
+                holdingudprx_depacketizer_sink_ready <= holdingudprx_depacketizer_source_ready;
             end else begin
-                rx_depacketizer_sink_ready <= 1'd1;
+                holdingudprx_depacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
-    liteethudp_liteethudprx_next_state <= 2'd0;
-    rx_count_liteethudp_next_value <= 16'd0;
-    rx_count_liteethudp_next_value_ce <= 1'd0;
-    rx_depacketizer_source_ready <= 1'd0;
-    rx_source_source_last <= 1'd0;
-    rx_source_source_payload_last_be <= 1'd0;
-    rx_source_source_valid <= 1'd0;
-    liteethudp_liteethudprx_next_state <= liteethudp_liteethudprx_state;
-    case (liteethudp_liteethudprx_state)
+    holdingudprx0_liteethudp_next_value3 <= 16'd0;
+    holdingudprx0_liteethudp_next_value_ce3 <= 1'd0;
+    holdingudprx1_liteethudp_next_value4 <= 16'd0;
+    holdingudprx1_liteethudp_next_value_ce4 <= 1'd0;
+    holdingudprx2_liteethudp_next_value5 <= 16'd0;
+    holdingudprx2_liteethudp_next_value_ce5 <= 1'd0;
+    holdingudprx3_liteethudp_next_value6 <= 32'd0;
+    holdingudprx3_liteethudp_next_value_ce6 <= 1'd0;
+    holdingudprx_count_liteethudp_next_value0 <= 16'd0;
+    holdingudprx_count_liteethudp_next_value_ce0 <= 1'd0;
+    holdingudprx_depacketizer_source_ready <= 1'd0;
+    holdingudprx_err_liteethudp_next_value1 <= 1'd0;
+    holdingudprx_err_liteethudp_next_value_ce1 <= 1'd0;
+    holdingudprx_held_liteethudp_next_value2 <= 8'd0;
+    holdingudprx_held_liteethudp_next_value_ce2 <= 1'd0;
+    holdingudprx_source_source_last <= 1'd0;
+    holdingudprx_source_source_param_dst_port <= 16'd0;
+    holdingudprx_source_source_param_ip_address <= 32'd0;
+    holdingudprx_source_source_param_length <= 16'd0;
+    holdingudprx_source_source_param_src_port <= 16'd0;
+    holdingudprx_source_source_payload_data <= 8'd0;
+    holdingudprx_source_source_payload_error <= 1'd0;
+    holdingudprx_source_source_valid <= 1'd0;
+    liteethudp_holdingudprx_next_state <= 3'd0;
+    liteethudp_holdingudprx_next_state <= liteethudp_holdingudprx_state;
+    case (liteethudp_holdingudprx_state)
         1'd1: begin
-            rx_source_source_valid <= rx_depacketizer_source_valid;
-            rx_depacketizer_source_ready <= rx_source_source_ready;
-            rx_source_source_last <= (rx_depacketizer_source_last | (rx_count >= rx_source_source_param_length));
-            if (rx_depacketizer_source_payload_last_be) begin
-                rx_source_source_payload_last_be <= rx_depacketizer_source_payload_last_be;
-            end else begin
-                if (rx_source_source_last) begin
-                    case ((rx_source_source_param_length & 1'd0))
-                        1'd1: begin
-                            rx_source_source_payload_last_be <= 1'd1;
-                        end
-                        2'd2: begin
-                            rx_source_source_payload_last_be <= 2'd2;
-                        end
-                        2'd3: begin
-                            rx_source_source_payload_last_be <= 3'd4;
-                        end
-                        3'd4: begin
-                            rx_source_source_payload_last_be <= 4'd8;
-                        end
-                        3'd5: begin
-                            rx_source_source_payload_last_be <= 5'd16;
-                        end
-                        3'd6: begin
-                            rx_source_source_payload_last_be <= 6'd32;
-                        end
-                        3'd7: begin
-                            rx_source_source_payload_last_be <= 7'd64;
-                        end
-                        default: begin
-                            rx_source_source_payload_last_be <= 1'd1;
-                        end
-                    endcase
-                end
-            end
-            if ((rx_source_source_valid & rx_source_source_ready)) begin
-                rx_count_liteethudp_next_value <= (rx_count + 1'd1);
-                rx_count_liteethudp_next_value_ce <= 1'd1;
-                if (rx_depacketizer_source_last) begin
-                    liteethudp_liteethudprx_next_state <= 1'd0;
-                end else begin
-                    if (rx_source_source_last) begin
-                        liteethudp_liteethudprx_next_state <= 2'd2;
+            holdingudprx_source_source_param_src_port <= holdingudprx_depacketizer_source_param_src_port;
+            holdingudprx_source_source_param_dst_port <= holdingudprx_depacketizer_source_param_dst_port;
+            holdingudprx_source_source_param_length <= holdingudprx_payload_len;
+            holdingudprx_source_source_param_ip_address <= holdingudprx_sink_sink_param_ip_address;
+            holdingudprx_source_source_payload_data <= holdingudprx_depacketizer_source_payload_data;
+            if ((holdingudprx_depacketizer_source_last | (holdingudprx_count < holdingudprx_payload_len))) begin
+                holdingudprx_source_source_valid <= holdingudprx_depacketizer_source_valid;
+                holdingudprx_depacketizer_source_ready <= holdingudprx_source_source_ready;
+                holdingudprx_source_source_last <= holdingudprx_depacketizer_source_last;
+                holdingudprx_source_source_payload_error <= (holdingudprx_depacketizer_source_payload_error | holdingudprx_err);
+                if ((holdingudprx_depacketizer_source_valid & holdingudprx_source_source_ready)) begin
+                    holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
+                    holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_depacketizer_source_payload_error);
+                    holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+                    if (holdingudprx_depacketizer_source_last) begin
+                        liteethudp_holdingudprx_next_state <= 1'd0;
                     end
+                end
+            end else begin
+                holdingudprx_depacketizer_source_ready <= 1'd1;
+                if (holdingudprx_depacketizer_source_valid) begin
+                    holdingudprx_held_liteethudp_next_value2 <= holdingudprx_depacketizer_source_payload_data;
+                    holdingudprx_held_liteethudp_next_value_ce2 <= 1'd1;
+                    holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_depacketizer_source_payload_error);
+                    holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+                    holdingudprx0_liteethudp_next_value3 <= holdingudprx_depacketizer_source_param_src_port;
+                    holdingudprx0_liteethudp_next_value_ce3 <= 1'd1;
+                    holdingudprx1_liteethudp_next_value4 <= holdingudprx_depacketizer_source_param_dst_port;
+                    holdingudprx1_liteethudp_next_value_ce4 <= 1'd1;
+                    holdingudprx2_liteethudp_next_value5 <= holdingudprx_payload_len;
+                    holdingudprx2_liteethudp_next_value_ce5 <= 1'd1;
+                    holdingudprx3_liteethudp_next_value6 <= holdingudprx_sink_sink_param_ip_address;
+                    holdingudprx3_liteethudp_next_value_ce6 <= 1'd1;
+                    liteethudp_holdingudprx_next_state <= 2'd2;
                 end
             end
         end
         2'd2: begin
-            rx_depacketizer_source_ready <= 1'd1;
-            if (((rx_depacketizer_source_valid & rx_depacketizer_source_last) & rx_depacketizer_source_ready)) begin
-                liteethudp_liteethudprx_next_state <= 1'd0;
+            holdingudprx_depacketizer_source_ready <= 1'd1;
+            if (holdingudprx_depacketizer_source_valid) begin
+                holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_depacketizer_source_payload_error);
+                holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+                if (holdingudprx_depacketizer_source_last) begin
+                    liteethudp_holdingudprx_next_state <= 2'd3;
+                end
+            end
+        end
+        2'd3: begin
+            holdingudprx_source_source_valid <= 1'd1;
+            holdingudprx_source_source_last <= 1'd1;
+            holdingudprx_source_source_payload_data <= holdingudprx_held;
+            holdingudprx_source_source_payload_error <= holdingudprx_err;
+            holdingudprx_source_source_param_src_port <= holdingudprx0;
+            holdingudprx_source_source_param_dst_port <= holdingudprx1;
+            holdingudprx_source_source_param_length <= holdingudprx2;
+            holdingudprx_source_source_param_ip_address <= holdingudprx3;
+            if (holdingudprx_source_source_ready) begin
+                liteethudp_holdingudprx_next_state <= 1'd0;
+            end
+        end
+        3'd4: begin
+            holdingudprx_depacketizer_source_ready <= 1'd1;
+            if ((holdingudprx_depacketizer_source_valid & holdingudprx_depacketizer_source_last)) begin
+                liteethudp_holdingudprx_next_state <= 1'd0;
             end
         end
         default: begin
-            rx_count_liteethudp_next_value <= 1'd1;
-            rx_count_liteethudp_next_value_ce <= 1'd1;
-            if (rx_depacketizer_source_valid) begin
-                liteethudp_liteethudprx_next_state <= 2'd2;
-                if ((rx_sink_sink_param_protocol == 5'd17)) begin
-                    liteethudp_liteethudprx_next_state <= 1'd1;
+            holdingudprx_count_liteethudp_next_value0 <= 1'd1;
+            holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+            holdingudprx_err_liteethudp_next_value1 <= 1'd0;
+            holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+            if (holdingudprx_depacketizer_source_valid) begin
+                liteethudp_holdingudprx_next_state <= 3'd4;
+                if ((holdingudprx_sink_sink_param_protocol == 5'd17)) begin
+                    liteethudp_holdingudprx_next_state <= 1'd1;
                 end
             end
         end
@@ -6098,14 +6146,14 @@ assign rhs_slice_proxy64 = icmp_rx_depacketizer_header[63:32];
 assign rhs_slice_proxy65 = icmp_rx_depacketizer_header[63:32];
 assign rhs_slice_proxy66 = icmp_rx_depacketizer_header[63:32];
 assign rhs_slice_proxy67 = icmp_rx_depacketizer_header[63:32];
-assign rhs_slice_proxy68 = rx_depacketizer_header[63:48];
-assign rhs_slice_proxy69 = rx_depacketizer_header[63:48];
-assign rhs_slice_proxy70 = rx_depacketizer_header[31:16];
-assign rhs_slice_proxy71 = rx_depacketizer_header[31:16];
-assign rhs_slice_proxy72 = rx_depacketizer_header[47:32];
-assign rhs_slice_proxy73 = rx_depacketizer_header[47:32];
-assign rhs_slice_proxy74 = rx_depacketizer_header[15:0];
-assign rhs_slice_proxy75 = rx_depacketizer_header[15:0];
+assign rhs_slice_proxy68 = holdingudprx_depacketizer_header[63:48];
+assign rhs_slice_proxy69 = holdingudprx_depacketizer_header[63:48];
+assign rhs_slice_proxy70 = holdingudprx_depacketizer_header[31:16];
+assign rhs_slice_proxy71 = holdingudprx_depacketizer_header[31:16];
+assign rhs_slice_proxy72 = holdingudprx_depacketizer_header[47:32];
+assign rhs_slice_proxy73 = holdingudprx_depacketizer_header[47:32];
+assign rhs_slice_proxy74 = holdingudprx_depacketizer_header[15:0];
+assign rhs_slice_proxy75 = holdingudprx_depacketizer_header[15:0];
 assign mac_core_tx_cdc_cdc_produce_rdomain = multiregimpl0_regs1;
 assign mac_core_tx_cdc_cdc_consume_wdomain = multiregimpl1_regs1;
 assign mac_core_pulsesynchronizer0_toggle_o = multiregimpl2_regs1;
@@ -6706,45 +6754,63 @@ always @(posedge sys_clk) begin
             icmp_echo_param_fifo_level0 <= (icmp_echo_param_fifo_level0 - 1'd1);
         end
     end
-    if (tx_packetizer_sr_load) begin
-        tx_packetizer_sr <= tx_packetizer_header;
+    if (packetizer_sr_load) begin
+        packetizer_sr <= packetizer_header;
     end
-    if (tx_packetizer_sr_shift) begin
-        tx_packetizer_sr <= tx_packetizer_sr[63:8];
+    if (packetizer_sr_shift) begin
+        packetizer_sr <= packetizer_sr[63:8];
     end
     liteethudp_liteethudptx_fsm0_state <= liteethudp_liteethudptx_fsm0_next_state;
-    if (tx_packetizer_count_liteethudp_fsm0_next_value_ce0) begin
-        tx_packetizer_count <= tx_packetizer_count_liteethudp_fsm0_next_value0;
+    if (packetizer_count_liteethudp_fsm0_next_value_ce0) begin
+        packetizer_count <= packetizer_count_liteethudp_fsm0_next_value0;
     end
-    if (tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1) begin
-        tx_packetizer_fsm_from_idle <= tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1;
+    if (packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1) begin
+        packetizer_fsm_from_idle <= packetizer_fsm_from_idle_liteethudp_fsm0_next_value1;
     end
     liteethudp_liteethudptx_fsm1_state <= liteethudp_liteethudptx_fsm1_next_state;
-    if (tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0) begin
-        tx_packetizer_delayed_last_be <= tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value0;
+    if (packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0) begin
+        packetizer_delayed_last_be <= packetizer_delayed_last_be_liteethudp_fsm1_next_value0;
     end
     liteethudp_liteethudptx_state <= liteethudp_liteethudptx_next_state;
-    if (rx_depacketizer_sr_shift) begin
-        rx_depacketizer_sr <= {rx_depacketizer_sink_payload_data, rx_depacketizer_sr[63:8]};
+    if (holdingudprx_depacketizer_sr_shift) begin
+        holdingudprx_depacketizer_sr <= {holdingudprx_depacketizer_sink_payload_data, holdingudprx_depacketizer_sr[63:8]};
     end
-    if (rx_depacketizer_sr_shift_leftover) begin
-        rx_depacketizer_sr <= {rx_depacketizer_sink_payload_data, rx_depacketizer_sr[63:0]};
+    if (holdingudprx_depacketizer_sr_shift_leftover) begin
+        holdingudprx_depacketizer_sr <= {holdingudprx_depacketizer_sink_payload_data, holdingudprx_depacketizer_sr[63:0]};
     end
-    rx_depacketizer_was_in_copy <= rx_depacketizer_is_in_copy;
-    liteethudp_liteethudprx_fsm0_state <= liteethudp_liteethudprx_fsm0_next_state;
-    if (rx_depacketizer_count_liteethudp_fsm0_next_value_ce2) begin
-        rx_depacketizer_count <= rx_depacketizer_count_liteethudp_fsm0_next_value2;
+    holdingudprx_depacketizer_was_in_copy <= holdingudprx_depacketizer_is_in_copy;
+    liteethudp_holdingudprx_fsm0_state <= liteethudp_holdingudprx_fsm0_next_state;
+    if (holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2) begin
+        holdingudprx_depacketizer_count <= holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2;
     end
-    if (rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
-        rx_depacketizer_fsm_from_idle <= rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
+    if (holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
+        holdingudprx_depacketizer_fsm_from_idle <= holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
     end
-    liteethudp_liteethudprx_fsm1_state <= liteethudp_liteethudprx_fsm1_next_state;
-    if (rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
-        rx_depacketizer_delayed_last_be <= rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
+    liteethudp_holdingudprx_fsm1_state <= liteethudp_holdingudprx_fsm1_next_state;
+    if (holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
+        holdingudprx_depacketizer_delayed_last_be <= holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
     end
-    liteethudp_liteethudprx_state <= liteethudp_liteethudprx_next_state;
-    if (rx_count_liteethudp_next_value_ce) begin
-        rx_count <= rx_count_liteethudp_next_value;
+    liteethudp_holdingudprx_state <= liteethudp_holdingudprx_next_state;
+    if (holdingudprx_count_liteethudp_next_value_ce0) begin
+        holdingudprx_count <= holdingudprx_count_liteethudp_next_value0;
+    end
+    if (holdingudprx_err_liteethudp_next_value_ce1) begin
+        holdingudprx_err <= holdingudprx_err_liteethudp_next_value1;
+    end
+    if (holdingudprx_held_liteethudp_next_value_ce2) begin
+        holdingudprx_held <= holdingudprx_held_liteethudp_next_value2;
+    end
+    if (holdingudprx0_liteethudp_next_value_ce3) begin
+        holdingudprx0 <= holdingudprx0_liteethudp_next_value3;
+    end
+    if (holdingudprx1_liteethudp_next_value_ce4) begin
+        holdingudprx1 <= holdingudprx1_liteethudp_next_value4;
+    end
+    if (holdingudprx2_liteethudp_next_value_ce5) begin
+        holdingudprx2 <= holdingudprx2_liteethudp_next_value5;
+    end
+    if (holdingudprx3_liteethudp_next_value_ce6) begin
+        holdingudprx3 <= holdingudprx3_liteethudp_next_value6;
     end
     if (liteethudp_first) begin
         liteethudp_sel_ongoing <= liteethudp_sel0;
@@ -6864,14 +6930,20 @@ always @(posedge sys_clk) begin
         icmp_echo_param_fifo_level0 <= 2'd0;
         icmp_echo_param_fifo_produce <= 1'd0;
         icmp_echo_param_fifo_consume <= 1'd0;
-        tx_packetizer_count <= 3'd0;
-        tx_packetizer_fsm_from_idle <= 1'd0;
-        tx_packetizer_delayed_last_be <= 1'd0;
-        rx_depacketizer_count <= 3'd0;
-        rx_depacketizer_fsm_from_idle <= 1'd0;
-        rx_depacketizer_delayed_last_be <= 1'd0;
-        rx_depacketizer_was_in_copy <= 1'd0;
-        rx_count <= 16'd0;
+        packetizer_count <= 3'd0;
+        packetizer_fsm_from_idle <= 1'd0;
+        packetizer_delayed_last_be <= 1'd0;
+        holdingudprx_depacketizer_count <= 3'd0;
+        holdingudprx_depacketizer_fsm_from_idle <= 1'd0;
+        holdingudprx_depacketizer_delayed_last_be <= 1'd0;
+        holdingudprx_depacketizer_was_in_copy <= 1'd0;
+        holdingudprx_count <= 16'd0;
+        holdingudprx_err <= 1'd0;
+        holdingudprx_held <= 8'd0;
+        holdingudprx0 <= 16'd0;
+        holdingudprx1 <= 16'd0;
+        holdingudprx2 <= 16'd0;
+        holdingudprx3 <= 32'd0;
         liteethmac_grant <= 1'd0;
         liteethmac_status0_first <= 1'd1;
         liteethmac_status0_ongoing1 <= 1'd0;
@@ -6915,9 +6987,9 @@ always @(posedge sys_clk) begin
         liteethudp_liteethudptx_fsm0_state <= 2'd0;
         liteethudp_liteethudptx_fsm1_state <= 1'd0;
         liteethudp_liteethudptx_state <= 1'd0;
-        liteethudp_liteethudprx_fsm0_state <= 2'd0;
-        liteethudp_liteethudprx_fsm1_state <= 1'd0;
-        liteethudp_liteethudprx_state <= 2'd0;
+        liteethudp_holdingudprx_fsm0_state <= 2'd0;
+        liteethudp_holdingudprx_fsm1_state <= 1'd0;
+        liteethudp_holdingudprx_state <= 3'd0;
         liteethudp_first <= 1'd1;
         liteethudp_ongoing1 <= 1'd0;
         liteethudp_sel_ongoing <= 1'd0;
@@ -7419,5 +7491,5 @@ IDDRX1F IDDRX1F_4(
 endmodule
 
 // -----------------------------------------------------------------------------
-//  Auto-Generated by LiteX on 2026-11-28 15:05:27.
+//  Auto-Generated by LiteX on 2026-11-28 15:35:07.
 //------------------------------------------------------------------------------

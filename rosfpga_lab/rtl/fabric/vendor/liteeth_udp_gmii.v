@@ -190,7 +190,7 @@ UDPPortCore
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
 │    │    │    └─── fsm (FSM)
-│    │    └─── rx (LiteEthUDPRX)
+│    │    └─── rx (HoldingUDPRX)
 │    │    │    └─── depacketizer (LiteEthUDPDepacketizer)
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
@@ -365,13 +365,13 @@ reg           builder_liteethmac_txdatapath_liteethmacpaddinginserter_state = 1'
 reg     [1:0] builder_liteethmac_txdatapath_liteethmacpreambleinserter_next_state = 2'd0;
 reg     [1:0] builder_liteethmac_txdatapath_liteethmacpreambleinserter_state = 2'd0;
 reg           builder_liteethudp_first = 1'd1;
+reg     [1:0] builder_liteethudp_holdingudprx_fsm0_next_state = 2'd0;
+reg     [1:0] builder_liteethudp_holdingudprx_fsm0_state = 2'd0;
+reg           builder_liteethudp_holdingudprx_fsm1_next_state = 1'd0;
+reg           builder_liteethudp_holdingudprx_fsm1_state = 1'd0;
+reg     [2:0] builder_liteethudp_holdingudprx_next_state = 3'd0;
+reg     [2:0] builder_liteethudp_holdingudprx_state = 3'd0;
 wire          builder_liteethudp_last;
-reg     [1:0] builder_liteethudp_liteethudprx_fsm0_next_state = 2'd0;
-reg     [1:0] builder_liteethudp_liteethudprx_fsm0_state = 2'd0;
-reg           builder_liteethudp_liteethudprx_fsm1_next_state = 1'd0;
-reg           builder_liteethudp_liteethudprx_fsm1_state = 1'd0;
-reg     [1:0] builder_liteethudp_liteethudprx_next_state = 2'd0;
-reg     [1:0] builder_liteethudp_liteethudprx_state = 2'd0;
 reg     [1:0] builder_liteethudp_liteethudptx_fsm0_next_state = 2'd0;
 reg     [1:0] builder_liteethudp_liteethudptx_fsm0_state = 2'd0;
 reg           builder_liteethudp_liteethudptx_fsm1_next_state = 1'd0;
@@ -742,6 +742,94 @@ wire          main_crossbar_source_payload_last_be;
 wire          main_crossbar_source_ready;
 wire          main_crossbar_source_valid;
 reg           main_dv_d = 1'd0;
+reg    [15:0] main_holdingudprx0 = 16'd0;
+reg    [15:0] main_holdingudprx0_liteethudp_next_value3 = 16'd0;
+reg           main_holdingudprx0_liteethudp_next_value_ce3 = 1'd0;
+reg    [15:0] main_holdingudprx1 = 16'd0;
+reg    [15:0] main_holdingudprx1_liteethudp_next_value4 = 16'd0;
+reg           main_holdingudprx1_liteethudp_next_value_ce4 = 1'd0;
+reg    [15:0] main_holdingudprx2 = 16'd0;
+reg    [15:0] main_holdingudprx2_liteethudp_next_value5 = 16'd0;
+reg           main_holdingudprx2_liteethudp_next_value_ce5 = 1'd0;
+reg    [31:0] main_holdingudprx3 = 32'd0;
+reg    [31:0] main_holdingudprx3_liteethudp_next_value6 = 32'd0;
+reg           main_holdingudprx3_liteethudp_next_value_ce6 = 1'd0;
+reg    [15:0] main_holdingudprx_count = 16'd0;
+reg    [15:0] main_holdingudprx_count_liteethudp_next_value0 = 16'd0;
+reg           main_holdingudprx_count_liteethudp_next_value_ce0 = 1'd0;
+reg     [2:0] main_holdingudprx_depacketizer_count = 3'd0;
+reg     [2:0] main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
+reg           main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
+reg           main_holdingudprx_depacketizer_delayed_last_be = 1'd0;
+reg           main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
+reg           main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
+reg           main_holdingudprx_depacketizer_fsm_from_idle = 1'd0;
+reg           main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
+reg           main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
+wire   [63:0] main_holdingudprx_depacketizer_header;
+wire          main_holdingudprx_depacketizer_is_in_copy;
+reg           main_holdingudprx_depacketizer_is_ongoing0 = 1'd0;
+reg           main_holdingudprx_depacketizer_is_ongoing1 = 1'd0;
+reg           main_holdingudprx_depacketizer_is_ongoing2 = 1'd0;
+reg           main_holdingudprx_depacketizer_is_ongoing3 = 1'd0;
+wire          main_holdingudprx_depacketizer_new_last_be;
+reg           main_holdingudprx_depacketizer_sink_d_last = 1'd0;
+wire          main_holdingudprx_depacketizer_sink_first;
+wire          main_holdingudprx_depacketizer_sink_last;
+wire          main_holdingudprx_depacketizer_sink_last_be;
+wire   [31:0] main_holdingudprx_depacketizer_sink_param_ip_address;
+wire   [15:0] main_holdingudprx_depacketizer_sink_param_length;
+wire    [7:0] main_holdingudprx_depacketizer_sink_param_protocol;
+wire    [7:0] main_holdingudprx_depacketizer_sink_payload_data;
+wire          main_holdingudprx_depacketizer_sink_payload_error;
+wire          main_holdingudprx_depacketizer_sink_payload_last_be;
+reg           main_holdingudprx_depacketizer_sink_ready = 1'd0;
+wire          main_holdingudprx_depacketizer_sink_valid;
+reg           main_holdingudprx_depacketizer_source_last = 1'd0;
+reg           main_holdingudprx_depacketizer_source_last_a = 1'd0;
+reg           main_holdingudprx_depacketizer_source_last_b = 1'd0;
+reg           main_holdingudprx_depacketizer_source_last_s = 1'd0;
+wire   [15:0] main_holdingudprx_depacketizer_source_param_checksum;
+wire   [15:0] main_holdingudprx_depacketizer_source_param_dst_port;
+wire   [15:0] main_holdingudprx_depacketizer_source_param_length;
+wire   [15:0] main_holdingudprx_depacketizer_source_param_src_port;
+reg     [7:0] main_holdingudprx_depacketizer_source_payload_data = 8'd0;
+wire          main_holdingudprx_depacketizer_source_payload_error;
+reg           main_holdingudprx_depacketizer_source_payload_last_be = 1'd0;
+reg           main_holdingudprx_depacketizer_source_ready = 1'd0;
+reg           main_holdingudprx_depacketizer_source_valid = 1'd0;
+reg    [63:0] main_holdingudprx_depacketizer_sr = 64'd0;
+reg           main_holdingudprx_depacketizer_sr_shift = 1'd0;
+reg           main_holdingudprx_depacketizer_sr_shift_leftover = 1'd0;
+reg           main_holdingudprx_depacketizer_was_in_copy = 1'd0;
+reg           main_holdingudprx_err = 1'd0;
+reg           main_holdingudprx_err_liteethudp_next_value1 = 1'd0;
+reg           main_holdingudprx_err_liteethudp_next_value_ce1 = 1'd0;
+reg     [7:0] main_holdingudprx_held = 8'd0;
+reg     [7:0] main_holdingudprx_held_liteethudp_next_value2 = 8'd0;
+reg           main_holdingudprx_held_liteethudp_next_value_ce2 = 1'd0;
+wire   [15:0] main_holdingudprx_payload_len;
+wire          main_holdingudprx_sink_sink_first;
+wire          main_holdingudprx_sink_sink_last;
+wire   [31:0] main_holdingudprx_sink_sink_param_ip_address;
+wire   [15:0] main_holdingudprx_sink_sink_param_length;
+wire    [7:0] main_holdingudprx_sink_sink_param_protocol;
+wire    [7:0] main_holdingudprx_sink_sink_payload_data;
+wire          main_holdingudprx_sink_sink_payload_error;
+wire          main_holdingudprx_sink_sink_payload_last_be;
+wire          main_holdingudprx_sink_sink_ready;
+wire          main_holdingudprx_sink_sink_valid;
+reg           main_holdingudprx_source_source_first = 1'd0;
+reg           main_holdingudprx_source_source_last = 1'd0;
+reg    [15:0] main_holdingudprx_source_source_param_dst_port = 16'd0;
+reg    [31:0] main_holdingudprx_source_source_param_ip_address = 32'd0;
+reg    [15:0] main_holdingudprx_source_source_param_length = 16'd0;
+reg    [15:0] main_holdingudprx_source_source_param_src_port = 16'd0;
+reg     [7:0] main_holdingudprx_source_source_payload_data = 8'd0;
+reg           main_holdingudprx_source_source_payload_error = 1'd0;
+reg           main_holdingudprx_source_source_payload_last_be = 1'd0;
+wire          main_holdingudprx_source_source_ready;
+reg           main_holdingudprx_source_source_valid = 1'd0;
 reg           main_icmp_echo_param_fifo_consume = 1'd0;
 wire          main_icmp_echo_param_fifo_do_read;
 wire          main_icmp_echo_param_fifo_fifo_in_first;
@@ -1886,6 +1974,48 @@ reg           main_mac_packetizer_source_valid = 1'd0;
 reg   [111:0] main_mac_packetizer_sr = 112'd0;
 reg           main_mac_packetizer_sr_load = 1'd0;
 reg           main_mac_packetizer_sr_shift = 1'd0;
+reg     [2:0] main_packetizer_count = 3'd0;
+reg     [2:0] main_packetizer_count_liteethudp_fsm0_next_value0 = 3'd0;
+reg           main_packetizer_count_liteethudp_fsm0_next_value_ce0 = 1'd0;
+reg           main_packetizer_delayed_last_be = 1'd0;
+reg           main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 = 1'd0;
+reg           main_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 = 1'd0;
+reg           main_packetizer_fsm_from_idle = 1'd0;
+reg           main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 = 1'd0;
+reg           main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 = 1'd0;
+reg    [63:0] main_packetizer_header = 64'd0;
+wire          main_packetizer_in_data_copy;
+reg           main_packetizer_is_ongoing0 = 1'd0;
+reg           main_packetizer_is_ongoing1 = 1'd0;
+reg           main_packetizer_is_ongoing2 = 1'd0;
+wire          main_packetizer_new_last_be;
+wire          main_packetizer_sink_last;
+wire          main_packetizer_sink_last_be;
+wire   [15:0] main_packetizer_sink_param_checksum;
+wire   [15:0] main_packetizer_sink_param_dst_port;
+wire   [15:0] main_packetizer_sink_param_length;
+wire   [15:0] main_packetizer_sink_param_src_port;
+wire    [7:0] main_packetizer_sink_payload_data;
+reg           main_packetizer_sink_payload_error = 1'd0;
+wire          main_packetizer_sink_payload_last_be;
+reg           main_packetizer_sink_ready = 1'd0;
+wire          main_packetizer_sink_valid;
+reg           main_packetizer_source_first = 1'd0;
+reg           main_packetizer_source_last = 1'd0;
+reg           main_packetizer_source_last_a = 1'd0;
+reg           main_packetizer_source_last_b = 1'd0;
+reg           main_packetizer_source_last_s = 1'd0;
+reg    [31:0] main_packetizer_source_param_ip_address = 32'd0;
+reg    [15:0] main_packetizer_source_param_length = 16'd0;
+reg     [7:0] main_packetizer_source_param_protocol = 8'd0;
+reg     [7:0] main_packetizer_source_payload_data = 8'd0;
+wire          main_packetizer_source_payload_error;
+reg           main_packetizer_source_payload_last_be = 1'd0;
+reg           main_packetizer_source_ready = 1'd0;
+reg           main_packetizer_source_valid = 1'd0;
+reg    [63:0] main_packetizer_sr = 64'd0;
+reg           main_packetizer_sr_load = 1'd0;
+reg           main_packetizer_sr_shift = 1'd0;
 reg           main_re = 1'd0;
 reg           main_reset_re = 1'd0;
 reg     [1:0] main_reset_storage = 2'd0;
@@ -1949,75 +2079,6 @@ wire    [9:0] main_rx_converter_source_source_payload_data;
 wire          main_rx_converter_source_source_ready;
 wire          main_rx_converter_source_source_valid;
 wire          main_rx_converter_source_valid;
-reg    [15:0] main_rx_count = 16'd0;
-reg    [15:0] main_rx_count_liteethudp_next_value = 16'd0;
-reg           main_rx_count_liteethudp_next_value_ce = 1'd0;
-reg     [2:0] main_rx_depacketizer_count = 3'd0;
-reg     [2:0] main_rx_depacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
-reg           main_rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
-reg           main_rx_depacketizer_delayed_last_be = 1'd0;
-reg           main_rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
-reg           main_rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
-reg           main_rx_depacketizer_fsm_from_idle = 1'd0;
-reg           main_rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
-reg           main_rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
-wire   [63:0] main_rx_depacketizer_header;
-wire          main_rx_depacketizer_is_in_copy;
-reg           main_rx_depacketizer_is_ongoing0 = 1'd0;
-reg           main_rx_depacketizer_is_ongoing1 = 1'd0;
-reg           main_rx_depacketizer_is_ongoing2 = 1'd0;
-reg           main_rx_depacketizer_is_ongoing3 = 1'd0;
-wire          main_rx_depacketizer_new_last_be;
-reg           main_rx_depacketizer_sink_d_last = 1'd0;
-wire          main_rx_depacketizer_sink_first;
-wire          main_rx_depacketizer_sink_last;
-wire          main_rx_depacketizer_sink_last_be;
-wire   [31:0] main_rx_depacketizer_sink_param_ip_address;
-wire   [15:0] main_rx_depacketizer_sink_param_length;
-wire    [7:0] main_rx_depacketizer_sink_param_protocol;
-wire    [7:0] main_rx_depacketizer_sink_payload_data;
-wire          main_rx_depacketizer_sink_payload_error;
-wire          main_rx_depacketizer_sink_payload_last_be;
-reg           main_rx_depacketizer_sink_ready = 1'd0;
-wire          main_rx_depacketizer_sink_valid;
-reg           main_rx_depacketizer_source_last = 1'd0;
-reg           main_rx_depacketizer_source_last_a = 1'd0;
-reg           main_rx_depacketizer_source_last_b = 1'd0;
-reg           main_rx_depacketizer_source_last_s = 1'd0;
-wire   [15:0] main_rx_depacketizer_source_param_checksum;
-wire   [15:0] main_rx_depacketizer_source_param_dst_port;
-wire   [15:0] main_rx_depacketizer_source_param_length;
-wire   [15:0] main_rx_depacketizer_source_param_src_port;
-reg     [7:0] main_rx_depacketizer_source_payload_data = 8'd0;
-wire          main_rx_depacketizer_source_payload_error;
-reg           main_rx_depacketizer_source_payload_last_be = 1'd0;
-reg           main_rx_depacketizer_source_ready = 1'd0;
-reg           main_rx_depacketizer_source_valid = 1'd0;
-reg    [63:0] main_rx_depacketizer_sr = 64'd0;
-reg           main_rx_depacketizer_sr_shift = 1'd0;
-reg           main_rx_depacketizer_sr_shift_leftover = 1'd0;
-reg           main_rx_depacketizer_was_in_copy = 1'd0;
-wire          main_rx_sink_sink_first;
-wire          main_rx_sink_sink_last;
-wire   [31:0] main_rx_sink_sink_param_ip_address;
-wire   [15:0] main_rx_sink_sink_param_length;
-wire    [7:0] main_rx_sink_sink_param_protocol;
-wire    [7:0] main_rx_sink_sink_payload_data;
-wire          main_rx_sink_sink_payload_error;
-wire          main_rx_sink_sink_payload_last_be;
-wire          main_rx_sink_sink_ready;
-wire          main_rx_sink_sink_valid;
-reg           main_rx_source_source_first = 1'd0;
-reg           main_rx_source_source_last = 1'd0;
-wire   [15:0] main_rx_source_source_param_dst_port;
-wire   [31:0] main_rx_source_source_param_ip_address;
-wire   [15:0] main_rx_source_source_param_length;
-wire   [15:0] main_rx_source_source_param_src_port;
-wire    [7:0] main_rx_source_source_payload_data;
-wire          main_rx_source_source_payload_error;
-reg           main_rx_source_source_payload_last_be = 1'd0;
-wire          main_rx_source_source_ready;
-reg           main_rx_source_source_valid = 1'd0;
 reg           main_scratch_re = 1'd0;
 reg    [31:0] main_scratch_storage = 32'd305419896;
 wire          main_sink_first;
@@ -2026,14 +2087,35 @@ wire    [7:0] main_sink_payload_data;
 wire          main_sink_payload_error;
 wire          main_sink_payload_last_be;
 reg           main_sink_ready = 1'd0;
+wire          main_sink_sink_first;
+wire          main_sink_sink_last;
+wire   [15:0] main_sink_sink_param_dst_port;
+wire   [31:0] main_sink_sink_param_ip_address;
+wire   [15:0] main_sink_sink_param_length;
+wire   [15:0] main_sink_sink_param_src_port;
+wire    [7:0] main_sink_sink_payload_data;
+wire          main_sink_sink_payload_error;
+wire          main_sink_sink_payload_last_be;
+wire          main_sink_sink_ready;
+wire          main_sink_sink_valid;
 wire          main_sink_valid;
 reg           main_soc_rst = 1'd0;
 reg           main_source_first = 1'd0;
 wire          main_source_last;
 reg     [7:0] main_source_payload_data = 8'd0;
 reg           main_source_payload_error = 1'd0;
-reg           main_source_payload_last_be = 1'd0;
+wire          main_source_payload_last_be;
 wire          main_source_ready;
+reg           main_source_source_first = 1'd0;
+reg           main_source_source_last = 1'd0;
+reg    [31:0] main_source_source_param_ip_address = 32'd0;
+reg    [15:0] main_source_source_param_length = 16'd0;
+reg     [7:0] main_source_source_param_protocol = 8'd0;
+reg     [7:0] main_source_source_payload_data = 8'd0;
+reg           main_source_source_payload_error = 1'd0;
+reg           main_source_source_payload_last_be = 1'd0;
+wire          main_source_source_ready;
+reg           main_source_source_valid = 1'd0;
 reg           main_source_valid = 1'd0;
 reg           main_storage = 1'd0;
 wire          main_tx_cdc_sink_first;
@@ -2096,69 +2178,6 @@ wire    [9:0] main_tx_converter_source_source_payload_data;
 wire          main_tx_converter_source_source_ready;
 wire          main_tx_converter_source_source_valid;
 wire          main_tx_converter_source_valid;
-reg     [2:0] main_tx_packetizer_count = 3'd0;
-reg     [2:0] main_tx_packetizer_count_liteethudp_fsm0_next_value0 = 3'd0;
-reg           main_tx_packetizer_count_liteethudp_fsm0_next_value_ce0 = 1'd0;
-reg           main_tx_packetizer_delayed_last_be = 1'd0;
-reg           main_tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 = 1'd0;
-reg           main_tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 = 1'd0;
-reg           main_tx_packetizer_fsm_from_idle = 1'd0;
-reg           main_tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 = 1'd0;
-reg           main_tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 = 1'd0;
-reg    [63:0] main_tx_packetizer_header = 64'd0;
-wire          main_tx_packetizer_in_data_copy;
-reg           main_tx_packetizer_is_ongoing0 = 1'd0;
-reg           main_tx_packetizer_is_ongoing1 = 1'd0;
-reg           main_tx_packetizer_is_ongoing2 = 1'd0;
-wire          main_tx_packetizer_new_last_be;
-wire          main_tx_packetizer_sink_last;
-wire          main_tx_packetizer_sink_last_be;
-wire   [15:0] main_tx_packetizer_sink_param_checksum;
-wire   [15:0] main_tx_packetizer_sink_param_dst_port;
-wire   [15:0] main_tx_packetizer_sink_param_length;
-wire   [15:0] main_tx_packetizer_sink_param_src_port;
-wire    [7:0] main_tx_packetizer_sink_payload_data;
-reg           main_tx_packetizer_sink_payload_error = 1'd0;
-wire          main_tx_packetizer_sink_payload_last_be;
-reg           main_tx_packetizer_sink_ready = 1'd0;
-wire          main_tx_packetizer_sink_valid;
-reg           main_tx_packetizer_source_first = 1'd0;
-reg           main_tx_packetizer_source_last = 1'd0;
-reg           main_tx_packetizer_source_last_a = 1'd0;
-reg           main_tx_packetizer_source_last_b = 1'd0;
-reg           main_tx_packetizer_source_last_s = 1'd0;
-reg    [31:0] main_tx_packetizer_source_param_ip_address = 32'd0;
-reg    [15:0] main_tx_packetizer_source_param_length = 16'd0;
-reg     [7:0] main_tx_packetizer_source_param_protocol = 8'd0;
-reg     [7:0] main_tx_packetizer_source_payload_data = 8'd0;
-wire          main_tx_packetizer_source_payload_error;
-reg           main_tx_packetizer_source_payload_last_be = 1'd0;
-reg           main_tx_packetizer_source_ready = 1'd0;
-reg           main_tx_packetizer_source_valid = 1'd0;
-reg    [63:0] main_tx_packetizer_sr = 64'd0;
-reg           main_tx_packetizer_sr_load = 1'd0;
-reg           main_tx_packetizer_sr_shift = 1'd0;
-wire          main_tx_sink_sink_first;
-wire          main_tx_sink_sink_last;
-wire   [15:0] main_tx_sink_sink_param_dst_port;
-wire   [31:0] main_tx_sink_sink_param_ip_address;
-wire   [15:0] main_tx_sink_sink_param_length;
-wire   [15:0] main_tx_sink_sink_param_src_port;
-wire    [7:0] main_tx_sink_sink_payload_data;
-wire          main_tx_sink_sink_payload_error;
-wire          main_tx_sink_sink_payload_last_be;
-wire          main_tx_sink_sink_ready;
-wire          main_tx_sink_sink_valid;
-reg           main_tx_source_source_first = 1'd0;
-reg           main_tx_source_source_last = 1'd0;
-reg    [31:0] main_tx_source_source_param_ip_address = 32'd0;
-reg    [15:0] main_tx_source_source_param_length = 16'd0;
-reg     [7:0] main_tx_source_source_param_protocol = 8'd0;
-reg     [7:0] main_tx_source_source_payload_data = 8'd0;
-reg           main_tx_source_source_payload_error = 1'd0;
-reg           main_tx_source_source_payload_last_be = 1'd0;
-wire          main_tx_source_source_ready;
-reg           main_tx_source_source_valid = 1'd0;
 reg           main_user_port_sink_first = 1'd0;
 wire          main_user_port_sink_last;
 wire   [15:0] main_user_port_sink_param_dst_port;
@@ -2189,6 +2208,7 @@ wire          sys_rst;
 // Combinatorial Logic
 //------------------------------------------------------------------------------
 
+assign main_source_payload_last_be = main_source_last;
 assign main_user_port_sink_valid = udp_sink_valid;
 assign main_user_port_sink_last = udp_sink_last;
 assign main_user_port_sink_param_dst_port = udp_sink_dst_port;
@@ -5232,144 +5252,144 @@ assign main_icmp_echo_param_fifo_syncfifo_dout = main_icmp_echo_param_fifo_rdpor
 assign main_icmp_echo_param_fifo_rdport_re = main_icmp_echo_param_fifo_do_read;
 assign main_icmp_echo_param_fifo_syncfifo_writable = (main_icmp_echo_param_fifo_level0 != 2'd2);
 assign main_icmp_echo_param_fifo_syncfifo_readable = (main_icmp_echo_param_fifo_level0 != 1'd0);
-assign main_ip_port_sink_valid = main_tx_source_source_valid;
-assign main_tx_source_source_ready = main_ip_port_sink_ready;
-assign main_ip_port_sink_first = main_tx_source_source_first;
-assign main_ip_port_sink_last = main_tx_source_source_last;
-assign main_ip_port_sink_payload_data = main_tx_source_source_payload_data;
-assign main_ip_port_sink_payload_last_be = main_tx_source_source_payload_last_be;
-assign main_ip_port_sink_payload_error = main_tx_source_source_payload_error;
-assign main_ip_port_sink_param_length = main_tx_source_source_param_length;
-assign main_ip_port_sink_param_protocol = main_tx_source_source_param_protocol;
-assign main_ip_port_sink_param_ip_address = main_tx_source_source_param_ip_address;
-assign main_rx_sink_sink_valid = main_ip_port_source_valid;
-assign main_ip_port_source_ready = main_rx_sink_sink_ready;
-assign main_rx_sink_sink_first = main_ip_port_source_first;
-assign main_rx_sink_sink_last = main_ip_port_source_last;
-assign main_rx_sink_sink_payload_data = main_ip_port_source_payload_data;
-assign main_rx_sink_sink_payload_last_be = main_ip_port_source_payload_last_be;
-assign main_rx_sink_sink_payload_error = main_ip_port_source_payload_error;
-assign main_rx_sink_sink_param_length = main_ip_port_source_param_length;
-assign main_rx_sink_sink_param_protocol = main_ip_port_source_param_protocol;
-assign main_rx_sink_sink_param_ip_address = main_ip_port_source_param_ip_address;
-assign main_tx_sink_sink_valid = main_crossbar_source_valid;
-assign main_crossbar_source_ready = main_tx_sink_sink_ready;
-assign main_tx_sink_sink_first = main_crossbar_source_first;
-assign main_tx_sink_sink_last = main_crossbar_source_last;
-assign main_tx_sink_sink_payload_data = main_crossbar_source_payload_data;
-assign main_tx_sink_sink_payload_last_be = main_crossbar_source_payload_last_be;
-assign main_tx_sink_sink_payload_error = main_crossbar_source_payload_error;
-assign main_tx_sink_sink_param_src_port = main_crossbar_source_param_src_port;
-assign main_tx_sink_sink_param_dst_port = main_crossbar_source_param_dst_port;
-assign main_tx_sink_sink_param_ip_address = main_crossbar_source_param_ip_address;
-assign main_tx_sink_sink_param_length = main_crossbar_source_param_length;
-assign main_crossbar_sink_valid = main_rx_source_source_valid;
-assign main_rx_source_source_ready = main_crossbar_sink_ready;
-assign main_crossbar_sink_first = main_rx_source_source_first;
-assign main_crossbar_sink_last = main_rx_source_source_last;
-assign main_crossbar_sink_payload_data = main_rx_source_source_payload_data;
-assign main_crossbar_sink_payload_last_be = main_rx_source_source_payload_last_be;
-assign main_crossbar_sink_payload_error = main_rx_source_source_payload_error;
-assign main_crossbar_sink_param_src_port = main_rx_source_source_param_src_port;
-assign main_crossbar_sink_param_dst_port = main_rx_source_source_param_dst_port;
-assign main_crossbar_sink_param_ip_address = main_rx_source_source_param_ip_address;
-assign main_crossbar_sink_param_length = main_rx_source_source_param_length;
-assign main_tx_packetizer_sink_valid = main_tx_sink_sink_valid;
-assign main_tx_sink_sink_ready = main_tx_packetizer_sink_ready;
-assign main_tx_packetizer_sink_last = main_tx_sink_sink_last;
-assign main_tx_packetizer_sink_payload_data = main_tx_sink_sink_payload_data;
-assign main_tx_packetizer_sink_payload_last_be = main_tx_sink_sink_payload_last_be;
-assign main_tx_packetizer_sink_param_src_port = main_tx_sink_sink_param_src_port;
-assign main_tx_packetizer_sink_param_dst_port = main_tx_sink_sink_param_dst_port;
-assign main_tx_packetizer_sink_param_length = (main_tx_sink_sink_param_length + 4'd8);
-assign main_tx_packetizer_sink_param_checksum = 1'd0;
+assign main_ip_port_sink_valid = main_source_source_valid;
+assign main_source_source_ready = main_ip_port_sink_ready;
+assign main_ip_port_sink_first = main_source_source_first;
+assign main_ip_port_sink_last = main_source_source_last;
+assign main_ip_port_sink_payload_data = main_source_source_payload_data;
+assign main_ip_port_sink_payload_last_be = main_source_source_payload_last_be;
+assign main_ip_port_sink_payload_error = main_source_source_payload_error;
+assign main_ip_port_sink_param_length = main_source_source_param_length;
+assign main_ip_port_sink_param_protocol = main_source_source_param_protocol;
+assign main_ip_port_sink_param_ip_address = main_source_source_param_ip_address;
+assign main_holdingudprx_sink_sink_valid = main_ip_port_source_valid;
+assign main_ip_port_source_ready = main_holdingudprx_sink_sink_ready;
+assign main_holdingudprx_sink_sink_first = main_ip_port_source_first;
+assign main_holdingudprx_sink_sink_last = main_ip_port_source_last;
+assign main_holdingudprx_sink_sink_payload_data = main_ip_port_source_payload_data;
+assign main_holdingudprx_sink_sink_payload_last_be = main_ip_port_source_payload_last_be;
+assign main_holdingudprx_sink_sink_payload_error = main_ip_port_source_payload_error;
+assign main_holdingudprx_sink_sink_param_length = main_ip_port_source_param_length;
+assign main_holdingudprx_sink_sink_param_protocol = main_ip_port_source_param_protocol;
+assign main_holdingudprx_sink_sink_param_ip_address = main_ip_port_source_param_ip_address;
+assign main_sink_sink_valid = main_crossbar_source_valid;
+assign main_crossbar_source_ready = main_sink_sink_ready;
+assign main_sink_sink_first = main_crossbar_source_first;
+assign main_sink_sink_last = main_crossbar_source_last;
+assign main_sink_sink_payload_data = main_crossbar_source_payload_data;
+assign main_sink_sink_payload_last_be = main_crossbar_source_payload_last_be;
+assign main_sink_sink_payload_error = main_crossbar_source_payload_error;
+assign main_sink_sink_param_src_port = main_crossbar_source_param_src_port;
+assign main_sink_sink_param_dst_port = main_crossbar_source_param_dst_port;
+assign main_sink_sink_param_ip_address = main_crossbar_source_param_ip_address;
+assign main_sink_sink_param_length = main_crossbar_source_param_length;
+assign main_crossbar_sink_valid = main_holdingudprx_source_source_valid;
+assign main_holdingudprx_source_source_ready = main_crossbar_sink_ready;
+assign main_crossbar_sink_first = main_holdingudprx_source_source_first;
+assign main_crossbar_sink_last = main_holdingudprx_source_source_last;
+assign main_crossbar_sink_payload_data = main_holdingudprx_source_source_payload_data;
+assign main_crossbar_sink_payload_last_be = main_holdingudprx_source_source_payload_last_be;
+assign main_crossbar_sink_payload_error = main_holdingudprx_source_source_payload_error;
+assign main_crossbar_sink_param_src_port = main_holdingudprx_source_source_param_src_port;
+assign main_crossbar_sink_param_dst_port = main_holdingudprx_source_source_param_dst_port;
+assign main_crossbar_sink_param_ip_address = main_holdingudprx_source_source_param_ip_address;
+assign main_crossbar_sink_param_length = main_holdingudprx_source_source_param_length;
+assign main_packetizer_sink_valid = main_sink_sink_valid;
+assign main_sink_sink_ready = main_packetizer_sink_ready;
+assign main_packetizer_sink_last = main_sink_sink_last;
+assign main_packetizer_sink_payload_data = main_sink_sink_payload_data;
+assign main_packetizer_sink_payload_last_be = main_sink_sink_payload_last_be;
+assign main_packetizer_sink_param_src_port = main_sink_sink_param_src_port;
+assign main_packetizer_sink_param_dst_port = main_sink_sink_param_dst_port;
+assign main_packetizer_sink_param_length = (main_sink_sink_param_length + 4'd8);
+assign main_packetizer_sink_param_checksum = 1'd0;
 always @(*) begin
-    main_tx_packetizer_header <= 64'd0;
-    main_tx_packetizer_header[63:48] <= {main_tx_packetizer_sink_param_checksum[7:0], main_tx_packetizer_sink_param_checksum[15:8]};
-    main_tx_packetizer_header[31:16] <= {main_tx_packetizer_sink_param_dst_port[7:0], main_tx_packetizer_sink_param_dst_port[15:8]};
-    main_tx_packetizer_header[47:32] <= {main_tx_packetizer_sink_param_length[7:0], main_tx_packetizer_sink_param_length[15:8]};
-    main_tx_packetizer_header[15:0] <= {main_tx_packetizer_sink_param_src_port[7:0], main_tx_packetizer_sink_param_src_port[15:8]};
+    main_packetizer_header <= 64'd0;
+    main_packetizer_header[63:48] <= {main_packetizer_sink_param_checksum[7:0], main_packetizer_sink_param_checksum[15:8]};
+    main_packetizer_header[31:16] <= {main_packetizer_sink_param_dst_port[7:0], main_packetizer_sink_param_dst_port[15:8]};
+    main_packetizer_header[47:32] <= {main_packetizer_sink_param_length[7:0], main_packetizer_sink_param_length[15:8]};
+    main_packetizer_header[15:0] <= {main_packetizer_sink_param_src_port[7:0], main_packetizer_sink_param_src_port[15:8]};
 end
-assign main_tx_packetizer_sink_last_be = main_tx_packetizer_sink_last;
-assign main_tx_packetizer_new_last_be = {main_tx_packetizer_sink_last_be};
-assign main_tx_packetizer_in_data_copy = (main_tx_packetizer_is_ongoing0 | main_tx_packetizer_is_ongoing1);
+assign main_packetizer_sink_last_be = main_packetizer_sink_last;
+assign main_packetizer_new_last_be = {main_packetizer_sink_last_be};
+assign main_packetizer_in_data_copy = (main_packetizer_is_ongoing0 | main_packetizer_is_ongoing1);
 always @(*) begin
-    main_tx_packetizer_source_last <= 1'd0;
-    if (main_tx_packetizer_source_last_s) begin
-        main_tx_packetizer_source_last <= main_tx_packetizer_source_last_b;
+    main_packetizer_source_last <= 1'd0;
+    if (main_packetizer_source_last_s) begin
+        main_packetizer_source_last <= main_packetizer_source_last_b;
     end else begin
-        main_tx_packetizer_source_last <= main_tx_packetizer_source_last_a;
+        main_packetizer_source_last <= main_packetizer_source_last_a;
     end
 end
-assign main_tx_packetizer_source_payload_error = main_tx_packetizer_sink_payload_error;
+assign main_packetizer_source_payload_error = main_packetizer_sink_payload_error;
 always @(*) begin
     builder_liteethudp_liteethudptx_fsm0_next_state <= 2'd0;
     builder_liteethudp_liteethudptx_fsm1_next_state <= 1'd0;
-    main_tx_packetizer_count_liteethudp_fsm0_next_value0 <= 3'd0;
-    main_tx_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd0;
-    main_tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= 1'd0;
-    main_tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd0;
-    main_tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd0;
-    main_tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd0;
-    main_tx_packetizer_is_ongoing0 <= 1'd0;
-    main_tx_packetizer_is_ongoing1 <= 1'd0;
-    main_tx_packetizer_is_ongoing2 <= 1'd0;
-    main_tx_packetizer_sink_ready <= 1'd0;
-    main_tx_packetizer_source_last_a <= 1'd0;
-    main_tx_packetizer_source_last_b <= 1'd0;
-    main_tx_packetizer_source_last_s <= 1'd0;
-    main_tx_packetizer_source_payload_data <= 8'd0;
-    main_tx_packetizer_source_payload_last_be <= 1'd0;
-    main_tx_packetizer_source_valid <= 1'd0;
-    main_tx_packetizer_sr_load <= 1'd0;
-    main_tx_packetizer_sr_shift <= 1'd0;
+    main_packetizer_count_liteethudp_fsm0_next_value0 <= 3'd0;
+    main_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd0;
+    main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= 1'd0;
+    main_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd0;
+    main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd0;
+    main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd0;
+    main_packetizer_is_ongoing0 <= 1'd0;
+    main_packetizer_is_ongoing1 <= 1'd0;
+    main_packetizer_is_ongoing2 <= 1'd0;
+    main_packetizer_sink_ready <= 1'd0;
+    main_packetizer_source_last_a <= 1'd0;
+    main_packetizer_source_last_b <= 1'd0;
+    main_packetizer_source_last_s <= 1'd0;
+    main_packetizer_source_payload_data <= 8'd0;
+    main_packetizer_source_payload_last_be <= 1'd0;
+    main_packetizer_source_valid <= 1'd0;
+    main_packetizer_sr_load <= 1'd0;
+    main_packetizer_sr_shift <= 1'd0;
     builder_liteethudp_liteethudptx_fsm0_next_state <= builder_liteethudp_liteethudptx_fsm0_state;
     case (builder_liteethudp_liteethudptx_fsm0_state)
         1'd1: begin
-            main_tx_packetizer_source_valid <= 1'd1;
-            main_tx_packetizer_source_last_a <= 1'd0;
-            main_tx_packetizer_source_payload_data <= main_tx_packetizer_sr[63:8];
-            if ((main_tx_packetizer_source_valid & main_tx_packetizer_source_ready)) begin
-                main_tx_packetizer_sr_shift <= 1'd1;
-                if ((main_tx_packetizer_count == 3'd7)) begin
-                    main_tx_packetizer_sr_shift <= 1'd0;
+            main_packetizer_source_valid <= 1'd1;
+            main_packetizer_source_last_a <= 1'd0;
+            main_packetizer_source_payload_data <= main_packetizer_sr[63:8];
+            if ((main_packetizer_source_valid & main_packetizer_source_ready)) begin
+                main_packetizer_sr_shift <= 1'd1;
+                if ((main_packetizer_count == 3'd7)) begin
+                    main_packetizer_sr_shift <= 1'd0;
                     builder_liteethudp_liteethudptx_fsm0_next_state <= 2'd2;
-                    main_tx_packetizer_count_liteethudp_fsm0_next_value0 <= (main_tx_packetizer_count + 1'd1);
-                    main_tx_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
+                    main_packetizer_count_liteethudp_fsm0_next_value0 <= (main_packetizer_count + 1'd1);
+                    main_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
                 end else begin
-                    main_tx_packetizer_count_liteethudp_fsm0_next_value0 <= (main_tx_packetizer_count + 1'd1);
-                    main_tx_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
+                    main_packetizer_count_liteethudp_fsm0_next_value0 <= (main_packetizer_count + 1'd1);
+                    main_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
                 end
             end
         end
         2'd2: begin
-            main_tx_packetizer_source_valid <= main_tx_packetizer_sink_valid;
-            main_tx_packetizer_source_last_a <= main_tx_packetizer_sink_last;
-            main_tx_packetizer_source_payload_data <= main_tx_packetizer_sink_payload_data;
-            if ((main_tx_packetizer_source_valid & main_tx_packetizer_source_ready)) begin
-                main_tx_packetizer_sink_ready <= 1'd1;
-                if (main_tx_packetizer_source_last) begin
+            main_packetizer_source_valid <= main_packetizer_sink_valid;
+            main_packetizer_source_last_a <= main_packetizer_sink_last;
+            main_packetizer_source_payload_data <= main_packetizer_sink_payload_data;
+            if ((main_packetizer_source_valid & main_packetizer_source_ready)) begin
+                main_packetizer_sink_ready <= 1'd1;
+                if (main_packetizer_source_last) begin
                     builder_liteethudp_liteethudptx_fsm0_next_state <= 1'd0;
                 end
             end
-            main_tx_packetizer_is_ongoing0 <= 1'd1;
+            main_packetizer_is_ongoing0 <= 1'd1;
         end
         2'd3: begin
-            main_tx_packetizer_is_ongoing1 <= 1'd1;
+            main_packetizer_is_ongoing1 <= 1'd1;
         end
         default: begin
-            main_tx_packetizer_sink_ready <= 1'd1;
-            main_tx_packetizer_count_liteethudp_fsm0_next_value0 <= 1'd1;
-            main_tx_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
-            if (main_tx_packetizer_sink_valid) begin
-                main_tx_packetizer_sink_ready <= 1'd0;
-                main_tx_packetizer_source_valid <= 1'd1;
-                main_tx_packetizer_source_last_a <= 1'd0;
-                main_tx_packetizer_source_payload_data <= main_tx_packetizer_header[7:0];
-                if ((main_tx_packetizer_source_valid & main_tx_packetizer_source_ready)) begin
-                    main_tx_packetizer_sr_load <= 1'd1;
-                    main_tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd1;
-                    main_tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd1;
+            main_packetizer_sink_ready <= 1'd1;
+            main_packetizer_count_liteethudp_fsm0_next_value0 <= 1'd1;
+            main_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
+            if (main_packetizer_sink_valid) begin
+                main_packetizer_sink_ready <= 1'd0;
+                main_packetizer_source_valid <= 1'd1;
+                main_packetizer_source_last_a <= 1'd0;
+                main_packetizer_source_payload_data <= main_packetizer_header[7:0];
+                if ((main_packetizer_source_valid & main_packetizer_source_ready)) begin
+                    main_packetizer_sr_load <= 1'd1;
+                    main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd1;
+                    main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd1;
                     if (1'd0) begin
                         builder_liteethudp_liteethudptx_fsm0_next_state <= 2'd2;
                     end else begin
@@ -5377,42 +5397,42 @@ always @(*) begin
                     end
                 end
             end
-            main_tx_packetizer_is_ongoing2 <= 1'd1;
+            main_packetizer_is_ongoing2 <= 1'd1;
         end
     endcase
     builder_liteethudp_liteethudptx_fsm1_next_state <= builder_liteethudp_liteethudptx_fsm1_state;
     case (builder_liteethudp_liteethudptx_fsm1_state)
         1'd1: begin
-            main_tx_packetizer_source_last_b <= 1'd1;
-            main_tx_packetizer_source_last_s <= 1'd1;
-            main_tx_packetizer_source_payload_last_be <= main_tx_packetizer_delayed_last_be;
-            main_tx_packetizer_sink_ready <= 1'd0;
-            if (main_tx_packetizer_source_ready) begin
+            main_packetizer_source_last_b <= 1'd1;
+            main_packetizer_source_last_s <= 1'd1;
+            main_packetizer_source_payload_last_be <= main_packetizer_delayed_last_be;
+            main_packetizer_sink_ready <= 1'd0;
+            if (main_packetizer_source_ready) begin
                 builder_liteethudp_liteethudptx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((main_tx_packetizer_in_data_copy & main_tx_packetizer_sink_last) & (main_tx_packetizer_sink_last_be > main_tx_packetizer_new_last_be))) begin
-                main_tx_packetizer_source_last_b <= 1'd0;
-                main_tx_packetizer_source_last_s <= 1'd1;
-                main_tx_packetizer_source_payload_last_be <= 1'd0;
-                if ((main_tx_packetizer_source_ready & main_tx_packetizer_source_valid)) begin
-                    main_tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= main_tx_packetizer_new_last_be;
-                    main_tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd1;
+            if (((main_packetizer_in_data_copy & main_packetizer_sink_last) & (main_packetizer_sink_last_be > main_packetizer_new_last_be))) begin
+                main_packetizer_source_last_b <= 1'd0;
+                main_packetizer_source_last_s <= 1'd1;
+                main_packetizer_source_payload_last_be <= 1'd0;
+                if ((main_packetizer_source_ready & main_packetizer_source_valid)) begin
+                    main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= main_packetizer_new_last_be;
+                    main_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd1;
                     builder_liteethudp_liteethudptx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (main_tx_packetizer_in_data_copy) begin
-                    main_tx_packetizer_source_last_b <= main_tx_packetizer_sink_last;
-                    main_tx_packetizer_source_last_s <= 1'd1;
-                    main_tx_packetizer_source_payload_last_be <= main_tx_packetizer_new_last_be;
+                if (main_packetizer_in_data_copy) begin
+                    main_packetizer_source_last_b <= main_packetizer_sink_last;
+                    main_packetizer_source_last_s <= 1'd1;
+                    main_packetizer_source_payload_last_be <= main_packetizer_new_last_be;
                 end
             end
-            if (main_tx_packetizer_in_data_copy) begin
-                main_tx_packetizer_sink_ready <= main_tx_packetizer_source_ready;
+            if (main_packetizer_in_data_copy) begin
+                main_packetizer_sink_ready <= main_packetizer_source_ready;
             end else begin
-                if (main_tx_packetizer_is_ongoing2) begin
-                    main_tx_packetizer_sink_ready <= (~main_tx_packetizer_sink_valid);
+                if (main_packetizer_is_ongoing2) begin
+                    main_packetizer_sink_ready <= (~main_packetizer_sink_valid);
                 end
             end
         end
@@ -5420,254 +5440,282 @@ always @(*) begin
 end
 always @(*) begin
     builder_liteethudp_liteethudptx_next_state <= 1'd0;
-    main_tx_packetizer_source_ready <= 1'd0;
-    main_tx_source_source_first <= 1'd0;
-    main_tx_source_source_last <= 1'd0;
-    main_tx_source_source_param_ip_address <= 32'd0;
-    main_tx_source_source_param_length <= 16'd0;
-    main_tx_source_source_param_protocol <= 8'd0;
-    main_tx_source_source_payload_data <= 8'd0;
-    main_tx_source_source_payload_error <= 1'd0;
-    main_tx_source_source_payload_last_be <= 1'd0;
-    main_tx_source_source_valid <= 1'd0;
+    main_packetizer_source_ready <= 1'd0;
+    main_source_source_first <= 1'd0;
+    main_source_source_last <= 1'd0;
+    main_source_source_param_ip_address <= 32'd0;
+    main_source_source_param_length <= 16'd0;
+    main_source_source_param_protocol <= 8'd0;
+    main_source_source_payload_data <= 8'd0;
+    main_source_source_payload_error <= 1'd0;
+    main_source_source_payload_last_be <= 1'd0;
+    main_source_source_valid <= 1'd0;
     builder_liteethudp_liteethudptx_next_state <= builder_liteethudp_liteethudptx_state;
     case (builder_liteethudp_liteethudptx_state)
         1'd1: begin
-            main_tx_source_source_valid <= main_tx_packetizer_source_valid;
-            main_tx_packetizer_source_ready <= main_tx_source_source_ready;
-            main_tx_source_source_first <= main_tx_packetizer_source_first;
-            main_tx_source_source_last <= main_tx_packetizer_source_last;
-            main_tx_source_source_payload_data <= main_tx_packetizer_source_payload_data;
-            main_tx_source_source_payload_last_be <= main_tx_packetizer_source_payload_last_be;
-            main_tx_source_source_payload_error <= main_tx_packetizer_source_payload_error;
-            main_tx_source_source_param_length <= main_tx_packetizer_source_param_length;
-            main_tx_source_source_param_protocol <= main_tx_packetizer_source_param_protocol;
-            main_tx_source_source_param_ip_address <= main_tx_packetizer_source_param_ip_address;
-            main_tx_source_source_param_length <= main_tx_packetizer_sink_param_length;
-            main_tx_source_source_param_protocol <= 5'd17;
-            main_tx_source_source_param_ip_address <= main_tx_sink_sink_param_ip_address;
-            if ((main_tx_source_source_valid & main_tx_source_source_ready)) begin
-                if (main_tx_source_source_last) begin
+            main_source_source_valid <= main_packetizer_source_valid;
+            main_packetizer_source_ready <= main_source_source_ready;
+            main_source_source_first <= main_packetizer_source_first;
+            main_source_source_last <= main_packetizer_source_last;
+            main_source_source_payload_data <= main_packetizer_source_payload_data;
+            main_source_source_payload_last_be <= main_packetizer_source_payload_last_be;
+            main_source_source_payload_error <= main_packetizer_source_payload_error;
+            main_source_source_param_length <= main_packetizer_source_param_length;
+            main_source_source_param_protocol <= main_packetizer_source_param_protocol;
+            main_source_source_param_ip_address <= main_packetizer_source_param_ip_address;
+            main_source_source_param_length <= main_packetizer_sink_param_length;
+            main_source_source_param_protocol <= 5'd17;
+            main_source_source_param_ip_address <= main_sink_sink_param_ip_address;
+            if ((main_source_source_valid & main_source_source_ready)) begin
+                if (main_source_source_last) begin
                     builder_liteethudp_liteethudptx_next_state <= 1'd0;
                 end
             end
         end
         default: begin
-            if (main_tx_packetizer_source_valid) begin
+            if (main_packetizer_source_valid) begin
                 builder_liteethudp_liteethudptx_next_state <= 1'd1;
             end
         end
     endcase
 end
-assign main_rx_depacketizer_sink_valid = main_rx_sink_sink_valid;
-assign main_rx_sink_sink_ready = main_rx_depacketizer_sink_ready;
-assign main_rx_depacketizer_sink_first = main_rx_sink_sink_first;
-assign main_rx_depacketizer_sink_last = main_rx_sink_sink_last;
-assign main_rx_depacketizer_sink_payload_data = main_rx_sink_sink_payload_data;
-assign main_rx_depacketizer_sink_payload_last_be = main_rx_sink_sink_payload_last_be;
-assign main_rx_depacketizer_sink_payload_error = main_rx_sink_sink_payload_error;
-assign main_rx_depacketizer_sink_param_length = main_rx_sink_sink_param_length;
-assign main_rx_depacketizer_sink_param_protocol = main_rx_sink_sink_param_protocol;
-assign main_rx_depacketizer_sink_param_ip_address = main_rx_sink_sink_param_ip_address;
-assign main_rx_source_source_payload_data = main_rx_depacketizer_source_payload_data;
-assign main_rx_source_source_payload_error = main_rx_depacketizer_source_payload_error;
-assign main_rx_source_source_param_dst_port = main_rx_depacketizer_source_param_dst_port;
-assign main_rx_source_source_param_src_port = main_rx_depacketizer_source_param_src_port;
-assign main_rx_source_source_param_ip_address = main_rx_sink_sink_param_ip_address;
-assign main_rx_source_source_param_length = (main_rx_depacketizer_source_param_length - 4'd8);
-assign main_rx_depacketizer_header = main_rx_depacketizer_sr;
-assign main_rx_depacketizer_source_param_checksum = {builder_rhs_slice_proxy69[7:0], builder_rhs_slice_proxy68[15:8]};
-assign main_rx_depacketizer_source_param_dst_port = {builder_rhs_slice_proxy71[7:0], builder_rhs_slice_proxy70[15:8]};
-assign main_rx_depacketizer_source_param_length = {builder_rhs_slice_proxy73[7:0], builder_rhs_slice_proxy72[15:8]};
-assign main_rx_depacketizer_source_param_src_port = {builder_rhs_slice_proxy75[7:0], builder_rhs_slice_proxy74[15:8]};
-assign main_rx_depacketizer_source_payload_error = main_rx_depacketizer_sink_payload_error;
-assign main_rx_depacketizer_sink_last_be = main_rx_depacketizer_sink_last;
-assign main_rx_depacketizer_new_last_be = {main_rx_depacketizer_sink_last_be};
-assign main_rx_depacketizer_is_in_copy = (main_rx_depacketizer_is_ongoing0 | main_rx_depacketizer_is_ongoing1);
+assign main_holdingudprx_depacketizer_sink_valid = main_holdingudprx_sink_sink_valid;
+assign main_holdingudprx_sink_sink_ready = main_holdingudprx_depacketizer_sink_ready;
+assign main_holdingudprx_depacketizer_sink_first = main_holdingudprx_sink_sink_first;
+assign main_holdingudprx_depacketizer_sink_last = main_holdingudprx_sink_sink_last;
+assign main_holdingudprx_depacketizer_sink_payload_data = main_holdingudprx_sink_sink_payload_data;
+assign main_holdingudprx_depacketizer_sink_payload_last_be = main_holdingudprx_sink_sink_payload_last_be;
+assign main_holdingudprx_depacketizer_sink_payload_error = main_holdingudprx_sink_sink_payload_error;
+assign main_holdingudprx_depacketizer_sink_param_length = main_holdingudprx_sink_sink_param_length;
+assign main_holdingudprx_depacketizer_sink_param_protocol = main_holdingudprx_sink_sink_param_protocol;
+assign main_holdingudprx_depacketizer_sink_param_ip_address = main_holdingudprx_sink_sink_param_ip_address;
+assign main_holdingudprx_payload_len = (main_holdingudprx_depacketizer_source_param_length - 4'd8);
+assign main_holdingudprx_depacketizer_header = main_holdingudprx_depacketizer_sr;
+assign main_holdingudprx_depacketizer_source_param_checksum = {builder_rhs_slice_proxy69[7:0], builder_rhs_slice_proxy68[15:8]};
+assign main_holdingudprx_depacketizer_source_param_dst_port = {builder_rhs_slice_proxy71[7:0], builder_rhs_slice_proxy70[15:8]};
+assign main_holdingudprx_depacketizer_source_param_length = {builder_rhs_slice_proxy73[7:0], builder_rhs_slice_proxy72[15:8]};
+assign main_holdingudprx_depacketizer_source_param_src_port = {builder_rhs_slice_proxy75[7:0], builder_rhs_slice_proxy74[15:8]};
+assign main_holdingudprx_depacketizer_source_payload_error = main_holdingudprx_depacketizer_sink_payload_error;
+assign main_holdingudprx_depacketizer_sink_last_be = main_holdingudprx_depacketizer_sink_last;
+assign main_holdingudprx_depacketizer_new_last_be = {main_holdingudprx_depacketizer_sink_last_be};
+assign main_holdingudprx_depacketizer_is_in_copy = (main_holdingudprx_depacketizer_is_ongoing0 | main_holdingudprx_depacketizer_is_ongoing1);
 always @(*) begin
-    main_rx_depacketizer_source_last <= 1'd0;
-    if (main_rx_depacketizer_source_last_s) begin
-        main_rx_depacketizer_source_last <= main_rx_depacketizer_source_last_b;
+    main_holdingudprx_depacketizer_source_last <= 1'd0;
+    if (main_holdingudprx_depacketizer_source_last_s) begin
+        main_holdingudprx_depacketizer_source_last <= main_holdingudprx_depacketizer_source_last_b;
     end else begin
-        main_rx_depacketizer_source_last <= main_rx_depacketizer_source_last_a;
+        main_holdingudprx_depacketizer_source_last <= main_holdingudprx_depacketizer_source_last_a;
     end
 end
 always @(*) begin
-    builder_liteethudp_liteethudprx_fsm0_next_state <= 2'd0;
-    builder_liteethudp_liteethudprx_fsm1_next_state <= 1'd0;
-    main_rx_depacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
-    main_rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
-    main_rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
-    main_rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
-    main_rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
-    main_rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
-    main_rx_depacketizer_is_ongoing0 <= 1'd0;
-    main_rx_depacketizer_is_ongoing1 <= 1'd0;
-    main_rx_depacketizer_is_ongoing2 <= 1'd0;
-    main_rx_depacketizer_is_ongoing3 <= 1'd0;
-    main_rx_depacketizer_sink_ready <= 1'd0;
-    main_rx_depacketizer_source_last_a <= 1'd0;
-    main_rx_depacketizer_source_last_b <= 1'd0;
-    main_rx_depacketizer_source_last_s <= 1'd0;
-    main_rx_depacketizer_source_payload_data <= 8'd0;
-    main_rx_depacketizer_source_payload_last_be <= 1'd0;
-    main_rx_depacketizer_source_valid <= 1'd0;
-    main_rx_depacketizer_sr_shift <= 1'd0;
-    builder_liteethudp_liteethudprx_fsm0_next_state <= builder_liteethudp_liteethudprx_fsm0_state;
-    case (builder_liteethudp_liteethudprx_fsm0_state)
+    builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd0;
+    builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
+    main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
+    main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
+    main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
+    main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
+    main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
+    main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
+    main_holdingudprx_depacketizer_is_ongoing0 <= 1'd0;
+    main_holdingudprx_depacketizer_is_ongoing1 <= 1'd0;
+    main_holdingudprx_depacketizer_is_ongoing2 <= 1'd0;
+    main_holdingudprx_depacketizer_is_ongoing3 <= 1'd0;
+    main_holdingudprx_depacketizer_sink_ready <= 1'd0;
+    main_holdingudprx_depacketizer_source_last_a <= 1'd0;
+    main_holdingudprx_depacketizer_source_last_b <= 1'd0;
+    main_holdingudprx_depacketizer_source_last_s <= 1'd0;
+    main_holdingudprx_depacketizer_source_payload_data <= 8'd0;
+    main_holdingudprx_depacketizer_source_payload_last_be <= 1'd0;
+    main_holdingudprx_depacketizer_source_valid <= 1'd0;
+    main_holdingudprx_depacketizer_sr_shift <= 1'd0;
+    builder_liteethudp_holdingudprx_fsm0_next_state <= builder_liteethudp_holdingudprx_fsm0_state;
+    case (builder_liteethudp_holdingudprx_fsm0_state)
         1'd1: begin
-            main_rx_depacketizer_sink_ready <= 1'd1;
-            if (main_rx_depacketizer_sink_valid) begin
-                main_rx_depacketizer_count_liteethudp_fsm0_next_value2 <= (main_rx_depacketizer_count + 1'd1);
-                main_rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-                main_rx_depacketizer_sr_shift <= 1'd1;
-                if ((main_rx_depacketizer_count == 3'd7)) begin
-                    builder_liteethudp_liteethudprx_fsm0_next_state <= 2'd2;
-                    main_rx_depacketizer_count_liteethudp_fsm0_next_value2 <= (main_rx_depacketizer_count + 1'd1);
-                    main_rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+            main_holdingudprx_depacketizer_sink_ready <= 1'd1;
+            if (main_holdingudprx_depacketizer_sink_valid) begin
+                main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= (main_holdingudprx_depacketizer_count + 1'd1);
+                main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+                main_holdingudprx_depacketizer_sr_shift <= 1'd1;
+                if ((main_holdingudprx_depacketizer_count == 3'd7)) begin
+                    builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
+                    main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= (main_holdingudprx_depacketizer_count + 1'd1);
+                    main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
                 end
             end
         end
         2'd2: begin
-            main_rx_depacketizer_source_valid <= (main_rx_depacketizer_sink_valid | main_rx_depacketizer_sink_d_last);
-            main_rx_depacketizer_source_last_a <= (main_rx_depacketizer_sink_last | main_rx_depacketizer_sink_d_last);
-            main_rx_depacketizer_sink_ready <= main_rx_depacketizer_source_ready;
-            main_rx_depacketizer_source_payload_data <= main_rx_depacketizer_sink_payload_data;
-            if ((main_rx_depacketizer_source_valid & main_rx_depacketizer_source_ready)) begin
-                if (main_rx_depacketizer_source_last) begin
-                    builder_liteethudp_liteethudprx_fsm0_next_state <= 1'd0;
+            main_holdingudprx_depacketizer_source_valid <= (main_holdingudprx_depacketizer_sink_valid | main_holdingudprx_depacketizer_sink_d_last);
+            main_holdingudprx_depacketizer_source_last_a <= (main_holdingudprx_depacketizer_sink_last | main_holdingudprx_depacketizer_sink_d_last);
+            main_holdingudprx_depacketizer_sink_ready <= main_holdingudprx_depacketizer_source_ready;
+            main_holdingudprx_depacketizer_source_payload_data <= main_holdingudprx_depacketizer_sink_payload_data;
+            if ((main_holdingudprx_depacketizer_source_valid & main_holdingudprx_depacketizer_source_ready)) begin
+                if (main_holdingudprx_depacketizer_source_last) begin
+                    builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
                 end
             end
-            main_rx_depacketizer_is_ongoing0 <= 1'd1;
-            main_rx_depacketizer_is_ongoing2 <= 1'd1;
+            main_holdingudprx_depacketizer_is_ongoing0 <= 1'd1;
+            main_holdingudprx_depacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            main_rx_depacketizer_is_ongoing1 <= 1'd1;
-            main_rx_depacketizer_is_ongoing3 <= 1'd1;
+            main_holdingudprx_depacketizer_is_ongoing1 <= 1'd1;
+            main_holdingudprx_depacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            main_rx_depacketizer_sink_ready <= 1'd1;
-            main_rx_depacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
-            main_rx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-            if (main_rx_depacketizer_sink_valid) begin
-                main_rx_depacketizer_sr_shift <= 1'd1;
-                main_rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
-                main_rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
+            main_holdingudprx_depacketizer_sink_ready <= 1'd1;
+            main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
+            main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+            if (main_holdingudprx_depacketizer_sink_valid) begin
+                main_holdingudprx_depacketizer_sr_shift <= 1'd1;
+                main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
+                main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
-                    builder_liteethudp_liteethudprx_fsm0_next_state <= 2'd2;
+                    builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
                 end else begin
-                    builder_liteethudp_liteethudprx_fsm0_next_state <= 1'd1;
+                    builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd1;
                 end
             end
         end
     endcase
-    builder_liteethudp_liteethudprx_fsm1_next_state <= builder_liteethudp_liteethudprx_fsm1_state;
-    case (builder_liteethudp_liteethudprx_fsm1_state)
+    builder_liteethudp_holdingudprx_fsm1_next_state <= builder_liteethudp_holdingudprx_fsm1_state;
+    case (builder_liteethudp_holdingudprx_fsm1_state)
         1'd1: begin
-            main_rx_depacketizer_source_last_b <= 1'd1;
-            main_rx_depacketizer_source_last_s <= 1'd1;
-            main_rx_depacketizer_source_payload_last_be <= main_rx_depacketizer_delayed_last_be;
-            main_rx_depacketizer_sink_ready <= 1'd0;
-            if ((main_rx_depacketizer_source_ready & main_rx_depacketizer_source_valid)) begin
-                builder_liteethudp_liteethudprx_fsm1_next_state <= 1'd0;
+            main_holdingudprx_depacketizer_source_last_b <= 1'd1;
+            main_holdingudprx_depacketizer_source_last_s <= 1'd1;
+            main_holdingudprx_depacketizer_source_payload_last_be <= main_holdingudprx_depacketizer_delayed_last_be;
+            main_holdingudprx_depacketizer_sink_ready <= 1'd0;
+            if ((main_holdingudprx_depacketizer_source_ready & main_holdingudprx_depacketizer_source_valid)) begin
+                builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((main_rx_depacketizer_sink_valid & main_rx_depacketizer_sink_last) & (main_rx_depacketizer_sink_last_be > main_rx_depacketizer_new_last_be))) begin
-                main_rx_depacketizer_source_last_b <= 1'd0;
-                main_rx_depacketizer_source_last_s <= 1'd1;
-                main_rx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((main_rx_depacketizer_source_ready & main_rx_depacketizer_source_valid) | ((~main_rx_depacketizer_was_in_copy) & main_rx_depacketizer_is_in_copy))) begin
-                    main_rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= main_rx_depacketizer_new_last_be;
-                    main_rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
-                    builder_liteethudp_liteethudprx_fsm1_next_state <= 1'd1;
+            if (((main_holdingudprx_depacketizer_sink_valid & main_holdingudprx_depacketizer_sink_last) & (main_holdingudprx_depacketizer_sink_last_be > main_holdingudprx_depacketizer_new_last_be))) begin
+                main_holdingudprx_depacketizer_source_last_b <= 1'd0;
+                main_holdingudprx_depacketizer_source_last_s <= 1'd1;
+                main_holdingudprx_depacketizer_source_payload_last_be <= 1'd0;
+                if (((main_holdingudprx_depacketizer_source_ready & main_holdingudprx_depacketizer_source_valid) | ((~main_holdingudprx_depacketizer_was_in_copy) & main_holdingudprx_depacketizer_is_in_copy))) begin
+                    main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= main_holdingudprx_depacketizer_new_last_be;
+                    main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
+                    builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (main_rx_depacketizer_sink_last) begin
-                    main_rx_depacketizer_source_last_b <= 1'd1;
-                    main_rx_depacketizer_source_last_s <= 1'd1;
-                    main_rx_depacketizer_source_payload_last_be <= main_rx_depacketizer_new_last_be;
+                if (main_holdingudprx_depacketizer_sink_last) begin
+                    main_holdingudprx_depacketizer_source_last_b <= 1'd1;
+                    main_holdingudprx_depacketizer_source_last_s <= 1'd1;
+                    main_holdingudprx_depacketizer_source_payload_last_be <= main_holdingudprx_depacketizer_new_last_be;
                 end
             end
-            if ((main_rx_depacketizer_is_ongoing2 | (main_rx_depacketizer_is_ongoing3 & (~main_rx_depacketizer_fsm_from_idle)))) begin
-                main_rx_depacketizer_sink_ready <= main_rx_depacketizer_source_ready;
+            if ((main_holdingudprx_depacketizer_is_ongoing2 | (main_holdingudprx_depacketizer_is_ongoing3 & (~main_holdingudprx_depacketizer_fsm_from_idle)))) begin
+                main_holdingudprx_depacketizer_sink_ready <= main_holdingudprx_depacketizer_source_ready;
             end else begin
-                main_rx_depacketizer_sink_ready <= 1'd1;
+                main_holdingudprx_depacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
-    builder_liteethudp_liteethudprx_next_state <= 2'd0;
-    main_rx_count_liteethudp_next_value <= 16'd0;
-    main_rx_count_liteethudp_next_value_ce <= 1'd0;
-    main_rx_depacketizer_source_ready <= 1'd0;
-    main_rx_source_source_last <= 1'd0;
-    main_rx_source_source_payload_last_be <= 1'd0;
-    main_rx_source_source_valid <= 1'd0;
-    builder_liteethudp_liteethudprx_next_state <= builder_liteethudp_liteethudprx_state;
-    case (builder_liteethudp_liteethudprx_state)
+    builder_liteethudp_holdingudprx_next_state <= 3'd0;
+    main_holdingudprx0_liteethudp_next_value3 <= 16'd0;
+    main_holdingudprx0_liteethudp_next_value_ce3 <= 1'd0;
+    main_holdingudprx1_liteethudp_next_value4 <= 16'd0;
+    main_holdingudprx1_liteethudp_next_value_ce4 <= 1'd0;
+    main_holdingudprx2_liteethudp_next_value5 <= 16'd0;
+    main_holdingudprx2_liteethudp_next_value_ce5 <= 1'd0;
+    main_holdingudprx3_liteethudp_next_value6 <= 32'd0;
+    main_holdingudprx3_liteethudp_next_value_ce6 <= 1'd0;
+    main_holdingudprx_count_liteethudp_next_value0 <= 16'd0;
+    main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd0;
+    main_holdingudprx_depacketizer_source_ready <= 1'd0;
+    main_holdingudprx_err_liteethudp_next_value1 <= 1'd0;
+    main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd0;
+    main_holdingudprx_held_liteethudp_next_value2 <= 8'd0;
+    main_holdingudprx_held_liteethudp_next_value_ce2 <= 1'd0;
+    main_holdingudprx_source_source_last <= 1'd0;
+    main_holdingudprx_source_source_param_dst_port <= 16'd0;
+    main_holdingudprx_source_source_param_ip_address <= 32'd0;
+    main_holdingudprx_source_source_param_length <= 16'd0;
+    main_holdingudprx_source_source_param_src_port <= 16'd0;
+    main_holdingudprx_source_source_payload_data <= 8'd0;
+    main_holdingudprx_source_source_payload_error <= 1'd0;
+    main_holdingudprx_source_source_valid <= 1'd0;
+    builder_liteethudp_holdingudprx_next_state <= builder_liteethudp_holdingudprx_state;
+    case (builder_liteethudp_holdingudprx_state)
         1'd1: begin
-            main_rx_source_source_valid <= main_rx_depacketizer_source_valid;
-            main_rx_depacketizer_source_ready <= main_rx_source_source_ready;
-            main_rx_source_source_last <= (main_rx_depacketizer_source_last | (main_rx_count >= main_rx_source_source_param_length));
-            if (main_rx_depacketizer_source_payload_last_be) begin
-                main_rx_source_source_payload_last_be <= main_rx_depacketizer_source_payload_last_be;
-            end else begin
-                if (main_rx_source_source_last) begin
-                    case ((main_rx_source_source_param_length & 1'd0))
-                        1'd1: begin
-                            main_rx_source_source_payload_last_be <= 1'd1;
-                        end
-                        2'd2: begin
-                            main_rx_source_source_payload_last_be <= 2'd2;
-                        end
-                        2'd3: begin
-                            main_rx_source_source_payload_last_be <= 3'd4;
-                        end
-                        3'd4: begin
-                            main_rx_source_source_payload_last_be <= 4'd8;
-                        end
-                        3'd5: begin
-                            main_rx_source_source_payload_last_be <= 5'd16;
-                        end
-                        3'd6: begin
-                            main_rx_source_source_payload_last_be <= 6'd32;
-                        end
-                        3'd7: begin
-                            main_rx_source_source_payload_last_be <= 7'd64;
-                        end
-                        default: begin
-                            main_rx_source_source_payload_last_be <= 1'd1;
-                        end
-                    endcase
-                end
-            end
-            if ((main_rx_source_source_valid & main_rx_source_source_ready)) begin
-                main_rx_count_liteethudp_next_value <= (main_rx_count + 1'd1);
-                main_rx_count_liteethudp_next_value_ce <= 1'd1;
-                if (main_rx_depacketizer_source_last) begin
-                    builder_liteethudp_liteethudprx_next_state <= 1'd0;
-                end else begin
-                    if (main_rx_source_source_last) begin
-                        builder_liteethudp_liteethudprx_next_state <= 2'd2;
+            main_holdingudprx_source_source_param_src_port <= main_holdingudprx_depacketizer_source_param_src_port;
+            main_holdingudprx_source_source_param_dst_port <= main_holdingudprx_depacketizer_source_param_dst_port;
+            main_holdingudprx_source_source_param_length <= main_holdingudprx_payload_len;
+            main_holdingudprx_source_source_param_ip_address <= main_holdingudprx_sink_sink_param_ip_address;
+            main_holdingudprx_source_source_payload_data <= main_holdingudprx_depacketizer_source_payload_data;
+            if ((main_holdingudprx_depacketizer_source_last | (main_holdingudprx_count < main_holdingudprx_payload_len))) begin
+                main_holdingudprx_source_source_valid <= main_holdingudprx_depacketizer_source_valid;
+                main_holdingudprx_depacketizer_source_ready <= main_holdingudprx_source_source_ready;
+                main_holdingudprx_source_source_last <= main_holdingudprx_depacketizer_source_last;
+                main_holdingudprx_source_source_payload_error <= (main_holdingudprx_depacketizer_source_payload_error | main_holdingudprx_err);
+                if ((main_holdingudprx_depacketizer_source_valid & main_holdingudprx_source_source_ready)) begin
+                    main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
+                    main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_depacketizer_source_payload_error);
+                    main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+                    if (main_holdingudprx_depacketizer_source_last) begin
+                        builder_liteethudp_holdingudprx_next_state <= 1'd0;
                     end
+                end
+            end else begin
+                main_holdingudprx_depacketizer_source_ready <= 1'd1;
+                if (main_holdingudprx_depacketizer_source_valid) begin
+                    main_holdingudprx_held_liteethudp_next_value2 <= main_holdingudprx_depacketizer_source_payload_data;
+                    main_holdingudprx_held_liteethudp_next_value_ce2 <= 1'd1;
+                    main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_depacketizer_source_payload_error);
+                    main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+                    main_holdingudprx0_liteethudp_next_value3 <= main_holdingudprx_depacketizer_source_param_src_port;
+                    main_holdingudprx0_liteethudp_next_value_ce3 <= 1'd1;
+                    main_holdingudprx1_liteethudp_next_value4 <= main_holdingudprx_depacketizer_source_param_dst_port;
+                    main_holdingudprx1_liteethudp_next_value_ce4 <= 1'd1;
+                    main_holdingudprx2_liteethudp_next_value5 <= main_holdingudprx_payload_len;
+                    main_holdingudprx2_liteethudp_next_value_ce5 <= 1'd1;
+                    main_holdingudprx3_liteethudp_next_value6 <= main_holdingudprx_sink_sink_param_ip_address;
+                    main_holdingudprx3_liteethudp_next_value_ce6 <= 1'd1;
+                    builder_liteethudp_holdingudprx_next_state <= 2'd2;
                 end
             end
         end
         2'd2: begin
-            main_rx_depacketizer_source_ready <= 1'd1;
-            if (((main_rx_depacketizer_source_valid & main_rx_depacketizer_source_last) & main_rx_depacketizer_source_ready)) begin
-                builder_liteethudp_liteethudprx_next_state <= 1'd0;
+            main_holdingudprx_depacketizer_source_ready <= 1'd1;
+            if (main_holdingudprx_depacketizer_source_valid) begin
+                main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_depacketizer_source_payload_error);
+                main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+                if (main_holdingudprx_depacketizer_source_last) begin
+                    builder_liteethudp_holdingudprx_next_state <= 2'd3;
+                end
+            end
+        end
+        2'd3: begin
+            main_holdingudprx_source_source_valid <= 1'd1;
+            main_holdingudprx_source_source_last <= 1'd1;
+            main_holdingudprx_source_source_payload_data <= main_holdingudprx_held;
+            main_holdingudprx_source_source_payload_error <= main_holdingudprx_err;
+            main_holdingudprx_source_source_param_src_port <= main_holdingudprx0;
+            main_holdingudprx_source_source_param_dst_port <= main_holdingudprx1;
+            main_holdingudprx_source_source_param_length <= main_holdingudprx2;
+            main_holdingudprx_source_source_param_ip_address <= main_holdingudprx3;
+            if (main_holdingudprx_source_source_ready) begin
+                builder_liteethudp_holdingudprx_next_state <= 1'd0;
+            end
+        end
+        3'd4: begin
+            main_holdingudprx_depacketizer_source_ready <= 1'd1;
+            if ((main_holdingudprx_depacketizer_source_valid & main_holdingudprx_depacketizer_source_last)) begin
+                builder_liteethudp_holdingudprx_next_state <= 1'd0;
             end
         end
         default: begin
-            main_rx_count_liteethudp_next_value <= 1'd1;
-            main_rx_count_liteethudp_next_value_ce <= 1'd1;
-            if (main_rx_depacketizer_source_valid) begin
-                builder_liteethudp_liteethudprx_next_state <= 2'd2;
-                if ((main_rx_sink_sink_param_protocol == 5'd17)) begin
-                    builder_liteethudp_liteethudprx_next_state <= 1'd1;
+            main_holdingudprx_count_liteethudp_next_value0 <= 1'd1;
+            main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+            main_holdingudprx_err_liteethudp_next_value1 <= 1'd0;
+            main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+            if (main_holdingudprx_depacketizer_source_valid) begin
+                builder_liteethudp_holdingudprx_next_state <= 3'd4;
+                if ((main_holdingudprx_sink_sink_param_protocol == 5'd17)) begin
+                    builder_liteethudp_holdingudprx_next_state <= 1'd1;
                 end
             end
         end
@@ -6028,14 +6076,14 @@ assign builder_rhs_slice_proxy64 = main_icmp_rx_depacketizer_header[63:32];
 assign builder_rhs_slice_proxy65 = main_icmp_rx_depacketizer_header[63:32];
 assign builder_rhs_slice_proxy66 = main_icmp_rx_depacketizer_header[63:32];
 assign builder_rhs_slice_proxy67 = main_icmp_rx_depacketizer_header[63:32];
-assign builder_rhs_slice_proxy68 = main_rx_depacketizer_header[63:48];
-assign builder_rhs_slice_proxy69 = main_rx_depacketizer_header[63:48];
-assign builder_rhs_slice_proxy70 = main_rx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy71 = main_rx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy72 = main_rx_depacketizer_header[47:32];
-assign builder_rhs_slice_proxy73 = main_rx_depacketizer_header[47:32];
-assign builder_rhs_slice_proxy74 = main_rx_depacketizer_header[15:0];
-assign builder_rhs_slice_proxy75 = main_rx_depacketizer_header[15:0];
+assign builder_rhs_slice_proxy68 = main_holdingudprx_depacketizer_header[63:48];
+assign builder_rhs_slice_proxy69 = main_holdingudprx_depacketizer_header[63:48];
+assign builder_rhs_slice_proxy70 = main_holdingudprx_depacketizer_header[31:16];
+assign builder_rhs_slice_proxy71 = main_holdingudprx_depacketizer_header[31:16];
+assign builder_rhs_slice_proxy72 = main_holdingudprx_depacketizer_header[47:32];
+assign builder_rhs_slice_proxy73 = main_holdingudprx_depacketizer_header[47:32];
+assign builder_rhs_slice_proxy74 = main_holdingudprx_depacketizer_header[15:0];
+assign builder_rhs_slice_proxy75 = main_holdingudprx_depacketizer_header[15:0];
 assign main_mac_core_tx_cdc_cdc_produce_rdomain = builder_multiregimpl0_regs1;
 assign main_mac_core_tx_cdc_cdc_consume_wdomain = builder_multiregimpl1_regs1;
 assign main_mac_core_pulsesynchronizer0_toggle_o = builder_multiregimpl2_regs1;
@@ -6629,45 +6677,63 @@ always @(posedge sys_clk) begin
             main_icmp_echo_param_fifo_level0 <= (main_icmp_echo_param_fifo_level0 - 1'd1);
         end
     end
-    if (main_tx_packetizer_sr_load) begin
-        main_tx_packetizer_sr <= main_tx_packetizer_header;
+    if (main_packetizer_sr_load) begin
+        main_packetizer_sr <= main_packetizer_header;
     end
-    if (main_tx_packetizer_sr_shift) begin
-        main_tx_packetizer_sr <= main_tx_packetizer_sr[63:8];
+    if (main_packetizer_sr_shift) begin
+        main_packetizer_sr <= main_packetizer_sr[63:8];
     end
     builder_liteethudp_liteethudptx_fsm0_state <= builder_liteethudp_liteethudptx_fsm0_next_state;
-    if (main_tx_packetizer_count_liteethudp_fsm0_next_value_ce0) begin
-        main_tx_packetizer_count <= main_tx_packetizer_count_liteethudp_fsm0_next_value0;
+    if (main_packetizer_count_liteethudp_fsm0_next_value_ce0) begin
+        main_packetizer_count <= main_packetizer_count_liteethudp_fsm0_next_value0;
     end
-    if (main_tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1) begin
-        main_tx_packetizer_fsm_from_idle <= main_tx_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1;
+    if (main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1) begin
+        main_packetizer_fsm_from_idle <= main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1;
     end
     builder_liteethudp_liteethudptx_fsm1_state <= builder_liteethudp_liteethudptx_fsm1_next_state;
-    if (main_tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0) begin
-        main_tx_packetizer_delayed_last_be <= main_tx_packetizer_delayed_last_be_liteethudp_fsm1_next_value0;
+    if (main_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0) begin
+        main_packetizer_delayed_last_be <= main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0;
     end
     builder_liteethudp_liteethudptx_state <= builder_liteethudp_liteethudptx_next_state;
-    if (main_rx_depacketizer_sr_shift) begin
-        main_rx_depacketizer_sr <= {main_rx_depacketizer_sink_payload_data, main_rx_depacketizer_sr[63:8]};
+    if (main_holdingudprx_depacketizer_sr_shift) begin
+        main_holdingudprx_depacketizer_sr <= {main_holdingudprx_depacketizer_sink_payload_data, main_holdingudprx_depacketizer_sr[63:8]};
     end
-    if (main_rx_depacketizer_sr_shift_leftover) begin
-        main_rx_depacketizer_sr <= {main_rx_depacketizer_sink_payload_data, main_rx_depacketizer_sr[63:0]};
+    if (main_holdingudprx_depacketizer_sr_shift_leftover) begin
+        main_holdingudprx_depacketizer_sr <= {main_holdingudprx_depacketizer_sink_payload_data, main_holdingudprx_depacketizer_sr[63:0]};
     end
-    main_rx_depacketizer_was_in_copy <= main_rx_depacketizer_is_in_copy;
-    builder_liteethudp_liteethudprx_fsm0_state <= builder_liteethudp_liteethudprx_fsm0_next_state;
-    if (main_rx_depacketizer_count_liteethudp_fsm0_next_value_ce2) begin
-        main_rx_depacketizer_count <= main_rx_depacketizer_count_liteethudp_fsm0_next_value2;
+    main_holdingudprx_depacketizer_was_in_copy <= main_holdingudprx_depacketizer_is_in_copy;
+    builder_liteethudp_holdingudprx_fsm0_state <= builder_liteethudp_holdingudprx_fsm0_next_state;
+    if (main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2) begin
+        main_holdingudprx_depacketizer_count <= main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2;
     end
-    if (main_rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
-        main_rx_depacketizer_fsm_from_idle <= main_rx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
+    if (main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
+        main_holdingudprx_depacketizer_fsm_from_idle <= main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
     end
-    builder_liteethudp_liteethudprx_fsm1_state <= builder_liteethudp_liteethudprx_fsm1_next_state;
-    if (main_rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
-        main_rx_depacketizer_delayed_last_be <= main_rx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
+    builder_liteethudp_holdingudprx_fsm1_state <= builder_liteethudp_holdingudprx_fsm1_next_state;
+    if (main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
+        main_holdingudprx_depacketizer_delayed_last_be <= main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
     end
-    builder_liteethudp_liteethudprx_state <= builder_liteethudp_liteethudprx_next_state;
-    if (main_rx_count_liteethudp_next_value_ce) begin
-        main_rx_count <= main_rx_count_liteethudp_next_value;
+    builder_liteethudp_holdingudprx_state <= builder_liteethudp_holdingudprx_next_state;
+    if (main_holdingudprx_count_liteethudp_next_value_ce0) begin
+        main_holdingudprx_count <= main_holdingudprx_count_liteethudp_next_value0;
+    end
+    if (main_holdingudprx_err_liteethudp_next_value_ce1) begin
+        main_holdingudprx_err <= main_holdingudprx_err_liteethudp_next_value1;
+    end
+    if (main_holdingudprx_held_liteethudp_next_value_ce2) begin
+        main_holdingudprx_held <= main_holdingudprx_held_liteethudp_next_value2;
+    end
+    if (main_holdingudprx0_liteethudp_next_value_ce3) begin
+        main_holdingudprx0 <= main_holdingudprx0_liteethudp_next_value3;
+    end
+    if (main_holdingudprx1_liteethudp_next_value_ce4) begin
+        main_holdingudprx1 <= main_holdingudprx1_liteethudp_next_value4;
+    end
+    if (main_holdingudprx2_liteethudp_next_value_ce5) begin
+        main_holdingudprx2 <= main_holdingudprx2_liteethudp_next_value5;
+    end
+    if (main_holdingudprx3_liteethudp_next_value_ce6) begin
+        main_holdingudprx3 <= main_holdingudprx3_liteethudp_next_value6;
     end
     if (builder_liteethudp_first) begin
         builder_liteethudp_sel_ongoing <= builder_liteethudp_sel0;
@@ -6782,14 +6848,20 @@ always @(posedge sys_clk) begin
         main_icmp_echo_param_fifo_level0 <= 2'd0;
         main_icmp_echo_param_fifo_produce <= 1'd0;
         main_icmp_echo_param_fifo_consume <= 1'd0;
-        main_tx_packetizer_count <= 3'd0;
-        main_tx_packetizer_fsm_from_idle <= 1'd0;
-        main_tx_packetizer_delayed_last_be <= 1'd0;
-        main_rx_depacketizer_count <= 3'd0;
-        main_rx_depacketizer_fsm_from_idle <= 1'd0;
-        main_rx_depacketizer_delayed_last_be <= 1'd0;
-        main_rx_depacketizer_was_in_copy <= 1'd0;
-        main_rx_count <= 16'd0;
+        main_packetizer_count <= 3'd0;
+        main_packetizer_fsm_from_idle <= 1'd0;
+        main_packetizer_delayed_last_be <= 1'd0;
+        main_holdingudprx_depacketizer_count <= 3'd0;
+        main_holdingudprx_depacketizer_fsm_from_idle <= 1'd0;
+        main_holdingudprx_depacketizer_delayed_last_be <= 1'd0;
+        main_holdingudprx_depacketizer_was_in_copy <= 1'd0;
+        main_holdingudprx_count <= 16'd0;
+        main_holdingudprx_err <= 1'd0;
+        main_holdingudprx_held <= 8'd0;
+        main_holdingudprx0 <= 16'd0;
+        main_holdingudprx1 <= 16'd0;
+        main_holdingudprx2 <= 16'd0;
+        main_holdingudprx3 <= 32'd0;
         builder_liteethmac_grant <= 1'd0;
         builder_liteethmac_status0_first <= 1'd1;
         builder_liteethmac_status0_ongoing1 <= 1'd0;
@@ -6833,9 +6905,9 @@ always @(posedge sys_clk) begin
         builder_liteethudp_liteethudptx_fsm0_state <= 2'd0;
         builder_liteethudp_liteethudptx_fsm1_state <= 1'd0;
         builder_liteethudp_liteethudptx_state <= 1'd0;
-        builder_liteethudp_liteethudprx_fsm0_state <= 2'd0;
-        builder_liteethudp_liteethudprx_fsm1_state <= 1'd0;
-        builder_liteethudp_liteethudprx_state <= 2'd0;
+        builder_liteethudp_holdingudprx_fsm0_state <= 2'd0;
+        builder_liteethudp_holdingudprx_fsm1_state <= 1'd0;
+        builder_liteethudp_holdingudprx_state <= 3'd0;
         builder_liteethudp_first <= 1'd1;
         builder_liteethudp_ongoing1 <= 1'd0;
         builder_liteethudp_sel_ongoing <= 1'd0;
@@ -6977,5 +7049,5 @@ assign main_icmp_echo_param_fifo_rdport_dat_r = storage_4_dat1;
 endmodule
 
 // -----------------------------------------------------------------------------
-//  Auto-Generated by LiteX on 2026-11-28 15:05:27.
+//  Auto-Generated by LiteX on 2026-11-28 15:35:06.
 //------------------------------------------------------------------------------
