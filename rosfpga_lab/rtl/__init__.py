@@ -58,7 +58,13 @@ writer's DATA / DATA_FRAG samples out (its header comment is the design note; pr
 ``tests/rtl/test_fabric_rtps_rx.py``); ``rfl_rtps_to_cdr`` turns its sample packets into the
 records a generated ``wire: cdr`` circuit's subscriber reads (the length, then the payload),
 forwarding a sample only once it ended good (proof ``rtps_to_cdr``; datagrams through both into
-a generated top in ``tests/rtl/test_fabric_rtps_cdr.py``).
+a generated top in ``tests/rtl/test_fabric_rtps_cdr.py``). Under them, the MAC / ARP / IPv4 /
+UDP stage is LiteEth's core, vendored as generated Verilog in ``fabric/vendor/`` (its README says
+which version, why LiteEth, and what ``tools/liteeth/gen_liteeth.py`` sets and fixes);
+``rfl_udp_port`` (with ``rfl_udp_store``, store and forward) joins its raw UDP port to the lab's
+streams, one payload per packet, and drops and counts what LiteEth flags late (proofs
+``udp_store``, ``udp_port``; a GMII peer in ``tests/rtl/test_fabric_udp.py``; place and route in
+``tests/benchmarks/bench_udp_timing.py``).
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError

@@ -38,7 +38,8 @@ from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 #: The network side of the node in the fabric (issue #31): modules proven here, not in a project.
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
-FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v")
+FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_udp_store.v",
+                  "rfl_udp_port.v")
 ENV_INCLUDE = "fv_env.vh"
 
 
@@ -173,6 +174,17 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_rtps_to_cdr (4-byte buffer, any input packets): a record only for a packet "
           "without TUSER that fitted, its length (LE32) that packet's byte count, its body that "
           "packet's bytes in order; 16 clocks (a 4-byte packet's whole record)"),
+    Proof("udp_store", ("rfl_udp_store.v",), "bmc", 24,
+          "rfl_udp_store (16-byte ring, 2 packets, WAIT 0, any input packets): output stream "
+          "rules with its meta and length, done pulses only with TLAST, input never held; 24 "
+          "clocks"),
+    Proof("udp_store", ("rfl_udp_store.v",), "bmc", 24,
+          "rfl_udp_store (16-byte ring, 2 packets, WAIT 1, any input packets): output stream "
+          "rules with its meta and length, done pulses only with TLAST; 24 clocks", ("FV_WAIT",)),
+    Proof("udp_port", ("rfl_udp_store.v", "rfl_udp_port.v"), "bmc", 20,
+          "rfl_udp_port (16-byte buffers, 2 payloads each way, any LiteEth stream and payloads): "
+          "both outputs keep the stream rules with their sideband, LiteEth never held back; 20 "
+          "clocks"),
 )
 
 

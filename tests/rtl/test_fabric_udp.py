@@ -1,7 +1,7 @@
 """The UDP stage of the node in the fabric (issue #31): the vendored LiteEth core
-(``rtl/fabric/vendor``) behind ``rfl_udp_port``, as ``rfl_udp_gmii``, driven at its GMII side.
+(``rtl/fabric/vendor``) behind ``rfl_udp_port``, as ``udp_gmii_top``, driven at its GMII side.
 
-A peer (cocotbext-eth's GMII models, in ``bench_rfl_udp_gmii.py``) sends frames the test builds
+A peer (cocotbext-eth's GMII models, in ``bench_udp_gmii_top.py``) sends frames the test builds
 with scapy: an ARP request for the node's IP (it must answer), one for another IP (no answer),
 then Ethernet/IPv4/UDP frames to the node's IP and port with random payload sizes (1 to 1,400
 bytes, padded frames among them) and random gaps, mixed with frames the node must drop: a bad
@@ -35,7 +35,7 @@ pytestmark = pytest.mark.rtl
 
 FABRIC = Path(__file__).resolve().parents[2] / "rosfpga_lab" / "rtl" / "fabric"
 SOURCES = [FABRIC / "vendor" / "liteeth_udp_gmii.v", FABRIC / "rfl_udp_store.v",
-           FABRIC / "rfl_udp_port.v", FABRIC / "rfl_udp_gmii.v"]
+           FABRIC / "rfl_udp_port.v", Path(__file__).with_name("udp_gmii_top.v")]
 NODE_MAC, NODE_IP = "02:52:46:4c:00:02", "192.168.10.2"
 PEER_MAC, PEER_IP = "02:00:00:00:00:aa", "192.168.10.1"
 OTHER_MAC, OTHER_IP = "02:00:00:00:00:bb", "192.168.10.9"
@@ -176,12 +176,12 @@ def cosimulate(tmp_path: Path, case: dict, monkeypatch: pytest.MonkeyPatch) -> d
     key = hashlib.sha256(b"".join(p.read_bytes() for p in SOURCES)).hexdigest()[:20]
     build = cache_root() / f"cocotb-udp-{key}"
     runner = get_runner("verilator")
-    runner.build(sources=SOURCES, hdl_toplevel="rfl_udp_gmii", build_dir=build,
+    runner.build(sources=SOURCES, hdl_toplevel="udp_gmii_top", build_dir=build,
                  timescale=("1ns", "1ps"), build_args=["-Wno-fatal", "-Wno-lint", "-Wno-style",
                                                        "-Wno-UNOPTFLAT"],
                  log_file=tmp_path / "build.log")
     try:
-        xml = runner.test(test_module="bench_rfl_udp_gmii", hdl_toplevel="rfl_udp_gmii",
+        xml = runner.test(test_module="bench_udp_gmii_top", hdl_toplevel="udp_gmii_top",
                           build_dir=build, test_dir=tmp_path,
                           extra_env={"UDP_CASE": str(tmp_path / "case.json"),
                                      "UDP_OUT": str(tmp_path / "out.json")},
@@ -214,7 +214,7 @@ def test_verilator_wall_is_silent_on_the_labs_files(tmp_path: Path) -> None:
     generated code, are not the lab's to fix)."""
     verilator = require_verilator()
     done = subprocess.run([verilator, "--lint-only", "-Wall", "-Wno-fatal", "--timescale",
-                           "1ns/1ps", "--top-module", "rfl_udp_gmii", *map(str, SOURCES)],
+                           "1ns/1ps", "--top-module", "udp_gmii_top", *map(str, SOURCES)],
                           cwd=tmp_path, capture_output=True, text=True, timeout=300)
     ours = [ln for ln in done.stderr.splitlines()
             if ln.startswith("%Warning") and "/vendor/" not in ln]
@@ -223,3 +223,24 @@ def test_verilator_wall_is_silent_on_the_labs_files(tmp_path: Path) -> None:
                            str(FABRIC / "rfl_udp_port.v")], cwd=tmp_path, capture_output=True,
                           text=True, timeout=120)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-3000:]
+
+
+@pytest.mark.parametrize("params,message", [
+    ({"COUNT_BITS": 33}, "rfl_udp_port: COUNT_BITS must be 1..32"),
+    ({"RX_BITS": 16}, "rfl_udp_store: ADDR_BITS must be 4..15"),
+    ({"TX_BITS": 3}, "rfl_udp_store: ADDR_BITS must be 4..15"),
+    ({"QUEUE_BITS": 0}, "rfl_udp_store: QUEUE_BITS must be 1..6"),
+])
+def test_verilator_refuses_an_illegal_port_parameter(params: dict[str, int], message: str,
+                                                     tmp_path: Path) -> None:
+    """rfl_udp_port's contracts (tests/rtl/test_house_rules.py compiles one file per module;
+    this one needs rfl_udp_store beside it); the defaults pass."""
+    verilator = require_verilator()
+    files = [str(FABRIC / "rfl_udp_store.v"), str(FABRIC / "rfl_udp_port.v")]
+    sets = [f"-G{k}={v}" for k, v in params.items()]
+    done = subprocess.run([verilator, "--lint-only", "--top-module", "rfl_udp_port", *sets,
+                           *files], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode != 0 and message in done.stderr, done.stderr[-3000:]
+    done = subprocess.run([verilator, "--lint-only", "--top-module", "rfl_udp_port", *files],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-3000:]

@@ -1,11 +1,11 @@
-// rfl_udp_gmii -- the UDP stage on a GMII PHY (issue #31): the vendored LiteEth core's
+// udp_gmii_top -- the UDP stage on a GMII PHY (issue #31): the vendored LiteEth core's
 // simulation variant (vendor/liteeth_udp_gmii.v: GMII in LiteEth's model mode, receive and send
 // on clk) joined to the lab's streams by rfl_udp_port (which says what is dropped and counted).
 // The node's MAC and IP addresses and its UDP port are inputs (held while running): LiteEth
 // answers ARP requests for cfg_ip and ICMP echo, and passes up the UDP datagrams to cfg_port.
 `default_nettype none
 
-module rfl_udp_gmii #(
+module udp_gmii_top #(
     parameter RX_BITS    = 11,                  // checked by rfl_udp_store / rfl_udp_port
     parameter TX_BITS    = 11,
     parameter QUEUE_BITS = 2,
