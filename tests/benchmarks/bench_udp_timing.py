@@ -21,9 +21,11 @@ rgmii  clk 53.0 / 59.0; PHY rx 111.8 / 112.9  4587          2806  3      102   1
 =====  =====================================  ===========  ====  =====  ====  =======
 
 Neither meets 125 MHz. The critical paths run through LiteEth's combinational ready and
-header-field chains across its depacketizers (MAC, IPv4, UDP) in the 8-bit stack's one clock;
-the lab's rfl_udp_port is not on them, and LiteEth as liteeth_gen would make it (no MAC/IP
-filter, no receive fixes) places at 61.8 MHz (gmii, seed 1), the same. The RGMII PHY's side
+header-field chains across its depacketizers (MAC, IPv4, UDP) in the 8-bit stack's one clock
+(gmii seed 1: from the IPv4 header through the UDP length compare of the generator's
+HoldingUDPRX, LiteEth's own compare in the same place, to the MAC depacketizer's state), not
+through rfl_udp_port; LiteEth as liteeth_gen would make it (no MAC/IP filter, no receive
+fixes) places at 61.8 MHz (gmii, seed 1), the same. The RGMII PHY's side
 (PHY, preamble, CRC, the clock-domain FIFOs) reaches 112 MHz. Line rate needs LiteEth's 32-bit
 datapath (vendor/README.md), not yet generated.
 
