@@ -10,7 +10,9 @@
 module udp_echo_rgmii #(
     parameter [47:0] MAC  = 48'h02_52_46_4C_00_02,
     parameter [31:0] IP   = 32'hC0_A8_0A_02,   // 192.168.10.2
-    parameter [15:0] PORT = 16'd7411
+    parameter [15:0] PORT = 16'd7411,          // with PORT_MASK: 7392..7423
+    parameter [15:0] PORT_MASK = 16'hFFE0,
+    parameter [31:0] MCAST = 32'hEF_FF_00_01   // 239.255.0.1
 ) (
     input  wire       clk,                      // the circuit's clock (125 MHz)
     input  wire       rst_n,
@@ -33,7 +35,8 @@ module udp_echo_rgmii #(
 
     liteeth_udp_ecp5_rgmii u_eth (
         .sys_clock(clk), .sys_reset(!rst_n),
-        .mac_address(MAC), .ip_address(IP), .udp_rx_port(PORT),
+        .mac_address(MAC), .ip_address(IP), .udp_rx_port(PORT), .udp_rx_port_mask(PORT_MASK),
+        .ip_multicast(MCAST),
         .rgmii_clocks_rx(rgmii_rx_clk), .rgmii_clocks_tx(rgmii_tx_clk),
         .rgmii_pads_rx_ctl(rgmii_rx_ctl), .rgmii_pads_rx_data(rgmii_rxd),
         .rgmii_pads_tx_ctl(rgmii_tx_ctl), .rgmii_pads_tx_data(rgmii_txd),

@@ -1,6 +1,6 @@
 """cocotb testbench of ``rfl_udp_gmii`` (run by tests/rtl/test_fabric_udp.py, not by pytest).
 
-The case comes in a JSON file (``UDP_CASE``): the node's addresses and port, the frames a peer
+The case comes in a JSON file (``UDP_CASE``): the node's addresses, ports and multicast group, the frames a peer
 sends on the GMII side (whole, FCS included, hex; built by the test with scapy), the payloads the
 lab side sends, the ARP reply the peer gives when the node asks for its MAC, per-mille input
 gaps and output backpressure. The bench plays the peer (cocotbext-eth's GMII source and sink)
@@ -88,6 +88,8 @@ async def udp_gmii(dut) -> None:
     dut.cfg_mac.value = int(case["node_mac"], 16)
     dut.cfg_ip.value = int(case["node_ip"], 16)
     dut.cfg_port.value = case["node_port"]
+    dut.cfg_port_mask.value = case["port_mask"]
+    dut.cfg_mcast.value = int(case["group"], 16)
     dut.s_axis_tvalid.value = 0
     dut.m_axis_tready.value = 0
     dut.gmii_rx_dv.value = 0

@@ -6,7 +6,9 @@ with scapy: an ARP request for the node's IP (it must answer), one for another I
 then Ethernet/IPv4/UDP frames to the node's IP and port with random payload sizes (1 to 1,400
 bytes, padded frames among them) and random gaps, mixed with frames the node must drop: a bad
 FCS, a bad IPv4 header checksum, another destination IP, another unicast MAC, another UDP port, a
-frame cut short (its IP and UDP lengths claim more), an empty datagram. Exactly the good
+frame cut short (its IP and UDP lengths claim more), an empty datagram, another multicast
+group. Good frames go to the node's IP, broadcast, or the SPDP multicast group, and to any of
+its participant's ports (user and metatraffic unicast, SPDP multicast: one masked port). Exactly the good
 payloads must come out, in order, with the sender's IP and ports, and the counters must count
 what ``rfl_udp_port`` says it counts. Then the lab side sends payloads to the peer: after ARP
 (the bench answers the node's request), each must leave as one well-formed frame (preamble, FCS,
@@ -29,7 +31,8 @@ from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
 from rosfpga_lab.rtl.sim import cache_root
-from rosfpga_lab.rtps.entities import user_port
+from rosfpga_lab.rtps.entities import discovery_multicast_port, discovery_port, user_port
+from rosfpga_lab.rtps.limits import SPDP_MULTICAST_ADDRESS
 from tests.support.rtltools import TB_DIR, cocotb_verilator, require_verilator
 
 pytestmark = pytest.mark.rtl
@@ -41,6 +44,9 @@ NODE_MAC, NODE_IP = "02:52:46:4c:00:02", "192.168.10.2"
 PEER_MAC, PEER_IP = "02:00:00:00:00:aa", "192.168.10.1"
 OTHER_MAC, OTHER_IP = "02:00:00:00:00:bb", "192.168.10.9"
 NODE_PORT = user_port(0, 0)
+PORT_MASK = 0xFFE0                               # 7392..7423: the domain 0 participant's ports
+NODE_PORTS = (NODE_PORT, discovery_port(0, 0), discovery_multicast_port(0))
+OTHER_GROUP = "239.255.0.2"
 PREAMBLE = bytes.fromhex("55555555555555d5")
 MIN_FRAME = 60                                   # without the FCS
 
@@ -57,13 +63,19 @@ def _udp(payload: bytes, *, mac: str = NODE_MAC, ip: str = NODE_IP, dport: int =
     return bytes(Ether(dst=mac, src=PEER_MAC) / ip_layer / UDP(sport=sport, dport=dport) / payload)
 
 
+def _group_mac(group: str) -> str:
+    """The Ethernet address of an IPv4 multicast group (RFC 1112: 01:00:5e + its low 23 bits)."""
+    low = int(ipaddress.IPv4Address(group)) & 0x7FFFFF
+    return "01:00:5e:" + ":".join(f"{b:02x}" for b in low.to_bytes(3, "big"))
+
+
 def _arp_request(target: str) -> bytes:
     return bytes(Ether(dst="ff:ff:ff:ff:ff:ff", src=PEER_MAC) /
                  ARP(op=1, hwsrc=PEER_MAC, psrc=PEER_IP, pdst=target))
 
 
-KINDS = ["good"] * 10 + ["bcast", "bad_fcs", "bad_ipsum", "other_ip", "other_mac", "other_port",
-                         "cut"]
+KINDS = ["good"] * 8 + ["bcast", "mcast", "bad_fcs", "bad_ipsum", "other_ip", "other_mac",
+                        "other_port", "other_group", "cut"]
 
 
 def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
@@ -73,17 +85,23 @@ def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
     good: list[dict] = []
     counts = {"rx_packets": 0, "rx_error": 0, "rx_length": 0, "rx_overflow": 0,
               "tx_packets": sends, "tx_overflow": 0}
-    kinds = [rng.choice(KINDS) for _ in range(frames)] + ["empty"]
+    kinds = [rng.choice(KINDS) for _ in range(frames)] + sorted(set(KINDS)) + ["empty"]
     rng.shuffle(kinds)
     for kind in kinds:
         size = rng.choice([rng.randint(1, 17), rng.randint(18, 200), rng.randint(200, 1400)])
         payload = rng.randbytes(size)
         sport = rng.randint(1024, 65535)
-        if kind in ("good", "bcast"):
-            wire.append(_fcs(_udp(payload, sport=sport,
-                                  mac="ff:ff:ff:ff:ff:ff" if kind == "bcast" else NODE_MAC)))
+        if kind in ("good", "bcast", "mcast"):
+            dport = rng.choice(NODE_PORTS)
+            if kind == "mcast":
+                frame = _udp(payload, sport=sport, dport=dport, ip=SPDP_MULTICAST_ADDRESS,
+                             mac=_group_mac(SPDP_MULTICAST_ADDRESS))
+            else:
+                frame = _udp(payload, sport=sport, dport=dport,
+                             mac="ff:ff:ff:ff:ff:ff" if kind == "bcast" else NODE_MAC)
+            wire.append(_fcs(frame))
             good.append({"data": payload.hex(), "ip": int(ipaddress.IPv4Address(PEER_IP)),
-                         "sport": sport, "dport": NODE_PORT, "length": size})
+                         "sport": sport, "dport": dport, "length": size})
             counts["rx_packets"] += 1
         elif kind == "bad_fcs":
             frame = bytearray(_fcs(_udp(payload, sport=sport)))
@@ -97,8 +115,11 @@ def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
             wire.append(_fcs(_udp(payload, sport=sport, ip=OTHER_IP)))
         elif kind == "other_mac":
             wire.append(_fcs(_udp(payload, sport=sport, mac=OTHER_MAC)))
-        elif kind == "other_port":
-            wire.append(_fcs(_udp(payload, sport=sport, dport=NODE_PORT + 1)))
+        elif kind == "other_port":                 # just past the ports the mask takes
+            wire.append(_fcs(_udp(payload, sport=sport, dport=rng.choice([7391, 7424, 7411 + 32]))))
+        elif kind == "other_group":
+            wire.append(_fcs(_udp(payload, sport=sport, ip=OTHER_GROUP,
+                                  mac=_group_mac(OTHER_GROUP))))
         elif kind == "cut":
             whole = _udp(rng.randbytes(rng.randint(80, 1400)), sport=sport)
             wire.append(_fcs(whole[:len(whole) - rng.randint(1, 40)]))
@@ -112,6 +133,7 @@ def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
     reply = _fcs(bytes(Ether(dst=NODE_MAC, src=PEER_MAC) /
                        ARP(op=2, hwsrc=PEER_MAC, psrc=PEER_IP, hwdst=NODE_MAC, pdst=NODE_IP)))
     return {"seed": seed, "gap": gap, "bp": bp, "node_mac": NODE_MAC.replace(":", ""),
+            "port_mask": PORT_MASK, "group": ipaddress.IPv4Address(SPDP_MULTICAST_ADDRESS).packed.hex(),
             "node_ip": ipaddress.IPv4Address(NODE_IP).packed.hex(), "node_port": NODE_PORT,
             "peer_ip": ipaddress.IPv4Address(PEER_IP).packed.hex(), "frames": [f.hex() for f in wire],
             "arp_reply": reply.hex(), "replies": 1, "sends": out, "good": good, "counts": counts}
@@ -122,6 +144,11 @@ def test_the_case_is_not_trivial() -> None:
     assert len(case["good"]) > 15 and case["counts"]["rx_error"] and case["counts"]["rx_length"]
     sizes = [len(g["data"]) // 2 for g in case["good"]]
     assert min(sizes) < 18 and max(sizes) > 1000          # padded frames and long ones
+    assert {g["dport"] for g in case["good"]} == set(NODE_PORTS)
+    for seed in (1, 2, 5):                                 # both groups reach the node
+        frames = make_case(seed, 40, 6, 0, 0)["frames"]
+        for group in (SPDP_MULTICAST_ADDRESS, OTHER_GROUP):
+            assert any(f.startswith(_group_mac(group).replace(":", "")) for f in frames)
 
 
 def _frames(sent: list[str]) -> list[bytes]:

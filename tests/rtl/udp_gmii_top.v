@@ -2,7 +2,8 @@
 // simulation variant (vendor/liteeth_udp_gmii.v: GMII in LiteEth's model mode, receive and send
 // on clk) joined to the lab's streams by rfl_udp_port (which says what is dropped and counted).
 // The node's MAC and IP addresses and its UDP port are inputs (held while running): LiteEth
-// answers ARP requests for cfg_ip and ICMP echo, and passes up the UDP datagrams to cfg_port.
+// answers ARP requests for cfg_ip and ICMP echo, and passes up the UDP datagrams to cfg_ip or
+// the group cfg_mcast and to the ports cfg_port / cfg_port_mask select.
 `default_nettype none
 
 module udp_gmii_top #(
@@ -15,7 +16,9 @@ module udp_gmii_top #(
     input  wire                  rst_n,
     input  wire [47:0]           cfg_mac,
     input  wire [31:0]           cfg_ip,
-    input  wire [15:0]           cfg_port,      // the UDP port received
+    input  wire [15:0]           cfg_port,      // the UDP ports received: those equal to
+    input  wire [15:0]           cfg_port_mask, // cfg_port on the mask's bits
+    input  wire [31:0]           cfg_mcast,     // the IPv4 multicast group received
     input  wire [7:0]            gmii_rxd,
     input  wire                  gmii_rx_dv,
     input  wire                  gmii_rx_er,
@@ -53,6 +56,7 @@ module udp_gmii_top #(
     liteeth_udp_gmii u_eth (
         .sys_clock(clk), .sys_reset(!rst_n),
         .mac_address(cfg_mac), .ip_address(cfg_ip), .udp_rx_port(cfg_port),
+        .udp_rx_port_mask(cfg_port_mask), .ip_multicast(cfg_mcast),
         .gmii_pads_rx_data(gmii_rxd), .gmii_pads_rx_dv(gmii_rx_dv), .gmii_pads_rx_er(gmii_rx_er),
         .gmii_pads_tx_data(gmii_txd), .gmii_pads_tx_en(gmii_tx_en), .gmii_pads_tx_er(gmii_tx_er),
         .udp_source_data(rx_data), .udp_source_valid(rx_valid), .udp_source_ready(rx_ready),

@@ -12,13 +12,16 @@ It builds what LiteEth's own ``liteeth_gen`` builds for ``core: udp`` (PHY, MAC,
 ICMP, UDP), from the same LiteEth classes, with three differences ``liteeth_gen`` has no
 configuration key for (so this script, not a YAML file for ``liteeth_gen``), and one fix:
 
-* the node's MAC address, IP address and UDP port are inputs of the core (``mac_address``,
-  ``ip_address``, ``udp_rx_port``), so one vendored file serves every configuration;
+* the node's MAC address, IP address, UDP port and one multicast group are inputs of the core
+  (``mac_address``, ``ip_address``, ``udp_rx_port`` with ``udp_rx_port_mask``: the ports taken
+  are those equal to it on the mask's bits, ``ip_multicast``), so one vendored file serves every
+  configuration;
   ``liteeth_gen``'s ``raw`` port receives on the port its transmit side sends to
   (``sink_dst_port``), which an RTPS node (listening on its port, sending to its peer's) cannot use;
 * received frames are filtered by destination MAC (ours, broadcast, IPv4 multicast) before the
   EtherType dispatch (LiteEth's crossbar MAC takes every frame; only its ``hybrid`` MAC filters)
-  and by destination IP (``with_ip_broadcast=False``: LiteEth's default takes every IPv4 frame);
+  and by destination IP (ours or ``ip_multicast``: LiteEth's ``with_ip_broadcast``, a switch
+  that takes every IPv4 frame when on, is driven by that comparison);
 * the PHY's receive stream gets ``last_be`` = ``last`` (without it LiteEth 2024.12's 8-bit
   receive path never flags a bad FCS: its CRC checker looks at the lanes ``last_be`` enables);
 * the UDP receiver holds a payload's last byte until its frame ends (``HoldingUDPRX``), so a
@@ -42,7 +45,7 @@ import liteeth.core.udp
 import liteeth.mac
 from liteeth.common import eth_ipv4_user_description, eth_udp_user_description, udp_header, \
     udp_protocol
-from liteeth.core.udp import LiteEthUDPDepacketizer
+from liteeth.core.udp import LiteEthUDPCrossbar, LiteEthUDPDepacketizer
 from liteeth import phy as liteeth_phys
 from liteeth.core import LiteEthUDPIPCore
 from liteeth.gen import _io, get_udp_raw_port_ios
@@ -70,6 +73,8 @@ PADS = [
         Subsignal("rx_ctl", Pins(1)), Subsignal("rx_data", Pins(4)),
         Subsignal("tx_ctl", Pins(1)), Subsignal("tx_data", Pins(4))),
     ("udp_rx_port", 0, Pins(16)),
+    ("udp_rx_port_mask", 0, Pins(16)),
+    ("ip_multicast", 0, Pins(32)),
 ]
 
 
@@ -90,6 +95,21 @@ class FilteringMACCrossbar(LiteEthMACCrossbar):
         # The parent set sel by EtherType; in Migen the later assignment wins: no port for a
         # frame that is not ours.
         self.comb += If(~ours, self.dispatcher.sel.eq(0))
+
+
+class MaskedUDPCrossbar(LiteEthUDPCrossbar):
+    """LiteEth's UDP crossbar with its one user port taking every destination port equal to
+    the port's key on the bits of ``mask`` (an RTPS participant listens on several: the SPDP
+    multicast port, its metatraffic and its user-data unicast ports; the sideband says which)."""
+
+    mask: Signal | None = None
+
+    def do_finalize(self) -> None:
+        super().do_finalize()
+        assert len(self.users) == 1
+        (key,) = self.users.keys()
+        dst = self.master.sink.dst_port
+        self.comb += If(((dst ^ key) & self.mask) == 0, self.dispatcher.sel.eq(1))
 
 
 class HoldingUDPRX(LiteXModule):
@@ -175,15 +195,20 @@ class UDPPortCore(SoCMini):
         mac_address = platform.request("mac_address")
         ip_address = platform.request("ip_address")
         FilteringMACCrossbar.hw_mac = mac_address
+        MaskedUDPCrossbar.mask = platform.request("udp_rx_port_mask")
+        ip_multicast = platform.request("ip_multicast")
+        take_group = Signal()                   # LiteEth's "broadcast" switch, made a signal
         self.core = LiteEthUDPIPCore(
             ethphy, mac_address=mac_address, ip_address=ip_address,
             clk_freq=int(float(cfg["clk_freq"])), dw=8,
             arp_entries=int(cfg.get("arp_entries", 1)),
             with_icmp=bool(cfg.get("with_icmp", True)),
-            with_ip_broadcast=False,
+            with_ip_broadcast=take_group,
             tx_cdc_depth=int(cfg.get("tx_cdc_depth", 32)), tx_cdc_buffered=False,
             rx_cdc_depth=int(cfg.get("rx_cdc_depth", 32)), rx_cdc_buffered=False)
 
+        target = self.core.ip.rx.depacketizer.source.target_ip
+        self.comb += take_group.eq(target == ip_multicast)
         rx_port = platform.request("udp_rx_port")
         platform.add_extension(get_udp_raw_port_ios("udp", data_width=8))
         pads = platform.request("udp")
@@ -215,6 +240,7 @@ def main() -> None:
     name = cfg["name"]
     liteeth.mac.LiteEthMACCrossbar = FilteringMACCrossbar   # before the core is built
     liteeth.core.udp.LiteEthUDPRX = HoldingUDPRX
+    liteeth.core.udp.LiteEthUDPCrossbar = MaskedUDPCrossbar
     platform = LatticePlatform(cfg["device"], io=[], toolchain="trellis")
     platform.add_extension(_io)
     platform.add_extension(PADS)

@@ -4,8 +4,8 @@
 // its last byte), the peer's IP address and the ports as sideband.
 //
 // Received (m_axis_*, m_udp_* hold for every beat of a packet): the payloads of the UDP datagrams
-// LiteEth passes up (for our MAC, broadcast or IPv4 multicast; for our IP; a good IPv4 header;
-// to the core's udp_rx_port), each only once it ended good (rfl_udp_store): LiteEth marks a
+// LiteEth passes up (vendor/README.md says which: our MAC and IP, or our multicast group; the
+// core's ports), each only once it ended good (rfl_udp_store): LiteEth marks a
 // frame with a bad FCS only at its end (le_rx_error), and cuts a payload to its UDP
 // length without saying when the frame was shorter. Dropped and counted here: le_rx_error
 // (cnt_rx_error), a payload whose bytes are not its UDP length (cnt_rx_length: a truncated
