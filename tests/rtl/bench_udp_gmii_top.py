@@ -1,13 +1,14 @@
-"""cocotb testbench of ``rfl_udp_gmii`` (run by tests/rtl/test_fabric_udp.py, not by pytest).
+"""cocotb testbench of ``udp_gmii_top`` (run by tests/rtl/test_fabric_udp.py, not pytest).
 
-The case comes in a JSON file (``UDP_CASE``): the node's addresses, ports and multicast group, the frames a peer
-sends on the GMII side (whole, FCS included, hex; built by the test with scapy), the payloads the
-lab side sends, the ARP reply the peer gives when the node asks for its MAC, per-mille input
-gaps and output backpressure. The bench plays the peer (cocotbext-eth's GMII source and sink)
-and the lab side (the AXI4-Stream ports, byte by byte, with random gaps and backpressure), and
-writes what came out (``UDP_OUT``): the payloads received with their sideband, every frame the
-node sent (preamble and FCS included), the counters. The test checks them; the bench checks only
-the stream rules (a valid beat held until taken, the sideband constant over a packet).
+The case comes in a JSON file (``UDP_CASE``): the node's addresses, ports and multicast group,
+the frames a peer sends on the GMII side (whole, FCS included, hex; built by the test with
+scapy), the payloads the lab side sends, the ARP reply the peer gives when the node asks for
+its MAC, per-mille input gaps and output backpressure. The bench plays the peer (cocotbext-eth's
+GMII source and sink) and the lab side (the AXI4-Stream ports, byte by byte, with random gaps
+and backpressure), and writes what came out (``UDP_OUT``): the payloads received with their
+sideband, every frame the node sent (preamble and FCS included), the counters. The test checks
+them; the bench checks only the stream rules (a valid beat held until taken, the sideband
+constant over a packet).
 """
 
 from __future__ import annotations

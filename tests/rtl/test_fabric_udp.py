@@ -8,11 +8,12 @@ bytes, padded frames among them) and random gaps, mixed with frames the node mus
 FCS, a bad IPv4 header checksum, another destination IP, another unicast MAC, another UDP port, a
 frame cut short (its IP and UDP lengths claim more), an empty datagram, another multicast
 group. Good frames go to the node's IP, broadcast, or the SPDP multicast group, and to any of
-its participant's ports (user and metatraffic unicast, SPDP multicast: one masked port). Exactly the good
-payloads must come out, in order, with the sender's IP and ports, and the counters must count
-what ``rfl_udp_port`` says it counts. Then the lab side sends payloads to the peer: after ARP
-(the bench answers the node's request), each must leave as one well-formed frame (preamble, FCS,
-IPv4 header checksum, addresses, ports, lengths), parsed here with scapy.
+its participant's ports (user and metatraffic unicast, SPDP multicast: one masked port).
+Exactly the good payloads must come out, in order, with the sender's IP and ports, and the
+counters must count what ``rfl_udp_port`` says it counts. Then the lab side sends payloads to
+the peer: after ARP (the bench answers the node's request), each must leave as one well-formed
+frame (preamble, FCS, IPv4 header checksum, addresses, ports, lengths), parsed here with scapy.
+Runs on Verilator (a first build some 20 to 50 s here, then cached; the simulation some 5 s).
 """
 
 from __future__ import annotations
@@ -127,16 +128,19 @@ def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
         else:                                    # empty: LiteEth passes one padding byte
             wire.append(_fcs(_udp(b"", sport=sport)))
             counts["rx_length"] += 1
+    peer = int(ipaddress.IPv4Address(PEER_IP))
     out = [{"data": rng.randbytes(rng.choice([1, rng.randint(2, 64), rng.randint(64, 1400)]))
-            .hex(), "ip": int(ipaddress.IPv4Address(PEER_IP)), "sport": NODE_PORT, "dport": rng.randint(7400, 7500)}
+            .hex(), "ip": peer, "sport": NODE_PORT, "dport": rng.randint(7400, 7500)}
            for _ in range(sends)]
     reply = _fcs(bytes(Ether(dst=NODE_MAC, src=PEER_MAC) /
                        ARP(op=2, hwsrc=PEER_MAC, psrc=PEER_IP, hwdst=NODE_MAC, pdst=NODE_IP)))
+    packed = {k: ipaddress.IPv4Address(v).packed.hex()
+              for k, v in (("group", SPDP_MULTICAST_ADDRESS), ("node_ip", NODE_IP),
+                           ("peer_ip", PEER_IP))}
     return {"seed": seed, "gap": gap, "bp": bp, "node_mac": NODE_MAC.replace(":", ""),
-            "port_mask": PORT_MASK, "group": ipaddress.IPv4Address(SPDP_MULTICAST_ADDRESS).packed.hex(),
-            "node_ip": ipaddress.IPv4Address(NODE_IP).packed.hex(), "node_port": NODE_PORT,
-            "peer_ip": ipaddress.IPv4Address(PEER_IP).packed.hex(), "frames": [f.hex() for f in wire],
-            "arp_reply": reply.hex(), "replies": 1, "sends": out, "good": good, "counts": counts}
+            "port_mask": PORT_MASK, **packed, "node_port": NODE_PORT,
+            "frames": [f.hex() for f in wire], "arp_reply": reply.hex(), "replies": 1,
+            "sends": out, "good": good, "counts": counts}
 
 
 def test_the_case_is_not_trivial() -> None:
