@@ -66,7 +66,13 @@ streamed without a sample buffer, and a HEARTBEAT), its GUID prefix and writer i
 :func:`rosfpga_lab.rtl.discrom.tx_parameters` of the participant the discovery ROM announces
 (proof ``rtps_tx``; byte for byte against the lab's RTPS builders in
 ``tests/rtl/test_fabric_rtps_tx.py``, RTPS in to RTPS out through a generated top in
-``tests/rtl/test_fabric_rtps_loop.py``, where Cyclone DDS takes what it sends).
+``tests/rtl/test_fabric_rtps_loop.py``, where Cyclone DDS takes what it sends). Under them, the
+MAC / ARP / IPv4 / UDP stage is LiteEth's core, vendored as generated Verilog in ``fabric/vendor/`` (its README says
+which version, why LiteEth, and what ``tools/liteeth/gen_liteeth.py`` sets and fixes);
+``rfl_udp_port`` (with ``rfl_udp_store``, store and forward) joins its raw UDP port to the lab's
+streams, one payload per packet, and drops and counts what LiteEth flags late (proofs
+``udp_store``, ``udp_port``; a GMII peer in ``tests/rtl/test_fabric_udp.py``; place and route in
+``tests/benchmarks/bench_udp_timing.py``).
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError

@@ -38,8 +38,8 @@ from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 #: The network side of the node in the fabric (issue #31): modules proven here, not in a project.
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
-FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v",
-                  "rfl_rtps_tx.v")
+FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
+                  "rfl_udp_store.v", "rfl_udp_port.v")
 ENV_INCLUDE = "fv_env.vh"
 
 
@@ -184,6 +184,17 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_rtps_tx (4-byte fragments, samples of at most 16 bytes, INFO_TS, any records): the "
           "first datagram opens with the RTPS header's magic, version 2.3 and vendor 0, no TLAST "
           "in them; 20 clocks (a record's length, the fields, 10 bytes out)"),
+    Proof("udp_store", ("rfl_udp_store.v",), "bmc", 24,
+          "rfl_udp_store (16-byte ring, 2 packets, WAIT 0, any input packets): output stream "
+          "rules with its meta and length, done pulses only with TLAST, input never held; 24 "
+          "clocks"),
+    Proof("udp_store", ("rfl_udp_store.v",), "bmc", 24,
+          "rfl_udp_store (16-byte ring, 2 packets, WAIT 1, any input packets): output stream "
+          "rules with its meta and length, done pulses only with TLAST; 24 clocks", ("FV_WAIT",)),
+    Proof("udp_port", ("rfl_udp_store.v", "rfl_udp_port.v"), "bmc", 20,
+          "rfl_udp_port (16-byte buffers, 2 payloads each way, any LiteEth stream and payloads): "
+          "both outputs keep the stream rules with their sideband, LiteEth never held back; 20 "
+          "clocks"),
 )
 
 

@@ -84,6 +84,7 @@ def test_the_rules_cover_every_module_file_in_scope() -> None:
     assert {"rfl_fifo.v", "rfl_fifo2axi.v", "rfl_axi2fifo.v", "rfl_slice.v", "rfl_subscriber.v",
             "rfl_publisher.v", "rfl_top.v", "rfl_morph.v", "rfl_harness.v", "rfl_tb.v",
             "rfl_rtps_disc_rom.v", "rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
+            "rfl_udp_store.v", "rfl_udp_port.v",
             "rfl_gsubscriber.v", "rfl_gpublisher.v", "rfl_gtop.v", "rfl_elem_pack.v",
             "rfl_elem_unpack.v", "rfl_window1d.v", "rfl_elem_tb.v"} <= names
 
@@ -165,6 +166,12 @@ CONTRACTS = [
     ("rfl_rtps_tx", {"MAX_SAMPLE": 0}, "rfl_rtps_tx: MAX_SAMPLE must be 1..2**31-1"),
     ("rfl_rtps_tx", {"INFO_TS": 2}, "rfl_rtps_tx: INFO_TS must be 0 or 1"),
     ("rfl_rtps_tx", {"COUNT_BITS": 33}, "rfl_rtps_tx: COUNT_BITS must be 1..32"),
+    ("rfl_udp_store", {"ADDR_BITS": 16}, "rfl_udp_store: ADDR_BITS must be 4..15"),
+    ("rfl_udp_store", {"ADDR_BITS": 3}, "rfl_udp_store: ADDR_BITS must be 4..15"),
+    ("rfl_udp_store", {"QUEUE_BITS": 7}, "rfl_udp_store: QUEUE_BITS must be 1..6"),
+    ("rfl_udp_store", {"META_W": 0}, "rfl_udp_store: META_W must be 1..128"),
+    ("rfl_udp_store", {"WAIT": 2}, "rfl_udp_store: WAIT must be 0 or 1"),
+    # rfl_udp_port needs rfl_udp_store beside it: its contract is tests/rtl/test_fabric_udp.py's
     # the generated projects' element modules (the walkers and rfl_gtop need a project's
     # rfl_layout.vh: their contracts are elaborated in hls/test_generic_project.py's lint)
     ("rfl_elem_pack", {"EBYTES": 9}, "rfl_elem_pack: EBYTES must be 1..8"),
@@ -177,7 +184,7 @@ CONTRACTS = [
 ]
 # Icarus cannot elaborate these at all (a part select [-1:0] before the check runs): refused,
 # though with its own message
-ICARUS_ELABORATION_FAILS = {("rfl_morph", "HEIGHT")}
+ICARUS_ELABORATION_FAILS = {("rfl_morph", "HEIGHT"), ("rfl_udp_store", "META_W")}
 _IDS = [f"{m}-{'-'.join(f'{k}{v}' for k, v in p.items())}" for m, p, _ in CONTRACTS]
 
 

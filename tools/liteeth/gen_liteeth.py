@@ -1,0 +1,265 @@
+#!/usr/bin/env python3
+"""Generate the lab's vendored LiteEth UDP/IP core (issue 31) as one Verilog file.
+
+Run it in a virtual environment of its own (LiteX and Migen are not lab dependencies)::
+
+    python -m venv /tmp/leth
+    /tmp/leth/bin/pip install liteeth==2024.12 litex==2024.12 migen==0.10.0 pyyaml
+    /tmp/leth/bin/python tools/liteeth/gen_liteeth.py tools/liteeth/liteeth_gmii.yml \
+        -o rosfpga_lab/rtl/fabric/vendor
+
+It builds what LiteEth's own ``liteeth_gen`` builds for ``core: udp`` (PHY, MAC, ARP, IPv4,
+ICMP, UDP), from the same LiteEth classes, with three differences ``liteeth_gen`` has no
+configuration key for (so this script, not a YAML file for ``liteeth_gen``), and one fix:
+
+* the node's MAC address, IP address, UDP port and one multicast group are inputs of the core
+  (``mac_address``, ``ip_address``, ``udp_rx_port`` with ``udp_rx_port_mask``: the ports taken
+  are those equal to it on the mask's bits, ``ip_multicast``), so one vendored file serves every
+  configuration;
+  ``liteeth_gen``'s ``raw`` port receives on the port its transmit side sends to
+  (``sink_dst_port``), which an RTPS node (listening on its port, sending to its peer's) cannot use;
+* received frames are filtered by destination MAC (ours, broadcast, IPv4 multicast) before the
+  EtherType dispatch (LiteEth's crossbar MAC takes every frame; only its ``hybrid`` MAC filters)
+  and by destination IP (ours or ``ip_multicast``: LiteEth's ``with_ip_broadcast``, a switch
+  that takes every IPv4 frame when on, is driven by that comparison);
+* the PHY's receive stream gets ``last_be`` = ``last`` (without it LiteEth 2024.12's 8-bit
+  receive path never flags a bad FCS: its CRC checker looks at the lanes ``last_be`` enables);
+* the UDP receiver holds a payload's last byte until its frame ends (``HoldingUDPRX``), so a
+  padded frame's bad FCS is not lost with the padding LiteEth's own receiver drops;
+* ``phy: gmii_model`` is LiteEth's GMII PHY in its ``model`` mode (RX and TX clocked by the
+  core's clock, no vendor clock buffers): the simulation variant; ``phy: ecp5_rgmii`` is
+  ``LiteEthECP5PHYRGMII`` (DELAYG, IDDRX1F, ODDRX1F), the board variant.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+from importlib.metadata import version
+from pathlib import Path
+
+import yaml
+from migen import FSM, If, NextState, NextValue, Signal
+
+import liteeth.core.udp
+import liteeth.mac
+from liteeth.common import eth_ipv4_user_description, eth_udp_user_description, udp_header, \
+    udp_protocol
+from liteeth.core.udp import LiteEthUDPCrossbar, LiteEthUDPDepacketizer
+from liteeth import phy as liteeth_phys
+from liteeth.core import LiteEthUDPIPCore
+from liteeth.gen import _io, get_udp_raw_port_ios
+from liteeth.mac.common import LiteEthMACCrossbar
+from litex.build.generic_platform import Pins, Subsignal
+from litex.build.io import CRG
+from litex.build.lattice.platform import LatticePlatform
+from litex.gen import LiteXModule
+from litex.soc.interconnect import stream
+from litex.soc.integration.builder import Builder
+from litex.soc.integration.soc_core import SoCMini
+
+MCAST_MAC_MASK = 0xFFFFFF000000
+MCAST_MAC_OUI = 0x01005E000000
+BCAST_MAC = 0xFFFFFFFFFFFF
+
+# The PHY pads the core drives: data and control only. LiteEth's MDIO master and the PHY's
+# reset are CSR-driven (no CSR bus here: the board's top drives the PHY's reset), and MDIO's
+# tristate buffer is a vendor primitive a simulator does not have.
+PADS = [
+    ("gmii_pads", 0,
+        Subsignal("rx_dv", Pins(1)), Subsignal("rx_er", Pins(1)), Subsignal("rx_data", Pins(8)),
+        Subsignal("tx_en", Pins(1)), Subsignal("tx_er", Pins(1)), Subsignal("tx_data", Pins(8))),
+    ("rgmii_pads", 0,
+        Subsignal("rx_ctl", Pins(1)), Subsignal("rx_data", Pins(4)),
+        Subsignal("tx_ctl", Pins(1)), Subsignal("tx_data", Pins(4))),
+    ("udp_rx_port", 0, Pins(16)),
+    ("udp_rx_port_mask", 0, Pins(16)),
+    ("ip_multicast", 0, Pins(32)),
+]
+
+
+class FilteringMACCrossbar(LiteEthMACCrossbar):
+    """LiteEth's MAC crossbar, dispatching only frames for our MAC, broadcast or IPv4 multicast.
+
+    A frame for another station gets no user port: LiteX's Dispatcher then drops it (its
+    ``default`` case takes the frame).
+    """
+
+    hw_mac: Signal | None = None
+
+    def do_finalize(self) -> None:
+        super().do_finalize()
+        target = self.master.sink.target_mac
+        ours = ((target == self.hw_mac) | (target == BCAST_MAC) |
+                ((target & MCAST_MAC_MASK) == MCAST_MAC_OUI))
+        # The parent set sel by EtherType; in Migen the later assignment wins: no port for a
+        # frame that is not ours.
+        self.comb += If(~ours, self.dispatcher.sel.eq(0))
+
+
+class MaskedUDPCrossbar(LiteEthUDPCrossbar):
+    """LiteEth's UDP crossbar with its one user port taking every destination port equal to
+    the port's key on the bits of ``mask`` (an RTPS participant listens on several: the SPDP
+    multicast port, its metatraffic and its user-data unicast ports; the sideband says which)."""
+
+    mask: Signal | None = None
+
+    def do_finalize(self) -> None:
+        super().do_finalize()
+        assert len(self.users) == 1
+        (key,) = self.users.keys()
+        dst = self.master.sink.dst_port
+        self.comb += If(((dst ^ key) & self.mask) == 0, self.dispatcher.sel.eq(1))
+
+
+class HoldingUDPRX(LiteXModule):
+    """LiteEth's UDP receiver (8 bits), but a payload shorter than its frame (Ethernet padding,
+    trailing bytes) keeps its last byte until the frame ends, so that the frame's error (a bad
+    FCS, known at its end) comes with it. LiteEth's own ends the payload at the UDP length and
+    drops the rest, error included: a padded frame with a bad FCS would pass as good.
+    """
+
+    def __init__(self, ip_address: object, dw: int = 8) -> None:
+        assert dw == 8
+        self.sink = sink = stream.Endpoint(eth_ipv4_user_description(dw))
+        self.source = source = stream.Endpoint(eth_udp_user_description(dw))
+        self.depacketizer = dep = LiteEthUDPDepacketizer(dw)
+        self.comb += sink.connect(dep.sink)
+        d = dep.source
+        count = Signal(16)
+        err = Signal()
+        held = Signal(8)
+        sport, dport, length, ip = Signal(16), Signal(16), Signal(16), Signal(32)
+        payload_len = Signal(16)
+        self.comb += payload_len.eq(d.length - udp_header.length)
+        self.fsm = fsm = FSM(reset_state="IDLE")
+        fsm.act("IDLE",
+            NextValue(count, 1), NextValue(err, 0),
+            If(d.valid, NextState("DROP"), If(sink.protocol == udp_protocol, NextState("RECEIVE"))))
+        fsm.act("RECEIVE",
+            source.src_port.eq(d.src_port), source.dst_port.eq(d.dst_port),
+            source.length.eq(payload_len), source.ip_address.eq(sink.ip_address),
+            source.data.eq(d.data),
+            If(d.last | (count < payload_len),
+                source.valid.eq(d.valid), d.ready.eq(source.ready),
+                source.last.eq(d.last), source.error.eq(d.error | err),
+                If(d.valid & source.ready,
+                    NextValue(count, count + 1), NextValue(err, err | d.error),
+                    If(d.last, NextState("IDLE"))),
+            ).Else(                              # the payload's last byte, the frame goes on
+                d.ready.eq(1),
+                If(d.valid,
+                    NextValue(held, d.data), NextValue(err, err | d.error),
+                    NextValue(sport, d.src_port), NextValue(dport, d.dst_port),
+                    NextValue(length, payload_len), NextValue(ip, sink.ip_address),
+                    NextState("HOLD"))))
+        fsm.act("HOLD",
+            d.ready.eq(1),
+            If(d.valid, NextValue(err, err | d.error), If(d.last, NextState("EMIT"))))
+        fsm.act("EMIT",
+            source.valid.eq(1), source.last.eq(1), source.data.eq(held), source.error.eq(err),
+            source.src_port.eq(sport), source.dst_port.eq(dport), source.length.eq(length),
+            source.ip_address.eq(ip),
+            If(source.ready, NextState("IDLE")))
+        fsm.act("DROP",
+            d.ready.eq(1),
+            If(d.valid & d.last, NextState("IDLE")))
+
+
+class UDPPortCore(SoCMini):
+    """PHY + LiteEthUDPIPCore + one raw UDP port (8-bit) with run-time addresses and port."""
+
+    def __init__(self, platform: LatticePlatform, cfg: dict) -> None:
+        SoCMini.__init__(self, platform, clk_freq=int(float(cfg["clk_freq"])))
+        self.crg = CRG(platform.request("sys_clock"), platform.request("sys_reset"))
+
+        phy = cfg["phy"]
+        if phy == "gmii_model":
+            ethphy = liteeth_phys.LiteEthPHYGMII(clock_pads=None, pads=platform.request("gmii_pads"),
+                                                  model=True)
+        elif phy == "ecp5_rgmii":
+            ethphy = liteeth_phys.LiteEthECP5PHYRGMII(
+                clock_pads=platform.request("rgmii_clocks"), pads=platform.request("rgmii_pads"),
+                tx_delay=float(cfg.get("phy_tx_delay", 2e-9)),
+                rx_delay=float(cfg.get("phy_rx_delay", 2e-9)),
+                with_hw_init_reset=False)
+        else:
+            raise ValueError(f"phy: {phy!r}: gmii_model or ecp5_rgmii")
+        self.ethphy = ethphy
+        # LiteEth 2024.12's receive path with an 8-bit PHY and an 8-bit core never drives
+        # last_be (LiteEthMACRXLastBE, which sets it from last, is only added when the core is
+        # wider), and its CRC checker flags an error only on a byte lane last_be enables: a frame
+        # with a bad FCS would pass as good. The PHY's last byte is its last lane.
+        self.comb += ethphy.source.last_be.eq(ethphy.source.last)
+
+        mac_address = platform.request("mac_address")
+        ip_address = platform.request("ip_address")
+        FilteringMACCrossbar.hw_mac = mac_address
+        MaskedUDPCrossbar.mask = platform.request("udp_rx_port_mask")
+        ip_multicast = platform.request("ip_multicast")
+        take_group = Signal()                   # LiteEth's "broadcast" switch, made a signal
+        self.core = LiteEthUDPIPCore(
+            ethphy, mac_address=mac_address, ip_address=ip_address,
+            clk_freq=int(float(cfg["clk_freq"])), dw=8,
+            arp_entries=int(cfg.get("arp_entries", 1)),
+            with_icmp=bool(cfg.get("with_icmp", True)),
+            with_ip_broadcast=take_group,
+            tx_cdc_depth=int(cfg.get("tx_cdc_depth", 32)), tx_cdc_buffered=False,
+            rx_cdc_depth=int(cfg.get("rx_cdc_depth", 32)), rx_cdc_buffered=False)
+
+        target = self.core.ip.rx.depacketizer.source.target_ip
+        self.comb += take_group.eq(target == ip_multicast)
+        rx_port = platform.request("udp_rx_port")
+        platform.add_extension(get_udp_raw_port_ios("udp", data_width=8))
+        pads = platform.request("udp")
+        port = self.core.udp.crossbar.get_port(rx_port, dw=8)
+        self.comb += [
+            port.sink.valid.eq(pads.sink_valid), port.sink.last.eq(pads.sink_last),
+            port.sink.dst_port.eq(pads.sink_dst_port), port.sink.src_port.eq(pads.sink_src_port),
+            port.sink.ip_address.eq(pads.sink_ip_address), port.sink.length.eq(pads.sink_length),
+            pads.sink_ready.eq(port.sink.ready), port.sink.data.eq(pads.sink_data),
+            port.sink.last_be.eq(pads.sink_last_be),
+            pads.source_valid.eq(port.source.valid), pads.source_last.eq(port.source.last),
+            pads.source_dst_port.eq(port.source.dst_port),
+            pads.source_src_port.eq(port.source.src_port),
+            pads.source_ip_address.eq(port.source.ip_address),
+            pads.source_length.eq(port.source.length), port.source.ready.eq(pads.source_ready),
+            pads.source_data.eq(port.source.data), pads.source_last_be.eq(port.source.last_be),
+            pads.source_error.eq(port.source.error),
+        ]
+
+
+def main() -> None:
+    """Generate the core a YAML file describes into the output folder (``NAME.v``)."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("config", help="YAML: name, phy, clk_freq, device (+ optional keys)")
+    ap.add_argument("-o", "--output", required=True, help="folder for NAME.v")
+    ap.add_argument("--build-dir", default="/tmp/liteeth_build")
+    args = ap.parse_args()
+    cfg = yaml.safe_load(Path(args.config).read_text())
+    name = cfg["name"]
+    liteeth.mac.LiteEthMACCrossbar = FilteringMACCrossbar   # before the core is built
+    liteeth.core.udp.LiteEthUDPRX = HoldingUDPRX
+    liteeth.core.udp.LiteEthUDPCrossbar = MaskedUDPCrossbar
+    platform = LatticePlatform(cfg["device"], io=[], toolchain="trellis")
+    platform.add_extension(_io)
+    platform.add_extension(PADS)
+    soc = UDPPortCore(platform, cfg)
+    build_dir = Path(args.build_dir) / name
+    builder = Builder(soc, output_dir=str(build_dir), compile_software=False,
+                      compile_gateware=False, csr_csv=str(build_dir / "csr.csv"))
+    builder.build(build_name=name)
+    out = Path(args.output)
+    out.mkdir(parents=True, exist_ok=True)
+    text = (build_dir / "gateware" / f"{name}.v").read_text()
+    # The date LiteX writes would make every run a new file: the versions that made it instead.
+    made = (f"// Made by   : tools/liteeth/gen_liteeth.py {Path(args.config).name} (liteeth "
+            f"{version('liteeth')}, litex {version('litex')}, migen {version('migen')})")
+    text = re.sub(r"^// Date .*$", made, text, count=1, flags=re.M)
+    text = re.sub(r"^(//  Auto-Generated by LiteX) on .*$", r"\1.", text, flags=re.M)
+    (out / f"{name}.v").write_text(text)
+    print(out / f"{name}.v")
+
+
+if __name__ == "__main__":
+    main()
