@@ -1,0 +1,361 @@
+// rfl_rtps_ctrl -- the RTPS control-submessage watcher of the fabric participant (issue #31:
+// its built-in writers are reliable): fed the received UDP payloads (RTPS messages; 8-bit
+// AXI4-Stream, TLAST on a datagram's last byte; it is always ready, so a top feeds it the beats
+// rfl_rtps_rx takes), it finds the ACKNACKs to this participant's answering writers and the
+// HEARTBEATs to its built-in SEDP readers, and asks rfl_rtps_disc_answer for the answers:
+// one request a beat on m_axis, {base[63:0], guidPrefix[95:0], message[7:0]}: send answer ROM
+// message `message` to participant `guidPrefix` (its INFO_DST), an ACKNACK answer with `base`.
+// The slots (which entities answer, and their messages) come from rosfpga_lab.rtl.discrom
+// (answer_params; its docstring says what each answer is and why it is what the software
+// participant sends). Slot i: entity id SLOT_IDS[32i +: 32], first answer message
+// SLOT_MSGS[8i +: 8], last sequence number SLOT_LASTS[8i +: 8] (a writer: 1..8; 0: a built-in
+// reader).
+// The walk (a byte per clock, never a wait):
+//   S_HDR     the 20-byte header: "RTPS", major version 2, the sender's GUID prefix (the
+//             source); a bad header or a message from cfg_prefix (our own, looped back): the
+//             rest of the datagram is ignored. The destination resets to "any" at each message.
+//   S_SUBHDR  id, flags (bit 0 E: byte order of the rest), octetsToNextHeader (0: to the end
+//             of the message, but for PAD and INFO_TS).
+//   S_BODY    INFO_DST (the destination: ours or all-zero keeps what follows), INFO_SRC (the
+//             source), ACKNACK (readerId, writerId, readerSNState base, numBits, the first
+//             bitmap word, count) and HEARTBEAT (readerId, writerId, firstSN, lastSN, count);
+//             other submessages are skipped by length.
+// At the end of an ACKNACK or HEARTBEAT for us, the fields go to one register stage (d_*); the
+// clock after, each slot matches:
+//   ACKNACK to writer slot i (writerId = its id): base 0 (preemptive) asks its HEARTBEAT
+//     (message SLOT_MSGS[i]); else each sequence number s in 1..last with its bit set (s >=
+//     base, s - base < numBits) asks message SLOT_MSGS[i] + s (its DATA and a HEARTBEAT);
+//     numbers past last are ignored (never written: no GAP, as the software writer).
+//   HEARTBEAT without F to reader slot i (readerId = its id, or ENTITYID_UNKNOWN and the
+//     writerId the matching built-in writer: its id with kind 0xC2 for 0xC7): its ACKNACK
+//     (message SLOT_MSGS[i]) with base lastSN + 1.
+// Bounded: each slot holds one pending request set (the asker's prefix, a bit per message); a
+// request for a slot whose set is not yet sent is dropped and counted (cnt_busy): a flood of
+// ACKNACKs asks at most one set per slot at a time, and rfl_rtps_disc_answer's credit bounds
+// the bytes sent per byte received (rx_byte: a pulse per byte taken).
+// Refused and counted (cnt_malformed; the rest of the datagram ignored, RTPS 2.3 8.3.4.1): a
+// submessage longer than the datagram, a length not a multiple of 4 that is not the last, an
+// ACKNACK with numBits > 256 or a body too short for its fields (ACKNACK, HEARTBEAT, INFO_DST,
+// INFO_SRC).
+// Timing: the slot decisions read registers only (the d_* stage).
+`default_nettype none
+
+module rfl_rtps_ctrl #(
+    parameter SLOTS = 5,                        // answering entities: 1..8, checked
+    parameter [32*SLOTS-1:0] SLOT_IDS = 0,      // entity ids, slot 0 in the low bits
+    parameter [8*SLOTS-1:0] SLOT_MSGS = 0,      // first answer message of each slot
+    parameter [8*SLOTS-1:0] SLOT_LASTS = 0,     // last sequence number (0..8; 0: a reader)
+    parameter COUNT_BITS = 32                   // width of the counters: 1..32, checked
+) (
+    input  wire                  clk,
+    input  wire                  rst_n,
+    input  wire [95:0]           cfg_prefix,    // this participant's GUID prefix
+    input  wire [7:0]            s_axis_tdata,
+    input  wire                  s_axis_tvalid,
+    output wire                  s_axis_tready, // always 1: a watcher
+    input  wire                  s_axis_tlast,
+    output wire [167:0]          m_axis_tdata,  // {base, guidPrefix, message}
+    output wire                  m_axis_tvalid,
+    input  wire                  m_axis_tready,
+    output wire                  rx_byte,       // a byte taken (rfl_rtps_disc_answer's credit)
+    output wire [COUNT_BITS-1:0] cnt_requests,  // request sets taken into a slot
+    output wire [COUNT_BITS-1:0] cnt_busy,      // request sets dropped: the slot was pending
+    output wire [COUNT_BITS-1:0] cnt_malformed
+);
+    // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
+    // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
+`ifdef __ICARUS__
+    integer ci;
+    initial begin
+        if (SLOTS < 1 || SLOTS > 8) $fatal(1, "rfl_rtps_ctrl: SLOTS must be 1..8");
+        if (COUNT_BITS < 1 || COUNT_BITS > 32) $fatal(1, "rfl_rtps_ctrl: COUNT_BITS must be 1..32");
+        for (ci = 0; ci < SLOTS && ci < 8; ci = ci + 1)
+            if (SLOT_LASTS[8*ci +: 8] > 8) $fatal(1, "rfl_rtps_ctrl: a slot's last must be 0..8");
+    end
+`else
+    if (SLOTS < 1 || SLOTS > 8) begin : g_bad_slots
+        $error("rfl_rtps_ctrl: SLOTS must be 1..8");
+    end
+    if (COUNT_BITS < 1 || COUNT_BITS > 32) begin : g_bad_count_bits
+        $error("rfl_rtps_ctrl: COUNT_BITS must be 1..32");
+    end
+    genvar gi;
+    for (gi = 0; gi < SLOTS && gi < 8; gi = gi + 1) begin : g_check_last
+        if (SLOT_LASTS[8*gi +: 8] > 8) begin : g_bad_last
+            $error("rfl_rtps_ctrl: a slot's last must be 0..8");
+        end
+    end
+`endif
+
+    localparam NS = (SLOTS >= 1 && SLOTS <= 8) ? SLOTS : 1;    // (sizes legal when refused)
+    // the slot table padded to 8 slots (a slot past SLOTS never matches)
+    localparam [32*NS+255:0] IDS_W = {256'd0, SLOT_IDS};
+    localparam [8*NS+63:0] MSGS_W = {64'd0, SLOT_MSGS};
+    localparam [8*NS+63:0] LASTS_W = {64'd0, SLOT_LASTS};
+    localparam [255:0] IDS = IDS_W[255:0];
+    localparam [63:0] MSGS = MSGS_W[63:0];
+    localparam [63:0] LASTS = LASTS_W[63:0];
+    localparam [1:0] S_HDR = 2'd0, S_SUBHDR = 2'd1, S_BODY = 2'd2, S_DROP = 2'd3;
+    localparam [7:0] ID_PAD = 8'h01, ID_ACKNACK = 8'h06, ID_HEARTBEAT = 8'h07,
+                     ID_INFO_TS = 8'h09, ID_INFO_SRC = 8'h0C, ID_INFO_DST = 8'h0E;
+
+    assign s_axis_tready = 1'b1;
+    wire take = s_axis_tvalid;
+    wire [7:0] b = s_axis_tdata;
+    wire tl = s_axis_tlast;
+    assign rx_byte = take;
+
+    reg [1:0] st;
+    reg [4:0] idx;                              // byte of the header / submessage header
+    reg hdr_bad;
+    reg [95:0] src;
+    reg [87:0] src_sh, dst_sh;           // the last 11 bytes of a prefix coming in
+    reg dst_ok;                                 // the submessages are for us
+    reg [7:0] kind, len_lo;
+    reg le, flag_f;
+    reg k_ack, k_hb, k_dst, k_src;
+    reg [15:0] pos;                             // body byte
+    reg [15:0] sub_left;                        // body bytes left (not with to_end)
+    reg to_end, misaligned;
+    reg [31:0] acc_e;
+    reg [23:0] acc_b;
+    reg [31:0] f_rid, f_wid, f_hi, f_lo, f_nbits, f_word0;
+    reg [15:0] need_last;                       // the last body byte of the ACKNACK's fields
+    reg fields_done;
+    reg [COUNT_BITS-1:0] n_req, n_busy, n_bad;
+
+    wire [31:0] acc_e_n = le ? {b, acc_e[31:8]} : {acc_e[23:0], b};
+    wire [31:0] acc_b_n = {acc_b, b};
+    wire [3:0] nwords = acc_e_n[8:5] + {3'd0, |acc_e_n[4:0]};   // bitmap words (<= 256 bits)
+    wire [15:0] len_n = le ? {b, len_lo} : {len_lo, b};
+    wire body_last = to_end ? tl : (sub_left == 16'd1);
+    wire trunc = tl && !body_last;
+    wire at_need = k_ack ? (pos == need_last) : k_hb ? (pos == 16'd27) :
+                   k_dst ? (pos == 16'd11) : (pos == 16'd19);
+    wire done_n = fields_done || at_need;
+    wire parsed = k_ack || k_hb || k_dst || k_src;
+    wire nbits_bad = k_ack && (pos == 16'd19) && (acc_e_n > 32'd256);
+    // the end of a submessage: its fields short, cut, or misaligned and not the last
+    wire sub_bad = body_last && ((parsed && !done_n) || trunc || (misaligned && !tl));
+    wire [95:0] src_sh_n = {src_sh[87:0], b};
+    wire [95:0] dst_sh_n = {dst_sh[87:0], b};
+
+    // the decision stage
+    reg d_valid, d_ack, d_final;
+    reg [31:0] d_rid, d_wid, d_hi, d_lo, d_word0;
+    reg [8:0] d_nbits;
+    reg [95:0] d_prefix;
+
+    // the slots
+    reg [71:0] pend;                            // 9 bits a slot; bit 0: the first message,
+                                                // bit s: DATA s
+    reg [95:0] p_prefix [0:7];
+    reg [63:0] p_base [0:7];
+    reg [167:0] o_data;
+    reg o_valid;
+    assign m_axis_tdata = o_data;
+    assign m_axis_tvalid = o_valid;
+    assign cnt_requests = n_req;
+    assign cnt_busy = n_busy;
+    assign cnt_malformed = n_bad;
+
+    // what each slot wants of the decision in d_*
+    wire d_base0 = (d_hi == 32'd0) && (d_lo == 32'd0);
+    wire d_small = (d_hi == 32'd0) && (d_lo[31:4] == 28'd0);
+    wire [63:0] d_next = {d_hi, d_lo} + 64'd1;
+    reg [71:0] want;                            // 9 bits a slot
+    integer wi, ws;
+    reg [4:0] off;
+    always @(*) begin
+        off = 5'd0;
+        for (wi = 0; wi < 8; wi = wi + 1) begin
+            want[9*wi +: 9] = 9'd0;
+            if (wi < NS && d_valid && d_ack && LASTS[8*wi +: 8] != 8'd0 &&
+                d_wid == IDS[32*wi +: 32]) begin
+                if (d_base0) begin
+                    want[9*wi + 0] = 1'b1;
+                end else if (d_small) begin
+                    for (ws = 1; ws <= 8; ws = ws + 1) begin
+                        off = ws[4:0] - {1'b0, d_lo[3:0]};
+                        if ({3'd0, ws[4:0]} <= LASTS[8*wi +: 8] && ws[4:0] >= {1'b0, d_lo[3:0]}
+                            && {4'd0, off} < d_nbits && d_word0[5'd31 - off])
+                            want[9*wi + ws] = 1'b1;
+                    end
+                end
+            end
+            if (wi < NS && d_valid && !d_ack && !d_final && LASTS[8*wi +: 8] == 8'd0 &&
+                (d_rid == IDS[32*wi +: 32] ||
+                 (d_rid == 32'd0 && {d_wid[31:8], 8'hC7} == IDS[32*wi +: 32])))
+                want[9*wi + 0] = 1'b1;
+        end
+    end
+
+    // the next request: the lowest slot pending, its lowest message
+    reg pick;
+    reg [7:0] pick_msg;
+    reg [2:0] pick_slot;
+    reg [3:0] pick_bit;
+    integer pi, ps;
+    always @(*) begin
+        pick = 1'b0;
+        pick_slot = 3'd0;
+        pick_bit = 4'd0;
+        for (pi = 7; pi >= 0; pi = pi - 1)
+            if (pend[9*pi +: 9] != 9'd0) begin
+                pick = 1'b1;
+                pick_slot = pi[2:0];
+            end
+        for (ps = 8; ps >= 0; ps = ps - 1)
+            if (pend[9*pick_slot + ps]) pick_bit = ps[3:0];
+        pick_msg = MSGS[8*pick_slot +: 8] + {4'd0, pick_bit};
+    end
+    wire load = pick && (!o_valid || m_axis_tready);
+
+    // the slot's set, set or dropped; any hit counts once
+    reg any_want, any_busy;
+    integer ai;
+    always @(*) begin
+        any_want = 1'b0;
+        any_busy = 1'b0;
+        for (ai = 0; ai < 8; ai = ai + 1)
+            if (want[9*ai +: 9] != 9'd0) begin
+                any_want = 1'b1;
+                if (pend[9*ai +: 9] != 9'd0) any_busy = 1'b1;
+            end
+    end
+    integer i;
+
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            st <= S_HDR;
+            idx <= 5'd0;
+            hdr_bad <= 1'b0;
+            dst_ok <= 1'b1;
+            d_valid <= 1'b0;
+            o_valid <= 1'b0;
+            n_req <= {COUNT_BITS{1'b0}};
+            n_busy <= {COUNT_BITS{1'b0}};
+            n_bad <= {COUNT_BITS{1'b0}};
+            pend <= 72'd0;
+        end else begin
+            d_valid <= 1'b0;
+            if (take) begin
+                case (st)
+                S_HDR: begin
+                    hdr_bad <= (idx != 5'd0 && hdr_bad) ||
+                               (idx == 5'd0 && b != 8'h52) || (idx == 5'd1 && b != 8'h54) ||
+                               (idx == 5'd2 && b != 8'h50) || (idx == 5'd3 && b != 8'h53) ||
+                               (idx == 5'd4 && b != 8'd2);
+                    src_sh <= src_sh_n[87:0];
+                    idx <= idx + 1'b1;
+                    dst_ok <= 1'b1;
+                    if (tl) begin
+                        idx <= 5'd0;
+                    end else if (idx == 5'd19) begin
+                        idx <= 5'd0;
+                        src <= src_sh_n;
+                        st <= (hdr_bad || src_sh_n == cfg_prefix) ? S_DROP : S_SUBHDR;
+                    end
+                end
+                S_SUBHDR: begin
+                    idx <= idx + 1'b1;
+                    if (idx == 5'd0) begin
+                        kind <= b;
+                        k_ack <= (b == ID_ACKNACK);
+                        k_hb <= (b == ID_HEARTBEAT);
+                        k_dst <= (b == ID_INFO_DST);
+                        k_src <= (b == ID_INFO_SRC);
+                    end
+                    if (idx == 5'd1) begin
+                        le <= b[0];
+                        flag_f <= b[1];
+                    end
+                    if (idx == 5'd2) len_lo <= b;
+                    pos <= 16'd0;
+                    fields_done <= 1'b0;
+                    if (tl) begin
+                        // the datagram ends in or right after a submessage header
+                        if (idx != 5'd3 || (len_n != 16'd0 || (kind != ID_PAD && kind != ID_INFO_TS)))
+                            n_bad <= n_bad + 1'b1;
+                        st <= S_HDR;
+                        idx <= 5'd0;
+                    end else if (idx == 5'd3) begin
+                        idx <= 5'd0;
+                        sub_left <= len_n;
+                        to_end <= (len_n == 16'd0);
+                        misaligned <= (len_n[1:0] != 2'd0);
+                        // an empty PAD or INFO_TS: the next submessage header
+                        st <= (len_n == 16'd0 && (kind == ID_PAD || kind == ID_INFO_TS))
+                              ? S_SUBHDR : S_BODY;
+                    end
+                end
+                S_BODY: begin
+                    acc_e <= acc_e_n;
+                    acc_b <= acc_b_n[23:0];
+                    pos <= pos + 1'b1;
+                    sub_left <= sub_left - 1'b1;
+                    fields_done <= done_n;
+                    if (k_dst && pos < 16'd12) dst_sh <= dst_sh_n[87:0];
+                    if (k_src && pos >= 16'd8 && pos < 16'd20) src_sh <= src_sh_n[87:0];
+                    if (pos == 16'd3) f_rid <= acc_b_n;
+                    if (pos == 16'd7) f_wid <= acc_b_n;
+                    if (pos == 16'd11 && k_ack) f_hi <= acc_e_n;
+                    if (pos == 16'd15 && k_ack) f_lo <= acc_e_n;
+                    if (pos == 16'd19 && k_hb) f_hi <= acc_e_n;
+                    if (pos == 16'd23 && k_hb) f_lo <= acc_e_n;
+                    if (pos == 16'd19) begin
+                        f_nbits <= acc_e_n;
+                        need_last <= 16'd23 + {10'd0, nwords, 2'b00};
+                    end
+                    if (pos == 16'd23) f_word0 <= acc_e_n;
+                    if (k_dst && pos == 16'd11)
+                        dst_ok <= (dst_sh_n == cfg_prefix) || (dst_sh_n == 96'd0);
+                    if (k_src && pos == 16'd19) src <= src_sh_n;
+                    if (nbits_bad || sub_bad) begin
+                        n_bad <= n_bad + 1'b1;
+                        st <= tl ? S_HDR : S_DROP;
+                    end else if (body_last) begin
+                        st <= tl ? S_HDR : S_SUBHDR;
+                        if ((k_ack || k_hb) && dst_ok) begin
+                            d_valid <= 1'b1;
+                            d_ack <= k_ack;
+                            d_final <= flag_f;
+                            d_rid <= f_rid;
+                            d_wid <= f_wid;
+                            d_hi <= f_hi;
+                            d_lo <= f_lo;           // HEARTBEAT: lastSN's low half
+                            d_nbits <= f_nbits[8:0];
+                            d_word0 <= (f_nbits == 32'd0) ? 32'd0 : f_word0;
+                            d_prefix <= src;
+                        end
+                    end else if (tl) begin
+                        st <= S_HDR;
+                    end
+                end
+                default: if (tl) st <= S_HDR;    // S_DROP: the rest of the datagram
+                endcase
+                if (tl) idx <= 5'd0;
+            end
+            // the slots: a request set taken, or dropped (busy); the next request out
+            if (any_want) begin
+                if (any_busy) n_busy <= n_busy + 1'b1;
+                else n_req <= n_req + 1'b1;
+            end
+            for (i = 0; i < 8; i = i + 1)
+                if (want[9*i +: 9] != 9'd0 && pend[9*i +: 9] == 9'd0) begin
+                    pend[9*i +: 9] <= want[9*i +: 9];
+                    p_prefix[i] <= d_prefix;
+                    p_base[i] <= d_next;
+                end
+            if (load) begin
+                pend[9*pick_slot +: 9] <= pend[9*pick_slot +: 9] & ~(9'd1 << pick_bit);
+                o_data <= {p_base[pick_slot], p_prefix[pick_slot], pick_msg};
+                o_valid <= 1'b1;
+            end else if (m_axis_tready) begin
+                o_valid <= 1'b0;
+            end
+        end
+    end
+endmodule
+
+`default_nettype wire
