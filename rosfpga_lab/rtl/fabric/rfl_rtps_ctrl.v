@@ -136,7 +136,7 @@ module rfl_rtps_ctrl #(
     wire parsed = k_ack || k_hb || k_dst || k_src;
     wire nbits_bad = k_ack && (pos == 16'd19) && (acc_e_n > 32'd256);
     // the end of a submessage: its fields short, cut, or misaligned and not the last
-    wire sub_bad = body_last && ((parsed && !done_n) || trunc || (misaligned && !tl));
+    wire sub_bad = trunc || (body_last && ((parsed && !done_n) || (misaligned && !tl)));
     wire [95:0] src_sh_n = {src_sh[87:0], b};
     wire [95:0] dst_sh_n = {dst_sh[87:0], b};
 
