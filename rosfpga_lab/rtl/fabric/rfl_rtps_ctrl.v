@@ -356,6 +356,27 @@ module rfl_rtps_ctrl #(
             end
         end
     end
+`ifdef FORMAL
+    // what the slots may hold (the induction's strengthening): a bit only for a message of
+    // the slot (a writer: its HEARTBEAT and sequence numbers 1..last; a reader: its ACKNACK),
+    // none past SLOTS; the request offered names a message of some slot
+    integer fi, fs;
+    reg f_named;
+    always @(*) begin
+        f_named = 1'b0;
+        for (fi = 0; fi < 8; fi = fi + 1)
+            if (fi < NS && o_data[7:0] >= MSGS[8*fi +: 8] &&
+                o_data[7:0] <= MSGS[8*fi +: 8] + LASTS[8*fi +: 8])
+                f_named = 1'b1;
+    end
+    always @(posedge clk) if (rst_n) begin
+        for (fi = 0; fi < 8; fi = fi + 1)
+            for (fs = 1; fs <= 8; fs = fs + 1)
+                if (fi >= NS || fs > LASTS[8*fi +: 8]) assert(!pend[9*fi + fs]);
+        for (fi = NS; fi < 8; fi = fi + 1) assert(!pend[9*fi]);
+        if (o_valid) assert(f_named);
+    end
+`endif
 endmodule
 
 `default_nettype wire
