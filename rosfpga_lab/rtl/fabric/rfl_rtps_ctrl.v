@@ -163,32 +163,25 @@ module rfl_rtps_ctrl #(
     wire d_base0 = (d_hi == 32'd0) && (d_lo == 32'd0);
     wire d_small = (d_hi == 32'd0) && (d_lo[31:4] == 28'd0);
     wire [63:0] d_next = {d_hi, d_lo} + 64'd1;
-    reg [71:0] want;                            // 9 bits a slot
-    integer wi, ws;
-    reg [4:0] off;
-    always @(*) begin
-        off = 5'd0;
-        for (wi = 0; wi < 8; wi = wi + 1) begin
-            want[9*wi +: 9] = 9'd0;
-            if (wi < NS && d_valid && d_ack && LASTS[8*wi +: 8] != 8'd0 &&
-                d_wid == IDS[32*wi +: 32]) begin
-                if (d_base0) begin
-                    want[9*wi + 0] = 1'b1;
-                end else if (d_small) begin
-                    for (ws = 1; ws <= 8; ws = ws + 1) begin
-                        off = ws[4:0] - {1'b0, d_lo[3:0]};
-                        if ({3'd0, ws[4:0]} <= LASTS[8*wi +: 8] && ws[4:0] >= {1'b0, d_lo[3:0]}
-                            && {4'd0, off} < d_nbits && d_word0[5'd31 - off])
-                            want[9*wi + ws] = 1'b1;
-                    end
-                end
+    wire [71:0] want;                           // 9 bits a slot, as pend
+    genvar gw, gs;
+    generate
+        for (gw = 0; gw < 8; gw = gw + 1) begin : g_want
+            wire [31:0] id = IDS[32*gw +: 32];
+            wire [7:0] lastsn = LASTS[8*gw +: 8];
+            wire is_w = (gw < NS) && d_valid && d_ack && (lastsn != 8'd0) && (d_wid == id);
+            wire is_r = (gw < NS) && d_valid && !d_ack && !d_final && (lastsn == 8'd0) &&
+                        (d_rid == id || (d_rid == 32'd0 && {d_wid[31:8], 8'hC7} == id));
+            assign want[9*gw] = (is_w && d_base0) || is_r;
+            for (gs = 1; gs <= 8; gs = gs + 1) begin : g_seq
+                localparam [4:0] S5 = gs;
+                wire [4:0] off = S5 - {1'b0, d_lo[3:0]};     // its bit in the bitmap
+                assign want[9*gw + gs] = is_w && !d_base0 && d_small && ({3'd0, S5} <= lastsn)
+                                         && (S5 >= {1'b0, d_lo[3:0]}) && ({4'd0, off} < d_nbits)
+                                         && d_word0[5'd31 - off];
             end
-            if (wi < NS && d_valid && !d_ack && !d_final && LASTS[8*wi +: 8] == 8'd0 &&
-                (d_rid == IDS[32*wi +: 32] ||
-                 (d_rid == 32'd0 && {d_wid[31:8], 8'hC7} == IDS[32*wi +: 32])))
-                want[9*wi + 0] = 1'b1;
         end
-    end
+    endgenerate
 
     // the next request: the lowest slot pending, its lowest message
     reg pick;

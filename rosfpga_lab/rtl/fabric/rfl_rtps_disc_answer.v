@@ -180,7 +180,7 @@ module rfl_rtps_disc_answer #(
     assign cnt_no_credit = n_poor;
 
     // an entry's flags and destination are wider than this module uses: their top bits are 0
-    wire [7:0] e_dest = entry[39:32];
+    wire [15:0] e_dest = {8'd0, entry[39:32]};   // (wide enough for any DEST_BITS refused)
     wire unused_ok = &{1'b0, entry, e_dest, r_msg, cred_n[16]};
 
     always @(posedge clk) begin
