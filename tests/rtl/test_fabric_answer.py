@@ -251,3 +251,28 @@ def test_a_flood_of_acknacks_stays_within_the_bound(burst: int, rate: int, idle:
     assert got["sent"] > burst                # it did answer, past the first burst
     assert got["cnt_busy"] > 0 and got["cnt_requests"] + got["cnt_busy"] == 200
     assert (got["cnt_no_credit"] > 0) == (rate == 1)
+
+
+@pytest.mark.parametrize("module,proof_mode,good,bad", [
+    ("rfl_rtps_disc_answer.v", "bmc", "wire start = req && afford;",
+     "wire start = req && in_table;"),                  # answers without the credit
+    ("rfl_rtps_ctrl.v", "prove", "assign rx_byte = take;",
+     "assign rx_byte = take && !tl;"),                  # a datagram's last byte earns no credit
+], ids=["answer-without-credit", "ctrl-credit-short"])
+def test_a_planted_bug_fails_the_proof(module: str, proof_mode: str, good: str, bad: str,
+                                       tmp_path: Path) -> None:
+    """The formal checks of the answer path (rtl.proofs; that they pass is
+    tests/rtl/test_formal.py's) fail on planted bugs."""
+    from rosfpga_lab.rtl.proofs import FABRIC_DIR, PROOFS, prove
+    from tests.support.rtltools import require_formal
+
+    require_formal()
+    name = module[len("rfl_"):-len(".v")]
+    proof = next(p for p in PROOFS if p.name == name and p.mode == proof_mode)
+    src = (FABRIC_DIR / module).read_text()
+    planted = src.replace(good, bad)
+    assert planted != src
+    (tmp_path / module).write_text(planted)
+    failed = prove(proof, replace={module: tmp_path / module})
+    assert failed.status == "FAIL" and any(f"fv_{name}.sv" in f for f in failed.failed), \
+        failed.log[-3000:]
