@@ -5,8 +5,9 @@ How this works: :class:`AnswerModel` reads each received datagram with the lab's
 (``rtps.parse_message(keep_valid=True)`` and ``RtpsMessage.routed``: what a malformed submessage
 drops, the destination INFO_DST sets), finds what the circuit's slots match (the rules are the
 Verilog's header comment and ``rtl.discrom``'s docstring: an ACKNACK to a writer slot asks its
-HEARTBEAT (base 0) or the DATA of each held number its bitmap names; a HEARTBEAT without F to a
-reader slot asks its ACKNACK with base lastSN + 1), and writes the answers from the rendered ROM
+HEARTBEAT (base 0, or a base at or below the last held with no held number named) or the DATA of
+each held number its bitmap names; a HEARTBEAT without F to a reader slot asks its ACKNACK with
+base lastSN + 1), and writes the answers from the rendered ROM
 (:attr:`~rosfpga_lab.rtl.discrom.DiscoveryRom.answers`) with their run-time fields patched
 (:func:`patch_answer`), spending the same credit (``burst`` at first, ``rate`` per byte
 received). It has no clock: requests for a slot still pending in the circuit (sent back to back)
@@ -67,11 +68,11 @@ def requests(rom: DiscoveryRom, datagram: bytes) -> list[tuple[int, bytes, int]]
             continue
         for slot in rom.slots:
             if isinstance(sub, AckNack) and slot.writer and sub.writer_id == slot.entity_id:
-                if sub.base == 0:
-                    out.append((slot.message, source, 0))
+                held = [s for s in sub.missing if 1 <= s <= min(slot.last, MAX_ANSWER_SEQ)]
+                if sub.base == 0 or (not held and sub.base <= slot.last):
+                    out.append((slot.message, source, 0))       # its HEARTBEAT
                 else:
-                    out += [(slot.message + s, source, 0) for s in sub.missing
-                            if 1 <= s <= min(slot.last, MAX_ANSWER_SEQ)]
+                    out += [(slot.message + s, source, 0) for s in held]
             elif (isinstance(sub, Heartbeat) and not slot.writer and not sub.flags & _FINAL and
                   (sub.reader_id == slot.entity_id or (sub.reader_id == 0 and (
                       sub.writer_id & ~0xFF | _BUILTIN_READER_KIND) == slot.entity_id))):

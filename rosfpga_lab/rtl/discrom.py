@@ -50,7 +50,9 @@ sends when a peer asks (``fabric/rfl_rtps_ctrl.v`` watches the received datagram
 each sample it asks for that the writer holds, one datagram each: the DATA, then a HEARTBEAT of
 the writer's whole history, as ``WriterSide._on_acknack`` sends; numbers past the last written
 are ignored, never GAPped, as there; every number written is held: the histories are fixed at
-build time, so no GAP is owed), and the built-in SEDP readers (a HEARTBEAT without F to them:
+build time, so no GAP is owed; one that asks for no held number with its base at or below the
+last held gets the HEARTBEAT too, where the software writer sends nothing and relies on its
+periodic HEARTBEATs, which the circuit has not), and the built-in SEDP readers (a HEARTBEAT without F to them:
 the ACKNACK of a reader that has every sample, base last + 1, no bits, flag F, as
 ``ReaderSide._on_heartbeat`` sends when nothing is missing: the circuit needs no peer's SEDP data,
 its reader takes the configured writer). Every answer starts with the header and INFO_DST, the

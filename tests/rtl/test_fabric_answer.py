@@ -103,6 +103,8 @@ def _cases(rom: DiscoveryRom) -> list[tuple[str, bytes, list[str]]]:
          _dg(PEER, b.acknack(SUB_READER, SUB_WRITER, 0, [], 1), dst=me), ["subscriptions_hb"]),
         ("ros_discovery_info: 1 held, 5 never written (ignored, no GAP)",
          _dg(PEER, b.acknack(USER_READER, graph, 1, [1, 5], 2)), ["ros_discovery_info_1"]),
+        ("Cyclone's preemptive ACKNACK (base 1, no bits)",
+         _dg(PEER, b.acknack(PUB_READER, PUB_WRITER, 1, [], 1), dst=me), ["publications_hb"]),
         ("an ACKNACK acknowledging all: nothing", _dg(PEER, b.acknack(PUB_READER, PUB_WRITER,
                                                                       3, [], 3), dst=me), []),
         ("HEARTBEAT to the publications reader", _dg(PEER, b.heartbeat(PUB_READER, PUB_WRITER,

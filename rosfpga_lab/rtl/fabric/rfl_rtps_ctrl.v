@@ -25,7 +25,10 @@
 //   ACKNACK to writer slot i (writerId = its id): base 0 (preemptive) asks its HEARTBEAT
 //     (message SLOT_MSGS[i]); else each sequence number s in 1..last with its bit set (s >=
 //     base, s - base < numBits) asks message SLOT_MSGS[i] + s (its DATA and a HEARTBEAT);
-//     numbers past last are ignored (never written: no GAP, as the software writer).
+//     numbers past last are ignored (never written: no GAP, as the software writer); a base
+//     at or below last with no held number asked (Cyclone DDS's preemptive form, base 1, no
+//     bits) asks the HEARTBEAT: the circuit's writers send no periodic HEARTBEAT (the software
+//     writer's tick does), so a reader that lost the first one learns what they hold then.
 //   HEARTBEAT without F to reader slot i (readerId = its id, or ENTITYID_UNKNOWN and the
 //     writerId the matching built-in writer: its id with kind 0xC2 for 0xC7): its ACKNACK
 //     (message SLOT_MSGS[i]) with base lastSN + 1.
@@ -172,7 +175,11 @@ module rfl_rtps_ctrl #(
             wire is_w = (gw < NS) && d_valid && d_ack && (lastsn != 8'd0) && (d_wid == id);
             wire is_r = (gw < NS) && d_valid && !d_ack && !d_final && (lastsn == 8'd0) &&
                         (d_rid == id || (d_rid == 32'd0 && {d_wid[31:8], 8'hC7} == id));
-            assign want[9*gw] = (is_w && d_base0) || is_r;
+            // the HEARTBEAT: base 0 (preemptive), or a base at or below last with no held
+            // number asked (the reader lacks samples it does not know of: the circuit's
+            // writer sends no periodic HEARTBEAT, so it tells it now)
+            wire behind = d_small && ({24'd0, lastsn} >= d_lo) && !(|want[9*gw+1 +: 8]);
+            assign want[9*gw] = (is_w && (d_base0 || behind)) || is_r;
             for (gs = 1; gs <= 8; gs = gs + 1) begin : g_seq
                 localparam [4:0] S5 = gs;
                 wire [4:0] off = S5 - {1'b0, d_lo[3:0]};     // its bit in the bitmap
