@@ -19,8 +19,10 @@
 // sent are never more than BURST + RATE x the bytes received (formal/fv_rtps_disc_answer.sv
 // proves it, with the stream rules, for any ROM contents).
 // A request is taken when no answer is on its way (s_axis_tready); the clock after, its table
-// entry is read and the answer starts (or is dropped); the ROM is read on the clock into the
-// register TDATA shows, one byte per clock taken.
+// entry is read into a register; the clock after, the answer starts (or is dropped). The ROM is
+// read on the clock into its own register (a block RAM's read port), one byte per clock taken;
+// TDATA is that register or, on a written field, the register that holds the field's byte.
+// Timing: the credit compare, the ROM address and the field positions read registers only.
 `default_nettype none
 
 module rfl_rtps_disc_answer #(
@@ -96,9 +98,9 @@ module rfl_rtps_disc_answer #(
     localparam MW = (NM > 1) ? $clog2(NM) : 1;
     localparam [31:0] NM_32 = NM;
     localparam [31:0] BURST_32 = BURST;
-    localparam [16:0] BURST_17 = {1'b0, BURST_32[15:0]};
     localparam [31:0] RATE_32 = RATE;
-    localparam [16:0] RATE_17 = {9'd0, RATE_32[7:0]};
+    // at or above this, a byte received fills the credit to BURST
+    localparam [15:0] BURST_LESS_RATE = (BURST > RATE) ? BURST_32[15:0] - RATE_32[15:0] : 16'd0;
     localparam [31:0] CS_32 = COUNT_START;
     localparam [31:0] DST_32 = DST_AT;
     localparam [31:0] BASE_32 = BASE_AT;
@@ -116,17 +118,22 @@ module rfl_rtps_disc_answer #(
         end
     endgenerate
 
-    reg req;                                    // a request taken, its entry read next
+    reg req;                                    // a request taken: its entry is read
+    reg look;                                   // its entry held: the answer starts or not
     reg [7:0] r_msg;
     reg [95:0] r_prefix;
+    reg [47:0] entry_r;
+    reg in_table_r;
     reg [95:0] pfx_sh;                          // the prefix, a byte out per INFO_DST byte
     reg [63:0] base_sh;                         // the base in wire order, a byte out per byte
     reg [31:0] count, cnt_sh;
     reg sending, r_base;
     reg [AW-1:0] addr;                          // the byte after the one offered
-    reg [7:0] q;
-    reg [15:0] left;                            // bytes of the datagram from q on
-    reg [15:0] pos;                             // the byte of the datagram q holds
+    reg [7:0] rom_q;                            // the ROM's read register (a block RAM's)
+    reg [7:0] q;                                // a written field's byte
+    reg q_rom;                                  // the byte offered is rom_q (else q)
+    reg [15:0] left;                            // bytes of the datagram from the one offered
+    reg [15:0] pos;                             // the byte of the datagram offered
     reg [DEST_BITS-1:0] dest;
     reg [15:0] cred;
     reg [COUNT_BITS-1:0] n_ans, n_poor;
@@ -134,43 +141,36 @@ module rfl_rtps_disc_answer #(
     wire take = sending && m_axis_tready;
     wire last = (left == 16'd1);
     wire done = take && last;
-    assign s_axis_tready = !sending && !req;
+    assign s_axis_tready = !sending && !req && !look;
     wire accept = s_axis_tvalid && s_axis_tready;
 
-    wire [47:0] entry;
-    wire [7:0] rom_q;
-    wire [15:0] e_len = entry[15:0];
-    wire in_table = ({24'd0, r_msg} < NM_32);     // (a request past the table: dropped)
-    wire afford = in_table && (cred >= e_len) && (e_len != 16'd0);
-    wire start = req && afford;
-    wire [AW-1:0] raddr = start ? entry[16 +: AW] : addr;
+    wire [47:0] entry;                          // the table's entry of r_msg
+    wire [7:0] rom_byte;                        // the ROM's byte at raddr
+    wire [15:0] e_len = entry_r[15:0];
+    wire afford = in_table_r && (cred >= e_len) && (e_len != 16'd0);
+    wire start = look && afford;
+    wire [AW-1:0] raddr = start ? entry_r[16 +: AW] : addr;
 `ifdef FORMAL
     (* anyseq *) wire [47:0] fv_entry;
     (* anyseq *) wire [7:0] fv_byte;
     assign entry = fv_entry;
-    assign rom_q = fv_byte;
+    assign rom_byte = fv_byte;
 `else
     assign entry = table_mem[r_msg[MW-1:0]];
-    assign rom_q = rom[raddr];
+    assign rom_byte = rom[raddr];
 `endif
 
-    // the byte loaded into q next (start: the first; a beat taken: the next) and where it is
+    // the byte read next (start: the first; a beat taken: the next) and where it is
     wire [15:0] ld_pos = start ? 16'd0 : pos + 16'd1;
     wire [15:0] ld_left = start ? e_len : left - 16'd1;
-    wire ld_base = start ? entry[40] : r_base;
+    wire ld_base = start ? entry_r[40] : r_base;
     wire in_dst = (ld_pos >= DST_FIRST) && (ld_pos < DST_END);
     wire in_base = ld_base && (ld_pos >= BASE_FIRST) && (ld_pos < BASE_END);
     wire in_count = (ld_left <= 16'd4);
     wire [95:0] pfx_now = start ? r_prefix : pfx_sh;
-    wire [7:0] ld_byte = in_dst ? pfx_now[95:88] : in_base ? base_sh[63:56] :
-                         in_count ? cnt_sh[7:0] : rom_q;
+    wire ld = start || (take && !last);
 
-    // the credit: RATE per byte received, at most BURST; an answer's length spent as it starts
-    wire [16:0] cred_in = {1'b0, cred} + (rx_byte ? RATE_17 : 17'd0);
-    wire [16:0] cred_cap = (cred_in > BURST_17) ? BURST_17 : cred_in;
-    wire [16:0] cred_n = start ? cred_cap - {1'b0, e_len} : cred_cap;
-
-    assign m_axis_tdata = q;
+    assign m_axis_tdata = q_rom ? rom_q : q;
     assign m_axis_tvalid = sending;
     assign m_axis_tlast = sending && last;
     assign m_axis_tdest = dest;
@@ -180,12 +180,13 @@ module rfl_rtps_disc_answer #(
     assign cnt_no_credit = n_poor;
 
     // an entry's flags and destination are wider than this module uses: their top bits are 0
-    wire [15:0] e_dest = {8'd0, entry[39:32]};   // (wide enough for any DEST_BITS refused)
-    wire unused_ok = &{1'b0, entry, e_dest, r_msg, cred_n[16]};
+    wire [15:0] e_dest = {8'd0, entry_r[39:32]};   // (wide enough for any DEST_BITS refused)
+    wire unused_ok = &{1'b0, entry_r, e_dest, r_msg};
 
     always @(posedge clk) begin
         if (!rst_n) begin
             req <= 1'b0;
+            look <= 1'b0;
             sending <= 1'b0;
             count <= CS_32;
             cred <= BURST_32[15:0];
@@ -194,11 +195,16 @@ module rfl_rtps_disc_answer #(
             left <= 16'd0;
             pos <= 16'd0;
             q <= 8'd0;
+            q_rom <= 1'b1;
             addr <= {AW{1'b0}};
             dest <= {DEST_BITS{1'b0}};
             r_base <= 1'b0;
         end else begin
-            cred <= cred_n[15:0];
+            // the credit: an answer's length spent as it starts (a byte received that clock
+            // earns nothing: the bound only gains), else RATE a byte received, at most BURST
+            if (start) cred <= cred - e_len;
+            else if (rx_byte) cred <= (cred >= BURST_LESS_RATE) ? BURST_32[15:0]
+                                                                 : cred + RATE_32[15:0];
             if (accept) begin
                 req <= 1'b1;
                 r_msg <= s_axis_tdata[7:0];
@@ -211,12 +217,20 @@ module rfl_rtps_disc_answer #(
             end
             if (req) begin
                 req <= 1'b0;
+                look <= 1'b1;
+                entry_r <= entry;
+                in_table_r <= ({24'd0, r_msg} < NM_32);   // (a request past the table: dropped)
+            end
+            if (look) begin
+                look <= 1'b0;
                 if (!afford) n_poor <= n_poor + 1'b1;
             end
-            if (start || (take && !last)) begin
-                q <= ld_byte;
+            if (ld) begin
+                rom_q <= rom_byte;
                 addr <= raddr + 1'b1;
                 pos <= ld_pos;
+                q_rom <= !(in_dst || in_base || in_count);
+                q <= in_dst ? pfx_now[95:88] : in_base ? base_sh[63:56] : cnt_sh[7:0];
                 if (in_dst) pfx_sh <= {pfx_now[87:0], 8'd0};
                 else if (start) pfx_sh <= r_prefix;
                 if (in_base) base_sh <= {base_sh[55:0], 8'd0};
@@ -226,7 +240,7 @@ module rfl_rtps_disc_answer #(
                 sending <= 1'b1;
                 left <= e_len;
                 dest <= e_dest[DEST_BITS-1:0];
-                r_base <= entry[40];
+                r_base <= entry_r[40];
             end else if (done) begin
                 sending <= 1'b0;
                 count <= count + 1'b1;
