@@ -106,6 +106,11 @@ module rfl_rtps_disc_answer #(
     localparam [31:0] BASE_32 = BASE_AT;
     localparam [15:0] DST_FIRST = DST_32[15:0], DST_END = DST_32[15:0] + 16'd12;
     localparam [15:0] BASE_FIRST = BASE_32[15:0], BASE_END = BASE_32[15:0] + 16'd8;
+    // the byte after the one at pos is in a field: pos in [FIRST - 1, END - 2] (constants:
+    // no adder on the path); the first byte (pos 0) is when FIRST is 0
+    localparam [16:0] DST_LO = {1'b0, DST_FIRST} - 17'd1, DST_HI = {1'b0, DST_END} - 17'd2;
+    localparam [16:0] BASE_LO = {1'b0, BASE_FIRST} - 17'd1, BASE_HI = {1'b0, BASE_END} - 17'd2;
+    localparam DST_AT_0 = (DST_32 == 0), BASE_AT_0 = (BASE_32 == 0);
 
     reg [7:0]  rom [0:RB-1];
     reg [47:0] table_mem [0:NM-1];
@@ -123,7 +128,8 @@ module rfl_rtps_disc_answer #(
     reg [7:0] r_msg;
     reg [95:0] r_prefix;
     reg [47:0] entry_r;
-    reg in_table_r;
+    reg afford;                                 // the credit holds its length (it only grows
+                                                // until an answer starts)
     reg [95:0] pfx_sh;                          // the prefix, a byte out per INFO_DST byte
     reg [63:0] base_sh;                         // the base in wire order, a byte out per byte
     reg [31:0] count, cnt_sh;
@@ -147,7 +153,6 @@ module rfl_rtps_disc_answer #(
     wire [47:0] entry;                          // the table's entry of r_msg
     wire [7:0] rom_byte;                        // the ROM's byte at raddr
     wire [15:0] e_len = entry_r[15:0];
-    wire afford = in_table_r && (cred >= e_len) && (e_len != 16'd0);
     wire start = look && afford;
     wire [AW-1:0] raddr = start ? entry_r[16 +: AW] : addr;
 `ifdef FORMAL
@@ -162,11 +167,10 @@ module rfl_rtps_disc_answer #(
 
     // the byte read next (start: the first; a beat taken: the next) and where it is
     wire [15:0] ld_pos = start ? 16'd0 : pos + 16'd1;
-    wire [15:0] ld_left = start ? e_len : left - 16'd1;
-    wire ld_base = start ? entry_r[40] : r_base;
-    wire in_dst = (ld_pos >= DST_FIRST) && (ld_pos < DST_END);
-    wire in_base = ld_base && (ld_pos >= BASE_FIRST) && (ld_pos < BASE_END);
-    wire in_count = (ld_left <= 16'd4);
+    wire in_dst = start ? DST_AT_0 : ({1'b0, pos} >= DST_LO && {1'b0, pos} <= DST_HI);
+    wire in_base = start ? (entry_r[40] && BASE_AT_0)
+                         : (r_base && {1'b0, pos} >= BASE_LO && {1'b0, pos} <= BASE_HI);
+    wire in_count = start ? (e_len <= 16'd4) : (left <= 16'd5);
     wire [95:0] pfx_now = start ? r_prefix : pfx_sh;
     wire ld = start || (take && !last);
 
@@ -219,7 +223,9 @@ module rfl_rtps_disc_answer #(
                 req <= 1'b0;
                 look <= 1'b1;
                 entry_r <= entry;
-                in_table_r <= ({24'd0, r_msg} < NM_32);   // (a request past the table: dropped)
+                // (a request past the table: dropped)
+                afford <= ({24'd0, r_msg} < NM_32) && (cred >= entry[15:0]) &&
+                          (entry[15:0] != 16'd0);
             end
             if (look) begin
                 look <= 1'b0;
