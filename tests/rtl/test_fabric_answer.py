@@ -18,14 +18,17 @@ What holds it:
 from __future__ import annotations
 
 import json
+import select
 import struct
+import threading
+import time
 from pathlib import Path
 
 import pytest
 
 from rosfpga_lab.rtl.discanswer import AnswerModel
 from rosfpga_lab.rtl.discrom import (
-    ANSWER_FILE, ANSWER_TABLE_FILE, DiscoveryRom, answer_params, fabric_participant, render_rom,
+    ANSWER_FILE, ANSWER_TABLE_FILE, DEST_META, DiscoveryRom, answer_params, fabric_participant, render_rom,
     write_rom,
 )
 from rosfpga_lab.config import load_config
@@ -278,3 +281,105 @@ def test_a_planted_bug_fails_the_proof(module: str, proof_mode: str, good: str, 
     failed = prove(proof, replace={module: tmp_path / module})
     assert failed.status == "FAIL" and any(f"fv_{name}.sv" in f for f in failed.failed), \
         failed.log[-3000:]
+
+
+# ---- Cyclone DDS on loopback, the circuit's answers played by the model -----------------------
+class AnsweringSender:
+    """The circuit on UDP sockets, its logic the model's (``rtl.discanswer``, the Verilog's
+    tables): SPDP every PERIOD to the discovery ports a loopback graph probes, and every
+    datagram received on its two ports answered as rfl_rtps_ctrl and rfl_rtps_disc_answer
+    answer it, to the asker's metatraffic or user port (learned from its SPDP). The SEDP and
+    ros_discovery_info datagrams are never sent unasked (``send_sedp`` unused, no periodic
+    re-send): a peer gets them only by ACKNACK. Runs on a thread until closed."""
+
+    PERIOD = 0.5
+
+    def __init__(self, domain: int) -> None:
+        from tests.rtl.test_discrom import PREFIX, _bind_free_index
+
+        self.index, self.meta, self.user = _bind_free_index(domain)
+        self.rom = render_rom(CONFIG, domain=domain, index=self.index, guid_prefix=PREFIX)
+        self.model = AnswerModel(self.rom)
+        self.peers: dict[bytes, tuple[int, int]] = {}
+        self.answered: list[str] = []
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        from tests.rtl.test_discrom import _peer_locators
+
+        last = -1.0
+        while not self._stop.is_set():
+            if time.monotonic() - last > self.PERIOD:
+                last = time.monotonic()
+                for port in self.rom.ports()["spdp_unicast"]:
+                    self.meta.sendto(self.rom.message("spdp").data, ("127.0.0.1", port))
+            ready, _, _ = select.select([self.meta, self.user], [], [], 0.05)
+            for sock in ready:
+                try:
+                    datagram, _ = sock.recvfrom(65536)
+                except OSError:
+                    continue
+                ports = _peer_locators(datagram)
+                if ports is not None:
+                    self.peers[datagram[8:20]] = ports
+                for a in self.model.receive(datagram):
+                    if a.prefix in self.peers:
+                        port = self.peers[a.prefix][0 if a.dest == DEST_META else 1]
+                        self.meta.sendto(a.data, ("127.0.0.1", port))
+                        self.answered.append(_names_of(self.rom, a))
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join(timeout=2.0)
+        self.meta.close()
+        self.user.close()
+
+
+def _names_of(rom: DiscoveryRom, answer) -> str:
+    return rom.answers[_names(rom, [answer])[0]].name
+
+
+@pytest.mark.timeout(30)
+def test_cyclone_matches_through_the_answers_alone() -> None:
+    """Cyclone DDS (as rmw_cyclonedds configures it on loopback) learns the fabric participant's
+    publication, subscription and ros_discovery_info sample though the circuit never sends its
+    SEDP unasked: Cyclone's readers' preemptive ACKNACKs get the writers' HEARTBEATs, their
+    ACKNACKs the DATA."""
+    from tests.rtl.test_discrom import PREFIX, _require_cyclonedds
+    from tests.support.ros2tools import DOMAIN, cyclone, wait
+
+    builtin, dds = _require_cyclonedds()
+    types = cyclone()
+    sender = AnsweringSender(DOMAIN)
+    try:
+        dp = dds.DomainParticipant(DOMAIN)
+        P = types.Policy
+        graph = types.DataReader(dp, types.Topic(dp, "ros_discovery_info",
+                                                 types.ParticipantEntitiesInfo_),
+                                 qos=types.Qos(P.Reliability.Reliable(1_000_000_000),
+                                               P.Durability.TransientLocal, P.History.KeepLast(1)))
+        infos: list = []
+        readers = {name: builtin.BuiltinDataReader(dp, topic) for name, topic in (
+            ("publication", builtin.BuiltinTopicDcpsPublication),
+            ("subscription", builtin.BuiltinTopicDcpsSubscription))}
+        seen: dict[str, list] = {name: [] for name in readers}
+        ours = {"publication": "rt/samples_dilated", "subscription": "rt/samples"}
+
+        def found() -> bool:
+            for name, r in readers.items():
+                seen[name] += r.take(N=64)
+            infos.extend(graph.take(N=8))
+            return bool(infos) and all(any(s.key.bytes[:12] == PREFIX and s.topic_name == topic
+                                           for s in seen[name]) for name, topic in ours.items())
+
+        assert wait(found, 10.0), (sender.answered, {k: len(v) for k, v in seen.items()})
+        # what it took: HEARTBEATs for the preemptive ACKNACKs, then the DATA asked for
+        assert {"publications_hb", "subscriptions_hb", "publications_1", "publications_2",
+                "subscriptions_1", "ros_discovery_info_1"} <= set(sender.answered), \
+            sender.answered
+        assert sender.model.no_credit == 0
+        dp = None
+    finally:
+        sender.close()
