@@ -152,8 +152,8 @@ module rfl_rtps_ctrl #(
     // the slots
     reg [71:0] pend;                            // 9 bits a slot; bit 0: the first message,
                                                 // bit s: DATA s
-    reg [95:0] p_prefix [0:7];
-    reg [63:0] p_base [0:7];
+    reg [767:0] p_prefix;                       // 96 bits a slot
+    reg [511:0] p_base;                         // 64 bits a slot
     reg [167:0] o_data;
     reg o_valid;
     assign m_axis_tdata = o_data;
@@ -190,24 +190,32 @@ module rfl_rtps_ctrl #(
         end
     endgenerate
 
-    // the next request: the lowest slot pending, its lowest message
-    reg pick;
-    reg [7:0] pick_msg;
-    reg [2:0] pick_slot;
-    reg [3:0] pick_bit;
-    integer pi, ps;
+    // the next request: the lowest slot pending, its lowest message (every slot's at once,
+    // then an AND-OR of the one picked: timing)
+    wire [7:0] nz;                              // slots pending
+    wire [71:0] low;                            // each slot's lowest pending bit, one-hot
+    wire [63:0] slot_msg;                       // each slot's message of that bit
+    genvar gp;
+    generate
+        for (gp = 0; gp < 8; gp = gp + 1) begin : g_pick
+            wire [8:0] p = pend[9*gp +: 9];
+            assign nz[gp] = |p;
+            assign low[9*gp +: 9] = p & (~p + 9'd1);
+            wire [3:0] lb = p[0] ? 4'd0 : p[1] ? 4'd1 : p[2] ? 4'd2 : p[3] ? 4'd3 :
+                            p[4] ? 4'd4 : p[5] ? 4'd5 : p[6] ? 4'd6 : p[7] ? 4'd7 : 4'd8;
+            assign slot_msg[8*gp +: 8] = MSGS[8*gp +: 8] + {4'd0, lb};
+        end
+    endgenerate
+    wire [7:0] sel = nz & (~nz + 8'd1);         // the lowest slot pending, one-hot
+    wire pick = |nz;
+    reg [167:0] pick_data;
+    integer pi;
     always @(*) begin
-        pick = 1'b0;
-        pick_slot = 3'd0;
-        pick_bit = 4'd0;
-        for (pi = 7; pi >= 0; pi = pi - 1)
-            if (pend[9*pi +: 9] != 9'd0) begin
-                pick = 1'b1;
-                pick_slot = pi[2:0];
-            end
-        for (ps = 8; ps >= 0; ps = ps - 1)
-            if (pend[9*pick_slot + ps]) pick_bit = ps[3:0];
-        pick_msg = MSGS[8*pick_slot +: 8] + {4'd0, pick_bit};
+        pick_data = 168'd0;
+        for (pi = 0; pi < 8; pi = pi + 1)
+            if (sel[pi])
+                pick_data = pick_data | {p_base[64*pi +: 64], p_prefix[96*pi +: 96],
+                                         slot_msg[8*pi +: 8]};
     end
     wire load = pick && (!o_valid || m_axis_tready);
 
@@ -344,12 +352,13 @@ module rfl_rtps_ctrl #(
             for (i = 0; i < 8; i = i + 1)
                 if (want[9*i +: 9] != 9'd0 && pend[9*i +: 9] == 9'd0) begin
                     pend[9*i +: 9] <= want[9*i +: 9];
-                    p_prefix[i] <= d_prefix;
-                    p_base[i] <= d_next;
+                    p_prefix[96*i +: 96] <= d_prefix;
+                    p_base[64*i +: 64] <= d_next;
                 end
             if (load) begin
-                pend[9*pick_slot +: 9] <= pend[9*pick_slot +: 9] & ~(9'd1 << pick_bit);
-                o_data <= {p_base[pick_slot], p_prefix[pick_slot], pick_msg};
+                for (i = 0; i < 8; i = i + 1)
+                    if (sel[i]) pend[9*i +: 9] <= pend[9*i +: 9] & ~low[9*i +: 9];
+                o_data <= pick_data;
                 o_valid <= 1'b1;
             end else if (m_axis_tready) begin
                 o_valid <= 1'b0;
