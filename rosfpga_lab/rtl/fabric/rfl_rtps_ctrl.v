@@ -207,17 +207,28 @@ module rfl_rtps_ctrl #(
         end
     endgenerate
     wire [7:0] sel = nz & (~nz + 8'd1);         // the lowest slot pending, one-hot
-    wire pick = |nz;
-    reg [167:0] pick_data;
+    reg [7:0] sel_msg;
     integer pi;
     always @(*) begin
-        pick_data = 168'd0;
+        sel_msg = 8'd0;
         for (pi = 0; pi < 8; pi = pi + 1)
-            if (sel[pi])
-                pick_data = pick_data | {p_base[64*pi +: 64], p_prefix[96*pi +: 96],
-                                         slot_msg[8*pi +: 8]};
+            if (sel[pi]) sel_msg = sel_msg | slot_msg[8*pi +: 8];
     end
-    wire load = pick && (!o_valid || m_axis_tready);
+    // the pick, registered (timing): it stays right while no request goes out (a slot's bits
+    // are only cleared by a request going out, only set while it has none), so a request
+    // goes out at most every other clock
+    reg pk_r, loaded;
+    reg [7:0] sel_r, msg_r;
+    reg [71:0] low_r;
+    reg [167:0] pick_data;
+    integer pj;
+    always @(*) begin
+        pick_data = {160'd0, msg_r};
+        for (pj = 0; pj < 8; pj = pj + 1)
+            if (sel_r[pj])
+                pick_data = pick_data | {p_base[64*pj +: 64], p_prefix[96*pj +: 96], 8'd0};
+    end
+    wire load = pk_r && !loaded && (!o_valid || m_axis_tready);
 
     // the slot's set, set or dropped; any hit counts once
     reg any_want, any_busy;
@@ -245,6 +256,8 @@ module rfl_rtps_ctrl #(
             n_busy <= {COUNT_BITS{1'b0}};
             n_bad <= {COUNT_BITS{1'b0}};
             pend <= 72'd0;
+            pk_r <= 1'b0;
+            loaded <= 1'b0;
         end else begin
             d_valid <= 1'b0;
             if (take) begin
@@ -355,9 +368,14 @@ module rfl_rtps_ctrl #(
                     p_prefix[96*i +: 96] <= d_prefix;
                     p_base[64*i +: 64] <= d_next;
                 end
+            pk_r <= |nz;
+            sel_r <= sel;
+            msg_r <= sel_msg;
+            low_r <= low;
+            loaded <= load;
             if (load) begin
                 for (i = 0; i < 8; i = i + 1)
-                    if (sel[i]) pend[9*i +: 9] <= pend[9*i +: 9] & ~low[9*i +: 9];
+                    if (sel_r[i]) pend[9*i +: 9] <= pend[9*i +: 9] & ~low_r[9*i +: 9];
                 o_data <= pick_data;
                 o_valid <= 1'b1;
             end else if (m_axis_tready) begin
@@ -384,6 +402,16 @@ module rfl_rtps_ctrl #(
                 if (fi >= NS || fs > LASTS[8*fi +: 8]) assert(!pend[9*fi + fs]);
         for (fi = NS; fi < 8; fi = fi + 1) assert(!pend[9*fi]);
         if (o_valid) assert(f_named);
+        // the registered pick: one slot, still pending, its lowest message
+        if (pk_r && !loaded) begin
+            assert(sel_r != 8'd0 && (sel_r & (sel_r - 8'd1)) == 8'd0);
+            for (fi = 0; fi < 8; fi = fi + 1)
+                if (sel_r[fi]) begin
+                    assert(pend[9*fi +: 9] != 9'd0);
+                    assert(low_r[9*fi +: 9] == low[9*fi +: 9]);
+                    assert(msg_r == slot_msg[8*fi +: 8]);
+                end
+        end
     end
 `endif
 endmodule
