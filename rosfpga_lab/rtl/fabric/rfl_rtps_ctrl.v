@@ -40,7 +40,8 @@
 // submessage longer than the datagram, a length not a multiple of 4 that is not the last, an
 // ACKNACK with numBits > 256 or a body too short for its fields (ACKNACK, HEARTBEAT, INFO_DST,
 // INFO_SRC).
-// Timing: the slot decisions read registers only (the d_* stage).
+// Timing: the slot decisions read registers only (the d_* stage), their outcome is registered
+// (want_r) before it sets a slot, and the pick of the next request is registered.
 `default_nettype none
 
 module rfl_rtps_ctrl #(
@@ -231,13 +232,16 @@ module rfl_rtps_ctrl #(
     wire load = pk_r && !loaded && (!o_valid || m_axis_tready);
 
     // the slot's set, set or dropped; any hit counts once
+    // what the slots want, registered (timing): d_* hold until the next decision, at least a
+    // submessage (24 bytes) later, so the prefix and base are still the decision's
+    reg [71:0] want_r;
     reg any_want, any_busy;
     integer ai;
     always @(*) begin
         any_want = 1'b0;
         any_busy = 1'b0;
         for (ai = 0; ai < 8; ai = ai + 1)
-            if (want[9*ai +: 9] != 9'd0) begin
+            if (want_r[9*ai +: 9] != 9'd0) begin
                 any_want = 1'b1;
                 if (pend[9*ai +: 9] != 9'd0) any_busy = 1'b1;
             end
@@ -256,6 +260,7 @@ module rfl_rtps_ctrl #(
             n_busy <= {COUNT_BITS{1'b0}};
             n_bad <= {COUNT_BITS{1'b0}};
             pend <= 72'd0;
+            want_r <= 72'd0;
             pk_r <= 1'b0;
             loaded <= 1'b0;
         end else begin
@@ -363,11 +368,12 @@ module rfl_rtps_ctrl #(
                 else n_req <= n_req + 1'b1;
             end
             for (i = 0; i < 8; i = i + 1)
-                if (want[9*i +: 9] != 9'd0 && pend[9*i +: 9] == 9'd0) begin
-                    pend[9*i +: 9] <= want[9*i +: 9];
+                if (want_r[9*i +: 9] != 9'd0 && pend[9*i +: 9] == 9'd0) begin
+                    pend[9*i +: 9] <= want_r[9*i +: 9];
                     p_prefix[96*i +: 96] <= d_prefix;
                     p_base[64*i +: 64] <= d_next;
                 end
+            want_r <= want;
             pk_r <= |nz;
             sel_r <= sel;
             msg_r <= sel_msg;
