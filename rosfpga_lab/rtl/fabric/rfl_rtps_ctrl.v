@@ -115,6 +115,8 @@ module rfl_rtps_ctrl #(
     reg [95:0] src;
     reg [87:0] src_sh, dst_sh;           // the last 11 bytes of a prefix coming in
     reg dst_ok;                                 // the submessages are for us
+    reg [95:0] dst;                             // the last INFO_DST's prefix
+    reg dst_chk, own_chk;                       // compare dst / src with ours (a clock late)
     reg [7:0] kind, len_lo;
     reg le, flag_f;
     reg k_ack, k_hb, k_dst, k_src;
@@ -138,7 +140,8 @@ module rfl_rtps_ctrl #(
                    k_dst ? (pos == 16'd11) : (pos == 16'd19);
     wire done_n = fields_done || at_need;
     wire parsed = k_ack || k_hb || k_dst || k_src;
-    wire nbits_bad = k_ack && (pos == 16'd19) && (acc_e_n > 32'd256);
+    // numBits > 256, from its register the byte after (timing)
+    wire nbits_bad = k_ack && (pos == 16'd20) && (|f_nbits[31:9] || (f_nbits[8] && |f_nbits[7:0]));
     // the end of a submessage: its fields short, cut, or misaligned and not the last
     wire sub_bad = trunc || (body_last && ((parsed && !done_n) || (misaligned && !tl)));
     wire [95:0] src_sh_n = {src_sh[87:0], b};
@@ -254,6 +257,8 @@ module rfl_rtps_ctrl #(
             idx <= 5'd0;
             hdr_bad <= 1'b0;
             dst_ok <= 1'b1;
+            dst_chk <= 1'b0;
+            own_chk <= 1'b0;
             d_valid <= 1'b0;
             o_valid <= 1'b0;
             n_req <= {COUNT_BITS{1'b0}};
@@ -280,7 +285,8 @@ module rfl_rtps_ctrl #(
                     end else if (idx == 5'd19) begin
                         idx <= 5'd0;
                         src <= src_sh_n;
-                        st <= (hdr_bad || src_sh_n == cfg_prefix) ? S_DROP : S_SUBHDR;
+                        st <= hdr_bad ? S_DROP : S_SUBHDR;
+                        own_chk <= !hdr_bad;    // ours, looped back: dropped a clock late
                     end
                 end
                 S_SUBHDR: begin
@@ -334,8 +340,10 @@ module rfl_rtps_ctrl #(
                         need_last <= 16'd23 + {10'd0, nwords, 2'b00};
                     end
                     if (pos == 16'd23) f_word0 <= acc_e_n;
-                    if (k_dst && pos == 16'd11)
-                        dst_ok <= (dst_sh_n == cfg_prefix) || (dst_sh_n == 96'd0);
+                    if (k_dst && pos == 16'd11) begin
+                        dst <= dst_sh_n;
+                        dst_chk <= 1'b1;
+                    end
                     if (k_src && pos == 16'd19) src <= src_sh_n;
                     if (nbits_bad || sub_bad) begin
                         n_bad <= n_bad + 1'b1;
@@ -361,6 +369,15 @@ module rfl_rtps_ctrl #(
                 default: if (tl) st <= S_HDR;    // S_DROP: the rest of the datagram
                 endcase
                 if (tl) idx <= 5'd0;
+            end
+            // the late comparisons (timing): INFO_DST's prefix ours or any; the message ours
+            if (dst_chk) begin
+                dst_chk <= 1'b0;
+                dst_ok <= (dst == cfg_prefix) || (dst == 96'd0);
+            end
+            if (own_chk) begin
+                own_chk <= 1'b0;
+                if (src == cfg_prefix && !(take && tl)) st <= S_DROP;
             end
             // the slots: a request set taken, or dropped (busy); the next request out
             if (any_want) begin
