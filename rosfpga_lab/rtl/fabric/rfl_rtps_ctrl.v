@@ -20,8 +20,8 @@
 //             source), ACKNACK (readerId, writerId, readerSNState base, numBits, the first
 //             bitmap word, count) and HEARTBEAT (readerId, writerId, firstSN, lastSN, count);
 //             other submessages are skipped by length.
-// At the end of an ACKNACK or HEARTBEAT for us, the fields go to one register stage (d_*); the
-// clock after, each slot matches:
+// At the end of an ACKNACK or HEARTBEAT for us, the fields go to a register stage (d_*); two
+// clocks after (the numbers asked registered between: timing), each slot matches:
 //   ACKNACK to writer slot i (writerId = its id): base 0 (preemptive) asks its HEARTBEAT
 //     (message SLOT_MSGS[i]); else each sequence number s in 1..last with its bit set (s >=
 //     base, s - base < numBits) asks message SLOT_MSGS[i] + s (its DATA and a HEARTBEAT);
@@ -171,26 +171,36 @@ module rfl_rtps_ctrl #(
     wire d_small = (d_hi == 32'd0) && (d_lo[31:4] == 28'd0);
     wire [63:0] d_next = {d_hi, d_lo} + 64'd1;
     wire [71:0] want;                           // 9 bits a slot, as pend
+    wire [8:1] asked_n;
+    reg [8:1] asked;                            // the numbers 1..8 the ACKNACK asks
+    reg d_valid2, base0_r, small_r;             // the decision, a clock later
     genvar gw, gs;
     generate
+        // the sequence numbers 1..8 the bitmap asks (any writer's), a clock after the decision
+        // (timing: d_* hold until the next one)
+        for (gs = 1; gs <= 8; gs = gs + 1) begin : g_seq
+            localparam [4:0] S5 = gs;
+            wire [4:0] off = S5 - {1'b0, d_lo[3:0]};         // its bit in the bitmap
+            assign asked_n[gs] = d_small && !d_base0 && (S5 >= {1'b0, d_lo[3:0]}) &&
+                                 ({4'd0, off} < d_nbits) && d_word0[5'd31 - off];
+        end
         for (gw = 0; gw < 8; gw = gw + 1) begin : g_want
             wire [31:0] id = IDS[32*gw +: 32];
             wire [7:0] lastsn = LASTS[8*gw +: 8];
-            wire is_w = (gw < NS) && d_valid && d_ack && (lastsn != 8'd0) && (d_wid == id);
-            wire is_r = (gw < NS) && d_valid && !d_ack && !d_final && (lastsn == 8'd0) &&
+            wire is_w = (gw < NS) && d_valid2 && d_ack && (lastsn != 8'd0) && (d_wid == id);
+            wire is_r = (gw < NS) && d_valid2 && !d_ack && !d_final && (lastsn == 8'd0) &&
                         (d_rid == id || (d_rid == 32'd0 && {d_wid[31:8], 8'hC7} == id));
+            wire [8:1] held;                            // asked and held
+            for (gs = 1; gs <= 8; gs = gs + 1) begin : g_held
+                localparam [7:0] S8 = gs;
+                assign held[gs] = asked[gs] && (S8 <= lastsn);
+            end
             // the HEARTBEAT: base 0 (preemptive), or a base at or below last with no held
             // number asked (the reader lacks samples it does not know of: the circuit's
             // writer sends no periodic HEARTBEAT, so it tells it now)
-            wire behind = d_small && ({24'd0, lastsn} >= d_lo) && !(|want[9*gw+1 +: 8]);
-            assign want[9*gw] = (is_w && (d_base0 || behind)) || is_r;
-            for (gs = 1; gs <= 8; gs = gs + 1) begin : g_seq
-                localparam [4:0] S5 = gs;
-                wire [4:0] off = S5 - {1'b0, d_lo[3:0]};     // its bit in the bitmap
-                assign want[9*gw + gs] = is_w && !d_base0 && d_small && ({3'd0, S5} <= lastsn)
-                                         && (S5 >= {1'b0, d_lo[3:0]}) && ({4'd0, off} < d_nbits)
-                                         && d_word0[5'd31 - off];
-            end
+            wire behind = small_r && ({4'd0, d_lo[3:0]} <= lastsn) && !(|held);
+            assign want[9*gw] = (is_w && (base0_r || behind)) || is_r;
+            assign want[9*gw+1 +: 8] = is_w ? held : 8'd0;
         end
     endgenerate
 
@@ -266,6 +276,7 @@ module rfl_rtps_ctrl #(
             n_bad <= {COUNT_BITS{1'b0}};
             pend <= 72'd0;
             want_r <= 72'd0;
+            d_valid2 <= 1'b0;
             pk_r <= 1'b0;
             loaded <= 1'b0;
         end else begin
@@ -391,6 +402,10 @@ module rfl_rtps_ctrl #(
                     p_base[64*i +: 64] <= d_next;
                 end
             want_r <= want;
+            d_valid2 <= d_valid;
+            asked <= asked_n;
+            base0_r <= d_base0;
+            small_r <= d_small;
             pk_r <= |nz;
             sel_r <= sel;
             msg_r <= sel_msg;
