@@ -134,7 +134,8 @@ module rfl_rtps_ctrl #(
     wire [31:0] acc_b_n = {acc_b, b};
     wire [3:0] nwords = acc_e_n[8:5] + {3'd0, |acc_e_n[4:0]};   // bitmap words (<= 256 bits)
     wire [15:0] len_n = le ? {b, len_lo} : {len_lo, b};
-    wire body_last = to_end ? tl : (sub_left == 16'd1);
+    reg sl1;                                    // sub_left == 1, registered (timing)
+    wire body_last = to_end ? tl : sl1;
     wire trunc = tl && !body_last;
     wire at_need = k_ack ? (pos == need_last) : k_hb ? (pos == 16'd27) :
                    k_dst ? (pos == 16'd11) : (pos == 16'd19);
@@ -325,6 +326,7 @@ module rfl_rtps_ctrl #(
                     end else if (idx == 5'd3) begin
                         idx <= 5'd0;
                         sub_left <= len_n;
+                        sl1 <= (len_n == 16'd1);
                         to_end <= (len_n == 16'd0);
                         misaligned <= (len_n[1:0] != 2'd0);
                         // an empty PAD or INFO_TS: the next submessage header
@@ -337,6 +339,7 @@ module rfl_rtps_ctrl #(
                     acc_b <= acc_b_n[23:0];
                     pos <= pos + 1'b1;
                     sub_left <= sub_left - 1'b1;
+                    sl1 <= (sub_left == 16'd2);
                     fields_done <= done_n;
                     if (k_dst && pos < 16'd12) dst_sh <= dst_sh_n[87:0];
                     if (k_src && pos >= 16'd8 && pos < 16'd20) src_sh <= src_sh_n[87:0];

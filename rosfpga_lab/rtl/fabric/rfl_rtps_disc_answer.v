@@ -145,7 +145,8 @@ module rfl_rtps_disc_answer #(
     reg [COUNT_BITS-1:0] n_ans, n_poor;
 
     wire take = sending && m_axis_tready;
-    wire last = (left == 16'd1);
+    reg left1, left5;                           // left == 1, left <= 5 (registered: timing)
+    wire last = left1;
     wire done = take && last;
     assign s_axis_tready = !sending && !req && !look;
     wire accept = s_axis_tvalid && s_axis_tready;
@@ -170,7 +171,7 @@ module rfl_rtps_disc_answer #(
     wire in_dst = start ? DST_AT_0 : ({1'b0, pos} >= DST_LO && {1'b0, pos} <= DST_HI);
     wire in_base = start ? (entry_r[40] && BASE_AT_0)
                          : (r_base && {1'b0, pos} >= BASE_LO && {1'b0, pos} <= BASE_HI);
-    wire in_count = start ? (e_len <= 16'd4) : (left <= 16'd5);
+    wire in_count = start ? (e_len <= 16'd4) : left5;
     wire [95:0] pfx_now = start ? r_prefix : pfx_sh;
     wire ld = start || (take && !last);
 
@@ -197,6 +198,8 @@ module rfl_rtps_disc_answer #(
             n_ans <= {COUNT_BITS{1'b0}};
             n_poor <= {COUNT_BITS{1'b0}};
             left <= 16'd0;
+            left1 <= 1'b0;
+            left5 <= 1'b0;
             pos <= 16'd0;
             q <= 8'd0;
             q_rom <= 1'b1;
@@ -245,6 +248,8 @@ module rfl_rtps_disc_answer #(
             if (start) begin
                 sending <= 1'b1;
                 left <= e_len;
+                left1 <= (e_len == 16'd1);
+                left5 <= (e_len <= 16'd5);
                 dest <= e_dest[DEST_BITS-1:0];
                 r_base <= entry_r[40];
             end else if (done) begin
@@ -253,6 +258,8 @@ module rfl_rtps_disc_answer #(
                 n_ans <= n_ans + 1'b1;
             end else if (take) begin
                 left <= left - 1'b1;
+                left1 <= (left == 16'd2);
+                left5 <= (left <= 16'd6);
             end
         end
     end
