@@ -10,10 +10,11 @@ each held number its bitmap names; a HEARTBEAT without F to a reader slot asks i
 base lastSN + 1), and writes the answers from the rendered ROM
 (:attr:`~rosfpga_lab.rtl.discrom.DiscoveryRom.answers`) with their run-time fields patched
 (:func:`patch_answer`), spending the same credit (``burst`` at first, ``rate`` per byte
-received). It has no clock: requests for a slot still pending in the circuit (sent back to back)
-are not modelled; the tests give the circuit time between datagrams, or check the bound alone.
-The loopback test (``tests/rtl/test_discanswer.py``) runs it beside Cyclone DDS in place of the
-circuit.
+received; the circuit's earns nothing on the clock an answer starts, so it may refuse a little
+more, never send more). It has no clock: requests for a slot still pending in the circuit (sent
+back to back) are not modelled; the tests give the circuit time between datagrams, or check the
+bound alone. The loopback test (``tests/rtl/test_fabric_answer.py``) runs it beside Cyclone DDS
+in place of the circuit.
 """
 
 from __future__ import annotations
