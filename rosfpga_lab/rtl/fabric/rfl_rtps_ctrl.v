@@ -205,43 +205,46 @@ module rfl_rtps_ctrl #(
         end
     endgenerate
 
+    // the index of a one-hot 9-bit value, from its bits 8..1 (0: none of them)
+    function [3:0] lowest(input [8:1] h);
+        lowest = {h[8], h[4] | h[5] | h[6] | h[7], h[2] | h[3] | h[6] | h[7],
+                  h[1] | h[3] | h[5] | h[7]};
+    endfunction
     // the next request: the lowest slot pending, its lowest message (every slot's at once,
-    // then an AND-OR of the one picked: timing)
+    // one-hot, registered; then an AND-OR of the one picked: timing)
     wire [7:0] nz;                              // slots pending
     wire [71:0] low;                            // each slot's lowest pending bit, one-hot
-    wire [63:0] slot_msg;                       // each slot's message of that bit
-    genvar gp;
+    wire [7:0] sel;                             // the lowest slot pending, one-hot
+    genvar gp, gb;
     generate
         for (gp = 0; gp < 8; gp = gp + 1) begin : g_pick
             wire [8:0] p = pend[9*gp +: 9];
             assign nz[gp] = |p;
-            assign low[9*gp +: 9] = p & (~p + 9'd1);
-            wire [3:0] lb = p[0] ? 4'd0 : p[1] ? 4'd1 : p[2] ? 4'd2 : p[3] ? 4'd3 :
-                            p[4] ? 4'd4 : p[5] ? 4'd5 : p[6] ? 4'd6 : p[7] ? 4'd7 : 4'd8;
-            assign slot_msg[8*gp +: 8] = MSGS[8*gp +: 8] + {4'd0, lb};
+            assign low[9*gp] = p[0];
+            for (gb = 1; gb < 9; gb = gb + 1) begin : g_low
+                assign low[9*gp + gb] = p[gb] && !(|p[gb-1:0]);
+            end
+            if (gp == 0) begin : g_first
+                assign sel[0] = nz[0];
+            end else begin : g_next
+                assign sel[gp] = nz[gp] && !(|nz[gp-1:0]);
+            end
         end
     endgenerate
-    wire [7:0] sel = nz & (~nz + 8'd1);         // the lowest slot pending, one-hot
-    reg [7:0] sel_msg;
-    integer pi;
-    always @(*) begin
-        sel_msg = 8'd0;
-        for (pi = 0; pi < 8; pi = pi + 1)
-            if (sel[pi]) sel_msg = sel_msg | slot_msg[8*pi +: 8];
-    end
     // the pick, registered (timing): it stays right while no request goes out (a slot's bits
     // are only cleared by a request going out, only set while it has none), so a request
     // goes out at most every other clock
     reg pk_r, loaded;
-    reg [7:0] sel_r, msg_r;
+    reg [7:0] sel_r;
     reg [71:0] low_r;
     reg [167:0] pick_data;
     integer pj;
     always @(*) begin
-        pick_data = {160'd0, msg_r};
+        pick_data = 168'd0;
         for (pj = 0; pj < 8; pj = pj + 1)
             if (sel_r[pj])
-                pick_data = pick_data | {p_base[64*pj +: 64], p_prefix[96*pj +: 96], 8'd0};
+                pick_data = pick_data | {p_base[64*pj +: 64], p_prefix[96*pj +: 96],
+                                         MSGS[8*pj +: 8] + {4'd0, lowest(low_r[9*pj+1 +: 8])}};
     end
     wire load = pk_r && !loaded && (!o_valid || m_axis_tready);
 
@@ -411,7 +414,6 @@ module rfl_rtps_ctrl #(
             small_r <= d_small;
             pk_r <= |nz;
             sel_r <= sel;
-            msg_r <= sel_msg;
             low_r <= low;
             loaded <= load;
             if (load) begin
@@ -450,7 +452,6 @@ module rfl_rtps_ctrl #(
                 if (sel_r[fi]) begin
                     assert(pend[9*fi +: 9] != 9'd0);
                     assert(low_r[9*fi +: 9] == low[9*fi +: 9]);
-                    assert(msg_r == slot_msg[8*fi +: 8]);
                 end
         end
     end

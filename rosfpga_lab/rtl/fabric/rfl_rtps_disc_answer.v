@@ -168,9 +168,10 @@ module rfl_rtps_disc_answer #(
 
     // the byte read next (start: the first; a beat taken: the next) and where it is
     wire [15:0] ld_pos = start ? 16'd0 : pos + 16'd1;
-    wire in_dst = start ? DST_AT_0 : ({1'b0, pos} >= DST_LO && {1'b0, pos} <= DST_HI);
-    wire in_base = start ? (entry_r[40] && BASE_AT_0)
-                         : (r_base && {1'b0, pos} >= BASE_LO && {1'b0, pos} <= BASE_HI);
+    // whether the byte after the one read is in a field, registered as it is read (timing)
+    reg dst_nx, base_nx;
+    wire in_dst = start ? DST_AT_0 : dst_nx;
+    wire in_base = start ? (entry_r[40] && BASE_AT_0) : (r_base && base_nx);
     wire in_count = start ? (e_len <= 16'd4) : left5;
     wire [95:0] pfx_now = start ? r_prefix : pfx_sh;
     wire ld = start || (take && !last);
@@ -238,6 +239,8 @@ module rfl_rtps_disc_answer #(
                 rom_q <= rom_byte;
                 addr <= raddr + 1'b1;
                 pos <= ld_pos;
+                dst_nx <= ({1'b0, ld_pos} >= DST_LO) && ({1'b0, ld_pos} <= DST_HI);
+                base_nx <= ({1'b0, ld_pos} >= BASE_LO) && ({1'b0, ld_pos} <= BASE_HI);
                 q_rom <= !(in_dst || in_base || in_count);
                 q <= in_dst ? pfx_now[95:88] : in_base ? base_sh[63:56] : cnt_sh[7:0];
                 if (in_dst) pfx_sh <= {pfx_now[87:0], 8'd0};
