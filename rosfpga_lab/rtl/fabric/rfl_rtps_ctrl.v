@@ -116,7 +116,8 @@ module rfl_rtps_ctrl #(
     reg [87:0] src_sh, dst_sh;           // the last 11 bytes of a prefix coming in
     reg dst_ok;                                 // the submessages are for us
     reg [95:0] dst;                             // the last INFO_DST's prefix
-    reg dst_chk, own_chk;                       // compare dst / src with ours (a clock late)
+    reg dst_chk, own_chk;                       // compare dst / src with ours (two clocks late)
+    reg dst_chk2, own_chk2, dst_eq, own_eq;
     reg [7:0] kind, len_lo;
     reg le, flag_f;
     reg k_ack, k_hb, k_dst, k_src;
@@ -285,6 +286,8 @@ module rfl_rtps_ctrl #(
             loaded <= 1'b0;
         end else begin
             d_valid <= 1'b0;
+            dst_chk <= 1'b0;                    // (pulses, set below)
+            own_chk <= 1'b0;
             if (take) begin
                 case (st)
                 S_HDR: begin
@@ -301,7 +304,7 @@ module rfl_rtps_ctrl #(
                         idx <= 5'd0;
                         src <= src_sh_n;
                         st <= hdr_bad ? S_DROP : S_SUBHDR;
-                        own_chk <= !hdr_bad;    // ours, looped back: dropped a clock late
+                        own_chk <= !hdr_bad;    // ours, looped back: dropped two clocks late
                     end
                 end
                 S_SUBHDR: begin
@@ -388,14 +391,13 @@ module rfl_rtps_ctrl #(
                 if (tl) idx <= 5'd0;
             end
             // the late comparisons (timing): INFO_DST's prefix ours or any; the message ours
-            if (dst_chk) begin
-                dst_chk <= 1'b0;
-                dst_ok <= (dst == cfg_prefix) || (dst == 96'd0);
-            end
-            if (own_chk) begin
-                own_chk <= 1'b0;
-                if (src == cfg_prefix && !(take && tl)) st <= S_DROP;
-            end
+            // (each compared into a register, then acted on: two clocks)
+            dst_eq <= (dst == cfg_prefix) || (dst == 96'd0);
+            own_eq <= (src == cfg_prefix);
+            dst_chk2 <= dst_chk;
+            own_chk2 <= own_chk;
+            if (dst_chk2) dst_ok <= dst_eq;
+            if (own_chk2 && own_eq && !(take && tl)) st <= S_DROP;
             // the slots: a request set taken, or dropped (busy); the next request out
             if (any_want) begin
                 if (any_busy) n_busy <= n_busy + 1'b1;

@@ -106,11 +106,16 @@ module rfl_rtps_disc_answer #(
     localparam [31:0] BASE_32 = BASE_AT;
     localparam [15:0] DST_FIRST = DST_32[15:0], DST_END = DST_32[15:0] + 16'd12;
     localparam [15:0] BASE_FIRST = BASE_32[15:0], BASE_END = BASE_32[15:0] + 16'd8;
-    // the byte after the one at pos is in a field: pos in [FIRST - 1, END - 2] (constants:
-    // no adder on the path); the first byte (pos 0) is when FIRST is 0
-    localparam [16:0] DST_LO = {1'b0, DST_FIRST} - 17'd1, DST_HI = {1'b0, DST_END} - 17'd2;
-    localparam [16:0] BASE_LO = {1'b0, BASE_FIRST} - 17'd1, BASE_HI = {1'b0, BASE_END} - 17'd2;
     localparam DST_AT_0 = (DST_32 == 0), BASE_AT_0 = (BASE_32 == 0);
+    // the byte two after the one at pos is in a field: pos in [FIRST - 2, END - 3] (the low
+    // end at least 0; constants: no adder on the path); after the first byte (pos 0), byte 1
+    // is when 1 is in [FIRST, END)
+    localparam [15:0] DST_LO2 = (DST_FIRST >= 16'd2) ? DST_FIRST - 16'd2 : 16'd0;
+    localparam [15:0] DST_HI2 = DST_END - 16'd3;
+    localparam [15:0] BASE_LO2 = (BASE_FIRST >= 16'd2) ? BASE_FIRST - 16'd2 : 16'd0;
+    localparam [15:0] BASE_HI2 = BASE_END - 16'd3;
+    localparam DST_AT_1 = (DST_32 <= 1) && (DST_32 + 12 > 1);
+    localparam BASE_AT_1 = (BASE_32 <= 1) && (BASE_32 + 8 > 1);
 
     reg [7:0]  rom [0:RB-1];
     reg [47:0] table_mem [0:NM-1];
@@ -239,8 +244,8 @@ module rfl_rtps_disc_answer #(
                 rom_q <= rom_byte;
                 addr <= raddr + 1'b1;
                 pos <= ld_pos;
-                dst_nx <= ({1'b0, ld_pos} >= DST_LO) && ({1'b0, ld_pos} <= DST_HI);
-                base_nx <= ({1'b0, ld_pos} >= BASE_LO) && ({1'b0, ld_pos} <= BASE_HI);
+                dst_nx <= start ? DST_AT_1 : (pos >= DST_LO2 && pos <= DST_HI2);
+                base_nx <= start ? BASE_AT_1 : (pos >= BASE_LO2 && pos <= BASE_HI2);
                 q_rom <= !(in_dst || in_base || in_count);
                 q <= in_dst ? pfx_now[95:88] : in_base ? base_sh[63:56] : cnt_sh[7:0];
                 if (in_dst) pfx_sh <= {pfx_now[87:0], 8'd0};
