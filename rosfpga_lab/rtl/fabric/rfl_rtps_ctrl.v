@@ -127,7 +127,7 @@ module rfl_rtps_ctrl #(
     reg [31:0] acc_e;
     reg [23:0] acc_b;
     reg [31:0] f_rid, f_wid, f_hi, f_lo, f_nbits, f_word0;
-    reg [15:0] need_last;                       // the last body byte of the ACKNACK's fields
+    reg [15:0] need_m1;                         // the byte before the ACKNACK's fields' last
     reg fields_done;
     reg [COUNT_BITS-1:0] n_req, n_busy, n_bad;
 
@@ -138,8 +138,9 @@ module rfl_rtps_ctrl #(
     reg sl1;                                    // sub_left == 1, registered (timing)
     wire body_last = to_end ? tl : sl1;
     wire trunc = tl && !body_last;
-    wire at_need = k_ack ? (pos == need_last) : k_hb ? (pos == 16'd27) :
-                   k_dst ? (pos == 16'd11) : (pos == 16'd19);
+    // the byte at pos is the last of the submessage's fields (registered a byte ahead: timing;
+    // an ACKNACK's last is known from byte 19 on, and is at least 23)
+    reg at_need;
     wire done_n = fields_done || at_need;
     wire parsed = k_ack || k_hb || k_dst || k_src;
     // numBits > 256, from its register the byte after (timing)
@@ -323,6 +324,7 @@ module rfl_rtps_ctrl #(
                     if (idx == 5'd2) len_lo <= b;
                     pos <= 16'd0;
                     fields_done <= 1'b0;
+                    at_need <= 1'b0;                // (body byte 0 is no field's last)
                     if (tl) begin
                         // the datagram ends in or right after a submessage header
                         if (idx != 5'd3 || (len_n != 16'd0 || (kind != ID_PAD && kind != ID_INFO_TS)))
@@ -347,6 +349,8 @@ module rfl_rtps_ctrl #(
                     sub_left <= sub_left - 1'b1;
                     sl1 <= (sub_left == 16'd2);
                     fields_done <= done_n;
+                    at_need <= k_ack ? (pos == need_m1) : k_hb ? (pos == 16'd26) :
+                               k_dst ? (pos == 16'd10) : (pos == 16'd18);
                     if (k_dst && pos < 16'd12) dst_sh <= dst_sh_n[87:0];
                     if (k_src && pos >= 16'd8 && pos < 16'd20) src_sh <= src_sh_n[87:0];
                     if (pos == 16'd3) f_rid <= acc_b_n;
@@ -357,7 +361,7 @@ module rfl_rtps_ctrl #(
                     if (pos == 16'd23 && k_hb) f_lo <= acc_e_n;
                     if (pos == 16'd19) begin
                         f_nbits <= acc_e_n;
-                        need_last <= 16'd23 + {10'd0, nwords, 2'b00};
+                        need_m1 <= 16'd22 + {10'd0, nwords, 2'b00};
                     end
                     if (pos == 16'd23) f_word0 <= acc_e_n;
                     if (k_dst && pos == 16'd11) begin
