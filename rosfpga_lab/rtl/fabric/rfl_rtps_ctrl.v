@@ -40,8 +40,9 @@
 // submessage longer than the datagram, a length not a multiple of 4 that is not the last, an
 // ACKNACK with numBits > 256 or a body too short for its fields (ACKNACK, HEARTBEAT, INFO_DST,
 // INFO_SRC).
-// Timing: the slot decisions read registers only (the d_* stage), their outcome is registered
-// (want_r) before it sets a slot, and the pick of the next request is registered.
+// Timing: the slot decisions read registers only (the d_* stage, taken at every submessage's
+// end), their outcome is registered (want_r) before it sets a slot, and the pick of the next
+// request is registered.
 `default_nettype none
 
 module rfl_rtps_ctrl #(
@@ -369,23 +370,26 @@ module rfl_rtps_ctrl #(
                         dst_chk <= 1'b1;
                     end
                     if (k_src && pos == 16'd19) src <= src_sh_n;
+                    if (body_last) begin
+                        // every submessage's fields, taken at its end (timing: no condition
+                        // but the end; d_valid says whether they are a decision; the next
+                        // end is at least 5 bytes later, after the slots have used them)
+                        d_ack <= k_ack;
+                        d_final <= flag_f;
+                        d_rid <= f_rid;
+                        d_wid <= f_wid;
+                        d_hi <= f_hi;
+                        d_lo <= f_lo;               // HEARTBEAT: lastSN's low half
+                        d_nbits <= f_nbits[8:0];    // (0: no number asked, whatever word0)
+                        d_word0 <= f_word0;
+                        d_prefix <= src;
+                    end
                     if (nbits_bad || sub_bad) begin
                         n_bad <= n_bad + 1'b1;
                         st <= tl ? S_HDR : S_DROP;
                     end else if (body_last) begin
                         st <= tl ? S_HDR : S_SUBHDR;
-                        if ((k_ack || k_hb) && dst_ok) begin
-                            d_valid <= 1'b1;
-                            d_ack <= k_ack;
-                            d_final <= flag_f;
-                            d_rid <= f_rid;
-                            d_wid <= f_wid;
-                            d_hi <= f_hi;
-                            d_lo <= f_lo;           // HEARTBEAT: lastSN's low half
-                            d_nbits <= f_nbits[8:0];
-                            d_word0 <= (f_nbits == 32'd0) ? 32'd0 : f_word0;
-                            d_prefix <= src;
-                        end
+                        if ((k_ack || k_hb) && dst_ok) d_valid <= 1'b1;
                     end else if (tl) begin
                         st <= S_HDR;
                     end
