@@ -39,7 +39,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "'fabric' the discovery ROM of the ROS 2 node in the fabric (wire: cdr "
                         "only): its SPDP, SEDP and ros_discovery_info datagrams as $readmemh "
                         "files, the ROM and message table rtl/fabric/rfl_rtps_disc_rom.v reads, "
-                        "and an index (offsets, lengths, destinations, run-time patch points)")
+                        "the answer ROM and table rtl/fabric/rfl_rtps_disc_answer.v reads "
+                        "(resends and HEARTBEATs of the reliable built-in writers), "
+                        "and an index (offsets, lengths, destinations, run-time patch points, "
+                        "answer slots)")
     parser.add_argument("--domain", type=int, default=0, metavar="ID",
                         help="--target fabric: the DDS domain (ROS_DOMAIN_ID; default 0)")
     parser.add_argument("--participant-index", type=int, default=0, metavar="N",

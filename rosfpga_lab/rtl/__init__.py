@@ -23,6 +23,10 @@ The ROS 2 node in the fabric (issue #31) announces itself from a ROM built at bu
 :mod:`rosfpga_lab.rtl.discrom` renders the software participant's SPDP, SEDP and
 ``ros_discovery_info`` datagrams for a ``wire: cdr`` configuration, ``fabric/rfl_rtps_disc_rom.v``
 streams them out (proof ``rtps_disc_rom``; ``rosfpga-lab generate CONFIG -o DIR --target fabric``).
+Its built-in writers are reliable: ``fabric/rfl_rtps_ctrl.v`` watches the received datagrams for
+ACKNACKs to them and HEARTBEATs to its SEDP readers, ``fabric/rfl_rtps_disc_answer.v`` sends the
+answers discrom renders (resent DATA, HEARTBEATs, ACKNACKs) within a byte credit (proofs
+``rtps_ctrl``, ``rtps_disc_answer``); :mod:`rosfpga_lab.rtl.discanswer` models both.
 
 From the shell (ARCHITECTURE.md's command table; each sub-command's ``--help``)::
 

@@ -43,6 +43,28 @@ counts (1 and 2: a new participant has seen none) too.
 lengths, destinations, patch points, and ``rfl_rtps_tx``: the transmit path's parameters).
 :func:`tx_parameters` gives the transmit path (``fabric/rfl_rtps_tx.v``) the same participant's
 GUID prefix and data writer id, so the data comes from the writer the ROM announces.
+
+Answers (issue 31: the built-in writers are reliable): ``answers`` are the datagrams the circuit
+sends when a peer asks (``fabric/rfl_rtps_ctrl.v`` watches the received datagrams and asks,
+``fabric/rfl_rtps_disc_answer.v`` sends). One *slot* per entity that answers
+(:class:`AnswerSlot`): the SEDP publications and subscriptions writers and the
+``ros_discovery_info`` writer (an ACKNACK to them: a HEARTBEAT for a preemptive one, base 0, else
+each sample it asks for that the writer holds, one datagram each: the DATA, then a HEARTBEAT of
+the writer's whole history, as ``WriterSide._on_acknack`` sends; numbers past the last written
+are ignored, never GAPped, as there; every number written is held: the histories are fixed at
+build time, so no GAP is owed; one that asks for no held number with its base at or below the
+last held gets the HEARTBEAT too, where the software writer sends nothing and relies on its
+periodic HEARTBEATs, which the circuit has not), and the built-in SEDP readers (a HEARTBEAT without F to them:
+the ACKNACK of a reader that has every sample, base last + 1, no bits, flag F, as
+``ReaderSide._on_heartbeat`` sends when nothing is missing: the circuit needs no peer's SEDP data,
+its reader takes the configured writer). Every answer starts with the header and INFO_DST, the
+asker's GUID prefix written at :data:`ANSWER_DST_AT`; it ends with its count (HEARTBEAT's or
+ACKNACK's, 4 bytes, little endian: the circuit's counter); an ACKNACK's base is written at
+:data:`ANSWER_BASE_AT`. A slot's messages are consecutive: a writer's HEARTBEAT, then its DATA of
+sequence numbers 1 .. last; a reader's ACKNACK. :func:`answer_params` gives the Verilog the slots
+(parameters), :func:`write_rom` the answer ROM and its table (``ANSWER_FILE``,
+``ANSWER_TABLE_FILE``: one entry a line, {flags[7:0] (bit 0: the base is written), dest[7:0],
+offset[15:0], length[15:0]}).
 """
 
 from __future__ import annotations
@@ -54,7 +76,10 @@ from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.rtl.errors import RtlError
-from rosfpga_lab.rtl.limits import FABRIC_MAX_DATAGRAM, MAX_DISC_ROM_BYTES
+from rosfpga_lab.rtl.limits import (
+    ANSWER_BURST, ANSWER_RATE, FABRIC_MAX_DATAGRAM, MAX_ANSWER_SEQ, MAX_ANSWER_SLOTS,
+    MAX_DISC_ROM_BYTES,
+)
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
     PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, Qos, discovery_multicast_port,
@@ -76,6 +101,20 @@ DEFAULT_FABRIC_PREFIX = b"\x01\x0frflFABRIC\x00"
 #: The file names :func:`write_rom` writes (the Verilog's default ROM_FILE/TABLE_FILE).
 ROM_FILE, TABLE_FILE, INDEX_FILE = ("rfl_rtps_disc_rom.hex", "rfl_rtps_disc_rom_table.hex",
                                     "rfl_rtps_disc_rom.json")
+#: The answer ROM and its table (``fabric/rfl_rtps_disc_answer.v``'s default files).
+ANSWER_FILE, ANSWER_TABLE_FILE = "rfl_rtps_disc_answer.hex", "rfl_rtps_disc_answer_table.hex"
+#: Where every answer's run-time fields are: the asker's GUID prefix (INFO_DST's, after the
+#: header and INFO_DST's submessage header) and an ACKNACK's base (after INFO_DST, the
+#: ACKNACK's submessage header, readerId and writerId).
+ANSWER_DST_AT = len(b.header(ANY_PARTICIPANT)) + 4
+ANSWER_BASE_AT = ANSWER_DST_AT + len(ANY_PARTICIPANT) + 4 + 8
+#: Bits of an answer table entry: flags (8), destination (8), offset (16), length (16).
+ANSWER_TABLE_BITS = 48
+#: Flag bit of an answer table entry: the ACKNACK's base is written at ANSWER_BASE_AT.
+ANSWER_FLAG_BASE = 0x01
+#: The first answer's count: above the ROM's own (HEARTBEAT 1, preemptive ACKNACKs 1 and 2),
+#: so a peer acts on the answers (rfl_rtps_disc_answer's COUNT_START).
+ANSWER_COUNT_START = 3
 
 
 @dataclass(frozen=True)
@@ -100,6 +139,22 @@ class RomMessage:
 
 
 @dataclass(frozen=True)
+class AnswerSlot:
+    """An entity that answers: a writer (``last``: its last sequence number; its messages from
+    ``message``: the HEARTBEAT, then DATA 1 .. last) or a built-in reader (``last`` 0; its
+    message: the ACKNACK)."""
+
+    name: str
+    entity_id: int
+    message: int
+    last: int
+
+    @property
+    def writer(self) -> bool:
+        return self.last > 0
+
+
+@dataclass(frozen=True)
 class DiscoveryRom:
     """The fabric participant's discovery messages and the facts they were built from."""
 
@@ -109,6 +164,8 @@ class DiscoveryRom:
     index: int
     address: str
     entity_ids: dict[str, int] = field(default_factory=dict)
+    answers: tuple[RomMessage, ...] = ()
+    slots: tuple[AnswerSlot, ...] = ()
 
     def message(self, name: str) -> RomMessage:
         return next(m for m in self.messages if m.name == name)
@@ -117,9 +174,13 @@ class DiscoveryRom:
         """The messages one after the other, as the ROM holds them."""
         return b"".join(m.data for m in self.messages)
 
-    def offsets(self) -> list[int]:
+    def answer_image(self) -> bytes:
+        """The answers one after the other, as the answer ROM holds them."""
+        return b"".join(m.data for m in self.answers)
+
+    def offsets(self, answers: bool = False) -> list[int]:
         out, at = [], 0
-        for m in self.messages:
+        for m in (self.answers if answers else self.messages):
             out.append(at)
             at += len(m.data)
         return out
@@ -133,17 +194,24 @@ class DiscoveryRom:
                 "own_user": user_port(self.domain, self.index)}
 
     def index_json(self) -> dict[str, object]:
+        def listed(messages: tuple[RomMessage, ...], offsets: list[int]) -> list[object]:
+            return [{"name": m.name, "offset": off, "length": len(m.data), "dest": m.dest,
+                     "dest_name": DEST_NAMES[m.dest],
+                     "patches": [{"name": p.name, "offset": p.offset, "width": p.width,
+                                  "what": p.what} for p in m.patches]}
+                    for m, off in zip(messages, offsets)]
+
         return {"guid_prefix": self.guid_prefix.hex(), "domain": self.domain, "index": self.index,
                 "address": self.address, "ports": self.ports(), "entity_ids": {
                     k: f"{v:08x}" for k, v in self.entity_ids.items()},
                 "rfl_rtps_tx": verilog_parameters(tx_parameters(self)),
                 "rom_file": ROM_FILE, "table_file": TABLE_FILE,
                 "rom_bytes": len(self.image()),
-                "messages": [{"name": m.name, "offset": off, "length": len(m.data),
-                              "dest": m.dest, "dest_name": DEST_NAMES[m.dest],
-                              "patches": [{"name": p.name, "offset": p.offset, "width": p.width,
-                                           "what": p.what} for p in m.patches]}
-                             for m, off in zip(self.messages, self.offsets())]}
+                "messages": listed(self.messages, self.offsets()),
+                "answer_file": ANSWER_FILE, "answer_table_file": ANSWER_TABLE_FILE,
+                "answers": listed(self.answers, self.offsets(answers=True)),
+                "slots": [{"name": s.name, "entity_id": f"{s.entity_id:08x}",
+                           "message": s.message, "last": s.last} for s in self.slots]}
 
 
 def _announce_ports(rom: DiscoveryRom) -> list[tuple[str, int, bytes]]:
@@ -201,6 +269,71 @@ def _heartbeat(msg: _Message, reader: int, writer: int, last: int, what: str) ->
              f"rise for a reader to act on a HEARTBEAT again)"))
 
 
+def _answer(prefix: bytes, subs: list[bytes], name: str, dest: int, count_what: str,
+            base: bool = False) -> RomMessage:
+    """One answer: header, INFO_DST (the asker's prefix written), ``subs`` (the last one ends
+    with its count, written)."""
+    msg = _Message(prefix)
+    _dst(msg)
+    for sub in subs[:-1]:
+        msg.add(sub)
+    last = subs[-1]
+    if base:
+        msg.patches.append(PatchPoint("acknack_base", ANSWER_BASE_AT, 8, "the ACKNACK's base: "
+                                      "the HEARTBEAT's last + 1 (every sample here)"))
+    msg.patches.append(PatchPoint("count", len(msg.data) + len(last) - 4, 4, f"the {count_what} "
+                                  f"count (the circuit's answer counter)"))
+    msg.data += last
+    return RomMessage(name, bytes(msg.data), dest, tuple(msg.patches))
+
+
+def render_answers(p: Participant, node: RosNodeEntities
+                   ) -> tuple[tuple[RomMessage, ...], tuple[AnswerSlot, ...]]:
+    """The answers of ``p``'s reliable built-in writers, its ``ros_discovery_info`` writer and
+    its built-in SEDP readers, and their slots (the module docstring says what each is)."""
+    writers = [(PUB_WRITER, PUB_READER, "publications", DEST_META,
+                list(p.local[PUB_WRITER].history.values())),
+               (SUB_WRITER, SUB_READER, "subscriptions", DEST_META,
+                list(p.local[SUB_WRITER].history.values())),
+               (node.graph_writer, 0, "ros_discovery_info", DEST_USER, [node.entities_info()])]
+    answers: list[RomMessage] = []
+    slots: list[AnswerSlot] = []
+    for writer, reader, what, dest, history in writers:
+        if not 1 <= len(history) <= MAX_ANSWER_SEQ:
+            raise RtlError(f"the {what} writer holds {len(history)} samples: the circuit "
+                           f"resends 1 .. {MAX_ANSWER_SEQ}")
+        slots.append(AnswerSlot(what, writer, len(answers), len(history)))
+        hb = b.heartbeat(reader, writer, 1, len(history), 1)
+        answers.append(_answer(p.guid_prefix, [hb], f"{what}_hb", dest, "HEARTBEAT"))
+        for seq, payload in enumerate(history, 1):
+            answers.append(_answer(p.guid_prefix, [b.data(reader, writer, seq,
+                                                          b.pad_payload(payload)), hb],
+                                   f"{what}_{seq}", dest, "HEARTBEAT"))
+    for reader, writer, what in ((PUB_READER, PUB_WRITER, "publications"),
+                                 (SUB_READER, SUB_WRITER, "subscriptions")):
+        slots.append(AnswerSlot(f"{what}_reader", reader, len(answers), 0))
+        answers.append(_answer(p.guid_prefix, [b.acknack(reader, writer, 1, [], 1, final=True)],
+                               f"{what}_ack", DEST_META, "ACKNACK", base=True))
+    if len(slots) > MAX_ANSWER_SLOTS:
+        raise RtlError(f"{len(slots)} answering entities: the circuit compares "
+                       f"{MAX_ANSWER_SLOTS}")
+    return tuple(answers), tuple(slots)
+
+
+def answer_params(rom: DiscoveryRom) -> dict[str, int | str]:
+    """The Verilog parameters of ``rom``'s answers: ``fabric/rfl_rtps_ctrl.v``'s slots (ids,
+    first messages, last sequence numbers, slot 0 in the low bits) and
+    ``fabric/rfl_rtps_disc_answer.v``'s ROM sizes and patch offsets."""
+    n = len(rom.slots)
+    ids = sum(s.entity_id << (32 * i) for i, s in enumerate(rom.slots))
+    msgs = sum(s.message << (8 * i) for i, s in enumerate(rom.slots))
+    lasts = sum(s.last << (8 * i) for i, s in enumerate(rom.slots))
+    return {"SLOTS": n, "SLOT_IDS": f"{32 * n}'h{ids:x}", "SLOT_MSGS": f"{8 * n}'h{msgs:x}",
+            "SLOT_LASTS": f"{8 * n}'h{lasts:x}", "ANSWER_BYTES": len(rom.answer_image()),
+            "ANSWERS": len(rom.answers), "DST_AT": ANSWER_DST_AT, "BASE_AT": ANSWER_BASE_AT,
+            "COUNT_START": ANSWER_COUNT_START, "BURST": ANSWER_BURST, "RATE": ANSWER_RATE}
+
+
 def render_rom(config: NodeConfig | str | Path, *, domain: int = 0, index: int = 0,
                address: str = "127.0.0.1", guid_prefix: bytes = DEFAULT_FABRIC_PREFIX,
                qos_in: Qos = Qos(), qos_out: Qos = Qos()) -> DiscoveryRom:
@@ -239,12 +372,20 @@ def render_rom(config: NodeConfig | str | Path, *, domain: int = 0, index: int =
         if len(m.data) > MAX_MESSAGE_BYTES:
             raise RtlError(f"discovery message {m.name} of {len(m.data)} bytes: more than one "
                            f"datagram ({MAX_MESSAGE_BYTES})")
+    answers, slots = render_answers(p, node)
     rom = DiscoveryRom(messages, p.guid_prefix, domain, index, address,
-                       {"ros_discovery_info": node.graph_writer, "writer": wid, "reader": rid})
-    if len(rom.image()) > MAX_DISC_ROM_BYTES:
-        raise RtlError(f"discovery ROM of {len(rom.image())} bytes: the table addresses "
-                       f"{MAX_DISC_ROM_BYTES}")
+                       {"ros_discovery_info": node.graph_writer, "writer": wid, "reader": rid},
+                       answers, slots)
+    for what, size in (("discovery ROM", len(rom.image())),
+                       ("answer ROM", len(rom.answer_image()))):
+        if size > MAX_DISC_ROM_BYTES:
+            raise RtlError(f"{what} of {size} bytes: the table addresses {MAX_DISC_ROM_BYTES}")
     return rom
+
+
+def answer_flags(message: RomMessage) -> int:
+    """The flags of an answer's table entry: ANSWER_FLAG_BASE for an ACKNACK (its base written)."""
+    return ANSWER_FLAG_BASE if any(p.name == "acknack_base" for p in message.patches) else 0
 
 
 def readmemh(data: bytes) -> str:
@@ -258,12 +399,20 @@ def table_readmemh(rom: DiscoveryRom) -> str:
                    for m, off in zip(rom.messages, rom.offsets()))
 
 
+def answer_table_readmemh(rom: DiscoveryRom) -> str:
+    """The answer table: one entry a line, {flags[7:0], dest[7:0], offset[15:0], length[15:0]}."""
+    return "".join(f"{answer_flags(m):02x}{m.dest:02x}{off:04x}{len(m.data):04x}\n"
+                   for m, off in zip(rom.answers, rom.offsets(answers=True)))
+
+
 def write_rom(rom: DiscoveryRom, out_dir: str | Path) -> list[Path]:
     """Write the ROM files into ``out_dir``; returns their paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files = {ROM_FILE: readmemh(rom.image()), TABLE_FILE: table_readmemh(rom),
-             INDEX_FILE: json.dumps(rom.index_json(), indent=1) + "\n"}
+             INDEX_FILE: json.dumps(rom.index_json(), indent=1) + "\n",
+             ANSWER_FILE: readmemh(rom.answer_image()),
+             ANSWER_TABLE_FILE: answer_table_readmemh(rom)}
     for m in rom.messages:
         files[f"rfl_rtps_disc_{m.name}.hex"] = readmemh(m.data)
     paths = []

@@ -57,3 +57,15 @@ MAX_DISC_ROM_BYTES = 1 << 16
 #: (a MAC without IP fragmentation sends it as one frame). The fragment size is the software
 #: participant's (``rtps.limits.FRAGMENT_BYTES``), whose DATA_FRAG datagram fits in it.
 FABRIC_MAX_DATAGRAM = 1500 - 20 - 8
+#: The fabric participant's answers (``rtl.discrom``, ``fabric/rfl_rtps_disc_answer.v``): the
+#: credit of bytes at reset and at most, and the credit earned per byte received. The bytes it
+#: answers never exceed ANSWER_BURST + ANSWER_RATE x the bytes received. Measured need: a
+#: Cyclone DDS peer's discovery asks ~1.2 kB of answers (both SEDP writers' DATA and
+#: HEARTBEATs) against its ~0.3 kB of ACKNACKs and HEARTBEATs; the burst covers two peers
+#: arriving at once.
+ANSWER_BURST = 4096
+ANSWER_RATE = 4
+#: The sequence numbers a writer slot resends (the watcher's bitmap window: 1 .. this) and the
+#: slots it compares in parallel.
+MAX_ANSWER_SEQ = 8
+MAX_ANSWER_SLOTS = 8

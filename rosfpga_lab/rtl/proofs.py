@@ -39,7 +39,7 @@ FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 #: The network side of the node in the fabric (issue #31): modules proven here, not in a project.
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
 FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
-                  "rfl_udp_store.v", "rfl_udp_port.v")
+                  "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v")
 ENV_INCLUDE = "fv_env.vh"
 
 
@@ -195,6 +195,16 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_udp_port (16-byte buffers, 2 payloads each way, any LiteEth stream and payloads): "
           "both outputs keep the stream rules with their sideband, LiteEth never held back; 20 "
           "clocks"),
+    Proof("rtps_ctrl", ("rfl_rtps_ctrl.v",), "prove", 4,
+          "rfl_rtps_ctrl (two slots, any input bytes, any prefix): request stream rules, every "
+          "request names an answer of the table, always ready; all reachable states"),
+    Proof("rtps_disc_answer", ("rfl_rtps_disc_answer.v",), "prove", 6,
+          "rfl_rtps_disc_answer (16-byte ROM, 2 answers, any contents, any requests): output "
+          "stream rules with the asker's prefix, TDEST and prefix constant and no gap inside a "
+          "datagram, credit at most BURST; all reachable states", ("FV_PROVE",)),
+    Proof("rtps_disc_answer", ("rfl_rtps_disc_answer.v",), "bmc", 14,
+          "rfl_rtps_disc_answer (credit 8 bytes, 1 per byte received): bytes sent at most "
+          "BURST + RATE x bytes received; 14 clocks (the first credit spent and earned again)"),
 )
 
 

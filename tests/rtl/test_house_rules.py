@@ -84,7 +84,7 @@ def test_the_rules_cover_every_module_file_in_scope() -> None:
     assert {"rfl_fifo.v", "rfl_fifo2axi.v", "rfl_axi2fifo.v", "rfl_slice.v", "rfl_subscriber.v",
             "rfl_publisher.v", "rfl_top.v", "rfl_morph.v", "rfl_harness.v", "rfl_tb.v",
             "rfl_rtps_disc_rom.v", "rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
-            "rfl_udp_store.v", "rfl_udp_port.v",
+            "rfl_udp_store.v", "rfl_udp_port.v", "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v",
             "rfl_gsubscriber.v", "rfl_gpublisher.v", "rfl_gtop.v", "rfl_elem_pack.v",
             "rfl_elem_unpack.v", "rfl_window1d.v", "rfl_elem_tb.v"} <= names
 
@@ -172,6 +172,19 @@ CONTRACTS = [
     ("rfl_udp_store", {"META_W": 0}, "rfl_udp_store: META_W must be 1..128"),
     ("rfl_udp_store", {"WAIT": 2}, "rfl_udp_store: WAIT must be 0 or 1"),
     # rfl_udp_port needs rfl_udp_store beside it: its contract is tests/rtl/test_fabric_udp.py's
+    ("rfl_rtps_ctrl", {"SLOTS": 9}, "rfl_rtps_ctrl: SLOTS must be 1..8"),
+    ("rfl_rtps_ctrl", {"COUNT_BITS": 33}, "rfl_rtps_ctrl: COUNT_BITS must be 1..32"),
+    ("rfl_rtps_ctrl", {"SLOTS": 1, "SLOT_LASTS": 9}, "rfl_rtps_ctrl: a slot's last must be 0..8"),
+    ("rfl_rtps_disc_answer", {"ROM_BYTES": 65537},
+     "rfl_rtps_disc_answer: ROM_BYTES must be 1..65536 (16-bit offsets)"),
+    ("rfl_rtps_disc_answer", {"MESSAGES": 0}, "rfl_rtps_disc_answer: MESSAGES must be 1..256"),
+    ("rfl_rtps_disc_answer", {"COUNT_START": 0},
+     "rfl_rtps_disc_answer: COUNT_START must be at least 1"),
+    ("rfl_rtps_disc_answer", {"BURST": 65536}, "rfl_rtps_disc_answer: BURST must be 1..65535"),
+    ("rfl_rtps_disc_answer", {"RATE": 256}, "rfl_rtps_disc_answer: RATE must be 0..255"),
+    ("rfl_rtps_disc_answer", {"DEST_BITS": 9}, "rfl_rtps_disc_answer: DEST_BITS must be 1..8"),
+    ("rfl_rtps_disc_answer", {"COUNT_BITS": 33},
+     "rfl_rtps_disc_answer: COUNT_BITS must be 1..32"),
     # the generated projects' element modules (the walkers and rfl_gtop need a project's
     # rfl_layout.vh: their contracts are elaborated in hls/test_generic_project.py's lint)
     ("rfl_elem_pack", {"EBYTES": 9}, "rfl_elem_pack: EBYTES must be 1..8"),

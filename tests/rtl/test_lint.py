@@ -174,6 +174,46 @@ def test_disc_rom_is_clean_under_three_linters(name: str, tmp_path: Path) -> Non
     assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]
 
 
+# the fabric's answers (rtl/fabric/rfl_rtps_ctrl.v, rfl_rtps_disc_answer.v) with the slots and
+# answer ROM of each ROS 2 configuration (rtl.discrom.answer_params)
+@pytest.mark.parametrize("name", CDR)
+@pytest.mark.parametrize("top", ["rfl_rtps_ctrl", "rfl_rtps_disc_answer"])
+def test_answer_path_is_clean_under_three_linters(top: str, name: str, tmp_path: Path) -> None:
+    from rosfpga_lab.rtl.discrom import (
+        ANSWER_FILE, ANSWER_TABLE_FILE, answer_params, render_rom, write_rom,
+    )
+    from rosfpga_lab.rtl.sim import VERILOG_DIR
+    from rosfpga_lab.rtl.synth import yosys_command
+
+    rom = render_rom(DATA / f"{name}.yaml")
+    write_rom(rom, tmp_path)
+    given = answer_params(rom)
+    source = str(Path(VERILOG_DIR).parent / "fabric" / f"{top}.v")
+    if top == "rfl_rtps_ctrl":
+        params = {k: given[k] for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS")}
+    else:
+        params = {"ROM_FILE": f'"{ANSWER_FILE}"', "TABLE_FILE": f'"{ANSWER_TABLE_FILE}"',
+                  "ROM_BYTES": given["ANSWER_BYTES"], "MESSAGES": given["ANSWERS"],
+                  **{k: given[k] for k in ("DST_AT", "BASE_AT", "COUNT_START", "BURST",
+                                           "RATE")}}
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", *(f"-G{k}={v}" for k, v
+                           in params.items()), source], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
+    require_yosys()
+    sets = " ".join(f"-set {k} {v}" for k, v in params.items())
+    (tmp_path / "check.ys").write_text(
+        f"read_verilog -defer {source}\nchparam {sets} {top}\nhierarchy -check -top {top}\nproc\n"
+        "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
+    done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]
+
+
 # the fabric's seam to a generated CDR circuit (rtl/fabric/rfl_rtps_to_cdr.v): its buffer and
 # counter widths follow the parameters (a power of two, another size, the smallest)
 @pytest.mark.parametrize("max_bytes,count_bits", [(4, 1), (2048, 32), (3000, 16)])
