@@ -263,11 +263,13 @@ class FpgaComponent:
         except LabError as exc:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         self._program: Any = None
+        self._stream_path = 0
         if not config.is_image:
-            from rosfpga_lab.hls.generic import spec_from_config
+            from rosfpga_lab.hls.generic import spec_from_config, stream_path
 
             try:
-                self._program = spec_from_config(config).program
+                spec = spec_from_config(config)
+                self._program, self._stream_path = spec.program, stream_path(spec)
             except LabError:
                 pass
         self._rtl: Any = None
@@ -386,7 +388,7 @@ class FpgaComponent:
         from rosfpga_lab.hls.program import Refused, frame_clocks
 
         try:
-            return frame_clocks(self._program, frame).total
+            return frame_clocks(self._program, frame, latency=self._stream_path).total
         except Refused:     # the walk and the model disagree: keep the model's stages' sum
             return result.total_cycles
 

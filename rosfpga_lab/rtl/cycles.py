@@ -173,17 +173,18 @@ def generic_rows(config: NodeConfig, *, bp: int = 500, simulator: str | None = N
             ``rtl cycles``; ``op: custom``), or the simulation failed.
     """
     from rosfpga_lab.hls.errors import GenerateError
-    from rosfpga_lab.hls.generic import spec_from_config
+    from rosfpga_lab.hls.generic import spec_from_config, stream_path
     from rosfpga_lab.rtl.generic import simulate_project
     from rosfpga_lab.rtl.project import generate_project
 
     say = progress or (lambda _line: None)
     try:
-        prog = spec_from_config(config).program
+        spec = spec_from_config(config)
     except GenerateError as exc:
         raise RtlError(f"no generated circuit to count: {exc}") from None
     if config.application.op == CUSTOM:
         raise RtlError("application.op is custom: the generated project has no RTL")
+    prog, latency = spec.program, stream_path(spec)
     with tempfile.TemporaryDirectory(prefix="rosfpga-cycles-") as tmp:
         project = Path(work_dir or tmp) / "project"
         say(f"generating the project of {prog.type_in} on {config.wire} in {project} ...")
@@ -199,7 +200,7 @@ def generic_rows(config: NodeConfig, *, bp: int = 500, simulator: str | None = N
                 if statuses != ["SUB_OK"]:
                     raise RtlError(f"frame {k}: the RTL said {statuses}, the model accepts it")
                 rtl = read_stats(project / "cycles" / "stats.txt")
-                model = frame_clocks(prog, frame, 1 - share / 1000)
+                model = frame_clocks(prog, frame, 1 - share / 1000, latency=latency)
                 rows.append(GenericCycleRow(
                     f"frame {k}", share, len(frame), len(out), model.total,
                     rtl["tx"].last - rtl["rx"].first + 1, model.publisher,
