@@ -264,14 +264,13 @@ class FpgaComponent:
             raise ComponentConfigError(f"cannot model this circuit: {exc}") from None
         self._program: Any = None
         self._stream_path = 0
-        if not config.is_image:
-            from rosfpga_lab.hls.generic import spec_from_config, stream_path
+        from rosfpga_lab.hls.generic import spec_from_config, stream_path
 
-            try:
-                spec = spec_from_config(config)
-                self._program, self._stream_path = spec.program, stream_path(spec)
-            except LabError:
-                pass
+        try:    # every type's generated circuit, Image's included (its clocks: frame_clocks)
+            spec = spec_from_config(config)
+            self._program, self._stream_path = spec.program, stream_path(spec)
+        except LabError:
+            pass
         self._rtl: Any = None
         if model == RTL_MODEL:
             from rosfpga_lab.rtl.server import RtlServer
@@ -380,9 +379,9 @@ class FpgaComponent:
 
     # ------------------------------------------------------------------ the data path
     def _clocks(self, frame: bytes, result: PipelineResult | MessageResult) -> int:
-        """The circuit's clocks for ``frame``: Image's cycle model (``hw.cycles``), any other
-        type's generated walk, first byte in to last byte out
-        (:func:`rosfpga_lab.hls.program.frame_clocks`, equal to the RTL's clock for clock)."""
+        """The circuit's clocks for ``frame``: the generated walk of its type, Image's included,
+        first byte in to last byte out (:func:`rosfpga_lab.hls.program.frame_clocks`, equal to
+        the RTL's clock for clock); the model's stages' sum when there is no generated walk."""
         if self._program is None:
             return result.total_cycles
         from rosfpga_lab.hls.program import Refused, frame_clocks

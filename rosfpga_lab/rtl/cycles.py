@@ -7,8 +7,10 @@ from the first byte into the subscriber to the last byte out of the node (the ou
 included, so that backpressure on the output counts). :func:`compare` sets the spans
 beside :func:`rosfpga_lab.hw.cycles.account`'s figures for the same frame.
 
-A generated circuit (any other message type, and Image on CDR) is measured the same way
-through its generated project's ``make rtlsim`` (:func:`generic_rows`) and set beside the walk's
+That is the hand-written Image circuit's table (the exhibit beside Table 1; its model is
+``hw.cycles``). Every configuration's generated circuit, ``sensor_msgs/Image`` on TCPROS
+included (what ``rtl cycles`` measures), is measured through its generated project's ``make
+rtlsim`` (:func:`generic_rows`) and set beside the walk's
 cycle model, :func:`rosfpga_lab.hls.program.frame_clocks`: a byte per clock through subscriber
 and publisher and the clocks of each walker's decisions (per state, as
 :func:`rosfpga_lab.hls.program.subscribe` and :func:`~rosfpga_lab.hls.program.publish` say);
@@ -169,8 +171,8 @@ def generic_rows(config: NodeConfig, *, bp: int = 500, simulator: str | None = N
     the cycle model.
 
     Raises:
-        RtlError: the configuration has no generated circuit (Image on TCPROS: its own
-            ``rtl cycles``; ``op: custom``), or the simulation failed.
+        RtlError: the configuration has no generated circuit (no walk for its type;
+            ``op: custom``), or the simulation failed.
     """
     from rosfpga_lab.hls.errors import GenerateError
     from rosfpga_lab.hls.generic import spec_from_config, stream_path

@@ -1,5 +1,5 @@
-"""Verilog of generated projects for any message type, ``sensor_msgs/Image`` included (on TCPROS
-its hand-written circuit, ``verilog/``, is the exhibit beside Table 1).
+"""Verilog of generated projects for any message type, ``sensor_msgs/Image`` included (every RTL
+tool runs it; the hand-written Image circuit, ``verilog/``, is the exhibit beside Table 1).
 
 How this works: the modules of ``generic/`` are written once and parameterized:
 ``rfl_gsubscriber`` and ``rfl_gpublisher`` walk a frame by stepping through a program, one

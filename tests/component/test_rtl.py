@@ -5,7 +5,8 @@
 * through the Python API: a refused frame carries the circuit's status code as its reason, the
   next frame comes out right, and the bytes equal the Python models';
 * ``timing="fpga"``: a flood at 200 frames/s of 640x480 ``rgba8`` comes out at no more than
-  the modelled rate (hw.cycles at clock_mhz), the rest counted as drops in front of it.
+  the modelled rate (the generated top's clocks at clock_mhz), the rest counted as drops in
+  front of it.
 """
 
 from __future__ import annotations
@@ -30,7 +31,6 @@ from rosfpga_lab.component.errors import ComponentConfigError
 from rosfpga_lab.config import load_config, parse_config
 from rosfpga_lab.graph import EmbeddedMaster, Node, call
 from rosfpga_lab.hw import Pipeline, image_frame
-from rosfpga_lab.hw.cycles import account
 from tests.component.test_node import Collector
 from tests.component.test_realros import parse_image, records, start
 
@@ -151,14 +151,17 @@ def test_rtl_model_without_a_simulator_says_so(monkeypatch) -> None:
 
 
 def test_fpga_timing_flood_comes_out_at_the_modelled_rate_excess_dropped() -> None:
-    """200 frames/s of 640x480 rgba8 for 2 s: the circuit at 100 MHz takes hw.cycles' clocks
-    per frame, so 1 / (clocks / clock) frames/s (+-10 %) come out, the rest are dropped."""
+    """200 frames/s of 640x480 rgba8 for 2 s: the circuit at 100 MHz takes the generated top's
+    clocks per frame (its walk's cycle model, equal to the RTL: tests/rtl/test_cycles.py), so
+    1 / (clocks / clock) frames/s (+-10 %) come out, the rest are dropped."""
+    from rosfpga_lab.hls.generic import spec_from_config, stream_path
+    from rosfpga_lab.hls.program import frame_clocks
+
     config = load_config(DATA / "fpga_dilate_rgba8.yaml")
-    pipe = Pipeline.from_config(config)
     image = np.random.default_rng(1).integers(0, 256, (480, 640, 4), dtype=np.uint8)
     frame = image_frame(image, "rgba8", frame_id="flood")
-    res = pipe.process(frame)
-    clocks = account(res.fields, pipe.op, pipe.ksize, len(frame), len(res.output_frame)).total
+    spec = spec_from_config(config)
+    clocks = frame_clocks(spec.program, frame, latency=stream_path(spec)).total
     modelled = config.clock_mhz * 1e6 / clocks            # frames/s the board would do
     assert 70 < modelled < 90                             # ~81 for byte-wide input at 100 MHz
     rate, seconds = 200.0, 2.0

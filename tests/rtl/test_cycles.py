@@ -191,7 +191,7 @@ def test_cli_rtl_cycles_of_a_generated_circuit(capsys: pytest.CaptureFixture[str
         else:
             assert abs(rtl - model) <= 4 * math.sqrt(out_bytes * 0.5) / 0.5 + 16
     assert main(["rtl", "cycles", str(data / "fpga_samples_dilate.yaml"), "--size", "4x4"]) == 1
-    assert "--size are for the Image circuit on TCPROS" in capsys.readouterr().err
+    assert "--size are for an Image configuration" in capsys.readouterr().err
 
 
 def _early_cases() -> list[tuple[str, Any, list[bytes], Any]]:
