@@ -212,11 +212,11 @@ def generic_rows(config: NodeConfig, *, bp: int = 500, simulator: str | None = N
 
 def format_generic_rows(rows: list[GenericCycleRow]) -> str:
     """The rows as an aligned text table."""
-    head = (f"{'frame':<10}{'in B':>8}{'out B':>8}{'backpr.':>8}{'model':>10}{'RTL':>10}"
-            f"{'diff':>8}  {'publisher: model':>16}{'RTL':>8}")
+    head = (f"{'frame':<10}{'in B':>11}{'out B':>11}{'backpr.':>8}{'model':>11}{'RTL':>11}"
+            f"{'diff':>8}  {'publisher: model':>16}{'RTL':>11}")
     lines = [head, "-" * len(head)]
     for r in rows:
-        lines.append(f"{r.label:<10}{r.in_bytes:>8,}{r.out_bytes:>8,}{r.bp / 10:>7.0f}%"
-                     f"{r.model:>10,}{r.rtl:>10,}{r.error * 100:>+7.2f}%  "
-                     f"{r.model_publisher:>16,}{r.rtl_publisher:>8,}")
+        lines.append(f"{r.label:<10}{r.in_bytes:>11,}{r.out_bytes:>11,}{r.bp / 10:>7.0f}%"
+                     f"{r.model:>11,}{r.rtl:>11,}{r.error * 100:>+7.2f}%  "
+                     f"{r.model_publisher:>16,}{r.rtl_publisher:>11,}")
     return "\n".join(lines)

@@ -23,7 +23,8 @@
 The build (compilation) time is printed apart: it is paid once per configuration.
 
 Usage: ``python tests/benchmarks/bench_rtl.py [--simulator verilator] [--repeat N] [--builds K]
-[--full-icarus] [--node STEM --frames N]`` (``--node``: only that node benchmark, repeatable)
+[--full-icarus] [--no-node] [--node STEM --frames N]`` (``--node``: only that node benchmark,
+repeatable)
 """
 
 from __future__ import annotations
@@ -139,6 +140,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="time Icarus Verilog on the 640x480 frame too (minutes)")
     parser.add_argument("--node", action="append", metavar="STEM",
                         help="only the live node benchmark of data/STEM.yaml (repeatable)")
+    parser.add_argument("--no-node", action="store_true",
+                        help="skip the live node benchmarks (the simulators only)")
     parser.add_argument("--frames", type=int, default=0, metavar="N",
                         help="frames per node benchmark (default 5 for Image, 500 for others)")
     args = parser.parse_args(argv)
@@ -174,7 +177,7 @@ def main(argv: list[str] | None = None) -> int:
             bench("fpga_dilate_rgba8", simulator)
         else:
             bench("fpga_passthrough_rgb8", simulator)
-    if "verilator" in sims:
+    if "verilator" in sims and not args.no_node:
         for stem in ("fpga_dilate_rgba8", "fpga_erode_mono8", "fpga_passthrough_rgb8"):
             bench_node(stem, args.frames or 5)
         for stem in ("fpga_laserscan_min", "fpga_samples_dilate"):
