@@ -21,7 +21,10 @@ message counter (``COUNT``: a uint32 from ``seq_start``), zeros (``ZERO``; an em
 array for ``VAR``) or the application's output (``STREAM``).
 
 The subscriber adds up the publisher's output length as it walks, so the publisher can write
-the frame length first; it starts once the subscriber has read (and accepted) the whole frame.
+the frame length first; it starts once the subscriber has read (and accepted) the whole frame,
+or, with streaming early release (:attr:`Program.stream_early`: nothing after the stream's count
+can refuse the frame), once the stream's count is checked, writing the stream as it flows (the
+Verilog; the HLS C++ and :func:`run_program` still hand whole frames over: same bytes).
 A frame refused after its stream went to the application is dropped by the publisher (it reads
 the application's output and writes nothing). :func:`run_program` is the Python executor of the
 same program: the specification the C++ and Verilog walkers are tested against.
