@@ -58,7 +58,7 @@ def test_every_proof_passes() -> None:
     together (some 100 s), so started 22nd of 25, after some 50 s, it made the whole some 190 s
     where it now takes its own 140 s. With streaming early release there are two (the early
     walk and FV_WHOLE's), started together on the two workers (measured on a loaded machine:
-    1180 s and 278 s; unloaded figures to be taken)."""
+    382 s and 278 s; unloaded figures to be taken)."""
     require_formal()
     first = sorted(PROOFS, key=lambda p: p.depth if p.mode == "bmc" else 0, reverse=True)
     with ThreadPoolExecutor(max_workers=2) as pool:
