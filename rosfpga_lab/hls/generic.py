@@ -312,7 +312,9 @@ def stream_path(spec: GenericSpec) -> int:
     the ``latency`` of :func:`~rosfpga_lab.hls.program.frame_clocks`)."""
     beat = beat_shape(spec)
     ksize = spec.ksize if spec.op in ("dilate", "erode") else 1
-    return stream_latency(beat["bytes"], ksize, None if spec.video is None else beat["line"])
+    if spec.video is None:
+        return stream_latency(beat["bytes"], ksize, length=beat["count"])
+    return stream_latency(beat["bytes"], ksize, beat["line"])
 
 
 def context(spec: GenericSpec) -> dict[str, object]:

@@ -622,7 +622,8 @@ VIDEO_PATH = 14
 CARRY_PATH = 3
 
 
-def stream_latency(ebytes: int, ksize: int, line: int | None = None) -> int:
+def stream_latency(ebytes: int, ksize: int, line: int | None = None,
+                   length: int | None = None) -> int:
     """Clocks from a streamed byte into the subscriber to that byte of the application's output
     at the publisher, when nothing waits (streaming early release: see :func:`frame_clocks`).
 
@@ -630,10 +631,13 @@ def stream_latency(ebytes: int, ksize: int, line: int | None = None) -> int:
         ebytes: bytes of a beat (an element; a pixel of a video stream).
         ksize: the window (1: pass-through).
         line: a video stream's pixels per line (``rfl_morph`` waits for ``ksize // 2`` lines
-            and pixels more); None: ``rfl_window1d`` (``ksize // 2`` elements more).
+            and pixels more); None: ``rfl_window1d`` (``ksize // 2`` elements more; of an
+            array shorter than that, the elements it has and a clock per missing one).
+        length: ``rfl_window1d``: the array's elements (None: long enough for the window).
     """
     if line is None:
-        return (ksize // 2 + 1) * ebytes + WINDOW_PATH
+        ahead = ksize // 2 if length is None else min(ksize // 2, length - 1)
+        return (ahead + 1) * ebytes + WINDOW_PATH + (ksize // 2 - ahead)
     return ((ksize // 2) * line + ksize // 2 + 1) * ebytes + VIDEO_PATH
 
 
