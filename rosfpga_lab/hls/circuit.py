@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 from rosfpga_lab.config import NodeConfig
-from rosfpga_lab.hls.generic import GenericSpec, spec_from_layouts
+from rosfpga_lab.hls.generic import GenericSpec, spec_from_layouts, stream_path
 from rosfpga_lab.hls.program import FrameClocks, Program, frame_clocks
 from rosfpga_lab.hw.cdrlayout import CdrLayout
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline
@@ -92,7 +92,7 @@ class Circuit:
             GenerateError: as :attr:`spec`.
             Refused: the circuit refuses the frame.
         """
-        return frame_clocks(self.program, frame)
+        return frame_clocks(self.program, frame, latency=stream_path(self.spec))
 
     def model(self, model: str = "fast") -> MessagePipeline:
         """A fresh Python model of the TCPROS circuit (its own publisher count).

@@ -34,7 +34,9 @@ from rosfpga_lab.hls import rtlbuild
 from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, HLS_HEADERS, SOURCES, TB_EXPECTED, TB_INPUT
 from rosfpga_lab.hls.compiler import program_from_cdr, program_from_layout
 from rosfpga_lab.hls.errors import GenerateError
-from rosfpga_lab.hls.program import ALIGN_ORIGIN, ENCAP_PAD_MASK, MAX_LOOP_DEPTH, Op, Program, Pub, Sub
+from rosfpga_lab.hls.program import (
+    ALIGN_ORIGIN, ENCAP_PAD_MASK, MAX_LOOP_DEPTH, Op, Program, Pub, Sub, stream_latency,
+)
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.cdrlayout import END_ALIGN
 # NUMBERED_FIELD: the field a TCPROS Image's publisher numbers itself (1, 2, 3 ...), as rospy and
@@ -303,6 +305,17 @@ def beat_shape(spec: GenericSpec) -> dict[str, int]:
             "bits": hw_limits.TDATA_BITS}
 
 
+def stream_path(spec: GenericSpec) -> int:
+    """Clocks of the stream's path through the generated top's application, for the cycle
+    model of a walk with streaming early release (:func:`rosfpga_lab.hls.program.stream_latency`,
+    the ``latency`` of :func:`~rosfpga_lab.hls.program.frame_clocks`)."""
+    beat = beat_shape(spec)
+    ksize = spec.ksize if spec.op in ("dilate", "erode") else 1
+    if spec.video is None:
+        return stream_latency(beat["bytes"], ksize, length=beat["count"])
+    return stream_latency(beat["bytes"], ksize, beat["line"])
+
+
 def context(spec: GenericSpec) -> dict[str, object]:
     """The template context of ``spec`` (shared with the Verilog renderer)."""
     from rosfpga_lab.hw.encodings import PIXEL_FORMATS
@@ -327,6 +340,7 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "frame": "CDR sample" if spec.wire == CDR_WIRE else "TCPROS frame", "statuses": list(prog.statuses),
         "consts": prog.const_table, "const_rows": _hex_rows(prog.const_table),
         "loop_depth": loop_depth(prog), "max_instr_steps": max_steps(prog),
+        "stream_early": prog.stream_early,
         "carry_bytes": max(1, prog.carry_bytes),
         "meta_fields": meta_fields(prog), "meta_bits": sum(f[1] for f in meta_fields(prog)),
         "carry_count_bits": meta_fields(prog)[1][1],

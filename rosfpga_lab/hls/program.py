@@ -21,7 +21,10 @@ message counter (``COUNT``: a uint32 from ``seq_start``), zeros (``ZERO``; an em
 array for ``VAR``) or the application's output (``STREAM``).
 
 The subscriber adds up the publisher's output length as it walks, so the publisher can write
-the frame length first; it starts once the subscriber has read (and accepted) the whole frame.
+the frame length first; it starts once the subscriber has read (and accepted) the whole frame,
+or, with streaming early release (:attr:`Program.stream_early`: nothing after the stream's count
+can refuse the frame), once the stream's count is checked, writing the stream as it flows (the
+Verilog; the HLS C++ and :func:`run_program` still hand whole frames over: same bytes).
 A frame refused after its stream went to the application is dropped by the publisher (it reads
 the application's output and writes nothing). :func:`run_program` is the Python executor of the
 same program: the specification the C++ and Verilog walkers are tested against.
@@ -201,6 +204,33 @@ class Program:
         return Program(tuple(fixed), const_offsets=tuple(offsets), **kwargs)  # type: ignore[arg-type]
 
     @property
+    def stream_early(self) -> int | None:
+        """Where the subscriber may hand a frame over early (streaming early release), or None.
+
+        When the streamed array is a ``VAR`` outside any loop whose count must fill the frame
+        exactly with what follows (``fixed_after`` >= 0: TCPROS), and only ``FIXED`` fields
+        that cannot refuse (skipped or carried) follow it, the frame's fate is decided once its
+        count is checked: nothing after it can refuse the frame. The subscriber then hands the
+        fields over (``meta_valid``, with the whole output length) at the count's decision, and
+        the publisher writes the frame while the stream flows (the FIFO after the application
+        holds a few beats, not the whole array). Returns the bytes the publisher writes from the
+        count on (the count, the array, the fixed fields after it), added to the output length
+        so far; None: the whole frame is read first (a variable field, a check or CDR's end
+        padding may refuse the frame after its stream went out).
+        """
+        depth = 0
+        for i, ins in enumerate(self.instrs):
+            depth += (ins.op == Op.LOOP) - (ins.op == Op.END)
+            if ins.sub != Sub.STREAM or ins.op not in (Op.FIXED, Op.VAR):
+                continue
+            rest = self.instrs[i + 1:-1]
+            if ins.op != Op.VAR or ins.pub != Pub.STREAM or depth or ins.fixed_after < 0 or any(
+                    r.op != Op.FIXED or r.sub not in (Sub.SKIP, Sub.CARRY) for r in rest):
+                return None
+            return 4 + ins.count * ins.size + sum(r.size for r in rest)
+        return None
+
+    @property
     def const_table(self) -> bytes:
         """Every instruction's constant bytes, one after the other."""
         return b"".join(ins.const for ins in self.instrs)
@@ -281,15 +311,18 @@ def least_clocks(elem_min: int) -> int:
 
 # long: one dispatch of the subscriber's state machine, whose closures (take, out_pad, fits)
 # share one walk's state (position, frame end, streamed bytes, output length) and its timeline
-def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
-              ) -> tuple[bytes, bytes, int]:
+def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None,
+              marks: dict[str, int] | None = None) -> tuple[bytes, bytes, int]:
     """Walk one whole frame as the subscriber does.
 
     ``timeline``: appended a 1 per clock the Verilog walker takes a byte and a 0 per clock it
     does not, from the frame length's first byte to the clock it accepts the frame (see
     :func:`frame_clocks`): :data:`DECIDE_CLOCKS` for each decision (the frame length's checks,
     each instruction's decode, a count's checks, each field's end), ``1 + bits(elem_min)`` for
-    an array of messages' fewest bytes (:func:`least_clocks`), a byte per clock.
+    an array of messages' fewest bytes (:func:`least_clocks`), a byte per clock. ``marks``:
+    set ``release`` to the timeline's length at the stream count's decision (where a walk with
+    :attr:`Program.stream_early` hands the frame over) and ``carried`` to the clock (1-based)
+    of each carried byte after the stream, in order, as ``carried_N``.
 
     Returns:
         ``(carried bytes, streamed bytes, output body length)``.
@@ -375,6 +408,10 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
             tl += decide if ins.size else b""          # S_FINISH
             out_pad(ins.size, ins.align)
             if ins.sub in (Sub.CARRY, Sub.RANGE):
+                if marks is not None and "release" in marks:  # the clock each was taken
+                    at = len(tl) - DECIDE_CLOCKS - ins.size + 1
+                    for k in range(ins.size):
+                        marks[f"carried_{len(carry) + k}"] = at + k
                 carry += b
             if ins.sub == Sub.CHECK and b != ins.const:
                 raise Refused(ins.status, bool(stream))
@@ -388,6 +425,8 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None
             tl += decide                                # S_COUNTED
             n = _u32(lb)
             fits(ins, n)
+            if ins.sub == Sub.STREAM and marks is not None:
+                marks["release"] = len(tl)
             b = take(n * ins.size, ins.status, ins.elem_align)
             tl += decide                                # S_FINISH
             text = b[:-1] if ins.nul else b
@@ -467,12 +506,14 @@ def _var_body(ins: Instr, carry: bytes, ci: int, stream: bytes, si: int
 
 
 def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int,
-            timeline: bytearray | None = None) -> bytes:
+            timeline: bytearray | None = None, marks: dict[str, int] | None = None) -> bytes:
     """The frame the publisher writes for an accepted frame (see the module docstring).
 
     ``timeline``: appended a 1 per clock the Verilog walker writes a byte and a 0 per clock it
     does not, from its first byte (output always ready, the stream's bytes there in time): a
-    clock to decode each instruction (P_DECODE) and one after each count (P_COUNTED)."""
+    clock to decode each instruction (P_DECODE) and one after each count (P_COUNTED).
+    ``marks``: set ``stream`` to the timeline's index of the stream's first byte and
+    ``carried_N`` to that of carried byte N (see :func:`subscribe`)."""
     out = bytearray(out_len.to_bytes(4, "little"))
     tl = timeline if timeline is not None else bytearray()
     written = 0
@@ -499,6 +540,9 @@ def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int,
         elif ins.op == Op.FIXED:
             if ins.size:
                 out += bytes(pad(len(out), ins.align))
+            if marks is not None and ins.pub == Pub.CARRY:
+                for k in range(ins.size):
+                    marks[f"carried_{ci + k}"] = len(tl) + k
             b, ci, si = _fixed_bytes(ins, carry, ci, stream, si, seq)
             out += b
         elif ins.op == Op.VAR:
@@ -509,6 +553,8 @@ def publish(prog: Program, carry: bytes, stream: bytes, out_len: int, seq: int,
             tl.append(0)
             if body:
                 out += bytes(pad(len(out), ins.elem_align))
+            if marks is not None and ins.pub == Pub.STREAM:
+                marks["stream"] = len(tl) + len(out) - written
             out += body
         elif ins.op == Op.LOOP:
             n = ins.count
@@ -566,6 +612,33 @@ ACCEPT_TO_PUBLISH = 2
 #: Clocks from the publisher's byte to the node's output: the register slice before the tx
 #: FIFO (one), then the FIFO (two).
 TX_LATENCY = 3
+#: Clocks of the stream's path from the subscriber to the publisher beyond the application's
+#: own wait (register slices, the element packer, the FIFOs' output registers, the unpacker):
+#: through ``rfl_window1d``, and through the video project's ``rfl_morph``.
+WINDOW_PATH = 9
+VIDEO_PATH = 14
+#: Clocks from the subscriber writing a carried byte to the publisher able to write it (the
+#: carry memory's write, its read register, carry_rdata).
+CARRY_PATH = 3
+
+
+def stream_latency(ebytes: int, ksize: int, line: int | None = None,
+                   length: int | None = None) -> int:
+    """Clocks from a streamed byte into the subscriber to that byte of the application's output
+    at the publisher, when nothing waits (streaming early release: see :func:`frame_clocks`).
+
+    Args:
+        ebytes: bytes of a beat (an element; a pixel of a video stream).
+        ksize: the window (1: pass-through).
+        line: a video stream's pixels per line (``rfl_morph`` waits for ``ksize // 2`` lines
+            and pixels more); None: ``rfl_window1d`` (``ksize // 2`` elements more; of an
+            array shorter than that, the elements it has and a clock per missing one).
+        length: ``rfl_window1d``: the array's elements (None: long enough for the window).
+    """
+    if line is None:
+        ahead = ksize // 2 if length is None else min(ksize // 2, length - 1)
+        return (ahead + 1) * ebytes + WINDOW_PATH + (ksize // 2 - ahead)
+    return ((ksize // 2) * line + ksize // 2 + 1) * ebytes + VIDEO_PATH
 
 
 @dataclass(frozen=True)
@@ -577,9 +650,12 @@ class FrameClocks:
         subscriber: from the frame length's first byte in to the clock the frame is accepted.
         publisher: from the publisher's first byte out to its last.
         total: from the first byte into the subscriber to the last byte out of the node,
-            ``subscriber + ACCEPT_TO_PUBLISH - 1 + publisher + TX_LATENCY`` with the output
-            always ready; with ``ready`` < 1 at least the output bytes at that share after the
-            publisher starts.
+            ``start + ACCEPT_TO_PUBLISH - 1 + publisher + TX_LATENCY`` with the output always
+            ready, where ``start`` is the clock the subscriber hands the frame over: its
+            acceptance, or with streaming early release (:attr:`Program.stream_early`) the
+            stream count's decision (and the publisher then waits for the stream, by
+            :func:`stream_latency`, and the carried bytes after it); with ``ready`` < 1 at least
+            the output bytes at that share after the publisher starts.
         in_bytes, out_bytes: the frames' sizes.
     """
 
@@ -590,9 +666,11 @@ class FrameClocks:
     out_bytes: int
 
 
-def frame_clocks(prog: Program, frame: bytes, ready: float = 1.0) -> FrameClocks:
+def frame_clocks(prog: Program, frame: bytes, ready: float = 1.0, *,
+                 latency: int = 0) -> FrameClocks:
     """The clocks of ``frame`` through the generated circuit (see :class:`FrameClocks`), the
-    output ready ``ready`` of the clocks.
+    output ready ``ready`` of the clocks. ``latency``: the stream's path,
+    :func:`stream_latency` (used by a walk with :attr:`Program.stream_early` only).
 
     Raises:
         Refused: the circuit refuses the frame (its clocks are not modelled).
@@ -601,11 +679,25 @@ def frame_clocks(prog: Program, frame: bytes, ready: float = 1.0) -> FrameClocks
     if not 0 < ready <= 1:
         raise ValueError(f"ready must be in (0, 1], got {ready}")
     sub_tl, pub_tl = bytearray(), bytearray()
-    carry, stream, out_len = subscribe(prog, frame, sub_tl)
-    out = publish(prog, carry, stream, out_len, prog.seq_start, pub_tl)
-    pub = pub_tl.rindex(1) + 1
-    total = len(sub_tl) + ACCEPT_TO_PUBLISH - 1 + pub + TX_LATENCY
+    sub_marks: dict[str, int] = {}
+    pub_marks: dict[str, int] = {}
+    carry, stream, out_len = subscribe(prog, frame, sub_tl, sub_marks)
+    out = publish(prog, carry, stream, out_len, prog.seq_start, pub_tl, pub_marks)
+    start = len(sub_tl)
+    wait = 0
+    if prog.stream_early is not None:
+        start = sub_marks["release"]
+        # the publisher's timeline index i is at clock start + ACCEPT_TO_PUBLISH + i; it waits
+        # for the stream's first byte (then the stream flows a byte per clock, as it writes)
+        # and for each carried byte after the stream
+        first = start + ACCEPT_TO_PUBLISH + pub_marks["stream"]
+        wait = max(0, start + 1 + latency - first)
+        for key, at in sub_marks.items():
+            if key.startswith("carried_"):
+                wait = max(wait, at + CARRY_PATH - (start + ACCEPT_TO_PUBLISH + pub_marks[key]))
+    pub = pub_tl.rindex(1) + 1 + wait
+    total = start + ACCEPT_TO_PUBLISH - 1 + pub + TX_LATENCY
     if ready < 1:
-        total = max(total, len(sub_tl) + ACCEPT_TO_PUBLISH + TX_LATENCY - 1
+        total = max(total, start + ACCEPT_TO_PUBLISH + TX_LATENCY - 1
                     + -(-len(out) * 1000 // round(ready * 1000)))
     return FrameClocks(len(sub_tl), pub, total, len(frame), len(out))

@@ -1,23 +1,27 @@
 """The circuit as a circuit: Verilog RTL of the data path, its simulation and synthesis.
 
-The Verilog (``verilog/``, module prefix ``rfl_``) is the paper's conventional design of the
+Every configuration, ``sensor_msgs/Image`` on TCPROS included, simulates, counts, synthesizes,
+times, proves and serves the generated top of :mod:`rosfpga_lab.rtl.generic` (walkers stepping
+through a generated program, one instruction per field of the message):
+``build(design_from_config(config))``. The hand-written Verilog (``verilog/``, module prefix
+``rfl_``), the exhibit beside Table 1, is the paper's conventional design of the
 same circuit the HLS C++ describes: ``rfl_subscriber`` (TCPROS frame in, fields checked, pixel
 bytes out), ``rfl_fifo2axi`` (Figure 7), the application ``rfl_morph``, ``rfl_axi2fifo``,
-``rfl_publisher`` (TCPROS frame out) and ``rfl_fifo``, joined by ``rfl_top``. Parameters come
-from the node configuration (:func:`rtl_params`); :func:`build` and :func:`run` simulate it with
-Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
+``rfl_publisher`` (TCPROS frame out) and ``rfl_fifo``, joined by ``rfl_top``. Its parameters come
+from the node configuration (:func:`rtl_params`); :func:`build` and :func:`run` simulate either
+circuit with Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
 
-    from rosfpga_lab.rtl import build, load_config, rtl_params, run
-    sim = build(rtl_params(load_config("data/fpga_dilate_rgba8.yaml")))
+    from rosfpga_lab.rtl import build, load_config, run
+    from rosfpga_lab.rtl.sim import design_from_config
+    sim = build(design_from_config(load_config("data/fpga_dilate_rgba8.yaml")))
     result = run(sim, frames, gap=100, bp=500)   # result.output: the frames sent
 
 :mod:`rosfpga_lab.rtl.vcd` reads waveform dumps into per-clock arrays,
 :mod:`rosfpga_lab.rtl.synth` synthesizes the modules with Yosys,
 :mod:`rosfpga_lab.rtl.timing` places and routes them with nextpnr-ecp5 (Fmax against the clock) and
-:mod:`rosfpga_lab.rtl.sloc` counts their lines for the paper's Table 1. A message type other
-than ``sensor_msgs/Image`` gets the generic circuit of :mod:`rosfpga_lab.rtl.generic` (walkers
-stepping through a generated program, one instruction per field of the message), which
-:func:`build` and :func:`run` simulate the same way (``build(design_from_config(config))``).
+:mod:`rosfpga_lab.rtl.sloc` counts their lines for the paper's Table 1. ``build(rtl_params(config))`` builds
+the hand circuit of an Image configuration (its tests and the benchmark set it beside the
+generated top).
 
 The ROS 2 node in the fabric (issue #31) announces itself from a ROM built at build time:
 :mod:`rosfpga_lab.rtl.discrom` renders the software participant's SPDP, SEDP and

@@ -7,8 +7,10 @@ from the first byte into the subscriber to the last byte out of the node (the ou
 included, so that backpressure on the output counts). :func:`compare` sets the spans
 beside :func:`rosfpga_lab.hw.cycles.account`'s figures for the same frame.
 
-A generated circuit (any other message type, and Image on CDR) is measured the same way
-through its generated project's ``make rtlsim`` (:func:`generic_rows`) and set beside the walk's
+That is the hand-written Image circuit's table (the exhibit beside Table 1; its model is
+``hw.cycles``). Every configuration's generated circuit, ``sensor_msgs/Image`` on TCPROS
+included (what ``rtl cycles`` measures), is measured through its generated project's ``make
+rtlsim`` (:func:`generic_rows`) and set beside the walk's
 cycle model, :func:`rosfpga_lab.hls.program.frame_clocks`: a byte per clock through subscriber
 and publisher and the clocks of each walker's decisions (per state, as
 :func:`rosfpga_lab.hls.program.subscribe` and :func:`~rosfpga_lab.hls.program.publish` say);
@@ -169,21 +171,22 @@ def generic_rows(config: NodeConfig, *, bp: int = 500, simulator: str | None = N
     the cycle model.
 
     Raises:
-        RtlError: the configuration has no generated circuit (Image on TCPROS: its own
-            ``rtl cycles``; ``op: custom``), or the simulation failed.
+        RtlError: the configuration has no generated circuit (no walk for its type;
+            ``op: custom``), or the simulation failed.
     """
     from rosfpga_lab.hls.errors import GenerateError
-    from rosfpga_lab.hls.generic import spec_from_config
+    from rosfpga_lab.hls.generic import spec_from_config, stream_path
     from rosfpga_lab.rtl.generic import simulate_project
     from rosfpga_lab.rtl.project import generate_project
 
     say = progress or (lambda _line: None)
     try:
-        prog = spec_from_config(config).program
+        spec = spec_from_config(config)
     except GenerateError as exc:
         raise RtlError(f"no generated circuit to count: {exc}") from None
     if config.application.op == CUSTOM:
         raise RtlError("application.op is custom: the generated project has no RTL")
+    prog, latency = spec.program, stream_path(spec)
     with tempfile.TemporaryDirectory(prefix="rosfpga-cycles-") as tmp:
         project = Path(work_dir or tmp) / "project"
         say(f"generating the project of {prog.type_in} on {config.wire} in {project} ...")
@@ -199,7 +202,7 @@ def generic_rows(config: NodeConfig, *, bp: int = 500, simulator: str | None = N
                 if statuses != ["SUB_OK"]:
                     raise RtlError(f"frame {k}: the RTL said {statuses}, the model accepts it")
                 rtl = read_stats(project / "cycles" / "stats.txt")
-                model = frame_clocks(prog, frame, 1 - share / 1000)
+                model = frame_clocks(prog, frame, 1 - share / 1000, latency=latency)
                 rows.append(GenericCycleRow(
                     f"frame {k}", share, len(frame), len(out), model.total,
                     rtl["tx"].last - rtl["rx"].first + 1, model.publisher,
@@ -209,11 +212,11 @@ def generic_rows(config: NodeConfig, *, bp: int = 500, simulator: str | None = N
 
 def format_generic_rows(rows: list[GenericCycleRow]) -> str:
     """The rows as an aligned text table."""
-    head = (f"{'frame':<10}{'in B':>8}{'out B':>8}{'backpr.':>8}{'model':>10}{'RTL':>10}"
-            f"{'diff':>8}  {'publisher: model':>16}{'RTL':>8}")
+    head = (f"{'frame':<10}{'in B':>11}{'out B':>11}{'backpr.':>8}{'model':>11}{'RTL':>11}"
+            f"{'diff':>8}  {'publisher: model':>16}{'RTL':>11}")
     lines = [head, "-" * len(head)]
     for r in rows:
-        lines.append(f"{r.label:<10}{r.in_bytes:>8,}{r.out_bytes:>8,}{r.bp / 10:>7.0f}%"
-                     f"{r.model:>10,}{r.rtl:>10,}{r.error * 100:>+7.2f}%  "
-                     f"{r.model_publisher:>16,}{r.rtl_publisher:>8,}")
+        lines.append(f"{r.label:<10}{r.in_bytes:>11,}{r.out_bytes:>11,}{r.bp / 10:>7.0f}%"
+                     f"{r.model:>11,}{r.rtl:>11,}{r.error * 100:>+7.2f}%  "
+                     f"{r.model_publisher:>16,}{r.rtl_publisher:>11,}")
     return "\n".join(lines)

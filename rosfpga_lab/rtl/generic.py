@@ -1,5 +1,5 @@
-"""Verilog of generated projects for any message type, ``sensor_msgs/Image`` included (on TCPROS
-its hand-written circuit, ``verilog/``, is the exhibit beside Table 1).
+"""Verilog of generated projects for any message type, ``sensor_msgs/Image`` included (every RTL
+tool runs it; the hand-written Image circuit, ``verilog/``, is the exhibit beside Table 1).
 
 How this works: the modules of ``generic/`` are written once and parameterized:
 ``rfl_gsubscriber`` and ``rfl_gpublisher`` walk a frame by stepping through a program, one
@@ -54,6 +54,15 @@ LAYOUT_INCLUDE = "rfl_layout.vh"
 TEMPLATES = Path(__file__).resolve().parent / "templates"
 
 
+def out_depth(spec: GenericSpec) -> int:
+    """Beats of ``rfl_gtop``'s FIFO after the application: a whole stream (and 2) when the
+    publisher starts a frame only once the subscriber has read all of it, ``axis_depth`` with
+    streaming early release (:attr:`rosfpga_lab.hls.program.Program.stream_early`)."""
+    if spec.program.stream_early is not None:
+        return max(2, spec.axis_depth)
+    return max(spec.axis_depth, beat_shape(spec)["count"] + 2)
+
+
 def generic_params(spec: GenericSpec) -> dict[str, int]:
     """``rfl_gtop``'s parameters for a generic project (with a video stream: a beat per pixel,
     ``VIDEO``, ``WIDTH`` and ``HEIGHT``; :func:`rosfpga_lab.hls.generic.beat_shape`)."""
@@ -69,8 +78,8 @@ def generic_params(spec: GenericSpec) -> dict[str, int]:
         "CARRY_BYTES": carry, "CW": max(1, (carry - 1).bit_length()),
         "MIN_BODY": prog.min_body, "MAX_FRAME": prog.max_frame,
         "RX_DEPTH": spec.input_depth, "TX_DEPTH": spec.output_depth,
-        "AXIS_DEPTH": spec.axis_depth, "OUT_DEPTH": max(spec.axis_depth, beat["count"] + 2),
-        "SEQ_START": prog.seq_start, **video,
+        "AXIS_DEPTH": spec.axis_depth, "OUT_DEPTH": out_depth(spec),
+        "SEQ_START": prog.seq_start, "EARLY": int(prog.stream_early is not None), **video,
     }
 
 

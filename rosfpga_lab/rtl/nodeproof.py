@@ -17,9 +17,11 @@ FIFOs make the proof slower, not different; :data:`NODE_PROOF_DEPTH` clocks of i
 top with more memory than ``rtl.limits.FORMAL_MAX_MEMORY_BITS`` is refused before the tools run
 (:func:`check_size`): prove a copy of the configuration with smaller FIFOs or stream.
 
-Every configuration's generated top, ``sensor_msgs/Image`` on TCPROS included (its 640x480
-examples are over the memory limit: prove a smaller image); the hand-written Image circuit's modules
-and top are what ``rtl prove`` without a configuration proves (:mod:`rosfpga_lab.rtl.proofs`).
+Every configuration's generated top, ``sensor_msgs/Image`` on TCPROS included (with streaming
+early release its FIFO after the application holds a few beats, so its 640x480 examples are under
+the memory limit; on CDR a whole stream, over it: prove a smaller image); the hand-written Image
+circuit's modules and top are what ``rtl prove`` without a configuration proves
+(:mod:`rosfpga_lab.rtl.proofs`).
 """
 
 from __future__ import annotations
@@ -115,10 +117,14 @@ def memory_bits(spec: GenericSpec) -> dict[str, int]:
     """The bits of each memory of the generated top (what the proof maps to flip-flops)."""
     p = generic_params(spec)
     beat = 9 * p["EBYTES"] + 2                 # a FIFO's beat: TDATA, TKEEP, TUSER, TLAST
-    return {"input FIFO": 8 * p["RX_DEPTH"], "output FIFO": 8 * p["TX_DEPTH"],
-            "FIFO to the application": beat * p["AXIS_DEPTH"],
-            "FIFO after the application (a whole stream)": beat * p["OUT_DEPTH"],
+    after = ("FIFO after the application" if p["EARLY"]   # streaming early release: a few beats
+             else "FIFO after the application (a whole stream)")
+    bits = {"input FIFO": 8 * p["RX_DEPTH"], "output FIFO": 8 * p["TX_DEPTH"],
+            "FIFO to the application": beat * p["AXIS_DEPTH"], after: beat * p["OUT_DEPTH"],
             "carry memory": 8 * p["CARRY_BYTES"]}
+    if p.get("VIDEO") and p["KSIZE"] > 1:      # rfl_morph's line memories: KSIZE - 1 lines
+        bits["line memories of the 2-D window"] = (p["KSIZE"] - 1) * p["WIDTH"] * 8 * p["EBYTES"]
+    return bits
 
 
 def check_size(config: NodeConfig, spec: GenericSpec) -> None:

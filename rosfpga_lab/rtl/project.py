@@ -18,7 +18,6 @@ from rosfpga_lab.hls.generic import render_generic, spec_from_config
 from rosfpga_lab.hls.vectors import sample_frames
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.generic import generic_rtl_files
-from rosfpga_lab.rtl.params import rtl_params
 from rosfpga_lab.rtl.sim import source_files
 
 #: The RTL's folder inside a generated project.
@@ -27,22 +26,17 @@ RTL_DIR = "rtl"
 
 def node_sources(config: NodeConfig) -> dict[str, bytes]:
     """``{file name: bytes}`` of the node's Verilog for any configuration: what ``rtl synth`` and
-    ``rtl timing`` read (from ``rfl_node``). Every type but Image on TCPROS: the generated top
-    ``rosfpga-lab generate`` writes into ``rtl/`` (:func:`~rosfpga_lab.rtl.generic.generic_rtl_files`).
-    ``sensor_msgs/Image`` on TCPROS: still the lab's hand circuit with
-    :func:`~rosfpga_lab.rtl.params.rtl_params` (the exhibit beside Table 1; ``generate`` writes
-    the generated top for it too, issue 28).
+    ``rtl timing`` read (from ``rfl_node``): the generated top ``rosfpga-lab generate`` writes
+    into ``rtl/`` (:func:`~rosfpga_lab.rtl.generic.generic_rtl_files`), every type and wire,
+    ``sensor_msgs/Image`` on TCPROS included.
 
     Raises:
-        RtlError: ``op: custom`` (the application is the user's C++: no Verilog), or the Image
-            circuit's parameters are refused.
+        RtlError: ``op: custom`` (the application is the user's C++: no Verilog).
         GenerateError: the generic walk cannot be generated for this configuration.
     """
     if config.application.op == CUSTOM:
         raise RtlError("a custom application has no RTL: the lab's Verilog holds dilate, erode "
                        "and passthrough only")
-    if config.is_image and config.wire != CDR_WIRE:
-        return source_files(rtl_params(config))
     return generic_rtl_files(spec_from_config(config))
 
 

@@ -55,7 +55,8 @@ class Proof:
         defines: Verilog macros for the wrapper (``FV_PROVE`` leaves out what only holds bounded).
         claim: what it shows, in words.
         layout: the design includes the generated walk ``rfl_layout.vh``: prove against the one
-            of :func:`formal_program` (a small message type).
+            of :func:`formal_program` (a small message type; with the define ``FV_WHOLE`` its
+            walk without streaming early release).
     """
 
     name: str
@@ -142,10 +143,15 @@ PROOFS: tuple[Proof, ...] = (
           "table; all reachable states", ("FV_PROVE",), True),
     Proof("gsubscriber", ("rfl_gsubscriber.v",), "bmc", 50,
           "rfl_gsubscriber (formal_program, any input bytes): fields held unchanged until "
-          "released, each frame handed over streamed exactly the array's 2 bytes, never more, "
-          "accepted: the answer's length in range; 50 clocks: every frame length (15 to 17 "
-          "bytes, 45 to 47 clocks to acceptance) handed over and held a clock after the reset "
-          "clock", (), True),
+          "released, each frame handed over at its stream's count (early release) before any "
+          "stream byte, never dropped nor refused, never more than the array's 2 bytes, accepted: the "
+          "answer's length in range; 50 clocks: every frame length (15 to 17 bytes, 45 to 47 "
+          "clocks to acceptance) handed over and held a clock after the reset clock", (), True),
+    Proof("gsubscriber", ("rfl_gsubscriber.v",), "bmc", 50,
+          "rfl_gsubscriber (formal_program without the exact fit: no early release, any input "
+          "bytes): fields held unchanged until released, each frame handed over streamed "
+          "exactly the array's 2 bytes, never more, accepted: the answer's length in range; "
+          "50 clocks", ("FV_WHOLE",), True),
     Proof("gpublisher", ("rfl_gpublisher.v",), "prove", 4,
           "rfl_gpublisher (formal_program, fields held until released): output stream rules; "
           "all reachable states", ("FV_PROVE",), True),
@@ -160,9 +166,13 @@ PROOFS: tuple[Proof, ...] = (
           "TUSER and the sample's sideband, TUSER only with TLAST, input taken only when the "
           "output register is free; all reachable states", ("FV_PROVE",)),
     Proof("gtop", ("rfl_fifo.v", "rfl_slice.v", *GENERIC_MODULES), "prove", 4,
-          "rfl_gtop (formal_program, 1-byte elements, FIFOs 2 and 4 deep, any input bytes): "
-          "output stream rules, status codes of the table, busy while output is pending; all "
-          "reachable states", (), True),
+          "rfl_gtop (formal_program, early release, 1-byte elements, FIFOs 2 and 4 deep, any "
+          "input bytes): output stream rules, status codes of the table, busy while output is "
+          "pending; all reachable states", (), True),
+    Proof("gtop", ("rfl_fifo.v", "rfl_slice.v", *GENERIC_MODULES), "prove", 4,
+          "rfl_gtop (formal_program without the exact fit: whole frames, 1-byte elements, "
+          "FIFOs 2 and 4 deep, any input bytes): output stream rules, status codes of the "
+          "table, busy while output is pending; all reachable states", ("FV_WHOLE",), True),
     # the fabric's network side (rtl/fabric, issue #31)
     Proof("rtps_disc_rom", ("rfl_rtps_disc_rom.v",), "prove", 8,
           "rfl_rtps_disc_rom (16-byte ROM, 4 messages, any contents, any requests): output "
@@ -208,15 +218,19 @@ PROOFS: tuple[Proof, ...] = (
 )
 
 
-def formal_program() -> Program:
+def formal_program(early: bool = True) -> Program:
     """The walk the program walkers are proven against: a small message of every part the
     subscriber checks (a constant, a carried string of at most 2 bytes, a streamed array of
-    exactly 2 one-byte elements), frames of 15 to 17 bytes."""
+    exactly 2 one-byte elements), frames of 15 to 17 bytes. The array fills the frame exactly,
+    so the walk hands a frame over at its count (:attr:`Program.stream_early`); ``early`` False:
+    the same walk without that exact fit (the frame's end decides it, as CDR's do), handed over
+    once read (the wrappers' ``FV_WHOLE``)."""
     instrs = [
         Instr(Op.FIXED, Sub.CHECK, Pub.CONST, 1, status=2, const=b"\x02", name="mode",
               type="uint8"),
         Instr(Op.VAR, Sub.CARRY, Pub.CARRY, 1, 2, status=3, name="label", type="string"),
-        Instr(Op.VAR, Sub.STREAM, Pub.STREAM, 1, 2, status=4, fixed_after=0, name="samples",
+        Instr(Op.VAR, Sub.STREAM, Pub.STREAM, 1, 2, status=4, fixed_after=0 if early else -1,
+              name="samples",
               type="uint8[]"),
         Instr(Op.DONE, status=1),
     ]
@@ -229,11 +243,11 @@ def formal_program() -> Program:
                          type_out="lab_msgs/FormalTiny")
 
 
-def formal_layout() -> str:
+def formal_layout(early: bool = True) -> str:
     """``rfl_layout.vh`` of :func:`formal_program`, rendered by the project generator."""
     hdr = {"callerid": "/fpga", "md5sum": "0" * 32, "type": "lab_msgs/FormalTiny",
            "topic": "/in", "message_definition": "", "tcp_nodelay": "1"}
-    spec = GenericSpec(program=formal_program(), node_name="/fpga", sub_topic="/in",
+    spec = GenericSpec(program=formal_program(early), node_name="/fpga", sub_topic="/in",
                        pub_topic="/out", master_uri="http://127.0.0.1:11311",
                        ip_address="127.0.0.1", input_depth=4, output_depth=4, axis_depth=4,
                        part="xc7z020clg400-1", clock_mhz=100.0, op="dilate", ksize=3,
@@ -331,7 +345,7 @@ def prove(proof: Proof, *, work_dir: str | Path | None = None,
         includes = []
         if proof.layout:
             includes.append(work / LAYOUT_INCLUDE)
-            includes[-1].write_text(formal_layout())
+            includes[-1].write_text(formal_layout("FV_WHOLE" not in proof.defines))
         return run_sby(proof, work, sby_text(proof, design, includes))
 
 

@@ -1,8 +1,8 @@
 """The Verilog on a live data path: one long-lived simulator process fed whole frames.
 
 How this works: :class:`RtlServer` builds (or takes from the cache) the fast harness of
-:mod:`rosfpga_lab.rtl.sim` for a node configuration -- the hand-written Image circuit, or for
-any other type the generated top, the same ``rtl/`` ``rosfpga-lab generate`` writes and its
+:mod:`rosfpga_lab.rtl.sim` for a node configuration -- the generated top of every type,
+``sensor_msgs/Image`` included, the same ``rtl/`` ``rosfpga-lab generate`` writes and its
 ``make rtlsim`` runs (:func:`rosfpga_lab.rtl.sim.design_from_config`) -- and starts it once in
 serve mode (``rfl_fast --serve``). Each :meth:`RtlServer.process` call writes one request
 (``RFLQ``, the length, the TCPROS frame) to its standard input and reads the reply (``RFLR``:

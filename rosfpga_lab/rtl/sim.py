@@ -40,7 +40,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from rosfpga_lab.config import CUSTOM, NodeConfig
-from rosfpga_lab.config.vocabulary import CDR_WIRE
 from rosfpga_lab.hls.csim import read_beats
 from rosfpga_lab.hls.errors import HlsError
 from rosfpga_lab.hls.generic import GenericSpec
@@ -69,11 +68,13 @@ STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "pub
            "axis_out")
 
 
-def design_from_config(config: NodeConfig) -> Design:
-    """The circuit a configuration simulates: ``sensor_msgs/Image`` on TCPROS the hand-written
-    one (:func:`~rosfpga_lab.rtl.params.rtl_params`), any other type, and Image on CDR, the
-    generated top (:func:`rosfpga_lab.hls.generic.spec_from_config`, what ``rosfpga-lab
-    generate`` renders).
+def design_from_config(config: NodeConfig) -> GenericSpec:
+    """The circuit a configuration simulates: the generated top of every type and wire,
+    ``sensor_msgs/Image`` included (:func:`rosfpga_lab.hls.generic.spec_from_config`, what
+    ``rosfpga-lab generate`` renders; Image on TCPROS streams its frames through with early
+    release, :attr:`rosfpga_lab.hls.program.Program.stream_early`). The hand-written Image
+    circuit (:class:`RtlParams`) is built only when its parameters are passed to :func:`build`
+    (the exhibit beside Table 1).
 
     Raises:
         RtlError: ``op: custom`` (no RTL of the user's C++) or a configuration the generator
@@ -81,15 +82,12 @@ def design_from_config(config: NodeConfig) -> Design:
     """
     from rosfpga_lab.hls.errors import GenerateError
     from rosfpga_lab.hls.generic import spec_from_config
-    from rosfpga_lab.rtl.params import rtl_params
 
     where = str(config.path) if config.path else "the configuration"
     if config.application.op == CUSTOM:
         raise RtlError(f"{where}: application.op is custom, so there is no RTL to simulate (the "
                        "application is your C++): run it on the fast or reference model, or "
                        "simulate the generated project's C++ (rosfpga-lab generate, make csim)")
-    if config.is_image and config.wire != CDR_WIRE:
-        return rtl_params(config)
     try:
         return spec_from_config(config)
     except GenerateError as exc:

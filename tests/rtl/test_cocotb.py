@@ -13,8 +13,8 @@ import pytest
 
 from tests.support.realros import require_rtl, skip_or_fail
 from rosfpga_lab.hw import PIXEL_FORMATS
-from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl import rtl_params, write_sources
+from rosfpga_lab.rtl.sim import design_from_config, status_table
 from tests.hls.test_csim import ros_frame
 from tests.rtl.test_sim import model_output, random_image, refusal_frames, small_config
 
@@ -22,8 +22,11 @@ pytestmark = pytest.mark.rtl
 HERE = Path(__file__).resolve().parents[1]
 
 
-def cosimulate(config, frames: list[bytes], tmp_path: Path, seed: int = 5) -> list[str]:
+def cosimulate(config, frames: list[bytes], tmp_path: Path, seed: int = 5,
+               generated: bool = False) -> list[str]:
     """Run the cocotb testbench on ``frames``; it asserts the output equals the models'.
+    ``generated``: the configuration's generated top (``design_from_config``; an Image on
+    TCPROS streams through with early release) instead of the hand-written circuit.
 
     Returns:
         The subscriber's statuses, one per frame it decided on.
@@ -36,8 +39,10 @@ def cosimulate(config, frames: list[bytes], tmp_path: Path, seed: int = 5) -> li
     expected, _ = model_output(config, frames)
     (tmp_path / "frames.bin").write_bytes(b"".join(frames))
     (tmp_path / "expected.bin").write_bytes(expected)
-    files = write_sources(rtl_params(config), tmp_path / "src")
-    sources = [tmp_path / "src" / f for f in files if f.endswith(".v") and f != "rfl_tb.v"]
+    design = design_from_config(config) if generated else rtl_params(config)
+    files = write_sources(design, tmp_path / "src")
+    sources = [tmp_path / "src" / f for f in files
+               if f.endswith(".v") and f not in ("rfl_tb.v", "rfl_harness.v")]
     runner = runner_mod.get_runner("icarus")
     runner.build(sources=sources, includes=[tmp_path / "src"], hdl_toplevel="rfl_node",
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"))
@@ -51,7 +56,7 @@ def cosimulate(config, frames: list[bytes], tmp_path: Path, seed: int = 5) -> li
     failed = runner_mod.get_results(results)[1]
     assert failed == 0, f"the cocotb test failed; its log is in {tmp_path / 'build'}"
     codes = [int(c) for c in (tmp_path / "status.txt").read_text().split()]
-    return [SUBSCRIBER_STATUSES[c][0] for c in codes]
+    return [status_table(design)[c][0] for c in codes]
 
 
 @pytest.mark.parametrize("encoding", list(PIXEL_FORMATS))
@@ -63,6 +68,20 @@ def test_cocotb_drives_real_frames_through_the_rtl(encoding: str, tmp_path: Path
     _, verdicts = model_output(config, [frames[0], bad, frames[1]])
     assert verdicts == ["SUB_OK", "refused", "SUB_OK"]
     statuses = cosimulate(config, [frames[0], bad, frames[1]], tmp_path)
+    assert statuses == ["SUB_OK", "SUB_BAD_WIDTH", "SUB_OK"]
+
+
+@pytest.mark.parametrize("encoding", ["rgba8", "mono8"])
+def test_cocotb_drives_real_frames_through_the_generated_image_top(encoding: str,
+                                                                   tmp_path: Path) -> None:
+    """The generated top every tool runs for Image on TCPROS (handed over at the data count,
+    the publisher writing while the stream flows): the same frames, gaps and backpressure, the
+    models' bytes, the refused frame's status from its walk's table."""
+    config = small_config(encoding, width=9, height=5)
+    frames = [ros_frame(random_image(config, s), encoding, seq=s, frame_id="cam" * s)
+              for s in (1, 2)]
+    bad = ros_frame(random_image(config, 3)[:, :-1], encoding)
+    statuses = cosimulate(config, [frames[0], bad, frames[1]], tmp_path, generated=True)
     assert statuses == ["SUB_OK", "SUB_BAD_WIDTH", "SUB_OK"]
 
 

@@ -305,11 +305,13 @@ def test_the_generated_node_wrapper_follows_the_rules(tmp_path: Path) -> None:
 # (module, parameters, message) of the modules that read a generated project's rfl_layout.vh
 GENERATED_CONTRACTS = [
     ("rfl_gtop", {"LENGTH": 16, "OUT_DEPTH": 17},
-     "rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream)"),
+     "rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream; EARLY: 2)"),
     ("rfl_gsubscriber", {"CARRY_BYTES": 65, "CW": 6},
      "rfl_gsubscriber: CARRY_BYTES must be at least 1 and at most 2**CW (CW 1..16)"),
     ("rfl_gsubscriber", {"MIN_BODY": 100, "MAX_FRAME": 99},
      "rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME"),
+    ("rfl_gsubscriber", {"EARLY": 5},
+     "rfl_gsubscriber: EARLY must be the walk's STREAM_EARLY (rfl_layout.vh)"),
 ]
 
 

@@ -5,10 +5,12 @@
 // rules: its output keeps the rules, it releases only fields it holds, a frame starts with the
 // frame length it was given (little-endian) and then the constant, it takes exactly the
 // array's 2 bytes of the application per frame (a dropped frame too), and writes nothing for a
-// dropped frame.
+// dropped frame. The carried byte at hand may wait (carry_valid: streaming early release, the
+// subscriber still writing it) and is then held until taken.
 module fv_gpublisher (
     input clk, input rst_n, input [7:0] s_tdata, input s_tvalid, input m_tready,
-    input meta_valid, input [31:0] meta_out_len, input meta_drop, input [7:0] carry_rdata
+    input meta_valid, input [31:0] meta_out_len, input meta_drop, input [7:0] carry_rdata,
+    input carry_valid
 );
     wire s_tready, m_tvalid, meta_release, idle;
     wire [7:0] m_tdata;
@@ -18,7 +20,7 @@ module fv_gpublisher (
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
         .meta_drop(meta_drop), .carry_restart(carry_restart), .carry_pop(carry_pop),
-        .carry_rdata(carry_rdata),
+        .carry_rdata(carry_rdata), .carry_valid(carry_valid),
         .idle(idle));
 `include "fv_env.vh"
     `FV_SOURCE(s_tvalid, s_tready, s_tdata)
@@ -33,8 +35,9 @@ module fv_gpublisher (
             assume(meta_valid && $stable(meta_out_len) && $stable(meta_drop));
         if ($past(meta_release)) assume(!meta_valid);
         if (!(meta_valid && !$past(meta_valid))) assume($stable(meta_out_len));
-        if ($past(!idle) && $past(!idle, 2) && $past(!idle, 3) && !$past(carry_pop))
-            assume($stable(carry_rdata));
+        if ($past(!idle) && $past(!idle, 2) && $past(!idle, 3) && !$past(carry_pop)
+            && $past(carry_valid))
+            assume($stable(carry_rdata) && carry_valid);
     end
 
     // per frame (from one release to the next): bytes written, application bytes taken

@@ -8,7 +8,10 @@
 // counted from its own output position (P_PAD); a string's count includes its NUL (written
 // after a constant; an empty string for a skipped one); OP_ENCAP writes its 4 constant bytes.
 // No multiplier (100 MHz on an ECP5 with no DSP): an OP_VAR's bytes are its count shifted by
-// lsize, and a body's last byte is found by a count down (left_b).
+// lsize, and a body's last byte is found by a count down (left_b). With streaming early release
+// (the subscriber's STREAM_EARLY) it starts a frame at the stream's count and writes the stream
+// as the application's bytes come; a carried byte waits for carry_valid (the fields after the
+// stream may not be in the carry memory yet).
 `default_nettype none
 
 module rfl_gpublisher #(
@@ -30,6 +33,8 @@ module rfl_gpublisher #(
     output wire        carry_restart,           // read the carried bytes from the first
     output wire        carry_pop,               // carry_rdata taken: the next carried byte
     input  wire [7:0]  carry_rdata,             // the carried byte at hand (a register)
+    input  wire        carry_valid,             // ... is there (the subscriber may still be
+                                                // writing it: streaming early release)
     output wire        idle                     // no frame being written
 );
 `include "rfl_layout.vh"
@@ -111,8 +116,9 @@ module rfl_gpublisher #(
         m_tdata = carried ? carry_rdata : other;
     end
 
-    assign m_tvalid = (state == P_LEN) || (state == P_COUNT) || (state == P_PAD)
-                      || (state == P_BODY && (!from_stream || s_tvalid));
+    assign m_tvalid = (state == P_LEN) || (state == P_PAD)
+                      || ((state == P_COUNT || state == P_BODY)
+                          && (from_stream ? s_tvalid : (!carried || carry_valid)));
     assign s_tready = (from_stream && m_tready) || (state == P_DROP);
     assign carry_restart = (state == P_IDLE) && meta_valid;
     assign meta_release = (state == P_DONE);

@@ -19,13 +19,22 @@
 // elem_min per clock, before S_COUNTED checks them. The bytes left for the fields (room: CDR
 // less the end padding) and in the frame (left_f) are registers kept with pos, and a body's
 // last byte is found by a count down (left_b), so that no clock subtracts and compares in a row.
+// Streaming early release (STREAM_EARLY, from Program.stream_early; EARLY must equal it): when
+// nothing after the stream's count can refuse the frame (its count fills the frame exactly with
+// fixed fields that are skipped or carried), the frame is handed over (meta_valid, out_len +
+// EARLY_ADD) at the count's decision, so the publisher writes it while the stream flows; the
+// frame's end then raises no meta_valid. The publisher may read the carry memory while the
+// fields after the stream are written into it: a byte is read only once written (craddr <
+// waddr), and carry_valid says the carried byte at hand is there.
 `default_nettype none
 
 module rfl_gsubscriber #(
     parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
     parameter CW = 6,                           // its address bits
     parameter MIN_BODY = 0,                     // shortest frame length accepted
-    parameter MAX_FRAME = 67108864              // longest frame length accepted
+    parameter MAX_FRAME = 67108864,             // longest frame length accepted
+    parameter EARLY = -1                        // streaming early release: the walk's STREAM_EARLY
+                                                // (-1: take it; else it must be the walk's)
 ) (
     input  wire        clk,
     input  wire        rst_n,
@@ -42,6 +51,7 @@ module rfl_gsubscriber #(
     input  wire        carry_restart,           // the publisher reads them from the first
     input  wire        carry_pop,               // ... has taken carry_rdata: the next
     output reg  [7:0]  carry_rdata,             // the carried byte at hand (a register)
+    output reg         carry_valid,             // ... is there (read from written bytes)
     output wire        frame_start,
     output reg         status_valid,
     output reg  [7:0]  status,
@@ -57,6 +67,8 @@ module rfl_gsubscriber #(
                    "rfl_gsubscriber: CARRY_BYTES must be at least 1 and at most 2**CW (CW 1..16)");
         if (MIN_BODY < 0 || MIN_BODY > MAX_FRAME)
             $fatal(1, "rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME");
+        if (EARLY != -1 && EARLY != STREAM_EARLY)
+            $fatal(1, "rfl_gsubscriber: EARLY must be the walk's STREAM_EARLY (rfl_layout.vh)");
     end
 `else
     if (CARRY_BYTES < 1 || CW < 1 || CW > 16 || (1 << CW) < CARRY_BYTES) begin : g_bad_carry
@@ -64,6 +76,9 @@ module rfl_gsubscriber #(
     end
     if (MIN_BODY < 0 || MIN_BODY > MAX_FRAME) begin : g_bad_frame
         $error("rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME");
+    end
+    if (EARLY != -1 && EARLY != STREAM_EARLY) begin : g_bad_early
+        $error("rfl_gsubscriber: EARLY must be the walk's STREAM_EARLY (rfl_layout.vh)");
     end
 `endif
 
@@ -90,8 +105,9 @@ module rfl_gsubscriber #(
     reg [63:0] value;                           // a SUB_RANGE field, little-endian
     reg        same;                            // a SUB_CHECK field equals its constant so far
     reg        streamed;                        // the stream went out
+    reg        released;                        // handed over early (STREAM_EARLY)
     reg [31:0] out_len;
-    reg [CW-1:0] waddr;
+    reg [CW:0] waddr;                           // carried bytes written (one bit more: 2**CW fit)
     reg [31:0] left [0:LOOPS-1];           // elements left of each open loop
     reg [LOOPS-1:0] quiet_of;              // that loop is written empty
     reg [DB-1:0] depth;
@@ -213,30 +229,36 @@ module rfl_gsubscriber #(
     wire [63:0] vkey = order_key(value, sign_m, all_m, kind);
 
     always @(posedge clk) begin
-        if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr] <= s_tdata;
+        if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr[CW-1:0]] <= s_tdata;
     end
 
     // The carry memory's read side: the publisher takes the carried bytes in order, from the
-    // first, once per frame (carry_restart, then carry_pop for each), while nothing is written
-    // (it writes while meta_valid holds, and a new frame waits for meta_release). They are read
-    // ahead into two registers, as rfl_fifo's OUTREG does: the block RAM's read register (cq),
-    // then carry_rdata in the fabric, so that the publisher's byte does not start from a block
-    // RAM's slow clock-to-output (100 MHz timing on an ECP5). Two clocks after carry_restart the
-    // first byte is in carry_rdata (the publisher's first carried byte comes after the frame
-    // length's 4 bytes and a decode); from then on each carry_pop moves the next one in.
-    reg [CW-1:0] craddr;                        // the next byte to read
+    // first, once per frame (carry_restart, then carry_pop for each); a new frame waits for
+    // meta_release, so waddr holds its frame's count while they are read. They are read ahead
+    // into two registers, as rfl_fifo's OUTREG does: the block RAM's read register (cq), then
+    // carry_rdata in the fabric, so that the publisher's byte does not start from a block RAM's
+    // slow clock-to-output (100 MHz timing on an ECP5). A byte is read only once written
+    // (craddr < waddr): with STREAM_EARLY the publisher starts before the carried fields after
+    // the stream are in; carry_valid says carry_rdata holds the next carried byte. Two clocks
+    // after carry_restart the first byte is in carry_rdata (the publisher's first carried byte
+    // comes after the frame length's 4 bytes and a decode); from then on each carry_pop moves
+    // the next one in (when written).
+    reg [CW:0] craddr;                          // the next byte to read
     reg [7:0]  cq;                              // the byte after carry_rdata
-    reg [1:0]  cfill;                           // registers filled since carry_restart (0..2)
-    wire       cadv = (cfill != 2'd2) || carry_pop;
+    reg        cq_valid;
+    wire       c_move = cq_valid && (!carry_valid || carry_pop);      // cq -> carry_rdata
+    wire       c_read = (!cq_valid || c_move) && (craddr != waddr);   // memory -> cq
     always @(posedge clk) begin
-        if (cadv) cq <= carry_mem[craddr];
-        if (cadv && cfill != 2'd0) carry_rdata <= cq;
+        if (c_read) cq <= carry_mem[craddr[CW-1:0]];
+        if (c_move) carry_rdata <= cq;
         if (!rst_n || carry_restart) begin
-            craddr <= {CW{1'b0}};
-            cfill <= 2'd0;
-        end else if (cadv) begin
-            craddr <= craddr + 1'b1;
-            if (cfill != 2'd2) cfill <= cfill + 2'd1;
+            craddr <= {(CW + 1){1'b0}};
+            cq_valid <= 1'b0;
+            carry_valid <= 1'b0;
+        end else begin
+            if (c_read) craddr <= craddr + 1'b1;
+            cq_valid <= c_read || (cq_valid && !c_move);
+            carry_valid <= c_move || (carry_valid && !carry_pop);
         end
     end
 
@@ -258,7 +280,7 @@ module rfl_gsubscriber #(
     // out_len and room after a decision's additions, settled the same way (each decision acts
     // on flip-flops only): an OP_VAR's count padding, a variable OP_LOOP's count, OP_ENCAP's
     // header and end padding
-    reg [31:0] p_out_var, p_out4, p_out_klen, p_room_encap;
+    reg [31:0] p_out_var, p_out4, p_out_klen, p_room_encap, p_out_early;
     // The next instructions, registered (the ROM look-up and the adders are not on the
     // decision's path): pc holds from one go() through the two settling clocks of the decision
     // that does the next, so by then these are prog_next(pc), prog_jump(pc) and their pcs.
@@ -273,6 +295,7 @@ module rfl_gsubscriber #(
         p_out4 <= out_len + 32'd4;
         p_out_klen <= out_len + {16'd0, klen};
         p_room_encap <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
+        p_out_early <= out_len + EARLY_ADD;
     end
     always @(posedge clk) begin
         c_tail <= tail_zero;
@@ -332,7 +355,7 @@ module rfl_gsubscriber #(
             status_valid <= 1'b1;
             status <= code;
             cnt <= 32'd0;
-            if (streamed) begin
+            if (streamed && !released) begin  // (never released: STREAM_EARLY's rule)
                 meta_valid <= 1'b1;
                 meta_drop <= 1'b1;
             end
@@ -350,9 +373,12 @@ module rfl_gsubscriber #(
         begin
             status_valid <= 1'b1;
             status <= SUB_OK;
-            meta_valid <= 1'b1;
-            meta_drop <= 1'b0;
-            meta_out_len <= out_len;
+            if (!released) begin  // (STREAM_EARLY: handed over at the stream's count)
+                meta_valid <= 1'b1;
+                meta_drop <= 1'b0;
+                meta_out_len <= out_len;
+            end
+            released <= 1'b0;
             cnt <= 32'd0;
             if (to_end) begin
                 state <= S_FLEN;
@@ -399,7 +425,8 @@ module rfl_gsubscriber #(
             same <= 1'b0;
             streamed <= 1'b0;
             out_len <= 32'd0;
-            waddr <= {CW{1'b0}};
+            waddr <= {(CW + 1){1'b0}};
+            released <= 1'b0;
             depth <= {DB{1'b0}};
             quiet <= 8'd0;
             quiet_of <= {LOOPS{1'b0}};
@@ -457,7 +484,7 @@ module rfl_gsubscriber #(
                             room <= n;
                             streamed <= 1'b0;
                             out_len <= 32'd0;
-                            waddr <= {CW{1'b0}};
+                            waddr <= {(CW + 1){1'b0}};
                             depth <= {DB{1'b0}};
                             quiet <= 8'd0;
                             meta_drop <= 1'b0;
@@ -575,6 +602,12 @@ module rfl_gsubscriber #(
                         left_b <= body;
                         last_b <= c_body1;
                         pad_then(pad_e, S_BODY);
+                        if (STREAM_EARLY && sub == SUB_STREAM) begin  // nothing after can refuse
+                            meta_valid <= 1'b1;
+                            meta_drop <= 1'b0;
+                            meta_out_len <= p_out_early;
+                            released <= 1'b1;
+                        end
                     end
                 end
                 S_PAD: if (take && cnt[2:0] + 3'd1 == padn) begin
@@ -628,6 +661,7 @@ module rfl_gsubscriber #(
     // the instruction register holds the word of pc (an invariant the proofs carry)
     always @(*) if (rst_n) assert(w == prog_word(pc));
     always @(*) if (rst_n) assert(last_b == (left_b == 35'd1));
+    always @(*) if (rst_n && !STREAM_EARLY) assert(!released);
     // a decision settles only in its own state, from 0 (each decision ends at 2 with 0)
     always @(*) if (rst_n)
         assert(settled == 2'd0 || (settled != 2'd3 && (state == S_FCHK || state == S_DECODE

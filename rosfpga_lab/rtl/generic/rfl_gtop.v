@@ -11,7 +11,10 @@
 //
 // The publisher starts a frame once the subscriber has read all of it (the frame length comes
 // first and depends on every field), so the FIFO after the application holds a whole stream:
-// OUT_DEPTH >= LENGTH + 2 (checked). The carry memory lives in the subscriber; the publisher
+// OUT_DEPTH >= LENGTH + 2 (checked). EARLY = 1 (streaming early release, the walk's
+// STREAM_EARLY, from Program.stream_early: nothing after the stream's count can refuse the
+// frame): the subscriber hands the frame over at the count, the publisher writes it while the
+// stream flows, and OUT_DEPTH needs only 2. The carry memory lives in the subscriber; the publisher
 // reads it in order (the subscriber reads it ahead into registers).
 // The FIFOs that feed logic (rx, axis in, axis out) register their RAM's output once more
 // (rfl_fifo's OUTREG, when at least 3 deep): what reads them does not start from a block RAM's
@@ -33,6 +36,8 @@ module rfl_gtop #(
     parameter AXIS_DEPTH = 16,
     parameter OUT_DEPTH = 18,
     parameter [31:0] SEQ_START = 1,
+    parameter EARLY = -1,                       // streaming early release: the walk's STREAM_EARLY
+                                                // (1 or 0; -1: the subscriber takes the walk's)
     parameter VIDEO = 0,                        // 1: frame the stream as video (rfl_morph)
     parameter WIDTH = LENGTH,                   // VIDEO: pixels per line
     /* verilator lint_off UNUSEDPARAM */
@@ -60,8 +65,8 @@ module rfl_gtop #(
                                                   || EBYTES == 8))
             $fatal(1, "rfl_gtop: EBYTES must be 1, 2, 4 or 8 (VIDEO: 1..4)");
         if (LENGTH < 1) $fatal(1, "rfl_gtop: LENGTH must be at least 1");
-        if (OUT_DEPTH < LENGTH + 2)
-            $fatal(1, "rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream)");
+        if (OUT_DEPTH < (EARLY == 1 ? 2 : LENGTH + 2))
+            $fatal(1, "rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream; EARLY: 2)");
     end
 `else
     if (VIDEO ? (EBYTES < 1 || EBYTES > 4) : !(EBYTES == 1 || EBYTES == 2 || EBYTES == 4
@@ -71,8 +76,8 @@ module rfl_gtop #(
     if (LENGTH < 1) begin : g_bad_length
         $error("rfl_gtop: LENGTH must be at least 1");
     end
-    if (OUT_DEPTH < LENGTH + 2) begin : g_bad_out_depth
-        $error("rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream)");
+    if (OUT_DEPTH < (EARLY == 1 ? 2 : LENGTH + 2)) begin : g_bad_out_depth
+        $error("rfl_gtop: OUT_DEPTH must be at least LENGTH + 2 (a whole stream; EARLY: 2)");
     end
 `endif
 
@@ -107,15 +112,17 @@ module rfl_gtop #(
     wire [7:0] pix_in_tdata, carry_rdata;
     wire pix_in_tvalid, pix_in_tready;
     wire meta_valid, meta_release, meta_drop, sub_idle, pub_idle, carry_restart, carry_pop;
+    wire carry_valid;
     wire [31:0] meta_out_len;
     rfl_gsubscriber #(.CARRY_BYTES(CARRY_BYTES), .CW(CW), .MIN_BODY(MIN_BODY),
-                      .MAX_FRAME(MAX_FRAME)) u_subscriber (
+                      .MAX_FRAME(MAX_FRAME), .EARLY(EARLY)) u_subscriber (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(rx_tdata), .s_tvalid(rx_tvalid), .s_tready(rx_tready),
         .m_tdata(pix_in_tdata), .m_tvalid(pix_in_tvalid), .m_tready(pix_in_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
         .meta_drop(meta_drop), .carry_restart(carry_restart), .carry_pop(carry_pop),
-        .carry_rdata(carry_rdata), .frame_start(frame_start), .status_valid(status_valid),
+        .carry_rdata(carry_rdata), .carry_valid(carry_valid), .frame_start(frame_start),
+        .status_valid(status_valid),
         .status(status), .idle(sub_idle));
 
     // element packer -> axis FIFO -> application
@@ -186,7 +193,7 @@ module rfl_gtop #(
         end
     endgenerate
 
-    // application -> axis FIFO (a whole stream) -> element unpacker -> publisher
+    // application -> axis FIFO (a whole stream; EARLY: a few beats) -> element unpacker -> publisher
     rfl_fifo #(.WIDTH(BW), .DEPTH(OUT_DEPTH), .OUTREG(OUT_DEPTH > 2 ? 1 : 0)) u_axis_out_fifo (
         .clk(clk), .rst_n(rst_n),
         .s_tdata({app_out_tlast, app_out_tuser, app_out_tkeep, app_out_tdata}),
@@ -210,7 +217,7 @@ module rfl_gtop #(
         .m_tdata(pub_tdata), .m_tvalid(pub_tvalid), .m_tready(pub_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
         .meta_drop(meta_drop), .carry_restart(carry_restart), .carry_pop(carry_pop),
-        .carry_rdata(carry_rdata), .idle(pub_idle));
+        .carry_rdata(carry_rdata), .carry_valid(carry_valid), .idle(pub_idle));
 
     // a register slice: the publisher's bytes (a carried one straight from the carry memory's
     // block RAM) reach a flip-flop before the tx FIFO's RAM (100 MHz timing on an ECP5)

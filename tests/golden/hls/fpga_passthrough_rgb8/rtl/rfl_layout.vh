@@ -37,6 +37,10 @@ localparam CDR = 0;                            // the walk reads and writes CDR 
 localparam [31:0] ALIGN_ORIGIN = 32'd8;           // CDR: alignment counts from this byte
 localparam [3:0] END_ALIGN = 4'd4;                    // CDR: unannounced zeros may pad the payload to a multiple of this
 localparam [7:0] ENCAP_PAD_MASK = 8'd3;            // CDR: options bits counting the end padding                            // bits of an instruction word
+// streaming early release (Program.stream_early): the subscriber hands the frame over at the
+// stream's count, with out_len + EARLY_ADD (the count, the array, the fixed fields after it)
+localparam STREAM_EARLY = 1;
+localparam [31:0] EARLY_ADD = 32'd57604;
 localparam LOOP_DEPTH = 1;                        // deepest nesting of arrays of messages
 localparam [7:0] SUB_OK = 8'd0, SUB_BAD_FRAME_LENGTH = 8'd1;
 localparam [7:0] SUB_BAD_HEADER_FRAME_ID_LENGTH = 8'd2;  // header.frame_id length

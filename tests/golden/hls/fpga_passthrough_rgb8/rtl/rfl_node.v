@@ -22,8 +22,9 @@ module rfl_node (
         .RX_DEPTH(2048),
         .TX_DEPTH(2048),
         .AXIS_DEPTH(16),
-        .OUT_DEPTH(19202),
+        .OUT_DEPTH(16),
         .SEQ_START(1),
+        .EARLY(1),
         .VIDEO(1),
         .WIDTH(160),
         .HEIGHT(120)

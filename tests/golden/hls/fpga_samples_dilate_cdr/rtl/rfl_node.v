@@ -23,7 +23,8 @@ module rfl_node (
         .TX_DEPTH(2048),
         .AXIS_DEPTH(16),
         .OUT_DEPTH(66),
-        .SEQ_START(1)
+        .SEQ_START(1),
+        .EARLY(0)
     ) u_top (
         .clk(clk), .rst_n(rst_n),
         .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
