@@ -10,7 +10,7 @@ import pytest
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hls.circuit import circuit_of
 from rosfpga_lab.hls.errors import GenerateError
-from rosfpga_lab.hls.generic import spec_from_config
+from rosfpga_lab.hls.generic import spec_from_config, stream_path
 from rosfpga_lab.hls.program import frame_clocks
 from rosfpga_lab.hls.vectors import sample_frames
 
@@ -27,7 +27,9 @@ def test_one_record_per_configuration_holds_the_spec_program_and_models(name: st
     assert circuit.spec == spec_from_config(config)
     frames, expected = sample_frames(config)
     first = frames[:4 + struct.unpack_from("<I", frames)[0]]
-    assert circuit.frame_clocks(first) == frame_clocks(spec_from_config(config).program, first)
+    spec = spec_from_config(config)
+    assert circuit.frame_clocks(first) == frame_clocks(spec.program, first,
+                                                       latency=stream_path(spec))
     if config.wire == "cdr":
         out = circuit.cdr_model().run_record(first).output_record
     else:
