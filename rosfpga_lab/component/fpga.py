@@ -153,8 +153,8 @@ def _check_arguments(config: NodeConfig, model: str, timing: str, input_queue: i
         raise ComponentConfigError(
             f"{config.path or 'the configuration'} has wire: cdr, whose circuit reads CDR "
             "samples (ROS 2); this ROS 1 node feeds its circuit TCPROS frames: for --model "
-            "rtl use a copy with wire: tcpros (or leave wire out), or run this one with "
-            "--model fast")
+            "rtl run this one as a ROS 2 node (node CONFIG --ros2 --model rtl), or use a copy "
+            "with wire: tcpros (or leave wire out)")
     if input_queue < 1 or output_queue < 1:
         raise ComponentConfigError("input_queue and output_queue must be at least 1")
 
@@ -168,9 +168,9 @@ class FpgaComponent:
         master: an :class:`~rosfpga_lab.graph.EmbeddedMaster` to use (overrides both).
         model: ``"fast"`` (numpy), ``"reference"`` (one byte or beat at a time; small images)
             or ``"rtl"`` (the Verilog itself, in a long-lived simulator:
-            :mod:`rosfpga_lab.rtl.server`; for any type but Image the generated top
-            ``rosfpga-lab generate`` writes; TCPROS configurations only: ``wire: cdr`` is
-            refused).
+            :mod:`rosfpga_lab.rtl.server`: the generated top ``rosfpga-lab generate`` writes,
+            for every type; TCPROS configurations only: ``wire: cdr`` is refused here and runs
+            as a ROS 2 node, :class:`~rosfpga_lab.component.ros2.Ros2Component`).
         timing: ``"host"`` (publish as soon as the data path is done) or ``"fpga"`` (publish
             when the circuit's clocks for the frame at ``clock_mhz`` have passed since it
             arrived, or since the circuit became free -- the generated circuit's walk

@@ -89,9 +89,9 @@ class CdrPipeline:
                  layouts: CircuitLayouts | None = None) -> None:
         if model == RTL_MODEL:
             raise PipelineConfigError(
-                "the CDR circuit has no live RTL model: run its Verilog with `rosfpga-lab generate "
-                "CONFIG -o DIR` then `make rtlsim` in DIR; live, use --model "
-                f"{' or '.join(PIPELINE_MODELS)}")
+                "CdrPipeline is the Python model of the CDR circuit: its Verilog runs live in the "
+                "ROS 2 node (`rosfpga-lab node CONFIG --ros2 --model rtl`, rtl/server.py); here use "
+                f"model {' or '.join(PIPELINE_MODELS)}")
         if model not in PIPELINE_MODELS:
             raise PipelineConfigError(
                 f"model must be one of {', '.join(PIPELINE_MODELS)}, got {model!r}")
