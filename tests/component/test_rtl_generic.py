@@ -128,7 +128,7 @@ def test_fpga_timing_of_a_generated_circuit_is_the_rtl_span_at_its_clock(model) 
 def test_model_rtl_refuses_a_cdr_configuration_and_a_custom_application(tmp_path) -> None:
     cdr = load_config(DATA / "fpga_laserscan_min_cdr.yaml")
     with pytest.raises(ComponentConfigError, match=r"fpga_laserscan_min_cdr.yaml has wire: cdr.*"
-                                                   r"wire: tcpros"):
+                                                   r"--ros2 --model rtl.*wire: tcpros"):
         FpgaComponent(cdr, model="rtl")
     text = SCAN.read_text().replace("application: {op: erode, ksize: 5}",
                                     "application: {op: custom, source: mine.cpp}")
