@@ -535,11 +535,12 @@ def test_skipped_fields_are_written_as_cdr_defaults_and_another_output_type_by_p
 
 def test_the_rtl_model_is_refused_with_where_the_cdr_verilog_runs() -> None:
     """``node --ros2 --model rtl`` once ran the Python model quietly: the CDR circuit's Verilog
-    runs in a generated project, so the live pipeline refuses ``rtl`` and says where to go."""
+    runs live in the ROS 2 node's simulator (rtl/server.py), so the Python pipeline refuses
+    ``rtl`` and says where it runs."""
     from rosfpga_lab.hw.errors import PipelineConfigError
 
     config = load_config(DATA / "fpga_dilate_rgba8.yaml")
-    with pytest.raises(PipelineConfigError, match="make rtlsim"):
+    with pytest.raises(PipelineConfigError, match=r"node CONFIG --ros2 --model rtl"):
         CdrPipeline(config, "rtl")
     with pytest.raises(PipelineConfigError, match="model must be one of fast, reference"):
         CdrPipeline(config, "fastest")
