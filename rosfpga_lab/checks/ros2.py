@@ -194,7 +194,7 @@ def check_pixel_offsets(answer: Any, tcpros_frame: bytes, cdr_payload: bytes) ->
         raise fail(ex, *problems)
     shift = want2 - want1
     return CheckResult(ex, [f"the pixels start at byte {want1} of the TCPROS frame and at byte "
-                            f"{want2} of the CDR payload ({shift:+d}): the circuit's interpreter "
+                            f"{want2} of the CDR payload ({shift:+d}): the circuit's subscriber "
                             f"walks {want1} bytes of fields on ROS 1 and {want2} on ROS 2 "
                             f"before it streams pixels"])
 

@@ -44,8 +44,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="start the lab's embedded master at that URI when none answers there")
     p.add_argument("--model", choices=MODELS, default=None,
                    help="the data path: fast (numpy model, default), reference (byte at a time; "
-                   "small images only) or rtl (the Verilog itself, simulated by Verilator); "
-                   "also the private parameter ~model")
+                   "small images only) or rtl (the Verilog itself, simulated by Verilator; with "
+                   "--ros2 the generated CDR top); also the private parameter ~model")
     p.add_argument("--timing", choices=TIMINGS, default=TIMINGS[0],
                    help="host (default): publish as soon as the data path is done; fpga: hold "
                    "each output for the circuit's clocks at clock_mhz and drop frames that come "
@@ -92,13 +92,15 @@ def run_ros2(args: argparse.Namespace) -> int:
         domain = int(raw)
         qos_in = Qos(reliable=not args.best_effort_input)
         model = args.model or MODELS[0]
-        comp = Ros2Component(args.config, domain=domain, model=model, qos_in=qos_in).start()
+        comp = Ros2Component(args.config, domain=domain, model=model, qos_in=qos_in,
+                             timing=args.timing).start()
     except (ValueError, LabError) as exc:
         print(f"rosfpga-lab node: error: {exc}", file=sys.stderr)
         return 1
     print(f"{comp.name}: ROS 2 (DDS domain {domain}, participant index "
           f"{comp.node.index if comp.node else '?'}, input {comp.qos_in.describe()}) "
-          f"{comp.input_topic} -> {comp.pipeline.op} ({model} CDR circuit model) -> "
+          f"{comp.input_topic} -> {comp.pipeline.op} ({model} CDR circuit model, {args.timing} "
+          "timing) -> "
           f"{comp.output_topic}; "
           "Ctrl-C to stop", flush=True)
     t_end = None if args.duration is None else time.monotonic() + args.duration

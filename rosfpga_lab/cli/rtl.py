@@ -244,8 +244,61 @@ def _register_timing(subparsers: argparse._SubParsersAction) -> None:
     timing.set_defaults(func=run_timing)
 
 
+def _register_demo(subparsers: argparse._SubParsersAction) -> None:
+    parser = subparsers.add_parser(
+        "demo", help="notebook 08's run: a few frames through a configuration's generated top, "
+        "each beside the Python models",
+        description="Simulate the generated top of CONFIG (any type on either wire; default: "
+        "notebook 08's 16x8 rgba8 dilate) on its demo frames (Image on TCPROS: one refused for "
+        "its width, then a picture; any other configuration generate's test frames: a good "
+        "one, a refused one, another good one) with random input gaps and output "
+        "backpressure, and print for each frame the subscriber's decision and whether its "
+        "output equals the Python models' (MessagePipeline or CdrPipeline). Exit status 1 on "
+        "any difference. Example: rosfpga-lab rtl demo data/fpga_laserscan_min_cdr.yaml")
+    parser.add_argument("config", type=Path, nargs="?", metavar="CONFIG",
+                        help="the node configuration (YAML; default: the demo's)")
+    parser.add_argument("--simulator", choices=SIMULATORS,
+                        help="the simulator (default: Verilator for large inputs when "
+                        "installed; else Icarus Verilog when installed, else Verilator)")
+    parser.add_argument("--vcd", type=Path, metavar="FILE",
+                        help="write a VCD of the stream and FIFO signals")
+    parser.add_argument("--gap", type=_per_mille, default=None,
+                        help=f"input gaps, {PER_MILLE_HELP} (default: the demo's)")
+    parser.add_argument("--bp", type=_per_mille, default=None,
+                        help=f"output backpressure, {PER_MILLE_HELP} (default: the demo's)")
+    parser.add_argument("--seed", type=positive_int, default=None,
+                        help="random seed (default: the demo's)")
+    parser.set_defaults(func=run_demo)
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    """Run the demo and print one line per frame; 1 when a frame differs from the models."""
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.rtl import demo
+
+    config = load_config(args.config) if args.config is not None else demo.demo_config()
+    frames = demo.demo_inputs(config)
+    _say(f"the generated {config.subscriber.type} circuit on {config.wire}: {len(frames)} "
+         f"frames, {sum(map(len, frames)):,} bytes ...")
+    result = demo.run_demo(
+        args.vcd, simulator=_pick_simulator(args.simulator, sum(map(len, frames))), config=config,
+        gap=demo.DEMO_GAP if args.gap is None else args.gap,
+        bp=demo.DEMO_BP if args.bp is None else args.bp,
+        seed=demo.DEMO_SEED if args.seed is None else args.seed)
+    report = demo.demo_report(config, frames, result)
+    print(demo.format_demo(report))
+    print(f"{result.cycles:,} clocks in {result.seconds:.2f} s")
+    if args.vcd is not None:
+        print(f"waveform: {args.vcd}")
+    if all(f.exact for f in report):
+        print("PASS: every frame as the Python models")
+        return 0
+    print("FAIL: the circuit and the Python models differ")
+    return 1
+
+
 SUBCOMMANDS = [_register_sim, _register_cycles, _register_synth, _register_timing,
-               _register_prove]
+               _register_prove, _register_demo]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

@@ -38,6 +38,8 @@ From the shell (ARCHITECTURE.md's command table; each sub-command's ``--help``):
     rosfpga-lab rtl cycles CONFIG     # the cycle model against the RTL (module ``cycles``)
     rosfpga-lab rtl prove|synth|timing CONFIG
     rosfpga-lab node CONFIG --model rtl --timing fpga       # the live node runs the Verilog
+    rosfpga-lab node CDR_CONFIG --ros2 --model rtl          # the ROS 2 node, the CDR top
+    rosfpga-lab rtl demo [CONFIG]     # notebook 08's run, each frame beside the models (``demo``)
 
 Simulation (module ``sim``): the testbench streams frames with random input gaps (``GAP``) and
 output backpressure (``BP``, per mille of clocks) and writes ``output.bin``, ``status.txt`` and
@@ -46,8 +48,8 @@ clock for clock the same (built by ``rosfpga_lab/hls/rtlbuild.py``); Icarus Veri
 ``SIM=`` picks one and builds are cached (module ``sim``). Speeds are measured, never asserted:
 ``tests/benchmarks/bench_rtl.py``. Without a simulator the RTL tests skip; with
 ``ROSFPGA_REQUIRE_RTL=1`` (CI) they fail. ``hw.cycles`` is held to the RTL (module ``cycles``).
-The live node on the RTL (``--model rtl``, ``FpgaComponent(config, model="rtl")``): one
-long-lived simulator, module ``server``; ``--timing fpga`` holds each output until the circuit's
+The live node on the RTL (``--model rtl``, ``FpgaComponent(config, model="rtl")``, on ROS 2
+``Ros2Component(config, model="rtl")``): one long-lived simulator, module ``server``; ``--timing fpga`` holds each output until the circuit's
 clocks have passed at ``clock_mhz``. Formal proofs of the stream handshakes (``formal/``, run by
 module ``proofs`` with SymbiYosys; which check, mode and claim: ``rosfpga-lab rtl prove``, limits
 in module ``limits``). The application ``rfl_morph.v``'s clocks and latency are its header

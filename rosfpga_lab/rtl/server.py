@@ -9,6 +9,12 @@ serve mode (``rfl_fast --serve``). Each :meth:`RtlServer.process` call writes on
 flags, clocks, span, the statuses the subscriber decided and the bytes the circuit sent). The
 circuit keeps its state between frames, as the board does (the publisher's sequence number
 counts on).
+
+On ``wire: cdr`` the same server runs the generated CDR top, and a request is one or more
+records as the RTPS reader's software writes them into the circuit's byte FIFO (the 4-byte
+sample length, then the CDR payload); the reply's bytes are the publisher's records (length,
+payload): what the ROS 2 node runs with ``--model rtl``
+(:class:`rosfpga_lab.component.ros2.Ros2Component`).
 """
 
 from __future__ import annotations
@@ -93,7 +99,8 @@ class RtlServer:
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
 
     def process(self, frames: bytes) -> RtlFrame:
-        """Feed ``frames`` (one or more TCPROS frames) to the circuit and run until it is idle.
+        """Feed ``frames`` (one or more TCPROS frames, or CDR records on ``wire: cdr``) to the
+        circuit and run until it is idle.
 
         Raises:
             RtlError: the simulator is closed, stalled or ended.

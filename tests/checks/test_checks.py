@@ -399,6 +399,9 @@ def test_frame_timing_frame_time_instead_of_the_filters_is_named_and_rounded():
 
 def test_frame_timing():
     assert C.check_frame_timing(308_321, 3.08321, "byte-wide stages").ok
+    assert C.check_frame_timing(308_321, 3.08321, "the walkers").ok     # notebook 5 names them
+    assert C.check_frame_timing(308_321, 3.08321, "subscriber and publisher").ok
+    assert "bottleneck 'dilate'" in problems_of(C.check_frame_timing, 308_321, 3.08321, "dilate")
     msg = problems_of(C.check_frame_timing, 307_200, 3.072, "filter")
     assert "one clock per pixel" in msg and "bottleneck 'filter'" in msg
     assert "counts bytes" in problems_of(C.check_frame_timing, 1_228_800, 12.288, "byte-wide stages")
@@ -528,19 +531,30 @@ def test_marshal_native_alignment_is_named_not_big_endian():
 
 
 def test_notebook_3_exercise_3_1_frame_is_not_the_printed_one():
-    """03 printed ``ImageFields(..., data_offset=52)`` for ``frame`` two cells above Exercise 3.1,
-    so ``fields.data_offset`` passed; the exercise now asks about a frame nothing prints."""
+    """03 printed ``data_offset=52`` (now "pixels from byte 52") for ``frame`` two cells above
+    Exercise 3.1, so that number passed; the exercise asks about a frame nothing prints."""
     from pathlib import Path
 
-    from rosfpga_lab import hw
+    from rosfpga_lab import tcpros
     from rosfpga_lab.checks import nbbuild
 
     path = Path(__file__).resolve().parents[2] / "notebooks" / "solutions" / "03_message_conversion.ipynb"
     cells = nbbuild.load(path)["cells"]
     source = next(nbbuild.cell_source(c) for c in cells if "check_data_offset(" in nbbuild.cell_source(c))
-    scope = {"hw": hw, "np": np}
+    reg = default_registry()
+
+    def image_frame(pixels, encoding, *, seq=0, frame_id=""):   # the notebook's, written again
+        rows, cols = pixels.shape[:2]
+        return tcpros.encode_frame(serialize(reg, "sensor_msgs/Image", {
+            "header": {"seq": seq, "stamp": {"secs": 0, "nsecs": 0}, "frame_id": frame_id},
+            "height": rows, "width": cols, "encoding": encoding, "is_bigendian": 0,
+            "step": pixels[0].size, "data": pixels.tobytes()}))
+
+    scope = {"image_frame": image_frame, "np": np}
     exec(source.split(nbbuild.BEGIN)[0], scope)                   # the exercise's set-up lines
-    printed_frame = hw.image_frame(np.zeros((3, 4, 4), np.uint8), "rgba8", frame_id="camera")
-    printed = hw.interpret_fast(printed_frame)[0].data_offset      # what cell 14 prints: 52
+    printed_body = image_frame(np.zeros((3, 4, 4), np.uint8), "rgba8", frame_id="camera")[4:]
+    data_at = next(s.offset for s in field_layout(reg, "sensor_msgs/Image", printed_body)
+                   if s.path == "data")                             # its uint32 length first
+    printed = 4 + data_at + 4                                       # what the notebook prints: 52
     assert "exercise_frame)" in source and printed == 52
     assert "not right yet" in problems_of(C.check_data_offset, printed, scope["exercise_frame"])

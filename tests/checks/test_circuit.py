@@ -1,4 +1,5 @@
-"""Notebook 8's checks: right answers pass, and each typical wrong answer gets its own diagnosis."""
+"""Notebook 8's checks: right answers pass, each typical wrong answer gets its own diagnosis, and
+the packer's clock model is the generated circuit's rfl_elem_pack, clock for clock."""
 
 from __future__ import annotations
 
@@ -9,12 +10,62 @@ import pytest
 
 from rosfpga_lab.checks import ExerciseError
 from rosfpga_lab.checks.circuit import (
-    BUG_SIGNAL, check_frame_clocks, check_ksize_rerun, check_planted_bug, planted_bug_arrays,
+    BUG_SIGNAL, check_frame_clocks, check_ksize_rerun, check_planted_bug, elem_pack_clocks,
+    model_frames, planted_bug_arrays,
 )
-from rosfpga_lab.hls import sample_image
-from rosfpga_lab.hw import image_frame
-from rosfpga_lab.rtl import rtl_params
-from rosfpga_lab.rtl.demo import demo_config
+from rosfpga_lab.hls.generic import spec_from_config
+from rosfpga_lab.rtl import build, run, simulator_missing_reason
+from rosfpga_lab.rtl.demo import DEMO_BP, DEMO_GAP, DEMO_SEED, demo_config, demo_frames
+from rosfpga_lab.rtl.sim import env_required
+from rosfpga_lab.rtl.vcd import read_vcd
+
+
+def _simulator_or_skip() -> None:
+    reason = simulator_missing_reason()
+    if reason is not None:
+        if env_required():
+            pytest.fail(f"ROSFPGA_REQUIRE_RTL is set but {reason}")
+        pytest.skip(reason)
+
+
+def test_elem_pack_clocks_is_the_generated_circuits_packer(tmp_path) -> None:
+    """The demo's two frames through the generated Image top (input gaps, 40 % backpressure):
+    fed the packer's own input handshakes and output ready, the clock model gives every
+    signal of rfl_elem_pack (nets pk_* in, axis_in_* out) on every clock of the good frame."""
+    _simulator_or_skip()
+    config = demo_config()
+    refused, good = demo_frames(config)
+    sim = build(spec_from_config(config), trace=True, cache=True)
+    run(sim, refused + good, gap=DEMO_GAP, bp=DEMO_BP, seed=DEMO_SEED, vcd=tmp_path / "d.vcd")
+    wave = read_vcd(tmp_path / "d.vcd", clock="clk")
+    offered, taken = wave.values("pk_tvalid").astype(bool), wave.values("pk_tready").astype(bool)
+    first = int(np.flatnonzero(offered)[0])
+    pixels = wave.values("pk_tdata")[offered & taken].astype(np.uint8)
+    assert pixels.tobytes() == good[-16 * 8 * 4:]          # the good frame's pixels, nothing else
+    sig = elem_pack_clocks(pixels, 16, 4, in_valid=offered[first:],
+                           out_ready=wave.values("axis_in_tready")[first:])
+    for net, port in (("pk_tready", "s_tready"), ("axis_in_tvalid", "m_axis_tvalid"),
+                      ("axis_in_tdata", "m_axis_tdata"), ("axis_in_tuser", "m_axis_tuser"),
+                      ("axis_in_tlast", "m_axis_tlast")):
+        rtl = wave.values(net)[first:].astype(np.uint64)
+        assert np.array_equal(rtl, sig[port]), (net, np.flatnonzero(rtl != sig[port])[:5])
+
+
+def test_model_frames_is_the_generated_circuits_output() -> None:
+    """The refused frame gets the width status; the good one the RTL's bytes (simulated here,
+    no model in the expectation) and its picture OpenCV's dilate."""
+    import cv2
+
+    config = demo_config()
+    refused, good = demo_frames(config)
+    spec = spec_from_config(config)
+    out, statuses = model_frames(spec, [refused, good])
+    assert statuses == ["SUB_BAD_WIDTH", "SUB_OK"]
+    picture = np.frombuffer(good[-16 * 8 * 4:], np.uint8).reshape(8, 16, 4)
+    dilated = cv2.dilate(picture, np.ones((3, 3), np.uint8))
+    assert out[-16 * 8 * 4:] == dilated.tobytes()
+    if simulator_missing_reason() is None:
+        assert run(build(spec, cache=True), refused + good).output == out
 
 
 def test_the_planted_bug_is_tlast_one_beat_late() -> None:
@@ -26,7 +77,7 @@ def test_the_planted_bug_is_tlast_one_beat_late() -> None:
 
 
 @pytest.mark.parametrize("signal,beat,says", [
-    ("m_axis_tuser", 0, "as fifo2axi makes it"),
+    ("m_axis_tuser", 0, "as rfl_elem_pack makes it"),
     ("m_axis_tlast", 4, "an earlier beat is already wrong"),
     ("m_axis_tlast", 1, "its TLAST is right"),
     ("s_tdata", 3, "the 8-bit side is fine"),
@@ -71,21 +122,20 @@ def test_frame_clocks_blank_answers() -> None:
             check_frame_clocks(129, blank, 513)
 
 
-def test_ksize_rerun_checks_the_parameters_and_reruns_the_circuit() -> None:
-    from rosfpga_lab.rtl import simulator_missing_reason
-
+def test_ksize_rerun_checks_the_spec_and_reruns_the_circuit() -> None:
     config = demo_config()
-    base = rtl_params(config)
-    good = image_frame(sample_image(config), config.image.encoding)
-    five = dataclasses.replace(base, KSIZE=5)
+    base = spec_from_config(config)
+    good = demo_frames(config)[1]
+    five = dataclasses.replace(base, ksize=5)
     text = str(check_ksize_rerun(five, base, good))
+    assert "KSIZE 3 -> 5" in text
     if simulator_missing_reason() is None:
         assert "equals the 5x5 model's" in text and "not re-run" not in text
     else:
         assert "not re-run here" in text
-    with pytest.raises(ExerciseError, match="KSIZE is 3"):
+    with pytest.raises(ExerciseError, match="ksize is 3"):
         check_ksize_rerun(base, base, good)
-    with pytest.raises(ExerciseError, match="these changed too: WIDTH"):
-        check_ksize_rerun(dataclasses.replace(five, WIDTH=17), base, good)
-    with pytest.raises(ExerciseError, match="must be the RtlParams"):
-        check_ksize_rerun({"KSIZE": 5}, base, good)
+    with pytest.raises(ExerciseError, match="these changed too: op"):
+        check_ksize_rerun(dataclasses.replace(five, op="erode"), base, good)
+    with pytest.raises(ExerciseError, match="must be the GenericSpec"):
+        check_ksize_rerun({"ksize": 5}, base, good)

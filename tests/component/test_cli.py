@@ -335,10 +335,17 @@ def test_camera_and_view_without_a_master_say_what_to_do(capsys) -> None:
     assert err.count(f"no ROS master answers at {uri}") == 2 and "rosfpga-lab master" in err
 
 
-def test_node_ros2_with_the_rtl_model_says_where_the_cdr_verilog_runs(
-        capsys: pytest.CaptureFixture[str]) -> None:
-    """It once served with the Python model while saying nothing; now it stops before any socket."""
-    config = Path(__file__).resolve().parents[2] / "data" / "fpga_dilate_rgba8.yaml"
-    assert main(["node", str(config), "--ros2", "--model", "rtl", "--duration", "1"]) == 1
+def test_node_ros2_with_the_rtl_model_and_no_verilog_says_why(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--ros2 --model rtl`` runs the generated CDR top (tests/component/test_ros2_rtl.py); an
+    application in the user's C++ has no Verilog: it stops before any socket, saying so."""
+    scan = Path(__file__).resolve().parents[2] / "data" / "fpga_laserscan_min_cdr.yaml"
+    text = scan.read_text().replace("application: {op: erode, ksize: 5}",
+                                    "application: {op: custom, source: mine.cpp}")
+    (tmp_path / "mine.cpp").write_text("// the user's application\n")
+    (tmp_path / "custom_scan.yaml").write_text(text)
+    assert main(["node", str(tmp_path / "custom_scan.yaml"), "--ros2", "--model", "rtl",
+                 "--duration", "1"]) == 1
     err = capsys.readouterr().err
-    assert "rosfpga-lab node: error:" in err and "make rtlsim" in err
+    assert "rosfpga-lab node: error:" in err and "(--model rtl)" in err, err
+    assert "custom_scan.yaml: application.op is custom" in err and "Traceback" not in err

@@ -37,7 +37,7 @@ def test_table_1_ratio_is_computed_not_written() -> None:
     assert "paper_verilog / table.total" not in code
     assert "verilog.total / table.total" in code and "paper_verilog / paper_hls" in code
     rtl_code = "\n".join("".join(c["source"]) for c in cells("08_rtl.ipynb") if c["cell_type"] == "code")
-    assert "verilog.total / hls.count_sloc(project).total" in rtl_code
+    assert "conventional.total / cpp.total" in rtl_code   # the hand-written exhibit over the generated C++
     assert "paper_verilog / paper_cpp" in rtl_code
 
 
@@ -149,9 +149,12 @@ def test_workshop_notebook_says_when_the_stop_button_is_there_and_explains_reset
     assert "live.close()" in code        # what the prose says the last cell does
 
 
-def test_notebook_08_shows_a_shipped_timing_report_that_meets_the_clock() -> None:
-    """Issue 21 item 4: notebook 08 shows the place-and-route report shipped in data/ (made by
-    data/make_timing_report.py) and says what its text claims about it."""
+def test_the_shipped_timing_report_meets_the_clock_and_notebook_08_says_how_to_make_one() -> None:
+    """Issue 21 item 4: the place-and-route report shipped in data/ (made by
+    data/make_timing_report.py) is what `rosfpga-lab rtl timing` prints and meets its clock.
+    Notebook 08 (issue 28: it steps through the generated circuit only) does not show it: it is
+    the hand-written exhibit's until the generated 640x480 top is placed and routed; the notebook
+    says how to place and route the generated project and what a critical path is."""
     from rosfpga_lab.config import load_config
     from rosfpga_lab.rtl.timing import (
         SHIPPED_CONFIG, SHIPPED_REPORT, format_timing, report_from_dict, shipped_report,
@@ -169,20 +172,12 @@ def test_notebook_08_shows_a_shipped_timing_report_that_meets_the_clock() -> Non
     assert text.rstrip("\n") == format_timing(report, title=f"Timing of data/{SHIPPED_CONFIG}")
     assert ": met (" in text
     assert shipped_report() == report
-    # what the notebook says of it
+    assert (ROOT / "data" / "make_timing_report.py").is_file()
+    # what the notebook says
     text08 = markdown("08_rtl.ipynb")
     code08 = "\n".join("".join(c["source"]) for c in cells("08_rtl.ipynb")
                        if c["cell_type"] == "code")
-    assert "rosfpga-lab rtl timing data/fpga_dilate_rgba8.yaml" in text08
-    assert f"data/{SHIPPED_REPORT}" in text08 and "shipped_report()" in code08
-    assert (ROOT / "data" / "make_timing_report.py").is_file()
-    routing = sum(s.delay_ns for s in report.path if s.kind == "routing")
-    assert "Most of\nits delay is routing" in text08 and routing > report.path_ns / 2
-    # the path's ends: the subscriber's byte counter and its state register, as the notebook
-    # says (the handshakes between the FIFOs and rfl_morph were the path before the RTL's
-    # simulation-speed rewrite of issue 21; the notebook says they are shorter)
-    assert report.path[0].source.startswith("u_top.u_subscriber.cnt")
-    assert report.path[-1].sink.startswith("u_top.u_subscriber.state")
-    assert all(s.source.startswith("u_top.u_subscriber.") for s in report.path)
-    assert "from its byte counter `cnt` to its state register" in text08.replace("\n", " ")
-    assert "valid/ready handshake" in text08 and "`rfl_morph`" in text08
+    assert "rosfpga-lab rtl timing CONFIG" in text08 and "place_and_route_dir" in code08
+    assert "shipped_report()" not in code08
+    assert "Most of\nits delay is routing" in text08
+    assert "valid/ready handshake" in text08

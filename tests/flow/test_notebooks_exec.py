@@ -117,7 +117,8 @@ def check_claims(stem: str, nb: nbformat.NotebookNode) -> None:
         assert re.search(r"tlast lost on line 60.*?in x \d+\.\.\d+, y 61\.\.119", html, re.S), \
             "the lost-TLAST frame is not compared with what AXIvideo2Mat should have made"
     if stem == "05_application":
-        payload = 640 * 480 * 4 + 4 + 4 + 8 + 4 + 4 + 4 + 4 + len("rgba8") + 1 + 4 + 4  # frame of the table
+        # the table's frame: the layout's example message (frame_id its own field name)
+        payload = 640 * 480 * 4 + 4 + 4 + 8 + 4 + len("frame_id") + 4 + 4 + 4 + len("rgba8") + 1 + 4 + 4
         segments = -(-payload // 1448)
         wire_ms = 8 * (payload + 90 * segments) / 1e9 * 1e3
         assert re.search(rf"640x480 rgba8\s+{payload:,}\s+\S+\s+{8 * payload / 1e6:.2f}\s+{wire_ms:.2f}", text), \
@@ -125,11 +126,11 @@ def check_claims(stem: str, nb: nbformat.NotebookNode) -> None:
     if stem == "11_ros2_live":
         check_ros2_live(text, html, cyclone=cyclone_imports())
     if stem == "06_design_flow":
-        table = re.search(r"total\s+(\d+)\s+127\s+860", text)
+        table = re.search(r"total\s+(\d+)\s+(\d+)\s+127\s+860", text)
         assert table, text[-1500:]
-        total = int(table[1])
-        from rosfpga_lab.rtl.sloc import count_verilog
-        lab_verilog = count_verilog().total     # like for like: the lab's Verilog over its C++
+        total, lab_verilog = int(table[1]), int(table[2])
+        # like for like: the generated Verilog of the same circuit over the generated C++
+        assert lab_verilog == generated_verilog_lines("fpga_dilate_rgba8.yaml")
         assert f"{lab_verilog} / {total} = {lab_verilog / total:.1f}x" in text
         assert "860 / 127 = 6.8x" in text and f"860 / {total} =" not in text
         assert "((0, 'SUB_OK'),)" not in text
@@ -140,6 +141,21 @@ def check_claims(stem: str, nb: nbformat.NotebookNode) -> None:
         check_own_message(text, html)
     if stem == "01_xmlrpc_handshake":
         check_handshake_claims(nb, ros_logging=False)
+
+
+def generated_verilog_lines(config_name: str) -> int:
+    """Table 1's Verilog total of the generated project of ``data/CONFIG`` (its ``rtl/``)."""
+    import tempfile
+
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.hls.generic import spec_from_config
+    from rosfpga_lab.rtl.generic import generic_rtl_files
+    from rosfpga_lab.rtl.sloc import count_verilog
+
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, data in generic_rtl_files(spec_from_config(load_config(ROOT / "data" / config_name))).items():
+            (Path(tmp) / name).write_bytes(data)
+        return count_verilog(tmp).total
 
 
 def check_handshake_claims(nb: nbformat.NotebookNode, ros_logging: bool) -> None:
@@ -238,10 +254,18 @@ def check_ros2_live(text: str, html: str, cyclone: bool) -> None:
     assert "and the same as the live run's first output: True" in text
     sample = 4 + 4 + 4 + 4 + len("camera") + 1 + 1 + 4 + 4 + 4 + len("rgba8") + 1 + 1 + 1 + 4 + 4 + 64 * 48 * 4
     assert f"{3 * sample:,} bytes of samples went through the circuit" in text, text[-600:]
-    # the applications' clocks in their own units (by hand: 64 x 48 pixels; 64 x 48 x 4 bytes
+    # the subscribers' clocks (by hand: the TCPROS frame is its 4-byte length, seq, stamp,
+    # frame_id "camera", height, width, "rgba8", is_bigendian, step and the data's length and
+    # bytes; the generated walker takes at most a byte per clock; the CDR model reads the sample
+    # and its 4-byte length a byte per clock), the CDR application's (64 x 48 x 4 bytes
     # + ksize // 2 = 1), and whether the run cut samples into DATA_FRAG, as counted
-    assert re.search(r"ROS 1 dilate [\d,]+ clocks for 3,072 pixels; ROS 2 application 12,289 "
-                     r"clocks for 12,288 bytes", text), text[-1500:]
+    frame = 4 + 4 + 8 + 4 + len("camera") + 4 + 4 + 4 + len("rgba8") + 1 + 4 + 4 + 64 * 48 * 4
+    clocks = re.search(r"the subscriber in each: ROS 1 ([\d,]+) clocks for ([\d,]+) bytes; ROS 2 "
+                       r"([\d,]+) clocks for ([\d,]+) bytes; ROS 2 application 12,289 clocks for "
+                       r"12,288 bytes", text)
+    assert clocks, text[-1500:]
+    ros1, ros1_bytes, ros2, ros2_bytes = (int(v.replace(",", "")) for v in clocks.groups())
+    assert ros1_bytes == frame and ros1 >= frame and ros2 == ros2_bytes == sample + 4
     frag_line = re.search(r"user samples received whole in one DATA: (\d+); DATA_FRAG fragments "
                           r"received: (\d+)", text)
     assert frag_line and int(frag_line[1]) + int(frag_line[2]) >= 3, text[-800:]
