@@ -19,6 +19,8 @@ from rosfpga_lab.rtl.errors import RtlError
 
 #: The exhibit's folder (the hand-written Image circuit); its shared modules are ``verilog/``'s.
 EXHIBIT_DIR = Path(__file__).resolve().parent / "exhibit"
+#: What a count of the default folder is, in words (``rosfpga-lab sloc`` without a project's RTL).
+DEFAULT_SOURCE = "the lab's exhibit, rosfpga_lab/rtl/exhibit"
 
 #: The exhibit's Verilog files counted as the subscriber and the publisher (Table 1).
 COUNTED = {"subscriber": ("rfl_subscriber.v", "rfl_fifo2axi.v"),
