@@ -84,7 +84,7 @@ STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "pub
            "axis_out")
 
 
-def design_from_config(config: NodeConfig) -> Design:
+def design_from_config(config: NodeConfig) -> GenericSpec:
     """The circuit a configuration simulates: the generated top of every type and wire,
     ``sensor_msgs/Image`` included (:func:`rosfpga_lab.hls.generic.spec_from_config`, what
     ``rosfpga-lab generate`` renders; Image on TCPROS streams its frames through with early
