@@ -76,7 +76,7 @@ Progress = Callable[[str], None]
 
 @dataclass(frozen=True)
 class SynthRow:
-    """Resources of one module of :data:`MODULES` (all its instances together).
+    """Resources of one module of :data:`GENERIC_MODULES` (all its instances together).
 
     Attributes:
         name: the row's name.
@@ -98,7 +98,7 @@ class SynthReport:
     """What :func:`synthesize` found.
 
     Attributes:
-        rows: one per module of :data:`MODULES` present in the node, in that order.
+        rows: one per module of :data:`GENERIC_MODULES` present in the node, in that order.
         total: the whole node (the sum of the rows).
         part: the FPGA part, and ``family`` the ``synth_xilinx -family`` used.
         yosys: the Yosys version line.

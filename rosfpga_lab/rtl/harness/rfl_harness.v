@@ -52,13 +52,21 @@ module rfl_harness (
         dut.u_top.pix_in_tvalid && dut.u_top.pix_in_tready,
         dut.u_top.rx_tvalid && dut.u_top.rx_tready
     };
+    // Each field at its place in the 38 bits: a generated top's beat is one element, its
+    // TDATA and TKEEP as narrow as the element (a mono8 pixel: 8 and 1 bits), so they are
+    // zero-extended to 32 and 4 bits first (as the testbench prints them), not concatenated
+    // at their own widths.
+    wire [31:0] in_tdata = dut.u_top.axis_in_tdata;
+    wire [3:0]  in_tkeep = dut.u_top.axis_in_tkeep;
+    wire [31:0] out_tdata = dut.u_top.app_out_tdata;
+    wire [3:0]  out_tkeep = dut.u_top.app_out_tkeep;
     // Held from the clock of each beat's handshake: the C++ reads a beat after that clock's
     // edge, and the model assembles the 38 bits once per beat, not every clock.
     always @(posedge clk) begin
-        if (hs[2]) beat_in <= {dut.u_top.axis_in_tlast, dut.u_top.axis_in_tuser,
-                               dut.u_top.axis_in_tkeep, dut.u_top.axis_in_tdata};
-        if (hs[4]) beat_out <= {dut.u_top.app_out_tlast, dut.u_top.app_out_tuser,
-                                dut.u_top.app_out_tkeep, dut.u_top.app_out_tdata};
+        if (hs[2]) beat_in <= {dut.u_top.axis_in_tlast, dut.u_top.axis_in_tuser, in_tkeep,
+                               in_tdata};
+        if (hs[4]) beat_out <= {dut.u_top.app_out_tlast, dut.u_top.app_out_tuser, out_tkeep,
+                                out_tdata};
     end
 endmodule
 
