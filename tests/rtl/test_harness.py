@@ -1,4 +1,5 @@
-"""The fast C++ harness (``rosfpga_lab/rtl/harness``) against today's Verilog testbench.
+"""The fast C++ harness (``rosfpga_lab/rtl/harness``) against today's Verilog testbench, both
+running the generated top of Image configurations (``design_from_config``).
 
 The harness does on Verilator, without ``--timing``, what ``rtl/tb/rfl_tb.v`` does; here both
 run the same frames with the same seed, gaps and backpressure, and must give the same output
@@ -73,7 +74,8 @@ def test_harness_equals_the_testbench(encoding: str, gap: int, bp: int, tmp_path
     expected, verdicts = model_output(config, frames)
     assert fast.output == expected
     assert [s if s == "SUB_OK" else "refused" for _, s in fast.status] == verdicts
-    assert [s for _, s in fast.status] == names
+    # (the walk names its refusals after the layout's fields, not ``names``: the same frames)
+    assert [s == "SUB_OK" for _, s in fast.status] == [n == "SUB_OK" for n in names]
     assert fast.cycles > 0 and fast.input_beats is not None and len(fast.input_beats) > 0
     if encoding == "rgba8":   # and when the input ends inside a frame (the circuit waits)
         cut = data + frames[0][: len(frames[0]) // 2]
