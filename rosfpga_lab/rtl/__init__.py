@@ -47,7 +47,7 @@ output backpressure (``BP``, per mille of clocks) and writes ``output.bin``, ``s
 clock for clock the same (built by ``rosfpga_lab/hls/rtlbuild.py``); Icarus Verilog is the slow fallback;
 ``SIM=`` picks one and builds are cached (module ``sim``). Speeds are measured, never asserted:
 ``tests/benchmarks/bench_rtl.py``. Without a simulator the RTL tests skip; with
-``ROSFPGA_REQUIRE_RTL=1`` (CI) they fail. ``hw.cycles`` is held to the RTL (module ``cycles``).
+``ROSFPGA_REQUIRE_RTL=1`` (CI) they fail. The walk's cycle model (``hls.program.frame_clocks``) is held to the RTL (module ``cycles``).
 The live node on the RTL (``--model rtl``, ``FpgaComponent(config, model="rtl")``, on ROS 2
 ``Ros2Component(config, model="rtl")``): one long-lived simulator, module ``server``; ``--timing fpga`` holds each output until the circuit's
 clocks have passed at ``clock_mhz``. Formal proofs of the stream handshakes (``formal/``, run by
