@@ -103,7 +103,7 @@ def _imports(tree: ast.AST) -> list[str]:
             names += [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom):
             names.append("." * node.level + (node.module or ""))
-            names += [f"{node.module}.{a.name}" for a in node.names if node.module]
+            names += [f"{node.module or ''}.{a.name}" for a in node.names]
     return names
 
 
