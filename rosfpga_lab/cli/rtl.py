@@ -145,7 +145,7 @@ def _register_prove(subparsers: argparse._SubParsersAction) -> None:
     )
     prove.add_argument("config", type=Path, nargs="?", metavar="CONFIG",
                        help="a node configuration (YAML): its generated top, any type on "
-                       "either wire (the hand-written Image modules are proven without CONFIG)")
+                       "either wire (without CONFIG: the lab's modules on small parameters)")
     prove.add_argument("--only", metavar="NAME", action="append",
                        help="without CONFIG: only this check, e.g. fifo or morph (repeatable; a "
                        "name that is not a check lists the checks)")

@@ -24,14 +24,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Print the table."""
     from rosfpga_lab.hls import count_sloc, format_table
-    from rosfpga_lab.rtl.sloc import count_verilog
+    from rosfpga_lab.rtl.sloc import DEFAULT_SOURCE, count_verilog
 
     hls = count_sloc(args.directory)
     rtl_dir = args.directory / "rtl"
     if rtl_dir.is_dir():
         verilog, source = count_verilog(rtl_dir), str(rtl_dir)
     else:
-        verilog, source = count_verilog(), "the lab's rosfpga_lab/rtl/verilog"
+        verilog, source = count_verilog(), DEFAULT_SOURCE
     print(format_table(hls, title=f"Source lines of {args.directory} (Verilog: {source})",
                        verilog=verilog))
     return 0

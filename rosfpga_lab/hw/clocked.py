@@ -1,7 +1,7 @@
 """Clock-by-clock model of ``fifo2axi``: the byte stream and the beat stream with valid/ready.
 
 The other models move whole bytes and beats; this one says *when*. It follows the RTL
-(``rosfpga_lab/rtl/verilog/rfl_fifo2axi.v``) register for register, so its per-clock arrays
+(``rosfpga_lab/rtl/exhibit/rfl_fifo2axi.v``) register for register, so its per-clock arrays
 are what a simulator's dump shows at every rising edge of ``aclk``:
 
 * one byte is taken from the 8-bit stream per clock when ``s_tvalid`` and ``s_tready`` are

@@ -3,15 +3,16 @@
 Every configuration, ``sensor_msgs/Image`` on TCPROS included, simulates, counts, synthesizes,
 times, proves and serves the generated top of :mod:`rosfpga_lab.rtl.generic` (walkers stepping
 through a generated program, one instruction per field of the message):
-``build(design_from_config(config))``. The hand-written Verilog (``verilog/``, module prefix
-``rfl_``), the exhibit beside Table 1, is the paper's conventional design of the
-same circuit the HLS C++ describes: ``rfl_subscriber`` (TCPROS frame in, fields checked, pixel
-bytes out), ``rfl_fifo2axi`` (Figure 7), the application ``rfl_morph``, ``rfl_axi2fifo``,
-``rfl_publisher`` (TCPROS frame out) and ``rfl_fifo``, joined by ``rfl_top``. Its parameters come
-from the node configuration (:func:`rtl_params`); :func:`build` and :func:`run` simulate either
-circuit with Icarus Verilog or Verilator through the file-based testbench ``tb/rfl_tb.v``::
+``build(design_from_config(config))``, with Icarus Verilog or Verilator through the file-based
+testbench ``tb/rfl_tb.v`` (the lab's shared modules ``rfl_fifo``, ``rfl_slice`` and the video
+application ``rfl_morph`` are in ``verilog/``). The hand-written Image circuit (``exhibit/``:
+``rfl_subscriber``, ``rfl_fifo2axi``, ``rfl_axi2fifo``, ``rfl_publisher``, ``rfl_top``) is kept as
+the paper's conventional design of Table 1, beside the generated one; nothing here imports it
+(``exhibit/README.md``; ``tests/rtl/test_exhibit.py`` holds it equal to the generated Image
+circuit)::
 
-    from rosfpga_lab.rtl import build, load_config, run
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.rtl import build, run
     from rosfpga_lab.rtl.sim import design_from_config
     sim = build(design_from_config(load_config("data/fpga_dilate_rgba8.yaml")))
     result = run(sim, frames, gap=100, bp=500)   # result.output: the frames sent
@@ -19,9 +20,8 @@ circuit with Icarus Verilog or Verilator through the file-based testbench ``tb/r
 :mod:`rosfpga_lab.rtl.vcd` reads waveform dumps into per-clock arrays,
 :mod:`rosfpga_lab.rtl.synth` synthesizes the modules with Yosys,
 :mod:`rosfpga_lab.rtl.timing` places and routes them with nextpnr-ecp5 (Fmax against the clock) and
-:mod:`rosfpga_lab.rtl.sloc` counts their lines for the paper's Table 1. ``build(rtl_params(config))`` builds
-the hand circuit of an Image configuration (its tests and the benchmark set it beside the
-generated top).
+:mod:`rosfpga_lab.rtl.sloc` counts the lines of a generated project's and of the exhibit's for the
+paper's Table 1.
 
 The ROS 2 node in the fabric (issue #31) announces itself from a ROM built at build time:
 :mod:`rosfpga_lab.rtl.discrom` renders the software participant's SPDP, SEDP and
@@ -51,7 +51,7 @@ output backpressure (``BP``, per mille of clocks) and writes ``output.bin``, ``s
 clock for clock the same (built by ``rosfpga_lab/hls/rtlbuild.py``); Icarus Verilog is the slow fallback;
 ``SIM=`` picks one and builds are cached (module ``sim``). Speeds are measured, never asserted:
 ``tests/benchmarks/bench_rtl.py``. Without a simulator the RTL tests skip; with
-``ROSFPGA_REQUIRE_RTL=1`` (CI) they fail. ``hw.cycles`` is held to the RTL (module ``cycles``).
+``ROSFPGA_REQUIRE_RTL=1`` (CI) they fail. The walk's cycle model (``hls.program.frame_clocks``) is held to the RTL (module ``cycles``).
 The live node on the RTL (``--model rtl``, ``FpgaComponent(config, model="rtl")``, on ROS 2
 ``Ros2Component(config, model="rtl")``): one long-lived simulator, module ``server``; ``--timing fpga`` holds each output until the circuit's
 clocks have passed at ``clock_mhz``. Formal proofs of the stream handshakes (``formal/``, run by
@@ -84,16 +84,14 @@ streams, one payload per packet, and drops and counts what LiteEth flags late (p
 """
 
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
-from rosfpga_lab.rtl.params import OP_CODES, RtlParams, load_config, node_wrapper, rtl_params, status_header
 from rosfpga_lab.config.vocabulary import SIMULATORS
 from rosfpga_lab.rtl.sim import (
-    STREAMS, Design, RtlBuild, RtlResult, StreamTiming, build, design_from_config,
+    STREAMS, Design, OwnSources, RtlBuild, RtlResult, StreamTiming, build, design_from_config,
     find_simulator, run, simulator_missing_reason, verilog_sources, write_sources,
 )
 
 __all__ = [
-    "OP_CODES", "SIMULATORS", "STREAMS", "Design", "RtlBuild", "RtlError", "RtlParams",
-    "RtlResult", "SimulatorMissingError", "StreamTiming", "build", "design_from_config",
-    "find_simulator", "load_config", "node_wrapper", "rtl_params", "run",
-    "simulator_missing_reason", "status_header", "verilog_sources", "write_sources",
+    "SIMULATORS", "STREAMS", "Design", "OwnSources", "RtlBuild", "RtlError", "RtlResult",
+    "SimulatorMissingError", "StreamTiming", "build", "design_from_config", "find_simulator",
+    "run", "simulator_missing_reason", "verilog_sources", "write_sources",
 ]

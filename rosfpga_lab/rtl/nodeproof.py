@@ -19,9 +19,8 @@ top with more memory than ``rtl.limits.FORMAL_MAX_MEMORY_BITS`` is refused befor
 
 Every configuration's generated top, ``sensor_msgs/Image`` on TCPROS included (with streaming
 early release its FIFO after the application holds a few beats, so its 640x480 examples are under
-the memory limit; on CDR a whole stream, over it: prove a smaller image); the hand-written Image
-circuit's modules and top are what ``rtl prove`` without a configuration proves
-(:mod:`rosfpga_lab.rtl.proofs`).
+the memory limit; on CDR a whole stream, over it: prove a smaller image); ``rtl prove`` without a
+configuration proves the lab's modules on small parameters (:mod:`rosfpga_lab.rtl.proofs`).
 """
 
 from __future__ import annotations
@@ -49,7 +48,7 @@ from rosfpga_lab.rtl.proofs import (
     ENV_INCLUDE, FORMAL_DIR, Proof, ProofResult, formal_missing_reason, run_sby, sby_command,
 )
 from rosfpga_lab.rtl.limits import FORMAL_MAX_MEMORY_BITS
-from rosfpga_lab.rtl.sim import NODE_FILE, VERILOG_DIR, find_tool
+from rosfpga_lab.rtl.sim import NODE_FILE, find_tool
 
 #: The streams inside ``rfl_gtop`` the proof watches: its wire prefix, in data-path order,
 #: whether it is AXI4-Stream (TKEEP, TUSER, TLAST beside TDATA) or bytes, and whether the
@@ -160,7 +159,7 @@ def node_sby_text(spec: GenericSpec, mode: str = "prove", depth: int = NODE_PROO
         for sig in ("tvalid", "tready", "tdata", *(("tkeep", "tuser", "tlast") if axis else ())):
             lines.append(f"connect -set fv_{stream}_{sig} {GTOP_PATH}.{stream}_{sig}")
     lines += ["cd ..", "memory_map", "opt -fast", "", "[files]", *design, WRAPPER,
-              LAYOUT_INCLUDE, str(FORMAL_DIR / ENV_INCLUDE), str(VERILOG_DIR / "rfl_status.vh"),
+              LAYOUT_INCLUDE, str(FORMAL_DIR / ENV_INCLUDE),
               ""]
     return "\n".join(lines)
 

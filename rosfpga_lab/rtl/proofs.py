@@ -1,6 +1,6 @@
 """Formal proofs of the stream handshakes: SymbiYosys (``sby``) on property wrappers.
 
-How this works: every module of ``verilog/`` has a wrapper in ``formal/fv_<name>.sv`` that
+How this works: every module of ``verilog/``, ``generic/`` and ``fabric/`` has a wrapper in ``formal/fv_<name>.sv`` that
 instantiates it with small parameters, constrains its inputs to the stream rules (``assume``:
 a valid beat stays valid and unchanged until taken) and asserts on its ports only what it must
 guarantee: its outputs keep the same rules, TUSER/TLAST only where they belong, nothing lost,
@@ -57,6 +57,8 @@ class Proof:
         layout: the design includes the generated walk ``rfl_layout.vh``: prove against the one
             of :func:`formal_program` (a small message type; with the define ``FV_WHOLE`` its
             walk without streaming early release).
+        home: a folder of its own holding the wrapper, design files found there first and its
+            ``*.vh`` includes (the exhibit's proofs, run from its test); None: the lab's folders.
     """
 
     name: str
@@ -66,6 +68,7 @@ class Proof:
     claim: str
     defines: tuple[str, ...] = ()
     layout: bool = False
+    home: Path | None = None
 
 
 #: Every check, every module of the circuit at least once. Inputs are assumed to keep the stream
@@ -78,16 +81,6 @@ PROOFS: tuple[Proof, ...] = (
     Proof("fifo", ("rfl_fifo.v",), "bmc", 12,
           "rfl_fifo (depth 4): the n-th beat out is the n-th beat in (no beat lost, "
           "duplicated or reordered), any n, 12 clocks"),
-    Proof("fifo2axi", ("rfl_fifo2axi.v",), "prove", 10,
-          "rfl_fifo2axi (3x2, 2 bytes/pixel): output stream rules; all reachable states",
-          ("FV_PROVE",)),
-    Proof("fifo2axi", ("rfl_fifo2axi.v",), "bmc", 20,
-          "rfl_fifo2axi (3x2, 2 bytes/pixel): TUSER on a frame's first pixel only, TLAST on a "
-          "line's last pixel only, TKEEP, each beat = the bytes taken; 20 clocks"),
-    Proof("axi2fifo", ("rfl_axi2fifo.v",), "prove", 8,
-          "rfl_axi2fifo: output stream rules; all reachable states", ("FV_PROVE",)),
-    Proof("axi2fifo", ("rfl_axi2fifo.v",), "bmc", 12,
-          "rfl_axi2fifo: one byte per kept lane in lane order, no beat overwritten; 12 clocks"),
     Proof("slice", ("rfl_slice.v",), "prove", 8,
           "rfl_slice (register slice): output stream rules, at most two words held, ready "
           "while fewer, a word held is offered; all reachable states", ("FV_PROVE",)),
@@ -100,18 +93,6 @@ PROOFS: tuple[Proof, ...] = (
     Proof("morph", ("rfl_morph.v",), "bmc", 24,
           "rfl_morph (3x2, 3x3 dilate): TUSER/TLAST on the output where they belong, no "
           "framing flag on a clean stream; 24 clocks (two 3x2 frames at full rate)"),
-    Proof("subscriber", ("rfl_subscriber.v",), "prove", 8,
-          "rfl_subscriber (any input bytes): pixel stream rules, status codes of the table; "
-          "all reachable states"),
-    # bounded: the publisher's place in the frame is not visible on its ports (the whole
-    # rfl_top below closes by induction instead); the wrapper reads frame_id from a RAM of any
-    # fixed contents with a clock, as rfl_top does
-    Proof("publisher", ("rfl_publisher.v",), "bmc", 32,
-          "rfl_publisher (2x1 mono8): output stream rules, releases only fields it holds; 32 "
-          "clocks (through the header and frame_id)"),
-    Proof("top", tuple(p.name for p in sorted(VERILOG_DIR.glob("*.v"))), "prove", 8,
-          "rfl_top (2x1 mono8, FIFOs 4 deep, any input bytes): output stream rules, busy while "
-          "output is pending; all reachable states"),
     # the generic element-stream modules (generic/)
     Proof("elem_pack", ("rfl_elem_pack.v",), "prove", 8,
           "rfl_elem_pack (2-byte elements, arrays of 3): output stream rules, TKEEP; all "
@@ -299,9 +280,11 @@ def sby_command() -> list[str]:
     return [find_tool("sby") or "sby"]
 
 
-def design_path(name: str) -> Path:
-    """Where the design file ``name`` of a :class:`Proof` lives (``generic/``, ``fabric/`` or
-    ``verilog/``)."""
+def design_path(name: str, home: Path | None = None) -> Path:
+    """Where the design file ``name`` of a :class:`Proof` lives (its ``home``, ``generic/``,
+    ``fabric/`` or ``verilog/``)."""
+    if home is not None and (home / name).is_file():
+        return home / name
     if name in FABRIC_MODULES:
         return FABRIC_DIR / name
     return (GENERIC_VERILOG_DIR if name in GENERIC_MODULES else VERILOG_DIR) / name
@@ -311,14 +294,15 @@ def sby_text(proof: Proof, design_files: Sequence[Path], includes: Sequence[Path
     """The ``.sby`` file of ``proof`` over ``design_files`` (``includes``: more included files,
     such as a generated ``rfl_layout.vh``)."""
     defines = " ".join(f"-D{d}" for d in proof.defines)
-    wrapper = FORMAL_DIR / f"fv_{proof.name}.sv"
+    wrapper = (proof.home or FORMAL_DIR) / f"fv_{proof.name}.sv"
     lines = ["[options]", f"mode {proof.mode}", f"depth {proof.depth}", "",
              "[engines]", "smtbmc yices", "", "[script]"]
     lines += [f"read_verilog -formal {p.name}" for p in design_files]
     lines += [f"read_verilog -formal -sv {defines} {wrapper.name}".replace("  ", " "),
               f"prep -top fv_{proof.name}", "memory_map", "opt -fast", "", "[files]"]
     lines += [str(p) for p in design_files]
-    lines += [str(wrapper), str(FORMAL_DIR / ENV_INCLUDE), str(VERILOG_DIR / "rfl_status.vh")]
+    lines += [str(wrapper), str(FORMAL_DIR / ENV_INCLUDE)]
+    lines += [str(p) for p in sorted(proof.home.glob("*.vh"))] if proof.home else []
     lines += [str(p) for p in includes]
     lines.append("")
     return "\n".join(lines)
@@ -338,7 +322,7 @@ def prove(proof: Proof, *, work_dir: str | Path | None = None,
         RtlError: the tools are missing or SymbiYosys could not run.
     """
     replace = replace or {}
-    design = [replace.get(name, design_path(name)) for name in proof.design]
+    design = [replace.get(name, design_path(name, proof.home)) for name in proof.design]
     with tempfile.TemporaryDirectory(prefix="rosfpga-formal-") as tmp:
         work = Path(work_dir) if work_dir else Path(tmp)
         work.mkdir(parents=True, exist_ok=True)

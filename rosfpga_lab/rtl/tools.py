@@ -1,6 +1,6 @@
 """Where the lab's Verilog lives and which simulation tools this machine has.
 
-The lowest part of :mod:`rosfpga_lab.rtl`: the folders of the hand circuit, its testbench and
+The lowest part of :mod:`rosfpga_lab.rtl`: the folders of the lab's shared Verilog, the testbench and
 the fast harness, and the lookup of Icarus Verilog, Verilator and a C++ compiler (on ``PATH`` or
 beside the lab's Python). :mod:`rosfpga_lab.rtl.sim` and :mod:`rosfpga_lab.rtl.generic` both
 stand on it, so neither imports the other to find a tool.

@@ -4,7 +4,8 @@
   the generated top (``rfl_gtop``: walkers, element packer, rfl_morph, FIFOs; the frame streams
   through with early release), with every output byte compared to the Python models'. Target:
   under 10 s of simulation on this 2-core machine. Beside it, while the lab keeps it, the
-  hand-written Image circuit (``rfl_top``, the exhibit beside Table 1) on the same frame.
+  hand-written Image circuit (``rtl/exhibit/``: ``rfl_top``, Table 1's conventional design) on
+  the same frame.
 * simulated clocks per second, per simulator installed (Icarus Verilog is timed on a
   160x120 ``rgb8`` frame unless --full-icarus: it is far slower than Verilator). On Verilator,
   the Verilog testbench (``verilator --binary --timing``) and the fast C++ harness side by side,
@@ -36,7 +37,8 @@ from pathlib import Path
 
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hls import sample_frames
-from rosfpga_lab.rtl import build, rtl_params, run, simulator_missing_reason
+from rosfpga_lab.rtl import build, run, simulator_missing_reason
+from rosfpga_lab.rtl.exhibit.params import rtl_params  # the exhibit, timed beside the engine
 from rosfpga_lab.rtl.project import model_output
 from rosfpga_lab.rtl.sim import RtlResult, design_from_config
 

@@ -304,17 +304,16 @@ def test_generated_image_cdr_verilog_is_lint_clean(name: str, projects: dict[str
     assert_rtl_lint_clean(projects[name] / "rtl")
 
 
-def test_the_tcpros_image_circuits_tools_refuse_a_cdr_configuration() -> None:
-    """rtl sim/cycles/synth/timing and --model rtl build the TCPROS Image circuit from
-    ``rtl_params``; for the shipped CDR configuration that would be the wrong circuit, so it is
-    refused with where the CDR circuit's Verilog is."""
+def test_the_rtl_tools_build_the_cdr_image_circuit() -> None:
+    """rtl sim/cycles/synth/timing and --model rtl build a configuration's generated top
+    (``design_from_config``): for the shipped CDR Image configuration, its CDR video circuit."""
     from rosfpga_lab.config import load_config
-    from rosfpga_lab.rtl import rtl_params
-    from rosfpga_lab.rtl.errors import RtlError
+    from rosfpga_lab.hls.generic import GenericSpec
+    from rosfpga_lab.rtl import design_from_config
 
-    with pytest.raises(RtlError, match="wire: cdr.*rosfpga-lab generate CONFIG -o DIR"):
-        rtl_params(load_config(DATA / SHIPPED))
-    assert rtl_params(load_config(DATA / "fpga_dilate_rgba8.yaml")).WIDTH == 640
+    spec = design_from_config(load_config(DATA / SHIPPED))
+    assert isinstance(spec, GenericSpec)
+    assert spec.wire == "cdr" and spec.video is not None and spec.video.width == 640
 
 
 def test_make_synth_reports_every_module_of_the_video_project(projects: dict[str, Path]) -> None:

@@ -1,4 +1,5 @@
-"""The fast C++ harness (``rosfpga_lab/rtl/harness``) against today's Verilog testbench.
+"""The fast C++ harness (``rosfpga_lab/rtl/harness``) against today's Verilog testbench, both
+running the generated top of Image configurations (``design_from_config``).
 
 The harness does on Verilator, without ``--timing``, what ``rtl/tb/rfl_tb.v`` does; here both
 run the same frames with the same seed, gaps and backpressure, and must give the same output
@@ -22,7 +23,7 @@ from pathlib import Path
 import pytest
 
 from tests.support.realros import require_rtl
-from rosfpga_lab.rtl import RtlError, build, rtl_params, run
+from rosfpga_lab.rtl import RtlError, build, design_from_config, run
 from rosfpga_lab.hw import image_frame
 from rosfpga_lab.rtl.project import generate_project
 from rosfpga_lab.rtl.sim import EVAL_MODES, RtlBuild, RtlResult, harness_command, nba_only
@@ -64,8 +65,8 @@ def test_harness_equals_the_testbench(encoding: str, gap: int, bp: int, tmp_path
         config = small_config(encoding)
         frames, names = mixed_frames(config)
     data = b"".join(frames)
-    fast_build = build(rtl_params(config), tmp_path / "fast", simulator="verilator")
-    tb_build = build(rtl_params(config), tmp_path / "tb", simulator="iverilog")
+    fast_build = build(design_from_config(config), tmp_path / "fast", simulator="verilator")
+    tb_build = build(design_from_config(config), tmp_path / "tb", simulator="iverilog")
     assert fast_build.harness and not tb_build.harness
     fast = run(fast_build, data, seed=29, gap=gap, bp=bp, beats=True)
     tb = run(tb_build, data, seed=29, gap=gap, bp=bp, beats=True)
@@ -73,7 +74,8 @@ def test_harness_equals_the_testbench(encoding: str, gap: int, bp: int, tmp_path
     expected, verdicts = model_output(config, frames)
     assert fast.output == expected
     assert [s if s == "SUB_OK" else "refused" for _, s in fast.status] == verdicts
-    assert [s for _, s in fast.status] == names
+    # (the walk names its refusals after the layout's fields, not ``names``: the same frames)
+    assert [s == "SUB_OK" for _, s in fast.status] == [n == "SUB_OK" for n in names]
     assert fast.cycles > 0 and fast.input_beats is not None and len(fast.input_beats) > 0
     if encoding == "rgba8":   # and when the input ends inside a frame (the circuit waits)
         cut = data + frames[0][: len(frames[0]) // 2]
@@ -307,13 +309,13 @@ def test_harness_refuses_testbench_only_options(tmp_path: Path) -> None:
     require_rtl("verilator")
     config = small_config("mono8")
     # the options are checked before anything runs: a build that was never compiled will do
-    sim = RtlBuild("verilator", ("false",), tmp_path, rtl_params(config), 0.0, False, True)
+    sim = RtlBuild("verilator", ("false",), tmp_path, design_from_config(config), 0.0, False, True)
     with pytest.raises(RtlError, match="harness=False"):
         run(sim, b"", plusargs=["+clocks_f2a=x.txt"])
     with pytest.raises(RtlError, match="trace=True"):
         run(sim, b"", vcd=tmp_path / "w.vcd")
     with pytest.raises(RtlError, match="Verilator without waveform"):
-        build(rtl_params(config), tmp_path / "x", simulator="verilator", trace=True, harness=True)
+        build(design_from_config(config), tmp_path / "x", simulator="verilator", trace=True, harness=True)
 
 
 @pytest.mark.parametrize("mode", EVAL_MODES[1:])
@@ -331,13 +333,13 @@ def test_the_eval_fallbacks_equal_the_testbench(tmp_path: Path, mode: str) -> No
     frames, _ = refusal_frames(config)
     data = b"".join(frames)
     plain_dir = tmp_path / mode
-    write_sources(rtl_params(config), plain_dir)
+    write_sources(design_from_config(config), plain_dir)
     done = subprocess.run(harness_command(plain_dir, eval_mode=mode), cwd=plain_dir,
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr
     plain = RtlBuild("verilator", _run_command("verilator", plain_dir, True), plain_dir,
-                     rtl_params(config), 0.0, False, True)
-    tb = build(rtl_params(config), tmp_path / "tb", simulator="iverilog")
+                     design_from_config(config), 0.0, False, True)
+    tb = build(design_from_config(config), tmp_path / "tb", simulator="iverilog")
     assert_same_run(run(plain, data, seed=6, gap=100, bp=700, beats=True),
                     run(tb, data, seed=6, gap=100, bp=700, beats=True))
 
@@ -347,7 +349,7 @@ def test_the_shipped_design_runs_in_the_nonblocking_region_alone(tmp_path: Path)
     region and no active region: the default build takes the fastest mode, and the check that
     guards it tells a model with such a region apart."""
     require_rtl("verilator")
-    built = build(rtl_params(small_config("rgb8")), tmp_path / "fast", simulator="verilator")
+    built = build(design_from_config(small_config("rgb8")), tmp_path / "fast", simulator="verilator")
     obj_dir = built.directory / "obj_dir"
     assert nba_only(obj_dir)
     assert "-DRFL_EVAL_NBA" in (obj_dir / "Vrfl_harness.mk").read_text()
@@ -400,7 +402,7 @@ def test_the_harness_runs_its_code_from_a_huge_page(tmp_path: Path, huge: bool) 
     if not thp.exists() or "[never]" in thp.read_text():
         pytest.skip("transparent huge pages are off on this machine")
     config = small_config("rgb8")
-    built = build(rtl_params(config), tmp_path / "fast", simulator="verilator")
+    built = build(design_from_config(config), tmp_path / "fast", simulator="verilator")
     env = {**os.environ, "RFL_NO_HUGE_TEXT": "" if huge else "1"}
     fallbacks = _thp_fallbacks()
     proc = subprocess.Popen([*built.command, "--serve"], stdin=subprocess.PIPE,

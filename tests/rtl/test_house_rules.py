@@ -28,7 +28,7 @@ from tests.support.rtltools import require_iverilog, require_verilator, require_
 
 RTL = Path(VERILOG_DIR).parent
 FILES = ["verilog/rfl_*.v", "harness/rfl_*.v", "tb/rfl_*.v", "generic/rfl_*.v",
-         "generic/tb/rfl_*.v", "fabric/rfl_*.v"]
+         "generic/tb/rfl_*.v", "fabric/rfl_*.v", "exhibit/rfl_*.v"]
 MODULE_FILES = sorted(p for pattern in FILES for p in RTL.glob(pattern))
 
 _COMMENT = re.compile(r"//.*?$|/\*.*?\*/", re.S | re.M)
@@ -116,7 +116,7 @@ def test_the_port_rule_catches_what_it_should() -> None:
     assert stream_problems({"in_tdata": "input", "in_tvalid": "input", "in_tready": "output"})
     assert stream_problems({"s_axis_tdata": "input", "s_axis_tvalid": "input",
                             "s_axis_tready": "input"})      # tready the wrong way
-    assert ports(RTL / "verilog" / "rfl_fifo2axi.v")["m_axis_tready"] == "input"
+    assert ports(RTL / "exhibit" / "rfl_fifo2axi.v")["m_axis_tready"] == "input"
 
 
 # (module, parameters, message): every contract, each with a value just past its edge
@@ -202,7 +202,7 @@ _IDS = [f"{m}-{'-'.join(f'{k}{v}' for k, v in p.items())}" for m, p, _ in CONTRA
 
 
 def _source(module: str) -> str:
-    for folder in (Path(VERILOG_DIR), RTL / "generic", RTL / "fabric"):
+    for folder in (Path(VERILOG_DIR), RTL / "generic", RTL / "fabric", RTL / "exhibit"):
         path = folder / f"{module}.v"
         if path.exists():
             return str(path)
@@ -215,7 +215,7 @@ def test_verilator_refuses_an_illegal_parameter(module: str, params: dict[str, i
                                                message: str, tmp_path: Path) -> None:
     verilator = require_verilator()
     sets = [f"-G{k}={v}" for k, v in params.items()]
-    done = subprocess.run([verilator, "--lint-only", f"-I{VERILOG_DIR}", "--top-module", module,
+    done = subprocess.run([verilator, "--lint-only", f"-I{Path(_source(module)).parent}", "--top-module", module,
                            *sets, _source(module)], cwd=tmp_path, capture_output=True, text=True,
                           timeout=120)
     assert done.returncode != 0 and "USERERROR" in done.stderr and message in done.stderr, \
@@ -228,7 +228,7 @@ def test_icarus_refuses_an_illegal_parameter(module: str, params: dict[str, int]
                                              message: str, tmp_path: Path) -> None:
     iverilog = require_iverilog()
     sets = [f"-P{module}.{k}={v}" for k, v in params.items()]
-    done = subprocess.run([iverilog, "-g2005", f"-I{VERILOG_DIR}", "-s", module, *sets, "-o",
+    done = subprocess.run([iverilog, "-g2005", f"-I{Path(_source(module)).parent}", "-s", module, *sets, "-o",
                            "m.vvp", _source(module)], cwd=tmp_path, capture_output=True,
                           text=True, timeout=120)
     if any((module, k) in ICARUS_ELABORATION_FAILS for k in params):
@@ -251,7 +251,7 @@ def test_yosys_refuses_an_illegal_parameter(module: str, params: dict[str, int],
     yosys = yosys_command()
     assert yosys is not None
     sets = " ".join(f"-chparam {k} {v}" for k, v in params.items())
-    (tmp_path / "m.ys").write_text(f"read_verilog -defer -I{VERILOG_DIR} {_source(module)}\n"
+    (tmp_path / "m.ys").write_text(f"read_verilog -defer -I{Path(_source(module)).parent} {_source(module)}\n"
                                    f"hierarchy -check -top {module} {sets}\n")
     done = subprocess.run([*yosys, "-q", "m.ys"], cwd=tmp_path, capture_output=True, text=True,
                           timeout=300)
@@ -264,12 +264,12 @@ def test_yosys_refuses_an_illegal_parameter(module: str, params: dict[str, int],
 def test_legal_defaults_pass_every_contract(module: str, tmp_path: Path) -> None:
     """The defaults (and the edge values the shipped tops use) elaborate in all three."""
     verilator = require_verilator()
-    done = subprocess.run([verilator, "--lint-only", "-Wno-fatal", f"-I{VERILOG_DIR}",
+    done = subprocess.run([verilator, "--lint-only", "-Wno-fatal", f"-I{Path(_source(module)).parent}",
                            "--top-module", module, _source(module)], cwd=tmp_path,
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "USERERROR" not in done.stderr, done.stderr[-3000:]
     iverilog = require_iverilog()
-    done = subprocess.run([iverilog, "-g2005", f"-I{VERILOG_DIR}", "-s", module, "-o", "m.vvp",
+    done = subprocess.run([iverilog, "-g2005", f"-I{Path(_source(module)).parent}", "-s", module, "-o", "m.vvp",
                            _source(module)], cwd=tmp_path, capture_output=True, text=True,
                           timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
@@ -289,10 +289,9 @@ def test_fifo_edge_depths_are_legal(tmp_path: Path) -> None:
         assert done.returncode == 0 and "USERERROR" not in done.stderr, done.stderr[-3000:]
 
 
-def test_the_generated_node_wrapper_follows_the_rules(tmp_path: Path) -> None:
-    """rfl_node.v (rtl.params.node_wrapper, the Image top of every configuration) too."""
-    from rosfpga_lab.rtl import rtl_params
-    from rosfpga_lab.rtl.params import node_wrapper
+def test_the_exhibits_node_wrapper_follows_the_rules(tmp_path: Path) -> None:
+    """The exhibit's rfl_node.v (``rtl.exhibit.params.node_wrapper``) too."""
+    from rosfpga_lab.rtl.exhibit.params import node_wrapper, rtl_params
     from tests.rtl.test_sim import small_config
 
     path = tmp_path / "rfl_node.v"

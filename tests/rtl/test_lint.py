@@ -1,10 +1,11 @@
 """The Verilog is clean under three linters, and a generated project finds its simulator in
 any POSIX shell.
 
-* Verilator ``--lint-only -Wall``: no warning for ``rfl_node`` (``rfl_top`` with a
-  configuration's parameters) of every shipped configuration and of small ones of every
-  encoding, kernel and ``frame_id_max`` (the widths of counters and RAM addresses follow the
-  parameters, so each set is linted on its own).
+* Verilator ``--lint-only -Wall``: no warning for ``rfl_node`` (the generated top with a
+  configuration's parameters) of every shipped Image configuration on TCPROS and of small ones
+  of every encoding, kernel and ``frame_id_max`` (the widths of counters and RAM addresses
+  follow the parameters, so each set is linted on its own); and for the exhibit's ``rfl_top``
+  (the hand-written Image circuit of Table 1) on one small configuration.
 * Icarus Verilog ``-g2005 -Wall``: no output.
 * Yosys ``check -assert`` after ``proc``: no multiple drivers, loops or undriven signals.
 * The generated Makefile builds without Verilator waivers (``-Wno-lint``, ``-Wno-style``), its
@@ -23,7 +24,8 @@ import pytest
 
 from tests.support.realros import skip_or_fail
 from rosfpga_lab.config import load_config
-from rosfpga_lab.rtl import rtl_params, write_sources
+from rosfpga_lab.rtl import design_from_config, write_sources
+from rosfpga_lab.rtl.exhibit.params import rtl_params as exhibit_params
 from rosfpga_lab.rtl.project import generate_project
 from rosfpga_lab.rtl.sim import TB_DIR
 from tests.support.rtltools import REQUIRE, require_iverilog, require_verilator, require_yosys
@@ -42,8 +44,12 @@ SMALL = [("rgba8", 11, 7, 256), ("rgb8", 9, 5, 3), ("mono8", 13, 6, 1), ("bgr8",
 
 
 def _design(config, where: Path) -> list[str]:
-    """Write the node's sources; return the synthesizable files (no testbench)."""
-    write_sources(rtl_params(config), where)
+    """Write the node's sources (``config`` an ``("exhibit", config)`` pair: the exhibit's);
+    return the synthesizable files (no testbench)."""
+    if isinstance(config, tuple):
+        write_sources(exhibit_params(config[1]), where)
+    else:
+        write_sources(design_from_config(config), where)
     tbs = {p.name for p in TB_DIR.glob("*.v")}
     return sorted(p.name for p in where.glob("*.v") if p.name not in tbs)
 
@@ -53,6 +59,7 @@ def _configs() -> list[tuple[str, object]]:
     for enc, w, h, fid in SMALL:
         cases.append((f"small-{enc}-fid{fid}", small_config(enc, width=w, height=h,
                                                              frame_id_max=fid)))
+    cases.append(("exhibit-rgba8", ("exhibit", small_config("rgba8", width=11, height=7))))
     return cases
 
 
@@ -68,8 +75,8 @@ def test_verilator_wall_has_no_warning(name: str, config, tmp_path: Path) -> Non
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
 
 
-@pytest.mark.parametrize("name,config", CASES[:len(SHIPPED)] + CASES[-2:],
-                         ids=[c[0] for c in CASES[:len(SHIPPED)] + CASES[-2:]])
+@pytest.mark.parametrize("name,config", CASES[:len(SHIPPED)] + CASES[-3:],
+                         ids=[c[0] for c in CASES[:len(SHIPPED)] + CASES[-3:]])
 def test_iverilog_wall_and_yosys_check_are_silent(name: str, config, tmp_path: Path) -> None:
     iverilog = require_iverilog()
     files = _design(config, tmp_path)

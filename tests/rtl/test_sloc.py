@@ -8,8 +8,7 @@ import sys
 from pathlib import Path
 
 from rosfpga_lab.hls.sloc import PAPER_TABLE1, SlocTable, format_table, sloc
-from rosfpga_lab.rtl.sim import VERILOG_DIR
-from rosfpga_lab.rtl.sloc import COUNTED, count_verilog, verilog_sloc
+from rosfpga_lab.rtl.sloc import COUNTED, EXHIBIT_DIR, count_verilog, verilog_sloc
 
 
 def _plain_count(text: str) -> int:
@@ -35,14 +34,15 @@ def test_verilog_rule() -> None:
     assert sloc(text) == 5           # the C rule reads 8'hFF ... as a character literal
 
 
-def test_the_lab_verilog_is_counted_file_by_file() -> None:
+def test_the_exhibits_verilog_is_counted_file_by_file() -> None:
+    """The default count is the exhibit's (the hand-written Image circuit, Table 1)."""
     table = count_verilog()
     for part, files in COUNTED.items():
-        want = sum(_plain_count((VERILOG_DIR / f).read_text()) for f in files)
+        want = sum(_plain_count((EXHIBIT_DIR / f).read_text()) for f in files)
         assert getattr(table, part) == want > 50, part
     assert table.total == table.subscriber + table.publisher
-    assert "rfl_morph.v" in table.others and table.others["rfl_morph.v"] == \
-        _plain_count((VERILOG_DIR / "rfl_morph.v").read_text())
+    assert "rfl_top.v" in table.others and table.others["rfl_top.v"] == \
+        _plain_count((EXHIBIT_DIR / "rfl_top.v").read_text())
 
 
 def test_table_has_both_columns() -> None:
@@ -64,4 +64,4 @@ def test_cli_without_rtl_counts_the_lab_verilog(tmp_path: Path) -> None:
     verilog = count_verilog()
     row = next(line.split() for line in done.stdout.splitlines() if line.startswith("total"))
     assert row == ["total", "6", str(verilog.total), "127", "860"]
-    assert "the lab's rosfpga_lab/rtl/verilog" in done.stdout
+    assert "the lab's exhibit, rosfpga_lab/rtl/exhibit" in done.stdout

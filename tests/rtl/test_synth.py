@@ -33,7 +33,7 @@ def dilate_report():
 
 def test_every_module_is_counted_and_the_rows_add_up_to_yosys_totals(dilate_report) -> None:
     report = dilate_report
-    # the generated top's modules, the 2-D application (a video stream) instead of rfl_window1d
+    # the generated video top: rfl_morph, not the 1-D window
     assert [row.module for row in report.rows] == [m for m, _ in GENERIC_MODULES
                                                    if m != "rfl_window1d"]
     assert report.family == "xc7" and report.part.startswith("xc7z020")
@@ -58,7 +58,7 @@ def test_resource_counts_keep_their_order_of_magnitude(dilate_report) -> None:
     assert 100 <= morph["LUT"] <= 2000 and 100 <= morph["FF"] <= 1000
     assert dilate_report.total["DSP"] == 0               # nothing multiplies
     for row in dilate_report.rows:
-        if row.module != "rfl_gtop":
+        if row.module != "rfl_gtop":  # the glue
             assert 10 <= row.counts["LUT"] <= 5000, row
             assert 10 <= row.counts["FF"] <= 2000, row
     assert 500 <= dilate_report.total["LUT"] <= 20000

@@ -215,7 +215,7 @@ def test_whole_path_dump_gives_the_output_bytes(simulator: str, tmp_path: Path) 
 
     from tests.support.realros import skip_or_fail
     from rosfpga_lab.hls import sample_frames
-    from rosfpga_lab.rtl import build, rtl_params, run, simulator_missing_reason
+    from rosfpga_lab.rtl import build, design_from_config, run, simulator_missing_reason
 
     reason = simulator_missing_reason(simulator)
     if simulator == "verilator" and not reason and cxx_compiler() is None:
@@ -231,7 +231,7 @@ def test_whole_path_dump_gives_the_output_bytes(simulator: str, tmp_path: Path) 
     config = dataclasses.replace(config, image=dataclasses.replace(config.image, width=12,
                                                                    height=6))
     frames, _ = sample_frames(config)
-    sim = build(rtl_params(config), tmp_path / "build", simulator=simulator, trace=True)
+    sim = build(design_from_config(config), tmp_path / "build", simulator=simulator, trace=True)
     result = run(sim, frames, gap=200, bp=300, vcd=tmp_path / "wave.vcd")
     wave = read_vcd(tmp_path / "wave.vcd", clock="u_top.clk")
     fire = (wave.values("u_top.tx_tvalid") == 1) & (wave.values("u_top.tx_tready") == 1)

@@ -1,5 +1,5 @@
-// rfl_tb -- a file-based testbench of the whole circuit (rfl_node: rfl_top, or a generated
-// project's rfl_gtop, with the node configuration's parameters; both have the same ports, an
+// rfl_tb -- a file-based testbench of the whole circuit (rfl_node: a generated project's
+// rfl_gtop, or any top with the same ports, with the node configuration's parameters: an
 // 8-bit status of the subscriber's table and the framing flags, which rfl_gtop ties to 0, and
 // the stream nets timed below; rfl_harness.v taps the same). It streams TCPROS frames from a file into the 8-bit input,
 // with random input gaps and random output backpressure from a seeded xorshift generator,

@@ -1,6 +1,7 @@
 // rfl_status.vh -- the subscriber's status codes (0: accepted, else the refused field).
 // Generated from rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES by
-// rosfpga_lab.rtl.params.status_header(); a test keeps this file equal to it.
+// rosfpga_lab.rtl.exhibit.params.status_header(); a test keeps this file equal
+// to it.
 localparam [3:0] SUB_OK = 4'd0;  // frame accepted
 localparam [3:0] SUB_BAD_FRAME_LENGTH = 4'd1;  // frame length
 localparam [3:0] SUB_BAD_FRAME_ID_LENGTH = 4'd2;  // header.frame_id length

@@ -1,4 +1,6 @@
-"""The RTL's parameters, read from the node configuration (the one place that reads it).
+"""The exhibit's parameters: the hand-written Image circuit's (``rfl_top``), read from a node
+configuration. Only the exhibit's own test (``tests/rtl/test_exhibit.py``) and benchmark use this
+module; no tool of the library imports it (that test holds it so).
 
 How this works: :func:`rtl_params` takes a :class:`NodeConfig` and the Python model the HLS
 configuration gives (:meth:`rosfpga_lab.hw.Pipeline.from_config`, so image, application, FIFO
@@ -6,7 +8,10 @@ depths, ``frame_id_max`` and the first ``header.seq`` come from the same owners)
 interpreter's limits and layout facts, and returns a frozen :class:`RtlParams`.
 :func:`node_wrapper` renders ``rfl_node.v``, the top level with those parameters, and
 :func:`status_header` the include of the subscriber's status codes
-(:data:`rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES`).
+(:data:`rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES`). An :class:`RtlParams` is a design
+:func:`rosfpga_lab.rtl.sim.build` takes (:class:`rosfpga_lab.rtl.sim.OwnSources`): its
+:meth:`RtlParams.rtl_files` are the exhibit's Verilog, the lab's shared modules
+(``rfl_fifo``, ``rfl_slice``, ``rfl_morph``) and the lab's testbench.
 """
 
 from __future__ import annotations
@@ -21,8 +26,14 @@ from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.encodings import PIXEL_FORMATS
 from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, SUBSCRIBER_STATUSES, fixed_after
 from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.proofs import Proof
+from rosfpga_lab.rtl.tools import NODE_FILE, TB_DIR, TB_TOP, VERILOG_DIR
 
-__all__ = ["OP_CODES", "RtlParams", "load_config", "node_wrapper", "rtl_params", "status_header"]
+__all__ = ["EXHIBIT_DIR", "OP_CODES", "RtlParams", "load_config", "node_wrapper", "rtl_params",
+           "status_header"]
+
+#: The exhibit's folder: its Verilog, status include and property wrappers.
+EXHIBIT_DIR = Path(__file__).resolve().parent
 
 #: ``rfl_morph``'s OP parameter per operation (the names of :data:`~rosfpga_lab.config.MODEL_OPS`;
 #: the codes are the Verilog's).
@@ -65,6 +76,20 @@ class RtlParams:
         """Pixel bytes of one frame."""
         return self.WIDTH * self.HEIGHT * self.BYTES
 
+    @property
+    def statuses(self) -> tuple[tuple[str, str], ...]:
+        """``(name, field)`` per status code of ``rfl_subscriber``, code 0 (accepted) first."""
+        return tuple(SUBSCRIBER_STATUSES)
+
+    def rtl_files(self, note: str = "") -> dict[str, bytes]:
+        """``{file name: bytes}`` the testbench runs: the exhibit's Verilog and status include,
+        the lab's shared modules (``verilog/``), the testbench and ``rfl_node.v``."""
+        files = {p.name: p.read_bytes()
+                 for p in [*sorted(VERILOG_DIR.glob("*.v")), *sorted(EXHIBIT_DIR.glob("rfl_*")),
+                           TB_DIR / f"{TB_TOP}.v"]}
+        files[NODE_FILE] = node_wrapper(self, note).encode("utf-8")
+        return files
+
 
 def rtl_params(config: NodeConfig) -> RtlParams:
     """The RTL parameters of ``config``.
@@ -101,6 +126,38 @@ def rtl_params(config: NodeConfig) -> RtlParams:
         RX_DEPTH=pipe.rx_fifo_depth, TX_DEPTH=config.fifo.output_depth,
         AXIS_DEPTH=config.fifo.axis_depth, SEQ_START=pipe.seq_start,
     )
+
+
+#: The exhibit's formal checks (wrappers ``fv_<name>.sv`` here; run by
+#: :func:`rosfpga_lab.rtl.proofs.prove` from ``tests/rtl/test_exhibit.py``, not by ``rtl prove``).
+EXHIBIT_PROOFS: tuple[Proof, ...] = (
+    Proof("fifo2axi", ("rfl_fifo2axi.v",), "prove", 10,
+          "rfl_fifo2axi (3x2, 2 bytes/pixel): output stream rules; all reachable states",
+          ("FV_PROVE",), home=EXHIBIT_DIR),
+    Proof("fifo2axi", ("rfl_fifo2axi.v",), "bmc", 20,
+          "rfl_fifo2axi (3x2, 2 bytes/pixel): TUSER on a frame's first pixel only, TLAST on a "
+          "line's last pixel only, TKEEP, each beat = the bytes taken; 20 clocks",
+          home=EXHIBIT_DIR),
+    Proof("axi2fifo", ("rfl_axi2fifo.v",), "prove", 8,
+          "rfl_axi2fifo: output stream rules; all reachable states", ("FV_PROVE",),
+          home=EXHIBIT_DIR),
+    Proof("axi2fifo", ("rfl_axi2fifo.v",), "bmc", 12,
+          "rfl_axi2fifo: one byte per kept lane in lane order, no beat overwritten; 12 clocks",
+          home=EXHIBIT_DIR),
+    Proof("subscriber", ("rfl_subscriber.v",), "prove", 8,
+          "rfl_subscriber (any input bytes): pixel stream rules, status codes of the table; "
+          "all reachable states", home=EXHIBIT_DIR),
+    # bounded: the publisher's place in the frame is not visible on its ports (the whole
+    # rfl_top below closes by induction instead); the wrapper reads frame_id from a RAM of any
+    # fixed contents with a clock, as rfl_top does
+    Proof("publisher", ("rfl_publisher.v",), "bmc", 32,
+          "rfl_publisher (2x1 mono8): output stream rules, releases only fields it holds; 32 "
+          "clocks (through the header and frame_id)", home=EXHIBIT_DIR),
+    Proof("top", tuple(sorted(p.name for p in [*VERILOG_DIR.glob("*.v"),
+                                               *EXHIBIT_DIR.glob("*.v")])), "prove", 8,
+          "rfl_top (2x1 mono8, FIFOs 4 deep, any input bytes): output stream rules, busy while "
+          "output is pending; all reachable states", home=EXHIBIT_DIR),
+)
 
 
 def _value(name: str, value: object) -> str:
@@ -150,7 +207,8 @@ def status_header() -> str:
     """``rfl_status.vh``: the subscriber's status codes as Verilog localparams."""
     lines = ["// rfl_status.vh -- the subscriber's status codes (0: accepted, else the refused field).",
              "// Generated from rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES by",
-             "// rosfpga_lab.rtl.params.status_header(); a test keeps this file equal to it."]
+             "// rosfpga_lab.rtl.exhibit.params.status_header(); a test keeps this file equal",
+             "// to it."]
     for code, (name, label) in enumerate(SUBSCRIBER_STATUSES):
         lines.append(f"localparam [3:0] {name} = 4'd{code};  // {label}")
     return "\n".join(lines) + "\n"
