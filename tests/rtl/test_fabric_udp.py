@@ -31,7 +31,7 @@ import pytest
 from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
-from rosfpga_lab.rtl.sim import cache_root
+from rosfpga_lab.rtl.sim import cache_root, simulator_version
 from rosfpga_lab.rtps.entities import discovery_multicast_port, discovery_port, user_port
 from rosfpga_lab.rtps.limits import SPDP_MULTICAST_ADDRESS
 from tests.support.rtltools import TB_DIR, cocotb_verilator, require_verilator
@@ -204,7 +204,13 @@ def cosimulate(tmp_path: Path, case: dict, monkeypatch: pytest.MonkeyPatch) -> d
     from cocotb_tools.runner import get_results, get_runner
 
     (tmp_path / "case.json").write_text(json.dumps(case))
-    key = hashlib.sha256(b"".join(p.read_bytes() for p in SOURCES)).hexdigest()[:20]
+    # Verilator's dependency files name the sources' and cocotb's absolute paths: a build made
+    # from another clone or environment must not be reused (its make fails on paths now gone).
+    import cocotb
+    digest = hashlib.sha256(f"{cocotb.__file__} {simulator_version('verilator')}".encode())
+    for path in SOURCES:
+        digest.update(str(path).encode() + b"\0" + path.read_bytes() + b"\0")
+    key = digest.hexdigest()[:20]
     build = cache_root() / f"cocotb-udp-{key}"
     runner = get_runner("verilator")
     runner.build(sources=SOURCES, hdl_toplevel="udp_gmii_top", build_dir=build,
