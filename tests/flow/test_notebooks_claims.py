@@ -152,9 +152,10 @@ def test_workshop_notebook_says_when_the_stop_button_is_there_and_explains_reset
 def test_the_shipped_timing_report_meets_the_clock_and_notebook_08_says_how_to_make_one() -> None:
     """Issue 21 item 4: the place-and-route report shipped in data/ (made by
     data/make_timing_report.py) is what `rosfpga-lab rtl timing` prints and meets its clock.
-    Notebook 08 (issue 28: it steps through the generated circuit only) does not show it: it is
-    the hand-written exhibit's until the generated 640x480 top is placed and routed; the notebook
-    says how to place and route the generated project and what a critical path is."""
+    Notebook 08 (issue 28: it steps through the generated circuit only) shows it: it is the
+    generated top's (its critical path runs through rfl_gsubscriber's registers, which the
+    exhibit's subscriber does not have), and the notebook says how to place and route the
+    generated project and what a critical path is."""
     from rosfpga_lab.config import load_config
     from rosfpga_lab.rtl.timing import (
         SHIPPED_CONFIG, SHIPPED_REPORT, format_timing, report_from_dict, shipped_report,
@@ -178,6 +179,13 @@ def test_the_shipped_timing_report_meets_the_clock_and_notebook_08_says_how_to_m
     code08 = "\n".join("".join(c["source"]) for c in cells("08_rtl.ipynb")
                        if c["cell_type"] == "code")
     assert "rosfpga-lab rtl timing CONFIG" in text08 and "place_and_route_dir" in code08
-    assert "shipped_report()" not in code08
+    assert "shipped_report()" in code08 and "format_timing(shipped" in code08
+    # the report is of the generated top: each register on its critical path is declared in
+    # rfl_gsubscriber.v (u_subscriber is rfl_gtop's instance of it), and one is not in the exhibit's
+    generic = (ROOT / "rosfpga_lab" / "rtl" / "generic" / "rfl_gsubscriber.v").read_text()
+    exhibit = (ROOT / "rosfpga_lab" / "rtl" / "exhibit" / "rfl_subscriber.v").read_text()
+    names = set(re.findall(r"u_top\.u_subscriber\.(\w+)", text))
+    assert names and all(re.search(rf"\b{n}\b", generic) for n in names), names
+    assert any(not re.search(rf"\b{n}\b", exhibit) for n in names), names
     assert "Most of\nits delay is routing" in text08
     assert "valid/ready handshake" in text08
