@@ -23,7 +23,7 @@ TDATA_BYTES = TDATA_BITS // 8
 #: Largest rectangular kernel of the dilate/erode application.
 MAX_KSIZE = _config.MAX_KSIZE
 
-#: Defaults of :class:`rosfpga_lab.hw.Pipeline`.
+#: Defaults of the circuit models (:class:`rosfpga_lab.hw.MessagePipeline`).
 DEFAULT_CLOCK_HZ = _config.DEFAULT_CLOCK_MHZ * 1e6
 DEFAULT_LINE_RATE_BPS = 1e9
 DEFAULT_RX_FIFO_DEPTH = _config.DEFAULT_INPUT_FIFO_DEPTH
