@@ -33,12 +33,11 @@ The video stretch of an Image circuit (module ``videostages``), importable for n
   :func:`mat2axivideo_reference`, :func:`mat2axivideo_fast` with :class:`Mat`;
 * application: :func:`morph_reference` / :func:`morph_fast` (``dilate``, ``erode``, ``copy``);
   on a beat stream, damaged or not, as ``rfl_morph.v``: :func:`morph_stream_reference` /
-  :func:`morph_stream_fast` (framing rules and flags :data:`FRAMING_FLAGS`, module ``framing``;
-  ``fifo2axi``'s start-of-frame re-sync: ``axis.fifo2axi_stream_reference`` / ``_fast``).
+  :func:`morph_stream_fast` (framing rules and flags :data:`FRAMING_FLAGS`, module ``framing``).
 
 Streams: :class:`Fifo`, :class:`ByteFIFO`, :class:`Beat`, :class:`Beats`. Faults:
 :class:`DropByte`, :class:`DuplicateByte`, :class:`SwapByteOrder`, :class:`LoseTlast`,
-:class:`LoseTuser`, :class:`ShallowFifo` (module ``faults``, at the taps of
+:class:`LoseTuser` (module ``faults``, at the taps of
 :func:`~rosfpga_lab.hw.videostages.video_stages`): a fault gives a wrong image, a status flag or
 a typed :class:`PipelineError`, never a hang. Errors: :class:`PipelineError` and subclasses.
 The packing rule (the generalised Figure 7: which bytes of a pixel go where in ``tdata``, and
@@ -52,7 +51,7 @@ from rosfpga_lab.hw.errors import (
     PipelineConfigError, PipelineError, StreamStarvedError, UnsupportedEncodingError,
 )
 from rosfpga_lab.hw.faults import (
-    DropByte, DuplicateByte, Fault, LoseTlast, LoseTuser, ShallowFifo, SwapByteOrder,
+    DropByte, DuplicateByte, Fault, LoseTlast, LoseTuser, SwapByteOrder,
 )
 from rosfpga_lab.hw.layoutderive import derive_layout, layout_from_config
 from rosfpga_lab.hw.layoutsteps import Layout, format_layout
@@ -79,7 +78,7 @@ __all__ = [
     "Beat", "Beats", "ByteFIFO", "DropByte", "DuplicateByte", "Fault", "Fifo",
     "FifoOverflowError", "FrameFieldError", "FrameLengthError", "FrameTruncatedError",
     "LoseTlast", "LoseTuser", "Mat", "PipelineConfigError", "PipelineError", "wire_bytes",
-    "PixelFormat", "ShallowFifo", "StreamStarvedError", "SwapByteOrder",
+    "PixelFormat", "StreamStarvedError", "SwapByteOrder",
     "UnsupportedEncodingError", "axi2fifo_fast", "axi2fifo_reference", "axivideo2mat_fast",
     "axivideo2mat_reference", "fifo2axi_fast", "fifo2axi_reference", "image_frame",
     "mat2axivideo_fast", "mat2axivideo_reference", "morph_fast", "morph_reference",
