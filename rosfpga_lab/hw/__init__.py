@@ -47,7 +47,7 @@ The packing rule (the generalised Figure 7: which bytes of a pixel go where in `
 from rosfpga_lab.hw.axis import axi2fifo_fast, axi2fifo_reference, fifo2axi_fast, fifo2axi_reference
 from rosfpga_lab.hw.encodings import PIXEL_FORMATS, PixelFormat, pixel_format
 from rosfpga_lab.hw.errors import (
-    FifoOverflowError, FrameFieldError, FrameLengthError, FrameTruncatedError,
+    FrameFieldError, FrameLengthError, FrameTruncatedError,
     PipelineConfigError, PipelineError, StreamStarvedError, UnsupportedEncodingError,
 )
 from rosfpga_lab.hw.faults import (
@@ -76,7 +76,7 @@ from rosfpga_lab.hw.video import (
 __all__ = [
     "ERROR_IO_EOL_EARLY", "ERROR_IO_EOL_LATE", "ERROR_IO_SOF_EARLY", "OPS", "PIXEL_FORMATS",
     "Beat", "Beats", "ByteFIFO", "DropByte", "DuplicateByte", "Fault", "Fifo",
-    "FifoOverflowError", "FrameFieldError", "FrameLengthError", "FrameTruncatedError",
+    "FrameFieldError", "FrameLengthError", "FrameTruncatedError",
     "LoseTlast", "LoseTuser", "Mat", "PipelineConfigError", "PipelineError", "wire_bytes",
     "PixelFormat", "StreamStarvedError", "SwapByteOrder",
     "UnsupportedEncodingError", "axi2fifo_fast", "axi2fifo_reference", "axivideo2mat_fast",

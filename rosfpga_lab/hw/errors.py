@@ -95,20 +95,6 @@ class StreamStarvedError(PipelineError):
         super().__init__(message, stage, partial)
 
 
-class FifoOverflowError(PipelineError):
-    """A write met a full FIFO: the circuit would have lost the byte.
-
-    Attributes:
-        depth: the FIFO's depth.
-        needed: the occupancy the traffic would have needed (the high-water mark without loss).
-    """
-
-    def __init__(self, message: str, stage: str, depth: int, needed: int) -> None:
-        self.depth = depth
-        self.needed = needed
-        super().__init__(message, stage)
-
-
 class LayoutError(PipelineConfigError):
     """A circuit layout cannot be derived: a key names a missing field or one it cannot take.
 
