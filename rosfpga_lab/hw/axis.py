@@ -28,7 +28,6 @@ import numpy as np
 
 from rosfpga_lab.hw.encodings import PixelFormat, pack_lanes, unpack_lanes
 from rosfpga_lab.hw.errors import StreamStarvedError
-from rosfpga_lab.hw.framing import Reframed, reframe_bytes_fast, reframe_bytes_reference
 from rosfpga_lab.hw.streams import Beat, Beats, ByteFIFO, Fifo, frame_flags
 
 LANE = np.arange(4, dtype=np.uint8)
@@ -135,34 +134,3 @@ def axi2fifo_fast(beats: Beats, count: int) -> tuple[np.ndarray, int]:
             "the upstream stage delivered too few (a lost byte, beat or TLAST?)",
             stage="axi2fifo", needed=count, got=len(beats), partial=data.tobytes())
     return data, len(beats) - use
-
-
-def fifo2axi_stream_reference(data: bytes | np.ndarray, marks: np.ndarray, rows: int, cols: int,
-                              fmt: PixelFormat) -> tuple[Beats, Reframed]:
-    """``fifo2axi`` on a byte stream with the subscriber's start-of-frame markers
-    (``rfl_fifo2axi.v``): re-synced frame by frame by
-    :func:`~rosfpga_lab.hw.framing.reframe_bytes_reference`, each frame packed by
-    :func:`fifo2axi_reference`.
-
-    Returns:
-        ``(beats, framing)``: every completed frame's beats, and what the re-sync did.
-    """
-    framed = reframe_bytes_reference(data, marks, rows * cols * fmt.bytes_per_pixel)
-    out: Fifo[Beat] = Fifo(None, "axis_in")
-    for frame in framed.frames:
-        inp = ByteFIFO(None, "pixels_in")
-        inp.extend(int(b) for b in frame)
-        fifo2axi_reference(inp, out, rows, cols, fmt)
-    return Beats.from_list(out.drain()), framed
-
-
-def fifo2axi_stream_fast(data: bytes | np.ndarray, marks: np.ndarray, rows: int, cols: int,
-                         fmt: PixelFormat) -> tuple[Beats, Reframed]:
-    """Fast model of :func:`fifo2axi_stream_reference`."""
-    framed = reframe_bytes_fast(data, marks, rows * cols * fmt.bytes_per_pixel)
-    if not framed.frames:
-        return Beats.empty(), framed
-    parts = [_pack(frame, rows, cols, fmt) for frame in framed.frames]
-    return Beats(np.concatenate([p.tdata for p in parts]), np.concatenate([p.tkeep for p in parts]),
-                 np.concatenate([p.tuser for p in parts]),
-                 np.concatenate([p.tlast for p in parts])), framed

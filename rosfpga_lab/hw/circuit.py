@@ -33,6 +33,9 @@ from rosfpga_lab.msg import MsgRegistry
 #: frames it publishes) instead of re-sending it, as rospy does and as the lab's Image circuit
 #: always has (the generated one: ``hls.compiler.program_from_layout(count=...)``).
 NUMBERED_FIELD = "header.seq"
+#: The layout idents of ``header.stamp`` (seconds, nanoseconds) whose values a result reports as
+#: its frame's stamp (``MessageResult.stamp``), for any type with a ``std_msgs/Header``.
+STAMP_FIELDS = ("header_stamp_secs", "header_stamp_nsecs")
 
 #: Configurations whose records are kept (the newest; a notebook loads a few).
 _KEPT = 16
@@ -143,4 +146,4 @@ def _derive(config: NodeConfig, reg: MsgRegistry) -> CircuitLayouts:
     return CircuitLayouts(config, reg, layout, out_layout, numbered_field(config))
 
 
-__all__ = ["NUMBERED_FIELD", "CircuitLayouts", "ConfigCache", "circuit_layouts", "numbered_field"]
+__all__ = ["NUMBERED_FIELD", "STAMP_FIELDS", "CircuitLayouts", "ConfigCache", "circuit_layouts", "numbered_field"]

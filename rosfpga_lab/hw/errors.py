@@ -3,7 +3,7 @@
 Every error names the stage that found it; frame errors also name the field (of
 ``sensor_msgs/Image`` or of any type's layout, e.g. ``history[1].sensor_name length``) and the
 byte offset in the TCPROS frame (offset 0 is the first byte of the 4-byte frame
-length). After any of these errors the stage (and the :class:`~rosfpga_lab.hw.Pipeline`) has
+length). After any of these errors the stage (and the :class:`~rosfpga_lab.hw.MessagePipeline`) has
 reset itself: the next good frame comes out right.
 """
 
@@ -93,20 +93,6 @@ class StreamStarvedError(PipelineError):
         self.needed = needed
         self.got = got
         super().__init__(message, stage, partial)
-
-
-class FifoOverflowError(PipelineError):
-    """A write met a full FIFO: the circuit would have lost the byte.
-
-    Attributes:
-        depth: the FIFO's depth.
-        needed: the occupancy the traffic would have needed (the high-water mark without loss).
-    """
-
-    def __init__(self, message: str, stage: str, depth: int, needed: int) -> None:
-        self.depth = depth
-        self.needed = needed
-        super().__init__(message, stage)
 
 
 class LayoutError(PipelineConfigError):

@@ -5,17 +5,18 @@ A fault acts at a *tap*, the stream between two stages:
 =============  ==================================================  =========
 tap            stream                                              carries
 =============  ==================================================  =========
-``rx``         TCPROS frame bytes, network to interpreter           bytes
-``pixels_in``  pixel bytes, interpreter to ``fifo2axi``             bytes
+``pixels_in``  pixel bytes, subscriber to ``fifo2axi``              bytes
 ``axis_in``    AXI4-Stream, ``fifo2axi`` to ``AXIvideo2Mat``        beats
 ``axis_out``   AXI4-Stream, ``Mat2AXIvideo`` to ``axi2fifo``        beats
-``pixels_out`` pixel bytes, ``axi2fifo`` to the generator           bytes
+``pixels_out`` pixel bytes, ``axi2fifo`` to the publisher           bytes
 =============  ==================================================  =========
 
-Every fault gives a visibly wrong image (shifted channels, wrong colours, a sheared image), a
-status flag in :attr:`PipelineResult.status`, or a :class:`~rosfpga_lab.hw.errors.PipelineError`
-(whose ``partial`` holds what was made so far); none can hang the model. A receive FIFO too
-shallow for the network's bursts is :class:`ShallowFifo`.
+The taps are those of an Image circuit's video stretch
+(:func:`~rosfpga_lab.hw.videostages.video_stages`). Every fault gives a visibly wrong image
+(shifted channels, wrong colours, a sheared image), a status flag in
+:attr:`~rosfpga_lab.hw.videostages.VideoStages.status`, or a
+:class:`~rosfpga_lab.hw.errors.PipelineError` (whose ``partial`` holds what was made so far);
+none can hang the model.
 """
 
 from __future__ import annotations
@@ -27,9 +28,9 @@ import numpy as np
 from rosfpga_lab.hw.errors import PipelineConfigError
 from rosfpga_lab.hw.streams import Beats
 
-BYTE_TAPS = ("rx", "pixels_in", "pixels_out")
+BYTE_TAPS = ("pixels_in", "pixels_out")
 BEAT_TAPS = ("axis_in", "axis_out")
-TAPS = ("rx", "pixels_in", "axis_in", "axis_out", "pixels_out")
+TAPS = ("pixels_in", "axis_in", "axis_out", "pixels_out")
 
 
 def _check_index(index: int, size: int, what: str, tap: str) -> None:
@@ -133,17 +134,3 @@ class LoseTuser(BeatFault):
         out = beats.copy()
         out.tuser[:] = False
         return out
-
-
-@dataclass(frozen=True, kw_only=True)
-class ShallowFifo(Fault):
-    """Make the receive FIFO ``depth`` bytes deep while the network lands ``burst_bytes`` at once.
-
-    A TCP segment (typically 1460 bytes) is written into the FIFO in one burst; the interpreter
-    drains one byte per clock. A FIFO shallower than the burst overflows: the circuit would lose
-    bytes, the model raises :class:`~rosfpga_lab.hw.errors.FifoOverflowError`.
-    """
-
-    depth: int = 512
-    burst_bytes: int = 1460
-    tap: str = "rx"

@@ -39,7 +39,8 @@ Worked example: ``pkg/Scan`` = ``Header header``, ``string[] names``, ``float32[
 (``x [11]``: as many elements as step 11 says). A frame's byte offsets follow from its values
 (:func:`frame_geometry`); a refused field is named by its label with indices filled in
 (``names[2] length``). Status codes: ``SUB_OK`` then one per checked step, in step order
-(:attr:`Layout.statuses`), exactly as ``hw.interpreter.SUBSCRIBER_STATUSES`` does for Image.
+(:attr:`Layout.statuses`); for Image the hand exhibit's ``rtl.exhibit.params.SUBSCRIBER_STATUSES`` but
+for the ``HEADER_`` prefix.
 
 Refusal order (what every renderer does, so models, C++ and RTL give the same status): when a
 step completes, (1) step 0, the frame length: below ``min_body`` or above

@@ -24,7 +24,7 @@ import numpy as np
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.config.vocabulary import CUSTOM, MODELS, canonical_op, model_ksize
 from rosfpga_lab.hw import limits
-from rosfpga_lab.hw.circuit import CircuitLayouts, circuit_layouts
+from rosfpga_lab.hw.circuit import STAMP_FIELDS, CircuitLayouts, circuit_layouts
 from rosfpga_lab.hw.errors import PipelineConfigError
 from rosfpga_lab.hw.layoutsteps import Layout, StepKind, VideoShape
 from rosfpga_lab.hw.morph import check_op, flush_extent, morph_fast, morph_reference
@@ -224,8 +224,9 @@ class MessagePipeline:
 
     def _stamp_steps(self) -> tuple[int, int] | None:
         idents = {s.ident: s.index for s in self.layout.steps}
-        if "header_stamp_secs" in idents and "header_stamp_nsecs" in idents:
-            return idents["header_stamp_secs"], idents["header_stamp_nsecs"]
+        secs, nsecs = STAMP_FIELDS
+        if secs in idents and nsecs in idents:
+            return idents[secs], idents[nsecs]
         return None
 
     def _numbered_step(self, count: str | None) -> int | None:

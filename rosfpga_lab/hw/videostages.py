@@ -31,7 +31,6 @@ import numpy as np
 from rosfpga_lab.config.vocabulary import canonical_op, model_ksize
 from rosfpga_lab.hw.axis import axi2fifo_fast, fifo2axi_fast
 from rosfpga_lab.hw.encodings import pixel_format
-from rosfpga_lab.hw.errors import PipelineConfigError
 from rosfpga_lab.hw.faults import BeatFault, ByteFault, Fault
 from rosfpga_lab.hw.layoutsteps import VideoShape
 from rosfpga_lab.hw.morph import check_op, morph_fast
@@ -79,15 +78,10 @@ def video_stages(video: VideoShape, stream: np.ndarray, op: str, ksize: int = 3,
     Raises:
         StreamStarvedError: a stage waited for a byte or beat that never came (``partial``: what
             it had made).
-        PipelineConfigError: a bad ``op``/``ksize``, or a fault at a tap this stretch has not.
+        PipelineConfigError: a bad ``op``/``ksize``.
     """
     name = canonical_op(op)
     window = check_op(name, model_ksize(op, ksize))
-    taps = {"pixels_in", "axis_in", "axis_out", "pixels_out"}
-    for fault in faults:
-        if fault.tap not in taps:
-            raise PipelineConfigError(f"{type(fault).__name__} at tap {fault.tap!r}: the video "
-                                      f"stages have the taps {', '.join(sorted(taps))}")
 
     def bytes_at(tap: str, data: np.ndarray) -> np.ndarray:
         for fault in faults:

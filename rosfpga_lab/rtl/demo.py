@@ -17,7 +17,7 @@ configuration generate's test frames (``hls.vectors``: a good one, a refused one
 one; records of a sample length and a CDR payload on ``wire: cdr``). :func:`demo_report` sets
 beside each input frame the subscriber's decision, the bytes the circuit sent for it and the
 bytes the Python models publish for it (:func:`rosfpga_lab.rtl.project.model_output`: the
-layout's ``MessagePipeline`` or ``CdrPipeline``, Image's ``Pipeline`` on TCPROS).
+layout's ``MessagePipeline`` or ``CdrPipeline``, Image included).
 """
 
 from __future__ import annotations

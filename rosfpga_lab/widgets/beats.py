@@ -104,16 +104,15 @@ class BeatMap:
         self.frame_bytes = width * height * bytes_per_pixel
 
     @classmethod
-    def from_result(cls, result: Any, which: str = "input") -> BeatMap:
-        """The beats of a ``rosfpga_lab.hw`` ``PipelineResult``: ``which`` is ``input`` (into
-        ``AXIvideo2Mat``) or ``output`` (out of ``Mat2AXIvideo``); geometry from its fields."""
-        from rosfpga_lab.hw.encodings import pixel_format
-
+    def from_stages(cls, stages: Any, which: str = "input") -> BeatMap:
+        """The beats of one frame's video stages (``rosfpga_lab.hw.videostages.VideoStages``):
+        ``which`` is ``input`` (into ``AXIvideo2Mat``) or ``output`` (out of ``Mat2AXIvideo``);
+        geometry from the stages' picture."""
         if which not in ("input", "output"):
             raise WidgetError(f"which must be 'input' or 'output', got {which!r}")
-        f = result.fields
-        beats = result.input_beats if which == "input" else result.output_beats
-        return cls(beats, width=f.width, height=f.height, bytes_per_pixel=pixel_format(f.encoding).bytes_per_pixel)
+        beats = stages.axis_in if which == "input" else stages.axis_out
+        height, width, bytes_per_pixel = stages.input_image.shape
+        return cls(beats, width=width, height=height, bytes_per_pixel=bytes_per_pixel)
 
     def __len__(self) -> int:
         return int(self.lanes.shape[0])
@@ -229,7 +228,7 @@ class BeatMap:
 
         One byte enters per clock, so a beat is on the bus the clock after its last byte: a
         pixel of ``B`` bytes every ``B`` clocks (4 for ``rgba8``), no gaps, no backpressure (the
-        timing of :func:`rosfpga_lab.hw.clocked.fifo2axi_clocks`; the RTL's dump shows the same).
+        generated ``fifo2axi``'s timing: ``tests/rtl/test_cycles.py`` holds the RTL to it).
         The beats' own ``tdata``/``tuser``/``tlast`` are drawn, wrong ones included, held in
         the output register until the next beat loads.
         """
@@ -342,10 +341,11 @@ class BeatViewer(StaticFallback, w.VBox):
         self._render()
 
     @classmethod
-    def from_result(cls, result: Any, which: str = "input") -> BeatViewer:
-        """A viewer of a ``PipelineResult``'s input or output beats and image (see :meth:`BeatMap.from_result`)."""
-        image = result.input_image if which == "input" else result.output_image
-        return cls(BeatMap.from_result(result, which), image=image)
+    def from_stages(cls, stages: Any, which: str = "input") -> BeatViewer:
+        """A viewer of one frame's video stages' input or output beats and picture (see
+        :meth:`BeatMap.from_stages`)."""
+        image = stages.input_image if which == "input" else stages.output_image
+        return cls(BeatMap.from_stages(stages, which), image=image)
 
     def select_beat(self, beat: int) -> list[tuple[int, int]]:
         """Select ``beat``; the pixel fields follow. Returns the beat's pixels."""

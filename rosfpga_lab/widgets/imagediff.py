@@ -136,7 +136,7 @@ class FrameDiff:
 
     @classmethod
     def from_result(cls, result: Any, reference: Any, **kwargs: Any) -> FrameDiff:
-        """Compare a ``rosfpga_lab.hw`` ``PipelineResult``'s output image with ``reference``
+        """Compare a ``rosfpga_lab.hw`` ``MessageResult``'s output image with ``reference``
         (its input image is shown too)."""
         return cls(result.output_image, reference, result.input_image, **kwargs)
 

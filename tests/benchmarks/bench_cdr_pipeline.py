@@ -3,7 +3,7 @@
 Per sample: deriving the CDR walk, the reference (byte at a time) and fast (numpy) CDR
 pipeline (``hw.cdrpipeline.CdrPipeline``) on the shipped ``lab_msgs/Samples`` example, and the
 fast CDR pipeline on one 640x480 rgba8 ``sensor_msgs/Image`` (3x3 dilation) beside the TCPROS
-``hw.Pipeline`` on the same image. Figures are printed, not asserted.
+``hw.MessagePipeline`` on the same image. Figures are printed, not asserted.
 
 Run:  .venv/bin/python tests/benchmarks/bench_cdr_pipeline.py [--samples N]
 """
@@ -18,7 +18,7 @@ import numpy as np
 from benchtools import per_call
 
 from rosfpga_lab.config import load_config
-from rosfpga_lab.hw import Pipeline, image_frame
+from rosfpga_lab.hw import MessagePipeline, image_frame
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline
 from rosfpga_lab.msg import new_message
@@ -56,7 +56,7 @@ def main() -> None:
                data=pixels.tobytes())
     img["header"]["frame_id"] = "camera"
     cdr_sample = serialize_cdr(cdr_image.cdr.registry, "sensor_msgs/Image", img)
-    tcpros = Pipeline.from_config(image_config)
+    tcpros = MessagePipeline.from_config(image_config)
     frame = image_frame(pixels, im.encoding, frame_id="camera")
     t_cdr = per_call(lambda: cdr_image.process(cdr_sample), n)
     t_tcp = per_call(lambda: tcpros.process(frame), n)

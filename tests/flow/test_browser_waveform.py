@@ -16,11 +16,11 @@ from tests.flow.test_browser_byteviewer import Lab, lab  # noqa: F401  (the modu
 
 BUILD_CELL = '''
 import numpy as np
-from rosfpga_lab.hw.clocked import fifo2axi_clocks
+from rosfpga_lab.checks.circuit import elem_pack_clocks
 from rosfpga_lab.widgets import Waves, WaveformViewer
 
 data = (np.arange(4 * 3 * 4) * 5 % 251).astype(np.uint8)   # a 4x3 rgba8 frame's pixel bytes
-waves = Waves.from_arrays(fifo2axi_clocks(data, 4, 4), widths={"m_axis_tdata": 32, "m_axis_tkeep": 4})
+waves = Waves.from_arrays(elem_pack_clocks(data, 4, 4), widths={"m_axis_tdata": 32, "m_axis_tkeep": 4})
 viewer = WaveformViewer(waves, width=4, span=40)
 viewer
 '''

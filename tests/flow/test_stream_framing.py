@@ -1,5 +1,6 @@
 """Short, long and oversize frames between good ones, as one continuous byte stream: the HLS C
-simulation, the Verilog and the Python models read it the same way, byte for byte.
+simulation and the Verilog read it the same way, byte for byte, and publish what the Python
+model (``hw.MessagePipeline``, which takes whole frames) publishes for the good frames.
 
 The circuit gets the TCP payload as one byte stream, not cut into frames. A frame length below
 the smallest Image (but framed) is refused and its bytes skipped; a frame longer than its
@@ -21,14 +22,15 @@ import pytest
 
 from tests.support.realros import cxx_missing_reason, require_rtl
 from rosfpga_lab.hls import generate, run_csim
-from rosfpga_lab.hw import Pipeline, image_frame
+from rosfpga_lab.hw import MessagePipeline, image_frame
 from rosfpga_lab.hw.limits import MAX_FRAME_BYTES
 from rosfpga_lab.rtl import build, design_from_config, run
 from tests.rtl.test_sim import random_image, small_config
 
 
 def _stream(config) -> tuple[bytes, list[tuple[int, str]]]:
-    """good, short, good, long, oversize, good: the bytes and the expected status per frame."""
+    """good, short, good, long, oversize, good: the bytes and the expected status per frame (the
+    long frame is refused at its frame length: the generated walk's exact-fit rule)."""
     enc = config.image.encoding
     goods = [image_frame(random_image(config, s), enc, frame_id=f"g{s}") for s in range(3)]
     # a short frame: length 12 and 12 body bytes that start like a 40-byte frame length
@@ -37,7 +39,7 @@ def _stream(config) -> tuple[bytes, list[tuple[int, str]]]:
     long_ = struct.pack("<I", len(good) - 4 + 8) + good[4:] + b"\x07" * 8
     oversize = struct.pack("<I", MAX_FRAME_BYTES + 1)
     parts = [(goods[0], "SUB_OK"), (short, "SUB_BAD_FRAME_LENGTH"), (good, "SUB_OK"),
-             (long_, "SUB_BAD_DATA_LENGTH"), (oversize, "SUB_BAD_FRAME_LENGTH"),
+             (long_, "SUB_BAD_FRAME_LENGTH"), (oversize, "SUB_BAD_FRAME_LENGTH"),
              (goods[2], "SUB_OK")]
     status, offset = [], 0
     for data, name in parts:
@@ -46,39 +48,25 @@ def _stream(config) -> tuple[bytes, list[tuple[int, str]]]:
     return b"".join(p for p, _ in parts), status
 
 
-def test_the_models_read_a_continuous_stream_as_the_circuit_does() -> None:
-    config = small_config("rgb8", width=5, height=3)
-    data, status = _stream(config)
-    got = Pipeline.from_config(config).process_stream(data)
-    assert got.status == tuple(status) and got.unread == 0
-    # the three good frames, in order, numbered 1, 2, 3 by the publisher
-    alone = Pipeline.from_config(config)
-    goods = [data[o:o + 4 + struct.unpack_from("<I", data, o)[0]]
-             for o, n in status if n == "SUB_OK"]
-    assert got.output == b"".join(alone.process(f).output_frame for f in goods)
-    # a frame cut short at the end is left unread
-    cut = Pipeline.from_config(config).process_stream(data + data[:20])
-    assert cut.unread == 20 and cut.status == tuple(status)
-
-
 @pytest.mark.rtl
 def test_csim_rtl_and_models_agree_byte_for_byte(tmp_path: Path) -> None:
     config = small_config("rgb8", width=5, height=3)
     data, status = _stream(config)
-    expected = Pipeline.from_config(config).process_stream(data)
-    # the long frame is refused as the generated walk's exact-fit rule says, at its frame
-    # length (the Python models name the data length)
-    walk_names = {"SUB_BAD_DATA_LENGTH": "SUB_BAD_FRAME_LENGTH"}
+    # the three good frames, in order, numbered 1, 2, 3 by the publisher
+    pipe = MessagePipeline.from_config(config)
+    goods = [data[o:o + 4 + struct.unpack_from("<I", data, o)[0]]
+             for o, n in status if n == "SUB_OK"]
+    expected = b"".join(pipe.process(f).output_frame for f in goods)
     sim = build(design_from_config(config), tmp_path / "rtl", simulator=require_rtl())
     rtl = run(sim, data, seed=5, gap=200, bp=300)
-    assert rtl.status == tuple((o, walk_names.get(n, n)) for o, n in status)
-    assert rtl.output == expected.output
+    assert rtl.status == tuple(status)
+    assert rtl.output == expected
     if cxx_missing_reason() is None:
         generate(config, tmp_path / "hls")
         csim = run_csim(tmp_path / "hls", data)
-        assert csim.status == tuple((o, walk_names.get(n, n)) for o, n in status)
-        assert csim.output == expected.output
+        assert csim.status == tuple(status)
+        assert csim.output == expected
         assert "cannot trust" in csim.log and "WARNING" not in csim.log
         # the beats were tapped for the three good frames only
         assert len(csim.input_beats) == 3 * 5 * 3
-    assert np.frombuffer(expected.output, np.uint8).size > 0
+    assert np.frombuffer(expected, np.uint8).size > 0

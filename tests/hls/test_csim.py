@@ -4,8 +4,8 @@ For each shipped configuration the generated project is compiled once per sessio
 Makefile: ``g++ -std=c++14 -Wall -Werror`` against the lab's HLS headers) and fed TCPROS frames
 serialized by real ROS (genpy, under the system Python; the lab's own serializer stands in only
 where ROS is not installed). The output bytes and the AXI4-Stream beats on both sides of the
-application must equal those of :class:`rosfpga_lab.hw.Pipeline` for the same configuration,
-and the output image must equal OpenCV's dilate/erode of the input. Without g++ these tests
+application must equal those of :class:`rosfpga_lab.hw.MessagePipeline` for the same
+configuration (``tests.support.imagemodel`` adds its beats), and the output image must equal OpenCV's dilate/erode of the input. Without g++ these tests
 skip (with ROSFPGA_REQUIRE_CXX=1, as in CI, they fail).
 """
 
@@ -26,7 +26,7 @@ from tests.support.realros import require_cxx, ros_missing_reason, run_ros_pytho
 from rosfpga_lab.config import HlsConfig, load_config, parse_config
 from rosfpga_lab.config.vocabulary import DEFAULT_HLS_FLAVOUR, HLS_FLAVOURS
 from rosfpga_lab.hls import CsimError, build_csim, generate, run_csim
-from rosfpga_lab.hw import Pipeline
+from tests.support.imagemodel import ImageModel
 from rosfpga_lab.hls.csim import CsimResult
 from rosfpga_lab.hw import Beats, PipelineError, image_frame
 from rosfpga_lab.msg import default_registry, deserialize
@@ -131,7 +131,7 @@ def test_csim_equals_python_models_and_opencv(projects: dict[str, Project], stem
     assert "hls_video.h" not in os.listdir(project.path / "hls_include")
     got = project.run(frame)
     config = load_config(DATA / f"{stem}.yaml")
-    model = Pipeline.from_config(config).process(frame)
+    model = ImageModel(config).process(frame)
     assert got.status == ((0, "SUB_OK"),)
     assert len(got.input_beats) == config.image.width * config.image.height
     assert got.input_beats == model.input_beats, f"first differing beat {got.input_beats.first_difference(model.input_beats)}"
@@ -236,7 +236,7 @@ def test_refused_frames_are_skipped_and_the_next_good_frame_comes_out_right(
     offsets = np.cumsum([0] + [len(f) for _, f, _ in frames])[:-1]
     assert got.status == tuple((int(o), s) for o, (_, _, s) in zip(offsets, frames))
     # The Python model refuses the same frames and numbers the accepted ones 1, 2.
-    pipe = Pipeline.from_config(config)
+    pipe = ImageModel(config)
     expected, beats_in, beats_out = b"", [], []
     for name, frame, status in frames:
         try:
@@ -344,7 +344,7 @@ def test_a_batch_of_varied_frames_equals_the_models(projects: dict[str, Project]
                                   stamp=(int(rng.integers(0, 2**32)), int(rng.integers(0, 10**9))),
                                   frame_id=frame_id, is_bigendian=i % 2))
     got = projects[stem].run(b"".join(frames))
-    pipe = Pipeline.from_config(config)
+    pipe = ImageModel(config)
     expected, statuses = b"", []
     for frame in frames:
         try:
@@ -368,7 +368,7 @@ def test_frame_id_max_is_the_same_limit_in_the_circuit_and_the_models(tmp_path: 
     frames = [image_frame(image, encoding, frame_id="f" * n) for n in (15, 16, 17, 0)]
     got = run_csim(tmp_path / "proj", b"".join(frames))
     assert [s for _, s in got.status] == ["SUB_OK", "SUB_OK", "SUB_BAD_HEADER_FRAME_ID_LENGTH", "SUB_OK"]
-    pipe = Pipeline.from_config(config)
+    pipe = ImageModel(config)
     expected = b""
     for n, frame in zip((15, 16, 17, 0), frames):
         if n == 17:
@@ -406,7 +406,7 @@ def test_vitis_line_buffer_on_small_images_and_kernels(tmp_path: Path, op: str, 
     frames = [image_frame(im, encoding, seq=i, frame_id=f"f{i}") for i, im in enumerate(images)]
     got = run_csim(tmp_path / "proj", b"".join(frames))
     assert "WARNING" not in got.log, got.log
-    pipe = Pipeline.from_config(config)
+    pipe = ImageModel(config)
     results = [pipe.process(f) for f in frames]
     assert got.output == b"".join(r.output_frame for r in results)
     n = width * height

@@ -306,13 +306,14 @@ def test_the_generic_circuit_given_the_image_layout_publishes_as_the_image_proje
         tmp_path: Path) -> None:
     """sensor_msgs/Image through the generic renderer (pixels as a byte stream, a pass-through,
     header.seq numbered by the publisher as the Image project's does): C simulation and RTL
-    simulation publish what the Image project's Python models publish, frame for frame,
+    simulation publish what the Image project's Python model (its video stream through the
+    2-D application) publishes, frame for frame,
     including a frame of the wrong width refused between good ones."""
     from rosfpga_lab.config import parse_config
     from rosfpga_lab.hls.compiler import program_from_layout
-    from rosfpga_lab.hw import Pipeline
+    from rosfpga_lab.hw import MessagePipeline
     from rosfpga_lab.hw.errors import PipelineError
-    from rosfpga_lab.hw.pipeline import image_frame
+    from rosfpga_lab.hw.sample import image_frame
 
     require_cxx()
     require_iverilog()
@@ -329,7 +330,7 @@ def test_the_generic_circuit_given_the_image_layout_publishes_as_the_image_proje
     for k, (w, fid) in enumerate([(6, "cam"), (6, ""), (5, "cam"), (6, "x" * 40)]):
         pic = rng.integers(0, 256, (4, w, 3), dtype=np.uint8)
         frames.append(image_frame(pic, "rgb8", seq=100 + k, stamp=(7 + k, 9), frame_id=fid))
-    pipe = Pipeline.from_config(config)
+    pipe = MessagePipeline.from_config(config)  # with the video stage: the Image project's model
     expected = b""
     refused = 0
     for frame in frames:

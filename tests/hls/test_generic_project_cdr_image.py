@@ -273,7 +273,7 @@ def test_generated_fifo2axi_frames_pixels_as_the_image_project(
 @pytest.mark.parametrize("name", list(SMALL))
 def test_image_on_tcpros_is_the_same_project(name: str, tmp_path: Path) -> None:
     """Image on TCPROS goes through the same renderer (issue 28): its data framed as video, its
-    header.seq numbered by the publisher as the Image model (hw.Pipeline) numbers it; the
+    header.seq numbered by the publisher as the Image model (hw.MessagePipeline) numbers it; the
     generated project's make csim and make rtlsim both publish exactly what the model publishes
     for the shipped test frame."""
     from rosfpga_lab.hls.generic import spec_from_config

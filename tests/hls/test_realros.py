@@ -26,7 +26,7 @@ import pytest
 from tests.support.realros import ROS_PYTHON, free_port, require_cxx, ros_env, stop_process
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hls import build_csim, generate, run_csim
-from rosfpga_lab.hw import Pipeline
+from tests.support.imagemodel import ImageModel
 from rosfpga_lab.msg import default_registry, deserialize
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -127,7 +127,7 @@ def test_real_rospy_publisher_accepts_the_generated_subscriber(
         pub.stdout.close()  # type: ignore[union-attr]
         pub.stderr.close()  # type: ignore[union-attr]
     got = run_csim(proj, frame, binary=binary)
-    model = Pipeline.from_config(load_config(CONFIG)).process(frame)
+    model = ImageModel(load_config(CONFIG)).process(frame)
     assert got.status == ((0, "SUB_OK"),)
     assert got.input_beats == model.input_beats and got.output_beats == model.output_beats
     assert got.output == model.output_frame

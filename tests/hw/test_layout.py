@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 from rosfpga_lab.hw.errors import LayoutError
-from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.hw.layout import (
     Action, CheckOp, StepKind, derive_layout, format_layout, frame_geometry, marshal, tokens,
 )
@@ -109,14 +108,23 @@ def test_frame_geometry_gives_frame_length_and_stream_offset(case: str) -> None:
     assert (geo.stream_offset, geo.stream_bytes) == (4 + span.offset, span.size)
 
 
-def test_the_image_layout_names_the_image_interpreters_statuses() -> None:
+#: The hand-written Image subscriber's statuses (the exhibit's rfl_status.vh), written out.
+IMAGE_STATUSES = (
+    ("SUB_OK", "frame accepted"), ("SUB_BAD_FRAME_LENGTH", "frame length"),
+    ("SUB_BAD_FRAME_ID_LENGTH", "header.frame_id length"), ("SUB_BAD_HEIGHT", "height"),
+    ("SUB_BAD_WIDTH", "width"), ("SUB_BAD_ENCODING_LENGTH", "encoding length"),
+    ("SUB_BAD_ENCODING", "encoding"), ("SUB_BAD_STEP", "step"),
+    ("SUB_BAD_DATA_LENGTH", "data length"))
+
+
+def test_the_image_layout_names_the_hand_image_subscribers_statuses() -> None:
     layout = derive_layout(REG, "sensor_msgs/Image", stream="data", stream_length=12,
                            checks={"height": 2, "width": 2, "encoding": "rgb8", "step": 6},
                            limits_={"encoding": 32})
     # same fields, same order, same labels; the names differ only by the header_ prefix
-    assert [label for _n, label in layout.statuses] == [label for _n, label in SUBSCRIBER_STATUSES]
+    assert [label for _n, label in layout.statuses] == [label for _n, label in IMAGE_STATUSES]
     assert [n.replace("HEADER_", "") for n, _l in layout.statuses] == \
-        [n for n, _l in SUBSCRIBER_STATUSES]
+        [n for n, _l in IMAGE_STATUSES]
     # Image's 37 bytes with empty strings and no pixels, plus what the checks fix: "rgb8" and
     # the 12 data bytes (the shortest body accepted)
     assert layout.min_body == 37 + 4 + 12 and layout.stream.ident == "data"

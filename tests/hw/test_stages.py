@@ -13,7 +13,7 @@ from rosfpga_lab.hw import (
     ERROR_IO_EOL_EARLY, ERROR_IO_EOL_LATE, ERROR_IO_SOF_EARLY, PIXEL_FORMATS, Beat, Beats,
     ByteFIFO, Fifo, Mat, PipelineConfigError, StreamStarvedError, axi2fifo_fast,
     axi2fifo_reference, axivideo2mat_fast, axivideo2mat_reference, fifo2axi_fast,
-    fifo2axi_reference, generate_fast, generate_reference, interpret_fast, mat2axivideo_fast,
+    fifo2axi_reference, mat2axivideo_fast,
     mat2axivideo_reference,
 )
 from rosfpga_lab.hw.video import beats_to_fifo
@@ -204,21 +204,3 @@ def test_axivideo2mat_flags_and_starvation_by_hand():
     extra = Beats.from_list(late.to_list() + [Beat(9, 1, False, True)] * 3)
     img, status, left = axivideo2mat_fast(extra, 2, 3, fmt)
     assert status & ERROR_IO_EOL_LATE and img[1, :, 0].tolist() == [9, 9, 9]
-
-
-# -- the message generator ------------------------------------------------------------------------
-
-@given(images(max_side=6), st.text(max_size=10), st.integers(0, 2**32 - 1), st.integers(0, 1))
-@settings(max_examples=80, deadline=None)
-def test_generator_reference_equals_fast_equals_message_layer(img_enc, frame_id, seq, bigendian):
-    image, encoding = img_enc
-    expected = tcpros_frame(image_msg(image, encoding, seq=seq, stamp=(3, 4), frame_id=frame_id,
-                                      is_bigendian=bigendian))
-    fields, _ = interpret_fast(expected)
-    inp, out = ByteFIFO(), ByteFIFO()
-    inp.extend(image.tobytes())
-    generate_reference(fields, inp, out)
-    assert out.to_bytes() == generate_fast(fields, image.reshape(-1)) == expected
-    fields = dataclasses.replace(fields, seq=seq ^ 1)
-    with pytest.raises(StreamStarvedError):
-        generate_fast(fields, image.reshape(-1)[:-1])

@@ -3,9 +3,9 @@ random message definitions on both wires, ``rtl cycles`` of a configuration, and
 with streaming early release, exactly without backpressure (the RTL is the oracle) and within
 four standard deviations with 50 % backpressure (the output takes a byte on a random half of
 the clocks: sending ``n`` bytes takes ``n / p`` clocks on average, standard deviation
-``sqrt(n (1 - p)) / p``). (The hand-written exhibit's cycle tests against ``hw.cycles`` and
-``hw.clocked`` went with it: ``tests/rtl/test_exhibit.py`` holds its output to the generated
-circuit's.)
+``sqrt(n (1 - p)) / p``). (The hand-written exhibit's cycle tests against the old
+``hw.cycles`` and ``hw.clocked`` models went with them: ``tests/rtl/test_exhibit.py`` holds its
+output to the generated circuit's.)
 """
 
 from __future__ import annotations

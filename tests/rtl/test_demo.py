@@ -17,7 +17,7 @@ from tests.support.realros import require_rtl
 from rosfpga_lab.cli import main
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hls import sample_frames
-from rosfpga_lab.hw import Pipeline
+from rosfpga_lab.hw import MessagePipeline
 from rosfpga_lab.hls.generic import spec_from_config
 from rosfpga_lab.rtl.demo import (DUMP_SIMULATOR, demo_config, demo_frames, demo_inputs,
                                   demo_report, run_demo, shipped_dump)
@@ -40,7 +40,7 @@ def test_the_shipped_dump_shows_a_refusal_then_the_models_output() -> None:
     dump = read_vcd(path, clock="clk")
     refused, good = demo_frames()
     assert _stream_bytes(dump, "s") == refused + good          # everything offered was taken
-    model = Pipeline.from_config(demo_config()).process(good).output_frame
+    model = MessagePipeline.from_config(demo_config()).process(good).output_frame
     assert _stream_bytes(dump, "m") == model                   # one frame out, bit-exact
     decided = dump.values("status_valid").astype(bool)
     codes = dump.values("status")[decided].tolist()
@@ -92,7 +92,7 @@ def test_rtl_demo_command_prints_each_frame(capsys: pytest.CaptureFixture[str]) 
     assert main(["rtl", "demo", "--simulator", "iverilog"]) == 0
     out = capsys.readouterr().out.splitlines()
     refused, good = demo_frames()
-    want = Pipeline.from_config(demo_config()).process(good).output_frame
+    want = MessagePipeline.from_config(demo_config()).process(good).output_frame
     assert out[0] == (f"frame 1 at byte 0 ({len(refused)} bytes): SUB_BAD_WIDTH (width); "
                       "nothing out, the models refuse it too")
     assert out[1] == (f"frame 2 at byte {len(refused)} ({len(good)} bytes): SUB_OK (frame "

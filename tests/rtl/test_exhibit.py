@@ -2,13 +2,13 @@
 conventional design, held equal to the generated Image circuit, and held apart from the library.
 
 (a) The same Image frames (good ones in rgba8, rgb8 and mono8, and refused ones: a column too
-narrow, and for mono8 every refusal reason of the interpreter's table) run through the exhibit's
+narrow, and for mono8 every refusal reason of its status table) run through the exhibit's
 ``rfl_top`` and through the generated top ``rfl_gtop`` of the same configuration, with the same
 random input gaps and output backpressure, and give the same output bytes and accept the same
 frames (each also equal to the Python models' output, so two empty outputs cannot agree).
 (b) No module of the library outside the exhibit imports its parameters or names its files;
-``rtl/sloc.py`` alone reads them (Table 1's count). (c) Its status include is generated from the
-interpreter's table and its formal checks hold (run here, not by ``rtl prove``).
+``rtl/sloc.py`` alone reads them (Table 1's count). (c) Its status include is generated from its
+status table and its formal checks hold (run here, not by ``rtl prove``).
 """
 
 from __future__ import annotations
@@ -21,10 +21,9 @@ from pathlib import Path
 import pytest
 
 from rosfpga_lab.hw import image_frame
-from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
 from rosfpga_lab.rtl import build, run
 from rosfpga_lab.rtl.exhibit.params import (
-    EXHIBIT_DIR, EXHIBIT_PROOFS, STATUS_HEADER, rtl_params, status_header,
+    EXHIBIT_DIR, EXHIBIT_PROOFS, STATUS_HEADER, SUBSCRIBER_STATUSES, rtl_params, status_header,
 )
 from rosfpga_lab.rtl.proofs import format_results, prove
 from rosfpga_lab.rtl.sim import OwnSources, design_from_config
@@ -79,7 +78,7 @@ def test_the_exhibit_equals_the_generated_image_circuit(encoding: str, tmp_path:
     assert not hand.cut_short and not generated.cut_short
 
 
-def test_the_exhibits_status_include_is_generated_from_the_interpreter_table() -> None:
+def test_the_exhibits_status_include_is_generated_from_its_status_table() -> None:
     assert (EXHIBIT_DIR / STATUS_HEADER).read_text() == status_header()
     assert status_header().count("localparam") == len(SUBSCRIBER_STATUSES)
 

@@ -3,7 +3,7 @@
 The file-based testbench (``rosfpga_lab/rtl/tb/rfl_tb.v``) streams TCPROS frames, serialized by
 real ROS (genpy) where it is installed, into the generated top (``design_from_config``: the circuit every RTL tool runs; the
 hand-written exhibit is held to it in ``test_exhibit.py``) with random input gaps and random
-output backpressure; every output byte must equal the Python models' (:class:`hw.Pipeline`)
+output backpressure; every output byte must equal the Python models' (:class:`hw.MessagePipeline`)
 and, where g++ is present, the HLS C simulation's. Small images keep Icarus Verilog quick; the
 640x480 ``rgba8`` frame runs on Verilator when it is installed. Without a simulator these tests
 skip; with ROSFPGA_REQUIRE_RTL=1 (CI) they fail.
@@ -21,8 +21,9 @@ import pytest
 from tests.support.realros import cxx_missing_reason, require_rtl
 from rosfpga_lab.config import load_config, parse_config
 from rosfpga_lab.hls import generate, run_csim, sample_frames
-from rosfpga_lab.hw import PIXEL_FORMATS, Beats, Pipeline, PipelineError, image_frame
-from rosfpga_lab.hw.interpreter import SUBSCRIBER_STATUSES
+from rosfpga_lab.hw import PIXEL_FORMATS, Beats, MessagePipeline, PipelineError, image_frame
+from rosfpga_lab.hw.videostages import video_stages
+from rosfpga_lab.hw.circuit import circuit_layouts
 from rosfpga_lab.rtl import RtlError, build, design_from_config, run
 from rosfpga_lab.rtl.project import generate_project
 from tests.hls.test_csim import ros_frame
@@ -59,7 +60,7 @@ def random_image(config, seed: int) -> np.ndarray:
 
 def model_output(config, frames: list[bytes]) -> tuple[bytes, list[str]]:
     """What the Python models send for ``frames``, and accepted/refused per frame."""
-    pipe = Pipeline.from_config(config)
+    pipe = MessagePipeline.from_config(config)
     out, verdicts = b"", []
     for frame in frames:
         try:
@@ -82,13 +83,16 @@ def test_every_encoding_with_random_gaps_and_backpressure(encoding: str, tmp_pat
     got = run(sim, b"".join(frames), seed=7, gap=300, bp=500, beats=True)
     expected, verdicts = model_output(config, frames)
     # The beats on both sides of the application equal the models' (unused lanes included).
-    pipe = Pipeline.from_config(config)
+    pipe = MessagePipeline.from_config(config)
+    video = pipe.layout.video
+    assert video is not None
     n = config.image.width * config.image.height
     assert got.input_beats is not None and got.output_beats is not None
     assert len(got.input_beats) == len(got.output_beats) == 3 * n
     for i, frame in enumerate(frames):
         res = pipe.process(frame)
-        for side, model in ((got.input_beats, res.input_beats), (got.output_beats, res.output_beats)):
+        stages = video_stages(video, res.extracted.stream, pipe.op, pipe.ksize)
+        for side, model in ((got.input_beats, stages.axis_in), (got.output_beats, stages.axis_out)):
             part = Beats(side.tdata[i * n:(i + 1) * n], side.tkeep[i * n:(i + 1) * n],
                          side.tuser[i * n:(i + 1) * n], side.tlast[i * n:(i + 1) * n])
             assert part == model, f"frame {i}: first differing beat {part.first_difference(model)}"
@@ -104,12 +108,13 @@ def test_every_encoding_with_random_gaps_and_backpressure(encoding: str, tmp_pat
 
 
 def refusal_frames(config) -> tuple[list[bytes], list[str]]:
-    """One frame per refusal reason of the interpreter's table, each followed by a good frame
+    """One frame per refusal reason of the Image layout's statuses, each followed by a good frame
     (for a ``mono8`` configuration with ``frame_id_max: 16``); and the statuses expected."""
+    statuses = circuit_layouts(config).layout.statuses
     image = random_image(config, 5)
     h, w = image.shape[:2]
     good = [ros_frame(random_image(config, 10 + i), "mono8", seq=i, frame_id=f"g{i}")
-            for i in range(len(SUBSCRIBER_STATUSES))]
+            for i in range(len(statuses))]
 
     def body(frame: bytes) -> bytes:
         return frame[4:]
@@ -120,7 +125,7 @@ def refusal_frames(config) -> tuple[list[bytes], list[str]]:
     stamp = struct.pack("<III", 1, 2, 3)
     bad = {
         "SUB_BAD_FRAME_LENGTH": struct.pack("<I", 10) + bytes(10),
-        "SUB_BAD_FRAME_ID_LENGTH": image_frame(image, "mono8", frame_id="f" * 17),
+        "SUB_BAD_HEADER_FRAME_ID_LENGTH": image_frame(image, "mono8", frame_id="f" * 17),
         "SUB_BAD_HEIGHT": image_frame(image[:-1], "mono8"),
         "SUB_BAD_WIDTH": image_frame(image[:, :-1], "mono8"),
         "SUB_BAD_ENCODING_LENGTH": framed(stamp + struct.pack("<I", 3) + b"cam"
@@ -131,7 +136,7 @@ def refusal_frames(config) -> tuple[list[bytes], list[str]]:
         "SUB_BAD_DATA_LENGTH": framed(body(image_frame(image, "mono8"))[:-4 - image.size]
                                       + struct.pack("<I", image.size - 1) + image.tobytes()[:-1]),
     }
-    assert set(bad) == {name for name, _ in SUBSCRIBER_STATUSES[1:]}  # every reason, no more
+    assert set(bad) == {name for name, _ in statuses[1:]}  # every reason, no more
     frames, names = [], []
     for i, (name, frame) in enumerate(bad.items()):
         frames += [frame, good[i]]
@@ -140,8 +145,8 @@ def refusal_frames(config) -> tuple[list[bytes], list[str]]:
 
 
 def test_every_refusal_reason_then_a_good_frame(tmp_path: Path) -> None:
-    """Each status of the interpreter's table, each followed by a good frame: the RTL refuses
-    what the HLS subscriber and the Python interpreter refuse, and numbers the good ones 1, 2..."""
+    """Each status of the Image layout, each followed by a good frame: the RTL refuses
+    what the HLS subscriber and the Python walker refuse, and numbers the good ones 1, 2..."""
     sim_name = require_rtl()
     config = small_config("mono8", frame_id_max=16)
     frames, names = refusal_frames(config)

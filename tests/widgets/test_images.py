@@ -142,10 +142,16 @@ def test_viewer_single_frame_and_sequence() -> None:
 
 
 def test_from_pipeline_result() -> None:
-    from rosfpga_lab.hw import Pipeline, image_frame
+    from rosfpga_lab.hw import MessagePipeline, derive_layout, image_frame
+    from rosfpga_lab.hw.layoutsteps import VideoShape
+    from rosfpga_lab.msg import MsgRegistry
 
     img = _image(6, 5)
-    res = Pipeline(op="dilate", ksize=(3, 3)).process(image_frame(img, "rgb8"))
+    layout = derive_layout(MsgRegistry.with_defaults(), "sensor_msgs/Image", stream="data",
+                           stream_length=90, limits_={"encoding": 32},
+                           checks={"height": 6, "width": 5, "encoding": "rgb8", "step": 15},
+                           video=VideoShape(5, 6, "rgb8", 3))
+    res = MessagePipeline(layout, "dilate", 3).process(image_frame(img, "rgb8"))
     d = FrameDiff.from_result(res, cv2.dilate(img, np.ones((3, 3), np.uint8)))
     assert d.equal and d.input is not None
     wrong = FrameDiff.from_result(res, img)  # not dilated: many pixels differ
@@ -278,14 +284,16 @@ def test_beat_viewer_picture_click_selects_the_pixels_beat() -> None:
         BeatViewer(tdata=td, width=4, height=3, bytes_per_pixel=3, image=img[:, :3])
 
 
-def test_beat_viewer_from_pipeline_result() -> None:
-    from rosfpga_lab.hw import Pipeline, image_frame
+def test_beat_viewer_from_video_stages() -> None:
+    from rosfpga_lab.hw.layoutsteps import VideoShape
+    from rosfpga_lab.hw.videostages import video_stages
 
     img = _image(4, 5, 4)
-    res = Pipeline(op="dilate").process(image_frame(img, "rgba8"))
-    v = BeatViewer.from_result(res, "output")
+    stages = video_stages(VideoShape(5, 4, "rgba8", 4), img.reshape(-1), "dilate")
+    v = BeatViewer.from_stages(stages, "output")
     assert len(v.map) == 20 and v.map.marker_mismatches() == []
-    assert v.map.beat_bytes(7) == res.output_image[1, 2].tobytes()
+    dilated = cv2.dilate(img, np.ones((3, 3), np.uint8))
+    assert v.map.beat_bytes(7) == dilated[1, 2].tobytes()
     assert v.picture is not None
 
 
@@ -301,16 +309,17 @@ def test_selected_beat_row_is_not_drawn_in_the_error_colour() -> None:
 
 
 def test_beat_waveform_is_clock_true_and_agrees_with_the_clocked_model() -> None:
-    """rgba8: one beat every 4 clocks, as the byte-wide fifo2axi makes them and hw.cycles counts."""
+    """rgba8: one beat every 4 clocks, as the generated circuit's byte-wide packer makes them
+    (``checks.circuit.elem_pack_clocks``, held to ``rfl_elem_pack`` by tests/checks/test_circuit)."""
+    from rosfpga_lab.checks.circuit import elem_pack_clocks
     from rosfpga_lab.hw import PIXEL_FORMATS, fifo2axi_fast
-    from rosfpga_lab.hw.clocked import fifo2axi_clocks
 
     rows, cols = 2, 3
     data = np.arange(rows * cols * 4, dtype=np.uint8) * 7
     beats, _ = fifo2axi_fast(data, rows, cols, PIXEL_FORMATS["rgba8"])
     m = BeatMap(beats, width=cols, height=rows, bytes_per_pixel=4)
     arrays = m.clock_arrays(0, rows * cols)
-    model = fifo2axi_clocks(data, cols, 4)
+    model = elem_pack_clocks(data, cols, 4)
     n = arrays["aclk"].size
     for name in ("s_tdata", "m_axis_tvalid", "m_axis_tdata", "m_axis_tuser", "m_axis_tlast"):
         assert arrays[name].astype(np.uint64).tolist() == model[name][:n].tolist(), name

@@ -2,13 +2,14 @@
 configuration. Only the exhibit's own test (``tests/rtl/test_exhibit.py``) and benchmark use this
 module; no tool of the library imports it (that test holds it so).
 
-How this works: :func:`rtl_params` takes a :class:`NodeConfig` and the Python model the HLS
-configuration gives (:meth:`rosfpga_lab.hw.Pipeline.from_config`, so image, application, FIFO
-depths, ``frame_id_max`` and the first ``header.seq`` come from the same owners), adds the
-interpreter's limits and layout facts, and returns a frozen :class:`RtlParams`.
+How this works: :func:`rtl_params` reads a :class:`NodeConfig` (image, application, FIFO depths,
+``frame_id_max``; pixel formats from :data:`rosfpga_lab.hw.encodings.PIXEL_FORMATS`, frame
+limits from :mod:`rosfpga_lab.hw.limits`), adds the exhibit's own facts about the Image frame it
+hard-codes (:data:`MIN_BODY_BYTES`, :data:`AFTER_FRAME_ID`, :data:`AFTER_ENCODING`,
+:data:`SUBSCRIBER_STATUSES`: the museum piece keeps them itself, the live lab derives every
+type's from its layout) and returns a frozen :class:`RtlParams`.
 :func:`node_wrapper` renders ``rfl_node.v``, the top level with those parameters, and
-:func:`status_header` the include of the subscriber's status codes
-(:data:`rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES`). An :class:`RtlParams` is a design
+:func:`status_header` the include of the subscriber's status codes. An :class:`RtlParams` is a design
 :func:`rosfpga_lab.rtl.sim.build` takes (:class:`rosfpga_lab.rtl.sim.OwnSources`): its
 :meth:`RtlParams.rtl_files` are the exhibit's Verilog, the lab's shared modules
 (``rfl_fifo``, ``rfl_slice``, ``rfl_morph``) and the lab's testbench.
@@ -20,11 +21,9 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 
 from rosfpga_lab.config import CUSTOM, MODEL_OPS, PASSTHROUGH, NodeConfig, load_config
-from rosfpga_lab.config.vocabulary import CDR_WIRE
-from rosfpga_lab.hw import Pipeline
+from rosfpga_lab.config.vocabulary import CDR_WIRE, canonical_op, model_ksize
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.encodings import PIXEL_FORMATS
-from rosfpga_lab.hw.interpreter import MIN_BODY_BYTES, SUBSCRIBER_STATUSES, fixed_after
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.proofs import Proof
 from rosfpga_lab.rtl.tools import NODE_FILE, TB_DIR, TB_TOP, VERILOG_DIR
@@ -43,6 +42,27 @@ assert set(OP_CODES) == set(MODEL_OPS), "every operation the models run has an R
 ENCODING_PARAM_BYTES = 32
 #: The status include's file name (beside the Verilog sources).
 STATUS_HEADER = "rfl_status.vh"
+#: ``rfl_subscriber``'s status codes, in code order: ``SUB_OK`` (0), then one per field it
+#: checks, with the field's label (the exhibit's own table: ``rfl_status.vh`` is generated from
+#: it; the generated circuit numbers its statuses from its layout instead).
+SUBSCRIBER_STATUSES: tuple[tuple[str, str], ...] = (
+    ("SUB_OK", "frame accepted"), ("SUB_BAD_FRAME_LENGTH", "frame length"),
+    ("SUB_BAD_FRAME_ID_LENGTH", "header.frame_id length"), ("SUB_BAD_HEIGHT", "height"),
+    ("SUB_BAD_WIDTH", "width"), ("SUB_BAD_ENCODING_LENGTH", "encoding length"),
+    ("SUB_BAD_ENCODING", "encoding"), ("SUB_BAD_STEP", "step"),
+    ("SUB_BAD_DATA_LENGTH", "data length"))
+#: Bytes of an Image body with empty strings and no pixels (``rfl_subscriber``'s MIN_BODY):
+#: seq, stamp (2), frame_id length, height, width, encoding length, is_bigendian (1 byte),
+#: step, data length.
+MIN_BODY_BYTES = 4 + 4 + 4 + 4 + 4 + 4 + 4 + 1 + 4 + 4
+#: Bytes of the fixed fields between ``header.frame_id`` and the next string (height, width,
+#: encoding length): the subscriber checks they fit in the frame before reading on.
+AFTER_FRAME_ID = 4 + 4 + 4
+#: Bytes of the fixed fields between ``encoding`` and ``data`` (is_bigendian, step, data length).
+AFTER_ENCODING = 1 + 4 + 4
+#: The number the publisher writes into the first frame's ``header.seq`` (then 2, 3 ...), as
+#: the generated publisher numbers it.
+SEQ_START = 1
 
 
 @dataclass(frozen=True)
@@ -106,25 +126,22 @@ def rtl_params(config: NodeConfig) -> RtlParams:
     if config.application.op == CUSTOM:
         raise RtlError("a custom application has no RTL: the lab's Verilog holds dilate, erode "
                        "and passthrough only")
-    pipe = Pipeline.from_config(config)
     for name, depth in (("input_depth", config.fifo.input_depth),
                         ("output_depth", config.fifo.output_depth),
                         ("axis_depth", config.fifo.axis_depth)):
         if depth < 2:
             raise RtlError(f"fifo.{name} is {depth}; the RTL FIFOs need a depth of at least 2")
-    assert pipe.encoding is not None and pipe.width is not None and pipe.height is not None
-    if pipe.seq_mode != "count" or pipe.stamp is not None or pipe.frame_id is not None:
-        raise RtlError("the RTL publisher numbers its frames and carries stamp and frame_id "
-                       "over; the model of this configuration does otherwise")
+    image, app = config.image, config.application
+    op = canonical_op(app.op)
     return RtlParams(
-        WIDTH=pipe.width, HEIGHT=pipe.height,
-        BYTES=PIXEL_FORMATS[pipe.encoding].bytes_per_pixel, ENCODING=pipe.encoding,
-        OP=OP_CODES[pipe.op], KSIZE=pipe.ksize[0],
-        FRAME_ID_MAX=pipe.max_frame_id_bytes, ENCODING_MAX=hw_limits.MAX_ENCODING_BYTES,
+        WIDTH=image.width, HEIGHT=image.height,
+        BYTES=PIXEL_FORMATS[image.encoding].bytes_per_pixel, ENCODING=image.encoding,
+        OP=OP_CODES[op], KSIZE=model_ksize(op, app.ksize)[0],
+        FRAME_ID_MAX=config.frame_id_max, ENCODING_MAX=hw_limits.MAX_ENCODING_BYTES,
         MIN_BODY=MIN_BODY_BYTES, MAX_FRAME=hw_limits.MAX_FRAME_BYTES,
-        AFTER_FRAME_ID=fixed_after("frame_id")[0], AFTER_ENCODING=fixed_after("encoding")[0],
-        RX_DEPTH=pipe.rx_fifo_depth, TX_DEPTH=config.fifo.output_depth,
-        AXIS_DEPTH=config.fifo.axis_depth, SEQ_START=pipe.seq_start,
+        AFTER_FRAME_ID=AFTER_FRAME_ID, AFTER_ENCODING=AFTER_ENCODING,
+        RX_DEPTH=config.fifo.input_depth, TX_DEPTH=config.fifo.output_depth,
+        AXIS_DEPTH=config.fifo.axis_depth, SEQ_START=SEQ_START,
     )
 
 
@@ -206,7 +223,7 @@ def node_wrapper(params: RtlParams, note: str = "") -> str:
 def status_header() -> str:
     """``rfl_status.vh``: the subscriber's status codes as Verilog localparams."""
     lines = ["// rfl_status.vh -- the subscriber's status codes (0: accepted, else the refused field).",
-             "// Generated from rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES by",
+             "// Generated from rosfpga_lab.rtl.exhibit.params.SUBSCRIBER_STATUSES by",
              "// rosfpga_lab.rtl.exhibit.params.status_header(); a test keeps this file equal",
              "// to it."]
     for code, (name, label) in enumerate(SUBSCRIBER_STATUSES):

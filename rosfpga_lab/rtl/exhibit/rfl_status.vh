@@ -1,5 +1,5 @@
 // rfl_status.vh -- the subscriber's status codes (0: accepted, else the refused field).
-// Generated from rosfpga_lab.hw.interpreter.SUBSCRIBER_STATUSES by
+// Generated from rosfpga_lab.rtl.exhibit.params.SUBSCRIBER_STATUSES by
 // rosfpga_lab.rtl.exhibit.params.status_header(); a test keeps this file equal
 // to it.
 localparam [3:0] SUB_OK = 4'd0;  // frame accepted
