@@ -17,8 +17,7 @@ from hypothesis import strategies as st
 from rosfpga_lab.hw import PipelineConfigError
 from rosfpga_lab.hw.encodings import pixel_format
 from rosfpga_lab.hw.framing import (EOL_EARLY, EOL_LATE, FRAMING_FLAGS, SOF_EARLY, SOF_MISSING,
-                                    flag_names, reframe_bytes_fast, reframe_bytes_reference,
-                                    reframe_fast, reframe_reference)
+                                    flag_names, reframe_fast, reframe_reference)
 from rosfpga_lab.hw.morph import morph_fast, morph_stream_fast, morph_stream_reference
 from rosfpga_lab.hw.streams import Beats
 
@@ -111,38 +110,5 @@ def damaged(draw):
 def test_fast_equals_reference_on_random_streams(case):
     rows, cols, beats = case
     ref, fast = reframe_reference(beats, rows, cols), reframe_fast(beats, rows, cols)
-    assert [f.tolist() for f in ref.frames] == [f.tolist() for f in fast.frames]
-    assert (ref.frame_flags, ref.flags, ref.used) == (fast.frame_flags, fast.flags, fast.used)
-
-
-# ---- fifo2axi: re-sync on the subscriber's start-of-frame marker ----------------------------
-
-BYTE_CASES = {
-    # name: (bytes, marked positions, frame bytes, expected frames, expected flags)
-    "clean": (bytes(range(1, 9)), [0, 4], 4, [[1, 2, 3, 4], [5, 6, 7, 8]], 0),
-    "cut-short": (bytes(range(1, 8)), [0, 3], 4, [[1, 2, 3, 0], [4, 5, 6, 7]], SOF_EARLY),
-    "too-long": (bytes(range(1, 11)), [0, 6], 4, [[1, 2, 3, 4], [7, 8, 9, 10]], SOF_MISSING),
-    "junk-first": (bytes(range(1, 7)), [2], 4, [[3, 4, 5, 6]], SOF_MISSING),
-}
-
-
-@pytest.mark.parametrize("name", list(BYTE_CASES))
-@pytest.mark.parametrize("model", [reframe_bytes_reference, reframe_bytes_fast],
-                         ids=["reference", "fast"])
-def test_byte_stream_resyncs_on_the_marker(name, model):
-    data, marked, size, frames, flags = BYTE_CASES[name]
-    marks = np.zeros(len(data), bool)
-    marks[marked] = True
-    got = model(data, marks, size)
-    assert [f.tolist() for f in got.frames] == frames
-    assert got.flags == flags and got.frame_flags[-1] == (SOF_MISSING if name in ("too-long", "junk-first") else 0)
-
-
-@given(st.integers(1, 6), st.lists(st.tuples(st.integers(0, 255), st.booleans()), max_size=40))
-@settings(max_examples=300, deadline=None)
-def test_byte_fast_equals_reference(size, items):
-    data = bytes(b for b, _ in items)
-    marks = np.array([m for _, m in items], bool)
-    ref, fast = reframe_bytes_reference(data, marks, size), reframe_bytes_fast(data, marks, size)
     assert [f.tolist() for f in ref.frames] == [f.tolist() for f in fast.frames]
     assert (ref.frame_flags, ref.flags, ref.used) == (fast.frame_flags, fast.flags, fast.used)
