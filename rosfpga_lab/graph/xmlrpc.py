@@ -371,10 +371,9 @@ class XmlRpcServer:
             self._release(reserved)
         keep = keeps_alive(head)
         reply = response_message("200 OK", reply_body, keep)
-        conn.settimeout(self.request_timeout)
-        conn.sendall(reply)   # still "busy": stop() lets a reply go out (a "shutdown" call's)
-        if not self._set_busy(conn, False):
-            return False
+        # The call ran: count and record it before its reply leaves, so a caller that has the
+        # reply finds it in the trace even if the server is stopped at once (stop() would
+        # otherwise win the race against the lines after sendall).
         self.requests += 1
         if self.trace is not None:
             caller = params[0] if params and isinstance(params[0], str) else peer
@@ -383,6 +382,10 @@ class XmlRpcServer:
                               result=result, raw=self.trace.excerpt(head.raw, body),
                               raw_reply=self.trace.excerpt(reply),
                               size=len(head.raw) + len(body) + len(reply), t0=t0, **ends)
+        conn.settimeout(self.request_timeout)
+        conn.sendall(reply)   # still "busy": stop() lets a reply go out (a "shutdown" call's)
+        if not self._set_busy(conn, False):
+            return False
         return keep
 
     def _request_body(self, conn: socket.socket, http: HttpDecoder,

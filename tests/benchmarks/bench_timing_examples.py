@@ -27,7 +27,7 @@ from rosfpga_lab.config import load_config
 from rosfpga_lab.hls.circuit import circuit_of
 from rosfpga_lab.hls.vectors import sample_frames
 from rosfpga_lab.rtl.errors import TimingError
-from rosfpga_lab.rtl.timing import choose_tools, place_and_route, place_and_route_dir
+from rosfpga_lab.rtl.timing import choose_tools, format_timing, place_and_route, place_and_route_dir
 
 ROOT = Path(__file__).resolve().parents[2]
 HEADER = (f"{'configuration':<30}{'type':<22}{'wire':<8}{'seed':>5}{'Fmax':>8}{'clock':>7}"
@@ -57,19 +57,25 @@ def first_frame_clocks(config) -> str:
 
 def random_tops(count: int, seeds: list[int]) -> None:
     """Place and route ``count`` generated tops of message definitions the property test draws."""
-    import warnings
-
-    from hypothesis.errors import NonInteractiveExampleWarning
+    from hypothesis import HealthCheck, Phase, given, settings
 
     from rosfpga_lab.hls.generic import spec_from_layout
     from rosfpga_lab.hw.layout import Action, StepKind, derive_layout
     from rosfpga_lab.rtl.generic import generic_rtl_files
+
     sys.path.insert(0, str(ROOT))  # run as a script: the suite's strategy lives in tests/
     from tests.hw.test_walker import definitions
 
-    warnings.simplefilter("ignore", NonInteractiveExampleWarning)
-    for k in range(count):
-        reg, type_name, stream = definitions().example()
+    drawn: list = []  # derandomized, as the suite draws them: the same N every run
+
+    @settings(max_examples=count, derandomize=True, database=None, deadline=None,
+              phases=[Phase.generate], suppress_health_check=list(HealthCheck))
+    @given(definitions())
+    def collect(definition) -> None:
+        drawn.append(definition)
+
+    collect()
+    for k, (reg, type_name, stream) in enumerate(drawn[:count]):
         layout = derive_layout(reg, type_name, stream=stream, stream_length=3)
         small = {s.path: 3 for s in layout.steps[1:] if s.kind is StepKind.LENGTH
                  and s.action is not Action.STREAM and not s.label.endswith("[] length")}
@@ -82,6 +88,12 @@ def random_tops(count: int, seeds: list[int]) -> None:
                 report = place_and_route_dir(work, 100.0, seed=seed)
                 print(row(f"random #{k + 1}", type_name[-21:], "tcpros", seed, report, "-"),
                       flush=True)
+                if not report.met:
+                    path = [line for line in format_timing(report).splitlines()
+                            if line.startswith(("critical path", "  through"))]
+                    print("\n".join(f"    {line.strip()}" for line in path), flush=True)
+            print(f"    {type_name}: {len(layout.steps)} layout steps, stream {stream}",
+                  flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:

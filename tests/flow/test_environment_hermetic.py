@@ -56,7 +56,7 @@ def test_a_variable_a_test_sets_is_seen(monkeypatch: pytest.MonkeyPatch) -> None
 def test_a_sample_of_the_suite_passes_in_a_ros_users_shell(tmp_path: Path) -> None:
     env = {**os.environ, **USER_SHELL}
     run = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "--durations=1",
          "--rootdir", str(HERE.parent),
          *(str(HERE / test) for test in SAMPLE)],
         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
