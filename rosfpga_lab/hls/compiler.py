@@ -24,7 +24,7 @@ from rosfpga_lab.hls.program import _replace
 from rosfpga_lab.hls.program import (
     ENCAP_BYTES, FRAME_LENGTH_STATUS, Instr, Op, Program, Pub, Sub,
 )
-from rosfpga_lab.hw.cdrlayout import TAIL_LABEL, CdrLayout, cdr_length_rules
+from rosfpga_lab.hw.cdrlayout import CdrLayout, cdr_length_rules
 from rosfpga_lab.hw.layout import Action, CheckOp, Layout, Step, StepKind, length_rules
 from rosfpga_lab.msg.builtins import SCALARS
 
@@ -198,10 +198,7 @@ def program_from_layout(layout: Layout, *, max_frame: int | None = None,
                             f"publisher, over the {MAX_CARRY_BYTES} a generated circuit holds: "
                             "lower the maxima of its strings and arrays (limits: in the "
                             "configuration)")
-    # CDR: the status of a non-zero byte in the unannounced end padding (the walk's own)
-    tail = {label: c for c, (_name, label) in enumerate(layout.statuses)}.get(TAIL_LABEL, 0) \
-        if cdr is not None else 0
-    instrs.append(Instr(Op.DONE, status=FRAME_LENGTH_STATUS, status2=tail, name="", type=""))
+    instrs.append(Instr(Op.DONE, status=FRAME_LENGTH_STATUS, name="", type=""))
     consts = sum(len(ins.const) for ins in instrs)
     for what, n, most in (("status codes", len(layout.statuses), 256),
                           ("instructions", len(instrs), 1 << 16),

@@ -40,9 +40,12 @@ output position, because skipped or re-sized fields change where its fields fall
 the payload from the options' two low bits (skipped after ``DONE``); the publisher writes its
 constant ``00 01 00 00``. At ``DONE``, when the options announce fewer bytes than are left and
 those are the 1 to :data:`END_ALIGN` - 1 that bring the payload (header included) to a multiple of
-:data:`END_ALIGN` (Cyclone DDS pads so with options ``00 00``), the subscriber takes them when
-they are zero, and refuses the first non-zero one with ``DONE``'s ``status2`` (the models'
-``payload end padding``); any other bytes left refuse the frame with the frame length's status. No count is held to an exact fit in CDR (``fixed_after`` -1).
+:data:`END_ALIGN` (Cyclone DDS pads so with options ``00 00``), the subscriber takes them; any
+other bytes left refuse the frame with the frame length's status. Padding is never looked at,
+whatever its value (CDR leaves it undefined; Cyclone DDS writes zeros and reads past it), so a
+walk whose stream is its last field can be released at the stream's count
+(:attr:`Program.stream_early`). No count is held to an exact fit in CDR (``fixed_after`` -1),
+but with early release the stream's count is held to the payload's end, up to that end padding.
 """
 
 from __future__ import annotations
@@ -103,8 +106,7 @@ class Instr:
         variable: LOOP: the count is read from the frame (a uint32) rather than fixed.
         status: the status code the subscriber refuses with at this field (0: it cannot fail);
             for VAR, a bad count.
-        status2: VAR with CHECK: the status of contents unlike the constant; CDR's DONE: the
-            status of a non-zero byte in the unannounced end padding (0: TCPROS, none taken).
+        status2: VAR with CHECK: the status of contents unlike the constant.
         fixed_after: VAR and variable LOOP: when only fixed-size fields follow the counted part,
             their bytes (then the count must fill the frame exactly), else -1.
         elem_min: VAR and variable LOOP: fewest bytes of one element (VAR: ``size``).
@@ -204,28 +206,42 @@ class Program:
         return Program(tuple(fixed), const_offsets=tuple(offsets), **kwargs)  # type: ignore[arg-type]
 
     @property
+    def cdr(self) -> bool:
+        """The walk reads CDR samples (it has an ``ENCAP``), not TCPROS frames."""
+        return any(ins.op == Op.ENCAP for ins in self.instrs)
+
+    @property
     def stream_early(self) -> int | None:
         """Where the subscriber may hand a frame over early (streaming early release), or None.
 
-        When the streamed array is a ``VAR`` outside any loop whose count must fill the frame
-        exactly with what follows (``fixed_after`` >= 0: TCPROS), and only ``FIXED`` fields
-        that cannot refuse (skipped or carried) follow it, the frame's fate is decided once its
-        count is checked: nothing after it can refuse the frame. The subscriber then hands the
-        fields over (``meta_valid``, with the whole output length) at the count's decision, and
-        the publisher writes the frame while the stream flows (the FIFO after the application
-        holds a few beats, not the whole array). Returns the bytes the publisher writes from the
-        count on (the count, the array, the fixed fields after it), added to the output length
-        so far; None: the whole frame is read first (a variable field, a check or CDR's end
-        padding may refuse the frame after its stream went out).
+        The streamed array must be a ``VAR`` outside any loop, written as the application's
+        output, whose count decides the frame's fate: nothing after the count may refuse it.
+        TCPROS: the count must fill the frame exactly with what follows (``fixed_after`` >= 0),
+        and only ``FIXED`` fields that cannot refuse (skipped or carried) follow it. CDR: the
+        array is the last field and its elements align to at most :data:`END_ALIGN` (so no
+        padding falls between its count and its elements, in or out); at the count the
+        subscriber then checks that the elements end the payload exactly or leave only the
+        unannounced end padding (whose bytes are never looked at). The subscriber then hands
+        the fields over (``meta_valid``, with the whole output length) at the count's decision,
+        and the publisher writes the frame while the stream flows (the FIFO after the
+        application holds a few beats, not the whole array). Returns the bytes the publisher
+        writes from the count on (the count, the array, the fixed fields after it), added to
+        the output length so far; None: the whole frame is read first (a variable field or a
+        check after the stream may refuse the frame after its stream went out).
         """
         depth = 0
+        cdr = self.cdr
         for i, ins in enumerate(self.instrs):
             depth += (ins.op == Op.LOOP) - (ins.op == Op.END)
             if ins.sub != Sub.STREAM or ins.op not in (Op.FIXED, Op.VAR):
                 continue
             rest = self.instrs[i + 1:-1]
-            if ins.op != Op.VAR or ins.pub != Pub.STREAM or depth or ins.fixed_after < 0 or any(
-                    r.op != Op.FIXED or r.sub not in (Sub.SKIP, Sub.CARRY) for r in rest):
+            if ins.op != Op.VAR or ins.pub != Pub.STREAM or depth:
+                return None
+            if cdr and (rest or ins.elem_align > END_ALIGN):
+                return None
+            if not cdr and (ins.fixed_after < 0 or any(
+                    r.op != Op.FIXED or r.sub not in (Sub.SKIP, Sub.CARRY) for r in rest)):
                 return None
             return 4 + ins.count * ins.size + sum(r.size for r in rest)
         return None
@@ -234,6 +250,14 @@ class Program:
     def const_table(self) -> bytes:
         """Every instruction's constant bytes, one after the other."""
         return b"".join(ins.const for ins in self.instrs)
+
+
+def _end_padding(pos: int, fend: int, end: int) -> bool:
+    """CDR: the bytes from ``pos`` (where the fields end) to the sample's ``end`` are the
+    unannounced end padding (``fend``: the end less the announced padding): 1 to
+    :data:`END_ALIGN` - 1 bytes that bring the payload to a multiple of :data:`END_ALIGN`."""
+    after = end - pos
+    return pos != fend and 0 < after < END_ALIGN and after == -(pos - ALIGN_ORIGIN) % END_ALIGN
 
 
 def _replace(ins: Instr, **changes: object) -> Instr:
@@ -377,7 +401,12 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None,
             raise Refused(FRAME_LENGTH_STATUS, bool(stream))
         if need > fend - pos:
             raise Refused(ins.status, bool(stream))
+        if early_cdr and ins.sub == Sub.STREAM and need != fend - pos and \
+                not _end_padding(pos + need, fend, end):
+            raise Refused(FRAME_LENGTH_STATUS, bool(stream))  # as DONE would, at the count
 
+    cdr = prog.cdr
+    early_cdr = cdr and prog.stream_early is not None
     suppressed = 0
     while True:
         ins = prog.instrs[pc]
@@ -385,10 +414,7 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None,
         tl += decide  # each instruction's decode (S_DECODE); S_COUNTED, S_FINISH below
         if ins.op == Op.DONE:
             after = end - pos  # CDR: Cyclone's unannounced zeros up to a multiple of END_ALIGN
-            if ins.status2 and pos != fend and 0 < after < END_ALIGN and \
-                    after == -(pos - ALIGN_ORIGIN) % END_ALIGN:
-                if any(frame[pos:end]):
-                    raise Refused(ins.status2, bool(stream))
+            if cdr and _end_padding(pos, fend, end):
                 tl.extend(b"\1" * after)  # taken before the frame is accepted
             elif pos != fend:
                 raise Refused(ins.status, bool(stream))

@@ -15,10 +15,11 @@ zero byte CDR sends for it) and then rewrites that walk for the CDR wire:
   the options' two low bits say how many padding bytes end the payload (DDS-XTypes 1.3
   7.6.3.1.2); after the last field the circuit takes exactly those bytes (not looked at) or,
   when the options announce fewer (or none), the 1 to 3 bytes that bring the payload (header
-  included) to a multiple of 4 when they are zero: Cyclone DDS pads its XCDR1 payloads to 4
-  with options ``00 00`` (a 398-byte ``lab_msgs/Samples`` arrives as 400 bytes). Any other bytes after the
-  last field are refused: ``frame length`` (bytes the sample length announces beyond that), or
-  ``payload end padding`` (a non-zero byte in the unannounced padding, at its offset);
+  included) to a multiple of 4: Cyclone DDS pads its XCDR1 payloads to 4 with options
+  ``00 00`` (a 398-byte ``lab_msgs/Samples`` arrives as 400 bytes). Padding bytes are never
+  looked at (CDR leaves their value undefined; Cyclone DDS writes zeros and reads past them).
+  Any other bytes after the last field are refused: ``frame length`` (bytes the sample length
+  announces beyond that);
 * every step has an *alignment* (:attr:`CdrLayout.align`): a scalar its size, a length prefix 4,
   a numeric array its element size (only when it has elements), everything else 1; before a step
   the circuit skips ``-(offset - 8) % align`` padding bytes (offset 8: after the sample length
@@ -60,7 +61,7 @@ OPTIONS_PADDING_MASK = 0x3
 #: Byte offset in the circuit's input of CDR's alignment origin (sample length + header).
 ALIGN_ORIGIN = 4 + ENCAPSULATION_SIZE
 #: Label of the padding bytes that end a payload (the encapsulation options count them, or they
-#: align the payload to :data:`END_ALIGN` unannounced); its status is the walk's last.
+#: align the payload to :data:`END_ALIGN` unannounced): where a sample cut short ends.
 TAIL_LABEL = "payload end padding"
 #: The serialized payload (header included) may end with zeros up to a multiple of this.
 END_ALIGN = 4
@@ -189,10 +190,8 @@ def to_cdr(base: Layout, reg: MsgRegistry) -> CdrLayout:
             align.append(1)
             base_index.append(None)
     stream_index = remap(base.stream_index)
-    tail_ident = _unique("payload_end_padding", taken)
     statuses = (base.statuses[0],) + tuple((s.check.status, s.label) for s in out
-                                           if s.check is not None) + \
-        ((f"SUB_BAD_{tail_ident.upper()}", TAIL_LABEL),)  # a non-zero unannounced pad byte
+                                           if s.check is not None)
     layout = Layout(type_name=base.type_name, md5=base.md5, steps=tuple(out),
                     stream_index=stream_index, stream_length=base.stream_length,
                     min_body=0, max_body=0, statuses=statuses, video=base.video)

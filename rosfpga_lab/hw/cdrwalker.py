@@ -6,10 +6,11 @@ steps with CDR's three additions: before a step it skips the step's alignment pa
 from after the encapsulation header), it checks the encapsulation header (representation
 CDR little-endian; the options' low bits give the padding that ends the payload, skipped after
 the last field) and a string's NUL, and a string takes ``length - 1`` bytes. After the last
-field it also takes, when the options announce fewer (Cyclone DDS: none), the 1 to 3 *zero* bytes that bring the serialized
-payload (header included) to a multiple of 4: RTPS 2.5 9.4.2.11 and DDS-XTypes 1.3 7.6.3.1.2
-ask for that padding, and Cyclone DDS sends it with options ``00 00`` (a 398-byte
-``lab_msgs/Samples`` arrives as 400 bytes); a non-zero byte there, or more bytes, is refused. Refusals and
+field it also takes, when the options announce fewer (Cyclone DDS: none), the 1 to 3 bytes that
+bring the serialized payload (header included) to a multiple of 4: RTPS 2.5 9.4.2.11 and
+DDS-XTypes 1.3 7.6.3.1.2 ask for that padding, and Cyclone DDS sends it with options ``00 00``
+(a 398-byte ``lab_msgs/Samples`` arrives as 400 bytes); like every padding byte, their values
+are not looked at (CDR leaves them undefined); more bytes are refused. Refusals and
 resynchronisation are the walker's: the field, its byte offset (in the input, 0 = the first
 byte of the sample length) and the rule; a refused sample is skipped to its end.
 :func:`extract_cdr_fast` runs the same machine a whole step at a time.
@@ -30,12 +31,12 @@ from rosfpga_lab.hw.cdrlayout import (
     ALIGN_ORIGIN, END_ALIGN, OPTIONS_PADDING_MASK, TAIL_LABEL, CdrLayout, cdr_length_rules,
     cdr_marshal, to_base_tokens, to_cdr_tokens,
 )
-from rosfpga_lab.hw.errors import FrameFieldError, FrameLengthError, FrameTruncatedError
+from rosfpga_lab.hw.errors import FrameLengthError, FrameTruncatedError
 from rosfpga_lab.hw.layoutsteps import Step, StepKind
 from rosfpga_lab.hw.layouttokens import Token
 from rosfpga_lab.hw.publisherwalker import published_tokens, shift_out, value_size, write_value
 from rosfpga_lab.hw.subscriberwalker import (
-    STAGE, Extracted, LayoutInterpreter, run_fast, run_reference,
+    Extracted, LayoutInterpreter, run_fast, run_reference,
 )
 from rosfpga_lab.msg.cdr import CDR_BE
 
@@ -64,7 +65,6 @@ class CdrInterpreter(LayoutInterpreter):
         super().reset()
         self._tail = 0
         self._tail_left = 0
-        self._tail_zero = False     # the end padding is unannounced: its bytes must be zero
         self._done: Extracted | None = None
 
     @property
@@ -96,9 +96,7 @@ class CdrInterpreter(LayoutInterpreter):
         """
         if self._tail_left:
             self.offset += 1
-            self._tail_left -= 1
-            if self._tail_zero and byte:
-                self._nonzero_tail(self.offset - 1, byte)
+            self._tail_left -= 1         # an end padding byte (its value is not looked at)
             if not self._tail_left:
                 self._publish_done()
             return
@@ -155,7 +153,7 @@ class CdrInterpreter(LayoutInterpreter):
         after = self._sample_end - self.offset   # bytes after the last field
         if after != self._tail and 0 < after < END_ALIGN and \
                 after == -(self.offset - ALIGN_ORIGIN) % END_ALIGN:
-            self._tail, self._tail_zero = after, True   # unannounced alignment to 4: zeros
+            self._tail = after   # unannounced alignment to END_ALIGN
         self._done = self._extracted()
         if self._tail:
             self._tail_left = self._tail
@@ -163,29 +161,17 @@ class CdrInterpreter(LayoutInterpreter):
             return
         self._publish_done()
 
-    def _nonzero_tail(self, at: int, byte: int) -> None:
-        self._fail(FrameFieldError(
-            f"byte 0x{byte:02x} after the last field, where only zero bytes may pad the payload "
-            f"to a multiple of {END_ALIGN} (the encapsulation options announce no end padding)",
-            TAIL_LABEL, at, byte, STAGE, rule="not zero"))
-
     def _publish_done(self) -> None:
         assert self._done is not None
         self._publish(self._done)
 
     def _take_tail(self, view: memoryview) -> bool:
-        """Fast model: take the end padding whole (its bytes checked when they must be zero)."""
+        """Fast model: take the end padding whole (its bytes are not looked at)."""
         if not self._tail_left:
             return False
         if self.offset + self._tail_left > len(view):
             raise FrameTruncatedError("the sample was cut short in its end padding",
                                       TAIL_LABEL, len(view))
-        if self._tail_zero:
-            tail = view[self.offset:self.offset + self._tail_left]
-            for k, byte in enumerate(tail):
-                if byte:
-                    self.offset += k + 1
-                    self._nonzero_tail(self.offset - 1, byte)
         self.offset += self._tail_left
         self._tail_left = 0
         self._publish_done()

@@ -123,8 +123,10 @@ def test_cli_rtl_cycles_of_a_generated_circuit(capsys: pytest.CaptureFixture[str
 
 def _early_cases() -> list[tuple[str, Any, list[bytes], Any]]:
     """Walks with streaming early release: small Image frames on TCPROS (the publisher waits
-    for the 2-D window's line, or writes its header first) and a message whose stream is
-    followed by carried fixed fields (the publisher waits for them in the carry memory)."""
+    for the 2-D window's line, or writes its header first), a message whose stream is
+    followed by carried fixed fields (the publisher waits for them in the carry memory), and a
+    CDR message whose stream is its last field: the payload exact, then with its unannounced
+    end padding (zeros, then not: padding is never looked at)."""
     from rosfpga_lab.hls.generic import spec_from_config
     from rosfpga_lab.msg.registry import MsgRegistry
 
@@ -145,6 +147,17 @@ def _early_cases() -> list[tuple[str, Any, list[bytes], Any]]:
                                                     "stamp": 2**63 + 5, "mode": 7})
             frames.append(struct.pack("<I", len(body)) + body)
         cases.append((f"lab_msgs/Tail {op}", spec, frames, None))
+    reg.add("lab_msgs/Last", "string name\nuint16[] data\n")
+    walk = derive_cdr_layout(reg, "lab_msgs/Last", stream="data", stream_length=5)
+    spec = spec_from_layout(walk.layout, walk.registry, program=program_from_cdr(walk),
+                            wire="cdr", op="dilate", ksize=3)
+    frames = []
+    for name, fill in (("abc", b""), ("a", b"\0\0"), ("ab", b"\x5a\x01")):
+        body = serialize_cdr(ros2_registry(reg), "lab_msgs/Last",
+                             {"name": name, "data": [1, 900, 3, 65535, 7]})
+        assert len(body) % 4 == 2, name  # the header, the name to 4, the count, 10 bytes
+        frames.append(struct.pack("<I", len(body + fill)) + body + fill)
+    cases.append(("lab_msgs/Last on CDR", spec, frames, None))
     # an array shorter than the window: it flushes a clock per missing element
     reg.add("lab_msgs/Short", "float32[] data\nuint64 stamp\n")
     for n, ksize in ((1, 5), (2, 7)):

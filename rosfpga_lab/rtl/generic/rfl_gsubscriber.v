@@ -12,16 +12,18 @@
 // field the bytes that align it are skipped (S_PAD); a string's count includes its NUL, which
 // must be 0; out_len includes the padding the publisher will write. After the last field, the
 // bytes the options do not announce that pad the payload to a multiple of END_ALIGN (Cyclone DDS
-// pads so with options 00 00) are taken when they are zero (S_TAIL); the first non-zero one
-// refuses the sample with OP_DONE's status2.
+// pads so with options 00 00) are taken (S_TAIL); no padding byte is looked at (CDR leaves its
+// value undefined).
 // No multiplier (100 MHz on an ECP5 with no DSP): an OP_VAR's bytes are its count shifted by
 // lsize; an OP_LOOP's fewest bytes (count x elem_min) are added up in S_LEAST, one bit of
 // elem_min per clock, before S_COUNTED checks them. The bytes left for the fields (room: CDR
 // less the end padding) and in the frame (left_f) are registers kept with pos, and a body's
 // last byte is found by a count down (left_b), so that no clock subtracts and compares in a row.
 // Streaming early release (STREAM_EARLY, from Program.stream_early; EARLY must equal it): when
-// nothing after the stream's count can refuse the frame (its count fills the frame exactly with
-// fixed fields that are skipped or carried), the frame is handed over (meta_valid, out_len +
+// nothing after the stream's count can refuse the frame (TCPROS: its count fills the frame
+// exactly with fixed fields that are skipped or carried; CDR: the stream is the last field and
+// its elements end the payload, or leave only the unannounced end padding, checked at the count
+// as c_early_bad), the frame is handed over (meta_valid, out_len +
 // EARLY_ADD) at the count's decision, so the publisher writes it while the stream flows; the
 // frame's end then raises no meta_valid. The publisher may read the carry memory while the
 // fields after the stream are written into it: a byte is read only once written (craddr <
@@ -154,10 +156,10 @@ module rfl_gsubscriber #(
     wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
     wire [31:0] pos_next = pos + 32'd1;
     wire        at_end = (left_f == 32'd0);         // nothing left of the frame to skip
-    // CDR: the bytes left after the last field are the unannounced zeros up to a multiple of
-    // END_ALIGN (OP_DONE's st2 != 0)
-    wire        tail_zero = CDR && st2 != 8'd0 && room != 32'd0 && left_f != 32'd0
-                            && left_f < {28'd0, END_ALIGN} && left_f == pad_at(pos, END_ALIGN);
+    // CDR: the bytes left after the last field are the unannounced padding up to a multiple of
+    // END_ALIGN
+    wire        tail_pad = CDR && room != 32'd0 && left_f != 32'd0
+                           && left_f < {28'd0, END_ALIGN} && left_f == pad_at(pos, END_ALIGN);
     wire [31:0] pad_f = pad_at(pos, align);         // before a field or a count
     wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
     wire [31:0] room_f = room - pad_f;              // bytes left after that padding
@@ -281,6 +283,10 @@ module rfl_gsubscriber #(
     // on flip-flops only): an OP_VAR's count padding, a variable OP_LOOP's count, OP_ENCAP's
     // header and end padding
     reg [31:0] p_out_var, p_out4, p_out_klen, p_room_encap, p_out_early;
+    // CDR's early release: where the stream's elements would end, and the bytes after them
+    // to the fields' end (room) and to the sample's end (left_f)
+    reg [31:0] p_end_pos, p_end_room, p_end_left;
+    reg        c_early_bad;
     // The next instructions, registered (the ROM look-up and the adders are not on the
     // decision's path): pc holds from one go() through the two settling clocks of the decision
     // that does the next, so by then these are prog_next(pc), prog_jump(pc) and their pcs.
@@ -296,9 +302,12 @@ module rfl_gsubscriber #(
         p_out_klen <= out_len + {16'd0, klen};
         p_room_encap <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
         p_out_early <= out_len + EARLY_ADD;
+        p_end_pos <= pos + body[31:0];
+        p_end_room <= room - body[31:0];
+        p_end_left <= left_f - body[31:0];
     end
     always @(posedge clk) begin
-        c_tail <= tail_zero;
+        c_tail <= tail_pad;
         c_at_end <= at_end;
         c_room0 <= (room == 32'd0);
         c_room_lt4 <= (room < 32'd4);
@@ -333,6 +342,10 @@ module rfl_gsubscriber #(
                                                       : {3'd0, size}) != {19'd0, klen});
         c_range_bad <= (sub == SUB_RANGE && !in_range);  // from p_vkey, p_vnan
         c_out_len <= p_out_at + p_written;
+        // (the elements end the payload, or leave only its unannounced end padding)
+        c_early_bad <= STREAM_EARLY != 0 && CDR != 0 && sub == SUB_STREAM && p_end_room != 32'd0
+                       && !(p_end_left != 32'd0 && p_end_left < {28'd0, END_ALIGN}
+                            && p_end_left == pad_at(p_end_pos, END_ALIGN));
     end
 
     // Skip `p` alignment bytes (if any), then go to state `next`.
@@ -598,6 +611,8 @@ module rfl_gsubscriber #(
                         refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                     end else if (c_body_gt) begin
                         refuse(st != 8'd0 ? st : SUB_BAD_FRAME_LENGTH, c_at_end);
+                    end else if (c_early_bad) begin  // as OP_DONE would, before the stream
+                        refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                     end else begin
                         left_b <= body;
                         last_b <= c_body1;
@@ -644,10 +659,7 @@ module rfl_gsubscriber #(
                         go(pc_nx, w_nx);
                     end
                 end
-                S_TAIL: if (take) begin  // CDR: an unannounced end pad byte, which must be 0
-                    if (s_tdata != 8'd0) refuse(st2, last_f);
-                    else if (last_f) accept(1'b1);
-                end
+                S_TAIL: if (take && last_f) accept(1'b1);  // CDR: the unannounced end padding
                 S_SKIP: if (take && last_f) begin
                     state <= S_FLEN;
                     cnt <= 32'd0;

@@ -37,7 +37,7 @@ struct instr_t {
     unsigned count;      // OP_VAR: most elements (a stream: exactly); OP_LOOP: elements (or most)
     bool variable;       // OP_LOOP: the count is read from the frame
     unsigned char status;  // the status a refusal at this field returns (OP_VAR: a bad count)
-    unsigned char status2;  // OP_VAR with SUB_CHECK: contents unlike the constant; CDR's OP_DONE: a non-zero unannounced end pad byte
+    unsigned char status2;  // OP_VAR with SUB_CHECK: contents unlike the constant
     unsigned char kind;  // SUB_RANGE: 0 unsigned, 1 signed, 2 float
     int fixed_after;     // a count: bytes of the fixed-size fields after, if only such follow, else -1
     unsigned elem_min;   // a count: fewest bytes of one element

@@ -32,7 +32,6 @@ static const char* status_name(int status) {
     case SUB_BAD_RANGE_MAX: return "SUB_BAD_RANGE_MAX";
     case SUB_BAD_RANGES_LENGTH: return "SUB_BAD_RANGES_LENGTH";
     case SUB_BAD_INTENSITIES_LENGTH: return "SUB_BAD_INTENSITIES_LENGTH";
-    case SUB_BAD_PAYLOAD_END_PADDING: return "SUB_BAD_PAYLOAD_END_PADDING";
     default: return "?";
     }
 }

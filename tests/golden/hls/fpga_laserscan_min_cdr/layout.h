@@ -28,7 +28,6 @@ enum subscriber_status {
     SUB_BAD_RANGE_MAX = 5,  // range_max
     SUB_BAD_RANGES_LENGTH = 6,  // ranges length
     SUB_BAD_INTENSITIES_LENGTH = 7,  // intensities length
-    SUB_BAD_PAYLOAD_END_PADDING = 8,  // payload end padding
 };
 
 struct instr_t {
@@ -37,7 +36,7 @@ struct instr_t {
     unsigned count;      // OP_VAR: most elements (a stream: exactly); OP_LOOP: elements (or most)
     bool variable;       // OP_LOOP: the count is read from the frame
     unsigned char status;  // the status a refusal at this field returns (OP_VAR: a bad count)
-    unsigned char status2;  // OP_VAR with SUB_CHECK: contents unlike the constant; CDR's OP_DONE: a non-zero unannounced end pad byte
+    unsigned char status2;  // OP_VAR with SUB_CHECK: contents unlike the constant
     unsigned char kind;  // SUB_RANGE: 0 unsigned, 1 signed, 2 float
     int fixed_after;     // a count: bytes of the fixed-size fields after, if only such follow, else -1
     unsigned elem_min;   // a count: fewest bytes of one element
@@ -65,7 +64,7 @@ static const instr_t PROGRAM[PROGRAM_LENGTH] = {
     {OP_FIXED, SUB_RANGE, PUB_CARRY, 4, 0, false, 5, 0, 2, -1, 0, 4, 8, 0, 4, 1, false, 0},  // 10: range_max (float32): 4 byte(s); carry, check bounds 000080ff..00007a44 (LE hex); out: as received; align 4
     {OP_VAR, SUB_STREAM, PUB_STREAM, 4, 360, false, 6, 0, 0, -1, 4, 12, 0, 0, 4, 4, false, 0},  // 11: ranges (float32[]): uint32 count + count x 4 byte(s), exactly 360; stream; out: the application's output; align 4; align 4 (elements)
     {OP_VAR, SUB_CARRY, PUB_CARRY, 4, 360, false, 7, 0, 0, -1, 4, 12, 0, 0, 4, 4, false, 0},  // 12: intensities (float32[]): uint32 count + count x 4 byte(s), at most 360; carry; out: as received; align 4; align 4 (elements)
-    {OP_DONE, SUB_SKIP, PUB_CARRY, 0, 0, false, 1, 8, 0, -1, 0, 12, 0, 0, 1, 1, false, 0},  // 13: end of the message: the frame must end here
+    {OP_DONE, SUB_SKIP, PUB_CARRY, 0, 0, false, 1, 0, 0, -1, 0, 12, 0, 0, 1, 1, false, 0},  // 13: end of the message: the frame must end here
 };
 
 // The constant bytes of checked fields and of fields the publisher writes as constants.

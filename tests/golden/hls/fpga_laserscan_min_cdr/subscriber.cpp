@@ -11,8 +11,9 @@
 // encapsulation header (00 01: CDR little-endian) and takes the padding that ends the payload
 // from its options; before each field the subscriber skips the bytes that align it (counted
 // from byte 8, after the sample length and the header); a string's count includes its NUL,
-// which must be there. After the last field it takes the zeros the options do not announce
-// that pad the payload to a multiple of END_ALIGN. It also adds the publisher's own padding
+// which must be there. After the last field it takes the bytes the options do not announce
+// that pad the payload to a multiple of END_ALIGN (padding is never looked at: CDR leaves its
+// value undefined). It also adds the publisher's own padding
 // to the output length.
 #include "ros_node.h"
 
@@ -22,7 +23,7 @@
 // per clock whatever the mix of fields; only steps with no byte of their own take a clock
 // without one (the end of each element of an array of messages, entering such an array, an
 // empty field, the end of the walk).
-enum { ST_LEN, ST_DECODE, ST_PAD, ST_COUNT, ST_BYTES, ST_ENCAP, ST_ENDPAD, ST_SKIP, ST_FINISH };
+enum { ST_LEN, ST_DECODE, ST_PAD, ST_COUNT, ST_BYTES, ST_ENCAP, ST_SKIP, ST_FINISH };
 
 // The order key of a value of `bytes` bytes (see layout.h: kind 0 unsigned, 1 signed, 2 float
 // with -0.0 taken as +0.0): a larger key is a larger value.
@@ -64,7 +65,7 @@ struct sub_walk {
     ap_uint<32> pos, end, fend;  // bytes read of the frame; its end; where its fields end
     ap_uint<32> out_len;     // bytes of the message the publisher will write
     ap_uint<32> n, bytes, i;  // the count read; the field's bytes; bytes of it taken so far
-    unsigned k;              // ST_LEN, ST_COUNT, ST_ENCAP: bytes taken; ST_PAD, ST_ENDPAD: bytes left
+    unsigned k;              // ST_LEN, ST_COUNT, ST_ENCAP: bytes taken; ST_PAD: bytes left
     unsigned long long value;  // a SUB_RANGE field, little-endian
     bool same;               // a SUB_CHECK field equals its constant so far
     bool nul_ok;             // a string's last byte is its NUL
@@ -177,16 +178,12 @@ static bool decode(sub_walk& w) {
     const instr_t& ins = w.ins;
     if (ins.op == OP_DONE) {
         // Bytes the options do not announce, that bring the payload to a multiple of
-        // END_ALIGN (Cyclone DDS pads so with options 00 00): taken when they are zero.
+        // END_ALIGN (Cyclone DDS pads so with options 00 00): skipped, as all padding is.
         const unsigned after = w.end.to_uint() - w.pos.to_uint();
-        if (ins.status2 != 0 && w.pos != w.fend && after != 0 && after < END_ALIGN &&
-            after == pad(w.pos.to_uint(), END_ALIGN)) {
-            w.k = after;
-            w.st = ST_ENDPAD;
-            return true;
-        }
-        if (w.pos != w.fend) refuse(w, ins.status);  // bytes left over
-        else w.st = w.pos < w.end ? ST_SKIP : ST_FINISH;  // the padding the options announce
+        const bool end_pad = w.pos != w.fend && after != 0 && after < END_ALIGN &&
+                             after == pad(w.pos.to_uint(), END_ALIGN);
+        if (w.pos != w.fend && !end_pad) refuse(w, ins.status);  // bytes left over
+        else w.st = w.pos < w.end ? ST_SKIP : ST_FINISH;  // the end padding
         return w.st == ST_SKIP;
     }
     if (ins.op == OP_ENCAP) {  // CDR's encapsulation header
@@ -290,11 +287,7 @@ static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& ca
             w.st = ST_DECODE;
         }
         break;
-    case ST_ENDPAD:
-        if (b != 0) refuse(w, ins.status2);  // the rest is skipped
-        else if (--w.k == 0) w.st = ST_FINISH;
-        break;
-    default:  // ST_SKIP: a refused frame, to its end (or an accepted one's announced end padding)
+    default:  // ST_SKIP: a refused frame, to its end (or an accepted one's end padding)
         if (w.pos == w.end) w.st = ST_FINISH;
         break;
     }

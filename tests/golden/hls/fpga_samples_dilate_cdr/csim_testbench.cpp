@@ -38,7 +38,6 @@ static const char* status_name(int status) {
     case SUB_BAD_HISTORY_LENGTH: return "SUB_BAD_HISTORY_LENGTH";
     case SUB_BAD_HISTORY_SENSOR_NAME_LENGTH: return "SUB_BAD_HISTORY_SENSOR_NAME_LENGTH";
     case SUB_BAD_HISTORY_SENSOR_NAME_NUL: return "SUB_BAD_HISTORY_SENSOR_NAME_NUL";
-    case SUB_BAD_PAYLOAD_END_PADDING: return "SUB_BAD_PAYLOAD_END_PADDING";
     default: return "?";
     }
 }

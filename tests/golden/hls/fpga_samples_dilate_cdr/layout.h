@@ -34,7 +34,6 @@ enum subscriber_status {
     SUB_BAD_HISTORY_LENGTH = 11,  // history length
     SUB_BAD_HISTORY_SENSOR_NAME_LENGTH = 12,  // history[].sensor_name length
     SUB_BAD_HISTORY_SENSOR_NAME_NUL = 13,  // history[].sensor_name NUL
-    SUB_BAD_PAYLOAD_END_PADDING = 14,  // payload end padding
 };
 
 struct instr_t {
@@ -43,7 +42,7 @@ struct instr_t {
     unsigned count;      // OP_VAR: most elements (a stream: exactly); OP_LOOP: elements (or most)
     bool variable;       // OP_LOOP: the count is read from the frame
     unsigned char status;  // the status a refusal at this field returns (OP_VAR: a bad count)
-    unsigned char status2;  // OP_VAR with SUB_CHECK: contents unlike the constant; CDR's OP_DONE: a non-zero unannounced end pad byte
+    unsigned char status2;  // OP_VAR with SUB_CHECK: contents unlike the constant
     unsigned char kind;  // SUB_RANGE: 0 unsigned, 1 signed, 2 float
     int fixed_after;     // a count: bytes of the fixed-size fields after, if only such follow, else -1
     unsigned elem_min;   // a count: fewest bytes of one element
@@ -76,7 +75,7 @@ static const instr_t PROGRAM[PROGRAM_LENGTH] = {
     {OP_FIXED, SUB_CARRY, PUB_CARRY, 1, 0, false, 0, 0, 0, -1, 0, 5, 0, 0, 1, 1, false, 0},  // 15:   history[].mode (uint8): 1 byte(s); carry; out: as received
     {OP_END, SUB_SKIP, PUB_CARRY, 0, 0, false, 0, 0, 0, -1, 0, 5, 0, 12, 1, 1, false, 0},  // 16: end of each element of history
     {OP_FIXED, SUB_CARRY, PUB_CARRY, 1, 0, false, 0, 0, 0, -1, 0, 5, 0, 0, 1, 1, false, 0},  // 17: valid (bool): 1 byte(s); carry; out: as received
-    {OP_DONE, SUB_SKIP, PUB_CARRY, 0, 0, false, 1, 14, 0, -1, 0, 5, 0, 0, 1, 1, false, 0},  // 18: end of the message: the frame must end here
+    {OP_DONE, SUB_SKIP, PUB_CARRY, 0, 0, false, 1, 0, 0, -1, 0, 5, 0, 0, 1, 1, false, 0},  // 18: end of the message: the frame must end here
 };
 
 // The constant bytes of checked fields and of fields the publisher writes as constants.

@@ -35,7 +35,7 @@ localparam [2:0] PUB_CARRY = 3'd0, PUB_CONST = 3'd1, PUB_COUNT = 3'd2, PUB_ZERO 
 localparam IW = 224;
 localparam CDR = 0;                            // the walk reads and writes CDR (else TCPROS: no CDR logic)
 localparam [31:0] ALIGN_ORIGIN = 32'd8;           // CDR: alignment counts from this byte
-localparam [3:0] END_ALIGN = 4'd4;                    // CDR: unannounced zeros may pad the payload to a multiple of this
+localparam [3:0] END_ALIGN = 4'd4;                    // CDR: unannounced bytes may pad the payload to a multiple of this
 localparam [7:0] ENCAP_PAD_MASK = 8'd3;            // CDR: options bits counting the end padding                            // bits of an instruction word
 // streaming early release (Program.stream_early): the subscriber hands the frame over at the
 // stream's count, with out_len + EARLY_ADD (the count, the array, the fixed fields after it)

@@ -35,7 +35,7 @@ localparam [2:0] PUB_CARRY = 3'd0, PUB_CONST = 3'd1, PUB_COUNT = 3'd2, PUB_ZERO 
 localparam IW = 224;
 localparam CDR = 1;                            // the walk reads and writes CDR (else TCPROS: no CDR logic)
 localparam [31:0] ALIGN_ORIGIN = 32'd8;           // CDR: alignment counts from this byte
-localparam [3:0] END_ALIGN = 4'd4;                    // CDR: unannounced zeros may pad the payload to a multiple of this
+localparam [3:0] END_ALIGN = 4'd4;                    // CDR: unannounced bytes may pad the payload to a multiple of this
 localparam [7:0] ENCAP_PAD_MASK = 8'd3;            // CDR: options bits counting the end padding                            // bits of an instruction word
 // streaming early release (Program.stream_early): the subscriber hands the frame over at the
 // stream's count, with out_len + EARLY_ADD (the count, the array, the fixed fields after it)
@@ -55,7 +55,6 @@ localparam [7:0] SUB_BAD_SAMPLES_LENGTH = 8'd10;  // samples length
 localparam [7:0] SUB_BAD_HISTORY_LENGTH = 8'd11;  // history length
 localparam [7:0] SUB_BAD_HISTORY_SENSOR_NAME_LENGTH = 8'd12;  // history[].sensor_name length
 localparam [7:0] SUB_BAD_HISTORY_SENSOR_NAME_NUL = 8'd13;  // history[].sensor_name NUL
-localparam [7:0] SUB_BAD_PAYLOAD_END_PADDING = 8'd14;  // payload end padding
 localparam DB = $clog2(LOOP_DEPTH + 1);        // bits of a loop depth
 localparam LOOPS = 1 << DB;                     // entries of the walkers' loop stacks
 /* verilator lint_on UNUSEDPARAM */
@@ -100,7 +99,7 @@ function [IW-1:0] prog_word(input [15:0] pc);
             // valid (bool): 1 byte(s); carry; out: as received
             16'd17: prog_word = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_FIXED, SUB_CARRY, PUB_CARRY, 1'b0, 2'd0, 8'd0, 8'd0, 32'd1, 32'd0, 16'd5, 16'd0, 16'd0, 1'b0, 32'd0, 32'd0};
             // end of the message: the frame must end here
-            16'd18: prog_word = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_DONE, SUB_SKIP, PUB_CARRY, 1'b0, 2'd0, 8'd1, 8'd14, 32'd0, 32'd0, 16'd5, 16'd0, 16'd0, 1'b0, 32'd0, 32'd0};
+            16'd18: prog_word = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_DONE, SUB_SKIP, PUB_CARRY, 1'b0, 2'd0, 8'd1, 8'd0, 32'd0, 32'd0, 16'd5, 16'd0, 16'd0, 1'b0, 32'd0, 32'd0};
             default: prog_word = {19'd0, OP_DONE, 202'd0};
         endcase
     end
@@ -131,7 +130,7 @@ function [IW-1:0] prog_next(input [15:0] pc);
             16'd14: prog_next = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_FIXED, SUB_CARRY, PUB_CARRY, 1'b0, 2'd0, 8'd0, 8'd0, 32'd1, 32'd0, 16'd5, 16'd0, 16'd0, 1'b0, 32'd0, 32'd0};
             16'd15: prog_next = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_END, SUB_SKIP, PUB_CARRY, 1'b0, 2'd0, 8'd0, 8'd0, 32'd0, 32'd0, 16'd5, 16'd0, 16'd12, 1'b0, 32'd0, 32'd0};
             16'd16: prog_next = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_FIXED, SUB_CARRY, PUB_CARRY, 1'b0, 2'd0, 8'd0, 8'd0, 32'd1, 32'd0, 16'd5, 16'd0, 16'd0, 1'b0, 32'd0, 32'd0};
-            16'd17: prog_next = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_DONE, SUB_SKIP, PUB_CARRY, 1'b0, 2'd0, 8'd1, 8'd14, 32'd0, 32'd0, 16'd5, 16'd0, 16'd0, 1'b0, 32'd0, 32'd0};
+            16'd17: prog_next = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_DONE, SUB_SKIP, PUB_CARRY, 1'b0, 2'd0, 8'd1, 8'd0, 32'd0, 32'd0, 16'd5, 16'd0, 16'd0, 1'b0, 32'd0, 32'd0};
             16'd65535: prog_next = {2'd0, 4'd1, 4'd1, 1'b0, 8'd0, OP_ENCAP, SUB_CHECK, PUB_CONST, 1'b0, 2'd0, 8'd2, 8'd0, 32'd4, 32'd0, 16'd0, 16'd4, 16'd0, 1'b0, 32'd0, 32'd0};  // pc + 1 wraps
             default: prog_next = {19'd0, OP_DONE, 202'd0};
         endcase
