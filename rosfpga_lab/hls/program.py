@@ -24,7 +24,8 @@ The subscriber adds up the publisher's output length as it walks, so the publish
 the frame length first; it starts once the subscriber has read (and accepted) the whole frame,
 or, with streaming early release (:attr:`Program.stream_early`: nothing after the stream's count
 can refuse the frame), once the stream's count is checked, writing the stream as it flows (the
-Verilog; the HLS C++ and :func:`run_program` still hand whole frames over: same bytes).
+Verilog, and the HLS C++'s metadata word at the count; :func:`run_program` hands whole frames
+over: the same bytes).
 A frame refused after its stream went to the application is dropped by the publisher (it reads
 the application's output and writes nothing). :func:`run_program` is the Python executor of the
 same program: the specification the C++ and Verilog walkers are tested against.

@@ -17,9 +17,9 @@ FIFOs make the proof slower, not different; :data:`NODE_PROOF_DEPTH` clocks of i
 top with more memory than ``rtl.limits.FORMAL_MAX_MEMORY_BITS`` is refused before the tools run
 (:func:`check_size`): prove a copy of the configuration with smaller FIFOs or stream.
 
-Every configuration's generated top, ``sensor_msgs/Image`` on TCPROS included (with streaming
-early release its FIFO after the application holds a few beats, so its 640x480 examples are under
-the memory limit; on CDR a whole stream, over it: prove a smaller image); ``rtl prove`` without a
+Every configuration's generated top, ``sensor_msgs/Image`` included (with streaming early
+release, on TCPROS and CDR alike, its FIFO after the application holds a few beats, so its
+640x480 examples are under the memory limit); ``rtl prove`` without a
 configuration proves the lab's modules on small parameters (:mod:`rosfpga_lab.rtl.proofs`).
 """
 

@@ -296,8 +296,8 @@ def _too_big(cell: str, lines: list[str]) -> str:
     """nextpnr ran out of ``cell``s: say so plainly, with its utilization line of that cell."""
     used = next((line.split("Info:", 1)[-1].strip() for line in lines
                  if re.search(rf"\b{cell}:\s+\d+/", line)), "")
-    hint = (" A generated top whose walk has no streaming early release (a variable field, a "
-            "check or CDR's end padding after its stream) keeps a whole stream in the FIFO "
+    hint = (" A generated top whose walk has no streaming early release (a variable field or "
+            "a check after its stream; on CDR any field after it) keeps a whole stream in the FIFO "
             "after the application (OUT_DEPTH: the publisher writes the frame length first); a "
             "smaller stream, or image, fits." if cell == "DP16KD" else "")
     return (f"the design does not fit the LFE5U-{ECP5_DEVICE.upper()} {ECP5_PACKAGE}: it needs "

@@ -237,3 +237,32 @@ def test_the_parsers_see_the_old_wide_word_and_its_carry_array() -> None:
                          "typedef hls::stream<frame_meta> meta_stream;\n"}
     assert stream_words(old) == {"frame_meta": 32 + 1 + 8 * 18128}
     assert register_arrays(old) == {"ros_node.h: carry": 18128}
+
+
+#: Which shipped walks release early, and a whole stream's bytes otherwise (from each
+#: configuration's stream: 360 float32 ranges, 64 int32 samples).
+EARLY = {"fpga_dilate_rgba8": True, "fpga_dilate_rgba8_cdr": True, "fpga_erode_mono8": True,
+         "fpga_passthrough_rgb8": True, "fpga_laserscan_min": 360 * 4,
+         "fpga_laserscan_min_cdr": 360 * 4, "fpga_samples_dilate": 64 * 4,
+         "fpga_samples_dilate_cdr": 64 * 4}
+
+
+@pytest.mark.parametrize("stem", CONFIGS)
+def test_an_early_walk_hands_its_meta_over_at_the_count_so_no_fifo_holds_a_stream(stem: str) -> None:
+    """Streaming early release in the HLS C++ too: the subscriber of a walk that releases early
+    writes the metadata word once, when the stream's count is checked (``count_read``), so the
+    FIFO before the publisher holds a few bytes in a concurrent block design; otherwise once, at
+    the frame's end, and the README asks for a FIFO of a whole stream there."""
+    texts = render_generic(spec_from_config(load_config(DATA / f"{stem}.yaml")))
+    code = _strip(texts["subscriber.cpp"])
+    at_count = function_body(code, "count_read").count("meta_out.write(")
+    at_end = function_body(code, "subscriber").count("meta_out.write(")
+    readme = " ".join(texts["README.md"].split())
+    if EARLY[stem] is True:
+        assert (at_count, at_end) == (1, 1) and "&& !w.released" in function_body(code, "subscriber")
+        assert "The FIFO before the publisher (after `axi2fifo`) holds a few bytes" in readme
+        assert "#define EARLY_ADD" in texts["layout.h"]
+    else:
+        assert (at_count, at_end) == (0, 1) and "released" not in function_body(code, "count_read")
+        assert (f"must hold a whole stream, STREAM_DATA_BYTES = {EARLY[stem]:,} bytes") in readme
+        assert "EARLY_ADD" not in texts["layout.h"]

@@ -263,9 +263,10 @@ def test_a_planted_bug_inside_the_generated_top_fails_its_proof(tmp_path: Path) 
 
 def test_rtl_prove_config_names_what_it_cannot_prove(tmp_path: Path,
                                                      capsys: pytest.CaptureFixture[str]) -> None:
-    """op: custom has no generated RTL; a top with megabits of FIFO (640x480 Image, on TCPROS now
-    that it is generated like every type, and on CDR) is refused before the tools run; a module
-    check's option is refused with a configuration."""
+    """op: custom has no generated RTL; a top with megabits of FIFO (a long stream with a field
+    after it, which may refuse the frame after the stream) is refused before the tools run, a
+    640x480 Image is not (early release, on TCPROS and CDR alike); a module check's option is
+    refused with a configuration."""
     from rosfpga_lab.cli import main
     from rosfpga_lab.config import load_config, parse_config
     from rosfpga_lab.rtl.errors import RtlError
@@ -278,19 +279,28 @@ def test_rtl_prove_config_names_what_it_cannot_prove(tmp_path: Path,
     custom = CHANNEL.replace("{op: dilate, ksize: 3}", "{op: custom, source: neg.cpp}")
     with pytest.raises(RtlError, match="application.op is custom"):
         node_files(parse_config(custom, base_dir=tmp_path))
-    # a 640x480 rgba8 stream on CDR: its FIFO alone is 11.7 Mbit (PyPI's Yosys gave up after
-    # 90 s); on TCPROS the stream goes through with early release (a 16-beat FIFO: under the
-    # limit, with the 2-D window's line memories counted)
+    # 100,000 int32 samples on CDR, fields after them: the FIFO holds the whole stream and 2,
+    # beats of 4 bytes, their 4 TKEEP bits, TUSER and TLAST: 3.8 Mbit
+    # (PyPI's Yosys gave up after 90 s on 11.7); a 640x480 rgba8 Image, on TCPROS and on CDR,
+    # goes through with early release (a 16-beat FIFO: under the limit, with the 2-D window's
+    # line memories counted)
     from rosfpga_lab.rtl.nodeproof import check_size, memory_bits, prove_config
 
-    with pytest.raises(RtlError, match=r"holds 11,\d{3},\d{3} bits of memory \(the FIFO after "
-                       r"the application \(a whole stream\): 11,673,\d{3}\), over the 262,144"):
-        prove_config(load_config(data / "fpga_dilate_rgba8_cdr.yaml"))
-    image = load_config(data / "fpga_dilate_rgba8.yaml")
-    bits = memory_bits(spec)
-    assert bits["FIFO after the application"] == 16 * (9 * 4 + 2)
-    assert bits["line memories of the 2-D window"] == 2 * 640 * 32
-    check_size(image, spec)
+    long = (data / "fpga_samples_dilate_cdr.yaml").read_text().replace(
+        "{field: samples, length: 64}", "{field: samples, length: 100000}")
+    (tmp_path / "msg").symlink_to(data / "msg")
+    (tmp_path / "long.yaml").write_text(long)
+    fifo = f"{100_002 * (4 * 8 + 4 + 2):,}"
+    with pytest.raises(RtlError, match=r"holds 3,\d{3},\d{3} bits of memory \(the FIFO after "
+                       rf"the application \(a whole stream\): {fifo}\), over the 262,144"):
+        prove_config(load_config(tmp_path / "long.yaml"))
+    for name in ("fpga_dilate_rgba8.yaml", "fpga_dilate_rgba8_cdr.yaml"):
+        image = load_config(data / name)
+        spec = node_files(image)[0]
+        bits = memory_bits(spec)
+        assert bits["FIFO after the application"] == 16 * (9 * 4 + 2), name
+        assert bits["line memories of the 2-D window"] == 2 * 640 * 32, name
+        check_size(image, spec)
     require_formal()
     (tmp_path / "ch.yaml").write_text(CHANNEL)
     assert main(["rtl", "prove", str(tmp_path / "ch.yaml"), "--only", "fifo"]) == 1

@@ -73,5 +73,9 @@ static const unsigned char CONSTS[CONSTS_LENGTH + 1] = {
 #define MAX_FRAME_BYTES 67108864
 #define CARRY_BYTES 269  // the carry memory: the most bytes kept of one frame
 #define SEQ_START 1u  // the publisher's first message number
+// Streaming early release (Program.stream_early): nothing after the stream's count can refuse
+// the frame, so the subscriber hands its meta word over at the count, with the output length
+// so far plus these bytes (the count, the array, the fixed fields after it).
+#define EARLY_ADD 1228804u
 
 #endif  // LAYOUT_H

@@ -62,6 +62,7 @@ struct sub_walk {
     bool same;               // a SUB_CHECK field equals its constant so far
     ap_uint<9> carried;  // bytes put on the carry FIFO
     bool streamed;
+    bool released;           // its meta handed over at the stream's count (EARLY_ADD)
     int status;
     ap_uint<32> left[LOOP_DEPTH];  // elements left of each open array of messages
     bool quiet_of[LOOP_DEPTH];     // that array is written empty: count none of its fields
@@ -129,7 +130,7 @@ static void start_field(sub_walk& w) {
 }
 
 // A count's four bytes are read: check it, then enter the array or start its bytes.
-static void count_read(sub_walk& w) {
+static void count_read(sub_walk& w, meta_stream& meta_out) {
     const instr_t& ins = w.ins;
     // its maximum (a stream's: exact), then the bytes left in the frame
     if (ins.sub == SUB_STREAM ? w.n != ins.count : w.n > ins.count) { refuse(w, ins.status); return; }
@@ -140,6 +141,17 @@ static void count_read(sub_walk& w) {
         return;
     }
     if (need > room) { refuse(w, ins.status); return; }
+    if (ins.sub == SUB_STREAM) {  // streaming early release (layout.h: EARLY_ADD)
+        // nothing after the count can refuse the frame: the publisher may write it while the
+        // stream flows (the FIFO before it holds a few bytes, not the whole stream)
+        frame_meta meta;
+        meta.out_len = w.out_len + EARLY_ADD;
+        meta.carried = 0;
+        meta.streamed = true;
+        meta.drop = false;
+        meta_out.write(meta);
+        w.released = true;
+    }
     if (ins.op == OP_LOOP) {
         enter_loop(w);
     } else {
@@ -192,7 +204,8 @@ static bool decode(sub_walk& w) {
 }
 
 // Take one byte `b` of the frame in the current state.
-static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& carry_out) {
+static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& carry_out,
+                 meta_stream& meta_out) {
     const instr_t& ins = w.ins;
     w.pos++;
     switch (w.st) {
@@ -222,7 +235,7 @@ static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& ca
             carry_out.write(b);
             w.carried++;
         }
-        if (++w.k == 4) count_read(w);
+        if (++w.k == 4) count_read(w, meta_out);
         break;
     case ST_BYTES:
         if (ins.sub == SUB_CARRY || ins.sub == SUB_RANGE) {
@@ -242,7 +255,8 @@ static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& ca
 
 // Interpret one frame. `status` gets SUB_OK or the status of the field that made it refuse the
 // frame. The streamed bytes go to stream_out, the carried ones to carry_out; when either did,
-// meta_out gets the frame's meta (drop set if the frame was refused after them).
+// meta_out gets the frame's meta (drop set if the frame was refused after them): at the
+// stream's count (streaming early release: nothing after it can refuse the frame).
 void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out,
                 meta_stream& meta_out, ap_uint<8>& status) {
     HLS_PRAGMA(HLS INTERFACE ap_fifo port = in)
@@ -274,6 +288,7 @@ void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out
     w.same = true;
     w.carried = 0;
     w.streamed = false;
+    w.released = false;
     w.status = SUB_OK;
     w.depth = 0;
     w.quiet = 0;
@@ -287,9 +302,9 @@ void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out
         HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 67108875)
         if (w.st == ST_DECODE && !decode(w)) continue;  // a step with no byte of its own
         if (w.st == ST_FINISH) break;
-        take(w, in.read(), stream_out, carry_out);
+        take(w, in.read(), stream_out, carry_out, meta_out);
     }
-    if (w.streamed || w.carried != 0) {
+    if ((w.streamed || w.carried != 0) && !w.released) {
         frame_meta meta;
         meta.out_len = w.out_len;
         meta.carried = w.carried;

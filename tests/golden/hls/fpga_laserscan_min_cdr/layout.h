@@ -80,7 +80,7 @@ static const unsigned char CONSTS[CONSTS_LENGTH + 1] = {
 #define SEQ_START 1u  // the publisher's first message number
 #define ALIGN_ORIGIN 8u  // CDR: alignment counts from this byte of a frame
 #define ENCAP_PAD_MASK 3u  // CDR: options bits counting the end padding
-#define END_ALIGN 4u  // CDR: unannounced zeros may pad the payload to a multiple of this
+#define END_ALIGN 4u  // CDR: unannounced bytes may pad the payload to a multiple of this
 
 // Padding bytes before a field of alignment `align` (a power of two) at byte `pos` of a frame.
 static inline unsigned pad(unsigned pos, unsigned align) {

@@ -72,6 +72,7 @@ struct sub_walk {
     bool hdr_ok;             // the encapsulation header's kind is CDR little-endian
     ap_uint<11> carried;  // bytes put on the carry FIFO
     bool streamed;
+    bool released;           // its meta handed over at the stream's count (EARLY_ADD)
     int status;
     ap_uint<32> left[LOOP_DEPTH];  // elements left of each open array of messages
     bool quiet_of[LOOP_DEPTH];     // that array is written empty: count none of its fields
@@ -152,7 +153,7 @@ static void start_field(sub_walk& w) {
 }
 
 // A count's four bytes are read: check it, then enter the array or start its bytes.
-static void count_read(sub_walk& w) {
+static void count_read(sub_walk& w, meta_stream& meta_out) {
     const instr_t& ins = w.ins;
     // its maximum (a stream's: exact), then the bytes left in the frame
     if (ins.sub == SUB_STREAM ? w.n != ins.count : w.n > ins.count) { refuse(w, ins.status); return; }
@@ -230,7 +231,8 @@ static bool decode(sub_walk& w) {
 }
 
 // Take one byte `b` of the frame in the current state.
-static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& carry_out) {
+static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& carry_out,
+                 meta_stream& meta_out) {
     const instr_t& ins = w.ins;
     w.pos++;
     switch (w.st) {
@@ -261,7 +263,7 @@ static void take(sub_walk& w, byte_t b, byte_stream& stream_out, byte_stream& ca
             carry_out.write(b);
             w.carried++;
         }
-        if (++w.k == 4) count_read(w);
+        if (++w.k == 4) count_read(w, meta_out);
         break;
     case ST_BYTES:
         if (ins.sub == SUB_CARRY || ins.sub == SUB_RANGE) {
@@ -330,6 +332,7 @@ void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out
     w.same = true;
     w.carried = 0;
     w.streamed = false;
+    w.released = false;
     w.status = SUB_OK;
     w.depth = 0;
     w.quiet = 0;
@@ -343,9 +346,9 @@ void subscriber(byte_stream& in, byte_stream& stream_out, byte_stream& carry_out
         HLS_PRAGMA(HLS LOOP_TRIPCOUNT max = 67108898)
         if (w.st == ST_DECODE && !decode(w)) continue;  // a step with no byte of its own
         if (w.st == ST_FINISH) break;
-        take(w, in.read(), stream_out, carry_out);
+        take(w, in.read(), stream_out, carry_out, meta_out);
     }
-    if (w.streamed || w.carried != 0) {
+    if ((w.streamed || w.carried != 0) && !w.released) {
         frame_meta meta;
         meta.out_len = w.out_len;
         meta.carried = w.carried;
