@@ -188,8 +188,9 @@ def _echo(args: argparse.Namespace, uri: str) -> int:
     reported, last_report = 0, time.monotonic()
     sub = None
     try:
-        sub = node.subscribe(args.topic, type_name if known else "*", show, raw=True,
-                             queue_size=args.queue_size, md5sum=None if known else "*")
+        with holding():   # registering: a signal waits for its end (then interrupts)
+            sub = node.subscribe(args.topic, type_name if known else "*", show, raw=True,
+                                 queue_size=args.queue_size, md5sum=None if known else "*")
         end = start + args.timeout if args.timeout else None
         while not done.is_set() and not _stopped_remotely(node):
             if end is not None and time.monotonic() >= end:
@@ -233,7 +234,9 @@ def _pub(args: argparse.Namespace, uri: str) -> int:
     node = _node(uri, "pub", args)
     try:
         value = tools.parse_message_value(node.registry, args.type, args.values)
-        pub = node.advertise(args.topic, args.type, latch=args.latch or args.once or not args.rate)
+        with holding():   # registering: a signal waits for its end (then interrupts)
+            pub = node.advertise(args.topic, args.type,
+                                 latch=args.latch or args.once or not args.rate)
         if args.rate > 0:
             print(f"publishing to {args.topic} at {args.rate} Hz (Ctrl-C to stop)", file=sys.stderr)
             n = 0
@@ -268,8 +271,9 @@ def _hz(args: argparse.Namespace, uri: str) -> int:
     meter = tools.RateMeter(samples=args.window + 1)  # the last N intervals, as rostopic hz -w N
     node = _node(uri, "hz", args)
     try:
-        node.subscribe(args.topic, "*", lambda body, info: meter.tick(), raw=True, queue_size=0,
-                       md5sum="*")
+        with holding():   # registering: a signal waits for its end (then interrupts)
+            node.subscribe(args.topic, "*", lambda body, info: meter.tick(), raw=True,
+                           queue_size=0, md5sum="*")
         print(f"subscribed to [{args.topic}]", flush=True)
         start = time.monotonic()
         while not args.duration or time.monotonic() - start < args.duration:

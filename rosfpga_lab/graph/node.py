@@ -286,6 +286,7 @@ class Node:
             with self._lock:
                 self.publishers.pop(topic, None)
             raise
+        self._undo_if_shut_down("unregisterPublisher", topic, self.uri)
         self._start_logging()
         return pub
 
@@ -357,6 +358,7 @@ class Node:
                 self.subscribers.pop(topic, None)
             sub.close()
             raise
+        self._undo_if_shut_down("unregisterSubscriber", topic, self.uri)
         self._start_logging()   # before connecting: a latched message comes after subscribe()
         if self._updates.get(topic, 0) == updates:  # else a newer list came meanwhile: kept
             sub.update_publishers([u for u in pubs if isinstance(u, str)])
@@ -376,7 +378,8 @@ class Node:
             self._logging = start_node_logging(self)
         except GraphError as exc:
             self._logging = None
-            rosout_log.warning("%s: no /rosout or logger services: %s", self.name, exc)
+            if not self.is_shutdown:
+                rosout_log.warning("%s: no /rosout or logger services: %s", self.name, exc)
         finally:
             self.logging_ready.set()
 
@@ -403,7 +406,20 @@ class Node:
             port = self._service_port
         port.add(name, srv, handler)
         self._master("registerService", name, port.uri, self.uri)
+        self._undo_if_shut_down("unregisterService", name, port.uri)
         return name
+
+    def _undo_if_shut_down(self, method: str, *args: object) -> None:
+        """After a registration: if the node shut down meanwhile (a slave-API ``shutdown``
+        while it registered), its unregistration may have reached the master before this
+        registration did, so take it back with ``method`` (the caller finds the node shut
+        down, as after any shutdown)."""
+        if not self.is_shutdown:
+            return
+        try:
+            self._master(method, *args)
+        except (GraphError, OSError):
+            pass
 
     def call_service(self, service: str, srv_type: str, request: dict | None = None, *,
                      timeout: float | None = None) -> dict:
