@@ -1,0 +1,224 @@
+// rfl_fabric_node -- the ROS 2 node in the fabric behind one UDP payload interface (issue 31).
+// In: UDP payloads, one datagram per packet (TLAST on its last byte), s_axis_tuser its kind as
+// rfl_udp_port's destination port tells it (1: the user-data port, 0: a metatraffic port; read
+// on a packet's first beat and held for the packet). User-data datagrams go through
+// rfl_rtps_rx -> rfl_rtps_to_cdr -> rfl_node (the generated wire: cdr top) -> rfl_rtps_tx;
+// metatraffic goes to rfl_rtps_ctrl (ACKNACK / HEARTBEAT) -> rfl_rtps_disc_answer, whose bytes
+// out stay within BURST + RATE x the metatraffic bytes in (rtl/limits.py's ANSWER_BURST,
+// ANSWER_RATE); rfl_rtps_disc_rom sends the SPDP announcement every PERIOD clocks (and SEDP on
+// a send_sedp pulse). Out: UDP payloads, TDEST their destination as rfl_rtps_disc_rom numbers
+// them (0 SPDP, 1 metatraffic unicast, 2 user-data unicast: the transmit path's USER_DEST) and
+// m_dst_prefix the asker an answer goes to (0 for the others).
+// The arbiter is frame-atomic: it grants one source a whole datagram (round robin among
+// transmit path, answers, discovery ROM, one idle clock between grants) and passes its beats
+// as they are, so a datagram is never interleaved with another and the stream rules of the
+// sources (TDATA, TLAST, TDEST stable until taken) hold on the output.
+`default_nettype none
+
+module rfl_fabric_node #(
+    parameter MAX_BYTES = 2048,                 // the seam's longest sample
+    parameter [95:0] GUID_PREFIX = 96'h010f_7266_6c46_4142_5249_4300,
+    parameter [31:0] WRITER_ID = 32'h00000203,
+    parameter [31:0] READER_ID = 32'd0,
+    parameter FRAG_BYTES = 1344,
+    parameter MAX_DATAGRAM = 1472,
+    parameter INFO_TS = 1,
+    parameter ROM_FILE = "",                    // discovery ROM (rtl.discrom.write_rom)
+    parameter TABLE_FILE = "",
+    parameter ROM_BYTES = 1472,
+    parameter MESSAGES = 3,
+    parameter PERIOD = 100000000,               // clocks between SPDP announcements, >= 1
+    parameter SLOTS = 5,                        // answers (rtl.discrom.answer_params)
+    parameter [32*SLOTS-1:0] SLOT_IDS = 0,
+    parameter [8*SLOTS-1:0] SLOT_MSGS = 0,
+    parameter [8*SLOTS-1:0] SLOT_LASTS = 0,
+    parameter ANSWER_FILE = "",
+    parameter ANSWER_TABLE_FILE = "",
+    parameter ANSWER_BYTES = 2048,
+    parameter ANSWERS = 9,
+    parameter DST_AT = 24,
+    parameter BASE_AT = 48,
+    parameter COUNT_START = 3,
+    parameter BURST = 4096,
+    parameter RATE = 4,
+    parameter USER_DEST = 2                     // TDEST of the transmit path's datagrams
+) (
+    input  wire         clk,
+    input  wire         rst_n,
+    input  wire [95:0]  cfg_prefix,             // this participant's GUID prefix
+    input  wire [31:0]  cfg_reader,             // our reader's entity id
+    input  wire [31:0]  cfg_writer,             // the writer taken (0: any)
+    input  wire [63:0]  cfg_time,               // INFO_TS of the transmit path
+    input  wire         send_sedp,              // one clock: send the SEDP messages
+    input  wire [7:0]   s_axis_tdata,
+    input  wire         s_axis_tvalid,
+    output wire         s_axis_tready,
+    input  wire         s_axis_tlast,
+    input  wire         s_axis_tuser,           // 1: user data, 0: metatraffic
+    output wire [7:0]   m_axis_tdata,
+    output wire         m_axis_tvalid,
+    input  wire         m_axis_tready,
+    output wire         m_axis_tlast,
+    output wire [1:0]   m_axis_tdest,
+    output wire [95:0]  m_dst_prefix,
+    output wire         status_valid,           // the generated subscriber's status
+    output wire [7:0]   status,
+    output wire [15:0]  credit,                 // the answers' byte credit
+    output wire [31:0]  cnt_samples,            // samples sent by the transmit path
+    output wire [31:0]  cnt_answers,
+    output wire [31:0]  cnt_no_credit
+);
+`ifdef __ICARUS__
+    initial begin
+        if (PERIOD < 1) $fatal(1, "rfl_fabric_node: PERIOD must be at least 1");
+        if (USER_DEST < 0 || USER_DEST > 3) $fatal(1, "rfl_fabric_node: USER_DEST must be 0..3");
+    end
+`else
+    if (PERIOD < 1) begin : g_bad_period
+        $error("rfl_fabric_node: PERIOD must be at least 1");
+    end
+    if (USER_DEST < 0 || USER_DEST > 3) begin : g_bad_user_dest
+        $error("rfl_fabric_node: USER_DEST must be 0..3");
+    end
+`endif
+    localparam [1:0] UDEST = USER_DEST[1:0];
+
+    // ---- routing in: the kind of a packet is its first beat's TUSER
+    reg in_pkt, in_kind;
+    wire kind = in_pkt ? in_kind : s_axis_tuser;
+    wire rx_in_ready, ctrl_in_ready;
+    assign s_axis_tready = kind ? rx_in_ready : ctrl_in_ready;
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            in_pkt <= 1'b0;
+            in_kind <= 1'b0;
+        end else if (s_axis_tvalid && s_axis_tready) begin
+            in_pkt <= !s_axis_tlast;
+            in_kind <= kind;
+        end
+    end
+
+    // ---- user data: rx -> seam -> generated top -> tx
+    wire [7:0] rx_tdata, rec_tdata, pub_tdata, tx_tdata;
+    wire rx_tvalid, rx_tready, rx_tlast, rx_tuser, rec_tvalid, rec_tready;
+    wire pub_tvalid, pub_tready, tx_tvalid, tx_tready, tx_tlast;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [127:0] guid;
+    wire [63:0] seq, ts, tx_seq;
+    wire ts_valid, frame_start, busy, rom_busy;
+    wire [31:0] cnt_packets, cnt_bad_header, cnt_malformed, cnt_rx_samples, cnt_rx_dropped;
+    wire [31:0] cnt_seam_samples, cnt_seam_dropped, cnt_too_long, cnt_datagrams, cnt_dropped;
+    wire [31:0] cnt_requests, cnt_busy, cnt_ctrl_malformed;
+    wire [7:0] framing;
+    /* verilator lint_on UNUSEDSIGNAL */
+    rfl_rtps_rx u_rx (
+        .clk(clk), .rst_n(rst_n), .cfg_prefix(cfg_prefix), .cfg_reader(cfg_reader),
+        .cfg_writer(cfg_writer), .s_axis_tdata(s_axis_tdata),
+        .s_axis_tvalid(s_axis_tvalid && kind), .s_axis_tready(rx_in_ready),
+        .s_axis_tlast(s_axis_tlast),
+        .m_axis_tdata(rx_tdata), .m_axis_tvalid(rx_tvalid), .m_axis_tready(rx_tready),
+        .m_axis_tlast(rx_tlast), .m_axis_tuser(rx_tuser), .m_sample_guid(guid),
+        .m_sample_seq(seq), .m_sample_ts(ts), .m_sample_ts_valid(ts_valid),
+        .cnt_packets(cnt_packets), .cnt_bad_header(cnt_bad_header),
+        .cnt_malformed(cnt_malformed), .cnt_samples(cnt_rx_samples),
+        .cnt_dropped(cnt_rx_dropped));
+    rfl_rtps_to_cdr #(.MAX_BYTES(MAX_BYTES)) u_seam (
+        .clk(clk), .rst_n(rst_n),
+        .s_axis_tdata(rx_tdata), .s_axis_tvalid(rx_tvalid), .s_axis_tready(rx_tready),
+        .s_axis_tlast(rx_tlast), .s_axis_tuser(rx_tuser),
+        .m_tdata(rec_tdata), .m_tvalid(rec_tvalid), .m_tready(rec_tready),
+        .cnt_samples(cnt_seam_samples), .cnt_dropped(cnt_seam_dropped),
+        .cnt_too_long(cnt_too_long));
+    rfl_node u_node (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata(rec_tdata), .s_tvalid(rec_tvalid), .s_tready(rec_tready),
+        .m_tdata(pub_tdata), .m_tvalid(pub_tvalid), .m_tready(pub_tready),
+        .frame_start(frame_start), .status_valid(status_valid), .status(status), .busy(busy),
+        .framing(framing));
+    rfl_rtps_tx #(.GUID_PREFIX(GUID_PREFIX), .WRITER_ID(WRITER_ID), .READER_ID(READER_ID),
+                  .FRAG_BYTES(FRAG_BYTES), .MAX_DATAGRAM(MAX_DATAGRAM), .INFO_TS(INFO_TS)) u_tx (
+        .clk(clk), .rst_n(rst_n), .cfg_time(cfg_time),
+        .s_tdata(pub_tdata), .s_tvalid(pub_tvalid), .s_tready(pub_tready),
+        .m_axis_tdata(tx_tdata), .m_axis_tvalid(tx_tvalid),
+        .m_axis_tready(tx_tready), .m_axis_tlast(tx_tlast), .m_seq(tx_seq),
+        .cnt_samples(cnt_samples), .cnt_datagrams(cnt_datagrams), .cnt_dropped(cnt_dropped));
+
+    // ---- metatraffic: ctrl -> answers
+    wire [167:0] req_tdata;
+    wire req_tvalid, req_tready, rx_byte;
+    wire [7:0] an_tdata;
+    wire an_tvalid, an_tready, an_tlast;
+    wire [1:0] an_tdest;
+    wire [95:0] an_prefix;
+    rfl_rtps_ctrl #(.SLOTS(SLOTS), .SLOT_IDS(SLOT_IDS), .SLOT_MSGS(SLOT_MSGS),
+                    .SLOT_LASTS(SLOT_LASTS)) u_ctrl (
+        .clk(clk), .rst_n(rst_n), .cfg_prefix(cfg_prefix), .s_axis_tdata(s_axis_tdata),
+        .s_axis_tvalid(s_axis_tvalid && !kind), .s_axis_tready(ctrl_in_ready),
+        .s_axis_tlast(s_axis_tlast), .m_axis_tdata(req_tdata), .m_axis_tvalid(req_tvalid),
+        .m_axis_tready(req_tready), .rx_byte(rx_byte), .cnt_requests(cnt_requests),
+        .cnt_busy(cnt_busy), .cnt_malformed(cnt_ctrl_malformed));
+    rfl_rtps_disc_answer #(.ROM_FILE(ANSWER_FILE), .TABLE_FILE(ANSWER_TABLE_FILE),
+                           .ROM_BYTES(ANSWER_BYTES), .MESSAGES(ANSWERS), .DST_AT(DST_AT),
+                           .BASE_AT(BASE_AT), .COUNT_START(COUNT_START), .BURST(BURST),
+                           .RATE(RATE)) u_answer (
+        .clk(clk), .rst_n(rst_n), .rx_byte(rx_byte), .s_axis_tdata(req_tdata),
+        .s_axis_tvalid(req_tvalid), .s_axis_tready(req_tready), .m_axis_tdata(an_tdata),
+        .m_axis_tvalid(an_tvalid), .m_axis_tready(an_tready),
+        .m_axis_tlast(an_tlast), .m_axis_tdest(an_tdest), .m_dst_prefix(an_prefix),
+        .credit(credit), .cnt_answers(cnt_answers), .cnt_no_credit(cnt_no_credit));
+
+    // ---- discovery: SPDP every PERIOD clocks, SEDP on request
+    wire [7:0] rom_tdata;
+    wire rom_tvalid, rom_tready, rom_tlast;
+    wire [1:0] rom_tdest;
+    rfl_rtps_disc_rom #(.ROM_FILE(ROM_FILE), .TABLE_FILE(TABLE_FILE), .ROM_BYTES(ROM_BYTES),
+                        .MESSAGES(MESSAGES), .PERIOD(PERIOD)) u_rom (
+        .clk(clk), .rst_n(rst_n), .send_sedp(send_sedp), .busy(rom_busy),
+        .m_axis_tdata(rom_tdata), .m_axis_tvalid(rom_tvalid), .m_axis_tready(rom_tready),
+        .m_axis_tlast(rom_tlast), .m_axis_tdest(rom_tdest));
+
+    // ---- frame-atomic round-robin arbiter: 0 transmit path, 1 answers, 2 discovery ROM
+    reg locked;
+    reg [1:0] grant;
+    wire [2:0] want = {rom_tvalid, an_tvalid, tx_tvalid};
+    // the next source after grant that wants the output
+    reg [1:0] pick;
+    reg found;
+    integer k;
+    always @* begin
+        pick = grant;
+        found = 1'b0;
+        for (k = 1; k <= 3; k = k + 1) begin
+            if (!found && want[(grant + k) % 3]) begin
+                pick = (grant + k) % 3;
+                found = 1'b1;
+            end
+        end
+    end
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            locked <= 1'b0;
+            grant <= 2'd2;
+        end else if (!locked) begin
+            if (found) begin
+                grant <= pick;
+                locked <= 1'b1;
+            end
+        end else if (m_axis_tvalid && m_axis_tready && m_axis_tlast) begin
+            locked <= 1'b0;
+        end
+    end
+    wire g_tx = locked && grant == 2'd0;
+    wire g_an = locked && grant == 2'd1;
+    wire g_rom = locked && grant == 2'd2;
+    assign tx_tready = g_tx && m_axis_tready;
+    assign an_tready = g_an && m_axis_tready;
+    assign rom_tready = g_rom && m_axis_tready;
+    assign m_axis_tvalid = (g_tx && tx_tvalid) || (g_an && an_tvalid) || (g_rom && rom_tvalid);
+    assign m_axis_tdata = g_an ? an_tdata : g_rom ? rom_tdata : tx_tdata;
+    assign m_axis_tlast = g_an ? an_tlast : g_rom ? rom_tlast : tx_tlast;
+    assign m_axis_tdest = g_an ? an_tdest : g_rom ? rom_tdest : UDEST;
+    assign m_dst_prefix = g_an ? an_prefix : 96'd0;
+endmodule
+
+`default_nettype wire
