@@ -181,19 +181,20 @@ module rfl_fabric_node #(
     reg locked;
     reg [1:0] grant;
     wire [2:0] want = {rom_tvalid, an_tvalid, tx_tvalid};
-    // the next source after grant that wants the output
+    // the next source after grant that wants the output (round robin over 0, 1, 2)
     reg [1:0] pick;
     reg found;
-    integer k;
     always @* begin
         pick = grant;
-        found = 1'b0;
-        for (k = 1; k <= 3; k = k + 1) begin
-            if (!found && want[(grant + k) % 3]) begin
-                pick = (grant + k) % 3;
-                found = 1'b1;
-            end
-        end
+        found = 1'b1;
+        case (grant)
+            2'd0: if (want[1]) pick = 2'd1; else if (want[2]) pick = 2'd2;
+                  else if (want[0]) pick = 2'd0; else found = 1'b0;
+            2'd1: if (want[2]) pick = 2'd2; else if (want[0]) pick = 2'd0;
+                  else if (want[1]) pick = 2'd1; else found = 1'b0;
+            default: if (want[0]) pick = 2'd0; else if (want[1]) pick = 2'd1;
+                     else if (want[2]) pick = 2'd2; else found = 1'b0;
+        endcase
     end
     always @(posedge clk) begin
         if (!rst_n) begin
