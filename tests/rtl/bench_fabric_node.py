@@ -5,8 +5,8 @@ The case comes in a JSON file (``FABRIC_NODE_CASE``): the datagrams in (hex, kin
 0 metatraffic), the receive side's configuration, ``cfg_time``, how many datagrams other than
 the SPDP announcement must come out, the clocks to run at least, per-mille input gaps and output
 backpressure, and the answers' credit (BURST, RATE). One coroutine drives a byte a clock when
-offered and takes the output when ready (a valid beat, its TDEST and prefix must stay unchanged
-until taken), cutting it into datagrams at TLAST, each with its TDEST, prefix and first clock.
+offered (TUSER, the kind, on a packet's first beat, random on its other beats) and takes the
+output when ready (a valid beat, its TDEST and prefix must stay unchanged until taken), cutting it into datagrams at TLAST, each with its TDEST, prefix and first clock.
 At every clock the metatraffic bytes out (TDEST 1: the answers, SEDP is never asked for) are at
 most BURST + RATE x the metatraffic bytes in (rtl/limits.py's credit). It ends 300 clocks after
 all this (more datagrams would show), or after a bound on the clocks (a lock-up).
@@ -63,7 +63,10 @@ async def fabric_node(dut) -> None:
         offer = i < len(stream) and prng.random() >= gap
         dut.s_axis_tvalid.value = int(offer)
         if offer:
-            dut.s_axis_tdata.value, dut.s_axis_tlast.value, dut.s_axis_tuser.value = stream[i]
+            dut.s_axis_tdata.value, dut.s_axis_tlast.value, kind = stream[i]
+            first = i == 0 or stream[i - 1][1] == 1
+            # TUSER counts on a packet's first beat only: random on the others
+            dut.s_axis_tuser.value = kind if first else prng.getrandbits(1)
         else:
             dut.s_axis_tdata.value = prng.getrandbits(8)
             dut.s_axis_tlast.value = prng.getrandbits(1)
