@@ -281,3 +281,47 @@ def test_rtps_tx_is_clean_under_three_linters(name: str, info_ts: bool, frag: in
     done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, (done.stdout + done.stderr)[-4000:]
+
+
+# the whole node in the fabric (rtl/fabric/rfl_fabric_node.v) with every stage and the generated
+# top of a wire: cdr configuration inside, the ROMs and answer slots of that configuration
+def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None:
+    import sys
+
+    from rosfpga_lab.rtl.discrom import (
+        ANSWER_FILE, ANSWER_TABLE_FILE, DEST_USER, ROM_FILE, TABLE_FILE, answer_params,
+        render_rom, tx_parameters, verilog_parameters, write_rom,
+    )
+    from rosfpga_lab.rtl.sim import VERILOG_DIR
+
+    config = DATA / "fpga_laserscan_min_cdr.yaml"
+    gen = tmp_path / "project"
+    done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(config), "-o",
+                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    rom = render_rom(config)
+    write_rom(rom, tmp_path)
+    a = answer_params(rom)
+    params = dict(verilog_parameters(tx_parameters(rom)), PERIOD="1000",
+                  USER_DEST=str(DEST_USER), ROM_FILE=f'"{ROM_FILE}"',
+                  TABLE_FILE=f'"{TABLE_FILE}"', ROM_BYTES=str(len(rom.image())),
+                  MESSAGES=str(len(rom.messages)), ANSWER_FILE=f'"{ANSWER_FILE}"',
+                  ANSWER_TABLE_FILE=f'"{ANSWER_TABLE_FILE}"',
+                  **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
+                                            "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
+                                            "COUNT_START", "BURST", "RATE")})
+    fabric = Path(VERILOG_DIR).parent / "fabric"
+    top = "rfl_fabric_node"
+    sources = [str(fabric / f"{m}.v") for m in (
+        "rfl_rtps_rx", "rfl_rtps_to_cdr", "rfl_rtps_tx", "rfl_rtps_ctrl", "rfl_rtps_disc_answer",
+        "rfl_rtps_disc_rom", top)]
+    sources += sorted(str(q) for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "--top-module", top,
+                           f"-I{gen / 'rtl'}", *(f"-G{k}={v}" for k, v in params.items()),
+                           *sources], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+                           f"-I{gen / 'rtl'}", *(f"-P{top}.{k}={v}" for k, v in params.items()),
+                           *sources], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "rfl_fabric_node.v" not in done.stdout + done.stderr, done.stdout + done.stderr
