@@ -9,7 +9,8 @@ offered (TUSER, the kind, on a packet's first beat, random on its other beats) a
 output when ready (a valid beat, its TDEST and prefix must stay unchanged until taken), cutting
 it into datagrams at TLAST, each with its TDEST, prefix and first clock. At every clock the
 metatraffic bytes out (TDEST 1: the answers, SEDP is never asked for) are at most BURST + RATE x
-the metatraffic bytes in (rtl/limits.py's credit). It ends 300 clocks after all this (more datagrams would show), or after a bound on the clocks (a lock-up).
+the metatraffic bytes in (rtl/limits.py's credit). It ends 300 clocks after all this (more
+datagrams would show), or after a bound on the clocks (a lock-up).
 """
 
 from __future__ import annotations
