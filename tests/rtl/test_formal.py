@@ -124,14 +124,14 @@ def test_the_walkers_are_proven_on_a_generated_walk() -> None:
 
 def test_the_subscribers_bounded_check_sees_every_frame_length_handed_over() -> None:
     """The gsubscriber bmc is deep enough for a frame of formal_program of each accepted length
-    (a label of 0 or 1 byte) to be handed over and held: the reset clock, the frame's clocks to
+    (a label of 0 to 2 bytes) to be handed over and held: the reset clock, the frame's clocks to
     its acceptance (the walk's cycle model, equal to the RTL's clock for clock:
     test_cycles.py), the clock meta_valid rises (the handover's checks: the answer's length
     in range) and one more (the fields held unchanged). 48 would see the shortest frame only."""
     prog = formal_program()
     bmc = next(p for p in PROOFS if p.name == "gsubscriber" and p.mode == "bmc")
     clocks = []
-    for label in (b"", b"a"):
+    for label in (b"", b"a", b"ab"):
         body = b"\x02" + struct.pack("<I", len(label)) + label + struct.pack("<I", 2) + b"\0\0"
         clocks.append(frame_clocks(prog, struct.pack("<I", len(body)) + body).subscriber)
     assert len(clocks) == prog.max_frame - prog.min_body + 1

@@ -1,5 +1,5 @@
 // fv_gsubscriber -- rfl_gsubscriber on its ports, walking the small program of
-// rosfpga_lab.rtl.proofs.formal_program (a checked byte, a carried string of at most 1 byte, a
+// rosfpga_lab.rtl.proofs.formal_program (a checked byte, a carried string of at most 2 bytes, a
 // stream of exactly 2 bytes), fed any bytes by the stream rules: its stream keeps the rules, a
 // frame's fields (meta_*) are held unchanged until the publisher releases them, every status is
 // a code of the table, and each frame whose fields it hands over (accepted, or refused after
@@ -19,7 +19,7 @@ module fv_gsubscriber #(parameter CW = 3) (
 `endif
     wire [7:0] m_tdata, carry_rdata, status;
     wire [31:0] meta_out_len;
-    rfl_gsubscriber #(.CARRY_BYTES(5), .CW(CW), .MIN_BODY(11), .MAX_FRAME(12), .EARLY(EARLY)) dut (
+    rfl_gsubscriber #(.CARRY_BYTES(6), .CW(CW), .MIN_BODY(11), .MAX_FRAME(13), .EARLY(EARLY)) dut (
         .clk(clk), .rst_n(rst_n), .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready),
         .meta_valid(meta_valid), .meta_release(meta_release), .meta_out_len(meta_out_len),
@@ -62,7 +62,7 @@ module fv_gsubscriber #(parameter CW = 3) (
         if (EARLY && meta_valid) assert(!meta_drop);         // handed over early: never dropped
         if (EARLY && handed && status_valid) assert(status == 8'd0);   // ... nor refused
         if (meta_valid && !meta_drop && !$past(meta_valid))  // the answer's length: 4 + label
-            assert(meta_out_len >= 1 + 4 + 4 + 2 && meta_out_len <= 1 + 4 + 1 + 4 + 2);
+            assert(meta_out_len >= 1 + 4 + 4 + 2 && meta_out_len <= 1 + 4 + 2 + 4 + 2);
 `endif
     end
 endmodule

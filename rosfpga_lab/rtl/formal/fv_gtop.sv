@@ -11,8 +11,8 @@ module fv_gtop (input clk, input rst_n, input [7:0] s_tdata, input s_tvalid, inp
 `else
     localparam EARLY = 1;
 `endif
-    rfl_gtop #(.EBYTES(1), .LENGTH(2), .KSIZE(3), .OP(0), .KIND(0), .CARRY_BYTES(5), .CW(3),
-               .MIN_BODY(11), .MAX_FRAME(12), .RX_DEPTH(2), .TX_DEPTH(2), .AXIS_DEPTH(2),
+    rfl_gtop #(.EBYTES(1), .LENGTH(2), .KSIZE(3), .OP(0), .KIND(0), .CARRY_BYTES(6), .CW(3),
+               .MIN_BODY(11), .MAX_FRAME(13), .RX_DEPTH(2), .TX_DEPTH(2), .AXIS_DEPTH(2),
                .OUT_DEPTH(4), .SEQ_START(1), .EARLY(EARLY)) dut (
         .clk(clk), .rst_n(rst_n), .s_tdata(s_tdata), .s_tvalid(s_tvalid), .s_tready(s_tready),
         .m_tdata(m_tdata), .m_tvalid(m_tvalid), .m_tready(m_tready), .frame_start(frame_start),
