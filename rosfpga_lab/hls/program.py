@@ -56,7 +56,9 @@ from dataclasses import dataclass, field, replace
 from enum import IntEnum
 
 from rosfpga_lab.hls.limits import MAX_LOOP_DEPTH
-from rosfpga_lab.hw.cdrlayout import ALIGN_ORIGIN, END_ALIGN, OPTIONS_PADDING_MASK
+from rosfpga_lab.hw.cdrlayout import (
+    ALIGN_ORIGIN, END_ALIGN, OPTIONS_PADDING_MASK, unannounced_padding,
+)
 from rosfpga_lab.msg.cdr import CDR_LE
 
 
@@ -253,14 +255,6 @@ class Program:
         return b"".join(ins.const for ins in self.instrs)
 
 
-def _end_padding(pos: int, fend: int, end: int) -> bool:
-    """CDR: the bytes from ``pos`` (where the fields end) to the sample's ``end`` are the
-    unannounced end padding (``fend``: the end less the announced padding): 1 to
-    :data:`END_ALIGN` - 1 bytes that bring the payload to a multiple of :data:`END_ALIGN`."""
-    after = end - pos
-    return pos != fend and 0 < after < END_ALIGN and after == -(pos - ALIGN_ORIGIN) % END_ALIGN
-
-
 def _replace(ins: Instr, **changes: object) -> Instr:
     return replace(ins, **changes)  # type: ignore[arg-type]
 
@@ -403,7 +397,7 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None,
         if need > fend - pos:
             raise Refused(ins.status, bool(stream))
         if early_cdr and ins.sub == Sub.STREAM and need != fend - pos and \
-                not _end_padding(pos + need, fend, end):
+                not unannounced_padding(pos + need, fend, end):
             raise Refused(FRAME_LENGTH_STATUS, bool(stream))  # as DONE would, at the count
 
     cdr = prog.cdr
@@ -414,8 +408,8 @@ def subscribe(prog: Program, frame: bytes, timeline: bytearray | None = None,
         quiet = suppressed > 0
         tl += decide  # each instruction's decode (S_DECODE); S_COUNTED, S_FINISH below
         if ins.op == Op.DONE:
-            after = end - pos  # CDR: Cyclone's unannounced zeros up to a multiple of END_ALIGN
-            if cdr and _end_padding(pos, fend, end):
+            after = end - pos  # CDR: unannounced padding up to a multiple of END_ALIGN
+            if cdr and unannounced_padding(pos, fend, end):
                 tl.extend(b"\1" * after)  # taken before the frame is accepted
             elif pos != fend:
                 raise Refused(ins.status, bool(stream))

@@ -67,6 +67,15 @@ TAIL_LABEL = "payload end padding"
 END_ALIGN = 4
 
 
+def unannounced_padding(pos: int, fend: int, end: int) -> bool:
+    """The bytes of a sample from ``pos`` (where its fields end, in the circuit's input) to its
+    ``end`` are the unannounced end padding: the fields do not end where the options' padding
+    starts (``fend``), and they are the 1 to :data:`END_ALIGN` - 1 bytes that bring the
+    payload, header included, to a multiple of :data:`END_ALIGN`."""
+    after = end - pos
+    return pos != fend and 0 < after < END_ALIGN and after == -(pos - ALIGN_ORIGIN) % END_ALIGN
+
+
 def cdr_registry(reg: MsgRegistry | None = None) -> MsgRegistry:
     """The ROS 2 forms of ``reg``'s types (default: the shipped ones), each message without
     fields given rosidl's ``uint8 structure_needs_at_least_one_member``."""
@@ -361,5 +370,5 @@ __all__ = [
     "REPRESENTATION", "TAIL_LABEL",
     "cdr_bytes", "cdr_layout_from_config", "cdr_length_rules", "cdr_marshal", "cdr_registry",
     "cdr_tokens", "derive_cdr_layout", "format_cdr_layout", "to_base_tokens", "to_cdr",
-    "to_cdr_tokens", "with_placeholders",
+    "to_cdr_tokens", "unannounced_padding", "with_placeholders",
 ]

@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 
 from rosfpga_lab.hw.cdrlayout import (
-    ALIGN_ORIGIN, END_ALIGN, OPTIONS_PADDING_MASK, TAIL_LABEL, CdrLayout, cdr_length_rules,
-    cdr_marshal, to_base_tokens, to_cdr_tokens,
+    END_ALIGN, OPTIONS_PADDING_MASK, TAIL_LABEL, CdrLayout, cdr_length_rules,
+    cdr_marshal, to_base_tokens, to_cdr_tokens, unannounced_padding,
 )
 from rosfpga_lab.hw.errors import FrameLengthError, FrameTruncatedError
 from rosfpga_lab.hw.layoutsteps import Step, StepKind
@@ -150,10 +150,8 @@ class CdrInterpreter(LayoutInterpreter):
 
     def _frame_done(self) -> None:
         assert self._frame_length is not None
-        after = self._sample_end - self.offset   # bytes after the last field
-        if after != self._tail and 0 < after < END_ALIGN and \
-                after == -(self.offset - ALIGN_ORIGIN) % END_ALIGN:
-            self._tail = after   # unannounced alignment to END_ALIGN
+        if unannounced_padding(self.offset, self._end, self._sample_end):
+            self._tail = self._sample_end - self.offset
         self._done = self._extracted()
         if self._tail:
             self._tail_left = self._tail

@@ -292,14 +292,19 @@ def design_path(name: str, home: Path | None = None) -> Path:
 
 def sby_text(proof: Proof, design_files: Sequence[Path], includes: Sequence[Path] = ()) -> str:
     """The ``.sby`` file of ``proof`` over ``design_files`` (``includes``: more included files,
-    such as a generated ``rfl_layout.vh``)."""
+    such as a generated ``rfl_layout.vh``). A bounded check's script flattens the design and optimises
+    it fully (``opt -full -sat``: flip-flops SAT proves constant go, with the logic they feed):
+    an equivalent, smaller model; the depth-50 gsubscriber bmc took 81 s instead of 260 s. An
+    induction keeps ``opt -fast`` (the full optimisation made gtop's 4 s proof take 27 s)."""
     defines = " ".join(f"-D{d}" for d in proof.defines)
     wrapper = (proof.home or FORMAL_DIR) / f"fv_{proof.name}.sv"
     lines = ["[options]", f"mode {proof.mode}", f"depth {proof.depth}", "",
              "[engines]", "smtbmc yices", "", "[script]"]
     lines += [f"read_verilog -formal {p.name}" for p in design_files]
     lines += [f"read_verilog -formal -sv {defines} {wrapper.name}".replace("  ", " "),
-              f"prep -top fv_{proof.name}", "memory_map", "opt -fast", "", "[files]"]
+              f"prep -top fv_{proof.name}", "memory_map",
+              *(("flatten", "opt -full -sat", "opt_clean") if proof.mode == "bmc" else ("opt -fast",)),
+              "", "[files]"]
     lines += [str(p) for p in design_files]
     lines += [str(wrapper), str(FORMAL_DIR / ENV_INCLUDE)]
     lines += [str(p) for p in sorted(proof.home.glob("*.vh"))] if proof.home else []

@@ -8,10 +8,11 @@ Fmax against the configuration's clock, LUT4, flip-flops, block RAMs, multiplier
 of the example's first test frame by the circuit record (``circuit_of(config).frame_clocks``,
 which tests/rtl/test_cycles.py holds equal to the RTL). ``--random N`` adds N message definitions
 drawn as the property test draws them (tests/hw/test_walker.py ``definitions``, small maxima as
-tests/rtl/test_timing.py takes them), placed at 100 MHz. The tools' versions are printed first.
+tests/rtl/test_timing.py takes them), placed at 100 MHz; ``--pick K`` places only the K-th of
+them (1-based, repeatable: ``--random 4 --pick 2``). The tools' versions are printed first.
 
 Usage: ``python tests/benchmarks/bench_timing_examples.py [--seeds 1 2 3] [--only laserscan]
-[--random N] [--no-examples]``
+[--random N [--pick K ...]] [--no-examples]``
 """
 
 from __future__ import annotations
@@ -55,8 +56,9 @@ def first_frame_clocks(config) -> str:
     return f"{circuit_of(config).frame_clocks(first).total:,}"
 
 
-def random_tops(count: int, seeds: list[int]) -> None:
-    """Place and route ``count`` generated tops of message definitions the property test draws."""
+def random_tops(count: int, seeds: list[int], pick: list[int] | None = None) -> None:
+    """Place and route ``count`` generated tops of message definitions the property test draws
+    (only the ``pick``-th ones, 1-based, when given)."""
     from hypothesis import HealthCheck, Phase, given, settings
 
     from rosfpga_lab.hls.generic import spec_from_layout
@@ -76,6 +78,8 @@ def random_tops(count: int, seeds: list[int]) -> None:
 
     collect()
     for k, (reg, type_name, stream) in enumerate(drawn[:count]):
+        if pick and k + 1 not in pick:
+            continue
         layout = derive_layout(reg, type_name, stream=stream, stream_length=3)
         small = {s.path: 3 for s in layout.steps[1:] if s.kind is StepKind.LENGTH
                  and s.action is not Action.STREAM and not s.label.endswith("[] length")}
@@ -104,7 +108,11 @@ def main(argv: list[str] | None = None) -> int:
                         help="place the shipped examples (default); --no-examples: only --random")
     parser.add_argument("--random", type=int, default=0, metavar="N",
                         help="also N random message definitions (property test's strategy)")
+    parser.add_argument("--pick", type=int, action="append", metavar="K",
+                        help="only the K-th of the --random definitions (1-based; repeatable)")
     args = parser.parse_args(argv)
+    if args.pick and not all(1 <= k <= args.random for k in args.pick):
+        parser.error(f"--pick takes 1 to --random N (got {args.pick} with --random {args.random})")
     yosys, nextpnr = choose_tools()
     print(f"tools: {yosys.describe()}; {nextpnr.describe()}", flush=True)
     print(HEADER, flush=True)
@@ -122,7 +130,7 @@ def main(argv: list[str] | None = None) -> int:
             print(row(path.stem, config.subscriber.type, config.wire, seed, report, clocks),
                   flush=True)
     if args.random:
-        random_tops(args.random, args.seeds)
+        random_tops(args.random, args.seeds, args.pick)
     print(f"{time.perf_counter() - start:.0f} s in all", file=sys.stderr)
     return 0
 

@@ -55,7 +55,8 @@ def test_every_module_has_a_proof() -> None:
 @pytest.mark.timeout(900)   # the proofs take 150-220 s on two idle cores; a loaded machine doubles it
 def test_every_proof_passes() -> None:
     """All checks, two at a time (the tools are single-threaded), the deepest bounded checks
-    started first: the gsubscriber bmc (depth 50, some 140 s) takes longer than the other checks
+    started first: the gsubscriber bmc (depth 50: 82 s, 50 s with FV_WHOLE, on two idle cores;
+    260 s and 160 s before bounded checks were optimised fully) takes longer than the other checks
     together, so started late it made the whole longer than its own time. With streaming early
     release there are two (the early walk and FV_WHOLE's), started together on the two workers.
     (The exhibit's seven checks run from ``tests/rtl/test_exhibit.py``.)"""

@@ -64,10 +64,12 @@ module rfl_gpublisher #(
     reg [34:0] left_b;                          // bytes of the current body still to write
     reg [31:0] seq;
     reg [31:0] left [0:LOOPS-1];
-    // Flags kept with the registers they test, so that no decision of P_DECODE or P_COUNTED
-    // compares 32 bits before choosing the next instruction (100 MHz on an ECP5): n is zero
-    // (OP_VAR: so is its body, n << lsize), and each open loop's last element.
+    // Flags kept with the registers they test, so that no decision that chooses the next
+    // instruction compares 32 bits first (100 MHz on an ECP5): n is zero (OP_VAR: so is its
+    // body, n << lsize), the body's last byte is next (left_b == 1), and each open loop's last
+    // element. (P_LEN's and P_COUNT's cnt counts 0 to 3: its low bits tell its 4th byte.)
     reg        n_zero;
+    reg        last_b;                          // left_b == 1
     reg [LOOPS-1:0] last_of;                    // left[d] == 1
     reg [DB-1:0] depth;
 
@@ -163,6 +165,7 @@ module rfl_gpublisher #(
             n_zero <= 1'b1;
             last_of <= {LOOPS{1'b0}};
             left_b <= 35'd0;
+            last_b <= 1'b0;
             seq <= SEQ_START;
             opos <= 32'd0;
             padn <= 3'd0;
@@ -185,7 +188,7 @@ module rfl_gpublisher #(
                     cnt <= cnt + 32'd1;
                     if (cnt == STREAM_DATA_BYTES - 1) state <= P_DONE;
                 end
-                P_LEN: if (put && cnt == 32'd3) go(16'd0, prog_word(16'd0));
+                P_LEN: if (put && cnt[1:0] == 2'd3) go(16'd0, prog_word(16'd0));
                 P_DECODE: case (op)
                     OP_DONE: begin
                         seq <= seq + 32'd1;
@@ -203,6 +206,7 @@ module rfl_gpublisher #(
                     end
                     OP_FIXED, OP_ENCAP: begin
                         left_b <= {3'd0, size};
+                        last_b <= (size == 32'd1);
                         if (size == 32'd0) begin
                             pc <= pc + 16'd1;
                             w <= prog_next(pc);
@@ -226,7 +230,7 @@ module rfl_gpublisher #(
                         n <= n_next;
                         n_zero <= (n_next == 32'd0);
                     end
-                    if (cnt == 32'd3) begin
+                    if (cnt[1:0] == 2'd3) begin
                         state <= P_COUNTED;
                         cnt <= 32'd0;
                     end
@@ -244,6 +248,7 @@ module rfl_gpublisher #(
                         go(pc + 16'd1, prog_next(pc));
                     end else begin
                         left_b <= body;
+                        last_b <= (body == 35'd1);
                         pad_then(pad_at(opos, elem_align), P_BODY);
                     end
                 end
@@ -253,7 +258,8 @@ module rfl_gpublisher #(
                 end
                 P_BODY: if (put) begin
                     left_b <= left_b - 35'd1;
-                    if (left_b == 35'd1) go(pc + 16'd1, prog_next(pc));
+                    last_b <= (left_b == 35'd2);
+                    if (last_b) go(pc + 16'd1, prog_next(pc));
                 end
                 P_DONE: state <= P_IDLE;
                 default: state <= P_IDLE;
@@ -267,6 +273,8 @@ module rfl_gpublisher #(
     integer fd;
     always @(*) if (rst_n) begin
         assert(n_zero == (n == 32'd0));
+        assert(last_b == (left_b == 35'd1));
+        if (state == P_LEN || state == P_COUNT) assert(cnt < 32'd4);
         for (fd = 0; fd < LOOPS; fd = fd + 1) assert(last_of[fd] == (left[fd] == 32'd1));
     end
 `endif

@@ -158,8 +158,7 @@ module rfl_gsubscriber #(
     wire        at_end = (left_f == 32'd0);         // nothing left of the frame to skip
     // CDR: the bytes left after the last field are the unannounced padding up to a multiple of
     // END_ALIGN
-    wire        tail_pad = CDR && room != 32'd0 && left_f != 32'd0
-                           && left_f < {28'd0, END_ALIGN} && left_f == pad_at(pos, END_ALIGN);
+    wire        tail_pad = CDR && unannounced_pad(room, left_f, pos);
     wire [31:0] pad_f = pad_at(pos, align);         // before a field or a count
     wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
     wire [31:0] room_f = room - pad_f;              // bytes left after that padding
@@ -344,8 +343,7 @@ module rfl_gsubscriber #(
         c_out_len <= p_out_at + p_written;
         // (the elements end the payload, or leave only its unannounced end padding)
         c_early_bad <= STREAM_EARLY != 0 && CDR != 0 && sub == SUB_STREAM && p_end_room != 32'd0
-                       && !(p_end_left != 32'd0 && p_end_left < {28'd0, END_ALIGN}
-                            && p_end_left == pad_at(p_end_pos, END_ALIGN));
+                       && !unannounced_pad(p_end_room, p_end_left, p_end_pos);
     end
 
     // Skip `p` alignment bytes (if any), then go to state `next`.

@@ -87,4 +87,13 @@ static inline unsigned pad(unsigned pos, unsigned align) {
     return (ALIGN_ORIGIN - pos) & (align - 1);
 }
 
+// The bytes from `pos` (where the fields end) to `end` are the payload's unannounced end padding:
+// the fields do not end at `fend` (where the options' padding starts), and they are the 1 to
+// END_ALIGN - 1 bytes that bring the payload to a multiple of END_ALIGN (Cyclone DDS pads so with
+// options 00 00). Padding is never looked at.
+static inline bool unannounced_padding(unsigned pos, unsigned fend, unsigned end) {
+    const unsigned after = end - pos;
+    return pos != fend && after != 0 && after < END_ALIGN && after == pad(pos, END_ALIGN);
+}
+
 #endif  // LAYOUT_H

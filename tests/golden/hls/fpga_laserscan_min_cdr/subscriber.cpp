@@ -178,12 +178,9 @@ static bool decode(sub_walk& w) {
     w.ins = PROGRAM[w.pc];
     const instr_t& ins = w.ins;
     if (ins.op == OP_DONE) {
-        // Bytes the options do not announce, that bring the payload to a multiple of
-        // END_ALIGN (Cyclone DDS pads so with options 00 00): skipped, as all padding is.
-        const unsigned after = w.end.to_uint() - w.pos.to_uint();
-        const bool end_pad = w.pos != w.fend && after != 0 && after < END_ALIGN &&
-                             after == pad(w.pos.to_uint(), END_ALIGN);
-        if (w.pos != w.fend && !end_pad) refuse(w, ins.status);  // bytes left over
+        // bytes left over, unless the unannounced end padding (skipped, as all padding is)
+        if (w.pos != w.fend && !unannounced_padding(w.pos.to_uint(), w.fend.to_uint(), w.end.to_uint()))
+            refuse(w, ins.status);
         else w.st = w.pos < w.end ? ST_SKIP : ST_FINISH;  // the end padding
         return w.st == ST_SKIP;
     }

@@ -131,6 +131,16 @@ function [31:0] pad_at(input [31:0] p, input [3:0] a);
         pad_at = {29'd0, (ALIGN_ORIGIN[2:0] - p[2:0]) & (a[2:0] - 3'd1)};
     end
 endfunction
+// CDR: the `left` bytes from byte `p` to the frame's end are its unannounced end padding: the
+// fields do not end where the options' padding starts (`room`, the bytes to there, is not 0) and
+// they are the 1 to END_ALIGN - 1 bytes that bring the payload to a multiple of END_ALIGN
+// (hw.cdrlayout.unannounced_padding).
+function unannounced_pad(input [31:0] room, input [31:0] left, input [31:0] p);
+    begin
+        unannounced_pad = room != 32'd0 && left != 32'd0 && left < {28'd0, END_ALIGN}
+                          && left == pad_at(p, END_ALIGN);
+    end
+endfunction
 /* verilator lint_on UNUSEDSIGNAL */
 
 function [7:0] konst(input [15:0] addr);
