@@ -45,6 +45,9 @@ from tests.support.rtltools import TB_DIR, require_cocotb
 pytestmark = pytest.mark.rtl
 
 PEER = bytes.fromhex("010fcafe0000000100000001")
+#: rfl_fabric_node and the fabric modules it instantiates (the generated top's files aside).
+NODE_MODULES = ("rfl_rtps_rx", "rfl_rtps_to_cdr", "rfl_rtps_tx", "rfl_rtps_ctrl",
+                "rfl_rtps_disc_answer", "rfl_rtps_disc_rom", "rfl_frame_arbiter", "rfl_fabric_node")
 PERIOD = 6000           # clocks between SPDP announcements: several in one run
 MIN_CLOCKS = 4 * PERIOD
 
@@ -91,9 +94,7 @@ def test_the_node_routes_answers_and_announces(seed: int, gap: int, bp: int, tmp
                                             "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
                                             "COUNT_START", "BURST", "RATE")})
     rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
-    sources = [FABRIC / f"{m}.v" for m in ("rfl_rtps_rx", "rfl_rtps_to_cdr", "rfl_rtps_tx",
-                                           "rfl_rtps_ctrl", "rfl_rtps_disc_answer",
-                                           "rfl_rtps_disc_rom", "rfl_fabric_node")] + rtl
+    sources = [FABRIC / f"{m}.v" for m in NODE_MODULES] + rtl
     runner = get_runner(sim)
     runner.build(sources=sources, includes=[gen / "rtl"], hdl_toplevel="rfl_fabric_node",
                  parameters=params, build_dir=tmp_path / "build", timescale=("1ns", "1ps"),

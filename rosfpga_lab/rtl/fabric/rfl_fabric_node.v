@@ -9,10 +9,10 @@
 // a send_sedp pulse). Out: UDP payloads, TDEST their destination as rfl_rtps_disc_rom numbers
 // them (0 SPDP, 1 metatraffic unicast, 2 user-data unicast: the transmit path's USER_DEST) and
 // m_dst_prefix the asker an answer goes to (0 for the others).
-// The arbiter is frame-atomic: it grants one source a whole datagram (round robin among
-// transmit path, answers, discovery ROM, one idle clock between grants) and passes its beats
-// as they are, so a datagram is never interleaved with another and the stream rules of the
-// sources (TDATA, TLAST, TDEST stable until taken) hold on the output.
+// The arbiter (rfl_frame_arbiter) is frame-atomic: it grants one source a whole datagram (round
+// robin among transmit path, answers, discovery ROM, one idle clock between grants) and passes
+// its beats as they are, so a datagram is never interleaved with another and the stream rules
+// of the sources (TDATA, TLAST, TDEST stable until taken) hold on the output.
 `default_nettype none
 
 module rfl_fabric_node #(
@@ -178,48 +178,17 @@ module rfl_fabric_node #(
         .m_axis_tlast(rom_tlast), .m_axis_tdest(rom_tdest));
 
     // ---- frame-atomic round-robin arbiter: 0 transmit path, 1 answers, 2 discovery ROM
-    reg locked;
-    reg [1:0] grant;
-    wire [2:0] want = {rom_tvalid, an_tvalid, tx_tvalid};
-    // the next source after grant that wants the output (round robin over 0, 1, 2)
-    reg [1:0] pick;
-    reg found;
-    always @* begin
-        pick = grant;
-        found = 1'b1;
-        case (grant)
-            2'd0: if (want[1]) pick = 2'd1; else if (want[2]) pick = 2'd2;
-                  else if (want[0]) pick = 2'd0; else found = 1'b0;
-            2'd1: if (want[2]) pick = 2'd2; else if (want[0]) pick = 2'd0;
-                  else if (want[1]) pick = 2'd1; else found = 1'b0;
-            default: if (want[0]) pick = 2'd0; else if (want[1]) pick = 2'd1;
-                     else if (want[2]) pick = 2'd2; else found = 1'b0;
-        endcase
-    end
-    always @(posedge clk) begin
-        if (!rst_n) begin
-            locked <= 1'b0;
-            grant <= 2'd2;
-        end else if (!locked) begin
-            if (found) begin
-                grant <= pick;
-                locked <= 1'b1;
-            end
-        end else if (m_axis_tvalid && m_axis_tready && m_axis_tlast) begin
-            locked <= 1'b0;
-        end
-    end
-    wire g_tx = locked && grant == 2'd0;
-    wire g_an = locked && grant == 2'd1;
-    wire g_rom = locked && grant == 2'd2;
-    assign tx_tready = g_tx && m_axis_tready;
-    assign an_tready = g_an && m_axis_tready;
-    assign rom_tready = g_rom && m_axis_tready;
-    assign m_axis_tvalid = (g_tx && tx_tvalid) || (g_an && an_tvalid) || (g_rom && rom_tvalid);
-    assign m_axis_tdata = g_an ? an_tdata : g_rom ? rom_tdata : tx_tdata;
-    assign m_axis_tlast = g_an ? an_tlast : g_rom ? rom_tlast : tx_tlast;
-    assign m_axis_tdest = g_an ? an_tdest : g_rom ? rom_tdest : UDEST;
-    assign m_dst_prefix = g_an ? an_prefix : 96'd0;
+    rfl_frame_arbiter #(.DATA_BITS(8), .DEST_BITS(2), .USER_BITS(96)) u_arb (
+        .clk(clk), .rst_n(rst_n),
+        .s_axis_tdata({rom_tdata, an_tdata, tx_tdata}),
+        .s_axis_tvalid({rom_tvalid, an_tvalid, tx_tvalid}),
+        .s_axis_tready({rom_tready, an_tready, tx_tready}),
+        .s_axis_tlast({rom_tlast, an_tlast, tx_tlast}),
+        .s_axis_tdest({rom_tdest, an_tdest, UDEST}),
+        .s_axis_tuser({96'd0, an_prefix, 96'd0}),
+        .m_axis_tdata(m_axis_tdata), .m_axis_tvalid(m_axis_tvalid),
+        .m_axis_tready(m_axis_tready), .m_axis_tlast(m_axis_tlast),
+        .m_axis_tdest(m_axis_tdest), .m_axis_tuser(m_dst_prefix));
 endmodule
 
 `default_nettype wire
