@@ -39,7 +39,8 @@ FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 #: The network side of the node in the fabric (issue #31): modules proven here, not in a project.
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
 FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
-                  "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v")
+                  "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v",
+                  "rfl_frame_arbiter.v", "rfl_fabric_node.v")
 ENV_INCLUDE = "fv_env.vh"
 
 
@@ -196,6 +197,11 @@ PROOFS: tuple[Proof, ...] = (
     Proof("rtps_disc_answer", ("rfl_rtps_disc_answer.v",), "bmc", 14,
           "rfl_rtps_disc_answer (credit 8 bytes, 1 per byte received): bytes sent at most "
           "BURST + RATE x bytes received; 14 clocks (the first credit spent and earned again)"),
+    Proof("frame_arbiter", ("rfl_frame_arbiter.v",), "prove", 4,
+          "rfl_frame_arbiter (three sources, any datagrams): output stream rules with TDEST and "
+          "TUSER, one source ready at a time, each beat taken out the one taken from it, a "
+          "datagram's source alone on the output until its TLAST (none interleaved), a source "
+          "waits behind at most two datagrams; all reachable states"),
 )
 
 

@@ -10,6 +10,7 @@ an element packer that drops TLAST).
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import struct
 from concurrent.futures import ThreadPoolExecutor
@@ -308,3 +309,46 @@ def test_rtl_prove_config_names_what_it_cannot_prove(tmp_path: Path,
     assert "--only names the modules' checks" in capsys.readouterr().err
     assert main(["rtl", "prove", "--depth", "3"]) == 1
     assert "--depth need a CONFIG" in capsys.readouterr().err
+
+
+def test_planted_bugs_fail_the_frame_arbiter_proof(tmp_path: Path) -> None:
+    """rfl_fabric_node's arbiter: one that may switch source after any beat (not only after
+    TLAST) interleaves datagrams: the proof fails on the atomicity assertions. One with a
+    fixed priority after source 1 (0 before 2, not round robin) lets source 2 wait behind more
+    than two datagrams: the induction does not close on the wait bound, and a bounded check of
+    12 clocks from reset finds the trace (0 and 1 taking turns while 2 waits)."""
+    require_formal()
+    name = "rfl_frame_arbiter.v"
+    text = (FABRIC_DIR / name).read_text()
+    lines = text.splitlines()
+    proof = next(p for p in PROOFS if p.name == "frame_arbiter")
+
+    def planted(old: str, new: str) -> Path:
+        assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+        buggy = tmp_path / name
+        buggy.write_text(text.replace(old, new + "   // PLANTED BUG"))
+        return buggy
+
+    def failed(result: ProofResult) -> set[str]:
+        assert all(f.startswith(f"{name}:") for f in result.failed), result.failed
+        return {lines[int(f.split(":")[1].split(".")[0]) - 1].strip() for f in result.failed}
+
+    buggy = planted("end else if (m_axis_tvalid && m_axis_tready && m_axis_tlast) begin",
+                    "end else if (m_axis_tvalid && m_axis_tready) begin")
+    result = prove(proof, replace={name: buggy})
+    assert result.status == "FAIL", format_results([result])
+    assert failed(result) == {"assert(locked && grant == f_src);",
+                              "assert(m_axis_tvalid == s_axis_tvalid[f_src]);"}
+    buggy = planted("2'd1: if (s_axis_tvalid[2]) pick = 2'd2; else if (s_axis_tvalid[0]) "
+                    "pick = 2'd0;", "2'd1: if (s_axis_tvalid[0]) pick = 2'd0; "
+                    "else if (s_axis_tvalid[2]) pick = 2'd2;")
+    result = prove(proof, replace={name: buggy})
+    assert result.status in ("FAIL", "UNKNOWN") and result.failed, format_results([result])
+    # the invariant of the rotation fails first; without it, the wait bound itself
+    invariant = "assert({1'b0, f_wait} + f_dist <= (locked ? 3'd2 : 3'd3));"
+    assert failed(result) == {invariant}, failed(result)
+    assert buggy.read_text().count(invariant) == 1
+    buggy.write_text(buggy.read_text().replace(invariant, "; // " + invariant))
+    result = prove(dataclasses.replace(proof, mode="bmc", depth=12), replace={name: buggy})
+    assert result.status == "FAIL", format_results([result])
+    assert failed(result) == {"assert(f_wait <= 2'd2);"}, failed(result)

@@ -67,6 +67,51 @@ module rfl_frame_arbiter #(
     assign m_axis_tlast = s_axis_tlast[g];
     assign m_axis_tdest = s_axis_tdest[g * DEST_BITS +: DEST_BITS];
     assign m_axis_tuser = s_axis_tuser[g * USER_BITS +: USER_BITS];
+
+`ifdef FORMAL
+    // On the ports, with the invariants that make them inductive (fv_frame_arbiter proves them).
+    // Frame atomicity: f_mid, a datagram's beat taken and not yet its TLAST, f_src its source;
+    // meanwhile the output is that source alone (its valid, TREADY to it only).
+    // Round robin: f_wait, the datagrams of other sources ended while source i offered a beat
+    // and waited: at most 2 (f_dist: steps of the rotation from the last grant to source i).
+    reg f_mid;
+    reg [1:0] f_src;
+    wire [2:0] f_take = s_axis_tvalid & s_axis_tready;
+    wire f_end = m_axis_tvalid && m_axis_tready && m_axis_tlast;
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            f_mid <= 1'b0;
+            f_src <= 2'd0;
+        end else if (f_take != 3'd0) begin
+            f_mid <= !m_axis_tlast;
+            f_src <= f_take[2] ? 2'd2 : f_take[1] ? 2'd1 : 2'd0;
+        end
+    end
+    always @(*) if (rst_n) begin
+        assert(grant != 2'd3);
+        assert(f_take == 3'd0 || f_take == 3'd1 || f_take == 3'd2 || f_take == 3'd4);
+        if (f_mid) begin
+            assert(locked && grant == f_src);
+            assert(m_axis_tvalid == s_axis_tvalid[f_src]);
+        end
+    end
+    genvar fi;
+    generate for (fi = 0; fi < 3; fi = fi + 1) begin : g_f_wait
+        localparam [1:0] I = fi;
+        reg [1:0] f_wait;
+        wire [2:0] f_dist = (grant == I) ? 3'd3 : (I > grant) ? {1'b0, I - grant}
+                                                               : {1'b0, I + 2'd3 - grant};
+        always @(posedge clk) begin
+            if (!rst_n || !s_axis_tvalid[fi] || f_take[fi]) f_wait <= 2'd0;
+            else if (f_end && f_wait != 2'd3) f_wait <= f_wait + 2'd1;
+        end
+        always @(*) if (rst_n) begin
+            assert(f_wait <= 2'd2);
+            if (s_axis_tvalid[fi] && !(locked && grant == I))
+                assert({1'b0, f_wait} + f_dist <= (locked ? 3'd2 : 3'd3));
+        end
+    end endgenerate
+`endif
 endmodule
 
 `default_nettype wire
