@@ -33,7 +33,6 @@ async def fabric_node(dut) -> None:
     for dg, kind in case["datagrams"]:
         raw = bytes.fromhex(dg)
         stream += [(x, int(i == len(raw) - 1), kind) for i, x in enumerate(raw)]
-    dut.cfg_prefix.value = int(case["local"], 16)
     dut.cfg_reader.value = case["reader"]
     dut.cfg_writer.value = case["writer"]
     dut.cfg_time.value = case["time"]

@@ -17,6 +17,9 @@
 
 module rfl_fabric_node #(
     parameter MAX_BYTES = 2048,                 // the seam's longest sample
+    // this participant's GUID prefix, the one the ROMs were rendered with
+    // (rtl.discrom.tx_parameters): the transmit path's source, and the receive side's and
+    // rfl_rtps_ctrl's own (INFO_DST to it taken, its own messages looped back dropped)
     parameter [95:0] GUID_PREFIX = 96'h010f_7266_6c46_4142_5249_4300,
     parameter [31:0] WRITER_ID = 32'h00000203,
     parameter [31:0] READER_ID = 32'd0,
@@ -45,7 +48,6 @@ module rfl_fabric_node #(
 ) (
     input  wire         clk,
     input  wire         rst_n,
-    input  wire [95:0]  cfg_prefix,             // this participant's GUID prefix
     input  wire [31:0]  cfg_reader,             // our reader's entity id
     input  wire [31:0]  cfg_writer,             // the writer taken (0: any)
     input  wire [63:0]  cfg_time,               // INFO_TS of the transmit path
@@ -112,7 +114,7 @@ module rfl_fabric_node #(
     wire [7:0] framing;
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_rtps_rx u_rx (
-        .clk(clk), .rst_n(rst_n), .cfg_prefix(cfg_prefix), .cfg_reader(cfg_reader),
+        .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .cfg_reader(cfg_reader),
         .cfg_writer(cfg_writer), .s_axis_tdata(s_axis_tdata),
         .s_axis_tvalid(s_axis_tvalid && kind), .s_axis_tready(rx_in_ready),
         .s_axis_tlast(s_axis_tlast),
@@ -152,7 +154,7 @@ module rfl_fabric_node #(
     wire [95:0] an_prefix;
     rfl_rtps_ctrl #(.SLOTS(SLOTS), .SLOT_IDS(SLOT_IDS), .SLOT_MSGS(SLOT_MSGS),
                     .SLOT_LASTS(SLOT_LASTS)) u_ctrl (
-        .clk(clk), .rst_n(rst_n), .cfg_prefix(cfg_prefix), .s_axis_tdata(s_axis_tdata),
+        .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .s_axis_tdata(s_axis_tdata),
         .s_axis_tvalid(s_axis_tvalid && !kind), .s_axis_tready(ctrl_in_ready),
         .s_axis_tlast(s_axis_tlast), .m_axis_tdata(req_tdata), .m_axis_tvalid(req_tvalid),
         .m_axis_tready(req_tready), .rx_byte(rx_byte), .cnt_requests(cnt_requests),
