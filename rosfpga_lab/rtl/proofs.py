@@ -42,6 +42,11 @@ FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "
                   "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v",
                   "rfl_frame_arbiter.v", "rfl_fabric_node.v")
 ENV_INCLUDE = "fv_env.vh"
+#: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node aside:
+#: the project's; the proof's wrapper has its own).
+FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
+               "rfl_rtps_disc_answer.v", "rfl_rtps_disc_rom.v", "rfl_frame_arbiter.v",
+               "rfl_fabric_node.v")
 
 
 @dataclass(frozen=True)
@@ -202,6 +207,15 @@ PROOFS: tuple[Proof, ...] = (
           "TUSER, one source ready at a time, each beat taken out the one taken from it, a "
           "datagram's source alone on the output until its TLAST (none interleaved), a source "
           "waits behind at most two datagrams; all reachable states"),
+    Proof("fabric_node", FABRIC_NODE, "prove", 4,
+          "rfl_fabric_node (every stage, small sizes, ROMs of any contents, any payloads in, "
+          "the generated top a passthrough): output stream rules with TDEST and the prefix, "
+          "each beat in to the side of its packet's first-beat kind alone, metatraffic never "
+          "held back, the arbiter's atomicity and wait bound and the stages' invariants in "
+          "place; all reachable states", ("FV_PROVE",)),
+    Proof("fabric_node", FABRIC_NODE, "bmc", 24,
+          "rfl_fabric_node (as above): TDEST and the prefix constant inside a datagram; 24 "
+          "clocks (SPDP datagrams of any length out, packets of both kinds in)"),
 )
 
 

@@ -31,6 +31,7 @@ from rosfpga_lab.rtl.discrom import (
     answer_params, fabric_participant, render_rom, tx_parameters, verilog_parameters, write_rom,
 )
 from rosfpga_lab.rtl.limits import ANSWER_BURST, ANSWER_RATE
+from rosfpga_lab.rtl.proofs import FABRIC_NODE
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import PUB_READER, PUB_WRITER
 from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
@@ -45,9 +46,6 @@ from tests.support.rtltools import TB_DIR, require_cocotb
 pytestmark = pytest.mark.rtl
 
 PEER = bytes.fromhex("010fcafe0000000100000001")
-#: rfl_fabric_node and the fabric modules it instantiates (the generated top's files aside).
-NODE_MODULES = ("rfl_rtps_rx", "rfl_rtps_to_cdr", "rfl_rtps_tx", "rfl_rtps_ctrl",
-                "rfl_rtps_disc_answer", "rfl_rtps_disc_rom", "rfl_frame_arbiter", "rfl_fabric_node")
 PERIOD = 6000           # clocks between SPDP announcements: several in one run
 MIN_CLOCKS = 4 * PERIOD
 
@@ -100,7 +98,7 @@ def test_the_node_routes_answers_and_announces(seed: int, gap: int, bp: int, tmp
                                             "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
                                             "COUNT_START", "BURST", "RATE")})
     rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
-    sources = [FABRIC / f"{m}.v" for m in NODE_MODULES] + rtl
+    sources = [FABRIC / m for m in FABRIC_NODE] + rtl
     runner = get_runner(sim)
     runner.build(sources=sources, includes=[gen / "rtl"], hdl_toplevel="rfl_fabric_node",
                  parameters=params, build_dir=tmp_path / "build", timescale=("1ns", "1ps"),

@@ -352,3 +352,24 @@ def test_planted_bugs_fail_the_frame_arbiter_proof(tmp_path: Path) -> None:
     result = prove(dataclasses.replace(proof, mode="bmc", depth=12), replace={name: buggy})
     assert result.status == "FAIL", format_results([result])
     assert failed(result) == {"assert(f_wait <= 2'd2);"}, failed(result)
+
+
+def test_a_planted_bug_fails_the_fabric_node_proof(tmp_path: Path) -> None:
+    """A node that reads the kind of a packet on every beat (not its first beat's alone) sends
+    a packet's later beats to the other side: the node's proof fails on the routing."""
+    require_formal()
+    name = "rfl_fabric_node.v"
+    text = (FABRIC_DIR / name).read_text()
+    old = "in_kind <= kind;"
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp_path / name
+    buggy.write_text(text.replace(old, "in_kind <= s_axis_tuser;   // PLANTED BUG"))
+    proof = next(p for p in PROOFS if p.name == "fabric_node" and p.mode == "prove")
+    result = prove(proof, replace={name: buggy})
+    assert result.status == "FAIL", format_results([result])
+    lines = text.splitlines()
+    failed = {lines[int(f.split(":")[1].split(".")[0]) - 1].strip() for f in result.failed}
+    assert all(f.startswith(f"{name}:") for f in result.failed), result.failed
+    assert failed & {"assert(rx_in_valid == (s_axis_tvalid && f_k));",
+                     "assert(ctrl_in_valid == (s_axis_tvalid && !f_k));",
+                     "if (f_pkt) assert(in_kind == f_kind);"}, failed

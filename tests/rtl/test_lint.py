@@ -293,7 +293,7 @@ def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None
         render_rom, tx_parameters, verilog_parameters, write_rom,
     )
     from rosfpga_lab.rtl.sim import VERILOG_DIR
-    from tests.rtl.test_fabric_node import NODE_MODULES
+    from rosfpga_lab.rtl.proofs import FABRIC_NODE
 
     config = DATA / "fpga_laserscan_min_cdr.yaml"
     gen = tmp_path / "project"
@@ -313,7 +313,7 @@ def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None
                                             "COUNT_START", "BURST", "RATE")})
     fabric = Path(VERILOG_DIR).parent / "fabric"
     top = "rfl_fabric_node"
-    sources = [str(fabric / f"{m}.v") for m in NODE_MODULES]
+    sources = [str(fabric / m) for m in FABRIC_NODE]
     sources += sorted(str(q) for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "--top-module", top,
                            f"-I{gen / 'rtl'}", *(f"-G{k}={v}" for k, v in params.items()),

@@ -89,6 +89,8 @@ module rfl_fabric_node #(
     reg in_pkt, in_kind;
     wire kind = in_pkt ? in_kind : s_axis_tuser;
     wire rx_in_ready, ctrl_in_ready;
+    wire rx_in_valid = s_axis_tvalid && kind;
+    wire ctrl_in_valid = s_axis_tvalid && !kind;
     assign s_axis_tready = kind ? rx_in_ready : ctrl_in_ready;
     always @(posedge clk) begin
         if (!rst_n) begin
@@ -116,7 +118,7 @@ module rfl_fabric_node #(
     rfl_rtps_rx u_rx (
         .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .cfg_reader(cfg_reader),
         .cfg_writer(cfg_writer), .s_axis_tdata(s_axis_tdata),
-        .s_axis_tvalid(s_axis_tvalid && kind), .s_axis_tready(rx_in_ready),
+        .s_axis_tvalid(rx_in_valid), .s_axis_tready(rx_in_ready),
         .s_axis_tlast(s_axis_tlast),
         .m_axis_tdata(rx_tdata), .m_axis_tvalid(rx_tvalid), .m_axis_tready(rx_tready),
         .m_axis_tlast(rx_tlast), .m_axis_tuser(rx_tuser), .m_sample_guid(guid),
@@ -155,7 +157,7 @@ module rfl_fabric_node #(
     rfl_rtps_ctrl #(.SLOTS(SLOTS), .SLOT_IDS(SLOT_IDS), .SLOT_MSGS(SLOT_MSGS),
                     .SLOT_LASTS(SLOT_LASTS)) u_ctrl (
         .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .s_axis_tdata(s_axis_tdata),
-        .s_axis_tvalid(s_axis_tvalid && !kind), .s_axis_tready(ctrl_in_ready),
+        .s_axis_tvalid(ctrl_in_valid), .s_axis_tready(ctrl_in_ready),
         .s_axis_tlast(s_axis_tlast), .m_axis_tdata(req_tdata), .m_axis_tvalid(req_tvalid),
         .m_axis_tready(req_tready), .rx_byte(rx_byte), .cnt_requests(cnt_requests),
         .cnt_busy(cnt_busy), .cnt_malformed(cnt_ctrl_malformed));
@@ -191,6 +193,32 @@ module rfl_fabric_node #(
         .m_axis_tdata(m_axis_tdata), .m_axis_tvalid(m_axis_tvalid),
         .m_axis_tready(m_axis_tready), .m_axis_tlast(m_axis_tlast),
         .m_axis_tdest(m_axis_tdest), .m_axis_tuser(m_dst_prefix));
+
+`ifdef FORMAL
+    // The routing in, on the ports (fv_fabric_node proves it): f_pkt, a packet's beat taken and
+    // not yet its TLAST; f_kind, the TUSER of its first beat. Each beat is offered to the side
+    // of its packet's kind alone, taken when that side is ready; metatraffic is never held back
+    // (rfl_rtps_ctrl is always ready). The latch agrees with f_pkt, f_kind (the invariant).
+    reg f_pkt, f_kind;
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            f_pkt <= 1'b0;
+            f_kind <= 1'b0;
+        end else if (s_axis_tvalid && s_axis_tready) begin
+            if (!f_pkt) f_kind <= s_axis_tuser;
+            f_pkt <= !s_axis_tlast;
+        end
+    end
+    wire f_k = f_pkt ? f_kind : s_axis_tuser;
+    always @(*) if (rst_n) begin
+        assert(rx_in_valid == (s_axis_tvalid && f_k));
+        assert(ctrl_in_valid == (s_axis_tvalid && !f_k));
+        assert(s_axis_tready == (f_k ? rx_in_ready : ctrl_in_ready));
+        if (s_axis_tvalid && !f_k) assert(s_axis_tready);
+        assert(in_pkt == f_pkt);
+        if (f_pkt) assert(in_kind == f_kind);
+    end
+`endif
 endmodule
 
 `default_nettype wire
