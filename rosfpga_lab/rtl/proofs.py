@@ -198,7 +198,8 @@ PROOFS: tuple[Proof, ...] = (
     Proof("rtps_disc_answer", ("rfl_rtps_disc_answer.v",), "prove", 6,
           "rfl_rtps_disc_answer (16-byte ROM, 2 answers, any contents, any requests): output "
           "stream rules with the asker's prefix, TDEST and prefix constant and no gap inside a "
-          "datagram, credit at most BURST; all reachable states", ("FV_PROVE",)),
+          "datagram, credit at most BURST, bytes sent at most BURST + RATE x bytes received; "
+          "all reachable states", ("FV_PROVE",)),
     Proof("rtps_disc_answer", ("rfl_rtps_disc_answer.v",), "bmc", 14,
           "rfl_rtps_disc_answer (credit 8 bytes, 1 per byte received): bytes sent at most "
           "BURST + RATE x bytes received; 14 clocks (the first credit spent and earned again)"),
@@ -211,8 +212,9 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_fabric_node (every stage, small sizes, ROMs of any contents, any payloads in, "
           "the generated top a passthrough): output stream rules with TDEST and the prefix, "
           "each beat in to the side of its packet's first-beat kind alone, metatraffic never "
-          "held back, the arbiter's atomicity and wait bound and the stages' invariants in "
-          "place; all reachable states", ("FV_PROVE",)),
+          "held back, answers' bytes out at most BURST + RATE x metatraffic bytes in, the "
+          "arbiter's atomicity and wait bound and the stages' invariants in place; all "
+          "reachable states", ("FV_PROVE",)),
     Proof("fabric_node", FABRIC_NODE, "bmc", 24,
           "rfl_fabric_node (as above): TDEST and the prefix constant inside a datagram; 24 "
           "clocks (SPDP datagrams of any length out, packets of both kinds in)"),

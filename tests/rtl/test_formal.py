@@ -373,3 +373,26 @@ def test_a_planted_bug_fails_the_fabric_node_proof(tmp_path: Path) -> None:
     assert failed & {"assert(rx_in_valid == (s_axis_tvalid && f_k));",
                      "assert(ctrl_in_valid == (s_axis_tvalid && !f_k));",
                      "if (f_pkt) assert(in_kind == f_kind);"}, failed
+
+
+def test_a_planted_bug_fails_the_answers_byte_bound(tmp_path: Path) -> None:
+    """An answer module that never spends its credit sends more than BURST + RATE x the bytes
+    received: its checks fail on the bound's invariant (the module's FORMAL block); the node's
+    proof, which has that block in place, no longer passes, on the same assertion (its base
+    case of 4 clocks takes no ACKNACK in: the induction step finds it)."""
+    require_formal()
+    name = "rfl_rtps_disc_answer.v"
+    text = (FABRIC_DIR / name).read_text()
+    old = "if (start) cred <= cred - e_len;"
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp_path / name
+    buggy.write_text(text.replace(old, "if (start) cred <= cred;   // PLANTED BUG"))
+    lines = text.splitlines()
+    bound = "assert(f_allow >= {16'd0, cred} + (sending ? {16'd0, left} : 32'd0));"
+    node = next(p for p in PROOFS if p.name == "fabric_node" and p.mode == "prove")
+    for proof in [p for p in PROOFS if p.name == "rtps_disc_answer"] + [node]:
+        result = prove(proof, replace={name: buggy})
+        assert result.status in (("FAIL", "UNKNOWN") if proof is node else ("FAIL",)), \
+            format_results([result])
+        assert {lines[int(f.split(":")[1].split(".")[0]) - 1].strip()
+                for f in result.failed if f.startswith(f"{name}:")} == {bound}, result.failed

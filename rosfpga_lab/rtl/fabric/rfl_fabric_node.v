@@ -199,6 +199,9 @@ module rfl_fabric_node #(
     // not yet its TLAST; f_kind, the TUSER of its first beat. Each beat is offered to the side
     // of its packet's kind alone, taken when that side is ready; metatraffic is never held back
     // (rfl_rtps_ctrl is always ready). The latch agrees with f_pkt, f_kind (the invariant).
+    // The answers' credit is earned by each metatraffic byte taken and by nothing else: with
+    // rfl_rtps_disc_answer's bound (its FORMAL block, in place), the answers' bytes out are never
+    // more than BURST + RATE x the metatraffic bytes in.
     reg f_pkt, f_kind;
     always @(posedge clk) begin
         if (!rst_n) begin
@@ -217,6 +220,7 @@ module rfl_fabric_node #(
         if (s_axis_tvalid && !f_k) assert(s_axis_tready);
         assert(in_pkt == f_pkt);
         if (f_pkt) assert(in_kind == f_kind);
+        assert(rx_byte == (s_axis_tvalid && s_axis_tready && !f_k));
     end
 `endif
 endmodule

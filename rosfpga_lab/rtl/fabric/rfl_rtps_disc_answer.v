@@ -17,7 +17,7 @@
 // BURST; an answer starts only when the credit holds its length, which it spends at once; one
 // it cannot afford is dropped and counted (cnt_no_credit: the peer asks again). So the bytes
 // sent are never more than BURST + RATE x the bytes received (formal/fv_rtps_disc_answer.sv
-// proves it, with the stream rules, for any ROM contents).
+// proves it, in every reachable state, with the stream rules, for any ROM contents).
 // A request is taken when no answer is on its way (s_axis_tready); the clock after, its table
 // entry is read into a register; the clock after, the answer starts (or is dropped). The ROM is
 // read on the clock into its own register (a block RAM's read port), one byte per clock taken;
@@ -271,6 +271,29 @@ module rfl_rtps_disc_answer #(
             end
         end
     end
+
+`ifdef FORMAL
+    // The byte bound on the ports, with the invariants that make it inductive (fv_rtps_disc_answer
+    // proves them): f_allow, BURST + RATE x the bytes received - the bytes sent (kept at most
+    // 2 x BURST, which only lowers it), always covers the credit and the bytes still to send of
+    // the answer going out; so it never goes below 0: the bytes sent are never more than
+    // BURST + RATE x the bytes received.
+    localparam [31:0] F_MAX = 2 * BURST;
+    reg [31:0] f_allow;
+    wire [31:0] f_earn = f_allow + (rx_byte ? RATE_32 : 32'd0);
+    always @(posedge clk) begin
+        if (!rst_n) f_allow <= BURST_32;
+        else f_allow <= ((f_earn > F_MAX) ? F_MAX : f_earn) - {31'd0, take};
+    end
+    always @(*) if (rst_n) begin
+        assert(cred <= BURST_32[15:0]);
+        assert(f_allow <= F_MAX);
+        assert(f_allow >= {16'd0, cred} + (sending ? {16'd0, left} : 32'd0));
+        if (sending) assert(left != 16'd0 && left <= BURST_32[15:0] && left1 == (left == 16'd1));
+        if (req || look) assert(!sending);
+        if (look && afford) assert(cred >= e_len && e_len != 16'd0);
+    end
+`endif
 endmodule
 
 `default_nettype wire

@@ -7,12 +7,12 @@
 // Always (prove, FV_PROVE): the output keeps the stream rules (TDATA, TLAST, TDEST and the
 // prefix held, valid not dropped, until taken), with the FORMAL blocks of the node (each beat
 // in offered to the side of its packet's kind, read on its first beat, alone; metatraffic never
-// held back) and of its stages in place: the arbiter's (a datagram's source alone on the output
-// until its TLAST, a source waits behind at most two datagrams) and the stages' invariants.
+// held back; the answers' credit earned by each metatraffic byte taken, nothing else) and of its
+// stages in place: the arbiter's (a datagram's source alone on the output until its TLAST, a
+// source waits behind at most two datagrams), the answers' (bytes sent at most BURST + RATE x
+// bytes received: so the answers' bytes out at most BURST + RATE x the metatraffic bytes in)
+// and the other stages' invariants.
 // Bounded (bmc, not FV_PROVE): TDEST and the prefix do not change inside a datagram.
-// The answers' byte bound is rfl_rtps_disc_answer's own check (its credit earned per byte
-// rfl_rtps_ctrl takes, rx_byte; every metatraffic byte reaches ctrl, as shown here): an answer
-// needs a whole ACKNACK in, deeper than a bounded check of the node reaches.
 module fv_fabric_node (
     input clk, input rst_n, input [31:0] cfg_reader, input [31:0] cfg_writer,
     input [63:0] cfg_time, input send_sedp, input [7:0] s_axis_tdata, input s_axis_tvalid,

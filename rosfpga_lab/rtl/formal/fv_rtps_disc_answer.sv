@@ -3,8 +3,10 @@
 // contents of the ROM and of its table (any lengths) and any requests under the stream rules.
 // Always (prove): the output keeps the stream rules (TDATA, TLAST, TDEST and the asker's prefix
 // unchanged until taken), TDEST and the prefix do not change inside a datagram, a datagram goes
-// on to its TLAST without a gap, and the credit never exceeds BURST.
-// Bounded (bmc, not FV_PROVE): the bytes sent never exceed BURST + RATE x the bytes received.
+// on to its TLAST without a gap, the credit never exceeds BURST, and (the module's FORMAL block,
+// with its invariants) the bytes sent never exceed BURST + RATE x the bytes received.
+// Bounded (bmc, not FV_PROVE): the same bound by counting the bytes (its own count, not the
+// module's block).
 module fv_rtps_disc_answer (
     input clk, input rst_n, input rx_byte, input [167:0] s_axis_tdata, input s_axis_tvalid,
     input m_axis_tready
