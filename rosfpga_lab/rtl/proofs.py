@@ -389,10 +389,12 @@ def run_sby(proof: Proof, work: Path, text: str) -> ProofResult:
 
 
 def format_results(results: Sequence[ProofResult]) -> str:
-    """A table: module, mode, depth, status, seconds, claim."""
-    lines = [f"{'check':<12}{'mode':<7}{'depth':>6}  {'result':<8}{'s':>6}  claim"]
+    """A table: module, mode, depth, status, seconds, claim (the check's column as wide for
+    every result: the CLI prints a row as each check ends)."""
+    w = max(len(p.name) for p in PROOFS) + 1
+    lines = [f"{'check':<{w}}{'mode':<7}{'depth':>6}  {'result':<8}{'s':>6}  claim"]
     for r in results:
-        lines.append(f"{r.proof.name:<12}{r.proof.mode:<7}{r.proof.depth:>6}  {r.status:<8}"
+        lines.append(f"{r.proof.name:<{w}}{r.proof.mode:<7}{r.proof.depth:>6}  {r.status:<8}"
                      f"{r.seconds:>6.1f}  {r.proof.claim}")
     return "\n".join(lines)
 
