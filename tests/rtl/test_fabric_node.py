@@ -5,7 +5,9 @@ output backpressure (tests/rtl/bench_fabric_node.py), the generated top of
 
 In: tests/rtl/test_fabric_rtps_loop.py's user datagrams (LaserScan samples the lab's CDR writer
 serialized, DATA_FRAGs, one fragment missing, one refused, one too long) with, among them, a
-peer's ACKNACK built with the lab's RTPS encoders on the metatraffic side. Expected, from the
+peer's ACKNACK built with the lab's RTPS encoders on the metatraffic side, and the node's own
+messages looped back (a user datagram and an ACKNACK from its GUID prefix: the one the ROMs
+are rendered with, the node's GUID_PREFIX, dropped on both sides). Expected, from the
 lab's software only: on the user-data destination, the CDR models' records as the lab's RTPS
 builders send them from the fabric participant's writer, byte for byte and reassembled by the
 lab's parser; on the metatraffic destination, the answers named here (both DATA(w) the ACKNACK
@@ -128,7 +130,7 @@ def test_the_node_routes_answers_and_announces(seed: int, gap: int, bp: int, tmp
     parse_message(rom.messages[0].data)
     starts = [g["clock"] for g in spdp]
     # one at reset, then one a PERIOD; each may wait behind the two other sources' datagrams
-    # and its own under backpressure (round robin)
+    # (round robin: at most two, rfl_frame_arbiter's proof) and its own under backpressure
     late = 3 * p["MAX_DATAGRAM"] * 1000 // (1000 - bp)
     assert len(starts) >= out["clocks"] // PERIOD, (starts, out["clocks"])
     assert all(PERIOD - late <= y - x <= PERIOD + late for x, y in zip(starts, starts[1:])), \
