@@ -17,9 +17,9 @@
 `default_nettype none
 
 module rfl_fabric_top #(
-    parameter [15:0] SPDP_PORT = 16'd0,         // all four: rtl.discrom.top_parameters
-    parameter [15:0] META_PORT = 16'd0,
-    parameter [15:0] USER_PORT = 16'd0,
+    parameter SPDP_PORT = 0,                    // all four: rtl.discrom.top_parameters
+    parameter META_PORT = 0,
+    parameter USER_PORT = 0,
     parameter [31:0] SPDP_GROUP = 32'd0,
     parameter RX_BITS = 11,                     // rfl_udp_port's buffers and queues
     parameter TX_BITS = 11,
@@ -85,16 +85,18 @@ module rfl_fabric_top #(
 );
 `ifdef __ICARUS__
     initial begin
-        if (SPDP_PORT == 0 || META_PORT == 0 || USER_PORT == 0)
-            $fatal(1, "rfl_fabric_top: set SPDP_PORT, META_PORT and USER_PORT");
+        if (SPDP_PORT < 1 || SPDP_PORT > 65535 || META_PORT < 1 || META_PORT > 65535 ||
+            USER_PORT < 1 || USER_PORT > 65535)
+            $fatal(1, "rfl_fabric_top: set SPDP_PORT, META_PORT and USER_PORT (1..65535)");
         if (SPDP_PORT == META_PORT || SPDP_PORT == USER_PORT || META_PORT == USER_PORT)
             $fatal(1, "rfl_fabric_top: SPDP_PORT, META_PORT and USER_PORT must differ");
         if (SPDP_GROUP[31:28] != 4'he)
             $fatal(1, "rfl_fabric_top: SPDP_GROUP must be an IPv4 multicast group");
     end
 `else
-    if (SPDP_PORT == 0 || META_PORT == 0 || USER_PORT == 0) begin : g_no_ports
-        $error("rfl_fabric_top: set SPDP_PORT, META_PORT and USER_PORT");
+    if (SPDP_PORT < 1 || SPDP_PORT > 65535 || META_PORT < 1 || META_PORT > 65535 ||
+        USER_PORT < 1 || USER_PORT > 65535) begin : g_no_ports
+        $error("rfl_fabric_top: set SPDP_PORT, META_PORT and USER_PORT (1..65535)");
     end
     if (SPDP_PORT == META_PORT || SPDP_PORT == USER_PORT || META_PORT == USER_PORT)
     begin : g_same_ports
@@ -104,8 +106,9 @@ module rfl_fabric_top #(
         $error("rfl_fabric_top: SPDP_GROUP must be an IPv4 multicast group");
     end
 `endif
+    localparam [15:0] SPDP = SPDP_PORT[15:0], META = META_PORT[15:0], USER = USER_PORT[15:0];
     // the bits on which the three ports agree: LiteEth's port filter
-    localparam [15:0] PORT_MASK = ~((SPDP_PORT ^ META_PORT) | (SPDP_PORT ^ USER_PORT));
+    localparam [15:0] PORT_MASK = ~((SPDP ^ META) | (SPDP ^ USER));
 
     // ---- LiteEth <-> rfl_udp_port
     wire [7:0] le_rx_data, le_tx_data;
@@ -115,7 +118,7 @@ module rfl_fabric_top #(
     wire [15:0] le_rx_sport, le_rx_dport, le_rx_len, le_tx_sport, le_tx_dport, le_tx_len;
     liteeth_udp_gmii u_eth (
         .sys_clock(clk), .sys_reset(!rst_n),
-        .mac_address(cfg_mac), .ip_address(cfg_ip), .udp_rx_port(SPDP_PORT),
+        .mac_address(cfg_mac), .ip_address(cfg_ip), .udp_rx_port(SPDP),
         .udp_rx_port_mask(PORT_MASK), .ip_multicast(SPDP_GROUP),
         .gmii_pads_rx_data(gmii_rxd), .gmii_pads_rx_dv(gmii_rx_dv), .gmii_pads_rx_er(gmii_rx_er),
         .gmii_pads_tx_data(gmii_txd), .gmii_pads_tx_en(gmii_tx_en), .gmii_pads_tx_er(gmii_tx_er),
@@ -159,8 +162,8 @@ module rfl_fabric_top #(
         .cnt_tx_packets(cnt_tx_packets), .cnt_tx_overflow(cnt_tx_overflow));
 
     // ---- received: the kind from the destination port (held by rfl_udp_port for the packet)
-    wire to_user = p_rx_dport == USER_PORT;
-    wire keep = to_user || p_rx_dport == META_PORT || p_rx_dport == SPDP_PORT;
+    wire to_user = p_rx_dport == USER;
+    wire keep = to_user || p_rx_dport == META || p_rx_dport == SPDP;
     wire n_tready;
     assign p_rx_tready = keep ? n_tready : 1'b1;
     reg [31:0] c_port;
@@ -180,18 +183,18 @@ module rfl_fabric_top #(
         case (n_tdest)
             2'd0: begin
                 p_tx_ip = SPDP_GROUP;
-                p_tx_dport = SPDP_PORT;
-                p_tx_sport = META_PORT;
+                p_tx_dport = SPDP;
+                p_tx_sport = META;
             end
             2'd1: begin
                 p_tx_ip = cfg_peer_ip;
                 p_tx_dport = cfg_peer_meta_port;
-                p_tx_sport = META_PORT;
+                p_tx_sport = META;
             end
             default: begin
                 p_tx_ip = cfg_peer_ip;
                 p_tx_dport = cfg_peer_user_port;
-                p_tx_sport = USER_PORT;
+                p_tx_sport = USER;
             end
         endcase
     end
