@@ -198,3 +198,23 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
         "samples": 1, "answers": len(answers), "no_credit": 0, "rx_packets": 5, "rx_error": 2,
         "rx_length": 0, "rx_overflow": 0, "tx_packets": len(udp), "tx_overflow": 0,
         "rx_port": 1}
+
+
+@pytest.mark.parametrize("bug", [
+    ("wire to_user = p_rx_dport == USER;", "wire to_user = p_rx_dport != META;"),
+    ("wire keep = to_user ||", "wire keep = 1'b1 || to_user ||"),
+    ("p_tx_dport = cfg_peer_meta_port;", "p_tx_dport = cfg_peer_user_port;"),
+], ids=["kind", "other-port", "tdest"])
+def test_a_planted_bug_fails_the_proof(bug: tuple[str, str], tmp_path: Path) -> None:
+    """The glue's proof (rtl/formal/fv_fabric_top.sv) sees a wrong kind, a datagram to another
+    port passed on, a destination mixed up."""
+    from rosfpga_lab.rtl.proofs import PROOFS, prove
+    from tests.support.rtltools import require_formal
+
+    require_formal()
+    proof = next(p for p in PROOFS if p.name == "fabric_top")
+    text = (FABRIC / "rfl_fabric_top.v").read_text()
+    assert bug[0] in text
+    planted = tmp_path / "rfl_fabric_top.v"
+    planted.write_text(text.replace(bug[0], bug[1]))
+    assert prove(proof, replace={"rfl_fabric_top.v": planted}).status == "FAIL"

@@ -83,26 +83,36 @@ module rfl_fabric_top #(
     output wire [31:0]  cnt_tx_overflow,
     output wire [31:0]  cnt_rx_port             // datagrams to another port LiteEth passed
 );
+    // 0: unset (the defaults), refused outside a proof: Yosys elaborates a file's defaults when
+    // it reads it, the proof sets them
+    localparam UNSET = SPDP_PORT == 0 || META_PORT == 0 || USER_PORT == 0 || SPDP_GROUP == 0;
+    localparam SAME = SPDP_PORT == META_PORT || SPDP_PORT == USER_PORT || META_PORT == USER_PORT;
 `ifdef __ICARUS__
     initial begin
-        if (SPDP_PORT < 1 || SPDP_PORT > 65535 || META_PORT < 1 || META_PORT > 65535 ||
-            USER_PORT < 1 || USER_PORT > 65535)
-            $fatal(1, "rfl_fabric_top: set SPDP_PORT, META_PORT and USER_PORT (1..65535)");
-        if (SPDP_PORT == META_PORT || SPDP_PORT == USER_PORT || META_PORT == USER_PORT)
+        if (UNSET)
+            $fatal(1, "rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT and SPDP_GROUP");
+        if (SPDP_PORT < 0 || SPDP_PORT > 65535 || META_PORT < 0 || META_PORT > 65535 ||
+            USER_PORT < 0 || USER_PORT > 65535)
+            $fatal(1, "rfl_fabric_top: the ports must be 1..65535");
+        if (!UNSET && SAME)
             $fatal(1, "rfl_fabric_top: SPDP_PORT, META_PORT and USER_PORT must differ");
-        if (SPDP_GROUP[31:28] != 4'he)
+        if (!UNSET && SPDP_GROUP[31:28] != 4'he)
             $fatal(1, "rfl_fabric_top: SPDP_GROUP must be an IPv4 multicast group");
     end
 `else
-    if (SPDP_PORT < 1 || SPDP_PORT > 65535 || META_PORT < 1 || META_PORT > 65535 ||
-        USER_PORT < 1 || USER_PORT > 65535) begin : g_no_ports
-        $error("rfl_fabric_top: set SPDP_PORT, META_PORT and USER_PORT (1..65535)");
+`ifndef FORMAL
+    if (UNSET) begin : g_unset
+        $error("rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT and SPDP_GROUP");
     end
-    if (SPDP_PORT == META_PORT || SPDP_PORT == USER_PORT || META_PORT == USER_PORT)
-    begin : g_same_ports
+`endif
+    if (SPDP_PORT < 0 || SPDP_PORT > 65535 || META_PORT < 0 || META_PORT > 65535 ||
+        USER_PORT < 0 || USER_PORT > 65535) begin : g_bad_ports
+        $error("rfl_fabric_top: the ports must be 1..65535");
+    end
+    if (!UNSET && SAME) begin : g_same_ports
         $error("rfl_fabric_top: SPDP_PORT, META_PORT and USER_PORT must differ");
     end
-    if (SPDP_GROUP[31:28] != 4'he) begin : g_bad_group
+    if (!UNSET && SPDP_GROUP[31:28] != 4'he) begin : g_bad_group
         $error("rfl_fabric_top: SPDP_GROUP must be an IPv4 multicast group");
     end
 `endif
