@@ -205,6 +205,7 @@ class DiscoveryRom:
                 "address": self.address, "ports": self.ports(), "entity_ids": {
                     k: f"{v:08x}" for k, v in self.entity_ids.items()},
                 "rfl_rtps_tx": verilog_parameters(tx_parameters(self)),
+                "rfl_fabric_top": verilog_parameters(top_parameters(self)),
                 "rom_file": ROM_FILE, "table_file": TABLE_FILE,
                 "rom_bytes": len(self.image()),
                 "messages": listed(self.messages, self.offsets()),
