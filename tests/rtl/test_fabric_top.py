@@ -29,6 +29,7 @@ import subprocess
 import sys
 import zlib
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from scapy.layers.inet import IP, UDP
@@ -53,6 +54,9 @@ from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER
 from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
 from tests.rtl.test_fabric_udp import PEER_IP, PEER_MAC, _fcs, _frames, _group_mac
 from tests.support.rtltools import TB_DIR, cocotb_verilator
+
+if TYPE_CHECKING:
+    from cocotb_tools.runner import Runner
 
 pytestmark = pytest.mark.rtl
 
@@ -82,7 +86,7 @@ def _ip(addr: str) -> str:
     return ipaddress.IPv4Address(addr).packed.hex()
 
 
-def _build(runner: object, gen: Path, params: dict[str, str], tmp_path: Path) -> Path:
+def _build(runner: Runner, gen: Path, params: dict[str, str], tmp_path: Path) -> Path:
     """Verilator's build, kept in the lab's RTL cache keyed by the sources (the generated ones
     too), the parameters and the tools (its dependency files name absolute paths)."""
     import cocotb
@@ -101,7 +105,7 @@ def _build(runner: object, gen: Path, params: dict[str, str], tmp_path: Path) ->
             if path.suffix in (".v", ".vh") and path.name != "rfl_tb.v":
                 shutil.copy2(path, kept / path.name)
     rtl = sorted(kept.glob("*.v"))
-    runner.build(  # type: ignore[attr-defined]
+    runner.build(
         sources=[*SOURCES, *rtl], includes=[kept], hdl_toplevel="rfl_fabric_top",
         parameters=params, build_dir=build, timescale=("1ns", "1ps"),
         build_args=["-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT"],
