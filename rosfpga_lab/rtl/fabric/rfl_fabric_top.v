@@ -1,19 +1,22 @@
 // rfl_fabric_top -- the ROS 2 node in the fabric on the network (issue 31): the vendored LiteEth
 // UDP/IP core (vendor/liteeth_udp_gmii.v, the GMII simulation variant; vendor/README.md) ->
 // rfl_udp_port -> rfl_fabric_node, and back.
-// Ports (RTPS 2.3 9.6.1.1, the mapping rtps.entities owns; rtl.discrom.top_parameters passes
-// them, there are no defaults here): SPDP_PORT (the domain's SPDP multicast port), META_PORT and
-// USER_PORT (this participant's metatraffic and user-data unicast ports). LiteEth passes up the
-// datagrams to the ports that agree with all three on the bits where the three agree; this top
-// keeps the three and drops the others there (counted: cnt_rx_port). Kind (the node's
-// s_axis_tuser): 1 for USER_PORT, 0 for SPDP_PORT and META_PORT.
-// Sent, by the node's TDEST: 0 to SPDP_GROUP:SPDP_PORT (LiteEth maps the group to its
-// multicast MAC), 1 to cfg_peer_ip:cfg_peer_meta_port, 2 (and 3) to cfg_peer_ip:
-// cfg_peer_user_port; from META_PORT, or USER_PORT for user data. The peer's locators are
-// registers the host sets (one peer: a point-to-point link, or the peer the software side
-// discovered; its ports from the mapping for its participant index): the circuit does not read
-// the locators of the peers' SPDP announcements. So an answer to another asker (the node's
-// m_dst_prefix, not read here) still goes to cfg_peer_*, and user data reaches one reader.
+// Ports (RTPS 2.3 9.6.1.1, the mapping rtps.entities owns; rtl.discrom.top_parameters gives
+// them and SPDP_GROUP; 0, the default, is refused): SPDP_PORT (the domain's SPDP multicast
+// port), META_PORT and USER_PORT (this participant's metatraffic and user-data unicast ports).
+// LiteEth passes up the datagrams to the ports that agree with all three on the bits where the
+// three agree; this top keeps the three and drops the others (counted: cnt_rx_port). Kind (the
+// node's s_axis_tuser): 1 for USER_PORT, 0 for SPDP_PORT and META_PORT.
+// Sent, by the node's TDEST (rtl.discrom's DEST_SPDP, DEST_META, DEST_USER): 0 to
+// SPDP_GROUP:SPDP_PORT (LiteEth maps the group to its multicast MAC), 1 to
+// cfg_peer_ip:cfg_peer_meta_port, 2 (and 3) to cfg_peer_ip:cfg_peer_user_port; from META_PORT,
+// or USER_PORT for user data. The peer's locators are registers the host sets (one peer: a
+// point-to-point link, or the peer the software side discovered; its ports from the mapping for
+// its participant index): the circuit does not read the locators of the peers' SPDP
+// announcements. So an answer to another asker (the node's m_dst_prefix, not read here) still
+// goes to cfg_peer_*, and user data reaches one reader.
+// The ECP5 RGMII variant (vendor/liteeth_udp_ecp5_rgmii.v, the same UDP port) is not joined yet.
+// The glue is proven with LiteEth and the node as stream models (rtl/formal/fv_fabric_top.sv).
 `default_nettype none
 
 module rfl_fabric_top #(
