@@ -205,6 +205,7 @@ class DiscoveryRom:
                 "address": self.address, "ports": self.ports(), "entity_ids": {
                     k: f"{v:08x}" for k, v in self.entity_ids.items()},
                 "rfl_rtps_tx": verilog_parameters(tx_parameters(self)),
+                "rfl_fabric_top": verilog_parameters(top_parameters(self)),
                 "rom_file": ROM_FILE, "table_file": TABLE_FILE,
                 "rom_bytes": len(self.image()),
                 "messages": listed(self.messages, self.offsets()),
@@ -435,8 +436,19 @@ def tx_parameters(rom: DiscoveryRom, *, frag_bytes: int = FRAGMENT_BYTES,
             "FRAG_BYTES": frag_bytes, "MAX_DATAGRAM": max_datagram, "INFO_TS": int(info_ts)}
 
 
-#: Bits of the parameters of :func:`tx_parameters` that are not Verilog integers.
-TX_PARAMETER_BITS = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32}
+def top_parameters(rom: DiscoveryRom) -> dict[str, int]:
+    """The network parameters of ``fabric/rfl_fabric_top.v`` for the participant ``rom`` was
+    rendered for (one owner: the RTPS port mapping of :mod:`rosfpga_lab.rtps.entities` and the
+    SPDP group of :mod:`rosfpga_lab.rtps.limits`, as :meth:`DiscoveryRom.ports` names them)."""
+    return {"SPDP_PORT": discovery_multicast_port(rom.domain),
+            "META_PORT": discovery_port(rom.domain, rom.index),
+            "USER_PORT": user_port(rom.domain, rom.index),
+            "SPDP_GROUP": int(ipaddress.IPv4Address(SPDP_MULTICAST_ADDRESS))}
+
+
+#: Bits of the parameters of :func:`tx_parameters` and :func:`top_parameters` that are not Verilog
+#: integers.
+TX_PARAMETER_BITS = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32, "SPDP_GROUP": 32}
 
 
 def verilog_parameters(params: dict[str, int]) -> dict[str, str]:

@@ -40,7 +40,7 @@ FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
 FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
                   "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v",
-                  "rfl_frame_arbiter.v", "rfl_fabric_node.v")
+                  "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_fabric_top.v")
 ENV_INCLUDE = "fv_env.vh"
 #: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node aside:
 #: the project's; the proof's wrapper has its own).
@@ -192,6 +192,11 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_udp_port (16-byte buffers, 2 payloads each way, any LiteEth stream and payloads): "
           "both outputs keep the stream rules with their sideband, LiteEth never held back; 20 "
           "clocks"),
+    Proof("fabric_top", ("rfl_udp_store.v", "rfl_udp_port.v", "rfl_fabric_top.v"), "bmc", 16,
+          "rfl_fabric_top's glue (LiteEth and rfl_fabric_node as models of any streams, "
+          "rfl_udp_port's 16-byte buffers): the node takes only datagrams to the three ports, "
+          "TUSER 1 exactly for the user-data port, by the stream rules; each datagram sent goes "
+          "to the address and ports its TDEST names, by the stream rules; 16 clocks"),
     Proof("rtps_ctrl", ("rfl_rtps_ctrl.v",), "prove", 4,
           "rfl_rtps_ctrl (two slots, any input bytes, any prefix): request stream rules, every "
           "request names an answer of the table, always ready; all reachable states"),

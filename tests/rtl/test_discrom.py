@@ -137,6 +137,10 @@ def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
     index = json.loads((tmp_path / INDEX_FILE).read_text())
     assert index["rfl_rtps_tx"] == verilog_parameters(tx_parameters(rom))
     assert index["rfl_rtps_tx"]["GUID_PREFIX"] == f"96'h{rom.guid_prefix.hex().lstrip('0')}"
+    # the network top's ports: RTPS 2.3 9.6.1.1 for domain 9, participant 1 (PB 7400, DG 250,
+    # PG 2, d0 0, d1 10, d3 11), the SPDP group 239.255.0.1
+    assert index["rfl_fabric_top"] == {"SPDP_PORT": "9650", "META_PORT": "9662",
+                                       "USER_PORT": "9663", "SPDP_GROUP": "32'hefff0001"}
 
 
 def _require_cyclonedds():

@@ -325,3 +325,49 @@ def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None
     assert done.returncode == 0, done.stdout + done.stderr
     for name in ("rfl_fabric_node.v", "rfl_frame_arbiter.v"):     # (its stages: their own cases)
         assert name not in done.stdout + done.stderr, done.stdout + done.stderr
+
+
+# the node on the network (rtl/fabric/rfl_fabric_top.v): LiteEth's GMII variant, rfl_udp_port and
+# the whole node with the generated top inside; the vendored core's own warnings (generated
+# code) are not the lab's to fix (tests/rtl/test_fabric_udp.py says the same of the UDP stage)
+def test_fabric_top_is_clean_under_verilator(tmp_path: Path) -> None:
+    import sys
+
+    from rosfpga_lab.rtl.discrom import (
+        ANSWER_FILE, ANSWER_TABLE_FILE, ROM_FILE, TABLE_FILE, answer_params, render_rom,
+        top_parameters, tx_parameters, verilog_parameters, write_rom,
+    )
+    from tests.rtl.test_fabric_top import SOURCES
+
+    config = DATA / "fpga_laserscan_min_cdr.yaml"
+    gen = tmp_path / "project"
+    done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(config), "-o",
+                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    rom = render_rom(config)
+    write_rom(rom, tmp_path)
+    a = answer_params(rom)
+    params = dict(verilog_parameters({**tx_parameters(rom), **top_parameters(rom)}),
+                  PERIOD="1000", ROM_FILE=f'"{ROM_FILE}"', TABLE_FILE=f'"{TABLE_FILE}"',
+                  ANSWER_FILE=f'"{ANSWER_FILE}"', ANSWER_TABLE_FILE=f'"{ANSWER_TABLE_FILE}"',
+                  ROM_BYTES=str(len(rom.image())),
+                  MESSAGES=str(len(rom.messages)),
+                  **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
+                                            "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
+                                            "COUNT_START", "BURST", "RATE")})
+    sources = [*map(str, SOURCES)]
+    sources += sorted(str(q) for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "-Wno-fatal",
+                           "--top-module", "rfl_fabric_top", f"-I{gen / 'rtl'}",
+                           *(f"-G{k}={v}" for k, v in params.items()), *sources],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    ours = [ln for ln in done.stderr.splitlines()
+            if ln.startswith("%") and "/vendor/" not in ln]
+    assert done.returncode == 0 and ours == [], "\n".join(ours)[-4000:] or done.stderr[-3000:]
+    # without the ports (rtl.discrom.top_parameters gives them) it refuses to elaborate
+    bare = {k: v for k, v in params.items() if not k.endswith("_PORT")}
+    done = subprocess.run([require_verilator(), "--lint-only", "--top-module", "rfl_fabric_top",
+                           f"-I{gen / 'rtl'}", *(f"-G{k}={v}" for k, v in bare.items()),
+                           *sources], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    unset = "rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT and SPDP_GROUP"
+    assert done.returncode != 0 and unset in done.stderr, done.stderr[-3000:]
