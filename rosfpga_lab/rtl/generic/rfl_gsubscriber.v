@@ -116,6 +116,15 @@ module rfl_gsubscriber #(
     reg [7:0]  quiet;
     reg [7:0]  carry_mem [0:CARRY_BYTES-1];
 
+    // The decisions' registers (r_out_*, the bounds' masks and keys, the next instructions, p_*
+    // and c_*) load on every clock but a field's bytes (S_BODY), where nothing reads them and a
+    // simulation spends nearly all its clocks (each load is work for Verilator, not for an
+    // FPGA). A decision reads what it would read if they loaded on every clock: what they are
+    // computed from holds through S_BODY (the instruction, out_len, n), or changes there (the
+    // field's value, the counts of bytes left, pos, same) and reaches the decision through at
+    // most two of them, which S_FINISH's two settling clocks load.
+    wire dec_load = (state != S_BODY);
+
     // The current instruction.
     reg [IW-1:0] w;                             // the current instruction: prog_word(pc)
     // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
@@ -171,7 +180,7 @@ module rfl_gsubscriber #(
     // (registered on every clock: out_len, n and the instruction hold from S_COUNTED, or the
     // field's last byte, to S_FINISH, whose first settling clock adds them up into p_out_at)
     reg [31:0]  r_out_base, r_out_pad;
-    always @(posedge clk) begin
+    always @(posedge clk) if (dec_load) begin
         r_out_base <= out_base;
         r_out_pad <= (written == 32'd0) ? 32'd0
                      : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
@@ -221,13 +230,12 @@ module rfl_gsubscriber #(
     // are registered one clock after the instruction, the keys one clock after the masks).
     // The sign and all-bits masks of the field's size (1, 2, 4 or 8 bytes) the same way.
     reg [63:0] lo_key, hi_key, sign_m, all_m;
-    always @(posedge clk) begin
+    always @(posedge clk) if (dec_load) begin
         sign_m <= 64'd1 << (8 * size[3:0] - 1);
         all_m <= (64'd1 << (8 * size[3:0] - 1)) | ((64'd1 << (8 * size[3:0] - 1)) - 64'd1);
         lo_key <= order_key(bound(kaddr, size), sign_m, all_m, kind);
         hi_key <= order_key(bound(kaddr + size[15:0], size), sign_m, all_m, kind);
     end
-    wire [63:0] vkey = order_key(value, sign_m, all_m, kind);
 
     always @(posedge clk) begin
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr[CW-1:0]] <= s_tdata;
@@ -291,7 +299,7 @@ module rfl_gsubscriber #(
     // that does the next, so by then these are prog_next(pc), prog_jump(pc) and their pcs.
     reg [IW-1:0] w_nx, w_jp;
     reg [15:0] pc_nx, pc_jp;
-    always @(posedge clk) begin
+    always @(posedge clk) if (dec_load) begin
         w_nx <= prog_next(pc);
         w_jp <= prog_jump(pc);
         pc_nx <= pc + 16'd1;
@@ -305,7 +313,7 @@ module rfl_gsubscriber #(
         p_end_room <= room - body[31:0];
         p_end_left <= left_f - body[31:0];
     end
-    always @(posedge clk) begin
+    always @(posedge clk) if (dec_load) begin
         c_tail <= tail_pad;
         c_at_end <= at_end;
         c_room0 <= (room == 32'd0);
@@ -319,7 +327,7 @@ module rfl_gsubscriber #(
         c_padf_bad <= (pad_f != 32'd0 && pad_f >= room);
         p_room_f <= room_f;
         p_room_e <= room_e;
-        p_vkey <= vkey;
+        p_vkey <= order_key(value, sign_m, all_m, kind);
         p_vnan <= (kind == 2'd2 && is_nan(value, size));
         p_least <= least;
         p_out_at <= r_out_base + r_out_pad;
