@@ -190,8 +190,9 @@ module rfl_gsubscriber #(
                      : (pub == PUB_CONST) ? {16'd0, klen} + {31'd0, nul} : {31'd0, nul};
     endfunction
     wire [31:0] out_base = (op == OP_FIXED) ? out_len : out_len + 32'd4;
-    // (registered on every clock: out_len, n and the instruction hold from S_COUNTED, or the
-    // field's last byte, to S_FINISH, whose first settling clock adds them up into p_out_at)
+    // (registered on every clock but S_BODY's: out_len, n and the instruction hold from
+    // S_COUNTED, or the field's last byte, to S_FINISH, whose first settling clock adds them up
+    // into p_out_at)
     reg [31:0]  r_out_base, r_out_pad;
     always @(posedge clk) if (dec_load) begin
         r_out_base <= out_base;
