@@ -108,7 +108,9 @@ module rfl_gpublisher #(
             P_LEN: other = len_byte;
             P_COUNT: other = cnt_byte;
             P_BODY: case (pub)
-                PUB_CONST: other = (cnt < {16'd0, klen}) ? konst(kaddr + cnt[15:0]) : 8'd0;  // then a NUL
+                PUB_CONST:  // then a NUL (an if, not ?:, so that the ROM is looked up only here)
+                    if (cnt < {16'd0, klen}) other = konst(kaddr + cnt[15:0]);
+                    else other = 8'd0;
                 PUB_COUNT: other = (cnt < 32'd4) ? seq_byte : 8'd0;
                 PUB_STREAM: other = s_tdata;
                 default: other = 8'd0;
@@ -127,8 +129,14 @@ module rfl_gpublisher #(
     assign idle = (state == P_IDLE);
     wire put = m_tvalid && m_tready;
     assign carry_pop = put && carried;
-    wire [31:0] n_next = {carry_rdata, n[31:8]};
-    wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
+    // the count completed by this byte (a function: evaluated in P_COUNT only)
+    function [31:0] n_next(input [7:0] byte_in);
+        n_next = {byte_in, n[31:8]};
+    endfunction
+    // OP_VAR: count x size (a function, not a wire: a simulation evaluates it in P_COUNTED only)
+    function [34:0] body_of(input [31:0] count_n);
+        body_of = {3'd0, count_n} << lsize;
+    endfunction
 
     // Write `p` alignment zeros (if any), then go to state `next`.
     task pad_then(input [31:0] p, input [3:0] next);
@@ -227,8 +235,8 @@ module rfl_gpublisher #(
                 endcase
                 P_COUNT: if (put) begin
                     if (pub == PUB_CARRY) begin
-                        n <= n_next;
-                        n_zero <= (n_next == 32'd0);
+                        n <= n_next(carry_rdata);
+                        n_zero <= (n_next(carry_rdata) == 32'd0);
                     end
                     if (cnt[1:0] == 2'd3) begin
                         state <= P_COUNTED;
@@ -247,8 +255,8 @@ module rfl_gpublisher #(
                     end else if (n_zero) begin  // body == 0
                         go(pc + 16'd1, prog_next(pc));
                     end else begin
-                        left_b <= body;
-                        last_b <= (body == 35'd1);
+                        left_b <= body_of(n);
+                        last_b <= (body_of(n) == 35'd1);
                         pad_then(pad_at(opos, elem_align), P_BODY);
                     end
                 end

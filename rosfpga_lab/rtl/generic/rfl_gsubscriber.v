@@ -116,6 +116,15 @@ module rfl_gsubscriber #(
     reg [7:0]  quiet;
     reg [7:0]  carry_mem [0:CARRY_BYTES-1];
 
+    // The decisions' registers (r_out_*, the bounds' masks and keys, the next instructions, p_*
+    // and c_*) load on every clock but a field's bytes (S_BODY), where nothing reads them and a
+    // simulation spends nearly all its clocks (each load is work for Verilator, not for an
+    // FPGA). A decision reads what it would read if they loaded on every clock: what they are
+    // computed from holds through S_BODY (the instruction, out_len, n), or changes there (the
+    // field's value, the counts of bytes left, pos, same) and reaches the decision through at
+    // most two of them, which S_FINISH's two settling clocks load.
+    wire dec_load = (state != S_BODY);
+
     // The current instruction.
     reg [IW-1:0] w;                             // the current instruction: prog_word(pc)
     // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
@@ -153,7 +162,10 @@ module rfl_gsubscriber #(
     assign frame_start = take && (state == S_FLEN) && (cnt[1:0] == 2'd0);
     assign idle = (state == S_FLEN) && (cnt[1:0] == 2'd0);
 
-    wire [31:0] n_next = {s_tdata, n[31:8]};   // the count completed by this byte
+    // the count completed by this byte (a function: evaluated in S_FLEN and S_COUNT only)
+    function [31:0] n_next(input [7:0] byte_in);
+        n_next = {byte_in, n[31:8]};
+    endfunction
     wire [31:0] pos_next = pos + 32'd1;
     wire        at_end = (left_f == 32'd0);         // nothing left of the frame to skip
     // CDR: the bytes left after the last field are the unannounced padding up to a multiple of
@@ -163,25 +175,36 @@ module rfl_gsubscriber #(
     wire [31:0] pad_e = pad_at(pos, elem_align);    // before an OP_VAR's elements
     wire [31:0] room_f = room - pad_f;              // bytes left after that padding
     wire [31:0] room_e = room - pad_e;              // (each used only when the padding fits)
+    // OP_VAR: count x size, and its low 32 bits (functions, not wires, so that a simulation
+    // evaluates them only where a decision reads them, not on every clock)
+    function [34:0] body_of(input [31:0] count_n);
+        body_of = {3'd0, count_n} << lsize;
+    endfunction
+    function [31:0] body32(input [31:0] count_n);
+        body32 = count_n << lsize;
+    endfunction
     // what the publisher writes for this OP_FIXED / OP_VAR: its bytes, and where they start
-    wire [31:0] written = (op == OP_FIXED) ? size
-                          : (pub == PUB_CARRY || pub == PUB_STREAM) ? body[31:0]
-                          : (pub == PUB_CONST) ? {16'd0, klen} + {31'd0, nul} : {31'd0, nul};
+    function [31:0] written_of(input [31:0] bytes);  // bytes: the OP_VAR's body
+        written_of = (op == OP_FIXED) ? size
+                     : (pub == PUB_CARRY || pub == PUB_STREAM) ? bytes
+                     : (pub == PUB_CONST) ? {16'd0, klen} + {31'd0, nul} : {31'd0, nul};
+    endfunction
     wire [31:0] out_base = (op == OP_FIXED) ? out_len : out_len + 32'd4;
-    // (registered on every clock: out_len, n and the instruction hold from S_COUNTED, or the
-    // field's last byte, to S_FINISH, whose first settling clock adds them up into p_out_at)
+    // (registered on every clock but S_BODY's: out_len, n and the instruction hold from
+    // S_COUNTED, or the field's last byte, to S_FINISH, whose first settling clock adds them up
+    // into p_out_at)
     reg [31:0]  r_out_base, r_out_pad;
-    always @(posedge clk) begin
+    always @(posedge clk) if (dec_load) begin
         r_out_base <= out_base;
-        r_out_pad <= (written == 32'd0) ? 32'd0
+        r_out_pad <= (written_of(body32(n)) == 32'd0) ? 32'd0
                      : pad_at(out_base + 32'd4, (op == OP_FIXED) ? align : elem_align);
     end
-    wire [34:0] body = {3'd0, n} << lsize;          // OP_VAR: count x size
     // fewest bytes of the counted elements (OP_VAR: its elements' bytes)
-    wire [63:0] least = (op == OP_VAR) ? {29'd0, body} : least_r;
+    function [63:0] least_of(input [34:0] bytes);
+        least_of = (op == OP_VAR) ? {29'd0, bytes} : least_r;
+    endfunction
     wire        keep = (state == S_COUNT) ? (sub == SUB_CARRY)
                        : (sub == SUB_CARRY || sub == SUB_RANGE);
-    wire [7:0]  want_byte = konst(kaddr + cnt[15:0]);
 
     // Bounds of a SUB_RANGE field: low, then high, little-endian, `size` bytes each.
     function [63:0] bound(input [15:0] at, input [31:0] nbytes);
@@ -221,13 +244,12 @@ module rfl_gsubscriber #(
     // are registered one clock after the instruction, the keys one clock after the masks).
     // The sign and all-bits masks of the field's size (1, 2, 4 or 8 bytes) the same way.
     reg [63:0] lo_key, hi_key, sign_m, all_m;
-    always @(posedge clk) begin
+    always @(posedge clk) if (dec_load) begin
         sign_m <= 64'd1 << (8 * size[3:0] - 1);
         all_m <= (64'd1 << (8 * size[3:0] - 1)) | ((64'd1 << (8 * size[3:0] - 1)) - 64'd1);
         lo_key <= order_key(bound(kaddr, size), sign_m, all_m, kind);
         hi_key <= order_key(bound(kaddr + size[15:0], size), sign_m, all_m, kind);
     end
-    wire [63:0] vkey = order_key(value, sign_m, all_m, kind);
 
     always @(posedge clk) begin
         if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr[CW-1:0]] <= s_tdata;
@@ -291,7 +313,7 @@ module rfl_gsubscriber #(
     // that does the next, so by then these are prog_next(pc), prog_jump(pc) and their pcs.
     reg [IW-1:0] w_nx, w_jp;
     reg [15:0] pc_nx, pc_jp;
-    always @(posedge clk) begin
+    always @(posedge clk) if (dec_load) begin
         w_nx <= prog_next(pc);
         w_jp <= prog_jump(pc);
         pc_nx <= pc + 16'd1;
@@ -301,11 +323,11 @@ module rfl_gsubscriber #(
         p_out_klen <= out_len + {16'd0, klen};
         p_room_encap <= room - {24'd0, value[31:24] & ENCAP_PAD_MASK};
         p_out_early <= out_len + EARLY_ADD;
-        p_end_pos <= pos + body[31:0];
-        p_end_room <= room - body[31:0];
-        p_end_left <= left_f - body[31:0];
+        p_end_pos <= pos + body32(n);
+        p_end_room <= room - body32(n);
+        p_end_left <= left_f - body32(n);
     end
-    always @(posedge clk) begin
+    always @(posedge clk) if (dec_load) begin
         c_tail <= tail_pad;
         c_at_end <= at_end;
         c_room0 <= (room == 32'd0);
@@ -319,25 +341,25 @@ module rfl_gsubscriber #(
         c_padf_bad <= (pad_f != 32'd0 && pad_f >= room);
         p_room_f <= room_f;
         p_room_e <= room_e;
-        p_vkey <= vkey;
+        p_vkey <= order_key(value, sign_m, all_m, kind);
         p_vnan <= (kind == 2'd2 && is_nan(value, size));
-        p_least <= least;
+        p_least <= least_of(body_of(n));
         p_out_at <= r_out_base + r_out_pad;
-        p_written <= written;
-        p_least_fa <= least + {32'd0, fixed_after};
+        p_written <= written_of(body32(n));
+        p_least_fa <= least_of(body_of(n)) + {32'd0, fixed_after};
         c_size_gt <= (size > p_room_f);
         c_roomf_lt4 <= (p_room_f < 32'd4);
         c_count_bad <= (sub == SUB_STREAM ? n != count : n > count) || (nul && n == 32'd0);
         c_fit_bad <= fits && p_least_fa != {32'd0, room};
         c_least_gt <= (p_least > {32'd0, room});
-        c_body0 <= (body == 35'd0);
-        c_body1 <= (body == 35'd1);
+        c_body0 <= (body_of(n) == 35'd0);
+        c_body1 <= (body_of(n) == 35'd1);
         c_size1 <= (size == 32'd1);
         c_pade_bad <= (pad_e != 32'd0 && pad_e >= room);
-        c_body_gt <= (body > {3'd0, p_room_e});
+        c_body_gt <= (body_of(n) > {3'd0, p_room_e});
         c_encap_bad <= (value[7:0] != konst(kaddr) || value[15:8] != konst(kaddr + 16'd1));
         c_encap_pad_gt <= ({24'd0, value[31:24] & ENCAP_PAD_MASK} > room);
-        c_check_bad <= sub == SUB_CHECK && (!same || (op == OP_VAR ? body - {34'd0, nul}
+        c_check_bad <= sub == SUB_CHECK && (!same || (op == OP_VAR ? body_of(n) - {34'd0, nul}
                                                       : {3'd0, size}) != {19'd0, klen});
         c_range_bad <= (sub == SUB_RANGE && !in_range);  // from p_vkey, p_vnan
         c_out_len <= p_out_at + p_written;
@@ -464,7 +486,7 @@ module rfl_gsubscriber #(
             if (state == S_BODY && s_tvalid && cnt < 32'd8) value[8*cnt[2:0] +: 8] <= s_tdata;
             case (state)
                 S_FLEN: if (take) begin
-                    n <= n_next;
+                    n <= n_next(s_tdata);
                     if (cnt[1:0] == 2'd3) begin  // (cnt counts 0..3 here)
                         cnt <= 32'd0;
                         state <= S_FCHK;
@@ -564,11 +586,11 @@ module rfl_gsubscriber #(
                 end
                 S_COUNT: begin
                     // S_LEAST's start, set on every clock here (the last is the count's last byte)
-                    nsh <= {32'd0, n_next};
+                    nsh <= {32'd0, n_next(s_tdata)};
                     least_r <= 64'd0;
                     mrem <= elem_min;
                     if (take) begin
-                        n <= n_next;
+                        n <= n_next(s_tdata);
                         if (cnt[1:0] == 2'd3) begin  // (cnt counts 0..3 here)
                             state <= (op == OP_LOOP) ? S_LEAST : S_COUNTED;
                             cnt <= 32'd0;
@@ -612,7 +634,7 @@ module rfl_gsubscriber #(
                     end else if (c_early_bad) begin  // as OP_DONE would, before the stream
                         refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                     end else begin
-                        left_b <= body;
+                        left_b <= body_of(n);
                         last_b <= c_body1;
                         pad_then(pad_e, S_BODY);
                         if (STREAM_EARLY && sub == SUB_STREAM) begin  // nothing after can refuse
@@ -631,7 +653,9 @@ module rfl_gsubscriber #(
                     left_b <= left_b - 35'd1;
                     last_b <= (left_b == 35'd2);
                     if (nul && last_b) nul_bad <= (s_tdata != 8'd0);
-                    else if (cnt >= {16'd0, klen} || s_tdata != want_byte) same <= 1'b0;
+                    else if (cnt >= {16'd0, klen}) same <= 1'b0;
+                    else if (s_tdata != konst(kaddr + cnt[15:0])) same <= 1'b0;  // (the ROM
+                    // looked up only for a byte that has a constant: not on every clock)
                     if (sub == SUB_STREAM) streamed <= 1'b1;
                     if (last_b) state <= S_FINISH;
                 end
