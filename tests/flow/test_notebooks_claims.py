@@ -180,12 +180,19 @@ def test_the_shipped_timing_report_meets_the_clock_and_notebook_08_says_how_to_m
                        if c["cell_type"] == "code")
     assert "rosfpga-lab rtl timing CONFIG" in text08 and "place_and_route_dir" in code08
     assert "shipped_report()" in code08 and "format_timing(shipped" in code08
-    # the report is of the generated top: each register on its critical path is declared in
-    # rfl_gsubscriber.v (u_subscriber is rfl_gtop's instance of it), and one is not in the exhibit's
-    generic = (ROOT / "rosfpga_lab" / "rtl" / "generic" / "rfl_gsubscriber.v").read_text()
-    exhibit = (ROOT / "rosfpga_lab" / "rtl" / "exhibit" / "rfl_subscriber.v").read_text()
-    names = set(re.findall(r"u_top\.u_subscriber\.(\w+)", text))
-    assert names and all(re.search(rf"\b{n}\b", generic) for n in names), names
-    assert any(not re.search(rf"\b{n}\b", exhibit) for n in names), names
+    # the report is of the generated top: each instance its critical path crosses is one
+    # rfl_gtop.v declares (u_top is the generated wrapper's instance of it), and one of them is
+    # not the exhibit's rfl_top.v
+    gtop = (ROOT / "rosfpga_lab" / "rtl" / "generic" / "rfl_gtop.v").read_text()
+    exhibit = (ROOT / "rosfpga_lab" / "rtl" / "exhibit" / "rfl_top.v").read_text()
+    blocks = {n for path in re.findall(r"u_top\.([\w.]+)", text)
+              for n in path.split(".")[:-1] if n.startswith(("u_", "g_"))}
+    assert blocks and all(re.search(rf"\b{n}\b", gtop) for n in blocks), blocks
+    assert any(not re.search(rf"\b{n}\b", exhibit) for n in blocks), blocks
+    # and the notebook says where this path lies (the circuits rfl_gtop names so)
+    words = {"u_subscriber": "walker", "u_publisher": "walker", "u_app": "dilate",
+             "u_axis_in_fifo": "FIFO before the dilate"}
+    assert any(n in words for n in blocks), blocks
+    assert all(words[n] in " ".join(text08.split()) for n in blocks if n in words), blocks
     assert "Most of\nits delay is routing" in text08
     assert "valid/ready handshake" in text08
