@@ -6,7 +6,7 @@
 // from the PHY) LiteEth's receive and send side, crossing to clk in its FIFOs.
 // The addresses and entity ids are parameters the generated project sets (rtl.board): the node's
 // MAC and IPv4 address, its one peer's IPv4 address and ports, the reader id the ROM announces.
-// Reset: held while the PLL is not locked and for 16 clocks after. SEDP is sent once, 1024
+// Reset: held while the PLL is not locked and for 16 clocks after. SEDP is sent once, SEDP_WAIT
 // clocks after reset (a send_sedp pulse); SPDP every PERIOD clocks (rfl_fabric_node). No clock
 // of the wall: INFO_TS carries TIME. LED (active low): on once a datagram reached the node.
 `default_nettype none
@@ -19,6 +19,7 @@ module rfl_board_5a75b #(
     parameter [15:0] PEER_USER_PORT = 16'h0,
     parameter [31:0] READER = 32'h0,            // our reader's entity id (cfg_reader)
     parameter [63:0] TIME = 64'h0,              // INFO_TS's time (RTPS Time_t)
+    parameter SEDP_WAIT = 1024,                 // clocks from reset to the send_sedp pulse
     parameter SPDP_PORT = 0,                    // the rest: rfl_fabric_top's
     parameter META_PORT = 0,
     parameter USER_PORT = 0,
@@ -59,10 +60,16 @@ module rfl_board_5a75b #(
     output wire       led_n
 );
     // 25 MHz in, 125 MHz out: the EHXPLLL settings yowasp-ecppll -i 25 -o 125 computes (Project
-    // Trellis 1.4-82-g3afe7b5: VCO 625 MHz, CLKI_DIV 1, CLKFB_DIV 5, CLKOP_DIV 5). Outside
-    // synthesis (lint, the proof) the oscillator's clock as it is, locked.
+    // Trellis 1.4-82-g3afe7b5: VCO 625 MHz, CLKI_DIV 1, CLKFB_DIV 5, CLKOP_DIV 5). In the proof
+    // and outside synthesis the oscillator's clock as it is, locked.
     wire clk, locked;
-`ifdef SYNTHESIS
+`ifdef FORMAL
+    assign clk = clk25;
+    assign locked = 1'b1;
+`elsif SYNTHESIS
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [5:0] pll_unused;
+    /* verilator lint_on UNUSEDSIGNAL */
     (* FREQUENCY_PIN_CLKI="25" *)
     (* FREQUENCY_PIN_CLKOP="125" *)
     (* ICP_CURRENT="12" *) (* LPF_RESISTOR="8" *) (* MFG_ENABLE_FILTEROPAMP="1" *)
@@ -74,24 +81,30 @@ module rfl_board_5a75b #(
         .CLKOP_ENABLE("ENABLED"), .CLKOP_DIV(5), .CLKOP_CPHASE(2), .CLKOP_FPHASE(0),
         .FEEDBK_PATH("CLKOP"), .CLKFB_DIV(5)
     ) u_pll (
-        .RST(1'b0), .STDBY(1'b0), .CLKI(clk25), .CLKOP(clk), .CLKFB(clk), .CLKINTFB(),
+        .RST(1'b0), .STDBY(1'b0), .CLKI(clk25), .CLKOP(clk), .CLKFB(clk),
+        .CLKINTFB(pll_unused[0]), .CLKOS(pll_unused[1]), .CLKOS2(pll_unused[2]),
+        .CLKOS3(pll_unused[3]), .INTLOCK(pll_unused[4]), .REFCLK(pll_unused[5]),
         .PHASESEL0(1'b0), .PHASESEL1(1'b0), .PHASEDIR(1'b1), .PHASESTEP(1'b1),
-        .PHASELOADREG(1'b1), .PLLWAKESYNC(1'b0), .ENCLKOP(1'b0), .LOCK(locked));
+        .PHASELOADREG(1'b1), .PLLWAKESYNC(1'b0), .ENCLKOP(1'b0), .ENCLKOS(1'b0),
+        .ENCLKOS2(1'b0), .ENCLKOS3(1'b0), .LOCK(locked));
 `else
     assign clk = clk25;
     assign locked = 1'b1;
 `endif
 
-    reg [4:0] rst_count = 5'd0;                 // bit 4: out of reset
-    reg [10:0] sedp_count = 11'd0;              // bit 10: SEDP sent
+    localparam WAIT_BITS = $clog2(SEDP_WAIT + 1);
+    localparam [WAIT_BITS-1:0] WAIT = SEDP_WAIT[WAIT_BITS-1:0];
+    reg [4:0] rst_count;                        // bit 4: out of reset
+    reg [WAIT_BITS-1:0] sedp_count;             // WAIT: SEDP sent
+    initial rst_count = 5'd0;                   // the configured FPGA's; before the PLL locks
     wire rst_n = rst_count[4];
     always @(posedge clk) begin
         if (!locked) rst_count <= 5'd0;
         else if (!rst_n) rst_count <= rst_count + 5'd1;
-        if (!rst_n) sedp_count <= 11'd0;
-        else if (!sedp_count[10]) sedp_count <= sedp_count + 11'd1;
+        if (!rst_n) sedp_count <= {WAIT_BITS{1'b0}};
+        else if (sedp_count != WAIT) sedp_count <= sedp_count + 1'b1;
     end
-    wire send_sedp = sedp_count == 11'h3ff;
+    wire send_sedp = rst_n && sedp_count == WAIT - 1'b1;
 
     wire [31:0] cnt_rx_packets;
     /* verilator lint_off UNUSEDSIGNAL */
