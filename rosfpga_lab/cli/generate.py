@@ -107,8 +107,8 @@ def _fabric(args: argparse.Namespace, config: object) -> int:
     rom = render_rom(config, domain=args.domain, index=args.participant_index,  # type: ignore[arg-type]
                      address=args.address, guid_prefix=prefix)
     paths = write_rom(rom, args.output)
-    paths += write_board(config, rom, args.output,  # type: ignore[arg-type]
-                          peer_ip=args.peer_ip or default_peer(args.address),
+    peer_ip = args.peer_ip or default_peer(args.address)
+    paths += write_board(config, rom, args.output, peer_ip=peer_ip,  # type: ignore[arg-type]
                          peer_index=args.peer_index, mac=args.mac or DEFAULT_MAC)
     if not args.quiet:
         sizes = ", ".join(f"{m.name} {len(m.data)}" for m in rom.messages)

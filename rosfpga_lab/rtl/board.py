@@ -31,7 +31,7 @@ from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_NODE
 from rosfpga_lab.rtl.sim import TB_DIR
 from rosfpga_lab.rtl.timing import RESOURCE_NAMES, choose_tools, timing_missing_reason
 from rosfpga_lab.rtps.entities import discovery_port, user_port
-from rosfpga_lab.rtps.limits import ANNOUNCE_SECONDS
+from rosfpga_lab.rtps.limits import ANNOUNCE_SECONDS, SPDP_MULTICAST_ADDRESS
 
 __all__ = ["BOARD", "BOARD_TOP", "BOARD_DIR", "BIT_FILE", "CLOCK_HZ", "DEFAULT_MAC",
            "board_parameters", "default_peer", "write_board", "clock_lines", "main"]
@@ -121,7 +121,7 @@ def _tools() -> tuple[str, str, str]:
 
 def _makefile(yosys: str, nextpnr: str, ecppack: str) -> str:
     b = BOARD_DIR
-    return f"""# The bitstream of the ROS 2 node in the fabric for a {BOARD} (rosfpga_lab.rtl.board).
+    return f"""# The bitstream of the ROS 2 node in the fabric for a {BOARD} (rtl.board).
 # make bitstream: Yosys synth_ecp5, nextpnr-ecp5 (pins: {b}/{LPF_FILE}), ecppack -> {b}/{BIT_FILE}
 YOSYS ?= {yosys}
 NEXTPNR ?= {nextpnr}
@@ -143,6 +143,51 @@ bitstream: {b}/{BIT_FILE}
 
 {b}/{BIT_FILE}: {b}/{BOARD_TOP}.config
 \t$(ECPPACK) {b}/{BOARD_TOP}.config {b}/{BIT_FILE}
+"""
+
+
+def _readme(rom: DiscoveryRom, mac: str, peer_ip: str, peer_index: int) -> str:
+    """board/README.md: what was checked here, and what a user with the board runs."""
+    return f"""# The ROS 2 node in the fabric on a {BOARD}
+
+No board was available where this lab was written: the bitstream is built, placed, routed and
+timed by open tools (`make bitstream`), never run on a board. What the build prints is what is
+known: Fmax per clock and the resources. At the time of writing neither clock meets 125 MHz
+(the node's clock some 62 MHz, the PHY's receive clock some 100 MHz: LiteEth's 8-bit datapath,
+rosfpga_lab/rtl/fabric/vendor/README.md, Timing), so expect lost or corrupted frames at line
+rate until LiteEth's 32-bit datapath is joined.
+
+One more thing to check on the board: LiteX-Boards' own 5A-75x target builds its RGMII PHY with
+no transmit delay in the FPGA (the RTL8211FD adds it); the vendored core adds 2 ns
+(tools/liteeth/liteeth_ecp5_rgmii.yml, `phy_tx_delay`). If the host sees no frames from the
+board, regenerate the core with `phy_tx_delay: 0` (tools/liteeth/gen_liteeth.py).
+
+## Build and load
+
+    make bitstream                                  # {BOARD_DIR}/{BIT_FILE}
+    openFPGALoader -b colorlight {BOARD_DIR}/{BIT_FILE}      # into SRAM (lost at power-off)
+    openFPGALoader -b colorlight -f {BOARD_DIR}/{BIT_FILE}   # into the flash
+
+(a JTAG adapter on the board's JTAG pads; `-c CABLE` names yours). The pins:
+{BOARD_DIR}/{LPF_FILE} (from LiteX-Boards' platform file, revision 8.0).
+
+## The host
+
+The node is participant {rom.index} of DDS domain {rom.domain} at {rom.address} (MAC {mac}),
+on the board's first Ethernet port (LiteX-Boards' eth 0). Its one peer is {peer_ip},
+participant {peer_index} (it sends its SEDP answers and user data to that participant's ports).
+On the host, the port to the board (`eth0` here) on the same subnet:
+
+    sudo ip addr add {peer_ip}/24 dev eth0
+    sudo ip link set eth0 up
+    ping {rom.address}                               # the core answers ARP and ICMP echo
+    ROS_DOMAIN_ID={rom.domain} ros2 topic list
+
+The DDS implementation must use that interface for SPDP's multicast
+({SPDP_MULTICAST_ADDRESS}); the host's ROS 2 process must be participant {peer_index} (the
+first one started on the host is 0).
+Other addresses: `rosfpga-lab generate CONFIG -o DIR --target fabric --address IP --peer-ip IP
+--mac MAC --peer-index N` ({BOARD_DIR}/parameters.json has what this build was given).
 """
 
 
@@ -181,6 +226,7 @@ def write_board(config: NodeConfig, rom: DiscoveryRom, out_dir: str | Path, *, p
                  {"board": BOARD, "top": BOARD_TOP, "mac": mac, "ip": rom.address,
                   "peer_ip": peer_ip, "peer_index": peer_index, "parameters": params},
                  indent=1) + "\n",
+             board / "README.md": _readme(rom, mac, peer_ip, peer_index),
              out / "Makefile": _makefile(*_tools())}
     for path, text in texts.items():
         path.write_text(text, encoding="utf-8")

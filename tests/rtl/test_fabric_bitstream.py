@@ -81,5 +81,6 @@ def test_make_bitstream_meets_timing_at_each_clock(built: tuple[Path, str, float
     _, stdout, _ = built
     found = FMAX.findall(stdout)
     assert found, stdout
-    short = [f"{c}: {got} MHz < {want} MHz" for c, got, want, _ in found if float(got) < float(want)]
+    short = [f"{c}: {got} MHz < {want} MHz" for c, got, want, _ in found
+             if float(got) < float(want)]
     assert not short, "; ".join(short)
