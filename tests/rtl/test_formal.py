@@ -403,3 +403,24 @@ def test_a_planted_bug_fails_the_answers_byte_bound(tmp_path: Path) -> None:
             format_results([result])
         assert {lines[int(f.split(":")[1].split(".")[0]) - 1].strip()
                 for f in result.failed if f.startswith(f"{name}:")} == {bound}, result.failed
+
+
+@pytest.mark.parametrize(("old", "new"), [
+    ("wire rst_n = rst_count[4];", "wire rst_n = rst_count[3];"),   # out of reset after 8
+    ("wire send_sedp = rst_n && sedp_count == WAIT - 1'b1;",
+     "wire send_sedp = rst_n && sedp_count != WAIT;"),             # a pulse of SEDP_WAIT clocks
+    (".cfg_writer(32'd0)", ".cfg_writer(READER)"),                  # only our own writer id
+    ("assign led_n = cnt_rx_packets == 32'd0;", "assign led_n = !cnt_rx_packets[0];"),
+], ids=["reset", "sedp", "writer", "led"])
+def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -> None:
+    """The board top's proof sees a short reset, a long SEDP pulse, a wrong id, a LED that
+    misses datagrams."""
+    require_formal()
+    name = "rfl_board_5a75b.v"
+    text = (FABRIC_DIR / name).read_text()
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp_path / name
+    buggy.write_text(text.replace(old, f"{new} /* PLANTED BUG */"))
+    proof = next(p for p in PROOFS if p.name == "board_5a75b")
+    result = prove(proof, replace={name: buggy})
+    assert result.status == "FAIL", format_results([result])
