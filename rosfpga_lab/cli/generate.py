@@ -42,7 +42,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "the answer ROM and table rtl/fabric/rfl_rtps_disc_answer.v reads "
                         "(resends and HEARTBEATs of the reliable built-in writers), "
                         "and an index (offsets, lengths, destinations, run-time patch points, "
-                        "answer slots)")
+                        "answer slots), with the board build of a Colorlight 5A-75B v8.0 "
+                        "(board/: its Verilog, pins and parameters; 'make bitstream' in the "
+                        "output directory runs Yosys, nextpnr-ecp5 and ecppack)")
     parser.add_argument("--domain", type=int, default=0, metavar="ID",
                         help="--target fabric: the DDS domain (ROS_DOMAIN_ID; default 0)")
     parser.add_argument("--participant-index", type=int, default=0, metavar="N",
@@ -55,6 +57,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="--target fabric: the participant's GUID prefix, 24 hex digits "
                         "(default: the lab's fixed fabric prefix; give each board of one DDS "
                         "domain its own)")
+    parser.add_argument("--mac", default=None, metavar="MAC",
+                        help="--target fabric: the board's MAC address (default "
+                        "02:52:46:4c:00:02, locally administered)")
+    parser.add_argument("--peer-ip", default=None, metavar="IPV4",
+                        help="--target fabric: the board's one peer, the host running ROS 2 "
+                        "(default: --address with the last number 1, or 2 when that is the node)")
+    parser.add_argument("--peer-index", type=int, default=0, metavar="N",
+                        help="--target fabric: the peer's participant index, which sets the "
+                        "ports the board sends to (default 0)")
     parser.set_defaults(func=run)
 
 
@@ -83,6 +94,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _fabric(args: argparse.Namespace, config: object) -> int:
     """``--target fabric``: the discovery ROM's files into the output directory."""
+    from rosfpga_lab.rtl.board import DEFAULT_MAC, default_peer, write_board
     from rosfpga_lab.rtl.discrom import DEFAULT_FABRIC_PREFIX, render_rom, write_rom
     from rosfpga_lab.rtl.errors import RtlError
 
@@ -95,8 +107,12 @@ def _fabric(args: argparse.Namespace, config: object) -> int:
     rom = render_rom(config, domain=args.domain, index=args.participant_index,  # type: ignore[arg-type]
                      address=args.address, guid_prefix=prefix)
     paths = write_rom(rom, args.output)
+    peer_ip = args.peer_ip or default_peer(args.address)
+    paths += write_board(config, rom, args.output, peer_ip=peer_ip,  # type: ignore[arg-type]
+                         peer_index=args.peer_index, mac=args.mac or DEFAULT_MAC)
     if not args.quiet:
         sizes = ", ".join(f"{m.name} {len(m.data)}" for m in rom.messages)
         print(f"wrote {len(paths)} files into {args.output}: discovery ROM of "
-              f"{len(rom.image())} bytes ({sizes})")
+              f"{len(rom.image())} bytes ({sizes}); 'make bitstream' there builds the "
+              "board's bitstream")
     return 0

@@ -22,7 +22,8 @@ from pathlib import Path
 from rosfpga_lab.hls.program import frame_clocks
 from rosfpga_lab.rtl.generic import GENERIC_MODULES, GENERIC_VERILOG_DIR, LAYOUT_INCLUDE
 from rosfpga_lab.rtl.proofs import (
-    FABRIC_DIR, FABRIC_MODULES, FORMAL_DIR, PROOFS, Proof, ProofResult, format_results, formal_layout, formal_program, prove,
+    FABRIC_DIR, FABRIC_MODULES, FORMAL_DIR, PROOFS, Proof, ProofResult, design_path,
+    format_results, formal_layout, formal_program, prove,
     sby_text,
 )
 from rosfpga_lab.rtl.sim import VERILOG_DIR
@@ -48,9 +49,15 @@ def test_every_module_has_a_proof() -> None:
     for p in PROOFS:
         assert (FORMAL_DIR / f"fv_{p.name}.sv").exists()
         assert p.mode in ("prove", "bmc") and p.depth > 0
-    # each valid/ready output of a wrapper is checked by the stream rules
+    # each valid/ready output of a wrapper is checked by the stream rules: every wrapper uses
+    # them, but the one of a design with no valid output (the board top: pins and a LED)
+    valid_out = re.compile(r"^\s*output\s+(?:wire|reg)?\s*(?:\[[^\]]*\]\s*)?\w*valid\b", re.M)
+    streams = {p.name: any(valid_out.search(design_path(f).read_text()) for f in p.design)
+               for p in PROOFS}
+    assert streams["board_5a75b"] is False and streams["fabric_top"] is True
     for wrapper in FORMAL_DIR.glob("fv_*.sv"):
-        assert "`FV_SINK(" in wrapper.read_text(), wrapper.name
+        if streams.get(wrapper.stem[len("fv_"):], True):
+            assert "`FV_SINK(" in wrapper.read_text(), wrapper.name
 
 
 @pytest.mark.timeout(900)   # the proofs take 150-220 s on two idle cores; a loaded machine doubles it
@@ -396,3 +403,24 @@ def test_a_planted_bug_fails_the_answers_byte_bound(tmp_path: Path) -> None:
             format_results([result])
         assert {lines[int(f.split(":")[1].split(".")[0]) - 1].strip()
                 for f in result.failed if f.startswith(f"{name}:")} == {bound}, result.failed
+
+
+@pytest.mark.parametrize(("old", "new"), [
+    ("wire rst_n = rst_count[4];", "wire rst_n = rst_count[3];"),   # out of reset after 8
+    ("wire send_sedp = rst_n && sedp_count == WAIT - 1'b1;",
+     "wire send_sedp = rst_n && sedp_count != WAIT;"),             # a pulse of SEDP_WAIT clocks
+    (".cfg_writer(32'd0)", ".cfg_writer(READER)"),                  # only our own writer id
+    ("assign led_n = cnt_rx_packets == 32'd0;", "assign led_n = !cnt_rx_packets[0];"),
+], ids=["reset", "sedp", "writer", "led"])
+def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -> None:
+    """The board top's proof sees a short reset, a long SEDP pulse, a wrong id, a LED that
+    misses datagrams."""
+    require_formal()
+    name = "rfl_board_5a75b.v"
+    text = (FABRIC_DIR / name).read_text()
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp_path / name
+    buggy.write_text(text.replace(old, f"{new} /* PLANTED BUG */"))
+    proof = next(p for p in PROOFS if p.name == "board_5a75b")
+    result = prove(proof, replace={name: buggy})
+    assert result.status == "FAIL", format_results([result])

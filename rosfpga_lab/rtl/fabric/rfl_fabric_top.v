@@ -1,6 +1,9 @@
 // rfl_fabric_top -- the ROS 2 node in the fabric on the network (issue 31): the vendored LiteEth
-// UDP/IP core (vendor/liteeth_udp_gmii.v, the GMII simulation variant; vendor/README.md) ->
-// rfl_udp_port -> rfl_fabric_node, and back.
+// UDP/IP core (vendor/README.md) -> rfl_udp_port -> rfl_fabric_node, and back. The core: the
+// GMII simulation variant (vendor/liteeth_udp_gmii.v, one clock), or with RFL_FABRIC_RGMII
+// defined the ECP5 RGMII board variant (vendor/liteeth_udp_ecp5_rgmii.v: the PHY's receive
+// clock drives its receive and send side, its FIFOs cross to clk), the glue the same; the
+// board top rfl_board_5a75b.v defines it.
 // Ports (RTPS 2.3 9.6.1.1, the mapping rtps.entities owns; rtl.discrom.top_parameters gives
 // them and SPDP_GROUP; 0, the default, is refused): SPDP_PORT (the domain's SPDP multicast
 // port), META_PORT and USER_PORT (this participant's metatraffic and user-data unicast ports).
@@ -15,7 +18,6 @@
 // its participant index): the circuit does not read the locators of the peers' SPDP
 // announcements. So an answer to another asker (the node's m_dst_prefix, not read here) still
 // goes to cfg_peer_*, and user data reaches one reader.
-// The ECP5 RGMII variant (vendor/liteeth_udp_ecp5_rgmii.v, the same UDP port) is not joined yet.
 // The glue is proven with LiteEth and the node as stream models (rtl/formal/fv_fabric_top.sv).
 `default_nettype none
 
@@ -54,7 +56,11 @@ module rfl_fabric_top #(
     parameter BURST = 4096,
     parameter RATE = 4
 ) (
+`ifdef RFL_FABRIC_RGMII
+    input  wire         clk,                    // 125 MHz: LiteEth's sys clock and the node's
+`else
     input  wire         clk,                    // 125 MHz: GMII's receive and send clock
+`endif
     input  wire         rst_n,
     input  wire [47:0]  cfg_mac,                // held while running, as the cfg_peer_*
     input  wire [31:0]  cfg_ip,
@@ -65,12 +71,21 @@ module rfl_fabric_top #(
     input  wire [31:0]  cfg_writer,
     input  wire [63:0]  cfg_time,
     input  wire         send_sedp,
+`ifdef RFL_FABRIC_RGMII
+    input  wire         rgmii_rx_clk,           // 125 MHz from the PHY
+    input  wire         rgmii_rx_ctl,
+    input  wire [3:0]   rgmii_rxd,
+    output wire         rgmii_tx_clk,
+    output wire         rgmii_tx_ctl,
+    output wire [3:0]   rgmii_txd,
+`else
     input  wire [7:0]   gmii_rxd,
     input  wire         gmii_rx_dv,
     input  wire         gmii_rx_er,
     output wire [7:0]   gmii_txd,
     output wire         gmii_tx_en,
     output wire         gmii_tx_er,
+`endif
     output wire         status_valid,
     output wire [7:0]   status,
     output wire [15:0]  credit,
@@ -128,12 +143,22 @@ module rfl_fabric_top #(
     wire le_tx_valid, le_tx_ready, le_tx_last;
     wire [31:0] le_rx_ip, le_tx_ip;
     wire [15:0] le_rx_sport, le_rx_dport, le_rx_len, le_tx_sport, le_tx_dport, le_tx_len;
+`ifdef RFL_FABRIC_RGMII
+    liteeth_udp_ecp5_rgmii u_eth (
+        .sys_clock(clk), .sys_reset(!rst_n),
+        .mac_address(cfg_mac), .ip_address(cfg_ip), .udp_rx_port(SPDP),
+        .udp_rx_port_mask(PORT_MASK), .ip_multicast(SPDP_GROUP),
+        .rgmii_clocks_rx(rgmii_rx_clk), .rgmii_clocks_tx(rgmii_tx_clk),
+        .rgmii_pads_rx_ctl(rgmii_rx_ctl), .rgmii_pads_rx_data(rgmii_rxd),
+        .rgmii_pads_tx_ctl(rgmii_tx_ctl), .rgmii_pads_tx_data(rgmii_txd),
+`else
     liteeth_udp_gmii u_eth (
         .sys_clock(clk), .sys_reset(!rst_n),
         .mac_address(cfg_mac), .ip_address(cfg_ip), .udp_rx_port(SPDP),
         .udp_rx_port_mask(PORT_MASK), .ip_multicast(SPDP_GROUP),
         .gmii_pads_rx_data(gmii_rxd), .gmii_pads_rx_dv(gmii_rx_dv), .gmii_pads_rx_er(gmii_rx_er),
         .gmii_pads_tx_data(gmii_txd), .gmii_pads_tx_en(gmii_tx_en), .gmii_pads_tx_er(gmii_tx_er),
+`endif
         .udp_source_data(le_rx_data), .udp_source_valid(le_rx_valid),
         .udp_source_ready(le_rx_ready), .udp_source_last(le_rx_last),
         .udp_source_last_be(le_rx_last_be), .udp_source_error(le_rx_error),

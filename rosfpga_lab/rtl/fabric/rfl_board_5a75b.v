@@ -1,0 +1,142 @@
+// rfl_board_5a75b -- the ROS 2 node in the fabric on a Colorlight 5A-75B v8.0 (LFE5U-25F-6BG256C,
+// its first RGMII PHY, a Realtek RTL8211FD): rfl_fabric_top with the ECP5 RGMII LiteEth core
+// (RFL_FABRIC_RGMII; the build defines it), its clock from the 25 MHz oscillator through the
+// ECP5's PLL, its addresses parameters. Pins: rfl_board_5a75b.lpf (LiteX-Boards' platform file).
+// Clocks: clk (125 MHz, the PLL's) runs the node and LiteEth's sys side; rgmii_rx_clk (125 MHz
+// from the PHY) LiteEth's receive and send side, crossing to clk in its FIFOs.
+// The addresses and entity ids are parameters the generated project sets (rtl.board): the node's
+// MAC and IPv4 address, its one peer's IPv4 address and ports, the reader id the ROM announces.
+// Reset: held while the PLL is not locked and for 16 clocks after. SEDP is sent once, SEDP_WAIT
+// clocks after reset (a send_sedp pulse); SPDP every PERIOD clocks (rfl_fabric_node). No clock
+// of the wall: INFO_TS carries TIME. LED (active low): on once a datagram reached the node.
+`default_nettype none
+
+module rfl_board_5a75b #(
+    parameter [47:0] MAC = 48'h0,               // all from rtl.board.board_parameters
+    parameter [31:0] IP = 32'h0,
+    parameter [31:0] PEER_IP = 32'h0,
+    parameter [15:0] PEER_META_PORT = 16'h0,
+    parameter [15:0] PEER_USER_PORT = 16'h0,
+    parameter [31:0] READER = 32'h0,            // our reader's entity id (cfg_reader)
+    parameter [63:0] TIME = 64'h0,              // INFO_TS's time (RTPS Time_t)
+    parameter SEDP_WAIT = 1024,                 // clocks from reset to the send_sedp pulse
+    parameter SPDP_PORT = 0,                    // the rest: rfl_fabric_top's
+    parameter META_PORT = 0,
+    parameter USER_PORT = 0,
+    parameter [31:0] SPDP_GROUP = 32'd0,
+    parameter MAX_BYTES = 2048,
+    parameter [95:0] GUID_PREFIX = 96'h010f_7266_6c46_4142_5249_4300,
+    parameter [31:0] WRITER_ID = 32'h00000203,
+    parameter [31:0] READER_ID = 32'd0,
+    parameter FRAG_BYTES = 1344,
+    parameter MAX_DATAGRAM = 1472,
+    parameter INFO_TS = 1,
+    parameter ROM_FILE = "",
+    parameter TABLE_FILE = "",
+    parameter ROM_BYTES = 1472,
+    parameter MESSAGES = 3,
+    parameter PERIOD = 125000000,
+    parameter SLOTS = 5,
+    parameter [32*SLOTS-1:0] SLOT_IDS = 0,
+    parameter [8*SLOTS-1:0] SLOT_MSGS = 0,
+    parameter [8*SLOTS-1:0] SLOT_LASTS = 0,
+    parameter ANSWER_FILE = "",
+    parameter ANSWER_TABLE_FILE = "",
+    parameter ANSWER_BYTES = 2048,
+    parameter ANSWERS = 9,
+    parameter DST_AT = 24,
+    parameter BASE_AT = 48,
+    parameter COUNT_START = 3,
+    parameter BURST = 4096,
+    parameter RATE = 4
+) (
+    input  wire       clk25,                    // the 25 MHz oscillator
+    input  wire       rgmii_rx_clk,
+    input  wire       rgmii_rx_ctl,
+    input  wire [3:0] rgmii_rxd,
+    output wire       rgmii_tx_clk,
+    output wire       rgmii_tx_ctl,
+    output wire [3:0] rgmii_txd,
+    output wire       led_n
+);
+    // 25 MHz in, 125 MHz out: the EHXPLLL settings yowasp-ecppll -i 25 -o 125 computes (Project
+    // Trellis 1.4-82-g3afe7b5: VCO 625 MHz, CLKI_DIV 1, CLKFB_DIV 5, CLKOP_DIV 5). In the proof
+    // and outside synthesis the oscillator's clock as it is, locked.
+    wire clk, locked;
+`ifdef FORMAL
+    assign clk = clk25;
+    assign locked = 1'b1;
+`elsif SYNTHESIS
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [5:0] pll_unused;
+    /* verilator lint_on UNUSEDSIGNAL */
+    (* FREQUENCY_PIN_CLKI="25" *)
+    (* FREQUENCY_PIN_CLKOP="125" *)
+    (* ICP_CURRENT="12" *) (* LPF_RESISTOR="8" *) (* MFG_ENABLE_FILTEROPAMP="1" *)
+    (* MFG_GMCREF_SEL="2" *)
+    EHXPLLL #(
+        .PLLRST_ENA("DISABLED"), .INTFB_WAKE("DISABLED"), .STDBY_ENABLE("DISABLED"),
+        .DPHASE_SOURCE("DISABLED"), .OUTDIVIDER_MUXA("DIVA"), .OUTDIVIDER_MUXB("DIVB"),
+        .OUTDIVIDER_MUXC("DIVC"), .OUTDIVIDER_MUXD("DIVD"), .CLKI_DIV(1),
+        .CLKOP_ENABLE("ENABLED"), .CLKOP_DIV(5), .CLKOP_CPHASE(2), .CLKOP_FPHASE(0),
+        .FEEDBK_PATH("CLKOP"), .CLKFB_DIV(5)
+    ) u_pll (
+        .RST(1'b0), .STDBY(1'b0), .CLKI(clk25), .CLKOP(clk), .CLKFB(clk),
+        .CLKINTFB(pll_unused[0]), .CLKOS(pll_unused[1]), .CLKOS2(pll_unused[2]),
+        .CLKOS3(pll_unused[3]), .INTLOCK(pll_unused[4]), .REFCLK(pll_unused[5]),
+        .PHASESEL0(1'b0), .PHASESEL1(1'b0), .PHASEDIR(1'b1), .PHASESTEP(1'b1),
+        .PHASELOADREG(1'b1), .PLLWAKESYNC(1'b0), .ENCLKOP(1'b0), .ENCLKOS(1'b0),
+        .ENCLKOS2(1'b0), .ENCLKOS3(1'b0), .LOCK(locked));
+`else
+    assign clk = clk25;
+    assign locked = 1'b1;
+`endif
+
+    localparam WAIT_BITS = $clog2(SEDP_WAIT + 1);
+    localparam [WAIT_BITS-1:0] WAIT = SEDP_WAIT[WAIT_BITS-1:0];
+    reg [4:0] rst_count;                        // bit 4: out of reset
+    reg [WAIT_BITS-1:0] sedp_count;             // WAIT: SEDP sent
+    initial rst_count = 5'd0;                   // the configured FPGA's; before the PLL locks
+    wire rst_n = rst_count[4];
+    always @(posedge clk) begin
+        if (!locked) rst_count <= 5'd0;
+        else if (!rst_n) rst_count <= rst_count + 5'd1;
+        if (!rst_n) sedp_count <= {WAIT_BITS{1'b0}};
+        else if (sedp_count != WAIT) sedp_count <= sedp_count + 1'b1;
+    end
+    wire send_sedp = rst_n && sedp_count == WAIT - 1'b1;
+
+    wire [31:0] cnt_rx_packets;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire status_valid;
+    wire [7:0] status;
+    wire [15:0] credit;
+    wire [31:0] cnt_samples, cnt_answers, cnt_no_credit, cnt_rx_error, cnt_rx_length,
+                cnt_rx_overflow, cnt_tx_packets, cnt_tx_overflow, cnt_rx_port;
+    /* verilator lint_on UNUSEDSIGNAL */
+    rfl_fabric_top #(
+        .SPDP_PORT(SPDP_PORT), .META_PORT(META_PORT), .USER_PORT(USER_PORT),
+        .SPDP_GROUP(SPDP_GROUP), .MAX_BYTES(MAX_BYTES), .GUID_PREFIX(GUID_PREFIX),
+        .WRITER_ID(WRITER_ID), .READER_ID(READER_ID), .FRAG_BYTES(FRAG_BYTES),
+        .MAX_DATAGRAM(MAX_DATAGRAM), .INFO_TS(INFO_TS), .ROM_FILE(ROM_FILE),
+        .TABLE_FILE(TABLE_FILE), .ROM_BYTES(ROM_BYTES), .MESSAGES(MESSAGES), .PERIOD(PERIOD),
+        .SLOTS(SLOTS), .SLOT_IDS(SLOT_IDS), .SLOT_MSGS(SLOT_MSGS), .SLOT_LASTS(SLOT_LASTS),
+        .ANSWER_FILE(ANSWER_FILE), .ANSWER_TABLE_FILE(ANSWER_TABLE_FILE),
+        .ANSWER_BYTES(ANSWER_BYTES), .ANSWERS(ANSWERS), .DST_AT(DST_AT), .BASE_AT(BASE_AT),
+        .COUNT_START(COUNT_START), .BURST(BURST), .RATE(RATE)) u_top (
+        .clk(clk), .rst_n(rst_n), .cfg_mac(MAC), .cfg_ip(IP), .cfg_peer_ip(PEER_IP),
+        .cfg_peer_meta_port(PEER_META_PORT), .cfg_peer_user_port(PEER_USER_PORT),
+        .cfg_reader(READER), .cfg_writer(32'd0), .cfg_time(TIME), .send_sedp(send_sedp),
+        .rgmii_rx_clk(rgmii_rx_clk), .rgmii_rx_ctl(rgmii_rx_ctl), .rgmii_rxd(rgmii_rxd),
+        .rgmii_tx_clk(rgmii_tx_clk), .rgmii_tx_ctl(rgmii_tx_ctl), .rgmii_txd(rgmii_txd),
+        .status_valid(status_valid), .status(status), .credit(credit),
+        .cnt_samples(cnt_samples), .cnt_answers(cnt_answers), .cnt_no_credit(cnt_no_credit),
+        .cnt_rx_packets(cnt_rx_packets), .cnt_rx_error(cnt_rx_error),
+        .cnt_rx_length(cnt_rx_length), .cnt_rx_overflow(cnt_rx_overflow),
+        .cnt_tx_packets(cnt_tx_packets), .cnt_tx_overflow(cnt_tx_overflow),
+        .cnt_rx_port(cnt_rx_port));
+
+    assign led_n = cnt_rx_packets == 32'd0;
+endmodule
+
+`default_nettype wire

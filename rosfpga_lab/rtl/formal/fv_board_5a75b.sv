@@ -1,0 +1,104 @@
+// fv_board_5a75b -- rfl_board_5a75b's own glue (rtl/fabric): the reset after the PLL locks, the
+// one send_sedp pulse, the addresses and ids from its parameters, the LED. The PLL is the
+// oscillator's clock here, locked from the start (the board top's FORMAL branch); rfl_fabric_top
+// (the glue proven in fv_fabric_top, the rest by their own proofs and tests) is the model below,
+// of the same name, parameters and ports (the RGMII ones), which checks what it is given.
+// Bounded (bmc, 32 clocks, SEDP_WAIT 4): the top's reset is low for the first 16 clocks and high
+// after; send_sedp is high in exactly one clock, the SEDP_WAIT-th of the top out of reset; the
+// top's cfg_* are the parameters (cfg_writer 0: any writer); the LED is on (low) exactly when the
+// top's cnt_rx_packets is not 0. The board has no stream of its own (no FV_SINK).
+`define FV_MAC 48'h02524c460002
+`define FV_IP 32'hc0a80a02
+`define FV_PEER_IP 32'hc0a80a01
+`define FV_PEER_META 16'd7412
+`define FV_PEER_USER 16'd7413
+`define FV_READER 32'h00000104
+`define FV_TIME 64'h0000_0001_8000_0000
+`define FV_WAIT 4
+
+module fv_board_5a75b (
+    input clk25, input rgmii_rx_clk, input rgmii_rx_ctl, input [3:0] rgmii_rxd
+);
+    wire rgmii_tx_clk, rgmii_tx_ctl, led_n;
+    wire [3:0] rgmii_txd;
+    rfl_board_5a75b #(.MAC(`FV_MAC), .IP(`FV_IP), .PEER_IP(`FV_PEER_IP),
+                      .PEER_META_PORT(`FV_PEER_META), .PEER_USER_PORT(`FV_PEER_USER),
+                      .READER(`FV_READER), .TIME(`FV_TIME), .SEDP_WAIT(`FV_WAIT),
+                      .SPDP_PORT(7400), .META_PORT(7410), .USER_PORT(7411),
+                      .SPDP_GROUP(32'hefff0001)) dut (
+        .clk25(clk25), .rgmii_rx_clk(rgmii_rx_clk), .rgmii_rx_ctl(rgmii_rx_ctl),
+        .rgmii_rxd(rgmii_rxd), .rgmii_tx_clk(rgmii_tx_clk), .rgmii_tx_ctl(rgmii_tx_ctl),
+        .rgmii_txd(rgmii_txd), .led_n(led_n));
+    // the model's cnt_rx_packets: {rgmii_rxd, 27'd0, rgmii_rx_ctl}
+    always @(*) assert(led_n == ({rgmii_rxd, rgmii_rx_ctl} == 5'd0));
+endmodule
+
+// rfl_fabric_top as the board sees it: checks its inputs; cnt_rx_packets from the RGMII inputs.
+module rfl_fabric_top #(
+    parameter SPDP_PORT = 0,
+    parameter META_PORT = 0,
+    parameter USER_PORT = 0,
+    parameter [31:0] SPDP_GROUP = 32'd0,
+    parameter RX_BITS = 11,
+    parameter TX_BITS = 11,
+    parameter QUEUE_BITS = 2,
+
+    parameter MAX_BYTES = 2048,
+    parameter [95:0] GUID_PREFIX = 96'h010f_7266_6c46_4142_5249_4300,
+    parameter [31:0] WRITER_ID = 32'h00000203,
+    parameter [31:0] READER_ID = 32'd0,
+    parameter FRAG_BYTES = 1344,
+    parameter MAX_DATAGRAM = 1472,
+    parameter INFO_TS = 1,
+    parameter ROM_FILE = "",
+    parameter TABLE_FILE = "",
+    parameter ROM_BYTES = 1472,
+    parameter MESSAGES = 3,
+    parameter PERIOD = 100000000,
+    parameter SLOTS = 5,
+    parameter [32*SLOTS-1:0] SLOT_IDS = 0,
+    parameter [8*SLOTS-1:0] SLOT_MSGS = 0,
+    parameter [8*SLOTS-1:0] SLOT_LASTS = 0,
+    parameter ANSWER_FILE = "",
+    parameter ANSWER_TABLE_FILE = "",
+    parameter ANSWER_BYTES = 2048,
+    parameter ANSWERS = 9,
+    parameter DST_AT = 24,
+    parameter BASE_AT = 48,
+    parameter COUNT_START = 3,
+    parameter BURST = 4096,
+    parameter RATE = 4
+) (
+    input clk, input rst_n, input [47:0] cfg_mac, input [31:0] cfg_ip, input [31:0] cfg_peer_ip,
+    input [15:0] cfg_peer_meta_port, input [15:0] cfg_peer_user_port, input [31:0] cfg_reader,
+    input [31:0] cfg_writer, input [63:0] cfg_time, input send_sedp,
+    input rgmii_rx_clk, input rgmii_rx_ctl, input [3:0] rgmii_rxd,
+    output rgmii_tx_clk, output rgmii_tx_ctl, output [3:0] rgmii_txd,
+    output status_valid, output [7:0] status, output [15:0] credit, output [31:0] cnt_samples,
+    output [31:0] cnt_answers, output [31:0] cnt_no_credit, output [31:0] cnt_rx_packets,
+    output [31:0] cnt_rx_error, output [31:0] cnt_rx_length, output [31:0] cnt_rx_overflow,
+    output [31:0] cnt_tx_packets, output [31:0] cnt_tx_overflow, output [31:0] cnt_rx_port
+);
+    assign {rgmii_tx_clk, rgmii_tx_ctl, rgmii_txd, status_valid, status, credit} = 31'd0;
+    assign {cnt_samples, cnt_answers, cnt_no_credit, cnt_rx_error, cnt_rx_length} = 160'd0;
+    assign {cnt_rx_overflow, cnt_tx_packets, cnt_tx_overflow, cnt_rx_port} = 128'd0;
+    assign cnt_rx_packets = {rgmii_rxd, 27'd0, rgmii_rx_ctl};
+    reg [7:0] t = 8'd0;                         // clocks since the start
+    reg [7:0] k = 8'd0;                         // clocks out of reset
+    reg sent = 1'b0;
+    always @(posedge clk) begin
+        if (t != 8'hff) t <= t + 8'd1;
+        if (rst_n && k != 8'hff) k <= k + 8'd1;
+        if (send_sedp) sent <= 1'b1;
+    end
+    always @(*) begin
+        assert(rst_n == (t >= 8'd16));
+        assert(send_sedp == (rst_n && k == `FV_WAIT - 1));
+        assert(!(send_sedp && sent));
+        assert(cfg_mac == `FV_MAC && cfg_ip == `FV_IP && cfg_peer_ip == `FV_PEER_IP);
+        assert(cfg_peer_meta_port == `FV_PEER_META && cfg_peer_user_port == `FV_PEER_USER);
+        assert(cfg_reader == `FV_READER && cfg_writer == 32'd0 && cfg_time == `FV_TIME);
+    end
+    // a bounded check that sees the pulse and what follows it
+    always @(*) if (t == 8'd30) assert(sent);
+endmodule

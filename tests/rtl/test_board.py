@@ -1,0 +1,53 @@
+"""The board build's files (``rtl.board``; ``make bitstream`` itself: test_fabric_bitstream.py):
+what ``generate --target fabric`` writes, no tools needed."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from rosfpga_lab.cli import main
+from rosfpga_lab.rtl.board import default_peer
+
+CONFIG = Path(__file__).resolve().parents[2] / "data" / "fpga_laserscan_min_cdr.yaml"
+
+
+def test_generate_writes_the_board_build(tmp_path: Path) -> None:
+    assert main(["generate", str(CONFIG), "-o", str(tmp_path), "-q", "--target", "fabric",
+                 "--address", "10.0.0.7", "--peer-index", "1", "--mac",
+                 "02:00:00:00:00:2a"]) == 0
+    index = json.loads((tmp_path / "board" / "parameters.json").read_text())
+    p = index["parameters"]
+    # RTPS 2.3 9.6.1.1, domain 0: participant 1's metatraffic 7400+10+2, user data 7400+11+2
+    assert (p["PEER_META_PORT"], p["PEER_USER_PORT"]) == ("16'h1cf4", "16'h1cf5")
+    assert (p["IP"], p["PEER_IP"], p["MAC"]) == ("32'ha000007", "32'ha000001", "48'h2000000002a")
+    assert p["SPDP_GROUP"] == "32'hefff0001" and p["PERIOD"] == "125000000"
+    assert p["ROM_FILE"] == '"rfl_rtps_disc_rom.hex"'
+    assert (tmp_path / "rfl_rtps_disc_rom.hex").exists()
+    make = (tmp_path / "Makefile").read_text()
+    assert "--25k --package CABGA256 --speed 6" in make
+    assert "--lpf board/rfl_board_5a75b.lpf" in make
+    assert "ECPPACK" in make and "board/rfl_board_5a75b.bit" in make
+    script = (tmp_path / "board" / "synth.ys").read_text()
+    assert "-D RFL_FABRIC_RGMII" in script and "board/node/rfl_node.v" in script
+    assert "synth_ecp5 -top rfl_board_5a75b -json board/netlist.json" in script
+    lpf = (tmp_path / "board" / "rfl_board_5a75b.lpf").read_text()
+    # LiteX-Boards' _io_v8_0: clk25 P6, eth_clocks 0 rx J1
+    assert 'LOCATE COMP "clk25" SITE "P6";' in lpf
+    assert 'LOCATE COMP "rgmii_rx_clk" SITE "J1";' in lpf
+    readme = (tmp_path / "board" / "README.md").read_text()
+    assert "No board was available" in readme and "sudo ip addr add 10.0.0.1/24" in readme
+
+
+def test_default_peer_and_bad_addresses(tmp_path: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    assert default_peer("192.168.10.2") == "192.168.10.1"
+    assert default_peer("192.168.10.1") == "192.168.10.2"
+    assert main(["generate", str(CONFIG), "-o", str(tmp_path), "-q", "--target", "fabric",
+                 "--mac", "02:00:00:00:2a"]) != 0
+    assert "is not six hex pairs" in capsys.readouterr().err
+    assert main(["generate", str(CONFIG), "-o", str(tmp_path / "b"), "-q", "--target",
+                 "fabric", "--address", "10.0.0.1", "--peer-ip", "10.0.0.1"]) != 0
+    assert "is the node's own" in capsys.readouterr().err
