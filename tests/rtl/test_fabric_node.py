@@ -1,6 +1,6 @@
 """The whole node in the fabric (issue #31): ``rfl_fabric_node`` (rosfpga_lab/rtl/fabric/
 rfl_fabric_node.v) behind one UDP payload interface, under cocotb with random input gaps and
-output backpressure (tests/rtl/bench_fabric_node.py), the generated top of
+output backpressure (tests/rtl/bench_rfl_fabric_node.py), the generated top of
 ``data/fpga_laserscan_min_cdr.yaml`` inside.
 
 In: tests/rtl/test_fabric_rtps_loop.py's user datagrams (LaserScan samples the lab's CDR writer
@@ -106,7 +106,7 @@ def test_the_node_routes_answers_and_announces(seed: int, gap: int, bp: int, tmp
                  parameters=params, build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
     try:
-        xml = runner.test(test_module="bench_fabric_node", hdl_toplevel="rfl_fabric_node",
+        xml = runner.test(test_module="bench_rfl_fabric_node", hdl_toplevel="rfl_fabric_node",
                           build_dir=tmp_path / "build", test_dir=tmp_path,
                           extra_env={"FABRIC_NODE_CASE": str(tmp_path / "case.json"),
                                      "FABRIC_NODE_OUT": str(tmp_path / "out.json")},

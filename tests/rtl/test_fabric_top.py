@@ -1,6 +1,6 @@
 """The node in the fabric on the network (issue #31): ``rfl_fabric_top`` (LiteEth's GMII
 variant -> rfl_udp_port -> rfl_fabric_node, rosfpga_lab/rtl/fabric/rfl_fabric_top.v) driven at
-its GMII side by a peer (cocotbext-eth, ``bench_fabric_top.py``) under Verilator, the generated
+its GMII side by a peer (cocotbext-eth, ``bench_rfl_fabric_top.py``) under Verilator, the generated
 top of ``data/fpga_laserscan_min_cdr.yaml`` inside.
 
 The peer (participant 1 of domain 0) sends, as Ethernet/IPv4/UDP frames built here with scapy:
@@ -167,7 +167,7 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
     build = _build(runner, gen, params, tmp_path)
     try:
         xml = runner.test(
-            test_module="bench_fabric_top", hdl_toplevel="rfl_fabric_top", build_dir=build,
+            test_module="bench_rfl_fabric_top", hdl_toplevel="rfl_fabric_top", build_dir=build,
             test_dir=tmp_path, extra_env={"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
                                           "FABRIC_TOP_OUT": str(tmp_path / "out.json")},
             log_file=tmp_path / "sim.log")
