@@ -1,0 +1,56 @@
+"""The whole node in the fabric, ``rfl_fabric_node``, under cocotb (tests/rtl/bench_rfl_fabric_node.py):
+built from rtl/fabric's files, a generated project's top and the parameters of a discovery ROM,
+run on one case. Shared by the tests that drive it (tests/rtl/test_fabric_node.py,
+tests/rtl/test_fabric_rtps_loop.py); the bench's module must be importable (``TB_DIR`` on the
+path)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from rosfpga_lab.rtl.discrom import DEST_USER, DiscoveryRom, node_parameters, write_rom
+from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_NODE
+from tests.support.rtltools import require_cocotb
+
+
+def generate_project(config: Path, out: Path) -> Path:
+    """``rosfpga-lab generate CONFIG -o OUT`` (the generated top rfl_node is under out/rtl)."""
+    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(config), "-o",
+                           str(out), "-q"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def run_fabric_node(gen: Path, rom: DiscoveryRom, case: dict[str, object], tmp_path: Path, *,
+                    period: int, max_bytes: int) -> dict:
+    """The bench's output (datagrams, counters, clocks) for ``case`` (its keys: the bench's
+    docstring), the node built with ``gen``'s generated top, ``rom``'s files and parameters,
+    SPDP every ``period`` clocks and a seam of ``max_bytes``."""
+    sim = require_cocotb()
+    from cocotb_tools.runner import get_results, get_runner
+
+    write_rom(rom, tmp_path)
+    (tmp_path / "case.json").write_text(json.dumps(case))
+    params = dict(node_parameters(rom, period=period), MAX_BYTES=str(max_bytes),
+                  USER_DEST=str(DEST_USER))
+    rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
+    runner = get_runner(sim)
+    runner.build(sources=[*(FABRIC_DIR / m for m in FABRIC_NODE), *rtl],
+                 includes=[gen / "rtl", FABRIC_DIR], hdl_toplevel="rfl_fabric_node",
+                 parameters=params, build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
+                 log_file=tmp_path / "build.log")
+    try:
+        xml = runner.test(test_module="bench_rfl_fabric_node", hdl_toplevel="rfl_fabric_node",
+                          build_dir=tmp_path / "build", test_dir=tmp_path,
+                          extra_env={"FABRIC_NODE_CASE": str(tmp_path / "case.json"),
+                                     "FABRIC_NODE_OUT": str(tmp_path / "out.json")},
+                          log_file=tmp_path / "sim.log")
+        total, failed = get_results(xml)
+    except (SystemExit, RuntimeError):
+        total, failed = 1, 1
+    log = (tmp_path / "sim.log").read_text(errors="replace")
+    assert total == 1 and failed == 0, log[-4000:]
+    return json.loads((tmp_path / "out.json").read_text())
