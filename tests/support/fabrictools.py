@@ -1,7 +1,8 @@
 """The whole node in the fabric, ``rfl_fabric_node``, under cocotb (tests/rtl/bench_rfl_fabric_node.py):
 built from rtl/fabric's files, a generated project's top and the parameters of a discovery ROM,
 run on one case. Shared by the tests that drive it (tests/rtl/test_fabric_node.py,
-tests/rtl/test_fabric_rtps_loop.py); the bench's module must be importable (``TB_DIR`` on the
+tests/rtl/test_fabric_rtps_loop.py, tests/rtl/test_fabric_answer.py with its own bench,
+tests/rtl/bench_rfl_rtps_ctrl.py); the bench's module must be importable (``TB_DIR`` on the
 path)."""
 
 from __future__ import annotations
@@ -25,17 +26,19 @@ def generate_project(config: Path, out: Path) -> Path:
 
 
 def run_fabric_node(gen: Path, rom: DiscoveryRom, case: dict[str, object], tmp_path: Path, *,
-                    period: int, max_bytes: int) -> dict:
-    """The bench's output (datagrams, counters, clocks) for ``case`` (its keys: the bench's
-    docstring), the node built with ``gen``'s generated top, ``rom``'s files and parameters,
-    SPDP every ``period`` clocks and a seam of ``max_bytes``."""
+                    period: int, max_bytes: int = 2048, bench: str = "bench_rfl_fabric_node",
+                    **params: str) -> dict:
+    """``bench``'s output for ``case`` (its keys: the bench's docstring; both read
+    ``FABRIC_NODE_CASE`` and write ``FABRIC_NODE_OUT``), the node built with ``gen``'s generated
+    top, ``rom``'s files and parameters, SPDP every ``period`` clocks, a seam of ``max_bytes``
+    and ``params`` over them."""
     sim = require_cocotb()
     from cocotb_tools.runner import get_results, get_runner
 
     write_rom(rom, tmp_path)
     (tmp_path / "case.json").write_text(json.dumps(case))
     params = dict(node_parameters(rom, period=period), MAX_BYTES=str(max_bytes),
-                  USER_DEST=str(DEST_USER))
+                  USER_DEST=str(DEST_USER), **params)
     rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
     runner = get_runner(sim)
     runner.build(sources=[*(FABRIC_DIR / m for m in FABRIC_NODE), *rtl],
@@ -43,7 +46,7 @@ def run_fabric_node(gen: Path, rom: DiscoveryRom, case: dict[str, object], tmp_p
                  parameters=params, build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
     try:
-        xml = runner.test(test_module="bench_rfl_fabric_node", hdl_toplevel="rfl_fabric_node",
+        xml = runner.test(test_module=bench, hdl_toplevel="rfl_fabric_node",
                           build_dir=tmp_path / "build", test_dir=tmp_path,
                           extra_env={"FABRIC_NODE_CASE": str(tmp_path / "case.json"),
                                      "FABRIC_NODE_OUT": str(tmp_path / "out.json")},
