@@ -133,7 +133,8 @@ SEED ?= 1
 bitstream: {b}/{BIT_FILE}
 \t$(PYTHON) -m rosfpga_lab.rtl.board report {b}/report.json
 
-{b}/netlist.json: {b}/synth.ys $(wildcard {b}/*.v {b}/*.vh {b}/vendor/*.v {b}/node/*) $(wildcard *.hex)
+{b}/netlist.json: {b}/synth.ys $(wildcard {b}/*.v {b}/*.vh {b}/vendor/*.v {b}/node/*) \\
+    $(wildcard *.hex)
 \t$(YOSYS) -q -l {b}/yosys.log {b}/synth.ys
 
 {b}/{BOARD_TOP}.config: {b}/netlist.json {b}/{LPF_FILE}

@@ -54,7 +54,7 @@ from tests.rtl.test_fabric_rtps_loop import TIME, published
 from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER
 from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
 from tests.rtl.test_fabric_udp import PEER_IP, PEER_MAC, _fcs, _frames, _group_mac
-from tests.support.rtltools import TB_DIR, cocotb_verilator
+from tests.support.rtltools import TB_DIR, cocotb_verilator, run_bench
 
 if TYPE_CHECKING:
     from cocotb_tools.runner import Runner
@@ -118,7 +118,7 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
                                                           monkeypatch: pytest.MonkeyPatch) -> None:
     cocotb_verilator(monkeypatch)
     monkeypatch.syspath_prepend(str(TB_DIR))
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
     gen = tmp_path / "project"
     proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
@@ -160,17 +160,9 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
                   MAX_BYTES=str(MAX_BYTES))
     runner = get_runner("verilator")
     build = _build(runner, gen, params, tmp_path)
-    try:
-        xml = runner.test(
-            test_module="bench_rfl_fabric_top", hdl_toplevel="rfl_fabric_top", build_dir=build,
-            test_dir=tmp_path, extra_env={"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
-                                          "FABRIC_TOP_OUT": str(tmp_path / "out.json")},
-            log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-4000:]
+    run_bench(runner, "bench_rfl_fabric_top", "rfl_fabric_top", build, tmp_path,
+              {"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
+               "FABRIC_TOP_OUT": str(tmp_path / "out.json")})
     out = json.loads((tmp_path / "out.json").read_text())
 
     sent = [Ether(f) for f in _frames(out["sent"])]

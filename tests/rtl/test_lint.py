@@ -286,29 +286,27 @@ def test_rtps_tx_is_clean_under_three_linters(name: str, info_ts: bool, frag: in
 # the whole node in the fabric (rtl/fabric/rfl_fabric_node.v) with every stage and the generated
 # top of a wire: cdr configuration inside, the ROMs and answer slots of that configuration
 def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None:
-    import sys
-
     from rosfpga_lab.rtl.discrom import DEST_USER, node_parameters, render_rom, write_rom
     from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_NODE
+    from tests.support.fabrictools import generate_project, generated_rtl
 
     config = DATA / "fpga_laserscan_min_cdr.yaml"
-    gen = tmp_path / "project"
-    done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(config), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
+    gen = generate_project(config, tmp_path / "project")
     rom = render_rom(config)
     write_rom(rom, tmp_path)
     params = dict(node_parameters(rom, period=1000), USER_DEST=str(DEST_USER))
     top = "rfl_fabric_node"
     sources = [str(FABRIC_DIR / m) for m in FABRIC_NODE]
-    sources += sorted(str(q) for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
+    sources += map(str, generated_rtl(gen))
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "--top-module", top,
-                           f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}", *(f"-G{k}={v}" for k, v in params.items()),
-                           *sources], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+                           f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}",
+                           *(f"-G{k}={v}" for k, v in params.items()), *sources],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
     done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
-                           f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}", *(f"-P{top}.{k}={v}" for k, v in params.items()),
-                           *sources], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+                           f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}",
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), *sources],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     for name in ("rfl_fabric_node.v", "rfl_frame_arbiter.v"):     # (its stages: their own cases)
         assert name not in done.stdout + done.stderr, done.stdout + done.stderr
@@ -318,24 +316,20 @@ def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None
 # the whole node with the generated top inside; the vendored core's own warnings (generated
 # code) are not the lab's to fix (tests/rtl/test_fabric_udp.py says the same of the UDP stage)
 def test_fabric_top_is_clean_under_verilator(tmp_path: Path) -> None:
-    import sys
-
     from rosfpga_lab.rtl.discrom import (
         node_parameters, render_rom, top_parameters, verilog_parameters, write_rom,
     )
     from rosfpga_lab.rtl.proofs import FABRIC_DIR
     from tests.rtl.test_fabric_top import SOURCES
+    from tests.support.fabrictools import generate_project, generated_rtl
 
     config = DATA / "fpga_laserscan_min_cdr.yaml"
-    gen = tmp_path / "project"
-    done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(config), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
+    gen = generate_project(config, tmp_path / "project")
     rom = render_rom(config)
     write_rom(rom, tmp_path)
     params = dict(node_parameters(rom, period=1000), **verilog_parameters(top_parameters(rom)))
     sources = [*map(str, SOURCES)]
-    sources += sorted(str(q) for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
+    sources += map(str, generated_rtl(gen))
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "-Wno-fatal",
                            "--top-module", "rfl_fabric_top", f"-I{gen / 'rtl'}",
                            f"-I{FABRIC_DIR}",

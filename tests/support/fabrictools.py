@@ -1,9 +1,9 @@
-"""The whole node in the fabric, ``rfl_fabric_node``, under cocotb (tests/rtl/bench_rfl_fabric_node.py):
-built from rtl/fabric's files, a generated project's top and the parameters of a discovery ROM,
-run on one case. Shared by the tests that drive it (tests/rtl/test_fabric_node.py,
-tests/rtl/test_fabric_rtps_loop.py, tests/rtl/test_fabric_answer.py with its own bench,
-tests/rtl/bench_rfl_rtps_ctrl.py); the bench's module must be importable (``TB_DIR`` on the
-path)."""
+"""The whole node in the fabric, ``rfl_fabric_node``, under cocotb: built from rtl/fabric's
+files, a generated project's top and the parameters of a discovery ROM, run on one case by a
+bench (tests/rtl/bench_rfl_fabric_node.py, or tests/rtl/bench_rfl_rtps_ctrl.py for the answer
+path alone). Shared by the tests that drive the node (tests/rtl/test_fabric_node.py,
+test_fabric_rtps_loop.py, test_fabric_answer.py); the bench's module must be importable
+(``TB_DIR`` on the path)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from pathlib import Path
 
 from rosfpga_lab.rtl.discrom import DEST_USER, DiscoveryRom, node_parameters, write_rom
 from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_NODE
-from tests.support.rtltools import require_cocotb
+from tests.support.rtltools import require_cocotb, run_bench
 
 
 def generate_project(config: Path, out: Path) -> Path:
@@ -25,6 +25,11 @@ def generate_project(config: Path, out: Path) -> Path:
     return out
 
 
+def generated_rtl(gen: Path) -> list[Path]:
+    """The generated project's Verilog modules (its testbench rfl_tb.v left out)."""
+    return sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
+
+
 def run_fabric_node(gen: Path, rom: DiscoveryRom, case: dict[str, object], tmp_path: Path, *,
                     period: int, max_bytes: int = 2048, bench: str = "bench_rfl_fabric_node",
                     **params: str) -> dict:
@@ -33,27 +38,18 @@ def run_fabric_node(gen: Path, rom: DiscoveryRom, case: dict[str, object], tmp_p
     top, ``rom``'s files and parameters, SPDP every ``period`` clocks, a seam of ``max_bytes``
     and ``params`` over them."""
     sim = require_cocotb()
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
     write_rom(rom, tmp_path)
     (tmp_path / "case.json").write_text(json.dumps(case))
     params = dict(node_parameters(rom, period=period), MAX_BYTES=str(max_bytes),
                   USER_DEST=str(DEST_USER), **params)
-    rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
     runner = get_runner(sim)
-    runner.build(sources=[*(FABRIC_DIR / m for m in FABRIC_NODE), *rtl],
+    runner.build(sources=[*(FABRIC_DIR / m for m in FABRIC_NODE), *generated_rtl(gen)],
                  includes=[gen / "rtl", FABRIC_DIR], hdl_toplevel="rfl_fabric_node",
                  parameters=params, build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
-    try:
-        xml = runner.test(test_module=bench, hdl_toplevel="rfl_fabric_node",
-                          build_dir=tmp_path / "build", test_dir=tmp_path,
-                          extra_env={"FABRIC_NODE_CASE": str(tmp_path / "case.json"),
-                                     "FABRIC_NODE_OUT": str(tmp_path / "out.json")},
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-4000:]
+    run_bench(runner, bench, "rfl_fabric_node", tmp_path / "build", tmp_path,
+              {"FABRIC_NODE_CASE": str(tmp_path / "case.json"),
+               "FABRIC_NODE_OUT": str(tmp_path / "out.json")})
     return json.loads((tmp_path / "out.json").read_text())
