@@ -21,13 +21,12 @@ from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.rtl.discrom import (
-    ANSWER_FILE, ANSWER_TABLE_FILE, ROM_FILE, TABLE_FILE, DiscoveryRom, answer_params,
-    top_parameters, tx_parameters, verilog_parameters,
+    DiscoveryRom, node_parameters, top_parameters, verilog_parameters,
 )
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.limits import ECP5_DEVICE, ECP5_PACKAGE
 from rosfpga_lab.rtl.project import node_sources
-from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_NODE
+from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, FABRIC_NODE
 from rosfpga_lab.rtl.sim import TB_DIR
 from rosfpga_lab.rtl.timing import RESOURCE_NAMES, choose_tools, timing_missing_reason
 from rosfpga_lab.rtl.tools import find_tool
@@ -95,17 +94,9 @@ def board_parameters(rom: DiscoveryRom, *, peer_ip: str, peer_index: int = 0,
         "PEER_META_PORT": discovery_port(rom.domain, peer_index),
         "PEER_USER_PORT": user_port(rom.domain, peer_index),
         "READER": rom.entity_ids["reader"], "TIME": 0}
-    a = answer_params(rom)
     params = {k: f"{_BITS[k]}'h{v:x}" for k, v in own.items()}
-    params.update(verilog_parameters({**tx_parameters(rom), **top_parameters(rom)}))
-    params.update({
-        "PERIOD": str(round(ANNOUNCE_SECONDS * CLOCK_HZ)),
-        "ROM_FILE": f'"{ROM_FILE}"', "TABLE_FILE": f'"{TABLE_FILE}"',
-        "ROM_BYTES": str(len(rom.image())), "MESSAGES": str(len(rom.messages)),
-        "ANSWER_FILE": f'"{ANSWER_FILE}"', "ANSWER_TABLE_FILE": f'"{ANSWER_TABLE_FILE}"',
-        **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
-                                  "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
-                                  "COUNT_START", "BURST", "RATE")}})
+    params.update(node_parameters(rom, period=round(ANNOUNCE_SECONDS * CLOCK_HZ)))
+    params.update(verilog_parameters(top_parameters(rom)))
     return params
 
 
@@ -142,7 +133,8 @@ SEED ?= 1
 bitstream: {b}/{BIT_FILE}
 \t$(PYTHON) -m rosfpga_lab.rtl.board report {b}/report.json
 
-{b}/netlist.json: {b}/synth.ys $(wildcard {b}/*.v {b}/vendor/*.v {b}/node/*) $(wildcard *.hex)
+{b}/netlist.json: {b}/synth.ys $(wildcard {b}/*.v {b}/*.vh {b}/vendor/*.v {b}/node/*) \\
+    $(wildcard *.hex)
 \t$(YOSYS) -q -l {b}/yosys.log {b}/synth.ys
 
 {b}/{BOARD_TOP}.config: {b}/netlist.json {b}/{LPF_FILE}
@@ -212,7 +204,7 @@ def write_board(config: NodeConfig, rom: DiscoveryRom, out_dir: str | Path, *, p
     for sub in ("vendor", "node"):
         (board / sub).mkdir(parents=True, exist_ok=True)
     written = []
-    for name in (*BOARD_FILES, LPF_FILE):
+    for name in (*BOARD_FILES, *FABRIC_INCLUDES, LPF_FILE):
         shutil.copyfile(FABRIC_DIR / name, board / name)
         written.append(board / name)
     testbenches = {p.name for p in TB_DIR.glob("*.v")}
@@ -227,7 +219,8 @@ def write_board(config: NodeConfig, rom: DiscoveryRom, out_dir: str | Path, *, p
     # hierarchy without -check: the PLL (EHXPLLL) is synth_ecp5's cell, which checks it
     sets = "\n".join(f"chparam -set {k} {v} {BOARD_TOP}" for k, v in params.items())
     files = " ".join([*node, *(f"{BOARD_DIR}/{name}" for name in BOARD_FILES)])
-    script = (f"read_verilog -defer -D {DEFINE} -I{BOARD_DIR}/node {files}\n{sets}\n"
+    script = (f"read_verilog -defer -D {DEFINE} -I{BOARD_DIR}/node -I{BOARD_DIR} {files}\n"
+              f"{sets}\n"
               f"hierarchy -top {BOARD_TOP}\n"
               f"synth_ecp5 -top {BOARD_TOP} -json {BOARD_DIR}/netlist.json\n")
     texts = {board / "synth.ys": script,

@@ -456,3 +456,18 @@ def verilog_parameters(params: dict[str, int]) -> dict[str, str]:
     the entity ids sized hex (96 bits do not fit an integer), the others decimal."""
     return {k: f"{TX_PARAMETER_BITS[k]}'h{v:x}" if k in TX_PARAMETER_BITS else str(v)
             for k, v in params.items()}
+
+
+def node_parameters(rom: DiscoveryRom, *, period: int) -> dict[str, str]:
+    """``fabric/rfl_fabric_node.v``'s parameters (``rfl_fabric_node_params.vh``) as Verilog
+    literals for the participant ``rom`` was rendered for: the transmit path's
+    (:func:`tx_parameters`), the discovery ROM's and answer ROM's files (:func:`write_rom` writes
+    them) and sizes, SPDP every ``period`` clocks, the answers' slots (:func:`answer_params`).
+    ``rfl_fabric_top`` takes these and :func:`top_parameters`."""
+    if period < 1:
+        raise RtlError(f"SPDP period of {period} clocks: it must be at least 1")
+    return {**verilog_parameters(tx_parameters(rom)), "PERIOD": str(period),
+            "ROM_FILE": f'"{ROM_FILE}"', "TABLE_FILE": f'"{TABLE_FILE}"',
+            "ROM_BYTES": str(len(rom.image())), "MESSAGES": str(len(rom.messages)),
+            "ANSWER_FILE": f'"{ANSWER_FILE}"', "ANSWER_TABLE_FILE": f'"{ANSWER_TABLE_FILE}"',
+            **{k: str(v) for k, v in answer_params(rom).items()}}

@@ -43,6 +43,9 @@ FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "
                   "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_fabric_top.v",
                   "rfl_board_5a75b.v")
 ENV_INCLUDE = "fv_env.vh"
+#: The parameter lists the fabric's tops share (declared, passed on), included from FABRIC_DIR.
+FABRIC_INCLUDES = ("rfl_fabric_node_params.vh", "rfl_fabric_node_pass.vh",
+                   "rfl_fabric_top_params.vh", "rfl_fabric_top_pass.vh")
 #: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node aside:
 #: the project's; the proof's wrapper has its own).
 FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
@@ -340,6 +343,8 @@ def sby_text(proof: Proof, design_files: Sequence[Path], includes: Sequence[Path
               "", "[files]"]
     lines += [str(p) for p in design_files]
     lines += [str(wrapper), str(FORMAL_DIR / ENV_INCLUDE)]
+    if any(name in FABRIC_MODULES for name in proof.design):
+        lines += [str(FABRIC_DIR / name) for name in FABRIC_INCLUDES]
     lines += [str(p) for p in sorted(proof.home.glob("*.vh"))] if proof.home else []
     lines += [str(p) for p in includes]
     lines.append("")

@@ -3,7 +3,10 @@
 // (rtl/fabric/vendor/liteeth_udp_ecp5_rgmii.v: LiteEth's ECP5 RGMII PHY, DELAYG and DDR
 // registers, 2 ns delays in the FPGA; receive and send on the PHY's receive clock, crossing to
 // clk in LiteEth's FIFOs) and rfl_udp_port, whose received payloads go straight back to their
-// sender (ports swapped). Its only other pin is a LED: on while nothing was dropped.
+// sender (ports swapped). Its only other pin is the LED (active low): on while nothing was
+// dropped. Its pins are the board build's (bench_udp_timing.py derives them from
+// rtl/fabric/rfl_board_5a75b.lpf), clk on the oscillator's: timed at 125 MHz as if from the
+// PLL, which it leaves out. Reset: for 16 clocks after configuration (no reset pin).
 // The simulated top the tests drive is tests/rtl/udp_gmii_top.v (GMII, one clock).
 `default_nettype none
 
@@ -15,15 +18,19 @@ module udp_echo_rgmii #(
     parameter [31:0] MCAST = 32'hEF_FF_00_01   // 239.255.0.1
 ) (
     input  wire       clk,                      // the circuit's clock (125 MHz)
-    input  wire       rst_n,
     input  wire       rgmii_rx_clk,             // 125 MHz from the PHY
     input  wire       rgmii_rx_ctl,
     input  wire [3:0] rgmii_rxd,
     output wire       rgmii_tx_clk,
     output wire       rgmii_tx_ctl,
     output wire [3:0] rgmii_txd,
-    output wire       led
+    output wire       led_n
 );
+    reg [4:0] rst_count;                        // bit 4: out of reset
+    initial rst_count = 5'd0;
+    wire rst_n = rst_count[4];
+    always @(posedge clk) if (!rst_n) rst_count <= rst_count + 5'd1;
+
     wire [7:0] rx_data, tx_data, m_data;
     wire rx_valid, rx_ready, rx_last, rx_error, rx_last_be;
     wire tx_valid, tx_ready, tx_last;
@@ -66,7 +73,7 @@ module udp_echo_rgmii #(
         .cnt_rx_packets(c_rx), .cnt_rx_error(c_err), .cnt_rx_length(c_len),
         .cnt_rx_overflow(c_ovf), .cnt_tx_packets(c_tx), .cnt_tx_overflow(c_tovf));
 
-    assign led = ~|{c_err, c_len, c_ovf, c_tovf};
+    assign led_n = |{c_err, c_len, c_ovf, c_tovf};
     wire unused_ok = &{1'b0, rx_last_be, m_len, c_rx, c_tx};
 endmodule
 

@@ -1,5 +1,6 @@
 """cocotb testbench of the whole node in the fabric, ``rfl_fabric_node``
-(rosfpga_lab/rtl/fabric/rfl_fabric_node.v; run by tests/rtl/test_fabric_node.py, not by pytest).
+(rosfpga_lab/rtl/fabric/rfl_fabric_node.v; run by tests/support/fabrictools.py for
+tests/rtl/test_fabric_node.py and tests/rtl/test_fabric_rtps_loop.py, not by pytest).
 
 The case comes in a JSON file (``FABRIC_NODE_CASE``): the datagrams in (hex, kind: 1 user data,
 0 metatraffic), the receive side's configuration, ``cfg_time``, how many datagrams other than
@@ -101,8 +102,10 @@ async def fabric_node(dut) -> None:
     assert done_at is not None, f"{others} of {case['expect']} datagrams out (locked up)"
     counts = {name: int(getattr(dut, f"cnt_{name}").value)
               for name in ("samples", "answers", "no_credit")}
+    # the transmit path's own counters (inside the node: its cnt_datagrams, cnt_dropped)
+    tx = {name: int(getattr(dut, f"cnt_{name}").value) for name in ("datagrams", "dropped")}
     with open(os.environ["FABRIC_NODE_OUT"], "w") as f:
-        json.dump({"datagrams": out, "counts": counts, "clocks": clock,
+        json.dump({"datagrams": out, "counts": counts, "tx": tx, "clocks": clock,
                    "meta": [meta_in, meta_out]}, f)
     dut._log.info("%d bytes in, %d datagrams out, %d clocks, counters %s",
                   len(stream), len(out), clock, counts)

@@ -1,12 +1,15 @@
-"""cocotb testbench of the answer path, ``rfl_rtps_ctrl`` into ``rfl_rtps_disc_answer``
-(``tests/rtl/rtps_ctrl_top.v``; run by tests/rtl/test_fabric_answer.py, not by pytest).
+"""cocotb testbench of the answer path, ``rfl_rtps_ctrl`` into ``rfl_rtps_disc_answer``, inside
+``rfl_fabric_node`` (its metatraffic side; run by tests/rtl/test_fabric_answer.py through
+tests/support/fabrictools.py, not by pytest).
 
-The case comes in a JSON file (``RTPS_CTRL_CASE``): the datagrams (hex) with the idle clocks
-after each, this participant's prefix, per-mille output backpressure, the credit's BURST and
-RATE. One coroutine drives a byte a clock and collects the answers: every beat offered and not
-taken held unchanged, TDEST and the destination prefix constant over a datagram, and at every
-clock the bytes sent at most BURST + RATE x the bytes received. The answers and counters go to
-``RTPS_CTRL_OUT`` for the test to compare with the model's.
+The case comes in a JSON file (``FABRIC_NODE_CASE``): the datagrams (hex; all metatraffic, TUSER
+0) with the idle clocks after each, per-mille output backpressure, the credit's BURST and RATE.
+One coroutine drives a byte a clock and collects the answers: every beat offered and not taken
+held unchanged, TDEST and the destination prefix constant over a datagram, and at every clock
+the answer bytes sent at most BURST + RATE x the bytes received. The discovery ROM's SPDP
+announcements (TDEST 0; SEDP is never asked for, no user data comes in) are left out. The
+answers and counters (rfl_rtps_ctrl's inside the node) go to ``FABRIC_NODE_OUT`` for the test to
+compare with the model's.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ from cocotb.triggers import ReadOnly, RisingEdge
 
 @cocotb.test()
 async def rtps_ctrl_answers(dut) -> None:
-    with open(os.environ["RTPS_CTRL_CASE"]) as f:
+    with open(os.environ["FABRIC_NODE_CASE"]) as f:
         case = json.load(f)
     prng = random.Random(case["seed"])
     stream: list[tuple[int, int, int]] = []       # (byte, last, idle clocks after)
@@ -30,7 +33,11 @@ async def rtps_ctrl_answers(dut) -> None:
         raw = bytes.fromhex(dg)
         stream += [(x, int(i == len(raw) - 1), idle if i == len(raw) - 1 else 0)
                    for i, x in enumerate(raw)]
-    dut.cfg_prefix.value = int(case["local"], 16)
+    dut.cfg_reader.value = 0
+    dut.cfg_writer.value = 0
+    dut.cfg_time.value = 0
+    dut.send_sedp.value = 0
+    dut.s_axis_tuser.value = 0
     cocotb.start_soon(Clock(dut.clk, 8, unit="ns").start())
     dut.rst_n.value = 0
     dut.s_axis_tvalid.value = 0
@@ -66,7 +73,9 @@ async def rtps_ctrl_answers(dut) -> None:
             i += 1
         elif wait:
             wait -= 1
-        if valid and ready:
+        if valid and ready and beat[2] == 0:
+            pass                                # the ROM's SPDP announcement
+        elif valid and ready:
             sent += 1
             data, last, dest, prefix = beat
             if cur_dest is not None:
@@ -82,7 +91,8 @@ async def rtps_ctrl_answers(dut) -> None:
         await RisingEdge(dut.clk)
     assert not cur, "the run ended inside an answer"
     out = {"answers": answers, "received": received, "sent": sent,
+           "cnt_malformed": int(dut.cnt_ctrl_malformed.value),
            **{name: int(getattr(dut, name).value) for name in (
-               "cnt_requests", "cnt_busy", "cnt_malformed", "cnt_answers", "cnt_no_credit")}}
-    with open(os.environ["RTPS_CTRL_OUT"], "w") as f:
+               "cnt_requests", "cnt_busy", "cnt_answers", "cnt_no_credit")}}
+    with open(os.environ["FABRIC_NODE_OUT"], "w") as f:
         json.dump(out, f)

@@ -1,6 +1,7 @@
 """The fabric participant answers ACKNACK and HEARTBEAT (issue 31, item 2): ``rfl_rtps_ctrl``
-into ``rfl_rtps_disc_answer`` (``tests/rtl/rtps_ctrl_top.v``) under cocotb, datagrams built with
-the lab's RTPS encoders (``rtps.build``; big-endian ones by swapping their fields).
+into ``rfl_rtps_disc_answer``, the metatraffic side of ``rfl_fabric_node``, under cocotb
+(tests/rtl/bench_rfl_rtps_ctrl.py), datagrams built with the lab's RTPS encoders
+(``rtps.build``; big-endian ones by swapping their fields).
 
 What holds it:
 * each answer the circuit sends is the model's (``rtl.discanswer``: the lab's decoder and the
@@ -17,7 +18,6 @@ What holds it:
 
 from __future__ import annotations
 
-import json
 import select
 import struct
 import threading
@@ -28,8 +28,7 @@ import pytest
 
 from rosfpga_lab.rtl.discanswer import AnswerModel
 from rosfpga_lab.rtl.discrom import (
-    ANSWER_FILE, ANSWER_TABLE_FILE, DEST_META, DiscoveryRom, answer_params, fabric_participant, render_rom,
-    write_rom,
+    DEST_META, DiscoveryRom, answer_params, fabric_participant, render_rom,
 )
 from rosfpga_lab.config import load_config
 from rosfpga_lab.rtl.limits import ANSWER_BURST, ANSWER_RATE
@@ -38,16 +37,17 @@ from rosfpga_lab.rtps.entities import PUB_READER, PUB_WRITER, SUB_READER, SUB_WR
 from rosfpga_lab.rtps.message import AckNack, Data, Heartbeat, InfoDst, parse_message
 from rosfpga_lab.rtps.participant import Participant
 from tests.rtl.test_fabric_rtps_rx import _swap
-from tests.support.rtltools import TB_DIR, require_cocotb
+from tests.support.fabrictools import generate_project, run_fabric_node
+from tests.support.rtltools import TB_DIR
 
 pytestmark = pytest.mark.rtl
 
-FABRIC = Path(__file__).resolve().parents[2] / "rosfpga_lab" / "rtl" / "fabric"
 DATA_DIR = Path(__file__).resolve().parents[2] / "data"
 CONFIG = DATA_DIR / "fpga_samples_dilate_cdr.yaml"
 PEER, PEER2 = bytes.fromhex("010fcafe0000000100000001"), bytes.fromhex("0110beef0000000200000007")
 USER_READER = 0x00000504
 IDLE = 1500           # clocks after a datagram: its answers (at most ~800 bytes) go out
+PERIOD = 100_000_000  # one SPDP announcement (at reset) in a run
 
 
 @pytest.fixture(autouse=True)
@@ -66,33 +66,14 @@ def _dg(prefix: bytes, *subs: bytes, dst: bytes | None = None) -> bytes:
 def cosimulate(rom: DiscoveryRom, datagrams: list[tuple[bytes, int]], tmp_path: Path,
                bp: int = 300, seed: int = 1, **credit: int) -> dict:
     """The circuit's answers (dest, prefix, bytes) and counters for ``datagrams`` (each with the
-    idle clocks after it); ``credit``: BURST and RATE other than the lab's."""
-    sim = require_cocotb()
-    from cocotb_tools.runner import get_results, get_runner
-
-    write_rom(rom, tmp_path)
-    params = answer_params(rom)
-    params.update(ROM_FILE=f'"{ANSWER_FILE}"', TABLE_FILE=f'"{ANSWER_TABLE_FILE}"', **credit)
-    case = {"seed": seed, "bp": bp, "local": rom.guid_prefix.hex(), "burst": params["BURST"],
-            "rate": params["RATE"], "datagrams": [[d.hex(), idle] for d, idle in datagrams]}
-    (tmp_path / "case.json").write_text(json.dumps(case))
-    runner = get_runner(sim)
-    sources = [FABRIC / "rfl_rtps_ctrl.v", FABRIC / "rfl_rtps_disc_answer.v",
-               TB_DIR / "rtps_ctrl_top.v"]
-    runner.build(sources=sources, hdl_toplevel="rtps_ctrl_top", build_dir=tmp_path / "build",
-                 parameters=params, timescale=("1ns", "1ps"), log_file=tmp_path / "build.log")
-    try:
-        xml = runner.test(test_module="bench_rfl_rtps_ctrl", hdl_toplevel="rtps_ctrl_top",
-                          build_dir=tmp_path / "build", test_dir=tmp_path,
-                          extra_env={"RTPS_CTRL_CASE": str(tmp_path / "case.json"),
-                                     "RTPS_CTRL_OUT": str(tmp_path / "out.json")},
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-6000:]
-    return json.loads((tmp_path / "out.json").read_text())
+    idle clocks after it) as metatraffic into ``rfl_fabric_node`` (its discovery ROM's one SPDP
+    announcement left out); ``credit``: BURST and RATE other than the lab's."""
+    params = {**answer_params(rom), **credit}
+    case = {"seed": seed, "bp": bp, "burst": params["BURST"], "rate": params["RATE"],
+            "datagrams": [[d.hex(), idle] for d, idle in datagrams]}
+    gen = generate_project(CONFIG, tmp_path / "project")
+    return run_fabric_node(gen, rom, case, tmp_path, period=PERIOD, bench="bench_rfl_rtps_ctrl",
+                           **{k: str(v) for k, v in credit.items()})
 
 
 def _cases(rom: DiscoveryRom) -> list[tuple[str, bytes, list[str]]]:

@@ -19,9 +19,6 @@ at every clock (the bench asserts it).
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -29,21 +26,20 @@ import pytest
 from rosfpga_lab.config import load_config
 from rosfpga_lab.rtl.discanswer import AnswerModel
 from rosfpga_lab.rtl.discrom import (
-    ANSWER_FILE, ANSWER_TABLE_FILE, DEST_META, DEST_SPDP, DEST_USER, ROM_FILE, TABLE_FILE,
-    answer_params, fabric_participant, render_rom, tx_parameters, verilog_parameters, write_rom,
+    DEST_META, DEST_SPDP, DEST_USER, fabric_participant, render_rom, tx_parameters,
 )
 from rosfpga_lab.rtl.limits import ANSWER_BURST, ANSWER_RATE
-from rosfpga_lab.rtl.proofs import FABRIC_NODE
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import PUB_READER, PUB_WRITER
 from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
 from rosfpga_lab.rtps.message import parse_message
 from tests.rtl.test_fabric_answer import _names
-from tests.rtl.test_fabric_rtps_cdr import CONFIG, FABRIC, MAX_BYTES
+from tests.rtl.test_fabric_rtps_cdr import CONFIG, MAX_BYTES
 from tests.rtl.test_fabric_rtps_loop import TIME, published
 from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER
 from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
-from tests.support.rtltools import TB_DIR, require_cocotb
+from tests.support.fabrictools import generate_project, run_fabric_node
+from tests.support.rtltools import TB_DIR
 
 pytestmark = pytest.mark.rtl
 
@@ -56,18 +52,11 @@ MIN_CLOCKS = 4 * PERIOD
 @pytest.mark.parametrize("seed,gap,bp", [(3, 200, 300), (8, 0, 700)])
 def test_the_node_routes_answers_and_announces(seed: int, gap: int, bp: int, tmp_path: Path,
                                                monkeypatch: pytest.MonkeyPatch) -> None:
-    sim = require_cocotb()
     monkeypatch.syspath_prepend(str(TB_DIR))
-    from cocotb_tools.runner import get_results, get_runner
-
-    gen = tmp_path / "project"
-    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr
+    gen = generate_project(CONFIG, tmp_path / "project")
     config = load_config(CONFIG)
     # the receive side's datagrams are for LOCAL: the node's GUID prefix, the ROMs' (one owner)
     rom = render_rom(config, guid_prefix=LOCAL)
-    write_rom(rom, tmp_path)
     part, _node, wid, _rid = fabric_participant(config, guid_prefix=LOCAL)
     assert part.guid_prefix == rom.guid_prefix == LOCAL
     user, payloads = published(5)
@@ -89,34 +78,7 @@ def test_the_node_routes_answers_and_announces(seed: int, gap: int, bp: int, tmp
             "writer": WRITER, "time": TIME, "datagrams": datagrams,
             "expect": len(want_user) + len(answers), "min_clocks": MIN_CLOCKS,
             "burst": ANSWER_BURST, "rate": ANSWER_RATE}
-    (tmp_path / "case.json").write_text(json.dumps(case))
-    a = answer_params(rom)
-    params = dict(verilog_parameters(p), MAX_BYTES=str(MAX_BYTES), PERIOD=str(PERIOD),
-                  USER_DEST=str(DEST_USER), ROM_FILE=f'"{ROM_FILE}"',
-                  TABLE_FILE=f'"{TABLE_FILE}"', ROM_BYTES=str(len(rom.image())),
-                  MESSAGES=str(len(rom.messages)), ANSWER_FILE=f'"{ANSWER_FILE}"',
-                  ANSWER_TABLE_FILE=f'"{ANSWER_TABLE_FILE}"',
-                  **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
-                                            "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
-                                            "COUNT_START", "BURST", "RATE")})
-    rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
-    sources = [FABRIC / m for m in FABRIC_NODE] + rtl
-    runner = get_runner(sim)
-    runner.build(sources=sources, includes=[gen / "rtl"], hdl_toplevel="rfl_fabric_node",
-                 parameters=params, build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
-                 log_file=tmp_path / "build.log")
-    try:
-        xml = runner.test(test_module="bench_rfl_fabric_node", hdl_toplevel="rfl_fabric_node",
-                          build_dir=tmp_path / "build", test_dir=tmp_path,
-                          extra_env={"FABRIC_NODE_CASE": str(tmp_path / "case.json"),
-                                     "FABRIC_NODE_OUT": str(tmp_path / "out.json")},
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-4000:]
-    out = json.loads((tmp_path / "out.json").read_text())
+    out = run_fabric_node(gen, rom, case, tmp_path, period=PERIOD, max_bytes=MAX_BYTES)
     got = out["datagrams"]
     assert {g["dest"] for g in got} <= {DEST_SPDP, DEST_META, DEST_USER}
     sent = [bytes.fromhex(g["data"]) for g in got if g["dest"] == DEST_USER]

@@ -35,7 +35,7 @@ from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.msg.cdr import serialize_cdr
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtl.proofs import PROOFS, prove
-from tests.support.rtltools import TB_DIR, require_cocotb, require_formal
+from tests.support.rtltools import TB_DIR, require_cocotb, require_formal, run_bench
 from tests.hls.test_generic_project_cdr import statuses_of
 from tests.rtl.test_fabric_rtps_rx import LOCAL, OTHER_READER, READER, REMOTES, WRITER, reference
 
@@ -146,7 +146,7 @@ def test_rtps_datagrams_through_the_seam_publish_the_models_records(
         seed: int, gap: int, bp: int, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     sim = require_cocotb()
     monkeypatch.syspath_prepend(str(TB_DIR))        # the cocotb module, for the simulator
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
     gen = tmp_path / "project"
     proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
@@ -176,17 +176,9 @@ def test_rtps_datagrams_through_the_seam_publish_the_models_records(
     runner.build(sources=sources, includes=[gen / "rtl"], hdl_toplevel="rtps_cdr_top",
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
-    try:
-        xml = runner.test(test_module="bench_rfl_rtps_to_cdr", hdl_toplevel="rtps_cdr_top",
-                          build_dir=tmp_path / "build", test_dir=tmp_path,
-                          extra_env={"RTPS_CDR_CASE": str(tmp_path / "case.json"),
-                                                   "RTPS_CDR_OUT": str(tmp_path / "out.json")},
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-4000:]
+    run_bench(runner, "bench_rfl_rtps_to_cdr", "rtps_cdr_top", tmp_path / "build", tmp_path,
+              {"RTPS_CDR_CASE": str(tmp_path / "case.json"),
+               "RTPS_CDR_OUT": str(tmp_path / "out.json")})
 
 
 def test_a_seam_that_forwards_a_dropped_sample_fails_its_proof(tmp_path: Path) -> None:

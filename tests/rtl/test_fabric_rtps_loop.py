@@ -1,7 +1,8 @@
-"""The node in the fabric from RTPS to RTPS (issue #31): RTPS datagrams in, through
-``rfl_rtps_rx`` -> ``rfl_rtps_to_cdr`` -> the generated top of ``data/fpga_laserscan_min_cdr.yaml``
-(``rosfpga-lab generate``) -> ``rfl_rtps_tx``, RTPS datagrams out, under cocotb with random input
-gaps and output backpressure (tests/rtl/rtps_loop_top.v, tests/rtl/bench_rtps_loop_top.py).
+"""The node in the fabric from RTPS to RTPS (issue #31): RTPS user-data datagrams into
+``rfl_fabric_node``, through ``rfl_rtps_rx`` -> ``rfl_rtps_to_cdr`` -> the generated top of
+``data/fpga_laserscan_min_cdr.yaml`` (``rosfpga-lab generate``) -> ``rfl_rtps_tx``, RTPS datagrams
+out, under cocotb with random input gaps and output backpressure (tests/support/fabrictools.py,
+tests/rtl/bench_rfl_fabric_node.py; the metatraffic side: tests/rtl/test_fabric_node.py).
 
 The input is tests/rtl/test_fabric_rtps_cdr.py's case (sensor_msgs/LaserScan samples the lab's
 CDR writer serialized, in DATA and DATA_FRAGs, one with a fragment missing, one the subscriber
@@ -19,10 +20,7 @@ circuit's datagrams, in order; its ACKNACKs to the HEARTBEATs (an empty history)
 
 from __future__ import annotations
 
-import json
 import struct
-import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -32,22 +30,25 @@ from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.hls.vectors import model_output_cdr
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.rtl.discrom import (
-    fabric_participant, render_rom, tx_parameters, verilog_parameters,
+    DEST_SPDP, DEST_USER, DiscoveryRom, fabric_participant, render_rom, tx_parameters,
 )
+from rosfpga_lab.rtl.limits import ANSWER_BURST, ANSWER_RATE
 from rosfpga_lab.rtps.build import dds_topic
 from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
 from rosfpga_lab.rtps.message import AckNack, parse_message
 from rosfpga_lab.rtps.participant import Participant
 from rosfpga_lab.rtps.rosnode import RosNodeEntities
-from tests.rtl.test_fabric_rtps_cdr import CONFIG, FABRIC, MAX_BYTES, _record, case_of
+from tests.rtl.test_fabric_rtps_cdr import CONFIG, MAX_BYTES, _record, case_of
 from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER, reference
 from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
-from tests.support.rtltools import TB_DIR, require_cocotb
+from tests.support.fabrictools import generate_project, run_fabric_node
+from tests.support.rtltools import TB_DIR
 
 pytestmark = pytest.mark.rtl
 
 LISTENER = bytes.fromhex("010f0000000000000000abcd")   # the software subscriber's GUID prefix
 TIME = (1_700_000 << 32) | 0x8000_0000          # cfg_time: seconds below 2**21, exact as a float
+PERIOD = 1_000_000                              # one SPDP announcement (at reset) in the run
 
 
 def split_records(stream: bytes) -> list[bytes]:
@@ -75,15 +76,15 @@ def published(seed: int) -> tuple[list[bytes], list[bytes]]:
     return datagrams, split_records(out_records)
 
 
-def software_subscriber(config: NodeConfig, datagrams: list[bytes]) -> tuple[list, list]:
+def software_subscriber(config: NodeConfig, rom: DiscoveryRom,
+                        datagrams: list[bytes]) -> tuple[list, list]:
     """A software ROS 2 node subscribed to the configuration's output topic, told of the fabric
-    participant by its discovery ROM only, given ``datagrams``: the samples it takes and the
-    ACKNACKs it answers with."""
+    participant by its discovery ROM ``rom`` only, given ``datagrams``: the samples it takes and
+    the ACKNACKs it answers with."""
     sub = Participant(0, 5, "127.0.0.1", "listener", guid_prefix=LISTENER)
     node = RosNodeEntities(sub, "listener", "/")
     rid = node.add_subscriber(config.publisher.topic, config.publisher.type,
                               registry=config.registry())
-    rom = render_rom(config)
     for m in rom.messages:
         sub.receive(m.data, ("127.0.0.1", 7410), 0.0)
     assert sub.matched(rid), sub.notes
@@ -97,51 +98,32 @@ def software_subscriber(config: NodeConfig, datagrams: list[bytes]) -> tuple[lis
 @pytest.mark.parametrize("seed,gap,bp", [(5, 200, 300)])
 def test_rtps_in_rtps_out_is_the_models_output_as_the_builders_send_it(
         seed: int, gap: int, bp: int, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    sim = require_cocotb()
     monkeypatch.syspath_prepend(str(TB_DIR))
-    from cocotb_tools.runner import get_results, get_runner
-
-    gen = tmp_path / "project"
-    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr
+    gen = generate_project(CONFIG, tmp_path / "project")
     datagrams, payloads = published(seed)
     config = load_config(CONFIG)
-    part, _node, wid, _rid = fabric_participant(config)
-    p = tx_parameters(render_rom(config))
+    # the datagrams are for LOCAL: the node's GUID prefix, the ROMs' and the transmit path's
+    rom = render_rom(config, guid_prefix=LOCAL)
+    part, _node, wid, _rid = fabric_participant(config, guid_prefix=LOCAL)
+    p = tx_parameters(rom)
     assert p["FRAG_BYTES"] == FRAGMENT_BYTES and p["INFO_TS"] == 1
     want = expected(payloads, [TIME] * len(payloads), FRAGMENT_BYTES, True, MAX_BYTES,
                     part.guid_prefix, wid, p["READER_ID"])
     assert len(payloads) == 5 and all(len(d) == 2 for d in want)   # each sample fragments
-    case = {"seed": seed, "gap": gap, "bp": bp, "local": LOCAL.hex(), "reader": READER,
-            "writer": WRITER, "time": TIME, "datagrams": [d.hex() for d in datagrams],
-            "expect": sum(map(len, want))}
-    (tmp_path / "case.json").write_text(json.dumps(case))
-    rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
-    sources = [FABRIC / "rfl_rtps_rx.v", FABRIC / "rfl_rtps_to_cdr.v", FABRIC / "rfl_rtps_tx.v",
-               *rtl, TB_DIR / "rtps_loop_top.v"]
-    runner = get_runner(sim)
-    runner.build(sources=sources, includes=[gen / "rtl"], hdl_toplevel="rtps_loop_top",
-                 parameters=dict(verilog_parameters(p), MAX_BYTES=str(MAX_BYTES)),
-                 build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
-                 log_file=tmp_path / "build.log")
-    try:
-        xml = runner.test(test_module="bench_rtps_loop_top", hdl_toplevel="rtps_loop_top",
-                          build_dir=tmp_path / "build", test_dir=tmp_path,
-                          extra_env={"RTPS_LOOP_CASE": str(tmp_path / "case.json"),
-                                     "RTPS_LOOP_OUT": str(tmp_path / "out.json")},
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-4000:]
-    out = json.loads((tmp_path / "out.json").read_text())
-    got = [bytes.fromhex(d) for d in out["datagrams"]]
+    case = {"seed": seed, "gap": gap, "bp": bp, "reader": READER, "writer": WRITER,
+            "time": TIME, "datagrams": [(d.hex(), 1) for d in datagrams],
+            "expect": sum(map(len, want)), "min_clocks": 0, "burst": ANSWER_BURST,
+            "rate": ANSWER_RATE}
+    out = run_fabric_node(gen, rom, case, tmp_path, period=PERIOD, max_bytes=MAX_BYTES)
+    # user data only in: on the user-data destination the transmit path's datagrams, beside
+    # them the one SPDP announcement at reset (no answers)
+    assert [g["dest"] for g in out["datagrams"]].count(DEST_SPDP) == 1
+    got = [bytes.fromhex(g["data"]) for g in out["datagrams"] if g["dest"] == DEST_USER]
     check_parsed(got, payloads, MAX_BYTES, part.guid_prefix, wid, p["READER_ID"], True)
     assert got == [d for dgs in want for d in dgs]
-    assert out["counts"] == {"samples": 5, "datagrams": 10, "dropped": 0}
-    taken, acks = software_subscriber(config, got)
+    assert out["counts"] == {"samples": 5, "answers": 0, "no_credit": 0}
+    assert out["tx"] == {"datagrams": 10, "dropped": 0}
+    taken, acks = software_subscriber(config, rom, got)
     writer_guid = part.guid_prefix + wid.to_bytes(4, "big")
     assert [(s.writer_guid, s.seq, s.payload) for s in taken] == \
         [(writer_guid, n, pay) for n, pay in enumerate(payloads, 1)]

@@ -32,6 +32,7 @@ from rosfpga_lab.rtps.message import (
 )
 from rosfpga_lab.rtl.proofs import PROOFS, prove
 from tests.support.rtltools import (
+    run_bench,
     TB_DIR, require_cocotb, require_formal, require_iverilog, require_verilator, require_yosys,
 )
 
@@ -377,7 +378,7 @@ def test_the_reference_sees_samples_and_damage() -> None:
 # ---- the Verilog -----------------------------------------------------------------------------
 def cosimulate(tmp_path: Path, seed: int, samples: int, gap: int, bp: int) -> None:
     sim = require_cocotb()
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
     datagrams = random_datagrams(seed, samples)
     want, counts = reference(datagrams)
@@ -388,17 +389,9 @@ def cosimulate(tmp_path: Path, seed: int, samples: int, gap: int, bp: int) -> No
     runner = get_runner(sim)
     runner.build(sources=[SOURCE], hdl_toplevel="rfl_rtps_rx", build_dir=tmp_path / "build",
                  timescale=("1ns", "1ps"), log_file=tmp_path / "build.log")
-    try:
-        xml = runner.test(test_module="bench_rfl_rtps_rx", hdl_toplevel="rfl_rtps_rx",
-                          build_dir=tmp_path / "build", test_dir=tmp_path,
-                          extra_env={"RTPS_RX_CASE": str(tmp_path / "case.json"),
-                                     "RTPS_RX_OUT": str(tmp_path / "out.json")},
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-6000:]
+    run_bench(runner, "bench_rfl_rtps_rx", "rfl_rtps_rx", tmp_path / "build", tmp_path,
+              {"RTPS_RX_CASE": str(tmp_path / "case.json"),
+               "RTPS_RX_OUT": str(tmp_path / "out.json")})
 
 
 @pytest.mark.parametrize("seed,samples,gap,bp", [(1, 70, 200, 300), (2, 70, 0, 0)],

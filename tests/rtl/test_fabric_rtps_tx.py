@@ -40,6 +40,7 @@ from rosfpga_lab.rtps.discovery import FragmentAssembler
 from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
 from rosfpga_lab.rtps.message import Data, DataFrag, Heartbeat, InfoTs, parse_message
 from tests.support.rtltools import (
+    run_bench,
     TB_DIR, require_cocotb, require_formal, require_iverilog, require_verilator, require_yosys,
 )
 
@@ -118,7 +119,7 @@ def run(tmp_path: Path, seed: int, frag: int, info_ts: bool, max_sample: int, ga
         bp: int) -> tuple[list[bytes], dict, dict[str, int]]:
     """The records through the Verilog: (payloads, the bench's output, the parameters)."""
     sim = require_cocotb()
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
     p = params(frag, info_ts, max_sample)
     payloads = records(seed, frag, max_sample)
@@ -129,17 +130,9 @@ def run(tmp_path: Path, seed: int, frag: int, info_ts: bool, max_sample: int, ga
     runner.build(sources=[SOURCE], hdl_toplevel="rfl_rtps_tx", build_dir=tmp_path / "build",
                  parameters=verilog_parameters(p), timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
-    try:
-        xml = runner.test(test_module="bench_rfl_rtps_tx", hdl_toplevel="rfl_rtps_tx",
-                          build_dir=tmp_path / "build", test_dir=tmp_path,
-                          extra_env={"RTPS_TX_CASE": str(tmp_path / "case.json"),
-                                     "RTPS_TX_OUT": str(tmp_path / "out.json")},
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-6000:]
+    run_bench(runner, "bench_rfl_rtps_tx", "rfl_rtps_tx", tmp_path / "build", tmp_path,
+              {"RTPS_TX_CASE": str(tmp_path / "case.json"),
+               "RTPS_TX_OUT": str(tmp_path / "out.json")})
     return payloads, json.loads((tmp_path / "out.json").read_text()), p
 
 

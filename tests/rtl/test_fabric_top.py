@@ -38,10 +38,10 @@ from scapy.layers.l2 import ARP, Ether
 from rosfpga_lab.config import load_config
 from rosfpga_lab.rtl.discanswer import AnswerModel
 from rosfpga_lab.rtl.discrom import (
-    ANSWER_FILE, ANSWER_TABLE_FILE, ROM_FILE, TABLE_FILE, answer_params, fabric_participant,
-    render_rom, top_parameters, tx_parameters, verilog_parameters, write_rom,
+    fabric_participant, node_parameters, render_rom, top_parameters, tx_parameters,
+    verilog_parameters, write_rom,
 )
-from rosfpga_lab.rtl.proofs import FABRIC_NODE
+from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, FABRIC_NODE
 from rosfpga_lab.rtl.sim import cache_root, simulator_version
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
@@ -54,7 +54,7 @@ from tests.rtl.test_fabric_rtps_loop import TIME, published
 from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER
 from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
 from tests.rtl.test_fabric_udp import PEER_IP, PEER_MAC, _fcs, _frames, _group_mac
-from tests.support.rtltools import TB_DIR, cocotb_verilator
+from tests.support.rtltools import TB_DIR, cocotb_verilator, run_bench
 
 if TYPE_CHECKING:
     from cocotb_tools.runner import Runner
@@ -92,7 +92,8 @@ def _build(runner: Runner, gen: Path, params: dict[str, str], tmp_path: Path) ->
 
     rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
     digest = hashlib.sha256(f"{cocotb.__file__} {simulator_version('verilator')}".encode())
-    for path in [*SOURCES, *rtl, *sorted((gen / "rtl").glob("*.vh"))]:
+    included = [FABRIC_DIR / name for name in FABRIC_INCLUDES]
+    for path in [*SOURCES, *included, *rtl, *sorted((gen / "rtl").glob("*.vh"))]:
         digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     digest.update(json.dumps(params, sort_keys=True).encode())
     build = cache_root() / f"cocotb-fabric-top-{digest.hexdigest()[:20]}"
@@ -105,7 +106,7 @@ def _build(runner: Runner, gen: Path, params: dict[str, str], tmp_path: Path) ->
                 shutil.copy2(path, kept / path.name)
     rtl = sorted(kept.glob("*.v"))
     runner.build(
-        sources=[*SOURCES, *rtl], includes=[kept], hdl_toplevel="rfl_fabric_top",
+        sources=[*SOURCES, *rtl], includes=[kept, FABRIC_DIR], hdl_toplevel="rfl_fabric_top",
         parameters=params, build_dir=build, timescale=("1ns", "1ps"),
         build_args=["-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT"],
         log_file=tmp_path / "build.log")
@@ -117,7 +118,7 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
                                                           monkeypatch: pytest.MonkeyPatch) -> None:
     cocotb_verilator(monkeypatch)
     monkeypatch.syspath_prepend(str(TB_DIR))
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
     gen = tmp_path / "project"
     proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
@@ -155,27 +156,13 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
             "expect": 1 + len(want_user) + len(answers), "max_clocks": MAX_CLOCKS}
     (tmp_path / "case.json").write_text(json.dumps(case))
 
-    a = answer_params(rom)
-    params = dict(verilog_parameters({**p, **top_parameters(rom)}), MAX_BYTES=str(MAX_BYTES),
-                  PERIOD=str(PERIOD), ROM_FILE=f'"{ROM_FILE}"', TABLE_FILE=f'"{TABLE_FILE}"',
-                  ROM_BYTES=str(len(rom.image())), MESSAGES=str(len(rom.messages)),
-                  ANSWER_FILE=f'"{ANSWER_FILE}"', ANSWER_TABLE_FILE=f'"{ANSWER_TABLE_FILE}"',
-                  **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
-                                            "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
-                                            "COUNT_START", "BURST", "RATE")})
+    params = dict(node_parameters(rom, period=PERIOD), **verilog_parameters(top_parameters(rom)),
+                  MAX_BYTES=str(MAX_BYTES))
     runner = get_runner("verilator")
     build = _build(runner, gen, params, tmp_path)
-    try:
-        xml = runner.test(
-            test_module="bench_rfl_fabric_top", hdl_toplevel="rfl_fabric_top", build_dir=build,
-            test_dir=tmp_path, extra_env={"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
-                                          "FABRIC_TOP_OUT": str(tmp_path / "out.json")},
-            log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-4000:]
+    run_bench(runner, "bench_rfl_fabric_top", "rfl_fabric_top", build, tmp_path,
+              {"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
+               "FABRIC_TOP_OUT": str(tmp_path / "out.json")})
     out = json.loads((tmp_path / "out.json").read_text())
 
     sent = [Ether(f) for f in _frames(out["sent"])]

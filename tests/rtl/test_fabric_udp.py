@@ -34,7 +34,7 @@ from scapy.layers.l2 import ARP, Ether
 from rosfpga_lab.rtl.sim import cache_root, simulator_version
 from rosfpga_lab.rtps.entities import discovery_multicast_port, discovery_port, user_port
 from rosfpga_lab.rtps.limits import SPDP_MULTICAST_ADDRESS
-from tests.support.rtltools import TB_DIR, cocotb_verilator, require_verilator
+from tests.support.rtltools import TB_DIR, cocotb_verilator, require_verilator, run_bench
 
 pytestmark = pytest.mark.rtl
 
@@ -201,7 +201,7 @@ def cosimulate(tmp_path: Path, case: dict, monkeypatch: pytest.MonkeyPatch) -> d
     tests.support.rtltools.cocotb_verilator); the build is kept in the lab's RTL cache, keyed
     by the sources, so a second run only simulates."""
     cocotb_verilator(monkeypatch)
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
     (tmp_path / "case.json").write_text(json.dumps(case))
     # Verilator's dependency files name the sources' and cocotb's absolute paths: a build made
@@ -217,17 +217,9 @@ def cosimulate(tmp_path: Path, case: dict, monkeypatch: pytest.MonkeyPatch) -> d
                  timescale=("1ns", "1ps"), build_args=["-Wno-fatal", "-Wno-lint", "-Wno-style",
                                                        "-Wno-UNOPTFLAT"],
                  log_file=tmp_path / "build.log")
-    try:
-        xml = runner.test(test_module="bench_udp_gmii_top", hdl_toplevel="udp_gmii_top",
-                          build_dir=build, test_dir=tmp_path,
-                          extra_env={"UDP_CASE": str(tmp_path / "case.json"),
-                                     "UDP_OUT": str(tmp_path / "out.json")},
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-6000:]
+    run_bench(runner, "bench_udp_gmii_top", "udp_gmii_top", build, tmp_path,
+              {"UDP_CASE": str(tmp_path / "case.json"),
+               "UDP_OUT": str(tmp_path / "out.json")})
     return json.loads((tmp_path / "out.json").read_text())
 
 

@@ -286,42 +286,27 @@ def test_rtps_tx_is_clean_under_three_linters(name: str, info_ts: bool, frag: in
 # the whole node in the fabric (rtl/fabric/rfl_fabric_node.v) with every stage and the generated
 # top of a wire: cdr configuration inside, the ROMs and answer slots of that configuration
 def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None:
-    import sys
-
-    from rosfpga_lab.rtl.discrom import (
-        ANSWER_FILE, ANSWER_TABLE_FILE, DEST_USER, ROM_FILE, TABLE_FILE, answer_params,
-        render_rom, tx_parameters, verilog_parameters, write_rom,
-    )
-    from rosfpga_lab.rtl.sim import VERILOG_DIR
-    from rosfpga_lab.rtl.proofs import FABRIC_NODE
+    from rosfpga_lab.rtl.discrom import DEST_USER, node_parameters, render_rom, write_rom
+    from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_NODE
+    from tests.support.fabrictools import generate_project, generated_rtl
 
     config = DATA / "fpga_laserscan_min_cdr.yaml"
-    gen = tmp_path / "project"
-    done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(config), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
+    gen = generate_project(config, tmp_path / "project")
     rom = render_rom(config)
     write_rom(rom, tmp_path)
-    a = answer_params(rom)
-    params = dict(verilog_parameters(tx_parameters(rom)), PERIOD="1000",
-                  USER_DEST=str(DEST_USER), ROM_FILE=f'"{ROM_FILE}"',
-                  TABLE_FILE=f'"{TABLE_FILE}"', ROM_BYTES=str(len(rom.image())),
-                  MESSAGES=str(len(rom.messages)), ANSWER_FILE=f'"{ANSWER_FILE}"',
-                  ANSWER_TABLE_FILE=f'"{ANSWER_TABLE_FILE}"',
-                  **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
-                                            "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
-                                            "COUNT_START", "BURST", "RATE")})
-    fabric = Path(VERILOG_DIR).parent / "fabric"
+    params = dict(node_parameters(rom, period=1000), USER_DEST=str(DEST_USER))
     top = "rfl_fabric_node"
-    sources = [str(fabric / m) for m in FABRIC_NODE]
-    sources += sorted(str(q) for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
+    sources = [str(FABRIC_DIR / m) for m in FABRIC_NODE]
+    sources += map(str, generated_rtl(gen))
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "--top-module", top,
-                           f"-I{gen / 'rtl'}", *(f"-G{k}={v}" for k, v in params.items()),
-                           *sources], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+                           f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}",
+                           *(f"-G{k}={v}" for k, v in params.items()), *sources],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
     done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
-                           f"-I{gen / 'rtl'}", *(f"-P{top}.{k}={v}" for k, v in params.items()),
-                           *sources], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+                           f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}",
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), *sources],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     for name in ("rfl_fabric_node.v", "rfl_frame_arbiter.v"):     # (its stages: their own cases)
         assert name not in done.stdout + done.stderr, done.stdout + done.stderr
@@ -331,34 +316,23 @@ def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None
 # the whole node with the generated top inside; the vendored core's own warnings (generated
 # code) are not the lab's to fix (tests/rtl/test_fabric_udp.py says the same of the UDP stage)
 def test_fabric_top_is_clean_under_verilator(tmp_path: Path) -> None:
-    import sys
-
     from rosfpga_lab.rtl.discrom import (
-        ANSWER_FILE, ANSWER_TABLE_FILE, ROM_FILE, TABLE_FILE, answer_params, render_rom,
-        top_parameters, tx_parameters, verilog_parameters, write_rom,
+        node_parameters, render_rom, top_parameters, verilog_parameters, write_rom,
     )
+    from rosfpga_lab.rtl.proofs import FABRIC_DIR
     from tests.rtl.test_fabric_top import SOURCES
+    from tests.support.fabrictools import generate_project, generated_rtl
 
     config = DATA / "fpga_laserscan_min_cdr.yaml"
-    gen = tmp_path / "project"
-    done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(config), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr
+    gen = generate_project(config, tmp_path / "project")
     rom = render_rom(config)
     write_rom(rom, tmp_path)
-    a = answer_params(rom)
-    params = dict(verilog_parameters({**tx_parameters(rom), **top_parameters(rom)}),
-                  PERIOD="1000", ROM_FILE=f'"{ROM_FILE}"', TABLE_FILE=f'"{TABLE_FILE}"',
-                  ANSWER_FILE=f'"{ANSWER_FILE}"', ANSWER_TABLE_FILE=f'"{ANSWER_TABLE_FILE}"',
-                  ROM_BYTES=str(len(rom.image())),
-                  MESSAGES=str(len(rom.messages)),
-                  **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
-                                            "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
-                                            "COUNT_START", "BURST", "RATE")})
+    params = dict(node_parameters(rom, period=1000), **verilog_parameters(top_parameters(rom)))
     sources = [*map(str, SOURCES)]
-    sources += sorted(str(q) for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
+    sources += map(str, generated_rtl(gen))
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "-Wno-fatal",
                            "--top-module", "rfl_fabric_top", f"-I{gen / 'rtl'}",
+                           f"-I{FABRIC_DIR}",
                            *(f"-G{k}={v}" for k, v in params.items()), *sources],
                           cwd=tmp_path, capture_output=True, text=True, timeout=300)
     ours = [ln for ln in done.stderr.splitlines()
@@ -367,7 +341,8 @@ def test_fabric_top_is_clean_under_verilator(tmp_path: Path) -> None:
     # without the ports (rtl.discrom.top_parameters gives them) it refuses to elaborate
     bare = {k: v for k, v in params.items() if not k.endswith("_PORT")}
     done = subprocess.run([require_verilator(), "--lint-only", "--top-module", "rfl_fabric_top",
-                           f"-I{gen / 'rtl'}", *(f"-G{k}={v}" for k, v in bare.items()),
+                           f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}",
+                           *(f"-G{k}={v}" for k, v in bare.items()),
                            *sources], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     unset = "rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT and SPDP_GROUP"
     assert done.returncode != 0 and unset in done.stderr, done.stderr[-3000:]
@@ -402,7 +377,7 @@ def test_board_top_is_clean_under_verilator(tmp_path: Path) -> None:
                *sorted(map(str, board.glob("*.v"))), *cells]
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "-Wno-fatal",
                            "-DRFL_FABRIC_RGMII", "-DSYNTHESIS", "--top-module", "rfl_board_5a75b",
-                           f"-I{board / 'node'}", f"-I{ecp5}",
+                           f"-I{board / 'node'}", f"-I{board}", f"-I{ecp5}",
                            *(f"-G{k}={v}" for k, v in params.items()), *sources],
                           cwd=tmp_path, capture_output=True, text=True, timeout=300)
     ours = [ln for ln in done.stderr.splitlines()

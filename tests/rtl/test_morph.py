@@ -14,7 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from tests.support.rtltools import TB_DIR, VERILOG_DIR, require_cocotb, require_iverilog, tool
+from tests.support.rtltools import (
+    TB_DIR, VERILOG_DIR, require_cocotb, require_iverilog, run_bench, tool,
+)
 
 # (width, height, ksize, op, bytes, frames, gap per mille, backpressure per mille, junk beats)
 CASES = {
@@ -44,7 +46,7 @@ CASES.update(DAMAGED)
 @pytest.mark.parametrize("name", list(CASES))
 def test_morph_cocotb(name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     sim = require_cocotb()
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
     width, height, ksize, op, nbytes, frames, gap, bp, junk = CASES[name]
     case = {"width": width, "height": height, "ksize": ksize, "op": op, "bytes": nbytes,
@@ -58,15 +60,7 @@ def test_morph_cocotb(name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
                  log_file=tmp_path / "build.log")
     monkeypatch.syspath_prepend(str(TB_DIR))     # the runner passes sys.path to the simulator
     env = {"MORPH_CASE": json.dumps(case)}
-    try:
-        xml = runner.test(test_module="bench_rfl_morph", hdl_toplevel="rfl_morph",
-                          build_dir=tmp_path / "build", test_dir=tmp_path, extra_env=env,
-                          log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):      # cocotb's runner exits on a failed test
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-6000:]
+    run_bench(runner, "bench_rfl_morph", "rfl_morph", tmp_path / "build", tmp_path, env)
 
 
 @pytest.mark.parametrize("ksize,op,nbytes", [(1, 0, 4), (3, 1, 3), (15, 0, 1), (5, 2, 4)])

@@ -9,12 +9,16 @@ from __future__ import annotations
 import functools
 import importlib.util
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
 from tests.support.realros import skip_or_fail
 from rosfpga_lab.rtl.sim import VERILOG_DIR, cxx_compiler
 from rosfpga_lab.rtl.sim import find_tool as tool
+
+if TYPE_CHECKING:
+    from cocotb_tools.runner import Runner
 
 REQUIRE = "ROSFPGA_REQUIRE_RTL"
 TB_DIR = Path(__file__).resolve().parents[1] / "rtl"
@@ -112,3 +116,20 @@ def cocotb_verilator(monkeypatch: pytest.MonkeyPatch) -> None:
         monkeypatch.setenv("VERILATOR_ROOT", str(root))
         monkeypatch.setenv("MAKEFLAGS", "CFG_CXXFLAGS_PCH_I=-include")
     monkeypatch.setenv("PATH", os.pathsep.join([*path, os.environ.get("PATH", "")]))
+
+
+def run_bench(runner: Runner, bench: str, top: str, build_dir: Path, test_dir: Path,
+              env: dict[str, str]) -> None:
+    """Run the cocotb bench module ``bench`` on ``top`` (built in ``build_dir`` by ``runner``) in
+    ``test_dir`` with ``env``; fail with the end of its log (``test_dir/sim.log``) unless its one
+    test passed."""
+    from cocotb_tools.runner import get_results
+
+    try:
+        xml = runner.test(test_module=bench, hdl_toplevel=top, build_dir=build_dir,
+                          test_dir=test_dir, extra_env=env, log_file=test_dir / "sim.log")
+        total, failed = get_results(xml)
+    except (SystemExit, RuntimeError):      # cocotb's runner exits on a failed test
+        total, failed = 1, 1
+    log = (test_dir / "sim.log").read_text(errors="replace")
+    assert total == 1 and failed == 0, log[-6000:]

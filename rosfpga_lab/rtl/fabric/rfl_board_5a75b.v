@@ -20,35 +20,7 @@ module rfl_board_5a75b #(
     parameter [31:0] READER = 32'h0,            // our reader's entity id (cfg_reader)
     parameter [63:0] TIME = 64'h0,              // INFO_TS's time (RTPS Time_t)
     parameter SEDP_WAIT = 1024,                 // clocks from reset to the send_sedp pulse
-    parameter SPDP_PORT = 0,                    // the rest: rfl_fabric_top's
-    parameter META_PORT = 0,
-    parameter USER_PORT = 0,
-    parameter [31:0] SPDP_GROUP = 32'd0,
-    parameter MAX_BYTES = 2048,
-    parameter [95:0] GUID_PREFIX = 96'h010f_7266_6c46_4142_5249_4300,
-    parameter [31:0] WRITER_ID = 32'h00000203,
-    parameter [31:0] READER_ID = 32'd0,
-    parameter FRAG_BYTES = 1344,
-    parameter MAX_DATAGRAM = 1472,
-    parameter INFO_TS = 1,
-    parameter ROM_FILE = "",
-    parameter TABLE_FILE = "",
-    parameter ROM_BYTES = 1472,
-    parameter MESSAGES = 3,
-    parameter PERIOD = 125000000,
-    parameter SLOTS = 5,
-    parameter [32*SLOTS-1:0] SLOT_IDS = 0,
-    parameter [8*SLOTS-1:0] SLOT_MSGS = 0,
-    parameter [8*SLOTS-1:0] SLOT_LASTS = 0,
-    parameter ANSWER_FILE = "",
-    parameter ANSWER_TABLE_FILE = "",
-    parameter ANSWER_BYTES = 2048,
-    parameter ANSWERS = 9,
-    parameter DST_AT = 24,
-    parameter BASE_AT = 48,
-    parameter COUNT_START = 3,
-    parameter BURST = 4096,
-    parameter RATE = 4
+`include "rfl_fabric_top_params.vh"          // the rest: rfl_fabric_top's
 ) (
     input  wire       clk25,                    // the 25 MHz oscillator
     input  wire       rgmii_rx_clk,
@@ -115,15 +87,8 @@ module rfl_board_5a75b #(
                 cnt_rx_overflow, cnt_tx_packets, cnt_tx_overflow, cnt_rx_port;
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_fabric_top #(
-        .SPDP_PORT(SPDP_PORT), .META_PORT(META_PORT), .USER_PORT(USER_PORT),
-        .SPDP_GROUP(SPDP_GROUP), .MAX_BYTES(MAX_BYTES), .GUID_PREFIX(GUID_PREFIX),
-        .WRITER_ID(WRITER_ID), .READER_ID(READER_ID), .FRAG_BYTES(FRAG_BYTES),
-        .MAX_DATAGRAM(MAX_DATAGRAM), .INFO_TS(INFO_TS), .ROM_FILE(ROM_FILE),
-        .TABLE_FILE(TABLE_FILE), .ROM_BYTES(ROM_BYTES), .MESSAGES(MESSAGES), .PERIOD(PERIOD),
-        .SLOTS(SLOTS), .SLOT_IDS(SLOT_IDS), .SLOT_MSGS(SLOT_MSGS), .SLOT_LASTS(SLOT_LASTS),
-        .ANSWER_FILE(ANSWER_FILE), .ANSWER_TABLE_FILE(ANSWER_TABLE_FILE),
-        .ANSWER_BYTES(ANSWER_BYTES), .ANSWERS(ANSWERS), .DST_AT(DST_AT), .BASE_AT(BASE_AT),
-        .COUNT_START(COUNT_START), .BURST(BURST), .RATE(RATE)) u_top (
+`include "rfl_fabric_top_pass.vh"
+    ) u_top (
         .clk(clk), .rst_n(rst_n), .cfg_mac(MAC), .cfg_ip(IP), .cfg_peer_ip(PEER_IP),
         .cfg_peer_meta_port(PEER_META_PORT), .cfg_peer_user_port(PEER_USER_PORT),
         .cfg_reader(READER), .cfg_writer(32'd0), .cfg_time(TIME), .send_sedp(send_sedp),

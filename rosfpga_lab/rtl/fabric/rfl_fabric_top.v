@@ -22,39 +22,7 @@
 `default_nettype none
 
 module rfl_fabric_top #(
-    parameter SPDP_PORT = 0,                    // all four: rtl.discrom.top_parameters
-    parameter META_PORT = 0,
-    parameter USER_PORT = 0,
-    parameter [31:0] SPDP_GROUP = 32'd0,
-    parameter RX_BITS = 11,                     // rfl_udp_port's buffers and queues
-    parameter TX_BITS = 11,
-    parameter QUEUE_BITS = 2,
-    // rfl_fabric_node's (it says what they are)
-    parameter MAX_BYTES = 2048,
-    parameter [95:0] GUID_PREFIX = 96'h010f_7266_6c46_4142_5249_4300,
-    parameter [31:0] WRITER_ID = 32'h00000203,
-    parameter [31:0] READER_ID = 32'd0,
-    parameter FRAG_BYTES = 1344,
-    parameter MAX_DATAGRAM = 1472,
-    parameter INFO_TS = 1,
-    parameter ROM_FILE = "",
-    parameter TABLE_FILE = "",
-    parameter ROM_BYTES = 1472,
-    parameter MESSAGES = 3,
-    parameter PERIOD = 100000000,
-    parameter SLOTS = 5,
-    parameter [32*SLOTS-1:0] SLOT_IDS = 0,
-    parameter [8*SLOTS-1:0] SLOT_MSGS = 0,
-    parameter [8*SLOTS-1:0] SLOT_LASTS = 0,
-    parameter ANSWER_FILE = "",
-    parameter ANSWER_TABLE_FILE = "",
-    parameter ANSWER_BYTES = 2048,
-    parameter ANSWERS = 9,
-    parameter DST_AT = 24,
-    parameter BASE_AT = 48,
-    parameter COUNT_START = 3,
-    parameter BURST = 4096,
-    parameter RATE = 4
+`include "rfl_fabric_top_params.vh"
 ) (
 `ifdef RFL_FABRIC_RGMII
     input  wire         clk,                    // 125 MHz: LiteEth's sys clock and the node's
@@ -237,14 +205,9 @@ module rfl_fabric_top #(
     end
 
     rfl_fabric_node #(
-        .MAX_BYTES(MAX_BYTES), .GUID_PREFIX(GUID_PREFIX), .WRITER_ID(WRITER_ID),
-        .READER_ID(READER_ID), .FRAG_BYTES(FRAG_BYTES), .MAX_DATAGRAM(MAX_DATAGRAM),
-        .INFO_TS(INFO_TS), .ROM_FILE(ROM_FILE), .TABLE_FILE(TABLE_FILE), .ROM_BYTES(ROM_BYTES),
-        .MESSAGES(MESSAGES), .PERIOD(PERIOD), .SLOTS(SLOTS), .SLOT_IDS(SLOT_IDS),
-        .SLOT_MSGS(SLOT_MSGS), .SLOT_LASTS(SLOT_LASTS), .ANSWER_FILE(ANSWER_FILE),
-        .ANSWER_TABLE_FILE(ANSWER_TABLE_FILE), .ANSWER_BYTES(ANSWER_BYTES), .ANSWERS(ANSWERS),
-        .DST_AT(DST_AT), .BASE_AT(BASE_AT), .COUNT_START(COUNT_START), .BURST(BURST),
-        .RATE(RATE), .USER_DEST(2)) u_node (
+        .USER_DEST(2),
+`include "rfl_fabric_node_pass.vh"
+    ) u_node (
         .clk(clk), .rst_n(rst_n), .cfg_reader(cfg_reader),
         .cfg_writer(cfg_writer), .cfg_time(cfg_time), .send_sedp(send_sedp),
         .s_axis_tdata(p_rx_tdata), .s_axis_tvalid(p_rx_tvalid && keep),

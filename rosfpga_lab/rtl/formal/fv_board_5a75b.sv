@@ -35,39 +35,7 @@ endmodule
 
 // rfl_fabric_top as the board sees it: checks its inputs; cnt_rx_packets from the RGMII inputs.
 module rfl_fabric_top #(
-    parameter SPDP_PORT = 0,
-    parameter META_PORT = 0,
-    parameter USER_PORT = 0,
-    parameter [31:0] SPDP_GROUP = 32'd0,
-    parameter RX_BITS = 11,
-    parameter TX_BITS = 11,
-    parameter QUEUE_BITS = 2,
-
-    parameter MAX_BYTES = 2048,
-    parameter [95:0] GUID_PREFIX = 96'h010f_7266_6c46_4142_5249_4300,
-    parameter [31:0] WRITER_ID = 32'h00000203,
-    parameter [31:0] READER_ID = 32'd0,
-    parameter FRAG_BYTES = 1344,
-    parameter MAX_DATAGRAM = 1472,
-    parameter INFO_TS = 1,
-    parameter ROM_FILE = "",
-    parameter TABLE_FILE = "",
-    parameter ROM_BYTES = 1472,
-    parameter MESSAGES = 3,
-    parameter PERIOD = 100000000,
-    parameter SLOTS = 5,
-    parameter [32*SLOTS-1:0] SLOT_IDS = 0,
-    parameter [8*SLOTS-1:0] SLOT_MSGS = 0,
-    parameter [8*SLOTS-1:0] SLOT_LASTS = 0,
-    parameter ANSWER_FILE = "",
-    parameter ANSWER_TABLE_FILE = "",
-    parameter ANSWER_BYTES = 2048,
-    parameter ANSWERS = 9,
-    parameter DST_AT = 24,
-    parameter BASE_AT = 48,
-    parameter COUNT_START = 3,
-    parameter BURST = 4096,
-    parameter RATE = 4
+`include "rfl_fabric_top_params.vh"
 ) (
     input clk, input rst_n, input [47:0] cfg_mac, input [31:0] cfg_ip, input [31:0] cfg_peer_ip,
     input [15:0] cfg_peer_meta_port, input [15:0] cfg_peer_user_port, input [31:0] cfg_reader,

@@ -1,0 +1,10 @@
+// rfl_fabric_node_pass.vh -- rfl_fabric_node_params.vh's parameters passed on as they are:
+// included in an instance's #( ... ) list, last (no comma after it).
+        .MAX_BYTES(MAX_BYTES), .GUID_PREFIX(GUID_PREFIX), .WRITER_ID(WRITER_ID),
+        .READER_ID(READER_ID), .FRAG_BYTES(FRAG_BYTES), .MAX_DATAGRAM(MAX_DATAGRAM),
+        .INFO_TS(INFO_TS), .ROM_FILE(ROM_FILE), .TABLE_FILE(TABLE_FILE), .ROM_BYTES(ROM_BYTES),
+        .MESSAGES(MESSAGES), .PERIOD(PERIOD), .SLOTS(SLOTS), .SLOT_IDS(SLOT_IDS),
+        .SLOT_MSGS(SLOT_MSGS), .SLOT_LASTS(SLOT_LASTS), .ANSWER_FILE(ANSWER_FILE),
+        .ANSWER_TABLE_FILE(ANSWER_TABLE_FILE), .ANSWER_BYTES(ANSWER_BYTES), .ANSWERS(ANSWERS),
+        .DST_AT(DST_AT), .BASE_AT(BASE_AT), .COUNT_START(COUNT_START), .BURST(BURST),
+        .RATE(RATE)

@@ -1,0 +1,5 @@
+// rfl_fabric_top_pass.vh -- rfl_fabric_top_params.vh's parameters passed on as they are:
+// included in an instance's #( ... ) list, last.
+        .SPDP_PORT(SPDP_PORT), .META_PORT(META_PORT), .USER_PORT(USER_PORT),
+        .SPDP_GROUP(SPDP_GROUP), .RX_BITS(RX_BITS), .TX_BITS(TX_BITS), .QUEUE_BITS(QUEUE_BITS),
+`include "rfl_fabric_node_pass.vh"
