@@ -40,6 +40,7 @@ from rosfpga_lab.rtl.discrom import (
 )
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.errors import SimulatorMissingError
+from rosfpga_lab.rtl.vcd import Waveform
 from rosfpga_lab.rtl.tools import TB_DIR, _verilator, simulator_missing_reason
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import discovery_port, user_port
@@ -283,3 +284,37 @@ def shipped_dump() -> Path | None:
         if path.is_file():
             return path
     return None
+
+
+#: The byte streams of the dump, in the order a sample crosses them: (name in the dump, what it
+#: carries). LiteEth's ports are named ``_data``/``_valid``/``_ready``, the lab's ``_t*``.
+STAGES = (
+    ("le_rx", "LiteEth's UDP payload out (a datagram as the frame's bytes arrive)"),
+    ("p_rx", "rfl_udp_port: a whole datagram, once its FCS was good"),
+    ("rx", "rfl_rtps_rx: the sample's bytes, the RTPS around them taken off"),
+    ("rec", "rfl_rtps_to_cdr: the sample's length, then the sample, into the CDR subscriber"),
+    ("pub", "the CDR publisher's output: the sample's length, then the new sample"),
+    ("tx", "rfl_rtps_tx: the RTPS datagram around the new sample"),
+    ("le_tx", "into LiteEth: the datagram it sends as Ethernet/IPv4/UDP"),
+)
+
+
+def _part(wave: Waveform, stage: str, part: str) -> np.ndarray:
+    lab = stage not in ("le_rx", "le_tx")
+    return wave.values(f"{stage}_{'t' if lab else ''}{part}")
+
+
+def stream_bytes(wave: Waveform, stage: str) -> tuple[np.ndarray, bytes]:
+    """The clocks at which ``stage`` (a name of :data:`STAGES`) moved a byte (valid and ready
+    both 1) and those bytes, in order."""
+    fire = _part(wave, stage, "valid").astype(bool) & _part(wave, stage, "ready").astype(bool)
+    return np.flatnonzero(fire), _part(wave, stage, "data")[fire].astype(np.uint8).tobytes()
+
+
+def gmii_frames(wave: Waveform, side: str) -> list[tuple[int, bytes]]:
+    """The frames on the GMII ``"rx"`` (into the node) or ``"tx"`` side: each its first clock
+    and its bytes (preamble, SFD and FCS included)."""
+    enable = wave.values("rx_dv" if side == "rx" else "tx_en").astype(np.int8)
+    data = wave.values("rxd" if side == "rx" else "txd").astype(np.uint8)
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], enable, [0]))))
+    return [(int(a), data[a:z].tobytes()) for a, z in zip(edges[::2], edges[1::2])]
