@@ -318,3 +318,38 @@ def gmii_frames(wave: Waveform, side: str) -> list[tuple[int, bytes]]:
     data = wave.values("rxd" if side == "rx" else "txd").astype(np.uint8)
     edges = np.flatnonzero(np.diff(np.concatenate(([0], enable, [0]))))
     return [(int(a), data[a:z].tobytes()) for a, z in zip(edges[::2], edges[1::2])]
+
+
+def frame_layers(frame: bytes) -> list[tuple[str, int, int, str]]:
+    """A GMII frame carrying IPv4/UDP (preamble first, FCS last) cut into its layers: each
+    ``(layer, first byte, end, what its fields say)``; the RTPS message is one layer here
+    (``rtps.parse_message`` reads it); padding up to Ethernet's minimum only when there is some.
+
+    Raises:
+        RtlError: not preamble + Ethernet II + IPv4 + UDP.
+    """
+    p = len(PREAMBLE)
+    if frame[:p] != PREAMBLE or frame[p + 12:p + 14] != b"\x08\x00" or frame[p + 23] != 17:
+        raise RtlError("not a GMII frame of IPv4/UDP (preamble, Ethernet II, IPv4, UDP)")
+    e, ihl = p + 14, 4 * (frame[p + 14] & 0x0F)
+    u = e + ihl
+    total, ident, ttl, _proto, csum = struct.unpack(">2xHH2xBBH", frame[e:e + 12])
+    sport, dport, ulen, ucsum = struct.unpack(">HHHH", frame[u:u + 8])
+
+    def mac(b: bytes) -> str:
+        return ":".join(f"{x:02x}" for x in b)
+
+    layers = [
+        ("preamble+SFD", 0, p, "7 x 0x55, then 0xd5: the receiver locks on, the frame starts"),
+        ("Ethernet", p, e, f"to {mac(frame[p:p + 6])} from {mac(frame[p + 6:p + 12])}, "
+                           "EtherType 0x0800 (IPv4)"),
+        ("IPv4", e, u, f"{ipaddress.IPv4Address(frame[e + 12:e + 16])} -> "
+                       f"{ipaddress.IPv4Address(frame[e + 16:e + 20])}, {total} bytes, id {ident}, "
+                       f"TTL {ttl}, protocol 17 (UDP), checksum 0x{csum:04x}"),
+        ("UDP", u, u + 8, f"port {sport} -> {dport}, {ulen} bytes, checksum 0x{ucsum:04x}"
+                          f"{' (none)' if ucsum == 0 else ''}"),
+        ("RTPS", u + 8, u + ulen, f"{ulen - 8} bytes: header and submessages"),
+        ("padding", u + ulen, len(frame) - 4, "up to Ethernet's 60-byte minimum"),
+        ("FCS", len(frame) - 4, len(frame), f"CRC-32 0x{int.from_bytes(frame[-4:], 'little'):08x}"),
+    ]
+    return [layer for layer in layers if layer[2] > layer[1]]     # no padding: none listed

@@ -23,7 +23,7 @@ SOLUTIONS = NOTEBOOKS / "solutions"
 EXPECTED = ["00_overview", "01_xmlrpc_handshake", "02_tcpros", "03_message_conversion",
             "04_fifo_to_axi_stream", "05_application", "06_design_flow", "07_workshop_demo",
             "08_rtl", "09_ros2_wire", "10_your_own_message",
-            "11_ros2_live"]
+            "11_ros2_live", "12_fabric_sample"]
 
 
 def notebook_paths(folder: Path) -> list[Path]:
