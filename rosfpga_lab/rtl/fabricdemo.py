@@ -40,6 +40,7 @@ from rosfpga_lab.rtl.discrom import (
 )
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.errors import SimulatorMissingError
+from rosfpga_lab.rtl.limits import FABRIC_DEMO_MAX_CLOCKS
 from rosfpga_lab.rtl.vcd import Waveform
 from rosfpga_lab.rtl.tools import TB_DIR, _verilator, simulator_missing_reason
 from rosfpga_lab.rtps import build as b
@@ -76,7 +77,6 @@ MIN_FRAME = 60                              # Ethernet's minimum, FCS not counte
 #: Idle clocks between the frames the peer sends, and after the last frame out.
 GAP, HOLD = 40, 60
 PERIOD = 1_000_000                          # one SPDP announcement (at reset) in the run
-MAX_CLOCKS = 40_000
 #: One compilation unit: the PyPI wheel's split build fails on its precompiled headers
 #: (:data:`rosfpga_lab.hls.rtlbuild.HARNESS_MAKEFLAGS` says how).
 MAKEFLAGS = "OPT_FAST=-O1 OPT_GLOBAL=-O1 VM_PARALLEL_BUILDS=0"
@@ -246,7 +246,7 @@ def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
                    "RFL_DEMO_TIME": f"64'h{TIME:016x}",
                    "RFL_DEMO_BYTES": str(sum(map(len, frames))), "RFL_DEMO_FRAMES": str(len(frames)),
                    "RFL_DEMO_GAP": str(GAP), "RFL_DEMO_HOLD": str(HOLD),
-                   "RFL_DEMO_EXPECT": str(expect), "RFL_DEMO_MAX_CLOCKS": str(MAX_CLOCKS),
+                   "RFL_DEMO_EXPECT": str(expect), "RFL_DEMO_MAX_CLOCKS": str(FABRIC_DEMO_MAX_CLOCKS),
                    "RFL_DEMO_VCD": f'"{vcd}"'}
         (where / "rfl_fabric_demo_params.vh").write_text(
             "".join(f"`define {k} {v}\n" for k, v in defines.items()))

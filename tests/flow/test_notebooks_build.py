@@ -163,7 +163,7 @@ def test_build_without_sources_says_where_it_looked(tmp_path: Path, capsys):
 def test_the_real_sources_build_into_an_empty_directory(tmp_path: Path):
     shutil.copytree(SOLUTIONS, tmp_path / "solutions")
     items = nbbuild.build(tmp_path / "solutions", tmp_path)
-    assert [i.exercises for i in items] == [0, 3, 3, 3, 3, 2, 2, 0, 3, 2, 3, 3]
+    assert [i.exercises for i in items] == [0, 3, 3, 3, 3, 2, 2, 0, 3, 2, 3, 3, 2]
     for item in items:
         assert item.target.read_text(encoding="utf-8") == (NOTEBOOKS / item.target.name).read_text(encoding="utf-8")
 
