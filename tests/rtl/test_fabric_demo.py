@@ -99,3 +99,16 @@ def test_the_shipped_dump_is_what_the_rtl_makes_today(tmp_path: Path) -> None:
     for name in old.signals:
         assert np.array_equal(old.values(name), new.values(name)), (
             f"{name} differs from the RTL's: run python data/make_fabric_dump.py and review")
+
+
+def test_the_rx_state_names_are_rfl_rtps_rx_s() -> None:
+    """``fabricdemo.RX_STATES`` (the notebook names ``rx_state`` with it) is the Verilog's
+    numbering."""
+    import re
+
+    from rosfpga_lab.rtl.fabricdemo import RX_STATES
+
+    text = (Path(__file__).resolve().parents[2] / "rosfpga_lab" / "rtl" / "fabric" /
+            "rfl_rtps_rx.v").read_text()
+    numbered = {int(n): name for name, n in re.findall(r"(S_[A-Z0-9]+) = 4'd(\d+)", text)}
+    assert [numbered[k] for k in range(len(numbered))] == list(RX_STATES)
