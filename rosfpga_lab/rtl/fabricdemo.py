@@ -24,7 +24,6 @@ node's ARP request) and runs it. Every parameter comes from the owners the cocot
 from __future__ import annotations
 
 import ipaddress
-import os
 import struct
 import subprocess
 import tempfile
@@ -40,7 +39,7 @@ from rosfpga_lab.rtl.discrom import (
 )
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.errors import SimulatorMissingError
-from rosfpga_lab.rtl.limits import FABRIC_DEMO_MAX_CLOCKS
+from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, FABRIC_DEMO_MAX_CLOCKS, RUN_TIMEOUT
 from rosfpga_lab.rtl.vcd import Waveform
 from rosfpga_lab.rtl.tools import TB_DIR, _verilator, simulator_missing_reason
 from rosfpga_lab.rtps import build as b
@@ -224,8 +223,7 @@ def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
     vcd = Path(vcd).resolve()
     fabric = Path(__file__).resolve().parent / "fabric"
     with tempfile.TemporaryDirectory(prefix="rfl-fabric-demo-") as tmp:
-        where = Path(os.environ.get("RFL_DEMO_KEEP", tmp))
-        where.mkdir(exist_ok=True)
+        where = Path(tmp)
         for name, data in node_sources(config).items():
             if name != "rfl_tb.v":
                 (where / name).write_bytes(data)
@@ -261,11 +259,11 @@ def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
                "--trace-depth", "1", "-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT",
                f"-I{where}", "--top-module", "tb", "-Mdir", str(where / "obj_dir"), "-o",
                "rfl_sim", "-MAKEFLAGS", MAKEFLAGS, *map(str, sources)]
-        done = subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=900)
+        done = subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
         if done.returncode:
             raise RtlError(f"Verilator failed:\n{done.stdout[-1500:]}{done.stderr[-3000:]}")
         done = subprocess.run([str(where / "obj_dir" / "rfl_sim")], cwd=where,
-                              capture_output=True, text=True, timeout=300)
+                              capture_output=True, text=True, timeout=RUN_TIMEOUT)
         if done.returncode or "RFL_DEMO_DONE" not in done.stdout:
             raise RtlError(f"the fabric demo did not finish:\n{done.stdout[-2000:]}"
                            f"{done.stderr[-2000:]}")

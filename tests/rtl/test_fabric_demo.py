@@ -11,6 +11,7 @@ import struct
 from pathlib import Path
 
 import numpy as np
+import pytest
 from scapy.layers.inet import IP, UDP
 from scapy.layers.l2 import ARP, Ether
 
@@ -90,7 +91,10 @@ def test_the_shipped_dump_carries_the_sample_through_every_stage() -> None:
     assert wave.values("status")[decided].tolist() == [0]          # SUB_OK, once
 
 
+@pytest.mark.rtl
+@pytest.mark.timeout(900)
 def test_the_shipped_dump_is_what_the_rtl_makes_today(tmp_path: Path) -> None:
+    """Verilator's build of the top (LiteEth included) some 40 s here, the run a second."""
     require_rtl(DUMP_SIMULATOR)
     fresh = run_fabric_demo(tmp_path / "fabric_demo.vcd")
     old, new = read_vcd(shipped_dump(), clock="clk"), read_vcd(fresh, clock="clk")
