@@ -66,5 +66,5 @@ def check_handoff_clock(answer: Any, wave: Waveform) -> CheckResult:
                       "pass it on yet",
              start: "that is the frame's first byte on the GMII side (rx_dv)",
              end: "that is the frame's last byte on the GMII side; look at p_rx_tvalid"}
-    raise fail(ex, f"handoff_clock {answer}, expected another clock: "
-                   f"{hints.get(answer, 'find the first clock with p_rx_tvalid and p_rx_tready both 1')}")
+    hint = hints.get(answer, "find the first clock with p_rx_tvalid and p_rx_tready both 1")
+    raise fail(ex, f"handoff_clock {answer}, expected another clock: {hint}")

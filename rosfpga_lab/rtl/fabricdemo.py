@@ -7,8 +7,9 @@ regenerates it share: the circuit (:data:`DEMO_YAML`, the 90-beam variant of
 ``data/fpga_laserscan_min_cdr.yaml``: a small sample keeps the dump small), the addresses, the
 sample (:func:`demo_sample`), how the peer sends it (:func:`demo_datagrams`: two DATA_FRAG
 datagrams of :data:`FRAGMENT` bytes each, in Ethernet/IPv4/UDP frames, :func:`demo_frames`), the
-signals kept in the dump (:data:`DUMP_SIGNALS`) and the simulator. Nothing here runs at
-notebook time: the notebook reads the shipped dump, made by Verilator (Icarus Verilog loops at
+signals kept in the dump (:data:`DUMP_SIGNALS`) and the simulator. No simulation runs at
+notebook time: the notebook reads the shipped dump (with :func:`stream_bytes`,
+:func:`gmii_frames` and :func:`frame_layers`), made by Verilator (Icarus Verilog loops at
 time 0 in LiteX's generated Verilog)::
 
     python data/make_fabric_dump.py          # rewrites data/fabric_demo.vcd (needs Verilator, g++)
@@ -242,9 +243,11 @@ def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
                    "RFL_DEMO_READER": f"32'h{_ids(config)[1]:08x}",
                    "RFL_DEMO_WRITER": f"32'h{PEER_WRITER:08x}",
                    "RFL_DEMO_TIME": f"64'h{TIME:016x}",
-                   "RFL_DEMO_BYTES": str(sum(map(len, frames))), "RFL_DEMO_FRAMES": str(len(frames)),
+                   "RFL_DEMO_BYTES": str(sum(map(len, frames))),
+                   "RFL_DEMO_FRAMES": str(len(frames)),
                    "RFL_DEMO_GAP": str(GAP), "RFL_DEMO_HOLD": str(HOLD),
-                   "RFL_DEMO_EXPECT": str(expect), "RFL_DEMO_MAX_CLOCKS": str(FABRIC_DEMO_MAX_CLOCKS),
+                   "RFL_DEMO_EXPECT": str(expect),
+                   "RFL_DEMO_MAX_CLOCKS": str(FABRIC_DEMO_MAX_CLOCKS),
                    "RFL_DEMO_VCD": f'"{vcd}"'}
         (where / "rfl_fabric_demo_params.vh").write_text(
             "".join(f"`define {k} {v}\n" for k, v in defines.items()))
@@ -259,7 +262,8 @@ def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
                "--trace-depth", "1", "-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT",
                f"-I{where}", "--top-module", "tb", "-Mdir", str(where / "obj_dir"), "-o",
                "rfl_sim", "-MAKEFLAGS", MAKEFLAGS, *map(str, sources)]
-        done = subprocess.run(cmd, cwd=where, capture_output=True, text=True, timeout=BUILD_TIMEOUT)
+        done = subprocess.run(cmd, cwd=where, capture_output=True, text=True,
+                              timeout=BUILD_TIMEOUT)
         if done.returncode:
             raise RtlError(f"Verilator failed:\n{done.stdout[-1500:]}{done.stderr[-3000:]}")
         done = subprocess.run([str(where / "obj_dir" / "rfl_sim")], cwd=where,
