@@ -23,6 +23,7 @@ notebook  checks
 9         :func:`check_cdr_data_offset`, :func:`check_fragment_count`
 10        :func:`check_stream_offset`, :func:`check_frame_clocks`, :func:`check_refused_field`
 11        :func:`check_discovery_port`, :func:`check_pixel_offsets`, :func:`check_qos_mismatch`
+12        :func:`check_rtps_offset`, :func:`check_handoff_clock`
 ========  ======================================================================
 
 :mod:`rosfpga_lab.checks.nbbuild` makes the student notebooks from the instructor notebooks
@@ -33,6 +34,7 @@ from rosfpga_lab.checks._core import (
     ByteField, CheckResult, ExerciseError, describe_byte_difference, field_at,
 )
 from rosfpga_lab.checks.application import check_dilate, check_frame_timing
+from rosfpga_lab.checks.fabric import check_handoff_clock, check_rtps_offset
 from rosfpga_lab.checks.flow import EROSION_NODE, check_node_config, check_sloc
 from rosfpga_lab.checks.handshake import (
     SUBSCRIBER_FIRST_CALLS, check_call_order, check_http_body, check_talker_contact,
@@ -59,4 +61,5 @@ __all__ = [
     "frame_fields", "header_fields", "message_fields",
     "check_frame_clocks", "check_refused_field", "check_stream_offset",
     "check_discovery_port", "check_pixel_offsets", "check_qos_mismatch",
+    "check_handoff_clock", "check_rtps_offset",
 ]

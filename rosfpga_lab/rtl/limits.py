@@ -69,3 +69,7 @@ ANSWER_RATE = 4
 #: slots it compares in parallel.
 MAX_ANSWER_SEQ = 8
 MAX_ANSWER_SLOTS = 8
+
+#: Clocks the fabric demo (notebook 12's run, ``rtl.fabricdemo``) waits for its frames out
+#: after the peer's last frame in, before it gives up.
+FABRIC_DEMO_MAX_CLOCKS = 40_000

@@ -23,7 +23,7 @@ SOLUTIONS = NOTEBOOKS / "solutions"
 EXPECTED = ["00_overview", "01_xmlrpc_handshake", "02_tcpros", "03_message_conversion",
             "04_fifo_to_axi_stream", "05_application", "06_design_flow", "07_workshop_demo",
             "08_rtl", "09_ros2_wire", "10_your_own_message",
-            "11_ros2_live"]
+            "11_ros2_live", "12_fabric_sample"]
 
 
 def notebook_paths(folder: Path) -> list[Path]:
@@ -163,7 +163,7 @@ def test_build_without_sources_says_where_it_looked(tmp_path: Path, capsys):
 def test_the_real_sources_build_into_an_empty_directory(tmp_path: Path):
     shutil.copytree(SOLUTIONS, tmp_path / "solutions")
     items = nbbuild.build(tmp_path / "solutions", tmp_path)
-    assert [i.exercises for i in items] == [0, 3, 3, 3, 3, 2, 2, 0, 3, 2, 3, 3]
+    assert [i.exercises for i in items] == [0, 3, 3, 3, 3, 2, 2, 0, 3, 2, 3, 3, 2]
     for item in items:
         assert item.target.read_text(encoding="utf-8") == (NOTEBOOKS / item.target.name).read_text(encoding="utf-8")
 

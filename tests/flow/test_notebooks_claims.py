@@ -196,3 +196,18 @@ def test_the_shipped_timing_report_meets_the_clock_and_notebook_08_says_how_to_m
     assert all(words[n] in " ".join(text08.split()) for n in blocks if n in words), blocks
     assert "Most of\nits delay is routing" in text08
     assert "valid/ready handshake" in text08
+
+
+def test_the_fabric_notebook_says_what_ran_and_how_big_its_dump_is() -> None:
+    """Notebook 12's opening: simulated, no board, the dump's script and test named, its size
+    and the datagrams as the shipped files have them."""
+    from rosfpga_lab.rtl.fabricdemo import DUMP_NAME, demo_datagrams
+
+    text = markdown("12_fabric_sample.ipynb")
+    assert "No board" in text and "Verilator simulated" in text
+    assert f"data/{DUMP_NAME}" in text and "data/make_fabric_dump.py" in text
+    assert "tests/rtl/test_fabric_demo.py" in text
+    said = re.search(r"about (\d+) KB", text)
+    size = (ROOT / "data" / DUMP_NAME).stat().st_size / 1000
+    assert said and abs(int(said[1]) - size) <= 0.1 * size, (said, size)
+    assert len(demo_datagrams()) == 2 and "**two DATA_FRAG datagrams**" in text

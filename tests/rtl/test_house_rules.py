@@ -101,7 +101,7 @@ def test_default_nettype_none_and_restored(path: Path) -> None:
 @pytest.mark.parametrize("path", MODULE_FILES, ids=[p.name for p in MODULE_FILES])
 def test_stream_ports_follow_the_names(path: Path) -> None:
     found = ports(path)
-    assert found or path.name in ("rfl_tb.v", "rfl_elem_tb.v"), \
+    assert found or path.name in ("rfl_tb.v", "rfl_elem_tb.v", "rfl_fabric_demo_tb.v"), \
         f"no port list parsed in {path.name}"
     assert stream_problems(found) == []
 
