@@ -35,12 +35,12 @@ import numpy as np
 
 from rosfpga_lab.config import NodeConfig, parse_config
 from rosfpga_lab.rtl.discrom import (
-    ANSWER_FILE, ANSWER_TABLE_FILE, ROM_FILE, TABLE_FILE, answer_params, fabric_participant,
-    render_rom, top_parameters, tx_parameters, verilog_parameters, write_rom,
+    fabric_participant, node_parameters, render_rom, top_parameters, verilog_parameters,
+    write_rom,
 )
-from rosfpga_lab.rtl.errors import RtlError
-from rosfpga_lab.rtl.errors import SimulatorMissingError
+from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
 from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, FABRIC_DEMO_MAX_CLOCKS, RUN_TIMEOUT
+from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_TOP_GMII
 from rosfpga_lab.rtl.vcd import Waveform
 from rosfpga_lab.rtl.tools import TB_DIR, _verilator, simulator_missing_reason
 from rosfpga_lab.rtps import build as b
@@ -193,15 +193,8 @@ def demo_frames(config: NodeConfig | None = None) -> list[bytes]:
 def _params(config: NodeConfig, where: Path) -> tuple[dict[str, str], int]:
     rom = render_rom(config)
     write_rom(rom, where)
-    a = answer_params(rom)
-    p = tx_parameters(rom)
-    params = dict(verilog_parameters({**p, **top_parameters(rom)}), MAX_BYTES="2048",
-                  PERIOD=str(PERIOD), ROM_FILE=f'"{ROM_FILE}"', TABLE_FILE=f'"{TABLE_FILE}"',
-                  ROM_BYTES=str(len(rom.image())), MESSAGES=str(len(rom.messages)),
-                  ANSWER_FILE=f'"{ANSWER_FILE}"', ANSWER_TABLE_FILE=f'"{ANSWER_TABLE_FILE}"',
-                  **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
-                                            "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
-                                            "COUNT_START", "BURST", "RATE")})
+    params = dict(node_parameters(rom, period=PERIOD),
+                  **verilog_parameters(top_parameters(rom)), MAX_BYTES="2048")
     return params, 2                    # out: the SPDP announcement, then one DATA datagram
 
 
@@ -222,7 +215,6 @@ def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
         raise SimulatorMissingError(why)
     config = config or demo_config()
     vcd = Path(vcd).resolve()
-    fabric = Path(__file__).resolve().parent / "fabric"
     with tempfile.TemporaryDirectory(prefix="rfl-fabric-demo-") as tmp:
         where = Path(tmp)
         for name, data in node_sources(config).items():
@@ -251,16 +243,11 @@ def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
                    "RFL_DEMO_VCD": f'"{vcd}"'}
         (where / "rfl_fabric_demo_params.vh").write_text(
             "".join(f"`define {k} {v}\n" for k, v in defines.items()))
-        sources = [fabric / "vendor" / "liteeth_udp_gmii.v",
-                   *(fabric / m for m in ("rfl_udp_store.v", "rfl_udp_port.v", "rfl_rtps_rx.v",
-                                          "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
-                                          "rfl_rtps_disc_answer.v", "rfl_rtps_disc_rom.v",
-                                          "rfl_frame_arbiter.v", "rfl_fabric_node.v",
-                                          "rfl_fabric_top.v")),
+        sources = [*(FABRIC_DIR / m for m in FABRIC_TOP_GMII),
                    *sorted(p for p in where.glob("*.v")), TB_DIR / "rfl_fabric_demo_tb.v"]
         cmd = [_verilator() or "verilator", "--binary", "--timing", "-O1", "--trace",
                "--trace-depth", "1", "-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT",
-               f"-I{where}", "--top-module", "tb", "-Mdir", str(where / "obj_dir"), "-o",
+               f"-I{where}", f"-I{FABRIC_DIR}", "--top-module", "tb", "-Mdir", str(where / "obj_dir"), "-o",
                "rfl_sim", "-MAKEFLAGS", MAKEFLAGS, *map(str, sources)]
         done = subprocess.run(cmd, cwd=where, capture_output=True, text=True,
                               timeout=BUILD_TIMEOUT)

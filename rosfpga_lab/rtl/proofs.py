@@ -51,6 +51,9 @@ FABRIC_INCLUDES = ("rfl_fabric_node_params.vh", "rfl_fabric_node_pass.vh",
 FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
                "rfl_rtps_disc_answer.v", "rfl_rtps_disc_rom.v", "rfl_frame_arbiter.v",
                "rfl_fabric_node.v")
+#: rfl_fabric_top's files for simulation (LiteEth's GMII variant), relative to FABRIC_DIR.
+FABRIC_TOP_GMII = ("vendor/liteeth_udp_gmii.v", "rfl_udp_store.v", "rfl_udp_port.v",
+                   *FABRIC_NODE, "rfl_fabric_top.v")
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ from rosfpga_lab.rtl.discrom import (
     fabric_participant, node_parameters, render_rom, top_parameters, tx_parameters,
     verilog_parameters, write_rom,
 )
-from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, FABRIC_NODE
+from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, FABRIC_TOP_GMII
 from rosfpga_lab.rtl.sim import cache_root, simulator_version
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
@@ -66,8 +66,7 @@ PEER = bytes.fromhex("010fcafe0000000100000001")
 PEER_INDEX = 1
 PERIOD = 1_000_000       # one SPDP announcement (at reset) in the run
 MAX_CLOCKS = 200_000
-SOURCES = [FABRIC / "vendor" / "liteeth_udp_gmii.v"] + [FABRIC / m for m in (
-    "rfl_udp_store.v", "rfl_udp_port.v", *FABRIC_NODE, "rfl_fabric_top.v")]
+SOURCES = [FABRIC_DIR / m for m in FABRIC_TOP_GMII]
 
 
 def _udp(payload: bytes, dport: int, sport: int = 40000) -> bytes:
