@@ -456,3 +456,24 @@ def verilog_parameters(params: dict[str, int]) -> dict[str, str]:
     the entity ids sized hex (96 bits do not fit an integer), the others decimal."""
     return {k: f"{TX_PARAMETER_BITS[k]}'h{v:x}" if k in TX_PARAMETER_BITS else str(v)
             for k, v in params.items()}
+
+
+def fabric_top_literals(rom: DiscoveryRom, *, period: int) -> dict[str, str]:
+    """``fabric/rfl_fabric_top.v``'s parameters as Verilog literals for the participant ``rom``
+    was rendered for: the transmit path's (:func:`tx_parameters`), the ports
+    (:func:`top_parameters`), the ROMs' files (as :func:`write_rom` names them), sizes and answer
+    slots (:func:`answer_params`), and SPDP every ``period`` clocks (the board top, the simulated
+    top and the tests take them from here)."""
+    if period < 1:
+        raise RtlError(f"SPDP period of {period} clocks: at least 1")
+    a = answer_params(rom)
+    params = verilog_parameters({**tx_parameters(rom), **top_parameters(rom)})
+    params.update({
+        "PERIOD": str(period),
+        "ROM_FILE": f'"{ROM_FILE}"', "TABLE_FILE": f'"{TABLE_FILE}"',
+        "ROM_BYTES": str(len(rom.image())), "MESSAGES": str(len(rom.messages)),
+        "ANSWER_FILE": f'"{ANSWER_FILE}"', "ANSWER_TABLE_FILE": f'"{ANSWER_TABLE_FILE}"',
+        **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
+                                  "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
+                                  "COUNT_START", "BURST", "RATE")}})
+    return params
