@@ -40,7 +40,7 @@ from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.rtl.discrom import DiscoveryRom, fabric_top_literals, write_rom
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.generic import generic_rtl_files
-from rosfpga_lab.rtl.limits import BUILD_TIMEOUT
+from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, FABRIC_SIM_MAX_RECORD
 from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_NODE
 from rosfpga_lab.rtl.sim import cache_root, design_from_config, simulator_version
 from rosfpga_lab.rtl.tools import HARNESS_DIR, TB_TOP, _verilator, cxx_compiler
@@ -63,8 +63,6 @@ COUNTERS = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_len
 #: at 125 MHz), if the model keeps up.
 SIM_PERIOD = 400_000
 SIM_RATE = 400_000
-#: The largest record the program takes (its MAX_RECORD).
-MAX_RECORD = 1 << 16
 _CONFIG = struct.Struct("<QIIHHIIQ")
 
 
@@ -199,8 +197,8 @@ class FabricSim:
         self.configure(config)
 
     def _put(self, tag: bytes, body: bytes = b"") -> None:
-        if len(body) > MAX_RECORD:
-            raise RtlError(f"a record of {len(body)} bytes: the simulation takes {MAX_RECORD}")
+        if len(body) > FABRIC_SIM_MAX_RECORD:
+            raise RtlError(f"a record of {len(body)} bytes: the simulation takes {FABRIC_SIM_MAX_RECORD}")
         assert self._proc.stdin is not None
         try:
             self._proc.stdin.write(tag + struct.pack("<I", len(body)) + body)

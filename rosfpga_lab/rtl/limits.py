@@ -69,3 +69,7 @@ ANSWER_RATE = 4
 #: slots it compares in parallel.
 MAX_ANSWER_SEQ = 8
 MAX_ANSWER_SLOTS = 8
+
+#: The largest record the fabric simulation's program takes on its stdin (an Ethernet frame, its
+#: configuration; harness/rfl_fabric_sim.cpp's MAX_RECORD).
+FABRIC_SIM_MAX_RECORD = 1 << 16
