@@ -1,0 +1,248 @@
+"""The ROS 2 node in the fabric, simulated whole and bridged to the host's network, so real ROS 2
+peers talk to it (``rosfpga-lab fabric sim``; issue 31 item 3).
+
+How this works: :func:`start_fabric` renders the configuration's discovery ROM for the address
+the peers reach the node at, builds (or takes from the cache) the Verilator model of
+``rfl_fabric_top`` (:mod:`rosfpga_lab.rtl.fabricsim`) and starts it; a bridge then moves frames
+between its PHY side and the host:
+
+* :class:`ShimBridge` (no root needed): binds the node's metatraffic and user-data UDP ports on
+  127.0.0.1 (the locators its SPDP and SEDP announce), wraps each datagram a peer sends there
+  into an Ethernet/IPv4/UDP frame for the PHY (:mod:`rosfpga_lab.graph.ethframe`: IPv4 header
+  checksum, FCS), and unwraps the circuit's frames back into datagrams, sent from the port the
+  circuit sent from: the circuit's SPDP (to the SPDP multicast group) goes to the unicast
+  discovery ports of participant indices 0..MAX_PARTICIPANT_INDEX on 127.0.0.1, as Cyclone DDS
+  configured for loopback (:func:`rosfpga_lab.rtps.cyclone.cyclone_loopback_uri`) sends its
+  own; the circuit's ARP requests are answered by the bridge.
+
+The paper's split: discovery knowledge lives in software. The circuit sends to one peer, whose
+address and ports are registers (``cfg_peer_*``): the bridge reads the SPDP announcements that
+come to the node's metatraffic port, and for a participant it has not seen sets the registers
+to that participant's metatraffic and user-data locators and pulses ``send_sedp`` (the circuit
+sends its SEDP data and ros_discovery_info sample there), and again once after the circuit's
+next SPDP announcement (a peer drops SEDP from a participant it has not discovered yet). The
+last participant learned is the circuit's peer: one peer at a time (run the publisher and the
+subscriber in one participant, as one ROS 2 process with both does).
+
+A datagram longer than one Ethernet frame carries (1472 bytes of UDP payload: the circuit does
+not reassemble IP fragments) is dropped and counted: configure the peer's DDS to send smaller
+ones (Cyclone DDS: ``MaxMessageSize`` 1472B, which :func:`fabric_peer_uri` sets).
+"""
+
+from __future__ import annotations
+
+import select
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from rosfpga_lab.config import NodeConfig
+from rosfpga_lab.graph.ethframe import (
+    ArpRequest, BadFrame, UdpDatagram, arp_reply, mac_bytes, parse_frame, udp_frame,
+)
+from rosfpga_lab.graph.udpports import UdpPorts
+from rosfpga_lab.rtl.board import DEFAULT_MAC, mac_value
+from rosfpga_lab.rtl.discrom import DiscoveryRom, render_rom
+from rosfpga_lab.rtl.fabricsim import (
+    SIM_PERIOD, SIM_RATE, FabricConfig, FabricSim, build_fabric_sim,
+)
+from rosfpga_lab.rtl.limits import FABRIC_MAX_DATAGRAM
+from rosfpga_lab.rtps import build as b
+from rosfpga_lab.rtps.cyclone import cyclone_loopback_uri
+from rosfpga_lab.rtps.discovery import parse_parameters
+from rosfpga_lab.rtps.entities import SPDP_WRITER, discovery_port, user_port
+from rosfpga_lab.rtps.errors import RtpsError
+from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX, SPDP_MULTICAST_ADDRESS
+from rosfpga_lab.rtps.message import Data, parse_message
+
+__all__ = ["HOST_MAC", "Peer", "ShimBridge", "fabric_peer_uri", "spdp_peer", "start_fabric"]
+
+#: The host's side of the simulated link (locally administered, "RFL" and 1).
+HOST_MAC = "02:52:46:4c:00:01"
+
+
+def fabric_peer_uri(lease_seconds: float | None = None) -> str:
+    """``CYCLONEDDS_URI`` for a ROS 2 peer of the simulated fabric on 127.0.0.1: the lab's
+    loopback configuration, with datagrams no longer than one Ethernet frame carries."""
+    return cyclone_loopback_uri(lease_seconds, max_message_bytes=FABRIC_MAX_DATAGRAM)
+
+
+@dataclass(frozen=True)
+class Peer:
+    """A participant learned from its SPDP: GUID prefix, metatraffic and user-data locators."""
+
+    guid_prefix: bytes
+    meta: tuple[str, int]
+    user: tuple[str, int]
+
+
+def spdp_peer(payload: bytes, source: tuple[str, int]) -> Peer | None:
+    """The participant an SPDP datagram announces (a loopback locator, or one at the sender's
+    address; else its port at the sender's address), or None (not SPDP, a goodbye, unusable)."""
+    try:
+        msg = parse_message(payload)
+    except RtpsError:
+        return None
+    for prefix, _dst, sub in msg.routed():
+        if not isinstance(sub, Data) or sub.writer_id != SPDP_WRITER or not sub.payload:
+            continue
+        try:
+            params = parse_parameters(sub.payload)
+        except RtpsError:
+            return None
+        little = sub.payload[:2] == b.PL_CDR_LE[:2]
+
+        def pick(pid: int) -> tuple[str, int] | None:
+            found = [x for x in (b.Locator.decode(raw, little) for raw in params.get(pid, []))
+                     if x is not None]
+            for loc in found:
+                if loc.address.startswith("127.") or loc.address == source[0]:
+                    return (loc.address, loc.port)
+            return (source[0], found[0].port) if found else None
+
+        meta = pick(b.PID_METATRAFFIC_UNICAST_LOCATOR)
+        user = pick(b.PID_DEFAULT_UNICAST_LOCATOR)
+        if meta and user:
+            return Peer(prefix, meta, user)
+    return None
+
+
+@dataclass
+class BridgeCounts:
+    """What the bridge moved and dropped."""
+
+    to_circuit: int = 0
+    from_circuit: int = 0
+    arp_answered: int = 0
+    spdp_copies: int = 0
+    send_refused: int = 0
+    sedp_pulses: int = 0
+    dropped: Counter = field(default_factory=Counter)
+    peers: list[Peer] = field(default_factory=list)
+
+    def lines(self) -> list[str]:
+        out = [f"datagrams to the circuit: {self.to_circuit}",
+               f"datagrams from the circuit: {self.from_circuit} (SPDP copies to the "
+               f"discovery ports: {self.spdp_copies}, refused by the host: {self.send_refused})",
+               f"ARP requests answered: {self.arp_answered}",
+               f"peers learned: {len(self.peers)}; send_sedp pulses: {self.sedp_pulses}"]
+        out += [f"dropped ({why}): {n}" for why, n in sorted(self.dropped.items())]
+        return out
+
+
+class ShimBridge:
+    """The simulated node's PHY side bridged to UDP ports on loopback (module docstring)."""
+
+    def __init__(self, sim: FabricSim, rom: DiscoveryRom, *, node_mac: str = DEFAULT_MAC,
+                 log: Callable[[str], None] = lambda line: None) -> None:
+        self.sim, self.rom, self.log = sim, rom, log
+        self.node_mac, self.host_mac = mac_bytes(node_mac), mac_bytes(HOST_MAC)
+        self.meta, self.user = discovery_port(rom.domain, rom.index), user_port(rom.domain,
+                                                                                rom.index)
+        self.ports = UdpPorts(rom.address, [self.meta, self.user])
+        self.counts = BridgeCounts()
+        self.peer: Peer | None = None
+        self._pulse_after_spdp = False
+        self._ident = 0
+
+    # ---- host -> circuit
+    def _from_host(self, port: int, source: tuple[str, int], payload: bytes) -> None:
+        if len(payload) > FABRIC_MAX_DATAGRAM:
+            self.counts.dropped["datagram longer than a frame carries"] += 1
+            if self.counts.dropped["datagram longer than a frame carries"] == 1:
+                self.log(f"a datagram of {len(payload)} bytes from {source[0]}:{source[1]} "
+                         f"dropped: one frame carries {FABRIC_MAX_DATAGRAM} (configure the "
+                         f"peer's DDS with MaxMessageSize {FABRIC_MAX_DATAGRAM}B)")
+            return
+        if port == self.meta:
+            peer = spdp_peer(payload, source)
+            if peer and peer.guid_prefix != self.rom.guid_prefix and peer != self.peer:
+                self._learn(peer)
+        self._ident += 1
+        self.sim.send_frame(udp_frame(payload, src_mac=self.host_mac, dst_mac=self.node_mac,
+                                      src_ip=source[0], dst_ip=self.rom.address,
+                                      src_port=source[1], dst_port=port, ident=self._ident))
+        self.counts.to_circuit += 1
+
+    def _learn(self, peer: Peer) -> None:
+        self.peer = peer
+        self.counts.peers.append(peer)
+        self.sim.configure(self._config(peer))
+        self.sim.send_sedp()
+        self.counts.sedp_pulses += 1
+        self._pulse_after_spdp = True
+        self.log(f"peer {peer.guid_prefix.hex()}: metatraffic {peer.meta[0]}:{peer.meta[1]}, "
+                 f"user data {peer.user[0]}:{peer.user[1]} (the circuit's cfg_peer_*)")
+
+    def _config(self, peer: Peer | None) -> FabricConfig:
+        meta = peer.meta if peer else (self.rom.address, 0)
+        user = peer.user if peer else (self.rom.address, 0)
+        return FabricConfig(mac_value(":".join(f"{x:02x}" for x in self.node_mac)),
+                            self.rom.address, meta[0], meta[1], user[1],
+                            self.rom.entity_ids["reader"])
+
+    # ---- circuit -> host
+    def _from_circuit(self, frame: bytes) -> None:
+        got = parse_frame(frame)
+        if isinstance(got, BadFrame):
+            self.counts.dropped[f"circuit frame: {got.reason}"] += 1
+        elif isinstance(got, ArpRequest):
+            self.sim.send_frame(arp_reply(got, self.host_mac))
+            self.counts.arp_answered += 1
+        elif isinstance(got, UdpDatagram):
+            self.counts.from_circuit += 1
+            if got.dst_ip == SPDP_MULTICAST_ADDRESS:
+                for index in range(MAX_PARTICIPANT_INDEX + 1):
+                    if index != self.rom.index:
+                        self.counts.spdp_copies += 1
+                        self.ports.send(got.src_port, self.rom.address,
+                                        discovery_port(self.rom.domain, index), got.payload)
+                if self._pulse_after_spdp:
+                    self._pulse_after_spdp = False
+                    self.sim.send_sedp()
+                    self.counts.sedp_pulses += 1
+            elif not self.ports.send(got.src_port, got.dst_ip, got.dst_port, got.payload):
+                self.counts.send_refused += 1
+
+    def start(self) -> None:
+        """Give the circuit its registers (no peer yet: ports 0) and let it run."""
+        self.sim.configure(self._config(None))
+
+    def run(self, seconds: float, *, stop: Callable[[], bool] = lambda: False) -> None:
+        """Bridge for ``seconds`` (or until ``stop()`` is true, or the simulation ends)."""
+        deadline = time.monotonic() + seconds
+        sim_fd = self.sim.fileno()
+        while time.monotonic() < deadline and not stop() and self.sim.running():
+            ready, _, _ = select.select([sim_fd, *self.ports.filenos()], [], [], 0.05)
+            for fd in ready:
+                if fd == sim_fd:
+                    for frame in self.sim.read().frames:
+                        self._from_circuit(frame)
+                else:
+                    for port, source, payload in self.ports.receive(fd):
+                        self._from_host(port, source, payload)
+
+    def close(self) -> None:
+        self.ports.close()
+
+
+def start_fabric(config: NodeConfig, *, domain: int = 0, address: str = "127.0.0.1",
+                 period: int = SIM_PERIOD, rate: int = SIM_RATE,
+                 log: Callable[[str], None] = lambda line: None) -> ShimBridge:
+    """Build (or take from the cache) and start ``config``'s node in the fabric as participant 0
+    of ``domain`` at ``address``, bridged by a :class:`ShimBridge` (call its ``run``, then
+    ``close`` it and its ``sim``)."""
+    rom = render_rom(config, domain=domain, address=address)
+    started = time.monotonic()
+    build = build_fabric_sim(config, rom, period=period)
+    log(f"Verilator model {'built in %.0f s' % build.seconds if build.seconds else 'from the cache'}"
+        f" ({time.monotonic() - started:.1f} s): {build.program}")
+    sim = FabricSim(build, FabricConfig(mac_value(DEFAULT_MAC), address, address, 0, 0,
+                                        rom.entity_ids["reader"]), rate=rate)
+    try:
+        bridge = ShimBridge(sim, rom, log=log)
+    except BaseException:
+        sim.close()
+        raise
+    return bridge
