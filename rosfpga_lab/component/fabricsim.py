@@ -24,6 +24,25 @@ next SPDP announcement (a peer drops SEDP from a participant it has not discover
 last participant learned is the circuit's peer: one peer at a time (run the publisher and the
 subscriber in one participant, as one ROS 2 process with both does).
 
+The circuit sends what goes to a reader to its peer's default user-data port; Fast DDS's
+readers (rclpy's ``ros_discovery_info`` reader among them) announce a unicast locator of their
+own in their SEDP data and take nothing at the default one, so the bridge reads the peer's SEDP
+subscriptions and sends the circuit's datagrams of a writer to the locator a reader of its topic
+announced (software knowledge of discovery again; the circuit has one peer port). The circuit's
+built-in readers answer a peer's SEDP HEARTBEAT as a reader that has every sample (it needs
+none), so a peer never sends them its SEDP data; the bridge asks the peer's SEDP subscriptions
+writer once for its samples with an ACKNACK of its own in the circuit's name (its GUID prefix
+and built-in reader), and reads the readers' locators from the DATA(r) that come back (which
+go on to the circuit, which drops them).
+
+The circuit answers ACKNACKs on its metatraffic port only (``rfl_fabric_top`` gives what comes
+to the user-data port to the data path); its ``ros_discovery_info`` writer is a user-data writer,
+which peers ask on the user-data port (Fast DDS does: rclpy's graph needs the sample, which the
+circuit sent before the peer had matched). So the bridge gives an ACKNACK to that writer which
+comes to the user-data port to the circuit's metatraffic port (counted), whose ``rfl_rtps_ctrl``
+answers it (the DATA and a HEARTBEAT, to the peer's user-data port). A fix in the Verilog (the
+top passing such ACKNACKs to the control path) would make this step unneeded.
+
 A datagram longer than one Ethernet frame carries (1472 bytes of UDP payload: the circuit does
 not reassemble IP fragments) is dropped and counted: configure the peer's DDS to send smaller
 ones (Cyclone DDS: ``MaxMessageSize`` 1472B, which :func:`fabric_peer_uri` sets).
@@ -32,6 +51,7 @@ ones (Cyclone DDS: ``MaxMessageSize`` 1472B, which :func:`fabric_peer_uri` sets)
 from __future__ import annotations
 
 import select
+import struct
 import time
 from collections import Counter
 from collections.abc import Callable
@@ -51,13 +71,18 @@ from rosfpga_lab.rtl.limits import FABRIC_MAX_DATAGRAM
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.cyclone import cyclone_loopback_uri
 from rosfpga_lab.rtps.discovery import parse_parameters
-from rosfpga_lab.rtps.entities import SPDP_WRITER, discovery_port, user_port
+from rosfpga_lab.rtps.entities import (
+    SPDP_WRITER, SUB_READER, SUB_WRITER, discovery_port, user_port,
+)
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX, SPDP_MULTICAST_ADDRESS
-from rosfpga_lab.rtps.message import Data, parse_message
+from rosfpga_lab.rtps.message import AckNack, Data, Heartbeat, parse_message
 
 __all__ = ["HOST_MAC", "Peer", "ShimBridge", "fabric_peer_uri", "spdp_peer", "start_fabric"]
 
+#: The count of the bridge's one ACKNACK to a peer's SEDP subscriptions writer: above any the
+#: circuit's answers reach in a run (they count up from rtl.discrom.ANSWER_COUNT_START).
+BRIDGE_ACKNACK_COUNT = 1 << 30
 #: The host's side of the simulated link (locally administered, "RFL" and 1).
 HOST_MAC = "02:52:46:4c:00:01"
 
@@ -80,32 +105,58 @@ class Peer:
 def spdp_peer(payload: bytes, source: tuple[str, int]) -> Peer | None:
     """The participant an SPDP datagram announces (a loopback locator, or one at the sender's
     address; else its port at the sender's address), or None (not SPDP, a goodbye, unusable)."""
-    try:
-        msg = parse_message(payload)
-    except RtpsError:
-        return None
-    for prefix, _dst, sub in msg.routed():
-        if not isinstance(sub, Data) or sub.writer_id != SPDP_WRITER or not sub.payload:
-            continue
+    for prefix, data in _samples(payload, SPDP_WRITER):
         try:
-            params = parse_parameters(sub.payload)
+            params = parse_parameters(data)
         except RtpsError:
             return None
-        little = sub.payload[:2] == b.PL_CDR_LE[:2]
-
-        def pick(pid: int) -> tuple[str, int] | None:
-            found = [x for x in (b.Locator.decode(raw, little) for raw in params.get(pid, []))
-                     if x is not None]
-            for loc in found:
-                if loc.address.startswith("127.") or loc.address == source[0]:
-                    return (loc.address, loc.port)
-            return (source[0], found[0].port) if found else None
-
-        meta = pick(b.PID_METATRAFFIC_UNICAST_LOCATOR)
-        user = pick(b.PID_DEFAULT_UNICAST_LOCATOR)
+        little = data[:2] == b.PL_CDR_LE[:2]
+        meta = _pick(params, b.PID_METATRAFFIC_UNICAST_LOCATOR, little, source)
+        user = _pick(params, b.PID_DEFAULT_UNICAST_LOCATOR, little, source)
         if meta and user:
             return Peer(prefix, meta, user)
     return None
+
+
+def _pick(params: dict[int, list[bytes]], pid: int, little: bool,
+          source: tuple[str, int]) -> tuple[str, int] | None:
+    """A locator of ``pid`` the host reaches: a loopback one, or one at the sender's address;
+    else the first one's port at the sender's address."""
+    found = [x for x in (b.Locator.decode(raw, little) for raw in params.get(pid, []))
+             if x is not None]
+    for loc in found:
+        if loc.address.startswith("127.") or loc.address == source[0]:
+            return (loc.address, loc.port)
+    return (source[0], found[0].port) if found else None
+
+
+def _samples(payload: bytes, writer_id: int) -> list[tuple[bytes, bytes]]:
+    """(source prefix, serialized data) of each DATA of ``writer_id`` in an RTPS datagram."""
+    try:
+        msg = parse_message(payload)
+    except RtpsError:
+        return []
+    return [(prefix, sub.payload) for prefix, _dst, sub in msg.routed()
+            if isinstance(sub, Data) and sub.writer_id == writer_id and sub.payload]
+
+
+def sedp_reader_locators(payload: bytes, source: tuple[str, int]) -> list[tuple[str, tuple[str,
+                                                                                           int]]]:
+    """(DDS topic, unicast locator) of each reader an SEDP datagram announces with a locator of
+    its own (Fast DDS's readers do; Cyclone's use their participant's)."""
+    out = []
+    for _prefix, data in _samples(payload, SUB_WRITER):
+        try:
+            params = parse_parameters(data)
+        except RtpsError:
+            continue
+        little = data[:2] == b.PL_CDR_LE[:2]
+        loc = _pick(params, b.PID_UNICAST_LOCATOR, little, source)
+        topic = params.get(b.PID_TOPIC_NAME)
+        if loc and topic and len(topic[0]) > 4:
+            (n,) = struct.unpack("<I" if little else ">I", topic[0][:4])
+            out.append((topic[0][4:4 + n].rstrip(b"\0").decode(errors="replace"), loc))
+    return out
 
 
 @dataclass
@@ -118,6 +169,8 @@ class BridgeCounts:
     spdp_copies: int = 0
     send_refused: int = 0
     sedp_pulses: int = 0
+    graph_acknacks: int = 0
+    subscriptions_asked: int = 0
     dropped: Counter = field(default_factory=Counter)
     peers: list[Peer] = field(default_factory=list)
 
@@ -126,7 +179,10 @@ class BridgeCounts:
                f"datagrams from the circuit: {self.from_circuit} (SPDP copies to the "
                f"discovery ports: {self.spdp_copies}, refused by the host: {self.send_refused})",
                f"ARP requests answered: {self.arp_answered}",
-               f"peers learned: {len(self.peers)}; send_sedp pulses: {self.sedp_pulses}"]
+               f"peers learned: {len(self.peers)}; send_sedp pulses: {self.sedp_pulses}",
+               f"ACKNACKs to ros_discovery_info's writer passed to the metatraffic port: "
+               f"{self.graph_acknacks}",
+               f"peers asked for their SEDP subscriptions: {self.subscriptions_asked}"]
         out += [f"dropped ({why}): {n}" for why, n in sorted(self.dropped.items())]
         return out
 
@@ -134,7 +190,8 @@ class BridgeCounts:
 class ShimBridge:
     """The simulated node's PHY side bridged to UDP ports on loopback (module docstring)."""
 
-    def __init__(self, sim: FabricSim, rom: DiscoveryRom, *, node_mac: str = DEFAULT_MAC,
+    def __init__(self, sim: FabricSim, rom: DiscoveryRom, out_topic: str, *,
+                 node_mac: str = DEFAULT_MAC,
                  log: Callable[[str], None] = lambda line: None) -> None:
         self.sim, self.rom, self.log = sim, rom, log
         self.node_mac, self.host_mac = mac_bytes(node_mac), mac_bytes(HOST_MAC)
@@ -145,9 +202,26 @@ class ShimBridge:
         self.peer: Peer | None = None
         self._pulse_after_spdp = False
         self._ident = 0
+        self._graph_writer = rom.entity_ids["ros_discovery_info"]
+        self._asked: set[bytes] = set()
+        self.readers: dict[str, tuple[str, int]] = {}   # DDS topic -> a reader's own locator
+        self._topics = {self._graph_writer: "ros_discovery_info",
+                        rom.entity_ids["writer"]: out_topic}
 
     # ---- host -> circuit
     def _from_host(self, port: int, source: tuple[str, int], payload: bytes) -> None:
+        if port == self.meta:
+            peer = spdp_peer(payload, source)
+            if peer and peer.guid_prefix != self.rom.guid_prefix and peer != self.peer:
+                self._learn(peer)
+            self._ask_subscriptions(payload)
+            for topic, loc in sedp_reader_locators(payload, source):
+                if self.readers.get(topic) != loc:
+                    self.readers[topic] = loc
+                    self.log(f"a reader of {topic} at {loc[0]}:{loc[1]} (its own locator)")
+        elif self._asks_graph_writer(payload):
+            port = self.meta             # see the module docstring: the circuit's ctrl answers
+            self.counts.graph_acknacks += 1
         if len(payload) > FABRIC_MAX_DATAGRAM:
             self.counts.dropped["datagram longer than a frame carries"] += 1
             if self.counts.dropped["datagram longer than a frame carries"] == 1:
@@ -155,15 +229,53 @@ class ShimBridge:
                          f"dropped: one frame carries {FABRIC_MAX_DATAGRAM} (configure the "
                          f"peer's DDS with MaxMessageSize {FABRIC_MAX_DATAGRAM}B)")
             return
-        if port == self.meta:
-            peer = spdp_peer(payload, source)
-            if peer and peer.guid_prefix != self.rom.guid_prefix and peer != self.peer:
-                self._learn(peer)
         self._ident += 1
         self.sim.send_frame(udp_frame(payload, src_mac=self.host_mac, dst_mac=self.node_mac,
                                       src_ip=source[0], dst_ip=self.rom.address,
                                       src_port=source[1], dst_port=port, ident=self._ident))
         self.counts.to_circuit += 1
+
+    def _ask_subscriptions(self, payload: bytes) -> None:
+        """On the peer's SEDP subscriptions writer's HEARTBEAT, ask once for its samples (the
+        circuit's reader answers that it has them all: it needs none)."""
+        if self.peer is None or self.peer.guid_prefix in self._asked:
+            return
+        try:
+            msg = parse_message(payload)
+        except RtpsError:
+            return
+        for src, _dst, sub in msg.routed():
+            if isinstance(sub, Heartbeat) and sub.writer_id == SUB_WRITER \
+                    and src == self.peer.guid_prefix and sub.last >= sub.first >= 1:
+                self._asked.add(src)
+                ask = (b.header(self.rom.guid_prefix) + b.info_dst(src) +
+                       b.acknack(SUB_READER, SUB_WRITER, sub.first,
+                                 range(sub.first, min(sub.last, sub.first + 255) + 1),
+                                 BRIDGE_ACKNACK_COUNT))
+                self.ports.send(self.meta, *self.peer.meta, ask)
+                self.counts.subscriptions_asked += 1
+                return
+
+    def _reader_of(self, payload: bytes) -> tuple[str, int] | None:
+        """The locator of its own a reader announced for the topic of the circuit's writer that
+        sent ``payload`` (the circuit sends to its peer's default user-data port)."""
+        try:
+            msg = parse_message(payload)
+        except RtpsError:
+            return None
+        for _src, _dst, sub in msg.routed():
+            topic = self._topics.get(getattr(sub, "writer_id", -1))
+            if topic in self.readers:
+                return self.readers[topic]
+        return None
+
+    def _asks_graph_writer(self, payload: bytes) -> bool:
+        try:
+            msg = parse_message(payload)
+        except RtpsError:
+            return False
+        return any(isinstance(sub, AckNack) and sub.writer_id == self._graph_writer
+                   for _src, _dst, sub in msg.routed())
 
     def _learn(self, peer: Peer) -> None:
         self.peer = peer
@@ -202,8 +314,12 @@ class ShimBridge:
                     self._pulse_after_spdp = False
                     self.sim.send_sedp()
                     self.counts.sedp_pulses += 1
-            elif not self.ports.send(got.src_port, got.dst_ip, got.dst_port, got.payload):
-                self.counts.send_refused += 1
+            else:
+                to = (got.dst_ip, got.dst_port)
+                if self.peer and to == self.peer.user:
+                    to = self._reader_of(got.payload) or to
+                if not self.ports.send(got.src_port, to[0], to[1], got.payload):
+                    self.counts.send_refused += 1
 
     def start(self) -> None:
         """Give the circuit its registers (no peer yet: ports 0) and let it run."""
@@ -241,7 +357,7 @@ def start_fabric(config: NodeConfig, *, domain: int = 0, address: str = "127.0.0
     sim = FabricSim(build, FabricConfig(mac_value(DEFAULT_MAC), address, address, 0, 0,
                                         rom.entity_ids["reader"]), rate=rate)
     try:
-        bridge = ShimBridge(sim, rom, log=log)
+        bridge = ShimBridge(sim, rom, b.dds_topic(config.publisher.topic), log=log)
     except BaseException:
         sim.close()
         raise
