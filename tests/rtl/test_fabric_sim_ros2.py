@@ -9,13 +9,16 @@ default QoS (RELIABLE, KEEP_LAST 10, VOLATILE).
 Discovery is the circuit's own (its SPDP, SEDP and answers from its ROMs; the bridge only sets
 its one peer's ports from the peer's SPDP and pulses send_sedp). Every output is compared with
 numpy (a 5-beam minimum over ``ranges``) and with the lab's CDR model, never with the circuit's
-own output. The scans go out 0.3 s apart (a scanner's rate): back to back at line rate, the
+own output. rclpy (the ``[ros2]`` extra: Fast DDS, ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST)
+sees the fabric's node, its publisher and subscriber, their types and type hashes in its graph
+API (the hash against rosidl's, copied in tests/msg/test_typehash_realros2.py). The scans go out 0.3 s apart (a scanner's rate): back to back at line rate, the
 circuit's 2 KB receive buffer overflows (counted), see the report in item 3's notes. Domain 230
 for the model's ports (a build per domain; cached after the first, some 15-50 s).
 """
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -32,6 +35,8 @@ from rosfpga_lab.hw.cdrpipeline import CdrPipeline
 from rosfpga_lab.rtl.discrom import render_rom
 from rosfpga_lab.rtl.fabricsim import build_fabric_sim
 from tests.component.test_ros2_rtl import SCAN_CDR, _assert_exact, _scans
+from tests.msg.test_typehash_realros2 import GOLDEN
+from tests.support.realros import ROS_PROGRAMS, require_ros2
 from tests.support.proctools import interruptible, kill_if_running, stop_with
 from tests.support.ros2tools import cyclone, qos, wait
 from tests.support.rtltools import require_verilator
@@ -105,3 +110,45 @@ def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
     assert (counters["samples"], counters["rx_error"], counters["rx_overflow"],
             counters["tx_overflow"]) == (str(SCANS), "0", "0", "0"), stdout
     assert "bridge: peers learned: 1;" in stdout, stdout
+
+
+def test_rclpy_sees_the_fabric_node_in_the_ros2_graph(tmp_path: Path) -> None:
+    """What ``ros2 node list`` / ``ros2 node info`` / ``ros2 topic list -t`` read, of the node
+    whose discovery is the circuit's ROMs: the node from its ros_discovery_info sample, its
+    endpoints from its SEDP data."""
+    require_verilator()
+    require_ros2()
+    config = load_config(SCAN_CDR)
+    build_fabric_sim(config, render_rom(config, domain=DOMAIN))   # the CLI's, cached
+    proc, lines = _start_cli(tmp_path)
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("ROS_", "RMW_", "FASTRTPS_", "FASTDDS_", "CYCLONEDDS_"))}
+    env.update(ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+               RMW_IMPLEMENTATION="rmw_fastrtps_cpp", ROS_LOG_DIR=str(tmp_path / "ros_log"),
+               ROS_HOME=str(tmp_path / "ros_home"))
+    try:
+        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
+                    60) and proc.poll() is None, "".join(lines)
+        peer = subprocess.run([sys.executable, str(ROS_PROGRAMS / "rclpy_peer.py"), "graph",
+                               "fpga_scan_min", "/", "/scan", "/scan_min", "--timeout", "15",
+                               "--out", str(tmp_path)], capture_output=True, text=True,
+                              env=env, timeout=60)
+        stdout, _ = stop_with(proc, signal.SIGINT)
+    finally:
+        kill_if_running(proc)
+    assert peer.returncode == 0, (peer.stderr[-2000:], "".join(lines))
+    report = json.loads(peer.stdout.strip().splitlines()[-1])
+    print(stdout)
+    assert ["fpga_scan_min", "/"] in report["nodes"], report["nodes"]
+    scan = ["sensor_msgs/msg/LaserScan"]
+    assert report["publishers"] == [["/scan_min", scan]]
+    assert report["subscribers"] == [["/scan", scan]]
+    topics = dict((name, types) for name, types in report["topics"])
+    assert topics["/scan"] == topics["/scan_min"] == scan
+    (sub,) = report["infos"]["/scan"]
+    (pub,) = report["infos"]["/scan_min"]
+    for info, kind in ((sub, "SUBSCRIPTION"), (pub, "PUBLISHER")):
+        assert (info["node"], info["ns"], info["type"], info["kind"]) == \
+            ("fpga_scan_min", "/", "sensor_msgs/msg/LaserScan", kind)
+        assert (info["reliability"], info["durability"]) == ("RELIABLE", "VOLATILE")
+        assert info["type_hash"] == GOLDEN["sensor_msgs/LaserScan"]
