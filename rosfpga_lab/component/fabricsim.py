@@ -344,14 +344,15 @@ class ShimBridge:
 
 
 def start_fabric(config: NodeConfig, *, domain: int = 0, address: str = "127.0.0.1",
-                 period: int = SIM_PERIOD, rate: int = SIM_RATE,
+                 period: int = SIM_PERIOD, rate: int = SIM_RATE, max_bytes: int | None = None,
                  log: Callable[[str], None] = lambda line: None) -> ShimBridge:
     """Build (or take from the cache) and start ``config``'s node in the fabric as participant 0
-    of ``domain`` at ``address``, bridged by a :class:`ShimBridge` (call its ``run``, then
+    of ``domain`` at ``address`` (``max_bytes``: the longest sample it takes, as
+    :func:`~rosfpga_lab.rtl.fabricsim.build_fabric_sim`), bridged by a :class:`ShimBridge` (call its ``run``, then
     ``close`` it and its ``sim``)."""
     rom = render_rom(config, domain=domain, address=address)
     started = time.monotonic()
-    build = build_fabric_sim(config, rom, period=period)
+    build = build_fabric_sim(config, rom, period=period, max_bytes=max_bytes)
     log(f"Verilator model {'built in %.0f s' % build.seconds if build.seconds else 'from the cache'}"
         f" ({time.monotonic() - started:.1f} s): {build.program}")
     sim = FabricSim(build, FabricConfig(mac_value(DEFAULT_MAC), address, address, 0, 0,

@@ -27,6 +27,7 @@ from __future__ import annotations
 import hashlib
 import ipaddress
 import os
+import re
 import select
 import shutil
 import struct
@@ -46,7 +47,7 @@ from rosfpga_lab.rtl.sim import cache_root, design_from_config, simulator_versio
 from rosfpga_lab.rtl.tools import HARNESS_DIR, TB_TOP, _verilator, cxx_compiler
 
 __all__ = ["COUNTERS", "FabricBuild", "FabricConfig", "FabricSim", "SIM_PERIOD", "SIM_RATE",
-           "build_fabric_sim", "fabric_missing_reason"]
+           "build_fabric_sim", "fabric_missing_reason", "fabric_top_default"]
 
 #: The C++ main and the program it builds.
 MAIN_FILE, PROGRAM = "rfl_fabric_sim.cpp", "rfl_fabric_sim"
@@ -64,6 +65,15 @@ COUNTERS = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_len
 SIM_PERIOD = 400_000
 SIM_RATE = 400_000
 _CONFIG = struct.Struct("<QIIHHIIQ")
+
+
+def fabric_top_default(name: str) -> str:
+    """The default of parameter ``name`` of ``rfl_fabric_top`` (its Verilog owns it)."""
+    text = (FABRIC_DIR / f"{TOP}.v").read_text()
+    found = re.search(rf"parameter\s+(?:\[[^]]*\]\s*)?{re.escape(name)}\s*=\s*([^,)/\s]+)", text)
+    if found is None:
+        raise RtlError(f"{TOP}.v has no parameter {name}")
+    return found.group(1)
 
 
 def fabric_missing_reason() -> str | None:
@@ -95,10 +105,12 @@ def _sources(config: NodeConfig) -> dict[str, bytes]:
     return files
 
 
-def build_fabric_sim(config: NodeConfig, rom: DiscoveryRom, *,
-                     period: int = SIM_PERIOD) -> FabricBuild:
+def build_fabric_sim(config: NodeConfig, rom: DiscoveryRom, *, period: int = SIM_PERIOD,
+                     max_bytes: int | None = None) -> FabricBuild:
     """Compile (or take from the cache) ``config``'s node in the fabric with ``rom`` as its
-    discovery ROM and SPDP every ``period`` clocks.
+    discovery ROM, SPDP every ``period`` clocks, and the longest sample the circuit takes
+    ``max_bytes`` (its store-and-forward buffer, rfl_rtps_to_cdr; None: the top's default, the
+    board's).
 
     Raises:
         RtlError: no Verilator or C++ compiler, or the build failed (its messages quoted).
@@ -107,6 +119,10 @@ def build_fabric_sim(config: NodeConfig, rom: DiscoveryRom, *,
     if reason:
         raise RtlError(f"cannot simulate the fabric: {reason}")
     params = fabric_top_literals(rom, period=period)
+    if max_bytes is not None:
+        if not 4 <= max_bytes <= 1 << 24:
+            raise RtlError(f"max_bytes {max_bytes}: the circuit takes 4 .. 2**24")
+        params["MAX_BYTES"] = str(max_bytes)
     files = _sources(config)
     with tempfile.TemporaryDirectory() as tmp:
         roms = {p.name: p.read_bytes() for p in write_rom(rom, tmp)}

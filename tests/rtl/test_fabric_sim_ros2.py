@@ -27,6 +27,8 @@ import threading
 import time
 from pathlib import Path
 
+import cv2
+import numpy as np
 import pytest
 
 from rosfpga_lab.component.fabricsim import fabric_peer_uri
@@ -38,20 +40,33 @@ from tests.component.test_ros2_rtl import SCAN_CDR, _assert_exact, _scans
 from tests.msg.test_typehash_realros2 import GOLDEN
 from tests.support.realros import ROS_PROGRAMS, require_ros2
 from tests.support.proctools import interruptible, kill_if_running, stop_with
-from tests.support.ros2tools import cyclone, qos, wait
+from tests.support.ros2tools import cyclone, image, qos, wait
 from tests.support.rtltools import require_verilator
 
 pytestmark = [pytest.mark.rtl, pytest.mark.timeout(300)]
 
 DOMAIN = 230
 SCANS = 3
+#: data/fpga_dilate_rgba8_cdr.yaml at 64x48 (its 640x480 samples are 1.2 MB: a store-and-forward
+#: buffer that large is not simulated here).
+IMAGE_CONFIG = """\
+node: {name: /fpga_dilate}
+subscriber: {topic: /image_raw, type: sensor_msgs/Image}
+publisher: {topic: /image_dilated, type: sensor_msgs/Image}
+image: {width: 64, height: 48, encoding: rgba8}
+application: {op: dilate, ksize: 3}
+wire: cdr
+"""
+IMAGE_MAX_BYTES = 16384
+IMAGES = 2
 
 
-def _start_cli(tmp_path: Path) -> tuple[subprocess.Popen, list[str]]:
+def _start_cli(tmp_path: Path, config: Path = SCAN_CDR,
+               *extra: str) -> tuple[subprocess.Popen, list[str]]:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     proc = subprocess.Popen(
-        [sys.executable, "-m", "rosfpga_lab", "fabric", "sim", str(SCAN_CDR), "--shim",
-         "--domain", str(DOMAIN), "--seconds", "60"],
+        [sys.executable, "-m", "rosfpga_lab", "fabric", "sim", str(config), "--shim",
+         "--domain", str(DOMAIN), "--seconds", "60", *extra],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path,
         preexec_fn=interruptible)
     lines: list[str] = []
@@ -152,3 +167,54 @@ def test_rclpy_sees_the_fabric_node_in_the_ros2_graph(tmp_path: Path) -> None:
             ("fpga_scan_min", "/", "sensor_msgs/msg/LaserScan", kind)
         assert (info["reliability"], info["durability"]) == ("RELIABLE", "VOLATILE")
         assert info["type_hash"] == GOLDEN["sensor_msgs/LaserScan"]
+
+
+def _counters(stdout: str) -> dict[str, str]:
+    line = next(x for x in stdout.splitlines() if x.startswith("circuit: "))
+    return dict(kv.rsplit(" ", 1) for kv in line[len("circuit: "):].split(", "))
+
+
+def test_cyclone_images_64x48_through_the_simulated_fabric_exact(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """sensor_msgs/Image 64x48 rgba8 (12 kB: ten DATA_FRAG datagrams each way) through the
+    fabric's dilation, exact against OpenCV's 3x3 dilation of what was sent."""
+    require_verilator()
+    dds = cyclone()
+    monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
+    path = tmp_path / "fpga_dilate_64x48_cdr.yaml"
+    path.write_text(IMAGE_CONFIG)
+    config = load_config(path)
+    start = time.monotonic()
+    build = build_fabric_sim(config, render_rom(config, domain=DOMAIN), max_bytes=IMAGE_MAX_BYTES)
+    print(f"build {build.seconds:.1f} s (0: cached), {time.monotonic() - start:.1f} s")
+    proc, lines = _start_cli(tmp_path, path, "--max-bytes", str(IMAGE_MAX_BYTES))
+    rng = np.random.default_rng(31)
+    pictures = [rng.integers(0, 256, (48, 64, 4), dtype=np.uint8) for _ in range(IMAGES)]
+    got: list = []
+    try:
+        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
+                    60) and proc.poll() is None, "".join(lines)
+        dp = dds.DomainParticipant(DOMAIN)
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/image_raw", dds.Image_), qos=qos(dds))
+        reader = dds.DataReader(dp, dds.Topic(dp, "rt/image_dilated", dds.Image_), qos=qos(dds))
+        assert wait(lambda: writer.get_matched_subscriptions()
+                    and reader.get_matched_publications(), 15), "".join(lines)
+        t0 = time.monotonic()
+        for k, pic in enumerate(pictures):
+            writer.write(image(dds, pic, "rgba8", sec=k, frame_id="cam"))
+            time.sleep(0.5)
+        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= IMAGES, 15), \
+            (len(got), "".join(lines))
+        print(f"{IMAGES} images back after {time.monotonic() - t0:.2f} s")
+        stdout, _ = stop_with(proc, signal.SIGINT)
+    finally:
+        kill_if_running(proc)
+    assert proc.returncode == 0, "".join(lines)
+    print(stdout)
+    for k, (pic, out) in enumerate(zip(pictures, got, strict=True)):
+        want = cv2.dilate(pic, np.ones((3, 3), np.uint8)).reshape(pic.shape)
+        assert (out.height, out.width, out.encoding, out.step) == (48, 64, "rgba8", 256)
+        assert (out.header.stamp.sec, out.header.frame_id) == (k, "cam")
+        assert bytes(out.data) == want.tobytes(), f"image {k}"
+    counters = _counters(stdout)
+    assert (counters["samples"], counters["rx_overflow"]) == (str(IMAGES), "0"), stdout
