@@ -22,7 +22,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "sim", help="run the whole network-attached top in Verilator, bridged to the host",
         description="Build (once; cached) the Verilator model of the node in the fabric for "
         "CONFIG (wire: cdr), its GMII side exchanging whole Ethernet frames with this "
-        "process, and bridge it to the host. --shim (the default; no root needed): the node's "
+        "process, and bridge it to the host: through a TAP interface (--tap) or, by "
+        "default, a shim. --shim (the default; no root needed): the node's "
         "metatraffic and user-data UDP ports are bound on 127.0.0.1 (participant index 0 of "
         "--domain: 7410 and 7411 for domain 0); each datagram a peer sends there goes to the "
         "circuit as an Ethernet/IPv4/UDP frame, each frame the circuit sends comes back as a "
@@ -42,8 +43,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     mode.add_argument("--shim", action="store_true",
                       help="bridge through UDP ports on 127.0.0.1 (the default; no root)")
     mode.add_argument("--tap", action="store_true",
-                      help="bridge through a Linux TAP interface (root, /dev/net/tun): not "
-                      "available yet")
+                      help="bridge through a Linux TAP interface rfltap0 (root, "
+                      "/dev/net/tun): the host is 10.31.0.1/24 on it, the node 10.31.0.2; "
+                      "peers bind that interface (Cyclone DDS: NetworkInterface name rfltap0, "
+                      "MaxMessageSize 1472B); the interface goes when the command ends")
     p.add_argument("--seconds", type=float, default=60.0, metavar="N",
                    help="run for N seconds (default 60)")
     p.add_argument("--domain", type=int, default=0, metavar="ID",
@@ -65,7 +68,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run_sim(args: argparse.Namespace) -> int:
     """Build, start, bridge for --seconds, print the counters."""
-    from rosfpga_lab.component.fabricsim import start_fabric
+    from rosfpga_lab.component.fabricsim import TAP_HOST_CIDR, TAP_NAME, start_fabric
     from rosfpga_lab.config import load_config
     from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
     from rosfpga_lab.rtl.fabricsim import fabric_top_default
@@ -77,9 +80,12 @@ def run_sim(args: argparse.Namespace) -> int:
             print(line, file=sys.stderr, flush=True)
 
     if args.tap:
-        print("rosfpga-lab fabric sim: error: --tap is not available yet; use --shim (the "
-              "default)", file=sys.stderr)
-        return 2
+        from rosfpga_lab.graph.tap import tap_missing_reason
+
+        reason = tap_missing_reason()
+        if reason:
+            print(f"rosfpga-lab fabric sim: error: --tap: {reason}", file=sys.stderr)
+            return 2
     if args.seconds <= 0:
         print("rosfpga-lab fabric sim: error: --seconds must be positive", file=sys.stderr)
         return 2
@@ -94,16 +100,18 @@ def run_sim(args: argparse.Namespace) -> int:
         say(f"note: {args.config} accepts samples up to {bound} bytes; the circuit takes "
             f"{held} (--max-bytes {bound} takes them all)")
     say(f"building (or taking from the cache) the Verilator model of {args.config} ...")
-    bridge = start_fabric(config, domain=args.domain,
+    bridge = start_fabric(config, domain=args.domain, tap=args.tap,
                           period=args.period or SIM_PERIOD,
                           rate=SIM_RATE if args.rate is None else args.rate,
                           max_bytes=args.max_bytes, log=say)
     started = time.monotonic()
     try:
         bridge.start()
-        say(f"ready: the node is participant 0 of domain {args.domain} on "
+        where = (f"TAP interface {TAP_NAME} (the host {TAP_HOST_CIDR})" if args.tap else
+                 "127.0.0.1 through the shim")
+        say(f"ready: the node is participant 0 of domain {args.domain} at "
             f"{bridge.rom.address}, UDP ports {bridge.meta} (metatraffic) and {bridge.user} "
-            f"(user data); running {args.seconds:g} s (Ctrl-C stops)")
+            f"(user data), on {where}; running {args.seconds:g} s (Ctrl-C stops)")
         try:
             bridge.run(args.seconds)
         except KeyboardInterrupt:

@@ -15,13 +15,20 @@ between its PHY side and the host:
   configured for loopback (:func:`rosfpga_lab.rtps.cyclone.cyclone_loopback_uri`) sends its
   own; the circuit's ARP requests are answered by the bridge.
 
+* :class:`TapBridge` (root and ``/dev/net/tun``): a TAP interface (:mod:`rosfpga_lab.graph.tap`)
+  with the host's address 10.31.0.1/24; the node is 10.31.0.2 (its ROM announces it). The
+  circuit's frames (FCS checked and taken off) go to the host's network stack, the host's
+  frames (FCS added) to the circuit: the host's kernel answers the circuit's ARP, the circuit's
+  LiteEth the host's, SPDP goes by multicast. Peers bind that interface
+  (:func:`fabric_tap_peer_uri`).
+
 The paper's split: discovery knowledge lives in software. The circuit sends to one peer, whose
 address and ports are registers (``cfg_peer_*``): the bridge reads the SPDP announcements that
 come to the node's metatraffic port, and for a participant it has not seen sets the registers
 to that participant's metatraffic and user-data locators and pulses ``send_sedp`` (the circuit
 sends its SEDP data and ros_discovery_info sample there), and again once after the circuit's
 next SPDP announcement (a peer drops SEDP from a participant it has not discovered yet). The
-last participant learned is the circuit's peer: one peer at a time (run the publisher and the
+participant that appeared last is the circuit's peer: one peer at a time (run the publisher and the
 subscriber in one participant, as one ROS 2 process with both does).
 
 The circuit sends what goes to a reader to its peer's default user-data port; Fast DDS's
@@ -59,8 +66,9 @@ from dataclasses import dataclass, field
 
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.graph.ethframe import (
-    ArpRequest, BadFrame, UdpDatagram, arp_reply, mac_bytes, parse_frame, udp_frame,
+    ArpRequest, BadFrame, UdpDatagram, arp_reply, fcs, mac_bytes, parse_frame, udp_frame,
 )
+from rosfpga_lab.graph.tap import TapDevice
 from rosfpga_lab.graph.udpports import UdpPorts
 from rosfpga_lab.rtl.board import DEFAULT_MAC, mac_value
 from rosfpga_lab.rtl.discrom import DiscoveryRom, render_rom
@@ -72,17 +80,20 @@ from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.cyclone import cyclone_loopback_uri
 from rosfpga_lab.rtps.discovery import parse_parameters
 from rosfpga_lab.rtps.entities import (
-    SPDP_WRITER, SUB_READER, SUB_WRITER, discovery_port, user_port,
+    SPDP_WRITER, SUB_READER, SUB_WRITER, discovery_multicast_port, discovery_port, user_port,
 )
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX, SPDP_MULTICAST_ADDRESS
 from rosfpga_lab.rtps.message import AckNack, Data, Heartbeat, parse_message
 
-__all__ = ["HOST_MAC", "Peer", "ShimBridge", "fabric_peer_uri", "spdp_peer", "start_fabric"]
+__all__ = ["HOST_MAC", "Peer", "ShimBridge", "TAP_HOST_CIDR", "TAP_NAME", "TAP_NODE_ADDRESS",
+           "TapBridge", "fabric_peer_uri", "fabric_tap_peer_uri", "sedp_reader_locators", "spdp_peer", "start_fabric"]
 
 #: The count of the bridge's one ACKNACK to a peer's SEDP subscriptions writer: above any the
 #: circuit's answers reach in a run (they count up from rtl.discrom.ANSWER_COUNT_START).
 BRIDGE_ACKNACK_COUNT = 1 << 30
+#: The TAP interface's name and the host's address on it; the node's address on that link.
+TAP_NAME, TAP_HOST_CIDR, TAP_NODE_ADDRESS = "rfltap0", "10.31.0.1/24", "10.31.0.2"
 #: The host's side of the simulated link (locally administered, "RFL" and 1).
 HOST_MAC = "02:52:46:4c:00:01"
 
@@ -91,6 +102,15 @@ def fabric_peer_uri(lease_seconds: float | None = None) -> str:
     """``CYCLONEDDS_URI`` for a ROS 2 peer of the simulated fabric on 127.0.0.1: the lab's
     loopback configuration, with datagrams no longer than one Ethernet frame carries."""
     return cyclone_loopback_uri(lease_seconds, max_message_bytes=FABRIC_MAX_DATAGRAM)
+
+
+def fabric_tap_peer_uri(name: str = TAP_NAME) -> str:
+    """``CYCLONEDDS_URI`` for a ROS 2 peer of the simulated fabric over the TAP interface
+    ``name``: that interface (multicast on, as on a wired LAN), datagrams no longer than one
+    Ethernet frame carries."""
+    return (f'<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface name="{name}"/>'
+            f'</Interfaces><MaxMessageSize>{FABRIC_MAX_DATAGRAM}B</MaxMessageSize></General>'
+            '</Domain></CycloneDDS>')
 
 
 @dataclass(frozen=True)
@@ -187,20 +207,58 @@ class BridgeCounts:
         return out
 
 
-class ShimBridge:
-    """The simulated node's PHY side bridged to UDP ports on loopback (module docstring)."""
+class _PeerKeeper:
+    """What both bridges do: keep the circuit's one peer (its registers) from the SPDP the host
+    side sees, and pulse send_sedp for it."""
 
-    def __init__(self, sim: FabricSim, rom: DiscoveryRom, out_topic: str, *,
-                 node_mac: str = DEFAULT_MAC,
+    def __init__(self, sim: FabricSim, rom: DiscoveryRom, *, node_mac: str = DEFAULT_MAC,
                  log: Callable[[str], None] = lambda line: None) -> None:
         self.sim, self.rom, self.log = sim, rom, log
         self.node_mac, self.host_mac = mac_bytes(node_mac), mac_bytes(HOST_MAC)
         self.meta, self.user = discovery_port(rom.domain, rom.index), user_port(rom.domain,
                                                                                 rom.index)
-        self.ports = UdpPorts(rom.address, [self.meta, self.user])
         self.counts = BridgeCounts()
         self.peer: Peer | None = None
+        self._known = {rom.guid_prefix}      # participants seen (their SPDP repeats)
         self._pulse_after_spdp = False
+
+    def _learn(self, peer: Peer) -> None:
+        self._known.add(peer.guid_prefix)
+        self.peer = peer
+        self.counts.peers.append(peer)
+        self.sim.configure(self._config(peer))
+        self.sim.send_sedp()
+        self.counts.sedp_pulses += 1
+        self._pulse_after_spdp = True
+        self.log(f"peer {peer.guid_prefix.hex()}: metatraffic {peer.meta[0]}:{peer.meta[1]}, "
+                 f"user data {peer.user[0]}:{peer.user[1]} (the circuit's cfg_peer_*)")
+
+    def _config(self, peer: Peer | None) -> FabricConfig:
+        meta = peer.meta if peer else (self.rom.address, 0)
+        user = peer.user if peer else (self.rom.address, 0)
+        return FabricConfig(mac_value(":".join(f"{x:02x}" for x in self.node_mac)),
+                            self.rom.address, meta[0], meta[1], user[1],
+                            self.rom.entity_ids["reader"])
+
+    def _spdp_went_out(self) -> None:
+        if self._pulse_after_spdp:
+            self._pulse_after_spdp = False
+            self.sim.send_sedp()
+            self.counts.sedp_pulses += 1
+
+    def start(self) -> None:
+        """Give the circuit its registers (no peer yet: ports 0) and let it run."""
+        self.sim.configure(self._config(None))
+
+
+class ShimBridge(_PeerKeeper):
+    """The simulated node's PHY side bridged to UDP ports on loopback (module docstring)."""
+
+    def __init__(self, sim: FabricSim, rom: DiscoveryRom, out_topic: str, *,
+                 node_mac: str = DEFAULT_MAC,
+                 log: Callable[[str], None] = lambda line: None) -> None:
+        super().__init__(sim, rom, node_mac=node_mac, log=log)
+        self.ports = UdpPorts(rom.address, [self.meta, self.user])
         self._ident = 0
         self._graph_writer = rom.entity_ids["ros_discovery_info"]
         self._asked: set[bytes] = set()
@@ -212,7 +270,7 @@ class ShimBridge:
     def _from_host(self, port: int, source: tuple[str, int], payload: bytes) -> None:
         if port == self.meta:
             peer = spdp_peer(payload, source)
-            if peer and peer.guid_prefix != self.rom.guid_prefix and peer != self.peer:
+            if peer and peer.guid_prefix not in self._known:
                 self._learn(peer)
             self._ask_subscriptions(payload)
             for topic, loc in sedp_reader_locators(payload, source):
@@ -277,23 +335,6 @@ class ShimBridge:
         return any(isinstance(sub, AckNack) and sub.writer_id == self._graph_writer
                    for _src, _dst, sub in msg.routed())
 
-    def _learn(self, peer: Peer) -> None:
-        self.peer = peer
-        self.counts.peers.append(peer)
-        self.sim.configure(self._config(peer))
-        self.sim.send_sedp()
-        self.counts.sedp_pulses += 1
-        self._pulse_after_spdp = True
-        self.log(f"peer {peer.guid_prefix.hex()}: metatraffic {peer.meta[0]}:{peer.meta[1]}, "
-                 f"user data {peer.user[0]}:{peer.user[1]} (the circuit's cfg_peer_*)")
-
-    def _config(self, peer: Peer | None) -> FabricConfig:
-        meta = peer.meta if peer else (self.rom.address, 0)
-        user = peer.user if peer else (self.rom.address, 0)
-        return FabricConfig(mac_value(":".join(f"{x:02x}" for x in self.node_mac)),
-                            self.rom.address, meta[0], meta[1], user[1],
-                            self.rom.entity_ids["reader"])
-
     # ---- circuit -> host
     def _from_circuit(self, frame: bytes) -> None:
         got = parse_frame(frame)
@@ -310,20 +351,13 @@ class ShimBridge:
                         self.counts.spdp_copies += 1
                         self.ports.send(got.src_port, self.rom.address,
                                         discovery_port(self.rom.domain, index), got.payload)
-                if self._pulse_after_spdp:
-                    self._pulse_after_spdp = False
-                    self.sim.send_sedp()
-                    self.counts.sedp_pulses += 1
+                self._spdp_went_out()
             else:
                 to = (got.dst_ip, got.dst_port)
                 if self.peer and to == self.peer.user:
                     to = self._reader_of(got.payload) or to
                 if not self.ports.send(got.src_port, to[0], to[1], got.payload):
                     self.counts.send_refused += 1
-
-    def start(self) -> None:
-        """Give the circuit its registers (no peer yet: ports 0) and let it run."""
-        self.sim.configure(self._config(None))
 
     def run(self, seconds: float, *, stop: Callable[[], bool] = lambda: False) -> None:
         """Bridge for ``seconds`` (or until ``stop()`` is true, or the simulation ends)."""
@@ -343,13 +377,66 @@ class ShimBridge:
         self.ports.close()
 
 
-def start_fabric(config: NodeConfig, *, domain: int = 0, address: str = "127.0.0.1",
-                 period: int = SIM_PERIOD, rate: int = SIM_RATE, max_bytes: int | None = None,
-                 log: Callable[[str], None] = lambda line: None) -> ShimBridge:
+class TapBridge(_PeerKeeper):
+    """The simulated node's PHY side bridged to a TAP interface: its frames (FCS checked and
+    taken off) to the host's network stack, the host's frames (FCS added) to it. The host
+    answers ARP and routes; the bridge only reads the SPDP going to the circuit to keep its peer.
+    """
+
+    def __init__(self, sim: FabricSim, rom: DiscoveryRom, *, name: str = TAP_NAME,
+                 host_cidr: str = TAP_HOST_CIDR, node_mac: str = DEFAULT_MAC,
+                 log: Callable[[str], None] = lambda line: None) -> None:
+        super().__init__(sim, rom, node_mac=node_mac, log=log)
+        self.tap = TapDevice(name, host_cidr)
+        self._spdp_port = discovery_multicast_port(rom.domain)
+
+    def _from_host(self, frame: bytes) -> None:
+        whole = fcs(frame)
+        got = parse_frame(whole)
+        if isinstance(got, UdpDatagram) and got.dst_port in (self._spdp_port, self.meta):
+            peer = spdp_peer(got.payload, (got.src_ip, got.src_port))
+            if peer and peer.guid_prefix not in self._known:
+                self._learn(peer)
+        self.sim.send_frame(whole)
+        self.counts.to_circuit += 1
+
+    def _from_circuit(self, frame: bytes) -> None:
+        got = parse_frame(frame)
+        if isinstance(got, BadFrame):
+            self.counts.dropped[f"circuit frame: {got.reason}"] += 1
+            return
+        if isinstance(got, UdpDatagram) and got.dst_ip == SPDP_MULTICAST_ADDRESS:
+            self._spdp_went_out()
+        self.tap.write(frame[:-4])
+        self.counts.from_circuit += 1
+
+    def run(self, seconds: float, *, stop: Callable[[], bool] = lambda: False) -> None:
+        """Bridge for ``seconds`` (or until ``stop()`` is true, or the simulation ends)."""
+        deadline = time.monotonic() + seconds
+        sim_fd, tap_fd = self.sim.fileno(), self.tap.fileno()
+        while time.monotonic() < deadline and not stop() and self.sim.running():
+            ready, _, _ = select.select([sim_fd, tap_fd], [], [], 0.05)
+            if sim_fd in ready:
+                for frame in self.sim.read().frames:
+                    self._from_circuit(frame)
+            if tap_fd in ready:
+                for frame in self.tap.read():
+                    self._from_host(frame)
+
+    def close(self) -> None:
+        self.tap.close()
+
+
+def start_fabric(config: NodeConfig, *, domain: int = 0, tap: bool = False,
+                 address: str | None = None, period: int = SIM_PERIOD, rate: int = SIM_RATE,
+                 max_bytes: int | None = None,
+                 log: Callable[[str], None] = lambda line: None) -> ShimBridge | TapBridge:
     """Build (or take from the cache) and start ``config``'s node in the fabric as participant 0
-    of ``domain`` at ``address`` (``max_bytes``: the longest sample it takes, as
-    :func:`~rosfpga_lab.rtl.fabricsim.build_fabric_sim`), bridged by a :class:`ShimBridge` (call its ``run``, then
-    ``close`` it and its ``sim``)."""
+    of ``domain`` at ``address`` (default 127.0.0.1 for the shim, :data:`TAP_NODE_ADDRESS` on a
+    TAP interface; ``max_bytes``: the longest sample it takes, as
+    :func:`~rosfpga_lab.rtl.fabricsim.build_fabric_sim`), bridged by a :class:`ShimBridge` or a
+    :class:`TapBridge` (call its ``start`` and ``run``, then ``close`` it and its ``sim``)."""
+    address = address or (TAP_NODE_ADDRESS if tap else "127.0.0.1")
     rom = render_rom(config, domain=domain, address=address)
     started = time.monotonic()
     build = build_fabric_sim(config, rom, period=period, max_bytes=max_bytes)
@@ -358,8 +445,9 @@ def start_fabric(config: NodeConfig, *, domain: int = 0, address: str = "127.0.0
     sim = FabricSim(build, FabricConfig(mac_value(DEFAULT_MAC), address, address, 0, 0,
                                         rom.entity_ids["reader"]), rate=rate)
     try:
-        bridge = ShimBridge(sim, rom, b.dds_topic(config.publisher.topic), log=log)
+        if tap:
+            return TapBridge(sim, rom, log=log)
+        return ShimBridge(sim, rom, b.dds_topic(config.publisher.topic), log=log)
     except BaseException:
         sim.close()
         raise
-    return bridge

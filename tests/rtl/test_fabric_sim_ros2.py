@@ -18,6 +18,7 @@ for the model's ports (a build per domain; cached after the first, some 15-50 s)
 
 from __future__ import annotations
 
+import gc
 import json
 import os
 import signal
@@ -31,7 +32,9 @@ import cv2
 import numpy as np
 import pytest
 
-from rosfpga_lab.component.fabricsim import fabric_peer_uri
+from rosfpga_lab.component.fabricsim import (
+    TAP_NAME, TAP_NODE_ADDRESS, fabric_peer_uri, fabric_tap_peer_uri,
+)
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline
 from rosfpga_lab.rtl.discrom import render_rom
@@ -41,7 +44,9 @@ from tests.msg.test_typehash_realros2 import GOLDEN
 from tests.support.realros import ROS_PROGRAMS, require_ros2
 from tests.support.proctools import interruptible, kill_if_running, stop_with
 from tests.support.ros2tools import cyclone, image, qos, wait
-from tests.support.rtltools import require_verilator
+from tests.support.realros import skip_or_fail
+from tests.support.rtltools import REQUIRE, require_verilator
+from tests.support.wiretools import require_tshark
 
 pytestmark = [pytest.mark.rtl, pytest.mark.timeout(300)]
 
@@ -58,15 +63,17 @@ application: {op: dilate, ksize: 3}
 wire: cdr
 """
 IMAGE_MAX_BYTES = 16384
+#: The TAP test's domain (a Cyclone domain of its own in this process: another configuration).
+TAP_DOMAIN = 231
 IMAGES = 2
 
 
-def _start_cli(tmp_path: Path, config: Path = SCAN_CDR,
-               *extra: str) -> tuple[subprocess.Popen, list[str]]:
+def _start_cli(tmp_path: Path, config: Path = SCAN_CDR, *extra: str,
+               domain: int = DOMAIN, mode: str = "--shim") -> tuple[subprocess.Popen, list[str]]:
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
     proc = subprocess.Popen(
-        [sys.executable, "-m", "rosfpga_lab", "fabric", "sim", str(config), "--shim",
-         "--domain", str(DOMAIN), "--seconds", "60", *extra],
+        [sys.executable, "-m", "rosfpga_lab", "fabric", "sim", str(config), mode,
+         "--domain", str(domain), "--seconds", "60", *extra],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path,
         preexec_fn=interruptible)
     lines: list[str] = []
@@ -218,3 +225,73 @@ def test_cyclone_images_64x48_through_the_simulated_fabric_exact(
         assert bytes(out.data) == want.tobytes(), f"image {k}"
     counters = _counters(stdout)
     assert (counters["samples"], counters["rx_overflow"]) == (str(IMAGES), "0"), stdout
+
+
+def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``--tap``: the circuit's frames on a Linux TAP interface (the host 10.31.0.1/24, the node
+    10.31.0.2): the host's own network stack answers ARP and routes, Cyclone DDS binds that
+    interface (multicast SPDP, as on a LAN); three scans exact; tshark reads a capture of the
+    interface with no malformed packet; the interface is gone after the command."""
+    from rosfpga_lab.graph.tap import tap_missing_reason
+
+    require_verilator()
+    reason = tap_missing_reason()
+    if reason:
+        skip_or_fail(reason, REQUIRE)
+    tshark = require_tshark()
+    dds = cyclone()
+    monkeypatch.setenv("CYCLONEDDS_URI", fabric_tap_peer_uri())
+    from tests.support import cdrtypes as T
+
+    config = load_config(SCAN_CDR)
+    build_fabric_sim(config, render_rom(config, domain=TAP_DOMAIN, address=TAP_NODE_ADDRESS))
+    proc, lines = _start_cli(tmp_path, SCAN_CDR, domain=TAP_DOMAIN, mode="--tap")
+    capture = tmp_path / "tap.pcapng"
+    dump = None
+    got: list = []
+    sent = _scans(T, SCANS)
+    try:
+        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
+                    60) and proc.poll() is None, "".join(lines)
+        dump = subprocess.Popen([tshark, "-i", TAP_NAME, "-w", str(capture), "-q"],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                preexec_fn=interruptible)
+        assert wait(capture.exists, 10), "tshark did not start"
+        dp = dds.DomainParticipant(TAP_DOMAIN)
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/scan", T.LaserScan_), qos=qos(dds))
+        reader = dds.DataReader(dp, dds.Topic(dp, "rt/scan_min", T.LaserScan_), qos=qos(dds))
+        assert wait(lambda: writer.get_matched_subscriptions()
+                    and reader.get_matched_publications(), 15), "".join(lines)
+        for msg in sent:
+            writer.write(msg)
+            time.sleep(0.3)
+        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= SCANS, 15), \
+            (len(got), "".join(lines))
+        time.sleep(0.5)
+        del writer, reader, dp                 # gone before the interface is
+        gc.collect()
+        stop_with(dump, signal.SIGINT)
+        stdout, _ = stop_with(proc, signal.SIGINT)
+    finally:
+        kill_if_running(proc)
+        if dump is not None:
+            kill_if_running(dump)
+    assert proc.returncode == 0, "".join(lines)
+    print(stdout)
+    pipe = CdrPipeline(config)
+    for msg, out in zip(sent, got, strict=True):
+        _assert_exact(T, msg, out, pipe)
+    assert _counters(stdout)["samples"] == str(SCANS), stdout
+
+    def rows(display: str) -> list[str]:
+        out = subprocess.run([tshark, "-r", str(capture), "-Y", display, "-T", "fields",
+                              "-e", "frame.number"], capture_output=True, text=True, timeout=60)
+        assert out.returncode == 0, out.stderr
+        return out.stdout.split()
+
+    assert rows("_ws.malformed || _ws.expert.severity >= error") == []
+    assert len(rows(f"ip.src == {TAP_NODE_ADDRESS} && rtps.sm.id == 0x16")) >= 2 * SCANS
+    assert rows(f"ip.src == {TAP_NODE_ADDRESS} && rtps.sm.id == 0x15")     # SPDP, SEDP...
+    gone = subprocess.run(["ip", "link", "show", TAP_NAME], capture_output=True, timeout=10)
+    assert gone.returncode != 0, "the TAP interface outlived the command"
