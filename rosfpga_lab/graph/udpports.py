@@ -44,7 +44,7 @@ class UdpPorts:
         """The datagrams waiting on the socket ``fileno``: (our port, sender, payload) each."""
         for port, s in self.sockets.items():
             if s.fileno() == fileno:
-                out = []
+                out: list[tuple[int, tuple[str, int], bytes]] = []
                 while True:
                     try:
                         data, source = s.recvfrom(_READ_BYTES)
