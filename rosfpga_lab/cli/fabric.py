@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 from rosfpga_lab.cli._args import positive_int
+from rosfpga_lab.cli._signals import StopSignals
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -35,7 +36,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "Ethernet frame: the circuit does not reassemble IP fragments); one peer participant "
         "at a time. The clock runs at most --rate clocks per second, SPDP every --period "
         "clocks (the board's is 125 million at 125 MHz; scaled down here). Stops after "
-        "--seconds or on Ctrl-C, and prints the circuit's and the bridge's counters. "
+        "--seconds or on Ctrl-C (SIGINT or SIGTERM), and prints the circuit's and the "
+        "bridge's counters. "
         "Example: rosfpga-lab fabric sim data/fpga_laserscan_min_cdr.yaml --seconds 60")
     p.add_argument("config", type=Path, metavar="CONFIG",
                    help="the node configuration (YAML, wire: cdr)")
@@ -112,10 +114,10 @@ def run_sim(args: argparse.Namespace) -> int:
         say(f"ready: the node is participant 0 of domain {args.domain} at "
             f"{bridge.rom.address}, UDP ports {bridge.meta} (metatraffic) and {bridge.user} "
             f"(user data), on {where}; running {args.seconds:g} s (Ctrl-C stops)")
-        try:
-            bridge.run(args.seconds)
-        except KeyboardInterrupt:
-            say("interrupted")
+        with StopSignals(raise_interrupt=False) as stop:   # SIGINT, SIGTERM: counters, then out
+            bridge.run(args.seconds, stop=lambda: stop.fired is not None)
+        if stop.fired is not None:
+            say("stopped by a signal")
     finally:
         bridge.close()
         report = bridge.sim.close()

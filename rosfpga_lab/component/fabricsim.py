@@ -87,7 +87,8 @@ from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX, SPDP_MULTICAST_ADDRES
 from rosfpga_lab.rtps.message import AckNack, Data, Heartbeat, parse_message
 
 __all__ = ["HOST_MAC", "Peer", "ShimBridge", "TAP_HOST_CIDR", "TAP_NAME", "TAP_NODE_ADDRESS",
-           "TapBridge", "fabric_peer_uri", "fabric_tap_peer_uri", "sedp_reader_locators", "spdp_peer", "start_fabric"]
+           "TapBridge", "fabric_peer_uri", "fabric_tap_peer_uri", "sedp_reader_locators",
+           "spdp_peer", "start_fabric"]
 
 #: The count of the bridge's one ACKNACK to a peer's SEDP subscriptions writer: above any the
 #: circuit's answers reach in a run (they count up from rtl.discrom.ANSWER_COUNT_START).
@@ -440,8 +441,8 @@ def start_fabric(config: NodeConfig, *, domain: int = 0, tap: bool = False,
     rom = render_rom(config, domain=domain, address=address)
     started = time.monotonic()
     build = build_fabric_sim(config, rom, period=period, max_bytes=max_bytes)
-    log(f"Verilator model {'built in %.0f s' % build.seconds if build.seconds else 'from the cache'}"
-        f" ({time.monotonic() - started:.1f} s): {build.program}")
+    how = f"built in {build.seconds:.0f} s" if build.seconds else "from the cache"
+    log(f"Verilator model {how} ({time.monotonic() - started:.1f} s): {build.program}")
     sim = FabricSim(build, FabricConfig(mac_value(DEFAULT_MAC), address, address, 0, 0,
                                         rom.entity_ids["reader"]), rate=rate)
     try:

@@ -214,7 +214,8 @@ class FabricSim:
 
     def _put(self, tag: bytes, body: bytes = b"") -> None:
         if len(body) > FABRIC_SIM_MAX_RECORD:
-            raise RtlError(f"a record of {len(body)} bytes: the simulation takes {FABRIC_SIM_MAX_RECORD}")
+            raise RtlError(f"a record of {len(body)} bytes: the simulation takes "
+                           f"{FABRIC_SIM_MAX_RECORD}")
         assert self._proc.stdin is not None
         try:
             self._proc.stdin.write(tag + struct.pack("<I", len(body)) + body)

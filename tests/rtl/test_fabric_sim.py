@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -31,16 +32,15 @@ def test_the_fast_model_sends_what_the_cocotb_bench_expects(tmp_path: Path) -> N
     sc = scenario(tmp_path)
     build = build_fabric_sim(load_config(CONFIG), sc.rom, period=PERIOD)
     assert {**build.params, "MAX_BYTES": sc.params["MAX_BYTES"]} == sc.params
-    case = sc.case
-    config = FabricConfig(int(str(case["node_mac"]), 16), _dotted(str(case["node_ip"])),
-                          _dotted(str(case["peer_ip"])), int(case["peer_meta_port"]),  # type: ignore[call-overload]
-                          int(case["peer_user_port"]), int(case["reader"]),  # type: ignore[call-overload]
-                          int(case["writer"]), int(case["time"]))  # type: ignore[call-overload]
+    case: dict[str, Any] = sc.case
+    config = FabricConfig(int(case["node_mac"], 16), _dotted(case["node_ip"]),
+                          _dotted(case["peer_ip"]), case["peer_meta_port"],
+                          case["peer_user_port"], case["reader"], case["writer"], case["time"])
     sim = FabricSim(build, config, rate=0, max_clocks=MAX_CLOCKS)
-    peer_ip = bytes.fromhex(str(case["peer_ip"]))
+    peer_ip = bytes.fromhex(case["peer_ip"])
     sent: list[bytes] = []
     try:
-        for raw in case["frames"]:  # type: ignore[attr-defined]
+        for raw in case["frames"]:
             sim.send_frame(bytes.fromhex(raw))
         deadline = time.monotonic() + 60
         while sim.running() and time.monotonic() < deadline:
@@ -48,7 +48,7 @@ def test_the_fast_model_sends_what_the_cocotb_bench_expects(tmp_path: Path) -> N
                 sent.append(frame)
                 if frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" \
                         and frame[38:42] == peer_ip:
-                    sim.send_frame(bytes.fromhex(str(case["arp_reply"])))
+                    sim.send_frame(bytes.fromhex(case["arp_reply"]))
     finally:
         report = sim.close()
     sent += report.frames

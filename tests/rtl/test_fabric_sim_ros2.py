@@ -11,9 +11,13 @@ its one peer's ports from the peer's SPDP and pulses send_sedp). Every output is
 numpy (a 5-beam minimum over ``ranges``) and with the lab's CDR model, never with the circuit's
 own output. rclpy (the ``[ros2]`` extra: Fast DDS, ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST)
 sees the fabric's node, its publisher and subscriber, their types and type hashes in its graph
-API (the hash against rosidl's, copied in tests/msg/test_typehash_realros2.py). The scans go out 0.3 s apart (a scanner's rate): back to back at line rate, the
-circuit's 2 KB receive buffer overflows (counted), see the report in item 3's notes. Domain 230
-for the model's ports (a build per domain; cached after the first, some 15-50 s).
+API (the hash against rosidl's, copied in tests/msg/test_typehash_realros2.py). A 64x48 Image
+goes through the dilation in ten DATA_FRAGs each way, exact against OpenCV; with ``--tap`` the
+same scans cross a Linux TAP interface, whose capture tshark reads without a malformed packet.
+The samples go out 0.3-0.5 s apart (a scanner's rate): three scans back to back at line rate
+overflowed the circuit's 2 KB receive buffer once (rx_overflow counts it; the circuit's reader
+asks for nothing again, so that sample is lost). Domains 230 and 231 for the model's ports (a
+build per domain, address and sample bound; each cached after the first, some 15-50 s).
 """
 
 from __future__ import annotations
@@ -63,6 +67,10 @@ application: {op: dilate, ksize: 3}
 wire: cdr
 """
 IMAGE_MAX_BYTES = 16384
+#: The shipped 640x480 configuration, its sample bound (1.2 MB and the header) and its domain.
+BIG_CONFIG = SCAN_CDR.parent / "fpga_dilate_rgba8_cdr.yaml"
+BIG_MAX_BYTES = 1310720
+BIG_DOMAIN = 229
 #: The TAP test's domain (a Cyclone domain of its own in this process: another configuration).
 TAP_DOMAIN = 231
 IMAGES = 2
@@ -295,3 +303,43 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
     assert rows(f"ip.src == {TAP_NODE_ADDRESS} && rtps.sm.id == 0x15")     # SPDP, SEDP...
     gone = subprocess.run(["ip", "link", "show", TAP_NAME], capture_output=True, timeout=10)
     assert gone.returncode != 0, "the TAP interface outlived the command"
+
+
+def test_one_640x480_image_fragments_through_the_simulated_fabric_exact(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """data/fpga_dilate_rgba8_cdr.yaml as shipped: one 640x480 rgba8 sample (1.2 MB: some 900
+    DATA_FRAGs each way, stored whole in the circuit's buffer, --max-bytes) exact against
+    OpenCV; the clock unthrottled (--rate 0). Some 10 s here, a first build some 45 s."""
+    require_verilator()
+    dds = cyclone()
+    monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
+    config = load_config(BIG_CONFIG)
+    build_fabric_sim(config, render_rom(config, domain=BIG_DOMAIN), max_bytes=BIG_MAX_BYTES)
+    proc, lines = _start_cli(tmp_path, BIG_CONFIG, "--max-bytes", str(BIG_MAX_BYTES),
+                             "--rate", "0", domain=BIG_DOMAIN)
+    pic = np.random.default_rng(5).integers(0, 256, (480, 640, 4), dtype=np.uint8)
+    got: list = []
+    try:
+        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
+                    60) and proc.poll() is None, "".join(lines)
+        dp = dds.DomainParticipant(BIG_DOMAIN)
+        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/image_raw", dds.Image_), qos=qos(dds))
+        reader = dds.DataReader(dp, dds.Topic(dp, "rt/image_dilated", dds.Image_), qos=qos(dds))
+        assert wait(lambda: writer.get_matched_subscriptions()
+                    and reader.get_matched_publications(), 15), "".join(lines)
+        t0 = time.monotonic()
+        writer.write(image(dds, pic, "rgba8", sec=1, frame_id="cam"))
+        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= 1, 60), "".join(lines)
+        print(f"640x480 back after {time.monotonic() - t0:.2f} s")
+        stdout, _ = stop_with(proc, signal.SIGINT)
+    finally:
+        kill_if_running(proc)
+    assert proc.returncode == 0, "".join(lines)
+    print(stdout)
+    (out,) = got
+    want = cv2.dilate(pic, np.ones((3, 3), np.uint8)).reshape(pic.shape)
+    assert (out.height, out.width, out.encoding, out.step) == (480, 640, "rgba8", 2560)
+    assert bytes(out.data) == want.tobytes()
+    # datagrams that came while the 2 KB receive buffer was full are counted (rx_overflow: 6 in
+    # a run here), none of the sample's fragments (it is exact)
+    assert _counters(stdout)["samples"] == "1", stdout
