@@ -18,7 +18,7 @@ from rosfpga_lab.config import load_config
 from rosfpga_lab.rtl.fabricsim import FabricConfig, FabricSim, build_fabric_sim
 from tests.rtl.test_fabric_rtps_cdr import CONFIG
 from tests.rtl.test_fabric_top import MAX_CLOCKS, PERIOD, check_sent, scenario
-from tests.support.rtltools import require_verilator
+from tests.support.rtltools import require_fabric_sim
 
 pytestmark = pytest.mark.rtl
 
@@ -28,7 +28,7 @@ ETHERTYPE_ARP = bytes.fromhex("0806")
 
 @pytest.mark.timeout(300)
 def test_the_fast_model_sends_what_the_cocotb_bench_expects(tmp_path: Path) -> None:
-    require_verilator()
+    require_fabric_sim()
     sc = scenario(tmp_path)
     build = build_fabric_sim(load_config(CONFIG), sc.rom, period=PERIOD)
     assert {**build.params, "MAX_BYTES": sc.params["MAX_BYTES"]} == sc.params

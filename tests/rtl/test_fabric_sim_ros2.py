@@ -49,7 +49,7 @@ from tests.support.realros import ROS_PROGRAMS, require_ros2
 from tests.support.proctools import interruptible, kill_if_running, stop_with
 from tests.support.ros2tools import cyclone, image, qos, wait
 from tests.support.realros import skip_or_fail
-from tests.support.rtltools import REQUIRE, require_verilator
+from tests.support.rtltools import REQUIRE, require_fabric_sim
 from tests.support.wiretools import require_tshark
 
 pytestmark = [pytest.mark.rtl, pytest.mark.timeout(300)]
@@ -97,7 +97,7 @@ def _start_cli(tmp_path: Path, config: Path = SCAN_CDR, *extra: str,
 
 def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    require_verilator()
+    require_fabric_sim()
     dds = cyclone()
     monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
     from tests.support import cdrtypes as T
@@ -126,6 +126,8 @@ def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
             (len(got), "".join(lines))
         print(f"matched after {matched:.2f} s, {SCANS} scans back after "
               f"{time.monotonic() - t0:.2f} s")
+        del writer, reader, dp                 # its goodbye: the next test's peer is its own
+        gc.collect()
         stdout, _ = stop_with(proc, signal.SIGINT)
     finally:
         kill_if_running(proc)
@@ -146,7 +148,7 @@ def test_rclpy_sees_the_fabric_node_in_the_ros2_graph(tmp_path: Path) -> None:
     """What ``ros2 node list`` / ``ros2 node info`` / ``ros2 topic list -t`` read, of the node
     whose discovery is the circuit's ROMs: the node from its ros_discovery_info sample, its
     endpoints from its SEDP data."""
-    require_verilator()
+    require_fabric_sim()
     require_ros2()
     config = load_config(SCAN_CDR)
     build_fabric_sim(config, render_rom(config, domain=DOMAIN))   # the CLI's, cached
@@ -193,7 +195,7 @@ def test_cyclone_images_64x48_through_the_simulated_fabric_exact(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """sensor_msgs/Image 64x48 rgba8 (12 kB: ten DATA_FRAG datagrams each way) through the
     fabric's dilation, exact against OpenCV's 3x3 dilation of what was sent."""
-    require_verilator()
+    require_fabric_sim()
     dds = cyclone()
     monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
     path = tmp_path / "fpga_dilate_64x48_cdr.yaml"
@@ -221,6 +223,8 @@ def test_cyclone_images_64x48_through_the_simulated_fabric_exact(
         assert wait(lambda: got.extend(reader.take(10)) or len(got) >= IMAGES, 15), \
             (len(got), "".join(lines))
         print(f"{IMAGES} images back after {time.monotonic() - t0:.2f} s")
+        del writer, reader, dp                 # its goodbye: the next test's peer is its own
+        gc.collect()
         stdout, _ = stop_with(proc, signal.SIGINT)
     finally:
         kill_if_running(proc)
@@ -243,7 +247,7 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
     interface with no malformed packet; the interface is gone after the command."""
     from rosfpga_lab.graph.tap import tap_missing_reason
 
-    require_verilator()
+    require_fabric_sim()
     reason = tap_missing_reason()
     if reason:
         skip_or_fail(reason, REQUIRE)
@@ -301,8 +305,7 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
     assert rows("_ws.malformed || _ws.expert.severity >= error") == []
     assert len(rows(f"ip.src == {TAP_NODE_ADDRESS} && rtps.sm.id == 0x16")) >= 2 * SCANS
     assert rows(f"ip.src == {TAP_NODE_ADDRESS} && rtps.sm.id == 0x15")     # SPDP, SEDP...
-    gone = subprocess.run(["ip", "link", "show", TAP_NAME], capture_output=True, timeout=10)
-    assert gone.returncode != 0, "the TAP interface outlived the command"
+    assert not Path(f"/sys/class/net/{TAP_NAME}").exists(), "the TAP interface outlived the command"
 
 
 def test_one_640x480_image_fragments_through_the_simulated_fabric_exact(
@@ -310,7 +313,7 @@ def test_one_640x480_image_fragments_through_the_simulated_fabric_exact(
     """data/fpga_dilate_rgba8_cdr.yaml as shipped: one 640x480 rgba8 sample (1.2 MB: some 900
     DATA_FRAGs each way, stored whole in the circuit's buffer, --max-bytes) exact against
     OpenCV; the clock unthrottled (--rate 0). Some 10 s here, a first build some 45 s."""
-    require_verilator()
+    require_fabric_sim()
     dds = cyclone()
     monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
     config = load_config(BIG_CONFIG)
@@ -331,6 +334,8 @@ def test_one_640x480_image_fragments_through_the_simulated_fabric_exact(
         writer.write(image(dds, pic, "rgba8", sec=1, frame_id="cam"))
         assert wait(lambda: got.extend(reader.take(10)) or len(got) >= 1, 60), "".join(lines)
         print(f"640x480 back after {time.monotonic() - t0:.2f} s")
+        del writer, reader, dp                 # its goodbye: the next test's peer is its own
+        gc.collect()
         stdout, _ = stop_with(proc, signal.SIGINT)
     finally:
         kill_if_running(proc)
