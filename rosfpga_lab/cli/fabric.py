@@ -72,8 +72,6 @@ def run_sim(args: argparse.Namespace) -> int:
     """Build, start, bridge for --seconds, print the counters."""
     from rosfpga_lab.component.fabricsim import TAP_HOST_CIDR, TAP_NAME, start_fabric
     from rosfpga_lab.config import load_config
-    from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
-    from rosfpga_lab.rtl.fabricsim import fabric_top_default
     from rosfpga_lab.rtl.fabricsim import SIM_PERIOD, SIM_RATE
     from rosfpga_lab.rtps.entities import check_domain
 
@@ -96,11 +94,6 @@ def run_sim(args: argparse.Namespace) -> int:
         return 2
     check_domain(args.domain)
     config = load_config(args.config)
-    bound = cdr_layout_from_config(config).layout.max_body + 4   # with the reader's length
-    held = args.max_bytes or int(fabric_top_default("MAX_BYTES"))
-    if bound > held:
-        say(f"note: {args.config} accepts samples up to {bound} bytes; the circuit takes "
-            f"{held} (--max-bytes {bound} takes them all)")
     say(f"building (or taking from the cache) the Verilator model of {args.config} ...")
     bridge = start_fabric(config, domain=args.domain, tap=args.tap,
                           period=args.period or SIM_PERIOD,

@@ -72,8 +72,9 @@ from rosfpga_lab.graph.tap import TapDevice
 from rosfpga_lab.graph.udpports import UdpPorts
 from rosfpga_lab.rtl.board import DEFAULT_MAC, mac_value
 from rosfpga_lab.rtl.discrom import DiscoveryRom, render_rom
+from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.rtl.fabricsim import (
-    SIM_PERIOD, SIM_RATE, FabricConfig, FabricSim, build_fabric_sim,
+    SIM_PERIOD, SIM_RATE, FabricConfig, FabricSim, build_fabric_sim, fabric_top_default,
 )
 from rosfpga_lab.rtl.limits import FABRIC_MAX_DATAGRAM
 from rosfpga_lab.rtps import build as b
@@ -438,7 +439,13 @@ def start_fabric(config: NodeConfig, *, domain: int = 0, tap: bool = False,
     :func:`~rosfpga_lab.rtl.fabricsim.build_fabric_sim`), bridged by a :class:`ShimBridge` or a
     :class:`TapBridge` (call its ``start`` and ``run``, then ``close`` it and its ``sim``)."""
     address = address or (TAP_NODE_ADDRESS if tap else "127.0.0.1")
-    rom = render_rom(config, domain=domain, address=address)
+    rom = render_rom(config, domain=domain, address=address)    # wire: cdr checked there
+    bound = cdr_layout_from_config(config).layout.max_body + 4   # with the reader's length
+    held = max_bytes or int(fabric_top_default("MAX_BYTES"))
+    if bound > held:
+        log(f"note: {config.path or 'the configuration'} accepts samples up to {bound} bytes; "
+            f"the circuit takes {held} (longer ones are dropped and counted; max_bytes "
+            f"{bound}, --max-bytes on the command line, takes them all)")
     started = time.monotonic()
     build = build_fabric_sim(config, rom, period=period, max_bytes=max_bytes)
     how = f"built in {build.seconds:.0f} s" if build.seconds else "from the cache"

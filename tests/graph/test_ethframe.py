@@ -77,3 +77,22 @@ def test_the_bridge_reads_a_peers_locators_from_its_spdp() -> None:
                                                         ("127.0.0.1", 7417))
     assert spdp_peer(b"RTPS" + bytes(16), ("127.0.0.1", 1)) is None
     assert spdp_peer(b"not rtps", ("127.0.0.1", 1)) is None
+
+
+def test_the_bridge_reads_a_readers_own_locator_from_sedp() -> None:
+    """A reader's SEDP data (the lab's builder) with a unicast locator of its own, in a datagram
+    from the subscriptions writer: the bridge learns its topic and locator; from another writer
+    (publications) nothing."""
+    from rosfpga_lab.component.fabricsim import sedp_reader_locators
+    from rosfpga_lab.rtps import build as b
+    from rosfpga_lab.rtps.entities import PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER
+
+    prefix = bytes(range(12))
+    data = b.sedp_payload(prefix + bytes.fromhex("00000104"), "ros_discovery_info",
+                          "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_", True, 1,
+                          b.Locator("127.0.0.1", 7000), transient_local=True)
+    sub = b.header(prefix) + b.data(SUB_READER, SUB_WRITER, 1, b.pad_payload(data))
+    assert sedp_reader_locators(sub, ("127.0.0.1", 40000)) == [("ros_discovery_info",
+                                                                ("127.0.0.1", 7000))]
+    pub = b.header(prefix) + b.data(PUB_READER, PUB_WRITER, 1, b.pad_payload(data))
+    assert sedp_reader_locators(pub, ("127.0.0.1", 40000)) == []
