@@ -55,10 +55,12 @@ TOP = "rfl_fabric_top"
 #: The fabric's Verilog in read order: the vendored core's GMII variant first.
 SOURCES = ("vendor/liteeth_udp_gmii.v", "rfl_udp_store.v", "rfl_udp_port.v", *FABRIC_NODE,
            f"{TOP}.v")
-#: The counters the program reports, in its order (the top's cnt_* outputs, then the answers'
-#: byte credit).
+#: The counters the program reports, in its order (the top's cnt_* outputs, the answers' byte
+#: credit, then the generated subscriber's verdicts: samples judged, refused, the last refusal's
+#: status code, the walk's table: ``spec.program.statuses``).
 COUNTERS = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_length",
-            "rx_overflow", "tx_packets", "tx_overflow", "rx_port", "credit")
+            "rx_overflow", "tx_packets", "tx_overflow", "rx_port", "credit", "judged",
+            "refused", "last_refusal")
 #: The simulation's SPDP period in clocks and the clock rate it is run at (clocks per second of
 #: wall time): an announcement about every second, as the board's (rtps.limits.ANNOUNCE_SECONDS
 #: at 125 MHz), if the model keeps up.

@@ -53,7 +53,9 @@ def test_the_fast_model_sends_what_the_cocotb_bench_expects(tmp_path: Path) -> N
         report = sim.close()
     sent += report.frames
     assert report.clocks >= MAX_CLOCKS, report.clocks   # it ran to its bound
-    counters = {k: v for k, v in report.counters.items() if k != "credit"}
+    counters = {k: v for k, v in report.counters.items()
+                if k not in ("credit", "judged", "refused", "last_refusal")}
+    assert (report.counters["judged"], report.counters["refused"]) == (1, 0)
     check_sent(sc, [PREAMBLE + f.hex() for f in sent], counters)
 
 

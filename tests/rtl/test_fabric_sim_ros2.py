@@ -139,8 +139,9 @@ def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
     counters = dict(kv.rsplit(" ", 1) for kv in
                     next(x for x in stdout.splitlines() if x.startswith("circuit: "))
                     [len("circuit: "):].split(", "))
-    assert (counters["samples"], counters["rx_error"], counters["rx_overflow"],
-            counters["tx_overflow"]) == (str(SCANS), "0", "0", "0"), stdout
+    assert (counters["samples"], counters["judged"], counters["refused"], counters["rx_error"],
+            counters["rx_overflow"], counters["tx_overflow"]) == \
+        (str(SCANS), str(SCANS), "0", "0", "0", "0"), stdout
     assert "bridge: peers learned: 1;" in stdout, stdout
 
 
@@ -236,7 +237,8 @@ def test_cyclone_images_64x48_through_the_simulated_fabric_exact(
         assert (out.header.stamp.sec, out.header.frame_id) == (k, "cam")
         assert bytes(out.data) == want.tobytes(), f"image {k}"
     counters = _counters(stdout)
-    assert (counters["samples"], counters["rx_overflow"]) == (str(IMAGES), "0"), stdout
+    assert (counters["samples"], counters["judged"], counters["refused"],
+            counters["rx_overflow"]) == (str(IMAGES), str(IMAGES), "0", "0"), stdout
 
 
 def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(

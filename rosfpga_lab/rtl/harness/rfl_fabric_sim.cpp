@@ -17,7 +17,9 @@
 //                'F' a frame for gmii_rxd;  'S' a one-clock send_sedp pulse;
 //                'K' counters now;  'Q' (or end of input): counters, then exit
 //   sim -> host  'F' a frame from gmii_txd;  'K' u64 clocks, then the counters as u32 in
-//                COUNTER_NAMES' order (rosfpga_lab.rtl.fabricsim.COUNTERS)
+//                rosfpga_lab.rtl.fabricsim.COUNTERS' order: the top's cnt_* and credit, then
+//                the generated subscriber's verdicts (status_valid pulses), the refusals among
+//                them (status not 0) and the last refusal's code
 #include "Vrfl_fabric_top.h"
 #include "verilated.h"
 
@@ -75,6 +77,7 @@ struct Fabric {
     std::vector<uint8_t> tx_frame;
     bool tx_on = false;
     int sedp = 0;
+    uint32_t statuses = 0, refused = 0, last_status = 0;   // the generated subscriber's verdicts
 
     explicit Fabric(Vrfl_fabric_top* t) : top(t) {}
 
@@ -132,19 +135,24 @@ struct Fabric {
         top->clk = 1;
         top->eval();
         collect_tx();
+        if (top->status_valid) {
+            ++statuses;
+            if (top->status != 0) { ++refused; last_status = top->status; }
+        }
         top->clk = 0;
         top->eval();
         ++clocks;
     }
 
     void counters() {
-        uint32_t c[11] = {top->cnt_samples, top->cnt_answers, top->cnt_no_credit,
+        uint32_t c[14] = {top->cnt_samples, top->cnt_answers, top->cnt_no_credit,
                           top->cnt_rx_packets, top->cnt_rx_error, top->cnt_rx_length,
                           top->cnt_rx_overflow, top->cnt_tx_packets, top->cnt_tx_overflow,
-                          top->cnt_rx_port, (uint32_t)top->credit};
+                          top->cnt_rx_port, (uint32_t)top->credit, statuses, refused,
+                          last_status};
         uint8_t out[8 + sizeof c];
         for (int i = 0; i < 8; ++i) out[i] = (uint8_t)(clocks >> (8 * i));
-        for (int k = 0; k < 11; ++k)
+        for (int k = 0; k < 14; ++k)
             for (int i = 0; i < 4; ++i) out[8 + 4 * k + i] = (uint8_t)(c[k] >> (8 * i));
         put_record('K', out, sizeof out);
     }
