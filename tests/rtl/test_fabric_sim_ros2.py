@@ -37,7 +37,7 @@ import numpy as np
 import pytest
 
 from rosfpga_lab.component.fabricsim import (
-    TAP_NAME, TAP_NODE_ADDRESS, fabric_peer_uri, fabric_tap_peer_uri,
+    TAP_NAME, TAP_NODE_ADDRESS, fabric_peer_uri, fabric_tap_peer_uri, fastdds_peer_profile,
 )
 from rosfpga_lab.config import load_config
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline
@@ -185,6 +185,55 @@ def test_rclpy_sees_the_fabric_node_in_the_ros2_graph(tmp_path: Path) -> None:
             ("fpga_scan_min", "/", "sensor_msgs/msg/LaserScan", kind)
         assert (info["reliability"], info["durability"]) == ("RELIABLE", "VOLATILE")
         assert info["type_hash"] == GOLDEN["sensor_msgs/LaserScan"]
+
+
+def _rclpy_env(tmp_path: Path, domain: int) -> dict[str, str]:
+    """A real ROS 2 process on Fast DDS, loopback discovery, ``domain``; nothing of the
+    caller's ROS, RMW or DDS settings."""
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("ROS_", "RMW_", "FASTRTPS_", "FASTDDS_", "CYCLONEDDS_"))}
+    env.update(ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+               RMW_IMPLEMENTATION="rmw_fastrtps_cpp", ROS_LOG_DIR=str(tmp_path / "ros_log"),
+               ROS_HOME=str(tmp_path / "ros_home"))
+    return env
+
+
+def test_rclpy_images_64x48_through_the_simulated_fabric_exact(tmp_path: Path) -> None:
+    """rclpy (Fast DDS, a profile that keeps datagrams to one frame: DATA_FRAGs) publishes two
+    64x48 rgba8 images with ROS 2's default QoS and subscribes to the output: each exact
+    against OpenCV's dilation of what it sent (tests/ros_programs/rclpy_peer.py's pictures)."""
+    from tests.flow.test_ros2_realros2 import cv2_dilate, picture
+
+    require_fabric_sim()
+    require_ros2()
+    path = tmp_path / "fpga_dilate_64x48_cdr.yaml"
+    path.write_text(IMAGE_CONFIG)
+    config = load_config(path)
+    build_fabric_sim(config, render_rom(config, domain=DOMAIN), max_bytes=IMAGE_MAX_BYTES)
+    profile = tmp_path / "fastdds.xml"
+    profile.write_text(fastdds_peer_profile())
+    env = dict(_rclpy_env(tmp_path, DOMAIN), FASTRTPS_DEFAULT_PROFILES_FILE=str(profile))
+    proc, lines = _start_cli(tmp_path, path, "--max-bytes", str(IMAGE_MAX_BYTES))
+    out = tmp_path / "got"
+    out.mkdir()
+    try:
+        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
+                    60) and proc.poll() is None, "".join(lines)
+        peer = subprocess.run([sys.executable, str(ROS_PROGRAMS / "rclpy_peer.py"), "relay",
+                               "/image_raw", "/image_dilated", "64", "48", str(IMAGES),
+                               "--out", str(out), "--timeout", "15"], input="go\n",
+                              capture_output=True, text=True, env=env, timeout=60)
+        stdout, _ = stop_with(proc, signal.SIGINT)
+    finally:
+        kill_if_running(proc)
+    assert peer.returncode == 0, (peer.stderr[-2000:], "".join(lines))
+    report = json.loads(peer.stdout.strip().splitlines()[-1])
+    print(stdout)
+    assert report["matched"] and len(report["got"]) == IMAGES, (report, stdout)
+    for k in range(IMAGES):
+        assert (out / f"{k}.bin").read_bytes() == cv2_dilate(picture(k, 48, 64)).tobytes(), k
+    counters = _counters(stdout)
+    assert (counters["samples"], counters["refused"]) == (str(IMAGES), "0"), stdout
 
 
 def _counters(stdout: str) -> dict[str, str]:
