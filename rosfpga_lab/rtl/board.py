@@ -20,9 +20,7 @@ import sys
 from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig
-from rosfpga_lab.rtl.discrom import (
-    DiscoveryRom, node_parameters, top_parameters, verilog_parameters,
-)
+from rosfpga_lab.rtl.discrom import DiscoveryRom, fabric_top_literals
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.limits import ECP5_DEVICE, ECP5_PACKAGE
 from rosfpga_lab.rtl.project import node_sources
@@ -34,7 +32,7 @@ from rosfpga_lab.rtps.entities import discovery_port, user_port
 from rosfpga_lab.rtps.limits import ANNOUNCE_SECONDS, SPDP_MULTICAST_ADDRESS
 
 __all__ = ["BOARD", "BOARD_TOP", "BOARD_DIR", "BIT_FILE", "CLOCK_HZ", "DEFAULT_MAC",
-           "board_parameters", "default_peer", "write_board", "clock_lines", "main"]
+           "board_parameters", "default_peer", "mac_value", "write_board", "clock_lines", "main"]
 
 BOARD = "Colorlight 5A-75B v8.0"
 BOARD_TOP = "rfl_board_5a75b"
@@ -54,7 +52,8 @@ _BITS = {"MAC": 48, "IP": 32, "PEER_IP": 32, "PEER_META_PORT": 16, "PEER_USER_PO
          "READER": 32, "TIME": 64}
 
 
-def _mac(text: str) -> int:
+def mac_value(text: str) -> int:
+    """A MAC written ``02:52:46:4c:00:02`` as the 48-bit number the circuit's registers hold."""
     parts = text.split(":")
     if len(parts) != 6 or not all(len(p) == 2 for p in parts):
         raise RtlError(f"MAC {text!r} is not six hex pairs separated by ':'")
@@ -90,13 +89,12 @@ def board_parameters(rom: DiscoveryRom, *, peer_ip: str, peer_index: int = 0,
     if peer == node_ip:
         raise RtlError(f"the peer's address {peer_ip} is the node's own")
     own: dict[str, int] = {
-        "MAC": _mac(mac), "IP": node_ip, "PEER_IP": peer,
+        "MAC": mac_value(mac), "IP": node_ip, "PEER_IP": peer,
         "PEER_META_PORT": discovery_port(rom.domain, peer_index),
         "PEER_USER_PORT": user_port(rom.domain, peer_index),
         "READER": rom.entity_ids["reader"], "TIME": 0}
     params = {k: f"{_BITS[k]}'h{v:x}" for k, v in own.items()}
-    params.update(node_parameters(rom, period=round(ANNOUNCE_SECONDS * CLOCK_HZ)))
-    params.update(verilog_parameters(top_parameters(rom)))
+    params.update(fabric_top_literals(rom, period=round(ANNOUNCE_SECONDS * CLOCK_HZ)))
     return params
 
 

@@ -471,3 +471,10 @@ def node_parameters(rom: DiscoveryRom, *, period: int) -> dict[str, str]:
             "ROM_BYTES": str(len(rom.image())), "MESSAGES": str(len(rom.messages)),
             "ANSWER_FILE": f'"{ANSWER_FILE}"', "ANSWER_TABLE_FILE": f'"{ANSWER_TABLE_FILE}"',
             **{k: str(v) for k, v in answer_params(rom).items()}}
+
+
+def fabric_top_literals(rom: DiscoveryRom, *, period: int) -> dict[str, str]:
+    """``fabric/rfl_fabric_top.v``'s parameters as Verilog literals: the node's
+    (:func:`node_parameters`) and the ports (:func:`top_parameters`); the board top, the simulated
+    top, the demo and the tests take them from here."""
+    return {**node_parameters(rom, period=period), **verilog_parameters(top_parameters(rom))}

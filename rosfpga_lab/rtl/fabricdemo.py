@@ -35,8 +35,7 @@ import numpy as np
 
 from rosfpga_lab.config import NodeConfig, parse_config
 from rosfpga_lab.rtl.discrom import (
-    fabric_participant, node_parameters, render_rom, top_parameters, verilog_parameters,
-    write_rom,
+    fabric_participant, fabric_top_literals, render_rom, write_rom,
 )
 from rosfpga_lab.rtl.errors import RtlError, SimulatorMissingError
 from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, FABRIC_DEMO_MAX_CLOCKS, RUN_TIMEOUT
@@ -193,8 +192,7 @@ def demo_frames(config: NodeConfig | None = None) -> list[bytes]:
 def _params(config: NodeConfig, where: Path) -> tuple[dict[str, str], int]:
     rom = render_rom(config)
     write_rom(rom, where)
-    params = dict(node_parameters(rom, period=PERIOD),
-                  **verilog_parameters(top_parameters(rom)), MAX_BYTES="2048")
+    params = dict(fabric_top_literals(rom, period=PERIOD), MAX_BYTES="2048")
     return params, 2                    # out: the SPDP announcement, then one DATA datagram
 
 

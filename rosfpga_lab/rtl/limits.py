@@ -73,3 +73,7 @@ MAX_ANSWER_SLOTS = 8
 #: Clocks the fabric demo (notebook 12's run, ``rtl.fabricdemo``) waits for its frames out
 #: after the peer's last frame in, before it gives up.
 FABRIC_DEMO_MAX_CLOCKS = 40_000
+
+#: The largest record the fabric simulation's program takes on its stdin (an Ethernet frame, its
+#: configuration; harness/rfl_fabric_sim.cpp's MAX_RECORD).
+FABRIC_SIM_MAX_RECORD = 1 << 16

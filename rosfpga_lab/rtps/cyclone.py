@@ -16,15 +16,21 @@ from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX
 __all__ = ["cyclone_loopback_uri"]
 
 
-def cyclone_loopback_uri(lease_seconds: float | None = None) -> str:
+def cyclone_loopback_uri(lease_seconds: float | None = None,
+                         max_message_bytes: int | None = None) -> str:
     """The ``CYCLONEDDS_URI`` value for a DDS graph on 127.0.0.1 without multicast.
 
     Args:
         lease_seconds: the participant lease Cyclone announces (None: Cyclone's default, 10 s).
+        max_message_bytes: the longest datagram Cyclone sends (None: its default, 14720 bytes,
+            which a network port passes as IP fragments; a peer that reassembles none, as the
+            node in the fabric, needs at most one Ethernet frame's payload, 1472).
     """
     lease = "" if lease_seconds is None else f"<LeaseDuration>{lease_seconds:g}s</LeaseDuration>"
+    size = ("" if max_message_bytes is None else
+            f"<MaxMessageSize>{max_message_bytes}B</MaxMessageSize>")
     return ('<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/>'
-            '</Interfaces><AllowMulticast>false</AllowMulticast></General><Discovery><Peers>'
+            f'</Interfaces><AllowMulticast>false</AllowMulticast>{size}</General><Discovery><Peers>'
             '<Peer address="localhost"/></Peers><ParticipantIndex>auto</ParticipantIndex>'
             f'<MaxAutoParticipantIndex>{MAX_PARTICIPANT_INDEX}</MaxAutoParticipantIndex>{lease}'
             '</Discovery></Domain></CycloneDDS>')

@@ -28,6 +28,7 @@ import struct
 import subprocess
 import sys
 import zlib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -38,8 +39,7 @@ from scapy.layers.l2 import ARP, Ether
 from rosfpga_lab.config import load_config
 from rosfpga_lab.rtl.discanswer import AnswerModel
 from rosfpga_lab.rtl.discrom import (
-    fabric_participant, node_parameters, render_rom, top_parameters, tx_parameters,
-    verilog_parameters, write_rom,
+    DiscoveryRom, fabric_participant, fabric_top_literals, render_rom, tx_parameters, write_rom,
 )
 from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, FABRIC_TOP_GMII
 from rosfpga_lab.rtl.sim import cache_root, simulator_version
@@ -112,17 +112,23 @@ def _build(runner: Runner, gen: Path, params: dict[str, str], tmp_path: Path) ->
     return build
 
 
-@pytest.mark.timeout(600)
-def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
-                                                          monkeypatch: pytest.MonkeyPatch) -> None:
-    cocotb_verilator(monkeypatch)
-    monkeypatch.syspath_prepend(str(TB_DIR))
-    from cocotb_tools.runner import get_runner
+@dataclass
+class Scenario:
+    """The peer's frames and what must come out (built from the lab's software only)."""
 
-    gen = tmp_path / "project"
-    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr
+    rom: DiscoveryRom
+    case: dict[str, object]
+    params: dict[str, str]
+    sample: list[bytes]
+    want_user: list[bytes]
+    answers: list
+    wid: int
+    guid_prefix: bytes
+
+
+def scenario(tmp_path: Path) -> Scenario:
+    """The ROM (written into ``tmp_path``), the frames the peer sends, the ARP reply it gives,
+    the top's parameters and the expected datagrams (the module docstring says which)."""
     config = load_config(CONFIG)
     rom = render_rom(config, guid_prefix=LOCAL)  # the node's one prefix (the ROMs')
     write_rom(rom, tmp_path)
@@ -153,22 +159,21 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
             "reader": READER, "writer": WRITER, "time": TIME,
             "frames": [f.hex() for f in frames], "arp_reply": reply.hex(), "gap": 50,
             "expect": 1 + len(want_user) + len(answers), "max_clocks": MAX_CLOCKS}
-    (tmp_path / "case.json").write_text(json.dumps(case))
+    params = dict(fabric_top_literals(rom, period=PERIOD), MAX_BYTES=str(MAX_BYTES))
+    return Scenario(rom, case, params, sample, want_user, answers, wid, part.guid_prefix)
 
-    params = dict(node_parameters(rom, period=PERIOD), **verilog_parameters(top_parameters(rom)),
-                  MAX_BYTES=str(MAX_BYTES))
-    runner = get_runner("verilator")
-    build = _build(runner, gen, params, tmp_path)
-    run_bench(runner, "bench_rfl_fabric_top", "rfl_fabric_top", build, tmp_path,
-              {"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
-               "FABRIC_TOP_OUT": str(tmp_path / "out.json")})
-    out = json.loads((tmp_path / "out.json").read_text())
 
-    sent = [Ether(f) for f in _frames(out["sent"])]
-    arp = [f for f in sent if f.haslayer(ARP)]
+def check_sent(sc: Scenario, sent: list[str], counters: dict[str, int]) -> None:
+    """What the node sent (frames as the GMII sink saw them, preamble and FCS included, hex)
+    is what ``sc`` expects, and the counters say why nothing else came."""
+    rom, p = sc.rom, tx_parameters(sc.rom)
+    spdp_port, meta, user = discovery_multicast_port(0), discovery_port(0, 0), user_port(0, 0)
+    peer_meta, peer_user = discovery_port(0, PEER_INDEX), user_port(0, PEER_INDEX)
+    sent_frames = [Ether(f) for f in _frames(sent)]
+    arp = [f for f in sent_frames if f.haslayer(ARP)]
     assert all(f[ARP].op == 1 and f[ARP].pdst == PEER_IP for f in arp)   # it asks for the peer
-    udp = [f for f in sent if f.type == 0x0800]
-    assert len(sent) == len(arp) + len(udp)
+    udp = [f for f in sent_frames if f.type == 0x0800]
+    assert len(sent_frames) == len(arp) + len(udp)
     for f in udp:
         assert (f.src, f[IP].src, f[IP].ihl, f[IP].proto) == (NODE_MAC, NODE_IP, 5, 17)
         assert sum(struct.unpack(">10H", bytes(f[IP])[:20])) % 0xFFFF == 0, "IPv4 checksum"
@@ -185,17 +190,39 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
     assert to(SPDP_MULTICAST_ADDRESS, spdp_port) == [rom.messages[0].data]
     # (2) the sample, as the software writer sends it, from the user-data port
     got_user = to(PEER_IP, peer_user)
-    assert got_user == want_user
-    check_parsed(got_user, sample, MAX_BYTES, part.guid_prefix, wid, p["READER_ID"], True)
+    assert got_user == sc.want_user
+    check_parsed(got_user, sc.sample, MAX_BYTES, sc.guid_prefix, sc.wid, p["READER_ID"], True)
     assert all(f[UDP].sport == user for f in udp if f[UDP].dport == peer_user)
     # (3) the answers to the ACKNACK, to the peer's metatraffic port
-    assert to(PEER_IP, peer_meta) == [x.data for x in answers]
+    assert to(PEER_IP, peer_meta) == [x.data for x in sc.answers]
     assert all(f.dst == PEER_MAC for f in udp if f[IP].dst == PEER_IP)
-    assert len(udp) == 1 + len(want_user) + len(answers)          # nothing else
-    assert out["counters"] == {
-        "samples": 1, "answers": len(answers), "no_credit": 0, "rx_packets": 5, "rx_error": 2,
-        "rx_length": 0, "rx_overflow": 0, "tx_packets": len(udp), "tx_overflow": 0,
-        "rx_port": 1}
+    assert len(udp) == 1 + len(sc.want_user) + len(sc.answers)          # nothing else
+    assert counters == {
+        "samples": 1, "answers": len(sc.answers), "no_credit": 0, "rx_packets": 5,
+        "rx_error": 2, "rx_length": 0, "rx_overflow": 0, "tx_packets": len(udp),
+        "tx_overflow": 0, "rx_port": 1}
+
+
+@pytest.mark.timeout(600)
+def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    cocotb_verilator(monkeypatch)
+    monkeypatch.syspath_prepend(str(TB_DIR))
+    from cocotb_tools.runner import get_runner
+
+    gen = tmp_path / "project"
+    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
+                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    sc = scenario(tmp_path)
+    (tmp_path / "case.json").write_text(json.dumps(sc.case))
+    runner = get_runner("verilator")
+    build = _build(runner, gen, sc.params, tmp_path)
+    run_bench(runner, "bench_rfl_fabric_top", "rfl_fabric_top", build, tmp_path,
+              {"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
+               "FABRIC_TOP_OUT": str(tmp_path / "out.json")})
+    out = json.loads((tmp_path / "out.json").read_text())
+    check_sent(sc, out["sent"], out["counters"])
 
 
 @pytest.mark.parametrize("bug", [

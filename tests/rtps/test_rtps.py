@@ -270,3 +270,6 @@ def test_the_cyclone_configuration_probes_the_indices_the_lab_probes() -> None:
     assert root.find("Domain/General/Interfaces/NetworkInterface").get("address") == "127.0.0.1"
     assert root.find("Domain/Discovery/LeaseDuration") is None
     assert ET.fromstring(cyclone_loopback_uri(1.5)).findtext("Domain/Discovery/LeaseDuration") == "1.5s"
+    assert root.find("Domain/General/MaxMessageSize") is None
+    sized = ET.fromstring(cyclone_loopback_uri(max_message_bytes=1472))
+    assert sized.findtext("Domain/General/MaxMessageSize") == "1472B"

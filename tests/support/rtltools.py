@@ -80,6 +80,16 @@ def require_verilator() -> str:
     return found
 
 
+def require_fabric_sim() -> None:
+    """Skip (or fail under CI) unless the fabric's Verilator model can be built here (Verilator
+    and a C++ compiler: ``rosfpga_lab.rtl.fabricsim``)."""
+    from rosfpga_lab.rtl.fabricsim import fabric_missing_reason
+
+    reason = fabric_missing_reason()
+    if reason:
+        skip_or_fail(reason, REQUIRE)
+
+
 def require_nextpnr() -> None:
     """Skip (or fail under CI) unless Yosys and nextpnr-ecp5 can place and route."""
     from rosfpga_lab.rtl.timing import timing_missing_reason
