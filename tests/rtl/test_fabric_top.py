@@ -20,16 +20,9 @@ files it was built from), then the whole test some 6 s.
 
 from __future__ import annotations
 
-import hashlib
 import ipaddress
-import json
-import shutil
 import struct
-import subprocess
-import sys
-import zlib
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import pytest
 from scapy.layers.inet import IP, UDP
@@ -37,12 +30,7 @@ from scapy.layers.l2 import ARP, Ether
 
 from rosfpga_lab.config import load_config
 from rosfpga_lab.rtl.discanswer import AnswerModel
-from rosfpga_lab.rtl.discrom import (
-    ANSWER_FILE, ANSWER_TABLE_FILE, ROM_FILE, TABLE_FILE, answer_params, fabric_participant,
-    render_rom, top_parameters, tx_parameters, verilog_parameters, write_rom,
-)
-from rosfpga_lab.rtl.proofs import FABRIC_NODE
-from rosfpga_lab.rtl.sim import cache_root, simulator_version
+from rosfpga_lab.rtl.discrom import fabric_participant, render_rom, tx_parameters, write_rom
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
     PUB_READER, PUB_WRITER, discovery_multicast_port, discovery_port, user_port,
@@ -54,10 +42,8 @@ from tests.rtl.test_fabric_rtps_loop import TIME, published
 from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER
 from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
 from tests.rtl.test_fabric_udp import PEER_IP, PEER_MAC, _fcs, _frames, _group_mac
+from tests.support import fabrictop
 from tests.support.rtltools import TB_DIR, cocotb_verilator
-
-if TYPE_CHECKING:
-    from cocotb_tools.runner import Runner
 
 pytestmark = pytest.mark.rtl
 
@@ -66,8 +52,7 @@ PEER = bytes.fromhex("010fcafe0000000100000001")
 PEER_INDEX = 1
 PERIOD = 1_000_000       # one SPDP announcement (at reset) in the run
 MAX_CLOCKS = 200_000
-SOURCES = [FABRIC / "vendor" / "liteeth_udp_gmii.v"] + [FABRIC / m for m in (
-    "rfl_udp_store.v", "rfl_udp_port.v", *FABRIC_NODE, "rfl_fabric_top.v")]
+SOURCES = fabrictop.SOURCES                      # tests/rtl/test_lint.py lints them
 
 
 def _udp(payload: bytes, dport: int, sport: int = 40000) -> bytes:
@@ -85,44 +70,14 @@ def _ip(addr: str) -> str:
     return ipaddress.IPv4Address(addr).packed.hex()
 
 
-def _build(runner: Runner, gen: Path, params: dict[str, str], tmp_path: Path) -> Path:
-    """Verilator's build, kept in the lab's RTL cache keyed by the sources (the generated ones
-    too), the parameters and the tools (its dependency files name absolute paths)."""
-    import cocotb
-
-    rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
-    digest = hashlib.sha256(f"{cocotb.__file__} {simulator_version('verilator')}".encode())
-    for path in [*SOURCES, *rtl, *sorted((gen / "rtl").glob("*.vh"))]:
-        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
-    digest.update(json.dumps(params, sort_keys=True).encode())
-    build = cache_root() / f"cocotb-fabric-top-{digest.hexdigest()[:20]}"
-    # the generated files kept beside the build: the runner rebuilds for sources newer than it
-    kept = build / "generated"
-    if not kept.is_dir():
-        kept.mkdir(parents=True)
-        for path in (gen / "rtl").iterdir():
-            if path.suffix in (".v", ".vh") and path.name != "rfl_tb.v":
-                shutil.copy2(path, kept / path.name)
-    rtl = sorted(kept.glob("*.v"))
-    runner.build(
-        sources=[*SOURCES, *rtl], includes=[kept], hdl_toplevel="rfl_fabric_top",
-        parameters=params, build_dir=build, timescale=("1ns", "1ps"),
-        build_args=["-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT"],
-        log_file=tmp_path / "build.log")
-    return build
-
-
 @pytest.mark.timeout(600)
 def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
                                                           monkeypatch: pytest.MonkeyPatch) -> None:
     cocotb_verilator(monkeypatch)
     monkeypatch.syspath_prepend(str(TB_DIR))
-    from cocotb_tools.runner import get_results, get_runner
+    from cocotb_tools.runner import get_runner
 
-    gen = tmp_path / "project"
-    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr
+    gen = fabrictop.generate(CONFIG, tmp_path / "project")
     config = load_config(CONFIG)
     rom = render_rom(config, guid_prefix=LOCAL)  # the node's one prefix (the ROMs')
     write_rom(rom, tmp_path)
@@ -153,30 +108,12 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
             "reader": READER, "writer": WRITER, "time": TIME,
             "frames": [f.hex() for f in frames], "arp_reply": reply.hex(), "gap": 50,
             "expect": 1 + len(want_user) + len(answers), "max_clocks": MAX_CLOCKS}
-    (tmp_path / "case.json").write_text(json.dumps(case))
 
-    a = answer_params(rom)
-    params = dict(verilog_parameters({**p, **top_parameters(rom)}), MAX_BYTES=str(MAX_BYTES),
-                  PERIOD=str(PERIOD), ROM_FILE=f'"{ROM_FILE}"', TABLE_FILE=f'"{TABLE_FILE}"',
-                  ROM_BYTES=str(len(rom.image())), MESSAGES=str(len(rom.messages)),
-                  ANSWER_FILE=f'"{ANSWER_FILE}"', ANSWER_TABLE_FILE=f'"{ANSWER_TABLE_FILE}"',
-                  **{k: str(a[k]) for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS",
-                                            "ANSWER_BYTES", "ANSWERS", "DST_AT", "BASE_AT",
-                                            "COUNT_START", "BURST", "RATE")})
+    params = fabrictop.top_parameters_of(rom, MAX_BYTES, PERIOD)
     runner = get_runner("verilator")
-    build = _build(runner, gen, params, tmp_path)
-    try:
-        xml = runner.test(
-            test_module="bench_rfl_fabric_top", hdl_toplevel="rfl_fabric_top", build_dir=build,
-            test_dir=tmp_path, extra_env={"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
-                                          "FABRIC_TOP_OUT": str(tmp_path / "out.json")},
-            log_file=tmp_path / "sim.log")
-        total, failed = get_results(xml)
-    except (SystemExit, RuntimeError):
-        total, failed = 1, 1
-    log = (tmp_path / "sim.log").read_text(errors="replace")
-    assert total == 1 and failed == 0, log[-4000:]
-    out = json.loads((tmp_path / "out.json").read_text())
+    build = fabrictop.build(runner, gen, params, tmp_path)
+    out = fabrictop.run(runner, build, "bench_rfl_fabric_top", case, tmp_path,
+                        "FABRIC_TOP_CASE", "FABRIC_TOP_OUT")
 
     sent = [Ether(f) for f in _frames(out["sent"])]
     arp = [f for f in sent if f.haslayer(ARP)]
