@@ -25,6 +25,7 @@ import os
 import cocotb
 from cocotb.clock import Clock
 from cocotb.triggers import ClockCycles, RisingEdge
+from cocotb.utils import get_time_from_sim_steps
 from cocotbext.eth import GmiiFrame, GmiiSink, GmiiSource
 
 ETHERTYPE_ARP = b"\x08\x06"
@@ -52,6 +53,10 @@ STAGES = {"liteeth_rx->udp_port": ("le_rx_valid", "le_rx_ready"),
 def _arp_request_for(frame: bytes, ip: bytes) -> bool:
     """Is this Ethernet frame (no preamble) an ARP request for ``ip``?"""
     return frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" and frame[38:42] == ip
+
+
+def _ns(steps: int) -> int:
+    return round(get_time_from_sim_steps(steps, "ns"))
 
 
 def _signal(dut, path: str):
@@ -97,8 +102,8 @@ async def fabric_wire(dut) -> None:
         while True:
             frame = await sink.recv()
             payload = bytes(frame.get_payload())
-            sent.append({"data": bytes(frame.data).hex(), "start": frame.sim_time_start,
-                         "end": frame.sim_time_end})
+            sent.append({"data": bytes(frame.data).hex(), "start": _ns(frame.sim_time_start),
+                         "end": _ns(frame.sim_time_end)})
             ipv4[0] += payload[12:14] == b"\x08\x00"
             if _arp_request_for(payload, peer_ip):
                 await source.send(GmiiFrame.from_raw_payload(bytes.fromhex(case["arp_reply"])))
@@ -120,7 +125,11 @@ async def fabric_wire(dut) -> None:
         cocotb.start_soon(watch())
     groups = []
     for group in case["groups"]:
-        frames = [GmiiFrame.from_raw_payload(bytes.fromhex(raw)) for raw in group["frames"]]
+        times: list[list[int]] = []               # the source sends copies: their times
+        frames = [GmiiFrame.from_raw_payload(
+            bytes.fromhex(raw), tx_complete=lambda f: times.append([_ns(f.sim_time_start),
+                                                                   _ns(f.sim_time_end)]))
+            for raw in group["frames"]]
         for k, at in group.get("errors", []):
             frames[k].error = [int(i == at) for i in range(len(frames[k].data))]
         for frame in frames:
@@ -139,7 +148,7 @@ async def fabric_wire(dut) -> None:
             clocks += 50
         await ClockCycles(dut.clk, group["quiet"])
         groups.append({"name": group["name"], "ipv4": ipv4[0], "sent": len(sent), "counters": _counters(dut),
-                       "in": [[f.sim_time_start, f.sim_time_end] for f in frames]})
+                       "in": times})
     with open(os.environ["FABRIC_WIRE_OUT"], "w") as f:
         json.dump({"sent": sent, "groups": groups,
                    "stalls": {k: {"stalled": v[0], "valid": v[1]} for k, v in stalls.items()}},
