@@ -126,7 +126,8 @@ def measure(config_path: Path, samples: int, watch: bool, work: Path) -> dict[st
             "peer_ip": _ip(PEER_IP), "peer_meta_port": discovery_port(0, PEER_INDEX),
             "peer_user_port": user_port(0, PEER_INDEX), "reader": READER, "writer": WRITER,
             "time": TIME, "arp_reply": reply.hex(), "groups": groups, "watch": watch,
-            "max_clocks": 200 * len(payload) * (samples + 2) + 200_000}
+            "max_clocks": 200 * len(payload) * (samples + 2) + 200_000,
+            "idle_clocks": 4 * len(payload) + 20_000}          # a dropped sample: no wait
     gen = fabrictop.generate(config_path, work / "project")
     runner = get_runner("verilator")
     build = fabrictop.build(runner, gen, fabrictop.top_parameters_of(rom, max_bytes, PERIOD),

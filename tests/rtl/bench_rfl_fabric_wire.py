@@ -8,7 +8,8 @@ groups of frames (whole, FCS included, hex), each with: ``gap`` (clocks of idle 
 frame, or null: back to back, cocotbext-eth's 12-byte interframe gap), ``errors`` (frame index,
 byte index: GMII rx_er raised on that byte, the preamble counted), ``expect`` (how many IPv4
 frames the node must have sent in all once the group is done) and ``samples`` (the samples its
-transmit path must have sent in all; the bench waits for both, at most ``max_clocks``) and
+transmit path must have sent in all; the bench waits for both, at most ``max_clocks``, or
+``idle_clocks`` with no frame out when given) and
 ``quiet`` (clocks waited after). After each group the counters are read:
 the top's and the node's stages' (through the hierarchy; Verilator's --public-flat-rw). With
 ``watch``, every clock each stage's stream is sampled: clocks it held data its next stage did not
@@ -140,12 +141,15 @@ async def fabric_wire(dut) -> None:
                 await source.wait()
                 await ClockCycles(dut.clk, group["gap"])
         await source.wait()
-        clocks = 0
+        clocks = idle = 0
+        seen = ipv4[0]
         while (ipv4[0] < group["expect"] or
                int(dut.cnt_samples.value) < group.get("samples", 0)) and \
-                clocks < case["max_clocks"]:
+                clocks < case["max_clocks"] and idle < case.get("idle_clocks", clocks + 1):
             await ClockCycles(dut.clk, 50)
             clocks += 50
+            idle = 0 if ipv4[0] != seen else idle + 50
+            seen = ipv4[0]
         await ClockCycles(dut.clk, group["quiet"])
         groups.append({"name": group["name"], "ipv4": ipv4[0], "sent": len(sent), "counters": _counters(dut),
                        "in": times})

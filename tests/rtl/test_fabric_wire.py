@@ -228,6 +228,7 @@ def wire(tmp_path_factory: pytest.TempPathFactory) -> dict:
 
 
 def _run(tmp_path: Path) -> dict:
+    """Every family and a good sample after each through the top; the run and the models."""
     from cocotb_tools.runner import get_runner
 
     gen = fabrictop.generate(CONFIG, tmp_path / "project")
