@@ -20,17 +20,10 @@ files it was built from), then the whole test some 6 s.
 
 from __future__ import annotations
 
-import hashlib
 import ipaddress
-import json
-import shutil
 import struct
-import subprocess
-import sys
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import pytest
 from scapy.layers.inet import IP, UDP
@@ -41,8 +34,6 @@ from rosfpga_lab.rtl.discanswer import AnswerModel
 from rosfpga_lab.rtl.discrom import (
     DiscoveryRom, fabric_participant, fabric_top_literals, render_rom, tx_parameters, write_rom,
 )
-from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, FABRIC_TOP_GMII
-from rosfpga_lab.rtl.sim import cache_root, simulator_version
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import (
     PUB_READER, PUB_WRITER, discovery_multicast_port, discovery_port, user_port,
@@ -54,10 +45,8 @@ from tests.rtl.test_fabric_rtps_loop import TIME, published
 from tests.rtl.test_fabric_rtps_rx import LOCAL, READER, WRITER
 from tests.rtl.test_fabric_rtps_tx import check_parsed, expected
 from tests.rtl.test_fabric_udp import PEER_IP, PEER_MAC, _fcs, _frames, _group_mac
-from tests.support.rtltools import TB_DIR, cocotb_verilator, run_bench
-
-if TYPE_CHECKING:
-    from cocotb_tools.runner import Runner
+from tests.support import fabrictop
+from tests.support.rtltools import TB_DIR, cocotb_verilator
 
 pytestmark = pytest.mark.rtl
 
@@ -66,7 +55,7 @@ PEER = bytes.fromhex("010fcafe0000000100000001")
 PEER_INDEX = 1
 PERIOD = 1_000_000       # one SPDP announcement (at reset) in the run
 MAX_CLOCKS = 200_000
-SOURCES = [FABRIC_DIR / m for m in FABRIC_TOP_GMII]
+SOURCES = fabrictop.SOURCES                      # tests/rtl/test_lint.py lints them
 
 
 def _udp(payload: bytes, dport: int, sport: int = 40000) -> bytes:
@@ -82,34 +71,6 @@ def _bad_fcs(frame: bytes) -> bytes:
 
 def _ip(addr: str) -> str:
     return ipaddress.IPv4Address(addr).packed.hex()
-
-
-def _build(runner: Runner, gen: Path, params: dict[str, str], tmp_path: Path) -> Path:
-    """Verilator's build, kept in the lab's RTL cache keyed by the sources (the generated ones
-    too), the parameters and the tools (its dependency files name absolute paths)."""
-    import cocotb
-
-    rtl = sorted(q for q in (gen / "rtl").glob("*.v") if q.name != "rfl_tb.v")
-    digest = hashlib.sha256(f"{cocotb.__file__} {simulator_version('verilator')}".encode())
-    included = [FABRIC_DIR / name for name in FABRIC_INCLUDES]
-    for path in [*SOURCES, *included, *rtl, *sorted((gen / "rtl").glob("*.vh"))]:
-        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
-    digest.update(json.dumps(params, sort_keys=True).encode())
-    build = cache_root() / f"cocotb-fabric-top-{digest.hexdigest()[:20]}"
-    # the generated files kept beside the build: the runner rebuilds for sources newer than it
-    kept = build / "generated"
-    if not kept.is_dir():
-        kept.mkdir(parents=True)
-        for path in (gen / "rtl").iterdir():
-            if path.suffix in (".v", ".vh") and path.name != "rfl_tb.v":
-                shutil.copy2(path, kept / path.name)
-    rtl = sorted(kept.glob("*.v"))
-    runner.build(
-        sources=[*SOURCES, *rtl], includes=[kept, FABRIC_DIR], hdl_toplevel="rfl_fabric_top",
-        parameters=params, build_dir=build, timescale=("1ns", "1ps"),
-        build_args=["-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT"],
-        log_file=tmp_path / "build.log")
-    return build
 
 
 @dataclass
@@ -210,18 +171,12 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
     monkeypatch.syspath_prepend(str(TB_DIR))
     from cocotb_tools.runner import get_runner
 
-    gen = tmp_path / "project"
-    proc = subprocess.run([sys.executable, "-m", "rosfpga_lab", "generate", str(CONFIG), "-o",
-                           str(gen), "-q"], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr
+    gen = fabrictop.generate(CONFIG, tmp_path / "project")
     sc = scenario(tmp_path)
-    (tmp_path / "case.json").write_text(json.dumps(sc.case))
     runner = get_runner("verilator")
-    build = _build(runner, gen, sc.params, tmp_path)
-    run_bench(runner, "bench_rfl_fabric_top", "rfl_fabric_top", build, tmp_path,
-              {"FABRIC_TOP_CASE": str(tmp_path / "case.json"),
-               "FABRIC_TOP_OUT": str(tmp_path / "out.json")})
-    out = json.loads((tmp_path / "out.json").read_text())
+    build = fabrictop.build(runner, gen, sc.params, tmp_path)
+    out = fabrictop.run(runner, build, "bench_rfl_fabric_top", sc.case, tmp_path,
+                        "FABRIC_TOP_CASE", "FABRIC_TOP_OUT")
     check_sent(sc, out["sent"], out["counters"])
 
 

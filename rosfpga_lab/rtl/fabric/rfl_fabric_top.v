@@ -124,7 +124,11 @@ module rfl_fabric_top #(
         .sys_clock(clk), .sys_reset(!rst_n),
         .mac_address(cfg_mac), .ip_address(cfg_ip), .udp_rx_port(SPDP),
         .udp_rx_port_mask(PORT_MASK), .ip_multicast(SPDP_GROUP),
-        .gmii_pads_rx_data(gmii_rxd), .gmii_pads_rx_dv(gmii_rx_dv), .gmii_pads_rx_er(gmii_rx_er),
+        // LiteEth's GMII PHY ignores rx_er: a byte the PHY marks bad is inverted, so the
+        // frame's FCS fails (CRC-32 finds any one bad byte; several, all but 1 in 2**32) and
+        // it is dropped and counted in cnt_rx_error as one
+        .gmii_pads_rx_data(gmii_rxd ^ {8{gmii_rx_dv && gmii_rx_er}}),
+        .gmii_pads_rx_dv(gmii_rx_dv), .gmii_pads_rx_er(gmii_rx_er),
         .gmii_pads_tx_data(gmii_txd), .gmii_pads_tx_en(gmii_tx_en), .gmii_pads_tx_er(gmii_tx_er),
 `endif
         .udp_source_data(le_rx_data), .udp_source_valid(le_rx_valid),

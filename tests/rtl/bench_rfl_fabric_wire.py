@@ -1,0 +1,159 @@
+"""cocotb testbench of ``rfl_fabric_top`` at its GMII side in groups of frames, with counters and
+times (run by tests/rtl/test_fabric_wire.py and tests/benchmarks/bench_fabric_wire.py, not by
+pytest).
+
+The case (JSON, ``FABRIC_WIRE_CASE``): the node's and the peer's addresses, the receive side's
+configuration, ``cfg_time``, the ARP reply the peer gives when the node asks for its MAC, and
+groups of frames (whole, FCS included, hex), each with: ``gap`` (clocks of idle after each
+frame, or null: back to back, cocotbext-eth's 12-byte interframe gap), ``errors`` (frame index,
+byte index: GMII rx_er raised on that byte, the preamble counted), ``expect`` (how many IPv4
+frames the node must have sent in all once the group is done) and ``samples`` (the samples its
+transmit path must have sent in all; the bench waits for both, at most ``max_clocks``, or
+``idle_clocks`` with no frame out when given) and
+``quiet`` (clocks waited after). After each group the counters are read:
+the top's and the node's stages' (through the hierarchy; Verilator's --public-flat-rw). With
+``watch``, every clock each stage's stream is sampled: clocks it held data its next stage did not
+take (stalled) and clocks it offered data. Written (``FABRIC_WIRE_OUT``): every frame the node
+sent (preamble and FCS included) with its GMII times, each group's frames' times and counters.
+Times in ns (8 ns a clock).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+
+import cocotb
+from cocotb.clock import Clock
+from cocotb.triggers import ClockCycles, RisingEdge
+from cocotb.utils import get_time_from_sim_steps
+from cocotbext.eth import GmiiFrame, GmiiSink, GmiiSource
+
+ETHERTYPE_ARP = b"\x08\x06"
+TOP = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_length", "rx_overflow",
+       "tx_packets", "tx_overflow", "rx_port")
+# rfl_fabric_node's internal counters: rfl_rtps_rx, rfl_rtps_to_cdr, rfl_rtps_tx, rfl_rtps_ctrl
+NODE = {"rtps_packets": "cnt_packets", "rtps_bad_header": "cnt_bad_header",
+        "rtps_malformed": "cnt_malformed", "rtps_samples": "cnt_rx_samples",
+        "rtps_dropped": "cnt_rx_dropped", "seam_samples": "cnt_seam_samples",
+        "seam_dropped": "cnt_seam_dropped", "seam_too_long": "cnt_too_long",
+        "tx_datagrams": "cnt_datagrams", "tx_dropped": "cnt_dropped",
+        "ctrl_requests": "cnt_requests", "ctrl_busy": "cnt_busy",
+        "ctrl_malformed": "cnt_ctrl_malformed"}
+# streams watched (stage: valid, ready), in the top (u_node: the node's)
+STAGES = {"liteeth_rx->udp_port": ("le_rx_valid", "le_rx_ready"),
+          "udp_port->node": ("p_rx_tvalid", "p_rx_tready"),
+          "rtps_rx->seam": ("u_node.rx_tvalid", "u_node.rx_tready"),
+          "seam->cdr_node": ("u_node.rec_tvalid", "u_node.rec_tready"),
+          "cdr_node->rtps_tx": ("u_node.pub_tvalid", "u_node.pub_tready"),
+          "rtps_tx->arbiter": ("u_node.tx_tvalid", "u_node.tx_tready"),
+          "node->udp_port": ("p_tx_tvalid", "p_tx_tready"),
+          "udp_port->liteeth_tx": ("le_tx_valid", "le_tx_ready")}
+
+
+def _arp_request_for(frame: bytes, ip: bytes) -> bool:
+    """Is this Ethernet frame (no preamble) an ARP request for ``ip``?"""
+    return frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" and frame[38:42] == ip
+
+
+def _ns(steps: int) -> int:
+    return round(get_time_from_sim_steps(steps, "ns"))
+
+
+def _signal(dut, path: str):
+    for name in path.split("."):
+        dut = getattr(dut, name)
+    return dut
+
+
+def _counters(dut) -> dict[str, int]:
+    out = {name: int(getattr(dut, f"cnt_{name}").value) for name in TOP}
+    out.update({name: int(getattr(dut.u_node, sig).value) for name, sig in NODE.items()})
+    return out
+
+
+@cocotb.test()
+async def fabric_wire(dut) -> None:
+    with open(os.environ["FABRIC_WIRE_CASE"]) as f:
+        case = json.load(f)
+    dut.cfg_mac.value = int(case["node_mac"], 16)
+    dut.cfg_ip.value = int(case["node_ip"], 16)
+    dut.cfg_peer_ip.value = int(case["peer_ip"], 16)
+    dut.cfg_peer_meta_port.value = case["peer_meta_port"]
+    dut.cfg_peer_user_port.value = case["peer_user_port"]
+    dut.cfg_reader.value = case["reader"]
+    dut.cfg_writer.value = case["writer"]
+    dut.cfg_time.value = case["time"]
+    dut.send_sedp.value = 0
+    dut.gmii_rx_dv.value = 0
+    dut.gmii_rx_er.value = 0
+    dut.gmii_rxd.value = 0
+    cocotb.start_soon(Clock(dut.clk, 8, unit="ns").start())
+    source = GmiiSource(dut.gmii_rxd, dut.gmii_rx_er, dut.gmii_rx_dv, dut.clk)
+    sink = GmiiSink(dut.gmii_txd, dut.gmii_tx_er, dut.gmii_tx_en, dut.clk)
+    dut.rst_n.value = 0
+    await ClockCycles(dut.clk, 10)
+    dut.rst_n.value = 1
+
+    sent: list[dict] = []
+    ipv4 = [0]
+    peer_ip = bytes.fromhex(case["peer_ip"])
+
+    async def peer() -> None:
+        while True:
+            frame = await sink.recv()
+            payload = bytes(frame.get_payload())
+            sent.append({"data": bytes(frame.data).hex(), "start": _ns(frame.sim_time_start),
+                         "end": _ns(frame.sim_time_end)})
+            ipv4[0] += payload[12:14] == b"\x08\x00"
+            if _arp_request_for(payload, peer_ip):
+                await source.send(GmiiFrame.from_raw_payload(bytes.fromhex(case["arp_reply"])))
+
+    stalls = {name: [0, 0] for name in STAGES}
+
+    async def watch() -> None:
+        pairs = [(name, _signal(dut, v), _signal(dut, r)) for name, (v, r) in STAGES.items()]
+        while True:
+            await RisingEdge(dut.clk)
+            for name, v, r in pairs:
+                if v.value:
+                    stalls[name][1] += 1
+                    if not r.value:
+                        stalls[name][0] += 1
+
+    cocotb.start_soon(peer())
+    if case.get("watch"):
+        cocotb.start_soon(watch())
+    groups = []
+    for group in case["groups"]:
+        times: list[list[int]] = []               # the source sends copies: their times
+        frames = [GmiiFrame.from_raw_payload(
+            bytes.fromhex(raw), tx_complete=lambda f: times.append([_ns(f.sim_time_start),
+                                                                   _ns(f.sim_time_end)]))
+            for raw in group["frames"]]
+        for k, at in group.get("errors", []):
+            frames[k].error = [int(i == at) for i in range(len(frames[k].data))]
+        for frame in frames:
+            if group["gap"] is None:
+                await source.send(frame)
+            else:
+                await source.send(frame)
+                await source.wait()
+                await ClockCycles(dut.clk, group["gap"])
+        await source.wait()
+        clocks = idle = 0
+        seen = ipv4[0]
+        while (ipv4[0] < group["expect"] or
+               int(dut.cnt_samples.value) < group.get("samples", 0)) and \
+                clocks < case["max_clocks"] and idle < case.get("idle_clocks", clocks + 1):
+            await ClockCycles(dut.clk, 50)
+            clocks += 50
+            idle = 0 if ipv4[0] != seen else idle + 50
+            seen = ipv4[0]
+        await ClockCycles(dut.clk, group["quiet"])
+        groups.append({"name": group["name"], "ipv4": ipv4[0], "sent": len(sent), "counters": _counters(dut),
+                       "in": times})
+    with open(os.environ["FABRIC_WIRE_OUT"], "w") as f:
+        json.dump({"sent": sent, "groups": groups,
+                   "stalls": {k: {"stalled": v[0], "valid": v[1]} for k, v in stalls.items()}},
+                  f)
