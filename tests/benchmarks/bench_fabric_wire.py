@@ -1,6 +1,6 @@
 """The node in the fabric at gigabit line rate (issue #31 item 5; prints figures, not a test).
 
-``rfl_fabric_top`` (GMII variant, 125 MHz, Verilator under cocotb: tests/rtl/bench_rfl_fabric_wire.py)
+``rfl_fabric_top`` (GMII variant, 125 MHz, Verilator under cocotb: tests/rtl/bench_rfl_fabric_top_wire.py)
 with the generated top of a ``wire: cdr`` configuration inside, fed at its GMII side with
 samples back to back at line rate: a byte a clock, each frame behind its 8-byte preamble and
 12-byte interframe gap, the samples as the lab's software writer sends them (DATA_FRAGs of
@@ -132,7 +132,7 @@ def measure(config_path: Path, samples: int, watch: bool, work: Path) -> dict[st
     runner = get_runner("verilator")
     build = fabrictop.build(runner, gen, fabrictop.top_parameters_of(rom, max_bytes, PERIOD),
                             work)
-    out = fabrictop.run(runner, build, "bench_rfl_fabric_wire", case, work, "FABRIC_WIRE_CASE",
+    out = fabrictop.run(runner, build, "bench_rfl_fabric_top_wire", case, work, "FABRIC_WIRE_CASE",
                         "FABRIC_WIRE_OUT")
 
     frames = _frames([s["data"] for s in out["sent"]])

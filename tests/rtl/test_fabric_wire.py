@@ -269,7 +269,7 @@ def _run(tmp_path: Path) -> dict:
     runner = get_runner("verilator")
     build = fabrictop.build(runner, gen, fabrictop.top_parameters_of(rom, MAX_BYTES, PERIOD),
                             tmp_path)
-    out = fabrictop.run(runner, build, "bench_rfl_fabric_wire", case, tmp_path,
+    out = fabrictop.run(runner, build, "bench_rfl_fabric_top_wire", case, tmp_path,
                         "FABRIC_WIRE_CASE", "FABRIC_WIRE_OUT")
     return {"out": out, "fams": fams, "rom": rom, "sample": sample, "n_samples": n_samples,
             "timed_answers": timed_answers, "part": part, "wid": wid, "reader_id": reader_id}
