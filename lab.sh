@@ -2,7 +2,8 @@
 # The lab's set-up in one place. Quick start (see README.md):
 #   ./lab.sh          set up (.venv, package installed editable) and open JupyterLab on notebooks/
 #                     (options go to JupyterLab: ./lab.sh --port 8889 --no-browser)
-#   ./lab.sh test     set up (with the test extras) and run the whole test suite (options go to pytest)
+#   ./lab.sh test     set up (with the test extras) and run the whole test suite (options go to pytest;
+#                     two workers on two or more cores, ROSFPGA_TEST_WORKERS=0 for one)
 # Further: ./lab.sh setup [--test]   only set up;   ./lab.sh help
 # Set PYTHON=/path/to/python3.x to choose the interpreter (3.11 to 3.13).
 set -euo pipefail
@@ -11,7 +12,7 @@ cd "$here"
 venv="$here/.venv"
 
 usage() {
-  sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'
 }
 
 find_python() {
@@ -94,7 +95,12 @@ case "$cmd" in
       --LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate "${root[@]}" "$@" ;;
   test)
     setup "[test]"
-    exec "$venv/bin/python" -m pytest "$@" ;;
+    # On two or more cores, two pytest-xdist workers (a file each at a time: its module fixtures
+    # built once); ROSFPGA_TEST_WORKERS=N sets how many, 0 runs in this one process.
+    workers="${ROSFPGA_TEST_WORKERS:-$( [ "$(nproc 2>/dev/null || echo 1)" -ge 2 ] && echo 2 || echo 0 )}"
+    parallel=()
+    if [ "$workers" != 0 ]; then parallel=(-n "$workers" --dist loadfile); fi
+    exec "$venv/bin/python" -m pytest "${parallel[@]}" "$@" ;;
   setup)
     if [ "${1:-}" = "--test" ]; then setup "[test]"; else setup ""; fi ;;
   help|-h|--help)
