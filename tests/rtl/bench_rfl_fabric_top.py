@@ -30,10 +30,9 @@ def _arp_request_for(frame: bytes, ip: bytes) -> bool:
     return frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" and frame[38:42] == ip
 
 
-@cocotb.test()
-async def fabric_top(dut) -> None:
-    with open(os.environ["FABRIC_TOP_CASE"]) as f:
-        case = json.load(f)
+async def start_top(dut, case: dict) -> tuple[GmiiSource, GmiiSink]:
+    """Set the top's registers from ``case``, start its 125 MHz clock and reset it; the peer's
+    GMII source and sink (tests/rtl/bench_rfl_fabric_top_wire.py starts the top the same way)."""
     dut.cfg_mac.value = int(case["node_mac"], 16)
     dut.cfg_ip.value = int(case["node_ip"], 16)
     dut.cfg_peer_ip.value = int(case["peer_ip"], 16)
@@ -52,6 +51,14 @@ async def fabric_top(dut) -> None:
     dut.rst_n.value = 0
     await ClockCycles(dut.clk, 10)
     dut.rst_n.value = 1
+    return source, sink
+
+
+@cocotb.test()
+async def fabric_top(dut) -> None:
+    with open(os.environ["FABRIC_TOP_CASE"]) as f:
+        case = json.load(f)
+    source, sink = await start_top(dut, case)
 
     sent: list[str] = []
     ipv4 = [0]

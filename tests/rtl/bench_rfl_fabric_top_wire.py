@@ -24,14 +24,12 @@ import json
 import os
 
 import cocotb
-from cocotb.clock import Clock
+from bench_rfl_fabric_top import COUNTERS, _arp_request_for, start_top
 from cocotb.triggers import ClockCycles, RisingEdge
 from cocotb.utils import get_time_from_sim_steps
-from cocotbext.eth import GmiiFrame, GmiiSink, GmiiSource
+from cocotbext.eth import GmiiFrame
 
-ETHERTYPE_ARP = b"\x08\x06"
-TOP = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_length", "rx_overflow",
-       "tx_packets", "tx_overflow", "rx_port")
+TOP = COUNTERS                  # the top's cnt_* outputs
 # rfl_fabric_node's internal counters: rfl_rtps_rx, rfl_rtps_to_cdr, rfl_rtps_tx, rfl_rtps_ctrl
 NODE = {"rtps_packets": "cnt_packets", "rtps_bad_header": "cnt_bad_header",
         "rtps_malformed": "cnt_malformed", "rtps_samples": "cnt_rx_samples",
@@ -49,11 +47,6 @@ STAGES = {"liteeth_rx->udp_port": ("le_rx_valid", "le_rx_ready"),
           "rtps_tx->arbiter": ("u_node.tx_tvalid", "u_node.tx_tready"),
           "node->udp_port": ("p_tx_tvalid", "p_tx_tready"),
           "udp_port->liteeth_tx": ("le_tx_valid", "le_tx_ready")}
-
-
-def _arp_request_for(frame: bytes, ip: bytes) -> bool:
-    """Is this Ethernet frame (no preamble) an ARP request for ``ip``?"""
-    return frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" and frame[38:42] == ip
 
 
 def _ns(steps: int) -> int:
@@ -76,24 +69,7 @@ def _counters(dut) -> dict[str, int]:
 async def fabric_wire(dut) -> None:
     with open(os.environ["FABRIC_WIRE_CASE"]) as f:
         case = json.load(f)
-    dut.cfg_mac.value = int(case["node_mac"], 16)
-    dut.cfg_ip.value = int(case["node_ip"], 16)
-    dut.cfg_peer_ip.value = int(case["peer_ip"], 16)
-    dut.cfg_peer_meta_port.value = case["peer_meta_port"]
-    dut.cfg_peer_user_port.value = case["peer_user_port"]
-    dut.cfg_reader.value = case["reader"]
-    dut.cfg_writer.value = case["writer"]
-    dut.cfg_time.value = case["time"]
-    dut.send_sedp.value = 0
-    dut.gmii_rx_dv.value = 0
-    dut.gmii_rx_er.value = 0
-    dut.gmii_rxd.value = 0
-    cocotb.start_soon(Clock(dut.clk, 8, unit="ns").start())
-    source = GmiiSource(dut.gmii_rxd, dut.gmii_rx_er, dut.gmii_rx_dv, dut.clk)
-    sink = GmiiSink(dut.gmii_txd, dut.gmii_tx_er, dut.gmii_tx_en, dut.clk)
-    dut.rst_n.value = 0
-    await ClockCycles(dut.clk, 10)
-    dut.rst_n.value = 1
+    source, sink = await start_top(dut, case)
 
     sent: list[dict] = []
     ipv4 = [0]
