@@ -43,12 +43,11 @@ and built-in reader), and reads the readers' locators from the DATA(r) that come
 go on to the circuit, which drops them).
 
 The circuit answers ACKNACKs on its metatraffic port only (``rfl_fabric_top`` gives what comes
-to the user-data port to the data path); its ``ros_discovery_info`` writer is a user-data writer,
-which peers ask on the user-data port (Fast DDS does: rclpy's graph needs the sample, which the
-circuit sent before the peer had matched). So the bridge gives an ACKNACK to that writer which
-comes to the user-data port to the circuit's metatraffic port (counted), whose ``rfl_rtps_ctrl``
-answers it (the DATA and a HEARTBEAT, to the peer's user-data port). A fix in the Verilog (the
-top passing such ACKNACKs to the control path) would make this step unneeded.
+to the user-data port to the data path); its ``ros_discovery_info`` writer's SEDP data announces
+the metatraffic locator as its own (``rtl.discrom.fabric_participant``), so a peer's reader asks
+it there (Fast DDS's does: rclpy's graph needs the sample, which the circuit sent before the
+peer had matched) and ``rfl_rtps_ctrl`` answers (the DATA and a HEARTBEAT, to the peer's
+user-data port, which the bridge sends on to the reader's own locator): nothing to forward.
 
 Fast DDS sends each datagram of a sample to every locator it has for a reader, and it has
 two for the circuit's (the participant's default and the reader's own, the same address and
@@ -94,7 +93,7 @@ from rosfpga_lab.rtps.entities import (
 )
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX, SPDP_MULTICAST_ADDRESS
-from rosfpga_lab.rtps.message import AckNack, Data, DataFrag, Heartbeat, parse_message
+from rosfpga_lab.rtps.message import Data, DataFrag, Heartbeat, parse_message
 
 __all__ = ["HOST_MAC", "Peer", "ShimBridge", "TAP_HOST_CIDR", "TAP_NAME", "TAP_NODE_ADDRESS",
            "TapBridge", "fabric_peer_uri", "fabric_tap_peer_uri", "fastdds_peer_profile", "sedp_reader_locators",
@@ -224,7 +223,6 @@ class BridgeCounts:
     spdp_copies: int = 0
     send_refused: int = 0
     sedp_pulses: int = 0
-    graph_acknacks: int = 0
     subscriptions_asked: int = 0
     dropped: Counter = field(default_factory=Counter)
     peers: list[Peer] = field(default_factory=list)
@@ -235,8 +233,6 @@ class BridgeCounts:
                f"discovery ports: {self.spdp_copies}, refused by the host: {self.send_refused})",
                f"ARP requests answered: {self.arp_answered}",
                f"peers learned: {len(self.peers)}; send_sedp pulses: {self.sedp_pulses}",
-               f"ACKNACKs to ros_discovery_info's writer passed to the metatraffic port: "
-               f"{self.graph_acknacks}",
                f"peers asked for their SEDP subscriptions: {self.subscriptions_asked}"]
         out += [f"dropped ({why}): {n}" for why, n in sorted(self.dropped.items())]
         return out
@@ -296,10 +292,9 @@ class ShimBridge(_PeerKeeper):
         self.ports = UdpPorts(rom.address, [self.meta, self.user])
         self._ident = 0
         self._last_frags: tuple[tuple[bytes, int, int, int], ...] = ()
-        self._graph_writer = rom.entity_ids["ros_discovery_info"]
         self._asked: set[bytes] = set()
         self.readers: dict[str, tuple[str, int]] = {}   # DDS topic -> a reader's own locator
-        self._topics = {self._graph_writer: "ros_discovery_info",
+        self._topics = {rom.entity_ids["ros_discovery_info"]: "ros_discovery_info",
                         rom.entity_ids["writer"]: out_topic}
 
     # ---- host -> circuit
@@ -313,9 +308,6 @@ class ShimBridge(_PeerKeeper):
                 if self.readers.get(topic) != loc:
                     self.readers[topic] = loc
                     self.log(f"a reader of {topic} at {loc[0]}:{loc[1]} (its own locator)")
-        elif self._asks_graph_writer(payload):
-            port = self.meta             # see the module docstring: the circuit's ctrl answers
-            self.counts.graph_acknacks += 1
         if port == self.user:
             frags = _fragments(payload)
             if frags and frags == self._last_frags:
@@ -368,14 +360,6 @@ class ShimBridge(_PeerKeeper):
             if topic in self.readers:
                 return self.readers[topic]
         return None
-
-    def _asks_graph_writer(self, payload: bytes) -> bool:
-        try:
-            msg = parse_message(payload)
-        except RtpsError:
-            return False
-        return any(isinstance(sub, AckNack) and sub.writer_id == self._graph_writer
-                   for _src, _dst, sub in msg.routed())
 
     # ---- circuit -> host
     def _from_circuit(self, frame: bytes) -> None:

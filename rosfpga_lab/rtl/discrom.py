@@ -14,10 +14,12 @@ runs, with the same entities (:class:`~rosfpga_lab.rtps.rosnode.RosNodeEntities`
   (destination :data:`DEST_SPDP`: the SPDP multicast port, or on a loopback graph the unicast
   discovery ports of indices 0..MAX_PARTICIPANT_INDEX, as the software participant probes);
 * ``sedp``: what ``Participant`` sends a participant it has just learned (``spdp._greet``): the
-  SEDP publications writer's DATA(w) (``ros_discovery_info``'s writer and the output topic's)
-  and HEARTBEAT, the subscriptions writer's DATA(r) (the input topic's) and HEARTBEAT, and the
-  built-in readers' preemptive ACKNACKs (destination :data:`DEST_META`: that participant's
-  metatraffic unicast port);
+  SEDP publications writer's DATA(w) (``ros_discovery_info``'s writer and the output topic's;
+  the former with the metatraffic locator as its own, where the software node announces its
+  user-data one, so a peer's ACKNACKs to it come where ``rfl_rtps_ctrl`` reads) and HEARTBEAT,
+  the subscriptions writer's DATA(r) (the input topic's) and HEARTBEAT, and the built-in
+  readers' preemptive ACKNACKs (destination :data:`DEST_META`: that participant's metatraffic
+  unicast port);
 * ``graph``: the ``ros_discovery_info`` sample (ParticipantEntitiesInfo: the node's name and its
   endpoints' GIDs) with its HEARTBEAT, to any reader of that participant (reader
   ENTITYID_UNKNOWN; destination :data:`DEST_USER`: its user-data unicast port; Fast DDS's
@@ -224,8 +226,8 @@ def fabric_participant(config: NodeConfig, *, domain: int = 0, index: int = 0,
                        qos_in: Qos = Qos(), qos_out: Qos = Qos()
                        ) -> tuple[Participant, RosNodeEntities, int, int]:
     """The sans-IO participant of ``config``'s node as the software node builds it (the same
-    entities, in the same order): the participant, its node entities, the output writer's and
-    the input reader's entity ids."""
+    entities, in the same order; its ``ros_discovery_info`` writer on the metatraffic locator):
+    the participant, its node entities, the output writer's and the input reader's entity ids."""
     if config.wire != "cdr":
         raise RtlError(f"{config.path or 'configuration'}: wire is {config.wire!r}: the "
                        f"fabric's discovery ROM is for a ROS 2 node (set wire: cdr)")
@@ -238,7 +240,9 @@ def fabric_participant(config: NodeConfig, *, domain: int = 0, index: int = 0,
             from None
     namespace, name = split_node_name(config.node.global_name)
     p = Participant(domain, index, address, name, guid_prefix=guid_prefix)
-    node = RosNodeEntities(p, name, namespace)
+    # the ros_discovery_info writer announces the metatraffic locator: its readers' ACKNACKs
+    # come where rfl_rtps_ctrl reads (rfl_fabric_top gives the user-data port to the data path)
+    node = RosNodeEntities(p, name, namespace, graph_locator=p.meta)
     reg = config.registry()
     wid = node.add_publisher(config.publisher.topic, config.publisher.type, qos_out, reg)
     rid = node.add_subscriber(config.subscriber.topic, config.subscriber.type, qos_in, reg)

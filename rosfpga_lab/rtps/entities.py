@@ -162,6 +162,8 @@ class LocalEndpoint:
     proxies: dict[tuple[bytes, int], ReaderProxy | WriterProxy] = field(default_factory=dict)
     hb_count: int = 0
     type_hash: str = ""                           # RIHS01_... announced in its USER_DATA
+    #: the unicast locator its SEDP data announces (None: the participant's default user-data one)
+    locator: tuple[str, int] | None = None
 
     @property
     def guid_tail(self) -> bytes:

@@ -89,12 +89,17 @@ class Participant(ParticipantDiscovery, ReaderSide, WriterSide):
                             f"digits: pass rosfpga_lab.msg.typehash.type_hash(type), or ''")
         return type_hash
 
-    def add_writer(self, topic: str, type_name: str, qos: Qos = Qos(), type_hash: str = "") -> int:
+    def add_writer(self, topic: str, type_name: str, qos: Qos = Qos(), type_hash: str = "", *,
+                   locator: tuple[str, int] | None = None) -> int:
         """A user writer on DDS topic ``topic`` (``rt/...`` for ROS 2); returns its entity id.
-        ``type_hash`` (``RIHS01_...``, '' for none) goes out in its SEDP USER_DATA."""
+        ``type_hash`` (``RIHS01_...``, '' for none) goes out in its SEDP USER_DATA; ``locator``
+        is the unicast locator its SEDP data announces, where its readers send their ACKNACKs
+        (None: the participant's default user-data locator; this participant takes any
+        submessage on any of its ports)."""
         ep = LocalEndpoint(self._new_entity(WRITER_KIND), "writer", topic, type_name,
                            Qos(qos.reliable, max(1, min(qos.depth, MAX_HISTORY_DEPTH)),
-                               qos.transient_local), type_hash=self._check_hash(type_hash))
+                               qos.transient_local), type_hash=self._check_hash(type_hash),
+                           locator=locator)
         self.local[ep.entity_id] = ep
         self._announce_endpoint(ep)
         return ep.entity_id

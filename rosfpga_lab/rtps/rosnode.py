@@ -35,12 +35,14 @@ def node_type_hash(type_name: str, registry: MsgRegistry | None = None) -> str:
 
 class RosNodeEntities:
     """One ROS 2 node's DDS entities on ``participant`` (its ``ros_discovery_info`` writer is
-    added at once: :attr:`graph_writer`)."""
+    added at once: :attr:`graph_writer`; ``graph_locator``: the unicast locator that writer's
+    SEDP data announces, None for the participant's default user-data one)."""
 
-    def __init__(self, participant: Participant, name: str, namespace: str = "/") -> None:
+    def __init__(self, participant: Participant, name: str, namespace: str = "/", *,
+                 graph_locator: tuple[str, int] | None = None) -> None:
         self.participant, self.name, self.namespace = participant, name, namespace
         self.graph_writer = participant.add_writer(ROS_DISCOVERY_TOPIC, ROS_DISCOVERY_TYPE,
-                                                   GRAPH_QOS)
+                                                   GRAPH_QOS, locator=graph_locator)
         self.readers: list[bytes] = []
         self.writers: list[bytes] = []
 

@@ -36,7 +36,8 @@ class EndpointDiscovery(ParticipantBase):
     def _announce_endpoint(self, ep: LocalEndpoint) -> None:
         sedp = self.local[PUB_WRITER if ep.kind == "writer" else SUB_WRITER]
         self._keep(sedp, b.sedp_payload(self.guid_prefix + ep.guid_tail, ep.topic, ep.type_name,
-                                        ep.qos.reliable, ep.qos.depth, b.Locator(*self.user),
+                                        ep.qos.reliable, ep.qos.depth,
+                                        b.Locator(*(ep.locator or self.user)),
                                         ep.qos.transient_local, ep.type_hash))
         for rem in list(self.remote.values()):
             self._try_match(ep, rem)

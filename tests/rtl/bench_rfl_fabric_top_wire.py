@@ -37,7 +37,7 @@ NODE = {"rtps_packets": "cnt_packets", "rtps_bad_header": "cnt_bad_header",
         "seam_dropped": "cnt_seam_dropped", "seam_too_long": "cnt_too_long",
         "tx_datagrams": "cnt_datagrams", "tx_dropped": "cnt_dropped",
         "ctrl_requests": "cnt_requests", "ctrl_busy": "cnt_busy",
-        "ctrl_malformed": "cnt_ctrl_malformed"}
+        "ctrl_malformed": "cnt_ctrl_malformed", "ctrl_bad_header": "cnt_ctrl_bad_header"}
 # streams watched (stage: valid, ready), in the top (u_node: the node's)
 STAGES = {"liteeth_rx->udp_port": ("le_rx_valid", "le_rx_ready"),
           "udp_port->node": ("p_rx_tvalid", "p_rx_tready"),

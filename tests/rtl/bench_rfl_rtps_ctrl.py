@@ -92,6 +92,7 @@ async def rtps_ctrl_answers(dut) -> None:
     assert not cur, "the run ended inside an answer"
     out = {"answers": answers, "received": received, "sent": sent,
            "cnt_malformed": int(dut.cnt_ctrl_malformed.value),
+           "cnt_bad_header": int(dut.cnt_ctrl_bad_header.value),
            **{name: int(getattr(dut, name).value) for name in (
                "cnt_requests", "cnt_busy", "cnt_answers", "cnt_no_credit")}}
     with open(os.environ["FABRIC_NODE_OUT"], "w") as f:

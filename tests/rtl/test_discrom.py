@@ -63,11 +63,16 @@ def test_rom_messages_parse_into_spdp_sedp_and_graph() -> None:
                             b.Locator("127.0.0.1", 7400 + 1750 + 11 + 6))
     assert b.cdr_string_value(params[b.PID_ENTITY_NAME][0]) == "fpga_samples"
     datas = [s for s in sedp.submessages if isinstance(s, Data)]
-    seen = {}
+    seen, locators = {}, {}
     for s in datas:
         p = _strings(s.payload)
-        seen[(s.writer_id, b.cdr_string_value(p[b.PID_TOPIC_NAME][0]))] = (
+        topic = b.cdr_string_value(p[b.PID_TOPIC_NAME][0])
+        seen[(s.writer_id, topic)] = (
             b.cdr_string_value(p[b.PID_TYPE_NAME][0]), _octets(p.get(b.PID_USER_DATA, [bytes(4)])[0]))
+        locators[topic] = b.Locator.decode(p[b.PID_UNICAST_LOCATOR][0])
+    # the ros_discovery_info writer's own locator is the metatraffic one (its readers' ACKNACKs
+    # go where rfl_rtps_ctrl reads); the topics' endpoints announce the user-data one
+    assert locators == {"ros_discovery_info": meta, "rt/samples_dilated": user, "rt/samples": user}
     hash_in = type_hash("lab_msgs/Samples", load_config(CONFIG).registry())
     assert seen == {
         (0x3C2, "ros_discovery_info"): ("rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_", b""),
@@ -96,13 +101,14 @@ def test_rom_messages_parse_into_spdp_sedp_and_graph() -> None:
 
 
 def test_rom_equals_what_the_software_participant_sends() -> None:
-    """A software participant with the same prefix and entities learns a peer: its SPDP and its
-    SEDP datagram are the ROM's bytes (the SEDP's INFO_DST names the peer where the ROM says
-    any)."""
+    """A software participant with the same prefix and entities (its ros_discovery_info writer
+    on the metatraffic locator, as the fabric's) learns a peer: its SPDP and its SEDP datagram
+    are the ROM's bytes (the SEDP's INFO_DST names the peer where the ROM says any)."""
     rom = render_rom(CONFIG, domain=7, index=3, guid_prefix=PREFIX)
     config = load_config(CONFIG)
     p = Participant(7, 3, "127.0.0.1", "fpga_samples", guid_prefix=PREFIX)
-    node = RosNodeEntities(p, "fpga_samples", "/")
+    node = RosNodeEntities(p, "fpga_samples", "/",
+                           graph_locator=("127.0.0.1", 7400 + 1750 + 10 + 6))   # RTPS 9.6.1.1
     node.add_publisher("/samples_dilated", "lab_msgs/Samples", registry=config.registry())
     node.add_subscriber("/samples", "lab_msgs/Samples", registry=config.registry())
     peer = Participant(7, 4, "127.0.0.1", "peer", guid_prefix=PEER)
@@ -303,7 +309,8 @@ def test_cyclone_discovers_the_rom_participant_and_its_topics() -> None:
 def test_rom_sedp_equals_the_software_component_s() -> None:
     """The ROS 2 component of the same configuration, on sockets: its SEDP writers' samples are
     the ROM's (its random GUID prefix put in the ROM's place): same entities, order, QoS,
-    names, hashes, locators."""
+    names, hashes, locators; but the ros_discovery_info writer's, which the component announces
+    at its user-data port and the fabric at its metatraffic port (rfl_rtps_ctrl answers there)."""
     from rosfpga_lab.component.ros2 import Ros2Component
     from rosfpga_lab.rtps.entities import PUB_WRITER, SUB_WRITER
 
@@ -312,6 +319,9 @@ def test_rom_sedp_equals_the_software_component_s() -> None:
         rom = render_rom(CONFIG, domain=DOMAIN, index=p.index, guid_prefix=PREFIX)
         theirs = [payload.replace(p.guid_prefix, PREFIX) for wid in (PUB_WRITER, SUB_WRITER)
                   for payload in p.local[wid].history.values()]
+        graph = theirs[0]
+        assert b"ros_discovery_info" in graph and b.Locator(*p.user).encode() in graph
+        theirs[0] = graph.replace(b.Locator(*p.user).encode(), b.Locator(*p.meta).encode())
     ours = [s.payload for s in parse_message(rom.message("sedp").data).submessages
             if isinstance(s, Data)]
     assert ours == theirs and len(ours) == 3

@@ -123,10 +123,19 @@ def _malformed(rom: DiscoveryRom) -> list[bytes]:
             _dg(PEER, bytes(short), dst=rom.guid_prefix) + bytes(4)]
 
 
+def _bad_headers() -> list[bytes]:
+    """Datagrams the circuit must ignore and count as bad headers: another magic, RTPS major
+    version 1, shorter than the 20-byte header (each an ACKNACK the circuit would answer)."""
+    ok = _dg(PEER, b.acknack(PUB_READER, PUB_WRITER, 1, [1], 12))
+    return [b"RTPX" + ok[4:], ok[:4] + b"\x01" + ok[5:], ok[:12]]
+
+
 def test_the_circuit_answers_as_the_model_and_drops_malformed(tmp_path: Path) -> None:
     rom = _rom()
-    cases, bad = _cases(rom), _malformed(rom)
-    datagrams = [(d, IDLE) for _, d, _ in cases] + [(d, IDLE) for d in bad]
+    cases, bad, bad_hdr = _cases(rom), _malformed(rom), _bad_headers()
+    empty = b.header(PEER)                      # a message of no submessages: not bad
+    datagrams = [(d, IDLE) for _, d, _ in cases] + [(d, IDLE) for d in bad] + \
+        [(d, IDLE) for d in [*bad_hdr, empty]]
     got = cosimulate(rom, datagrams, tmp_path)
     model = AnswerModel(rom)
     want = []
@@ -134,13 +143,14 @@ def test_the_circuit_answers_as_the_model_and_drops_malformed(tmp_path: Path) ->
         answers = model.receive(dg)
         assert [rom.answers[i].name for i in _names(rom, answers)] == names, what
         want += answers
-    for dg in bad:
+    for dg in [*bad, *bad_hdr, empty]:
         assert model.receive(dg) == []
     assert [(a["dest"], bytes.fromhex(a["prefix"]), bytes.fromhex(a["data"]))
             for a in got["answers"]] == [(a.dest, a.prefix, a.data) for a in want]
     for a in got["answers"]:
         parse_message(bytes.fromhex(a["data"]))         # each parses whole
     assert got["cnt_malformed"] == len(bad)
+    assert got["cnt_bad_header"] == 3       # not the empty message, nor our own looped back
     assert got["cnt_answers"] == len(want) and got["cnt_busy"] == 0
     assert got["cnt_no_credit"] == 0
 

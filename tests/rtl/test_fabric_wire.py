@@ -176,11 +176,12 @@ def families(frags: list[bytes]) -> list[Family]:
                    UDP(sport=40000, dport=USER) / good)),
     ], moves={"rx_packets": 2, "rx_port": 2}))
     bad_hdr = [b"RTPX" + good[4:], good[:4] + b"\x01" + good[5:], good[:12]]
-    bad_meta = [b"RTPX" + ack[4:], ack[:12]]     # rfl_rtps_ctrl ignores them, uncounted
+    bad_meta = [b"RTPX" + ack[4:], ack[:12]]     # rfl_rtps_ctrl ignores and counts them
     out.append(Family("RTPS header", [_fcs(_eth_ip(d, USER)) for d in bad_hdr] +
                       [_fcs(_eth_ip(d, META)) for d in bad_meta],
                       user=bad_hdr, meta=bad_meta,
-                      moves={"rx_packets": 5, "rtps_packets": 3, "rtps_bad_header": 3}))
+                      moves={"rx_packets": 5, "rtps_packets": 3, "rtps_bad_header": 3,
+                             "ctrl_bad_header": 2}))
     unknown = [b.header(PEER) + _unknown(0x33) + _unknown(0x80),
                b.header(PEER) + _unknown(0x7f)]
     inside = good[:20] + _unknown(0x33) + good[20:]            # a good sample with one inside
@@ -302,7 +303,7 @@ def test_bad_input_is_dropped_counted_and_the_next_sample_is_exact(wire: dict) -
     # per family: the counters that must move, by as much; the others stand still
     watched = ("rx_error", "rx_length", "rx_overflow", "rx_packets", "rx_port", "rtps_packets",
                "rtps_bad_header", "rtps_malformed", "seam_dropped", "seam_too_long",
-               "ctrl_malformed", "tx_dropped", "tx_overflow")
+               "ctrl_malformed", "ctrl_bad_header", "tx_dropped", "tx_overflow")
     before = {k: 0 for k in watched}
     good_moves = {"rx_packets": 2, "rtps_packets": 2}
     for fam, (bad, after) in zip(fams, zip(out["groups"][::2], out["groups"][1::2])):

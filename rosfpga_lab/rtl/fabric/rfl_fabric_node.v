@@ -85,7 +85,7 @@ module rfl_fabric_node #(
     wire ts_valid, frame_start, busy, rom_busy;
     wire [31:0] cnt_packets, cnt_bad_header, cnt_malformed, cnt_rx_samples, cnt_rx_dropped;
     wire [31:0] cnt_seam_samples, cnt_seam_dropped, cnt_too_long, cnt_datagrams, cnt_dropped;
-    wire [31:0] cnt_requests, cnt_busy, cnt_ctrl_malformed;
+    wire [31:0] cnt_requests, cnt_busy, cnt_ctrl_malformed, cnt_ctrl_bad_header;
     wire [7:0] framing;
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_rtps_rx u_rx (
@@ -133,7 +133,8 @@ module rfl_fabric_node #(
         .s_axis_tvalid(ctrl_in_valid), .s_axis_tready(ctrl_in_ready),
         .s_axis_tlast(s_axis_tlast), .m_axis_tdata(req_tdata), .m_axis_tvalid(req_tvalid),
         .m_axis_tready(req_tready), .rx_byte(rx_byte), .cnt_requests(cnt_requests),
-        .cnt_busy(cnt_busy), .cnt_malformed(cnt_ctrl_malformed));
+        .cnt_busy(cnt_busy), .cnt_malformed(cnt_ctrl_malformed),
+        .cnt_bad_header(cnt_ctrl_bad_header));
     rfl_rtps_disc_answer #(.ROM_FILE(ANSWER_FILE), .TABLE_FILE(ANSWER_TABLE_FILE),
                            .ROM_BYTES(ANSWER_BYTES), .MESSAGES(ANSWERS), .DST_AT(DST_AT),
                            .BASE_AT(BASE_AT), .COUNT_START(COUNT_START), .BURST(BURST),

@@ -12,8 +12,10 @@
 // reader).
 // The walk (a byte per clock, never a wait):
 //   S_HDR     the 20-byte header: "RTPS", major version 2, the sender's GUID prefix (the
-//             source); a bad header or a message from cfg_prefix (our own, looped back): the
-//             rest of the datagram is ignored. The destination resets to "any" at each message.
+//             source); a bad header (magic, version) or a datagram shorter than a header:
+//             ignored and counted (cnt_bad_header, as rfl_rtps_rx's); a message from
+//             cfg_prefix (our own, looped back): the rest of the datagram is ignored, uncounted.
+//             The destination resets to "any" at each message.
 //   S_SUBHDR  id, flags (bit 0 E: byte order of the rest), octetsToNextHeader (0: to the end
 //             of the message, but for PAD and INFO_TS).
 //   S_BODY    INFO_DST (the destination: ours or all-zero keeps what follows), INFO_SRC (the
@@ -65,7 +67,8 @@ module rfl_rtps_ctrl #(
     output wire                  rx_byte,       // a byte taken (rfl_rtps_disc_answer's credit)
     output wire [COUNT_BITS-1:0] cnt_requests,  // request sets taken into a slot
     output wire [COUNT_BITS-1:0] cnt_busy,      // request sets dropped: the slot was pending
-    output wire [COUNT_BITS-1:0] cnt_malformed
+    output wire [COUNT_BITS-1:0] cnt_malformed,
+    output wire [COUNT_BITS-1:0] cnt_bad_header // bad magic or version, or shorter than 20
 );
     // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
     // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
@@ -130,7 +133,7 @@ module rfl_rtps_ctrl #(
     reg [31:0] f_rid, f_wid, f_hi, f_lo, f_nbits, f_word0;
     reg [15:0] need_m1;                         // the byte before the ACKNACK's fields' last
     reg fields_done;
-    reg [COUNT_BITS-1:0] n_req, n_busy, n_bad;
+    reg [COUNT_BITS-1:0] n_req, n_busy, n_bad, n_hdr;
 
     wire [31:0] acc_e_n = le ? {b, acc_e[31:8]} : {acc_e[23:0], b};
     wire [31:0] acc_b_n = {acc_b, b};
@@ -169,6 +172,7 @@ module rfl_rtps_ctrl #(
     assign cnt_requests = n_req;
     assign cnt_busy = n_busy;
     assign cnt_malformed = n_bad;
+    assign cnt_bad_header = n_hdr;
 
     // what each slot wants of the decision in d_*
     wire d_base0 = (d_hi == 32'd0) && (d_lo == 32'd0);
@@ -281,6 +285,7 @@ module rfl_rtps_ctrl #(
             n_req <= {COUNT_BITS{1'b0}};
             n_busy <= {COUNT_BITS{1'b0}};
             n_bad <= {COUNT_BITS{1'b0}};
+            n_hdr <= {COUNT_BITS{1'b0}};
             pend <= 72'd0;
             want_r <= 72'd0;
             d_valid2 <= 1'b0;
@@ -300,6 +305,9 @@ module rfl_rtps_ctrl #(
                     src_sh <= src_sh_n[87:0];
                     idx <= idx + 1'b1;
                     dst_ok <= 1'b1;
+                    // (hdr_bad holds bytes 0..4 by byte 19)
+                    if ((idx == 5'd19 && hdr_bad) || (tl && idx != 5'd19))
+                        n_hdr <= n_hdr + 1'b1;
                     if (tl) begin
                         idx <= 5'd0;
                     end else if (idx == 5'd19) begin

@@ -9,14 +9,15 @@ module fv_rtps_ctrl (
 );
     wire s_axis_tready, m_axis_tvalid, rx_byte;
     wire [167:0] m_axis_tdata;
-    wire [3:0] cnt_requests, cnt_busy, cnt_malformed;
+    wire [3:0] cnt_requests, cnt_busy, cnt_malformed, cnt_bad_header;
     rfl_rtps_ctrl #(.SLOTS(2), .SLOT_IDS(64'h000003C7_000003C2), .SLOT_MSGS(16'h0300),
                     .SLOT_LASTS(16'h0002), .COUNT_BITS(4)) dut (
         .clk(clk), .rst_n(rst_n), .cfg_prefix(cfg_prefix), .s_axis_tdata(s_axis_tdata),
         .s_axis_tvalid(s_axis_tvalid), .s_axis_tready(s_axis_tready),
         .s_axis_tlast(s_axis_tlast), .m_axis_tdata(m_axis_tdata), .m_axis_tvalid(m_axis_tvalid),
         .m_axis_tready(m_axis_tready), .rx_byte(rx_byte), .cnt_requests(cnt_requests),
-        .cnt_busy(cnt_busy), .cnt_malformed(cnt_malformed));
+        .cnt_busy(cnt_busy), .cnt_malformed(cnt_malformed),
+        .cnt_bad_header(cnt_bad_header));
 `include "fv_env.vh"
     `FV_SINK(m_axis_tvalid, m_axis_tready, m_axis_tdata)
     always @(posedge clk) if (!fv_init && rst_n) begin
