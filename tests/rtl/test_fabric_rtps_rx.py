@@ -9,8 +9,8 @@ walker's contract on top (:func:`reference`): DATA (flag D) and DATA_FRAG for ou
 ENTITYID_UNKNOWN) from our writer, writerSN >= 1, destination ours or any; fragments streamed
 in order only (a sample whose fragments come out of order or with one missing is dropped, as
 is the sample in progress when another one starts); a DATA_FRAG repeating fragments already
-taken (of the sample in progress, or of the fragmented sample sent last) is skipped and
-counted, the sample going on; every fragmented sample it puts together is also what the
+taken (of the sample in progress, or past the first of the fragmented sample sent last) is
+skipped and counted, the sample going on; every fragmented sample it puts together is also what the
 participant's ``FragmentAssembler`` puts together from the same fragments.
 """
 
@@ -313,8 +313,10 @@ def reference(datagrams: list[bytes], local: bytes = LOCAL, reader: int = READER
             writer in (0, wr) and seq >= 1
 
     def repeats(key: tuple, start: int, valid: bool) -> bool:
-        return valid and start >= 1 and \
-            (key == done or (act is not None and act["key"] == key and start < act["next"]))
+        """Fragments already taken: of the sample in progress, or past the first of the one
+        sent last (its fragment 1 starts it again: no history of writerSNs)."""
+        return valid and start >= 1 and ((key == done and start >= 2) or (
+            act is not None and act["key"] == key and start < act["next"]))
 
     for dg in datagrams:
         try:

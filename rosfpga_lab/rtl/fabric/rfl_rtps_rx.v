@@ -24,10 +24,12 @@
 //             the next one; with number 1 it starts a new sample; anything else is dropped.
 //             A repeat is skipped whole and counted (cnt_repeated), the sample going on: a
 //             DATA_FRAG of that sample (same GUID, writerSN and sizes) whose fragmentStartingNum
-//             is 1 or more and below the next one, or any of the fragmented sample sent last
-//             whole (RTPS lets a reader see a fragment twice; Fast DDS sends each twice, one
-//             per locator it has for the reader). Fragments past the next one in a repeat are
-//             not taken: a sample that needed them is dropped at its next fragment.
+//             is 1 or more and below the next one, or 2 or more of the fragmented sample sent
+//             last whole (RTPS lets a reader see a fragment twice; Fast DDS sends each twice,
+//             one per locator it has for the reader). Fragments past the next one in a repeat
+//             are not taken: a sample that needed them is dropped at its next fragment. No
+//             history of writerSNs is kept: a sample sent again from fragment 1 once it went
+//             out (as a DATA sent again) comes out again.
 //             A taken DATA, or a DATA_FRAG that neither continues nor repeats, drops the
 //             sample in progress (its packet ends with TUSER set).
 //   S_GAP     the bytes up to octetsToInlineQos; S_QOS the inline QoS parameter list (flag Q)
@@ -177,7 +179,8 @@ module rfl_rtps_rx #(
     reg f_k_eq, f_start_eq, f_start1, f_start0, f_below, f_fsz_eq, f_ssz_eq, f_valid, f_matched;
     wire f_same = f_matched && is_frag && f_k_eq && f_fsz_eq && f_ssz_eq && f_valid;
     wire cont_now = f_same && act && act_frag && f_start_eq;
-    wire rep_now = f_same && !f_start0 && (a_done || (act && act_frag && f_below));
+    wire rep_now = f_same && !f_start0 &&
+                   ((a_done && !f_start1) || (act && act_frag && f_below));
     wire need_abort = act && f_matched && !rep_now && (!is_frag || !cont_now);
     wire start_now = f_matched && !rep_now && (!is_frag || (f_start1 && f_valid));
     wire d_ok = !d_bad && !gap_pos && !sm_flags[1];
