@@ -409,7 +409,7 @@ def test_the_reference_sees_samples_and_damage() -> None:
     samples, counts = reference(datagrams)
     assert len(samples) > 15 and counts["malformed"] > 0 and counts["bad_header"] > 0
     # the co-simulated seeds repeat fragments
-    assert all(reference(random_datagrams(seed, 70))[1]["repeated"] > 3 for seed in (1, 2))
+    assert all(reference(random_datagrams(seed, 70))[1]["repeated"] >= 3 for seed in (1, 2))
     assert any(dg[HEADER_SIZE:].find(bytes([b.DATA_FRAG, 0])) >= 0 for dg in datagrams)
 
 
