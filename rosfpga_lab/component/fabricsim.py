@@ -51,12 +51,9 @@ user-data port, which the bridge sends on to the reader's own locator): nothing 
 
 Fast DDS sends each datagram of a sample to every locator it has for a reader, and it has
 two for the circuit's (the participant's default and the reader's own, the same address and
-port): each DATA_FRAG comes twice in a row. The circuit takes a DATA_FRAG that is not the next
-fragment as a broken sample and drops it (``rfl_rtps_rx``); RTPS lets a receiver see a
-fragment twice, so the bridge drops a user-data datagram whose DATA_FRAGs (writer, sequence
-number, fragment) are the ones of the datagram before it (counted; the copies differ only in a
-vendor submessage).
-A fix in the Verilog (a repeated fragment ignored) would make this step unneeded.
+port): each DATA_FRAG comes twice in a row. The bridge passes both: ``rfl_rtps_rx`` skips a
+DATA_FRAG whose fragments it has taken already (counted in its ``cnt_repeated``), as RTPS lets
+a reader see a fragment twice.
 
 A datagram longer than one Ethernet frame carries (1472 bytes of UDP payload: the circuit does
 not reassemble IP fragments) is dropped and counted: configure the peer's DDS to send smaller
@@ -93,7 +90,7 @@ from rosfpga_lab.rtps.entities import (
 )
 from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.limits import MAX_PARTICIPANT_INDEX, SPDP_MULTICAST_ADDRESS
-from rosfpga_lab.rtps.message import Data, DataFrag, Heartbeat, parse_message
+from rosfpga_lab.rtps.message import Data, Heartbeat, parse_message
 
 __all__ = ["HOST_MAC", "Peer", "ShimBridge", "TAP_HOST_CIDR", "TAP_NAME", "TAP_NODE_ADDRESS",
            "TapBridge", "fabric_peer_uri", "fabric_tap_peer_uri", "fastdds_peer_profile", "sedp_reader_locators",
@@ -182,16 +179,6 @@ def _samples(payload: bytes, writer_id: int) -> list[tuple[bytes, bytes]]:
         return []
     return [(prefix, sub.payload) for prefix, _dst, sub in msg.routed()
             if isinstance(sub, Data) and sub.writer_id == writer_id and sub.payload]
-
-
-def _fragments(payload: bytes) -> tuple[tuple[bytes, int, int, int], ...]:
-    """(source prefix, writerId, writerSN, first fragment) of each DATA_FRAG in a datagram."""
-    try:
-        msg = parse_message(payload)
-    except RtpsError:
-        return ()
-    return tuple((prefix, sub.writer_id, sub.seq, sub.frag_start)
-                 for prefix, _dst, sub in msg.routed() if isinstance(sub, DataFrag))
 
 
 def sedp_reader_locators(payload: bytes, source: tuple[str, int]) -> list[tuple[str, tuple[str,
@@ -291,7 +278,6 @@ class ShimBridge(_PeerKeeper):
         super().__init__(sim, rom, node_mac=node_mac, log=log)
         self.ports = UdpPorts(rom.address, [self.meta, self.user])
         self._ident = 0
-        self._last_frags: tuple[tuple[bytes, int, int, int], ...] = ()
         self._asked: set[bytes] = set()
         self.readers: dict[str, tuple[str, int]] = {}   # DDS topic -> a reader's own locator
         self._topics = {rom.entity_ids["ros_discovery_info"]: "ros_discovery_info",
@@ -308,12 +294,6 @@ class ShimBridge(_PeerKeeper):
                 if self.readers.get(topic) != loc:
                     self.readers[topic] = loc
                     self.log(f"a reader of {topic} at {loc[0]}:{loc[1]} (its own locator)")
-        if port == self.user:
-            frags = _fragments(payload)
-            if frags and frags == self._last_frags:
-                self.counts.dropped["the same fragments again (DATA_FRAG repeated)"] += 1
-                return
-            self._last_frags = frags
         if len(payload) > FABRIC_MAX_DATAGRAM:
             self.counts.dropped["datagram longer than a frame carries"] += 1
             if self.counts.dropped["datagram longer than a frame carries"] == 1:

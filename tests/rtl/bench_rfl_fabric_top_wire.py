@@ -33,7 +33,8 @@ TOP = COUNTERS                  # the top's cnt_* outputs
 # rfl_fabric_node's internal counters: rfl_rtps_rx, rfl_rtps_to_cdr, rfl_rtps_tx, rfl_rtps_ctrl
 NODE = {"rtps_packets": "cnt_packets", "rtps_bad_header": "cnt_bad_header",
         "rtps_malformed": "cnt_malformed", "rtps_samples": "cnt_rx_samples",
-        "rtps_dropped": "cnt_rx_dropped", "seam_samples": "cnt_seam_samples",
+        "rtps_dropped": "cnt_rx_dropped", "rtps_repeated": "cnt_rx_repeated",
+        "seam_samples": "cnt_seam_samples",
         "seam_dropped": "cnt_seam_dropped", "seam_too_long": "cnt_too_long",
         "tx_datagrams": "cnt_datagrams", "tx_dropped": "cnt_dropped",
         "ctrl_requests": "cnt_requests", "ctrl_busy": "cnt_busy",

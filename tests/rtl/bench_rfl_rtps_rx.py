@@ -1,7 +1,8 @@
 """cocotb testbench of ``rfl_rtps_rx`` alone (run by tests/rtl/test_fabric_rtps_rx.py, not by pytest).
 
 The case comes in a JSON file (``RTPS_RX_CASE``): the datagrams (hex), the configuration, the
-expected samples and counters (computed by the test from the lab's RTPS decoder), per-mille
+expected samples and counters (computed by the test from the lab's RTPS decoder, or written
+by hand; a counter expected as null is not checked beyond the packets dropped), per-mille
 input gaps and output backpressure. One coroutine drives a byte a clock when it is offered and
 collects the output: every beat of a valid output held until taken, the sideband constant over
 a packet, TUSER only with TLAST, output beats never more than input bytes taken; the packets
@@ -107,7 +108,9 @@ async def rtps_rx_walk(dut) -> None:
     assert len(good) == len(want), f"{len(good)} samples out, {len(want)} expected"
     counts = {name: int(getattr(dut, f"cnt_{name}").value) for name in case["counts"]}
     assert counts["dropped"] >= len(packets) - len(good)
-    want_counts = dict(case["counts"], dropped=counts["dropped"])
+    want_counts = dict(case["counts"])
+    if want_counts["dropped"] is None:                # not predicted by the reference
+        want_counts["dropped"] = counts["dropped"]
     assert counts == want_counts, f"counters {counts}, expected {want_counts}"
     dut._log.info("%d bytes, %d clocks, %d samples, %d dropped packets, counters %s",
                   len(stream), clock, len(good), len(packets) - len(good), counts)

@@ -34,7 +34,7 @@ module rtps_cdr_top #(
     wire [127:0] guid;
     wire [63:0] seq, ts;
     wire ts_valid, frame_start, busy;
-    wire [31:0] cnt_packets, cnt_bad_header, cnt_malformed;
+    wire [31:0] cnt_packets, cnt_bad_header, cnt_malformed, cnt_rx_repeated;
     wire [7:0] framing;
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_rtps_rx u_rx (
@@ -46,7 +46,7 @@ module rtps_cdr_top #(
         .m_sample_seq(seq), .m_sample_ts(ts), .m_sample_ts_valid(ts_valid),
         .cnt_packets(cnt_packets), .cnt_bad_header(cnt_bad_header),
         .cnt_malformed(cnt_malformed), .cnt_samples(cnt_rx_samples),
-        .cnt_dropped(cnt_rx_dropped));
+        .cnt_dropped(cnt_rx_dropped), .cnt_repeated(cnt_rx_repeated));
     rfl_rtps_to_cdr #(.MAX_BYTES(MAX_BYTES)) u_seam (
         .clk(clk), .rst_n(rst_n),
         .s_axis_tdata(rx_tdata), .s_axis_tvalid(rx_tvalid), .s_axis_tready(rx_tready),

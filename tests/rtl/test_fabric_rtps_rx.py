@@ -8,8 +8,10 @@ The reference is the lab's decoder, ``rtps.parse_message(keep_valid=True)`` and
 walker's contract on top (:func:`reference`): DATA (flag D) and DATA_FRAG for our reader (or
 ENTITYID_UNKNOWN) from our writer, writerSN >= 1, destination ours or any; fragments streamed
 in order only (a sample whose fragments come out of order or with one missing is dropped, as
-is the sample in progress when another one starts); every fragmented sample it puts together
-is also what the participant's ``FragmentAssembler`` puts together from the same fragments.
+is the sample in progress when another one starts); a DATA_FRAG repeating fragments already
+taken (of the sample in progress, or past the first of the fragmented sample sent last) is
+skipped and counted, the sample going on; every fragmented sample it puts together is also what the
+participant's ``FragmentAssembler`` puts together from the same fragments.
 """
 
 from __future__ import annotations
@@ -176,6 +178,11 @@ def _sample_items(rng: random.Random, seq: int) -> list[tuple[bytes, bytes]]:
         chunks[k], chunks[k + 1] = chunks[k + 1], chunks[k]  # out of order
     elif fault < 0.22:
         chunks.insert(rng.randrange(len(chunks) + 1), chunks[0])   # a resent first one
+    elif fault < 0.30:
+        chunks = [c for c in chunks for _ in range(2)]             # each twice (Fast DDS)
+    elif fault < 0.36 and len(chunks) > 2:
+        k = rng.randrange(1, len(chunks) - 1)
+        chunks.insert(rng.randrange(k + 2, len(chunks) + 1), chunks[k])   # one again, later
     out = []
     for start, count in chunks:
         part = sample[(start - 1) * fsize:(start - 1 + count) * fsize]
@@ -286,17 +293,30 @@ def _fields(dg: bytes, at: int, le: bool) -> tuple[int, int, int]:
     return reader, writer, (high << 32) | low
 
 
+def _frag_fields(dg: bytes, at: int, le: bool) -> tuple[int, int, int, int]:
+    """fragmentStartingNum, fragmentsInSubmessage, fragmentSize, sampleSize of a DATA_FRAG."""
+    return struct.unpack(("<" if le else ">") + "IHHI", dg[at + 24:at + 36])
+
+
 def reference(datagrams: list[bytes], local: bytes = LOCAL, reader: int = READER,
               writer: int = WRITER) -> tuple[list[dict], dict[str, int]]:
     """The samples the walker must send whole, and its counters (dropped: not predicted)."""
     samples: list[dict] = []
-    counts = {"packets": len(datagrams), "bad_header": 0, "malformed": 0, "samples": 0}
+    counts = {"packets": len(datagrams), "bad_header": 0, "malformed": 0, "samples": 0,
+              "repeated": 0}
     act: dict | None = None
+    done: tuple | None = None                   # the fragmented sample sent last whole
     assembler = FragmentAssembler()
 
     def wanted(dst: bytes, rd: int, wr: int, seq: int) -> bool:
         return dst in (local, ANY_PARTICIPANT) and rd in (0, reader) and \
             writer in (0, wr) and seq >= 1
+
+    def repeats(key: tuple, start: int, valid: bool) -> bool:
+        """Fragments already taken: of the sample in progress, or past the first of the one
+        sent last (its fragment 1 starts it again: no history of writerSNs)."""
+        return valid and start >= 1 and ((key == done and start >= 2) or (
+            act is not None and act["key"] == key and start < act["next"]))
 
     for dg in datagrams:
         try:
@@ -309,7 +329,7 @@ def reference(datagrams: list[bytes], local: bytes = LOCAL, reader: int = READER
             continue
         if msg.header.guid_prefix == local:
             continue
-        ts, dst = None, ANY_PARTICIPANT
+        ts, src, dst = None, msg.header.guid_prefix, ANY_PARTICIPANT
         for src, dst, sub in msg.routed():
             if isinstance(sub, InfoTs):           # {seconds, fraction} as the walker keeps it
                 ts = None
@@ -325,17 +345,21 @@ def reference(datagrams: list[bytes], local: bytes = LOCAL, reader: int = READER
             if isinstance(sub, Data):
                 if sub.flags & 0x0C != 0x04:
                     continue
-                act = None
+                act = done = None
                 if sub.payload:
                     samples.append(dict(meta, data=sub.payload.hex()))
                 continue
             key = (src, sub.writer_id, sub.seq, sub.frag_size, sub.sample_size)
-            valid = sub.frag_size and sub.frag_count and sub.sample_size
+            valid = bool(sub.frag_size and sub.frag_count and sub.sample_size)
+            if repeats(key, sub.frag_start, valid):
+                counts["repeated"] += 1
+                continue
             if not (act and valid and act["key"] == key and sub.frag_start == act["next"]):
                 act = None
                 if sub.frag_start != 1 or not valid:
                     continue
                 act = {"key": key, "next": 1, "data": b"", "meta": meta}
+                done = None
             need = min(sub.frag_count * sub.frag_size, sub.sample_size - len(act["data"]))
             whole = assembler.add(src, sub)
             if len(sub.payload) < need:
@@ -346,7 +370,7 @@ def reference(datagrams: list[bytes], local: bytes = LOCAL, reader: int = READER
             if len(act["data"]) == sub.sample_size:
                 assert whole == act["data"], "the participant's assembler puts it otherwise"
                 samples.append(dict(act["meta"], data=act["data"].hex()))
-                act = None
+                act, done = None, key
         if msg.error is not None:
             counts["malformed"] += 1
             last = msg.submessages[-1] if msg.submessages else None
@@ -357,34 +381,82 @@ def reference(datagrams: list[bytes], local: bytes = LOCAL, reader: int = READER
             (length,) = struct.unpack("<H" if le else ">H", dg[at + 2:at + 4])
             end = len(dg) if length == 0 else min(len(dg), at + 4 + length)
             need = DATA_FIELDS if kind == b.DATA else FRAG_FIELDS
-            # a DATA / DATA_FRAG for us whose fields are all there drops the sample in progress
+            # a DATA / DATA_FRAG for us whose fields are all there drops the sample in progress,
+            # unless it repeats fragments already taken
             if kind in (b.DATA, b.DATA_FRAG) and end - at - 4 >= need and \
                     (kind == b.DATA_FRAG or dg[at + 1] & 0x0C == 0x04) and \
                     wanted(dst, *_fields(dg, at, le)):
+                if kind == b.DATA:
+                    act = done = None
+                    continue
+                start, count, fsize, ssize = _frag_fields(dg, at, le)
+                key = (src, _fields(dg, at, le)[1], _fields(dg, at, le)[2], fsize, ssize)
+                valid = bool(fsize and count and ssize)
+                if repeats(key, start, valid):
+                    counts["repeated"] += 1
+                    continue
                 act = None
+                if start == 1 and valid:
+                    done = None                    # it started a sample, then broke it
     counts["samples"] = len(samples)
     return samples, counts
 
 
 def test_the_reference_sees_samples_and_damage() -> None:
     """The random traffic is not trivial: whole samples of both kinds and both byte orders,
-    damaged datagrams of each counter."""
+    damaged datagrams of each counter, repeated fragments."""
     datagrams = random_datagrams(11, 60)
     samples, counts = reference(datagrams)
     assert len(samples) > 15 and counts["malformed"] > 0 and counts["bad_header"] > 0
+    # the co-simulated seeds repeat fragments
+    assert all(reference(random_datagrams(seed, 70))[1]["repeated"] >= 3 for seed in (1, 2))
     assert any(dg[HEADER_SIZE:].find(bytes([b.DATA_FRAG, 0])) >= 0 for dg in datagrams)
 
 
+# ---- repeated fragments, written by hand -----------------------------------------------------
+def _frag_datagram(seq: int, sample: bytes, starts: list[int], fsize: int = 8) -> bytes:
+    """One datagram of DATA_FRAGs (a fragment each) of ``sample`` from REMOTES[0]'s WRITER."""
+    dg = b.header(REMOTES[0]) + b.info_dst(LOCAL)
+    for n in starts:
+        part = sample[(n - 1) * fsize:n * fsize]
+        dg += b.data_frag(READER, WRITER, seq, n, fsize, len(sample), part, 1)
+    return dg
+
+
+def repeated_fragments_case() -> tuple[list[bytes], list[dict], dict[str, int]]:
+    """Datagrams with repeated fragments, and what the walker must do with them: samples 1, 2
+    and 5 whole (1: each datagram twice, as Fast DDS sends them; 2: fragment 1 again after 2,
+    2 again after 3; 5: the copies in one datagram, 3's across two), 3 (fragment 2 missing)
+    and 4 (fragments 1, 3, 2, 4) dropped and counted."""
+    sample = {seq: bytes([seq]) * 4 + bytes(range(seq * 16, seq * 16 + 26)) for seq in range(1, 6)}
+    order = {1: [1, 1, 2, 2, 3, 3, 4, 4], 2: [1, 2, 1, 3, 2, 4], 3: [1, 3, 4], 4: [1, 3, 2, 4]}
+    datagrams = [_frag_datagram(seq, sample[seq], [n]) for seq in (1, 2, 3, 4) for n in order[seq]]
+    datagrams += [_frag_datagram(5, sample[5], [1, 1]), _frag_datagram(5, sample[5], [2, 2, 3]),
+                  _frag_datagram(5, sample[5], [3, 4, 4])]
+    guid = (REMOTES[0] + WRITER.to_bytes(4, "big")).hex()
+    want = [{"guid": guid, "seq": seq, "ts": None, "data": sample[seq].hex()} for seq in (1, 2, 5)]
+    # repeated: the second copies (1: four, the last after the sample went out; 2: two; 5:
+    # four); dropped: 3 at its fragment 3 (the sample, then the fragment alone) and its 4
+    # alone, 4 likewise at its 3, then its 2 and 4 alone
+    counts = {"packets": len(datagrams), "bad_header": 0, "malformed": 0, "samples": 3,
+              "repeated": 4 + 2 + 4, "dropped": 3 + 4}
+    return datagrams, want, counts
+
+
+def test_the_repeated_fragments_case_is_what_the_reference_says() -> None:
+    datagrams, want, counts = repeated_fragments_case()
+    assert reference(datagrams) == (want, {k: v for k, v in counts.items() if k != "dropped"})
+
+
 # ---- the Verilog -----------------------------------------------------------------------------
-def cosimulate(tmp_path: Path, seed: int, samples: int, gap: int, bp: int) -> None:
+def cosimulate(tmp_path: Path, seed: int, gap: int, bp: int, datagrams: list[bytes],
+               want: list[dict], counts: dict[str, int | None]) -> None:
     sim = require_cocotb()
     from cocotb_tools.runner import get_runner
 
-    datagrams = random_datagrams(seed, samples)
-    want, counts = reference(datagrams)
     case = {"seed": seed, "gap": gap, "bp": bp, "local": LOCAL.hex(), "reader": READER,
             "writer": WRITER, "datagrams": [d.hex() for d in datagrams], "samples": want,
-            "counts": dict(counts, dropped=0)}
+            "counts": counts}
     (tmp_path / "case.json").write_text(json.dumps(case))
     runner = get_runner(sim)
     runner.build(sources=[SOURCE], hdl_toplevel="rfl_rtps_rx", build_dir=tmp_path / "build",
@@ -400,7 +472,19 @@ def test_rtps_rx_streams_the_references_samples(seed: int, samples: int, gap: in
                                                tmp_path: Path,
                                                monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.syspath_prepend(str(TB_DIR))
-    cosimulate(tmp_path, seed, samples, gap, bp)
+    datagrams = random_datagrams(seed, samples)
+    want, counts = reference(datagrams)
+    cosimulate(tmp_path, seed, gap, bp, datagrams, want, dict(counts, dropped=None))
+
+
+@pytest.mark.parametrize("gap,bp", [(200, 300), (0, 0)], ids=["gaps-backpressure", "full-rate"])
+def test_rtps_rx_skips_repeated_fragments(gap: int, bp: int, tmp_path: Path,
+                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """Repeated fragments (Fast DDS sends each twice) leave the sample whole; a fragment
+    missing or out of order still drops it, counted."""
+    monkeypatch.syspath_prepend(str(TB_DIR))
+    datagrams, want, counts = repeated_fragments_case()
+    cosimulate(tmp_path, 5, gap, bp, datagrams, want, counts)
 
 
 def test_verilator_wall_has_no_warning(tmp_path: Path) -> None:

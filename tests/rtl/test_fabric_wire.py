@@ -139,20 +139,22 @@ def families(frags: list[bytes]) -> list[Family]:
         _fcs(_eth_ip(good, USER, options=b"\x01\x01\x01\x00")),   # header length 6 (options)
     ]))
     # LiteEth does not read the IPv4 total length, flags nor fragment offset (LITEETH_PASSES):
-    # each of these carries the good sample's first DATA_FRAG, which starts a sample the next
-    # one drops (the seam counts it)
+    # each of these carries the good sample's first DATA_FRAG: the first starts the sample, the
+    # others repeat its fragments (skipped, counted), as does the good sample's first after them
     out.append(Family("IPv4 total length", [
         _fcs(_patch_ip(whole, len=IP(whole[14:]).len + 64)),     # longer than the frame
         _fcs(_patch_ip(whole, len=IP(whole[14:]).len - 64)),     # shorter than the UDP length
         _fcs(_patch_ip(whole, len=16)),                          # shorter than its header
-    ], user=[good] * 3, moves={"rx_packets": 3, "seam_dropped": 2}, then={"seam_dropped": 1}))
+    ], user=[good] * 3, moves={"rx_packets": 3, "rtps_repeated": 2},
+        then={"rtps_repeated": 1}))
     # IPv4 fragments: LiteEth does not reassemble; a fragment is not a datagram
     second = bytes(UDP(sport=40000, dport=USER, len=8 + len(good), chksum=0)) + good
     out.append(Family("IPv4 fragments", [
         _fcs(_patch_ip(whole, flags=1)),                         # MF: the first of several
         _fcs(bytes(Ether(dst=NODE_MAC, src=PEER_MAC) /
                    IP(src=PEER_IP, dst=NODE_IP, proto=17, frag=185) / second)),  # a later one
-    ], user=[good] * 2, moves={"rx_packets": 2, "seam_dropped": 1}, then={"seam_dropped": 1}))
+    ], user=[good] * 2, moves={"rx_packets": 2, "rtps_repeated": 1},
+        then={"rtps_repeated": 1}))
     udp_at = 14 + 20
 
     def udp_len(n: int) -> bytes:
@@ -302,8 +304,8 @@ def test_bad_input_is_dropped_counted_and_the_next_sample_is_exact(wire: dict) -
 
     # per family: the counters that must move, by as much; the others stand still
     watched = ("rx_error", "rx_length", "rx_overflow", "rx_packets", "rx_port", "rtps_packets",
-               "rtps_bad_header", "rtps_malformed", "seam_dropped", "seam_too_long",
-               "ctrl_malformed", "ctrl_bad_header", "tx_dropped", "tx_overflow")
+               "rtps_bad_header", "rtps_malformed", "rtps_repeated", "seam_dropped",
+               "seam_too_long", "ctrl_malformed", "ctrl_bad_header", "tx_dropped", "tx_overflow")
     before = {k: 0 for k in watched}
     good_moves = {"rx_packets": 2, "rtps_packets": 2}
     for fam, (bad, after) in zip(fams, zip(out["groups"][::2], out["groups"][1::2])):

@@ -84,6 +84,7 @@ module rfl_fabric_node #(
     wire [63:0] seq, ts, tx_seq;
     wire ts_valid, frame_start, busy, rom_busy;
     wire [31:0] cnt_packets, cnt_bad_header, cnt_malformed, cnt_rx_samples, cnt_rx_dropped;
+    wire [31:0] cnt_rx_repeated;
     wire [31:0] cnt_seam_samples, cnt_seam_dropped, cnt_too_long, cnt_datagrams, cnt_dropped;
     wire [31:0] cnt_requests, cnt_busy, cnt_ctrl_malformed, cnt_ctrl_bad_header;
     wire [7:0] framing;
@@ -98,7 +99,7 @@ module rfl_fabric_node #(
         .m_sample_seq(seq), .m_sample_ts(ts), .m_sample_ts_valid(ts_valid),
         .cnt_packets(cnt_packets), .cnt_bad_header(cnt_bad_header),
         .cnt_malformed(cnt_malformed), .cnt_samples(cnt_rx_samples),
-        .cnt_dropped(cnt_rx_dropped));
+        .cnt_dropped(cnt_rx_dropped), .cnt_repeated(cnt_rx_repeated));
     rfl_rtps_to_cdr #(.MAX_BYTES(MAX_BYTES)) u_seam (
         .clk(clk), .rst_n(rst_n),
         .s_axis_tdata(rx_tdata), .s_axis_tvalid(rx_tvalid), .s_axis_tready(rx_tready),

@@ -22,8 +22,16 @@
 //             writerSN >= 1. A DATA_FRAG continues the sample being streamed when it has the
 //             same writer GUID, writerSN, fragment and sample sizes and fragmentStartingNum is
 //             the next one; with number 1 it starts a new sample; anything else is dropped.
-//             A taken DATA, or a DATA_FRAG that does not continue, drops the sample in
-//             progress (its packet ends with TUSER set).
+//             A repeat is skipped whole and counted (cnt_repeated), the sample going on: a
+//             DATA_FRAG of that sample (same GUID, writerSN and sizes) whose fragmentStartingNum
+//             is 1 or more and below the next one, or 2 or more of the fragmented sample sent
+//             last whole (RTPS lets a reader see a fragment twice; Fast DDS sends each twice,
+//             one per locator it has for the reader). Fragments past the next one in a repeat
+//             are not taken: a sample that needed them is dropped at its next fragment. No
+//             history of writerSNs is kept: a sample sent again from fragment 1 once it went
+//             out (as a DATA sent again) comes out again.
+//             A taken DATA, or a DATA_FRAG that neither continues nor repeats, drops the
+//             sample in progress (its packet ends with TUSER set).
 //   S_GAP     the bytes up to octetsToInlineQos; S_QOS the inline QoS parameter list (flag Q)
 //             up to PID_SENTINEL; S_PAY the payload: streamed when taken (a DATA's to the end
 //             of the submessage; a DATA_FRAG's fragments up to the sample's end), else skipped.
@@ -71,7 +79,8 @@ module rfl_rtps_rx #(
     output wire [COUNT_BITS-1:0] cnt_bad_header,
     output wire [COUNT_BITS-1:0] cnt_malformed,
     output wire [COUNT_BITS-1:0] cnt_samples,   // samples sent whole
-    output wire [COUNT_BITS-1:0] cnt_dropped    // samples dropped, fragments out of order
+    output wire [COUNT_BITS-1:0] cnt_dropped,   // samples dropped, fragments out of order
+    output wire [COUNT_BITS-1:0] cnt_repeated   // DATA_FRAGs skipped: fragments taken before
 );
     // Parameter contracts: an illegal value is refused at elaboration (Verilator, Yosys);
     // Icarus -g2005 has no elaboration tasks, so it stops at time 0, before any clock.
@@ -160,20 +169,23 @@ module rfl_rtps_rx #(
     reg [31:0] meta_writer;
     reg [63:0] meta_seq, meta_ts;
     reg meta_ts_valid;
+    reg a_done;                                 // meta_* is a fragmented sample sent whole
     wire fin = act_frag ? al1 : body_last;      // the sample's last byte
     wire fset_end = act_frag && fl1 && fc1;
 
     // the decision (S_D1 registers, S_D2 reads)
     reg d_body_end, d_pkt_end, d_bad;
     reg eq_pfx, eq_wr, eq_seq;                  // registered every clock (timing)
-    reg f_k_eq, f_start_eq, f_start1, f_fsz_eq, f_ssz_eq, f_valid, f_matched;
-    wire cont_now = f_matched && act && act_frag && f_k_eq && f_start_eq && f_fsz_eq &&
-                    f_ssz_eq && f_valid;
-    wire need_abort = act && f_matched && (!is_frag || !cont_now);
-    wire start_now = f_matched && (!is_frag || (f_start1 && f_valid));
+    reg f_k_eq, f_start_eq, f_start1, f_start0, f_below, f_fsz_eq, f_ssz_eq, f_valid, f_matched;
+    wire f_same = f_matched && is_frag && f_k_eq && f_fsz_eq && f_ssz_eq && f_valid;
+    wire cont_now = f_same && act && act_frag && f_start_eq;
+    wire rep_now = f_same && !f_start0 &&
+                   ((a_done && !f_start1) || (act && act_frag && f_below));
+    wire need_abort = act && f_matched && !rep_now && (!is_frag || !cont_now);
+    wire start_now = f_matched && !rep_now && (!is_frag || (f_start1 && f_valid));
     wire d_ok = !d_bad && !gap_pos && !sm_flags[1];
 
-    reg p_pkt, p_badhdr, p_mal, p_ok, p_drop;   // counter pulses
+    reg p_pkt, p_badhdr, p_mal, p_ok, p_drop, p_rep;    // counter pulses
 
     task emit(input [7:0] d, input l, input u);
         begin
@@ -250,6 +262,7 @@ module rfl_rtps_rx #(
         p_mal <= 1'b0;
         p_ok <= 1'b0;
         p_drop <= 1'b0;
+        p_rep <= 1'b0;
         if (m_axis_tready) o_valid <= 1'b0;
         if (take) begin
             acc_e <= acc_e_n;
@@ -269,6 +282,7 @@ module rfl_rtps_rx #(
             hold <= 1'b0;
             pay_on <= 1'b0;
             sm_acc <= 1'b0;
+            a_done <= 1'b0;
         end else begin
             case (st)
             S_HDR: if (take) begin
@@ -380,6 +394,8 @@ module rfl_rtps_rx #(
                 f_k_eq <= eq_pfx && eq_wr && eq_seq;    // DATA_FRAG: writerSN is 12 bytes old
                 f_start_eq <= (frag_start == next_frag);
                 f_start1 <= (frag_start == 32'd1);
+                f_start0 <= (frag_start == 32'd0);
+                f_below <= (frag_start < next_frag);
                 f_fsz_eq <= (frag_size == a_fsize);
                 f_ssz_eq <= (sample_size == a_ssize);
                 f_valid <= (frag_size != 16'd0) && (frag_count != 16'd0) &&
@@ -405,6 +421,7 @@ module rfl_rtps_rx #(
                         load_meta;
                         act <= 1'b1;
                         act_frag <= is_frag;
+                        a_done <= 1'b0;
                         beats <= 1'b0;
                         next_frag <= 32'd1;
                         a_fsize <= frag_size;
@@ -412,7 +429,8 @@ module rfl_rtps_rx #(
                         a_ssize <= sample_size;
                         a_left <= sample_size;
                         al1 <= (sample_size == 32'd1);
-                    end else if (f_matched && !cont_now) p_drop <= 1'b1;  // out of order
+                    end else if (rep_now) p_rep <= 1'b1;
+                    else if (f_matched && !cont_now) p_drop <= 1'b1;        // out of order
                     if (d_body_end) begin       // nothing after the fields
                         if (!d_ok) p_mal <= 1'b1;
                         if ((start_now || cont_now) && (is_frag || !d_ok)) begin
@@ -483,6 +501,7 @@ module rfl_rtps_rx #(
                         if (body_end) begin
                             emit(b, 1'b1, end_bad);
                             act <= 1'b0;
+                            a_done <= act_frag && !end_bad;
                         end else begin          // its verdict comes with the submessage's end
                             hold <= 1'b1;
                             hold_data <= b;
@@ -500,6 +519,7 @@ module rfl_rtps_rx #(
                     emit(hold_data, 1'b1, end_bad);
                     hold <= 1'b0;
                     act <= 1'b0;
+                    a_done <= act_frag && !end_bad;
                 end else if (body_end && end_bad && sm_acc) abort_act;
                 if (body_end) begin
                     if (end_bad) begin
@@ -522,7 +542,7 @@ module rfl_rtps_rx #(
     end
 
     // counters (a clock after the event)
-    reg [COUNT_BITS-1:0] c_pkt, c_badhdr, c_mal, c_ok, c_drop;
+    reg [COUNT_BITS-1:0] c_pkt, c_badhdr, c_mal, c_ok, c_drop, c_rep;
     always @(posedge clk) begin
         if (!rst_n) begin
             c_pkt <= {COUNT_BITS{1'b0}};
@@ -530,12 +550,14 @@ module rfl_rtps_rx #(
             c_mal <= {COUNT_BITS{1'b0}};
             c_ok <= {COUNT_BITS{1'b0}};
             c_drop <= {COUNT_BITS{1'b0}};
+            c_rep <= {COUNT_BITS{1'b0}};
         end else begin
             c_pkt <= c_pkt + {{(COUNT_BITS-1){1'b0}}, p_pkt};
             c_badhdr <= c_badhdr + {{(COUNT_BITS-1){1'b0}}, p_badhdr};
             c_mal <= c_mal + {{(COUNT_BITS-1){1'b0}}, p_mal};
             c_ok <= c_ok + {{(COUNT_BITS-1){1'b0}}, p_ok};
             c_drop <= c_drop + {{(COUNT_BITS-1){1'b0}}, p_drop};
+            c_rep <= c_rep + {{(COUNT_BITS-1){1'b0}}, p_rep};
         end
     end
 
@@ -552,6 +574,7 @@ module rfl_rtps_rx #(
     assign cnt_malformed = c_mal;
     assign cnt_samples = c_ok;
     assign cnt_dropped = c_drop;
+    assign cnt_repeated = c_rep;
 endmodule
 
 `default_nettype wire

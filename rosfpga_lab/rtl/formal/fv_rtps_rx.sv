@@ -12,6 +12,7 @@ module fv_rtps_rx (
     wire [127:0] m_sample_guid;
     wire [63:0] m_sample_seq, m_sample_ts;
     wire [3:0] cnt_packets, cnt_bad_header, cnt_malformed, cnt_samples, cnt_dropped;
+    wire [3:0] cnt_repeated;
     rfl_rtps_rx #(.COUNT_BITS(4)) dut (
         .clk(clk), .rst_n(rst_n), .cfg_prefix(cfg_prefix), .cfg_reader(cfg_reader),
         .cfg_writer(cfg_writer), .s_axis_tdata(s_axis_tdata), .s_axis_tvalid(s_axis_tvalid),
@@ -22,7 +23,7 @@ module fv_rtps_rx (
         .m_sample_seq(m_sample_seq), .m_sample_ts(m_sample_ts),
         .m_sample_ts_valid(m_sample_ts_valid), .cnt_packets(cnt_packets),
         .cnt_bad_header(cnt_bad_header), .cnt_malformed(cnt_malformed),
-        .cnt_samples(cnt_samples), .cnt_dropped(cnt_dropped));
+        .cnt_samples(cnt_samples), .cnt_dropped(cnt_dropped), .cnt_repeated(cnt_repeated));
 `include "fv_env.vh"
     `FV_SOURCE(s_axis_tvalid, s_axis_tready, {s_axis_tdata, s_axis_tlast})
     `FV_SINK(m_axis_tvalid, m_axis_tready, {m_axis_tdata, m_axis_tlast, m_axis_tuser,
