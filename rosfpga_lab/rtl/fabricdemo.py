@@ -28,12 +28,13 @@ import ipaddress
 import struct
 import subprocess
 import tempfile
-import zlib
 from pathlib import Path
 
 import numpy as np
 
 from rosfpga_lab.config import NodeConfig, parse_config
+from rosfpga_lab.graph import ethframe
+from rosfpga_lab.graph.ethframe import ArpRequest, mac_bytes
 from rosfpga_lab.rtl.discrom import (
     fabric_participant, fabric_top_literals, render_rom, write_rom,
 )
@@ -72,7 +73,6 @@ FRAGMENT = 256
 #: The node's INFO_TS (``cfg_time``: seconds, then 2**-32 s).
 TIME = (1_700_000_000 << 32) | 0x8000_0000
 PREAMBLE = bytes.fromhex("55555555555555d5")
-MIN_FRAME = 60                              # Ethernet's minimum, FCS not counted
 #: Idle clocks between the frames the peer sends, and after the last frame out.
 GAP, HOLD = 40, 60
 PERIOD = 1_000_000                          # one SPDP announcement (at reset) in the run
@@ -146,40 +146,18 @@ def demo_datagrams(config: NodeConfig | None = None) -> list[bytes]:
             hdr + b.data_frag(rid, PEER_WRITER, 1, 2, FRAGMENT, len(sample), parts[1], 1)]
 
 
-def _mac(text: str) -> bytes:
-    return bytes.fromhex(text.replace(":", ""))
-
-
-def ipv4_checksum(header: bytes) -> int:
-    """The IPv4 header checksum (RFC 791: one's complement of the one's complement sum of the
-    16-bit words, the checksum field taken as 0)."""
-    total = sum(struct.unpack(f">{len(header) // 2}H", header))
-    while total >> 16:
-        total = (total & 0xFFFF) + (total >> 16)
-    return ~total & 0xFFFF
-
-
 def udp_frame(payload: bytes, dport: int, *, sport: int = PEER_SPORT, ident: int = 1) -> bytes:
-    """An Ethernet II frame from the peer to the node holding IPv4 and UDP (checksum 0: none,
-    as IPv4 allows) around ``payload``, padded to the minimum and ended by its FCS (CRC-32,
-    least significant byte first); no preamble."""
-    udp = struct.pack(">HHHH", sport, dport, 8 + len(payload), 0) + payload
-    ip = bytearray(struct.pack(">BBHHHBBH4s4s", 0x45, 0, 20 + len(udp), ident, 0x4000, 64, 17, 0,
-                               ipaddress.IPv4Address(PEER_IP).packed,
-                               ipaddress.IPv4Address(NODE_IP).packed))
-    ip[10:12] = struct.pack(">H", ipv4_checksum(bytes(ip)))
-    frame = (_mac(NODE_MAC) + _mac(PEER_MAC) + b"\x08\x00" + bytes(ip) + udp).ljust(MIN_FRAME,
-                                                                                    b"\0")
-    return frame + struct.pack("<I", zlib.crc32(frame))
+    """The peer's Ethernet II frame to the node around ``payload`` (IPv4, UDP without a
+    checksum, padded, FCS: :func:`rosfpga_lab.graph.ethframe.udp_frame`); no preamble."""
+    return ethframe.udp_frame(payload, src_mac=mac_bytes(PEER_MAC), dst_mac=mac_bytes(NODE_MAC),
+                              src_ip=PEER_IP, dst_ip=NODE_IP, src_port=sport, dst_port=dport,
+                              ident=ident)
 
 
 def arp_reply() -> bytes:
     """The peer's ARP reply to the node (its MAC for its IP), with FCS; no preamble."""
-    arp = (struct.pack(">HHBBH", 1, 0x0800, 6, 4, 2) + _mac(PEER_MAC) +
-           ipaddress.IPv4Address(PEER_IP).packed + _mac(NODE_MAC) +
-           ipaddress.IPv4Address(NODE_IP).packed)
-    frame = (_mac(NODE_MAC) + _mac(PEER_MAC) + b"\x08\x06" + arp).ljust(MIN_FRAME, b"\0")
-    return frame + struct.pack("<I", zlib.crc32(frame))
+    return ethframe.arp_reply(ArpRequest(mac_bytes(NODE_MAC), NODE_IP, PEER_IP),
+                              mac_bytes(PEER_MAC))
 
 
 def demo_frames(config: NodeConfig | None = None) -> list[bytes]:
