@@ -291,7 +291,8 @@ class ShimBridge(_PeerKeeper):
                 self._learn(peer)
             self._ask_subscriptions(payload)
             for topic, loc in sedp_reader_locators(payload, source):
-                if self.readers.get(topic) != loc:
+                # only the circuit's own topics: a peer announcing many others costs nothing here
+                if topic in self._topics.values() and self.readers.get(topic) != loc:
                     self.readers[topic] = loc
                     self.log(f"a reader of {topic} at {loc[0]}:{loc[1]} (its own locator)")
         if len(payload) > FABRIC_MAX_DATAGRAM:
