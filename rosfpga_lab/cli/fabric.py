@@ -36,8 +36,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "Ethernet frame: the circuit does not reassemble IP fragments); one peer participant "
         "at a time. The clock runs at most --rate clocks per second, SPDP every --period "
         "clocks (the board's is 125 million at 125 MHz; scaled down here). Stops after "
-        "--seconds or on Ctrl-C (SIGINT or SIGTERM), and prints the circuit's and the "
-        "bridge's counters. "
+        "--seconds or on Ctrl-C (SIGINT or SIGTERM), and prints the circuit's counters (the "
+        "top's, then the RTPS stages' inside the node: rfl_rtps_rx, the seam rfl_rtps_to_cdr, "
+        "rfl_rtps_tx, rfl_rtps_ctrl) and the bridge's. "
         "Example: rosfpga-lab fabric sim data/fpga_laserscan_min_cdr.yaml --seconds 60")
     p.add_argument("config", type=Path, metavar="CONFIG",
                    help="the node configuration (YAML, wire: cdr)")
@@ -73,6 +74,7 @@ def run_sim(args: argparse.Namespace) -> int:
     from rosfpga_lab.component.fabricsim import TAP_HOST_CIDR, TAP_NAME, start_fabric
     from rosfpga_lab.config import load_config
     from rosfpga_lab.rtl.fabricsim import SIM_PERIOD, SIM_RATE
+    from rosfpga_lab.rtl.fabriccounters import stage_lines
     from rosfpga_lab.rtps.entities import check_domain
 
     def say(line: str) -> None:
@@ -118,6 +120,8 @@ def run_sim(args: argparse.Namespace) -> int:
     print(f"fabric sim: {report.clocks} clocks in {seconds:.1f} s "
           f"({report.clocks / max(seconds, 1e-9):,.0f} clocks/s)")
     print("circuit: " + ", ".join(f"{k} {v}" for k, v in report.counters.items()))
+    for line in stage_lines(report.node_counters):    # the RTPS stages', inside the node
+        print(line)
     for line in bridge.counts.lines():
         print("bridge: " + line)
     err = bridge.sim.stderr().strip()
