@@ -11,7 +11,8 @@ its one peer's ports from the peer's SPDP and pulses send_sedp). Every output is
 numpy (a 5-beam minimum over ``ranges``) and with the lab's CDR model, never with the circuit's
 own output. rclpy (the ``[ros2]`` extra: Fast DDS, ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST)
 sees the fabric's node, its publisher and subscriber, their types and type hashes in its graph
-API (the hash against rosidl's, copied in tests/msg/test_typehash_realros2.py). A 64x48 Image
+API (the hash against rosidl's, copied in tests/msg/test_typehash_realros2.py), and its
+LaserScans come back exact against numpy (Fast DDS sends each DATA_FRAG twice). A 64x48 Image
 goes through the dilation in ten DATA_FRAGs each way, exact against OpenCV; with ``--tap`` the
 same scans cross a Linux TAP interface, whose capture tshark reads without a malformed packet.
 The samples go out 0.3-0.5 s apart (a scanner's rate): three scans back to back at line rate
@@ -22,6 +23,7 @@ build per domain, address and sample bound; each cached after the first, some 15
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import json
 import os
@@ -30,6 +32,8 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
@@ -43,7 +47,8 @@ from rosfpga_lab.config import load_config
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline
 from rosfpga_lab.rtl.discrom import render_rom
 from rosfpga_lab.rtl.fabricsim import build_fabric_sim
-from tests.component.test_ros2_rtl import SCAN_CDR, _assert_exact, _scans
+from tests.component.test_ros2_rtl import SCAN_CDR, SPECIALS, _assert_exact, _scans
+from tests.support.generictools import window_oracle
 from tests.msg.test_typehash_realros2 import GOLDEN
 from tests.support.realros import ROS_PROGRAMS, require_ros2
 from tests.support.proctools import interruptible, kill_if_running, stop_with
@@ -74,6 +79,37 @@ BIG_DOMAIN = 229
 #: The TAP test's domain (a Cyclone domain of its own in this process: another configuration).
 TAP_DOMAIN = 231
 IMAGES = 2
+
+
+@dataclass
+class _Cli:
+    """``rosfpga-lab fabric sim`` running (ready), its stderr lines as they come."""
+
+    proc: subprocess.Popen
+    lines: list[str]
+
+    def stop(self) -> str:
+        """Ctrl-C: its stdout (the counters) once it ended."""
+        stdout, _ = stop_with(self.proc, signal.SIGINT)
+        return stdout
+
+    def log(self) -> str:
+        return "".join(self.lines)
+
+
+@contextlib.contextmanager
+def _running_cli(tmp_path: Path, config: Path = SCAN_CDR, *extra: str, domain: int = DOMAIN,
+                 mode: str = "--shim") -> Iterator[_Cli]:
+    """The command started and ready (the model built, the bridge bound), killed if the test
+    ends before it did."""
+    proc, lines = _start_cli(tmp_path, config, *extra, domain=domain, mode=mode)
+    cli = _Cli(proc, lines)
+    try:
+        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
+                    60) and proc.poll() is None, cli.log()
+        yield cli
+    finally:
+        kill_if_running(proc)
 
 
 def _start_cli(tmp_path: Path, config: Path = SCAN_CDR, *extra: str,
@@ -196,6 +232,58 @@ def _rclpy_env(tmp_path: Path, domain: int) -> dict[str, str]:
                RMW_IMPLEMENTATION="rmw_fastrtps_cpp", ROS_LOG_DIR=str(tmp_path / "ros_log"),
                ROS_HOME=str(tmp_path / "ros_home"))
     return env
+
+
+def _scan_descriptions(n: int) -> list[dict]:
+    """``n`` LaserScans for tests/ros_programs/rclpy_peer.py's ``scans`` mode: 360 beams (the
+    configuration's stream), every other one of special values (signed zeros, infinities,
+    NaN), float32 fields as little-endian hex."""
+    rng = np.random.default_rng(31)
+    out = []
+    for k in range(n):
+        ranges = rng.choice(SPECIALS, 360) if k % 2 else rng.uniform(0.1, 30, 360)
+        f32 = {name: np.array([v], "<f4").tobytes().hex() for name, v in (
+            ("angle_min", -1.5), ("angle_max", 1.5), ("angle_increment", 0.01),
+            ("time_increment", 1e-5 * k), ("scan_time", 0.1), ("range_min", 0.05),
+            ("range_max", 30.0))}
+        out.append({"sec": 200 + k, "nanosec": 1000 * k, "frame_id": "l" * 64 if k % 2 else "laser",
+                    **f32, "ranges": np.asarray(ranges, "<f4").tobytes().hex(),
+                    "intensities": np.arange(k * 7 % 12, dtype="<f4").tobytes().hex()})
+    return out
+
+
+def test_rclpy_laserscans_through_the_simulated_fabric_exact(tmp_path: Path) -> None:
+    """rclpy (Fast DDS, datagrams of one frame: each scan in two DATA_FRAGs, each sent twice)
+    publishes LaserScans with ROS 2's default QoS to the fabric node of
+    data/fpga_laserscan_min_cdr.yaml and subscribes to its output: each exact against numpy's
+    5-beam minimum of what it sent (every other field as sent), bit for bit."""
+    require_fabric_sim()
+    require_ros2()
+    config = load_config(SCAN_CDR)
+    build_fabric_sim(config, render_rom(config, domain=DOMAIN))   # the CLI's, cached
+    profile = tmp_path / "fastdds.xml"
+    profile.write_text(fastdds_peer_profile())
+    env = dict(_rclpy_env(tmp_path, DOMAIN), FASTRTPS_DEFAULT_PROFILES_FILE=str(profile))
+    sent = _scan_descriptions(SCANS)
+    (tmp_path / "scans.json").write_text(json.dumps(sent))
+    with _running_cli(tmp_path) as cli:
+        peer = subprocess.run([sys.executable, str(ROS_PROGRAMS / "rclpy_peer.py"), "scans",
+                               "/scan", "/scan_min", str(tmp_path / "scans.json"),
+                               "--timeout", "15"], input="go\n", capture_output=True,
+                              text=True, env=env, timeout=60)
+        stdout = cli.stop()
+    assert peer.returncode == 0, (peer.stderr[-2000:], cli.log())
+    report = json.loads(peer.stdout.strip().splitlines()[-1])
+    print(stdout)
+    assert report["matched"] and len(report["got"]) == SCANS, (report.get("matched"), stdout)
+    for k, (want, got) in enumerate(zip(sent, report["got"], strict=True)):
+        ranges = window_oracle(bytes.fromhex(want["ranges"]), "<f4", 5, "erode")
+        assert bytes.fromhex(got["ranges"]) == ranges, k
+        assert {n: v for n, v in got.items() if n != "ranges"} == \
+            {n: v for n, v in want.items() if n != "ranges"}, k
+    counters = _counters(stdout)
+    assert (counters["samples"], counters["judged"], counters["refused"]) == \
+        (str(SCANS), str(SCANS), "0"), stdout
 
 
 def test_rclpy_images_64x48_through_the_simulated_fabric_exact(tmp_path: Path) -> None:
