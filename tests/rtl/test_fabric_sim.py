@@ -99,8 +99,8 @@ def _heartbeat_too_long() -> bytes:
 def test_fabric_sim_prints_the_rtps_stages_counters_moved_by_bad_input(tmp_path: Path) -> None:
     """One good LaserScan in two DATA_FRAGs with its first fragment sent twice, a bad RTPS
     header and a malformed submessage to the user-data port, the same two to the metatraffic
-    port: the printed counters, counted by hand from the modules' headers (rfl_rtps_rx,
-    rfl_rtps_ctrl)."""
+    port: the printed counters (on SIGUSR1 and at the end), counted by hand from the modules'
+    headers (rfl_rtps_rx, rfl_rtps_ctrl)."""
     require_fabric_sim()
     config = load_config(CONFIG)
     build_fabric_sim(config, render_rom(config, domain=COUNT_DOMAIN))   # the CLI's, cached
@@ -141,18 +141,24 @@ def test_fabric_sim_prints_the_rtps_stages_counters_moved_by_bad_input(tmp_path:
                 sock.sendto(datagram, ("127.0.0.1", port))
                 time.sleep(0.3)                    # some 100,000 clocks: one at a time
         time.sleep(0.5)
+        proc.send_signal(signal.SIGUSR1)           # the counters now, then at the end
+        time.sleep(1.0)
         stdout, _ = stop_with(proc, signal.SIGINT)
     finally:
         kill_if_running(proc)
     assert proc.returncode == 0, log.read_text()
     print(stdout)
-    printed = {}
+    blocks: list[dict[str, dict[str, int]]] = []
     for line in stdout.splitlines():
+        if line.startswith("fabric sim: "):
+            blocks.append({})
         stage, sep, rest = line.partition(": ")
         if sep and stage in want:
-            printed[stage] = {k: int(v) for k, v in (kv.split(" ") for kv in rest.split(", "))}
-    for stage, counts in want.items():
-        assert {k: printed[stage][k] for k in counts} == counts, (stage, stdout)
+            blocks[-1][stage] = {k: int(v) for k, v in (kv.split(" ") for kv in rest.split(", "))}
+    assert len(blocks) == 2, stdout                 # on SIGUSR1, then at the end
+    for printed in blocks:
+        for stage, counts in want.items():
+            assert {k: printed[stage][k] for k in counts} == counts, (stage, stdout)
     top = dict(kv.rsplit(" ", 1) for kv in next(
         x for x in stdout.splitlines() if x.startswith("circuit: "))[len("circuit: "):].split(", "))
     assert (top["rx_packets"], top["rx_overflow"], top["judged"], top["refused"]) == \
