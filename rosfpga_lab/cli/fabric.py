@@ -4,12 +4,19 @@ and bridged to the host's network, for real ROS 2 peers (issue 31 item 3)."""
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 import time
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rosfpga_lab.cli._args import positive_int
 from rosfpga_lab.cli._signals import StopSignals
+
+if TYPE_CHECKING:
+    from rosfpga_lab.component.fabricsim import ShimBridge, TapBridge
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -36,8 +43,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "Ethernet frame: the circuit does not reassemble IP fragments); one peer participant "
         "at a time. The clock runs at most --rate clocks per second, SPDP every --period "
         "clocks (the board's is 125 million at 125 MHz; scaled down here). Stops after "
-        "--seconds or on Ctrl-C (SIGINT or SIGTERM), and prints the circuit's and the "
-        "bridge's counters. "
+        "--seconds or on Ctrl-C (SIGINT or SIGTERM), and prints the circuit's counters (the "
+        "top's, then the RTPS stages' inside the node: rfl_rtps_rx, the seam rfl_rtps_to_cdr, "
+        "rfl_rtps_tx, rfl_rtps_ctrl) and the bridge's; SIGUSR1 prints them while it runs "
+        "(kill -USR1 PID). "
         "Example: rosfpga-lab fabric sim data/fpga_laserscan_min_cdr.yaml --seconds 60")
     p.add_argument("config", type=Path, metavar="CONFIG",
                    help="the node configuration (YAML, wire: cdr)")
@@ -108,19 +117,56 @@ def run_sim(args: argparse.Namespace) -> int:
             f"{bridge.rom.address}, UDP ports {bridge.meta} (metatraffic) and {bridge.user} "
             f"(user data), on {where}; running {args.seconds:g} s (Ctrl-C stops)")
         with StopSignals(raise_interrupt=False) as stop:   # SIGINT, SIGTERM: counters, then out
-            bridge.run(args.seconds, stop=lambda: stop.fired is not None)
+            _bridge(bridge, args.seconds, lambda: stop.fired is not None, started)
         if stop.fired is not None:
             say("stopped by a signal")
     finally:
         bridge.close()
         report = bridge.sim.close()
-    seconds = time.monotonic() - started
-    print(f"fabric sim: {report.clocks} clocks in {seconds:.1f} s "
-          f"({report.clocks / max(seconds, 1e-9):,.0f} clocks/s)")
-    print("circuit: " + ", ".join(f"{k} {v}" for k, v in report.counters.items()))
-    for line in bridge.counts.lines():
-        print("bridge: " + line)
+    _print_counters(report.clocks, time.monotonic() - started, report.counters,
+                    report.node_counters, bridge.counts.lines())
     err = bridge.sim.stderr().strip()
     if err:
         print(f"simulation's stderr: {err}", file=sys.stderr)
     return 0
+
+
+def _print_counters(clocks: int, seconds: float, counters: Mapping[str, int],
+                    node_counters: Mapping[str, int], bridge_lines: list[str]) -> None:
+    """The circuit's counters (the top's, then the RTPS stages' a line a stage) and the
+    bridge's, on stdout."""
+    from rosfpga_lab.rtl.fabriccounters import stage_lines
+
+    print(f"fabric sim: {clocks} clocks in {seconds:.1f} s "
+          f"({clocks / max(seconds, 1e-9):,.0f} clocks/s)")
+    print("circuit: " + ", ".join(f"{k} {v}" for k, v in counters.items()))
+    for line in stage_lines(node_counters):
+        print(line)
+    for line in bridge_lines:
+        print("bridge: " + line)
+    sys.stdout.flush()
+
+
+def _bridge(bridge: ShimBridge | TapBridge, seconds: float, stopped: Callable[[], bool],
+            started: float) -> None:
+    """Bridge for ``seconds`` or until ``stopped()``; on SIGUSR1 (main thread only) ask the
+    simulation for its counters and print them when they come (at most a second's wait)."""
+    asked = threading.Event()
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGUSR1, lambda _n, _f: asked.set()) if main else None
+    try:
+        end = time.monotonic() + seconds
+        while not stopped() and bridge.sim.running() and time.monotonic() < end:
+            bridge.run(end - time.monotonic(), stop=lambda: stopped() or asked.is_set())
+            if asked.is_set():
+                asked.clear()
+                before = bridge.sim.node_counters
+                bridge.sim.ask_counters()       # its 'N' report comes after the 'K' one
+                bridge.run(min(1.0, max(end - time.monotonic(), 0.0)),
+                           stop=lambda: stopped() or bridge.sim.node_counters is not before)
+                _print_counters(bridge.sim.clocks, time.monotonic() - started,
+                                bridge.sim.counters, bridge.sim.node_counters,
+                                bridge.counts.lines())
+    finally:
+        if main:
+            signal.signal(signal.SIGUSR1, signal.SIG_DFL if previous is None else previous)

@@ -1,12 +1,13 @@
 """The run notebook 12 shows: one ``sensor_msgs/LaserScan`` sample through the ROS 2 node in the
 fabric (``fabric/rfl_fabric_top.v``, GMII variant), from the Ethernet preamble in to the RTPS
-DATA out, and the dump shipped in data/.
+DATA_FRAGs out, and the dump shipped in data/.
 
 One owner for what the notebook, the script that made ``data/fabric_demo.vcd`` and the test that
-regenerates it share: the circuit (:data:`DEMO_YAML`, the 90-beam variant of
-``data/fpga_laserscan_min_cdr.yaml``: a small sample keeps the dump small), the addresses, the
+regenerates it share: the circuit (:data:`DEMO_YAML`, the 330-beam variant of
+``data/fpga_laserscan_min_cdr.yaml``: its new sample goes back in two DATA_FRAGs, as the peer's
+came in, and the dump stays small), the addresses, the
 sample (:func:`demo_sample`), how the peer sends it (:func:`demo_datagrams`: two DATA_FRAG
-datagrams of :data:`FRAGMENT` bytes each, in Ethernet/IPv4/UDP frames, :func:`demo_frames`), the
+datagrams, fragments of :data:`FRAGMENT` bytes, in Ethernet/IPv4/UDP frames, :func:`demo_frames`), the
 signals kept in the dump (:data:`DUMP_SIGNALS`) and the simulator. No simulation runs at
 notebook time: the notebook reads the shipped dump (with :func:`stream_bytes`,
 :func:`gmii_frames` and :func:`frame_layers`), made by Verilator (Icarus Verilog loops at
@@ -45,19 +46,24 @@ from rosfpga_lab.rtl.vcd import Waveform
 from rosfpga_lab.rtl.tools import TB_DIR, _verilator, simulator_missing_reason
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import discovery_port, user_port
+from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
 
-#: The circuit: fpga_laserscan_min_cdr.yaml with 90 beams instead of 360.
-DEMO_YAML = """\
-node: {name: /fpga_scan_min}
-subscriber: {topic: /scan, type: sensor_msgs/LaserScan}
-publisher: {topic: /scan_min}
-stream: {field: ranges, length: 90}
+#: The scan's beams: enough that the new sample (1380 bytes) is longer than rfl_rtps_tx's
+#: DATA_FRAG fragment (FRAG_BYTES, 1344: it goes back as two DATA_FRAGs), few enough that the
+#: dump stays under 250 KB (360 would make it some 260 KB).
+BEAMS = 330
+#: The circuit: data/fpga_laserscan_min_cdr.yaml with :data:`BEAMS` beams instead of 360.
+DEMO_YAML = f"""\
+node: {{name: /fpga_scan_min}}
+subscriber: {{topic: /scan, type: sensor_msgs/LaserScan}}
+publisher: {{topic: /scan_min}}
+stream: {{field: ranges, length: {BEAMS}}}
 checks:
-  range_max: {max: 1000.0}
+  range_max: {{max: 1000.0}}
 limits:
   header.frame_id: 64
-  intensities: 90
-application: {op: erode, ksize: 5}
+  intensities: {BEAMS}
+application: {{op: erode, ksize: 5}}
 wire: cdr
 """
 NODE_MAC, NODE_IP = "02:52:46:4c:00:02", "192.168.10.2"
@@ -68,11 +74,14 @@ PEER_INDEX = 1
 PEER_WRITER = 0x00001103
 #: The peer's source port (any: the node answers on the RTPS mapping's ports).
 PEER_SPORT = 40000
-#: The peer's DATA_FRAG fragment size: the sample goes in two datagrams.
-FRAGMENT = 256
+#: The peer's DATA_FRAG fragment size, the lab's software writer's: the sample goes in two
+#: datagrams.
+FRAGMENT = FRAGMENT_BYTES
 #: The node's INFO_TS (``cfg_time``: seconds, then 2**-32 s).
 TIME = (1_700_000_000 << 32) | 0x8000_0000
 PREAMBLE = bytes.fromhex("55555555555555d5")
+#: The beams that see the post (the notebook shows the minimum widen it by two each side).
+POST = slice(160, 164)
 #: Idle clocks between the frames the peer sends, and after the last frame out.
 GAP, HOLD = 40, 60
 PERIOD = 1_000_000                          # one SPDP announcement (at reset) in the run
@@ -81,6 +90,9 @@ PERIOD = 1_000_000                          # one SPDP announcement (at reset) i
 MAKEFLAGS = "OPT_FAST=-O1 OPT_GLOBAL=-O1 VM_PARALLEL_BUILDS=0"
 DUMP_NAME = "fabric_demo.vcd"
 DUMP_SIMULATOR = "verilator"
+#: The dump's time unit and precision: whole nanoseconds (a clock is 8 ns) keep its timestamps,
+#: half its bytes at picoseconds, short.
+DUMP_TIMESCALE = "1ns/1ns"
 #: The signals in the dump, stage by stage (tb/rfl_fabric_demo_tb.v declares them, in its scope).
 DUMP_SIGNALS = (
     "clk", "rst_n", "rxd", "rx_dv",                               # GMII in (the PHY's bytes)
@@ -106,11 +118,11 @@ def demo_config() -> NodeConfig:
 
 
 def demo_ranges() -> np.ndarray:
-    """The sample's 90 ranges (float32, metres): a wall at 2 m with a post at 1.2 m and one beam
-    that saw nothing (inf)."""
-    ranges = np.full(90, 2.0, np.float32)
-    ranges[40:44] = 1.2
-    ranges[70] = np.inf
+    """The sample's :data:`BEAMS` ranges (float32, metres): a wall at 2 m with a post at 1.2 m
+    (beams :data:`POST`) and one beam that saw nothing (inf, beam 280)."""
+    ranges = np.full(BEAMS, 2.0, np.float32)
+    ranges[POST] = 1.2
+    ranges[280] = np.inf
     return ranges
 
 
@@ -171,7 +183,7 @@ def _params(config: NodeConfig, where: Path) -> tuple[dict[str, str], int]:
     rom = render_rom(config)
     write_rom(rom, where)
     params = dict(fabric_top_literals(rom, period=PERIOD), MAX_BYTES="2048")
-    return params, 2                    # out: the SPDP announcement, then one DATA datagram
+    return params, 3       # out: the SPDP announcement, then the new sample's two DATA_FRAGs
 
 
 def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
@@ -222,6 +234,7 @@ def run_fabric_demo(vcd: str | Path, *, config: NodeConfig | None = None,
         sources = [*(FABRIC_DIR / m for m in FABRIC_TOP_GMII),
                    *sorted(p for p in where.glob("*.v")), TB_DIR / "rfl_fabric_demo_tb.v"]
         cmd = [_verilator() or "verilator", "--binary", "--timing", "-O1", "--trace",
+               "--timescale-override", DUMP_TIMESCALE,
                "--trace-depth", "1", "-Wno-fatal", "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT",
                f"-I{where}", f"-I{FABRIC_DIR}", "--top-module", "tb", "-Mdir", str(where / "obj_dir"), "-o",
                "rfl_sim", "-MAKEFLAGS", MAKEFLAGS, *map(str, sources)]

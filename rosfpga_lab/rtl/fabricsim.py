@@ -40,6 +40,7 @@ from pathlib import Path
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.rtl.discrom import DiscoveryRom, fabric_top_literals, write_rom
 from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.fabriccounters import NODE_COUNTERS, cxx_header, verilator_config
 from rosfpga_lab.rtl.generic import generic_rtl_files
 from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, FABRIC_SIM_MAX_RECORD
 from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, FABRIC_TOP_GMII
@@ -51,6 +52,8 @@ __all__ = ["COUNTERS", "FabricBuild", "FabricConfig", "FabricSim", "SIM_PERIOD",
 
 #: The C++ main and the program it builds.
 MAIN_FILE, PROGRAM = "rfl_fabric_sim.cpp", "rfl_fabric_sim"
+#: What the main reads the RTPS stages' counters with (rtl.fabriccounters renders both).
+COUNTERS_HEADER, COUNTERS_VLT = "rfl_node_counters.h", "rfl_node_counters.vlt"
 TOP = "rfl_fabric_top"
 #: The fabric's Verilog in read order (the vendored core's GMII variant first), and the shared
 #: parameter lists its modules include.
@@ -105,6 +108,8 @@ def _sources(config: NodeConfig) -> dict[str, bytes]:
     for name in SOURCES:
         files[Path(name).name] = (FABRIC_DIR / name).read_bytes()
     files[MAIN_FILE] = (HARNESS_DIR / MAIN_FILE).read_bytes()
+    files[COUNTERS_HEADER] = cxx_header(TOP).encode()
+    files[COUNTERS_VLT] = verilator_config().encode()
     return files
 
 
@@ -149,7 +154,7 @@ def build_fabric_sim(config: NodeConfig, rom: DiscoveryRom, *, period: int = SIM
                "-Wno-lint", "-Wno-style", "-Wno-UNOPTFLAT", "-I.", "--top-module", TOP,
                "-Mdir", "obj_dir", "-o", PROGRAM, "-j", "2", "-CFLAGS", "-O2",
                "-MAKEFLAGS", "OPT_FAST=-O2 OPT_GLOBAL=-O2 VM_PARALLEL_BUILDS=0",
-               *(f"-G{k}={v}" for k, v in params.items()), MAIN_FILE, *verilog]
+               *(f"-G{k}={v}" for k, v in params.items()), COUNTERS_VLT, MAIN_FILE, *verilog]
         try:
             proc = subprocess.run(cmd, cwd=where, capture_output=True, text=True,
                                   timeout=BUILD_TIMEOUT)
@@ -192,11 +197,13 @@ class FabricConfig:
 
 @dataclass
 class Report:
-    """What the program read back: the frames it sent (FCS included) and its last counters."""
+    """What the program read back: the frames it sent (FCS included) and its last counters
+    (``node_counters``: the RTPS stages', by rtl.fabriccounters' keys)."""
 
     frames: list[bytes] = field(default_factory=list)
     clocks: int = 0
     counters: dict[str, int] = field(default_factory=dict)
+    node_counters: dict[str, int] = field(default_factory=dict)
 
 
 class FabricSim:
@@ -208,6 +215,7 @@ class FabricSim:
         self.started = time.monotonic()
         self.clocks = 0
         self.counters: dict[str, int] = {}
+        self.node_counters: dict[str, int] = {}
         self._buf = bytearray()
         self._proc = subprocess.Popen(
             [str(build.program), f"+rate={rate}", f"+max_clocks={max_clocks}"],
@@ -239,7 +247,8 @@ class FabricSim:
         self._put(b"S")
 
     def ask_counters(self) -> None:
-        """Ask for a counter report (it comes with :meth:`read`)."""
+        """Ask for a counter report, the top's and the RTPS stages' (it comes with
+        :meth:`read`)."""
         self._put(b"K")
 
     def fileno(self) -> int:
@@ -269,6 +278,10 @@ class FabricSim:
                 values = struct.unpack_from(f"<{len(COUNTERS)}I", body, 8)
                 self.counters = dict(zip(COUNTERS, values))
                 report.clocks, report.counters = self.clocks, dict(self.counters)
+            elif tag == b"N":
+                values = struct.unpack_from(f"<{len(NODE_COUNTERS)}I", body)
+                self.node_counters = {c.key: v for c, v in zip(NODE_COUNTERS, values)}
+                report.node_counters = dict(self.node_counters)
             else:
                 raise RtlError(f"the fabric simulation sent a record tagged {tag!r}")
         return report
@@ -292,6 +305,7 @@ class FabricSim:
         self._buf += out
         report = self._parse()
         report.clocks, report.counters = self.clocks, dict(self.counters)
+        report.node_counters = dict(self.node_counters)
         return report
 
     def stderr(self) -> str:

@@ -7,6 +7,9 @@ last line; frames received are written as raw files into --out.
 
   relay IN OUT W H N      publish N random rgba8 W x H pictures (numpy seed k) on IN, receive on OUT
                           (prints "matched", then waits for a line on stdin before publishing)
+  scans IN OUT FILE       publish the LaserScans FILE describes (a JSON list, the float32 fields
+                          as little-endian hex) on IN, receive on OUT (as relay: "matched", a
+                          line on stdin, then one at a time); what came back in the same form
   listen TOPIC N          receive N images
   talk TOPIC W H N        publish N pictures once a subscriber is matched
   graph NODE NS TOPIC...  what the ROS 2 graph API says about node NS/NODE and the topics
@@ -14,6 +17,7 @@ last line; frames received are written as raw files into --out.
 """
 
 import argparse
+import array
 import json
 import sys
 import time
@@ -23,7 +27,7 @@ import numpy as np
 import rclpy
 from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from sensor_msgs.msg import Image
+from sensor_msgs.msg import Image, LaserScan
 
 
 def picture(k: int, h: int, w: int) -> np.ndarray:
@@ -53,6 +57,33 @@ class Sink:
         self.got.append({"sec": msg.header.stamp.sec, "nanosec": msg.header.stamp.nanosec,
                          "frame_id": msg.header.frame_id, "width": msg.width,
                          "height": msg.height, "encoding": msg.encoding, "step": msg.step})
+
+
+#: LaserScan's float32 fields besides the two arrays.
+SCAN_FLOATS = ("angle_min", "angle_max", "angle_increment", "time_increment", "scan_time",
+               "range_min", "range_max")
+
+
+def scan(d: dict) -> LaserScan:
+    """A LaserScan from its description (float32 fields as little-endian hex: bit exact)."""
+    msg = LaserScan()
+    msg.header.stamp.sec, msg.header.stamp.nanosec = d["sec"], d["nanosec"]
+    msg.header.frame_id = d["frame_id"]
+    for name in SCAN_FLOATS:
+        setattr(msg, name, float(np.frombuffer(bytes.fromhex(d[name]), "<f4")[0]))
+    msg.ranges = array.array("f", bytes.fromhex(d["ranges"]))
+    msg.intensities = array.array("f", bytes.fromhex(d["intensities"]))
+    return msg
+
+
+def scan_description(msg: LaserScan) -> dict:
+    out = {"sec": msg.header.stamp.sec, "nanosec": msg.header.stamp.nanosec,
+           "frame_id": msg.header.frame_id}
+    for name in SCAN_FLOATS:
+        out[name] = np.float32(getattr(msg, name)).astype("<f4").tobytes().hex()
+    out["ranges"] = np.asarray(msg.ranges, "<f4").tobytes().hex()
+    out["intensities"] = np.asarray(msg.intensities, "<f4").tobytes().hex()
+    return out
 
 
 def spin_until(node, cond, timeout: float) -> bool:
@@ -93,6 +124,22 @@ def main() -> int:
                 spin_until(node, lambda: len(sink.got) > k, 2.0)   # paced: one at a time
             spin_until(node, lambda: len(sink.got) >= n, opt.timeout)
             report["got"] = sink.got
+        elif opt.mode == "scans":
+            topic_in, topic_out, scans = a[0], a[1], json.loads(Path(a[2]).read_text())
+            pub = node.create_publisher(LaserScan, topic_in, 10)   # RELIABLE KEEP_LAST 10
+            got: list[dict] = []
+            sub = node.create_subscription(LaserScan, topic_out,
+                                           lambda m: got.append(scan_description(m)), 10)
+            report["matched"] = spin_until(
+                node, lambda: pub.get_subscription_count() >= 1 and
+                sub.get_publisher_count() >= 1, opt.timeout)
+            print("matched" if report["matched"] else "unmatched", flush=True)
+            sys.stdin.readline()
+            for k, d in enumerate(scans):
+                pub.publish(scan(d))
+                spin_until(node, lambda: len(got) > k, 2.0)        # paced: one at a time
+            spin_until(node, lambda: len(got) >= len(scans), opt.timeout)
+            report["got"] = got
         elif opt.mode == "listen":
             sink = Sink(node, a[0], opt.out)
             spin_until(node, lambda: len(sink.got) >= int(a[1]), opt.timeout)

@@ -29,16 +29,12 @@ from cocotb.triggers import ClockCycles, RisingEdge
 from cocotb.utils import get_time_from_sim_steps
 from cocotbext.eth import GmiiFrame
 
+from rosfpga_lab.rtl.fabriccounters import NODE_INSTANCE, node_wires
+
 TOP = COUNTERS                  # the top's cnt_* outputs
 # rfl_fabric_node's internal counters: rfl_rtps_rx, rfl_rtps_to_cdr, rfl_rtps_tx, rfl_rtps_ctrl
-NODE = {"rtps_packets": "cnt_packets", "rtps_bad_header": "cnt_bad_header",
-        "rtps_malformed": "cnt_malformed", "rtps_samples": "cnt_rx_samples",
-        "rtps_dropped": "cnt_rx_dropped", "rtps_repeated": "cnt_rx_repeated",
-        "seam_samples": "cnt_seam_samples",
-        "seam_dropped": "cnt_seam_dropped", "seam_too_long": "cnt_too_long",
-        "tx_datagrams": "cnt_datagrams", "tx_dropped": "cnt_dropped",
-        "ctrl_requests": "cnt_requests", "ctrl_busy": "cnt_busy",
-        "ctrl_malformed": "cnt_ctrl_malformed", "ctrl_bad_header": "cnt_ctrl_bad_header"}
+# (key -> the node's wire; the library owns the list: the fast model reads the same)
+NODE = node_wires()
 # streams watched (stage: valid, ready), in the top (u_node: the node's)
 STAGES = {"liteeth_rx->udp_port": ("le_rx_valid", "le_rx_ready"),
           "udp_port->node": ("p_rx_tvalid", "p_rx_tready"),
@@ -62,7 +58,8 @@ def _signal(dut, path: str):
 
 def _counters(dut) -> dict[str, int]:
     out = {name: int(getattr(dut, f"cnt_{name}").value) for name in TOP}
-    out.update({name: int(getattr(dut.u_node, sig).value) for name, sig in NODE.items()})
+    node = getattr(dut, NODE_INSTANCE)
+    out.update({name: int(getattr(node, sig).value) for name, sig in NODE.items()})
     return out
 
 

@@ -28,10 +28,13 @@ from rosfpga_lab.rtl.fabricdemo import (
 from rosfpga_lab.rtl.vcd import read_vcd
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import user_port
+from rosfpga_lab.rtps.limits import FRAGMENT_BYTES
 
 
-def _expected_datagram() -> tuple[bytes, bytes]:
-    """The new sample (the CDR models') and the datagram the lab's software writer sends it in."""
+def _expected_datagrams() -> tuple[bytes, list[bytes]]:
+    """The new sample (the CDR models') and the two datagrams the lab's software writer sends it
+    in: longer than one fragment, DATA_FRAGs of 1344 bytes (rtps.limits), the HEARTBEAT after
+    the last."""
     config = demo_config()
     sample = b.pad_payload(demo_sample())
     records, why = model_output_cdr(cdr_layout_from_config(config), config.application.op,
@@ -41,9 +44,12 @@ def _expected_datagram() -> tuple[bytes, bytes]:
     assert len(records) == 4 + n, why
     out = records[4:]
     part, _node, wid, _rid = fabric_participant(config)
-    dg = (b.header(part.guid_prefix) + b.info_ts((TIME >> 32) + (TIME & 0xFFFFFFFF) / 2**32)
-          + b.data(0, wid, 1, b.pad_payload(out)) + b.heartbeat(0, wid, 2, 1, 1))
-    return out, dg
+    head = b.header(part.guid_prefix) + b.info_ts((TIME >> 32) + (TIME & 0xFFFFFFFF) / 2**32)
+    padded = b.pad_payload(out)
+    assert FRAGMENT_BYTES < len(padded) <= 2 * FRAGMENT_BYTES
+    frags = [b.data_frag(0, wid, 1, n, FRAGMENT_BYTES, len(padded),
+                         padded[(n - 1) * FRAGMENT_BYTES:n * FRAGMENT_BYTES], 1) for n in (1, 2)]
+    return out, [head + frags[0], head + frags[1] + b.heartbeat(0, wid, 2, 1, 1)]
 
 
 def test_the_demo_frames_are_ethernet_ipv4_udp_as_scapy_reads_them() -> None:
@@ -62,7 +68,7 @@ def test_the_demo_frames_are_ethernet_ipv4_udp_as_scapy_reads_them() -> None:
 def test_the_shipped_dump_carries_the_sample_through_every_stage() -> None:
     path = shipped_dump()
     assert path is not None and path.name == "fabric_demo.vcd"
-    assert path.stat().st_size < 300_000
+    assert path.stat().st_size < 250_000
     wave = read_vcd(path, clock="clk")
     sample = b.pad_payload(demo_sample())
     rx = gmii_frames(wave, "rx")
@@ -72,20 +78,22 @@ def test_the_shipped_dump_carries_the_sample_through_every_stage() -> None:
     assert stream_bytes(wave, "rx")[1] == sample                    # RTPS taken off
     rec = stream_bytes(wave, "rec")[1]
     assert rec == struct.pack("<I", len(sample)) + sample
-    out, dg = _expected_datagram()
+    out, dgs = _expected_datagrams()
     pub = stream_bytes(wave, "pub")[1]
     assert pub == struct.pack("<I", len(out)) + out
     # the ranges out are numpy's sliding minimum over 5 beams of the ranges in
     raw = demo_ranges().astype("<f4").tobytes()
-    at = sample.find(struct.pack("<I", 90) + raw) + 4
+    n = len(raw) // 4
+    at = sample.find(struct.pack("<I", n) + raw) + 4
     r = np.frombuffer(raw, "<f4")
-    want = np.array([r[max(0, k - 2):k + 3].min() for k in range(90)], "<f4").tobytes()
-    assert out[at:at + 360] == want and out[:at] == sample[:at]
-    assert stream_bytes(wave, "tx")[1] == dg == stream_bytes(wave, "le_tx")[1][-len(dg):]
+    want = np.array([r[max(0, k - 2):k + 3].min() for k in range(n)], "<f4").tobytes()
+    assert out[at:at + 4 * n] == want and out[:at] == sample[:at]
+    both = b"".join(dgs)
+    assert stream_bytes(wave, "tx")[1] == both == stream_bytes(wave, "le_tx")[1][-len(both):]
     sent = [Ether(f[8:-4]) for _c, f in gmii_frames(wave, "tx")]
     data = [f for f in sent if f.haslayer(UDP) and f[IP].dst == PEER_IP]
-    assert len(data) == 1 and data[0].dst == PEER_MAC
-    assert bytes(data[0][UDP].payload)[:data[0][UDP].len - 8] == dg
+    assert [f.dst for f in data] == [PEER_MAC] * 2
+    assert [bytes(f[UDP].payload)[:f[UDP].len - 8] for f in data] == dgs
     assert any(f.haslayer(ARP) and f[ARP].op == 1 for f in sent)   # it asked for the peer
     decided = wave.values("status_valid").astype(bool)
     assert wave.values("status")[decided].tolist() == [0]          # SUB_OK, once

@@ -4,19 +4,35 @@
 tests/rtl/test_fabric_top.py's cocotb peer sends, answering the circuit's ARP request as that peer
 does: the same frames out, checked by that test's own expectations (the lab's software only), the
 same counters. The build is cached (some 15-30 s the first time); the run a fraction of a second.
+
+And ``rosfpga-lab fabric sim``'s printout of the RTPS stages' counters (inside
+``rfl_fabric_node``, read by the C++ main through the model's hierarchy): known bad input sent
+to the node's UDP ports through the shim moves each printed counter by what the modules' rules
+say, counted by hand here.
 """
 
 from __future__ import annotations
 
+import os
+import signal
+import socket
+import struct
+import subprocess
+import sys
 import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from rosfpga_lab.config import load_config
+from rosfpga_lab.rtl.discrom import render_rom
 from rosfpga_lab.rtl.fabricsim import FabricConfig, FabricSim, build_fabric_sim
-from tests.rtl.test_fabric_rtps_cdr import CONFIG
+from rosfpga_lab.rtps import build as b
+from rosfpga_lab.rtps.entities import discovery_port, user_port
+from tests.rtl.test_fabric_rtps_cdr import CONFIG, scan
+from tests.support.proctools import interruptible, kill_if_running, stop_with
 from tests.rtl.test_fabric_top import MAX_CLOCKS, PERIOD, check_sent, scenario
 from tests.support.rtltools import require_fabric_sim
 
@@ -61,3 +77,89 @@ def test_the_fast_model_sends_what_the_cocotb_bench_expects(tmp_path: Path) -> N
 
 def _dotted(hexed: str) -> str:
     return ".".join(str(b) for b in bytes.fromhex(hexed))
+
+
+#: The counter test's domain (its own ports: 7400 + 250 x 228 + 10 and 11), a peer's prefix and
+#: writer.
+COUNT_DOMAIN = 228
+PEER = bytes.fromhex("010fcafe00000002000000a1")
+WRITER = 0x00001203
+FRAG = 1024
+
+
+def _heartbeat_too_long() -> bytes:
+    """A HEARTBEAT whose octetsToNextHeader (little endian: flag E) claims 200 bytes, more than
+    the datagram holds: malformed (both walkers' rule)."""
+    hb = bytearray(b.heartbeat(0, WRITER, 1, 1, 1))
+    hb[2:4] = struct.pack("<H", 200)
+    return b.header(PEER) + bytes(hb)
+
+
+@pytest.mark.timeout(300)
+def test_fabric_sim_prints_the_rtps_stages_counters_moved_by_bad_input(tmp_path: Path) -> None:
+    """One good LaserScan in two DATA_FRAGs with its first fragment sent twice, a bad RTPS
+    header and a malformed submessage to the user-data port, the same two to the metatraffic
+    port: the printed counters (on SIGUSR1 and at the end), counted by hand from the modules'
+    headers (rfl_rtps_rx, rfl_rtps_ctrl)."""
+    require_fabric_sim()
+    config = load_config(CONFIG)
+    build_fabric_sim(config, render_rom(config, domain=COUNT_DOMAIN))   # the CLI's, cached
+    sample = b.pad_payload(scan(np.linspace(0.5, 20.0, 360, dtype=np.float32), 3, "laser"))
+    assert FRAG < len(sample) <= 2 * FRAG                 # two fragments
+    frag = [b.data_frag(0, WRITER, 1, n, FRAG, len(sample), sample[(n - 1) * FRAG:n * FRAG], 1)
+            for n in (1, 2)]
+    hdr = b.header(PEER)
+    user, meta = user_port(COUNT_DOMAIN, 0), discovery_port(COUNT_DOMAIN, 0)
+    sends = [(user, hdr + b.info_ts(1.7e9) + frag[0]),
+             (user, hdr + frag[0]),                       # the same fragment again: repeated
+             (user, hdr + frag[1]),                       # the sample whole
+             (user, b"RTPX" + hdr[4:] + frag[1]),         # bad magic
+             (user, _heartbeat_too_long()),               # a submessage past the datagram
+             (meta, b"RTPX" + hdr[4:]),
+             (meta, _heartbeat_too_long())]
+    want = {"rfl_rtps_rx": {"cnt_packets": 5, "cnt_bad_header": 1, "cnt_malformed": 1,
+                            "cnt_samples": 1, "cnt_dropped": 0, "cnt_repeated": 1},
+            "rfl_rtps_to_cdr": {"cnt_samples": 1, "cnt_dropped": 0, "cnt_too_long": 0},
+            "rfl_rtps_ctrl": {"cnt_requests": 0, "cnt_busy": 0, "cnt_malformed": 1,
+                              "cnt_bad_header": 1}}
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    log = tmp_path / "stderr.txt"
+    with log.open("w") as err:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rosfpga_lab", "fabric", "sim", str(CONFIG), "--domain",
+             str(COUNT_DOMAIN), "--seconds", "60"], stdout=subprocess.PIPE, stderr=err,
+            text=True, env=env, cwd=tmp_path, preexec_fn=interruptible)
+    try:
+        deadline = time.monotonic() + 120
+        while "\nready:" not in "\n" + log.read_text() and proc.poll() is None \
+                and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert proc.poll() is None and "\nready:" in "\n" + log.read_text(), log.read_text()
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+            for port, datagram in sends:
+                sock.sendto(datagram, ("127.0.0.1", port))
+                time.sleep(0.3)                    # some 100,000 clocks: one at a time
+        time.sleep(0.5)
+        proc.send_signal(signal.SIGUSR1)           # the counters now, then at the end
+        time.sleep(1.0)
+        stdout, _ = stop_with(proc, signal.SIGINT)
+    finally:
+        kill_if_running(proc)
+    assert proc.returncode == 0, log.read_text()
+    print(stdout)
+    blocks: list[dict[str, dict[str, int]]] = []
+    for line in stdout.splitlines():
+        if line.startswith("fabric sim: "):
+            blocks.append({})
+        stage, sep, rest = line.partition(": ")
+        if sep and stage in want:
+            blocks[-1][stage] = {k: int(v) for k, v in (kv.split(" ") for kv in rest.split(", "))}
+    assert len(blocks) == 2, stdout                 # on SIGUSR1, then at the end
+    for printed in blocks:
+        for stage, counts in want.items():
+            assert {k: printed[stage][k] for k in counts} == counts, (stage, stdout)
+    top = dict(kv.rsplit(" ", 1) for kv in next(
+        x for x in stdout.splitlines() if x.startswith("circuit: "))[len("circuit: "):].split(", "))
+    assert (top["rx_packets"], top["rx_overflow"], top["judged"], top["refused"]) == \
+        ("7", "0", "1", "0"), stdout

@@ -11,7 +11,8 @@ its one peer's ports from the peer's SPDP and pulses send_sedp). Every output is
 numpy (a 5-beam minimum over ``ranges``) and with the lab's CDR model, never with the circuit's
 own output. rclpy (the ``[ros2]`` extra: Fast DDS, ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST)
 sees the fabric's node, its publisher and subscriber, their types and type hashes in its graph
-API (the hash against rosidl's, copied in tests/msg/test_typehash_realros2.py). A 64x48 Image
+API (the hash against rosidl's, copied in tests/msg/test_typehash_realros2.py), and its
+LaserScans come back exact against numpy (Fast DDS sends each DATA_FRAG twice). A 64x48 Image
 goes through the dilation in ten DATA_FRAGs each way, exact against OpenCV; with ``--tap`` the
 same scans cross a Linux TAP interface, whose capture tshark reads without a malformed packet.
 The samples go out 0.3-0.5 s apart (a scanner's rate): three scans back to back at line rate
@@ -22,15 +23,18 @@ build per domain, address and sample bound; each cached after the first, some 15
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import json
 import os
 import signal
 import subprocess
 import sys
-import threading
 import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -39,11 +43,12 @@ import pytest
 from rosfpga_lab.component.fabricsim import (
     TAP_NAME, TAP_NODE_ADDRESS, fabric_peer_uri, fabric_tap_peer_uri, fastdds_peer_profile,
 )
-from rosfpga_lab.config import load_config
+from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline
 from rosfpga_lab.rtl.discrom import render_rom
 from rosfpga_lab.rtl.fabricsim import build_fabric_sim
-from tests.component.test_ros2_rtl import SCAN_CDR, _assert_exact, _scans
+from tests.component.test_ros2_rtl import SCAN_CDR, SPECIALS, _assert_exact, _scans
+from tests.support.generictools import window_oracle
 from tests.msg.test_typehash_realros2 import GOLDEN
 from tests.support.realros import ROS_PROGRAMS, require_ros2
 from tests.support.proctools import interruptible, kill_if_running, stop_with
@@ -76,23 +81,82 @@ TAP_DOMAIN = 231
 IMAGES = 2
 
 
-def _start_cli(tmp_path: Path, config: Path = SCAN_CDR, *extra: str,
-               domain: int = DOMAIN, mode: str = "--shim") -> tuple[subprocess.Popen, list[str]]:
+@dataclass
+class _Cli:
+    """``rosfpga-lab fabric sim`` running, its stderr going to a file."""
+
+    proc: subprocess.Popen
+    stderr: Path
+
+    def stop(self) -> str:
+        """Ctrl-C: its stdout (the counters) once it ended."""
+        stdout, _ = stop_with(self.proc, signal.SIGINT)
+        return stdout
+
+    def log(self) -> str:
+        """What it wrote on stderr so far."""
+        return self.stderr.read_text(errors="replace")
+
+    def ready(self) -> bool:
+        return any(x.startswith("ready:") for x in self.log().splitlines())
+
+
+@contextlib.contextmanager
+def _running_cli(tmp_path: Path, config: Path = SCAN_CDR, *extra: str, domain: int = DOMAIN,
+                 mode: str = "--shim") -> Iterator[_Cli]:
+    """The command started and ready (the model built, the bridge bound), killed if the test
+    ends before it did."""
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "rosfpga_lab", "fabric", "sim", str(config), mode,
-         "--domain", str(domain), "--seconds", "60", *extra],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path,
-        preexec_fn=interruptible)
-    lines: list[str] = []
+    stderr = tmp_path / "fabric_sim.stderr"
+    with stderr.open("w") as err:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rosfpga_lab", "fabric", "sim", str(config), mode,
+             "--domain", str(domain), "--seconds", "60", *extra],
+            stdout=subprocess.PIPE, stderr=err, text=True, env=env, cwd=tmp_path,
+            preexec_fn=interruptible)
+    cli = _Cli(proc, stderr)
+    try:
+        assert wait(lambda: cli.ready() or proc.poll() is not None, 60) \
+            and proc.poll() is None, cli.log()
+        yield cli
+    finally:
+        kill_if_running(proc)
 
-    def pump() -> None:
-        assert proc.stderr is not None
-        for line in proc.stderr:
-            lines.append(line)
 
-    threading.Thread(target=pump, daemon=True).start()
-    return proc, lines
+def _build(config: NodeConfig, domain: int = DOMAIN, *, address: str = "127.0.0.1",
+           max_bytes: int | None = None) -> None:
+    """The model the command will take from the cache (built here first: its time printed)."""
+    start = time.monotonic()
+    build = build_fabric_sim(config, render_rom(config, domain=domain, address=address),
+                             max_bytes=max_bytes)
+    print(f"build {build.seconds:.1f} s (0: cached), {time.monotonic() - start:.1f} s")
+
+
+class _CyclonePeer:
+    """A Cyclone DDS participant of ``domain`` writing ``topic_in`` and reading ``topic_out`` of
+    ``kind`` with ROS 2's default QoS, matched with the fabric's node (``log``: the command's
+    stderr, for the failure's message); :meth:`close` says goodbye (the next test's peer is its
+    own)."""
+
+    def __init__(self, dds: Any, domain: int, topic_in: str, topic_out: str, kind: Any,
+                 log: Callable[[], str]) -> None:
+        self.log = log
+        self.dp = dds.DomainParticipant(domain)
+        self.writer = dds.DataWriter(self.dp, dds.Topic(self.dp, topic_in, kind), qos=qos(dds))
+        self.reader = dds.DataReader(self.dp, dds.Topic(self.dp, topic_out, kind), qos=qos(dds))
+        assert wait(lambda: self.writer.get_matched_subscriptions()
+                    and self.reader.get_matched_publications(), 15), log()
+
+    def take(self, n: int, timeout: float) -> list:
+        """``n`` samples from the reader, within ``timeout`` seconds."""
+        got: list = []
+        assert wait(lambda: got.extend(self.reader.take(10)) or len(got) >= n, timeout), \
+            (len(got), self.log())
+        return got
+
+    def close(self) -> None:
+        del self.writer, self.reader, self.dp
+        gc.collect()
 
 
 def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
@@ -103,42 +167,26 @@ def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
     from tests.support import cdrtypes as T
 
     config = load_config(SCAN_CDR)
-    start = time.monotonic()
-    build = build_fabric_sim(config, render_rom(config, domain=DOMAIN))   # the CLI's, cached
-    print(f"build {build.seconds:.1f} s (0: cached), {time.monotonic() - start:.1f} s")
-    proc, lines = _start_cli(tmp_path)
-    got: list = []
+    _build(config)
     sent = _scans(T, SCANS)
-    try:
-        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
-                    60) and proc.poll() is None, "".join(lines)
+    with _running_cli(tmp_path) as cli:
         t0 = time.monotonic()
-        dp = dds.DomainParticipant(DOMAIN)
-        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/scan", T.LaserScan_), qos=qos(dds))
-        reader = dds.DataReader(dp, dds.Topic(dp, "rt/scan_min", T.LaserScan_), qos=qos(dds))
-        assert wait(lambda: writer.get_matched_subscriptions()
-                    and reader.get_matched_publications(), 15), "".join(lines)
+        peer = _CyclonePeer(dds, DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_, cli.log)
         matched = time.monotonic() - t0
         for msg in sent:
-            writer.write(msg)
+            peer.writer.write(msg)
             time.sleep(0.3)
-        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= SCANS, 15), \
-            (len(got), "".join(lines))
+        got = peer.take(SCANS, 15)
         print(f"matched after {matched:.2f} s, {SCANS} scans back after "
               f"{time.monotonic() - t0:.2f} s")
-        del writer, reader, dp                 # its goodbye: the next test's peer is its own
-        gc.collect()
-        stdout, _ = stop_with(proc, signal.SIGINT)
-    finally:
-        kill_if_running(proc)
-    assert proc.returncode == 0, "".join(lines)
+        peer.close()
+        stdout = cli.stop()
+    assert cli.proc.returncode == 0, cli.log()
     print(stdout)
     pipe = CdrPipeline(config)
     for msg, out in zip(sent, got, strict=True):
         _assert_exact(T, msg, out, pipe)
-    counters = dict(kv.rsplit(" ", 1) for kv in
-                    next(x for x in stdout.splitlines() if x.startswith("circuit: "))
-                    [len("circuit: "):].split(", "))
+    counters = _counters(stdout)
     assert (counters["samples"], counters["judged"], counters["refused"], counters["rx_error"],
             counters["rx_overflow"], counters["tx_overflow"]) == \
         (str(SCANS), str(SCANS), "0", "0", "0", "0"), stdout
@@ -151,25 +199,14 @@ def test_rclpy_sees_the_fabric_node_in_the_ros2_graph(tmp_path: Path) -> None:
     endpoints from its SEDP data."""
     require_fabric_sim()
     require_ros2()
-    config = load_config(SCAN_CDR)
-    build_fabric_sim(config, render_rom(config, domain=DOMAIN))   # the CLI's, cached
-    proc, lines = _start_cli(tmp_path)
-    env = {k: v for k, v in os.environ.items()
-           if not k.startswith(("ROS_", "RMW_", "FASTRTPS_", "FASTDDS_", "CYCLONEDDS_"))}
-    env.update(ROS_DOMAIN_ID=str(DOMAIN), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
-               RMW_IMPLEMENTATION="rmw_fastrtps_cpp", ROS_LOG_DIR=str(tmp_path / "ros_log"),
-               ROS_HOME=str(tmp_path / "ros_home"))
-    try:
-        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
-                    60) and proc.poll() is None, "".join(lines)
+    _build(load_config(SCAN_CDR))
+    with _running_cli(tmp_path) as cli:
         peer = subprocess.run([sys.executable, str(ROS_PROGRAMS / "rclpy_peer.py"), "graph",
                                "fpga_scan_min", "/", "/scan", "/scan_min", "--timeout", "15",
                                "--out", str(tmp_path)], capture_output=True, text=True,
-                              env=env, timeout=60)
-        stdout, _ = stop_with(proc, signal.SIGINT)
-    finally:
-        kill_if_running(proc)
-    assert peer.returncode == 0, (peer.stderr[-2000:], "".join(lines))
+                              env=_rclpy_env(tmp_path, DOMAIN), timeout=60)
+        stdout = cli.stop()
+    assert peer.returncode == 0, (peer.stderr[-2000:], cli.log())
     report = json.loads(peer.stdout.strip().splitlines()[-1])
     print(stdout)
     assert ["fpga_scan_min", "/"] in report["nodes"], report["nodes"]
@@ -198,6 +235,62 @@ def _rclpy_env(tmp_path: Path, domain: int) -> dict[str, str]:
     return env
 
 
+def _rclpy_fabric_env(tmp_path: Path, domain: int) -> dict[str, str]:
+    """:func:`_rclpy_env` with the Fast DDS profile that keeps datagrams to one frame."""
+    profile = tmp_path / "fastdds.xml"
+    profile.write_text(fastdds_peer_profile())
+    return dict(_rclpy_env(tmp_path, domain), FASTRTPS_DEFAULT_PROFILES_FILE=str(profile))
+
+
+def _scan_descriptions(n: int) -> list[dict]:
+    """``n`` LaserScans for tests/ros_programs/rclpy_peer.py's ``scans`` mode: 360 beams (the
+    configuration's stream), every other one of special values (signed zeros, infinities,
+    NaN), float32 fields as little-endian hex."""
+    rng = np.random.default_rng(31)
+    out = []
+    for k in range(n):
+        ranges = rng.choice(SPECIALS, 360) if k % 2 else rng.uniform(0.1, 30, 360)
+        f32 = {name: np.array([v], "<f4").tobytes().hex() for name, v in (
+            ("angle_min", -1.5), ("angle_max", 1.5), ("angle_increment", 0.01),
+            ("time_increment", 1e-5 * k), ("scan_time", 0.1), ("range_min", 0.05),
+            ("range_max", 30.0))}
+        out.append({"sec": 200 + k, "nanosec": 1000 * k, "frame_id": "l" * 64 if k % 2 else "laser",
+                    **f32, "ranges": np.asarray(ranges, "<f4").tobytes().hex(),
+                    "intensities": np.arange(k * 7 % 12, dtype="<f4").tobytes().hex()})
+    return out
+
+
+def test_rclpy_laserscans_through_the_simulated_fabric_exact(tmp_path: Path) -> None:
+    """rclpy (Fast DDS, datagrams of one frame: each scan in two DATA_FRAGs, each sent twice)
+    publishes LaserScans with ROS 2's default QoS to the fabric node of
+    data/fpga_laserscan_min_cdr.yaml and subscribes to its output: each exact against numpy's
+    5-beam minimum of what it sent (every other field as sent), bit for bit."""
+    require_fabric_sim()
+    require_ros2()
+    _build(load_config(SCAN_CDR))
+    env = _rclpy_fabric_env(tmp_path, DOMAIN)
+    sent = _scan_descriptions(SCANS)
+    (tmp_path / "scans.json").write_text(json.dumps(sent))
+    with _running_cli(tmp_path) as cli:
+        peer = subprocess.run([sys.executable, str(ROS_PROGRAMS / "rclpy_peer.py"), "scans",
+                               "/scan", "/scan_min", str(tmp_path / "scans.json"),
+                               "--timeout", "15"], input="go\n", capture_output=True,
+                              text=True, env=env, timeout=60)
+        stdout = cli.stop()
+    assert peer.returncode == 0, (peer.stderr[-2000:], cli.log())
+    report = json.loads(peer.stdout.strip().splitlines()[-1])
+    print(stdout)
+    assert report["matched"] and len(report["got"]) == SCANS, (report.get("matched"), stdout)
+    for k, (want, got) in enumerate(zip(sent, report["got"], strict=True)):
+        ranges = window_oracle(bytes.fromhex(want["ranges"]), "<f4", 5, "erode")
+        assert bytes.fromhex(got["ranges"]) == ranges, k
+        assert {n: v for n, v in got.items() if n != "ranges"} == \
+            {n: v for n, v in want.items() if n != "ranges"}, k
+    counters = _counters(stdout)
+    assert (counters["samples"], counters["judged"], counters["refused"]) == \
+        (str(SCANS), str(SCANS), "0"), stdout
+
+
 def test_rclpy_images_64x48_through_the_simulated_fabric_exact(tmp_path: Path) -> None:
     """rclpy (Fast DDS, a profile that keeps datagrams to one frame: DATA_FRAGs) publishes two
     64x48 rgba8 images with ROS 2's default QoS and subscribes to the output: each exact
@@ -208,25 +301,17 @@ def test_rclpy_images_64x48_through_the_simulated_fabric_exact(tmp_path: Path) -
     require_ros2()
     path = tmp_path / "fpga_dilate_64x48_cdr.yaml"
     path.write_text(IMAGE_CONFIG)
-    config = load_config(path)
-    build_fabric_sim(config, render_rom(config, domain=DOMAIN), max_bytes=IMAGE_MAX_BYTES)
-    profile = tmp_path / "fastdds.xml"
-    profile.write_text(fastdds_peer_profile())
-    env = dict(_rclpy_env(tmp_path, DOMAIN), FASTRTPS_DEFAULT_PROFILES_FILE=str(profile))
-    proc, lines = _start_cli(tmp_path, path, "--max-bytes", str(IMAGE_MAX_BYTES))
+    _build(load_config(path), max_bytes=IMAGE_MAX_BYTES)
+    env = _rclpy_fabric_env(tmp_path, DOMAIN)
     out = tmp_path / "got"
     out.mkdir()
-    try:
-        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
-                    60) and proc.poll() is None, "".join(lines)
+    with _running_cli(tmp_path, path, "--max-bytes", str(IMAGE_MAX_BYTES)) as cli:
         peer = subprocess.run([sys.executable, str(ROS_PROGRAMS / "rclpy_peer.py"), "relay",
                                "/image_raw", "/image_dilated", "64", "48", str(IMAGES),
                                "--out", str(out), "--timeout", "15"], input="go\n",
                               capture_output=True, text=True, env=env, timeout=60)
-        stdout, _ = stop_with(proc, signal.SIGINT)
-    finally:
-        kill_if_running(proc)
-    assert peer.returncode == 0, (peer.stderr[-2000:], "".join(lines))
+        stdout = cli.stop()
+    assert peer.returncode == 0, (peer.stderr[-2000:], cli.log())
     report = json.loads(peer.stdout.strip().splitlines()[-1])
     print(stdout)
     assert report["matched"] and len(report["got"]) == IMAGES, (report, stdout)
@@ -250,35 +335,21 @@ def test_cyclone_images_64x48_through_the_simulated_fabric_exact(
     monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
     path = tmp_path / "fpga_dilate_64x48_cdr.yaml"
     path.write_text(IMAGE_CONFIG)
-    config = load_config(path)
-    start = time.monotonic()
-    build = build_fabric_sim(config, render_rom(config, domain=DOMAIN), max_bytes=IMAGE_MAX_BYTES)
-    print(f"build {build.seconds:.1f} s (0: cached), {time.monotonic() - start:.1f} s")
-    proc, lines = _start_cli(tmp_path, path, "--max-bytes", str(IMAGE_MAX_BYTES))
+    _build(load_config(path), max_bytes=IMAGE_MAX_BYTES)
     rng = np.random.default_rng(31)
     pictures = [rng.integers(0, 256, (48, 64, 4), dtype=np.uint8) for _ in range(IMAGES)]
-    got: list = []
-    try:
-        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
-                    60) and proc.poll() is None, "".join(lines)
-        dp = dds.DomainParticipant(DOMAIN)
-        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/image_raw", dds.Image_), qos=qos(dds))
-        reader = dds.DataReader(dp, dds.Topic(dp, "rt/image_dilated", dds.Image_), qos=qos(dds))
-        assert wait(lambda: writer.get_matched_subscriptions()
-                    and reader.get_matched_publications(), 15), "".join(lines)
+    with _running_cli(tmp_path, path, "--max-bytes", str(IMAGE_MAX_BYTES)) as cli:
+        peer = _CyclonePeer(dds, DOMAIN, "rt/image_raw", "rt/image_dilated", dds.Image_,
+                            cli.log)
         t0 = time.monotonic()
         for k, pic in enumerate(pictures):
-            writer.write(image(dds, pic, "rgba8", sec=k, frame_id="cam"))
+            peer.writer.write(image(dds, pic, "rgba8", sec=k, frame_id="cam"))
             time.sleep(0.5)
-        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= IMAGES, 15), \
-            (len(got), "".join(lines))
+        got = peer.take(IMAGES, 15)
         print(f"{IMAGES} images back after {time.monotonic() - t0:.2f} s")
-        del writer, reader, dp                 # its goodbye: the next test's peer is its own
-        gc.collect()
-        stdout, _ = stop_with(proc, signal.SIGINT)
-    finally:
-        kill_if_running(proc)
-    assert proc.returncode == 0, "".join(lines)
+        peer.close()
+        stdout = cli.stop()
+    assert cli.proc.returncode == 0, cli.log()
     print(stdout)
     for k, (pic, out) in enumerate(zip(pictures, got, strict=True)):
         want = cv2.dilate(pic, np.ones((3, 3), np.uint8)).reshape(pic.shape)
@@ -308,39 +379,30 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
     from tests.support import cdrtypes as T
 
     config = load_config(SCAN_CDR)
-    build_fabric_sim(config, render_rom(config, domain=TAP_DOMAIN, address=TAP_NODE_ADDRESS))
-    proc, lines = _start_cli(tmp_path, SCAN_CDR, domain=TAP_DOMAIN, mode="--tap")
+    _build(config, TAP_DOMAIN, address=TAP_NODE_ADDRESS)
     capture = tmp_path / "tap.pcapng"
     dump = None
-    got: list = []
     sent = _scans(T, SCANS)
     try:
-        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
-                    60) and proc.poll() is None, "".join(lines)
-        dump = subprocess.Popen([tshark, "-i", TAP_NAME, "-w", str(capture), "-q"],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                                preexec_fn=interruptible)
-        assert wait(capture.exists, 10), "tshark did not start"
-        dp = dds.DomainParticipant(TAP_DOMAIN)
-        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/scan", T.LaserScan_), qos=qos(dds))
-        reader = dds.DataReader(dp, dds.Topic(dp, "rt/scan_min", T.LaserScan_), qos=qos(dds))
-        assert wait(lambda: writer.get_matched_subscriptions()
-                    and reader.get_matched_publications(), 15), "".join(lines)
-        for msg in sent:
-            writer.write(msg)
-            time.sleep(0.3)
-        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= SCANS, 15), \
-            (len(got), "".join(lines))
-        time.sleep(0.5)
-        del writer, reader, dp                 # gone before the interface is
-        gc.collect()
-        stop_with(dump, signal.SIGINT)
-        stdout, _ = stop_with(proc, signal.SIGINT)
+        with _running_cli(tmp_path, SCAN_CDR, domain=TAP_DOMAIN, mode="--tap") as cli:
+            dump = subprocess.Popen([tshark, "-i", TAP_NAME, "-w", str(capture), "-q"],
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                    preexec_fn=interruptible)
+            assert wait(capture.exists, 10), "tshark did not start"
+            peer = _CyclonePeer(dds, TAP_DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_,
+                                cli.log)
+            for msg in sent:
+                peer.writer.write(msg)
+                time.sleep(0.3)
+            got = peer.take(SCANS, 15)
+            time.sleep(0.5)
+            peer.close()                       # gone before the interface is
+            stop_with(dump, signal.SIGINT)
+            stdout = cli.stop()
     finally:
-        kill_if_running(proc)
         if dump is not None:
             kill_if_running(dump)
-    assert proc.returncode == 0, "".join(lines)
+    assert cli.proc.returncode == 0, cli.log()
     print(stdout)
     pipe = CdrPipeline(config)
     for msg, out in zip(sent, got, strict=True):
@@ -367,30 +429,19 @@ def test_one_640x480_image_fragments_through_the_simulated_fabric_exact(
     require_fabric_sim()
     dds = cyclone()
     monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
-    config = load_config(BIG_CONFIG)
-    build_fabric_sim(config, render_rom(config, domain=BIG_DOMAIN), max_bytes=BIG_MAX_BYTES)
-    proc, lines = _start_cli(tmp_path, BIG_CONFIG, "--max-bytes", str(BIG_MAX_BYTES),
-                             "--rate", "0", domain=BIG_DOMAIN)
+    _build(load_config(BIG_CONFIG), BIG_DOMAIN, max_bytes=BIG_MAX_BYTES)
     pic = np.random.default_rng(5).integers(0, 256, (480, 640, 4), dtype=np.uint8)
-    got: list = []
-    try:
-        assert wait(lambda: any(x.startswith("ready:") for x in lines) or proc.poll() is not None,
-                    60) and proc.poll() is None, "".join(lines)
-        dp = dds.DomainParticipant(BIG_DOMAIN)
-        writer = dds.DataWriter(dp, dds.Topic(dp, "rt/image_raw", dds.Image_), qos=qos(dds))
-        reader = dds.DataReader(dp, dds.Topic(dp, "rt/image_dilated", dds.Image_), qos=qos(dds))
-        assert wait(lambda: writer.get_matched_subscriptions()
-                    and reader.get_matched_publications(), 15), "".join(lines)
+    with _running_cli(tmp_path, BIG_CONFIG, "--max-bytes", str(BIG_MAX_BYTES), "--rate", "0",
+                      domain=BIG_DOMAIN) as cli:
+        peer = _CyclonePeer(dds, BIG_DOMAIN, "rt/image_raw", "rt/image_dilated", dds.Image_,
+                            cli.log)
         t0 = time.monotonic()
-        writer.write(image(dds, pic, "rgba8", sec=1, frame_id="cam"))
-        assert wait(lambda: got.extend(reader.take(10)) or len(got) >= 1, 60), "".join(lines)
+        peer.writer.write(image(dds, pic, "rgba8", sec=1, frame_id="cam"))
+        got = peer.take(1, 60)
         print(f"640x480 back after {time.monotonic() - t0:.2f} s")
-        del writer, reader, dp                 # its goodbye: the next test's peer is its own
-        gc.collect()
-        stdout, _ = stop_with(proc, signal.SIGINT)
-    finally:
-        kill_if_running(proc)
-    assert proc.returncode == 0, "".join(lines)
+        peer.close()
+        stdout = cli.stop()
+    assert cli.proc.returncode == 0, cli.log()
     print(stdout)
     (out,) = got
     want = cv2.dilate(pic, np.ones((3, 3), np.uint8)).reshape(pic.shape)

@@ -20,7 +20,12 @@
 //                rosfpga_lab.rtl.fabricsim.COUNTERS' order: the top's cnt_* and credit, then
 //                the generated subscriber's verdicts (status_valid pulses), the refusals among
 //                them (status not 0) and the last refusal's code
+//                'N' after each 'K': the RTPS stages' counters inside rfl_fabric_node as u32
+//                in rosfpga_lab.rtl.fabriccounters.NODE_COUNTERS' order (rfl_node_counters.h and
+//                the .vlt that keeps those wires public are generated from that list)
 #include "Vrfl_fabric_top.h"
+#include "Vrfl_fabric_top___024root.h"
+#include "rfl_node_counters.h"
 #include "verilated.h"
 
 #include <poll.h>
@@ -155,6 +160,17 @@ struct Fabric {
         for (int k = 0; k < 14; ++k)
             for (int i = 0; i < 4; ++i) out[8 + 4 * k + i] = (uint8_t)(c[k] >> (8 * i));
         put_record('K', out, sizeof out);
+        node_counters();
+    }
+
+    void node_counters() {
+#define RFL_READ(member) (uint32_t)top->rootp->member,
+        const uint32_t c[RFL_NODE_COUNTER_COUNT] = {RFL_NODE_COUNTERS(RFL_READ)};
+#undef RFL_READ
+        uint8_t out[sizeof c];
+        for (size_t k = 0; k < RFL_NODE_COUNTER_COUNT; ++k)
+            for (int i = 0; i < 4; ++i) out[4 * k + i] = (uint8_t)(c[k] >> (8 * i));
+        put_record('N', out, sizeof out);
     }
 };
 
