@@ -112,7 +112,7 @@ module rfl_rtps_to_cdr #(
     wire [31:0] klen32 = {{(32 - NW){1'b0}}, klen};
     wire [7:0] hbyte = (hi == 2'd0) ? klen32[7:0] : (hi == 2'd1) ? klen32[15:8] :
                        (hi == 2'd2) ? klen32[23:16] : klen32[31:24];
-    wire [PW-1:0] haddr = cp + {{(PW - 2){1'b0}}, hi};
+    wire [RW-1:0] haddr = cp[RW-1:0] + {{(RW - 2){1'b0}}, hi};
     wire load = (rp != ce) && (!qvalid || m_tready);
     wire pop = qvalid && m_tready;
     assign m_tvalid = qvalid;
@@ -122,7 +122,7 @@ module rfl_rtps_to_cdr #(
     assign cnt_too_long = c_too_long;
 
     always @(posedge clk) begin
-        if (hdr) mem[haddr[RW-1:0]] <= hbyte;
+        if (hdr) mem[haddr] <= hbyte;
         else if (wr) mem[wp[RW-1:0]] <= s_axis_tdata;
         if (load) q <= mem[rp[RW-1:0]];
     end
