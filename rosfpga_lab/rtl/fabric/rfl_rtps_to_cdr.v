@@ -23,9 +23,10 @@
 // The input waits only for those 4 clocks after a kept sample, or while the ring is full (a
 // byte of a sample still within MAX_BYTES, no room). A record is its sample + 4 bytes, the
 // input's 4 clocks of waiting: with samples back to back and TREADY high, samples and records
-// go through a byte a clock (the input waits exactly 4 clocks a kept sample, the ring never
-// fills: it holds one record going out and the sample coming in, at most MAX_BYTES + 13
-// bytes), and a record's first byte goes out 6 clocks after its sample's last byte came in.
+// go through a byte a clock (the input waits exactly 4 clocks a kept sample; the ring never
+// fills: it holds the record going out and the sample coming in, at most MAX_BYTES + 8 bytes,
+// less than RING once MAX_BYTES > 8), and a record's first byte goes out 6 clocks after its
+// sample's last byte came in.
 // With the output stopped, the ring takes two records when their samples total at most
 // RING - 8 bytes (two of MAX_BYTES when it is at most 2**clog2(MAX_BYTES) - 4).
 // Block RAM on an ECP5 (DP16KD, 2048 x 9): RING / 2048 blocks, at least one (or LUT RAM, as
