@@ -1,11 +1,12 @@
-// fv_rtps_to_cdr -- rfl_rtps_to_cdr (rtl/fabric) with MAX_BYTES 5 (a ring of 16 bytes: two records of 4-byte packets) on its
-// ports: any input packets (any bytes, TLAST, TUSER) under the stream rules. Always (prove): the
-// output keeps the stream rules. Bounded (bmc, not FV_PROVE): a record goes out only for a
-// packet that ended without TUSER and fitted, in order, its length (4 bytes, little-endian) that
-// packet's byte count and its body that packet's bytes; and the input waits only in the 4 clocks
-// after a kept packet or while the ring is full (records not yet out + 4 + the packet's bytes
-// stored = 16) with the packet still within MAX_BYTES: never while a record goes out with room
-// left (the one-buffer seam did), never on a byte past MAX_BYTES.
+// fv_rtps_to_cdr -- rfl_rtps_to_cdr (rtl/fabric) with MAX_BYTES 5 (a ring of 16 bytes: two
+// records of 4-byte packets) on its ports: any input packets (any bytes, TLAST, TUSER) under the
+// stream rules. Always (prove): the output keeps the stream rules. Bounded (bmc, not FV_PROVE):
+// a record goes out only for a packet that ended without TUSER and fitted, in order, its length
+// (4 bytes, little-endian) that packet's byte count and its body that packet's bytes; and the
+// input waits only in the 4 clocks after a kept packet or while the ring is full (records not
+// yet out + 4 + the packet's bytes stored = 16) with the packet still within MAX_BYTES: never
+// while a record goes out with room left (the one-buffer seam did), never on a byte past
+// MAX_BYTES.
 module fv_rtps_to_cdr (
     input clk, input rst_n, input [7:0] s_axis_tdata, input s_axis_tvalid,
     input s_axis_tlast, input s_axis_tuser, input m_tready
