@@ -67,8 +67,9 @@ writer's DATA / DATA_FRAG samples out (its header comment is the design note; pr
 ``rtps_rx``; tested against :func:`rosfpga_lab.rtps.parse_message` in
 ``tests/rtl/test_fabric_rtps_rx.py``); ``rfl_rtps_to_cdr`` turns its sample packets into the
 records a generated ``wire: cdr`` circuit's subscriber reads (the length, then the payload),
-forwarding a sample only once it ended good (proof ``rtps_to_cdr``; datagrams through both into
-a generated top in ``tests/rtl/test_fabric_rtps_cdr.py``). ``rfl_rtps_tx`` is the way back: the
+forwarding a sample only once it ended good, through a ring that fills while it sends (proof
+``rtps_to_cdr``; alone in ``tests/rtl/test_fabric_seam.py``; datagrams through both into a
+generated top in ``tests/rtl/test_fabric_rtps_cdr.py``). ``rfl_rtps_tx`` is the way back: the
 generated publisher's records become the data writer's RTPS datagrams (DATA, or DATA_FRAGs
 streamed without a sample buffer, and a HEARTBEAT), its GUID prefix and writer id
 :func:`rosfpga_lab.rtl.discrom.tx_parameters` of the participant the discovery ROM announces

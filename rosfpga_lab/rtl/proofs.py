@@ -172,12 +172,15 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_rtps_disc_rom (16-byte ROM, 4 messages, any contents, any requests): output "
           "stream rules, TDEST constant and no gap inside a datagram; all reachable states"),
     Proof("rtps_to_cdr", ("rfl_rtps_to_cdr.v",), "prove", 4,
-          "rfl_rtps_to_cdr (4-byte buffer, any input packets): output stream rules, no input "
-          "taken while a record goes out; all reachable states", ("FV_PROVE",)),
-    Proof("rtps_to_cdr", ("rfl_rtps_to_cdr.v",), "bmc", 16,
-          "rfl_rtps_to_cdr (4-byte buffer, any input packets): a record only for a packet "
-          "without TUSER that fitted, its length (LE32) that packet's byte count, its body that "
-          "packet's bytes in order; 16 clocks (a 4-byte packet's whole record)"),
+          "rfl_rtps_to_cdr (MAX_BYTES 5, a 16-byte ring, any input packets): output stream "
+          "rules; all reachable states", ("FV_PROVE",)),
+    Proof("rtps_to_cdr", ("rfl_rtps_to_cdr.v",), "bmc", 20,
+          "rfl_rtps_to_cdr (MAX_BYTES 5, a 16-byte ring, any input packets): a record only for "
+          "a packet without TUSER that fitted, in order, its length (LE32) that packet's byte "
+          "count, its body that packet's bytes; the input waits only in the 4 clocks after a "
+          "kept packet or while the ring is full with the packet within MAX_BYTES (never while "
+          "a record goes out with room left, never on a byte past MAX_BYTES); 20 clocks (two "
+          "4-byte packets in, the first's record out)"),
     Proof("rtps_tx", ("rfl_rtps_tx.v",), "prove", 4,
           "rfl_rtps_tx (4-byte fragments, samples of at most 16 bytes, INFO_TS, any records, "
           "any time): output stream rules with TLAST; every datagram opens with the magic's R "

@@ -181,14 +181,30 @@ def test_rtps_datagrams_through_the_seam_publish_the_models_records(
                "RTPS_CDR_OUT": str(tmp_path / "out.json")})
 
 
-def test_a_seam_that_forwards_a_dropped_sample_fails_its_proof(tmp_path: Path) -> None:
+#: planted bugs the bounded proof must catch: (what is replaced, by what)
+SEAM_BUGS = {
+    # forwards a packet that ended with TUSER
+    "forwards_dropped": ("wire keep = fin && !s_axis_tuser && !full;",
+                         "wire keep = fin && !full;"),
+    # the one-buffer seam's way: the input waits while a record goes out
+    "waits_while_sending": ("assign s_axis_tready = !hdr && (room || full);",
+                            "assign s_axis_tready = !hdr && (room || full) && !m_tvalid;"),
+    # stalls on the bytes past MAX_BYTES of an overlong packet when the ring is full
+    "stalls_on_overlong": ("assign s_axis_tready = !hdr && (room || full);",
+                           "assign s_axis_tready = !hdr && room;"),
+}
+
+
+@pytest.mark.parametrize("bug", sorted(SEAM_BUGS))
+def test_a_seam_with_a_planted_bug_fails_its_proof(bug: str, tmp_path: Path) -> None:
     """The bounded proof (tests/rtl/test_formal.py runs it) sees a record go out for a packet
-    that ended with TUSER once the seam forgets to look at it."""
+    that ended with TUSER, or the input wait while a record goes out with room in the ring, or
+    wait on a byte it would throw away."""
     require_formal()
     good = (FABRIC / "rfl_rtps_to_cdr.v").read_text()
-    check = "                        if (s_axis_tuser) begin\n"
+    check, planted = SEAM_BUGS[bug]
     assert good.count(check) == 1
     buggy = tmp_path / "rfl_rtps_to_cdr.v"
-    buggy.write_text(good.replace(check, check.replace("s_axis_tuser", "1'b0")))
+    buggy.write_text(good.replace(check, planted))
     bmc = next(p for p in PROOFS if p.name == "rtps_to_cdr" and p.mode == "bmc")
     assert prove(bmc, replace={"rfl_rtps_to_cdr.v": buggy}).status == "FAIL"

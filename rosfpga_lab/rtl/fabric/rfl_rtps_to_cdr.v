@@ -8,17 +8,29 @@
 // and no abort; it knows a record's end by the length in front. So nothing of a sample may go
 // out before its last byte has come in good: the length is known only then, and a sample that
 // ends with TUSER (a fragment missing, a malformed submessage) must not reach the subscriber.
-// Hence store and forward: one buffer of MAX_BYTES bytes (a RAM with a registered read).
-//   S_FILL  input taken a byte per clock into the buffer. At TLAST: TUSER set -> the sample is
-//           discarded (cnt_dropped); more than MAX_BYTES bytes -> discarded (cnt_too_long;
-//           the bytes past the buffer are taken and thrown away, never a stall on them);
-//           else -> S_LEN.
-//   S_LEN   the length's four bytes out (the RAM's first byte read meanwhile); then S_BODY.
-//   S_BODY  the buffer out, a byte per clock while TREADY; then S_FILL (cnt_samples). No
-//           TLAST: the subscriber's byte stream has none (the length says where a record ends).
-// The input waits (TREADY low) in S_LEN and S_BODY: one sample at a time, so a sample costs
-// its length in clocks twice plus 5. Two buffers would overlap filling and sending; the
-// subscriber's own rx FIFO (RX_DEPTH) takes the record at a byte per clock meanwhile.
+// Hence store and forward, through a ring of RING = 2 x 2**clog2(MAX_BYTES) bytes (one block
+// RAM, one write port, one registered read port) that holds the records themselves, so that
+// samples fill it while earlier records go out:
+//   Fill    a sample's bytes go in a byte per clock behind 4 bytes kept free for its length.
+//           At TLAST: TUSER set -> discarded (cnt_dropped); more than MAX_BYTES bytes ->
+//           discarded (cnt_too_long; the bytes past MAX_BYTES are taken and thrown away, never
+//           a stall on them); else kept: its length goes in the 4 bytes kept for it, one a
+//           clock (the input waits these 4 clocks), and the record is handed to the send side.
+//           A discarded sample's space is taken back at once.
+//   Send    the records handed over, a byte per clock while TREADY, through the RAM's read
+//           register (cnt_samples at a record's last byte). No TLAST: the subscriber's byte
+//           stream has none (the length says where a record ends).
+// The input waits only for those 4 clocks after a kept sample, or while the ring is full (a
+// byte of a sample still within MAX_BYTES, no room). A record is its sample + 4 bytes, the
+// input's 4 clocks of waiting: with samples back to back and TREADY high, samples and records
+// go through a byte a clock (the input waits exactly 4 clocks a kept sample; the ring never
+// fills: it holds the record going out and the sample coming in, at most MAX_BYTES + 8 bytes,
+// less than RING once MAX_BYTES > 8), and a record's first byte goes out 6 clocks after its
+// sample's last byte came in.
+// With the output stopped, the ring takes two records when their samples total at most
+// RING - 8 bytes (two of MAX_BYTES when it is at most 2**clog2(MAX_BYTES) - 4).
+// Block RAM on an ECP5 (DP16KD, 2048 x 9): RING / 2048 blocks, at least one (or LUT RAM, as
+// Yosys picks): MAX_BYTES 2048 (rfl_fabric_node's default, the board's) 2, 4096 4, 16384 16.
 // The padding the encapsulation options declare (their low 2 bits) is not stripped here: the
 // subscriber reads it from the header and skips it after the last field (OP_ENCAP, S_SKIP), as
 // Cyclone DDS's unannounced zeros to a multiple of 4 (S_TAIL); the lab's CDR models take the
@@ -63,100 +75,120 @@ module rfl_rtps_to_cdr #(
     end
 `endif
 
-    localparam AW = $clog2(MAX_BYTES);          // buffer address
+    localparam AW = $clog2(MAX_BYTES);
+    localparam RW = AW + 1;                     // ring address: RING = 2**RW bytes
+    localparam PW = AW + 2;                     // ring pointers, a bit more (a full ring)
     localparam NW = $clog2(MAX_BYTES + 1);      // a sample's length, 0..MAX_BYTES
     localparam [31:0] MAX_32 = MAX_BYTES;
     localparam [NW-1:0] FULL = MAX_32[NW-1:0];
-    localparam [1:0] S_FILL = 2'd0, S_LEN = 2'd1, S_BODY = 2'd2;
+    localparam [PW-1:0] RING = {1'b1, {RW{1'b0}}};
+    localparam [PW-1:0] LEN_BYTES = 4;
 
-    reg [1:0] st;
-    reg [7:0] mem [0:(1 << AW)-1];             // MAX_BYTES used
-    reg [NW-1:0] n;                             // S_FILL: bytes stored; S_LEN, S_BODY: the length
-    reg over;                                   // S_FILL: the sample did not fit
-    reg [AW-1:0] ra;                            // the next byte read from the buffer
-    reg [NW-1:0] rleft;                         // bytes still to read from the buffer
-    reg [NW-1:0] oleft;                         // S_BODY: bytes still to send
+    reg [7:0] mem [0:(1 << RW)-1];
+    // fill side
+    reg [PW-1:0] cp;                            // the record being filled starts here
+    reg [PW-1:0] wp;                            // the next sample byte goes here (cp + 4 + n)
+    reg [NW-1:0] n;                             // bytes of the sample stored
+    reg hdr;                                    // writing the kept sample's length at cp
+    reg [1:0] hi;                               // ... its byte hi
+    reg [NW-1:0] klen;                          // ... the length
+    // send side
+    reg [PW-1:0] ce;                            // the records handed over end here
+    reg [PW-1:0] rp;                            // the next byte read from the ring
     reg [7:0] q;                                // the RAM's read register
     reg qvalid;
-    reg [1:0] li;                               // S_LEN: the length byte out
+    reg body;                                   // a record's body is going out (else its length)
+    reg [1:0] oi;                               // length bytes out
+    reg [31:0] ol;                              // the length as it went out; then bytes left
     reg [COUNT_BITS-1:0] c_samples, c_dropped, c_too_long;
 
+    wire [PW-1:0] used = wp - rp;               // at most RING + 3: a ring's worth + the 4 kept
+    wire room = (used < RING);
     wire full = (n == FULL);
-    assign s_axis_tready = (st == S_FILL);
+    assign s_axis_tready = !hdr && (room || full);
     wire take = s_axis_tvalid && s_axis_tready;
     wire wr = take && !full;
-    wire [31:0] len32 = {{(32 - NW){1'b0}}, n};
-    wire [7:0] len_byte = (li == 2'd0) ? len32[7:0] : (li == 2'd1) ? len32[15:8] :
-                          (li == 2'd2) ? len32[23:16] : len32[31:24];
-    assign m_tvalid = (st == S_LEN) || (st == S_BODY && qvalid);
-    assign m_tdata = (st == S_LEN) ? len_byte : q;
-    wire pop = m_tvalid && m_tready;
-    wire pop_body = pop && (st == S_BODY);
-    wire load = (st != S_FILL) && (rleft != {NW{1'b0}}) && (!qvalid || pop_body);
+    wire fin = take && s_axis_tlast;
+    wire keep = fin && !s_axis_tuser && !full;
+    wire [31:0] klen32 = {{(32 - NW){1'b0}}, klen};
+    wire [7:0] hbyte = (hi == 2'd0) ? klen32[7:0] : (hi == 2'd1) ? klen32[15:8] :
+                       (hi == 2'd2) ? klen32[23:16] : klen32[31:24];
+    wire [RW-1:0] haddr = cp[RW-1:0] + {{(RW - 2){1'b0}}, hi};
+    wire load = (rp != ce) && (!qvalid || m_tready);
+    wire pop = qvalid && m_tready;
+    assign m_tvalid = qvalid;
+    assign m_tdata = q;
     assign cnt_samples = c_samples;
     assign cnt_dropped = c_dropped;
     assign cnt_too_long = c_too_long;
 
     always @(posedge clk) begin
-        if (wr) mem[n[AW-1:0]] <= s_axis_tdata;
-        if (load) q <= mem[ra];
+        if (hdr) mem[haddr] <= hbyte;
+        else if (wr) mem[wp[RW-1:0]] <= s_axis_tdata;
+        if (load) q <= mem[rp[RW-1:0]];
     end
 
     always @(posedge clk) begin
         if (!rst_n) begin
-            st <= S_FILL;
+            cp <= {PW{1'b0}};
+            wp <= LEN_BYTES;
             n <= {NW{1'b0}};
-            over <= 1'b0;
-            ra <= {AW{1'b0}};
-            rleft <= {NW{1'b0}};
-            oleft <= {NW{1'b0}};
+            hdr <= 1'b0;
+            hi <= 2'd0;
+            klen <= {NW{1'b0}};
+            ce <= {PW{1'b0}};
+            rp <= {PW{1'b0}};
             qvalid <= 1'b0;
-            li <= 2'd0;
+            body <= 1'b0;
+            oi <= 2'd0;
+            ol <= 32'd0;
             c_samples <= {COUNT_BITS{1'b0}};
             c_dropped <= {COUNT_BITS{1'b0}};
             c_too_long <= {COUNT_BITS{1'b0}};
         end else begin
-            if (load) begin
-                ra <= ra + 1'b1;
-                rleft <= rleft - 1'b1;
+            // ---- fill
+            if (wr) begin
+                wp <= wp + 1'b1;
+                n <= n + 1'b1;
             end
+            if (fin) begin
+                n <= {NW{1'b0}};
+                if (s_axis_tuser) c_dropped <= c_dropped + 1'b1;
+                else if (full) c_too_long <= c_too_long + 1'b1;
+                if (keep) begin
+                    klen <= n + 1'b1;
+                    hdr <= 1'b1;
+                    hi <= 2'd0;
+                end else begin
+                    wp <= cp + LEN_BYTES;       // the space taken back
+                end
+            end
+            if (hdr) begin
+                hi <= hi + 2'd1;
+                if (hi == 2'd3) begin           // the record is whole: hand it over
+                    hdr <= 1'b0;
+                    ce <= wp;
+                    cp <= wp;
+                    wp <= wp + LEN_BYTES;
+                end
+            end
+            // ---- send
+            if (load) rp <= rp + 1'b1;
             if (load) qvalid <= 1'b1;
-            else if (pop_body) qvalid <= 1'b0;
-            case (st)
-                S_FILL: if (take) begin
-                    if (wr) n <= n + 1'b1;
-                    if (full) over <= 1'b1;
-                    if (s_axis_tlast) begin
-                        over <= 1'b0;
-                        ra <= {AW{1'b0}};
-                        li <= 2'd0;
-                        if (s_axis_tuser) begin
-                            n <= {NW{1'b0}};
-                            c_dropped <= c_dropped + 1'b1;
-                        end else if (over || full) begin
-                            n <= {NW{1'b0}};
-                            c_too_long <= c_too_long + 1'b1;
-                        end else begin
-                            rleft <= n + 1'b1;
-                            oleft <= n + 1'b1;
-                            st <= S_LEN;
-                        end
-                    end
-                end
-                S_LEN: if (pop) begin
-                    li <= li + 2'd1;
-                    if (li == 2'd3) st <= S_BODY;
-                end
-                S_BODY: if (pop) begin
-                    oleft <= oleft - 1'b1;
-                    if (oleft == {{(NW-1){1'b0}}, 1'b1}) begin
-                        n <= {NW{1'b0}};
+            else if (pop) qvalid <= 1'b0;
+            if (pop) begin
+                if (!body) begin
+                    ol <= {q, ol[31:8]};
+                    oi <= oi + 2'd1;
+                    if (oi == 2'd3) body <= 1'b1;
+                end else begin
+                    ol <= ol - 32'd1;
+                    if (ol == 32'd1) begin
+                        body <= 1'b0;
                         c_samples <= c_samples + 1'b1;
-                        st <= S_FILL;
                     end
                 end
-                default: st <= S_FILL;
-            endcase
+            end
         end
     end
 endmodule
