@@ -8,7 +8,7 @@ bytes, padded frames among them) and random gaps, mixed with frames the node mus
 FCS, a bad IPv4 header checksum, another destination IP, another unicast MAC, another UDP port, a
 frame cut short (its IP and UDP lengths claim more), an empty datagram, another multicast
 group, IPv4 fragments (MF set, an offset), an IPv4 total length above the frame, below the UDP
-length or below 28. Good frames go to the node's IP, broadcast, or the SPDP multicast group, and to any of
+length or below 28, a runt (not padded) that ends inside its Ethernet, IPv4 or UDP header. Good frames go to the node's IP, broadcast, or the SPDP multicast group, and to any of
 its participant's ports (user and metatraffic unicast, SPDP multicast: one masked port).
 Exactly the good payloads must come out, in order, with the sender's IP and ports, and the
 counters must count what ``rfl_udp_port`` says it counts. Then the lab side sends payloads to
@@ -78,7 +78,7 @@ def _arp_request(target: str) -> bytes:
 
 KINDS = ["good"] * 8 + ["bcast", "mcast", "bad_fcs", "bad_ipsum", "other_ip", "other_mac",
                         "other_port", "other_group", "cut", "more_fragments", "fragment",
-                        "ip_long", "ip_short", "ip_tiny"]
+                        "ip_long", "ip_short", "ip_tiny", "runt"]
 
 
 def _with_ip(frame: bytes, **fields: int) -> bytes:
@@ -146,6 +146,10 @@ def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
                       "ip_short": {"len": 20 + 8 + size - rng.randint(1, min(size, 8))},
                       "ip_tiny": {"len": rng.randint(0, 27)}}[kind]
             wire.append(_fcs(_with_ip(_udp(payload, sport=sport), **fields)))
+            counts["rx_header"] += 1
+        elif kind == "runt":                     # not padded: it ends inside a header
+            body = _udp(payload, sport=sport)[:rng.randint(14, 14 + 20 + 7)]
+            wire.append(body + struct.pack("<I", zlib.crc32(body)))
             counts["rx_header"] += 1
         elif kind == "ip_long":                  # the frame (padding aside) ends before it
             whole = _udp(payload, sport=sport)

@@ -147,7 +147,7 @@ def families(frags: list[bytes]) -> list[Family]:
         _fcs(_patch_ip(whole, len=IP(whole[14:]).len - 64)),     # shorter than the UDP length
         _fcs(_patch_ip(whole, len=16)),                          # shorter than its header
     ], moves={"rx_length": 1, "rx_header": 2}))
-    # IPv4 fragments: LiteEth does not reassemble; a fragment is not a datagram
+    # IPv4 fragments: not reassembled; a fragment is not a datagram
     second = bytes(UDP(sport=40000, dport=USER, len=8 + len(good), chksum=0)) + good
     out.append(Family("IPv4 fragments", [
         _fcs(_patch_ip(whole, flags=1)),                         # MF: the first of several
