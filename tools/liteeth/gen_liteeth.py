@@ -253,16 +253,22 @@ class HoldingUDPRX(LiteXModule):
         held = Signal(8)
         sport, dport, length, ip = Signal(16), Signal(16), Signal(16), Signal(32)
         payload_len = Signal(16)
-        # the frame ends (this beat, the count-th after the UDP header) before its IPv4 payload
+        # bytes of the IPv4 payload after this beat (a register: no arithmetic between the
+        # IPv4 header and the payload's length, LiteEth's long paths are there already); the
+        # frame ends before its IPv4 payload if its last beat leaves some
+        rest = Signal(16)
         cut = Signal()
         self.comb += [
             payload_len.eq(d.length - udp_header.length),
-            cut.eq(count + udp_header.length < sink.length),
+            cut.eq(rest != 0),
         ]
+        take = [NextValue(count, count + 1), If(cut, NextValue(rest, rest - 1))]
         self.drop_header = Signal()
         self.fsm = fsm = FSM(reset_state="IDLE")
         fsm.act("IDLE",
             NextValue(count, 1), NextValue(err, 0),
+            NextValue(rest, sink.length - (udp_header.length + 1)),
+            If(sink.length <= udp_header.length, NextValue(rest, 0)),
             If(d.valid, NextState("DROP"),
                 If(sink.protocol == udp_protocol,
                     If(d.length > sink.length, self.drop_header.eq(1)
@@ -276,7 +282,7 @@ class HoldingUDPRX(LiteXModule):
                 source.last.eq(d.last), source.error.eq(d.error | err),
                 If(d.last & cut, source.length.eq(0)),
                 If(d.valid & source.ready,
-                    NextValue(count, count + 1), NextValue(err, err | d.error),
+                    *take, NextValue(err, err | d.error),
                     If(d.last, NextState("IDLE"))),
             ).Else(                              # the payload's last byte, the frame goes on
                 d.ready.eq(1),
@@ -284,11 +290,11 @@ class HoldingUDPRX(LiteXModule):
                     NextValue(held, d.data), NextValue(err, err | d.error),
                     NextValue(sport, d.src_port), NextValue(dport, d.dst_port),
                     NextValue(length, payload_len), NextValue(ip, sink.ip_address),
-                    NextValue(count, count + 1),
+                    *take,
                     NextState("HOLD"))))
         fsm.act("HOLD",
             d.ready.eq(1),
-            If(d.valid, NextValue(err, err | d.error), NextValue(count, count + 1),
+            If(d.valid, NextValue(err, err | d.error), *take,
                 If(d.last, If(cut, NextValue(length, 0)), NextState("EMIT"))))
         fsm.act("EMIT",
             source.valid.eq(1), source.last.eq(1), source.data.eq(held), source.error.eq(err),

@@ -233,19 +233,19 @@ UDPPortCore
 │    │    └─── csrstorage_0* (CSRStorage)
 │    │    └─── csrstatus_0* (CSRStatus)
 └─── csr_interconnect (InterconnectShared)
+└─── [ODDRX1F]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
-└─── [ODDRX1F]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
 * : Generated name.
@@ -584,17 +584,17 @@ wire          ethphy_we;
 reg     [2:0] fsm_next_state = 3'd0;
 reg     [2:0] fsm_state = 3'd0;
 reg    [15:0] holdingudprx0 = 16'd0;
-reg    [15:0] holdingudprx0_liteethudp_next_value3 = 16'd0;
-reg           holdingudprx0_liteethudp_next_value_ce3 = 1'd0;
+reg    [15:0] holdingudprx0_liteethudp_next_value4 = 16'd0;
+reg           holdingudprx0_liteethudp_next_value_ce4 = 1'd0;
 reg    [15:0] holdingudprx1 = 16'd0;
-reg    [15:0] holdingudprx1_liteethudp_next_value4 = 16'd0;
-reg           holdingudprx1_liteethudp_next_value_ce4 = 1'd0;
+reg    [15:0] holdingudprx1_liteethudp_next_value5 = 16'd0;
+reg           holdingudprx1_liteethudp_next_value_ce5 = 1'd0;
 reg    [15:0] holdingudprx2 = 16'd0;
-reg    [15:0] holdingudprx2_liteethudp_next_value5 = 16'd0;
-reg           holdingudprx2_liteethudp_next_value_ce5 = 1'd0;
+reg    [15:0] holdingudprx2_liteethudp_next_value6 = 16'd0;
+reg           holdingudprx2_liteethudp_next_value_ce6 = 1'd0;
 reg    [31:0] holdingudprx3 = 32'd0;
-reg    [31:0] holdingudprx3_liteethudp_next_value6 = 32'd0;
-reg           holdingudprx3_liteethudp_next_value_ce6 = 1'd0;
+reg    [31:0] holdingudprx3_liteethudp_next_value7 = 32'd0;
+reg           holdingudprx3_liteethudp_next_value_ce7 = 1'd0;
 reg    [15:0] holdingudprx_count = 16'd0;
 reg    [15:0] holdingudprx_count_liteethudp_next_value0 = 16'd0;
 reg           holdingudprx_count_liteethudp_next_value_ce0 = 1'd0;
@@ -607,8 +607,8 @@ reg           holdingudprx_err_liteethudp_next_value_ce1 = 1'd0;
 reg           holdingudprx_fsm_is_ongoing0 = 1'd0;
 reg           holdingudprx_fsm_is_ongoing1 = 1'd0;
 reg     [7:0] holdingudprx_held = 8'd0;
-reg     [7:0] holdingudprx_held_liteethudp_next_value2 = 8'd0;
-reg           holdingudprx_held_liteethudp_next_value_ce2 = 1'd0;
+reg     [7:0] holdingudprx_held_liteethudp_next_value3 = 8'd0;
+reg           holdingudprx_held_liteethudp_next_value_ce3 = 1'd0;
 reg     [2:0] holdingudprx_liteethudpdepacketizer_count = 3'd0;
 reg     [2:0] holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
 reg           holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
@@ -655,6 +655,9 @@ reg           holdingudprx_liteethudpdepacketizer_sr_shift = 1'd0;
 reg           holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
 reg           holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
 wire   [15:0] holdingudprx_payload_len;
+reg    [15:0] holdingudprx_rest = 16'd0;
+reg    [15:0] holdingudprx_rest_liteethudp_next_value2 = 16'd0;
+reg           holdingudprx_rest_liteethudp_next_value_ce2 = 1'd0;
 wire          holdingudprx_sink_first;
 wire          holdingudprx_sink_last;
 wire   [31:0] holdingudprx_sink_param_ip_address;
@@ -5642,7 +5645,7 @@ assign holdingudprx_liteethudpdepacketizer_sink_param_length = holdingudprx_sink
 assign holdingudprx_liteethudpdepacketizer_sink_param_protocol = holdingudprx_sink_param_protocol;
 assign holdingudprx_liteethudpdepacketizer_sink_param_ip_address = holdingudprx_sink_param_ip_address;
 assign holdingudprx_payload_len = (holdingudprx_liteethudpdepacketizer_source_param_length - 4'd8);
-assign holdingudprx_cut1 = ((holdingudprx_count + 4'd8) < holdingudprx_sink_param_length);
+assign holdingudprx_cut1 = (holdingudprx_rest != 1'd0);
 assign holdingudprx_liteethudpdepacketizer_header = holdingudprx_liteethudpdepacketizer_sr;
 assign holdingudprx_liteethudpdepacketizer_source_param_checksum = {rhs_slice_proxy69[7:0], rhs_slice_proxy68[15:8]};
 assign holdingudprx_liteethudpdepacketizer_source_param_dst_port = {rhs_slice_proxy71[7:0], rhs_slice_proxy70[15:8]};
@@ -5777,22 +5780,24 @@ always @(*) begin
     endcase
 end
 always @(*) begin
-    holdingudprx0_liteethudp_next_value3 <= 16'd0;
-    holdingudprx0_liteethudp_next_value_ce3 <= 1'd0;
-    holdingudprx1_liteethudp_next_value4 <= 16'd0;
-    holdingudprx1_liteethudp_next_value_ce4 <= 1'd0;
-    holdingudprx2_liteethudp_next_value5 <= 16'd0;
-    holdingudprx2_liteethudp_next_value_ce5 <= 1'd0;
-    holdingudprx3_liteethudp_next_value6 <= 32'd0;
-    holdingudprx3_liteethudp_next_value_ce6 <= 1'd0;
+    holdingudprx0_liteethudp_next_value4 <= 16'd0;
+    holdingudprx0_liteethudp_next_value_ce4 <= 1'd0;
+    holdingudprx1_liteethudp_next_value5 <= 16'd0;
+    holdingudprx1_liteethudp_next_value_ce5 <= 1'd0;
+    holdingudprx2_liteethudp_next_value6 <= 16'd0;
+    holdingudprx2_liteethudp_next_value_ce6 <= 1'd0;
+    holdingudprx3_liteethudp_next_value7 <= 32'd0;
+    holdingudprx3_liteethudp_next_value_ce7 <= 1'd0;
     holdingudprx_count_liteethudp_next_value0 <= 16'd0;
     holdingudprx_count_liteethudp_next_value_ce0 <= 1'd0;
     holdingudprx_drop_header <= 1'd0;
     holdingudprx_err_liteethudp_next_value1 <= 1'd0;
     holdingudprx_err_liteethudp_next_value_ce1 <= 1'd0;
-    holdingudprx_held_liteethudp_next_value2 <= 8'd0;
-    holdingudprx_held_liteethudp_next_value_ce2 <= 1'd0;
+    holdingudprx_held_liteethudp_next_value3 <= 8'd0;
+    holdingudprx_held_liteethudp_next_value_ce3 <= 1'd0;
     holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
+    holdingudprx_rest_liteethudp_next_value2 <= 16'd0;
+    holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd0;
     holdingudprx_source_last <= 1'd0;
     holdingudprx_source_param_dst_port <= 16'd0;
     holdingudprx_source_param_ip_address <= 32'd0;
@@ -5821,6 +5826,10 @@ always @(*) begin
                 if ((holdingudprx_liteethudpdepacketizer_source_valid & holdingudprx_source_ready)) begin
                     holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
                     holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    if (holdingudprx_cut1) begin
+                        holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
+                        holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    end
                     holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
                     holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
                     if (holdingudprx_liteethudpdepacketizer_source_last) begin
@@ -5830,20 +5839,24 @@ always @(*) begin
             end else begin
                 holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
                 if (holdingudprx_liteethudpdepacketizer_source_valid) begin
-                    holdingudprx_held_liteethudp_next_value2 <= holdingudprx_liteethudpdepacketizer_source_payload_data;
-                    holdingudprx_held_liteethudp_next_value_ce2 <= 1'd1;
+                    holdingudprx_held_liteethudp_next_value3 <= holdingudprx_liteethudpdepacketizer_source_payload_data;
+                    holdingudprx_held_liteethudp_next_value_ce3 <= 1'd1;
                     holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
                     holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    holdingudprx0_liteethudp_next_value3 <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
-                    holdingudprx0_liteethudp_next_value_ce3 <= 1'd1;
-                    holdingudprx1_liteethudp_next_value4 <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
-                    holdingudprx1_liteethudp_next_value_ce4 <= 1'd1;
-                    holdingudprx2_liteethudp_next_value5 <= holdingudprx_payload_len;
-                    holdingudprx2_liteethudp_next_value_ce5 <= 1'd1;
-                    holdingudprx3_liteethudp_next_value6 <= holdingudprx_sink_param_ip_address;
-                    holdingudprx3_liteethudp_next_value_ce6 <= 1'd1;
+                    holdingudprx0_liteethudp_next_value4 <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
+                    holdingudprx0_liteethudp_next_value_ce4 <= 1'd1;
+                    holdingudprx1_liteethudp_next_value5 <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+                    holdingudprx1_liteethudp_next_value_ce5 <= 1'd1;
+                    holdingudprx2_liteethudp_next_value6 <= holdingudprx_payload_len;
+                    holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
+                    holdingudprx3_liteethudp_next_value7 <= holdingudprx_sink_param_ip_address;
+                    holdingudprx3_liteethudp_next_value_ce7 <= 1'd1;
                     holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
                     holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    if (holdingudprx_cut1) begin
+                        holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
+                        holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    end
                     liteethudp_holdingudprx_next_state <= 2'd2;
                 end
             end
@@ -5855,10 +5868,14 @@ always @(*) begin
                 holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
                 holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
                 holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                if (holdingudprx_cut1) begin
+                    holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
+                    holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                end
                 if (holdingudprx_liteethudpdepacketizer_source_last) begin
                     if (holdingudprx_cut1) begin
-                        holdingudprx2_liteethudp_next_value5 <= 1'd0;
-                        holdingudprx2_liteethudp_next_value_ce5 <= 1'd1;
+                        holdingudprx2_liteethudp_next_value6 <= 1'd0;
+                        holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
                     end
                     liteethudp_holdingudprx_next_state <= 2'd3;
                 end
@@ -5888,6 +5905,12 @@ always @(*) begin
             holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
             holdingudprx_err_liteethudp_next_value1 <= 1'd0;
             holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+            holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_sink_param_length - 4'd9);
+            holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            if ((holdingudprx_sink_param_length <= 4'd8)) begin
+                holdingudprx_rest_liteethudp_next_value2 <= 1'd0;
+                holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            end
             if (holdingudprx_liteethudpdepacketizer_source_valid) begin
                 liteethudp_holdingudprx_next_state <= 3'd4;
                 if ((holdingudprx_sink_param_protocol == 5'd17)) begin
@@ -6929,20 +6952,23 @@ always @(posedge sys_clk) begin
     if (holdingudprx_err_liteethudp_next_value_ce1) begin
         holdingudprx_err <= holdingudprx_err_liteethudp_next_value1;
     end
-    if (holdingudprx_held_liteethudp_next_value_ce2) begin
-        holdingudprx_held <= holdingudprx_held_liteethudp_next_value2;
+    if (holdingudprx_rest_liteethudp_next_value_ce2) begin
+        holdingudprx_rest <= holdingudprx_rest_liteethudp_next_value2;
     end
-    if (holdingudprx0_liteethudp_next_value_ce3) begin
-        holdingudprx0 <= holdingudprx0_liteethudp_next_value3;
+    if (holdingudprx_held_liteethudp_next_value_ce3) begin
+        holdingudprx_held <= holdingudprx_held_liteethudp_next_value3;
     end
-    if (holdingudprx1_liteethudp_next_value_ce4) begin
-        holdingudprx1 <= holdingudprx1_liteethudp_next_value4;
+    if (holdingudprx0_liteethudp_next_value_ce4) begin
+        holdingudprx0 <= holdingudprx0_liteethudp_next_value4;
     end
-    if (holdingudprx2_liteethudp_next_value_ce5) begin
-        holdingudprx2 <= holdingudprx2_liteethudp_next_value5;
+    if (holdingudprx1_liteethudp_next_value_ce5) begin
+        holdingudprx1 <= holdingudprx1_liteethudp_next_value5;
     end
-    if (holdingudprx3_liteethudp_next_value_ce6) begin
-        holdingudprx3 <= holdingudprx3_liteethudp_next_value6;
+    if (holdingudprx2_liteethudp_next_value_ce6) begin
+        holdingudprx2 <= holdingudprx2_liteethudp_next_value6;
+    end
+    if (holdingudprx3_liteethudp_next_value_ce7) begin
+        holdingudprx3 <= holdingudprx3_liteethudp_next_value7;
     end
     if (liteethudp_first) begin
         liteethudp_sel_ongoing <= liteethudp_sel0;
@@ -7076,6 +7102,7 @@ always @(posedge sys_clk) begin
         holdingudprx1 <= 16'd0;
         holdingudprx2 <= 16'd0;
         holdingudprx3 <= 32'd0;
+        holdingudprx_rest <= 16'd0;
         liteethmac_grant <= 1'd0;
         liteethmac_status0_first <= 1'd1;
         liteethmac_status0_ongoing1 <= 1'd0;

@@ -754,17 +754,17 @@ wire          main_crossbar_source_ready;
 wire          main_crossbar_source_valid;
 reg           main_dv_d = 1'd0;
 reg    [15:0] main_holdingudprx0 = 16'd0;
-reg    [15:0] main_holdingudprx0_liteethudp_next_value3 = 16'd0;
-reg           main_holdingudprx0_liteethudp_next_value_ce3 = 1'd0;
+reg    [15:0] main_holdingudprx0_liteethudp_next_value4 = 16'd0;
+reg           main_holdingudprx0_liteethudp_next_value_ce4 = 1'd0;
 reg    [15:0] main_holdingudprx1 = 16'd0;
-reg    [15:0] main_holdingudprx1_liteethudp_next_value4 = 16'd0;
-reg           main_holdingudprx1_liteethudp_next_value_ce4 = 1'd0;
+reg    [15:0] main_holdingudprx1_liteethudp_next_value5 = 16'd0;
+reg           main_holdingudprx1_liteethudp_next_value_ce5 = 1'd0;
 reg    [15:0] main_holdingudprx2 = 16'd0;
-reg    [15:0] main_holdingudprx2_liteethudp_next_value5 = 16'd0;
-reg           main_holdingudprx2_liteethudp_next_value_ce5 = 1'd0;
+reg    [15:0] main_holdingudprx2_liteethudp_next_value6 = 16'd0;
+reg           main_holdingudprx2_liteethudp_next_value_ce6 = 1'd0;
 reg    [31:0] main_holdingudprx3 = 32'd0;
-reg    [31:0] main_holdingudprx3_liteethudp_next_value6 = 32'd0;
-reg           main_holdingudprx3_liteethudp_next_value_ce6 = 1'd0;
+reg    [31:0] main_holdingudprx3_liteethudp_next_value7 = 32'd0;
+reg           main_holdingudprx3_liteethudp_next_value_ce7 = 1'd0;
 reg    [15:0] main_holdingudprx_count = 16'd0;
 reg    [15:0] main_holdingudprx_count_liteethudp_next_value0 = 16'd0;
 reg           main_holdingudprx_count_liteethudp_next_value_ce0 = 1'd0;
@@ -777,8 +777,8 @@ reg           main_holdingudprx_err_liteethudp_next_value_ce1 = 1'd0;
 reg           main_holdingudprx_fsm_is_ongoing0 = 1'd0;
 reg           main_holdingudprx_fsm_is_ongoing1 = 1'd0;
 reg     [7:0] main_holdingudprx_held = 8'd0;
-reg     [7:0] main_holdingudprx_held_liteethudp_next_value2 = 8'd0;
-reg           main_holdingudprx_held_liteethudp_next_value_ce2 = 1'd0;
+reg     [7:0] main_holdingudprx_held_liteethudp_next_value3 = 8'd0;
+reg           main_holdingudprx_held_liteethudp_next_value_ce3 = 1'd0;
 reg     [2:0] main_holdingudprx_liteethudpdepacketizer_count = 3'd0;
 reg     [2:0] main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
 reg           main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
@@ -825,6 +825,9 @@ reg           main_holdingudprx_liteethudpdepacketizer_sr_shift = 1'd0;
 reg           main_holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
 reg           main_holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
 wire   [15:0] main_holdingudprx_payload_len;
+reg    [15:0] main_holdingudprx_rest = 16'd0;
+reg    [15:0] main_holdingudprx_rest_liteethudp_next_value2 = 16'd0;
+reg           main_holdingudprx_rest_liteethudp_next_value_ce2 = 1'd0;
 wire          main_holdingudprx_sink_first;
 wire          main_holdingudprx_sink_last;
 wire   [31:0] main_holdingudprx_sink_param_ip_address;
@@ -5587,7 +5590,7 @@ assign main_holdingudprx_liteethudpdepacketizer_sink_param_length = main_holding
 assign main_holdingudprx_liteethudpdepacketizer_sink_param_protocol = main_holdingudprx_sink_param_protocol;
 assign main_holdingudprx_liteethudpdepacketizer_sink_param_ip_address = main_holdingudprx_sink_param_ip_address;
 assign main_holdingudprx_payload_len = (main_holdingudprx_liteethudpdepacketizer_source_param_length - 4'd8);
-assign main_holdingudprx_cut1 = ((main_holdingudprx_count + 4'd8) < main_holdingudprx_sink_param_length);
+assign main_holdingudprx_cut1 = (main_holdingudprx_rest != 1'd0);
 assign main_holdingudprx_liteethudpdepacketizer_header = main_holdingudprx_liteethudpdepacketizer_sr;
 assign main_holdingudprx_liteethudpdepacketizer_source_param_checksum = {builder_rhs_slice_proxy69[7:0], builder_rhs_slice_proxy68[15:8]};
 assign main_holdingudprx_liteethudpdepacketizer_source_param_dst_port = {builder_rhs_slice_proxy71[7:0], builder_rhs_slice_proxy70[15:8]};
@@ -5723,22 +5726,24 @@ always @(*) begin
 end
 always @(*) begin
     builder_liteethudp_holdingudprx_next_state <= 3'd0;
-    main_holdingudprx0_liteethudp_next_value3 <= 16'd0;
-    main_holdingudprx0_liteethudp_next_value_ce3 <= 1'd0;
-    main_holdingudprx1_liteethudp_next_value4 <= 16'd0;
-    main_holdingudprx1_liteethudp_next_value_ce4 <= 1'd0;
-    main_holdingudprx2_liteethudp_next_value5 <= 16'd0;
-    main_holdingudprx2_liteethudp_next_value_ce5 <= 1'd0;
-    main_holdingudprx3_liteethudp_next_value6 <= 32'd0;
-    main_holdingudprx3_liteethudp_next_value_ce6 <= 1'd0;
+    main_holdingudprx0_liteethudp_next_value4 <= 16'd0;
+    main_holdingudprx0_liteethudp_next_value_ce4 <= 1'd0;
+    main_holdingudprx1_liteethudp_next_value5 <= 16'd0;
+    main_holdingudprx1_liteethudp_next_value_ce5 <= 1'd0;
+    main_holdingudprx2_liteethudp_next_value6 <= 16'd0;
+    main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd0;
+    main_holdingudprx3_liteethudp_next_value7 <= 32'd0;
+    main_holdingudprx3_liteethudp_next_value_ce7 <= 1'd0;
     main_holdingudprx_count_liteethudp_next_value0 <= 16'd0;
     main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd0;
     main_holdingudprx_drop_header <= 1'd0;
     main_holdingudprx_err_liteethudp_next_value1 <= 1'd0;
     main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd0;
-    main_holdingudprx_held_liteethudp_next_value2 <= 8'd0;
-    main_holdingudprx_held_liteethudp_next_value_ce2 <= 1'd0;
+    main_holdingudprx_held_liteethudp_next_value3 <= 8'd0;
+    main_holdingudprx_held_liteethudp_next_value_ce3 <= 1'd0;
     main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
+    main_holdingudprx_rest_liteethudp_next_value2 <= 16'd0;
+    main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd0;
     main_holdingudprx_source_last <= 1'd0;
     main_holdingudprx_source_param_dst_port <= 16'd0;
     main_holdingudprx_source_param_ip_address <= 32'd0;
@@ -5766,6 +5771,10 @@ always @(*) begin
                 if ((main_holdingudprx_liteethudpdepacketizer_source_valid & main_holdingudprx_source_ready)) begin
                     main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
                     main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    if (main_holdingudprx_cut1) begin
+                        main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
+                        main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    end
                     main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_liteethudpdepacketizer_source_payload_error);
                     main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
                     if (main_holdingudprx_liteethudpdepacketizer_source_last) begin
@@ -5775,20 +5784,24 @@ always @(*) begin
             end else begin
                 main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
                 if (main_holdingudprx_liteethudpdepacketizer_source_valid) begin
-                    main_holdingudprx_held_liteethudp_next_value2 <= main_holdingudprx_liteethudpdepacketizer_source_payload_data;
-                    main_holdingudprx_held_liteethudp_next_value_ce2 <= 1'd1;
+                    main_holdingudprx_held_liteethudp_next_value3 <= main_holdingudprx_liteethudpdepacketizer_source_payload_data;
+                    main_holdingudprx_held_liteethudp_next_value_ce3 <= 1'd1;
                     main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_liteethudpdepacketizer_source_payload_error);
                     main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    main_holdingudprx0_liteethudp_next_value3 <= main_holdingudprx_liteethudpdepacketizer_source_param_src_port;
-                    main_holdingudprx0_liteethudp_next_value_ce3 <= 1'd1;
-                    main_holdingudprx1_liteethudp_next_value4 <= main_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
-                    main_holdingudprx1_liteethudp_next_value_ce4 <= 1'd1;
-                    main_holdingudprx2_liteethudp_next_value5 <= main_holdingudprx_payload_len;
-                    main_holdingudprx2_liteethudp_next_value_ce5 <= 1'd1;
-                    main_holdingudprx3_liteethudp_next_value6 <= main_holdingudprx_sink_param_ip_address;
-                    main_holdingudprx3_liteethudp_next_value_ce6 <= 1'd1;
+                    main_holdingudprx0_liteethudp_next_value4 <= main_holdingudprx_liteethudpdepacketizer_source_param_src_port;
+                    main_holdingudprx0_liteethudp_next_value_ce4 <= 1'd1;
+                    main_holdingudprx1_liteethudp_next_value5 <= main_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+                    main_holdingudprx1_liteethudp_next_value_ce5 <= 1'd1;
+                    main_holdingudprx2_liteethudp_next_value6 <= main_holdingudprx_payload_len;
+                    main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
+                    main_holdingudprx3_liteethudp_next_value7 <= main_holdingudprx_sink_param_ip_address;
+                    main_holdingudprx3_liteethudp_next_value_ce7 <= 1'd1;
                     main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
                     main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    if (main_holdingudprx_cut1) begin
+                        main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
+                        main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    end
                     builder_liteethudp_holdingudprx_next_state <= 2'd2;
                 end
             end
@@ -5800,10 +5813,14 @@ always @(*) begin
                 main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
                 main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
                 main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                if (main_holdingudprx_cut1) begin
+                    main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
+                    main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                end
                 if (main_holdingudprx_liteethudpdepacketizer_source_last) begin
                     if (main_holdingudprx_cut1) begin
-                        main_holdingudprx2_liteethudp_next_value5 <= 1'd0;
-                        main_holdingudprx2_liteethudp_next_value_ce5 <= 1'd1;
+                        main_holdingudprx2_liteethudp_next_value6 <= 1'd0;
+                        main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
                     end
                     builder_liteethudp_holdingudprx_next_state <= 2'd3;
                 end
@@ -5833,6 +5850,12 @@ always @(*) begin
             main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
             main_holdingudprx_err_liteethudp_next_value1 <= 1'd0;
             main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+            main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_sink_param_length - 4'd9);
+            main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            if ((main_holdingudprx_sink_param_length <= 4'd8)) begin
+                main_holdingudprx_rest_liteethudp_next_value2 <= 1'd0;
+                main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            end
             if (main_holdingudprx_liteethudpdepacketizer_source_valid) begin
                 builder_liteethudp_holdingudprx_next_state <= 3'd4;
                 if ((main_holdingudprx_sink_param_protocol == 5'd17)) begin
@@ -6850,20 +6873,23 @@ always @(posedge sys_clk) begin
     if (main_holdingudprx_err_liteethudp_next_value_ce1) begin
         main_holdingudprx_err <= main_holdingudprx_err_liteethudp_next_value1;
     end
-    if (main_holdingudprx_held_liteethudp_next_value_ce2) begin
-        main_holdingudprx_held <= main_holdingudprx_held_liteethudp_next_value2;
+    if (main_holdingudprx_rest_liteethudp_next_value_ce2) begin
+        main_holdingudprx_rest <= main_holdingudprx_rest_liteethudp_next_value2;
     end
-    if (main_holdingudprx0_liteethudp_next_value_ce3) begin
-        main_holdingudprx0 <= main_holdingudprx0_liteethudp_next_value3;
+    if (main_holdingudprx_held_liteethudp_next_value_ce3) begin
+        main_holdingudprx_held <= main_holdingudprx_held_liteethudp_next_value3;
     end
-    if (main_holdingudprx1_liteethudp_next_value_ce4) begin
-        main_holdingudprx1 <= main_holdingudprx1_liteethudp_next_value4;
+    if (main_holdingudprx0_liteethudp_next_value_ce4) begin
+        main_holdingudprx0 <= main_holdingudprx0_liteethudp_next_value4;
     end
-    if (main_holdingudprx2_liteethudp_next_value_ce5) begin
-        main_holdingudprx2 <= main_holdingudprx2_liteethudp_next_value5;
+    if (main_holdingudprx1_liteethudp_next_value_ce5) begin
+        main_holdingudprx1 <= main_holdingudprx1_liteethudp_next_value5;
     end
-    if (main_holdingudprx3_liteethudp_next_value_ce6) begin
-        main_holdingudprx3 <= main_holdingudprx3_liteethudp_next_value6;
+    if (main_holdingudprx2_liteethudp_next_value_ce6) begin
+        main_holdingudprx2 <= main_holdingudprx2_liteethudp_next_value6;
+    end
+    if (main_holdingudprx3_liteethudp_next_value_ce7) begin
+        main_holdingudprx3 <= main_holdingudprx3_liteethudp_next_value7;
     end
     if (builder_liteethudp_first) begin
         builder_liteethudp_sel_ongoing <= builder_liteethudp_sel0;
@@ -6992,6 +7018,7 @@ always @(posedge sys_clk) begin
         main_holdingudprx1 <= 16'd0;
         main_holdingudprx2 <= 16'd0;
         main_holdingudprx3 <= 32'd0;
+        main_holdingudprx_rest <= 16'd0;
         builder_liteethmac_grant <= 1'd0;
         builder_liteethmac_status0_first <= 1'd1;
         builder_liteethmac_status0_ongoing1 <= 1'd0;
