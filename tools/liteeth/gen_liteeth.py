@@ -9,7 +9,7 @@ Run it in a virtual environment of its own (LiteX and Migen are not lab dependen
         -o rosfpga_lab/rtl/fabric/vendor
 
 It builds what LiteEth's own ``liteeth_gen`` builds for ``core: udp`` (PHY, MAC, ARP, IPv4,
-ICMP, UDP), from the same LiteEth classes, with three differences ``liteeth_gen`` has no
+ICMP, UDP), from the same LiteEth classes, with differences ``liteeth_gen`` has no
 configuration key for (so this script, not a YAML file for ``liteeth_gen``), and fixes:
 
 * the node's MAC address, IP address, UDP port and one multicast group are inputs of the core
@@ -36,8 +36,8 @@ configuration key for (so this script, not a YAML file for ``liteeth_gen``), and
 * two one-clock outputs say what the core dropped (``rx_drop_header``: cut inside its Ethernet,
   IPv4 or UDP header, a bad IPv4 header (checksum, version, options, fragment, total length), a
   UDP length above the IPv4 payload; ``rx_drop_other``: not for this node (another MAC or
-  EtherType, another IP address, a protocol not UDP or ICMP, a port outside the mask)): its
-  counters are CSRs, without a bus here;
+  EtherType, another IP address, a protocol not UDP or ICMP, a port outside the mask)), for
+  the lab's counters (LiteEth's are CSRs, without a bus here);
 * the ECP5 RGMII PHY's receiver (``ErrorRGMIIRX``) reads ``rx_ctl``'s second half too (RX_DV xor
   RX_ER): a byte the PHY marks errored is inverted, so the frame's FCS fails (LiteEth's reads
   only RX_DV);

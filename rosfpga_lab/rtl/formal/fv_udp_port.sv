@@ -5,7 +5,8 @@ module fv_udp_port (
     input clk, input rst_n,
     input [7:0] le_rx_data, input le_rx_valid, input le_rx_last, input le_rx_error,
     input [31:0] le_rx_ip, input [15:0] le_rx_src_port, input [15:0] le_rx_dst_port,
-    input [15:0] le_rx_length, input le_rx_drop_header, input le_rx_drop_other, input le_tx_ready, input m_axis_tready,
+    input [15:0] le_rx_length, input le_rx_drop_header, input le_rx_drop_other,
+    input le_tx_ready, input m_axis_tready,
     input [7:0] s_axis_tdata, input s_axis_tvalid, input s_axis_tlast, input [31:0] s_udp_ip,
     input [15:0] s_udp_src_port, input [15:0] s_udp_dst_port
 );
