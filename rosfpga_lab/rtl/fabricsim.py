@@ -62,8 +62,8 @@ SOURCES = (*FABRIC_TOP_GMII, *FABRIC_INCLUDES)
 #: credit, then the generated subscriber's verdicts: samples judged, refused, the last refusal's
 #: status code, the walk's table: ``spec.program.statuses``).
 COUNTERS = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_length",
-            "rx_overflow", "tx_packets", "tx_overflow", "rx_port", "credit", "judged",
-            "refused", "last_refusal")
+            "rx_overflow", "tx_packets", "tx_overflow", "rx_port", "rx_header", "rx_other",
+            "credit", "judged", "refused", "last_refusal")
 #: The simulation's SPDP period in clocks and the clock rate it is run at (clocks per second of
 #: wall time): an announcement about every second, as the board's (rtps.limits.ANNOUNCE_SECONDS
 #: at 125 MHz), if the model keeps up.

@@ -36,9 +36,10 @@ module udp_echo_rgmii #(
     wire tx_valid, tx_ready, tx_last;
     wire [31:0] rx_ip, tx_ip, m_ip;
     wire [15:0] rx_sport, rx_dport, rx_len, tx_sport, tx_dport, tx_len;
+    wire drop_header, drop_other;
     wire [15:0] m_sport, m_dport, m_len;
     wire m_valid, m_ready, m_last;
-    wire [7:0] c_rx, c_err, c_len, c_ovf, c_tx, c_tovf;
+    wire [7:0] c_rx, c_err, c_len, c_ovf, c_tx, c_tovf, c_hdr, c_oth;
 
     liteeth_udp_ecp5_rgmii u_eth (
         .sys_clock(clk), .sys_reset(!rst_n),
@@ -54,13 +55,15 @@ module udp_echo_rgmii #(
         .udp_source_length(rx_len),
         .udp_sink_data(tx_data), .udp_sink_valid(tx_valid), .udp_sink_ready(tx_ready),
         .udp_sink_last(tx_last), .udp_sink_last_be(tx_last), .udp_sink_ip_address(tx_ip),
-        .udp_sink_src_port(tx_sport), .udp_sink_dst_port(tx_dport), .udp_sink_length(tx_len));
+        .udp_sink_src_port(tx_sport), .udp_sink_dst_port(tx_dport), .udp_sink_length(tx_len),
+        .rx_drop_header(drop_header), .rx_drop_other(drop_other));
 
     rfl_udp_port #(.COUNT_BITS(8)) u_port (
         .clk(clk), .rst_n(rst_n),
         .le_rx_data(rx_data), .le_rx_valid(rx_valid), .le_rx_ready(rx_ready),
         .le_rx_last(rx_last), .le_rx_error(rx_error), .le_rx_ip(rx_ip),
         .le_rx_src_port(rx_sport), .le_rx_dst_port(rx_dport), .le_rx_length(rx_len),
+        .le_rx_drop_header(drop_header), .le_rx_drop_other(drop_other),
         .le_tx_data(tx_data), .le_tx_valid(tx_valid), .le_tx_ready(tx_ready),
         .le_tx_last(tx_last), .le_tx_ip(tx_ip), .le_tx_src_port(tx_sport),
         .le_tx_dst_port(tx_dport), .le_tx_length(tx_len),
@@ -71,10 +74,11 @@ module udp_echo_rgmii #(
         .s_axis_tlast(m_last), .s_udp_ip(m_ip), .s_udp_src_port(m_dport),
         .s_udp_dst_port(m_sport),
         .cnt_rx_packets(c_rx), .cnt_rx_error(c_err), .cnt_rx_length(c_len),
-        .cnt_rx_overflow(c_ovf), .cnt_tx_packets(c_tx), .cnt_tx_overflow(c_tovf));
+        .cnt_rx_overflow(c_ovf), .cnt_tx_packets(c_tx), .cnt_tx_overflow(c_tovf),
+        .cnt_rx_header(c_hdr), .cnt_rx_other(c_oth));
 
     assign led_n = |{c_err, c_len, c_ovf, c_tovf};
-    wire unused_ok = &{1'b0, rx_last_be, m_len, c_rx, c_tx};
+    wire unused_ok = &{1'b0, rx_last_be, m_len, c_rx, c_tx, c_hdr, c_oth};
 endmodule
 
 `default_nettype wire

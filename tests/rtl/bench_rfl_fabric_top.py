@@ -22,7 +22,7 @@ from cocotbext.eth import GmiiFrame, GmiiSink, GmiiSource
 
 ETHERTYPE_ARP = b"\x08\x06"
 COUNTERS = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_length",
-            "rx_overflow", "tx_packets", "tx_overflow", "rx_port")
+            "rx_overflow", "tx_packets", "tx_overflow", "rx_port", "rx_header", "rx_other")
 
 
 def _arp_request_for(frame: bytes, ip: bytes) -> bool:

@@ -137,6 +137,6 @@ async def udp_gmii(dut) -> None:
 
     counters = {name: int(getattr(dut, f"cnt_{name}").value) for name in
                 ("rx_packets", "rx_error", "rx_length", "rx_overflow", "tx_packets",
-                 "tx_overflow")}
+                 "tx_overflow", "rx_header", "rx_other")}
     with open(os.environ["UDP_OUT"], "w") as f:
         json.dump({"received": got, "sent": sent, "counters": counters}, f)

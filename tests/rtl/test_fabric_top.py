@@ -161,7 +161,7 @@ def check_sent(sc: Scenario, sent: list[str], counters: dict[str, int]) -> None:
     assert counters == {
         "samples": 1, "answers": len(sc.answers), "no_credit": 0, "rx_packets": 5,
         "rx_error": 2, "rx_length": 0, "rx_overflow": 0, "tx_packets": len(udp),
-        "tx_overflow": 0, "rx_port": 1}
+        "tx_overflow": 0, "rx_port": 1, "rx_header": 0, "rx_other": 0}
 
 
 @pytest.mark.timeout(600)

@@ -7,7 +7,8 @@ then Ethernet/IPv4/UDP frames to the node's IP and port with random payload size
 bytes, padded frames among them) and random gaps, mixed with frames the node must drop: a bad
 FCS, a bad IPv4 header checksum, another destination IP, another unicast MAC, another UDP port, a
 frame cut short (its IP and UDP lengths claim more), an empty datagram, another multicast
-group. Good frames go to the node's IP, broadcast, or the SPDP multicast group, and to any of
+group, IPv4 fragments (MF set, an offset), an IPv4 total length above the frame, below the UDP
+length or below 28, a runt (not padded) that ends inside its Ethernet, IPv4 or UDP header. Good frames go to the node's IP, broadcast, or the SPDP multicast group, and to any of
 its participant's ports (user and metatraffic unicast, SPDP multicast: one masked port).
 Exactly the good payloads must come out, in order, with the sender's IP and ports, and the
 counters must count what ``rfl_udp_port`` says it counts. Then the lab side sends payloads to
@@ -76,7 +77,17 @@ def _arp_request(target: str) -> bytes:
 
 
 KINDS = ["good"] * 8 + ["bcast", "mcast", "bad_fcs", "bad_ipsum", "other_ip", "other_mac",
-                        "other_port", "other_group", "cut"]
+                        "other_port", "other_group", "cut", "more_fragments", "fragment",
+                        "ip_long", "ip_short", "ip_tiny", "runt"]
+
+
+def _with_ip(frame: bytes, **fields: int) -> bytes:
+    """``frame`` (Ethernet/IPv4/UDP) with IPv4 header fields changed, the checksum made good."""
+    ip = IP(frame[14:34])
+    for k, v in fields.items():
+        setattr(ip, k, v)
+    ip.chksum = None
+    return frame[:14] + bytes(ip)[:20] + frame[34:]
 
 
 def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
@@ -85,7 +96,7 @@ def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
     wire = [_fcs(_arp_request(NODE_IP)), _fcs(_arp_request(OTHER_IP))]
     good: list[dict] = []
     counts = {"rx_packets": 0, "rx_error": 0, "rx_length": 0, "rx_overflow": 0,
-              "tx_packets": sends, "tx_overflow": 0}
+              "tx_packets": sends, "tx_overflow": 0, "rx_header": 0, "rx_other": 0}
     kinds = [rng.choice(KINDS) for _ in range(frames)] + sorted(set(KINDS)) + ["empty"]
     rng.shuffle(kinds)
     for kind in kinds:
@@ -112,18 +123,37 @@ def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
         elif kind == "bad_ipsum":
             right = IP(bytes(IP(src=PEER_IP, dst=NODE_IP) / UDP(dport=NODE_PORT) / payload)).chksum
             wire.append(_fcs(_udp(payload, sport=sport, chksum=right ^ 0x0100)))
+            counts["rx_header"] += 1
         elif kind == "other_ip":
             wire.append(_fcs(_udp(payload, sport=sport, ip=OTHER_IP)))
+            counts["rx_other"] += 1
         elif kind == "other_mac":
             wire.append(_fcs(_udp(payload, sport=sport, mac=OTHER_MAC)))
+            counts["rx_other"] += 1
         elif kind == "other_port":                 # just past the ports the mask takes
             wire.append(_fcs(_udp(payload, sport=sport, dport=rng.choice([7391, 7424, 7411 + 32]))))
+            counts["rx_other"] += 1
         elif kind == "other_group":
             wire.append(_fcs(_udp(payload, sport=sport, ip=OTHER_GROUP,
                                   mac=_group_mac(OTHER_GROUP))))
+            counts["rx_other"] += 1
         elif kind == "cut":
             whole = _udp(rng.randbytes(rng.randint(80, 1400)), sport=sport)
             wire.append(_fcs(whole[:len(whole) - rng.randint(1, 40)]))
+            counts["rx_length"] += 1
+        elif kind in ("more_fragments", "fragment", "ip_short", "ip_tiny"):
+            fields = {"more_fragments": {"flags": 1}, "fragment": {"frag": rng.randint(1, 8191)},
+                      "ip_short": {"len": 20 + 8 + size - rng.randint(1, min(size, 8))},
+                      "ip_tiny": {"len": rng.randint(0, 27)}}[kind]
+            wire.append(_fcs(_with_ip(_udp(payload, sport=sport), **fields)))
+            counts["rx_header"] += 1
+        elif kind == "runt":                     # not padded: it ends inside a header
+            body = _udp(payload, sport=sport)[:rng.randint(14, 14 + 20 + 7)]
+            wire.append(body + struct.pack("<I", zlib.crc32(body)))
+            counts["rx_header"] += 1
+        elif kind == "ip_long":                  # the frame (padding aside) ends before it
+            whole = _udp(payload, sport=sport)
+            wire.append(_fcs(_with_ip(whole, len=max(len(whole), 60) - 14 + rng.randint(1, 64))))
             counts["rx_length"] += 1
         else:                                    # empty: LiteEth passes one padding byte
             wire.append(_fcs(_udp(b"", sport=sport)))
@@ -146,6 +176,7 @@ def make_case(seed: int, frames: int, sends: int, gap: int, bp: int) -> dict:
 def test_the_case_is_not_trivial() -> None:
     case = make_case(5, 40, 6, 300, 300)
     assert len(case["good"]) > 15 and case["counts"]["rx_error"] and case["counts"]["rx_length"]
+    assert case["counts"]["rx_header"] >= 5 and case["counts"]["rx_other"] >= 4
     sizes = [len(g["data"]) // 2 for g in case["good"]]
     assert min(sizes) < 18 and max(sizes) > 1000          # padded frames and long ones
     assert {g["dport"] for g in case["good"]} == set(NODE_PORTS)

@@ -45,13 +45,16 @@ module udp_gmii_top #(
     output wire [COUNT_BITS-1:0] cnt_rx_length,
     output wire [COUNT_BITS-1:0] cnt_rx_overflow,
     output wire [COUNT_BITS-1:0] cnt_tx_packets,
-    output wire [COUNT_BITS-1:0] cnt_tx_overflow
+    output wire [COUNT_BITS-1:0] cnt_tx_overflow,
+    output wire [COUNT_BITS-1:0] cnt_rx_header,
+    output wire [COUNT_BITS-1:0] cnt_rx_other
 );
     wire [7:0] rx_data, tx_data;
     wire rx_valid, rx_ready, rx_last, rx_error, rx_last_be;
     wire tx_valid, tx_ready, tx_last;
     wire [31:0] rx_ip, tx_ip;
     wire [15:0] rx_sport, rx_dport, rx_len, tx_sport, tx_dport, tx_len;
+    wire drop_header, drop_other;
 
     liteeth_udp_gmii u_eth (
         .sys_clock(clk), .sys_reset(!rst_n),
@@ -66,7 +69,8 @@ module udp_gmii_top #(
         .udp_source_length(rx_len),
         .udp_sink_data(tx_data), .udp_sink_valid(tx_valid), .udp_sink_ready(tx_ready),
         .udp_sink_last(tx_last), .udp_sink_last_be(tx_last), .udp_sink_ip_address(tx_ip),
-        .udp_sink_src_port(tx_sport), .udp_sink_dst_port(tx_dport), .udp_sink_length(tx_len));
+        .udp_sink_src_port(tx_sport), .udp_sink_dst_port(tx_dport), .udp_sink_length(tx_len),
+        .rx_drop_header(drop_header), .rx_drop_other(drop_other));
 
     wire unused_ok = &{1'b0, rx_last_be};      // 8 bits a beat: the last beat is one byte
 
@@ -76,6 +80,7 @@ module udp_gmii_top #(
         .le_rx_data(rx_data), .le_rx_valid(rx_valid), .le_rx_ready(rx_ready),
         .le_rx_last(rx_last), .le_rx_error(rx_error), .le_rx_ip(rx_ip),
         .le_rx_src_port(rx_sport), .le_rx_dst_port(rx_dport), .le_rx_length(rx_len),
+        .le_rx_drop_header(drop_header), .le_rx_drop_other(drop_other),
         .le_tx_data(tx_data), .le_tx_valid(tx_valid), .le_tx_ready(tx_ready),
         .le_tx_last(tx_last), .le_tx_ip(tx_ip), .le_tx_src_port(tx_sport),
         .le_tx_dst_port(tx_dport), .le_tx_length(tx_len),
@@ -88,7 +93,8 @@ module udp_gmii_top #(
         .s_udp_src_port(s_udp_src_port), .s_udp_dst_port(s_udp_dst_port),
         .cnt_rx_packets(cnt_rx_packets), .cnt_rx_error(cnt_rx_error),
         .cnt_rx_length(cnt_rx_length), .cnt_rx_overflow(cnt_rx_overflow),
-        .cnt_tx_packets(cnt_tx_packets), .cnt_tx_overflow(cnt_tx_overflow));
+        .cnt_tx_packets(cnt_tx_packets), .cnt_tx_overflow(cnt_tx_overflow),
+        .cnt_rx_header(cnt_rx_header), .cnt_rx_other(cnt_rx_other));
 endmodule
 
 `default_nettype wire

@@ -9,8 +9,8 @@ Run it in a virtual environment of its own (LiteX and Migen are not lab dependen
         -o rosfpga_lab/rtl/fabric/vendor
 
 It builds what LiteEth's own ``liteeth_gen`` builds for ``core: udp`` (PHY, MAC, ARP, IPv4,
-ICMP, UDP), from the same LiteEth classes, with three differences ``liteeth_gen`` has no
-configuration key for (so this script, not a YAML file for ``liteeth_gen``), and one fix:
+ICMP, UDP), from the same LiteEth classes, with differences ``liteeth_gen`` has no
+configuration key for (so this script, not a YAML file for ``liteeth_gen``), and fixes:
 
 * the node's MAC address, IP address, UDP port and one multicast group are inputs of the core
   (``mac_address``, ``ip_address``, ``udp_rx_port`` with ``udp_rx_port_mask``: the ports taken
@@ -26,6 +26,21 @@ configuration key for (so this script, not a YAML file for ``liteeth_gen``), and
   receive path never flags a bad FCS: its CRC checker looks at the lanes ``last_be`` enables);
 * the UDP receiver holds a payload's last byte until its frame ends (``HoldingUDPRX``), so a
   padded frame's bad FCS is not lost with the padding LiteEth's own receiver drops;
+* the IPv4 receiver (``CheckingIPRX``) also refuses fragments (MF set or an offset: LiteEth does
+  not reassemble) and a total length below 28 (an IPv4 and a UDP header); the UDP receiver
+  refuses a UDP length above the IPv4 payload (total length - 20), and ends a datagram whose
+  frame is shorter than its IPv4 total length with ``length`` 0 (so ``rfl_udp_port`` counts it
+  cut: its bytes are not its length); a frame longer than it (Ethernet padding) is fine;
+* a frame that ends inside a header is dropped (LiteEth's depacketizers would take the next
+  frame's first bytes as the rest of the header: ``Depacketizer`` patched);
+* two one-clock outputs say what the core dropped (``rx_drop_header``: cut inside its Ethernet,
+  IPv4 or UDP header, a bad IPv4 header (checksum, version, options, fragment, total length), a
+  UDP length above the IPv4 payload; ``rx_drop_other``: not for this node (another MAC or
+  EtherType, another IP address, a protocol not UDP or ICMP, a port outside the mask)), for
+  the lab's counters (LiteEth's are CSRs, without a bus here);
+* the ECP5 RGMII PHY's receiver (``ErrorRGMIIRX``) reads ``rx_ctl``'s second half too (RX_DV xor
+  RX_ER): a byte the PHY marks errored is inverted, so the frame's FCS fails (LiteEth's reads
+  only RX_DV);
 * ``phy: gmii_model`` is LiteEth's GMII PHY in its ``model`` mode (RX and TX clocked by the
   core's clock, no vendor clock buffers): the simulation variant; ``phy: ecp5_rgmii`` is
   ``LiteEthECP5PHYRGMII`` (DELAYG, IDDRX1F, ODDRX1F), the board variant.
@@ -39,17 +54,23 @@ from importlib.metadata import version
 from pathlib import Path
 
 import yaml
-from migen import FSM, If, NextState, NextValue, Signal
+from migen import FSM, Cat, If, NextState, NextValue, Replicate, Signal
+from migen.fhdl.structure import _Assign
 
+import liteeth.core.ip
 import liteeth.core.udp
 import liteeth.mac
-from liteeth.common import eth_ipv4_user_description, eth_udp_user_description, udp_header, \
-    udp_protocol
+import liteeth.packet
+import liteeth.phy.ecp5rgmii
+from liteeth.common import eth_ipv4_user_description, eth_udp_user_description, \
+    ipv4_header_length, udp_header, udp_protocol
+from liteeth.core.ip import LiteEthIPRX, LiteEthIPV4Crossbar
 from liteeth.core.udp import LiteEthUDPCrossbar, LiteEthUDPDepacketizer
 from liteeth import phy as liteeth_phys
 from liteeth.core import LiteEthUDPIPCore
 from liteeth.gen import _io, get_udp_raw_port_ios
 from liteeth.mac.common import LiteEthMACCrossbar
+from liteeth.phy.ecp5rgmii import LiteEthPHYRGMIIRX
 from litex.build.generic_platform import Pins, Subsignal
 from litex.build.io import CRG
 from litex.build.lattice.platform import LatticePlatform
@@ -75,10 +96,49 @@ PADS = [
     ("udp_rx_port", 0, Pins(16)),
     ("udp_rx_port_mask", 0, Pins(16)),
     ("ip_multicast", 0, Pins(32)),
+    ("rx_drop_header", 0, Pins(1)),
+    ("rx_drop_other", 0, Pins(1)),
 ]
+MIN_IPV4_UDP = ipv4_header_length + udp_header.length   # the least total length taken: 28
 
 
-class FilteringMACCrossbar(LiteEthMACCrossbar):
+class DropSaying:
+    """A LiteEth crossbar that says when its dispatcher gave a packet no port (its ``default``
+    case takes it): ``dropped``, one clock at the packet's last beat. Mixed in before the
+    crossbar's class; ``do_finalize`` after the parent's."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)
+        self.dropped = Signal()
+
+    def do_finalize(self) -> None:
+        super().do_finalize()
+        sink = self.master.sink
+        taken = Signal()
+        self.comb += [
+            taken.eq(sum(port.source.valid for port in self.users.values()) != 0),
+            self.dropped.eq(sink.valid & sink.ready & sink.last & ~taken),
+        ]
+
+
+_depacketizer_init = liteeth.packet.Depacketizer.__init__
+
+
+def _cut_dropping_init(self: object, *args: object, **kwargs: object) -> None:
+    """LiteEth's depacketizer, but a frame that ends inside the header is dropped (``cut``: one
+    clock): LiteEth's only leaves the header state once the header is whole, so it would take
+    the next frame's first bytes as the rest of this header."""
+    _depacketizer_init(self, *args, **kwargs)
+    sink, fsm = self.sink, self.fsm
+    self.cut = Signal()
+    self.comb += self.cut.eq(sink.valid & sink.last &
+                             (fsm.ongoing("IDLE") | fsm.ongoing("HEADER-RECEIVE")))
+    # the later assignment wins in Migen: back to IDLE, the partial header forgotten
+    fsm.act("IDLE", If(sink.valid & sink.last, NextState("IDLE")))
+    fsm.act("HEADER-RECEIVE", If(sink.valid & sink.last, NextState("IDLE")))
+
+
+class FilteringMACCrossbar(DropSaying, LiteEthMACCrossbar):
     """LiteEth's MAC crossbar, dispatching only frames for our MAC, broadcast or IPv4 multicast.
 
     A frame for another station gets no user port: LiteX's Dispatcher then drops it (its
@@ -97,7 +157,44 @@ class FilteringMACCrossbar(LiteEthMACCrossbar):
         self.comb += If(~ours, self.dispatcher.sel.eq(0))
 
 
-class MaskedUDPCrossbar(LiteEthUDPCrossbar):
+class CountingIPCrossbar(DropSaying, LiteEthIPV4Crossbar):
+    """LiteEth's IPv4 crossbar, saying when it drops a datagram (a protocol not UDP or ICMP)."""
+
+
+class CheckingIPRX(LiteEthIPRX):
+    """LiteEth's IPv4 receiver, refusing also fragments (MF set or a fragment offset: LiteEth
+    does not reassemble) and a total length below an IPv4 and a UDP header; ``drop_header`` and
+    ``drop_other`` (one clock) say it refused a datagram for its header or for its address."""
+
+    def __init__(self, mac_address: object, ip_address: object, with_broadcast: object = True,
+                 dw: int = 8) -> None:
+        super().__init__(mac_address, ip_address, with_broadcast, dw)
+        dep, fsm = self.depacketizer, self.fsm
+        src = dep.source
+        header = dep.header                      # byte k at bits 8k..8k+7
+        more = header[6 * 8 + 5]                 # flags: MF
+        offset = Signal(13)
+        self.comb += offset.eq(Cat(header[7 * 8:8 * 8], header[6 * 8:6 * 8 + 5]))
+        header_ok = Signal()
+        ours = Signal()
+        self.comb += [
+            header_ok.eq((src.version == 0x4) & (src.ihl == 0x5) & (self.checksum.value == 0) &
+                         ~more & (offset == 0) & (src.total_length >= MIN_IPV4_UDP)),
+            ours.eq((src.target_ip == ip_address) | with_broadcast),
+        ]
+        decide = Signal()
+        self.comb += decide.eq(fsm.ongoing("IDLE") & src.valid & self.checksum.done)
+        # LiteEth's IDLE goes to RECEIVE on its own checks; the later assignment wins
+        fsm.act("IDLE", If(decide & ~(header_ok & ours), NextState("DROP")))
+        self.drop_header = Signal()
+        self.drop_other = Signal()
+        self.comb += [
+            self.drop_header.eq(decide & ~header_ok),
+            self.drop_other.eq(decide & header_ok & ~ours),
+        ]
+
+
+class MaskedUDPCrossbar(DropSaying, LiteEthUDPCrossbar):
     """LiteEth's UDP crossbar with its one user port taking every destination port equal to
     the port's key on the bits of ``mask`` (an RTPS participant listens on several: the SPDP
     multicast port, its metatraffic and its user-data unicast ports; the sideband says which)."""
@@ -112,11 +209,36 @@ class MaskedUDPCrossbar(LiteEthUDPCrossbar):
         self.comb += If(((dst ^ key) & self.mask) == 0, self.dispatcher.sel.eq(1))
 
 
+class ErrorRGMIIRX(LiteEthPHYRGMIIRX):
+    """LiteEth's ECP5 RGMII receiver, with RGMII's receive error: ``rx_ctl`` carries RX_DV on the
+    clock's rising edge and RX_DV xor RX_ER on its falling edge (IDDRX1F's two outputs, LiteEth
+    reads the first only); a byte with RX_DV and RX_ER is inverted, so its frame's FCS fails
+    (CRC-32 finds any one bad byte), as rfl_fabric_top does for GMII's rx_er. Found in LiteEth's
+    statements (their names are local): the one registering ``source.valid`` from the rising
+    edge's half of ``rx_ctl``, the one registering ``source.data``.
+    """
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)
+        sync = self._fragment.sync["sys"]
+        valid = [st for st in sync if isinstance(st, _Assign) and st.l is self.source.valid]
+        data = [st for st in sync if isinstance(st, _Assign) and st.l is self.source.data]
+        assert len(valid) == 1 and len(data) == 1, "LiteEth's RGMII receiver changed"
+        ctl = valid[0].r.value                  # rx_ctl_reg: [0] rising edge, [1] falling
+        assert len(ctl) == 2 and valid[0].r.start == 0, "LiteEth's RGMII receiver changed"
+        errored = Signal()
+        self.comb += errored.eq(ctl[0] & ~ctl[1])         # RX_DV and (RX_DV xor RX_ER) = 0
+        data[0].r = data[0].r ^ Replicate(errored, 8)
+
+
 class HoldingUDPRX(LiteXModule):
     """LiteEth's UDP receiver (8 bits), but a payload shorter than its frame (Ethernet padding,
     trailing bytes) keeps its last byte until the frame ends, so that the frame's error (a bad
     FCS, known at its end) comes with it. LiteEth's own ends the payload at the UDP length and
     drops the rest, error included: a padded frame with a bad FCS would pass as good.
+    Also refused: a UDP length above the IPv4 payload (``drop_header``, one clock); a frame
+    shorter than its IPv4 total length ends its payload with ``length`` 0 (its bytes are not its
+    length: the lab's port drops and counts it as cut).
     """
 
     def __init__(self, ip_address: object, dw: int = 8) -> None:
@@ -131,11 +253,26 @@ class HoldingUDPRX(LiteXModule):
         held = Signal(8)
         sport, dport, length, ip = Signal(16), Signal(16), Signal(16), Signal(32)
         payload_len = Signal(16)
-        self.comb += payload_len.eq(d.length - udp_header.length)
+        # bytes of the IPv4 payload after this beat (a register: no arithmetic between the
+        # IPv4 header and the payload's length, LiteEth's long paths are there already); the
+        # frame ends before its IPv4 payload if its last beat leaves some
+        rest = Signal(16)
+        cut = Signal()
+        self.comb += [
+            payload_len.eq(d.length - udp_header.length),
+            cut.eq(rest != 0),
+        ]
+        take = [NextValue(count, count + 1), If(cut, NextValue(rest, rest - 1))]
+        self.drop_header = Signal()
         self.fsm = fsm = FSM(reset_state="IDLE")
         fsm.act("IDLE",
             NextValue(count, 1), NextValue(err, 0),
-            If(d.valid, NextState("DROP"), If(sink.protocol == udp_protocol, NextState("RECEIVE"))))
+            NextValue(rest, sink.length - (udp_header.length + 1)),
+            If(sink.length <= udp_header.length, NextValue(rest, 0)),
+            If(d.valid, NextState("DROP"),
+                If(sink.protocol == udp_protocol,
+                    If(d.length > sink.length, self.drop_header.eq(1)
+                    ).Else(NextState("RECEIVE")))))
         fsm.act("RECEIVE",
             source.src_port.eq(d.src_port), source.dst_port.eq(d.dst_port),
             source.length.eq(payload_len), source.ip_address.eq(sink.ip_address),
@@ -143,8 +280,9 @@ class HoldingUDPRX(LiteXModule):
             If(d.last | (count < payload_len),
                 source.valid.eq(d.valid), d.ready.eq(source.ready),
                 source.last.eq(d.last), source.error.eq(d.error | err),
+                If(d.last & cut, source.length.eq(0)),
                 If(d.valid & source.ready,
-                    NextValue(count, count + 1), NextValue(err, err | d.error),
+                    *take, NextValue(err, err | d.error),
                     If(d.last, NextState("IDLE"))),
             ).Else(                              # the payload's last byte, the frame goes on
                 d.ready.eq(1),
@@ -152,10 +290,12 @@ class HoldingUDPRX(LiteXModule):
                     NextValue(held, d.data), NextValue(err, err | d.error),
                     NextValue(sport, d.src_port), NextValue(dport, d.dst_port),
                     NextValue(length, payload_len), NextValue(ip, sink.ip_address),
+                    *take,
                     NextState("HOLD"))))
         fsm.act("HOLD",
             d.ready.eq(1),
-            If(d.valid, NextValue(err, err | d.error), If(d.last, NextState("EMIT"))))
+            If(d.valid, NextValue(err, err | d.error), *take,
+                If(d.last, If(cut, NextValue(length, 0)), NextState("EMIT"))))
         fsm.act("EMIT",
             source.valid.eq(1), source.last.eq(1), source.data.eq(held), source.error.eq(err),
             source.src_port.eq(sport), source.dst_port.eq(dport), source.length.eq(length),
@@ -209,6 +349,15 @@ class UDPPortCore(SoCMini):
 
         target = self.core.ip.rx.depacketizer.source.target_ip
         self.comb += take_group.eq(target == ip_multicast)
+        ip_rx, udp_rx = self.core.ip.rx, self.core.udp.rx
+        self.comb += [
+            platform.request("rx_drop_header").eq(
+                self.core.mac.depacketizer.cut | ip_rx.depacketizer.cut | ip_rx.drop_header |
+                udp_rx.depacketizer.cut | udp_rx.drop_header),
+            platform.request("rx_drop_other").eq(
+                self.core.mac.crossbar.dropped | ip_rx.drop_other | self.core.ip.crossbar.dropped |
+                self.core.udp.crossbar.dropped),
+        ]
         rx_port = platform.request("udp_rx_port")
         platform.add_extension(get_udp_raw_port_ios("udp", data_width=8))
         pads = platform.request("udp")
@@ -239,6 +388,10 @@ def main() -> None:
     cfg = yaml.safe_load(Path(args.config).read_text())
     name = cfg["name"]
     liteeth.mac.LiteEthMACCrossbar = FilteringMACCrossbar   # before the core is built
+    liteeth.packet.Depacketizer.__init__ = _cut_dropping_init
+    liteeth.core.ip.LiteEthIPRX = CheckingIPRX
+    liteeth.core.ip.LiteEthIPV4Crossbar = CountingIPCrossbar
+    liteeth.phy.ecp5rgmii.LiteEthPHYRGMIIRX = ErrorRGMIIRX
     liteeth.core.udp.LiteEthUDPRX = HoldingUDPRX
     liteeth.core.udp.LiteEthUDPCrossbar = MaskedUDPCrossbar
     platform = LatticePlatform(cfg["device"], io=[], toolchain="trellis")

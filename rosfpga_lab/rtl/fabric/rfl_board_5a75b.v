@@ -85,6 +85,7 @@ module rfl_board_5a75b #(
     wire [15:0] credit;
     wire [31:0] cnt_samples, cnt_answers, cnt_no_credit, cnt_rx_error, cnt_rx_length,
                 cnt_rx_overflow, cnt_tx_packets, cnt_tx_overflow, cnt_rx_port;
+    wire [31:0] cnt_rx_header, cnt_rx_other;
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_fabric_top #(
 `include "rfl_fabric_top_pass.vh"
@@ -99,7 +100,7 @@ module rfl_board_5a75b #(
         .cnt_rx_packets(cnt_rx_packets), .cnt_rx_error(cnt_rx_error),
         .cnt_rx_length(cnt_rx_length), .cnt_rx_overflow(cnt_rx_overflow),
         .cnt_tx_packets(cnt_tx_packets), .cnt_tx_overflow(cnt_tx_overflow),
-        .cnt_rx_port(cnt_rx_port));
+        .cnt_rx_port(cnt_rx_port), .cnt_rx_header(cnt_rx_header), .cnt_rx_other(cnt_rx_other));
 
     assign led_n = cnt_rx_packets == 32'd0;
 endmodule

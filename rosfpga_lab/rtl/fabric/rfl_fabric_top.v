@@ -66,7 +66,9 @@ module rfl_fabric_top #(
     output wire [31:0]  cnt_rx_overflow,
     output wire [31:0]  cnt_tx_packets,
     output wire [31:0]  cnt_tx_overflow,
-    output wire [31:0]  cnt_rx_port             // datagrams to another port LiteEth passed
+    output wire [31:0]  cnt_rx_port,            // datagrams to another port LiteEth passed
+    output wire [31:0]  cnt_rx_header,          // rfl_udp_port's: frames LiteEth dropped
+    output wire [31:0]  cnt_rx_other
 );
     // 0: unset (the defaults), refused outside a proof: Yosys elaborates a file's defaults when
     // it reads it, the proof sets them
@@ -109,6 +111,7 @@ module rfl_fabric_top #(
     wire [7:0] le_rx_data, le_tx_data;
     wire le_rx_valid, le_rx_ready, le_rx_last, le_rx_error, le_rx_last_be;
     wire le_tx_valid, le_tx_ready, le_tx_last;
+    wire le_drop_header, le_drop_other;
     wire [31:0] le_rx_ip, le_tx_ip;
     wire [15:0] le_rx_sport, le_rx_dport, le_rx_len, le_tx_sport, le_tx_dport, le_tx_len;
 `ifdef RFL_FABRIC_RGMII
@@ -139,7 +142,8 @@ module rfl_fabric_top #(
         .udp_sink_data(le_tx_data), .udp_sink_valid(le_tx_valid), .udp_sink_ready(le_tx_ready),
         .udp_sink_last(le_tx_last), .udp_sink_last_be(le_tx_last),
         .udp_sink_ip_address(le_tx_ip), .udp_sink_src_port(le_tx_sport),
-        .udp_sink_dst_port(le_tx_dport), .udp_sink_length(le_tx_len));
+        .udp_sink_dst_port(le_tx_dport), .udp_sink_length(le_tx_len),
+        .rx_drop_header(le_drop_header), .rx_drop_other(le_drop_other));
 
     // ---- rfl_udp_port: whole payloads each way
     wire [7:0] p_rx_tdata, p_tx_tdata;
@@ -157,6 +161,7 @@ module rfl_fabric_top #(
         .le_rx_data(le_rx_data), .le_rx_valid(le_rx_valid), .le_rx_ready(le_rx_ready),
         .le_rx_last(le_rx_last), .le_rx_error(le_rx_error), .le_rx_ip(le_rx_ip),
         .le_rx_src_port(le_rx_sport), .le_rx_dst_port(le_rx_dport), .le_rx_length(le_rx_len),
+        .le_rx_drop_header(le_drop_header), .le_rx_drop_other(le_drop_other),
         .le_tx_data(le_tx_data), .le_tx_valid(le_tx_valid), .le_tx_ready(le_tx_ready),
         .le_tx_last(le_tx_last), .le_tx_ip(le_tx_ip), .le_tx_src_port(le_tx_sport),
         .le_tx_dst_port(le_tx_dport), .le_tx_length(le_tx_len),
@@ -168,7 +173,8 @@ module rfl_fabric_top #(
         .s_udp_dst_port(p_tx_dport),
         .cnt_rx_packets(cnt_rx_packets), .cnt_rx_error(cnt_rx_error),
         .cnt_rx_length(cnt_rx_length), .cnt_rx_overflow(cnt_rx_overflow),
-        .cnt_tx_packets(cnt_tx_packets), .cnt_tx_overflow(cnt_tx_overflow));
+        .cnt_tx_packets(cnt_tx_packets), .cnt_tx_overflow(cnt_tx_overflow),
+        .cnt_rx_header(cnt_rx_header), .cnt_rx_other(cnt_rx_other));
 
     // ---- received: the kind from the destination port (held by rfl_udp_port for the packet)
     wire to_user = p_rx_dport == USER;

@@ -10,8 +10,10 @@
 // length without saying when the frame was shorter. Dropped and counted here: le_rx_error
 // (cnt_rx_error), a payload whose bytes are not its UDP length (cnt_rx_length: a truncated
 // datagram, or an empty one, which LiteEth passes as one padding byte), no room in the
-// 2**RX_BITS-byte buffer (cnt_rx_overflow). What LiteEth drops before (another MAC or IP, a bad
-// IPv4 checksum, another port) is not counted: the core's counters are CSRs without a bus here.
+// 2**RX_BITS-byte buffer (cnt_rx_overflow). What LiteEth drops before, it says with a pulse,
+// counted here: le_rx_drop_header (cnt_rx_header: a frame cut inside its headers, a bad IPv4
+// header, a fragment, lengths that disagree; the generated core's header says which),
+// le_rx_drop_other (cnt_rx_other: not for this node: another MAC, IP, protocol or port).
 // Sent (s_axis_*; s_udp_* read with the TLAST beat): each payload is stored whole (its length
 // goes in the UDP header before its bytes), then given to LiteEth, which resolves the peer's MAC
 // by ARP (a peer that does not answer: the datagram is dropped by LiteEth) and sends
@@ -37,6 +39,8 @@ module rfl_udp_port #(
     input  wire [15:0]           le_rx_src_port,
     input  wire [15:0]           le_rx_dst_port,
     input  wire [15:0]           le_rx_length,  // the UDP length - 8
+    input  wire                  le_rx_drop_header, // one clock a frame LiteEth dropped
+    input  wire                  le_rx_drop_other,
     output wire [7:0]            le_tx_data,
     output wire                  le_tx_valid,
     input  wire                  le_tx_ready,
@@ -67,7 +71,9 @@ module rfl_udp_port #(
     output wire [COUNT_BITS-1:0] cnt_rx_length,     // payload bytes != UDP length - 8
     output wire [COUNT_BITS-1:0] cnt_rx_overflow,   // no room
     output wire [COUNT_BITS-1:0] cnt_tx_packets,    // payloads taken whole, to be sent
-    output wire [COUNT_BITS-1:0] cnt_tx_overflow    // longer than the send buffer
+    output wire [COUNT_BITS-1:0] cnt_tx_overflow,   // longer than the send buffer
+    output wire [COUNT_BITS-1:0] cnt_rx_header,     // dropped by LiteEth: its headers
+    output wire [COUNT_BITS-1:0] cnt_rx_other       // dropped by LiteEth: not for us
 );
 `ifdef __ICARUS__
     initial begin
@@ -122,7 +128,7 @@ module rfl_udp_port #(
         .m_len(le_tx_length), .done_keep(tx_keep), .done_drop(tx_drop), .done_user(tx_user));
 
     // ---- counters (saturating) --------------------------------------------------------------
-    reg [COUNT_BITS-1:0] c_rx, c_err, c_len, c_ovf, c_tx, c_tovf;
+    reg [COUNT_BITS-1:0] c_rx, c_err, c_len, c_ovf, c_tx, c_tovf, c_hdr, c_oth;
     wire [COUNT_BITS-1:0] top = {COUNT_BITS{1'b1}};
     wire rx_fin = rx_take && le_rx_last;
     always @(posedge clk) begin
@@ -133,6 +139,8 @@ module rfl_udp_port #(
             c_ovf <= {COUNT_BITS{1'b0}};
             c_tx <= {COUNT_BITS{1'b0}};
             c_tovf <= {COUNT_BITS{1'b0}};
+            c_hdr <= {COUNT_BITS{1'b0}};
+            c_oth <= {COUNT_BITS{1'b0}};
         end else begin
             if (rx_keep && c_rx != top) c_rx <= c_rx + 1'b1;
             if (rx_fin && rx_err && c_err != top) c_err <= c_err + 1'b1;
@@ -140,6 +148,8 @@ module rfl_udp_port #(
             if (rx_drop && !rx_user && c_ovf != top) c_ovf <= c_ovf + 1'b1;
             if (tx_keep && c_tx != top) c_tx <= c_tx + 1'b1;
             if (tx_drop && !tx_user && c_tovf != top) c_tovf <= c_tovf + 1'b1;
+            if (le_rx_drop_header && c_hdr != top) c_hdr <= c_hdr + 1'b1;
+            if (le_rx_drop_other && c_oth != top) c_oth <= c_oth + 1'b1;
         end
     end
     assign cnt_rx_packets = c_rx;
@@ -148,6 +158,8 @@ module rfl_udp_port #(
     assign cnt_rx_overflow = c_ovf;
     assign cnt_tx_packets = c_tx;
     assign cnt_tx_overflow = c_tovf;
+    assign cnt_rx_header = c_hdr;
+    assign cnt_rx_other = c_oth;
 endmodule
 
 `default_nettype wire

@@ -45,11 +45,13 @@ module rfl_fabric_top #(
     output status_valid, output [7:0] status, output [15:0] credit, output [31:0] cnt_samples,
     output [31:0] cnt_answers, output [31:0] cnt_no_credit, output [31:0] cnt_rx_packets,
     output [31:0] cnt_rx_error, output [31:0] cnt_rx_length, output [31:0] cnt_rx_overflow,
-    output [31:0] cnt_tx_packets, output [31:0] cnt_tx_overflow, output [31:0] cnt_rx_port
+    output [31:0] cnt_tx_packets, output [31:0] cnt_tx_overflow, output [31:0] cnt_rx_port,
+    output [31:0] cnt_rx_header, output [31:0] cnt_rx_other
 );
     assign {rgmii_tx_clk, rgmii_tx_ctl, rgmii_txd, status_valid, status, credit} = 31'd0;
     assign {cnt_samples, cnt_answers, cnt_no_credit, cnt_rx_error, cnt_rx_length} = 160'd0;
     assign {cnt_rx_overflow, cnt_tx_packets, cnt_tx_overflow, cnt_rx_port} = 128'd0;
+    assign {cnt_rx_header, cnt_rx_other} = 64'd0;
     assign cnt_rx_packets = {rgmii_rxd, 27'd0, rgmii_rx_ctl};
     reg [7:0] t = 8'd0;                         // clocks since the start
     reg [7:0] k = 8'd0;                         // clocks out of reset

@@ -25,7 +25,7 @@ module fv_fabric_top (
     wire [7:0] gmii_txd, status;
     wire gmii_tx_en, gmii_tx_er, status_valid;
     wire [15:0] credit;
-    wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9;
+    wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11;
     rfl_fabric_top #(.SPDP_PORT(`FV_SPDP), .META_PORT(`FV_META), .USER_PORT(`FV_USER),
                      .SPDP_GROUP(`FV_GROUP), .RX_BITS(4), .TX_BITS(4), .QUEUE_BITS(1)) dut (
         .clk(clk), .rst_n(rst_n), .cfg_mac(cfg_mac), .cfg_ip(cfg_ip),
@@ -37,7 +37,7 @@ module fv_fabric_top (
         .status_valid(status_valid), .status(status), .credit(credit),
         .cnt_samples(c0), .cnt_answers(c1), .cnt_no_credit(c2), .cnt_rx_packets(c3),
         .cnt_rx_error(c4), .cnt_rx_length(c5), .cnt_rx_overflow(c6), .cnt_tx_packets(c7),
-        .cnt_tx_overflow(c8), .cnt_rx_port(c9));
+        .cnt_tx_overflow(c8), .cnt_rx_port(c9), .cnt_rx_header(c10), .cnt_rx_other(c11));
 endmodule
 
 // LiteEth's UDP port as seen by rfl_fabric_top: any received datagrams (the first byte: the low
@@ -53,7 +53,8 @@ module liteeth_udp_gmii (
     output [15:0] udp_source_dst_port, output [15:0] udp_source_length,
     input [7:0] udp_sink_data, input udp_sink_valid, output udp_sink_ready,
     input udp_sink_last, input udp_sink_last_be, input [31:0] udp_sink_ip_address,
-    input [15:0] udp_sink_src_port, input [15:0] udp_sink_dst_port, input [15:0] udp_sink_length
+    input [15:0] udp_sink_src_port, input [15:0] udp_sink_dst_port, input [15:0] udp_sink_length,
+    output rx_drop_header, output rx_drop_other
 );
     wire clk = sys_clock;
     wire rst_n = !sys_reset;
@@ -61,6 +62,9 @@ module liteeth_udp_gmii (
     (* anyseq *) reg rx_valid, rx_last, rx_error, tx_ready;
     (* anyseq *) reg [31:0] rx_ip;
     (* anyseq *) reg [15:0] rx_sport, rx_dport, rx_length;
+    (* anyseq *) reg drop_header, drop_other;
+    assign rx_drop_header = drop_header;
+    assign rx_drop_other = drop_other;
     assign udp_source_data = rx_data;
     assign udp_source_valid = rx_valid;
     assign udp_source_last = rx_last;

@@ -150,14 +150,14 @@ struct Fabric {
     }
 
     void counters() {
-        uint32_t c[14] = {top->cnt_samples, top->cnt_answers, top->cnt_no_credit,
+        uint32_t c[16] = {top->cnt_samples, top->cnt_answers, top->cnt_no_credit,
                           top->cnt_rx_packets, top->cnt_rx_error, top->cnt_rx_length,
                           top->cnt_rx_overflow, top->cnt_tx_packets, top->cnt_tx_overflow,
-                          top->cnt_rx_port, (uint32_t)top->credit, statuses, refused,
-                          last_status};
+                          top->cnt_rx_port, top->cnt_rx_header, top->cnt_rx_other,
+                          (uint32_t)top->credit, statuses, refused, last_status};
         uint8_t out[8 + sizeof c];
         for (int i = 0; i < 8; ++i) out[i] = (uint8_t)(clocks >> (8 * i));
-        for (int k = 0; k < 14; ++k)
+        for (int k = 0; k < 16; ++k)
             for (int i = 0; i < 4; ++i) out[8 + 4 * k + i] = (uint8_t)(c[k] >> (8 * i));
         put_record('K', out, sizeof out);
         node_counters();

@@ -45,7 +45,7 @@ module tb;
     wire tx_er;
     /* verilator lint_off UNUSEDSIGNAL */
     wire [15:0] credit;
-    wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9;
+    wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11;
     /* verilator lint_on UNUSEDSIGNAL */
 
     rfl_fabric_top #(`RFL_DEMO_PARAMS) dut (
@@ -58,7 +58,7 @@ module tb;
         .status_valid(status_valid), .status(status), .credit(credit),
         .cnt_samples(c0), .cnt_answers(c1), .cnt_no_credit(c2), .cnt_rx_packets(c3),
         .cnt_rx_error(c4), .cnt_rx_length(c5), .cnt_rx_overflow(c6), .cnt_tx_packets(c7),
-        .cnt_tx_overflow(c8), .cnt_rx_port(c9));
+        .cnt_tx_overflow(c8), .cnt_rx_port(c9), .cnt_rx_header(c10), .cnt_rx_other(c11));
 
     // frame 0 the ARP reply, frames 1.. the input; each a length, then its bytes
     reg [7:0] mem [0:`RFL_DEMO_BYTES-1];

@@ -28,6 +28,8 @@ module liteeth_udp_ecp5_rgmii (
     input  wire    [3:0] rgmii_pads_rx_data,
     output wire          rgmii_pads_tx_ctl,
     output wire    [3:0] rgmii_pads_tx_data,
+    output wire          rx_drop_header,
+    output wire          rx_drop_other,
     input  wire          sys_clock,
     input  wire          sys_reset,
     input  wire   [15:0] udp_rx_port,
@@ -75,7 +77,7 @@ UDPPortCore
 │    │    └─── [DELAYG]
 │    │    └─── [DELAYG]
 │    │    └─── [DELAYG]
-│    └─── rx (LiteEthPHYRGMIIRX)
+│    └─── rx (ErrorRGMIIRX)
 │    │    └─── [DELAYG]
 │    │    └─── [DELAYG]
 │    │    └─── [DELAYG]
@@ -165,13 +167,13 @@ UDPPortCore
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
 │    │    │    └─── fsm (FSM)
-│    │    └─── rx (LiteEthIPRX)
+│    │    └─── rx (CheckingIPRX)
 │    │    │    └─── depacketizer (LiteEthIPV4Depacketizer)
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
 │    │    │    └─── checksum (LiteEthIPV4Checksum)
 │    │    │    └─── fsm (FSM)
-│    │    └─── crossbar (LiteEthIPV4Crossbar)
+│    │    └─── crossbar (CountingIPCrossbar)
 │    │    │    └─── arbiter (Arbiter)
 │    │    │    │    └─── rr (RoundRobin)
 │    │    │    │    └─── status_0* (Status)
@@ -240,8 +242,8 @@ UDPPortCore
 └─── [ODDRX1F]
 └─── [ODDRX1F]
 └─── [ODDRX1F]
-└─── [IDDRX1F]
 └─── [ODDRX1F]
+└─── [IDDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
@@ -255,6 +257,9 @@ UDPPortCore
 //------------------------------------------------------------------------------
 
 wire   [13:0] adr;
+reg     [5:0] arp_counter = 6'd0;
+reg     [5:0] arp_counter_liteetharp_next_value = 6'd0;
+reg           arp_counter_liteetharp_next_value_ce = 1'd0;
 wire          arp_mac_port_sink_first;
 wire          arp_mac_port_sink_last;
 wire    [7:0] arp_mac_port_sink_payload_data;
@@ -275,77 +280,145 @@ reg    [47:0] arp_mac_port_source_payload_sender_mac = 48'd0;
 reg    [47:0] arp_mac_port_source_payload_target_mac = 48'd0;
 wire          arp_mac_port_source_ready;
 reg           arp_mac_port_source_valid = 1'd0;
-reg     [4:0] arp_rx_depacketizer_count = 5'd0;
-reg     [4:0] arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 = 5'd0;
-reg           arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 = 1'd0;
-reg           arp_rx_depacketizer_delayed_last_be = 1'd0;
-reg           arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value1 = 1'd0;
-reg           arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 = 1'd0;
-reg           arp_rx_depacketizer_fsm_from_idle = 1'd0;
-reg           arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 = 1'd0;
-reg           arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 = 1'd0;
-wire  [223:0] arp_rx_depacketizer_header;
-wire          arp_rx_depacketizer_is_in_copy;
-reg           arp_rx_depacketizer_is_ongoing0 = 1'd0;
-reg           arp_rx_depacketizer_is_ongoing1 = 1'd0;
-reg           arp_rx_depacketizer_is_ongoing2 = 1'd0;
-reg           arp_rx_depacketizer_is_ongoing3 = 1'd0;
-wire          arp_rx_depacketizer_new_last_be;
-reg           arp_rx_depacketizer_sink_d_last = 1'd0;
-wire          arp_rx_depacketizer_sink_first;
-wire          arp_rx_depacketizer_sink_last;
-wire          arp_rx_depacketizer_sink_last_be;
-wire    [7:0] arp_rx_depacketizer_sink_payload_data;
-wire          arp_rx_depacketizer_sink_payload_error;
-wire   [15:0] arp_rx_depacketizer_sink_payload_ethernet_type;
-wire          arp_rx_depacketizer_sink_payload_last_be;
-wire   [47:0] arp_rx_depacketizer_sink_payload_sender_mac;
-wire   [47:0] arp_rx_depacketizer_sink_payload_target_mac;
-reg           arp_rx_depacketizer_sink_ready = 1'd0;
-wire          arp_rx_depacketizer_sink_valid;
-reg           arp_rx_depacketizer_source_last = 1'd0;
-reg           arp_rx_depacketizer_source_last_a = 1'd0;
-reg           arp_rx_depacketizer_source_last_b = 1'd0;
-reg           arp_rx_depacketizer_source_last_s = 1'd0;
-wire    [7:0] arp_rx_depacketizer_source_param_hwsize;
-wire   [15:0] arp_rx_depacketizer_source_param_hwtype;
-wire   [15:0] arp_rx_depacketizer_source_param_opcode;
-wire   [15:0] arp_rx_depacketizer_source_param_proto;
-wire    [7:0] arp_rx_depacketizer_source_param_protosize;
-wire   [31:0] arp_rx_depacketizer_source_param_sender_ip;
-wire   [47:0] arp_rx_depacketizer_source_param_sender_mac;
-wire   [31:0] arp_rx_depacketizer_source_param_target_ip;
-wire   [47:0] arp_rx_depacketizer_source_param_target_mac;
-reg     [7:0] arp_rx_depacketizer_source_payload_data = 8'd0;
-wire          arp_rx_depacketizer_source_payload_error;
-reg           arp_rx_depacketizer_source_payload_last_be = 1'd0;
-reg           arp_rx_depacketizer_source_ready = 1'd0;
-reg           arp_rx_depacketizer_source_valid = 1'd0;
-reg   [223:0] arp_rx_depacketizer_sr = 224'd0;
-reg           arp_rx_depacketizer_sr_shift = 1'd0;
-reg           arp_rx_depacketizer_sr_shift_leftover = 1'd0;
-reg           arp_rx_depacketizer_was_in_copy = 1'd0;
+reg     [4:0] arp_packetizer_count = 5'd0;
+reg     [4:0] arp_packetizer_count_liteetharp_fsm0_next_value0 = 5'd0;
+reg           arp_packetizer_count_liteetharp_fsm0_next_value_ce0 = 1'd0;
+reg           arp_packetizer_delayed_last_be = 1'd0;
+reg           arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 = 1'd0;
+reg           arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 = 1'd0;
+reg           arp_packetizer_fsm_from_idle = 1'd0;
+reg           arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 = 1'd0;
+reg           arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 = 1'd0;
+reg   [223:0] arp_packetizer_header = 224'd0;
+wire          arp_packetizer_in_data_copy;
+reg           arp_packetizer_is_ongoing0 = 1'd0;
+reg           arp_packetizer_is_ongoing1 = 1'd0;
+reg           arp_packetizer_is_ongoing2 = 1'd0;
+wire          arp_packetizer_new_last_be;
+wire          arp_packetizer_sink_last;
+wire          arp_packetizer_sink_last_be;
+wire    [7:0] arp_packetizer_sink_param_hwsize;
+wire   [15:0] arp_packetizer_sink_param_hwtype;
+reg    [15:0] arp_packetizer_sink_param_opcode = 16'd0;
+wire   [15:0] arp_packetizer_sink_param_proto;
+wire    [7:0] arp_packetizer_sink_param_protosize;
+wire   [31:0] arp_packetizer_sink_param_sender_ip;
+wire   [47:0] arp_packetizer_sink_param_sender_mac;
+wire   [31:0] arp_packetizer_sink_param_target_ip;
+reg    [47:0] arp_packetizer_sink_param_target_mac = 48'd0;
+reg     [7:0] arp_packetizer_sink_payload_data = 8'd0;
+reg           arp_packetizer_sink_payload_error = 1'd0;
+reg           arp_packetizer_sink_payload_last_be = 1'd0;
+reg           arp_packetizer_sink_ready = 1'd0;
+reg           arp_packetizer_sink_valid = 1'd0;
+reg           arp_packetizer_source_first = 1'd0;
+reg           arp_packetizer_source_last = 1'd0;
+reg           arp_packetizer_source_last_a = 1'd0;
+reg           arp_packetizer_source_last_b = 1'd0;
+reg           arp_packetizer_source_last_s = 1'd0;
+reg     [7:0] arp_packetizer_source_payload_data = 8'd0;
+wire          arp_packetizer_source_payload_error;
+reg    [15:0] arp_packetizer_source_payload_ethernet_type = 16'd0;
+reg           arp_packetizer_source_payload_last_be = 1'd0;
+reg    [47:0] arp_packetizer_source_payload_sender_mac = 48'd0;
+reg    [47:0] arp_packetizer_source_payload_target_mac = 48'd0;
+reg           arp_packetizer_source_ready = 1'd0;
+reg           arp_packetizer_source_valid = 1'd0;
+reg   [223:0] arp_packetizer_sr = 224'd0;
+reg           arp_packetizer_sr_load = 1'd0;
+reg           arp_packetizer_sr_shift = 1'd0;
+wire          arp_rx_cut;
+reg           arp_rx_fsm_is_ongoing0 = 1'd0;
+reg           arp_rx_fsm_is_ongoing1 = 1'd0;
+reg     [4:0] arp_rx_liteetharpdepacketizer_count = 5'd0;
+reg     [4:0] arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 = 5'd0;
+reg           arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_delayed_last_be = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_fsm_from_idle = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 = 1'd0;
+wire  [223:0] arp_rx_liteetharpdepacketizer_header;
+wire          arp_rx_liteetharpdepacketizer_is_in_copy;
+reg           arp_rx_liteetharpdepacketizer_is_ongoing0 = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_is_ongoing1 = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_is_ongoing2 = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_is_ongoing3 = 1'd0;
+wire          arp_rx_liteetharpdepacketizer_new_last_be;
+reg           arp_rx_liteetharpdepacketizer_sink_d_last = 1'd0;
+wire          arp_rx_liteetharpdepacketizer_sink_first;
+wire          arp_rx_liteetharpdepacketizer_sink_last;
+wire          arp_rx_liteetharpdepacketizer_sink_last_be;
+wire    [7:0] arp_rx_liteetharpdepacketizer_sink_payload_data;
+wire          arp_rx_liteetharpdepacketizer_sink_payload_error;
+wire   [15:0] arp_rx_liteetharpdepacketizer_sink_payload_ethernet_type;
+wire          arp_rx_liteetharpdepacketizer_sink_payload_last_be;
+wire   [47:0] arp_rx_liteetharpdepacketizer_sink_payload_sender_mac;
+wire   [47:0] arp_rx_liteetharpdepacketizer_sink_payload_target_mac;
+reg           arp_rx_liteetharpdepacketizer_sink_ready = 1'd0;
+wire          arp_rx_liteetharpdepacketizer_sink_valid;
+reg           arp_rx_liteetharpdepacketizer_source_last = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_source_last_a = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_source_last_b = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_source_last_s = 1'd0;
+wire    [7:0] arp_rx_liteetharpdepacketizer_source_param_hwsize;
+wire   [15:0] arp_rx_liteetharpdepacketizer_source_param_hwtype;
+wire   [15:0] arp_rx_liteetharpdepacketizer_source_param_opcode;
+wire   [15:0] arp_rx_liteetharpdepacketizer_source_param_proto;
+wire    [7:0] arp_rx_liteetharpdepacketizer_source_param_protosize;
+wire   [31:0] arp_rx_liteetharpdepacketizer_source_param_sender_ip;
+wire   [47:0] arp_rx_liteetharpdepacketizer_source_param_sender_mac;
+wire   [31:0] arp_rx_liteetharpdepacketizer_source_param_target_ip;
+wire   [47:0] arp_rx_liteetharpdepacketizer_source_param_target_mac;
+reg     [7:0] arp_rx_liteetharpdepacketizer_source_payload_data = 8'd0;
+wire          arp_rx_liteetharpdepacketizer_source_payload_error;
+reg           arp_rx_liteetharpdepacketizer_source_payload_last_be = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_source_ready = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_source_valid = 1'd0;
+reg   [223:0] arp_rx_liteetharpdepacketizer_sr = 224'd0;
+reg           arp_rx_liteetharpdepacketizer_sr_shift = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_sr_shift_leftover = 1'd0;
+reg           arp_rx_liteetharpdepacketizer_was_in_copy = 1'd0;
 reg           arp_rx_reply = 1'd0;
 reg           arp_rx_request = 1'd0;
-wire          arp_rx_sink_sink_first;
-wire          arp_rx_sink_sink_last;
-wire    [7:0] arp_rx_sink_sink_payload_data;
-wire          arp_rx_sink_sink_payload_error;
-wire   [15:0] arp_rx_sink_sink_payload_ethernet_type;
-wire          arp_rx_sink_sink_payload_last_be;
-wire   [47:0] arp_rx_sink_sink_payload_sender_mac;
-wire   [47:0] arp_rx_sink_sink_payload_target_mac;
-wire          arp_rx_sink_sink_ready;
-wire          arp_rx_sink_sink_valid;
-reg           arp_rx_source_source_first = 1'd0;
-reg           arp_rx_source_source_last = 1'd0;
-wire   [31:0] arp_rx_source_source_payload_ip_address;
-wire   [47:0] arp_rx_source_source_payload_mac_address;
-reg           arp_rx_source_source_payload_reply = 1'd0;
-reg           arp_rx_source_source_payload_request = 1'd0;
-wire          arp_rx_source_source_ready;
-reg           arp_rx_source_source_valid = 1'd0;
+wire          arp_rx_sink_first;
+wire          arp_rx_sink_last;
+wire    [7:0] arp_rx_sink_payload_data;
+wire          arp_rx_sink_payload_error;
+wire   [15:0] arp_rx_sink_payload_ethernet_type;
+wire          arp_rx_sink_payload_last_be;
+wire   [47:0] arp_rx_sink_payload_sender_mac;
+wire   [47:0] arp_rx_sink_payload_target_mac;
+wire          arp_rx_sink_ready;
+wire          arp_rx_sink_valid;
+reg           arp_rx_source_first = 1'd0;
+reg           arp_rx_source_last = 1'd0;
+wire   [31:0] arp_rx_source_payload_ip_address;
+wire   [47:0] arp_rx_source_payload_mac_address;
+reg           arp_rx_source_payload_reply = 1'd0;
+reg           arp_rx_source_payload_request = 1'd0;
+wire          arp_rx_source_ready;
+reg           arp_rx_source_valid = 1'd0;
 reg           arp_rx_valid = 1'd0;
+wire          arp_sink_sink_first;
+wire          arp_sink_sink_last;
+wire   [31:0] arp_sink_sink_payload_ip_address;
+wire   [47:0] arp_sink_sink_payload_mac_address;
+wire          arp_sink_sink_payload_reply;
+wire          arp_sink_sink_payload_request;
+reg           arp_sink_sink_ready = 1'd0;
+wire          arp_sink_sink_valid;
+wire          arp_source_source_first;
+wire          arp_source_source_last;
+wire    [7:0] arp_source_source_payload_data;
+wire          arp_source_source_payload_error;
+reg    [15:0] arp_source_source_payload_ethernet_type = 16'd0;
+wire          arp_source_source_payload_last_be;
+reg    [47:0] arp_source_source_payload_sender_mac = 48'd0;
+reg    [47:0] arp_source_source_payload_target_mac = 48'd0;
+wire          arp_source_source_ready;
+reg           arp_source_source_valid = 1'd0;
 reg           arp_table_cache_clear_enable = 1'd1;
 reg    [26:0] arp_table_cache_count = 27'd125000000;
 wire          arp_table_cache_done;
@@ -421,75 +494,8 @@ reg           arp_table_source_payload_reply = 1'd0;
 reg           arp_table_source_payload_request = 1'd0;
 wire          arp_table_source_ready;
 reg           arp_table_source_valid = 1'd0;
-reg     [5:0] arp_tx_counter = 6'd0;
-reg     [5:0] arp_tx_counter_liteetharp_next_value = 6'd0;
-reg           arp_tx_counter_liteetharp_next_value_ce = 1'd0;
-reg     [4:0] arp_tx_packetizer_count = 5'd0;
-reg     [4:0] arp_tx_packetizer_count_liteetharp_fsm0_next_value0 = 5'd0;
-reg           arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 = 1'd0;
-reg           arp_tx_packetizer_delayed_last_be = 1'd0;
-reg           arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 = 1'd0;
-reg           arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 = 1'd0;
-reg           arp_tx_packetizer_fsm_from_idle = 1'd0;
-reg           arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 = 1'd0;
-reg           arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 = 1'd0;
-reg   [223:0] arp_tx_packetizer_header = 224'd0;
-wire          arp_tx_packetizer_in_data_copy;
-reg           arp_tx_packetizer_is_ongoing0 = 1'd0;
-reg           arp_tx_packetizer_is_ongoing1 = 1'd0;
-reg           arp_tx_packetizer_is_ongoing2 = 1'd0;
-wire          arp_tx_packetizer_new_last_be;
-wire          arp_tx_packetizer_sink_last;
-wire          arp_tx_packetizer_sink_last_be;
-wire    [7:0] arp_tx_packetizer_sink_param_hwsize;
-wire   [15:0] arp_tx_packetizer_sink_param_hwtype;
-reg    [15:0] arp_tx_packetizer_sink_param_opcode = 16'd0;
-wire   [15:0] arp_tx_packetizer_sink_param_proto;
-wire    [7:0] arp_tx_packetizer_sink_param_protosize;
-wire   [31:0] arp_tx_packetizer_sink_param_sender_ip;
-wire   [47:0] arp_tx_packetizer_sink_param_sender_mac;
-wire   [31:0] arp_tx_packetizer_sink_param_target_ip;
-reg    [47:0] arp_tx_packetizer_sink_param_target_mac = 48'd0;
-reg     [7:0] arp_tx_packetizer_sink_payload_data = 8'd0;
-reg           arp_tx_packetizer_sink_payload_error = 1'd0;
-reg           arp_tx_packetizer_sink_payload_last_be = 1'd0;
-reg           arp_tx_packetizer_sink_ready = 1'd0;
-reg           arp_tx_packetizer_sink_valid = 1'd0;
-reg           arp_tx_packetizer_source_first = 1'd0;
-reg           arp_tx_packetizer_source_last = 1'd0;
-reg           arp_tx_packetizer_source_last_a = 1'd0;
-reg           arp_tx_packetizer_source_last_b = 1'd0;
-reg           arp_tx_packetizer_source_last_s = 1'd0;
-reg     [7:0] arp_tx_packetizer_source_payload_data = 8'd0;
-wire          arp_tx_packetizer_source_payload_error;
-reg    [15:0] arp_tx_packetizer_source_payload_ethernet_type = 16'd0;
-reg           arp_tx_packetizer_source_payload_last_be = 1'd0;
-reg    [47:0] arp_tx_packetizer_source_payload_sender_mac = 48'd0;
-reg    [47:0] arp_tx_packetizer_source_payload_target_mac = 48'd0;
-reg           arp_tx_packetizer_source_ready = 1'd0;
-reg           arp_tx_packetizer_source_valid = 1'd0;
-reg   [223:0] arp_tx_packetizer_sr = 224'd0;
-reg           arp_tx_packetizer_sr_load = 1'd0;
-reg           arp_tx_packetizer_sr_shift = 1'd0;
-wire          arp_tx_sink_sink_first;
-wire          arp_tx_sink_sink_last;
-wire   [31:0] arp_tx_sink_sink_payload_ip_address;
-wire   [47:0] arp_tx_sink_sink_payload_mac_address;
-wire          arp_tx_sink_sink_payload_reply;
-wire          arp_tx_sink_sink_payload_request;
-reg           arp_tx_sink_sink_ready = 1'd0;
-wire          arp_tx_sink_sink_valid;
-wire          arp_tx_source_source_first;
-wire          arp_tx_source_source_last;
-wire    [7:0] arp_tx_source_source_payload_data;
-wire          arp_tx_source_source_payload_error;
-reg    [15:0] arp_tx_source_source_payload_ethernet_type = 16'd0;
-wire          arp_tx_source_source_payload_last_be;
-reg    [47:0] arp_tx_source_source_payload_sender_mac = 48'd0;
-reg    [47:0] arp_tx_source_source_payload_target_mac = 48'd0;
-wire          arp_tx_source_source_ready;
-reg           arp_tx_source_source_valid = 1'd0;
 wire   [39:0] cases_slice_proxy;
+wire          crossbar_dropped;
 wire          crossbar_sink_first;
 wire          crossbar_sink_last;
 wire   [15:0] crossbar_sink_param_dst_port;
@@ -542,6 +548,7 @@ wire          eth_tx_clk;
 wire          eth_tx_rst;
 reg     [1:0] ethphy_clock_speed = 2'd0;
 reg           ethphy_duplex_status = 1'd0;
+wire          ethphy_errored;
 wire          ethphy_eth_tx_clk_o;
 wire          ethphy_last;
 reg           ethphy_link_status = 1'd0;
@@ -577,93 +584,101 @@ wire          ethphy_we;
 reg     [2:0] fsm_next_state = 3'd0;
 reg     [2:0] fsm_state = 3'd0;
 reg    [15:0] holdingudprx0 = 16'd0;
-reg    [15:0] holdingudprx0_liteethudp_next_value3 = 16'd0;
-reg           holdingudprx0_liteethudp_next_value_ce3 = 1'd0;
+reg    [15:0] holdingudprx0_liteethudp_next_value4 = 16'd0;
+reg           holdingudprx0_liteethudp_next_value_ce4 = 1'd0;
 reg    [15:0] holdingudprx1 = 16'd0;
-reg    [15:0] holdingudprx1_liteethudp_next_value4 = 16'd0;
-reg           holdingudprx1_liteethudp_next_value_ce4 = 1'd0;
+reg    [15:0] holdingudprx1_liteethudp_next_value5 = 16'd0;
+reg           holdingudprx1_liteethudp_next_value_ce5 = 1'd0;
 reg    [15:0] holdingudprx2 = 16'd0;
-reg    [15:0] holdingudprx2_liteethudp_next_value5 = 16'd0;
-reg           holdingudprx2_liteethudp_next_value_ce5 = 1'd0;
+reg    [15:0] holdingudprx2_liteethudp_next_value6 = 16'd0;
+reg           holdingudprx2_liteethudp_next_value_ce6 = 1'd0;
 reg    [31:0] holdingudprx3 = 32'd0;
-reg    [31:0] holdingudprx3_liteethudp_next_value6 = 32'd0;
-reg           holdingudprx3_liteethudp_next_value_ce6 = 1'd0;
+reg    [31:0] holdingudprx3_liteethudp_next_value7 = 32'd0;
+reg           holdingudprx3_liteethudp_next_value_ce7 = 1'd0;
 reg    [15:0] holdingudprx_count = 16'd0;
 reg    [15:0] holdingudprx_count_liteethudp_next_value0 = 16'd0;
 reg           holdingudprx_count_liteethudp_next_value_ce0 = 1'd0;
-reg     [2:0] holdingudprx_depacketizer_count = 3'd0;
-reg     [2:0] holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
-reg           holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
-reg           holdingudprx_depacketizer_delayed_last_be = 1'd0;
-reg           holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
-reg           holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
-reg           holdingudprx_depacketizer_fsm_from_idle = 1'd0;
-reg           holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
-reg           holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
-wire   [63:0] holdingudprx_depacketizer_header;
-wire          holdingudprx_depacketizer_is_in_copy;
-reg           holdingudprx_depacketizer_is_ongoing0 = 1'd0;
-reg           holdingudprx_depacketizer_is_ongoing1 = 1'd0;
-reg           holdingudprx_depacketizer_is_ongoing2 = 1'd0;
-reg           holdingudprx_depacketizer_is_ongoing3 = 1'd0;
-wire          holdingudprx_depacketizer_new_last_be;
-reg           holdingudprx_depacketizer_sink_d_last = 1'd0;
-wire          holdingudprx_depacketizer_sink_first;
-wire          holdingudprx_depacketizer_sink_last;
-wire          holdingudprx_depacketizer_sink_last_be;
-wire   [31:0] holdingudprx_depacketizer_sink_param_ip_address;
-wire   [15:0] holdingudprx_depacketizer_sink_param_length;
-wire    [7:0] holdingudprx_depacketizer_sink_param_protocol;
-wire    [7:0] holdingudprx_depacketizer_sink_payload_data;
-wire          holdingudprx_depacketizer_sink_payload_error;
-wire          holdingudprx_depacketizer_sink_payload_last_be;
-reg           holdingudprx_depacketizer_sink_ready = 1'd0;
-wire          holdingudprx_depacketizer_sink_valid;
-reg           holdingudprx_depacketizer_source_last = 1'd0;
-reg           holdingudprx_depacketizer_source_last_a = 1'd0;
-reg           holdingudprx_depacketizer_source_last_b = 1'd0;
-reg           holdingudprx_depacketizer_source_last_s = 1'd0;
-wire   [15:0] holdingudprx_depacketizer_source_param_checksum;
-wire   [15:0] holdingudprx_depacketizer_source_param_dst_port;
-wire   [15:0] holdingudprx_depacketizer_source_param_length;
-wire   [15:0] holdingudprx_depacketizer_source_param_src_port;
-reg     [7:0] holdingudprx_depacketizer_source_payload_data = 8'd0;
-wire          holdingudprx_depacketizer_source_payload_error;
-reg           holdingudprx_depacketizer_source_payload_last_be = 1'd0;
-reg           holdingudprx_depacketizer_source_ready = 1'd0;
-reg           holdingudprx_depacketizer_source_valid = 1'd0;
-reg    [63:0] holdingudprx_depacketizer_sr = 64'd0;
-reg           holdingudprx_depacketizer_sr_shift = 1'd0;
-reg           holdingudprx_depacketizer_sr_shift_leftover = 1'd0;
-reg           holdingudprx_depacketizer_was_in_copy = 1'd0;
+wire          holdingudprx_cut0;
+wire          holdingudprx_cut1;
+reg           holdingudprx_drop_header = 1'd0;
 reg           holdingudprx_err = 1'd0;
 reg           holdingudprx_err_liteethudp_next_value1 = 1'd0;
 reg           holdingudprx_err_liteethudp_next_value_ce1 = 1'd0;
+reg           holdingudprx_fsm_is_ongoing0 = 1'd0;
+reg           holdingudprx_fsm_is_ongoing1 = 1'd0;
 reg     [7:0] holdingudprx_held = 8'd0;
-reg     [7:0] holdingudprx_held_liteethudp_next_value2 = 8'd0;
-reg           holdingudprx_held_liteethudp_next_value_ce2 = 1'd0;
+reg     [7:0] holdingudprx_held_liteethudp_next_value3 = 8'd0;
+reg           holdingudprx_held_liteethudp_next_value_ce3 = 1'd0;
+reg     [2:0] holdingudprx_liteethudpdepacketizer_count = 3'd0;
+reg     [2:0] holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
+reg           holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_delayed_last_be = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_fsm_from_idle = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
+wire   [63:0] holdingudprx_liteethudpdepacketizer_header;
+wire          holdingudprx_liteethudpdepacketizer_is_in_copy;
+reg           holdingudprx_liteethudpdepacketizer_is_ongoing0 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_is_ongoing1 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_is_ongoing2 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_is_ongoing3 = 1'd0;
+wire          holdingudprx_liteethudpdepacketizer_new_last_be;
+reg           holdingudprx_liteethudpdepacketizer_sink_d_last = 1'd0;
+wire          holdingudprx_liteethudpdepacketizer_sink_first;
+wire          holdingudprx_liteethudpdepacketizer_sink_last;
+wire          holdingudprx_liteethudpdepacketizer_sink_last_be;
+wire   [31:0] holdingudprx_liteethudpdepacketizer_sink_param_ip_address;
+wire   [15:0] holdingudprx_liteethudpdepacketizer_sink_param_length;
+wire    [7:0] holdingudprx_liteethudpdepacketizer_sink_param_protocol;
+wire    [7:0] holdingudprx_liteethudpdepacketizer_sink_payload_data;
+wire          holdingudprx_liteethudpdepacketizer_sink_payload_error;
+wire          holdingudprx_liteethudpdepacketizer_sink_payload_last_be;
+reg           holdingudprx_liteethudpdepacketizer_sink_ready = 1'd0;
+wire          holdingudprx_liteethudpdepacketizer_sink_valid;
+reg           holdingudprx_liteethudpdepacketizer_source_last = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_source_last_a = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_source_last_b = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_source_last_s = 1'd0;
+wire   [15:0] holdingudprx_liteethudpdepacketizer_source_param_checksum;
+wire   [15:0] holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+wire   [15:0] holdingudprx_liteethudpdepacketizer_source_param_length;
+wire   [15:0] holdingudprx_liteethudpdepacketizer_source_param_src_port;
+reg     [7:0] holdingudprx_liteethudpdepacketizer_source_payload_data = 8'd0;
+wire          holdingudprx_liteethudpdepacketizer_source_payload_error;
+reg           holdingudprx_liteethudpdepacketizer_source_payload_last_be = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_source_ready = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_source_valid = 1'd0;
+reg    [63:0] holdingudprx_liteethudpdepacketizer_sr = 64'd0;
+reg           holdingudprx_liteethudpdepacketizer_sr_shift = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
 wire   [15:0] holdingudprx_payload_len;
-wire          holdingudprx_sink_sink_first;
-wire          holdingudprx_sink_sink_last;
-wire   [31:0] holdingudprx_sink_sink_param_ip_address;
-wire   [15:0] holdingudprx_sink_sink_param_length;
-wire    [7:0] holdingudprx_sink_sink_param_protocol;
-wire    [7:0] holdingudprx_sink_sink_payload_data;
-wire          holdingudprx_sink_sink_payload_error;
-wire          holdingudprx_sink_sink_payload_last_be;
-wire          holdingudprx_sink_sink_ready;
-wire          holdingudprx_sink_sink_valid;
-reg           holdingudprx_source_source_first = 1'd0;
-reg           holdingudprx_source_source_last = 1'd0;
-reg    [15:0] holdingudprx_source_source_param_dst_port = 16'd0;
-reg    [31:0] holdingudprx_source_source_param_ip_address = 32'd0;
-reg    [15:0] holdingudprx_source_source_param_length = 16'd0;
-reg    [15:0] holdingudprx_source_source_param_src_port = 16'd0;
-reg     [7:0] holdingudprx_source_source_payload_data = 8'd0;
-reg           holdingudprx_source_source_payload_error = 1'd0;
-reg           holdingudprx_source_source_payload_last_be = 1'd0;
-wire          holdingudprx_source_source_ready;
-reg           holdingudprx_source_source_valid = 1'd0;
+reg    [15:0] holdingudprx_rest = 16'd0;
+reg    [15:0] holdingudprx_rest_liteethudp_next_value2 = 16'd0;
+reg           holdingudprx_rest_liteethudp_next_value_ce2 = 1'd0;
+wire          holdingudprx_sink_first;
+wire          holdingudprx_sink_last;
+wire   [31:0] holdingudprx_sink_param_ip_address;
+wire   [15:0] holdingudprx_sink_param_length;
+wire    [7:0] holdingudprx_sink_param_protocol;
+wire    [7:0] holdingudprx_sink_payload_data;
+wire          holdingudprx_sink_payload_error;
+wire          holdingudprx_sink_payload_last_be;
+wire          holdingudprx_sink_ready;
+wire          holdingudprx_sink_valid;
+reg           holdingudprx_source_first = 1'd0;
+reg           holdingudprx_source_last = 1'd0;
+reg    [15:0] holdingudprx_source_param_dst_port = 16'd0;
+reg    [31:0] holdingudprx_source_param_ip_address = 32'd0;
+reg    [15:0] holdingudprx_source_param_length = 16'd0;
+reg    [15:0] holdingudprx_source_param_src_port = 16'd0;
+reg     [7:0] holdingudprx_source_payload_data = 8'd0;
+reg           holdingudprx_source_payload_error = 1'd0;
+reg           holdingudprx_source_payload_last_be = 1'd0;
+wire          holdingudprx_source_ready;
+reg           holdingudprx_source_valid = 1'd0;
 reg           icmp_echo_param_fifo_consume = 1'd0;
 wire          icmp_echo_param_fifo_do_read;
 wire          icmp_echo_param_fifo_fifo_in_first;
@@ -838,74 +853,77 @@ reg           icmp_ip_port_source_payload_error = 1'd0;
 reg           icmp_ip_port_source_payload_last_be = 1'd0;
 wire          icmp_ip_port_source_ready;
 reg           icmp_ip_port_source_valid = 1'd0;
-reg     [2:0] icmp_rx_depacketizer_count = 3'd0;
-reg     [2:0] icmp_rx_depacketizer_count_fsm0_next_value2 = 3'd0;
-reg           icmp_rx_depacketizer_count_fsm0_next_value_ce2 = 1'd0;
-reg           icmp_rx_depacketizer_delayed_last_be = 1'd0;
-reg           icmp_rx_depacketizer_delayed_last_be_fsm1_next_value1 = 1'd0;
-reg           icmp_rx_depacketizer_delayed_last_be_fsm1_next_value_ce1 = 1'd0;
-reg           icmp_rx_depacketizer_fsm_from_idle = 1'd0;
-reg           icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value3 = 1'd0;
-reg           icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value_ce3 = 1'd0;
-wire   [63:0] icmp_rx_depacketizer_header;
-wire          icmp_rx_depacketizer_is_in_copy;
-reg           icmp_rx_depacketizer_is_ongoing0 = 1'd0;
-reg           icmp_rx_depacketizer_is_ongoing1 = 1'd0;
-reg           icmp_rx_depacketizer_is_ongoing2 = 1'd0;
-reg           icmp_rx_depacketizer_is_ongoing3 = 1'd0;
-wire          icmp_rx_depacketizer_new_last_be;
-reg           icmp_rx_depacketizer_sink_d_last = 1'd0;
-wire          icmp_rx_depacketizer_sink_first;
-wire          icmp_rx_depacketizer_sink_last;
-wire          icmp_rx_depacketizer_sink_last_be;
-wire   [31:0] icmp_rx_depacketizer_sink_param_ip_address;
-wire   [15:0] icmp_rx_depacketizer_sink_param_length;
-wire    [7:0] icmp_rx_depacketizer_sink_param_protocol;
-wire    [7:0] icmp_rx_depacketizer_sink_payload_data;
-wire          icmp_rx_depacketizer_sink_payload_error;
-wire          icmp_rx_depacketizer_sink_payload_last_be;
-reg           icmp_rx_depacketizer_sink_ready = 1'd0;
-wire          icmp_rx_depacketizer_sink_valid;
-reg           icmp_rx_depacketizer_source_last = 1'd0;
-reg           icmp_rx_depacketizer_source_last_a = 1'd0;
-reg           icmp_rx_depacketizer_source_last_b = 1'd0;
-reg           icmp_rx_depacketizer_source_last_s = 1'd0;
-wire   [15:0] icmp_rx_depacketizer_source_param_checksum;
-wire    [7:0] icmp_rx_depacketizer_source_param_code;
-wire    [7:0] icmp_rx_depacketizer_source_param_msgtype;
-wire   [31:0] icmp_rx_depacketizer_source_param_quench;
-reg     [7:0] icmp_rx_depacketizer_source_payload_data = 8'd0;
-wire          icmp_rx_depacketizer_source_payload_error;
-reg           icmp_rx_depacketizer_source_payload_last_be = 1'd0;
-reg           icmp_rx_depacketizer_source_ready = 1'd0;
-reg           icmp_rx_depacketizer_source_valid = 1'd0;
-reg    [63:0] icmp_rx_depacketizer_sr = 64'd0;
-reg           icmp_rx_depacketizer_sr_shift = 1'd0;
-reg           icmp_rx_depacketizer_sr_shift_leftover = 1'd0;
-reg           icmp_rx_depacketizer_was_in_copy = 1'd0;
-wire          icmp_rx_sink_sink_first;
-wire          icmp_rx_sink_sink_last;
-wire   [31:0] icmp_rx_sink_sink_param_ip_address;
-wire   [15:0] icmp_rx_sink_sink_param_length;
-wire    [7:0] icmp_rx_sink_sink_param_protocol;
-wire    [7:0] icmp_rx_sink_sink_payload_data;
-wire          icmp_rx_sink_sink_payload_error;
-wire          icmp_rx_sink_sink_payload_last_be;
-wire          icmp_rx_sink_sink_ready;
-wire          icmp_rx_sink_sink_valid;
-reg           icmp_rx_source_source_first = 1'd0;
-wire          icmp_rx_source_source_last;
-wire   [15:0] icmp_rx_source_source_param_checksum;
-wire    [7:0] icmp_rx_source_source_param_code;
-wire   [31:0] icmp_rx_source_source_param_ip_address;
-wire   [15:0] icmp_rx_source_source_param_length;
-wire    [7:0] icmp_rx_source_source_param_msgtype;
-wire   [31:0] icmp_rx_source_source_param_quench;
-wire    [7:0] icmp_rx_source_source_payload_data;
-wire          icmp_rx_source_source_payload_error;
-wire          icmp_rx_source_source_payload_last_be;
-wire          icmp_rx_source_source_ready;
-reg           icmp_rx_source_source_valid = 1'd0;
+wire          icmp_rx_cut;
+reg           icmp_rx_fsm_is_ongoing0 = 1'd0;
+reg           icmp_rx_fsm_is_ongoing1 = 1'd0;
+reg     [2:0] icmp_rx_liteethicmpdepacketizer_count = 3'd0;
+reg     [2:0] icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 = 3'd0;
+reg           icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_delayed_last_be = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_fsm_from_idle = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3 = 1'd0;
+wire   [63:0] icmp_rx_liteethicmpdepacketizer_header;
+wire          icmp_rx_liteethicmpdepacketizer_is_in_copy;
+reg           icmp_rx_liteethicmpdepacketizer_is_ongoing0 = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_is_ongoing1 = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_is_ongoing2 = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_is_ongoing3 = 1'd0;
+wire          icmp_rx_liteethicmpdepacketizer_new_last_be;
+reg           icmp_rx_liteethicmpdepacketizer_sink_d_last = 1'd0;
+wire          icmp_rx_liteethicmpdepacketizer_sink_first;
+wire          icmp_rx_liteethicmpdepacketizer_sink_last;
+wire          icmp_rx_liteethicmpdepacketizer_sink_last_be;
+wire   [31:0] icmp_rx_liteethicmpdepacketizer_sink_param_ip_address;
+wire   [15:0] icmp_rx_liteethicmpdepacketizer_sink_param_length;
+wire    [7:0] icmp_rx_liteethicmpdepacketizer_sink_param_protocol;
+wire    [7:0] icmp_rx_liteethicmpdepacketizer_sink_payload_data;
+wire          icmp_rx_liteethicmpdepacketizer_sink_payload_error;
+wire          icmp_rx_liteethicmpdepacketizer_sink_payload_last_be;
+reg           icmp_rx_liteethicmpdepacketizer_sink_ready = 1'd0;
+wire          icmp_rx_liteethicmpdepacketizer_sink_valid;
+reg           icmp_rx_liteethicmpdepacketizer_source_last = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_source_last_a = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_source_last_b = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_source_last_s = 1'd0;
+wire   [15:0] icmp_rx_liteethicmpdepacketizer_source_param_checksum;
+wire    [7:0] icmp_rx_liteethicmpdepacketizer_source_param_code;
+wire    [7:0] icmp_rx_liteethicmpdepacketizer_source_param_msgtype;
+wire   [31:0] icmp_rx_liteethicmpdepacketizer_source_param_quench;
+reg     [7:0] icmp_rx_liteethicmpdepacketizer_source_payload_data = 8'd0;
+wire          icmp_rx_liteethicmpdepacketizer_source_payload_error;
+reg           icmp_rx_liteethicmpdepacketizer_source_payload_last_be = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_source_ready = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_source_valid = 1'd0;
+reg    [63:0] icmp_rx_liteethicmpdepacketizer_sr = 64'd0;
+reg           icmp_rx_liteethicmpdepacketizer_sr_shift = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_sr_shift_leftover = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_was_in_copy = 1'd0;
+wire          icmp_rx_sink_first;
+wire          icmp_rx_sink_last;
+wire   [31:0] icmp_rx_sink_param_ip_address;
+wire   [15:0] icmp_rx_sink_param_length;
+wire    [7:0] icmp_rx_sink_param_protocol;
+wire    [7:0] icmp_rx_sink_payload_data;
+wire          icmp_rx_sink_payload_error;
+wire          icmp_rx_sink_payload_last_be;
+wire          icmp_rx_sink_ready;
+wire          icmp_rx_sink_valid;
+reg           icmp_rx_source_first = 1'd0;
+wire          icmp_rx_source_last;
+wire   [15:0] icmp_rx_source_param_checksum;
+wire    [7:0] icmp_rx_source_param_code;
+wire   [31:0] icmp_rx_source_param_ip_address;
+wire   [15:0] icmp_rx_source_param_length;
+wire    [7:0] icmp_rx_source_param_msgtype;
+wire   [31:0] icmp_rx_source_param_quench;
+wire    [7:0] icmp_rx_source_payload_data;
+wire          icmp_rx_source_payload_error;
+wire          icmp_rx_source_payload_last_be;
+wire          icmp_rx_source_ready;
+reg           icmp_rx_source_valid = 1'd0;
 reg     [2:0] icmp_tx_packetizer_count = 3'd0;
 reg     [2:0] icmp_tx_packetizer_count_fsm0_next_value0 = 3'd0;
 reg           icmp_tx_packetizer_count_fsm0_next_value_ce0 = 1'd0;
@@ -1017,6 +1035,7 @@ reg           internal_port_source_payload_error = 1'd0;
 reg           internal_port_source_payload_last_be = 1'd0;
 wire          internal_port_source_ready;
 reg           internal_port_source_valid = 1'd0;
+wire          ip_crossbar_dropped;
 wire          ip_crossbar_sink_first;
 wire          ip_crossbar_sink_last;
 wire   [31:0] ip_crossbar_sink_param_ip_address;
@@ -1078,56 +1097,14 @@ reg           ip_port_source_payload_last_be = 1'd0;
 wire          ip_port_source_ready;
 reg           ip_port_source_valid = 1'd0;
 wire          ip_rx_ce;
-reg     [4:0] ip_rx_depacketizer_count = 5'd0;
-reg     [4:0] ip_rx_depacketizer_count_liteethip_fsm0_next_value2 = 5'd0;
-reg           ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 = 1'd0;
-reg           ip_rx_depacketizer_delayed_last_be = 1'd0;
-reg           ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value1 = 1'd0;
-reg           ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 = 1'd0;
-reg           ip_rx_depacketizer_fsm_from_idle = 1'd0;
-reg           ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 = 1'd0;
-reg           ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 = 1'd0;
-wire  [159:0] ip_rx_depacketizer_header;
-wire          ip_rx_depacketizer_is_in_copy;
-reg           ip_rx_depacketizer_is_ongoing0 = 1'd0;
-reg           ip_rx_depacketizer_is_ongoing1 = 1'd0;
-reg           ip_rx_depacketizer_is_ongoing2 = 1'd0;
-reg           ip_rx_depacketizer_is_ongoing3 = 1'd0;
-wire          ip_rx_depacketizer_new_last_be;
-reg           ip_rx_depacketizer_sink_d_last = 1'd0;
-wire          ip_rx_depacketizer_sink_first;
-wire          ip_rx_depacketizer_sink_last;
-wire          ip_rx_depacketizer_sink_last_be;
-wire    [7:0] ip_rx_depacketizer_sink_payload_data;
-wire          ip_rx_depacketizer_sink_payload_error;
-wire   [15:0] ip_rx_depacketizer_sink_payload_ethernet_type;
-wire          ip_rx_depacketizer_sink_payload_last_be;
-wire   [47:0] ip_rx_depacketizer_sink_payload_sender_mac;
-wire   [47:0] ip_rx_depacketizer_sink_payload_target_mac;
-reg           ip_rx_depacketizer_sink_ready = 1'd0;
-wire          ip_rx_depacketizer_sink_valid;
-reg           ip_rx_depacketizer_source_last = 1'd0;
-reg           ip_rx_depacketizer_source_last_a = 1'd0;
-reg           ip_rx_depacketizer_source_last_b = 1'd0;
-reg           ip_rx_depacketizer_source_last_s = 1'd0;
-wire   [15:0] ip_rx_depacketizer_source_param_checksum;
-wire   [15:0] ip_rx_depacketizer_source_param_identification;
-wire    [3:0] ip_rx_depacketizer_source_param_ihl;
-wire    [7:0] ip_rx_depacketizer_source_param_protocol;
-wire   [31:0] ip_rx_depacketizer_source_param_sender_ip;
-wire   [31:0] ip_rx_depacketizer_source_param_target_ip;
-wire   [15:0] ip_rx_depacketizer_source_param_total_length;
-wire    [7:0] ip_rx_depacketizer_source_param_ttl;
-wire    [3:0] ip_rx_depacketizer_source_param_version;
-reg     [7:0] ip_rx_depacketizer_source_payload_data = 8'd0;
-wire          ip_rx_depacketizer_source_payload_error;
-reg           ip_rx_depacketizer_source_payload_last_be = 1'd0;
-reg           ip_rx_depacketizer_source_ready = 1'd0;
-reg           ip_rx_depacketizer_source_valid = 1'd0;
-reg   [159:0] ip_rx_depacketizer_sr = 160'd0;
-reg           ip_rx_depacketizer_sr_shift = 1'd0;
-reg           ip_rx_depacketizer_sr_shift_leftover = 1'd0;
-reg           ip_rx_depacketizer_was_in_copy = 1'd0;
+wire          ip_rx_cut;
+wire          ip_rx_decide;
+wire          ip_rx_drop_header;
+wire          ip_rx_drop_other;
+reg           ip_rx_fsm_is_ongoing0 = 1'd0;
+reg           ip_rx_fsm_is_ongoing1 = 1'd0;
+wire          ip_rx_header_ok;
+reg           ip_rx_is_ongoing = 1'd0;
 reg           ip_rx_liteethipv4checksum0 = 1'd0;
 reg           ip_rx_liteethipv4checksum1 = 1'd0;
 reg           ip_rx_liteethipv4checksum2 = 1'd0;
@@ -1164,27 +1141,79 @@ wire   [16:0] ip_rx_liteethipv4checksum_s_next7;
 wire   [16:0] ip_rx_liteethipv4checksum_s_next8;
 wire   [16:0] ip_rx_liteethipv4checksum_s_next9;
 wire   [15:0] ip_rx_liteethipv4checksum_value;
+reg     [4:0] ip_rx_liteethipv4depacketizer_count = 5'd0;
+reg     [4:0] ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 = 5'd0;
+reg           ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_delayed_last_be = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_fsm_from_idle = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 = 1'd0;
+wire  [159:0] ip_rx_liteethipv4depacketizer_header;
+wire          ip_rx_liteethipv4depacketizer_is_in_copy;
+reg           ip_rx_liteethipv4depacketizer_is_ongoing0 = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_is_ongoing1 = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_is_ongoing2 = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_is_ongoing3 = 1'd0;
+wire          ip_rx_liteethipv4depacketizer_new_last_be;
+reg           ip_rx_liteethipv4depacketizer_sink_d_last = 1'd0;
+wire          ip_rx_liteethipv4depacketizer_sink_first;
+wire          ip_rx_liteethipv4depacketizer_sink_last;
+wire          ip_rx_liteethipv4depacketizer_sink_last_be;
+wire    [7:0] ip_rx_liteethipv4depacketizer_sink_payload_data;
+wire          ip_rx_liteethipv4depacketizer_sink_payload_error;
+wire   [15:0] ip_rx_liteethipv4depacketizer_sink_payload_ethernet_type;
+wire          ip_rx_liteethipv4depacketizer_sink_payload_last_be;
+wire   [47:0] ip_rx_liteethipv4depacketizer_sink_payload_sender_mac;
+wire   [47:0] ip_rx_liteethipv4depacketizer_sink_payload_target_mac;
+reg           ip_rx_liteethipv4depacketizer_sink_ready = 1'd0;
+wire          ip_rx_liteethipv4depacketizer_sink_valid;
+reg           ip_rx_liteethipv4depacketizer_source_last = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_source_last_a = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_source_last_b = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_source_last_s = 1'd0;
+wire   [15:0] ip_rx_liteethipv4depacketizer_source_param_checksum;
+wire   [15:0] ip_rx_liteethipv4depacketizer_source_param_identification;
+wire    [3:0] ip_rx_liteethipv4depacketizer_source_param_ihl;
+wire    [7:0] ip_rx_liteethipv4depacketizer_source_param_protocol;
+wire   [31:0] ip_rx_liteethipv4depacketizer_source_param_sender_ip;
+wire   [31:0] ip_rx_liteethipv4depacketizer_source_param_target_ip;
+wire   [15:0] ip_rx_liteethipv4depacketizer_source_param_total_length;
+wire    [7:0] ip_rx_liteethipv4depacketizer_source_param_ttl;
+wire    [3:0] ip_rx_liteethipv4depacketizer_source_param_version;
+reg     [7:0] ip_rx_liteethipv4depacketizer_source_payload_data = 8'd0;
+wire          ip_rx_liteethipv4depacketizer_source_payload_error;
+reg           ip_rx_liteethipv4depacketizer_source_payload_last_be = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_source_ready = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_source_valid = 1'd0;
+reg   [159:0] ip_rx_liteethipv4depacketizer_sr = 160'd0;
+reg           ip_rx_liteethipv4depacketizer_sr_shift = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_sr_shift_leftover = 1'd0;
+reg           ip_rx_liteethipv4depacketizer_was_in_copy = 1'd0;
+wire   [12:0] ip_rx_offset;
+wire          ip_rx_ours;
 wire          ip_rx_reset;
-wire          ip_rx_sink_sink_first;
-wire          ip_rx_sink_sink_last;
-wire    [7:0] ip_rx_sink_sink_payload_data;
-wire          ip_rx_sink_sink_payload_error;
-wire   [15:0] ip_rx_sink_sink_payload_ethernet_type;
-wire          ip_rx_sink_sink_payload_last_be;
-wire   [47:0] ip_rx_sink_sink_payload_sender_mac;
-wire   [47:0] ip_rx_sink_sink_payload_target_mac;
-wire          ip_rx_sink_sink_ready;
-wire          ip_rx_sink_sink_valid;
-reg           ip_rx_source_source_first = 1'd0;
-wire          ip_rx_source_source_last;
-wire   [31:0] ip_rx_source_source_param_ip_address;
-wire   [15:0] ip_rx_source_source_param_length;
-wire    [7:0] ip_rx_source_source_param_protocol;
-wire    [7:0] ip_rx_source_source_payload_data;
-wire          ip_rx_source_source_payload_error;
-wire          ip_rx_source_source_payload_last_be;
-wire          ip_rx_source_source_ready;
-reg           ip_rx_source_source_valid = 1'd0;
+wire          ip_rx_sink_first;
+wire          ip_rx_sink_last;
+wire    [7:0] ip_rx_sink_payload_data;
+wire          ip_rx_sink_payload_error;
+wire   [15:0] ip_rx_sink_payload_ethernet_type;
+wire          ip_rx_sink_payload_last_be;
+wire   [47:0] ip_rx_sink_payload_sender_mac;
+wire   [47:0] ip_rx_sink_payload_target_mac;
+wire          ip_rx_sink_ready;
+wire          ip_rx_sink_valid;
+reg           ip_rx_source_first = 1'd0;
+wire          ip_rx_source_last;
+wire   [31:0] ip_rx_source_param_ip_address;
+wire   [15:0] ip_rx_source_param_length;
+wire    [7:0] ip_rx_source_param_protocol;
+wire    [7:0] ip_rx_source_payload_data;
+wire          ip_rx_source_payload_error;
+wire          ip_rx_source_payload_last_be;
+wire          ip_rx_source_ready;
+reg           ip_rx_source_valid = 1'd0;
 wire          ip_tx_ce;
 reg           ip_tx_liteethipv4checksum0 = 1'd0;
 reg           ip_tx_liteethipv4checksum1 = 1'd0;
@@ -1357,15 +1386,15 @@ reg           liteethicmptx_fsm1_next_state = 1'd0;
 reg           liteethicmptx_fsm1_state = 1'd0;
 reg           liteethicmptx_next_state = 1'd0;
 reg           liteethicmptx_state = 1'd0;
+reg     [1:0] liteethip_checkingiprx_fsm0_next_state = 2'd0;
+reg     [1:0] liteethip_checkingiprx_fsm0_state = 2'd0;
+reg           liteethip_checkingiprx_fsm1_next_state = 1'd0;
+reg           liteethip_checkingiprx_fsm1_state = 1'd0;
+reg     [1:0] liteethip_checkingiprx_next_state = 2'd0;
+reg     [1:0] liteethip_checkingiprx_state = 2'd0;
 reg           liteethip_first = 1'd1;
 reg           liteethip_grant = 1'd0;
 wire          liteethip_last;
-reg     [1:0] liteethip_liteethiprx_fsm0_next_state = 2'd0;
-reg     [1:0] liteethip_liteethiprx_fsm0_state = 2'd0;
-reg           liteethip_liteethiprx_fsm1_next_state = 1'd0;
-reg           liteethip_liteethiprx_fsm1_state = 1'd0;
-reg     [1:0] liteethip_liteethiprx_next_state = 2'd0;
-reg     [1:0] liteethip_liteethiprx_state = 2'd0;
 reg     [1:0] liteethip_liteethiptx_fsm0_next_state = 2'd0;
 reg     [1:0] liteethip_liteethiptx_fsm0_state = 2'd0;
 reg           liteethip_liteethiptx_fsm1_next_state = 1'd0;
@@ -1386,6 +1415,7 @@ reg           liteethip_status1_first = 1'd1;
 wire          liteethip_status1_last;
 wire          liteethip_status1_ongoing0;
 reg           liteethip_status1_ongoing1 = 1'd0;
+wire          liteethip_taken;
 reg           liteethmac_first = 1'd1;
 reg     [1:0] liteethmac_fsm0_next_state0 = 2'd0;
 reg     [1:0] liteethmac_fsm0_next_state1 = 2'd0;
@@ -1415,6 +1445,7 @@ reg           liteethmac_status1_first = 1'd1;
 wire          liteethmac_status1_last;
 wire          liteethmac_status1_ongoing0;
 reg           liteethmac_status1_ongoing1 = 1'd0;
+wire          liteethmac_taken;
 reg     [1:0] liteethmac_txdatapath_bufferizeendpoints_next_state = 2'd0;
 reg     [1:0] liteethmac_txdatapath_bufferizeendpoints_state = 2'd0;
 reg           liteethmac_txdatapath_liteethmacgap_next_state = 1'd0;
@@ -1442,6 +1473,7 @@ reg           liteethudp_ongoing1 = 1'd0;
 reg           liteethudp_sel0 = 1'd0;
 reg           liteethudp_sel1 = 1'd0;
 reg           liteethudp_sel_ongoing = 1'd0;
+wire          liteethudp_taken;
 wire          mac_core_bufferizeendpoints_pipe_valid_sink_first;
 wire          mac_core_bufferizeendpoints_pipe_valid_sink_last;
 wire    [7:0] mac_core_bufferizeendpoints_pipe_valid_sink_payload_data;
@@ -1841,6 +1873,7 @@ reg           mac_core_tx_preamble_source_payload_error = 1'd0;
 wire          mac_core_tx_preamble_source_payload_last_be;
 wire          mac_core_tx_preamble_source_ready;
 reg           mac_core_tx_preamble_source_valid = 1'd0;
+wire          mac_crossbar_dropped;
 wire          mac_crossbar_sink_first;
 wire          mac_crossbar_sink_last;
 wire    [7:0] mac_crossbar_sink_payload_data;
@@ -1861,48 +1894,51 @@ reg    [47:0] mac_crossbar_source_payload_sender_mac = 48'd0;
 reg    [47:0] mac_crossbar_source_payload_target_mac = 48'd0;
 wire          mac_crossbar_source_ready;
 reg           mac_crossbar_source_valid = 1'd0;
-reg     [3:0] mac_depacketizer_count = 4'd0;
-reg     [3:0] mac_depacketizer_count_liteethmac_fsm0_next_value2 = 4'd0;
-reg           mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 = 1'd0;
-reg           mac_depacketizer_delayed_last_be = 1'd0;
-reg           mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value1 = 1'd0;
-reg           mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 = 1'd0;
-reg           mac_depacketizer_fsm_from_idle = 1'd0;
-reg           mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 = 1'd0;
-reg           mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 = 1'd0;
-wire  [111:0] mac_depacketizer_header;
-wire          mac_depacketizer_is_in_copy;
-reg           mac_depacketizer_is_ongoing0 = 1'd0;
-reg           mac_depacketizer_is_ongoing1 = 1'd0;
-reg           mac_depacketizer_is_ongoing2 = 1'd0;
-reg           mac_depacketizer_is_ongoing3 = 1'd0;
-wire          mac_depacketizer_new_last_be;
-reg           mac_depacketizer_sink_d_last = 1'd0;
-wire          mac_depacketizer_sink_first;
-wire          mac_depacketizer_sink_last;
-wire          mac_depacketizer_sink_last_be;
-wire    [7:0] mac_depacketizer_sink_payload_data;
-wire          mac_depacketizer_sink_payload_error;
-wire          mac_depacketizer_sink_payload_last_be;
-reg           mac_depacketizer_sink_ready = 1'd0;
-wire          mac_depacketizer_sink_valid;
-reg           mac_depacketizer_source_first = 1'd0;
-reg           mac_depacketizer_source_last = 1'd0;
-reg           mac_depacketizer_source_last_a = 1'd0;
-reg           mac_depacketizer_source_last_b = 1'd0;
-reg           mac_depacketizer_source_last_s = 1'd0;
-reg     [7:0] mac_depacketizer_source_payload_data = 8'd0;
-wire          mac_depacketizer_source_payload_error;
-wire   [15:0] mac_depacketizer_source_payload_ethernet_type;
-reg           mac_depacketizer_source_payload_last_be = 1'd0;
-wire   [47:0] mac_depacketizer_source_payload_sender_mac;
-wire   [47:0] mac_depacketizer_source_payload_target_mac;
-wire          mac_depacketizer_source_ready;
-reg           mac_depacketizer_source_valid = 1'd0;
-reg   [111:0] mac_depacketizer_sr = 112'd0;
-reg           mac_depacketizer_sr_shift = 1'd0;
-reg           mac_depacketizer_sr_shift_leftover = 1'd0;
-reg           mac_depacketizer_was_in_copy = 1'd0;
+wire          mac_cut;
+reg           mac_fsm_is_ongoing0 = 1'd0;
+reg           mac_fsm_is_ongoing1 = 1'd0;
+reg     [3:0] mac_liteethmacdepacketizer_count = 4'd0;
+reg     [3:0] mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 = 4'd0;
+reg           mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 = 1'd0;
+reg           mac_liteethmacdepacketizer_delayed_last_be = 1'd0;
+reg           mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 = 1'd0;
+reg           mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 = 1'd0;
+reg           mac_liteethmacdepacketizer_fsm_from_idle = 1'd0;
+reg           mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 = 1'd0;
+reg           mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 = 1'd0;
+wire  [111:0] mac_liteethmacdepacketizer_header;
+wire          mac_liteethmacdepacketizer_is_in_copy;
+reg           mac_liteethmacdepacketizer_is_ongoing0 = 1'd0;
+reg           mac_liteethmacdepacketizer_is_ongoing1 = 1'd0;
+reg           mac_liteethmacdepacketizer_is_ongoing2 = 1'd0;
+reg           mac_liteethmacdepacketizer_is_ongoing3 = 1'd0;
+wire          mac_liteethmacdepacketizer_new_last_be;
+reg           mac_liteethmacdepacketizer_sink_d_last = 1'd0;
+wire          mac_liteethmacdepacketizer_sink_first;
+wire          mac_liteethmacdepacketizer_sink_last;
+wire          mac_liteethmacdepacketizer_sink_last_be;
+wire    [7:0] mac_liteethmacdepacketizer_sink_payload_data;
+wire          mac_liteethmacdepacketizer_sink_payload_error;
+wire          mac_liteethmacdepacketizer_sink_payload_last_be;
+reg           mac_liteethmacdepacketizer_sink_ready = 1'd0;
+wire          mac_liteethmacdepacketizer_sink_valid;
+reg           mac_liteethmacdepacketizer_source_first = 1'd0;
+reg           mac_liteethmacdepacketizer_source_last = 1'd0;
+reg           mac_liteethmacdepacketizer_source_last_a = 1'd0;
+reg           mac_liteethmacdepacketizer_source_last_b = 1'd0;
+reg           mac_liteethmacdepacketizer_source_last_s = 1'd0;
+reg     [7:0] mac_liteethmacdepacketizer_source_payload_data = 8'd0;
+wire          mac_liteethmacdepacketizer_source_payload_error;
+wire   [15:0] mac_liteethmacdepacketizer_source_payload_ethernet_type;
+reg           mac_liteethmacdepacketizer_source_payload_last_be = 1'd0;
+wire   [47:0] mac_liteethmacdepacketizer_source_payload_sender_mac;
+wire   [47:0] mac_liteethmacdepacketizer_source_payload_target_mac;
+wire          mac_liteethmacdepacketizer_source_ready;
+reg           mac_liteethmacdepacketizer_source_valid = 1'd0;
+reg   [111:0] mac_liteethmacdepacketizer_sr = 112'd0;
+reg           mac_liteethmacdepacketizer_sr_shift = 1'd0;
+reg           mac_liteethmacdepacketizer_sr_shift_leftover = 1'd0;
+reg           mac_liteethmacdepacketizer_was_in_copy = 1'd0;
 reg     [3:0] mac_packetizer_count = 4'd0;
 reg     [3:0] mac_packetizer_count_liteethmac_fsm0_next_value0 = 4'd0;
 reg           mac_packetizer_count_liteethmac_fsm0_next_value_ce0 = 1'd0;
@@ -2262,7 +2298,9 @@ wire          we;
 //------------------------------------------------------------------------------
 
 assign ethphy_source_payload_last_be = ethphy_source_last;
-assign take_group = (ip_rx_depacketizer_source_param_target_ip == ip_multicast);
+assign take_group = (ip_rx_liteethipv4depacketizer_source_param_target_ip == ip_multicast);
+assign rx_drop_header = ((((mac_cut | ip_rx_cut) | ip_rx_drop_header) | holdingudprx_cut0) | holdingudprx_drop_header);
+assign rx_drop_other = (((mac_crossbar_dropped | ip_rx_drop_other) | ip_crossbar_dropped) | crossbar_dropped);
 assign user_port_sink_valid = udp_sink_valid;
 assign user_port_sink_last = udp_sink_last;
 assign user_port_sink_param_dst_port = udp_sink_dst_port;
@@ -2292,6 +2330,7 @@ assign ethphy_reset = ethphy_reset_storage;
 assign ethphy_sink_ready = 1'd1;
 assign ethphy_last = ((~ethphy_rx_ctl_reg[0]) & ethphy_rx_ctl_reg_d[0]);
 assign ethphy_source_last = ethphy_last;
+assign ethphy_errored = (ethphy_rx_ctl_reg[0] & (~ethphy_rx_ctl_reg[1]));
 assign mac_packetizer_sink_valid = mac_crossbar_source_valid;
 assign mac_crossbar_source_ready = mac_packetizer_sink_ready;
 assign mac_packetizer_sink_first = mac_crossbar_source_first;
@@ -2309,23 +2348,23 @@ assign mac_core_sink_last = mac_packetizer_source_last;
 assign mac_core_sink_payload_data = mac_packetizer_source_payload_data;
 assign mac_core_sink_payload_last_be = mac_packetizer_source_payload_last_be;
 assign mac_core_sink_payload_error = mac_packetizer_source_payload_error;
-assign mac_depacketizer_sink_valid = mac_core_source_valid;
-assign mac_core_source_ready = mac_depacketizer_sink_ready;
-assign mac_depacketizer_sink_first = mac_core_source_first;
-assign mac_depacketizer_sink_last = mac_core_source_last;
-assign mac_depacketizer_sink_payload_data = mac_core_source_payload_data;
-assign mac_depacketizer_sink_payload_last_be = mac_core_source_payload_last_be;
-assign mac_depacketizer_sink_payload_error = mac_core_source_payload_error;
-assign mac_crossbar_sink_valid = mac_depacketizer_source_valid;
-assign mac_depacketizer_source_ready = mac_crossbar_sink_ready;
-assign mac_crossbar_sink_first = mac_depacketizer_source_first;
-assign mac_crossbar_sink_last = mac_depacketizer_source_last;
-assign mac_crossbar_sink_payload_ethernet_type = mac_depacketizer_source_payload_ethernet_type;
-assign mac_crossbar_sink_payload_sender_mac = mac_depacketizer_source_payload_sender_mac;
-assign mac_crossbar_sink_payload_target_mac = mac_depacketizer_source_payload_target_mac;
-assign mac_crossbar_sink_payload_data = mac_depacketizer_source_payload_data;
-assign mac_crossbar_sink_payload_last_be = mac_depacketizer_source_payload_last_be;
-assign mac_crossbar_sink_payload_error = mac_depacketizer_source_payload_error;
+assign mac_liteethmacdepacketizer_sink_valid = mac_core_source_valid;
+assign mac_core_source_ready = mac_liteethmacdepacketizer_sink_ready;
+assign mac_liteethmacdepacketizer_sink_first = mac_core_source_first;
+assign mac_liteethmacdepacketizer_sink_last = mac_core_source_last;
+assign mac_liteethmacdepacketizer_sink_payload_data = mac_core_source_payload_data;
+assign mac_liteethmacdepacketizer_sink_payload_last_be = mac_core_source_payload_last_be;
+assign mac_liteethmacdepacketizer_sink_payload_error = mac_core_source_payload_error;
+assign mac_crossbar_sink_valid = mac_liteethmacdepacketizer_source_valid;
+assign mac_liteethmacdepacketizer_source_ready = mac_crossbar_sink_ready;
+assign mac_crossbar_sink_first = mac_liteethmacdepacketizer_source_first;
+assign mac_crossbar_sink_last = mac_liteethmacdepacketizer_source_last;
+assign mac_crossbar_sink_payload_ethernet_type = mac_liteethmacdepacketizer_source_payload_ethernet_type;
+assign mac_crossbar_sink_payload_sender_mac = mac_liteethmacdepacketizer_source_payload_sender_mac;
+assign mac_crossbar_sink_payload_target_mac = mac_liteethmacdepacketizer_source_payload_target_mac;
+assign mac_crossbar_sink_payload_data = mac_liteethmacdepacketizer_source_payload_data;
+assign mac_crossbar_sink_payload_last_be = mac_liteethmacdepacketizer_source_payload_last_be;
+assign mac_crossbar_sink_payload_error = mac_liteethmacdepacketizer_source_payload_error;
 assign mac_core_tx_cdc_cdc_sink_valid = mac_core_tx_cdc_sink_sink_valid;
 assign mac_core_tx_cdc_sink_sink_ready = mac_core_tx_cdc_cdc_sink_ready;
 assign mac_core_tx_cdc_cdc_sink_first = mac_core_tx_cdc_sink_sink_first;
@@ -3081,6 +3120,8 @@ assign mac_core_source_last = mac_core_source_source_last;
 assign mac_core_source_payload_data = mac_core_source_source_payload_data;
 assign mac_core_source_payload_last_be = mac_core_source_source_payload_last_be;
 assign mac_core_source_payload_error = mac_core_source_source_payload_error;
+assign liteethmac_taken = (((1'd0 + arp_mac_port_source_valid) + ip_mac_port_source_valid) != 1'd0);
+assign mac_crossbar_dropped = (((mac_crossbar_sink_valid & mac_crossbar_sink_ready) & mac_crossbar_sink_last) & (~liteethmac_taken));
 always @(*) begin
     liteethmac_sel0 <= 2'd0;
     if ((mac_crossbar_sink_payload_ethernet_type == 12'd2054)) begin
@@ -3335,302 +3376,313 @@ always @(*) begin
         end
     endcase
 end
-assign mac_depacketizer_header = mac_depacketizer_sr;
-assign mac_depacketizer_source_payload_ethernet_type = {rhs_slice_proxy1[7:0], rhs_slice_proxy0[15:8]};
-assign mac_depacketizer_source_payload_sender_mac = {rhs_slice_proxy7[7:0], rhs_slice_proxy6[15:8], rhs_slice_proxy5[23:16], rhs_slice_proxy4[31:24], rhs_slice_proxy3[39:32], rhs_slice_proxy2[47:40]};
-assign mac_depacketizer_source_payload_target_mac = {rhs_slice_proxy13[7:0], rhs_slice_proxy12[15:8], rhs_slice_proxy11[23:16], rhs_slice_proxy10[31:24], rhs_slice_proxy9[39:32], rhs_slice_proxy8[47:40]};
-assign mac_depacketizer_source_payload_error = mac_depacketizer_sink_payload_error;
-assign mac_depacketizer_sink_last_be = mac_depacketizer_sink_last;
-assign mac_depacketizer_new_last_be = {mac_depacketizer_sink_last_be};
-assign mac_depacketizer_is_in_copy = (mac_depacketizer_is_ongoing0 | mac_depacketizer_is_ongoing1);
+assign mac_liteethmacdepacketizer_header = mac_liteethmacdepacketizer_sr;
+assign mac_liteethmacdepacketizer_source_payload_ethernet_type = {rhs_slice_proxy1[7:0], rhs_slice_proxy0[15:8]};
+assign mac_liteethmacdepacketizer_source_payload_sender_mac = {rhs_slice_proxy7[7:0], rhs_slice_proxy6[15:8], rhs_slice_proxy5[23:16], rhs_slice_proxy4[31:24], rhs_slice_proxy3[39:32], rhs_slice_proxy2[47:40]};
+assign mac_liteethmacdepacketizer_source_payload_target_mac = {rhs_slice_proxy13[7:0], rhs_slice_proxy12[15:8], rhs_slice_proxy11[23:16], rhs_slice_proxy10[31:24], rhs_slice_proxy9[39:32], rhs_slice_proxy8[47:40]};
+assign mac_liteethmacdepacketizer_source_payload_error = mac_liteethmacdepacketizer_sink_payload_error;
+assign mac_liteethmacdepacketizer_sink_last_be = mac_liteethmacdepacketizer_sink_last;
+assign mac_liteethmacdepacketizer_new_last_be = {mac_liteethmacdepacketizer_sink_last_be};
+assign mac_liteethmacdepacketizer_is_in_copy = (mac_liteethmacdepacketizer_is_ongoing0 | mac_liteethmacdepacketizer_is_ongoing1);
 always @(*) begin
-    mac_depacketizer_source_last <= 1'd0;
-    if (mac_depacketizer_source_last_s) begin
-        mac_depacketizer_source_last <= mac_depacketizer_source_last_b;
+    mac_liteethmacdepacketizer_source_last <= 1'd0;
+    if (mac_liteethmacdepacketizer_source_last_s) begin
+        mac_liteethmacdepacketizer_source_last <= mac_liteethmacdepacketizer_source_last_b;
     end else begin
-        mac_depacketizer_source_last <= mac_depacketizer_source_last_a;
+        mac_liteethmacdepacketizer_source_last <= mac_liteethmacdepacketizer_source_last_a;
     end
 end
+assign mac_cut = ((mac_liteethmacdepacketizer_sink_valid & mac_liteethmacdepacketizer_sink_last) & (mac_fsm_is_ongoing0 | mac_fsm_is_ongoing1));
 always @(*) begin
     liteethmac_fsm0_next_state1 <= 2'd0;
     liteethmac_fsm1_next_state1 <= 1'd0;
-    mac_depacketizer_count_liteethmac_fsm0_next_value2 <= 4'd0;
-    mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd0;
-    mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= 1'd0;
-    mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd0;
-    mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd0;
-    mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd0;
-    mac_depacketizer_is_ongoing0 <= 1'd0;
-    mac_depacketizer_is_ongoing1 <= 1'd0;
-    mac_depacketizer_is_ongoing2 <= 1'd0;
-    mac_depacketizer_is_ongoing3 <= 1'd0;
-    mac_depacketizer_sink_ready <= 1'd0;
-    mac_depacketizer_source_last_a <= 1'd0;
-    mac_depacketizer_source_last_b <= 1'd0;
-    mac_depacketizer_source_last_s <= 1'd0;
-    mac_depacketizer_source_payload_data <= 8'd0;
-    mac_depacketizer_source_payload_last_be <= 1'd0;
-    mac_depacketizer_source_valid <= 1'd0;
-    mac_depacketizer_sr_shift <= 1'd0;
+    mac_fsm_is_ongoing0 <= 1'd0;
+    mac_fsm_is_ongoing1 <= 1'd0;
+    mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= 4'd0;
+    mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd0;
+    mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= 1'd0;
+    mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd0;
+    mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd0;
+    mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd0;
+    mac_liteethmacdepacketizer_is_ongoing0 <= 1'd0;
+    mac_liteethmacdepacketizer_is_ongoing1 <= 1'd0;
+    mac_liteethmacdepacketizer_is_ongoing2 <= 1'd0;
+    mac_liteethmacdepacketizer_is_ongoing3 <= 1'd0;
+    mac_liteethmacdepacketizer_sink_ready <= 1'd0;
+    mac_liteethmacdepacketizer_source_last_a <= 1'd0;
+    mac_liteethmacdepacketizer_source_last_b <= 1'd0;
+    mac_liteethmacdepacketizer_source_last_s <= 1'd0;
+    mac_liteethmacdepacketizer_source_payload_data <= 8'd0;
+    mac_liteethmacdepacketizer_source_payload_last_be <= 1'd0;
+    mac_liteethmacdepacketizer_source_valid <= 1'd0;
+    mac_liteethmacdepacketizer_sr_shift <= 1'd0;
     liteethmac_fsm0_next_state1 <= liteethmac_fsm0_state1;
     case (liteethmac_fsm0_state1)
         1'd1: begin
-            mac_depacketizer_sink_ready <= 1'd1;
-            if (mac_depacketizer_sink_valid) begin
-                mac_depacketizer_count_liteethmac_fsm0_next_value2 <= (mac_depacketizer_count + 1'd1);
-                mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
-                mac_depacketizer_sr_shift <= 1'd1;
-                if ((mac_depacketizer_count == 4'd13)) begin
+            mac_liteethmacdepacketizer_sink_ready <= 1'd1;
+            if (mac_liteethmacdepacketizer_sink_valid) begin
+                mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= (mac_liteethmacdepacketizer_count + 1'd1);
+                mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
+                mac_liteethmacdepacketizer_sr_shift <= 1'd1;
+                if ((mac_liteethmacdepacketizer_count == 4'd13)) begin
                     liteethmac_fsm0_next_state1 <= 2'd2;
-                    mac_depacketizer_count_liteethmac_fsm0_next_value2 <= (mac_depacketizer_count + 1'd1);
-                    mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
+                    mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= (mac_liteethmacdepacketizer_count + 1'd1);
+                    mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            mac_fsm_is_ongoing1 <= 1'd1;
+            if ((mac_liteethmacdepacketizer_sink_valid & mac_liteethmacdepacketizer_sink_last)) begin
+                liteethmac_fsm0_next_state1 <= 1'd0;
             end
         end
         2'd2: begin
-            mac_depacketizer_source_valid <= (mac_depacketizer_sink_valid | mac_depacketizer_sink_d_last);
-            mac_depacketizer_source_last_a <= (mac_depacketizer_sink_last | mac_depacketizer_sink_d_last);
-            mac_depacketizer_sink_ready <= mac_depacketizer_source_ready;
-            mac_depacketizer_source_payload_data <= mac_depacketizer_sink_payload_data;
-            if ((mac_depacketizer_source_valid & mac_depacketizer_source_ready)) begin
-                if (mac_depacketizer_source_last) begin
+            mac_liteethmacdepacketizer_source_valid <= (mac_liteethmacdepacketizer_sink_valid | mac_liteethmacdepacketizer_sink_d_last);
+            mac_liteethmacdepacketizer_source_last_a <= (mac_liteethmacdepacketizer_sink_last | mac_liteethmacdepacketizer_sink_d_last);
+            mac_liteethmacdepacketizer_sink_ready <= mac_liteethmacdepacketizer_source_ready;
+            mac_liteethmacdepacketizer_source_payload_data <= mac_liteethmacdepacketizer_sink_payload_data;
+            if ((mac_liteethmacdepacketizer_source_valid & mac_liteethmacdepacketizer_source_ready)) begin
+                if (mac_liteethmacdepacketizer_source_last) begin
                     liteethmac_fsm0_next_state1 <= 1'd0;
                 end
             end
-            mac_depacketizer_is_ongoing0 <= 1'd1;
-            mac_depacketizer_is_ongoing2 <= 1'd1;
+            mac_liteethmacdepacketizer_is_ongoing0 <= 1'd1;
+            mac_liteethmacdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            mac_depacketizer_is_ongoing1 <= 1'd1;
-            mac_depacketizer_is_ongoing3 <= 1'd1;
+            mac_liteethmacdepacketizer_is_ongoing1 <= 1'd1;
+            mac_liteethmacdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            mac_depacketizer_sink_ready <= 1'd1;
-            mac_depacketizer_count_liteethmac_fsm0_next_value2 <= 1'd1;
-            mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
-            if (mac_depacketizer_sink_valid) begin
-                mac_depacketizer_sr_shift <= 1'd1;
-                mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd1;
-                mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd1;
+            mac_liteethmacdepacketizer_sink_ready <= 1'd1;
+            mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= 1'd1;
+            mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
+            if (mac_liteethmacdepacketizer_sink_valid) begin
+                mac_liteethmacdepacketizer_sr_shift <= 1'd1;
+                mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd1;
+                mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
                     liteethmac_fsm0_next_state1 <= 2'd2;
                 end else begin
                     liteethmac_fsm0_next_state1 <= 1'd1;
                 end
             end
+            mac_fsm_is_ongoing0 <= 1'd1;
+            if ((mac_liteethmacdepacketizer_sink_valid & mac_liteethmacdepacketizer_sink_last)) begin
+                liteethmac_fsm0_next_state1 <= 1'd0;
+            end
         end
     endcase
     liteethmac_fsm1_next_state1 <= liteethmac_fsm1_state1;
     case (liteethmac_fsm1_state1)
         1'd1: begin
-            mac_depacketizer_source_last_b <= 1'd1;
-            mac_depacketizer_source_last_s <= 1'd1;
-            mac_depacketizer_source_payload_last_be <= mac_depacketizer_delayed_last_be;
-            mac_depacketizer_sink_ready <= 1'd0;
-            if ((mac_depacketizer_source_ready & mac_depacketizer_source_valid)) begin
+            mac_liteethmacdepacketizer_source_last_b <= 1'd1;
+            mac_liteethmacdepacketizer_source_last_s <= 1'd1;
+            mac_liteethmacdepacketizer_source_payload_last_be <= mac_liteethmacdepacketizer_delayed_last_be;
+            mac_liteethmacdepacketizer_sink_ready <= 1'd0;
+            if ((mac_liteethmacdepacketizer_source_ready & mac_liteethmacdepacketizer_source_valid)) begin
                 liteethmac_fsm1_next_state1 <= 1'd0;
             end
         end
         default: begin
-            if (((mac_depacketizer_sink_valid & mac_depacketizer_sink_last) & (mac_depacketizer_sink_last_be > mac_depacketizer_new_last_be))) begin
-                mac_depacketizer_source_last_b <= 1'd0;
-                mac_depacketizer_source_last_s <= 1'd1;
-                mac_depacketizer_source_payload_last_be <= 1'd0;
-                if (((mac_depacketizer_source_ready & mac_depacketizer_source_valid) | ((~mac_depacketizer_was_in_copy) & mac_depacketizer_is_in_copy))) begin
-                    mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= mac_depacketizer_new_last_be;
-                    mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd1;
+            if (((mac_liteethmacdepacketizer_sink_valid & mac_liteethmacdepacketizer_sink_last) & (mac_liteethmacdepacketizer_sink_last_be > mac_liteethmacdepacketizer_new_last_be))) begin
+                mac_liteethmacdepacketizer_source_last_b <= 1'd0;
+                mac_liteethmacdepacketizer_source_last_s <= 1'd1;
+                mac_liteethmacdepacketizer_source_payload_last_be <= 1'd0;
+                if (((mac_liteethmacdepacketizer_source_ready & mac_liteethmacdepacketizer_source_valid) | ((~mac_liteethmacdepacketizer_was_in_copy) & mac_liteethmacdepacketizer_is_in_copy))) begin
+                    mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= mac_liteethmacdepacketizer_new_last_be;
+                    mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd1;
                     liteethmac_fsm1_next_state1 <= 1'd1;
                 end
             end else begin
-                if (mac_depacketizer_sink_last) begin
-                    mac_depacketizer_source_last_b <= 1'd1;
-                    mac_depacketizer_source_last_s <= 1'd1;
-                    mac_depacketizer_source_payload_last_be <= mac_depacketizer_new_last_be;
+                if (mac_liteethmacdepacketizer_sink_last) begin
+                    mac_liteethmacdepacketizer_source_last_b <= 1'd1;
+                    mac_liteethmacdepacketizer_source_last_s <= 1'd1;
+                    mac_liteethmacdepacketizer_source_payload_last_be <= mac_liteethmacdepacketizer_new_last_be;
                 end
             end
-            if ((mac_depacketizer_is_ongoing2 | (mac_depacketizer_is_ongoing3 & (~mac_depacketizer_fsm_from_idle)))) begin
-                mac_depacketizer_sink_ready <= mac_depacketizer_source_ready;
+            if ((mac_liteethmacdepacketizer_is_ongoing2 | (mac_liteethmacdepacketizer_is_ongoing3 & (~mac_liteethmacdepacketizer_fsm_from_idle)))) begin
+                mac_liteethmacdepacketizer_sink_ready <= mac_liteethmacdepacketizer_source_ready;
             end else begin
-                mac_depacketizer_sink_ready <= 1'd1;
+                mac_liteethmacdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
-assign arp_table_sink_valid = arp_rx_source_source_valid;
-assign arp_rx_source_source_ready = arp_table_sink_ready;
-assign arp_table_sink_first = arp_rx_source_source_first;
-assign arp_table_sink_last = arp_rx_source_source_last;
-assign arp_table_sink_payload_reply = arp_rx_source_source_payload_reply;
-assign arp_table_sink_payload_request = arp_rx_source_source_payload_request;
-assign arp_table_sink_payload_ip_address = arp_rx_source_source_payload_ip_address;
-assign arp_table_sink_payload_mac_address = arp_rx_source_source_payload_mac_address;
-assign arp_tx_sink_sink_valid = arp_table_source_valid;
-assign arp_table_source_ready = arp_tx_sink_sink_ready;
-assign arp_tx_sink_sink_first = arp_table_source_first;
-assign arp_tx_sink_sink_last = arp_table_source_last;
-assign arp_tx_sink_sink_payload_reply = arp_table_source_payload_reply;
-assign arp_tx_sink_sink_payload_request = arp_table_source_payload_request;
-assign arp_tx_sink_sink_payload_ip_address = arp_table_source_payload_ip_address;
-assign arp_tx_sink_sink_payload_mac_address = arp_table_source_payload_mac_address;
-assign arp_mac_port_sink_valid = arp_tx_source_source_valid;
-assign arp_tx_source_source_ready = arp_mac_port_sink_ready;
-assign arp_mac_port_sink_first = arp_tx_source_source_first;
-assign arp_mac_port_sink_last = arp_tx_source_source_last;
-assign arp_mac_port_sink_payload_ethernet_type = arp_tx_source_source_payload_ethernet_type;
-assign arp_mac_port_sink_payload_sender_mac = arp_tx_source_source_payload_sender_mac;
-assign arp_mac_port_sink_payload_target_mac = arp_tx_source_source_payload_target_mac;
-assign arp_mac_port_sink_payload_data = arp_tx_source_source_payload_data;
-assign arp_mac_port_sink_payload_last_be = arp_tx_source_source_payload_last_be;
-assign arp_mac_port_sink_payload_error = arp_tx_source_source_payload_error;
-assign arp_rx_sink_sink_valid = arp_mac_port_source_valid;
-assign arp_mac_port_source_ready = arp_rx_sink_sink_ready;
-assign arp_rx_sink_sink_first = arp_mac_port_source_first;
-assign arp_rx_sink_sink_last = arp_mac_port_source_last;
-assign arp_rx_sink_sink_payload_ethernet_type = arp_mac_port_source_payload_ethernet_type;
-assign arp_rx_sink_sink_payload_sender_mac = arp_mac_port_source_payload_sender_mac;
-assign arp_rx_sink_sink_payload_target_mac = arp_mac_port_source_payload_target_mac;
-assign arp_rx_sink_sink_payload_data = arp_mac_port_source_payload_data;
-assign arp_rx_sink_sink_payload_last_be = arp_mac_port_source_payload_last_be;
-assign arp_rx_sink_sink_payload_error = arp_mac_port_source_payload_error;
-assign arp_tx_packetizer_sink_last = (arp_tx_counter == 6'd45);
+assign arp_table_sink_valid = arp_rx_source_valid;
+assign arp_rx_source_ready = arp_table_sink_ready;
+assign arp_table_sink_first = arp_rx_source_first;
+assign arp_table_sink_last = arp_rx_source_last;
+assign arp_table_sink_payload_reply = arp_rx_source_payload_reply;
+assign arp_table_sink_payload_request = arp_rx_source_payload_request;
+assign arp_table_sink_payload_ip_address = arp_rx_source_payload_ip_address;
+assign arp_table_sink_payload_mac_address = arp_rx_source_payload_mac_address;
+assign arp_sink_sink_valid = arp_table_source_valid;
+assign arp_table_source_ready = arp_sink_sink_ready;
+assign arp_sink_sink_first = arp_table_source_first;
+assign arp_sink_sink_last = arp_table_source_last;
+assign arp_sink_sink_payload_reply = arp_table_source_payload_reply;
+assign arp_sink_sink_payload_request = arp_table_source_payload_request;
+assign arp_sink_sink_payload_ip_address = arp_table_source_payload_ip_address;
+assign arp_sink_sink_payload_mac_address = arp_table_source_payload_mac_address;
+assign arp_mac_port_sink_valid = arp_source_source_valid;
+assign arp_source_source_ready = arp_mac_port_sink_ready;
+assign arp_mac_port_sink_first = arp_source_source_first;
+assign arp_mac_port_sink_last = arp_source_source_last;
+assign arp_mac_port_sink_payload_ethernet_type = arp_source_source_payload_ethernet_type;
+assign arp_mac_port_sink_payload_sender_mac = arp_source_source_payload_sender_mac;
+assign arp_mac_port_sink_payload_target_mac = arp_source_source_payload_target_mac;
+assign arp_mac_port_sink_payload_data = arp_source_source_payload_data;
+assign arp_mac_port_sink_payload_last_be = arp_source_source_payload_last_be;
+assign arp_mac_port_sink_payload_error = arp_source_source_payload_error;
+assign arp_rx_sink_valid = arp_mac_port_source_valid;
+assign arp_mac_port_source_ready = arp_rx_sink_ready;
+assign arp_rx_sink_first = arp_mac_port_source_first;
+assign arp_rx_sink_last = arp_mac_port_source_last;
+assign arp_rx_sink_payload_ethernet_type = arp_mac_port_source_payload_ethernet_type;
+assign arp_rx_sink_payload_sender_mac = arp_mac_port_source_payload_sender_mac;
+assign arp_rx_sink_payload_target_mac = arp_mac_port_source_payload_target_mac;
+assign arp_rx_sink_payload_data = arp_mac_port_source_payload_data;
+assign arp_rx_sink_payload_last_be = arp_mac_port_source_payload_last_be;
+assign arp_rx_sink_payload_error = arp_mac_port_source_payload_error;
+assign arp_packetizer_sink_last = (arp_counter == 6'd45);
 always @(*) begin
-    arp_tx_packetizer_sink_payload_last_be <= 1'd0;
-    if (arp_tx_packetizer_sink_last) begin
-        arp_tx_packetizer_sink_payload_last_be <= 1'd1;
+    arp_packetizer_sink_payload_last_be <= 1'd0;
+    if (arp_packetizer_sink_last) begin
+        arp_packetizer_sink_payload_last_be <= 1'd1;
     end
 end
-assign arp_tx_packetizer_sink_param_hwtype = 1'd1;
-assign arp_tx_packetizer_sink_param_proto = 12'd2048;
-assign arp_tx_packetizer_sink_param_hwsize = 3'd6;
-assign arp_tx_packetizer_sink_param_protosize = 3'd4;
-assign arp_tx_packetizer_sink_param_sender_mac = mac_address;
-assign arp_tx_packetizer_sink_param_sender_ip = ip_address;
-assign arp_tx_packetizer_sink_param_target_ip = arp_tx_sink_sink_payload_ip_address;
+assign arp_packetizer_sink_param_hwtype = 1'd1;
+assign arp_packetizer_sink_param_proto = 12'd2048;
+assign arp_packetizer_sink_param_hwsize = 3'd6;
+assign arp_packetizer_sink_param_protosize = 3'd4;
+assign arp_packetizer_sink_param_sender_mac = mac_address;
+assign arp_packetizer_sink_param_sender_ip = ip_address;
+assign arp_packetizer_sink_param_target_ip = arp_sink_sink_payload_ip_address;
 always @(*) begin
-    arp_tx_packetizer_sink_param_opcode <= 16'd0;
-    arp_tx_packetizer_sink_param_target_mac <= 48'd0;
-    if (arp_tx_sink_sink_payload_reply) begin
-        arp_tx_packetizer_sink_param_opcode <= 2'd2;
-        arp_tx_packetizer_sink_param_target_mac <= arp_tx_sink_sink_payload_mac_address;
+    arp_packetizer_sink_param_opcode <= 16'd0;
+    arp_packetizer_sink_param_target_mac <= 48'd0;
+    if (arp_sink_sink_payload_reply) begin
+        arp_packetizer_sink_param_opcode <= 2'd2;
+        arp_packetizer_sink_param_target_mac <= arp_sink_sink_payload_mac_address;
     end else begin
-        if (arp_tx_sink_sink_payload_request) begin
-            arp_tx_packetizer_sink_param_opcode <= 1'd1;
-            arp_tx_packetizer_sink_param_target_mac <= 48'd281474976710655;
+        if (arp_sink_sink_payload_request) begin
+            arp_packetizer_sink_param_opcode <= 1'd1;
+            arp_packetizer_sink_param_target_mac <= 48'd281474976710655;
         end
     end
 end
-assign arp_tx_source_source_first = arp_tx_packetizer_source_first;
-assign arp_tx_source_source_last = arp_tx_packetizer_source_last;
-assign arp_tx_source_source_payload_data = arp_tx_packetizer_source_payload_data;
-assign arp_tx_source_source_payload_last_be = arp_tx_packetizer_source_payload_last_be;
-assign arp_tx_source_source_payload_error = arp_tx_packetizer_source_payload_error;
+assign arp_source_source_first = arp_packetizer_source_first;
+assign arp_source_source_last = arp_packetizer_source_last;
+assign arp_source_source_payload_data = arp_packetizer_source_payload_data;
+assign arp_source_source_payload_last_be = arp_packetizer_source_payload_last_be;
+assign arp_source_source_payload_error = arp_packetizer_source_payload_error;
 always @(*) begin
-    arp_tx_source_source_payload_target_mac <= 48'd0;
-    arp_tx_source_source_payload_target_mac <= arp_tx_packetizer_source_payload_target_mac;
-    arp_tx_source_source_payload_target_mac <= arp_tx_packetizer_sink_param_target_mac;
+    arp_source_source_payload_target_mac <= 48'd0;
+    arp_source_source_payload_target_mac <= arp_packetizer_source_payload_target_mac;
+    arp_source_source_payload_target_mac <= arp_packetizer_sink_param_target_mac;
 end
 always @(*) begin
-    arp_tx_source_source_payload_sender_mac <= 48'd0;
-    arp_tx_source_source_payload_sender_mac <= arp_tx_packetizer_source_payload_sender_mac;
-    arp_tx_source_source_payload_sender_mac <= mac_address;
+    arp_source_source_payload_sender_mac <= 48'd0;
+    arp_source_source_payload_sender_mac <= arp_packetizer_source_payload_sender_mac;
+    arp_source_source_payload_sender_mac <= mac_address;
 end
 always @(*) begin
-    arp_tx_source_source_payload_ethernet_type <= 16'd0;
-    arp_tx_source_source_payload_ethernet_type <= arp_tx_packetizer_source_payload_ethernet_type;
-    arp_tx_source_source_payload_ethernet_type <= 12'd2054;
+    arp_source_source_payload_ethernet_type <= 16'd0;
+    arp_source_source_payload_ethernet_type <= arp_packetizer_source_payload_ethernet_type;
+    arp_source_source_payload_ethernet_type <= 12'd2054;
 end
 always @(*) begin
-    arp_tx_packetizer_header <= 224'd0;
-    arp_tx_packetizer_header[39:32] <= {arp_tx_packetizer_sink_param_hwsize[7:0]};
-    arp_tx_packetizer_header[15:0] <= {arp_tx_packetizer_sink_param_hwtype[7:0], arp_tx_packetizer_sink_param_hwtype[15:8]};
-    arp_tx_packetizer_header[63:48] <= {arp_tx_packetizer_sink_param_opcode[7:0], arp_tx_packetizer_sink_param_opcode[15:8]};
-    arp_tx_packetizer_header[31:16] <= {arp_tx_packetizer_sink_param_proto[7:0], arp_tx_packetizer_sink_param_proto[15:8]};
-    arp_tx_packetizer_header[47:40] <= {arp_tx_packetizer_sink_param_protosize[7:0]};
-    arp_tx_packetizer_header[143:112] <= {arp_tx_packetizer_sink_param_sender_ip[7:0], arp_tx_packetizer_sink_param_sender_ip[15:8], arp_tx_packetizer_sink_param_sender_ip[23:16], arp_tx_packetizer_sink_param_sender_ip[31:24]};
-    arp_tx_packetizer_header[111:64] <= {arp_tx_packetizer_sink_param_sender_mac[7:0], arp_tx_packetizer_sink_param_sender_mac[15:8], arp_tx_packetizer_sink_param_sender_mac[23:16], arp_tx_packetizer_sink_param_sender_mac[31:24], arp_tx_packetizer_sink_param_sender_mac[39:32], arp_tx_packetizer_sink_param_sender_mac[47:40]};
-    arp_tx_packetizer_header[223:192] <= {arp_tx_packetizer_sink_param_target_ip[7:0], arp_tx_packetizer_sink_param_target_ip[15:8], arp_tx_packetizer_sink_param_target_ip[23:16], arp_tx_packetizer_sink_param_target_ip[31:24]};
-    arp_tx_packetizer_header[191:144] <= {arp_tx_packetizer_sink_param_target_mac[7:0], arp_tx_packetizer_sink_param_target_mac[15:8], arp_tx_packetizer_sink_param_target_mac[23:16], arp_tx_packetizer_sink_param_target_mac[31:24], arp_tx_packetizer_sink_param_target_mac[39:32], arp_tx_packetizer_sink_param_target_mac[47:40]};
+    arp_packetizer_header <= 224'd0;
+    arp_packetizer_header[39:32] <= {arp_packetizer_sink_param_hwsize[7:0]};
+    arp_packetizer_header[15:0] <= {arp_packetizer_sink_param_hwtype[7:0], arp_packetizer_sink_param_hwtype[15:8]};
+    arp_packetizer_header[63:48] <= {arp_packetizer_sink_param_opcode[7:0], arp_packetizer_sink_param_opcode[15:8]};
+    arp_packetizer_header[31:16] <= {arp_packetizer_sink_param_proto[7:0], arp_packetizer_sink_param_proto[15:8]};
+    arp_packetizer_header[47:40] <= {arp_packetizer_sink_param_protosize[7:0]};
+    arp_packetizer_header[143:112] <= {arp_packetizer_sink_param_sender_ip[7:0], arp_packetizer_sink_param_sender_ip[15:8], arp_packetizer_sink_param_sender_ip[23:16], arp_packetizer_sink_param_sender_ip[31:24]};
+    arp_packetizer_header[111:64] <= {arp_packetizer_sink_param_sender_mac[7:0], arp_packetizer_sink_param_sender_mac[15:8], arp_packetizer_sink_param_sender_mac[23:16], arp_packetizer_sink_param_sender_mac[31:24], arp_packetizer_sink_param_sender_mac[39:32], arp_packetizer_sink_param_sender_mac[47:40]};
+    arp_packetizer_header[223:192] <= {arp_packetizer_sink_param_target_ip[7:0], arp_packetizer_sink_param_target_ip[15:8], arp_packetizer_sink_param_target_ip[23:16], arp_packetizer_sink_param_target_ip[31:24]};
+    arp_packetizer_header[191:144] <= {arp_packetizer_sink_param_target_mac[7:0], arp_packetizer_sink_param_target_mac[15:8], arp_packetizer_sink_param_target_mac[23:16], arp_packetizer_sink_param_target_mac[31:24], arp_packetizer_sink_param_target_mac[39:32], arp_packetizer_sink_param_target_mac[47:40]};
 end
-assign arp_tx_packetizer_sink_last_be = arp_tx_packetizer_sink_last;
-assign arp_tx_packetizer_new_last_be = {arp_tx_packetizer_sink_last_be};
-assign arp_tx_packetizer_in_data_copy = (arp_tx_packetizer_is_ongoing0 | arp_tx_packetizer_is_ongoing1);
+assign arp_packetizer_sink_last_be = arp_packetizer_sink_last;
+assign arp_packetizer_new_last_be = {arp_packetizer_sink_last_be};
+assign arp_packetizer_in_data_copy = (arp_packetizer_is_ongoing0 | arp_packetizer_is_ongoing1);
 always @(*) begin
-    arp_tx_packetizer_source_last <= 1'd0;
-    if (arp_tx_packetizer_source_last_s) begin
-        arp_tx_packetizer_source_last <= arp_tx_packetizer_source_last_b;
+    arp_packetizer_source_last <= 1'd0;
+    if (arp_packetizer_source_last_s) begin
+        arp_packetizer_source_last <= arp_packetizer_source_last_b;
     end else begin
-        arp_tx_packetizer_source_last <= arp_tx_packetizer_source_last_a;
+        arp_packetizer_source_last <= arp_packetizer_source_last_a;
     end
 end
-assign arp_tx_packetizer_source_payload_error = arp_tx_packetizer_sink_payload_error;
+assign arp_packetizer_source_payload_error = arp_packetizer_sink_payload_error;
 always @(*) begin
-    arp_tx_packetizer_count_liteetharp_fsm0_next_value0 <= 5'd0;
-    arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd0;
-    arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= 1'd0;
-    arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd0;
-    arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd0;
-    arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd0;
-    arp_tx_packetizer_is_ongoing0 <= 1'd0;
-    arp_tx_packetizer_is_ongoing1 <= 1'd0;
-    arp_tx_packetizer_is_ongoing2 <= 1'd0;
-    arp_tx_packetizer_sink_ready <= 1'd0;
-    arp_tx_packetizer_source_last_a <= 1'd0;
-    arp_tx_packetizer_source_last_b <= 1'd0;
-    arp_tx_packetizer_source_last_s <= 1'd0;
-    arp_tx_packetizer_source_payload_data <= 8'd0;
-    arp_tx_packetizer_source_payload_last_be <= 1'd0;
-    arp_tx_packetizer_source_valid <= 1'd0;
-    arp_tx_packetizer_sr_load <= 1'd0;
-    arp_tx_packetizer_sr_shift <= 1'd0;
+    arp_packetizer_count_liteetharp_fsm0_next_value0 <= 5'd0;
+    arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd0;
+    arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= 1'd0;
+    arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd0;
+    arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd0;
+    arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd0;
+    arp_packetizer_is_ongoing0 <= 1'd0;
+    arp_packetizer_is_ongoing1 <= 1'd0;
+    arp_packetizer_is_ongoing2 <= 1'd0;
+    arp_packetizer_sink_ready <= 1'd0;
+    arp_packetizer_source_last_a <= 1'd0;
+    arp_packetizer_source_last_b <= 1'd0;
+    arp_packetizer_source_last_s <= 1'd0;
+    arp_packetizer_source_payload_data <= 8'd0;
+    arp_packetizer_source_payload_last_be <= 1'd0;
+    arp_packetizer_source_valid <= 1'd0;
+    arp_packetizer_sr_load <= 1'd0;
+    arp_packetizer_sr_shift <= 1'd0;
     liteetharptx_fsm0_next_state <= 2'd0;
     liteetharptx_fsm1_next_state <= 1'd0;
     liteetharptx_fsm0_next_state <= liteetharptx_fsm0_state;
     case (liteetharptx_fsm0_state)
         1'd1: begin
-            arp_tx_packetizer_source_valid <= 1'd1;
-            arp_tx_packetizer_source_last_a <= 1'd0;
-            arp_tx_packetizer_source_payload_data <= arp_tx_packetizer_sr[223:8];
-            if ((arp_tx_packetizer_source_valid & arp_tx_packetizer_source_ready)) begin
-                arp_tx_packetizer_sr_shift <= 1'd1;
-                if ((arp_tx_packetizer_count == 5'd27)) begin
-                    arp_tx_packetizer_sr_shift <= 1'd0;
+            arp_packetizer_source_valid <= 1'd1;
+            arp_packetizer_source_last_a <= 1'd0;
+            arp_packetizer_source_payload_data <= arp_packetizer_sr[223:8];
+            if ((arp_packetizer_source_valid & arp_packetizer_source_ready)) begin
+                arp_packetizer_sr_shift <= 1'd1;
+                if ((arp_packetizer_count == 5'd27)) begin
+                    arp_packetizer_sr_shift <= 1'd0;
                     liteetharptx_fsm0_next_state <= 2'd2;
-                    arp_tx_packetizer_count_liteetharp_fsm0_next_value0 <= (arp_tx_packetizer_count + 1'd1);
-                    arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
+                    arp_packetizer_count_liteetharp_fsm0_next_value0 <= (arp_packetizer_count + 1'd1);
+                    arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
                 end else begin
-                    arp_tx_packetizer_count_liteetharp_fsm0_next_value0 <= (arp_tx_packetizer_count + 1'd1);
-                    arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
+                    arp_packetizer_count_liteetharp_fsm0_next_value0 <= (arp_packetizer_count + 1'd1);
+                    arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
                 end
             end
         end
         2'd2: begin
-            arp_tx_packetizer_source_valid <= arp_tx_packetizer_sink_valid;
-            arp_tx_packetizer_source_last_a <= arp_tx_packetizer_sink_last;
-            arp_tx_packetizer_source_payload_data <= arp_tx_packetizer_sink_payload_data;
-            if ((arp_tx_packetizer_source_valid & arp_tx_packetizer_source_ready)) begin
-                arp_tx_packetizer_sink_ready <= 1'd1;
-                if (arp_tx_packetizer_source_last) begin
+            arp_packetizer_source_valid <= arp_packetizer_sink_valid;
+            arp_packetizer_source_last_a <= arp_packetizer_sink_last;
+            arp_packetizer_source_payload_data <= arp_packetizer_sink_payload_data;
+            if ((arp_packetizer_source_valid & arp_packetizer_source_ready)) begin
+                arp_packetizer_sink_ready <= 1'd1;
+                if (arp_packetizer_source_last) begin
                     liteetharptx_fsm0_next_state <= 1'd0;
                 end
             end
-            arp_tx_packetizer_is_ongoing0 <= 1'd1;
+            arp_packetizer_is_ongoing0 <= 1'd1;
         end
         2'd3: begin
-            arp_tx_packetizer_is_ongoing1 <= 1'd1;
+            arp_packetizer_is_ongoing1 <= 1'd1;
         end
         default: begin
-            arp_tx_packetizer_sink_ready <= 1'd1;
-            arp_tx_packetizer_count_liteetharp_fsm0_next_value0 <= 1'd1;
-            arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
-            if (arp_tx_packetizer_sink_valid) begin
-                arp_tx_packetizer_sink_ready <= 1'd0;
-                arp_tx_packetizer_source_valid <= 1'd1;
-                arp_tx_packetizer_source_last_a <= 1'd0;
-                arp_tx_packetizer_source_payload_data <= arp_tx_packetizer_header[7:0];
-                if ((arp_tx_packetizer_source_valid & arp_tx_packetizer_source_ready)) begin
-                    arp_tx_packetizer_sr_load <= 1'd1;
-                    arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd1;
-                    arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd1;
+            arp_packetizer_sink_ready <= 1'd1;
+            arp_packetizer_count_liteetharp_fsm0_next_value0 <= 1'd1;
+            arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
+            if (arp_packetizer_sink_valid) begin
+                arp_packetizer_sink_ready <= 1'd0;
+                arp_packetizer_source_valid <= 1'd1;
+                arp_packetizer_source_last_a <= 1'd0;
+                arp_packetizer_source_payload_data <= arp_packetizer_header[7:0];
+                if ((arp_packetizer_source_valid & arp_packetizer_source_ready)) begin
+                    arp_packetizer_sr_load <= 1'd1;
+                    arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd1;
+                    arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd1;
                     if (1'd0) begin
                         liteetharptx_fsm0_next_state <= 2'd2;
                     end else begin
@@ -3638,93 +3690,93 @@ always @(*) begin
                     end
                 end
             end
-            arp_tx_packetizer_is_ongoing2 <= 1'd1;
+            arp_packetizer_is_ongoing2 <= 1'd1;
         end
     endcase
     liteetharptx_fsm1_next_state <= liteetharptx_fsm1_state;
     case (liteetharptx_fsm1_state)
         1'd1: begin
-            arp_tx_packetizer_source_last_b <= 1'd1;
-            arp_tx_packetizer_source_last_s <= 1'd1;
-            arp_tx_packetizer_source_payload_last_be <= arp_tx_packetizer_delayed_last_be;
-            arp_tx_packetizer_sink_ready <= 1'd0;
-            if (arp_tx_packetizer_source_ready) begin
+            arp_packetizer_source_last_b <= 1'd1;
+            arp_packetizer_source_last_s <= 1'd1;
+            arp_packetizer_source_payload_last_be <= arp_packetizer_delayed_last_be;
+            arp_packetizer_sink_ready <= 1'd0;
+            if (arp_packetizer_source_ready) begin
                 liteetharptx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((arp_tx_packetizer_in_data_copy & arp_tx_packetizer_sink_last) & (arp_tx_packetizer_sink_last_be > arp_tx_packetizer_new_last_be))) begin
-                arp_tx_packetizer_source_last_b <= 1'd0;
-                arp_tx_packetizer_source_last_s <= 1'd1;
-                arp_tx_packetizer_source_payload_last_be <= 1'd0;
-                if ((arp_tx_packetizer_source_ready & arp_tx_packetizer_source_valid)) begin
-                    arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= arp_tx_packetizer_new_last_be;
-                    arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd1;
+            if (((arp_packetizer_in_data_copy & arp_packetizer_sink_last) & (arp_packetizer_sink_last_be > arp_packetizer_new_last_be))) begin
+                arp_packetizer_source_last_b <= 1'd0;
+                arp_packetizer_source_last_s <= 1'd1;
+                arp_packetizer_source_payload_last_be <= 1'd0;
+                if ((arp_packetizer_source_ready & arp_packetizer_source_valid)) begin
+                    arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= arp_packetizer_new_last_be;
+                    arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd1;
                     liteetharptx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (arp_tx_packetizer_in_data_copy) begin
-                    arp_tx_packetizer_source_last_b <= arp_tx_packetizer_sink_last;
-                    arp_tx_packetizer_source_last_s <= 1'd1;
-                    arp_tx_packetizer_source_payload_last_be <= arp_tx_packetizer_new_last_be;
+                if (arp_packetizer_in_data_copy) begin
+                    arp_packetizer_source_last_b <= arp_packetizer_sink_last;
+                    arp_packetizer_source_last_s <= 1'd1;
+                    arp_packetizer_source_payload_last_be <= arp_packetizer_new_last_be;
                 end
             end
-            if (arp_tx_packetizer_in_data_copy) begin
-                arp_tx_packetizer_sink_ready <= arp_tx_packetizer_source_ready;
+            if (arp_packetizer_in_data_copy) begin
+                arp_packetizer_sink_ready <= arp_packetizer_source_ready;
             end else begin
-                if (arp_tx_packetizer_is_ongoing2) begin
-                    arp_tx_packetizer_sink_ready <= (~arp_tx_packetizer_sink_valid);
+                if (arp_packetizer_is_ongoing2) begin
+                    arp_packetizer_sink_ready <= (~arp_packetizer_sink_valid);
                 end
             end
         end
     endcase
 end
 always @(*) begin
-    arp_tx_counter_liteetharp_next_value <= 6'd0;
-    arp_tx_counter_liteetharp_next_value_ce <= 1'd0;
-    arp_tx_packetizer_sink_valid <= 1'd0;
-    arp_tx_packetizer_source_ready <= 1'd0;
-    arp_tx_sink_sink_ready <= 1'd0;
-    arp_tx_source_source_valid <= 1'd0;
+    arp_counter_liteetharp_next_value <= 6'd0;
+    arp_counter_liteetharp_next_value_ce <= 1'd0;
+    arp_packetizer_sink_valid <= 1'd0;
+    arp_packetizer_source_ready <= 1'd0;
+    arp_sink_sink_ready <= 1'd0;
+    arp_source_source_valid <= 1'd0;
     liteetharptx_next_state <= 1'd0;
     liteetharptx_next_state <= liteetharptx_state;
     case (liteetharptx_state)
         1'd1: begin
-            arp_tx_packetizer_sink_valid <= 1'd1;
-            arp_tx_source_source_valid <= arp_tx_packetizer_source_valid;
-            arp_tx_packetizer_source_ready <= arp_tx_source_source_ready;
-            if ((arp_tx_source_source_valid & arp_tx_source_source_ready)) begin
-                arp_tx_counter_liteetharp_next_value <= (arp_tx_counter + 1'd1);
-                arp_tx_counter_liteetharp_next_value_ce <= 1'd1;
-                if (arp_tx_source_source_last) begin
-                    arp_tx_sink_sink_ready <= 1'd1;
+            arp_packetizer_sink_valid <= 1'd1;
+            arp_source_source_valid <= arp_packetizer_source_valid;
+            arp_packetizer_source_ready <= arp_source_source_ready;
+            if ((arp_source_source_valid & arp_source_source_ready)) begin
+                arp_counter_liteetharp_next_value <= (arp_counter + 1'd1);
+                arp_counter_liteetharp_next_value_ce <= 1'd1;
+                if (arp_source_source_last) begin
+                    arp_sink_sink_ready <= 1'd1;
                     liteetharptx_next_state <= 1'd0;
                 end
             end
         end
         default: begin
-            arp_tx_counter_liteetharp_next_value <= 1'd0;
-            arp_tx_counter_liteetharp_next_value_ce <= 1'd1;
-            if (arp_tx_sink_sink_valid) begin
+            arp_counter_liteetharp_next_value <= 1'd0;
+            arp_counter_liteetharp_next_value_ce <= 1'd1;
+            if (arp_sink_sink_valid) begin
                 liteetharptx_next_state <= 1'd1;
             end
         end
     endcase
 end
-assign arp_rx_depacketizer_sink_valid = arp_rx_sink_sink_valid;
-assign arp_rx_sink_sink_ready = arp_rx_depacketizer_sink_ready;
-assign arp_rx_depacketizer_sink_first = arp_rx_sink_sink_first;
-assign arp_rx_depacketizer_sink_last = arp_rx_sink_sink_last;
-assign arp_rx_depacketizer_sink_payload_ethernet_type = arp_rx_sink_sink_payload_ethernet_type;
-assign arp_rx_depacketizer_sink_payload_sender_mac = arp_rx_sink_sink_payload_sender_mac;
-assign arp_rx_depacketizer_sink_payload_target_mac = arp_rx_sink_sink_payload_target_mac;
-assign arp_rx_depacketizer_sink_payload_data = arp_rx_sink_sink_payload_data;
-assign arp_rx_depacketizer_sink_payload_last_be = arp_rx_sink_sink_payload_last_be;
-assign arp_rx_depacketizer_sink_payload_error = arp_rx_sink_sink_payload_error;
+assign arp_rx_liteetharpdepacketizer_sink_valid = arp_rx_sink_valid;
+assign arp_rx_sink_ready = arp_rx_liteetharpdepacketizer_sink_ready;
+assign arp_rx_liteetharpdepacketizer_sink_first = arp_rx_sink_first;
+assign arp_rx_liteetharpdepacketizer_sink_last = arp_rx_sink_last;
+assign arp_rx_liteetharpdepacketizer_sink_payload_ethernet_type = arp_rx_sink_payload_ethernet_type;
+assign arp_rx_liteetharpdepacketizer_sink_payload_sender_mac = arp_rx_sink_payload_sender_mac;
+assign arp_rx_liteetharpdepacketizer_sink_payload_target_mac = arp_rx_sink_payload_target_mac;
+assign arp_rx_liteetharpdepacketizer_sink_payload_data = arp_rx_sink_payload_data;
+assign arp_rx_liteetharpdepacketizer_sink_payload_last_be = arp_rx_sink_payload_last_be;
+assign arp_rx_liteetharpdepacketizer_sink_payload_error = arp_rx_sink_payload_error;
 always @(*) begin
     arp_rx_reply <= 1'd0;
     arp_rx_request <= 1'd0;
-    case (arp_rx_depacketizer_source_param_opcode)
+    case (arp_rx_liteetharpdepacketizer_source_param_opcode)
         1'd1: begin
             arp_rx_request <= 1'd1;
         end
@@ -3735,161 +3787,172 @@ always @(*) begin
         end
     endcase
 end
-assign arp_rx_source_source_payload_ip_address = arp_rx_depacketizer_source_param_sender_ip;
-assign arp_rx_source_source_payload_mac_address = arp_rx_depacketizer_source_param_sender_mac;
-assign arp_rx_depacketizer_header = arp_rx_depacketizer_sr;
-assign arp_rx_depacketizer_source_param_hwsize = {rhs_slice_proxy14[7:0]};
-assign arp_rx_depacketizer_source_param_hwtype = {rhs_slice_proxy16[7:0], rhs_slice_proxy15[15:8]};
-assign arp_rx_depacketizer_source_param_opcode = {rhs_slice_proxy18[7:0], rhs_slice_proxy17[15:8]};
-assign arp_rx_depacketizer_source_param_proto = {rhs_slice_proxy20[7:0], rhs_slice_proxy19[15:8]};
-assign arp_rx_depacketizer_source_param_protosize = {rhs_slice_proxy21[7:0]};
-assign arp_rx_depacketizer_source_param_sender_ip = {rhs_slice_proxy25[7:0], rhs_slice_proxy24[15:8], rhs_slice_proxy23[23:16], rhs_slice_proxy22[31:24]};
-assign arp_rx_depacketizer_source_param_sender_mac = {rhs_slice_proxy31[7:0], rhs_slice_proxy30[15:8], rhs_slice_proxy29[23:16], rhs_slice_proxy28[31:24], rhs_slice_proxy27[39:32], rhs_slice_proxy26[47:40]};
-assign arp_rx_depacketizer_source_param_target_ip = {rhs_slice_proxy35[7:0], rhs_slice_proxy34[15:8], rhs_slice_proxy33[23:16], rhs_slice_proxy32[31:24]};
-assign arp_rx_depacketizer_source_param_target_mac = {rhs_slice_proxy41[7:0], rhs_slice_proxy40[15:8], rhs_slice_proxy39[23:16], rhs_slice_proxy38[31:24], rhs_slice_proxy37[39:32], rhs_slice_proxy36[47:40]};
-assign arp_rx_depacketizer_source_payload_error = arp_rx_depacketizer_sink_payload_error;
-assign arp_rx_depacketizer_sink_last_be = arp_rx_depacketizer_sink_last;
-assign arp_rx_depacketizer_new_last_be = {arp_rx_depacketizer_sink_last_be};
-assign arp_rx_depacketizer_is_in_copy = (arp_rx_depacketizer_is_ongoing0 | arp_rx_depacketizer_is_ongoing1);
+assign arp_rx_source_payload_ip_address = arp_rx_liteetharpdepacketizer_source_param_sender_ip;
+assign arp_rx_source_payload_mac_address = arp_rx_liteetharpdepacketizer_source_param_sender_mac;
+assign arp_rx_liteetharpdepacketizer_header = arp_rx_liteetharpdepacketizer_sr;
+assign arp_rx_liteetharpdepacketizer_source_param_hwsize = {rhs_slice_proxy14[7:0]};
+assign arp_rx_liteetharpdepacketizer_source_param_hwtype = {rhs_slice_proxy16[7:0], rhs_slice_proxy15[15:8]};
+assign arp_rx_liteetharpdepacketizer_source_param_opcode = {rhs_slice_proxy18[7:0], rhs_slice_proxy17[15:8]};
+assign arp_rx_liteetharpdepacketizer_source_param_proto = {rhs_slice_proxy20[7:0], rhs_slice_proxy19[15:8]};
+assign arp_rx_liteetharpdepacketizer_source_param_protosize = {rhs_slice_proxy21[7:0]};
+assign arp_rx_liteetharpdepacketizer_source_param_sender_ip = {rhs_slice_proxy25[7:0], rhs_slice_proxy24[15:8], rhs_slice_proxy23[23:16], rhs_slice_proxy22[31:24]};
+assign arp_rx_liteetharpdepacketizer_source_param_sender_mac = {rhs_slice_proxy31[7:0], rhs_slice_proxy30[15:8], rhs_slice_proxy29[23:16], rhs_slice_proxy28[31:24], rhs_slice_proxy27[39:32], rhs_slice_proxy26[47:40]};
+assign arp_rx_liteetharpdepacketizer_source_param_target_ip = {rhs_slice_proxy35[7:0], rhs_slice_proxy34[15:8], rhs_slice_proxy33[23:16], rhs_slice_proxy32[31:24]};
+assign arp_rx_liteetharpdepacketizer_source_param_target_mac = {rhs_slice_proxy41[7:0], rhs_slice_proxy40[15:8], rhs_slice_proxy39[23:16], rhs_slice_proxy38[31:24], rhs_slice_proxy37[39:32], rhs_slice_proxy36[47:40]};
+assign arp_rx_liteetharpdepacketizer_source_payload_error = arp_rx_liteetharpdepacketizer_sink_payload_error;
+assign arp_rx_liteetharpdepacketizer_sink_last_be = arp_rx_liteetharpdepacketizer_sink_last;
+assign arp_rx_liteetharpdepacketizer_new_last_be = {arp_rx_liteetharpdepacketizer_sink_last_be};
+assign arp_rx_liteetharpdepacketizer_is_in_copy = (arp_rx_liteetharpdepacketizer_is_ongoing0 | arp_rx_liteetharpdepacketizer_is_ongoing1);
 always @(*) begin
-    arp_rx_depacketizer_source_last <= 1'd0;
-    if (arp_rx_depacketizer_source_last_s) begin
-        arp_rx_depacketizer_source_last <= arp_rx_depacketizer_source_last_b;
+    arp_rx_liteetharpdepacketizer_source_last <= 1'd0;
+    if (arp_rx_liteetharpdepacketizer_source_last_s) begin
+        arp_rx_liteetharpdepacketizer_source_last <= arp_rx_liteetharpdepacketizer_source_last_b;
     end else begin
-        arp_rx_depacketizer_source_last <= arp_rx_depacketizer_source_last_a;
+        arp_rx_liteetharpdepacketizer_source_last <= arp_rx_liteetharpdepacketizer_source_last_a;
     end
 end
+assign arp_rx_cut = ((arp_rx_liteetharpdepacketizer_sink_valid & arp_rx_liteetharpdepacketizer_sink_last) & (arp_rx_fsm_is_ongoing0 | arp_rx_fsm_is_ongoing1));
 always @(*) begin
-    arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 <= 5'd0;
-    arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd0;
-    arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= 1'd0;
-    arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd0;
-    arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd0;
-    arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd0;
-    arp_rx_depacketizer_is_ongoing0 <= 1'd0;
-    arp_rx_depacketizer_is_ongoing1 <= 1'd0;
-    arp_rx_depacketizer_is_ongoing2 <= 1'd0;
-    arp_rx_depacketizer_is_ongoing3 <= 1'd0;
-    arp_rx_depacketizer_sink_ready <= 1'd0;
-    arp_rx_depacketizer_source_last_a <= 1'd0;
-    arp_rx_depacketizer_source_last_b <= 1'd0;
-    arp_rx_depacketizer_source_last_s <= 1'd0;
-    arp_rx_depacketizer_source_payload_data <= 8'd0;
-    arp_rx_depacketizer_source_payload_last_be <= 1'd0;
-    arp_rx_depacketizer_source_valid <= 1'd0;
-    arp_rx_depacketizer_sr_shift <= 1'd0;
+    arp_rx_fsm_is_ongoing0 <= 1'd0;
+    arp_rx_fsm_is_ongoing1 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= 5'd0;
+    arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_is_ongoing0 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_is_ongoing1 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_is_ongoing2 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_is_ongoing3 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_sink_ready <= 1'd0;
+    arp_rx_liteetharpdepacketizer_source_last_a <= 1'd0;
+    arp_rx_liteetharpdepacketizer_source_last_b <= 1'd0;
+    arp_rx_liteetharpdepacketizer_source_last_s <= 1'd0;
+    arp_rx_liteetharpdepacketizer_source_payload_data <= 8'd0;
+    arp_rx_liteetharpdepacketizer_source_payload_last_be <= 1'd0;
+    arp_rx_liteetharpdepacketizer_source_valid <= 1'd0;
+    arp_rx_liteetharpdepacketizer_sr_shift <= 1'd0;
     liteetharprx_fsm0_next_state <= 2'd0;
     liteetharprx_fsm1_next_state <= 1'd0;
     liteetharprx_fsm0_next_state <= liteetharprx_fsm0_state;
     case (liteetharprx_fsm0_state)
         1'd1: begin
-            arp_rx_depacketizer_sink_ready <= 1'd1;
-            if (arp_rx_depacketizer_sink_valid) begin
-                arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 <= (arp_rx_depacketizer_count + 1'd1);
-                arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
-                arp_rx_depacketizer_sr_shift <= 1'd1;
-                if ((arp_rx_depacketizer_count == 5'd27)) begin
+            arp_rx_liteetharpdepacketizer_sink_ready <= 1'd1;
+            if (arp_rx_liteetharpdepacketizer_sink_valid) begin
+                arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= (arp_rx_liteetharpdepacketizer_count + 1'd1);
+                arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
+                arp_rx_liteetharpdepacketizer_sr_shift <= 1'd1;
+                if ((arp_rx_liteetharpdepacketizer_count == 5'd27)) begin
                     liteetharprx_fsm0_next_state <= 2'd2;
-                    arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 <= (arp_rx_depacketizer_count + 1'd1);
-                    arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
+                    arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= (arp_rx_liteetharpdepacketizer_count + 1'd1);
+                    arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            arp_rx_fsm_is_ongoing1 <= 1'd1;
+            if ((arp_rx_liteetharpdepacketizer_sink_valid & arp_rx_liteetharpdepacketizer_sink_last)) begin
+                liteetharprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            arp_rx_depacketizer_source_valid <= (arp_rx_depacketizer_sink_valid | arp_rx_depacketizer_sink_d_last);
-            arp_rx_depacketizer_source_last_a <= (arp_rx_depacketizer_sink_last | arp_rx_depacketizer_sink_d_last);
-            arp_rx_depacketizer_sink_ready <= arp_rx_depacketizer_source_ready;
-            arp_rx_depacketizer_source_payload_data <= arp_rx_depacketizer_sink_payload_data;
-            if ((arp_rx_depacketizer_source_valid & arp_rx_depacketizer_source_ready)) begin
-                if (arp_rx_depacketizer_source_last) begin
+            arp_rx_liteetharpdepacketizer_source_valid <= (arp_rx_liteetharpdepacketizer_sink_valid | arp_rx_liteetharpdepacketizer_sink_d_last);
+            arp_rx_liteetharpdepacketizer_source_last_a <= (arp_rx_liteetharpdepacketizer_sink_last | arp_rx_liteetharpdepacketizer_sink_d_last);
+            arp_rx_liteetharpdepacketizer_sink_ready <= arp_rx_liteetharpdepacketizer_source_ready;
+            arp_rx_liteetharpdepacketizer_source_payload_data <= arp_rx_liteetharpdepacketizer_sink_payload_data;
+            if ((arp_rx_liteetharpdepacketizer_source_valid & arp_rx_liteetharpdepacketizer_source_ready)) begin
+                if (arp_rx_liteetharpdepacketizer_source_last) begin
                     liteetharprx_fsm0_next_state <= 1'd0;
                 end
             end
-            arp_rx_depacketizer_is_ongoing0 <= 1'd1;
-            arp_rx_depacketizer_is_ongoing2 <= 1'd1;
+            arp_rx_liteetharpdepacketizer_is_ongoing0 <= 1'd1;
+            arp_rx_liteetharpdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            arp_rx_depacketizer_is_ongoing1 <= 1'd1;
-            arp_rx_depacketizer_is_ongoing3 <= 1'd1;
+            arp_rx_liteetharpdepacketizer_is_ongoing1 <= 1'd1;
+            arp_rx_liteetharpdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            arp_rx_depacketizer_sink_ready <= 1'd1;
-            arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 <= 1'd1;
-            arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
-            if (arp_rx_depacketizer_sink_valid) begin
-                arp_rx_depacketizer_sr_shift <= 1'd1;
-                arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd1;
-                arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd1;
+            arp_rx_liteetharpdepacketizer_sink_ready <= 1'd1;
+            arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= 1'd1;
+            arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
+            if (arp_rx_liteetharpdepacketizer_sink_valid) begin
+                arp_rx_liteetharpdepacketizer_sr_shift <= 1'd1;
+                arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd1;
+                arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
                     liteetharprx_fsm0_next_state <= 2'd2;
                 end else begin
                     liteetharprx_fsm0_next_state <= 1'd1;
                 end
             end
+            arp_rx_fsm_is_ongoing0 <= 1'd1;
+            if ((arp_rx_liteetharpdepacketizer_sink_valid & arp_rx_liteetharpdepacketizer_sink_last)) begin
+                liteetharprx_fsm0_next_state <= 1'd0;
+            end
         end
     endcase
     liteetharprx_fsm1_next_state <= liteetharprx_fsm1_state;
     case (liteetharprx_fsm1_state)
         1'd1: begin
-            arp_rx_depacketizer_source_last_b <= 1'd1;
-            arp_rx_depacketizer_source_last_s <= 1'd1;
-            arp_rx_depacketizer_source_payload_last_be <= arp_rx_depacketizer_delayed_last_be;
-            arp_rx_depacketizer_sink_ready <= 1'd0;
-            if ((arp_rx_depacketizer_source_ready & arp_rx_depacketizer_source_valid)) begin
+            arp_rx_liteetharpdepacketizer_source_last_b <= 1'd1;
+            arp_rx_liteetharpdepacketizer_source_last_s <= 1'd1;
+            arp_rx_liteetharpdepacketizer_source_payload_last_be <= arp_rx_liteetharpdepacketizer_delayed_last_be;
+            arp_rx_liteetharpdepacketizer_sink_ready <= 1'd0;
+            if ((arp_rx_liteetharpdepacketizer_source_ready & arp_rx_liteetharpdepacketizer_source_valid)) begin
                 liteetharprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((arp_rx_depacketizer_sink_valid & arp_rx_depacketizer_sink_last) & (arp_rx_depacketizer_sink_last_be > arp_rx_depacketizer_new_last_be))) begin
-                arp_rx_depacketizer_source_last_b <= 1'd0;
-                arp_rx_depacketizer_source_last_s <= 1'd1;
-                arp_rx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((arp_rx_depacketizer_source_ready & arp_rx_depacketizer_source_valid) | ((~arp_rx_depacketizer_was_in_copy) & arp_rx_depacketizer_is_in_copy))) begin
-                    arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= arp_rx_depacketizer_new_last_be;
-                    arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd1;
+            if (((arp_rx_liteetharpdepacketizer_sink_valid & arp_rx_liteetharpdepacketizer_sink_last) & (arp_rx_liteetharpdepacketizer_sink_last_be > arp_rx_liteetharpdepacketizer_new_last_be))) begin
+                arp_rx_liteetharpdepacketizer_source_last_b <= 1'd0;
+                arp_rx_liteetharpdepacketizer_source_last_s <= 1'd1;
+                arp_rx_liteetharpdepacketizer_source_payload_last_be <= 1'd0;
+                if (((arp_rx_liteetharpdepacketizer_source_ready & arp_rx_liteetharpdepacketizer_source_valid) | ((~arp_rx_liteetharpdepacketizer_was_in_copy) & arp_rx_liteetharpdepacketizer_is_in_copy))) begin
+                    arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= arp_rx_liteetharpdepacketizer_new_last_be;
+                    arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd1;
                     liteetharprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (arp_rx_depacketizer_sink_last) begin
-                    arp_rx_depacketizer_source_last_b <= 1'd1;
-                    arp_rx_depacketizer_source_last_s <= 1'd1;
-                    arp_rx_depacketizer_source_payload_last_be <= arp_rx_depacketizer_new_last_be;
+                if (arp_rx_liteetharpdepacketizer_sink_last) begin
+                    arp_rx_liteetharpdepacketizer_source_last_b <= 1'd1;
+                    arp_rx_liteetharpdepacketizer_source_last_s <= 1'd1;
+                    arp_rx_liteetharpdepacketizer_source_payload_last_be <= arp_rx_liteetharpdepacketizer_new_last_be;
                 end
             end
-            if ((arp_rx_depacketizer_is_ongoing2 | (arp_rx_depacketizer_is_ongoing3 & (~arp_rx_depacketizer_fsm_from_idle)))) begin
-                arp_rx_depacketizer_sink_ready <= arp_rx_depacketizer_source_ready;
+            if ((arp_rx_liteetharpdepacketizer_is_ongoing2 | (arp_rx_liteetharpdepacketizer_is_ongoing3 & (~arp_rx_liteetharpdepacketizer_fsm_from_idle)))) begin
+                arp_rx_liteetharpdepacketizer_sink_ready <= arp_rx_liteetharpdepacketizer_source_ready;
             end else begin
-                arp_rx_depacketizer_sink_ready <= 1'd1;
+                arp_rx_liteetharpdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
-    arp_rx_depacketizer_source_ready <= 1'd0;
-    arp_rx_source_source_payload_reply <= 1'd0;
-    arp_rx_source_source_payload_request <= 1'd0;
-    arp_rx_source_source_valid <= 1'd0;
+    arp_rx_liteetharpdepacketizer_source_ready <= 1'd0;
+    arp_rx_source_payload_reply <= 1'd0;
+    arp_rx_source_payload_request <= 1'd0;
+    arp_rx_source_valid <= 1'd0;
     liteetharprx_next_state <= 2'd0;
     liteetharprx_next_state <= liteetharprx_state;
     case (liteetharprx_state)
         1'd1: begin
             if (arp_rx_valid) begin
-                arp_rx_source_source_valid <= 1'd1;
-                arp_rx_source_source_payload_reply <= arp_rx_reply;
-                arp_rx_source_source_payload_request <= arp_rx_request;
+                arp_rx_source_valid <= 1'd1;
+                arp_rx_source_payload_reply <= arp_rx_reply;
+                arp_rx_source_payload_request <= arp_rx_request;
             end
             liteetharprx_next_state <= 2'd2;
         end
         2'd2: begin
-            arp_rx_depacketizer_source_ready <= 1'd1;
-            if ((arp_rx_depacketizer_source_valid & arp_rx_depacketizer_source_last)) begin
+            arp_rx_liteetharpdepacketizer_source_ready <= 1'd1;
+            if ((arp_rx_liteetharpdepacketizer_source_valid & arp_rx_liteetharpdepacketizer_source_last)) begin
                 liteetharprx_next_state <= 1'd0;
             end
         end
         default: begin
-            arp_rx_depacketizer_source_ready <= 1'd1;
-            if (arp_rx_depacketizer_source_valid) begin
-                arp_rx_depacketizer_source_ready <= 1'd0;
+            arp_rx_liteetharpdepacketizer_source_ready <= 1'd1;
+            if (arp_rx_liteetharpdepacketizer_source_valid) begin
+                arp_rx_liteetharpdepacketizer_source_ready <= 1'd0;
                 liteetharprx_next_state <= 1'd1;
             end
         end
@@ -4130,16 +4193,16 @@ assign ip_mac_port_sink_payload_target_mac = ip_tx_source_source_payload_target_
 assign ip_mac_port_sink_payload_data = ip_tx_source_source_payload_data0;
 assign ip_mac_port_sink_payload_last_be = ip_tx_source_source_payload_last_be0;
 assign ip_mac_port_sink_payload_error = ip_tx_source_source_payload_error0;
-assign ip_rx_sink_sink_valid = ip_mac_port_source_valid;
-assign ip_mac_port_source_ready = ip_rx_sink_sink_ready;
-assign ip_rx_sink_sink_first = ip_mac_port_source_first;
-assign ip_rx_sink_sink_last = ip_mac_port_source_last;
-assign ip_rx_sink_sink_payload_ethernet_type = ip_mac_port_source_payload_ethernet_type;
-assign ip_rx_sink_sink_payload_sender_mac = ip_mac_port_source_payload_sender_mac;
-assign ip_rx_sink_sink_payload_target_mac = ip_mac_port_source_payload_target_mac;
-assign ip_rx_sink_sink_payload_data = ip_mac_port_source_payload_data;
-assign ip_rx_sink_sink_payload_last_be = ip_mac_port_source_payload_last_be;
-assign ip_rx_sink_sink_payload_error = ip_mac_port_source_payload_error;
+assign ip_rx_sink_valid = ip_mac_port_source_valid;
+assign ip_mac_port_source_ready = ip_rx_sink_ready;
+assign ip_rx_sink_first = ip_mac_port_source_first;
+assign ip_rx_sink_last = ip_mac_port_source_last;
+assign ip_rx_sink_payload_ethernet_type = ip_mac_port_source_payload_ethernet_type;
+assign ip_rx_sink_payload_sender_mac = ip_mac_port_source_payload_sender_mac;
+assign ip_rx_sink_payload_target_mac = ip_mac_port_source_payload_target_mac;
+assign ip_rx_sink_payload_data = ip_mac_port_source_payload_data;
+assign ip_rx_sink_payload_last_be = ip_mac_port_source_payload_last_be;
+assign ip_rx_sink_payload_error = ip_mac_port_source_payload_error;
 assign ip_tx_sink_sink_valid0 = ip_crossbar_source_valid;
 assign ip_crossbar_source_ready = ip_tx_sink_sink_ready0;
 assign ip_tx_sink_sink_first0 = ip_crossbar_source_first;
@@ -4150,16 +4213,16 @@ assign ip_tx_sink_sink_payload_error0 = ip_crossbar_source_payload_error;
 assign ip_tx_sink_sink_param_length0 = ip_crossbar_source_param_length;
 assign ip_tx_sink_sink_param_protocol0 = ip_crossbar_source_param_protocol;
 assign ip_tx_sink_sink_param_ip_address0 = ip_crossbar_source_param_ip_address;
-assign ip_crossbar_sink_valid = ip_rx_source_source_valid;
-assign ip_rx_source_source_ready = ip_crossbar_sink_ready;
-assign ip_crossbar_sink_first = ip_rx_source_source_first;
-assign ip_crossbar_sink_last = ip_rx_source_source_last;
-assign ip_crossbar_sink_payload_data = ip_rx_source_source_payload_data;
-assign ip_crossbar_sink_payload_last_be = ip_rx_source_source_payload_last_be;
-assign ip_crossbar_sink_payload_error = ip_rx_source_source_payload_error;
-assign ip_crossbar_sink_param_length = ip_rx_source_source_param_length;
-assign ip_crossbar_sink_param_protocol = ip_rx_source_source_param_protocol;
-assign ip_crossbar_sink_param_ip_address = ip_rx_source_source_param_ip_address;
+assign ip_crossbar_sink_valid = ip_rx_source_valid;
+assign ip_rx_source_ready = ip_crossbar_sink_ready;
+assign ip_crossbar_sink_first = ip_rx_source_first;
+assign ip_crossbar_sink_last = ip_rx_source_last;
+assign ip_crossbar_sink_payload_data = ip_rx_source_payload_data;
+assign ip_crossbar_sink_payload_last_be = ip_rx_source_payload_last_be;
+assign ip_crossbar_sink_payload_error = ip_rx_source_payload_error;
+assign ip_crossbar_sink_param_length = ip_rx_source_param_length;
+assign ip_crossbar_sink_param_protocol = ip_rx_source_param_protocol;
+assign ip_crossbar_sink_param_ip_address = ip_rx_source_param_ip_address;
 assign ip_tx_sink_sink_valid1 = ip_tx_sink_sink_valid0;
 assign ip_tx_sink_sink_ready0 = ip_tx_sink_sink_ready1;
 assign ip_tx_sink_sink_first1 = ip_tx_sink_sink_first0;
@@ -4442,149 +4505,166 @@ always @(*) begin
         end
     endcase
 end
-assign ip_rx_depacketizer_sink_valid = ip_rx_sink_sink_valid;
-assign ip_rx_sink_sink_ready = ip_rx_depacketizer_sink_ready;
-assign ip_rx_depacketizer_sink_first = ip_rx_sink_sink_first;
-assign ip_rx_depacketizer_sink_last = ip_rx_sink_sink_last;
-assign ip_rx_depacketizer_sink_payload_ethernet_type = ip_rx_sink_sink_payload_ethernet_type;
-assign ip_rx_depacketizer_sink_payload_sender_mac = ip_rx_sink_sink_payload_sender_mac;
-assign ip_rx_depacketizer_sink_payload_target_mac = ip_rx_sink_sink_payload_target_mac;
-assign ip_rx_depacketizer_sink_payload_data = ip_rx_sink_sink_payload_data;
-assign ip_rx_depacketizer_sink_payload_last_be = ip_rx_sink_sink_payload_last_be;
-assign ip_rx_depacketizer_sink_payload_error = ip_rx_sink_sink_payload_error;
-assign ip_rx_liteethipv4checksum_header = ip_rx_depacketizer_header;
-assign ip_rx_reset = (~ip_rx_depacketizer_source_valid);
+assign ip_rx_liteethipv4depacketizer_sink_valid = ip_rx_sink_valid;
+assign ip_rx_sink_ready = ip_rx_liteethipv4depacketizer_sink_ready;
+assign ip_rx_liteethipv4depacketizer_sink_first = ip_rx_sink_first;
+assign ip_rx_liteethipv4depacketizer_sink_last = ip_rx_sink_last;
+assign ip_rx_liteethipv4depacketizer_sink_payload_ethernet_type = ip_rx_sink_payload_ethernet_type;
+assign ip_rx_liteethipv4depacketizer_sink_payload_sender_mac = ip_rx_sink_payload_sender_mac;
+assign ip_rx_liteethipv4depacketizer_sink_payload_target_mac = ip_rx_sink_payload_target_mac;
+assign ip_rx_liteethipv4depacketizer_sink_payload_data = ip_rx_sink_payload_data;
+assign ip_rx_liteethipv4depacketizer_sink_payload_last_be = ip_rx_sink_payload_last_be;
+assign ip_rx_liteethipv4depacketizer_sink_payload_error = ip_rx_sink_payload_error;
+assign ip_rx_liteethipv4checksum_header = ip_rx_liteethipv4depacketizer_header;
+assign ip_rx_reset = (~ip_rx_liteethipv4depacketizer_source_valid);
 assign ip_rx_ce = 1'd1;
-assign ip_rx_source_source_last = ip_rx_depacketizer_source_last;
-assign ip_rx_source_source_payload_data = ip_rx_depacketizer_source_payload_data;
-assign ip_rx_source_source_payload_last_be = ip_rx_depacketizer_source_payload_last_be;
-assign ip_rx_source_source_payload_error = ip_rx_depacketizer_source_payload_error;
-assign ip_rx_source_source_param_protocol = ip_rx_depacketizer_source_param_protocol;
-assign ip_rx_source_source_param_length = (ip_rx_depacketizer_source_param_total_length - 5'd20);
-assign ip_rx_source_source_param_ip_address = ip_rx_depacketizer_source_param_sender_ip;
-assign ip_rx_depacketizer_header = ip_rx_depacketizer_sr;
-assign ip_rx_depacketizer_source_param_checksum = {rhs_slice_proxy43[7:0], rhs_slice_proxy42[15:8]};
-assign ip_rx_depacketizer_source_param_identification = {rhs_slice_proxy45[7:0], rhs_slice_proxy44[15:8]};
-assign ip_rx_depacketizer_source_param_ihl = {rhs_slice_proxy46[3:0]};
-assign ip_rx_depacketizer_source_param_protocol = {rhs_slice_proxy47[7:0]};
-assign ip_rx_depacketizer_source_param_sender_ip = {rhs_slice_proxy51[7:0], rhs_slice_proxy50[15:8], rhs_slice_proxy49[23:16], rhs_slice_proxy48[31:24]};
-assign ip_rx_depacketizer_source_param_target_ip = {rhs_slice_proxy55[7:0], rhs_slice_proxy54[15:8], rhs_slice_proxy53[23:16], rhs_slice_proxy52[31:24]};
-assign ip_rx_depacketizer_source_param_total_length = {rhs_slice_proxy57[7:0], rhs_slice_proxy56[15:8]};
-assign ip_rx_depacketizer_source_param_ttl = {rhs_slice_proxy58[7:0]};
-assign ip_rx_depacketizer_source_param_version = {rhs_slice_proxy59[3:0]};
-assign ip_rx_depacketizer_source_payload_error = ip_rx_depacketizer_sink_payload_error;
-assign ip_rx_depacketizer_sink_last_be = ip_rx_depacketizer_sink_last;
-assign ip_rx_depacketizer_new_last_be = {ip_rx_depacketizer_sink_last_be};
-assign ip_rx_depacketizer_is_in_copy = (ip_rx_depacketizer_is_ongoing0 | ip_rx_depacketizer_is_ongoing1);
+assign ip_rx_source_last = ip_rx_liteethipv4depacketizer_source_last;
+assign ip_rx_source_payload_data = ip_rx_liteethipv4depacketizer_source_payload_data;
+assign ip_rx_source_payload_last_be = ip_rx_liteethipv4depacketizer_source_payload_last_be;
+assign ip_rx_source_payload_error = ip_rx_liteethipv4depacketizer_source_payload_error;
+assign ip_rx_source_param_protocol = ip_rx_liteethipv4depacketizer_source_param_protocol;
+assign ip_rx_source_param_length = (ip_rx_liteethipv4depacketizer_source_param_total_length - 5'd20);
+assign ip_rx_source_param_ip_address = ip_rx_liteethipv4depacketizer_source_param_sender_ip;
+assign ip_rx_offset = {ip_rx_liteethipv4depacketizer_header[52:48], ip_rx_liteethipv4depacketizer_header[63:56]};
+assign ip_rx_header_ok = ((((((ip_rx_liteethipv4depacketizer_source_param_version == 3'd4) & (ip_rx_liteethipv4depacketizer_source_param_ihl == 3'd5)) & (ip_rx_liteethipv4checksum_value == 1'd0)) & (~ip_rx_liteethipv4depacketizer_header[53])) & (ip_rx_offset == 1'd0)) & (ip_rx_liteethipv4depacketizer_source_param_total_length >= 5'd28));
+assign ip_rx_ours = ((ip_rx_liteethipv4depacketizer_source_param_target_ip == ip_address) | take_group);
+assign ip_rx_decide = ((ip_rx_is_ongoing & ip_rx_liteethipv4depacketizer_source_valid) & ip_rx_liteethipv4checksum_done);
+assign ip_rx_drop_header = (ip_rx_decide & (~ip_rx_header_ok));
+assign ip_rx_drop_other = ((ip_rx_decide & ip_rx_header_ok) & (~ip_rx_ours));
+assign ip_rx_liteethipv4depacketizer_header = ip_rx_liteethipv4depacketizer_sr;
+assign ip_rx_liteethipv4depacketizer_source_param_checksum = {rhs_slice_proxy43[7:0], rhs_slice_proxy42[15:8]};
+assign ip_rx_liteethipv4depacketizer_source_param_identification = {rhs_slice_proxy45[7:0], rhs_slice_proxy44[15:8]};
+assign ip_rx_liteethipv4depacketizer_source_param_ihl = {rhs_slice_proxy46[3:0]};
+assign ip_rx_liteethipv4depacketizer_source_param_protocol = {rhs_slice_proxy47[7:0]};
+assign ip_rx_liteethipv4depacketizer_source_param_sender_ip = {rhs_slice_proxy51[7:0], rhs_slice_proxy50[15:8], rhs_slice_proxy49[23:16], rhs_slice_proxy48[31:24]};
+assign ip_rx_liteethipv4depacketizer_source_param_target_ip = {rhs_slice_proxy55[7:0], rhs_slice_proxy54[15:8], rhs_slice_proxy53[23:16], rhs_slice_proxy52[31:24]};
+assign ip_rx_liteethipv4depacketizer_source_param_total_length = {rhs_slice_proxy57[7:0], rhs_slice_proxy56[15:8]};
+assign ip_rx_liteethipv4depacketizer_source_param_ttl = {rhs_slice_proxy58[7:0]};
+assign ip_rx_liteethipv4depacketizer_source_param_version = {rhs_slice_proxy59[3:0]};
+assign ip_rx_liteethipv4depacketizer_source_payload_error = ip_rx_liteethipv4depacketizer_sink_payload_error;
+assign ip_rx_liteethipv4depacketizer_sink_last_be = ip_rx_liteethipv4depacketizer_sink_last;
+assign ip_rx_liteethipv4depacketizer_new_last_be = {ip_rx_liteethipv4depacketizer_sink_last_be};
+assign ip_rx_liteethipv4depacketizer_is_in_copy = (ip_rx_liteethipv4depacketizer_is_ongoing0 | ip_rx_liteethipv4depacketizer_is_ongoing1);
 always @(*) begin
-    ip_rx_depacketizer_source_last <= 1'd0;
-    if (ip_rx_depacketizer_source_last_s) begin
-        ip_rx_depacketizer_source_last <= ip_rx_depacketizer_source_last_b;
+    ip_rx_liteethipv4depacketizer_source_last <= 1'd0;
+    if (ip_rx_liteethipv4depacketizer_source_last_s) begin
+        ip_rx_liteethipv4depacketizer_source_last <= ip_rx_liteethipv4depacketizer_source_last_b;
     end else begin
-        ip_rx_depacketizer_source_last <= ip_rx_depacketizer_source_last_a;
+        ip_rx_liteethipv4depacketizer_source_last <= ip_rx_liteethipv4depacketizer_source_last_a;
     end
 end
+assign ip_rx_cut = ((ip_rx_liteethipv4depacketizer_sink_valid & ip_rx_liteethipv4depacketizer_sink_last) & (ip_rx_fsm_is_ongoing0 | ip_rx_fsm_is_ongoing1));
 always @(*) begin
-    ip_rx_depacketizer_count_liteethip_fsm0_next_value2 <= 5'd0;
-    ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd0;
-    ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= 1'd0;
-    ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd0;
-    ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd0;
-    ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd0;
-    ip_rx_depacketizer_is_ongoing0 <= 1'd0;
-    ip_rx_depacketizer_is_ongoing1 <= 1'd0;
-    ip_rx_depacketizer_is_ongoing2 <= 1'd0;
-    ip_rx_depacketizer_is_ongoing3 <= 1'd0;
-    ip_rx_depacketizer_sink_ready <= 1'd0;
-    ip_rx_depacketizer_source_last_a <= 1'd0;
-    ip_rx_depacketizer_source_last_b <= 1'd0;
-    ip_rx_depacketizer_source_last_s <= 1'd0;
-    ip_rx_depacketizer_source_payload_data <= 8'd0;
-    ip_rx_depacketizer_source_payload_last_be <= 1'd0;
-    ip_rx_depacketizer_source_valid <= 1'd0;
-    ip_rx_depacketizer_sr_shift <= 1'd0;
-    liteethip_liteethiprx_fsm0_next_state <= 2'd0;
-    liteethip_liteethiprx_fsm1_next_state <= 1'd0;
-    liteethip_liteethiprx_fsm0_next_state <= liteethip_liteethiprx_fsm0_state;
-    case (liteethip_liteethiprx_fsm0_state)
+    ip_rx_fsm_is_ongoing0 <= 1'd0;
+    ip_rx_fsm_is_ongoing1 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= 5'd0;
+    ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_is_ongoing0 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_is_ongoing1 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_is_ongoing2 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_is_ongoing3 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_sink_ready <= 1'd0;
+    ip_rx_liteethipv4depacketizer_source_last_a <= 1'd0;
+    ip_rx_liteethipv4depacketizer_source_last_b <= 1'd0;
+    ip_rx_liteethipv4depacketizer_source_last_s <= 1'd0;
+    ip_rx_liteethipv4depacketizer_source_payload_data <= 8'd0;
+    ip_rx_liteethipv4depacketizer_source_payload_last_be <= 1'd0;
+    ip_rx_liteethipv4depacketizer_source_valid <= 1'd0;
+    ip_rx_liteethipv4depacketizer_sr_shift <= 1'd0;
+    liteethip_checkingiprx_fsm0_next_state <= 2'd0;
+    liteethip_checkingiprx_fsm1_next_state <= 1'd0;
+    liteethip_checkingiprx_fsm0_next_state <= liteethip_checkingiprx_fsm0_state;
+    case (liteethip_checkingiprx_fsm0_state)
         1'd1: begin
-            ip_rx_depacketizer_sink_ready <= 1'd1;
-            if (ip_rx_depacketizer_sink_valid) begin
-                ip_rx_depacketizer_count_liteethip_fsm0_next_value2 <= (ip_rx_depacketizer_count + 1'd1);
-                ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
-                ip_rx_depacketizer_sr_shift <= 1'd1;
-                if ((ip_rx_depacketizer_count == 5'd19)) begin
-                    liteethip_liteethiprx_fsm0_next_state <= 2'd2;
-                    ip_rx_depacketizer_count_liteethip_fsm0_next_value2 <= (ip_rx_depacketizer_count + 1'd1);
-                    ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
+            ip_rx_liteethipv4depacketizer_sink_ready <= 1'd1;
+            if (ip_rx_liteethipv4depacketizer_sink_valid) begin
+                ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= (ip_rx_liteethipv4depacketizer_count + 1'd1);
+                ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
+                ip_rx_liteethipv4depacketizer_sr_shift <= 1'd1;
+                if ((ip_rx_liteethipv4depacketizer_count == 5'd19)) begin
+                    liteethip_checkingiprx_fsm0_next_state <= 2'd2;
+                    ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= (ip_rx_liteethipv4depacketizer_count + 1'd1);
+                    ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            ip_rx_fsm_is_ongoing1 <= 1'd1;
+            if ((ip_rx_liteethipv4depacketizer_sink_valid & ip_rx_liteethipv4depacketizer_sink_last)) begin
+                liteethip_checkingiprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            ip_rx_depacketizer_source_valid <= (ip_rx_depacketizer_sink_valid | ip_rx_depacketizer_sink_d_last);
-            ip_rx_depacketizer_source_last_a <= (ip_rx_depacketizer_sink_last | ip_rx_depacketizer_sink_d_last);
-            ip_rx_depacketizer_sink_ready <= ip_rx_depacketizer_source_ready;
-            ip_rx_depacketizer_source_payload_data <= ip_rx_depacketizer_sink_payload_data;
-            if ((ip_rx_depacketizer_source_valid & ip_rx_depacketizer_source_ready)) begin
-                if (ip_rx_depacketizer_source_last) begin
-                    liteethip_liteethiprx_fsm0_next_state <= 1'd0;
+            ip_rx_liteethipv4depacketizer_source_valid <= (ip_rx_liteethipv4depacketizer_sink_valid | ip_rx_liteethipv4depacketizer_sink_d_last);
+            ip_rx_liteethipv4depacketizer_source_last_a <= (ip_rx_liteethipv4depacketizer_sink_last | ip_rx_liteethipv4depacketizer_sink_d_last);
+            ip_rx_liteethipv4depacketizer_sink_ready <= ip_rx_liteethipv4depacketizer_source_ready;
+            ip_rx_liteethipv4depacketizer_source_payload_data <= ip_rx_liteethipv4depacketizer_sink_payload_data;
+            if ((ip_rx_liteethipv4depacketizer_source_valid & ip_rx_liteethipv4depacketizer_source_ready)) begin
+                if (ip_rx_liteethipv4depacketizer_source_last) begin
+                    liteethip_checkingiprx_fsm0_next_state <= 1'd0;
                 end
             end
-            ip_rx_depacketizer_is_ongoing0 <= 1'd1;
-            ip_rx_depacketizer_is_ongoing2 <= 1'd1;
+            ip_rx_liteethipv4depacketizer_is_ongoing0 <= 1'd1;
+            ip_rx_liteethipv4depacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            ip_rx_depacketizer_is_ongoing1 <= 1'd1;
-            ip_rx_depacketizer_is_ongoing3 <= 1'd1;
+            ip_rx_liteethipv4depacketizer_is_ongoing1 <= 1'd1;
+            ip_rx_liteethipv4depacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            ip_rx_depacketizer_sink_ready <= 1'd1;
-            ip_rx_depacketizer_count_liteethip_fsm0_next_value2 <= 1'd1;
-            ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
-            if (ip_rx_depacketizer_sink_valid) begin
-                ip_rx_depacketizer_sr_shift <= 1'd1;
-                ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd1;
-                ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd1;
+            ip_rx_liteethipv4depacketizer_sink_ready <= 1'd1;
+            ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= 1'd1;
+            ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
+            if (ip_rx_liteethipv4depacketizer_sink_valid) begin
+                ip_rx_liteethipv4depacketizer_sr_shift <= 1'd1;
+                ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd1;
+                ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
-                    liteethip_liteethiprx_fsm0_next_state <= 2'd2;
+                    liteethip_checkingiprx_fsm0_next_state <= 2'd2;
                 end else begin
-                    liteethip_liteethiprx_fsm0_next_state <= 1'd1;
+                    liteethip_checkingiprx_fsm0_next_state <= 1'd1;
                 end
+            end
+            ip_rx_fsm_is_ongoing0 <= 1'd1;
+            if ((ip_rx_liteethipv4depacketizer_sink_valid & ip_rx_liteethipv4depacketizer_sink_last)) begin
+                liteethip_checkingiprx_fsm0_next_state <= 1'd0;
             end
         end
     endcase
-    liteethip_liteethiprx_fsm1_next_state <= liteethip_liteethiprx_fsm1_state;
-    case (liteethip_liteethiprx_fsm1_state)
+    liteethip_checkingiprx_fsm1_next_state <= liteethip_checkingiprx_fsm1_state;
+    case (liteethip_checkingiprx_fsm1_state)
         1'd1: begin
-            ip_rx_depacketizer_source_last_b <= 1'd1;
-            ip_rx_depacketizer_source_last_s <= 1'd1;
-            ip_rx_depacketizer_source_payload_last_be <= ip_rx_depacketizer_delayed_last_be;
-            ip_rx_depacketizer_sink_ready <= 1'd0;
-            if ((ip_rx_depacketizer_source_ready & ip_rx_depacketizer_source_valid)) begin
-                liteethip_liteethiprx_fsm1_next_state <= 1'd0;
+            ip_rx_liteethipv4depacketizer_source_last_b <= 1'd1;
+            ip_rx_liteethipv4depacketizer_source_last_s <= 1'd1;
+            ip_rx_liteethipv4depacketizer_source_payload_last_be <= ip_rx_liteethipv4depacketizer_delayed_last_be;
+            ip_rx_liteethipv4depacketizer_sink_ready <= 1'd0;
+            if ((ip_rx_liteethipv4depacketizer_source_ready & ip_rx_liteethipv4depacketizer_source_valid)) begin
+                liteethip_checkingiprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((ip_rx_depacketizer_sink_valid & ip_rx_depacketizer_sink_last) & (ip_rx_depacketizer_sink_last_be > ip_rx_depacketizer_new_last_be))) begin
-                ip_rx_depacketizer_source_last_b <= 1'd0;
-                ip_rx_depacketizer_source_last_s <= 1'd1;
-                ip_rx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((ip_rx_depacketizer_source_ready & ip_rx_depacketizer_source_valid) | ((~ip_rx_depacketizer_was_in_copy) & ip_rx_depacketizer_is_in_copy))) begin
-                    ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= ip_rx_depacketizer_new_last_be;
-                    ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd1;
-                    liteethip_liteethiprx_fsm1_next_state <= 1'd1;
+            if (((ip_rx_liteethipv4depacketizer_sink_valid & ip_rx_liteethipv4depacketizer_sink_last) & (ip_rx_liteethipv4depacketizer_sink_last_be > ip_rx_liteethipv4depacketizer_new_last_be))) begin
+                ip_rx_liteethipv4depacketizer_source_last_b <= 1'd0;
+                ip_rx_liteethipv4depacketizer_source_last_s <= 1'd1;
+                ip_rx_liteethipv4depacketizer_source_payload_last_be <= 1'd0;
+                if (((ip_rx_liteethipv4depacketizer_source_ready & ip_rx_liteethipv4depacketizer_source_valid) | ((~ip_rx_liteethipv4depacketizer_was_in_copy) & ip_rx_liteethipv4depacketizer_is_in_copy))) begin
+                    ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= ip_rx_liteethipv4depacketizer_new_last_be;
+                    ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd1;
+                    liteethip_checkingiprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (ip_rx_depacketizer_sink_last) begin
-                    ip_rx_depacketizer_source_last_b <= 1'd1;
-                    ip_rx_depacketizer_source_last_s <= 1'd1;
-                    ip_rx_depacketizer_source_payload_last_be <= ip_rx_depacketizer_new_last_be;
+                if (ip_rx_liteethipv4depacketizer_sink_last) begin
+                    ip_rx_liteethipv4depacketizer_source_last_b <= 1'd1;
+                    ip_rx_liteethipv4depacketizer_source_last_s <= 1'd1;
+                    ip_rx_liteethipv4depacketizer_source_payload_last_be <= ip_rx_liteethipv4depacketizer_new_last_be;
                 end
             end
-            if ((ip_rx_depacketizer_is_ongoing2 | (ip_rx_depacketizer_is_ongoing3 & (~ip_rx_depacketizer_fsm_from_idle)))) begin
-                ip_rx_depacketizer_sink_ready <= ip_rx_depacketizer_source_ready;
+            if ((ip_rx_liteethipv4depacketizer_is_ongoing2 | (ip_rx_liteethipv4depacketizer_is_ongoing3 & (~ip_rx_liteethipv4depacketizer_fsm_from_idle)))) begin
+                ip_rx_liteethipv4depacketizer_sink_ready <= ip_rx_liteethipv4depacketizer_source_ready;
             end else begin
-                ip_rx_depacketizer_sink_ready <= 1'd1;
+                ip_rx_liteethipv4depacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
@@ -4603,32 +4683,37 @@ assign ip_rx_liteethipv4checksum_value = (~{ip_rx_liteethipv4checksum_r_next9[7:
 assign ip_rx_liteethipv4checksum_counter_ce = (~ip_rx_liteethipv4checksum_done);
 assign ip_rx_liteethipv4checksum_done = (ip_rx_liteethipv4checksum_counter == 4'd11);
 always @(*) begin
-    ip_rx_depacketizer_source_ready <= 1'd0;
-    ip_rx_source_source_valid <= 1'd0;
-    liteethip_liteethiprx_next_state <= 2'd0;
-    liteethip_liteethiprx_next_state <= liteethip_liteethiprx_state;
-    case (liteethip_liteethiprx_state)
+    ip_rx_is_ongoing <= 1'd0;
+    ip_rx_liteethipv4depacketizer_source_ready <= 1'd0;
+    ip_rx_source_valid <= 1'd0;
+    liteethip_checkingiprx_next_state <= 2'd0;
+    liteethip_checkingiprx_next_state <= liteethip_checkingiprx_state;
+    case (liteethip_checkingiprx_state)
         1'd1: begin
-            ip_rx_source_source_valid <= ip_rx_depacketizer_source_valid;
-            ip_rx_depacketizer_source_ready <= ip_rx_source_source_ready;
-            if ((ip_rx_source_source_valid & ip_rx_source_source_ready)) begin
-                if (ip_rx_source_source_last) begin
-                    liteethip_liteethiprx_next_state <= 1'd0;
+            ip_rx_source_valid <= ip_rx_liteethipv4depacketizer_source_valid;
+            ip_rx_liteethipv4depacketizer_source_ready <= ip_rx_source_ready;
+            if ((ip_rx_source_valid & ip_rx_source_ready)) begin
+                if (ip_rx_source_last) begin
+                    liteethip_checkingiprx_next_state <= 1'd0;
                 end
             end
         end
         2'd2: begin
-            ip_rx_depacketizer_source_ready <= 1'd1;
-            if (((ip_rx_depacketizer_source_valid & ip_rx_depacketizer_source_last) & ip_rx_depacketizer_source_ready)) begin
-                liteethip_liteethiprx_next_state <= 1'd0;
+            ip_rx_liteethipv4depacketizer_source_ready <= 1'd1;
+            if (((ip_rx_liteethipv4depacketizer_source_valid & ip_rx_liteethipv4depacketizer_source_last) & ip_rx_liteethipv4depacketizer_source_ready)) begin
+                liteethip_checkingiprx_next_state <= 1'd0;
             end
         end
         default: begin
-            if ((ip_rx_depacketizer_source_valid & ip_rx_liteethipv4checksum_done)) begin
-                liteethip_liteethiprx_next_state <= 2'd2;
-                if ((((((ip_rx_depacketizer_source_param_target_ip == ip_address) | take_group) & (ip_rx_depacketizer_source_param_version == 3'd4)) & (ip_rx_depacketizer_source_param_ihl == 3'd5)) & (ip_rx_liteethipv4checksum_value == 1'd0))) begin
-                    liteethip_liteethiprx_next_state <= 1'd1;
+            if ((ip_rx_liteethipv4depacketizer_source_valid & ip_rx_liteethipv4checksum_done)) begin
+                liteethip_checkingiprx_next_state <= 2'd2;
+                if ((((((ip_rx_liteethipv4depacketizer_source_param_target_ip == ip_address) | take_group) & (ip_rx_liteethipv4depacketizer_source_param_version == 3'd4)) & (ip_rx_liteethipv4depacketizer_source_param_ihl == 3'd5)) & (ip_rx_liteethipv4checksum_value == 1'd0))) begin
+                    liteethip_checkingiprx_next_state <= 1'd1;
                 end
+            end
+            ip_rx_is_ongoing <= 1'd1;
+            if ((ip_rx_decide & (~(ip_rx_header_ok & ip_rx_ours)))) begin
+                liteethip_checkingiprx_next_state <= 2'd2;
             end
         end
     endcase
@@ -4642,6 +4727,8 @@ always @(*) begin
         liteethip_sel0 <= 2'd2;
     end
 end
+assign liteethip_taken = (((1'd0 + icmp_ip_port_source_valid) + ip_port_source_valid) != 1'd0);
+assign ip_crossbar_dropped = (((ip_crossbar_sink_valid & ip_crossbar_sink_ready) & ip_crossbar_sink_last) & (~liteethip_taken));
 always @(*) begin
     liteethip_request <= 2'd0;
     liteethip_request[0] <= liteethip_status0_ongoing0;
@@ -4750,19 +4837,19 @@ always @(*) begin
 end
 assign liteethip_last = ((ip_crossbar_sink_valid & ip_crossbar_sink_last) & ip_crossbar_sink_ready);
 assign liteethip_ongoing0 = ((ip_crossbar_sink_valid | liteethip_ongoing1) & (~liteethip_last));
-assign icmp_echo_sink_valid = icmp_rx_source_source_valid;
-assign icmp_rx_source_source_ready = icmp_echo_sink_ready;
-assign icmp_echo_sink_first = icmp_rx_source_source_first;
-assign icmp_echo_sink_last = icmp_rx_source_source_last;
-assign icmp_echo_sink_payload_data = icmp_rx_source_source_payload_data;
-assign icmp_echo_sink_payload_last_be = icmp_rx_source_source_payload_last_be;
-assign icmp_echo_sink_payload_error = icmp_rx_source_source_payload_error;
-assign icmp_echo_sink_param_checksum = icmp_rx_source_source_param_checksum;
-assign icmp_echo_sink_param_code = icmp_rx_source_source_param_code;
-assign icmp_echo_sink_param_msgtype = icmp_rx_source_source_param_msgtype;
-assign icmp_echo_sink_param_quench = icmp_rx_source_source_param_quench;
-assign icmp_echo_sink_param_ip_address = icmp_rx_source_source_param_ip_address;
-assign icmp_echo_sink_param_length = icmp_rx_source_source_param_length;
+assign icmp_echo_sink_valid = icmp_rx_source_valid;
+assign icmp_rx_source_ready = icmp_echo_sink_ready;
+assign icmp_echo_sink_first = icmp_rx_source_first;
+assign icmp_echo_sink_last = icmp_rx_source_last;
+assign icmp_echo_sink_payload_data = icmp_rx_source_payload_data;
+assign icmp_echo_sink_payload_last_be = icmp_rx_source_payload_last_be;
+assign icmp_echo_sink_payload_error = icmp_rx_source_payload_error;
+assign icmp_echo_sink_param_checksum = icmp_rx_source_param_checksum;
+assign icmp_echo_sink_param_code = icmp_rx_source_param_code;
+assign icmp_echo_sink_param_msgtype = icmp_rx_source_param_msgtype;
+assign icmp_echo_sink_param_quench = icmp_rx_source_param_quench;
+assign icmp_echo_sink_param_ip_address = icmp_rx_source_param_ip_address;
+assign icmp_echo_sink_param_length = icmp_rx_source_param_length;
 assign icmp_tx_sink_sink_valid = icmp_echo_source_valid;
 assign icmp_echo_source_ready = icmp_tx_sink_sink_ready;
 assign icmp_tx_sink_sink_first = icmp_echo_source_first;
@@ -4786,16 +4873,16 @@ assign icmp_ip_port_sink_payload_error = icmp_tx_source_source_payload_error;
 assign icmp_ip_port_sink_param_length = icmp_tx_source_source_param_length;
 assign icmp_ip_port_sink_param_protocol = icmp_tx_source_source_param_protocol;
 assign icmp_ip_port_sink_param_ip_address = icmp_tx_source_source_param_ip_address;
-assign icmp_rx_sink_sink_valid = icmp_ip_port_source_valid;
-assign icmp_ip_port_source_ready = icmp_rx_sink_sink_ready;
-assign icmp_rx_sink_sink_first = icmp_ip_port_source_first;
-assign icmp_rx_sink_sink_last = icmp_ip_port_source_last;
-assign icmp_rx_sink_sink_payload_data = icmp_ip_port_source_payload_data;
-assign icmp_rx_sink_sink_payload_last_be = icmp_ip_port_source_payload_last_be;
-assign icmp_rx_sink_sink_payload_error = icmp_ip_port_source_payload_error;
-assign icmp_rx_sink_sink_param_length = icmp_ip_port_source_param_length;
-assign icmp_rx_sink_sink_param_protocol = icmp_ip_port_source_param_protocol;
-assign icmp_rx_sink_sink_param_ip_address = icmp_ip_port_source_param_ip_address;
+assign icmp_rx_sink_valid = icmp_ip_port_source_valid;
+assign icmp_ip_port_source_ready = icmp_rx_sink_ready;
+assign icmp_rx_sink_first = icmp_ip_port_source_first;
+assign icmp_rx_sink_last = icmp_ip_port_source_last;
+assign icmp_rx_sink_payload_data = icmp_ip_port_source_payload_data;
+assign icmp_rx_sink_payload_last_be = icmp_ip_port_source_payload_last_be;
+assign icmp_rx_sink_payload_error = icmp_ip_port_source_payload_error;
+assign icmp_rx_sink_param_length = icmp_ip_port_source_param_length;
+assign icmp_rx_sink_param_protocol = icmp_ip_port_source_param_protocol;
+assign icmp_rx_sink_param_ip_address = icmp_ip_port_source_param_ip_address;
 assign icmp_tx_packetizer_sink_valid = icmp_tx_sink_sink_valid;
 assign icmp_tx_sink_sink_ready = icmp_tx_packetizer_sink_ready;
 assign icmp_tx_packetizer_sink_last = icmp_tx_sink_sink_last;
@@ -4980,174 +5067,185 @@ always @(*) begin
         end
     endcase
 end
-assign icmp_rx_depacketizer_sink_valid = icmp_rx_sink_sink_valid;
-assign icmp_rx_sink_sink_ready = icmp_rx_depacketizer_sink_ready;
-assign icmp_rx_depacketizer_sink_first = icmp_rx_sink_sink_first;
-assign icmp_rx_depacketizer_sink_last = icmp_rx_sink_sink_last;
-assign icmp_rx_depacketizer_sink_payload_data = icmp_rx_sink_sink_payload_data;
-assign icmp_rx_depacketizer_sink_payload_last_be = icmp_rx_sink_sink_payload_last_be;
-assign icmp_rx_depacketizer_sink_payload_error = icmp_rx_sink_sink_payload_error;
-assign icmp_rx_depacketizer_sink_param_length = icmp_rx_sink_sink_param_length;
-assign icmp_rx_depacketizer_sink_param_protocol = icmp_rx_sink_sink_param_protocol;
-assign icmp_rx_depacketizer_sink_param_ip_address = icmp_rx_sink_sink_param_ip_address;
-assign icmp_rx_source_source_last = icmp_rx_depacketizer_source_last;
-assign icmp_rx_source_source_payload_data = icmp_rx_depacketizer_source_payload_data;
-assign icmp_rx_source_source_payload_last_be = icmp_rx_depacketizer_source_payload_last_be;
-assign icmp_rx_source_source_payload_error = icmp_rx_depacketizer_source_payload_error;
-assign icmp_rx_source_source_param_checksum = icmp_rx_depacketizer_source_param_checksum;
-assign icmp_rx_source_source_param_code = icmp_rx_depacketizer_source_param_code;
-assign icmp_rx_source_source_param_msgtype = icmp_rx_depacketizer_source_param_msgtype;
-assign icmp_rx_source_source_param_quench = icmp_rx_depacketizer_source_param_quench;
-assign icmp_rx_source_source_param_ip_address = icmp_rx_sink_sink_param_ip_address;
-assign icmp_rx_source_source_param_length = (icmp_rx_sink_sink_param_length - 4'd8);
-assign icmp_rx_depacketizer_header = icmp_rx_depacketizer_sr;
-assign icmp_rx_depacketizer_source_param_checksum = {rhs_slice_proxy61[7:0], rhs_slice_proxy60[15:8]};
-assign icmp_rx_depacketizer_source_param_code = {rhs_slice_proxy62[7:0]};
-assign icmp_rx_depacketizer_source_param_msgtype = {rhs_slice_proxy63[7:0]};
-assign icmp_rx_depacketizer_source_param_quench = {rhs_slice_proxy67[7:0], rhs_slice_proxy66[15:8], rhs_slice_proxy65[23:16], rhs_slice_proxy64[31:24]};
-assign icmp_rx_depacketizer_source_payload_error = icmp_rx_depacketizer_sink_payload_error;
-assign icmp_rx_depacketizer_sink_last_be = icmp_rx_depacketizer_sink_last;
-assign icmp_rx_depacketizer_new_last_be = {icmp_rx_depacketizer_sink_last_be};
-assign icmp_rx_depacketizer_is_in_copy = (icmp_rx_depacketizer_is_ongoing0 | icmp_rx_depacketizer_is_ongoing1);
+assign icmp_rx_liteethicmpdepacketizer_sink_valid = icmp_rx_sink_valid;
+assign icmp_rx_sink_ready = icmp_rx_liteethicmpdepacketizer_sink_ready;
+assign icmp_rx_liteethicmpdepacketizer_sink_first = icmp_rx_sink_first;
+assign icmp_rx_liteethicmpdepacketizer_sink_last = icmp_rx_sink_last;
+assign icmp_rx_liteethicmpdepacketizer_sink_payload_data = icmp_rx_sink_payload_data;
+assign icmp_rx_liteethicmpdepacketizer_sink_payload_last_be = icmp_rx_sink_payload_last_be;
+assign icmp_rx_liteethicmpdepacketizer_sink_payload_error = icmp_rx_sink_payload_error;
+assign icmp_rx_liteethicmpdepacketizer_sink_param_length = icmp_rx_sink_param_length;
+assign icmp_rx_liteethicmpdepacketizer_sink_param_protocol = icmp_rx_sink_param_protocol;
+assign icmp_rx_liteethicmpdepacketizer_sink_param_ip_address = icmp_rx_sink_param_ip_address;
+assign icmp_rx_source_last = icmp_rx_liteethicmpdepacketizer_source_last;
+assign icmp_rx_source_payload_data = icmp_rx_liteethicmpdepacketizer_source_payload_data;
+assign icmp_rx_source_payload_last_be = icmp_rx_liteethicmpdepacketizer_source_payload_last_be;
+assign icmp_rx_source_payload_error = icmp_rx_liteethicmpdepacketizer_source_payload_error;
+assign icmp_rx_source_param_checksum = icmp_rx_liteethicmpdepacketizer_source_param_checksum;
+assign icmp_rx_source_param_code = icmp_rx_liteethicmpdepacketizer_source_param_code;
+assign icmp_rx_source_param_msgtype = icmp_rx_liteethicmpdepacketizer_source_param_msgtype;
+assign icmp_rx_source_param_quench = icmp_rx_liteethicmpdepacketizer_source_param_quench;
+assign icmp_rx_source_param_ip_address = icmp_rx_sink_param_ip_address;
+assign icmp_rx_source_param_length = (icmp_rx_sink_param_length - 4'd8);
+assign icmp_rx_liteethicmpdepacketizer_header = icmp_rx_liteethicmpdepacketizer_sr;
+assign icmp_rx_liteethicmpdepacketizer_source_param_checksum = {rhs_slice_proxy61[7:0], rhs_slice_proxy60[15:8]};
+assign icmp_rx_liteethicmpdepacketizer_source_param_code = {rhs_slice_proxy62[7:0]};
+assign icmp_rx_liteethicmpdepacketizer_source_param_msgtype = {rhs_slice_proxy63[7:0]};
+assign icmp_rx_liteethicmpdepacketizer_source_param_quench = {rhs_slice_proxy67[7:0], rhs_slice_proxy66[15:8], rhs_slice_proxy65[23:16], rhs_slice_proxy64[31:24]};
+assign icmp_rx_liteethicmpdepacketizer_source_payload_error = icmp_rx_liteethicmpdepacketizer_sink_payload_error;
+assign icmp_rx_liteethicmpdepacketizer_sink_last_be = icmp_rx_liteethicmpdepacketizer_sink_last;
+assign icmp_rx_liteethicmpdepacketizer_new_last_be = {icmp_rx_liteethicmpdepacketizer_sink_last_be};
+assign icmp_rx_liteethicmpdepacketizer_is_in_copy = (icmp_rx_liteethicmpdepacketizer_is_ongoing0 | icmp_rx_liteethicmpdepacketizer_is_ongoing1);
 always @(*) begin
-    icmp_rx_depacketizer_source_last <= 1'd0;
-    if (icmp_rx_depacketizer_source_last_s) begin
-        icmp_rx_depacketizer_source_last <= icmp_rx_depacketizer_source_last_b;
+    icmp_rx_liteethicmpdepacketizer_source_last <= 1'd0;
+    if (icmp_rx_liteethicmpdepacketizer_source_last_s) begin
+        icmp_rx_liteethicmpdepacketizer_source_last <= icmp_rx_liteethicmpdepacketizer_source_last_b;
     end else begin
-        icmp_rx_depacketizer_source_last <= icmp_rx_depacketizer_source_last_a;
+        icmp_rx_liteethicmpdepacketizer_source_last <= icmp_rx_liteethicmpdepacketizer_source_last_a;
     end
 end
+assign icmp_rx_cut = ((icmp_rx_liteethicmpdepacketizer_sink_valid & icmp_rx_liteethicmpdepacketizer_sink_last) & (icmp_rx_fsm_is_ongoing0 | icmp_rx_fsm_is_ongoing1));
 always @(*) begin
-    icmp_rx_depacketizer_count_fsm0_next_value2 <= 3'd0;
-    icmp_rx_depacketizer_count_fsm0_next_value_ce2 <= 1'd0;
-    icmp_rx_depacketizer_delayed_last_be_fsm1_next_value1 <= 1'd0;
-    icmp_rx_depacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd0;
-    icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd0;
-    icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd0;
-    icmp_rx_depacketizer_is_ongoing0 <= 1'd0;
-    icmp_rx_depacketizer_is_ongoing1 <= 1'd0;
-    icmp_rx_depacketizer_is_ongoing2 <= 1'd0;
-    icmp_rx_depacketizer_is_ongoing3 <= 1'd0;
-    icmp_rx_depacketizer_sink_ready <= 1'd0;
-    icmp_rx_depacketizer_source_last_a <= 1'd0;
-    icmp_rx_depacketizer_source_last_b <= 1'd0;
-    icmp_rx_depacketizer_source_last_s <= 1'd0;
-    icmp_rx_depacketizer_source_payload_data <= 8'd0;
-    icmp_rx_depacketizer_source_payload_last_be <= 1'd0;
-    icmp_rx_depacketizer_source_valid <= 1'd0;
-    icmp_rx_depacketizer_sr_shift <= 1'd0;
+    icmp_rx_fsm_is_ongoing0 <= 1'd0;
+    icmp_rx_fsm_is_ongoing1 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= 3'd0;
+    icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_is_ongoing0 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_is_ongoing1 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_is_ongoing2 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_is_ongoing3 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_source_last_a <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_source_payload_data <= 8'd0;
+    icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_source_valid <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd0;
     liteethicmprx_fsm0_next_state <= 2'd0;
     liteethicmprx_fsm1_next_state <= 1'd0;
     liteethicmprx_fsm0_next_state <= liteethicmprx_fsm0_state;
     case (liteethicmprx_fsm0_state)
         1'd1: begin
-            icmp_rx_depacketizer_sink_ready <= 1'd1;
-            if (icmp_rx_depacketizer_sink_valid) begin
-                icmp_rx_depacketizer_count_fsm0_next_value2 <= (icmp_rx_depacketizer_count + 1'd1);
-                icmp_rx_depacketizer_count_fsm0_next_value_ce2 <= 1'd1;
-                icmp_rx_depacketizer_sr_shift <= 1'd1;
-                if ((icmp_rx_depacketizer_count == 3'd7)) begin
+            icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd1;
+            if (icmp_rx_liteethicmpdepacketizer_sink_valid) begin
+                icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= (icmp_rx_liteethicmpdepacketizer_count + 1'd1);
+                icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
+                icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd1;
+                if ((icmp_rx_liteethicmpdepacketizer_count == 3'd7)) begin
                     liteethicmprx_fsm0_next_state <= 2'd2;
-                    icmp_rx_depacketizer_count_fsm0_next_value2 <= (icmp_rx_depacketizer_count + 1'd1);
-                    icmp_rx_depacketizer_count_fsm0_next_value_ce2 <= 1'd1;
+                    icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= (icmp_rx_liteethicmpdepacketizer_count + 1'd1);
+                    icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            icmp_rx_fsm_is_ongoing1 <= 1'd1;
+            if ((icmp_rx_liteethicmpdepacketizer_sink_valid & icmp_rx_liteethicmpdepacketizer_sink_last)) begin
+                liteethicmprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            icmp_rx_depacketizer_source_valid <= (icmp_rx_depacketizer_sink_valid | icmp_rx_depacketizer_sink_d_last);
-            icmp_rx_depacketizer_source_last_a <= (icmp_rx_depacketizer_sink_last | icmp_rx_depacketizer_sink_d_last);
-            icmp_rx_depacketizer_sink_ready <= icmp_rx_depacketizer_source_ready;
-            icmp_rx_depacketizer_source_payload_data <= icmp_rx_depacketizer_sink_payload_data;
-            if ((icmp_rx_depacketizer_source_valid & icmp_rx_depacketizer_source_ready)) begin
-                if (icmp_rx_depacketizer_source_last) begin
+            icmp_rx_liteethicmpdepacketizer_source_valid <= (icmp_rx_liteethicmpdepacketizer_sink_valid | icmp_rx_liteethicmpdepacketizer_sink_d_last);
+            icmp_rx_liteethicmpdepacketizer_source_last_a <= (icmp_rx_liteethicmpdepacketizer_sink_last | icmp_rx_liteethicmpdepacketizer_sink_d_last);
+            icmp_rx_liteethicmpdepacketizer_sink_ready <= icmp_rx_liteethicmpdepacketizer_source_ready;
+            icmp_rx_liteethicmpdepacketizer_source_payload_data <= icmp_rx_liteethicmpdepacketizer_sink_payload_data;
+            if ((icmp_rx_liteethicmpdepacketizer_source_valid & icmp_rx_liteethicmpdepacketizer_source_ready)) begin
+                if (icmp_rx_liteethicmpdepacketizer_source_last) begin
                     liteethicmprx_fsm0_next_state <= 1'd0;
                 end
             end
-            icmp_rx_depacketizer_is_ongoing0 <= 1'd1;
-            icmp_rx_depacketizer_is_ongoing2 <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_is_ongoing0 <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            icmp_rx_depacketizer_is_ongoing1 <= 1'd1;
-            icmp_rx_depacketizer_is_ongoing3 <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_is_ongoing1 <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            icmp_rx_depacketizer_sink_ready <= 1'd1;
-            icmp_rx_depacketizer_count_fsm0_next_value2 <= 1'd1;
-            icmp_rx_depacketizer_count_fsm0_next_value_ce2 <= 1'd1;
-            if (icmp_rx_depacketizer_sink_valid) begin
-                icmp_rx_depacketizer_sr_shift <= 1'd1;
-                icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd1;
-                icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
+            if (icmp_rx_liteethicmpdepacketizer_sink_valid) begin
+                icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd1;
+                icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd1;
+                icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
                     liteethicmprx_fsm0_next_state <= 2'd2;
                 end else begin
                     liteethicmprx_fsm0_next_state <= 1'd1;
                 end
             end
+            icmp_rx_fsm_is_ongoing0 <= 1'd1;
+            if ((icmp_rx_liteethicmpdepacketizer_sink_valid & icmp_rx_liteethicmpdepacketizer_sink_last)) begin
+                liteethicmprx_fsm0_next_state <= 1'd0;
+            end
         end
     endcase
     liteethicmprx_fsm1_next_state <= liteethicmprx_fsm1_state;
     case (liteethicmprx_fsm1_state)
         1'd1: begin
-            icmp_rx_depacketizer_source_last_b <= 1'd1;
-            icmp_rx_depacketizer_source_last_s <= 1'd1;
-            icmp_rx_depacketizer_source_payload_last_be <= icmp_rx_depacketizer_delayed_last_be;
-            icmp_rx_depacketizer_sink_ready <= 1'd0;
-            if ((icmp_rx_depacketizer_source_ready & icmp_rx_depacketizer_source_valid)) begin
+            icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd1;
+            icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= icmp_rx_liteethicmpdepacketizer_delayed_last_be;
+            icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd0;
+            if ((icmp_rx_liteethicmpdepacketizer_source_ready & icmp_rx_liteethicmpdepacketizer_source_valid)) begin
                 liteethicmprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((icmp_rx_depacketizer_sink_valid & icmp_rx_depacketizer_sink_last) & (icmp_rx_depacketizer_sink_last_be > icmp_rx_depacketizer_new_last_be))) begin
-                icmp_rx_depacketizer_source_last_b <= 1'd0;
-                icmp_rx_depacketizer_source_last_s <= 1'd1;
-                icmp_rx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((icmp_rx_depacketizer_source_ready & icmp_rx_depacketizer_source_valid) | ((~icmp_rx_depacketizer_was_in_copy) & icmp_rx_depacketizer_is_in_copy))) begin
-                    icmp_rx_depacketizer_delayed_last_be_fsm1_next_value1 <= icmp_rx_depacketizer_new_last_be;
-                    icmp_rx_depacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd1;
+            if (((icmp_rx_liteethicmpdepacketizer_sink_valid & icmp_rx_liteethicmpdepacketizer_sink_last) & (icmp_rx_liteethicmpdepacketizer_sink_last_be > icmp_rx_liteethicmpdepacketizer_new_last_be))) begin
+                icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd0;
+                icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd1;
+                icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 1'd0;
+                if (((icmp_rx_liteethicmpdepacketizer_source_ready & icmp_rx_liteethicmpdepacketizer_source_valid) | ((~icmp_rx_liteethicmpdepacketizer_was_in_copy) & icmp_rx_liteethicmpdepacketizer_is_in_copy))) begin
+                    icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 <= icmp_rx_liteethicmpdepacketizer_new_last_be;
+                    icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd1;
                     liteethicmprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (icmp_rx_depacketizer_sink_last) begin
-                    icmp_rx_depacketizer_source_last_b <= 1'd1;
-                    icmp_rx_depacketizer_source_last_s <= 1'd1;
-                    icmp_rx_depacketizer_source_payload_last_be <= icmp_rx_depacketizer_new_last_be;
+                if (icmp_rx_liteethicmpdepacketizer_sink_last) begin
+                    icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd1;
+                    icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd1;
+                    icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= icmp_rx_liteethicmpdepacketizer_new_last_be;
                 end
             end
-            if ((icmp_rx_depacketizer_is_ongoing2 | (icmp_rx_depacketizer_is_ongoing3 & (~icmp_rx_depacketizer_fsm_from_idle)))) begin
-                icmp_rx_depacketizer_sink_ready <= icmp_rx_depacketizer_source_ready;
+            if ((icmp_rx_liteethicmpdepacketizer_is_ongoing2 | (icmp_rx_liteethicmpdepacketizer_is_ongoing3 & (~icmp_rx_liteethicmpdepacketizer_fsm_from_idle)))) begin
+                icmp_rx_liteethicmpdepacketizer_sink_ready <= icmp_rx_liteethicmpdepacketizer_source_ready;
             end else begin
-                icmp_rx_depacketizer_sink_ready <= 1'd1;
+                icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
-    icmp_rx_depacketizer_source_ready <= 1'd0;
-    icmp_rx_source_source_valid <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_source_ready <= 1'd0;
+    icmp_rx_source_valid <= 1'd0;
     liteethicmprx_next_state <= 2'd0;
     liteethicmprx_next_state <= liteethicmprx_state;
     case (liteethicmprx_state)
         1'd1: begin
-            icmp_rx_source_source_valid <= icmp_rx_depacketizer_source_valid;
-            icmp_rx_depacketizer_source_ready <= icmp_rx_source_source_ready;
-            if ((icmp_rx_source_source_valid & icmp_rx_source_source_ready)) begin
-                if (icmp_rx_source_source_last) begin
+            icmp_rx_source_valid <= icmp_rx_liteethicmpdepacketizer_source_valid;
+            icmp_rx_liteethicmpdepacketizer_source_ready <= icmp_rx_source_ready;
+            if ((icmp_rx_source_valid & icmp_rx_source_ready)) begin
+                if (icmp_rx_source_last) begin
                     liteethicmprx_next_state <= 1'd0;
                 end
             end
         end
         2'd2: begin
-            icmp_rx_depacketizer_source_ready <= 1'd1;
-            if (((icmp_rx_depacketizer_source_valid & icmp_rx_depacketizer_source_last) & icmp_rx_depacketizer_source_ready)) begin
+            icmp_rx_liteethicmpdepacketizer_source_ready <= 1'd1;
+            if (((icmp_rx_liteethicmpdepacketizer_source_valid & icmp_rx_liteethicmpdepacketizer_source_last) & icmp_rx_liteethicmpdepacketizer_source_ready)) begin
                 liteethicmprx_next_state <= 1'd0;
             end
         end
         default: begin
-            if (icmp_rx_depacketizer_source_valid) begin
+            if (icmp_rx_liteethicmpdepacketizer_source_valid) begin
                 liteethicmprx_next_state <= 2'd2;
-                if ((icmp_rx_sink_sink_param_protocol == 1'd1)) begin
-                    if ((icmp_rx_depacketizer_source_param_msgtype == 4'd8)) begin
+                if ((icmp_rx_sink_param_protocol == 1'd1)) begin
+                    if ((icmp_rx_liteethicmpdepacketizer_source_param_msgtype == 4'd8)) begin
                         liteethicmprx_next_state <= 1'd1;
                     end
                 end
@@ -5319,16 +5417,16 @@ assign ip_port_sink_payload_error = source_source_payload_error;
 assign ip_port_sink_param_length = source_source_param_length;
 assign ip_port_sink_param_protocol = source_source_param_protocol;
 assign ip_port_sink_param_ip_address = source_source_param_ip_address;
-assign holdingudprx_sink_sink_valid = ip_port_source_valid;
-assign ip_port_source_ready = holdingudprx_sink_sink_ready;
-assign holdingudprx_sink_sink_first = ip_port_source_first;
-assign holdingudprx_sink_sink_last = ip_port_source_last;
-assign holdingudprx_sink_sink_payload_data = ip_port_source_payload_data;
-assign holdingudprx_sink_sink_payload_last_be = ip_port_source_payload_last_be;
-assign holdingudprx_sink_sink_payload_error = ip_port_source_payload_error;
-assign holdingudprx_sink_sink_param_length = ip_port_source_param_length;
-assign holdingudprx_sink_sink_param_protocol = ip_port_source_param_protocol;
-assign holdingudprx_sink_sink_param_ip_address = ip_port_source_param_ip_address;
+assign holdingudprx_sink_valid = ip_port_source_valid;
+assign ip_port_source_ready = holdingudprx_sink_ready;
+assign holdingudprx_sink_first = ip_port_source_first;
+assign holdingudprx_sink_last = ip_port_source_last;
+assign holdingudprx_sink_payload_data = ip_port_source_payload_data;
+assign holdingudprx_sink_payload_last_be = ip_port_source_payload_last_be;
+assign holdingudprx_sink_payload_error = ip_port_source_payload_error;
+assign holdingudprx_sink_param_length = ip_port_source_param_length;
+assign holdingudprx_sink_param_protocol = ip_port_source_param_protocol;
+assign holdingudprx_sink_param_ip_address = ip_port_source_param_ip_address;
 assign sink_sink_valid = crossbar_source_valid;
 assign crossbar_source_ready = sink_sink_ready;
 assign sink_sink_first = crossbar_source_first;
@@ -5340,17 +5438,17 @@ assign sink_sink_param_src_port = crossbar_source_param_src_port;
 assign sink_sink_param_dst_port = crossbar_source_param_dst_port;
 assign sink_sink_param_ip_address = crossbar_source_param_ip_address;
 assign sink_sink_param_length = crossbar_source_param_length;
-assign crossbar_sink_valid = holdingudprx_source_source_valid;
-assign holdingudprx_source_source_ready = crossbar_sink_ready;
-assign crossbar_sink_first = holdingudprx_source_source_first;
-assign crossbar_sink_last = holdingudprx_source_source_last;
-assign crossbar_sink_payload_data = holdingudprx_source_source_payload_data;
-assign crossbar_sink_payload_last_be = holdingudprx_source_source_payload_last_be;
-assign crossbar_sink_payload_error = holdingudprx_source_source_payload_error;
-assign crossbar_sink_param_src_port = holdingudprx_source_source_param_src_port;
-assign crossbar_sink_param_dst_port = holdingudprx_source_source_param_dst_port;
-assign crossbar_sink_param_ip_address = holdingudprx_source_source_param_ip_address;
-assign crossbar_sink_param_length = holdingudprx_source_source_param_length;
+assign crossbar_sink_valid = holdingudprx_source_valid;
+assign holdingudprx_source_ready = crossbar_sink_ready;
+assign crossbar_sink_first = holdingudprx_source_first;
+assign crossbar_sink_last = holdingudprx_source_last;
+assign crossbar_sink_payload_data = holdingudprx_source_payload_data;
+assign crossbar_sink_payload_last_be = holdingudprx_source_payload_last_be;
+assign crossbar_sink_payload_error = holdingudprx_source_payload_error;
+assign crossbar_sink_param_src_port = holdingudprx_source_param_src_port;
+assign crossbar_sink_param_dst_port = holdingudprx_source_param_dst_port;
+assign crossbar_sink_param_ip_address = holdingudprx_source_param_ip_address;
+assign crossbar_sink_param_length = holdingudprx_source_param_length;
 assign packetizer_sink_valid = sink_sink_valid;
 assign sink_sink_ready = packetizer_sink_ready;
 assign packetizer_sink_last = sink_sink_last;
@@ -5536,231 +5634,269 @@ always @(*) begin
         end
     endcase
 end
-assign holdingudprx_depacketizer_sink_valid = holdingudprx_sink_sink_valid;
-assign holdingudprx_sink_sink_ready = holdingudprx_depacketizer_sink_ready;
-assign holdingudprx_depacketizer_sink_first = holdingudprx_sink_sink_first;
-assign holdingudprx_depacketizer_sink_last = holdingudprx_sink_sink_last;
-assign holdingudprx_depacketizer_sink_payload_data = holdingudprx_sink_sink_payload_data;
-assign holdingudprx_depacketizer_sink_payload_last_be = holdingudprx_sink_sink_payload_last_be;
-assign holdingudprx_depacketizer_sink_payload_error = holdingudprx_sink_sink_payload_error;
-assign holdingudprx_depacketizer_sink_param_length = holdingudprx_sink_sink_param_length;
-assign holdingudprx_depacketizer_sink_param_protocol = holdingudprx_sink_sink_param_protocol;
-assign holdingudprx_depacketizer_sink_param_ip_address = holdingudprx_sink_sink_param_ip_address;
-assign holdingudprx_payload_len = (holdingudprx_depacketizer_source_param_length - 4'd8);
-assign holdingudprx_depacketizer_header = holdingudprx_depacketizer_sr;
-assign holdingudprx_depacketizer_source_param_checksum = {rhs_slice_proxy69[7:0], rhs_slice_proxy68[15:8]};
-assign holdingudprx_depacketizer_source_param_dst_port = {rhs_slice_proxy71[7:0], rhs_slice_proxy70[15:8]};
-assign holdingudprx_depacketizer_source_param_length = {rhs_slice_proxy73[7:0], rhs_slice_proxy72[15:8]};
-assign holdingudprx_depacketizer_source_param_src_port = {rhs_slice_proxy75[7:0], rhs_slice_proxy74[15:8]};
-assign holdingudprx_depacketizer_source_payload_error = holdingudprx_depacketizer_sink_payload_error;
-assign holdingudprx_depacketizer_sink_last_be = holdingudprx_depacketizer_sink_last;
-assign holdingudprx_depacketizer_new_last_be = {holdingudprx_depacketizer_sink_last_be};
-assign holdingudprx_depacketizer_is_in_copy = (holdingudprx_depacketizer_is_ongoing0 | holdingudprx_depacketizer_is_ongoing1);
+assign holdingudprx_liteethudpdepacketizer_sink_valid = holdingudprx_sink_valid;
+assign holdingudprx_sink_ready = holdingudprx_liteethudpdepacketizer_sink_ready;
+assign holdingudprx_liteethudpdepacketizer_sink_first = holdingudprx_sink_first;
+assign holdingudprx_liteethudpdepacketizer_sink_last = holdingudprx_sink_last;
+assign holdingudprx_liteethudpdepacketizer_sink_payload_data = holdingudprx_sink_payload_data;
+assign holdingudprx_liteethudpdepacketizer_sink_payload_last_be = holdingudprx_sink_payload_last_be;
+assign holdingudprx_liteethudpdepacketizer_sink_payload_error = holdingudprx_sink_payload_error;
+assign holdingudprx_liteethudpdepacketizer_sink_param_length = holdingudprx_sink_param_length;
+assign holdingudprx_liteethudpdepacketizer_sink_param_protocol = holdingudprx_sink_param_protocol;
+assign holdingudprx_liteethudpdepacketizer_sink_param_ip_address = holdingudprx_sink_param_ip_address;
+assign holdingudprx_payload_len = (holdingudprx_liteethudpdepacketizer_source_param_length - 4'd8);
+assign holdingudprx_cut1 = (holdingudprx_rest != 1'd0);
+assign holdingudprx_liteethudpdepacketizer_header = holdingudprx_liteethudpdepacketizer_sr;
+assign holdingudprx_liteethudpdepacketizer_source_param_checksum = {rhs_slice_proxy69[7:0], rhs_slice_proxy68[15:8]};
+assign holdingudprx_liteethudpdepacketizer_source_param_dst_port = {rhs_slice_proxy71[7:0], rhs_slice_proxy70[15:8]};
+assign holdingudprx_liteethudpdepacketizer_source_param_length = {rhs_slice_proxy73[7:0], rhs_slice_proxy72[15:8]};
+assign holdingudprx_liteethudpdepacketizer_source_param_src_port = {rhs_slice_proxy75[7:0], rhs_slice_proxy74[15:8]};
+assign holdingudprx_liteethudpdepacketizer_source_payload_error = holdingudprx_liteethudpdepacketizer_sink_payload_error;
+assign holdingudprx_liteethudpdepacketizer_sink_last_be = holdingudprx_liteethudpdepacketizer_sink_last;
+assign holdingudprx_liteethudpdepacketizer_new_last_be = {holdingudprx_liteethudpdepacketizer_sink_last_be};
+assign holdingudprx_liteethudpdepacketizer_is_in_copy = (holdingudprx_liteethudpdepacketizer_is_ongoing0 | holdingudprx_liteethudpdepacketizer_is_ongoing1);
 always @(*) begin
-    holdingudprx_depacketizer_source_last <= 1'd0;
-    if (holdingudprx_depacketizer_source_last_s) begin
-        holdingudprx_depacketizer_source_last <= holdingudprx_depacketizer_source_last_b;
+    holdingudprx_liteethudpdepacketizer_source_last <= 1'd0;
+    if (holdingudprx_liteethudpdepacketizer_source_last_s) begin
+        holdingudprx_liteethudpdepacketizer_source_last <= holdingudprx_liteethudpdepacketizer_source_last_b;
     end else begin
-        holdingudprx_depacketizer_source_last <= holdingudprx_depacketizer_source_last_a;
+        holdingudprx_liteethudpdepacketizer_source_last <= holdingudprx_liteethudpdepacketizer_source_last_a;
     end
 end
+assign holdingudprx_cut0 = ((holdingudprx_liteethudpdepacketizer_sink_valid & holdingudprx_liteethudpdepacketizer_sink_last) & (holdingudprx_fsm_is_ongoing0 | holdingudprx_fsm_is_ongoing1));
 always @(*) begin
-    holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
-    holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
-    holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
-    holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
-    holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
-    holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
-    holdingudprx_depacketizer_is_ongoing0 <= 1'd0;
-    holdingudprx_depacketizer_is_ongoing1 <= 1'd0;
-    holdingudprx_depacketizer_is_ongoing2 <= 1'd0;
-    holdingudprx_depacketizer_is_ongoing3 <= 1'd0;
-    holdingudprx_depacketizer_sink_ready <= 1'd0;
-    holdingudprx_depacketizer_source_last_a <= 1'd0;
-    holdingudprx_depacketizer_source_last_b <= 1'd0;
-    holdingudprx_depacketizer_source_last_s <= 1'd0;
-    holdingudprx_depacketizer_source_payload_data <= 8'd0;
-    holdingudprx_depacketizer_source_payload_last_be <= 1'd0;
-    holdingudprx_depacketizer_source_valid <= 1'd0;
-    holdingudprx_depacketizer_sr_shift <= 1'd0;
+    holdingudprx_fsm_is_ongoing0 <= 1'd0;
+    holdingudprx_fsm_is_ongoing1 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
+    holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_is_ongoing3 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_source_last_a <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_source_payload_data <= 8'd0;
+    holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_source_valid <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd0;
     liteethudp_holdingudprx_fsm0_next_state <= 2'd0;
     liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
     liteethudp_holdingudprx_fsm0_next_state <= liteethudp_holdingudprx_fsm0_state;
     case (liteethudp_holdingudprx_fsm0_state)
         1'd1: begin
-            holdingudprx_depacketizer_sink_ready <= 1'd1;
-            if (holdingudprx_depacketizer_sink_valid) begin
-                holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= (holdingudprx_depacketizer_count + 1'd1);
-                holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-                holdingudprx_depacketizer_sr_shift <= 1'd1;
-                if ((holdingudprx_depacketizer_count == 3'd7)) begin
+            holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
+            if (holdingudprx_liteethudpdepacketizer_sink_valid) begin
+                holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= (holdingudprx_liteethudpdepacketizer_count + 1'd1);
+                holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+                holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
+                if ((holdingudprx_liteethudpdepacketizer_count == 3'd7)) begin
                     liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
-                    holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= (holdingudprx_depacketizer_count + 1'd1);
-                    holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+                    holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= (holdingudprx_liteethudpdepacketizer_count + 1'd1);
+                    holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            holdingudprx_fsm_is_ongoing1 <= 1'd1;
+            if ((holdingudprx_liteethudpdepacketizer_sink_valid & holdingudprx_liteethudpdepacketizer_sink_last)) begin
+                liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            holdingudprx_depacketizer_source_valid <= (holdingudprx_depacketizer_sink_valid | holdingudprx_depacketizer_sink_d_last);
-            holdingudprx_depacketizer_source_last_a <= (holdingudprx_depacketizer_sink_last | holdingudprx_depacketizer_sink_d_last);
-            holdingudprx_depacketizer_sink_ready <= holdingudprx_depacketizer_source_ready;
-            holdingudprx_depacketizer_source_payload_data <= holdingudprx_depacketizer_sink_payload_data;
-            if ((holdingudprx_depacketizer_source_valid & holdingudprx_depacketizer_source_ready)) begin
-                if (holdingudprx_depacketizer_source_last) begin
+            holdingudprx_liteethudpdepacketizer_source_valid <= (holdingudprx_liteethudpdepacketizer_sink_valid | holdingudprx_liteethudpdepacketizer_sink_d_last);
+            holdingudprx_liteethudpdepacketizer_source_last_a <= (holdingudprx_liteethudpdepacketizer_sink_last | holdingudprx_liteethudpdepacketizer_sink_d_last);
+            holdingudprx_liteethudpdepacketizer_sink_ready <= holdingudprx_liteethudpdepacketizer_source_ready;
+            holdingudprx_liteethudpdepacketizer_source_payload_data <= holdingudprx_liteethudpdepacketizer_sink_payload_data;
+            if ((holdingudprx_liteethudpdepacketizer_source_valid & holdingudprx_liteethudpdepacketizer_source_ready)) begin
+                if (holdingudprx_liteethudpdepacketizer_source_last) begin
                     liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
                 end
             end
-            holdingudprx_depacketizer_is_ongoing0 <= 1'd1;
-            holdingudprx_depacketizer_is_ongoing2 <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            holdingudprx_depacketizer_is_ongoing1 <= 1'd1;
-            holdingudprx_depacketizer_is_ongoing3 <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            holdingudprx_depacketizer_sink_ready <= 1'd1;
-            holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
-            holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-            if (holdingudprx_depacketizer_sink_valid) begin
-                holdingudprx_depacketizer_sr_shift <= 1'd1;
-                holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
-                holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+            if (holdingudprx_liteethudpdepacketizer_sink_valid) begin
+                holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
+                holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
+                holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
                     liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
                 end else begin
                     liteethudp_holdingudprx_fsm0_next_state <= 1'd1;
                 end
             end
+            holdingudprx_fsm_is_ongoing0 <= 1'd1;
+            if ((holdingudprx_liteethudpdepacketizer_sink_valid & holdingudprx_liteethudpdepacketizer_sink_last)) begin
+                liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
+            end
         end
     endcase
     liteethudp_holdingudprx_fsm1_next_state <= liteethudp_holdingudprx_fsm1_state;
     case (liteethudp_holdingudprx_fsm1_state)
         1'd1: begin
-            holdingudprx_depacketizer_source_last_b <= 1'd1;
-            holdingudprx_depacketizer_source_last_s <= 1'd1;
-            holdingudprx_depacketizer_source_payload_last_be <= holdingudprx_depacketizer_delayed_last_be;
-            holdingudprx_depacketizer_sink_ready <= 1'd0;
-            if ((holdingudprx_depacketizer_source_ready & holdingudprx_depacketizer_source_valid)) begin
+            holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_source_payload_last_be <= holdingudprx_liteethudpdepacketizer_delayed_last_be;
+            holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
+            if ((holdingudprx_liteethudpdepacketizer_source_ready & holdingudprx_liteethudpdepacketizer_source_valid)) begin
                 liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((holdingudprx_depacketizer_sink_valid & holdingudprx_depacketizer_sink_last) & (holdingudprx_depacketizer_sink_last_be > holdingudprx_depacketizer_new_last_be))) begin
-                holdingudprx_depacketizer_source_last_b <= 1'd0;
-                holdingudprx_depacketizer_source_last_s <= 1'd1;
-                holdingudprx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((holdingudprx_depacketizer_source_ready & holdingudprx_depacketizer_source_valid) | ((~holdingudprx_depacketizer_was_in_copy) & holdingudprx_depacketizer_is_in_copy))) begin
-                    holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= holdingudprx_depacketizer_new_last_be;
-                    holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
+            if (((holdingudprx_liteethudpdepacketizer_sink_valid & holdingudprx_liteethudpdepacketizer_sink_last) & (holdingudprx_liteethudpdepacketizer_sink_last_be > holdingudprx_liteethudpdepacketizer_new_last_be))) begin
+                holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd0;
+                holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+                holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
+                if (((holdingudprx_liteethudpdepacketizer_source_ready & holdingudprx_liteethudpdepacketizer_source_valid) | ((~holdingudprx_liteethudpdepacketizer_was_in_copy) & holdingudprx_liteethudpdepacketizer_is_in_copy))) begin
+                    holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= holdingudprx_liteethudpdepacketizer_new_last_be;
+                    holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
                     liteethudp_holdingudprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (holdingudprx_depacketizer_sink_last) begin
-                    holdingudprx_depacketizer_source_last_b <= 1'd1;
-                    holdingudprx_depacketizer_source_last_s <= 1'd1;
-                    holdingudprx_depacketizer_source_payload_last_be <= holdingudprx_depacketizer_new_last_be;
+                if (holdingudprx_liteethudpdepacketizer_sink_last) begin
+                    holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
+                    holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+                    holdingudprx_liteethudpdepacketizer_source_payload_last_be <= holdingudprx_liteethudpdepacketizer_new_last_be;
                 end
             end
-            if ((holdingudprx_depacketizer_is_ongoing2 | (holdingudprx_depacketizer_is_ongoing3 & (~holdingudprx_depacketizer_fsm_from_idle)))) begin
-                holdingudprx_depacketizer_sink_ready <= holdingudprx_depacketizer_source_ready;
+            if ((holdingudprx_liteethudpdepacketizer_is_ongoing2 | (holdingudprx_liteethudpdepacketizer_is_ongoing3 & (~holdingudprx_liteethudpdepacketizer_fsm_from_idle)))) begin
+                holdingudprx_liteethudpdepacketizer_sink_ready <= holdingudprx_liteethudpdepacketizer_source_ready;
             end else begin
-                holdingudprx_depacketizer_sink_ready <= 1'd1;
+                holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
-    holdingudprx0_liteethudp_next_value3 <= 16'd0;
-    holdingudprx0_liteethudp_next_value_ce3 <= 1'd0;
-    holdingudprx1_liteethudp_next_value4 <= 16'd0;
-    holdingudprx1_liteethudp_next_value_ce4 <= 1'd0;
-    holdingudprx2_liteethudp_next_value5 <= 16'd0;
-    holdingudprx2_liteethudp_next_value_ce5 <= 1'd0;
-    holdingudprx3_liteethudp_next_value6 <= 32'd0;
-    holdingudprx3_liteethudp_next_value_ce6 <= 1'd0;
+    holdingudprx0_liteethudp_next_value4 <= 16'd0;
+    holdingudprx0_liteethudp_next_value_ce4 <= 1'd0;
+    holdingudprx1_liteethudp_next_value5 <= 16'd0;
+    holdingudprx1_liteethudp_next_value_ce5 <= 1'd0;
+    holdingudprx2_liteethudp_next_value6 <= 16'd0;
+    holdingudprx2_liteethudp_next_value_ce6 <= 1'd0;
+    holdingudprx3_liteethudp_next_value7 <= 32'd0;
+    holdingudprx3_liteethudp_next_value_ce7 <= 1'd0;
     holdingudprx_count_liteethudp_next_value0 <= 16'd0;
     holdingudprx_count_liteethudp_next_value_ce0 <= 1'd0;
-    holdingudprx_depacketizer_source_ready <= 1'd0;
+    holdingudprx_drop_header <= 1'd0;
     holdingudprx_err_liteethudp_next_value1 <= 1'd0;
     holdingudprx_err_liteethudp_next_value_ce1 <= 1'd0;
-    holdingudprx_held_liteethudp_next_value2 <= 8'd0;
-    holdingudprx_held_liteethudp_next_value_ce2 <= 1'd0;
-    holdingudprx_source_source_last <= 1'd0;
-    holdingudprx_source_source_param_dst_port <= 16'd0;
-    holdingudprx_source_source_param_ip_address <= 32'd0;
-    holdingudprx_source_source_param_length <= 16'd0;
-    holdingudprx_source_source_param_src_port <= 16'd0;
-    holdingudprx_source_source_payload_data <= 8'd0;
-    holdingudprx_source_source_payload_error <= 1'd0;
-    holdingudprx_source_source_valid <= 1'd0;
+    holdingudprx_held_liteethudp_next_value3 <= 8'd0;
+    holdingudprx_held_liteethudp_next_value_ce3 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
+    holdingudprx_rest_liteethudp_next_value2 <= 16'd0;
+    holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd0;
+    holdingudprx_source_last <= 1'd0;
+    holdingudprx_source_param_dst_port <= 16'd0;
+    holdingudprx_source_param_ip_address <= 32'd0;
+    holdingudprx_source_param_length <= 16'd0;
+    holdingudprx_source_param_src_port <= 16'd0;
+    holdingudprx_source_payload_data <= 8'd0;
+    holdingudprx_source_payload_error <= 1'd0;
+    holdingudprx_source_valid <= 1'd0;
     liteethudp_holdingudprx_next_state <= 3'd0;
     liteethudp_holdingudprx_next_state <= liteethudp_holdingudprx_state;
     case (liteethudp_holdingudprx_state)
         1'd1: begin
-            holdingudprx_source_source_param_src_port <= holdingudprx_depacketizer_source_param_src_port;
-            holdingudprx_source_source_param_dst_port <= holdingudprx_depacketizer_source_param_dst_port;
-            holdingudprx_source_source_param_length <= holdingudprx_payload_len;
-            holdingudprx_source_source_param_ip_address <= holdingudprx_sink_sink_param_ip_address;
-            holdingudprx_source_source_payload_data <= holdingudprx_depacketizer_source_payload_data;
-            if ((holdingudprx_depacketizer_source_last | (holdingudprx_count < holdingudprx_payload_len))) begin
-                holdingudprx_source_source_valid <= holdingudprx_depacketizer_source_valid;
-                holdingudprx_depacketizer_source_ready <= holdingudprx_source_source_ready;
-                holdingudprx_source_source_last <= holdingudprx_depacketizer_source_last;
-                holdingudprx_source_source_payload_error <= (holdingudprx_depacketizer_source_payload_error | holdingudprx_err);
-                if ((holdingudprx_depacketizer_source_valid & holdingudprx_source_source_ready)) begin
+            holdingudprx_source_param_src_port <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
+            holdingudprx_source_param_dst_port <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+            holdingudprx_source_param_length <= holdingudprx_payload_len;
+            holdingudprx_source_param_ip_address <= holdingudprx_sink_param_ip_address;
+            holdingudprx_source_payload_data <= holdingudprx_liteethudpdepacketizer_source_payload_data;
+            if ((holdingudprx_liteethudpdepacketizer_source_last | (holdingudprx_count < holdingudprx_payload_len))) begin
+                holdingudprx_source_valid <= holdingudprx_liteethudpdepacketizer_source_valid;
+                holdingudprx_liteethudpdepacketizer_source_ready <= holdingudprx_source_ready;
+                holdingudprx_source_last <= holdingudprx_liteethudpdepacketizer_source_last;
+                holdingudprx_source_payload_error <= (holdingudprx_liteethudpdepacketizer_source_payload_error | holdingudprx_err);
+                if ((holdingudprx_liteethudpdepacketizer_source_last & holdingudprx_cut1)) begin
+                    holdingudprx_source_param_length <= 1'd0;
+                end
+                if ((holdingudprx_liteethudpdepacketizer_source_valid & holdingudprx_source_ready)) begin
                     holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
                     holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
-                    holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_depacketizer_source_payload_error);
+                    if (holdingudprx_cut1) begin
+                        holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
+                        holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    end
+                    holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
                     holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    if (holdingudprx_depacketizer_source_last) begin
+                    if (holdingudprx_liteethudpdepacketizer_source_last) begin
                         liteethudp_holdingudprx_next_state <= 1'd0;
                     end
                 end
             end else begin
-                holdingudprx_depacketizer_source_ready <= 1'd1;
-                if (holdingudprx_depacketizer_source_valid) begin
-                    holdingudprx_held_liteethudp_next_value2 <= holdingudprx_depacketizer_source_payload_data;
-                    holdingudprx_held_liteethudp_next_value_ce2 <= 1'd1;
-                    holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_depacketizer_source_payload_error);
+                holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+                if (holdingudprx_liteethudpdepacketizer_source_valid) begin
+                    holdingudprx_held_liteethudp_next_value3 <= holdingudprx_liteethudpdepacketizer_source_payload_data;
+                    holdingudprx_held_liteethudp_next_value_ce3 <= 1'd1;
+                    holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
                     holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    holdingudprx0_liteethudp_next_value3 <= holdingudprx_depacketizer_source_param_src_port;
-                    holdingudprx0_liteethudp_next_value_ce3 <= 1'd1;
-                    holdingudprx1_liteethudp_next_value4 <= holdingudprx_depacketizer_source_param_dst_port;
-                    holdingudprx1_liteethudp_next_value_ce4 <= 1'd1;
-                    holdingudprx2_liteethudp_next_value5 <= holdingudprx_payload_len;
-                    holdingudprx2_liteethudp_next_value_ce5 <= 1'd1;
-                    holdingudprx3_liteethudp_next_value6 <= holdingudprx_sink_sink_param_ip_address;
-                    holdingudprx3_liteethudp_next_value_ce6 <= 1'd1;
+                    holdingudprx0_liteethudp_next_value4 <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
+                    holdingudprx0_liteethudp_next_value_ce4 <= 1'd1;
+                    holdingudprx1_liteethudp_next_value5 <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+                    holdingudprx1_liteethudp_next_value_ce5 <= 1'd1;
+                    holdingudprx2_liteethudp_next_value6 <= holdingudprx_payload_len;
+                    holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
+                    holdingudprx3_liteethudp_next_value7 <= holdingudprx_sink_param_ip_address;
+                    holdingudprx3_liteethudp_next_value_ce7 <= 1'd1;
+                    holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
+                    holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    if (holdingudprx_cut1) begin
+                        holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
+                        holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    end
                     liteethudp_holdingudprx_next_state <= 2'd2;
                 end
             end
         end
         2'd2: begin
-            holdingudprx_depacketizer_source_ready <= 1'd1;
-            if (holdingudprx_depacketizer_source_valid) begin
-                holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_depacketizer_source_payload_error);
+            holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+            if (holdingudprx_liteethudpdepacketizer_source_valid) begin
+                holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
                 holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                if (holdingudprx_depacketizer_source_last) begin
+                holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
+                holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                if (holdingudprx_cut1) begin
+                    holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
+                    holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                end
+                if (holdingudprx_liteethudpdepacketizer_source_last) begin
+                    if (holdingudprx_cut1) begin
+                        holdingudprx2_liteethudp_next_value6 <= 1'd0;
+                        holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
+                    end
                     liteethudp_holdingudprx_next_state <= 2'd3;
                 end
             end
         end
         2'd3: begin
-            holdingudprx_source_source_valid <= 1'd1;
-            holdingudprx_source_source_last <= 1'd1;
-            holdingudprx_source_source_payload_data <= holdingudprx_held;
-            holdingudprx_source_source_payload_error <= holdingudprx_err;
-            holdingudprx_source_source_param_src_port <= holdingudprx0;
-            holdingudprx_source_source_param_dst_port <= holdingudprx1;
-            holdingudprx_source_source_param_length <= holdingudprx2;
-            holdingudprx_source_source_param_ip_address <= holdingudprx3;
-            if (holdingudprx_source_source_ready) begin
+            holdingudprx_source_valid <= 1'd1;
+            holdingudprx_source_last <= 1'd1;
+            holdingudprx_source_payload_data <= holdingudprx_held;
+            holdingudprx_source_payload_error <= holdingudprx_err;
+            holdingudprx_source_param_src_port <= holdingudprx0;
+            holdingudprx_source_param_dst_port <= holdingudprx1;
+            holdingudprx_source_param_length <= holdingudprx2;
+            holdingudprx_source_param_ip_address <= holdingudprx3;
+            if (holdingudprx_source_ready) begin
                 liteethudp_holdingudprx_next_state <= 1'd0;
             end
         end
         3'd4: begin
-            holdingudprx_depacketizer_source_ready <= 1'd1;
-            if ((holdingudprx_depacketizer_source_valid & holdingudprx_depacketizer_source_last)) begin
+            holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+            if ((holdingudprx_liteethudpdepacketizer_source_valid & holdingudprx_liteethudpdepacketizer_source_last)) begin
                 liteethudp_holdingudprx_next_state <= 1'd0;
             end
         end
@@ -5769,10 +5905,20 @@ always @(*) begin
             holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
             holdingudprx_err_liteethudp_next_value1 <= 1'd0;
             holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-            if (holdingudprx_depacketizer_source_valid) begin
+            holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_sink_param_length - 4'd9);
+            holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            if ((holdingudprx_sink_param_length <= 4'd8)) begin
+                holdingudprx_rest_liteethudp_next_value2 <= 1'd0;
+                holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            end
+            if (holdingudprx_liteethudpdepacketizer_source_valid) begin
                 liteethudp_holdingudprx_next_state <= 3'd4;
-                if ((holdingudprx_sink_sink_param_protocol == 5'd17)) begin
-                    liteethudp_holdingudprx_next_state <= 1'd1;
+                if ((holdingudprx_sink_param_protocol == 5'd17)) begin
+                    if ((holdingudprx_liteethudpdepacketizer_source_param_length > holdingudprx_sink_param_length)) begin
+                        holdingudprx_drop_header <= 1'd1;
+                    end else begin
+                        liteethudp_holdingudprx_next_state <= 1'd1;
+                    end
                 end
             end
         end
@@ -5844,6 +5990,8 @@ assign user_port_source_param_src_port = rx_cdc_source_param_src_port;
 assign user_port_source_param_dst_port = rx_cdc_source_param_dst_port;
 assign user_port_source_param_ip_address = rx_cdc_source_param_ip_address;
 assign user_port_source_param_length = rx_cdc_source_param_length;
+assign liteethudp_taken = ((1'd0 + internal_port_source_valid) != 1'd0);
+assign crossbar_dropped = (((crossbar_sink_valid & crossbar_sink_ready) & crossbar_sink_last) & (~liteethudp_taken));
 always @(*) begin
     liteethudp_sel0 <= 1'd0;
     if ((crossbar_sink_param_dst_port == udp_rx_port)) begin
@@ -6085,82 +6233,82 @@ assign interface0_bank_bus_dat_w = dat_w;
 assign interface1_bank_bus_dat_w = dat_w;
 assign dat_r = (interface0_bank_bus_dat_r | interface1_bank_bus_dat_r);
 assign cases_slice_proxy = {mac_core_tx_crc_value, mac_core_tx_crc_sink_payload_data[7:0]};
-assign rhs_slice_proxy0 = mac_depacketizer_header[111:96];
-assign rhs_slice_proxy1 = mac_depacketizer_header[111:96];
-assign rhs_slice_proxy2 = mac_depacketizer_header[95:48];
-assign rhs_slice_proxy3 = mac_depacketizer_header[95:48];
-assign rhs_slice_proxy4 = mac_depacketizer_header[95:48];
-assign rhs_slice_proxy5 = mac_depacketizer_header[95:48];
-assign rhs_slice_proxy6 = mac_depacketizer_header[95:48];
-assign rhs_slice_proxy7 = mac_depacketizer_header[95:48];
-assign rhs_slice_proxy8 = mac_depacketizer_header[47:0];
-assign rhs_slice_proxy9 = mac_depacketizer_header[47:0];
-assign rhs_slice_proxy10 = mac_depacketizer_header[47:0];
-assign rhs_slice_proxy11 = mac_depacketizer_header[47:0];
-assign rhs_slice_proxy12 = mac_depacketizer_header[47:0];
-assign rhs_slice_proxy13 = mac_depacketizer_header[47:0];
-assign rhs_slice_proxy14 = arp_rx_depacketizer_header[39:32];
-assign rhs_slice_proxy15 = arp_rx_depacketizer_header[15:0];
-assign rhs_slice_proxy16 = arp_rx_depacketizer_header[15:0];
-assign rhs_slice_proxy17 = arp_rx_depacketizer_header[63:48];
-assign rhs_slice_proxy18 = arp_rx_depacketizer_header[63:48];
-assign rhs_slice_proxy19 = arp_rx_depacketizer_header[31:16];
-assign rhs_slice_proxy20 = arp_rx_depacketizer_header[31:16];
-assign rhs_slice_proxy21 = arp_rx_depacketizer_header[47:40];
-assign rhs_slice_proxy22 = arp_rx_depacketizer_header[143:112];
-assign rhs_slice_proxy23 = arp_rx_depacketizer_header[143:112];
-assign rhs_slice_proxy24 = arp_rx_depacketizer_header[143:112];
-assign rhs_slice_proxy25 = arp_rx_depacketizer_header[143:112];
-assign rhs_slice_proxy26 = arp_rx_depacketizer_header[111:64];
-assign rhs_slice_proxy27 = arp_rx_depacketizer_header[111:64];
-assign rhs_slice_proxy28 = arp_rx_depacketizer_header[111:64];
-assign rhs_slice_proxy29 = arp_rx_depacketizer_header[111:64];
-assign rhs_slice_proxy30 = arp_rx_depacketizer_header[111:64];
-assign rhs_slice_proxy31 = arp_rx_depacketizer_header[111:64];
-assign rhs_slice_proxy32 = arp_rx_depacketizer_header[223:192];
-assign rhs_slice_proxy33 = arp_rx_depacketizer_header[223:192];
-assign rhs_slice_proxy34 = arp_rx_depacketizer_header[223:192];
-assign rhs_slice_proxy35 = arp_rx_depacketizer_header[223:192];
-assign rhs_slice_proxy36 = arp_rx_depacketizer_header[191:144];
-assign rhs_slice_proxy37 = arp_rx_depacketizer_header[191:144];
-assign rhs_slice_proxy38 = arp_rx_depacketizer_header[191:144];
-assign rhs_slice_proxy39 = arp_rx_depacketizer_header[191:144];
-assign rhs_slice_proxy40 = arp_rx_depacketizer_header[191:144];
-assign rhs_slice_proxy41 = arp_rx_depacketizer_header[191:144];
-assign rhs_slice_proxy42 = ip_rx_depacketizer_header[95:80];
-assign rhs_slice_proxy43 = ip_rx_depacketizer_header[95:80];
-assign rhs_slice_proxy44 = ip_rx_depacketizer_header[47:32];
-assign rhs_slice_proxy45 = ip_rx_depacketizer_header[47:32];
-assign rhs_slice_proxy46 = ip_rx_depacketizer_header[3:0];
-assign rhs_slice_proxy47 = ip_rx_depacketizer_header[79:72];
-assign rhs_slice_proxy48 = ip_rx_depacketizer_header[127:96];
-assign rhs_slice_proxy49 = ip_rx_depacketizer_header[127:96];
-assign rhs_slice_proxy50 = ip_rx_depacketizer_header[127:96];
-assign rhs_slice_proxy51 = ip_rx_depacketizer_header[127:96];
-assign rhs_slice_proxy52 = ip_rx_depacketizer_header[159:128];
-assign rhs_slice_proxy53 = ip_rx_depacketizer_header[159:128];
-assign rhs_slice_proxy54 = ip_rx_depacketizer_header[159:128];
-assign rhs_slice_proxy55 = ip_rx_depacketizer_header[159:128];
-assign rhs_slice_proxy56 = ip_rx_depacketizer_header[31:16];
-assign rhs_slice_proxy57 = ip_rx_depacketizer_header[31:16];
-assign rhs_slice_proxy58 = ip_rx_depacketizer_header[71:64];
-assign rhs_slice_proxy59 = ip_rx_depacketizer_header[7:4];
-assign rhs_slice_proxy60 = icmp_rx_depacketizer_header[31:16];
-assign rhs_slice_proxy61 = icmp_rx_depacketizer_header[31:16];
-assign rhs_slice_proxy62 = icmp_rx_depacketizer_header[15:8];
-assign rhs_slice_proxy63 = icmp_rx_depacketizer_header[7:0];
-assign rhs_slice_proxy64 = icmp_rx_depacketizer_header[63:32];
-assign rhs_slice_proxy65 = icmp_rx_depacketizer_header[63:32];
-assign rhs_slice_proxy66 = icmp_rx_depacketizer_header[63:32];
-assign rhs_slice_proxy67 = icmp_rx_depacketizer_header[63:32];
-assign rhs_slice_proxy68 = holdingudprx_depacketizer_header[63:48];
-assign rhs_slice_proxy69 = holdingudprx_depacketizer_header[63:48];
-assign rhs_slice_proxy70 = holdingudprx_depacketizer_header[31:16];
-assign rhs_slice_proxy71 = holdingudprx_depacketizer_header[31:16];
-assign rhs_slice_proxy72 = holdingudprx_depacketizer_header[47:32];
-assign rhs_slice_proxy73 = holdingudprx_depacketizer_header[47:32];
-assign rhs_slice_proxy74 = holdingudprx_depacketizer_header[15:0];
-assign rhs_slice_proxy75 = holdingudprx_depacketizer_header[15:0];
+assign rhs_slice_proxy0 = mac_liteethmacdepacketizer_header[111:96];
+assign rhs_slice_proxy1 = mac_liteethmacdepacketizer_header[111:96];
+assign rhs_slice_proxy2 = mac_liteethmacdepacketizer_header[95:48];
+assign rhs_slice_proxy3 = mac_liteethmacdepacketizer_header[95:48];
+assign rhs_slice_proxy4 = mac_liteethmacdepacketizer_header[95:48];
+assign rhs_slice_proxy5 = mac_liteethmacdepacketizer_header[95:48];
+assign rhs_slice_proxy6 = mac_liteethmacdepacketizer_header[95:48];
+assign rhs_slice_proxy7 = mac_liteethmacdepacketizer_header[95:48];
+assign rhs_slice_proxy8 = mac_liteethmacdepacketizer_header[47:0];
+assign rhs_slice_proxy9 = mac_liteethmacdepacketizer_header[47:0];
+assign rhs_slice_proxy10 = mac_liteethmacdepacketizer_header[47:0];
+assign rhs_slice_proxy11 = mac_liteethmacdepacketizer_header[47:0];
+assign rhs_slice_proxy12 = mac_liteethmacdepacketizer_header[47:0];
+assign rhs_slice_proxy13 = mac_liteethmacdepacketizer_header[47:0];
+assign rhs_slice_proxy14 = arp_rx_liteetharpdepacketizer_header[39:32];
+assign rhs_slice_proxy15 = arp_rx_liteetharpdepacketizer_header[15:0];
+assign rhs_slice_proxy16 = arp_rx_liteetharpdepacketizer_header[15:0];
+assign rhs_slice_proxy17 = arp_rx_liteetharpdepacketizer_header[63:48];
+assign rhs_slice_proxy18 = arp_rx_liteetharpdepacketizer_header[63:48];
+assign rhs_slice_proxy19 = arp_rx_liteetharpdepacketizer_header[31:16];
+assign rhs_slice_proxy20 = arp_rx_liteetharpdepacketizer_header[31:16];
+assign rhs_slice_proxy21 = arp_rx_liteetharpdepacketizer_header[47:40];
+assign rhs_slice_proxy22 = arp_rx_liteetharpdepacketizer_header[143:112];
+assign rhs_slice_proxy23 = arp_rx_liteetharpdepacketizer_header[143:112];
+assign rhs_slice_proxy24 = arp_rx_liteetharpdepacketizer_header[143:112];
+assign rhs_slice_proxy25 = arp_rx_liteetharpdepacketizer_header[143:112];
+assign rhs_slice_proxy26 = arp_rx_liteetharpdepacketizer_header[111:64];
+assign rhs_slice_proxy27 = arp_rx_liteetharpdepacketizer_header[111:64];
+assign rhs_slice_proxy28 = arp_rx_liteetharpdepacketizer_header[111:64];
+assign rhs_slice_proxy29 = arp_rx_liteetharpdepacketizer_header[111:64];
+assign rhs_slice_proxy30 = arp_rx_liteetharpdepacketizer_header[111:64];
+assign rhs_slice_proxy31 = arp_rx_liteetharpdepacketizer_header[111:64];
+assign rhs_slice_proxy32 = arp_rx_liteetharpdepacketizer_header[223:192];
+assign rhs_slice_proxy33 = arp_rx_liteetharpdepacketizer_header[223:192];
+assign rhs_slice_proxy34 = arp_rx_liteetharpdepacketizer_header[223:192];
+assign rhs_slice_proxy35 = arp_rx_liteetharpdepacketizer_header[223:192];
+assign rhs_slice_proxy36 = arp_rx_liteetharpdepacketizer_header[191:144];
+assign rhs_slice_proxy37 = arp_rx_liteetharpdepacketizer_header[191:144];
+assign rhs_slice_proxy38 = arp_rx_liteetharpdepacketizer_header[191:144];
+assign rhs_slice_proxy39 = arp_rx_liteetharpdepacketizer_header[191:144];
+assign rhs_slice_proxy40 = arp_rx_liteetharpdepacketizer_header[191:144];
+assign rhs_slice_proxy41 = arp_rx_liteetharpdepacketizer_header[191:144];
+assign rhs_slice_proxy42 = ip_rx_liteethipv4depacketizer_header[95:80];
+assign rhs_slice_proxy43 = ip_rx_liteethipv4depacketizer_header[95:80];
+assign rhs_slice_proxy44 = ip_rx_liteethipv4depacketizer_header[47:32];
+assign rhs_slice_proxy45 = ip_rx_liteethipv4depacketizer_header[47:32];
+assign rhs_slice_proxy46 = ip_rx_liteethipv4depacketizer_header[3:0];
+assign rhs_slice_proxy47 = ip_rx_liteethipv4depacketizer_header[79:72];
+assign rhs_slice_proxy48 = ip_rx_liteethipv4depacketizer_header[127:96];
+assign rhs_slice_proxy49 = ip_rx_liteethipv4depacketizer_header[127:96];
+assign rhs_slice_proxy50 = ip_rx_liteethipv4depacketizer_header[127:96];
+assign rhs_slice_proxy51 = ip_rx_liteethipv4depacketizer_header[127:96];
+assign rhs_slice_proxy52 = ip_rx_liteethipv4depacketizer_header[159:128];
+assign rhs_slice_proxy53 = ip_rx_liteethipv4depacketizer_header[159:128];
+assign rhs_slice_proxy54 = ip_rx_liteethipv4depacketizer_header[159:128];
+assign rhs_slice_proxy55 = ip_rx_liteethipv4depacketizer_header[159:128];
+assign rhs_slice_proxy56 = ip_rx_liteethipv4depacketizer_header[31:16];
+assign rhs_slice_proxy57 = ip_rx_liteethipv4depacketizer_header[31:16];
+assign rhs_slice_proxy58 = ip_rx_liteethipv4depacketizer_header[71:64];
+assign rhs_slice_proxy59 = ip_rx_liteethipv4depacketizer_header[7:4];
+assign rhs_slice_proxy60 = icmp_rx_liteethicmpdepacketizer_header[31:16];
+assign rhs_slice_proxy61 = icmp_rx_liteethicmpdepacketizer_header[31:16];
+assign rhs_slice_proxy62 = icmp_rx_liteethicmpdepacketizer_header[15:8];
+assign rhs_slice_proxy63 = icmp_rx_liteethicmpdepacketizer_header[7:0];
+assign rhs_slice_proxy64 = icmp_rx_liteethicmpdepacketizer_header[63:32];
+assign rhs_slice_proxy65 = icmp_rx_liteethicmpdepacketizer_header[63:32];
+assign rhs_slice_proxy66 = icmp_rx_liteethicmpdepacketizer_header[63:32];
+assign rhs_slice_proxy67 = icmp_rx_liteethicmpdepacketizer_header[63:32];
+assign rhs_slice_proxy68 = holdingudprx_liteethudpdepacketizer_header[63:48];
+assign rhs_slice_proxy69 = holdingudprx_liteethudpdepacketizer_header[63:48];
+assign rhs_slice_proxy70 = holdingudprx_liteethudpdepacketizer_header[31:16];
+assign rhs_slice_proxy71 = holdingudprx_liteethudpdepacketizer_header[31:16];
+assign rhs_slice_proxy72 = holdingudprx_liteethudpdepacketizer_header[47:32];
+assign rhs_slice_proxy73 = holdingudprx_liteethudpdepacketizer_header[47:32];
+assign rhs_slice_proxy74 = holdingudprx_liteethudpdepacketizer_header[15:0];
+assign rhs_slice_proxy75 = holdingudprx_liteethudpdepacketizer_header[15:0];
 assign mac_core_tx_cdc_cdc_produce_rdomain = multiregimpl0_regs1;
 assign mac_core_tx_cdc_cdc_consume_wdomain = multiregimpl1_regs1;
 assign mac_core_pulsesynchronizer0_toggle_o = multiregimpl2_regs1;
@@ -6178,7 +6326,7 @@ always @(posedge eth_rx_clk) begin
     ethphy_rx_data_reg <= ethphy_rx_data;
     ethphy_rx_ctl_reg_d <= ethphy_rx_ctl_reg;
     ethphy_source_valid <= ethphy_rx_ctl_reg[0];
-    ethphy_source_payload_data <= ethphy_rx_data_reg;
+    ethphy_source_payload_data <= (ethphy_rx_data_reg ^ {8{ethphy_errored}});
     if ((ethphy_rx_ctl == 1'd0)) begin
         ethphy_link_status <= ethphy_rx_data[0];
         ethphy_clock_speed <= ethphy_rx_data[2:1];
@@ -6414,63 +6562,63 @@ always @(posedge sys_clk) begin
     if (mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value_ce0) begin
         mac_packetizer_delayed_last_be <= mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0;
     end
-    if (mac_depacketizer_sr_shift) begin
-        mac_depacketizer_sr <= {mac_depacketizer_sink_payload_data, mac_depacketizer_sr[111:8]};
+    if (mac_liteethmacdepacketizer_sr_shift) begin
+        mac_liteethmacdepacketizer_sr <= {mac_liteethmacdepacketizer_sink_payload_data, mac_liteethmacdepacketizer_sr[111:8]};
     end
-    if (mac_depacketizer_sr_shift_leftover) begin
-        mac_depacketizer_sr <= {mac_depacketizer_sink_payload_data, mac_depacketizer_sr[111:0]};
+    if (mac_liteethmacdepacketizer_sr_shift_leftover) begin
+        mac_liteethmacdepacketizer_sr <= {mac_liteethmacdepacketizer_sink_payload_data, mac_liteethmacdepacketizer_sr[111:0]};
     end
-    mac_depacketizer_was_in_copy <= mac_depacketizer_is_in_copy;
+    mac_liteethmacdepacketizer_was_in_copy <= mac_liteethmacdepacketizer_is_in_copy;
     liteethmac_fsm0_state1 <= liteethmac_fsm0_next_state1;
-    if (mac_depacketizer_count_liteethmac_fsm0_next_value_ce2) begin
-        mac_depacketizer_count <= mac_depacketizer_count_liteethmac_fsm0_next_value2;
+    if (mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2) begin
+        mac_liteethmacdepacketizer_count <= mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2;
     end
-    if (mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3) begin
-        mac_depacketizer_fsm_from_idle <= mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value3;
+    if (mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3) begin
+        mac_liteethmacdepacketizer_fsm_from_idle <= mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3;
     end
     liteethmac_fsm1_state1 <= liteethmac_fsm1_next_state1;
-    if (mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1) begin
-        mac_depacketizer_delayed_last_be <= mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value1;
+    if (mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1) begin
+        mac_liteethmacdepacketizer_delayed_last_be <= mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1;
     end
-    if (arp_tx_packetizer_sr_load) begin
-        arp_tx_packetizer_sr <= arp_tx_packetizer_header;
+    if (arp_packetizer_sr_load) begin
+        arp_packetizer_sr <= arp_packetizer_header;
     end
-    if (arp_tx_packetizer_sr_shift) begin
-        arp_tx_packetizer_sr <= arp_tx_packetizer_sr[223:8];
+    if (arp_packetizer_sr_shift) begin
+        arp_packetizer_sr <= arp_packetizer_sr[223:8];
     end
     liteetharptx_fsm0_state <= liteetharptx_fsm0_next_state;
-    if (arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0) begin
-        arp_tx_packetizer_count <= arp_tx_packetizer_count_liteetharp_fsm0_next_value0;
+    if (arp_packetizer_count_liteetharp_fsm0_next_value_ce0) begin
+        arp_packetizer_count <= arp_packetizer_count_liteetharp_fsm0_next_value0;
     end
-    if (arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1) begin
-        arp_tx_packetizer_fsm_from_idle <= arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1;
+    if (arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1) begin
+        arp_packetizer_fsm_from_idle <= arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1;
     end
     liteetharptx_fsm1_state <= liteetharptx_fsm1_next_state;
-    if (arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0) begin
-        arp_tx_packetizer_delayed_last_be <= arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value0;
+    if (arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0) begin
+        arp_packetizer_delayed_last_be <= arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0;
     end
     liteetharptx_state <= liteetharptx_next_state;
-    if (arp_tx_counter_liteetharp_next_value_ce) begin
-        arp_tx_counter <= arp_tx_counter_liteetharp_next_value;
+    if (arp_counter_liteetharp_next_value_ce) begin
+        arp_counter <= arp_counter_liteetharp_next_value;
     end
-    arp_rx_valid <= (((((arp_rx_depacketizer_source_valid & (arp_rx_depacketizer_source_param_hwtype == 1'd1)) & (arp_rx_depacketizer_source_param_proto == 12'd2048)) & (arp_rx_depacketizer_source_param_hwsize == 3'd6)) & (arp_rx_depacketizer_source_param_protosize == 3'd4)) & (arp_rx_depacketizer_source_param_target_ip == ip_address));
-    if (arp_rx_depacketizer_sr_shift) begin
-        arp_rx_depacketizer_sr <= {arp_rx_depacketizer_sink_payload_data, arp_rx_depacketizer_sr[223:8]};
+    arp_rx_valid <= (((((arp_rx_liteetharpdepacketizer_source_valid & (arp_rx_liteetharpdepacketizer_source_param_hwtype == 1'd1)) & (arp_rx_liteetharpdepacketizer_source_param_proto == 12'd2048)) & (arp_rx_liteetharpdepacketizer_source_param_hwsize == 3'd6)) & (arp_rx_liteetharpdepacketizer_source_param_protosize == 3'd4)) & (arp_rx_liteetharpdepacketizer_source_param_target_ip == ip_address));
+    if (arp_rx_liteetharpdepacketizer_sr_shift) begin
+        arp_rx_liteetharpdepacketizer_sr <= {arp_rx_liteetharpdepacketizer_sink_payload_data, arp_rx_liteetharpdepacketizer_sr[223:8]};
     end
-    if (arp_rx_depacketizer_sr_shift_leftover) begin
-        arp_rx_depacketizer_sr <= {arp_rx_depacketizer_sink_payload_data, arp_rx_depacketizer_sr[223:0]};
+    if (arp_rx_liteetharpdepacketizer_sr_shift_leftover) begin
+        arp_rx_liteetharpdepacketizer_sr <= {arp_rx_liteetharpdepacketizer_sink_payload_data, arp_rx_liteetharpdepacketizer_sr[223:0]};
     end
-    arp_rx_depacketizer_was_in_copy <= arp_rx_depacketizer_is_in_copy;
+    arp_rx_liteetharpdepacketizer_was_in_copy <= arp_rx_liteetharpdepacketizer_is_in_copy;
     liteetharprx_fsm0_state <= liteetharprx_fsm0_next_state;
-    if (arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2) begin
-        arp_rx_depacketizer_count <= arp_rx_depacketizer_count_liteetharp_fsm0_next_value2;
+    if (arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2) begin
+        arp_rx_liteetharpdepacketizer_count <= arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2;
     end
-    if (arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3) begin
-        arp_rx_depacketizer_fsm_from_idle <= arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value3;
+    if (arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3) begin
+        arp_rx_liteetharpdepacketizer_fsm_from_idle <= arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3;
     end
     liteetharprx_fsm1_state <= liteetharprx_fsm1_next_state;
-    if (arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1) begin
-        arp_rx_depacketizer_delayed_last_be <= arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value1;
+    if (arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1) begin
+        arp_rx_liteetharpdepacketizer_delayed_last_be <= arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1;
     end
     liteetharprx_state <= liteetharprx_next_state;
     if (arp_table_request_timer_wait) begin
@@ -6580,23 +6728,23 @@ always @(posedge sys_clk) begin
     if (ip_tx_target_mac_liteethip_next_value_ce) begin
         ip_tx_target_mac <= ip_tx_target_mac_liteethip_next_value;
     end
-    if (ip_rx_depacketizer_sr_shift) begin
-        ip_rx_depacketizer_sr <= {ip_rx_depacketizer_sink_payload_data, ip_rx_depacketizer_sr[159:8]};
+    if (ip_rx_liteethipv4depacketizer_sr_shift) begin
+        ip_rx_liteethipv4depacketizer_sr <= {ip_rx_liteethipv4depacketizer_sink_payload_data, ip_rx_liteethipv4depacketizer_sr[159:8]};
     end
-    if (ip_rx_depacketizer_sr_shift_leftover) begin
-        ip_rx_depacketizer_sr <= {ip_rx_depacketizer_sink_payload_data, ip_rx_depacketizer_sr[159:0]};
+    if (ip_rx_liteethipv4depacketizer_sr_shift_leftover) begin
+        ip_rx_liteethipv4depacketizer_sr <= {ip_rx_liteethipv4depacketizer_sink_payload_data, ip_rx_liteethipv4depacketizer_sr[159:0]};
     end
-    ip_rx_depacketizer_was_in_copy <= ip_rx_depacketizer_is_in_copy;
-    liteethip_liteethiprx_fsm0_state <= liteethip_liteethiprx_fsm0_next_state;
-    if (ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2) begin
-        ip_rx_depacketizer_count <= ip_rx_depacketizer_count_liteethip_fsm0_next_value2;
+    ip_rx_liteethipv4depacketizer_was_in_copy <= ip_rx_liteethipv4depacketizer_is_in_copy;
+    liteethip_checkingiprx_fsm0_state <= liteethip_checkingiprx_fsm0_next_state;
+    if (ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2) begin
+        ip_rx_liteethipv4depacketizer_count <= ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2;
     end
-    if (ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3) begin
-        ip_rx_depacketizer_fsm_from_idle <= ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value3;
+    if (ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3) begin
+        ip_rx_liteethipv4depacketizer_fsm_from_idle <= ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3;
     end
-    liteethip_liteethiprx_fsm1_state <= liteethip_liteethiprx_fsm1_next_state;
-    if (ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1) begin
-        ip_rx_depacketizer_delayed_last_be <= ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value1;
+    liteethip_checkingiprx_fsm1_state <= liteethip_checkingiprx_fsm1_next_state;
+    if (ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1) begin
+        ip_rx_liteethipv4depacketizer_delayed_last_be <= ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1;
     end
     if (ip_rx_ce) begin
         if ((~ip_rx_liteethipv4checksum_done)) begin
@@ -6636,7 +6784,7 @@ always @(posedge sys_clk) begin
     if (ip_rx_reset) begin
         ip_rx_liteethipv4checksum_counter <= 4'd0;
     end
-    liteethip_liteethiprx_state <= liteethip_liteethiprx_next_state;
+    liteethip_checkingiprx_state <= liteethip_checkingiprx_next_state;
     case (liteethip_grant)
         1'd0: begin
             if ((~liteethip_request[0])) begin
@@ -6698,23 +6846,23 @@ always @(posedge sys_clk) begin
         icmp_tx_packetizer_delayed_last_be <= icmp_tx_packetizer_delayed_last_be_fsm1_next_value0;
     end
     liteethicmptx_state <= liteethicmptx_next_state;
-    if (icmp_rx_depacketizer_sr_shift) begin
-        icmp_rx_depacketizer_sr <= {icmp_rx_depacketizer_sink_payload_data, icmp_rx_depacketizer_sr[63:8]};
+    if (icmp_rx_liteethicmpdepacketizer_sr_shift) begin
+        icmp_rx_liteethicmpdepacketizer_sr <= {icmp_rx_liteethicmpdepacketizer_sink_payload_data, icmp_rx_liteethicmpdepacketizer_sr[63:8]};
     end
-    if (icmp_rx_depacketizer_sr_shift_leftover) begin
-        icmp_rx_depacketizer_sr <= {icmp_rx_depacketizer_sink_payload_data, icmp_rx_depacketizer_sr[63:0]};
+    if (icmp_rx_liteethicmpdepacketizer_sr_shift_leftover) begin
+        icmp_rx_liteethicmpdepacketizer_sr <= {icmp_rx_liteethicmpdepacketizer_sink_payload_data, icmp_rx_liteethicmpdepacketizer_sr[63:0]};
     end
-    icmp_rx_depacketizer_was_in_copy <= icmp_rx_depacketizer_is_in_copy;
+    icmp_rx_liteethicmpdepacketizer_was_in_copy <= icmp_rx_liteethicmpdepacketizer_is_in_copy;
     liteethicmprx_fsm0_state <= liteethicmprx_fsm0_next_state;
-    if (icmp_rx_depacketizer_count_fsm0_next_value_ce2) begin
-        icmp_rx_depacketizer_count <= icmp_rx_depacketizer_count_fsm0_next_value2;
+    if (icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2) begin
+        icmp_rx_liteethicmpdepacketizer_count <= icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2;
     end
-    if (icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value_ce3) begin
-        icmp_rx_depacketizer_fsm_from_idle <= icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value3;
+    if (icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3) begin
+        icmp_rx_liteethicmpdepacketizer_fsm_from_idle <= icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3;
     end
     liteethicmprx_fsm1_state <= liteethicmprx_fsm1_next_state;
-    if (icmp_rx_depacketizer_delayed_last_be_fsm1_next_value_ce1) begin
-        icmp_rx_depacketizer_delayed_last_be <= icmp_rx_depacketizer_delayed_last_be_fsm1_next_value1;
+    if (icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1) begin
+        icmp_rx_liteethicmpdepacketizer_delayed_last_be <= icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1;
     end
     liteethicmprx_state <= liteethicmprx_next_state;
     if (icmp_echo_payload_fifo_syncfifo_re) begin
@@ -6779,23 +6927,23 @@ always @(posedge sys_clk) begin
         packetizer_delayed_last_be <= packetizer_delayed_last_be_liteethudp_fsm1_next_value0;
     end
     liteethudp_liteethudptx_state <= liteethudp_liteethudptx_next_state;
-    if (holdingudprx_depacketizer_sr_shift) begin
-        holdingudprx_depacketizer_sr <= {holdingudprx_depacketizer_sink_payload_data, holdingudprx_depacketizer_sr[63:8]};
+    if (holdingudprx_liteethudpdepacketizer_sr_shift) begin
+        holdingudprx_liteethudpdepacketizer_sr <= {holdingudprx_liteethudpdepacketizer_sink_payload_data, holdingudprx_liteethudpdepacketizer_sr[63:8]};
     end
-    if (holdingudprx_depacketizer_sr_shift_leftover) begin
-        holdingudprx_depacketizer_sr <= {holdingudprx_depacketizer_sink_payload_data, holdingudprx_depacketizer_sr[63:0]};
+    if (holdingudprx_liteethudpdepacketizer_sr_shift_leftover) begin
+        holdingudprx_liteethudpdepacketizer_sr <= {holdingudprx_liteethudpdepacketizer_sink_payload_data, holdingudprx_liteethudpdepacketizer_sr[63:0]};
     end
-    holdingudprx_depacketizer_was_in_copy <= holdingudprx_depacketizer_is_in_copy;
+    holdingudprx_liteethudpdepacketizer_was_in_copy <= holdingudprx_liteethudpdepacketizer_is_in_copy;
     liteethudp_holdingudprx_fsm0_state <= liteethudp_holdingudprx_fsm0_next_state;
-    if (holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2) begin
-        holdingudprx_depacketizer_count <= holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2;
+    if (holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2) begin
+        holdingudprx_liteethudpdepacketizer_count <= holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2;
     end
-    if (holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
-        holdingudprx_depacketizer_fsm_from_idle <= holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
+    if (holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
+        holdingudprx_liteethudpdepacketizer_fsm_from_idle <= holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
     end
     liteethudp_holdingudprx_fsm1_state <= liteethudp_holdingudprx_fsm1_next_state;
-    if (holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
-        holdingudprx_depacketizer_delayed_last_be <= holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
+    if (holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
+        holdingudprx_liteethudpdepacketizer_delayed_last_be <= holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
     end
     liteethudp_holdingudprx_state <= liteethudp_holdingudprx_next_state;
     if (holdingudprx_count_liteethudp_next_value_ce0) begin
@@ -6804,20 +6952,23 @@ always @(posedge sys_clk) begin
     if (holdingudprx_err_liteethudp_next_value_ce1) begin
         holdingudprx_err <= holdingudprx_err_liteethudp_next_value1;
     end
-    if (holdingudprx_held_liteethudp_next_value_ce2) begin
-        holdingudprx_held <= holdingudprx_held_liteethudp_next_value2;
+    if (holdingudprx_rest_liteethudp_next_value_ce2) begin
+        holdingudprx_rest <= holdingudprx_rest_liteethudp_next_value2;
     end
-    if (holdingudprx0_liteethudp_next_value_ce3) begin
-        holdingudprx0 <= holdingudprx0_liteethudp_next_value3;
+    if (holdingudprx_held_liteethudp_next_value_ce3) begin
+        holdingudprx_held <= holdingudprx_held_liteethudp_next_value3;
     end
-    if (holdingudprx1_liteethudp_next_value_ce4) begin
-        holdingudprx1 <= holdingudprx1_liteethudp_next_value4;
+    if (holdingudprx0_liteethudp_next_value_ce4) begin
+        holdingudprx0 <= holdingudprx0_liteethudp_next_value4;
     end
-    if (holdingudprx2_liteethudp_next_value_ce5) begin
-        holdingudprx2 <= holdingudprx2_liteethudp_next_value5;
+    if (holdingudprx1_liteethudp_next_value_ce5) begin
+        holdingudprx1 <= holdingudprx1_liteethudp_next_value5;
     end
-    if (holdingudprx3_liteethudp_next_value_ce6) begin
-        holdingudprx3 <= holdingudprx3_liteethudp_next_value6;
+    if (holdingudprx2_liteethudp_next_value_ce6) begin
+        holdingudprx2 <= holdingudprx2_liteethudp_next_value6;
+    end
+    if (holdingudprx3_liteethudp_next_value_ce7) begin
+        holdingudprx3 <= holdingudprx3_liteethudp_next_value7;
     end
     if (liteethudp_first) begin
         liteethudp_sel_ongoing <= liteethudp_sel0;
@@ -6889,17 +7040,17 @@ always @(posedge sys_clk) begin
         mac_packetizer_count <= 4'd0;
         mac_packetizer_fsm_from_idle <= 1'd0;
         mac_packetizer_delayed_last_be <= 1'd0;
-        mac_depacketizer_count <= 4'd0;
-        mac_depacketizer_fsm_from_idle <= 1'd0;
-        mac_depacketizer_delayed_last_be <= 1'd0;
-        mac_depacketizer_was_in_copy <= 1'd0;
-        arp_tx_packetizer_count <= 5'd0;
-        arp_tx_packetizer_fsm_from_idle <= 1'd0;
-        arp_tx_packetizer_delayed_last_be <= 1'd0;
-        arp_rx_depacketizer_count <= 5'd0;
-        arp_rx_depacketizer_fsm_from_idle <= 1'd0;
-        arp_rx_depacketizer_delayed_last_be <= 1'd0;
-        arp_rx_depacketizer_was_in_copy <= 1'd0;
+        mac_liteethmacdepacketizer_count <= 4'd0;
+        mac_liteethmacdepacketizer_fsm_from_idle <= 1'd0;
+        mac_liteethmacdepacketizer_delayed_last_be <= 1'd0;
+        mac_liteethmacdepacketizer_was_in_copy <= 1'd0;
+        arp_packetizer_count <= 5'd0;
+        arp_packetizer_fsm_from_idle <= 1'd0;
+        arp_packetizer_delayed_last_be <= 1'd0;
+        arp_rx_liteetharpdepacketizer_count <= 5'd0;
+        arp_rx_liteetharpdepacketizer_fsm_from_idle <= 1'd0;
+        arp_rx_liteetharpdepacketizer_delayed_last_be <= 1'd0;
+        arp_rx_liteetharpdepacketizer_was_in_copy <= 1'd0;
         arp_table_response_response_payload_failed <= 1'd0;
         arp_table_response_response_payload_mac_address <= 48'd0;
         arp_table_request_pending <= 1'd0;
@@ -6917,18 +7068,18 @@ always @(posedge sys_clk) begin
         ip_tx_packetizer_count <= 5'd0;
         ip_tx_packetizer_fsm_from_idle <= 1'd0;
         ip_tx_packetizer_delayed_last_be <= 1'd0;
-        ip_rx_depacketizer_count <= 5'd0;
-        ip_rx_depacketizer_fsm_from_idle <= 1'd0;
-        ip_rx_depacketizer_delayed_last_be <= 1'd0;
-        ip_rx_depacketizer_was_in_copy <= 1'd0;
+        ip_rx_liteethipv4depacketizer_count <= 5'd0;
+        ip_rx_liteethipv4depacketizer_fsm_from_idle <= 1'd0;
+        ip_rx_liteethipv4depacketizer_delayed_last_be <= 1'd0;
+        ip_rx_liteethipv4depacketizer_was_in_copy <= 1'd0;
         ip_rx_liteethipv4checksum_counter <= 4'd0;
         icmp_tx_packetizer_count <= 3'd0;
         icmp_tx_packetizer_fsm_from_idle <= 1'd0;
         icmp_tx_packetizer_delayed_last_be <= 1'd0;
-        icmp_rx_depacketizer_count <= 3'd0;
-        icmp_rx_depacketizer_fsm_from_idle <= 1'd0;
-        icmp_rx_depacketizer_delayed_last_be <= 1'd0;
-        icmp_rx_depacketizer_was_in_copy <= 1'd0;
+        icmp_rx_liteethicmpdepacketizer_count <= 3'd0;
+        icmp_rx_liteethicmpdepacketizer_fsm_from_idle <= 1'd0;
+        icmp_rx_liteethicmpdepacketizer_delayed_last_be <= 1'd0;
+        icmp_rx_liteethicmpdepacketizer_was_in_copy <= 1'd0;
         icmp_echo_payload_fifo_readable <= 1'd0;
         icmp_echo_payload_fifo_level0 <= 8'd0;
         icmp_echo_payload_fifo_produce <= 7'd0;
@@ -6940,10 +7091,10 @@ always @(posedge sys_clk) begin
         packetizer_count <= 3'd0;
         packetizer_fsm_from_idle <= 1'd0;
         packetizer_delayed_last_be <= 1'd0;
-        holdingudprx_depacketizer_count <= 3'd0;
-        holdingudprx_depacketizer_fsm_from_idle <= 1'd0;
-        holdingudprx_depacketizer_delayed_last_be <= 1'd0;
-        holdingudprx_depacketizer_was_in_copy <= 1'd0;
+        holdingudprx_liteethudpdepacketizer_count <= 3'd0;
+        holdingudprx_liteethudpdepacketizer_fsm_from_idle <= 1'd0;
+        holdingudprx_liteethudpdepacketizer_delayed_last_be <= 1'd0;
+        holdingudprx_liteethudpdepacketizer_was_in_copy <= 1'd0;
         holdingudprx_count <= 16'd0;
         holdingudprx_err <= 1'd0;
         holdingudprx_held <= 8'd0;
@@ -6951,6 +7102,7 @@ always @(posedge sys_clk) begin
         holdingudprx1 <= 16'd0;
         holdingudprx2 <= 16'd0;
         holdingudprx3 <= 32'd0;
+        holdingudprx_rest <= 16'd0;
         liteethmac_grant <= 1'd0;
         liteethmac_status0_first <= 1'd1;
         liteethmac_status0_ongoing1 <= 1'd0;
@@ -6974,9 +7126,9 @@ always @(posedge sys_clk) begin
         liteethip_liteethiptx_fsm0_state <= 2'd0;
         liteethip_liteethiptx_fsm1_state <= 1'd0;
         liteethip_liteethiptx_state <= 3'd0;
-        liteethip_liteethiprx_fsm0_state <= 2'd0;
-        liteethip_liteethiprx_fsm1_state <= 1'd0;
-        liteethip_liteethiprx_state <= 2'd0;
+        liteethip_checkingiprx_fsm0_state <= 2'd0;
+        liteethip_checkingiprx_fsm1_state <= 1'd0;
+        liteethip_checkingiprx_state <= 2'd0;
         liteethip_grant <= 1'd0;
         liteethip_status0_first <= 1'd1;
         liteethip_status0_ongoing1 <= 1'd0;

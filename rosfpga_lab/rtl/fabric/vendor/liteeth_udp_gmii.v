@@ -28,6 +28,8 @@ module liteeth_udp_gmii (
     input  wire   [31:0] ip_address,
     input  wire   [31:0] ip_multicast,
     input  wire   [47:0] mac_address,
+    output wire          rx_drop_header,
+    output wire          rx_drop_other,
     input  wire          sys_clock,
     input  wire          sys_reset,
     input  wire   [15:0] udp_rx_port,
@@ -154,13 +156,13 @@ UDPPortCore
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
 │    │    │    └─── fsm (FSM)
-│    │    └─── rx (LiteEthIPRX)
+│    │    └─── rx (CheckingIPRX)
 │    │    │    └─── depacketizer (LiteEthIPV4Depacketizer)
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
 │    │    │    └─── checksum (LiteEthIPV4Checksum)
 │    │    │    └─── fsm (FSM)
-│    │    └─── crossbar (LiteEthIPV4Crossbar)
+│    │    └─── crossbar (CountingIPCrossbar)
 │    │    │    └─── arbiter (Arbiter)
 │    │    │    │    └─── rr (RoundRobin)
 │    │    │    │    └─── status_0* (Status)
@@ -300,15 +302,15 @@ reg           builder_liteethicmptx_fsm1_next_state = 1'd0;
 reg           builder_liteethicmptx_fsm1_state = 1'd0;
 reg           builder_liteethicmptx_next_state = 1'd0;
 reg           builder_liteethicmptx_state = 1'd0;
+reg     [1:0] builder_liteethip_checkingiprx_fsm0_next_state = 2'd0;
+reg     [1:0] builder_liteethip_checkingiprx_fsm0_state = 2'd0;
+reg           builder_liteethip_checkingiprx_fsm1_next_state = 1'd0;
+reg           builder_liteethip_checkingiprx_fsm1_state = 1'd0;
+reg     [1:0] builder_liteethip_checkingiprx_next_state = 2'd0;
+reg     [1:0] builder_liteethip_checkingiprx_state = 2'd0;
 reg           builder_liteethip_first = 1'd1;
 reg           builder_liteethip_grant = 1'd0;
 wire          builder_liteethip_last;
-reg     [1:0] builder_liteethip_liteethiprx_fsm0_next_state = 2'd0;
-reg     [1:0] builder_liteethip_liteethiprx_fsm0_state = 2'd0;
-reg           builder_liteethip_liteethiprx_fsm1_next_state = 1'd0;
-reg           builder_liteethip_liteethiprx_fsm1_state = 1'd0;
-reg     [1:0] builder_liteethip_liteethiprx_next_state = 2'd0;
-reg     [1:0] builder_liteethip_liteethiprx_state = 2'd0;
 reg     [1:0] builder_liteethip_liteethiptx_fsm0_next_state = 2'd0;
 reg     [1:0] builder_liteethip_liteethiptx_fsm0_state = 2'd0;
 reg           builder_liteethip_liteethiptx_fsm1_next_state = 1'd0;
@@ -329,6 +331,7 @@ reg           builder_liteethip_status1_first = 1'd1;
 wire          builder_liteethip_status1_last;
 wire          builder_liteethip_status1_ongoing0;
 reg           builder_liteethip_status1_ongoing1 = 1'd0;
+wire          builder_liteethip_taken;
 reg           builder_liteethmac_first = 1'd1;
 reg     [1:0] builder_liteethmac_fsm0_next_state0 = 2'd0;
 reg     [1:0] builder_liteethmac_fsm0_next_state1 = 2'd0;
@@ -358,6 +361,7 @@ reg           builder_liteethmac_status1_first = 1'd1;
 wire          builder_liteethmac_status1_last;
 wire          builder_liteethmac_status1_ongoing0;
 reg           builder_liteethmac_status1_ongoing1 = 1'd0;
+wire          builder_liteethmac_taken;
 reg     [1:0] builder_liteethmac_txdatapath_bufferizeendpoints_next_state = 2'd0;
 reg     [1:0] builder_liteethmac_txdatapath_bufferizeendpoints_state = 2'd0;
 reg           builder_liteethmac_txdatapath_liteethmacgap_next_state = 1'd0;
@@ -385,6 +389,7 @@ reg           builder_liteethudp_ongoing1 = 1'd0;
 reg           builder_liteethudp_sel0 = 1'd0;
 reg           builder_liteethudp_sel1 = 1'd0;
 reg           builder_liteethudp_sel_ongoing = 1'd0;
+wire          builder_liteethudp_taken;
 reg     [5:0] builder_multiregimpl0_regs0 = 6'd0;
 reg     [5:0] builder_multiregimpl0_regs1 = 6'd0;
 reg     [5:0] builder_multiregimpl1_regs0 = 6'd0;
@@ -481,6 +486,9 @@ wire          eth_rx_clk;
 reg           eth_rx_rst = 1'd0;
 wire          eth_tx_clk;
 reg           eth_tx_rst = 1'd0;
+reg     [5:0] main_arp_counter = 6'd0;
+reg     [5:0] main_arp_counter_liteetharp_next_value = 6'd0;
+reg           main_arp_counter_liteetharp_next_value_ce = 1'd0;
 wire          main_arp_mac_port_sink_first;
 wire          main_arp_mac_port_sink_last;
 wire    [7:0] main_arp_mac_port_sink_payload_data;
@@ -501,77 +509,145 @@ reg    [47:0] main_arp_mac_port_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_arp_mac_port_source_payload_target_mac = 48'd0;
 wire          main_arp_mac_port_source_ready;
 reg           main_arp_mac_port_source_valid = 1'd0;
-reg     [4:0] main_arp_rx_depacketizer_count = 5'd0;
-reg     [4:0] main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 = 5'd0;
-reg           main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 = 1'd0;
-reg           main_arp_rx_depacketizer_delayed_last_be = 1'd0;
-reg           main_arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value1 = 1'd0;
-reg           main_arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 = 1'd0;
-reg           main_arp_rx_depacketizer_fsm_from_idle = 1'd0;
-reg           main_arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 = 1'd0;
-reg           main_arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 = 1'd0;
-wire  [223:0] main_arp_rx_depacketizer_header;
-wire          main_arp_rx_depacketizer_is_in_copy;
-reg           main_arp_rx_depacketizer_is_ongoing0 = 1'd0;
-reg           main_arp_rx_depacketizer_is_ongoing1 = 1'd0;
-reg           main_arp_rx_depacketizer_is_ongoing2 = 1'd0;
-reg           main_arp_rx_depacketizer_is_ongoing3 = 1'd0;
-wire          main_arp_rx_depacketizer_new_last_be;
-reg           main_arp_rx_depacketizer_sink_d_last = 1'd0;
-wire          main_arp_rx_depacketizer_sink_first;
-wire          main_arp_rx_depacketizer_sink_last;
-wire          main_arp_rx_depacketizer_sink_last_be;
-wire    [7:0] main_arp_rx_depacketizer_sink_payload_data;
-wire          main_arp_rx_depacketizer_sink_payload_error;
-wire   [15:0] main_arp_rx_depacketizer_sink_payload_ethernet_type;
-wire          main_arp_rx_depacketizer_sink_payload_last_be;
-wire   [47:0] main_arp_rx_depacketizer_sink_payload_sender_mac;
-wire   [47:0] main_arp_rx_depacketizer_sink_payload_target_mac;
-reg           main_arp_rx_depacketizer_sink_ready = 1'd0;
-wire          main_arp_rx_depacketizer_sink_valid;
-reg           main_arp_rx_depacketizer_source_last = 1'd0;
-reg           main_arp_rx_depacketizer_source_last_a = 1'd0;
-reg           main_arp_rx_depacketizer_source_last_b = 1'd0;
-reg           main_arp_rx_depacketizer_source_last_s = 1'd0;
-wire    [7:0] main_arp_rx_depacketizer_source_param_hwsize;
-wire   [15:0] main_arp_rx_depacketizer_source_param_hwtype;
-wire   [15:0] main_arp_rx_depacketizer_source_param_opcode;
-wire   [15:0] main_arp_rx_depacketizer_source_param_proto;
-wire    [7:0] main_arp_rx_depacketizer_source_param_protosize;
-wire   [31:0] main_arp_rx_depacketizer_source_param_sender_ip;
-wire   [47:0] main_arp_rx_depacketizer_source_param_sender_mac;
-wire   [31:0] main_arp_rx_depacketizer_source_param_target_ip;
-wire   [47:0] main_arp_rx_depacketizer_source_param_target_mac;
-reg     [7:0] main_arp_rx_depacketizer_source_payload_data = 8'd0;
-wire          main_arp_rx_depacketizer_source_payload_error;
-reg           main_arp_rx_depacketizer_source_payload_last_be = 1'd0;
-reg           main_arp_rx_depacketizer_source_ready = 1'd0;
-reg           main_arp_rx_depacketizer_source_valid = 1'd0;
-reg   [223:0] main_arp_rx_depacketizer_sr = 224'd0;
-reg           main_arp_rx_depacketizer_sr_shift = 1'd0;
-reg           main_arp_rx_depacketizer_sr_shift_leftover = 1'd0;
-reg           main_arp_rx_depacketizer_was_in_copy = 1'd0;
+reg     [4:0] main_arp_packetizer_count = 5'd0;
+reg     [4:0] main_arp_packetizer_count_liteetharp_fsm0_next_value0 = 5'd0;
+reg           main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0 = 1'd0;
+reg           main_arp_packetizer_delayed_last_be = 1'd0;
+reg           main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 = 1'd0;
+reg           main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 = 1'd0;
+reg           main_arp_packetizer_fsm_from_idle = 1'd0;
+reg           main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 = 1'd0;
+reg           main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 = 1'd0;
+reg   [223:0] main_arp_packetizer_header = 224'd0;
+wire          main_arp_packetizer_in_data_copy;
+reg           main_arp_packetizer_is_ongoing0 = 1'd0;
+reg           main_arp_packetizer_is_ongoing1 = 1'd0;
+reg           main_arp_packetizer_is_ongoing2 = 1'd0;
+wire          main_arp_packetizer_new_last_be;
+wire          main_arp_packetizer_sink_last;
+wire          main_arp_packetizer_sink_last_be;
+wire    [7:0] main_arp_packetizer_sink_param_hwsize;
+wire   [15:0] main_arp_packetizer_sink_param_hwtype;
+reg    [15:0] main_arp_packetizer_sink_param_opcode = 16'd0;
+wire   [15:0] main_arp_packetizer_sink_param_proto;
+wire    [7:0] main_arp_packetizer_sink_param_protosize;
+wire   [31:0] main_arp_packetizer_sink_param_sender_ip;
+wire   [47:0] main_arp_packetizer_sink_param_sender_mac;
+wire   [31:0] main_arp_packetizer_sink_param_target_ip;
+reg    [47:0] main_arp_packetizer_sink_param_target_mac = 48'd0;
+reg     [7:0] main_arp_packetizer_sink_payload_data = 8'd0;
+reg           main_arp_packetizer_sink_payload_error = 1'd0;
+reg           main_arp_packetizer_sink_payload_last_be = 1'd0;
+reg           main_arp_packetizer_sink_ready = 1'd0;
+reg           main_arp_packetizer_sink_valid = 1'd0;
+reg           main_arp_packetizer_source_first = 1'd0;
+reg           main_arp_packetizer_source_last = 1'd0;
+reg           main_arp_packetizer_source_last_a = 1'd0;
+reg           main_arp_packetizer_source_last_b = 1'd0;
+reg           main_arp_packetizer_source_last_s = 1'd0;
+reg     [7:0] main_arp_packetizer_source_payload_data = 8'd0;
+wire          main_arp_packetizer_source_payload_error;
+reg    [15:0] main_arp_packetizer_source_payload_ethernet_type = 16'd0;
+reg           main_arp_packetizer_source_payload_last_be = 1'd0;
+reg    [47:0] main_arp_packetizer_source_payload_sender_mac = 48'd0;
+reg    [47:0] main_arp_packetizer_source_payload_target_mac = 48'd0;
+reg           main_arp_packetizer_source_ready = 1'd0;
+reg           main_arp_packetizer_source_valid = 1'd0;
+reg   [223:0] main_arp_packetizer_sr = 224'd0;
+reg           main_arp_packetizer_sr_load = 1'd0;
+reg           main_arp_packetizer_sr_shift = 1'd0;
+wire          main_arp_rx_cut;
+reg           main_arp_rx_fsm_is_ongoing0 = 1'd0;
+reg           main_arp_rx_fsm_is_ongoing1 = 1'd0;
+reg     [4:0] main_arp_rx_liteetharpdepacketizer_count = 5'd0;
+reg     [4:0] main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 = 5'd0;
+reg           main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_delayed_last_be = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_fsm_from_idle = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 = 1'd0;
+wire  [223:0] main_arp_rx_liteetharpdepacketizer_header;
+wire          main_arp_rx_liteetharpdepacketizer_is_in_copy;
+reg           main_arp_rx_liteetharpdepacketizer_is_ongoing0 = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_is_ongoing1 = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_is_ongoing2 = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_is_ongoing3 = 1'd0;
+wire          main_arp_rx_liteetharpdepacketizer_new_last_be;
+reg           main_arp_rx_liteetharpdepacketizer_sink_d_last = 1'd0;
+wire          main_arp_rx_liteetharpdepacketizer_sink_first;
+wire          main_arp_rx_liteetharpdepacketizer_sink_last;
+wire          main_arp_rx_liteetharpdepacketizer_sink_last_be;
+wire    [7:0] main_arp_rx_liteetharpdepacketizer_sink_payload_data;
+wire          main_arp_rx_liteetharpdepacketizer_sink_payload_error;
+wire   [15:0] main_arp_rx_liteetharpdepacketizer_sink_payload_ethernet_type;
+wire          main_arp_rx_liteetharpdepacketizer_sink_payload_last_be;
+wire   [47:0] main_arp_rx_liteetharpdepacketizer_sink_payload_sender_mac;
+wire   [47:0] main_arp_rx_liteetharpdepacketizer_sink_payload_target_mac;
+reg           main_arp_rx_liteetharpdepacketizer_sink_ready = 1'd0;
+wire          main_arp_rx_liteetharpdepacketizer_sink_valid;
+reg           main_arp_rx_liteetharpdepacketizer_source_last = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_source_last_a = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_source_last_b = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_source_last_s = 1'd0;
+wire    [7:0] main_arp_rx_liteetharpdepacketizer_source_param_hwsize;
+wire   [15:0] main_arp_rx_liteetharpdepacketizer_source_param_hwtype;
+wire   [15:0] main_arp_rx_liteetharpdepacketizer_source_param_opcode;
+wire   [15:0] main_arp_rx_liteetharpdepacketizer_source_param_proto;
+wire    [7:0] main_arp_rx_liteetharpdepacketizer_source_param_protosize;
+wire   [31:0] main_arp_rx_liteetharpdepacketizer_source_param_sender_ip;
+wire   [47:0] main_arp_rx_liteetharpdepacketizer_source_param_sender_mac;
+wire   [31:0] main_arp_rx_liteetharpdepacketizer_source_param_target_ip;
+wire   [47:0] main_arp_rx_liteetharpdepacketizer_source_param_target_mac;
+reg     [7:0] main_arp_rx_liteetharpdepacketizer_source_payload_data = 8'd0;
+wire          main_arp_rx_liteetharpdepacketizer_source_payload_error;
+reg           main_arp_rx_liteetharpdepacketizer_source_payload_last_be = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_source_ready = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_source_valid = 1'd0;
+reg   [223:0] main_arp_rx_liteetharpdepacketizer_sr = 224'd0;
+reg           main_arp_rx_liteetharpdepacketizer_sr_shift = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_sr_shift_leftover = 1'd0;
+reg           main_arp_rx_liteetharpdepacketizer_was_in_copy = 1'd0;
 reg           main_arp_rx_reply = 1'd0;
 reg           main_arp_rx_request = 1'd0;
-wire          main_arp_rx_sink_sink_first;
-wire          main_arp_rx_sink_sink_last;
-wire    [7:0] main_arp_rx_sink_sink_payload_data;
-wire          main_arp_rx_sink_sink_payload_error;
-wire   [15:0] main_arp_rx_sink_sink_payload_ethernet_type;
-wire          main_arp_rx_sink_sink_payload_last_be;
-wire   [47:0] main_arp_rx_sink_sink_payload_sender_mac;
-wire   [47:0] main_arp_rx_sink_sink_payload_target_mac;
-wire          main_arp_rx_sink_sink_ready;
-wire          main_arp_rx_sink_sink_valid;
-reg           main_arp_rx_source_source_first = 1'd0;
-reg           main_arp_rx_source_source_last = 1'd0;
-wire   [31:0] main_arp_rx_source_source_payload_ip_address;
-wire   [47:0] main_arp_rx_source_source_payload_mac_address;
-reg           main_arp_rx_source_source_payload_reply = 1'd0;
-reg           main_arp_rx_source_source_payload_request = 1'd0;
-wire          main_arp_rx_source_source_ready;
-reg           main_arp_rx_source_source_valid = 1'd0;
+wire          main_arp_rx_sink_first;
+wire          main_arp_rx_sink_last;
+wire    [7:0] main_arp_rx_sink_payload_data;
+wire          main_arp_rx_sink_payload_error;
+wire   [15:0] main_arp_rx_sink_payload_ethernet_type;
+wire          main_arp_rx_sink_payload_last_be;
+wire   [47:0] main_arp_rx_sink_payload_sender_mac;
+wire   [47:0] main_arp_rx_sink_payload_target_mac;
+wire          main_arp_rx_sink_ready;
+wire          main_arp_rx_sink_valid;
+reg           main_arp_rx_source_first = 1'd0;
+reg           main_arp_rx_source_last = 1'd0;
+wire   [31:0] main_arp_rx_source_payload_ip_address;
+wire   [47:0] main_arp_rx_source_payload_mac_address;
+reg           main_arp_rx_source_payload_reply = 1'd0;
+reg           main_arp_rx_source_payload_request = 1'd0;
+wire          main_arp_rx_source_ready;
+reg           main_arp_rx_source_valid = 1'd0;
 reg           main_arp_rx_valid = 1'd0;
+wire          main_arp_sink_sink_first;
+wire          main_arp_sink_sink_last;
+wire   [31:0] main_arp_sink_sink_payload_ip_address;
+wire   [47:0] main_arp_sink_sink_payload_mac_address;
+wire          main_arp_sink_sink_payload_reply;
+wire          main_arp_sink_sink_payload_request;
+reg           main_arp_sink_sink_ready = 1'd0;
+wire          main_arp_sink_sink_valid;
+wire          main_arp_source_source_first;
+wire          main_arp_source_source_last;
+wire    [7:0] main_arp_source_source_payload_data;
+wire          main_arp_source_source_payload_error;
+reg    [15:0] main_arp_source_source_payload_ethernet_type = 16'd0;
+wire          main_arp_source_source_payload_last_be;
+reg    [47:0] main_arp_source_source_payload_sender_mac = 48'd0;
+reg    [47:0] main_arp_source_source_payload_target_mac = 48'd0;
+wire          main_arp_source_source_ready;
+reg           main_arp_source_source_valid = 1'd0;
 reg           main_arp_table_cache_clear_enable = 1'd1;
 reg    [26:0] main_arp_table_cache_count = 27'd125000000;
 wire          main_arp_table_cache_done;
@@ -647,80 +723,13 @@ reg           main_arp_table_source_payload_reply = 1'd0;
 reg           main_arp_table_source_payload_request = 1'd0;
 wire          main_arp_table_source_ready;
 reg           main_arp_table_source_valid = 1'd0;
-reg     [5:0] main_arp_tx_counter = 6'd0;
-reg     [5:0] main_arp_tx_counter_liteetharp_next_value = 6'd0;
-reg           main_arp_tx_counter_liteetharp_next_value_ce = 1'd0;
-reg     [4:0] main_arp_tx_packetizer_count = 5'd0;
-reg     [4:0] main_arp_tx_packetizer_count_liteetharp_fsm0_next_value0 = 5'd0;
-reg           main_arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 = 1'd0;
-reg           main_arp_tx_packetizer_delayed_last_be = 1'd0;
-reg           main_arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 = 1'd0;
-reg           main_arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 = 1'd0;
-reg           main_arp_tx_packetizer_fsm_from_idle = 1'd0;
-reg           main_arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 = 1'd0;
-reg           main_arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 = 1'd0;
-reg   [223:0] main_arp_tx_packetizer_header = 224'd0;
-wire          main_arp_tx_packetizer_in_data_copy;
-reg           main_arp_tx_packetizer_is_ongoing0 = 1'd0;
-reg           main_arp_tx_packetizer_is_ongoing1 = 1'd0;
-reg           main_arp_tx_packetizer_is_ongoing2 = 1'd0;
-wire          main_arp_tx_packetizer_new_last_be;
-wire          main_arp_tx_packetizer_sink_last;
-wire          main_arp_tx_packetizer_sink_last_be;
-wire    [7:0] main_arp_tx_packetizer_sink_param_hwsize;
-wire   [15:0] main_arp_tx_packetizer_sink_param_hwtype;
-reg    [15:0] main_arp_tx_packetizer_sink_param_opcode = 16'd0;
-wire   [15:0] main_arp_tx_packetizer_sink_param_proto;
-wire    [7:0] main_arp_tx_packetizer_sink_param_protosize;
-wire   [31:0] main_arp_tx_packetizer_sink_param_sender_ip;
-wire   [47:0] main_arp_tx_packetizer_sink_param_sender_mac;
-wire   [31:0] main_arp_tx_packetizer_sink_param_target_ip;
-reg    [47:0] main_arp_tx_packetizer_sink_param_target_mac = 48'd0;
-reg     [7:0] main_arp_tx_packetizer_sink_payload_data = 8'd0;
-reg           main_arp_tx_packetizer_sink_payload_error = 1'd0;
-reg           main_arp_tx_packetizer_sink_payload_last_be = 1'd0;
-reg           main_arp_tx_packetizer_sink_ready = 1'd0;
-reg           main_arp_tx_packetizer_sink_valid = 1'd0;
-reg           main_arp_tx_packetizer_source_first = 1'd0;
-reg           main_arp_tx_packetizer_source_last = 1'd0;
-reg           main_arp_tx_packetizer_source_last_a = 1'd0;
-reg           main_arp_tx_packetizer_source_last_b = 1'd0;
-reg           main_arp_tx_packetizer_source_last_s = 1'd0;
-reg     [7:0] main_arp_tx_packetizer_source_payload_data = 8'd0;
-wire          main_arp_tx_packetizer_source_payload_error;
-reg    [15:0] main_arp_tx_packetizer_source_payload_ethernet_type = 16'd0;
-reg           main_arp_tx_packetizer_source_payload_last_be = 1'd0;
-reg    [47:0] main_arp_tx_packetizer_source_payload_sender_mac = 48'd0;
-reg    [47:0] main_arp_tx_packetizer_source_payload_target_mac = 48'd0;
-reg           main_arp_tx_packetizer_source_ready = 1'd0;
-reg           main_arp_tx_packetizer_source_valid = 1'd0;
-reg   [223:0] main_arp_tx_packetizer_sr = 224'd0;
-reg           main_arp_tx_packetizer_sr_load = 1'd0;
-reg           main_arp_tx_packetizer_sr_shift = 1'd0;
-wire          main_arp_tx_sink_sink_first;
-wire          main_arp_tx_sink_sink_last;
-wire   [31:0] main_arp_tx_sink_sink_payload_ip_address;
-wire   [47:0] main_arp_tx_sink_sink_payload_mac_address;
-wire          main_arp_tx_sink_sink_payload_reply;
-wire          main_arp_tx_sink_sink_payload_request;
-reg           main_arp_tx_sink_sink_ready = 1'd0;
-wire          main_arp_tx_sink_sink_valid;
-wire          main_arp_tx_source_source_first;
-wire          main_arp_tx_source_source_last;
-wire    [7:0] main_arp_tx_source_source_payload_data;
-wire          main_arp_tx_source_source_payload_error;
-reg    [15:0] main_arp_tx_source_source_payload_ethernet_type = 16'd0;
-wire          main_arp_tx_source_source_payload_last_be;
-reg    [47:0] main_arp_tx_source_source_payload_sender_mac = 48'd0;
-reg    [47:0] main_arp_tx_source_source_payload_target_mac = 48'd0;
-wire          main_arp_tx_source_source_ready;
-reg           main_arp_tx_source_source_valid = 1'd0;
 reg           main_bus_error = 1'd0;
 reg    [31:0] main_bus_errors = 32'd0;
 reg           main_bus_errors_re = 1'd0;
 wire   [31:0] main_bus_errors_status;
 wire          main_bus_errors_we;
 wire          main_cpu_rst;
+wire          main_crossbar_dropped;
 wire          main_crossbar_sink_first;
 wire          main_crossbar_sink_last;
 wire   [15:0] main_crossbar_sink_param_dst_port;
@@ -745,93 +754,101 @@ wire          main_crossbar_source_ready;
 wire          main_crossbar_source_valid;
 reg           main_dv_d = 1'd0;
 reg    [15:0] main_holdingudprx0 = 16'd0;
-reg    [15:0] main_holdingudprx0_liteethudp_next_value3 = 16'd0;
-reg           main_holdingudprx0_liteethudp_next_value_ce3 = 1'd0;
+reg    [15:0] main_holdingudprx0_liteethudp_next_value4 = 16'd0;
+reg           main_holdingudprx0_liteethudp_next_value_ce4 = 1'd0;
 reg    [15:0] main_holdingudprx1 = 16'd0;
-reg    [15:0] main_holdingudprx1_liteethudp_next_value4 = 16'd0;
-reg           main_holdingudprx1_liteethudp_next_value_ce4 = 1'd0;
+reg    [15:0] main_holdingudprx1_liteethudp_next_value5 = 16'd0;
+reg           main_holdingudprx1_liteethudp_next_value_ce5 = 1'd0;
 reg    [15:0] main_holdingudprx2 = 16'd0;
-reg    [15:0] main_holdingudprx2_liteethudp_next_value5 = 16'd0;
-reg           main_holdingudprx2_liteethudp_next_value_ce5 = 1'd0;
+reg    [15:0] main_holdingudprx2_liteethudp_next_value6 = 16'd0;
+reg           main_holdingudprx2_liteethudp_next_value_ce6 = 1'd0;
 reg    [31:0] main_holdingudprx3 = 32'd0;
-reg    [31:0] main_holdingudprx3_liteethudp_next_value6 = 32'd0;
-reg           main_holdingudprx3_liteethudp_next_value_ce6 = 1'd0;
+reg    [31:0] main_holdingudprx3_liteethudp_next_value7 = 32'd0;
+reg           main_holdingudprx3_liteethudp_next_value_ce7 = 1'd0;
 reg    [15:0] main_holdingudprx_count = 16'd0;
 reg    [15:0] main_holdingudprx_count_liteethudp_next_value0 = 16'd0;
 reg           main_holdingudprx_count_liteethudp_next_value_ce0 = 1'd0;
-reg     [2:0] main_holdingudprx_depacketizer_count = 3'd0;
-reg     [2:0] main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
-reg           main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
-reg           main_holdingudprx_depacketizer_delayed_last_be = 1'd0;
-reg           main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
-reg           main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
-reg           main_holdingudprx_depacketizer_fsm_from_idle = 1'd0;
-reg           main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
-reg           main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
-wire   [63:0] main_holdingudprx_depacketizer_header;
-wire          main_holdingudprx_depacketizer_is_in_copy;
-reg           main_holdingudprx_depacketizer_is_ongoing0 = 1'd0;
-reg           main_holdingudprx_depacketizer_is_ongoing1 = 1'd0;
-reg           main_holdingudprx_depacketizer_is_ongoing2 = 1'd0;
-reg           main_holdingudprx_depacketizer_is_ongoing3 = 1'd0;
-wire          main_holdingudprx_depacketizer_new_last_be;
-reg           main_holdingudprx_depacketizer_sink_d_last = 1'd0;
-wire          main_holdingudprx_depacketizer_sink_first;
-wire          main_holdingudprx_depacketizer_sink_last;
-wire          main_holdingudprx_depacketizer_sink_last_be;
-wire   [31:0] main_holdingudprx_depacketizer_sink_param_ip_address;
-wire   [15:0] main_holdingudprx_depacketizer_sink_param_length;
-wire    [7:0] main_holdingudprx_depacketizer_sink_param_protocol;
-wire    [7:0] main_holdingudprx_depacketizer_sink_payload_data;
-wire          main_holdingudprx_depacketizer_sink_payload_error;
-wire          main_holdingudprx_depacketizer_sink_payload_last_be;
-reg           main_holdingudprx_depacketizer_sink_ready = 1'd0;
-wire          main_holdingudprx_depacketizer_sink_valid;
-reg           main_holdingudprx_depacketizer_source_last = 1'd0;
-reg           main_holdingudprx_depacketizer_source_last_a = 1'd0;
-reg           main_holdingudprx_depacketizer_source_last_b = 1'd0;
-reg           main_holdingudprx_depacketizer_source_last_s = 1'd0;
-wire   [15:0] main_holdingudprx_depacketizer_source_param_checksum;
-wire   [15:0] main_holdingudprx_depacketizer_source_param_dst_port;
-wire   [15:0] main_holdingudprx_depacketizer_source_param_length;
-wire   [15:0] main_holdingudprx_depacketizer_source_param_src_port;
-reg     [7:0] main_holdingudprx_depacketizer_source_payload_data = 8'd0;
-wire          main_holdingudprx_depacketizer_source_payload_error;
-reg           main_holdingudprx_depacketizer_source_payload_last_be = 1'd0;
-reg           main_holdingudprx_depacketizer_source_ready = 1'd0;
-reg           main_holdingudprx_depacketizer_source_valid = 1'd0;
-reg    [63:0] main_holdingudprx_depacketizer_sr = 64'd0;
-reg           main_holdingudprx_depacketizer_sr_shift = 1'd0;
-reg           main_holdingudprx_depacketizer_sr_shift_leftover = 1'd0;
-reg           main_holdingudprx_depacketizer_was_in_copy = 1'd0;
+wire          main_holdingudprx_cut0;
+wire          main_holdingudprx_cut1;
+reg           main_holdingudprx_drop_header = 1'd0;
 reg           main_holdingudprx_err = 1'd0;
 reg           main_holdingudprx_err_liteethudp_next_value1 = 1'd0;
 reg           main_holdingudprx_err_liteethudp_next_value_ce1 = 1'd0;
+reg           main_holdingudprx_fsm_is_ongoing0 = 1'd0;
+reg           main_holdingudprx_fsm_is_ongoing1 = 1'd0;
 reg     [7:0] main_holdingudprx_held = 8'd0;
-reg     [7:0] main_holdingudprx_held_liteethudp_next_value2 = 8'd0;
-reg           main_holdingudprx_held_liteethudp_next_value_ce2 = 1'd0;
+reg     [7:0] main_holdingudprx_held_liteethudp_next_value3 = 8'd0;
+reg           main_holdingudprx_held_liteethudp_next_value_ce3 = 1'd0;
+reg     [2:0] main_holdingudprx_liteethudpdepacketizer_count = 3'd0;
+reg     [2:0] main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_delayed_last_be = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_fsm_from_idle = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
+wire   [63:0] main_holdingudprx_liteethudpdepacketizer_header;
+wire          main_holdingudprx_liteethudpdepacketizer_is_in_copy;
+reg           main_holdingudprx_liteethudpdepacketizer_is_ongoing0 = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_is_ongoing1 = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_is_ongoing2 = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_is_ongoing3 = 1'd0;
+wire          main_holdingudprx_liteethudpdepacketizer_new_last_be;
+reg           main_holdingudprx_liteethudpdepacketizer_sink_d_last = 1'd0;
+wire          main_holdingudprx_liteethudpdepacketizer_sink_first;
+wire          main_holdingudprx_liteethudpdepacketizer_sink_last;
+wire          main_holdingudprx_liteethudpdepacketizer_sink_last_be;
+wire   [31:0] main_holdingudprx_liteethudpdepacketizer_sink_param_ip_address;
+wire   [15:0] main_holdingudprx_liteethudpdepacketizer_sink_param_length;
+wire    [7:0] main_holdingudprx_liteethudpdepacketizer_sink_param_protocol;
+wire    [7:0] main_holdingudprx_liteethudpdepacketizer_sink_payload_data;
+wire          main_holdingudprx_liteethudpdepacketizer_sink_payload_error;
+wire          main_holdingudprx_liteethudpdepacketizer_sink_payload_last_be;
+reg           main_holdingudprx_liteethudpdepacketizer_sink_ready = 1'd0;
+wire          main_holdingudprx_liteethudpdepacketizer_sink_valid;
+reg           main_holdingudprx_liteethudpdepacketizer_source_last = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_source_last_a = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_source_last_b = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_source_last_s = 1'd0;
+wire   [15:0] main_holdingudprx_liteethudpdepacketizer_source_param_checksum;
+wire   [15:0] main_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+wire   [15:0] main_holdingudprx_liteethudpdepacketizer_source_param_length;
+wire   [15:0] main_holdingudprx_liteethudpdepacketizer_source_param_src_port;
+reg     [7:0] main_holdingudprx_liteethudpdepacketizer_source_payload_data = 8'd0;
+wire          main_holdingudprx_liteethudpdepacketizer_source_payload_error;
+reg           main_holdingudprx_liteethudpdepacketizer_source_payload_last_be = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_source_ready = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_source_valid = 1'd0;
+reg    [63:0] main_holdingudprx_liteethudpdepacketizer_sr = 64'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_sr_shift = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
+reg           main_holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
 wire   [15:0] main_holdingudprx_payload_len;
-wire          main_holdingudprx_sink_sink_first;
-wire          main_holdingudprx_sink_sink_last;
-wire   [31:0] main_holdingudprx_sink_sink_param_ip_address;
-wire   [15:0] main_holdingudprx_sink_sink_param_length;
-wire    [7:0] main_holdingudprx_sink_sink_param_protocol;
-wire    [7:0] main_holdingudprx_sink_sink_payload_data;
-wire          main_holdingudprx_sink_sink_payload_error;
-wire          main_holdingudprx_sink_sink_payload_last_be;
-wire          main_holdingudprx_sink_sink_ready;
-wire          main_holdingudprx_sink_sink_valid;
-reg           main_holdingudprx_source_source_first = 1'd0;
-reg           main_holdingudprx_source_source_last = 1'd0;
-reg    [15:0] main_holdingudprx_source_source_param_dst_port = 16'd0;
-reg    [31:0] main_holdingudprx_source_source_param_ip_address = 32'd0;
-reg    [15:0] main_holdingudprx_source_source_param_length = 16'd0;
-reg    [15:0] main_holdingudprx_source_source_param_src_port = 16'd0;
-reg     [7:0] main_holdingudprx_source_source_payload_data = 8'd0;
-reg           main_holdingudprx_source_source_payload_error = 1'd0;
-reg           main_holdingudprx_source_source_payload_last_be = 1'd0;
-wire          main_holdingudprx_source_source_ready;
-reg           main_holdingudprx_source_source_valid = 1'd0;
+reg    [15:0] main_holdingudprx_rest = 16'd0;
+reg    [15:0] main_holdingudprx_rest_liteethudp_next_value2 = 16'd0;
+reg           main_holdingudprx_rest_liteethudp_next_value_ce2 = 1'd0;
+wire          main_holdingudprx_sink_first;
+wire          main_holdingudprx_sink_last;
+wire   [31:0] main_holdingudprx_sink_param_ip_address;
+wire   [15:0] main_holdingudprx_sink_param_length;
+wire    [7:0] main_holdingudprx_sink_param_protocol;
+wire    [7:0] main_holdingudprx_sink_payload_data;
+wire          main_holdingudprx_sink_payload_error;
+wire          main_holdingudprx_sink_payload_last_be;
+wire          main_holdingudprx_sink_ready;
+wire          main_holdingudprx_sink_valid;
+reg           main_holdingudprx_source_first = 1'd0;
+reg           main_holdingudprx_source_last = 1'd0;
+reg    [15:0] main_holdingudprx_source_param_dst_port = 16'd0;
+reg    [31:0] main_holdingudprx_source_param_ip_address = 32'd0;
+reg    [15:0] main_holdingudprx_source_param_length = 16'd0;
+reg    [15:0] main_holdingudprx_source_param_src_port = 16'd0;
+reg     [7:0] main_holdingudprx_source_payload_data = 8'd0;
+reg           main_holdingudprx_source_payload_error = 1'd0;
+reg           main_holdingudprx_source_payload_last_be = 1'd0;
+wire          main_holdingudprx_source_ready;
+reg           main_holdingudprx_source_valid = 1'd0;
 reg           main_icmp_echo_param_fifo_consume = 1'd0;
 wire          main_icmp_echo_param_fifo_do_read;
 wire          main_icmp_echo_param_fifo_fifo_in_first;
@@ -1006,74 +1023,77 @@ reg           main_icmp_ip_port_source_payload_error = 1'd0;
 reg           main_icmp_ip_port_source_payload_last_be = 1'd0;
 wire          main_icmp_ip_port_source_ready;
 reg           main_icmp_ip_port_source_valid = 1'd0;
-reg     [2:0] main_icmp_rx_depacketizer_count = 3'd0;
-reg     [2:0] main_icmp_rx_depacketizer_count_fsm0_next_value2 = 3'd0;
-reg           main_icmp_rx_depacketizer_count_fsm0_next_value_ce2 = 1'd0;
-reg           main_icmp_rx_depacketizer_delayed_last_be = 1'd0;
-reg           main_icmp_rx_depacketizer_delayed_last_be_fsm1_next_value1 = 1'd0;
-reg           main_icmp_rx_depacketizer_delayed_last_be_fsm1_next_value_ce1 = 1'd0;
-reg           main_icmp_rx_depacketizer_fsm_from_idle = 1'd0;
-reg           main_icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value3 = 1'd0;
-reg           main_icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value_ce3 = 1'd0;
-wire   [63:0] main_icmp_rx_depacketizer_header;
-wire          main_icmp_rx_depacketizer_is_in_copy;
-reg           main_icmp_rx_depacketizer_is_ongoing0 = 1'd0;
-reg           main_icmp_rx_depacketizer_is_ongoing1 = 1'd0;
-reg           main_icmp_rx_depacketizer_is_ongoing2 = 1'd0;
-reg           main_icmp_rx_depacketizer_is_ongoing3 = 1'd0;
-wire          main_icmp_rx_depacketizer_new_last_be;
-reg           main_icmp_rx_depacketizer_sink_d_last = 1'd0;
-wire          main_icmp_rx_depacketizer_sink_first;
-wire          main_icmp_rx_depacketizer_sink_last;
-wire          main_icmp_rx_depacketizer_sink_last_be;
-wire   [31:0] main_icmp_rx_depacketizer_sink_param_ip_address;
-wire   [15:0] main_icmp_rx_depacketizer_sink_param_length;
-wire    [7:0] main_icmp_rx_depacketizer_sink_param_protocol;
-wire    [7:0] main_icmp_rx_depacketizer_sink_payload_data;
-wire          main_icmp_rx_depacketizer_sink_payload_error;
-wire          main_icmp_rx_depacketizer_sink_payload_last_be;
-reg           main_icmp_rx_depacketizer_sink_ready = 1'd0;
-wire          main_icmp_rx_depacketizer_sink_valid;
-reg           main_icmp_rx_depacketizer_source_last = 1'd0;
-reg           main_icmp_rx_depacketizer_source_last_a = 1'd0;
-reg           main_icmp_rx_depacketizer_source_last_b = 1'd0;
-reg           main_icmp_rx_depacketizer_source_last_s = 1'd0;
-wire   [15:0] main_icmp_rx_depacketizer_source_param_checksum;
-wire    [7:0] main_icmp_rx_depacketizer_source_param_code;
-wire    [7:0] main_icmp_rx_depacketizer_source_param_msgtype;
-wire   [31:0] main_icmp_rx_depacketizer_source_param_quench;
-reg     [7:0] main_icmp_rx_depacketizer_source_payload_data = 8'd0;
-wire          main_icmp_rx_depacketizer_source_payload_error;
-reg           main_icmp_rx_depacketizer_source_payload_last_be = 1'd0;
-reg           main_icmp_rx_depacketizer_source_ready = 1'd0;
-reg           main_icmp_rx_depacketizer_source_valid = 1'd0;
-reg    [63:0] main_icmp_rx_depacketizer_sr = 64'd0;
-reg           main_icmp_rx_depacketizer_sr_shift = 1'd0;
-reg           main_icmp_rx_depacketizer_sr_shift_leftover = 1'd0;
-reg           main_icmp_rx_depacketizer_was_in_copy = 1'd0;
-wire          main_icmp_rx_sink_sink_first;
-wire          main_icmp_rx_sink_sink_last;
-wire   [31:0] main_icmp_rx_sink_sink_param_ip_address;
-wire   [15:0] main_icmp_rx_sink_sink_param_length;
-wire    [7:0] main_icmp_rx_sink_sink_param_protocol;
-wire    [7:0] main_icmp_rx_sink_sink_payload_data;
-wire          main_icmp_rx_sink_sink_payload_error;
-wire          main_icmp_rx_sink_sink_payload_last_be;
-wire          main_icmp_rx_sink_sink_ready;
-wire          main_icmp_rx_sink_sink_valid;
-reg           main_icmp_rx_source_source_first = 1'd0;
-wire          main_icmp_rx_source_source_last;
-wire   [15:0] main_icmp_rx_source_source_param_checksum;
-wire    [7:0] main_icmp_rx_source_source_param_code;
-wire   [31:0] main_icmp_rx_source_source_param_ip_address;
-wire   [15:0] main_icmp_rx_source_source_param_length;
-wire    [7:0] main_icmp_rx_source_source_param_msgtype;
-wire   [31:0] main_icmp_rx_source_source_param_quench;
-wire    [7:0] main_icmp_rx_source_source_payload_data;
-wire          main_icmp_rx_source_source_payload_error;
-wire          main_icmp_rx_source_source_payload_last_be;
-wire          main_icmp_rx_source_source_ready;
-reg           main_icmp_rx_source_source_valid = 1'd0;
+wire          main_icmp_rx_cut;
+reg           main_icmp_rx_fsm_is_ongoing0 = 1'd0;
+reg           main_icmp_rx_fsm_is_ongoing1 = 1'd0;
+reg     [2:0] main_icmp_rx_liteethicmpdepacketizer_count = 3'd0;
+reg     [2:0] main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 = 3'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_delayed_last_be = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3 = 1'd0;
+wire   [63:0] main_icmp_rx_liteethicmpdepacketizer_header;
+wire          main_icmp_rx_liteethicmpdepacketizer_is_in_copy;
+reg           main_icmp_rx_liteethicmpdepacketizer_is_ongoing0 = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_is_ongoing1 = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_is_ongoing2 = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_is_ongoing3 = 1'd0;
+wire          main_icmp_rx_liteethicmpdepacketizer_new_last_be;
+reg           main_icmp_rx_liteethicmpdepacketizer_sink_d_last = 1'd0;
+wire          main_icmp_rx_liteethicmpdepacketizer_sink_first;
+wire          main_icmp_rx_liteethicmpdepacketizer_sink_last;
+wire          main_icmp_rx_liteethicmpdepacketizer_sink_last_be;
+wire   [31:0] main_icmp_rx_liteethicmpdepacketizer_sink_param_ip_address;
+wire   [15:0] main_icmp_rx_liteethicmpdepacketizer_sink_param_length;
+wire    [7:0] main_icmp_rx_liteethicmpdepacketizer_sink_param_protocol;
+wire    [7:0] main_icmp_rx_liteethicmpdepacketizer_sink_payload_data;
+wire          main_icmp_rx_liteethicmpdepacketizer_sink_payload_error;
+wire          main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be;
+reg           main_icmp_rx_liteethicmpdepacketizer_sink_ready = 1'd0;
+wire          main_icmp_rx_liteethicmpdepacketizer_sink_valid;
+reg           main_icmp_rx_liteethicmpdepacketizer_source_last = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_source_last_a = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_source_last_b = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_source_last_s = 1'd0;
+wire   [15:0] main_icmp_rx_liteethicmpdepacketizer_source_param_checksum;
+wire    [7:0] main_icmp_rx_liteethicmpdepacketizer_source_param_code;
+wire    [7:0] main_icmp_rx_liteethicmpdepacketizer_source_param_msgtype;
+wire   [31:0] main_icmp_rx_liteethicmpdepacketizer_source_param_quench;
+reg     [7:0] main_icmp_rx_liteethicmpdepacketizer_source_payload_data = 8'd0;
+wire          main_icmp_rx_liteethicmpdepacketizer_source_payload_error;
+reg           main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_source_ready = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_source_valid = 1'd0;
+reg    [63:0] main_icmp_rx_liteethicmpdepacketizer_sr = 64'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_sr_shift = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_sr_shift_leftover = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_was_in_copy = 1'd0;
+wire          main_icmp_rx_sink_first;
+wire          main_icmp_rx_sink_last;
+wire   [31:0] main_icmp_rx_sink_param_ip_address;
+wire   [15:0] main_icmp_rx_sink_param_length;
+wire    [7:0] main_icmp_rx_sink_param_protocol;
+wire    [7:0] main_icmp_rx_sink_payload_data;
+wire          main_icmp_rx_sink_payload_error;
+wire          main_icmp_rx_sink_payload_last_be;
+wire          main_icmp_rx_sink_ready;
+wire          main_icmp_rx_sink_valid;
+reg           main_icmp_rx_source_first = 1'd0;
+wire          main_icmp_rx_source_last;
+wire   [15:0] main_icmp_rx_source_param_checksum;
+wire    [7:0] main_icmp_rx_source_param_code;
+wire   [31:0] main_icmp_rx_source_param_ip_address;
+wire   [15:0] main_icmp_rx_source_param_length;
+wire    [7:0] main_icmp_rx_source_param_msgtype;
+wire   [31:0] main_icmp_rx_source_param_quench;
+wire    [7:0] main_icmp_rx_source_payload_data;
+wire          main_icmp_rx_source_payload_error;
+wire          main_icmp_rx_source_payload_last_be;
+wire          main_icmp_rx_source_ready;
+reg           main_icmp_rx_source_valid = 1'd0;
 reg     [2:0] main_icmp_tx_packetizer_count = 3'd0;
 reg     [2:0] main_icmp_tx_packetizer_count_fsm0_next_value0 = 3'd0;
 reg           main_icmp_tx_packetizer_count_fsm0_next_value_ce0 = 1'd0;
@@ -1162,6 +1182,7 @@ reg           main_internal_port_source_payload_error = 1'd0;
 reg           main_internal_port_source_payload_last_be = 1'd0;
 wire          main_internal_port_source_ready;
 reg           main_internal_port_source_valid = 1'd0;
+wire          main_ip_crossbar_dropped;
 wire          main_ip_crossbar_sink_first;
 wire          main_ip_crossbar_sink_last;
 wire   [31:0] main_ip_crossbar_sink_param_ip_address;
@@ -1223,56 +1244,14 @@ reg           main_ip_port_source_payload_last_be = 1'd0;
 wire          main_ip_port_source_ready;
 reg           main_ip_port_source_valid = 1'd0;
 wire          main_ip_rx_ce;
-reg     [4:0] main_ip_rx_depacketizer_count = 5'd0;
-reg     [4:0] main_ip_rx_depacketizer_count_liteethip_fsm0_next_value2 = 5'd0;
-reg           main_ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 = 1'd0;
-reg           main_ip_rx_depacketizer_delayed_last_be = 1'd0;
-reg           main_ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value1 = 1'd0;
-reg           main_ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 = 1'd0;
-reg           main_ip_rx_depacketizer_fsm_from_idle = 1'd0;
-reg           main_ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 = 1'd0;
-reg           main_ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 = 1'd0;
-wire  [159:0] main_ip_rx_depacketizer_header;
-wire          main_ip_rx_depacketizer_is_in_copy;
-reg           main_ip_rx_depacketizer_is_ongoing0 = 1'd0;
-reg           main_ip_rx_depacketizer_is_ongoing1 = 1'd0;
-reg           main_ip_rx_depacketizer_is_ongoing2 = 1'd0;
-reg           main_ip_rx_depacketizer_is_ongoing3 = 1'd0;
-wire          main_ip_rx_depacketizer_new_last_be;
-reg           main_ip_rx_depacketizer_sink_d_last = 1'd0;
-wire          main_ip_rx_depacketizer_sink_first;
-wire          main_ip_rx_depacketizer_sink_last;
-wire          main_ip_rx_depacketizer_sink_last_be;
-wire    [7:0] main_ip_rx_depacketizer_sink_payload_data;
-wire          main_ip_rx_depacketizer_sink_payload_error;
-wire   [15:0] main_ip_rx_depacketizer_sink_payload_ethernet_type;
-wire          main_ip_rx_depacketizer_sink_payload_last_be;
-wire   [47:0] main_ip_rx_depacketizer_sink_payload_sender_mac;
-wire   [47:0] main_ip_rx_depacketizer_sink_payload_target_mac;
-reg           main_ip_rx_depacketizer_sink_ready = 1'd0;
-wire          main_ip_rx_depacketizer_sink_valid;
-reg           main_ip_rx_depacketizer_source_last = 1'd0;
-reg           main_ip_rx_depacketizer_source_last_a = 1'd0;
-reg           main_ip_rx_depacketizer_source_last_b = 1'd0;
-reg           main_ip_rx_depacketizer_source_last_s = 1'd0;
-wire   [15:0] main_ip_rx_depacketizer_source_param_checksum;
-wire   [15:0] main_ip_rx_depacketizer_source_param_identification;
-wire    [3:0] main_ip_rx_depacketizer_source_param_ihl;
-wire    [7:0] main_ip_rx_depacketizer_source_param_protocol;
-wire   [31:0] main_ip_rx_depacketizer_source_param_sender_ip;
-wire   [31:0] main_ip_rx_depacketizer_source_param_target_ip;
-wire   [15:0] main_ip_rx_depacketizer_source_param_total_length;
-wire    [7:0] main_ip_rx_depacketizer_source_param_ttl;
-wire    [3:0] main_ip_rx_depacketizer_source_param_version;
-reg     [7:0] main_ip_rx_depacketizer_source_payload_data = 8'd0;
-wire          main_ip_rx_depacketizer_source_payload_error;
-reg           main_ip_rx_depacketizer_source_payload_last_be = 1'd0;
-reg           main_ip_rx_depacketizer_source_ready = 1'd0;
-reg           main_ip_rx_depacketizer_source_valid = 1'd0;
-reg   [159:0] main_ip_rx_depacketizer_sr = 160'd0;
-reg           main_ip_rx_depacketizer_sr_shift = 1'd0;
-reg           main_ip_rx_depacketizer_sr_shift_leftover = 1'd0;
-reg           main_ip_rx_depacketizer_was_in_copy = 1'd0;
+wire          main_ip_rx_cut;
+wire          main_ip_rx_decide;
+wire          main_ip_rx_drop_header;
+wire          main_ip_rx_drop_other;
+reg           main_ip_rx_fsm_is_ongoing0 = 1'd0;
+reg           main_ip_rx_fsm_is_ongoing1 = 1'd0;
+wire          main_ip_rx_header_ok;
+reg           main_ip_rx_is_ongoing = 1'd0;
 reg           main_ip_rx_liteethipv4checksum0 = 1'd0;
 reg           main_ip_rx_liteethipv4checksum1 = 1'd0;
 reg           main_ip_rx_liteethipv4checksum2 = 1'd0;
@@ -1309,27 +1288,79 @@ wire   [16:0] main_ip_rx_liteethipv4checksum_s_next7;
 wire   [16:0] main_ip_rx_liteethipv4checksum_s_next8;
 wire   [16:0] main_ip_rx_liteethipv4checksum_s_next9;
 wire   [15:0] main_ip_rx_liteethipv4checksum_value;
+reg     [4:0] main_ip_rx_liteethipv4depacketizer_count = 5'd0;
+reg     [4:0] main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 = 5'd0;
+reg           main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_delayed_last_be = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_fsm_from_idle = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 = 1'd0;
+wire  [159:0] main_ip_rx_liteethipv4depacketizer_header;
+wire          main_ip_rx_liteethipv4depacketizer_is_in_copy;
+reg           main_ip_rx_liteethipv4depacketizer_is_ongoing0 = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_is_ongoing1 = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_is_ongoing2 = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_is_ongoing3 = 1'd0;
+wire          main_ip_rx_liteethipv4depacketizer_new_last_be;
+reg           main_ip_rx_liteethipv4depacketizer_sink_d_last = 1'd0;
+wire          main_ip_rx_liteethipv4depacketizer_sink_first;
+wire          main_ip_rx_liteethipv4depacketizer_sink_last;
+wire          main_ip_rx_liteethipv4depacketizer_sink_last_be;
+wire    [7:0] main_ip_rx_liteethipv4depacketizer_sink_payload_data;
+wire          main_ip_rx_liteethipv4depacketizer_sink_payload_error;
+wire   [15:0] main_ip_rx_liteethipv4depacketizer_sink_payload_ethernet_type;
+wire          main_ip_rx_liteethipv4depacketizer_sink_payload_last_be;
+wire   [47:0] main_ip_rx_liteethipv4depacketizer_sink_payload_sender_mac;
+wire   [47:0] main_ip_rx_liteethipv4depacketizer_sink_payload_target_mac;
+reg           main_ip_rx_liteethipv4depacketizer_sink_ready = 1'd0;
+wire          main_ip_rx_liteethipv4depacketizer_sink_valid;
+reg           main_ip_rx_liteethipv4depacketizer_source_last = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_source_last_a = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_source_last_b = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_source_last_s = 1'd0;
+wire   [15:0] main_ip_rx_liteethipv4depacketizer_source_param_checksum;
+wire   [15:0] main_ip_rx_liteethipv4depacketizer_source_param_identification;
+wire    [3:0] main_ip_rx_liteethipv4depacketizer_source_param_ihl;
+wire    [7:0] main_ip_rx_liteethipv4depacketizer_source_param_protocol;
+wire   [31:0] main_ip_rx_liteethipv4depacketizer_source_param_sender_ip;
+wire   [31:0] main_ip_rx_liteethipv4depacketizer_source_param_target_ip;
+wire   [15:0] main_ip_rx_liteethipv4depacketizer_source_param_total_length;
+wire    [7:0] main_ip_rx_liteethipv4depacketizer_source_param_ttl;
+wire    [3:0] main_ip_rx_liteethipv4depacketizer_source_param_version;
+reg     [7:0] main_ip_rx_liteethipv4depacketizer_source_payload_data = 8'd0;
+wire          main_ip_rx_liteethipv4depacketizer_source_payload_error;
+reg           main_ip_rx_liteethipv4depacketizer_source_payload_last_be = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_source_ready = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_source_valid = 1'd0;
+reg   [159:0] main_ip_rx_liteethipv4depacketizer_sr = 160'd0;
+reg           main_ip_rx_liteethipv4depacketizer_sr_shift = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_sr_shift_leftover = 1'd0;
+reg           main_ip_rx_liteethipv4depacketizer_was_in_copy = 1'd0;
+wire   [12:0] main_ip_rx_offset;
+wire          main_ip_rx_ours;
 wire          main_ip_rx_reset;
-wire          main_ip_rx_sink_sink_first;
-wire          main_ip_rx_sink_sink_last;
-wire    [7:0] main_ip_rx_sink_sink_payload_data;
-wire          main_ip_rx_sink_sink_payload_error;
-wire   [15:0] main_ip_rx_sink_sink_payload_ethernet_type;
-wire          main_ip_rx_sink_sink_payload_last_be;
-wire   [47:0] main_ip_rx_sink_sink_payload_sender_mac;
-wire   [47:0] main_ip_rx_sink_sink_payload_target_mac;
-wire          main_ip_rx_sink_sink_ready;
-wire          main_ip_rx_sink_sink_valid;
-reg           main_ip_rx_source_source_first = 1'd0;
-wire          main_ip_rx_source_source_last;
-wire   [31:0] main_ip_rx_source_source_param_ip_address;
-wire   [15:0] main_ip_rx_source_source_param_length;
-wire    [7:0] main_ip_rx_source_source_param_protocol;
-wire    [7:0] main_ip_rx_source_source_payload_data;
-wire          main_ip_rx_source_source_payload_error;
-wire          main_ip_rx_source_source_payload_last_be;
-wire          main_ip_rx_source_source_ready;
-reg           main_ip_rx_source_source_valid = 1'd0;
+wire          main_ip_rx_sink_first;
+wire          main_ip_rx_sink_last;
+wire    [7:0] main_ip_rx_sink_payload_data;
+wire          main_ip_rx_sink_payload_error;
+wire   [15:0] main_ip_rx_sink_payload_ethernet_type;
+wire          main_ip_rx_sink_payload_last_be;
+wire   [47:0] main_ip_rx_sink_payload_sender_mac;
+wire   [47:0] main_ip_rx_sink_payload_target_mac;
+wire          main_ip_rx_sink_ready;
+wire          main_ip_rx_sink_valid;
+reg           main_ip_rx_source_first = 1'd0;
+wire          main_ip_rx_source_last;
+wire   [31:0] main_ip_rx_source_param_ip_address;
+wire   [15:0] main_ip_rx_source_param_length;
+wire    [7:0] main_ip_rx_source_param_protocol;
+wire    [7:0] main_ip_rx_source_payload_data;
+wire          main_ip_rx_source_payload_error;
+wire          main_ip_rx_source_payload_last_be;
+wire          main_ip_rx_source_ready;
+reg           main_ip_rx_source_valid = 1'd0;
 wire          main_ip_tx_ce;
 reg           main_ip_tx_liteethipv4checksum0 = 1'd0;
 reg           main_ip_tx_liteethipv4checksum1 = 1'd0;
@@ -1875,6 +1906,7 @@ reg           main_mac_core_tx_preamble_source_payload_error = 1'd0;
 wire          main_mac_core_tx_preamble_source_payload_last_be;
 wire          main_mac_core_tx_preamble_source_ready;
 reg           main_mac_core_tx_preamble_source_valid = 1'd0;
+wire          main_mac_crossbar_dropped;
 wire          main_mac_crossbar_sink_first;
 wire          main_mac_crossbar_sink_last;
 wire    [7:0] main_mac_crossbar_sink_payload_data;
@@ -1895,48 +1927,51 @@ reg    [47:0] main_mac_crossbar_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_mac_crossbar_source_payload_target_mac = 48'd0;
 wire          main_mac_crossbar_source_ready;
 reg           main_mac_crossbar_source_valid = 1'd0;
-reg     [3:0] main_mac_depacketizer_count = 4'd0;
-reg     [3:0] main_mac_depacketizer_count_liteethmac_fsm0_next_value2 = 4'd0;
-reg           main_mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 = 1'd0;
-reg           main_mac_depacketizer_delayed_last_be = 1'd0;
-reg           main_mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value1 = 1'd0;
-reg           main_mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 = 1'd0;
-reg           main_mac_depacketizer_fsm_from_idle = 1'd0;
-reg           main_mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 = 1'd0;
-reg           main_mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 = 1'd0;
-wire  [111:0] main_mac_depacketizer_header;
-wire          main_mac_depacketizer_is_in_copy;
-reg           main_mac_depacketizer_is_ongoing0 = 1'd0;
-reg           main_mac_depacketizer_is_ongoing1 = 1'd0;
-reg           main_mac_depacketizer_is_ongoing2 = 1'd0;
-reg           main_mac_depacketizer_is_ongoing3 = 1'd0;
-wire          main_mac_depacketizer_new_last_be;
-reg           main_mac_depacketizer_sink_d_last = 1'd0;
-wire          main_mac_depacketizer_sink_first;
-wire          main_mac_depacketizer_sink_last;
-wire          main_mac_depacketizer_sink_last_be;
-wire    [7:0] main_mac_depacketizer_sink_payload_data;
-wire          main_mac_depacketizer_sink_payload_error;
-wire          main_mac_depacketizer_sink_payload_last_be;
-reg           main_mac_depacketizer_sink_ready = 1'd0;
-wire          main_mac_depacketizer_sink_valid;
-reg           main_mac_depacketizer_source_first = 1'd0;
-reg           main_mac_depacketizer_source_last = 1'd0;
-reg           main_mac_depacketizer_source_last_a = 1'd0;
-reg           main_mac_depacketizer_source_last_b = 1'd0;
-reg           main_mac_depacketizer_source_last_s = 1'd0;
-reg     [7:0] main_mac_depacketizer_source_payload_data = 8'd0;
-wire          main_mac_depacketizer_source_payload_error;
-wire   [15:0] main_mac_depacketizer_source_payload_ethernet_type;
-reg           main_mac_depacketizer_source_payload_last_be = 1'd0;
-wire   [47:0] main_mac_depacketizer_source_payload_sender_mac;
-wire   [47:0] main_mac_depacketizer_source_payload_target_mac;
-wire          main_mac_depacketizer_source_ready;
-reg           main_mac_depacketizer_source_valid = 1'd0;
-reg   [111:0] main_mac_depacketizer_sr = 112'd0;
-reg           main_mac_depacketizer_sr_shift = 1'd0;
-reg           main_mac_depacketizer_sr_shift_leftover = 1'd0;
-reg           main_mac_depacketizer_was_in_copy = 1'd0;
+wire          main_mac_cut;
+reg           main_mac_fsm_is_ongoing0 = 1'd0;
+reg           main_mac_fsm_is_ongoing1 = 1'd0;
+reg     [3:0] main_mac_liteethmacdepacketizer_count = 4'd0;
+reg     [3:0] main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 = 4'd0;
+reg           main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 = 1'd0;
+reg           main_mac_liteethmacdepacketizer_delayed_last_be = 1'd0;
+reg           main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 = 1'd0;
+reg           main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 = 1'd0;
+reg           main_mac_liteethmacdepacketizer_fsm_from_idle = 1'd0;
+reg           main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 = 1'd0;
+reg           main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 = 1'd0;
+wire  [111:0] main_mac_liteethmacdepacketizer_header;
+wire          main_mac_liteethmacdepacketizer_is_in_copy;
+reg           main_mac_liteethmacdepacketizer_is_ongoing0 = 1'd0;
+reg           main_mac_liteethmacdepacketizer_is_ongoing1 = 1'd0;
+reg           main_mac_liteethmacdepacketizer_is_ongoing2 = 1'd0;
+reg           main_mac_liteethmacdepacketizer_is_ongoing3 = 1'd0;
+wire          main_mac_liteethmacdepacketizer_new_last_be;
+reg           main_mac_liteethmacdepacketizer_sink_d_last = 1'd0;
+wire          main_mac_liteethmacdepacketizer_sink_first;
+wire          main_mac_liteethmacdepacketizer_sink_last;
+wire          main_mac_liteethmacdepacketizer_sink_last_be;
+wire    [7:0] main_mac_liteethmacdepacketizer_sink_payload_data;
+wire          main_mac_liteethmacdepacketizer_sink_payload_error;
+wire          main_mac_liteethmacdepacketizer_sink_payload_last_be;
+reg           main_mac_liteethmacdepacketizer_sink_ready = 1'd0;
+wire          main_mac_liteethmacdepacketizer_sink_valid;
+reg           main_mac_liteethmacdepacketizer_source_first = 1'd0;
+reg           main_mac_liteethmacdepacketizer_source_last = 1'd0;
+reg           main_mac_liteethmacdepacketizer_source_last_a = 1'd0;
+reg           main_mac_liteethmacdepacketizer_source_last_b = 1'd0;
+reg           main_mac_liteethmacdepacketizer_source_last_s = 1'd0;
+reg     [7:0] main_mac_liteethmacdepacketizer_source_payload_data = 8'd0;
+wire          main_mac_liteethmacdepacketizer_source_payload_error;
+wire   [15:0] main_mac_liteethmacdepacketizer_source_payload_ethernet_type;
+reg           main_mac_liteethmacdepacketizer_source_payload_last_be = 1'd0;
+wire   [47:0] main_mac_liteethmacdepacketizer_source_payload_sender_mac;
+wire   [47:0] main_mac_liteethmacdepacketizer_source_payload_target_mac;
+wire          main_mac_liteethmacdepacketizer_source_ready;
+reg           main_mac_liteethmacdepacketizer_source_valid = 1'd0;
+reg   [111:0] main_mac_liteethmacdepacketizer_sr = 112'd0;
+reg           main_mac_liteethmacdepacketizer_sr_shift = 1'd0;
+reg           main_mac_liteethmacdepacketizer_sr_shift_leftover = 1'd0;
+reg           main_mac_liteethmacdepacketizer_was_in_copy = 1'd0;
 reg     [3:0] main_mac_packetizer_count = 4'd0;
 reg     [3:0] main_mac_packetizer_count_liteethmac_fsm0_next_value0 = 4'd0;
 reg           main_mac_packetizer_count_liteethmac_fsm0_next_value_ce0 = 1'd0;
@@ -2212,7 +2247,9 @@ wire          sys_rst;
 //------------------------------------------------------------------------------
 
 assign main_source_payload_last_be = main_source_last;
-assign main_take_group = (main_ip_rx_depacketizer_source_param_target_ip == ip_multicast);
+assign main_take_group = (main_ip_rx_liteethipv4depacketizer_source_param_target_ip == ip_multicast);
+assign rx_drop_header = ((((main_mac_cut | main_ip_rx_cut) | main_ip_rx_drop_header) | main_holdingudprx_cut0) | main_holdingudprx_drop_header);
+assign rx_drop_other = (((main_mac_crossbar_dropped | main_ip_rx_drop_other) | main_ip_crossbar_dropped) | main_crossbar_dropped);
 assign main_user_port_sink_valid = udp_sink_valid;
 assign main_user_port_sink_last = udp_sink_last;
 assign main_user_port_sink_param_dst_port = udp_sink_dst_port;
@@ -2256,23 +2293,23 @@ assign main_mac_core_sink_last = main_mac_packetizer_source_last;
 assign main_mac_core_sink_payload_data = main_mac_packetizer_source_payload_data;
 assign main_mac_core_sink_payload_last_be = main_mac_packetizer_source_payload_last_be;
 assign main_mac_core_sink_payload_error = main_mac_packetizer_source_payload_error;
-assign main_mac_depacketizer_sink_valid = main_mac_core_source_valid;
-assign main_mac_core_source_ready = main_mac_depacketizer_sink_ready;
-assign main_mac_depacketizer_sink_first = main_mac_core_source_first;
-assign main_mac_depacketizer_sink_last = main_mac_core_source_last;
-assign main_mac_depacketizer_sink_payload_data = main_mac_core_source_payload_data;
-assign main_mac_depacketizer_sink_payload_last_be = main_mac_core_source_payload_last_be;
-assign main_mac_depacketizer_sink_payload_error = main_mac_core_source_payload_error;
-assign main_mac_crossbar_sink_valid = main_mac_depacketizer_source_valid;
-assign main_mac_depacketizer_source_ready = main_mac_crossbar_sink_ready;
-assign main_mac_crossbar_sink_first = main_mac_depacketizer_source_first;
-assign main_mac_crossbar_sink_last = main_mac_depacketizer_source_last;
-assign main_mac_crossbar_sink_payload_ethernet_type = main_mac_depacketizer_source_payload_ethernet_type;
-assign main_mac_crossbar_sink_payload_sender_mac = main_mac_depacketizer_source_payload_sender_mac;
-assign main_mac_crossbar_sink_payload_target_mac = main_mac_depacketizer_source_payload_target_mac;
-assign main_mac_crossbar_sink_payload_data = main_mac_depacketizer_source_payload_data;
-assign main_mac_crossbar_sink_payload_last_be = main_mac_depacketizer_source_payload_last_be;
-assign main_mac_crossbar_sink_payload_error = main_mac_depacketizer_source_payload_error;
+assign main_mac_liteethmacdepacketizer_sink_valid = main_mac_core_source_valid;
+assign main_mac_core_source_ready = main_mac_liteethmacdepacketizer_sink_ready;
+assign main_mac_liteethmacdepacketizer_sink_first = main_mac_core_source_first;
+assign main_mac_liteethmacdepacketizer_sink_last = main_mac_core_source_last;
+assign main_mac_liteethmacdepacketizer_sink_payload_data = main_mac_core_source_payload_data;
+assign main_mac_liteethmacdepacketizer_sink_payload_last_be = main_mac_core_source_payload_last_be;
+assign main_mac_liteethmacdepacketizer_sink_payload_error = main_mac_core_source_payload_error;
+assign main_mac_crossbar_sink_valid = main_mac_liteethmacdepacketizer_source_valid;
+assign main_mac_liteethmacdepacketizer_source_ready = main_mac_crossbar_sink_ready;
+assign main_mac_crossbar_sink_first = main_mac_liteethmacdepacketizer_source_first;
+assign main_mac_crossbar_sink_last = main_mac_liteethmacdepacketizer_source_last;
+assign main_mac_crossbar_sink_payload_ethernet_type = main_mac_liteethmacdepacketizer_source_payload_ethernet_type;
+assign main_mac_crossbar_sink_payload_sender_mac = main_mac_liteethmacdepacketizer_source_payload_sender_mac;
+assign main_mac_crossbar_sink_payload_target_mac = main_mac_liteethmacdepacketizer_source_payload_target_mac;
+assign main_mac_crossbar_sink_payload_data = main_mac_liteethmacdepacketizer_source_payload_data;
+assign main_mac_crossbar_sink_payload_last_be = main_mac_liteethmacdepacketizer_source_payload_last_be;
+assign main_mac_crossbar_sink_payload_error = main_mac_liteethmacdepacketizer_source_payload_error;
 assign main_mac_core_tx_cdc_cdc_sink_valid = main_mac_core_tx_cdc_sink_sink_valid;
 assign main_mac_core_tx_cdc_sink_sink_ready = main_mac_core_tx_cdc_cdc_sink_ready;
 assign main_mac_core_tx_cdc_cdc_sink_first = main_mac_core_tx_cdc_sink_sink_first;
@@ -3028,6 +3065,8 @@ assign main_mac_core_source_last = main_mac_core_source_source_last;
 assign main_mac_core_source_payload_data = main_mac_core_source_source_payload_data;
 assign main_mac_core_source_payload_last_be = main_mac_core_source_source_payload_last_be;
 assign main_mac_core_source_payload_error = main_mac_core_source_source_payload_error;
+assign builder_liteethmac_taken = (((1'd0 + main_arp_mac_port_source_valid) + main_ip_mac_port_source_valid) != 1'd0);
+assign main_mac_crossbar_dropped = (((main_mac_crossbar_sink_valid & main_mac_crossbar_sink_ready) & main_mac_crossbar_sink_last) & (~builder_liteethmac_taken));
 always @(*) begin
     builder_liteethmac_sel0 <= 2'd0;
     if ((main_mac_crossbar_sink_payload_ethernet_type == 12'd2054)) begin
@@ -3282,302 +3321,313 @@ always @(*) begin
         end
     endcase
 end
-assign main_mac_depacketizer_header = main_mac_depacketizer_sr;
-assign main_mac_depacketizer_source_payload_ethernet_type = {builder_rhs_slice_proxy1[7:0], builder_rhs_slice_proxy0[15:8]};
-assign main_mac_depacketizer_source_payload_sender_mac = {builder_rhs_slice_proxy7[7:0], builder_rhs_slice_proxy6[15:8], builder_rhs_slice_proxy5[23:16], builder_rhs_slice_proxy4[31:24], builder_rhs_slice_proxy3[39:32], builder_rhs_slice_proxy2[47:40]};
-assign main_mac_depacketizer_source_payload_target_mac = {builder_rhs_slice_proxy13[7:0], builder_rhs_slice_proxy12[15:8], builder_rhs_slice_proxy11[23:16], builder_rhs_slice_proxy10[31:24], builder_rhs_slice_proxy9[39:32], builder_rhs_slice_proxy8[47:40]};
-assign main_mac_depacketizer_source_payload_error = main_mac_depacketizer_sink_payload_error;
-assign main_mac_depacketizer_sink_last_be = main_mac_depacketizer_sink_last;
-assign main_mac_depacketizer_new_last_be = {main_mac_depacketizer_sink_last_be};
-assign main_mac_depacketizer_is_in_copy = (main_mac_depacketizer_is_ongoing0 | main_mac_depacketizer_is_ongoing1);
+assign main_mac_liteethmacdepacketizer_header = main_mac_liteethmacdepacketizer_sr;
+assign main_mac_liteethmacdepacketizer_source_payload_ethernet_type = {builder_rhs_slice_proxy1[7:0], builder_rhs_slice_proxy0[15:8]};
+assign main_mac_liteethmacdepacketizer_source_payload_sender_mac = {builder_rhs_slice_proxy7[7:0], builder_rhs_slice_proxy6[15:8], builder_rhs_slice_proxy5[23:16], builder_rhs_slice_proxy4[31:24], builder_rhs_slice_proxy3[39:32], builder_rhs_slice_proxy2[47:40]};
+assign main_mac_liteethmacdepacketizer_source_payload_target_mac = {builder_rhs_slice_proxy13[7:0], builder_rhs_slice_proxy12[15:8], builder_rhs_slice_proxy11[23:16], builder_rhs_slice_proxy10[31:24], builder_rhs_slice_proxy9[39:32], builder_rhs_slice_proxy8[47:40]};
+assign main_mac_liteethmacdepacketizer_source_payload_error = main_mac_liteethmacdepacketizer_sink_payload_error;
+assign main_mac_liteethmacdepacketizer_sink_last_be = main_mac_liteethmacdepacketizer_sink_last;
+assign main_mac_liteethmacdepacketizer_new_last_be = {main_mac_liteethmacdepacketizer_sink_last_be};
+assign main_mac_liteethmacdepacketizer_is_in_copy = (main_mac_liteethmacdepacketizer_is_ongoing0 | main_mac_liteethmacdepacketizer_is_ongoing1);
 always @(*) begin
-    main_mac_depacketizer_source_last <= 1'd0;
-    if (main_mac_depacketizer_source_last_s) begin
-        main_mac_depacketizer_source_last <= main_mac_depacketizer_source_last_b;
+    main_mac_liteethmacdepacketizer_source_last <= 1'd0;
+    if (main_mac_liteethmacdepacketizer_source_last_s) begin
+        main_mac_liteethmacdepacketizer_source_last <= main_mac_liteethmacdepacketizer_source_last_b;
     end else begin
-        main_mac_depacketizer_source_last <= main_mac_depacketizer_source_last_a;
+        main_mac_liteethmacdepacketizer_source_last <= main_mac_liteethmacdepacketizer_source_last_a;
     end
 end
+assign main_mac_cut = ((main_mac_liteethmacdepacketizer_sink_valid & main_mac_liteethmacdepacketizer_sink_last) & (main_mac_fsm_is_ongoing0 | main_mac_fsm_is_ongoing1));
 always @(*) begin
     builder_liteethmac_fsm0_next_state1 <= 2'd0;
     builder_liteethmac_fsm1_next_state1 <= 1'd0;
-    main_mac_depacketizer_count_liteethmac_fsm0_next_value2 <= 4'd0;
-    main_mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd0;
-    main_mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= 1'd0;
-    main_mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd0;
-    main_mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd0;
-    main_mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd0;
-    main_mac_depacketizer_is_ongoing0 <= 1'd0;
-    main_mac_depacketizer_is_ongoing1 <= 1'd0;
-    main_mac_depacketizer_is_ongoing2 <= 1'd0;
-    main_mac_depacketizer_is_ongoing3 <= 1'd0;
-    main_mac_depacketizer_sink_ready <= 1'd0;
-    main_mac_depacketizer_source_last_a <= 1'd0;
-    main_mac_depacketizer_source_last_b <= 1'd0;
-    main_mac_depacketizer_source_last_s <= 1'd0;
-    main_mac_depacketizer_source_payload_data <= 8'd0;
-    main_mac_depacketizer_source_payload_last_be <= 1'd0;
-    main_mac_depacketizer_source_valid <= 1'd0;
-    main_mac_depacketizer_sr_shift <= 1'd0;
+    main_mac_fsm_is_ongoing0 <= 1'd0;
+    main_mac_fsm_is_ongoing1 <= 1'd0;
+    main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= 4'd0;
+    main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd0;
+    main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= 1'd0;
+    main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd0;
+    main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd0;
+    main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd0;
+    main_mac_liteethmacdepacketizer_is_ongoing0 <= 1'd0;
+    main_mac_liteethmacdepacketizer_is_ongoing1 <= 1'd0;
+    main_mac_liteethmacdepacketizer_is_ongoing2 <= 1'd0;
+    main_mac_liteethmacdepacketizer_is_ongoing3 <= 1'd0;
+    main_mac_liteethmacdepacketizer_sink_ready <= 1'd0;
+    main_mac_liteethmacdepacketizer_source_last_a <= 1'd0;
+    main_mac_liteethmacdepacketizer_source_last_b <= 1'd0;
+    main_mac_liteethmacdepacketizer_source_last_s <= 1'd0;
+    main_mac_liteethmacdepacketizer_source_payload_data <= 8'd0;
+    main_mac_liteethmacdepacketizer_source_payload_last_be <= 1'd0;
+    main_mac_liteethmacdepacketizer_source_valid <= 1'd0;
+    main_mac_liteethmacdepacketizer_sr_shift <= 1'd0;
     builder_liteethmac_fsm0_next_state1 <= builder_liteethmac_fsm0_state1;
     case (builder_liteethmac_fsm0_state1)
         1'd1: begin
-            main_mac_depacketizer_sink_ready <= 1'd1;
-            if (main_mac_depacketizer_sink_valid) begin
-                main_mac_depacketizer_count_liteethmac_fsm0_next_value2 <= (main_mac_depacketizer_count + 1'd1);
-                main_mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
-                main_mac_depacketizer_sr_shift <= 1'd1;
-                if ((main_mac_depacketizer_count == 4'd13)) begin
+            main_mac_liteethmacdepacketizer_sink_ready <= 1'd1;
+            if (main_mac_liteethmacdepacketizer_sink_valid) begin
+                main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= (main_mac_liteethmacdepacketizer_count + 1'd1);
+                main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
+                main_mac_liteethmacdepacketizer_sr_shift <= 1'd1;
+                if ((main_mac_liteethmacdepacketizer_count == 4'd13)) begin
                     builder_liteethmac_fsm0_next_state1 <= 2'd2;
-                    main_mac_depacketizer_count_liteethmac_fsm0_next_value2 <= (main_mac_depacketizer_count + 1'd1);
-                    main_mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
+                    main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= (main_mac_liteethmacdepacketizer_count + 1'd1);
+                    main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            main_mac_fsm_is_ongoing1 <= 1'd1;
+            if ((main_mac_liteethmacdepacketizer_sink_valid & main_mac_liteethmacdepacketizer_sink_last)) begin
+                builder_liteethmac_fsm0_next_state1 <= 1'd0;
             end
         end
         2'd2: begin
-            main_mac_depacketizer_source_valid <= (main_mac_depacketizer_sink_valid | main_mac_depacketizer_sink_d_last);
-            main_mac_depacketizer_source_last_a <= (main_mac_depacketizer_sink_last | main_mac_depacketizer_sink_d_last);
-            main_mac_depacketizer_sink_ready <= main_mac_depacketizer_source_ready;
-            main_mac_depacketizer_source_payload_data <= main_mac_depacketizer_sink_payload_data;
-            if ((main_mac_depacketizer_source_valid & main_mac_depacketizer_source_ready)) begin
-                if (main_mac_depacketizer_source_last) begin
+            main_mac_liteethmacdepacketizer_source_valid <= (main_mac_liteethmacdepacketizer_sink_valid | main_mac_liteethmacdepacketizer_sink_d_last);
+            main_mac_liteethmacdepacketizer_source_last_a <= (main_mac_liteethmacdepacketizer_sink_last | main_mac_liteethmacdepacketizer_sink_d_last);
+            main_mac_liteethmacdepacketizer_sink_ready <= main_mac_liteethmacdepacketizer_source_ready;
+            main_mac_liteethmacdepacketizer_source_payload_data <= main_mac_liteethmacdepacketizer_sink_payload_data;
+            if ((main_mac_liteethmacdepacketizer_source_valid & main_mac_liteethmacdepacketizer_source_ready)) begin
+                if (main_mac_liteethmacdepacketizer_source_last) begin
                     builder_liteethmac_fsm0_next_state1 <= 1'd0;
                 end
             end
-            main_mac_depacketizer_is_ongoing0 <= 1'd1;
-            main_mac_depacketizer_is_ongoing2 <= 1'd1;
+            main_mac_liteethmacdepacketizer_is_ongoing0 <= 1'd1;
+            main_mac_liteethmacdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            main_mac_depacketizer_is_ongoing1 <= 1'd1;
-            main_mac_depacketizer_is_ongoing3 <= 1'd1;
+            main_mac_liteethmacdepacketizer_is_ongoing1 <= 1'd1;
+            main_mac_liteethmacdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            main_mac_depacketizer_sink_ready <= 1'd1;
-            main_mac_depacketizer_count_liteethmac_fsm0_next_value2 <= 1'd1;
-            main_mac_depacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
-            if (main_mac_depacketizer_sink_valid) begin
-                main_mac_depacketizer_sr_shift <= 1'd1;
-                main_mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd1;
-                main_mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd1;
+            main_mac_liteethmacdepacketizer_sink_ready <= 1'd1;
+            main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= 1'd1;
+            main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
+            if (main_mac_liteethmacdepacketizer_sink_valid) begin
+                main_mac_liteethmacdepacketizer_sr_shift <= 1'd1;
+                main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd1;
+                main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
                     builder_liteethmac_fsm0_next_state1 <= 2'd2;
                 end else begin
                     builder_liteethmac_fsm0_next_state1 <= 1'd1;
                 end
             end
+            main_mac_fsm_is_ongoing0 <= 1'd1;
+            if ((main_mac_liteethmacdepacketizer_sink_valid & main_mac_liteethmacdepacketizer_sink_last)) begin
+                builder_liteethmac_fsm0_next_state1 <= 1'd0;
+            end
         end
     endcase
     builder_liteethmac_fsm1_next_state1 <= builder_liteethmac_fsm1_state1;
     case (builder_liteethmac_fsm1_state1)
         1'd1: begin
-            main_mac_depacketizer_source_last_b <= 1'd1;
-            main_mac_depacketizer_source_last_s <= 1'd1;
-            main_mac_depacketizer_source_payload_last_be <= main_mac_depacketizer_delayed_last_be;
-            main_mac_depacketizer_sink_ready <= 1'd0;
-            if ((main_mac_depacketizer_source_ready & main_mac_depacketizer_source_valid)) begin
+            main_mac_liteethmacdepacketizer_source_last_b <= 1'd1;
+            main_mac_liteethmacdepacketizer_source_last_s <= 1'd1;
+            main_mac_liteethmacdepacketizer_source_payload_last_be <= main_mac_liteethmacdepacketizer_delayed_last_be;
+            main_mac_liteethmacdepacketizer_sink_ready <= 1'd0;
+            if ((main_mac_liteethmacdepacketizer_source_ready & main_mac_liteethmacdepacketizer_source_valid)) begin
                 builder_liteethmac_fsm1_next_state1 <= 1'd0;
             end
         end
         default: begin
-            if (((main_mac_depacketizer_sink_valid & main_mac_depacketizer_sink_last) & (main_mac_depacketizer_sink_last_be > main_mac_depacketizer_new_last_be))) begin
-                main_mac_depacketizer_source_last_b <= 1'd0;
-                main_mac_depacketizer_source_last_s <= 1'd1;
-                main_mac_depacketizer_source_payload_last_be <= 1'd0;
-                if (((main_mac_depacketizer_source_ready & main_mac_depacketizer_source_valid) | ((~main_mac_depacketizer_was_in_copy) & main_mac_depacketizer_is_in_copy))) begin
-                    main_mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= main_mac_depacketizer_new_last_be;
-                    main_mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd1;
+            if (((main_mac_liteethmacdepacketizer_sink_valid & main_mac_liteethmacdepacketizer_sink_last) & (main_mac_liteethmacdepacketizer_sink_last_be > main_mac_liteethmacdepacketizer_new_last_be))) begin
+                main_mac_liteethmacdepacketizer_source_last_b <= 1'd0;
+                main_mac_liteethmacdepacketizer_source_last_s <= 1'd1;
+                main_mac_liteethmacdepacketizer_source_payload_last_be <= 1'd0;
+                if (((main_mac_liteethmacdepacketizer_source_ready & main_mac_liteethmacdepacketizer_source_valid) | ((~main_mac_liteethmacdepacketizer_was_in_copy) & main_mac_liteethmacdepacketizer_is_in_copy))) begin
+                    main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= main_mac_liteethmacdepacketizer_new_last_be;
+                    main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd1;
                     builder_liteethmac_fsm1_next_state1 <= 1'd1;
                 end
             end else begin
-                if (main_mac_depacketizer_sink_last) begin
-                    main_mac_depacketizer_source_last_b <= 1'd1;
-                    main_mac_depacketizer_source_last_s <= 1'd1;
-                    main_mac_depacketizer_source_payload_last_be <= main_mac_depacketizer_new_last_be;
+                if (main_mac_liteethmacdepacketizer_sink_last) begin
+                    main_mac_liteethmacdepacketizer_source_last_b <= 1'd1;
+                    main_mac_liteethmacdepacketizer_source_last_s <= 1'd1;
+                    main_mac_liteethmacdepacketizer_source_payload_last_be <= main_mac_liteethmacdepacketizer_new_last_be;
                 end
             end
-            if ((main_mac_depacketizer_is_ongoing2 | (main_mac_depacketizer_is_ongoing3 & (~main_mac_depacketizer_fsm_from_idle)))) begin
-                main_mac_depacketizer_sink_ready <= main_mac_depacketizer_source_ready;
+            if ((main_mac_liteethmacdepacketizer_is_ongoing2 | (main_mac_liteethmacdepacketizer_is_ongoing3 & (~main_mac_liteethmacdepacketizer_fsm_from_idle)))) begin
+                main_mac_liteethmacdepacketizer_sink_ready <= main_mac_liteethmacdepacketizer_source_ready;
             end else begin
-                main_mac_depacketizer_sink_ready <= 1'd1;
+                main_mac_liteethmacdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
-assign main_arp_table_sink_valid = main_arp_rx_source_source_valid;
-assign main_arp_rx_source_source_ready = main_arp_table_sink_ready;
-assign main_arp_table_sink_first = main_arp_rx_source_source_first;
-assign main_arp_table_sink_last = main_arp_rx_source_source_last;
-assign main_arp_table_sink_payload_reply = main_arp_rx_source_source_payload_reply;
-assign main_arp_table_sink_payload_request = main_arp_rx_source_source_payload_request;
-assign main_arp_table_sink_payload_ip_address = main_arp_rx_source_source_payload_ip_address;
-assign main_arp_table_sink_payload_mac_address = main_arp_rx_source_source_payload_mac_address;
-assign main_arp_tx_sink_sink_valid = main_arp_table_source_valid;
-assign main_arp_table_source_ready = main_arp_tx_sink_sink_ready;
-assign main_arp_tx_sink_sink_first = main_arp_table_source_first;
-assign main_arp_tx_sink_sink_last = main_arp_table_source_last;
-assign main_arp_tx_sink_sink_payload_reply = main_arp_table_source_payload_reply;
-assign main_arp_tx_sink_sink_payload_request = main_arp_table_source_payload_request;
-assign main_arp_tx_sink_sink_payload_ip_address = main_arp_table_source_payload_ip_address;
-assign main_arp_tx_sink_sink_payload_mac_address = main_arp_table_source_payload_mac_address;
-assign main_arp_mac_port_sink_valid = main_arp_tx_source_source_valid;
-assign main_arp_tx_source_source_ready = main_arp_mac_port_sink_ready;
-assign main_arp_mac_port_sink_first = main_arp_tx_source_source_first;
-assign main_arp_mac_port_sink_last = main_arp_tx_source_source_last;
-assign main_arp_mac_port_sink_payload_ethernet_type = main_arp_tx_source_source_payload_ethernet_type;
-assign main_arp_mac_port_sink_payload_sender_mac = main_arp_tx_source_source_payload_sender_mac;
-assign main_arp_mac_port_sink_payload_target_mac = main_arp_tx_source_source_payload_target_mac;
-assign main_arp_mac_port_sink_payload_data = main_arp_tx_source_source_payload_data;
-assign main_arp_mac_port_sink_payload_last_be = main_arp_tx_source_source_payload_last_be;
-assign main_arp_mac_port_sink_payload_error = main_arp_tx_source_source_payload_error;
-assign main_arp_rx_sink_sink_valid = main_arp_mac_port_source_valid;
-assign main_arp_mac_port_source_ready = main_arp_rx_sink_sink_ready;
-assign main_arp_rx_sink_sink_first = main_arp_mac_port_source_first;
-assign main_arp_rx_sink_sink_last = main_arp_mac_port_source_last;
-assign main_arp_rx_sink_sink_payload_ethernet_type = main_arp_mac_port_source_payload_ethernet_type;
-assign main_arp_rx_sink_sink_payload_sender_mac = main_arp_mac_port_source_payload_sender_mac;
-assign main_arp_rx_sink_sink_payload_target_mac = main_arp_mac_port_source_payload_target_mac;
-assign main_arp_rx_sink_sink_payload_data = main_arp_mac_port_source_payload_data;
-assign main_arp_rx_sink_sink_payload_last_be = main_arp_mac_port_source_payload_last_be;
-assign main_arp_rx_sink_sink_payload_error = main_arp_mac_port_source_payload_error;
-assign main_arp_tx_packetizer_sink_last = (main_arp_tx_counter == 6'd45);
+assign main_arp_table_sink_valid = main_arp_rx_source_valid;
+assign main_arp_rx_source_ready = main_arp_table_sink_ready;
+assign main_arp_table_sink_first = main_arp_rx_source_first;
+assign main_arp_table_sink_last = main_arp_rx_source_last;
+assign main_arp_table_sink_payload_reply = main_arp_rx_source_payload_reply;
+assign main_arp_table_sink_payload_request = main_arp_rx_source_payload_request;
+assign main_arp_table_sink_payload_ip_address = main_arp_rx_source_payload_ip_address;
+assign main_arp_table_sink_payload_mac_address = main_arp_rx_source_payload_mac_address;
+assign main_arp_sink_sink_valid = main_arp_table_source_valid;
+assign main_arp_table_source_ready = main_arp_sink_sink_ready;
+assign main_arp_sink_sink_first = main_arp_table_source_first;
+assign main_arp_sink_sink_last = main_arp_table_source_last;
+assign main_arp_sink_sink_payload_reply = main_arp_table_source_payload_reply;
+assign main_arp_sink_sink_payload_request = main_arp_table_source_payload_request;
+assign main_arp_sink_sink_payload_ip_address = main_arp_table_source_payload_ip_address;
+assign main_arp_sink_sink_payload_mac_address = main_arp_table_source_payload_mac_address;
+assign main_arp_mac_port_sink_valid = main_arp_source_source_valid;
+assign main_arp_source_source_ready = main_arp_mac_port_sink_ready;
+assign main_arp_mac_port_sink_first = main_arp_source_source_first;
+assign main_arp_mac_port_sink_last = main_arp_source_source_last;
+assign main_arp_mac_port_sink_payload_ethernet_type = main_arp_source_source_payload_ethernet_type;
+assign main_arp_mac_port_sink_payload_sender_mac = main_arp_source_source_payload_sender_mac;
+assign main_arp_mac_port_sink_payload_target_mac = main_arp_source_source_payload_target_mac;
+assign main_arp_mac_port_sink_payload_data = main_arp_source_source_payload_data;
+assign main_arp_mac_port_sink_payload_last_be = main_arp_source_source_payload_last_be;
+assign main_arp_mac_port_sink_payload_error = main_arp_source_source_payload_error;
+assign main_arp_rx_sink_valid = main_arp_mac_port_source_valid;
+assign main_arp_mac_port_source_ready = main_arp_rx_sink_ready;
+assign main_arp_rx_sink_first = main_arp_mac_port_source_first;
+assign main_arp_rx_sink_last = main_arp_mac_port_source_last;
+assign main_arp_rx_sink_payload_ethernet_type = main_arp_mac_port_source_payload_ethernet_type;
+assign main_arp_rx_sink_payload_sender_mac = main_arp_mac_port_source_payload_sender_mac;
+assign main_arp_rx_sink_payload_target_mac = main_arp_mac_port_source_payload_target_mac;
+assign main_arp_rx_sink_payload_data = main_arp_mac_port_source_payload_data;
+assign main_arp_rx_sink_payload_last_be = main_arp_mac_port_source_payload_last_be;
+assign main_arp_rx_sink_payload_error = main_arp_mac_port_source_payload_error;
+assign main_arp_packetizer_sink_last = (main_arp_counter == 6'd45);
 always @(*) begin
-    main_arp_tx_packetizer_sink_payload_last_be <= 1'd0;
-    if (main_arp_tx_packetizer_sink_last) begin
-        main_arp_tx_packetizer_sink_payload_last_be <= 1'd1;
+    main_arp_packetizer_sink_payload_last_be <= 1'd0;
+    if (main_arp_packetizer_sink_last) begin
+        main_arp_packetizer_sink_payload_last_be <= 1'd1;
     end
 end
-assign main_arp_tx_packetizer_sink_param_hwtype = 1'd1;
-assign main_arp_tx_packetizer_sink_param_proto = 12'd2048;
-assign main_arp_tx_packetizer_sink_param_hwsize = 3'd6;
-assign main_arp_tx_packetizer_sink_param_protosize = 3'd4;
-assign main_arp_tx_packetizer_sink_param_sender_mac = mac_address;
-assign main_arp_tx_packetizer_sink_param_sender_ip = ip_address;
-assign main_arp_tx_packetizer_sink_param_target_ip = main_arp_tx_sink_sink_payload_ip_address;
+assign main_arp_packetizer_sink_param_hwtype = 1'd1;
+assign main_arp_packetizer_sink_param_proto = 12'd2048;
+assign main_arp_packetizer_sink_param_hwsize = 3'd6;
+assign main_arp_packetizer_sink_param_protosize = 3'd4;
+assign main_arp_packetizer_sink_param_sender_mac = mac_address;
+assign main_arp_packetizer_sink_param_sender_ip = ip_address;
+assign main_arp_packetizer_sink_param_target_ip = main_arp_sink_sink_payload_ip_address;
 always @(*) begin
-    main_arp_tx_packetizer_sink_param_opcode <= 16'd0;
-    main_arp_tx_packetizer_sink_param_target_mac <= 48'd0;
-    if (main_arp_tx_sink_sink_payload_reply) begin
-        main_arp_tx_packetizer_sink_param_opcode <= 2'd2;
-        main_arp_tx_packetizer_sink_param_target_mac <= main_arp_tx_sink_sink_payload_mac_address;
+    main_arp_packetizer_sink_param_opcode <= 16'd0;
+    main_arp_packetizer_sink_param_target_mac <= 48'd0;
+    if (main_arp_sink_sink_payload_reply) begin
+        main_arp_packetizer_sink_param_opcode <= 2'd2;
+        main_arp_packetizer_sink_param_target_mac <= main_arp_sink_sink_payload_mac_address;
     end else begin
-        if (main_arp_tx_sink_sink_payload_request) begin
-            main_arp_tx_packetizer_sink_param_opcode <= 1'd1;
-            main_arp_tx_packetizer_sink_param_target_mac <= 48'd281474976710655;
+        if (main_arp_sink_sink_payload_request) begin
+            main_arp_packetizer_sink_param_opcode <= 1'd1;
+            main_arp_packetizer_sink_param_target_mac <= 48'd281474976710655;
         end
     end
 end
-assign main_arp_tx_source_source_first = main_arp_tx_packetizer_source_first;
-assign main_arp_tx_source_source_last = main_arp_tx_packetizer_source_last;
-assign main_arp_tx_source_source_payload_data = main_arp_tx_packetizer_source_payload_data;
-assign main_arp_tx_source_source_payload_last_be = main_arp_tx_packetizer_source_payload_last_be;
-assign main_arp_tx_source_source_payload_error = main_arp_tx_packetizer_source_payload_error;
+assign main_arp_source_source_first = main_arp_packetizer_source_first;
+assign main_arp_source_source_last = main_arp_packetizer_source_last;
+assign main_arp_source_source_payload_data = main_arp_packetizer_source_payload_data;
+assign main_arp_source_source_payload_last_be = main_arp_packetizer_source_payload_last_be;
+assign main_arp_source_source_payload_error = main_arp_packetizer_source_payload_error;
 always @(*) begin
-    main_arp_tx_source_source_payload_target_mac <= 48'd0;
-    main_arp_tx_source_source_payload_target_mac <= main_arp_tx_packetizer_source_payload_target_mac;
-    main_arp_tx_source_source_payload_target_mac <= main_arp_tx_packetizer_sink_param_target_mac;
+    main_arp_source_source_payload_target_mac <= 48'd0;
+    main_arp_source_source_payload_target_mac <= main_arp_packetizer_source_payload_target_mac;
+    main_arp_source_source_payload_target_mac <= main_arp_packetizer_sink_param_target_mac;
 end
 always @(*) begin
-    main_arp_tx_source_source_payload_sender_mac <= 48'd0;
-    main_arp_tx_source_source_payload_sender_mac <= main_arp_tx_packetizer_source_payload_sender_mac;
-    main_arp_tx_source_source_payload_sender_mac <= mac_address;
+    main_arp_source_source_payload_sender_mac <= 48'd0;
+    main_arp_source_source_payload_sender_mac <= main_arp_packetizer_source_payload_sender_mac;
+    main_arp_source_source_payload_sender_mac <= mac_address;
 end
 always @(*) begin
-    main_arp_tx_source_source_payload_ethernet_type <= 16'd0;
-    main_arp_tx_source_source_payload_ethernet_type <= main_arp_tx_packetizer_source_payload_ethernet_type;
-    main_arp_tx_source_source_payload_ethernet_type <= 12'd2054;
+    main_arp_source_source_payload_ethernet_type <= 16'd0;
+    main_arp_source_source_payload_ethernet_type <= main_arp_packetizer_source_payload_ethernet_type;
+    main_arp_source_source_payload_ethernet_type <= 12'd2054;
 end
 always @(*) begin
-    main_arp_tx_packetizer_header <= 224'd0;
-    main_arp_tx_packetizer_header[39:32] <= {main_arp_tx_packetizer_sink_param_hwsize[7:0]};
-    main_arp_tx_packetizer_header[15:0] <= {main_arp_tx_packetizer_sink_param_hwtype[7:0], main_arp_tx_packetizer_sink_param_hwtype[15:8]};
-    main_arp_tx_packetizer_header[63:48] <= {main_arp_tx_packetizer_sink_param_opcode[7:0], main_arp_tx_packetizer_sink_param_opcode[15:8]};
-    main_arp_tx_packetizer_header[31:16] <= {main_arp_tx_packetizer_sink_param_proto[7:0], main_arp_tx_packetizer_sink_param_proto[15:8]};
-    main_arp_tx_packetizer_header[47:40] <= {main_arp_tx_packetizer_sink_param_protosize[7:0]};
-    main_arp_tx_packetizer_header[143:112] <= {main_arp_tx_packetizer_sink_param_sender_ip[7:0], main_arp_tx_packetizer_sink_param_sender_ip[15:8], main_arp_tx_packetizer_sink_param_sender_ip[23:16], main_arp_tx_packetizer_sink_param_sender_ip[31:24]};
-    main_arp_tx_packetizer_header[111:64] <= {main_arp_tx_packetizer_sink_param_sender_mac[7:0], main_arp_tx_packetizer_sink_param_sender_mac[15:8], main_arp_tx_packetizer_sink_param_sender_mac[23:16], main_arp_tx_packetizer_sink_param_sender_mac[31:24], main_arp_tx_packetizer_sink_param_sender_mac[39:32], main_arp_tx_packetizer_sink_param_sender_mac[47:40]};
-    main_arp_tx_packetizer_header[223:192] <= {main_arp_tx_packetizer_sink_param_target_ip[7:0], main_arp_tx_packetizer_sink_param_target_ip[15:8], main_arp_tx_packetizer_sink_param_target_ip[23:16], main_arp_tx_packetizer_sink_param_target_ip[31:24]};
-    main_arp_tx_packetizer_header[191:144] <= {main_arp_tx_packetizer_sink_param_target_mac[7:0], main_arp_tx_packetizer_sink_param_target_mac[15:8], main_arp_tx_packetizer_sink_param_target_mac[23:16], main_arp_tx_packetizer_sink_param_target_mac[31:24], main_arp_tx_packetizer_sink_param_target_mac[39:32], main_arp_tx_packetizer_sink_param_target_mac[47:40]};
+    main_arp_packetizer_header <= 224'd0;
+    main_arp_packetizer_header[39:32] <= {main_arp_packetizer_sink_param_hwsize[7:0]};
+    main_arp_packetizer_header[15:0] <= {main_arp_packetizer_sink_param_hwtype[7:0], main_arp_packetizer_sink_param_hwtype[15:8]};
+    main_arp_packetizer_header[63:48] <= {main_arp_packetizer_sink_param_opcode[7:0], main_arp_packetizer_sink_param_opcode[15:8]};
+    main_arp_packetizer_header[31:16] <= {main_arp_packetizer_sink_param_proto[7:0], main_arp_packetizer_sink_param_proto[15:8]};
+    main_arp_packetizer_header[47:40] <= {main_arp_packetizer_sink_param_protosize[7:0]};
+    main_arp_packetizer_header[143:112] <= {main_arp_packetizer_sink_param_sender_ip[7:0], main_arp_packetizer_sink_param_sender_ip[15:8], main_arp_packetizer_sink_param_sender_ip[23:16], main_arp_packetizer_sink_param_sender_ip[31:24]};
+    main_arp_packetizer_header[111:64] <= {main_arp_packetizer_sink_param_sender_mac[7:0], main_arp_packetizer_sink_param_sender_mac[15:8], main_arp_packetizer_sink_param_sender_mac[23:16], main_arp_packetizer_sink_param_sender_mac[31:24], main_arp_packetizer_sink_param_sender_mac[39:32], main_arp_packetizer_sink_param_sender_mac[47:40]};
+    main_arp_packetizer_header[223:192] <= {main_arp_packetizer_sink_param_target_ip[7:0], main_arp_packetizer_sink_param_target_ip[15:8], main_arp_packetizer_sink_param_target_ip[23:16], main_arp_packetizer_sink_param_target_ip[31:24]};
+    main_arp_packetizer_header[191:144] <= {main_arp_packetizer_sink_param_target_mac[7:0], main_arp_packetizer_sink_param_target_mac[15:8], main_arp_packetizer_sink_param_target_mac[23:16], main_arp_packetizer_sink_param_target_mac[31:24], main_arp_packetizer_sink_param_target_mac[39:32], main_arp_packetizer_sink_param_target_mac[47:40]};
 end
-assign main_arp_tx_packetizer_sink_last_be = main_arp_tx_packetizer_sink_last;
-assign main_arp_tx_packetizer_new_last_be = {main_arp_tx_packetizer_sink_last_be};
-assign main_arp_tx_packetizer_in_data_copy = (main_arp_tx_packetizer_is_ongoing0 | main_arp_tx_packetizer_is_ongoing1);
+assign main_arp_packetizer_sink_last_be = main_arp_packetizer_sink_last;
+assign main_arp_packetizer_new_last_be = {main_arp_packetizer_sink_last_be};
+assign main_arp_packetizer_in_data_copy = (main_arp_packetizer_is_ongoing0 | main_arp_packetizer_is_ongoing1);
 always @(*) begin
-    main_arp_tx_packetizer_source_last <= 1'd0;
-    if (main_arp_tx_packetizer_source_last_s) begin
-        main_arp_tx_packetizer_source_last <= main_arp_tx_packetizer_source_last_b;
+    main_arp_packetizer_source_last <= 1'd0;
+    if (main_arp_packetizer_source_last_s) begin
+        main_arp_packetizer_source_last <= main_arp_packetizer_source_last_b;
     end else begin
-        main_arp_tx_packetizer_source_last <= main_arp_tx_packetizer_source_last_a;
+        main_arp_packetizer_source_last <= main_arp_packetizer_source_last_a;
     end
 end
-assign main_arp_tx_packetizer_source_payload_error = main_arp_tx_packetizer_sink_payload_error;
+assign main_arp_packetizer_source_payload_error = main_arp_packetizer_sink_payload_error;
 always @(*) begin
     builder_liteetharptx_fsm0_next_state <= 2'd0;
     builder_liteetharptx_fsm1_next_state <= 1'd0;
-    main_arp_tx_packetizer_count_liteetharp_fsm0_next_value0 <= 5'd0;
-    main_arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd0;
-    main_arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= 1'd0;
-    main_arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd0;
-    main_arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd0;
-    main_arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd0;
-    main_arp_tx_packetizer_is_ongoing0 <= 1'd0;
-    main_arp_tx_packetizer_is_ongoing1 <= 1'd0;
-    main_arp_tx_packetizer_is_ongoing2 <= 1'd0;
-    main_arp_tx_packetizer_sink_ready <= 1'd0;
-    main_arp_tx_packetizer_source_last_a <= 1'd0;
-    main_arp_tx_packetizer_source_last_b <= 1'd0;
-    main_arp_tx_packetizer_source_last_s <= 1'd0;
-    main_arp_tx_packetizer_source_payload_data <= 8'd0;
-    main_arp_tx_packetizer_source_payload_last_be <= 1'd0;
-    main_arp_tx_packetizer_source_valid <= 1'd0;
-    main_arp_tx_packetizer_sr_load <= 1'd0;
-    main_arp_tx_packetizer_sr_shift <= 1'd0;
+    main_arp_packetizer_count_liteetharp_fsm0_next_value0 <= 5'd0;
+    main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd0;
+    main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= 1'd0;
+    main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd0;
+    main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd0;
+    main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd0;
+    main_arp_packetizer_is_ongoing0 <= 1'd0;
+    main_arp_packetizer_is_ongoing1 <= 1'd0;
+    main_arp_packetizer_is_ongoing2 <= 1'd0;
+    main_arp_packetizer_sink_ready <= 1'd0;
+    main_arp_packetizer_source_last_a <= 1'd0;
+    main_arp_packetizer_source_last_b <= 1'd0;
+    main_arp_packetizer_source_last_s <= 1'd0;
+    main_arp_packetizer_source_payload_data <= 8'd0;
+    main_arp_packetizer_source_payload_last_be <= 1'd0;
+    main_arp_packetizer_source_valid <= 1'd0;
+    main_arp_packetizer_sr_load <= 1'd0;
+    main_arp_packetizer_sr_shift <= 1'd0;
     builder_liteetharptx_fsm0_next_state <= builder_liteetharptx_fsm0_state;
     case (builder_liteetharptx_fsm0_state)
         1'd1: begin
-            main_arp_tx_packetizer_source_valid <= 1'd1;
-            main_arp_tx_packetizer_source_last_a <= 1'd0;
-            main_arp_tx_packetizer_source_payload_data <= main_arp_tx_packetizer_sr[223:8];
-            if ((main_arp_tx_packetizer_source_valid & main_arp_tx_packetizer_source_ready)) begin
-                main_arp_tx_packetizer_sr_shift <= 1'd1;
-                if ((main_arp_tx_packetizer_count == 5'd27)) begin
-                    main_arp_tx_packetizer_sr_shift <= 1'd0;
+            main_arp_packetizer_source_valid <= 1'd1;
+            main_arp_packetizer_source_last_a <= 1'd0;
+            main_arp_packetizer_source_payload_data <= main_arp_packetizer_sr[223:8];
+            if ((main_arp_packetizer_source_valid & main_arp_packetizer_source_ready)) begin
+                main_arp_packetizer_sr_shift <= 1'd1;
+                if ((main_arp_packetizer_count == 5'd27)) begin
+                    main_arp_packetizer_sr_shift <= 1'd0;
                     builder_liteetharptx_fsm0_next_state <= 2'd2;
-                    main_arp_tx_packetizer_count_liteetharp_fsm0_next_value0 <= (main_arp_tx_packetizer_count + 1'd1);
-                    main_arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
+                    main_arp_packetizer_count_liteetharp_fsm0_next_value0 <= (main_arp_packetizer_count + 1'd1);
+                    main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
                 end else begin
-                    main_arp_tx_packetizer_count_liteetharp_fsm0_next_value0 <= (main_arp_tx_packetizer_count + 1'd1);
-                    main_arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
+                    main_arp_packetizer_count_liteetharp_fsm0_next_value0 <= (main_arp_packetizer_count + 1'd1);
+                    main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
                 end
             end
         end
         2'd2: begin
-            main_arp_tx_packetizer_source_valid <= main_arp_tx_packetizer_sink_valid;
-            main_arp_tx_packetizer_source_last_a <= main_arp_tx_packetizer_sink_last;
-            main_arp_tx_packetizer_source_payload_data <= main_arp_tx_packetizer_sink_payload_data;
-            if ((main_arp_tx_packetizer_source_valid & main_arp_tx_packetizer_source_ready)) begin
-                main_arp_tx_packetizer_sink_ready <= 1'd1;
-                if (main_arp_tx_packetizer_source_last) begin
+            main_arp_packetizer_source_valid <= main_arp_packetizer_sink_valid;
+            main_arp_packetizer_source_last_a <= main_arp_packetizer_sink_last;
+            main_arp_packetizer_source_payload_data <= main_arp_packetizer_sink_payload_data;
+            if ((main_arp_packetizer_source_valid & main_arp_packetizer_source_ready)) begin
+                main_arp_packetizer_sink_ready <= 1'd1;
+                if (main_arp_packetizer_source_last) begin
                     builder_liteetharptx_fsm0_next_state <= 1'd0;
                 end
             end
-            main_arp_tx_packetizer_is_ongoing0 <= 1'd1;
+            main_arp_packetizer_is_ongoing0 <= 1'd1;
         end
         2'd3: begin
-            main_arp_tx_packetizer_is_ongoing1 <= 1'd1;
+            main_arp_packetizer_is_ongoing1 <= 1'd1;
         end
         default: begin
-            main_arp_tx_packetizer_sink_ready <= 1'd1;
-            main_arp_tx_packetizer_count_liteetharp_fsm0_next_value0 <= 1'd1;
-            main_arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
-            if (main_arp_tx_packetizer_sink_valid) begin
-                main_arp_tx_packetizer_sink_ready <= 1'd0;
-                main_arp_tx_packetizer_source_valid <= 1'd1;
-                main_arp_tx_packetizer_source_last_a <= 1'd0;
-                main_arp_tx_packetizer_source_payload_data <= main_arp_tx_packetizer_header[7:0];
-                if ((main_arp_tx_packetizer_source_valid & main_arp_tx_packetizer_source_ready)) begin
-                    main_arp_tx_packetizer_sr_load <= 1'd1;
-                    main_arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd1;
-                    main_arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd1;
+            main_arp_packetizer_sink_ready <= 1'd1;
+            main_arp_packetizer_count_liteetharp_fsm0_next_value0 <= 1'd1;
+            main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd1;
+            if (main_arp_packetizer_sink_valid) begin
+                main_arp_packetizer_sink_ready <= 1'd0;
+                main_arp_packetizer_source_valid <= 1'd1;
+                main_arp_packetizer_source_last_a <= 1'd0;
+                main_arp_packetizer_source_payload_data <= main_arp_packetizer_header[7:0];
+                if ((main_arp_packetizer_source_valid & main_arp_packetizer_source_ready)) begin
+                    main_arp_packetizer_sr_load <= 1'd1;
+                    main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd1;
+                    main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd1;
                     if (1'd0) begin
                         builder_liteetharptx_fsm0_next_state <= 2'd2;
                     end else begin
@@ -3585,42 +3635,42 @@ always @(*) begin
                     end
                 end
             end
-            main_arp_tx_packetizer_is_ongoing2 <= 1'd1;
+            main_arp_packetizer_is_ongoing2 <= 1'd1;
         end
     endcase
     builder_liteetharptx_fsm1_next_state <= builder_liteetharptx_fsm1_state;
     case (builder_liteetharptx_fsm1_state)
         1'd1: begin
-            main_arp_tx_packetizer_source_last_b <= 1'd1;
-            main_arp_tx_packetizer_source_last_s <= 1'd1;
-            main_arp_tx_packetizer_source_payload_last_be <= main_arp_tx_packetizer_delayed_last_be;
-            main_arp_tx_packetizer_sink_ready <= 1'd0;
-            if (main_arp_tx_packetizer_source_ready) begin
+            main_arp_packetizer_source_last_b <= 1'd1;
+            main_arp_packetizer_source_last_s <= 1'd1;
+            main_arp_packetizer_source_payload_last_be <= main_arp_packetizer_delayed_last_be;
+            main_arp_packetizer_sink_ready <= 1'd0;
+            if (main_arp_packetizer_source_ready) begin
                 builder_liteetharptx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((main_arp_tx_packetizer_in_data_copy & main_arp_tx_packetizer_sink_last) & (main_arp_tx_packetizer_sink_last_be > main_arp_tx_packetizer_new_last_be))) begin
-                main_arp_tx_packetizer_source_last_b <= 1'd0;
-                main_arp_tx_packetizer_source_last_s <= 1'd1;
-                main_arp_tx_packetizer_source_payload_last_be <= 1'd0;
-                if ((main_arp_tx_packetizer_source_ready & main_arp_tx_packetizer_source_valid)) begin
-                    main_arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= main_arp_tx_packetizer_new_last_be;
-                    main_arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd1;
+            if (((main_arp_packetizer_in_data_copy & main_arp_packetizer_sink_last) & (main_arp_packetizer_sink_last_be > main_arp_packetizer_new_last_be))) begin
+                main_arp_packetizer_source_last_b <= 1'd0;
+                main_arp_packetizer_source_last_s <= 1'd1;
+                main_arp_packetizer_source_payload_last_be <= 1'd0;
+                if ((main_arp_packetizer_source_ready & main_arp_packetizer_source_valid)) begin
+                    main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= main_arp_packetizer_new_last_be;
+                    main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd1;
                     builder_liteetharptx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (main_arp_tx_packetizer_in_data_copy) begin
-                    main_arp_tx_packetizer_source_last_b <= main_arp_tx_packetizer_sink_last;
-                    main_arp_tx_packetizer_source_last_s <= 1'd1;
-                    main_arp_tx_packetizer_source_payload_last_be <= main_arp_tx_packetizer_new_last_be;
+                if (main_arp_packetizer_in_data_copy) begin
+                    main_arp_packetizer_source_last_b <= main_arp_packetizer_sink_last;
+                    main_arp_packetizer_source_last_s <= 1'd1;
+                    main_arp_packetizer_source_payload_last_be <= main_arp_packetizer_new_last_be;
                 end
             end
-            if (main_arp_tx_packetizer_in_data_copy) begin
-                main_arp_tx_packetizer_sink_ready <= main_arp_tx_packetizer_source_ready;
+            if (main_arp_packetizer_in_data_copy) begin
+                main_arp_packetizer_sink_ready <= main_arp_packetizer_source_ready;
             end else begin
-                if (main_arp_tx_packetizer_is_ongoing2) begin
-                    main_arp_tx_packetizer_sink_ready <= (~main_arp_tx_packetizer_sink_valid);
+                if (main_arp_packetizer_is_ongoing2) begin
+                    main_arp_packetizer_sink_ready <= (~main_arp_packetizer_sink_valid);
                 end
             end
         end
@@ -3628,50 +3678,50 @@ always @(*) begin
 end
 always @(*) begin
     builder_liteetharptx_next_state <= 1'd0;
-    main_arp_tx_counter_liteetharp_next_value <= 6'd0;
-    main_arp_tx_counter_liteetharp_next_value_ce <= 1'd0;
-    main_arp_tx_packetizer_sink_valid <= 1'd0;
-    main_arp_tx_packetizer_source_ready <= 1'd0;
-    main_arp_tx_sink_sink_ready <= 1'd0;
-    main_arp_tx_source_source_valid <= 1'd0;
+    main_arp_counter_liteetharp_next_value <= 6'd0;
+    main_arp_counter_liteetharp_next_value_ce <= 1'd0;
+    main_arp_packetizer_sink_valid <= 1'd0;
+    main_arp_packetizer_source_ready <= 1'd0;
+    main_arp_sink_sink_ready <= 1'd0;
+    main_arp_source_source_valid <= 1'd0;
     builder_liteetharptx_next_state <= builder_liteetharptx_state;
     case (builder_liteetharptx_state)
         1'd1: begin
-            main_arp_tx_packetizer_sink_valid <= 1'd1;
-            main_arp_tx_source_source_valid <= main_arp_tx_packetizer_source_valid;
-            main_arp_tx_packetizer_source_ready <= main_arp_tx_source_source_ready;
-            if ((main_arp_tx_source_source_valid & main_arp_tx_source_source_ready)) begin
-                main_arp_tx_counter_liteetharp_next_value <= (main_arp_tx_counter + 1'd1);
-                main_arp_tx_counter_liteetharp_next_value_ce <= 1'd1;
-                if (main_arp_tx_source_source_last) begin
-                    main_arp_tx_sink_sink_ready <= 1'd1;
+            main_arp_packetizer_sink_valid <= 1'd1;
+            main_arp_source_source_valid <= main_arp_packetizer_source_valid;
+            main_arp_packetizer_source_ready <= main_arp_source_source_ready;
+            if ((main_arp_source_source_valid & main_arp_source_source_ready)) begin
+                main_arp_counter_liteetharp_next_value <= (main_arp_counter + 1'd1);
+                main_arp_counter_liteetharp_next_value_ce <= 1'd1;
+                if (main_arp_source_source_last) begin
+                    main_arp_sink_sink_ready <= 1'd1;
                     builder_liteetharptx_next_state <= 1'd0;
                 end
             end
         end
         default: begin
-            main_arp_tx_counter_liteetharp_next_value <= 1'd0;
-            main_arp_tx_counter_liteetharp_next_value_ce <= 1'd1;
-            if (main_arp_tx_sink_sink_valid) begin
+            main_arp_counter_liteetharp_next_value <= 1'd0;
+            main_arp_counter_liteetharp_next_value_ce <= 1'd1;
+            if (main_arp_sink_sink_valid) begin
                 builder_liteetharptx_next_state <= 1'd1;
             end
         end
     endcase
 end
-assign main_arp_rx_depacketizer_sink_valid = main_arp_rx_sink_sink_valid;
-assign main_arp_rx_sink_sink_ready = main_arp_rx_depacketizer_sink_ready;
-assign main_arp_rx_depacketizer_sink_first = main_arp_rx_sink_sink_first;
-assign main_arp_rx_depacketizer_sink_last = main_arp_rx_sink_sink_last;
-assign main_arp_rx_depacketizer_sink_payload_ethernet_type = main_arp_rx_sink_sink_payload_ethernet_type;
-assign main_arp_rx_depacketizer_sink_payload_sender_mac = main_arp_rx_sink_sink_payload_sender_mac;
-assign main_arp_rx_depacketizer_sink_payload_target_mac = main_arp_rx_sink_sink_payload_target_mac;
-assign main_arp_rx_depacketizer_sink_payload_data = main_arp_rx_sink_sink_payload_data;
-assign main_arp_rx_depacketizer_sink_payload_last_be = main_arp_rx_sink_sink_payload_last_be;
-assign main_arp_rx_depacketizer_sink_payload_error = main_arp_rx_sink_sink_payload_error;
+assign main_arp_rx_liteetharpdepacketizer_sink_valid = main_arp_rx_sink_valid;
+assign main_arp_rx_sink_ready = main_arp_rx_liteetharpdepacketizer_sink_ready;
+assign main_arp_rx_liteetharpdepacketizer_sink_first = main_arp_rx_sink_first;
+assign main_arp_rx_liteetharpdepacketizer_sink_last = main_arp_rx_sink_last;
+assign main_arp_rx_liteetharpdepacketizer_sink_payload_ethernet_type = main_arp_rx_sink_payload_ethernet_type;
+assign main_arp_rx_liteetharpdepacketizer_sink_payload_sender_mac = main_arp_rx_sink_payload_sender_mac;
+assign main_arp_rx_liteetharpdepacketizer_sink_payload_target_mac = main_arp_rx_sink_payload_target_mac;
+assign main_arp_rx_liteetharpdepacketizer_sink_payload_data = main_arp_rx_sink_payload_data;
+assign main_arp_rx_liteetharpdepacketizer_sink_payload_last_be = main_arp_rx_sink_payload_last_be;
+assign main_arp_rx_liteetharpdepacketizer_sink_payload_error = main_arp_rx_sink_payload_error;
 always @(*) begin
     main_arp_rx_reply <= 1'd0;
     main_arp_rx_request <= 1'd0;
-    case (main_arp_rx_depacketizer_source_param_opcode)
+    case (main_arp_rx_liteetharpdepacketizer_source_param_opcode)
         1'd1: begin
             main_arp_rx_request <= 1'd1;
         end
@@ -3682,161 +3732,172 @@ always @(*) begin
         end
     endcase
 end
-assign main_arp_rx_source_source_payload_ip_address = main_arp_rx_depacketizer_source_param_sender_ip;
-assign main_arp_rx_source_source_payload_mac_address = main_arp_rx_depacketizer_source_param_sender_mac;
-assign main_arp_rx_depacketizer_header = main_arp_rx_depacketizer_sr;
-assign main_arp_rx_depacketizer_source_param_hwsize = {builder_rhs_slice_proxy14[7:0]};
-assign main_arp_rx_depacketizer_source_param_hwtype = {builder_rhs_slice_proxy16[7:0], builder_rhs_slice_proxy15[15:8]};
-assign main_arp_rx_depacketizer_source_param_opcode = {builder_rhs_slice_proxy18[7:0], builder_rhs_slice_proxy17[15:8]};
-assign main_arp_rx_depacketizer_source_param_proto = {builder_rhs_slice_proxy20[7:0], builder_rhs_slice_proxy19[15:8]};
-assign main_arp_rx_depacketizer_source_param_protosize = {builder_rhs_slice_proxy21[7:0]};
-assign main_arp_rx_depacketizer_source_param_sender_ip = {builder_rhs_slice_proxy25[7:0], builder_rhs_slice_proxy24[15:8], builder_rhs_slice_proxy23[23:16], builder_rhs_slice_proxy22[31:24]};
-assign main_arp_rx_depacketizer_source_param_sender_mac = {builder_rhs_slice_proxy31[7:0], builder_rhs_slice_proxy30[15:8], builder_rhs_slice_proxy29[23:16], builder_rhs_slice_proxy28[31:24], builder_rhs_slice_proxy27[39:32], builder_rhs_slice_proxy26[47:40]};
-assign main_arp_rx_depacketizer_source_param_target_ip = {builder_rhs_slice_proxy35[7:0], builder_rhs_slice_proxy34[15:8], builder_rhs_slice_proxy33[23:16], builder_rhs_slice_proxy32[31:24]};
-assign main_arp_rx_depacketizer_source_param_target_mac = {builder_rhs_slice_proxy41[7:0], builder_rhs_slice_proxy40[15:8], builder_rhs_slice_proxy39[23:16], builder_rhs_slice_proxy38[31:24], builder_rhs_slice_proxy37[39:32], builder_rhs_slice_proxy36[47:40]};
-assign main_arp_rx_depacketizer_source_payload_error = main_arp_rx_depacketizer_sink_payload_error;
-assign main_arp_rx_depacketizer_sink_last_be = main_arp_rx_depacketizer_sink_last;
-assign main_arp_rx_depacketizer_new_last_be = {main_arp_rx_depacketizer_sink_last_be};
-assign main_arp_rx_depacketizer_is_in_copy = (main_arp_rx_depacketizer_is_ongoing0 | main_arp_rx_depacketizer_is_ongoing1);
+assign main_arp_rx_source_payload_ip_address = main_arp_rx_liteetharpdepacketizer_source_param_sender_ip;
+assign main_arp_rx_source_payload_mac_address = main_arp_rx_liteetharpdepacketizer_source_param_sender_mac;
+assign main_arp_rx_liteetharpdepacketizer_header = main_arp_rx_liteetharpdepacketizer_sr;
+assign main_arp_rx_liteetharpdepacketizer_source_param_hwsize = {builder_rhs_slice_proxy14[7:0]};
+assign main_arp_rx_liteetharpdepacketizer_source_param_hwtype = {builder_rhs_slice_proxy16[7:0], builder_rhs_slice_proxy15[15:8]};
+assign main_arp_rx_liteetharpdepacketizer_source_param_opcode = {builder_rhs_slice_proxy18[7:0], builder_rhs_slice_proxy17[15:8]};
+assign main_arp_rx_liteetharpdepacketizer_source_param_proto = {builder_rhs_slice_proxy20[7:0], builder_rhs_slice_proxy19[15:8]};
+assign main_arp_rx_liteetharpdepacketizer_source_param_protosize = {builder_rhs_slice_proxy21[7:0]};
+assign main_arp_rx_liteetharpdepacketizer_source_param_sender_ip = {builder_rhs_slice_proxy25[7:0], builder_rhs_slice_proxy24[15:8], builder_rhs_slice_proxy23[23:16], builder_rhs_slice_proxy22[31:24]};
+assign main_arp_rx_liteetharpdepacketizer_source_param_sender_mac = {builder_rhs_slice_proxy31[7:0], builder_rhs_slice_proxy30[15:8], builder_rhs_slice_proxy29[23:16], builder_rhs_slice_proxy28[31:24], builder_rhs_slice_proxy27[39:32], builder_rhs_slice_proxy26[47:40]};
+assign main_arp_rx_liteetharpdepacketizer_source_param_target_ip = {builder_rhs_slice_proxy35[7:0], builder_rhs_slice_proxy34[15:8], builder_rhs_slice_proxy33[23:16], builder_rhs_slice_proxy32[31:24]};
+assign main_arp_rx_liteetharpdepacketizer_source_param_target_mac = {builder_rhs_slice_proxy41[7:0], builder_rhs_slice_proxy40[15:8], builder_rhs_slice_proxy39[23:16], builder_rhs_slice_proxy38[31:24], builder_rhs_slice_proxy37[39:32], builder_rhs_slice_proxy36[47:40]};
+assign main_arp_rx_liteetharpdepacketizer_source_payload_error = main_arp_rx_liteetharpdepacketizer_sink_payload_error;
+assign main_arp_rx_liteetharpdepacketizer_sink_last_be = main_arp_rx_liteetharpdepacketizer_sink_last;
+assign main_arp_rx_liteetharpdepacketizer_new_last_be = {main_arp_rx_liteetharpdepacketizer_sink_last_be};
+assign main_arp_rx_liteetharpdepacketizer_is_in_copy = (main_arp_rx_liteetharpdepacketizer_is_ongoing0 | main_arp_rx_liteetharpdepacketizer_is_ongoing1);
 always @(*) begin
-    main_arp_rx_depacketizer_source_last <= 1'd0;
-    if (main_arp_rx_depacketizer_source_last_s) begin
-        main_arp_rx_depacketizer_source_last <= main_arp_rx_depacketizer_source_last_b;
+    main_arp_rx_liteetharpdepacketizer_source_last <= 1'd0;
+    if (main_arp_rx_liteetharpdepacketizer_source_last_s) begin
+        main_arp_rx_liteetharpdepacketizer_source_last <= main_arp_rx_liteetharpdepacketizer_source_last_b;
     end else begin
-        main_arp_rx_depacketizer_source_last <= main_arp_rx_depacketizer_source_last_a;
+        main_arp_rx_liteetharpdepacketizer_source_last <= main_arp_rx_liteetharpdepacketizer_source_last_a;
     end
 end
+assign main_arp_rx_cut = ((main_arp_rx_liteetharpdepacketizer_sink_valid & main_arp_rx_liteetharpdepacketizer_sink_last) & (main_arp_rx_fsm_is_ongoing0 | main_arp_rx_fsm_is_ongoing1));
 always @(*) begin
     builder_liteetharprx_fsm0_next_state <= 2'd0;
     builder_liteetharprx_fsm1_next_state <= 1'd0;
-    main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 <= 5'd0;
-    main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd0;
-    main_arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= 1'd0;
-    main_arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd0;
-    main_arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd0;
-    main_arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd0;
-    main_arp_rx_depacketizer_is_ongoing0 <= 1'd0;
-    main_arp_rx_depacketizer_is_ongoing1 <= 1'd0;
-    main_arp_rx_depacketizer_is_ongoing2 <= 1'd0;
-    main_arp_rx_depacketizer_is_ongoing3 <= 1'd0;
-    main_arp_rx_depacketizer_sink_ready <= 1'd0;
-    main_arp_rx_depacketizer_source_last_a <= 1'd0;
-    main_arp_rx_depacketizer_source_last_b <= 1'd0;
-    main_arp_rx_depacketizer_source_last_s <= 1'd0;
-    main_arp_rx_depacketizer_source_payload_data <= 8'd0;
-    main_arp_rx_depacketizer_source_payload_last_be <= 1'd0;
-    main_arp_rx_depacketizer_source_valid <= 1'd0;
-    main_arp_rx_depacketizer_sr_shift <= 1'd0;
+    main_arp_rx_fsm_is_ongoing0 <= 1'd0;
+    main_arp_rx_fsm_is_ongoing1 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= 5'd0;
+    main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_is_ongoing0 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_is_ongoing1 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_is_ongoing2 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_is_ongoing3 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_sink_ready <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_source_last_a <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_source_last_b <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_source_last_s <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_source_payload_data <= 8'd0;
+    main_arp_rx_liteetharpdepacketizer_source_payload_last_be <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_source_valid <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_sr_shift <= 1'd0;
     builder_liteetharprx_fsm0_next_state <= builder_liteetharprx_fsm0_state;
     case (builder_liteetharprx_fsm0_state)
         1'd1: begin
-            main_arp_rx_depacketizer_sink_ready <= 1'd1;
-            if (main_arp_rx_depacketizer_sink_valid) begin
-                main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 <= (main_arp_rx_depacketizer_count + 1'd1);
-                main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
-                main_arp_rx_depacketizer_sr_shift <= 1'd1;
-                if ((main_arp_rx_depacketizer_count == 5'd27)) begin
+            main_arp_rx_liteetharpdepacketizer_sink_ready <= 1'd1;
+            if (main_arp_rx_liteetharpdepacketizer_sink_valid) begin
+                main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= (main_arp_rx_liteetharpdepacketizer_count + 1'd1);
+                main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
+                main_arp_rx_liteetharpdepacketizer_sr_shift <= 1'd1;
+                if ((main_arp_rx_liteetharpdepacketizer_count == 5'd27)) begin
                     builder_liteetharprx_fsm0_next_state <= 2'd2;
-                    main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 <= (main_arp_rx_depacketizer_count + 1'd1);
-                    main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
+                    main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= (main_arp_rx_liteetharpdepacketizer_count + 1'd1);
+                    main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            main_arp_rx_fsm_is_ongoing1 <= 1'd1;
+            if ((main_arp_rx_liteetharpdepacketizer_sink_valid & main_arp_rx_liteetharpdepacketizer_sink_last)) begin
+                builder_liteetharprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            main_arp_rx_depacketizer_source_valid <= (main_arp_rx_depacketizer_sink_valid | main_arp_rx_depacketizer_sink_d_last);
-            main_arp_rx_depacketizer_source_last_a <= (main_arp_rx_depacketizer_sink_last | main_arp_rx_depacketizer_sink_d_last);
-            main_arp_rx_depacketizer_sink_ready <= main_arp_rx_depacketizer_source_ready;
-            main_arp_rx_depacketizer_source_payload_data <= main_arp_rx_depacketizer_sink_payload_data;
-            if ((main_arp_rx_depacketizer_source_valid & main_arp_rx_depacketizer_source_ready)) begin
-                if (main_arp_rx_depacketizer_source_last) begin
+            main_arp_rx_liteetharpdepacketizer_source_valid <= (main_arp_rx_liteetharpdepacketizer_sink_valid | main_arp_rx_liteetharpdepacketizer_sink_d_last);
+            main_arp_rx_liteetharpdepacketizer_source_last_a <= (main_arp_rx_liteetharpdepacketizer_sink_last | main_arp_rx_liteetharpdepacketizer_sink_d_last);
+            main_arp_rx_liteetharpdepacketizer_sink_ready <= main_arp_rx_liteetharpdepacketizer_source_ready;
+            main_arp_rx_liteetharpdepacketizer_source_payload_data <= main_arp_rx_liteetharpdepacketizer_sink_payload_data;
+            if ((main_arp_rx_liteetharpdepacketizer_source_valid & main_arp_rx_liteetharpdepacketizer_source_ready)) begin
+                if (main_arp_rx_liteetharpdepacketizer_source_last) begin
                     builder_liteetharprx_fsm0_next_state <= 1'd0;
                 end
             end
-            main_arp_rx_depacketizer_is_ongoing0 <= 1'd1;
-            main_arp_rx_depacketizer_is_ongoing2 <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_is_ongoing0 <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            main_arp_rx_depacketizer_is_ongoing1 <= 1'd1;
-            main_arp_rx_depacketizer_is_ongoing3 <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_is_ongoing1 <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            main_arp_rx_depacketizer_sink_ready <= 1'd1;
-            main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value2 <= 1'd1;
-            main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
-            if (main_arp_rx_depacketizer_sink_valid) begin
-                main_arp_rx_depacketizer_sr_shift <= 1'd1;
-                main_arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd1;
-                main_arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_sink_ready <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
+            if (main_arp_rx_liteetharpdepacketizer_sink_valid) begin
+                main_arp_rx_liteetharpdepacketizer_sr_shift <= 1'd1;
+                main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd1;
+                main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
                     builder_liteetharprx_fsm0_next_state <= 2'd2;
                 end else begin
                     builder_liteetharprx_fsm0_next_state <= 1'd1;
                 end
             end
+            main_arp_rx_fsm_is_ongoing0 <= 1'd1;
+            if ((main_arp_rx_liteetharpdepacketizer_sink_valid & main_arp_rx_liteetharpdepacketizer_sink_last)) begin
+                builder_liteetharprx_fsm0_next_state <= 1'd0;
+            end
         end
     endcase
     builder_liteetharprx_fsm1_next_state <= builder_liteetharprx_fsm1_state;
     case (builder_liteetharprx_fsm1_state)
         1'd1: begin
-            main_arp_rx_depacketizer_source_last_b <= 1'd1;
-            main_arp_rx_depacketizer_source_last_s <= 1'd1;
-            main_arp_rx_depacketizer_source_payload_last_be <= main_arp_rx_depacketizer_delayed_last_be;
-            main_arp_rx_depacketizer_sink_ready <= 1'd0;
-            if ((main_arp_rx_depacketizer_source_ready & main_arp_rx_depacketizer_source_valid)) begin
+            main_arp_rx_liteetharpdepacketizer_source_last_b <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_source_last_s <= 1'd1;
+            main_arp_rx_liteetharpdepacketizer_source_payload_last_be <= main_arp_rx_liteetharpdepacketizer_delayed_last_be;
+            main_arp_rx_liteetharpdepacketizer_sink_ready <= 1'd0;
+            if ((main_arp_rx_liteetharpdepacketizer_source_ready & main_arp_rx_liteetharpdepacketizer_source_valid)) begin
                 builder_liteetharprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((main_arp_rx_depacketizer_sink_valid & main_arp_rx_depacketizer_sink_last) & (main_arp_rx_depacketizer_sink_last_be > main_arp_rx_depacketizer_new_last_be))) begin
-                main_arp_rx_depacketizer_source_last_b <= 1'd0;
-                main_arp_rx_depacketizer_source_last_s <= 1'd1;
-                main_arp_rx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((main_arp_rx_depacketizer_source_ready & main_arp_rx_depacketizer_source_valid) | ((~main_arp_rx_depacketizer_was_in_copy) & main_arp_rx_depacketizer_is_in_copy))) begin
-                    main_arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= main_arp_rx_depacketizer_new_last_be;
-                    main_arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd1;
+            if (((main_arp_rx_liteetharpdepacketizer_sink_valid & main_arp_rx_liteetharpdepacketizer_sink_last) & (main_arp_rx_liteetharpdepacketizer_sink_last_be > main_arp_rx_liteetharpdepacketizer_new_last_be))) begin
+                main_arp_rx_liteetharpdepacketizer_source_last_b <= 1'd0;
+                main_arp_rx_liteetharpdepacketizer_source_last_s <= 1'd1;
+                main_arp_rx_liteetharpdepacketizer_source_payload_last_be <= 1'd0;
+                if (((main_arp_rx_liteetharpdepacketizer_source_ready & main_arp_rx_liteetharpdepacketizer_source_valid) | ((~main_arp_rx_liteetharpdepacketizer_was_in_copy) & main_arp_rx_liteetharpdepacketizer_is_in_copy))) begin
+                    main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= main_arp_rx_liteetharpdepacketizer_new_last_be;
+                    main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd1;
                     builder_liteetharprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (main_arp_rx_depacketizer_sink_last) begin
-                    main_arp_rx_depacketizer_source_last_b <= 1'd1;
-                    main_arp_rx_depacketizer_source_last_s <= 1'd1;
-                    main_arp_rx_depacketizer_source_payload_last_be <= main_arp_rx_depacketizer_new_last_be;
+                if (main_arp_rx_liteetharpdepacketizer_sink_last) begin
+                    main_arp_rx_liteetharpdepacketizer_source_last_b <= 1'd1;
+                    main_arp_rx_liteetharpdepacketizer_source_last_s <= 1'd1;
+                    main_arp_rx_liteetharpdepacketizer_source_payload_last_be <= main_arp_rx_liteetharpdepacketizer_new_last_be;
                 end
             end
-            if ((main_arp_rx_depacketizer_is_ongoing2 | (main_arp_rx_depacketizer_is_ongoing3 & (~main_arp_rx_depacketizer_fsm_from_idle)))) begin
-                main_arp_rx_depacketizer_sink_ready <= main_arp_rx_depacketizer_source_ready;
+            if ((main_arp_rx_liteetharpdepacketizer_is_ongoing2 | (main_arp_rx_liteetharpdepacketizer_is_ongoing3 & (~main_arp_rx_liteetharpdepacketizer_fsm_from_idle)))) begin
+                main_arp_rx_liteetharpdepacketizer_sink_ready <= main_arp_rx_liteetharpdepacketizer_source_ready;
             end else begin
-                main_arp_rx_depacketizer_sink_ready <= 1'd1;
+                main_arp_rx_liteetharpdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
     builder_liteetharprx_next_state <= 2'd0;
-    main_arp_rx_depacketizer_source_ready <= 1'd0;
-    main_arp_rx_source_source_payload_reply <= 1'd0;
-    main_arp_rx_source_source_payload_request <= 1'd0;
-    main_arp_rx_source_source_valid <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_source_ready <= 1'd0;
+    main_arp_rx_source_payload_reply <= 1'd0;
+    main_arp_rx_source_payload_request <= 1'd0;
+    main_arp_rx_source_valid <= 1'd0;
     builder_liteetharprx_next_state <= builder_liteetharprx_state;
     case (builder_liteetharprx_state)
         1'd1: begin
             if (main_arp_rx_valid) begin
-                main_arp_rx_source_source_valid <= 1'd1;
-                main_arp_rx_source_source_payload_reply <= main_arp_rx_reply;
-                main_arp_rx_source_source_payload_request <= main_arp_rx_request;
+                main_arp_rx_source_valid <= 1'd1;
+                main_arp_rx_source_payload_reply <= main_arp_rx_reply;
+                main_arp_rx_source_payload_request <= main_arp_rx_request;
             end
             builder_liteetharprx_next_state <= 2'd2;
         end
         2'd2: begin
-            main_arp_rx_depacketizer_source_ready <= 1'd1;
-            if ((main_arp_rx_depacketizer_source_valid & main_arp_rx_depacketizer_source_last)) begin
+            main_arp_rx_liteetharpdepacketizer_source_ready <= 1'd1;
+            if ((main_arp_rx_liteetharpdepacketizer_source_valid & main_arp_rx_liteetharpdepacketizer_source_last)) begin
                 builder_liteetharprx_next_state <= 1'd0;
             end
         end
         default: begin
-            main_arp_rx_depacketizer_source_ready <= 1'd1;
-            if (main_arp_rx_depacketizer_source_valid) begin
-                main_arp_rx_depacketizer_source_ready <= 1'd0;
+            main_arp_rx_liteetharpdepacketizer_source_ready <= 1'd1;
+            if (main_arp_rx_liteetharpdepacketizer_source_valid) begin
+                main_arp_rx_liteetharpdepacketizer_source_ready <= 1'd0;
                 builder_liteetharprx_next_state <= 1'd1;
             end
         end
@@ -4077,16 +4138,16 @@ assign main_ip_mac_port_sink_payload_target_mac = main_ip_tx_source_source_paylo
 assign main_ip_mac_port_sink_payload_data = main_ip_tx_source_source_payload_data0;
 assign main_ip_mac_port_sink_payload_last_be = main_ip_tx_source_source_payload_last_be0;
 assign main_ip_mac_port_sink_payload_error = main_ip_tx_source_source_payload_error0;
-assign main_ip_rx_sink_sink_valid = main_ip_mac_port_source_valid;
-assign main_ip_mac_port_source_ready = main_ip_rx_sink_sink_ready;
-assign main_ip_rx_sink_sink_first = main_ip_mac_port_source_first;
-assign main_ip_rx_sink_sink_last = main_ip_mac_port_source_last;
-assign main_ip_rx_sink_sink_payload_ethernet_type = main_ip_mac_port_source_payload_ethernet_type;
-assign main_ip_rx_sink_sink_payload_sender_mac = main_ip_mac_port_source_payload_sender_mac;
-assign main_ip_rx_sink_sink_payload_target_mac = main_ip_mac_port_source_payload_target_mac;
-assign main_ip_rx_sink_sink_payload_data = main_ip_mac_port_source_payload_data;
-assign main_ip_rx_sink_sink_payload_last_be = main_ip_mac_port_source_payload_last_be;
-assign main_ip_rx_sink_sink_payload_error = main_ip_mac_port_source_payload_error;
+assign main_ip_rx_sink_valid = main_ip_mac_port_source_valid;
+assign main_ip_mac_port_source_ready = main_ip_rx_sink_ready;
+assign main_ip_rx_sink_first = main_ip_mac_port_source_first;
+assign main_ip_rx_sink_last = main_ip_mac_port_source_last;
+assign main_ip_rx_sink_payload_ethernet_type = main_ip_mac_port_source_payload_ethernet_type;
+assign main_ip_rx_sink_payload_sender_mac = main_ip_mac_port_source_payload_sender_mac;
+assign main_ip_rx_sink_payload_target_mac = main_ip_mac_port_source_payload_target_mac;
+assign main_ip_rx_sink_payload_data = main_ip_mac_port_source_payload_data;
+assign main_ip_rx_sink_payload_last_be = main_ip_mac_port_source_payload_last_be;
+assign main_ip_rx_sink_payload_error = main_ip_mac_port_source_payload_error;
 assign main_ip_tx_sink_sink_valid0 = main_ip_crossbar_source_valid;
 assign main_ip_crossbar_source_ready = main_ip_tx_sink_sink_ready0;
 assign main_ip_tx_sink_sink_first0 = main_ip_crossbar_source_first;
@@ -4097,16 +4158,16 @@ assign main_ip_tx_sink_sink_payload_error0 = main_ip_crossbar_source_payload_err
 assign main_ip_tx_sink_sink_param_length0 = main_ip_crossbar_source_param_length;
 assign main_ip_tx_sink_sink_param_protocol0 = main_ip_crossbar_source_param_protocol;
 assign main_ip_tx_sink_sink_param_ip_address0 = main_ip_crossbar_source_param_ip_address;
-assign main_ip_crossbar_sink_valid = main_ip_rx_source_source_valid;
-assign main_ip_rx_source_source_ready = main_ip_crossbar_sink_ready;
-assign main_ip_crossbar_sink_first = main_ip_rx_source_source_first;
-assign main_ip_crossbar_sink_last = main_ip_rx_source_source_last;
-assign main_ip_crossbar_sink_payload_data = main_ip_rx_source_source_payload_data;
-assign main_ip_crossbar_sink_payload_last_be = main_ip_rx_source_source_payload_last_be;
-assign main_ip_crossbar_sink_payload_error = main_ip_rx_source_source_payload_error;
-assign main_ip_crossbar_sink_param_length = main_ip_rx_source_source_param_length;
-assign main_ip_crossbar_sink_param_protocol = main_ip_rx_source_source_param_protocol;
-assign main_ip_crossbar_sink_param_ip_address = main_ip_rx_source_source_param_ip_address;
+assign main_ip_crossbar_sink_valid = main_ip_rx_source_valid;
+assign main_ip_rx_source_ready = main_ip_crossbar_sink_ready;
+assign main_ip_crossbar_sink_first = main_ip_rx_source_first;
+assign main_ip_crossbar_sink_last = main_ip_rx_source_last;
+assign main_ip_crossbar_sink_payload_data = main_ip_rx_source_payload_data;
+assign main_ip_crossbar_sink_payload_last_be = main_ip_rx_source_payload_last_be;
+assign main_ip_crossbar_sink_payload_error = main_ip_rx_source_payload_error;
+assign main_ip_crossbar_sink_param_length = main_ip_rx_source_param_length;
+assign main_ip_crossbar_sink_param_protocol = main_ip_rx_source_param_protocol;
+assign main_ip_crossbar_sink_param_ip_address = main_ip_rx_source_param_ip_address;
 assign main_ip_tx_sink_sink_valid1 = main_ip_tx_sink_sink_valid0;
 assign main_ip_tx_sink_sink_ready0 = main_ip_tx_sink_sink_ready1;
 assign main_ip_tx_sink_sink_first1 = main_ip_tx_sink_sink_first0;
@@ -4389,149 +4450,166 @@ always @(*) begin
         end
     endcase
 end
-assign main_ip_rx_depacketizer_sink_valid = main_ip_rx_sink_sink_valid;
-assign main_ip_rx_sink_sink_ready = main_ip_rx_depacketizer_sink_ready;
-assign main_ip_rx_depacketizer_sink_first = main_ip_rx_sink_sink_first;
-assign main_ip_rx_depacketizer_sink_last = main_ip_rx_sink_sink_last;
-assign main_ip_rx_depacketizer_sink_payload_ethernet_type = main_ip_rx_sink_sink_payload_ethernet_type;
-assign main_ip_rx_depacketizer_sink_payload_sender_mac = main_ip_rx_sink_sink_payload_sender_mac;
-assign main_ip_rx_depacketizer_sink_payload_target_mac = main_ip_rx_sink_sink_payload_target_mac;
-assign main_ip_rx_depacketizer_sink_payload_data = main_ip_rx_sink_sink_payload_data;
-assign main_ip_rx_depacketizer_sink_payload_last_be = main_ip_rx_sink_sink_payload_last_be;
-assign main_ip_rx_depacketizer_sink_payload_error = main_ip_rx_sink_sink_payload_error;
-assign main_ip_rx_liteethipv4checksum_header = main_ip_rx_depacketizer_header;
-assign main_ip_rx_reset = (~main_ip_rx_depacketizer_source_valid);
+assign main_ip_rx_liteethipv4depacketizer_sink_valid = main_ip_rx_sink_valid;
+assign main_ip_rx_sink_ready = main_ip_rx_liteethipv4depacketizer_sink_ready;
+assign main_ip_rx_liteethipv4depacketizer_sink_first = main_ip_rx_sink_first;
+assign main_ip_rx_liteethipv4depacketizer_sink_last = main_ip_rx_sink_last;
+assign main_ip_rx_liteethipv4depacketizer_sink_payload_ethernet_type = main_ip_rx_sink_payload_ethernet_type;
+assign main_ip_rx_liteethipv4depacketizer_sink_payload_sender_mac = main_ip_rx_sink_payload_sender_mac;
+assign main_ip_rx_liteethipv4depacketizer_sink_payload_target_mac = main_ip_rx_sink_payload_target_mac;
+assign main_ip_rx_liteethipv4depacketizer_sink_payload_data = main_ip_rx_sink_payload_data;
+assign main_ip_rx_liteethipv4depacketizer_sink_payload_last_be = main_ip_rx_sink_payload_last_be;
+assign main_ip_rx_liteethipv4depacketizer_sink_payload_error = main_ip_rx_sink_payload_error;
+assign main_ip_rx_liteethipv4checksum_header = main_ip_rx_liteethipv4depacketizer_header;
+assign main_ip_rx_reset = (~main_ip_rx_liteethipv4depacketizer_source_valid);
 assign main_ip_rx_ce = 1'd1;
-assign main_ip_rx_source_source_last = main_ip_rx_depacketizer_source_last;
-assign main_ip_rx_source_source_payload_data = main_ip_rx_depacketizer_source_payload_data;
-assign main_ip_rx_source_source_payload_last_be = main_ip_rx_depacketizer_source_payload_last_be;
-assign main_ip_rx_source_source_payload_error = main_ip_rx_depacketizer_source_payload_error;
-assign main_ip_rx_source_source_param_protocol = main_ip_rx_depacketizer_source_param_protocol;
-assign main_ip_rx_source_source_param_length = (main_ip_rx_depacketizer_source_param_total_length - 5'd20);
-assign main_ip_rx_source_source_param_ip_address = main_ip_rx_depacketizer_source_param_sender_ip;
-assign main_ip_rx_depacketizer_header = main_ip_rx_depacketizer_sr;
-assign main_ip_rx_depacketizer_source_param_checksum = {builder_rhs_slice_proxy43[7:0], builder_rhs_slice_proxy42[15:8]};
-assign main_ip_rx_depacketizer_source_param_identification = {builder_rhs_slice_proxy45[7:0], builder_rhs_slice_proxy44[15:8]};
-assign main_ip_rx_depacketizer_source_param_ihl = {builder_rhs_slice_proxy46[3:0]};
-assign main_ip_rx_depacketizer_source_param_protocol = {builder_rhs_slice_proxy47[7:0]};
-assign main_ip_rx_depacketizer_source_param_sender_ip = {builder_rhs_slice_proxy51[7:0], builder_rhs_slice_proxy50[15:8], builder_rhs_slice_proxy49[23:16], builder_rhs_slice_proxy48[31:24]};
-assign main_ip_rx_depacketizer_source_param_target_ip = {builder_rhs_slice_proxy55[7:0], builder_rhs_slice_proxy54[15:8], builder_rhs_slice_proxy53[23:16], builder_rhs_slice_proxy52[31:24]};
-assign main_ip_rx_depacketizer_source_param_total_length = {builder_rhs_slice_proxy57[7:0], builder_rhs_slice_proxy56[15:8]};
-assign main_ip_rx_depacketizer_source_param_ttl = {builder_rhs_slice_proxy58[7:0]};
-assign main_ip_rx_depacketizer_source_param_version = {builder_rhs_slice_proxy59[3:0]};
-assign main_ip_rx_depacketizer_source_payload_error = main_ip_rx_depacketizer_sink_payload_error;
-assign main_ip_rx_depacketizer_sink_last_be = main_ip_rx_depacketizer_sink_last;
-assign main_ip_rx_depacketizer_new_last_be = {main_ip_rx_depacketizer_sink_last_be};
-assign main_ip_rx_depacketizer_is_in_copy = (main_ip_rx_depacketizer_is_ongoing0 | main_ip_rx_depacketizer_is_ongoing1);
+assign main_ip_rx_source_last = main_ip_rx_liteethipv4depacketizer_source_last;
+assign main_ip_rx_source_payload_data = main_ip_rx_liteethipv4depacketizer_source_payload_data;
+assign main_ip_rx_source_payload_last_be = main_ip_rx_liteethipv4depacketizer_source_payload_last_be;
+assign main_ip_rx_source_payload_error = main_ip_rx_liteethipv4depacketizer_source_payload_error;
+assign main_ip_rx_source_param_protocol = main_ip_rx_liteethipv4depacketizer_source_param_protocol;
+assign main_ip_rx_source_param_length = (main_ip_rx_liteethipv4depacketizer_source_param_total_length - 5'd20);
+assign main_ip_rx_source_param_ip_address = main_ip_rx_liteethipv4depacketizer_source_param_sender_ip;
+assign main_ip_rx_offset = {main_ip_rx_liteethipv4depacketizer_header[52:48], main_ip_rx_liteethipv4depacketizer_header[63:56]};
+assign main_ip_rx_header_ok = ((((((main_ip_rx_liteethipv4depacketizer_source_param_version == 3'd4) & (main_ip_rx_liteethipv4depacketizer_source_param_ihl == 3'd5)) & (main_ip_rx_liteethipv4checksum_value == 1'd0)) & (~main_ip_rx_liteethipv4depacketizer_header[53])) & (main_ip_rx_offset == 1'd0)) & (main_ip_rx_liteethipv4depacketizer_source_param_total_length >= 5'd28));
+assign main_ip_rx_ours = ((main_ip_rx_liteethipv4depacketizer_source_param_target_ip == ip_address) | main_take_group);
+assign main_ip_rx_decide = ((main_ip_rx_is_ongoing & main_ip_rx_liteethipv4depacketizer_source_valid) & main_ip_rx_liteethipv4checksum_done);
+assign main_ip_rx_drop_header = (main_ip_rx_decide & (~main_ip_rx_header_ok));
+assign main_ip_rx_drop_other = ((main_ip_rx_decide & main_ip_rx_header_ok) & (~main_ip_rx_ours));
+assign main_ip_rx_liteethipv4depacketizer_header = main_ip_rx_liteethipv4depacketizer_sr;
+assign main_ip_rx_liteethipv4depacketizer_source_param_checksum = {builder_rhs_slice_proxy43[7:0], builder_rhs_slice_proxy42[15:8]};
+assign main_ip_rx_liteethipv4depacketizer_source_param_identification = {builder_rhs_slice_proxy45[7:0], builder_rhs_slice_proxy44[15:8]};
+assign main_ip_rx_liteethipv4depacketizer_source_param_ihl = {builder_rhs_slice_proxy46[3:0]};
+assign main_ip_rx_liteethipv4depacketizer_source_param_protocol = {builder_rhs_slice_proxy47[7:0]};
+assign main_ip_rx_liteethipv4depacketizer_source_param_sender_ip = {builder_rhs_slice_proxy51[7:0], builder_rhs_slice_proxy50[15:8], builder_rhs_slice_proxy49[23:16], builder_rhs_slice_proxy48[31:24]};
+assign main_ip_rx_liteethipv4depacketizer_source_param_target_ip = {builder_rhs_slice_proxy55[7:0], builder_rhs_slice_proxy54[15:8], builder_rhs_slice_proxy53[23:16], builder_rhs_slice_proxy52[31:24]};
+assign main_ip_rx_liteethipv4depacketizer_source_param_total_length = {builder_rhs_slice_proxy57[7:0], builder_rhs_slice_proxy56[15:8]};
+assign main_ip_rx_liteethipv4depacketizer_source_param_ttl = {builder_rhs_slice_proxy58[7:0]};
+assign main_ip_rx_liteethipv4depacketizer_source_param_version = {builder_rhs_slice_proxy59[3:0]};
+assign main_ip_rx_liteethipv4depacketizer_source_payload_error = main_ip_rx_liteethipv4depacketizer_sink_payload_error;
+assign main_ip_rx_liteethipv4depacketizer_sink_last_be = main_ip_rx_liteethipv4depacketizer_sink_last;
+assign main_ip_rx_liteethipv4depacketizer_new_last_be = {main_ip_rx_liteethipv4depacketizer_sink_last_be};
+assign main_ip_rx_liteethipv4depacketizer_is_in_copy = (main_ip_rx_liteethipv4depacketizer_is_ongoing0 | main_ip_rx_liteethipv4depacketizer_is_ongoing1);
 always @(*) begin
-    main_ip_rx_depacketizer_source_last <= 1'd0;
-    if (main_ip_rx_depacketizer_source_last_s) begin
-        main_ip_rx_depacketizer_source_last <= main_ip_rx_depacketizer_source_last_b;
+    main_ip_rx_liteethipv4depacketizer_source_last <= 1'd0;
+    if (main_ip_rx_liteethipv4depacketizer_source_last_s) begin
+        main_ip_rx_liteethipv4depacketizer_source_last <= main_ip_rx_liteethipv4depacketizer_source_last_b;
     end else begin
-        main_ip_rx_depacketizer_source_last <= main_ip_rx_depacketizer_source_last_a;
+        main_ip_rx_liteethipv4depacketizer_source_last <= main_ip_rx_liteethipv4depacketizer_source_last_a;
     end
 end
+assign main_ip_rx_cut = ((main_ip_rx_liteethipv4depacketizer_sink_valid & main_ip_rx_liteethipv4depacketizer_sink_last) & (main_ip_rx_fsm_is_ongoing0 | main_ip_rx_fsm_is_ongoing1));
 always @(*) begin
-    builder_liteethip_liteethiprx_fsm0_next_state <= 2'd0;
-    builder_liteethip_liteethiprx_fsm1_next_state <= 1'd0;
-    main_ip_rx_depacketizer_count_liteethip_fsm0_next_value2 <= 5'd0;
-    main_ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd0;
-    main_ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= 1'd0;
-    main_ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd0;
-    main_ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd0;
-    main_ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd0;
-    main_ip_rx_depacketizer_is_ongoing0 <= 1'd0;
-    main_ip_rx_depacketizer_is_ongoing1 <= 1'd0;
-    main_ip_rx_depacketizer_is_ongoing2 <= 1'd0;
-    main_ip_rx_depacketizer_is_ongoing3 <= 1'd0;
-    main_ip_rx_depacketizer_sink_ready <= 1'd0;
-    main_ip_rx_depacketizer_source_last_a <= 1'd0;
-    main_ip_rx_depacketizer_source_last_b <= 1'd0;
-    main_ip_rx_depacketizer_source_last_s <= 1'd0;
-    main_ip_rx_depacketizer_source_payload_data <= 8'd0;
-    main_ip_rx_depacketizer_source_payload_last_be <= 1'd0;
-    main_ip_rx_depacketizer_source_valid <= 1'd0;
-    main_ip_rx_depacketizer_sr_shift <= 1'd0;
-    builder_liteethip_liteethiprx_fsm0_next_state <= builder_liteethip_liteethiprx_fsm0_state;
-    case (builder_liteethip_liteethiprx_fsm0_state)
+    builder_liteethip_checkingiprx_fsm0_next_state <= 2'd0;
+    builder_liteethip_checkingiprx_fsm1_next_state <= 1'd0;
+    main_ip_rx_fsm_is_ongoing0 <= 1'd0;
+    main_ip_rx_fsm_is_ongoing1 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= 5'd0;
+    main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_is_ongoing0 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_is_ongoing1 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_is_ongoing2 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_is_ongoing3 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_sink_ready <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_source_last_a <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_source_last_b <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_source_last_s <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_source_payload_data <= 8'd0;
+    main_ip_rx_liteethipv4depacketizer_source_payload_last_be <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_source_valid <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_sr_shift <= 1'd0;
+    builder_liteethip_checkingiprx_fsm0_next_state <= builder_liteethip_checkingiprx_fsm0_state;
+    case (builder_liteethip_checkingiprx_fsm0_state)
         1'd1: begin
-            main_ip_rx_depacketizer_sink_ready <= 1'd1;
-            if (main_ip_rx_depacketizer_sink_valid) begin
-                main_ip_rx_depacketizer_count_liteethip_fsm0_next_value2 <= (main_ip_rx_depacketizer_count + 1'd1);
-                main_ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
-                main_ip_rx_depacketizer_sr_shift <= 1'd1;
-                if ((main_ip_rx_depacketizer_count == 5'd19)) begin
-                    builder_liteethip_liteethiprx_fsm0_next_state <= 2'd2;
-                    main_ip_rx_depacketizer_count_liteethip_fsm0_next_value2 <= (main_ip_rx_depacketizer_count + 1'd1);
-                    main_ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_sink_ready <= 1'd1;
+            if (main_ip_rx_liteethipv4depacketizer_sink_valid) begin
+                main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= (main_ip_rx_liteethipv4depacketizer_count + 1'd1);
+                main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
+                main_ip_rx_liteethipv4depacketizer_sr_shift <= 1'd1;
+                if ((main_ip_rx_liteethipv4depacketizer_count == 5'd19)) begin
+                    builder_liteethip_checkingiprx_fsm0_next_state <= 2'd2;
+                    main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= (main_ip_rx_liteethipv4depacketizer_count + 1'd1);
+                    main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            main_ip_rx_fsm_is_ongoing1 <= 1'd1;
+            if ((main_ip_rx_liteethipv4depacketizer_sink_valid & main_ip_rx_liteethipv4depacketizer_sink_last)) begin
+                builder_liteethip_checkingiprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            main_ip_rx_depacketizer_source_valid <= (main_ip_rx_depacketizer_sink_valid | main_ip_rx_depacketizer_sink_d_last);
-            main_ip_rx_depacketizer_source_last_a <= (main_ip_rx_depacketizer_sink_last | main_ip_rx_depacketizer_sink_d_last);
-            main_ip_rx_depacketizer_sink_ready <= main_ip_rx_depacketizer_source_ready;
-            main_ip_rx_depacketizer_source_payload_data <= main_ip_rx_depacketizer_sink_payload_data;
-            if ((main_ip_rx_depacketizer_source_valid & main_ip_rx_depacketizer_source_ready)) begin
-                if (main_ip_rx_depacketizer_source_last) begin
-                    builder_liteethip_liteethiprx_fsm0_next_state <= 1'd0;
+            main_ip_rx_liteethipv4depacketizer_source_valid <= (main_ip_rx_liteethipv4depacketizer_sink_valid | main_ip_rx_liteethipv4depacketizer_sink_d_last);
+            main_ip_rx_liteethipv4depacketizer_source_last_a <= (main_ip_rx_liteethipv4depacketizer_sink_last | main_ip_rx_liteethipv4depacketizer_sink_d_last);
+            main_ip_rx_liteethipv4depacketizer_sink_ready <= main_ip_rx_liteethipv4depacketizer_source_ready;
+            main_ip_rx_liteethipv4depacketizer_source_payload_data <= main_ip_rx_liteethipv4depacketizer_sink_payload_data;
+            if ((main_ip_rx_liteethipv4depacketizer_source_valid & main_ip_rx_liteethipv4depacketizer_source_ready)) begin
+                if (main_ip_rx_liteethipv4depacketizer_source_last) begin
+                    builder_liteethip_checkingiprx_fsm0_next_state <= 1'd0;
                 end
             end
-            main_ip_rx_depacketizer_is_ongoing0 <= 1'd1;
-            main_ip_rx_depacketizer_is_ongoing2 <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_is_ongoing0 <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            main_ip_rx_depacketizer_is_ongoing1 <= 1'd1;
-            main_ip_rx_depacketizer_is_ongoing3 <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_is_ongoing1 <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            main_ip_rx_depacketizer_sink_ready <= 1'd1;
-            main_ip_rx_depacketizer_count_liteethip_fsm0_next_value2 <= 1'd1;
-            main_ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
-            if (main_ip_rx_depacketizer_sink_valid) begin
-                main_ip_rx_depacketizer_sr_shift <= 1'd1;
-                main_ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd1;
-                main_ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_sink_ready <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
+            if (main_ip_rx_liteethipv4depacketizer_sink_valid) begin
+                main_ip_rx_liteethipv4depacketizer_sr_shift <= 1'd1;
+                main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd1;
+                main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
-                    builder_liteethip_liteethiprx_fsm0_next_state <= 2'd2;
+                    builder_liteethip_checkingiprx_fsm0_next_state <= 2'd2;
                 end else begin
-                    builder_liteethip_liteethiprx_fsm0_next_state <= 1'd1;
+                    builder_liteethip_checkingiprx_fsm0_next_state <= 1'd1;
                 end
+            end
+            main_ip_rx_fsm_is_ongoing0 <= 1'd1;
+            if ((main_ip_rx_liteethipv4depacketizer_sink_valid & main_ip_rx_liteethipv4depacketizer_sink_last)) begin
+                builder_liteethip_checkingiprx_fsm0_next_state <= 1'd0;
             end
         end
     endcase
-    builder_liteethip_liteethiprx_fsm1_next_state <= builder_liteethip_liteethiprx_fsm1_state;
-    case (builder_liteethip_liteethiprx_fsm1_state)
+    builder_liteethip_checkingiprx_fsm1_next_state <= builder_liteethip_checkingiprx_fsm1_state;
+    case (builder_liteethip_checkingiprx_fsm1_state)
         1'd1: begin
-            main_ip_rx_depacketizer_source_last_b <= 1'd1;
-            main_ip_rx_depacketizer_source_last_s <= 1'd1;
-            main_ip_rx_depacketizer_source_payload_last_be <= main_ip_rx_depacketizer_delayed_last_be;
-            main_ip_rx_depacketizer_sink_ready <= 1'd0;
-            if ((main_ip_rx_depacketizer_source_ready & main_ip_rx_depacketizer_source_valid)) begin
-                builder_liteethip_liteethiprx_fsm1_next_state <= 1'd0;
+            main_ip_rx_liteethipv4depacketizer_source_last_b <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_source_last_s <= 1'd1;
+            main_ip_rx_liteethipv4depacketizer_source_payload_last_be <= main_ip_rx_liteethipv4depacketizer_delayed_last_be;
+            main_ip_rx_liteethipv4depacketizer_sink_ready <= 1'd0;
+            if ((main_ip_rx_liteethipv4depacketizer_source_ready & main_ip_rx_liteethipv4depacketizer_source_valid)) begin
+                builder_liteethip_checkingiprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((main_ip_rx_depacketizer_sink_valid & main_ip_rx_depacketizer_sink_last) & (main_ip_rx_depacketizer_sink_last_be > main_ip_rx_depacketizer_new_last_be))) begin
-                main_ip_rx_depacketizer_source_last_b <= 1'd0;
-                main_ip_rx_depacketizer_source_last_s <= 1'd1;
-                main_ip_rx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((main_ip_rx_depacketizer_source_ready & main_ip_rx_depacketizer_source_valid) | ((~main_ip_rx_depacketizer_was_in_copy) & main_ip_rx_depacketizer_is_in_copy))) begin
-                    main_ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= main_ip_rx_depacketizer_new_last_be;
-                    main_ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd1;
-                    builder_liteethip_liteethiprx_fsm1_next_state <= 1'd1;
+            if (((main_ip_rx_liteethipv4depacketizer_sink_valid & main_ip_rx_liteethipv4depacketizer_sink_last) & (main_ip_rx_liteethipv4depacketizer_sink_last_be > main_ip_rx_liteethipv4depacketizer_new_last_be))) begin
+                main_ip_rx_liteethipv4depacketizer_source_last_b <= 1'd0;
+                main_ip_rx_liteethipv4depacketizer_source_last_s <= 1'd1;
+                main_ip_rx_liteethipv4depacketizer_source_payload_last_be <= 1'd0;
+                if (((main_ip_rx_liteethipv4depacketizer_source_ready & main_ip_rx_liteethipv4depacketizer_source_valid) | ((~main_ip_rx_liteethipv4depacketizer_was_in_copy) & main_ip_rx_liteethipv4depacketizer_is_in_copy))) begin
+                    main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= main_ip_rx_liteethipv4depacketizer_new_last_be;
+                    main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd1;
+                    builder_liteethip_checkingiprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (main_ip_rx_depacketizer_sink_last) begin
-                    main_ip_rx_depacketizer_source_last_b <= 1'd1;
-                    main_ip_rx_depacketizer_source_last_s <= 1'd1;
-                    main_ip_rx_depacketizer_source_payload_last_be <= main_ip_rx_depacketizer_new_last_be;
+                if (main_ip_rx_liteethipv4depacketizer_sink_last) begin
+                    main_ip_rx_liteethipv4depacketizer_source_last_b <= 1'd1;
+                    main_ip_rx_liteethipv4depacketizer_source_last_s <= 1'd1;
+                    main_ip_rx_liteethipv4depacketizer_source_payload_last_be <= main_ip_rx_liteethipv4depacketizer_new_last_be;
                 end
             end
-            if ((main_ip_rx_depacketizer_is_ongoing2 | (main_ip_rx_depacketizer_is_ongoing3 & (~main_ip_rx_depacketizer_fsm_from_idle)))) begin
-                main_ip_rx_depacketizer_sink_ready <= main_ip_rx_depacketizer_source_ready;
+            if ((main_ip_rx_liteethipv4depacketizer_is_ongoing2 | (main_ip_rx_liteethipv4depacketizer_is_ongoing3 & (~main_ip_rx_liteethipv4depacketizer_fsm_from_idle)))) begin
+                main_ip_rx_liteethipv4depacketizer_sink_ready <= main_ip_rx_liteethipv4depacketizer_source_ready;
             end else begin
-                main_ip_rx_depacketizer_sink_ready <= 1'd1;
+                main_ip_rx_liteethipv4depacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
@@ -4550,32 +4628,37 @@ assign main_ip_rx_liteethipv4checksum_value = (~{main_ip_rx_liteethipv4checksum_
 assign main_ip_rx_liteethipv4checksum_counter_ce = (~main_ip_rx_liteethipv4checksum_done);
 assign main_ip_rx_liteethipv4checksum_done = (main_ip_rx_liteethipv4checksum_counter == 4'd11);
 always @(*) begin
-    builder_liteethip_liteethiprx_next_state <= 2'd0;
-    main_ip_rx_depacketizer_source_ready <= 1'd0;
-    main_ip_rx_source_source_valid <= 1'd0;
-    builder_liteethip_liteethiprx_next_state <= builder_liteethip_liteethiprx_state;
-    case (builder_liteethip_liteethiprx_state)
+    builder_liteethip_checkingiprx_next_state <= 2'd0;
+    main_ip_rx_is_ongoing <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_source_ready <= 1'd0;
+    main_ip_rx_source_valid <= 1'd0;
+    builder_liteethip_checkingiprx_next_state <= builder_liteethip_checkingiprx_state;
+    case (builder_liteethip_checkingiprx_state)
         1'd1: begin
-            main_ip_rx_source_source_valid <= main_ip_rx_depacketizer_source_valid;
-            main_ip_rx_depacketizer_source_ready <= main_ip_rx_source_source_ready;
-            if ((main_ip_rx_source_source_valid & main_ip_rx_source_source_ready)) begin
-                if (main_ip_rx_source_source_last) begin
-                    builder_liteethip_liteethiprx_next_state <= 1'd0;
+            main_ip_rx_source_valid <= main_ip_rx_liteethipv4depacketizer_source_valid;
+            main_ip_rx_liteethipv4depacketizer_source_ready <= main_ip_rx_source_ready;
+            if ((main_ip_rx_source_valid & main_ip_rx_source_ready)) begin
+                if (main_ip_rx_source_last) begin
+                    builder_liteethip_checkingiprx_next_state <= 1'd0;
                 end
             end
         end
         2'd2: begin
-            main_ip_rx_depacketizer_source_ready <= 1'd1;
-            if (((main_ip_rx_depacketizer_source_valid & main_ip_rx_depacketizer_source_last) & main_ip_rx_depacketizer_source_ready)) begin
-                builder_liteethip_liteethiprx_next_state <= 1'd0;
+            main_ip_rx_liteethipv4depacketizer_source_ready <= 1'd1;
+            if (((main_ip_rx_liteethipv4depacketizer_source_valid & main_ip_rx_liteethipv4depacketizer_source_last) & main_ip_rx_liteethipv4depacketizer_source_ready)) begin
+                builder_liteethip_checkingiprx_next_state <= 1'd0;
             end
         end
         default: begin
-            if ((main_ip_rx_depacketizer_source_valid & main_ip_rx_liteethipv4checksum_done)) begin
-                builder_liteethip_liteethiprx_next_state <= 2'd2;
-                if ((((((main_ip_rx_depacketizer_source_param_target_ip == ip_address) | main_take_group) & (main_ip_rx_depacketizer_source_param_version == 3'd4)) & (main_ip_rx_depacketizer_source_param_ihl == 3'd5)) & (main_ip_rx_liteethipv4checksum_value == 1'd0))) begin
-                    builder_liteethip_liteethiprx_next_state <= 1'd1;
+            if ((main_ip_rx_liteethipv4depacketizer_source_valid & main_ip_rx_liteethipv4checksum_done)) begin
+                builder_liteethip_checkingiprx_next_state <= 2'd2;
+                if ((((((main_ip_rx_liteethipv4depacketizer_source_param_target_ip == ip_address) | main_take_group) & (main_ip_rx_liteethipv4depacketizer_source_param_version == 3'd4)) & (main_ip_rx_liteethipv4depacketizer_source_param_ihl == 3'd5)) & (main_ip_rx_liteethipv4checksum_value == 1'd0))) begin
+                    builder_liteethip_checkingiprx_next_state <= 1'd1;
                 end
+            end
+            main_ip_rx_is_ongoing <= 1'd1;
+            if ((main_ip_rx_decide & (~(main_ip_rx_header_ok & main_ip_rx_ours)))) begin
+                builder_liteethip_checkingiprx_next_state <= 2'd2;
             end
         end
     endcase
@@ -4589,6 +4672,8 @@ always @(*) begin
         builder_liteethip_sel0 <= 2'd2;
     end
 end
+assign builder_liteethip_taken = (((1'd0 + main_icmp_ip_port_source_valid) + main_ip_port_source_valid) != 1'd0);
+assign main_ip_crossbar_dropped = (((main_ip_crossbar_sink_valid & main_ip_crossbar_sink_ready) & main_ip_crossbar_sink_last) & (~builder_liteethip_taken));
 always @(*) begin
     builder_liteethip_request <= 2'd0;
     builder_liteethip_request[0] <= builder_liteethip_status0_ongoing0;
@@ -4697,19 +4782,19 @@ always @(*) begin
 end
 assign builder_liteethip_last = ((main_ip_crossbar_sink_valid & main_ip_crossbar_sink_last) & main_ip_crossbar_sink_ready);
 assign builder_liteethip_ongoing0 = ((main_ip_crossbar_sink_valid | builder_liteethip_ongoing1) & (~builder_liteethip_last));
-assign main_icmp_echo_sink_valid = main_icmp_rx_source_source_valid;
-assign main_icmp_rx_source_source_ready = main_icmp_echo_sink_ready;
-assign main_icmp_echo_sink_first = main_icmp_rx_source_source_first;
-assign main_icmp_echo_sink_last = main_icmp_rx_source_source_last;
-assign main_icmp_echo_sink_payload_data = main_icmp_rx_source_source_payload_data;
-assign main_icmp_echo_sink_payload_last_be = main_icmp_rx_source_source_payload_last_be;
-assign main_icmp_echo_sink_payload_error = main_icmp_rx_source_source_payload_error;
-assign main_icmp_echo_sink_param_checksum = main_icmp_rx_source_source_param_checksum;
-assign main_icmp_echo_sink_param_code = main_icmp_rx_source_source_param_code;
-assign main_icmp_echo_sink_param_msgtype = main_icmp_rx_source_source_param_msgtype;
-assign main_icmp_echo_sink_param_quench = main_icmp_rx_source_source_param_quench;
-assign main_icmp_echo_sink_param_ip_address = main_icmp_rx_source_source_param_ip_address;
-assign main_icmp_echo_sink_param_length = main_icmp_rx_source_source_param_length;
+assign main_icmp_echo_sink_valid = main_icmp_rx_source_valid;
+assign main_icmp_rx_source_ready = main_icmp_echo_sink_ready;
+assign main_icmp_echo_sink_first = main_icmp_rx_source_first;
+assign main_icmp_echo_sink_last = main_icmp_rx_source_last;
+assign main_icmp_echo_sink_payload_data = main_icmp_rx_source_payload_data;
+assign main_icmp_echo_sink_payload_last_be = main_icmp_rx_source_payload_last_be;
+assign main_icmp_echo_sink_payload_error = main_icmp_rx_source_payload_error;
+assign main_icmp_echo_sink_param_checksum = main_icmp_rx_source_param_checksum;
+assign main_icmp_echo_sink_param_code = main_icmp_rx_source_param_code;
+assign main_icmp_echo_sink_param_msgtype = main_icmp_rx_source_param_msgtype;
+assign main_icmp_echo_sink_param_quench = main_icmp_rx_source_param_quench;
+assign main_icmp_echo_sink_param_ip_address = main_icmp_rx_source_param_ip_address;
+assign main_icmp_echo_sink_param_length = main_icmp_rx_source_param_length;
 assign main_icmp_tx_sink_sink_valid = main_icmp_echo_source_valid;
 assign main_icmp_echo_source_ready = main_icmp_tx_sink_sink_ready;
 assign main_icmp_tx_sink_sink_first = main_icmp_echo_source_first;
@@ -4733,16 +4818,16 @@ assign main_icmp_ip_port_sink_payload_error = main_icmp_tx_source_source_payload
 assign main_icmp_ip_port_sink_param_length = main_icmp_tx_source_source_param_length;
 assign main_icmp_ip_port_sink_param_protocol = main_icmp_tx_source_source_param_protocol;
 assign main_icmp_ip_port_sink_param_ip_address = main_icmp_tx_source_source_param_ip_address;
-assign main_icmp_rx_sink_sink_valid = main_icmp_ip_port_source_valid;
-assign main_icmp_ip_port_source_ready = main_icmp_rx_sink_sink_ready;
-assign main_icmp_rx_sink_sink_first = main_icmp_ip_port_source_first;
-assign main_icmp_rx_sink_sink_last = main_icmp_ip_port_source_last;
-assign main_icmp_rx_sink_sink_payload_data = main_icmp_ip_port_source_payload_data;
-assign main_icmp_rx_sink_sink_payload_last_be = main_icmp_ip_port_source_payload_last_be;
-assign main_icmp_rx_sink_sink_payload_error = main_icmp_ip_port_source_payload_error;
-assign main_icmp_rx_sink_sink_param_length = main_icmp_ip_port_source_param_length;
-assign main_icmp_rx_sink_sink_param_protocol = main_icmp_ip_port_source_param_protocol;
-assign main_icmp_rx_sink_sink_param_ip_address = main_icmp_ip_port_source_param_ip_address;
+assign main_icmp_rx_sink_valid = main_icmp_ip_port_source_valid;
+assign main_icmp_ip_port_source_ready = main_icmp_rx_sink_ready;
+assign main_icmp_rx_sink_first = main_icmp_ip_port_source_first;
+assign main_icmp_rx_sink_last = main_icmp_ip_port_source_last;
+assign main_icmp_rx_sink_payload_data = main_icmp_ip_port_source_payload_data;
+assign main_icmp_rx_sink_payload_last_be = main_icmp_ip_port_source_payload_last_be;
+assign main_icmp_rx_sink_payload_error = main_icmp_ip_port_source_payload_error;
+assign main_icmp_rx_sink_param_length = main_icmp_ip_port_source_param_length;
+assign main_icmp_rx_sink_param_protocol = main_icmp_ip_port_source_param_protocol;
+assign main_icmp_rx_sink_param_ip_address = main_icmp_ip_port_source_param_ip_address;
 assign main_icmp_tx_packetizer_sink_valid = main_icmp_tx_sink_sink_valid;
 assign main_icmp_tx_sink_sink_ready = main_icmp_tx_packetizer_sink_ready;
 assign main_icmp_tx_packetizer_sink_last = main_icmp_tx_sink_sink_last;
@@ -4927,174 +5012,185 @@ always @(*) begin
         end
     endcase
 end
-assign main_icmp_rx_depacketizer_sink_valid = main_icmp_rx_sink_sink_valid;
-assign main_icmp_rx_sink_sink_ready = main_icmp_rx_depacketizer_sink_ready;
-assign main_icmp_rx_depacketizer_sink_first = main_icmp_rx_sink_sink_first;
-assign main_icmp_rx_depacketizer_sink_last = main_icmp_rx_sink_sink_last;
-assign main_icmp_rx_depacketizer_sink_payload_data = main_icmp_rx_sink_sink_payload_data;
-assign main_icmp_rx_depacketizer_sink_payload_last_be = main_icmp_rx_sink_sink_payload_last_be;
-assign main_icmp_rx_depacketizer_sink_payload_error = main_icmp_rx_sink_sink_payload_error;
-assign main_icmp_rx_depacketizer_sink_param_length = main_icmp_rx_sink_sink_param_length;
-assign main_icmp_rx_depacketizer_sink_param_protocol = main_icmp_rx_sink_sink_param_protocol;
-assign main_icmp_rx_depacketizer_sink_param_ip_address = main_icmp_rx_sink_sink_param_ip_address;
-assign main_icmp_rx_source_source_last = main_icmp_rx_depacketizer_source_last;
-assign main_icmp_rx_source_source_payload_data = main_icmp_rx_depacketizer_source_payload_data;
-assign main_icmp_rx_source_source_payload_last_be = main_icmp_rx_depacketizer_source_payload_last_be;
-assign main_icmp_rx_source_source_payload_error = main_icmp_rx_depacketizer_source_payload_error;
-assign main_icmp_rx_source_source_param_checksum = main_icmp_rx_depacketizer_source_param_checksum;
-assign main_icmp_rx_source_source_param_code = main_icmp_rx_depacketizer_source_param_code;
-assign main_icmp_rx_source_source_param_msgtype = main_icmp_rx_depacketizer_source_param_msgtype;
-assign main_icmp_rx_source_source_param_quench = main_icmp_rx_depacketizer_source_param_quench;
-assign main_icmp_rx_source_source_param_ip_address = main_icmp_rx_sink_sink_param_ip_address;
-assign main_icmp_rx_source_source_param_length = (main_icmp_rx_sink_sink_param_length - 4'd8);
-assign main_icmp_rx_depacketizer_header = main_icmp_rx_depacketizer_sr;
-assign main_icmp_rx_depacketizer_source_param_checksum = {builder_rhs_slice_proxy61[7:0], builder_rhs_slice_proxy60[15:8]};
-assign main_icmp_rx_depacketizer_source_param_code = {builder_rhs_slice_proxy62[7:0]};
-assign main_icmp_rx_depacketizer_source_param_msgtype = {builder_rhs_slice_proxy63[7:0]};
-assign main_icmp_rx_depacketizer_source_param_quench = {builder_rhs_slice_proxy67[7:0], builder_rhs_slice_proxy66[15:8], builder_rhs_slice_proxy65[23:16], builder_rhs_slice_proxy64[31:24]};
-assign main_icmp_rx_depacketizer_source_payload_error = main_icmp_rx_depacketizer_sink_payload_error;
-assign main_icmp_rx_depacketizer_sink_last_be = main_icmp_rx_depacketizer_sink_last;
-assign main_icmp_rx_depacketizer_new_last_be = {main_icmp_rx_depacketizer_sink_last_be};
-assign main_icmp_rx_depacketizer_is_in_copy = (main_icmp_rx_depacketizer_is_ongoing0 | main_icmp_rx_depacketizer_is_ongoing1);
+assign main_icmp_rx_liteethicmpdepacketizer_sink_valid = main_icmp_rx_sink_valid;
+assign main_icmp_rx_sink_ready = main_icmp_rx_liteethicmpdepacketizer_sink_ready;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_first = main_icmp_rx_sink_first;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_last = main_icmp_rx_sink_last;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_payload_data = main_icmp_rx_sink_payload_data;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be = main_icmp_rx_sink_payload_last_be;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_payload_error = main_icmp_rx_sink_payload_error;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_param_length = main_icmp_rx_sink_param_length;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_param_protocol = main_icmp_rx_sink_param_protocol;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_param_ip_address = main_icmp_rx_sink_param_ip_address;
+assign main_icmp_rx_source_last = main_icmp_rx_liteethicmpdepacketizer_source_last;
+assign main_icmp_rx_source_payload_data = main_icmp_rx_liteethicmpdepacketizer_source_payload_data;
+assign main_icmp_rx_source_payload_last_be = main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be;
+assign main_icmp_rx_source_payload_error = main_icmp_rx_liteethicmpdepacketizer_source_payload_error;
+assign main_icmp_rx_source_param_checksum = main_icmp_rx_liteethicmpdepacketizer_source_param_checksum;
+assign main_icmp_rx_source_param_code = main_icmp_rx_liteethicmpdepacketizer_source_param_code;
+assign main_icmp_rx_source_param_msgtype = main_icmp_rx_liteethicmpdepacketizer_source_param_msgtype;
+assign main_icmp_rx_source_param_quench = main_icmp_rx_liteethicmpdepacketizer_source_param_quench;
+assign main_icmp_rx_source_param_ip_address = main_icmp_rx_sink_param_ip_address;
+assign main_icmp_rx_source_param_length = (main_icmp_rx_sink_param_length - 4'd8);
+assign main_icmp_rx_liteethicmpdepacketizer_header = main_icmp_rx_liteethicmpdepacketizer_sr;
+assign main_icmp_rx_liteethicmpdepacketizer_source_param_checksum = {builder_rhs_slice_proxy61[7:0], builder_rhs_slice_proxy60[15:8]};
+assign main_icmp_rx_liteethicmpdepacketizer_source_param_code = {builder_rhs_slice_proxy62[7:0]};
+assign main_icmp_rx_liteethicmpdepacketizer_source_param_msgtype = {builder_rhs_slice_proxy63[7:0]};
+assign main_icmp_rx_liteethicmpdepacketizer_source_param_quench = {builder_rhs_slice_proxy67[7:0], builder_rhs_slice_proxy66[15:8], builder_rhs_slice_proxy65[23:16], builder_rhs_slice_proxy64[31:24]};
+assign main_icmp_rx_liteethicmpdepacketizer_source_payload_error = main_icmp_rx_liteethicmpdepacketizer_sink_payload_error;
+assign main_icmp_rx_liteethicmpdepacketizer_sink_last_be = main_icmp_rx_liteethicmpdepacketizer_sink_last;
+assign main_icmp_rx_liteethicmpdepacketizer_new_last_be = {main_icmp_rx_liteethicmpdepacketizer_sink_last_be};
+assign main_icmp_rx_liteethicmpdepacketizer_is_in_copy = (main_icmp_rx_liteethicmpdepacketizer_is_ongoing0 | main_icmp_rx_liteethicmpdepacketizer_is_ongoing1);
 always @(*) begin
-    main_icmp_rx_depacketizer_source_last <= 1'd0;
-    if (main_icmp_rx_depacketizer_source_last_s) begin
-        main_icmp_rx_depacketizer_source_last <= main_icmp_rx_depacketizer_source_last_b;
+    main_icmp_rx_liteethicmpdepacketizer_source_last <= 1'd0;
+    if (main_icmp_rx_liteethicmpdepacketizer_source_last_s) begin
+        main_icmp_rx_liteethicmpdepacketizer_source_last <= main_icmp_rx_liteethicmpdepacketizer_source_last_b;
     end else begin
-        main_icmp_rx_depacketizer_source_last <= main_icmp_rx_depacketizer_source_last_a;
+        main_icmp_rx_liteethicmpdepacketizer_source_last <= main_icmp_rx_liteethicmpdepacketizer_source_last_a;
     end
 end
+assign main_icmp_rx_cut = ((main_icmp_rx_liteethicmpdepacketizer_sink_valid & main_icmp_rx_liteethicmpdepacketizer_sink_last) & (main_icmp_rx_fsm_is_ongoing0 | main_icmp_rx_fsm_is_ongoing1));
 always @(*) begin
     builder_liteethicmprx_fsm0_next_state <= 2'd0;
     builder_liteethicmprx_fsm1_next_state <= 1'd0;
-    main_icmp_rx_depacketizer_count_fsm0_next_value2 <= 3'd0;
-    main_icmp_rx_depacketizer_count_fsm0_next_value_ce2 <= 1'd0;
-    main_icmp_rx_depacketizer_delayed_last_be_fsm1_next_value1 <= 1'd0;
-    main_icmp_rx_depacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd0;
-    main_icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd0;
-    main_icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd0;
-    main_icmp_rx_depacketizer_is_ongoing0 <= 1'd0;
-    main_icmp_rx_depacketizer_is_ongoing1 <= 1'd0;
-    main_icmp_rx_depacketizer_is_ongoing2 <= 1'd0;
-    main_icmp_rx_depacketizer_is_ongoing3 <= 1'd0;
-    main_icmp_rx_depacketizer_sink_ready <= 1'd0;
-    main_icmp_rx_depacketizer_source_last_a <= 1'd0;
-    main_icmp_rx_depacketizer_source_last_b <= 1'd0;
-    main_icmp_rx_depacketizer_source_last_s <= 1'd0;
-    main_icmp_rx_depacketizer_source_payload_data <= 8'd0;
-    main_icmp_rx_depacketizer_source_payload_last_be <= 1'd0;
-    main_icmp_rx_depacketizer_source_valid <= 1'd0;
-    main_icmp_rx_depacketizer_sr_shift <= 1'd0;
+    main_icmp_rx_fsm_is_ongoing0 <= 1'd0;
+    main_icmp_rx_fsm_is_ongoing1 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= 3'd0;
+    main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_is_ongoing0 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_is_ongoing1 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_is_ongoing2 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_is_ongoing3 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_last_a <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_payload_data <= 8'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_valid <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd0;
     builder_liteethicmprx_fsm0_next_state <= builder_liteethicmprx_fsm0_state;
     case (builder_liteethicmprx_fsm0_state)
         1'd1: begin
-            main_icmp_rx_depacketizer_sink_ready <= 1'd1;
-            if (main_icmp_rx_depacketizer_sink_valid) begin
-                main_icmp_rx_depacketizer_count_fsm0_next_value2 <= (main_icmp_rx_depacketizer_count + 1'd1);
-                main_icmp_rx_depacketizer_count_fsm0_next_value_ce2 <= 1'd1;
-                main_icmp_rx_depacketizer_sr_shift <= 1'd1;
-                if ((main_icmp_rx_depacketizer_count == 3'd7)) begin
+            main_icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd1;
+            if (main_icmp_rx_liteethicmpdepacketizer_sink_valid) begin
+                main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= (main_icmp_rx_liteethicmpdepacketizer_count + 1'd1);
+                main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
+                main_icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd1;
+                if ((main_icmp_rx_liteethicmpdepacketizer_count == 3'd7)) begin
                     builder_liteethicmprx_fsm0_next_state <= 2'd2;
-                    main_icmp_rx_depacketizer_count_fsm0_next_value2 <= (main_icmp_rx_depacketizer_count + 1'd1);
-                    main_icmp_rx_depacketizer_count_fsm0_next_value_ce2 <= 1'd1;
+                    main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= (main_icmp_rx_liteethicmpdepacketizer_count + 1'd1);
+                    main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            main_icmp_rx_fsm_is_ongoing1 <= 1'd1;
+            if ((main_icmp_rx_liteethicmpdepacketizer_sink_valid & main_icmp_rx_liteethicmpdepacketizer_sink_last)) begin
+                builder_liteethicmprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            main_icmp_rx_depacketizer_source_valid <= (main_icmp_rx_depacketizer_sink_valid | main_icmp_rx_depacketizer_sink_d_last);
-            main_icmp_rx_depacketizer_source_last_a <= (main_icmp_rx_depacketizer_sink_last | main_icmp_rx_depacketizer_sink_d_last);
-            main_icmp_rx_depacketizer_sink_ready <= main_icmp_rx_depacketizer_source_ready;
-            main_icmp_rx_depacketizer_source_payload_data <= main_icmp_rx_depacketizer_sink_payload_data;
-            if ((main_icmp_rx_depacketizer_source_valid & main_icmp_rx_depacketizer_source_ready)) begin
-                if (main_icmp_rx_depacketizer_source_last) begin
+            main_icmp_rx_liteethicmpdepacketizer_source_valid <= (main_icmp_rx_liteethicmpdepacketizer_sink_valid | main_icmp_rx_liteethicmpdepacketizer_sink_d_last);
+            main_icmp_rx_liteethicmpdepacketizer_source_last_a <= (main_icmp_rx_liteethicmpdepacketizer_sink_last | main_icmp_rx_liteethicmpdepacketizer_sink_d_last);
+            main_icmp_rx_liteethicmpdepacketizer_sink_ready <= main_icmp_rx_liteethicmpdepacketizer_source_ready;
+            main_icmp_rx_liteethicmpdepacketizer_source_payload_data <= main_icmp_rx_liteethicmpdepacketizer_sink_payload_data;
+            if ((main_icmp_rx_liteethicmpdepacketizer_source_valid & main_icmp_rx_liteethicmpdepacketizer_source_ready)) begin
+                if (main_icmp_rx_liteethicmpdepacketizer_source_last) begin
                     builder_liteethicmprx_fsm0_next_state <= 1'd0;
                 end
             end
-            main_icmp_rx_depacketizer_is_ongoing0 <= 1'd1;
-            main_icmp_rx_depacketizer_is_ongoing2 <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_is_ongoing0 <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            main_icmp_rx_depacketizer_is_ongoing1 <= 1'd1;
-            main_icmp_rx_depacketizer_is_ongoing3 <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_is_ongoing1 <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            main_icmp_rx_depacketizer_sink_ready <= 1'd1;
-            main_icmp_rx_depacketizer_count_fsm0_next_value2 <= 1'd1;
-            main_icmp_rx_depacketizer_count_fsm0_next_value_ce2 <= 1'd1;
-            if (main_icmp_rx_depacketizer_sink_valid) begin
-                main_icmp_rx_depacketizer_sr_shift <= 1'd1;
-                main_icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd1;
-                main_icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
+            if (main_icmp_rx_liteethicmpdepacketizer_sink_valid) begin
+                main_icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd1;
+                main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd1;
+                main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
                     builder_liteethicmprx_fsm0_next_state <= 2'd2;
                 end else begin
                     builder_liteethicmprx_fsm0_next_state <= 1'd1;
                 end
             end
+            main_icmp_rx_fsm_is_ongoing0 <= 1'd1;
+            if ((main_icmp_rx_liteethicmpdepacketizer_sink_valid & main_icmp_rx_liteethicmpdepacketizer_sink_last)) begin
+                builder_liteethicmprx_fsm0_next_state <= 1'd0;
+            end
         end
     endcase
     builder_liteethicmprx_fsm1_next_state <= builder_liteethicmprx_fsm1_state;
     case (builder_liteethicmprx_fsm1_state)
         1'd1: begin
-            main_icmp_rx_depacketizer_source_last_b <= 1'd1;
-            main_icmp_rx_depacketizer_source_last_s <= 1'd1;
-            main_icmp_rx_depacketizer_source_payload_last_be <= main_icmp_rx_depacketizer_delayed_last_be;
-            main_icmp_rx_depacketizer_sink_ready <= 1'd0;
-            if ((main_icmp_rx_depacketizer_source_ready & main_icmp_rx_depacketizer_source_valid)) begin
+            main_icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd1;
+            main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= main_icmp_rx_liteethicmpdepacketizer_delayed_last_be;
+            main_icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd0;
+            if ((main_icmp_rx_liteethicmpdepacketizer_source_ready & main_icmp_rx_liteethicmpdepacketizer_source_valid)) begin
                 builder_liteethicmprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((main_icmp_rx_depacketizer_sink_valid & main_icmp_rx_depacketizer_sink_last) & (main_icmp_rx_depacketizer_sink_last_be > main_icmp_rx_depacketizer_new_last_be))) begin
-                main_icmp_rx_depacketizer_source_last_b <= 1'd0;
-                main_icmp_rx_depacketizer_source_last_s <= 1'd1;
-                main_icmp_rx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((main_icmp_rx_depacketizer_source_ready & main_icmp_rx_depacketizer_source_valid) | ((~main_icmp_rx_depacketizer_was_in_copy) & main_icmp_rx_depacketizer_is_in_copy))) begin
-                    main_icmp_rx_depacketizer_delayed_last_be_fsm1_next_value1 <= main_icmp_rx_depacketizer_new_last_be;
-                    main_icmp_rx_depacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd1;
+            if (((main_icmp_rx_liteethicmpdepacketizer_sink_valid & main_icmp_rx_liteethicmpdepacketizer_sink_last) & (main_icmp_rx_liteethicmpdepacketizer_sink_last_be > main_icmp_rx_liteethicmpdepacketizer_new_last_be))) begin
+                main_icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd0;
+                main_icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd1;
+                main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 1'd0;
+                if (((main_icmp_rx_liteethicmpdepacketizer_source_ready & main_icmp_rx_liteethicmpdepacketizer_source_valid) | ((~main_icmp_rx_liteethicmpdepacketizer_was_in_copy) & main_icmp_rx_liteethicmpdepacketizer_is_in_copy))) begin
+                    main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 <= main_icmp_rx_liteethicmpdepacketizer_new_last_be;
+                    main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd1;
                     builder_liteethicmprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (main_icmp_rx_depacketizer_sink_last) begin
-                    main_icmp_rx_depacketizer_source_last_b <= 1'd1;
-                    main_icmp_rx_depacketizer_source_last_s <= 1'd1;
-                    main_icmp_rx_depacketizer_source_payload_last_be <= main_icmp_rx_depacketizer_new_last_be;
+                if (main_icmp_rx_liteethicmpdepacketizer_sink_last) begin
+                    main_icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd1;
+                    main_icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd1;
+                    main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= main_icmp_rx_liteethicmpdepacketizer_new_last_be;
                 end
             end
-            if ((main_icmp_rx_depacketizer_is_ongoing2 | (main_icmp_rx_depacketizer_is_ongoing3 & (~main_icmp_rx_depacketizer_fsm_from_idle)))) begin
-                main_icmp_rx_depacketizer_sink_ready <= main_icmp_rx_depacketizer_source_ready;
+            if ((main_icmp_rx_liteethicmpdepacketizer_is_ongoing2 | (main_icmp_rx_liteethicmpdepacketizer_is_ongoing3 & (~main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle)))) begin
+                main_icmp_rx_liteethicmpdepacketizer_sink_ready <= main_icmp_rx_liteethicmpdepacketizer_source_ready;
             end else begin
-                main_icmp_rx_depacketizer_sink_ready <= 1'd1;
+                main_icmp_rx_liteethicmpdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
     builder_liteethicmprx_next_state <= 2'd0;
-    main_icmp_rx_depacketizer_source_ready <= 1'd0;
-    main_icmp_rx_source_source_valid <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_ready <= 1'd0;
+    main_icmp_rx_source_valid <= 1'd0;
     builder_liteethicmprx_next_state <= builder_liteethicmprx_state;
     case (builder_liteethicmprx_state)
         1'd1: begin
-            main_icmp_rx_source_source_valid <= main_icmp_rx_depacketizer_source_valid;
-            main_icmp_rx_depacketizer_source_ready <= main_icmp_rx_source_source_ready;
-            if ((main_icmp_rx_source_source_valid & main_icmp_rx_source_source_ready)) begin
-                if (main_icmp_rx_source_source_last) begin
+            main_icmp_rx_source_valid <= main_icmp_rx_liteethicmpdepacketizer_source_valid;
+            main_icmp_rx_liteethicmpdepacketizer_source_ready <= main_icmp_rx_source_ready;
+            if ((main_icmp_rx_source_valid & main_icmp_rx_source_ready)) begin
+                if (main_icmp_rx_source_last) begin
                     builder_liteethicmprx_next_state <= 1'd0;
                 end
             end
         end
         2'd2: begin
-            main_icmp_rx_depacketizer_source_ready <= 1'd1;
-            if (((main_icmp_rx_depacketizer_source_valid & main_icmp_rx_depacketizer_source_last) & main_icmp_rx_depacketizer_source_ready)) begin
+            main_icmp_rx_liteethicmpdepacketizer_source_ready <= 1'd1;
+            if (((main_icmp_rx_liteethicmpdepacketizer_source_valid & main_icmp_rx_liteethicmpdepacketizer_source_last) & main_icmp_rx_liteethicmpdepacketizer_source_ready)) begin
                 builder_liteethicmprx_next_state <= 1'd0;
             end
         end
         default: begin
-            if (main_icmp_rx_depacketizer_source_valid) begin
+            if (main_icmp_rx_liteethicmpdepacketizer_source_valid) begin
                 builder_liteethicmprx_next_state <= 2'd2;
-                if ((main_icmp_rx_sink_sink_param_protocol == 1'd1)) begin
-                    if ((main_icmp_rx_depacketizer_source_param_msgtype == 4'd8)) begin
+                if ((main_icmp_rx_sink_param_protocol == 1'd1)) begin
+                    if ((main_icmp_rx_liteethicmpdepacketizer_source_param_msgtype == 4'd8)) begin
                         builder_liteethicmprx_next_state <= 1'd1;
                     end
                 end
@@ -5266,16 +5362,16 @@ assign main_ip_port_sink_payload_error = main_source_source_payload_error;
 assign main_ip_port_sink_param_length = main_source_source_param_length;
 assign main_ip_port_sink_param_protocol = main_source_source_param_protocol;
 assign main_ip_port_sink_param_ip_address = main_source_source_param_ip_address;
-assign main_holdingudprx_sink_sink_valid = main_ip_port_source_valid;
-assign main_ip_port_source_ready = main_holdingudprx_sink_sink_ready;
-assign main_holdingudprx_sink_sink_first = main_ip_port_source_first;
-assign main_holdingudprx_sink_sink_last = main_ip_port_source_last;
-assign main_holdingudprx_sink_sink_payload_data = main_ip_port_source_payload_data;
-assign main_holdingudprx_sink_sink_payload_last_be = main_ip_port_source_payload_last_be;
-assign main_holdingudprx_sink_sink_payload_error = main_ip_port_source_payload_error;
-assign main_holdingudprx_sink_sink_param_length = main_ip_port_source_param_length;
-assign main_holdingudprx_sink_sink_param_protocol = main_ip_port_source_param_protocol;
-assign main_holdingudprx_sink_sink_param_ip_address = main_ip_port_source_param_ip_address;
+assign main_holdingudprx_sink_valid = main_ip_port_source_valid;
+assign main_ip_port_source_ready = main_holdingudprx_sink_ready;
+assign main_holdingudprx_sink_first = main_ip_port_source_first;
+assign main_holdingudprx_sink_last = main_ip_port_source_last;
+assign main_holdingudprx_sink_payload_data = main_ip_port_source_payload_data;
+assign main_holdingudprx_sink_payload_last_be = main_ip_port_source_payload_last_be;
+assign main_holdingudprx_sink_payload_error = main_ip_port_source_payload_error;
+assign main_holdingudprx_sink_param_length = main_ip_port_source_param_length;
+assign main_holdingudprx_sink_param_protocol = main_ip_port_source_param_protocol;
+assign main_holdingudprx_sink_param_ip_address = main_ip_port_source_param_ip_address;
 assign main_sink_sink_valid = main_crossbar_source_valid;
 assign main_crossbar_source_ready = main_sink_sink_ready;
 assign main_sink_sink_first = main_crossbar_source_first;
@@ -5287,17 +5383,17 @@ assign main_sink_sink_param_src_port = main_crossbar_source_param_src_port;
 assign main_sink_sink_param_dst_port = main_crossbar_source_param_dst_port;
 assign main_sink_sink_param_ip_address = main_crossbar_source_param_ip_address;
 assign main_sink_sink_param_length = main_crossbar_source_param_length;
-assign main_crossbar_sink_valid = main_holdingudprx_source_source_valid;
-assign main_holdingudprx_source_source_ready = main_crossbar_sink_ready;
-assign main_crossbar_sink_first = main_holdingudprx_source_source_first;
-assign main_crossbar_sink_last = main_holdingudprx_source_source_last;
-assign main_crossbar_sink_payload_data = main_holdingudprx_source_source_payload_data;
-assign main_crossbar_sink_payload_last_be = main_holdingudprx_source_source_payload_last_be;
-assign main_crossbar_sink_payload_error = main_holdingudprx_source_source_payload_error;
-assign main_crossbar_sink_param_src_port = main_holdingudprx_source_source_param_src_port;
-assign main_crossbar_sink_param_dst_port = main_holdingudprx_source_source_param_dst_port;
-assign main_crossbar_sink_param_ip_address = main_holdingudprx_source_source_param_ip_address;
-assign main_crossbar_sink_param_length = main_holdingudprx_source_source_param_length;
+assign main_crossbar_sink_valid = main_holdingudprx_source_valid;
+assign main_holdingudprx_source_ready = main_crossbar_sink_ready;
+assign main_crossbar_sink_first = main_holdingudprx_source_first;
+assign main_crossbar_sink_last = main_holdingudprx_source_last;
+assign main_crossbar_sink_payload_data = main_holdingudprx_source_payload_data;
+assign main_crossbar_sink_payload_last_be = main_holdingudprx_source_payload_last_be;
+assign main_crossbar_sink_payload_error = main_holdingudprx_source_payload_error;
+assign main_crossbar_sink_param_src_port = main_holdingudprx_source_param_src_port;
+assign main_crossbar_sink_param_dst_port = main_holdingudprx_source_param_dst_port;
+assign main_crossbar_sink_param_ip_address = main_holdingudprx_source_param_ip_address;
+assign main_crossbar_sink_param_length = main_holdingudprx_source_param_length;
 assign main_packetizer_sink_valid = main_sink_sink_valid;
 assign main_sink_sink_ready = main_packetizer_sink_ready;
 assign main_packetizer_sink_last = main_sink_sink_last;
@@ -5483,231 +5579,269 @@ always @(*) begin
         end
     endcase
 end
-assign main_holdingudprx_depacketizer_sink_valid = main_holdingudprx_sink_sink_valid;
-assign main_holdingudprx_sink_sink_ready = main_holdingudprx_depacketizer_sink_ready;
-assign main_holdingudprx_depacketizer_sink_first = main_holdingudprx_sink_sink_first;
-assign main_holdingudprx_depacketizer_sink_last = main_holdingudprx_sink_sink_last;
-assign main_holdingudprx_depacketizer_sink_payload_data = main_holdingudprx_sink_sink_payload_data;
-assign main_holdingudprx_depacketizer_sink_payload_last_be = main_holdingudprx_sink_sink_payload_last_be;
-assign main_holdingudprx_depacketizer_sink_payload_error = main_holdingudprx_sink_sink_payload_error;
-assign main_holdingudprx_depacketizer_sink_param_length = main_holdingudprx_sink_sink_param_length;
-assign main_holdingudprx_depacketizer_sink_param_protocol = main_holdingudprx_sink_sink_param_protocol;
-assign main_holdingudprx_depacketizer_sink_param_ip_address = main_holdingudprx_sink_sink_param_ip_address;
-assign main_holdingudprx_payload_len = (main_holdingudprx_depacketizer_source_param_length - 4'd8);
-assign main_holdingudprx_depacketizer_header = main_holdingudprx_depacketizer_sr;
-assign main_holdingudprx_depacketizer_source_param_checksum = {builder_rhs_slice_proxy69[7:0], builder_rhs_slice_proxy68[15:8]};
-assign main_holdingudprx_depacketizer_source_param_dst_port = {builder_rhs_slice_proxy71[7:0], builder_rhs_slice_proxy70[15:8]};
-assign main_holdingudprx_depacketizer_source_param_length = {builder_rhs_slice_proxy73[7:0], builder_rhs_slice_proxy72[15:8]};
-assign main_holdingudprx_depacketizer_source_param_src_port = {builder_rhs_slice_proxy75[7:0], builder_rhs_slice_proxy74[15:8]};
-assign main_holdingudprx_depacketizer_source_payload_error = main_holdingudprx_depacketizer_sink_payload_error;
-assign main_holdingudprx_depacketizer_sink_last_be = main_holdingudprx_depacketizer_sink_last;
-assign main_holdingudprx_depacketizer_new_last_be = {main_holdingudprx_depacketizer_sink_last_be};
-assign main_holdingudprx_depacketizer_is_in_copy = (main_holdingudprx_depacketizer_is_ongoing0 | main_holdingudprx_depacketizer_is_ongoing1);
+assign main_holdingudprx_liteethudpdepacketizer_sink_valid = main_holdingudprx_sink_valid;
+assign main_holdingudprx_sink_ready = main_holdingudprx_liteethudpdepacketizer_sink_ready;
+assign main_holdingudprx_liteethudpdepacketizer_sink_first = main_holdingudprx_sink_first;
+assign main_holdingudprx_liteethudpdepacketizer_sink_last = main_holdingudprx_sink_last;
+assign main_holdingudprx_liteethudpdepacketizer_sink_payload_data = main_holdingudprx_sink_payload_data;
+assign main_holdingudprx_liteethudpdepacketizer_sink_payload_last_be = main_holdingudprx_sink_payload_last_be;
+assign main_holdingudprx_liteethudpdepacketizer_sink_payload_error = main_holdingudprx_sink_payload_error;
+assign main_holdingudprx_liteethudpdepacketizer_sink_param_length = main_holdingudprx_sink_param_length;
+assign main_holdingudprx_liteethudpdepacketizer_sink_param_protocol = main_holdingudprx_sink_param_protocol;
+assign main_holdingudprx_liteethudpdepacketizer_sink_param_ip_address = main_holdingudprx_sink_param_ip_address;
+assign main_holdingudprx_payload_len = (main_holdingudprx_liteethudpdepacketizer_source_param_length - 4'd8);
+assign main_holdingudprx_cut1 = (main_holdingudprx_rest != 1'd0);
+assign main_holdingudprx_liteethudpdepacketizer_header = main_holdingudprx_liteethudpdepacketizer_sr;
+assign main_holdingudprx_liteethudpdepacketizer_source_param_checksum = {builder_rhs_slice_proxy69[7:0], builder_rhs_slice_proxy68[15:8]};
+assign main_holdingudprx_liteethudpdepacketizer_source_param_dst_port = {builder_rhs_slice_proxy71[7:0], builder_rhs_slice_proxy70[15:8]};
+assign main_holdingudprx_liteethudpdepacketizer_source_param_length = {builder_rhs_slice_proxy73[7:0], builder_rhs_slice_proxy72[15:8]};
+assign main_holdingudprx_liteethudpdepacketizer_source_param_src_port = {builder_rhs_slice_proxy75[7:0], builder_rhs_slice_proxy74[15:8]};
+assign main_holdingudprx_liteethudpdepacketizer_source_payload_error = main_holdingudprx_liteethudpdepacketizer_sink_payload_error;
+assign main_holdingudprx_liteethudpdepacketizer_sink_last_be = main_holdingudprx_liteethudpdepacketizer_sink_last;
+assign main_holdingudprx_liteethudpdepacketizer_new_last_be = {main_holdingudprx_liteethudpdepacketizer_sink_last_be};
+assign main_holdingudprx_liteethudpdepacketizer_is_in_copy = (main_holdingudprx_liteethudpdepacketizer_is_ongoing0 | main_holdingudprx_liteethudpdepacketizer_is_ongoing1);
 always @(*) begin
-    main_holdingudprx_depacketizer_source_last <= 1'd0;
-    if (main_holdingudprx_depacketizer_source_last_s) begin
-        main_holdingudprx_depacketizer_source_last <= main_holdingudprx_depacketizer_source_last_b;
+    main_holdingudprx_liteethudpdepacketizer_source_last <= 1'd0;
+    if (main_holdingudprx_liteethudpdepacketizer_source_last_s) begin
+        main_holdingudprx_liteethudpdepacketizer_source_last <= main_holdingudprx_liteethudpdepacketizer_source_last_b;
     end else begin
-        main_holdingudprx_depacketizer_source_last <= main_holdingudprx_depacketizer_source_last_a;
+        main_holdingudprx_liteethudpdepacketizer_source_last <= main_holdingudprx_liteethudpdepacketizer_source_last_a;
     end
 end
+assign main_holdingudprx_cut0 = ((main_holdingudprx_liteethudpdepacketizer_sink_valid & main_holdingudprx_liteethudpdepacketizer_sink_last) & (main_holdingudprx_fsm_is_ongoing0 | main_holdingudprx_fsm_is_ongoing1));
 always @(*) begin
     builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd0;
     builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
-    main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
-    main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
-    main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
-    main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
-    main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
-    main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
-    main_holdingudprx_depacketizer_is_ongoing0 <= 1'd0;
-    main_holdingudprx_depacketizer_is_ongoing1 <= 1'd0;
-    main_holdingudprx_depacketizer_is_ongoing2 <= 1'd0;
-    main_holdingudprx_depacketizer_is_ongoing3 <= 1'd0;
-    main_holdingudprx_depacketizer_sink_ready <= 1'd0;
-    main_holdingudprx_depacketizer_source_last_a <= 1'd0;
-    main_holdingudprx_depacketizer_source_last_b <= 1'd0;
-    main_holdingudprx_depacketizer_source_last_s <= 1'd0;
-    main_holdingudprx_depacketizer_source_payload_data <= 8'd0;
-    main_holdingudprx_depacketizer_source_payload_last_be <= 1'd0;
-    main_holdingudprx_depacketizer_source_valid <= 1'd0;
-    main_holdingudprx_depacketizer_sr_shift <= 1'd0;
+    main_holdingudprx_fsm_is_ongoing0 <= 1'd0;
+    main_holdingudprx_fsm_is_ongoing1 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
+    main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_is_ongoing3 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_source_last_a <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_source_payload_data <= 8'd0;
+    main_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_source_valid <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd0;
     builder_liteethudp_holdingudprx_fsm0_next_state <= builder_liteethudp_holdingudprx_fsm0_state;
     case (builder_liteethudp_holdingudprx_fsm0_state)
         1'd1: begin
-            main_holdingudprx_depacketizer_sink_ready <= 1'd1;
-            if (main_holdingudprx_depacketizer_sink_valid) begin
-                main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= (main_holdingudprx_depacketizer_count + 1'd1);
-                main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-                main_holdingudprx_depacketizer_sr_shift <= 1'd1;
-                if ((main_holdingudprx_depacketizer_count == 3'd7)) begin
+            main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
+            if (main_holdingudprx_liteethudpdepacketizer_sink_valid) begin
+                main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= (main_holdingudprx_liteethudpdepacketizer_count + 1'd1);
+                main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+                main_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
+                if ((main_holdingudprx_liteethudpdepacketizer_count == 3'd7)) begin
                     builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
-                    main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= (main_holdingudprx_depacketizer_count + 1'd1);
-                    main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+                    main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= (main_holdingudprx_liteethudpdepacketizer_count + 1'd1);
+                    main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
                 end
+            end
+            main_holdingudprx_fsm_is_ongoing1 <= 1'd1;
+            if ((main_holdingudprx_liteethudpdepacketizer_sink_valid & main_holdingudprx_liteethudpdepacketizer_sink_last)) begin
+                builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            main_holdingudprx_depacketizer_source_valid <= (main_holdingudprx_depacketizer_sink_valid | main_holdingudprx_depacketizer_sink_d_last);
-            main_holdingudprx_depacketizer_source_last_a <= (main_holdingudprx_depacketizer_sink_last | main_holdingudprx_depacketizer_sink_d_last);
-            main_holdingudprx_depacketizer_sink_ready <= main_holdingudprx_depacketizer_source_ready;
-            main_holdingudprx_depacketizer_source_payload_data <= main_holdingudprx_depacketizer_sink_payload_data;
-            if ((main_holdingudprx_depacketizer_source_valid & main_holdingudprx_depacketizer_source_ready)) begin
-                if (main_holdingudprx_depacketizer_source_last) begin
+            main_holdingudprx_liteethudpdepacketizer_source_valid <= (main_holdingudprx_liteethudpdepacketizer_sink_valid | main_holdingudprx_liteethudpdepacketizer_sink_d_last);
+            main_holdingudprx_liteethudpdepacketizer_source_last_a <= (main_holdingudprx_liteethudpdepacketizer_sink_last | main_holdingudprx_liteethudpdepacketizer_sink_d_last);
+            main_holdingudprx_liteethudpdepacketizer_sink_ready <= main_holdingudprx_liteethudpdepacketizer_source_ready;
+            main_holdingudprx_liteethudpdepacketizer_source_payload_data <= main_holdingudprx_liteethudpdepacketizer_sink_payload_data;
+            if ((main_holdingudprx_liteethudpdepacketizer_source_valid & main_holdingudprx_liteethudpdepacketizer_source_ready)) begin
+                if (main_holdingudprx_liteethudpdepacketizer_source_last) begin
                     builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
                 end
             end
-            main_holdingudprx_depacketizer_is_ongoing0 <= 1'd1;
-            main_holdingudprx_depacketizer_is_ongoing2 <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            main_holdingudprx_depacketizer_is_ongoing1 <= 1'd1;
-            main_holdingudprx_depacketizer_is_ongoing3 <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            main_holdingudprx_depacketizer_sink_ready <= 1'd1;
-            main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
-            main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-            if (main_holdingudprx_depacketizer_sink_valid) begin
-                main_holdingudprx_depacketizer_sr_shift <= 1'd1;
-                main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
-                main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+            if (main_holdingudprx_liteethudpdepacketizer_sink_valid) begin
+                main_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
+                main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
+                main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
                     builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
                 end else begin
                     builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd1;
                 end
             end
+            main_holdingudprx_fsm_is_ongoing0 <= 1'd1;
+            if ((main_holdingudprx_liteethudpdepacketizer_sink_valid & main_holdingudprx_liteethudpdepacketizer_sink_last)) begin
+                builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
+            end
         end
     endcase
     builder_liteethudp_holdingudprx_fsm1_next_state <= builder_liteethudp_holdingudprx_fsm1_state;
     case (builder_liteethudp_holdingudprx_fsm1_state)
         1'd1: begin
-            main_holdingudprx_depacketizer_source_last_b <= 1'd1;
-            main_holdingudprx_depacketizer_source_last_s <= 1'd1;
-            main_holdingudprx_depacketizer_source_payload_last_be <= main_holdingudprx_depacketizer_delayed_last_be;
-            main_holdingudprx_depacketizer_sink_ready <= 1'd0;
-            if ((main_holdingudprx_depacketizer_source_ready & main_holdingudprx_depacketizer_source_valid)) begin
+            main_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+            main_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= main_holdingudprx_liteethudpdepacketizer_delayed_last_be;
+            main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
+            if ((main_holdingudprx_liteethudpdepacketizer_source_ready & main_holdingudprx_liteethudpdepacketizer_source_valid)) begin
                 builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((main_holdingudprx_depacketizer_sink_valid & main_holdingudprx_depacketizer_sink_last) & (main_holdingudprx_depacketizer_sink_last_be > main_holdingudprx_depacketizer_new_last_be))) begin
-                main_holdingudprx_depacketizer_source_last_b <= 1'd0;
-                main_holdingudprx_depacketizer_source_last_s <= 1'd1;
-                main_holdingudprx_depacketizer_source_payload_last_be <= 1'd0;
-                if (((main_holdingudprx_depacketizer_source_ready & main_holdingudprx_depacketizer_source_valid) | ((~main_holdingudprx_depacketizer_was_in_copy) & main_holdingudprx_depacketizer_is_in_copy))) begin
-                    main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= main_holdingudprx_depacketizer_new_last_be;
-                    main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
+            if (((main_holdingudprx_liteethudpdepacketizer_sink_valid & main_holdingudprx_liteethudpdepacketizer_sink_last) & (main_holdingudprx_liteethudpdepacketizer_sink_last_be > main_holdingudprx_liteethudpdepacketizer_new_last_be))) begin
+                main_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd0;
+                main_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+                main_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
+                if (((main_holdingudprx_liteethudpdepacketizer_source_ready & main_holdingudprx_liteethudpdepacketizer_source_valid) | ((~main_holdingudprx_liteethudpdepacketizer_was_in_copy) & main_holdingudprx_liteethudpdepacketizer_is_in_copy))) begin
+                    main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= main_holdingudprx_liteethudpdepacketizer_new_last_be;
+                    main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
                     builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (main_holdingudprx_depacketizer_sink_last) begin
-                    main_holdingudprx_depacketizer_source_last_b <= 1'd1;
-                    main_holdingudprx_depacketizer_source_last_s <= 1'd1;
-                    main_holdingudprx_depacketizer_source_payload_last_be <= main_holdingudprx_depacketizer_new_last_be;
+                if (main_holdingudprx_liteethudpdepacketizer_sink_last) begin
+                    main_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
+                    main_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+                    main_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= main_holdingudprx_liteethudpdepacketizer_new_last_be;
                 end
             end
-            if ((main_holdingudprx_depacketizer_is_ongoing2 | (main_holdingudprx_depacketizer_is_ongoing3 & (~main_holdingudprx_depacketizer_fsm_from_idle)))) begin
-                main_holdingudprx_depacketizer_sink_ready <= main_holdingudprx_depacketizer_source_ready;
+            if ((main_holdingudprx_liteethudpdepacketizer_is_ongoing2 | (main_holdingudprx_liteethudpdepacketizer_is_ongoing3 & (~main_holdingudprx_liteethudpdepacketizer_fsm_from_idle)))) begin
+                main_holdingudprx_liteethudpdepacketizer_sink_ready <= main_holdingudprx_liteethudpdepacketizer_source_ready;
             end else begin
-                main_holdingudprx_depacketizer_sink_ready <= 1'd1;
+                main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
     builder_liteethudp_holdingudprx_next_state <= 3'd0;
-    main_holdingudprx0_liteethudp_next_value3 <= 16'd0;
-    main_holdingudprx0_liteethudp_next_value_ce3 <= 1'd0;
-    main_holdingudprx1_liteethudp_next_value4 <= 16'd0;
-    main_holdingudprx1_liteethudp_next_value_ce4 <= 1'd0;
-    main_holdingudprx2_liteethudp_next_value5 <= 16'd0;
-    main_holdingudprx2_liteethudp_next_value_ce5 <= 1'd0;
-    main_holdingudprx3_liteethudp_next_value6 <= 32'd0;
-    main_holdingudprx3_liteethudp_next_value_ce6 <= 1'd0;
+    main_holdingudprx0_liteethudp_next_value4 <= 16'd0;
+    main_holdingudprx0_liteethudp_next_value_ce4 <= 1'd0;
+    main_holdingudprx1_liteethudp_next_value5 <= 16'd0;
+    main_holdingudprx1_liteethudp_next_value_ce5 <= 1'd0;
+    main_holdingudprx2_liteethudp_next_value6 <= 16'd0;
+    main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd0;
+    main_holdingudprx3_liteethudp_next_value7 <= 32'd0;
+    main_holdingudprx3_liteethudp_next_value_ce7 <= 1'd0;
     main_holdingudprx_count_liteethudp_next_value0 <= 16'd0;
     main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd0;
-    main_holdingudprx_depacketizer_source_ready <= 1'd0;
+    main_holdingudprx_drop_header <= 1'd0;
     main_holdingudprx_err_liteethudp_next_value1 <= 1'd0;
     main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd0;
-    main_holdingudprx_held_liteethudp_next_value2 <= 8'd0;
-    main_holdingudprx_held_liteethudp_next_value_ce2 <= 1'd0;
-    main_holdingudprx_source_source_last <= 1'd0;
-    main_holdingudprx_source_source_param_dst_port <= 16'd0;
-    main_holdingudprx_source_source_param_ip_address <= 32'd0;
-    main_holdingudprx_source_source_param_length <= 16'd0;
-    main_holdingudprx_source_source_param_src_port <= 16'd0;
-    main_holdingudprx_source_source_payload_data <= 8'd0;
-    main_holdingudprx_source_source_payload_error <= 1'd0;
-    main_holdingudprx_source_source_valid <= 1'd0;
+    main_holdingudprx_held_liteethudp_next_value3 <= 8'd0;
+    main_holdingudprx_held_liteethudp_next_value_ce3 <= 1'd0;
+    main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
+    main_holdingudprx_rest_liteethudp_next_value2 <= 16'd0;
+    main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd0;
+    main_holdingudprx_source_last <= 1'd0;
+    main_holdingudprx_source_param_dst_port <= 16'd0;
+    main_holdingudprx_source_param_ip_address <= 32'd0;
+    main_holdingudprx_source_param_length <= 16'd0;
+    main_holdingudprx_source_param_src_port <= 16'd0;
+    main_holdingudprx_source_payload_data <= 8'd0;
+    main_holdingudprx_source_payload_error <= 1'd0;
+    main_holdingudprx_source_valid <= 1'd0;
     builder_liteethudp_holdingudprx_next_state <= builder_liteethudp_holdingudprx_state;
     case (builder_liteethudp_holdingudprx_state)
         1'd1: begin
-            main_holdingudprx_source_source_param_src_port <= main_holdingudprx_depacketizer_source_param_src_port;
-            main_holdingudprx_source_source_param_dst_port <= main_holdingudprx_depacketizer_source_param_dst_port;
-            main_holdingudprx_source_source_param_length <= main_holdingudprx_payload_len;
-            main_holdingudprx_source_source_param_ip_address <= main_holdingudprx_sink_sink_param_ip_address;
-            main_holdingudprx_source_source_payload_data <= main_holdingudprx_depacketizer_source_payload_data;
-            if ((main_holdingudprx_depacketizer_source_last | (main_holdingudprx_count < main_holdingudprx_payload_len))) begin
-                main_holdingudprx_source_source_valid <= main_holdingudprx_depacketizer_source_valid;
-                main_holdingudprx_depacketizer_source_ready <= main_holdingudprx_source_source_ready;
-                main_holdingudprx_source_source_last <= main_holdingudprx_depacketizer_source_last;
-                main_holdingudprx_source_source_payload_error <= (main_holdingudprx_depacketizer_source_payload_error | main_holdingudprx_err);
-                if ((main_holdingudprx_depacketizer_source_valid & main_holdingudprx_source_source_ready)) begin
+            main_holdingudprx_source_param_src_port <= main_holdingudprx_liteethudpdepacketizer_source_param_src_port;
+            main_holdingudprx_source_param_dst_port <= main_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+            main_holdingudprx_source_param_length <= main_holdingudprx_payload_len;
+            main_holdingudprx_source_param_ip_address <= main_holdingudprx_sink_param_ip_address;
+            main_holdingudprx_source_payload_data <= main_holdingudprx_liteethudpdepacketizer_source_payload_data;
+            if ((main_holdingudprx_liteethudpdepacketizer_source_last | (main_holdingudprx_count < main_holdingudprx_payload_len))) begin
+                main_holdingudprx_source_valid <= main_holdingudprx_liteethudpdepacketizer_source_valid;
+                main_holdingudprx_liteethudpdepacketizer_source_ready <= main_holdingudprx_source_ready;
+                main_holdingudprx_source_last <= main_holdingudprx_liteethudpdepacketizer_source_last;
+                main_holdingudprx_source_payload_error <= (main_holdingudprx_liteethudpdepacketizer_source_payload_error | main_holdingudprx_err);
+                if ((main_holdingudprx_liteethudpdepacketizer_source_last & main_holdingudprx_cut1)) begin
+                    main_holdingudprx_source_param_length <= 1'd0;
+                end
+                if ((main_holdingudprx_liteethudpdepacketizer_source_valid & main_holdingudprx_source_ready)) begin
                     main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
                     main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
-                    main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_depacketizer_source_payload_error);
+                    if (main_holdingudprx_cut1) begin
+                        main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
+                        main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    end
+                    main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_liteethudpdepacketizer_source_payload_error);
                     main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    if (main_holdingudprx_depacketizer_source_last) begin
+                    if (main_holdingudprx_liteethudpdepacketizer_source_last) begin
                         builder_liteethudp_holdingudprx_next_state <= 1'd0;
                     end
                 end
             end else begin
-                main_holdingudprx_depacketizer_source_ready <= 1'd1;
-                if (main_holdingudprx_depacketizer_source_valid) begin
-                    main_holdingudprx_held_liteethudp_next_value2 <= main_holdingudprx_depacketizer_source_payload_data;
-                    main_holdingudprx_held_liteethudp_next_value_ce2 <= 1'd1;
-                    main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_depacketizer_source_payload_error);
+                main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+                if (main_holdingudprx_liteethudpdepacketizer_source_valid) begin
+                    main_holdingudprx_held_liteethudp_next_value3 <= main_holdingudprx_liteethudpdepacketizer_source_payload_data;
+                    main_holdingudprx_held_liteethudp_next_value_ce3 <= 1'd1;
+                    main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_liteethudpdepacketizer_source_payload_error);
                     main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    main_holdingudprx0_liteethudp_next_value3 <= main_holdingudprx_depacketizer_source_param_src_port;
-                    main_holdingudprx0_liteethudp_next_value_ce3 <= 1'd1;
-                    main_holdingudprx1_liteethudp_next_value4 <= main_holdingudprx_depacketizer_source_param_dst_port;
-                    main_holdingudprx1_liteethudp_next_value_ce4 <= 1'd1;
-                    main_holdingudprx2_liteethudp_next_value5 <= main_holdingudprx_payload_len;
-                    main_holdingudprx2_liteethudp_next_value_ce5 <= 1'd1;
-                    main_holdingudprx3_liteethudp_next_value6 <= main_holdingudprx_sink_sink_param_ip_address;
-                    main_holdingudprx3_liteethudp_next_value_ce6 <= 1'd1;
+                    main_holdingudprx0_liteethudp_next_value4 <= main_holdingudprx_liteethudpdepacketizer_source_param_src_port;
+                    main_holdingudprx0_liteethudp_next_value_ce4 <= 1'd1;
+                    main_holdingudprx1_liteethudp_next_value5 <= main_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+                    main_holdingudprx1_liteethudp_next_value_ce5 <= 1'd1;
+                    main_holdingudprx2_liteethudp_next_value6 <= main_holdingudprx_payload_len;
+                    main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
+                    main_holdingudprx3_liteethudp_next_value7 <= main_holdingudprx_sink_param_ip_address;
+                    main_holdingudprx3_liteethudp_next_value_ce7 <= 1'd1;
+                    main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
+                    main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    if (main_holdingudprx_cut1) begin
+                        main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
+                        main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    end
                     builder_liteethudp_holdingudprx_next_state <= 2'd2;
                 end
             end
         end
         2'd2: begin
-            main_holdingudprx_depacketizer_source_ready <= 1'd1;
-            if (main_holdingudprx_depacketizer_source_valid) begin
-                main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_depacketizer_source_payload_error);
+            main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+            if (main_holdingudprx_liteethudpdepacketizer_source_valid) begin
+                main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_liteethudpdepacketizer_source_payload_error);
                 main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                if (main_holdingudprx_depacketizer_source_last) begin
+                main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
+                main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                if (main_holdingudprx_cut1) begin
+                    main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
+                    main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                end
+                if (main_holdingudprx_liteethudpdepacketizer_source_last) begin
+                    if (main_holdingudprx_cut1) begin
+                        main_holdingudprx2_liteethudp_next_value6 <= 1'd0;
+                        main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
+                    end
                     builder_liteethudp_holdingudprx_next_state <= 2'd3;
                 end
             end
         end
         2'd3: begin
-            main_holdingudprx_source_source_valid <= 1'd1;
-            main_holdingudprx_source_source_last <= 1'd1;
-            main_holdingudprx_source_source_payload_data <= main_holdingudprx_held;
-            main_holdingudprx_source_source_payload_error <= main_holdingudprx_err;
-            main_holdingudprx_source_source_param_src_port <= main_holdingudprx0;
-            main_holdingudprx_source_source_param_dst_port <= main_holdingudprx1;
-            main_holdingudprx_source_source_param_length <= main_holdingudprx2;
-            main_holdingudprx_source_source_param_ip_address <= main_holdingudprx3;
-            if (main_holdingudprx_source_source_ready) begin
+            main_holdingudprx_source_valid <= 1'd1;
+            main_holdingudprx_source_last <= 1'd1;
+            main_holdingudprx_source_payload_data <= main_holdingudprx_held;
+            main_holdingudprx_source_payload_error <= main_holdingudprx_err;
+            main_holdingudprx_source_param_src_port <= main_holdingudprx0;
+            main_holdingudprx_source_param_dst_port <= main_holdingudprx1;
+            main_holdingudprx_source_param_length <= main_holdingudprx2;
+            main_holdingudprx_source_param_ip_address <= main_holdingudprx3;
+            if (main_holdingudprx_source_ready) begin
                 builder_liteethudp_holdingudprx_next_state <= 1'd0;
             end
         end
         3'd4: begin
-            main_holdingudprx_depacketizer_source_ready <= 1'd1;
-            if ((main_holdingudprx_depacketizer_source_valid & main_holdingudprx_depacketizer_source_last)) begin
+            main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+            if ((main_holdingudprx_liteethudpdepacketizer_source_valid & main_holdingudprx_liteethudpdepacketizer_source_last)) begin
                 builder_liteethudp_holdingudprx_next_state <= 1'd0;
             end
         end
@@ -5716,10 +5850,20 @@ always @(*) begin
             main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
             main_holdingudprx_err_liteethudp_next_value1 <= 1'd0;
             main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-            if (main_holdingudprx_depacketizer_source_valid) begin
+            main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_sink_param_length - 4'd9);
+            main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            if ((main_holdingudprx_sink_param_length <= 4'd8)) begin
+                main_holdingudprx_rest_liteethudp_next_value2 <= 1'd0;
+                main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            end
+            if (main_holdingudprx_liteethudpdepacketizer_source_valid) begin
                 builder_liteethudp_holdingudprx_next_state <= 3'd4;
-                if ((main_holdingudprx_sink_sink_param_protocol == 5'd17)) begin
-                    builder_liteethudp_holdingudprx_next_state <= 1'd1;
+                if ((main_holdingudprx_sink_param_protocol == 5'd17)) begin
+                    if ((main_holdingudprx_liteethudpdepacketizer_source_param_length > main_holdingudprx_sink_param_length)) begin
+                        main_holdingudprx_drop_header <= 1'd1;
+                    end else begin
+                        builder_liteethudp_holdingudprx_next_state <= 1'd1;
+                    end
                 end
             end
         end
@@ -5791,6 +5935,8 @@ assign main_user_port_source_param_src_port = main_rx_cdc_source_param_src_port;
 assign main_user_port_source_param_dst_port = main_rx_cdc_source_param_dst_port;
 assign main_user_port_source_param_ip_address = main_rx_cdc_source_param_ip_address;
 assign main_user_port_source_param_length = main_rx_cdc_source_param_length;
+assign builder_liteethudp_taken = ((1'd0 + main_internal_port_source_valid) != 1'd0);
+assign main_crossbar_dropped = (((main_crossbar_sink_valid & main_crossbar_sink_ready) & main_crossbar_sink_last) & (~builder_liteethudp_taken));
 always @(*) begin
     builder_liteethudp_sel0 <= 1'd0;
     if ((main_crossbar_sink_param_dst_port == udp_rx_port)) begin
@@ -6015,82 +6161,82 @@ assign builder_interface0_bank_bus_dat_w = builder_dat_w;
 assign builder_interface1_bank_bus_dat_w = builder_dat_w;
 assign builder_dat_r = (builder_interface0_bank_bus_dat_r | builder_interface1_bank_bus_dat_r);
 assign builder_cases_slice_proxy = {main_mac_core_tx_crc_value, main_mac_core_tx_crc_sink_payload_data[7:0]};
-assign builder_rhs_slice_proxy0 = main_mac_depacketizer_header[111:96];
-assign builder_rhs_slice_proxy1 = main_mac_depacketizer_header[111:96];
-assign builder_rhs_slice_proxy2 = main_mac_depacketizer_header[95:48];
-assign builder_rhs_slice_proxy3 = main_mac_depacketizer_header[95:48];
-assign builder_rhs_slice_proxy4 = main_mac_depacketizer_header[95:48];
-assign builder_rhs_slice_proxy5 = main_mac_depacketizer_header[95:48];
-assign builder_rhs_slice_proxy6 = main_mac_depacketizer_header[95:48];
-assign builder_rhs_slice_proxy7 = main_mac_depacketizer_header[95:48];
-assign builder_rhs_slice_proxy8 = main_mac_depacketizer_header[47:0];
-assign builder_rhs_slice_proxy9 = main_mac_depacketizer_header[47:0];
-assign builder_rhs_slice_proxy10 = main_mac_depacketizer_header[47:0];
-assign builder_rhs_slice_proxy11 = main_mac_depacketizer_header[47:0];
-assign builder_rhs_slice_proxy12 = main_mac_depacketizer_header[47:0];
-assign builder_rhs_slice_proxy13 = main_mac_depacketizer_header[47:0];
-assign builder_rhs_slice_proxy14 = main_arp_rx_depacketizer_header[39:32];
-assign builder_rhs_slice_proxy15 = main_arp_rx_depacketizer_header[15:0];
-assign builder_rhs_slice_proxy16 = main_arp_rx_depacketizer_header[15:0];
-assign builder_rhs_slice_proxy17 = main_arp_rx_depacketizer_header[63:48];
-assign builder_rhs_slice_proxy18 = main_arp_rx_depacketizer_header[63:48];
-assign builder_rhs_slice_proxy19 = main_arp_rx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy20 = main_arp_rx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy21 = main_arp_rx_depacketizer_header[47:40];
-assign builder_rhs_slice_proxy22 = main_arp_rx_depacketizer_header[143:112];
-assign builder_rhs_slice_proxy23 = main_arp_rx_depacketizer_header[143:112];
-assign builder_rhs_slice_proxy24 = main_arp_rx_depacketizer_header[143:112];
-assign builder_rhs_slice_proxy25 = main_arp_rx_depacketizer_header[143:112];
-assign builder_rhs_slice_proxy26 = main_arp_rx_depacketizer_header[111:64];
-assign builder_rhs_slice_proxy27 = main_arp_rx_depacketizer_header[111:64];
-assign builder_rhs_slice_proxy28 = main_arp_rx_depacketizer_header[111:64];
-assign builder_rhs_slice_proxy29 = main_arp_rx_depacketizer_header[111:64];
-assign builder_rhs_slice_proxy30 = main_arp_rx_depacketizer_header[111:64];
-assign builder_rhs_slice_proxy31 = main_arp_rx_depacketizer_header[111:64];
-assign builder_rhs_slice_proxy32 = main_arp_rx_depacketizer_header[223:192];
-assign builder_rhs_slice_proxy33 = main_arp_rx_depacketizer_header[223:192];
-assign builder_rhs_slice_proxy34 = main_arp_rx_depacketizer_header[223:192];
-assign builder_rhs_slice_proxy35 = main_arp_rx_depacketizer_header[223:192];
-assign builder_rhs_slice_proxy36 = main_arp_rx_depacketizer_header[191:144];
-assign builder_rhs_slice_proxy37 = main_arp_rx_depacketizer_header[191:144];
-assign builder_rhs_slice_proxy38 = main_arp_rx_depacketizer_header[191:144];
-assign builder_rhs_slice_proxy39 = main_arp_rx_depacketizer_header[191:144];
-assign builder_rhs_slice_proxy40 = main_arp_rx_depacketizer_header[191:144];
-assign builder_rhs_slice_proxy41 = main_arp_rx_depacketizer_header[191:144];
-assign builder_rhs_slice_proxy42 = main_ip_rx_depacketizer_header[95:80];
-assign builder_rhs_slice_proxy43 = main_ip_rx_depacketizer_header[95:80];
-assign builder_rhs_slice_proxy44 = main_ip_rx_depacketizer_header[47:32];
-assign builder_rhs_slice_proxy45 = main_ip_rx_depacketizer_header[47:32];
-assign builder_rhs_slice_proxy46 = main_ip_rx_depacketizer_header[3:0];
-assign builder_rhs_slice_proxy47 = main_ip_rx_depacketizer_header[79:72];
-assign builder_rhs_slice_proxy48 = main_ip_rx_depacketizer_header[127:96];
-assign builder_rhs_slice_proxy49 = main_ip_rx_depacketizer_header[127:96];
-assign builder_rhs_slice_proxy50 = main_ip_rx_depacketizer_header[127:96];
-assign builder_rhs_slice_proxy51 = main_ip_rx_depacketizer_header[127:96];
-assign builder_rhs_slice_proxy52 = main_ip_rx_depacketizer_header[159:128];
-assign builder_rhs_slice_proxy53 = main_ip_rx_depacketizer_header[159:128];
-assign builder_rhs_slice_proxy54 = main_ip_rx_depacketizer_header[159:128];
-assign builder_rhs_slice_proxy55 = main_ip_rx_depacketizer_header[159:128];
-assign builder_rhs_slice_proxy56 = main_ip_rx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy57 = main_ip_rx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy58 = main_ip_rx_depacketizer_header[71:64];
-assign builder_rhs_slice_proxy59 = main_ip_rx_depacketizer_header[7:4];
-assign builder_rhs_slice_proxy60 = main_icmp_rx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy61 = main_icmp_rx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy62 = main_icmp_rx_depacketizer_header[15:8];
-assign builder_rhs_slice_proxy63 = main_icmp_rx_depacketizer_header[7:0];
-assign builder_rhs_slice_proxy64 = main_icmp_rx_depacketizer_header[63:32];
-assign builder_rhs_slice_proxy65 = main_icmp_rx_depacketizer_header[63:32];
-assign builder_rhs_slice_proxy66 = main_icmp_rx_depacketizer_header[63:32];
-assign builder_rhs_slice_proxy67 = main_icmp_rx_depacketizer_header[63:32];
-assign builder_rhs_slice_proxy68 = main_holdingudprx_depacketizer_header[63:48];
-assign builder_rhs_slice_proxy69 = main_holdingudprx_depacketizer_header[63:48];
-assign builder_rhs_slice_proxy70 = main_holdingudprx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy71 = main_holdingudprx_depacketizer_header[31:16];
-assign builder_rhs_slice_proxy72 = main_holdingudprx_depacketizer_header[47:32];
-assign builder_rhs_slice_proxy73 = main_holdingudprx_depacketizer_header[47:32];
-assign builder_rhs_slice_proxy74 = main_holdingudprx_depacketizer_header[15:0];
-assign builder_rhs_slice_proxy75 = main_holdingudprx_depacketizer_header[15:0];
+assign builder_rhs_slice_proxy0 = main_mac_liteethmacdepacketizer_header[111:96];
+assign builder_rhs_slice_proxy1 = main_mac_liteethmacdepacketizer_header[111:96];
+assign builder_rhs_slice_proxy2 = main_mac_liteethmacdepacketizer_header[95:48];
+assign builder_rhs_slice_proxy3 = main_mac_liteethmacdepacketizer_header[95:48];
+assign builder_rhs_slice_proxy4 = main_mac_liteethmacdepacketizer_header[95:48];
+assign builder_rhs_slice_proxy5 = main_mac_liteethmacdepacketizer_header[95:48];
+assign builder_rhs_slice_proxy6 = main_mac_liteethmacdepacketizer_header[95:48];
+assign builder_rhs_slice_proxy7 = main_mac_liteethmacdepacketizer_header[95:48];
+assign builder_rhs_slice_proxy8 = main_mac_liteethmacdepacketizer_header[47:0];
+assign builder_rhs_slice_proxy9 = main_mac_liteethmacdepacketizer_header[47:0];
+assign builder_rhs_slice_proxy10 = main_mac_liteethmacdepacketizer_header[47:0];
+assign builder_rhs_slice_proxy11 = main_mac_liteethmacdepacketizer_header[47:0];
+assign builder_rhs_slice_proxy12 = main_mac_liteethmacdepacketizer_header[47:0];
+assign builder_rhs_slice_proxy13 = main_mac_liteethmacdepacketizer_header[47:0];
+assign builder_rhs_slice_proxy14 = main_arp_rx_liteetharpdepacketizer_header[39:32];
+assign builder_rhs_slice_proxy15 = main_arp_rx_liteetharpdepacketizer_header[15:0];
+assign builder_rhs_slice_proxy16 = main_arp_rx_liteetharpdepacketizer_header[15:0];
+assign builder_rhs_slice_proxy17 = main_arp_rx_liteetharpdepacketizer_header[63:48];
+assign builder_rhs_slice_proxy18 = main_arp_rx_liteetharpdepacketizer_header[63:48];
+assign builder_rhs_slice_proxy19 = main_arp_rx_liteetharpdepacketizer_header[31:16];
+assign builder_rhs_slice_proxy20 = main_arp_rx_liteetharpdepacketizer_header[31:16];
+assign builder_rhs_slice_proxy21 = main_arp_rx_liteetharpdepacketizer_header[47:40];
+assign builder_rhs_slice_proxy22 = main_arp_rx_liteetharpdepacketizer_header[143:112];
+assign builder_rhs_slice_proxy23 = main_arp_rx_liteetharpdepacketizer_header[143:112];
+assign builder_rhs_slice_proxy24 = main_arp_rx_liteetharpdepacketizer_header[143:112];
+assign builder_rhs_slice_proxy25 = main_arp_rx_liteetharpdepacketizer_header[143:112];
+assign builder_rhs_slice_proxy26 = main_arp_rx_liteetharpdepacketizer_header[111:64];
+assign builder_rhs_slice_proxy27 = main_arp_rx_liteetharpdepacketizer_header[111:64];
+assign builder_rhs_slice_proxy28 = main_arp_rx_liteetharpdepacketizer_header[111:64];
+assign builder_rhs_slice_proxy29 = main_arp_rx_liteetharpdepacketizer_header[111:64];
+assign builder_rhs_slice_proxy30 = main_arp_rx_liteetharpdepacketizer_header[111:64];
+assign builder_rhs_slice_proxy31 = main_arp_rx_liteetharpdepacketizer_header[111:64];
+assign builder_rhs_slice_proxy32 = main_arp_rx_liteetharpdepacketizer_header[223:192];
+assign builder_rhs_slice_proxy33 = main_arp_rx_liteetharpdepacketizer_header[223:192];
+assign builder_rhs_slice_proxy34 = main_arp_rx_liteetharpdepacketizer_header[223:192];
+assign builder_rhs_slice_proxy35 = main_arp_rx_liteetharpdepacketizer_header[223:192];
+assign builder_rhs_slice_proxy36 = main_arp_rx_liteetharpdepacketizer_header[191:144];
+assign builder_rhs_slice_proxy37 = main_arp_rx_liteetharpdepacketizer_header[191:144];
+assign builder_rhs_slice_proxy38 = main_arp_rx_liteetharpdepacketizer_header[191:144];
+assign builder_rhs_slice_proxy39 = main_arp_rx_liteetharpdepacketizer_header[191:144];
+assign builder_rhs_slice_proxy40 = main_arp_rx_liteetharpdepacketizer_header[191:144];
+assign builder_rhs_slice_proxy41 = main_arp_rx_liteetharpdepacketizer_header[191:144];
+assign builder_rhs_slice_proxy42 = main_ip_rx_liteethipv4depacketizer_header[95:80];
+assign builder_rhs_slice_proxy43 = main_ip_rx_liteethipv4depacketizer_header[95:80];
+assign builder_rhs_slice_proxy44 = main_ip_rx_liteethipv4depacketizer_header[47:32];
+assign builder_rhs_slice_proxy45 = main_ip_rx_liteethipv4depacketizer_header[47:32];
+assign builder_rhs_slice_proxy46 = main_ip_rx_liteethipv4depacketizer_header[3:0];
+assign builder_rhs_slice_proxy47 = main_ip_rx_liteethipv4depacketizer_header[79:72];
+assign builder_rhs_slice_proxy48 = main_ip_rx_liteethipv4depacketizer_header[127:96];
+assign builder_rhs_slice_proxy49 = main_ip_rx_liteethipv4depacketizer_header[127:96];
+assign builder_rhs_slice_proxy50 = main_ip_rx_liteethipv4depacketizer_header[127:96];
+assign builder_rhs_slice_proxy51 = main_ip_rx_liteethipv4depacketizer_header[127:96];
+assign builder_rhs_slice_proxy52 = main_ip_rx_liteethipv4depacketizer_header[159:128];
+assign builder_rhs_slice_proxy53 = main_ip_rx_liteethipv4depacketizer_header[159:128];
+assign builder_rhs_slice_proxy54 = main_ip_rx_liteethipv4depacketizer_header[159:128];
+assign builder_rhs_slice_proxy55 = main_ip_rx_liteethipv4depacketizer_header[159:128];
+assign builder_rhs_slice_proxy56 = main_ip_rx_liteethipv4depacketizer_header[31:16];
+assign builder_rhs_slice_proxy57 = main_ip_rx_liteethipv4depacketizer_header[31:16];
+assign builder_rhs_slice_proxy58 = main_ip_rx_liteethipv4depacketizer_header[71:64];
+assign builder_rhs_slice_proxy59 = main_ip_rx_liteethipv4depacketizer_header[7:4];
+assign builder_rhs_slice_proxy60 = main_icmp_rx_liteethicmpdepacketizer_header[31:16];
+assign builder_rhs_slice_proxy61 = main_icmp_rx_liteethicmpdepacketizer_header[31:16];
+assign builder_rhs_slice_proxy62 = main_icmp_rx_liteethicmpdepacketizer_header[15:8];
+assign builder_rhs_slice_proxy63 = main_icmp_rx_liteethicmpdepacketizer_header[7:0];
+assign builder_rhs_slice_proxy64 = main_icmp_rx_liteethicmpdepacketizer_header[63:32];
+assign builder_rhs_slice_proxy65 = main_icmp_rx_liteethicmpdepacketizer_header[63:32];
+assign builder_rhs_slice_proxy66 = main_icmp_rx_liteethicmpdepacketizer_header[63:32];
+assign builder_rhs_slice_proxy67 = main_icmp_rx_liteethicmpdepacketizer_header[63:32];
+assign builder_rhs_slice_proxy68 = main_holdingudprx_liteethudpdepacketizer_header[63:48];
+assign builder_rhs_slice_proxy69 = main_holdingudprx_liteethudpdepacketizer_header[63:48];
+assign builder_rhs_slice_proxy70 = main_holdingudprx_liteethudpdepacketizer_header[31:16];
+assign builder_rhs_slice_proxy71 = main_holdingudprx_liteethudpdepacketizer_header[31:16];
+assign builder_rhs_slice_proxy72 = main_holdingudprx_liteethudpdepacketizer_header[47:32];
+assign builder_rhs_slice_proxy73 = main_holdingudprx_liteethudpdepacketizer_header[47:32];
+assign builder_rhs_slice_proxy74 = main_holdingudprx_liteethudpdepacketizer_header[15:0];
+assign builder_rhs_slice_proxy75 = main_holdingudprx_liteethudpdepacketizer_header[15:0];
 assign main_mac_core_tx_cdc_cdc_produce_rdomain = builder_multiregimpl0_regs1;
 assign main_mac_core_tx_cdc_cdc_consume_wdomain = builder_multiregimpl1_regs1;
 assign main_mac_core_pulsesynchronizer0_toggle_o = builder_multiregimpl2_regs1;
@@ -6337,63 +6483,63 @@ always @(posedge sys_clk) begin
     if (main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value_ce0) begin
         main_mac_packetizer_delayed_last_be <= main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0;
     end
-    if (main_mac_depacketizer_sr_shift) begin
-        main_mac_depacketizer_sr <= {main_mac_depacketizer_sink_payload_data, main_mac_depacketizer_sr[111:8]};
+    if (main_mac_liteethmacdepacketizer_sr_shift) begin
+        main_mac_liteethmacdepacketizer_sr <= {main_mac_liteethmacdepacketizer_sink_payload_data, main_mac_liteethmacdepacketizer_sr[111:8]};
     end
-    if (main_mac_depacketizer_sr_shift_leftover) begin
-        main_mac_depacketizer_sr <= {main_mac_depacketizer_sink_payload_data, main_mac_depacketizer_sr[111:0]};
+    if (main_mac_liteethmacdepacketizer_sr_shift_leftover) begin
+        main_mac_liteethmacdepacketizer_sr <= {main_mac_liteethmacdepacketizer_sink_payload_data, main_mac_liteethmacdepacketizer_sr[111:0]};
     end
-    main_mac_depacketizer_was_in_copy <= main_mac_depacketizer_is_in_copy;
+    main_mac_liteethmacdepacketizer_was_in_copy <= main_mac_liteethmacdepacketizer_is_in_copy;
     builder_liteethmac_fsm0_state1 <= builder_liteethmac_fsm0_next_state1;
-    if (main_mac_depacketizer_count_liteethmac_fsm0_next_value_ce2) begin
-        main_mac_depacketizer_count <= main_mac_depacketizer_count_liteethmac_fsm0_next_value2;
+    if (main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2) begin
+        main_mac_liteethmacdepacketizer_count <= main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2;
     end
-    if (main_mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3) begin
-        main_mac_depacketizer_fsm_from_idle <= main_mac_depacketizer_fsm_from_idle_liteethmac_fsm0_next_value3;
+    if (main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3) begin
+        main_mac_liteethmacdepacketizer_fsm_from_idle <= main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3;
     end
     builder_liteethmac_fsm1_state1 <= builder_liteethmac_fsm1_next_state1;
-    if (main_mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1) begin
-        main_mac_depacketizer_delayed_last_be <= main_mac_depacketizer_delayed_last_be_liteethmac_fsm1_next_value1;
+    if (main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1) begin
+        main_mac_liteethmacdepacketizer_delayed_last_be <= main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1;
     end
-    if (main_arp_tx_packetizer_sr_load) begin
-        main_arp_tx_packetizer_sr <= main_arp_tx_packetizer_header;
+    if (main_arp_packetizer_sr_load) begin
+        main_arp_packetizer_sr <= main_arp_packetizer_header;
     end
-    if (main_arp_tx_packetizer_sr_shift) begin
-        main_arp_tx_packetizer_sr <= main_arp_tx_packetizer_sr[223:8];
+    if (main_arp_packetizer_sr_shift) begin
+        main_arp_packetizer_sr <= main_arp_packetizer_sr[223:8];
     end
     builder_liteetharptx_fsm0_state <= builder_liteetharptx_fsm0_next_state;
-    if (main_arp_tx_packetizer_count_liteetharp_fsm0_next_value_ce0) begin
-        main_arp_tx_packetizer_count <= main_arp_tx_packetizer_count_liteetharp_fsm0_next_value0;
+    if (main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0) begin
+        main_arp_packetizer_count <= main_arp_packetizer_count_liteetharp_fsm0_next_value0;
     end
-    if (main_arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1) begin
-        main_arp_tx_packetizer_fsm_from_idle <= main_arp_tx_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1;
+    if (main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1) begin
+        main_arp_packetizer_fsm_from_idle <= main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1;
     end
     builder_liteetharptx_fsm1_state <= builder_liteetharptx_fsm1_next_state;
-    if (main_arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0) begin
-        main_arp_tx_packetizer_delayed_last_be <= main_arp_tx_packetizer_delayed_last_be_liteetharp_fsm1_next_value0;
+    if (main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0) begin
+        main_arp_packetizer_delayed_last_be <= main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0;
     end
     builder_liteetharptx_state <= builder_liteetharptx_next_state;
-    if (main_arp_tx_counter_liteetharp_next_value_ce) begin
-        main_arp_tx_counter <= main_arp_tx_counter_liteetharp_next_value;
+    if (main_arp_counter_liteetharp_next_value_ce) begin
+        main_arp_counter <= main_arp_counter_liteetharp_next_value;
     end
-    main_arp_rx_valid <= (((((main_arp_rx_depacketizer_source_valid & (main_arp_rx_depacketizer_source_param_hwtype == 1'd1)) & (main_arp_rx_depacketizer_source_param_proto == 12'd2048)) & (main_arp_rx_depacketizer_source_param_hwsize == 3'd6)) & (main_arp_rx_depacketizer_source_param_protosize == 3'd4)) & (main_arp_rx_depacketizer_source_param_target_ip == ip_address));
-    if (main_arp_rx_depacketizer_sr_shift) begin
-        main_arp_rx_depacketizer_sr <= {main_arp_rx_depacketizer_sink_payload_data, main_arp_rx_depacketizer_sr[223:8]};
+    main_arp_rx_valid <= (((((main_arp_rx_liteetharpdepacketizer_source_valid & (main_arp_rx_liteetharpdepacketizer_source_param_hwtype == 1'd1)) & (main_arp_rx_liteetharpdepacketizer_source_param_proto == 12'd2048)) & (main_arp_rx_liteetharpdepacketizer_source_param_hwsize == 3'd6)) & (main_arp_rx_liteetharpdepacketizer_source_param_protosize == 3'd4)) & (main_arp_rx_liteetharpdepacketizer_source_param_target_ip == ip_address));
+    if (main_arp_rx_liteetharpdepacketizer_sr_shift) begin
+        main_arp_rx_liteetharpdepacketizer_sr <= {main_arp_rx_liteetharpdepacketizer_sink_payload_data, main_arp_rx_liteetharpdepacketizer_sr[223:8]};
     end
-    if (main_arp_rx_depacketizer_sr_shift_leftover) begin
-        main_arp_rx_depacketizer_sr <= {main_arp_rx_depacketizer_sink_payload_data, main_arp_rx_depacketizer_sr[223:0]};
+    if (main_arp_rx_liteetharpdepacketizer_sr_shift_leftover) begin
+        main_arp_rx_liteetharpdepacketizer_sr <= {main_arp_rx_liteetharpdepacketizer_sink_payload_data, main_arp_rx_liteetharpdepacketizer_sr[223:0]};
     end
-    main_arp_rx_depacketizer_was_in_copy <= main_arp_rx_depacketizer_is_in_copy;
+    main_arp_rx_liteetharpdepacketizer_was_in_copy <= main_arp_rx_liteetharpdepacketizer_is_in_copy;
     builder_liteetharprx_fsm0_state <= builder_liteetharprx_fsm0_next_state;
-    if (main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value_ce2) begin
-        main_arp_rx_depacketizer_count <= main_arp_rx_depacketizer_count_liteetharp_fsm0_next_value2;
+    if (main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2) begin
+        main_arp_rx_liteetharpdepacketizer_count <= main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2;
     end
-    if (main_arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3) begin
-        main_arp_rx_depacketizer_fsm_from_idle <= main_arp_rx_depacketizer_fsm_from_idle_liteetharp_fsm0_next_value3;
+    if (main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3) begin
+        main_arp_rx_liteetharpdepacketizer_fsm_from_idle <= main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3;
     end
     builder_liteetharprx_fsm1_state <= builder_liteetharprx_fsm1_next_state;
-    if (main_arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1) begin
-        main_arp_rx_depacketizer_delayed_last_be <= main_arp_rx_depacketizer_delayed_last_be_liteetharp_fsm1_next_value1;
+    if (main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1) begin
+        main_arp_rx_liteetharpdepacketizer_delayed_last_be <= main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1;
     end
     builder_liteetharprx_state <= builder_liteetharprx_next_state;
     if (main_arp_table_request_timer_wait) begin
@@ -6503,23 +6649,23 @@ always @(posedge sys_clk) begin
     if (main_ip_tx_target_mac_liteethip_next_value_ce) begin
         main_ip_tx_target_mac <= main_ip_tx_target_mac_liteethip_next_value;
     end
-    if (main_ip_rx_depacketizer_sr_shift) begin
-        main_ip_rx_depacketizer_sr <= {main_ip_rx_depacketizer_sink_payload_data, main_ip_rx_depacketizer_sr[159:8]};
+    if (main_ip_rx_liteethipv4depacketizer_sr_shift) begin
+        main_ip_rx_liteethipv4depacketizer_sr <= {main_ip_rx_liteethipv4depacketizer_sink_payload_data, main_ip_rx_liteethipv4depacketizer_sr[159:8]};
     end
-    if (main_ip_rx_depacketizer_sr_shift_leftover) begin
-        main_ip_rx_depacketizer_sr <= {main_ip_rx_depacketizer_sink_payload_data, main_ip_rx_depacketizer_sr[159:0]};
+    if (main_ip_rx_liteethipv4depacketizer_sr_shift_leftover) begin
+        main_ip_rx_liteethipv4depacketizer_sr <= {main_ip_rx_liteethipv4depacketizer_sink_payload_data, main_ip_rx_liteethipv4depacketizer_sr[159:0]};
     end
-    main_ip_rx_depacketizer_was_in_copy <= main_ip_rx_depacketizer_is_in_copy;
-    builder_liteethip_liteethiprx_fsm0_state <= builder_liteethip_liteethiprx_fsm0_next_state;
-    if (main_ip_rx_depacketizer_count_liteethip_fsm0_next_value_ce2) begin
-        main_ip_rx_depacketizer_count <= main_ip_rx_depacketizer_count_liteethip_fsm0_next_value2;
+    main_ip_rx_liteethipv4depacketizer_was_in_copy <= main_ip_rx_liteethipv4depacketizer_is_in_copy;
+    builder_liteethip_checkingiprx_fsm0_state <= builder_liteethip_checkingiprx_fsm0_next_state;
+    if (main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2) begin
+        main_ip_rx_liteethipv4depacketizer_count <= main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2;
     end
-    if (main_ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3) begin
-        main_ip_rx_depacketizer_fsm_from_idle <= main_ip_rx_depacketizer_fsm_from_idle_liteethip_fsm0_next_value3;
+    if (main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3) begin
+        main_ip_rx_liteethipv4depacketizer_fsm_from_idle <= main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3;
     end
-    builder_liteethip_liteethiprx_fsm1_state <= builder_liteethip_liteethiprx_fsm1_next_state;
-    if (main_ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1) begin
-        main_ip_rx_depacketizer_delayed_last_be <= main_ip_rx_depacketizer_delayed_last_be_liteethip_fsm1_next_value1;
+    builder_liteethip_checkingiprx_fsm1_state <= builder_liteethip_checkingiprx_fsm1_next_state;
+    if (main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1) begin
+        main_ip_rx_liteethipv4depacketizer_delayed_last_be <= main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1;
     end
     if (main_ip_rx_ce) begin
         if ((~main_ip_rx_liteethipv4checksum_done)) begin
@@ -6559,7 +6705,7 @@ always @(posedge sys_clk) begin
     if (main_ip_rx_reset) begin
         main_ip_rx_liteethipv4checksum_counter <= 4'd0;
     end
-    builder_liteethip_liteethiprx_state <= builder_liteethip_liteethiprx_next_state;
+    builder_liteethip_checkingiprx_state <= builder_liteethip_checkingiprx_next_state;
     case (builder_liteethip_grant)
         1'd0: begin
             if ((~builder_liteethip_request[0])) begin
@@ -6621,23 +6767,23 @@ always @(posedge sys_clk) begin
         main_icmp_tx_packetizer_delayed_last_be <= main_icmp_tx_packetizer_delayed_last_be_fsm1_next_value0;
     end
     builder_liteethicmptx_state <= builder_liteethicmptx_next_state;
-    if (main_icmp_rx_depacketizer_sr_shift) begin
-        main_icmp_rx_depacketizer_sr <= {main_icmp_rx_depacketizer_sink_payload_data, main_icmp_rx_depacketizer_sr[63:8]};
+    if (main_icmp_rx_liteethicmpdepacketizer_sr_shift) begin
+        main_icmp_rx_liteethicmpdepacketizer_sr <= {main_icmp_rx_liteethicmpdepacketizer_sink_payload_data, main_icmp_rx_liteethicmpdepacketizer_sr[63:8]};
     end
-    if (main_icmp_rx_depacketizer_sr_shift_leftover) begin
-        main_icmp_rx_depacketizer_sr <= {main_icmp_rx_depacketizer_sink_payload_data, main_icmp_rx_depacketizer_sr[63:0]};
+    if (main_icmp_rx_liteethicmpdepacketizer_sr_shift_leftover) begin
+        main_icmp_rx_liteethicmpdepacketizer_sr <= {main_icmp_rx_liteethicmpdepacketizer_sink_payload_data, main_icmp_rx_liteethicmpdepacketizer_sr[63:0]};
     end
-    main_icmp_rx_depacketizer_was_in_copy <= main_icmp_rx_depacketizer_is_in_copy;
+    main_icmp_rx_liteethicmpdepacketizer_was_in_copy <= main_icmp_rx_liteethicmpdepacketizer_is_in_copy;
     builder_liteethicmprx_fsm0_state <= builder_liteethicmprx_fsm0_next_state;
-    if (main_icmp_rx_depacketizer_count_fsm0_next_value_ce2) begin
-        main_icmp_rx_depacketizer_count <= main_icmp_rx_depacketizer_count_fsm0_next_value2;
+    if (main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2) begin
+        main_icmp_rx_liteethicmpdepacketizer_count <= main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2;
     end
-    if (main_icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value_ce3) begin
-        main_icmp_rx_depacketizer_fsm_from_idle <= main_icmp_rx_depacketizer_fsm_from_idle_fsm0_next_value3;
+    if (main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3) begin
+        main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle <= main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3;
     end
     builder_liteethicmprx_fsm1_state <= builder_liteethicmprx_fsm1_next_state;
-    if (main_icmp_rx_depacketizer_delayed_last_be_fsm1_next_value_ce1) begin
-        main_icmp_rx_depacketizer_delayed_last_be <= main_icmp_rx_depacketizer_delayed_last_be_fsm1_next_value1;
+    if (main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1) begin
+        main_icmp_rx_liteethicmpdepacketizer_delayed_last_be <= main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1;
     end
     builder_liteethicmprx_state <= builder_liteethicmprx_next_state;
     if (main_icmp_echo_payload_fifo_syncfifo_re) begin
@@ -6702,23 +6848,23 @@ always @(posedge sys_clk) begin
         main_packetizer_delayed_last_be <= main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0;
     end
     builder_liteethudp_liteethudptx_state <= builder_liteethudp_liteethudptx_next_state;
-    if (main_holdingudprx_depacketizer_sr_shift) begin
-        main_holdingudprx_depacketizer_sr <= {main_holdingudprx_depacketizer_sink_payload_data, main_holdingudprx_depacketizer_sr[63:8]};
+    if (main_holdingudprx_liteethudpdepacketizer_sr_shift) begin
+        main_holdingudprx_liteethudpdepacketizer_sr <= {main_holdingudprx_liteethudpdepacketizer_sink_payload_data, main_holdingudprx_liteethudpdepacketizer_sr[63:8]};
     end
-    if (main_holdingudprx_depacketizer_sr_shift_leftover) begin
-        main_holdingudprx_depacketizer_sr <= {main_holdingudprx_depacketizer_sink_payload_data, main_holdingudprx_depacketizer_sr[63:0]};
+    if (main_holdingudprx_liteethudpdepacketizer_sr_shift_leftover) begin
+        main_holdingudprx_liteethudpdepacketizer_sr <= {main_holdingudprx_liteethudpdepacketizer_sink_payload_data, main_holdingudprx_liteethudpdepacketizer_sr[63:0]};
     end
-    main_holdingudprx_depacketizer_was_in_copy <= main_holdingudprx_depacketizer_is_in_copy;
+    main_holdingudprx_liteethudpdepacketizer_was_in_copy <= main_holdingudprx_liteethudpdepacketizer_is_in_copy;
     builder_liteethudp_holdingudprx_fsm0_state <= builder_liteethudp_holdingudprx_fsm0_next_state;
-    if (main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value_ce2) begin
-        main_holdingudprx_depacketizer_count <= main_holdingudprx_depacketizer_count_liteethudp_fsm0_next_value2;
+    if (main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2) begin
+        main_holdingudprx_liteethudpdepacketizer_count <= main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2;
     end
-    if (main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
-        main_holdingudprx_depacketizer_fsm_from_idle <= main_holdingudprx_depacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
+    if (main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
+        main_holdingudprx_liteethudpdepacketizer_fsm_from_idle <= main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
     end
     builder_liteethudp_holdingudprx_fsm1_state <= builder_liteethudp_holdingudprx_fsm1_next_state;
-    if (main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
-        main_holdingudprx_depacketizer_delayed_last_be <= main_holdingudprx_depacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
+    if (main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
+        main_holdingudprx_liteethudpdepacketizer_delayed_last_be <= main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
     end
     builder_liteethudp_holdingudprx_state <= builder_liteethudp_holdingudprx_next_state;
     if (main_holdingudprx_count_liteethudp_next_value_ce0) begin
@@ -6727,20 +6873,23 @@ always @(posedge sys_clk) begin
     if (main_holdingudprx_err_liteethudp_next_value_ce1) begin
         main_holdingudprx_err <= main_holdingudprx_err_liteethudp_next_value1;
     end
-    if (main_holdingudprx_held_liteethudp_next_value_ce2) begin
-        main_holdingudprx_held <= main_holdingudprx_held_liteethudp_next_value2;
+    if (main_holdingudprx_rest_liteethudp_next_value_ce2) begin
+        main_holdingudprx_rest <= main_holdingudprx_rest_liteethudp_next_value2;
     end
-    if (main_holdingudprx0_liteethudp_next_value_ce3) begin
-        main_holdingudprx0 <= main_holdingudprx0_liteethudp_next_value3;
+    if (main_holdingudprx_held_liteethudp_next_value_ce3) begin
+        main_holdingudprx_held <= main_holdingudprx_held_liteethudp_next_value3;
     end
-    if (main_holdingudprx1_liteethudp_next_value_ce4) begin
-        main_holdingudprx1 <= main_holdingudprx1_liteethudp_next_value4;
+    if (main_holdingudprx0_liteethudp_next_value_ce4) begin
+        main_holdingudprx0 <= main_holdingudprx0_liteethudp_next_value4;
     end
-    if (main_holdingudprx2_liteethudp_next_value_ce5) begin
-        main_holdingudprx2 <= main_holdingudprx2_liteethudp_next_value5;
+    if (main_holdingudprx1_liteethudp_next_value_ce5) begin
+        main_holdingudprx1 <= main_holdingudprx1_liteethudp_next_value5;
     end
-    if (main_holdingudprx3_liteethudp_next_value_ce6) begin
-        main_holdingudprx3 <= main_holdingudprx3_liteethudp_next_value6;
+    if (main_holdingudprx2_liteethudp_next_value_ce6) begin
+        main_holdingudprx2 <= main_holdingudprx2_liteethudp_next_value6;
+    end
+    if (main_holdingudprx3_liteethudp_next_value_ce7) begin
+        main_holdingudprx3 <= main_holdingudprx3_liteethudp_next_value7;
     end
     if (builder_liteethudp_first) begin
         builder_liteethudp_sel_ongoing <= builder_liteethudp_sel0;
@@ -6807,17 +6956,17 @@ always @(posedge sys_clk) begin
         main_mac_packetizer_count <= 4'd0;
         main_mac_packetizer_fsm_from_idle <= 1'd0;
         main_mac_packetizer_delayed_last_be <= 1'd0;
-        main_mac_depacketizer_count <= 4'd0;
-        main_mac_depacketizer_fsm_from_idle <= 1'd0;
-        main_mac_depacketizer_delayed_last_be <= 1'd0;
-        main_mac_depacketizer_was_in_copy <= 1'd0;
-        main_arp_tx_packetizer_count <= 5'd0;
-        main_arp_tx_packetizer_fsm_from_idle <= 1'd0;
-        main_arp_tx_packetizer_delayed_last_be <= 1'd0;
-        main_arp_rx_depacketizer_count <= 5'd0;
-        main_arp_rx_depacketizer_fsm_from_idle <= 1'd0;
-        main_arp_rx_depacketizer_delayed_last_be <= 1'd0;
-        main_arp_rx_depacketizer_was_in_copy <= 1'd0;
+        main_mac_liteethmacdepacketizer_count <= 4'd0;
+        main_mac_liteethmacdepacketizer_fsm_from_idle <= 1'd0;
+        main_mac_liteethmacdepacketizer_delayed_last_be <= 1'd0;
+        main_mac_liteethmacdepacketizer_was_in_copy <= 1'd0;
+        main_arp_packetizer_count <= 5'd0;
+        main_arp_packetizer_fsm_from_idle <= 1'd0;
+        main_arp_packetizer_delayed_last_be <= 1'd0;
+        main_arp_rx_liteetharpdepacketizer_count <= 5'd0;
+        main_arp_rx_liteetharpdepacketizer_fsm_from_idle <= 1'd0;
+        main_arp_rx_liteetharpdepacketizer_delayed_last_be <= 1'd0;
+        main_arp_rx_liteetharpdepacketizer_was_in_copy <= 1'd0;
         main_arp_table_response_response_payload_failed <= 1'd0;
         main_arp_table_response_response_payload_mac_address <= 48'd0;
         main_arp_table_request_pending <= 1'd0;
@@ -6835,18 +6984,18 @@ always @(posedge sys_clk) begin
         main_ip_tx_packetizer_count <= 5'd0;
         main_ip_tx_packetizer_fsm_from_idle <= 1'd0;
         main_ip_tx_packetizer_delayed_last_be <= 1'd0;
-        main_ip_rx_depacketizer_count <= 5'd0;
-        main_ip_rx_depacketizer_fsm_from_idle <= 1'd0;
-        main_ip_rx_depacketizer_delayed_last_be <= 1'd0;
-        main_ip_rx_depacketizer_was_in_copy <= 1'd0;
+        main_ip_rx_liteethipv4depacketizer_count <= 5'd0;
+        main_ip_rx_liteethipv4depacketizer_fsm_from_idle <= 1'd0;
+        main_ip_rx_liteethipv4depacketizer_delayed_last_be <= 1'd0;
+        main_ip_rx_liteethipv4depacketizer_was_in_copy <= 1'd0;
         main_ip_rx_liteethipv4checksum_counter <= 4'd0;
         main_icmp_tx_packetizer_count <= 3'd0;
         main_icmp_tx_packetizer_fsm_from_idle <= 1'd0;
         main_icmp_tx_packetizer_delayed_last_be <= 1'd0;
-        main_icmp_rx_depacketizer_count <= 3'd0;
-        main_icmp_rx_depacketizer_fsm_from_idle <= 1'd0;
-        main_icmp_rx_depacketizer_delayed_last_be <= 1'd0;
-        main_icmp_rx_depacketizer_was_in_copy <= 1'd0;
+        main_icmp_rx_liteethicmpdepacketizer_count <= 3'd0;
+        main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle <= 1'd0;
+        main_icmp_rx_liteethicmpdepacketizer_delayed_last_be <= 1'd0;
+        main_icmp_rx_liteethicmpdepacketizer_was_in_copy <= 1'd0;
         main_icmp_echo_payload_fifo_readable <= 1'd0;
         main_icmp_echo_payload_fifo_level0 <= 8'd0;
         main_icmp_echo_payload_fifo_produce <= 7'd0;
@@ -6858,10 +7007,10 @@ always @(posedge sys_clk) begin
         main_packetizer_count <= 3'd0;
         main_packetizer_fsm_from_idle <= 1'd0;
         main_packetizer_delayed_last_be <= 1'd0;
-        main_holdingudprx_depacketizer_count <= 3'd0;
-        main_holdingudprx_depacketizer_fsm_from_idle <= 1'd0;
-        main_holdingudprx_depacketizer_delayed_last_be <= 1'd0;
-        main_holdingudprx_depacketizer_was_in_copy <= 1'd0;
+        main_holdingudprx_liteethudpdepacketizer_count <= 3'd0;
+        main_holdingudprx_liteethudpdepacketizer_fsm_from_idle <= 1'd0;
+        main_holdingudprx_liteethudpdepacketizer_delayed_last_be <= 1'd0;
+        main_holdingudprx_liteethudpdepacketizer_was_in_copy <= 1'd0;
         main_holdingudprx_count <= 16'd0;
         main_holdingudprx_err <= 1'd0;
         main_holdingudprx_held <= 8'd0;
@@ -6869,6 +7018,7 @@ always @(posedge sys_clk) begin
         main_holdingudprx1 <= 16'd0;
         main_holdingudprx2 <= 16'd0;
         main_holdingudprx3 <= 32'd0;
+        main_holdingudprx_rest <= 16'd0;
         builder_liteethmac_grant <= 1'd0;
         builder_liteethmac_status0_first <= 1'd1;
         builder_liteethmac_status0_ongoing1 <= 1'd0;
@@ -6892,9 +7042,9 @@ always @(posedge sys_clk) begin
         builder_liteethip_liteethiptx_fsm0_state <= 2'd0;
         builder_liteethip_liteethiptx_fsm1_state <= 1'd0;
         builder_liteethip_liteethiptx_state <= 3'd0;
-        builder_liteethip_liteethiprx_fsm0_state <= 2'd0;
-        builder_liteethip_liteethiprx_fsm1_state <= 1'd0;
-        builder_liteethip_liteethiprx_state <= 2'd0;
+        builder_liteethip_checkingiprx_fsm0_state <= 2'd0;
+        builder_liteethip_checkingiprx_fsm1_state <= 1'd0;
+        builder_liteethip_checkingiprx_state <= 2'd0;
         builder_liteethip_grant <= 1'd0;
         builder_liteethip_status0_first <= 1'd1;
         builder_liteethip_status0_ongoing1 <= 1'd0;
