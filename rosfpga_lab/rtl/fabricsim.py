@@ -57,16 +57,17 @@ TOP = "rfl_fabric_top"
 SOURCES = (*FABRIC_TOP_GMII, *FABRIC_INCLUDES)
 #: The counters the program reports, in its order (the top's cnt_* outputs, the answers' byte
 #: credit, then the generated subscriber's verdicts: samples judged, refused, the last refusal's
-#: status code, the walk's table: ``spec.program.statuses``).
+#: status code, the walk's table: ``spec.program.statuses``), then the SPDP learner's
+#: (rfl_spdp_peer: peers taken or changed, announcements refused, others while the peer lives).
 COUNTERS = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_length",
             "rx_overflow", "tx_packets", "tx_overflow", "rx_port", "credit", "judged",
-            "refused", "last_refusal")
+            "refused", "last_refusal", "peer_learned", "peer_refused", "peer_other")
 #: The simulation's SPDP period in clocks and the clock rate it is run at (clocks per second of
 #: wall time): an announcement about every second, as the board's (rtps.limits.ANNOUNCE_SECONDS
 #: at 125 MHz), if the model keeps up.
 SIM_PERIOD = 400_000
 SIM_RATE = 400_000
-_CONFIG = struct.Struct("<QIIHHIIQ")
+_CONFIG = struct.Struct("<QIIHHIIQB")
 
 
 def fabric_top_default(name: str) -> str:
@@ -173,7 +174,9 @@ def build_fabric_sim(config: NodeConfig, rom: DiscoveryRom, *, period: int = SIM
 @dataclass(frozen=True)
 class FabricConfig:
     """The top's registers: its MAC and IPv4 address, its one peer's address and metatraffic
-    and user-data ports, its reader's entity id, the writer it takes (0: any), INFO_TS's time."""
+    and user-data ports, its reader's entity id, the writer it takes (0: any), INFO_TS's time,
+    and ``learn`` (cfg_learn): the circuit learns its peer from SPDP and the peer's fields
+    are not used."""
 
     mac: int
     ip: str
@@ -183,11 +186,13 @@ class FabricConfig:
     reader: int
     writer: int = 0
     time: int = 0
+    learn: bool = False
 
     def pack(self) -> bytes:
         return _CONFIG.pack(self.mac, int(ipaddress.IPv4Address(self.ip)),
                             int(ipaddress.IPv4Address(self.peer_ip)), self.peer_meta_port,
-                            self.peer_user_port, self.reader, self.writer, self.time)
+                            self.peer_user_port, self.reader, self.writer, self.time,
+                            int(self.learn))
 
 
 @dataclass

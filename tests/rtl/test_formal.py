@@ -407,13 +407,12 @@ def test_a_planted_bug_fails_the_answers_byte_bound(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(("old", "new"), [
     ("wire rst_n = rst_count[4];", "wire rst_n = rst_count[3];"),   # out of reset after 8
-    ("wire send_sedp = rst_n && sedp_count == WAIT - 1'b1;",
-     "wire send_sedp = rst_n && sedp_count != WAIT;"),             # a pulse of SEDP_WAIT clocks
+    (".cfg_learn(1'b1)", ".cfg_learn(1'b0)"),                      # the peer not learned
     (".cfg_writer(32'd0)", ".cfg_writer(READER)"),                  # only our own writer id
     ("assign led_n = cnt_rx_packets == 32'd0;", "assign led_n = !cnt_rx_packets[0];"),
-], ids=["reset", "sedp", "writer", "led"])
+], ids=["reset", "learn", "writer", "led"])
 def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -> None:
-    """The board top's proof sees a short reset, a long SEDP pulse, a wrong id, a LED that
+    """The board top's proof sees a short reset, a peer not learned, a wrong id, a LED that
     misses datagrams."""
     require_formal()
     name = "rfl_board_5a75b.v"
