@@ -374,7 +374,9 @@ class ShimBridge(_PeerKeeper):
                 self._spdp_went_out()
             else:
                 to = (got.dst_ip, got.dst_port)
-                if self.peer and to == self.peer.user:
+                # to the peer's default locator (by its port: the circuit takes the address
+                # the announcement lists, which may be another of this host's than the bridge's)
+                if self.peer and to[1] == self.peer.user[1]:
                     to = self._reader_of(got.payload) or to
                 if not self.ports.send(got.src_port, to[0], to[1], got.payload):
                     self.counts.send_refused += 1

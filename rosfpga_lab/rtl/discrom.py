@@ -447,14 +447,14 @@ def tx_parameters(rom: DiscoveryRom, *, frag_bytes: int = FRAGMENT_BYTES,
 def spdp_parameters() -> dict[str, int]:
     """The constants of ``fabric/rfl_spdp_peer.v`` (the circuit learns its peer from SPDP), from
     the software participant's owners: the SPDP writer's entity id
-    (:mod:`rosfpga_lab.rtps.entities`), the parameter ids (sentinel, lease, default and
-    metatraffic unicast locators) and the UDPv4 locator kind (:mod:`rosfpga_lab.rtps.build`), the
+    (:mod:`rosfpga_lab.rtps.entities`), the parameter ids (status info, for a goodbye;
+    sentinel, lease, default and metatraffic unicast locators) and the UDPv4 locator kind (:mod:`rosfpga_lab.rtps.build`), the
     parameter lists' encapsulations (:mod:`rosfpga_lab.rtps.discovery`), the lease when none is
     announced and its cap in seconds (:mod:`rosfpga_lab.rtps.limits`)."""
-    pids = (b.PID_SENTINEL, b.PID_PARTICIPANT_LEASE_DURATION, b.PID_DEFAULT_UNICAST_LOCATOR,
-            b.PID_METATRAFFIC_UNICAST_LOCATOR)
+    pids = (b.PID_STATUS_INFO, b.PID_SENTINEL, b.PID_PARTICIPANT_LEASE_DURATION,
+            b.PID_DEFAULT_UNICAST_LOCATOR, b.PID_METATRAFFIC_UNICAST_LOCATOR)
     return {"SPDP_WRITER_ID": SPDP_WRITER,
-            "SPDP_PIDS": sum(pid << (16 * (3 - i)) for i, pid in enumerate(pids)),
+            "SPDP_PIDS": sum(pid << (16 * (len(pids) - 1 - i)) for i, pid in enumerate(pids)),
             "SPDP_ENCAPS": int.from_bytes(PL_CDR_BE + PL_CDR_LE, "big"),
             "SPDP_LOCATOR_KIND": b.LOCATOR_KIND_UDPV4,
             "SPDP_LEASE_DEFAULT": round(DEFAULT_LEASE_SECONDS),
@@ -476,7 +476,7 @@ def top_parameters(rom: DiscoveryRom) -> dict[str, int]:
 #: Bits of the parameters of :func:`tx_parameters` and :func:`top_parameters` that are not Verilog
 #: integers.
 TX_PARAMETER_BITS = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32, "SPDP_GROUP": 32,
-                     "SPDP_WRITER_ID": 32, "SPDP_PIDS": 64, "SPDP_ENCAPS": 32,
+                     "SPDP_WRITER_ID": 32, "SPDP_PIDS": 80, "SPDP_ENCAPS": 32,
                      "SPDP_LOCATOR_KIND": 32}
 
 

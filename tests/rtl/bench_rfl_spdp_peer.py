@@ -1,5 +1,5 @@
 """cocotb testbench of ``rfl_spdp_peer`` (run by tests/rtl/test_fabric_spdp_peer.py, not by
-pytest): the case's datagrams (``SPDP_PEER_CASE``: hex, each with the idle clocks after it) go in
+pytest): the case's datagrams (``SPDP_PEER_CASE``: hex, each with the idle clocks after it and its IPv4 source) go in
 a byte a clock; every send_sedp pulse is recorded with the clock and the peer registers then,
 and at the end the registers and counters, into ``SPDP_PEER_OUT``. The watcher must always be
 ready (asserted at every beat)."""
@@ -28,6 +28,7 @@ async def spdp_peer(dut) -> None:
     dut.s_axis_tvalid.value = 0
     dut.s_axis_tdata.value = 0
     dut.s_axis_tlast.value = 0
+    dut.s_src_ip.value = 0
     cocotb.start_soon(Clock(dut.clk, 8, unit="ns").start())
     dut.rst_n.value = 0
     for _ in range(3):
@@ -45,14 +46,14 @@ async def spdp_peer(dut) -> None:
         if int(dut.send_sedp.value):
             pulses.append({"clock": clock, "peer": _peer(dut)})
 
-    for raw, idle in case["datagrams"]:
+    for raw, idle, src in case["datagrams"]:
         data = bytes.fromhex(raw)
         for i, x in enumerate(data):
-            await _drive(dut, x, i == len(data) - 1)
+            await _drive(dut, x, i == len(data) - 1, src)
             assert int(dut.s_axis_tready.value) == 1
             await tick()
         ends.append(clock)
-        await _drive(dut, None, False)
+        await _drive(dut, None, False, 0)
         for _ in range(idle):
             await tick()
     out = {"pulses": pulses, "ends": ends, "peer": _peer(dut),
@@ -62,9 +63,11 @@ async def spdp_peer(dut) -> None:
         json.dump(out, f)
 
 
-async def _drive(dut, byte: int | None, last: bool) -> None:
-    """Offer ``byte`` (None: nothing) for the next clock (out of the read-only phase first)."""
+async def _drive(dut, byte: int | None, last: bool, src: int) -> None:
+    """Offer ``byte`` (None: nothing) from IPv4 source ``src`` for the next clock (out of the
+    read-only phase first)."""
     await Timer(1, unit="ns")
+    dut.s_src_ip.value = src
     dut.s_axis_tvalid.value = int(byte is not None)
     dut.s_axis_tdata.value = byte or 0
     dut.s_axis_tlast.value = int(last)

@@ -23,7 +23,7 @@ def test_generate_writes_the_board_build(tmp_path: Path) -> None:
     # PID_METATRAFFIC_UNICAST_LOCATOR 0x32, PID_DEFAULT_UNICAST_LOCATOR 0x31, UDPv4 kind 1)
     assert not any(k.startswith("PEER") for k in p) and "SEDP_WAIT" not in p
     assert (p["SPDP_WRITER_ID"], p["SPDP_LOCATOR_KIND"]) == ("32'h100c2", "32'h1")
-    assert p["SPDP_PIDS"] == "64'h1000200310032" and p["SPDP_ENCAPS"] == "32'h20003"
+    assert p["SPDP_PIDS"] == "80'h710001000200310032" and p["SPDP_ENCAPS"] == "32'h20003"
     assert (p["IP"], p["MAC"]) == ("32'ha000007", "48'h2000000002a")
     assert index["peer_ip"] == "10.0.0.1"
     assert p["SPDP_GROUP"] == "32'hefff0001" and p["PERIOD"] == "125000000"

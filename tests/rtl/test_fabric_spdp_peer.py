@@ -5,13 +5,15 @@ one written big-endian here by hand, and hostile ones; its constants from
 ``rtl.discrom.spdp_parameters`` (the software's owners).
 
 What holds it (the expected peers are the locators written into the announcements here, never
-read back from the circuit): the first participant's first UDPv4 metatraffic and default
-locators are taken (a UDPv6 locator before them skipped) and send_sedp pulses at once and
+read back from the circuit): the first participant's UDPv4 metatraffic and default locators
+are taken (a UDPv6 locator before them skipped; the first UDPv4 one, or the first at the
+address its datagram came from) and send_sedp pulses at once and
 RESEND clocks later; a second participant, and a flood of 20 more, while the peer lives are
 counted, never taken, no pulse; our own announcement (looped back) is ignored; a newer
 announcement of the peer with another port updates it (two pulses again); after the peer's
 lease (announced 1000 s, capped at rtps.limits.MAX_LEASE_SECONDS, TICK clocks a second) another
-participant takes the place, not before; cut parameter lists, a huge parameter length, a
+participant takes the place, not before, and after the peer's goodbye at once (another's
+goodbye changes nothing); cut parameter lists, a huge parameter length, a
 locator of another kind only, an unknown encapsulation and a short octetsToInlineQos are
 refused and counted; two pulses per peer change, no more.
 """
@@ -38,6 +40,8 @@ OWN = bytes.fromhex("010f7266 6c464142 52494300".replace(" ", ""))
 A = bytes.fromhex("010fcafe0000000100000001")
 B = bytes.fromhex("010fbeef0000000200000002")
 TICK, RESEND, IDLE = 20, 50, 120
+#: The IPv4 source of a participant's datagrams (by GUID prefix; others 0.0.0.0).
+SOURCES = {A: "10.1.2.3", B: "10.1.2.99"}
 LEASE_CLOCKS = (int(MAX_LEASE_SECONDS) + 1) * TICK     # A's 1000 s lease, capped
 
 
@@ -67,6 +71,15 @@ def spdp(prefix: bytes, meta: list[tuple[int, int, str]], user: list[tuple[int, 
     return b.header(prefix) + b.info_ts(1.0) + b.data(SPDP_READER, SPDP_WRITER, 1, payload)
 
 
+def goodbye(prefix: bytes) -> bytes:
+    """The software participant's goodbye (``rtps.spdp``'s): disposed and unregistered in the
+    inline QoS, the key only."""
+    guid = prefix + b"\x00\x00\x01\xc1"
+    qos = b.inline_qos([(b.PID_KEY_HASH, guid), (b.PID_STATUS_INFO, b"\x00\x00\x00\x03")])
+    key = b.param_list([(b.PID_PARTICIPANT_GUID, guid)])
+    return b.header(prefix) + b.info_ts(0.0) + b.data(SPDP_READER, SPDP_WRITER, 2, key, qos)
+
+
 def _ip(addr: str) -> int:
     return int.from_bytes(bytes(int(x) for x in addr.split(".")), "big")
 
@@ -82,7 +95,9 @@ def _run(datagrams: list[tuple[bytes, int]], tmp_path: Path) -> dict:
     runner.build(sources=[FABRIC_DIR / "rfl_spdp_peer.v"], hdl_toplevel="rfl_spdp_peer",
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"), parameters=params)
     (tmp_path / "case.json").write_text(json.dumps(
-        {"prefix": OWN.hex(), "datagrams": [[d.hex(), idle] for d, idle in datagrams]}))
+        {"prefix": OWN.hex(),
+         "datagrams": [[d.hex(), idle, _ip(SOURCES.get(d[8:20], "0.0.0.0"))]
+                       for d, idle in datagrams]}))
     results = runner.test(hdl_toplevel="rfl_spdp_peer", test_module="bench_rfl_spdp_peer",
                           test_dir=HERE, build_dir=tmp_path / "build",
                           results_xml=str(tmp_path / "results.xml"),
@@ -93,9 +108,11 @@ def _run(datagrams: list[tuple[bytes, int]], tmp_path: Path) -> dict:
 
 
 def test_the_circuit_learns_its_peer_from_spdp_and_refuses_the_rest(tmp_path: Path) -> None:
-    assert verilog_parameters(spdp_parameters())["SPDP_PIDS"] == "64'h1000200310032"
-    good_a = spdp(A, [(2, 7410, "0.0.0.0"), (1, 7412, "10.1.2.3"), (1, 9999, "10.9.9.9")],
-                  [(1, 7413, "10.1.2.3")])                     # UDPv6 first: skipped
+    assert verilog_parameters(spdp_parameters())["SPDP_PIDS"] == "80'h710001000200310032"
+    # UDPv6 first: skipped; then the first UDPv4 one, but a later one at the sender's address
+    # (A sends from 10.1.2.3) taken instead, and not the one after it
+    good_a = spdp(A, [(2, 7410, "0.0.0.0"), (1, 9999, "10.9.9.9"), (1, 7412, "10.1.2.3"),
+                      (1, 7777, "10.1.2.3")], [(1, 7413, "10.1.2.3")])
     a_lab = spdp(A, [(1, 7412, "10.1.2.3")], [(1, 7415, "10.1.2.4")])  # the lab's builder
     whole = spdp(B, [(1, 7414, "10.1.2.5")], [(1, 7415, "10.1.2.5")])
     cut = whole[:-12]                                           # no sentinel, ends early
@@ -112,7 +129,7 @@ def test_the_circuit_learns_its_peer_from_spdp_and_refuses_the_rest(tmp_path: Pa
     short_q[d_at + 6:d_at + 8] = struct.pack("<H", 8)         # octetsToInlineQos 8
     flood = [(spdp(bytes([1, 15]) + i.to_bytes(10, "big"), [(1, 8000 + i, "10.2.0.1")],
                    [(1, 9000 + i, "10.2.0.1")]), 0) for i in range(20)]
-    b_be = spdp(B, [(1, 7420, "10.1.2.6")], [(1, 7421, "10.1.2.7")], lease=5, little=False)
+    b_be = spdp(B, [(1, 7420, "10.1.2.6")], [(1, 7421, "10.1.2.7")], lease=1000, little=False)
     own = spdp(OWN, [(1, 7410, "127.0.0.1")], [(1, 7411, "127.0.0.1")])
     seq = [(cut, IDLE), (bytes(huge), IDLE), (v6_only, IDLE), (bytes(bad_enc), IDLE),
            (bytes(short_q), IDLE), (own, IDLE),
@@ -120,18 +137,22 @@ def test_the_circuit_learns_its_peer_from_spdp_and_refuses_the_rest(tmp_path: Pa
     seq = [x for x in seq if x[0]]
     # the lease from A's last announcement: B before it ends is another, after it the peer
     seq += [(b_be, LEASE_CLOCKS - 2 * TICK - 300), (b_be, 300 + 2 * TICK + IDLE), (b_be, IDLE)]
+    # goodbyes: another's (nothing), then the peer's: the next announcement takes the place
+    seq += [(goodbye(A), IDLE), (a_lab, IDLE), (goodbye(B), IDLE), (a_lab, IDLE)]
     out = _run(seq, tmp_path)
     pulses = [(p["clock"], p["peer"]) for p in out["pulses"]]
     ends = out["ends"]
     a1 = [1, _ip("10.1.2.3"), 7412, _ip("10.1.2.3"), 7413]
     a2 = [1, _ip("10.1.2.3"), 7412, _ip("10.1.2.4"), 7415]
     b1 = [1, _ip("10.1.2.6"), 7420, _ip("10.1.2.7"), 7421]
-    assert [p for _, p in pulses] == [a1, a1, a2, a2, b1, b1], pulses
+    assert [p for _, p in pulses] == [a1, a1, a2, a2, b1, b1, a2, a2], pulses
     i_a, i_a2, i_b = 6, 6 + 2 + 20, 6 + 2 + 20 + 2
     firsts = [pulses[0][0] - ends[i_a], pulses[2][0] - ends[i_a2], pulses[4][0] - ends[i_b]]
     assert all(0 < d <= 4 for d in firsts), firsts               # at the announcement's end
     assert [pulses[k + 1][0] - pulses[k][0] for k in (0, 2, 4)] == [RESEND] * 3
-    assert out["peer"] == b1
-    # learned A, A's new port, B; refused: cut, huge, UDPv6 only, encapsulation, short
-    # octetsToInlineQos; others: B and the flood while A lived, B once more before its lease ended
-    assert out["counters"] == [3, 5, 1 + 20 + 1], out["counters"]
+    assert pulses[6][0] - ends[-1] in range(1, 5)
+    assert out["peer"] == a2
+    # learned A, A's new port, B, A after B's goodbye; refused: cut, huge, UDPv6 only,
+    # encapsulation, short octetsToInlineQos; others: B and the flood while A lived, B once more
+    # before A's lease ended, A while B lived (the goodbyes: none of these)
+    assert out["counters"] == [4, 5, 1 + 20 + 1 + 1], out["counters"]

@@ -156,7 +156,7 @@ module rfl_fabric_top #(
     reg [31:0] p_tx_ip;
     reg [15:0] p_tx_sport, p_tx_dport;
     /* verilator lint_off UNUSEDSIGNAL */
-    wire unused_ok = &{1'b0, le_rx_last_be, p_rx_ip, p_rx_sport, p_rx_len};
+    wire unused_ok = &{1'b0, le_rx_last_be, p_rx_sport, p_rx_len};
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_udp_port #(.RX_BITS(RX_BITS), .TX_BITS(TX_BITS), .QUEUE_BITS(QUEUE_BITS),
                    .COUNT_BITS(32)) u_port (
@@ -204,7 +204,8 @@ module rfl_fabric_top #(
                     .TICK(PERIOD), .RESEND(PERIOD < 2 ? 2 : PERIOD)) u_peer (
         .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .s_axis_tdata(p_rx_tdata),
         .s_axis_tvalid(p_rx_tvalid && p_rx_tready && keep && !to_user),
-        .s_axis_tready(l_ready), .s_axis_tlast(p_rx_tlast), .peer_valid(l_valid),
+        .s_axis_tready(l_ready), .s_axis_tlast(p_rx_tlast), .s_src_ip(p_rx_ip),
+        .peer_valid(l_valid),
         .peer_meta_ip(l_meta_ip), .peer_meta_port(l_meta_port), .peer_user_ip(l_user_ip),
         .peer_user_port(l_user_port), .send_sedp(l_sedp), .cnt_learned(cnt_peer_learned),
         .cnt_refused(cnt_peer_refused), .cnt_other(cnt_peer_other));

@@ -3,8 +3,10 @@
 // metatraffic port (RTPS messages; 8-bit AXI4-Stream, TLAST on a datagram's last byte; always
 // ready, a watcher of the beats the top takes), it reads each SPDP participant announcement (a
 // DATA of the built-in participant writer SPDP_WRITER_ID, flag D, not K) and takes from its
-// parameter list the first UDPv4 locator (kind SPDP_LOCATOR_KIND) of
-// PID_METATRAFFIC_UNICAST_LOCATOR and of PID_DEFAULT_UNICAST_LOCATOR, and its lease
+// parameter list a UDPv4 locator (kind SPDP_LOCATOR_KIND) of PID_METATRAFFIC_UNICAST_LOCATOR
+// and of PID_DEFAULT_UNICAST_LOCATOR (the first, unless a later one is at the address the
+// datagram came from, s_src_ip: a multi-homed host lists addresses the node may not reach, and
+// reaches it from that one), and its lease
 // (PID_PARTICIPANT_LEASE_DURATION, whole seconds; SPDP_LEASE_DEFAULT when absent, at most
 // SPDP_LEASE_MAX, at least 1). The constants are parameters rosfpga_lab.rtl.discrom
 // (spdp_parameters) takes from the software participant's builders (one owner).
@@ -13,7 +15,9 @@
 // (counted in seconds of TICK clocks), the next participant announced takes it. So a flood of
 // participants (or a second live one) cannot take the peer away from a live one, nor make the
 // circuit flap between two (each change sends the SEDP set); a peer that left is replaced
-// after its lease. A newer announcement of the peer with other locators updates them. On each
+// after its lease, or at once after its goodbye (an SPDP DATA whose inline QoS has
+// PID_STATUS_INFO with the disposed or unregistered flag, as the software participant's and
+// Cyclone DDS's are). A newer announcement of the peer with other locators updates them. On each
 // peer taken or changed: a send_sedp pulse, and a second one RESEND clocks later (the ROM's
 // SPDP goes out between: a peer drops SEDP from a participant it has not discovered yet).
 // Bounded: at most one peer change (two send_sedp pulses) per SPDP DATA received, and
@@ -23,18 +27,19 @@
 // octetsToInlineQos below 16, or no UDPv4 metatraffic or default locator (a locator of another
 // kind, or a port 0 or above 65535, is skipped). Counted in cnt_other: a well-formed
 // announcement of another participant while the peer is live. Our own (GUID prefix
-// cfg_prefix, looped back) is ignored. Not read: INFO_SRC (the header's prefix names the
-// participant), INFO_DST (an announcement is the participant's whoever it is addressed to),
-// goodbyes (a DATA with K or without D: the lease ends the peer).
+// cfg_prefix, looped back) is ignored, as is a goodbye (of the peer: it ends the peer's place).
+// Not read: INFO_SRC (the header's prefix names the participant), INFO_DST (an announcement is
+// the participant's whoever it is addressed to).
 // The walk: a byte a clock, as rfl_rtps_ctrl's (header, submessage headers, bodies by
 // length, octetsToNextHeader 0 to the end of the message), then in an SPDP DATA the inline QoS
-// (flag Q, skipped by its parameters' lengths), the encapsulation (PL_CDR_BE or PL_CDR_LE: the
+// (flag Q, walked by its parameters' lengths for PID_STATUS_INFO), the encapsulation (PL_CDR_BE or PL_CDR_LE: the
 // parameters' byte order) and the parameters.
 `default_nettype none
 
 module rfl_spdp_peer #(
     parameter [31:0] SPDP_WRITER_ID = 32'd0,    // all SPDP_*: rtl.discrom.spdp_parameters
-    parameter [63:0] SPDP_PIDS = 64'd0,         // {sentinel, lease, default, metatraffic}
+    parameter [79:0] SPDP_PIDS = 80'd0,         // {status info, sentinel, lease, default,
+                                                //  metatraffic}
     parameter [31:0] SPDP_ENCAPS = 32'd0,       // {PL_CDR_BE, PL_CDR_LE}
     parameter [31:0] SPDP_LOCATOR_KIND = 32'd0, // LOCATOR_KIND_UDPv4
     parameter SPDP_LEASE_DEFAULT = 100,         // seconds
@@ -50,6 +55,7 @@ module rfl_spdp_peer #(
     input  wire                  s_axis_tvalid,
     output wire                  s_axis_tready, // always 1: a watcher
     input  wire                  s_axis_tlast,
+    input  wire [31:0]           s_src_ip,      // the datagram's IPv4 source, held over it
     output wire                  peer_valid,    // a peer was taken (its registers below)
     output wire [31:0]           peer_meta_ip,
     output wire [15:0]           peer_meta_port,
@@ -78,7 +84,7 @@ module rfl_spdp_peer #(
         $error("rfl_spdp_peer: COUNT_BITS must be 1..32");
     end
 `endif
-    localparam [15:0] PID_SENTINEL = SPDP_PIDS[63:48], PID_LEASE = SPDP_PIDS[47:32],
+    localparam [15:0] PID_STATUS = SPDP_PIDS[79:64], PID_SENTINEL = SPDP_PIDS[63:48], PID_LEASE = SPDP_PIDS[47:32],
                       PID_USER = SPDP_PIDS[31:16], PID_META = SPDP_PIDS[15:0];
     localparam [15:0] ENC_BE = SPDP_ENCAPS[31:16], ENC_LE = SPDP_ENCAPS[15:0];
     localparam [31:0] LEASE_MAX_32 = SPDP_LEASE_MAX, LEASE_DEF_32 = SPDP_LEASE_DEFAULT;
@@ -127,9 +133,13 @@ module rfl_spdp_peer #(
     reg [15:0] vleft;
     reg vl1;
     reg [4:0] vpos;                             // value byte, held at 31
-    reg k_meta, k_user, k_lease;
+    reg k_meta, k_user, k_lease, k_status;
+    reg f_gone;                                 // a goodbye (PID_STATUS_INFO disposed or
+                                                // unregistered)
     reg [31:0] v_kind, v_port;
     reg have_meta, have_user, have_lease, pl_ok;
+    reg meta_src, user_src;                     // the one taken is at s_src_ip
+    reg m_hi;                                   // a value's bytes 20..22 are s_src_ip's first
     reg [31:0] meta_ip, user_ip, lease_sec;
     reg [15:0] meta_port, user_port;
 
@@ -143,12 +153,14 @@ module rfl_spdp_peer #(
     wire body_last = to_end ? tl : sl1;
     wire sub_end = body_last || tl;             // (tl first: cut short)
     wire [95:0] src_sh_n = {src_sh, b};
-    wire announce = k_data && f_d && !f_k && wid_ok;
+    wire spdp_data = k_data && wid_ok;
+    wire announce = spdp_data && f_d && !f_k && !f_gone;
     // a UDPv4 locator with a port of 1..65535, its value's bytes 0..7 taken
     wire loc_ok = v_kind == SPDP_LOCATOR_KIND && v_port != 32'd0 && v_port[31:16] == 16'd0;
+    wire src_match = m_hi && b == s_src_ip[7:0];   // (at a locator's byte 23)
 
     // the candidate (c_*), compared (e_*), then acted on; the peer (p_*)
-    reg c_valid, e_valid, e_own, e_same, e_loc_eq;
+    reg c_valid, c_bye, e_valid, e_own, e_same, e_loc_eq;
     reg [95:0] c_prefix, p_prefix;
     reg [31:0] c_mip, c_uip, p_mip, p_uip;
     reg [15:0] c_mport, c_uport, p_mport, p_uport;
@@ -230,8 +242,11 @@ module rfl_spdp_peer #(
                     ph <= P_FIX;
                     wid_ok <= 1'b0;
                     f_bad <= 1'b0;
+                    f_gone <= 1'b0;
                     have_meta <= 1'b0;
                     have_user <= 1'b0;
+                    meta_src <= 1'b0;
+                    user_src <= 1'b0;
                     have_lease <= 1'b0;
                     pl_ok <= 1'b0;
                     if (tl) begin
@@ -274,6 +289,7 @@ module rfl_spdp_peer #(
                             k_meta <= (ph == P_HEAD) && pid_n == PID_META;
                             k_user <= (ph == P_HEAD) && pid_n == PID_USER;
                             k_lease <= (ph == P_HEAD) && pid_n == PID_LEASE;
+                            k_status <= (ph == P_QHEAD) && pid_n == PID_STATUS;
                             vleft <= hlen;
                             vl1 <= (hlen == 16'd1);
                             vpos <= 5'd0;
@@ -291,17 +307,24 @@ module rfl_spdp_peer #(
                         if (vpos != 5'd31) vpos <= vpos + 1'b1;
                         if (vpos == 5'd3) v_kind <= acc_e_n;      // a locator's kind, or seconds
                         if (vpos == 5'd7) v_port <= acc_e_n;
+                        // StatusInfo_t: octet[4], the flags in the last
+                        if (k_status && vpos == 5'd3 && b[1:0] != 2'b00) f_gone <= 1'b1;
                         if (k_lease && vpos == 5'd3) begin
                             lease_sec <= acc_e_n;
                             have_lease <= 1'b1;
                         end
-                        if (k_meta && vpos == 5'd23 && loc_ok && !have_meta) begin
+                        if (vpos == 5'd22) m_hi <= acc_b_n[23:0] == s_src_ip[31:8];
+                        if (k_meta && vpos == 5'd23 && loc_ok &&
+                            (!have_meta || (src_match && !meta_src))) begin
                             have_meta <= 1'b1;
+                            meta_src <= src_match;
                             meta_ip <= acc_b_n;
                             meta_port <= v_port[15:0];
                         end
-                        if (k_user && vpos == 5'd23 && loc_ok && !have_user) begin
+                        if (k_user && vpos == 5'd23 && loc_ok &&
+                            (!have_user || (src_match && !user_src))) begin
                             have_user <= 1'b1;
+                            user_src <= src_match;
                             user_ip <= acc_b_n;
                             user_port <= v_port[15:0];
                         end
@@ -328,7 +351,13 @@ module rfl_spdp_peer #(
                         st <= tl ? S_HDR : S_SUBHDR;
                         // (this byte's own field is not needed: an announcement ends after
                         // its sentinel, the last byte of which is taken above at hcnt 3)
+                        if (spdp_data && f_gone) begin
+                            c_valid <= 1'b1;
+                            c_bye <= 1'b1;
+                            c_prefix <= src;
+                        end
                         if (announce) begin
+                            c_bye <= 1'b0;
                             if (!f_bad && (pl_ok || (ph == P_HEAD && hcnt == 2'd3 &&
                                                       pid_n == PID_SENTINEL))
                                 && have_meta && have_user) begin
@@ -365,7 +394,9 @@ module rfl_spdp_peer #(
                 resend <= resend - 1'b1;
                 if (resend == {{(RW-1){1'b0}}, 1'b1}) sedp <= 1'b1;
             end
-            if (e_valid && !e_own) begin
+            if (e_valid && !e_own && c_bye) begin
+                if (e_same) lease_left <= 16'd0;        // the peer's goodbye: its place free
+            end else if (e_valid && !e_own) begin
                 if (e_same || !have || lease_left == 16'd0) begin
                     lease_left <= c_lease;
                     if (!e_same || !e_loc_eq) begin
