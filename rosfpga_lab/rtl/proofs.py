@@ -210,6 +210,11 @@ PROOFS: tuple[Proof, ...] = (
           "the top's reset low for 16 clocks, then high; the peer learned (cfg_learn high, no "
           "send_sedp of its own); the addresses and ids the parameters; the LED on exactly when "
           "a datagram was taken; 32 clocks"),
+    Proof("spdp_peer", ("rfl_spdp_peer.v",), "prove", 4,
+          "rfl_spdp_peer (any input bytes, sources and prefix): always ready; the peer's "
+          "registers zero until one is taken, kept after, changed only with a send_sedp pulse; "
+          "at most two pulses per peer taken or changed; counters never fall; all reachable "
+          "states"),
     Proof("rtps_ctrl", ("rfl_rtps_ctrl.v",), "prove", 4,
           "rfl_rtps_ctrl (two slots, any input bytes, any prefix): request stream rules, every "
           "request names an answer of the table, always ready; all reachable states"),

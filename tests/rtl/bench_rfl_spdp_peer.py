@@ -15,7 +15,7 @@ from cocotb.triggers import ReadOnly, RisingEdge, Timer
 
 
 def _peer(dut) -> list[int]:
-    return [int(dut.peer_valid.value), int(dut.peer_meta_ip.value),
+    return [int(dut.peer_known.value), int(dut.peer_meta_ip.value),
             int(dut.peer_meta_port.value), int(dut.peer_user_ip.value),
             int(dut.peer_user_port.value)]
 

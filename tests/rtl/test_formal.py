@@ -423,3 +423,24 @@ def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -
     proof = next(p for p in PROOFS if p.name == "board_5a75b")
     result = prove(proof, replace={name: buggy})
     assert result.status == "FAIL", format_results([result])
+
+
+@pytest.mark.parametrize(("old", "new", "status"), [
+    ("            p_uport <= 16'd0;\n", "            p_uport <= 16'd7;\n", ("FAIL",)),
+    # a resend pulse twice: a peer is some 100 bytes away, past the bounded check's reach, so
+    # the induction fails to close (UNKNOWN) or finds it (FAIL), never PASS
+    ("if (resend == {{(RW-1){1'b0}}, 1'b1}) sedp <= 1'b1;",
+     "if (resend <= {{(RW-2){1'b0}}, 2'b10}) sedp <= 1'b1;", ("FAIL", "UNKNOWN")),
+], ids=["registers", "pulses"])
+def test_planted_bugs_fail_the_spdp_peer_proof(tmp_path: Path, old: str, new: str,
+                                               status: tuple[str, ...]) -> None:
+    """The SPDP learner's proof sees peer registers set with no peer, a third SEDP pulse."""
+    require_formal()
+    name = "rfl_spdp_peer.v"
+    text = (FABRIC_DIR / name).read_text()
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp_path / name
+    buggy.write_text(text.replace(old, new))
+    proof = next(p for p in PROOFS if p.name == "spdp_peer")
+    result = prove(proof, replace={name: buggy})
+    assert result.status in status, format_results([result])

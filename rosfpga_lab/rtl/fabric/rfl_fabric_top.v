@@ -205,7 +205,7 @@ module rfl_fabric_top #(
         .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .s_axis_tdata(p_rx_tdata),
         .s_axis_tvalid(p_rx_tvalid && p_rx_tready && keep && !to_user),
         .s_axis_tready(l_ready), .s_axis_tlast(p_rx_tlast), .s_src_ip(p_rx_ip),
-        .peer_valid(l_valid),
+        .peer_known(l_valid),
         .peer_meta_ip(l_meta_ip), .peer_meta_port(l_meta_port), .peer_user_ip(l_user_ip),
         .peer_user_port(l_user_port), .send_sedp(l_sedp), .cnt_learned(cnt_peer_learned),
         .cnt_refused(cnt_peer_refused), .cnt_other(cnt_peer_other));

@@ -56,7 +56,7 @@ module rfl_spdp_peer #(
     output wire                  s_axis_tready, // always 1: a watcher
     input  wire                  s_axis_tlast,
     input  wire [31:0]           s_src_ip,      // the datagram's IPv4 source, held over it
-    output wire                  peer_valid,    // a peer was taken (its registers below)
+    output wire                  peer_known,    // a peer was taken (its registers below)
     output wire [31:0]           peer_meta_ip,
     output wire [15:0]           peer_meta_port,
     output wire [31:0]           peer_user_ip,
@@ -170,7 +170,7 @@ module rfl_spdp_peer #(
     reg [RW-1:0] resend;
     reg sedp;
     reg [COUNT_BITS-1:0] n_learned, n_refused, n_other;
-    assign peer_valid = have;
+    assign peer_known = have;
     assign peer_meta_ip = p_mip;
     assign peer_meta_port = p_mport;
     assign peer_user_ip = p_uip;
@@ -416,6 +416,28 @@ module rfl_spdp_peer #(
             end
         end
     end
+`ifdef FORMAL
+    // The pulses (formal/fv_spdp_peer.sv proves them): f_change, a peer taken or changed now
+    // (its registers and send_sedp a clock later); f_sent, the pulses decided since the last
+    // change (that one included): one at the change, one when the resend count runs out, none
+    // else, so never more than two per change.
+    wire f_change = e_valid && !e_own && !c_bye && (e_same || !have || lease_left == 16'd0) &&
+                    (!e_same || !e_loc_eq);
+    wire f_resend = resend == {{(RW-1){1'b0}}, 1'b1};
+    reg [1:0] f_sent;
+    always @(posedge clk) begin
+        if (!rst_n) f_sent <= 2'd0;
+        else if (f_change) f_sent <= 2'd1;
+        else if (f_resend) f_sent <= f_sent + 2'd1;
+    end
+    always @(posedge clk) if (rst_n) begin
+        assert(f_sent <= 2'd2);
+        if (resend != {RW{1'b0}}) assert(f_sent == 2'd1);
+        if (!have) assert(resend == {RW{1'b0}} && f_sent == 2'd0 && !sedp);
+        if (!have) assert({p_mip, p_mport, p_uip, p_uport} == 96'd0);
+        if ($past(rst_n)) assert(sedp == $past(f_change || f_resend));
+    end
+`endif
 endmodule
 
 `default_nettype wire
