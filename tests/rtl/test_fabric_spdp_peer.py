@@ -156,3 +156,63 @@ def test_the_circuit_learns_its_peer_from_spdp_and_refuses_the_rest(tmp_path: Pa
     # encapsulation, short octetsToInlineQos; others: B and the flood while A lived, B once more
     # before A's lease ended, A while B lived (the goodbyes: none of these)
     assert out["counters"] == [4, 5, 1 + 20 + 1 + 1], out["counters"]
+
+
+CYCLONE_DOMAIN = 227
+CAPTURE = """
+import os, sys, time
+from cyclonedds.domain import DomainParticipant
+dp = DomainParticipant(int(sys.argv[1]))
+time.sleep(float(sys.argv[2]))
+"""
+
+
+def test_a_cyclone_dds_participants_spdp_is_learned(tmp_path: Path) -> None:
+    """A real Cyclone DDS participant (PyPI cyclonedds, configured as the fabric's peers are:
+    ``fabric_peer_uri``) announces itself to the discovery port of participant index 0, bound
+    here first; its SPDP datagram, captured, goes to the circuit from 127.0.0.1: the peer it
+    learns is the first UDPv4 metatraffic and default locators the lab's software decoder
+    reads in it (``rtps.discovery.parse_parameters``, ``rtps.build.Locator.decode``)."""
+    import importlib.util
+    import os
+    import socket
+    import subprocess
+    import sys
+
+    from rosfpga_lab.component.fabricsim import fabric_peer_uri
+    from rosfpga_lab.rtps.discovery import PL_CDR_LE, parse_parameters
+    from rosfpga_lab.rtps.entities import discovery_port
+    from rosfpga_lab.rtps.message import Data, parse_message
+    from tests.support.realros import skip_or_fail as skip
+
+    if importlib.util.find_spec("cyclonedds") is None:
+        skip("cyclonedds not installed (pip install cyclonedds)", "ROSFPGA_REQUIRE_ROS2")
+    sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    sock.bind(("127.0.0.1", discovery_port(CYCLONE_DOMAIN, 0)))
+    sock.settimeout(15)
+    env = dict(os.environ, CYCLONEDDS_URI=fabric_peer_uri(lease_seconds=7))
+    proc = subprocess.Popen([sys.executable, "-c", CAPTURE, str(CYCLONE_DOMAIN), "4"], env=env)
+    try:
+        while True:
+            raw, source = sock.recvfrom(65536)
+            datas = [(src, sub) for src, _dst, sub in parse_message(raw).routed()
+                     if isinstance(sub, Data) and sub.writer_id == SPDP_WRITER and sub.payload]
+            if datas:
+                break
+    finally:
+        sock.close()
+        proc.wait(timeout=30)
+    prefix, data = datas[0]
+    little = data.payload[:2] == PL_CDR_LE
+    params = parse_parameters(data.payload)
+
+    def first(pid: int) -> list[int]:
+        loc = next(x for x in (b.Locator.decode(v, little) for v in params[pid]) if x)
+        return [_ip(loc.address), loc.port]
+
+    SOURCES[prefix] = source[0]
+    out = _run([(raw, 2 * IDLE)], tmp_path)
+    want = [1, *first(b.PID_METATRAFFIC_UNICAST_LOCATOR), *first(b.PID_DEFAULT_UNICAST_LOCATOR)]
+    assert out["peer"] == want and [p["peer"] for p in out["pulses"]] == [want, want]
+    assert out["counters"] == [1, 0, 0]
+    (tmp_path / "cyclone_spdp.bin").write_bytes(raw)
