@@ -78,7 +78,8 @@ def test_the_fast_model_learns_its_peer_from_spdp_and_sends_it_sedp(tmp_path: Pa
     builders, to the domain's SPDP group and port) makes the circuit send its SEDP data and
     ros_discovery_info sample (the ROM's messages after SPDP, byte for byte) to the locators
     that announcement gave, and nowhere else; a second participant's later is counted, not
-    taken (no more SEDP)."""
+    taken (no more SEDP); another domain's announcement, and one to another port, are never
+    heard (the domain honoured: LiteEth's port filter, the top's three ports)."""
     require_fabric_sim()
     sc = scenario(tmp_path)
     build = build_fabric_sim(load_config(CONFIG), sc.rom, period=PERIOD)
@@ -87,18 +88,27 @@ def test_the_fast_model_learns_its_peer_from_spdp_and_sends_it_sedp(tmp_path: Pa
     config = FabricConfig(int(case["node_mac"], 16), _dotted(case["node_ip"]), "0.0.0.0", 0, 0,
                           case["reader"], case["writer"], case["time"], learn=True)
 
-    def announce(prefix: bytes, ip: str, index: int) -> bytes:
-        payload = b.spdp_payload(prefix, b.Locator(ip, discovery_port(0, index)),
-                                 b.Locator(ip, user_port(0, index)), 10.0, "peer", b"", 0)
+    def announce(prefix: bytes, ip: str, index: int, domain: int = 0,
+                 port: int | None = None) -> bytes:
+        payload = b.spdp_payload(prefix, b.Locator(ip, discovery_port(domain, index)),
+                                 b.Locator(ip, user_port(domain, index)), 10.0, "peer", b"",
+                                 domain)
         rtps = b.header(prefix) + b.data(SPDP_READER, SPDP_WRITER, 1, payload)
         return _fcs(bytes(Ether(dst=_group_mac(SPDP_MULTICAST_ADDRESS), src=PEER_MAC) /
                           IP(src=ip, dst=SPDP_MULTICAST_ADDRESS) /
-                          UDP(sport=40000, dport=discovery_multicast_port(0)) / rtps))
+                          UDP(sport=40000, dport=port or discovery_multicast_port(domain)) /
+                          rtps))
 
     sim = FabricSim(build, config, rate=0, max_clocks=MAX_CLOCKS)
     peer_ip = bytes.fromhex(case["peer_ip"])
     sent: list[bytes] = []
+    other = bytes.fromhex("010f0dd00000000300000003")
     try:
+        # another domain's (its SPDP port: LiteEth's filter drops it), one to a port LiteEth
+        # passes but the top does not own (counted in rx_port): neither is heard, so PEER is
+        # the first participant announced in this domain
+        sim.send_frame(announce(other, "192.168.10.7", 0, domain=1))
+        sim.send_frame(announce(other, "192.168.10.7", 0, port=discovery_multicast_port(0) + 1))
         sim.send_frame(announce(PEER, PEER_IP, PEER_INDEX))
         sim.send_frame(announce(bytes.fromhex("010fbeef0000000200000002"), "192.168.10.9", 3))
         deadline = time.monotonic() + 60
@@ -117,6 +127,7 @@ def test_the_fast_model_learns_its_peer_from_spdp_and_sends_it_sedp(tmp_path: Pa
     port = {DEST_META: meta, DEST_USER: user}
     assert to_peer == [(PEER_IP, port[m.dest], m.data) for m in sc.rom.messages[1:]]
     assert [report.counters[f"peer_{k}"] for k in ("learned", "refused", "other")] == [1, 0, 1]
+    assert (report.counters["rx_port"], report.counters["rx_packets"]) == (1, 3)
 
 
 def _dotted(hexed: str) -> str:
