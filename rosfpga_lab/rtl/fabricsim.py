@@ -15,9 +15,10 @@ them by name).
 :class:`FabricSim` runs the program as a child process and speaks its record protocol on its
 stdin and stdout (``rfl_fabric_sim.cpp``'s header): :meth:`FabricSim.send_frame` gives it an
 Ethernet frame (FCS included), :meth:`FabricSim.read` returns the frames it sent and counter
-reports, :meth:`FabricSim.configure` sets its registers (its address, its one peer's address and
-ports: the peer the host's software side knows from discovery), :meth:`FabricSim.send_sedp`
-pulses the SEDP request. The clock runs whether frames come or not, at most ``rate`` clocks per
+reports, :meth:`FabricSim.configure` sets its registers (its address; ``learn``: the circuit
+learns its one peer from SPDP, else that peer's address and ports, as the host's software side
+knows them from discovery), :meth:`FabricSim.send_sedp` pulses the SEDP request (without
+``learn``). The clock runs whether frames come or not, at most ``rate`` clocks per
 second of wall time: the SPDP period is in clocks, so a simulation takes a PERIOD scaled to its
 speed (:data:`SIM_PERIOD` at :data:`SIM_RATE`: an announcement about every second).
 """

@@ -113,8 +113,8 @@ module rfl_spdp_peer #(
     reg [1:0] st;
     reg [4:0] idx;
     reg hdr_bad;
-    reg [87:0] src_sh;
-    reg [95:0] src;
+    reg [95:0] src;                             // the header's prefix, shifted in (the last
+                                                // candidate's is used 2 clocks after its end)
     reg [7:0] kind, len_lo;
     reg le;                                     // the submessage's byte order
     reg f_q, f_d, f_k;
@@ -152,18 +152,18 @@ module rfl_spdp_peer #(
     wire [15:0] pid_n = hpid[15] ? hpid : {2'b00, hpid[13:0]};    // must-understand bit off
     wire body_last = to_end ? tl : sl1;
     wire sub_end = body_last || tl;             // (tl first: cut short)
-    wire [95:0] src_sh_n = {src_sh, b};
     wire spdp_data = k_data && wid_ok;
     wire announce = spdp_data && f_d && !f_k && !f_gone;
     // a UDPv4 locator with a port of 1..65535, its value's bytes 0..7 taken
     wire loc_ok = v_kind == SPDP_LOCATOR_KIND && v_port != 32'd0 && v_port[31:16] == 16'd0;
     wire src_match = m_hi && b == s_src_ip[7:0];   // (at a locator's byte 23)
 
-    // the candidate (c_*), compared (e_*), then acted on; the peer (p_*)
+    // the candidate (c_*: src and the locators taken hold it, the next header's prefix and the
+    // next locator at least 20 bytes later), compared (e_*), then acted on; the peer (p_*)
     reg c_valid, c_bye, e_valid, e_own, e_same, e_loc_eq;
-    reg [95:0] c_prefix, p_prefix;
-    reg [31:0] c_mip, c_uip, p_mip, p_uip;
-    reg [15:0] c_mport, c_uport, p_mport, p_uport;
+    reg [95:0] p_prefix;
+    reg [31:0] p_mip, p_uip;
+    reg [15:0] p_mport, p_uport;
     reg [15:0] c_lease, lease_left;
     reg have;
     reg [TW-1:0] tick;
@@ -215,13 +215,12 @@ module rfl_spdp_peer #(
                                (idx == 5'd0 && b != 8'h52) || (idx == 5'd1 && b != 8'h54) ||
                                (idx == 5'd2 && b != 8'h50) || (idx == 5'd3 && b != 8'h53) ||
                                (idx == 5'd4 && b != 8'd2);
-                    src_sh <= src_sh_n[87:0];
+                    if (idx >= 5'd8) src <= {src[87:0], b};
                     idx <= idx + 1'b1;
                     if (tl) begin
                         idx <= 5'd0;
                     end else if (idx == 5'd19) begin
                         idx <= 5'd0;
-                        src <= src_sh_n;
                         st <= hdr_bad ? S_DROP : S_SUBHDR;
                     end
                 end
@@ -354,7 +353,6 @@ module rfl_spdp_peer #(
                         if (spdp_data && f_gone) begin
                             c_valid <= 1'b1;
                             c_bye <= 1'b1;
-                            c_prefix <= src;
                         end
                         if (announce) begin
                             c_bye <= 1'b0;
@@ -362,11 +360,6 @@ module rfl_spdp_peer #(
                                                       pid_n == PID_SENTINEL))
                                 && have_meta && have_user) begin
                                 c_valid <= 1'b1;
-                                c_prefix <= src;
-                                c_mip <= meta_ip;
-                                c_mport <= meta_port;
-                                c_uip <= user_ip;
-                                c_uport <= user_port;
                                 c_lease <= lease_n + 16'd1;
                             end else if (n_refused != {COUNT_BITS{1'b1}}) begin
                                 n_refused <= n_refused + 1'b1;
@@ -380,9 +373,10 @@ module rfl_spdp_peer #(
             end
             // the candidate compared (registered: timing), then acted on
             e_valid <= c_valid;
-            e_own <= c_prefix == cfg_prefix;
-            e_same <= have && c_prefix == p_prefix;
-            e_loc_eq <= {c_mip, c_mport, c_uip, c_uport} == {p_mip, p_mport, p_uip, p_uport};
+            e_own <= src == cfg_prefix;
+            e_same <= have && src == p_prefix;
+            e_loc_eq <= {meta_ip, meta_port, user_ip, user_port} ==
+                        {p_mip, p_mport, p_uip, p_uport};
             // the lease, in seconds
             if (tick == TICK_LAST) begin
                 tick <= {TW{1'b0}};
@@ -401,11 +395,11 @@ module rfl_spdp_peer #(
                     lease_left <= c_lease;
                     if (!e_same || !e_loc_eq) begin
                         have <= 1'b1;
-                        p_prefix <= c_prefix;
-                        p_mip <= c_mip;
-                        p_mport <= c_mport;
-                        p_uip <= c_uip;
-                        p_uport <= c_uport;
+                        p_prefix <= src;
+                        p_mip <= meta_ip;
+                        p_mport <= meta_port;
+                        p_uip <= user_ip;
+                        p_uport <= user_port;
                         sedp <= 1'b1;
                         resend <= RESEND_N;
                         if (n_learned != {COUNT_BITS{1'b1}}) n_learned <= n_learned + 1'b1;
