@@ -448,9 +448,10 @@ def spdp_parameters() -> dict[str, int]:
     """The constants of ``fabric/rfl_spdp_peer.v`` (the circuit learns its peer from SPDP), from
     the software participant's owners: the SPDP writer's entity id
     (:mod:`rosfpga_lab.rtps.entities`), the parameter ids (status info, for a goodbye;
-    sentinel, lease, default and metatraffic unicast locators) and the UDPv4 locator kind (:mod:`rosfpga_lab.rtps.build`), the
-    parameter lists' encapsulations (:mod:`rosfpga_lab.rtps.discovery`), the lease when none is
-    announced and its cap in seconds (:mod:`rosfpga_lab.rtps.limits`)."""
+    sentinel, lease, default and metatraffic unicast locators) and the UDPv4 locator kind
+    (:mod:`rosfpga_lab.rtps.build`), the parameter lists' encapsulations
+    (:mod:`rosfpga_lab.rtps.discovery`), the lease when none is announced and its cap in
+    seconds (:mod:`rosfpga_lab.rtps.limits`)."""
     pids = (b.PID_STATUS_INFO, b.PID_SENTINEL, b.PID_PARTICIPANT_LEASE_DURATION,
             b.PID_DEFAULT_UNICAST_LOCATOR, b.PID_METATRAFFIC_UNICAST_LOCATOR)
     return {"SPDP_WRITER_ID": SPDP_WRITER,

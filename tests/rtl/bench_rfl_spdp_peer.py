@@ -1,8 +1,8 @@
 """cocotb testbench of ``rfl_spdp_peer`` (run by tests/rtl/test_fabric_spdp_peer.py, not by
-pytest): the case's datagrams (``SPDP_PEER_CASE``: hex, each with the idle clocks after it and its IPv4 source) go in
-a byte a clock; every send_sedp pulse is recorded with the clock and the peer registers then,
-and at the end the registers and counters, into ``SPDP_PEER_OUT``. The watcher must always be
-ready (asserted at every beat)."""
+pytest): the case's datagrams (``SPDP_PEER_CASE``: hex, each with the idle clocks after it and
+its IPv4 source) go in a byte a clock; every send_sedp pulse is recorded with the clock and the
+peer registers then, and at the end the registers and counters, into ``SPDP_PEER_OUT``. The
+watcher must always be ready (asserted at every beat)."""
 
 from __future__ import annotations
 

@@ -6,18 +6,18 @@
 // parameter list a UDPv4 locator (kind SPDP_LOCATOR_KIND) of PID_METATRAFFIC_UNICAST_LOCATOR
 // and of PID_DEFAULT_UNICAST_LOCATOR (the first, unless a later one is at the address the
 // datagram came from, s_src_ip: a multi-homed host lists addresses the node may not reach, and
-// reaches it from that one), and its lease
-// (PID_PARTICIPANT_LEASE_DURATION, whole seconds; SPDP_LEASE_DEFAULT when absent, at most
-// SPDP_LEASE_MAX, at least 1). The constants are parameters rosfpga_lab.rtl.discrom
-// (spdp_parameters) takes from the software participant's builders (one owner).
+// reaches it from that one), and its lease (PID_PARTICIPANT_LEASE_DURATION, whole seconds;
+// SPDP_LEASE_DEFAULT when absent, at most SPDP_LEASE_MAX, at least 1). The constants are
+// parameters rosfpga_lab.rtl.discrom (spdp_parameters) takes from the software participant's
+// builders (one owner).
 // The peer (one; several peers are a later step): the first participant announced keeps the
 // place while it announces itself within its lease; once it has been silent for its lease
 // (counted in seconds of TICK clocks), the next participant announced takes it. So a flood of
 // participants (or a second live one) cannot take the peer away from a live one, nor make the
 // circuit flap between two (each change sends the SEDP set); a peer that left is replaced
 // after its lease, or at once after its goodbye (an SPDP DATA whose inline QoS has
-// PID_STATUS_INFO with the disposed or unregistered flag, as the software participant's and
-// Cyclone DDS's are). A newer announcement of the peer with other locators updates them. On each
+// PID_STATUS_INFO with the disposed or unregistered flag, as rosfpga_lab.rtps.spdp's goodbye).
+// A newer announcement of the peer with other locators updates them. On each
 // peer taken or changed: a send_sedp pulse, and a second one RESEND clocks later (the ROM's
 // SPDP goes out between: a peer drops SEDP from a participant it has not discovered yet).
 // Bounded: at most one peer change (two send_sedp pulses) per SPDP DATA received, and
@@ -32,8 +32,8 @@
 // the participant's whoever it is addressed to).
 // The walk: a byte a clock, as rfl_rtps_ctrl's (header, submessage headers, bodies by
 // length, octetsToNextHeader 0 to the end of the message), then in an SPDP DATA the inline QoS
-// (flag Q, walked by its parameters' lengths for PID_STATUS_INFO), the encapsulation (PL_CDR_BE or PL_CDR_LE: the
-// parameters' byte order) and the parameters.
+// (flag Q, walked by its parameters' lengths for PID_STATUS_INFO), the encapsulation
+// (PL_CDR_BE or PL_CDR_LE: the parameters' byte order) and the parameters.
 `default_nettype none
 
 module rfl_spdp_peer #(
@@ -84,8 +84,9 @@ module rfl_spdp_peer #(
         $error("rfl_spdp_peer: COUNT_BITS must be 1..32");
     end
 `endif
-    localparam [15:0] PID_STATUS = SPDP_PIDS[79:64], PID_SENTINEL = SPDP_PIDS[63:48], PID_LEASE = SPDP_PIDS[47:32],
-                      PID_USER = SPDP_PIDS[31:16], PID_META = SPDP_PIDS[15:0];
+    localparam [15:0] PID_STATUS = SPDP_PIDS[79:64], PID_SENTINEL = SPDP_PIDS[63:48],
+                      PID_LEASE = SPDP_PIDS[47:32], PID_USER = SPDP_PIDS[31:16],
+                      PID_META = SPDP_PIDS[15:0];
     localparam [15:0] ENC_BE = SPDP_ENCAPS[31:16], ENC_LE = SPDP_ENCAPS[15:0];
     localparam [31:0] LEASE_MAX_32 = SPDP_LEASE_MAX, LEASE_DEF_32 = SPDP_LEASE_DEFAULT;
     localparam [15:0] LEASE_MAX = LEASE_MAX_32[15:0];
