@@ -213,8 +213,8 @@ PROOFS: tuple[Proof, ...] = (
     Proof("spdp_peer", ("rfl_spdp_peer.v",), "prove", 4,
           "rfl_spdp_peer (any input bytes, sources and prefix): always ready; the peer's "
           "registers zero until one is taken, kept after, changed only with a send_sedp pulse; "
-          "at most two pulses per peer taken or changed; counters never fall; all reachable "
-          "states"),
+          "at most two pulses per peer taken or changed, at most one change a second (TICK "
+          "clocks); counters never fall; all reachable states"),
     Proof("rtps_ctrl", ("rfl_rtps_ctrl.v",), "prove", 4,
           "rfl_rtps_ctrl (two slots, any input bytes, any prefix): request stream rules, every "
           "request names an answer of the table, always ready; all reachable states"),

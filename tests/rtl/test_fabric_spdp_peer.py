@@ -84,13 +84,13 @@ def _ip(addr: str) -> int:
     return int.from_bytes(bytes(int(x) for x in addr.split(".")), "big")
 
 
-def _run(datagrams: list[tuple[bytes, int]], tmp_path: Path) -> dict:
+def _run(datagrams: list[tuple[bytes, int]], tmp_path: Path, tick: int = TICK) -> dict:
     require_iverilog()
     require_cocotb()
     import cocotb_tools.runner as runner_mod
 
     params: dict[str, object] = {k: v for k, v in spdp_parameters().items()}
-    params.update(TICK=TICK, RESEND=RESEND)
+    params.update(TICK=tick, RESEND=RESEND)
     runner = runner_mod.get_runner("icarus")
     runner.build(sources=[FABRIC_DIR / "rfl_spdp_peer.v"], hdl_toplevel="rfl_spdp_peer",
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"), parameters=params)
@@ -216,3 +216,17 @@ def test_a_cyclone_dds_participants_spdp_is_learned(tmp_path: Path) -> None:
     assert out["peer"] == want and [p["peer"] for p in out["pulses"]] == [want, want]
     assert out["counters"] == [1, 0, 0]
     (tmp_path / "cyclone_spdp.bin").write_bytes(raw)
+
+
+def test_at_most_one_peer_change_a_second(tmp_path: Path) -> None:
+    """A second of 1000 clocks: the peer's new locators a few hundred clocks after it was taken
+    are counted, not taken (no SEDP); its next announcement after the second has ended takes
+    them: at most two SEDP sets a second, whatever comes in."""
+    first = spdp(A, [(1, 7412, "10.1.2.3")], [(1, 7413, "10.1.2.3")])
+    moved = spdp(A, [(1, 7412, "10.1.2.3")], [(1, 7999, "10.1.2.3")])
+    out = _run([(first, 100), (moved, 1200), (moved, 100)], tmp_path, tick=1000)
+    a1 = [1, _ip("10.1.2.3"), 7412, _ip("10.1.2.3"), 7413]
+    a2 = [1, _ip("10.1.2.3"), 7412, _ip("10.1.2.3"), 7999]
+    assert [p["peer"] for p in out["pulses"]] == [a1, a1, a2, a2]
+    assert out["pulses"][2]["clock"] > out["ends"][2] > out["pulses"][0]["clock"] + 1000
+    assert out["counters"] == [2, 0, 1]

@@ -431,10 +431,13 @@ def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -
     # the induction fails to close (UNKNOWN) or finds it (FAIL), never PASS
     ("if (resend == {{(RW-1){1'b0}}, 1'b1}) sedp <= 1'b1;",
      "if (resend <= {{(RW-2){1'b0}}, 2'b10}) sedp <= 1'b1;", ("FAIL", "UNKNOWN")),
-], ids=["registers", "pulses"])
+    ("wire change = heard && !c_bye && !recent &&", "wire change = heard && !c_bye &&",
+     ("FAIL", "UNKNOWN")),
+], ids=["registers", "pulses", "rate"])
 def test_planted_bugs_fail_the_spdp_peer_proof(tmp_path: Path, old: str, new: str,
                                                status: tuple[str, ...]) -> None:
-    """The SPDP learner's proof sees peer registers set with no peer, a third SEDP pulse."""
+    """The SPDP learner's proof sees peer registers set with no peer, a third SEDP pulse, two
+    changes in a second."""
     require_formal()
     name = "rfl_spdp_peer.v"
     text = (FABRIC_DIR / name).read_text()

@@ -20,13 +20,15 @@
 // A newer announcement of the peer with other locators updates them. On each
 // peer taken or changed: a send_sedp pulse, and a second one RESEND clocks later (the ROM's
 // SPDP goes out between: a peer drops SEDP from a participant it has not discovered yet).
-// Bounded: at most one peer change (two send_sedp pulses) per SPDP DATA received, and
-// rfl_rtps_disc_rom merges the requests that come while one waits.
+// Bounded, whatever comes in: at most one peer change a second (TICK clocks; a change the
+// second after another waits for the peer's next announcement), two send_sedp pulses each, so
+// at most two SEDP sets a second (rfl_rtps_disc_rom also merges requests that wait).
 // Refused and counted (cnt_refused): an announcement whose submessage or parameter list ends
 // before PID_SENTINEL (a length past the submessage's end included), an unknown encapsulation,
 // octetsToInlineQos below 16, or no UDPv4 metatraffic or default locator (a locator of another
 // kind, or a port 0 or above 65535, is skipped). Counted in cnt_other: a well-formed
-// announcement of another participant while the peer is live. Our own (GUID prefix
+// announcement of another participant while the peer is live, or a change in the second of
+// the last. Our own (GUID prefix
 // cfg_prefix, looped back) is ignored, as is a goodbye (of the peer: it ends the peer's place).
 // Not read: INFO_SRC (the header's prefix names the participant), INFO_DST (an announcement is
 // the participant's whoever it is addressed to).
@@ -181,6 +183,13 @@ module rfl_spdp_peer #(
     assign cnt_refused = n_refused;
     assign cnt_other = n_other;
 
+    // the decision on the candidate compared (e_*): another's announcement (not ours looped
+    // back) heard; a new peer (the place free: none yet, or silent for its lease) or the peer's
+    // new locators taken, at most one change a second (recent: one in this second)
+    reg recent;
+    wire heard = e_valid && !e_own;
+    wire change = heard && !c_bye && !recent &&
+                  (e_same ? !e_loc_eq : (!have || lease_left == 16'd0));
     // the announced lease in seconds, 1..LEASE_MAX, and one more (a tick may come right after)
     wire [15:0] lease_n = !have_lease ? LEASE_DEF :
                           (lease_sec[31] || lease_sec > LEASE_MAX_32) ? LEASE_MAX :
@@ -203,6 +212,7 @@ module rfl_spdp_peer #(
             tick <= {TW{1'b0}};
             resend <= {RW{1'b0}};
             sedp <= 1'b0;
+            recent <= 1'b0;
             n_learned <= {COUNT_BITS{1'b0}};
             n_refused <= {COUNT_BITS{1'b0}};
             n_other <= {COUNT_BITS{1'b0}};
@@ -389,26 +399,25 @@ module rfl_spdp_peer #(
                 resend <= resend - 1'b1;
                 if (resend == {{(RW-1){1'b0}}, 1'b1}) sedp <= 1'b1;
             end
-            if (e_valid && !e_own && c_bye) begin
-                if (e_same) lease_left <= 16'd0;        // the peer's goodbye: its place free
-            end else if (e_valid && !e_own) begin
-                if (e_same || !have || lease_left == 16'd0) begin
-                    lease_left <= c_lease;
-                    if (!e_same || !e_loc_eq) begin
-                        have <= 1'b1;
-                        p_prefix <= src;
-                        p_mip <= meta_ip;
-                        p_mport <= meta_port;
-                        p_uip <= user_ip;
-                        p_uport <= user_port;
-                        sedp <= 1'b1;
-                        resend <= RESEND_N;
-                        if (n_learned != {COUNT_BITS{1'b1}}) n_learned <= n_learned + 1'b1;
-                    end
-                end else if (n_other != {COUNT_BITS{1'b1}}) begin
-                    n_other <= n_other + 1'b1;
-                end
+            if (tick == TICK_LAST) recent <= 1'b0;
+            if (heard && e_same) lease_left <= c_lease;
+            if (heard && c_bye && e_same) lease_left <= 16'd0;     // its goodbye: the place free
+            if (change) begin
+                have <= 1'b1;
+                recent <= 1'b1;
+                lease_left <= c_lease;
+                p_prefix <= src;
+                p_mip <= meta_ip;
+                p_mport <= meta_port;
+                p_uip <= user_ip;
+                p_uport <= user_port;
+                sedp <= 1'b1;
+                resend <= RESEND_N;
+                if (n_learned != {COUNT_BITS{1'b1}}) n_learned <= n_learned + 1'b1;
             end
+            if (heard && !c_bye && !change && !(e_same && e_loc_eq) &&
+                n_other != {COUNT_BITS{1'b1}})
+                n_other <= n_other + 1'b1;
         end
     end
 `ifdef FORMAL
@@ -416,14 +425,21 @@ module rfl_spdp_peer #(
     // (its registers and send_sedp a clock later); f_sent, the pulses decided since the last
     // change (that one included): one at the change, one when the resend count runs out, none
     // else, so never more than two per change.
-    wire f_change = e_valid && !e_own && !c_bye && (e_same || !have || lease_left == 16'd0) &&
-                    (!e_same || !e_loc_eq);
+    wire f_change = change;
     wire f_resend = resend == {{(RW-1){1'b0}}, 1'b1};
     reg [1:0] f_sent;
+    reg f_any, f_tick;                          // a change yet; a second's end since the last
     always @(posedge clk) begin
-        if (!rst_n) f_sent <= 2'd0;
-        else if (f_change) f_sent <= 2'd1;
-        else if (f_resend) f_sent <= f_sent + 2'd1;
+        if (!rst_n) begin
+            f_sent <= 2'd0;
+            f_any <= 1'b0;
+            f_tick <= 1'b0;
+        end else begin
+            if (f_change) f_sent <= 2'd1;
+            else if (f_resend) f_sent <= f_sent + 2'd1;
+            if (f_change) f_any <= 1'b1;
+            f_tick <= !f_change && (f_tick || tick == TICK_LAST);
+        end
     end
     always @(posedge clk) if (rst_n) begin
         assert(f_sent <= 2'd2);
@@ -431,6 +447,9 @@ module rfl_spdp_peer #(
         if (!have) assert(resend == {RW{1'b0}} && f_sent == 2'd0 && !sedp);
         if (!have) assert({p_mip, p_mport, p_uip, p_uport} == 96'd0);
         if ($past(rst_n)) assert(sedp == $past(f_change || f_resend));
+        // at most one change a second: a second ends between two
+        if (f_change) assert(!f_any || f_tick);
+        assert(recent == (f_any && !f_tick));
     end
 `endif
 endmodule

@@ -2,7 +2,8 @@
 // after) on its ports, for ANY input bytes, datagram ends, source addresses and configuration
 // prefix: the watcher is always ready; the peer's registers are zero until a peer is taken,
 // then it stays taken, and they change only in a clock that pulses send_sedp; the counters
-// never fall; and (its FORMAL block) at most two send_sedp pulses per peer taken or changed.
+// never fall; and (its FORMAL block) at most two send_sedp pulses per peer taken or changed,
+// at most one change a second.
 module fv_spdp_peer (
     input clk, input rst_n, input [95:0] cfg_prefix, input [7:0] s_axis_tdata,
     input s_axis_tvalid, input s_axis_tlast, input [31:0] s_src_ip
