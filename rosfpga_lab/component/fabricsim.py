@@ -402,7 +402,8 @@ class ShimBridge(_PeerKeeper):
 class TapBridge(_PeerKeeper):
     """The simulated node's PHY side bridged to a TAP interface: its frames (FCS checked and
     taken off) to the host's network stack, the host's frames (FCS added) to it. The host
-    answers ARP and routes; the bridge only reads the SPDP going to the circuit to keep its peer.
+    answers ARP and routes; the circuit learns its peer (with ``bridge_peer`` the bridge reads
+    the SPDP going to the circuit to set it).
     """
 
     def __init__(self, sim: FabricSim, rom: DiscoveryRom, *, name: str = TAP_NAME,
