@@ -277,18 +277,17 @@ module rfl_spdp_peer #(
                     pos <= pos + 1'b1;
                     sub_left <= sub_left - 1'b1;
                     sl1 <= (sub_left == 16'd2);
-                    if (pos == 16'd3) begin
-                        dstart_m1 <= 16'd3 + len_n;     // (len_n: bytes 2, 3 in le's order)
-                        if (len_n < 16'd16) begin
-                            f_bad <= 1'b1;
-                            ph <= P_IGN;
-                        end
-                    end
+                    if (pos == 16'd3) dstart_m1 <= 16'd3 + len_n;   // (bytes 2, 3 in le's order)
                     if (pos == 16'd10) wid <= acc_b_n[23:0];
                     if (pos == 16'd11) wid_ok <= ({wid, b} == SPDP_WRITER_ID);
                     if (pos == 16'd2) len_lo <= b;
                     case (ph)
-                    P_FIX: if (pos >= 16'd4 && pos == dstart_m1) begin
+                    P_FIX: if (pos == 16'd4 && dstart_m1 < 16'd19) begin
+                        // octetsToInlineQos below 16 (or past 65532: 3 + it wraps), checked
+                        // from its register (timing)
+                        f_bad <= 1'b1;
+                        ph <= P_IGN;
+                    end else if (pos >= 16'd19 && pos == dstart_m1) begin
                         ph <= f_q ? P_QHEAD : P_ENC;
                         ple <= le;
                         hcnt <= 2'd0;
