@@ -36,9 +36,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--domain: 7410 and 7411 for domain 0); each datagram a peer sends there goes to the "
         "circuit as an Ethernet/IPv4/UDP frame, each frame the circuit sends comes back as a "
         "datagram (its SPDP to the unicast discovery ports of indices 0-9, as Cyclone DDS "
-        "does on loopback); the bridge answers the circuit's ARP and, from the SPDP of a new "
-        "participant, sets the circuit's one peer (cfg_peer_* registers) and asks it to send "
-        "its SEDP data. Peers: ROS 2 on this host with Cyclone DDS configured for loopback "
+        "does on loopback); the bridge answers the circuit's ARP. The circuit learns its one "
+        "peer from the participants' SPDP itself (the first one heard, until it is silent for "
+        "its lease) and sends it its SEDP data (--bridge-peer: the bridge sets the peer's "
+        "registers and asks for SEDP instead, the old way). Peers: ROS 2 on this host with Cyclone DDS configured for loopback "
         "(ParticipantIndex auto, peer localhost, no multicast) and MaxMessageSize 1472B (one "
         "Ethernet frame: the circuit does not reassemble IP fragments); one peer participant "
         "at a time. The clock runs at most --rate clocks per second, SPDP every --period "
@@ -72,6 +73,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="the longest sample the circuit takes (its store-and-forward buffer; "
                    "default 2048, the board's): longer ones are dropped and counted; a 64x48 "
                    "rgba8 Image needs 16384")
+    p.add_argument("--bridge-peer", action="store_true",
+                   help="the bridge sets the circuit's peer (cfg_peer_* registers, send_sedp) "
+                   "from the SPDP it reads, instead of the circuit learning it (cfg_learn)")
     p.add_argument("-q", "--quiet", action="store_true", help="print only the counters")
     p.set_defaults(func=run_sim)
     parser.set_defaults(func=lambda args: parser.print_help() or 2)
@@ -107,7 +111,7 @@ def run_sim(args: argparse.Namespace) -> int:
     bridge = start_fabric(config, domain=args.domain, tap=args.tap,
                           period=args.period or SIM_PERIOD,
                           rate=SIM_RATE if args.rate is None else args.rate,
-                          max_bytes=args.max_bytes, log=say)
+                          max_bytes=args.max_bytes, bridge_peer=args.bridge_peer, log=say)
     started = time.monotonic()
     try:
         bridge.start()

@@ -61,11 +61,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="--target fabric: the board's MAC address (default "
                         "02:52:46:4c:00:02, locally administered)")
     parser.add_argument("--peer-ip", default=None, metavar="IPV4",
-                        help="--target fabric: the board's one peer, the host running ROS 2 "
-                        "(default: --address with the last number 1, or 2 when that is the node)")
-    parser.add_argument("--peer-index", type=int, default=0, metavar="N",
-                        help="--target fabric: the peer's participant index, which sets the "
-                        "ports the board sends to (default 0)")
+                        help="--target fabric: the host's address on the board's link, for the "
+                        "board's README (the board learns its peer from SPDP; default: "
+                        "--address with the last number 1, or 2 when that is the node)")
     parser.set_defaults(func=run)
 
 
@@ -109,7 +107,7 @@ def _fabric(args: argparse.Namespace, config: object) -> int:
     paths = write_rom(rom, args.output)
     peer_ip = args.peer_ip or default_peer(args.address)
     paths += write_board(config, rom, args.output, peer_ip=peer_ip,  # type: ignore[arg-type]
-                         peer_index=args.peer_index, mac=args.mac or DEFAULT_MAC)
+                         mac=args.mac or DEFAULT_MAC)
     if not args.quiet:
         sizes = ", ".join(f"{m.name} {len(m.data)}" for m in rom.messages)
         print(f"wrote {len(paths)} files into {args.output}: discovery ROM of "

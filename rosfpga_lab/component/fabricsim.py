@@ -22,14 +22,18 @@ between its PHY side and the host:
   LiteEth the host's, SPDP goes by multicast. Peers bind that interface
   (:func:`fabric_tap_peer_uri`).
 
-The paper's split: discovery knowledge lives in software. The circuit sends to one peer, whose
-address and ports are registers (``cfg_peer_*``): the bridge reads the SPDP announcements that
-come to the node's metatraffic port, and for a participant it has not seen sets the registers
-to that participant's metatraffic and user-data locators and pulses ``send_sedp`` (the circuit
-sends its SEDP data and ros_discovery_info sample there), and again once after the circuit's
-next SPDP announcement (a peer drops SEDP from a participant it has not discovered yet). The
-participant that appeared last is the circuit's peer: one peer at a time (run the publisher and the
-subscriber in one participant, as one ROS 2 process with both does).
+The circuit learns its one peer itself (``rfl_spdp_peer`` in ``rfl_fabric_top``, cfg_learn):
+from the SPDP announcements that reach its SPDP or metatraffic port it takes the first
+participant's metatraffic and default unicast locators (until that participant is silent for
+its lease), and sends its SEDP data and ros_discovery_info sample there, again a period later.
+The bridge only moves frames. With ``bridge_peer`` (``--bridge-peer``) the old way instead: the
+bridge reads the SPDP announcements that come to the node's metatraffic port, and for a
+participant it has not seen sets the circuit's registers (``cfg_peer_*``) to that participant's
+locators and pulses ``send_sedp``, and again once after the circuit's next SPDP announcement
+(a peer drops SEDP from a participant it has not discovered yet); the participant that
+appeared last is the peer. Either way one peer at a time (run the publisher and the subscriber
+in one participant, as one ROS 2 process with both does); the bridge still reads the peers'
+SPDP for what it forwards (below).
 
 The circuit sends what goes to a reader to its peer's default user-data port; Fast DDS's
 readers (rclpy's ``ros_discovery_info`` reader among them) announce a unicast locator of their
@@ -219,19 +223,22 @@ class BridgeCounts:
                f"datagrams from the circuit: {self.from_circuit} (SPDP copies to the "
                f"discovery ports: {self.spdp_copies}, refused by the host: {self.send_refused})",
                f"ARP requests answered: {self.arp_answered}",
-               f"peers learned: {len(self.peers)}; send_sedp pulses: {self.sedp_pulses}",
+               f"peers seen: {len(self.peers)}; send_sedp pulses: {self.sedp_pulses}",
                f"peers asked for their SEDP subscriptions: {self.subscriptions_asked}"]
         out += [f"dropped ({why}): {n}" for why, n in sorted(self.dropped.items())]
         return out
 
 
 class _PeerKeeper:
-    """What both bridges do: keep the circuit's one peer (its registers) from the SPDP the host
-    side sees, and pulse send_sedp for it."""
+    """What both bridges do: note the participants the host side announces (for what the
+    bridge forwards) and, with ``bridge_peer``, keep the circuit's one peer (its registers) and
+    pulse send_sedp for it; else the circuit learns its peer itself (cfg_learn)."""
 
     def __init__(self, sim: FabricSim, rom: DiscoveryRom, *, node_mac: str = DEFAULT_MAC,
+                 bridge_peer: bool = False,
                  log: Callable[[str], None] = lambda line: None) -> None:
         self.sim, self.rom, self.log = sim, rom, log
+        self.bridge_peer = bridge_peer
         self.node_mac, self.host_mac = mac_bytes(node_mac), mac_bytes(HOST_MAC)
         self.meta, self.user = discovery_port(rom.domain, rom.index), user_port(rom.domain,
                                                                                 rom.index)
@@ -242,8 +249,14 @@ class _PeerKeeper:
 
     def _learn(self, peer: Peer) -> None:
         self._known.add(peer.guid_prefix)
-        self.peer = peer
         self.counts.peers.append(peer)
+        if not self.bridge_peer:
+            self.peer = self.peer or peer     # the circuit's: the first, while it lives
+            self.log(f"participant {peer.guid_prefix.hex()} seen: metatraffic "
+                     f"{peer.meta[0]}:{peer.meta[1]}, user data {peer.user[0]}:{peer.user[1]} "
+                     "(the circuit learns its peer from SPDP itself)")
+            return
+        self.peer = peer
         self.sim.configure(self._config(peer))
         self.sim.send_sedp()
         self.counts.sedp_pulses += 1
@@ -256,7 +269,7 @@ class _PeerKeeper:
         user = peer.user if peer else (self.rom.address, 0)
         return FabricConfig(mac_value(":".join(f"{x:02x}" for x in self.node_mac)),
                             self.rom.address, meta[0], meta[1], user[1],
-                            self.rom.entity_ids["reader"])
+                            self.rom.entity_ids["reader"], learn=not self.bridge_peer)
 
     def _spdp_went_out(self) -> None:
         if self._pulse_after_spdp:
@@ -265,7 +278,7 @@ class _PeerKeeper:
             self.counts.sedp_pulses += 1
 
     def start(self) -> None:
-        """Give the circuit its registers (no peer yet: ports 0) and let it run."""
+        """Give the circuit its registers (learning, or no peer yet: ports 0) and let it run."""
         self.sim.configure(self._config(None))
 
 
@@ -273,9 +286,9 @@ class ShimBridge(_PeerKeeper):
     """The simulated node's PHY side bridged to UDP ports on loopback (module docstring)."""
 
     def __init__(self, sim: FabricSim, rom: DiscoveryRom, out_topic: str, *,
-                 node_mac: str = DEFAULT_MAC,
+                 node_mac: str = DEFAULT_MAC, bridge_peer: bool = False,
                  log: Callable[[str], None] = lambda line: None) -> None:
-        super().__init__(sim, rom, node_mac=node_mac, log=log)
+        super().__init__(sim, rom, node_mac=node_mac, bridge_peer=bridge_peer, log=log)
         self.ports = UdpPorts(rom.address, [self.meta, self.user])
         self._ident = 0
         self._asked: set[bytes] = set()
@@ -361,7 +374,9 @@ class ShimBridge(_PeerKeeper):
                 self._spdp_went_out()
             else:
                 to = (got.dst_ip, got.dst_port)
-                if self.peer and to == self.peer.user:
+                # to the peer's default locator (by its port: the circuit takes the address
+                # the announcement lists, which may be another of this host's than the bridge's)
+                if self.peer and to[1] == self.peer.user[1]:
                     to = self._reader_of(got.payload) or to
                 if not self.ports.send(got.src_port, to[0], to[1], got.payload):
                     self.counts.send_refused += 1
@@ -387,13 +402,15 @@ class ShimBridge(_PeerKeeper):
 class TapBridge(_PeerKeeper):
     """The simulated node's PHY side bridged to a TAP interface: its frames (FCS checked and
     taken off) to the host's network stack, the host's frames (FCS added) to it. The host
-    answers ARP and routes; the bridge only reads the SPDP going to the circuit to keep its peer.
+    answers ARP and routes; the circuit learns its peer (with ``bridge_peer`` the bridge reads
+    the SPDP going to the circuit to set it).
     """
 
     def __init__(self, sim: FabricSim, rom: DiscoveryRom, *, name: str = TAP_NAME,
                  host_cidr: str = TAP_HOST_CIDR, node_mac: str = DEFAULT_MAC,
+                 bridge_peer: bool = False,
                  log: Callable[[str], None] = lambda line: None) -> None:
-        super().__init__(sim, rom, node_mac=node_mac, log=log)
+        super().__init__(sim, rom, node_mac=node_mac, bridge_peer=bridge_peer, log=log)
         self.tap = TapDevice(name, host_cidr)
         self._spdp_port = discovery_multicast_port(rom.domain)
 
@@ -436,13 +453,14 @@ class TapBridge(_PeerKeeper):
 
 def start_fabric(config: NodeConfig, *, domain: int = 0, tap: bool = False,
                  address: str | None = None, period: int = SIM_PERIOD, rate: int = SIM_RATE,
-                 max_bytes: int | None = None,
+                 max_bytes: int | None = None, bridge_peer: bool = False,
                  log: Callable[[str], None] = lambda line: None) -> ShimBridge | TapBridge:
     """Build (or take from the cache) and start ``config``'s node in the fabric as participant 0
     of ``domain`` at ``address`` (default 127.0.0.1 for the shim, :data:`TAP_NODE_ADDRESS` on a
     TAP interface; ``max_bytes``: the longest sample it takes, as
     :func:`~rosfpga_lab.rtl.fabricsim.build_fabric_sim`), bridged by a :class:`ShimBridge` or a
-    :class:`TapBridge` (call its ``start`` and ``run``, then ``close`` it and its ``sim``)."""
+    :class:`TapBridge` (call its ``start`` and ``run``, then ``close`` it and its ``sim``);
+    ``bridge_peer``: the bridge sets the circuit's peer (else the circuit learns it)."""
     address = address or (TAP_NODE_ADDRESS if tap else "127.0.0.1")
     rom = render_rom(config, domain=domain, address=address)    # wire: cdr checked there
     bound = cdr_layout_from_config(config).layout.max_body + 4   # with the reader's length
@@ -456,11 +474,13 @@ def start_fabric(config: NodeConfig, *, domain: int = 0, tap: bool = False,
     how = f"built in {build.seconds:.0f} s" if build.seconds else "from the cache"
     log(f"Verilator model {how} ({time.monotonic() - started:.1f} s): {build.program}")
     sim = FabricSim(build, FabricConfig(mac_value(DEFAULT_MAC), address, address, 0, 0,
-                                        rom.entity_ids["reader"]), rate=rate)
+                                        rom.entity_ids["reader"], learn=not bridge_peer),
+                    rate=rate)
     try:
         if tap:
-            return TapBridge(sim, rom, log=log)
-        return ShimBridge(sim, rom, b.dds_topic(config.publisher.topic), log=log)
+            return TapBridge(sim, rom, bridge_peer=bridge_peer, log=log)
+        return ShimBridge(sim, rom, b.dds_topic(config.publisher.topic),
+                          bridge_peer=bridge_peer, log=log)
     except BaseException:
         sim.close()
         raise

@@ -44,12 +44,11 @@ CLOCK_HZ = 125_000_000
 DEFAULT_MAC = "02:52:46:4c:00:02"
 #: The files of the board build, in read order (the vendored core's board variant first).
 BOARD_FILES = ("vendor/liteeth_udp_ecp5_rgmii.v", "rfl_udp_store.v", "rfl_udp_port.v",
-               *FABRIC_NODE, "rfl_fabric_top.v", f"{BOARD_TOP}.v")
+               *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_fabric_top.v", f"{BOARD_TOP}.v")
 LPF_FILE = f"{BOARD_TOP}.lpf"
 DEFINE = "RFL_FABRIC_RGMII"
 #: Bits of the board's own parameters (sized hex in Verilog).
-_BITS = {"MAC": 48, "IP": 32, "PEER_IP": 32, "PEER_META_PORT": 16, "PEER_USER_PORT": 16,
-         "READER": 32, "TIME": 64}
+_BITS = {"MAC": 48, "IP": 32, "READER": 32, "TIME": 64}
 
 
 def mac_value(text: str) -> int:
@@ -71,28 +70,21 @@ def _ip(text: str) -> int:
 
 
 def default_peer(address: str) -> str:
-    """The peer's default address: ``address`` with its last number 1 (2 when that is it)."""
+    """The host's default address on the board's subnet (the board's README sets it up):
+    ``address`` with its last number 1 (2 when that is it)."""
     node = ipaddress.IPv4Address(_ip(address))
     peer = ipaddress.IPv4Address((int(node) & ~0xFF) | 1)
     return str(peer if peer != node else ipaddress.IPv4Address(int(peer) + 1))
 
 
-def board_parameters(rom: DiscoveryRom, *, peer_ip: str, peer_index: int = 0,
-                     mac: str = DEFAULT_MAC) -> dict[str, str]:
+def board_parameters(rom: DiscoveryRom, *, mac: str = DEFAULT_MAC) -> dict[str, str]:
     """``rfl_board_5a75b``'s parameters as Verilog literals: the node's MAC and IPv4 address
-    (the one ``rom`` announces), its one peer's address and ports (the RTPS port mapping for
-    the peer's participant index in ``rom``'s domain), the reader id ``rom`` announces, SPDP
-    every :data:`ANNOUNCE_SECONDS` at :data:`CLOCK_HZ`, and ``rfl_fabric_top``'s (the ports, the
-    transmit path's, the ROMs' files, sizes and answer slots)."""
-    node_ip = _ip(rom.address)
-    peer = _ip(peer_ip)
-    if peer == node_ip:
-        raise RtlError(f"the peer's address {peer_ip} is the node's own")
-    own: dict[str, int] = {
-        "MAC": mac_value(mac), "IP": node_ip, "PEER_IP": peer,
-        "PEER_META_PORT": discovery_port(rom.domain, peer_index),
-        "PEER_USER_PORT": user_port(rom.domain, peer_index),
-        "READER": rom.entity_ids["reader"], "TIME": 0}
+    (the one ``rom`` announces), the reader id ``rom`` announces, SPDP every
+    :data:`ANNOUNCE_SECONDS` at :data:`CLOCK_HZ`, and ``rfl_fabric_top``'s (the ports, the SPDP
+    learner's constants, the transmit path's, the ROMs' files, sizes and answer slots). No peer:
+    the board learns it from SPDP (``rfl_spdp_peer``)."""
+    own: dict[str, int] = {"MAC": mac_value(mac), "IP": _ip(rom.address),
+                           "READER": rom.entity_ids["reader"], "TIME": 0}
     params = {k: f"{_BITS[k]}'h{v:x}" for k, v in own.items()}
     params.update(fabric_top_literals(rom, period=round(ANNOUNCE_SECONDS * CLOCK_HZ)))
     return params
@@ -145,7 +137,7 @@ bitstream: {b}/{BIT_FILE}
 """
 
 
-def _readme(rom: DiscoveryRom, mac: str, peer_ip: str, peer_index: int) -> str:
+def _readme(rom: DiscoveryRom, mac: str, peer_ip: str) -> str:
     """board/README.md: what was checked here, and what a user with the board runs."""
     return f"""# The ROS 2 node in the fabric on a {BOARD}
 
@@ -173,9 +165,11 @@ board, regenerate the core with `phy_tx_delay: 0` (tools/liteeth/gen_liteeth.py)
 ## The host
 
 The node is participant {rom.index} of DDS domain {rom.domain} at {rom.address} (MAC {mac}),
-on the board's first Ethernet port (LiteX-Boards' eth 0). Its one peer is {peer_ip},
-participant {peer_index} (it sends its SEDP answers and user data to that participant's ports).
-On the host, the port to the board (`eth0` here) on the same subnet:
+on the board's first Ethernet port (LiteX-Boards' eth 0). Its one peer it learns from the SPDP
+announcements that reach it (the first participant of domain {rom.domain} heard, until it is
+silent for its lease: the host's ROS 2 process, whatever its participant index), and sends its
+SEDP data, answers and user data to that participant's locators. On the host, the port to the
+board (`eth0` here) on the same subnet:
 
     sudo ip addr add {peer_ip}/24 dev eth0
     sudo ip link set eth0 up
@@ -183,21 +177,28 @@ On the host, the port to the board (`eth0` here) on the same subnet:
     ROS_DOMAIN_ID={rom.domain} ros2 topic list
 
 The DDS implementation must use that interface for SPDP's multicast
-({SPDP_MULTICAST_ADDRESS}); the host's ROS 2 process must be participant {peer_index} (the
-first one started on the host is 0).
+({SPDP_MULTICAST_ADDRESS}); run one ROS 2 participant in the domain on that link (the board
+keeps one peer).
 Other addresses: `rosfpga-lab generate CONFIG -o DIR --target fabric --address IP --peer-ip IP
---mac MAC --peer-index N` ({BOARD_DIR}/parameters.json has what this build was given).
+--mac MAC` ({BOARD_DIR}/parameters.json has what this build was given).
 """
 
 
 def write_board(config: NodeConfig, rom: DiscoveryRom, out_dir: str | Path, *, peer_ip: str,
-                peer_index: int = 0, mac: str = DEFAULT_MAC) -> list[Path]:
+                mac: str = DEFAULT_MAC) -> list[Path]:
     """The board build's files into ``out_dir`` (a ``--target fabric`` project, the ROM's files
     already there: Yosys reads them from ``out_dir``, where ``make`` runs): the fabric's Verilog,
     the generated CDR circuit of ``config`` (``board/node/``, :func:`node_sources`), pins,
-    parameters, the Yosys script and the Makefile; the paths written."""
+    parameters, the Yosys script and the Makefile; the paths written. ``peer_ip``: the host's
+    address on the board's subnet, for the README's set-up (the board learns its peer).
+
+    Raises:
+        RtlError: an address is not IPv4, ``peer_ip`` is the node's, the MAC is malformed.
+    """
     out = Path(out_dir)
-    params = board_parameters(rom, peer_ip=peer_ip, peer_index=peer_index, mac=mac)
+    if _ip(peer_ip) == _ip(rom.address):
+        raise RtlError(f"the peer's address {peer_ip} is the node's own")
+    params = board_parameters(rom, mac=mac)
     board = out / BOARD_DIR
     for sub in ("vendor", "node"):
         (board / sub).mkdir(parents=True, exist_ok=True)
@@ -224,9 +225,9 @@ def write_board(config: NodeConfig, rom: DiscoveryRom, out_dir: str | Path, *, p
     texts = {board / "synth.ys": script,
              board / "parameters.json": json.dumps(
                  {"board": BOARD, "top": BOARD_TOP, "mac": mac, "ip": rom.address,
-                  "peer_ip": peer_ip, "peer_index": peer_index, "parameters": params},
+                  "peer_ip": peer_ip, "parameters": params},
                  indent=1) + "\n",
-             board / "README.md": _readme(rom, mac, peer_ip, peer_index),
+             board / "README.md": _readme(rom, mac, peer_ip),
              out / "Makefile": _makefile(*_tools())}
     for path, text in texts.items():
         path.write_text(text, encoding="utf-8")

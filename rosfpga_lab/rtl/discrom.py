@@ -83,11 +83,15 @@ from rosfpga_lab.rtl.limits import (
     MAX_DISC_ROM_BYTES,
 )
 from rosfpga_lab.rtps import build as b
+from rosfpga_lab.rtps.discovery import PL_CDR_BE, PL_CDR_LE
 from rosfpga_lab.rtps.entities import (
-    PUB_READER, PUB_WRITER, SUB_READER, SUB_WRITER, Qos, discovery_multicast_port,
+    PUB_READER, PUB_WRITER, SPDP_WRITER, SUB_READER, SUB_WRITER, Qos, discovery_multicast_port,
     discovery_port, user_port,
 )
-from rosfpga_lab.rtps.limits import FRAGMENT_BYTES, MAX_MESSAGE_BYTES, SPDP_MULTICAST_ADDRESS
+from rosfpga_lab.rtps.limits import (
+    ANNOUNCE_SECONDS, DEFAULT_LEASE_SECONDS, FRAGMENT_BYTES, MAX_LEASE_SECONDS, MAX_MESSAGE_BYTES,
+    SPDP_MULTICAST_ADDRESS,
+)
 from rosfpga_lab.rtps.message import ANY_PARTICIPANT
 from rosfpga_lab.rtps.participant import Participant
 from rosfpga_lab.rtps.rosnode import RosNodeEntities, split_node_name
@@ -440,19 +444,41 @@ def tx_parameters(rom: DiscoveryRom, *, frag_bytes: int = FRAGMENT_BYTES,
             "FRAG_BYTES": frag_bytes, "MAX_DATAGRAM": max_datagram, "INFO_TS": int(info_ts)}
 
 
+def spdp_parameters() -> dict[str, int]:
+    """The constants of ``fabric/rfl_spdp_peer.v`` (the circuit learns its peer from SPDP), from
+    the software participant's owners: the SPDP writer's entity id
+    (:mod:`rosfpga_lab.rtps.entities`), the parameter ids (status info, for a goodbye;
+    sentinel, lease, default and metatraffic unicast locators) and the UDPv4 locator kind
+    (:mod:`rosfpga_lab.rtps.build`), the parameter lists' encapsulations
+    (:mod:`rosfpga_lab.rtps.discovery`), the lease when none is announced and its cap in
+    seconds (:mod:`rosfpga_lab.rtps.limits`)."""
+    pids = (b.PID_STATUS_INFO, b.PID_SENTINEL, b.PID_PARTICIPANT_LEASE_DURATION,
+            b.PID_DEFAULT_UNICAST_LOCATOR, b.PID_METATRAFFIC_UNICAST_LOCATOR)
+    return {"SPDP_WRITER_ID": SPDP_WRITER,
+            "SPDP_PIDS": sum(pid << (16 * (len(pids) - 1 - i)) for i, pid in enumerate(pids)),
+            "SPDP_ENCAPS": int.from_bytes(PL_CDR_BE + PL_CDR_LE, "big"),
+            "SPDP_LOCATOR_KIND": b.LOCATOR_KIND_UDPV4,
+            "SPDP_LEASE_DEFAULT": round(DEFAULT_LEASE_SECONDS),
+            "SPDP_LEASE_MAX": round(MAX_LEASE_SECONDS)}
+
+
 def top_parameters(rom: DiscoveryRom) -> dict[str, int]:
     """The network parameters of ``fabric/rfl_fabric_top.v`` for the participant ``rom`` was
     rendered for (one owner: the RTPS port mapping of :mod:`rosfpga_lab.rtps.entities` and the
-    SPDP group of :mod:`rosfpga_lab.rtps.limits`, as :meth:`DiscoveryRom.ports` names them)."""
+    SPDP group of :mod:`rosfpga_lab.rtps.limits`, as :meth:`DiscoveryRom.ports` names them), and
+    its SPDP learner's constants (:func:`spdp_parameters`)."""
     return {"SPDP_PORT": discovery_multicast_port(rom.domain),
             "META_PORT": discovery_port(rom.domain, rom.index),
             "USER_PORT": user_port(rom.domain, rom.index),
-            "SPDP_GROUP": int(ipaddress.IPv4Address(SPDP_MULTICAST_ADDRESS))}
+            "SPDP_GROUP": int(ipaddress.IPv4Address(SPDP_MULTICAST_ADDRESS)),
+            **spdp_parameters()}
 
 
 #: Bits of the parameters of :func:`tx_parameters` and :func:`top_parameters` that are not Verilog
 #: integers.
-TX_PARAMETER_BITS = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32, "SPDP_GROUP": 32}
+TX_PARAMETER_BITS = {"GUID_PREFIX": 96, "WRITER_ID": 32, "READER_ID": 32, "SPDP_GROUP": 32,
+                     "SPDP_WRITER_ID": 32, "SPDP_PIDS": 80, "SPDP_ENCAPS": 32,
+                     "SPDP_LOCATOR_KIND": 32}
 
 
 def verilog_parameters(params: dict[str, int]) -> dict[str, str]:
@@ -470,6 +496,9 @@ def node_parameters(rom: DiscoveryRom, *, period: int) -> dict[str, str]:
     ``rfl_fabric_top`` takes these and :func:`top_parameters`."""
     if period < 1:
         raise RtlError(f"SPDP period of {period} clocks: it must be at least 1")
+    if ANNOUNCE_SECONDS != 1.0:     # rfl_fabric_top counts a peer's lease in PERIODs
+        raise RtlError(f"ANNOUNCE_SECONDS is {ANNOUNCE_SECONDS}: rfl_spdp_peer's second is a "
+                       "PERIOD of clocks")
     return {**verilog_parameters(tx_parameters(rom)), "PERIOD": str(period),
             "ROM_FILE": f'"{ROM_FILE}"', "TABLE_FILE": f'"{TABLE_FILE}"',
             "ROM_BYTES": str(len(rom.image())), "MESSAGES": str(len(rom.messages)),

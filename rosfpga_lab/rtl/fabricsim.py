@@ -15,9 +15,10 @@ them by name).
 :class:`FabricSim` runs the program as a child process and speaks its record protocol on its
 stdin and stdout (``rfl_fabric_sim.cpp``'s header): :meth:`FabricSim.send_frame` gives it an
 Ethernet frame (FCS included), :meth:`FabricSim.read` returns the frames it sent and counter
-reports, :meth:`FabricSim.configure` sets its registers (its address, its one peer's address and
-ports: the peer the host's software side knows from discovery), :meth:`FabricSim.send_sedp`
-pulses the SEDP request. The clock runs whether frames come or not, at most ``rate`` clocks per
+reports, :meth:`FabricSim.configure` sets its registers (its address; ``learn``: the circuit
+learns its one peer from SPDP, else that peer's address and ports, as the host's software side
+knows them from discovery), :meth:`FabricSim.send_sedp` pulses the SEDP request (without
+``learn``). The clock runs whether frames come or not, at most ``rate`` clocks per
 second of wall time: the SPDP period is in clocks, so a simulation takes a PERIOD scaled to its
 speed (:data:`SIM_PERIOD` at :data:`SIM_RATE`: an announcement about every second).
 """
@@ -60,16 +61,18 @@ TOP = "rfl_fabric_top"
 SOURCES = (*FABRIC_TOP_GMII, *FABRIC_INCLUDES)
 #: The counters the program reports, in its order (the top's cnt_* outputs, the answers' byte
 #: credit, then the generated subscriber's verdicts: samples judged, refused, the last refusal's
-#: status code, the walk's table: ``spec.program.statuses``).
+#: status code, the walk's table: ``spec.program.statuses``), then the SPDP learner's
+#: (rfl_spdp_peer: peers taken or changed, announcements refused, others while the peer lives).
 COUNTERS = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_length",
             "rx_overflow", "tx_packets", "tx_overflow", "rx_port", "rx_header", "rx_other",
-            "credit", "judged", "refused", "last_refusal")
+            "credit", "judged", "refused", "last_refusal", "peer_learned", "peer_refused",
+            "peer_other")
 #: The simulation's SPDP period in clocks and the clock rate it is run at (clocks per second of
 #: wall time): an announcement about every second, as the board's (rtps.limits.ANNOUNCE_SECONDS
 #: at 125 MHz), if the model keeps up.
 SIM_PERIOD = 400_000
 SIM_RATE = 400_000
-_CONFIG = struct.Struct("<QIIHHIIQ")
+_CONFIG = struct.Struct("<QIIHHIIQB")
 
 
 def fabric_top_default(name: str) -> str:
@@ -178,7 +181,9 @@ def build_fabric_sim(config: NodeConfig, rom: DiscoveryRom, *, period: int = SIM
 @dataclass(frozen=True)
 class FabricConfig:
     """The top's registers: its MAC and IPv4 address, its one peer's address and metatraffic
-    and user-data ports, its reader's entity id, the writer it takes (0: any), INFO_TS's time."""
+    and user-data ports, its reader's entity id, the writer it takes (0: any), INFO_TS's time,
+    and ``learn`` (cfg_learn): the circuit learns its peer from SPDP and the peer's fields
+    are not used."""
 
     mac: int
     ip: str
@@ -188,11 +193,13 @@ class FabricConfig:
     reader: int
     writer: int = 0
     time: int = 0
+    learn: bool = False
 
     def pack(self) -> bytes:
         return _CONFIG.pack(self.mac, int(ipaddress.IPv4Address(self.ip)),
                             int(ipaddress.IPv4Address(self.peer_ip)), self.peer_meta_port,
-                            self.peer_user_port, self.reader, self.writer, self.time)
+                            self.peer_user_port, self.reader, self.writer, self.time,
+                            int(self.learn))
 
 
 @dataclass

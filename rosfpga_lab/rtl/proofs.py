@@ -40,8 +40,8 @@ FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
 FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
                   "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v",
-                  "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_fabric_top.v",
-                  "rfl_board_5a75b.v")
+                  "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_spdp_peer.v",
+                  "rfl_fabric_top.v", "rfl_board_5a75b.v")
 ENV_INCLUDE = "fv_env.vh"
 #: The parameter lists the fabric's tops share (declared, passed on), included from FABRIC_DIR.
 FABRIC_INCLUDES = ("rfl_fabric_node_params.vh", "rfl_fabric_node_pass.vh",
@@ -53,7 +53,7 @@ FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_
                "rfl_fabric_node.v")
 #: rfl_fabric_top's files for simulation (LiteEth's GMII variant), relative to FABRIC_DIR.
 FABRIC_TOP_GMII = ("vendor/liteeth_udp_gmii.v", "rfl_udp_store.v", "rfl_udp_port.v",
-                   *FABRIC_NODE, "rfl_fabric_top.v")
+                   *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_fabric_top.v")
 
 
 @dataclass(frozen=True)
@@ -202,16 +202,22 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_udp_port (16-byte buffers, 2 payloads each way, any LiteEth stream and payloads): "
           "both outputs keep the stream rules with their sideband, LiteEth never held back; 20 "
           "clocks"),
-    Proof("fabric_top", ("rfl_udp_store.v", "rfl_udp_port.v", "rfl_fabric_top.v"), "bmc", 16,
+    Proof("fabric_top", ("rfl_udp_store.v", "rfl_udp_port.v", "rfl_spdp_peer.v",
+                         "rfl_fabric_top.v"), "bmc", 16,
           "rfl_fabric_top's glue (LiteEth and rfl_fabric_node as models of any streams, "
           "rfl_udp_port's 16-byte buffers): the node takes only datagrams to the three ports, "
           "TUSER 1 exactly for the user-data port, by the stream rules; each datagram sent goes "
           "to the address and ports its TDEST names, by the stream rules; 16 clocks"),
     Proof("board_5a75b", ("rfl_board_5a75b.v",), "bmc", 32,
           "rfl_board_5a75b's glue (rfl_fabric_top as a model, the PLL locked from the start): "
-          "the top's reset low for 16 clocks, then high; one send_sedp pulse SEDP_WAIT clocks "
-          "after; the addresses and ids the parameters; the LED on exactly when a datagram was "
-          "taken; 32 clocks"),
+          "the top's reset low for 16 clocks, then high; the peer learned (cfg_learn high, no "
+          "send_sedp of its own); the addresses and ids the parameters; the LED on exactly when "
+          "a datagram was taken; 32 clocks"),
+    Proof("spdp_peer", ("rfl_spdp_peer.v",), "prove", 4,
+          "rfl_spdp_peer (any input bytes, sources and prefix): always ready; the peer's "
+          "registers zero until one is taken, kept after, changed only with a send_sedp pulse; "
+          "at most two pulses per peer taken or changed, at most one change a second (TICK "
+          "clocks); counters never fall; all reachable states"),
     Proof("rtps_ctrl", ("rfl_rtps_ctrl.v",), "prove", 4,
           "rfl_rtps_ctrl (two slots, any input bytes, any prefix): request stream rules, every "
           "request names an answer of the table, always ready; all reachable states"),

@@ -35,6 +35,7 @@ async def start_top(dut, case: dict) -> tuple[GmiiSource, GmiiSink]:
     GMII source and sink (tests/rtl/bench_rfl_fabric_top_wire.py starts the top the same way)."""
     dut.cfg_mac.value = int(case["node_mac"], 16)
     dut.cfg_ip.value = int(case["node_ip"], 16)
+    dut.cfg_learn.value = int(case.get("learn", 0))
     dut.cfg_peer_ip.value = int(case["peer_ip"], 16)
     dut.cfg_peer_meta_port.value = case["peer_meta_port"]
     dut.cfg_peer_user_port.value = case["peer_user_port"]

@@ -16,13 +16,16 @@ CONFIG = Path(__file__).resolve().parents[2] / "data" / "fpga_laserscan_min_cdr.
 
 def test_generate_writes_the_board_build(tmp_path: Path) -> None:
     assert main(["generate", str(CONFIG), "-o", str(tmp_path), "-q", "--target", "fabric",
-                 "--address", "10.0.0.7", "--peer-index", "1", "--mac",
-                 "02:00:00:00:00:2a"]) == 0
+                 "--address", "10.0.0.7", "--mac", "02:00:00:00:00:2a"]) == 0
     index = json.loads((tmp_path / "board" / "parameters.json").read_text())
     p = index["parameters"]
-    # RTPS 2.3 9.6.1.1, domain 0: participant 1's metatraffic 7400+10+2, user data 7400+11+2
-    assert (p["PEER_META_PORT"], p["PEER_USER_PORT"]) == ("16'h1cf4", "16'h1cf5")
-    assert (p["IP"], p["PEER_IP"], p["MAC"]) == ("32'ha000007", "32'ha000001", "48'h2000000002a")
+    # no peer at build time: the board learns it from SPDP (RTPS 2.3: the SPDP writer's id,
+    # PID_METATRAFFIC_UNICAST_LOCATOR 0x32, PID_DEFAULT_UNICAST_LOCATOR 0x31, UDPv4 kind 1)
+    assert not any(k.startswith("PEER") for k in p) and "SEDP_WAIT" not in p
+    assert (p["SPDP_WRITER_ID"], p["SPDP_LOCATOR_KIND"]) == ("32'h100c2", "32'h1")
+    assert p["SPDP_PIDS"] == "80'h710001000200310032" and p["SPDP_ENCAPS"] == "32'h20003"
+    assert (p["IP"], p["MAC"]) == ("32'ha000007", "48'h2000000002a")
+    assert index["peer_ip"] == "10.0.0.1"
     assert p["SPDP_GROUP"] == "32'hefff0001" and p["PERIOD"] == "125000000"
     assert p["ROM_FILE"] == '"rfl_rtps_disc_rom.hex"'
     assert (tmp_path / "rfl_rtps_disc_rom.hex").exists()

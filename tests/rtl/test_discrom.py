@@ -144,9 +144,16 @@ def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
     assert index["rfl_rtps_tx"] == verilog_parameters(tx_parameters(rom))
     assert index["rfl_rtps_tx"]["GUID_PREFIX"] == f"96'h{rom.guid_prefix.hex().lstrip('0')}"
     # the network top's ports: RTPS 2.3 9.6.1.1 for domain 9, participant 1 (PB 7400, DG 250,
-    # PG 2, d0 0, d1 10, d3 11), the SPDP group 239.255.0.1
-    assert index["rfl_fabric_top"] == {"SPDP_PORT": "9650", "META_PORT": "9662",
-                                       "USER_PORT": "9663", "SPDP_GROUP": "32'hefff0001"}
+    # PG 2, d0 0, d1 10, d3 11), the SPDP group 239.255.0.1; the SPDP learner's constants:
+    # ENTITYID_SPDP_BUILTIN_PARTICIPANT_WRITER (9.3.1.2), PID_STATUS_INFO 0x71, PID_SENTINEL 1,
+    # PID_PARTICIPANT_LEASE_DURATION 2, PID_DEFAULT_UNICAST_LOCATOR 0x31,
+    # PID_METATRAFFIC_UNICAST_LOCATOR 0x32 (9.6.2.2), PL_CDR_BE 2 / PL_CDR_LE 3 (10.5),
+    # LOCATOR_KIND_UDPv4 1, the default lease 100 s (8.5.3.1), the lab's cap 300 s
+    assert index["rfl_fabric_top"] == {
+        "SPDP_PORT": "9650", "META_PORT": "9662", "USER_PORT": "9663",
+        "SPDP_GROUP": "32'hefff0001", "SPDP_WRITER_ID": "32'h100c2",
+        "SPDP_PIDS": "80'h710001000200310032", "SPDP_ENCAPS": "32'h20003",
+        "SPDP_LOCATOR_KIND": "32'h1", "SPDP_LEASE_DEFAULT": "100", "SPDP_LEASE_MAX": "300"}
 
 
 def _require_cyclonedds():

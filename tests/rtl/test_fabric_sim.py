@@ -26,14 +26,21 @@ from typing import Any
 import numpy as np
 import pytest
 
+from scapy.layers.inet import IP, UDP
+from scapy.layers.l2 import Ether
+
 from rosfpga_lab.config import load_config
-from rosfpga_lab.rtl.discrom import render_rom
+from rosfpga_lab.rtl.discrom import DEST_META, DEST_USER, render_rom
 from rosfpga_lab.rtl.fabricsim import FabricConfig, FabricSim, build_fabric_sim
 from rosfpga_lab.rtps import build as b
-from rosfpga_lab.rtps.entities import discovery_port, user_port
+from rosfpga_lab.rtps.entities import (
+    SPDP_READER, SPDP_WRITER, discovery_multicast_port, discovery_port, user_port,
+)
+from rosfpga_lab.rtps.limits import SPDP_MULTICAST_ADDRESS
 from tests.rtl.test_fabric_rtps_cdr import CONFIG, scan
 from tests.support.proctools import interruptible, kill_if_running, stop_with
-from tests.rtl.test_fabric_top import MAX_CLOCKS, PERIOD, check_sent, scenario
+from tests.rtl.test_fabric_top import MAX_CLOCKS, PEER, PEER_INDEX, PERIOD, check_sent, scenario
+from tests.rtl.test_fabric_udp import PEER_IP, PEER_MAC, _fcs, _group_mac
 from tests.support.rtltools import require_fabric_sim
 
 pytestmark = pytest.mark.rtl
@@ -70,9 +77,70 @@ def test_the_fast_model_sends_what_the_cocotb_bench_expects(tmp_path: Path) -> N
     sent += report.frames
     assert report.clocks >= MAX_CLOCKS, report.clocks   # it ran to its bound
     counters = {k: v for k, v in report.counters.items()
-                if k not in ("credit", "judged", "refused", "last_refusal")}
+                if k not in ("credit", "judged", "refused", "last_refusal")
+                and not k.startswith("peer_")}
+    # no SPDP came: the learner (not used: cfg_learn low) took nothing, refused nothing
+    assert [report.counters[f"peer_{k}"] for k in ("learned", "refused", "other")] == [0, 0, 0]
     assert (report.counters["judged"], report.counters["refused"]) == (1, 0)
     check_sent(sc, [PREAMBLE + f.hex() for f in sent], counters)
+
+
+@pytest.mark.timeout(300)
+def test_the_fast_model_learns_its_peer_from_spdp_and_sends_it_sedp(tmp_path: Path) -> None:
+    """cfg_learn high, the cfg_peer_* registers zero: the peer's SPDP announcement (the lab's
+    builders, to the domain's SPDP group and port) makes the circuit send its SEDP data and
+    ros_discovery_info sample (the ROM's messages after SPDP, byte for byte) to the locators
+    that announcement gave, and nowhere else; a second participant's later is counted, not
+    taken (no more SEDP); another domain's announcement, and one to another port, are never
+    heard (the domain honoured: LiteEth's port filter, the top's three ports)."""
+    require_fabric_sim()
+    sc = scenario(tmp_path)
+    build = build_fabric_sim(load_config(CONFIG), sc.rom, period=PERIOD)
+    case: dict[str, Any] = sc.case
+    meta, user = discovery_port(0, PEER_INDEX), user_port(0, PEER_INDEX)
+    config = FabricConfig(int(case["node_mac"], 16), _dotted(case["node_ip"]), "0.0.0.0", 0, 0,
+                          case["reader"], case["writer"], case["time"], learn=True)
+
+    def announce(prefix: bytes, ip: str, index: int, domain: int = 0,
+                 port: int | None = None) -> bytes:
+        payload = b.spdp_payload(prefix, b.Locator(ip, discovery_port(domain, index)),
+                                 b.Locator(ip, user_port(domain, index)), 10.0, "peer", b"",
+                                 domain)
+        rtps = b.header(prefix) + b.data(SPDP_READER, SPDP_WRITER, 1, payload)
+        return _fcs(bytes(Ether(dst=_group_mac(SPDP_MULTICAST_ADDRESS), src=PEER_MAC) /
+                          IP(src=ip, dst=SPDP_MULTICAST_ADDRESS) /
+                          UDP(sport=40000, dport=port or discovery_multicast_port(domain)) /
+                          rtps))
+
+    sim = FabricSim(build, config, rate=0, max_clocks=MAX_CLOCKS)
+    peer_ip = bytes.fromhex(case["peer_ip"])
+    sent: list[bytes] = []
+    other = bytes.fromhex("010f0dd00000000300000003")
+    try:
+        # another domain's (its SPDP port: LiteEth's filter drops it), one to a port LiteEth
+        # passes but the top does not own (counted in rx_port): neither is heard, so PEER is
+        # the first participant announced in this domain
+        sim.send_frame(announce(other, "192.168.10.7", 0, domain=1))
+        sim.send_frame(announce(other, "192.168.10.7", 0, port=discovery_multicast_port(0) + 1))
+        sim.send_frame(announce(PEER, PEER_IP, PEER_INDEX))
+        sim.send_frame(announce(bytes.fromhex("010fbeef0000000200000002"), "192.168.10.9", 3))
+        deadline = time.monotonic() + 60
+        while sim.running() and time.monotonic() < deadline:
+            for frame in sim.read(0.05).frames:
+                sent.append(frame)
+                if frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" \
+                        and frame[38:42] == peer_ip:
+                    sim.send_frame(bytes.fromhex(case["arp_reply"]))
+    finally:
+        report = sim.close()
+    sent += report.frames
+    udp = [Ether(f) for f in sent if f[12:14] == b"\x08\x00"]
+    to_peer = [(f[IP].dst, f[UDP].dport, bytes(f[UDP].payload)[:f[UDP].len - 8]) for f in udp
+               if f[IP].dst != SPDP_MULTICAST_ADDRESS]
+    port = {DEST_META: meta, DEST_USER: user}
+    assert to_peer == [(PEER_IP, port[m.dest], m.data) for m in sc.rom.messages[1:]]
+    assert [report.counters[f"peer_{k}"] for k in ("learned", "refused", "other")] == [1, 0, 1]
+    assert (report.counters["rx_port"], report.counters["rx_packets"]) == (1, 3)
 
 
 def _dotted(hexed: str) -> str:

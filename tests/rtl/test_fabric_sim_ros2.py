@@ -6,8 +6,9 @@ with MaxMessageSize one frame's payload: the circuit reassembles no IP fragments
 publishes sensor_msgs/LaserScan on rt/scan and subscribes to rt/scan_min, both with ROS 2's
 default QoS (RELIABLE, KEEP_LAST 10, VOLATILE).
 
-Discovery is the circuit's own (its SPDP, SEDP and answers from its ROMs; the bridge only sets
-its one peer's ports from the peer's SPDP and pulses send_sedp). Every output is compared with
+Discovery is the circuit's own (its SPDP, SEDP and answers from its ROMs; its one peer learned
+from the peer's SPDP by the circuit itself, rfl_spdp_peer: the bridge sets no register and
+pulses no send_sedp). Every output is compared with
 numpy (a 5-beam minimum over ``ranges``) and with the lab's CDR model, never with the circuit's
 own output. rclpy (the ``[ros2]`` extra: Fast DDS, ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST)
 sees the fabric's node, its publisher and subscriber, their types and type hashes in its graph
@@ -190,7 +191,8 @@ def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
     assert (counters["samples"], counters["judged"], counters["refused"], counters["rx_error"],
             counters["rx_overflow"], counters["tx_overflow"]) == \
         (str(SCANS), str(SCANS), "0", "0", "0", "0"), stdout
-    assert "bridge: peers learned: 1;" in stdout, stdout
+    assert counters["peer_learned"] == "1", stdout        # the circuit learned its peer itself
+    assert "bridge: peers seen: 1;" in stdout and "send_sedp pulses: 0" in stdout, stdout
 
 
 def test_rclpy_sees_the_fabric_node_in_the_ros2_graph(tmp_path: Path) -> None:

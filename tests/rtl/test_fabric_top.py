@@ -183,7 +183,7 @@ def test_the_top_announces_routes_and_answers_on_the_wire(tmp_path: Path,
 @pytest.mark.parametrize("bug", [
     ("wire to_user = p_rx_dport == USER;", "wire to_user = p_rx_dport != META;"),
     ("wire keep = to_user ||", "wire keep = 1'b1 || to_user ||"),
-    ("p_tx_dport = cfg_peer_meta_port;", "p_tx_dport = cfg_peer_user_port;"),
+    ("p_tx_dport = peer_meta_port;", "p_tx_dport = peer_user_port;"),
 ], ids=["kind", "other-port", "tdest"])
 def test_a_planted_bug_fails_the_proof(bug: tuple[str, str], tmp_path: Path) -> None:
     """The glue's proof (rtl/formal/fv_fabric_top.sv) sees a wrong kind, a datagram to another

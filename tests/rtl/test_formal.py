@@ -407,13 +407,12 @@ def test_a_planted_bug_fails_the_answers_byte_bound(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(("old", "new"), [
     ("wire rst_n = rst_count[4];", "wire rst_n = rst_count[3];"),   # out of reset after 8
-    ("wire send_sedp = rst_n && sedp_count == WAIT - 1'b1;",
-     "wire send_sedp = rst_n && sedp_count != WAIT;"),             # a pulse of SEDP_WAIT clocks
+    (".cfg_learn(1'b1)", ".cfg_learn(1'b0)"),                      # the peer not learned
     (".cfg_writer(32'd0)", ".cfg_writer(READER)"),                  # only our own writer id
     ("assign led_n = cnt_rx_packets == 32'd0;", "assign led_n = !cnt_rx_packets[0];"),
-], ids=["reset", "sedp", "writer", "led"])
+], ids=["reset", "learn", "writer", "led"])
 def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -> None:
-    """The board top's proof sees a short reset, a long SEDP pulse, a wrong id, a LED that
+    """The board top's proof sees a short reset, a peer not learned, a wrong id, a LED that
     misses datagrams."""
     require_formal()
     name = "rfl_board_5a75b.v"
@@ -424,3 +423,27 @@ def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -
     proof = next(p for p in PROOFS if p.name == "board_5a75b")
     result = prove(proof, replace={name: buggy})
     assert result.status == "FAIL", format_results([result])
+
+
+@pytest.mark.parametrize(("old", "new", "status"), [
+    ("            p_uport <= 16'd0;\n", "            p_uport <= 16'd7;\n", ("FAIL",)),
+    # a resend pulse twice: a peer is some 100 bytes away, past the bounded check's reach, so
+    # the induction fails to close (UNKNOWN) or finds it (FAIL), never PASS
+    ("if (resend == {{(RW-1){1'b0}}, 1'b1}) sedp <= 1'b1;",
+     "if (resend <= {{(RW-2){1'b0}}, 2'b10}) sedp <= 1'b1;", ("FAIL", "UNKNOWN")),
+    ("wire change = heard && !c_bye && !recent &&", "wire change = heard && !c_bye &&",
+     ("FAIL", "UNKNOWN")),
+], ids=["registers", "pulses", "rate"])
+def test_planted_bugs_fail_the_spdp_peer_proof(tmp_path: Path, old: str, new: str,
+                                               status: tuple[str, ...]) -> None:
+    """The SPDP learner's proof sees peer registers set with no peer, a third SEDP pulse, two
+    changes in a second."""
+    require_formal()
+    name = "rfl_spdp_peer.v"
+    text = (FABRIC_DIR / name).read_text()
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp_path / name
+    buggy.write_text(text.replace(old, new))
+    proof = next(p for p in PROOFS if p.name == "spdp_peer")
+    result = prove(proof, replace={name: buggy})
+    assert result.status in status, format_results([result])

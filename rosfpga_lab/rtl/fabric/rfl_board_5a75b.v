@@ -5,21 +5,18 @@
 // Clocks: clk (125 MHz, the PLL's) runs the node and LiteEth's sys side; rgmii_rx_clk (125 MHz
 // from the PHY) LiteEth's receive and send side, crossing to clk in its FIFOs.
 // The addresses and entity ids are parameters the generated project sets (rtl.board): the node's
-// MAC and IPv4 address, its one peer's IPv4 address and ports, the reader id the ROM announces.
-// Reset: held while the PLL is not locked and for 16 clocks after. SEDP is sent once, SEDP_WAIT
-// clocks after reset (a send_sedp pulse); SPDP every PERIOD clocks (rfl_fabric_node). No clock
-// of the wall: INFO_TS carries TIME. LED (active low): on once a datagram reached the node.
+// MAC and IPv4 address, the reader id the ROM announces. Its one peer it learns from the peers'
+// SPDP announcements (cfg_learn: rfl_spdp_peer in rfl_fabric_top), which also sends its SEDP
+// to it: nothing of the peer is known at build time. Reset: held while the PLL is not locked
+// and for 16 clocks after. SPDP every PERIOD clocks (rfl_fabric_node). No clock of the wall:
+// INFO_TS carries TIME. LED (active low): on once a datagram reached the node.
 `default_nettype none
 
 module rfl_board_5a75b #(
     parameter [47:0] MAC = 48'h0,               // all from rtl.board.board_parameters
     parameter [31:0] IP = 32'h0,
-    parameter [31:0] PEER_IP = 32'h0,
-    parameter [15:0] PEER_META_PORT = 16'h0,
-    parameter [15:0] PEER_USER_PORT = 16'h0,
     parameter [31:0] READER = 32'h0,            // our reader's entity id (cfg_reader)
     parameter [63:0] TIME = 64'h0,              // INFO_TS's time (RTPS Time_t)
-    parameter SEDP_WAIT = 1024,                 // clocks from reset to the send_sedp pulse
 `include "rfl_fabric_top_params.vh"          // the rest: rfl_fabric_top's
 ) (
     input  wire       clk25,                    // the 25 MHz oscillator
@@ -64,19 +61,13 @@ module rfl_board_5a75b #(
     assign locked = 1'b1;
 `endif
 
-    localparam WAIT_BITS = $clog2(SEDP_WAIT + 1);
-    localparam [WAIT_BITS-1:0] WAIT = SEDP_WAIT[WAIT_BITS-1:0];
     reg [4:0] rst_count;                        // bit 4: out of reset
-    reg [WAIT_BITS-1:0] sedp_count;             // WAIT: SEDP sent
     initial rst_count = 5'd0;                   // the configured FPGA's; before the PLL locks
     wire rst_n = rst_count[4];
     always @(posedge clk) begin
         if (!locked) rst_count <= 5'd0;
         else if (!rst_n) rst_count <= rst_count + 5'd1;
-        if (!rst_n) sedp_count <= {WAIT_BITS{1'b0}};
-        else if (sedp_count != WAIT) sedp_count <= sedp_count + 1'b1;
     end
-    wire send_sedp = rst_n && sedp_count == WAIT - 1'b1;
 
     wire [31:0] cnt_rx_packets;
     /* verilator lint_off UNUSEDSIGNAL */
@@ -84,15 +75,16 @@ module rfl_board_5a75b #(
     wire [7:0] status;
     wire [15:0] credit;
     wire [31:0] cnt_samples, cnt_answers, cnt_no_credit, cnt_rx_error, cnt_rx_length,
-                cnt_rx_overflow, cnt_tx_packets, cnt_tx_overflow, cnt_rx_port;
+                cnt_rx_overflow, cnt_tx_packets, cnt_tx_overflow, cnt_rx_port,
+                cnt_peer_learned, cnt_peer_refused, cnt_peer_other;
     wire [31:0] cnt_rx_header, cnt_rx_other;
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_fabric_top #(
 `include "rfl_fabric_top_pass.vh"
     ) u_top (
-        .clk(clk), .rst_n(rst_n), .cfg_mac(MAC), .cfg_ip(IP), .cfg_peer_ip(PEER_IP),
-        .cfg_peer_meta_port(PEER_META_PORT), .cfg_peer_user_port(PEER_USER_PORT),
-        .cfg_reader(READER), .cfg_writer(32'd0), .cfg_time(TIME), .send_sedp(send_sedp),
+        .clk(clk), .rst_n(rst_n), .cfg_mac(MAC), .cfg_ip(IP), .cfg_learn(1'b1),
+        .cfg_peer_ip(32'd0), .cfg_peer_meta_port(16'd0), .cfg_peer_user_port(16'd0),
+        .cfg_reader(READER), .cfg_writer(32'd0), .cfg_time(TIME), .send_sedp(1'b0),
         .rgmii_rx_clk(rgmii_rx_clk), .rgmii_rx_ctl(rgmii_rx_ctl), .rgmii_rxd(rgmii_rxd),
         .rgmii_tx_clk(rgmii_tx_clk), .rgmii_tx_ctl(rgmii_tx_ctl), .rgmii_txd(rgmii_txd),
         .status_valid(status_valid), .status(status), .credit(credit),
@@ -100,7 +92,9 @@ module rfl_board_5a75b #(
         .cnt_rx_packets(cnt_rx_packets), .cnt_rx_error(cnt_rx_error),
         .cnt_rx_length(cnt_rx_length), .cnt_rx_overflow(cnt_rx_overflow),
         .cnt_tx_packets(cnt_tx_packets), .cnt_tx_overflow(cnt_tx_overflow),
-        .cnt_rx_port(cnt_rx_port), .cnt_rx_header(cnt_rx_header), .cnt_rx_other(cnt_rx_other));
+        .cnt_rx_port(cnt_rx_port), .cnt_rx_header(cnt_rx_header), .cnt_rx_other(cnt_rx_other),
+        .cnt_peer_learned(cnt_peer_learned), .cnt_peer_refused(cnt_peer_refused),
+        .cnt_peer_other(cnt_peer_other));
 
     assign led_n = cnt_rx_packets == 32'd0;
 endmodule

@@ -11,13 +11,16 @@
 // three agree; this top keeps the three and drops the others (counted: cnt_rx_port). Kind (the
 // node's s_axis_tuser): 1 for USER_PORT, 0 for SPDP_PORT and META_PORT.
 // Sent, by the node's TDEST (rtl.discrom's DEST_SPDP, DEST_META, DEST_USER): 0 to
-// SPDP_GROUP:SPDP_PORT (LiteEth maps the group to its multicast MAC), 1 to
-// cfg_peer_ip:cfg_peer_meta_port, 2 (and 3) to cfg_peer_ip:cfg_peer_user_port; from META_PORT,
-// or USER_PORT for user data. The peer's locators are registers the host sets (one peer: a
-// point-to-point link, or the peer the software side discovered; its ports from the mapping for
-// its participant index): the circuit does not read the locators of the peers' SPDP
-// announcements. So an answer to another asker (the node's m_dst_prefix, not read here) still
-// goes to cfg_peer_*, and user data reaches one reader.
+// SPDP_GROUP:SPDP_PORT (LiteEth maps the group to its multicast MAC), 1 to the peer's
+// metatraffic locator, 2 (and 3) to its default (user-data) locator; from META_PORT, or
+// USER_PORT for user data. One peer: with cfg_learn high the one rfl_spdp_peer learns from the
+// SPDP announcements that come to SPDP_PORT or META_PORT (so of this domain: LiteEth's port
+// filter and this top's keep only this domain's ports), whose taking or change sends the SEDP
+// set (send_sedp; rfl_spdp_peer's header says which participant is the peer, and why); a
+// datagram to the peer while none is known is dropped. With cfg_learn low the registers
+// cfg_peer_* (a point-to-point link, or a peer the host's software chose) and the send_sedp
+// input. So an answer to another asker (the node's m_dst_prefix, not read here) still goes to
+// the one peer, and user data reaches one reader.
 // The glue is proven with LiteEth and the node as stream models (rtl/formal/fv_fabric_top.sv).
 `default_nettype none
 
@@ -31,6 +34,7 @@ module rfl_fabric_top #(
 `endif
     input  wire         rst_n,
     input  wire [47:0]  cfg_mac,                // held while running, as the cfg_peer_*
+    input  wire         cfg_learn,              // 1: the peer from SPDP; 0: cfg_peer_*
     input  wire [31:0]  cfg_ip,
     input  wire [31:0]  cfg_peer_ip,
     input  wire [15:0]  cfg_peer_meta_port,
@@ -38,7 +42,7 @@ module rfl_fabric_top #(
     input  wire [31:0]  cfg_reader,
     input  wire [31:0]  cfg_writer,
     input  wire [63:0]  cfg_time,
-    input  wire         send_sedp,
+    input  wire         send_sedp,              // (with cfg_learn as well)
 `ifdef RFL_FABRIC_RGMII
     input  wire         rgmii_rx_clk,           // 125 MHz from the PHY
     input  wire         rgmii_rx_ctl,
@@ -68,7 +72,10 @@ module rfl_fabric_top #(
     output wire [31:0]  cnt_tx_overflow,
     output wire [31:0]  cnt_rx_port,            // datagrams to another port LiteEth passed
     output wire [31:0]  cnt_rx_header,          // rfl_udp_port's: frames LiteEth dropped
-    output wire [31:0]  cnt_rx_other
+    output wire [31:0]  cnt_rx_other,
+    output wire [31:0]  cnt_peer_learned,       // rfl_spdp_peer's: peers taken or changed,
+    output wire [31:0]  cnt_peer_refused,       // announcements refused,
+    output wire [31:0]  cnt_peer_other          // another participant's while the peer is live
 );
     // 0: unset (the defaults), refused outside a proof: Yosys elaborates a file's defaults when
     // it reads it, the proof sets them
@@ -153,7 +160,7 @@ module rfl_fabric_top #(
     reg [31:0] p_tx_ip;
     reg [15:0] p_tx_sport, p_tx_dport;
     /* verilator lint_off UNUSEDSIGNAL */
-    wire unused_ok = &{1'b0, le_rx_last_be, p_rx_ip, p_rx_sport, p_rx_len};
+    wire unused_ok = &{1'b0, le_rx_last_be, p_rx_sport, p_rx_len};
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_udp_port #(.RX_BITS(RX_BITS), .TX_BITS(TX_BITS), .QUEUE_BITS(QUEUE_BITS),
                    .COUNT_BITS(32)) u_port (
@@ -179,8 +186,8 @@ module rfl_fabric_top #(
     // ---- received: the kind from the destination port (held by rfl_udp_port for the packet)
     wire to_user = p_rx_dport == USER;
     wire keep = to_user || p_rx_dport == META || p_rx_dport == SPDP;
-    wire n_tready;
-    assign p_rx_tready = keep ? n_tready : 1'b1;
+    wire n_rx_tready;
+    assign p_rx_tready = keep ? n_rx_tready : 1'b1;
     reg [31:0] c_port;
     always @(posedge clk) begin
         if (!rst_n) c_port <= 32'd0;
@@ -189,8 +196,49 @@ module rfl_fabric_top #(
     end
     assign cnt_rx_port = c_port;
 
-    // ---- sent: the destination from TDEST (held by the node until taken)
+    // ---- the peer: learned from SPDP (cfg_learn) or the registers
+    wire l_valid, l_sedp;
+    wire [31:0] l_meta_ip, l_user_ip;
+    wire [15:0] l_meta_port, l_user_port;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire l_ready;                               // (always 1)
+    /* verilator lint_on UNUSEDSIGNAL */
+    // PERIOD is rtps.limits.ANNOUNCE_SECONDS (1 s) of clocks (rtl.discrom): the lease's second
+    rfl_spdp_peer #(.SPDP_WRITER_ID(SPDP_WRITER_ID), .SPDP_PIDS(SPDP_PIDS),
+                    .SPDP_ENCAPS(SPDP_ENCAPS), .SPDP_LOCATOR_KIND(SPDP_LOCATOR_KIND),
+                    .SPDP_LEASE_DEFAULT(SPDP_LEASE_DEFAULT), .SPDP_LEASE_MAX(SPDP_LEASE_MAX),
+                    .TICK(PERIOD), .RESEND(PERIOD < 2 ? 2 : PERIOD)) u_peer (
+        .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .s_axis_tdata(p_rx_tdata),
+        .s_axis_tvalid(p_rx_tvalid && p_rx_tready && keep && !to_user),
+        .s_axis_tready(l_ready), .s_axis_tlast(p_rx_tlast), .s_src_ip(p_rx_ip),
+        .peer_known(l_valid),
+        .peer_meta_ip(l_meta_ip), .peer_meta_port(l_meta_port), .peer_user_ip(l_user_ip),
+        .peer_user_port(l_user_port), .send_sedp(l_sedp), .cnt_learned(cnt_peer_learned),
+        .cnt_refused(cnt_peer_refused), .cnt_other(cnt_peer_other));
+    wire [31:0] peer_meta_ip = cfg_learn ? l_meta_ip : cfg_peer_ip;
+    wire [31:0] peer_user_ip = cfg_learn ? l_user_ip : cfg_peer_ip;
+    wire [15:0] peer_meta_port = cfg_learn ? l_meta_port : cfg_peer_meta_port;
+    wire [15:0] peer_user_port = cfg_learn ? l_user_port : cfg_peer_user_port;
+    wire node_sedp = cfg_learn ? l_sedp : send_sedp;
+
+    // ---- sent: the destination from TDEST (held by the node until taken); a datagram to the
+    // peer while none is learned is dropped (decided at its first beat, for all of it)
     wire [1:0] n_tdest;
+    wire n_tvalid, n_tlast;
+    reg tx_in, tx_drop_r;
+    wire tx_drop = tx_in ? tx_drop_r : (cfg_learn && !l_valid && n_tdest != 2'd0);
+    assign p_tx_tvalid = n_tvalid && !tx_drop;
+    assign p_tx_tlast = n_tlast;
+    wire n_tready = tx_drop ? 1'b1 : p_tx_tready;
+    always @(posedge clk) begin
+        if (!rst_n) begin
+            tx_in <= 1'b0;
+            tx_drop_r <= 1'b0;
+        end else if (n_tvalid && n_tready) begin
+            tx_in <= !n_tlast;
+            tx_drop_r <= tx_drop;
+        end
+    end
     /* verilator lint_off UNUSEDSIGNAL */
     wire [95:0] n_dst_prefix;                   // one peer: see the header
     /* verilator lint_on UNUSEDSIGNAL */
@@ -202,13 +250,13 @@ module rfl_fabric_top #(
                 p_tx_sport = META;
             end
             2'd1: begin
-                p_tx_ip = cfg_peer_ip;
-                p_tx_dport = cfg_peer_meta_port;
+                p_tx_ip = peer_meta_ip;
+                p_tx_dport = peer_meta_port;
                 p_tx_sport = META;
             end
             default: begin
-                p_tx_ip = cfg_peer_ip;
-                p_tx_dport = cfg_peer_user_port;
+                p_tx_ip = peer_user_ip;
+                p_tx_dport = peer_user_port;
                 p_tx_sport = USER;
             end
         endcase
@@ -219,11 +267,11 @@ module rfl_fabric_top #(
 `include "rfl_fabric_node_pass.vh"
     ) u_node (
         .clk(clk), .rst_n(rst_n), .cfg_reader(cfg_reader),
-        .cfg_writer(cfg_writer), .cfg_time(cfg_time), .send_sedp(send_sedp),
+        .cfg_writer(cfg_writer), .cfg_time(cfg_time), .send_sedp(node_sedp),
         .s_axis_tdata(p_rx_tdata), .s_axis_tvalid(p_rx_tvalid && keep),
-        .s_axis_tready(n_tready), .s_axis_tlast(p_rx_tlast), .s_axis_tuser(to_user),
-        .m_axis_tdata(p_tx_tdata), .m_axis_tvalid(p_tx_tvalid), .m_axis_tready(p_tx_tready),
-        .m_axis_tlast(p_tx_tlast), .m_axis_tdest(n_tdest), .m_dst_prefix(n_dst_prefix),
+        .s_axis_tready(n_rx_tready), .s_axis_tlast(p_rx_tlast), .s_axis_tuser(to_user),
+        .m_axis_tdata(p_tx_tdata), .m_axis_tvalid(n_tvalid), .m_axis_tready(n_tready),
+        .m_axis_tlast(n_tlast), .m_axis_tdest(n_tdest), .m_dst_prefix(n_dst_prefix),
         .status_valid(status_valid), .status(status), .credit(credit),
         .cnt_samples(cnt_samples), .cnt_answers(cnt_answers), .cnt_no_credit(cnt_no_credit));
 endmodule

@@ -5,6 +5,13 @@
     parameter META_PORT = 0,
     parameter USER_PORT = 0,
     parameter [31:0] SPDP_GROUP = 32'd0,
+    // rfl_spdp_peer's constants, all from rtl.discrom.spdp_parameters (the software's builders)
+    parameter [31:0] SPDP_WRITER_ID = 32'd0,
+    parameter [79:0] SPDP_PIDS = 80'd0,         // {status, sentinel, lease, default, meta}
+    parameter [31:0] SPDP_ENCAPS = 32'd0,       // {PL_CDR_BE, PL_CDR_LE}
+    parameter [31:0] SPDP_LOCATOR_KIND = 32'd0,
+    parameter SPDP_LEASE_DEFAULT = 100,         // seconds
+    parameter SPDP_LEASE_MAX = 300,
     parameter RX_BITS = 11,                     // rfl_udp_port's buffers and queues
     parameter TX_BITS = 11,
     parameter QUEUE_BITS = 2,

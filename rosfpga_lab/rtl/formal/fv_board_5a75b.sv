@@ -1,29 +1,24 @@
 // fv_board_5a75b -- rfl_board_5a75b's own glue (rtl/fabric): the reset after the PLL locks, the
-// one send_sedp pulse, the addresses and ids from its parameters, the LED. The PLL is the
+// peer learned (cfg_learn, no send_sedp of its own), the addresses and ids from its parameters,
+// the LED. The PLL is the
 // oscillator's clock here, locked from the start (the board top's FORMAL branch); rfl_fabric_top
 // (the glue proven in fv_fabric_top, the rest by their own proofs and tests) is the model below,
 // of the same name, parameters and ports (the RGMII ones), which checks what it is given.
-// Bounded (bmc, 32 clocks, SEDP_WAIT 4): the top's reset is low for the first 16 clocks and high
-// after; send_sedp is high in exactly one clock, the SEDP_WAIT-th of the top out of reset; the
-// top's cfg_* are the parameters (cfg_writer 0: any writer); the LED is on (low) exactly when the
+// Bounded (bmc, 32 clocks): the top's reset is low for the first 16 clocks and high after;
+// cfg_learn is high and send_sedp low (the top learns its peer and sends SEDP to it); the top's
+// cfg_* are the parameters (cfg_writer 0: any writer); the LED is on (low) exactly when the
 // top's cnt_rx_packets is not 0. The board has no stream of its own (no FV_SINK).
 `define FV_MAC 48'h02524c460002
 `define FV_IP 32'hc0a80a02
-`define FV_PEER_IP 32'hc0a80a01
-`define FV_PEER_META 16'd7412
-`define FV_PEER_USER 16'd7413
 `define FV_READER 32'h00000104
 `define FV_TIME 64'h0000_0001_8000_0000
-`define FV_WAIT 4
 
 module fv_board_5a75b (
     input clk25, input rgmii_rx_clk, input rgmii_rx_ctl, input [3:0] rgmii_rxd
 );
     wire rgmii_tx_clk, rgmii_tx_ctl, led_n;
     wire [3:0] rgmii_txd;
-    rfl_board_5a75b #(.MAC(`FV_MAC), .IP(`FV_IP), .PEER_IP(`FV_PEER_IP),
-                      .PEER_META_PORT(`FV_PEER_META), .PEER_USER_PORT(`FV_PEER_USER),
-                      .READER(`FV_READER), .TIME(`FV_TIME), .SEDP_WAIT(`FV_WAIT),
+    rfl_board_5a75b #(.MAC(`FV_MAC), .IP(`FV_IP), .READER(`FV_READER), .TIME(`FV_TIME),
                       .SPDP_PORT(7400), .META_PORT(7410), .USER_PORT(7411),
                       .SPDP_GROUP(32'hefff0001)) dut (
         .clk25(clk25), .rgmii_rx_clk(rgmii_rx_clk), .rgmii_rx_ctl(rgmii_rx_ctl),
@@ -37,7 +32,8 @@ endmodule
 module rfl_fabric_top #(
 `include "rfl_fabric_top_params.vh"
 ) (
-    input clk, input rst_n, input [47:0] cfg_mac, input [31:0] cfg_ip, input [31:0] cfg_peer_ip,
+    input clk, input rst_n, input [47:0] cfg_mac, input [31:0] cfg_ip, input cfg_learn,
+    input [31:0] cfg_peer_ip,
     input [15:0] cfg_peer_meta_port, input [15:0] cfg_peer_user_port, input [31:0] cfg_reader,
     input [31:0] cfg_writer, input [63:0] cfg_time, input send_sedp,
     input rgmii_rx_clk, input rgmii_rx_ctl, input [3:0] rgmii_rxd,
@@ -46,29 +42,21 @@ module rfl_fabric_top #(
     output [31:0] cnt_answers, output [31:0] cnt_no_credit, output [31:0] cnt_rx_packets,
     output [31:0] cnt_rx_error, output [31:0] cnt_rx_length, output [31:0] cnt_rx_overflow,
     output [31:0] cnt_tx_packets, output [31:0] cnt_tx_overflow, output [31:0] cnt_rx_port,
-    output [31:0] cnt_rx_header, output [31:0] cnt_rx_other
+    output [31:0] cnt_rx_header, output [31:0] cnt_rx_other,
+    output [31:0] cnt_peer_learned, output [31:0] cnt_peer_refused, output [31:0] cnt_peer_other
 );
     assign {rgmii_tx_clk, rgmii_tx_ctl, rgmii_txd, status_valid, status, credit} = 31'd0;
     assign {cnt_samples, cnt_answers, cnt_no_credit, cnt_rx_error, cnt_rx_length} = 160'd0;
     assign {cnt_rx_overflow, cnt_tx_packets, cnt_tx_overflow, cnt_rx_port} = 128'd0;
     assign {cnt_rx_header, cnt_rx_other} = 64'd0;
+    assign {cnt_peer_learned, cnt_peer_refused, cnt_peer_other} = 96'd0;
     assign cnt_rx_packets = {rgmii_rxd, 27'd0, rgmii_rx_ctl};
     reg [7:0] t = 8'd0;                         // clocks since the start
-    reg [7:0] k = 8'd0;                         // clocks out of reset
-    reg sent = 1'b0;
-    always @(posedge clk) begin
-        if (t != 8'hff) t <= t + 8'd1;
-        if (rst_n && k != 8'hff) k <= k + 8'd1;
-        if (send_sedp) sent <= 1'b1;
-    end
+    always @(posedge clk) if (t != 8'hff) t <= t + 8'd1;
     always @(*) begin
         assert(rst_n == (t >= 8'd16));
-        assert(send_sedp == (rst_n && k == `FV_WAIT - 1));
-        assert(!(send_sedp && sent));
-        assert(cfg_mac == `FV_MAC && cfg_ip == `FV_IP && cfg_peer_ip == `FV_PEER_IP);
-        assert(cfg_peer_meta_port == `FV_PEER_META && cfg_peer_user_port == `FV_PEER_USER);
+        assert(cfg_learn && !send_sedp);
+        assert(cfg_mac == `FV_MAC && cfg_ip == `FV_IP);
         assert(cfg_reader == `FV_READER && cfg_writer == 32'd0 && cfg_time == `FV_TIME);
     end
-    // a bounded check that sees the pulse and what follows it
-    always @(*) if (t == 8'd30) assert(sent);
 endmodule

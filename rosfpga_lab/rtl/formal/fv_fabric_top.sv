@@ -25,10 +25,10 @@ module fv_fabric_top (
     wire [7:0] gmii_txd, status;
     wire gmii_tx_en, gmii_tx_er, status_valid;
     wire [15:0] credit;
-    wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11;
+    wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12, c13, c14;
     rfl_fabric_top #(.SPDP_PORT(`FV_SPDP), .META_PORT(`FV_META), .USER_PORT(`FV_USER),
                      .SPDP_GROUP(`FV_GROUP), .RX_BITS(4), .TX_BITS(4), .QUEUE_BITS(1)) dut (
-        .clk(clk), .rst_n(rst_n), .cfg_mac(cfg_mac), .cfg_ip(cfg_ip),
+        .clk(clk), .rst_n(rst_n), .cfg_mac(cfg_mac), .cfg_ip(cfg_ip), .cfg_learn(1'b0),
         .cfg_peer_ip(`FV_PEER_IP), .cfg_peer_meta_port(`FV_PEER_META),
         .cfg_peer_user_port(`FV_PEER_USER), .cfg_reader(32'd0),
         .cfg_writer(32'd0), .cfg_time(64'd0), .send_sedp(send_sedp),
@@ -37,7 +37,8 @@ module fv_fabric_top (
         .status_valid(status_valid), .status(status), .credit(credit),
         .cnt_samples(c0), .cnt_answers(c1), .cnt_no_credit(c2), .cnt_rx_packets(c3),
         .cnt_rx_error(c4), .cnt_rx_length(c5), .cnt_rx_overflow(c6), .cnt_tx_packets(c7),
-        .cnt_tx_overflow(c8), .cnt_rx_port(c9), .cnt_rx_header(c10), .cnt_rx_other(c11));
+        .cnt_tx_overflow(c8), .cnt_rx_port(c9), .cnt_rx_header(c10), .cnt_rx_other(c11),
+        .cnt_peer_learned(c12), .cnt_peer_refused(c13), .cnt_peer_other(c14));
 endmodule
 
 // LiteEth's UDP port as seen by rfl_fabric_top: any received datagrams (the first byte: the low

@@ -11,7 +11,8 @@
 //
 // Records, both ways: a tag byte, a u32 length (little endian), that many bytes.
 //   host -> sim  'C' config: u64 mac, u32 ip, u32 peer_ip, u16 peer_meta_port,
-//                    u16 peer_user_port, u32 reader, u32 writer, u64 time (36 bytes, LE);
+//                    u16 peer_user_port, u32 reader, u32 writer, u64 time, u8 learn
+//                    (37 bytes, LE; learn: cfg_learn, the peer from SPDP);
 //                    the first record must be one (reset is released after it), later ones
 //                    change the registers between frames
 //                'F' a frame for gmii_rxd;  'S' a one-clock send_sedp pulse;
@@ -19,7 +20,7 @@
 //   sim -> host  'F' a frame from gmii_txd;  'K' u64 clocks, then the counters as u32 in
 //                rosfpga_lab.rtl.fabricsim.COUNTERS' order: the top's cnt_* and credit, then
 //                the generated subscriber's verdicts (status_valid pulses), the refusals among
-//                them (status not 0) and the last refusal's code
+//                them (status not 0) and the last refusal's code, then the top's cnt_peer_*
 //                'N' after each 'K': the RTPS stages' counters inside rfl_fabric_node as u32
 //                in rosfpga_lab.rtl.fabriccounters.NODE_COUNTERS' order (rfl_node_counters.h and
 //                the .vlt that keeps those wires public are generated from that list)
@@ -95,6 +96,7 @@ struct Fabric {
         top->cfg_reader = (uint32_t)le(p + 20, 4);
         top->cfg_writer = (uint32_t)le(p + 24, 4);
         top->cfg_time = le(p + 28, 8);
+        top->cfg_learn = p[36] & 1;
     }
 
     bool idle() const { return rx_queue.empty() && rx_frame.empty() && !tx_on; }
@@ -150,14 +152,15 @@ struct Fabric {
     }
 
     void counters() {
-        uint32_t c[16] = {top->cnt_samples, top->cnt_answers, top->cnt_no_credit,
+        uint32_t c[19] = {top->cnt_samples, top->cnt_answers, top->cnt_no_credit,
                           top->cnt_rx_packets, top->cnt_rx_error, top->cnt_rx_length,
                           top->cnt_rx_overflow, top->cnt_tx_packets, top->cnt_tx_overflow,
                           top->cnt_rx_port, top->cnt_rx_header, top->cnt_rx_other,
-                          (uint32_t)top->credit, statuses, refused, last_status};
+                          (uint32_t)top->credit, statuses, refused, last_status,
+                          top->cnt_peer_learned, top->cnt_peer_refused, top->cnt_peer_other};
         uint8_t out[8 + sizeof c];
         for (int i = 0; i < 8; ++i) out[i] = (uint8_t)(clocks >> (8 * i));
-        for (int k = 0; k < 16; ++k)
+        for (int k = 0; k < 19; ++k)
             for (int i = 0; i < 4; ++i) out[8 + 4 * k + i] = (uint8_t)(c[k] >> (8 * i));
         put_record('K', out, sizeof out);
         node_counters();
@@ -199,7 +202,7 @@ static bool take(std::vector<uint8_t>& buf, Fabric& f, bool& configured) {
         const uint8_t* body = &buf[at + 5];
         switch (buf[at]) {
         case 'C':
-            if (n != 36) { fprintf(stderr, "rfl_fabric_sim: config of %u bytes\n", n); exit(2); }
+            if (n != 37) { fprintf(stderr, "rfl_fabric_sim: config of %u bytes\n", n); exit(2); }
             f.config(body);
             configured = true;
             break;

@@ -45,12 +45,12 @@ module tb;
     wire tx_er;
     /* verilator lint_off UNUSEDSIGNAL */
     wire [15:0] credit;
-    wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11;
+    wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12, c13, c14;
     /* verilator lint_on UNUSEDSIGNAL */
 
     rfl_fabric_top #(`RFL_DEMO_PARAMS) dut (
         .clk(clk), .rst_n(rst_n), .cfg_mac(`RFL_DEMO_MAC), .cfg_ip(`RFL_DEMO_IP),
-        .cfg_peer_ip(`RFL_DEMO_PEER_IP), .cfg_peer_meta_port(`RFL_DEMO_PEER_META),
+        .cfg_learn(1'b0), .cfg_peer_ip(`RFL_DEMO_PEER_IP), .cfg_peer_meta_port(`RFL_DEMO_PEER_META),
         .cfg_peer_user_port(`RFL_DEMO_PEER_USER), .cfg_reader(`RFL_DEMO_READER),
         .cfg_writer(`RFL_DEMO_WRITER), .cfg_time(`RFL_DEMO_TIME), .send_sedp(1'b0),
         .gmii_rxd(rxd), .gmii_rx_dv(rx_dv), .gmii_rx_er(1'b0),
@@ -58,7 +58,8 @@ module tb;
         .status_valid(status_valid), .status(status), .credit(credit),
         .cnt_samples(c0), .cnt_answers(c1), .cnt_no_credit(c2), .cnt_rx_packets(c3),
         .cnt_rx_error(c4), .cnt_rx_length(c5), .cnt_rx_overflow(c6), .cnt_tx_packets(c7),
-        .cnt_tx_overflow(c8), .cnt_rx_port(c9), .cnt_rx_header(c10), .cnt_rx_other(c11));
+        .cnt_tx_overflow(c8), .cnt_rx_port(c9), .cnt_rx_header(c10), .cnt_rx_other(c11),
+        .cnt_peer_learned(c12), .cnt_peer_refused(c13), .cnt_peer_other(c14));
 
     // frame 0 the ARP reply, frames 1.. the input; each a length, then its bytes
     reg [7:0] mem [0:`RFL_DEMO_BYTES-1];
