@@ -63,7 +63,9 @@ module rfl_gpublisher #(
     reg [31:0] n;                               // the count being written
     reg [34:0] left_b;                          // bytes of the current body still to write
     reg [31:0] seq;
-    reg [31:0] left [0:LOOPS-1];
+    // elements left of each open loop, 32 bits each (a vector, not a memory: Verilator keeps
+    // a memory's every write site, the reset's one per entry, as work on every clock)
+    reg [32*LOOPS-1:0] left;
     // Flags kept with the registers they test, so that no decision that chooses the next
     // instruction compares 32 bits first (100 MHz on an ECP5): n is zero (OP_VAR: so is its
     // body, n << lsize), the body's last byte is next (left_b == 1), and each open loop's last
@@ -73,7 +75,11 @@ module rfl_gpublisher #(
     reg [LOOPS-1:0] last_of;                    // left[d] == 1
     reg [DB-1:0] depth;
 
-    reg [IW-1:0] w;                             // the current instruction: prog_word(pc)
+    // The current instruction, prog_word(pc): a memory of one word (a register on an FPGA),
+    // written at one place, so that Verilator copies its 224 bits only on the clocks it loads
+    // (a register the walk's block writes is copied in and out on every clock).
+    reg [IW-1:0] w_q [0:0];
+    wire [IW-1:0] w = w_q[0];
     // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
     wire [3:0]  align = CDR ? w[221:218] : 4'd1;
     wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
@@ -152,22 +158,37 @@ module rfl_gpublisher #(
         end
     endtask
 
-    // (w follows pc: `word` is prog_word(next), from a look-up by the current pc.)
-    task go(input [15:0] next, input [IW-1:0] word);
+    // Where the program goes on this clock: pc and w load as it says, at one place (the end of
+    // the walk's block).
+    localparam [1:0] G_STAY = 2'd0, G_FIRST = 2'd1, G_NEXT = 2'd2, G_JUMP = 2'd3;
+    reg [1:0] step;
+    always @* begin
+        step = G_STAY;
+        case (state)
+            P_IDLE: if (meta_valid) step = G_FIRST;
+            P_LEN: if (put && cnt[1:0] == 2'd3) step = G_FIRST;
+            P_DECODE:
+                if (op == OP_END) step = last_of[depth - 1'b1] ? G_NEXT : G_JUMP;
+                else if ((op == OP_FIXED || op == OP_ENCAP) && size == 32'd0) step = G_NEXT;
+            P_COUNTED:
+                if (op == OP_LOOP && n_zero) step = G_JUMP;
+                else if (op == OP_LOOP || n_zero) step = G_NEXT;
+            P_BODY: if (put && last_b) step = G_NEXT;
+            default: step = G_STAY;
+        endcase
+    end
+
+    // Go on with the instruction `step` loads.
+    task go;
         begin
-            pc <= next;
-            w <= word;
             state <= P_DECODE;
             cnt <= 32'd0;
         end
     endtask
 
-    integer d;
     always @(posedge clk) begin
         if (!rst_n) begin
             state <= P_IDLE;
-            pc <= 16'd0;
-            w <= prog_word(16'd0);
             cnt <= 32'd0;
             n <= 32'd0;
             n_zero <= 1'b1;
@@ -179,7 +200,7 @@ module rfl_gpublisher #(
             padn <= 3'd0;
             pad_ret <= P_IDLE;
             depth <= {DB{1'b0}};
-            for (d = 0; d < LOOPS; d = d + 1) left[d] <= 32'd0;
+            left <= {(32 * LOOPS){1'b0}};
         end else begin
             if (put) cnt <= cnt + 32'd1;
             if (put) opos <= opos + 32'd1;
@@ -188,15 +209,13 @@ module rfl_gpublisher #(
                     cnt <= 32'd0;
                     opos <= 32'd0;
                     depth <= {DB{1'b0}};
-                    pc <= 16'd0;
-                    w <= prog_word(16'd0);
                     state <= meta_drop ? ((STREAM_DATA_BYTES == 0) ? P_DONE : P_DROP) : P_LEN;
                 end
                 P_DROP: if (s_tvalid) begin
                     cnt <= cnt + 32'd1;
                     if (cnt == STREAM_DATA_BYTES - 1) state <= P_DONE;
                 end
-                P_LEN: if (put && cnt[1:0] == 2'd3) go(16'd0, prog_word(16'd0));
+                P_LEN: if (put && cnt[1:0] == 2'd3) go;
                 P_DECODE: case (op)
                     OP_DONE: begin
                         seq <= seq + 32'd1;
@@ -204,22 +223,17 @@ module rfl_gpublisher #(
                     end
                     OP_END: begin
                         if (!last_of[depth - 1'b1]) begin
-                            left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
-                            last_of[depth - 1'b1] <= (left[depth - 1'b1] == 32'd2);
-                            go(jump + 16'd1, prog_jump(pc));
+                            left[{depth - 1'b1, 5'd0} +: 32] <= left[{depth - 1'b1, 5'd0} +: 32] - 32'd1;
+                            last_of[depth - 1'b1] <= (left[{depth - 1'b1, 5'd0} +: 32] == 32'd2);
                         end else begin
                             depth <= depth - 1'b1;
-                            go(pc + 16'd1, prog_next(pc));
                         end
+                        go;
                     end
                     OP_FIXED, OP_ENCAP: begin
                         left_b <= {3'd0, size};
                         last_b <= (size == 32'd1);
-                        if (size == 32'd0) begin
-                            pc <= pc + 16'd1;
-                            w <= prog_next(pc);
-                        end
-                        else pad_then(pad_at(opos, align), P_BODY);
+                        if (size != 32'd0) pad_then(pad_at(opos, align), P_BODY);
                     end
                     default: begin  // OP_VAR, OP_LOOP
                         if (op == OP_LOOP && !variable) begin
@@ -245,15 +259,14 @@ module rfl_gpublisher #(
                 end
                 P_COUNTED: begin
                     if (op == OP_LOOP) begin
-                        if (n_zero) go(jump + 16'd1, prog_jump(pc));
-                        else begin
-                            left[depth] <= n;
+                        if (!n_zero) begin
+                            left[{depth, 5'd0} +: 32] <= n;
                             last_of[depth] <= (n == 32'd1);
                             depth <= depth + 1'b1;
-                            go(pc + 16'd1, prog_next(pc));
                         end
+                        go;
                     end else if (n_zero) begin  // body == 0
-                        go(pc + 16'd1, prog_next(pc));
+                        go;
                     end else begin
                         left_b <= body_of(n);
                         last_b <= (body_of(n) == 35'd1);
@@ -267,11 +280,18 @@ module rfl_gpublisher #(
                 P_BODY: if (put) begin
                     left_b <= left_b - 35'd1;
                     last_b <= (left_b == 35'd2);
-                    if (last_b) go(pc + 16'd1, prog_next(pc));
+                    if (last_b) go;
                 end
                 P_DONE: state <= P_IDLE;
                 default: state <= P_IDLE;
             endcase
+        end
+        // (w follows pc: the word of the next pc, from a look-up by the current pc)
+        if (!rst_n || step != G_STAY) begin
+            w_q[0] <= (!rst_n || step == G_FIRST) ? prog_word(16'd0)
+                    : (step == G_JUMP) ? prog_jump(pc) : prog_next(pc);
+            pc <= (!rst_n || step == G_FIRST) ? 16'd0
+                  : (step == G_JUMP) ? jump + 16'd1 : pc + 16'd1;
         end
     end
 `ifdef FORMAL
@@ -283,7 +303,7 @@ module rfl_gpublisher #(
         assert(n_zero == (n == 32'd0));
         assert(last_b == (left_b == 35'd1));
         if (state == P_LEN || state == P_COUNT) assert(cnt < 32'd4);
-        for (fd = 0; fd < LOOPS; fd = fd + 1) assert(last_of[fd] == (left[fd] == 32'd1));
+        for (fd = 0; fd < LOOPS; fd = fd + 1) assert(last_of[fd] == (left[32 * fd +: 32] == 32'd1));
     end
 `endif
 endmodule

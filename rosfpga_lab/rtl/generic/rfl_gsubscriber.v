@@ -106,11 +106,14 @@ module rfl_gsubscriber #(
     reg [31:0] mrem;                            // elem_min's bits still to add
     reg [63:0] value;                           // a SUB_RANGE field, little-endian
     reg        same;                            // a SUB_CHECK field equals its constant so far
-    reg        streamed;                        // the stream went out
+    reg        streamed;                        // the stream went out (set as its body starts:
+                                                // every byte of it is taken before a decision)
     reg        released;                        // handed over early (STREAM_EARLY)
     reg [31:0] out_len;
     reg [CW:0] waddr;                           // carried bytes written (one bit more: 2**CW fit)
-    reg [31:0] left [0:LOOPS-1];           // elements left of each open loop
+    // elements left of each open loop, 32 bits each (a vector, not a memory: Verilator keeps
+    // a memory's every write site, the reset's one per entry, as work on every clock)
+    reg [32*LOOPS-1:0] left;
     reg [LOOPS-1:0] quiet_of;              // that loop is written empty
     reg [DB-1:0] depth;
     reg [7:0]  quiet;
@@ -125,8 +128,10 @@ module rfl_gsubscriber #(
     // most two of them, which S_FINISH's two settling clocks load.
     wire dec_load = (state != S_BODY);
 
-    // The current instruction.
-    reg [IW-1:0] w;                             // the current instruction: prog_word(pc)
+    // The current instruction, prog_word(pc): a memory of one word, written at one place (as
+    // rfl_gpublisher's w).
+    reg [IW-1:0] w_q [0:0];
+    wire [IW-1:0] w = w_q[0];
     // CDR's parts, constant for TCPROS (CDR = 0) so that synthesis removes their logic
     wire [3:0]  align = CDR ? w[221:218] : 4'd1;
     wire [3:0]  elem_align = CDR ? w[217:214] : 4'd1;
@@ -337,7 +342,7 @@ module rfl_gsubscriber #(
         c_n1 <= (n == 32'd1);
         c_flen_long <= (n > MAX_FRAME);
         c_flen_short <= (n < MIN_BODY);
-        c_left1 <= (left[depth - 1'b1] != 32'd1);
+        c_left1 <= (left[{depth - 1'b1, 5'd0} +: 32] != 32'd1);
         c_padf_bad <= (pad_f != 32'd0 && pad_f >= room);
         p_room_f <= room_f;
         p_room_e <= room_e;
@@ -422,23 +427,40 @@ module rfl_gsubscriber #(
         end
     endtask
 
-    // Go on with instruction `next`.
-    // (w follows pc: `word` is prog_word(next), from a look-up by the current pc.)
-    task go(input [15:0] next, input [IW-1:0] word);
+    // Where the program goes on this clock (the decisions that call go below): pc and w load as
+    // it says, at one place (the end of the walk's block).
+    localparam [1:0] G_STAY = 2'd0, G_FIRST = 2'd1, G_NEXT = 2'd2, G_JUMP = 2'd3;
+    reg [1:0] step;
+    always @* begin
+        step = G_STAY;
+        if (settled == 2'd2)
+            case (state)
+                S_FCHK: if (!c_flen_long && !c_flen_short) step = G_FIRST;
+                S_DECODE:
+                    if (op == OP_END) step = c_left1 ? G_JUMP : G_NEXT;
+                    else if (op == OP_FIXED && c_size0) step = G_NEXT;
+                S_COUNTED:
+                    if (op == OP_LOOP && !c_count_bad && !c_fit_bad && !c_least_gt)
+                        step = c_n0 ? G_JUMP : G_NEXT;
+                S_FINISH:
+                    if (CDR && op == OP_ENCAP) begin
+                        if (!c_encap_bad && !c_encap_pad_gt) step = G_NEXT;
+                    end else if (!c_check_bad && !c_range_bad && !nul_bad) step = G_NEXT;
+                default: step = G_STAY;
+            endcase
+    end
+
+    // Go on with the instruction `step` loads.
+    task go;
         begin
-            pc <= next;
-            w <= word;
             state <= S_DECODE;
             cnt <= 32'd0;
         end
     endtask
 
-    integer d;
     always @(posedge clk) begin
         if (!rst_n) begin
             state <= S_FLEN;
-            pc <= 16'd0;
-            w <= prog_word(16'd0);
             pos <= 32'd0;
             left_f <= 32'd0;
             last_f <= 1'b0;
@@ -463,7 +485,7 @@ module rfl_gsubscriber #(
             depth <= {DB{1'b0}};
             quiet <= 8'd0;
             quiet_of <= {LOOPS{1'b0}};
-            for (d = 0; d < LOOPS; d = d + 1) left[d] <= 32'd0;
+            left <= {(32 * LOOPS){1'b0}};
             meta_valid <= 1'b0;
             meta_out_len <= 32'd0;
             meta_drop <= 1'b0;
@@ -521,7 +543,7 @@ module rfl_gsubscriber #(
                             depth <= {DB{1'b0}};
                             quiet <= 8'd0;
                             meta_drop <= 1'b0;
-                            go(16'd0, prog_word(16'd0));
+                            go;
                         end
                     end
                 end
@@ -547,16 +569,16 @@ module rfl_gsubscriber #(
                         end
                         OP_END: begin
                             if (c_left1) begin
-                                left[depth - 1'b1] <= left[depth - 1'b1] - 32'd1;
-                                go(pc_jp, w_jp);
+                                left[{depth - 1'b1, 5'd0} +: 32] <= left[{depth - 1'b1, 5'd0} +: 32] - 32'd1;
+                                go;
                             end else begin
                                 depth <= depth - 1'b1;
                                 if (quiet_of[depth - 1'b1]) quiet <= quiet - 8'd1;
-                                go(pc_nx, w_nx);
+                                go;
                             end
                         end
                         OP_FIXED: begin
-                            if (c_size0) go(pc_nx, w_nx);
+                            if (c_size0) go;
                             else if (c_padf_bad)
                                 refuse(SUB_BAD_FRAME_LENGTH, c_at_end);
                             else if (c_size_gt)
@@ -564,6 +586,7 @@ module rfl_gsubscriber #(
                             else begin
                                 left_b <= {3'd0, size};
                                 last_b <= c_size1;
+                                if (sub == SUB_STREAM) streamed <= 1'b1;
                                 pad_then(pad_f, S_BODY);
                             end
                         end
@@ -616,13 +639,13 @@ module rfl_gsubscriber #(
                     else if (op == OP_LOOP) begin
                         begin
                             if (variable && quiet == 8'd0) out_len <= p_out4;
-                            if (c_n0) go(pc_jp, w_jp);
+                            if (c_n0) go;
                             else begin
-                                left[depth] <= n;
+                                left[{depth, 5'd0} +: 32] <= n;
                                 quiet_of[depth] <= variable && pub == PUB_ZERO;
                                 if (variable && pub == PUB_ZERO) quiet <= quiet + 8'd1;
                                 depth <= depth + 1'b1;
-                                go(pc_nx, w_nx);
+                                go;
                             end
                         end
                     end else if (c_body0) begin
@@ -636,6 +659,7 @@ module rfl_gsubscriber #(
                     end else begin
                         left_b <= body_of(n);
                         last_b <= c_body1;
+                        if (sub == SUB_STREAM) streamed <= 1'b1;
                         pad_then(pad_e, S_BODY);
                         if (STREAM_EARLY && sub == SUB_STREAM) begin  // nothing after can refuse
                             meta_valid <= 1'b1;
@@ -656,7 +680,6 @@ module rfl_gsubscriber #(
                     else if (cnt >= {16'd0, klen}) same <= 1'b0;
                     else if (s_tdata != konst(kaddr + cnt[15:0])) same <= 1'b0;  // (the ROM
                     // looked up only for a byte that has a constant: not on every clock)
-                    if (sub == SUB_STREAM) streamed <= 1'b1;
                     if (last_b) state <= S_FINISH;
                 end
                 S_FINISH: if (settled != 2'd2) settled <= settled + 2'd1; else begin
@@ -669,7 +692,7 @@ module rfl_gsubscriber #(
                         else begin
                             room <= p_room_encap;
                             out_len <= p_out_klen;
-                            go(pc_nx, w_nx);
+                            go;
                         end
                     end
                     else if (c_check_bad)
@@ -678,7 +701,7 @@ module rfl_gsubscriber #(
                     else if (nul_bad) refuse(st3, c_at_end);
                     else begin
                         if (quiet == 8'd0) out_len <= c_out_len;
-                        go(pc_nx, w_nx);
+                        go;
                     end
                 end
                 S_TAIL: if (take && last_f) accept(1'b1);  // CDR: the unannounced end padding
@@ -689,6 +712,12 @@ module rfl_gsubscriber #(
                 end
                 default: state <= S_FLEN;
             endcase
+        end
+        // (w follows pc: w_nx and w_jp are the words of pc_nx and pc_jp)
+        if (!rst_n || step != G_STAY) begin
+            w_q[0] <= (!rst_n || step == G_FIRST) ? prog_word(16'd0)
+                      : (step == G_JUMP) ? w_jp : w_nx;
+            pc <= (!rst_n || step == G_FIRST) ? 16'd0 : (step == G_JUMP) ? pc_jp : pc_nx;
         end
     end
 `ifdef FORMAL
