@@ -260,23 +260,26 @@ def test_rtps_tx_is_clean_under_three_linters(name: str, info_ts: bool, frag: in
     from rosfpga_lab.rtl.sim import VERILOG_DIR
     from rosfpga_lab.rtl.synth import yosys_command
 
-    source = str(Path(VERILOG_DIR).parent / "fabric" / "rfl_rtps_tx.v")
+    fabric = Path(VERILOG_DIR).parent / "fabric"
+    source = str(fabric / "rfl_rtps_tx.v")
     top = "rfl_rtps_tx"
     given = tx_parameters(render_rom(DATA / f"{name}.yaml"), info_ts=info_ts,
                           **({"frag_bytes": frag} if frag else {}))
     params = verilog_parameters(given)
-    done = subprocess.run([require_verilator(), "--lint-only", "-Wall",
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", f"-I{fabric}",
                            *(f"-G{k}={v}" for k, v in params.items()), source], cwd=tmp_path,
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
-    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", f"-I{fabric}", "-s", top,
+                           "-o", "m.vvp",
                            *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
     require_yosys()
     sets = " ".join(f"-set {k} {v}" for k, v in params.items())
     (tmp_path / "check.ys").write_text(
-        f"read_verilog -defer {source}\nchparam {sets} {top}\nhierarchy -check -top {top}\nproc\n"
+        f"read_verilog -defer -I{fabric} {source}\nchparam {sets} {top}\n"
+        f"hierarchy -check -top {top}\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=300)
