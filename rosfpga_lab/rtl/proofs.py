@@ -43,9 +43,10 @@ FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "
                   "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_spdp_peer.v",
                   "rfl_fabric_top.v", "rfl_board_5a75b.v")
 ENV_INCLUDE = "fv_env.vh"
-#: The parameter lists the fabric's tops share (declared, passed on), included from FABRIC_DIR.
+#: Included from FABRIC_DIR: the parameter lists the fabric's tops share (declared, passed on),
+#: and the RTPS wire vocabulary the stages share (submessage ids, header magic and version).
 FABRIC_INCLUDES = ("rfl_fabric_node_params.vh", "rfl_fabric_node_pass.vh",
-                   "rfl_fabric_top_params.vh", "rfl_fabric_top_pass.vh")
+                   "rfl_fabric_top_params.vh", "rfl_fabric_top_pass.vh", "rfl_rtps_wire.vh")
 #: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node aside:
 #: the project's; the proof's wrapper has its own).
 FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",

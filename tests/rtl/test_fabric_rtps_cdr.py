@@ -173,7 +173,7 @@ def test_rtps_datagrams_through_the_seam_publish_the_models_records(
     sources = [FABRIC / "rfl_rtps_rx.v", FABRIC / "rfl_rtps_to_cdr.v", *rtl,
                TB_DIR / "rtps_cdr_top.v"]
     runner = get_runner(sim)
-    runner.build(sources=sources, includes=[gen / "rtl"], hdl_toplevel="rtps_cdr_top",
+    runner.build(sources=sources, includes=[gen / "rtl", FABRIC], hdl_toplevel="rtps_cdr_top",
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
     run_bench(runner, "bench_rfl_rtps_to_cdr", "rtps_cdr_top", tmp_path / "build", tmp_path,

@@ -459,7 +459,8 @@ def cosimulate(tmp_path: Path, seed: int, gap: int, bp: int, datagrams: list[byt
             "counts": counts}
     (tmp_path / "case.json").write_text(json.dumps(case))
     runner = get_runner(sim)
-    runner.build(sources=[SOURCE], hdl_toplevel="rfl_rtps_rx", build_dir=tmp_path / "build",
+    runner.build(sources=[SOURCE], includes=[FABRIC], hdl_toplevel="rfl_rtps_rx",
+                 build_dir=tmp_path / "build",
                  timescale=("1ns", "1ps"), log_file=tmp_path / "build.log")
     run_bench(runner, "bench_rfl_rtps_rx", "rfl_rtps_rx", tmp_path / "build", tmp_path,
               {"RTPS_RX_CASE": str(tmp_path / "case.json"),
@@ -490,15 +491,16 @@ def test_rtps_rx_skips_repeated_fragments(gap: int, bp: int, tmp_path: Path,
 def test_verilator_wall_has_no_warning(tmp_path: Path) -> None:
     """Verilator -Wall is silent (the parameter contract is tests/rtl/test_house_rules.py's)."""
     verilator = require_verilator()
-    done = subprocess.run([verilator, "--lint-only", "-Wall", str(SOURCE)], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=120)
+    done = subprocess.run([verilator, "--lint-only", "-Wall", f"-I{FABRIC}", str(SOURCE)],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-3000:]
 
 
 def test_iverilog_wall_and_yosys_check_are_silent(tmp_path: Path) -> None:
     """Icarus -Wall says nothing; Yosys finds no latch, loop, multiple or missing driver."""
     iverilog = require_iverilog()
-    done = subprocess.run([iverilog, "-g2005", "-Wall", "-o", "m.vvp", str(SOURCE)],
+    done = subprocess.run([iverilog, "-g2005", "-Wall", f"-I{FABRIC}", "-o", "m.vvp",
+                           str(SOURCE)],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
     require_yosys()
@@ -507,7 +509,7 @@ def test_iverilog_wall_and_yosys_check_are_silent(tmp_path: Path) -> None:
     yosys = yosys_command()
     assert yosys is not None
     (tmp_path / "check.ys").write_text(
-        f"read_verilog {SOURCE}\nhierarchy -check -top rfl_rtps_rx\nproc\n"
+        f"read_verilog -I{FABRIC} {SOURCE}\nhierarchy -check -top rfl_rtps_rx\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys, "-q", "check.ys"], cwd=tmp_path, capture_output=True,
                           text=True, timeout=300)

@@ -127,7 +127,8 @@ def run(tmp_path: Path, seed: int, frag: int, info_ts: bool, max_sample: int, ga
     case = {"seed": seed, "gap": gap, "bp": bp, "records": [r.hex() for r in recs]}
     (tmp_path / "case.json").write_text(json.dumps(case))
     runner = get_runner(sim)
-    runner.build(sources=[SOURCE], hdl_toplevel="rfl_rtps_tx", build_dir=tmp_path / "build",
+    runner.build(sources=[SOURCE], includes=[SOURCE.parent], hdl_toplevel="rfl_rtps_tx",
+                 build_dir=tmp_path / "build",
                  parameters=verilog_parameters(p), timescale=("1ns", "1ps"),
                  log_file=tmp_path / "build.log")
     run_bench(runner, "bench_rfl_rtps_tx", "rfl_rtps_tx", tmp_path / "build", tmp_path,
@@ -243,7 +244,8 @@ def test_a_planted_bug_fails_the_proof(tmp_path: Path) -> None:
              ("fv_rtps_tx.sv", "rfl_rtps_tx.v")),
             ("emit(sh[SHW-1 -: 8], h1);", "emit(sh[SHW-1 -: 8], 1'b0);", "prove",
              "rfl_rtps_tx.v"),
-            ("8'h02, 8'h03, 8'h00, 8'h00, GUID_PREFIX", "8'h03, 8'h02, 8'h00, 8'h00, GUID_PREFIX",
+            ("RTPS_VERSION, RTPS_VENDOR, GUID_PREFIX",
+             "RTPS_VERSION[7:0], RTPS_VERSION[15:8], RTPS_VENDOR, GUID_PREFIX",
              "bmc", "fv_rtps_tx.sv"))):
         assert text.count(good) == 1
         buggy = tmp_path / str(k) / "rfl_rtps_tx.v"

@@ -92,7 +92,8 @@ def _run(datagrams: list[tuple[bytes, int]], tmp_path: Path, tick: int = TICK) -
     params: dict[str, object] = {k: v for k, v in spdp_parameters().items()}
     params.update(TICK=tick, RESEND=RESEND)
     runner = runner_mod.get_runner("icarus")
-    runner.build(sources=[FABRIC_DIR / "rfl_spdp_peer.v"], hdl_toplevel="rfl_spdp_peer",
+    runner.build(sources=[FABRIC_DIR / "rfl_spdp_peer.v"], includes=[FABRIC_DIR],
+                 hdl_toplevel="rfl_spdp_peer",
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"), parameters=params)
     (tmp_path / "case.json").write_text(json.dumps(
         {"prefix": OWN.hex(),

@@ -195,7 +195,8 @@ def test_answer_path_is_clean_under_three_linters(top: str, name: str, tmp_path:
     rom = render_rom(DATA / f"{name}.yaml")
     write_rom(rom, tmp_path)
     given = answer_params(rom)
-    source = str(Path(VERILOG_DIR).parent / "fabric" / f"{top}.v")
+    fabric = Path(VERILOG_DIR).parent / "fabric"
+    source = str(fabric / f"{top}.v")
     if top == "rfl_rtps_ctrl":
         params = {k: given[k] for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS")}
     else:
@@ -203,18 +204,20 @@ def test_answer_path_is_clean_under_three_linters(top: str, name: str, tmp_path:
                   "ROM_BYTES": given["ANSWER_BYTES"], "MESSAGES": given["ANSWERS"],
                   **{k: given[k] for k in ("DST_AT", "BASE_AT", "COUNT_START", "BURST",
                                            "RATE")}}
-    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", *(f"-G{k}={v}" for k, v
-                           in params.items()), source], cwd=tmp_path, capture_output=True,
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", f"-I{fabric}",
+                           *(f"-G{k}={v}" for k, v in params.items()), source], cwd=tmp_path, capture_output=True,
                           text=True, timeout=120)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
-    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", f"-I{fabric}", "-s", top,
+                           "-o", "m.vvp",
                            *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
     require_yosys()
     sets = " ".join(f"-set {k} {v}" for k, v in params.items())
     (tmp_path / "check.ys").write_text(
-        f"read_verilog -defer {source}\nchparam {sets} {top}\nhierarchy -check -top {top}\nproc\n"
+        f"read_verilog -defer -I{fabric} {source}\nchparam {sets} {top}\n"
+        f"hierarchy -check -top {top}\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=300)
@@ -260,23 +263,26 @@ def test_rtps_tx_is_clean_under_three_linters(name: str, info_ts: bool, frag: in
     from rosfpga_lab.rtl.sim import VERILOG_DIR
     from rosfpga_lab.rtl.synth import yosys_command
 
-    source = str(Path(VERILOG_DIR).parent / "fabric" / "rfl_rtps_tx.v")
+    fabric = Path(VERILOG_DIR).parent / "fabric"
+    source = str(fabric / "rfl_rtps_tx.v")
     top = "rfl_rtps_tx"
     given = tx_parameters(render_rom(DATA / f"{name}.yaml"), info_ts=info_ts,
                           **({"frag_bytes": frag} if frag else {}))
     params = verilog_parameters(given)
-    done = subprocess.run([require_verilator(), "--lint-only", "-Wall",
+    done = subprocess.run([require_verilator(), "--lint-only", "-Wall", f"-I{fabric}",
                            *(f"-G{k}={v}" for k, v in params.items()), source], cwd=tmp_path,
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
-    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
+    done = subprocess.run([require_iverilog(), "-g2005", "-Wall", f"-I{fabric}", "-s", top,
+                           "-o", "m.vvp",
                            *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
     require_yosys()
     sets = " ".join(f"-set {k} {v}" for k, v in params.items())
     (tmp_path / "check.ys").write_text(
-        f"read_verilog -defer {source}\nchparam {sets} {top}\nhierarchy -check -top {top}\nproc\n"
+        f"read_verilog -defer -I{fabric} {source}\nchparam {sets} {top}\n"
+        f"hierarchy -check -top {top}\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=300)

@@ -104,8 +104,7 @@ module rfl_rtps_ctrl #(
     localparam [63:0] MSGS = MSGS_W[63:0];
     localparam [63:0] LASTS = LASTS_W[63:0];
     localparam [1:0] S_HDR = 2'd0, S_SUBHDR = 2'd1, S_BODY = 2'd2, S_DROP = 2'd3;
-    localparam [7:0] ID_PAD = 8'h01, ID_ACKNACK = 8'h06, ID_HEARTBEAT = 8'h07,
-                     ID_INFO_TS = 8'h09, ID_INFO_SRC = 8'h0C, ID_INFO_DST = 8'h0E;
+`include "rfl_rtps_wire.vh"             // ID_*, RTPS_MAGIC, RTPS_VERSION, FLAG_E
 
     assign s_axis_tready = 1'b1;
     wire take = s_axis_tvalid;
@@ -299,9 +298,11 @@ module rfl_rtps_ctrl #(
                 case (st)
                 S_HDR: begin
                     hdr_bad <= (idx != 5'd0 && hdr_bad) ||
-                               (idx == 5'd0 && b != 8'h52) || (idx == 5'd1 && b != 8'h54) ||
-                               (idx == 5'd2 && b != 8'h50) || (idx == 5'd3 && b != 8'h53) ||
-                               (idx == 5'd4 && b != 8'd2);
+                               (idx == 5'd0 && b != RTPS_MAGIC[31:24]) ||
+                               (idx == 5'd1 && b != RTPS_MAGIC[23:16]) ||
+                               (idx == 5'd2 && b != RTPS_MAGIC[15:8]) ||
+                               (idx == 5'd3 && b != RTPS_MAGIC[7:0]) ||
+                               (idx == 5'd4 && b != RTPS_VERSION[15:8]);
                     src_sh <= src_sh_n[87:0];
                     idx <= idx + 1'b1;
                     dst_ok <= 1'b1;

@@ -96,8 +96,7 @@ module rfl_rtps_rx #(
 
     localparam [3:0] S_HDR = 4'd0, S_SUBHDR = 4'd1, S_FIELDS = 4'd2, S_D1 = 4'd3, S_D2 = 4'd4,
                      S_GAP = 4'd5, S_QOS = 4'd6, S_PAY = 4'd7, S_SKIP = 4'd8, S_DROP = 4'd9;
-    localparam [7:0] ID_PAD = 8'h01, ID_INFO_TS = 8'h09, ID_INFO_SRC = 8'h0C,
-                     ID_INFO_DST = 8'h0E, ID_DATA = 8'h15, ID_DATA_FRAG = 8'h16;
+`include "rfl_rtps_wire.vh"             // ID_*, RTPS_MAGIC, RTPS_VERSION, FLAG_E
 
     reg [3:0] st;
     reg dwait;                                  // in S_D1 or S_D2 (timing: no state decode)
@@ -121,10 +120,11 @@ module rfl_rtps_rx #(
     reg [63:0] ts;
     reg ts_valid;
     wire cmp_eq = (b == cmp_sh[95:88]);
-    wire [7:0] magic = (idx[1:0] == 2'd0) ? 8'h52 : (idx[1:0] == 2'd1) ? 8'h54 :
-                       (idx[1:0] == 2'd2) ? 8'h50 : 8'h53;       // R T P S
+    wire [7:0] magic = (idx[1:0] == 2'd0) ? RTPS_MAGIC[31:24] :
+                       (idx[1:0] == 2'd1) ? RTPS_MAGIC[23:16] :
+                       (idx[1:0] == 2'd2) ? RTPS_MAGIC[15:8] : RTPS_MAGIC[7:0];
     wire hdr_bad_n = ((idx != 6'd0) && hdr_bad) || ((idx < 6'd4) && (b != magic)) ||
-                     ((idx == 6'd4) && (b != 8'd2));
+                     ((idx == 6'd4) && (b != RTPS_VERSION[15:8]));
     wire own_n = ((idx == 6'd8) || own_eq) && cmp_eq;
 
     // the submessage

@@ -122,6 +122,7 @@ module rfl_rtps_tx #(
 `endif
 
     localparam SHW = 8 * HEAD_BYTES;
+`include "rfl_rtps_wire.vh"             // ID_*, RTPS_MAGIC, RTPS_VERSION, FLAG_E
     localparam [31:0] FRAG_32 = FRAG_BYTES;
     localparam [31:0] MAX_32 = MAX_SAMPLE;
     localparam [6:0] N_FRAG = HEAD_BYTES, N_DATA = HEAD_BYTES - 12, N_HB = 7'd32;
@@ -172,22 +173,24 @@ module rfl_rtps_tx #(
 
     // what S_P4 loads: header, INFO_TS, DATA / DATA_FRAG fields (DATA uses the first N_DATA)
     wire [15:0] sublen = fb + (frag ? 16'd32 : 16'd20);
-    wire [159:0] v_hdr = {8'h52, 8'h54, 8'h50, 8'h53, 8'h02, 8'h03, 8'h00, 8'h00, GUID_PREFIX};
-    wire [191:0] v_sub = {frag ? 8'h16 : 8'h15, frag ? 8'h01 : 8'h05, le16(sublen), 16'h0000,
+    wire [159:0] v_hdr = {RTPS_MAGIC, RTPS_VERSION, RTPS_VENDOR, GUID_PREFIX};
+    wire [191:0] v_sub = {frag ? ID_DATA_FRAG : ID_DATA, frag ? FLAG_E : FLAG_E | 8'h04,  // D
+                          le16(sublen), 16'h0000,
                           frag ? 16'h1C00 : 16'h1000, READER_ID, WRITER_ID, le32(seq[63:32]),
                           le32(seq[31:0])};
     wire [95:0] v_frag = {le32(fnum), 16'h0100, le16(FRAG_32[15:0]), le32(w4)};
     wire [SHW-1:0] v_head;
     generate
         if (INFO_TS != 0) begin : g_ts
-            assign v_head = {v_hdr, 32'h09010800, le32(ts[63:32]), le32(ts[31:0]), v_sub,
-                             v_frag};
+            assign v_head = {v_hdr, ID_INFO_TS, FLAG_E, 16'h0800, le32(ts[63:32]),
+                             le32(ts[31:0]), v_sub, v_frag};
         end else begin : g_no_ts
             assign v_head = {v_hdr, v_sub, v_frag};
         end
     endgenerate
-    wire [255:0] v_hb = {32'h07011C00, READER_ID, WRITER_ID, le32(seq1[63:32]),
-                         le32(seq1[31:0]), le32(seq[63:32]), le32(seq[31:0]), le32(seq[31:0])};
+    wire [255:0] v_hb = {ID_HEARTBEAT, FLAG_E, 16'h1C00, READER_ID, WRITER_ID,
+                         le32(seq1[63:32]), le32(seq1[31:0]), le32(seq[63:32]), le32(seq[31:0]),
+                         le32(seq[31:0])};
 
     task emit(input [7:0] d, input l);
         begin
@@ -331,7 +334,7 @@ module rfl_rtps_tx #(
                 (last_dg || (frag && fb == FRAG_32[15:0] && rem > FRAG_32));
     always @(*) if (rst_n) begin
         assert(f_e <= F_MAX);                                   // no datagram longer
-        if (o_valid && f_pos == 16'd0) assert(o_data == 8'h52); // each opens with "RTPS"
+        if (o_valid && f_pos == 16'd0) assert(o_data == RTPS_MAGIC[31:24]);  // "RTPS" first
         assert(st <= S_SKIP);
         case (st)
         S_P2: assert(f_fresh && (zero || big || w4 != 32'd0));
@@ -340,7 +343,7 @@ module rfl_rtps_tx #(
         S_HDR: begin
             assert(f_fb && hcnt != 7'd0 && {9'd0, hcnt} <= f_h && h1 == (hcnt == 7'd1));
             assert(pay_left == fb && pl1 == (fb == 16'd1));
-            if ({9'd0, hcnt} == f_h) assert(f_fresh && sh[SHW-1 -: 8] == 8'h52);
+            if ({9'd0, hcnt} == f_h) assert(f_fresh && sh[SHW-1 -: 8] == RTPS_MAGIC[31:24]);
             else assert(!(o_valid && o_last) && f_e == f_h - {9'd0, hcnt});
         end
         S_PAY: begin

@@ -102,7 +102,7 @@ module rfl_spdp_peer #(
     localparam [31:0] RESEND_32 = RESEND;
     localparam [RW-1:0] RESEND_N = RESEND_32[RW-1:0];
     localparam [1:0] S_HDR = 2'd0, S_SUBHDR = 2'd1, S_BODY = 2'd2, S_DROP = 2'd3;
-    localparam [7:0] ID_PAD = 8'h01, ID_INFO_TS = 8'h09, ID_DATA = 8'h15;
+`include "rfl_rtps_wire.vh"             // ID_*, RTPS_MAGIC, RTPS_VERSION, FLAG_E
     // within a DATA: the fixed fields, the inline QoS's parameter heads and values, the
     // encapsulation, the payload's heads and values, done (the sentinel), ignored
     localparam [2:0] P_FIX = 3'd0, P_QHEAD = 3'd1, P_QVAL = 3'd2, P_ENC = 3'd3,
@@ -223,9 +223,11 @@ module rfl_spdp_peer #(
                 case (st)
                 S_HDR: begin
                     hdr_bad <= (idx != 5'd0 && hdr_bad) ||
-                               (idx == 5'd0 && b != 8'h52) || (idx == 5'd1 && b != 8'h54) ||
-                               (idx == 5'd2 && b != 8'h50) || (idx == 5'd3 && b != 8'h53) ||
-                               (idx == 5'd4 && b != 8'd2);
+                               (idx == 5'd0 && b != RTPS_MAGIC[31:24]) ||
+                               (idx == 5'd1 && b != RTPS_MAGIC[23:16]) ||
+                               (idx == 5'd2 && b != RTPS_MAGIC[15:8]) ||
+                               (idx == 5'd3 && b != RTPS_MAGIC[7:0]) ||
+                               (idx == 5'd4 && b != RTPS_VERSION[15:8]);
                     if (idx >= 5'd8) src <= {src[87:0], b};
                     idx <= idx + 1'b1;
                     if (tl) begin
