@@ -50,9 +50,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--participant-index", type=int, default=0, metavar="N",
                         help="--target fabric: the participant index, which sets the node's "
                         "UDP ports (RTPS port mapping; default 0)")
-    parser.add_argument("--address", default="127.0.0.1", metavar="IPV4",
-                        help="--target fabric: the address the node announces (default "
-                        "127.0.0.1)")
+    parser.add_argument("--address", default=None, metavar="IPV4",
+                        help="--target fabric: the board's address on its link, which the node "
+                        "announces (default 10.31.0.2, the node's address under 'fabric sim "
+                        "--tap': one host set-up, 10.31.0.1/24, serves both)")
     parser.add_argument("--guid-prefix", metavar="HEX",
                         help="--target fabric: the participant's GUID prefix, 24 hex digits "
                         "(default: the lab's fixed fabric prefix; give each board of one DDS "
@@ -102,10 +103,13 @@ def _fabric(args: argparse.Namespace, config: object) -> int:
             prefix = bytes.fromhex(args.guid_prefix)
         except ValueError:
             raise RtlError(f"--guid-prefix {args.guid_prefix!r} is not hex digits") from None
+    from rosfpga_lab.component.fabricsim import TAP_NODE_ADDRESS
+
+    address = args.address or TAP_NODE_ADDRESS
     rom = render_rom(config, domain=args.domain, index=args.participant_index,  # type: ignore[arg-type]
-                     address=args.address, guid_prefix=prefix)
+                     address=address, guid_prefix=prefix)
     paths = write_rom(rom, args.output)
-    peer_ip = args.peer_ip or default_peer(args.address)
+    peer_ip = args.peer_ip or default_peer(address)
     paths += write_board(config, rom, args.output, peer_ip=peer_ip,  # type: ignore[arg-type]
                          mac=args.mac or DEFAULT_MAC)
     if not args.quiet:

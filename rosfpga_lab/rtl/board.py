@@ -144,9 +144,9 @@ def _readme(rom: DiscoveryRom, mac: str, peer_ip: str) -> str:
 No board was available where this lab was written: the bitstream is built, placed, routed and
 timed by open tools (`make bitstream`), never run on a board. What the build prints is what is
 known: Fmax per clock and the resources. At the time of writing neither clock meets 125 MHz
-(the node's clock some 63 MHz, the PHY's receive clock some 108 MHz: LiteEth's 8-bit datapath,
-rosfpga_lab/rtl/fabric/vendor/README.md, Timing), so expect lost or corrupted frames at line
-rate until LiteEth's 32-bit datapath is joined.
+(the figures `make bitstream` prints; the node's clock falls short the most: LiteEth's 8-bit
+datapath, rosfpga_lab/rtl/fabric/vendor/README.md, Timing), so expect lost or corrupted frames
+at line rate until LiteEth's 32-bit datapath is joined.
 
 One more thing to check on the board: LiteX-Boards' own 5A-75x target builds its RGMII PHY with
 no transmit delay in the FPGA (the RTL8211FD adds it); the vendored core adds 2 ns

@@ -54,3 +54,20 @@ def test_default_peer_and_bad_addresses(tmp_path: Path,
     assert main(["generate", str(CONFIG), "-o", str(tmp_path / "b"), "-q", "--target",
                  "fabric", "--address", "10.0.0.1", "--peer-ip", "10.0.0.1"]) != 0
     assert "is the node's own" in capsys.readouterr().err
+
+
+def test_the_board_defaults_to_the_tap_link_not_loopback(tmp_path: Path,
+                                                         capsys: pytest.CaptureFixture[str]) -> None:
+    """Without --address the board is on a real link, the one `fabric sim --tap` sets up (the
+    node 10.31.0.2, the host 10.31.0.1/24), not loopback, where no frame leaves the host."""
+    from rosfpga_lab.component.fabricsim import TAP_HOST_CIDR, TAP_NODE_ADDRESS
+
+    assert main(["generate", str(CONFIG), "-o", str(tmp_path), "-q", "--target", "fabric"]) == 0
+    index = json.loads((tmp_path / "board" / "parameters.json").read_text())
+    assert (index["ip"], index["peer_ip"]) == (TAP_NODE_ADDRESS, TAP_HOST_CIDR.split("/")[0])
+    assert index["parameters"]["IP"] == "32'ha1f0002"        # 10.31.0.2
+    readme = (tmp_path / "board" / "README.md").read_text()
+    assert f"sudo ip addr add {TAP_HOST_CIDR} dev eth0" in readme and "127.0.0" not in readme
+    with pytest.raises(SystemExit):
+        main(["generate", "--help"])
+    assert f"default {TAP_NODE_ADDRESS}" in " ".join(capsys.readouterr().out.split())

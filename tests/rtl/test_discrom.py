@@ -129,7 +129,11 @@ def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
 
     assert main(["generate", str(CONFIG), "-o", str(tmp_path), "-q", "--target", "fabric",
                  "--domain", "9", "--participant-index", "1"]) == 0
-    rom = render_rom(CONFIG, domain=9, index=1)
+    from rosfpga_lab.component.fabricsim import TAP_NODE_ADDRESS
+
+    # the board's default address is fabric sim --tap's node's (one host set-up for both)
+    rom = render_rom(CONFIG, domain=9, index=1, address=TAP_NODE_ADDRESS)
+    assert rom.address == "10.31.0.2"
     image = bytes(int(x, 16) for x in (tmp_path / ROM_FILE).read_text().split())
     assert image == b"".join(m.data for m in rom.messages)
     table = [int(x, 16) for x in (tmp_path / TABLE_FILE).read_text().split()]
