@@ -49,6 +49,21 @@ PREAMBLE = "55" * 7 + "d5"
 ETHERTYPE_ARP = bytes.fromhex("0806")
 
 
+def run_answering_arp(sim: FabricSim, peer_ip: bytes, arp_reply: bytes,
+                      seconds: float = 60) -> list[bytes]:
+    """The frames the fast model sends until it stops (or ``seconds``), answering its ARP
+    requests for ``peer_ip`` with ``arp_reply``."""
+    sent: list[bytes] = []
+    deadline = time.monotonic() + seconds
+    while sim.running() and time.monotonic() < deadline:
+        for frame in sim.read(0.05).frames:
+            sent.append(frame)
+            if frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" \
+                    and frame[38:42] == peer_ip:
+                sim.send_frame(arp_reply)
+    return sent
+
+
 @pytest.mark.timeout(300)
 def test_the_fast_model_sends_what_the_cocotb_bench_expects(tmp_path: Path) -> None:
     require_fabric_sim()
@@ -65,13 +80,7 @@ def test_the_fast_model_sends_what_the_cocotb_bench_expects(tmp_path: Path) -> N
     try:
         for raw in case["frames"]:
             sim.send_frame(bytes.fromhex(raw))
-        deadline = time.monotonic() + 60
-        while sim.running() and time.monotonic() < deadline:
-            for frame in sim.read(0.05).frames:
-                sent.append(frame)
-                if frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" \
-                        and frame[38:42] == peer_ip:
-                    sim.send_frame(bytes.fromhex(case["arp_reply"]))
+        sent += run_answering_arp(sim, peer_ip, bytes.fromhex(case["arp_reply"]))
     finally:
         report = sim.close()
     sent += report.frames
@@ -124,13 +133,7 @@ def test_the_fast_model_learns_its_peer_from_spdp_and_sends_it_sedp(tmp_path: Pa
         sim.send_frame(announce(other, "192.168.10.7", 0, port=discovery_multicast_port(0) + 1))
         sim.send_frame(announce(PEER, PEER_IP, PEER_INDEX))
         sim.send_frame(announce(bytes.fromhex("010fbeef0000000200000002"), "192.168.10.9", 3))
-        deadline = time.monotonic() + 60
-        while sim.running() and time.monotonic() < deadline:
-            for frame in sim.read(0.05).frames:
-                sent.append(frame)
-                if frame[12:14] == ETHERTYPE_ARP and frame[20:22] == b"\x00\x01" \
-                        and frame[38:42] == peer_ip:
-                    sim.send_frame(bytes.fromhex(case["arp_reply"]))
+        sent += run_answering_arp(sim, peer_ip, bytes.fromhex(case["arp_reply"]))
     finally:
         report = sim.close()
     sent += report.frames
