@@ -186,6 +186,7 @@ class Node:
         self.is_shutdown = False
         self.shutdown_reason = ""   # why it shut down (e.g. a remote slave-API shutdown's message)
         self._down = threading.Event()
+        self._shutting_down_in: threading.Thread | None = None  # the thread that runs _shutdown
         self._service_port: ServiceServer | None = None   # started with the first service
         self._logging: Any = None   # /rosout and logger services, from the first registration
         self.ros_logging = True     # False: this node offers neither (before its first registration)
@@ -652,10 +653,16 @@ class Node:
 
     def _shutdown(self, reason: str = "") -> None:
         with self._lock:
-            if self.is_shutdown:
-                return
-            self.is_shutdown = True
-            self.shutdown_reason = reason or "shut down"
+            first = self._shutting_down_in
+            if first is None:
+                self._shutting_down_in = threading.current_thread()
+                self.shutdown_reason = reason or "shut down"
+                self.is_shutdown = True
+        if first is not None:
+            if first is not threading.current_thread():  # another thread (a remote shutdown's) is
+                self._down.wait(JOIN_TIMEOUT)  # at it: return once it is done, so a caller that
+            return                             # then exits lets that call's reply out first
+        with self._lock:
             pubs = list(self.publishers.values())
             subs = list(self.subscribers.values())
             self.publishers.clear()

@@ -349,6 +349,34 @@ def test_remote_shutdown(nodes) -> None:
     assert wait_until(lambda: a.is_shutdown)
 
 
+def test_shutdown_during_a_remote_one_returns_once_that_is_done(nodes, monkeypatch) -> None:
+    """rostopic's echo saw ``is_shutdown`` from a remote shutdown, called shutdown(), which
+    returned at once, and exited while the remote call's reply was still unsent: the caller got
+    "connection closed before any reply" (a CI failure under load). shutdown() from another
+    thread now returns only when the first one has finished, its reply out."""
+    a = nodes("/victim")
+    a.advertise("/slow", "std_msgs/String")
+    leave = Node._leave
+    leaving = threading.Event()
+
+    def slow_leave(self, topic_object) -> None:
+        leaving.set()
+        time.sleep(0.5)
+        leave(self, topic_object)
+
+    monkeypatch.setattr(Node, "_leave", slow_leave)
+    reply: list = []
+    caller = threading.Thread(target=lambda: reply.append(
+        xmlrpc.client.ServerProxy(a.uri).shutdown("/x", "bye")))
+    caller.start()
+    assert leaving.wait(10)
+    assert a.is_shutdown and a.shutdown_reason == "remote shutdown by /x: bye"
+    a.shutdown()
+    assert a.wait_for_shutdown(0), "shutdown() returned before the remote shutdown had finished"
+    caller.join(10)
+    assert reply == [[1, "shutdown", 0]]
+
+
 # ----------------------------------------------------------------------------- hostile publishers
 class FakePublisher:
     """A slave API + TCP port that answers the handshake correctly, then misbehaves."""
