@@ -34,7 +34,7 @@ from pathlib import Path
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.rtl.errors import SynthError
 from rosfpga_lab.rtl.limits import SYNTH_TIMEOUT
-from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR
+from rosfpga_lab.rtl.tools import stage_project_rtl
 
 #: Modules reported, in data-path order, with their row names (adding one is one line): the
 #: generated top of every configuration (rosfpga_lab.rtl.generic); any other module a node
@@ -209,20 +209,12 @@ def synthesize_dir(rtl_dir: str | Path, part: str, *, progress: Progress | None 
     """
     say = progress or (lambda _msg: None)
     family = family_of(part)
-    src = Path(rtl_dir)
-    if not (src / NODE_FILE).is_file():
-        raise SynthError(f"{src / NODE_FILE} not found: is {src} the rtl/ folder of a project "
-                         "written by 'rosfpga-lab generate'?")
-    command = yosys_command(yosys)
-    if command is None:
-        raise SynthError(yosys_missing_reason(yosys) or "no Yosys")
-    testbenches = {p.name for p in TB_DIR.glob("*.v")}
-    files = sorted(p.name for p in src.glob("*.v") if p.name not in testbenches)
     with tempfile.TemporaryDirectory(prefix="rosfpga-synth-") as tmp:
         work = Path(tmp)
-        for pattern in ("*.v", "*.vh"):
-            for path in src.glob(pattern):
-                shutil.copyfile(path, work / path.name)
+        files = stage_project_rtl(rtl_dir, work, SynthError)
+        command = yosys_command(yosys)
+        if command is None:
+            raise SynthError(yosys_missing_reason(yosys) or "no Yosys")
         (work / "synth.ys").write_text(synth_script(files, family), encoding="utf-8")
         say(f"Yosys: synth_xilinx -family {family} of {len(files)} files (a minute or less)")
         start = time.monotonic()

@@ -40,7 +40,8 @@ from rosfpga_lab.rtl.limits import (
     VERSION_TIMEOUT,
 )
 from rosfpga_lab.rtl.project import node_sources
-from rosfpga_lab.rtl.sim import NODE_FILE, TB_DIR, find_tool
+from rosfpga_lab.rtl.sim import find_tool
+from rosfpga_lab.rtl.tools import stage_project_rtl
 from rosfpga_lab.rtl.synth import TOP, yosys_command
 
 __all__ = ["NEXTPNR_PROGRAMS", "PathStep", "SHIPPED_CONFIG", "SHIPPED_REPORT", "TIMING_YOSYS",
@@ -320,19 +321,11 @@ def place_and_route_dir(rtl_dir: str | Path, clock_mhz: float, *,
     say = progress or (lambda _msg: None)
     if not clock_mhz > 0:
         raise TimingError(f"clock_mhz is {clock_mhz}; give a positive clock in MHz")
-    src = Path(rtl_dir)
-    if not (src / NODE_FILE).is_file():
-        raise TimingError(f"{src / NODE_FILE} not found: is {src} the rtl/ folder of a project "
-                          "written by 'rosfpga-lab generate'?")
-    ytool, ptool = choose_tools(yosys, nextpnr)
-    say(f"tools: {ytool.describe()}, {ptool.describe()}")
-    testbenches = {p.name for p in TB_DIR.glob("*.v")}
-    files = sorted(p.name for p in src.glob("*.v") if p.name not in testbenches)
     with tempfile.TemporaryDirectory(prefix="rosfpga-timing-") as tmp:
         work = Path(tmp)
-        for pattern in ("*.v", "*.vh"):
-            for path in src.glob(pattern):
-                shutil.copyfile(path, work / path.name)
+        files = stage_project_rtl(rtl_dir, work, TimingError)
+        ytool, ptool = choose_tools(yosys, nextpnr)
+        say(f"tools: {ytool.describe()}, {ptool.describe()}")
         (work / "synth.ys").write_text(synth_ecp5_script(files), encoding="utf-8")
         say(f"Yosys: synth_ecp5 of {len(files)} files")
         start = time.monotonic()
@@ -367,20 +360,12 @@ def ecp5_cells(rtl_dir: str | Path, *, yosys: str | None = None) -> dict[str, in
     """
     from rosfpga_lab.rtl.synth import parse_stat
 
-    src = Path(rtl_dir)
-    if not (src / NODE_FILE).is_file():
-        raise TimingError(f"{src / NODE_FILE} not found: is {src} the rtl/ folder of a project "
-                          "written by 'rosfpga-lab generate'?")
-    ytool = choose_yosys(yosys)
-    if ytool is None:
-        raise TimingError(timing_missing_reason(yosys) or "no Yosys")
-    testbenches = {p.name for p in TB_DIR.glob("*.v")}
-    files = sorted(p.name for p in src.glob("*.v") if p.name not in testbenches)
     with tempfile.TemporaryDirectory(prefix="rosfpga-ecp5-") as tmp:
         work = Path(tmp)
-        for pattern in ("*.v", "*.vh"):
-            for path in src.glob(pattern):
-                shutil.copyfile(path, work / path.name)
+        files = stage_project_rtl(rtl_dir, work, TimingError)
+        ytool = choose_yosys(yosys)
+        if ytool is None:
+            raise TimingError(timing_missing_reason(yosys) or "no Yosys")
         script = synth_ecp5_script(files).replace(" -json netlist.json", " -flatten")
         (work / "synth.ys").write_text(script + f"tee -q -o stat.txt stat -top {TOP}\n",
                                        encoding="utf-8")

@@ -22,6 +22,24 @@ TB_TOP = "rfl_tb"
 NODE_FILE = "rfl_node.v"
 
 
+def stage_project_rtl(rtl_dir: str | Path, work: Path, error: type[Exception]) -> list[str]:
+    """Copy the Verilog (``.v``, ``.vh``) of ``rtl_dir``, a generated project's ``rtl/``, into
+    ``work``, and return the design's ``.v`` files by name, sorted (the testbenches left out).
+
+    Raises:
+        error: there is no :data:`NODE_FILE` in ``rtl_dir``.
+    """
+    src = Path(rtl_dir)
+    if not (src / NODE_FILE).is_file():
+        raise error(f"{src / NODE_FILE} not found: is {src} the rtl/ folder of a project "
+                    "written by 'rosfpga-lab generate'?")
+    testbenches = {p.name for p in TB_DIR.glob("*.v")}
+    for pattern in ("*.v", "*.vh"):
+        for path in src.glob(pattern):
+            shutil.copyfile(path, work / path.name)
+    return sorted(p.name for p in src.glob("*.v") if p.name not in testbenches)
+
+
 def find_tool(name: str) -> str | None:
     """``name`` on PATH, or beside this Python (a virtual environment's ``bin``)."""
     found = shutil.which(name)
@@ -74,4 +92,4 @@ def find_simulator(prefer: str | None = None) -> str:
 
 
 __all__ = ["HARNESS_DIR", "NODE_FILE", "TB_DIR", "TB_TOP", "VERILOG_DIR", "cxx_compiler",
-           "find_simulator", "find_tool", "simulator_missing_reason"]
+           "find_simulator", "find_tool", "simulator_missing_reason", "stage_project_rtl"]
