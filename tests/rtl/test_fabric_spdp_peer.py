@@ -13,7 +13,8 @@ counted, never taken, no pulse; our own announcement (looped back) is ignored; a
 announcement of the peer with another port updates it (two pulses again); after the peer's
 lease (announced 1000 s, capped at rtps.limits.MAX_LEASE_SECONDS, TICK clocks a second) another
 participant takes the place, not before, and after the peer's goodbye at once (another's
-goodbye changes nothing); cut parameter lists, a huge parameter length, a
+goodbye changes nothing; a real Cyclone DDS participant's announcement and goodbye likewise);
+cut parameter lists, a huge parameter length, a
 locator of another kind only, an unknown encapsulation and a short octetsToInlineQos are
 refused and counted; two pulses per peer change, no more.
 """
@@ -161,19 +162,25 @@ def test_the_circuit_learns_its_peer_from_spdp_and_refuses_the_rest(tmp_path: Pa
 
 CYCLONE_DOMAIN = 227
 CAPTURE = """
-import os, sys, time
+import gc, sys, time
 from cyclonedds.domain import DomainParticipant
 dp = DomainParticipant(int(sys.argv[1]))
 time.sleep(float(sys.argv[2]))
+del dp       # deleting the participant sends its goodbye
+gc.collect()
+time.sleep(1.0)
 """
 
 
-def test_a_cyclone_dds_participants_spdp_is_learned(tmp_path: Path) -> None:
+def test_a_cyclone_dds_participants_spdp_and_goodbye_are_learned(tmp_path: Path) -> None:
     """A real Cyclone DDS participant (PyPI cyclonedds, configured as the fabric's peers are:
     ``fabric_peer_uri``) announces itself to the discovery port of participant index 0, bound
-    here first; its SPDP datagram, captured, goes to the circuit from 127.0.0.1: the peer it
-    learns is the first UDPv4 metatraffic and default locators the lab's software decoder
-    reads in it (``rtps.discovery.parse_parameters``, ``rtps.build.Locator.decode``)."""
+    here first, and says goodbye when it is deleted; both datagrams, captured, go to the
+    circuit from 127.0.0.1: the peer it learns is the first UDPv4 metatraffic and default
+    locators the lab's software decoder reads in the announcement
+    (``rtps.discovery.parse_parameters``, ``rtps.build.Locator.decode``); another participant
+    (B) is refused while Cyclone's lives, and taken at once after Cyclone's own goodbye
+    (its status info, read here with ``rtps.build``'s ids, disposed and unregistered)."""
     import importlib.util
     import os
     import socket
@@ -181,7 +188,7 @@ def test_a_cyclone_dds_participants_spdp_is_learned(tmp_path: Path) -> None:
     import sys
 
     from rosfpga_lab.component.fabricsim import fabric_peer_uri
-    from rosfpga_lab.rtps.discovery import PL_CDR_LE, parse_parameters
+    from rosfpga_lab.rtps.discovery import PL_CDR_BE, PL_CDR_LE, parse_parameters
     from rosfpga_lab.rtps.entities import discovery_port
     from rosfpga_lab.rtps.message import Data, parse_message
     from tests.support.realros import skip_or_fail as skip
@@ -192,18 +199,27 @@ def test_a_cyclone_dds_participants_spdp_is_learned(tmp_path: Path) -> None:
     sock.bind(("127.0.0.1", discovery_port(CYCLONE_DOMAIN, 0)))
     sock.settimeout(15)
     env = dict(os.environ, CYCLONEDDS_URI=fabric_peer_uri(lease_seconds=7))
-    proc = subprocess.Popen([sys.executable, "-c", CAPTURE, str(CYCLONE_DOMAIN), "4"], env=env)
+    proc = subprocess.Popen([sys.executable, "-c", CAPTURE, str(CYCLONE_DOMAIN), "2"], env=env)
+    announce: tuple[bytes, bytes, Data] | None = None
+    bye = None
     try:
-        while True:
+        while bye is None:
             raw, source = sock.recvfrom(65536)
-            datas = [(src, sub) for src, _dst, sub in parse_message(raw).routed()
-                     if isinstance(sub, Data) and sub.writer_id == SPDP_WRITER and sub.payload]
-            if datas:
-                break
+            for prefix, _dst, sub in parse_message(raw).routed():
+                if not (isinstance(sub, Data) and sub.writer_id == SPDP_WRITER):
+                    continue
+                status = parse_parameters(
+                    (PL_CDR_LE if sub.flags & 1 else PL_CDR_BE) + b"\0\0" + sub.inline_qos
+                ).get(b.PID_STATUS_INFO) if sub.inline_qos else None
+                if status and status[0][3] & 3 == 3:
+                    bye = raw
+                elif announce is None and sub.payload:
+                    announce = (raw, prefix, sub)
     finally:
         sock.close()
         proc.wait(timeout=30)
-    prefix, data = datas[0]
+    assert announce is not None, "Cyclone's goodbye came before any announcement"
+    raw, prefix, data = announce
     little = data.payload[:2] == PL_CDR_LE
     params = parse_parameters(data.payload)
 
@@ -212,10 +228,18 @@ def test_a_cyclone_dds_participants_spdp_is_learned(tmp_path: Path) -> None:
         return [_ip(loc.address), loc.port]
 
     SOURCES[prefix] = source[0]
-    out = _run([(raw, 2 * IDLE)], tmp_path)
+    b_lab = spdp(B, [(1, 7420, "10.1.2.6")], [(1, 7421, "10.1.2.7")])
+    # a second is 20 TICKs here: Cyclone's 7 s lease (over 2,800 clocks) outlasts the run up to
+    # B's second announcement, so only Cyclone's goodbye can free the place for B
+    tick = 20 * TICK
+    assert len(raw) + 2 * len(b_lab) + len(bye) + 5 * IDLE < 7 * tick
+    out = _run([(raw, 2 * IDLE), (b_lab, IDLE), (bye, 2 * IDLE), (b_lab, 2 * IDLE)], tmp_path,
+               tick)
     want = [1, *first(b.PID_METATRAFFIC_UNICAST_LOCATOR), *first(b.PID_DEFAULT_UNICAST_LOCATOR)]
-    assert out["peer"] == want and [p["peer"] for p in out["pulses"]] == [want, want]
-    assert out["counters"] == [1, 0, 0]
+    b1 = [1, _ip("10.1.2.6"), 7420, _ip("10.1.2.7"), 7421]
+    assert [p["peer"] for p in out["pulses"]] == [want, want, b1, b1]
+    assert out["peer"] == b1
+    assert out["counters"] == [2, 0, 1]          # learned Cyclone's, then B's; B once refused
     (tmp_path / "cyclone_spdp.bin").write_bytes(raw)
 
 
