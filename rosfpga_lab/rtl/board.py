@@ -44,7 +44,8 @@ CLOCK_HZ = 125_000_000
 DEFAULT_MAC = "02:52:46:4c:00:02"
 #: The files of the board build, in read order (the vendored core's board variant first).
 BOARD_FILES = ("vendor/liteeth_udp_ecp5_rgmii.v", "rfl_udp_store.v", "rfl_udp_port.v",
-               *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_fabric_top.v", f"{BOARD_TOP}.v")
+               *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_counter_readout.v", "rfl_fabric_top.v",
+               f"{BOARD_TOP}.v")
 LPF_FILE = f"{BOARD_TOP}.lpf"
 DEFINE = "RFL_FABRIC_RGMII"
 #: Bits of the board's own parameters (sized hex in Verilog).

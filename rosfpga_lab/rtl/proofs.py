@@ -41,12 +41,13 @@ FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
 FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
                   "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v",
                   "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_spdp_peer.v",
-                  "rfl_fabric_top.v", "rfl_board_5a75b.v")
+                  "rfl_counter_readout.v", "rfl_fabric_top.v", "rfl_board_5a75b.v")
 ENV_INCLUDE = "fv_env.vh"
 #: Included from FABRIC_DIR: the parameter lists the fabric's tops share (declared, passed on),
 #: and the RTPS wire vocabulary the stages share (submessage ids, header magic and version).
 FABRIC_INCLUDES = ("rfl_fabric_node_params.vh", "rfl_fabric_node_pass.vh",
-                   "rfl_fabric_top_params.vh", "rfl_fabric_top_pass.vh", "rfl_rtps_wire.vh")
+                   "rfl_fabric_top_params.vh", "rfl_fabric_top_pass.vh", "rfl_rtps_wire.vh",
+                   "rfl_fabric_counters.vh")
 #: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node aside:
 #: the project's; the proof's wrapper has its own).
 FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
@@ -54,7 +55,7 @@ FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_
                "rfl_fabric_node.v")
 #: rfl_fabric_top's files for simulation (LiteEth's GMII variant), relative to FABRIC_DIR.
 FABRIC_TOP_GMII = ("vendor/liteeth_udp_gmii.v", "rfl_udp_store.v", "rfl_udp_port.v",
-                   *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_fabric_top.v")
+                   *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_counter_readout.v", "rfl_fabric_top.v")
 
 
 @dataclass(frozen=True)
