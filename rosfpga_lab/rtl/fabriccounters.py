@@ -34,12 +34,13 @@ import struct
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from rosfpga_lab.graph.udpports import ask
 from rosfpga_lab.rtl.errors import RtlError
 
 __all__ = ["ANSWERS_PER_SECOND", "CountersError", "FABRIC_COUNTERS", "INCLUDE_FILE", "MAGIC",
            "NODE_COUNTERS", "NODE_INSTANCE", "NODE_MODULE", "READOUT_MODULE", "StageCounter",
            "answer_bytes", "counters_gap", "cxx_header", "node_wires", "parse_answer",
-           "request", "stage_lines", "verilator_config", "verilog_include"]
+           "read_counters", "request", "stage_lines", "verilator_config", "verilog_include"]
 
 #: The node's module and its instance in ``rfl_fabric_top``.
 NODE_MODULE, NODE_INSTANCE = "rfl_fabric_node", "u_node"
@@ -158,6 +159,21 @@ def parse_answer(data: bytes) -> dict[str, int]:
                             f"{len(FABRIC_COUNTERS)} (a bitstream of another version)")
     values = struct.unpack_from(f">{count}I", data, 8)
     return {c.key: v for c, v in zip(FABRIC_COUNTERS, values)}
+
+
+def read_counters(host: str, port: int, timeout: float = 1.0) -> dict[str, int]:
+    """Ask the counter readout at ``host``:``port`` (a board, or ``fabric sim``) for the counters.
+
+    Raises:
+        CountersError: no answer within ``timeout`` seconds, or not the readout's.
+        GraphError: the request could not be sent.
+    """
+    data = ask(host, port, request(), timeout)
+    if data is None:
+        raise CountersError(f"no answer from {host}:{port} within {timeout:g} s: is the board "
+                            "up / fabric sim running? (a request within a millisecond of "
+                            "another one's answer is dropped: ask again)")
+    return parse_answer(data)
 
 
 def _packed(counters: tuple[StageCounter, ...]) -> str:

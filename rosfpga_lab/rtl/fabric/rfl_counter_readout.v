@@ -142,34 +142,45 @@ module rfl_counter_readout #(
     assign cnt_limited = c_lim;
 
 `ifdef FORMAL
-    // Proven (fv_counter_readout): the output keeps the stream rules with its destination; an
-    // answer is BYTES beats, TLAST on the last alone; bytes out never exceed the bytes of
-    // well-formed requests in (f_credit, saturating: a lower bound of that difference), and an
-    // answer going out has its remaining bytes covered; no answer starts within GAP clocks of
-    // the last one's start; counters never fall.
-    reg f_past;
+    // Proven (fv_counter_readout): the output keeps the stream rules with its destination, held
+    // over an answer; an answer is BYTES beats (from 0, one a beat, TLAST on the last alone),
+    // the magic word and the count first; the bytes out never
+    // exceed the bytes of well-formed requests in (f_credit: that difference, saturating, so a
+    // lower bound of it), the rest of an answer going out covered; an answer starts GAP clocks
+    // or more after the last one started; always ready; the counters never fall.
     reg [15:0] f_credit;
-    reg [NB-1:0] f_gap_age;                     // clocks since the last answer started (sat.)
-    initial f_past = 1'b0;
-    always @(posedge clk) f_past <= 1'b1;
-    wire [15:0] f_left = sending ? BYTES - an : 16'd0;
+    reg [NG-1:0] f_age;                         // clocks since the last answer started (sat.)
+    localparam [15:0] F_BYTES = BYTES[15:0];
+    wire [15:0] f_left = sending ? F_BYTES - {{(16-NB){1'b0}}, an} : 16'd0;
     always @(posedge clk) begin
-        if (!rst_n) f_credit <= 16'd0;
-        else f_credit <= (good && f_credit > 16'hffff - BYTES ? 16'hffff
-                          : f_credit + (good ? BYTES : 0)) - (out ? 16'd1 : 16'd0);
+        if (!rst_n) begin
+            f_credit <= 16'd0;
+            f_age <= GAP_N;
+        end else begin
+            f_credit <= (good && f_credit > 16'hffff - F_BYTES ? 16'hffff
+                         : f_credit + (good ? F_BYTES : 16'd0)) - (out ? 16'd1 : 16'd0);
+            f_age <= accept ? {NG{1'b0}} : (f_age == GAP_N ? f_age : f_age + 1'b1);
+        end
     end
-    always @(*) if (f_past && rst_n) begin
-        assert(f_credit >= f_left);
-        assert(an <= LAST_AT);
-        if (sending) assert(gap > GAP_N - BYTES || GAP < BYTES || an >= GAP_N - gap);
+    always @(*) if (rst_n) begin
         assert(s_axis_tready);
+        assert(f_credit >= f_left);
+        assert(f_age <= GAP_N && gap == GAP_N - f_age);
+        if (accept) assert(f_age == GAP_N);
+        if (sending) assert(an <= LAST_AT);
+        if (sending && an < 4) assert(word == MAGIC);
+        if (sending && an >= 4 && an < 8) assert(word == TOTAL);
+        assert(m_axis_tvalid == sending);
     end
-    always @(posedge clk) if (f_past && $past(rst_n) && rst_n) begin
+    reg f_past;
+    initial f_past = 1'b0;
+    always @(posedge clk) f_past <= rst_n;
+    always @(posedge clk) if (f_past && rst_n) begin
         if ($past(m_axis_tvalid && !m_axis_tready))
             assert(m_axis_tvalid && $stable({m_axis_tdata, m_axis_tlast, m_ip, m_port}));
         if ($past(m_axis_tvalid && m_axis_tready && !m_axis_tlast))
-            assert(m_axis_tvalid && $stable({m_ip, m_port}));
-        if (m_axis_tvalid && !$past(m_axis_tvalid)) assert(an == 0 && gap == GAP_N);
+            assert(m_axis_tvalid && $stable({m_ip, m_port}) && an == $past(an) + 1'b1);
+        if (m_axis_tvalid && !$past(m_axis_tvalid)) assert(an == {NB{1'b0}});
         assert(c_ans >= $past(c_ans) && c_bad >= $past(c_bad) && c_lim >= $past(c_lim));
     end
 `endif

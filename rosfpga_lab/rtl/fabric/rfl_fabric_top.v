@@ -245,7 +245,7 @@ module rfl_fabric_top #(
     wire [31:0] cr_answered, cr_malformed, cr_limited;  // in its answers
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_counter_readout #(.COUNT(`RFL_TOP_COUNTER_COUNT), .MAGIC(`RFL_COUNTERS_MAGIC),
-                          .GAP(COUNTERS_GAP)) u_counters (
+                          .GAP(COUNTERS_GAP < 1 ? 1 : COUNTERS_GAP)) u_counters (  // 0: UNSET
         .clk(clk), .rst_n(rst_n), .counters(`RFL_TOP_COUNTER_BUS),
         .s_axis_tdata(p_rx_tdata), .s_axis_tvalid(p_rx_tvalid && to_cnt),
         .s_axis_tready(r_in_ready), .s_axis_tlast(p_rx_tlast), .s_ip(p_rx_ip),
