@@ -17,7 +17,10 @@ import numpy as np
 import pytest
 
 from rosfpga_lab.config import load_config
-from rosfpga_lab.graph.ethframe import ArpRequest, UdpDatagram, arp_reply, parse_frame, udp_frame
+from rosfpga_lab.component.fabricsim import HOST_MAC as SHIM_HOST_MAC
+from rosfpga_lab.graph.ethframe import (
+    ArpRequest, UdpDatagram, arp_reply, mac_bytes, parse_frame, udp_frame,
+)
 from rosfpga_lab.rtl.board import DEFAULT_MAC, mac_value
 from rosfpga_lab.rtl.discrom import counters_port, render_rom
 from rosfpga_lab.rtl.fabriccounters import (
@@ -34,7 +37,7 @@ from tests.support.rtltools import require_fabric_sim
 pytestmark = pytest.mark.rtl
 
 NODE_IP, HOST_IP = "192.168.10.2", "192.168.10.1"
-HOST_MAC = bytes.fromhex("02524c4c0001")
+HOST_MAC = mac_bytes(SHIM_HOST_MAC)
 NODE_MAC = mac_value(DEFAULT_MAC).to_bytes(6, "big")
 PERIOD = 400_000                    # the gap: 400 clocks
 ASKER = 40001
