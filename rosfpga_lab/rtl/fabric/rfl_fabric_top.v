@@ -93,19 +93,19 @@ module rfl_fabric_top #(
 `ifdef __ICARUS__
     initial begin
         if (UNSET)
-            $fatal(1, "rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT, SPDP_GROUP, COUNTERS_PORT and COUNTERS_GAP");
+            $fatal(1, "rfl_fabric_top: set the *_PORT parameters, SPDP_GROUP and COUNTERS_GAP");
         if (SPDP_PORT < 0 || SPDP_PORT > 65535 || META_PORT < 0 || META_PORT > 65535 ||
             USER_PORT < 0 || USER_PORT > 65535 || COUNTERS_PORT < 0 || COUNTERS_PORT > 65535)
             $fatal(1, "rfl_fabric_top: the ports must be 1..65535");
         if (!UNSET && SAME)
-            $fatal(1, "rfl_fabric_top: SPDP_PORT, META_PORT, USER_PORT and COUNTERS_PORT must differ");
+            $fatal(1, "rfl_fabric_top: the four *_PORT parameters must differ");
         if (!UNSET && SPDP_GROUP[31:28] != 4'he)
             $fatal(1, "rfl_fabric_top: SPDP_GROUP must be an IPv4 multicast group");
     end
 `else
 `ifndef FORMAL
     if (UNSET) begin : g_unset
-        $error("rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT, SPDP_GROUP, COUNTERS_PORT and COUNTERS_GAP");
+        $error("rfl_fabric_top: set the *_PORT parameters, SPDP_GROUP and COUNTERS_GAP");
     end
 `endif
     if (SPDP_PORT < 0 || SPDP_PORT > 65535 || META_PORT < 0 || META_PORT > 65535 ||
@@ -114,7 +114,7 @@ module rfl_fabric_top #(
         $error("rfl_fabric_top: the ports must be 1..65535");
     end
     if (!UNSET && SAME) begin : g_same_ports
-        $error("rfl_fabric_top: SPDP_PORT, META_PORT, USER_PORT and COUNTERS_PORT must differ");
+        $error("rfl_fabric_top: the four *_PORT parameters must differ");
     end
     if (!UNSET && SPDP_GROUP[31:28] != 4'he) begin : g_bad_group
         $error("rfl_fabric_top: SPDP_GROUP must be an IPv4 multicast group");
