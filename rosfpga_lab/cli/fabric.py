@@ -24,7 +24,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "fabric", help="the ROS 2 node in the fabric: simulate the network-attached top",
         description="The ROS 2 node in the fabric (rtl/fabric/rfl_fabric_top.v: LiteEth's "
-        "UDP/IP core, RTPS and the generated CDR circuit). 'fabric sim CONFIG' runs it.")
+        "UDP/IP core, RTPS and the generated CDR circuit). 'fabric sim CONFIG' runs it; "
+        "'fabric counters' reads its counters over the network (a board, or fabric sim).")
     sub = parser.add_subparsers(dest="fabric_command", metavar="ACTION")
     p = sub.add_parser(
         "sim", help="run the whole network-attached top in Verilator, bridged to the host",
@@ -78,7 +79,56 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    "from the SPDP it reads, instead of the circuit learning it (cfg_learn)")
     p.add_argument("-q", "--quiet", action="store_true", help="print only the counters")
     p.set_defaults(func=run_sim)
+    c = sub.add_parser(
+        "counters", help="read the circuit's counters over UDP (a board, or fabric sim)",
+        description="Ask the node in the fabric for its counters: one UDP datagram to its "
+        "counter readout's port, one back with every counter (the top's, the RTPS stages', the "
+        "readout's own; rtl/fabric/rfl_counter_readout.v), printed by name. Works on a board "
+        "and against 'fabric sim' (--tap: the node is 10.31.0.2; the shim: 127.0.0.1). The "
+        "readout answers at most 1000 requests a second and only well-formed ones; all others "
+        "are dropped and counted. Example: rosfpga-lab fabric counters --host 10.31.0.2")
+    c.add_argument("--host", default=None, metavar="IP",
+                   help="the node's address (default 10.31.0.2: the board's and fabric sim "
+                   "--tap's)")
+    c.add_argument("--port", type=positive_int, default=None, metavar="P",
+                   help="its counters port (default: the one of --domain, 7408 in domain 0)")
+    c.add_argument("--domain", type=int, default=0, metavar="ID",
+                   help="the DDS domain the node is in (gives the default --port; default 0)")
+    c.add_argument("--timeout", type=float, default=1.0, metavar="S",
+                   help="seconds to wait for the answer (default 1)")
+    c.add_argument("--json", action="store_true", help="print them as one JSON object")
+    c.set_defaults(func=run_counters)
     parser.set_defaults(func=lambda args: parser.print_help() or 2)
+
+
+def run_counters(args: argparse.Namespace) -> int:
+    """Ask for the counters, print them (name value a line, or JSON); 1 on no answer."""
+    import json
+
+    from rosfpga_lab.component.fabricsim import TAP_NODE_ADDRESS
+    from rosfpga_lab.errors import LabError
+    from rosfpga_lab.rtl.discrom import counters_port
+    from rosfpga_lab.rtl.fabriccounters import read_counters
+    from rosfpga_lab.rtps.entities import check_domain
+
+    if args.timeout <= 0:
+        print("rosfpga-lab fabric counters: error: --timeout must be positive", file=sys.stderr)
+        return 2
+    check_domain(args.domain)
+    host = args.host or TAP_NODE_ADDRESS
+    port = args.port or counters_port(args.domain)
+    try:
+        values = read_counters(host, port, args.timeout)
+    except LabError as exc:
+        print(f"rosfpga-lab fabric counters: error: {exc}", file=sys.stderr)
+        return 1
+    if args.json:
+        print(json.dumps(values))
+    else:
+        width = max(map(len, values))
+        for key, value in values.items():
+            print(f"{key:<{width}}  {value}")
+    return 0
 
 
 def run_sim(args: argparse.Namespace) -> int:
@@ -119,7 +169,8 @@ def run_sim(args: argparse.Namespace) -> int:
                  "127.0.0.1 through the shim")
         say(f"ready: the node is participant 0 of domain {args.domain} at "
             f"{bridge.rom.address}, UDP ports {bridge.meta} (metatraffic) and {bridge.user} "
-            f"(user data), on {where}; running {args.seconds:g} s (Ctrl-C stops)")
+            f"(user data), counters on {bridge.counters} (rosfpga-lab fabric counters --host "
+            f"{bridge.rom.address}), on {where}; running {args.seconds:g} s (Ctrl-C stops)")
         with StopSignals(raise_interrupt=False) as stop:   # SIGINT, SIGTERM: counters, then out
             _bridge(bridge, args.seconds, lambda: stop.fired is not None, started)
         if stop.fired is not None:

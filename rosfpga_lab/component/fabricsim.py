@@ -7,7 +7,7 @@ the peers reach the node at, builds (or takes from the cache) the Verilator mode
 between its PHY side and the host:
 
 * :class:`ShimBridge` (no root needed): binds the node's metatraffic and user-data UDP ports on
-  127.0.0.1 (the locators its SPDP and SEDP announce), wraps each datagram a peer sends there
+  127.0.0.1 (the locators its SPDP and SEDP announce) and its counter readout's port, wraps each datagram a peer sends there
   into an Ethernet/IPv4/UDP frame for the PHY (:mod:`rosfpga_lab.graph.ethframe`: IPv4 header
   checksum, FCS), and unwraps the circuit's frames back into datagrams, sent from the port the
   circuit sent from: the circuit's SPDP (to the SPDP multicast group) goes to the unicast
@@ -80,7 +80,7 @@ from rosfpga_lab.graph.ethframe import (
 from rosfpga_lab.graph.tap import TapDevice
 from rosfpga_lab.graph.udpports import UdpPorts
 from rosfpga_lab.rtl.board import DEFAULT_MAC, mac_value
-from rosfpga_lab.rtl.discrom import DiscoveryRom, render_rom
+from rosfpga_lab.rtl.discrom import DiscoveryRom, counters_port, render_rom
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.rtl.fabricsim import (
     SIM_PERIOD, SIM_RATE, FabricConfig, FabricSim, build_fabric_sim, fabric_top_default,
@@ -242,6 +242,7 @@ class _PeerKeeper:
         self.node_mac, self.host_mac = mac_bytes(node_mac), mac_bytes(HOST_MAC)
         self.meta, self.user = discovery_port(rom.domain, rom.index), user_port(rom.domain,
                                                                                 rom.index)
+        self.counters = counters_port(rom.domain)      # the counter readout's
         self.counts = BridgeCounts()
         self.peer: Peer | None = None
         self._known = {rom.guid_prefix}      # participants seen (their SPDP repeats)
@@ -289,7 +290,7 @@ class ShimBridge(_PeerKeeper):
                  node_mac: str = DEFAULT_MAC, bridge_peer: bool = False,
                  log: Callable[[str], None] = lambda line: None) -> None:
         super().__init__(sim, rom, node_mac=node_mac, bridge_peer=bridge_peer, log=log)
-        self.ports = UdpPorts(rom.address, [self.meta, self.user])
+        self.ports = UdpPorts(rom.address, [self.meta, self.user, self.counters])
         self._ident = 0
         self._asked: set[bytes] = set()
         self.readers: dict[str, tuple[str, int]] = {}   # DDS topic -> a reader's own locator

@@ -1,17 +1,20 @@
 """A set of UDP ports bound on one address, waited on together: the host side of a simulated
 network port (``rosfpga-lab fabric sim --shim`` binds the node's metatraffic and user-data
-ports on 127.0.0.1 and sends what the circuit sends from them).
+ports on 127.0.0.1 and sends what the circuit sends from them); and :func:`ask`, one datagram
+out and the first one back (``rosfpga-lab fabric counters``).
 """
 
 from __future__ import annotations
 
 import errno
+import select
 import socket
+import time
 
 from rosfpga_lab.graph.errors import GraphError
 from rosfpga_lab.graph.limits import ROS2_SOCKET_BUFFER_BYTES
 
-__all__ = ["UdpPorts"]
+__all__ = ["UdpPorts", "ask"]
 
 #: The largest UDP payload read at once.
 _READ_BYTES = 65535
@@ -69,3 +72,27 @@ class UdpPorts:
         for s in self.sockets.values():
             s.close()
         self.sockets.clear()
+
+
+def ask(host: str, port: int, payload: bytes, timeout: float) -> bytes | None:
+    """Send ``payload`` to ``host``:``port`` from a fresh UDP port and return the first datagram
+    that comes back from that address and port within ``timeout`` seconds (None: none came).
+
+    Raises:
+        GraphError: the datagram could not be sent (no route, a bad address).
+    """
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        try:
+            s.connect((host, port))     # only its answers come in
+            s.send(payload)
+        except OSError as exc:
+            raise GraphError(f"cannot send to {host}:{port}: {exc}") from None
+        end = time.monotonic() + timeout
+        while (left := end - time.monotonic()) > 0:
+            if not select.select([s], [], [], left)[0]:
+                break
+            try:
+                return s.recv(_READ_BYTES)
+            except ConnectionRefusedError:     # an ICMP port unreachable: nobody there yet
+                return None
+    return None

@@ -20,7 +20,7 @@ import sys
 from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig
-from rosfpga_lab.rtl.discrom import DiscoveryRom, fabric_top_literals
+from rosfpga_lab.rtl.discrom import DiscoveryRom, counters_port, fabric_top_literals
 from rosfpga_lab.rtl.errors import RtlError
 from rosfpga_lab.rtl.limits import ECP5_DEVICE, ECP5_PACKAGE
 from rosfpga_lab.rtl.project import node_sources
@@ -44,7 +44,8 @@ CLOCK_HZ = 125_000_000
 DEFAULT_MAC = "02:52:46:4c:00:02"
 #: The files of the board build, in read order (the vendored core's board variant first).
 BOARD_FILES = ("vendor/liteeth_udp_ecp5_rgmii.v", "rfl_udp_store.v", "rfl_udp_port.v",
-               *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_fabric_top.v", f"{BOARD_TOP}.v")
+               *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_counter_readout.v", "rfl_fabric_top.v",
+               f"{BOARD_TOP}.v")
 LPF_FILE = f"{BOARD_TOP}.lpf"
 DEFINE = "RFL_FABRIC_RGMII"
 #: Bits of the board's own parameters (sized hex in Verilog).
@@ -181,6 +182,15 @@ The DDS implementation must use that interface for SPDP's multicast
 keeps one peer).
 Other addresses: `rosfpga-lab generate CONFIG -o DIR --target fabric --address IP --peer-ip IP
 --mac MAC` ({BOARD_DIR}/parameters.json has what this build was given).
+
+## The circuit's counters
+
+What the circuit refuses it drops and counts (rosfpga_lab/rtl/fabric/vendor/README.md, "What
+the node refuses"). No bus is needed to read the counters: the circuit answers a request on UDP
+port {counters_port(rom.domain)} with one datagram holding every counter (at most 1000 answers a
+second; anything else sent there is dropped and counted):
+
+    rosfpga-lab fabric counters --host {rom.address} --domain {rom.domain}     # --json for a script
 """
 
 

@@ -78,6 +78,7 @@ from pathlib import Path
 
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.rtl.errors import RtlError
+from rosfpga_lab.rtl.fabriccounters import counters_gap
 from rosfpga_lab.rtl.limits import (
     ANSWER_BURST, ANSWER_RATE, FABRIC_MAX_DATAGRAM, MAX_ANSWER_SEQ, MAX_ANSWER_SLOTS,
     MAX_DISC_ROM_BYTES,
@@ -462,14 +463,27 @@ def spdp_parameters() -> dict[str, int]:
             "SPDP_LEASE_MAX": round(MAX_LEASE_SECONDS)}
 
 
+#: The counter readout's port past the domain's SPDP multicast port: within the domain's range
+#: of ports, one the RTPS mapping gives no participant (its offsets are 0, 1, 10 + 2i, 11 + 2i).
+COUNTERS_PORT_OFFSET = 8
+
+
+def counters_port(domain: int) -> int:
+    """The UDP port the fabric node's counter readout answers on in ``domain`` (7408 in domain
+    0; ``fabric/rfl_counter_readout.v``, :mod:`rosfpga_lab.rtl.fabriccounters`)."""
+    return discovery_multicast_port(domain) + COUNTERS_PORT_OFFSET
+
+
 def top_parameters(rom: DiscoveryRom) -> dict[str, int]:
     """The network parameters of ``fabric/rfl_fabric_top.v`` for the participant ``rom`` was
     rendered for (one owner: the RTPS port mapping of :mod:`rosfpga_lab.rtps.entities` and the
-    SPDP group of :mod:`rosfpga_lab.rtps.limits`, as :meth:`DiscoveryRom.ports` names them), and
-    its SPDP learner's constants (:func:`spdp_parameters`)."""
+    SPDP group of :mod:`rosfpga_lab.rtps.limits`, as :meth:`DiscoveryRom.ports` names them; the
+    counter readout's port, :func:`counters_port`), and its SPDP learner's constants
+    (:func:`spdp_parameters`)."""
     return {"SPDP_PORT": discovery_multicast_port(rom.domain),
             "META_PORT": discovery_port(rom.domain, rom.index),
             "USER_PORT": user_port(rom.domain, rom.index),
+            "COUNTERS_PORT": counters_port(rom.domain),
             "SPDP_GROUP": int(ipaddress.IPv4Address(SPDP_MULTICAST_ADDRESS)),
             **spdp_parameters()}
 
@@ -508,6 +522,8 @@ def node_parameters(rom: DiscoveryRom, *, period: int) -> dict[str, str]:
 
 def fabric_top_literals(rom: DiscoveryRom, *, period: int) -> dict[str, str]:
     """``fabric/rfl_fabric_top.v``'s parameters as Verilog literals: the node's
-    (:func:`node_parameters`) and the ports (:func:`top_parameters`); the board top, the simulated
-    top, the demo and the tests take them from here."""
-    return {**node_parameters(rom, period=period), **verilog_parameters(top_parameters(rom))}
+    (:func:`node_parameters`), the ports (:func:`top_parameters`) and the counter readout's gap
+    (a second of ``period`` clocks, :func:`~rosfpga_lab.rtl.fabriccounters.counters_gap`); the
+    board top, the simulated top, the demo and the tests take them from here."""
+    return {**node_parameters(rom, period=period), **verilog_parameters(top_parameters(rom)),
+            "COUNTERS_GAP": str(counters_gap(period))}

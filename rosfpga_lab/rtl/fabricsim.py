@@ -41,7 +41,9 @@ from pathlib import Path
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.rtl.discrom import DiscoveryRom, fabric_top_literals, write_rom
 from rosfpga_lab.rtl.errors import RtlError
-from rosfpga_lab.rtl.fabriccounters import NODE_COUNTERS, cxx_header, verilator_config
+from rosfpga_lab.rtl.fabriccounters import (
+    FABRIC_COUNTERS, NODE_COUNTERS, cxx_header, verilator_config,
+)
 from rosfpga_lab.rtl.generic import generic_rtl_files
 from rosfpga_lab.rtl.limits import BUILD_TIMEOUT, FABRIC_SIM_MAX_RECORD
 from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, FABRIC_TOP_GMII
@@ -63,10 +65,10 @@ SOURCES = (*FABRIC_TOP_GMII, *FABRIC_INCLUDES)
 #: credit, then the generated subscriber's verdicts: samples judged, refused, the last refusal's
 #: status code, the walk's table: ``spec.program.statuses``), then the SPDP learner's
 #: (rfl_spdp_peer: peers taken or changed, announcements refused, others while the peer lives).
-COUNTERS = ("samples", "answers", "no_credit", "rx_packets", "rx_error", "rx_length",
-            "rx_overflow", "tx_packets", "tx_overflow", "rx_port", "rx_header", "rx_other",
-            "credit", "judged", "refused", "last_refusal", "peer_learned", "peer_refused",
-            "peer_other")
+#: The top's names are rtl.fabriccounters' (its FABRIC_COUNTERS of scope "top", in its order).
+_TOP_COUNTERS = tuple(c.key for c in FABRIC_COUNTERS if c.scope == "top")
+COUNTERS = (*_TOP_COUNTERS[:12], "credit", "judged", "refused", "last_refusal",
+            *_TOP_COUNTERS[12:])
 #: The simulation's SPDP period in clocks and the clock rate it is run at (clocks per second of
 #: wall time): an announcement about every second, as the board's (rtps.limits.ANNOUNCE_SECONDS
 #: at 125 MHz), if the model keeps up.

@@ -41,12 +41,13 @@ FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
 FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
                   "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v",
                   "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_spdp_peer.v",
-                  "rfl_fabric_top.v", "rfl_board_5a75b.v")
+                  "rfl_counter_readout.v", "rfl_fabric_top.v", "rfl_board_5a75b.v")
 ENV_INCLUDE = "fv_env.vh"
 #: Included from FABRIC_DIR: the parameter lists the fabric's tops share (declared, passed on),
 #: and the RTPS wire vocabulary the stages share (submessage ids, header magic and version).
 FABRIC_INCLUDES = ("rfl_fabric_node_params.vh", "rfl_fabric_node_pass.vh",
-                   "rfl_fabric_top_params.vh", "rfl_fabric_top_pass.vh", "rfl_rtps_wire.vh")
+                   "rfl_fabric_top_params.vh", "rfl_fabric_top_pass.vh", "rfl_rtps_wire.vh",
+                   "rfl_fabric_counters.vh")
 #: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node aside:
 #: the project's; the proof's wrapper has its own).
 FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
@@ -54,7 +55,7 @@ FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_
                "rfl_fabric_node.v")
 #: rfl_fabric_top's files for simulation (LiteEth's GMII variant), relative to FABRIC_DIR.
 FABRIC_TOP_GMII = ("vendor/liteeth_udp_gmii.v", "rfl_udp_store.v", "rfl_udp_port.v",
-                   *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_fabric_top.v")
+                   *FABRIC_NODE, "rfl_spdp_peer.v", "rfl_counter_readout.v", "rfl_fabric_top.v")
 
 
 @dataclass(frozen=True)
@@ -204,7 +205,8 @@ PROOFS: tuple[Proof, ...] = (
           "both outputs keep the stream rules with their sideband, LiteEth never held back; 20 "
           "clocks"),
     Proof("fabric_top", ("rfl_udp_store.v", "rfl_udp_port.v", "rfl_spdp_peer.v",
-                         "rfl_fabric_top.v"), "bmc", 16,
+                         "rfl_frame_arbiter.v", "rfl_counter_readout.v", "rfl_fabric_top.v"),
+          "bmc", 16,
           "rfl_fabric_top's glue (LiteEth and rfl_fabric_node as models of any streams, "
           "rfl_udp_port's 16-byte buffers): the node takes only datagrams to the three ports, "
           "TUSER 1 exactly for the user-data port, by the stream rules; each datagram sent goes "
@@ -235,6 +237,12 @@ PROOFS: tuple[Proof, ...] = (
           "TUSER, one source ready at a time, each beat taken out the one taken from it, a "
           "datagram's source alone on the output until its TLAST (none interleaved), a source "
           "waits behind at most two datagrams; all reachable states"),
+    Proof("counter_readout", ("rfl_counter_readout.v",), "prove", 6,
+          "rfl_counter_readout (two counters: 28-byte requests and answers, a gap of 40 clocks; "
+          "any input bytes, senders, counter values, readiness): output stream rules with the "
+          "destination held over an answer, an answer exactly 28 beats starting with the magic "
+          "word and the count, bytes out at most the well-formed requests' bytes in, an answer "
+          "at most every GAP clocks, always ready, counters never fall; all reachable states"),
     Proof("fabric_node", FABRIC_NODE, "prove", 4,
           "rfl_fabric_node (every stage, small sizes, ROMs of any contents, any payloads in, "
           "the generated top a passthrough): output stream rules with TDEST and the prefix, "

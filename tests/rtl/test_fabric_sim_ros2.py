@@ -195,6 +195,63 @@ def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
     assert "bridge: peers seen: 1;" in stdout and "send_sedp pulses: 0" in stdout, stdout
 
 
+def _read_counters(host: str, domain: int) -> dict[str, int]:
+    """``rosfpga-lab fabric counters --json`` against the running command (the shim's or the
+    TAP's node address)."""
+    from rosfpga_lab.rtl.discrom import counters_port
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "fabric", "counters", "--host",
+                           host, "--port", str(counters_port(domain)), "--json"],
+                          capture_output=True, text=True, timeout=60, env=env)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+def test_fabric_counters_reads_the_circuit_after_a_cyclone_exchange(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``rosfpga-lab fabric counters`` (one UDP request to the circuit's counter readout, through
+    the shim) after a Cyclone DDS peer sent three scans and got them back: every counter by name,
+    equal to what the command prints at its end for those that did not move since (the user data
+    path's, the RTPS stages'); the readout's own say one request answered. With nothing running
+    on the port: a clear error, exit 1, within the timeout."""
+    require_fabric_sim()
+    dds = cyclone()
+    monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
+    from tests.support import cdrtypes as T
+
+    config = load_config(SCAN_CDR)
+    _build(config)
+    sent = _scans(T, SCANS)
+    with _running_cli(tmp_path) as cli:
+        peer = _CyclonePeer(dds, DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_, cli.log)
+        for msg in sent:
+            peer.writer.write(msg)
+            time.sleep(0.3)
+        peer.take(SCANS, 15)
+        read = _read_counters("127.0.0.1", DOMAIN)
+        peer.close()
+        stdout = cli.stop()
+    assert cli.proc.returncode == 0, cli.log()
+    print(json.dumps(read), stdout)
+    printed = _counters(stdout)
+    assert (read["samples"], read["rtps_samples"], read["seam_samples"], read["peer_learned"],
+            read["rx_error"], read["rx_overflow"]) == (SCANS, SCANS, SCANS, 1, 0, 0), read
+    for key in ("samples", "rx_error", "rx_length", "rx_overflow", "tx_overflow",
+                "peer_learned"):
+        assert str(read[key]) == printed[key], (key, read[key], stdout)
+    assert int(printed["rx_packets"]) > read["rx_packets"] > SCANS   # the request among them
+    assert (read["counters_answered"], read["counters_malformed"],
+            read["counters_limited"]) == (1, 0, 0)
+    # the command gone: no answer, said so
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    done = subprocess.run([sys.executable, "-m", "rosfpga_lab", "fabric", "counters", "--host",
+                           "127.0.0.1", "--domain", str(DOMAIN)], capture_output=True,
+                          text=True, timeout=60, env=env)
+    assert done.returncode == 1 and "no answer from 127.0.0.1:" in done.stderr, done.stderr
+    assert "is the board up / fabric sim running?" in done.stderr
+
+
 def test_rclpy_sees_the_fabric_node_in_the_ros2_graph(tmp_path: Path) -> None:
     """What ``ros2 node list`` / ``ros2 node info`` / ``ros2 topic list -t`` read, of the node
     whose discovery is the circuit's ROMs: the node from its ros_discovery_info sample, its
@@ -368,7 +425,8 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
     """``--tap``: the circuit's frames on a Linux TAP interface (the host 10.31.0.1/24, the node
     10.31.0.2): the host's own network stack answers ARP and routes, Cyclone DDS binds that
     interface (multicast SPDP, as on a LAN); three scans exact; tshark reads a capture of the
-    interface with no malformed packet; the interface is gone after the command."""
+    interface with no malformed packet; ``rosfpga-lab fabric counters`` reads the circuit's
+    counters over the interface; the interface is gone after the command."""
     from rosfpga_lab.graph.tap import tap_missing_reason
 
     require_fabric_sim()
@@ -397,6 +455,7 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
                 peer.writer.write(msg)
                 time.sleep(0.3)
             got = peer.take(SCANS, 15)
+            read = _read_counters(TAP_NODE_ADDRESS, TAP_DOMAIN)    # over the TAP interface
             time.sleep(0.5)
             peer.close()                       # gone before the interface is
             stop_with(dump, signal.SIGINT)
@@ -410,6 +469,8 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
     for msg, out in zip(sent, got, strict=True):
         _assert_exact(T, msg, out, pipe)
     assert _counters(stdout)["samples"] == str(SCANS), stdout
+    assert (read["samples"], read["rtps_samples"], read["counters_answered"]) == \
+        (SCANS, SCANS, 1), read
 
     def rows(display: str) -> list[str]:
         out = subprocess.run([tshark, "-r", str(capture), "-Y", display, "-T", "fields",

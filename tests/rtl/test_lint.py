@@ -322,9 +322,7 @@ def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None
 # the whole node with the generated top inside; the vendored core's own warnings (generated
 # code) are not the lab's to fix (tests/rtl/test_fabric_udp.py says the same of the UDP stage)
 def test_fabric_top_is_clean_under_verilator(tmp_path: Path) -> None:
-    from rosfpga_lab.rtl.discrom import (
-        node_parameters, render_rom, top_parameters, verilog_parameters, write_rom,
-    )
+    from rosfpga_lab.rtl.discrom import fabric_top_literals, render_rom, write_rom
     from rosfpga_lab.rtl.proofs import FABRIC_DIR
     from tests.rtl.test_fabric_top import SOURCES
     from tests.support.fabrictools import generate_project, generated_rtl
@@ -333,7 +331,7 @@ def test_fabric_top_is_clean_under_verilator(tmp_path: Path) -> None:
     gen = generate_project(config, tmp_path / "project")
     rom = render_rom(config)
     write_rom(rom, tmp_path)
-    params = dict(node_parameters(rom, period=1000), **verilog_parameters(top_parameters(rom)))
+    params = fabric_top_literals(rom, period=1000)
     sources = [*map(str, SOURCES)]
     sources += map(str, generated_rtl(gen))
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall", "-Wno-fatal",
@@ -350,7 +348,7 @@ def test_fabric_top_is_clean_under_verilator(tmp_path: Path) -> None:
                            f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}",
                            *(f"-G{k}={v}" for k, v in bare.items()),
                            *sources], cwd=tmp_path, capture_output=True, text=True, timeout=300)
-    unset = "rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT and SPDP_GROUP"
+    unset = "rfl_fabric_top: set the *_PORT parameters, SPDP_GROUP and COUNTERS_GAP"
     assert done.returncode != 0 and unset in done.stderr, done.stderr[-3000:]
 
 

@@ -13,7 +13,10 @@
 // robin among transmit path, answers, discovery ROM, one idle clock between grants) and passes
 // its beats as they are, so a datagram is never interleaved with another and the stream rules
 // of the sources (TDATA, TLAST, TDEST stable until taken) hold on the output.
+// cnt_stages: the RTPS stages' counters packed (rosfpga_lab.rtl.fabriccounters' order), for
+// rfl_fabric_top's counter readout.
 `default_nettype none
+`include "rfl_fabric_counters.vh"
 
 module rfl_fabric_node #(
     parameter USER_DEST = 2,                    // TDEST of the transmit path's datagrams
@@ -41,7 +44,8 @@ module rfl_fabric_node #(
     output wire [15:0]  credit,                 // the answers' byte credit
     output wire [31:0]  cnt_samples,            // samples sent by the transmit path
     output wire [31:0]  cnt_answers,
-    output wire [31:0]  cnt_no_credit
+    output wire [31:0]  cnt_no_credit,
+    output wire [32*`RFL_NODE_COUNTER_COUNT-1:0] cnt_stages
 );
 `ifdef __ICARUS__
     initial begin
@@ -120,6 +124,8 @@ module rfl_fabric_node #(
         .m_axis_tdata(tx_tdata), .m_axis_tvalid(tx_tvalid),
         .m_axis_tready(tx_tready), .m_axis_tlast(tx_tlast), .m_seq(tx_seq),
         .cnt_samples(cnt_samples), .cnt_datagrams(cnt_datagrams), .cnt_dropped(cnt_dropped));
+
+    assign cnt_stages = `RFL_NODE_COUNTER_BUS;
 
     // ---- metatraffic: ctrl -> answers
     wire [167:0] req_tdata;

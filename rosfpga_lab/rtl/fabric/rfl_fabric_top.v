@@ -21,8 +21,14 @@
 // cfg_peer_* (a point-to-point link, or a peer the host's software chose) and the send_sedp
 // input. So an answer to another asker (the node's m_dst_prefix, not read here) still goes to
 // the one peer, and user data reaches one reader.
+// The counter readout (rfl_counter_readout) takes what comes to COUNTERS_PORT (the fourth port
+// LiteEth passes) and answers a well-formed request with every counter, the top's, the node's
+// (its cnt_stages) and its own, in rosfpga_lab.rtl.fabriccounters' order (rfl_fabric_counters.vh),
+// to the request's sender from COUNTERS_PORT; rfl_frame_arbiter puts its answers and the node's
+// datagrams out whole, one after the other.
 // The glue is proven with LiteEth and the node as stream models (rtl/formal/fv_fabric_top.sv).
 `default_nettype none
+`include "rfl_fabric_counters.vh"
 
 module rfl_fabric_top #(
 `include "rfl_fabric_top_params.vh"
@@ -79,40 +85,45 @@ module rfl_fabric_top #(
 );
     // 0: unset (the defaults), refused outside a proof: Yosys elaborates a file's defaults when
     // it reads it, the proof sets them
-    localparam UNSET = SPDP_PORT == 0 || META_PORT == 0 || USER_PORT == 0 || SPDP_GROUP == 0;
-    localparam SAME = SPDP_PORT == META_PORT || SPDP_PORT == USER_PORT || META_PORT == USER_PORT;
+    localparam UNSET = SPDP_PORT == 0 || META_PORT == 0 || USER_PORT == 0 || SPDP_GROUP == 0 ||
+                       COUNTERS_PORT == 0 || COUNTERS_GAP == 0;
+    localparam SAME = SPDP_PORT == META_PORT || SPDP_PORT == USER_PORT || META_PORT == USER_PORT ||
+                      COUNTERS_PORT == SPDP_PORT || COUNTERS_PORT == META_PORT ||
+                      COUNTERS_PORT == USER_PORT;
 `ifdef __ICARUS__
     initial begin
         if (UNSET)
-            $fatal(1, "rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT and SPDP_GROUP");
+            $fatal(1, "rfl_fabric_top: set the *_PORT parameters, SPDP_GROUP and COUNTERS_GAP");
         if (SPDP_PORT < 0 || SPDP_PORT > 65535 || META_PORT < 0 || META_PORT > 65535 ||
-            USER_PORT < 0 || USER_PORT > 65535)
+            USER_PORT < 0 || USER_PORT > 65535 || COUNTERS_PORT < 0 || COUNTERS_PORT > 65535)
             $fatal(1, "rfl_fabric_top: the ports must be 1..65535");
         if (!UNSET && SAME)
-            $fatal(1, "rfl_fabric_top: SPDP_PORT, META_PORT and USER_PORT must differ");
+            $fatal(1, "rfl_fabric_top: the four *_PORT parameters must differ");
         if (!UNSET && SPDP_GROUP[31:28] != 4'he)
             $fatal(1, "rfl_fabric_top: SPDP_GROUP must be an IPv4 multicast group");
     end
 `else
 `ifndef FORMAL
     if (UNSET) begin : g_unset
-        $error("rfl_fabric_top: set SPDP_PORT, META_PORT, USER_PORT and SPDP_GROUP");
+        $error("rfl_fabric_top: set the *_PORT parameters, SPDP_GROUP and COUNTERS_GAP");
     end
 `endif
     if (SPDP_PORT < 0 || SPDP_PORT > 65535 || META_PORT < 0 || META_PORT > 65535 ||
-        USER_PORT < 0 || USER_PORT > 65535) begin : g_bad_ports
+        USER_PORT < 0 || USER_PORT > 65535 || COUNTERS_PORT < 0 || COUNTERS_PORT > 65535
+    ) begin : g_bad_ports
         $error("rfl_fabric_top: the ports must be 1..65535");
     end
     if (!UNSET && SAME) begin : g_same_ports
-        $error("rfl_fabric_top: SPDP_PORT, META_PORT and USER_PORT must differ");
+        $error("rfl_fabric_top: the four *_PORT parameters must differ");
     end
     if (!UNSET && SPDP_GROUP[31:28] != 4'he) begin : g_bad_group
         $error("rfl_fabric_top: SPDP_GROUP must be an IPv4 multicast group");
     end
 `endif
     localparam [15:0] SPDP = SPDP_PORT[15:0], META = META_PORT[15:0], USER = USER_PORT[15:0];
-    // the bits on which the three ports agree: LiteEth's port filter
-    localparam [15:0] PORT_MASK = ~((SPDP ^ META) | (SPDP ^ USER));
+    localparam [15:0] CNT = COUNTERS_PORT[15:0];
+    // the bits on which the four ports agree: LiteEth's port filter
+    localparam [15:0] PORT_MASK = ~((SPDP ^ META) | (SPDP ^ USER) | (SPDP ^ CNT));
 
     // ---- LiteEth <-> rfl_udp_port
     wire [7:0] le_rx_data, le_tx_data;
@@ -160,7 +171,7 @@ module rfl_fabric_top #(
     reg [31:0] p_tx_ip;
     reg [15:0] p_tx_sport, p_tx_dport;
     /* verilator lint_off UNUSEDSIGNAL */
-    wire unused_ok = &{1'b0, le_rx_last_be, p_rx_sport, p_rx_len};
+    wire unused_ok = &{1'b0, le_rx_last_be, p_rx_len};
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_udp_port #(.RX_BITS(RX_BITS), .TX_BITS(TX_BITS), .QUEUE_BITS(QUEUE_BITS),
                    .COUNT_BITS(32)) u_port (
@@ -186,12 +197,14 @@ module rfl_fabric_top #(
     // ---- received: the kind from the destination port (held by rfl_udp_port for the packet)
     wire to_user = p_rx_dport == USER;
     wire keep = to_user || p_rx_dport == META || p_rx_dport == SPDP;
+    wire to_cnt = p_rx_dport == CNT;            // the readout: always ready
     wire n_rx_tready;
     assign p_rx_tready = keep ? n_rx_tready : 1'b1;
     reg [31:0] c_port;
     always @(posedge clk) begin
         if (!rst_n) c_port <= 32'd0;
-        else if (p_rx_tvalid && p_rx_tready && p_rx_tlast && !keep && c_port != 32'hffffffff)
+        else if (p_rx_tvalid && p_rx_tready && p_rx_tlast && !keep && !to_cnt &&
+                 c_port != 32'hffffffff)
             c_port <= c_port + 32'd1;
     end
     assign cnt_rx_port = c_port;
@@ -221,21 +234,59 @@ module rfl_fabric_top #(
     wire [15:0] peer_user_port = cfg_learn ? l_user_port : cfg_peer_user_port;
     wire node_sedp = cfg_learn ? l_sedp : send_sedp;
 
-    // ---- sent: the destination from TDEST (held by the node until taken); a datagram to the
-    // peer while none is learned is dropped (decided at its first beat, for all of it)
-    wire [1:0] n_tdest;
-    wire n_tvalid, n_tlast;
+    // ---- the counter readout: the top's counters and the node's, then its own
+    wire [32*`RFL_NODE_COUNTER_COUNT-1:0] cnt_stages;
+    wire [7:0] r_tdata;
+    wire r_tvalid, r_tready, r_tlast;
+    wire [31:0] r_ip;
+    wire [15:0] r_port;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire r_in_ready;                            // (always 1)
+    wire [31:0] cr_answered, cr_malformed, cr_limited;  // in its answers
+    /* verilator lint_on UNUSEDSIGNAL */
+    rfl_counter_readout #(.COUNT(`RFL_TOP_COUNTER_COUNT), .MAGIC(`RFL_COUNTERS_MAGIC),
+                          .GAP(COUNTERS_GAP < 1 ? 1 : COUNTERS_GAP)) u_counters (  // 0: UNSET
+        .clk(clk), .rst_n(rst_n), .counters(`RFL_TOP_COUNTER_BUS),
+        .s_axis_tdata(p_rx_tdata), .s_axis_tvalid(p_rx_tvalid && to_cnt),
+        .s_axis_tready(r_in_ready), .s_axis_tlast(p_rx_tlast), .s_ip(p_rx_ip),
+        .s_port(p_rx_sport), .m_axis_tdata(r_tdata), .m_axis_tvalid(r_tvalid),
+        .m_axis_tready(r_tready), .m_axis_tlast(r_tlast), .m_ip(r_ip), .m_port(r_port),
+        .cnt_answered(cr_answered), .cnt_malformed(cr_malformed),
+        .cnt_limited(cr_limited));
+
+    // ---- sent: the node's datagrams and the readout's answers, whole, one after the other
+    // (TUSER: 1 and the answer's address and port for the readout's, 0 for the node's)
+    wire [1:0] n_tdest, a_tdest;
+    wire [7:0] n_tdata;
+    wire n_tvalid, n_tlast, n_tready, a_tvalid, a_tready, a_tlast;
+    wire [48:0] a_tuser;
+    wire a_cnt = a_tuser[48];
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [2:0] arb_ready;                       // (the third source is none)
+    /* verilator lint_on UNUSEDSIGNAL */
+    assign n_tready = arb_ready[0];
+    assign r_tready = arb_ready[1];
+    rfl_frame_arbiter #(.DATA_BITS(8), .DEST_BITS(2), .USER_BITS(49)) u_tx_arb (
+        .clk(clk), .rst_n(rst_n), .s_axis_tdata({8'd0, r_tdata, n_tdata}),
+        .s_axis_tvalid({1'b0, r_tvalid, n_tvalid}), .s_axis_tready(arb_ready),
+        .s_axis_tlast({1'b0, r_tlast, n_tlast}), .s_axis_tdest({2'd0, 2'd0, n_tdest}),
+        .s_axis_tuser({49'd0, 1'b1, r_ip, r_port, 49'd0}),
+        .m_axis_tdata(p_tx_tdata), .m_axis_tvalid(a_tvalid), .m_axis_tready(a_tready),
+        .m_axis_tlast(a_tlast), .m_axis_tdest(a_tdest), .m_axis_tuser(a_tuser));
+
+    // the destination from TDEST (held until taken); a datagram to the peer while none is
+    // learned is dropped (decided at its first beat, for all of it)
     reg tx_in, tx_drop_r;
-    wire tx_drop = tx_in ? tx_drop_r : (cfg_learn && !l_valid && n_tdest != 2'd0);
-    assign p_tx_tvalid = n_tvalid && !tx_drop;
-    assign p_tx_tlast = n_tlast;
-    wire n_tready = tx_drop ? 1'b1 : p_tx_tready;
+    wire tx_drop = tx_in ? tx_drop_r : (cfg_learn && !l_valid && a_tdest != 2'd0 && !a_cnt);
+    assign p_tx_tvalid = a_tvalid && !tx_drop;
+    assign p_tx_tlast = a_tlast;
+    assign a_tready = tx_drop ? 1'b1 : p_tx_tready;
     always @(posedge clk) begin
         if (!rst_n) begin
             tx_in <= 1'b0;
             tx_drop_r <= 1'b0;
-        end else if (n_tvalid && n_tready) begin
-            tx_in <= !n_tlast;
+        end else if (a_tvalid && a_tready) begin
+            tx_in <= !a_tlast;
             tx_drop_r <= tx_drop;
         end
     end
@@ -243,11 +294,11 @@ module rfl_fabric_top #(
     wire [95:0] n_dst_prefix;                   // one peer: see the header
     /* verilator lint_on UNUSEDSIGNAL */
     always @* begin
-        case (n_tdest)
+        case (a_cnt ? 2'd0 : a_tdest)
             2'd0: begin
-                p_tx_ip = SPDP_GROUP;
-                p_tx_dport = SPDP;
-                p_tx_sport = META;
+                p_tx_ip = a_cnt ? a_tuser[47:16] : SPDP_GROUP;
+                p_tx_dport = a_cnt ? a_tuser[15:0] : SPDP;
+                p_tx_sport = a_cnt ? CNT : META;
             end
             2'd1: begin
                 p_tx_ip = peer_meta_ip;
@@ -270,10 +321,11 @@ module rfl_fabric_top #(
         .cfg_writer(cfg_writer), .cfg_time(cfg_time), .send_sedp(node_sedp),
         .s_axis_tdata(p_rx_tdata), .s_axis_tvalid(p_rx_tvalid && keep),
         .s_axis_tready(n_rx_tready), .s_axis_tlast(p_rx_tlast), .s_axis_tuser(to_user),
-        .m_axis_tdata(p_tx_tdata), .m_axis_tvalid(n_tvalid), .m_axis_tready(n_tready),
+        .m_axis_tdata(n_tdata), .m_axis_tvalid(n_tvalid), .m_axis_tready(n_tready),
         .m_axis_tlast(n_tlast), .m_axis_tdest(n_tdest), .m_dst_prefix(n_dst_prefix),
         .status_valid(status_valid), .status(status), .credit(credit),
-        .cnt_samples(cnt_samples), .cnt_answers(cnt_answers), .cnt_no_credit(cnt_no_credit));
+        .cnt_samples(cnt_samples), .cnt_answers(cnt_answers), .cnt_no_credit(cnt_no_credit),
+        .cnt_stages(cnt_stages));
 endmodule
 
 `default_nettype wire

@@ -5,6 +5,8 @@
     parameter META_PORT = 0,
     parameter USER_PORT = 0,
     parameter [31:0] SPDP_GROUP = 32'd0,
+    parameter COUNTERS_PORT = 0,                // the counter readout's: rtl.discrom too
+    parameter COUNTERS_GAP = 0,                 // its clocks between answers (fabriccounters)
     // rfl_spdp_peer's constants, all from rtl.discrom.spdp_parameters (the software's builders)
     parameter [31:0] SPDP_WRITER_ID = 32'd0,
     parameter [79:0] SPDP_PIDS = 80'd0,         // {status, sentinel, lease, default, meta}

@@ -13,6 +13,7 @@
 `define FV_SPDP 7400
 `define FV_META 7410
 `define FV_USER 7411
+`define FV_COUNTERS 7408
 `define FV_GROUP 32'hefff0001
 `define FV_PEER_IP 32'hc0a80a01
 `define FV_PEER_META 16'd7412
@@ -27,7 +28,8 @@ module fv_fabric_top (
     wire [15:0] credit;
     wire [31:0] c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12, c13, c14;
     rfl_fabric_top #(.SPDP_PORT(`FV_SPDP), .META_PORT(`FV_META), .USER_PORT(`FV_USER),
-                     .SPDP_GROUP(`FV_GROUP), .RX_BITS(4), .TX_BITS(4), .QUEUE_BITS(1)) dut (
+                     .SPDP_GROUP(`FV_GROUP), .COUNTERS_PORT(`FV_COUNTERS), .COUNTERS_GAP(64),
+                     .RX_BITS(4), .TX_BITS(4), .QUEUE_BITS(1)) dut (
         .clk(clk), .rst_n(rst_n), .cfg_mac(cfg_mac), .cfg_ip(cfg_ip), .cfg_learn(1'b0),
         .cfg_peer_ip(`FV_PEER_IP), .cfg_peer_meta_port(`FV_PEER_META),
         .cfg_peer_user_port(`FV_PEER_USER), .cfg_reader(32'd0),
@@ -100,7 +102,7 @@ module liteeth_udp_gmii (
                                                                         rx_length};
     always @(*) if (rx_valid && rx_in) assume({rx_ip, rx_sport, rx_dport, rx_length} == rx_held);
     always @(*) if (rx_valid && !rx_in) assume(rx_data == rx_dport[7:0]);
-    wire [15:0] spdp = `FV_SPDP, meta = `FV_META, user = `FV_USER;
+    wire [15:0] spdp = `FV_SPDP, meta = `FV_META, user = `FV_USER, counters = `FV_COUNTERS;
     always @(posedge clk) if (!fv_init && rst_n && udp_sink_valid && !tx_in) begin
         assert(udp_sink_last_be == udp_sink_last);
         if (udp_sink_data == 8'd0)
@@ -114,9 +116,10 @@ module liteeth_udp_gmii (
                    udp_sink_src_port == user);
     end
     always @(posedge clk) if (!fv_init && rst_n) begin
-        // the port filter passes the three ports
+        // the port filter passes the four ports
         assert(udp_rx_port == spdp && (meta & udp_rx_port_mask) == (spdp & udp_rx_port_mask) &&
                (user & udp_rx_port_mask) == (spdp & udp_rx_port_mask) &&
+               (counters & udp_rx_port_mask) == (spdp & udp_rx_port_mask) &&
                ip_multicast == `FV_GROUP);
     end
 endmodule
@@ -142,7 +145,7 @@ module rfl_fabric_node #(
     output [7:0] m_axis_tdata, output m_axis_tvalid, input m_axis_tready, output m_axis_tlast,
     output [1:0] m_axis_tdest, output [95:0] m_dst_prefix,
     output status_valid, output [7:0] status, output [15:0] credit, output [31:0] cnt_samples,
-    output [31:0] cnt_answers, output [31:0] cnt_no_credit
+    output [31:0] cnt_answers, output [31:0] cnt_no_credit, output [479:0] cnt_stages
 );
     (* anyseq *) reg [7:0] tx_data;
     (* anyseq *) reg tx_valid, tx_last, rx_ready;
@@ -159,6 +162,7 @@ module rfl_fabric_node #(
     assign cnt_samples = 32'd0;
     assign cnt_answers = 32'd0;
     assign cnt_no_credit = 32'd0;
+    assign cnt_stages = 480'd0;
 `include "fv_env.vh"
     `FV_SOURCE(tx_valid, m_axis_tready, {tx_data, tx_last, tx_dest})
     `FV_SINK(s_axis_tvalid, s_axis_tready, {s_axis_tdata, s_axis_tlast, s_axis_tuser})
