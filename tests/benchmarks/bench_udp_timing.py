@@ -62,13 +62,20 @@ LPF = "udp_echo_rgmii.lpf"
 SHOWN = ("TRELLIS_COMB", "TRELLIS_FF", "DP16KD", "TRELLIS_RAMW", "TRELLIS_IO", "DELAYG")
 
 
+#: udp_echo_rgmii's eth_clk (LiteEth's 32-bit core: the board's PLL makes it, the echo takes it
+#: as a pin): J1's first pin on a 5A-75B v8.0 (LiteX-Boards' _connectors_v8_0), at 62.5 MHz.
+ETH_CLK_LPF = ('LOCATE COMP "eth_clk" SITE "C4";\nIOBUF PORT "eth_clk" IO_TYPE=LVCMOS33;\n'
+               'FREQUENCY PORT "eth_clk" 62.5 MHZ;\n')
+
+
 def echo_lpf() -> str:
     """udp_echo_rgmii's pins: the board build's (one owner), its RGMII pins and LED as they are,
     its ``clk`` on the oscillator's pin (clk25's) without the 25 MHz constraint (timed at the
-    frequency asked, as if from the PLL the echo leaves out)."""
+    frequency asked, as if from the PLL the echo leaves out), ``eth_clk`` on a spare pin
+    (:data:`ETH_CLK_LPF`)."""
     lines = [line.replace('"clk25"', '"clk"') for line in BOARD_LPF.read_text().splitlines()
              if not line.startswith(("#", 'FREQUENCY PORT "clk25"'))]
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n" + ETH_CLK_LPF
 
 
 def place(variant: str, seeds: list[int], mhz: float = 125.0) -> None:

@@ -24,6 +24,10 @@ configuration key for (so this script, not a YAML file for ``liteeth_gen``), and
   that takes every IPv4 frame when on, is driven by that comparison);
 * the PHY's receive stream gets ``last_be`` = ``last`` (without it LiteEth 2024.12's 8-bit
   receive path never flags a bad FCS: its CRC checker looks at the lanes ``last_be`` enables);
+* the 32-to-8 converter's last word is whole (LiteX's converter ignores ``last_be``):
+  ``LastByteTrim`` ends each packet at its ``last_be`` byte and puts the packet's error on it
+  (LiteEth's MAC depacketizer moves the payload by the Ethernet header's 14 bytes but not the
+  error lanes, so a bad FCS's flag may come on an earlier byte or word);
 * the UDP receiver holds a payload's last byte until its frame ends (``HoldingUDPRX``), so a
   padded frame's bad FCS is not lost with the padding LiteEth's own receiver drops;
 * the IPv4 receiver (``CheckingIPRX``) also refuses fragments (MF set or an offset: LiteEth does
@@ -41,6 +45,16 @@ configuration key for (so this script, not a YAML file for ``liteeth_gen``), and
 * the ECP5 RGMII PHY's receiver (``ErrorRGMIIRX``) reads ``rx_ctl``'s second half too (RX_DV xor
   RX_ER): a byte the PHY marks errored is inverted, so the frame's FCS fails (LiteEth's reads
   only RX_DV);
+* ``data_width: 32``: LiteEth's MAC, ARP, IPv4 and ICMP at 32 bits (a word a clock: the core
+  keeps gigabit line rate from 31.25 MHz up, where its 8-bit datapath needed 125 MHz and, on an
+  ECP5-6, closes at some 60), its PHY side (preamble, CRC) at 8 bits on the PHY's clock as
+  LiteEth builds it; the UDP layer stays at 8 bits (``PortUDP``: the IPv4 crossbar's UDP port
+  crosses at 32 bits, LiteX's StrideConverter then ``LastByteTrim`` make bytes of it, and the
+  receive rules below run on bytes as before), so the lab's port is 8 bits either way;
+* ``port_clock: true``: that UDP layer and the port on a clock of their own (ports
+  ``port_clock``, ``port_reset``; LiteX's asynchronous FIFOs from and to the core's ``sys``,
+  the drop pulses crossed by a toggle), so the lab's node runs at the byte rate while the core
+  runs slower; without it (the GMII simulation variant) one clock runs all;
 * ``phy: gmii_model`` is LiteEth's GMII PHY in its ``model`` mode (RX and TX clocked by the
   core's clock, no vendor clock buffers): the simulation variant; ``phy: ecp5_rgmii`` is
   ``LiteEthECP5PHYRGMII`` (DELAYG, IDDRX1F, ODDRX1F), the board variant.
@@ -387,7 +401,8 @@ class PulseMerge(LiteXModule):
 
 
 class UDPPortCore(SoCMini):
-    """PHY + LiteEthUDPIPCore + one raw UDP port (8-bit) with run-time addresses and port."""
+    """PHY + LiteEthIPCore (``data_width`` bits) + ``PortUDP`` + one raw UDP port (8 bits)
+    with run-time addresses and port."""
 
     def __init__(self, platform: LatticePlatform, cfg: dict) -> None:
         SoCMini.__init__(self, platform, clk_freq=int(float(cfg["clk_freq"])))
