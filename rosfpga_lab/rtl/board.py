@@ -144,7 +144,7 @@ def _readme(rom: DiscoveryRom, mac: str, peer_ip: str) -> str:
 No board was available where this lab was written: the bitstream is built, placed, routed and
 timed by open tools (`make bitstream`), never run on a board. What the build prints is what is
 known: Fmax per clock against its constraint, and the resources. Three clocks: the node's and
-LiteEth's 8-bit UDP port's (the PLL's 125 MHz), LiteEth's 32-bit core's (the PLL's 62.5 MHz)
+LiteEth's 8-bit UDP port's (the PLL's 125 MHz), LiteEth's 32-bit core's (the PLL's 52.08 MHz)
 and the PHY's receive clock (125 MHz at gigabit; LiteEth's PHY side). A clock `make bitstream`
 prints as NOT MET may lose or corrupt frames on the board; which ones missed when it was last
 measured, and why: rosfpga_lab/rtl/fabric/vendor/README.md, Timing.

@@ -63,9 +63,9 @@ SHOWN = ("TRELLIS_COMB", "TRELLIS_FF", "DP16KD", "TRELLIS_RAMW", "TRELLIS_IO", "
 
 
 #: udp_echo_rgmii's eth_clk (LiteEth's 32-bit core: the board's PLL makes it, the echo takes it
-#: as a pin): J1's first pin on a 5A-75B v8.0 (LiteX-Boards' _connectors_v8_0), at 62.5 MHz.
+#: as a pin): J1's first pin on a 5A-75B v8.0 (LiteX-Boards' _connectors_v8_0), at 52.08 MHz.
 ETH_CLK_LPF = ('LOCATE COMP "eth_clk" SITE "C4";\nIOBUF PORT "eth_clk" IO_TYPE=LVCMOS33;\n'
-               'FREQUENCY PORT "eth_clk" 62.5 MHZ;\n')
+               'FREQUENCY PORT "eth_clk" 52.0833 MHZ;\n')
 
 
 def echo_lpf() -> str:

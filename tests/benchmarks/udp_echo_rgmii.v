@@ -19,7 +19,7 @@ module udp_echo_rgmii #(
     parameter [31:0] MCAST = 32'hEF_FF_00_01   // 239.255.0.1
 ) (
     input  wire       clk,                      // the circuit's clock (125 MHz)
-    input  wire       eth_clk,                  // LiteEth's 32-bit core's (62.5 MHz)
+    input  wire       eth_clk,                  // LiteEth's 32-bit core's (52.08 MHz)
     input  wire       rgmii_rx_clk,             // 125 MHz from the PHY
     input  wire       rgmii_rx_ctl,
     input  wire [3:0] rgmii_rxd,

@@ -77,8 +77,8 @@ import liteeth.core.ip
 import liteeth.mac
 import liteeth.packet
 import liteeth.phy.ecp5rgmii
-from liteeth.common import eth_ipv4_user_description, eth_udp_user_description, \
-    ipv4_header_length, udp_header, udp_protocol
+from liteeth.common import eth_ipv4_user_description, eth_phy_description, \
+    eth_udp_user_description, ipv4_header_length, udp_header, udp_protocol
 from liteeth.core.ip import LiteEthIPRX, LiteEthIPV4Crossbar
 from liteeth.core.udp import LiteEthUDPCrossbar, LiteEthUDPDepacketizer, LiteEthUDPTX
 from liteeth import phy as liteeth_phys
@@ -374,14 +374,21 @@ class PortUDP(LiteXModule):
         self.tx_converter = renamed(stream.StrideConverter(narrow, wide))
         self.tx_cdc = stream.ClockDomainCrossing(wide, cd_from=cd, cd_to="sys", depth=tx_depth)
         self.crossbar = renamed(MaskedUDPCrossbar(8))
+        # registers both ways between the byte-wide stages (LiteX's Buffer): LiteEth's stages
+        # pass ready and valid combinationally, which chained across the layers was the 8-bit
+        # core's critical path
+        self.rx_buffer = renamed(stream.Buffer(narrow, pipe_valid=True, pipe_ready=True))
+        self.tx_buffer = renamed(stream.Buffer(narrow, pipe_valid=True, pipe_ready=True))
         self.comb += [
             ip_port.source.connect(self.rx_cdc.sink),
             self.rx_cdc.source.connect(self.rx_converter.sink),
             self.rx_converter.source.connect(self.rx_trim.sink),
-            self.rx_trim.source.connect(self.rx.sink),
+            self.rx_trim.source.connect(self.rx_buffer.sink),
+            self.rx_buffer.source.connect(self.rx.sink),
             self.rx.source.connect(self.crossbar.master.sink),
             self.crossbar.master.source.connect(self.tx.sink),
-            self.tx.source.connect(self.tx_converter.sink),
+            self.tx.source.connect(self.tx_buffer.sink),
+            self.tx_buffer.source.connect(self.tx_converter.sink),
             self.tx_converter.source.connect(self.tx_cdc.sink),
             self.tx_cdc.source.connect(ip_port.sink),
         ]
@@ -451,6 +458,17 @@ class UDPPortCore(SoCMini):
             with_sys_datapath=bool(cfg.get("with_sys_datapath", False)),
             tx_cdc_depth=int(cfg.get("tx_cdc_depth", 32)), tx_cdc_buffered=False,
             rx_cdc_depth=int(cfg.get("rx_cdc_depth", 32)), rx_cdc_buffered=False)
+        # LiteEth's send path on the PHY's clock: its FIFO's read side, the 32-to-8 converter,
+        # padding, CRC, preamble, gap: one combinational ready chain from the CRC back to the
+        # FIFO's read pointer and memory (the PHY clock's critical path at 8 and at 32 bits).
+        # A register both ways (LiteX's Buffer) after the FIFO cuts it; its Pipeline is made at
+        # finalize time from this list.
+        tx_path = self.core.mac.core.tx_datapath.pipeline
+        (at,) = [k for k, m in enumerate(tx_path) if isinstance(m, stream.ClockDomainCrossing)]
+        tx_buffer = ClockDomainsRenamer("eth_tx")(stream.Buffer(
+            eth_phy_description(dw), pipe_valid=True, pipe_ready=True))
+        self.core.mac.core.tx_datapath.tx_buffer = tx_buffer
+        tx_path.insert(at + 1, tx_buffer)
         self.core.udp = PortUDP(self.core.ip, ip_address, dw, cd,
                                 rx_depth=int(cfg.get("port_rx_cdc_depth", 16)),
                                 tx_depth=int(cfg.get("port_tx_cdc_depth", 16)))

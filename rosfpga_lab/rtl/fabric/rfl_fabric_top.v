@@ -30,7 +30,7 @@ module rfl_fabric_top #(
 ) (
 `ifdef RFL_FABRIC_RGMII
     input  wire         clk,                    // 125 MHz: the node's and LiteEth's UDP port's
-    input  wire         eth_clk,                // LiteEth's 32-bit core's (62.5 MHz)
+    input  wire         eth_clk,                // LiteEth's 32-bit core's (52.08 MHz)
     input  wire         eth_rst_n,              // eth_clk's reset (rst_n is clk's)
 `else
     input  wire         clk,                    // 125 MHz: GMII's receive and send clock

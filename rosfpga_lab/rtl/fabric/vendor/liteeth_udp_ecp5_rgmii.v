@@ -113,6 +113,10 @@ UDPPortCore
 │    │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── liteethmacgap_0* (LiteEthMACGap)
 │    │    │    │    │    └─── fsm (FSM)
+│    │    │    │    └─── tx_buffer (Buffer)
+│    │    │    │    │    └─── pipe_valid (PipeValid)
+│    │    │    │    │    └─── pipe_ready (PipeReady)
+│    │    │    │    │    └─── pipeline (Pipeline)
 │    │    │    │    └─── pipeline_0* (Pipeline)
 │    │    │    └─── rx_datapath (RXDatapath)
 │    │    │    │    └─── liteethmacpreamblechecker_0* (LiteEthMACPreambleChecker)
@@ -252,6 +256,14 @@ UDPPortCore
 │    │    │    └─── arbiter (Arbiter)
 │    │    │    └─── dispatcher (Dispatcher)
 │    │    │    │    └─── status_0* (Status)
+│    │    └─── rx_buffer (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
+│    │    └─── tx_buffer (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
 └─── rx_drop_header_core (PulseMerge)
 └─── rx_drop_header_cdc (PulseSynchronizer)
 └─── rx_drop_header_port (PulseMerge)
@@ -271,19 +283,19 @@ UDPPortCore
 └─── csr_interconnect (InterconnectShared)
 └─── [IDDRX1F]
 └─── [IDDRX1F]
+└─── [ODDRX1F]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
 * : Generated name.
 []: BlackBox.
 */
@@ -454,7 +466,7 @@ reg    [47:0] arp_source_source_payload_target_mac = 48'd0;
 wire          arp_source_source_ready;
 reg           arp_source_source_valid = 1'd0;
 reg           arp_table_cache_clear_enable = 1'd1;
-reg    [25:0] arp_table_cache_count = 26'd62500000;
+reg    [25:0] arp_table_cache_count = 26'd52083300;
 wire          arp_table_cache_done;
 reg           arp_table_cache_enable = 1'd1;
 reg           arp_table_cache_error = 1'd0;
@@ -501,7 +513,7 @@ reg           arp_table_request_pending_liteetharp_fsm_next_value_ce0 = 1'd0;
 wire   [31:0] arp_table_request_request_payload_ip_address;
 reg           arp_table_request_request_ready = 1'd0;
 reg           arp_table_request_request_valid = 1'd0;
-reg    [22:0] arp_table_request_timer_count = 23'd6250000;
+reg    [22:0] arp_table_request_timer_count = 23'd5208330;
 wire          arp_table_request_timer_done;
 wire          arp_table_request_timer_wait;
 reg           arp_table_response_response_payload_failed = 1'd0;
@@ -528,6 +540,148 @@ reg           arp_table_source_payload_reply = 1'd0;
 reg           arp_table_source_payload_request = 1'd0;
 wire          arp_table_source_ready;
 reg           arp_table_source_valid = 1'd0;
+reg           buffer0_pipe_ready_sink_d_first = 1'd0;
+reg           buffer0_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] buffer0_pipe_ready_sink_d_param_ip_address = 32'd0;
+reg    [15:0] buffer0_pipe_ready_sink_d_param_length = 16'd0;
+reg     [7:0] buffer0_pipe_ready_sink_d_param_protocol = 8'd0;
+reg     [7:0] buffer0_pipe_ready_sink_d_payload_data = 8'd0;
+reg           buffer0_pipe_ready_sink_d_payload_error = 1'd0;
+reg           buffer0_pipe_ready_sink_d_payload_last_be = 1'd0;
+reg           buffer0_pipe_ready_sink_d_ready = 1'd0;
+reg           buffer0_pipe_ready_sink_d_valid = 1'd0;
+wire          buffer0_pipe_ready_sink_first;
+wire          buffer0_pipe_ready_sink_last;
+wire   [31:0] buffer0_pipe_ready_sink_param_ip_address;
+wire   [15:0] buffer0_pipe_ready_sink_param_length;
+wire    [7:0] buffer0_pipe_ready_sink_param_protocol;
+wire    [7:0] buffer0_pipe_ready_sink_payload_data;
+wire          buffer0_pipe_ready_sink_payload_error;
+wire          buffer0_pipe_ready_sink_payload_last_be;
+wire          buffer0_pipe_ready_sink_ready;
+wire          buffer0_pipe_ready_sink_valid;
+reg           buffer0_pipe_ready_source_first = 1'd0;
+reg           buffer0_pipe_ready_source_last = 1'd0;
+reg    [31:0] buffer0_pipe_ready_source_param_ip_address = 32'd0;
+reg    [15:0] buffer0_pipe_ready_source_param_length = 16'd0;
+reg     [7:0] buffer0_pipe_ready_source_param_protocol = 8'd0;
+reg     [7:0] buffer0_pipe_ready_source_payload_data = 8'd0;
+reg           buffer0_pipe_ready_source_payload_error = 1'd0;
+reg           buffer0_pipe_ready_source_payload_last_be = 1'd0;
+wire          buffer0_pipe_ready_source_ready;
+reg           buffer0_pipe_ready_source_valid = 1'd0;
+reg           buffer0_pipe_ready_valid = 1'd0;
+wire          buffer0_pipe_valid_sink_first;
+wire          buffer0_pipe_valid_sink_last;
+wire   [31:0] buffer0_pipe_valid_sink_param_ip_address;
+wire   [15:0] buffer0_pipe_valid_sink_param_length;
+wire    [7:0] buffer0_pipe_valid_sink_param_protocol;
+wire    [7:0] buffer0_pipe_valid_sink_payload_data;
+wire          buffer0_pipe_valid_sink_payload_error;
+wire          buffer0_pipe_valid_sink_payload_last_be;
+wire          buffer0_pipe_valid_sink_ready;
+wire          buffer0_pipe_valid_sink_valid;
+reg           buffer0_pipe_valid_source_first = 1'd0;
+reg           buffer0_pipe_valid_source_last = 1'd0;
+reg    [31:0] buffer0_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] buffer0_pipe_valid_source_param_length = 16'd0;
+reg     [7:0] buffer0_pipe_valid_source_param_protocol = 8'd0;
+reg     [7:0] buffer0_pipe_valid_source_payload_data = 8'd0;
+reg           buffer0_pipe_valid_source_payload_error = 1'd0;
+reg           buffer0_pipe_valid_source_payload_last_be = 1'd0;
+wire          buffer0_pipe_valid_source_ready;
+reg           buffer0_pipe_valid_source_valid = 1'd0;
+wire          buffer0_sink_sink_first;
+wire          buffer0_sink_sink_last;
+wire   [31:0] buffer0_sink_sink_param_ip_address;
+wire   [15:0] buffer0_sink_sink_param_length;
+wire    [7:0] buffer0_sink_sink_param_protocol;
+wire    [7:0] buffer0_sink_sink_payload_data;
+wire          buffer0_sink_sink_payload_error;
+wire          buffer0_sink_sink_payload_last_be;
+wire          buffer0_sink_sink_ready;
+wire          buffer0_sink_sink_valid;
+wire          buffer0_source_source_first;
+wire          buffer0_source_source_last;
+wire   [31:0] buffer0_source_source_param_ip_address;
+wire   [15:0] buffer0_source_source_param_length;
+wire    [7:0] buffer0_source_source_param_protocol;
+wire    [7:0] buffer0_source_source_payload_data;
+wire          buffer0_source_source_payload_error;
+wire          buffer0_source_source_payload_last_be;
+wire          buffer0_source_source_ready;
+wire          buffer0_source_source_valid;
+reg           buffer1_pipe_ready_sink_d_first = 1'd0;
+reg           buffer1_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] buffer1_pipe_ready_sink_d_param_ip_address = 32'd0;
+reg    [15:0] buffer1_pipe_ready_sink_d_param_length = 16'd0;
+reg     [7:0] buffer1_pipe_ready_sink_d_param_protocol = 8'd0;
+reg     [7:0] buffer1_pipe_ready_sink_d_payload_data = 8'd0;
+reg           buffer1_pipe_ready_sink_d_payload_error = 1'd0;
+reg           buffer1_pipe_ready_sink_d_payload_last_be = 1'd0;
+reg           buffer1_pipe_ready_sink_d_ready = 1'd0;
+reg           buffer1_pipe_ready_sink_d_valid = 1'd0;
+wire          buffer1_pipe_ready_sink_first;
+wire          buffer1_pipe_ready_sink_last;
+wire   [31:0] buffer1_pipe_ready_sink_param_ip_address;
+wire   [15:0] buffer1_pipe_ready_sink_param_length;
+wire    [7:0] buffer1_pipe_ready_sink_param_protocol;
+wire    [7:0] buffer1_pipe_ready_sink_payload_data;
+wire          buffer1_pipe_ready_sink_payload_error;
+wire          buffer1_pipe_ready_sink_payload_last_be;
+wire          buffer1_pipe_ready_sink_ready;
+wire          buffer1_pipe_ready_sink_valid;
+reg           buffer1_pipe_ready_source_first = 1'd0;
+reg           buffer1_pipe_ready_source_last = 1'd0;
+reg    [31:0] buffer1_pipe_ready_source_param_ip_address = 32'd0;
+reg    [15:0] buffer1_pipe_ready_source_param_length = 16'd0;
+reg     [7:0] buffer1_pipe_ready_source_param_protocol = 8'd0;
+reg     [7:0] buffer1_pipe_ready_source_payload_data = 8'd0;
+reg           buffer1_pipe_ready_source_payload_error = 1'd0;
+reg           buffer1_pipe_ready_source_payload_last_be = 1'd0;
+wire          buffer1_pipe_ready_source_ready;
+reg           buffer1_pipe_ready_source_valid = 1'd0;
+reg           buffer1_pipe_ready_valid = 1'd0;
+wire          buffer1_pipe_valid_sink_first;
+wire          buffer1_pipe_valid_sink_last;
+wire   [31:0] buffer1_pipe_valid_sink_param_ip_address;
+wire   [15:0] buffer1_pipe_valid_sink_param_length;
+wire    [7:0] buffer1_pipe_valid_sink_param_protocol;
+wire    [7:0] buffer1_pipe_valid_sink_payload_data;
+wire          buffer1_pipe_valid_sink_payload_error;
+wire          buffer1_pipe_valid_sink_payload_last_be;
+wire          buffer1_pipe_valid_sink_ready;
+wire          buffer1_pipe_valid_sink_valid;
+reg           buffer1_pipe_valid_source_first = 1'd0;
+reg           buffer1_pipe_valid_source_last = 1'd0;
+reg    [31:0] buffer1_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] buffer1_pipe_valid_source_param_length = 16'd0;
+reg     [7:0] buffer1_pipe_valid_source_param_protocol = 8'd0;
+reg     [7:0] buffer1_pipe_valid_source_payload_data = 8'd0;
+reg           buffer1_pipe_valid_source_payload_error = 1'd0;
+reg           buffer1_pipe_valid_source_payload_last_be = 1'd0;
+wire          buffer1_pipe_valid_source_ready;
+reg           buffer1_pipe_valid_source_valid = 1'd0;
+wire          buffer1_sink_sink_first;
+wire          buffer1_sink_sink_last;
+wire   [31:0] buffer1_sink_sink_param_ip_address;
+wire   [15:0] buffer1_sink_sink_param_length;
+wire    [7:0] buffer1_sink_sink_param_protocol;
+wire    [7:0] buffer1_sink_sink_payload_data;
+wire          buffer1_sink_sink_payload_error;
+wire          buffer1_sink_sink_payload_last_be;
+wire          buffer1_sink_sink_ready;
+wire          buffer1_sink_sink_valid;
+wire          buffer1_source_source_first;
+wire          buffer1_source_source_last;
+wire   [31:0] buffer1_source_source_param_ip_address;
+wire   [15:0] buffer1_source_source_param_length;
+wire    [7:0] buffer1_source_source_param_protocol;
+wire    [7:0] buffer1_source_source_payload_data;
+wire          buffer1_source_source_payload_error;
+wire          buffer1_source_source_payload_last_be;
+wire          buffer1_source_source_ready;
+wire          buffer1_source_source_valid;
 wire   [39:0] cases_slice_proxy;
 wire   [31:0] csrbank0_bus_errors_r;
 reg           csrbank0_bus_errors_re = 1'd0;
@@ -2224,6 +2378,42 @@ reg     [4:0] multiregimpl8_regs1 = 5'd0;
 reg     [4:0] multiregimpl9_regs0 = 5'd0;
 reg     [4:0] multiregimpl9_regs1 = 5'd0;
 reg           next_state = 1'd0;
+reg           pipe_ready_sink_d_first = 1'd0;
+reg           pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] pipe_ready_sink_d_payload_data = 32'd0;
+reg     [3:0] pipe_ready_sink_d_payload_error = 4'd0;
+reg     [3:0] pipe_ready_sink_d_payload_last_be = 4'd0;
+reg           pipe_ready_sink_d_ready = 1'd0;
+reg           pipe_ready_sink_d_valid = 1'd0;
+wire          pipe_ready_sink_first;
+wire          pipe_ready_sink_last;
+wire   [31:0] pipe_ready_sink_payload_data;
+wire    [3:0] pipe_ready_sink_payload_error;
+wire    [3:0] pipe_ready_sink_payload_last_be;
+wire          pipe_ready_sink_ready;
+wire          pipe_ready_sink_valid;
+reg           pipe_ready_source_first = 1'd0;
+reg           pipe_ready_source_last = 1'd0;
+reg    [31:0] pipe_ready_source_payload_data = 32'd0;
+reg     [3:0] pipe_ready_source_payload_error = 4'd0;
+reg     [3:0] pipe_ready_source_payload_last_be = 4'd0;
+wire          pipe_ready_source_ready;
+reg           pipe_ready_source_valid = 1'd0;
+reg           pipe_ready_valid = 1'd0;
+wire          pipe_valid_sink_first;
+wire          pipe_valid_sink_last;
+wire   [31:0] pipe_valid_sink_payload_data;
+wire    [3:0] pipe_valid_sink_payload_error;
+wire    [3:0] pipe_valid_sink_payload_last_be;
+wire          pipe_valid_sink_ready;
+wire          pipe_valid_sink_valid;
+reg           pipe_valid_source_first = 1'd0;
+reg           pipe_valid_source_last = 1'd0;
+reg    [31:0] pipe_valid_source_payload_data = 32'd0;
+reg     [3:0] pipe_valid_source_payload_error = 4'd0;
+reg     [3:0] pipe_valid_source_payload_last_be = 4'd0;
+wire          pipe_valid_source_ready;
+reg           pipe_valid_source_valid = 1'd0;
 wire          por_clk;
 wire          port_clk;
 wire          port_rst;
@@ -2490,6 +2680,20 @@ wire    [9:0] rx_converter_source_source_payload_data;
 wire          rx_converter_source_source_ready;
 wire          rx_converter_source_source_valid;
 wire          rx_converter_source_valid;
+wire          sink_sink_first;
+wire          sink_sink_last;
+wire   [31:0] sink_sink_payload_data;
+wire    [3:0] sink_sink_payload_error;
+wire    [3:0] sink_sink_payload_last_be;
+wire          sink_sink_ready;
+wire          sink_sink_valid;
+wire          source_source_first;
+wire          source_source_last;
+wire   [31:0] source_source_payload_data;
+wire    [3:0] source_source_payload_error;
+wire    [3:0] source_source_payload_last_be;
+wire          source_source_ready;
+wire          source_source_valid;
 reg           state = 1'd0;
 wire          strideconverter0_converter_first;
 wire          strideconverter0_converter_last;
@@ -3310,6 +3514,52 @@ always @(*) begin
         end
     endcase
 end
+assign pipe_valid_sink_ready = ((~pipe_valid_source_valid) | pipe_valid_source_ready);
+assign pipe_ready_sink_ready = (~pipe_ready_valid);
+always @(*) begin
+    pipe_ready_source_first <= 1'd0;
+    pipe_ready_source_last <= 1'd0;
+    pipe_ready_source_payload_data <= 32'd0;
+    pipe_ready_source_payload_error <= 4'd0;
+    pipe_ready_source_payload_last_be <= 4'd0;
+    pipe_ready_source_valid <= 1'd0;
+    if (pipe_ready_valid) begin
+        pipe_ready_source_valid <= pipe_ready_sink_d_valid;
+        pipe_ready_source_first <= pipe_ready_sink_d_first;
+        pipe_ready_source_last <= pipe_ready_sink_d_last;
+        pipe_ready_source_payload_data <= pipe_ready_sink_d_payload_data;
+        pipe_ready_source_payload_last_be <= pipe_ready_sink_d_payload_last_be;
+        pipe_ready_source_payload_error <= pipe_ready_sink_d_payload_error;
+    end else begin
+        pipe_ready_source_valid <= pipe_ready_sink_valid;
+        pipe_ready_source_first <= pipe_ready_sink_first;
+        pipe_ready_source_last <= pipe_ready_sink_last;
+        pipe_ready_source_payload_data <= pipe_ready_sink_payload_data;
+        pipe_ready_source_payload_last_be <= pipe_ready_sink_payload_last_be;
+        pipe_ready_source_payload_error <= pipe_ready_sink_payload_error;
+    end
+end
+assign pipe_valid_sink_valid = sink_sink_valid;
+assign sink_sink_ready = pipe_valid_sink_ready;
+assign pipe_valid_sink_first = sink_sink_first;
+assign pipe_valid_sink_last = sink_sink_last;
+assign pipe_valid_sink_payload_data = sink_sink_payload_data;
+assign pipe_valid_sink_payload_last_be = sink_sink_payload_last_be;
+assign pipe_valid_sink_payload_error = sink_sink_payload_error;
+assign pipe_ready_sink_valid = pipe_valid_source_valid;
+assign pipe_valid_source_ready = pipe_ready_sink_ready;
+assign pipe_ready_sink_first = pipe_valid_source_first;
+assign pipe_ready_sink_last = pipe_valid_source_last;
+assign pipe_ready_sink_payload_data = pipe_valid_source_payload_data;
+assign pipe_ready_sink_payload_last_be = pipe_valid_source_payload_last_be;
+assign pipe_ready_sink_payload_error = pipe_valid_source_payload_error;
+assign source_source_valid = pipe_ready_source_valid;
+assign pipe_ready_source_ready = source_source_ready;
+assign source_source_first = pipe_ready_source_first;
+assign source_source_last = pipe_ready_source_last;
+assign source_source_payload_data = pipe_ready_source_payload_data;
+assign source_source_payload_last_be = pipe_ready_source_payload_last_be;
+assign source_source_payload_error = pipe_ready_source_payload_error;
 assign mac_core_tx_cdc_sink_sink_valid = mac_core_sink_valid;
 assign mac_core_sink_ready = mac_core_tx_cdc_sink_sink_ready;
 assign mac_core_tx_cdc_sink_sink_first = mac_core_sink_first;
@@ -3317,13 +3567,20 @@ assign mac_core_tx_cdc_sink_sink_last = mac_core_sink_last;
 assign mac_core_tx_cdc_sink_sink_payload_data = mac_core_sink_payload_data;
 assign mac_core_tx_cdc_sink_sink_payload_last_be = mac_core_sink_payload_last_be;
 assign mac_core_tx_cdc_sink_sink_payload_error = mac_core_sink_payload_error;
-assign mac_core_tx_converter_sink_valid = mac_core_tx_cdc_source_source_valid;
-assign mac_core_tx_cdc_source_source_ready = mac_core_tx_converter_sink_ready;
-assign mac_core_tx_converter_sink_first = mac_core_tx_cdc_source_source_first;
-assign mac_core_tx_converter_sink_last = mac_core_tx_cdc_source_source_last;
-assign mac_core_tx_converter_sink_payload_data = mac_core_tx_cdc_source_source_payload_data;
-assign mac_core_tx_converter_sink_payload_last_be = mac_core_tx_cdc_source_source_payload_last_be;
-assign mac_core_tx_converter_sink_payload_error = mac_core_tx_cdc_source_source_payload_error;
+assign sink_sink_valid = mac_core_tx_cdc_source_source_valid;
+assign mac_core_tx_cdc_source_source_ready = sink_sink_ready;
+assign sink_sink_first = mac_core_tx_cdc_source_source_first;
+assign sink_sink_last = mac_core_tx_cdc_source_source_last;
+assign sink_sink_payload_data = mac_core_tx_cdc_source_source_payload_data;
+assign sink_sink_payload_last_be = mac_core_tx_cdc_source_source_payload_last_be;
+assign sink_sink_payload_error = mac_core_tx_cdc_source_source_payload_error;
+assign mac_core_tx_converter_sink_valid = source_source_valid;
+assign source_source_ready = mac_core_tx_converter_sink_ready;
+assign mac_core_tx_converter_sink_first = source_source_first;
+assign mac_core_tx_converter_sink_last = source_source_last;
+assign mac_core_tx_converter_sink_payload_data = source_source_payload_data;
+assign mac_core_tx_converter_sink_payload_last_be = source_source_payload_last_be;
+assign mac_core_tx_converter_sink_payload_error = source_source_payload_error;
 assign mac_core_tx_last_be_sink_sink_valid = mac_core_tx_converter_source_valid;
 assign mac_core_tx_converter_source_ready = mac_core_tx_last_be_sink_sink_ready;
 assign mac_core_tx_last_be_sink_sink_first = mac_core_tx_converter_source_first;
@@ -6103,16 +6360,26 @@ assign lastbytetrim_sink_payload_error = strideconverter0_source_payload_error;
 assign lastbytetrim_sink_param_length = strideconverter0_source_param_length;
 assign lastbytetrim_sink_param_protocol = strideconverter0_source_param_protocol;
 assign lastbytetrim_sink_param_ip_address = strideconverter0_source_param_ip_address;
-assign holdingudprx_sink_valid = lastbytetrim_source_valid;
-assign lastbytetrim_source_ready = holdingudprx_sink_ready;
-assign holdingudprx_sink_first = lastbytetrim_source_first;
-assign holdingudprx_sink_last = lastbytetrim_source_last;
-assign holdingudprx_sink_payload_data = lastbytetrim_source_payload_data;
-assign holdingudprx_sink_payload_last_be = lastbytetrim_source_payload_last_be;
-assign holdingudprx_sink_payload_error = lastbytetrim_source_payload_error;
-assign holdingudprx_sink_param_length = lastbytetrim_source_param_length;
-assign holdingudprx_sink_param_protocol = lastbytetrim_source_param_protocol;
-assign holdingudprx_sink_param_ip_address = lastbytetrim_source_param_ip_address;
+assign buffer0_sink_sink_valid = lastbytetrim_source_valid;
+assign lastbytetrim_source_ready = buffer0_sink_sink_ready;
+assign buffer0_sink_sink_first = lastbytetrim_source_first;
+assign buffer0_sink_sink_last = lastbytetrim_source_last;
+assign buffer0_sink_sink_payload_data = lastbytetrim_source_payload_data;
+assign buffer0_sink_sink_payload_last_be = lastbytetrim_source_payload_last_be;
+assign buffer0_sink_sink_payload_error = lastbytetrim_source_payload_error;
+assign buffer0_sink_sink_param_length = lastbytetrim_source_param_length;
+assign buffer0_sink_sink_param_protocol = lastbytetrim_source_param_protocol;
+assign buffer0_sink_sink_param_ip_address = lastbytetrim_source_param_ip_address;
+assign holdingudprx_sink_valid = buffer0_source_source_valid;
+assign buffer0_source_source_ready = holdingudprx_sink_ready;
+assign holdingudprx_sink_first = buffer0_source_source_first;
+assign holdingudprx_sink_last = buffer0_source_source_last;
+assign holdingudprx_sink_payload_data = buffer0_source_source_payload_data;
+assign holdingudprx_sink_payload_last_be = buffer0_source_source_payload_last_be;
+assign holdingudprx_sink_payload_error = buffer0_source_source_payload_error;
+assign holdingudprx_sink_param_length = buffer0_source_source_param_length;
+assign holdingudprx_sink_param_protocol = buffer0_source_source_param_protocol;
+assign holdingudprx_sink_param_ip_address = buffer0_source_source_param_ip_address;
 assign maskedudpcrossbar_sink_valid = holdingudprx_source_valid;
 assign holdingudprx_source_ready = maskedudpcrossbar_sink_ready;
 assign maskedudpcrossbar_sink_first = holdingudprx_source_first;
@@ -6135,16 +6402,26 @@ assign liteethudptx_sink_sink_param_src_port = maskedudpcrossbar_source_param_sr
 assign liteethudptx_sink_sink_param_dst_port = maskedudpcrossbar_source_param_dst_port;
 assign liteethudptx_sink_sink_param_ip_address = maskedudpcrossbar_source_param_ip_address;
 assign liteethudptx_sink_sink_param_length = maskedudpcrossbar_source_param_length;
-assign strideconverter1_sink_valid = liteethudptx_source_source_valid;
-assign liteethudptx_source_source_ready = strideconverter1_sink_ready;
-assign strideconverter1_sink_first = liteethudptx_source_source_first;
-assign strideconverter1_sink_last = liteethudptx_source_source_last;
-assign strideconverter1_sink_payload_data = liteethudptx_source_source_payload_data;
-assign strideconverter1_sink_payload_last_be = liteethudptx_source_source_payload_last_be;
-assign strideconverter1_sink_payload_error = liteethudptx_source_source_payload_error;
-assign strideconverter1_sink_param_length = liteethudptx_source_source_param_length;
-assign strideconverter1_sink_param_protocol = liteethudptx_source_source_param_protocol;
-assign strideconverter1_sink_param_ip_address = liteethudptx_source_source_param_ip_address;
+assign buffer1_sink_sink_valid = liteethudptx_source_source_valid;
+assign liteethudptx_source_source_ready = buffer1_sink_sink_ready;
+assign buffer1_sink_sink_first = liteethudptx_source_source_first;
+assign buffer1_sink_sink_last = liteethudptx_source_source_last;
+assign buffer1_sink_sink_payload_data = liteethudptx_source_source_payload_data;
+assign buffer1_sink_sink_payload_last_be = liteethudptx_source_source_payload_last_be;
+assign buffer1_sink_sink_payload_error = liteethudptx_source_source_payload_error;
+assign buffer1_sink_sink_param_length = liteethudptx_source_source_param_length;
+assign buffer1_sink_sink_param_protocol = liteethudptx_source_source_param_protocol;
+assign buffer1_sink_sink_param_ip_address = liteethudptx_source_source_param_ip_address;
+assign strideconverter1_sink_valid = buffer1_source_source_valid;
+assign buffer1_source_source_ready = strideconverter1_sink_ready;
+assign strideconverter1_sink_first = buffer1_source_source_first;
+assign strideconverter1_sink_last = buffer1_source_source_last;
+assign strideconverter1_sink_payload_data = buffer1_source_source_payload_data;
+assign strideconverter1_sink_payload_last_be = buffer1_source_source_payload_last_be;
+assign strideconverter1_sink_payload_error = buffer1_source_source_payload_error;
+assign strideconverter1_sink_param_length = buffer1_source_source_param_length;
+assign strideconverter1_sink_param_protocol = buffer1_source_source_param_protocol;
+assign strideconverter1_sink_param_ip_address = buffer1_source_source_param_ip_address;
 assign tx_cdc_sink_sink_valid = strideconverter1_source_valid;
 assign strideconverter1_source_ready = tx_cdc_sink_sink_ready;
 assign tx_cdc_sink_sink_first = strideconverter1_source_first;
@@ -7121,6 +7398,134 @@ always @(*) begin
 end
 assign portudp_last = ((maskedudpcrossbar_sink_valid & maskedudpcrossbar_sink_last) & maskedudpcrossbar_sink_ready);
 assign portudp_ongoing0 = ((maskedudpcrossbar_sink_valid | portudp_ongoing1) & (~portudp_last));
+assign buffer0_pipe_valid_sink_ready = ((~buffer0_pipe_valid_source_valid) | buffer0_pipe_valid_source_ready);
+assign buffer0_pipe_ready_sink_ready = (~buffer0_pipe_ready_valid);
+always @(*) begin
+    buffer0_pipe_ready_source_first <= 1'd0;
+    buffer0_pipe_ready_source_last <= 1'd0;
+    buffer0_pipe_ready_source_param_ip_address <= 32'd0;
+    buffer0_pipe_ready_source_param_length <= 16'd0;
+    buffer0_pipe_ready_source_param_protocol <= 8'd0;
+    buffer0_pipe_ready_source_payload_data <= 8'd0;
+    buffer0_pipe_ready_source_payload_error <= 1'd0;
+    buffer0_pipe_ready_source_payload_last_be <= 1'd0;
+    buffer0_pipe_ready_source_valid <= 1'd0;
+    if (buffer0_pipe_ready_valid) begin
+        buffer0_pipe_ready_source_valid <= buffer0_pipe_ready_sink_d_valid;
+        buffer0_pipe_ready_source_first <= buffer0_pipe_ready_sink_d_first;
+        buffer0_pipe_ready_source_last <= buffer0_pipe_ready_sink_d_last;
+        buffer0_pipe_ready_source_payload_data <= buffer0_pipe_ready_sink_d_payload_data;
+        buffer0_pipe_ready_source_payload_last_be <= buffer0_pipe_ready_sink_d_payload_last_be;
+        buffer0_pipe_ready_source_payload_error <= buffer0_pipe_ready_sink_d_payload_error;
+        buffer0_pipe_ready_source_param_length <= buffer0_pipe_ready_sink_d_param_length;
+        buffer0_pipe_ready_source_param_protocol <= buffer0_pipe_ready_sink_d_param_protocol;
+        buffer0_pipe_ready_source_param_ip_address <= buffer0_pipe_ready_sink_d_param_ip_address;
+    end else begin
+        buffer0_pipe_ready_source_valid <= buffer0_pipe_ready_sink_valid;
+        buffer0_pipe_ready_source_first <= buffer0_pipe_ready_sink_first;
+        buffer0_pipe_ready_source_last <= buffer0_pipe_ready_sink_last;
+        buffer0_pipe_ready_source_payload_data <= buffer0_pipe_ready_sink_payload_data;
+        buffer0_pipe_ready_source_payload_last_be <= buffer0_pipe_ready_sink_payload_last_be;
+        buffer0_pipe_ready_source_payload_error <= buffer0_pipe_ready_sink_payload_error;
+        buffer0_pipe_ready_source_param_length <= buffer0_pipe_ready_sink_param_length;
+        buffer0_pipe_ready_source_param_protocol <= buffer0_pipe_ready_sink_param_protocol;
+        buffer0_pipe_ready_source_param_ip_address <= buffer0_pipe_ready_sink_param_ip_address;
+    end
+end
+assign buffer0_pipe_valid_sink_valid = buffer0_sink_sink_valid;
+assign buffer0_sink_sink_ready = buffer0_pipe_valid_sink_ready;
+assign buffer0_pipe_valid_sink_first = buffer0_sink_sink_first;
+assign buffer0_pipe_valid_sink_last = buffer0_sink_sink_last;
+assign buffer0_pipe_valid_sink_payload_data = buffer0_sink_sink_payload_data;
+assign buffer0_pipe_valid_sink_payload_last_be = buffer0_sink_sink_payload_last_be;
+assign buffer0_pipe_valid_sink_payload_error = buffer0_sink_sink_payload_error;
+assign buffer0_pipe_valid_sink_param_length = buffer0_sink_sink_param_length;
+assign buffer0_pipe_valid_sink_param_protocol = buffer0_sink_sink_param_protocol;
+assign buffer0_pipe_valid_sink_param_ip_address = buffer0_sink_sink_param_ip_address;
+assign buffer0_pipe_ready_sink_valid = buffer0_pipe_valid_source_valid;
+assign buffer0_pipe_valid_source_ready = buffer0_pipe_ready_sink_ready;
+assign buffer0_pipe_ready_sink_first = buffer0_pipe_valid_source_first;
+assign buffer0_pipe_ready_sink_last = buffer0_pipe_valid_source_last;
+assign buffer0_pipe_ready_sink_payload_data = buffer0_pipe_valid_source_payload_data;
+assign buffer0_pipe_ready_sink_payload_last_be = buffer0_pipe_valid_source_payload_last_be;
+assign buffer0_pipe_ready_sink_payload_error = buffer0_pipe_valid_source_payload_error;
+assign buffer0_pipe_ready_sink_param_length = buffer0_pipe_valid_source_param_length;
+assign buffer0_pipe_ready_sink_param_protocol = buffer0_pipe_valid_source_param_protocol;
+assign buffer0_pipe_ready_sink_param_ip_address = buffer0_pipe_valid_source_param_ip_address;
+assign buffer0_source_source_valid = buffer0_pipe_ready_source_valid;
+assign buffer0_pipe_ready_source_ready = buffer0_source_source_ready;
+assign buffer0_source_source_first = buffer0_pipe_ready_source_first;
+assign buffer0_source_source_last = buffer0_pipe_ready_source_last;
+assign buffer0_source_source_payload_data = buffer0_pipe_ready_source_payload_data;
+assign buffer0_source_source_payload_last_be = buffer0_pipe_ready_source_payload_last_be;
+assign buffer0_source_source_payload_error = buffer0_pipe_ready_source_payload_error;
+assign buffer0_source_source_param_length = buffer0_pipe_ready_source_param_length;
+assign buffer0_source_source_param_protocol = buffer0_pipe_ready_source_param_protocol;
+assign buffer0_source_source_param_ip_address = buffer0_pipe_ready_source_param_ip_address;
+assign buffer1_pipe_valid_sink_ready = ((~buffer1_pipe_valid_source_valid) | buffer1_pipe_valid_source_ready);
+assign buffer1_pipe_ready_sink_ready = (~buffer1_pipe_ready_valid);
+always @(*) begin
+    buffer1_pipe_ready_source_first <= 1'd0;
+    buffer1_pipe_ready_source_last <= 1'd0;
+    buffer1_pipe_ready_source_param_ip_address <= 32'd0;
+    buffer1_pipe_ready_source_param_length <= 16'd0;
+    buffer1_pipe_ready_source_param_protocol <= 8'd0;
+    buffer1_pipe_ready_source_payload_data <= 8'd0;
+    buffer1_pipe_ready_source_payload_error <= 1'd0;
+    buffer1_pipe_ready_source_payload_last_be <= 1'd0;
+    buffer1_pipe_ready_source_valid <= 1'd0;
+    if (buffer1_pipe_ready_valid) begin
+        buffer1_pipe_ready_source_valid <= buffer1_pipe_ready_sink_d_valid;
+        buffer1_pipe_ready_source_first <= buffer1_pipe_ready_sink_d_first;
+        buffer1_pipe_ready_source_last <= buffer1_pipe_ready_sink_d_last;
+        buffer1_pipe_ready_source_payload_data <= buffer1_pipe_ready_sink_d_payload_data;
+        buffer1_pipe_ready_source_payload_last_be <= buffer1_pipe_ready_sink_d_payload_last_be;
+        buffer1_pipe_ready_source_payload_error <= buffer1_pipe_ready_sink_d_payload_error;
+        buffer1_pipe_ready_source_param_length <= buffer1_pipe_ready_sink_d_param_length;
+        buffer1_pipe_ready_source_param_protocol <= buffer1_pipe_ready_sink_d_param_protocol;
+        buffer1_pipe_ready_source_param_ip_address <= buffer1_pipe_ready_sink_d_param_ip_address;
+    end else begin
+        buffer1_pipe_ready_source_valid <= buffer1_pipe_ready_sink_valid;
+        buffer1_pipe_ready_source_first <= buffer1_pipe_ready_sink_first;
+        buffer1_pipe_ready_source_last <= buffer1_pipe_ready_sink_last;
+        buffer1_pipe_ready_source_payload_data <= buffer1_pipe_ready_sink_payload_data;
+        buffer1_pipe_ready_source_payload_last_be <= buffer1_pipe_ready_sink_payload_last_be;
+        buffer1_pipe_ready_source_payload_error <= buffer1_pipe_ready_sink_payload_error;
+        buffer1_pipe_ready_source_param_length <= buffer1_pipe_ready_sink_param_length;
+        buffer1_pipe_ready_source_param_protocol <= buffer1_pipe_ready_sink_param_protocol;
+        buffer1_pipe_ready_source_param_ip_address <= buffer1_pipe_ready_sink_param_ip_address;
+    end
+end
+assign buffer1_pipe_valid_sink_valid = buffer1_sink_sink_valid;
+assign buffer1_sink_sink_ready = buffer1_pipe_valid_sink_ready;
+assign buffer1_pipe_valid_sink_first = buffer1_sink_sink_first;
+assign buffer1_pipe_valid_sink_last = buffer1_sink_sink_last;
+assign buffer1_pipe_valid_sink_payload_data = buffer1_sink_sink_payload_data;
+assign buffer1_pipe_valid_sink_payload_last_be = buffer1_sink_sink_payload_last_be;
+assign buffer1_pipe_valid_sink_payload_error = buffer1_sink_sink_payload_error;
+assign buffer1_pipe_valid_sink_param_length = buffer1_sink_sink_param_length;
+assign buffer1_pipe_valid_sink_param_protocol = buffer1_sink_sink_param_protocol;
+assign buffer1_pipe_valid_sink_param_ip_address = buffer1_sink_sink_param_ip_address;
+assign buffer1_pipe_ready_sink_valid = buffer1_pipe_valid_source_valid;
+assign buffer1_pipe_valid_source_ready = buffer1_pipe_ready_sink_ready;
+assign buffer1_pipe_ready_sink_first = buffer1_pipe_valid_source_first;
+assign buffer1_pipe_ready_sink_last = buffer1_pipe_valid_source_last;
+assign buffer1_pipe_ready_sink_payload_data = buffer1_pipe_valid_source_payload_data;
+assign buffer1_pipe_ready_sink_payload_last_be = buffer1_pipe_valid_source_payload_last_be;
+assign buffer1_pipe_ready_sink_payload_error = buffer1_pipe_valid_source_payload_error;
+assign buffer1_pipe_ready_sink_param_length = buffer1_pipe_valid_source_param_length;
+assign buffer1_pipe_ready_sink_param_protocol = buffer1_pipe_valid_source_param_protocol;
+assign buffer1_pipe_ready_sink_param_ip_address = buffer1_pipe_valid_source_param_ip_address;
+assign buffer1_source_source_valid = buffer1_pipe_ready_source_valid;
+assign buffer1_pipe_ready_source_ready = buffer1_source_source_ready;
+assign buffer1_source_source_first = buffer1_pipe_ready_source_first;
+assign buffer1_source_source_last = buffer1_pipe_ready_source_last;
+assign buffer1_source_source_payload_data = buffer1_pipe_ready_source_payload_data;
+assign buffer1_source_source_payload_last_be = buffer1_pipe_ready_source_payload_last_be;
+assign buffer1_source_source_payload_error = buffer1_pipe_ready_source_payload_error;
+assign buffer1_source_source_param_length = buffer1_pipe_ready_source_param_length;
+assign buffer1_source_source_param_protocol = buffer1_pipe_ready_source_param_protocol;
+assign buffer1_source_source_param_ip_address = buffer1_pipe_ready_source_param_ip_address;
 assign pulsemerge0_total0 = ((((1'd0 + mac_cut) + ip_rx_cut) + ip_rx_drop_header) + pulsemerge0_backlog0);
 assign pulsemerge0_o0 = (pulsemerge0_total0 != 1'd0);
 assign pulsesynchronizer0_o = (pulsesynchronizer0_toggle_o ^ pulsesynchronizer0_toggle_o_r);
@@ -7529,6 +7934,30 @@ always @(posedge eth_tx_clk) begin
     if (mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value_ce) begin
         mac_core_tx_gap_counter <= mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value;
     end
+    if (((~pipe_valid_source_valid) | pipe_valid_source_ready)) begin
+        pipe_valid_source_valid <= pipe_valid_sink_valid;
+        pipe_valid_source_first <= pipe_valid_sink_first;
+        pipe_valid_source_last <= pipe_valid_sink_last;
+        pipe_valid_source_payload_data <= pipe_valid_sink_payload_data;
+        pipe_valid_source_payload_last_be <= pipe_valid_sink_payload_last_be;
+        pipe_valid_source_payload_error <= pipe_valid_sink_payload_error;
+    end
+    if ((pipe_ready_sink_valid & (~pipe_ready_source_ready))) begin
+        pipe_ready_valid <= 1'd1;
+    end else begin
+        if (pipe_ready_source_ready) begin
+            pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~pipe_ready_source_ready) & (~pipe_ready_valid))) begin
+        pipe_ready_sink_d_valid <= pipe_ready_sink_valid;
+        pipe_ready_sink_d_ready <= pipe_ready_sink_ready;
+        pipe_ready_sink_d_first <= pipe_ready_sink_first;
+        pipe_ready_sink_d_last <= pipe_ready_sink_last;
+        pipe_ready_sink_d_payload_data <= pipe_ready_sink_payload_data;
+        pipe_ready_sink_d_payload_last_be <= pipe_ready_sink_payload_last_be;
+        pipe_ready_sink_d_payload_error <= pipe_ready_sink_payload_error;
+    end
     if (eth_tx_rst) begin
         mac_core_tx_cdc_cdc_graycounter1_q <= 6'd0;
         mac_core_tx_cdc_cdc_graycounter1_q_binary <= 6'd0;
@@ -7540,6 +7969,16 @@ always @(posedge eth_tx_clk) begin
         mac_core_tx_crc_pipe_valid_source_payload_data <= 8'd0;
         mac_core_tx_crc_pipe_valid_source_payload_last_be <= 1'd0;
         mac_core_tx_crc_pipe_valid_source_payload_error <= 1'd0;
+        pipe_valid_source_valid <= 1'd0;
+        pipe_valid_source_payload_data <= 32'd0;
+        pipe_valid_source_payload_last_be <= 4'd0;
+        pipe_valid_source_payload_error <= 4'd0;
+        pipe_ready_valid <= 1'd0;
+        pipe_ready_sink_d_valid <= 1'd0;
+        pipe_ready_sink_d_ready <= 1'd0;
+        pipe_ready_sink_d_payload_data <= 32'd0;
+        pipe_ready_sink_d_payload_last_be <= 4'd0;
+        pipe_ready_sink_d_payload_error <= 4'd0;
         liteethmac_txdatapath_liteethmactxlastbe_state <= 1'd0;
         liteethmac_txdatapath_liteethmacpaddinginserter_state <= 1'd0;
         liteethmac_txdatapath_bufferizeendpoints_state <= 2'd0;
@@ -7689,6 +8128,66 @@ always @(posedge port_clk) begin
             portudp_first <= 1'd0;
         end
     end
+    if (((~buffer0_pipe_valid_source_valid) | buffer0_pipe_valid_source_ready)) begin
+        buffer0_pipe_valid_source_valid <= buffer0_pipe_valid_sink_valid;
+        buffer0_pipe_valid_source_first <= buffer0_pipe_valid_sink_first;
+        buffer0_pipe_valid_source_last <= buffer0_pipe_valid_sink_last;
+        buffer0_pipe_valid_source_payload_data <= buffer0_pipe_valid_sink_payload_data;
+        buffer0_pipe_valid_source_payload_last_be <= buffer0_pipe_valid_sink_payload_last_be;
+        buffer0_pipe_valid_source_payload_error <= buffer0_pipe_valid_sink_payload_error;
+        buffer0_pipe_valid_source_param_length <= buffer0_pipe_valid_sink_param_length;
+        buffer0_pipe_valid_source_param_protocol <= buffer0_pipe_valid_sink_param_protocol;
+        buffer0_pipe_valid_source_param_ip_address <= buffer0_pipe_valid_sink_param_ip_address;
+    end
+    if ((buffer0_pipe_ready_sink_valid & (~buffer0_pipe_ready_source_ready))) begin
+        buffer0_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (buffer0_pipe_ready_source_ready) begin
+            buffer0_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~buffer0_pipe_ready_source_ready) & (~buffer0_pipe_ready_valid))) begin
+        buffer0_pipe_ready_sink_d_valid <= buffer0_pipe_ready_sink_valid;
+        buffer0_pipe_ready_sink_d_ready <= buffer0_pipe_ready_sink_ready;
+        buffer0_pipe_ready_sink_d_first <= buffer0_pipe_ready_sink_first;
+        buffer0_pipe_ready_sink_d_last <= buffer0_pipe_ready_sink_last;
+        buffer0_pipe_ready_sink_d_payload_data <= buffer0_pipe_ready_sink_payload_data;
+        buffer0_pipe_ready_sink_d_payload_last_be <= buffer0_pipe_ready_sink_payload_last_be;
+        buffer0_pipe_ready_sink_d_payload_error <= buffer0_pipe_ready_sink_payload_error;
+        buffer0_pipe_ready_sink_d_param_length <= buffer0_pipe_ready_sink_param_length;
+        buffer0_pipe_ready_sink_d_param_protocol <= buffer0_pipe_ready_sink_param_protocol;
+        buffer0_pipe_ready_sink_d_param_ip_address <= buffer0_pipe_ready_sink_param_ip_address;
+    end
+    if (((~buffer1_pipe_valid_source_valid) | buffer1_pipe_valid_source_ready)) begin
+        buffer1_pipe_valid_source_valid <= buffer1_pipe_valid_sink_valid;
+        buffer1_pipe_valid_source_first <= buffer1_pipe_valid_sink_first;
+        buffer1_pipe_valid_source_last <= buffer1_pipe_valid_sink_last;
+        buffer1_pipe_valid_source_payload_data <= buffer1_pipe_valid_sink_payload_data;
+        buffer1_pipe_valid_source_payload_last_be <= buffer1_pipe_valid_sink_payload_last_be;
+        buffer1_pipe_valid_source_payload_error <= buffer1_pipe_valid_sink_payload_error;
+        buffer1_pipe_valid_source_param_length <= buffer1_pipe_valid_sink_param_length;
+        buffer1_pipe_valid_source_param_protocol <= buffer1_pipe_valid_sink_param_protocol;
+        buffer1_pipe_valid_source_param_ip_address <= buffer1_pipe_valid_sink_param_ip_address;
+    end
+    if ((buffer1_pipe_ready_sink_valid & (~buffer1_pipe_ready_source_ready))) begin
+        buffer1_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (buffer1_pipe_ready_source_ready) begin
+            buffer1_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~buffer1_pipe_ready_source_ready) & (~buffer1_pipe_ready_valid))) begin
+        buffer1_pipe_ready_sink_d_valid <= buffer1_pipe_ready_sink_valid;
+        buffer1_pipe_ready_sink_d_ready <= buffer1_pipe_ready_sink_ready;
+        buffer1_pipe_ready_sink_d_first <= buffer1_pipe_ready_sink_first;
+        buffer1_pipe_ready_sink_d_last <= buffer1_pipe_ready_sink_last;
+        buffer1_pipe_ready_sink_d_payload_data <= buffer1_pipe_ready_sink_payload_data;
+        buffer1_pipe_ready_sink_d_payload_last_be <= buffer1_pipe_ready_sink_payload_last_be;
+        buffer1_pipe_ready_sink_d_payload_error <= buffer1_pipe_ready_sink_payload_error;
+        buffer1_pipe_ready_sink_d_param_length <= buffer1_pipe_ready_sink_param_length;
+        buffer1_pipe_ready_sink_d_param_protocol <= buffer1_pipe_ready_sink_param_protocol;
+        buffer1_pipe_ready_sink_d_param_ip_address <= buffer1_pipe_ready_sink_param_ip_address;
+    end
     pulsesynchronizer0_toggle_o_r <= pulsesynchronizer0_toggle_o;
     pulsemerge0_backlog1 <= (pulsemerge0_total1 - pulsemerge0_o1);
     pulsesynchronizer1_toggle_o_r <= pulsesynchronizer1_toggle_o;
@@ -7719,6 +8218,26 @@ always @(posedge port_clk) begin
         strideconverter1_converter_strobe_all <= 1'd0;
         tx_cdc_cdc_graycounter0_q <= 5'd0;
         tx_cdc_cdc_graycounter0_q_binary <= 5'd0;
+        buffer0_pipe_valid_source_valid <= 1'd0;
+        buffer0_pipe_valid_source_payload_data <= 8'd0;
+        buffer0_pipe_valid_source_payload_last_be <= 1'd0;
+        buffer0_pipe_valid_source_payload_error <= 1'd0;
+        buffer0_pipe_ready_valid <= 1'd0;
+        buffer0_pipe_ready_sink_d_valid <= 1'd0;
+        buffer0_pipe_ready_sink_d_ready <= 1'd0;
+        buffer0_pipe_ready_sink_d_payload_data <= 8'd0;
+        buffer0_pipe_ready_sink_d_payload_last_be <= 1'd0;
+        buffer0_pipe_ready_sink_d_payload_error <= 1'd0;
+        buffer1_pipe_valid_source_valid <= 1'd0;
+        buffer1_pipe_valid_source_payload_data <= 8'd0;
+        buffer1_pipe_valid_source_payload_last_be <= 1'd0;
+        buffer1_pipe_valid_source_payload_error <= 1'd0;
+        buffer1_pipe_ready_valid <= 1'd0;
+        buffer1_pipe_ready_sink_d_valid <= 1'd0;
+        buffer1_pipe_ready_sink_d_ready <= 1'd0;
+        buffer1_pipe_ready_sink_d_payload_data <= 8'd0;
+        buffer1_pipe_ready_sink_d_payload_last_be <= 1'd0;
+        buffer1_pipe_ready_sink_d_payload_error <= 1'd0;
         pulsemerge0_backlog1 <= 3'd0;
         pulsemerge1_backlog1 <= 3'd0;
         portudp_lastbytetrim_state <= 1'd0;
@@ -7905,14 +8424,14 @@ always @(posedge sys_clk) begin
             arp_table_request_timer_count <= (arp_table_request_timer_count - 1'd1);
         end
     end else begin
-        arp_table_request_timer_count <= 23'd6250000;
+        arp_table_request_timer_count <= 23'd5208330;
     end
     if (arp_table_cache_wait) begin
         if ((~arp_table_cache_done)) begin
             arp_table_cache_count <= (arp_table_cache_count - 1'd1);
         end
     end else begin
-        arp_table_cache_count <= 26'd62500000;
+        arp_table_cache_count <= 26'd52083300;
     end
     liteetharpcache_state <= liteetharpcache_next_state;
     if (arp_table_cache_update_count_liteetharp_liteetharpcache_next_value_ce0) begin
@@ -8287,11 +8806,11 @@ always @(posedge sys_clk) begin
         arp_table_response_response_payload_mac_address <= 48'd0;
         arp_table_request_pending <= 1'd0;
         arp_table_request_counter <= 3'd0;
-        arp_table_request_timer_count <= 23'd6250000;
+        arp_table_request_timer_count <= 23'd5208330;
         arp_table_cache_update_count <= 1'd0;
         arp_table_cache_search_count <= 1'd0;
         arp_table_cache_error <= 1'd0;
-        arp_table_cache_count <= 26'd62500000;
+        arp_table_cache_count <= 26'd52083300;
         ip_tx_pipe_valid_source_valid <= 1'd0;
         ip_tx_pipe_valid_source_payload_data <= 32'd0;
         ip_tx_pipe_valid_source_payload_last_be <= 4'd0;

@@ -100,6 +100,10 @@ UDPPortCore
 │    │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── liteethmacgap_0* (LiteEthMACGap)
 │    │    │    │    │    └─── fsm (FSM)
+│    │    │    │    └─── tx_buffer (Buffer)
+│    │    │    │    │    └─── pipe_valid (PipeValid)
+│    │    │    │    │    └─── pipe_ready (PipeReady)
+│    │    │    │    │    └─── pipeline (Pipeline)
 │    │    │    │    └─── pipeline_0* (Pipeline)
 │    │    │    └─── rx_datapath (RXDatapath)
 │    │    │    │    └─── liteethmacpreamblechecker_0* (LiteEthMACPreambleChecker)
@@ -231,6 +235,14 @@ UDPPortCore
 │    │    │    └─── arbiter (Arbiter)
 │    │    │    └─── dispatcher (Dispatcher)
 │    │    │    │    └─── status_0* (Status)
+│    │    └─── rx_buffer (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
+│    │    └─── tx_buffer (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
 └─── rx_drop_header_core (PulseMerge)
 └─── rx_drop_header_port (PulseMerge)
 └─── rx_drop_other_core (PulseMerge)
@@ -1994,6 +2006,42 @@ reg           main_mac_packetizer_source_valid = 1'd0;
 reg   [111:0] main_mac_packetizer_sr = 112'd0;
 reg           main_mac_packetizer_sr_load = 1'd0;
 reg           main_mac_packetizer_sr_shift = 1'd0;
+reg           main_pipe_ready_sink_d_first = 1'd0;
+reg           main_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] main_pipe_ready_sink_d_payload_data = 32'd0;
+reg     [3:0] main_pipe_ready_sink_d_payload_error = 4'd0;
+reg     [3:0] main_pipe_ready_sink_d_payload_last_be = 4'd0;
+reg           main_pipe_ready_sink_d_ready = 1'd0;
+reg           main_pipe_ready_sink_d_valid = 1'd0;
+wire          main_pipe_ready_sink_first;
+wire          main_pipe_ready_sink_last;
+wire   [31:0] main_pipe_ready_sink_payload_data;
+wire    [3:0] main_pipe_ready_sink_payload_error;
+wire    [3:0] main_pipe_ready_sink_payload_last_be;
+wire          main_pipe_ready_sink_ready;
+wire          main_pipe_ready_sink_valid;
+reg           main_pipe_ready_source_first = 1'd0;
+reg           main_pipe_ready_source_last = 1'd0;
+reg    [31:0] main_pipe_ready_source_payload_data = 32'd0;
+reg     [3:0] main_pipe_ready_source_payload_error = 4'd0;
+reg     [3:0] main_pipe_ready_source_payload_last_be = 4'd0;
+wire          main_pipe_ready_source_ready;
+reg           main_pipe_ready_source_valid = 1'd0;
+reg           main_pipe_ready_valid = 1'd0;
+wire          main_pipe_valid_sink_first;
+wire          main_pipe_valid_sink_last;
+wire   [31:0] main_pipe_valid_sink_payload_data;
+wire    [3:0] main_pipe_valid_sink_payload_error;
+wire    [3:0] main_pipe_valid_sink_payload_last_be;
+wire          main_pipe_valid_sink_ready;
+wire          main_pipe_valid_sink_valid;
+reg           main_pipe_valid_source_first = 1'd0;
+reg           main_pipe_valid_source_last = 1'd0;
+reg    [31:0] main_pipe_valid_source_payload_data = 32'd0;
+reg     [3:0] main_pipe_valid_source_payload_error = 4'd0;
+reg     [3:0] main_pipe_valid_source_payload_last_be = 4'd0;
+wire          main_pipe_valid_source_ready;
+reg           main_pipe_valid_source_valid = 1'd0;
 wire          main_port_internal_port_sink_first;
 wire          main_port_internal_port_sink_last;
 wire   [15:0] main_port_internal_port_sink_param_dst_port;
@@ -2181,6 +2229,13 @@ wire    [7:0] main_sink_payload_data;
 wire          main_sink_payload_error;
 wire          main_sink_payload_last_be;
 reg           main_sink_ready = 1'd0;
+wire          main_sink_sink_first;
+wire          main_sink_sink_last;
+wire   [31:0] main_sink_sink_payload_data;
+wire    [3:0] main_sink_sink_payload_error;
+wire    [3:0] main_sink_sink_payload_last_be;
+wire          main_sink_sink_ready;
+wire          main_sink_sink_valid;
 wire          main_sink_valid;
 reg           main_soc_rst = 1'd0;
 reg           main_source_first = 1'd0;
@@ -2189,9 +2244,158 @@ reg     [7:0] main_source_payload_data = 8'd0;
 reg           main_source_payload_error = 1'd0;
 wire          main_source_payload_last_be;
 wire          main_source_ready;
+wire          main_source_source_first;
+wire          main_source_source_last;
+wire   [31:0] main_source_source_payload_data;
+wire    [3:0] main_source_source_payload_error;
+wire    [3:0] main_source_source_payload_last_be;
+wire          main_source_source_ready;
+wire          main_source_source_valid;
 reg           main_source_valid = 1'd0;
 reg           main_storage = 1'd0;
 wire          main_take_group;
+reg           main_udp_buffer0_pipe_ready_sink_d_first = 1'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] main_udp_buffer0_pipe_ready_sink_d_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer0_pipe_ready_sink_d_param_length = 16'd0;
+reg     [7:0] main_udp_buffer0_pipe_ready_sink_d_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer0_pipe_ready_sink_d_payload_data = 8'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_payload_error = 1'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_payload_last_be = 1'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_ready = 1'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_valid = 1'd0;
+wire          main_udp_buffer0_pipe_ready_sink_first;
+wire          main_udp_buffer0_pipe_ready_sink_last;
+wire   [31:0] main_udp_buffer0_pipe_ready_sink_param_ip_address;
+wire   [15:0] main_udp_buffer0_pipe_ready_sink_param_length;
+wire    [7:0] main_udp_buffer0_pipe_ready_sink_param_protocol;
+wire    [7:0] main_udp_buffer0_pipe_ready_sink_payload_data;
+wire          main_udp_buffer0_pipe_ready_sink_payload_error;
+wire          main_udp_buffer0_pipe_ready_sink_payload_last_be;
+wire          main_udp_buffer0_pipe_ready_sink_ready;
+wire          main_udp_buffer0_pipe_ready_sink_valid;
+reg           main_udp_buffer0_pipe_ready_source_first = 1'd0;
+reg           main_udp_buffer0_pipe_ready_source_last = 1'd0;
+reg    [31:0] main_udp_buffer0_pipe_ready_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer0_pipe_ready_source_param_length = 16'd0;
+reg     [7:0] main_udp_buffer0_pipe_ready_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer0_pipe_ready_source_payload_data = 8'd0;
+reg           main_udp_buffer0_pipe_ready_source_payload_error = 1'd0;
+reg           main_udp_buffer0_pipe_ready_source_payload_last_be = 1'd0;
+wire          main_udp_buffer0_pipe_ready_source_ready;
+reg           main_udp_buffer0_pipe_ready_source_valid = 1'd0;
+reg           main_udp_buffer0_pipe_ready_valid = 1'd0;
+wire          main_udp_buffer0_pipe_valid_sink_first;
+wire          main_udp_buffer0_pipe_valid_sink_last;
+wire   [31:0] main_udp_buffer0_pipe_valid_sink_param_ip_address;
+wire   [15:0] main_udp_buffer0_pipe_valid_sink_param_length;
+wire    [7:0] main_udp_buffer0_pipe_valid_sink_param_protocol;
+wire    [7:0] main_udp_buffer0_pipe_valid_sink_payload_data;
+wire          main_udp_buffer0_pipe_valid_sink_payload_error;
+wire          main_udp_buffer0_pipe_valid_sink_payload_last_be;
+wire          main_udp_buffer0_pipe_valid_sink_ready;
+wire          main_udp_buffer0_pipe_valid_sink_valid;
+reg           main_udp_buffer0_pipe_valid_source_first = 1'd0;
+reg           main_udp_buffer0_pipe_valid_source_last = 1'd0;
+reg    [31:0] main_udp_buffer0_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer0_pipe_valid_source_param_length = 16'd0;
+reg     [7:0] main_udp_buffer0_pipe_valid_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer0_pipe_valid_source_payload_data = 8'd0;
+reg           main_udp_buffer0_pipe_valid_source_payload_error = 1'd0;
+reg           main_udp_buffer0_pipe_valid_source_payload_last_be = 1'd0;
+wire          main_udp_buffer0_pipe_valid_source_ready;
+reg           main_udp_buffer0_pipe_valid_source_valid = 1'd0;
+wire          main_udp_buffer0_sink_sink_first;
+wire          main_udp_buffer0_sink_sink_last;
+wire   [31:0] main_udp_buffer0_sink_sink_param_ip_address;
+wire   [15:0] main_udp_buffer0_sink_sink_param_length;
+wire    [7:0] main_udp_buffer0_sink_sink_param_protocol;
+wire    [7:0] main_udp_buffer0_sink_sink_payload_data;
+wire          main_udp_buffer0_sink_sink_payload_error;
+wire          main_udp_buffer0_sink_sink_payload_last_be;
+wire          main_udp_buffer0_sink_sink_ready;
+wire          main_udp_buffer0_sink_sink_valid;
+wire          main_udp_buffer0_source_source_first;
+wire          main_udp_buffer0_source_source_last;
+wire   [31:0] main_udp_buffer0_source_source_param_ip_address;
+wire   [15:0] main_udp_buffer0_source_source_param_length;
+wire    [7:0] main_udp_buffer0_source_source_param_protocol;
+wire    [7:0] main_udp_buffer0_source_source_payload_data;
+wire          main_udp_buffer0_source_source_payload_error;
+wire          main_udp_buffer0_source_source_payload_last_be;
+wire          main_udp_buffer0_source_source_ready;
+wire          main_udp_buffer0_source_source_valid;
+reg           main_udp_buffer1_pipe_ready_sink_d_first = 1'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] main_udp_buffer1_pipe_ready_sink_d_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer1_pipe_ready_sink_d_param_length = 16'd0;
+reg     [7:0] main_udp_buffer1_pipe_ready_sink_d_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer1_pipe_ready_sink_d_payload_data = 8'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_payload_error = 1'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_payload_last_be = 1'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_ready = 1'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_valid = 1'd0;
+wire          main_udp_buffer1_pipe_ready_sink_first;
+wire          main_udp_buffer1_pipe_ready_sink_last;
+wire   [31:0] main_udp_buffer1_pipe_ready_sink_param_ip_address;
+wire   [15:0] main_udp_buffer1_pipe_ready_sink_param_length;
+wire    [7:0] main_udp_buffer1_pipe_ready_sink_param_protocol;
+wire    [7:0] main_udp_buffer1_pipe_ready_sink_payload_data;
+wire          main_udp_buffer1_pipe_ready_sink_payload_error;
+wire          main_udp_buffer1_pipe_ready_sink_payload_last_be;
+wire          main_udp_buffer1_pipe_ready_sink_ready;
+wire          main_udp_buffer1_pipe_ready_sink_valid;
+reg           main_udp_buffer1_pipe_ready_source_first = 1'd0;
+reg           main_udp_buffer1_pipe_ready_source_last = 1'd0;
+reg    [31:0] main_udp_buffer1_pipe_ready_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer1_pipe_ready_source_param_length = 16'd0;
+reg     [7:0] main_udp_buffer1_pipe_ready_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer1_pipe_ready_source_payload_data = 8'd0;
+reg           main_udp_buffer1_pipe_ready_source_payload_error = 1'd0;
+reg           main_udp_buffer1_pipe_ready_source_payload_last_be = 1'd0;
+wire          main_udp_buffer1_pipe_ready_source_ready;
+reg           main_udp_buffer1_pipe_ready_source_valid = 1'd0;
+reg           main_udp_buffer1_pipe_ready_valid = 1'd0;
+wire          main_udp_buffer1_pipe_valid_sink_first;
+wire          main_udp_buffer1_pipe_valid_sink_last;
+wire   [31:0] main_udp_buffer1_pipe_valid_sink_param_ip_address;
+wire   [15:0] main_udp_buffer1_pipe_valid_sink_param_length;
+wire    [7:0] main_udp_buffer1_pipe_valid_sink_param_protocol;
+wire    [7:0] main_udp_buffer1_pipe_valid_sink_payload_data;
+wire          main_udp_buffer1_pipe_valid_sink_payload_error;
+wire          main_udp_buffer1_pipe_valid_sink_payload_last_be;
+wire          main_udp_buffer1_pipe_valid_sink_ready;
+wire          main_udp_buffer1_pipe_valid_sink_valid;
+reg           main_udp_buffer1_pipe_valid_source_first = 1'd0;
+reg           main_udp_buffer1_pipe_valid_source_last = 1'd0;
+reg    [31:0] main_udp_buffer1_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer1_pipe_valid_source_param_length = 16'd0;
+reg     [7:0] main_udp_buffer1_pipe_valid_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer1_pipe_valid_source_payload_data = 8'd0;
+reg           main_udp_buffer1_pipe_valid_source_payload_error = 1'd0;
+reg           main_udp_buffer1_pipe_valid_source_payload_last_be = 1'd0;
+wire          main_udp_buffer1_pipe_valid_source_ready;
+reg           main_udp_buffer1_pipe_valid_source_valid = 1'd0;
+wire          main_udp_buffer1_sink_sink_first;
+wire          main_udp_buffer1_sink_sink_last;
+wire   [31:0] main_udp_buffer1_sink_sink_param_ip_address;
+wire   [15:0] main_udp_buffer1_sink_sink_param_length;
+wire    [7:0] main_udp_buffer1_sink_sink_param_protocol;
+wire    [7:0] main_udp_buffer1_sink_sink_payload_data;
+wire          main_udp_buffer1_sink_sink_payload_error;
+wire          main_udp_buffer1_sink_sink_payload_last_be;
+wire          main_udp_buffer1_sink_sink_ready;
+wire          main_udp_buffer1_sink_sink_valid;
+wire          main_udp_buffer1_source_source_first;
+wire          main_udp_buffer1_source_source_last;
+wire   [31:0] main_udp_buffer1_source_source_param_ip_address;
+wire   [15:0] main_udp_buffer1_source_source_param_length;
+wire    [7:0] main_udp_buffer1_source_source_param_protocol;
+wire    [7:0] main_udp_buffer1_source_source_payload_data;
+wire          main_udp_buffer1_source_source_payload_error;
+wire          main_udp_buffer1_source_source_payload_last_be;
+wire          main_udp_buffer1_source_source_ready;
+wire          main_udp_buffer1_source_source_valid;
 reg    [15:0] main_udp_holdingudprx0 = 16'd0;
 reg    [15:0] main_udp_holdingudprx0_holdingudprx_next_value4 = 16'd0;
 reg           main_udp_holdingudprx0_holdingudprx_next_value_ce4 = 1'd0;
@@ -3095,6 +3299,52 @@ always @(*) begin
         end
     endcase
 end
+assign main_pipe_valid_sink_ready = ((~main_pipe_valid_source_valid) | main_pipe_valid_source_ready);
+assign main_pipe_ready_sink_ready = (~main_pipe_ready_valid);
+always @(*) begin
+    main_pipe_ready_source_first <= 1'd0;
+    main_pipe_ready_source_last <= 1'd0;
+    main_pipe_ready_source_payload_data <= 32'd0;
+    main_pipe_ready_source_payload_error <= 4'd0;
+    main_pipe_ready_source_payload_last_be <= 4'd0;
+    main_pipe_ready_source_valid <= 1'd0;
+    if (main_pipe_ready_valid) begin
+        main_pipe_ready_source_valid <= main_pipe_ready_sink_d_valid;
+        main_pipe_ready_source_first <= main_pipe_ready_sink_d_first;
+        main_pipe_ready_source_last <= main_pipe_ready_sink_d_last;
+        main_pipe_ready_source_payload_data <= main_pipe_ready_sink_d_payload_data;
+        main_pipe_ready_source_payload_last_be <= main_pipe_ready_sink_d_payload_last_be;
+        main_pipe_ready_source_payload_error <= main_pipe_ready_sink_d_payload_error;
+    end else begin
+        main_pipe_ready_source_valid <= main_pipe_ready_sink_valid;
+        main_pipe_ready_source_first <= main_pipe_ready_sink_first;
+        main_pipe_ready_source_last <= main_pipe_ready_sink_last;
+        main_pipe_ready_source_payload_data <= main_pipe_ready_sink_payload_data;
+        main_pipe_ready_source_payload_last_be <= main_pipe_ready_sink_payload_last_be;
+        main_pipe_ready_source_payload_error <= main_pipe_ready_sink_payload_error;
+    end
+end
+assign main_pipe_valid_sink_valid = main_sink_sink_valid;
+assign main_sink_sink_ready = main_pipe_valid_sink_ready;
+assign main_pipe_valid_sink_first = main_sink_sink_first;
+assign main_pipe_valid_sink_last = main_sink_sink_last;
+assign main_pipe_valid_sink_payload_data = main_sink_sink_payload_data;
+assign main_pipe_valid_sink_payload_last_be = main_sink_sink_payload_last_be;
+assign main_pipe_valid_sink_payload_error = main_sink_sink_payload_error;
+assign main_pipe_ready_sink_valid = main_pipe_valid_source_valid;
+assign main_pipe_valid_source_ready = main_pipe_ready_sink_ready;
+assign main_pipe_ready_sink_first = main_pipe_valid_source_first;
+assign main_pipe_ready_sink_last = main_pipe_valid_source_last;
+assign main_pipe_ready_sink_payload_data = main_pipe_valid_source_payload_data;
+assign main_pipe_ready_sink_payload_last_be = main_pipe_valid_source_payload_last_be;
+assign main_pipe_ready_sink_payload_error = main_pipe_valid_source_payload_error;
+assign main_source_source_valid = main_pipe_ready_source_valid;
+assign main_pipe_ready_source_ready = main_source_source_ready;
+assign main_source_source_first = main_pipe_ready_source_first;
+assign main_source_source_last = main_pipe_ready_source_last;
+assign main_source_source_payload_data = main_pipe_ready_source_payload_data;
+assign main_source_source_payload_last_be = main_pipe_ready_source_payload_last_be;
+assign main_source_source_payload_error = main_pipe_ready_source_payload_error;
 assign main_mac_core_tx_cdc_sink_sink_valid = main_mac_core_sink_valid;
 assign main_mac_core_sink_ready = main_mac_core_tx_cdc_sink_sink_ready;
 assign main_mac_core_tx_cdc_sink_sink_first = main_mac_core_sink_first;
@@ -3102,13 +3352,20 @@ assign main_mac_core_tx_cdc_sink_sink_last = main_mac_core_sink_last;
 assign main_mac_core_tx_cdc_sink_sink_payload_data = main_mac_core_sink_payload_data;
 assign main_mac_core_tx_cdc_sink_sink_payload_last_be = main_mac_core_sink_payload_last_be;
 assign main_mac_core_tx_cdc_sink_sink_payload_error = main_mac_core_sink_payload_error;
-assign main_mac_core_tx_converter_sink_valid = main_mac_core_tx_cdc_source_source_valid;
-assign main_mac_core_tx_cdc_source_source_ready = main_mac_core_tx_converter_sink_ready;
-assign main_mac_core_tx_converter_sink_first = main_mac_core_tx_cdc_source_source_first;
-assign main_mac_core_tx_converter_sink_last = main_mac_core_tx_cdc_source_source_last;
-assign main_mac_core_tx_converter_sink_payload_data = main_mac_core_tx_cdc_source_source_payload_data;
-assign main_mac_core_tx_converter_sink_payload_last_be = main_mac_core_tx_cdc_source_source_payload_last_be;
-assign main_mac_core_tx_converter_sink_payload_error = main_mac_core_tx_cdc_source_source_payload_error;
+assign main_sink_sink_valid = main_mac_core_tx_cdc_source_source_valid;
+assign main_mac_core_tx_cdc_source_source_ready = main_sink_sink_ready;
+assign main_sink_sink_first = main_mac_core_tx_cdc_source_source_first;
+assign main_sink_sink_last = main_mac_core_tx_cdc_source_source_last;
+assign main_sink_sink_payload_data = main_mac_core_tx_cdc_source_source_payload_data;
+assign main_sink_sink_payload_last_be = main_mac_core_tx_cdc_source_source_payload_last_be;
+assign main_sink_sink_payload_error = main_mac_core_tx_cdc_source_source_payload_error;
+assign main_mac_core_tx_converter_sink_valid = main_source_source_valid;
+assign main_source_source_ready = main_mac_core_tx_converter_sink_ready;
+assign main_mac_core_tx_converter_sink_first = main_source_source_first;
+assign main_mac_core_tx_converter_sink_last = main_source_source_last;
+assign main_mac_core_tx_converter_sink_payload_data = main_source_source_payload_data;
+assign main_mac_core_tx_converter_sink_payload_last_be = main_source_source_payload_last_be;
+assign main_mac_core_tx_converter_sink_payload_error = main_source_source_payload_error;
 assign main_mac_core_tx_last_be_sink_sink_valid = main_mac_core_tx_converter_source_valid;
 assign main_mac_core_tx_converter_source_ready = main_mac_core_tx_last_be_sink_sink_ready;
 assign main_mac_core_tx_last_be_sink_sink_first = main_mac_core_tx_converter_source_first;
@@ -5888,16 +6145,26 @@ assign main_udp_lastbytetrim_sink_payload_error = main_udp_strideconverter0_sour
 assign main_udp_lastbytetrim_sink_param_length = main_udp_strideconverter0_source_param_length;
 assign main_udp_lastbytetrim_sink_param_protocol = main_udp_strideconverter0_source_param_protocol;
 assign main_udp_lastbytetrim_sink_param_ip_address = main_udp_strideconverter0_source_param_ip_address;
-assign main_udp_holdingudprx_sink_valid = main_udp_lastbytetrim_source_valid;
-assign main_udp_lastbytetrim_source_ready = main_udp_holdingudprx_sink_ready;
-assign main_udp_holdingudprx_sink_first = main_udp_lastbytetrim_source_first;
-assign main_udp_holdingudprx_sink_last = main_udp_lastbytetrim_source_last;
-assign main_udp_holdingudprx_sink_payload_data = main_udp_lastbytetrim_source_payload_data;
-assign main_udp_holdingudprx_sink_payload_last_be = main_udp_lastbytetrim_source_payload_last_be;
-assign main_udp_holdingudprx_sink_payload_error = main_udp_lastbytetrim_source_payload_error;
-assign main_udp_holdingudprx_sink_param_length = main_udp_lastbytetrim_source_param_length;
-assign main_udp_holdingudprx_sink_param_protocol = main_udp_lastbytetrim_source_param_protocol;
-assign main_udp_holdingudprx_sink_param_ip_address = main_udp_lastbytetrim_source_param_ip_address;
+assign main_udp_buffer0_sink_sink_valid = main_udp_lastbytetrim_source_valid;
+assign main_udp_lastbytetrim_source_ready = main_udp_buffer0_sink_sink_ready;
+assign main_udp_buffer0_sink_sink_first = main_udp_lastbytetrim_source_first;
+assign main_udp_buffer0_sink_sink_last = main_udp_lastbytetrim_source_last;
+assign main_udp_buffer0_sink_sink_payload_data = main_udp_lastbytetrim_source_payload_data;
+assign main_udp_buffer0_sink_sink_payload_last_be = main_udp_lastbytetrim_source_payload_last_be;
+assign main_udp_buffer0_sink_sink_payload_error = main_udp_lastbytetrim_source_payload_error;
+assign main_udp_buffer0_sink_sink_param_length = main_udp_lastbytetrim_source_param_length;
+assign main_udp_buffer0_sink_sink_param_protocol = main_udp_lastbytetrim_source_param_protocol;
+assign main_udp_buffer0_sink_sink_param_ip_address = main_udp_lastbytetrim_source_param_ip_address;
+assign main_udp_holdingudprx_sink_valid = main_udp_buffer0_source_source_valid;
+assign main_udp_buffer0_source_source_ready = main_udp_holdingudprx_sink_ready;
+assign main_udp_holdingudprx_sink_first = main_udp_buffer0_source_source_first;
+assign main_udp_holdingudprx_sink_last = main_udp_buffer0_source_source_last;
+assign main_udp_holdingudprx_sink_payload_data = main_udp_buffer0_source_source_payload_data;
+assign main_udp_holdingudprx_sink_payload_last_be = main_udp_buffer0_source_source_payload_last_be;
+assign main_udp_holdingudprx_sink_payload_error = main_udp_buffer0_source_source_payload_error;
+assign main_udp_holdingudprx_sink_param_length = main_udp_buffer0_source_source_param_length;
+assign main_udp_holdingudprx_sink_param_protocol = main_udp_buffer0_source_source_param_protocol;
+assign main_udp_holdingudprx_sink_param_ip_address = main_udp_buffer0_source_source_param_ip_address;
 assign main_udp_maskedudpcrossbar_sink_valid = main_udp_holdingudprx_source_valid;
 assign main_udp_holdingudprx_source_ready = main_udp_maskedudpcrossbar_sink_ready;
 assign main_udp_maskedudpcrossbar_sink_first = main_udp_holdingudprx_source_first;
@@ -5920,16 +6187,26 @@ assign main_udp_liteethudptx_sink_sink_param_src_port = main_udp_maskedudpcrossb
 assign main_udp_liteethudptx_sink_sink_param_dst_port = main_udp_maskedudpcrossbar_source_param_dst_port;
 assign main_udp_liteethudptx_sink_sink_param_ip_address = main_udp_maskedudpcrossbar_source_param_ip_address;
 assign main_udp_liteethudptx_sink_sink_param_length = main_udp_maskedudpcrossbar_source_param_length;
-assign main_udp_strideconverter1_sink_valid = main_udp_liteethudptx_source_source_valid;
-assign main_udp_liteethudptx_source_source_ready = main_udp_strideconverter1_sink_ready;
-assign main_udp_strideconverter1_sink_first = main_udp_liteethudptx_source_source_first;
-assign main_udp_strideconverter1_sink_last = main_udp_liteethudptx_source_source_last;
-assign main_udp_strideconverter1_sink_payload_data = main_udp_liteethudptx_source_source_payload_data;
-assign main_udp_strideconverter1_sink_payload_last_be = main_udp_liteethudptx_source_source_payload_last_be;
-assign main_udp_strideconverter1_sink_payload_error = main_udp_liteethudptx_source_source_payload_error;
-assign main_udp_strideconverter1_sink_param_length = main_udp_liteethudptx_source_source_param_length;
-assign main_udp_strideconverter1_sink_param_protocol = main_udp_liteethudptx_source_source_param_protocol;
-assign main_udp_strideconverter1_sink_param_ip_address = main_udp_liteethudptx_source_source_param_ip_address;
+assign main_udp_buffer1_sink_sink_valid = main_udp_liteethudptx_source_source_valid;
+assign main_udp_liteethudptx_source_source_ready = main_udp_buffer1_sink_sink_ready;
+assign main_udp_buffer1_sink_sink_first = main_udp_liteethudptx_source_source_first;
+assign main_udp_buffer1_sink_sink_last = main_udp_liteethudptx_source_source_last;
+assign main_udp_buffer1_sink_sink_payload_data = main_udp_liteethudptx_source_source_payload_data;
+assign main_udp_buffer1_sink_sink_payload_last_be = main_udp_liteethudptx_source_source_payload_last_be;
+assign main_udp_buffer1_sink_sink_payload_error = main_udp_liteethudptx_source_source_payload_error;
+assign main_udp_buffer1_sink_sink_param_length = main_udp_liteethudptx_source_source_param_length;
+assign main_udp_buffer1_sink_sink_param_protocol = main_udp_liteethudptx_source_source_param_protocol;
+assign main_udp_buffer1_sink_sink_param_ip_address = main_udp_liteethudptx_source_source_param_ip_address;
+assign main_udp_strideconverter1_sink_valid = main_udp_buffer1_source_source_valid;
+assign main_udp_buffer1_source_source_ready = main_udp_strideconverter1_sink_ready;
+assign main_udp_strideconverter1_sink_first = main_udp_buffer1_source_source_first;
+assign main_udp_strideconverter1_sink_last = main_udp_buffer1_source_source_last;
+assign main_udp_strideconverter1_sink_payload_data = main_udp_buffer1_source_source_payload_data;
+assign main_udp_strideconverter1_sink_payload_last_be = main_udp_buffer1_source_source_payload_last_be;
+assign main_udp_strideconverter1_sink_payload_error = main_udp_buffer1_source_source_payload_error;
+assign main_udp_strideconverter1_sink_param_length = main_udp_buffer1_source_source_param_length;
+assign main_udp_strideconverter1_sink_param_protocol = main_udp_buffer1_source_source_param_protocol;
+assign main_udp_strideconverter1_sink_param_ip_address = main_udp_buffer1_source_source_param_ip_address;
 assign main_udp_tx_cdc_sink_valid = main_udp_strideconverter1_source_valid;
 assign main_udp_strideconverter1_source_ready = main_udp_tx_cdc_sink_ready;
 assign main_udp_tx_cdc_sink_first = main_udp_strideconverter1_source_first;
@@ -6788,6 +7065,134 @@ always @(*) begin
 end
 assign builder_portudp_last = ((main_udp_maskedudpcrossbar_sink_valid & main_udp_maskedudpcrossbar_sink_last) & main_udp_maskedudpcrossbar_sink_ready);
 assign builder_portudp_ongoing0 = ((main_udp_maskedudpcrossbar_sink_valid | builder_portudp_ongoing1) & (~builder_portudp_last));
+assign main_udp_buffer0_pipe_valid_sink_ready = ((~main_udp_buffer0_pipe_valid_source_valid) | main_udp_buffer0_pipe_valid_source_ready);
+assign main_udp_buffer0_pipe_ready_sink_ready = (~main_udp_buffer0_pipe_ready_valid);
+always @(*) begin
+    main_udp_buffer0_pipe_ready_source_first <= 1'd0;
+    main_udp_buffer0_pipe_ready_source_last <= 1'd0;
+    main_udp_buffer0_pipe_ready_source_param_ip_address <= 32'd0;
+    main_udp_buffer0_pipe_ready_source_param_length <= 16'd0;
+    main_udp_buffer0_pipe_ready_source_param_protocol <= 8'd0;
+    main_udp_buffer0_pipe_ready_source_payload_data <= 8'd0;
+    main_udp_buffer0_pipe_ready_source_payload_error <= 1'd0;
+    main_udp_buffer0_pipe_ready_source_payload_last_be <= 1'd0;
+    main_udp_buffer0_pipe_ready_source_valid <= 1'd0;
+    if (main_udp_buffer0_pipe_ready_valid) begin
+        main_udp_buffer0_pipe_ready_source_valid <= main_udp_buffer0_pipe_ready_sink_d_valid;
+        main_udp_buffer0_pipe_ready_source_first <= main_udp_buffer0_pipe_ready_sink_d_first;
+        main_udp_buffer0_pipe_ready_source_last <= main_udp_buffer0_pipe_ready_sink_d_last;
+        main_udp_buffer0_pipe_ready_source_payload_data <= main_udp_buffer0_pipe_ready_sink_d_payload_data;
+        main_udp_buffer0_pipe_ready_source_payload_last_be <= main_udp_buffer0_pipe_ready_sink_d_payload_last_be;
+        main_udp_buffer0_pipe_ready_source_payload_error <= main_udp_buffer0_pipe_ready_sink_d_payload_error;
+        main_udp_buffer0_pipe_ready_source_param_length <= main_udp_buffer0_pipe_ready_sink_d_param_length;
+        main_udp_buffer0_pipe_ready_source_param_protocol <= main_udp_buffer0_pipe_ready_sink_d_param_protocol;
+        main_udp_buffer0_pipe_ready_source_param_ip_address <= main_udp_buffer0_pipe_ready_sink_d_param_ip_address;
+    end else begin
+        main_udp_buffer0_pipe_ready_source_valid <= main_udp_buffer0_pipe_ready_sink_valid;
+        main_udp_buffer0_pipe_ready_source_first <= main_udp_buffer0_pipe_ready_sink_first;
+        main_udp_buffer0_pipe_ready_source_last <= main_udp_buffer0_pipe_ready_sink_last;
+        main_udp_buffer0_pipe_ready_source_payload_data <= main_udp_buffer0_pipe_ready_sink_payload_data;
+        main_udp_buffer0_pipe_ready_source_payload_last_be <= main_udp_buffer0_pipe_ready_sink_payload_last_be;
+        main_udp_buffer0_pipe_ready_source_payload_error <= main_udp_buffer0_pipe_ready_sink_payload_error;
+        main_udp_buffer0_pipe_ready_source_param_length <= main_udp_buffer0_pipe_ready_sink_param_length;
+        main_udp_buffer0_pipe_ready_source_param_protocol <= main_udp_buffer0_pipe_ready_sink_param_protocol;
+        main_udp_buffer0_pipe_ready_source_param_ip_address <= main_udp_buffer0_pipe_ready_sink_param_ip_address;
+    end
+end
+assign main_udp_buffer0_pipe_valid_sink_valid = main_udp_buffer0_sink_sink_valid;
+assign main_udp_buffer0_sink_sink_ready = main_udp_buffer0_pipe_valid_sink_ready;
+assign main_udp_buffer0_pipe_valid_sink_first = main_udp_buffer0_sink_sink_first;
+assign main_udp_buffer0_pipe_valid_sink_last = main_udp_buffer0_sink_sink_last;
+assign main_udp_buffer0_pipe_valid_sink_payload_data = main_udp_buffer0_sink_sink_payload_data;
+assign main_udp_buffer0_pipe_valid_sink_payload_last_be = main_udp_buffer0_sink_sink_payload_last_be;
+assign main_udp_buffer0_pipe_valid_sink_payload_error = main_udp_buffer0_sink_sink_payload_error;
+assign main_udp_buffer0_pipe_valid_sink_param_length = main_udp_buffer0_sink_sink_param_length;
+assign main_udp_buffer0_pipe_valid_sink_param_protocol = main_udp_buffer0_sink_sink_param_protocol;
+assign main_udp_buffer0_pipe_valid_sink_param_ip_address = main_udp_buffer0_sink_sink_param_ip_address;
+assign main_udp_buffer0_pipe_ready_sink_valid = main_udp_buffer0_pipe_valid_source_valid;
+assign main_udp_buffer0_pipe_valid_source_ready = main_udp_buffer0_pipe_ready_sink_ready;
+assign main_udp_buffer0_pipe_ready_sink_first = main_udp_buffer0_pipe_valid_source_first;
+assign main_udp_buffer0_pipe_ready_sink_last = main_udp_buffer0_pipe_valid_source_last;
+assign main_udp_buffer0_pipe_ready_sink_payload_data = main_udp_buffer0_pipe_valid_source_payload_data;
+assign main_udp_buffer0_pipe_ready_sink_payload_last_be = main_udp_buffer0_pipe_valid_source_payload_last_be;
+assign main_udp_buffer0_pipe_ready_sink_payload_error = main_udp_buffer0_pipe_valid_source_payload_error;
+assign main_udp_buffer0_pipe_ready_sink_param_length = main_udp_buffer0_pipe_valid_source_param_length;
+assign main_udp_buffer0_pipe_ready_sink_param_protocol = main_udp_buffer0_pipe_valid_source_param_protocol;
+assign main_udp_buffer0_pipe_ready_sink_param_ip_address = main_udp_buffer0_pipe_valid_source_param_ip_address;
+assign main_udp_buffer0_source_source_valid = main_udp_buffer0_pipe_ready_source_valid;
+assign main_udp_buffer0_pipe_ready_source_ready = main_udp_buffer0_source_source_ready;
+assign main_udp_buffer0_source_source_first = main_udp_buffer0_pipe_ready_source_first;
+assign main_udp_buffer0_source_source_last = main_udp_buffer0_pipe_ready_source_last;
+assign main_udp_buffer0_source_source_payload_data = main_udp_buffer0_pipe_ready_source_payload_data;
+assign main_udp_buffer0_source_source_payload_last_be = main_udp_buffer0_pipe_ready_source_payload_last_be;
+assign main_udp_buffer0_source_source_payload_error = main_udp_buffer0_pipe_ready_source_payload_error;
+assign main_udp_buffer0_source_source_param_length = main_udp_buffer0_pipe_ready_source_param_length;
+assign main_udp_buffer0_source_source_param_protocol = main_udp_buffer0_pipe_ready_source_param_protocol;
+assign main_udp_buffer0_source_source_param_ip_address = main_udp_buffer0_pipe_ready_source_param_ip_address;
+assign main_udp_buffer1_pipe_valid_sink_ready = ((~main_udp_buffer1_pipe_valid_source_valid) | main_udp_buffer1_pipe_valid_source_ready);
+assign main_udp_buffer1_pipe_ready_sink_ready = (~main_udp_buffer1_pipe_ready_valid);
+always @(*) begin
+    main_udp_buffer1_pipe_ready_source_first <= 1'd0;
+    main_udp_buffer1_pipe_ready_source_last <= 1'd0;
+    main_udp_buffer1_pipe_ready_source_param_ip_address <= 32'd0;
+    main_udp_buffer1_pipe_ready_source_param_length <= 16'd0;
+    main_udp_buffer1_pipe_ready_source_param_protocol <= 8'd0;
+    main_udp_buffer1_pipe_ready_source_payload_data <= 8'd0;
+    main_udp_buffer1_pipe_ready_source_payload_error <= 1'd0;
+    main_udp_buffer1_pipe_ready_source_payload_last_be <= 1'd0;
+    main_udp_buffer1_pipe_ready_source_valid <= 1'd0;
+    if (main_udp_buffer1_pipe_ready_valid) begin
+        main_udp_buffer1_pipe_ready_source_valid <= main_udp_buffer1_pipe_ready_sink_d_valid;
+        main_udp_buffer1_pipe_ready_source_first <= main_udp_buffer1_pipe_ready_sink_d_first;
+        main_udp_buffer1_pipe_ready_source_last <= main_udp_buffer1_pipe_ready_sink_d_last;
+        main_udp_buffer1_pipe_ready_source_payload_data <= main_udp_buffer1_pipe_ready_sink_d_payload_data;
+        main_udp_buffer1_pipe_ready_source_payload_last_be <= main_udp_buffer1_pipe_ready_sink_d_payload_last_be;
+        main_udp_buffer1_pipe_ready_source_payload_error <= main_udp_buffer1_pipe_ready_sink_d_payload_error;
+        main_udp_buffer1_pipe_ready_source_param_length <= main_udp_buffer1_pipe_ready_sink_d_param_length;
+        main_udp_buffer1_pipe_ready_source_param_protocol <= main_udp_buffer1_pipe_ready_sink_d_param_protocol;
+        main_udp_buffer1_pipe_ready_source_param_ip_address <= main_udp_buffer1_pipe_ready_sink_d_param_ip_address;
+    end else begin
+        main_udp_buffer1_pipe_ready_source_valid <= main_udp_buffer1_pipe_ready_sink_valid;
+        main_udp_buffer1_pipe_ready_source_first <= main_udp_buffer1_pipe_ready_sink_first;
+        main_udp_buffer1_pipe_ready_source_last <= main_udp_buffer1_pipe_ready_sink_last;
+        main_udp_buffer1_pipe_ready_source_payload_data <= main_udp_buffer1_pipe_ready_sink_payload_data;
+        main_udp_buffer1_pipe_ready_source_payload_last_be <= main_udp_buffer1_pipe_ready_sink_payload_last_be;
+        main_udp_buffer1_pipe_ready_source_payload_error <= main_udp_buffer1_pipe_ready_sink_payload_error;
+        main_udp_buffer1_pipe_ready_source_param_length <= main_udp_buffer1_pipe_ready_sink_param_length;
+        main_udp_buffer1_pipe_ready_source_param_protocol <= main_udp_buffer1_pipe_ready_sink_param_protocol;
+        main_udp_buffer1_pipe_ready_source_param_ip_address <= main_udp_buffer1_pipe_ready_sink_param_ip_address;
+    end
+end
+assign main_udp_buffer1_pipe_valid_sink_valid = main_udp_buffer1_sink_sink_valid;
+assign main_udp_buffer1_sink_sink_ready = main_udp_buffer1_pipe_valid_sink_ready;
+assign main_udp_buffer1_pipe_valid_sink_first = main_udp_buffer1_sink_sink_first;
+assign main_udp_buffer1_pipe_valid_sink_last = main_udp_buffer1_sink_sink_last;
+assign main_udp_buffer1_pipe_valid_sink_payload_data = main_udp_buffer1_sink_sink_payload_data;
+assign main_udp_buffer1_pipe_valid_sink_payload_last_be = main_udp_buffer1_sink_sink_payload_last_be;
+assign main_udp_buffer1_pipe_valid_sink_payload_error = main_udp_buffer1_sink_sink_payload_error;
+assign main_udp_buffer1_pipe_valid_sink_param_length = main_udp_buffer1_sink_sink_param_length;
+assign main_udp_buffer1_pipe_valid_sink_param_protocol = main_udp_buffer1_sink_sink_param_protocol;
+assign main_udp_buffer1_pipe_valid_sink_param_ip_address = main_udp_buffer1_sink_sink_param_ip_address;
+assign main_udp_buffer1_pipe_ready_sink_valid = main_udp_buffer1_pipe_valid_source_valid;
+assign main_udp_buffer1_pipe_valid_source_ready = main_udp_buffer1_pipe_ready_sink_ready;
+assign main_udp_buffer1_pipe_ready_sink_first = main_udp_buffer1_pipe_valid_source_first;
+assign main_udp_buffer1_pipe_ready_sink_last = main_udp_buffer1_pipe_valid_source_last;
+assign main_udp_buffer1_pipe_ready_sink_payload_data = main_udp_buffer1_pipe_valid_source_payload_data;
+assign main_udp_buffer1_pipe_ready_sink_payload_last_be = main_udp_buffer1_pipe_valid_source_payload_last_be;
+assign main_udp_buffer1_pipe_ready_sink_payload_error = main_udp_buffer1_pipe_valid_source_payload_error;
+assign main_udp_buffer1_pipe_ready_sink_param_length = main_udp_buffer1_pipe_valid_source_param_length;
+assign main_udp_buffer1_pipe_ready_sink_param_protocol = main_udp_buffer1_pipe_valid_source_param_protocol;
+assign main_udp_buffer1_pipe_ready_sink_param_ip_address = main_udp_buffer1_pipe_valid_source_param_ip_address;
+assign main_udp_buffer1_source_source_valid = main_udp_buffer1_pipe_ready_source_valid;
+assign main_udp_buffer1_pipe_ready_source_ready = main_udp_buffer1_source_source_ready;
+assign main_udp_buffer1_source_source_first = main_udp_buffer1_pipe_ready_source_first;
+assign main_udp_buffer1_source_source_last = main_udp_buffer1_pipe_ready_source_last;
+assign main_udp_buffer1_source_source_payload_data = main_udp_buffer1_pipe_ready_source_payload_data;
+assign main_udp_buffer1_source_source_payload_last_be = main_udp_buffer1_pipe_ready_source_payload_last_be;
+assign main_udp_buffer1_source_source_payload_error = main_udp_buffer1_pipe_ready_source_payload_error;
+assign main_udp_buffer1_source_source_param_length = main_udp_buffer1_pipe_ready_source_param_length;
+assign main_udp_buffer1_source_source_param_protocol = main_udp_buffer1_pipe_ready_source_param_protocol;
+assign main_udp_buffer1_source_source_param_ip_address = main_udp_buffer1_pipe_ready_source_param_ip_address;
 assign main_pulsemerge0_total0 = ((((1'd0 + main_mac_cut) + main_ip_rx_cut) + main_ip_rx_drop_header) + main_pulsemerge0_backlog0);
 assign main_pulsemerge0_o0 = (main_pulsemerge0_total0 != 1'd0);
 assign main_pulsemerge0_total1 = ((((1'd0 + main_pulsemerge0_o0) + main_udp_holdingudprx_cut0) + main_udp_holdingudprx_drop_header) + main_pulsemerge0_backlog1);
@@ -7163,6 +7568,30 @@ always @(posedge eth_tx_clk) begin
     if (main_mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value_ce) begin
         main_mac_core_tx_gap_counter <= main_mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value;
     end
+    if (((~main_pipe_valid_source_valid) | main_pipe_valid_source_ready)) begin
+        main_pipe_valid_source_valid <= main_pipe_valid_sink_valid;
+        main_pipe_valid_source_first <= main_pipe_valid_sink_first;
+        main_pipe_valid_source_last <= main_pipe_valid_sink_last;
+        main_pipe_valid_source_payload_data <= main_pipe_valid_sink_payload_data;
+        main_pipe_valid_source_payload_last_be <= main_pipe_valid_sink_payload_last_be;
+        main_pipe_valid_source_payload_error <= main_pipe_valid_sink_payload_error;
+    end
+    if ((main_pipe_ready_sink_valid & (~main_pipe_ready_source_ready))) begin
+        main_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (main_pipe_ready_source_ready) begin
+            main_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~main_pipe_ready_source_ready) & (~main_pipe_ready_valid))) begin
+        main_pipe_ready_sink_d_valid <= main_pipe_ready_sink_valid;
+        main_pipe_ready_sink_d_ready <= main_pipe_ready_sink_ready;
+        main_pipe_ready_sink_d_first <= main_pipe_ready_sink_first;
+        main_pipe_ready_sink_d_last <= main_pipe_ready_sink_last;
+        main_pipe_ready_sink_d_payload_data <= main_pipe_ready_sink_payload_data;
+        main_pipe_ready_sink_d_payload_last_be <= main_pipe_ready_sink_payload_last_be;
+        main_pipe_ready_sink_d_payload_error <= main_pipe_ready_sink_payload_error;
+    end
     if (eth_tx_rst) begin
         main_sink_ready <= 1'd0;
         main_mac_core_tx_cdc_cdc_graycounter1_q <= 6'd0;
@@ -7175,6 +7604,16 @@ always @(posedge eth_tx_clk) begin
         main_mac_core_tx_crc_pipe_valid_source_payload_data <= 8'd0;
         main_mac_core_tx_crc_pipe_valid_source_payload_last_be <= 1'd0;
         main_mac_core_tx_crc_pipe_valid_source_payload_error <= 1'd0;
+        main_pipe_valid_source_valid <= 1'd0;
+        main_pipe_valid_source_payload_data <= 32'd0;
+        main_pipe_valid_source_payload_last_be <= 4'd0;
+        main_pipe_valid_source_payload_error <= 4'd0;
+        main_pipe_ready_valid <= 1'd0;
+        main_pipe_ready_sink_d_valid <= 1'd0;
+        main_pipe_ready_sink_d_ready <= 1'd0;
+        main_pipe_ready_sink_d_payload_data <= 32'd0;
+        main_pipe_ready_sink_d_payload_last_be <= 4'd0;
+        main_pipe_ready_sink_d_payload_error <= 4'd0;
         builder_liteethmac_txdatapath_liteethmactxlastbe_state <= 1'd0;
         builder_liteethmac_txdatapath_liteethmacpaddinginserter_state <= 1'd0;
         builder_liteethmac_txdatapath_bufferizeendpoints_state <= 2'd0;
@@ -7765,6 +8204,66 @@ always @(posedge sys_clk) begin
             builder_portudp_first <= 1'd0;
         end
     end
+    if (((~main_udp_buffer0_pipe_valid_source_valid) | main_udp_buffer0_pipe_valid_source_ready)) begin
+        main_udp_buffer0_pipe_valid_source_valid <= main_udp_buffer0_pipe_valid_sink_valid;
+        main_udp_buffer0_pipe_valid_source_first <= main_udp_buffer0_pipe_valid_sink_first;
+        main_udp_buffer0_pipe_valid_source_last <= main_udp_buffer0_pipe_valid_sink_last;
+        main_udp_buffer0_pipe_valid_source_payload_data <= main_udp_buffer0_pipe_valid_sink_payload_data;
+        main_udp_buffer0_pipe_valid_source_payload_last_be <= main_udp_buffer0_pipe_valid_sink_payload_last_be;
+        main_udp_buffer0_pipe_valid_source_payload_error <= main_udp_buffer0_pipe_valid_sink_payload_error;
+        main_udp_buffer0_pipe_valid_source_param_length <= main_udp_buffer0_pipe_valid_sink_param_length;
+        main_udp_buffer0_pipe_valid_source_param_protocol <= main_udp_buffer0_pipe_valid_sink_param_protocol;
+        main_udp_buffer0_pipe_valid_source_param_ip_address <= main_udp_buffer0_pipe_valid_sink_param_ip_address;
+    end
+    if ((main_udp_buffer0_pipe_ready_sink_valid & (~main_udp_buffer0_pipe_ready_source_ready))) begin
+        main_udp_buffer0_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (main_udp_buffer0_pipe_ready_source_ready) begin
+            main_udp_buffer0_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~main_udp_buffer0_pipe_ready_source_ready) & (~main_udp_buffer0_pipe_ready_valid))) begin
+        main_udp_buffer0_pipe_ready_sink_d_valid <= main_udp_buffer0_pipe_ready_sink_valid;
+        main_udp_buffer0_pipe_ready_sink_d_ready <= main_udp_buffer0_pipe_ready_sink_ready;
+        main_udp_buffer0_pipe_ready_sink_d_first <= main_udp_buffer0_pipe_ready_sink_first;
+        main_udp_buffer0_pipe_ready_sink_d_last <= main_udp_buffer0_pipe_ready_sink_last;
+        main_udp_buffer0_pipe_ready_sink_d_payload_data <= main_udp_buffer0_pipe_ready_sink_payload_data;
+        main_udp_buffer0_pipe_ready_sink_d_payload_last_be <= main_udp_buffer0_pipe_ready_sink_payload_last_be;
+        main_udp_buffer0_pipe_ready_sink_d_payload_error <= main_udp_buffer0_pipe_ready_sink_payload_error;
+        main_udp_buffer0_pipe_ready_sink_d_param_length <= main_udp_buffer0_pipe_ready_sink_param_length;
+        main_udp_buffer0_pipe_ready_sink_d_param_protocol <= main_udp_buffer0_pipe_ready_sink_param_protocol;
+        main_udp_buffer0_pipe_ready_sink_d_param_ip_address <= main_udp_buffer0_pipe_ready_sink_param_ip_address;
+    end
+    if (((~main_udp_buffer1_pipe_valid_source_valid) | main_udp_buffer1_pipe_valid_source_ready)) begin
+        main_udp_buffer1_pipe_valid_source_valid <= main_udp_buffer1_pipe_valid_sink_valid;
+        main_udp_buffer1_pipe_valid_source_first <= main_udp_buffer1_pipe_valid_sink_first;
+        main_udp_buffer1_pipe_valid_source_last <= main_udp_buffer1_pipe_valid_sink_last;
+        main_udp_buffer1_pipe_valid_source_payload_data <= main_udp_buffer1_pipe_valid_sink_payload_data;
+        main_udp_buffer1_pipe_valid_source_payload_last_be <= main_udp_buffer1_pipe_valid_sink_payload_last_be;
+        main_udp_buffer1_pipe_valid_source_payload_error <= main_udp_buffer1_pipe_valid_sink_payload_error;
+        main_udp_buffer1_pipe_valid_source_param_length <= main_udp_buffer1_pipe_valid_sink_param_length;
+        main_udp_buffer1_pipe_valid_source_param_protocol <= main_udp_buffer1_pipe_valid_sink_param_protocol;
+        main_udp_buffer1_pipe_valid_source_param_ip_address <= main_udp_buffer1_pipe_valid_sink_param_ip_address;
+    end
+    if ((main_udp_buffer1_pipe_ready_sink_valid & (~main_udp_buffer1_pipe_ready_source_ready))) begin
+        main_udp_buffer1_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (main_udp_buffer1_pipe_ready_source_ready) begin
+            main_udp_buffer1_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~main_udp_buffer1_pipe_ready_source_ready) & (~main_udp_buffer1_pipe_ready_valid))) begin
+        main_udp_buffer1_pipe_ready_sink_d_valid <= main_udp_buffer1_pipe_ready_sink_valid;
+        main_udp_buffer1_pipe_ready_sink_d_ready <= main_udp_buffer1_pipe_ready_sink_ready;
+        main_udp_buffer1_pipe_ready_sink_d_first <= main_udp_buffer1_pipe_ready_sink_first;
+        main_udp_buffer1_pipe_ready_sink_d_last <= main_udp_buffer1_pipe_ready_sink_last;
+        main_udp_buffer1_pipe_ready_sink_d_payload_data <= main_udp_buffer1_pipe_ready_sink_payload_data;
+        main_udp_buffer1_pipe_ready_sink_d_payload_last_be <= main_udp_buffer1_pipe_ready_sink_payload_last_be;
+        main_udp_buffer1_pipe_ready_sink_d_payload_error <= main_udp_buffer1_pipe_ready_sink_payload_error;
+        main_udp_buffer1_pipe_ready_sink_d_param_length <= main_udp_buffer1_pipe_ready_sink_param_length;
+        main_udp_buffer1_pipe_ready_sink_d_param_protocol <= main_udp_buffer1_pipe_ready_sink_param_protocol;
+        main_udp_buffer1_pipe_ready_sink_d_param_ip_address <= main_udp_buffer1_pipe_ready_sink_param_ip_address;
+    end
     main_pulsemerge0_backlog0 <= (main_pulsemerge0_total0 - main_pulsemerge0_o0);
     main_pulsemerge0_backlog1 <= (main_pulsemerge0_total1 - main_pulsemerge0_o1);
     main_pulsemerge1_backlog0 <= (main_pulsemerge1_total0 - main_pulsemerge1_o0);
@@ -7905,6 +8404,26 @@ always @(posedge sys_clk) begin
         main_udp_strideconverter1_converter_source_payload_valid_token_count <= 3'd0;
         main_udp_strideconverter1_converter_demux <= 2'd0;
         main_udp_strideconverter1_converter_strobe_all <= 1'd0;
+        main_udp_buffer0_pipe_valid_source_valid <= 1'd0;
+        main_udp_buffer0_pipe_valid_source_payload_data <= 8'd0;
+        main_udp_buffer0_pipe_valid_source_payload_last_be <= 1'd0;
+        main_udp_buffer0_pipe_valid_source_payload_error <= 1'd0;
+        main_udp_buffer0_pipe_ready_valid <= 1'd0;
+        main_udp_buffer0_pipe_ready_sink_d_valid <= 1'd0;
+        main_udp_buffer0_pipe_ready_sink_d_ready <= 1'd0;
+        main_udp_buffer0_pipe_ready_sink_d_payload_data <= 8'd0;
+        main_udp_buffer0_pipe_ready_sink_d_payload_last_be <= 1'd0;
+        main_udp_buffer0_pipe_ready_sink_d_payload_error <= 1'd0;
+        main_udp_buffer1_pipe_valid_source_valid <= 1'd0;
+        main_udp_buffer1_pipe_valid_source_payload_data <= 8'd0;
+        main_udp_buffer1_pipe_valid_source_payload_last_be <= 1'd0;
+        main_udp_buffer1_pipe_valid_source_payload_error <= 1'd0;
+        main_udp_buffer1_pipe_ready_valid <= 1'd0;
+        main_udp_buffer1_pipe_ready_sink_d_valid <= 1'd0;
+        main_udp_buffer1_pipe_ready_sink_d_ready <= 1'd0;
+        main_udp_buffer1_pipe_ready_sink_d_payload_data <= 8'd0;
+        main_udp_buffer1_pipe_ready_sink_d_payload_last_be <= 1'd0;
+        main_udp_buffer1_pipe_ready_sink_d_payload_error <= 1'd0;
         main_pulsemerge0_backlog0 <= 3'd0;
         main_pulsemerge0_backlog1 <= 3'd0;
         main_pulsemerge1_backlog0 <= 3'd0;
