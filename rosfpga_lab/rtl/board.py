@@ -144,10 +144,11 @@ def _readme(rom: DiscoveryRom, mac: str, peer_ip: str) -> str:
 
 No board was available where this lab was written: the bitstream is built, placed, routed and
 timed by open tools (`make bitstream`), never run on a board. What the build prints is what is
-known: Fmax per clock and the resources. At the time of writing neither clock meets 125 MHz
-(the figures `make bitstream` prints; the node's clock falls short the most: LiteEth's 8-bit
-datapath, rosfpga_lab/rtl/fabric/vendor/README.md, Timing), so expect lost or corrupted frames
-at line rate until LiteEth's 32-bit datapath is joined.
+known: Fmax per clock against its constraint, and the resources. Three clocks: the node's and
+LiteEth's 8-bit UDP port's (the PLL's 125 MHz), LiteEth's 32-bit core's (the PLL's 52.08 MHz)
+and the PHY's receive clock (125 MHz at gigabit; LiteEth's PHY side). A clock `make bitstream`
+prints as NOT MET may lose or corrupt frames on the board; which ones missed when it was last
+measured, and why: rosfpga_lab/rtl/fabric/vendor/README.md, Timing.
 
 One more thing to check on the board: LiteX-Boards' own 5A-75x target builds its RGMII PHY with
 no transmit delay in the FPGA (the RTL8211FD adds it); the vendored core adds 2 ns

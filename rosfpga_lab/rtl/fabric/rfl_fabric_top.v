@@ -2,8 +2,9 @@
 // UDP/IP core (vendor/README.md) -> rfl_udp_port -> rfl_fabric_node, and back. The core: the
 // GMII simulation variant (vendor/liteeth_udp_gmii.v, one clock), or with RFL_FABRIC_RGMII
 // defined the ECP5 RGMII board variant (vendor/liteeth_udp_ecp5_rgmii.v: the PHY's receive
-// clock drives its receive and send side, its FIFOs cross to clk), the glue the same; the
-// board top rfl_board_5a75b.v defines it.
+// clock drives its receive and send side, its 32-bit core runs on eth_clk, its 8-bit UDP port
+// on clk, FIFOs crossing between the three), the glue the same; the board top
+// rfl_board_5a75b.v defines it.
 // Ports (RTPS 2.3 9.6.1.1, the mapping rtps.entities owns; rtl.discrom.top_parameters gives
 // them and SPDP_GROUP; 0, the default, is refused): SPDP_PORT (the domain's SPDP multicast
 // port), META_PORT and USER_PORT (this participant's metatraffic and user-data unicast ports).
@@ -34,7 +35,9 @@ module rfl_fabric_top #(
 `include "rfl_fabric_top_params.vh"
 ) (
 `ifdef RFL_FABRIC_RGMII
-    input  wire         clk,                    // 125 MHz: LiteEth's sys clock and the node's
+    input  wire         clk,                    // 125 MHz: the node's and LiteEth's UDP port's
+    input  wire         eth_clk,                // LiteEth's 32-bit core's (52.08 MHz)
+    input  wire         eth_rst_n,              // eth_clk's reset (rst_n is clk's)
 `else
     input  wire         clk,                    // 125 MHz: GMII's receive and send clock
 `endif
@@ -134,7 +137,7 @@ module rfl_fabric_top #(
     wire [15:0] le_rx_sport, le_rx_dport, le_rx_len, le_tx_sport, le_tx_dport, le_tx_len;
 `ifdef RFL_FABRIC_RGMII
     liteeth_udp_ecp5_rgmii u_eth (
-        .sys_clock(clk), .sys_reset(!rst_n),
+        .sys_clock(eth_clk), .sys_reset(!eth_rst_n), .port_clock(clk), .port_reset(!rst_n),
         .mac_address(cfg_mac), .ip_address(cfg_ip), .udp_rx_port(SPDP),
         .udp_rx_port_mask(PORT_MASK), .ip_multicast(SPDP_GROUP),
         .rgmii_clocks_rx(rgmii_rx_clk), .rgmii_clocks_tx(rgmii_tx_clk),

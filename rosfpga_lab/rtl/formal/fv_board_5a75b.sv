@@ -4,7 +4,8 @@
 // oscillator's clock here, locked from the start (the board top's FORMAL branch); rfl_fabric_top
 // (the glue proven in fv_fabric_top, the rest by their own proofs and tests) is the model below,
 // of the same name, parameters and ports (the RGMII ones), which checks what it is given.
-// Bounded (bmc, 32 clocks): the top's reset is low for the first 16 clocks and high after;
+// Bounded (bmc, 32 clocks): the top's resets (clk's and eth_clk's, one clock here) are low for
+// the first 18 clocks (the lock through two flops, then 16) and high after;
 // cfg_learn is high and send_sedp low (the top learns its peer and sends SEDP to it); the top's
 // cfg_* are the parameters (cfg_writer 0: any writer); the LED is on (low) exactly when the
 // top's cnt_rx_packets is not 0. The board has no stream of its own (no FV_SINK).
@@ -32,7 +33,7 @@ endmodule
 module rfl_fabric_top #(
 `include "rfl_fabric_top_params.vh"
 ) (
-    input clk, input rst_n, input [47:0] cfg_mac, input [31:0] cfg_ip, input cfg_learn,
+    input clk, input rst_n, input eth_clk, input eth_rst_n, input [47:0] cfg_mac, input [31:0] cfg_ip, input cfg_learn,
     input [31:0] cfg_peer_ip,
     input [15:0] cfg_peer_meta_port, input [15:0] cfg_peer_user_port, input [31:0] cfg_reader,
     input [31:0] cfg_writer, input [63:0] cfg_time, input send_sedp,
@@ -54,7 +55,7 @@ module rfl_fabric_top #(
     reg [7:0] t = 8'd0;                         // clocks since the start
     always @(posedge clk) if (t != 8'hff) t <= t + 8'd1;
     always @(*) begin
-        assert(rst_n == (t >= 8'd16));
+        assert(rst_n == (t >= 8'd18) && eth_rst_n == rst_n);
         assert(cfg_learn && !send_sedp);
         assert(cfg_mac == `FV_MAC && cfg_ip == `FV_IP);
         assert(cfg_reader == `FV_READER && cfg_writer == 32'd0 && cfg_time == `FV_TIME);

@@ -22,6 +22,8 @@ module liteeth_udp_ecp5_rgmii (
     input  wire   [31:0] ip_address,
     input  wire   [31:0] ip_multicast,
     input  wire   [47:0] mac_address,
+    input  wire          port_clock,
+    input  wire          port_reset,
     input  wire          rgmii_clocks_rx,
     output wire          rgmii_clocks_tx,
     input  wire          rgmii_pads_rx_ctl,
@@ -83,7 +85,7 @@ UDPPortCore
 │    │    └─── [DELAYG]
 │    │    └─── [DELAYG]
 │    │    └─── [DELAYG]
-└─── core (LiteEthUDPIPCore)
+└─── core (LiteEthIPCore)
 │    └─── mac (LiteEthMAC)
 │    │    └─── core (LiteEthMACCore)
 │    │    │    └─── tx_datapath (TXDatapath)
@@ -92,6 +94,12 @@ UDPPortCore
 │    │    │    │    │    │    └─── fifo (AsyncFIFO)
 │    │    │    │    │    │    │    └─── graycounter_0* (GrayCounter)
 │    │    │    │    │    │    │    └─── graycounter_1* (GrayCounter)
+│    │    │    │    └─── strideconverter_0* (StrideConverter)
+│    │    │    │    │    └─── converter_0* (Converter)
+│    │    │    │    │    │    └─── _downconverter_0* (_DownConverter)
+│    │    │    │    └─── liteethmactxlastbe_0* (LiteEthMACTXLastBE)
+│    │    │    │    │    └─── last_handler (LiteEthLastHandler)
+│    │    │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── liteethmacpaddinginserter_0* (LiteEthMACPaddingInserter)
 │    │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── liteethmaccrc32inserter_0* (LiteEthMACCRC32Inserter)
@@ -105,6 +113,10 @@ UDPPortCore
 │    │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── liteethmacgap_0* (LiteEthMACGap)
 │    │    │    │    │    └─── fsm (FSM)
+│    │    │    │    └─── tx_buffer (Buffer)
+│    │    │    │    │    └─── pipe_valid (PipeValid)
+│    │    │    │    │    └─── pipe_ready (PipeReady)
+│    │    │    │    │    └─── pipeline (Pipeline)
 │    │    │    │    └─── pipeline_0* (Pipeline)
 │    │    │    └─── rx_datapath (RXDatapath)
 │    │    │    │    └─── liteethmacpreamblechecker_0* (LiteEthMACPreambleChecker)
@@ -121,6 +133,10 @@ UDPPortCore
 │    │    │    │    │    │    └─── pipeline (Pipeline)
 │    │    │    │    └─── pulsesynchronizer_1* (PulseSynchronizer)
 │    │    │    │    └─── liteethmacpaddingchecker_0* (LiteEthMACPaddingChecker)
+│    │    │    │    └─── liteethmacrxlastbe_0* (LiteEthMACRXLastBE)
+│    │    │    │    └─── strideconverter_0* (StrideConverter)
+│    │    │    │    │    └─── converter_0* (Converter)
+│    │    │    │    │    │    └─── _upconverter_0* (_UpConverter)
 │    │    │    │    └─── clockdomaincrossing_0* (ClockDomainCrossing)
 │    │    │    │    │    └─── asyncfifo_0* (AsyncFIFO)
 │    │    │    │    │    │    └─── fifo (AsyncFIFO)
@@ -199,17 +215,35 @@ UDPPortCore
 │    │    │    │    └─── param_fifo (SyncFIFO)
 │    │    │    │    │    └─── fifo (SyncFIFOBuffered)
 │    │    │    │    │    │    └─── fifo (SyncFIFO)
-│    └─── udp (LiteEthUDP)
-│    │    └─── tx (LiteEthUDPTX)
-│    │    │    └─── packetizer (LiteEthUDPPacketizer)
-│    │    │    │    └─── fsm (FSM)
-│    │    │    │    └─── last_be_fsm (FSM)
+│    └─── udp (PortUDP)
+│    │    └─── rx_cdc (ClockDomainCrossing)
+│    │    │    └─── asyncfifo_0* (AsyncFIFO)
+│    │    │    │    └─── fifo (AsyncFIFO)
+│    │    │    │    │    └─── graycounter_0* (GrayCounter)
+│    │    │    │    │    └─── graycounter_1* (GrayCounter)
+│    │    └─── rx_converter (StrideConverter)
+│    │    │    └─── converter_0* (Converter)
+│    │    │    │    └─── _downconverter_0* (_DownConverter)
+│    │    └─── rx_trim (LastByteTrim)
 │    │    │    └─── fsm (FSM)
 │    │    └─── rx (HoldingUDPRX)
 │    │    │    └─── depacketizer (LiteEthUDPDepacketizer)
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
 │    │    │    └─── fsm (FSM)
+│    │    └─── tx (LiteEthUDPTX)
+│    │    │    └─── packetizer (LiteEthUDPPacketizer)
+│    │    │    │    └─── fsm (FSM)
+│    │    │    │    └─── last_be_fsm (FSM)
+│    │    │    └─── fsm (FSM)
+│    │    └─── tx_converter (StrideConverter)
+│    │    │    └─── converter_0* (Converter)
+│    │    │    │    └─── _upconverter_0* (_UpConverter)
+│    │    └─── tx_cdc (ClockDomainCrossing)
+│    │    │    └─── asyncfifo_0* (AsyncFIFO)
+│    │    │    │    └─── fifo (AsyncFIFO)
+│    │    │    │    │    └─── graycounter_0* (GrayCounter)
+│    │    │    │    │    └─── graycounter_1* (GrayCounter)
 │    │    └─── crossbar (MaskedUDPCrossbar)
 │    │    │    └─── tx_cdc (ClockDomainCrossing)
 │    │    │    └─── tx_converter (StrideConverter)
@@ -222,6 +256,20 @@ UDPPortCore
 │    │    │    └─── arbiter (Arbiter)
 │    │    │    └─── dispatcher (Dispatcher)
 │    │    │    │    └─── status_0* (Status)
+│    │    └─── rx_buffer (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
+│    │    └─── tx_buffer (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
+└─── rx_drop_header_core (PulseMerge)
+└─── rx_drop_header_cdc (PulseSynchronizer)
+└─── rx_drop_header_port (PulseMerge)
+└─── rx_drop_other_core (PulseMerge)
+└─── rx_drop_other_cdc (PulseSynchronizer)
+└─── rx_drop_other_port (PulseMerge)
 └─── csr_bridge (Wishbone2CSR)
 │    └─── fsm (FSM)
 └─── csr_bankarray (CSRBankArray)
@@ -233,18 +281,18 @@ UDPPortCore
 │    │    └─── csrstorage_0* (CSRStorage)
 │    │    └─── csrstatus_0* (CSRStatus)
 └─── csr_interconnect (InterconnectShared)
-└─── [ODDRX1F]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
+└─── [ODDRX1F]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
@@ -257,34 +305,34 @@ UDPPortCore
 //------------------------------------------------------------------------------
 
 wire   [13:0] adr;
-reg     [5:0] arp_counter = 6'd0;
-reg     [5:0] arp_counter_liteetharp_next_value = 6'd0;
+reg     [3:0] arp_counter = 4'd0;
+reg     [3:0] arp_counter_liteetharp_next_value = 4'd0;
 reg           arp_counter_liteetharp_next_value_ce = 1'd0;
 wire          arp_mac_port_sink_first;
 wire          arp_mac_port_sink_last;
-wire    [7:0] arp_mac_port_sink_payload_data;
-wire          arp_mac_port_sink_payload_error;
+wire   [31:0] arp_mac_port_sink_payload_data;
+wire    [3:0] arp_mac_port_sink_payload_error;
 wire   [15:0] arp_mac_port_sink_payload_ethernet_type;
-wire          arp_mac_port_sink_payload_last_be;
+wire    [3:0] arp_mac_port_sink_payload_last_be;
 wire   [47:0] arp_mac_port_sink_payload_sender_mac;
 wire   [47:0] arp_mac_port_sink_payload_target_mac;
 reg           arp_mac_port_sink_ready = 1'd0;
 wire          arp_mac_port_sink_valid;
 reg           arp_mac_port_source_first = 1'd0;
 reg           arp_mac_port_source_last = 1'd0;
-reg     [7:0] arp_mac_port_source_payload_data = 8'd0;
-reg           arp_mac_port_source_payload_error = 1'd0;
+reg    [31:0] arp_mac_port_source_payload_data = 32'd0;
+reg     [3:0] arp_mac_port_source_payload_error = 4'd0;
 reg    [15:0] arp_mac_port_source_payload_ethernet_type = 16'd0;
-reg           arp_mac_port_source_payload_last_be = 1'd0;
+reg     [3:0] arp_mac_port_source_payload_last_be = 4'd0;
 reg    [47:0] arp_mac_port_source_payload_sender_mac = 48'd0;
 reg    [47:0] arp_mac_port_source_payload_target_mac = 48'd0;
 wire          arp_mac_port_source_ready;
 reg           arp_mac_port_source_valid = 1'd0;
-reg     [4:0] arp_packetizer_count = 5'd0;
-reg     [4:0] arp_packetizer_count_liteetharp_fsm0_next_value0 = 5'd0;
+reg     [2:0] arp_packetizer_count = 3'd0;
+reg     [2:0] arp_packetizer_count_liteetharp_fsm0_next_value0 = 3'd0;
 reg           arp_packetizer_count_liteetharp_fsm0_next_value_ce0 = 1'd0;
-reg           arp_packetizer_delayed_last_be = 1'd0;
-reg           arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 = 1'd0;
+reg     [3:0] arp_packetizer_delayed_last_be = 4'd0;
+reg     [3:0] arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 = 4'd0;
 reg           arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 = 1'd0;
 reg           arp_packetizer_fsm_from_idle = 1'd0;
 reg           arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 = 1'd0;
@@ -294,9 +342,8 @@ wire          arp_packetizer_in_data_copy;
 reg           arp_packetizer_is_ongoing0 = 1'd0;
 reg           arp_packetizer_is_ongoing1 = 1'd0;
 reg           arp_packetizer_is_ongoing2 = 1'd0;
-wire          arp_packetizer_new_last_be;
+wire    [3:0] arp_packetizer_new_last_be;
 wire          arp_packetizer_sink_last;
-wire          arp_packetizer_sink_last_be;
 wire    [7:0] arp_packetizer_sink_param_hwsize;
 wire   [15:0] arp_packetizer_sink_param_hwtype;
 reg    [15:0] arp_packetizer_sink_param_opcode = 16'd0;
@@ -306,9 +353,9 @@ wire   [31:0] arp_packetizer_sink_param_sender_ip;
 wire   [47:0] arp_packetizer_sink_param_sender_mac;
 wire   [31:0] arp_packetizer_sink_param_target_ip;
 reg    [47:0] arp_packetizer_sink_param_target_mac = 48'd0;
-reg     [7:0] arp_packetizer_sink_payload_data = 8'd0;
-reg           arp_packetizer_sink_payload_error = 1'd0;
-reg           arp_packetizer_sink_payload_last_be = 1'd0;
+reg    [31:0] arp_packetizer_sink_payload_data = 32'd0;
+reg     [3:0] arp_packetizer_sink_payload_error = 4'd0;
+reg     [3:0] arp_packetizer_sink_payload_last_be = 4'd0;
 reg           arp_packetizer_sink_ready = 1'd0;
 reg           arp_packetizer_sink_valid = 1'd0;
 reg           arp_packetizer_source_first = 1'd0;
@@ -316,10 +363,10 @@ reg           arp_packetizer_source_last = 1'd0;
 reg           arp_packetizer_source_last_a = 1'd0;
 reg           arp_packetizer_source_last_b = 1'd0;
 reg           arp_packetizer_source_last_s = 1'd0;
-reg     [7:0] arp_packetizer_source_payload_data = 8'd0;
-wire          arp_packetizer_source_payload_error;
+reg    [31:0] arp_packetizer_source_payload_data = 32'd0;
+wire    [3:0] arp_packetizer_source_payload_error;
 reg    [15:0] arp_packetizer_source_payload_ethernet_type = 16'd0;
-reg           arp_packetizer_source_payload_last_be = 1'd0;
+reg     [3:0] arp_packetizer_source_payload_last_be = 4'd0;
 reg    [47:0] arp_packetizer_source_payload_sender_mac = 48'd0;
 reg    [47:0] arp_packetizer_source_payload_target_mac = 48'd0;
 reg           arp_packetizer_source_ready = 1'd0;
@@ -330,11 +377,11 @@ reg           arp_packetizer_sr_shift = 1'd0;
 wire          arp_rx_cut;
 reg           arp_rx_fsm_is_ongoing0 = 1'd0;
 reg           arp_rx_fsm_is_ongoing1 = 1'd0;
-reg     [4:0] arp_rx_liteetharpdepacketizer_count = 5'd0;
-reg     [4:0] arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 = 5'd0;
+reg     [2:0] arp_rx_liteetharpdepacketizer_count = 3'd0;
+reg     [2:0] arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 = 3'd0;
 reg           arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 = 1'd0;
-reg           arp_rx_liteetharpdepacketizer_delayed_last_be = 1'd0;
-reg           arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 = 1'd0;
+reg     [3:0] arp_rx_liteetharpdepacketizer_delayed_last_be = 4'd0;
+reg     [3:0] arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 = 4'd0;
 reg           arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 = 1'd0;
 reg           arp_rx_liteetharpdepacketizer_fsm_from_idle = 1'd0;
 reg           arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 = 1'd0;
@@ -345,15 +392,14 @@ reg           arp_rx_liteetharpdepacketizer_is_ongoing0 = 1'd0;
 reg           arp_rx_liteetharpdepacketizer_is_ongoing1 = 1'd0;
 reg           arp_rx_liteetharpdepacketizer_is_ongoing2 = 1'd0;
 reg           arp_rx_liteetharpdepacketizer_is_ongoing3 = 1'd0;
-wire          arp_rx_liteetharpdepacketizer_new_last_be;
+wire    [3:0] arp_rx_liteetharpdepacketizer_new_last_be;
 reg           arp_rx_liteetharpdepacketizer_sink_d_last = 1'd0;
 wire          arp_rx_liteetharpdepacketizer_sink_first;
 wire          arp_rx_liteetharpdepacketizer_sink_last;
-wire          arp_rx_liteetharpdepacketizer_sink_last_be;
-wire    [7:0] arp_rx_liteetharpdepacketizer_sink_payload_data;
-wire          arp_rx_liteetharpdepacketizer_sink_payload_error;
+wire   [31:0] arp_rx_liteetharpdepacketizer_sink_payload_data;
+wire    [3:0] arp_rx_liteetharpdepacketizer_sink_payload_error;
 wire   [15:0] arp_rx_liteetharpdepacketizer_sink_payload_ethernet_type;
-wire          arp_rx_liteetharpdepacketizer_sink_payload_last_be;
+wire    [3:0] arp_rx_liteetharpdepacketizer_sink_payload_last_be;
 wire   [47:0] arp_rx_liteetharpdepacketizer_sink_payload_sender_mac;
 wire   [47:0] arp_rx_liteetharpdepacketizer_sink_payload_target_mac;
 reg           arp_rx_liteetharpdepacketizer_sink_ready = 1'd0;
@@ -371,9 +417,9 @@ wire   [31:0] arp_rx_liteetharpdepacketizer_source_param_sender_ip;
 wire   [47:0] arp_rx_liteetharpdepacketizer_source_param_sender_mac;
 wire   [31:0] arp_rx_liteetharpdepacketizer_source_param_target_ip;
 wire   [47:0] arp_rx_liteetharpdepacketizer_source_param_target_mac;
-reg     [7:0] arp_rx_liteetharpdepacketizer_source_payload_data = 8'd0;
-wire          arp_rx_liteetharpdepacketizer_source_payload_error;
-reg           arp_rx_liteetharpdepacketizer_source_payload_last_be = 1'd0;
+reg    [31:0] arp_rx_liteetharpdepacketizer_source_payload_data = 32'd0;
+wire    [3:0] arp_rx_liteetharpdepacketizer_source_payload_error;
+reg     [3:0] arp_rx_liteetharpdepacketizer_source_payload_last_be = 4'd0;
 reg           arp_rx_liteetharpdepacketizer_source_ready = 1'd0;
 reg           arp_rx_liteetharpdepacketizer_source_valid = 1'd0;
 reg   [223:0] arp_rx_liteetharpdepacketizer_sr = 224'd0;
@@ -384,10 +430,10 @@ reg           arp_rx_reply = 1'd0;
 reg           arp_rx_request = 1'd0;
 wire          arp_rx_sink_first;
 wire          arp_rx_sink_last;
-wire    [7:0] arp_rx_sink_payload_data;
-wire          arp_rx_sink_payload_error;
+wire   [31:0] arp_rx_sink_payload_data;
+wire    [3:0] arp_rx_sink_payload_error;
 wire   [15:0] arp_rx_sink_payload_ethernet_type;
-wire          arp_rx_sink_payload_last_be;
+wire    [3:0] arp_rx_sink_payload_last_be;
 wire   [47:0] arp_rx_sink_payload_sender_mac;
 wire   [47:0] arp_rx_sink_payload_target_mac;
 wire          arp_rx_sink_ready;
@@ -411,16 +457,16 @@ reg           arp_sink_sink_ready = 1'd0;
 wire          arp_sink_sink_valid;
 wire          arp_source_source_first;
 wire          arp_source_source_last;
-wire    [7:0] arp_source_source_payload_data;
-wire          arp_source_source_payload_error;
+wire   [31:0] arp_source_source_payload_data;
+wire    [3:0] arp_source_source_payload_error;
 reg    [15:0] arp_source_source_payload_ethernet_type = 16'd0;
-wire          arp_source_source_payload_last_be;
+wire    [3:0] arp_source_source_payload_last_be;
 reg    [47:0] arp_source_source_payload_sender_mac = 48'd0;
 reg    [47:0] arp_source_source_payload_target_mac = 48'd0;
 wire          arp_source_source_ready;
 reg           arp_source_source_valid = 1'd0;
 reg           arp_table_cache_clear_enable = 1'd1;
-reg    [26:0] arp_table_cache_count = 27'd125000000;
+reg    [25:0] arp_table_cache_count = 26'd52083300;
 wire          arp_table_cache_done;
 reg           arp_table_cache_enable = 1'd1;
 reg           arp_table_cache_error = 1'd0;
@@ -467,7 +513,7 @@ reg           arp_table_request_pending_liteetharp_fsm_next_value_ce0 = 1'd0;
 wire   [31:0] arp_table_request_request_payload_ip_address;
 reg           arp_table_request_request_ready = 1'd0;
 reg           arp_table_request_request_valid = 1'd0;
-reg    [23:0] arp_table_request_timer_count = 24'd12500000;
+reg    [22:0] arp_table_request_timer_count = 23'd5208330;
 wire          arp_table_request_timer_done;
 wire          arp_table_request_timer_wait;
 reg           arp_table_response_response_payload_failed = 1'd0;
@@ -494,30 +540,149 @@ reg           arp_table_source_payload_reply = 1'd0;
 reg           arp_table_source_payload_request = 1'd0;
 wire          arp_table_source_ready;
 reg           arp_table_source_valid = 1'd0;
+reg           buffer0_pipe_ready_sink_d_first = 1'd0;
+reg           buffer0_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] buffer0_pipe_ready_sink_d_param_ip_address = 32'd0;
+reg    [15:0] buffer0_pipe_ready_sink_d_param_length = 16'd0;
+reg     [7:0] buffer0_pipe_ready_sink_d_param_protocol = 8'd0;
+reg     [7:0] buffer0_pipe_ready_sink_d_payload_data = 8'd0;
+reg           buffer0_pipe_ready_sink_d_payload_error = 1'd0;
+reg           buffer0_pipe_ready_sink_d_payload_last_be = 1'd0;
+reg           buffer0_pipe_ready_sink_d_ready = 1'd0;
+reg           buffer0_pipe_ready_sink_d_valid = 1'd0;
+wire          buffer0_pipe_ready_sink_first;
+wire          buffer0_pipe_ready_sink_last;
+wire   [31:0] buffer0_pipe_ready_sink_param_ip_address;
+wire   [15:0] buffer0_pipe_ready_sink_param_length;
+wire    [7:0] buffer0_pipe_ready_sink_param_protocol;
+wire    [7:0] buffer0_pipe_ready_sink_payload_data;
+wire          buffer0_pipe_ready_sink_payload_error;
+wire          buffer0_pipe_ready_sink_payload_last_be;
+wire          buffer0_pipe_ready_sink_ready;
+wire          buffer0_pipe_ready_sink_valid;
+reg           buffer0_pipe_ready_source_first = 1'd0;
+reg           buffer0_pipe_ready_source_last = 1'd0;
+reg    [31:0] buffer0_pipe_ready_source_param_ip_address = 32'd0;
+reg    [15:0] buffer0_pipe_ready_source_param_length = 16'd0;
+reg     [7:0] buffer0_pipe_ready_source_param_protocol = 8'd0;
+reg     [7:0] buffer0_pipe_ready_source_payload_data = 8'd0;
+reg           buffer0_pipe_ready_source_payload_error = 1'd0;
+reg           buffer0_pipe_ready_source_payload_last_be = 1'd0;
+wire          buffer0_pipe_ready_source_ready;
+reg           buffer0_pipe_ready_source_valid = 1'd0;
+reg           buffer0_pipe_ready_valid = 1'd0;
+wire          buffer0_pipe_valid_sink_first;
+wire          buffer0_pipe_valid_sink_last;
+wire   [31:0] buffer0_pipe_valid_sink_param_ip_address;
+wire   [15:0] buffer0_pipe_valid_sink_param_length;
+wire    [7:0] buffer0_pipe_valid_sink_param_protocol;
+wire    [7:0] buffer0_pipe_valid_sink_payload_data;
+wire          buffer0_pipe_valid_sink_payload_error;
+wire          buffer0_pipe_valid_sink_payload_last_be;
+wire          buffer0_pipe_valid_sink_ready;
+wire          buffer0_pipe_valid_sink_valid;
+reg           buffer0_pipe_valid_source_first = 1'd0;
+reg           buffer0_pipe_valid_source_last = 1'd0;
+reg    [31:0] buffer0_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] buffer0_pipe_valid_source_param_length = 16'd0;
+reg     [7:0] buffer0_pipe_valid_source_param_protocol = 8'd0;
+reg     [7:0] buffer0_pipe_valid_source_payload_data = 8'd0;
+reg           buffer0_pipe_valid_source_payload_error = 1'd0;
+reg           buffer0_pipe_valid_source_payload_last_be = 1'd0;
+wire          buffer0_pipe_valid_source_ready;
+reg           buffer0_pipe_valid_source_valid = 1'd0;
+wire          buffer0_sink_sink_first;
+wire          buffer0_sink_sink_last;
+wire   [31:0] buffer0_sink_sink_param_ip_address;
+wire   [15:0] buffer0_sink_sink_param_length;
+wire    [7:0] buffer0_sink_sink_param_protocol;
+wire    [7:0] buffer0_sink_sink_payload_data;
+wire          buffer0_sink_sink_payload_error;
+wire          buffer0_sink_sink_payload_last_be;
+wire          buffer0_sink_sink_ready;
+wire          buffer0_sink_sink_valid;
+wire          buffer0_source_source_first;
+wire          buffer0_source_source_last;
+wire   [31:0] buffer0_source_source_param_ip_address;
+wire   [15:0] buffer0_source_source_param_length;
+wire    [7:0] buffer0_source_source_param_protocol;
+wire    [7:0] buffer0_source_source_payload_data;
+wire          buffer0_source_source_payload_error;
+wire          buffer0_source_source_payload_last_be;
+wire          buffer0_source_source_ready;
+wire          buffer0_source_source_valid;
+reg           buffer1_pipe_ready_sink_d_first = 1'd0;
+reg           buffer1_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] buffer1_pipe_ready_sink_d_param_ip_address = 32'd0;
+reg    [15:0] buffer1_pipe_ready_sink_d_param_length = 16'd0;
+reg     [7:0] buffer1_pipe_ready_sink_d_param_protocol = 8'd0;
+reg     [7:0] buffer1_pipe_ready_sink_d_payload_data = 8'd0;
+reg           buffer1_pipe_ready_sink_d_payload_error = 1'd0;
+reg           buffer1_pipe_ready_sink_d_payload_last_be = 1'd0;
+reg           buffer1_pipe_ready_sink_d_ready = 1'd0;
+reg           buffer1_pipe_ready_sink_d_valid = 1'd0;
+wire          buffer1_pipe_ready_sink_first;
+wire          buffer1_pipe_ready_sink_last;
+wire   [31:0] buffer1_pipe_ready_sink_param_ip_address;
+wire   [15:0] buffer1_pipe_ready_sink_param_length;
+wire    [7:0] buffer1_pipe_ready_sink_param_protocol;
+wire    [7:0] buffer1_pipe_ready_sink_payload_data;
+wire          buffer1_pipe_ready_sink_payload_error;
+wire          buffer1_pipe_ready_sink_payload_last_be;
+wire          buffer1_pipe_ready_sink_ready;
+wire          buffer1_pipe_ready_sink_valid;
+reg           buffer1_pipe_ready_source_first = 1'd0;
+reg           buffer1_pipe_ready_source_last = 1'd0;
+reg    [31:0] buffer1_pipe_ready_source_param_ip_address = 32'd0;
+reg    [15:0] buffer1_pipe_ready_source_param_length = 16'd0;
+reg     [7:0] buffer1_pipe_ready_source_param_protocol = 8'd0;
+reg     [7:0] buffer1_pipe_ready_source_payload_data = 8'd0;
+reg           buffer1_pipe_ready_source_payload_error = 1'd0;
+reg           buffer1_pipe_ready_source_payload_last_be = 1'd0;
+wire          buffer1_pipe_ready_source_ready;
+reg           buffer1_pipe_ready_source_valid = 1'd0;
+reg           buffer1_pipe_ready_valid = 1'd0;
+wire          buffer1_pipe_valid_sink_first;
+wire          buffer1_pipe_valid_sink_last;
+wire   [31:0] buffer1_pipe_valid_sink_param_ip_address;
+wire   [15:0] buffer1_pipe_valid_sink_param_length;
+wire    [7:0] buffer1_pipe_valid_sink_param_protocol;
+wire    [7:0] buffer1_pipe_valid_sink_payload_data;
+wire          buffer1_pipe_valid_sink_payload_error;
+wire          buffer1_pipe_valid_sink_payload_last_be;
+wire          buffer1_pipe_valid_sink_ready;
+wire          buffer1_pipe_valid_sink_valid;
+reg           buffer1_pipe_valid_source_first = 1'd0;
+reg           buffer1_pipe_valid_source_last = 1'd0;
+reg    [31:0] buffer1_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] buffer1_pipe_valid_source_param_length = 16'd0;
+reg     [7:0] buffer1_pipe_valid_source_param_protocol = 8'd0;
+reg     [7:0] buffer1_pipe_valid_source_payload_data = 8'd0;
+reg           buffer1_pipe_valid_source_payload_error = 1'd0;
+reg           buffer1_pipe_valid_source_payload_last_be = 1'd0;
+wire          buffer1_pipe_valid_source_ready;
+reg           buffer1_pipe_valid_source_valid = 1'd0;
+wire          buffer1_sink_sink_first;
+wire          buffer1_sink_sink_last;
+wire   [31:0] buffer1_sink_sink_param_ip_address;
+wire   [15:0] buffer1_sink_sink_param_length;
+wire    [7:0] buffer1_sink_sink_param_protocol;
+wire    [7:0] buffer1_sink_sink_payload_data;
+wire          buffer1_sink_sink_payload_error;
+wire          buffer1_sink_sink_payload_last_be;
+wire          buffer1_sink_sink_ready;
+wire          buffer1_sink_sink_valid;
+wire          buffer1_source_source_first;
+wire          buffer1_source_source_last;
+wire   [31:0] buffer1_source_source_param_ip_address;
+wire   [15:0] buffer1_source_source_param_length;
+wire    [7:0] buffer1_source_source_param_protocol;
+wire    [7:0] buffer1_source_source_payload_data;
+wire          buffer1_source_source_payload_error;
+wire          buffer1_source_source_payload_last_be;
+wire          buffer1_source_source_ready;
+wire          buffer1_source_source_valid;
 wire   [39:0] cases_slice_proxy;
-wire          crossbar_dropped;
-wire          crossbar_sink_first;
-wire          crossbar_sink_last;
-wire   [15:0] crossbar_sink_param_dst_port;
-wire   [31:0] crossbar_sink_param_ip_address;
-wire   [15:0] crossbar_sink_param_length;
-wire   [15:0] crossbar_sink_param_src_port;
-wire    [7:0] crossbar_sink_payload_data;
-wire          crossbar_sink_payload_error;
-wire          crossbar_sink_payload_last_be;
-reg           crossbar_sink_ready = 1'd0;
-wire          crossbar_sink_valid;
-wire          crossbar_source_first;
-wire          crossbar_source_last;
-wire   [15:0] crossbar_source_param_dst_port;
-wire   [31:0] crossbar_source_param_ip_address;
-wire   [15:0] crossbar_source_param_length;
-wire   [15:0] crossbar_source_param_src_port;
-wire    [7:0] crossbar_source_payload_data;
-wire          crossbar_source_payload_error;
-wire          crossbar_source_payload_last_be;
-wire          crossbar_source_ready;
-wire          crossbar_source_valid;
 wire   [31:0] csrbank0_bus_errors_r;
 reg           csrbank0_bus_errors_re = 1'd0;
 wire   [31:0] csrbank0_bus_errors_w;
@@ -584,40 +749,40 @@ wire          ethphy_we;
 reg     [2:0] fsm_next_state = 3'd0;
 reg     [2:0] fsm_state = 3'd0;
 reg    [15:0] holdingudprx0 = 16'd0;
-reg    [15:0] holdingudprx0_liteethudp_next_value4 = 16'd0;
-reg           holdingudprx0_liteethudp_next_value_ce4 = 1'd0;
+reg    [15:0] holdingudprx0_holdingudprx_next_value4 = 16'd0;
+reg           holdingudprx0_holdingudprx_next_value_ce4 = 1'd0;
 reg    [15:0] holdingudprx1 = 16'd0;
-reg    [15:0] holdingudprx1_liteethudp_next_value5 = 16'd0;
-reg           holdingudprx1_liteethudp_next_value_ce5 = 1'd0;
+reg    [15:0] holdingudprx1_holdingudprx_next_value5 = 16'd0;
+reg           holdingudprx1_holdingudprx_next_value_ce5 = 1'd0;
 reg    [15:0] holdingudprx2 = 16'd0;
-reg    [15:0] holdingudprx2_liteethudp_next_value6 = 16'd0;
-reg           holdingudprx2_liteethudp_next_value_ce6 = 1'd0;
+reg    [15:0] holdingudprx2_holdingudprx_next_value6 = 16'd0;
+reg           holdingudprx2_holdingudprx_next_value_ce6 = 1'd0;
 reg    [31:0] holdingudprx3 = 32'd0;
-reg    [31:0] holdingudprx3_liteethudp_next_value7 = 32'd0;
-reg           holdingudprx3_liteethudp_next_value_ce7 = 1'd0;
+reg    [31:0] holdingudprx3_holdingudprx_next_value7 = 32'd0;
+reg           holdingudprx3_holdingudprx_next_value_ce7 = 1'd0;
 reg    [15:0] holdingudprx_count = 16'd0;
-reg    [15:0] holdingudprx_count_liteethudp_next_value0 = 16'd0;
-reg           holdingudprx_count_liteethudp_next_value_ce0 = 1'd0;
+reg    [15:0] holdingudprx_count_holdingudprx_next_value0 = 16'd0;
+reg           holdingudprx_count_holdingudprx_next_value_ce0 = 1'd0;
 wire          holdingudprx_cut0;
 wire          holdingudprx_cut1;
 reg           holdingudprx_drop_header = 1'd0;
 reg           holdingudprx_err = 1'd0;
-reg           holdingudprx_err_liteethudp_next_value1 = 1'd0;
-reg           holdingudprx_err_liteethudp_next_value_ce1 = 1'd0;
+reg           holdingudprx_err_holdingudprx_next_value1 = 1'd0;
+reg           holdingudprx_err_holdingudprx_next_value_ce1 = 1'd0;
 reg           holdingudprx_fsm_is_ongoing0 = 1'd0;
 reg           holdingudprx_fsm_is_ongoing1 = 1'd0;
 reg     [7:0] holdingudprx_held = 8'd0;
-reg     [7:0] holdingudprx_held_liteethudp_next_value3 = 8'd0;
-reg           holdingudprx_held_liteethudp_next_value_ce3 = 1'd0;
+reg     [7:0] holdingudprx_held_holdingudprx_next_value3 = 8'd0;
+reg           holdingudprx_held_holdingudprx_next_value_ce3 = 1'd0;
 reg     [2:0] holdingudprx_liteethudpdepacketizer_count = 3'd0;
-reg     [2:0] holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
-reg           holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
+reg     [2:0] holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 = 3'd0;
+reg           holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 = 1'd0;
 reg           holdingudprx_liteethudpdepacketizer_delayed_last_be = 1'd0;
-reg           holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
-reg           holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value_ce = 1'd0;
 reg           holdingudprx_liteethudpdepacketizer_fsm_from_idle = 1'd0;
-reg           holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
-reg           holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value1 = 1'd0;
+reg           holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value_ce1 = 1'd0;
 wire   [63:0] holdingudprx_liteethudpdepacketizer_header;
 wire          holdingudprx_liteethudpdepacketizer_is_in_copy;
 reg           holdingudprx_liteethudpdepacketizer_is_ongoing0 = 1'd0;
@@ -656,8 +821,8 @@ reg           holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
 reg           holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
 wire   [15:0] holdingudprx_payload_len;
 reg    [15:0] holdingudprx_rest = 16'd0;
-reg    [15:0] holdingudprx_rest_liteethudp_next_value2 = 16'd0;
-reg           holdingudprx_rest_liteethudp_next_value_ce2 = 1'd0;
+reg    [15:0] holdingudprx_rest_holdingudprx_next_value2 = 16'd0;
+reg           holdingudprx_rest_holdingudprx_next_value_ce2 = 1'd0;
 wire          holdingudprx_sink_first;
 wire          holdingudprx_sink_last;
 wire   [31:0] holdingudprx_sink_param_ip_address;
@@ -736,50 +901,50 @@ reg           icmp_echo_param_fifo_wrport_adr = 1'd0;
 wire  [113:0] icmp_echo_param_fifo_wrport_dat_r;
 wire  [113:0] icmp_echo_param_fifo_wrport_dat_w;
 wire          icmp_echo_param_fifo_wrport_we;
-reg     [6:0] icmp_echo_payload_fifo_consume = 7'd0;
+reg     [4:0] icmp_echo_payload_fifo_consume = 5'd0;
 wire          icmp_echo_payload_fifo_do_read;
 wire          icmp_echo_payload_fifo_fifo_in_first;
 wire          icmp_echo_payload_fifo_fifo_in_last;
-wire    [7:0] icmp_echo_payload_fifo_fifo_in_payload_data;
-wire          icmp_echo_payload_fifo_fifo_in_payload_error;
-wire          icmp_echo_payload_fifo_fifo_in_payload_last_be;
+wire   [31:0] icmp_echo_payload_fifo_fifo_in_payload_data;
+wire    [3:0] icmp_echo_payload_fifo_fifo_in_payload_error;
+wire    [3:0] icmp_echo_payload_fifo_fifo_in_payload_last_be;
 wire          icmp_echo_payload_fifo_fifo_out_first;
 wire          icmp_echo_payload_fifo_fifo_out_last;
-wire    [7:0] icmp_echo_payload_fifo_fifo_out_payload_data;
-wire          icmp_echo_payload_fifo_fifo_out_payload_error;
-wire          icmp_echo_payload_fifo_fifo_out_payload_last_be;
-reg     [7:0] icmp_echo_payload_fifo_level0 = 8'd0;
-wire    [7:0] icmp_echo_payload_fifo_level1;
-reg     [6:0] icmp_echo_payload_fifo_produce = 7'd0;
-wire    [6:0] icmp_echo_payload_fifo_rdport_adr;
-wire   [11:0] icmp_echo_payload_fifo_rdport_dat_r;
+wire   [31:0] icmp_echo_payload_fifo_fifo_out_payload_data;
+wire    [3:0] icmp_echo_payload_fifo_fifo_out_payload_error;
+wire    [3:0] icmp_echo_payload_fifo_fifo_out_payload_last_be;
+reg     [5:0] icmp_echo_payload_fifo_level0 = 6'd0;
+wire    [5:0] icmp_echo_payload_fifo_level1;
+reg     [4:0] icmp_echo_payload_fifo_produce = 5'd0;
+wire    [4:0] icmp_echo_payload_fifo_rdport_adr;
+wire   [41:0] icmp_echo_payload_fifo_rdport_dat_r;
 wire          icmp_echo_payload_fifo_rdport_re;
 wire          icmp_echo_payload_fifo_re;
 reg           icmp_echo_payload_fifo_readable = 1'd0;
 reg           icmp_echo_payload_fifo_replace = 1'd0;
 reg           icmp_echo_payload_fifo_sink_first = 1'd0;
 wire          icmp_echo_payload_fifo_sink_last;
-wire    [7:0] icmp_echo_payload_fifo_sink_payload_data;
-wire          icmp_echo_payload_fifo_sink_payload_error;
-wire          icmp_echo_payload_fifo_sink_payload_last_be;
+wire   [31:0] icmp_echo_payload_fifo_sink_payload_data;
+wire    [3:0] icmp_echo_payload_fifo_sink_payload_error;
+wire    [3:0] icmp_echo_payload_fifo_sink_payload_last_be;
 wire          icmp_echo_payload_fifo_sink_ready;
 wire          icmp_echo_payload_fifo_sink_valid;
 wire          icmp_echo_payload_fifo_source_first;
 wire          icmp_echo_payload_fifo_source_last;
-wire    [7:0] icmp_echo_payload_fifo_source_payload_data;
-wire          icmp_echo_payload_fifo_source_payload_error;
-wire          icmp_echo_payload_fifo_source_payload_last_be;
+wire   [31:0] icmp_echo_payload_fifo_source_payload_data;
+wire    [3:0] icmp_echo_payload_fifo_source_payload_error;
+wire    [3:0] icmp_echo_payload_fifo_source_payload_last_be;
 wire          icmp_echo_payload_fifo_source_ready;
 wire          icmp_echo_payload_fifo_source_valid;
-wire   [11:0] icmp_echo_payload_fifo_syncfifo_din;
-wire   [11:0] icmp_echo_payload_fifo_syncfifo_dout;
+wire   [41:0] icmp_echo_payload_fifo_syncfifo_din;
+wire   [41:0] icmp_echo_payload_fifo_syncfifo_dout;
 wire          icmp_echo_payload_fifo_syncfifo_re;
 wire          icmp_echo_payload_fifo_syncfifo_readable;
 wire          icmp_echo_payload_fifo_syncfifo_we;
 wire          icmp_echo_payload_fifo_syncfifo_writable;
-reg     [6:0] icmp_echo_payload_fifo_wrport_adr = 7'd0;
-wire   [11:0] icmp_echo_payload_fifo_wrport_dat_r;
-wire   [11:0] icmp_echo_payload_fifo_wrport_dat_w;
+reg     [4:0] icmp_echo_payload_fifo_wrport_adr = 5'd0;
+wire   [41:0] icmp_echo_payload_fifo_wrport_dat_r;
+wire   [41:0] icmp_echo_payload_fifo_wrport_dat_w;
 wire          icmp_echo_payload_fifo_wrport_we;
 wire          icmp_echo_sink_first;
 wire          icmp_echo_sink_last;
@@ -789,9 +954,9 @@ wire   [31:0] icmp_echo_sink_param_ip_address;
 wire   [15:0] icmp_echo_sink_param_length;
 wire    [7:0] icmp_echo_sink_param_msgtype;
 wire   [31:0] icmp_echo_sink_param_quench;
-wire    [7:0] icmp_echo_sink_payload_data;
-wire          icmp_echo_sink_payload_error;
-wire          icmp_echo_sink_payload_last_be;
+wire   [31:0] icmp_echo_sink_payload_data;
+wire    [3:0] icmp_echo_sink_payload_error;
+wire    [3:0] icmp_echo_sink_payload_last_be;
 reg           icmp_echo_sink_ready = 1'd0;
 reg           icmp_echo_sink_sink_first = 1'd0;
 reg           icmp_echo_sink_sink_last = 1'd0;
@@ -801,9 +966,9 @@ reg    [31:0] icmp_echo_sink_sink_param_ip_address = 32'd0;
 reg    [15:0] icmp_echo_sink_sink_param_length = 16'd0;
 reg     [7:0] icmp_echo_sink_sink_param_msgtype = 8'd0;
 reg    [31:0] icmp_echo_sink_sink_param_quench = 32'd0;
-reg     [7:0] icmp_echo_sink_sink_payload_data = 8'd0;
-reg           icmp_echo_sink_sink_payload_error = 1'd0;
-reg           icmp_echo_sink_sink_payload_last_be = 1'd0;
+reg    [31:0] icmp_echo_sink_sink_payload_data = 32'd0;
+reg     [3:0] icmp_echo_sink_sink_payload_error = 4'd0;
+reg     [3:0] icmp_echo_sink_sink_payload_last_be = 4'd0;
 wire          icmp_echo_sink_sink_ready;
 reg           icmp_echo_sink_sink_valid = 1'd0;
 wire          icmp_echo_sink_valid;
@@ -815,9 +980,9 @@ wire   [31:0] icmp_echo_source_param_ip_address;
 wire   [15:0] icmp_echo_source_param_length;
 reg     [7:0] icmp_echo_source_param_msgtype = 8'd0;
 wire   [31:0] icmp_echo_source_param_quench;
-wire    [7:0] icmp_echo_source_payload_data;
-wire          icmp_echo_source_payload_error;
-wire          icmp_echo_source_payload_last_be;
+wire   [31:0] icmp_echo_source_payload_data;
+wire    [3:0] icmp_echo_source_payload_error;
+wire    [3:0] icmp_echo_source_payload_last_be;
 wire          icmp_echo_source_ready;
 reg           icmp_echo_source_source_first = 1'd0;
 wire          icmp_echo_source_source_last;
@@ -827,9 +992,9 @@ wire   [31:0] icmp_echo_source_source_param_ip_address;
 wire   [15:0] icmp_echo_source_source_param_length;
 wire    [7:0] icmp_echo_source_source_param_msgtype;
 wire   [31:0] icmp_echo_source_source_param_quench;
-wire    [7:0] icmp_echo_source_source_payload_data;
-wire          icmp_echo_source_source_payload_error;
-wire          icmp_echo_source_source_payload_last_be;
+wire   [31:0] icmp_echo_source_source_payload_data;
+wire    [3:0] icmp_echo_source_source_payload_error;
+wire    [3:0] icmp_echo_source_source_payload_last_be;
 wire          icmp_echo_source_source_ready;
 wire          icmp_echo_source_source_valid;
 wire          icmp_echo_source_valid;
@@ -838,9 +1003,9 @@ wire          icmp_ip_port_sink_last;
 wire   [31:0] icmp_ip_port_sink_param_ip_address;
 wire   [15:0] icmp_ip_port_sink_param_length;
 wire    [7:0] icmp_ip_port_sink_param_protocol;
-wire    [7:0] icmp_ip_port_sink_payload_data;
-wire          icmp_ip_port_sink_payload_error;
-wire          icmp_ip_port_sink_payload_last_be;
+wire   [31:0] icmp_ip_port_sink_payload_data;
+wire    [3:0] icmp_ip_port_sink_payload_error;
+wire    [3:0] icmp_ip_port_sink_payload_last_be;
 reg           icmp_ip_port_sink_ready = 1'd0;
 wire          icmp_ip_port_sink_valid;
 reg           icmp_ip_port_source_first = 1'd0;
@@ -848,19 +1013,19 @@ reg           icmp_ip_port_source_last = 1'd0;
 reg    [31:0] icmp_ip_port_source_param_ip_address = 32'd0;
 reg    [15:0] icmp_ip_port_source_param_length = 16'd0;
 reg     [7:0] icmp_ip_port_source_param_protocol = 8'd0;
-reg     [7:0] icmp_ip_port_source_payload_data = 8'd0;
-reg           icmp_ip_port_source_payload_error = 1'd0;
-reg           icmp_ip_port_source_payload_last_be = 1'd0;
+reg    [31:0] icmp_ip_port_source_payload_data = 32'd0;
+reg     [3:0] icmp_ip_port_source_payload_error = 4'd0;
+reg     [3:0] icmp_ip_port_source_payload_last_be = 4'd0;
 wire          icmp_ip_port_source_ready;
 reg           icmp_ip_port_source_valid = 1'd0;
 wire          icmp_rx_cut;
 reg           icmp_rx_fsm_is_ongoing0 = 1'd0;
 reg           icmp_rx_fsm_is_ongoing1 = 1'd0;
-reg     [2:0] icmp_rx_liteethicmpdepacketizer_count = 3'd0;
-reg     [2:0] icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 = 3'd0;
+reg           icmp_rx_liteethicmpdepacketizer_count = 1'd0;
+reg           icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 = 1'd0;
 reg           icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 = 1'd0;
-reg           icmp_rx_liteethicmpdepacketizer_delayed_last_be = 1'd0;
-reg           icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 = 1'd0;
+reg     [3:0] icmp_rx_liteethicmpdepacketizer_delayed_last_be = 4'd0;
+reg     [3:0] icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 = 4'd0;
 reg           icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 = 1'd0;
 reg           icmp_rx_liteethicmpdepacketizer_fsm_from_idle = 1'd0;
 reg           icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 = 1'd0;
@@ -871,17 +1036,16 @@ reg           icmp_rx_liteethicmpdepacketizer_is_ongoing0 = 1'd0;
 reg           icmp_rx_liteethicmpdepacketizer_is_ongoing1 = 1'd0;
 reg           icmp_rx_liteethicmpdepacketizer_is_ongoing2 = 1'd0;
 reg           icmp_rx_liteethicmpdepacketizer_is_ongoing3 = 1'd0;
-wire          icmp_rx_liteethicmpdepacketizer_new_last_be;
+wire    [3:0] icmp_rx_liteethicmpdepacketizer_new_last_be;
 reg           icmp_rx_liteethicmpdepacketizer_sink_d_last = 1'd0;
 wire          icmp_rx_liteethicmpdepacketizer_sink_first;
 wire          icmp_rx_liteethicmpdepacketizer_sink_last;
-wire          icmp_rx_liteethicmpdepacketizer_sink_last_be;
 wire   [31:0] icmp_rx_liteethicmpdepacketizer_sink_param_ip_address;
 wire   [15:0] icmp_rx_liteethicmpdepacketizer_sink_param_length;
 wire    [7:0] icmp_rx_liteethicmpdepacketizer_sink_param_protocol;
-wire    [7:0] icmp_rx_liteethicmpdepacketizer_sink_payload_data;
-wire          icmp_rx_liteethicmpdepacketizer_sink_payload_error;
-wire          icmp_rx_liteethicmpdepacketizer_sink_payload_last_be;
+wire   [31:0] icmp_rx_liteethicmpdepacketizer_sink_payload_data;
+wire    [3:0] icmp_rx_liteethicmpdepacketizer_sink_payload_error;
+wire    [3:0] icmp_rx_liteethicmpdepacketizer_sink_payload_last_be;
 reg           icmp_rx_liteethicmpdepacketizer_sink_ready = 1'd0;
 wire          icmp_rx_liteethicmpdepacketizer_sink_valid;
 reg           icmp_rx_liteethicmpdepacketizer_source_last = 1'd0;
@@ -892,9 +1056,9 @@ wire   [15:0] icmp_rx_liteethicmpdepacketizer_source_param_checksum;
 wire    [7:0] icmp_rx_liteethicmpdepacketizer_source_param_code;
 wire    [7:0] icmp_rx_liteethicmpdepacketizer_source_param_msgtype;
 wire   [31:0] icmp_rx_liteethicmpdepacketizer_source_param_quench;
-reg     [7:0] icmp_rx_liteethicmpdepacketizer_source_payload_data = 8'd0;
-wire          icmp_rx_liteethicmpdepacketizer_source_payload_error;
-reg           icmp_rx_liteethicmpdepacketizer_source_payload_last_be = 1'd0;
+reg    [31:0] icmp_rx_liteethicmpdepacketizer_source_payload_data = 32'd0;
+wire    [3:0] icmp_rx_liteethicmpdepacketizer_source_payload_error;
+reg     [3:0] icmp_rx_liteethicmpdepacketizer_source_payload_last_be = 4'd0;
 reg           icmp_rx_liteethicmpdepacketizer_source_ready = 1'd0;
 reg           icmp_rx_liteethicmpdepacketizer_source_valid = 1'd0;
 reg    [63:0] icmp_rx_liteethicmpdepacketizer_sr = 64'd0;
@@ -906,9 +1070,9 @@ wire          icmp_rx_sink_last;
 wire   [31:0] icmp_rx_sink_param_ip_address;
 wire   [15:0] icmp_rx_sink_param_length;
 wire    [7:0] icmp_rx_sink_param_protocol;
-wire    [7:0] icmp_rx_sink_payload_data;
-wire          icmp_rx_sink_payload_error;
-wire          icmp_rx_sink_payload_last_be;
+wire   [31:0] icmp_rx_sink_payload_data;
+wire    [3:0] icmp_rx_sink_payload_error;
+wire    [3:0] icmp_rx_sink_payload_last_be;
 wire          icmp_rx_sink_ready;
 wire          icmp_rx_sink_valid;
 reg           icmp_rx_source_first = 1'd0;
@@ -919,16 +1083,16 @@ wire   [31:0] icmp_rx_source_param_ip_address;
 wire   [15:0] icmp_rx_source_param_length;
 wire    [7:0] icmp_rx_source_param_msgtype;
 wire   [31:0] icmp_rx_source_param_quench;
-wire    [7:0] icmp_rx_source_payload_data;
-wire          icmp_rx_source_payload_error;
-wire          icmp_rx_source_payload_last_be;
+wire   [31:0] icmp_rx_source_payload_data;
+wire    [3:0] icmp_rx_source_payload_error;
+wire    [3:0] icmp_rx_source_payload_last_be;
 wire          icmp_rx_source_ready;
 reg           icmp_rx_source_valid = 1'd0;
-reg     [2:0] icmp_tx_packetizer_count = 3'd0;
-reg     [2:0] icmp_tx_packetizer_count_fsm0_next_value0 = 3'd0;
+reg           icmp_tx_packetizer_count = 1'd0;
+reg           icmp_tx_packetizer_count_fsm0_next_value0 = 1'd0;
 reg           icmp_tx_packetizer_count_fsm0_next_value_ce0 = 1'd0;
-reg           icmp_tx_packetizer_delayed_last_be = 1'd0;
-reg           icmp_tx_packetizer_delayed_last_be_fsm1_next_value0 = 1'd0;
+reg     [3:0] icmp_tx_packetizer_delayed_last_be = 4'd0;
+reg     [3:0] icmp_tx_packetizer_delayed_last_be_fsm1_next_value0 = 4'd0;
 reg           icmp_tx_packetizer_delayed_last_be_fsm1_next_value_ce0 = 1'd0;
 reg           icmp_tx_packetizer_fsm_from_idle = 1'd0;
 reg           icmp_tx_packetizer_fsm_from_idle_fsm0_next_value1 = 1'd0;
@@ -938,16 +1102,15 @@ wire          icmp_tx_packetizer_in_data_copy;
 reg           icmp_tx_packetizer_is_ongoing0 = 1'd0;
 reg           icmp_tx_packetizer_is_ongoing1 = 1'd0;
 reg           icmp_tx_packetizer_is_ongoing2 = 1'd0;
-wire          icmp_tx_packetizer_new_last_be;
+wire    [3:0] icmp_tx_packetizer_new_last_be;
 wire          icmp_tx_packetizer_sink_last;
-wire          icmp_tx_packetizer_sink_last_be;
 wire   [15:0] icmp_tx_packetizer_sink_param_checksum;
 wire    [7:0] icmp_tx_packetizer_sink_param_code;
 wire    [7:0] icmp_tx_packetizer_sink_param_msgtype;
 wire   [31:0] icmp_tx_packetizer_sink_param_quench;
-wire    [7:0] icmp_tx_packetizer_sink_payload_data;
-reg           icmp_tx_packetizer_sink_payload_error = 1'd0;
-wire          icmp_tx_packetizer_sink_payload_last_be;
+wire   [31:0] icmp_tx_packetizer_sink_payload_data;
+reg     [3:0] icmp_tx_packetizer_sink_payload_error = 4'd0;
+wire    [3:0] icmp_tx_packetizer_sink_payload_last_be;
 reg           icmp_tx_packetizer_sink_ready = 1'd0;
 wire          icmp_tx_packetizer_sink_valid;
 reg           icmp_tx_packetizer_source_first = 1'd0;
@@ -958,9 +1121,9 @@ reg           icmp_tx_packetizer_source_last_s = 1'd0;
 reg    [31:0] icmp_tx_packetizer_source_param_ip_address = 32'd0;
 reg    [15:0] icmp_tx_packetizer_source_param_length = 16'd0;
 reg     [7:0] icmp_tx_packetizer_source_param_protocol = 8'd0;
-reg     [7:0] icmp_tx_packetizer_source_payload_data = 8'd0;
-wire          icmp_tx_packetizer_source_payload_error;
-reg           icmp_tx_packetizer_source_payload_last_be = 1'd0;
+reg    [31:0] icmp_tx_packetizer_source_payload_data = 32'd0;
+wire    [3:0] icmp_tx_packetizer_source_payload_error;
+reg     [3:0] icmp_tx_packetizer_source_payload_last_be = 4'd0;
 reg           icmp_tx_packetizer_source_ready = 1'd0;
 reg           icmp_tx_packetizer_source_valid = 1'd0;
 reg    [63:0] icmp_tx_packetizer_sr = 64'd0;
@@ -974,9 +1137,9 @@ wire   [31:0] icmp_tx_sink_sink_param_ip_address;
 wire   [15:0] icmp_tx_sink_sink_param_length;
 wire    [7:0] icmp_tx_sink_sink_param_msgtype;
 wire   [31:0] icmp_tx_sink_sink_param_quench;
-wire    [7:0] icmp_tx_sink_sink_payload_data;
-wire          icmp_tx_sink_sink_payload_error;
-wire          icmp_tx_sink_sink_payload_last_be;
+wire   [31:0] icmp_tx_sink_sink_payload_data;
+wire    [3:0] icmp_tx_sink_sink_payload_error;
+wire    [3:0] icmp_tx_sink_sink_payload_last_be;
 wire          icmp_tx_sink_sink_ready;
 wire          icmp_tx_sink_sink_valid;
 wire          icmp_tx_source_source_first;
@@ -984,9 +1147,9 @@ wire          icmp_tx_source_source_last;
 reg    [31:0] icmp_tx_source_source_param_ip_address = 32'd0;
 reg    [15:0] icmp_tx_source_source_param_length = 16'd0;
 reg     [7:0] icmp_tx_source_source_param_protocol = 8'd0;
-wire    [7:0] icmp_tx_source_source_payload_data;
-wire          icmp_tx_source_source_payload_error;
-wire          icmp_tx_source_source_payload_last_be;
+wire   [31:0] icmp_tx_source_source_payload_data;
+wire    [3:0] icmp_tx_source_source_payload_error;
+wire    [3:0] icmp_tx_source_source_payload_last_be;
 wire          icmp_tx_source_source_ready;
 reg           icmp_tx_source_source_valid = 1'd0;
 reg           int_rst = 1'd1;
@@ -1041,9 +1204,9 @@ wire          ip_crossbar_sink_last;
 wire   [31:0] ip_crossbar_sink_param_ip_address;
 wire   [15:0] ip_crossbar_sink_param_length;
 wire    [7:0] ip_crossbar_sink_param_protocol;
-wire    [7:0] ip_crossbar_sink_payload_data;
-wire          ip_crossbar_sink_payload_error;
-wire          ip_crossbar_sink_payload_last_be;
+wire   [31:0] ip_crossbar_sink_payload_data;
+wire    [3:0] ip_crossbar_sink_payload_error;
+wire    [3:0] ip_crossbar_sink_payload_last_be;
 reg           ip_crossbar_sink_ready = 1'd0;
 wire          ip_crossbar_sink_valid;
 reg           ip_crossbar_source_first = 1'd0;
@@ -1051,27 +1214,27 @@ reg           ip_crossbar_source_last = 1'd0;
 reg    [31:0] ip_crossbar_source_param_ip_address = 32'd0;
 reg    [15:0] ip_crossbar_source_param_length = 16'd0;
 reg     [7:0] ip_crossbar_source_param_protocol = 8'd0;
-reg     [7:0] ip_crossbar_source_payload_data = 8'd0;
-reg           ip_crossbar_source_payload_error = 1'd0;
-reg           ip_crossbar_source_payload_last_be = 1'd0;
+reg    [31:0] ip_crossbar_source_payload_data = 32'd0;
+reg     [3:0] ip_crossbar_source_payload_error = 4'd0;
+reg     [3:0] ip_crossbar_source_payload_last_be = 4'd0;
 wire          ip_crossbar_source_ready;
 reg           ip_crossbar_source_valid = 1'd0;
 wire          ip_mac_port_sink_first;
 wire          ip_mac_port_sink_last;
-wire    [7:0] ip_mac_port_sink_payload_data;
-wire          ip_mac_port_sink_payload_error;
+wire   [31:0] ip_mac_port_sink_payload_data;
+wire    [3:0] ip_mac_port_sink_payload_error;
 wire   [15:0] ip_mac_port_sink_payload_ethernet_type;
-wire          ip_mac_port_sink_payload_last_be;
+wire    [3:0] ip_mac_port_sink_payload_last_be;
 wire   [47:0] ip_mac_port_sink_payload_sender_mac;
 wire   [47:0] ip_mac_port_sink_payload_target_mac;
 reg           ip_mac_port_sink_ready = 1'd0;
 wire          ip_mac_port_sink_valid;
 reg           ip_mac_port_source_first = 1'd0;
 reg           ip_mac_port_source_last = 1'd0;
-reg     [7:0] ip_mac_port_source_payload_data = 8'd0;
-reg           ip_mac_port_source_payload_error = 1'd0;
+reg    [31:0] ip_mac_port_source_payload_data = 32'd0;
+reg     [3:0] ip_mac_port_source_payload_error = 4'd0;
 reg    [15:0] ip_mac_port_source_payload_ethernet_type = 16'd0;
-reg           ip_mac_port_source_payload_last_be = 1'd0;
+reg     [3:0] ip_mac_port_source_payload_last_be = 4'd0;
 reg    [47:0] ip_mac_port_source_payload_sender_mac = 48'd0;
 reg    [47:0] ip_mac_port_source_payload_target_mac = 48'd0;
 wire          ip_mac_port_source_ready;
@@ -1081,9 +1244,9 @@ wire          ip_port_sink_last;
 wire   [31:0] ip_port_sink_param_ip_address;
 wire   [15:0] ip_port_sink_param_length;
 wire    [7:0] ip_port_sink_param_protocol;
-wire    [7:0] ip_port_sink_payload_data;
-wire          ip_port_sink_payload_error;
-wire          ip_port_sink_payload_last_be;
+wire   [31:0] ip_port_sink_payload_data;
+wire    [3:0] ip_port_sink_payload_error;
+wire    [3:0] ip_port_sink_payload_last_be;
 reg           ip_port_sink_ready = 1'd0;
 wire          ip_port_sink_valid;
 reg           ip_port_source_first = 1'd0;
@@ -1091,9 +1254,9 @@ reg           ip_port_source_last = 1'd0;
 reg    [31:0] ip_port_source_param_ip_address = 32'd0;
 reg    [15:0] ip_port_source_param_length = 16'd0;
 reg     [7:0] ip_port_source_param_protocol = 8'd0;
-reg     [7:0] ip_port_source_payload_data = 8'd0;
-reg           ip_port_source_payload_error = 1'd0;
-reg           ip_port_source_payload_last_be = 1'd0;
+reg    [31:0] ip_port_source_payload_data = 32'd0;
+reg     [3:0] ip_port_source_payload_error = 4'd0;
+reg     [3:0] ip_port_source_payload_last_be = 4'd0;
 wire          ip_port_source_ready;
 reg           ip_port_source_valid = 1'd0;
 wire          ip_rx_ce;
@@ -1141,11 +1304,11 @@ wire   [16:0] ip_rx_liteethipv4checksum_s_next7;
 wire   [16:0] ip_rx_liteethipv4checksum_s_next8;
 wire   [16:0] ip_rx_liteethipv4checksum_s_next9;
 wire   [15:0] ip_rx_liteethipv4checksum_value;
-reg     [4:0] ip_rx_liteethipv4depacketizer_count = 5'd0;
-reg     [4:0] ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 = 5'd0;
+reg     [2:0] ip_rx_liteethipv4depacketizer_count = 3'd0;
+reg     [2:0] ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 = 3'd0;
 reg           ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 = 1'd0;
-reg           ip_rx_liteethipv4depacketizer_delayed_last_be = 1'd0;
-reg           ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 = 1'd0;
+reg     [3:0] ip_rx_liteethipv4depacketizer_delayed_last_be = 4'd0;
+reg     [3:0] ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 = 4'd0;
 reg           ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 = 1'd0;
 reg           ip_rx_liteethipv4depacketizer_fsm_from_idle = 1'd0;
 reg           ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 = 1'd0;
@@ -1156,15 +1319,14 @@ reg           ip_rx_liteethipv4depacketizer_is_ongoing0 = 1'd0;
 reg           ip_rx_liteethipv4depacketizer_is_ongoing1 = 1'd0;
 reg           ip_rx_liteethipv4depacketizer_is_ongoing2 = 1'd0;
 reg           ip_rx_liteethipv4depacketizer_is_ongoing3 = 1'd0;
-wire          ip_rx_liteethipv4depacketizer_new_last_be;
+wire    [3:0] ip_rx_liteethipv4depacketizer_new_last_be;
 reg           ip_rx_liteethipv4depacketizer_sink_d_last = 1'd0;
 wire          ip_rx_liteethipv4depacketizer_sink_first;
 wire          ip_rx_liteethipv4depacketizer_sink_last;
-wire          ip_rx_liteethipv4depacketizer_sink_last_be;
-wire    [7:0] ip_rx_liteethipv4depacketizer_sink_payload_data;
-wire          ip_rx_liteethipv4depacketizer_sink_payload_error;
+wire   [31:0] ip_rx_liteethipv4depacketizer_sink_payload_data;
+wire    [3:0] ip_rx_liteethipv4depacketizer_sink_payload_error;
 wire   [15:0] ip_rx_liteethipv4depacketizer_sink_payload_ethernet_type;
-wire          ip_rx_liteethipv4depacketizer_sink_payload_last_be;
+wire    [3:0] ip_rx_liteethipv4depacketizer_sink_payload_last_be;
 wire   [47:0] ip_rx_liteethipv4depacketizer_sink_payload_sender_mac;
 wire   [47:0] ip_rx_liteethipv4depacketizer_sink_payload_target_mac;
 reg           ip_rx_liteethipv4depacketizer_sink_ready = 1'd0;
@@ -1182,9 +1344,9 @@ wire   [31:0] ip_rx_liteethipv4depacketizer_source_param_target_ip;
 wire   [15:0] ip_rx_liteethipv4depacketizer_source_param_total_length;
 wire    [7:0] ip_rx_liteethipv4depacketizer_source_param_ttl;
 wire    [3:0] ip_rx_liteethipv4depacketizer_source_param_version;
-reg     [7:0] ip_rx_liteethipv4depacketizer_source_payload_data = 8'd0;
-wire          ip_rx_liteethipv4depacketizer_source_payload_error;
-reg           ip_rx_liteethipv4depacketizer_source_payload_last_be = 1'd0;
+reg    [31:0] ip_rx_liteethipv4depacketizer_source_payload_data = 32'd0;
+wire    [3:0] ip_rx_liteethipv4depacketizer_source_payload_error;
+reg     [3:0] ip_rx_liteethipv4depacketizer_source_payload_last_be = 4'd0;
 reg           ip_rx_liteethipv4depacketizer_source_ready = 1'd0;
 reg           ip_rx_liteethipv4depacketizer_source_valid = 1'd0;
 reg   [159:0] ip_rx_liteethipv4depacketizer_sr = 160'd0;
@@ -1196,10 +1358,10 @@ wire          ip_rx_ours;
 wire          ip_rx_reset;
 wire          ip_rx_sink_first;
 wire          ip_rx_sink_last;
-wire    [7:0] ip_rx_sink_payload_data;
-wire          ip_rx_sink_payload_error;
+wire   [31:0] ip_rx_sink_payload_data;
+wire    [3:0] ip_rx_sink_payload_error;
 wire   [15:0] ip_rx_sink_payload_ethernet_type;
-wire          ip_rx_sink_payload_last_be;
+wire    [3:0] ip_rx_sink_payload_last_be;
 wire   [47:0] ip_rx_sink_payload_sender_mac;
 wire   [47:0] ip_rx_sink_payload_target_mac;
 wire          ip_rx_sink_ready;
@@ -1209,9 +1371,9 @@ wire          ip_rx_source_last;
 wire   [31:0] ip_rx_source_param_ip_address;
 wire   [15:0] ip_rx_source_param_length;
 wire    [7:0] ip_rx_source_param_protocol;
-wire    [7:0] ip_rx_source_payload_data;
-wire          ip_rx_source_payload_error;
-wire          ip_rx_source_payload_last_be;
+wire   [31:0] ip_rx_source_payload_data;
+wire    [3:0] ip_rx_source_payload_error;
+wire    [3:0] ip_rx_source_payload_last_be;
 wire          ip_rx_source_ready;
 reg           ip_rx_source_valid = 1'd0;
 wire          ip_tx_ce;
@@ -1248,11 +1410,11 @@ wire   [16:0] ip_tx_liteethipv4checksum_s_next6;
 wire   [16:0] ip_tx_liteethipv4checksum_s_next7;
 wire   [16:0] ip_tx_liteethipv4checksum_s_next8;
 wire   [15:0] ip_tx_liteethipv4checksum_value;
-reg     [4:0] ip_tx_packetizer_count = 5'd0;
-reg     [4:0] ip_tx_packetizer_count_liteethip_fsm0_next_value0 = 5'd0;
+reg     [2:0] ip_tx_packetizer_count = 3'd0;
+reg     [2:0] ip_tx_packetizer_count_liteethip_fsm0_next_value0 = 3'd0;
 reg           ip_tx_packetizer_count_liteethip_fsm0_next_value_ce0 = 1'd0;
-reg           ip_tx_packetizer_delayed_last_be = 1'd0;
-reg           ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value0 = 1'd0;
+reg     [3:0] ip_tx_packetizer_delayed_last_be = 4'd0;
+reg     [3:0] ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value0 = 4'd0;
 reg           ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value_ce0 = 1'd0;
 reg           ip_tx_packetizer_fsm_from_idle = 1'd0;
 reg           ip_tx_packetizer_fsm_from_idle_liteethip_fsm0_next_value1 = 1'd0;
@@ -1262,9 +1424,8 @@ wire          ip_tx_packetizer_in_data_copy;
 reg           ip_tx_packetizer_is_ongoing0 = 1'd0;
 reg           ip_tx_packetizer_is_ongoing1 = 1'd0;
 reg           ip_tx_packetizer_is_ongoing2 = 1'd0;
-wire          ip_tx_packetizer_new_last_be;
+wire    [3:0] ip_tx_packetizer_new_last_be;
 wire          ip_tx_packetizer_sink_last;
-wire          ip_tx_packetizer_sink_last_be;
 wire   [15:0] ip_tx_packetizer_sink_param_checksum;
 wire   [15:0] ip_tx_packetizer_sink_param_identification;
 wire    [3:0] ip_tx_packetizer_sink_param_ihl;
@@ -1274,9 +1435,9 @@ wire   [31:0] ip_tx_packetizer_sink_param_target_ip;
 wire   [15:0] ip_tx_packetizer_sink_param_total_length;
 wire    [7:0] ip_tx_packetizer_sink_param_ttl;
 wire    [3:0] ip_tx_packetizer_sink_param_version;
-wire    [7:0] ip_tx_packetizer_sink_payload_data;
-reg           ip_tx_packetizer_sink_payload_error = 1'd0;
-wire          ip_tx_packetizer_sink_payload_last_be;
+wire   [31:0] ip_tx_packetizer_sink_payload_data;
+reg     [3:0] ip_tx_packetizer_sink_payload_error = 4'd0;
+wire    [3:0] ip_tx_packetizer_sink_payload_last_be;
 reg           ip_tx_packetizer_sink_ready = 1'd0;
 wire          ip_tx_packetizer_sink_valid;
 reg           ip_tx_packetizer_source_first = 1'd0;
@@ -1284,10 +1445,10 @@ reg           ip_tx_packetizer_source_last = 1'd0;
 reg           ip_tx_packetizer_source_last_a = 1'd0;
 reg           ip_tx_packetizer_source_last_b = 1'd0;
 reg           ip_tx_packetizer_source_last_s = 1'd0;
-reg     [7:0] ip_tx_packetizer_source_payload_data = 8'd0;
-wire          ip_tx_packetizer_source_payload_error;
+reg    [31:0] ip_tx_packetizer_source_payload_data = 32'd0;
+wire    [3:0] ip_tx_packetizer_source_payload_error;
 reg    [15:0] ip_tx_packetizer_source_payload_ethernet_type = 16'd0;
-reg           ip_tx_packetizer_source_payload_last_be = 1'd0;
+reg     [3:0] ip_tx_packetizer_source_payload_last_be = 4'd0;
 reg    [47:0] ip_tx_packetizer_source_payload_sender_mac = 48'd0;
 reg    [47:0] ip_tx_packetizer_source_payload_target_mac = 48'd0;
 reg           ip_tx_packetizer_source_ready = 1'd0;
@@ -1300,9 +1461,9 @@ wire          ip_tx_pipe_valid_sink_last;
 wire   [31:0] ip_tx_pipe_valid_sink_param_ip_address;
 wire   [15:0] ip_tx_pipe_valid_sink_param_length;
 wire    [7:0] ip_tx_pipe_valid_sink_param_protocol;
-wire    [7:0] ip_tx_pipe_valid_sink_payload_data;
-wire          ip_tx_pipe_valid_sink_payload_error;
-wire          ip_tx_pipe_valid_sink_payload_last_be;
+wire   [31:0] ip_tx_pipe_valid_sink_payload_data;
+wire    [3:0] ip_tx_pipe_valid_sink_payload_error;
+wire    [3:0] ip_tx_pipe_valid_sink_payload_last_be;
 wire          ip_tx_pipe_valid_sink_ready;
 wire          ip_tx_pipe_valid_sink_valid;
 reg           ip_tx_pipe_valid_source_first = 1'd0;
@@ -1310,9 +1471,9 @@ reg           ip_tx_pipe_valid_source_last = 1'd0;
 reg    [31:0] ip_tx_pipe_valid_source_param_ip_address = 32'd0;
 reg    [15:0] ip_tx_pipe_valid_source_param_length = 16'd0;
 reg     [7:0] ip_tx_pipe_valid_source_param_protocol = 8'd0;
-reg     [7:0] ip_tx_pipe_valid_source_payload_data = 8'd0;
-reg           ip_tx_pipe_valid_source_payload_error = 1'd0;
-reg           ip_tx_pipe_valid_source_payload_last_be = 1'd0;
+reg    [31:0] ip_tx_pipe_valid_source_payload_data = 32'd0;
+reg     [3:0] ip_tx_pipe_valid_source_payload_error = 4'd0;
+reg     [3:0] ip_tx_pipe_valid_source_payload_last_be = 4'd0;
 wire          ip_tx_pipe_valid_source_ready;
 reg           ip_tx_pipe_valid_source_valid = 1'd0;
 wire          ip_tx_reset;
@@ -1326,12 +1487,12 @@ wire   [15:0] ip_tx_sink_sink_param_length0;
 wire   [15:0] ip_tx_sink_sink_param_length1;
 wire    [7:0] ip_tx_sink_sink_param_protocol0;
 wire    [7:0] ip_tx_sink_sink_param_protocol1;
-wire    [7:0] ip_tx_sink_sink_payload_data0;
-wire    [7:0] ip_tx_sink_sink_payload_data1;
-wire          ip_tx_sink_sink_payload_error0;
-wire          ip_tx_sink_sink_payload_error1;
-wire          ip_tx_sink_sink_payload_last_be0;
-wire          ip_tx_sink_sink_payload_last_be1;
+wire   [31:0] ip_tx_sink_sink_payload_data0;
+wire   [31:0] ip_tx_sink_sink_payload_data1;
+wire    [3:0] ip_tx_sink_sink_payload_error0;
+wire    [3:0] ip_tx_sink_sink_payload_error1;
+wire    [3:0] ip_tx_sink_sink_payload_last_be0;
+wire    [3:0] ip_tx_sink_sink_payload_last_be1;
 wire          ip_tx_sink_sink_ready0;
 wire          ip_tx_sink_sink_ready1;
 wire          ip_tx_sink_sink_valid0;
@@ -1343,13 +1504,13 @@ wire          ip_tx_source_source_last1;
 wire   [31:0] ip_tx_source_source_param_ip_address;
 wire   [15:0] ip_tx_source_source_param_length;
 wire    [7:0] ip_tx_source_source_param_protocol;
-reg     [7:0] ip_tx_source_source_payload_data0 = 8'd0;
-wire    [7:0] ip_tx_source_source_payload_data1;
-reg           ip_tx_source_source_payload_error0 = 1'd0;
-wire          ip_tx_source_source_payload_error1;
+reg    [31:0] ip_tx_source_source_payload_data0 = 32'd0;
+wire   [31:0] ip_tx_source_source_payload_data1;
+reg     [3:0] ip_tx_source_source_payload_error0 = 4'd0;
+wire    [3:0] ip_tx_source_source_payload_error1;
 reg    [15:0] ip_tx_source_source_payload_ethernet_type = 16'd0;
-reg           ip_tx_source_source_payload_last_be0 = 1'd0;
-wire          ip_tx_source_source_payload_last_be1;
+reg     [3:0] ip_tx_source_source_payload_last_be0 = 4'd0;
+wire    [3:0] ip_tx_source_source_payload_last_be1;
 reg    [47:0] ip_tx_source_source_payload_sender_mac = 48'd0;
 reg    [47:0] ip_tx_source_source_payload_target_mac = 48'd0;
 wire          ip_tx_source_source_ready0;
@@ -1360,6 +1521,30 @@ reg    [47:0] ip_tx_target_mac = 48'd0;
 reg    [47:0] ip_tx_target_mac_liteethip_next_value = 48'd0;
 reg           ip_tx_target_mac_liteethip_next_value_ce = 1'd0;
 reg           ip_tx_target_unreachable = 1'd0;
+wire          lastbytetrim_end;
+reg           lastbytetrim_err = 1'd0;
+reg           lastbytetrim_err_lastbytetrim_next_value = 1'd0;
+reg           lastbytetrim_err_lastbytetrim_next_value_ce = 1'd0;
+wire          lastbytetrim_sink_first;
+wire          lastbytetrim_sink_last;
+wire   [31:0] lastbytetrim_sink_param_ip_address;
+wire   [15:0] lastbytetrim_sink_param_length;
+wire    [7:0] lastbytetrim_sink_param_protocol;
+wire    [7:0] lastbytetrim_sink_payload_data;
+wire          lastbytetrim_sink_payload_error;
+wire          lastbytetrim_sink_payload_last_be;
+reg           lastbytetrim_sink_ready = 1'd0;
+wire          lastbytetrim_sink_valid;
+reg           lastbytetrim_source_first = 1'd0;
+reg           lastbytetrim_source_last = 1'd0;
+reg    [31:0] lastbytetrim_source_param_ip_address = 32'd0;
+reg    [15:0] lastbytetrim_source_param_length = 16'd0;
+reg     [7:0] lastbytetrim_source_param_protocol = 8'd0;
+reg     [7:0] lastbytetrim_source_payload_data = 8'd0;
+reg           lastbytetrim_source_payload_error = 1'd0;
+reg           lastbytetrim_source_payload_last_be = 1'd0;
+wire          lastbytetrim_source_ready;
+reg           lastbytetrim_source_valid = 1'd0;
 reg     [2:0] liteetharpcache_next_state = 3'd0;
 reg     [2:0] liteetharpcache_state = 3'd0;
 reg     [1:0] liteetharprx_fsm0_next_state = 2'd0;
@@ -1454,26 +1639,71 @@ reg           liteethmac_txdatapath_liteethmacpaddinginserter_next_state = 1'd0;
 reg           liteethmac_txdatapath_liteethmacpaddinginserter_state = 1'd0;
 reg     [1:0] liteethmac_txdatapath_liteethmacpreambleinserter_next_state = 2'd0;
 reg     [1:0] liteethmac_txdatapath_liteethmacpreambleinserter_state = 2'd0;
-reg           liteethudp_first = 1'd1;
-reg     [1:0] liteethudp_holdingudprx_fsm0_next_state = 2'd0;
-reg     [1:0] liteethudp_holdingudprx_fsm0_state = 2'd0;
-reg           liteethudp_holdingudprx_fsm1_next_state = 1'd0;
-reg           liteethudp_holdingudprx_fsm1_state = 1'd0;
-reg     [2:0] liteethudp_holdingudprx_next_state = 3'd0;
-reg     [2:0] liteethudp_holdingudprx_state = 3'd0;
-wire          liteethudp_last;
-reg     [1:0] liteethudp_liteethudptx_fsm0_next_state = 2'd0;
-reg     [1:0] liteethudp_liteethudptx_fsm0_state = 2'd0;
-reg           liteethudp_liteethudptx_fsm1_next_state = 1'd0;
-reg           liteethudp_liteethudptx_fsm1_state = 1'd0;
-reg           liteethudp_liteethudptx_next_state = 1'd0;
-reg           liteethudp_liteethudptx_state = 1'd0;
-wire          liteethudp_ongoing0;
-reg           liteethudp_ongoing1 = 1'd0;
-reg           liteethudp_sel0 = 1'd0;
-reg           liteethudp_sel1 = 1'd0;
-reg           liteethudp_sel_ongoing = 1'd0;
-wire          liteethudp_taken;
+reg           liteethmac_txdatapath_liteethmactxlastbe_next_state = 1'd0;
+reg           liteethmac_txdatapath_liteethmactxlastbe_state = 1'd0;
+reg     [2:0] liteethudptx_packetizer_count = 3'd0;
+reg     [2:0] liteethudptx_packetizer_count_fsm0_next_value4 = 3'd0;
+reg           liteethudptx_packetizer_count_fsm0_next_value_ce4 = 1'd0;
+reg           liteethudptx_packetizer_delayed_last_be = 1'd0;
+reg           liteethudptx_packetizer_delayed_last_be_fsm1_next_value2 = 1'd0;
+reg           liteethudptx_packetizer_delayed_last_be_fsm1_next_value_ce2 = 1'd0;
+reg           liteethudptx_packetizer_fsm_from_idle = 1'd0;
+reg           liteethudptx_packetizer_fsm_from_idle_fsm0_next_value5 = 1'd0;
+reg           liteethudptx_packetizer_fsm_from_idle_fsm0_next_value_ce5 = 1'd0;
+reg    [63:0] liteethudptx_packetizer_header = 64'd0;
+wire          liteethudptx_packetizer_in_data_copy;
+reg           liteethudptx_packetizer_is_ongoing0 = 1'd0;
+reg           liteethudptx_packetizer_is_ongoing1 = 1'd0;
+reg           liteethudptx_packetizer_is_ongoing2 = 1'd0;
+wire          liteethudptx_packetizer_new_last_be;
+wire          liteethudptx_packetizer_sink_last;
+wire          liteethudptx_packetizer_sink_last_be;
+wire   [15:0] liteethudptx_packetizer_sink_param_checksum;
+wire   [15:0] liteethudptx_packetizer_sink_param_dst_port;
+wire   [15:0] liteethudptx_packetizer_sink_param_length;
+wire   [15:0] liteethudptx_packetizer_sink_param_src_port;
+wire    [7:0] liteethudptx_packetizer_sink_payload_data;
+reg           liteethudptx_packetizer_sink_payload_error = 1'd0;
+wire          liteethudptx_packetizer_sink_payload_last_be;
+reg           liteethudptx_packetizer_sink_ready = 1'd0;
+wire          liteethudptx_packetizer_sink_valid;
+reg           liteethudptx_packetizer_source_first = 1'd0;
+reg           liteethudptx_packetizer_source_last = 1'd0;
+reg           liteethudptx_packetizer_source_last_a = 1'd0;
+reg           liteethudptx_packetizer_source_last_b = 1'd0;
+reg           liteethudptx_packetizer_source_last_s = 1'd0;
+reg    [31:0] liteethudptx_packetizer_source_param_ip_address = 32'd0;
+reg    [15:0] liteethudptx_packetizer_source_param_length = 16'd0;
+reg     [7:0] liteethudptx_packetizer_source_param_protocol = 8'd0;
+reg     [7:0] liteethudptx_packetizer_source_payload_data = 8'd0;
+wire          liteethudptx_packetizer_source_payload_error;
+reg           liteethudptx_packetizer_source_payload_last_be = 1'd0;
+reg           liteethudptx_packetizer_source_ready = 1'd0;
+reg           liteethudptx_packetizer_source_valid = 1'd0;
+reg    [63:0] liteethudptx_packetizer_sr = 64'd0;
+reg           liteethudptx_packetizer_sr_load = 1'd0;
+reg           liteethudptx_packetizer_sr_shift = 1'd0;
+wire          liteethudptx_sink_sink_first;
+wire          liteethudptx_sink_sink_last;
+wire   [15:0] liteethudptx_sink_sink_param_dst_port;
+wire   [31:0] liteethudptx_sink_sink_param_ip_address;
+wire   [15:0] liteethudptx_sink_sink_param_length;
+wire   [15:0] liteethudptx_sink_sink_param_src_port;
+wire    [7:0] liteethudptx_sink_sink_payload_data;
+wire          liteethudptx_sink_sink_payload_error;
+wire          liteethudptx_sink_sink_payload_last_be;
+wire          liteethudptx_sink_sink_ready;
+wire          liteethudptx_sink_sink_valid;
+reg           liteethudptx_source_source_first = 1'd0;
+reg           liteethudptx_source_source_last = 1'd0;
+reg    [31:0] liteethudptx_source_source_param_ip_address = 32'd0;
+reg    [15:0] liteethudptx_source_source_param_length = 16'd0;
+reg     [7:0] liteethudptx_source_source_param_protocol = 8'd0;
+reg     [7:0] liteethudptx_source_source_payload_data = 8'd0;
+reg           liteethudptx_source_source_payload_error = 1'd0;
+reg           liteethudptx_source_source_payload_last_be = 1'd0;
+wire          liteethudptx_source_source_ready;
+reg           liteethudptx_source_source_valid = 1'd0;
 wire          mac_core_bufferizeendpoints_pipe_valid_sink_first;
 wire          mac_core_bufferizeendpoints_pipe_valid_sink_last;
 wire    [7:0] mac_core_bufferizeendpoints_pipe_valid_sink_payload_data;
@@ -1502,54 +1732,6 @@ wire          mac_core_bufferizeendpoints_source_source_payload_error;
 wire          mac_core_bufferizeendpoints_source_source_payload_last_be;
 wire          mac_core_bufferizeendpoints_source_source_ready;
 wire          mac_core_bufferizeendpoints_source_source_valid;
-wire   [11:0] mac_core_cdc_asyncfifo_din;
-wire   [11:0] mac_core_cdc_asyncfifo_dout;
-wire          mac_core_cdc_asyncfifo_re;
-wire          mac_core_cdc_asyncfifo_readable;
-wire          mac_core_cdc_asyncfifo_we;
-wire          mac_core_cdc_asyncfifo_writable;
-wire    [5:0] mac_core_cdc_consume_wdomain;
-wire          mac_core_cdc_fifo_in_first;
-wire          mac_core_cdc_fifo_in_last;
-wire    [7:0] mac_core_cdc_fifo_in_payload_data;
-wire          mac_core_cdc_fifo_in_payload_error;
-wire          mac_core_cdc_fifo_in_payload_last_be;
-wire          mac_core_cdc_fifo_out_first;
-wire          mac_core_cdc_fifo_out_last;
-wire    [7:0] mac_core_cdc_fifo_out_payload_data;
-wire          mac_core_cdc_fifo_out_payload_error;
-wire          mac_core_cdc_fifo_out_payload_last_be;
-wire          mac_core_cdc_graycounter0_ce;
-reg     [5:0] mac_core_cdc_graycounter0_q = 6'd0;
-reg     [5:0] mac_core_cdc_graycounter0_q_binary = 6'd0;
-wire    [5:0] mac_core_cdc_graycounter0_q_next;
-reg     [5:0] mac_core_cdc_graycounter0_q_next_binary = 6'd0;
-wire          mac_core_cdc_graycounter1_ce;
-reg     [5:0] mac_core_cdc_graycounter1_q = 6'd0;
-reg     [5:0] mac_core_cdc_graycounter1_q_binary = 6'd0;
-wire    [5:0] mac_core_cdc_graycounter1_q_next;
-reg     [5:0] mac_core_cdc_graycounter1_q_next_binary = 6'd0;
-wire    [5:0] mac_core_cdc_produce_rdomain;
-wire    [4:0] mac_core_cdc_rdport_adr;
-wire   [11:0] mac_core_cdc_rdport_dat_r;
-wire          mac_core_cdc_sink_first;
-wire          mac_core_cdc_sink_last;
-wire    [7:0] mac_core_cdc_sink_payload_data;
-wire          mac_core_cdc_sink_payload_error;
-wire          mac_core_cdc_sink_payload_last_be;
-wire          mac_core_cdc_sink_ready;
-wire          mac_core_cdc_sink_valid;
-wire          mac_core_cdc_source_first;
-wire          mac_core_cdc_source_last;
-wire    [7:0] mac_core_cdc_source_payload_data;
-wire          mac_core_cdc_source_payload_error;
-wire          mac_core_cdc_source_payload_last_be;
-wire          mac_core_cdc_source_ready;
-wire          mac_core_cdc_source_valid;
-wire    [4:0] mac_core_cdc_wrport_adr;
-wire   [11:0] mac_core_cdc_wrport_dat_r;
-wire   [11:0] mac_core_cdc_wrport_dat_w;
-wire          mac_core_cdc_wrport_we;
 reg    [31:0] mac_core_crc_errors_status = 32'd0;
 wire          mac_core_liteethmaccrc32checker_crc_be;
 reg           mac_core_liteethmaccrc32checker_crc_ce = 1'd0;
@@ -1638,6 +1820,115 @@ wire          mac_core_pulsesynchronizer1_o;
 reg           mac_core_pulsesynchronizer1_toggle_i = 1'd0;
 wire          mac_core_pulsesynchronizer1_toggle_o;
 reg           mac_core_pulsesynchronizer1_toggle_o_r = 1'd0;
+wire   [41:0] mac_core_rx_cdc_cdc_asyncfifo_din;
+wire   [41:0] mac_core_rx_cdc_cdc_asyncfifo_dout;
+wire          mac_core_rx_cdc_cdc_asyncfifo_re;
+wire          mac_core_rx_cdc_cdc_asyncfifo_readable;
+wire          mac_core_rx_cdc_cdc_asyncfifo_we;
+wire          mac_core_rx_cdc_cdc_asyncfifo_writable;
+wire    [5:0] mac_core_rx_cdc_cdc_consume_wdomain;
+wire          mac_core_rx_cdc_cdc_fifo_in_first;
+wire          mac_core_rx_cdc_cdc_fifo_in_last;
+wire   [31:0] mac_core_rx_cdc_cdc_fifo_in_payload_data;
+wire    [3:0] mac_core_rx_cdc_cdc_fifo_in_payload_error;
+wire    [3:0] mac_core_rx_cdc_cdc_fifo_in_payload_last_be;
+wire          mac_core_rx_cdc_cdc_fifo_out_first;
+wire          mac_core_rx_cdc_cdc_fifo_out_last;
+wire   [31:0] mac_core_rx_cdc_cdc_fifo_out_payload_data;
+wire    [3:0] mac_core_rx_cdc_cdc_fifo_out_payload_error;
+wire    [3:0] mac_core_rx_cdc_cdc_fifo_out_payload_last_be;
+wire          mac_core_rx_cdc_cdc_graycounter0_ce;
+reg     [5:0] mac_core_rx_cdc_cdc_graycounter0_q = 6'd0;
+reg     [5:0] mac_core_rx_cdc_cdc_graycounter0_q_binary = 6'd0;
+wire    [5:0] mac_core_rx_cdc_cdc_graycounter0_q_next;
+reg     [5:0] mac_core_rx_cdc_cdc_graycounter0_q_next_binary = 6'd0;
+wire          mac_core_rx_cdc_cdc_graycounter1_ce;
+reg     [5:0] mac_core_rx_cdc_cdc_graycounter1_q = 6'd0;
+reg     [5:0] mac_core_rx_cdc_cdc_graycounter1_q_binary = 6'd0;
+wire    [5:0] mac_core_rx_cdc_cdc_graycounter1_q_next;
+reg     [5:0] mac_core_rx_cdc_cdc_graycounter1_q_next_binary = 6'd0;
+wire    [5:0] mac_core_rx_cdc_cdc_produce_rdomain;
+wire    [4:0] mac_core_rx_cdc_cdc_rdport_adr;
+wire   [41:0] mac_core_rx_cdc_cdc_rdport_dat_r;
+wire          mac_core_rx_cdc_cdc_sink_first;
+wire          mac_core_rx_cdc_cdc_sink_last;
+wire   [31:0] mac_core_rx_cdc_cdc_sink_payload_data;
+wire    [3:0] mac_core_rx_cdc_cdc_sink_payload_error;
+wire    [3:0] mac_core_rx_cdc_cdc_sink_payload_last_be;
+wire          mac_core_rx_cdc_cdc_sink_ready;
+wire          mac_core_rx_cdc_cdc_sink_valid;
+wire          mac_core_rx_cdc_cdc_source_first;
+wire          mac_core_rx_cdc_cdc_source_last;
+wire   [31:0] mac_core_rx_cdc_cdc_source_payload_data;
+wire    [3:0] mac_core_rx_cdc_cdc_source_payload_error;
+wire    [3:0] mac_core_rx_cdc_cdc_source_payload_last_be;
+wire          mac_core_rx_cdc_cdc_source_ready;
+wire          mac_core_rx_cdc_cdc_source_valid;
+wire    [4:0] mac_core_rx_cdc_cdc_wrport_adr;
+wire   [41:0] mac_core_rx_cdc_cdc_wrport_dat_r;
+wire   [41:0] mac_core_rx_cdc_cdc_wrport_dat_w;
+wire          mac_core_rx_cdc_cdc_wrport_we;
+wire          mac_core_rx_cdc_sink_sink_first;
+wire          mac_core_rx_cdc_sink_sink_last;
+wire   [31:0] mac_core_rx_cdc_sink_sink_payload_data;
+wire    [3:0] mac_core_rx_cdc_sink_sink_payload_error;
+wire    [3:0] mac_core_rx_cdc_sink_sink_payload_last_be;
+wire          mac_core_rx_cdc_sink_sink_ready;
+wire          mac_core_rx_cdc_sink_sink_valid;
+wire          mac_core_rx_cdc_source_source_first;
+wire          mac_core_rx_cdc_source_source_last;
+wire   [31:0] mac_core_rx_cdc_source_source_payload_data;
+wire    [3:0] mac_core_rx_cdc_source_source_payload_error;
+wire    [3:0] mac_core_rx_cdc_source_source_payload_last_be;
+wire          mac_core_rx_cdc_source_source_ready;
+wire          mac_core_rx_cdc_source_source_valid;
+reg     [1:0] mac_core_rx_converter_converter_demux = 2'd0;
+wire          mac_core_rx_converter_converter_load_part;
+wire          mac_core_rx_converter_converter_sink_first;
+wire          mac_core_rx_converter_converter_sink_last;
+wire    [9:0] mac_core_rx_converter_converter_sink_payload_data;
+wire          mac_core_rx_converter_converter_sink_ready;
+wire          mac_core_rx_converter_converter_sink_valid;
+reg           mac_core_rx_converter_converter_source_first = 1'd0;
+reg           mac_core_rx_converter_converter_source_last = 1'd0;
+reg    [39:0] mac_core_rx_converter_converter_source_payload_data = 40'd0;
+reg     [2:0] mac_core_rx_converter_converter_source_payload_valid_token_count = 3'd0;
+wire          mac_core_rx_converter_converter_source_ready;
+wire          mac_core_rx_converter_converter_source_valid;
+reg           mac_core_rx_converter_converter_strobe_all = 1'd0;
+wire          mac_core_rx_converter_sink_first;
+wire          mac_core_rx_converter_sink_last;
+wire    [7:0] mac_core_rx_converter_sink_payload_data;
+wire          mac_core_rx_converter_sink_payload_error;
+wire          mac_core_rx_converter_sink_payload_last_be;
+wire          mac_core_rx_converter_sink_ready;
+wire          mac_core_rx_converter_sink_valid;
+wire          mac_core_rx_converter_source_first;
+wire          mac_core_rx_converter_source_last;
+reg    [31:0] mac_core_rx_converter_source_payload_data = 32'd0;
+reg     [3:0] mac_core_rx_converter_source_payload_error = 4'd0;
+reg     [3:0] mac_core_rx_converter_source_payload_last_be = 4'd0;
+wire          mac_core_rx_converter_source_ready;
+wire          mac_core_rx_converter_source_source_first;
+wire          mac_core_rx_converter_source_source_last;
+wire   [39:0] mac_core_rx_converter_source_source_payload_data;
+wire          mac_core_rx_converter_source_source_ready;
+wire          mac_core_rx_converter_source_source_valid;
+wire          mac_core_rx_converter_source_valid;
+wire          mac_core_rx_last_be_sink_first;
+wire          mac_core_rx_last_be_sink_last;
+wire    [7:0] mac_core_rx_last_be_sink_payload_data;
+wire          mac_core_rx_last_be_sink_payload_error;
+wire          mac_core_rx_last_be_sink_payload_last_be;
+wire          mac_core_rx_last_be_sink_ready;
+wire          mac_core_rx_last_be_sink_valid;
+wire          mac_core_rx_last_be_source_first;
+wire          mac_core_rx_last_be_source_last;
+wire    [7:0] mac_core_rx_last_be_source_payload_data;
+wire          mac_core_rx_last_be_source_payload_error;
+reg           mac_core_rx_last_be_source_payload_last_be = 1'd0;
+wire          mac_core_rx_last_be_source_ready;
+wire          mac_core_rx_last_be_source_valid;
 wire          mac_core_rx_padding_sink_first;
 wire          mac_core_rx_padding_sink_last;
 wire    [7:0] mac_core_rx_padding_sink_payload_data;
@@ -1670,34 +1961,20 @@ wire          mac_core_rx_preamble_source_ready;
 reg           mac_core_rx_preamble_source_valid = 1'd0;
 wire          mac_core_sink_first;
 wire          mac_core_sink_last;
-wire    [7:0] mac_core_sink_payload_data;
-wire          mac_core_sink_payload_error;
-wire          mac_core_sink_payload_last_be;
+wire   [31:0] mac_core_sink_payload_data;
+wire    [3:0] mac_core_sink_payload_error;
+wire    [3:0] mac_core_sink_payload_last_be;
 wire          mac_core_sink_ready;
-wire          mac_core_sink_sink_first;
-wire          mac_core_sink_sink_last;
-wire    [7:0] mac_core_sink_sink_payload_data;
-wire          mac_core_sink_sink_payload_error;
-wire          mac_core_sink_sink_payload_last_be;
-wire          mac_core_sink_sink_ready;
-wire          mac_core_sink_sink_valid;
 wire          mac_core_sink_valid;
 wire          mac_core_source_first;
 wire          mac_core_source_last;
-wire    [7:0] mac_core_source_payload_data;
-wire          mac_core_source_payload_error;
-wire          mac_core_source_payload_last_be;
+wire   [31:0] mac_core_source_payload_data;
+wire    [3:0] mac_core_source_payload_error;
+wire    [3:0] mac_core_source_payload_last_be;
 wire          mac_core_source_ready;
-wire          mac_core_source_source_first;
-wire          mac_core_source_source_last;
-wire    [7:0] mac_core_source_source_payload_data;
-wire          mac_core_source_source_payload_error;
-wire          mac_core_source_source_payload_last_be;
-wire          mac_core_source_source_ready;
-wire          mac_core_source_source_valid;
 wire          mac_core_source_valid;
-wire   [11:0] mac_core_tx_cdc_cdc_asyncfifo_din;
-wire   [11:0] mac_core_tx_cdc_cdc_asyncfifo_dout;
+wire   [41:0] mac_core_tx_cdc_cdc_asyncfifo_din;
+wire   [41:0] mac_core_tx_cdc_cdc_asyncfifo_dout;
 wire          mac_core_tx_cdc_cdc_asyncfifo_re;
 wire          mac_core_tx_cdc_cdc_asyncfifo_readable;
 wire          mac_core_tx_cdc_cdc_asyncfifo_we;
@@ -1705,14 +1982,14 @@ wire          mac_core_tx_cdc_cdc_asyncfifo_writable;
 wire    [5:0] mac_core_tx_cdc_cdc_consume_wdomain;
 wire          mac_core_tx_cdc_cdc_fifo_in_first;
 wire          mac_core_tx_cdc_cdc_fifo_in_last;
-wire    [7:0] mac_core_tx_cdc_cdc_fifo_in_payload_data;
-wire          mac_core_tx_cdc_cdc_fifo_in_payload_error;
-wire          mac_core_tx_cdc_cdc_fifo_in_payload_last_be;
+wire   [31:0] mac_core_tx_cdc_cdc_fifo_in_payload_data;
+wire    [3:0] mac_core_tx_cdc_cdc_fifo_in_payload_error;
+wire    [3:0] mac_core_tx_cdc_cdc_fifo_in_payload_last_be;
 wire          mac_core_tx_cdc_cdc_fifo_out_first;
 wire          mac_core_tx_cdc_cdc_fifo_out_last;
-wire    [7:0] mac_core_tx_cdc_cdc_fifo_out_payload_data;
-wire          mac_core_tx_cdc_cdc_fifo_out_payload_error;
-wire          mac_core_tx_cdc_cdc_fifo_out_payload_last_be;
+wire   [31:0] mac_core_tx_cdc_cdc_fifo_out_payload_data;
+wire    [3:0] mac_core_tx_cdc_cdc_fifo_out_payload_error;
+wire    [3:0] mac_core_tx_cdc_cdc_fifo_out_payload_last_be;
 wire          mac_core_tx_cdc_cdc_graycounter0_ce;
 reg     [5:0] mac_core_tx_cdc_cdc_graycounter0_q = 6'd0;
 reg     [5:0] mac_core_tx_cdc_cdc_graycounter0_q_binary = 6'd0;
@@ -1725,39 +2002,72 @@ wire    [5:0] mac_core_tx_cdc_cdc_graycounter1_q_next;
 reg     [5:0] mac_core_tx_cdc_cdc_graycounter1_q_next_binary = 6'd0;
 wire    [5:0] mac_core_tx_cdc_cdc_produce_rdomain;
 wire    [4:0] mac_core_tx_cdc_cdc_rdport_adr;
-wire   [11:0] mac_core_tx_cdc_cdc_rdport_dat_r;
+wire   [41:0] mac_core_tx_cdc_cdc_rdport_dat_r;
 wire          mac_core_tx_cdc_cdc_sink_first;
 wire          mac_core_tx_cdc_cdc_sink_last;
-wire    [7:0] mac_core_tx_cdc_cdc_sink_payload_data;
-wire          mac_core_tx_cdc_cdc_sink_payload_error;
-wire          mac_core_tx_cdc_cdc_sink_payload_last_be;
+wire   [31:0] mac_core_tx_cdc_cdc_sink_payload_data;
+wire    [3:0] mac_core_tx_cdc_cdc_sink_payload_error;
+wire    [3:0] mac_core_tx_cdc_cdc_sink_payload_last_be;
 wire          mac_core_tx_cdc_cdc_sink_ready;
 wire          mac_core_tx_cdc_cdc_sink_valid;
 wire          mac_core_tx_cdc_cdc_source_first;
 wire          mac_core_tx_cdc_cdc_source_last;
-wire    [7:0] mac_core_tx_cdc_cdc_source_payload_data;
-wire          mac_core_tx_cdc_cdc_source_payload_error;
-wire          mac_core_tx_cdc_cdc_source_payload_last_be;
+wire   [31:0] mac_core_tx_cdc_cdc_source_payload_data;
+wire    [3:0] mac_core_tx_cdc_cdc_source_payload_error;
+wire    [3:0] mac_core_tx_cdc_cdc_source_payload_last_be;
 wire          mac_core_tx_cdc_cdc_source_ready;
 wire          mac_core_tx_cdc_cdc_source_valid;
 wire    [4:0] mac_core_tx_cdc_cdc_wrport_adr;
-wire   [11:0] mac_core_tx_cdc_cdc_wrport_dat_r;
-wire   [11:0] mac_core_tx_cdc_cdc_wrport_dat_w;
+wire   [41:0] mac_core_tx_cdc_cdc_wrport_dat_r;
+wire   [41:0] mac_core_tx_cdc_cdc_wrport_dat_w;
 wire          mac_core_tx_cdc_cdc_wrport_we;
 wire          mac_core_tx_cdc_sink_sink_first;
 wire          mac_core_tx_cdc_sink_sink_last;
-wire    [7:0] mac_core_tx_cdc_sink_sink_payload_data;
-wire          mac_core_tx_cdc_sink_sink_payload_error;
-wire          mac_core_tx_cdc_sink_sink_payload_last_be;
+wire   [31:0] mac_core_tx_cdc_sink_sink_payload_data;
+wire    [3:0] mac_core_tx_cdc_sink_sink_payload_error;
+wire    [3:0] mac_core_tx_cdc_sink_sink_payload_last_be;
 wire          mac_core_tx_cdc_sink_sink_ready;
 wire          mac_core_tx_cdc_sink_sink_valid;
 wire          mac_core_tx_cdc_source_source_first;
 wire          mac_core_tx_cdc_source_source_last;
-wire    [7:0] mac_core_tx_cdc_source_source_payload_data;
-wire          mac_core_tx_cdc_source_source_payload_error;
-wire          mac_core_tx_cdc_source_source_payload_last_be;
+wire   [31:0] mac_core_tx_cdc_source_source_payload_data;
+wire    [3:0] mac_core_tx_cdc_source_source_payload_error;
+wire    [3:0] mac_core_tx_cdc_source_source_payload_last_be;
 wire          mac_core_tx_cdc_source_source_ready;
 wire          mac_core_tx_cdc_source_source_valid;
+wire          mac_core_tx_converter_converter_first;
+wire          mac_core_tx_converter_converter_last;
+reg     [1:0] mac_core_tx_converter_converter_mux = 2'd0;
+wire          mac_core_tx_converter_converter_sink_first;
+wire          mac_core_tx_converter_converter_sink_last;
+reg    [39:0] mac_core_tx_converter_converter_sink_payload_data = 40'd0;
+wire          mac_core_tx_converter_converter_sink_ready;
+wire          mac_core_tx_converter_converter_sink_valid;
+wire          mac_core_tx_converter_converter_source_first;
+wire          mac_core_tx_converter_converter_source_last;
+reg     [9:0] mac_core_tx_converter_converter_source_payload_data = 10'd0;
+wire          mac_core_tx_converter_converter_source_payload_valid_token_count;
+wire          mac_core_tx_converter_converter_source_ready;
+wire          mac_core_tx_converter_converter_source_valid;
+wire          mac_core_tx_converter_sink_first;
+wire          mac_core_tx_converter_sink_last;
+wire   [31:0] mac_core_tx_converter_sink_payload_data;
+wire    [3:0] mac_core_tx_converter_sink_payload_error;
+wire    [3:0] mac_core_tx_converter_sink_payload_last_be;
+wire          mac_core_tx_converter_sink_ready;
+wire          mac_core_tx_converter_sink_valid;
+wire          mac_core_tx_converter_source_first;
+wire          mac_core_tx_converter_source_last;
+wire    [7:0] mac_core_tx_converter_source_payload_data;
+wire          mac_core_tx_converter_source_payload_error;
+wire          mac_core_tx_converter_source_payload_last_be;
+wire          mac_core_tx_converter_source_ready;
+wire          mac_core_tx_converter_source_source_first;
+wire          mac_core_tx_converter_source_source_last;
+wire    [9:0] mac_core_tx_converter_source_source_payload_data;
+wire          mac_core_tx_converter_source_source_ready;
+wire          mac_core_tx_converter_source_source_valid;
+wire          mac_core_tx_converter_source_valid;
 wire          mac_core_tx_crc_be;
 reg           mac_core_tx_crc_ce = 1'd0;
 reg     [1:0] mac_core_tx_crc_cnt = 2'd3;
@@ -1837,6 +2147,34 @@ reg           mac_core_tx_gap_source_payload_error = 1'd0;
 reg           mac_core_tx_gap_source_payload_last_be = 1'd0;
 wire          mac_core_tx_gap_source_ready;
 reg           mac_core_tx_gap_source_valid = 1'd0;
+wire          mac_core_tx_last_be_last_handler_sink_first;
+wire          mac_core_tx_last_be_last_handler_sink_last;
+wire    [7:0] mac_core_tx_last_be_last_handler_sink_payload_data;
+wire          mac_core_tx_last_be_last_handler_sink_payload_error;
+wire          mac_core_tx_last_be_last_handler_sink_payload_last_be;
+reg           mac_core_tx_last_be_last_handler_sink_ready = 1'd0;
+wire          mac_core_tx_last_be_last_handler_sink_valid;
+reg           mac_core_tx_last_be_last_handler_source_first = 1'd0;
+reg           mac_core_tx_last_be_last_handler_source_last = 1'd0;
+reg     [7:0] mac_core_tx_last_be_last_handler_source_payload_data = 8'd0;
+reg           mac_core_tx_last_be_last_handler_source_payload_error = 1'd0;
+reg           mac_core_tx_last_be_last_handler_source_payload_last_be = 1'd0;
+wire          mac_core_tx_last_be_last_handler_source_ready;
+reg           mac_core_tx_last_be_last_handler_source_valid = 1'd0;
+wire          mac_core_tx_last_be_sink_sink_first;
+wire          mac_core_tx_last_be_sink_sink_last;
+wire    [7:0] mac_core_tx_last_be_sink_sink_payload_data;
+wire          mac_core_tx_last_be_sink_sink_payload_error;
+wire          mac_core_tx_last_be_sink_sink_payload_last_be;
+wire          mac_core_tx_last_be_sink_sink_ready;
+wire          mac_core_tx_last_be_sink_sink_valid;
+wire          mac_core_tx_last_be_source_source_first;
+wire          mac_core_tx_last_be_source_source_last;
+wire    [7:0] mac_core_tx_last_be_source_source_payload_data;
+wire          mac_core_tx_last_be_source_source_payload_error;
+wire          mac_core_tx_last_be_source_source_payload_last_be;
+wire          mac_core_tx_last_be_source_source_ready;
+wire          mac_core_tx_last_be_source_source_valid;
 reg    [15:0] mac_core_tx_padding_counter = 16'd0;
 wire          mac_core_tx_padding_counter_done;
 reg    [15:0] mac_core_tx_padding_counter_liteethmac_clockdomainsrenamer0_next_value = 16'd0;
@@ -1876,20 +2214,20 @@ reg           mac_core_tx_preamble_source_valid = 1'd0;
 wire          mac_crossbar_dropped;
 wire          mac_crossbar_sink_first;
 wire          mac_crossbar_sink_last;
-wire    [7:0] mac_crossbar_sink_payload_data;
-wire          mac_crossbar_sink_payload_error;
+wire   [31:0] mac_crossbar_sink_payload_data;
+wire    [3:0] mac_crossbar_sink_payload_error;
 wire   [15:0] mac_crossbar_sink_payload_ethernet_type;
-wire          mac_crossbar_sink_payload_last_be;
+wire    [3:0] mac_crossbar_sink_payload_last_be;
 wire   [47:0] mac_crossbar_sink_payload_sender_mac;
 wire   [47:0] mac_crossbar_sink_payload_target_mac;
 reg           mac_crossbar_sink_ready = 1'd0;
 wire          mac_crossbar_sink_valid;
 reg           mac_crossbar_source_first = 1'd0;
 reg           mac_crossbar_source_last = 1'd0;
-reg     [7:0] mac_crossbar_source_payload_data = 8'd0;
-reg           mac_crossbar_source_payload_error = 1'd0;
+reg    [31:0] mac_crossbar_source_payload_data = 32'd0;
+reg     [3:0] mac_crossbar_source_payload_error = 4'd0;
 reg    [15:0] mac_crossbar_source_payload_ethernet_type = 16'd0;
-reg           mac_crossbar_source_payload_last_be = 1'd0;
+reg     [3:0] mac_crossbar_source_payload_last_be = 4'd0;
 reg    [47:0] mac_crossbar_source_payload_sender_mac = 48'd0;
 reg    [47:0] mac_crossbar_source_payload_target_mac = 48'd0;
 wire          mac_crossbar_source_ready;
@@ -1897,11 +2235,11 @@ reg           mac_crossbar_source_valid = 1'd0;
 wire          mac_cut;
 reg           mac_fsm_is_ongoing0 = 1'd0;
 reg           mac_fsm_is_ongoing1 = 1'd0;
-reg     [3:0] mac_liteethmacdepacketizer_count = 4'd0;
-reg     [3:0] mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 = 4'd0;
+reg     [1:0] mac_liteethmacdepacketizer_count = 2'd0;
+reg     [1:0] mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 = 2'd0;
 reg           mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 = 1'd0;
-reg           mac_liteethmacdepacketizer_delayed_last_be = 1'd0;
-reg           mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 = 1'd0;
+reg     [3:0] mac_liteethmacdepacketizer_delayed_last_be = 4'd0;
+reg     [3:0] mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 = 4'd0;
 reg           mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 = 1'd0;
 reg           mac_liteethmacdepacketizer_fsm_from_idle = 1'd0;
 reg           mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 = 1'd0;
@@ -1912,14 +2250,19 @@ reg           mac_liteethmacdepacketizer_is_ongoing0 = 1'd0;
 reg           mac_liteethmacdepacketizer_is_ongoing1 = 1'd0;
 reg           mac_liteethmacdepacketizer_is_ongoing2 = 1'd0;
 reg           mac_liteethmacdepacketizer_is_ongoing3 = 1'd0;
-wire          mac_liteethmacdepacketizer_new_last_be;
+wire    [3:0] mac_liteethmacdepacketizer_new_last_be;
+reg           mac_liteethmacdepacketizer_sink_d_first = 1'd0;
 reg           mac_liteethmacdepacketizer_sink_d_last = 1'd0;
+reg    [31:0] mac_liteethmacdepacketizer_sink_d_payload_data = 32'd0;
+reg     [3:0] mac_liteethmacdepacketizer_sink_d_payload_error = 4'd0;
+reg     [3:0] mac_liteethmacdepacketizer_sink_d_payload_last_be = 4'd0;
+reg           mac_liteethmacdepacketizer_sink_d_ready = 1'd0;
+reg           mac_liteethmacdepacketizer_sink_d_valid = 1'd0;
 wire          mac_liteethmacdepacketizer_sink_first;
 wire          mac_liteethmacdepacketizer_sink_last;
-wire          mac_liteethmacdepacketizer_sink_last_be;
-wire    [7:0] mac_liteethmacdepacketizer_sink_payload_data;
-wire          mac_liteethmacdepacketizer_sink_payload_error;
-wire          mac_liteethmacdepacketizer_sink_payload_last_be;
+wire   [31:0] mac_liteethmacdepacketizer_sink_payload_data;
+wire    [3:0] mac_liteethmacdepacketizer_sink_payload_error;
+wire    [3:0] mac_liteethmacdepacketizer_sink_payload_last_be;
 reg           mac_liteethmacdepacketizer_sink_ready = 1'd0;
 wire          mac_liteethmacdepacketizer_sink_valid;
 reg           mac_liteethmacdepacketizer_source_first = 1'd0;
@@ -1927,10 +2270,10 @@ reg           mac_liteethmacdepacketizer_source_last = 1'd0;
 reg           mac_liteethmacdepacketizer_source_last_a = 1'd0;
 reg           mac_liteethmacdepacketizer_source_last_b = 1'd0;
 reg           mac_liteethmacdepacketizer_source_last_s = 1'd0;
-reg     [7:0] mac_liteethmacdepacketizer_source_payload_data = 8'd0;
-wire          mac_liteethmacdepacketizer_source_payload_error;
+reg    [31:0] mac_liteethmacdepacketizer_source_payload_data = 32'd0;
+wire    [3:0] mac_liteethmacdepacketizer_source_payload_error;
 wire   [15:0] mac_liteethmacdepacketizer_source_payload_ethernet_type;
-reg           mac_liteethmacdepacketizer_source_payload_last_be = 1'd0;
+reg     [3:0] mac_liteethmacdepacketizer_source_payload_last_be = 4'd0;
 wire   [47:0] mac_liteethmacdepacketizer_source_payload_sender_mac;
 wire   [47:0] mac_liteethmacdepacketizer_source_payload_target_mac;
 wire          mac_liteethmacdepacketizer_source_ready;
@@ -1939,11 +2282,11 @@ reg   [111:0] mac_liteethmacdepacketizer_sr = 112'd0;
 reg           mac_liteethmacdepacketizer_sr_shift = 1'd0;
 reg           mac_liteethmacdepacketizer_sr_shift_leftover = 1'd0;
 reg           mac_liteethmacdepacketizer_was_in_copy = 1'd0;
-reg     [3:0] mac_packetizer_count = 4'd0;
-reg     [3:0] mac_packetizer_count_liteethmac_fsm0_next_value0 = 4'd0;
+reg     [1:0] mac_packetizer_count = 2'd0;
+reg     [1:0] mac_packetizer_count_liteethmac_fsm0_next_value0 = 2'd0;
 reg           mac_packetizer_count_liteethmac_fsm0_next_value_ce0 = 1'd0;
-reg           mac_packetizer_delayed_last_be = 1'd0;
-reg           mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0 = 1'd0;
+reg     [3:0] mac_packetizer_delayed_last_be = 4'd0;
+reg     [3:0] mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0 = 4'd0;
 reg           mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value_ce0 = 1'd0;
 reg           mac_packetizer_fsm_from_idle = 1'd0;
 reg           mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value1 = 1'd0;
@@ -1953,14 +2296,23 @@ wire          mac_packetizer_in_data_copy;
 reg           mac_packetizer_is_ongoing0 = 1'd0;
 reg           mac_packetizer_is_ongoing1 = 1'd0;
 reg           mac_packetizer_is_ongoing2 = 1'd0;
-wire          mac_packetizer_new_last_be;
+wire    [3:0] mac_packetizer_new_last_be;
+reg           mac_packetizer_sink_d_first = 1'd0;
+reg           mac_packetizer_sink_d_last = 1'd0;
+reg    [31:0] mac_packetizer_sink_d_payload_data = 32'd0;
+reg     [3:0] mac_packetizer_sink_d_payload_error = 4'd0;
+reg    [15:0] mac_packetizer_sink_d_payload_ethernet_type = 16'd0;
+reg     [3:0] mac_packetizer_sink_d_payload_last_be = 4'd0;
+reg    [47:0] mac_packetizer_sink_d_payload_sender_mac = 48'd0;
+reg    [47:0] mac_packetizer_sink_d_payload_target_mac = 48'd0;
+reg           mac_packetizer_sink_d_ready = 1'd0;
+reg           mac_packetizer_sink_d_valid = 1'd0;
 wire          mac_packetizer_sink_first;
 wire          mac_packetizer_sink_last;
-wire          mac_packetizer_sink_last_be;
-wire    [7:0] mac_packetizer_sink_payload_data;
-wire          mac_packetizer_sink_payload_error;
+wire   [31:0] mac_packetizer_sink_payload_data;
+wire    [3:0] mac_packetizer_sink_payload_error;
 wire   [15:0] mac_packetizer_sink_payload_ethernet_type;
-wire          mac_packetizer_sink_payload_last_be;
+wire    [3:0] mac_packetizer_sink_payload_last_be;
 wire   [47:0] mac_packetizer_sink_payload_sender_mac;
 wire   [47:0] mac_packetizer_sink_payload_target_mac;
 reg           mac_packetizer_sink_ready = 1'd0;
@@ -1970,16 +2322,43 @@ reg           mac_packetizer_source_last = 1'd0;
 reg           mac_packetizer_source_last_a = 1'd0;
 reg           mac_packetizer_source_last_b = 1'd0;
 reg           mac_packetizer_source_last_s = 1'd0;
-reg     [7:0] mac_packetizer_source_payload_data = 8'd0;
-wire          mac_packetizer_source_payload_error;
-reg           mac_packetizer_source_payload_last_be = 1'd0;
+reg    [31:0] mac_packetizer_source_payload_data = 32'd0;
+wire    [3:0] mac_packetizer_source_payload_error;
+reg     [3:0] mac_packetizer_source_payload_last_be = 4'd0;
 wire          mac_packetizer_source_ready;
 reg           mac_packetizer_source_valid = 1'd0;
 reg   [111:0] mac_packetizer_sr = 112'd0;
 reg           mac_packetizer_sr_load = 1'd0;
 reg           mac_packetizer_sr_shift = 1'd0;
+wire          maskedudpcrossbar_dropped;
+wire          maskedudpcrossbar_sink_first;
+wire          maskedudpcrossbar_sink_last;
+wire   [15:0] maskedudpcrossbar_sink_param_dst_port;
+wire   [31:0] maskedudpcrossbar_sink_param_ip_address;
+wire   [15:0] maskedudpcrossbar_sink_param_length;
+wire   [15:0] maskedudpcrossbar_sink_param_src_port;
+wire    [7:0] maskedudpcrossbar_sink_payload_data;
+wire          maskedudpcrossbar_sink_payload_error;
+wire          maskedudpcrossbar_sink_payload_last_be;
+reg           maskedudpcrossbar_sink_ready = 1'd0;
+wire          maskedudpcrossbar_sink_valid;
+wire          maskedudpcrossbar_source_first;
+wire          maskedudpcrossbar_source_last;
+wire   [15:0] maskedudpcrossbar_source_param_dst_port;
+wire   [31:0] maskedudpcrossbar_source_param_ip_address;
+wire   [15:0] maskedudpcrossbar_source_param_length;
+wire   [15:0] maskedudpcrossbar_source_param_src_port;
+wire    [7:0] maskedudpcrossbar_source_payload_data;
+wire          maskedudpcrossbar_source_payload_error;
+wire          maskedudpcrossbar_source_payload_last_be;
+wire          maskedudpcrossbar_source_ready;
+wire          maskedudpcrossbar_source_valid;
 reg     [5:0] multiregimpl0_regs0 = 6'd0;
 reg     [5:0] multiregimpl0_regs1 = 6'd0;
+reg           multiregimpl10_regs0 = 1'd0;
+reg           multiregimpl10_regs1 = 1'd0;
+reg           multiregimpl11_regs0 = 1'd0;
+reg           multiregimpl11_regs1 = 1'd0;
 reg     [5:0] multiregimpl1_regs0 = 6'd0;
 reg     [5:0] multiregimpl1_regs1 = 6'd0;
 reg           multiregimpl2_regs0 = 1'd0;
@@ -1990,50 +2369,98 @@ reg     [5:0] multiregimpl4_regs0 = 6'd0;
 reg     [5:0] multiregimpl4_regs1 = 6'd0;
 reg     [5:0] multiregimpl5_regs0 = 6'd0;
 reg     [5:0] multiregimpl5_regs1 = 6'd0;
+reg     [4:0] multiregimpl6_regs0 = 5'd0;
+reg     [4:0] multiregimpl6_regs1 = 5'd0;
+reg     [4:0] multiregimpl7_regs0 = 5'd0;
+reg     [4:0] multiregimpl7_regs1 = 5'd0;
+reg     [4:0] multiregimpl8_regs0 = 5'd0;
+reg     [4:0] multiregimpl8_regs1 = 5'd0;
+reg     [4:0] multiregimpl9_regs0 = 5'd0;
+reg     [4:0] multiregimpl9_regs1 = 5'd0;
 reg           next_state = 1'd0;
-reg     [2:0] packetizer_count = 3'd0;
-reg     [2:0] packetizer_count_liteethudp_fsm0_next_value0 = 3'd0;
-reg           packetizer_count_liteethudp_fsm0_next_value_ce0 = 1'd0;
-reg           packetizer_delayed_last_be = 1'd0;
-reg           packetizer_delayed_last_be_liteethudp_fsm1_next_value0 = 1'd0;
-reg           packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 = 1'd0;
-reg           packetizer_fsm_from_idle = 1'd0;
-reg           packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 = 1'd0;
-reg           packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 = 1'd0;
-reg    [63:0] packetizer_header = 64'd0;
-wire          packetizer_in_data_copy;
-reg           packetizer_is_ongoing0 = 1'd0;
-reg           packetizer_is_ongoing1 = 1'd0;
-reg           packetizer_is_ongoing2 = 1'd0;
-wire          packetizer_new_last_be;
-wire          packetizer_sink_last;
-wire          packetizer_sink_last_be;
-wire   [15:0] packetizer_sink_param_checksum;
-wire   [15:0] packetizer_sink_param_dst_port;
-wire   [15:0] packetizer_sink_param_length;
-wire   [15:0] packetizer_sink_param_src_port;
-wire    [7:0] packetizer_sink_payload_data;
-reg           packetizer_sink_payload_error = 1'd0;
-wire          packetizer_sink_payload_last_be;
-reg           packetizer_sink_ready = 1'd0;
-wire          packetizer_sink_valid;
-reg           packetizer_source_first = 1'd0;
-reg           packetizer_source_last = 1'd0;
-reg           packetizer_source_last_a = 1'd0;
-reg           packetizer_source_last_b = 1'd0;
-reg           packetizer_source_last_s = 1'd0;
-reg    [31:0] packetizer_source_param_ip_address = 32'd0;
-reg    [15:0] packetizer_source_param_length = 16'd0;
-reg     [7:0] packetizer_source_param_protocol = 8'd0;
-reg     [7:0] packetizer_source_payload_data = 8'd0;
-wire          packetizer_source_payload_error;
-reg           packetizer_source_payload_last_be = 1'd0;
-reg           packetizer_source_ready = 1'd0;
-reg           packetizer_source_valid = 1'd0;
-reg    [63:0] packetizer_sr = 64'd0;
-reg           packetizer_sr_load = 1'd0;
-reg           packetizer_sr_shift = 1'd0;
+reg           pipe_ready_sink_d_first = 1'd0;
+reg           pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] pipe_ready_sink_d_payload_data = 32'd0;
+reg     [3:0] pipe_ready_sink_d_payload_error = 4'd0;
+reg     [3:0] pipe_ready_sink_d_payload_last_be = 4'd0;
+reg           pipe_ready_sink_d_ready = 1'd0;
+reg           pipe_ready_sink_d_valid = 1'd0;
+wire          pipe_ready_sink_first;
+wire          pipe_ready_sink_last;
+wire   [31:0] pipe_ready_sink_payload_data;
+wire    [3:0] pipe_ready_sink_payload_error;
+wire    [3:0] pipe_ready_sink_payload_last_be;
+wire          pipe_ready_sink_ready;
+wire          pipe_ready_sink_valid;
+reg           pipe_ready_source_first = 1'd0;
+reg           pipe_ready_source_last = 1'd0;
+reg    [31:0] pipe_ready_source_payload_data = 32'd0;
+reg     [3:0] pipe_ready_source_payload_error = 4'd0;
+reg     [3:0] pipe_ready_source_payload_last_be = 4'd0;
+wire          pipe_ready_source_ready;
+reg           pipe_ready_source_valid = 1'd0;
+reg           pipe_ready_valid = 1'd0;
+wire          pipe_valid_sink_first;
+wire          pipe_valid_sink_last;
+wire   [31:0] pipe_valid_sink_payload_data;
+wire    [3:0] pipe_valid_sink_payload_error;
+wire    [3:0] pipe_valid_sink_payload_last_be;
+wire          pipe_valid_sink_ready;
+wire          pipe_valid_sink_valid;
+reg           pipe_valid_source_first = 1'd0;
+reg           pipe_valid_source_last = 1'd0;
+reg    [31:0] pipe_valid_source_payload_data = 32'd0;
+reg     [3:0] pipe_valid_source_payload_error = 4'd0;
+reg     [3:0] pipe_valid_source_payload_last_be = 4'd0;
+wire          pipe_valid_source_ready;
+reg           pipe_valid_source_valid = 1'd0;
 wire          por_clk;
+wire          port_clk;
+wire          port_rst;
+reg           portudp_first = 1'd1;
+reg     [1:0] portudp_holdingudprx_fsm0_next_state = 2'd0;
+reg     [1:0] portudp_holdingudprx_fsm0_state = 2'd0;
+reg           portudp_holdingudprx_fsm1_next_state = 1'd0;
+reg           portudp_holdingudprx_fsm1_state = 1'd0;
+reg     [2:0] portudp_holdingudprx_next_state = 3'd0;
+reg     [2:0] portudp_holdingudprx_state = 3'd0;
+wire          portudp_last;
+reg           portudp_lastbytetrim_next_state = 1'd0;
+reg           portudp_lastbytetrim_state = 1'd0;
+reg     [1:0] portudp_liteethudptx_fsm0_next_state = 2'd0;
+reg     [1:0] portudp_liteethudptx_fsm0_state = 2'd0;
+reg           portudp_liteethudptx_fsm1_next_state = 1'd0;
+reg           portudp_liteethudptx_fsm1_state = 1'd0;
+reg           portudp_liteethudptx_next_state = 1'd0;
+reg           portudp_liteethudptx_state = 1'd0;
+wire          portudp_ongoing0;
+reg           portudp_ongoing1 = 1'd0;
+reg           portudp_sel0 = 1'd0;
+reg           portudp_sel1 = 1'd0;
+reg           portudp_sel_ongoing = 1'd0;
+wire          portudp_taken;
+reg     [2:0] pulsemerge0_backlog0 = 3'd0;
+reg     [2:0] pulsemerge0_backlog1 = 3'd0;
+wire          pulsemerge0_o0;
+wire          pulsemerge0_o1;
+wire    [3:0] pulsemerge0_total0;
+wire    [3:0] pulsemerge0_total1;
+reg     [2:0] pulsemerge1_backlog0 = 3'd0;
+reg     [2:0] pulsemerge1_backlog1 = 3'd0;
+wire          pulsemerge1_o0;
+wire          pulsemerge1_o1;
+wire    [3:0] pulsemerge1_total0;
+wire    [3:0] pulsemerge1_total1;
+wire          pulsesynchronizer0_i;
+wire          pulsesynchronizer0_o;
+reg           pulsesynchronizer0_toggle_i = 1'd0;
+wire          pulsesynchronizer0_toggle_o;
+reg           pulsesynchronizer0_toggle_o_r = 1'd0;
+wire          pulsesynchronizer1_i;
+wire          pulsesynchronizer1_o;
+reg           pulsesynchronizer1_toggle_i = 1'd0;
+wire          pulsesynchronizer1_toggle_o;
+reg           pulsesynchronizer1_toggle_o_r = 1'd0;
 wire          re;
 wire   [15:0] rhs_slice_proxy0;
 wire   [15:0] rhs_slice_proxy1;
@@ -2113,6 +2540,66 @@ wire   [47:0] rhs_slice_proxy8;
 wire   [47:0] rhs_slice_proxy9;
 wire          rst10;
 wire          rst11;
+wire   [97:0] rx_cdc_cdc_asyncfifo_din;
+wire   [97:0] rx_cdc_cdc_asyncfifo_dout;
+wire          rx_cdc_cdc_asyncfifo_re;
+wire          rx_cdc_cdc_asyncfifo_readable;
+wire          rx_cdc_cdc_asyncfifo_we;
+wire          rx_cdc_cdc_asyncfifo_writable;
+wire    [4:0] rx_cdc_cdc_consume_wdomain;
+wire          rx_cdc_cdc_fifo_in_first;
+wire          rx_cdc_cdc_fifo_in_last;
+wire   [31:0] rx_cdc_cdc_fifo_in_param_ip_address;
+wire   [15:0] rx_cdc_cdc_fifo_in_param_length;
+wire    [7:0] rx_cdc_cdc_fifo_in_param_protocol;
+wire   [31:0] rx_cdc_cdc_fifo_in_payload_data;
+wire    [3:0] rx_cdc_cdc_fifo_in_payload_error;
+wire    [3:0] rx_cdc_cdc_fifo_in_payload_last_be;
+wire          rx_cdc_cdc_fifo_out_first;
+wire          rx_cdc_cdc_fifo_out_last;
+wire   [31:0] rx_cdc_cdc_fifo_out_param_ip_address;
+wire   [15:0] rx_cdc_cdc_fifo_out_param_length;
+wire    [7:0] rx_cdc_cdc_fifo_out_param_protocol;
+wire   [31:0] rx_cdc_cdc_fifo_out_payload_data;
+wire    [3:0] rx_cdc_cdc_fifo_out_payload_error;
+wire    [3:0] rx_cdc_cdc_fifo_out_payload_last_be;
+wire          rx_cdc_cdc_graycounter0_ce;
+reg     [4:0] rx_cdc_cdc_graycounter0_q = 5'd0;
+reg     [4:0] rx_cdc_cdc_graycounter0_q_binary = 5'd0;
+wire    [4:0] rx_cdc_cdc_graycounter0_q_next;
+reg     [4:0] rx_cdc_cdc_graycounter0_q_next_binary = 5'd0;
+wire          rx_cdc_cdc_graycounter1_ce;
+reg     [4:0] rx_cdc_cdc_graycounter1_q = 5'd0;
+reg     [4:0] rx_cdc_cdc_graycounter1_q_binary = 5'd0;
+wire    [4:0] rx_cdc_cdc_graycounter1_q_next;
+reg     [4:0] rx_cdc_cdc_graycounter1_q_next_binary = 5'd0;
+wire    [4:0] rx_cdc_cdc_produce_rdomain;
+wire    [3:0] rx_cdc_cdc_rdport_adr;
+wire   [97:0] rx_cdc_cdc_rdport_dat_r;
+wire          rx_cdc_cdc_sink_first;
+wire          rx_cdc_cdc_sink_last;
+wire   [31:0] rx_cdc_cdc_sink_param_ip_address;
+wire   [15:0] rx_cdc_cdc_sink_param_length;
+wire    [7:0] rx_cdc_cdc_sink_param_protocol;
+wire   [31:0] rx_cdc_cdc_sink_payload_data;
+wire    [3:0] rx_cdc_cdc_sink_payload_error;
+wire    [3:0] rx_cdc_cdc_sink_payload_last_be;
+wire          rx_cdc_cdc_sink_ready;
+wire          rx_cdc_cdc_sink_valid;
+wire          rx_cdc_cdc_source_first;
+wire          rx_cdc_cdc_source_last;
+wire   [31:0] rx_cdc_cdc_source_param_ip_address;
+wire   [15:0] rx_cdc_cdc_source_param_length;
+wire    [7:0] rx_cdc_cdc_source_param_protocol;
+wire   [31:0] rx_cdc_cdc_source_payload_data;
+wire    [3:0] rx_cdc_cdc_source_payload_error;
+wire    [3:0] rx_cdc_cdc_source_payload_last_be;
+wire          rx_cdc_cdc_source_ready;
+wire          rx_cdc_cdc_source_valid;
+wire    [3:0] rx_cdc_cdc_wrport_adr;
+wire   [97:0] rx_cdc_cdc_wrport_dat_r;
+wire   [97:0] rx_cdc_cdc_wrport_dat_w;
+wire          rx_cdc_cdc_wrport_we;
 wire          rx_cdc_sink_first;
 wire          rx_cdc_sink_last;
 wire   [15:0] rx_cdc_sink_param_dst_port;
@@ -2123,6 +2610,16 @@ wire    [7:0] rx_cdc_sink_payload_data;
 wire          rx_cdc_sink_payload_error;
 wire          rx_cdc_sink_payload_last_be;
 wire          rx_cdc_sink_ready;
+wire          rx_cdc_sink_sink_first;
+wire          rx_cdc_sink_sink_last;
+wire   [31:0] rx_cdc_sink_sink_param_ip_address;
+wire   [15:0] rx_cdc_sink_sink_param_length;
+wire    [7:0] rx_cdc_sink_sink_param_protocol;
+wire   [31:0] rx_cdc_sink_sink_payload_data;
+wire    [3:0] rx_cdc_sink_sink_payload_error;
+wire    [3:0] rx_cdc_sink_sink_payload_last_be;
+wire          rx_cdc_sink_sink_ready;
+wire          rx_cdc_sink_sink_valid;
 wire          rx_cdc_sink_valid;
 wire          rx_cdc_source_first;
 wire          rx_cdc_source_last;
@@ -2134,6 +2631,16 @@ wire    [7:0] rx_cdc_source_payload_data;
 wire          rx_cdc_source_payload_error;
 wire          rx_cdc_source_payload_last_be;
 wire          rx_cdc_source_ready;
+wire          rx_cdc_source_source_first;
+wire          rx_cdc_source_source_last;
+wire   [31:0] rx_cdc_source_source_param_ip_address;
+wire   [15:0] rx_cdc_source_source_param_length;
+wire    [7:0] rx_cdc_source_source_param_protocol;
+wire   [31:0] rx_cdc_source_source_payload_data;
+wire    [3:0] rx_cdc_source_source_payload_error;
+wire    [3:0] rx_cdc_source_source_payload_last_be;
+wire          rx_cdc_source_source_ready;
+wire          rx_cdc_source_source_valid;
 wire          rx_cdc_source_valid;
 wire          rx_converter_converter_sink_first;
 wire          rx_converter_converter_sink_last;
@@ -2175,29 +2682,160 @@ wire          rx_converter_source_source_valid;
 wire          rx_converter_source_valid;
 wire          sink_sink_first;
 wire          sink_sink_last;
-wire   [15:0] sink_sink_param_dst_port;
-wire   [31:0] sink_sink_param_ip_address;
-wire   [15:0] sink_sink_param_length;
-wire   [15:0] sink_sink_param_src_port;
-wire    [7:0] sink_sink_payload_data;
-wire          sink_sink_payload_error;
-wire          sink_sink_payload_last_be;
+wire   [31:0] sink_sink_payload_data;
+wire    [3:0] sink_sink_payload_error;
+wire    [3:0] sink_sink_payload_last_be;
 wire          sink_sink_ready;
 wire          sink_sink_valid;
-reg           source_source_first = 1'd0;
-reg           source_source_last = 1'd0;
-reg    [31:0] source_source_param_ip_address = 32'd0;
-reg    [15:0] source_source_param_length = 16'd0;
-reg     [7:0] source_source_param_protocol = 8'd0;
-reg     [7:0] source_source_payload_data = 8'd0;
-reg           source_source_payload_error = 1'd0;
-reg           source_source_payload_last_be = 1'd0;
+wire          source_source_first;
+wire          source_source_last;
+wire   [31:0] source_source_payload_data;
+wire    [3:0] source_source_payload_error;
+wire    [3:0] source_source_payload_last_be;
 wire          source_source_ready;
-reg           source_source_valid = 1'd0;
+wire          source_source_valid;
 reg           state = 1'd0;
+wire          strideconverter0_converter_first;
+wire          strideconverter0_converter_last;
+reg     [1:0] strideconverter0_converter_mux = 2'd0;
+wire          strideconverter0_converter_sink_first;
+wire          strideconverter0_converter_sink_last;
+reg    [39:0] strideconverter0_converter_sink_payload_data = 40'd0;
+wire          strideconverter0_converter_sink_ready;
+wire          strideconverter0_converter_sink_valid;
+wire          strideconverter0_converter_source_first;
+wire          strideconverter0_converter_source_last;
+reg     [9:0] strideconverter0_converter_source_payload_data = 10'd0;
+wire          strideconverter0_converter_source_payload_valid_token_count;
+wire          strideconverter0_converter_source_ready;
+wire          strideconverter0_converter_source_valid;
+wire          strideconverter0_sink_first;
+wire          strideconverter0_sink_last;
+wire   [31:0] strideconverter0_sink_param_ip_address;
+wire   [15:0] strideconverter0_sink_param_length;
+wire    [7:0] strideconverter0_sink_param_protocol;
+wire   [31:0] strideconverter0_sink_payload_data;
+wire    [3:0] strideconverter0_sink_payload_error;
+wire    [3:0] strideconverter0_sink_payload_last_be;
+wire          strideconverter0_sink_ready;
+wire          strideconverter0_sink_valid;
+wire          strideconverter0_source_first;
+wire          strideconverter0_source_last;
+wire   [31:0] strideconverter0_source_param_ip_address;
+wire   [15:0] strideconverter0_source_param_length;
+wire    [7:0] strideconverter0_source_param_protocol;
+wire    [7:0] strideconverter0_source_payload_data;
+wire          strideconverter0_source_payload_error;
+wire          strideconverter0_source_payload_last_be;
+wire          strideconverter0_source_ready;
+wire          strideconverter0_source_source_first;
+wire          strideconverter0_source_source_last;
+wire    [9:0] strideconverter0_source_source_payload_data;
+wire          strideconverter0_source_source_ready;
+wire          strideconverter0_source_source_valid;
+wire          strideconverter0_source_valid;
+reg     [1:0] strideconverter1_converter_demux = 2'd0;
+wire          strideconverter1_converter_load_part;
+wire          strideconverter1_converter_sink_first;
+wire          strideconverter1_converter_sink_last;
+wire    [9:0] strideconverter1_converter_sink_payload_data;
+wire          strideconverter1_converter_sink_ready;
+wire          strideconverter1_converter_sink_valid;
+reg           strideconverter1_converter_source_first = 1'd0;
+reg           strideconverter1_converter_source_last = 1'd0;
+reg    [39:0] strideconverter1_converter_source_payload_data = 40'd0;
+reg     [2:0] strideconverter1_converter_source_payload_valid_token_count = 3'd0;
+wire          strideconverter1_converter_source_ready;
+wire          strideconverter1_converter_source_valid;
+reg           strideconverter1_converter_strobe_all = 1'd0;
+wire          strideconverter1_sink_first;
+wire          strideconverter1_sink_last;
+wire   [31:0] strideconverter1_sink_param_ip_address;
+wire   [15:0] strideconverter1_sink_param_length;
+wire    [7:0] strideconverter1_sink_param_protocol;
+wire    [7:0] strideconverter1_sink_payload_data;
+wire          strideconverter1_sink_payload_error;
+wire          strideconverter1_sink_payload_last_be;
+wire          strideconverter1_sink_ready;
+wire          strideconverter1_sink_valid;
+wire          strideconverter1_source_first;
+wire          strideconverter1_source_last;
+reg    [31:0] strideconverter1_source_param_ip_address = 32'd0;
+reg    [15:0] strideconverter1_source_param_length = 16'd0;
+reg     [7:0] strideconverter1_source_param_protocol = 8'd0;
+reg    [31:0] strideconverter1_source_payload_data = 32'd0;
+reg     [3:0] strideconverter1_source_payload_error = 4'd0;
+reg     [3:0] strideconverter1_source_payload_last_be = 4'd0;
+wire          strideconverter1_source_ready;
+wire          strideconverter1_source_source_first;
+wire          strideconverter1_source_source_last;
+wire   [39:0] strideconverter1_source_source_payload_data;
+wire          strideconverter1_source_source_ready;
+wire          strideconverter1_source_source_valid;
+wire          strideconverter1_source_valid;
 wire          sys_clk;
 wire          sys_rst;
 wire          take_group;
+wire   [97:0] tx_cdc_cdc_asyncfifo_din;
+wire   [97:0] tx_cdc_cdc_asyncfifo_dout;
+wire          tx_cdc_cdc_asyncfifo_re;
+wire          tx_cdc_cdc_asyncfifo_readable;
+wire          tx_cdc_cdc_asyncfifo_we;
+wire          tx_cdc_cdc_asyncfifo_writable;
+wire    [4:0] tx_cdc_cdc_consume_wdomain;
+wire          tx_cdc_cdc_fifo_in_first;
+wire          tx_cdc_cdc_fifo_in_last;
+wire   [31:0] tx_cdc_cdc_fifo_in_param_ip_address;
+wire   [15:0] tx_cdc_cdc_fifo_in_param_length;
+wire    [7:0] tx_cdc_cdc_fifo_in_param_protocol;
+wire   [31:0] tx_cdc_cdc_fifo_in_payload_data;
+wire    [3:0] tx_cdc_cdc_fifo_in_payload_error;
+wire    [3:0] tx_cdc_cdc_fifo_in_payload_last_be;
+wire          tx_cdc_cdc_fifo_out_first;
+wire          tx_cdc_cdc_fifo_out_last;
+wire   [31:0] tx_cdc_cdc_fifo_out_param_ip_address;
+wire   [15:0] tx_cdc_cdc_fifo_out_param_length;
+wire    [7:0] tx_cdc_cdc_fifo_out_param_protocol;
+wire   [31:0] tx_cdc_cdc_fifo_out_payload_data;
+wire    [3:0] tx_cdc_cdc_fifo_out_payload_error;
+wire    [3:0] tx_cdc_cdc_fifo_out_payload_last_be;
+wire          tx_cdc_cdc_graycounter0_ce;
+reg     [4:0] tx_cdc_cdc_graycounter0_q = 5'd0;
+reg     [4:0] tx_cdc_cdc_graycounter0_q_binary = 5'd0;
+wire    [4:0] tx_cdc_cdc_graycounter0_q_next;
+reg     [4:0] tx_cdc_cdc_graycounter0_q_next_binary = 5'd0;
+wire          tx_cdc_cdc_graycounter1_ce;
+reg     [4:0] tx_cdc_cdc_graycounter1_q = 5'd0;
+reg     [4:0] tx_cdc_cdc_graycounter1_q_binary = 5'd0;
+wire    [4:0] tx_cdc_cdc_graycounter1_q_next;
+reg     [4:0] tx_cdc_cdc_graycounter1_q_next_binary = 5'd0;
+wire    [4:0] tx_cdc_cdc_produce_rdomain;
+wire    [3:0] tx_cdc_cdc_rdport_adr;
+wire   [97:0] tx_cdc_cdc_rdport_dat_r;
+wire          tx_cdc_cdc_sink_first;
+wire          tx_cdc_cdc_sink_last;
+wire   [31:0] tx_cdc_cdc_sink_param_ip_address;
+wire   [15:0] tx_cdc_cdc_sink_param_length;
+wire    [7:0] tx_cdc_cdc_sink_param_protocol;
+wire   [31:0] tx_cdc_cdc_sink_payload_data;
+wire    [3:0] tx_cdc_cdc_sink_payload_error;
+wire    [3:0] tx_cdc_cdc_sink_payload_last_be;
+wire          tx_cdc_cdc_sink_ready;
+wire          tx_cdc_cdc_sink_valid;
+wire          tx_cdc_cdc_source_first;
+wire          tx_cdc_cdc_source_last;
+wire   [31:0] tx_cdc_cdc_source_param_ip_address;
+wire   [15:0] tx_cdc_cdc_source_param_length;
+wire    [7:0] tx_cdc_cdc_source_param_protocol;
+wire   [31:0] tx_cdc_cdc_source_payload_data;
+wire    [3:0] tx_cdc_cdc_source_payload_error;
+wire    [3:0] tx_cdc_cdc_source_payload_last_be;
+wire          tx_cdc_cdc_source_ready;
+wire          tx_cdc_cdc_source_valid;
+wire    [3:0] tx_cdc_cdc_wrport_adr;
+wire   [97:0] tx_cdc_cdc_wrport_dat_r;
+wire   [97:0] tx_cdc_cdc_wrport_dat_w;
+wire          tx_cdc_cdc_wrport_we;
 wire          tx_cdc_sink_first;
 wire          tx_cdc_sink_last;
 wire   [15:0] tx_cdc_sink_param_dst_port;
@@ -2208,6 +2846,16 @@ wire    [7:0] tx_cdc_sink_payload_data;
 wire          tx_cdc_sink_payload_error;
 wire          tx_cdc_sink_payload_last_be;
 wire          tx_cdc_sink_ready;
+wire          tx_cdc_sink_sink_first;
+wire          tx_cdc_sink_sink_last;
+wire   [31:0] tx_cdc_sink_sink_param_ip_address;
+wire   [15:0] tx_cdc_sink_sink_param_length;
+wire    [7:0] tx_cdc_sink_sink_param_protocol;
+wire   [31:0] tx_cdc_sink_sink_payload_data;
+wire    [3:0] tx_cdc_sink_sink_payload_error;
+wire    [3:0] tx_cdc_sink_sink_payload_last_be;
+wire          tx_cdc_sink_sink_ready;
+wire          tx_cdc_sink_sink_valid;
 wire          tx_cdc_sink_valid;
 wire          tx_cdc_source_first;
 wire          tx_cdc_source_last;
@@ -2219,6 +2867,16 @@ wire    [7:0] tx_cdc_source_payload_data;
 wire          tx_cdc_source_payload_error;
 wire          tx_cdc_source_payload_last_be;
 wire          tx_cdc_source_ready;
+wire          tx_cdc_source_source_first;
+wire          tx_cdc_source_source_last;
+wire   [31:0] tx_cdc_source_source_param_ip_address;
+wire   [15:0] tx_cdc_source_source_param_length;
+wire    [7:0] tx_cdc_source_source_param_protocol;
+wire   [31:0] tx_cdc_source_source_payload_data;
+wire    [3:0] tx_cdc_source_source_payload_error;
+wire    [3:0] tx_cdc_source_source_payload_last_be;
+wire          tx_cdc_source_source_ready;
+wire          tx_cdc_source_source_valid;
 wire          tx_cdc_source_valid;
 wire          tx_converter_converter_sink_first;
 wire          tx_converter_converter_sink_last;
@@ -2298,9 +2956,13 @@ wire          we;
 //------------------------------------------------------------------------------
 
 assign ethphy_source_payload_last_be = ethphy_source_last;
+assign port_clk = port_clock;
+assign port_rst = port_reset;
 assign take_group = (ip_rx_liteethipv4depacketizer_source_param_target_ip == ip_multicast);
-assign rx_drop_header = ((((mac_cut | ip_rx_cut) | ip_rx_drop_header) | holdingudprx_cut0) | holdingudprx_drop_header);
-assign rx_drop_other = (((mac_crossbar_dropped | ip_rx_drop_other) | ip_crossbar_dropped) | crossbar_dropped);
+assign pulsesynchronizer0_i = pulsemerge0_o0;
+assign rx_drop_header = pulsemerge0_o1;
+assign pulsesynchronizer1_i = pulsemerge1_o0;
+assign rx_drop_other = pulsemerge1_o1;
 assign user_port_sink_valid = udp_sink_valid;
 assign user_port_sink_last = udp_sink_last;
 assign user_port_sink_param_dst_port = udp_sink_dst_port;
@@ -2422,6 +3084,107 @@ always @(*) begin
     end
 end
 assign mac_core_tx_cdc_cdc_graycounter1_q_next = (mac_core_tx_cdc_cdc_graycounter1_q_next_binary ^ mac_core_tx_cdc_cdc_graycounter1_q_next_binary[5:1]);
+assign mac_core_tx_converter_converter_sink_valid = mac_core_tx_converter_sink_valid;
+assign mac_core_tx_converter_converter_sink_first = mac_core_tx_converter_sink_first;
+assign mac_core_tx_converter_converter_sink_last = mac_core_tx_converter_sink_last;
+assign mac_core_tx_converter_sink_ready = mac_core_tx_converter_converter_sink_ready;
+always @(*) begin
+    mac_core_tx_converter_converter_sink_payload_data <= 40'd0;
+    mac_core_tx_converter_converter_sink_payload_data[7:0] <= mac_core_tx_converter_sink_payload_data[7:0];
+    mac_core_tx_converter_converter_sink_payload_data[8] <= mac_core_tx_converter_sink_payload_last_be[0];
+    mac_core_tx_converter_converter_sink_payload_data[9] <= mac_core_tx_converter_sink_payload_error[0];
+    mac_core_tx_converter_converter_sink_payload_data[17:10] <= mac_core_tx_converter_sink_payload_data[15:8];
+    mac_core_tx_converter_converter_sink_payload_data[18] <= mac_core_tx_converter_sink_payload_last_be[1];
+    mac_core_tx_converter_converter_sink_payload_data[19] <= mac_core_tx_converter_sink_payload_error[1];
+    mac_core_tx_converter_converter_sink_payload_data[27:20] <= mac_core_tx_converter_sink_payload_data[23:16];
+    mac_core_tx_converter_converter_sink_payload_data[28] <= mac_core_tx_converter_sink_payload_last_be[2];
+    mac_core_tx_converter_converter_sink_payload_data[29] <= mac_core_tx_converter_sink_payload_error[2];
+    mac_core_tx_converter_converter_sink_payload_data[37:30] <= mac_core_tx_converter_sink_payload_data[31:24];
+    mac_core_tx_converter_converter_sink_payload_data[38] <= mac_core_tx_converter_sink_payload_last_be[3];
+    mac_core_tx_converter_converter_sink_payload_data[39] <= mac_core_tx_converter_sink_payload_error[3];
+end
+assign mac_core_tx_converter_source_valid = mac_core_tx_converter_source_source_valid;
+assign mac_core_tx_converter_source_first = mac_core_tx_converter_source_source_first;
+assign mac_core_tx_converter_source_last = mac_core_tx_converter_source_source_last;
+assign mac_core_tx_converter_source_source_ready = mac_core_tx_converter_source_ready;
+assign {mac_core_tx_converter_source_payload_error, mac_core_tx_converter_source_payload_last_be, mac_core_tx_converter_source_payload_data} = mac_core_tx_converter_source_source_payload_data;
+assign mac_core_tx_converter_source_source_valid = mac_core_tx_converter_converter_source_valid;
+assign mac_core_tx_converter_converter_source_ready = mac_core_tx_converter_source_source_ready;
+assign mac_core_tx_converter_source_source_first = mac_core_tx_converter_converter_source_first;
+assign mac_core_tx_converter_source_source_last = mac_core_tx_converter_converter_source_last;
+assign mac_core_tx_converter_source_source_payload_data = mac_core_tx_converter_converter_source_payload_data;
+assign mac_core_tx_converter_converter_first = (mac_core_tx_converter_converter_mux == 1'd0);
+assign mac_core_tx_converter_converter_last = (mac_core_tx_converter_converter_mux == 2'd3);
+assign mac_core_tx_converter_converter_source_valid = mac_core_tx_converter_converter_sink_valid;
+assign mac_core_tx_converter_converter_source_first = (mac_core_tx_converter_converter_sink_first & mac_core_tx_converter_converter_first);
+assign mac_core_tx_converter_converter_source_last = (mac_core_tx_converter_converter_sink_last & mac_core_tx_converter_converter_last);
+assign mac_core_tx_converter_converter_sink_ready = (mac_core_tx_converter_converter_last & mac_core_tx_converter_converter_source_ready);
+always @(*) begin
+    mac_core_tx_converter_converter_source_payload_data <= 10'd0;
+    case (mac_core_tx_converter_converter_mux)
+        1'd0: begin
+            mac_core_tx_converter_converter_source_payload_data <= mac_core_tx_converter_converter_sink_payload_data[9:0];
+        end
+        1'd1: begin
+            mac_core_tx_converter_converter_source_payload_data <= mac_core_tx_converter_converter_sink_payload_data[19:10];
+        end
+        2'd2: begin
+            mac_core_tx_converter_converter_source_payload_data <= mac_core_tx_converter_converter_sink_payload_data[29:20];
+        end
+        default: begin
+            mac_core_tx_converter_converter_source_payload_data <= mac_core_tx_converter_converter_sink_payload_data[39:30];
+        end
+    endcase
+end
+assign mac_core_tx_converter_converter_source_payload_valid_token_count = mac_core_tx_converter_converter_last;
+assign mac_core_tx_last_be_last_handler_sink_valid = mac_core_tx_last_be_sink_sink_valid;
+assign mac_core_tx_last_be_sink_sink_ready = mac_core_tx_last_be_last_handler_sink_ready;
+assign mac_core_tx_last_be_last_handler_sink_first = mac_core_tx_last_be_sink_sink_first;
+assign mac_core_tx_last_be_last_handler_sink_last = mac_core_tx_last_be_sink_sink_last;
+assign mac_core_tx_last_be_last_handler_sink_payload_data = mac_core_tx_last_be_sink_sink_payload_data;
+assign mac_core_tx_last_be_last_handler_sink_payload_last_be = mac_core_tx_last_be_sink_sink_payload_last_be;
+assign mac_core_tx_last_be_last_handler_sink_payload_error = mac_core_tx_last_be_sink_sink_payload_error;
+assign mac_core_tx_last_be_source_source_valid = mac_core_tx_last_be_last_handler_source_valid;
+assign mac_core_tx_last_be_last_handler_source_ready = mac_core_tx_last_be_source_source_ready;
+assign mac_core_tx_last_be_source_source_first = mac_core_tx_last_be_last_handler_source_first;
+assign mac_core_tx_last_be_source_source_last = mac_core_tx_last_be_last_handler_source_last;
+assign mac_core_tx_last_be_source_source_payload_data = mac_core_tx_last_be_last_handler_source_payload_data;
+assign mac_core_tx_last_be_source_source_payload_last_be = mac_core_tx_last_be_last_handler_source_payload_last_be;
+assign mac_core_tx_last_be_source_source_payload_error = mac_core_tx_last_be_last_handler_source_payload_error;
+always @(*) begin
+    liteethmac_txdatapath_liteethmactxlastbe_next_state <= 1'd0;
+    mac_core_tx_last_be_last_handler_sink_ready <= 1'd0;
+    mac_core_tx_last_be_last_handler_source_first <= 1'd0;
+    mac_core_tx_last_be_last_handler_source_last <= 1'd0;
+    mac_core_tx_last_be_last_handler_source_payload_data <= 8'd0;
+    mac_core_tx_last_be_last_handler_source_payload_error <= 1'd0;
+    mac_core_tx_last_be_last_handler_source_payload_last_be <= 1'd0;
+    mac_core_tx_last_be_last_handler_source_valid <= 1'd0;
+    liteethmac_txdatapath_liteethmactxlastbe_next_state <= liteethmac_txdatapath_liteethmactxlastbe_state;
+    case (liteethmac_txdatapath_liteethmactxlastbe_state)
+        1'd1: begin
+            mac_core_tx_last_be_last_handler_sink_ready <= 1'd1;
+            if ((mac_core_tx_last_be_last_handler_sink_valid & mac_core_tx_last_be_last_handler_sink_last)) begin
+                liteethmac_txdatapath_liteethmactxlastbe_next_state <= 1'd0;
+            end
+        end
+        default: begin
+            mac_core_tx_last_be_last_handler_source_valid <= mac_core_tx_last_be_last_handler_sink_valid;
+            mac_core_tx_last_be_last_handler_sink_ready <= mac_core_tx_last_be_last_handler_source_ready;
+            mac_core_tx_last_be_last_handler_source_first <= mac_core_tx_last_be_last_handler_sink_first;
+            mac_core_tx_last_be_last_handler_source_last <= mac_core_tx_last_be_last_handler_sink_last;
+            mac_core_tx_last_be_last_handler_source_payload_data <= mac_core_tx_last_be_last_handler_sink_payload_data;
+            mac_core_tx_last_be_last_handler_source_payload_last_be <= mac_core_tx_last_be_last_handler_sink_payload_last_be;
+            mac_core_tx_last_be_last_handler_source_payload_error <= mac_core_tx_last_be_last_handler_sink_payload_error;
+            mac_core_tx_last_be_last_handler_source_last <= (mac_core_tx_last_be_last_handler_sink_payload_last_be != 1'd0);
+            if ((mac_core_tx_last_be_last_handler_sink_valid & mac_core_tx_last_be_last_handler_sink_ready)) begin
+                if ((mac_core_tx_last_be_last_handler_source_last & (~mac_core_tx_last_be_last_handler_sink_last))) begin
+                    liteethmac_txdatapath_liteethmactxlastbe_next_state <= 1'd1;
+                end
+            end
+        end
+    endcase
+end
 assign mac_core_tx_padding_counter_done = (mac_core_tx_padding_counter >= 6'd59);
 always @(*) begin
     liteethmac_txdatapath_liteethmacpaddinginserter_next_state <= 1'd0;
@@ -2751,6 +3514,52 @@ always @(*) begin
         end
     endcase
 end
+assign pipe_valid_sink_ready = ((~pipe_valid_source_valid) | pipe_valid_source_ready);
+assign pipe_ready_sink_ready = (~pipe_ready_valid);
+always @(*) begin
+    pipe_ready_source_first <= 1'd0;
+    pipe_ready_source_last <= 1'd0;
+    pipe_ready_source_payload_data <= 32'd0;
+    pipe_ready_source_payload_error <= 4'd0;
+    pipe_ready_source_payload_last_be <= 4'd0;
+    pipe_ready_source_valid <= 1'd0;
+    if (pipe_ready_valid) begin
+        pipe_ready_source_valid <= pipe_ready_sink_d_valid;
+        pipe_ready_source_first <= pipe_ready_sink_d_first;
+        pipe_ready_source_last <= pipe_ready_sink_d_last;
+        pipe_ready_source_payload_data <= pipe_ready_sink_d_payload_data;
+        pipe_ready_source_payload_last_be <= pipe_ready_sink_d_payload_last_be;
+        pipe_ready_source_payload_error <= pipe_ready_sink_d_payload_error;
+    end else begin
+        pipe_ready_source_valid <= pipe_ready_sink_valid;
+        pipe_ready_source_first <= pipe_ready_sink_first;
+        pipe_ready_source_last <= pipe_ready_sink_last;
+        pipe_ready_source_payload_data <= pipe_ready_sink_payload_data;
+        pipe_ready_source_payload_last_be <= pipe_ready_sink_payload_last_be;
+        pipe_ready_source_payload_error <= pipe_ready_sink_payload_error;
+    end
+end
+assign pipe_valid_sink_valid = sink_sink_valid;
+assign sink_sink_ready = pipe_valid_sink_ready;
+assign pipe_valid_sink_first = sink_sink_first;
+assign pipe_valid_sink_last = sink_sink_last;
+assign pipe_valid_sink_payload_data = sink_sink_payload_data;
+assign pipe_valid_sink_payload_last_be = sink_sink_payload_last_be;
+assign pipe_valid_sink_payload_error = sink_sink_payload_error;
+assign pipe_ready_sink_valid = pipe_valid_source_valid;
+assign pipe_valid_source_ready = pipe_ready_sink_ready;
+assign pipe_ready_sink_first = pipe_valid_source_first;
+assign pipe_ready_sink_last = pipe_valid_source_last;
+assign pipe_ready_sink_payload_data = pipe_valid_source_payload_data;
+assign pipe_ready_sink_payload_last_be = pipe_valid_source_payload_last_be;
+assign pipe_ready_sink_payload_error = pipe_valid_source_payload_error;
+assign source_source_valid = pipe_ready_source_valid;
+assign pipe_ready_source_ready = source_source_ready;
+assign source_source_first = pipe_ready_source_first;
+assign source_source_last = pipe_ready_source_last;
+assign source_source_payload_data = pipe_ready_source_payload_data;
+assign source_source_payload_last_be = pipe_ready_source_payload_last_be;
+assign source_source_payload_error = pipe_ready_source_payload_error;
 assign mac_core_tx_cdc_sink_sink_valid = mac_core_sink_valid;
 assign mac_core_sink_ready = mac_core_tx_cdc_sink_sink_ready;
 assign mac_core_tx_cdc_sink_sink_first = mac_core_sink_first;
@@ -2758,13 +3567,34 @@ assign mac_core_tx_cdc_sink_sink_last = mac_core_sink_last;
 assign mac_core_tx_cdc_sink_sink_payload_data = mac_core_sink_payload_data;
 assign mac_core_tx_cdc_sink_sink_payload_last_be = mac_core_sink_payload_last_be;
 assign mac_core_tx_cdc_sink_sink_payload_error = mac_core_sink_payload_error;
-assign mac_core_tx_padding_sink_valid = mac_core_tx_cdc_source_source_valid;
-assign mac_core_tx_cdc_source_source_ready = mac_core_tx_padding_sink_ready;
-assign mac_core_tx_padding_sink_first = mac_core_tx_cdc_source_source_first;
-assign mac_core_tx_padding_sink_last = mac_core_tx_cdc_source_source_last;
-assign mac_core_tx_padding_sink_payload_data = mac_core_tx_cdc_source_source_payload_data;
-assign mac_core_tx_padding_sink_payload_last_be = mac_core_tx_cdc_source_source_payload_last_be;
-assign mac_core_tx_padding_sink_payload_error = mac_core_tx_cdc_source_source_payload_error;
+assign sink_sink_valid = mac_core_tx_cdc_source_source_valid;
+assign mac_core_tx_cdc_source_source_ready = sink_sink_ready;
+assign sink_sink_first = mac_core_tx_cdc_source_source_first;
+assign sink_sink_last = mac_core_tx_cdc_source_source_last;
+assign sink_sink_payload_data = mac_core_tx_cdc_source_source_payload_data;
+assign sink_sink_payload_last_be = mac_core_tx_cdc_source_source_payload_last_be;
+assign sink_sink_payload_error = mac_core_tx_cdc_source_source_payload_error;
+assign mac_core_tx_converter_sink_valid = source_source_valid;
+assign source_source_ready = mac_core_tx_converter_sink_ready;
+assign mac_core_tx_converter_sink_first = source_source_first;
+assign mac_core_tx_converter_sink_last = source_source_last;
+assign mac_core_tx_converter_sink_payload_data = source_source_payload_data;
+assign mac_core_tx_converter_sink_payload_last_be = source_source_payload_last_be;
+assign mac_core_tx_converter_sink_payload_error = source_source_payload_error;
+assign mac_core_tx_last_be_sink_sink_valid = mac_core_tx_converter_source_valid;
+assign mac_core_tx_converter_source_ready = mac_core_tx_last_be_sink_sink_ready;
+assign mac_core_tx_last_be_sink_sink_first = mac_core_tx_converter_source_first;
+assign mac_core_tx_last_be_sink_sink_last = mac_core_tx_converter_source_last;
+assign mac_core_tx_last_be_sink_sink_payload_data = mac_core_tx_converter_source_payload_data;
+assign mac_core_tx_last_be_sink_sink_payload_last_be = mac_core_tx_converter_source_payload_last_be;
+assign mac_core_tx_last_be_sink_sink_payload_error = mac_core_tx_converter_source_payload_error;
+assign mac_core_tx_padding_sink_valid = mac_core_tx_last_be_source_source_valid;
+assign mac_core_tx_last_be_source_source_ready = mac_core_tx_padding_sink_ready;
+assign mac_core_tx_padding_sink_first = mac_core_tx_last_be_source_source_first;
+assign mac_core_tx_padding_sink_last = mac_core_tx_last_be_source_source_last;
+assign mac_core_tx_padding_sink_payload_data = mac_core_tx_last_be_source_source_payload_data;
+assign mac_core_tx_padding_sink_payload_last_be = mac_core_tx_last_be_source_source_payload_last_be;
+assign mac_core_tx_padding_sink_payload_error = mac_core_tx_last_be_source_source_payload_error;
 assign mac_core_tx_crc_sink_sink_valid = mac_core_tx_padding_source_valid;
 assign mac_core_tx_padding_source_ready = mac_core_tx_crc_sink_sink_ready;
 assign mac_core_tx_crc_sink_sink_first = mac_core_tx_padding_source_first;
@@ -3028,63 +3858,114 @@ assign mac_core_rx_padding_source_last = mac_core_rx_padding_sink_last;
 assign mac_core_rx_padding_source_payload_data = mac_core_rx_padding_sink_payload_data;
 assign mac_core_rx_padding_source_payload_last_be = mac_core_rx_padding_sink_payload_last_be;
 assign mac_core_rx_padding_source_payload_error = mac_core_rx_padding_sink_payload_error;
-assign mac_core_cdc_sink_valid = mac_core_sink_sink_valid;
-assign mac_core_sink_sink_ready = mac_core_cdc_sink_ready;
-assign mac_core_cdc_sink_first = mac_core_sink_sink_first;
-assign mac_core_cdc_sink_last = mac_core_sink_sink_last;
-assign mac_core_cdc_sink_payload_data = mac_core_sink_sink_payload_data;
-assign mac_core_cdc_sink_payload_last_be = mac_core_sink_sink_payload_last_be;
-assign mac_core_cdc_sink_payload_error = mac_core_sink_sink_payload_error;
-assign mac_core_source_source_valid = mac_core_cdc_source_valid;
-assign mac_core_cdc_source_ready = mac_core_source_source_ready;
-assign mac_core_source_source_first = mac_core_cdc_source_first;
-assign mac_core_source_source_last = mac_core_cdc_source_last;
-assign mac_core_source_source_payload_data = mac_core_cdc_source_payload_data;
-assign mac_core_source_source_payload_last_be = mac_core_cdc_source_payload_last_be;
-assign mac_core_source_source_payload_error = mac_core_cdc_source_payload_error;
-assign mac_core_cdc_asyncfifo_din = {mac_core_cdc_fifo_in_last, mac_core_cdc_fifo_in_first, mac_core_cdc_fifo_in_payload_error, mac_core_cdc_fifo_in_payload_last_be, mac_core_cdc_fifo_in_payload_data};
-assign {mac_core_cdc_fifo_out_last, mac_core_cdc_fifo_out_first, mac_core_cdc_fifo_out_payload_error, mac_core_cdc_fifo_out_payload_last_be, mac_core_cdc_fifo_out_payload_data} = mac_core_cdc_asyncfifo_dout;
-assign mac_core_cdc_sink_ready = mac_core_cdc_asyncfifo_writable;
-assign mac_core_cdc_asyncfifo_we = mac_core_cdc_sink_valid;
-assign mac_core_cdc_fifo_in_first = mac_core_cdc_sink_first;
-assign mac_core_cdc_fifo_in_last = mac_core_cdc_sink_last;
-assign mac_core_cdc_fifo_in_payload_data = mac_core_cdc_sink_payload_data;
-assign mac_core_cdc_fifo_in_payload_last_be = mac_core_cdc_sink_payload_last_be;
-assign mac_core_cdc_fifo_in_payload_error = mac_core_cdc_sink_payload_error;
-assign mac_core_cdc_source_valid = mac_core_cdc_asyncfifo_readable;
-assign mac_core_cdc_source_first = mac_core_cdc_fifo_out_first;
-assign mac_core_cdc_source_last = mac_core_cdc_fifo_out_last;
-assign mac_core_cdc_source_payload_data = mac_core_cdc_fifo_out_payload_data;
-assign mac_core_cdc_source_payload_last_be = mac_core_cdc_fifo_out_payload_last_be;
-assign mac_core_cdc_source_payload_error = mac_core_cdc_fifo_out_payload_error;
-assign mac_core_cdc_asyncfifo_re = mac_core_cdc_source_ready;
-assign mac_core_cdc_graycounter0_ce = (mac_core_cdc_asyncfifo_writable & mac_core_cdc_asyncfifo_we);
-assign mac_core_cdc_graycounter1_ce = (mac_core_cdc_asyncfifo_readable & mac_core_cdc_asyncfifo_re);
-assign mac_core_cdc_asyncfifo_writable = (((mac_core_cdc_graycounter0_q[5] == mac_core_cdc_consume_wdomain[5]) | (mac_core_cdc_graycounter0_q[4] == mac_core_cdc_consume_wdomain[4])) | (mac_core_cdc_graycounter0_q[3:0] != mac_core_cdc_consume_wdomain[3:0]));
-assign mac_core_cdc_asyncfifo_readable = (mac_core_cdc_graycounter1_q != mac_core_cdc_produce_rdomain);
-assign mac_core_cdc_wrport_adr = mac_core_cdc_graycounter0_q_binary[4:0];
-assign mac_core_cdc_wrport_dat_w = mac_core_cdc_asyncfifo_din;
-assign mac_core_cdc_wrport_we = mac_core_cdc_graycounter0_ce;
-assign mac_core_cdc_rdport_adr = mac_core_cdc_graycounter1_q_next_binary[4:0];
-assign mac_core_cdc_asyncfifo_dout = mac_core_cdc_rdport_dat_r;
+assign mac_core_rx_last_be_source_valid = mac_core_rx_last_be_sink_valid;
+assign mac_core_rx_last_be_sink_ready = mac_core_rx_last_be_source_ready;
+assign mac_core_rx_last_be_source_first = mac_core_rx_last_be_sink_first;
+assign mac_core_rx_last_be_source_last = mac_core_rx_last_be_sink_last;
+assign mac_core_rx_last_be_source_payload_data = mac_core_rx_last_be_sink_payload_data;
+assign mac_core_rx_last_be_source_payload_error = mac_core_rx_last_be_sink_payload_error;
 always @(*) begin
-    mac_core_cdc_graycounter0_q_next_binary <= 6'd0;
-    if (mac_core_cdc_graycounter0_ce) begin
-        mac_core_cdc_graycounter0_q_next_binary <= (mac_core_cdc_graycounter0_q_binary + 1'd1);
-    end else begin
-        mac_core_cdc_graycounter0_q_next_binary <= mac_core_cdc_graycounter0_q_binary;
+    mac_core_rx_last_be_source_payload_last_be <= 1'd0;
+    mac_core_rx_last_be_source_payload_last_be <= mac_core_rx_last_be_sink_payload_last_be;
+    if (1'd1) begin
+        mac_core_rx_last_be_source_payload_last_be <= mac_core_rx_last_be_sink_last;
     end
 end
-assign mac_core_cdc_graycounter0_q_next = (mac_core_cdc_graycounter0_q_next_binary ^ mac_core_cdc_graycounter0_q_next_binary[5:1]);
+assign mac_core_rx_converter_converter_sink_valid = mac_core_rx_converter_sink_valid;
+assign mac_core_rx_converter_converter_sink_first = mac_core_rx_converter_sink_first;
+assign mac_core_rx_converter_converter_sink_last = mac_core_rx_converter_sink_last;
+assign mac_core_rx_converter_sink_ready = mac_core_rx_converter_converter_sink_ready;
+assign mac_core_rx_converter_converter_sink_payload_data = {mac_core_rx_converter_sink_payload_error, mac_core_rx_converter_sink_payload_last_be, mac_core_rx_converter_sink_payload_data};
+assign mac_core_rx_converter_source_valid = mac_core_rx_converter_source_source_valid;
+assign mac_core_rx_converter_source_first = mac_core_rx_converter_source_source_first;
+assign mac_core_rx_converter_source_last = mac_core_rx_converter_source_source_last;
+assign mac_core_rx_converter_source_source_ready = mac_core_rx_converter_source_ready;
 always @(*) begin
-    mac_core_cdc_graycounter1_q_next_binary <= 6'd0;
-    if (mac_core_cdc_graycounter1_ce) begin
-        mac_core_cdc_graycounter1_q_next_binary <= (mac_core_cdc_graycounter1_q_binary + 1'd1);
+    mac_core_rx_converter_source_payload_data <= 32'd0;
+    mac_core_rx_converter_source_payload_data[7:0] <= mac_core_rx_converter_source_source_payload_data[7:0];
+    mac_core_rx_converter_source_payload_data[15:8] <= mac_core_rx_converter_source_source_payload_data[17:10];
+    mac_core_rx_converter_source_payload_data[23:16] <= mac_core_rx_converter_source_source_payload_data[27:20];
+    mac_core_rx_converter_source_payload_data[31:24] <= mac_core_rx_converter_source_source_payload_data[37:30];
+end
+always @(*) begin
+    mac_core_rx_converter_source_payload_last_be <= 4'd0;
+    mac_core_rx_converter_source_payload_last_be[0] <= mac_core_rx_converter_source_source_payload_data[8];
+    mac_core_rx_converter_source_payload_last_be[1] <= mac_core_rx_converter_source_source_payload_data[18];
+    mac_core_rx_converter_source_payload_last_be[2] <= mac_core_rx_converter_source_source_payload_data[28];
+    mac_core_rx_converter_source_payload_last_be[3] <= mac_core_rx_converter_source_source_payload_data[38];
+end
+always @(*) begin
+    mac_core_rx_converter_source_payload_error <= 4'd0;
+    mac_core_rx_converter_source_payload_error[0] <= mac_core_rx_converter_source_source_payload_data[9];
+    mac_core_rx_converter_source_payload_error[1] <= mac_core_rx_converter_source_source_payload_data[19];
+    mac_core_rx_converter_source_payload_error[2] <= mac_core_rx_converter_source_source_payload_data[29];
+    mac_core_rx_converter_source_payload_error[3] <= mac_core_rx_converter_source_source_payload_data[39];
+end
+assign mac_core_rx_converter_source_source_valid = mac_core_rx_converter_converter_source_valid;
+assign mac_core_rx_converter_converter_source_ready = mac_core_rx_converter_source_source_ready;
+assign mac_core_rx_converter_source_source_first = mac_core_rx_converter_converter_source_first;
+assign mac_core_rx_converter_source_source_last = mac_core_rx_converter_converter_source_last;
+assign mac_core_rx_converter_source_source_payload_data = mac_core_rx_converter_converter_source_payload_data;
+assign mac_core_rx_converter_converter_sink_ready = ((~mac_core_rx_converter_converter_strobe_all) | mac_core_rx_converter_converter_source_ready);
+assign mac_core_rx_converter_converter_source_valid = mac_core_rx_converter_converter_strobe_all;
+assign mac_core_rx_converter_converter_load_part = (mac_core_rx_converter_converter_sink_valid & mac_core_rx_converter_converter_sink_ready);
+assign mac_core_rx_cdc_cdc_sink_valid = mac_core_rx_cdc_sink_sink_valid;
+assign mac_core_rx_cdc_sink_sink_ready = mac_core_rx_cdc_cdc_sink_ready;
+assign mac_core_rx_cdc_cdc_sink_first = mac_core_rx_cdc_sink_sink_first;
+assign mac_core_rx_cdc_cdc_sink_last = mac_core_rx_cdc_sink_sink_last;
+assign mac_core_rx_cdc_cdc_sink_payload_data = mac_core_rx_cdc_sink_sink_payload_data;
+assign mac_core_rx_cdc_cdc_sink_payload_last_be = mac_core_rx_cdc_sink_sink_payload_last_be;
+assign mac_core_rx_cdc_cdc_sink_payload_error = mac_core_rx_cdc_sink_sink_payload_error;
+assign mac_core_rx_cdc_source_source_valid = mac_core_rx_cdc_cdc_source_valid;
+assign mac_core_rx_cdc_cdc_source_ready = mac_core_rx_cdc_source_source_ready;
+assign mac_core_rx_cdc_source_source_first = mac_core_rx_cdc_cdc_source_first;
+assign mac_core_rx_cdc_source_source_last = mac_core_rx_cdc_cdc_source_last;
+assign mac_core_rx_cdc_source_source_payload_data = mac_core_rx_cdc_cdc_source_payload_data;
+assign mac_core_rx_cdc_source_source_payload_last_be = mac_core_rx_cdc_cdc_source_payload_last_be;
+assign mac_core_rx_cdc_source_source_payload_error = mac_core_rx_cdc_cdc_source_payload_error;
+assign mac_core_rx_cdc_cdc_asyncfifo_din = {mac_core_rx_cdc_cdc_fifo_in_last, mac_core_rx_cdc_cdc_fifo_in_first, mac_core_rx_cdc_cdc_fifo_in_payload_error, mac_core_rx_cdc_cdc_fifo_in_payload_last_be, mac_core_rx_cdc_cdc_fifo_in_payload_data};
+assign {mac_core_rx_cdc_cdc_fifo_out_last, mac_core_rx_cdc_cdc_fifo_out_first, mac_core_rx_cdc_cdc_fifo_out_payload_error, mac_core_rx_cdc_cdc_fifo_out_payload_last_be, mac_core_rx_cdc_cdc_fifo_out_payload_data} = mac_core_rx_cdc_cdc_asyncfifo_dout;
+assign mac_core_rx_cdc_cdc_sink_ready = mac_core_rx_cdc_cdc_asyncfifo_writable;
+assign mac_core_rx_cdc_cdc_asyncfifo_we = mac_core_rx_cdc_cdc_sink_valid;
+assign mac_core_rx_cdc_cdc_fifo_in_first = mac_core_rx_cdc_cdc_sink_first;
+assign mac_core_rx_cdc_cdc_fifo_in_last = mac_core_rx_cdc_cdc_sink_last;
+assign mac_core_rx_cdc_cdc_fifo_in_payload_data = mac_core_rx_cdc_cdc_sink_payload_data;
+assign mac_core_rx_cdc_cdc_fifo_in_payload_last_be = mac_core_rx_cdc_cdc_sink_payload_last_be;
+assign mac_core_rx_cdc_cdc_fifo_in_payload_error = mac_core_rx_cdc_cdc_sink_payload_error;
+assign mac_core_rx_cdc_cdc_source_valid = mac_core_rx_cdc_cdc_asyncfifo_readable;
+assign mac_core_rx_cdc_cdc_source_first = mac_core_rx_cdc_cdc_fifo_out_first;
+assign mac_core_rx_cdc_cdc_source_last = mac_core_rx_cdc_cdc_fifo_out_last;
+assign mac_core_rx_cdc_cdc_source_payload_data = mac_core_rx_cdc_cdc_fifo_out_payload_data;
+assign mac_core_rx_cdc_cdc_source_payload_last_be = mac_core_rx_cdc_cdc_fifo_out_payload_last_be;
+assign mac_core_rx_cdc_cdc_source_payload_error = mac_core_rx_cdc_cdc_fifo_out_payload_error;
+assign mac_core_rx_cdc_cdc_asyncfifo_re = mac_core_rx_cdc_cdc_source_ready;
+assign mac_core_rx_cdc_cdc_graycounter0_ce = (mac_core_rx_cdc_cdc_asyncfifo_writable & mac_core_rx_cdc_cdc_asyncfifo_we);
+assign mac_core_rx_cdc_cdc_graycounter1_ce = (mac_core_rx_cdc_cdc_asyncfifo_readable & mac_core_rx_cdc_cdc_asyncfifo_re);
+assign mac_core_rx_cdc_cdc_asyncfifo_writable = (((mac_core_rx_cdc_cdc_graycounter0_q[5] == mac_core_rx_cdc_cdc_consume_wdomain[5]) | (mac_core_rx_cdc_cdc_graycounter0_q[4] == mac_core_rx_cdc_cdc_consume_wdomain[4])) | (mac_core_rx_cdc_cdc_graycounter0_q[3:0] != mac_core_rx_cdc_cdc_consume_wdomain[3:0]));
+assign mac_core_rx_cdc_cdc_asyncfifo_readable = (mac_core_rx_cdc_cdc_graycounter1_q != mac_core_rx_cdc_cdc_produce_rdomain);
+assign mac_core_rx_cdc_cdc_wrport_adr = mac_core_rx_cdc_cdc_graycounter0_q_binary[4:0];
+assign mac_core_rx_cdc_cdc_wrport_dat_w = mac_core_rx_cdc_cdc_asyncfifo_din;
+assign mac_core_rx_cdc_cdc_wrport_we = mac_core_rx_cdc_cdc_graycounter0_ce;
+assign mac_core_rx_cdc_cdc_rdport_adr = mac_core_rx_cdc_cdc_graycounter1_q_next_binary[4:0];
+assign mac_core_rx_cdc_cdc_asyncfifo_dout = mac_core_rx_cdc_cdc_rdport_dat_r;
+always @(*) begin
+    mac_core_rx_cdc_cdc_graycounter0_q_next_binary <= 6'd0;
+    if (mac_core_rx_cdc_cdc_graycounter0_ce) begin
+        mac_core_rx_cdc_cdc_graycounter0_q_next_binary <= (mac_core_rx_cdc_cdc_graycounter0_q_binary + 1'd1);
     end else begin
-        mac_core_cdc_graycounter1_q_next_binary <= mac_core_cdc_graycounter1_q_binary;
+        mac_core_rx_cdc_cdc_graycounter0_q_next_binary <= mac_core_rx_cdc_cdc_graycounter0_q_binary;
     end
 end
-assign mac_core_cdc_graycounter1_q_next = (mac_core_cdc_graycounter1_q_next_binary ^ mac_core_cdc_graycounter1_q_next_binary[5:1]);
+assign mac_core_rx_cdc_cdc_graycounter0_q_next = (mac_core_rx_cdc_cdc_graycounter0_q_next_binary ^ mac_core_rx_cdc_cdc_graycounter0_q_next_binary[5:1]);
+always @(*) begin
+    mac_core_rx_cdc_cdc_graycounter1_q_next_binary <= 6'd0;
+    if (mac_core_rx_cdc_cdc_graycounter1_ce) begin
+        mac_core_rx_cdc_cdc_graycounter1_q_next_binary <= (mac_core_rx_cdc_cdc_graycounter1_q_binary + 1'd1);
+    end else begin
+        mac_core_rx_cdc_cdc_graycounter1_q_next_binary <= mac_core_rx_cdc_cdc_graycounter1_q_binary;
+    end
+end
+assign mac_core_rx_cdc_cdc_graycounter1_q_next = (mac_core_rx_cdc_cdc_graycounter1_q_next_binary ^ mac_core_rx_cdc_cdc_graycounter1_q_next_binary[5:1]);
 assign mac_core_rx_preamble_sink_valid = ethphy_source_valid;
 assign ethphy_source_ready = mac_core_rx_preamble_sink_ready;
 assign mac_core_rx_preamble_sink_first = ethphy_source_first;
@@ -3106,20 +3987,34 @@ assign mac_core_rx_padding_sink_last = mac_core_liteethmaccrc32checker_source_so
 assign mac_core_rx_padding_sink_payload_data = mac_core_liteethmaccrc32checker_source_source_payload_data;
 assign mac_core_rx_padding_sink_payload_last_be = mac_core_liteethmaccrc32checker_source_source_payload_last_be;
 assign mac_core_rx_padding_sink_payload_error = mac_core_liteethmaccrc32checker_source_source_payload_error;
-assign mac_core_sink_sink_valid = mac_core_rx_padding_source_valid;
-assign mac_core_rx_padding_source_ready = mac_core_sink_sink_ready;
-assign mac_core_sink_sink_first = mac_core_rx_padding_source_first;
-assign mac_core_sink_sink_last = mac_core_rx_padding_source_last;
-assign mac_core_sink_sink_payload_data = mac_core_rx_padding_source_payload_data;
-assign mac_core_sink_sink_payload_last_be = mac_core_rx_padding_source_payload_last_be;
-assign mac_core_sink_sink_payload_error = mac_core_rx_padding_source_payload_error;
-assign mac_core_source_valid = mac_core_source_source_valid;
-assign mac_core_source_source_ready = mac_core_source_ready;
-assign mac_core_source_first = mac_core_source_source_first;
-assign mac_core_source_last = mac_core_source_source_last;
-assign mac_core_source_payload_data = mac_core_source_source_payload_data;
-assign mac_core_source_payload_last_be = mac_core_source_source_payload_last_be;
-assign mac_core_source_payload_error = mac_core_source_source_payload_error;
+assign mac_core_rx_last_be_sink_valid = mac_core_rx_padding_source_valid;
+assign mac_core_rx_padding_source_ready = mac_core_rx_last_be_sink_ready;
+assign mac_core_rx_last_be_sink_first = mac_core_rx_padding_source_first;
+assign mac_core_rx_last_be_sink_last = mac_core_rx_padding_source_last;
+assign mac_core_rx_last_be_sink_payload_data = mac_core_rx_padding_source_payload_data;
+assign mac_core_rx_last_be_sink_payload_last_be = mac_core_rx_padding_source_payload_last_be;
+assign mac_core_rx_last_be_sink_payload_error = mac_core_rx_padding_source_payload_error;
+assign mac_core_rx_converter_sink_valid = mac_core_rx_last_be_source_valid;
+assign mac_core_rx_last_be_source_ready = mac_core_rx_converter_sink_ready;
+assign mac_core_rx_converter_sink_first = mac_core_rx_last_be_source_first;
+assign mac_core_rx_converter_sink_last = mac_core_rx_last_be_source_last;
+assign mac_core_rx_converter_sink_payload_data = mac_core_rx_last_be_source_payload_data;
+assign mac_core_rx_converter_sink_payload_last_be = mac_core_rx_last_be_source_payload_last_be;
+assign mac_core_rx_converter_sink_payload_error = mac_core_rx_last_be_source_payload_error;
+assign mac_core_rx_cdc_sink_sink_valid = mac_core_rx_converter_source_valid;
+assign mac_core_rx_converter_source_ready = mac_core_rx_cdc_sink_sink_ready;
+assign mac_core_rx_cdc_sink_sink_first = mac_core_rx_converter_source_first;
+assign mac_core_rx_cdc_sink_sink_last = mac_core_rx_converter_source_last;
+assign mac_core_rx_cdc_sink_sink_payload_data = mac_core_rx_converter_source_payload_data;
+assign mac_core_rx_cdc_sink_sink_payload_last_be = mac_core_rx_converter_source_payload_last_be;
+assign mac_core_rx_cdc_sink_sink_payload_error = mac_core_rx_converter_source_payload_error;
+assign mac_core_source_valid = mac_core_rx_cdc_source_source_valid;
+assign mac_core_rx_cdc_source_source_ready = mac_core_source_ready;
+assign mac_core_source_first = mac_core_rx_cdc_source_source_first;
+assign mac_core_source_last = mac_core_rx_cdc_source_source_last;
+assign mac_core_source_payload_data = mac_core_rx_cdc_source_source_payload_data;
+assign mac_core_source_payload_last_be = mac_core_rx_cdc_source_source_payload_last_be;
+assign mac_core_source_payload_error = mac_core_rx_cdc_source_source_payload_error;
 assign liteethmac_taken = (((1'd0 + arp_mac_port_source_valid) + ip_mac_port_source_valid) != 1'd0);
 assign mac_crossbar_dropped = (((mac_crossbar_sink_valid & mac_crossbar_sink_ready) & mac_crossbar_sink_last) & (~liteethmac_taken));
 always @(*) begin
@@ -3144,10 +4039,10 @@ always @(*) begin
     ip_mac_port_sink_ready <= 1'd0;
     mac_crossbar_source_first <= 1'd0;
     mac_crossbar_source_last <= 1'd0;
-    mac_crossbar_source_payload_data <= 8'd0;
-    mac_crossbar_source_payload_error <= 1'd0;
+    mac_crossbar_source_payload_data <= 32'd0;
+    mac_crossbar_source_payload_error <= 4'd0;
     mac_crossbar_source_payload_ethernet_type <= 16'd0;
-    mac_crossbar_source_payload_last_be <= 1'd0;
+    mac_crossbar_source_payload_last_be <= 4'd0;
     mac_crossbar_source_payload_sender_mac <= 48'd0;
     mac_crossbar_source_payload_target_mac <= 48'd0;
     mac_crossbar_source_valid <= 1'd0;
@@ -3193,19 +4088,19 @@ end
 always @(*) begin
     arp_mac_port_source_first <= 1'd0;
     arp_mac_port_source_last <= 1'd0;
-    arp_mac_port_source_payload_data <= 8'd0;
-    arp_mac_port_source_payload_error <= 1'd0;
+    arp_mac_port_source_payload_data <= 32'd0;
+    arp_mac_port_source_payload_error <= 4'd0;
     arp_mac_port_source_payload_ethernet_type <= 16'd0;
-    arp_mac_port_source_payload_last_be <= 1'd0;
+    arp_mac_port_source_payload_last_be <= 4'd0;
     arp_mac_port_source_payload_sender_mac <= 48'd0;
     arp_mac_port_source_payload_target_mac <= 48'd0;
     arp_mac_port_source_valid <= 1'd0;
     ip_mac_port_source_first <= 1'd0;
     ip_mac_port_source_last <= 1'd0;
-    ip_mac_port_source_payload_data <= 8'd0;
-    ip_mac_port_source_payload_error <= 1'd0;
+    ip_mac_port_source_payload_data <= 32'd0;
+    ip_mac_port_source_payload_error <= 4'd0;
     ip_mac_port_source_payload_ethernet_type <= 16'd0;
-    ip_mac_port_source_payload_last_be <= 1'd0;
+    ip_mac_port_source_payload_last_be <= 4'd0;
     ip_mac_port_source_payload_sender_mac <= 48'd0;
     ip_mac_port_source_payload_target_mac <= 48'd0;
     ip_mac_port_source_valid <= 1'd0;
@@ -3248,8 +4143,7 @@ always @(*) begin
     mac_packetizer_header[95:48] <= {mac_packetizer_sink_payload_sender_mac[7:0], mac_packetizer_sink_payload_sender_mac[15:8], mac_packetizer_sink_payload_sender_mac[23:16], mac_packetizer_sink_payload_sender_mac[31:24], mac_packetizer_sink_payload_sender_mac[39:32], mac_packetizer_sink_payload_sender_mac[47:40]};
     mac_packetizer_header[47:0] <= {mac_packetizer_sink_payload_target_mac[7:0], mac_packetizer_sink_payload_target_mac[15:8], mac_packetizer_sink_payload_target_mac[23:16], mac_packetizer_sink_payload_target_mac[31:24], mac_packetizer_sink_payload_target_mac[39:32], mac_packetizer_sink_payload_target_mac[47:40]};
 end
-assign mac_packetizer_sink_last_be = mac_packetizer_sink_last;
-assign mac_packetizer_new_last_be = {mac_packetizer_sink_last_be};
+assign mac_packetizer_new_last_be = {mac_packetizer_sink_payload_last_be[1], mac_packetizer_sink_payload_last_be[0], mac_packetizer_sink_payload_last_be[3], mac_packetizer_sink_payload_last_be[2]};
 assign mac_packetizer_in_data_copy = (mac_packetizer_is_ongoing0 | mac_packetizer_is_ongoing1);
 always @(*) begin
     mac_packetizer_source_last <= 1'd0;
@@ -3263,9 +4157,9 @@ assign mac_packetizer_source_payload_error = mac_packetizer_sink_payload_error;
 always @(*) begin
     liteethmac_fsm0_next_state0 <= 2'd0;
     liteethmac_fsm1_next_state0 <= 1'd0;
-    mac_packetizer_count_liteethmac_fsm0_next_value0 <= 4'd0;
+    mac_packetizer_count_liteethmac_fsm0_next_value0 <= 2'd0;
     mac_packetizer_count_liteethmac_fsm0_next_value_ce0 <= 1'd0;
-    mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0 <= 1'd0;
+    mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0 <= 4'd0;
     mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value_ce0 <= 1'd0;
     mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value1 <= 1'd0;
     mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value_ce1 <= 1'd0;
@@ -3276,8 +4170,8 @@ always @(*) begin
     mac_packetizer_source_last_a <= 1'd0;
     mac_packetizer_source_last_b <= 1'd0;
     mac_packetizer_source_last_s <= 1'd0;
-    mac_packetizer_source_payload_data <= 8'd0;
-    mac_packetizer_source_payload_last_be <= 1'd0;
+    mac_packetizer_source_payload_data <= 32'd0;
+    mac_packetizer_source_payload_last_be <= 4'd0;
     mac_packetizer_source_valid <= 1'd0;
     mac_packetizer_sr_load <= 1'd0;
     mac_packetizer_sr_shift <= 1'd0;
@@ -3286,12 +4180,12 @@ always @(*) begin
         1'd1: begin
             mac_packetizer_source_valid <= 1'd1;
             mac_packetizer_source_last_a <= 1'd0;
-            mac_packetizer_source_payload_data <= mac_packetizer_sr[111:8];
+            mac_packetizer_source_payload_data <= mac_packetizer_sr[111:32];
             if ((mac_packetizer_source_valid & mac_packetizer_source_ready)) begin
                 mac_packetizer_sr_shift <= 1'd1;
-                if ((mac_packetizer_count == 4'd13)) begin
+                if ((mac_packetizer_count == 2'd2)) begin
                     mac_packetizer_sr_shift <= 1'd0;
-                    liteethmac_fsm0_next_state0 <= 2'd2;
+                    liteethmac_fsm0_next_state0 <= 2'd3;
                     mac_packetizer_count_liteethmac_fsm0_next_value0 <= (mac_packetizer_count + 1'd1);
                     mac_packetizer_count_liteethmac_fsm0_next_value_ce0 <= 1'd1;
                 end else begin
@@ -3313,6 +4207,22 @@ always @(*) begin
             mac_packetizer_is_ongoing0 <= 1'd1;
         end
         2'd3: begin
+            mac_packetizer_source_valid <= (mac_packetizer_sink_valid | mac_packetizer_sink_d_last);
+            mac_packetizer_source_last_a <= (mac_packetizer_sink_last | mac_packetizer_sink_d_last);
+            if (mac_packetizer_fsm_from_idle) begin
+                mac_packetizer_source_payload_data[15:0] <= mac_packetizer_sr[111:64];
+            end else begin
+                mac_packetizer_source_payload_data[15:0] <= mac_packetizer_sink_d_payload_data[31:16];
+            end
+            mac_packetizer_source_payload_data[31:16] <= mac_packetizer_sink_payload_data;
+            if ((mac_packetizer_source_valid & mac_packetizer_source_ready)) begin
+                mac_packetizer_sink_ready <= ((~mac_packetizer_source_last) | mac_packetizer_sink_last);
+                mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value1 <= 1'd0;
+                mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value_ce1 <= 1'd1;
+                if (mac_packetizer_source_last) begin
+                    liteethmac_fsm0_next_state0 <= 1'd0;
+                end
+            end
             mac_packetizer_is_ongoing1 <= 1'd1;
         end
         default: begin
@@ -3323,13 +4233,13 @@ always @(*) begin
                 mac_packetizer_sink_ready <= 1'd0;
                 mac_packetizer_source_valid <= 1'd1;
                 mac_packetizer_source_last_a <= 1'd0;
-                mac_packetizer_source_payload_data <= mac_packetizer_header[7:0];
+                mac_packetizer_source_payload_data <= mac_packetizer_header[31:0];
                 if ((mac_packetizer_source_valid & mac_packetizer_source_ready)) begin
                     mac_packetizer_sr_load <= 1'd1;
                     mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value1 <= 1'd1;
                     mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value_ce1 <= 1'd1;
                     if (1'd0) begin
-                        liteethmac_fsm0_next_state0 <= 2'd2;
+                        liteethmac_fsm0_next_state0 <= 2'd3;
                     end else begin
                         liteethmac_fsm0_next_state0 <= 1'd1;
                     end
@@ -3350,7 +4260,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((mac_packetizer_in_data_copy & mac_packetizer_sink_last) & (mac_packetizer_sink_last_be > mac_packetizer_new_last_be))) begin
+            if (((mac_packetizer_in_data_copy & mac_packetizer_sink_last) & (mac_packetizer_sink_payload_last_be > mac_packetizer_new_last_be))) begin
                 mac_packetizer_source_last_b <= 1'd0;
                 mac_packetizer_source_last_s <= 1'd1;
                 mac_packetizer_source_payload_last_be <= 1'd0;
@@ -3381,8 +4291,7 @@ assign mac_liteethmacdepacketizer_source_payload_ethernet_type = {rhs_slice_prox
 assign mac_liteethmacdepacketizer_source_payload_sender_mac = {rhs_slice_proxy7[7:0], rhs_slice_proxy6[15:8], rhs_slice_proxy5[23:16], rhs_slice_proxy4[31:24], rhs_slice_proxy3[39:32], rhs_slice_proxy2[47:40]};
 assign mac_liteethmacdepacketizer_source_payload_target_mac = {rhs_slice_proxy13[7:0], rhs_slice_proxy12[15:8], rhs_slice_proxy11[23:16], rhs_slice_proxy10[31:24], rhs_slice_proxy9[39:32], rhs_slice_proxy8[47:40]};
 assign mac_liteethmacdepacketizer_source_payload_error = mac_liteethmacdepacketizer_sink_payload_error;
-assign mac_liteethmacdepacketizer_sink_last_be = mac_liteethmacdepacketizer_sink_last;
-assign mac_liteethmacdepacketizer_new_last_be = {mac_liteethmacdepacketizer_sink_last_be};
+assign mac_liteethmacdepacketizer_new_last_be = {mac_liteethmacdepacketizer_sink_payload_last_be[1], mac_liteethmacdepacketizer_sink_payload_last_be[0], mac_liteethmacdepacketizer_sink_payload_last_be[3], mac_liteethmacdepacketizer_sink_payload_last_be[2]};
 assign mac_liteethmacdepacketizer_is_in_copy = (mac_liteethmacdepacketizer_is_ongoing0 | mac_liteethmacdepacketizer_is_ongoing1);
 always @(*) begin
     mac_liteethmacdepacketizer_source_last <= 1'd0;
@@ -3398,9 +4307,9 @@ always @(*) begin
     liteethmac_fsm1_next_state1 <= 1'd0;
     mac_fsm_is_ongoing0 <= 1'd0;
     mac_fsm_is_ongoing1 <= 1'd0;
-    mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= 4'd0;
+    mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= 2'd0;
     mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd0;
-    mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= 1'd0;
+    mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= 4'd0;
     mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd0;
     mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd0;
     mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd0;
@@ -3412,10 +4321,11 @@ always @(*) begin
     mac_liteethmacdepacketizer_source_last_a <= 1'd0;
     mac_liteethmacdepacketizer_source_last_b <= 1'd0;
     mac_liteethmacdepacketizer_source_last_s <= 1'd0;
-    mac_liteethmacdepacketizer_source_payload_data <= 8'd0;
-    mac_liteethmacdepacketizer_source_payload_last_be <= 1'd0;
+    mac_liteethmacdepacketizer_source_payload_data <= 32'd0;
+    mac_liteethmacdepacketizer_source_payload_last_be <= 4'd0;
     mac_liteethmacdepacketizer_source_valid <= 1'd0;
     mac_liteethmacdepacketizer_sr_shift <= 1'd0;
+    mac_liteethmacdepacketizer_sr_shift_leftover <= 1'd0;
     liteethmac_fsm0_next_state1 <= liteethmac_fsm0_state1;
     case (liteethmac_fsm0_state1)
         1'd1: begin
@@ -3424,8 +4334,8 @@ always @(*) begin
                 mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= (mac_liteethmacdepacketizer_count + 1'd1);
                 mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
                 mac_liteethmacdepacketizer_sr_shift <= 1'd1;
-                if ((mac_liteethmacdepacketizer_count == 4'd13)) begin
-                    liteethmac_fsm0_next_state1 <= 2'd2;
+                if ((mac_liteethmacdepacketizer_count == 2'd2)) begin
+                    liteethmac_fsm0_next_state1 <= 2'd3;
                     mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= (mac_liteethmacdepacketizer_count + 1'd1);
                     mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
                 end
@@ -3449,6 +4359,25 @@ always @(*) begin
             mac_liteethmacdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
+            mac_liteethmacdepacketizer_source_valid <= (mac_liteethmacdepacketizer_sink_valid | mac_liteethmacdepacketizer_sink_d_last);
+            mac_liteethmacdepacketizer_source_last_a <= mac_liteethmacdepacketizer_sink_d_last;
+            mac_liteethmacdepacketizer_sink_ready <= (mac_liteethmacdepacketizer_source_ready & (~mac_liteethmacdepacketizer_source_last));
+            mac_liteethmacdepacketizer_source_payload_data <= mac_liteethmacdepacketizer_sink_d_payload_data[31:16];
+            mac_liteethmacdepacketizer_source_payload_data[31:16] <= mac_liteethmacdepacketizer_sink_payload_data;
+            if (mac_liteethmacdepacketizer_fsm_from_idle) begin
+                mac_liteethmacdepacketizer_source_valid <= mac_liteethmacdepacketizer_sink_d_last;
+                mac_liteethmacdepacketizer_sink_ready <= (~mac_liteethmacdepacketizer_sink_d_last);
+                if (mac_liteethmacdepacketizer_sink_valid) begin
+                    mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd0;
+                    mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd1;
+                    mac_liteethmacdepacketizer_sr_shift_leftover <= 1'd1;
+                end
+            end
+            if ((mac_liteethmacdepacketizer_source_valid & mac_liteethmacdepacketizer_source_ready)) begin
+                if (mac_liteethmacdepacketizer_source_last) begin
+                    liteethmac_fsm0_next_state1 <= 1'd0;
+                end
+            end
             mac_liteethmacdepacketizer_is_ongoing1 <= 1'd1;
             mac_liteethmacdepacketizer_is_ongoing3 <= 1'd1;
         end
@@ -3461,7 +4390,7 @@ always @(*) begin
                 mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd1;
                 mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
-                    liteethmac_fsm0_next_state1 <= 2'd2;
+                    liteethmac_fsm0_next_state1 <= 2'd3;
                 end else begin
                     liteethmac_fsm0_next_state1 <= 1'd1;
                 end
@@ -3484,7 +4413,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((mac_liteethmacdepacketizer_sink_valid & mac_liteethmacdepacketizer_sink_last) & (mac_liteethmacdepacketizer_sink_last_be > mac_liteethmacdepacketizer_new_last_be))) begin
+            if (((mac_liteethmacdepacketizer_sink_valid & mac_liteethmacdepacketizer_sink_last) & (mac_liteethmacdepacketizer_sink_payload_last_be > mac_liteethmacdepacketizer_new_last_be))) begin
                 mac_liteethmacdepacketizer_source_last_b <= 1'd0;
                 mac_liteethmacdepacketizer_source_last_s <= 1'd1;
                 mac_liteethmacdepacketizer_source_payload_last_be <= 1'd0;
@@ -3544,11 +4473,11 @@ assign arp_rx_sink_payload_target_mac = arp_mac_port_source_payload_target_mac;
 assign arp_rx_sink_payload_data = arp_mac_port_source_payload_data;
 assign arp_rx_sink_payload_last_be = arp_mac_port_source_payload_last_be;
 assign arp_rx_sink_payload_error = arp_mac_port_source_payload_error;
-assign arp_packetizer_sink_last = (arp_counter == 6'd45);
+assign arp_packetizer_sink_last = (arp_counter == 4'd10);
 always @(*) begin
-    arp_packetizer_sink_payload_last_be <= 1'd0;
+    arp_packetizer_sink_payload_last_be <= 4'd0;
     if (arp_packetizer_sink_last) begin
-        arp_packetizer_sink_payload_last_be <= 1'd1;
+        arp_packetizer_sink_payload_last_be <= 2'd2;
     end
 end
 assign arp_packetizer_sink_param_hwtype = 1'd1;
@@ -3603,8 +4532,7 @@ always @(*) begin
     arp_packetizer_header[223:192] <= {arp_packetizer_sink_param_target_ip[7:0], arp_packetizer_sink_param_target_ip[15:8], arp_packetizer_sink_param_target_ip[23:16], arp_packetizer_sink_param_target_ip[31:24]};
     arp_packetizer_header[191:144] <= {arp_packetizer_sink_param_target_mac[7:0], arp_packetizer_sink_param_target_mac[15:8], arp_packetizer_sink_param_target_mac[23:16], arp_packetizer_sink_param_target_mac[31:24], arp_packetizer_sink_param_target_mac[39:32], arp_packetizer_sink_param_target_mac[47:40]};
 end
-assign arp_packetizer_sink_last_be = arp_packetizer_sink_last;
-assign arp_packetizer_new_last_be = {arp_packetizer_sink_last_be};
+assign arp_packetizer_new_last_be = {arp_packetizer_sink_payload_last_be[3], arp_packetizer_sink_payload_last_be[2], arp_packetizer_sink_payload_last_be[1], arp_packetizer_sink_payload_last_be[0]};
 assign arp_packetizer_in_data_copy = (arp_packetizer_is_ongoing0 | arp_packetizer_is_ongoing1);
 always @(*) begin
     arp_packetizer_source_last <= 1'd0;
@@ -3616,9 +4544,9 @@ always @(*) begin
 end
 assign arp_packetizer_source_payload_error = arp_packetizer_sink_payload_error;
 always @(*) begin
-    arp_packetizer_count_liteetharp_fsm0_next_value0 <= 5'd0;
+    arp_packetizer_count_liteetharp_fsm0_next_value0 <= 3'd0;
     arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd0;
-    arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= 1'd0;
+    arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= 4'd0;
     arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd0;
     arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd0;
     arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd0;
@@ -3629,8 +4557,8 @@ always @(*) begin
     arp_packetizer_source_last_a <= 1'd0;
     arp_packetizer_source_last_b <= 1'd0;
     arp_packetizer_source_last_s <= 1'd0;
-    arp_packetizer_source_payload_data <= 8'd0;
-    arp_packetizer_source_payload_last_be <= 1'd0;
+    arp_packetizer_source_payload_data <= 32'd0;
+    arp_packetizer_source_payload_last_be <= 4'd0;
     arp_packetizer_source_valid <= 1'd0;
     arp_packetizer_sr_load <= 1'd0;
     arp_packetizer_sr_shift <= 1'd0;
@@ -3641,10 +4569,10 @@ always @(*) begin
         1'd1: begin
             arp_packetizer_source_valid <= 1'd1;
             arp_packetizer_source_last_a <= 1'd0;
-            arp_packetizer_source_payload_data <= arp_packetizer_sr[223:8];
+            arp_packetizer_source_payload_data <= arp_packetizer_sr[223:32];
             if ((arp_packetizer_source_valid & arp_packetizer_source_ready)) begin
                 arp_packetizer_sr_shift <= 1'd1;
-                if ((arp_packetizer_count == 5'd27)) begin
+                if ((arp_packetizer_count == 3'd6)) begin
                     arp_packetizer_sr_shift <= 1'd0;
                     liteetharptx_fsm0_next_state <= 2'd2;
                     arp_packetizer_count_liteetharp_fsm0_next_value0 <= (arp_packetizer_count + 1'd1);
@@ -3678,7 +4606,7 @@ always @(*) begin
                 arp_packetizer_sink_ready <= 1'd0;
                 arp_packetizer_source_valid <= 1'd1;
                 arp_packetizer_source_last_a <= 1'd0;
-                arp_packetizer_source_payload_data <= arp_packetizer_header[7:0];
+                arp_packetizer_source_payload_data <= arp_packetizer_header[31:0];
                 if ((arp_packetizer_source_valid & arp_packetizer_source_ready)) begin
                     arp_packetizer_sr_load <= 1'd1;
                     arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd1;
@@ -3705,7 +4633,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((arp_packetizer_in_data_copy & arp_packetizer_sink_last) & (arp_packetizer_sink_last_be > arp_packetizer_new_last_be))) begin
+            if (((arp_packetizer_in_data_copy & arp_packetizer_sink_last) & (arp_packetizer_sink_payload_last_be > arp_packetizer_new_last_be))) begin
                 arp_packetizer_source_last_b <= 1'd0;
                 arp_packetizer_source_last_s <= 1'd1;
                 arp_packetizer_source_payload_last_be <= 1'd0;
@@ -3732,7 +4660,7 @@ always @(*) begin
     endcase
 end
 always @(*) begin
-    arp_counter_liteetharp_next_value <= 6'd0;
+    arp_counter_liteetharp_next_value <= 4'd0;
     arp_counter_liteetharp_next_value_ce <= 1'd0;
     arp_packetizer_sink_valid <= 1'd0;
     arp_packetizer_source_ready <= 1'd0;
@@ -3800,8 +4728,7 @@ assign arp_rx_liteetharpdepacketizer_source_param_sender_mac = {rhs_slice_proxy3
 assign arp_rx_liteetharpdepacketizer_source_param_target_ip = {rhs_slice_proxy35[7:0], rhs_slice_proxy34[15:8], rhs_slice_proxy33[23:16], rhs_slice_proxy32[31:24]};
 assign arp_rx_liteetharpdepacketizer_source_param_target_mac = {rhs_slice_proxy41[7:0], rhs_slice_proxy40[15:8], rhs_slice_proxy39[23:16], rhs_slice_proxy38[31:24], rhs_slice_proxy37[39:32], rhs_slice_proxy36[47:40]};
 assign arp_rx_liteetharpdepacketizer_source_payload_error = arp_rx_liteetharpdepacketizer_sink_payload_error;
-assign arp_rx_liteetharpdepacketizer_sink_last_be = arp_rx_liteetharpdepacketizer_sink_last;
-assign arp_rx_liteetharpdepacketizer_new_last_be = {arp_rx_liteetharpdepacketizer_sink_last_be};
+assign arp_rx_liteetharpdepacketizer_new_last_be = {arp_rx_liteetharpdepacketizer_sink_payload_last_be[3], arp_rx_liteetharpdepacketizer_sink_payload_last_be[2], arp_rx_liteetharpdepacketizer_sink_payload_last_be[1], arp_rx_liteetharpdepacketizer_sink_payload_last_be[0]};
 assign arp_rx_liteetharpdepacketizer_is_in_copy = (arp_rx_liteetharpdepacketizer_is_ongoing0 | arp_rx_liteetharpdepacketizer_is_ongoing1);
 always @(*) begin
     arp_rx_liteetharpdepacketizer_source_last <= 1'd0;
@@ -3815,9 +4742,9 @@ assign arp_rx_cut = ((arp_rx_liteetharpdepacketizer_sink_valid & arp_rx_liteetha
 always @(*) begin
     arp_rx_fsm_is_ongoing0 <= 1'd0;
     arp_rx_fsm_is_ongoing1 <= 1'd0;
-    arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= 5'd0;
+    arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= 3'd0;
     arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd0;
-    arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= 1'd0;
+    arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= 4'd0;
     arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd0;
     arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd0;
     arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd0;
@@ -3829,8 +4756,8 @@ always @(*) begin
     arp_rx_liteetharpdepacketizer_source_last_a <= 1'd0;
     arp_rx_liteetharpdepacketizer_source_last_b <= 1'd0;
     arp_rx_liteetharpdepacketizer_source_last_s <= 1'd0;
-    arp_rx_liteetharpdepacketizer_source_payload_data <= 8'd0;
-    arp_rx_liteetharpdepacketizer_source_payload_last_be <= 1'd0;
+    arp_rx_liteetharpdepacketizer_source_payload_data <= 32'd0;
+    arp_rx_liteetharpdepacketizer_source_payload_last_be <= 4'd0;
     arp_rx_liteetharpdepacketizer_source_valid <= 1'd0;
     arp_rx_liteetharpdepacketizer_sr_shift <= 1'd0;
     liteetharprx_fsm0_next_state <= 2'd0;
@@ -3843,7 +4770,7 @@ always @(*) begin
                 arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= (arp_rx_liteetharpdepacketizer_count + 1'd1);
                 arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
                 arp_rx_liteetharpdepacketizer_sr_shift <= 1'd1;
-                if ((arp_rx_liteetharpdepacketizer_count == 5'd27)) begin
+                if ((arp_rx_liteetharpdepacketizer_count == 3'd6)) begin
                     liteetharprx_fsm0_next_state <= 2'd2;
                     arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= (arp_rx_liteetharpdepacketizer_count + 1'd1);
                     arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
@@ -3903,7 +4830,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((arp_rx_liteetharpdepacketizer_sink_valid & arp_rx_liteetharpdepacketizer_sink_last) & (arp_rx_liteetharpdepacketizer_sink_last_be > arp_rx_liteetharpdepacketizer_new_last_be))) begin
+            if (((arp_rx_liteetharpdepacketizer_sink_valid & arp_rx_liteetharpdepacketizer_sink_last) & (arp_rx_liteetharpdepacketizer_sink_payload_last_be > arp_rx_liteetharpdepacketizer_new_last_be))) begin
                 arp_rx_liteetharpdepacketizer_source_last_b <= 1'd0;
                 arp_rx_liteetharpdepacketizer_source_last_s <= 1'd1;
                 arp_rx_liteetharpdepacketizer_source_payload_last_be <= 1'd0;
@@ -4296,8 +5223,7 @@ always @(*) begin
     ip_tx_packetizer_header[71:64] <= {ip_tx_packetizer_sink_param_ttl[7:0]};
     ip_tx_packetizer_header[7:4] <= {ip_tx_packetizer_sink_param_version[3:0]};
 end
-assign ip_tx_packetizer_sink_last_be = ip_tx_packetizer_sink_last;
-assign ip_tx_packetizer_new_last_be = {ip_tx_packetizer_sink_last_be};
+assign ip_tx_packetizer_new_last_be = {ip_tx_packetizer_sink_payload_last_be[3], ip_tx_packetizer_sink_payload_last_be[2], ip_tx_packetizer_sink_payload_last_be[1], ip_tx_packetizer_sink_payload_last_be[0]};
 assign ip_tx_packetizer_in_data_copy = (ip_tx_packetizer_is_ongoing0 | ip_tx_packetizer_is_ongoing1);
 always @(*) begin
     ip_tx_packetizer_source_last <= 1'd0;
@@ -4309,9 +5235,9 @@ always @(*) begin
 end
 assign ip_tx_packetizer_source_payload_error = ip_tx_packetizer_sink_payload_error;
 always @(*) begin
-    ip_tx_packetizer_count_liteethip_fsm0_next_value0 <= 5'd0;
+    ip_tx_packetizer_count_liteethip_fsm0_next_value0 <= 3'd0;
     ip_tx_packetizer_count_liteethip_fsm0_next_value_ce0 <= 1'd0;
-    ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value0 <= 1'd0;
+    ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value0 <= 4'd0;
     ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value_ce0 <= 1'd0;
     ip_tx_packetizer_fsm_from_idle_liteethip_fsm0_next_value1 <= 1'd0;
     ip_tx_packetizer_fsm_from_idle_liteethip_fsm0_next_value_ce1 <= 1'd0;
@@ -4322,8 +5248,8 @@ always @(*) begin
     ip_tx_packetizer_source_last_a <= 1'd0;
     ip_tx_packetizer_source_last_b <= 1'd0;
     ip_tx_packetizer_source_last_s <= 1'd0;
-    ip_tx_packetizer_source_payload_data <= 8'd0;
-    ip_tx_packetizer_source_payload_last_be <= 1'd0;
+    ip_tx_packetizer_source_payload_data <= 32'd0;
+    ip_tx_packetizer_source_payload_last_be <= 4'd0;
     ip_tx_packetizer_source_valid <= 1'd0;
     ip_tx_packetizer_sr_load <= 1'd0;
     ip_tx_packetizer_sr_shift <= 1'd0;
@@ -4334,10 +5260,10 @@ always @(*) begin
         1'd1: begin
             ip_tx_packetizer_source_valid <= 1'd1;
             ip_tx_packetizer_source_last_a <= 1'd0;
-            ip_tx_packetizer_source_payload_data <= ip_tx_packetizer_sr[159:8];
+            ip_tx_packetizer_source_payload_data <= ip_tx_packetizer_sr[159:32];
             if ((ip_tx_packetizer_source_valid & ip_tx_packetizer_source_ready)) begin
                 ip_tx_packetizer_sr_shift <= 1'd1;
-                if ((ip_tx_packetizer_count == 5'd19)) begin
+                if ((ip_tx_packetizer_count == 3'd4)) begin
                     ip_tx_packetizer_sr_shift <= 1'd0;
                     liteethip_liteethiptx_fsm0_next_state <= 2'd2;
                     ip_tx_packetizer_count_liteethip_fsm0_next_value0 <= (ip_tx_packetizer_count + 1'd1);
@@ -4371,7 +5297,7 @@ always @(*) begin
                 ip_tx_packetizer_sink_ready <= 1'd0;
                 ip_tx_packetizer_source_valid <= 1'd1;
                 ip_tx_packetizer_source_last_a <= 1'd0;
-                ip_tx_packetizer_source_payload_data <= ip_tx_packetizer_header[7:0];
+                ip_tx_packetizer_source_payload_data <= ip_tx_packetizer_header[31:0];
                 if ((ip_tx_packetizer_source_valid & ip_tx_packetizer_source_ready)) begin
                     ip_tx_packetizer_sr_load <= 1'd1;
                     ip_tx_packetizer_fsm_from_idle_liteethip_fsm0_next_value1 <= 1'd1;
@@ -4398,7 +5324,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((ip_tx_packetizer_in_data_copy & ip_tx_packetizer_sink_last) & (ip_tx_packetizer_sink_last_be > ip_tx_packetizer_new_last_be))) begin
+            if (((ip_tx_packetizer_in_data_copy & ip_tx_packetizer_sink_last) & (ip_tx_packetizer_sink_payload_last_be > ip_tx_packetizer_new_last_be))) begin
                 ip_tx_packetizer_source_last_b <= 1'd0;
                 ip_tx_packetizer_source_last_s <= 1'd1;
                 ip_tx_packetizer_source_payload_last_be <= 1'd0;
@@ -4430,10 +5356,10 @@ always @(*) begin
     ip_tx_packetizer_source_ready <= 1'd0;
     ip_tx_source_source_first0 <= 1'd0;
     ip_tx_source_source_last0 <= 1'd0;
-    ip_tx_source_source_payload_data0 <= 8'd0;
-    ip_tx_source_source_payload_error0 <= 1'd0;
+    ip_tx_source_source_payload_data0 <= 32'd0;
+    ip_tx_source_source_payload_error0 <= 4'd0;
     ip_tx_source_source_payload_ethernet_type <= 16'd0;
-    ip_tx_source_source_payload_last_be0 <= 1'd0;
+    ip_tx_source_source_payload_last_be0 <= 4'd0;
     ip_tx_source_source_payload_sender_mac <= 48'd0;
     ip_tx_source_source_payload_target_mac <= 48'd0;
     ip_tx_source_source_valid0 <= 1'd0;
@@ -4542,8 +5468,7 @@ assign ip_rx_liteethipv4depacketizer_source_param_total_length = {rhs_slice_prox
 assign ip_rx_liteethipv4depacketizer_source_param_ttl = {rhs_slice_proxy58[7:0]};
 assign ip_rx_liteethipv4depacketizer_source_param_version = {rhs_slice_proxy59[3:0]};
 assign ip_rx_liteethipv4depacketizer_source_payload_error = ip_rx_liteethipv4depacketizer_sink_payload_error;
-assign ip_rx_liteethipv4depacketizer_sink_last_be = ip_rx_liteethipv4depacketizer_sink_last;
-assign ip_rx_liteethipv4depacketizer_new_last_be = {ip_rx_liteethipv4depacketizer_sink_last_be};
+assign ip_rx_liteethipv4depacketizer_new_last_be = {ip_rx_liteethipv4depacketizer_sink_payload_last_be[3], ip_rx_liteethipv4depacketizer_sink_payload_last_be[2], ip_rx_liteethipv4depacketizer_sink_payload_last_be[1], ip_rx_liteethipv4depacketizer_sink_payload_last_be[0]};
 assign ip_rx_liteethipv4depacketizer_is_in_copy = (ip_rx_liteethipv4depacketizer_is_ongoing0 | ip_rx_liteethipv4depacketizer_is_ongoing1);
 always @(*) begin
     ip_rx_liteethipv4depacketizer_source_last <= 1'd0;
@@ -4557,9 +5482,9 @@ assign ip_rx_cut = ((ip_rx_liteethipv4depacketizer_sink_valid & ip_rx_liteethipv
 always @(*) begin
     ip_rx_fsm_is_ongoing0 <= 1'd0;
     ip_rx_fsm_is_ongoing1 <= 1'd0;
-    ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= 5'd0;
+    ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= 3'd0;
     ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd0;
-    ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= 1'd0;
+    ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= 4'd0;
     ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd0;
     ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd0;
     ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd0;
@@ -4571,8 +5496,8 @@ always @(*) begin
     ip_rx_liteethipv4depacketizer_source_last_a <= 1'd0;
     ip_rx_liteethipv4depacketizer_source_last_b <= 1'd0;
     ip_rx_liteethipv4depacketizer_source_last_s <= 1'd0;
-    ip_rx_liteethipv4depacketizer_source_payload_data <= 8'd0;
-    ip_rx_liteethipv4depacketizer_source_payload_last_be <= 1'd0;
+    ip_rx_liteethipv4depacketizer_source_payload_data <= 32'd0;
+    ip_rx_liteethipv4depacketizer_source_payload_last_be <= 4'd0;
     ip_rx_liteethipv4depacketizer_source_valid <= 1'd0;
     ip_rx_liteethipv4depacketizer_sr_shift <= 1'd0;
     liteethip_checkingiprx_fsm0_next_state <= 2'd0;
@@ -4585,7 +5510,7 @@ always @(*) begin
                 ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= (ip_rx_liteethipv4depacketizer_count + 1'd1);
                 ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
                 ip_rx_liteethipv4depacketizer_sr_shift <= 1'd1;
-                if ((ip_rx_liteethipv4depacketizer_count == 5'd19)) begin
+                if ((ip_rx_liteethipv4depacketizer_count == 3'd4)) begin
                     liteethip_checkingiprx_fsm0_next_state <= 2'd2;
                     ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= (ip_rx_liteethipv4depacketizer_count + 1'd1);
                     ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
@@ -4645,7 +5570,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((ip_rx_liteethipv4depacketizer_sink_valid & ip_rx_liteethipv4depacketizer_sink_last) & (ip_rx_liteethipv4depacketizer_sink_last_be > ip_rx_liteethipv4depacketizer_new_last_be))) begin
+            if (((ip_rx_liteethipv4depacketizer_sink_valid & ip_rx_liteethipv4depacketizer_sink_last) & (ip_rx_liteethipv4depacketizer_sink_payload_last_be > ip_rx_liteethipv4depacketizer_new_last_be))) begin
                 ip_rx_liteethipv4depacketizer_source_last_b <= 1'd0;
                 ip_rx_liteethipv4depacketizer_source_last_s <= 1'd1;
                 ip_rx_liteethipv4depacketizer_source_payload_last_be <= 1'd0;
@@ -4741,9 +5666,9 @@ always @(*) begin
     ip_crossbar_source_param_ip_address <= 32'd0;
     ip_crossbar_source_param_length <= 16'd0;
     ip_crossbar_source_param_protocol <= 8'd0;
-    ip_crossbar_source_payload_data <= 8'd0;
-    ip_crossbar_source_payload_error <= 1'd0;
-    ip_crossbar_source_payload_last_be <= 1'd0;
+    ip_crossbar_source_payload_data <= 32'd0;
+    ip_crossbar_source_payload_error <= 4'd0;
+    ip_crossbar_source_payload_last_be <= 4'd0;
     ip_crossbar_source_valid <= 1'd0;
     ip_port_sink_ready <= 1'd0;
     case (liteethip_grant)
@@ -4791,9 +5716,9 @@ always @(*) begin
     icmp_ip_port_source_param_ip_address <= 32'd0;
     icmp_ip_port_source_param_length <= 16'd0;
     icmp_ip_port_source_param_protocol <= 8'd0;
-    icmp_ip_port_source_payload_data <= 8'd0;
-    icmp_ip_port_source_payload_error <= 1'd0;
-    icmp_ip_port_source_payload_last_be <= 1'd0;
+    icmp_ip_port_source_payload_data <= 32'd0;
+    icmp_ip_port_source_payload_error <= 4'd0;
+    icmp_ip_port_source_payload_last_be <= 4'd0;
     icmp_ip_port_source_valid <= 1'd0;
     ip_crossbar_sink_ready <= 1'd0;
     ip_port_source_first <= 1'd0;
@@ -4801,9 +5726,9 @@ always @(*) begin
     ip_port_source_param_ip_address <= 32'd0;
     ip_port_source_param_length <= 16'd0;
     ip_port_source_param_protocol <= 8'd0;
-    ip_port_source_payload_data <= 8'd0;
-    ip_port_source_payload_error <= 1'd0;
-    ip_port_source_payload_last_be <= 1'd0;
+    ip_port_source_payload_data <= 32'd0;
+    ip_port_source_payload_error <= 4'd0;
+    ip_port_source_payload_last_be <= 4'd0;
     ip_port_source_valid <= 1'd0;
     case (liteethip_sel1)
         1'd1: begin
@@ -4919,8 +5844,7 @@ always @(*) begin
     icmp_tx_packetizer_header[7:0] <= {icmp_tx_packetizer_sink_param_msgtype[7:0]};
     icmp_tx_packetizer_header[63:32] <= {icmp_tx_packetizer_sink_param_quench[7:0], icmp_tx_packetizer_sink_param_quench[15:8], icmp_tx_packetizer_sink_param_quench[23:16], icmp_tx_packetizer_sink_param_quench[31:24]};
 end
-assign icmp_tx_packetizer_sink_last_be = icmp_tx_packetizer_sink_last;
-assign icmp_tx_packetizer_new_last_be = {icmp_tx_packetizer_sink_last_be};
+assign icmp_tx_packetizer_new_last_be = {icmp_tx_packetizer_sink_payload_last_be[3], icmp_tx_packetizer_sink_payload_last_be[2], icmp_tx_packetizer_sink_payload_last_be[1], icmp_tx_packetizer_sink_payload_last_be[0]};
 assign icmp_tx_packetizer_in_data_copy = (icmp_tx_packetizer_is_ongoing0 | icmp_tx_packetizer_is_ongoing1);
 always @(*) begin
     icmp_tx_packetizer_source_last <= 1'd0;
@@ -4932,9 +5856,9 @@ always @(*) begin
 end
 assign icmp_tx_packetizer_source_payload_error = icmp_tx_packetizer_sink_payload_error;
 always @(*) begin
-    icmp_tx_packetizer_count_fsm0_next_value0 <= 3'd0;
+    icmp_tx_packetizer_count_fsm0_next_value0 <= 1'd0;
     icmp_tx_packetizer_count_fsm0_next_value_ce0 <= 1'd0;
-    icmp_tx_packetizer_delayed_last_be_fsm1_next_value0 <= 1'd0;
+    icmp_tx_packetizer_delayed_last_be_fsm1_next_value0 <= 4'd0;
     icmp_tx_packetizer_delayed_last_be_fsm1_next_value_ce0 <= 1'd0;
     icmp_tx_packetizer_fsm_from_idle_fsm0_next_value1 <= 1'd0;
     icmp_tx_packetizer_fsm_from_idle_fsm0_next_value_ce1 <= 1'd0;
@@ -4945,8 +5869,8 @@ always @(*) begin
     icmp_tx_packetizer_source_last_a <= 1'd0;
     icmp_tx_packetizer_source_last_b <= 1'd0;
     icmp_tx_packetizer_source_last_s <= 1'd0;
-    icmp_tx_packetizer_source_payload_data <= 8'd0;
-    icmp_tx_packetizer_source_payload_last_be <= 1'd0;
+    icmp_tx_packetizer_source_payload_data <= 32'd0;
+    icmp_tx_packetizer_source_payload_last_be <= 4'd0;
     icmp_tx_packetizer_source_valid <= 1'd0;
     icmp_tx_packetizer_sr_load <= 1'd0;
     icmp_tx_packetizer_sr_shift <= 1'd0;
@@ -4957,10 +5881,10 @@ always @(*) begin
         1'd1: begin
             icmp_tx_packetizer_source_valid <= 1'd1;
             icmp_tx_packetizer_source_last_a <= 1'd0;
-            icmp_tx_packetizer_source_payload_data <= icmp_tx_packetizer_sr[63:8];
+            icmp_tx_packetizer_source_payload_data <= icmp_tx_packetizer_sr[63:32];
             if ((icmp_tx_packetizer_source_valid & icmp_tx_packetizer_source_ready)) begin
                 icmp_tx_packetizer_sr_shift <= 1'd1;
-                if ((icmp_tx_packetizer_count == 3'd7)) begin
+                if ((icmp_tx_packetizer_count == 1'd1)) begin
                     icmp_tx_packetizer_sr_shift <= 1'd0;
                     liteethicmptx_fsm0_next_state <= 2'd2;
                     icmp_tx_packetizer_count_fsm0_next_value0 <= (icmp_tx_packetizer_count + 1'd1);
@@ -4994,7 +5918,7 @@ always @(*) begin
                 icmp_tx_packetizer_sink_ready <= 1'd0;
                 icmp_tx_packetizer_source_valid <= 1'd1;
                 icmp_tx_packetizer_source_last_a <= 1'd0;
-                icmp_tx_packetizer_source_payload_data <= icmp_tx_packetizer_header[7:0];
+                icmp_tx_packetizer_source_payload_data <= icmp_tx_packetizer_header[31:0];
                 if ((icmp_tx_packetizer_source_valid & icmp_tx_packetizer_source_ready)) begin
                     icmp_tx_packetizer_sr_load <= 1'd1;
                     icmp_tx_packetizer_fsm_from_idle_fsm0_next_value1 <= 1'd1;
@@ -5021,7 +5945,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((icmp_tx_packetizer_in_data_copy & icmp_tx_packetizer_sink_last) & (icmp_tx_packetizer_sink_last_be > icmp_tx_packetizer_new_last_be))) begin
+            if (((icmp_tx_packetizer_in_data_copy & icmp_tx_packetizer_sink_last) & (icmp_tx_packetizer_sink_payload_last_be > icmp_tx_packetizer_new_last_be))) begin
                 icmp_tx_packetizer_source_last_b <= 1'd0;
                 icmp_tx_packetizer_source_last_s <= 1'd1;
                 icmp_tx_packetizer_source_payload_last_be <= 1'd0;
@@ -5093,8 +6017,7 @@ assign icmp_rx_liteethicmpdepacketizer_source_param_code = {rhs_slice_proxy62[7:
 assign icmp_rx_liteethicmpdepacketizer_source_param_msgtype = {rhs_slice_proxy63[7:0]};
 assign icmp_rx_liteethicmpdepacketizer_source_param_quench = {rhs_slice_proxy67[7:0], rhs_slice_proxy66[15:8], rhs_slice_proxy65[23:16], rhs_slice_proxy64[31:24]};
 assign icmp_rx_liteethicmpdepacketizer_source_payload_error = icmp_rx_liteethicmpdepacketizer_sink_payload_error;
-assign icmp_rx_liteethicmpdepacketizer_sink_last_be = icmp_rx_liteethicmpdepacketizer_sink_last;
-assign icmp_rx_liteethicmpdepacketizer_new_last_be = {icmp_rx_liteethicmpdepacketizer_sink_last_be};
+assign icmp_rx_liteethicmpdepacketizer_new_last_be = {icmp_rx_liteethicmpdepacketizer_sink_payload_last_be[3], icmp_rx_liteethicmpdepacketizer_sink_payload_last_be[2], icmp_rx_liteethicmpdepacketizer_sink_payload_last_be[1], icmp_rx_liteethicmpdepacketizer_sink_payload_last_be[0]};
 assign icmp_rx_liteethicmpdepacketizer_is_in_copy = (icmp_rx_liteethicmpdepacketizer_is_ongoing0 | icmp_rx_liteethicmpdepacketizer_is_ongoing1);
 always @(*) begin
     icmp_rx_liteethicmpdepacketizer_source_last <= 1'd0;
@@ -5108,9 +6031,9 @@ assign icmp_rx_cut = ((icmp_rx_liteethicmpdepacketizer_sink_valid & icmp_rx_lite
 always @(*) begin
     icmp_rx_fsm_is_ongoing0 <= 1'd0;
     icmp_rx_fsm_is_ongoing1 <= 1'd0;
-    icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= 3'd0;
+    icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= 1'd0;
     icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd0;
-    icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 <= 4'd0;
     icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd0;
     icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd0;
     icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd0;
@@ -5122,8 +6045,8 @@ always @(*) begin
     icmp_rx_liteethicmpdepacketizer_source_last_a <= 1'd0;
     icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd0;
     icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd0;
-    icmp_rx_liteethicmpdepacketizer_source_payload_data <= 8'd0;
-    icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 1'd0;
+    icmp_rx_liteethicmpdepacketizer_source_payload_data <= 32'd0;
+    icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 4'd0;
     icmp_rx_liteethicmpdepacketizer_source_valid <= 1'd0;
     icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd0;
     liteethicmprx_fsm0_next_state <= 2'd0;
@@ -5136,7 +6059,7 @@ always @(*) begin
                 icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= (icmp_rx_liteethicmpdepacketizer_count + 1'd1);
                 icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
                 icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd1;
-                if ((icmp_rx_liteethicmpdepacketizer_count == 3'd7)) begin
+                if ((icmp_rx_liteethicmpdepacketizer_count == 1'd1)) begin
                     liteethicmprx_fsm0_next_state <= 2'd2;
                     icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= (icmp_rx_liteethicmpdepacketizer_count + 1'd1);
                     icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
@@ -5196,7 +6119,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((icmp_rx_liteethicmpdepacketizer_sink_valid & icmp_rx_liteethicmpdepacketizer_sink_last) & (icmp_rx_liteethicmpdepacketizer_sink_last_be > icmp_rx_liteethicmpdepacketizer_new_last_be))) begin
+            if (((icmp_rx_liteethicmpdepacketizer_sink_valid & icmp_rx_liteethicmpdepacketizer_sink_last) & (icmp_rx_liteethicmpdepacketizer_sink_payload_last_be > icmp_rx_liteethicmpdepacketizer_new_last_be))) begin
                 icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd0;
                 icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd1;
                 icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 1'd0;
@@ -5263,9 +6186,9 @@ always @(*) begin
     icmp_echo_sink_sink_param_length <= 16'd0;
     icmp_echo_sink_sink_param_msgtype <= 8'd0;
     icmp_echo_sink_sink_param_quench <= 32'd0;
-    icmp_echo_sink_sink_payload_data <= 8'd0;
-    icmp_echo_sink_sink_payload_error <= 1'd0;
-    icmp_echo_sink_sink_payload_last_be <= 1'd0;
+    icmp_echo_sink_sink_payload_data <= 32'd0;
+    icmp_echo_sink_sink_payload_error <= 4'd0;
+    icmp_echo_sink_sink_payload_last_be <= 4'd0;
     icmp_echo_sink_sink_valid <= 1'd0;
     if ((icmp_echo_sink_param_length <= 8'd128)) begin
         icmp_echo_sink_sink_valid <= icmp_echo_sink_valid;
@@ -5352,7 +6275,7 @@ assign icmp_echo_payload_fifo_re = icmp_echo_payload_fifo_source_ready;
 assign icmp_echo_payload_fifo_syncfifo_re = (icmp_echo_payload_fifo_syncfifo_readable & ((~icmp_echo_payload_fifo_readable) | icmp_echo_payload_fifo_re));
 assign icmp_echo_payload_fifo_level1 = (icmp_echo_payload_fifo_level0 + icmp_echo_payload_fifo_readable);
 always @(*) begin
-    icmp_echo_payload_fifo_wrport_adr <= 7'd0;
+    icmp_echo_payload_fifo_wrport_adr <= 5'd0;
     if (icmp_echo_payload_fifo_replace) begin
         icmp_echo_payload_fifo_wrport_adr <= (icmp_echo_payload_fifo_produce - 1'd1);
     end else begin
@@ -5365,7 +6288,7 @@ assign icmp_echo_payload_fifo_do_read = (icmp_echo_payload_fifo_syncfifo_readabl
 assign icmp_echo_payload_fifo_rdport_adr = icmp_echo_payload_fifo_consume;
 assign icmp_echo_payload_fifo_syncfifo_dout = icmp_echo_payload_fifo_rdport_dat_r;
 assign icmp_echo_payload_fifo_rdport_re = icmp_echo_payload_fifo_do_read;
-assign icmp_echo_payload_fifo_syncfifo_writable = (icmp_echo_payload_fifo_level0 != 8'd128);
+assign icmp_echo_payload_fifo_syncfifo_writable = (icmp_echo_payload_fifo_level0 != 6'd32);
 assign icmp_echo_payload_fifo_syncfifo_readable = (icmp_echo_payload_fifo_level0 != 1'd0);
 assign icmp_echo_param_fifo_syncfifo_din = {icmp_echo_param_fifo_fifo_in_last, icmp_echo_param_fifo_fifo_in_first, icmp_echo_param_fifo_fifo_in_param_length, icmp_echo_param_fifo_fifo_in_param_ip_address, icmp_echo_param_fifo_fifo_in_param_quench, icmp_echo_param_fifo_fifo_in_param_msgtype, icmp_echo_param_fifo_fifo_in_param_code, icmp_echo_param_fifo_fifo_in_param_checksum};
 assign {icmp_echo_param_fifo_fifo_out_last, icmp_echo_param_fifo_fifo_out_first, icmp_echo_param_fifo_fifo_out_param_length, icmp_echo_param_fifo_fifo_out_param_ip_address, icmp_echo_param_fifo_fifo_out_param_quench, icmp_echo_param_fifo_fifo_out_param_msgtype, icmp_echo_param_fifo_fifo_out_param_code, icmp_echo_param_fifo_fifo_out_param_checksum} = icmp_echo_param_fifo_syncfifo_dout;
@@ -5407,229 +6330,287 @@ assign icmp_echo_param_fifo_syncfifo_dout = icmp_echo_param_fifo_rdport_dat_r;
 assign icmp_echo_param_fifo_rdport_re = icmp_echo_param_fifo_do_read;
 assign icmp_echo_param_fifo_syncfifo_writable = (icmp_echo_param_fifo_level0 != 2'd2);
 assign icmp_echo_param_fifo_syncfifo_readable = (icmp_echo_param_fifo_level0 != 1'd0);
-assign ip_port_sink_valid = source_source_valid;
-assign source_source_ready = ip_port_sink_ready;
-assign ip_port_sink_first = source_source_first;
-assign ip_port_sink_last = source_source_last;
-assign ip_port_sink_payload_data = source_source_payload_data;
-assign ip_port_sink_payload_last_be = source_source_payload_last_be;
-assign ip_port_sink_payload_error = source_source_payload_error;
-assign ip_port_sink_param_length = source_source_param_length;
-assign ip_port_sink_param_protocol = source_source_param_protocol;
-assign ip_port_sink_param_ip_address = source_source_param_ip_address;
-assign holdingudprx_sink_valid = ip_port_source_valid;
-assign ip_port_source_ready = holdingudprx_sink_ready;
-assign holdingudprx_sink_first = ip_port_source_first;
-assign holdingudprx_sink_last = ip_port_source_last;
-assign holdingudprx_sink_payload_data = ip_port_source_payload_data;
-assign holdingudprx_sink_payload_last_be = ip_port_source_payload_last_be;
-assign holdingudprx_sink_payload_error = ip_port_source_payload_error;
-assign holdingudprx_sink_param_length = ip_port_source_param_length;
-assign holdingudprx_sink_param_protocol = ip_port_source_param_protocol;
-assign holdingudprx_sink_param_ip_address = ip_port_source_param_ip_address;
-assign sink_sink_valid = crossbar_source_valid;
-assign crossbar_source_ready = sink_sink_ready;
-assign sink_sink_first = crossbar_source_first;
-assign sink_sink_last = crossbar_source_last;
-assign sink_sink_payload_data = crossbar_source_payload_data;
-assign sink_sink_payload_last_be = crossbar_source_payload_last_be;
-assign sink_sink_payload_error = crossbar_source_payload_error;
-assign sink_sink_param_src_port = crossbar_source_param_src_port;
-assign sink_sink_param_dst_port = crossbar_source_param_dst_port;
-assign sink_sink_param_ip_address = crossbar_source_param_ip_address;
-assign sink_sink_param_length = crossbar_source_param_length;
-assign crossbar_sink_valid = holdingudprx_source_valid;
-assign holdingudprx_source_ready = crossbar_sink_ready;
-assign crossbar_sink_first = holdingudprx_source_first;
-assign crossbar_sink_last = holdingudprx_source_last;
-assign crossbar_sink_payload_data = holdingudprx_source_payload_data;
-assign crossbar_sink_payload_last_be = holdingudprx_source_payload_last_be;
-assign crossbar_sink_payload_error = holdingudprx_source_payload_error;
-assign crossbar_sink_param_src_port = holdingudprx_source_param_src_port;
-assign crossbar_sink_param_dst_port = holdingudprx_source_param_dst_port;
-assign crossbar_sink_param_ip_address = holdingudprx_source_param_ip_address;
-assign crossbar_sink_param_length = holdingudprx_source_param_length;
-assign packetizer_sink_valid = sink_sink_valid;
-assign sink_sink_ready = packetizer_sink_ready;
-assign packetizer_sink_last = sink_sink_last;
-assign packetizer_sink_payload_data = sink_sink_payload_data;
-assign packetizer_sink_payload_last_be = sink_sink_payload_last_be;
-assign packetizer_sink_param_src_port = sink_sink_param_src_port;
-assign packetizer_sink_param_dst_port = sink_sink_param_dst_port;
-assign packetizer_sink_param_length = (sink_sink_param_length + 4'd8);
-assign packetizer_sink_param_checksum = 1'd0;
+assign rx_cdc_sink_sink_valid = ip_port_source_valid;
+assign ip_port_source_ready = rx_cdc_sink_sink_ready;
+assign rx_cdc_sink_sink_first = ip_port_source_first;
+assign rx_cdc_sink_sink_last = ip_port_source_last;
+assign rx_cdc_sink_sink_payload_data = ip_port_source_payload_data;
+assign rx_cdc_sink_sink_payload_last_be = ip_port_source_payload_last_be;
+assign rx_cdc_sink_sink_payload_error = ip_port_source_payload_error;
+assign rx_cdc_sink_sink_param_length = ip_port_source_param_length;
+assign rx_cdc_sink_sink_param_protocol = ip_port_source_param_protocol;
+assign rx_cdc_sink_sink_param_ip_address = ip_port_source_param_ip_address;
+assign strideconverter0_sink_valid = rx_cdc_source_source_valid;
+assign rx_cdc_source_source_ready = strideconverter0_sink_ready;
+assign strideconverter0_sink_first = rx_cdc_source_source_first;
+assign strideconverter0_sink_last = rx_cdc_source_source_last;
+assign strideconverter0_sink_payload_data = rx_cdc_source_source_payload_data;
+assign strideconverter0_sink_payload_last_be = rx_cdc_source_source_payload_last_be;
+assign strideconverter0_sink_payload_error = rx_cdc_source_source_payload_error;
+assign strideconverter0_sink_param_length = rx_cdc_source_source_param_length;
+assign strideconverter0_sink_param_protocol = rx_cdc_source_source_param_protocol;
+assign strideconverter0_sink_param_ip_address = rx_cdc_source_source_param_ip_address;
+assign lastbytetrim_sink_valid = strideconverter0_source_valid;
+assign strideconverter0_source_ready = lastbytetrim_sink_ready;
+assign lastbytetrim_sink_first = strideconverter0_source_first;
+assign lastbytetrim_sink_last = strideconverter0_source_last;
+assign lastbytetrim_sink_payload_data = strideconverter0_source_payload_data;
+assign lastbytetrim_sink_payload_last_be = strideconverter0_source_payload_last_be;
+assign lastbytetrim_sink_payload_error = strideconverter0_source_payload_error;
+assign lastbytetrim_sink_param_length = strideconverter0_source_param_length;
+assign lastbytetrim_sink_param_protocol = strideconverter0_source_param_protocol;
+assign lastbytetrim_sink_param_ip_address = strideconverter0_source_param_ip_address;
+assign buffer0_sink_sink_valid = lastbytetrim_source_valid;
+assign lastbytetrim_source_ready = buffer0_sink_sink_ready;
+assign buffer0_sink_sink_first = lastbytetrim_source_first;
+assign buffer0_sink_sink_last = lastbytetrim_source_last;
+assign buffer0_sink_sink_payload_data = lastbytetrim_source_payload_data;
+assign buffer0_sink_sink_payload_last_be = lastbytetrim_source_payload_last_be;
+assign buffer0_sink_sink_payload_error = lastbytetrim_source_payload_error;
+assign buffer0_sink_sink_param_length = lastbytetrim_source_param_length;
+assign buffer0_sink_sink_param_protocol = lastbytetrim_source_param_protocol;
+assign buffer0_sink_sink_param_ip_address = lastbytetrim_source_param_ip_address;
+assign holdingudprx_sink_valid = buffer0_source_source_valid;
+assign buffer0_source_source_ready = holdingudprx_sink_ready;
+assign holdingudprx_sink_first = buffer0_source_source_first;
+assign holdingudprx_sink_last = buffer0_source_source_last;
+assign holdingudprx_sink_payload_data = buffer0_source_source_payload_data;
+assign holdingudprx_sink_payload_last_be = buffer0_source_source_payload_last_be;
+assign holdingudprx_sink_payload_error = buffer0_source_source_payload_error;
+assign holdingudprx_sink_param_length = buffer0_source_source_param_length;
+assign holdingudprx_sink_param_protocol = buffer0_source_source_param_protocol;
+assign holdingudprx_sink_param_ip_address = buffer0_source_source_param_ip_address;
+assign maskedudpcrossbar_sink_valid = holdingudprx_source_valid;
+assign holdingudprx_source_ready = maskedudpcrossbar_sink_ready;
+assign maskedudpcrossbar_sink_first = holdingudprx_source_first;
+assign maskedudpcrossbar_sink_last = holdingudprx_source_last;
+assign maskedudpcrossbar_sink_payload_data = holdingudprx_source_payload_data;
+assign maskedudpcrossbar_sink_payload_last_be = holdingudprx_source_payload_last_be;
+assign maskedudpcrossbar_sink_payload_error = holdingudprx_source_payload_error;
+assign maskedudpcrossbar_sink_param_src_port = holdingudprx_source_param_src_port;
+assign maskedudpcrossbar_sink_param_dst_port = holdingudprx_source_param_dst_port;
+assign maskedudpcrossbar_sink_param_ip_address = holdingudprx_source_param_ip_address;
+assign maskedudpcrossbar_sink_param_length = holdingudprx_source_param_length;
+assign liteethudptx_sink_sink_valid = maskedudpcrossbar_source_valid;
+assign maskedudpcrossbar_source_ready = liteethudptx_sink_sink_ready;
+assign liteethudptx_sink_sink_first = maskedudpcrossbar_source_first;
+assign liteethudptx_sink_sink_last = maskedudpcrossbar_source_last;
+assign liteethudptx_sink_sink_payload_data = maskedudpcrossbar_source_payload_data;
+assign liteethudptx_sink_sink_payload_last_be = maskedudpcrossbar_source_payload_last_be;
+assign liteethudptx_sink_sink_payload_error = maskedudpcrossbar_source_payload_error;
+assign liteethudptx_sink_sink_param_src_port = maskedudpcrossbar_source_param_src_port;
+assign liteethudptx_sink_sink_param_dst_port = maskedudpcrossbar_source_param_dst_port;
+assign liteethudptx_sink_sink_param_ip_address = maskedudpcrossbar_source_param_ip_address;
+assign liteethudptx_sink_sink_param_length = maskedudpcrossbar_source_param_length;
+assign buffer1_sink_sink_valid = liteethudptx_source_source_valid;
+assign liteethudptx_source_source_ready = buffer1_sink_sink_ready;
+assign buffer1_sink_sink_first = liteethudptx_source_source_first;
+assign buffer1_sink_sink_last = liteethudptx_source_source_last;
+assign buffer1_sink_sink_payload_data = liteethudptx_source_source_payload_data;
+assign buffer1_sink_sink_payload_last_be = liteethudptx_source_source_payload_last_be;
+assign buffer1_sink_sink_payload_error = liteethudptx_source_source_payload_error;
+assign buffer1_sink_sink_param_length = liteethudptx_source_source_param_length;
+assign buffer1_sink_sink_param_protocol = liteethudptx_source_source_param_protocol;
+assign buffer1_sink_sink_param_ip_address = liteethudptx_source_source_param_ip_address;
+assign strideconverter1_sink_valid = buffer1_source_source_valid;
+assign buffer1_source_source_ready = strideconverter1_sink_ready;
+assign strideconverter1_sink_first = buffer1_source_source_first;
+assign strideconverter1_sink_last = buffer1_source_source_last;
+assign strideconverter1_sink_payload_data = buffer1_source_source_payload_data;
+assign strideconverter1_sink_payload_last_be = buffer1_source_source_payload_last_be;
+assign strideconverter1_sink_payload_error = buffer1_source_source_payload_error;
+assign strideconverter1_sink_param_length = buffer1_source_source_param_length;
+assign strideconverter1_sink_param_protocol = buffer1_source_source_param_protocol;
+assign strideconverter1_sink_param_ip_address = buffer1_source_source_param_ip_address;
+assign tx_cdc_sink_sink_valid = strideconverter1_source_valid;
+assign strideconverter1_source_ready = tx_cdc_sink_sink_ready;
+assign tx_cdc_sink_sink_first = strideconverter1_source_first;
+assign tx_cdc_sink_sink_last = strideconverter1_source_last;
+assign tx_cdc_sink_sink_payload_data = strideconverter1_source_payload_data;
+assign tx_cdc_sink_sink_payload_last_be = strideconverter1_source_payload_last_be;
+assign tx_cdc_sink_sink_payload_error = strideconverter1_source_payload_error;
+assign tx_cdc_sink_sink_param_length = strideconverter1_source_param_length;
+assign tx_cdc_sink_sink_param_protocol = strideconverter1_source_param_protocol;
+assign tx_cdc_sink_sink_param_ip_address = strideconverter1_source_param_ip_address;
+assign ip_port_sink_valid = tx_cdc_source_source_valid;
+assign tx_cdc_source_source_ready = ip_port_sink_ready;
+assign ip_port_sink_first = tx_cdc_source_source_first;
+assign ip_port_sink_last = tx_cdc_source_source_last;
+assign ip_port_sink_payload_data = tx_cdc_source_source_payload_data;
+assign ip_port_sink_payload_last_be = tx_cdc_source_source_payload_last_be;
+assign ip_port_sink_payload_error = tx_cdc_source_source_payload_error;
+assign ip_port_sink_param_length = tx_cdc_source_source_param_length;
+assign ip_port_sink_param_protocol = tx_cdc_source_source_param_protocol;
+assign ip_port_sink_param_ip_address = tx_cdc_source_source_param_ip_address;
+assign rx_cdc_cdc_sink_valid = rx_cdc_sink_sink_valid;
+assign rx_cdc_sink_sink_ready = rx_cdc_cdc_sink_ready;
+assign rx_cdc_cdc_sink_first = rx_cdc_sink_sink_first;
+assign rx_cdc_cdc_sink_last = rx_cdc_sink_sink_last;
+assign rx_cdc_cdc_sink_payload_data = rx_cdc_sink_sink_payload_data;
+assign rx_cdc_cdc_sink_payload_last_be = rx_cdc_sink_sink_payload_last_be;
+assign rx_cdc_cdc_sink_payload_error = rx_cdc_sink_sink_payload_error;
+assign rx_cdc_cdc_sink_param_length = rx_cdc_sink_sink_param_length;
+assign rx_cdc_cdc_sink_param_protocol = rx_cdc_sink_sink_param_protocol;
+assign rx_cdc_cdc_sink_param_ip_address = rx_cdc_sink_sink_param_ip_address;
+assign rx_cdc_source_source_valid = rx_cdc_cdc_source_valid;
+assign rx_cdc_cdc_source_ready = rx_cdc_source_source_ready;
+assign rx_cdc_source_source_first = rx_cdc_cdc_source_first;
+assign rx_cdc_source_source_last = rx_cdc_cdc_source_last;
+assign rx_cdc_source_source_payload_data = rx_cdc_cdc_source_payload_data;
+assign rx_cdc_source_source_payload_last_be = rx_cdc_cdc_source_payload_last_be;
+assign rx_cdc_source_source_payload_error = rx_cdc_cdc_source_payload_error;
+assign rx_cdc_source_source_param_length = rx_cdc_cdc_source_param_length;
+assign rx_cdc_source_source_param_protocol = rx_cdc_cdc_source_param_protocol;
+assign rx_cdc_source_source_param_ip_address = rx_cdc_cdc_source_param_ip_address;
+assign rx_cdc_cdc_asyncfifo_din = {rx_cdc_cdc_fifo_in_last, rx_cdc_cdc_fifo_in_first, rx_cdc_cdc_fifo_in_param_ip_address, rx_cdc_cdc_fifo_in_param_protocol, rx_cdc_cdc_fifo_in_param_length, rx_cdc_cdc_fifo_in_payload_error, rx_cdc_cdc_fifo_in_payload_last_be, rx_cdc_cdc_fifo_in_payload_data};
+assign {rx_cdc_cdc_fifo_out_last, rx_cdc_cdc_fifo_out_first, rx_cdc_cdc_fifo_out_param_ip_address, rx_cdc_cdc_fifo_out_param_protocol, rx_cdc_cdc_fifo_out_param_length, rx_cdc_cdc_fifo_out_payload_error, rx_cdc_cdc_fifo_out_payload_last_be, rx_cdc_cdc_fifo_out_payload_data} = rx_cdc_cdc_asyncfifo_dout;
+assign rx_cdc_cdc_sink_ready = rx_cdc_cdc_asyncfifo_writable;
+assign rx_cdc_cdc_asyncfifo_we = rx_cdc_cdc_sink_valid;
+assign rx_cdc_cdc_fifo_in_first = rx_cdc_cdc_sink_first;
+assign rx_cdc_cdc_fifo_in_last = rx_cdc_cdc_sink_last;
+assign rx_cdc_cdc_fifo_in_payload_data = rx_cdc_cdc_sink_payload_data;
+assign rx_cdc_cdc_fifo_in_payload_last_be = rx_cdc_cdc_sink_payload_last_be;
+assign rx_cdc_cdc_fifo_in_payload_error = rx_cdc_cdc_sink_payload_error;
+assign rx_cdc_cdc_fifo_in_param_length = rx_cdc_cdc_sink_param_length;
+assign rx_cdc_cdc_fifo_in_param_protocol = rx_cdc_cdc_sink_param_protocol;
+assign rx_cdc_cdc_fifo_in_param_ip_address = rx_cdc_cdc_sink_param_ip_address;
+assign rx_cdc_cdc_source_valid = rx_cdc_cdc_asyncfifo_readable;
+assign rx_cdc_cdc_source_first = rx_cdc_cdc_fifo_out_first;
+assign rx_cdc_cdc_source_last = rx_cdc_cdc_fifo_out_last;
+assign rx_cdc_cdc_source_payload_data = rx_cdc_cdc_fifo_out_payload_data;
+assign rx_cdc_cdc_source_payload_last_be = rx_cdc_cdc_fifo_out_payload_last_be;
+assign rx_cdc_cdc_source_payload_error = rx_cdc_cdc_fifo_out_payload_error;
+assign rx_cdc_cdc_source_param_length = rx_cdc_cdc_fifo_out_param_length;
+assign rx_cdc_cdc_source_param_protocol = rx_cdc_cdc_fifo_out_param_protocol;
+assign rx_cdc_cdc_source_param_ip_address = rx_cdc_cdc_fifo_out_param_ip_address;
+assign rx_cdc_cdc_asyncfifo_re = rx_cdc_cdc_source_ready;
+assign rx_cdc_cdc_graycounter0_ce = (rx_cdc_cdc_asyncfifo_writable & rx_cdc_cdc_asyncfifo_we);
+assign rx_cdc_cdc_graycounter1_ce = (rx_cdc_cdc_asyncfifo_readable & rx_cdc_cdc_asyncfifo_re);
+assign rx_cdc_cdc_asyncfifo_writable = (((rx_cdc_cdc_graycounter0_q[4] == rx_cdc_cdc_consume_wdomain[4]) | (rx_cdc_cdc_graycounter0_q[3] == rx_cdc_cdc_consume_wdomain[3])) | (rx_cdc_cdc_graycounter0_q[2:0] != rx_cdc_cdc_consume_wdomain[2:0]));
+assign rx_cdc_cdc_asyncfifo_readable = (rx_cdc_cdc_graycounter1_q != rx_cdc_cdc_produce_rdomain);
+assign rx_cdc_cdc_wrport_adr = rx_cdc_cdc_graycounter0_q_binary[3:0];
+assign rx_cdc_cdc_wrport_dat_w = rx_cdc_cdc_asyncfifo_din;
+assign rx_cdc_cdc_wrport_we = rx_cdc_cdc_graycounter0_ce;
+assign rx_cdc_cdc_rdport_adr = rx_cdc_cdc_graycounter1_q_next_binary[3:0];
+assign rx_cdc_cdc_asyncfifo_dout = rx_cdc_cdc_rdport_dat_r;
 always @(*) begin
-    packetizer_header <= 64'd0;
-    packetizer_header[63:48] <= {packetizer_sink_param_checksum[7:0], packetizer_sink_param_checksum[15:8]};
-    packetizer_header[31:16] <= {packetizer_sink_param_dst_port[7:0], packetizer_sink_param_dst_port[15:8]};
-    packetizer_header[47:32] <= {packetizer_sink_param_length[7:0], packetizer_sink_param_length[15:8]};
-    packetizer_header[15:0] <= {packetizer_sink_param_src_port[7:0], packetizer_sink_param_src_port[15:8]};
-end
-assign packetizer_sink_last_be = packetizer_sink_last;
-assign packetizer_new_last_be = {packetizer_sink_last_be};
-assign packetizer_in_data_copy = (packetizer_is_ongoing0 | packetizer_is_ongoing1);
-always @(*) begin
-    packetizer_source_last <= 1'd0;
-    if (packetizer_source_last_s) begin
-        packetizer_source_last <= packetizer_source_last_b;
+    rx_cdc_cdc_graycounter0_q_next_binary <= 5'd0;
+    if (rx_cdc_cdc_graycounter0_ce) begin
+        rx_cdc_cdc_graycounter0_q_next_binary <= (rx_cdc_cdc_graycounter0_q_binary + 1'd1);
     end else begin
-        packetizer_source_last <= packetizer_source_last_a;
+        rx_cdc_cdc_graycounter0_q_next_binary <= rx_cdc_cdc_graycounter0_q_binary;
     end
 end
-assign packetizer_source_payload_error = packetizer_sink_payload_error;
+assign rx_cdc_cdc_graycounter0_q_next = (rx_cdc_cdc_graycounter0_q_next_binary ^ rx_cdc_cdc_graycounter0_q_next_binary[4:1]);
 always @(*) begin
-    liteethudp_liteethudptx_fsm0_next_state <= 2'd0;
-    liteethudp_liteethudptx_fsm1_next_state <= 1'd0;
-    packetizer_count_liteethudp_fsm0_next_value0 <= 3'd0;
-    packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd0;
-    packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= 1'd0;
-    packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd0;
-    packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd0;
-    packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd0;
-    packetizer_is_ongoing0 <= 1'd0;
-    packetizer_is_ongoing1 <= 1'd0;
-    packetizer_is_ongoing2 <= 1'd0;
-    packetizer_sink_ready <= 1'd0;
-    packetizer_source_last_a <= 1'd0;
-    packetizer_source_last_b <= 1'd0;
-    packetizer_source_last_s <= 1'd0;
-    packetizer_source_payload_data <= 8'd0;
-    packetizer_source_payload_last_be <= 1'd0;
-    packetizer_source_valid <= 1'd0;
-    packetizer_sr_load <= 1'd0;
-    packetizer_sr_shift <= 1'd0;
-    liteethudp_liteethudptx_fsm0_next_state <= liteethudp_liteethudptx_fsm0_state;
-    case (liteethudp_liteethudptx_fsm0_state)
+    rx_cdc_cdc_graycounter1_q_next_binary <= 5'd0;
+    if (rx_cdc_cdc_graycounter1_ce) begin
+        rx_cdc_cdc_graycounter1_q_next_binary <= (rx_cdc_cdc_graycounter1_q_binary + 1'd1);
+    end else begin
+        rx_cdc_cdc_graycounter1_q_next_binary <= rx_cdc_cdc_graycounter1_q_binary;
+    end
+end
+assign rx_cdc_cdc_graycounter1_q_next = (rx_cdc_cdc_graycounter1_q_next_binary ^ rx_cdc_cdc_graycounter1_q_next_binary[4:1]);
+assign strideconverter0_converter_sink_valid = strideconverter0_sink_valid;
+assign strideconverter0_converter_sink_first = strideconverter0_sink_first;
+assign strideconverter0_converter_sink_last = strideconverter0_sink_last;
+assign strideconverter0_sink_ready = strideconverter0_converter_sink_ready;
+always @(*) begin
+    strideconverter0_converter_sink_payload_data <= 40'd0;
+    strideconverter0_converter_sink_payload_data[7:0] <= strideconverter0_sink_payload_data[7:0];
+    strideconverter0_converter_sink_payload_data[8] <= strideconverter0_sink_payload_last_be[0];
+    strideconverter0_converter_sink_payload_data[9] <= strideconverter0_sink_payload_error[0];
+    strideconverter0_converter_sink_payload_data[17:10] <= strideconverter0_sink_payload_data[15:8];
+    strideconverter0_converter_sink_payload_data[18] <= strideconverter0_sink_payload_last_be[1];
+    strideconverter0_converter_sink_payload_data[19] <= strideconverter0_sink_payload_error[1];
+    strideconverter0_converter_sink_payload_data[27:20] <= strideconverter0_sink_payload_data[23:16];
+    strideconverter0_converter_sink_payload_data[28] <= strideconverter0_sink_payload_last_be[2];
+    strideconverter0_converter_sink_payload_data[29] <= strideconverter0_sink_payload_error[2];
+    strideconverter0_converter_sink_payload_data[37:30] <= strideconverter0_sink_payload_data[31:24];
+    strideconverter0_converter_sink_payload_data[38] <= strideconverter0_sink_payload_last_be[3];
+    strideconverter0_converter_sink_payload_data[39] <= strideconverter0_sink_payload_error[3];
+end
+assign strideconverter0_source_valid = strideconverter0_source_source_valid;
+assign strideconverter0_source_first = strideconverter0_source_source_first;
+assign strideconverter0_source_last = strideconverter0_source_source_last;
+assign strideconverter0_source_source_ready = strideconverter0_source_ready;
+assign {strideconverter0_source_payload_error, strideconverter0_source_payload_last_be, strideconverter0_source_payload_data} = strideconverter0_source_source_payload_data;
+assign strideconverter0_source_param_length = strideconverter0_sink_param_length;
+assign strideconverter0_source_param_protocol = strideconverter0_sink_param_protocol;
+assign strideconverter0_source_param_ip_address = strideconverter0_sink_param_ip_address;
+assign strideconverter0_source_source_valid = strideconverter0_converter_source_valid;
+assign strideconverter0_converter_source_ready = strideconverter0_source_source_ready;
+assign strideconverter0_source_source_first = strideconverter0_converter_source_first;
+assign strideconverter0_source_source_last = strideconverter0_converter_source_last;
+assign strideconverter0_source_source_payload_data = strideconverter0_converter_source_payload_data;
+assign strideconverter0_converter_first = (strideconverter0_converter_mux == 1'd0);
+assign strideconverter0_converter_last = (strideconverter0_converter_mux == 2'd3);
+assign strideconverter0_converter_source_valid = strideconverter0_converter_sink_valid;
+assign strideconverter0_converter_source_first = (strideconverter0_converter_sink_first & strideconverter0_converter_first);
+assign strideconverter0_converter_source_last = (strideconverter0_converter_sink_last & strideconverter0_converter_last);
+assign strideconverter0_converter_sink_ready = (strideconverter0_converter_last & strideconverter0_converter_source_ready);
+always @(*) begin
+    strideconverter0_converter_source_payload_data <= 10'd0;
+    case (strideconverter0_converter_mux)
+        1'd0: begin
+            strideconverter0_converter_source_payload_data <= strideconverter0_converter_sink_payload_data[9:0];
+        end
         1'd1: begin
-            packetizer_source_valid <= 1'd1;
-            packetizer_source_last_a <= 1'd0;
-            packetizer_source_payload_data <= packetizer_sr[63:8];
-            if ((packetizer_source_valid & packetizer_source_ready)) begin
-                packetizer_sr_shift <= 1'd1;
-                if ((packetizer_count == 3'd7)) begin
-                    packetizer_sr_shift <= 1'd0;
-                    liteethudp_liteethudptx_fsm0_next_state <= 2'd2;
-                    packetizer_count_liteethudp_fsm0_next_value0 <= (packetizer_count + 1'd1);
-                    packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
-                end else begin
-                    packetizer_count_liteethudp_fsm0_next_value0 <= (packetizer_count + 1'd1);
-                    packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
-                end
-            end
+            strideconverter0_converter_source_payload_data <= strideconverter0_converter_sink_payload_data[19:10];
         end
         2'd2: begin
-            packetizer_source_valid <= packetizer_sink_valid;
-            packetizer_source_last_a <= packetizer_sink_last;
-            packetizer_source_payload_data <= packetizer_sink_payload_data;
-            if ((packetizer_source_valid & packetizer_source_ready)) begin
-                packetizer_sink_ready <= 1'd1;
-                if (packetizer_source_last) begin
-                    liteethudp_liteethudptx_fsm0_next_state <= 1'd0;
-                end
-            end
-            packetizer_is_ongoing0 <= 1'd1;
-        end
-        2'd3: begin
-            packetizer_is_ongoing1 <= 1'd1;
+            strideconverter0_converter_source_payload_data <= strideconverter0_converter_sink_payload_data[29:20];
         end
         default: begin
-            packetizer_sink_ready <= 1'd1;
-            packetizer_count_liteethudp_fsm0_next_value0 <= 1'd1;
-            packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
-            if (packetizer_sink_valid) begin
-                packetizer_sink_ready <= 1'd0;
-                packetizer_source_valid <= 1'd1;
-                packetizer_source_last_a <= 1'd0;
-                packetizer_source_payload_data <= packetizer_header[7:0];
-                if ((packetizer_source_valid & packetizer_source_ready)) begin
-                    packetizer_sr_load <= 1'd1;
-                    packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd1;
-                    packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd1;
-                    if (1'd0) begin
-                        liteethudp_liteethudptx_fsm0_next_state <= 2'd2;
-                    end else begin
-                        liteethudp_liteethudptx_fsm0_next_state <= 1'd1;
-                    end
-                end
-            end
-            packetizer_is_ongoing2 <= 1'd1;
-        end
-    endcase
-    liteethudp_liteethudptx_fsm1_next_state <= liteethudp_liteethudptx_fsm1_state;
-    case (liteethudp_liteethudptx_fsm1_state)
-        1'd1: begin
-            packetizer_source_last_b <= 1'd1;
-            packetizer_source_last_s <= 1'd1;
-            packetizer_source_payload_last_be <= packetizer_delayed_last_be;
-            packetizer_sink_ready <= 1'd0;
-            if (packetizer_source_ready) begin
-                liteethudp_liteethudptx_fsm1_next_state <= 1'd0;
-            end
-        end
-        default: begin
-            if (((packetizer_in_data_copy & packetizer_sink_last) & (packetizer_sink_last_be > packetizer_new_last_be))) begin
-                packetizer_source_last_b <= 1'd0;
-                packetizer_source_last_s <= 1'd1;
-                packetizer_source_payload_last_be <= 1'd0;
-                if ((packetizer_source_ready & packetizer_source_valid)) begin
-                    packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= packetizer_new_last_be;
-                    packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd1;
-                    liteethudp_liteethudptx_fsm1_next_state <= 1'd1;
-                end
-            end else begin
-                if (packetizer_in_data_copy) begin
-                    packetizer_source_last_b <= packetizer_sink_last;
-                    packetizer_source_last_s <= 1'd1;
-                    packetizer_source_payload_last_be <= packetizer_new_last_be;
-                end
-            end
-            if (packetizer_in_data_copy) begin
-                packetizer_sink_ready <= packetizer_source_ready;
-            end else begin
-                if (packetizer_is_ongoing2) begin
-                    packetizer_sink_ready <= (~packetizer_sink_valid);
-                end
-            end
+            strideconverter0_converter_source_payload_data <= strideconverter0_converter_sink_payload_data[39:30];
         end
     endcase
 end
+assign strideconverter0_converter_source_payload_valid_token_count = strideconverter0_converter_last;
+assign lastbytetrim_end = (lastbytetrim_sink_payload_last_be | lastbytetrim_sink_last);
 always @(*) begin
-    liteethudp_liteethudptx_next_state <= 1'd0;
-    packetizer_source_ready <= 1'd0;
-    source_source_first <= 1'd0;
-    source_source_last <= 1'd0;
-    source_source_param_ip_address <= 32'd0;
-    source_source_param_length <= 16'd0;
-    source_source_param_protocol <= 8'd0;
-    source_source_payload_data <= 8'd0;
-    source_source_payload_error <= 1'd0;
-    source_source_payload_last_be <= 1'd0;
-    source_source_valid <= 1'd0;
-    liteethudp_liteethudptx_next_state <= liteethudp_liteethudptx_state;
-    case (liteethudp_liteethudptx_state)
+    lastbytetrim_err_lastbytetrim_next_value <= 1'd0;
+    lastbytetrim_err_lastbytetrim_next_value_ce <= 1'd0;
+    lastbytetrim_sink_ready <= 1'd0;
+    lastbytetrim_source_first <= 1'd0;
+    lastbytetrim_source_last <= 1'd0;
+    lastbytetrim_source_param_ip_address <= 32'd0;
+    lastbytetrim_source_param_length <= 16'd0;
+    lastbytetrim_source_param_protocol <= 8'd0;
+    lastbytetrim_source_payload_data <= 8'd0;
+    lastbytetrim_source_payload_error <= 1'd0;
+    lastbytetrim_source_payload_last_be <= 1'd0;
+    lastbytetrim_source_valid <= 1'd0;
+    portudp_lastbytetrim_next_state <= 1'd0;
+    portudp_lastbytetrim_next_state <= portudp_lastbytetrim_state;
+    case (portudp_lastbytetrim_state)
         1'd1: begin
-            source_source_valid <= packetizer_source_valid;
-            packetizer_source_ready <= source_source_ready;
-            source_source_first <= packetizer_source_first;
-            source_source_last <= packetizer_source_last;
-            source_source_payload_data <= packetizer_source_payload_data;
-            source_source_payload_last_be <= packetizer_source_payload_last_be;
-            source_source_payload_error <= packetizer_source_payload_error;
-            source_source_param_length <= packetizer_source_param_length;
-            source_source_param_protocol <= packetizer_source_param_protocol;
-            source_source_param_ip_address <= packetizer_source_param_ip_address;
-            source_source_param_length <= packetizer_sink_param_length;
-            source_source_param_protocol <= 5'd17;
-            source_source_param_ip_address <= sink_sink_param_ip_address;
-            if ((source_source_valid & source_source_ready)) begin
-                if (source_source_last) begin
-                    liteethudp_liteethudptx_next_state <= 1'd0;
-                end
+            lastbytetrim_sink_ready <= 1'd1;
+            if ((lastbytetrim_sink_valid & lastbytetrim_sink_last)) begin
+                portudp_lastbytetrim_next_state <= 1'd0;
             end
         end
         default: begin
-            if (packetizer_source_valid) begin
-                liteethudp_liteethudptx_next_state <= 1'd1;
+            lastbytetrim_source_valid <= lastbytetrim_sink_valid;
+            lastbytetrim_sink_ready <= lastbytetrim_source_ready;
+            lastbytetrim_source_first <= lastbytetrim_sink_first;
+            lastbytetrim_source_payload_data <= lastbytetrim_sink_payload_data;
+            lastbytetrim_source_payload_last_be <= lastbytetrim_sink_payload_last_be;
+            lastbytetrim_source_param_length <= lastbytetrim_sink_param_length;
+            lastbytetrim_source_param_protocol <= lastbytetrim_sink_param_protocol;
+            lastbytetrim_source_param_ip_address <= lastbytetrim_sink_param_ip_address;
+            lastbytetrim_source_last <= lastbytetrim_end;
+            lastbytetrim_source_payload_error <= (lastbytetrim_end & (lastbytetrim_err | lastbytetrim_sink_payload_error));
+            if ((lastbytetrim_sink_valid & lastbytetrim_source_ready)) begin
+                lastbytetrim_err_lastbytetrim_next_value <= (lastbytetrim_err | lastbytetrim_sink_payload_error);
+                lastbytetrim_err_lastbytetrim_next_value_ce <= 1'd1;
+                if (lastbytetrim_end) begin
+                    lastbytetrim_err_lastbytetrim_next_value <= 1'd0;
+                    lastbytetrim_err_lastbytetrim_next_value_ce <= 1'd1;
+                    if ((~lastbytetrim_sink_last)) begin
+                        portudp_lastbytetrim_next_state <= 1'd1;
+                    end
+                end
             end
         end
     endcase
@@ -5667,12 +6648,12 @@ assign holdingudprx_cut0 = ((holdingudprx_liteethudpdepacketizer_sink_valid & ho
 always @(*) begin
     holdingudprx_fsm_is_ongoing0 <= 1'd0;
     holdingudprx_fsm_is_ongoing1 <= 1'd0;
-    holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
-    holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
-    holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
-    holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
-    holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
-    holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 <= 3'd0;
+    holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value_ce <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value1 <= 1'd0;
+    holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value_ce1 <= 1'd0;
     holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd0;
     holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd0;
     holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd0;
@@ -5685,25 +6666,25 @@ always @(*) begin
     holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
     holdingudprx_liteethudpdepacketizer_source_valid <= 1'd0;
     holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd0;
-    liteethudp_holdingudprx_fsm0_next_state <= 2'd0;
-    liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
-    liteethudp_holdingudprx_fsm0_next_state <= liteethudp_holdingudprx_fsm0_state;
-    case (liteethudp_holdingudprx_fsm0_state)
+    portudp_holdingudprx_fsm0_next_state <= 2'd0;
+    portudp_holdingudprx_fsm1_next_state <= 1'd0;
+    portudp_holdingudprx_fsm0_next_state <= portudp_holdingudprx_fsm0_state;
+    case (portudp_holdingudprx_fsm0_state)
         1'd1: begin
             holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
             if (holdingudprx_liteethudpdepacketizer_sink_valid) begin
-                holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= (holdingudprx_liteethudpdepacketizer_count + 1'd1);
-                holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+                holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 <= (holdingudprx_liteethudpdepacketizer_count + 1'd1);
+                holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 <= 1'd1;
                 holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
                 if ((holdingudprx_liteethudpdepacketizer_count == 3'd7)) begin
-                    liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
-                    holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= (holdingudprx_liteethudpdepacketizer_count + 1'd1);
-                    holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+                    portudp_holdingudprx_fsm0_next_state <= 2'd2;
+                    holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 <= (holdingudprx_liteethudpdepacketizer_count + 1'd1);
+                    holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 <= 1'd1;
                 end
             end
             holdingudprx_fsm_is_ongoing1 <= 1'd1;
             if ((holdingudprx_liteethudpdepacketizer_sink_valid & holdingudprx_liteethudpdepacketizer_sink_last)) begin
-                liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
+                portudp_holdingudprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
@@ -5713,7 +6694,7 @@ always @(*) begin
             holdingudprx_liteethudpdepacketizer_source_payload_data <= holdingudprx_liteethudpdepacketizer_sink_payload_data;
             if ((holdingudprx_liteethudpdepacketizer_source_valid & holdingudprx_liteethudpdepacketizer_source_ready)) begin
                 if (holdingudprx_liteethudpdepacketizer_source_last) begin
-                    liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
+                    portudp_holdingudprx_fsm0_next_state <= 1'd0;
                 end
             end
             holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd1;
@@ -5725,33 +6706,33 @@ always @(*) begin
         end
         default: begin
             holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
-            holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
-            holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 <= 1'd1;
+            holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 <= 1'd1;
             if (holdingudprx_liteethudpdepacketizer_sink_valid) begin
                 holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
-                holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
-                holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
+                holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value1 <= 1'd1;
+                holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value_ce1 <= 1'd1;
                 if (1'd0) begin
-                    liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
+                    portudp_holdingudprx_fsm0_next_state <= 2'd2;
                 end else begin
-                    liteethudp_holdingudprx_fsm0_next_state <= 1'd1;
+                    portudp_holdingudprx_fsm0_next_state <= 1'd1;
                 end
             end
             holdingudprx_fsm_is_ongoing0 <= 1'd1;
             if ((holdingudprx_liteethudpdepacketizer_sink_valid & holdingudprx_liteethudpdepacketizer_sink_last)) begin
-                liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
+                portudp_holdingudprx_fsm0_next_state <= 1'd0;
             end
         end
     endcase
-    liteethudp_holdingudprx_fsm1_next_state <= liteethudp_holdingudprx_fsm1_state;
-    case (liteethudp_holdingudprx_fsm1_state)
+    portudp_holdingudprx_fsm1_next_state <= portudp_holdingudprx_fsm1_state;
+    case (portudp_holdingudprx_fsm1_state)
         1'd1: begin
             holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
             holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
             holdingudprx_liteethudpdepacketizer_source_payload_last_be <= holdingudprx_liteethudpdepacketizer_delayed_last_be;
             holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
             if ((holdingudprx_liteethudpdepacketizer_source_ready & holdingudprx_liteethudpdepacketizer_source_valid)) begin
-                liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
+                portudp_holdingudprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
@@ -5760,9 +6741,9 @@ always @(*) begin
                 holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
                 holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
                 if (((holdingudprx_liteethudpdepacketizer_source_ready & holdingudprx_liteethudpdepacketizer_source_valid) | ((~holdingudprx_liteethudpdepacketizer_was_in_copy) & holdingudprx_liteethudpdepacketizer_is_in_copy))) begin
-                    holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= holdingudprx_liteethudpdepacketizer_new_last_be;
-                    holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
-                    liteethudp_holdingudprx_fsm1_next_state <= 1'd1;
+                    holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value <= holdingudprx_liteethudpdepacketizer_new_last_be;
+                    holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value_ce <= 1'd1;
+                    portudp_holdingudprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
                 if (holdingudprx_liteethudpdepacketizer_sink_last) begin
@@ -5780,24 +6761,24 @@ always @(*) begin
     endcase
 end
 always @(*) begin
-    holdingudprx0_liteethudp_next_value4 <= 16'd0;
-    holdingudprx0_liteethudp_next_value_ce4 <= 1'd0;
-    holdingudprx1_liteethudp_next_value5 <= 16'd0;
-    holdingudprx1_liteethudp_next_value_ce5 <= 1'd0;
-    holdingudprx2_liteethudp_next_value6 <= 16'd0;
-    holdingudprx2_liteethudp_next_value_ce6 <= 1'd0;
-    holdingudprx3_liteethudp_next_value7 <= 32'd0;
-    holdingudprx3_liteethudp_next_value_ce7 <= 1'd0;
-    holdingudprx_count_liteethudp_next_value0 <= 16'd0;
-    holdingudprx_count_liteethudp_next_value_ce0 <= 1'd0;
+    holdingudprx0_holdingudprx_next_value4 <= 16'd0;
+    holdingudprx0_holdingudprx_next_value_ce4 <= 1'd0;
+    holdingudprx1_holdingudprx_next_value5 <= 16'd0;
+    holdingudprx1_holdingudprx_next_value_ce5 <= 1'd0;
+    holdingudprx2_holdingudprx_next_value6 <= 16'd0;
+    holdingudprx2_holdingudprx_next_value_ce6 <= 1'd0;
+    holdingudprx3_holdingudprx_next_value7 <= 32'd0;
+    holdingudprx3_holdingudprx_next_value_ce7 <= 1'd0;
+    holdingudprx_count_holdingudprx_next_value0 <= 16'd0;
+    holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd0;
     holdingudprx_drop_header <= 1'd0;
-    holdingudprx_err_liteethudp_next_value1 <= 1'd0;
-    holdingudprx_err_liteethudp_next_value_ce1 <= 1'd0;
-    holdingudprx_held_liteethudp_next_value3 <= 8'd0;
-    holdingudprx_held_liteethudp_next_value_ce3 <= 1'd0;
+    holdingudprx_err_holdingudprx_next_value1 <= 1'd0;
+    holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd0;
+    holdingudprx_held_holdingudprx_next_value3 <= 8'd0;
+    holdingudprx_held_holdingudprx_next_value_ce3 <= 1'd0;
     holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
-    holdingudprx_rest_liteethudp_next_value2 <= 16'd0;
-    holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd0;
+    holdingudprx_rest_holdingudprx_next_value2 <= 16'd0;
+    holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd0;
     holdingudprx_source_last <= 1'd0;
     holdingudprx_source_param_dst_port <= 16'd0;
     holdingudprx_source_param_ip_address <= 32'd0;
@@ -5806,9 +6787,9 @@ always @(*) begin
     holdingudprx_source_payload_data <= 8'd0;
     holdingudprx_source_payload_error <= 1'd0;
     holdingudprx_source_valid <= 1'd0;
-    liteethudp_holdingudprx_next_state <= 3'd0;
-    liteethudp_holdingudprx_next_state <= liteethudp_holdingudprx_state;
-    case (liteethudp_holdingudprx_state)
+    portudp_holdingudprx_next_state <= 3'd0;
+    portudp_holdingudprx_next_state <= portudp_holdingudprx_state;
+    case (portudp_holdingudprx_state)
         1'd1: begin
             holdingudprx_source_param_src_port <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
             holdingudprx_source_param_dst_port <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
@@ -5824,60 +6805,60 @@ always @(*) begin
                     holdingudprx_source_param_length <= 1'd0;
                 end
                 if ((holdingudprx_liteethudpdepacketizer_source_valid & holdingudprx_source_ready)) begin
-                    holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
-                    holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    holdingudprx_count_holdingudprx_next_value0 <= (holdingudprx_count + 1'd1);
+                    holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
                     if (holdingudprx_cut1) begin
-                        holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
-                        holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                        holdingudprx_rest_holdingudprx_next_value2 <= (holdingudprx_rest - 1'd1);
+                        holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
                     end
-                    holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
-                    holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
+                    holdingudprx_err_holdingudprx_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
+                    holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
                     if (holdingudprx_liteethudpdepacketizer_source_last) begin
-                        liteethudp_holdingudprx_next_state <= 1'd0;
+                        portudp_holdingudprx_next_state <= 1'd0;
                     end
                 end
             end else begin
                 holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
                 if (holdingudprx_liteethudpdepacketizer_source_valid) begin
-                    holdingudprx_held_liteethudp_next_value3 <= holdingudprx_liteethudpdepacketizer_source_payload_data;
-                    holdingudprx_held_liteethudp_next_value_ce3 <= 1'd1;
-                    holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
-                    holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    holdingudprx0_liteethudp_next_value4 <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
-                    holdingudprx0_liteethudp_next_value_ce4 <= 1'd1;
-                    holdingudprx1_liteethudp_next_value5 <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
-                    holdingudprx1_liteethudp_next_value_ce5 <= 1'd1;
-                    holdingudprx2_liteethudp_next_value6 <= holdingudprx_payload_len;
-                    holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
-                    holdingudprx3_liteethudp_next_value7 <= holdingudprx_sink_param_ip_address;
-                    holdingudprx3_liteethudp_next_value_ce7 <= 1'd1;
-                    holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
-                    holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                    holdingudprx_held_holdingudprx_next_value3 <= holdingudprx_liteethudpdepacketizer_source_payload_data;
+                    holdingudprx_held_holdingudprx_next_value_ce3 <= 1'd1;
+                    holdingudprx_err_holdingudprx_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
+                    holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                    holdingudprx0_holdingudprx_next_value4 <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
+                    holdingudprx0_holdingudprx_next_value_ce4 <= 1'd1;
+                    holdingudprx1_holdingudprx_next_value5 <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+                    holdingudprx1_holdingudprx_next_value_ce5 <= 1'd1;
+                    holdingudprx2_holdingudprx_next_value6 <= holdingudprx_payload_len;
+                    holdingudprx2_holdingudprx_next_value_ce6 <= 1'd1;
+                    holdingudprx3_holdingudprx_next_value7 <= holdingudprx_sink_param_ip_address;
+                    holdingudprx3_holdingudprx_next_value_ce7 <= 1'd1;
+                    holdingudprx_count_holdingudprx_next_value0 <= (holdingudprx_count + 1'd1);
+                    holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
                     if (holdingudprx_cut1) begin
-                        holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
-                        holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                        holdingudprx_rest_holdingudprx_next_value2 <= (holdingudprx_rest - 1'd1);
+                        holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
                     end
-                    liteethudp_holdingudprx_next_state <= 2'd2;
+                    portudp_holdingudprx_next_state <= 2'd2;
                 end
             end
         end
         2'd2: begin
             holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
             if (holdingudprx_liteethudpdepacketizer_source_valid) begin
-                holdingudprx_err_liteethudp_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
-                holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                holdingudprx_count_liteethudp_next_value0 <= (holdingudprx_count + 1'd1);
-                holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
+                holdingudprx_err_holdingudprx_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
+                holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                holdingudprx_count_holdingudprx_next_value0 <= (holdingudprx_count + 1'd1);
+                holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
                 if (holdingudprx_cut1) begin
-                    holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_rest - 1'd1);
-                    holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                    holdingudprx_rest_holdingudprx_next_value2 <= (holdingudprx_rest - 1'd1);
+                    holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
                 end
                 if (holdingudprx_liteethudpdepacketizer_source_last) begin
                     if (holdingudprx_cut1) begin
-                        holdingudprx2_liteethudp_next_value6 <= 1'd0;
-                        holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
+                        holdingudprx2_holdingudprx_next_value6 <= 1'd0;
+                        holdingudprx2_holdingudprx_next_value_ce6 <= 1'd1;
                     end
-                    liteethudp_holdingudprx_next_state <= 2'd3;
+                    portudp_holdingudprx_next_state <= 2'd3;
                 end
             end
         end
@@ -5891,39 +6872,331 @@ always @(*) begin
             holdingudprx_source_param_length <= holdingudprx2;
             holdingudprx_source_param_ip_address <= holdingudprx3;
             if (holdingudprx_source_ready) begin
-                liteethudp_holdingudprx_next_state <= 1'd0;
+                portudp_holdingudprx_next_state <= 1'd0;
             end
         end
         3'd4: begin
             holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
             if ((holdingudprx_liteethudpdepacketizer_source_valid & holdingudprx_liteethudpdepacketizer_source_last)) begin
-                liteethudp_holdingudprx_next_state <= 1'd0;
+                portudp_holdingudprx_next_state <= 1'd0;
             end
         end
         default: begin
-            holdingudprx_count_liteethudp_next_value0 <= 1'd1;
-            holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
-            holdingudprx_err_liteethudp_next_value1 <= 1'd0;
-            holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-            holdingudprx_rest_liteethudp_next_value2 <= (holdingudprx_sink_param_length - 4'd9);
-            holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            holdingudprx_count_holdingudprx_next_value0 <= 1'd1;
+            holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+            holdingudprx_err_holdingudprx_next_value1 <= 1'd0;
+            holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+            holdingudprx_rest_holdingudprx_next_value2 <= (holdingudprx_sink_param_length - 4'd9);
+            holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
             if ((holdingudprx_sink_param_length <= 4'd8)) begin
-                holdingudprx_rest_liteethudp_next_value2 <= 1'd0;
-                holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                holdingudprx_rest_holdingudprx_next_value2 <= 1'd0;
+                holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
             end
             if (holdingudprx_liteethudpdepacketizer_source_valid) begin
-                liteethudp_holdingudprx_next_state <= 3'd4;
+                portudp_holdingudprx_next_state <= 3'd4;
                 if ((holdingudprx_sink_param_protocol == 5'd17)) begin
                     if ((holdingudprx_liteethudpdepacketizer_source_param_length > holdingudprx_sink_param_length)) begin
                         holdingudprx_drop_header <= 1'd1;
                     end else begin
-                        liteethudp_holdingudprx_next_state <= 1'd1;
+                        portudp_holdingudprx_next_state <= 1'd1;
                     end
                 end
             end
         end
     endcase
 end
+assign liteethudptx_packetizer_sink_valid = liteethudptx_sink_sink_valid;
+assign liteethudptx_sink_sink_ready = liteethudptx_packetizer_sink_ready;
+assign liteethudptx_packetizer_sink_last = liteethudptx_sink_sink_last;
+assign liteethudptx_packetizer_sink_payload_data = liteethudptx_sink_sink_payload_data;
+assign liteethudptx_packetizer_sink_payload_last_be = liteethudptx_sink_sink_payload_last_be;
+assign liteethudptx_packetizer_sink_param_src_port = liteethudptx_sink_sink_param_src_port;
+assign liteethudptx_packetizer_sink_param_dst_port = liteethudptx_sink_sink_param_dst_port;
+assign liteethudptx_packetizer_sink_param_length = (liteethudptx_sink_sink_param_length + 4'd8);
+assign liteethudptx_packetizer_sink_param_checksum = 1'd0;
+always @(*) begin
+    liteethudptx_packetizer_header <= 64'd0;
+    liteethudptx_packetizer_header[63:48] <= {liteethudptx_packetizer_sink_param_checksum[7:0], liteethudptx_packetizer_sink_param_checksum[15:8]};
+    liteethudptx_packetizer_header[31:16] <= {liteethudptx_packetizer_sink_param_dst_port[7:0], liteethudptx_packetizer_sink_param_dst_port[15:8]};
+    liteethudptx_packetizer_header[47:32] <= {liteethudptx_packetizer_sink_param_length[7:0], liteethudptx_packetizer_sink_param_length[15:8]};
+    liteethudptx_packetizer_header[15:0] <= {liteethudptx_packetizer_sink_param_src_port[7:0], liteethudptx_packetizer_sink_param_src_port[15:8]};
+end
+assign liteethudptx_packetizer_sink_last_be = liteethudptx_packetizer_sink_last;
+assign liteethudptx_packetizer_new_last_be = {liteethudptx_packetizer_sink_last_be};
+assign liteethudptx_packetizer_in_data_copy = (liteethudptx_packetizer_is_ongoing0 | liteethudptx_packetizer_is_ongoing1);
+always @(*) begin
+    liteethudptx_packetizer_source_last <= 1'd0;
+    if (liteethudptx_packetizer_source_last_s) begin
+        liteethudptx_packetizer_source_last <= liteethudptx_packetizer_source_last_b;
+    end else begin
+        liteethudptx_packetizer_source_last <= liteethudptx_packetizer_source_last_a;
+    end
+end
+assign liteethudptx_packetizer_source_payload_error = liteethudptx_packetizer_sink_payload_error;
+always @(*) begin
+    liteethudptx_packetizer_count_fsm0_next_value4 <= 3'd0;
+    liteethudptx_packetizer_count_fsm0_next_value_ce4 <= 1'd0;
+    liteethudptx_packetizer_delayed_last_be_fsm1_next_value2 <= 1'd0;
+    liteethudptx_packetizer_delayed_last_be_fsm1_next_value_ce2 <= 1'd0;
+    liteethudptx_packetizer_fsm_from_idle_fsm0_next_value5 <= 1'd0;
+    liteethudptx_packetizer_fsm_from_idle_fsm0_next_value_ce5 <= 1'd0;
+    liteethudptx_packetizer_is_ongoing0 <= 1'd0;
+    liteethudptx_packetizer_is_ongoing1 <= 1'd0;
+    liteethudptx_packetizer_is_ongoing2 <= 1'd0;
+    liteethudptx_packetizer_sink_ready <= 1'd0;
+    liteethudptx_packetizer_source_last_a <= 1'd0;
+    liteethudptx_packetizer_source_last_b <= 1'd0;
+    liteethudptx_packetizer_source_last_s <= 1'd0;
+    liteethudptx_packetizer_source_payload_data <= 8'd0;
+    liteethudptx_packetizer_source_payload_last_be <= 1'd0;
+    liteethudptx_packetizer_source_valid <= 1'd0;
+    liteethudptx_packetizer_sr_load <= 1'd0;
+    liteethudptx_packetizer_sr_shift <= 1'd0;
+    portudp_liteethudptx_fsm0_next_state <= 2'd0;
+    portudp_liteethudptx_fsm1_next_state <= 1'd0;
+    portudp_liteethudptx_fsm0_next_state <= portudp_liteethudptx_fsm0_state;
+    case (portudp_liteethudptx_fsm0_state)
+        1'd1: begin
+            liteethudptx_packetizer_source_valid <= 1'd1;
+            liteethudptx_packetizer_source_last_a <= 1'd0;
+            liteethudptx_packetizer_source_payload_data <= liteethudptx_packetizer_sr[63:8];
+            if ((liteethudptx_packetizer_source_valid & liteethudptx_packetizer_source_ready)) begin
+                liteethudptx_packetizer_sr_shift <= 1'd1;
+                if ((liteethudptx_packetizer_count == 3'd7)) begin
+                    liteethudptx_packetizer_sr_shift <= 1'd0;
+                    portudp_liteethudptx_fsm0_next_state <= 2'd2;
+                    liteethudptx_packetizer_count_fsm0_next_value4 <= (liteethudptx_packetizer_count + 1'd1);
+                    liteethudptx_packetizer_count_fsm0_next_value_ce4 <= 1'd1;
+                end else begin
+                    liteethudptx_packetizer_count_fsm0_next_value4 <= (liteethudptx_packetizer_count + 1'd1);
+                    liteethudptx_packetizer_count_fsm0_next_value_ce4 <= 1'd1;
+                end
+            end
+        end
+        2'd2: begin
+            liteethudptx_packetizer_source_valid <= liteethudptx_packetizer_sink_valid;
+            liteethudptx_packetizer_source_last_a <= liteethudptx_packetizer_sink_last;
+            liteethudptx_packetizer_source_payload_data <= liteethudptx_packetizer_sink_payload_data;
+            if ((liteethudptx_packetizer_source_valid & liteethudptx_packetizer_source_ready)) begin
+                liteethudptx_packetizer_sink_ready <= 1'd1;
+                if (liteethudptx_packetizer_source_last) begin
+                    portudp_liteethudptx_fsm0_next_state <= 1'd0;
+                end
+            end
+            liteethudptx_packetizer_is_ongoing0 <= 1'd1;
+        end
+        2'd3: begin
+            liteethudptx_packetizer_is_ongoing1 <= 1'd1;
+        end
+        default: begin
+            liteethudptx_packetizer_sink_ready <= 1'd1;
+            liteethudptx_packetizer_count_fsm0_next_value4 <= 1'd1;
+            liteethudptx_packetizer_count_fsm0_next_value_ce4 <= 1'd1;
+            if (liteethudptx_packetizer_sink_valid) begin
+                liteethudptx_packetizer_sink_ready <= 1'd0;
+                liteethudptx_packetizer_source_valid <= 1'd1;
+                liteethudptx_packetizer_source_last_a <= 1'd0;
+                liteethudptx_packetizer_source_payload_data <= liteethudptx_packetizer_header[7:0];
+                if ((liteethudptx_packetizer_source_valid & liteethudptx_packetizer_source_ready)) begin
+                    liteethudptx_packetizer_sr_load <= 1'd1;
+                    liteethudptx_packetizer_fsm_from_idle_fsm0_next_value5 <= 1'd1;
+                    liteethudptx_packetizer_fsm_from_idle_fsm0_next_value_ce5 <= 1'd1;
+                    if (1'd0) begin
+                        portudp_liteethudptx_fsm0_next_state <= 2'd2;
+                    end else begin
+                        portudp_liteethudptx_fsm0_next_state <= 1'd1;
+                    end
+                end
+            end
+            liteethudptx_packetizer_is_ongoing2 <= 1'd1;
+        end
+    endcase
+    portudp_liteethudptx_fsm1_next_state <= portudp_liteethudptx_fsm1_state;
+    case (portudp_liteethudptx_fsm1_state)
+        1'd1: begin
+            liteethudptx_packetizer_source_last_b <= 1'd1;
+            liteethudptx_packetizer_source_last_s <= 1'd1;
+            liteethudptx_packetizer_source_payload_last_be <= liteethudptx_packetizer_delayed_last_be;
+            liteethudptx_packetizer_sink_ready <= 1'd0;
+            if (liteethudptx_packetizer_source_ready) begin
+                portudp_liteethudptx_fsm1_next_state <= 1'd0;
+            end
+        end
+        default: begin
+            if (((liteethudptx_packetizer_in_data_copy & liteethudptx_packetizer_sink_last) & (liteethudptx_packetizer_sink_last_be > liteethudptx_packetizer_new_last_be))) begin
+                liteethudptx_packetizer_source_last_b <= 1'd0;
+                liteethudptx_packetizer_source_last_s <= 1'd1;
+                liteethudptx_packetizer_source_payload_last_be <= 1'd0;
+                if ((liteethudptx_packetizer_source_ready & liteethudptx_packetizer_source_valid)) begin
+                    liteethudptx_packetizer_delayed_last_be_fsm1_next_value2 <= liteethudptx_packetizer_new_last_be;
+                    liteethudptx_packetizer_delayed_last_be_fsm1_next_value_ce2 <= 1'd1;
+                    portudp_liteethudptx_fsm1_next_state <= 1'd1;
+                end
+            end else begin
+                if (liteethudptx_packetizer_in_data_copy) begin
+                    liteethudptx_packetizer_source_last_b <= liteethudptx_packetizer_sink_last;
+                    liteethudptx_packetizer_source_last_s <= 1'd1;
+                    liteethudptx_packetizer_source_payload_last_be <= liteethudptx_packetizer_new_last_be;
+                end
+            end
+            if (liteethudptx_packetizer_in_data_copy) begin
+                liteethudptx_packetizer_sink_ready <= liteethudptx_packetizer_source_ready;
+            end else begin
+                if (liteethudptx_packetizer_is_ongoing2) begin
+                    liteethudptx_packetizer_sink_ready <= (~liteethudptx_packetizer_sink_valid);
+                end
+            end
+        end
+    endcase
+end
+always @(*) begin
+    liteethudptx_packetizer_source_ready <= 1'd0;
+    liteethudptx_source_source_first <= 1'd0;
+    liteethudptx_source_source_last <= 1'd0;
+    liteethudptx_source_source_param_ip_address <= 32'd0;
+    liteethudptx_source_source_param_length <= 16'd0;
+    liteethudptx_source_source_param_protocol <= 8'd0;
+    liteethudptx_source_source_payload_data <= 8'd0;
+    liteethudptx_source_source_payload_error <= 1'd0;
+    liteethudptx_source_source_payload_last_be <= 1'd0;
+    liteethudptx_source_source_valid <= 1'd0;
+    portudp_liteethudptx_next_state <= 1'd0;
+    portudp_liteethudptx_next_state <= portudp_liteethudptx_state;
+    case (portudp_liteethudptx_state)
+        1'd1: begin
+            liteethudptx_source_source_valid <= liteethudptx_packetizer_source_valid;
+            liteethudptx_packetizer_source_ready <= liteethudptx_source_source_ready;
+            liteethudptx_source_source_first <= liteethudptx_packetizer_source_first;
+            liteethudptx_source_source_last <= liteethudptx_packetizer_source_last;
+            liteethudptx_source_source_payload_data <= liteethudptx_packetizer_source_payload_data;
+            liteethudptx_source_source_payload_last_be <= liteethudptx_packetizer_source_payload_last_be;
+            liteethudptx_source_source_payload_error <= liteethudptx_packetizer_source_payload_error;
+            liteethudptx_source_source_param_length <= liteethudptx_packetizer_source_param_length;
+            liteethudptx_source_source_param_protocol <= liteethudptx_packetizer_source_param_protocol;
+            liteethudptx_source_source_param_ip_address <= liteethudptx_packetizer_source_param_ip_address;
+            liteethudptx_source_source_param_length <= liteethudptx_packetizer_sink_param_length;
+            liteethudptx_source_source_param_protocol <= 5'd17;
+            liteethudptx_source_source_param_ip_address <= liteethudptx_sink_sink_param_ip_address;
+            if ((liteethudptx_source_source_valid & liteethudptx_source_source_ready)) begin
+                if (liteethudptx_source_source_last) begin
+                    portudp_liteethudptx_next_state <= 1'd0;
+                end
+            end
+        end
+        default: begin
+            if (liteethudptx_packetizer_source_valid) begin
+                portudp_liteethudptx_next_state <= 1'd1;
+            end
+        end
+    endcase
+end
+assign strideconverter1_converter_sink_valid = strideconverter1_sink_valid;
+assign strideconverter1_converter_sink_first = strideconverter1_sink_first;
+assign strideconverter1_converter_sink_last = strideconverter1_sink_last;
+assign strideconverter1_sink_ready = strideconverter1_converter_sink_ready;
+assign strideconverter1_converter_sink_payload_data = {strideconverter1_sink_payload_error, strideconverter1_sink_payload_last_be, strideconverter1_sink_payload_data};
+assign strideconverter1_source_valid = strideconverter1_source_source_valid;
+assign strideconverter1_source_first = strideconverter1_source_source_first;
+assign strideconverter1_source_last = strideconverter1_source_source_last;
+assign strideconverter1_source_source_ready = strideconverter1_source_ready;
+always @(*) begin
+    strideconverter1_source_payload_data <= 32'd0;
+    strideconverter1_source_payload_data[7:0] <= strideconverter1_source_source_payload_data[7:0];
+    strideconverter1_source_payload_data[15:8] <= strideconverter1_source_source_payload_data[17:10];
+    strideconverter1_source_payload_data[23:16] <= strideconverter1_source_source_payload_data[27:20];
+    strideconverter1_source_payload_data[31:24] <= strideconverter1_source_source_payload_data[37:30];
+end
+always @(*) begin
+    strideconverter1_source_payload_last_be <= 4'd0;
+    strideconverter1_source_payload_last_be[0] <= strideconverter1_source_source_payload_data[8];
+    strideconverter1_source_payload_last_be[1] <= strideconverter1_source_source_payload_data[18];
+    strideconverter1_source_payload_last_be[2] <= strideconverter1_source_source_payload_data[28];
+    strideconverter1_source_payload_last_be[3] <= strideconverter1_source_source_payload_data[38];
+end
+always @(*) begin
+    strideconverter1_source_payload_error <= 4'd0;
+    strideconverter1_source_payload_error[0] <= strideconverter1_source_source_payload_data[9];
+    strideconverter1_source_payload_error[1] <= strideconverter1_source_source_payload_data[19];
+    strideconverter1_source_payload_error[2] <= strideconverter1_source_source_payload_data[29];
+    strideconverter1_source_payload_error[3] <= strideconverter1_source_source_payload_data[39];
+end
+assign strideconverter1_source_source_valid = strideconverter1_converter_source_valid;
+assign strideconverter1_converter_source_ready = strideconverter1_source_source_ready;
+assign strideconverter1_source_source_first = strideconverter1_converter_source_first;
+assign strideconverter1_source_source_last = strideconverter1_converter_source_last;
+assign strideconverter1_source_source_payload_data = strideconverter1_converter_source_payload_data;
+assign strideconverter1_converter_sink_ready = ((~strideconverter1_converter_strobe_all) | strideconverter1_converter_source_ready);
+assign strideconverter1_converter_source_valid = strideconverter1_converter_strobe_all;
+assign strideconverter1_converter_load_part = (strideconverter1_converter_sink_valid & strideconverter1_converter_sink_ready);
+assign tx_cdc_cdc_sink_valid = tx_cdc_sink_sink_valid;
+assign tx_cdc_sink_sink_ready = tx_cdc_cdc_sink_ready;
+assign tx_cdc_cdc_sink_first = tx_cdc_sink_sink_first;
+assign tx_cdc_cdc_sink_last = tx_cdc_sink_sink_last;
+assign tx_cdc_cdc_sink_payload_data = tx_cdc_sink_sink_payload_data;
+assign tx_cdc_cdc_sink_payload_last_be = tx_cdc_sink_sink_payload_last_be;
+assign tx_cdc_cdc_sink_payload_error = tx_cdc_sink_sink_payload_error;
+assign tx_cdc_cdc_sink_param_length = tx_cdc_sink_sink_param_length;
+assign tx_cdc_cdc_sink_param_protocol = tx_cdc_sink_sink_param_protocol;
+assign tx_cdc_cdc_sink_param_ip_address = tx_cdc_sink_sink_param_ip_address;
+assign tx_cdc_source_source_valid = tx_cdc_cdc_source_valid;
+assign tx_cdc_cdc_source_ready = tx_cdc_source_source_ready;
+assign tx_cdc_source_source_first = tx_cdc_cdc_source_first;
+assign tx_cdc_source_source_last = tx_cdc_cdc_source_last;
+assign tx_cdc_source_source_payload_data = tx_cdc_cdc_source_payload_data;
+assign tx_cdc_source_source_payload_last_be = tx_cdc_cdc_source_payload_last_be;
+assign tx_cdc_source_source_payload_error = tx_cdc_cdc_source_payload_error;
+assign tx_cdc_source_source_param_length = tx_cdc_cdc_source_param_length;
+assign tx_cdc_source_source_param_protocol = tx_cdc_cdc_source_param_protocol;
+assign tx_cdc_source_source_param_ip_address = tx_cdc_cdc_source_param_ip_address;
+assign tx_cdc_cdc_asyncfifo_din = {tx_cdc_cdc_fifo_in_last, tx_cdc_cdc_fifo_in_first, tx_cdc_cdc_fifo_in_param_ip_address, tx_cdc_cdc_fifo_in_param_protocol, tx_cdc_cdc_fifo_in_param_length, tx_cdc_cdc_fifo_in_payload_error, tx_cdc_cdc_fifo_in_payload_last_be, tx_cdc_cdc_fifo_in_payload_data};
+assign {tx_cdc_cdc_fifo_out_last, tx_cdc_cdc_fifo_out_first, tx_cdc_cdc_fifo_out_param_ip_address, tx_cdc_cdc_fifo_out_param_protocol, tx_cdc_cdc_fifo_out_param_length, tx_cdc_cdc_fifo_out_payload_error, tx_cdc_cdc_fifo_out_payload_last_be, tx_cdc_cdc_fifo_out_payload_data} = tx_cdc_cdc_asyncfifo_dout;
+assign tx_cdc_cdc_sink_ready = tx_cdc_cdc_asyncfifo_writable;
+assign tx_cdc_cdc_asyncfifo_we = tx_cdc_cdc_sink_valid;
+assign tx_cdc_cdc_fifo_in_first = tx_cdc_cdc_sink_first;
+assign tx_cdc_cdc_fifo_in_last = tx_cdc_cdc_sink_last;
+assign tx_cdc_cdc_fifo_in_payload_data = tx_cdc_cdc_sink_payload_data;
+assign tx_cdc_cdc_fifo_in_payload_last_be = tx_cdc_cdc_sink_payload_last_be;
+assign tx_cdc_cdc_fifo_in_payload_error = tx_cdc_cdc_sink_payload_error;
+assign tx_cdc_cdc_fifo_in_param_length = tx_cdc_cdc_sink_param_length;
+assign tx_cdc_cdc_fifo_in_param_protocol = tx_cdc_cdc_sink_param_protocol;
+assign tx_cdc_cdc_fifo_in_param_ip_address = tx_cdc_cdc_sink_param_ip_address;
+assign tx_cdc_cdc_source_valid = tx_cdc_cdc_asyncfifo_readable;
+assign tx_cdc_cdc_source_first = tx_cdc_cdc_fifo_out_first;
+assign tx_cdc_cdc_source_last = tx_cdc_cdc_fifo_out_last;
+assign tx_cdc_cdc_source_payload_data = tx_cdc_cdc_fifo_out_payload_data;
+assign tx_cdc_cdc_source_payload_last_be = tx_cdc_cdc_fifo_out_payload_last_be;
+assign tx_cdc_cdc_source_payload_error = tx_cdc_cdc_fifo_out_payload_error;
+assign tx_cdc_cdc_source_param_length = tx_cdc_cdc_fifo_out_param_length;
+assign tx_cdc_cdc_source_param_protocol = tx_cdc_cdc_fifo_out_param_protocol;
+assign tx_cdc_cdc_source_param_ip_address = tx_cdc_cdc_fifo_out_param_ip_address;
+assign tx_cdc_cdc_asyncfifo_re = tx_cdc_cdc_source_ready;
+assign tx_cdc_cdc_graycounter0_ce = (tx_cdc_cdc_asyncfifo_writable & tx_cdc_cdc_asyncfifo_we);
+assign tx_cdc_cdc_graycounter1_ce = (tx_cdc_cdc_asyncfifo_readable & tx_cdc_cdc_asyncfifo_re);
+assign tx_cdc_cdc_asyncfifo_writable = (((tx_cdc_cdc_graycounter0_q[4] == tx_cdc_cdc_consume_wdomain[4]) | (tx_cdc_cdc_graycounter0_q[3] == tx_cdc_cdc_consume_wdomain[3])) | (tx_cdc_cdc_graycounter0_q[2:0] != tx_cdc_cdc_consume_wdomain[2:0]));
+assign tx_cdc_cdc_asyncfifo_readable = (tx_cdc_cdc_graycounter1_q != tx_cdc_cdc_produce_rdomain);
+assign tx_cdc_cdc_wrport_adr = tx_cdc_cdc_graycounter0_q_binary[3:0];
+assign tx_cdc_cdc_wrport_dat_w = tx_cdc_cdc_asyncfifo_din;
+assign tx_cdc_cdc_wrport_we = tx_cdc_cdc_graycounter0_ce;
+assign tx_cdc_cdc_rdport_adr = tx_cdc_cdc_graycounter1_q_next_binary[3:0];
+assign tx_cdc_cdc_asyncfifo_dout = tx_cdc_cdc_rdport_dat_r;
+always @(*) begin
+    tx_cdc_cdc_graycounter0_q_next_binary <= 5'd0;
+    if (tx_cdc_cdc_graycounter0_ce) begin
+        tx_cdc_cdc_graycounter0_q_next_binary <= (tx_cdc_cdc_graycounter0_q_binary + 1'd1);
+    end else begin
+        tx_cdc_cdc_graycounter0_q_next_binary <= tx_cdc_cdc_graycounter0_q_binary;
+    end
+end
+assign tx_cdc_cdc_graycounter0_q_next = (tx_cdc_cdc_graycounter0_q_next_binary ^ tx_cdc_cdc_graycounter0_q_next_binary[4:1]);
+always @(*) begin
+    tx_cdc_cdc_graycounter1_q_next_binary <= 5'd0;
+    if (tx_cdc_cdc_graycounter1_ce) begin
+        tx_cdc_cdc_graycounter1_q_next_binary <= (tx_cdc_cdc_graycounter1_q_binary + 1'd1);
+    end else begin
+        tx_cdc_cdc_graycounter1_q_next_binary <= tx_cdc_cdc_graycounter1_q_binary;
+    end
+end
+assign tx_cdc_cdc_graycounter1_q_next = (tx_cdc_cdc_graycounter1_q_next_binary ^ tx_cdc_cdc_graycounter1_q_next_binary[4:1]);
 assign tx_cdc_sink_valid = user_port_sink_valid;
 assign user_port_sink_ready = tx_cdc_sink_ready;
 assign tx_cdc_sink_first = user_port_sink_first;
@@ -5990,15 +7263,15 @@ assign user_port_source_param_src_port = rx_cdc_source_param_src_port;
 assign user_port_source_param_dst_port = rx_cdc_source_param_dst_port;
 assign user_port_source_param_ip_address = rx_cdc_source_param_ip_address;
 assign user_port_source_param_length = rx_cdc_source_param_length;
-assign liteethudp_taken = ((1'd0 + internal_port_source_valid) != 1'd0);
-assign crossbar_dropped = (((crossbar_sink_valid & crossbar_sink_ready) & crossbar_sink_last) & (~liteethudp_taken));
+assign portudp_taken = ((1'd0 + internal_port_source_valid) != 1'd0);
+assign maskedudpcrossbar_dropped = (((maskedudpcrossbar_sink_valid & maskedudpcrossbar_sink_ready) & maskedudpcrossbar_sink_last) & (~portudp_taken));
 always @(*) begin
-    liteethudp_sel0 <= 1'd0;
-    if ((crossbar_sink_param_dst_port == udp_rx_port)) begin
-        liteethudp_sel0 <= 1'd1;
+    portudp_sel0 <= 1'd0;
+    if ((maskedudpcrossbar_sink_param_dst_port == udp_rx_port)) begin
+        portudp_sel0 <= 1'd1;
     end
-    if ((((crossbar_sink_param_dst_port ^ udp_rx_port) & udp_rx_port_mask) == 1'd0)) begin
-        liteethudp_sel0 <= 1'd1;
+    if ((((maskedudpcrossbar_sink_param_dst_port ^ udp_rx_port) & udp_rx_port_mask) == 1'd0)) begin
+        portudp_sel0 <= 1'd1;
     end
 end
 assign tx_cdc_source_valid = tx_cdc_sink_valid;
@@ -6073,27 +7346,26 @@ assign rx_cdc_source_param_src_port = rx_cdc_sink_param_src_port;
 assign rx_cdc_source_param_dst_port = rx_cdc_sink_param_dst_port;
 assign rx_cdc_source_param_ip_address = rx_cdc_sink_param_ip_address;
 assign rx_cdc_source_param_length = rx_cdc_sink_param_length;
-assign crossbar_source_valid = internal_port_sink_valid;
-assign internal_port_sink_ready = crossbar_source_ready;
-assign crossbar_source_first = internal_port_sink_first;
-assign crossbar_source_last = internal_port_sink_last;
-assign crossbar_source_payload_data = internal_port_sink_payload_data;
-assign crossbar_source_payload_last_be = internal_port_sink_payload_last_be;
-assign crossbar_source_payload_error = internal_port_sink_payload_error;
-assign crossbar_source_param_src_port = internal_port_sink_param_src_port;
-assign crossbar_source_param_dst_port = internal_port_sink_param_dst_port;
-assign crossbar_source_param_ip_address = internal_port_sink_param_ip_address;
-assign crossbar_source_param_length = internal_port_sink_param_length;
+assign maskedudpcrossbar_source_valid = internal_port_sink_valid;
+assign internal_port_sink_ready = maskedudpcrossbar_source_ready;
+assign maskedudpcrossbar_source_first = internal_port_sink_first;
+assign maskedudpcrossbar_source_last = internal_port_sink_last;
+assign maskedudpcrossbar_source_payload_data = internal_port_sink_payload_data;
+assign maskedudpcrossbar_source_payload_last_be = internal_port_sink_payload_last_be;
+assign maskedudpcrossbar_source_payload_error = internal_port_sink_payload_error;
+assign maskedudpcrossbar_source_param_src_port = internal_port_sink_param_src_port;
+assign maskedudpcrossbar_source_param_dst_port = internal_port_sink_param_dst_port;
+assign maskedudpcrossbar_source_param_ip_address = internal_port_sink_param_ip_address;
+assign maskedudpcrossbar_source_param_length = internal_port_sink_param_length;
 always @(*) begin
-    liteethudp_sel1 <= 1'd0;
-    if (liteethudp_first) begin
-        liteethudp_sel1 <= liteethudp_sel0;
+    portudp_sel1 <= 1'd0;
+    if (portudp_first) begin
+        portudp_sel1 <= portudp_sel0;
     end else begin
-        liteethudp_sel1 <= liteethudp_sel_ongoing;
+        portudp_sel1 <= portudp_sel_ongoing;
     end
 end
 always @(*) begin
-    crossbar_sink_ready <= 1'd0;
     internal_port_source_first <= 1'd0;
     internal_port_source_last <= 1'd0;
     internal_port_source_param_dst_port <= 16'd0;
@@ -6104,27 +7376,166 @@ always @(*) begin
     internal_port_source_payload_error <= 1'd0;
     internal_port_source_payload_last_be <= 1'd0;
     internal_port_source_valid <= 1'd0;
-    case (liteethudp_sel1)
+    maskedudpcrossbar_sink_ready <= 1'd0;
+    case (portudp_sel1)
         1'd1: begin
-            internal_port_source_valid <= crossbar_sink_valid;
-            crossbar_sink_ready <= internal_port_source_ready;
-            internal_port_source_first <= crossbar_sink_first;
-            internal_port_source_last <= crossbar_sink_last;
-            internal_port_source_payload_data <= crossbar_sink_payload_data;
-            internal_port_source_payload_last_be <= crossbar_sink_payload_last_be;
-            internal_port_source_payload_error <= crossbar_sink_payload_error;
-            internal_port_source_param_src_port <= crossbar_sink_param_src_port;
-            internal_port_source_param_dst_port <= crossbar_sink_param_dst_port;
-            internal_port_source_param_ip_address <= crossbar_sink_param_ip_address;
-            internal_port_source_param_length <= crossbar_sink_param_length;
+            internal_port_source_valid <= maskedudpcrossbar_sink_valid;
+            maskedudpcrossbar_sink_ready <= internal_port_source_ready;
+            internal_port_source_first <= maskedudpcrossbar_sink_first;
+            internal_port_source_last <= maskedudpcrossbar_sink_last;
+            internal_port_source_payload_data <= maskedudpcrossbar_sink_payload_data;
+            internal_port_source_payload_last_be <= maskedudpcrossbar_sink_payload_last_be;
+            internal_port_source_payload_error <= maskedudpcrossbar_sink_payload_error;
+            internal_port_source_param_src_port <= maskedudpcrossbar_sink_param_src_port;
+            internal_port_source_param_dst_port <= maskedudpcrossbar_sink_param_dst_port;
+            internal_port_source_param_ip_address <= maskedudpcrossbar_sink_param_ip_address;
+            internal_port_source_param_length <= maskedudpcrossbar_sink_param_length;
         end
         default: begin
-            crossbar_sink_ready <= 1'd1;
+            maskedudpcrossbar_sink_ready <= 1'd1;
         end
     endcase
 end
-assign liteethudp_last = ((crossbar_sink_valid & crossbar_sink_last) & crossbar_sink_ready);
-assign liteethudp_ongoing0 = ((crossbar_sink_valid | liteethudp_ongoing1) & (~liteethudp_last));
+assign portudp_last = ((maskedudpcrossbar_sink_valid & maskedudpcrossbar_sink_last) & maskedudpcrossbar_sink_ready);
+assign portudp_ongoing0 = ((maskedudpcrossbar_sink_valid | portudp_ongoing1) & (~portudp_last));
+assign buffer0_pipe_valid_sink_ready = ((~buffer0_pipe_valid_source_valid) | buffer0_pipe_valid_source_ready);
+assign buffer0_pipe_ready_sink_ready = (~buffer0_pipe_ready_valid);
+always @(*) begin
+    buffer0_pipe_ready_source_first <= 1'd0;
+    buffer0_pipe_ready_source_last <= 1'd0;
+    buffer0_pipe_ready_source_param_ip_address <= 32'd0;
+    buffer0_pipe_ready_source_param_length <= 16'd0;
+    buffer0_pipe_ready_source_param_protocol <= 8'd0;
+    buffer0_pipe_ready_source_payload_data <= 8'd0;
+    buffer0_pipe_ready_source_payload_error <= 1'd0;
+    buffer0_pipe_ready_source_payload_last_be <= 1'd0;
+    buffer0_pipe_ready_source_valid <= 1'd0;
+    if (buffer0_pipe_ready_valid) begin
+        buffer0_pipe_ready_source_valid <= buffer0_pipe_ready_sink_d_valid;
+        buffer0_pipe_ready_source_first <= buffer0_pipe_ready_sink_d_first;
+        buffer0_pipe_ready_source_last <= buffer0_pipe_ready_sink_d_last;
+        buffer0_pipe_ready_source_payload_data <= buffer0_pipe_ready_sink_d_payload_data;
+        buffer0_pipe_ready_source_payload_last_be <= buffer0_pipe_ready_sink_d_payload_last_be;
+        buffer0_pipe_ready_source_payload_error <= buffer0_pipe_ready_sink_d_payload_error;
+        buffer0_pipe_ready_source_param_length <= buffer0_pipe_ready_sink_d_param_length;
+        buffer0_pipe_ready_source_param_protocol <= buffer0_pipe_ready_sink_d_param_protocol;
+        buffer0_pipe_ready_source_param_ip_address <= buffer0_pipe_ready_sink_d_param_ip_address;
+    end else begin
+        buffer0_pipe_ready_source_valid <= buffer0_pipe_ready_sink_valid;
+        buffer0_pipe_ready_source_first <= buffer0_pipe_ready_sink_first;
+        buffer0_pipe_ready_source_last <= buffer0_pipe_ready_sink_last;
+        buffer0_pipe_ready_source_payload_data <= buffer0_pipe_ready_sink_payload_data;
+        buffer0_pipe_ready_source_payload_last_be <= buffer0_pipe_ready_sink_payload_last_be;
+        buffer0_pipe_ready_source_payload_error <= buffer0_pipe_ready_sink_payload_error;
+        buffer0_pipe_ready_source_param_length <= buffer0_pipe_ready_sink_param_length;
+        buffer0_pipe_ready_source_param_protocol <= buffer0_pipe_ready_sink_param_protocol;
+        buffer0_pipe_ready_source_param_ip_address <= buffer0_pipe_ready_sink_param_ip_address;
+    end
+end
+assign buffer0_pipe_valid_sink_valid = buffer0_sink_sink_valid;
+assign buffer0_sink_sink_ready = buffer0_pipe_valid_sink_ready;
+assign buffer0_pipe_valid_sink_first = buffer0_sink_sink_first;
+assign buffer0_pipe_valid_sink_last = buffer0_sink_sink_last;
+assign buffer0_pipe_valid_sink_payload_data = buffer0_sink_sink_payload_data;
+assign buffer0_pipe_valid_sink_payload_last_be = buffer0_sink_sink_payload_last_be;
+assign buffer0_pipe_valid_sink_payload_error = buffer0_sink_sink_payload_error;
+assign buffer0_pipe_valid_sink_param_length = buffer0_sink_sink_param_length;
+assign buffer0_pipe_valid_sink_param_protocol = buffer0_sink_sink_param_protocol;
+assign buffer0_pipe_valid_sink_param_ip_address = buffer0_sink_sink_param_ip_address;
+assign buffer0_pipe_ready_sink_valid = buffer0_pipe_valid_source_valid;
+assign buffer0_pipe_valid_source_ready = buffer0_pipe_ready_sink_ready;
+assign buffer0_pipe_ready_sink_first = buffer0_pipe_valid_source_first;
+assign buffer0_pipe_ready_sink_last = buffer0_pipe_valid_source_last;
+assign buffer0_pipe_ready_sink_payload_data = buffer0_pipe_valid_source_payload_data;
+assign buffer0_pipe_ready_sink_payload_last_be = buffer0_pipe_valid_source_payload_last_be;
+assign buffer0_pipe_ready_sink_payload_error = buffer0_pipe_valid_source_payload_error;
+assign buffer0_pipe_ready_sink_param_length = buffer0_pipe_valid_source_param_length;
+assign buffer0_pipe_ready_sink_param_protocol = buffer0_pipe_valid_source_param_protocol;
+assign buffer0_pipe_ready_sink_param_ip_address = buffer0_pipe_valid_source_param_ip_address;
+assign buffer0_source_source_valid = buffer0_pipe_ready_source_valid;
+assign buffer0_pipe_ready_source_ready = buffer0_source_source_ready;
+assign buffer0_source_source_first = buffer0_pipe_ready_source_first;
+assign buffer0_source_source_last = buffer0_pipe_ready_source_last;
+assign buffer0_source_source_payload_data = buffer0_pipe_ready_source_payload_data;
+assign buffer0_source_source_payload_last_be = buffer0_pipe_ready_source_payload_last_be;
+assign buffer0_source_source_payload_error = buffer0_pipe_ready_source_payload_error;
+assign buffer0_source_source_param_length = buffer0_pipe_ready_source_param_length;
+assign buffer0_source_source_param_protocol = buffer0_pipe_ready_source_param_protocol;
+assign buffer0_source_source_param_ip_address = buffer0_pipe_ready_source_param_ip_address;
+assign buffer1_pipe_valid_sink_ready = ((~buffer1_pipe_valid_source_valid) | buffer1_pipe_valid_source_ready);
+assign buffer1_pipe_ready_sink_ready = (~buffer1_pipe_ready_valid);
+always @(*) begin
+    buffer1_pipe_ready_source_first <= 1'd0;
+    buffer1_pipe_ready_source_last <= 1'd0;
+    buffer1_pipe_ready_source_param_ip_address <= 32'd0;
+    buffer1_pipe_ready_source_param_length <= 16'd0;
+    buffer1_pipe_ready_source_param_protocol <= 8'd0;
+    buffer1_pipe_ready_source_payload_data <= 8'd0;
+    buffer1_pipe_ready_source_payload_error <= 1'd0;
+    buffer1_pipe_ready_source_payload_last_be <= 1'd0;
+    buffer1_pipe_ready_source_valid <= 1'd0;
+    if (buffer1_pipe_ready_valid) begin
+        buffer1_pipe_ready_source_valid <= buffer1_pipe_ready_sink_d_valid;
+        buffer1_pipe_ready_source_first <= buffer1_pipe_ready_sink_d_first;
+        buffer1_pipe_ready_source_last <= buffer1_pipe_ready_sink_d_last;
+        buffer1_pipe_ready_source_payload_data <= buffer1_pipe_ready_sink_d_payload_data;
+        buffer1_pipe_ready_source_payload_last_be <= buffer1_pipe_ready_sink_d_payload_last_be;
+        buffer1_pipe_ready_source_payload_error <= buffer1_pipe_ready_sink_d_payload_error;
+        buffer1_pipe_ready_source_param_length <= buffer1_pipe_ready_sink_d_param_length;
+        buffer1_pipe_ready_source_param_protocol <= buffer1_pipe_ready_sink_d_param_protocol;
+        buffer1_pipe_ready_source_param_ip_address <= buffer1_pipe_ready_sink_d_param_ip_address;
+    end else begin
+        buffer1_pipe_ready_source_valid <= buffer1_pipe_ready_sink_valid;
+        buffer1_pipe_ready_source_first <= buffer1_pipe_ready_sink_first;
+        buffer1_pipe_ready_source_last <= buffer1_pipe_ready_sink_last;
+        buffer1_pipe_ready_source_payload_data <= buffer1_pipe_ready_sink_payload_data;
+        buffer1_pipe_ready_source_payload_last_be <= buffer1_pipe_ready_sink_payload_last_be;
+        buffer1_pipe_ready_source_payload_error <= buffer1_pipe_ready_sink_payload_error;
+        buffer1_pipe_ready_source_param_length <= buffer1_pipe_ready_sink_param_length;
+        buffer1_pipe_ready_source_param_protocol <= buffer1_pipe_ready_sink_param_protocol;
+        buffer1_pipe_ready_source_param_ip_address <= buffer1_pipe_ready_sink_param_ip_address;
+    end
+end
+assign buffer1_pipe_valid_sink_valid = buffer1_sink_sink_valid;
+assign buffer1_sink_sink_ready = buffer1_pipe_valid_sink_ready;
+assign buffer1_pipe_valid_sink_first = buffer1_sink_sink_first;
+assign buffer1_pipe_valid_sink_last = buffer1_sink_sink_last;
+assign buffer1_pipe_valid_sink_payload_data = buffer1_sink_sink_payload_data;
+assign buffer1_pipe_valid_sink_payload_last_be = buffer1_sink_sink_payload_last_be;
+assign buffer1_pipe_valid_sink_payload_error = buffer1_sink_sink_payload_error;
+assign buffer1_pipe_valid_sink_param_length = buffer1_sink_sink_param_length;
+assign buffer1_pipe_valid_sink_param_protocol = buffer1_sink_sink_param_protocol;
+assign buffer1_pipe_valid_sink_param_ip_address = buffer1_sink_sink_param_ip_address;
+assign buffer1_pipe_ready_sink_valid = buffer1_pipe_valid_source_valid;
+assign buffer1_pipe_valid_source_ready = buffer1_pipe_ready_sink_ready;
+assign buffer1_pipe_ready_sink_first = buffer1_pipe_valid_source_first;
+assign buffer1_pipe_ready_sink_last = buffer1_pipe_valid_source_last;
+assign buffer1_pipe_ready_sink_payload_data = buffer1_pipe_valid_source_payload_data;
+assign buffer1_pipe_ready_sink_payload_last_be = buffer1_pipe_valid_source_payload_last_be;
+assign buffer1_pipe_ready_sink_payload_error = buffer1_pipe_valid_source_payload_error;
+assign buffer1_pipe_ready_sink_param_length = buffer1_pipe_valid_source_param_length;
+assign buffer1_pipe_ready_sink_param_protocol = buffer1_pipe_valid_source_param_protocol;
+assign buffer1_pipe_ready_sink_param_ip_address = buffer1_pipe_valid_source_param_ip_address;
+assign buffer1_source_source_valid = buffer1_pipe_ready_source_valid;
+assign buffer1_pipe_ready_source_ready = buffer1_source_source_ready;
+assign buffer1_source_source_first = buffer1_pipe_ready_source_first;
+assign buffer1_source_source_last = buffer1_pipe_ready_source_last;
+assign buffer1_source_source_payload_data = buffer1_pipe_ready_source_payload_data;
+assign buffer1_source_source_payload_last_be = buffer1_pipe_ready_source_payload_last_be;
+assign buffer1_source_source_payload_error = buffer1_pipe_ready_source_payload_error;
+assign buffer1_source_source_param_length = buffer1_pipe_ready_source_param_length;
+assign buffer1_source_source_param_protocol = buffer1_pipe_ready_source_param_protocol;
+assign buffer1_source_source_param_ip_address = buffer1_pipe_ready_source_param_ip_address;
+assign pulsemerge0_total0 = ((((1'd0 + mac_cut) + ip_rx_cut) + ip_rx_drop_header) + pulsemerge0_backlog0);
+assign pulsemerge0_o0 = (pulsemerge0_total0 != 1'd0);
+assign pulsesynchronizer0_o = (pulsesynchronizer0_toggle_o ^ pulsesynchronizer0_toggle_o_r);
+assign pulsemerge0_total1 = ((((1'd0 + pulsesynchronizer0_o) + holdingudprx_cut0) + holdingudprx_drop_header) + pulsemerge0_backlog1);
+assign pulsemerge0_o1 = (pulsemerge0_total1 != 1'd0);
+assign pulsemerge1_total0 = ((((1'd0 + mac_crossbar_dropped) + ip_rx_drop_other) + ip_crossbar_dropped) + pulsemerge1_backlog0);
+assign pulsemerge1_o0 = (pulsemerge1_total0 != 1'd0);
+assign pulsesynchronizer1_o = (pulsesynchronizer1_toggle_o ^ pulsesynchronizer1_toggle_o_r);
+assign pulsemerge1_total1 = (((1'd0 + pulsesynchronizer1_o) + maskedudpcrossbar_dropped) + pulsemerge1_backlog1);
+assign pulsemerge1_o1 = (pulsemerge1_total1 != 1'd0);
 always @(*) begin
     interface0_ack <= 1'd0;
     interface0_dat_r <= 32'd0;
@@ -6313,8 +7724,14 @@ assign mac_core_tx_cdc_cdc_produce_rdomain = multiregimpl0_regs1;
 assign mac_core_tx_cdc_cdc_consume_wdomain = multiregimpl1_regs1;
 assign mac_core_pulsesynchronizer0_toggle_o = multiregimpl2_regs1;
 assign mac_core_pulsesynchronizer1_toggle_o = multiregimpl3_regs1;
-assign mac_core_cdc_produce_rdomain = multiregimpl4_regs1;
-assign mac_core_cdc_consume_wdomain = multiregimpl5_regs1;
+assign mac_core_rx_cdc_cdc_produce_rdomain = multiregimpl4_regs1;
+assign mac_core_rx_cdc_cdc_consume_wdomain = multiregimpl5_regs1;
+assign rx_cdc_cdc_produce_rdomain = multiregimpl6_regs1;
+assign rx_cdc_cdc_consume_wdomain = multiregimpl7_regs1;
+assign tx_cdc_cdc_produce_rdomain = multiregimpl8_regs1;
+assign tx_cdc_cdc_consume_wdomain = multiregimpl9_regs1;
+assign pulsesynchronizer0_toggle_o = multiregimpl10_regs1;
+assign pulsesynchronizer1_toggle_o = multiregimpl11_regs1;
 
 
 //------------------------------------------------------------------------------
@@ -6388,8 +7805,52 @@ always @(posedge eth_rx_clk) begin
     if (mac_core_pulsesynchronizer1_i) begin
         mac_core_pulsesynchronizer1_toggle_i <= (~mac_core_pulsesynchronizer1_toggle_i);
     end
-    mac_core_cdc_graycounter0_q_binary <= mac_core_cdc_graycounter0_q_next_binary;
-    mac_core_cdc_graycounter0_q <= mac_core_cdc_graycounter0_q_next;
+    if (mac_core_rx_converter_converter_source_ready) begin
+        mac_core_rx_converter_converter_strobe_all <= 1'd0;
+    end
+    if (mac_core_rx_converter_converter_load_part) begin
+        if (((mac_core_rx_converter_converter_demux == 2'd3) | mac_core_rx_converter_converter_sink_last)) begin
+            mac_core_rx_converter_converter_demux <= 1'd0;
+            mac_core_rx_converter_converter_strobe_all <= 1'd1;
+        end else begin
+            mac_core_rx_converter_converter_demux <= (mac_core_rx_converter_converter_demux + 1'd1);
+        end
+    end
+    if ((mac_core_rx_converter_converter_source_valid & mac_core_rx_converter_converter_source_ready)) begin
+        if ((mac_core_rx_converter_converter_sink_valid & mac_core_rx_converter_converter_sink_ready)) begin
+            mac_core_rx_converter_converter_source_first <= mac_core_rx_converter_converter_sink_first;
+            mac_core_rx_converter_converter_source_last <= mac_core_rx_converter_converter_sink_last;
+        end else begin
+            mac_core_rx_converter_converter_source_first <= 1'd0;
+            mac_core_rx_converter_converter_source_last <= 1'd0;
+        end
+    end else begin
+        if ((mac_core_rx_converter_converter_sink_valid & mac_core_rx_converter_converter_sink_ready)) begin
+            mac_core_rx_converter_converter_source_first <= (mac_core_rx_converter_converter_sink_first | mac_core_rx_converter_converter_source_first);
+            mac_core_rx_converter_converter_source_last <= (mac_core_rx_converter_converter_sink_last | mac_core_rx_converter_converter_source_last);
+        end
+    end
+    if (mac_core_rx_converter_converter_load_part) begin
+        case (mac_core_rx_converter_converter_demux)
+            1'd0: begin
+                mac_core_rx_converter_converter_source_payload_data[9:0] <= mac_core_rx_converter_converter_sink_payload_data;
+            end
+            1'd1: begin
+                mac_core_rx_converter_converter_source_payload_data[19:10] <= mac_core_rx_converter_converter_sink_payload_data;
+            end
+            2'd2: begin
+                mac_core_rx_converter_converter_source_payload_data[29:20] <= mac_core_rx_converter_converter_sink_payload_data;
+            end
+            2'd3: begin
+                mac_core_rx_converter_converter_source_payload_data[39:30] <= mac_core_rx_converter_converter_sink_payload_data;
+            end
+        endcase
+    end
+    if (mac_core_rx_converter_converter_load_part) begin
+        mac_core_rx_converter_converter_source_payload_valid_token_count <= (mac_core_rx_converter_converter_demux + 1'd1);
+    end
+    mac_core_rx_cdc_cdc_graycounter0_q_binary <= mac_core_rx_cdc_cdc_graycounter0_q_next_binary;
+    mac_core_rx_cdc_cdc_graycounter0_q <= mac_core_rx_cdc_cdc_graycounter0_q_next;
     if (eth_rx_rst) begin
         ethphy_source_valid <= 1'd0;
         ethphy_source_payload_data <= 8'd0;
@@ -6409,18 +7870,30 @@ always @(posedge eth_rx_clk) begin
         mac_core_bufferizeendpoints_pipe_valid_source_payload_data <= 8'd0;
         mac_core_bufferizeendpoints_pipe_valid_source_payload_last_be <= 1'd0;
         mac_core_bufferizeendpoints_pipe_valid_source_payload_error <= 1'd0;
-        mac_core_cdc_graycounter0_q <= 6'd0;
-        mac_core_cdc_graycounter0_q_binary <= 6'd0;
+        mac_core_rx_converter_converter_source_payload_data <= 40'd0;
+        mac_core_rx_converter_converter_source_payload_valid_token_count <= 3'd0;
+        mac_core_rx_converter_converter_demux <= 2'd0;
+        mac_core_rx_converter_converter_strobe_all <= 1'd0;
+        mac_core_rx_cdc_cdc_graycounter0_q <= 6'd0;
+        mac_core_rx_cdc_cdc_graycounter0_q_binary <= 6'd0;
         liteethmac_rxdatapath_liteethmacpreamblechecker_state <= 1'd0;
         liteethmac_rxdatapath_bufferizeendpoints_state <= 2'd0;
     end
-    multiregimpl5_regs0 <= mac_core_cdc_graycounter1_q;
+    multiregimpl5_regs0 <= mac_core_rx_cdc_cdc_graycounter1_q;
     multiregimpl5_regs1 <= multiregimpl5_regs0;
 end
 
 always @(posedge eth_tx_clk) begin
     mac_core_tx_cdc_cdc_graycounter1_q_binary <= mac_core_tx_cdc_cdc_graycounter1_q_next_binary;
     mac_core_tx_cdc_cdc_graycounter1_q <= mac_core_tx_cdc_cdc_graycounter1_q_next;
+    if ((mac_core_tx_converter_converter_source_valid & mac_core_tx_converter_converter_source_ready)) begin
+        if (mac_core_tx_converter_converter_last) begin
+            mac_core_tx_converter_converter_mux <= 1'd0;
+        end else begin
+            mac_core_tx_converter_converter_mux <= (mac_core_tx_converter_converter_mux + 1'd1);
+        end
+    end
+    liteethmac_txdatapath_liteethmactxlastbe_state <= liteethmac_txdatapath_liteethmactxlastbe_next_state;
     liteethmac_txdatapath_liteethmacpaddinginserter_state <= liteethmac_txdatapath_liteethmacpaddinginserter_next_state;
     if (mac_core_tx_padding_counter_liteethmac_clockdomainsrenamer0_next_value_ce) begin
         mac_core_tx_padding_counter <= mac_core_tx_padding_counter_liteethmac_clockdomainsrenamer0_next_value;
@@ -6461,9 +7934,34 @@ always @(posedge eth_tx_clk) begin
     if (mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value_ce) begin
         mac_core_tx_gap_counter <= mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value;
     end
+    if (((~pipe_valid_source_valid) | pipe_valid_source_ready)) begin
+        pipe_valid_source_valid <= pipe_valid_sink_valid;
+        pipe_valid_source_first <= pipe_valid_sink_first;
+        pipe_valid_source_last <= pipe_valid_sink_last;
+        pipe_valid_source_payload_data <= pipe_valid_sink_payload_data;
+        pipe_valid_source_payload_last_be <= pipe_valid_sink_payload_last_be;
+        pipe_valid_source_payload_error <= pipe_valid_sink_payload_error;
+    end
+    if ((pipe_ready_sink_valid & (~pipe_ready_source_ready))) begin
+        pipe_ready_valid <= 1'd1;
+    end else begin
+        if (pipe_ready_source_ready) begin
+            pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~pipe_ready_source_ready) & (~pipe_ready_valid))) begin
+        pipe_ready_sink_d_valid <= pipe_ready_sink_valid;
+        pipe_ready_sink_d_ready <= pipe_ready_sink_ready;
+        pipe_ready_sink_d_first <= pipe_ready_sink_first;
+        pipe_ready_sink_d_last <= pipe_ready_sink_last;
+        pipe_ready_sink_d_payload_data <= pipe_ready_sink_payload_data;
+        pipe_ready_sink_d_payload_last_be <= pipe_ready_sink_payload_last_be;
+        pipe_ready_sink_d_payload_error <= pipe_ready_sink_payload_error;
+    end
     if (eth_tx_rst) begin
         mac_core_tx_cdc_cdc_graycounter1_q <= 6'd0;
         mac_core_tx_cdc_cdc_graycounter1_q_binary <= 6'd0;
+        mac_core_tx_converter_converter_mux <= 2'd0;
         mac_core_tx_padding_counter <= 16'd0;
         mac_core_tx_crc_reg <= 32'd4294967295;
         mac_core_tx_crc_cnt <= 2'd3;
@@ -6471,6 +7969,17 @@ always @(posedge eth_tx_clk) begin
         mac_core_tx_crc_pipe_valid_source_payload_data <= 8'd0;
         mac_core_tx_crc_pipe_valid_source_payload_last_be <= 1'd0;
         mac_core_tx_crc_pipe_valid_source_payload_error <= 1'd0;
+        pipe_valid_source_valid <= 1'd0;
+        pipe_valid_source_payload_data <= 32'd0;
+        pipe_valid_source_payload_last_be <= 4'd0;
+        pipe_valid_source_payload_error <= 4'd0;
+        pipe_ready_valid <= 1'd0;
+        pipe_ready_sink_d_valid <= 1'd0;
+        pipe_ready_sink_d_ready <= 1'd0;
+        pipe_ready_sink_d_payload_data <= 32'd0;
+        pipe_ready_sink_d_payload_last_be <= 4'd0;
+        pipe_ready_sink_d_payload_error <= 4'd0;
+        liteethmac_txdatapath_liteethmactxlastbe_state <= 1'd0;
         liteethmac_txdatapath_liteethmacpaddinginserter_state <= 1'd0;
         liteethmac_txdatapath_bufferizeendpoints_state <= 2'd0;
         liteethmac_txdatapath_liteethmacpreambleinserter_state <= 2'd0;
@@ -6482,6 +7991,274 @@ end
 
 always @(posedge por_clk) begin
     int_rst <= sys_reset;
+end
+
+always @(posedge port_clk) begin
+    rx_cdc_cdc_graycounter1_q_binary <= rx_cdc_cdc_graycounter1_q_next_binary;
+    rx_cdc_cdc_graycounter1_q <= rx_cdc_cdc_graycounter1_q_next;
+    if ((strideconverter0_converter_source_valid & strideconverter0_converter_source_ready)) begin
+        if (strideconverter0_converter_last) begin
+            strideconverter0_converter_mux <= 1'd0;
+        end else begin
+            strideconverter0_converter_mux <= (strideconverter0_converter_mux + 1'd1);
+        end
+    end
+    portudp_lastbytetrim_state <= portudp_lastbytetrim_next_state;
+    if (lastbytetrim_err_lastbytetrim_next_value_ce) begin
+        lastbytetrim_err <= lastbytetrim_err_lastbytetrim_next_value;
+    end
+    if (holdingudprx_liteethudpdepacketizer_sr_shift) begin
+        holdingudprx_liteethudpdepacketizer_sr <= {holdingudprx_liteethudpdepacketizer_sink_payload_data, holdingudprx_liteethudpdepacketizer_sr[63:8]};
+    end
+    if (holdingudprx_liteethudpdepacketizer_sr_shift_leftover) begin
+        holdingudprx_liteethudpdepacketizer_sr <= {holdingudprx_liteethudpdepacketizer_sink_payload_data, holdingudprx_liteethudpdepacketizer_sr[63:0]};
+    end
+    holdingudprx_liteethudpdepacketizer_was_in_copy <= holdingudprx_liteethudpdepacketizer_is_in_copy;
+    portudp_holdingudprx_fsm0_state <= portudp_holdingudprx_fsm0_next_state;
+    if (holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0) begin
+        holdingudprx_liteethudpdepacketizer_count <= holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0;
+    end
+    if (holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value_ce1) begin
+        holdingudprx_liteethudpdepacketizer_fsm_from_idle <= holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value1;
+    end
+    portudp_holdingudprx_fsm1_state <= portudp_holdingudprx_fsm1_next_state;
+    if (holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value_ce) begin
+        holdingudprx_liteethudpdepacketizer_delayed_last_be <= holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value;
+    end
+    portudp_holdingudprx_state <= portudp_holdingudprx_next_state;
+    if (holdingudprx_count_holdingudprx_next_value_ce0) begin
+        holdingudprx_count <= holdingudprx_count_holdingudprx_next_value0;
+    end
+    if (holdingudprx_err_holdingudprx_next_value_ce1) begin
+        holdingudprx_err <= holdingudprx_err_holdingudprx_next_value1;
+    end
+    if (holdingudprx_rest_holdingudprx_next_value_ce2) begin
+        holdingudprx_rest <= holdingudprx_rest_holdingudprx_next_value2;
+    end
+    if (holdingudprx_held_holdingudprx_next_value_ce3) begin
+        holdingudprx_held <= holdingudprx_held_holdingudprx_next_value3;
+    end
+    if (holdingudprx0_holdingudprx_next_value_ce4) begin
+        holdingudprx0 <= holdingudprx0_holdingudprx_next_value4;
+    end
+    if (holdingudprx1_holdingudprx_next_value_ce5) begin
+        holdingudprx1 <= holdingudprx1_holdingudprx_next_value5;
+    end
+    if (holdingudprx2_holdingudprx_next_value_ce6) begin
+        holdingudprx2 <= holdingudprx2_holdingudprx_next_value6;
+    end
+    if (holdingudprx3_holdingudprx_next_value_ce7) begin
+        holdingudprx3 <= holdingudprx3_holdingudprx_next_value7;
+    end
+    if (liteethudptx_packetizer_sr_load) begin
+        liteethudptx_packetizer_sr <= liteethudptx_packetizer_header;
+    end
+    if (liteethudptx_packetizer_sr_shift) begin
+        liteethudptx_packetizer_sr <= liteethudptx_packetizer_sr[63:8];
+    end
+    portudp_liteethudptx_fsm0_state <= portudp_liteethudptx_fsm0_next_state;
+    if (liteethudptx_packetizer_count_fsm0_next_value_ce4) begin
+        liteethudptx_packetizer_count <= liteethudptx_packetizer_count_fsm0_next_value4;
+    end
+    if (liteethudptx_packetizer_fsm_from_idle_fsm0_next_value_ce5) begin
+        liteethudptx_packetizer_fsm_from_idle <= liteethudptx_packetizer_fsm_from_idle_fsm0_next_value5;
+    end
+    portudp_liteethudptx_fsm1_state <= portudp_liteethudptx_fsm1_next_state;
+    if (liteethudptx_packetizer_delayed_last_be_fsm1_next_value_ce2) begin
+        liteethudptx_packetizer_delayed_last_be <= liteethudptx_packetizer_delayed_last_be_fsm1_next_value2;
+    end
+    portudp_liteethudptx_state <= portudp_liteethudptx_next_state;
+    strideconverter1_source_param_length <= strideconverter1_sink_param_length;
+    strideconverter1_source_param_protocol <= strideconverter1_sink_param_protocol;
+    strideconverter1_source_param_ip_address <= strideconverter1_sink_param_ip_address;
+    if (strideconverter1_converter_source_ready) begin
+        strideconverter1_converter_strobe_all <= 1'd0;
+    end
+    if (strideconverter1_converter_load_part) begin
+        if (((strideconverter1_converter_demux == 2'd3) | strideconverter1_converter_sink_last)) begin
+            strideconverter1_converter_demux <= 1'd0;
+            strideconverter1_converter_strobe_all <= 1'd1;
+        end else begin
+            strideconverter1_converter_demux <= (strideconverter1_converter_demux + 1'd1);
+        end
+    end
+    if ((strideconverter1_converter_source_valid & strideconverter1_converter_source_ready)) begin
+        if ((strideconverter1_converter_sink_valid & strideconverter1_converter_sink_ready)) begin
+            strideconverter1_converter_source_first <= strideconverter1_converter_sink_first;
+            strideconverter1_converter_source_last <= strideconverter1_converter_sink_last;
+        end else begin
+            strideconverter1_converter_source_first <= 1'd0;
+            strideconverter1_converter_source_last <= 1'd0;
+        end
+    end else begin
+        if ((strideconverter1_converter_sink_valid & strideconverter1_converter_sink_ready)) begin
+            strideconverter1_converter_source_first <= (strideconverter1_converter_sink_first | strideconverter1_converter_source_first);
+            strideconverter1_converter_source_last <= (strideconverter1_converter_sink_last | strideconverter1_converter_source_last);
+        end
+    end
+    if (strideconverter1_converter_load_part) begin
+        case (strideconverter1_converter_demux)
+            1'd0: begin
+                strideconverter1_converter_source_payload_data[9:0] <= strideconverter1_converter_sink_payload_data;
+            end
+            1'd1: begin
+                strideconverter1_converter_source_payload_data[19:10] <= strideconverter1_converter_sink_payload_data;
+            end
+            2'd2: begin
+                strideconverter1_converter_source_payload_data[29:20] <= strideconverter1_converter_sink_payload_data;
+            end
+            2'd3: begin
+                strideconverter1_converter_source_payload_data[39:30] <= strideconverter1_converter_sink_payload_data;
+            end
+        endcase
+    end
+    if (strideconverter1_converter_load_part) begin
+        strideconverter1_converter_source_payload_valid_token_count <= (strideconverter1_converter_demux + 1'd1);
+    end
+    tx_cdc_cdc_graycounter0_q_binary <= tx_cdc_cdc_graycounter0_q_next_binary;
+    tx_cdc_cdc_graycounter0_q <= tx_cdc_cdc_graycounter0_q_next;
+    if (portudp_first) begin
+        portudp_sel_ongoing <= portudp_sel0;
+    end
+    portudp_ongoing1 <= portudp_ongoing0;
+    if (portudp_last) begin
+        portudp_first <= 1'd1;
+    end else begin
+        if ((maskedudpcrossbar_sink_valid & maskedudpcrossbar_sink_ready)) begin
+            portudp_first <= 1'd0;
+        end
+    end
+    if (((~buffer0_pipe_valid_source_valid) | buffer0_pipe_valid_source_ready)) begin
+        buffer0_pipe_valid_source_valid <= buffer0_pipe_valid_sink_valid;
+        buffer0_pipe_valid_source_first <= buffer0_pipe_valid_sink_first;
+        buffer0_pipe_valid_source_last <= buffer0_pipe_valid_sink_last;
+        buffer0_pipe_valid_source_payload_data <= buffer0_pipe_valid_sink_payload_data;
+        buffer0_pipe_valid_source_payload_last_be <= buffer0_pipe_valid_sink_payload_last_be;
+        buffer0_pipe_valid_source_payload_error <= buffer0_pipe_valid_sink_payload_error;
+        buffer0_pipe_valid_source_param_length <= buffer0_pipe_valid_sink_param_length;
+        buffer0_pipe_valid_source_param_protocol <= buffer0_pipe_valid_sink_param_protocol;
+        buffer0_pipe_valid_source_param_ip_address <= buffer0_pipe_valid_sink_param_ip_address;
+    end
+    if ((buffer0_pipe_ready_sink_valid & (~buffer0_pipe_ready_source_ready))) begin
+        buffer0_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (buffer0_pipe_ready_source_ready) begin
+            buffer0_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~buffer0_pipe_ready_source_ready) & (~buffer0_pipe_ready_valid))) begin
+        buffer0_pipe_ready_sink_d_valid <= buffer0_pipe_ready_sink_valid;
+        buffer0_pipe_ready_sink_d_ready <= buffer0_pipe_ready_sink_ready;
+        buffer0_pipe_ready_sink_d_first <= buffer0_pipe_ready_sink_first;
+        buffer0_pipe_ready_sink_d_last <= buffer0_pipe_ready_sink_last;
+        buffer0_pipe_ready_sink_d_payload_data <= buffer0_pipe_ready_sink_payload_data;
+        buffer0_pipe_ready_sink_d_payload_last_be <= buffer0_pipe_ready_sink_payload_last_be;
+        buffer0_pipe_ready_sink_d_payload_error <= buffer0_pipe_ready_sink_payload_error;
+        buffer0_pipe_ready_sink_d_param_length <= buffer0_pipe_ready_sink_param_length;
+        buffer0_pipe_ready_sink_d_param_protocol <= buffer0_pipe_ready_sink_param_protocol;
+        buffer0_pipe_ready_sink_d_param_ip_address <= buffer0_pipe_ready_sink_param_ip_address;
+    end
+    if (((~buffer1_pipe_valid_source_valid) | buffer1_pipe_valid_source_ready)) begin
+        buffer1_pipe_valid_source_valid <= buffer1_pipe_valid_sink_valid;
+        buffer1_pipe_valid_source_first <= buffer1_pipe_valid_sink_first;
+        buffer1_pipe_valid_source_last <= buffer1_pipe_valid_sink_last;
+        buffer1_pipe_valid_source_payload_data <= buffer1_pipe_valid_sink_payload_data;
+        buffer1_pipe_valid_source_payload_last_be <= buffer1_pipe_valid_sink_payload_last_be;
+        buffer1_pipe_valid_source_payload_error <= buffer1_pipe_valid_sink_payload_error;
+        buffer1_pipe_valid_source_param_length <= buffer1_pipe_valid_sink_param_length;
+        buffer1_pipe_valid_source_param_protocol <= buffer1_pipe_valid_sink_param_protocol;
+        buffer1_pipe_valid_source_param_ip_address <= buffer1_pipe_valid_sink_param_ip_address;
+    end
+    if ((buffer1_pipe_ready_sink_valid & (~buffer1_pipe_ready_source_ready))) begin
+        buffer1_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (buffer1_pipe_ready_source_ready) begin
+            buffer1_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~buffer1_pipe_ready_source_ready) & (~buffer1_pipe_ready_valid))) begin
+        buffer1_pipe_ready_sink_d_valid <= buffer1_pipe_ready_sink_valid;
+        buffer1_pipe_ready_sink_d_ready <= buffer1_pipe_ready_sink_ready;
+        buffer1_pipe_ready_sink_d_first <= buffer1_pipe_ready_sink_first;
+        buffer1_pipe_ready_sink_d_last <= buffer1_pipe_ready_sink_last;
+        buffer1_pipe_ready_sink_d_payload_data <= buffer1_pipe_ready_sink_payload_data;
+        buffer1_pipe_ready_sink_d_payload_last_be <= buffer1_pipe_ready_sink_payload_last_be;
+        buffer1_pipe_ready_sink_d_payload_error <= buffer1_pipe_ready_sink_payload_error;
+        buffer1_pipe_ready_sink_d_param_length <= buffer1_pipe_ready_sink_param_length;
+        buffer1_pipe_ready_sink_d_param_protocol <= buffer1_pipe_ready_sink_param_protocol;
+        buffer1_pipe_ready_sink_d_param_ip_address <= buffer1_pipe_ready_sink_param_ip_address;
+    end
+    pulsesynchronizer0_toggle_o_r <= pulsesynchronizer0_toggle_o;
+    pulsemerge0_backlog1 <= (pulsemerge0_total1 - pulsemerge0_o1);
+    pulsesynchronizer1_toggle_o_r <= pulsesynchronizer1_toggle_o;
+    pulsemerge1_backlog1 <= (pulsemerge1_total1 - pulsemerge1_o1);
+    if (port_rst) begin
+        rx_cdc_cdc_graycounter1_q <= 5'd0;
+        rx_cdc_cdc_graycounter1_q_binary <= 5'd0;
+        strideconverter0_converter_mux <= 2'd0;
+        lastbytetrim_err <= 1'd0;
+        holdingudprx_liteethudpdepacketizer_count <= 3'd0;
+        holdingudprx_liteethudpdepacketizer_fsm_from_idle <= 1'd0;
+        holdingudprx_liteethudpdepacketizer_delayed_last_be <= 1'd0;
+        holdingudprx_liteethudpdepacketizer_was_in_copy <= 1'd0;
+        holdingudprx_count <= 16'd0;
+        holdingudprx_err <= 1'd0;
+        holdingudprx_held <= 8'd0;
+        holdingudprx0 <= 16'd0;
+        holdingudprx1 <= 16'd0;
+        holdingudprx2 <= 16'd0;
+        holdingudprx3 <= 32'd0;
+        holdingudprx_rest <= 16'd0;
+        liteethudptx_packetizer_count <= 3'd0;
+        liteethudptx_packetizer_fsm_from_idle <= 1'd0;
+        liteethudptx_packetizer_delayed_last_be <= 1'd0;
+        strideconverter1_converter_source_payload_data <= 40'd0;
+        strideconverter1_converter_source_payload_valid_token_count <= 3'd0;
+        strideconverter1_converter_demux <= 2'd0;
+        strideconverter1_converter_strobe_all <= 1'd0;
+        tx_cdc_cdc_graycounter0_q <= 5'd0;
+        tx_cdc_cdc_graycounter0_q_binary <= 5'd0;
+        buffer0_pipe_valid_source_valid <= 1'd0;
+        buffer0_pipe_valid_source_payload_data <= 8'd0;
+        buffer0_pipe_valid_source_payload_last_be <= 1'd0;
+        buffer0_pipe_valid_source_payload_error <= 1'd0;
+        buffer0_pipe_ready_valid <= 1'd0;
+        buffer0_pipe_ready_sink_d_valid <= 1'd0;
+        buffer0_pipe_ready_sink_d_ready <= 1'd0;
+        buffer0_pipe_ready_sink_d_payload_data <= 8'd0;
+        buffer0_pipe_ready_sink_d_payload_last_be <= 1'd0;
+        buffer0_pipe_ready_sink_d_payload_error <= 1'd0;
+        buffer1_pipe_valid_source_valid <= 1'd0;
+        buffer1_pipe_valid_source_payload_data <= 8'd0;
+        buffer1_pipe_valid_source_payload_last_be <= 1'd0;
+        buffer1_pipe_valid_source_payload_error <= 1'd0;
+        buffer1_pipe_ready_valid <= 1'd0;
+        buffer1_pipe_ready_sink_d_valid <= 1'd0;
+        buffer1_pipe_ready_sink_d_ready <= 1'd0;
+        buffer1_pipe_ready_sink_d_payload_data <= 8'd0;
+        buffer1_pipe_ready_sink_d_payload_last_be <= 1'd0;
+        buffer1_pipe_ready_sink_d_payload_error <= 1'd0;
+        pulsemerge0_backlog1 <= 3'd0;
+        pulsemerge1_backlog1 <= 3'd0;
+        portudp_lastbytetrim_state <= 1'd0;
+        portudp_holdingudprx_fsm0_state <= 2'd0;
+        portudp_holdingudprx_fsm1_state <= 1'd0;
+        portudp_holdingudprx_state <= 3'd0;
+        portudp_liteethudptx_fsm0_state <= 2'd0;
+        portudp_liteethudptx_fsm1_state <= 1'd0;
+        portudp_liteethudptx_state <= 1'd0;
+        portudp_first <= 1'd1;
+        portudp_ongoing1 <= 1'd0;
+        portudp_sel_ongoing <= 1'd0;
+    end
+    multiregimpl6_regs0 <= rx_cdc_cdc_graycounter0_q;
+    multiregimpl6_regs1 <= multiregimpl6_regs0;
+    multiregimpl9_regs0 <= tx_cdc_cdc_graycounter1_q;
+    multiregimpl9_regs1 <= multiregimpl9_regs0;
+    multiregimpl10_regs0 <= pulsesynchronizer0_toggle_i;
+    multiregimpl10_regs1 <= multiregimpl10_regs0;
+    multiregimpl11_regs0 <= pulsesynchronizer1_toggle_i;
+    multiregimpl11_regs1 <= multiregimpl11_regs0;
 end
 
 always @(posedge sys_clk) begin
@@ -6500,8 +8277,8 @@ always @(posedge sys_clk) begin
     end
     mac_core_pulsesynchronizer0_toggle_o_r <= mac_core_pulsesynchronizer0_toggle_o;
     mac_core_pulsesynchronizer1_toggle_o_r <= mac_core_pulsesynchronizer1_toggle_o;
-    mac_core_cdc_graycounter1_q_binary <= mac_core_cdc_graycounter1_q_next_binary;
-    mac_core_cdc_graycounter1_q <= mac_core_cdc_graycounter1_q_next;
+    mac_core_rx_cdc_cdc_graycounter1_q_binary <= mac_core_rx_cdc_cdc_graycounter1_q_next_binary;
+    mac_core_rx_cdc_cdc_graycounter1_q <= mac_core_rx_cdc_cdc_graycounter1_q_next;
     case (liteethmac_grant)
         1'd0: begin
             if ((~liteethmac_request[0])) begin
@@ -6549,7 +8326,19 @@ always @(posedge sys_clk) begin
         mac_packetizer_sr <= mac_packetizer_header;
     end
     if (mac_packetizer_sr_shift) begin
-        mac_packetizer_sr <= mac_packetizer_sr[111:8];
+        mac_packetizer_sr <= mac_packetizer_sr[111:32];
+    end
+    if ((mac_packetizer_source_valid & mac_packetizer_source_ready)) begin
+        mac_packetizer_sink_d_valid <= mac_packetizer_sink_valid;
+        mac_packetizer_sink_d_ready <= mac_packetizer_sink_ready;
+        mac_packetizer_sink_d_first <= mac_packetizer_sink_first;
+        mac_packetizer_sink_d_last <= mac_packetizer_sink_last;
+        mac_packetizer_sink_d_payload_ethernet_type <= mac_packetizer_sink_payload_ethernet_type;
+        mac_packetizer_sink_d_payload_sender_mac <= mac_packetizer_sink_payload_sender_mac;
+        mac_packetizer_sink_d_payload_target_mac <= mac_packetizer_sink_payload_target_mac;
+        mac_packetizer_sink_d_payload_data <= mac_packetizer_sink_payload_data;
+        mac_packetizer_sink_d_payload_last_be <= mac_packetizer_sink_payload_last_be;
+        mac_packetizer_sink_d_payload_error <= mac_packetizer_sink_payload_error;
     end
     liteethmac_fsm0_state0 <= liteethmac_fsm0_next_state0;
     if (mac_packetizer_count_liteethmac_fsm0_next_value_ce0) begin
@@ -6563,10 +8352,19 @@ always @(posedge sys_clk) begin
         mac_packetizer_delayed_last_be <= mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0;
     end
     if (mac_liteethmacdepacketizer_sr_shift) begin
-        mac_liteethmacdepacketizer_sr <= {mac_liteethmacdepacketizer_sink_payload_data, mac_liteethmacdepacketizer_sr[111:8]};
+        mac_liteethmacdepacketizer_sr <= {mac_liteethmacdepacketizer_sink_payload_data, mac_liteethmacdepacketizer_sr[111:32]};
     end
     if (mac_liteethmacdepacketizer_sr_shift_leftover) begin
-        mac_liteethmacdepacketizer_sr <= {mac_liteethmacdepacketizer_sink_payload_data, mac_liteethmacdepacketizer_sr[111:0]};
+        mac_liteethmacdepacketizer_sr <= {mac_liteethmacdepacketizer_sink_payload_data, mac_liteethmacdepacketizer_sr[111:16]};
+    end
+    if ((mac_liteethmacdepacketizer_sink_valid & mac_liteethmacdepacketizer_sink_ready)) begin
+        mac_liteethmacdepacketizer_sink_d_valid <= mac_liteethmacdepacketizer_sink_valid;
+        mac_liteethmacdepacketizer_sink_d_ready <= mac_liteethmacdepacketizer_sink_ready;
+        mac_liteethmacdepacketizer_sink_d_first <= mac_liteethmacdepacketizer_sink_first;
+        mac_liteethmacdepacketizer_sink_d_last <= mac_liteethmacdepacketizer_sink_last;
+        mac_liteethmacdepacketizer_sink_d_payload_data <= mac_liteethmacdepacketizer_sink_payload_data;
+        mac_liteethmacdepacketizer_sink_d_payload_last_be <= mac_liteethmacdepacketizer_sink_payload_last_be;
+        mac_liteethmacdepacketizer_sink_d_payload_error <= mac_liteethmacdepacketizer_sink_payload_error;
     end
     mac_liteethmacdepacketizer_was_in_copy <= mac_liteethmacdepacketizer_is_in_copy;
     liteethmac_fsm0_state1 <= liteethmac_fsm0_next_state1;
@@ -6584,7 +8382,7 @@ always @(posedge sys_clk) begin
         arp_packetizer_sr <= arp_packetizer_header;
     end
     if (arp_packetizer_sr_shift) begin
-        arp_packetizer_sr <= arp_packetizer_sr[223:8];
+        arp_packetizer_sr <= arp_packetizer_sr[223:32];
     end
     liteetharptx_fsm0_state <= liteetharptx_fsm0_next_state;
     if (arp_packetizer_count_liteetharp_fsm0_next_value_ce0) begin
@@ -6603,7 +8401,7 @@ always @(posedge sys_clk) begin
     end
     arp_rx_valid <= (((((arp_rx_liteetharpdepacketizer_source_valid & (arp_rx_liteetharpdepacketizer_source_param_hwtype == 1'd1)) & (arp_rx_liteetharpdepacketizer_source_param_proto == 12'd2048)) & (arp_rx_liteetharpdepacketizer_source_param_hwsize == 3'd6)) & (arp_rx_liteetharpdepacketizer_source_param_protosize == 3'd4)) & (arp_rx_liteetharpdepacketizer_source_param_target_ip == ip_address));
     if (arp_rx_liteetharpdepacketizer_sr_shift) begin
-        arp_rx_liteetharpdepacketizer_sr <= {arp_rx_liteetharpdepacketizer_sink_payload_data, arp_rx_liteetharpdepacketizer_sr[223:8]};
+        arp_rx_liteetharpdepacketizer_sr <= {arp_rx_liteetharpdepacketizer_sink_payload_data, arp_rx_liteetharpdepacketizer_sr[223:32]};
     end
     if (arp_rx_liteetharpdepacketizer_sr_shift_leftover) begin
         arp_rx_liteetharpdepacketizer_sr <= {arp_rx_liteetharpdepacketizer_sink_payload_data, arp_rx_liteetharpdepacketizer_sr[223:0]};
@@ -6626,14 +8424,14 @@ always @(posedge sys_clk) begin
             arp_table_request_timer_count <= (arp_table_request_timer_count - 1'd1);
         end
     end else begin
-        arp_table_request_timer_count <= 24'd12500000;
+        arp_table_request_timer_count <= 23'd5208330;
     end
     if (arp_table_cache_wait) begin
         if ((~arp_table_cache_done)) begin
             arp_table_cache_count <= (arp_table_cache_count - 1'd1);
         end
     end else begin
-        arp_table_cache_count <= 27'd125000000;
+        arp_table_cache_count <= 26'd52083300;
     end
     liteetharpcache_state <= liteetharpcache_next_state;
     if (arp_table_cache_update_count_liteetharp_liteetharpcache_next_value_ce0) begin
@@ -6711,7 +8509,7 @@ always @(posedge sys_clk) begin
         ip_tx_packetizer_sr <= ip_tx_packetizer_header;
     end
     if (ip_tx_packetizer_sr_shift) begin
-        ip_tx_packetizer_sr <= ip_tx_packetizer_sr[159:8];
+        ip_tx_packetizer_sr <= ip_tx_packetizer_sr[159:32];
     end
     liteethip_liteethiptx_fsm0_state <= liteethip_liteethiptx_fsm0_next_state;
     if (ip_tx_packetizer_count_liteethip_fsm0_next_value_ce0) begin
@@ -6729,7 +8527,7 @@ always @(posedge sys_clk) begin
         ip_tx_target_mac <= ip_tx_target_mac_liteethip_next_value;
     end
     if (ip_rx_liteethipv4depacketizer_sr_shift) begin
-        ip_rx_liteethipv4depacketizer_sr <= {ip_rx_liteethipv4depacketizer_sink_payload_data, ip_rx_liteethipv4depacketizer_sr[159:8]};
+        ip_rx_liteethipv4depacketizer_sr <= {ip_rx_liteethipv4depacketizer_sink_payload_data, ip_rx_liteethipv4depacketizer_sr[159:32]};
     end
     if (ip_rx_liteethipv4depacketizer_sr_shift_leftover) begin
         ip_rx_liteethipv4depacketizer_sr <= {ip_rx_liteethipv4depacketizer_sink_payload_data, ip_rx_liteethipv4depacketizer_sr[159:0]};
@@ -6832,7 +8630,7 @@ always @(posedge sys_clk) begin
         icmp_tx_packetizer_sr <= icmp_tx_packetizer_header;
     end
     if (icmp_tx_packetizer_sr_shift) begin
-        icmp_tx_packetizer_sr <= icmp_tx_packetizer_sr[63:8];
+        icmp_tx_packetizer_sr <= icmp_tx_packetizer_sr[63:32];
     end
     liteethicmptx_fsm0_state <= liteethicmptx_fsm0_next_state;
     if (icmp_tx_packetizer_count_fsm0_next_value_ce0) begin
@@ -6847,7 +8645,7 @@ always @(posedge sys_clk) begin
     end
     liteethicmptx_state <= liteethicmptx_next_state;
     if (icmp_rx_liteethicmpdepacketizer_sr_shift) begin
-        icmp_rx_liteethicmpdepacketizer_sr <= {icmp_rx_liteethicmpdepacketizer_sink_payload_data, icmp_rx_liteethicmpdepacketizer_sr[63:8]};
+        icmp_rx_liteethicmpdepacketizer_sr <= {icmp_rx_liteethicmpdepacketizer_sink_payload_data, icmp_rx_liteethicmpdepacketizer_sr[63:32]};
     end
     if (icmp_rx_liteethicmpdepacketizer_sr_shift_leftover) begin
         icmp_rx_liteethicmpdepacketizer_sr <= {icmp_rx_liteethicmpdepacketizer_sink_payload_data, icmp_rx_liteethicmpdepacketizer_sr[63:0]};
@@ -6909,77 +8707,17 @@ always @(posedge sys_clk) begin
             icmp_echo_param_fifo_level0 <= (icmp_echo_param_fifo_level0 - 1'd1);
         end
     end
-    if (packetizer_sr_load) begin
-        packetizer_sr <= packetizer_header;
+    rx_cdc_cdc_graycounter0_q_binary <= rx_cdc_cdc_graycounter0_q_next_binary;
+    rx_cdc_cdc_graycounter0_q <= rx_cdc_cdc_graycounter0_q_next;
+    tx_cdc_cdc_graycounter1_q_binary <= tx_cdc_cdc_graycounter1_q_next_binary;
+    tx_cdc_cdc_graycounter1_q <= tx_cdc_cdc_graycounter1_q_next;
+    pulsemerge0_backlog0 <= (pulsemerge0_total0 - pulsemerge0_o0);
+    if (pulsesynchronizer0_i) begin
+        pulsesynchronizer0_toggle_i <= (~pulsesynchronizer0_toggle_i);
     end
-    if (packetizer_sr_shift) begin
-        packetizer_sr <= packetizer_sr[63:8];
-    end
-    liteethudp_liteethudptx_fsm0_state <= liteethudp_liteethudptx_fsm0_next_state;
-    if (packetizer_count_liteethudp_fsm0_next_value_ce0) begin
-        packetizer_count <= packetizer_count_liteethudp_fsm0_next_value0;
-    end
-    if (packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1) begin
-        packetizer_fsm_from_idle <= packetizer_fsm_from_idle_liteethudp_fsm0_next_value1;
-    end
-    liteethudp_liteethudptx_fsm1_state <= liteethudp_liteethudptx_fsm1_next_state;
-    if (packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0) begin
-        packetizer_delayed_last_be <= packetizer_delayed_last_be_liteethudp_fsm1_next_value0;
-    end
-    liteethudp_liteethudptx_state <= liteethudp_liteethudptx_next_state;
-    if (holdingudprx_liteethudpdepacketizer_sr_shift) begin
-        holdingudprx_liteethudpdepacketizer_sr <= {holdingudprx_liteethudpdepacketizer_sink_payload_data, holdingudprx_liteethudpdepacketizer_sr[63:8]};
-    end
-    if (holdingudprx_liteethudpdepacketizer_sr_shift_leftover) begin
-        holdingudprx_liteethudpdepacketizer_sr <= {holdingudprx_liteethudpdepacketizer_sink_payload_data, holdingudprx_liteethudpdepacketizer_sr[63:0]};
-    end
-    holdingudprx_liteethudpdepacketizer_was_in_copy <= holdingudprx_liteethudpdepacketizer_is_in_copy;
-    liteethudp_holdingudprx_fsm0_state <= liteethudp_holdingudprx_fsm0_next_state;
-    if (holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2) begin
-        holdingudprx_liteethudpdepacketizer_count <= holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2;
-    end
-    if (holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
-        holdingudprx_liteethudpdepacketizer_fsm_from_idle <= holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
-    end
-    liteethudp_holdingudprx_fsm1_state <= liteethudp_holdingudprx_fsm1_next_state;
-    if (holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
-        holdingudprx_liteethudpdepacketizer_delayed_last_be <= holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
-    end
-    liteethudp_holdingudprx_state <= liteethudp_holdingudprx_next_state;
-    if (holdingudprx_count_liteethudp_next_value_ce0) begin
-        holdingudprx_count <= holdingudprx_count_liteethudp_next_value0;
-    end
-    if (holdingudprx_err_liteethudp_next_value_ce1) begin
-        holdingudprx_err <= holdingudprx_err_liteethudp_next_value1;
-    end
-    if (holdingudprx_rest_liteethudp_next_value_ce2) begin
-        holdingudprx_rest <= holdingudprx_rest_liteethudp_next_value2;
-    end
-    if (holdingudprx_held_liteethudp_next_value_ce3) begin
-        holdingudprx_held <= holdingudprx_held_liteethudp_next_value3;
-    end
-    if (holdingudprx0_liteethudp_next_value_ce4) begin
-        holdingudprx0 <= holdingudprx0_liteethudp_next_value4;
-    end
-    if (holdingudprx1_liteethudp_next_value_ce5) begin
-        holdingudprx1 <= holdingudprx1_liteethudp_next_value5;
-    end
-    if (holdingudprx2_liteethudp_next_value_ce6) begin
-        holdingudprx2 <= holdingudprx2_liteethudp_next_value6;
-    end
-    if (holdingudprx3_liteethudp_next_value_ce7) begin
-        holdingudprx3 <= holdingudprx3_liteethudp_next_value7;
-    end
-    if (liteethudp_first) begin
-        liteethudp_sel_ongoing <= liteethudp_sel0;
-    end
-    liteethudp_ongoing1 <= liteethudp_ongoing0;
-    if (liteethudp_last) begin
-        liteethudp_first <= 1'd1;
-    end else begin
-        if ((crossbar_sink_valid & crossbar_sink_ready)) begin
-            liteethudp_first <= 1'd0;
-        end
+    pulsemerge1_backlog0 <= (pulsemerge1_total0 - pulsemerge1_o0);
+    if (pulsesynchronizer1_i) begin
+        pulsesynchronizer1_toggle_i <= (~pulsesynchronizer1_toggle_i);
     end
     state <= next_state;
     interface0_bank_bus_dat_r <= 1'd0;
@@ -7035,74 +8773,78 @@ always @(posedge sys_clk) begin
         mac_core_tx_cdc_cdc_graycounter0_q_binary <= 6'd0;
         mac_core_preamble_errors_status <= 32'd0;
         mac_core_crc_errors_status <= 32'd0;
-        mac_core_cdc_graycounter1_q <= 6'd0;
-        mac_core_cdc_graycounter1_q_binary <= 6'd0;
-        mac_packetizer_count <= 4'd0;
+        mac_core_rx_cdc_cdc_graycounter1_q <= 6'd0;
+        mac_core_rx_cdc_cdc_graycounter1_q_binary <= 6'd0;
+        mac_packetizer_count <= 2'd0;
+        mac_packetizer_sink_d_valid <= 1'd0;
+        mac_packetizer_sink_d_ready <= 1'd0;
+        mac_packetizer_sink_d_payload_ethernet_type <= 16'd0;
+        mac_packetizer_sink_d_payload_sender_mac <= 48'd0;
+        mac_packetizer_sink_d_payload_target_mac <= 48'd0;
+        mac_packetizer_sink_d_payload_data <= 32'd0;
+        mac_packetizer_sink_d_payload_last_be <= 4'd0;
+        mac_packetizer_sink_d_payload_error <= 4'd0;
         mac_packetizer_fsm_from_idle <= 1'd0;
-        mac_packetizer_delayed_last_be <= 1'd0;
-        mac_liteethmacdepacketizer_count <= 4'd0;
+        mac_packetizer_delayed_last_be <= 4'd0;
+        mac_liteethmacdepacketizer_count <= 2'd0;
+        mac_liteethmacdepacketizer_sink_d_valid <= 1'd0;
+        mac_liteethmacdepacketizer_sink_d_ready <= 1'd0;
+        mac_liteethmacdepacketizer_sink_d_payload_data <= 32'd0;
+        mac_liteethmacdepacketizer_sink_d_payload_last_be <= 4'd0;
+        mac_liteethmacdepacketizer_sink_d_payload_error <= 4'd0;
         mac_liteethmacdepacketizer_fsm_from_idle <= 1'd0;
-        mac_liteethmacdepacketizer_delayed_last_be <= 1'd0;
+        mac_liteethmacdepacketizer_delayed_last_be <= 4'd0;
         mac_liteethmacdepacketizer_was_in_copy <= 1'd0;
-        arp_packetizer_count <= 5'd0;
+        arp_packetizer_count <= 3'd0;
         arp_packetizer_fsm_from_idle <= 1'd0;
-        arp_packetizer_delayed_last_be <= 1'd0;
-        arp_rx_liteetharpdepacketizer_count <= 5'd0;
+        arp_packetizer_delayed_last_be <= 4'd0;
+        arp_rx_liteetharpdepacketizer_count <= 3'd0;
         arp_rx_liteetharpdepacketizer_fsm_from_idle <= 1'd0;
-        arp_rx_liteetharpdepacketizer_delayed_last_be <= 1'd0;
+        arp_rx_liteetharpdepacketizer_delayed_last_be <= 4'd0;
         arp_rx_liteetharpdepacketizer_was_in_copy <= 1'd0;
         arp_table_response_response_payload_failed <= 1'd0;
         arp_table_response_response_payload_mac_address <= 48'd0;
         arp_table_request_pending <= 1'd0;
         arp_table_request_counter <= 3'd0;
-        arp_table_request_timer_count <= 24'd12500000;
+        arp_table_request_timer_count <= 23'd5208330;
         arp_table_cache_update_count <= 1'd0;
         arp_table_cache_search_count <= 1'd0;
         arp_table_cache_error <= 1'd0;
-        arp_table_cache_count <= 27'd125000000;
+        arp_table_cache_count <= 26'd52083300;
         ip_tx_pipe_valid_source_valid <= 1'd0;
-        ip_tx_pipe_valid_source_payload_data <= 8'd0;
-        ip_tx_pipe_valid_source_payload_last_be <= 1'd0;
-        ip_tx_pipe_valid_source_payload_error <= 1'd0;
+        ip_tx_pipe_valid_source_payload_data <= 32'd0;
+        ip_tx_pipe_valid_source_payload_last_be <= 4'd0;
+        ip_tx_pipe_valid_source_payload_error <= 4'd0;
         ip_tx_liteethipv4checksum_counter <= 4'd0;
-        ip_tx_packetizer_count <= 5'd0;
+        ip_tx_packetizer_count <= 3'd0;
         ip_tx_packetizer_fsm_from_idle <= 1'd0;
-        ip_tx_packetizer_delayed_last_be <= 1'd0;
-        ip_rx_liteethipv4depacketizer_count <= 5'd0;
+        ip_tx_packetizer_delayed_last_be <= 4'd0;
+        ip_rx_liteethipv4depacketizer_count <= 3'd0;
         ip_rx_liteethipv4depacketizer_fsm_from_idle <= 1'd0;
-        ip_rx_liteethipv4depacketizer_delayed_last_be <= 1'd0;
+        ip_rx_liteethipv4depacketizer_delayed_last_be <= 4'd0;
         ip_rx_liteethipv4depacketizer_was_in_copy <= 1'd0;
         ip_rx_liteethipv4checksum_counter <= 4'd0;
-        icmp_tx_packetizer_count <= 3'd0;
+        icmp_tx_packetizer_count <= 1'd0;
         icmp_tx_packetizer_fsm_from_idle <= 1'd0;
-        icmp_tx_packetizer_delayed_last_be <= 1'd0;
-        icmp_rx_liteethicmpdepacketizer_count <= 3'd0;
+        icmp_tx_packetizer_delayed_last_be <= 4'd0;
+        icmp_rx_liteethicmpdepacketizer_count <= 1'd0;
         icmp_rx_liteethicmpdepacketizer_fsm_from_idle <= 1'd0;
-        icmp_rx_liteethicmpdepacketizer_delayed_last_be <= 1'd0;
+        icmp_rx_liteethicmpdepacketizer_delayed_last_be <= 4'd0;
         icmp_rx_liteethicmpdepacketizer_was_in_copy <= 1'd0;
         icmp_echo_payload_fifo_readable <= 1'd0;
-        icmp_echo_payload_fifo_level0 <= 8'd0;
-        icmp_echo_payload_fifo_produce <= 7'd0;
-        icmp_echo_payload_fifo_consume <= 7'd0;
+        icmp_echo_payload_fifo_level0 <= 6'd0;
+        icmp_echo_payload_fifo_produce <= 5'd0;
+        icmp_echo_payload_fifo_consume <= 5'd0;
         icmp_echo_param_fifo_readable <= 1'd0;
         icmp_echo_param_fifo_level0 <= 2'd0;
         icmp_echo_param_fifo_produce <= 1'd0;
         icmp_echo_param_fifo_consume <= 1'd0;
-        packetizer_count <= 3'd0;
-        packetizer_fsm_from_idle <= 1'd0;
-        packetizer_delayed_last_be <= 1'd0;
-        holdingudprx_liteethudpdepacketizer_count <= 3'd0;
-        holdingudprx_liteethudpdepacketizer_fsm_from_idle <= 1'd0;
-        holdingudprx_liteethudpdepacketizer_delayed_last_be <= 1'd0;
-        holdingudprx_liteethudpdepacketizer_was_in_copy <= 1'd0;
-        holdingudprx_count <= 16'd0;
-        holdingudprx_err <= 1'd0;
-        holdingudprx_held <= 8'd0;
-        holdingudprx0 <= 16'd0;
-        holdingudprx1 <= 16'd0;
-        holdingudprx2 <= 16'd0;
-        holdingudprx3 <= 32'd0;
-        holdingudprx_rest <= 16'd0;
+        rx_cdc_cdc_graycounter0_q <= 5'd0;
+        rx_cdc_cdc_graycounter0_q_binary <= 5'd0;
+        tx_cdc_cdc_graycounter1_q <= 5'd0;
+        tx_cdc_cdc_graycounter1_q_binary <= 5'd0;
+        pulsemerge0_backlog0 <= 3'd0;
+        pulsemerge1_backlog0 <= 3'd0;
         liteethmac_grant <= 1'd0;
         liteethmac_status0_first <= 1'd1;
         liteethmac_status0_ongoing1 <= 1'd0;
@@ -7143,15 +8885,6 @@ always @(posedge sys_clk) begin
         liteethicmprx_fsm0_state <= 2'd0;
         liteethicmprx_fsm1_state <= 1'd0;
         liteethicmprx_state <= 2'd0;
-        liteethudp_liteethudptx_fsm0_state <= 2'd0;
-        liteethudp_liteethudptx_fsm1_state <= 1'd0;
-        liteethudp_liteethudptx_state <= 1'd0;
-        liteethudp_holdingudprx_fsm0_state <= 2'd0;
-        liteethudp_holdingudprx_fsm1_state <= 1'd0;
-        liteethudp_holdingudprx_state <= 3'd0;
-        liteethudp_first <= 1'd1;
-        liteethudp_ongoing1 <= 1'd0;
-        liteethudp_sel_ongoing <= 1'd0;
         state <= 1'd0;
     end
     multiregimpl1_regs0 <= mac_core_tx_cdc_cdc_graycounter1_q;
@@ -7160,8 +8893,12 @@ always @(posedge sys_clk) begin
     multiregimpl2_regs1 <= multiregimpl2_regs0;
     multiregimpl3_regs0 <= mac_core_pulsesynchronizer1_toggle_i;
     multiregimpl3_regs1 <= multiregimpl3_regs0;
-    multiregimpl4_regs0 <= mac_core_cdc_graycounter0_q;
+    multiregimpl4_regs0 <= mac_core_rx_cdc_cdc_graycounter0_q;
     multiregimpl4_regs1 <= multiregimpl4_regs0;
+    multiregimpl7_regs0 <= rx_cdc_cdc_graycounter1_q;
+    multiregimpl7_regs1 <= multiregimpl7_regs0;
+    multiregimpl8_regs0 <= tx_cdc_cdc_graycounter0_q;
+    multiregimpl8_regs1 <= multiregimpl8_regs0;
 end
 
 
@@ -7335,13 +9072,13 @@ DELAYG #(
 );
 
 //------------------------------------------------------------------------------
-// Memory storage: 32-words x 12-bit
+// Memory storage: 32-words x 42-bit
 //------------------------------------------------------------------------------
-// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 12 
+// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 42 
 // Port 1 | Read: Sync  | Write: ---- | 
-reg [11:0] storage[0:31];
-reg [11:0] storage_dat0;
-reg [11:0] storage_dat1;
+reg [41:0] storage[0:31];
+reg [41:0] storage_dat0;
+reg [41:0] storage_dat1;
 always @(posedge sys_clk) begin
 	if (mac_core_tx_cdc_cdc_wrport_we)
 		storage[mac_core_tx_cdc_cdc_wrport_adr] <= mac_core_tx_cdc_cdc_wrport_dat_w;
@@ -7373,23 +9110,23 @@ assign mac_core_liteethmaccrc32checker_syncfifo_rdport_dat_r = storage_1[mac_cor
 
 
 //------------------------------------------------------------------------------
-// Memory storage_2: 32-words x 12-bit
+// Memory storage_2: 32-words x 42-bit
 //------------------------------------------------------------------------------
-// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 12 
+// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 42 
 // Port 1 | Read: Sync  | Write: ---- | 
-reg [11:0] storage_2[0:31];
-reg [11:0] storage_2_dat0;
-reg [11:0] storage_2_dat1;
+reg [41:0] storage_2[0:31];
+reg [41:0] storage_2_dat0;
+reg [41:0] storage_2_dat1;
 always @(posedge eth_rx_clk) begin
-	if (mac_core_cdc_wrport_we)
-		storage_2[mac_core_cdc_wrport_adr] <= mac_core_cdc_wrport_dat_w;
-	storage_2_dat0 <= storage_2[mac_core_cdc_wrport_adr];
+	if (mac_core_rx_cdc_cdc_wrport_we)
+		storage_2[mac_core_rx_cdc_cdc_wrport_adr] <= mac_core_rx_cdc_cdc_wrport_dat_w;
+	storage_2_dat0 <= storage_2[mac_core_rx_cdc_cdc_wrport_adr];
 end
 always @(posedge sys_clk) begin
-	storage_2_dat1 <= storage_2[mac_core_cdc_rdport_adr];
+	storage_2_dat1 <= storage_2[mac_core_rx_cdc_cdc_rdport_adr];
 end
-assign mac_core_cdc_wrport_dat_r = storage_2_dat0;
-assign mac_core_cdc_rdport_dat_r = storage_2_dat1;
+assign mac_core_rx_cdc_cdc_wrport_dat_r = storage_2_dat0;
+assign mac_core_rx_cdc_cdc_rdport_dat_r = storage_2_dat1;
 
 
 //------------------------------------------------------------------------------
@@ -7411,13 +9148,13 @@ assign arp_table_cache_mem_rd_port_dat_r = mem[arp_table_cache_mem_rd_port_adr];
 
 
 //------------------------------------------------------------------------------
-// Memory storage_3: 128-words x 12-bit
+// Memory storage_3: 32-words x 42-bit
 //------------------------------------------------------------------------------
-// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 12 
+// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 42 
 // Port 1 | Read: Sync  | Write: ---- | 
-reg [11:0] storage_3[0:127];
-reg [11:0] storage_3_dat0;
-reg [11:0] storage_3_dat1;
+reg [41:0] storage_3[0:31];
+reg [41:0] storage_3_dat0;
+reg [41:0] storage_3_dat1;
 always @(posedge sys_clk) begin
 	if (icmp_echo_payload_fifo_wrport_we)
 		storage_3[icmp_echo_payload_fifo_wrport_adr] <= icmp_echo_payload_fifo_wrport_dat_w;
@@ -7450,6 +9187,46 @@ always @(posedge sys_clk) begin
 end
 assign icmp_echo_param_fifo_wrport_dat_r = storage_4_dat0;
 assign icmp_echo_param_fifo_rdport_dat_r = storage_4_dat1;
+
+
+//------------------------------------------------------------------------------
+// Memory storage_5: 16-words x 98-bit
+//------------------------------------------------------------------------------
+// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 98 
+// Port 1 | Read: Sync  | Write: ---- | 
+reg [97:0] storage_5[0:15];
+reg [97:0] storage_5_dat0;
+reg [97:0] storage_5_dat1;
+always @(posedge sys_clk) begin
+	if (rx_cdc_cdc_wrport_we)
+		storage_5[rx_cdc_cdc_wrport_adr] <= rx_cdc_cdc_wrport_dat_w;
+	storage_5_dat0 <= storage_5[rx_cdc_cdc_wrport_adr];
+end
+always @(posedge port_clk) begin
+	storage_5_dat1 <= storage_5[rx_cdc_cdc_rdport_adr];
+end
+assign rx_cdc_cdc_wrport_dat_r = storage_5_dat0;
+assign rx_cdc_cdc_rdport_dat_r = storage_5_dat1;
+
+
+//------------------------------------------------------------------------------
+// Memory storage_6: 16-words x 98-bit
+//------------------------------------------------------------------------------
+// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 98 
+// Port 1 | Read: Sync  | Write: ---- | 
+reg [97:0] storage_6[0:15];
+reg [97:0] storage_6_dat0;
+reg [97:0] storage_6_dat1;
+always @(posedge port_clk) begin
+	if (tx_cdc_cdc_wrport_we)
+		storage_6[tx_cdc_cdc_wrport_adr] <= tx_cdc_cdc_wrport_dat_w;
+	storage_6_dat0 <= storage_6[tx_cdc_cdc_wrport_adr];
+end
+always @(posedge sys_clk) begin
+	storage_6_dat1 <= storage_6[tx_cdc_cdc_rdport_adr];
+end
+assign tx_cdc_cdc_wrport_dat_r = storage_6_dat0;
+assign tx_cdc_cdc_rdport_dat_r = storage_6_dat1;
 
 
 //------------------------------------------------------------------------------

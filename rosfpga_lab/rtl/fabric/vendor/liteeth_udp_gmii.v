@@ -72,7 +72,7 @@ UDPPortCore
 │    └─── crg (LiteEthPHYGMIICRG)
 │    └─── tx (LiteEthPHYGMIITX)
 │    └─── rx (LiteEthPHYGMIIRX)
-└─── core (LiteEthUDPIPCore)
+└─── core (LiteEthIPCore)
 │    └─── mac (LiteEthMAC)
 │    │    └─── core (LiteEthMACCore)
 │    │    │    └─── tx_datapath (TXDatapath)
@@ -81,6 +81,12 @@ UDPPortCore
 │    │    │    │    │    │    └─── fifo (AsyncFIFO)
 │    │    │    │    │    │    │    └─── graycounter_0* (GrayCounter)
 │    │    │    │    │    │    │    └─── graycounter_1* (GrayCounter)
+│    │    │    │    └─── strideconverter_0* (StrideConverter)
+│    │    │    │    │    └─── converter_0* (Converter)
+│    │    │    │    │    │    └─── _downconverter_0* (_DownConverter)
+│    │    │    │    └─── liteethmactxlastbe_0* (LiteEthMACTXLastBE)
+│    │    │    │    │    └─── last_handler (LiteEthLastHandler)
+│    │    │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── liteethmacpaddinginserter_0* (LiteEthMACPaddingInserter)
 │    │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── liteethmaccrc32inserter_0* (LiteEthMACCRC32Inserter)
@@ -94,6 +100,10 @@ UDPPortCore
 │    │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── liteethmacgap_0* (LiteEthMACGap)
 │    │    │    │    │    └─── fsm (FSM)
+│    │    │    │    └─── tx_buffer (Buffer)
+│    │    │    │    │    └─── pipe_valid (PipeValid)
+│    │    │    │    │    └─── pipe_ready (PipeReady)
+│    │    │    │    │    └─── pipeline (Pipeline)
 │    │    │    │    └─── pipeline_0* (Pipeline)
 │    │    │    └─── rx_datapath (RXDatapath)
 │    │    │    │    └─── liteethmacpreamblechecker_0* (LiteEthMACPreambleChecker)
@@ -110,6 +120,10 @@ UDPPortCore
 │    │    │    │    │    │    └─── pipeline (Pipeline)
 │    │    │    │    └─── pulsesynchronizer_1* (PulseSynchronizer)
 │    │    │    │    └─── liteethmacpaddingchecker_0* (LiteEthMACPaddingChecker)
+│    │    │    │    └─── liteethmacrxlastbe_0* (LiteEthMACRXLastBE)
+│    │    │    │    └─── strideconverter_0* (StrideConverter)
+│    │    │    │    │    └─── converter_0* (Converter)
+│    │    │    │    │    │    └─── _upconverter_0* (_UpConverter)
 │    │    │    │    └─── clockdomaincrossing_0* (ClockDomainCrossing)
 │    │    │    │    │    └─── asyncfifo_0* (AsyncFIFO)
 │    │    │    │    │    │    └─── fifo (AsyncFIFO)
@@ -188,17 +202,27 @@ UDPPortCore
 │    │    │    │    └─── param_fifo (SyncFIFO)
 │    │    │    │    │    └─── fifo (SyncFIFOBuffered)
 │    │    │    │    │    │    └─── fifo (SyncFIFO)
-│    └─── udp (LiteEthUDP)
-│    │    └─── tx (LiteEthUDPTX)
-│    │    │    └─── packetizer (LiteEthUDPPacketizer)
-│    │    │    │    └─── fsm (FSM)
-│    │    │    │    └─── last_be_fsm (FSM)
+│    └─── udp (PortUDP)
+│    │    └─── rx_cdc (ClockDomainCrossing)
+│    │    └─── rx_converter (StrideConverter)
+│    │    │    └─── converter_0* (Converter)
+│    │    │    │    └─── _downconverter_0* (_DownConverter)
+│    │    └─── rx_trim (LastByteTrim)
 │    │    │    └─── fsm (FSM)
 │    │    └─── rx (HoldingUDPRX)
 │    │    │    └─── depacketizer (LiteEthUDPDepacketizer)
 │    │    │    │    └─── fsm (FSM)
 │    │    │    │    └─── last_be_fsm (FSM)
 │    │    │    └─── fsm (FSM)
+│    │    └─── tx (LiteEthUDPTX)
+│    │    │    └─── packetizer (LiteEthUDPPacketizer)
+│    │    │    │    └─── fsm (FSM)
+│    │    │    │    └─── last_be_fsm (FSM)
+│    │    │    └─── fsm (FSM)
+│    │    └─── tx_converter (StrideConverter)
+│    │    │    └─── converter_0* (Converter)
+│    │    │    │    └─── _upconverter_0* (_UpConverter)
+│    │    └─── tx_cdc (ClockDomainCrossing)
 │    │    └─── crossbar (MaskedUDPCrossbar)
 │    │    │    └─── tx_cdc (ClockDomainCrossing)
 │    │    │    └─── tx_converter (StrideConverter)
@@ -211,6 +235,18 @@ UDPPortCore
 │    │    │    └─── arbiter (Arbiter)
 │    │    │    └─── dispatcher (Dispatcher)
 │    │    │    │    └─── status_0* (Status)
+│    │    └─── rx_buffer (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
+│    │    └─── tx_buffer (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
+└─── rx_drop_header_core (PulseMerge)
+└─── rx_drop_header_port (PulseMerge)
+└─── rx_drop_other_core (PulseMerge)
+└─── rx_drop_other_port (PulseMerge)
 └─── csr_bridge (Wishbone2CSR)
 │    └─── fsm (FSM)
 └─── csr_bankarray (CSRBankArray)
@@ -370,26 +406,8 @@ reg           builder_liteethmac_txdatapath_liteethmacpaddinginserter_next_state
 reg           builder_liteethmac_txdatapath_liteethmacpaddinginserter_state = 1'd0;
 reg     [1:0] builder_liteethmac_txdatapath_liteethmacpreambleinserter_next_state = 2'd0;
 reg     [1:0] builder_liteethmac_txdatapath_liteethmacpreambleinserter_state = 2'd0;
-reg           builder_liteethudp_first = 1'd1;
-reg     [1:0] builder_liteethudp_holdingudprx_fsm0_next_state = 2'd0;
-reg     [1:0] builder_liteethudp_holdingudprx_fsm0_state = 2'd0;
-reg           builder_liteethudp_holdingudprx_fsm1_next_state = 1'd0;
-reg           builder_liteethudp_holdingudprx_fsm1_state = 1'd0;
-reg     [2:0] builder_liteethudp_holdingudprx_next_state = 3'd0;
-reg     [2:0] builder_liteethudp_holdingudprx_state = 3'd0;
-wire          builder_liteethudp_last;
-reg     [1:0] builder_liteethudp_liteethudptx_fsm0_next_state = 2'd0;
-reg     [1:0] builder_liteethudp_liteethudptx_fsm0_state = 2'd0;
-reg           builder_liteethudp_liteethudptx_fsm1_next_state = 1'd0;
-reg           builder_liteethudp_liteethudptx_fsm1_state = 1'd0;
-reg           builder_liteethudp_liteethudptx_next_state = 1'd0;
-reg           builder_liteethudp_liteethudptx_state = 1'd0;
-wire          builder_liteethudp_ongoing0;
-reg           builder_liteethudp_ongoing1 = 1'd0;
-reg           builder_liteethudp_sel0 = 1'd0;
-reg           builder_liteethudp_sel1 = 1'd0;
-reg           builder_liteethudp_sel_ongoing = 1'd0;
-wire          builder_liteethudp_taken;
+reg           builder_liteethmac_txdatapath_liteethmactxlastbe_next_state = 1'd0;
+reg           builder_liteethmac_txdatapath_liteethmactxlastbe_state = 1'd0;
 reg     [5:0] builder_multiregimpl0_regs0 = 6'd0;
 reg     [5:0] builder_multiregimpl0_regs1 = 6'd0;
 reg     [5:0] builder_multiregimpl1_regs0 = 6'd0;
@@ -403,6 +421,28 @@ reg     [5:0] builder_multiregimpl4_regs1 = 6'd0;
 reg     [5:0] builder_multiregimpl5_regs0 = 6'd0;
 reg     [5:0] builder_multiregimpl5_regs1 = 6'd0;
 reg           builder_next_state = 1'd0;
+reg           builder_portudp_first = 1'd1;
+reg     [1:0] builder_portudp_holdingudprx_fsm0_next_state = 2'd0;
+reg     [1:0] builder_portudp_holdingudprx_fsm0_state = 2'd0;
+reg           builder_portudp_holdingudprx_fsm1_next_state = 1'd0;
+reg           builder_portudp_holdingudprx_fsm1_state = 1'd0;
+reg     [2:0] builder_portudp_holdingudprx_next_state = 3'd0;
+reg     [2:0] builder_portudp_holdingudprx_state = 3'd0;
+wire          builder_portudp_last;
+reg           builder_portudp_lastbytetrim_next_state = 1'd0;
+reg           builder_portudp_lastbytetrim_state = 1'd0;
+reg     [1:0] builder_portudp_liteethudptx_fsm0_next_state = 2'd0;
+reg     [1:0] builder_portudp_liteethudptx_fsm0_state = 2'd0;
+reg           builder_portudp_liteethudptx_fsm1_next_state = 1'd0;
+reg           builder_portudp_liteethudptx_fsm1_state = 1'd0;
+reg           builder_portudp_liteethudptx_next_state = 1'd0;
+reg           builder_portudp_liteethudptx_state = 1'd0;
+wire          builder_portudp_ongoing0;
+reg           builder_portudp_ongoing1 = 1'd0;
+reg           builder_portudp_sel0 = 1'd0;
+reg           builder_portudp_sel1 = 1'd0;
+reg           builder_portudp_sel_ongoing = 1'd0;
+wire          builder_portudp_taken;
 wire          builder_re;
 wire   [15:0] builder_rhs_slice_proxy0;
 wire   [15:0] builder_rhs_slice_proxy1;
@@ -486,34 +526,34 @@ wire          eth_rx_clk;
 reg           eth_rx_rst = 1'd0;
 wire          eth_tx_clk;
 reg           eth_tx_rst = 1'd0;
-reg     [5:0] main_arp_counter = 6'd0;
-reg     [5:0] main_arp_counter_liteetharp_next_value = 6'd0;
+reg     [3:0] main_arp_counter = 4'd0;
+reg     [3:0] main_arp_counter_liteetharp_next_value = 4'd0;
 reg           main_arp_counter_liteetharp_next_value_ce = 1'd0;
 wire          main_arp_mac_port_sink_first;
 wire          main_arp_mac_port_sink_last;
-wire    [7:0] main_arp_mac_port_sink_payload_data;
-wire          main_arp_mac_port_sink_payload_error;
+wire   [31:0] main_arp_mac_port_sink_payload_data;
+wire    [3:0] main_arp_mac_port_sink_payload_error;
 wire   [15:0] main_arp_mac_port_sink_payload_ethernet_type;
-wire          main_arp_mac_port_sink_payload_last_be;
+wire    [3:0] main_arp_mac_port_sink_payload_last_be;
 wire   [47:0] main_arp_mac_port_sink_payload_sender_mac;
 wire   [47:0] main_arp_mac_port_sink_payload_target_mac;
 reg           main_arp_mac_port_sink_ready = 1'd0;
 wire          main_arp_mac_port_sink_valid;
 reg           main_arp_mac_port_source_first = 1'd0;
 reg           main_arp_mac_port_source_last = 1'd0;
-reg     [7:0] main_arp_mac_port_source_payload_data = 8'd0;
-reg           main_arp_mac_port_source_payload_error = 1'd0;
+reg    [31:0] main_arp_mac_port_source_payload_data = 32'd0;
+reg     [3:0] main_arp_mac_port_source_payload_error = 4'd0;
 reg    [15:0] main_arp_mac_port_source_payload_ethernet_type = 16'd0;
-reg           main_arp_mac_port_source_payload_last_be = 1'd0;
+reg     [3:0] main_arp_mac_port_source_payload_last_be = 4'd0;
 reg    [47:0] main_arp_mac_port_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_arp_mac_port_source_payload_target_mac = 48'd0;
 wire          main_arp_mac_port_source_ready;
 reg           main_arp_mac_port_source_valid = 1'd0;
-reg     [4:0] main_arp_packetizer_count = 5'd0;
-reg     [4:0] main_arp_packetizer_count_liteetharp_fsm0_next_value0 = 5'd0;
+reg     [2:0] main_arp_packetizer_count = 3'd0;
+reg     [2:0] main_arp_packetizer_count_liteetharp_fsm0_next_value0 = 3'd0;
 reg           main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0 = 1'd0;
-reg           main_arp_packetizer_delayed_last_be = 1'd0;
-reg           main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 = 1'd0;
+reg     [3:0] main_arp_packetizer_delayed_last_be = 4'd0;
+reg     [3:0] main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 = 4'd0;
 reg           main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 = 1'd0;
 reg           main_arp_packetizer_fsm_from_idle = 1'd0;
 reg           main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 = 1'd0;
@@ -523,9 +563,8 @@ wire          main_arp_packetizer_in_data_copy;
 reg           main_arp_packetizer_is_ongoing0 = 1'd0;
 reg           main_arp_packetizer_is_ongoing1 = 1'd0;
 reg           main_arp_packetizer_is_ongoing2 = 1'd0;
-wire          main_arp_packetizer_new_last_be;
+wire    [3:0] main_arp_packetizer_new_last_be;
 wire          main_arp_packetizer_sink_last;
-wire          main_arp_packetizer_sink_last_be;
 wire    [7:0] main_arp_packetizer_sink_param_hwsize;
 wire   [15:0] main_arp_packetizer_sink_param_hwtype;
 reg    [15:0] main_arp_packetizer_sink_param_opcode = 16'd0;
@@ -535,9 +574,9 @@ wire   [31:0] main_arp_packetizer_sink_param_sender_ip;
 wire   [47:0] main_arp_packetizer_sink_param_sender_mac;
 wire   [31:0] main_arp_packetizer_sink_param_target_ip;
 reg    [47:0] main_arp_packetizer_sink_param_target_mac = 48'd0;
-reg     [7:0] main_arp_packetizer_sink_payload_data = 8'd0;
-reg           main_arp_packetizer_sink_payload_error = 1'd0;
-reg           main_arp_packetizer_sink_payload_last_be = 1'd0;
+reg    [31:0] main_arp_packetizer_sink_payload_data = 32'd0;
+reg     [3:0] main_arp_packetizer_sink_payload_error = 4'd0;
+reg     [3:0] main_arp_packetizer_sink_payload_last_be = 4'd0;
 reg           main_arp_packetizer_sink_ready = 1'd0;
 reg           main_arp_packetizer_sink_valid = 1'd0;
 reg           main_arp_packetizer_source_first = 1'd0;
@@ -545,10 +584,10 @@ reg           main_arp_packetizer_source_last = 1'd0;
 reg           main_arp_packetizer_source_last_a = 1'd0;
 reg           main_arp_packetizer_source_last_b = 1'd0;
 reg           main_arp_packetizer_source_last_s = 1'd0;
-reg     [7:0] main_arp_packetizer_source_payload_data = 8'd0;
-wire          main_arp_packetizer_source_payload_error;
+reg    [31:0] main_arp_packetizer_source_payload_data = 32'd0;
+wire    [3:0] main_arp_packetizer_source_payload_error;
 reg    [15:0] main_arp_packetizer_source_payload_ethernet_type = 16'd0;
-reg           main_arp_packetizer_source_payload_last_be = 1'd0;
+reg     [3:0] main_arp_packetizer_source_payload_last_be = 4'd0;
 reg    [47:0] main_arp_packetizer_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_arp_packetizer_source_payload_target_mac = 48'd0;
 reg           main_arp_packetizer_source_ready = 1'd0;
@@ -559,11 +598,11 @@ reg           main_arp_packetizer_sr_shift = 1'd0;
 wire          main_arp_rx_cut;
 reg           main_arp_rx_fsm_is_ongoing0 = 1'd0;
 reg           main_arp_rx_fsm_is_ongoing1 = 1'd0;
-reg     [4:0] main_arp_rx_liteetharpdepacketizer_count = 5'd0;
-reg     [4:0] main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 = 5'd0;
+reg     [2:0] main_arp_rx_liteetharpdepacketizer_count = 3'd0;
+reg     [2:0] main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 = 3'd0;
 reg           main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 = 1'd0;
-reg           main_arp_rx_liteetharpdepacketizer_delayed_last_be = 1'd0;
-reg           main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 = 1'd0;
+reg     [3:0] main_arp_rx_liteetharpdepacketizer_delayed_last_be = 4'd0;
+reg     [3:0] main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 = 4'd0;
 reg           main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 = 1'd0;
 reg           main_arp_rx_liteetharpdepacketizer_fsm_from_idle = 1'd0;
 reg           main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 = 1'd0;
@@ -574,15 +613,14 @@ reg           main_arp_rx_liteetharpdepacketizer_is_ongoing0 = 1'd0;
 reg           main_arp_rx_liteetharpdepacketizer_is_ongoing1 = 1'd0;
 reg           main_arp_rx_liteetharpdepacketizer_is_ongoing2 = 1'd0;
 reg           main_arp_rx_liteetharpdepacketizer_is_ongoing3 = 1'd0;
-wire          main_arp_rx_liteetharpdepacketizer_new_last_be;
+wire    [3:0] main_arp_rx_liteetharpdepacketizer_new_last_be;
 reg           main_arp_rx_liteetharpdepacketizer_sink_d_last = 1'd0;
 wire          main_arp_rx_liteetharpdepacketizer_sink_first;
 wire          main_arp_rx_liteetharpdepacketizer_sink_last;
-wire          main_arp_rx_liteetharpdepacketizer_sink_last_be;
-wire    [7:0] main_arp_rx_liteetharpdepacketizer_sink_payload_data;
-wire          main_arp_rx_liteetharpdepacketizer_sink_payload_error;
+wire   [31:0] main_arp_rx_liteetharpdepacketizer_sink_payload_data;
+wire    [3:0] main_arp_rx_liteetharpdepacketizer_sink_payload_error;
 wire   [15:0] main_arp_rx_liteetharpdepacketizer_sink_payload_ethernet_type;
-wire          main_arp_rx_liteetharpdepacketizer_sink_payload_last_be;
+wire    [3:0] main_arp_rx_liteetharpdepacketizer_sink_payload_last_be;
 wire   [47:0] main_arp_rx_liteetharpdepacketizer_sink_payload_sender_mac;
 wire   [47:0] main_arp_rx_liteetharpdepacketizer_sink_payload_target_mac;
 reg           main_arp_rx_liteetharpdepacketizer_sink_ready = 1'd0;
@@ -600,9 +638,9 @@ wire   [31:0] main_arp_rx_liteetharpdepacketizer_source_param_sender_ip;
 wire   [47:0] main_arp_rx_liteetharpdepacketizer_source_param_sender_mac;
 wire   [31:0] main_arp_rx_liteetharpdepacketizer_source_param_target_ip;
 wire   [47:0] main_arp_rx_liteetharpdepacketizer_source_param_target_mac;
-reg     [7:0] main_arp_rx_liteetharpdepacketizer_source_payload_data = 8'd0;
-wire          main_arp_rx_liteetharpdepacketizer_source_payload_error;
-reg           main_arp_rx_liteetharpdepacketizer_source_payload_last_be = 1'd0;
+reg    [31:0] main_arp_rx_liteetharpdepacketizer_source_payload_data = 32'd0;
+wire    [3:0] main_arp_rx_liteetharpdepacketizer_source_payload_error;
+reg     [3:0] main_arp_rx_liteetharpdepacketizer_source_payload_last_be = 4'd0;
 reg           main_arp_rx_liteetharpdepacketizer_source_ready = 1'd0;
 reg           main_arp_rx_liteetharpdepacketizer_source_valid = 1'd0;
 reg   [223:0] main_arp_rx_liteetharpdepacketizer_sr = 224'd0;
@@ -613,10 +651,10 @@ reg           main_arp_rx_reply = 1'd0;
 reg           main_arp_rx_request = 1'd0;
 wire          main_arp_rx_sink_first;
 wire          main_arp_rx_sink_last;
-wire    [7:0] main_arp_rx_sink_payload_data;
-wire          main_arp_rx_sink_payload_error;
+wire   [31:0] main_arp_rx_sink_payload_data;
+wire    [3:0] main_arp_rx_sink_payload_error;
 wire   [15:0] main_arp_rx_sink_payload_ethernet_type;
-wire          main_arp_rx_sink_payload_last_be;
+wire    [3:0] main_arp_rx_sink_payload_last_be;
 wire   [47:0] main_arp_rx_sink_payload_sender_mac;
 wire   [47:0] main_arp_rx_sink_payload_target_mac;
 wire          main_arp_rx_sink_ready;
@@ -640,10 +678,10 @@ reg           main_arp_sink_sink_ready = 1'd0;
 wire          main_arp_sink_sink_valid;
 wire          main_arp_source_source_first;
 wire          main_arp_source_source_last;
-wire    [7:0] main_arp_source_source_payload_data;
-wire          main_arp_source_source_payload_error;
+wire   [31:0] main_arp_source_source_payload_data;
+wire    [3:0] main_arp_source_source_payload_error;
 reg    [15:0] main_arp_source_source_payload_ethernet_type = 16'd0;
-wire          main_arp_source_source_payload_last_be;
+wire    [3:0] main_arp_source_source_payload_last_be;
 reg    [47:0] main_arp_source_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_arp_source_source_payload_target_mac = 48'd0;
 wire          main_arp_source_source_ready;
@@ -729,126 +767,7 @@ reg           main_bus_errors_re = 1'd0;
 wire   [31:0] main_bus_errors_status;
 wire          main_bus_errors_we;
 wire          main_cpu_rst;
-wire          main_crossbar_dropped;
-wire          main_crossbar_sink_first;
-wire          main_crossbar_sink_last;
-wire   [15:0] main_crossbar_sink_param_dst_port;
-wire   [31:0] main_crossbar_sink_param_ip_address;
-wire   [15:0] main_crossbar_sink_param_length;
-wire   [15:0] main_crossbar_sink_param_src_port;
-wire    [7:0] main_crossbar_sink_payload_data;
-wire          main_crossbar_sink_payload_error;
-wire          main_crossbar_sink_payload_last_be;
-reg           main_crossbar_sink_ready = 1'd0;
-wire          main_crossbar_sink_valid;
-wire          main_crossbar_source_first;
-wire          main_crossbar_source_last;
-wire   [15:0] main_crossbar_source_param_dst_port;
-wire   [31:0] main_crossbar_source_param_ip_address;
-wire   [15:0] main_crossbar_source_param_length;
-wire   [15:0] main_crossbar_source_param_src_port;
-wire    [7:0] main_crossbar_source_payload_data;
-wire          main_crossbar_source_payload_error;
-wire          main_crossbar_source_payload_last_be;
-wire          main_crossbar_source_ready;
-wire          main_crossbar_source_valid;
 reg           main_dv_d = 1'd0;
-reg    [15:0] main_holdingudprx0 = 16'd0;
-reg    [15:0] main_holdingudprx0_liteethudp_next_value4 = 16'd0;
-reg           main_holdingudprx0_liteethudp_next_value_ce4 = 1'd0;
-reg    [15:0] main_holdingudprx1 = 16'd0;
-reg    [15:0] main_holdingudprx1_liteethudp_next_value5 = 16'd0;
-reg           main_holdingudprx1_liteethudp_next_value_ce5 = 1'd0;
-reg    [15:0] main_holdingudprx2 = 16'd0;
-reg    [15:0] main_holdingudprx2_liteethudp_next_value6 = 16'd0;
-reg           main_holdingudprx2_liteethudp_next_value_ce6 = 1'd0;
-reg    [31:0] main_holdingudprx3 = 32'd0;
-reg    [31:0] main_holdingudprx3_liteethudp_next_value7 = 32'd0;
-reg           main_holdingudprx3_liteethudp_next_value_ce7 = 1'd0;
-reg    [15:0] main_holdingudprx_count = 16'd0;
-reg    [15:0] main_holdingudprx_count_liteethudp_next_value0 = 16'd0;
-reg           main_holdingudprx_count_liteethudp_next_value_ce0 = 1'd0;
-wire          main_holdingudprx_cut0;
-wire          main_holdingudprx_cut1;
-reg           main_holdingudprx_drop_header = 1'd0;
-reg           main_holdingudprx_err = 1'd0;
-reg           main_holdingudprx_err_liteethudp_next_value1 = 1'd0;
-reg           main_holdingudprx_err_liteethudp_next_value_ce1 = 1'd0;
-reg           main_holdingudprx_fsm_is_ongoing0 = 1'd0;
-reg           main_holdingudprx_fsm_is_ongoing1 = 1'd0;
-reg     [7:0] main_holdingudprx_held = 8'd0;
-reg     [7:0] main_holdingudprx_held_liteethudp_next_value3 = 8'd0;
-reg           main_holdingudprx_held_liteethudp_next_value_ce3 = 1'd0;
-reg     [2:0] main_holdingudprx_liteethudpdepacketizer_count = 3'd0;
-reg     [2:0] main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 = 3'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_delayed_last_be = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_fsm_from_idle = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 = 1'd0;
-wire   [63:0] main_holdingudprx_liteethudpdepacketizer_header;
-wire          main_holdingudprx_liteethudpdepacketizer_is_in_copy;
-reg           main_holdingudprx_liteethudpdepacketizer_is_ongoing0 = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_is_ongoing1 = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_is_ongoing2 = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_is_ongoing3 = 1'd0;
-wire          main_holdingudprx_liteethudpdepacketizer_new_last_be;
-reg           main_holdingudprx_liteethudpdepacketizer_sink_d_last = 1'd0;
-wire          main_holdingudprx_liteethudpdepacketizer_sink_first;
-wire          main_holdingudprx_liteethudpdepacketizer_sink_last;
-wire          main_holdingudprx_liteethudpdepacketizer_sink_last_be;
-wire   [31:0] main_holdingudprx_liteethudpdepacketizer_sink_param_ip_address;
-wire   [15:0] main_holdingudprx_liteethudpdepacketizer_sink_param_length;
-wire    [7:0] main_holdingudprx_liteethudpdepacketizer_sink_param_protocol;
-wire    [7:0] main_holdingudprx_liteethudpdepacketizer_sink_payload_data;
-wire          main_holdingudprx_liteethudpdepacketizer_sink_payload_error;
-wire          main_holdingudprx_liteethudpdepacketizer_sink_payload_last_be;
-reg           main_holdingudprx_liteethudpdepacketizer_sink_ready = 1'd0;
-wire          main_holdingudprx_liteethudpdepacketizer_sink_valid;
-reg           main_holdingudprx_liteethudpdepacketizer_source_last = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_source_last_a = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_source_last_b = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_source_last_s = 1'd0;
-wire   [15:0] main_holdingudprx_liteethudpdepacketizer_source_param_checksum;
-wire   [15:0] main_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
-wire   [15:0] main_holdingudprx_liteethudpdepacketizer_source_param_length;
-wire   [15:0] main_holdingudprx_liteethudpdepacketizer_source_param_src_port;
-reg     [7:0] main_holdingudprx_liteethudpdepacketizer_source_payload_data = 8'd0;
-wire          main_holdingudprx_liteethudpdepacketizer_source_payload_error;
-reg           main_holdingudprx_liteethudpdepacketizer_source_payload_last_be = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_source_ready = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_source_valid = 1'd0;
-reg    [63:0] main_holdingudprx_liteethudpdepacketizer_sr = 64'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_sr_shift = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
-reg           main_holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
-wire   [15:0] main_holdingudprx_payload_len;
-reg    [15:0] main_holdingudprx_rest = 16'd0;
-reg    [15:0] main_holdingudprx_rest_liteethudp_next_value2 = 16'd0;
-reg           main_holdingudprx_rest_liteethudp_next_value_ce2 = 1'd0;
-wire          main_holdingudprx_sink_first;
-wire          main_holdingudprx_sink_last;
-wire   [31:0] main_holdingudprx_sink_param_ip_address;
-wire   [15:0] main_holdingudprx_sink_param_length;
-wire    [7:0] main_holdingudprx_sink_param_protocol;
-wire    [7:0] main_holdingudprx_sink_payload_data;
-wire          main_holdingudprx_sink_payload_error;
-wire          main_holdingudprx_sink_payload_last_be;
-wire          main_holdingudprx_sink_ready;
-wire          main_holdingudprx_sink_valid;
-reg           main_holdingudprx_source_first = 1'd0;
-reg           main_holdingudprx_source_last = 1'd0;
-reg    [15:0] main_holdingudprx_source_param_dst_port = 16'd0;
-reg    [31:0] main_holdingudprx_source_param_ip_address = 32'd0;
-reg    [15:0] main_holdingudprx_source_param_length = 16'd0;
-reg    [15:0] main_holdingudprx_source_param_src_port = 16'd0;
-reg     [7:0] main_holdingudprx_source_payload_data = 8'd0;
-reg           main_holdingudprx_source_payload_error = 1'd0;
-reg           main_holdingudprx_source_payload_last_be = 1'd0;
-wire          main_holdingudprx_source_ready;
-reg           main_holdingudprx_source_valid = 1'd0;
 reg           main_icmp_echo_param_fifo_consume = 1'd0;
 wire          main_icmp_echo_param_fifo_do_read;
 wire          main_icmp_echo_param_fifo_fifo_in_first;
@@ -906,50 +825,50 @@ reg           main_icmp_echo_param_fifo_wrport_adr = 1'd0;
 wire  [113:0] main_icmp_echo_param_fifo_wrport_dat_r;
 wire  [113:0] main_icmp_echo_param_fifo_wrport_dat_w;
 wire          main_icmp_echo_param_fifo_wrport_we;
-reg     [6:0] main_icmp_echo_payload_fifo_consume = 7'd0;
+reg     [4:0] main_icmp_echo_payload_fifo_consume = 5'd0;
 wire          main_icmp_echo_payload_fifo_do_read;
 wire          main_icmp_echo_payload_fifo_fifo_in_first;
 wire          main_icmp_echo_payload_fifo_fifo_in_last;
-wire    [7:0] main_icmp_echo_payload_fifo_fifo_in_payload_data;
-wire          main_icmp_echo_payload_fifo_fifo_in_payload_error;
-wire          main_icmp_echo_payload_fifo_fifo_in_payload_last_be;
+wire   [31:0] main_icmp_echo_payload_fifo_fifo_in_payload_data;
+wire    [3:0] main_icmp_echo_payload_fifo_fifo_in_payload_error;
+wire    [3:0] main_icmp_echo_payload_fifo_fifo_in_payload_last_be;
 wire          main_icmp_echo_payload_fifo_fifo_out_first;
 wire          main_icmp_echo_payload_fifo_fifo_out_last;
-wire    [7:0] main_icmp_echo_payload_fifo_fifo_out_payload_data;
-wire          main_icmp_echo_payload_fifo_fifo_out_payload_error;
-wire          main_icmp_echo_payload_fifo_fifo_out_payload_last_be;
-reg     [7:0] main_icmp_echo_payload_fifo_level0 = 8'd0;
-wire    [7:0] main_icmp_echo_payload_fifo_level1;
-reg     [6:0] main_icmp_echo_payload_fifo_produce = 7'd0;
-wire    [6:0] main_icmp_echo_payload_fifo_rdport_adr;
-wire   [11:0] main_icmp_echo_payload_fifo_rdport_dat_r;
+wire   [31:0] main_icmp_echo_payload_fifo_fifo_out_payload_data;
+wire    [3:0] main_icmp_echo_payload_fifo_fifo_out_payload_error;
+wire    [3:0] main_icmp_echo_payload_fifo_fifo_out_payload_last_be;
+reg     [5:0] main_icmp_echo_payload_fifo_level0 = 6'd0;
+wire    [5:0] main_icmp_echo_payload_fifo_level1;
+reg     [4:0] main_icmp_echo_payload_fifo_produce = 5'd0;
+wire    [4:0] main_icmp_echo_payload_fifo_rdport_adr;
+wire   [41:0] main_icmp_echo_payload_fifo_rdport_dat_r;
 wire          main_icmp_echo_payload_fifo_rdport_re;
 wire          main_icmp_echo_payload_fifo_re;
 reg           main_icmp_echo_payload_fifo_readable = 1'd0;
 reg           main_icmp_echo_payload_fifo_replace = 1'd0;
 reg           main_icmp_echo_payload_fifo_sink_first = 1'd0;
 wire          main_icmp_echo_payload_fifo_sink_last;
-wire    [7:0] main_icmp_echo_payload_fifo_sink_payload_data;
-wire          main_icmp_echo_payload_fifo_sink_payload_error;
-wire          main_icmp_echo_payload_fifo_sink_payload_last_be;
+wire   [31:0] main_icmp_echo_payload_fifo_sink_payload_data;
+wire    [3:0] main_icmp_echo_payload_fifo_sink_payload_error;
+wire    [3:0] main_icmp_echo_payload_fifo_sink_payload_last_be;
 wire          main_icmp_echo_payload_fifo_sink_ready;
 wire          main_icmp_echo_payload_fifo_sink_valid;
 wire          main_icmp_echo_payload_fifo_source_first;
 wire          main_icmp_echo_payload_fifo_source_last;
-wire    [7:0] main_icmp_echo_payload_fifo_source_payload_data;
-wire          main_icmp_echo_payload_fifo_source_payload_error;
-wire          main_icmp_echo_payload_fifo_source_payload_last_be;
+wire   [31:0] main_icmp_echo_payload_fifo_source_payload_data;
+wire    [3:0] main_icmp_echo_payload_fifo_source_payload_error;
+wire    [3:0] main_icmp_echo_payload_fifo_source_payload_last_be;
 wire          main_icmp_echo_payload_fifo_source_ready;
 wire          main_icmp_echo_payload_fifo_source_valid;
-wire   [11:0] main_icmp_echo_payload_fifo_syncfifo_din;
-wire   [11:0] main_icmp_echo_payload_fifo_syncfifo_dout;
+wire   [41:0] main_icmp_echo_payload_fifo_syncfifo_din;
+wire   [41:0] main_icmp_echo_payload_fifo_syncfifo_dout;
 wire          main_icmp_echo_payload_fifo_syncfifo_re;
 wire          main_icmp_echo_payload_fifo_syncfifo_readable;
 wire          main_icmp_echo_payload_fifo_syncfifo_we;
 wire          main_icmp_echo_payload_fifo_syncfifo_writable;
-reg     [6:0] main_icmp_echo_payload_fifo_wrport_adr = 7'd0;
-wire   [11:0] main_icmp_echo_payload_fifo_wrport_dat_r;
-wire   [11:0] main_icmp_echo_payload_fifo_wrport_dat_w;
+reg     [4:0] main_icmp_echo_payload_fifo_wrport_adr = 5'd0;
+wire   [41:0] main_icmp_echo_payload_fifo_wrport_dat_r;
+wire   [41:0] main_icmp_echo_payload_fifo_wrport_dat_w;
 wire          main_icmp_echo_payload_fifo_wrport_we;
 wire          main_icmp_echo_sink_first;
 wire          main_icmp_echo_sink_last;
@@ -959,9 +878,9 @@ wire   [31:0] main_icmp_echo_sink_param_ip_address;
 wire   [15:0] main_icmp_echo_sink_param_length;
 wire    [7:0] main_icmp_echo_sink_param_msgtype;
 wire   [31:0] main_icmp_echo_sink_param_quench;
-wire    [7:0] main_icmp_echo_sink_payload_data;
-wire          main_icmp_echo_sink_payload_error;
-wire          main_icmp_echo_sink_payload_last_be;
+wire   [31:0] main_icmp_echo_sink_payload_data;
+wire    [3:0] main_icmp_echo_sink_payload_error;
+wire    [3:0] main_icmp_echo_sink_payload_last_be;
 reg           main_icmp_echo_sink_ready = 1'd0;
 reg           main_icmp_echo_sink_sink_first = 1'd0;
 reg           main_icmp_echo_sink_sink_last = 1'd0;
@@ -971,9 +890,9 @@ reg    [31:0] main_icmp_echo_sink_sink_param_ip_address = 32'd0;
 reg    [15:0] main_icmp_echo_sink_sink_param_length = 16'd0;
 reg     [7:0] main_icmp_echo_sink_sink_param_msgtype = 8'd0;
 reg    [31:0] main_icmp_echo_sink_sink_param_quench = 32'd0;
-reg     [7:0] main_icmp_echo_sink_sink_payload_data = 8'd0;
-reg           main_icmp_echo_sink_sink_payload_error = 1'd0;
-reg           main_icmp_echo_sink_sink_payload_last_be = 1'd0;
+reg    [31:0] main_icmp_echo_sink_sink_payload_data = 32'd0;
+reg     [3:0] main_icmp_echo_sink_sink_payload_error = 4'd0;
+reg     [3:0] main_icmp_echo_sink_sink_payload_last_be = 4'd0;
 wire          main_icmp_echo_sink_sink_ready;
 reg           main_icmp_echo_sink_sink_valid = 1'd0;
 wire          main_icmp_echo_sink_valid;
@@ -985,9 +904,9 @@ wire   [31:0] main_icmp_echo_source_param_ip_address;
 wire   [15:0] main_icmp_echo_source_param_length;
 reg     [7:0] main_icmp_echo_source_param_msgtype = 8'd0;
 wire   [31:0] main_icmp_echo_source_param_quench;
-wire    [7:0] main_icmp_echo_source_payload_data;
-wire          main_icmp_echo_source_payload_error;
-wire          main_icmp_echo_source_payload_last_be;
+wire   [31:0] main_icmp_echo_source_payload_data;
+wire    [3:0] main_icmp_echo_source_payload_error;
+wire    [3:0] main_icmp_echo_source_payload_last_be;
 wire          main_icmp_echo_source_ready;
 reg           main_icmp_echo_source_source_first = 1'd0;
 wire          main_icmp_echo_source_source_last;
@@ -997,9 +916,9 @@ wire   [31:0] main_icmp_echo_source_source_param_ip_address;
 wire   [15:0] main_icmp_echo_source_source_param_length;
 wire    [7:0] main_icmp_echo_source_source_param_msgtype;
 wire   [31:0] main_icmp_echo_source_source_param_quench;
-wire    [7:0] main_icmp_echo_source_source_payload_data;
-wire          main_icmp_echo_source_source_payload_error;
-wire          main_icmp_echo_source_source_payload_last_be;
+wire   [31:0] main_icmp_echo_source_source_payload_data;
+wire    [3:0] main_icmp_echo_source_source_payload_error;
+wire    [3:0] main_icmp_echo_source_source_payload_last_be;
 wire          main_icmp_echo_source_source_ready;
 wire          main_icmp_echo_source_source_valid;
 wire          main_icmp_echo_source_valid;
@@ -1008,9 +927,9 @@ wire          main_icmp_ip_port_sink_last;
 wire   [31:0] main_icmp_ip_port_sink_param_ip_address;
 wire   [15:0] main_icmp_ip_port_sink_param_length;
 wire    [7:0] main_icmp_ip_port_sink_param_protocol;
-wire    [7:0] main_icmp_ip_port_sink_payload_data;
-wire          main_icmp_ip_port_sink_payload_error;
-wire          main_icmp_ip_port_sink_payload_last_be;
+wire   [31:0] main_icmp_ip_port_sink_payload_data;
+wire    [3:0] main_icmp_ip_port_sink_payload_error;
+wire    [3:0] main_icmp_ip_port_sink_payload_last_be;
 reg           main_icmp_ip_port_sink_ready = 1'd0;
 wire          main_icmp_ip_port_sink_valid;
 reg           main_icmp_ip_port_source_first = 1'd0;
@@ -1018,19 +937,19 @@ reg           main_icmp_ip_port_source_last = 1'd0;
 reg    [31:0] main_icmp_ip_port_source_param_ip_address = 32'd0;
 reg    [15:0] main_icmp_ip_port_source_param_length = 16'd0;
 reg     [7:0] main_icmp_ip_port_source_param_protocol = 8'd0;
-reg     [7:0] main_icmp_ip_port_source_payload_data = 8'd0;
-reg           main_icmp_ip_port_source_payload_error = 1'd0;
-reg           main_icmp_ip_port_source_payload_last_be = 1'd0;
+reg    [31:0] main_icmp_ip_port_source_payload_data = 32'd0;
+reg     [3:0] main_icmp_ip_port_source_payload_error = 4'd0;
+reg     [3:0] main_icmp_ip_port_source_payload_last_be = 4'd0;
 wire          main_icmp_ip_port_source_ready;
 reg           main_icmp_ip_port_source_valid = 1'd0;
 wire          main_icmp_rx_cut;
 reg           main_icmp_rx_fsm_is_ongoing0 = 1'd0;
 reg           main_icmp_rx_fsm_is_ongoing1 = 1'd0;
-reg     [2:0] main_icmp_rx_liteethicmpdepacketizer_count = 3'd0;
-reg     [2:0] main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 = 3'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_count = 1'd0;
+reg           main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 = 1'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 = 1'd0;
-reg           main_icmp_rx_liteethicmpdepacketizer_delayed_last_be = 1'd0;
-reg           main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 = 1'd0;
+reg     [3:0] main_icmp_rx_liteethicmpdepacketizer_delayed_last_be = 4'd0;
+reg     [3:0] main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 = 4'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 = 1'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle = 1'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 = 1'd0;
@@ -1041,17 +960,16 @@ reg           main_icmp_rx_liteethicmpdepacketizer_is_ongoing0 = 1'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_is_ongoing1 = 1'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_is_ongoing2 = 1'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_is_ongoing3 = 1'd0;
-wire          main_icmp_rx_liteethicmpdepacketizer_new_last_be;
+wire    [3:0] main_icmp_rx_liteethicmpdepacketizer_new_last_be;
 reg           main_icmp_rx_liteethicmpdepacketizer_sink_d_last = 1'd0;
 wire          main_icmp_rx_liteethicmpdepacketizer_sink_first;
 wire          main_icmp_rx_liteethicmpdepacketizer_sink_last;
-wire          main_icmp_rx_liteethicmpdepacketizer_sink_last_be;
 wire   [31:0] main_icmp_rx_liteethicmpdepacketizer_sink_param_ip_address;
 wire   [15:0] main_icmp_rx_liteethicmpdepacketizer_sink_param_length;
 wire    [7:0] main_icmp_rx_liteethicmpdepacketizer_sink_param_protocol;
-wire    [7:0] main_icmp_rx_liteethicmpdepacketizer_sink_payload_data;
-wire          main_icmp_rx_liteethicmpdepacketizer_sink_payload_error;
-wire          main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be;
+wire   [31:0] main_icmp_rx_liteethicmpdepacketizer_sink_payload_data;
+wire    [3:0] main_icmp_rx_liteethicmpdepacketizer_sink_payload_error;
+wire    [3:0] main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be;
 reg           main_icmp_rx_liteethicmpdepacketizer_sink_ready = 1'd0;
 wire          main_icmp_rx_liteethicmpdepacketizer_sink_valid;
 reg           main_icmp_rx_liteethicmpdepacketizer_source_last = 1'd0;
@@ -1062,9 +980,9 @@ wire   [15:0] main_icmp_rx_liteethicmpdepacketizer_source_param_checksum;
 wire    [7:0] main_icmp_rx_liteethicmpdepacketizer_source_param_code;
 wire    [7:0] main_icmp_rx_liteethicmpdepacketizer_source_param_msgtype;
 wire   [31:0] main_icmp_rx_liteethicmpdepacketizer_source_param_quench;
-reg     [7:0] main_icmp_rx_liteethicmpdepacketizer_source_payload_data = 8'd0;
-wire          main_icmp_rx_liteethicmpdepacketizer_source_payload_error;
-reg           main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be = 1'd0;
+reg    [31:0] main_icmp_rx_liteethicmpdepacketizer_source_payload_data = 32'd0;
+wire    [3:0] main_icmp_rx_liteethicmpdepacketizer_source_payload_error;
+reg     [3:0] main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be = 4'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_source_ready = 1'd0;
 reg           main_icmp_rx_liteethicmpdepacketizer_source_valid = 1'd0;
 reg    [63:0] main_icmp_rx_liteethicmpdepacketizer_sr = 64'd0;
@@ -1076,9 +994,9 @@ wire          main_icmp_rx_sink_last;
 wire   [31:0] main_icmp_rx_sink_param_ip_address;
 wire   [15:0] main_icmp_rx_sink_param_length;
 wire    [7:0] main_icmp_rx_sink_param_protocol;
-wire    [7:0] main_icmp_rx_sink_payload_data;
-wire          main_icmp_rx_sink_payload_error;
-wire          main_icmp_rx_sink_payload_last_be;
+wire   [31:0] main_icmp_rx_sink_payload_data;
+wire    [3:0] main_icmp_rx_sink_payload_error;
+wire    [3:0] main_icmp_rx_sink_payload_last_be;
 wire          main_icmp_rx_sink_ready;
 wire          main_icmp_rx_sink_valid;
 reg           main_icmp_rx_source_first = 1'd0;
@@ -1089,16 +1007,16 @@ wire   [31:0] main_icmp_rx_source_param_ip_address;
 wire   [15:0] main_icmp_rx_source_param_length;
 wire    [7:0] main_icmp_rx_source_param_msgtype;
 wire   [31:0] main_icmp_rx_source_param_quench;
-wire    [7:0] main_icmp_rx_source_payload_data;
-wire          main_icmp_rx_source_payload_error;
-wire          main_icmp_rx_source_payload_last_be;
+wire   [31:0] main_icmp_rx_source_payload_data;
+wire    [3:0] main_icmp_rx_source_payload_error;
+wire    [3:0] main_icmp_rx_source_payload_last_be;
 wire          main_icmp_rx_source_ready;
 reg           main_icmp_rx_source_valid = 1'd0;
-reg     [2:0] main_icmp_tx_packetizer_count = 3'd0;
-reg     [2:0] main_icmp_tx_packetizer_count_fsm0_next_value0 = 3'd0;
+reg           main_icmp_tx_packetizer_count = 1'd0;
+reg           main_icmp_tx_packetizer_count_fsm0_next_value0 = 1'd0;
 reg           main_icmp_tx_packetizer_count_fsm0_next_value_ce0 = 1'd0;
-reg           main_icmp_tx_packetizer_delayed_last_be = 1'd0;
-reg           main_icmp_tx_packetizer_delayed_last_be_fsm1_next_value0 = 1'd0;
+reg     [3:0] main_icmp_tx_packetizer_delayed_last_be = 4'd0;
+reg     [3:0] main_icmp_tx_packetizer_delayed_last_be_fsm1_next_value0 = 4'd0;
 reg           main_icmp_tx_packetizer_delayed_last_be_fsm1_next_value_ce0 = 1'd0;
 reg           main_icmp_tx_packetizer_fsm_from_idle = 1'd0;
 reg           main_icmp_tx_packetizer_fsm_from_idle_fsm0_next_value1 = 1'd0;
@@ -1108,16 +1026,15 @@ wire          main_icmp_tx_packetizer_in_data_copy;
 reg           main_icmp_tx_packetizer_is_ongoing0 = 1'd0;
 reg           main_icmp_tx_packetizer_is_ongoing1 = 1'd0;
 reg           main_icmp_tx_packetizer_is_ongoing2 = 1'd0;
-wire          main_icmp_tx_packetizer_new_last_be;
+wire    [3:0] main_icmp_tx_packetizer_new_last_be;
 wire          main_icmp_tx_packetizer_sink_last;
-wire          main_icmp_tx_packetizer_sink_last_be;
 wire   [15:0] main_icmp_tx_packetizer_sink_param_checksum;
 wire    [7:0] main_icmp_tx_packetizer_sink_param_code;
 wire    [7:0] main_icmp_tx_packetizer_sink_param_msgtype;
 wire   [31:0] main_icmp_tx_packetizer_sink_param_quench;
-wire    [7:0] main_icmp_tx_packetizer_sink_payload_data;
-reg           main_icmp_tx_packetizer_sink_payload_error = 1'd0;
-wire          main_icmp_tx_packetizer_sink_payload_last_be;
+wire   [31:0] main_icmp_tx_packetizer_sink_payload_data;
+reg     [3:0] main_icmp_tx_packetizer_sink_payload_error = 4'd0;
+wire    [3:0] main_icmp_tx_packetizer_sink_payload_last_be;
 reg           main_icmp_tx_packetizer_sink_ready = 1'd0;
 wire          main_icmp_tx_packetizer_sink_valid;
 reg           main_icmp_tx_packetizer_source_first = 1'd0;
@@ -1128,9 +1045,9 @@ reg           main_icmp_tx_packetizer_source_last_s = 1'd0;
 reg    [31:0] main_icmp_tx_packetizer_source_param_ip_address = 32'd0;
 reg    [15:0] main_icmp_tx_packetizer_source_param_length = 16'd0;
 reg     [7:0] main_icmp_tx_packetizer_source_param_protocol = 8'd0;
-reg     [7:0] main_icmp_tx_packetizer_source_payload_data = 8'd0;
-wire          main_icmp_tx_packetizer_source_payload_error;
-reg           main_icmp_tx_packetizer_source_payload_last_be = 1'd0;
+reg    [31:0] main_icmp_tx_packetizer_source_payload_data = 32'd0;
+wire    [3:0] main_icmp_tx_packetizer_source_payload_error;
+reg     [3:0] main_icmp_tx_packetizer_source_payload_last_be = 4'd0;
 reg           main_icmp_tx_packetizer_source_ready = 1'd0;
 reg           main_icmp_tx_packetizer_source_valid = 1'd0;
 reg    [63:0] main_icmp_tx_packetizer_sr = 64'd0;
@@ -1144,9 +1061,9 @@ wire   [31:0] main_icmp_tx_sink_sink_param_ip_address;
 wire   [15:0] main_icmp_tx_sink_sink_param_length;
 wire    [7:0] main_icmp_tx_sink_sink_param_msgtype;
 wire   [31:0] main_icmp_tx_sink_sink_param_quench;
-wire    [7:0] main_icmp_tx_sink_sink_payload_data;
-wire          main_icmp_tx_sink_sink_payload_error;
-wire          main_icmp_tx_sink_sink_payload_last_be;
+wire   [31:0] main_icmp_tx_sink_sink_payload_data;
+wire    [3:0] main_icmp_tx_sink_sink_payload_error;
+wire    [3:0] main_icmp_tx_sink_sink_payload_last_be;
 wire          main_icmp_tx_sink_sink_ready;
 wire          main_icmp_tx_sink_sink_valid;
 wire          main_icmp_tx_source_source_first;
@@ -1154,43 +1071,21 @@ wire          main_icmp_tx_source_source_last;
 reg    [31:0] main_icmp_tx_source_source_param_ip_address = 32'd0;
 reg    [15:0] main_icmp_tx_source_source_param_length = 16'd0;
 reg     [7:0] main_icmp_tx_source_source_param_protocol = 8'd0;
-wire    [7:0] main_icmp_tx_source_source_payload_data;
-wire          main_icmp_tx_source_source_payload_error;
-wire          main_icmp_tx_source_source_payload_last_be;
+wire   [31:0] main_icmp_tx_source_source_payload_data;
+wire    [3:0] main_icmp_tx_source_source_payload_error;
+wire    [3:0] main_icmp_tx_source_source_payload_last_be;
 wire          main_icmp_tx_source_source_ready;
 reg           main_icmp_tx_source_source_valid = 1'd0;
 reg           main_int_rst = 1'd1;
-wire          main_internal_port_sink_first;
-wire          main_internal_port_sink_last;
-wire   [15:0] main_internal_port_sink_param_dst_port;
-wire   [31:0] main_internal_port_sink_param_ip_address;
-wire   [15:0] main_internal_port_sink_param_length;
-wire   [15:0] main_internal_port_sink_param_src_port;
-wire    [7:0] main_internal_port_sink_payload_data;
-wire          main_internal_port_sink_payload_error;
-wire          main_internal_port_sink_payload_last_be;
-wire          main_internal_port_sink_ready;
-wire          main_internal_port_sink_valid;
-reg           main_internal_port_source_first = 1'd0;
-reg           main_internal_port_source_last = 1'd0;
-reg    [15:0] main_internal_port_source_param_dst_port = 16'd0;
-reg    [31:0] main_internal_port_source_param_ip_address = 32'd0;
-reg    [15:0] main_internal_port_source_param_length = 16'd0;
-reg    [15:0] main_internal_port_source_param_src_port = 16'd0;
-reg     [7:0] main_internal_port_source_payload_data = 8'd0;
-reg           main_internal_port_source_payload_error = 1'd0;
-reg           main_internal_port_source_payload_last_be = 1'd0;
-wire          main_internal_port_source_ready;
-reg           main_internal_port_source_valid = 1'd0;
 wire          main_ip_crossbar_dropped;
 wire          main_ip_crossbar_sink_first;
 wire          main_ip_crossbar_sink_last;
 wire   [31:0] main_ip_crossbar_sink_param_ip_address;
 wire   [15:0] main_ip_crossbar_sink_param_length;
 wire    [7:0] main_ip_crossbar_sink_param_protocol;
-wire    [7:0] main_ip_crossbar_sink_payload_data;
-wire          main_ip_crossbar_sink_payload_error;
-wire          main_ip_crossbar_sink_payload_last_be;
+wire   [31:0] main_ip_crossbar_sink_payload_data;
+wire    [3:0] main_ip_crossbar_sink_payload_error;
+wire    [3:0] main_ip_crossbar_sink_payload_last_be;
 reg           main_ip_crossbar_sink_ready = 1'd0;
 wire          main_ip_crossbar_sink_valid;
 reg           main_ip_crossbar_source_first = 1'd0;
@@ -1198,51 +1093,31 @@ reg           main_ip_crossbar_source_last = 1'd0;
 reg    [31:0] main_ip_crossbar_source_param_ip_address = 32'd0;
 reg    [15:0] main_ip_crossbar_source_param_length = 16'd0;
 reg     [7:0] main_ip_crossbar_source_param_protocol = 8'd0;
-reg     [7:0] main_ip_crossbar_source_payload_data = 8'd0;
-reg           main_ip_crossbar_source_payload_error = 1'd0;
-reg           main_ip_crossbar_source_payload_last_be = 1'd0;
+reg    [31:0] main_ip_crossbar_source_payload_data = 32'd0;
+reg     [3:0] main_ip_crossbar_source_payload_error = 4'd0;
+reg     [3:0] main_ip_crossbar_source_payload_last_be = 4'd0;
 wire          main_ip_crossbar_source_ready;
 reg           main_ip_crossbar_source_valid = 1'd0;
 wire          main_ip_mac_port_sink_first;
 wire          main_ip_mac_port_sink_last;
-wire    [7:0] main_ip_mac_port_sink_payload_data;
-wire          main_ip_mac_port_sink_payload_error;
+wire   [31:0] main_ip_mac_port_sink_payload_data;
+wire    [3:0] main_ip_mac_port_sink_payload_error;
 wire   [15:0] main_ip_mac_port_sink_payload_ethernet_type;
-wire          main_ip_mac_port_sink_payload_last_be;
+wire    [3:0] main_ip_mac_port_sink_payload_last_be;
 wire   [47:0] main_ip_mac_port_sink_payload_sender_mac;
 wire   [47:0] main_ip_mac_port_sink_payload_target_mac;
 reg           main_ip_mac_port_sink_ready = 1'd0;
 wire          main_ip_mac_port_sink_valid;
 reg           main_ip_mac_port_source_first = 1'd0;
 reg           main_ip_mac_port_source_last = 1'd0;
-reg     [7:0] main_ip_mac_port_source_payload_data = 8'd0;
-reg           main_ip_mac_port_source_payload_error = 1'd0;
+reg    [31:0] main_ip_mac_port_source_payload_data = 32'd0;
+reg     [3:0] main_ip_mac_port_source_payload_error = 4'd0;
 reg    [15:0] main_ip_mac_port_source_payload_ethernet_type = 16'd0;
-reg           main_ip_mac_port_source_payload_last_be = 1'd0;
+reg     [3:0] main_ip_mac_port_source_payload_last_be = 4'd0;
 reg    [47:0] main_ip_mac_port_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_ip_mac_port_source_payload_target_mac = 48'd0;
 wire          main_ip_mac_port_source_ready;
 reg           main_ip_mac_port_source_valid = 1'd0;
-wire          main_ip_port_sink_first;
-wire          main_ip_port_sink_last;
-wire   [31:0] main_ip_port_sink_param_ip_address;
-wire   [15:0] main_ip_port_sink_param_length;
-wire    [7:0] main_ip_port_sink_param_protocol;
-wire    [7:0] main_ip_port_sink_payload_data;
-wire          main_ip_port_sink_payload_error;
-wire          main_ip_port_sink_payload_last_be;
-reg           main_ip_port_sink_ready = 1'd0;
-wire          main_ip_port_sink_valid;
-reg           main_ip_port_source_first = 1'd0;
-reg           main_ip_port_source_last = 1'd0;
-reg    [31:0] main_ip_port_source_param_ip_address = 32'd0;
-reg    [15:0] main_ip_port_source_param_length = 16'd0;
-reg     [7:0] main_ip_port_source_param_protocol = 8'd0;
-reg     [7:0] main_ip_port_source_payload_data = 8'd0;
-reg           main_ip_port_source_payload_error = 1'd0;
-reg           main_ip_port_source_payload_last_be = 1'd0;
-wire          main_ip_port_source_ready;
-reg           main_ip_port_source_valid = 1'd0;
 wire          main_ip_rx_ce;
 wire          main_ip_rx_cut;
 wire          main_ip_rx_decide;
@@ -1288,11 +1163,11 @@ wire   [16:0] main_ip_rx_liteethipv4checksum_s_next7;
 wire   [16:0] main_ip_rx_liteethipv4checksum_s_next8;
 wire   [16:0] main_ip_rx_liteethipv4checksum_s_next9;
 wire   [15:0] main_ip_rx_liteethipv4checksum_value;
-reg     [4:0] main_ip_rx_liteethipv4depacketizer_count = 5'd0;
-reg     [4:0] main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 = 5'd0;
+reg     [2:0] main_ip_rx_liteethipv4depacketizer_count = 3'd0;
+reg     [2:0] main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 = 3'd0;
 reg           main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 = 1'd0;
-reg           main_ip_rx_liteethipv4depacketizer_delayed_last_be = 1'd0;
-reg           main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 = 1'd0;
+reg     [3:0] main_ip_rx_liteethipv4depacketizer_delayed_last_be = 4'd0;
+reg     [3:0] main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 = 4'd0;
 reg           main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 = 1'd0;
 reg           main_ip_rx_liteethipv4depacketizer_fsm_from_idle = 1'd0;
 reg           main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 = 1'd0;
@@ -1303,15 +1178,14 @@ reg           main_ip_rx_liteethipv4depacketizer_is_ongoing0 = 1'd0;
 reg           main_ip_rx_liteethipv4depacketizer_is_ongoing1 = 1'd0;
 reg           main_ip_rx_liteethipv4depacketizer_is_ongoing2 = 1'd0;
 reg           main_ip_rx_liteethipv4depacketizer_is_ongoing3 = 1'd0;
-wire          main_ip_rx_liteethipv4depacketizer_new_last_be;
+wire    [3:0] main_ip_rx_liteethipv4depacketizer_new_last_be;
 reg           main_ip_rx_liteethipv4depacketizer_sink_d_last = 1'd0;
 wire          main_ip_rx_liteethipv4depacketizer_sink_first;
 wire          main_ip_rx_liteethipv4depacketizer_sink_last;
-wire          main_ip_rx_liteethipv4depacketizer_sink_last_be;
-wire    [7:0] main_ip_rx_liteethipv4depacketizer_sink_payload_data;
-wire          main_ip_rx_liteethipv4depacketizer_sink_payload_error;
+wire   [31:0] main_ip_rx_liteethipv4depacketizer_sink_payload_data;
+wire    [3:0] main_ip_rx_liteethipv4depacketizer_sink_payload_error;
 wire   [15:0] main_ip_rx_liteethipv4depacketizer_sink_payload_ethernet_type;
-wire          main_ip_rx_liteethipv4depacketizer_sink_payload_last_be;
+wire    [3:0] main_ip_rx_liteethipv4depacketizer_sink_payload_last_be;
 wire   [47:0] main_ip_rx_liteethipv4depacketizer_sink_payload_sender_mac;
 wire   [47:0] main_ip_rx_liteethipv4depacketizer_sink_payload_target_mac;
 reg           main_ip_rx_liteethipv4depacketizer_sink_ready = 1'd0;
@@ -1329,9 +1203,9 @@ wire   [31:0] main_ip_rx_liteethipv4depacketizer_source_param_target_ip;
 wire   [15:0] main_ip_rx_liteethipv4depacketizer_source_param_total_length;
 wire    [7:0] main_ip_rx_liteethipv4depacketizer_source_param_ttl;
 wire    [3:0] main_ip_rx_liteethipv4depacketizer_source_param_version;
-reg     [7:0] main_ip_rx_liteethipv4depacketizer_source_payload_data = 8'd0;
-wire          main_ip_rx_liteethipv4depacketizer_source_payload_error;
-reg           main_ip_rx_liteethipv4depacketizer_source_payload_last_be = 1'd0;
+reg    [31:0] main_ip_rx_liteethipv4depacketizer_source_payload_data = 32'd0;
+wire    [3:0] main_ip_rx_liteethipv4depacketizer_source_payload_error;
+reg     [3:0] main_ip_rx_liteethipv4depacketizer_source_payload_last_be = 4'd0;
 reg           main_ip_rx_liteethipv4depacketizer_source_ready = 1'd0;
 reg           main_ip_rx_liteethipv4depacketizer_source_valid = 1'd0;
 reg   [159:0] main_ip_rx_liteethipv4depacketizer_sr = 160'd0;
@@ -1343,10 +1217,10 @@ wire          main_ip_rx_ours;
 wire          main_ip_rx_reset;
 wire          main_ip_rx_sink_first;
 wire          main_ip_rx_sink_last;
-wire    [7:0] main_ip_rx_sink_payload_data;
-wire          main_ip_rx_sink_payload_error;
+wire   [31:0] main_ip_rx_sink_payload_data;
+wire    [3:0] main_ip_rx_sink_payload_error;
 wire   [15:0] main_ip_rx_sink_payload_ethernet_type;
-wire          main_ip_rx_sink_payload_last_be;
+wire    [3:0] main_ip_rx_sink_payload_last_be;
 wire   [47:0] main_ip_rx_sink_payload_sender_mac;
 wire   [47:0] main_ip_rx_sink_payload_target_mac;
 wire          main_ip_rx_sink_ready;
@@ -1356,9 +1230,9 @@ wire          main_ip_rx_source_last;
 wire   [31:0] main_ip_rx_source_param_ip_address;
 wire   [15:0] main_ip_rx_source_param_length;
 wire    [7:0] main_ip_rx_source_param_protocol;
-wire    [7:0] main_ip_rx_source_payload_data;
-wire          main_ip_rx_source_payload_error;
-wire          main_ip_rx_source_payload_last_be;
+wire   [31:0] main_ip_rx_source_payload_data;
+wire    [3:0] main_ip_rx_source_payload_error;
+wire    [3:0] main_ip_rx_source_payload_last_be;
 wire          main_ip_rx_source_ready;
 reg           main_ip_rx_source_valid = 1'd0;
 wire          main_ip_tx_ce;
@@ -1395,11 +1269,11 @@ wire   [16:0] main_ip_tx_liteethipv4checksum_s_next6;
 wire   [16:0] main_ip_tx_liteethipv4checksum_s_next7;
 wire   [16:0] main_ip_tx_liteethipv4checksum_s_next8;
 wire   [15:0] main_ip_tx_liteethipv4checksum_value;
-reg     [4:0] main_ip_tx_packetizer_count = 5'd0;
-reg     [4:0] main_ip_tx_packetizer_count_liteethip_fsm0_next_value0 = 5'd0;
+reg     [2:0] main_ip_tx_packetizer_count = 3'd0;
+reg     [2:0] main_ip_tx_packetizer_count_liteethip_fsm0_next_value0 = 3'd0;
 reg           main_ip_tx_packetizer_count_liteethip_fsm0_next_value_ce0 = 1'd0;
-reg           main_ip_tx_packetizer_delayed_last_be = 1'd0;
-reg           main_ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value0 = 1'd0;
+reg     [3:0] main_ip_tx_packetizer_delayed_last_be = 4'd0;
+reg     [3:0] main_ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value0 = 4'd0;
 reg           main_ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value_ce0 = 1'd0;
 reg           main_ip_tx_packetizer_fsm_from_idle = 1'd0;
 reg           main_ip_tx_packetizer_fsm_from_idle_liteethip_fsm0_next_value1 = 1'd0;
@@ -1409,9 +1283,8 @@ wire          main_ip_tx_packetizer_in_data_copy;
 reg           main_ip_tx_packetizer_is_ongoing0 = 1'd0;
 reg           main_ip_tx_packetizer_is_ongoing1 = 1'd0;
 reg           main_ip_tx_packetizer_is_ongoing2 = 1'd0;
-wire          main_ip_tx_packetizer_new_last_be;
+wire    [3:0] main_ip_tx_packetizer_new_last_be;
 wire          main_ip_tx_packetizer_sink_last;
-wire          main_ip_tx_packetizer_sink_last_be;
 wire   [15:0] main_ip_tx_packetizer_sink_param_checksum;
 wire   [15:0] main_ip_tx_packetizer_sink_param_identification;
 wire    [3:0] main_ip_tx_packetizer_sink_param_ihl;
@@ -1421,9 +1294,9 @@ wire   [31:0] main_ip_tx_packetizer_sink_param_target_ip;
 wire   [15:0] main_ip_tx_packetizer_sink_param_total_length;
 wire    [7:0] main_ip_tx_packetizer_sink_param_ttl;
 wire    [3:0] main_ip_tx_packetizer_sink_param_version;
-wire    [7:0] main_ip_tx_packetizer_sink_payload_data;
-reg           main_ip_tx_packetizer_sink_payload_error = 1'd0;
-wire          main_ip_tx_packetizer_sink_payload_last_be;
+wire   [31:0] main_ip_tx_packetizer_sink_payload_data;
+reg     [3:0] main_ip_tx_packetizer_sink_payload_error = 4'd0;
+wire    [3:0] main_ip_tx_packetizer_sink_payload_last_be;
 reg           main_ip_tx_packetizer_sink_ready = 1'd0;
 wire          main_ip_tx_packetizer_sink_valid;
 reg           main_ip_tx_packetizer_source_first = 1'd0;
@@ -1431,10 +1304,10 @@ reg           main_ip_tx_packetizer_source_last = 1'd0;
 reg           main_ip_tx_packetizer_source_last_a = 1'd0;
 reg           main_ip_tx_packetizer_source_last_b = 1'd0;
 reg           main_ip_tx_packetizer_source_last_s = 1'd0;
-reg     [7:0] main_ip_tx_packetizer_source_payload_data = 8'd0;
-wire          main_ip_tx_packetizer_source_payload_error;
+reg    [31:0] main_ip_tx_packetizer_source_payload_data = 32'd0;
+wire    [3:0] main_ip_tx_packetizer_source_payload_error;
 reg    [15:0] main_ip_tx_packetizer_source_payload_ethernet_type = 16'd0;
-reg           main_ip_tx_packetizer_source_payload_last_be = 1'd0;
+reg     [3:0] main_ip_tx_packetizer_source_payload_last_be = 4'd0;
 reg    [47:0] main_ip_tx_packetizer_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_ip_tx_packetizer_source_payload_target_mac = 48'd0;
 reg           main_ip_tx_packetizer_source_ready = 1'd0;
@@ -1447,9 +1320,9 @@ wire          main_ip_tx_pipe_valid_sink_last;
 wire   [31:0] main_ip_tx_pipe_valid_sink_param_ip_address;
 wire   [15:0] main_ip_tx_pipe_valid_sink_param_length;
 wire    [7:0] main_ip_tx_pipe_valid_sink_param_protocol;
-wire    [7:0] main_ip_tx_pipe_valid_sink_payload_data;
-wire          main_ip_tx_pipe_valid_sink_payload_error;
-wire          main_ip_tx_pipe_valid_sink_payload_last_be;
+wire   [31:0] main_ip_tx_pipe_valid_sink_payload_data;
+wire    [3:0] main_ip_tx_pipe_valid_sink_payload_error;
+wire    [3:0] main_ip_tx_pipe_valid_sink_payload_last_be;
 wire          main_ip_tx_pipe_valid_sink_ready;
 wire          main_ip_tx_pipe_valid_sink_valid;
 reg           main_ip_tx_pipe_valid_source_first = 1'd0;
@@ -1457,9 +1330,9 @@ reg           main_ip_tx_pipe_valid_source_last = 1'd0;
 reg    [31:0] main_ip_tx_pipe_valid_source_param_ip_address = 32'd0;
 reg    [15:0] main_ip_tx_pipe_valid_source_param_length = 16'd0;
 reg     [7:0] main_ip_tx_pipe_valid_source_param_protocol = 8'd0;
-reg     [7:0] main_ip_tx_pipe_valid_source_payload_data = 8'd0;
-reg           main_ip_tx_pipe_valid_source_payload_error = 1'd0;
-reg           main_ip_tx_pipe_valid_source_payload_last_be = 1'd0;
+reg    [31:0] main_ip_tx_pipe_valid_source_payload_data = 32'd0;
+reg     [3:0] main_ip_tx_pipe_valid_source_payload_error = 4'd0;
+reg     [3:0] main_ip_tx_pipe_valid_source_payload_last_be = 4'd0;
 wire          main_ip_tx_pipe_valid_source_ready;
 reg           main_ip_tx_pipe_valid_source_valid = 1'd0;
 wire          main_ip_tx_reset;
@@ -1473,12 +1346,12 @@ wire   [15:0] main_ip_tx_sink_sink_param_length0;
 wire   [15:0] main_ip_tx_sink_sink_param_length1;
 wire    [7:0] main_ip_tx_sink_sink_param_protocol0;
 wire    [7:0] main_ip_tx_sink_sink_param_protocol1;
-wire    [7:0] main_ip_tx_sink_sink_payload_data0;
-wire    [7:0] main_ip_tx_sink_sink_payload_data1;
-wire          main_ip_tx_sink_sink_payload_error0;
-wire          main_ip_tx_sink_sink_payload_error1;
-wire          main_ip_tx_sink_sink_payload_last_be0;
-wire          main_ip_tx_sink_sink_payload_last_be1;
+wire   [31:0] main_ip_tx_sink_sink_payload_data0;
+wire   [31:0] main_ip_tx_sink_sink_payload_data1;
+wire    [3:0] main_ip_tx_sink_sink_payload_error0;
+wire    [3:0] main_ip_tx_sink_sink_payload_error1;
+wire    [3:0] main_ip_tx_sink_sink_payload_last_be0;
+wire    [3:0] main_ip_tx_sink_sink_payload_last_be1;
 wire          main_ip_tx_sink_sink_ready0;
 wire          main_ip_tx_sink_sink_ready1;
 wire          main_ip_tx_sink_sink_valid0;
@@ -1490,13 +1363,13 @@ wire          main_ip_tx_source_source_last1;
 wire   [31:0] main_ip_tx_source_source_param_ip_address;
 wire   [15:0] main_ip_tx_source_source_param_length;
 wire    [7:0] main_ip_tx_source_source_param_protocol;
-reg     [7:0] main_ip_tx_source_source_payload_data0 = 8'd0;
-wire    [7:0] main_ip_tx_source_source_payload_data1;
-reg           main_ip_tx_source_source_payload_error0 = 1'd0;
-wire          main_ip_tx_source_source_payload_error1;
+reg    [31:0] main_ip_tx_source_source_payload_data0 = 32'd0;
+wire   [31:0] main_ip_tx_source_source_payload_data1;
+reg     [3:0] main_ip_tx_source_source_payload_error0 = 4'd0;
+wire    [3:0] main_ip_tx_source_source_payload_error1;
 reg    [15:0] main_ip_tx_source_source_payload_ethernet_type = 16'd0;
-reg           main_ip_tx_source_source_payload_last_be0 = 1'd0;
-wire          main_ip_tx_source_source_payload_last_be1;
+reg     [3:0] main_ip_tx_source_source_payload_last_be0 = 4'd0;
+wire    [3:0] main_ip_tx_source_source_payload_last_be1;
 reg    [47:0] main_ip_tx_source_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_ip_tx_source_source_payload_target_mac = 48'd0;
 wire          main_ip_tx_source_source_ready0;
@@ -1535,54 +1408,6 @@ wire          main_mac_core_bufferizeendpoints_source_source_payload_error;
 wire          main_mac_core_bufferizeendpoints_source_source_payload_last_be;
 wire          main_mac_core_bufferizeendpoints_source_source_ready;
 wire          main_mac_core_bufferizeendpoints_source_source_valid;
-wire   [11:0] main_mac_core_cdc_asyncfifo_din;
-wire   [11:0] main_mac_core_cdc_asyncfifo_dout;
-wire          main_mac_core_cdc_asyncfifo_re;
-wire          main_mac_core_cdc_asyncfifo_readable;
-wire          main_mac_core_cdc_asyncfifo_we;
-wire          main_mac_core_cdc_asyncfifo_writable;
-wire    [5:0] main_mac_core_cdc_consume_wdomain;
-wire          main_mac_core_cdc_fifo_in_first;
-wire          main_mac_core_cdc_fifo_in_last;
-wire    [7:0] main_mac_core_cdc_fifo_in_payload_data;
-wire          main_mac_core_cdc_fifo_in_payload_error;
-wire          main_mac_core_cdc_fifo_in_payload_last_be;
-wire          main_mac_core_cdc_fifo_out_first;
-wire          main_mac_core_cdc_fifo_out_last;
-wire    [7:0] main_mac_core_cdc_fifo_out_payload_data;
-wire          main_mac_core_cdc_fifo_out_payload_error;
-wire          main_mac_core_cdc_fifo_out_payload_last_be;
-wire          main_mac_core_cdc_graycounter0_ce;
-reg     [5:0] main_mac_core_cdc_graycounter0_q = 6'd0;
-reg     [5:0] main_mac_core_cdc_graycounter0_q_binary = 6'd0;
-wire    [5:0] main_mac_core_cdc_graycounter0_q_next;
-reg     [5:0] main_mac_core_cdc_graycounter0_q_next_binary = 6'd0;
-wire          main_mac_core_cdc_graycounter1_ce;
-reg     [5:0] main_mac_core_cdc_graycounter1_q = 6'd0;
-reg     [5:0] main_mac_core_cdc_graycounter1_q_binary = 6'd0;
-wire    [5:0] main_mac_core_cdc_graycounter1_q_next;
-reg     [5:0] main_mac_core_cdc_graycounter1_q_next_binary = 6'd0;
-wire    [5:0] main_mac_core_cdc_produce_rdomain;
-wire    [4:0] main_mac_core_cdc_rdport_adr;
-wire   [11:0] main_mac_core_cdc_rdport_dat_r;
-wire          main_mac_core_cdc_sink_first;
-wire          main_mac_core_cdc_sink_last;
-wire    [7:0] main_mac_core_cdc_sink_payload_data;
-wire          main_mac_core_cdc_sink_payload_error;
-wire          main_mac_core_cdc_sink_payload_last_be;
-wire          main_mac_core_cdc_sink_ready;
-wire          main_mac_core_cdc_sink_valid;
-wire          main_mac_core_cdc_source_first;
-wire          main_mac_core_cdc_source_last;
-wire    [7:0] main_mac_core_cdc_source_payload_data;
-wire          main_mac_core_cdc_source_payload_error;
-wire          main_mac_core_cdc_source_payload_last_be;
-wire          main_mac_core_cdc_source_ready;
-wire          main_mac_core_cdc_source_valid;
-wire    [4:0] main_mac_core_cdc_wrport_adr;
-wire   [11:0] main_mac_core_cdc_wrport_dat_r;
-wire   [11:0] main_mac_core_cdc_wrport_dat_w;
-wire          main_mac_core_cdc_wrport_we;
 reg    [31:0] main_mac_core_crc_errors_status = 32'd0;
 wire          main_mac_core_liteethmaccrc32checker_crc_be;
 reg           main_mac_core_liteethmaccrc32checker_crc_ce = 1'd0;
@@ -1671,6 +1496,115 @@ wire          main_mac_core_pulsesynchronizer1_o;
 reg           main_mac_core_pulsesynchronizer1_toggle_i = 1'd0;
 wire          main_mac_core_pulsesynchronizer1_toggle_o;
 reg           main_mac_core_pulsesynchronizer1_toggle_o_r = 1'd0;
+wire   [41:0] main_mac_core_rx_cdc_cdc_asyncfifo_din;
+wire   [41:0] main_mac_core_rx_cdc_cdc_asyncfifo_dout;
+wire          main_mac_core_rx_cdc_cdc_asyncfifo_re;
+wire          main_mac_core_rx_cdc_cdc_asyncfifo_readable;
+wire          main_mac_core_rx_cdc_cdc_asyncfifo_we;
+wire          main_mac_core_rx_cdc_cdc_asyncfifo_writable;
+wire    [5:0] main_mac_core_rx_cdc_cdc_consume_wdomain;
+wire          main_mac_core_rx_cdc_cdc_fifo_in_first;
+wire          main_mac_core_rx_cdc_cdc_fifo_in_last;
+wire   [31:0] main_mac_core_rx_cdc_cdc_fifo_in_payload_data;
+wire    [3:0] main_mac_core_rx_cdc_cdc_fifo_in_payload_error;
+wire    [3:0] main_mac_core_rx_cdc_cdc_fifo_in_payload_last_be;
+wire          main_mac_core_rx_cdc_cdc_fifo_out_first;
+wire          main_mac_core_rx_cdc_cdc_fifo_out_last;
+wire   [31:0] main_mac_core_rx_cdc_cdc_fifo_out_payload_data;
+wire    [3:0] main_mac_core_rx_cdc_cdc_fifo_out_payload_error;
+wire    [3:0] main_mac_core_rx_cdc_cdc_fifo_out_payload_last_be;
+wire          main_mac_core_rx_cdc_cdc_graycounter0_ce;
+reg     [5:0] main_mac_core_rx_cdc_cdc_graycounter0_q = 6'd0;
+reg     [5:0] main_mac_core_rx_cdc_cdc_graycounter0_q_binary = 6'd0;
+wire    [5:0] main_mac_core_rx_cdc_cdc_graycounter0_q_next;
+reg     [5:0] main_mac_core_rx_cdc_cdc_graycounter0_q_next_binary = 6'd0;
+wire          main_mac_core_rx_cdc_cdc_graycounter1_ce;
+reg     [5:0] main_mac_core_rx_cdc_cdc_graycounter1_q = 6'd0;
+reg     [5:0] main_mac_core_rx_cdc_cdc_graycounter1_q_binary = 6'd0;
+wire    [5:0] main_mac_core_rx_cdc_cdc_graycounter1_q_next;
+reg     [5:0] main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary = 6'd0;
+wire    [5:0] main_mac_core_rx_cdc_cdc_produce_rdomain;
+wire    [4:0] main_mac_core_rx_cdc_cdc_rdport_adr;
+wire   [41:0] main_mac_core_rx_cdc_cdc_rdport_dat_r;
+wire          main_mac_core_rx_cdc_cdc_sink_first;
+wire          main_mac_core_rx_cdc_cdc_sink_last;
+wire   [31:0] main_mac_core_rx_cdc_cdc_sink_payload_data;
+wire    [3:0] main_mac_core_rx_cdc_cdc_sink_payload_error;
+wire    [3:0] main_mac_core_rx_cdc_cdc_sink_payload_last_be;
+wire          main_mac_core_rx_cdc_cdc_sink_ready;
+wire          main_mac_core_rx_cdc_cdc_sink_valid;
+wire          main_mac_core_rx_cdc_cdc_source_first;
+wire          main_mac_core_rx_cdc_cdc_source_last;
+wire   [31:0] main_mac_core_rx_cdc_cdc_source_payload_data;
+wire    [3:0] main_mac_core_rx_cdc_cdc_source_payload_error;
+wire    [3:0] main_mac_core_rx_cdc_cdc_source_payload_last_be;
+wire          main_mac_core_rx_cdc_cdc_source_ready;
+wire          main_mac_core_rx_cdc_cdc_source_valid;
+wire    [4:0] main_mac_core_rx_cdc_cdc_wrport_adr;
+wire   [41:0] main_mac_core_rx_cdc_cdc_wrport_dat_r;
+wire   [41:0] main_mac_core_rx_cdc_cdc_wrport_dat_w;
+wire          main_mac_core_rx_cdc_cdc_wrport_we;
+wire          main_mac_core_rx_cdc_sink_sink_first;
+wire          main_mac_core_rx_cdc_sink_sink_last;
+wire   [31:0] main_mac_core_rx_cdc_sink_sink_payload_data;
+wire    [3:0] main_mac_core_rx_cdc_sink_sink_payload_error;
+wire    [3:0] main_mac_core_rx_cdc_sink_sink_payload_last_be;
+wire          main_mac_core_rx_cdc_sink_sink_ready;
+wire          main_mac_core_rx_cdc_sink_sink_valid;
+wire          main_mac_core_rx_cdc_source_source_first;
+wire          main_mac_core_rx_cdc_source_source_last;
+wire   [31:0] main_mac_core_rx_cdc_source_source_payload_data;
+wire    [3:0] main_mac_core_rx_cdc_source_source_payload_error;
+wire    [3:0] main_mac_core_rx_cdc_source_source_payload_last_be;
+wire          main_mac_core_rx_cdc_source_source_ready;
+wire          main_mac_core_rx_cdc_source_source_valid;
+reg     [1:0] main_mac_core_rx_converter_converter_demux = 2'd0;
+wire          main_mac_core_rx_converter_converter_load_part;
+wire          main_mac_core_rx_converter_converter_sink_first;
+wire          main_mac_core_rx_converter_converter_sink_last;
+wire    [9:0] main_mac_core_rx_converter_converter_sink_payload_data;
+wire          main_mac_core_rx_converter_converter_sink_ready;
+wire          main_mac_core_rx_converter_converter_sink_valid;
+reg           main_mac_core_rx_converter_converter_source_first = 1'd0;
+reg           main_mac_core_rx_converter_converter_source_last = 1'd0;
+reg    [39:0] main_mac_core_rx_converter_converter_source_payload_data = 40'd0;
+reg     [2:0] main_mac_core_rx_converter_converter_source_payload_valid_token_count = 3'd0;
+wire          main_mac_core_rx_converter_converter_source_ready;
+wire          main_mac_core_rx_converter_converter_source_valid;
+reg           main_mac_core_rx_converter_converter_strobe_all = 1'd0;
+wire          main_mac_core_rx_converter_sink_first;
+wire          main_mac_core_rx_converter_sink_last;
+wire    [7:0] main_mac_core_rx_converter_sink_payload_data;
+wire          main_mac_core_rx_converter_sink_payload_error;
+wire          main_mac_core_rx_converter_sink_payload_last_be;
+wire          main_mac_core_rx_converter_sink_ready;
+wire          main_mac_core_rx_converter_sink_valid;
+wire          main_mac_core_rx_converter_source_first;
+wire          main_mac_core_rx_converter_source_last;
+reg    [31:0] main_mac_core_rx_converter_source_payload_data = 32'd0;
+reg     [3:0] main_mac_core_rx_converter_source_payload_error = 4'd0;
+reg     [3:0] main_mac_core_rx_converter_source_payload_last_be = 4'd0;
+wire          main_mac_core_rx_converter_source_ready;
+wire          main_mac_core_rx_converter_source_source_first;
+wire          main_mac_core_rx_converter_source_source_last;
+wire   [39:0] main_mac_core_rx_converter_source_source_payload_data;
+wire          main_mac_core_rx_converter_source_source_ready;
+wire          main_mac_core_rx_converter_source_source_valid;
+wire          main_mac_core_rx_converter_source_valid;
+wire          main_mac_core_rx_last_be_sink_first;
+wire          main_mac_core_rx_last_be_sink_last;
+wire    [7:0] main_mac_core_rx_last_be_sink_payload_data;
+wire          main_mac_core_rx_last_be_sink_payload_error;
+wire          main_mac_core_rx_last_be_sink_payload_last_be;
+wire          main_mac_core_rx_last_be_sink_ready;
+wire          main_mac_core_rx_last_be_sink_valid;
+wire          main_mac_core_rx_last_be_source_first;
+wire          main_mac_core_rx_last_be_source_last;
+wire    [7:0] main_mac_core_rx_last_be_source_payload_data;
+wire          main_mac_core_rx_last_be_source_payload_error;
+reg           main_mac_core_rx_last_be_source_payload_last_be = 1'd0;
+wire          main_mac_core_rx_last_be_source_ready;
+wire          main_mac_core_rx_last_be_source_valid;
 wire          main_mac_core_rx_padding_sink_first;
 wire          main_mac_core_rx_padding_sink_last;
 wire    [7:0] main_mac_core_rx_padding_sink_payload_data;
@@ -1703,34 +1637,20 @@ wire          main_mac_core_rx_preamble_source_ready;
 reg           main_mac_core_rx_preamble_source_valid = 1'd0;
 wire          main_mac_core_sink_first;
 wire          main_mac_core_sink_last;
-wire    [7:0] main_mac_core_sink_payload_data;
-wire          main_mac_core_sink_payload_error;
-wire          main_mac_core_sink_payload_last_be;
+wire   [31:0] main_mac_core_sink_payload_data;
+wire    [3:0] main_mac_core_sink_payload_error;
+wire    [3:0] main_mac_core_sink_payload_last_be;
 wire          main_mac_core_sink_ready;
-wire          main_mac_core_sink_sink_first;
-wire          main_mac_core_sink_sink_last;
-wire    [7:0] main_mac_core_sink_sink_payload_data;
-wire          main_mac_core_sink_sink_payload_error;
-wire          main_mac_core_sink_sink_payload_last_be;
-wire          main_mac_core_sink_sink_ready;
-wire          main_mac_core_sink_sink_valid;
 wire          main_mac_core_sink_valid;
 wire          main_mac_core_source_first;
 wire          main_mac_core_source_last;
-wire    [7:0] main_mac_core_source_payload_data;
-wire          main_mac_core_source_payload_error;
-wire          main_mac_core_source_payload_last_be;
+wire   [31:0] main_mac_core_source_payload_data;
+wire    [3:0] main_mac_core_source_payload_error;
+wire    [3:0] main_mac_core_source_payload_last_be;
 wire          main_mac_core_source_ready;
-wire          main_mac_core_source_source_first;
-wire          main_mac_core_source_source_last;
-wire    [7:0] main_mac_core_source_source_payload_data;
-wire          main_mac_core_source_source_payload_error;
-wire          main_mac_core_source_source_payload_last_be;
-wire          main_mac_core_source_source_ready;
-wire          main_mac_core_source_source_valid;
 wire          main_mac_core_source_valid;
-wire   [11:0] main_mac_core_tx_cdc_cdc_asyncfifo_din;
-wire   [11:0] main_mac_core_tx_cdc_cdc_asyncfifo_dout;
+wire   [41:0] main_mac_core_tx_cdc_cdc_asyncfifo_din;
+wire   [41:0] main_mac_core_tx_cdc_cdc_asyncfifo_dout;
 wire          main_mac_core_tx_cdc_cdc_asyncfifo_re;
 wire          main_mac_core_tx_cdc_cdc_asyncfifo_readable;
 wire          main_mac_core_tx_cdc_cdc_asyncfifo_we;
@@ -1738,14 +1658,14 @@ wire          main_mac_core_tx_cdc_cdc_asyncfifo_writable;
 wire    [5:0] main_mac_core_tx_cdc_cdc_consume_wdomain;
 wire          main_mac_core_tx_cdc_cdc_fifo_in_first;
 wire          main_mac_core_tx_cdc_cdc_fifo_in_last;
-wire    [7:0] main_mac_core_tx_cdc_cdc_fifo_in_payload_data;
-wire          main_mac_core_tx_cdc_cdc_fifo_in_payload_error;
-wire          main_mac_core_tx_cdc_cdc_fifo_in_payload_last_be;
+wire   [31:0] main_mac_core_tx_cdc_cdc_fifo_in_payload_data;
+wire    [3:0] main_mac_core_tx_cdc_cdc_fifo_in_payload_error;
+wire    [3:0] main_mac_core_tx_cdc_cdc_fifo_in_payload_last_be;
 wire          main_mac_core_tx_cdc_cdc_fifo_out_first;
 wire          main_mac_core_tx_cdc_cdc_fifo_out_last;
-wire    [7:0] main_mac_core_tx_cdc_cdc_fifo_out_payload_data;
-wire          main_mac_core_tx_cdc_cdc_fifo_out_payload_error;
-wire          main_mac_core_tx_cdc_cdc_fifo_out_payload_last_be;
+wire   [31:0] main_mac_core_tx_cdc_cdc_fifo_out_payload_data;
+wire    [3:0] main_mac_core_tx_cdc_cdc_fifo_out_payload_error;
+wire    [3:0] main_mac_core_tx_cdc_cdc_fifo_out_payload_last_be;
 wire          main_mac_core_tx_cdc_cdc_graycounter0_ce;
 reg     [5:0] main_mac_core_tx_cdc_cdc_graycounter0_q = 6'd0;
 reg     [5:0] main_mac_core_tx_cdc_cdc_graycounter0_q_binary = 6'd0;
@@ -1758,39 +1678,72 @@ wire    [5:0] main_mac_core_tx_cdc_cdc_graycounter1_q_next;
 reg     [5:0] main_mac_core_tx_cdc_cdc_graycounter1_q_next_binary = 6'd0;
 wire    [5:0] main_mac_core_tx_cdc_cdc_produce_rdomain;
 wire    [4:0] main_mac_core_tx_cdc_cdc_rdport_adr;
-wire   [11:0] main_mac_core_tx_cdc_cdc_rdport_dat_r;
+wire   [41:0] main_mac_core_tx_cdc_cdc_rdport_dat_r;
 wire          main_mac_core_tx_cdc_cdc_sink_first;
 wire          main_mac_core_tx_cdc_cdc_sink_last;
-wire    [7:0] main_mac_core_tx_cdc_cdc_sink_payload_data;
-wire          main_mac_core_tx_cdc_cdc_sink_payload_error;
-wire          main_mac_core_tx_cdc_cdc_sink_payload_last_be;
+wire   [31:0] main_mac_core_tx_cdc_cdc_sink_payload_data;
+wire    [3:0] main_mac_core_tx_cdc_cdc_sink_payload_error;
+wire    [3:0] main_mac_core_tx_cdc_cdc_sink_payload_last_be;
 wire          main_mac_core_tx_cdc_cdc_sink_ready;
 wire          main_mac_core_tx_cdc_cdc_sink_valid;
 wire          main_mac_core_tx_cdc_cdc_source_first;
 wire          main_mac_core_tx_cdc_cdc_source_last;
-wire    [7:0] main_mac_core_tx_cdc_cdc_source_payload_data;
-wire          main_mac_core_tx_cdc_cdc_source_payload_error;
-wire          main_mac_core_tx_cdc_cdc_source_payload_last_be;
+wire   [31:0] main_mac_core_tx_cdc_cdc_source_payload_data;
+wire    [3:0] main_mac_core_tx_cdc_cdc_source_payload_error;
+wire    [3:0] main_mac_core_tx_cdc_cdc_source_payload_last_be;
 wire          main_mac_core_tx_cdc_cdc_source_ready;
 wire          main_mac_core_tx_cdc_cdc_source_valid;
 wire    [4:0] main_mac_core_tx_cdc_cdc_wrport_adr;
-wire   [11:0] main_mac_core_tx_cdc_cdc_wrport_dat_r;
-wire   [11:0] main_mac_core_tx_cdc_cdc_wrport_dat_w;
+wire   [41:0] main_mac_core_tx_cdc_cdc_wrport_dat_r;
+wire   [41:0] main_mac_core_tx_cdc_cdc_wrport_dat_w;
 wire          main_mac_core_tx_cdc_cdc_wrport_we;
 wire          main_mac_core_tx_cdc_sink_sink_first;
 wire          main_mac_core_tx_cdc_sink_sink_last;
-wire    [7:0] main_mac_core_tx_cdc_sink_sink_payload_data;
-wire          main_mac_core_tx_cdc_sink_sink_payload_error;
-wire          main_mac_core_tx_cdc_sink_sink_payload_last_be;
+wire   [31:0] main_mac_core_tx_cdc_sink_sink_payload_data;
+wire    [3:0] main_mac_core_tx_cdc_sink_sink_payload_error;
+wire    [3:0] main_mac_core_tx_cdc_sink_sink_payload_last_be;
 wire          main_mac_core_tx_cdc_sink_sink_ready;
 wire          main_mac_core_tx_cdc_sink_sink_valid;
 wire          main_mac_core_tx_cdc_source_source_first;
 wire          main_mac_core_tx_cdc_source_source_last;
-wire    [7:0] main_mac_core_tx_cdc_source_source_payload_data;
-wire          main_mac_core_tx_cdc_source_source_payload_error;
-wire          main_mac_core_tx_cdc_source_source_payload_last_be;
+wire   [31:0] main_mac_core_tx_cdc_source_source_payload_data;
+wire    [3:0] main_mac_core_tx_cdc_source_source_payload_error;
+wire    [3:0] main_mac_core_tx_cdc_source_source_payload_last_be;
 wire          main_mac_core_tx_cdc_source_source_ready;
 wire          main_mac_core_tx_cdc_source_source_valid;
+wire          main_mac_core_tx_converter_converter_first;
+wire          main_mac_core_tx_converter_converter_last;
+reg     [1:0] main_mac_core_tx_converter_converter_mux = 2'd0;
+wire          main_mac_core_tx_converter_converter_sink_first;
+wire          main_mac_core_tx_converter_converter_sink_last;
+reg    [39:0] main_mac_core_tx_converter_converter_sink_payload_data = 40'd0;
+wire          main_mac_core_tx_converter_converter_sink_ready;
+wire          main_mac_core_tx_converter_converter_sink_valid;
+wire          main_mac_core_tx_converter_converter_source_first;
+wire          main_mac_core_tx_converter_converter_source_last;
+reg     [9:0] main_mac_core_tx_converter_converter_source_payload_data = 10'd0;
+wire          main_mac_core_tx_converter_converter_source_payload_valid_token_count;
+wire          main_mac_core_tx_converter_converter_source_ready;
+wire          main_mac_core_tx_converter_converter_source_valid;
+wire          main_mac_core_tx_converter_sink_first;
+wire          main_mac_core_tx_converter_sink_last;
+wire   [31:0] main_mac_core_tx_converter_sink_payload_data;
+wire    [3:0] main_mac_core_tx_converter_sink_payload_error;
+wire    [3:0] main_mac_core_tx_converter_sink_payload_last_be;
+wire          main_mac_core_tx_converter_sink_ready;
+wire          main_mac_core_tx_converter_sink_valid;
+wire          main_mac_core_tx_converter_source_first;
+wire          main_mac_core_tx_converter_source_last;
+wire    [7:0] main_mac_core_tx_converter_source_payload_data;
+wire          main_mac_core_tx_converter_source_payload_error;
+wire          main_mac_core_tx_converter_source_payload_last_be;
+wire          main_mac_core_tx_converter_source_ready;
+wire          main_mac_core_tx_converter_source_source_first;
+wire          main_mac_core_tx_converter_source_source_last;
+wire    [9:0] main_mac_core_tx_converter_source_source_payload_data;
+wire          main_mac_core_tx_converter_source_source_ready;
+wire          main_mac_core_tx_converter_source_source_valid;
+wire          main_mac_core_tx_converter_source_valid;
 wire          main_mac_core_tx_crc_be;
 reg           main_mac_core_tx_crc_ce = 1'd0;
 reg     [1:0] main_mac_core_tx_crc_cnt = 2'd3;
@@ -1870,6 +1823,34 @@ reg           main_mac_core_tx_gap_source_payload_error = 1'd0;
 reg           main_mac_core_tx_gap_source_payload_last_be = 1'd0;
 wire          main_mac_core_tx_gap_source_ready;
 reg           main_mac_core_tx_gap_source_valid = 1'd0;
+wire          main_mac_core_tx_last_be_last_handler_sink_first;
+wire          main_mac_core_tx_last_be_last_handler_sink_last;
+wire    [7:0] main_mac_core_tx_last_be_last_handler_sink_payload_data;
+wire          main_mac_core_tx_last_be_last_handler_sink_payload_error;
+wire          main_mac_core_tx_last_be_last_handler_sink_payload_last_be;
+reg           main_mac_core_tx_last_be_last_handler_sink_ready = 1'd0;
+wire          main_mac_core_tx_last_be_last_handler_sink_valid;
+reg           main_mac_core_tx_last_be_last_handler_source_first = 1'd0;
+reg           main_mac_core_tx_last_be_last_handler_source_last = 1'd0;
+reg     [7:0] main_mac_core_tx_last_be_last_handler_source_payload_data = 8'd0;
+reg           main_mac_core_tx_last_be_last_handler_source_payload_error = 1'd0;
+reg           main_mac_core_tx_last_be_last_handler_source_payload_last_be = 1'd0;
+wire          main_mac_core_tx_last_be_last_handler_source_ready;
+reg           main_mac_core_tx_last_be_last_handler_source_valid = 1'd0;
+wire          main_mac_core_tx_last_be_sink_sink_first;
+wire          main_mac_core_tx_last_be_sink_sink_last;
+wire    [7:0] main_mac_core_tx_last_be_sink_sink_payload_data;
+wire          main_mac_core_tx_last_be_sink_sink_payload_error;
+wire          main_mac_core_tx_last_be_sink_sink_payload_last_be;
+wire          main_mac_core_tx_last_be_sink_sink_ready;
+wire          main_mac_core_tx_last_be_sink_sink_valid;
+wire          main_mac_core_tx_last_be_source_source_first;
+wire          main_mac_core_tx_last_be_source_source_last;
+wire    [7:0] main_mac_core_tx_last_be_source_source_payload_data;
+wire          main_mac_core_tx_last_be_source_source_payload_error;
+wire          main_mac_core_tx_last_be_source_source_payload_last_be;
+wire          main_mac_core_tx_last_be_source_source_ready;
+wire          main_mac_core_tx_last_be_source_source_valid;
 reg    [15:0] main_mac_core_tx_padding_counter = 16'd0;
 wire          main_mac_core_tx_padding_counter_done;
 reg    [15:0] main_mac_core_tx_padding_counter_liteethmac_clockdomainsrenamer0_next_value = 16'd0;
@@ -1909,20 +1890,20 @@ reg           main_mac_core_tx_preamble_source_valid = 1'd0;
 wire          main_mac_crossbar_dropped;
 wire          main_mac_crossbar_sink_first;
 wire          main_mac_crossbar_sink_last;
-wire    [7:0] main_mac_crossbar_sink_payload_data;
-wire          main_mac_crossbar_sink_payload_error;
+wire   [31:0] main_mac_crossbar_sink_payload_data;
+wire    [3:0] main_mac_crossbar_sink_payload_error;
 wire   [15:0] main_mac_crossbar_sink_payload_ethernet_type;
-wire          main_mac_crossbar_sink_payload_last_be;
+wire    [3:0] main_mac_crossbar_sink_payload_last_be;
 wire   [47:0] main_mac_crossbar_sink_payload_sender_mac;
 wire   [47:0] main_mac_crossbar_sink_payload_target_mac;
 reg           main_mac_crossbar_sink_ready = 1'd0;
 wire          main_mac_crossbar_sink_valid;
 reg           main_mac_crossbar_source_first = 1'd0;
 reg           main_mac_crossbar_source_last = 1'd0;
-reg     [7:0] main_mac_crossbar_source_payload_data = 8'd0;
-reg           main_mac_crossbar_source_payload_error = 1'd0;
+reg    [31:0] main_mac_crossbar_source_payload_data = 32'd0;
+reg     [3:0] main_mac_crossbar_source_payload_error = 4'd0;
 reg    [15:0] main_mac_crossbar_source_payload_ethernet_type = 16'd0;
-reg           main_mac_crossbar_source_payload_last_be = 1'd0;
+reg     [3:0] main_mac_crossbar_source_payload_last_be = 4'd0;
 reg    [47:0] main_mac_crossbar_source_payload_sender_mac = 48'd0;
 reg    [47:0] main_mac_crossbar_source_payload_target_mac = 48'd0;
 wire          main_mac_crossbar_source_ready;
@@ -1930,11 +1911,11 @@ reg           main_mac_crossbar_source_valid = 1'd0;
 wire          main_mac_cut;
 reg           main_mac_fsm_is_ongoing0 = 1'd0;
 reg           main_mac_fsm_is_ongoing1 = 1'd0;
-reg     [3:0] main_mac_liteethmacdepacketizer_count = 4'd0;
-reg     [3:0] main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 = 4'd0;
+reg     [1:0] main_mac_liteethmacdepacketizer_count = 2'd0;
+reg     [1:0] main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 = 2'd0;
 reg           main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 = 1'd0;
-reg           main_mac_liteethmacdepacketizer_delayed_last_be = 1'd0;
-reg           main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 = 1'd0;
+reg     [3:0] main_mac_liteethmacdepacketizer_delayed_last_be = 4'd0;
+reg     [3:0] main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 = 4'd0;
 reg           main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 = 1'd0;
 reg           main_mac_liteethmacdepacketizer_fsm_from_idle = 1'd0;
 reg           main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 = 1'd0;
@@ -1945,14 +1926,19 @@ reg           main_mac_liteethmacdepacketizer_is_ongoing0 = 1'd0;
 reg           main_mac_liteethmacdepacketizer_is_ongoing1 = 1'd0;
 reg           main_mac_liteethmacdepacketizer_is_ongoing2 = 1'd0;
 reg           main_mac_liteethmacdepacketizer_is_ongoing3 = 1'd0;
-wire          main_mac_liteethmacdepacketizer_new_last_be;
+wire    [3:0] main_mac_liteethmacdepacketizer_new_last_be;
+reg           main_mac_liteethmacdepacketizer_sink_d_first = 1'd0;
 reg           main_mac_liteethmacdepacketizer_sink_d_last = 1'd0;
+reg    [31:0] main_mac_liteethmacdepacketizer_sink_d_payload_data = 32'd0;
+reg     [3:0] main_mac_liteethmacdepacketizer_sink_d_payload_error = 4'd0;
+reg     [3:0] main_mac_liteethmacdepacketizer_sink_d_payload_last_be = 4'd0;
+reg           main_mac_liteethmacdepacketizer_sink_d_ready = 1'd0;
+reg           main_mac_liteethmacdepacketizer_sink_d_valid = 1'd0;
 wire          main_mac_liteethmacdepacketizer_sink_first;
 wire          main_mac_liteethmacdepacketizer_sink_last;
-wire          main_mac_liteethmacdepacketizer_sink_last_be;
-wire    [7:0] main_mac_liteethmacdepacketizer_sink_payload_data;
-wire          main_mac_liteethmacdepacketizer_sink_payload_error;
-wire          main_mac_liteethmacdepacketizer_sink_payload_last_be;
+wire   [31:0] main_mac_liteethmacdepacketizer_sink_payload_data;
+wire    [3:0] main_mac_liteethmacdepacketizer_sink_payload_error;
+wire    [3:0] main_mac_liteethmacdepacketizer_sink_payload_last_be;
 reg           main_mac_liteethmacdepacketizer_sink_ready = 1'd0;
 wire          main_mac_liteethmacdepacketizer_sink_valid;
 reg           main_mac_liteethmacdepacketizer_source_first = 1'd0;
@@ -1960,10 +1946,10 @@ reg           main_mac_liteethmacdepacketizer_source_last = 1'd0;
 reg           main_mac_liteethmacdepacketizer_source_last_a = 1'd0;
 reg           main_mac_liteethmacdepacketizer_source_last_b = 1'd0;
 reg           main_mac_liteethmacdepacketizer_source_last_s = 1'd0;
-reg     [7:0] main_mac_liteethmacdepacketizer_source_payload_data = 8'd0;
-wire          main_mac_liteethmacdepacketizer_source_payload_error;
+reg    [31:0] main_mac_liteethmacdepacketizer_source_payload_data = 32'd0;
+wire    [3:0] main_mac_liteethmacdepacketizer_source_payload_error;
 wire   [15:0] main_mac_liteethmacdepacketizer_source_payload_ethernet_type;
-reg           main_mac_liteethmacdepacketizer_source_payload_last_be = 1'd0;
+reg     [3:0] main_mac_liteethmacdepacketizer_source_payload_last_be = 4'd0;
 wire   [47:0] main_mac_liteethmacdepacketizer_source_payload_sender_mac;
 wire   [47:0] main_mac_liteethmacdepacketizer_source_payload_target_mac;
 wire          main_mac_liteethmacdepacketizer_source_ready;
@@ -1972,11 +1958,11 @@ reg   [111:0] main_mac_liteethmacdepacketizer_sr = 112'd0;
 reg           main_mac_liteethmacdepacketizer_sr_shift = 1'd0;
 reg           main_mac_liteethmacdepacketizer_sr_shift_leftover = 1'd0;
 reg           main_mac_liteethmacdepacketizer_was_in_copy = 1'd0;
-reg     [3:0] main_mac_packetizer_count = 4'd0;
-reg     [3:0] main_mac_packetizer_count_liteethmac_fsm0_next_value0 = 4'd0;
+reg     [1:0] main_mac_packetizer_count = 2'd0;
+reg     [1:0] main_mac_packetizer_count_liteethmac_fsm0_next_value0 = 2'd0;
 reg           main_mac_packetizer_count_liteethmac_fsm0_next_value_ce0 = 1'd0;
-reg           main_mac_packetizer_delayed_last_be = 1'd0;
-reg           main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0 = 1'd0;
+reg     [3:0] main_mac_packetizer_delayed_last_be = 4'd0;
+reg     [3:0] main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0 = 4'd0;
 reg           main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value_ce0 = 1'd0;
 reg           main_mac_packetizer_fsm_from_idle = 1'd0;
 reg           main_mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value1 = 1'd0;
@@ -1986,14 +1972,23 @@ wire          main_mac_packetizer_in_data_copy;
 reg           main_mac_packetizer_is_ongoing0 = 1'd0;
 reg           main_mac_packetizer_is_ongoing1 = 1'd0;
 reg           main_mac_packetizer_is_ongoing2 = 1'd0;
-wire          main_mac_packetizer_new_last_be;
+wire    [3:0] main_mac_packetizer_new_last_be;
+reg           main_mac_packetizer_sink_d_first = 1'd0;
+reg           main_mac_packetizer_sink_d_last = 1'd0;
+reg    [31:0] main_mac_packetizer_sink_d_payload_data = 32'd0;
+reg     [3:0] main_mac_packetizer_sink_d_payload_error = 4'd0;
+reg    [15:0] main_mac_packetizer_sink_d_payload_ethernet_type = 16'd0;
+reg     [3:0] main_mac_packetizer_sink_d_payload_last_be = 4'd0;
+reg    [47:0] main_mac_packetizer_sink_d_payload_sender_mac = 48'd0;
+reg    [47:0] main_mac_packetizer_sink_d_payload_target_mac = 48'd0;
+reg           main_mac_packetizer_sink_d_ready = 1'd0;
+reg           main_mac_packetizer_sink_d_valid = 1'd0;
 wire          main_mac_packetizer_sink_first;
 wire          main_mac_packetizer_sink_last;
-wire          main_mac_packetizer_sink_last_be;
-wire    [7:0] main_mac_packetizer_sink_payload_data;
-wire          main_mac_packetizer_sink_payload_error;
+wire   [31:0] main_mac_packetizer_sink_payload_data;
+wire    [3:0] main_mac_packetizer_sink_payload_error;
 wire   [15:0] main_mac_packetizer_sink_payload_ethernet_type;
-wire          main_mac_packetizer_sink_payload_last_be;
+wire    [3:0] main_mac_packetizer_sink_payload_last_be;
 wire   [47:0] main_mac_packetizer_sink_payload_sender_mac;
 wire   [47:0] main_mac_packetizer_sink_payload_target_mac;
 reg           main_mac_packetizer_sink_ready = 1'd0;
@@ -2003,119 +1998,229 @@ reg           main_mac_packetizer_source_last = 1'd0;
 reg           main_mac_packetizer_source_last_a = 1'd0;
 reg           main_mac_packetizer_source_last_b = 1'd0;
 reg           main_mac_packetizer_source_last_s = 1'd0;
-reg     [7:0] main_mac_packetizer_source_payload_data = 8'd0;
-wire          main_mac_packetizer_source_payload_error;
-reg           main_mac_packetizer_source_payload_last_be = 1'd0;
+reg    [31:0] main_mac_packetizer_source_payload_data = 32'd0;
+wire    [3:0] main_mac_packetizer_source_payload_error;
+reg     [3:0] main_mac_packetizer_source_payload_last_be = 4'd0;
 wire          main_mac_packetizer_source_ready;
 reg           main_mac_packetizer_source_valid = 1'd0;
 reg   [111:0] main_mac_packetizer_sr = 112'd0;
 reg           main_mac_packetizer_sr_load = 1'd0;
 reg           main_mac_packetizer_sr_shift = 1'd0;
-reg     [2:0] main_packetizer_count = 3'd0;
-reg     [2:0] main_packetizer_count_liteethudp_fsm0_next_value0 = 3'd0;
-reg           main_packetizer_count_liteethudp_fsm0_next_value_ce0 = 1'd0;
-reg           main_packetizer_delayed_last_be = 1'd0;
-reg           main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 = 1'd0;
-reg           main_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 = 1'd0;
-reg           main_packetizer_fsm_from_idle = 1'd0;
-reg           main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 = 1'd0;
-reg           main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 = 1'd0;
-reg    [63:0] main_packetizer_header = 64'd0;
-wire          main_packetizer_in_data_copy;
-reg           main_packetizer_is_ongoing0 = 1'd0;
-reg           main_packetizer_is_ongoing1 = 1'd0;
-reg           main_packetizer_is_ongoing2 = 1'd0;
-wire          main_packetizer_new_last_be;
-wire          main_packetizer_sink_last;
-wire          main_packetizer_sink_last_be;
-wire   [15:0] main_packetizer_sink_param_checksum;
-wire   [15:0] main_packetizer_sink_param_dst_port;
-wire   [15:0] main_packetizer_sink_param_length;
-wire   [15:0] main_packetizer_sink_param_src_port;
-wire    [7:0] main_packetizer_sink_payload_data;
-reg           main_packetizer_sink_payload_error = 1'd0;
-wire          main_packetizer_sink_payload_last_be;
-reg           main_packetizer_sink_ready = 1'd0;
-wire          main_packetizer_sink_valid;
-reg           main_packetizer_source_first = 1'd0;
-reg           main_packetizer_source_last = 1'd0;
-reg           main_packetizer_source_last_a = 1'd0;
-reg           main_packetizer_source_last_b = 1'd0;
-reg           main_packetizer_source_last_s = 1'd0;
-reg    [31:0] main_packetizer_source_param_ip_address = 32'd0;
-reg    [15:0] main_packetizer_source_param_length = 16'd0;
-reg     [7:0] main_packetizer_source_param_protocol = 8'd0;
-reg     [7:0] main_packetizer_source_payload_data = 8'd0;
-wire          main_packetizer_source_payload_error;
-reg           main_packetizer_source_payload_last_be = 1'd0;
-reg           main_packetizer_source_ready = 1'd0;
-reg           main_packetizer_source_valid = 1'd0;
-reg    [63:0] main_packetizer_sr = 64'd0;
-reg           main_packetizer_sr_load = 1'd0;
-reg           main_packetizer_sr_shift = 1'd0;
+reg           main_pipe_ready_sink_d_first = 1'd0;
+reg           main_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] main_pipe_ready_sink_d_payload_data = 32'd0;
+reg     [3:0] main_pipe_ready_sink_d_payload_error = 4'd0;
+reg     [3:0] main_pipe_ready_sink_d_payload_last_be = 4'd0;
+reg           main_pipe_ready_sink_d_ready = 1'd0;
+reg           main_pipe_ready_sink_d_valid = 1'd0;
+wire          main_pipe_ready_sink_first;
+wire          main_pipe_ready_sink_last;
+wire   [31:0] main_pipe_ready_sink_payload_data;
+wire    [3:0] main_pipe_ready_sink_payload_error;
+wire    [3:0] main_pipe_ready_sink_payload_last_be;
+wire          main_pipe_ready_sink_ready;
+wire          main_pipe_ready_sink_valid;
+reg           main_pipe_ready_source_first = 1'd0;
+reg           main_pipe_ready_source_last = 1'd0;
+reg    [31:0] main_pipe_ready_source_payload_data = 32'd0;
+reg     [3:0] main_pipe_ready_source_payload_error = 4'd0;
+reg     [3:0] main_pipe_ready_source_payload_last_be = 4'd0;
+wire          main_pipe_ready_source_ready;
+reg           main_pipe_ready_source_valid = 1'd0;
+reg           main_pipe_ready_valid = 1'd0;
+wire          main_pipe_valid_sink_first;
+wire          main_pipe_valid_sink_last;
+wire   [31:0] main_pipe_valid_sink_payload_data;
+wire    [3:0] main_pipe_valid_sink_payload_error;
+wire    [3:0] main_pipe_valid_sink_payload_last_be;
+wire          main_pipe_valid_sink_ready;
+wire          main_pipe_valid_sink_valid;
+reg           main_pipe_valid_source_first = 1'd0;
+reg           main_pipe_valid_source_last = 1'd0;
+reg    [31:0] main_pipe_valid_source_payload_data = 32'd0;
+reg     [3:0] main_pipe_valid_source_payload_error = 4'd0;
+reg     [3:0] main_pipe_valid_source_payload_last_be = 4'd0;
+wire          main_pipe_valid_source_ready;
+reg           main_pipe_valid_source_valid = 1'd0;
+wire          main_port_internal_port_sink_first;
+wire          main_port_internal_port_sink_last;
+wire   [15:0] main_port_internal_port_sink_param_dst_port;
+wire   [31:0] main_port_internal_port_sink_param_ip_address;
+wire   [15:0] main_port_internal_port_sink_param_length;
+wire   [15:0] main_port_internal_port_sink_param_src_port;
+wire    [7:0] main_port_internal_port_sink_payload_data;
+wire          main_port_internal_port_sink_payload_error;
+wire          main_port_internal_port_sink_payload_last_be;
+wire          main_port_internal_port_sink_ready;
+wire          main_port_internal_port_sink_valid;
+reg           main_port_internal_port_source_first = 1'd0;
+reg           main_port_internal_port_source_last = 1'd0;
+reg    [15:0] main_port_internal_port_source_param_dst_port = 16'd0;
+reg    [31:0] main_port_internal_port_source_param_ip_address = 32'd0;
+reg    [15:0] main_port_internal_port_source_param_length = 16'd0;
+reg    [15:0] main_port_internal_port_source_param_src_port = 16'd0;
+reg     [7:0] main_port_internal_port_source_payload_data = 8'd0;
+reg           main_port_internal_port_source_payload_error = 1'd0;
+reg           main_port_internal_port_source_payload_last_be = 1'd0;
+wire          main_port_internal_port_source_ready;
+reg           main_port_internal_port_source_valid = 1'd0;
+wire          main_port_rx_cdc_sink_first;
+wire          main_port_rx_cdc_sink_last;
+wire   [15:0] main_port_rx_cdc_sink_param_dst_port;
+wire   [31:0] main_port_rx_cdc_sink_param_ip_address;
+wire   [15:0] main_port_rx_cdc_sink_param_length;
+wire   [15:0] main_port_rx_cdc_sink_param_src_port;
+wire    [7:0] main_port_rx_cdc_sink_payload_data;
+wire          main_port_rx_cdc_sink_payload_error;
+wire          main_port_rx_cdc_sink_payload_last_be;
+wire          main_port_rx_cdc_sink_ready;
+wire          main_port_rx_cdc_sink_valid;
+wire          main_port_rx_cdc_source_first;
+wire          main_port_rx_cdc_source_last;
+wire   [15:0] main_port_rx_cdc_source_param_dst_port;
+wire   [31:0] main_port_rx_cdc_source_param_ip_address;
+wire   [15:0] main_port_rx_cdc_source_param_length;
+wire   [15:0] main_port_rx_cdc_source_param_src_port;
+wire    [7:0] main_port_rx_cdc_source_payload_data;
+wire          main_port_rx_cdc_source_payload_error;
+wire          main_port_rx_cdc_source_payload_last_be;
+wire          main_port_rx_cdc_source_ready;
+wire          main_port_rx_cdc_source_valid;
+wire          main_port_rx_converter_converter_sink_first;
+wire          main_port_rx_converter_converter_sink_last;
+wire    [9:0] main_port_rx_converter_converter_sink_payload_data;
+wire          main_port_rx_converter_converter_sink_ready;
+wire          main_port_rx_converter_converter_sink_valid;
+wire          main_port_rx_converter_converter_source_first;
+wire          main_port_rx_converter_converter_source_last;
+wire    [9:0] main_port_rx_converter_converter_source_payload_data;
+wire          main_port_rx_converter_converter_source_payload_valid_token_count;
+wire          main_port_rx_converter_converter_source_ready;
+wire          main_port_rx_converter_converter_source_valid;
+wire          main_port_rx_converter_sink_first;
+wire          main_port_rx_converter_sink_last;
+wire   [15:0] main_port_rx_converter_sink_param_dst_port;
+wire   [31:0] main_port_rx_converter_sink_param_ip_address;
+wire   [15:0] main_port_rx_converter_sink_param_length;
+wire   [15:0] main_port_rx_converter_sink_param_src_port;
+wire    [7:0] main_port_rx_converter_sink_payload_data;
+wire          main_port_rx_converter_sink_payload_error;
+wire          main_port_rx_converter_sink_payload_last_be;
+wire          main_port_rx_converter_sink_ready;
+wire          main_port_rx_converter_sink_valid;
+wire          main_port_rx_converter_source_first;
+wire          main_port_rx_converter_source_last;
+wire   [15:0] main_port_rx_converter_source_param_dst_port;
+wire   [31:0] main_port_rx_converter_source_param_ip_address;
+wire   [15:0] main_port_rx_converter_source_param_length;
+wire   [15:0] main_port_rx_converter_source_param_src_port;
+wire    [7:0] main_port_rx_converter_source_payload_data;
+wire          main_port_rx_converter_source_payload_error;
+wire          main_port_rx_converter_source_payload_last_be;
+wire          main_port_rx_converter_source_ready;
+wire          main_port_rx_converter_source_source_first;
+wire          main_port_rx_converter_source_source_last;
+wire    [9:0] main_port_rx_converter_source_source_payload_data;
+wire          main_port_rx_converter_source_source_ready;
+wire          main_port_rx_converter_source_source_valid;
+wire          main_port_rx_converter_source_valid;
+wire          main_port_tx_cdc_sink_first;
+wire          main_port_tx_cdc_sink_last;
+wire   [15:0] main_port_tx_cdc_sink_param_dst_port;
+wire   [31:0] main_port_tx_cdc_sink_param_ip_address;
+wire   [15:0] main_port_tx_cdc_sink_param_length;
+wire   [15:0] main_port_tx_cdc_sink_param_src_port;
+wire    [7:0] main_port_tx_cdc_sink_payload_data;
+wire          main_port_tx_cdc_sink_payload_error;
+wire          main_port_tx_cdc_sink_payload_last_be;
+wire          main_port_tx_cdc_sink_ready;
+wire          main_port_tx_cdc_sink_valid;
+wire          main_port_tx_cdc_source_first;
+wire          main_port_tx_cdc_source_last;
+wire   [15:0] main_port_tx_cdc_source_param_dst_port;
+wire   [31:0] main_port_tx_cdc_source_param_ip_address;
+wire   [15:0] main_port_tx_cdc_source_param_length;
+wire   [15:0] main_port_tx_cdc_source_param_src_port;
+wire    [7:0] main_port_tx_cdc_source_payload_data;
+wire          main_port_tx_cdc_source_payload_error;
+wire          main_port_tx_cdc_source_payload_last_be;
+wire          main_port_tx_cdc_source_ready;
+wire          main_port_tx_cdc_source_valid;
+wire          main_port_tx_converter_converter_sink_first;
+wire          main_port_tx_converter_converter_sink_last;
+wire    [9:0] main_port_tx_converter_converter_sink_payload_data;
+wire          main_port_tx_converter_converter_sink_ready;
+wire          main_port_tx_converter_converter_sink_valid;
+wire          main_port_tx_converter_converter_source_first;
+wire          main_port_tx_converter_converter_source_last;
+wire    [9:0] main_port_tx_converter_converter_source_payload_data;
+wire          main_port_tx_converter_converter_source_payload_valid_token_count;
+wire          main_port_tx_converter_converter_source_ready;
+wire          main_port_tx_converter_converter_source_valid;
+wire          main_port_tx_converter_sink_first;
+wire          main_port_tx_converter_sink_last;
+wire   [15:0] main_port_tx_converter_sink_param_dst_port;
+wire   [31:0] main_port_tx_converter_sink_param_ip_address;
+wire   [15:0] main_port_tx_converter_sink_param_length;
+wire   [15:0] main_port_tx_converter_sink_param_src_port;
+wire    [7:0] main_port_tx_converter_sink_payload_data;
+wire          main_port_tx_converter_sink_payload_error;
+wire          main_port_tx_converter_sink_payload_last_be;
+wire          main_port_tx_converter_sink_ready;
+wire          main_port_tx_converter_sink_valid;
+wire          main_port_tx_converter_source_first;
+wire          main_port_tx_converter_source_last;
+wire   [15:0] main_port_tx_converter_source_param_dst_port;
+wire   [31:0] main_port_tx_converter_source_param_ip_address;
+wire   [15:0] main_port_tx_converter_source_param_length;
+wire   [15:0] main_port_tx_converter_source_param_src_port;
+wire    [7:0] main_port_tx_converter_source_payload_data;
+wire          main_port_tx_converter_source_payload_error;
+wire          main_port_tx_converter_source_payload_last_be;
+wire          main_port_tx_converter_source_ready;
+wire          main_port_tx_converter_source_source_first;
+wire          main_port_tx_converter_source_source_last;
+wire    [9:0] main_port_tx_converter_source_source_payload_data;
+wire          main_port_tx_converter_source_source_ready;
+wire          main_port_tx_converter_source_source_valid;
+wire          main_port_tx_converter_source_valid;
+reg           main_port_user_port_sink_first = 1'd0;
+wire          main_port_user_port_sink_last;
+wire   [15:0] main_port_user_port_sink_param_dst_port;
+wire   [31:0] main_port_user_port_sink_param_ip_address;
+wire   [15:0] main_port_user_port_sink_param_length;
+wire   [15:0] main_port_user_port_sink_param_src_port;
+wire    [7:0] main_port_user_port_sink_payload_data;
+reg           main_port_user_port_sink_payload_error = 1'd0;
+wire          main_port_user_port_sink_payload_last_be;
+wire          main_port_user_port_sink_ready;
+wire          main_port_user_port_sink_valid;
+wire          main_port_user_port_source_first;
+wire          main_port_user_port_source_last;
+wire   [15:0] main_port_user_port_source_param_dst_port;
+wire   [31:0] main_port_user_port_source_param_ip_address;
+wire   [15:0] main_port_user_port_source_param_length;
+wire   [15:0] main_port_user_port_source_param_src_port;
+wire    [7:0] main_port_user_port_source_payload_data;
+wire          main_port_user_port_source_payload_error;
+wire          main_port_user_port_source_payload_last_be;
+wire          main_port_user_port_source_ready;
+wire          main_port_user_port_source_valid;
+reg     [2:0] main_pulsemerge0_backlog0 = 3'd0;
+reg     [2:0] main_pulsemerge0_backlog1 = 3'd0;
+wire          main_pulsemerge0_o0;
+wire          main_pulsemerge0_o1;
+wire    [3:0] main_pulsemerge0_total0;
+wire    [3:0] main_pulsemerge0_total1;
+reg     [2:0] main_pulsemerge1_backlog0 = 3'd0;
+reg     [2:0] main_pulsemerge1_backlog1 = 3'd0;
+wire          main_pulsemerge1_o0;
+wire          main_pulsemerge1_o1;
+wire    [3:0] main_pulsemerge1_total0;
+wire    [3:0] main_pulsemerge1_total1;
 reg           main_re = 1'd0;
 reg           main_reset_re = 1'd0;
 reg     [1:0] main_reset_storage = 2'd0;
-wire          main_rx_cdc_sink_first;
-wire          main_rx_cdc_sink_last;
-wire   [15:0] main_rx_cdc_sink_param_dst_port;
-wire   [31:0] main_rx_cdc_sink_param_ip_address;
-wire   [15:0] main_rx_cdc_sink_param_length;
-wire   [15:0] main_rx_cdc_sink_param_src_port;
-wire    [7:0] main_rx_cdc_sink_payload_data;
-wire          main_rx_cdc_sink_payload_error;
-wire          main_rx_cdc_sink_payload_last_be;
-wire          main_rx_cdc_sink_ready;
-wire          main_rx_cdc_sink_valid;
-wire          main_rx_cdc_source_first;
-wire          main_rx_cdc_source_last;
-wire   [15:0] main_rx_cdc_source_param_dst_port;
-wire   [31:0] main_rx_cdc_source_param_ip_address;
-wire   [15:0] main_rx_cdc_source_param_length;
-wire   [15:0] main_rx_cdc_source_param_src_port;
-wire    [7:0] main_rx_cdc_source_payload_data;
-wire          main_rx_cdc_source_payload_error;
-wire          main_rx_cdc_source_payload_last_be;
-wire          main_rx_cdc_source_ready;
-wire          main_rx_cdc_source_valid;
-wire          main_rx_converter_converter_sink_first;
-wire          main_rx_converter_converter_sink_last;
-wire    [9:0] main_rx_converter_converter_sink_payload_data;
-wire          main_rx_converter_converter_sink_ready;
-wire          main_rx_converter_converter_sink_valid;
-wire          main_rx_converter_converter_source_first;
-wire          main_rx_converter_converter_source_last;
-wire    [9:0] main_rx_converter_converter_source_payload_data;
-wire          main_rx_converter_converter_source_payload_valid_token_count;
-wire          main_rx_converter_converter_source_ready;
-wire          main_rx_converter_converter_source_valid;
-wire          main_rx_converter_sink_first;
-wire          main_rx_converter_sink_last;
-wire   [15:0] main_rx_converter_sink_param_dst_port;
-wire   [31:0] main_rx_converter_sink_param_ip_address;
-wire   [15:0] main_rx_converter_sink_param_length;
-wire   [15:0] main_rx_converter_sink_param_src_port;
-wire    [7:0] main_rx_converter_sink_payload_data;
-wire          main_rx_converter_sink_payload_error;
-wire          main_rx_converter_sink_payload_last_be;
-wire          main_rx_converter_sink_ready;
-wire          main_rx_converter_sink_valid;
-wire          main_rx_converter_source_first;
-wire          main_rx_converter_source_last;
-wire   [15:0] main_rx_converter_source_param_dst_port;
-wire   [31:0] main_rx_converter_source_param_ip_address;
-wire   [15:0] main_rx_converter_source_param_length;
-wire   [15:0] main_rx_converter_source_param_src_port;
-wire    [7:0] main_rx_converter_source_payload_data;
-wire          main_rx_converter_source_payload_error;
-wire          main_rx_converter_source_payload_last_be;
-wire          main_rx_converter_source_ready;
-wire          main_rx_converter_source_source_first;
-wire          main_rx_converter_source_source_last;
-wire    [9:0] main_rx_converter_source_source_payload_data;
-wire          main_rx_converter_source_source_ready;
-wire          main_rx_converter_source_source_valid;
-wire          main_rx_converter_source_valid;
 reg           main_scratch_re = 1'd0;
 reg    [31:0] main_scratch_storage = 32'd305419896;
 wire          main_sink_first;
@@ -2126,13 +2231,9 @@ wire          main_sink_payload_last_be;
 reg           main_sink_ready = 1'd0;
 wire          main_sink_sink_first;
 wire          main_sink_sink_last;
-wire   [15:0] main_sink_sink_param_dst_port;
-wire   [31:0] main_sink_sink_param_ip_address;
-wire   [15:0] main_sink_sink_param_length;
-wire   [15:0] main_sink_sink_param_src_port;
-wire    [7:0] main_sink_sink_payload_data;
-wire          main_sink_sink_payload_error;
-wire          main_sink_sink_payload_last_be;
+wire   [31:0] main_sink_sink_payload_data;
+wire    [3:0] main_sink_sink_payload_error;
+wire    [3:0] main_sink_sink_payload_last_be;
 wire          main_sink_sink_ready;
 wire          main_sink_sink_valid;
 wire          main_sink_valid;
@@ -2143,101 +2244,502 @@ reg     [7:0] main_source_payload_data = 8'd0;
 reg           main_source_payload_error = 1'd0;
 wire          main_source_payload_last_be;
 wire          main_source_ready;
-reg           main_source_source_first = 1'd0;
-reg           main_source_source_last = 1'd0;
-reg    [31:0] main_source_source_param_ip_address = 32'd0;
-reg    [15:0] main_source_source_param_length = 16'd0;
-reg     [7:0] main_source_source_param_protocol = 8'd0;
-reg     [7:0] main_source_source_payload_data = 8'd0;
-reg           main_source_source_payload_error = 1'd0;
-reg           main_source_source_payload_last_be = 1'd0;
+wire          main_source_source_first;
+wire          main_source_source_last;
+wire   [31:0] main_source_source_payload_data;
+wire    [3:0] main_source_source_payload_error;
+wire    [3:0] main_source_source_payload_last_be;
 wire          main_source_source_ready;
-reg           main_source_source_valid = 1'd0;
+wire          main_source_source_valid;
 reg           main_source_valid = 1'd0;
 reg           main_storage = 1'd0;
 wire          main_take_group;
-wire          main_tx_cdc_sink_first;
-wire          main_tx_cdc_sink_last;
-wire   [15:0] main_tx_cdc_sink_param_dst_port;
-wire   [31:0] main_tx_cdc_sink_param_ip_address;
-wire   [15:0] main_tx_cdc_sink_param_length;
-wire   [15:0] main_tx_cdc_sink_param_src_port;
-wire    [7:0] main_tx_cdc_sink_payload_data;
-wire          main_tx_cdc_sink_payload_error;
-wire          main_tx_cdc_sink_payload_last_be;
-wire          main_tx_cdc_sink_ready;
-wire          main_tx_cdc_sink_valid;
-wire          main_tx_cdc_source_first;
-wire          main_tx_cdc_source_last;
-wire   [15:0] main_tx_cdc_source_param_dst_port;
-wire   [31:0] main_tx_cdc_source_param_ip_address;
-wire   [15:0] main_tx_cdc_source_param_length;
-wire   [15:0] main_tx_cdc_source_param_src_port;
-wire    [7:0] main_tx_cdc_source_payload_data;
-wire          main_tx_cdc_source_payload_error;
-wire          main_tx_cdc_source_payload_last_be;
-wire          main_tx_cdc_source_ready;
-wire          main_tx_cdc_source_valid;
-wire          main_tx_converter_converter_sink_first;
-wire          main_tx_converter_converter_sink_last;
-wire    [9:0] main_tx_converter_converter_sink_payload_data;
-wire          main_tx_converter_converter_sink_ready;
-wire          main_tx_converter_converter_sink_valid;
-wire          main_tx_converter_converter_source_first;
-wire          main_tx_converter_converter_source_last;
-wire    [9:0] main_tx_converter_converter_source_payload_data;
-wire          main_tx_converter_converter_source_payload_valid_token_count;
-wire          main_tx_converter_converter_source_ready;
-wire          main_tx_converter_converter_source_valid;
-wire          main_tx_converter_sink_first;
-wire          main_tx_converter_sink_last;
-wire   [15:0] main_tx_converter_sink_param_dst_port;
-wire   [31:0] main_tx_converter_sink_param_ip_address;
-wire   [15:0] main_tx_converter_sink_param_length;
-wire   [15:0] main_tx_converter_sink_param_src_port;
-wire    [7:0] main_tx_converter_sink_payload_data;
-wire          main_tx_converter_sink_payload_error;
-wire          main_tx_converter_sink_payload_last_be;
-wire          main_tx_converter_sink_ready;
-wire          main_tx_converter_sink_valid;
-wire          main_tx_converter_source_first;
-wire          main_tx_converter_source_last;
-wire   [15:0] main_tx_converter_source_param_dst_port;
-wire   [31:0] main_tx_converter_source_param_ip_address;
-wire   [15:0] main_tx_converter_source_param_length;
-wire   [15:0] main_tx_converter_source_param_src_port;
-wire    [7:0] main_tx_converter_source_payload_data;
-wire          main_tx_converter_source_payload_error;
-wire          main_tx_converter_source_payload_last_be;
-wire          main_tx_converter_source_ready;
-wire          main_tx_converter_source_source_first;
-wire          main_tx_converter_source_source_last;
-wire    [9:0] main_tx_converter_source_source_payload_data;
-wire          main_tx_converter_source_source_ready;
-wire          main_tx_converter_source_source_valid;
-wire          main_tx_converter_source_valid;
-reg           main_user_port_sink_first = 1'd0;
-wire          main_user_port_sink_last;
-wire   [15:0] main_user_port_sink_param_dst_port;
-wire   [31:0] main_user_port_sink_param_ip_address;
-wire   [15:0] main_user_port_sink_param_length;
-wire   [15:0] main_user_port_sink_param_src_port;
-wire    [7:0] main_user_port_sink_payload_data;
-reg           main_user_port_sink_payload_error = 1'd0;
-wire          main_user_port_sink_payload_last_be;
-wire          main_user_port_sink_ready;
-wire          main_user_port_sink_valid;
-wire          main_user_port_source_first;
-wire          main_user_port_source_last;
-wire   [15:0] main_user_port_source_param_dst_port;
-wire   [31:0] main_user_port_source_param_ip_address;
-wire   [15:0] main_user_port_source_param_length;
-wire   [15:0] main_user_port_source_param_src_port;
-wire    [7:0] main_user_port_source_payload_data;
-wire          main_user_port_source_payload_error;
-wire          main_user_port_source_payload_last_be;
-wire          main_user_port_source_ready;
-wire          main_user_port_source_valid;
+reg           main_udp_buffer0_pipe_ready_sink_d_first = 1'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] main_udp_buffer0_pipe_ready_sink_d_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer0_pipe_ready_sink_d_param_length = 16'd0;
+reg     [7:0] main_udp_buffer0_pipe_ready_sink_d_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer0_pipe_ready_sink_d_payload_data = 8'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_payload_error = 1'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_payload_last_be = 1'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_ready = 1'd0;
+reg           main_udp_buffer0_pipe_ready_sink_d_valid = 1'd0;
+wire          main_udp_buffer0_pipe_ready_sink_first;
+wire          main_udp_buffer0_pipe_ready_sink_last;
+wire   [31:0] main_udp_buffer0_pipe_ready_sink_param_ip_address;
+wire   [15:0] main_udp_buffer0_pipe_ready_sink_param_length;
+wire    [7:0] main_udp_buffer0_pipe_ready_sink_param_protocol;
+wire    [7:0] main_udp_buffer0_pipe_ready_sink_payload_data;
+wire          main_udp_buffer0_pipe_ready_sink_payload_error;
+wire          main_udp_buffer0_pipe_ready_sink_payload_last_be;
+wire          main_udp_buffer0_pipe_ready_sink_ready;
+wire          main_udp_buffer0_pipe_ready_sink_valid;
+reg           main_udp_buffer0_pipe_ready_source_first = 1'd0;
+reg           main_udp_buffer0_pipe_ready_source_last = 1'd0;
+reg    [31:0] main_udp_buffer0_pipe_ready_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer0_pipe_ready_source_param_length = 16'd0;
+reg     [7:0] main_udp_buffer0_pipe_ready_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer0_pipe_ready_source_payload_data = 8'd0;
+reg           main_udp_buffer0_pipe_ready_source_payload_error = 1'd0;
+reg           main_udp_buffer0_pipe_ready_source_payload_last_be = 1'd0;
+wire          main_udp_buffer0_pipe_ready_source_ready;
+reg           main_udp_buffer0_pipe_ready_source_valid = 1'd0;
+reg           main_udp_buffer0_pipe_ready_valid = 1'd0;
+wire          main_udp_buffer0_pipe_valid_sink_first;
+wire          main_udp_buffer0_pipe_valid_sink_last;
+wire   [31:0] main_udp_buffer0_pipe_valid_sink_param_ip_address;
+wire   [15:0] main_udp_buffer0_pipe_valid_sink_param_length;
+wire    [7:0] main_udp_buffer0_pipe_valid_sink_param_protocol;
+wire    [7:0] main_udp_buffer0_pipe_valid_sink_payload_data;
+wire          main_udp_buffer0_pipe_valid_sink_payload_error;
+wire          main_udp_buffer0_pipe_valid_sink_payload_last_be;
+wire          main_udp_buffer0_pipe_valid_sink_ready;
+wire          main_udp_buffer0_pipe_valid_sink_valid;
+reg           main_udp_buffer0_pipe_valid_source_first = 1'd0;
+reg           main_udp_buffer0_pipe_valid_source_last = 1'd0;
+reg    [31:0] main_udp_buffer0_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer0_pipe_valid_source_param_length = 16'd0;
+reg     [7:0] main_udp_buffer0_pipe_valid_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer0_pipe_valid_source_payload_data = 8'd0;
+reg           main_udp_buffer0_pipe_valid_source_payload_error = 1'd0;
+reg           main_udp_buffer0_pipe_valid_source_payload_last_be = 1'd0;
+wire          main_udp_buffer0_pipe_valid_source_ready;
+reg           main_udp_buffer0_pipe_valid_source_valid = 1'd0;
+wire          main_udp_buffer0_sink_sink_first;
+wire          main_udp_buffer0_sink_sink_last;
+wire   [31:0] main_udp_buffer0_sink_sink_param_ip_address;
+wire   [15:0] main_udp_buffer0_sink_sink_param_length;
+wire    [7:0] main_udp_buffer0_sink_sink_param_protocol;
+wire    [7:0] main_udp_buffer0_sink_sink_payload_data;
+wire          main_udp_buffer0_sink_sink_payload_error;
+wire          main_udp_buffer0_sink_sink_payload_last_be;
+wire          main_udp_buffer0_sink_sink_ready;
+wire          main_udp_buffer0_sink_sink_valid;
+wire          main_udp_buffer0_source_source_first;
+wire          main_udp_buffer0_source_source_last;
+wire   [31:0] main_udp_buffer0_source_source_param_ip_address;
+wire   [15:0] main_udp_buffer0_source_source_param_length;
+wire    [7:0] main_udp_buffer0_source_source_param_protocol;
+wire    [7:0] main_udp_buffer0_source_source_payload_data;
+wire          main_udp_buffer0_source_source_payload_error;
+wire          main_udp_buffer0_source_source_payload_last_be;
+wire          main_udp_buffer0_source_source_ready;
+wire          main_udp_buffer0_source_source_valid;
+reg           main_udp_buffer1_pipe_ready_sink_d_first = 1'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] main_udp_buffer1_pipe_ready_sink_d_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer1_pipe_ready_sink_d_param_length = 16'd0;
+reg     [7:0] main_udp_buffer1_pipe_ready_sink_d_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer1_pipe_ready_sink_d_payload_data = 8'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_payload_error = 1'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_payload_last_be = 1'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_ready = 1'd0;
+reg           main_udp_buffer1_pipe_ready_sink_d_valid = 1'd0;
+wire          main_udp_buffer1_pipe_ready_sink_first;
+wire          main_udp_buffer1_pipe_ready_sink_last;
+wire   [31:0] main_udp_buffer1_pipe_ready_sink_param_ip_address;
+wire   [15:0] main_udp_buffer1_pipe_ready_sink_param_length;
+wire    [7:0] main_udp_buffer1_pipe_ready_sink_param_protocol;
+wire    [7:0] main_udp_buffer1_pipe_ready_sink_payload_data;
+wire          main_udp_buffer1_pipe_ready_sink_payload_error;
+wire          main_udp_buffer1_pipe_ready_sink_payload_last_be;
+wire          main_udp_buffer1_pipe_ready_sink_ready;
+wire          main_udp_buffer1_pipe_ready_sink_valid;
+reg           main_udp_buffer1_pipe_ready_source_first = 1'd0;
+reg           main_udp_buffer1_pipe_ready_source_last = 1'd0;
+reg    [31:0] main_udp_buffer1_pipe_ready_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer1_pipe_ready_source_param_length = 16'd0;
+reg     [7:0] main_udp_buffer1_pipe_ready_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer1_pipe_ready_source_payload_data = 8'd0;
+reg           main_udp_buffer1_pipe_ready_source_payload_error = 1'd0;
+reg           main_udp_buffer1_pipe_ready_source_payload_last_be = 1'd0;
+wire          main_udp_buffer1_pipe_ready_source_ready;
+reg           main_udp_buffer1_pipe_ready_source_valid = 1'd0;
+reg           main_udp_buffer1_pipe_ready_valid = 1'd0;
+wire          main_udp_buffer1_pipe_valid_sink_first;
+wire          main_udp_buffer1_pipe_valid_sink_last;
+wire   [31:0] main_udp_buffer1_pipe_valid_sink_param_ip_address;
+wire   [15:0] main_udp_buffer1_pipe_valid_sink_param_length;
+wire    [7:0] main_udp_buffer1_pipe_valid_sink_param_protocol;
+wire    [7:0] main_udp_buffer1_pipe_valid_sink_payload_data;
+wire          main_udp_buffer1_pipe_valid_sink_payload_error;
+wire          main_udp_buffer1_pipe_valid_sink_payload_last_be;
+wire          main_udp_buffer1_pipe_valid_sink_ready;
+wire          main_udp_buffer1_pipe_valid_sink_valid;
+reg           main_udp_buffer1_pipe_valid_source_first = 1'd0;
+reg           main_udp_buffer1_pipe_valid_source_last = 1'd0;
+reg    [31:0] main_udp_buffer1_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer1_pipe_valid_source_param_length = 16'd0;
+reg     [7:0] main_udp_buffer1_pipe_valid_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_buffer1_pipe_valid_source_payload_data = 8'd0;
+reg           main_udp_buffer1_pipe_valid_source_payload_error = 1'd0;
+reg           main_udp_buffer1_pipe_valid_source_payload_last_be = 1'd0;
+wire          main_udp_buffer1_pipe_valid_source_ready;
+reg           main_udp_buffer1_pipe_valid_source_valid = 1'd0;
+wire          main_udp_buffer1_sink_sink_first;
+wire          main_udp_buffer1_sink_sink_last;
+wire   [31:0] main_udp_buffer1_sink_sink_param_ip_address;
+wire   [15:0] main_udp_buffer1_sink_sink_param_length;
+wire    [7:0] main_udp_buffer1_sink_sink_param_protocol;
+wire    [7:0] main_udp_buffer1_sink_sink_payload_data;
+wire          main_udp_buffer1_sink_sink_payload_error;
+wire          main_udp_buffer1_sink_sink_payload_last_be;
+wire          main_udp_buffer1_sink_sink_ready;
+wire          main_udp_buffer1_sink_sink_valid;
+wire          main_udp_buffer1_source_source_first;
+wire          main_udp_buffer1_source_source_last;
+wire   [31:0] main_udp_buffer1_source_source_param_ip_address;
+wire   [15:0] main_udp_buffer1_source_source_param_length;
+wire    [7:0] main_udp_buffer1_source_source_param_protocol;
+wire    [7:0] main_udp_buffer1_source_source_payload_data;
+wire          main_udp_buffer1_source_source_payload_error;
+wire          main_udp_buffer1_source_source_payload_last_be;
+wire          main_udp_buffer1_source_source_ready;
+wire          main_udp_buffer1_source_source_valid;
+reg    [15:0] main_udp_holdingudprx0 = 16'd0;
+reg    [15:0] main_udp_holdingudprx0_holdingudprx_next_value4 = 16'd0;
+reg           main_udp_holdingudprx0_holdingudprx_next_value_ce4 = 1'd0;
+reg    [15:0] main_udp_holdingudprx1 = 16'd0;
+reg    [15:0] main_udp_holdingudprx1_holdingudprx_next_value5 = 16'd0;
+reg           main_udp_holdingudprx1_holdingudprx_next_value_ce5 = 1'd0;
+reg    [15:0] main_udp_holdingudprx2 = 16'd0;
+reg    [15:0] main_udp_holdingudprx2_holdingudprx_next_value6 = 16'd0;
+reg           main_udp_holdingudprx2_holdingudprx_next_value_ce6 = 1'd0;
+reg    [31:0] main_udp_holdingudprx3 = 32'd0;
+reg    [31:0] main_udp_holdingudprx3_holdingudprx_next_value7 = 32'd0;
+reg           main_udp_holdingudprx3_holdingudprx_next_value_ce7 = 1'd0;
+reg    [15:0] main_udp_holdingudprx_count = 16'd0;
+reg    [15:0] main_udp_holdingudprx_count_holdingudprx_next_value0 = 16'd0;
+reg           main_udp_holdingudprx_count_holdingudprx_next_value_ce0 = 1'd0;
+wire          main_udp_holdingudprx_cut0;
+wire          main_udp_holdingudprx_cut1;
+reg           main_udp_holdingudprx_drop_header = 1'd0;
+reg           main_udp_holdingudprx_err = 1'd0;
+reg           main_udp_holdingudprx_err_holdingudprx_next_value1 = 1'd0;
+reg           main_udp_holdingudprx_err_holdingudprx_next_value_ce1 = 1'd0;
+reg           main_udp_holdingudprx_fsm_is_ongoing0 = 1'd0;
+reg           main_udp_holdingudprx_fsm_is_ongoing1 = 1'd0;
+reg     [7:0] main_udp_holdingudprx_held = 8'd0;
+reg     [7:0] main_udp_holdingudprx_held_holdingudprx_next_value3 = 8'd0;
+reg           main_udp_holdingudprx_held_holdingudprx_next_value_ce3 = 1'd0;
+reg     [2:0] main_udp_holdingudprx_liteethudpdepacketizer_count = 3'd0;
+reg     [2:0] main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 = 3'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value_ce = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value1 = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value_ce1 = 1'd0;
+wire   [63:0] main_udp_holdingudprx_liteethudpdepacketizer_header;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_is_in_copy;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing0 = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing1 = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing2 = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing3 = 1'd0;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_new_last_be;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_sink_d_last = 1'd0;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_sink_first;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_sink_last;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_sink_last_be;
+wire   [31:0] main_udp_holdingudprx_liteethudpdepacketizer_sink_param_ip_address;
+wire   [15:0] main_udp_holdingudprx_liteethudpdepacketizer_sink_param_length;
+wire    [7:0] main_udp_holdingudprx_liteethudpdepacketizer_sink_param_protocol;
+wire    [7:0] main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_data;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_error;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_last_be;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_sink_ready = 1'd0;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_sink_valid;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_source_last = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_source_last_a = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_source_last_b = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_source_last_s = 1'd0;
+wire   [15:0] main_udp_holdingudprx_liteethudpdepacketizer_source_param_checksum;
+wire   [15:0] main_udp_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+wire   [15:0] main_udp_holdingudprx_liteethudpdepacketizer_source_param_length;
+wire   [15:0] main_udp_holdingudprx_liteethudpdepacketizer_source_param_src_port;
+reg     [7:0] main_udp_holdingudprx_liteethudpdepacketizer_source_payload_data = 8'd0;
+wire          main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_source_payload_last_be = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_source_ready = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_source_valid = 1'd0;
+reg    [63:0] main_udp_holdingudprx_liteethudpdepacketizer_sr = 64'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_sr_shift = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
+reg           main_udp_holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
+wire   [15:0] main_udp_holdingudprx_payload_len;
+reg    [15:0] main_udp_holdingudprx_rest = 16'd0;
+reg    [15:0] main_udp_holdingudprx_rest_holdingudprx_next_value2 = 16'd0;
+reg           main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 = 1'd0;
+wire          main_udp_holdingudprx_sink_first;
+wire          main_udp_holdingudprx_sink_last;
+wire   [31:0] main_udp_holdingudprx_sink_param_ip_address;
+wire   [15:0] main_udp_holdingudprx_sink_param_length;
+wire    [7:0] main_udp_holdingudprx_sink_param_protocol;
+wire    [7:0] main_udp_holdingudprx_sink_payload_data;
+wire          main_udp_holdingudprx_sink_payload_error;
+wire          main_udp_holdingudprx_sink_payload_last_be;
+wire          main_udp_holdingudprx_sink_ready;
+wire          main_udp_holdingudprx_sink_valid;
+reg           main_udp_holdingudprx_source_first = 1'd0;
+reg           main_udp_holdingudprx_source_last = 1'd0;
+reg    [15:0] main_udp_holdingudprx_source_param_dst_port = 16'd0;
+reg    [31:0] main_udp_holdingudprx_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_holdingudprx_source_param_length = 16'd0;
+reg    [15:0] main_udp_holdingudprx_source_param_src_port = 16'd0;
+reg     [7:0] main_udp_holdingudprx_source_payload_data = 8'd0;
+reg           main_udp_holdingudprx_source_payload_error = 1'd0;
+reg           main_udp_holdingudprx_source_payload_last_be = 1'd0;
+wire          main_udp_holdingudprx_source_ready;
+reg           main_udp_holdingudprx_source_valid = 1'd0;
+wire          main_udp_ip_port_sink_first;
+wire          main_udp_ip_port_sink_last;
+wire   [31:0] main_udp_ip_port_sink_param_ip_address;
+wire   [15:0] main_udp_ip_port_sink_param_length;
+wire    [7:0] main_udp_ip_port_sink_param_protocol;
+wire   [31:0] main_udp_ip_port_sink_payload_data;
+wire    [3:0] main_udp_ip_port_sink_payload_error;
+wire    [3:0] main_udp_ip_port_sink_payload_last_be;
+reg           main_udp_ip_port_sink_ready = 1'd0;
+wire          main_udp_ip_port_sink_valid;
+reg           main_udp_ip_port_source_first = 1'd0;
+reg           main_udp_ip_port_source_last = 1'd0;
+reg    [31:0] main_udp_ip_port_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_ip_port_source_param_length = 16'd0;
+reg     [7:0] main_udp_ip_port_source_param_protocol = 8'd0;
+reg    [31:0] main_udp_ip_port_source_payload_data = 32'd0;
+reg     [3:0] main_udp_ip_port_source_payload_error = 4'd0;
+reg     [3:0] main_udp_ip_port_source_payload_last_be = 4'd0;
+wire          main_udp_ip_port_source_ready;
+reg           main_udp_ip_port_source_valid = 1'd0;
+wire          main_udp_lastbytetrim_end;
+reg           main_udp_lastbytetrim_err = 1'd0;
+reg           main_udp_lastbytetrim_err_lastbytetrim_next_value = 1'd0;
+reg           main_udp_lastbytetrim_err_lastbytetrim_next_value_ce = 1'd0;
+wire          main_udp_lastbytetrim_sink_first;
+wire          main_udp_lastbytetrim_sink_last;
+wire   [31:0] main_udp_lastbytetrim_sink_param_ip_address;
+wire   [15:0] main_udp_lastbytetrim_sink_param_length;
+wire    [7:0] main_udp_lastbytetrim_sink_param_protocol;
+wire    [7:0] main_udp_lastbytetrim_sink_payload_data;
+wire          main_udp_lastbytetrim_sink_payload_error;
+wire          main_udp_lastbytetrim_sink_payload_last_be;
+reg           main_udp_lastbytetrim_sink_ready = 1'd0;
+wire          main_udp_lastbytetrim_sink_valid;
+reg           main_udp_lastbytetrim_source_first = 1'd0;
+reg           main_udp_lastbytetrim_source_last = 1'd0;
+reg    [31:0] main_udp_lastbytetrim_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_lastbytetrim_source_param_length = 16'd0;
+reg     [7:0] main_udp_lastbytetrim_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_lastbytetrim_source_payload_data = 8'd0;
+reg           main_udp_lastbytetrim_source_payload_error = 1'd0;
+reg           main_udp_lastbytetrim_source_payload_last_be = 1'd0;
+wire          main_udp_lastbytetrim_source_ready;
+reg           main_udp_lastbytetrim_source_valid = 1'd0;
+reg     [2:0] main_udp_liteethudptx_packetizer_count = 3'd0;
+reg     [2:0] main_udp_liteethudptx_packetizer_count_fsm0_next_value4 = 3'd0;
+reg           main_udp_liteethudptx_packetizer_count_fsm0_next_value_ce4 = 1'd0;
+reg           main_udp_liteethudptx_packetizer_delayed_last_be = 1'd0;
+reg           main_udp_liteethudptx_packetizer_delayed_last_be_fsm1_next_value2 = 1'd0;
+reg           main_udp_liteethudptx_packetizer_delayed_last_be_fsm1_next_value_ce2 = 1'd0;
+reg           main_udp_liteethudptx_packetizer_fsm_from_idle = 1'd0;
+reg           main_udp_liteethudptx_packetizer_fsm_from_idle_fsm0_next_value5 = 1'd0;
+reg           main_udp_liteethudptx_packetizer_fsm_from_idle_fsm0_next_value_ce5 = 1'd0;
+reg    [63:0] main_udp_liteethudptx_packetizer_header = 64'd0;
+wire          main_udp_liteethudptx_packetizer_in_data_copy;
+reg           main_udp_liteethudptx_packetizer_is_ongoing0 = 1'd0;
+reg           main_udp_liteethudptx_packetizer_is_ongoing1 = 1'd0;
+reg           main_udp_liteethudptx_packetizer_is_ongoing2 = 1'd0;
+wire          main_udp_liteethudptx_packetizer_new_last_be;
+wire          main_udp_liteethudptx_packetizer_sink_last;
+wire          main_udp_liteethudptx_packetizer_sink_last_be;
+wire   [15:0] main_udp_liteethudptx_packetizer_sink_param_checksum;
+wire   [15:0] main_udp_liteethudptx_packetizer_sink_param_dst_port;
+wire   [15:0] main_udp_liteethudptx_packetizer_sink_param_length;
+wire   [15:0] main_udp_liteethudptx_packetizer_sink_param_src_port;
+wire    [7:0] main_udp_liteethudptx_packetizer_sink_payload_data;
+reg           main_udp_liteethudptx_packetizer_sink_payload_error = 1'd0;
+wire          main_udp_liteethudptx_packetizer_sink_payload_last_be;
+reg           main_udp_liteethudptx_packetizer_sink_ready = 1'd0;
+wire          main_udp_liteethudptx_packetizer_sink_valid;
+reg           main_udp_liteethudptx_packetizer_source_first = 1'd0;
+reg           main_udp_liteethudptx_packetizer_source_last = 1'd0;
+reg           main_udp_liteethudptx_packetizer_source_last_a = 1'd0;
+reg           main_udp_liteethudptx_packetizer_source_last_b = 1'd0;
+reg           main_udp_liteethudptx_packetizer_source_last_s = 1'd0;
+reg    [31:0] main_udp_liteethudptx_packetizer_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_liteethudptx_packetizer_source_param_length = 16'd0;
+reg     [7:0] main_udp_liteethudptx_packetizer_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_liteethudptx_packetizer_source_payload_data = 8'd0;
+wire          main_udp_liteethudptx_packetizer_source_payload_error;
+reg           main_udp_liteethudptx_packetizer_source_payload_last_be = 1'd0;
+reg           main_udp_liteethudptx_packetizer_source_ready = 1'd0;
+reg           main_udp_liteethudptx_packetizer_source_valid = 1'd0;
+reg    [63:0] main_udp_liteethudptx_packetizer_sr = 64'd0;
+reg           main_udp_liteethudptx_packetizer_sr_load = 1'd0;
+reg           main_udp_liteethudptx_packetizer_sr_shift = 1'd0;
+wire          main_udp_liteethudptx_sink_sink_first;
+wire          main_udp_liteethudptx_sink_sink_last;
+wire   [15:0] main_udp_liteethudptx_sink_sink_param_dst_port;
+wire   [31:0] main_udp_liteethudptx_sink_sink_param_ip_address;
+wire   [15:0] main_udp_liteethudptx_sink_sink_param_length;
+wire   [15:0] main_udp_liteethudptx_sink_sink_param_src_port;
+wire    [7:0] main_udp_liteethudptx_sink_sink_payload_data;
+wire          main_udp_liteethudptx_sink_sink_payload_error;
+wire          main_udp_liteethudptx_sink_sink_payload_last_be;
+wire          main_udp_liteethudptx_sink_sink_ready;
+wire          main_udp_liteethudptx_sink_sink_valid;
+reg           main_udp_liteethudptx_source_source_first = 1'd0;
+reg           main_udp_liteethudptx_source_source_last = 1'd0;
+reg    [31:0] main_udp_liteethudptx_source_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_liteethudptx_source_source_param_length = 16'd0;
+reg     [7:0] main_udp_liteethudptx_source_source_param_protocol = 8'd0;
+reg     [7:0] main_udp_liteethudptx_source_source_payload_data = 8'd0;
+reg           main_udp_liteethudptx_source_source_payload_error = 1'd0;
+reg           main_udp_liteethudptx_source_source_payload_last_be = 1'd0;
+wire          main_udp_liteethudptx_source_source_ready;
+reg           main_udp_liteethudptx_source_source_valid = 1'd0;
+wire          main_udp_maskedudpcrossbar_dropped;
+wire          main_udp_maskedudpcrossbar_sink_first;
+wire          main_udp_maskedudpcrossbar_sink_last;
+wire   [15:0] main_udp_maskedudpcrossbar_sink_param_dst_port;
+wire   [31:0] main_udp_maskedudpcrossbar_sink_param_ip_address;
+wire   [15:0] main_udp_maskedudpcrossbar_sink_param_length;
+wire   [15:0] main_udp_maskedudpcrossbar_sink_param_src_port;
+wire    [7:0] main_udp_maskedudpcrossbar_sink_payload_data;
+wire          main_udp_maskedudpcrossbar_sink_payload_error;
+wire          main_udp_maskedudpcrossbar_sink_payload_last_be;
+reg           main_udp_maskedudpcrossbar_sink_ready = 1'd0;
+wire          main_udp_maskedudpcrossbar_sink_valid;
+wire          main_udp_maskedudpcrossbar_source_first;
+wire          main_udp_maskedudpcrossbar_source_last;
+wire   [15:0] main_udp_maskedudpcrossbar_source_param_dst_port;
+wire   [31:0] main_udp_maskedudpcrossbar_source_param_ip_address;
+wire   [15:0] main_udp_maskedudpcrossbar_source_param_length;
+wire   [15:0] main_udp_maskedudpcrossbar_source_param_src_port;
+wire    [7:0] main_udp_maskedudpcrossbar_source_payload_data;
+wire          main_udp_maskedudpcrossbar_source_payload_error;
+wire          main_udp_maskedudpcrossbar_source_payload_last_be;
+wire          main_udp_maskedudpcrossbar_source_ready;
+wire          main_udp_maskedudpcrossbar_source_valid;
+wire          main_udp_rx_cdc_sink_first;
+wire          main_udp_rx_cdc_sink_last;
+wire   [31:0] main_udp_rx_cdc_sink_param_ip_address;
+wire   [15:0] main_udp_rx_cdc_sink_param_length;
+wire    [7:0] main_udp_rx_cdc_sink_param_protocol;
+wire   [31:0] main_udp_rx_cdc_sink_payload_data;
+wire    [3:0] main_udp_rx_cdc_sink_payload_error;
+wire    [3:0] main_udp_rx_cdc_sink_payload_last_be;
+wire          main_udp_rx_cdc_sink_ready;
+wire          main_udp_rx_cdc_sink_valid;
+wire          main_udp_rx_cdc_source_first;
+wire          main_udp_rx_cdc_source_last;
+wire   [31:0] main_udp_rx_cdc_source_param_ip_address;
+wire   [15:0] main_udp_rx_cdc_source_param_length;
+wire    [7:0] main_udp_rx_cdc_source_param_protocol;
+wire   [31:0] main_udp_rx_cdc_source_payload_data;
+wire    [3:0] main_udp_rx_cdc_source_payload_error;
+wire    [3:0] main_udp_rx_cdc_source_payload_last_be;
+wire          main_udp_rx_cdc_source_ready;
+wire          main_udp_rx_cdc_source_valid;
+wire          main_udp_strideconverter0_converter_first;
+wire          main_udp_strideconverter0_converter_last;
+reg     [1:0] main_udp_strideconverter0_converter_mux = 2'd0;
+wire          main_udp_strideconverter0_converter_sink_first;
+wire          main_udp_strideconverter0_converter_sink_last;
+reg    [39:0] main_udp_strideconverter0_converter_sink_payload_data = 40'd0;
+wire          main_udp_strideconverter0_converter_sink_ready;
+wire          main_udp_strideconverter0_converter_sink_valid;
+wire          main_udp_strideconverter0_converter_source_first;
+wire          main_udp_strideconverter0_converter_source_last;
+reg     [9:0] main_udp_strideconverter0_converter_source_payload_data = 10'd0;
+wire          main_udp_strideconverter0_converter_source_payload_valid_token_count;
+wire          main_udp_strideconverter0_converter_source_ready;
+wire          main_udp_strideconverter0_converter_source_valid;
+wire          main_udp_strideconverter0_sink_first;
+wire          main_udp_strideconverter0_sink_last;
+wire   [31:0] main_udp_strideconverter0_sink_param_ip_address;
+wire   [15:0] main_udp_strideconverter0_sink_param_length;
+wire    [7:0] main_udp_strideconverter0_sink_param_protocol;
+wire   [31:0] main_udp_strideconverter0_sink_payload_data;
+wire    [3:0] main_udp_strideconverter0_sink_payload_error;
+wire    [3:0] main_udp_strideconverter0_sink_payload_last_be;
+wire          main_udp_strideconverter0_sink_ready;
+wire          main_udp_strideconverter0_sink_valid;
+wire          main_udp_strideconverter0_source_first;
+wire          main_udp_strideconverter0_source_last;
+wire   [31:0] main_udp_strideconverter0_source_param_ip_address;
+wire   [15:0] main_udp_strideconverter0_source_param_length;
+wire    [7:0] main_udp_strideconverter0_source_param_protocol;
+wire    [7:0] main_udp_strideconverter0_source_payload_data;
+wire          main_udp_strideconverter0_source_payload_error;
+wire          main_udp_strideconverter0_source_payload_last_be;
+wire          main_udp_strideconverter0_source_ready;
+wire          main_udp_strideconverter0_source_source_first;
+wire          main_udp_strideconverter0_source_source_last;
+wire    [9:0] main_udp_strideconverter0_source_source_payload_data;
+wire          main_udp_strideconverter0_source_source_ready;
+wire          main_udp_strideconverter0_source_source_valid;
+wire          main_udp_strideconverter0_source_valid;
+reg     [1:0] main_udp_strideconverter1_converter_demux = 2'd0;
+wire          main_udp_strideconverter1_converter_load_part;
+wire          main_udp_strideconverter1_converter_sink_first;
+wire          main_udp_strideconverter1_converter_sink_last;
+wire    [9:0] main_udp_strideconverter1_converter_sink_payload_data;
+wire          main_udp_strideconverter1_converter_sink_ready;
+wire          main_udp_strideconverter1_converter_sink_valid;
+reg           main_udp_strideconverter1_converter_source_first = 1'd0;
+reg           main_udp_strideconverter1_converter_source_last = 1'd0;
+reg    [39:0] main_udp_strideconverter1_converter_source_payload_data = 40'd0;
+reg     [2:0] main_udp_strideconverter1_converter_source_payload_valid_token_count = 3'd0;
+wire          main_udp_strideconverter1_converter_source_ready;
+wire          main_udp_strideconverter1_converter_source_valid;
+reg           main_udp_strideconverter1_converter_strobe_all = 1'd0;
+wire          main_udp_strideconverter1_sink_first;
+wire          main_udp_strideconverter1_sink_last;
+wire   [31:0] main_udp_strideconverter1_sink_param_ip_address;
+wire   [15:0] main_udp_strideconverter1_sink_param_length;
+wire    [7:0] main_udp_strideconverter1_sink_param_protocol;
+wire    [7:0] main_udp_strideconverter1_sink_payload_data;
+wire          main_udp_strideconverter1_sink_payload_error;
+wire          main_udp_strideconverter1_sink_payload_last_be;
+wire          main_udp_strideconverter1_sink_ready;
+wire          main_udp_strideconverter1_sink_valid;
+wire          main_udp_strideconverter1_source_first;
+wire          main_udp_strideconverter1_source_last;
+reg    [31:0] main_udp_strideconverter1_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_strideconverter1_source_param_length = 16'd0;
+reg     [7:0] main_udp_strideconverter1_source_param_protocol = 8'd0;
+reg    [31:0] main_udp_strideconverter1_source_payload_data = 32'd0;
+reg     [3:0] main_udp_strideconverter1_source_payload_error = 4'd0;
+reg     [3:0] main_udp_strideconverter1_source_payload_last_be = 4'd0;
+wire          main_udp_strideconverter1_source_ready;
+wire          main_udp_strideconverter1_source_source_first;
+wire          main_udp_strideconverter1_source_source_last;
+wire   [39:0] main_udp_strideconverter1_source_source_payload_data;
+wire          main_udp_strideconverter1_source_source_ready;
+wire          main_udp_strideconverter1_source_source_valid;
+wire          main_udp_strideconverter1_source_valid;
+wire          main_udp_tx_cdc_sink_first;
+wire          main_udp_tx_cdc_sink_last;
+wire   [31:0] main_udp_tx_cdc_sink_param_ip_address;
+wire   [15:0] main_udp_tx_cdc_sink_param_length;
+wire    [7:0] main_udp_tx_cdc_sink_param_protocol;
+wire   [31:0] main_udp_tx_cdc_sink_payload_data;
+wire    [3:0] main_udp_tx_cdc_sink_payload_error;
+wire    [3:0] main_udp_tx_cdc_sink_payload_last_be;
+wire          main_udp_tx_cdc_sink_ready;
+wire          main_udp_tx_cdc_sink_valid;
+wire          main_udp_tx_cdc_source_first;
+wire          main_udp_tx_cdc_source_last;
+wire   [31:0] main_udp_tx_cdc_source_param_ip_address;
+wire   [15:0] main_udp_tx_cdc_source_param_length;
+wire    [7:0] main_udp_tx_cdc_source_param_protocol;
+wire   [31:0] main_udp_tx_cdc_source_payload_data;
+wire    [3:0] main_udp_tx_cdc_source_payload_error;
+wire    [3:0] main_udp_tx_cdc_source_payload_last_be;
+wire          main_udp_tx_cdc_source_ready;
+wire          main_udp_tx_cdc_source_valid;
 wire          por_clk;
 wire          sys_clk;
 wire          sys_rst;
@@ -2248,27 +2750,27 @@ wire          sys_rst;
 
 assign main_source_payload_last_be = main_source_last;
 assign main_take_group = (main_ip_rx_liteethipv4depacketizer_source_param_target_ip == ip_multicast);
-assign rx_drop_header = ((((main_mac_cut | main_ip_rx_cut) | main_ip_rx_drop_header) | main_holdingudprx_cut0) | main_holdingudprx_drop_header);
-assign rx_drop_other = (((main_mac_crossbar_dropped | main_ip_rx_drop_other) | main_ip_crossbar_dropped) | main_crossbar_dropped);
-assign main_user_port_sink_valid = udp_sink_valid;
-assign main_user_port_sink_last = udp_sink_last;
-assign main_user_port_sink_param_dst_port = udp_sink_dst_port;
-assign main_user_port_sink_param_src_port = udp_sink_src_port;
-assign main_user_port_sink_param_ip_address = udp_sink_ip_address;
-assign main_user_port_sink_param_length = udp_sink_length;
-assign udp_sink_ready = main_user_port_sink_ready;
-assign main_user_port_sink_payload_data = udp_sink_data;
-assign main_user_port_sink_payload_last_be = udp_sink_last_be;
-assign udp_source_valid = main_user_port_source_valid;
-assign udp_source_last = main_user_port_source_last;
-assign udp_source_dst_port = main_user_port_source_param_dst_port;
-assign udp_source_src_port = main_user_port_source_param_src_port;
-assign udp_source_ip_address = main_user_port_source_param_ip_address;
-assign udp_source_length = main_user_port_source_param_length;
-assign main_user_port_source_ready = udp_source_ready;
-assign udp_source_data = main_user_port_source_payload_data;
-assign udp_source_last_be = main_user_port_source_payload_last_be;
-assign udp_source_error = main_user_port_source_payload_error;
+assign rx_drop_header = main_pulsemerge0_o1;
+assign rx_drop_other = main_pulsemerge1_o1;
+assign main_port_user_port_sink_valid = udp_sink_valid;
+assign main_port_user_port_sink_last = udp_sink_last;
+assign main_port_user_port_sink_param_dst_port = udp_sink_dst_port;
+assign main_port_user_port_sink_param_src_port = udp_sink_src_port;
+assign main_port_user_port_sink_param_ip_address = udp_sink_ip_address;
+assign main_port_user_port_sink_param_length = udp_sink_length;
+assign udp_sink_ready = main_port_user_port_sink_ready;
+assign main_port_user_port_sink_payload_data = udp_sink_data;
+assign main_port_user_port_sink_payload_last_be = udp_sink_last_be;
+assign udp_source_valid = main_port_user_port_source_valid;
+assign udp_source_last = main_port_user_port_source_last;
+assign udp_source_dst_port = main_port_user_port_source_param_dst_port;
+assign udp_source_src_port = main_port_user_port_source_param_src_port;
+assign udp_source_ip_address = main_port_user_port_source_param_ip_address;
+assign udp_source_length = main_port_user_port_source_param_length;
+assign main_port_user_port_source_ready = udp_source_ready;
+assign udp_source_data = main_port_user_port_source_payload_data;
+assign udp_source_last_be = main_port_user_port_source_payload_last_be;
+assign udp_source_error = main_port_user_port_source_payload_error;
 assign main_bus_errors_status = main_bus_errors;
 assign sys_clk = sys_clock;
 assign por_clk = sys_clock;
@@ -2367,6 +2869,107 @@ always @(*) begin
     end
 end
 assign main_mac_core_tx_cdc_cdc_graycounter1_q_next = (main_mac_core_tx_cdc_cdc_graycounter1_q_next_binary ^ main_mac_core_tx_cdc_cdc_graycounter1_q_next_binary[5:1]);
+assign main_mac_core_tx_converter_converter_sink_valid = main_mac_core_tx_converter_sink_valid;
+assign main_mac_core_tx_converter_converter_sink_first = main_mac_core_tx_converter_sink_first;
+assign main_mac_core_tx_converter_converter_sink_last = main_mac_core_tx_converter_sink_last;
+assign main_mac_core_tx_converter_sink_ready = main_mac_core_tx_converter_converter_sink_ready;
+always @(*) begin
+    main_mac_core_tx_converter_converter_sink_payload_data <= 40'd0;
+    main_mac_core_tx_converter_converter_sink_payload_data[7:0] <= main_mac_core_tx_converter_sink_payload_data[7:0];
+    main_mac_core_tx_converter_converter_sink_payload_data[8] <= main_mac_core_tx_converter_sink_payload_last_be[0];
+    main_mac_core_tx_converter_converter_sink_payload_data[9] <= main_mac_core_tx_converter_sink_payload_error[0];
+    main_mac_core_tx_converter_converter_sink_payload_data[17:10] <= main_mac_core_tx_converter_sink_payload_data[15:8];
+    main_mac_core_tx_converter_converter_sink_payload_data[18] <= main_mac_core_tx_converter_sink_payload_last_be[1];
+    main_mac_core_tx_converter_converter_sink_payload_data[19] <= main_mac_core_tx_converter_sink_payload_error[1];
+    main_mac_core_tx_converter_converter_sink_payload_data[27:20] <= main_mac_core_tx_converter_sink_payload_data[23:16];
+    main_mac_core_tx_converter_converter_sink_payload_data[28] <= main_mac_core_tx_converter_sink_payload_last_be[2];
+    main_mac_core_tx_converter_converter_sink_payload_data[29] <= main_mac_core_tx_converter_sink_payload_error[2];
+    main_mac_core_tx_converter_converter_sink_payload_data[37:30] <= main_mac_core_tx_converter_sink_payload_data[31:24];
+    main_mac_core_tx_converter_converter_sink_payload_data[38] <= main_mac_core_tx_converter_sink_payload_last_be[3];
+    main_mac_core_tx_converter_converter_sink_payload_data[39] <= main_mac_core_tx_converter_sink_payload_error[3];
+end
+assign main_mac_core_tx_converter_source_valid = main_mac_core_tx_converter_source_source_valid;
+assign main_mac_core_tx_converter_source_first = main_mac_core_tx_converter_source_source_first;
+assign main_mac_core_tx_converter_source_last = main_mac_core_tx_converter_source_source_last;
+assign main_mac_core_tx_converter_source_source_ready = main_mac_core_tx_converter_source_ready;
+assign {main_mac_core_tx_converter_source_payload_error, main_mac_core_tx_converter_source_payload_last_be, main_mac_core_tx_converter_source_payload_data} = main_mac_core_tx_converter_source_source_payload_data;
+assign main_mac_core_tx_converter_source_source_valid = main_mac_core_tx_converter_converter_source_valid;
+assign main_mac_core_tx_converter_converter_source_ready = main_mac_core_tx_converter_source_source_ready;
+assign main_mac_core_tx_converter_source_source_first = main_mac_core_tx_converter_converter_source_first;
+assign main_mac_core_tx_converter_source_source_last = main_mac_core_tx_converter_converter_source_last;
+assign main_mac_core_tx_converter_source_source_payload_data = main_mac_core_tx_converter_converter_source_payload_data;
+assign main_mac_core_tx_converter_converter_first = (main_mac_core_tx_converter_converter_mux == 1'd0);
+assign main_mac_core_tx_converter_converter_last = (main_mac_core_tx_converter_converter_mux == 2'd3);
+assign main_mac_core_tx_converter_converter_source_valid = main_mac_core_tx_converter_converter_sink_valid;
+assign main_mac_core_tx_converter_converter_source_first = (main_mac_core_tx_converter_converter_sink_first & main_mac_core_tx_converter_converter_first);
+assign main_mac_core_tx_converter_converter_source_last = (main_mac_core_tx_converter_converter_sink_last & main_mac_core_tx_converter_converter_last);
+assign main_mac_core_tx_converter_converter_sink_ready = (main_mac_core_tx_converter_converter_last & main_mac_core_tx_converter_converter_source_ready);
+always @(*) begin
+    main_mac_core_tx_converter_converter_source_payload_data <= 10'd0;
+    case (main_mac_core_tx_converter_converter_mux)
+        1'd0: begin
+            main_mac_core_tx_converter_converter_source_payload_data <= main_mac_core_tx_converter_converter_sink_payload_data[9:0];
+        end
+        1'd1: begin
+            main_mac_core_tx_converter_converter_source_payload_data <= main_mac_core_tx_converter_converter_sink_payload_data[19:10];
+        end
+        2'd2: begin
+            main_mac_core_tx_converter_converter_source_payload_data <= main_mac_core_tx_converter_converter_sink_payload_data[29:20];
+        end
+        default: begin
+            main_mac_core_tx_converter_converter_source_payload_data <= main_mac_core_tx_converter_converter_sink_payload_data[39:30];
+        end
+    endcase
+end
+assign main_mac_core_tx_converter_converter_source_payload_valid_token_count = main_mac_core_tx_converter_converter_last;
+assign main_mac_core_tx_last_be_last_handler_sink_valid = main_mac_core_tx_last_be_sink_sink_valid;
+assign main_mac_core_tx_last_be_sink_sink_ready = main_mac_core_tx_last_be_last_handler_sink_ready;
+assign main_mac_core_tx_last_be_last_handler_sink_first = main_mac_core_tx_last_be_sink_sink_first;
+assign main_mac_core_tx_last_be_last_handler_sink_last = main_mac_core_tx_last_be_sink_sink_last;
+assign main_mac_core_tx_last_be_last_handler_sink_payload_data = main_mac_core_tx_last_be_sink_sink_payload_data;
+assign main_mac_core_tx_last_be_last_handler_sink_payload_last_be = main_mac_core_tx_last_be_sink_sink_payload_last_be;
+assign main_mac_core_tx_last_be_last_handler_sink_payload_error = main_mac_core_tx_last_be_sink_sink_payload_error;
+assign main_mac_core_tx_last_be_source_source_valid = main_mac_core_tx_last_be_last_handler_source_valid;
+assign main_mac_core_tx_last_be_last_handler_source_ready = main_mac_core_tx_last_be_source_source_ready;
+assign main_mac_core_tx_last_be_source_source_first = main_mac_core_tx_last_be_last_handler_source_first;
+assign main_mac_core_tx_last_be_source_source_last = main_mac_core_tx_last_be_last_handler_source_last;
+assign main_mac_core_tx_last_be_source_source_payload_data = main_mac_core_tx_last_be_last_handler_source_payload_data;
+assign main_mac_core_tx_last_be_source_source_payload_last_be = main_mac_core_tx_last_be_last_handler_source_payload_last_be;
+assign main_mac_core_tx_last_be_source_source_payload_error = main_mac_core_tx_last_be_last_handler_source_payload_error;
+always @(*) begin
+    builder_liteethmac_txdatapath_liteethmactxlastbe_next_state <= 1'd0;
+    main_mac_core_tx_last_be_last_handler_sink_ready <= 1'd0;
+    main_mac_core_tx_last_be_last_handler_source_first <= 1'd0;
+    main_mac_core_tx_last_be_last_handler_source_last <= 1'd0;
+    main_mac_core_tx_last_be_last_handler_source_payload_data <= 8'd0;
+    main_mac_core_tx_last_be_last_handler_source_payload_error <= 1'd0;
+    main_mac_core_tx_last_be_last_handler_source_payload_last_be <= 1'd0;
+    main_mac_core_tx_last_be_last_handler_source_valid <= 1'd0;
+    builder_liteethmac_txdatapath_liteethmactxlastbe_next_state <= builder_liteethmac_txdatapath_liteethmactxlastbe_state;
+    case (builder_liteethmac_txdatapath_liteethmactxlastbe_state)
+        1'd1: begin
+            main_mac_core_tx_last_be_last_handler_sink_ready <= 1'd1;
+            if ((main_mac_core_tx_last_be_last_handler_sink_valid & main_mac_core_tx_last_be_last_handler_sink_last)) begin
+                builder_liteethmac_txdatapath_liteethmactxlastbe_next_state <= 1'd0;
+            end
+        end
+        default: begin
+            main_mac_core_tx_last_be_last_handler_source_valid <= main_mac_core_tx_last_be_last_handler_sink_valid;
+            main_mac_core_tx_last_be_last_handler_sink_ready <= main_mac_core_tx_last_be_last_handler_source_ready;
+            main_mac_core_tx_last_be_last_handler_source_first <= main_mac_core_tx_last_be_last_handler_sink_first;
+            main_mac_core_tx_last_be_last_handler_source_last <= main_mac_core_tx_last_be_last_handler_sink_last;
+            main_mac_core_tx_last_be_last_handler_source_payload_data <= main_mac_core_tx_last_be_last_handler_sink_payload_data;
+            main_mac_core_tx_last_be_last_handler_source_payload_last_be <= main_mac_core_tx_last_be_last_handler_sink_payload_last_be;
+            main_mac_core_tx_last_be_last_handler_source_payload_error <= main_mac_core_tx_last_be_last_handler_sink_payload_error;
+            main_mac_core_tx_last_be_last_handler_source_last <= (main_mac_core_tx_last_be_last_handler_sink_payload_last_be != 1'd0);
+            if ((main_mac_core_tx_last_be_last_handler_sink_valid & main_mac_core_tx_last_be_last_handler_sink_ready)) begin
+                if ((main_mac_core_tx_last_be_last_handler_source_last & (~main_mac_core_tx_last_be_last_handler_sink_last))) begin
+                    builder_liteethmac_txdatapath_liteethmactxlastbe_next_state <= 1'd1;
+                end
+            end
+        end
+    endcase
+end
 assign main_mac_core_tx_padding_counter_done = (main_mac_core_tx_padding_counter >= 6'd59);
 always @(*) begin
     builder_liteethmac_txdatapath_liteethmacpaddinginserter_next_state <= 1'd0;
@@ -2696,6 +3299,52 @@ always @(*) begin
         end
     endcase
 end
+assign main_pipe_valid_sink_ready = ((~main_pipe_valid_source_valid) | main_pipe_valid_source_ready);
+assign main_pipe_ready_sink_ready = (~main_pipe_ready_valid);
+always @(*) begin
+    main_pipe_ready_source_first <= 1'd0;
+    main_pipe_ready_source_last <= 1'd0;
+    main_pipe_ready_source_payload_data <= 32'd0;
+    main_pipe_ready_source_payload_error <= 4'd0;
+    main_pipe_ready_source_payload_last_be <= 4'd0;
+    main_pipe_ready_source_valid <= 1'd0;
+    if (main_pipe_ready_valid) begin
+        main_pipe_ready_source_valid <= main_pipe_ready_sink_d_valid;
+        main_pipe_ready_source_first <= main_pipe_ready_sink_d_first;
+        main_pipe_ready_source_last <= main_pipe_ready_sink_d_last;
+        main_pipe_ready_source_payload_data <= main_pipe_ready_sink_d_payload_data;
+        main_pipe_ready_source_payload_last_be <= main_pipe_ready_sink_d_payload_last_be;
+        main_pipe_ready_source_payload_error <= main_pipe_ready_sink_d_payload_error;
+    end else begin
+        main_pipe_ready_source_valid <= main_pipe_ready_sink_valid;
+        main_pipe_ready_source_first <= main_pipe_ready_sink_first;
+        main_pipe_ready_source_last <= main_pipe_ready_sink_last;
+        main_pipe_ready_source_payload_data <= main_pipe_ready_sink_payload_data;
+        main_pipe_ready_source_payload_last_be <= main_pipe_ready_sink_payload_last_be;
+        main_pipe_ready_source_payload_error <= main_pipe_ready_sink_payload_error;
+    end
+end
+assign main_pipe_valid_sink_valid = main_sink_sink_valid;
+assign main_sink_sink_ready = main_pipe_valid_sink_ready;
+assign main_pipe_valid_sink_first = main_sink_sink_first;
+assign main_pipe_valid_sink_last = main_sink_sink_last;
+assign main_pipe_valid_sink_payload_data = main_sink_sink_payload_data;
+assign main_pipe_valid_sink_payload_last_be = main_sink_sink_payload_last_be;
+assign main_pipe_valid_sink_payload_error = main_sink_sink_payload_error;
+assign main_pipe_ready_sink_valid = main_pipe_valid_source_valid;
+assign main_pipe_valid_source_ready = main_pipe_ready_sink_ready;
+assign main_pipe_ready_sink_first = main_pipe_valid_source_first;
+assign main_pipe_ready_sink_last = main_pipe_valid_source_last;
+assign main_pipe_ready_sink_payload_data = main_pipe_valid_source_payload_data;
+assign main_pipe_ready_sink_payload_last_be = main_pipe_valid_source_payload_last_be;
+assign main_pipe_ready_sink_payload_error = main_pipe_valid_source_payload_error;
+assign main_source_source_valid = main_pipe_ready_source_valid;
+assign main_pipe_ready_source_ready = main_source_source_ready;
+assign main_source_source_first = main_pipe_ready_source_first;
+assign main_source_source_last = main_pipe_ready_source_last;
+assign main_source_source_payload_data = main_pipe_ready_source_payload_data;
+assign main_source_source_payload_last_be = main_pipe_ready_source_payload_last_be;
+assign main_source_source_payload_error = main_pipe_ready_source_payload_error;
 assign main_mac_core_tx_cdc_sink_sink_valid = main_mac_core_sink_valid;
 assign main_mac_core_sink_ready = main_mac_core_tx_cdc_sink_sink_ready;
 assign main_mac_core_tx_cdc_sink_sink_first = main_mac_core_sink_first;
@@ -2703,13 +3352,34 @@ assign main_mac_core_tx_cdc_sink_sink_last = main_mac_core_sink_last;
 assign main_mac_core_tx_cdc_sink_sink_payload_data = main_mac_core_sink_payload_data;
 assign main_mac_core_tx_cdc_sink_sink_payload_last_be = main_mac_core_sink_payload_last_be;
 assign main_mac_core_tx_cdc_sink_sink_payload_error = main_mac_core_sink_payload_error;
-assign main_mac_core_tx_padding_sink_valid = main_mac_core_tx_cdc_source_source_valid;
-assign main_mac_core_tx_cdc_source_source_ready = main_mac_core_tx_padding_sink_ready;
-assign main_mac_core_tx_padding_sink_first = main_mac_core_tx_cdc_source_source_first;
-assign main_mac_core_tx_padding_sink_last = main_mac_core_tx_cdc_source_source_last;
-assign main_mac_core_tx_padding_sink_payload_data = main_mac_core_tx_cdc_source_source_payload_data;
-assign main_mac_core_tx_padding_sink_payload_last_be = main_mac_core_tx_cdc_source_source_payload_last_be;
-assign main_mac_core_tx_padding_sink_payload_error = main_mac_core_tx_cdc_source_source_payload_error;
+assign main_sink_sink_valid = main_mac_core_tx_cdc_source_source_valid;
+assign main_mac_core_tx_cdc_source_source_ready = main_sink_sink_ready;
+assign main_sink_sink_first = main_mac_core_tx_cdc_source_source_first;
+assign main_sink_sink_last = main_mac_core_tx_cdc_source_source_last;
+assign main_sink_sink_payload_data = main_mac_core_tx_cdc_source_source_payload_data;
+assign main_sink_sink_payload_last_be = main_mac_core_tx_cdc_source_source_payload_last_be;
+assign main_sink_sink_payload_error = main_mac_core_tx_cdc_source_source_payload_error;
+assign main_mac_core_tx_converter_sink_valid = main_source_source_valid;
+assign main_source_source_ready = main_mac_core_tx_converter_sink_ready;
+assign main_mac_core_tx_converter_sink_first = main_source_source_first;
+assign main_mac_core_tx_converter_sink_last = main_source_source_last;
+assign main_mac_core_tx_converter_sink_payload_data = main_source_source_payload_data;
+assign main_mac_core_tx_converter_sink_payload_last_be = main_source_source_payload_last_be;
+assign main_mac_core_tx_converter_sink_payload_error = main_source_source_payload_error;
+assign main_mac_core_tx_last_be_sink_sink_valid = main_mac_core_tx_converter_source_valid;
+assign main_mac_core_tx_converter_source_ready = main_mac_core_tx_last_be_sink_sink_ready;
+assign main_mac_core_tx_last_be_sink_sink_first = main_mac_core_tx_converter_source_first;
+assign main_mac_core_tx_last_be_sink_sink_last = main_mac_core_tx_converter_source_last;
+assign main_mac_core_tx_last_be_sink_sink_payload_data = main_mac_core_tx_converter_source_payload_data;
+assign main_mac_core_tx_last_be_sink_sink_payload_last_be = main_mac_core_tx_converter_source_payload_last_be;
+assign main_mac_core_tx_last_be_sink_sink_payload_error = main_mac_core_tx_converter_source_payload_error;
+assign main_mac_core_tx_padding_sink_valid = main_mac_core_tx_last_be_source_source_valid;
+assign main_mac_core_tx_last_be_source_source_ready = main_mac_core_tx_padding_sink_ready;
+assign main_mac_core_tx_padding_sink_first = main_mac_core_tx_last_be_source_source_first;
+assign main_mac_core_tx_padding_sink_last = main_mac_core_tx_last_be_source_source_last;
+assign main_mac_core_tx_padding_sink_payload_data = main_mac_core_tx_last_be_source_source_payload_data;
+assign main_mac_core_tx_padding_sink_payload_last_be = main_mac_core_tx_last_be_source_source_payload_last_be;
+assign main_mac_core_tx_padding_sink_payload_error = main_mac_core_tx_last_be_source_source_payload_error;
 assign main_mac_core_tx_crc_sink_sink_valid = main_mac_core_tx_padding_source_valid;
 assign main_mac_core_tx_padding_source_ready = main_mac_core_tx_crc_sink_sink_ready;
 assign main_mac_core_tx_crc_sink_sink_first = main_mac_core_tx_padding_source_first;
@@ -2973,63 +3643,114 @@ assign main_mac_core_rx_padding_source_last = main_mac_core_rx_padding_sink_last
 assign main_mac_core_rx_padding_source_payload_data = main_mac_core_rx_padding_sink_payload_data;
 assign main_mac_core_rx_padding_source_payload_last_be = main_mac_core_rx_padding_sink_payload_last_be;
 assign main_mac_core_rx_padding_source_payload_error = main_mac_core_rx_padding_sink_payload_error;
-assign main_mac_core_cdc_sink_valid = main_mac_core_sink_sink_valid;
-assign main_mac_core_sink_sink_ready = main_mac_core_cdc_sink_ready;
-assign main_mac_core_cdc_sink_first = main_mac_core_sink_sink_first;
-assign main_mac_core_cdc_sink_last = main_mac_core_sink_sink_last;
-assign main_mac_core_cdc_sink_payload_data = main_mac_core_sink_sink_payload_data;
-assign main_mac_core_cdc_sink_payload_last_be = main_mac_core_sink_sink_payload_last_be;
-assign main_mac_core_cdc_sink_payload_error = main_mac_core_sink_sink_payload_error;
-assign main_mac_core_source_source_valid = main_mac_core_cdc_source_valid;
-assign main_mac_core_cdc_source_ready = main_mac_core_source_source_ready;
-assign main_mac_core_source_source_first = main_mac_core_cdc_source_first;
-assign main_mac_core_source_source_last = main_mac_core_cdc_source_last;
-assign main_mac_core_source_source_payload_data = main_mac_core_cdc_source_payload_data;
-assign main_mac_core_source_source_payload_last_be = main_mac_core_cdc_source_payload_last_be;
-assign main_mac_core_source_source_payload_error = main_mac_core_cdc_source_payload_error;
-assign main_mac_core_cdc_asyncfifo_din = {main_mac_core_cdc_fifo_in_last, main_mac_core_cdc_fifo_in_first, main_mac_core_cdc_fifo_in_payload_error, main_mac_core_cdc_fifo_in_payload_last_be, main_mac_core_cdc_fifo_in_payload_data};
-assign {main_mac_core_cdc_fifo_out_last, main_mac_core_cdc_fifo_out_first, main_mac_core_cdc_fifo_out_payload_error, main_mac_core_cdc_fifo_out_payload_last_be, main_mac_core_cdc_fifo_out_payload_data} = main_mac_core_cdc_asyncfifo_dout;
-assign main_mac_core_cdc_sink_ready = main_mac_core_cdc_asyncfifo_writable;
-assign main_mac_core_cdc_asyncfifo_we = main_mac_core_cdc_sink_valid;
-assign main_mac_core_cdc_fifo_in_first = main_mac_core_cdc_sink_first;
-assign main_mac_core_cdc_fifo_in_last = main_mac_core_cdc_sink_last;
-assign main_mac_core_cdc_fifo_in_payload_data = main_mac_core_cdc_sink_payload_data;
-assign main_mac_core_cdc_fifo_in_payload_last_be = main_mac_core_cdc_sink_payload_last_be;
-assign main_mac_core_cdc_fifo_in_payload_error = main_mac_core_cdc_sink_payload_error;
-assign main_mac_core_cdc_source_valid = main_mac_core_cdc_asyncfifo_readable;
-assign main_mac_core_cdc_source_first = main_mac_core_cdc_fifo_out_first;
-assign main_mac_core_cdc_source_last = main_mac_core_cdc_fifo_out_last;
-assign main_mac_core_cdc_source_payload_data = main_mac_core_cdc_fifo_out_payload_data;
-assign main_mac_core_cdc_source_payload_last_be = main_mac_core_cdc_fifo_out_payload_last_be;
-assign main_mac_core_cdc_source_payload_error = main_mac_core_cdc_fifo_out_payload_error;
-assign main_mac_core_cdc_asyncfifo_re = main_mac_core_cdc_source_ready;
-assign main_mac_core_cdc_graycounter0_ce = (main_mac_core_cdc_asyncfifo_writable & main_mac_core_cdc_asyncfifo_we);
-assign main_mac_core_cdc_graycounter1_ce = (main_mac_core_cdc_asyncfifo_readable & main_mac_core_cdc_asyncfifo_re);
-assign main_mac_core_cdc_asyncfifo_writable = (((main_mac_core_cdc_graycounter0_q[5] == main_mac_core_cdc_consume_wdomain[5]) | (main_mac_core_cdc_graycounter0_q[4] == main_mac_core_cdc_consume_wdomain[4])) | (main_mac_core_cdc_graycounter0_q[3:0] != main_mac_core_cdc_consume_wdomain[3:0]));
-assign main_mac_core_cdc_asyncfifo_readable = (main_mac_core_cdc_graycounter1_q != main_mac_core_cdc_produce_rdomain);
-assign main_mac_core_cdc_wrport_adr = main_mac_core_cdc_graycounter0_q_binary[4:0];
-assign main_mac_core_cdc_wrport_dat_w = main_mac_core_cdc_asyncfifo_din;
-assign main_mac_core_cdc_wrport_we = main_mac_core_cdc_graycounter0_ce;
-assign main_mac_core_cdc_rdport_adr = main_mac_core_cdc_graycounter1_q_next_binary[4:0];
-assign main_mac_core_cdc_asyncfifo_dout = main_mac_core_cdc_rdport_dat_r;
+assign main_mac_core_rx_last_be_source_valid = main_mac_core_rx_last_be_sink_valid;
+assign main_mac_core_rx_last_be_sink_ready = main_mac_core_rx_last_be_source_ready;
+assign main_mac_core_rx_last_be_source_first = main_mac_core_rx_last_be_sink_first;
+assign main_mac_core_rx_last_be_source_last = main_mac_core_rx_last_be_sink_last;
+assign main_mac_core_rx_last_be_source_payload_data = main_mac_core_rx_last_be_sink_payload_data;
+assign main_mac_core_rx_last_be_source_payload_error = main_mac_core_rx_last_be_sink_payload_error;
 always @(*) begin
-    main_mac_core_cdc_graycounter0_q_next_binary <= 6'd0;
-    if (main_mac_core_cdc_graycounter0_ce) begin
-        main_mac_core_cdc_graycounter0_q_next_binary <= (main_mac_core_cdc_graycounter0_q_binary + 1'd1);
-    end else begin
-        main_mac_core_cdc_graycounter0_q_next_binary <= main_mac_core_cdc_graycounter0_q_binary;
+    main_mac_core_rx_last_be_source_payload_last_be <= 1'd0;
+    main_mac_core_rx_last_be_source_payload_last_be <= main_mac_core_rx_last_be_sink_payload_last_be;
+    if (1'd1) begin
+        main_mac_core_rx_last_be_source_payload_last_be <= main_mac_core_rx_last_be_sink_last;
     end
 end
-assign main_mac_core_cdc_graycounter0_q_next = (main_mac_core_cdc_graycounter0_q_next_binary ^ main_mac_core_cdc_graycounter0_q_next_binary[5:1]);
+assign main_mac_core_rx_converter_converter_sink_valid = main_mac_core_rx_converter_sink_valid;
+assign main_mac_core_rx_converter_converter_sink_first = main_mac_core_rx_converter_sink_first;
+assign main_mac_core_rx_converter_converter_sink_last = main_mac_core_rx_converter_sink_last;
+assign main_mac_core_rx_converter_sink_ready = main_mac_core_rx_converter_converter_sink_ready;
+assign main_mac_core_rx_converter_converter_sink_payload_data = {main_mac_core_rx_converter_sink_payload_error, main_mac_core_rx_converter_sink_payload_last_be, main_mac_core_rx_converter_sink_payload_data};
+assign main_mac_core_rx_converter_source_valid = main_mac_core_rx_converter_source_source_valid;
+assign main_mac_core_rx_converter_source_first = main_mac_core_rx_converter_source_source_first;
+assign main_mac_core_rx_converter_source_last = main_mac_core_rx_converter_source_source_last;
+assign main_mac_core_rx_converter_source_source_ready = main_mac_core_rx_converter_source_ready;
 always @(*) begin
-    main_mac_core_cdc_graycounter1_q_next_binary <= 6'd0;
-    if (main_mac_core_cdc_graycounter1_ce) begin
-        main_mac_core_cdc_graycounter1_q_next_binary <= (main_mac_core_cdc_graycounter1_q_binary + 1'd1);
+    main_mac_core_rx_converter_source_payload_data <= 32'd0;
+    main_mac_core_rx_converter_source_payload_data[7:0] <= main_mac_core_rx_converter_source_source_payload_data[7:0];
+    main_mac_core_rx_converter_source_payload_data[15:8] <= main_mac_core_rx_converter_source_source_payload_data[17:10];
+    main_mac_core_rx_converter_source_payload_data[23:16] <= main_mac_core_rx_converter_source_source_payload_data[27:20];
+    main_mac_core_rx_converter_source_payload_data[31:24] <= main_mac_core_rx_converter_source_source_payload_data[37:30];
+end
+always @(*) begin
+    main_mac_core_rx_converter_source_payload_last_be <= 4'd0;
+    main_mac_core_rx_converter_source_payload_last_be[0] <= main_mac_core_rx_converter_source_source_payload_data[8];
+    main_mac_core_rx_converter_source_payload_last_be[1] <= main_mac_core_rx_converter_source_source_payload_data[18];
+    main_mac_core_rx_converter_source_payload_last_be[2] <= main_mac_core_rx_converter_source_source_payload_data[28];
+    main_mac_core_rx_converter_source_payload_last_be[3] <= main_mac_core_rx_converter_source_source_payload_data[38];
+end
+always @(*) begin
+    main_mac_core_rx_converter_source_payload_error <= 4'd0;
+    main_mac_core_rx_converter_source_payload_error[0] <= main_mac_core_rx_converter_source_source_payload_data[9];
+    main_mac_core_rx_converter_source_payload_error[1] <= main_mac_core_rx_converter_source_source_payload_data[19];
+    main_mac_core_rx_converter_source_payload_error[2] <= main_mac_core_rx_converter_source_source_payload_data[29];
+    main_mac_core_rx_converter_source_payload_error[3] <= main_mac_core_rx_converter_source_source_payload_data[39];
+end
+assign main_mac_core_rx_converter_source_source_valid = main_mac_core_rx_converter_converter_source_valid;
+assign main_mac_core_rx_converter_converter_source_ready = main_mac_core_rx_converter_source_source_ready;
+assign main_mac_core_rx_converter_source_source_first = main_mac_core_rx_converter_converter_source_first;
+assign main_mac_core_rx_converter_source_source_last = main_mac_core_rx_converter_converter_source_last;
+assign main_mac_core_rx_converter_source_source_payload_data = main_mac_core_rx_converter_converter_source_payload_data;
+assign main_mac_core_rx_converter_converter_sink_ready = ((~main_mac_core_rx_converter_converter_strobe_all) | main_mac_core_rx_converter_converter_source_ready);
+assign main_mac_core_rx_converter_converter_source_valid = main_mac_core_rx_converter_converter_strobe_all;
+assign main_mac_core_rx_converter_converter_load_part = (main_mac_core_rx_converter_converter_sink_valid & main_mac_core_rx_converter_converter_sink_ready);
+assign main_mac_core_rx_cdc_cdc_sink_valid = main_mac_core_rx_cdc_sink_sink_valid;
+assign main_mac_core_rx_cdc_sink_sink_ready = main_mac_core_rx_cdc_cdc_sink_ready;
+assign main_mac_core_rx_cdc_cdc_sink_first = main_mac_core_rx_cdc_sink_sink_first;
+assign main_mac_core_rx_cdc_cdc_sink_last = main_mac_core_rx_cdc_sink_sink_last;
+assign main_mac_core_rx_cdc_cdc_sink_payload_data = main_mac_core_rx_cdc_sink_sink_payload_data;
+assign main_mac_core_rx_cdc_cdc_sink_payload_last_be = main_mac_core_rx_cdc_sink_sink_payload_last_be;
+assign main_mac_core_rx_cdc_cdc_sink_payload_error = main_mac_core_rx_cdc_sink_sink_payload_error;
+assign main_mac_core_rx_cdc_source_source_valid = main_mac_core_rx_cdc_cdc_source_valid;
+assign main_mac_core_rx_cdc_cdc_source_ready = main_mac_core_rx_cdc_source_source_ready;
+assign main_mac_core_rx_cdc_source_source_first = main_mac_core_rx_cdc_cdc_source_first;
+assign main_mac_core_rx_cdc_source_source_last = main_mac_core_rx_cdc_cdc_source_last;
+assign main_mac_core_rx_cdc_source_source_payload_data = main_mac_core_rx_cdc_cdc_source_payload_data;
+assign main_mac_core_rx_cdc_source_source_payload_last_be = main_mac_core_rx_cdc_cdc_source_payload_last_be;
+assign main_mac_core_rx_cdc_source_source_payload_error = main_mac_core_rx_cdc_cdc_source_payload_error;
+assign main_mac_core_rx_cdc_cdc_asyncfifo_din = {main_mac_core_rx_cdc_cdc_fifo_in_last, main_mac_core_rx_cdc_cdc_fifo_in_first, main_mac_core_rx_cdc_cdc_fifo_in_payload_error, main_mac_core_rx_cdc_cdc_fifo_in_payload_last_be, main_mac_core_rx_cdc_cdc_fifo_in_payload_data};
+assign {main_mac_core_rx_cdc_cdc_fifo_out_last, main_mac_core_rx_cdc_cdc_fifo_out_first, main_mac_core_rx_cdc_cdc_fifo_out_payload_error, main_mac_core_rx_cdc_cdc_fifo_out_payload_last_be, main_mac_core_rx_cdc_cdc_fifo_out_payload_data} = main_mac_core_rx_cdc_cdc_asyncfifo_dout;
+assign main_mac_core_rx_cdc_cdc_sink_ready = main_mac_core_rx_cdc_cdc_asyncfifo_writable;
+assign main_mac_core_rx_cdc_cdc_asyncfifo_we = main_mac_core_rx_cdc_cdc_sink_valid;
+assign main_mac_core_rx_cdc_cdc_fifo_in_first = main_mac_core_rx_cdc_cdc_sink_first;
+assign main_mac_core_rx_cdc_cdc_fifo_in_last = main_mac_core_rx_cdc_cdc_sink_last;
+assign main_mac_core_rx_cdc_cdc_fifo_in_payload_data = main_mac_core_rx_cdc_cdc_sink_payload_data;
+assign main_mac_core_rx_cdc_cdc_fifo_in_payload_last_be = main_mac_core_rx_cdc_cdc_sink_payload_last_be;
+assign main_mac_core_rx_cdc_cdc_fifo_in_payload_error = main_mac_core_rx_cdc_cdc_sink_payload_error;
+assign main_mac_core_rx_cdc_cdc_source_valid = main_mac_core_rx_cdc_cdc_asyncfifo_readable;
+assign main_mac_core_rx_cdc_cdc_source_first = main_mac_core_rx_cdc_cdc_fifo_out_first;
+assign main_mac_core_rx_cdc_cdc_source_last = main_mac_core_rx_cdc_cdc_fifo_out_last;
+assign main_mac_core_rx_cdc_cdc_source_payload_data = main_mac_core_rx_cdc_cdc_fifo_out_payload_data;
+assign main_mac_core_rx_cdc_cdc_source_payload_last_be = main_mac_core_rx_cdc_cdc_fifo_out_payload_last_be;
+assign main_mac_core_rx_cdc_cdc_source_payload_error = main_mac_core_rx_cdc_cdc_fifo_out_payload_error;
+assign main_mac_core_rx_cdc_cdc_asyncfifo_re = main_mac_core_rx_cdc_cdc_source_ready;
+assign main_mac_core_rx_cdc_cdc_graycounter0_ce = (main_mac_core_rx_cdc_cdc_asyncfifo_writable & main_mac_core_rx_cdc_cdc_asyncfifo_we);
+assign main_mac_core_rx_cdc_cdc_graycounter1_ce = (main_mac_core_rx_cdc_cdc_asyncfifo_readable & main_mac_core_rx_cdc_cdc_asyncfifo_re);
+assign main_mac_core_rx_cdc_cdc_asyncfifo_writable = (((main_mac_core_rx_cdc_cdc_graycounter0_q[5] == main_mac_core_rx_cdc_cdc_consume_wdomain[5]) | (main_mac_core_rx_cdc_cdc_graycounter0_q[4] == main_mac_core_rx_cdc_cdc_consume_wdomain[4])) | (main_mac_core_rx_cdc_cdc_graycounter0_q[3:0] != main_mac_core_rx_cdc_cdc_consume_wdomain[3:0]));
+assign main_mac_core_rx_cdc_cdc_asyncfifo_readable = (main_mac_core_rx_cdc_cdc_graycounter1_q != main_mac_core_rx_cdc_cdc_produce_rdomain);
+assign main_mac_core_rx_cdc_cdc_wrport_adr = main_mac_core_rx_cdc_cdc_graycounter0_q_binary[4:0];
+assign main_mac_core_rx_cdc_cdc_wrport_dat_w = main_mac_core_rx_cdc_cdc_asyncfifo_din;
+assign main_mac_core_rx_cdc_cdc_wrport_we = main_mac_core_rx_cdc_cdc_graycounter0_ce;
+assign main_mac_core_rx_cdc_cdc_rdport_adr = main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary[4:0];
+assign main_mac_core_rx_cdc_cdc_asyncfifo_dout = main_mac_core_rx_cdc_cdc_rdport_dat_r;
+always @(*) begin
+    main_mac_core_rx_cdc_cdc_graycounter0_q_next_binary <= 6'd0;
+    if (main_mac_core_rx_cdc_cdc_graycounter0_ce) begin
+        main_mac_core_rx_cdc_cdc_graycounter0_q_next_binary <= (main_mac_core_rx_cdc_cdc_graycounter0_q_binary + 1'd1);
     end else begin
-        main_mac_core_cdc_graycounter1_q_next_binary <= main_mac_core_cdc_graycounter1_q_binary;
+        main_mac_core_rx_cdc_cdc_graycounter0_q_next_binary <= main_mac_core_rx_cdc_cdc_graycounter0_q_binary;
     end
 end
-assign main_mac_core_cdc_graycounter1_q_next = (main_mac_core_cdc_graycounter1_q_next_binary ^ main_mac_core_cdc_graycounter1_q_next_binary[5:1]);
+assign main_mac_core_rx_cdc_cdc_graycounter0_q_next = (main_mac_core_rx_cdc_cdc_graycounter0_q_next_binary ^ main_mac_core_rx_cdc_cdc_graycounter0_q_next_binary[5:1]);
+always @(*) begin
+    main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary <= 6'd0;
+    if (main_mac_core_rx_cdc_cdc_graycounter1_ce) begin
+        main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary <= (main_mac_core_rx_cdc_cdc_graycounter1_q_binary + 1'd1);
+    end else begin
+        main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary <= main_mac_core_rx_cdc_cdc_graycounter1_q_binary;
+    end
+end
+assign main_mac_core_rx_cdc_cdc_graycounter1_q_next = (main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary ^ main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary[5:1]);
 assign main_mac_core_rx_preamble_sink_valid = main_source_valid;
 assign main_source_ready = main_mac_core_rx_preamble_sink_ready;
 assign main_mac_core_rx_preamble_sink_first = main_source_first;
@@ -3051,20 +3772,34 @@ assign main_mac_core_rx_padding_sink_last = main_mac_core_liteethmaccrc32checker
 assign main_mac_core_rx_padding_sink_payload_data = main_mac_core_liteethmaccrc32checker_source_source_payload_data;
 assign main_mac_core_rx_padding_sink_payload_last_be = main_mac_core_liteethmaccrc32checker_source_source_payload_last_be;
 assign main_mac_core_rx_padding_sink_payload_error = main_mac_core_liteethmaccrc32checker_source_source_payload_error;
-assign main_mac_core_sink_sink_valid = main_mac_core_rx_padding_source_valid;
-assign main_mac_core_rx_padding_source_ready = main_mac_core_sink_sink_ready;
-assign main_mac_core_sink_sink_first = main_mac_core_rx_padding_source_first;
-assign main_mac_core_sink_sink_last = main_mac_core_rx_padding_source_last;
-assign main_mac_core_sink_sink_payload_data = main_mac_core_rx_padding_source_payload_data;
-assign main_mac_core_sink_sink_payload_last_be = main_mac_core_rx_padding_source_payload_last_be;
-assign main_mac_core_sink_sink_payload_error = main_mac_core_rx_padding_source_payload_error;
-assign main_mac_core_source_valid = main_mac_core_source_source_valid;
-assign main_mac_core_source_source_ready = main_mac_core_source_ready;
-assign main_mac_core_source_first = main_mac_core_source_source_first;
-assign main_mac_core_source_last = main_mac_core_source_source_last;
-assign main_mac_core_source_payload_data = main_mac_core_source_source_payload_data;
-assign main_mac_core_source_payload_last_be = main_mac_core_source_source_payload_last_be;
-assign main_mac_core_source_payload_error = main_mac_core_source_source_payload_error;
+assign main_mac_core_rx_last_be_sink_valid = main_mac_core_rx_padding_source_valid;
+assign main_mac_core_rx_padding_source_ready = main_mac_core_rx_last_be_sink_ready;
+assign main_mac_core_rx_last_be_sink_first = main_mac_core_rx_padding_source_first;
+assign main_mac_core_rx_last_be_sink_last = main_mac_core_rx_padding_source_last;
+assign main_mac_core_rx_last_be_sink_payload_data = main_mac_core_rx_padding_source_payload_data;
+assign main_mac_core_rx_last_be_sink_payload_last_be = main_mac_core_rx_padding_source_payload_last_be;
+assign main_mac_core_rx_last_be_sink_payload_error = main_mac_core_rx_padding_source_payload_error;
+assign main_mac_core_rx_converter_sink_valid = main_mac_core_rx_last_be_source_valid;
+assign main_mac_core_rx_last_be_source_ready = main_mac_core_rx_converter_sink_ready;
+assign main_mac_core_rx_converter_sink_first = main_mac_core_rx_last_be_source_first;
+assign main_mac_core_rx_converter_sink_last = main_mac_core_rx_last_be_source_last;
+assign main_mac_core_rx_converter_sink_payload_data = main_mac_core_rx_last_be_source_payload_data;
+assign main_mac_core_rx_converter_sink_payload_last_be = main_mac_core_rx_last_be_source_payload_last_be;
+assign main_mac_core_rx_converter_sink_payload_error = main_mac_core_rx_last_be_source_payload_error;
+assign main_mac_core_rx_cdc_sink_sink_valid = main_mac_core_rx_converter_source_valid;
+assign main_mac_core_rx_converter_source_ready = main_mac_core_rx_cdc_sink_sink_ready;
+assign main_mac_core_rx_cdc_sink_sink_first = main_mac_core_rx_converter_source_first;
+assign main_mac_core_rx_cdc_sink_sink_last = main_mac_core_rx_converter_source_last;
+assign main_mac_core_rx_cdc_sink_sink_payload_data = main_mac_core_rx_converter_source_payload_data;
+assign main_mac_core_rx_cdc_sink_sink_payload_last_be = main_mac_core_rx_converter_source_payload_last_be;
+assign main_mac_core_rx_cdc_sink_sink_payload_error = main_mac_core_rx_converter_source_payload_error;
+assign main_mac_core_source_valid = main_mac_core_rx_cdc_source_source_valid;
+assign main_mac_core_rx_cdc_source_source_ready = main_mac_core_source_ready;
+assign main_mac_core_source_first = main_mac_core_rx_cdc_source_source_first;
+assign main_mac_core_source_last = main_mac_core_rx_cdc_source_source_last;
+assign main_mac_core_source_payload_data = main_mac_core_rx_cdc_source_source_payload_data;
+assign main_mac_core_source_payload_last_be = main_mac_core_rx_cdc_source_source_payload_last_be;
+assign main_mac_core_source_payload_error = main_mac_core_rx_cdc_source_source_payload_error;
 assign builder_liteethmac_taken = (((1'd0 + main_arp_mac_port_source_valid) + main_ip_mac_port_source_valid) != 1'd0);
 assign main_mac_crossbar_dropped = (((main_mac_crossbar_sink_valid & main_mac_crossbar_sink_ready) & main_mac_crossbar_sink_last) & (~builder_liteethmac_taken));
 always @(*) begin
@@ -3089,10 +3824,10 @@ always @(*) begin
     main_ip_mac_port_sink_ready <= 1'd0;
     main_mac_crossbar_source_first <= 1'd0;
     main_mac_crossbar_source_last <= 1'd0;
-    main_mac_crossbar_source_payload_data <= 8'd0;
-    main_mac_crossbar_source_payload_error <= 1'd0;
+    main_mac_crossbar_source_payload_data <= 32'd0;
+    main_mac_crossbar_source_payload_error <= 4'd0;
     main_mac_crossbar_source_payload_ethernet_type <= 16'd0;
-    main_mac_crossbar_source_payload_last_be <= 1'd0;
+    main_mac_crossbar_source_payload_last_be <= 4'd0;
     main_mac_crossbar_source_payload_sender_mac <= 48'd0;
     main_mac_crossbar_source_payload_target_mac <= 48'd0;
     main_mac_crossbar_source_valid <= 1'd0;
@@ -3138,19 +3873,19 @@ end
 always @(*) begin
     main_arp_mac_port_source_first <= 1'd0;
     main_arp_mac_port_source_last <= 1'd0;
-    main_arp_mac_port_source_payload_data <= 8'd0;
-    main_arp_mac_port_source_payload_error <= 1'd0;
+    main_arp_mac_port_source_payload_data <= 32'd0;
+    main_arp_mac_port_source_payload_error <= 4'd0;
     main_arp_mac_port_source_payload_ethernet_type <= 16'd0;
-    main_arp_mac_port_source_payload_last_be <= 1'd0;
+    main_arp_mac_port_source_payload_last_be <= 4'd0;
     main_arp_mac_port_source_payload_sender_mac <= 48'd0;
     main_arp_mac_port_source_payload_target_mac <= 48'd0;
     main_arp_mac_port_source_valid <= 1'd0;
     main_ip_mac_port_source_first <= 1'd0;
     main_ip_mac_port_source_last <= 1'd0;
-    main_ip_mac_port_source_payload_data <= 8'd0;
-    main_ip_mac_port_source_payload_error <= 1'd0;
+    main_ip_mac_port_source_payload_data <= 32'd0;
+    main_ip_mac_port_source_payload_error <= 4'd0;
     main_ip_mac_port_source_payload_ethernet_type <= 16'd0;
-    main_ip_mac_port_source_payload_last_be <= 1'd0;
+    main_ip_mac_port_source_payload_last_be <= 4'd0;
     main_ip_mac_port_source_payload_sender_mac <= 48'd0;
     main_ip_mac_port_source_payload_target_mac <= 48'd0;
     main_ip_mac_port_source_valid <= 1'd0;
@@ -3193,8 +3928,7 @@ always @(*) begin
     main_mac_packetizer_header[95:48] <= {main_mac_packetizer_sink_payload_sender_mac[7:0], main_mac_packetizer_sink_payload_sender_mac[15:8], main_mac_packetizer_sink_payload_sender_mac[23:16], main_mac_packetizer_sink_payload_sender_mac[31:24], main_mac_packetizer_sink_payload_sender_mac[39:32], main_mac_packetizer_sink_payload_sender_mac[47:40]};
     main_mac_packetizer_header[47:0] <= {main_mac_packetizer_sink_payload_target_mac[7:0], main_mac_packetizer_sink_payload_target_mac[15:8], main_mac_packetizer_sink_payload_target_mac[23:16], main_mac_packetizer_sink_payload_target_mac[31:24], main_mac_packetizer_sink_payload_target_mac[39:32], main_mac_packetizer_sink_payload_target_mac[47:40]};
 end
-assign main_mac_packetizer_sink_last_be = main_mac_packetizer_sink_last;
-assign main_mac_packetizer_new_last_be = {main_mac_packetizer_sink_last_be};
+assign main_mac_packetizer_new_last_be = {main_mac_packetizer_sink_payload_last_be[1], main_mac_packetizer_sink_payload_last_be[0], main_mac_packetizer_sink_payload_last_be[3], main_mac_packetizer_sink_payload_last_be[2]};
 assign main_mac_packetizer_in_data_copy = (main_mac_packetizer_is_ongoing0 | main_mac_packetizer_is_ongoing1);
 always @(*) begin
     main_mac_packetizer_source_last <= 1'd0;
@@ -3208,9 +3942,9 @@ assign main_mac_packetizer_source_payload_error = main_mac_packetizer_sink_paylo
 always @(*) begin
     builder_liteethmac_fsm0_next_state0 <= 2'd0;
     builder_liteethmac_fsm1_next_state0 <= 1'd0;
-    main_mac_packetizer_count_liteethmac_fsm0_next_value0 <= 4'd0;
+    main_mac_packetizer_count_liteethmac_fsm0_next_value0 <= 2'd0;
     main_mac_packetizer_count_liteethmac_fsm0_next_value_ce0 <= 1'd0;
-    main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0 <= 1'd0;
+    main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0 <= 4'd0;
     main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value_ce0 <= 1'd0;
     main_mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value1 <= 1'd0;
     main_mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value_ce1 <= 1'd0;
@@ -3221,8 +3955,8 @@ always @(*) begin
     main_mac_packetizer_source_last_a <= 1'd0;
     main_mac_packetizer_source_last_b <= 1'd0;
     main_mac_packetizer_source_last_s <= 1'd0;
-    main_mac_packetizer_source_payload_data <= 8'd0;
-    main_mac_packetizer_source_payload_last_be <= 1'd0;
+    main_mac_packetizer_source_payload_data <= 32'd0;
+    main_mac_packetizer_source_payload_last_be <= 4'd0;
     main_mac_packetizer_source_valid <= 1'd0;
     main_mac_packetizer_sr_load <= 1'd0;
     main_mac_packetizer_sr_shift <= 1'd0;
@@ -3231,12 +3965,12 @@ always @(*) begin
         1'd1: begin
             main_mac_packetizer_source_valid <= 1'd1;
             main_mac_packetizer_source_last_a <= 1'd0;
-            main_mac_packetizer_source_payload_data <= main_mac_packetizer_sr[111:8];
+            main_mac_packetizer_source_payload_data <= main_mac_packetizer_sr[111:32];
             if ((main_mac_packetizer_source_valid & main_mac_packetizer_source_ready)) begin
                 main_mac_packetizer_sr_shift <= 1'd1;
-                if ((main_mac_packetizer_count == 4'd13)) begin
+                if ((main_mac_packetizer_count == 2'd2)) begin
                     main_mac_packetizer_sr_shift <= 1'd0;
-                    builder_liteethmac_fsm0_next_state0 <= 2'd2;
+                    builder_liteethmac_fsm0_next_state0 <= 2'd3;
                     main_mac_packetizer_count_liteethmac_fsm0_next_value0 <= (main_mac_packetizer_count + 1'd1);
                     main_mac_packetizer_count_liteethmac_fsm0_next_value_ce0 <= 1'd1;
                 end else begin
@@ -3258,6 +3992,22 @@ always @(*) begin
             main_mac_packetizer_is_ongoing0 <= 1'd1;
         end
         2'd3: begin
+            main_mac_packetizer_source_valid <= (main_mac_packetizer_sink_valid | main_mac_packetizer_sink_d_last);
+            main_mac_packetizer_source_last_a <= (main_mac_packetizer_sink_last | main_mac_packetizer_sink_d_last);
+            if (main_mac_packetizer_fsm_from_idle) begin
+                main_mac_packetizer_source_payload_data[15:0] <= main_mac_packetizer_sr[111:64];
+            end else begin
+                main_mac_packetizer_source_payload_data[15:0] <= main_mac_packetizer_sink_d_payload_data[31:16];
+            end
+            main_mac_packetizer_source_payload_data[31:16] <= main_mac_packetizer_sink_payload_data;
+            if ((main_mac_packetizer_source_valid & main_mac_packetizer_source_ready)) begin
+                main_mac_packetizer_sink_ready <= ((~main_mac_packetizer_source_last) | main_mac_packetizer_sink_last);
+                main_mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value1 <= 1'd0;
+                main_mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value_ce1 <= 1'd1;
+                if (main_mac_packetizer_source_last) begin
+                    builder_liteethmac_fsm0_next_state0 <= 1'd0;
+                end
+            end
             main_mac_packetizer_is_ongoing1 <= 1'd1;
         end
         default: begin
@@ -3268,13 +4018,13 @@ always @(*) begin
                 main_mac_packetizer_sink_ready <= 1'd0;
                 main_mac_packetizer_source_valid <= 1'd1;
                 main_mac_packetizer_source_last_a <= 1'd0;
-                main_mac_packetizer_source_payload_data <= main_mac_packetizer_header[7:0];
+                main_mac_packetizer_source_payload_data <= main_mac_packetizer_header[31:0];
                 if ((main_mac_packetizer_source_valid & main_mac_packetizer_source_ready)) begin
                     main_mac_packetizer_sr_load <= 1'd1;
                     main_mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value1 <= 1'd1;
                     main_mac_packetizer_fsm_from_idle_liteethmac_fsm0_next_value_ce1 <= 1'd1;
                     if (1'd0) begin
-                        builder_liteethmac_fsm0_next_state0 <= 2'd2;
+                        builder_liteethmac_fsm0_next_state0 <= 2'd3;
                     end else begin
                         builder_liteethmac_fsm0_next_state0 <= 1'd1;
                     end
@@ -3295,7 +4045,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((main_mac_packetizer_in_data_copy & main_mac_packetizer_sink_last) & (main_mac_packetizer_sink_last_be > main_mac_packetizer_new_last_be))) begin
+            if (((main_mac_packetizer_in_data_copy & main_mac_packetizer_sink_last) & (main_mac_packetizer_sink_payload_last_be > main_mac_packetizer_new_last_be))) begin
                 main_mac_packetizer_source_last_b <= 1'd0;
                 main_mac_packetizer_source_last_s <= 1'd1;
                 main_mac_packetizer_source_payload_last_be <= 1'd0;
@@ -3326,8 +4076,7 @@ assign main_mac_liteethmacdepacketizer_source_payload_ethernet_type = {builder_r
 assign main_mac_liteethmacdepacketizer_source_payload_sender_mac = {builder_rhs_slice_proxy7[7:0], builder_rhs_slice_proxy6[15:8], builder_rhs_slice_proxy5[23:16], builder_rhs_slice_proxy4[31:24], builder_rhs_slice_proxy3[39:32], builder_rhs_slice_proxy2[47:40]};
 assign main_mac_liteethmacdepacketizer_source_payload_target_mac = {builder_rhs_slice_proxy13[7:0], builder_rhs_slice_proxy12[15:8], builder_rhs_slice_proxy11[23:16], builder_rhs_slice_proxy10[31:24], builder_rhs_slice_proxy9[39:32], builder_rhs_slice_proxy8[47:40]};
 assign main_mac_liteethmacdepacketizer_source_payload_error = main_mac_liteethmacdepacketizer_sink_payload_error;
-assign main_mac_liteethmacdepacketizer_sink_last_be = main_mac_liteethmacdepacketizer_sink_last;
-assign main_mac_liteethmacdepacketizer_new_last_be = {main_mac_liteethmacdepacketizer_sink_last_be};
+assign main_mac_liteethmacdepacketizer_new_last_be = {main_mac_liteethmacdepacketizer_sink_payload_last_be[1], main_mac_liteethmacdepacketizer_sink_payload_last_be[0], main_mac_liteethmacdepacketizer_sink_payload_last_be[3], main_mac_liteethmacdepacketizer_sink_payload_last_be[2]};
 assign main_mac_liteethmacdepacketizer_is_in_copy = (main_mac_liteethmacdepacketizer_is_ongoing0 | main_mac_liteethmacdepacketizer_is_ongoing1);
 always @(*) begin
     main_mac_liteethmacdepacketizer_source_last <= 1'd0;
@@ -3343,9 +4092,9 @@ always @(*) begin
     builder_liteethmac_fsm1_next_state1 <= 1'd0;
     main_mac_fsm_is_ongoing0 <= 1'd0;
     main_mac_fsm_is_ongoing1 <= 1'd0;
-    main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= 4'd0;
+    main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= 2'd0;
     main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd0;
-    main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= 1'd0;
+    main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value1 <= 4'd0;
     main_mac_liteethmacdepacketizer_delayed_last_be_liteethmac_fsm1_next_value_ce1 <= 1'd0;
     main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd0;
     main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd0;
@@ -3357,10 +4106,11 @@ always @(*) begin
     main_mac_liteethmacdepacketizer_source_last_a <= 1'd0;
     main_mac_liteethmacdepacketizer_source_last_b <= 1'd0;
     main_mac_liteethmacdepacketizer_source_last_s <= 1'd0;
-    main_mac_liteethmacdepacketizer_source_payload_data <= 8'd0;
-    main_mac_liteethmacdepacketizer_source_payload_last_be <= 1'd0;
+    main_mac_liteethmacdepacketizer_source_payload_data <= 32'd0;
+    main_mac_liteethmacdepacketizer_source_payload_last_be <= 4'd0;
     main_mac_liteethmacdepacketizer_source_valid <= 1'd0;
     main_mac_liteethmacdepacketizer_sr_shift <= 1'd0;
+    main_mac_liteethmacdepacketizer_sr_shift_leftover <= 1'd0;
     builder_liteethmac_fsm0_next_state1 <= builder_liteethmac_fsm0_state1;
     case (builder_liteethmac_fsm0_state1)
         1'd1: begin
@@ -3369,8 +4119,8 @@ always @(*) begin
                 main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= (main_mac_liteethmacdepacketizer_count + 1'd1);
                 main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
                 main_mac_liteethmacdepacketizer_sr_shift <= 1'd1;
-                if ((main_mac_liteethmacdepacketizer_count == 4'd13)) begin
-                    builder_liteethmac_fsm0_next_state1 <= 2'd2;
+                if ((main_mac_liteethmacdepacketizer_count == 2'd2)) begin
+                    builder_liteethmac_fsm0_next_state1 <= 2'd3;
                     main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value2 <= (main_mac_liteethmacdepacketizer_count + 1'd1);
                     main_mac_liteethmacdepacketizer_count_liteethmac_fsm0_next_value_ce2 <= 1'd1;
                 end
@@ -3394,6 +4144,25 @@ always @(*) begin
             main_mac_liteethmacdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
+            main_mac_liteethmacdepacketizer_source_valid <= (main_mac_liteethmacdepacketizer_sink_valid | main_mac_liteethmacdepacketizer_sink_d_last);
+            main_mac_liteethmacdepacketizer_source_last_a <= main_mac_liteethmacdepacketizer_sink_d_last;
+            main_mac_liteethmacdepacketizer_sink_ready <= (main_mac_liteethmacdepacketizer_source_ready & (~main_mac_liteethmacdepacketizer_source_last));
+            main_mac_liteethmacdepacketizer_source_payload_data <= main_mac_liteethmacdepacketizer_sink_d_payload_data[31:16];
+            main_mac_liteethmacdepacketizer_source_payload_data[31:16] <= main_mac_liteethmacdepacketizer_sink_payload_data;
+            if (main_mac_liteethmacdepacketizer_fsm_from_idle) begin
+                main_mac_liteethmacdepacketizer_source_valid <= main_mac_liteethmacdepacketizer_sink_d_last;
+                main_mac_liteethmacdepacketizer_sink_ready <= (~main_mac_liteethmacdepacketizer_sink_d_last);
+                if (main_mac_liteethmacdepacketizer_sink_valid) begin
+                    main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd0;
+                    main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd1;
+                    main_mac_liteethmacdepacketizer_sr_shift_leftover <= 1'd1;
+                end
+            end
+            if ((main_mac_liteethmacdepacketizer_source_valid & main_mac_liteethmacdepacketizer_source_ready)) begin
+                if (main_mac_liteethmacdepacketizer_source_last) begin
+                    builder_liteethmac_fsm0_next_state1 <= 1'd0;
+                end
+            end
             main_mac_liteethmacdepacketizer_is_ongoing1 <= 1'd1;
             main_mac_liteethmacdepacketizer_is_ongoing3 <= 1'd1;
         end
@@ -3406,7 +4175,7 @@ always @(*) begin
                 main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value3 <= 1'd1;
                 main_mac_liteethmacdepacketizer_fsm_from_idle_liteethmac_fsm0_next_value_ce3 <= 1'd1;
                 if (1'd0) begin
-                    builder_liteethmac_fsm0_next_state1 <= 2'd2;
+                    builder_liteethmac_fsm0_next_state1 <= 2'd3;
                 end else begin
                     builder_liteethmac_fsm0_next_state1 <= 1'd1;
                 end
@@ -3429,7 +4198,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((main_mac_liteethmacdepacketizer_sink_valid & main_mac_liteethmacdepacketizer_sink_last) & (main_mac_liteethmacdepacketizer_sink_last_be > main_mac_liteethmacdepacketizer_new_last_be))) begin
+            if (((main_mac_liteethmacdepacketizer_sink_valid & main_mac_liteethmacdepacketizer_sink_last) & (main_mac_liteethmacdepacketizer_sink_payload_last_be > main_mac_liteethmacdepacketizer_new_last_be))) begin
                 main_mac_liteethmacdepacketizer_source_last_b <= 1'd0;
                 main_mac_liteethmacdepacketizer_source_last_s <= 1'd1;
                 main_mac_liteethmacdepacketizer_source_payload_last_be <= 1'd0;
@@ -3489,11 +4258,11 @@ assign main_arp_rx_sink_payload_target_mac = main_arp_mac_port_source_payload_ta
 assign main_arp_rx_sink_payload_data = main_arp_mac_port_source_payload_data;
 assign main_arp_rx_sink_payload_last_be = main_arp_mac_port_source_payload_last_be;
 assign main_arp_rx_sink_payload_error = main_arp_mac_port_source_payload_error;
-assign main_arp_packetizer_sink_last = (main_arp_counter == 6'd45);
+assign main_arp_packetizer_sink_last = (main_arp_counter == 4'd10);
 always @(*) begin
-    main_arp_packetizer_sink_payload_last_be <= 1'd0;
+    main_arp_packetizer_sink_payload_last_be <= 4'd0;
     if (main_arp_packetizer_sink_last) begin
-        main_arp_packetizer_sink_payload_last_be <= 1'd1;
+        main_arp_packetizer_sink_payload_last_be <= 2'd2;
     end
 end
 assign main_arp_packetizer_sink_param_hwtype = 1'd1;
@@ -3548,8 +4317,7 @@ always @(*) begin
     main_arp_packetizer_header[223:192] <= {main_arp_packetizer_sink_param_target_ip[7:0], main_arp_packetizer_sink_param_target_ip[15:8], main_arp_packetizer_sink_param_target_ip[23:16], main_arp_packetizer_sink_param_target_ip[31:24]};
     main_arp_packetizer_header[191:144] <= {main_arp_packetizer_sink_param_target_mac[7:0], main_arp_packetizer_sink_param_target_mac[15:8], main_arp_packetizer_sink_param_target_mac[23:16], main_arp_packetizer_sink_param_target_mac[31:24], main_arp_packetizer_sink_param_target_mac[39:32], main_arp_packetizer_sink_param_target_mac[47:40]};
 end
-assign main_arp_packetizer_sink_last_be = main_arp_packetizer_sink_last;
-assign main_arp_packetizer_new_last_be = {main_arp_packetizer_sink_last_be};
+assign main_arp_packetizer_new_last_be = {main_arp_packetizer_sink_payload_last_be[3], main_arp_packetizer_sink_payload_last_be[2], main_arp_packetizer_sink_payload_last_be[1], main_arp_packetizer_sink_payload_last_be[0]};
 assign main_arp_packetizer_in_data_copy = (main_arp_packetizer_is_ongoing0 | main_arp_packetizer_is_ongoing1);
 always @(*) begin
     main_arp_packetizer_source_last <= 1'd0;
@@ -3563,9 +4331,9 @@ assign main_arp_packetizer_source_payload_error = main_arp_packetizer_sink_paylo
 always @(*) begin
     builder_liteetharptx_fsm0_next_state <= 2'd0;
     builder_liteetharptx_fsm1_next_state <= 1'd0;
-    main_arp_packetizer_count_liteetharp_fsm0_next_value0 <= 5'd0;
+    main_arp_packetizer_count_liteetharp_fsm0_next_value0 <= 3'd0;
     main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0 <= 1'd0;
-    main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= 1'd0;
+    main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value0 <= 4'd0;
     main_arp_packetizer_delayed_last_be_liteetharp_fsm1_next_value_ce0 <= 1'd0;
     main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd0;
     main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value_ce1 <= 1'd0;
@@ -3576,8 +4344,8 @@ always @(*) begin
     main_arp_packetizer_source_last_a <= 1'd0;
     main_arp_packetizer_source_last_b <= 1'd0;
     main_arp_packetizer_source_last_s <= 1'd0;
-    main_arp_packetizer_source_payload_data <= 8'd0;
-    main_arp_packetizer_source_payload_last_be <= 1'd0;
+    main_arp_packetizer_source_payload_data <= 32'd0;
+    main_arp_packetizer_source_payload_last_be <= 4'd0;
     main_arp_packetizer_source_valid <= 1'd0;
     main_arp_packetizer_sr_load <= 1'd0;
     main_arp_packetizer_sr_shift <= 1'd0;
@@ -3586,10 +4354,10 @@ always @(*) begin
         1'd1: begin
             main_arp_packetizer_source_valid <= 1'd1;
             main_arp_packetizer_source_last_a <= 1'd0;
-            main_arp_packetizer_source_payload_data <= main_arp_packetizer_sr[223:8];
+            main_arp_packetizer_source_payload_data <= main_arp_packetizer_sr[223:32];
             if ((main_arp_packetizer_source_valid & main_arp_packetizer_source_ready)) begin
                 main_arp_packetizer_sr_shift <= 1'd1;
-                if ((main_arp_packetizer_count == 5'd27)) begin
+                if ((main_arp_packetizer_count == 3'd6)) begin
                     main_arp_packetizer_sr_shift <= 1'd0;
                     builder_liteetharptx_fsm0_next_state <= 2'd2;
                     main_arp_packetizer_count_liteetharp_fsm0_next_value0 <= (main_arp_packetizer_count + 1'd1);
@@ -3623,7 +4391,7 @@ always @(*) begin
                 main_arp_packetizer_sink_ready <= 1'd0;
                 main_arp_packetizer_source_valid <= 1'd1;
                 main_arp_packetizer_source_last_a <= 1'd0;
-                main_arp_packetizer_source_payload_data <= main_arp_packetizer_header[7:0];
+                main_arp_packetizer_source_payload_data <= main_arp_packetizer_header[31:0];
                 if ((main_arp_packetizer_source_valid & main_arp_packetizer_source_ready)) begin
                     main_arp_packetizer_sr_load <= 1'd1;
                     main_arp_packetizer_fsm_from_idle_liteetharp_fsm0_next_value1 <= 1'd1;
@@ -3650,7 +4418,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((main_arp_packetizer_in_data_copy & main_arp_packetizer_sink_last) & (main_arp_packetizer_sink_last_be > main_arp_packetizer_new_last_be))) begin
+            if (((main_arp_packetizer_in_data_copy & main_arp_packetizer_sink_last) & (main_arp_packetizer_sink_payload_last_be > main_arp_packetizer_new_last_be))) begin
                 main_arp_packetizer_source_last_b <= 1'd0;
                 main_arp_packetizer_source_last_s <= 1'd1;
                 main_arp_packetizer_source_payload_last_be <= 1'd0;
@@ -3678,7 +4446,7 @@ always @(*) begin
 end
 always @(*) begin
     builder_liteetharptx_next_state <= 1'd0;
-    main_arp_counter_liteetharp_next_value <= 6'd0;
+    main_arp_counter_liteetharp_next_value <= 4'd0;
     main_arp_counter_liteetharp_next_value_ce <= 1'd0;
     main_arp_packetizer_sink_valid <= 1'd0;
     main_arp_packetizer_source_ready <= 1'd0;
@@ -3745,8 +4513,7 @@ assign main_arp_rx_liteetharpdepacketizer_source_param_sender_mac = {builder_rhs
 assign main_arp_rx_liteetharpdepacketizer_source_param_target_ip = {builder_rhs_slice_proxy35[7:0], builder_rhs_slice_proxy34[15:8], builder_rhs_slice_proxy33[23:16], builder_rhs_slice_proxy32[31:24]};
 assign main_arp_rx_liteetharpdepacketizer_source_param_target_mac = {builder_rhs_slice_proxy41[7:0], builder_rhs_slice_proxy40[15:8], builder_rhs_slice_proxy39[23:16], builder_rhs_slice_proxy38[31:24], builder_rhs_slice_proxy37[39:32], builder_rhs_slice_proxy36[47:40]};
 assign main_arp_rx_liteetharpdepacketizer_source_payload_error = main_arp_rx_liteetharpdepacketizer_sink_payload_error;
-assign main_arp_rx_liteetharpdepacketizer_sink_last_be = main_arp_rx_liteetharpdepacketizer_sink_last;
-assign main_arp_rx_liteetharpdepacketizer_new_last_be = {main_arp_rx_liteetharpdepacketizer_sink_last_be};
+assign main_arp_rx_liteetharpdepacketizer_new_last_be = {main_arp_rx_liteetharpdepacketizer_sink_payload_last_be[3], main_arp_rx_liteetharpdepacketizer_sink_payload_last_be[2], main_arp_rx_liteetharpdepacketizer_sink_payload_last_be[1], main_arp_rx_liteetharpdepacketizer_sink_payload_last_be[0]};
 assign main_arp_rx_liteetharpdepacketizer_is_in_copy = (main_arp_rx_liteetharpdepacketizer_is_ongoing0 | main_arp_rx_liteetharpdepacketizer_is_ongoing1);
 always @(*) begin
     main_arp_rx_liteetharpdepacketizer_source_last <= 1'd0;
@@ -3762,9 +4529,9 @@ always @(*) begin
     builder_liteetharprx_fsm1_next_state <= 1'd0;
     main_arp_rx_fsm_is_ongoing0 <= 1'd0;
     main_arp_rx_fsm_is_ongoing1 <= 1'd0;
-    main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= 5'd0;
+    main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= 3'd0;
     main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd0;
-    main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value1 <= 4'd0;
     main_arp_rx_liteetharpdepacketizer_delayed_last_be_liteetharp_fsm1_next_value_ce1 <= 1'd0;
     main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value3 <= 1'd0;
     main_arp_rx_liteetharpdepacketizer_fsm_from_idle_liteetharp_fsm0_next_value_ce3 <= 1'd0;
@@ -3776,8 +4543,8 @@ always @(*) begin
     main_arp_rx_liteetharpdepacketizer_source_last_a <= 1'd0;
     main_arp_rx_liteetharpdepacketizer_source_last_b <= 1'd0;
     main_arp_rx_liteetharpdepacketizer_source_last_s <= 1'd0;
-    main_arp_rx_liteetharpdepacketizer_source_payload_data <= 8'd0;
-    main_arp_rx_liteetharpdepacketizer_source_payload_last_be <= 1'd0;
+    main_arp_rx_liteetharpdepacketizer_source_payload_data <= 32'd0;
+    main_arp_rx_liteetharpdepacketizer_source_payload_last_be <= 4'd0;
     main_arp_rx_liteetharpdepacketizer_source_valid <= 1'd0;
     main_arp_rx_liteetharpdepacketizer_sr_shift <= 1'd0;
     builder_liteetharprx_fsm0_next_state <= builder_liteetharprx_fsm0_state;
@@ -3788,7 +4555,7 @@ always @(*) begin
                 main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= (main_arp_rx_liteetharpdepacketizer_count + 1'd1);
                 main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
                 main_arp_rx_liteetharpdepacketizer_sr_shift <= 1'd1;
-                if ((main_arp_rx_liteetharpdepacketizer_count == 5'd27)) begin
+                if ((main_arp_rx_liteetharpdepacketizer_count == 3'd6)) begin
                     builder_liteetharprx_fsm0_next_state <= 2'd2;
                     main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value2 <= (main_arp_rx_liteetharpdepacketizer_count + 1'd1);
                     main_arp_rx_liteetharpdepacketizer_count_liteetharp_fsm0_next_value_ce2 <= 1'd1;
@@ -3848,7 +4615,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((main_arp_rx_liteetharpdepacketizer_sink_valid & main_arp_rx_liteetharpdepacketizer_sink_last) & (main_arp_rx_liteetharpdepacketizer_sink_last_be > main_arp_rx_liteetharpdepacketizer_new_last_be))) begin
+            if (((main_arp_rx_liteetharpdepacketizer_sink_valid & main_arp_rx_liteetharpdepacketizer_sink_last) & (main_arp_rx_liteetharpdepacketizer_sink_payload_last_be > main_arp_rx_liteetharpdepacketizer_new_last_be))) begin
                 main_arp_rx_liteetharpdepacketizer_source_last_b <= 1'd0;
                 main_arp_rx_liteetharpdepacketizer_source_last_s <= 1'd1;
                 main_arp_rx_liteetharpdepacketizer_source_payload_last_be <= 1'd0;
@@ -4241,8 +5008,7 @@ always @(*) begin
     main_ip_tx_packetizer_header[71:64] <= {main_ip_tx_packetizer_sink_param_ttl[7:0]};
     main_ip_tx_packetizer_header[7:4] <= {main_ip_tx_packetizer_sink_param_version[3:0]};
 end
-assign main_ip_tx_packetizer_sink_last_be = main_ip_tx_packetizer_sink_last;
-assign main_ip_tx_packetizer_new_last_be = {main_ip_tx_packetizer_sink_last_be};
+assign main_ip_tx_packetizer_new_last_be = {main_ip_tx_packetizer_sink_payload_last_be[3], main_ip_tx_packetizer_sink_payload_last_be[2], main_ip_tx_packetizer_sink_payload_last_be[1], main_ip_tx_packetizer_sink_payload_last_be[0]};
 assign main_ip_tx_packetizer_in_data_copy = (main_ip_tx_packetizer_is_ongoing0 | main_ip_tx_packetizer_is_ongoing1);
 always @(*) begin
     main_ip_tx_packetizer_source_last <= 1'd0;
@@ -4256,9 +5022,9 @@ assign main_ip_tx_packetizer_source_payload_error = main_ip_tx_packetizer_sink_p
 always @(*) begin
     builder_liteethip_liteethiptx_fsm0_next_state <= 2'd0;
     builder_liteethip_liteethiptx_fsm1_next_state <= 1'd0;
-    main_ip_tx_packetizer_count_liteethip_fsm0_next_value0 <= 5'd0;
+    main_ip_tx_packetizer_count_liteethip_fsm0_next_value0 <= 3'd0;
     main_ip_tx_packetizer_count_liteethip_fsm0_next_value_ce0 <= 1'd0;
-    main_ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value0 <= 1'd0;
+    main_ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value0 <= 4'd0;
     main_ip_tx_packetizer_delayed_last_be_liteethip_fsm1_next_value_ce0 <= 1'd0;
     main_ip_tx_packetizer_fsm_from_idle_liteethip_fsm0_next_value1 <= 1'd0;
     main_ip_tx_packetizer_fsm_from_idle_liteethip_fsm0_next_value_ce1 <= 1'd0;
@@ -4269,8 +5035,8 @@ always @(*) begin
     main_ip_tx_packetizer_source_last_a <= 1'd0;
     main_ip_tx_packetizer_source_last_b <= 1'd0;
     main_ip_tx_packetizer_source_last_s <= 1'd0;
-    main_ip_tx_packetizer_source_payload_data <= 8'd0;
-    main_ip_tx_packetizer_source_payload_last_be <= 1'd0;
+    main_ip_tx_packetizer_source_payload_data <= 32'd0;
+    main_ip_tx_packetizer_source_payload_last_be <= 4'd0;
     main_ip_tx_packetizer_source_valid <= 1'd0;
     main_ip_tx_packetizer_sr_load <= 1'd0;
     main_ip_tx_packetizer_sr_shift <= 1'd0;
@@ -4279,10 +5045,10 @@ always @(*) begin
         1'd1: begin
             main_ip_tx_packetizer_source_valid <= 1'd1;
             main_ip_tx_packetizer_source_last_a <= 1'd0;
-            main_ip_tx_packetizer_source_payload_data <= main_ip_tx_packetizer_sr[159:8];
+            main_ip_tx_packetizer_source_payload_data <= main_ip_tx_packetizer_sr[159:32];
             if ((main_ip_tx_packetizer_source_valid & main_ip_tx_packetizer_source_ready)) begin
                 main_ip_tx_packetizer_sr_shift <= 1'd1;
-                if ((main_ip_tx_packetizer_count == 5'd19)) begin
+                if ((main_ip_tx_packetizer_count == 3'd4)) begin
                     main_ip_tx_packetizer_sr_shift <= 1'd0;
                     builder_liteethip_liteethiptx_fsm0_next_state <= 2'd2;
                     main_ip_tx_packetizer_count_liteethip_fsm0_next_value0 <= (main_ip_tx_packetizer_count + 1'd1);
@@ -4316,7 +5082,7 @@ always @(*) begin
                 main_ip_tx_packetizer_sink_ready <= 1'd0;
                 main_ip_tx_packetizer_source_valid <= 1'd1;
                 main_ip_tx_packetizer_source_last_a <= 1'd0;
-                main_ip_tx_packetizer_source_payload_data <= main_ip_tx_packetizer_header[7:0];
+                main_ip_tx_packetizer_source_payload_data <= main_ip_tx_packetizer_header[31:0];
                 if ((main_ip_tx_packetizer_source_valid & main_ip_tx_packetizer_source_ready)) begin
                     main_ip_tx_packetizer_sr_load <= 1'd1;
                     main_ip_tx_packetizer_fsm_from_idle_liteethip_fsm0_next_value1 <= 1'd1;
@@ -4343,7 +5109,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((main_ip_tx_packetizer_in_data_copy & main_ip_tx_packetizer_sink_last) & (main_ip_tx_packetizer_sink_last_be > main_ip_tx_packetizer_new_last_be))) begin
+            if (((main_ip_tx_packetizer_in_data_copy & main_ip_tx_packetizer_sink_last) & (main_ip_tx_packetizer_sink_payload_last_be > main_ip_tx_packetizer_new_last_be))) begin
                 main_ip_tx_packetizer_source_last_b <= 1'd0;
                 main_ip_tx_packetizer_source_last_s <= 1'd1;
                 main_ip_tx_packetizer_source_payload_last_be <= 1'd0;
@@ -4376,10 +5142,10 @@ always @(*) begin
     main_ip_tx_packetizer_source_ready <= 1'd0;
     main_ip_tx_source_source_first0 <= 1'd0;
     main_ip_tx_source_source_last0 <= 1'd0;
-    main_ip_tx_source_source_payload_data0 <= 8'd0;
-    main_ip_tx_source_source_payload_error0 <= 1'd0;
+    main_ip_tx_source_source_payload_data0 <= 32'd0;
+    main_ip_tx_source_source_payload_error0 <= 4'd0;
     main_ip_tx_source_source_payload_ethernet_type <= 16'd0;
-    main_ip_tx_source_source_payload_last_be0 <= 1'd0;
+    main_ip_tx_source_source_payload_last_be0 <= 4'd0;
     main_ip_tx_source_source_payload_sender_mac <= 48'd0;
     main_ip_tx_source_source_payload_target_mac <= 48'd0;
     main_ip_tx_source_source_valid0 <= 1'd0;
@@ -4487,8 +5253,7 @@ assign main_ip_rx_liteethipv4depacketizer_source_param_total_length = {builder_r
 assign main_ip_rx_liteethipv4depacketizer_source_param_ttl = {builder_rhs_slice_proxy58[7:0]};
 assign main_ip_rx_liteethipv4depacketizer_source_param_version = {builder_rhs_slice_proxy59[3:0]};
 assign main_ip_rx_liteethipv4depacketizer_source_payload_error = main_ip_rx_liteethipv4depacketizer_sink_payload_error;
-assign main_ip_rx_liteethipv4depacketizer_sink_last_be = main_ip_rx_liteethipv4depacketizer_sink_last;
-assign main_ip_rx_liteethipv4depacketizer_new_last_be = {main_ip_rx_liteethipv4depacketizer_sink_last_be};
+assign main_ip_rx_liteethipv4depacketizer_new_last_be = {main_ip_rx_liteethipv4depacketizer_sink_payload_last_be[3], main_ip_rx_liteethipv4depacketizer_sink_payload_last_be[2], main_ip_rx_liteethipv4depacketizer_sink_payload_last_be[1], main_ip_rx_liteethipv4depacketizer_sink_payload_last_be[0]};
 assign main_ip_rx_liteethipv4depacketizer_is_in_copy = (main_ip_rx_liteethipv4depacketizer_is_ongoing0 | main_ip_rx_liteethipv4depacketizer_is_ongoing1);
 always @(*) begin
     main_ip_rx_liteethipv4depacketizer_source_last <= 1'd0;
@@ -4504,9 +5269,9 @@ always @(*) begin
     builder_liteethip_checkingiprx_fsm1_next_state <= 1'd0;
     main_ip_rx_fsm_is_ongoing0 <= 1'd0;
     main_ip_rx_fsm_is_ongoing1 <= 1'd0;
-    main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= 5'd0;
+    main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= 3'd0;
     main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd0;
-    main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value1 <= 4'd0;
     main_ip_rx_liteethipv4depacketizer_delayed_last_be_liteethip_fsm1_next_value_ce1 <= 1'd0;
     main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value3 <= 1'd0;
     main_ip_rx_liteethipv4depacketizer_fsm_from_idle_liteethip_fsm0_next_value_ce3 <= 1'd0;
@@ -4518,8 +5283,8 @@ always @(*) begin
     main_ip_rx_liteethipv4depacketizer_source_last_a <= 1'd0;
     main_ip_rx_liteethipv4depacketizer_source_last_b <= 1'd0;
     main_ip_rx_liteethipv4depacketizer_source_last_s <= 1'd0;
-    main_ip_rx_liteethipv4depacketizer_source_payload_data <= 8'd0;
-    main_ip_rx_liteethipv4depacketizer_source_payload_last_be <= 1'd0;
+    main_ip_rx_liteethipv4depacketizer_source_payload_data <= 32'd0;
+    main_ip_rx_liteethipv4depacketizer_source_payload_last_be <= 4'd0;
     main_ip_rx_liteethipv4depacketizer_source_valid <= 1'd0;
     main_ip_rx_liteethipv4depacketizer_sr_shift <= 1'd0;
     builder_liteethip_checkingiprx_fsm0_next_state <= builder_liteethip_checkingiprx_fsm0_state;
@@ -4530,7 +5295,7 @@ always @(*) begin
                 main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= (main_ip_rx_liteethipv4depacketizer_count + 1'd1);
                 main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
                 main_ip_rx_liteethipv4depacketizer_sr_shift <= 1'd1;
-                if ((main_ip_rx_liteethipv4depacketizer_count == 5'd19)) begin
+                if ((main_ip_rx_liteethipv4depacketizer_count == 3'd4)) begin
                     builder_liteethip_checkingiprx_fsm0_next_state <= 2'd2;
                     main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value2 <= (main_ip_rx_liteethipv4depacketizer_count + 1'd1);
                     main_ip_rx_liteethipv4depacketizer_count_liteethip_fsm0_next_value_ce2 <= 1'd1;
@@ -4590,7 +5355,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((main_ip_rx_liteethipv4depacketizer_sink_valid & main_ip_rx_liteethipv4depacketizer_sink_last) & (main_ip_rx_liteethipv4depacketizer_sink_last_be > main_ip_rx_liteethipv4depacketizer_new_last_be))) begin
+            if (((main_ip_rx_liteethipv4depacketizer_sink_valid & main_ip_rx_liteethipv4depacketizer_sink_last) & (main_ip_rx_liteethipv4depacketizer_sink_payload_last_be > main_ip_rx_liteethipv4depacketizer_new_last_be))) begin
                 main_ip_rx_liteethipv4depacketizer_source_last_b <= 1'd0;
                 main_ip_rx_liteethipv4depacketizer_source_last_s <= 1'd1;
                 main_ip_rx_liteethipv4depacketizer_source_payload_last_be <= 1'd0;
@@ -4672,7 +5437,7 @@ always @(*) begin
         builder_liteethip_sel0 <= 2'd2;
     end
 end
-assign builder_liteethip_taken = (((1'd0 + main_icmp_ip_port_source_valid) + main_ip_port_source_valid) != 1'd0);
+assign builder_liteethip_taken = (((1'd0 + main_icmp_ip_port_source_valid) + main_udp_ip_port_source_valid) != 1'd0);
 assign main_ip_crossbar_dropped = (((main_ip_crossbar_sink_valid & main_ip_crossbar_sink_ready) & main_ip_crossbar_sink_last) & (~builder_liteethip_taken));
 always @(*) begin
     builder_liteethip_request <= 2'd0;
@@ -4686,11 +5451,11 @@ always @(*) begin
     main_ip_crossbar_source_param_ip_address <= 32'd0;
     main_ip_crossbar_source_param_length <= 16'd0;
     main_ip_crossbar_source_param_protocol <= 8'd0;
-    main_ip_crossbar_source_payload_data <= 8'd0;
-    main_ip_crossbar_source_payload_error <= 1'd0;
-    main_ip_crossbar_source_payload_last_be <= 1'd0;
+    main_ip_crossbar_source_payload_data <= 32'd0;
+    main_ip_crossbar_source_payload_error <= 4'd0;
+    main_ip_crossbar_source_payload_last_be <= 4'd0;
     main_ip_crossbar_source_valid <= 1'd0;
-    main_ip_port_sink_ready <= 1'd0;
+    main_udp_ip_port_sink_ready <= 1'd0;
     case (builder_liteethip_grant)
         1'd0: begin
             main_ip_crossbar_source_valid <= main_icmp_ip_port_sink_valid;
@@ -4705,23 +5470,23 @@ always @(*) begin
             main_ip_crossbar_source_param_ip_address <= main_icmp_ip_port_sink_param_ip_address;
         end
         1'd1: begin
-            main_ip_crossbar_source_valid <= main_ip_port_sink_valid;
-            main_ip_port_sink_ready <= main_ip_crossbar_source_ready;
-            main_ip_crossbar_source_first <= main_ip_port_sink_first;
-            main_ip_crossbar_source_last <= main_ip_port_sink_last;
-            main_ip_crossbar_source_payload_data <= main_ip_port_sink_payload_data;
-            main_ip_crossbar_source_payload_last_be <= main_ip_port_sink_payload_last_be;
-            main_ip_crossbar_source_payload_error <= main_ip_port_sink_payload_error;
-            main_ip_crossbar_source_param_length <= main_ip_port_sink_param_length;
-            main_ip_crossbar_source_param_protocol <= main_ip_port_sink_param_protocol;
-            main_ip_crossbar_source_param_ip_address <= main_ip_port_sink_param_ip_address;
+            main_ip_crossbar_source_valid <= main_udp_ip_port_sink_valid;
+            main_udp_ip_port_sink_ready <= main_ip_crossbar_source_ready;
+            main_ip_crossbar_source_first <= main_udp_ip_port_sink_first;
+            main_ip_crossbar_source_last <= main_udp_ip_port_sink_last;
+            main_ip_crossbar_source_payload_data <= main_udp_ip_port_sink_payload_data;
+            main_ip_crossbar_source_payload_last_be <= main_udp_ip_port_sink_payload_last_be;
+            main_ip_crossbar_source_payload_error <= main_udp_ip_port_sink_payload_error;
+            main_ip_crossbar_source_param_length <= main_udp_ip_port_sink_param_length;
+            main_ip_crossbar_source_param_protocol <= main_udp_ip_port_sink_param_protocol;
+            main_ip_crossbar_source_param_ip_address <= main_udp_ip_port_sink_param_ip_address;
         end
     endcase
 end
 assign builder_liteethip_status0_last = ((main_icmp_ip_port_sink_valid & main_icmp_ip_port_sink_last) & main_icmp_ip_port_sink_ready);
 assign builder_liteethip_status0_ongoing0 = ((main_icmp_ip_port_sink_valid | builder_liteethip_status0_ongoing1) & (~builder_liteethip_status0_last));
-assign builder_liteethip_status1_last = ((main_ip_port_sink_valid & main_ip_port_sink_last) & main_ip_port_sink_ready);
-assign builder_liteethip_status1_ongoing0 = ((main_ip_port_sink_valid | builder_liteethip_status1_ongoing1) & (~builder_liteethip_status1_last));
+assign builder_liteethip_status1_last = ((main_udp_ip_port_sink_valid & main_udp_ip_port_sink_last) & main_udp_ip_port_sink_ready);
+assign builder_liteethip_status1_ongoing0 = ((main_udp_ip_port_sink_valid | builder_liteethip_status1_ongoing1) & (~builder_liteethip_status1_last));
 always @(*) begin
     builder_liteethip_sel1 <= 2'd0;
     if (builder_liteethip_first) begin
@@ -4736,20 +5501,20 @@ always @(*) begin
     main_icmp_ip_port_source_param_ip_address <= 32'd0;
     main_icmp_ip_port_source_param_length <= 16'd0;
     main_icmp_ip_port_source_param_protocol <= 8'd0;
-    main_icmp_ip_port_source_payload_data <= 8'd0;
-    main_icmp_ip_port_source_payload_error <= 1'd0;
-    main_icmp_ip_port_source_payload_last_be <= 1'd0;
+    main_icmp_ip_port_source_payload_data <= 32'd0;
+    main_icmp_ip_port_source_payload_error <= 4'd0;
+    main_icmp_ip_port_source_payload_last_be <= 4'd0;
     main_icmp_ip_port_source_valid <= 1'd0;
     main_ip_crossbar_sink_ready <= 1'd0;
-    main_ip_port_source_first <= 1'd0;
-    main_ip_port_source_last <= 1'd0;
-    main_ip_port_source_param_ip_address <= 32'd0;
-    main_ip_port_source_param_length <= 16'd0;
-    main_ip_port_source_param_protocol <= 8'd0;
-    main_ip_port_source_payload_data <= 8'd0;
-    main_ip_port_source_payload_error <= 1'd0;
-    main_ip_port_source_payload_last_be <= 1'd0;
-    main_ip_port_source_valid <= 1'd0;
+    main_udp_ip_port_source_first <= 1'd0;
+    main_udp_ip_port_source_last <= 1'd0;
+    main_udp_ip_port_source_param_ip_address <= 32'd0;
+    main_udp_ip_port_source_param_length <= 16'd0;
+    main_udp_ip_port_source_param_protocol <= 8'd0;
+    main_udp_ip_port_source_payload_data <= 32'd0;
+    main_udp_ip_port_source_payload_error <= 4'd0;
+    main_udp_ip_port_source_payload_last_be <= 4'd0;
+    main_udp_ip_port_source_valid <= 1'd0;
     case (builder_liteethip_sel1)
         1'd1: begin
             main_icmp_ip_port_source_valid <= main_ip_crossbar_sink_valid;
@@ -4764,16 +5529,16 @@ always @(*) begin
             main_icmp_ip_port_source_param_ip_address <= main_ip_crossbar_sink_param_ip_address;
         end
         2'd2: begin
-            main_ip_port_source_valid <= main_ip_crossbar_sink_valid;
-            main_ip_crossbar_sink_ready <= main_ip_port_source_ready;
-            main_ip_port_source_first <= main_ip_crossbar_sink_first;
-            main_ip_port_source_last <= main_ip_crossbar_sink_last;
-            main_ip_port_source_payload_data <= main_ip_crossbar_sink_payload_data;
-            main_ip_port_source_payload_last_be <= main_ip_crossbar_sink_payload_last_be;
-            main_ip_port_source_payload_error <= main_ip_crossbar_sink_payload_error;
-            main_ip_port_source_param_length <= main_ip_crossbar_sink_param_length;
-            main_ip_port_source_param_protocol <= main_ip_crossbar_sink_param_protocol;
-            main_ip_port_source_param_ip_address <= main_ip_crossbar_sink_param_ip_address;
+            main_udp_ip_port_source_valid <= main_ip_crossbar_sink_valid;
+            main_ip_crossbar_sink_ready <= main_udp_ip_port_source_ready;
+            main_udp_ip_port_source_first <= main_ip_crossbar_sink_first;
+            main_udp_ip_port_source_last <= main_ip_crossbar_sink_last;
+            main_udp_ip_port_source_payload_data <= main_ip_crossbar_sink_payload_data;
+            main_udp_ip_port_source_payload_last_be <= main_ip_crossbar_sink_payload_last_be;
+            main_udp_ip_port_source_payload_error <= main_ip_crossbar_sink_payload_error;
+            main_udp_ip_port_source_param_length <= main_ip_crossbar_sink_param_length;
+            main_udp_ip_port_source_param_protocol <= main_ip_crossbar_sink_param_protocol;
+            main_udp_ip_port_source_param_ip_address <= main_ip_crossbar_sink_param_ip_address;
         end
         default: begin
             main_ip_crossbar_sink_ready <= 1'd1;
@@ -4864,8 +5629,7 @@ always @(*) begin
     main_icmp_tx_packetizer_header[7:0] <= {main_icmp_tx_packetizer_sink_param_msgtype[7:0]};
     main_icmp_tx_packetizer_header[63:32] <= {main_icmp_tx_packetizer_sink_param_quench[7:0], main_icmp_tx_packetizer_sink_param_quench[15:8], main_icmp_tx_packetizer_sink_param_quench[23:16], main_icmp_tx_packetizer_sink_param_quench[31:24]};
 end
-assign main_icmp_tx_packetizer_sink_last_be = main_icmp_tx_packetizer_sink_last;
-assign main_icmp_tx_packetizer_new_last_be = {main_icmp_tx_packetizer_sink_last_be};
+assign main_icmp_tx_packetizer_new_last_be = {main_icmp_tx_packetizer_sink_payload_last_be[3], main_icmp_tx_packetizer_sink_payload_last_be[2], main_icmp_tx_packetizer_sink_payload_last_be[1], main_icmp_tx_packetizer_sink_payload_last_be[0]};
 assign main_icmp_tx_packetizer_in_data_copy = (main_icmp_tx_packetizer_is_ongoing0 | main_icmp_tx_packetizer_is_ongoing1);
 always @(*) begin
     main_icmp_tx_packetizer_source_last <= 1'd0;
@@ -4879,9 +5643,9 @@ assign main_icmp_tx_packetizer_source_payload_error = main_icmp_tx_packetizer_si
 always @(*) begin
     builder_liteethicmptx_fsm0_next_state <= 2'd0;
     builder_liteethicmptx_fsm1_next_state <= 1'd0;
-    main_icmp_tx_packetizer_count_fsm0_next_value0 <= 3'd0;
+    main_icmp_tx_packetizer_count_fsm0_next_value0 <= 1'd0;
     main_icmp_tx_packetizer_count_fsm0_next_value_ce0 <= 1'd0;
-    main_icmp_tx_packetizer_delayed_last_be_fsm1_next_value0 <= 1'd0;
+    main_icmp_tx_packetizer_delayed_last_be_fsm1_next_value0 <= 4'd0;
     main_icmp_tx_packetizer_delayed_last_be_fsm1_next_value_ce0 <= 1'd0;
     main_icmp_tx_packetizer_fsm_from_idle_fsm0_next_value1 <= 1'd0;
     main_icmp_tx_packetizer_fsm_from_idle_fsm0_next_value_ce1 <= 1'd0;
@@ -4892,8 +5656,8 @@ always @(*) begin
     main_icmp_tx_packetizer_source_last_a <= 1'd0;
     main_icmp_tx_packetizer_source_last_b <= 1'd0;
     main_icmp_tx_packetizer_source_last_s <= 1'd0;
-    main_icmp_tx_packetizer_source_payload_data <= 8'd0;
-    main_icmp_tx_packetizer_source_payload_last_be <= 1'd0;
+    main_icmp_tx_packetizer_source_payload_data <= 32'd0;
+    main_icmp_tx_packetizer_source_payload_last_be <= 4'd0;
     main_icmp_tx_packetizer_source_valid <= 1'd0;
     main_icmp_tx_packetizer_sr_load <= 1'd0;
     main_icmp_tx_packetizer_sr_shift <= 1'd0;
@@ -4902,10 +5666,10 @@ always @(*) begin
         1'd1: begin
             main_icmp_tx_packetizer_source_valid <= 1'd1;
             main_icmp_tx_packetizer_source_last_a <= 1'd0;
-            main_icmp_tx_packetizer_source_payload_data <= main_icmp_tx_packetizer_sr[63:8];
+            main_icmp_tx_packetizer_source_payload_data <= main_icmp_tx_packetizer_sr[63:32];
             if ((main_icmp_tx_packetizer_source_valid & main_icmp_tx_packetizer_source_ready)) begin
                 main_icmp_tx_packetizer_sr_shift <= 1'd1;
-                if ((main_icmp_tx_packetizer_count == 3'd7)) begin
+                if ((main_icmp_tx_packetizer_count == 1'd1)) begin
                     main_icmp_tx_packetizer_sr_shift <= 1'd0;
                     builder_liteethicmptx_fsm0_next_state <= 2'd2;
                     main_icmp_tx_packetizer_count_fsm0_next_value0 <= (main_icmp_tx_packetizer_count + 1'd1);
@@ -4939,7 +5703,7 @@ always @(*) begin
                 main_icmp_tx_packetizer_sink_ready <= 1'd0;
                 main_icmp_tx_packetizer_source_valid <= 1'd1;
                 main_icmp_tx_packetizer_source_last_a <= 1'd0;
-                main_icmp_tx_packetizer_source_payload_data <= main_icmp_tx_packetizer_header[7:0];
+                main_icmp_tx_packetizer_source_payload_data <= main_icmp_tx_packetizer_header[31:0];
                 if ((main_icmp_tx_packetizer_source_valid & main_icmp_tx_packetizer_source_ready)) begin
                     main_icmp_tx_packetizer_sr_load <= 1'd1;
                     main_icmp_tx_packetizer_fsm_from_idle_fsm0_next_value1 <= 1'd1;
@@ -4966,7 +5730,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((main_icmp_tx_packetizer_in_data_copy & main_icmp_tx_packetizer_sink_last) & (main_icmp_tx_packetizer_sink_last_be > main_icmp_tx_packetizer_new_last_be))) begin
+            if (((main_icmp_tx_packetizer_in_data_copy & main_icmp_tx_packetizer_sink_last) & (main_icmp_tx_packetizer_sink_payload_last_be > main_icmp_tx_packetizer_new_last_be))) begin
                 main_icmp_tx_packetizer_source_last_b <= 1'd0;
                 main_icmp_tx_packetizer_source_last_s <= 1'd1;
                 main_icmp_tx_packetizer_source_payload_last_be <= 1'd0;
@@ -5038,8 +5802,7 @@ assign main_icmp_rx_liteethicmpdepacketizer_source_param_code = {builder_rhs_sli
 assign main_icmp_rx_liteethicmpdepacketizer_source_param_msgtype = {builder_rhs_slice_proxy63[7:0]};
 assign main_icmp_rx_liteethicmpdepacketizer_source_param_quench = {builder_rhs_slice_proxy67[7:0], builder_rhs_slice_proxy66[15:8], builder_rhs_slice_proxy65[23:16], builder_rhs_slice_proxy64[31:24]};
 assign main_icmp_rx_liteethicmpdepacketizer_source_payload_error = main_icmp_rx_liteethicmpdepacketizer_sink_payload_error;
-assign main_icmp_rx_liteethicmpdepacketizer_sink_last_be = main_icmp_rx_liteethicmpdepacketizer_sink_last;
-assign main_icmp_rx_liteethicmpdepacketizer_new_last_be = {main_icmp_rx_liteethicmpdepacketizer_sink_last_be};
+assign main_icmp_rx_liteethicmpdepacketizer_new_last_be = {main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be[3], main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be[2], main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be[1], main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be[0]};
 assign main_icmp_rx_liteethicmpdepacketizer_is_in_copy = (main_icmp_rx_liteethicmpdepacketizer_is_ongoing0 | main_icmp_rx_liteethicmpdepacketizer_is_ongoing1);
 always @(*) begin
     main_icmp_rx_liteethicmpdepacketizer_source_last <= 1'd0;
@@ -5055,9 +5818,9 @@ always @(*) begin
     builder_liteethicmprx_fsm1_next_state <= 1'd0;
     main_icmp_rx_fsm_is_ongoing0 <= 1'd0;
     main_icmp_rx_fsm_is_ongoing1 <= 1'd0;
-    main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= 3'd0;
+    main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= 1'd0;
     main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd0;
-    main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value1 <= 4'd0;
     main_icmp_rx_liteethicmpdepacketizer_delayed_last_be_fsm1_next_value_ce1 <= 1'd0;
     main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value3 <= 1'd0;
     main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle_fsm0_next_value_ce3 <= 1'd0;
@@ -5069,8 +5832,8 @@ always @(*) begin
     main_icmp_rx_liteethicmpdepacketizer_source_last_a <= 1'd0;
     main_icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd0;
     main_icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd0;
-    main_icmp_rx_liteethicmpdepacketizer_source_payload_data <= 8'd0;
-    main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 1'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_payload_data <= 32'd0;
+    main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 4'd0;
     main_icmp_rx_liteethicmpdepacketizer_source_valid <= 1'd0;
     main_icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd0;
     builder_liteethicmprx_fsm0_next_state <= builder_liteethicmprx_fsm0_state;
@@ -5081,7 +5844,7 @@ always @(*) begin
                 main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= (main_icmp_rx_liteethicmpdepacketizer_count + 1'd1);
                 main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
                 main_icmp_rx_liteethicmpdepacketizer_sr_shift <= 1'd1;
-                if ((main_icmp_rx_liteethicmpdepacketizer_count == 3'd7)) begin
+                if ((main_icmp_rx_liteethicmpdepacketizer_count == 1'd1)) begin
                     builder_liteethicmprx_fsm0_next_state <= 2'd2;
                     main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value2 <= (main_icmp_rx_liteethicmpdepacketizer_count + 1'd1);
                     main_icmp_rx_liteethicmpdepacketizer_count_fsm0_next_value_ce2 <= 1'd1;
@@ -5141,7 +5904,7 @@ always @(*) begin
             end
         end
         default: begin
-            if (((main_icmp_rx_liteethicmpdepacketizer_sink_valid & main_icmp_rx_liteethicmpdepacketizer_sink_last) & (main_icmp_rx_liteethicmpdepacketizer_sink_last_be > main_icmp_rx_liteethicmpdepacketizer_new_last_be))) begin
+            if (((main_icmp_rx_liteethicmpdepacketizer_sink_valid & main_icmp_rx_liteethicmpdepacketizer_sink_last) & (main_icmp_rx_liteethicmpdepacketizer_sink_payload_last_be > main_icmp_rx_liteethicmpdepacketizer_new_last_be))) begin
                 main_icmp_rx_liteethicmpdepacketizer_source_last_b <= 1'd0;
                 main_icmp_rx_liteethicmpdepacketizer_source_last_s <= 1'd1;
                 main_icmp_rx_liteethicmpdepacketizer_source_payload_last_be <= 1'd0;
@@ -5208,9 +5971,9 @@ always @(*) begin
     main_icmp_echo_sink_sink_param_length <= 16'd0;
     main_icmp_echo_sink_sink_param_msgtype <= 8'd0;
     main_icmp_echo_sink_sink_param_quench <= 32'd0;
-    main_icmp_echo_sink_sink_payload_data <= 8'd0;
-    main_icmp_echo_sink_sink_payload_error <= 1'd0;
-    main_icmp_echo_sink_sink_payload_last_be <= 1'd0;
+    main_icmp_echo_sink_sink_payload_data <= 32'd0;
+    main_icmp_echo_sink_sink_payload_error <= 4'd0;
+    main_icmp_echo_sink_sink_payload_last_be <= 4'd0;
     main_icmp_echo_sink_sink_valid <= 1'd0;
     if ((main_icmp_echo_sink_param_length <= 8'd128)) begin
         main_icmp_echo_sink_sink_valid <= main_icmp_echo_sink_valid;
@@ -5297,7 +6060,7 @@ assign main_icmp_echo_payload_fifo_re = main_icmp_echo_payload_fifo_source_ready
 assign main_icmp_echo_payload_fifo_syncfifo_re = (main_icmp_echo_payload_fifo_syncfifo_readable & ((~main_icmp_echo_payload_fifo_readable) | main_icmp_echo_payload_fifo_re));
 assign main_icmp_echo_payload_fifo_level1 = (main_icmp_echo_payload_fifo_level0 + main_icmp_echo_payload_fifo_readable);
 always @(*) begin
-    main_icmp_echo_payload_fifo_wrport_adr <= 7'd0;
+    main_icmp_echo_payload_fifo_wrport_adr <= 5'd0;
     if (main_icmp_echo_payload_fifo_replace) begin
         main_icmp_echo_payload_fifo_wrport_adr <= (main_icmp_echo_payload_fifo_produce - 1'd1);
     end else begin
@@ -5310,7 +6073,7 @@ assign main_icmp_echo_payload_fifo_do_read = (main_icmp_echo_payload_fifo_syncfi
 assign main_icmp_echo_payload_fifo_rdport_adr = main_icmp_echo_payload_fifo_consume;
 assign main_icmp_echo_payload_fifo_syncfifo_dout = main_icmp_echo_payload_fifo_rdport_dat_r;
 assign main_icmp_echo_payload_fifo_rdport_re = main_icmp_echo_payload_fifo_do_read;
-assign main_icmp_echo_payload_fifo_syncfifo_writable = (main_icmp_echo_payload_fifo_level0 != 8'd128);
+assign main_icmp_echo_payload_fifo_syncfifo_writable = (main_icmp_echo_payload_fifo_level0 != 6'd32);
 assign main_icmp_echo_payload_fifo_syncfifo_readable = (main_icmp_echo_payload_fifo_level0 != 1'd0);
 assign main_icmp_echo_param_fifo_syncfifo_din = {main_icmp_echo_param_fifo_fifo_in_last, main_icmp_echo_param_fifo_fifo_in_first, main_icmp_echo_param_fifo_fifo_in_param_length, main_icmp_echo_param_fifo_fifo_in_param_ip_address, main_icmp_echo_param_fifo_fifo_in_param_quench, main_icmp_echo_param_fifo_fifo_in_param_msgtype, main_icmp_echo_param_fifo_fifo_in_param_code, main_icmp_echo_param_fifo_fifo_in_param_checksum};
 assign {main_icmp_echo_param_fifo_fifo_out_last, main_icmp_echo_param_fifo_fifo_out_first, main_icmp_echo_param_fifo_fifo_out_param_length, main_icmp_echo_param_fifo_fifo_out_param_ip_address, main_icmp_echo_param_fifo_fifo_out_param_quench, main_icmp_echo_param_fifo_fifo_out_param_msgtype, main_icmp_echo_param_fifo_fifo_out_param_code, main_icmp_echo_param_fifo_fifo_out_param_checksum} = main_icmp_echo_param_fifo_syncfifo_dout;
@@ -5352,724 +6115,1092 @@ assign main_icmp_echo_param_fifo_syncfifo_dout = main_icmp_echo_param_fifo_rdpor
 assign main_icmp_echo_param_fifo_rdport_re = main_icmp_echo_param_fifo_do_read;
 assign main_icmp_echo_param_fifo_syncfifo_writable = (main_icmp_echo_param_fifo_level0 != 2'd2);
 assign main_icmp_echo_param_fifo_syncfifo_readable = (main_icmp_echo_param_fifo_level0 != 1'd0);
-assign main_ip_port_sink_valid = main_source_source_valid;
-assign main_source_source_ready = main_ip_port_sink_ready;
-assign main_ip_port_sink_first = main_source_source_first;
-assign main_ip_port_sink_last = main_source_source_last;
-assign main_ip_port_sink_payload_data = main_source_source_payload_data;
-assign main_ip_port_sink_payload_last_be = main_source_source_payload_last_be;
-assign main_ip_port_sink_payload_error = main_source_source_payload_error;
-assign main_ip_port_sink_param_length = main_source_source_param_length;
-assign main_ip_port_sink_param_protocol = main_source_source_param_protocol;
-assign main_ip_port_sink_param_ip_address = main_source_source_param_ip_address;
-assign main_holdingudprx_sink_valid = main_ip_port_source_valid;
-assign main_ip_port_source_ready = main_holdingudprx_sink_ready;
-assign main_holdingudprx_sink_first = main_ip_port_source_first;
-assign main_holdingudprx_sink_last = main_ip_port_source_last;
-assign main_holdingudprx_sink_payload_data = main_ip_port_source_payload_data;
-assign main_holdingudprx_sink_payload_last_be = main_ip_port_source_payload_last_be;
-assign main_holdingudprx_sink_payload_error = main_ip_port_source_payload_error;
-assign main_holdingudprx_sink_param_length = main_ip_port_source_param_length;
-assign main_holdingudprx_sink_param_protocol = main_ip_port_source_param_protocol;
-assign main_holdingudprx_sink_param_ip_address = main_ip_port_source_param_ip_address;
-assign main_sink_sink_valid = main_crossbar_source_valid;
-assign main_crossbar_source_ready = main_sink_sink_ready;
-assign main_sink_sink_first = main_crossbar_source_first;
-assign main_sink_sink_last = main_crossbar_source_last;
-assign main_sink_sink_payload_data = main_crossbar_source_payload_data;
-assign main_sink_sink_payload_last_be = main_crossbar_source_payload_last_be;
-assign main_sink_sink_payload_error = main_crossbar_source_payload_error;
-assign main_sink_sink_param_src_port = main_crossbar_source_param_src_port;
-assign main_sink_sink_param_dst_port = main_crossbar_source_param_dst_port;
-assign main_sink_sink_param_ip_address = main_crossbar_source_param_ip_address;
-assign main_sink_sink_param_length = main_crossbar_source_param_length;
-assign main_crossbar_sink_valid = main_holdingudprx_source_valid;
-assign main_holdingudprx_source_ready = main_crossbar_sink_ready;
-assign main_crossbar_sink_first = main_holdingudprx_source_first;
-assign main_crossbar_sink_last = main_holdingudprx_source_last;
-assign main_crossbar_sink_payload_data = main_holdingudprx_source_payload_data;
-assign main_crossbar_sink_payload_last_be = main_holdingudprx_source_payload_last_be;
-assign main_crossbar_sink_payload_error = main_holdingudprx_source_payload_error;
-assign main_crossbar_sink_param_src_port = main_holdingudprx_source_param_src_port;
-assign main_crossbar_sink_param_dst_port = main_holdingudprx_source_param_dst_port;
-assign main_crossbar_sink_param_ip_address = main_holdingudprx_source_param_ip_address;
-assign main_crossbar_sink_param_length = main_holdingudprx_source_param_length;
-assign main_packetizer_sink_valid = main_sink_sink_valid;
-assign main_sink_sink_ready = main_packetizer_sink_ready;
-assign main_packetizer_sink_last = main_sink_sink_last;
-assign main_packetizer_sink_payload_data = main_sink_sink_payload_data;
-assign main_packetizer_sink_payload_last_be = main_sink_sink_payload_last_be;
-assign main_packetizer_sink_param_src_port = main_sink_sink_param_src_port;
-assign main_packetizer_sink_param_dst_port = main_sink_sink_param_dst_port;
-assign main_packetizer_sink_param_length = (main_sink_sink_param_length + 4'd8);
-assign main_packetizer_sink_param_checksum = 1'd0;
+assign main_udp_rx_cdc_sink_valid = main_udp_ip_port_source_valid;
+assign main_udp_ip_port_source_ready = main_udp_rx_cdc_sink_ready;
+assign main_udp_rx_cdc_sink_first = main_udp_ip_port_source_first;
+assign main_udp_rx_cdc_sink_last = main_udp_ip_port_source_last;
+assign main_udp_rx_cdc_sink_payload_data = main_udp_ip_port_source_payload_data;
+assign main_udp_rx_cdc_sink_payload_last_be = main_udp_ip_port_source_payload_last_be;
+assign main_udp_rx_cdc_sink_payload_error = main_udp_ip_port_source_payload_error;
+assign main_udp_rx_cdc_sink_param_length = main_udp_ip_port_source_param_length;
+assign main_udp_rx_cdc_sink_param_protocol = main_udp_ip_port_source_param_protocol;
+assign main_udp_rx_cdc_sink_param_ip_address = main_udp_ip_port_source_param_ip_address;
+assign main_udp_strideconverter0_sink_valid = main_udp_rx_cdc_source_valid;
+assign main_udp_rx_cdc_source_ready = main_udp_strideconverter0_sink_ready;
+assign main_udp_strideconverter0_sink_first = main_udp_rx_cdc_source_first;
+assign main_udp_strideconverter0_sink_last = main_udp_rx_cdc_source_last;
+assign main_udp_strideconverter0_sink_payload_data = main_udp_rx_cdc_source_payload_data;
+assign main_udp_strideconverter0_sink_payload_last_be = main_udp_rx_cdc_source_payload_last_be;
+assign main_udp_strideconverter0_sink_payload_error = main_udp_rx_cdc_source_payload_error;
+assign main_udp_strideconverter0_sink_param_length = main_udp_rx_cdc_source_param_length;
+assign main_udp_strideconverter0_sink_param_protocol = main_udp_rx_cdc_source_param_protocol;
+assign main_udp_strideconverter0_sink_param_ip_address = main_udp_rx_cdc_source_param_ip_address;
+assign main_udp_lastbytetrim_sink_valid = main_udp_strideconverter0_source_valid;
+assign main_udp_strideconverter0_source_ready = main_udp_lastbytetrim_sink_ready;
+assign main_udp_lastbytetrim_sink_first = main_udp_strideconverter0_source_first;
+assign main_udp_lastbytetrim_sink_last = main_udp_strideconverter0_source_last;
+assign main_udp_lastbytetrim_sink_payload_data = main_udp_strideconverter0_source_payload_data;
+assign main_udp_lastbytetrim_sink_payload_last_be = main_udp_strideconverter0_source_payload_last_be;
+assign main_udp_lastbytetrim_sink_payload_error = main_udp_strideconverter0_source_payload_error;
+assign main_udp_lastbytetrim_sink_param_length = main_udp_strideconverter0_source_param_length;
+assign main_udp_lastbytetrim_sink_param_protocol = main_udp_strideconverter0_source_param_protocol;
+assign main_udp_lastbytetrim_sink_param_ip_address = main_udp_strideconverter0_source_param_ip_address;
+assign main_udp_buffer0_sink_sink_valid = main_udp_lastbytetrim_source_valid;
+assign main_udp_lastbytetrim_source_ready = main_udp_buffer0_sink_sink_ready;
+assign main_udp_buffer0_sink_sink_first = main_udp_lastbytetrim_source_first;
+assign main_udp_buffer0_sink_sink_last = main_udp_lastbytetrim_source_last;
+assign main_udp_buffer0_sink_sink_payload_data = main_udp_lastbytetrim_source_payload_data;
+assign main_udp_buffer0_sink_sink_payload_last_be = main_udp_lastbytetrim_source_payload_last_be;
+assign main_udp_buffer0_sink_sink_payload_error = main_udp_lastbytetrim_source_payload_error;
+assign main_udp_buffer0_sink_sink_param_length = main_udp_lastbytetrim_source_param_length;
+assign main_udp_buffer0_sink_sink_param_protocol = main_udp_lastbytetrim_source_param_protocol;
+assign main_udp_buffer0_sink_sink_param_ip_address = main_udp_lastbytetrim_source_param_ip_address;
+assign main_udp_holdingudprx_sink_valid = main_udp_buffer0_source_source_valid;
+assign main_udp_buffer0_source_source_ready = main_udp_holdingudprx_sink_ready;
+assign main_udp_holdingudprx_sink_first = main_udp_buffer0_source_source_first;
+assign main_udp_holdingudprx_sink_last = main_udp_buffer0_source_source_last;
+assign main_udp_holdingudprx_sink_payload_data = main_udp_buffer0_source_source_payload_data;
+assign main_udp_holdingudprx_sink_payload_last_be = main_udp_buffer0_source_source_payload_last_be;
+assign main_udp_holdingudprx_sink_payload_error = main_udp_buffer0_source_source_payload_error;
+assign main_udp_holdingudprx_sink_param_length = main_udp_buffer0_source_source_param_length;
+assign main_udp_holdingudprx_sink_param_protocol = main_udp_buffer0_source_source_param_protocol;
+assign main_udp_holdingudprx_sink_param_ip_address = main_udp_buffer0_source_source_param_ip_address;
+assign main_udp_maskedudpcrossbar_sink_valid = main_udp_holdingudprx_source_valid;
+assign main_udp_holdingudprx_source_ready = main_udp_maskedudpcrossbar_sink_ready;
+assign main_udp_maskedudpcrossbar_sink_first = main_udp_holdingudprx_source_first;
+assign main_udp_maskedudpcrossbar_sink_last = main_udp_holdingudprx_source_last;
+assign main_udp_maskedudpcrossbar_sink_payload_data = main_udp_holdingudprx_source_payload_data;
+assign main_udp_maskedudpcrossbar_sink_payload_last_be = main_udp_holdingudprx_source_payload_last_be;
+assign main_udp_maskedudpcrossbar_sink_payload_error = main_udp_holdingudprx_source_payload_error;
+assign main_udp_maskedudpcrossbar_sink_param_src_port = main_udp_holdingudprx_source_param_src_port;
+assign main_udp_maskedudpcrossbar_sink_param_dst_port = main_udp_holdingudprx_source_param_dst_port;
+assign main_udp_maskedudpcrossbar_sink_param_ip_address = main_udp_holdingudprx_source_param_ip_address;
+assign main_udp_maskedudpcrossbar_sink_param_length = main_udp_holdingudprx_source_param_length;
+assign main_udp_liteethudptx_sink_sink_valid = main_udp_maskedudpcrossbar_source_valid;
+assign main_udp_maskedudpcrossbar_source_ready = main_udp_liteethudptx_sink_sink_ready;
+assign main_udp_liteethudptx_sink_sink_first = main_udp_maskedudpcrossbar_source_first;
+assign main_udp_liteethudptx_sink_sink_last = main_udp_maskedudpcrossbar_source_last;
+assign main_udp_liteethudptx_sink_sink_payload_data = main_udp_maskedudpcrossbar_source_payload_data;
+assign main_udp_liteethudptx_sink_sink_payload_last_be = main_udp_maskedudpcrossbar_source_payload_last_be;
+assign main_udp_liteethudptx_sink_sink_payload_error = main_udp_maskedudpcrossbar_source_payload_error;
+assign main_udp_liteethudptx_sink_sink_param_src_port = main_udp_maskedudpcrossbar_source_param_src_port;
+assign main_udp_liteethudptx_sink_sink_param_dst_port = main_udp_maskedudpcrossbar_source_param_dst_port;
+assign main_udp_liteethudptx_sink_sink_param_ip_address = main_udp_maskedudpcrossbar_source_param_ip_address;
+assign main_udp_liteethudptx_sink_sink_param_length = main_udp_maskedudpcrossbar_source_param_length;
+assign main_udp_buffer1_sink_sink_valid = main_udp_liteethudptx_source_source_valid;
+assign main_udp_liteethudptx_source_source_ready = main_udp_buffer1_sink_sink_ready;
+assign main_udp_buffer1_sink_sink_first = main_udp_liteethudptx_source_source_first;
+assign main_udp_buffer1_sink_sink_last = main_udp_liteethudptx_source_source_last;
+assign main_udp_buffer1_sink_sink_payload_data = main_udp_liteethudptx_source_source_payload_data;
+assign main_udp_buffer1_sink_sink_payload_last_be = main_udp_liteethudptx_source_source_payload_last_be;
+assign main_udp_buffer1_sink_sink_payload_error = main_udp_liteethudptx_source_source_payload_error;
+assign main_udp_buffer1_sink_sink_param_length = main_udp_liteethudptx_source_source_param_length;
+assign main_udp_buffer1_sink_sink_param_protocol = main_udp_liteethudptx_source_source_param_protocol;
+assign main_udp_buffer1_sink_sink_param_ip_address = main_udp_liteethudptx_source_source_param_ip_address;
+assign main_udp_strideconverter1_sink_valid = main_udp_buffer1_source_source_valid;
+assign main_udp_buffer1_source_source_ready = main_udp_strideconverter1_sink_ready;
+assign main_udp_strideconverter1_sink_first = main_udp_buffer1_source_source_first;
+assign main_udp_strideconverter1_sink_last = main_udp_buffer1_source_source_last;
+assign main_udp_strideconverter1_sink_payload_data = main_udp_buffer1_source_source_payload_data;
+assign main_udp_strideconverter1_sink_payload_last_be = main_udp_buffer1_source_source_payload_last_be;
+assign main_udp_strideconverter1_sink_payload_error = main_udp_buffer1_source_source_payload_error;
+assign main_udp_strideconverter1_sink_param_length = main_udp_buffer1_source_source_param_length;
+assign main_udp_strideconverter1_sink_param_protocol = main_udp_buffer1_source_source_param_protocol;
+assign main_udp_strideconverter1_sink_param_ip_address = main_udp_buffer1_source_source_param_ip_address;
+assign main_udp_tx_cdc_sink_valid = main_udp_strideconverter1_source_valid;
+assign main_udp_strideconverter1_source_ready = main_udp_tx_cdc_sink_ready;
+assign main_udp_tx_cdc_sink_first = main_udp_strideconverter1_source_first;
+assign main_udp_tx_cdc_sink_last = main_udp_strideconverter1_source_last;
+assign main_udp_tx_cdc_sink_payload_data = main_udp_strideconverter1_source_payload_data;
+assign main_udp_tx_cdc_sink_payload_last_be = main_udp_strideconverter1_source_payload_last_be;
+assign main_udp_tx_cdc_sink_payload_error = main_udp_strideconverter1_source_payload_error;
+assign main_udp_tx_cdc_sink_param_length = main_udp_strideconverter1_source_param_length;
+assign main_udp_tx_cdc_sink_param_protocol = main_udp_strideconverter1_source_param_protocol;
+assign main_udp_tx_cdc_sink_param_ip_address = main_udp_strideconverter1_source_param_ip_address;
+assign main_udp_ip_port_sink_valid = main_udp_tx_cdc_source_valid;
+assign main_udp_tx_cdc_source_ready = main_udp_ip_port_sink_ready;
+assign main_udp_ip_port_sink_first = main_udp_tx_cdc_source_first;
+assign main_udp_ip_port_sink_last = main_udp_tx_cdc_source_last;
+assign main_udp_ip_port_sink_payload_data = main_udp_tx_cdc_source_payload_data;
+assign main_udp_ip_port_sink_payload_last_be = main_udp_tx_cdc_source_payload_last_be;
+assign main_udp_ip_port_sink_payload_error = main_udp_tx_cdc_source_payload_error;
+assign main_udp_ip_port_sink_param_length = main_udp_tx_cdc_source_param_length;
+assign main_udp_ip_port_sink_param_protocol = main_udp_tx_cdc_source_param_protocol;
+assign main_udp_ip_port_sink_param_ip_address = main_udp_tx_cdc_source_param_ip_address;
+assign main_udp_rx_cdc_source_valid = main_udp_rx_cdc_sink_valid;
+assign main_udp_rx_cdc_sink_ready = main_udp_rx_cdc_source_ready;
+assign main_udp_rx_cdc_source_first = main_udp_rx_cdc_sink_first;
+assign main_udp_rx_cdc_source_last = main_udp_rx_cdc_sink_last;
+assign main_udp_rx_cdc_source_payload_data = main_udp_rx_cdc_sink_payload_data;
+assign main_udp_rx_cdc_source_payload_last_be = main_udp_rx_cdc_sink_payload_last_be;
+assign main_udp_rx_cdc_source_payload_error = main_udp_rx_cdc_sink_payload_error;
+assign main_udp_rx_cdc_source_param_length = main_udp_rx_cdc_sink_param_length;
+assign main_udp_rx_cdc_source_param_protocol = main_udp_rx_cdc_sink_param_protocol;
+assign main_udp_rx_cdc_source_param_ip_address = main_udp_rx_cdc_sink_param_ip_address;
+assign main_udp_strideconverter0_converter_sink_valid = main_udp_strideconverter0_sink_valid;
+assign main_udp_strideconverter0_converter_sink_first = main_udp_strideconverter0_sink_first;
+assign main_udp_strideconverter0_converter_sink_last = main_udp_strideconverter0_sink_last;
+assign main_udp_strideconverter0_sink_ready = main_udp_strideconverter0_converter_sink_ready;
 always @(*) begin
-    main_packetizer_header <= 64'd0;
-    main_packetizer_header[63:48] <= {main_packetizer_sink_param_checksum[7:0], main_packetizer_sink_param_checksum[15:8]};
-    main_packetizer_header[31:16] <= {main_packetizer_sink_param_dst_port[7:0], main_packetizer_sink_param_dst_port[15:8]};
-    main_packetizer_header[47:32] <= {main_packetizer_sink_param_length[7:0], main_packetizer_sink_param_length[15:8]};
-    main_packetizer_header[15:0] <= {main_packetizer_sink_param_src_port[7:0], main_packetizer_sink_param_src_port[15:8]};
+    main_udp_strideconverter0_converter_sink_payload_data <= 40'd0;
+    main_udp_strideconverter0_converter_sink_payload_data[7:0] <= main_udp_strideconverter0_sink_payload_data[7:0];
+    main_udp_strideconverter0_converter_sink_payload_data[8] <= main_udp_strideconverter0_sink_payload_last_be[0];
+    main_udp_strideconverter0_converter_sink_payload_data[9] <= main_udp_strideconverter0_sink_payload_error[0];
+    main_udp_strideconverter0_converter_sink_payload_data[17:10] <= main_udp_strideconverter0_sink_payload_data[15:8];
+    main_udp_strideconverter0_converter_sink_payload_data[18] <= main_udp_strideconverter0_sink_payload_last_be[1];
+    main_udp_strideconverter0_converter_sink_payload_data[19] <= main_udp_strideconverter0_sink_payload_error[1];
+    main_udp_strideconverter0_converter_sink_payload_data[27:20] <= main_udp_strideconverter0_sink_payload_data[23:16];
+    main_udp_strideconverter0_converter_sink_payload_data[28] <= main_udp_strideconverter0_sink_payload_last_be[2];
+    main_udp_strideconverter0_converter_sink_payload_data[29] <= main_udp_strideconverter0_sink_payload_error[2];
+    main_udp_strideconverter0_converter_sink_payload_data[37:30] <= main_udp_strideconverter0_sink_payload_data[31:24];
+    main_udp_strideconverter0_converter_sink_payload_data[38] <= main_udp_strideconverter0_sink_payload_last_be[3];
+    main_udp_strideconverter0_converter_sink_payload_data[39] <= main_udp_strideconverter0_sink_payload_error[3];
 end
-assign main_packetizer_sink_last_be = main_packetizer_sink_last;
-assign main_packetizer_new_last_be = {main_packetizer_sink_last_be};
-assign main_packetizer_in_data_copy = (main_packetizer_is_ongoing0 | main_packetizer_is_ongoing1);
+assign main_udp_strideconverter0_source_valid = main_udp_strideconverter0_source_source_valid;
+assign main_udp_strideconverter0_source_first = main_udp_strideconverter0_source_source_first;
+assign main_udp_strideconverter0_source_last = main_udp_strideconverter0_source_source_last;
+assign main_udp_strideconverter0_source_source_ready = main_udp_strideconverter0_source_ready;
+assign {main_udp_strideconverter0_source_payload_error, main_udp_strideconverter0_source_payload_last_be, main_udp_strideconverter0_source_payload_data} = main_udp_strideconverter0_source_source_payload_data;
+assign main_udp_strideconverter0_source_param_length = main_udp_strideconverter0_sink_param_length;
+assign main_udp_strideconverter0_source_param_protocol = main_udp_strideconverter0_sink_param_protocol;
+assign main_udp_strideconverter0_source_param_ip_address = main_udp_strideconverter0_sink_param_ip_address;
+assign main_udp_strideconverter0_source_source_valid = main_udp_strideconverter0_converter_source_valid;
+assign main_udp_strideconverter0_converter_source_ready = main_udp_strideconverter0_source_source_ready;
+assign main_udp_strideconverter0_source_source_first = main_udp_strideconverter0_converter_source_first;
+assign main_udp_strideconverter0_source_source_last = main_udp_strideconverter0_converter_source_last;
+assign main_udp_strideconverter0_source_source_payload_data = main_udp_strideconverter0_converter_source_payload_data;
+assign main_udp_strideconverter0_converter_first = (main_udp_strideconverter0_converter_mux == 1'd0);
+assign main_udp_strideconverter0_converter_last = (main_udp_strideconverter0_converter_mux == 2'd3);
+assign main_udp_strideconverter0_converter_source_valid = main_udp_strideconverter0_converter_sink_valid;
+assign main_udp_strideconverter0_converter_source_first = (main_udp_strideconverter0_converter_sink_first & main_udp_strideconverter0_converter_first);
+assign main_udp_strideconverter0_converter_source_last = (main_udp_strideconverter0_converter_sink_last & main_udp_strideconverter0_converter_last);
+assign main_udp_strideconverter0_converter_sink_ready = (main_udp_strideconverter0_converter_last & main_udp_strideconverter0_converter_source_ready);
 always @(*) begin
-    main_packetizer_source_last <= 1'd0;
-    if (main_packetizer_source_last_s) begin
-        main_packetizer_source_last <= main_packetizer_source_last_b;
-    end else begin
-        main_packetizer_source_last <= main_packetizer_source_last_a;
-    end
-end
-assign main_packetizer_source_payload_error = main_packetizer_sink_payload_error;
-always @(*) begin
-    builder_liteethudp_liteethudptx_fsm0_next_state <= 2'd0;
-    builder_liteethudp_liteethudptx_fsm1_next_state <= 1'd0;
-    main_packetizer_count_liteethudp_fsm0_next_value0 <= 3'd0;
-    main_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd0;
-    main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= 1'd0;
-    main_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd0;
-    main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd0;
-    main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd0;
-    main_packetizer_is_ongoing0 <= 1'd0;
-    main_packetizer_is_ongoing1 <= 1'd0;
-    main_packetizer_is_ongoing2 <= 1'd0;
-    main_packetizer_sink_ready <= 1'd0;
-    main_packetizer_source_last_a <= 1'd0;
-    main_packetizer_source_last_b <= 1'd0;
-    main_packetizer_source_last_s <= 1'd0;
-    main_packetizer_source_payload_data <= 8'd0;
-    main_packetizer_source_payload_last_be <= 1'd0;
-    main_packetizer_source_valid <= 1'd0;
-    main_packetizer_sr_load <= 1'd0;
-    main_packetizer_sr_shift <= 1'd0;
-    builder_liteethudp_liteethudptx_fsm0_next_state <= builder_liteethudp_liteethudptx_fsm0_state;
-    case (builder_liteethudp_liteethudptx_fsm0_state)
+    main_udp_strideconverter0_converter_source_payload_data <= 10'd0;
+    case (main_udp_strideconverter0_converter_mux)
+        1'd0: begin
+            main_udp_strideconverter0_converter_source_payload_data <= main_udp_strideconverter0_converter_sink_payload_data[9:0];
+        end
         1'd1: begin
-            main_packetizer_source_valid <= 1'd1;
-            main_packetizer_source_last_a <= 1'd0;
-            main_packetizer_source_payload_data <= main_packetizer_sr[63:8];
-            if ((main_packetizer_source_valid & main_packetizer_source_ready)) begin
-                main_packetizer_sr_shift <= 1'd1;
-                if ((main_packetizer_count == 3'd7)) begin
-                    main_packetizer_sr_shift <= 1'd0;
-                    builder_liteethudp_liteethudptx_fsm0_next_state <= 2'd2;
-                    main_packetizer_count_liteethudp_fsm0_next_value0 <= (main_packetizer_count + 1'd1);
-                    main_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
-                end else begin
-                    main_packetizer_count_liteethudp_fsm0_next_value0 <= (main_packetizer_count + 1'd1);
-                    main_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
-                end
-            end
+            main_udp_strideconverter0_converter_source_payload_data <= main_udp_strideconverter0_converter_sink_payload_data[19:10];
         end
         2'd2: begin
-            main_packetizer_source_valid <= main_packetizer_sink_valid;
-            main_packetizer_source_last_a <= main_packetizer_sink_last;
-            main_packetizer_source_payload_data <= main_packetizer_sink_payload_data;
-            if ((main_packetizer_source_valid & main_packetizer_source_ready)) begin
-                main_packetizer_sink_ready <= 1'd1;
-                if (main_packetizer_source_last) begin
-                    builder_liteethudp_liteethudptx_fsm0_next_state <= 1'd0;
-                end
-            end
-            main_packetizer_is_ongoing0 <= 1'd1;
-        end
-        2'd3: begin
-            main_packetizer_is_ongoing1 <= 1'd1;
+            main_udp_strideconverter0_converter_source_payload_data <= main_udp_strideconverter0_converter_sink_payload_data[29:20];
         end
         default: begin
-            main_packetizer_sink_ready <= 1'd1;
-            main_packetizer_count_liteethudp_fsm0_next_value0 <= 1'd1;
-            main_packetizer_count_liteethudp_fsm0_next_value_ce0 <= 1'd1;
-            if (main_packetizer_sink_valid) begin
-                main_packetizer_sink_ready <= 1'd0;
-                main_packetizer_source_valid <= 1'd1;
-                main_packetizer_source_last_a <= 1'd0;
-                main_packetizer_source_payload_data <= main_packetizer_header[7:0];
-                if ((main_packetizer_source_valid & main_packetizer_source_ready)) begin
-                    main_packetizer_sr_load <= 1'd1;
-                    main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1 <= 1'd1;
-                    main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1 <= 1'd1;
-                    if (1'd0) begin
-                        builder_liteethudp_liteethudptx_fsm0_next_state <= 2'd2;
-                    end else begin
-                        builder_liteethudp_liteethudptx_fsm0_next_state <= 1'd1;
+            main_udp_strideconverter0_converter_source_payload_data <= main_udp_strideconverter0_converter_sink_payload_data[39:30];
+        end
+    endcase
+end
+assign main_udp_strideconverter0_converter_source_payload_valid_token_count = main_udp_strideconverter0_converter_last;
+assign main_udp_lastbytetrim_end = (main_udp_lastbytetrim_sink_payload_last_be | main_udp_lastbytetrim_sink_last);
+always @(*) begin
+    builder_portudp_lastbytetrim_next_state <= 1'd0;
+    main_udp_lastbytetrim_err_lastbytetrim_next_value <= 1'd0;
+    main_udp_lastbytetrim_err_lastbytetrim_next_value_ce <= 1'd0;
+    main_udp_lastbytetrim_sink_ready <= 1'd0;
+    main_udp_lastbytetrim_source_first <= 1'd0;
+    main_udp_lastbytetrim_source_last <= 1'd0;
+    main_udp_lastbytetrim_source_param_ip_address <= 32'd0;
+    main_udp_lastbytetrim_source_param_length <= 16'd0;
+    main_udp_lastbytetrim_source_param_protocol <= 8'd0;
+    main_udp_lastbytetrim_source_payload_data <= 8'd0;
+    main_udp_lastbytetrim_source_payload_error <= 1'd0;
+    main_udp_lastbytetrim_source_payload_last_be <= 1'd0;
+    main_udp_lastbytetrim_source_valid <= 1'd0;
+    builder_portudp_lastbytetrim_next_state <= builder_portudp_lastbytetrim_state;
+    case (builder_portudp_lastbytetrim_state)
+        1'd1: begin
+            main_udp_lastbytetrim_sink_ready <= 1'd1;
+            if ((main_udp_lastbytetrim_sink_valid & main_udp_lastbytetrim_sink_last)) begin
+                builder_portudp_lastbytetrim_next_state <= 1'd0;
+            end
+        end
+        default: begin
+            main_udp_lastbytetrim_source_valid <= main_udp_lastbytetrim_sink_valid;
+            main_udp_lastbytetrim_sink_ready <= main_udp_lastbytetrim_source_ready;
+            main_udp_lastbytetrim_source_first <= main_udp_lastbytetrim_sink_first;
+            main_udp_lastbytetrim_source_payload_data <= main_udp_lastbytetrim_sink_payload_data;
+            main_udp_lastbytetrim_source_payload_last_be <= main_udp_lastbytetrim_sink_payload_last_be;
+            main_udp_lastbytetrim_source_param_length <= main_udp_lastbytetrim_sink_param_length;
+            main_udp_lastbytetrim_source_param_protocol <= main_udp_lastbytetrim_sink_param_protocol;
+            main_udp_lastbytetrim_source_param_ip_address <= main_udp_lastbytetrim_sink_param_ip_address;
+            main_udp_lastbytetrim_source_last <= main_udp_lastbytetrim_end;
+            main_udp_lastbytetrim_source_payload_error <= (main_udp_lastbytetrim_end & (main_udp_lastbytetrim_err | main_udp_lastbytetrim_sink_payload_error));
+            if ((main_udp_lastbytetrim_sink_valid & main_udp_lastbytetrim_source_ready)) begin
+                main_udp_lastbytetrim_err_lastbytetrim_next_value <= (main_udp_lastbytetrim_err | main_udp_lastbytetrim_sink_payload_error);
+                main_udp_lastbytetrim_err_lastbytetrim_next_value_ce <= 1'd1;
+                if (main_udp_lastbytetrim_end) begin
+                    main_udp_lastbytetrim_err_lastbytetrim_next_value <= 1'd0;
+                    main_udp_lastbytetrim_err_lastbytetrim_next_value_ce <= 1'd1;
+                    if ((~main_udp_lastbytetrim_sink_last)) begin
+                        builder_portudp_lastbytetrim_next_state <= 1'd1;
                     end
                 end
             end
-            main_packetizer_is_ongoing2 <= 1'd1;
-        end
-    endcase
-    builder_liteethudp_liteethudptx_fsm1_next_state <= builder_liteethudp_liteethudptx_fsm1_state;
-    case (builder_liteethudp_liteethudptx_fsm1_state)
-        1'd1: begin
-            main_packetizer_source_last_b <= 1'd1;
-            main_packetizer_source_last_s <= 1'd1;
-            main_packetizer_source_payload_last_be <= main_packetizer_delayed_last_be;
-            main_packetizer_sink_ready <= 1'd0;
-            if (main_packetizer_source_ready) begin
-                builder_liteethudp_liteethudptx_fsm1_next_state <= 1'd0;
-            end
-        end
-        default: begin
-            if (((main_packetizer_in_data_copy & main_packetizer_sink_last) & (main_packetizer_sink_last_be > main_packetizer_new_last_be))) begin
-                main_packetizer_source_last_b <= 1'd0;
-                main_packetizer_source_last_s <= 1'd1;
-                main_packetizer_source_payload_last_be <= 1'd0;
-                if ((main_packetizer_source_ready & main_packetizer_source_valid)) begin
-                    main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0 <= main_packetizer_new_last_be;
-                    main_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0 <= 1'd1;
-                    builder_liteethudp_liteethudptx_fsm1_next_state <= 1'd1;
-                end
-            end else begin
-                if (main_packetizer_in_data_copy) begin
-                    main_packetizer_source_last_b <= main_packetizer_sink_last;
-                    main_packetizer_source_last_s <= 1'd1;
-                    main_packetizer_source_payload_last_be <= main_packetizer_new_last_be;
-                end
-            end
-            if (main_packetizer_in_data_copy) begin
-                main_packetizer_sink_ready <= main_packetizer_source_ready;
-            end else begin
-                if (main_packetizer_is_ongoing2) begin
-                    main_packetizer_sink_ready <= (~main_packetizer_sink_valid);
-                end
-            end
         end
     endcase
 end
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_valid = main_udp_holdingudprx_sink_valid;
+assign main_udp_holdingudprx_sink_ready = main_udp_holdingudprx_liteethudpdepacketizer_sink_ready;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_first = main_udp_holdingudprx_sink_first;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_last = main_udp_holdingudprx_sink_last;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_data = main_udp_holdingudprx_sink_payload_data;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_last_be = main_udp_holdingudprx_sink_payload_last_be;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_error = main_udp_holdingudprx_sink_payload_error;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_param_length = main_udp_holdingudprx_sink_param_length;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_param_protocol = main_udp_holdingudprx_sink_param_protocol;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_param_ip_address = main_udp_holdingudprx_sink_param_ip_address;
+assign main_udp_holdingudprx_payload_len = (main_udp_holdingudprx_liteethudpdepacketizer_source_param_length - 4'd8);
+assign main_udp_holdingudprx_cut1 = (main_udp_holdingudprx_rest != 1'd0);
+assign main_udp_holdingudprx_liteethudpdepacketizer_header = main_udp_holdingudprx_liteethudpdepacketizer_sr;
+assign main_udp_holdingudprx_liteethudpdepacketizer_source_param_checksum = {builder_rhs_slice_proxy69[7:0], builder_rhs_slice_proxy68[15:8]};
+assign main_udp_holdingudprx_liteethudpdepacketizer_source_param_dst_port = {builder_rhs_slice_proxy71[7:0], builder_rhs_slice_proxy70[15:8]};
+assign main_udp_holdingudprx_liteethudpdepacketizer_source_param_length = {builder_rhs_slice_proxy73[7:0], builder_rhs_slice_proxy72[15:8]};
+assign main_udp_holdingudprx_liteethudpdepacketizer_source_param_src_port = {builder_rhs_slice_proxy75[7:0], builder_rhs_slice_proxy74[15:8]};
+assign main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error = main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_error;
+assign main_udp_holdingudprx_liteethudpdepacketizer_sink_last_be = main_udp_holdingudprx_liteethudpdepacketizer_sink_last;
+assign main_udp_holdingudprx_liteethudpdepacketizer_new_last_be = {main_udp_holdingudprx_liteethudpdepacketizer_sink_last_be};
+assign main_udp_holdingudprx_liteethudpdepacketizer_is_in_copy = (main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing0 | main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing1);
 always @(*) begin
-    builder_liteethudp_liteethudptx_next_state <= 1'd0;
-    main_packetizer_source_ready <= 1'd0;
-    main_source_source_first <= 1'd0;
-    main_source_source_last <= 1'd0;
-    main_source_source_param_ip_address <= 32'd0;
-    main_source_source_param_length <= 16'd0;
-    main_source_source_param_protocol <= 8'd0;
-    main_source_source_payload_data <= 8'd0;
-    main_source_source_payload_error <= 1'd0;
-    main_source_source_payload_last_be <= 1'd0;
-    main_source_source_valid <= 1'd0;
-    builder_liteethudp_liteethudptx_next_state <= builder_liteethudp_liteethudptx_state;
-    case (builder_liteethudp_liteethudptx_state)
-        1'd1: begin
-            main_source_source_valid <= main_packetizer_source_valid;
-            main_packetizer_source_ready <= main_source_source_ready;
-            main_source_source_first <= main_packetizer_source_first;
-            main_source_source_last <= main_packetizer_source_last;
-            main_source_source_payload_data <= main_packetizer_source_payload_data;
-            main_source_source_payload_last_be <= main_packetizer_source_payload_last_be;
-            main_source_source_payload_error <= main_packetizer_source_payload_error;
-            main_source_source_param_length <= main_packetizer_source_param_length;
-            main_source_source_param_protocol <= main_packetizer_source_param_protocol;
-            main_source_source_param_ip_address <= main_packetizer_source_param_ip_address;
-            main_source_source_param_length <= main_packetizer_sink_param_length;
-            main_source_source_param_protocol <= 5'd17;
-            main_source_source_param_ip_address <= main_sink_sink_param_ip_address;
-            if ((main_source_source_valid & main_source_source_ready)) begin
-                if (main_source_source_last) begin
-                    builder_liteethudp_liteethudptx_next_state <= 1'd0;
-                end
-            end
-        end
-        default: begin
-            if (main_packetizer_source_valid) begin
-                builder_liteethudp_liteethudptx_next_state <= 1'd1;
-            end
-        end
-    endcase
-end
-assign main_holdingudprx_liteethudpdepacketizer_sink_valid = main_holdingudprx_sink_valid;
-assign main_holdingudprx_sink_ready = main_holdingudprx_liteethudpdepacketizer_sink_ready;
-assign main_holdingudprx_liteethudpdepacketizer_sink_first = main_holdingudprx_sink_first;
-assign main_holdingudprx_liteethudpdepacketizer_sink_last = main_holdingudprx_sink_last;
-assign main_holdingudprx_liteethudpdepacketizer_sink_payload_data = main_holdingudprx_sink_payload_data;
-assign main_holdingudprx_liteethudpdepacketizer_sink_payload_last_be = main_holdingudprx_sink_payload_last_be;
-assign main_holdingudprx_liteethudpdepacketizer_sink_payload_error = main_holdingudprx_sink_payload_error;
-assign main_holdingudprx_liteethudpdepacketizer_sink_param_length = main_holdingudprx_sink_param_length;
-assign main_holdingudprx_liteethudpdepacketizer_sink_param_protocol = main_holdingudprx_sink_param_protocol;
-assign main_holdingudprx_liteethudpdepacketizer_sink_param_ip_address = main_holdingudprx_sink_param_ip_address;
-assign main_holdingudprx_payload_len = (main_holdingudprx_liteethudpdepacketizer_source_param_length - 4'd8);
-assign main_holdingudprx_cut1 = (main_holdingudprx_rest != 1'd0);
-assign main_holdingudprx_liteethudpdepacketizer_header = main_holdingudprx_liteethudpdepacketizer_sr;
-assign main_holdingudprx_liteethudpdepacketizer_source_param_checksum = {builder_rhs_slice_proxy69[7:0], builder_rhs_slice_proxy68[15:8]};
-assign main_holdingudprx_liteethudpdepacketizer_source_param_dst_port = {builder_rhs_slice_proxy71[7:0], builder_rhs_slice_proxy70[15:8]};
-assign main_holdingudprx_liteethudpdepacketizer_source_param_length = {builder_rhs_slice_proxy73[7:0], builder_rhs_slice_proxy72[15:8]};
-assign main_holdingudprx_liteethudpdepacketizer_source_param_src_port = {builder_rhs_slice_proxy75[7:0], builder_rhs_slice_proxy74[15:8]};
-assign main_holdingudprx_liteethudpdepacketizer_source_payload_error = main_holdingudprx_liteethudpdepacketizer_sink_payload_error;
-assign main_holdingudprx_liteethudpdepacketizer_sink_last_be = main_holdingudprx_liteethudpdepacketizer_sink_last;
-assign main_holdingudprx_liteethudpdepacketizer_new_last_be = {main_holdingudprx_liteethudpdepacketizer_sink_last_be};
-assign main_holdingudprx_liteethudpdepacketizer_is_in_copy = (main_holdingudprx_liteethudpdepacketizer_is_ongoing0 | main_holdingudprx_liteethudpdepacketizer_is_ongoing1);
-always @(*) begin
-    main_holdingudprx_liteethudpdepacketizer_source_last <= 1'd0;
-    if (main_holdingudprx_liteethudpdepacketizer_source_last_s) begin
-        main_holdingudprx_liteethudpdepacketizer_source_last <= main_holdingudprx_liteethudpdepacketizer_source_last_b;
+    main_udp_holdingudprx_liteethudpdepacketizer_source_last <= 1'd0;
+    if (main_udp_holdingudprx_liteethudpdepacketizer_source_last_s) begin
+        main_udp_holdingudprx_liteethudpdepacketizer_source_last <= main_udp_holdingudprx_liteethudpdepacketizer_source_last_b;
     end else begin
-        main_holdingudprx_liteethudpdepacketizer_source_last <= main_holdingudprx_liteethudpdepacketizer_source_last_a;
+        main_udp_holdingudprx_liteethudpdepacketizer_source_last <= main_udp_holdingudprx_liteethudpdepacketizer_source_last_a;
     end
 end
-assign main_holdingudprx_cut0 = ((main_holdingudprx_liteethudpdepacketizer_sink_valid & main_holdingudprx_liteethudpdepacketizer_sink_last) & (main_holdingudprx_fsm_is_ongoing0 | main_holdingudprx_fsm_is_ongoing1));
+assign main_udp_holdingudprx_cut0 = ((main_udp_holdingudprx_liteethudpdepacketizer_sink_valid & main_udp_holdingudprx_liteethudpdepacketizer_sink_last) & (main_udp_holdingudprx_fsm_is_ongoing0 | main_udp_holdingudprx_fsm_is_ongoing1));
 always @(*) begin
-    builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd0;
-    builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
-    main_holdingudprx_fsm_is_ongoing0 <= 1'd0;
-    main_holdingudprx_fsm_is_ongoing1 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= 3'd0;
-    main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_is_ongoing3 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_source_last_a <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_source_payload_data <= 8'd0;
-    main_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_source_valid <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd0;
-    builder_liteethudp_holdingudprx_fsm0_next_state <= builder_liteethudp_holdingudprx_fsm0_state;
-    case (builder_liteethudp_holdingudprx_fsm0_state)
+    builder_portudp_holdingudprx_fsm0_next_state <= 2'd0;
+    builder_portudp_holdingudprx_fsm1_next_state <= 1'd0;
+    main_udp_holdingudprx_fsm_is_ongoing0 <= 1'd0;
+    main_udp_holdingudprx_fsm_is_ongoing1 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 <= 3'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value_ce <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value1 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value_ce1 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing3 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_source_last_a <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_source_payload_data <= 8'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_source_valid <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd0;
+    builder_portudp_holdingudprx_fsm0_next_state <= builder_portudp_holdingudprx_fsm0_state;
+    case (builder_portudp_holdingudprx_fsm0_state)
         1'd1: begin
-            main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
-            if (main_holdingudprx_liteethudpdepacketizer_sink_valid) begin
-                main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= (main_holdingudprx_liteethudpdepacketizer_count + 1'd1);
-                main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-                main_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
-                if ((main_holdingudprx_liteethudpdepacketizer_count == 3'd7)) begin
-                    builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
-                    main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= (main_holdingudprx_liteethudpdepacketizer_count + 1'd1);
-                    main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
+            if (main_udp_holdingudprx_liteethudpdepacketizer_sink_valid) begin
+                main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 <= (main_udp_holdingudprx_liteethudpdepacketizer_count + 1'd1);
+                main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 <= 1'd1;
+                main_udp_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
+                if ((main_udp_holdingudprx_liteethudpdepacketizer_count == 3'd7)) begin
+                    builder_portudp_holdingudprx_fsm0_next_state <= 2'd2;
+                    main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 <= (main_udp_holdingudprx_liteethudpdepacketizer_count + 1'd1);
+                    main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 <= 1'd1;
                 end
             end
-            main_holdingudprx_fsm_is_ongoing1 <= 1'd1;
-            if ((main_holdingudprx_liteethudpdepacketizer_sink_valid & main_holdingudprx_liteethudpdepacketizer_sink_last)) begin
-                builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
+            main_udp_holdingudprx_fsm_is_ongoing1 <= 1'd1;
+            if ((main_udp_holdingudprx_liteethudpdepacketizer_sink_valid & main_udp_holdingudprx_liteethudpdepacketizer_sink_last)) begin
+                builder_portudp_holdingudprx_fsm0_next_state <= 1'd0;
             end
         end
         2'd2: begin
-            main_holdingudprx_liteethudpdepacketizer_source_valid <= (main_holdingudprx_liteethudpdepacketizer_sink_valid | main_holdingudprx_liteethudpdepacketizer_sink_d_last);
-            main_holdingudprx_liteethudpdepacketizer_source_last_a <= (main_holdingudprx_liteethudpdepacketizer_sink_last | main_holdingudprx_liteethudpdepacketizer_sink_d_last);
-            main_holdingudprx_liteethudpdepacketizer_sink_ready <= main_holdingudprx_liteethudpdepacketizer_source_ready;
-            main_holdingudprx_liteethudpdepacketizer_source_payload_data <= main_holdingudprx_liteethudpdepacketizer_sink_payload_data;
-            if ((main_holdingudprx_liteethudpdepacketizer_source_valid & main_holdingudprx_liteethudpdepacketizer_source_ready)) begin
-                if (main_holdingudprx_liteethudpdepacketizer_source_last) begin
-                    builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
+            main_udp_holdingudprx_liteethudpdepacketizer_source_valid <= (main_udp_holdingudprx_liteethudpdepacketizer_sink_valid | main_udp_holdingudprx_liteethudpdepacketizer_sink_d_last);
+            main_udp_holdingudprx_liteethudpdepacketizer_source_last_a <= (main_udp_holdingudprx_liteethudpdepacketizer_sink_last | main_udp_holdingudprx_liteethudpdepacketizer_sink_d_last);
+            main_udp_holdingudprx_liteethudpdepacketizer_sink_ready <= main_udp_holdingudprx_liteethudpdepacketizer_source_ready;
+            main_udp_holdingudprx_liteethudpdepacketizer_source_payload_data <= main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_data;
+            if ((main_udp_holdingudprx_liteethudpdepacketizer_source_valid & main_udp_holdingudprx_liteethudpdepacketizer_source_ready)) begin
+                if (main_udp_holdingudprx_liteethudpdepacketizer_source_last) begin
+                    builder_portudp_holdingudprx_fsm0_next_state <= 1'd0;
                 end
             end
-            main_holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd1;
-            main_holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing0 <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing2 <= 1'd1;
         end
         2'd3: begin
-            main_holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd1;
-            main_holdingudprx_liteethudpdepacketizer_is_ongoing3 <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing1 <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing3 <= 1'd1;
         end
         default: begin
-            main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
-            main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2 <= 1'd1;
-            main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2 <= 1'd1;
-            if (main_holdingudprx_liteethudpdepacketizer_sink_valid) begin
-                main_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
-                main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3 <= 1'd1;
-                main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3 <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 <= 1'd1;
+            if (main_udp_holdingudprx_liteethudpdepacketizer_sink_valid) begin
+                main_udp_holdingudprx_liteethudpdepacketizer_sr_shift <= 1'd1;
+                main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value1 <= 1'd1;
+                main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value_ce1 <= 1'd1;
                 if (1'd0) begin
-                    builder_liteethudp_holdingudprx_fsm0_next_state <= 2'd2;
+                    builder_portudp_holdingudprx_fsm0_next_state <= 2'd2;
                 end else begin
-                    builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd1;
+                    builder_portudp_holdingudprx_fsm0_next_state <= 1'd1;
                 end
             end
-            main_holdingudprx_fsm_is_ongoing0 <= 1'd1;
-            if ((main_holdingudprx_liteethudpdepacketizer_sink_valid & main_holdingudprx_liteethudpdepacketizer_sink_last)) begin
-                builder_liteethudp_holdingudprx_fsm0_next_state <= 1'd0;
+            main_udp_holdingudprx_fsm_is_ongoing0 <= 1'd1;
+            if ((main_udp_holdingudprx_liteethudpdepacketizer_sink_valid & main_udp_holdingudprx_liteethudpdepacketizer_sink_last)) begin
+                builder_portudp_holdingudprx_fsm0_next_state <= 1'd0;
             end
         end
     endcase
-    builder_liteethudp_holdingudprx_fsm1_next_state <= builder_liteethudp_holdingudprx_fsm1_state;
-    case (builder_liteethudp_holdingudprx_fsm1_state)
+    builder_portudp_holdingudprx_fsm1_next_state <= builder_portudp_holdingudprx_fsm1_state;
+    case (builder_portudp_holdingudprx_fsm1_state)
         1'd1: begin
-            main_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
-            main_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
-            main_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= main_holdingudprx_liteethudpdepacketizer_delayed_last_be;
-            main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
-            if ((main_holdingudprx_liteethudpdepacketizer_source_ready & main_holdingudprx_liteethudpdepacketizer_source_valid)) begin
-                builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd0;
+            main_udp_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be;
+            main_udp_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd0;
+            if ((main_udp_holdingudprx_liteethudpdepacketizer_source_ready & main_udp_holdingudprx_liteethudpdepacketizer_source_valid)) begin
+                builder_portudp_holdingudprx_fsm1_next_state <= 1'd0;
             end
         end
         default: begin
-            if (((main_holdingudprx_liteethudpdepacketizer_sink_valid & main_holdingudprx_liteethudpdepacketizer_sink_last) & (main_holdingudprx_liteethudpdepacketizer_sink_last_be > main_holdingudprx_liteethudpdepacketizer_new_last_be))) begin
-                main_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd0;
-                main_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
-                main_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
-                if (((main_holdingudprx_liteethudpdepacketizer_source_ready & main_holdingudprx_liteethudpdepacketizer_source_valid) | ((~main_holdingudprx_liteethudpdepacketizer_was_in_copy) & main_holdingudprx_liteethudpdepacketizer_is_in_copy))) begin
-                    main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1 <= main_holdingudprx_liteethudpdepacketizer_new_last_be;
-                    main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1 <= 1'd1;
-                    builder_liteethudp_holdingudprx_fsm1_next_state <= 1'd1;
+            if (((main_udp_holdingudprx_liteethudpdepacketizer_sink_valid & main_udp_holdingudprx_liteethudpdepacketizer_sink_last) & (main_udp_holdingudprx_liteethudpdepacketizer_sink_last_be > main_udp_holdingudprx_liteethudpdepacketizer_new_last_be))) begin
+                main_udp_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd0;
+                main_udp_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+                main_udp_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= 1'd0;
+                if (((main_udp_holdingudprx_liteethudpdepacketizer_source_ready & main_udp_holdingudprx_liteethudpdepacketizer_source_valid) | ((~main_udp_holdingudprx_liteethudpdepacketizer_was_in_copy) & main_udp_holdingudprx_liteethudpdepacketizer_is_in_copy))) begin
+                    main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value <= main_udp_holdingudprx_liteethudpdepacketizer_new_last_be;
+                    main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value_ce <= 1'd1;
+                    builder_portudp_holdingudprx_fsm1_next_state <= 1'd1;
                 end
             end else begin
-                if (main_holdingudprx_liteethudpdepacketizer_sink_last) begin
-                    main_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
-                    main_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
-                    main_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= main_holdingudprx_liteethudpdepacketizer_new_last_be;
+                if (main_udp_holdingudprx_liteethudpdepacketizer_sink_last) begin
+                    main_udp_holdingudprx_liteethudpdepacketizer_source_last_b <= 1'd1;
+                    main_udp_holdingudprx_liteethudpdepacketizer_source_last_s <= 1'd1;
+                    main_udp_holdingudprx_liteethudpdepacketizer_source_payload_last_be <= main_udp_holdingudprx_liteethudpdepacketizer_new_last_be;
                 end
             end
-            if ((main_holdingudprx_liteethudpdepacketizer_is_ongoing2 | (main_holdingudprx_liteethudpdepacketizer_is_ongoing3 & (~main_holdingudprx_liteethudpdepacketizer_fsm_from_idle)))) begin
-                main_holdingudprx_liteethudpdepacketizer_sink_ready <= main_holdingudprx_liteethudpdepacketizer_source_ready;
+            if ((main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing2 | (main_udp_holdingudprx_liteethudpdepacketizer_is_ongoing3 & (~main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle)))) begin
+                main_udp_holdingudprx_liteethudpdepacketizer_sink_ready <= main_udp_holdingudprx_liteethudpdepacketizer_source_ready;
             end else begin
-                main_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
+                main_udp_holdingudprx_liteethudpdepacketizer_sink_ready <= 1'd1;
             end
         end
     endcase
 end
 always @(*) begin
-    builder_liteethudp_holdingudprx_next_state <= 3'd0;
-    main_holdingudprx0_liteethudp_next_value4 <= 16'd0;
-    main_holdingudprx0_liteethudp_next_value_ce4 <= 1'd0;
-    main_holdingudprx1_liteethudp_next_value5 <= 16'd0;
-    main_holdingudprx1_liteethudp_next_value_ce5 <= 1'd0;
-    main_holdingudprx2_liteethudp_next_value6 <= 16'd0;
-    main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd0;
-    main_holdingudprx3_liteethudp_next_value7 <= 32'd0;
-    main_holdingudprx3_liteethudp_next_value_ce7 <= 1'd0;
-    main_holdingudprx_count_liteethudp_next_value0 <= 16'd0;
-    main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd0;
-    main_holdingudprx_drop_header <= 1'd0;
-    main_holdingudprx_err_liteethudp_next_value1 <= 1'd0;
-    main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd0;
-    main_holdingudprx_held_liteethudp_next_value3 <= 8'd0;
-    main_holdingudprx_held_liteethudp_next_value_ce3 <= 1'd0;
-    main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
-    main_holdingudprx_rest_liteethudp_next_value2 <= 16'd0;
-    main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd0;
-    main_holdingudprx_source_last <= 1'd0;
-    main_holdingudprx_source_param_dst_port <= 16'd0;
-    main_holdingudprx_source_param_ip_address <= 32'd0;
-    main_holdingudprx_source_param_length <= 16'd0;
-    main_holdingudprx_source_param_src_port <= 16'd0;
-    main_holdingudprx_source_payload_data <= 8'd0;
-    main_holdingudprx_source_payload_error <= 1'd0;
-    main_holdingudprx_source_valid <= 1'd0;
-    builder_liteethudp_holdingudprx_next_state <= builder_liteethudp_holdingudprx_state;
-    case (builder_liteethudp_holdingudprx_state)
+    builder_portudp_holdingudprx_next_state <= 3'd0;
+    main_udp_holdingudprx0_holdingudprx_next_value4 <= 16'd0;
+    main_udp_holdingudprx0_holdingudprx_next_value_ce4 <= 1'd0;
+    main_udp_holdingudprx1_holdingudprx_next_value5 <= 16'd0;
+    main_udp_holdingudprx1_holdingudprx_next_value_ce5 <= 1'd0;
+    main_udp_holdingudprx2_holdingudprx_next_value6 <= 16'd0;
+    main_udp_holdingudprx2_holdingudprx_next_value_ce6 <= 1'd0;
+    main_udp_holdingudprx3_holdingudprx_next_value7 <= 32'd0;
+    main_udp_holdingudprx3_holdingudprx_next_value_ce7 <= 1'd0;
+    main_udp_holdingudprx_count_holdingudprx_next_value0 <= 16'd0;
+    main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd0;
+    main_udp_holdingudprx_drop_header <= 1'd0;
+    main_udp_holdingudprx_err_holdingudprx_next_value1 <= 1'd0;
+    main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd0;
+    main_udp_holdingudprx_held_holdingudprx_next_value3 <= 8'd0;
+    main_udp_holdingudprx_held_holdingudprx_next_value_ce3 <= 1'd0;
+    main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
+    main_udp_holdingudprx_rest_holdingudprx_next_value2 <= 16'd0;
+    main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd0;
+    main_udp_holdingudprx_source_last <= 1'd0;
+    main_udp_holdingudprx_source_param_dst_port <= 16'd0;
+    main_udp_holdingudprx_source_param_ip_address <= 32'd0;
+    main_udp_holdingudprx_source_param_length <= 16'd0;
+    main_udp_holdingudprx_source_param_src_port <= 16'd0;
+    main_udp_holdingudprx_source_payload_data <= 8'd0;
+    main_udp_holdingudprx_source_payload_error <= 1'd0;
+    main_udp_holdingudprx_source_valid <= 1'd0;
+    builder_portudp_holdingudprx_next_state <= builder_portudp_holdingudprx_state;
+    case (builder_portudp_holdingudprx_state)
         1'd1: begin
-            main_holdingudprx_source_param_src_port <= main_holdingudprx_liteethudpdepacketizer_source_param_src_port;
-            main_holdingudprx_source_param_dst_port <= main_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
-            main_holdingudprx_source_param_length <= main_holdingudprx_payload_len;
-            main_holdingudprx_source_param_ip_address <= main_holdingudprx_sink_param_ip_address;
-            main_holdingudprx_source_payload_data <= main_holdingudprx_liteethudpdepacketizer_source_payload_data;
-            if ((main_holdingudprx_liteethudpdepacketizer_source_last | (main_holdingudprx_count < main_holdingudprx_payload_len))) begin
-                main_holdingudprx_source_valid <= main_holdingudprx_liteethudpdepacketizer_source_valid;
-                main_holdingudprx_liteethudpdepacketizer_source_ready <= main_holdingudprx_source_ready;
-                main_holdingudprx_source_last <= main_holdingudprx_liteethudpdepacketizer_source_last;
-                main_holdingudprx_source_payload_error <= (main_holdingudprx_liteethudpdepacketizer_source_payload_error | main_holdingudprx_err);
-                if ((main_holdingudprx_liteethudpdepacketizer_source_last & main_holdingudprx_cut1)) begin
-                    main_holdingudprx_source_param_length <= 1'd0;
+            main_udp_holdingudprx_source_param_src_port <= main_udp_holdingudprx_liteethudpdepacketizer_source_param_src_port;
+            main_udp_holdingudprx_source_param_dst_port <= main_udp_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+            main_udp_holdingudprx_source_param_length <= main_udp_holdingudprx_payload_len;
+            main_udp_holdingudprx_source_param_ip_address <= main_udp_holdingudprx_sink_param_ip_address;
+            main_udp_holdingudprx_source_payload_data <= main_udp_holdingudprx_liteethudpdepacketizer_source_payload_data;
+            if ((main_udp_holdingudprx_liteethudpdepacketizer_source_last | (main_udp_holdingudprx_count < main_udp_holdingudprx_payload_len))) begin
+                main_udp_holdingudprx_source_valid <= main_udp_holdingudprx_liteethudpdepacketizer_source_valid;
+                main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= main_udp_holdingudprx_source_ready;
+                main_udp_holdingudprx_source_last <= main_udp_holdingudprx_liteethudpdepacketizer_source_last;
+                main_udp_holdingudprx_source_payload_error <= (main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error | main_udp_holdingudprx_err);
+                if ((main_udp_holdingudprx_liteethudpdepacketizer_source_last & main_udp_holdingudprx_cut1)) begin
+                    main_udp_holdingudprx_source_param_length <= 1'd0;
                 end
-                if ((main_holdingudprx_liteethudpdepacketizer_source_valid & main_holdingudprx_source_ready)) begin
-                    main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
-                    main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
-                    if (main_holdingudprx_cut1) begin
-                        main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
-                        main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                if ((main_udp_holdingudprx_liteethudpdepacketizer_source_valid & main_udp_holdingudprx_source_ready)) begin
+                    main_udp_holdingudprx_count_holdingudprx_next_value0 <= (main_udp_holdingudprx_count + 1'd1);
+                    main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                    if (main_udp_holdingudprx_cut1) begin
+                        main_udp_holdingudprx_rest_holdingudprx_next_value2 <= (main_udp_holdingudprx_rest - 1'd1);
+                        main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
                     end
-                    main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_liteethudpdepacketizer_source_payload_error);
-                    main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    if (main_holdingudprx_liteethudpdepacketizer_source_last) begin
-                        builder_liteethudp_holdingudprx_next_state <= 1'd0;
+                    main_udp_holdingudprx_err_holdingudprx_next_value1 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
+                    main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                    if (main_udp_holdingudprx_liteethudpdepacketizer_source_last) begin
+                        builder_portudp_holdingudprx_next_state <= 1'd0;
                     end
                 end
             end else begin
-                main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
-                if (main_holdingudprx_liteethudpdepacketizer_source_valid) begin
-                    main_holdingudprx_held_liteethudp_next_value3 <= main_holdingudprx_liteethudpdepacketizer_source_payload_data;
-                    main_holdingudprx_held_liteethudp_next_value_ce3 <= 1'd1;
-                    main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_liteethudpdepacketizer_source_payload_error);
-                    main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                    main_holdingudprx0_liteethudp_next_value4 <= main_holdingudprx_liteethudpdepacketizer_source_param_src_port;
-                    main_holdingudprx0_liteethudp_next_value_ce4 <= 1'd1;
-                    main_holdingudprx1_liteethudp_next_value5 <= main_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
-                    main_holdingudprx1_liteethudp_next_value_ce5 <= 1'd1;
-                    main_holdingudprx2_liteethudp_next_value6 <= main_holdingudprx_payload_len;
-                    main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
-                    main_holdingudprx3_liteethudp_next_value7 <= main_holdingudprx_sink_param_ip_address;
-                    main_holdingudprx3_liteethudp_next_value_ce7 <= 1'd1;
-                    main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
-                    main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
-                    if (main_holdingudprx_cut1) begin
-                        main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
-                        main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+                main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+                if (main_udp_holdingudprx_liteethudpdepacketizer_source_valid) begin
+                    main_udp_holdingudprx_held_holdingudprx_next_value3 <= main_udp_holdingudprx_liteethudpdepacketizer_source_payload_data;
+                    main_udp_holdingudprx_held_holdingudprx_next_value_ce3 <= 1'd1;
+                    main_udp_holdingudprx_err_holdingudprx_next_value1 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
+                    main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                    main_udp_holdingudprx0_holdingudprx_next_value4 <= main_udp_holdingudprx_liteethudpdepacketizer_source_param_src_port;
+                    main_udp_holdingudprx0_holdingudprx_next_value_ce4 <= 1'd1;
+                    main_udp_holdingudprx1_holdingudprx_next_value5 <= main_udp_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+                    main_udp_holdingudprx1_holdingudprx_next_value_ce5 <= 1'd1;
+                    main_udp_holdingudprx2_holdingudprx_next_value6 <= main_udp_holdingudprx_payload_len;
+                    main_udp_holdingudprx2_holdingudprx_next_value_ce6 <= 1'd1;
+                    main_udp_holdingudprx3_holdingudprx_next_value7 <= main_udp_holdingudprx_sink_param_ip_address;
+                    main_udp_holdingudprx3_holdingudprx_next_value_ce7 <= 1'd1;
+                    main_udp_holdingudprx_count_holdingudprx_next_value0 <= (main_udp_holdingudprx_count + 1'd1);
+                    main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                    if (main_udp_holdingudprx_cut1) begin
+                        main_udp_holdingudprx_rest_holdingudprx_next_value2 <= (main_udp_holdingudprx_rest - 1'd1);
+                        main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
                     end
-                    builder_liteethudp_holdingudprx_next_state <= 2'd2;
+                    builder_portudp_holdingudprx_next_state <= 2'd2;
                 end
             end
         end
         2'd2: begin
-            main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
-            if (main_holdingudprx_liteethudpdepacketizer_source_valid) begin
-                main_holdingudprx_err_liteethudp_next_value1 <= (main_holdingudprx_err | main_holdingudprx_liteethudpdepacketizer_source_payload_error);
-                main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-                main_holdingudprx_count_liteethudp_next_value0 <= (main_holdingudprx_count + 1'd1);
-                main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
-                if (main_holdingudprx_cut1) begin
-                    main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_rest - 1'd1);
-                    main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+            if (main_udp_holdingudprx_liteethudpdepacketizer_source_valid) begin
+                main_udp_holdingudprx_err_holdingudprx_next_value1 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
+                main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                main_udp_holdingudprx_count_holdingudprx_next_value0 <= (main_udp_holdingudprx_count + 1'd1);
+                main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                if (main_udp_holdingudprx_cut1) begin
+                    main_udp_holdingudprx_rest_holdingudprx_next_value2 <= (main_udp_holdingudprx_rest - 1'd1);
+                    main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
                 end
-                if (main_holdingudprx_liteethudpdepacketizer_source_last) begin
-                    if (main_holdingudprx_cut1) begin
-                        main_holdingudprx2_liteethudp_next_value6 <= 1'd0;
-                        main_holdingudprx2_liteethudp_next_value_ce6 <= 1'd1;
+                if (main_udp_holdingudprx_liteethudpdepacketizer_source_last) begin
+                    if (main_udp_holdingudprx_cut1) begin
+                        main_udp_holdingudprx2_holdingudprx_next_value6 <= 1'd0;
+                        main_udp_holdingudprx2_holdingudprx_next_value_ce6 <= 1'd1;
                     end
-                    builder_liteethudp_holdingudprx_next_state <= 2'd3;
+                    builder_portudp_holdingudprx_next_state <= 2'd3;
                 end
             end
         end
         2'd3: begin
-            main_holdingudprx_source_valid <= 1'd1;
-            main_holdingudprx_source_last <= 1'd1;
-            main_holdingudprx_source_payload_data <= main_holdingudprx_held;
-            main_holdingudprx_source_payload_error <= main_holdingudprx_err;
-            main_holdingudprx_source_param_src_port <= main_holdingudprx0;
-            main_holdingudprx_source_param_dst_port <= main_holdingudprx1;
-            main_holdingudprx_source_param_length <= main_holdingudprx2;
-            main_holdingudprx_source_param_ip_address <= main_holdingudprx3;
-            if (main_holdingudprx_source_ready) begin
-                builder_liteethudp_holdingudprx_next_state <= 1'd0;
+            main_udp_holdingudprx_source_valid <= 1'd1;
+            main_udp_holdingudprx_source_last <= 1'd1;
+            main_udp_holdingudprx_source_payload_data <= main_udp_holdingudprx_held;
+            main_udp_holdingudprx_source_payload_error <= main_udp_holdingudprx_err;
+            main_udp_holdingudprx_source_param_src_port <= main_udp_holdingudprx0;
+            main_udp_holdingudprx_source_param_dst_port <= main_udp_holdingudprx1;
+            main_udp_holdingudprx_source_param_length <= main_udp_holdingudprx2;
+            main_udp_holdingudprx_source_param_ip_address <= main_udp_holdingudprx3;
+            if (main_udp_holdingudprx_source_ready) begin
+                builder_portudp_holdingudprx_next_state <= 1'd0;
             end
         end
         3'd4: begin
-            main_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
-            if ((main_holdingudprx_liteethudpdepacketizer_source_valid & main_holdingudprx_liteethudpdepacketizer_source_last)) begin
-                builder_liteethudp_holdingudprx_next_state <= 1'd0;
+            main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
+            if ((main_udp_holdingudprx_liteethudpdepacketizer_source_valid & main_udp_holdingudprx_liteethudpdepacketizer_source_last)) begin
+                builder_portudp_holdingudprx_next_state <= 1'd0;
             end
         end
         default: begin
-            main_holdingudprx_count_liteethudp_next_value0 <= 1'd1;
-            main_holdingudprx_count_liteethudp_next_value_ce0 <= 1'd1;
-            main_holdingudprx_err_liteethudp_next_value1 <= 1'd0;
-            main_holdingudprx_err_liteethudp_next_value_ce1 <= 1'd1;
-            main_holdingudprx_rest_liteethudp_next_value2 <= (main_holdingudprx_sink_param_length - 4'd9);
-            main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
-            if ((main_holdingudprx_sink_param_length <= 4'd8)) begin
-                main_holdingudprx_rest_liteethudp_next_value2 <= 1'd0;
-                main_holdingudprx_rest_liteethudp_next_value_ce2 <= 1'd1;
+            main_udp_holdingudprx_count_holdingudprx_next_value0 <= 1'd1;
+            main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+            main_udp_holdingudprx_err_holdingudprx_next_value1 <= 1'd0;
+            main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+            main_udp_holdingudprx_rest_holdingudprx_next_value2 <= (main_udp_holdingudprx_sink_param_length - 4'd9);
+            main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+            if ((main_udp_holdingudprx_sink_param_length <= 4'd8)) begin
+                main_udp_holdingudprx_rest_holdingudprx_next_value2 <= 1'd0;
+                main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
             end
-            if (main_holdingudprx_liteethudpdepacketizer_source_valid) begin
-                builder_liteethudp_holdingudprx_next_state <= 3'd4;
-                if ((main_holdingudprx_sink_param_protocol == 5'd17)) begin
-                    if ((main_holdingudprx_liteethudpdepacketizer_source_param_length > main_holdingudprx_sink_param_length)) begin
-                        main_holdingudprx_drop_header <= 1'd1;
+            if (main_udp_holdingudprx_liteethudpdepacketizer_source_valid) begin
+                builder_portudp_holdingudprx_next_state <= 3'd4;
+                if ((main_udp_holdingudprx_sink_param_protocol == 5'd17)) begin
+                    if ((main_udp_holdingudprx_liteethudpdepacketizer_source_param_length > main_udp_holdingudprx_sink_param_length)) begin
+                        main_udp_holdingudprx_drop_header <= 1'd1;
                     end else begin
-                        builder_liteethudp_holdingudprx_next_state <= 1'd1;
+                        builder_portudp_holdingudprx_next_state <= 1'd1;
                     end
                 end
             end
         end
     endcase
 end
-assign main_tx_cdc_sink_valid = main_user_port_sink_valid;
-assign main_user_port_sink_ready = main_tx_cdc_sink_ready;
-assign main_tx_cdc_sink_first = main_user_port_sink_first;
-assign main_tx_cdc_sink_last = main_user_port_sink_last;
-assign main_tx_cdc_sink_payload_data = main_user_port_sink_payload_data;
-assign main_tx_cdc_sink_payload_last_be = main_user_port_sink_payload_last_be;
-assign main_tx_cdc_sink_payload_error = main_user_port_sink_payload_error;
-assign main_tx_cdc_sink_param_src_port = main_user_port_sink_param_src_port;
-assign main_tx_cdc_sink_param_dst_port = main_user_port_sink_param_dst_port;
-assign main_tx_cdc_sink_param_ip_address = main_user_port_sink_param_ip_address;
-assign main_tx_cdc_sink_param_length = main_user_port_sink_param_length;
-assign main_tx_converter_sink_valid = main_tx_cdc_source_valid;
-assign main_tx_cdc_source_ready = main_tx_converter_sink_ready;
-assign main_tx_converter_sink_first = main_tx_cdc_source_first;
-assign main_tx_converter_sink_last = main_tx_cdc_source_last;
-assign main_tx_converter_sink_payload_data = main_tx_cdc_source_payload_data;
-assign main_tx_converter_sink_payload_last_be = main_tx_cdc_source_payload_last_be;
-assign main_tx_converter_sink_payload_error = main_tx_cdc_source_payload_error;
-assign main_tx_converter_sink_param_src_port = main_tx_cdc_source_param_src_port;
-assign main_tx_converter_sink_param_dst_port = main_tx_cdc_source_param_dst_port;
-assign main_tx_converter_sink_param_ip_address = main_tx_cdc_source_param_ip_address;
-assign main_tx_converter_sink_param_length = main_tx_cdc_source_param_length;
-assign main_internal_port_sink_valid = main_tx_converter_source_valid;
-assign main_tx_converter_source_ready = main_internal_port_sink_ready;
-assign main_internal_port_sink_first = main_tx_converter_source_first;
-assign main_internal_port_sink_last = main_tx_converter_source_last;
-assign main_internal_port_sink_payload_data = main_tx_converter_source_payload_data;
-assign main_internal_port_sink_payload_last_be = main_tx_converter_source_payload_last_be;
-assign main_internal_port_sink_payload_error = main_tx_converter_source_payload_error;
-assign main_internal_port_sink_param_src_port = main_tx_converter_source_param_src_port;
-assign main_internal_port_sink_param_dst_port = main_tx_converter_source_param_dst_port;
-assign main_internal_port_sink_param_ip_address = main_tx_converter_source_param_ip_address;
-assign main_internal_port_sink_param_length = main_tx_converter_source_param_length;
-assign main_rx_converter_sink_valid = main_internal_port_source_valid;
-assign main_internal_port_source_ready = main_rx_converter_sink_ready;
-assign main_rx_converter_sink_first = main_internal_port_source_first;
-assign main_rx_converter_sink_last = main_internal_port_source_last;
-assign main_rx_converter_sink_payload_data = main_internal_port_source_payload_data;
-assign main_rx_converter_sink_payload_last_be = main_internal_port_source_payload_last_be;
-assign main_rx_converter_sink_payload_error = main_internal_port_source_payload_error;
-assign main_rx_converter_sink_param_src_port = main_internal_port_source_param_src_port;
-assign main_rx_converter_sink_param_dst_port = main_internal_port_source_param_dst_port;
-assign main_rx_converter_sink_param_ip_address = main_internal_port_source_param_ip_address;
-assign main_rx_converter_sink_param_length = main_internal_port_source_param_length;
-assign main_rx_cdc_sink_valid = main_rx_converter_source_valid;
-assign main_rx_converter_source_ready = main_rx_cdc_sink_ready;
-assign main_rx_cdc_sink_first = main_rx_converter_source_first;
-assign main_rx_cdc_sink_last = main_rx_converter_source_last;
-assign main_rx_cdc_sink_payload_data = main_rx_converter_source_payload_data;
-assign main_rx_cdc_sink_payload_last_be = main_rx_converter_source_payload_last_be;
-assign main_rx_cdc_sink_payload_error = main_rx_converter_source_payload_error;
-assign main_rx_cdc_sink_param_src_port = main_rx_converter_source_param_src_port;
-assign main_rx_cdc_sink_param_dst_port = main_rx_converter_source_param_dst_port;
-assign main_rx_cdc_sink_param_ip_address = main_rx_converter_source_param_ip_address;
-assign main_rx_cdc_sink_param_length = main_rx_converter_source_param_length;
-assign main_user_port_source_valid = main_rx_cdc_source_valid;
-assign main_rx_cdc_source_ready = main_user_port_source_ready;
-assign main_user_port_source_first = main_rx_cdc_source_first;
-assign main_user_port_source_last = main_rx_cdc_source_last;
-assign main_user_port_source_payload_data = main_rx_cdc_source_payload_data;
-assign main_user_port_source_payload_last_be = main_rx_cdc_source_payload_last_be;
-assign main_user_port_source_payload_error = main_rx_cdc_source_payload_error;
-assign main_user_port_source_param_src_port = main_rx_cdc_source_param_src_port;
-assign main_user_port_source_param_dst_port = main_rx_cdc_source_param_dst_port;
-assign main_user_port_source_param_ip_address = main_rx_cdc_source_param_ip_address;
-assign main_user_port_source_param_length = main_rx_cdc_source_param_length;
-assign builder_liteethudp_taken = ((1'd0 + main_internal_port_source_valid) != 1'd0);
-assign main_crossbar_dropped = (((main_crossbar_sink_valid & main_crossbar_sink_ready) & main_crossbar_sink_last) & (~builder_liteethudp_taken));
+assign main_udp_liteethudptx_packetizer_sink_valid = main_udp_liteethudptx_sink_sink_valid;
+assign main_udp_liteethudptx_sink_sink_ready = main_udp_liteethudptx_packetizer_sink_ready;
+assign main_udp_liteethudptx_packetizer_sink_last = main_udp_liteethudptx_sink_sink_last;
+assign main_udp_liteethudptx_packetizer_sink_payload_data = main_udp_liteethudptx_sink_sink_payload_data;
+assign main_udp_liteethudptx_packetizer_sink_payload_last_be = main_udp_liteethudptx_sink_sink_payload_last_be;
+assign main_udp_liteethudptx_packetizer_sink_param_src_port = main_udp_liteethudptx_sink_sink_param_src_port;
+assign main_udp_liteethudptx_packetizer_sink_param_dst_port = main_udp_liteethudptx_sink_sink_param_dst_port;
+assign main_udp_liteethudptx_packetizer_sink_param_length = (main_udp_liteethudptx_sink_sink_param_length + 4'd8);
+assign main_udp_liteethudptx_packetizer_sink_param_checksum = 1'd0;
 always @(*) begin
-    builder_liteethudp_sel0 <= 1'd0;
-    if ((main_crossbar_sink_param_dst_port == udp_rx_port)) begin
-        builder_liteethudp_sel0 <= 1'd1;
-    end
-    if ((((main_crossbar_sink_param_dst_port ^ udp_rx_port) & udp_rx_port_mask) == 1'd0)) begin
-        builder_liteethudp_sel0 <= 1'd1;
-    end
+    main_udp_liteethudptx_packetizer_header <= 64'd0;
+    main_udp_liteethudptx_packetizer_header[63:48] <= {main_udp_liteethudptx_packetizer_sink_param_checksum[7:0], main_udp_liteethudptx_packetizer_sink_param_checksum[15:8]};
+    main_udp_liteethudptx_packetizer_header[31:16] <= {main_udp_liteethudptx_packetizer_sink_param_dst_port[7:0], main_udp_liteethudptx_packetizer_sink_param_dst_port[15:8]};
+    main_udp_liteethudptx_packetizer_header[47:32] <= {main_udp_liteethudptx_packetizer_sink_param_length[7:0], main_udp_liteethudptx_packetizer_sink_param_length[15:8]};
+    main_udp_liteethudptx_packetizer_header[15:0] <= {main_udp_liteethudptx_packetizer_sink_param_src_port[7:0], main_udp_liteethudptx_packetizer_sink_param_src_port[15:8]};
 end
-assign main_tx_cdc_source_valid = main_tx_cdc_sink_valid;
-assign main_tx_cdc_sink_ready = main_tx_cdc_source_ready;
-assign main_tx_cdc_source_first = main_tx_cdc_sink_first;
-assign main_tx_cdc_source_last = main_tx_cdc_sink_last;
-assign main_tx_cdc_source_payload_data = main_tx_cdc_sink_payload_data;
-assign main_tx_cdc_source_payload_last_be = main_tx_cdc_sink_payload_last_be;
-assign main_tx_cdc_source_payload_error = main_tx_cdc_sink_payload_error;
-assign main_tx_cdc_source_param_src_port = main_tx_cdc_sink_param_src_port;
-assign main_tx_cdc_source_param_dst_port = main_tx_cdc_sink_param_dst_port;
-assign main_tx_cdc_source_param_ip_address = main_tx_cdc_sink_param_ip_address;
-assign main_tx_cdc_source_param_length = main_tx_cdc_sink_param_length;
-assign main_tx_converter_converter_sink_valid = main_tx_converter_sink_valid;
-assign main_tx_converter_converter_sink_first = main_tx_converter_sink_first;
-assign main_tx_converter_converter_sink_last = main_tx_converter_sink_last;
-assign main_tx_converter_sink_ready = main_tx_converter_converter_sink_ready;
-assign main_tx_converter_converter_sink_payload_data = {main_tx_converter_sink_payload_error, main_tx_converter_sink_payload_last_be, main_tx_converter_sink_payload_data};
-assign main_tx_converter_source_valid = main_tx_converter_source_source_valid;
-assign main_tx_converter_source_first = main_tx_converter_source_source_first;
-assign main_tx_converter_source_last = main_tx_converter_source_source_last;
-assign main_tx_converter_source_source_ready = main_tx_converter_source_ready;
-assign {main_tx_converter_source_payload_error, main_tx_converter_source_payload_last_be, main_tx_converter_source_payload_data} = main_tx_converter_source_source_payload_data;
-assign main_tx_converter_source_param_src_port = main_tx_converter_sink_param_src_port;
-assign main_tx_converter_source_param_dst_port = main_tx_converter_sink_param_dst_port;
-assign main_tx_converter_source_param_ip_address = main_tx_converter_sink_param_ip_address;
-assign main_tx_converter_source_param_length = main_tx_converter_sink_param_length;
-assign main_tx_converter_source_source_valid = main_tx_converter_converter_source_valid;
-assign main_tx_converter_converter_source_ready = main_tx_converter_source_source_ready;
-assign main_tx_converter_source_source_first = main_tx_converter_converter_source_first;
-assign main_tx_converter_source_source_last = main_tx_converter_converter_source_last;
-assign main_tx_converter_source_source_payload_data = main_tx_converter_converter_source_payload_data;
-assign main_tx_converter_converter_source_valid = main_tx_converter_converter_sink_valid;
-assign main_tx_converter_converter_sink_ready = main_tx_converter_converter_source_ready;
-assign main_tx_converter_converter_source_first = main_tx_converter_converter_sink_first;
-assign main_tx_converter_converter_source_last = main_tx_converter_converter_sink_last;
-assign main_tx_converter_converter_source_payload_data = main_tx_converter_converter_sink_payload_data;
-assign main_tx_converter_converter_source_payload_valid_token_count = 1'd1;
-assign main_rx_converter_converter_sink_valid = main_rx_converter_sink_valid;
-assign main_rx_converter_converter_sink_first = main_rx_converter_sink_first;
-assign main_rx_converter_converter_sink_last = main_rx_converter_sink_last;
-assign main_rx_converter_sink_ready = main_rx_converter_converter_sink_ready;
-assign main_rx_converter_converter_sink_payload_data = {main_rx_converter_sink_payload_error, main_rx_converter_sink_payload_last_be, main_rx_converter_sink_payload_data};
-assign main_rx_converter_source_valid = main_rx_converter_source_source_valid;
-assign main_rx_converter_source_first = main_rx_converter_source_source_first;
-assign main_rx_converter_source_last = main_rx_converter_source_source_last;
-assign main_rx_converter_source_source_ready = main_rx_converter_source_ready;
-assign {main_rx_converter_source_payload_error, main_rx_converter_source_payload_last_be, main_rx_converter_source_payload_data} = main_rx_converter_source_source_payload_data;
-assign main_rx_converter_source_param_src_port = main_rx_converter_sink_param_src_port;
-assign main_rx_converter_source_param_dst_port = main_rx_converter_sink_param_dst_port;
-assign main_rx_converter_source_param_ip_address = main_rx_converter_sink_param_ip_address;
-assign main_rx_converter_source_param_length = main_rx_converter_sink_param_length;
-assign main_rx_converter_source_source_valid = main_rx_converter_converter_source_valid;
-assign main_rx_converter_converter_source_ready = main_rx_converter_source_source_ready;
-assign main_rx_converter_source_source_first = main_rx_converter_converter_source_first;
-assign main_rx_converter_source_source_last = main_rx_converter_converter_source_last;
-assign main_rx_converter_source_source_payload_data = main_rx_converter_converter_source_payload_data;
-assign main_rx_converter_converter_source_valid = main_rx_converter_converter_sink_valid;
-assign main_rx_converter_converter_sink_ready = main_rx_converter_converter_source_ready;
-assign main_rx_converter_converter_source_first = main_rx_converter_converter_sink_first;
-assign main_rx_converter_converter_source_last = main_rx_converter_converter_sink_last;
-assign main_rx_converter_converter_source_payload_data = main_rx_converter_converter_sink_payload_data;
-assign main_rx_converter_converter_source_payload_valid_token_count = 1'd1;
-assign main_rx_cdc_source_valid = main_rx_cdc_sink_valid;
-assign main_rx_cdc_sink_ready = main_rx_cdc_source_ready;
-assign main_rx_cdc_source_first = main_rx_cdc_sink_first;
-assign main_rx_cdc_source_last = main_rx_cdc_sink_last;
-assign main_rx_cdc_source_payload_data = main_rx_cdc_sink_payload_data;
-assign main_rx_cdc_source_payload_last_be = main_rx_cdc_sink_payload_last_be;
-assign main_rx_cdc_source_payload_error = main_rx_cdc_sink_payload_error;
-assign main_rx_cdc_source_param_src_port = main_rx_cdc_sink_param_src_port;
-assign main_rx_cdc_source_param_dst_port = main_rx_cdc_sink_param_dst_port;
-assign main_rx_cdc_source_param_ip_address = main_rx_cdc_sink_param_ip_address;
-assign main_rx_cdc_source_param_length = main_rx_cdc_sink_param_length;
-assign main_crossbar_source_valid = main_internal_port_sink_valid;
-assign main_internal_port_sink_ready = main_crossbar_source_ready;
-assign main_crossbar_source_first = main_internal_port_sink_first;
-assign main_crossbar_source_last = main_internal_port_sink_last;
-assign main_crossbar_source_payload_data = main_internal_port_sink_payload_data;
-assign main_crossbar_source_payload_last_be = main_internal_port_sink_payload_last_be;
-assign main_crossbar_source_payload_error = main_internal_port_sink_payload_error;
-assign main_crossbar_source_param_src_port = main_internal_port_sink_param_src_port;
-assign main_crossbar_source_param_dst_port = main_internal_port_sink_param_dst_port;
-assign main_crossbar_source_param_ip_address = main_internal_port_sink_param_ip_address;
-assign main_crossbar_source_param_length = main_internal_port_sink_param_length;
+assign main_udp_liteethudptx_packetizer_sink_last_be = main_udp_liteethudptx_packetizer_sink_last;
+assign main_udp_liteethudptx_packetizer_new_last_be = {main_udp_liteethudptx_packetizer_sink_last_be};
+assign main_udp_liteethudptx_packetizer_in_data_copy = (main_udp_liteethudptx_packetizer_is_ongoing0 | main_udp_liteethudptx_packetizer_is_ongoing1);
 always @(*) begin
-    builder_liteethudp_sel1 <= 1'd0;
-    if (builder_liteethudp_first) begin
-        builder_liteethudp_sel1 <= builder_liteethudp_sel0;
+    main_udp_liteethudptx_packetizer_source_last <= 1'd0;
+    if (main_udp_liteethudptx_packetizer_source_last_s) begin
+        main_udp_liteethudptx_packetizer_source_last <= main_udp_liteethudptx_packetizer_source_last_b;
     end else begin
-        builder_liteethudp_sel1 <= builder_liteethudp_sel_ongoing;
+        main_udp_liteethudptx_packetizer_source_last <= main_udp_liteethudptx_packetizer_source_last_a;
     end
 end
+assign main_udp_liteethudptx_packetizer_source_payload_error = main_udp_liteethudptx_packetizer_sink_payload_error;
 always @(*) begin
-    main_crossbar_sink_ready <= 1'd0;
-    main_internal_port_source_first <= 1'd0;
-    main_internal_port_source_last <= 1'd0;
-    main_internal_port_source_param_dst_port <= 16'd0;
-    main_internal_port_source_param_ip_address <= 32'd0;
-    main_internal_port_source_param_length <= 16'd0;
-    main_internal_port_source_param_src_port <= 16'd0;
-    main_internal_port_source_payload_data <= 8'd0;
-    main_internal_port_source_payload_error <= 1'd0;
-    main_internal_port_source_payload_last_be <= 1'd0;
-    main_internal_port_source_valid <= 1'd0;
-    case (builder_liteethudp_sel1)
+    builder_portudp_liteethudptx_fsm0_next_state <= 2'd0;
+    builder_portudp_liteethudptx_fsm1_next_state <= 1'd0;
+    main_udp_liteethudptx_packetizer_count_fsm0_next_value4 <= 3'd0;
+    main_udp_liteethudptx_packetizer_count_fsm0_next_value_ce4 <= 1'd0;
+    main_udp_liteethudptx_packetizer_delayed_last_be_fsm1_next_value2 <= 1'd0;
+    main_udp_liteethudptx_packetizer_delayed_last_be_fsm1_next_value_ce2 <= 1'd0;
+    main_udp_liteethudptx_packetizer_fsm_from_idle_fsm0_next_value5 <= 1'd0;
+    main_udp_liteethudptx_packetizer_fsm_from_idle_fsm0_next_value_ce5 <= 1'd0;
+    main_udp_liteethudptx_packetizer_is_ongoing0 <= 1'd0;
+    main_udp_liteethudptx_packetizer_is_ongoing1 <= 1'd0;
+    main_udp_liteethudptx_packetizer_is_ongoing2 <= 1'd0;
+    main_udp_liteethudptx_packetizer_sink_ready <= 1'd0;
+    main_udp_liteethudptx_packetizer_source_last_a <= 1'd0;
+    main_udp_liteethudptx_packetizer_source_last_b <= 1'd0;
+    main_udp_liteethudptx_packetizer_source_last_s <= 1'd0;
+    main_udp_liteethudptx_packetizer_source_payload_data <= 8'd0;
+    main_udp_liteethudptx_packetizer_source_payload_last_be <= 1'd0;
+    main_udp_liteethudptx_packetizer_source_valid <= 1'd0;
+    main_udp_liteethudptx_packetizer_sr_load <= 1'd0;
+    main_udp_liteethudptx_packetizer_sr_shift <= 1'd0;
+    builder_portudp_liteethudptx_fsm0_next_state <= builder_portudp_liteethudptx_fsm0_state;
+    case (builder_portudp_liteethudptx_fsm0_state)
         1'd1: begin
-            main_internal_port_source_valid <= main_crossbar_sink_valid;
-            main_crossbar_sink_ready <= main_internal_port_source_ready;
-            main_internal_port_source_first <= main_crossbar_sink_first;
-            main_internal_port_source_last <= main_crossbar_sink_last;
-            main_internal_port_source_payload_data <= main_crossbar_sink_payload_data;
-            main_internal_port_source_payload_last_be <= main_crossbar_sink_payload_last_be;
-            main_internal_port_source_payload_error <= main_crossbar_sink_payload_error;
-            main_internal_port_source_param_src_port <= main_crossbar_sink_param_src_port;
-            main_internal_port_source_param_dst_port <= main_crossbar_sink_param_dst_port;
-            main_internal_port_source_param_ip_address <= main_crossbar_sink_param_ip_address;
-            main_internal_port_source_param_length <= main_crossbar_sink_param_length;
+            main_udp_liteethudptx_packetizer_source_valid <= 1'd1;
+            main_udp_liteethudptx_packetizer_source_last_a <= 1'd0;
+            main_udp_liteethudptx_packetizer_source_payload_data <= main_udp_liteethudptx_packetizer_sr[63:8];
+            if ((main_udp_liteethudptx_packetizer_source_valid & main_udp_liteethudptx_packetizer_source_ready)) begin
+                main_udp_liteethudptx_packetizer_sr_shift <= 1'd1;
+                if ((main_udp_liteethudptx_packetizer_count == 3'd7)) begin
+                    main_udp_liteethudptx_packetizer_sr_shift <= 1'd0;
+                    builder_portudp_liteethudptx_fsm0_next_state <= 2'd2;
+                    main_udp_liteethudptx_packetizer_count_fsm0_next_value4 <= (main_udp_liteethudptx_packetizer_count + 1'd1);
+                    main_udp_liteethudptx_packetizer_count_fsm0_next_value_ce4 <= 1'd1;
+                end else begin
+                    main_udp_liteethudptx_packetizer_count_fsm0_next_value4 <= (main_udp_liteethudptx_packetizer_count + 1'd1);
+                    main_udp_liteethudptx_packetizer_count_fsm0_next_value_ce4 <= 1'd1;
+                end
+            end
+        end
+        2'd2: begin
+            main_udp_liteethudptx_packetizer_source_valid <= main_udp_liteethudptx_packetizer_sink_valid;
+            main_udp_liteethudptx_packetizer_source_last_a <= main_udp_liteethudptx_packetizer_sink_last;
+            main_udp_liteethudptx_packetizer_source_payload_data <= main_udp_liteethudptx_packetizer_sink_payload_data;
+            if ((main_udp_liteethudptx_packetizer_source_valid & main_udp_liteethudptx_packetizer_source_ready)) begin
+                main_udp_liteethudptx_packetizer_sink_ready <= 1'd1;
+                if (main_udp_liteethudptx_packetizer_source_last) begin
+                    builder_portudp_liteethudptx_fsm0_next_state <= 1'd0;
+                end
+            end
+            main_udp_liteethudptx_packetizer_is_ongoing0 <= 1'd1;
+        end
+        2'd3: begin
+            main_udp_liteethudptx_packetizer_is_ongoing1 <= 1'd1;
         end
         default: begin
-            main_crossbar_sink_ready <= 1'd1;
+            main_udp_liteethudptx_packetizer_sink_ready <= 1'd1;
+            main_udp_liteethudptx_packetizer_count_fsm0_next_value4 <= 1'd1;
+            main_udp_liteethudptx_packetizer_count_fsm0_next_value_ce4 <= 1'd1;
+            if (main_udp_liteethudptx_packetizer_sink_valid) begin
+                main_udp_liteethudptx_packetizer_sink_ready <= 1'd0;
+                main_udp_liteethudptx_packetizer_source_valid <= 1'd1;
+                main_udp_liteethudptx_packetizer_source_last_a <= 1'd0;
+                main_udp_liteethudptx_packetizer_source_payload_data <= main_udp_liteethudptx_packetizer_header[7:0];
+                if ((main_udp_liteethudptx_packetizer_source_valid & main_udp_liteethudptx_packetizer_source_ready)) begin
+                    main_udp_liteethudptx_packetizer_sr_load <= 1'd1;
+                    main_udp_liteethudptx_packetizer_fsm_from_idle_fsm0_next_value5 <= 1'd1;
+                    main_udp_liteethudptx_packetizer_fsm_from_idle_fsm0_next_value_ce5 <= 1'd1;
+                    if (1'd0) begin
+                        builder_portudp_liteethudptx_fsm0_next_state <= 2'd2;
+                    end else begin
+                        builder_portudp_liteethudptx_fsm0_next_state <= 1'd1;
+                    end
+                end
+            end
+            main_udp_liteethudptx_packetizer_is_ongoing2 <= 1'd1;
+        end
+    endcase
+    builder_portudp_liteethudptx_fsm1_next_state <= builder_portudp_liteethudptx_fsm1_state;
+    case (builder_portudp_liteethudptx_fsm1_state)
+        1'd1: begin
+            main_udp_liteethudptx_packetizer_source_last_b <= 1'd1;
+            main_udp_liteethudptx_packetizer_source_last_s <= 1'd1;
+            main_udp_liteethudptx_packetizer_source_payload_last_be <= main_udp_liteethudptx_packetizer_delayed_last_be;
+            main_udp_liteethudptx_packetizer_sink_ready <= 1'd0;
+            if (main_udp_liteethudptx_packetizer_source_ready) begin
+                builder_portudp_liteethudptx_fsm1_next_state <= 1'd0;
+            end
+        end
+        default: begin
+            if (((main_udp_liteethudptx_packetizer_in_data_copy & main_udp_liteethudptx_packetizer_sink_last) & (main_udp_liteethudptx_packetizer_sink_last_be > main_udp_liteethudptx_packetizer_new_last_be))) begin
+                main_udp_liteethudptx_packetizer_source_last_b <= 1'd0;
+                main_udp_liteethudptx_packetizer_source_last_s <= 1'd1;
+                main_udp_liteethudptx_packetizer_source_payload_last_be <= 1'd0;
+                if ((main_udp_liteethudptx_packetizer_source_ready & main_udp_liteethudptx_packetizer_source_valid)) begin
+                    main_udp_liteethudptx_packetizer_delayed_last_be_fsm1_next_value2 <= main_udp_liteethudptx_packetizer_new_last_be;
+                    main_udp_liteethudptx_packetizer_delayed_last_be_fsm1_next_value_ce2 <= 1'd1;
+                    builder_portudp_liteethudptx_fsm1_next_state <= 1'd1;
+                end
+            end else begin
+                if (main_udp_liteethudptx_packetizer_in_data_copy) begin
+                    main_udp_liteethudptx_packetizer_source_last_b <= main_udp_liteethudptx_packetizer_sink_last;
+                    main_udp_liteethudptx_packetizer_source_last_s <= 1'd1;
+                    main_udp_liteethudptx_packetizer_source_payload_last_be <= main_udp_liteethudptx_packetizer_new_last_be;
+                end
+            end
+            if (main_udp_liteethudptx_packetizer_in_data_copy) begin
+                main_udp_liteethudptx_packetizer_sink_ready <= main_udp_liteethudptx_packetizer_source_ready;
+            end else begin
+                if (main_udp_liteethudptx_packetizer_is_ongoing2) begin
+                    main_udp_liteethudptx_packetizer_sink_ready <= (~main_udp_liteethudptx_packetizer_sink_valid);
+                end
+            end
         end
     endcase
 end
-assign builder_liteethudp_last = ((main_crossbar_sink_valid & main_crossbar_sink_last) & main_crossbar_sink_ready);
-assign builder_liteethudp_ongoing0 = ((main_crossbar_sink_valid | builder_liteethudp_ongoing1) & (~builder_liteethudp_last));
+always @(*) begin
+    builder_portudp_liteethudptx_next_state <= 1'd0;
+    main_udp_liteethudptx_packetizer_source_ready <= 1'd0;
+    main_udp_liteethudptx_source_source_first <= 1'd0;
+    main_udp_liteethudptx_source_source_last <= 1'd0;
+    main_udp_liteethudptx_source_source_param_ip_address <= 32'd0;
+    main_udp_liteethudptx_source_source_param_length <= 16'd0;
+    main_udp_liteethudptx_source_source_param_protocol <= 8'd0;
+    main_udp_liteethudptx_source_source_payload_data <= 8'd0;
+    main_udp_liteethudptx_source_source_payload_error <= 1'd0;
+    main_udp_liteethudptx_source_source_payload_last_be <= 1'd0;
+    main_udp_liteethudptx_source_source_valid <= 1'd0;
+    builder_portudp_liteethudptx_next_state <= builder_portudp_liteethudptx_state;
+    case (builder_portudp_liteethudptx_state)
+        1'd1: begin
+            main_udp_liteethudptx_source_source_valid <= main_udp_liteethudptx_packetizer_source_valid;
+            main_udp_liteethudptx_packetizer_source_ready <= main_udp_liteethudptx_source_source_ready;
+            main_udp_liteethudptx_source_source_first <= main_udp_liteethudptx_packetizer_source_first;
+            main_udp_liteethudptx_source_source_last <= main_udp_liteethudptx_packetizer_source_last;
+            main_udp_liteethudptx_source_source_payload_data <= main_udp_liteethudptx_packetizer_source_payload_data;
+            main_udp_liteethudptx_source_source_payload_last_be <= main_udp_liteethudptx_packetizer_source_payload_last_be;
+            main_udp_liteethudptx_source_source_payload_error <= main_udp_liteethudptx_packetizer_source_payload_error;
+            main_udp_liteethudptx_source_source_param_length <= main_udp_liteethudptx_packetizer_source_param_length;
+            main_udp_liteethudptx_source_source_param_protocol <= main_udp_liteethudptx_packetizer_source_param_protocol;
+            main_udp_liteethudptx_source_source_param_ip_address <= main_udp_liteethudptx_packetizer_source_param_ip_address;
+            main_udp_liteethudptx_source_source_param_length <= main_udp_liteethudptx_packetizer_sink_param_length;
+            main_udp_liteethudptx_source_source_param_protocol <= 5'd17;
+            main_udp_liteethudptx_source_source_param_ip_address <= main_udp_liteethudptx_sink_sink_param_ip_address;
+            if ((main_udp_liteethudptx_source_source_valid & main_udp_liteethudptx_source_source_ready)) begin
+                if (main_udp_liteethudptx_source_source_last) begin
+                    builder_portudp_liteethudptx_next_state <= 1'd0;
+                end
+            end
+        end
+        default: begin
+            if (main_udp_liteethudptx_packetizer_source_valid) begin
+                builder_portudp_liteethudptx_next_state <= 1'd1;
+            end
+        end
+    endcase
+end
+assign main_udp_strideconverter1_converter_sink_valid = main_udp_strideconverter1_sink_valid;
+assign main_udp_strideconverter1_converter_sink_first = main_udp_strideconverter1_sink_first;
+assign main_udp_strideconverter1_converter_sink_last = main_udp_strideconverter1_sink_last;
+assign main_udp_strideconverter1_sink_ready = main_udp_strideconverter1_converter_sink_ready;
+assign main_udp_strideconverter1_converter_sink_payload_data = {main_udp_strideconverter1_sink_payload_error, main_udp_strideconverter1_sink_payload_last_be, main_udp_strideconverter1_sink_payload_data};
+assign main_udp_strideconverter1_source_valid = main_udp_strideconverter1_source_source_valid;
+assign main_udp_strideconverter1_source_first = main_udp_strideconverter1_source_source_first;
+assign main_udp_strideconverter1_source_last = main_udp_strideconverter1_source_source_last;
+assign main_udp_strideconverter1_source_source_ready = main_udp_strideconverter1_source_ready;
+always @(*) begin
+    main_udp_strideconverter1_source_payload_data <= 32'd0;
+    main_udp_strideconverter1_source_payload_data[7:0] <= main_udp_strideconverter1_source_source_payload_data[7:0];
+    main_udp_strideconverter1_source_payload_data[15:8] <= main_udp_strideconverter1_source_source_payload_data[17:10];
+    main_udp_strideconverter1_source_payload_data[23:16] <= main_udp_strideconverter1_source_source_payload_data[27:20];
+    main_udp_strideconverter1_source_payload_data[31:24] <= main_udp_strideconverter1_source_source_payload_data[37:30];
+end
+always @(*) begin
+    main_udp_strideconverter1_source_payload_last_be <= 4'd0;
+    main_udp_strideconverter1_source_payload_last_be[0] <= main_udp_strideconverter1_source_source_payload_data[8];
+    main_udp_strideconverter1_source_payload_last_be[1] <= main_udp_strideconverter1_source_source_payload_data[18];
+    main_udp_strideconverter1_source_payload_last_be[2] <= main_udp_strideconverter1_source_source_payload_data[28];
+    main_udp_strideconverter1_source_payload_last_be[3] <= main_udp_strideconverter1_source_source_payload_data[38];
+end
+always @(*) begin
+    main_udp_strideconverter1_source_payload_error <= 4'd0;
+    main_udp_strideconverter1_source_payload_error[0] <= main_udp_strideconverter1_source_source_payload_data[9];
+    main_udp_strideconverter1_source_payload_error[1] <= main_udp_strideconverter1_source_source_payload_data[19];
+    main_udp_strideconverter1_source_payload_error[2] <= main_udp_strideconverter1_source_source_payload_data[29];
+    main_udp_strideconverter1_source_payload_error[3] <= main_udp_strideconverter1_source_source_payload_data[39];
+end
+assign main_udp_strideconverter1_source_source_valid = main_udp_strideconverter1_converter_source_valid;
+assign main_udp_strideconverter1_converter_source_ready = main_udp_strideconverter1_source_source_ready;
+assign main_udp_strideconverter1_source_source_first = main_udp_strideconverter1_converter_source_first;
+assign main_udp_strideconverter1_source_source_last = main_udp_strideconverter1_converter_source_last;
+assign main_udp_strideconverter1_source_source_payload_data = main_udp_strideconverter1_converter_source_payload_data;
+assign main_udp_strideconverter1_converter_sink_ready = ((~main_udp_strideconverter1_converter_strobe_all) | main_udp_strideconverter1_converter_source_ready);
+assign main_udp_strideconverter1_converter_source_valid = main_udp_strideconverter1_converter_strobe_all;
+assign main_udp_strideconverter1_converter_load_part = (main_udp_strideconverter1_converter_sink_valid & main_udp_strideconverter1_converter_sink_ready);
+assign main_udp_tx_cdc_source_valid = main_udp_tx_cdc_sink_valid;
+assign main_udp_tx_cdc_sink_ready = main_udp_tx_cdc_source_ready;
+assign main_udp_tx_cdc_source_first = main_udp_tx_cdc_sink_first;
+assign main_udp_tx_cdc_source_last = main_udp_tx_cdc_sink_last;
+assign main_udp_tx_cdc_source_payload_data = main_udp_tx_cdc_sink_payload_data;
+assign main_udp_tx_cdc_source_payload_last_be = main_udp_tx_cdc_sink_payload_last_be;
+assign main_udp_tx_cdc_source_payload_error = main_udp_tx_cdc_sink_payload_error;
+assign main_udp_tx_cdc_source_param_length = main_udp_tx_cdc_sink_param_length;
+assign main_udp_tx_cdc_source_param_protocol = main_udp_tx_cdc_sink_param_protocol;
+assign main_udp_tx_cdc_source_param_ip_address = main_udp_tx_cdc_sink_param_ip_address;
+assign main_port_tx_cdc_sink_valid = main_port_user_port_sink_valid;
+assign main_port_user_port_sink_ready = main_port_tx_cdc_sink_ready;
+assign main_port_tx_cdc_sink_first = main_port_user_port_sink_first;
+assign main_port_tx_cdc_sink_last = main_port_user_port_sink_last;
+assign main_port_tx_cdc_sink_payload_data = main_port_user_port_sink_payload_data;
+assign main_port_tx_cdc_sink_payload_last_be = main_port_user_port_sink_payload_last_be;
+assign main_port_tx_cdc_sink_payload_error = main_port_user_port_sink_payload_error;
+assign main_port_tx_cdc_sink_param_src_port = main_port_user_port_sink_param_src_port;
+assign main_port_tx_cdc_sink_param_dst_port = main_port_user_port_sink_param_dst_port;
+assign main_port_tx_cdc_sink_param_ip_address = main_port_user_port_sink_param_ip_address;
+assign main_port_tx_cdc_sink_param_length = main_port_user_port_sink_param_length;
+assign main_port_tx_converter_sink_valid = main_port_tx_cdc_source_valid;
+assign main_port_tx_cdc_source_ready = main_port_tx_converter_sink_ready;
+assign main_port_tx_converter_sink_first = main_port_tx_cdc_source_first;
+assign main_port_tx_converter_sink_last = main_port_tx_cdc_source_last;
+assign main_port_tx_converter_sink_payload_data = main_port_tx_cdc_source_payload_data;
+assign main_port_tx_converter_sink_payload_last_be = main_port_tx_cdc_source_payload_last_be;
+assign main_port_tx_converter_sink_payload_error = main_port_tx_cdc_source_payload_error;
+assign main_port_tx_converter_sink_param_src_port = main_port_tx_cdc_source_param_src_port;
+assign main_port_tx_converter_sink_param_dst_port = main_port_tx_cdc_source_param_dst_port;
+assign main_port_tx_converter_sink_param_ip_address = main_port_tx_cdc_source_param_ip_address;
+assign main_port_tx_converter_sink_param_length = main_port_tx_cdc_source_param_length;
+assign main_port_internal_port_sink_valid = main_port_tx_converter_source_valid;
+assign main_port_tx_converter_source_ready = main_port_internal_port_sink_ready;
+assign main_port_internal_port_sink_first = main_port_tx_converter_source_first;
+assign main_port_internal_port_sink_last = main_port_tx_converter_source_last;
+assign main_port_internal_port_sink_payload_data = main_port_tx_converter_source_payload_data;
+assign main_port_internal_port_sink_payload_last_be = main_port_tx_converter_source_payload_last_be;
+assign main_port_internal_port_sink_payload_error = main_port_tx_converter_source_payload_error;
+assign main_port_internal_port_sink_param_src_port = main_port_tx_converter_source_param_src_port;
+assign main_port_internal_port_sink_param_dst_port = main_port_tx_converter_source_param_dst_port;
+assign main_port_internal_port_sink_param_ip_address = main_port_tx_converter_source_param_ip_address;
+assign main_port_internal_port_sink_param_length = main_port_tx_converter_source_param_length;
+assign main_port_rx_converter_sink_valid = main_port_internal_port_source_valid;
+assign main_port_internal_port_source_ready = main_port_rx_converter_sink_ready;
+assign main_port_rx_converter_sink_first = main_port_internal_port_source_first;
+assign main_port_rx_converter_sink_last = main_port_internal_port_source_last;
+assign main_port_rx_converter_sink_payload_data = main_port_internal_port_source_payload_data;
+assign main_port_rx_converter_sink_payload_last_be = main_port_internal_port_source_payload_last_be;
+assign main_port_rx_converter_sink_payload_error = main_port_internal_port_source_payload_error;
+assign main_port_rx_converter_sink_param_src_port = main_port_internal_port_source_param_src_port;
+assign main_port_rx_converter_sink_param_dst_port = main_port_internal_port_source_param_dst_port;
+assign main_port_rx_converter_sink_param_ip_address = main_port_internal_port_source_param_ip_address;
+assign main_port_rx_converter_sink_param_length = main_port_internal_port_source_param_length;
+assign main_port_rx_cdc_sink_valid = main_port_rx_converter_source_valid;
+assign main_port_rx_converter_source_ready = main_port_rx_cdc_sink_ready;
+assign main_port_rx_cdc_sink_first = main_port_rx_converter_source_first;
+assign main_port_rx_cdc_sink_last = main_port_rx_converter_source_last;
+assign main_port_rx_cdc_sink_payload_data = main_port_rx_converter_source_payload_data;
+assign main_port_rx_cdc_sink_payload_last_be = main_port_rx_converter_source_payload_last_be;
+assign main_port_rx_cdc_sink_payload_error = main_port_rx_converter_source_payload_error;
+assign main_port_rx_cdc_sink_param_src_port = main_port_rx_converter_source_param_src_port;
+assign main_port_rx_cdc_sink_param_dst_port = main_port_rx_converter_source_param_dst_port;
+assign main_port_rx_cdc_sink_param_ip_address = main_port_rx_converter_source_param_ip_address;
+assign main_port_rx_cdc_sink_param_length = main_port_rx_converter_source_param_length;
+assign main_port_user_port_source_valid = main_port_rx_cdc_source_valid;
+assign main_port_rx_cdc_source_ready = main_port_user_port_source_ready;
+assign main_port_user_port_source_first = main_port_rx_cdc_source_first;
+assign main_port_user_port_source_last = main_port_rx_cdc_source_last;
+assign main_port_user_port_source_payload_data = main_port_rx_cdc_source_payload_data;
+assign main_port_user_port_source_payload_last_be = main_port_rx_cdc_source_payload_last_be;
+assign main_port_user_port_source_payload_error = main_port_rx_cdc_source_payload_error;
+assign main_port_user_port_source_param_src_port = main_port_rx_cdc_source_param_src_port;
+assign main_port_user_port_source_param_dst_port = main_port_rx_cdc_source_param_dst_port;
+assign main_port_user_port_source_param_ip_address = main_port_rx_cdc_source_param_ip_address;
+assign main_port_user_port_source_param_length = main_port_rx_cdc_source_param_length;
+assign builder_portudp_taken = ((1'd0 + main_port_internal_port_source_valid) != 1'd0);
+assign main_udp_maskedudpcrossbar_dropped = (((main_udp_maskedudpcrossbar_sink_valid & main_udp_maskedudpcrossbar_sink_ready) & main_udp_maskedudpcrossbar_sink_last) & (~builder_portudp_taken));
+always @(*) begin
+    builder_portudp_sel0 <= 1'd0;
+    if ((main_udp_maskedudpcrossbar_sink_param_dst_port == udp_rx_port)) begin
+        builder_portudp_sel0 <= 1'd1;
+    end
+    if ((((main_udp_maskedudpcrossbar_sink_param_dst_port ^ udp_rx_port) & udp_rx_port_mask) == 1'd0)) begin
+        builder_portudp_sel0 <= 1'd1;
+    end
+end
+assign main_port_tx_cdc_source_valid = main_port_tx_cdc_sink_valid;
+assign main_port_tx_cdc_sink_ready = main_port_tx_cdc_source_ready;
+assign main_port_tx_cdc_source_first = main_port_tx_cdc_sink_first;
+assign main_port_tx_cdc_source_last = main_port_tx_cdc_sink_last;
+assign main_port_tx_cdc_source_payload_data = main_port_tx_cdc_sink_payload_data;
+assign main_port_tx_cdc_source_payload_last_be = main_port_tx_cdc_sink_payload_last_be;
+assign main_port_tx_cdc_source_payload_error = main_port_tx_cdc_sink_payload_error;
+assign main_port_tx_cdc_source_param_src_port = main_port_tx_cdc_sink_param_src_port;
+assign main_port_tx_cdc_source_param_dst_port = main_port_tx_cdc_sink_param_dst_port;
+assign main_port_tx_cdc_source_param_ip_address = main_port_tx_cdc_sink_param_ip_address;
+assign main_port_tx_cdc_source_param_length = main_port_tx_cdc_sink_param_length;
+assign main_port_tx_converter_converter_sink_valid = main_port_tx_converter_sink_valid;
+assign main_port_tx_converter_converter_sink_first = main_port_tx_converter_sink_first;
+assign main_port_tx_converter_converter_sink_last = main_port_tx_converter_sink_last;
+assign main_port_tx_converter_sink_ready = main_port_tx_converter_converter_sink_ready;
+assign main_port_tx_converter_converter_sink_payload_data = {main_port_tx_converter_sink_payload_error, main_port_tx_converter_sink_payload_last_be, main_port_tx_converter_sink_payload_data};
+assign main_port_tx_converter_source_valid = main_port_tx_converter_source_source_valid;
+assign main_port_tx_converter_source_first = main_port_tx_converter_source_source_first;
+assign main_port_tx_converter_source_last = main_port_tx_converter_source_source_last;
+assign main_port_tx_converter_source_source_ready = main_port_tx_converter_source_ready;
+assign {main_port_tx_converter_source_payload_error, main_port_tx_converter_source_payload_last_be, main_port_tx_converter_source_payload_data} = main_port_tx_converter_source_source_payload_data;
+assign main_port_tx_converter_source_param_src_port = main_port_tx_converter_sink_param_src_port;
+assign main_port_tx_converter_source_param_dst_port = main_port_tx_converter_sink_param_dst_port;
+assign main_port_tx_converter_source_param_ip_address = main_port_tx_converter_sink_param_ip_address;
+assign main_port_tx_converter_source_param_length = main_port_tx_converter_sink_param_length;
+assign main_port_tx_converter_source_source_valid = main_port_tx_converter_converter_source_valid;
+assign main_port_tx_converter_converter_source_ready = main_port_tx_converter_source_source_ready;
+assign main_port_tx_converter_source_source_first = main_port_tx_converter_converter_source_first;
+assign main_port_tx_converter_source_source_last = main_port_tx_converter_converter_source_last;
+assign main_port_tx_converter_source_source_payload_data = main_port_tx_converter_converter_source_payload_data;
+assign main_port_tx_converter_converter_source_valid = main_port_tx_converter_converter_sink_valid;
+assign main_port_tx_converter_converter_sink_ready = main_port_tx_converter_converter_source_ready;
+assign main_port_tx_converter_converter_source_first = main_port_tx_converter_converter_sink_first;
+assign main_port_tx_converter_converter_source_last = main_port_tx_converter_converter_sink_last;
+assign main_port_tx_converter_converter_source_payload_data = main_port_tx_converter_converter_sink_payload_data;
+assign main_port_tx_converter_converter_source_payload_valid_token_count = 1'd1;
+assign main_port_rx_converter_converter_sink_valid = main_port_rx_converter_sink_valid;
+assign main_port_rx_converter_converter_sink_first = main_port_rx_converter_sink_first;
+assign main_port_rx_converter_converter_sink_last = main_port_rx_converter_sink_last;
+assign main_port_rx_converter_sink_ready = main_port_rx_converter_converter_sink_ready;
+assign main_port_rx_converter_converter_sink_payload_data = {main_port_rx_converter_sink_payload_error, main_port_rx_converter_sink_payload_last_be, main_port_rx_converter_sink_payload_data};
+assign main_port_rx_converter_source_valid = main_port_rx_converter_source_source_valid;
+assign main_port_rx_converter_source_first = main_port_rx_converter_source_source_first;
+assign main_port_rx_converter_source_last = main_port_rx_converter_source_source_last;
+assign main_port_rx_converter_source_source_ready = main_port_rx_converter_source_ready;
+assign {main_port_rx_converter_source_payload_error, main_port_rx_converter_source_payload_last_be, main_port_rx_converter_source_payload_data} = main_port_rx_converter_source_source_payload_data;
+assign main_port_rx_converter_source_param_src_port = main_port_rx_converter_sink_param_src_port;
+assign main_port_rx_converter_source_param_dst_port = main_port_rx_converter_sink_param_dst_port;
+assign main_port_rx_converter_source_param_ip_address = main_port_rx_converter_sink_param_ip_address;
+assign main_port_rx_converter_source_param_length = main_port_rx_converter_sink_param_length;
+assign main_port_rx_converter_source_source_valid = main_port_rx_converter_converter_source_valid;
+assign main_port_rx_converter_converter_source_ready = main_port_rx_converter_source_source_ready;
+assign main_port_rx_converter_source_source_first = main_port_rx_converter_converter_source_first;
+assign main_port_rx_converter_source_source_last = main_port_rx_converter_converter_source_last;
+assign main_port_rx_converter_source_source_payload_data = main_port_rx_converter_converter_source_payload_data;
+assign main_port_rx_converter_converter_source_valid = main_port_rx_converter_converter_sink_valid;
+assign main_port_rx_converter_converter_sink_ready = main_port_rx_converter_converter_source_ready;
+assign main_port_rx_converter_converter_source_first = main_port_rx_converter_converter_sink_first;
+assign main_port_rx_converter_converter_source_last = main_port_rx_converter_converter_sink_last;
+assign main_port_rx_converter_converter_source_payload_data = main_port_rx_converter_converter_sink_payload_data;
+assign main_port_rx_converter_converter_source_payload_valid_token_count = 1'd1;
+assign main_port_rx_cdc_source_valid = main_port_rx_cdc_sink_valid;
+assign main_port_rx_cdc_sink_ready = main_port_rx_cdc_source_ready;
+assign main_port_rx_cdc_source_first = main_port_rx_cdc_sink_first;
+assign main_port_rx_cdc_source_last = main_port_rx_cdc_sink_last;
+assign main_port_rx_cdc_source_payload_data = main_port_rx_cdc_sink_payload_data;
+assign main_port_rx_cdc_source_payload_last_be = main_port_rx_cdc_sink_payload_last_be;
+assign main_port_rx_cdc_source_payload_error = main_port_rx_cdc_sink_payload_error;
+assign main_port_rx_cdc_source_param_src_port = main_port_rx_cdc_sink_param_src_port;
+assign main_port_rx_cdc_source_param_dst_port = main_port_rx_cdc_sink_param_dst_port;
+assign main_port_rx_cdc_source_param_ip_address = main_port_rx_cdc_sink_param_ip_address;
+assign main_port_rx_cdc_source_param_length = main_port_rx_cdc_sink_param_length;
+assign main_udp_maskedudpcrossbar_source_valid = main_port_internal_port_sink_valid;
+assign main_port_internal_port_sink_ready = main_udp_maskedudpcrossbar_source_ready;
+assign main_udp_maskedudpcrossbar_source_first = main_port_internal_port_sink_first;
+assign main_udp_maskedudpcrossbar_source_last = main_port_internal_port_sink_last;
+assign main_udp_maskedudpcrossbar_source_payload_data = main_port_internal_port_sink_payload_data;
+assign main_udp_maskedudpcrossbar_source_payload_last_be = main_port_internal_port_sink_payload_last_be;
+assign main_udp_maskedudpcrossbar_source_payload_error = main_port_internal_port_sink_payload_error;
+assign main_udp_maskedudpcrossbar_source_param_src_port = main_port_internal_port_sink_param_src_port;
+assign main_udp_maskedudpcrossbar_source_param_dst_port = main_port_internal_port_sink_param_dst_port;
+assign main_udp_maskedudpcrossbar_source_param_ip_address = main_port_internal_port_sink_param_ip_address;
+assign main_udp_maskedudpcrossbar_source_param_length = main_port_internal_port_sink_param_length;
+always @(*) begin
+    builder_portudp_sel1 <= 1'd0;
+    if (builder_portudp_first) begin
+        builder_portudp_sel1 <= builder_portudp_sel0;
+    end else begin
+        builder_portudp_sel1 <= builder_portudp_sel_ongoing;
+    end
+end
+always @(*) begin
+    main_port_internal_port_source_first <= 1'd0;
+    main_port_internal_port_source_last <= 1'd0;
+    main_port_internal_port_source_param_dst_port <= 16'd0;
+    main_port_internal_port_source_param_ip_address <= 32'd0;
+    main_port_internal_port_source_param_length <= 16'd0;
+    main_port_internal_port_source_param_src_port <= 16'd0;
+    main_port_internal_port_source_payload_data <= 8'd0;
+    main_port_internal_port_source_payload_error <= 1'd0;
+    main_port_internal_port_source_payload_last_be <= 1'd0;
+    main_port_internal_port_source_valid <= 1'd0;
+    main_udp_maskedudpcrossbar_sink_ready <= 1'd0;
+    case (builder_portudp_sel1)
+        1'd1: begin
+            main_port_internal_port_source_valid <= main_udp_maskedudpcrossbar_sink_valid;
+            main_udp_maskedudpcrossbar_sink_ready <= main_port_internal_port_source_ready;
+            main_port_internal_port_source_first <= main_udp_maskedudpcrossbar_sink_first;
+            main_port_internal_port_source_last <= main_udp_maskedudpcrossbar_sink_last;
+            main_port_internal_port_source_payload_data <= main_udp_maskedudpcrossbar_sink_payload_data;
+            main_port_internal_port_source_payload_last_be <= main_udp_maskedudpcrossbar_sink_payload_last_be;
+            main_port_internal_port_source_payload_error <= main_udp_maskedudpcrossbar_sink_payload_error;
+            main_port_internal_port_source_param_src_port <= main_udp_maskedudpcrossbar_sink_param_src_port;
+            main_port_internal_port_source_param_dst_port <= main_udp_maskedudpcrossbar_sink_param_dst_port;
+            main_port_internal_port_source_param_ip_address <= main_udp_maskedudpcrossbar_sink_param_ip_address;
+            main_port_internal_port_source_param_length <= main_udp_maskedudpcrossbar_sink_param_length;
+        end
+        default: begin
+            main_udp_maskedudpcrossbar_sink_ready <= 1'd1;
+        end
+    endcase
+end
+assign builder_portudp_last = ((main_udp_maskedudpcrossbar_sink_valid & main_udp_maskedudpcrossbar_sink_last) & main_udp_maskedudpcrossbar_sink_ready);
+assign builder_portudp_ongoing0 = ((main_udp_maskedudpcrossbar_sink_valid | builder_portudp_ongoing1) & (~builder_portudp_last));
+assign main_udp_buffer0_pipe_valid_sink_ready = ((~main_udp_buffer0_pipe_valid_source_valid) | main_udp_buffer0_pipe_valid_source_ready);
+assign main_udp_buffer0_pipe_ready_sink_ready = (~main_udp_buffer0_pipe_ready_valid);
+always @(*) begin
+    main_udp_buffer0_pipe_ready_source_first <= 1'd0;
+    main_udp_buffer0_pipe_ready_source_last <= 1'd0;
+    main_udp_buffer0_pipe_ready_source_param_ip_address <= 32'd0;
+    main_udp_buffer0_pipe_ready_source_param_length <= 16'd0;
+    main_udp_buffer0_pipe_ready_source_param_protocol <= 8'd0;
+    main_udp_buffer0_pipe_ready_source_payload_data <= 8'd0;
+    main_udp_buffer0_pipe_ready_source_payload_error <= 1'd0;
+    main_udp_buffer0_pipe_ready_source_payload_last_be <= 1'd0;
+    main_udp_buffer0_pipe_ready_source_valid <= 1'd0;
+    if (main_udp_buffer0_pipe_ready_valid) begin
+        main_udp_buffer0_pipe_ready_source_valid <= main_udp_buffer0_pipe_ready_sink_d_valid;
+        main_udp_buffer0_pipe_ready_source_first <= main_udp_buffer0_pipe_ready_sink_d_first;
+        main_udp_buffer0_pipe_ready_source_last <= main_udp_buffer0_pipe_ready_sink_d_last;
+        main_udp_buffer0_pipe_ready_source_payload_data <= main_udp_buffer0_pipe_ready_sink_d_payload_data;
+        main_udp_buffer0_pipe_ready_source_payload_last_be <= main_udp_buffer0_pipe_ready_sink_d_payload_last_be;
+        main_udp_buffer0_pipe_ready_source_payload_error <= main_udp_buffer0_pipe_ready_sink_d_payload_error;
+        main_udp_buffer0_pipe_ready_source_param_length <= main_udp_buffer0_pipe_ready_sink_d_param_length;
+        main_udp_buffer0_pipe_ready_source_param_protocol <= main_udp_buffer0_pipe_ready_sink_d_param_protocol;
+        main_udp_buffer0_pipe_ready_source_param_ip_address <= main_udp_buffer0_pipe_ready_sink_d_param_ip_address;
+    end else begin
+        main_udp_buffer0_pipe_ready_source_valid <= main_udp_buffer0_pipe_ready_sink_valid;
+        main_udp_buffer0_pipe_ready_source_first <= main_udp_buffer0_pipe_ready_sink_first;
+        main_udp_buffer0_pipe_ready_source_last <= main_udp_buffer0_pipe_ready_sink_last;
+        main_udp_buffer0_pipe_ready_source_payload_data <= main_udp_buffer0_pipe_ready_sink_payload_data;
+        main_udp_buffer0_pipe_ready_source_payload_last_be <= main_udp_buffer0_pipe_ready_sink_payload_last_be;
+        main_udp_buffer0_pipe_ready_source_payload_error <= main_udp_buffer0_pipe_ready_sink_payload_error;
+        main_udp_buffer0_pipe_ready_source_param_length <= main_udp_buffer0_pipe_ready_sink_param_length;
+        main_udp_buffer0_pipe_ready_source_param_protocol <= main_udp_buffer0_pipe_ready_sink_param_protocol;
+        main_udp_buffer0_pipe_ready_source_param_ip_address <= main_udp_buffer0_pipe_ready_sink_param_ip_address;
+    end
+end
+assign main_udp_buffer0_pipe_valid_sink_valid = main_udp_buffer0_sink_sink_valid;
+assign main_udp_buffer0_sink_sink_ready = main_udp_buffer0_pipe_valid_sink_ready;
+assign main_udp_buffer0_pipe_valid_sink_first = main_udp_buffer0_sink_sink_first;
+assign main_udp_buffer0_pipe_valid_sink_last = main_udp_buffer0_sink_sink_last;
+assign main_udp_buffer0_pipe_valid_sink_payload_data = main_udp_buffer0_sink_sink_payload_data;
+assign main_udp_buffer0_pipe_valid_sink_payload_last_be = main_udp_buffer0_sink_sink_payload_last_be;
+assign main_udp_buffer0_pipe_valid_sink_payload_error = main_udp_buffer0_sink_sink_payload_error;
+assign main_udp_buffer0_pipe_valid_sink_param_length = main_udp_buffer0_sink_sink_param_length;
+assign main_udp_buffer0_pipe_valid_sink_param_protocol = main_udp_buffer0_sink_sink_param_protocol;
+assign main_udp_buffer0_pipe_valid_sink_param_ip_address = main_udp_buffer0_sink_sink_param_ip_address;
+assign main_udp_buffer0_pipe_ready_sink_valid = main_udp_buffer0_pipe_valid_source_valid;
+assign main_udp_buffer0_pipe_valid_source_ready = main_udp_buffer0_pipe_ready_sink_ready;
+assign main_udp_buffer0_pipe_ready_sink_first = main_udp_buffer0_pipe_valid_source_first;
+assign main_udp_buffer0_pipe_ready_sink_last = main_udp_buffer0_pipe_valid_source_last;
+assign main_udp_buffer0_pipe_ready_sink_payload_data = main_udp_buffer0_pipe_valid_source_payload_data;
+assign main_udp_buffer0_pipe_ready_sink_payload_last_be = main_udp_buffer0_pipe_valid_source_payload_last_be;
+assign main_udp_buffer0_pipe_ready_sink_payload_error = main_udp_buffer0_pipe_valid_source_payload_error;
+assign main_udp_buffer0_pipe_ready_sink_param_length = main_udp_buffer0_pipe_valid_source_param_length;
+assign main_udp_buffer0_pipe_ready_sink_param_protocol = main_udp_buffer0_pipe_valid_source_param_protocol;
+assign main_udp_buffer0_pipe_ready_sink_param_ip_address = main_udp_buffer0_pipe_valid_source_param_ip_address;
+assign main_udp_buffer0_source_source_valid = main_udp_buffer0_pipe_ready_source_valid;
+assign main_udp_buffer0_pipe_ready_source_ready = main_udp_buffer0_source_source_ready;
+assign main_udp_buffer0_source_source_first = main_udp_buffer0_pipe_ready_source_first;
+assign main_udp_buffer0_source_source_last = main_udp_buffer0_pipe_ready_source_last;
+assign main_udp_buffer0_source_source_payload_data = main_udp_buffer0_pipe_ready_source_payload_data;
+assign main_udp_buffer0_source_source_payload_last_be = main_udp_buffer0_pipe_ready_source_payload_last_be;
+assign main_udp_buffer0_source_source_payload_error = main_udp_buffer0_pipe_ready_source_payload_error;
+assign main_udp_buffer0_source_source_param_length = main_udp_buffer0_pipe_ready_source_param_length;
+assign main_udp_buffer0_source_source_param_protocol = main_udp_buffer0_pipe_ready_source_param_protocol;
+assign main_udp_buffer0_source_source_param_ip_address = main_udp_buffer0_pipe_ready_source_param_ip_address;
+assign main_udp_buffer1_pipe_valid_sink_ready = ((~main_udp_buffer1_pipe_valid_source_valid) | main_udp_buffer1_pipe_valid_source_ready);
+assign main_udp_buffer1_pipe_ready_sink_ready = (~main_udp_buffer1_pipe_ready_valid);
+always @(*) begin
+    main_udp_buffer1_pipe_ready_source_first <= 1'd0;
+    main_udp_buffer1_pipe_ready_source_last <= 1'd0;
+    main_udp_buffer1_pipe_ready_source_param_ip_address <= 32'd0;
+    main_udp_buffer1_pipe_ready_source_param_length <= 16'd0;
+    main_udp_buffer1_pipe_ready_source_param_protocol <= 8'd0;
+    main_udp_buffer1_pipe_ready_source_payload_data <= 8'd0;
+    main_udp_buffer1_pipe_ready_source_payload_error <= 1'd0;
+    main_udp_buffer1_pipe_ready_source_payload_last_be <= 1'd0;
+    main_udp_buffer1_pipe_ready_source_valid <= 1'd0;
+    if (main_udp_buffer1_pipe_ready_valid) begin
+        main_udp_buffer1_pipe_ready_source_valid <= main_udp_buffer1_pipe_ready_sink_d_valid;
+        main_udp_buffer1_pipe_ready_source_first <= main_udp_buffer1_pipe_ready_sink_d_first;
+        main_udp_buffer1_pipe_ready_source_last <= main_udp_buffer1_pipe_ready_sink_d_last;
+        main_udp_buffer1_pipe_ready_source_payload_data <= main_udp_buffer1_pipe_ready_sink_d_payload_data;
+        main_udp_buffer1_pipe_ready_source_payload_last_be <= main_udp_buffer1_pipe_ready_sink_d_payload_last_be;
+        main_udp_buffer1_pipe_ready_source_payload_error <= main_udp_buffer1_pipe_ready_sink_d_payload_error;
+        main_udp_buffer1_pipe_ready_source_param_length <= main_udp_buffer1_pipe_ready_sink_d_param_length;
+        main_udp_buffer1_pipe_ready_source_param_protocol <= main_udp_buffer1_pipe_ready_sink_d_param_protocol;
+        main_udp_buffer1_pipe_ready_source_param_ip_address <= main_udp_buffer1_pipe_ready_sink_d_param_ip_address;
+    end else begin
+        main_udp_buffer1_pipe_ready_source_valid <= main_udp_buffer1_pipe_ready_sink_valid;
+        main_udp_buffer1_pipe_ready_source_first <= main_udp_buffer1_pipe_ready_sink_first;
+        main_udp_buffer1_pipe_ready_source_last <= main_udp_buffer1_pipe_ready_sink_last;
+        main_udp_buffer1_pipe_ready_source_payload_data <= main_udp_buffer1_pipe_ready_sink_payload_data;
+        main_udp_buffer1_pipe_ready_source_payload_last_be <= main_udp_buffer1_pipe_ready_sink_payload_last_be;
+        main_udp_buffer1_pipe_ready_source_payload_error <= main_udp_buffer1_pipe_ready_sink_payload_error;
+        main_udp_buffer1_pipe_ready_source_param_length <= main_udp_buffer1_pipe_ready_sink_param_length;
+        main_udp_buffer1_pipe_ready_source_param_protocol <= main_udp_buffer1_pipe_ready_sink_param_protocol;
+        main_udp_buffer1_pipe_ready_source_param_ip_address <= main_udp_buffer1_pipe_ready_sink_param_ip_address;
+    end
+end
+assign main_udp_buffer1_pipe_valid_sink_valid = main_udp_buffer1_sink_sink_valid;
+assign main_udp_buffer1_sink_sink_ready = main_udp_buffer1_pipe_valid_sink_ready;
+assign main_udp_buffer1_pipe_valid_sink_first = main_udp_buffer1_sink_sink_first;
+assign main_udp_buffer1_pipe_valid_sink_last = main_udp_buffer1_sink_sink_last;
+assign main_udp_buffer1_pipe_valid_sink_payload_data = main_udp_buffer1_sink_sink_payload_data;
+assign main_udp_buffer1_pipe_valid_sink_payload_last_be = main_udp_buffer1_sink_sink_payload_last_be;
+assign main_udp_buffer1_pipe_valid_sink_payload_error = main_udp_buffer1_sink_sink_payload_error;
+assign main_udp_buffer1_pipe_valid_sink_param_length = main_udp_buffer1_sink_sink_param_length;
+assign main_udp_buffer1_pipe_valid_sink_param_protocol = main_udp_buffer1_sink_sink_param_protocol;
+assign main_udp_buffer1_pipe_valid_sink_param_ip_address = main_udp_buffer1_sink_sink_param_ip_address;
+assign main_udp_buffer1_pipe_ready_sink_valid = main_udp_buffer1_pipe_valid_source_valid;
+assign main_udp_buffer1_pipe_valid_source_ready = main_udp_buffer1_pipe_ready_sink_ready;
+assign main_udp_buffer1_pipe_ready_sink_first = main_udp_buffer1_pipe_valid_source_first;
+assign main_udp_buffer1_pipe_ready_sink_last = main_udp_buffer1_pipe_valid_source_last;
+assign main_udp_buffer1_pipe_ready_sink_payload_data = main_udp_buffer1_pipe_valid_source_payload_data;
+assign main_udp_buffer1_pipe_ready_sink_payload_last_be = main_udp_buffer1_pipe_valid_source_payload_last_be;
+assign main_udp_buffer1_pipe_ready_sink_payload_error = main_udp_buffer1_pipe_valid_source_payload_error;
+assign main_udp_buffer1_pipe_ready_sink_param_length = main_udp_buffer1_pipe_valid_source_param_length;
+assign main_udp_buffer1_pipe_ready_sink_param_protocol = main_udp_buffer1_pipe_valid_source_param_protocol;
+assign main_udp_buffer1_pipe_ready_sink_param_ip_address = main_udp_buffer1_pipe_valid_source_param_ip_address;
+assign main_udp_buffer1_source_source_valid = main_udp_buffer1_pipe_ready_source_valid;
+assign main_udp_buffer1_pipe_ready_source_ready = main_udp_buffer1_source_source_ready;
+assign main_udp_buffer1_source_source_first = main_udp_buffer1_pipe_ready_source_first;
+assign main_udp_buffer1_source_source_last = main_udp_buffer1_pipe_ready_source_last;
+assign main_udp_buffer1_source_source_payload_data = main_udp_buffer1_pipe_ready_source_payload_data;
+assign main_udp_buffer1_source_source_payload_last_be = main_udp_buffer1_pipe_ready_source_payload_last_be;
+assign main_udp_buffer1_source_source_payload_error = main_udp_buffer1_pipe_ready_source_payload_error;
+assign main_udp_buffer1_source_source_param_length = main_udp_buffer1_pipe_ready_source_param_length;
+assign main_udp_buffer1_source_source_param_protocol = main_udp_buffer1_pipe_ready_source_param_protocol;
+assign main_udp_buffer1_source_source_param_ip_address = main_udp_buffer1_pipe_ready_source_param_ip_address;
+assign main_pulsemerge0_total0 = ((((1'd0 + main_mac_cut) + main_ip_rx_cut) + main_ip_rx_drop_header) + main_pulsemerge0_backlog0);
+assign main_pulsemerge0_o0 = (main_pulsemerge0_total0 != 1'd0);
+assign main_pulsemerge0_total1 = ((((1'd0 + main_pulsemerge0_o0) + main_udp_holdingudprx_cut0) + main_udp_holdingudprx_drop_header) + main_pulsemerge0_backlog1);
+assign main_pulsemerge0_o1 = (main_pulsemerge0_total1 != 1'd0);
+assign main_pulsemerge1_total0 = ((((1'd0 + main_mac_crossbar_dropped) + main_ip_rx_drop_other) + main_ip_crossbar_dropped) + main_pulsemerge1_backlog0);
+assign main_pulsemerge1_o0 = (main_pulsemerge1_total0 != 1'd0);
+assign main_pulsemerge1_total1 = (((1'd0 + main_pulsemerge1_o0) + main_udp_maskedudpcrossbar_dropped) + main_pulsemerge1_backlog1);
+assign main_pulsemerge1_o1 = (main_pulsemerge1_total1 != 1'd0);
 always @(*) begin
     builder_interface0_ack <= 1'd0;
     builder_interface0_dat_r <= 32'd0;
@@ -6229,20 +7360,20 @@ assign builder_rhs_slice_proxy64 = main_icmp_rx_liteethicmpdepacketizer_header[6
 assign builder_rhs_slice_proxy65 = main_icmp_rx_liteethicmpdepacketizer_header[63:32];
 assign builder_rhs_slice_proxy66 = main_icmp_rx_liteethicmpdepacketizer_header[63:32];
 assign builder_rhs_slice_proxy67 = main_icmp_rx_liteethicmpdepacketizer_header[63:32];
-assign builder_rhs_slice_proxy68 = main_holdingudprx_liteethudpdepacketizer_header[63:48];
-assign builder_rhs_slice_proxy69 = main_holdingudprx_liteethudpdepacketizer_header[63:48];
-assign builder_rhs_slice_proxy70 = main_holdingudprx_liteethudpdepacketizer_header[31:16];
-assign builder_rhs_slice_proxy71 = main_holdingudprx_liteethudpdepacketizer_header[31:16];
-assign builder_rhs_slice_proxy72 = main_holdingudprx_liteethudpdepacketizer_header[47:32];
-assign builder_rhs_slice_proxy73 = main_holdingudprx_liteethudpdepacketizer_header[47:32];
-assign builder_rhs_slice_proxy74 = main_holdingudprx_liteethudpdepacketizer_header[15:0];
-assign builder_rhs_slice_proxy75 = main_holdingudprx_liteethudpdepacketizer_header[15:0];
+assign builder_rhs_slice_proxy68 = main_udp_holdingudprx_liteethudpdepacketizer_header[63:48];
+assign builder_rhs_slice_proxy69 = main_udp_holdingudprx_liteethudpdepacketizer_header[63:48];
+assign builder_rhs_slice_proxy70 = main_udp_holdingudprx_liteethudpdepacketizer_header[31:16];
+assign builder_rhs_slice_proxy71 = main_udp_holdingudprx_liteethudpdepacketizer_header[31:16];
+assign builder_rhs_slice_proxy72 = main_udp_holdingudprx_liteethudpdepacketizer_header[47:32];
+assign builder_rhs_slice_proxy73 = main_udp_holdingudprx_liteethudpdepacketizer_header[47:32];
+assign builder_rhs_slice_proxy74 = main_udp_holdingudprx_liteethudpdepacketizer_header[15:0];
+assign builder_rhs_slice_proxy75 = main_udp_holdingudprx_liteethudpdepacketizer_header[15:0];
 assign main_mac_core_tx_cdc_cdc_produce_rdomain = builder_multiregimpl0_regs1;
 assign main_mac_core_tx_cdc_cdc_consume_wdomain = builder_multiregimpl1_regs1;
 assign main_mac_core_pulsesynchronizer0_toggle_o = builder_multiregimpl2_regs1;
 assign main_mac_core_pulsesynchronizer1_toggle_o = builder_multiregimpl3_regs1;
-assign main_mac_core_cdc_produce_rdomain = builder_multiregimpl4_regs1;
-assign main_mac_core_cdc_consume_wdomain = builder_multiregimpl5_regs1;
+assign main_mac_core_rx_cdc_cdc_produce_rdomain = builder_multiregimpl4_regs1;
+assign main_mac_core_rx_cdc_cdc_consume_wdomain = builder_multiregimpl5_regs1;
 
 
 //------------------------------------------------------------------------------
@@ -6309,8 +7440,52 @@ always @(posedge eth_rx_clk) begin
     if (main_mac_core_pulsesynchronizer1_i) begin
         main_mac_core_pulsesynchronizer1_toggle_i <= (~main_mac_core_pulsesynchronizer1_toggle_i);
     end
-    main_mac_core_cdc_graycounter0_q_binary <= main_mac_core_cdc_graycounter0_q_next_binary;
-    main_mac_core_cdc_graycounter0_q <= main_mac_core_cdc_graycounter0_q_next;
+    if (main_mac_core_rx_converter_converter_source_ready) begin
+        main_mac_core_rx_converter_converter_strobe_all <= 1'd0;
+    end
+    if (main_mac_core_rx_converter_converter_load_part) begin
+        if (((main_mac_core_rx_converter_converter_demux == 2'd3) | main_mac_core_rx_converter_converter_sink_last)) begin
+            main_mac_core_rx_converter_converter_demux <= 1'd0;
+            main_mac_core_rx_converter_converter_strobe_all <= 1'd1;
+        end else begin
+            main_mac_core_rx_converter_converter_demux <= (main_mac_core_rx_converter_converter_demux + 1'd1);
+        end
+    end
+    if ((main_mac_core_rx_converter_converter_source_valid & main_mac_core_rx_converter_converter_source_ready)) begin
+        if ((main_mac_core_rx_converter_converter_sink_valid & main_mac_core_rx_converter_converter_sink_ready)) begin
+            main_mac_core_rx_converter_converter_source_first <= main_mac_core_rx_converter_converter_sink_first;
+            main_mac_core_rx_converter_converter_source_last <= main_mac_core_rx_converter_converter_sink_last;
+        end else begin
+            main_mac_core_rx_converter_converter_source_first <= 1'd0;
+            main_mac_core_rx_converter_converter_source_last <= 1'd0;
+        end
+    end else begin
+        if ((main_mac_core_rx_converter_converter_sink_valid & main_mac_core_rx_converter_converter_sink_ready)) begin
+            main_mac_core_rx_converter_converter_source_first <= (main_mac_core_rx_converter_converter_sink_first | main_mac_core_rx_converter_converter_source_first);
+            main_mac_core_rx_converter_converter_source_last <= (main_mac_core_rx_converter_converter_sink_last | main_mac_core_rx_converter_converter_source_last);
+        end
+    end
+    if (main_mac_core_rx_converter_converter_load_part) begin
+        case (main_mac_core_rx_converter_converter_demux)
+            1'd0: begin
+                main_mac_core_rx_converter_converter_source_payload_data[9:0] <= main_mac_core_rx_converter_converter_sink_payload_data;
+            end
+            1'd1: begin
+                main_mac_core_rx_converter_converter_source_payload_data[19:10] <= main_mac_core_rx_converter_converter_sink_payload_data;
+            end
+            2'd2: begin
+                main_mac_core_rx_converter_converter_source_payload_data[29:20] <= main_mac_core_rx_converter_converter_sink_payload_data;
+            end
+            2'd3: begin
+                main_mac_core_rx_converter_converter_source_payload_data[39:30] <= main_mac_core_rx_converter_converter_sink_payload_data;
+            end
+        endcase
+    end
+    if (main_mac_core_rx_converter_converter_load_part) begin
+        main_mac_core_rx_converter_converter_source_payload_valid_token_count <= (main_mac_core_rx_converter_converter_demux + 1'd1);
+    end
+    main_mac_core_rx_cdc_cdc_graycounter0_q_binary <= main_mac_core_rx_cdc_cdc_graycounter0_q_next_binary;
+    main_mac_core_rx_cdc_cdc_graycounter0_q <= main_mac_core_rx_cdc_cdc_graycounter0_q_next;
     if (eth_rx_rst) begin
         main_source_valid <= 1'd0;
         main_source_payload_data <= 8'd0;
@@ -6325,12 +7500,16 @@ always @(posedge eth_rx_clk) begin
         main_mac_core_bufferizeendpoints_pipe_valid_source_payload_data <= 8'd0;
         main_mac_core_bufferizeendpoints_pipe_valid_source_payload_last_be <= 1'd0;
         main_mac_core_bufferizeendpoints_pipe_valid_source_payload_error <= 1'd0;
-        main_mac_core_cdc_graycounter0_q <= 6'd0;
-        main_mac_core_cdc_graycounter0_q_binary <= 6'd0;
+        main_mac_core_rx_converter_converter_source_payload_data <= 40'd0;
+        main_mac_core_rx_converter_converter_source_payload_valid_token_count <= 3'd0;
+        main_mac_core_rx_converter_converter_demux <= 2'd0;
+        main_mac_core_rx_converter_converter_strobe_all <= 1'd0;
+        main_mac_core_rx_cdc_cdc_graycounter0_q <= 6'd0;
+        main_mac_core_rx_cdc_cdc_graycounter0_q_binary <= 6'd0;
         builder_liteethmac_rxdatapath_liteethmacpreamblechecker_state <= 1'd0;
         builder_liteethmac_rxdatapath_bufferizeendpoints_state <= 2'd0;
     end
-    builder_multiregimpl5_regs0 <= main_mac_core_cdc_graycounter1_q;
+    builder_multiregimpl5_regs0 <= main_mac_core_rx_cdc_cdc_graycounter1_q;
     builder_multiregimpl5_regs1 <= builder_multiregimpl5_regs0;
 end
 
@@ -6341,6 +7520,14 @@ always @(posedge eth_tx_clk) begin
     main_sink_ready <= 1'd1;
     main_mac_core_tx_cdc_cdc_graycounter1_q_binary <= main_mac_core_tx_cdc_cdc_graycounter1_q_next_binary;
     main_mac_core_tx_cdc_cdc_graycounter1_q <= main_mac_core_tx_cdc_cdc_graycounter1_q_next;
+    if ((main_mac_core_tx_converter_converter_source_valid & main_mac_core_tx_converter_converter_source_ready)) begin
+        if (main_mac_core_tx_converter_converter_last) begin
+            main_mac_core_tx_converter_converter_mux <= 1'd0;
+        end else begin
+            main_mac_core_tx_converter_converter_mux <= (main_mac_core_tx_converter_converter_mux + 1'd1);
+        end
+    end
+    builder_liteethmac_txdatapath_liteethmactxlastbe_state <= builder_liteethmac_txdatapath_liteethmactxlastbe_next_state;
     builder_liteethmac_txdatapath_liteethmacpaddinginserter_state <= builder_liteethmac_txdatapath_liteethmacpaddinginserter_next_state;
     if (main_mac_core_tx_padding_counter_liteethmac_clockdomainsrenamer0_next_value_ce) begin
         main_mac_core_tx_padding_counter <= main_mac_core_tx_padding_counter_liteethmac_clockdomainsrenamer0_next_value;
@@ -6381,10 +7568,35 @@ always @(posedge eth_tx_clk) begin
     if (main_mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value_ce) begin
         main_mac_core_tx_gap_counter <= main_mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value;
     end
+    if (((~main_pipe_valid_source_valid) | main_pipe_valid_source_ready)) begin
+        main_pipe_valid_source_valid <= main_pipe_valid_sink_valid;
+        main_pipe_valid_source_first <= main_pipe_valid_sink_first;
+        main_pipe_valid_source_last <= main_pipe_valid_sink_last;
+        main_pipe_valid_source_payload_data <= main_pipe_valid_sink_payload_data;
+        main_pipe_valid_source_payload_last_be <= main_pipe_valid_sink_payload_last_be;
+        main_pipe_valid_source_payload_error <= main_pipe_valid_sink_payload_error;
+    end
+    if ((main_pipe_ready_sink_valid & (~main_pipe_ready_source_ready))) begin
+        main_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (main_pipe_ready_source_ready) begin
+            main_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~main_pipe_ready_source_ready) & (~main_pipe_ready_valid))) begin
+        main_pipe_ready_sink_d_valid <= main_pipe_ready_sink_valid;
+        main_pipe_ready_sink_d_ready <= main_pipe_ready_sink_ready;
+        main_pipe_ready_sink_d_first <= main_pipe_ready_sink_first;
+        main_pipe_ready_sink_d_last <= main_pipe_ready_sink_last;
+        main_pipe_ready_sink_d_payload_data <= main_pipe_ready_sink_payload_data;
+        main_pipe_ready_sink_d_payload_last_be <= main_pipe_ready_sink_payload_last_be;
+        main_pipe_ready_sink_d_payload_error <= main_pipe_ready_sink_payload_error;
+    end
     if (eth_tx_rst) begin
         main_sink_ready <= 1'd0;
         main_mac_core_tx_cdc_cdc_graycounter1_q <= 6'd0;
         main_mac_core_tx_cdc_cdc_graycounter1_q_binary <= 6'd0;
+        main_mac_core_tx_converter_converter_mux <= 2'd0;
         main_mac_core_tx_padding_counter <= 16'd0;
         main_mac_core_tx_crc_reg <= 32'd4294967295;
         main_mac_core_tx_crc_cnt <= 2'd3;
@@ -6392,6 +7604,17 @@ always @(posedge eth_tx_clk) begin
         main_mac_core_tx_crc_pipe_valid_source_payload_data <= 8'd0;
         main_mac_core_tx_crc_pipe_valid_source_payload_last_be <= 1'd0;
         main_mac_core_tx_crc_pipe_valid_source_payload_error <= 1'd0;
+        main_pipe_valid_source_valid <= 1'd0;
+        main_pipe_valid_source_payload_data <= 32'd0;
+        main_pipe_valid_source_payload_last_be <= 4'd0;
+        main_pipe_valid_source_payload_error <= 4'd0;
+        main_pipe_ready_valid <= 1'd0;
+        main_pipe_ready_sink_d_valid <= 1'd0;
+        main_pipe_ready_sink_d_ready <= 1'd0;
+        main_pipe_ready_sink_d_payload_data <= 32'd0;
+        main_pipe_ready_sink_d_payload_last_be <= 4'd0;
+        main_pipe_ready_sink_d_payload_error <= 4'd0;
+        builder_liteethmac_txdatapath_liteethmactxlastbe_state <= 1'd0;
         builder_liteethmac_txdatapath_liteethmacpaddinginserter_state <= 1'd0;
         builder_liteethmac_txdatapath_bufferizeendpoints_state <= 2'd0;
         builder_liteethmac_txdatapath_liteethmacpreambleinserter_state <= 2'd0;
@@ -6421,8 +7644,8 @@ always @(posedge sys_clk) begin
     end
     main_mac_core_pulsesynchronizer0_toggle_o_r <= main_mac_core_pulsesynchronizer0_toggle_o;
     main_mac_core_pulsesynchronizer1_toggle_o_r <= main_mac_core_pulsesynchronizer1_toggle_o;
-    main_mac_core_cdc_graycounter1_q_binary <= main_mac_core_cdc_graycounter1_q_next_binary;
-    main_mac_core_cdc_graycounter1_q <= main_mac_core_cdc_graycounter1_q_next;
+    main_mac_core_rx_cdc_cdc_graycounter1_q_binary <= main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary;
+    main_mac_core_rx_cdc_cdc_graycounter1_q <= main_mac_core_rx_cdc_cdc_graycounter1_q_next;
     case (builder_liteethmac_grant)
         1'd0: begin
             if ((~builder_liteethmac_request[0])) begin
@@ -6470,7 +7693,19 @@ always @(posedge sys_clk) begin
         main_mac_packetizer_sr <= main_mac_packetizer_header;
     end
     if (main_mac_packetizer_sr_shift) begin
-        main_mac_packetizer_sr <= main_mac_packetizer_sr[111:8];
+        main_mac_packetizer_sr <= main_mac_packetizer_sr[111:32];
+    end
+    if ((main_mac_packetizer_source_valid & main_mac_packetizer_source_ready)) begin
+        main_mac_packetizer_sink_d_valid <= main_mac_packetizer_sink_valid;
+        main_mac_packetizer_sink_d_ready <= main_mac_packetizer_sink_ready;
+        main_mac_packetizer_sink_d_first <= main_mac_packetizer_sink_first;
+        main_mac_packetizer_sink_d_last <= main_mac_packetizer_sink_last;
+        main_mac_packetizer_sink_d_payload_ethernet_type <= main_mac_packetizer_sink_payload_ethernet_type;
+        main_mac_packetizer_sink_d_payload_sender_mac <= main_mac_packetizer_sink_payload_sender_mac;
+        main_mac_packetizer_sink_d_payload_target_mac <= main_mac_packetizer_sink_payload_target_mac;
+        main_mac_packetizer_sink_d_payload_data <= main_mac_packetizer_sink_payload_data;
+        main_mac_packetizer_sink_d_payload_last_be <= main_mac_packetizer_sink_payload_last_be;
+        main_mac_packetizer_sink_d_payload_error <= main_mac_packetizer_sink_payload_error;
     end
     builder_liteethmac_fsm0_state0 <= builder_liteethmac_fsm0_next_state0;
     if (main_mac_packetizer_count_liteethmac_fsm0_next_value_ce0) begin
@@ -6484,10 +7719,19 @@ always @(posedge sys_clk) begin
         main_mac_packetizer_delayed_last_be <= main_mac_packetizer_delayed_last_be_liteethmac_fsm1_next_value0;
     end
     if (main_mac_liteethmacdepacketizer_sr_shift) begin
-        main_mac_liteethmacdepacketizer_sr <= {main_mac_liteethmacdepacketizer_sink_payload_data, main_mac_liteethmacdepacketizer_sr[111:8]};
+        main_mac_liteethmacdepacketizer_sr <= {main_mac_liteethmacdepacketizer_sink_payload_data, main_mac_liteethmacdepacketizer_sr[111:32]};
     end
     if (main_mac_liteethmacdepacketizer_sr_shift_leftover) begin
-        main_mac_liteethmacdepacketizer_sr <= {main_mac_liteethmacdepacketizer_sink_payload_data, main_mac_liteethmacdepacketizer_sr[111:0]};
+        main_mac_liteethmacdepacketizer_sr <= {main_mac_liteethmacdepacketizer_sink_payload_data, main_mac_liteethmacdepacketizer_sr[111:16]};
+    end
+    if ((main_mac_liteethmacdepacketizer_sink_valid & main_mac_liteethmacdepacketizer_sink_ready)) begin
+        main_mac_liteethmacdepacketizer_sink_d_valid <= main_mac_liteethmacdepacketizer_sink_valid;
+        main_mac_liteethmacdepacketizer_sink_d_ready <= main_mac_liteethmacdepacketizer_sink_ready;
+        main_mac_liteethmacdepacketizer_sink_d_first <= main_mac_liteethmacdepacketizer_sink_first;
+        main_mac_liteethmacdepacketizer_sink_d_last <= main_mac_liteethmacdepacketizer_sink_last;
+        main_mac_liteethmacdepacketizer_sink_d_payload_data <= main_mac_liteethmacdepacketizer_sink_payload_data;
+        main_mac_liteethmacdepacketizer_sink_d_payload_last_be <= main_mac_liteethmacdepacketizer_sink_payload_last_be;
+        main_mac_liteethmacdepacketizer_sink_d_payload_error <= main_mac_liteethmacdepacketizer_sink_payload_error;
     end
     main_mac_liteethmacdepacketizer_was_in_copy <= main_mac_liteethmacdepacketizer_is_in_copy;
     builder_liteethmac_fsm0_state1 <= builder_liteethmac_fsm0_next_state1;
@@ -6505,7 +7749,7 @@ always @(posedge sys_clk) begin
         main_arp_packetizer_sr <= main_arp_packetizer_header;
     end
     if (main_arp_packetizer_sr_shift) begin
-        main_arp_packetizer_sr <= main_arp_packetizer_sr[223:8];
+        main_arp_packetizer_sr <= main_arp_packetizer_sr[223:32];
     end
     builder_liteetharptx_fsm0_state <= builder_liteetharptx_fsm0_next_state;
     if (main_arp_packetizer_count_liteetharp_fsm0_next_value_ce0) begin
@@ -6524,7 +7768,7 @@ always @(posedge sys_clk) begin
     end
     main_arp_rx_valid <= (((((main_arp_rx_liteetharpdepacketizer_source_valid & (main_arp_rx_liteetharpdepacketizer_source_param_hwtype == 1'd1)) & (main_arp_rx_liteetharpdepacketizer_source_param_proto == 12'd2048)) & (main_arp_rx_liteetharpdepacketizer_source_param_hwsize == 3'd6)) & (main_arp_rx_liteetharpdepacketizer_source_param_protosize == 3'd4)) & (main_arp_rx_liteetharpdepacketizer_source_param_target_ip == ip_address));
     if (main_arp_rx_liteetharpdepacketizer_sr_shift) begin
-        main_arp_rx_liteetharpdepacketizer_sr <= {main_arp_rx_liteetharpdepacketizer_sink_payload_data, main_arp_rx_liteetharpdepacketizer_sr[223:8]};
+        main_arp_rx_liteetharpdepacketizer_sr <= {main_arp_rx_liteetharpdepacketizer_sink_payload_data, main_arp_rx_liteetharpdepacketizer_sr[223:32]};
     end
     if (main_arp_rx_liteetharpdepacketizer_sr_shift_leftover) begin
         main_arp_rx_liteetharpdepacketizer_sr <= {main_arp_rx_liteetharpdepacketizer_sink_payload_data, main_arp_rx_liteetharpdepacketizer_sr[223:0]};
@@ -6632,7 +7876,7 @@ always @(posedge sys_clk) begin
         main_ip_tx_packetizer_sr <= main_ip_tx_packetizer_header;
     end
     if (main_ip_tx_packetizer_sr_shift) begin
-        main_ip_tx_packetizer_sr <= main_ip_tx_packetizer_sr[159:8];
+        main_ip_tx_packetizer_sr <= main_ip_tx_packetizer_sr[159:32];
     end
     builder_liteethip_liteethiptx_fsm0_state <= builder_liteethip_liteethiptx_fsm0_next_state;
     if (main_ip_tx_packetizer_count_liteethip_fsm0_next_value_ce0) begin
@@ -6650,7 +7894,7 @@ always @(posedge sys_clk) begin
         main_ip_tx_target_mac <= main_ip_tx_target_mac_liteethip_next_value;
     end
     if (main_ip_rx_liteethipv4depacketizer_sr_shift) begin
-        main_ip_rx_liteethipv4depacketizer_sr <= {main_ip_rx_liteethipv4depacketizer_sink_payload_data, main_ip_rx_liteethipv4depacketizer_sr[159:8]};
+        main_ip_rx_liteethipv4depacketizer_sr <= {main_ip_rx_liteethipv4depacketizer_sink_payload_data, main_ip_rx_liteethipv4depacketizer_sr[159:32]};
     end
     if (main_ip_rx_liteethipv4depacketizer_sr_shift_leftover) begin
         main_ip_rx_liteethipv4depacketizer_sr <= {main_ip_rx_liteethipv4depacketizer_sink_payload_data, main_ip_rx_liteethipv4depacketizer_sr[159:0]};
@@ -6734,7 +7978,7 @@ always @(posedge sys_clk) begin
     if (builder_liteethip_status1_last) begin
         builder_liteethip_status1_first <= 1'd1;
     end else begin
-        if ((main_ip_port_sink_valid & main_ip_port_sink_ready)) begin
+        if ((main_udp_ip_port_sink_valid & main_udp_ip_port_sink_ready)) begin
             builder_liteethip_status1_first <= 1'd0;
         end
     end
@@ -6753,7 +7997,7 @@ always @(posedge sys_clk) begin
         main_icmp_tx_packetizer_sr <= main_icmp_tx_packetizer_header;
     end
     if (main_icmp_tx_packetizer_sr_shift) begin
-        main_icmp_tx_packetizer_sr <= main_icmp_tx_packetizer_sr[63:8];
+        main_icmp_tx_packetizer_sr <= main_icmp_tx_packetizer_sr[63:32];
     end
     builder_liteethicmptx_fsm0_state <= builder_liteethicmptx_fsm0_next_state;
     if (main_icmp_tx_packetizer_count_fsm0_next_value_ce0) begin
@@ -6768,7 +8012,7 @@ always @(posedge sys_clk) begin
     end
     builder_liteethicmptx_state <= builder_liteethicmptx_next_state;
     if (main_icmp_rx_liteethicmpdepacketizer_sr_shift) begin
-        main_icmp_rx_liteethicmpdepacketizer_sr <= {main_icmp_rx_liteethicmpdepacketizer_sink_payload_data, main_icmp_rx_liteethicmpdepacketizer_sr[63:8]};
+        main_icmp_rx_liteethicmpdepacketizer_sr <= {main_icmp_rx_liteethicmpdepacketizer_sink_payload_data, main_icmp_rx_liteethicmpdepacketizer_sr[63:32]};
     end
     if (main_icmp_rx_liteethicmpdepacketizer_sr_shift_leftover) begin
         main_icmp_rx_liteethicmpdepacketizer_sr <= {main_icmp_rx_liteethicmpdepacketizer_sink_payload_data, main_icmp_rx_liteethicmpdepacketizer_sr[63:0]};
@@ -6830,78 +8074,200 @@ always @(posedge sys_clk) begin
             main_icmp_echo_param_fifo_level0 <= (main_icmp_echo_param_fifo_level0 - 1'd1);
         end
     end
-    if (main_packetizer_sr_load) begin
-        main_packetizer_sr <= main_packetizer_header;
-    end
-    if (main_packetizer_sr_shift) begin
-        main_packetizer_sr <= main_packetizer_sr[63:8];
-    end
-    builder_liteethudp_liteethudptx_fsm0_state <= builder_liteethudp_liteethudptx_fsm0_next_state;
-    if (main_packetizer_count_liteethudp_fsm0_next_value_ce0) begin
-        main_packetizer_count <= main_packetizer_count_liteethudp_fsm0_next_value0;
-    end
-    if (main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value_ce1) begin
-        main_packetizer_fsm_from_idle <= main_packetizer_fsm_from_idle_liteethudp_fsm0_next_value1;
-    end
-    builder_liteethudp_liteethudptx_fsm1_state <= builder_liteethudp_liteethudptx_fsm1_next_state;
-    if (main_packetizer_delayed_last_be_liteethudp_fsm1_next_value_ce0) begin
-        main_packetizer_delayed_last_be <= main_packetizer_delayed_last_be_liteethudp_fsm1_next_value0;
-    end
-    builder_liteethudp_liteethudptx_state <= builder_liteethudp_liteethudptx_next_state;
-    if (main_holdingudprx_liteethudpdepacketizer_sr_shift) begin
-        main_holdingudprx_liteethudpdepacketizer_sr <= {main_holdingudprx_liteethudpdepacketizer_sink_payload_data, main_holdingudprx_liteethudpdepacketizer_sr[63:8]};
-    end
-    if (main_holdingudprx_liteethudpdepacketizer_sr_shift_leftover) begin
-        main_holdingudprx_liteethudpdepacketizer_sr <= {main_holdingudprx_liteethudpdepacketizer_sink_payload_data, main_holdingudprx_liteethudpdepacketizer_sr[63:0]};
-    end
-    main_holdingudprx_liteethudpdepacketizer_was_in_copy <= main_holdingudprx_liteethudpdepacketizer_is_in_copy;
-    builder_liteethudp_holdingudprx_fsm0_state <= builder_liteethudp_holdingudprx_fsm0_next_state;
-    if (main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value_ce2) begin
-        main_holdingudprx_liteethudpdepacketizer_count <= main_holdingudprx_liteethudpdepacketizer_count_liteethudp_fsm0_next_value2;
-    end
-    if (main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value_ce3) begin
-        main_holdingudprx_liteethudpdepacketizer_fsm_from_idle <= main_holdingudprx_liteethudpdepacketizer_fsm_from_idle_liteethudp_fsm0_next_value3;
-    end
-    builder_liteethudp_holdingudprx_fsm1_state <= builder_liteethudp_holdingudprx_fsm1_next_state;
-    if (main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value_ce1) begin
-        main_holdingudprx_liteethudpdepacketizer_delayed_last_be <= main_holdingudprx_liteethudpdepacketizer_delayed_last_be_liteethudp_fsm1_next_value1;
-    end
-    builder_liteethudp_holdingudprx_state <= builder_liteethudp_holdingudprx_next_state;
-    if (main_holdingudprx_count_liteethudp_next_value_ce0) begin
-        main_holdingudprx_count <= main_holdingudprx_count_liteethudp_next_value0;
-    end
-    if (main_holdingudprx_err_liteethudp_next_value_ce1) begin
-        main_holdingudprx_err <= main_holdingudprx_err_liteethudp_next_value1;
-    end
-    if (main_holdingudprx_rest_liteethudp_next_value_ce2) begin
-        main_holdingudprx_rest <= main_holdingudprx_rest_liteethudp_next_value2;
-    end
-    if (main_holdingudprx_held_liteethudp_next_value_ce3) begin
-        main_holdingudprx_held <= main_holdingudprx_held_liteethudp_next_value3;
-    end
-    if (main_holdingudprx0_liteethudp_next_value_ce4) begin
-        main_holdingudprx0 <= main_holdingudprx0_liteethudp_next_value4;
-    end
-    if (main_holdingudprx1_liteethudp_next_value_ce5) begin
-        main_holdingudprx1 <= main_holdingudprx1_liteethudp_next_value5;
-    end
-    if (main_holdingudprx2_liteethudp_next_value_ce6) begin
-        main_holdingudprx2 <= main_holdingudprx2_liteethudp_next_value6;
-    end
-    if (main_holdingudprx3_liteethudp_next_value_ce7) begin
-        main_holdingudprx3 <= main_holdingudprx3_liteethudp_next_value7;
-    end
-    if (builder_liteethudp_first) begin
-        builder_liteethudp_sel_ongoing <= builder_liteethudp_sel0;
-    end
-    builder_liteethudp_ongoing1 <= builder_liteethudp_ongoing0;
-    if (builder_liteethudp_last) begin
-        builder_liteethudp_first <= 1'd1;
-    end else begin
-        if ((main_crossbar_sink_valid & main_crossbar_sink_ready)) begin
-            builder_liteethudp_first <= 1'd0;
+    if ((main_udp_strideconverter0_converter_source_valid & main_udp_strideconverter0_converter_source_ready)) begin
+        if (main_udp_strideconverter0_converter_last) begin
+            main_udp_strideconverter0_converter_mux <= 1'd0;
+        end else begin
+            main_udp_strideconverter0_converter_mux <= (main_udp_strideconverter0_converter_mux + 1'd1);
         end
     end
+    builder_portudp_lastbytetrim_state <= builder_portudp_lastbytetrim_next_state;
+    if (main_udp_lastbytetrim_err_lastbytetrim_next_value_ce) begin
+        main_udp_lastbytetrim_err <= main_udp_lastbytetrim_err_lastbytetrim_next_value;
+    end
+    if (main_udp_holdingudprx_liteethudpdepacketizer_sr_shift) begin
+        main_udp_holdingudprx_liteethudpdepacketizer_sr <= {main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_data, main_udp_holdingudprx_liteethudpdepacketizer_sr[63:8]};
+    end
+    if (main_udp_holdingudprx_liteethudpdepacketizer_sr_shift_leftover) begin
+        main_udp_holdingudprx_liteethudpdepacketizer_sr <= {main_udp_holdingudprx_liteethudpdepacketizer_sink_payload_data, main_udp_holdingudprx_liteethudpdepacketizer_sr[63:0]};
+    end
+    main_udp_holdingudprx_liteethudpdepacketizer_was_in_copy <= main_udp_holdingudprx_liteethudpdepacketizer_is_in_copy;
+    builder_portudp_holdingudprx_fsm0_state <= builder_portudp_holdingudprx_fsm0_next_state;
+    if (main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0) begin
+        main_udp_holdingudprx_liteethudpdepacketizer_count <= main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0;
+    end
+    if (main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value_ce1) begin
+        main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle <= main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle_holdingudprx_fsm0_next_value1;
+    end
+    builder_portudp_holdingudprx_fsm1_state <= builder_portudp_holdingudprx_fsm1_next_state;
+    if (main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value_ce) begin
+        main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be <= main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be_holdingudprx_fsm1_next_value;
+    end
+    builder_portudp_holdingudprx_state <= builder_portudp_holdingudprx_next_state;
+    if (main_udp_holdingudprx_count_holdingudprx_next_value_ce0) begin
+        main_udp_holdingudprx_count <= main_udp_holdingudprx_count_holdingudprx_next_value0;
+    end
+    if (main_udp_holdingudprx_err_holdingudprx_next_value_ce1) begin
+        main_udp_holdingudprx_err <= main_udp_holdingudprx_err_holdingudprx_next_value1;
+    end
+    if (main_udp_holdingudprx_rest_holdingudprx_next_value_ce2) begin
+        main_udp_holdingudprx_rest <= main_udp_holdingudprx_rest_holdingudprx_next_value2;
+    end
+    if (main_udp_holdingudprx_held_holdingudprx_next_value_ce3) begin
+        main_udp_holdingudprx_held <= main_udp_holdingudprx_held_holdingudprx_next_value3;
+    end
+    if (main_udp_holdingudprx0_holdingudprx_next_value_ce4) begin
+        main_udp_holdingudprx0 <= main_udp_holdingudprx0_holdingudprx_next_value4;
+    end
+    if (main_udp_holdingudprx1_holdingudprx_next_value_ce5) begin
+        main_udp_holdingudprx1 <= main_udp_holdingudprx1_holdingudprx_next_value5;
+    end
+    if (main_udp_holdingudprx2_holdingudprx_next_value_ce6) begin
+        main_udp_holdingudprx2 <= main_udp_holdingudprx2_holdingudprx_next_value6;
+    end
+    if (main_udp_holdingudprx3_holdingudprx_next_value_ce7) begin
+        main_udp_holdingudprx3 <= main_udp_holdingudprx3_holdingudprx_next_value7;
+    end
+    if (main_udp_liteethudptx_packetizer_sr_load) begin
+        main_udp_liteethudptx_packetizer_sr <= main_udp_liteethudptx_packetizer_header;
+    end
+    if (main_udp_liteethudptx_packetizer_sr_shift) begin
+        main_udp_liteethudptx_packetizer_sr <= main_udp_liteethudptx_packetizer_sr[63:8];
+    end
+    builder_portudp_liteethudptx_fsm0_state <= builder_portudp_liteethudptx_fsm0_next_state;
+    if (main_udp_liteethudptx_packetizer_count_fsm0_next_value_ce4) begin
+        main_udp_liteethudptx_packetizer_count <= main_udp_liteethudptx_packetizer_count_fsm0_next_value4;
+    end
+    if (main_udp_liteethudptx_packetizer_fsm_from_idle_fsm0_next_value_ce5) begin
+        main_udp_liteethudptx_packetizer_fsm_from_idle <= main_udp_liteethudptx_packetizer_fsm_from_idle_fsm0_next_value5;
+    end
+    builder_portudp_liteethudptx_fsm1_state <= builder_portudp_liteethudptx_fsm1_next_state;
+    if (main_udp_liteethudptx_packetizer_delayed_last_be_fsm1_next_value_ce2) begin
+        main_udp_liteethudptx_packetizer_delayed_last_be <= main_udp_liteethudptx_packetizer_delayed_last_be_fsm1_next_value2;
+    end
+    builder_portudp_liteethudptx_state <= builder_portudp_liteethudptx_next_state;
+    main_udp_strideconverter1_source_param_length <= main_udp_strideconverter1_sink_param_length;
+    main_udp_strideconverter1_source_param_protocol <= main_udp_strideconverter1_sink_param_protocol;
+    main_udp_strideconverter1_source_param_ip_address <= main_udp_strideconverter1_sink_param_ip_address;
+    if (main_udp_strideconverter1_converter_source_ready) begin
+        main_udp_strideconverter1_converter_strobe_all <= 1'd0;
+    end
+    if (main_udp_strideconverter1_converter_load_part) begin
+        if (((main_udp_strideconverter1_converter_demux == 2'd3) | main_udp_strideconverter1_converter_sink_last)) begin
+            main_udp_strideconverter1_converter_demux <= 1'd0;
+            main_udp_strideconverter1_converter_strobe_all <= 1'd1;
+        end else begin
+            main_udp_strideconverter1_converter_demux <= (main_udp_strideconverter1_converter_demux + 1'd1);
+        end
+    end
+    if ((main_udp_strideconverter1_converter_source_valid & main_udp_strideconverter1_converter_source_ready)) begin
+        if ((main_udp_strideconverter1_converter_sink_valid & main_udp_strideconverter1_converter_sink_ready)) begin
+            main_udp_strideconverter1_converter_source_first <= main_udp_strideconverter1_converter_sink_first;
+            main_udp_strideconverter1_converter_source_last <= main_udp_strideconverter1_converter_sink_last;
+        end else begin
+            main_udp_strideconverter1_converter_source_first <= 1'd0;
+            main_udp_strideconverter1_converter_source_last <= 1'd0;
+        end
+    end else begin
+        if ((main_udp_strideconverter1_converter_sink_valid & main_udp_strideconverter1_converter_sink_ready)) begin
+            main_udp_strideconverter1_converter_source_first <= (main_udp_strideconverter1_converter_sink_first | main_udp_strideconverter1_converter_source_first);
+            main_udp_strideconverter1_converter_source_last <= (main_udp_strideconverter1_converter_sink_last | main_udp_strideconverter1_converter_source_last);
+        end
+    end
+    if (main_udp_strideconverter1_converter_load_part) begin
+        case (main_udp_strideconverter1_converter_demux)
+            1'd0: begin
+                main_udp_strideconverter1_converter_source_payload_data[9:0] <= main_udp_strideconverter1_converter_sink_payload_data;
+            end
+            1'd1: begin
+                main_udp_strideconverter1_converter_source_payload_data[19:10] <= main_udp_strideconverter1_converter_sink_payload_data;
+            end
+            2'd2: begin
+                main_udp_strideconverter1_converter_source_payload_data[29:20] <= main_udp_strideconverter1_converter_sink_payload_data;
+            end
+            2'd3: begin
+                main_udp_strideconverter1_converter_source_payload_data[39:30] <= main_udp_strideconverter1_converter_sink_payload_data;
+            end
+        endcase
+    end
+    if (main_udp_strideconverter1_converter_load_part) begin
+        main_udp_strideconverter1_converter_source_payload_valid_token_count <= (main_udp_strideconverter1_converter_demux + 1'd1);
+    end
+    if (builder_portudp_first) begin
+        builder_portudp_sel_ongoing <= builder_portudp_sel0;
+    end
+    builder_portudp_ongoing1 <= builder_portudp_ongoing0;
+    if (builder_portudp_last) begin
+        builder_portudp_first <= 1'd1;
+    end else begin
+        if ((main_udp_maskedudpcrossbar_sink_valid & main_udp_maskedudpcrossbar_sink_ready)) begin
+            builder_portudp_first <= 1'd0;
+        end
+    end
+    if (((~main_udp_buffer0_pipe_valid_source_valid) | main_udp_buffer0_pipe_valid_source_ready)) begin
+        main_udp_buffer0_pipe_valid_source_valid <= main_udp_buffer0_pipe_valid_sink_valid;
+        main_udp_buffer0_pipe_valid_source_first <= main_udp_buffer0_pipe_valid_sink_first;
+        main_udp_buffer0_pipe_valid_source_last <= main_udp_buffer0_pipe_valid_sink_last;
+        main_udp_buffer0_pipe_valid_source_payload_data <= main_udp_buffer0_pipe_valid_sink_payload_data;
+        main_udp_buffer0_pipe_valid_source_payload_last_be <= main_udp_buffer0_pipe_valid_sink_payload_last_be;
+        main_udp_buffer0_pipe_valid_source_payload_error <= main_udp_buffer0_pipe_valid_sink_payload_error;
+        main_udp_buffer0_pipe_valid_source_param_length <= main_udp_buffer0_pipe_valid_sink_param_length;
+        main_udp_buffer0_pipe_valid_source_param_protocol <= main_udp_buffer0_pipe_valid_sink_param_protocol;
+        main_udp_buffer0_pipe_valid_source_param_ip_address <= main_udp_buffer0_pipe_valid_sink_param_ip_address;
+    end
+    if ((main_udp_buffer0_pipe_ready_sink_valid & (~main_udp_buffer0_pipe_ready_source_ready))) begin
+        main_udp_buffer0_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (main_udp_buffer0_pipe_ready_source_ready) begin
+            main_udp_buffer0_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~main_udp_buffer0_pipe_ready_source_ready) & (~main_udp_buffer0_pipe_ready_valid))) begin
+        main_udp_buffer0_pipe_ready_sink_d_valid <= main_udp_buffer0_pipe_ready_sink_valid;
+        main_udp_buffer0_pipe_ready_sink_d_ready <= main_udp_buffer0_pipe_ready_sink_ready;
+        main_udp_buffer0_pipe_ready_sink_d_first <= main_udp_buffer0_pipe_ready_sink_first;
+        main_udp_buffer0_pipe_ready_sink_d_last <= main_udp_buffer0_pipe_ready_sink_last;
+        main_udp_buffer0_pipe_ready_sink_d_payload_data <= main_udp_buffer0_pipe_ready_sink_payload_data;
+        main_udp_buffer0_pipe_ready_sink_d_payload_last_be <= main_udp_buffer0_pipe_ready_sink_payload_last_be;
+        main_udp_buffer0_pipe_ready_sink_d_payload_error <= main_udp_buffer0_pipe_ready_sink_payload_error;
+        main_udp_buffer0_pipe_ready_sink_d_param_length <= main_udp_buffer0_pipe_ready_sink_param_length;
+        main_udp_buffer0_pipe_ready_sink_d_param_protocol <= main_udp_buffer0_pipe_ready_sink_param_protocol;
+        main_udp_buffer0_pipe_ready_sink_d_param_ip_address <= main_udp_buffer0_pipe_ready_sink_param_ip_address;
+    end
+    if (((~main_udp_buffer1_pipe_valid_source_valid) | main_udp_buffer1_pipe_valid_source_ready)) begin
+        main_udp_buffer1_pipe_valid_source_valid <= main_udp_buffer1_pipe_valid_sink_valid;
+        main_udp_buffer1_pipe_valid_source_first <= main_udp_buffer1_pipe_valid_sink_first;
+        main_udp_buffer1_pipe_valid_source_last <= main_udp_buffer1_pipe_valid_sink_last;
+        main_udp_buffer1_pipe_valid_source_payload_data <= main_udp_buffer1_pipe_valid_sink_payload_data;
+        main_udp_buffer1_pipe_valid_source_payload_last_be <= main_udp_buffer1_pipe_valid_sink_payload_last_be;
+        main_udp_buffer1_pipe_valid_source_payload_error <= main_udp_buffer1_pipe_valid_sink_payload_error;
+        main_udp_buffer1_pipe_valid_source_param_length <= main_udp_buffer1_pipe_valid_sink_param_length;
+        main_udp_buffer1_pipe_valid_source_param_protocol <= main_udp_buffer1_pipe_valid_sink_param_protocol;
+        main_udp_buffer1_pipe_valid_source_param_ip_address <= main_udp_buffer1_pipe_valid_sink_param_ip_address;
+    end
+    if ((main_udp_buffer1_pipe_ready_sink_valid & (~main_udp_buffer1_pipe_ready_source_ready))) begin
+        main_udp_buffer1_pipe_ready_valid <= 1'd1;
+    end else begin
+        if (main_udp_buffer1_pipe_ready_source_ready) begin
+            main_udp_buffer1_pipe_ready_valid <= 1'd0;
+        end
+    end
+    if (((~main_udp_buffer1_pipe_ready_source_ready) & (~main_udp_buffer1_pipe_ready_valid))) begin
+        main_udp_buffer1_pipe_ready_sink_d_valid <= main_udp_buffer1_pipe_ready_sink_valid;
+        main_udp_buffer1_pipe_ready_sink_d_ready <= main_udp_buffer1_pipe_ready_sink_ready;
+        main_udp_buffer1_pipe_ready_sink_d_first <= main_udp_buffer1_pipe_ready_sink_first;
+        main_udp_buffer1_pipe_ready_sink_d_last <= main_udp_buffer1_pipe_ready_sink_last;
+        main_udp_buffer1_pipe_ready_sink_d_payload_data <= main_udp_buffer1_pipe_ready_sink_payload_data;
+        main_udp_buffer1_pipe_ready_sink_d_payload_last_be <= main_udp_buffer1_pipe_ready_sink_payload_last_be;
+        main_udp_buffer1_pipe_ready_sink_d_payload_error <= main_udp_buffer1_pipe_ready_sink_payload_error;
+        main_udp_buffer1_pipe_ready_sink_d_param_length <= main_udp_buffer1_pipe_ready_sink_param_length;
+        main_udp_buffer1_pipe_ready_sink_d_param_protocol <= main_udp_buffer1_pipe_ready_sink_param_protocol;
+        main_udp_buffer1_pipe_ready_sink_d_param_ip_address <= main_udp_buffer1_pipe_ready_sink_param_ip_address;
+    end
+    main_pulsemerge0_backlog0 <= (main_pulsemerge0_total0 - main_pulsemerge0_o0);
+    main_pulsemerge0_backlog1 <= (main_pulsemerge0_total1 - main_pulsemerge0_o1);
+    main_pulsemerge1_backlog0 <= (main_pulsemerge1_total0 - main_pulsemerge1_o0);
+    main_pulsemerge1_backlog1 <= (main_pulsemerge1_total1 - main_pulsemerge1_o1);
     builder_state <= builder_next_state;
     builder_interface0_bank_bus_dat_r <= 1'd0;
     if (builder_csrbank0_sel) begin
@@ -6951,21 +8317,34 @@ always @(posedge sys_clk) begin
         main_mac_core_tx_cdc_cdc_graycounter0_q_binary <= 6'd0;
         main_mac_core_preamble_errors_status <= 32'd0;
         main_mac_core_crc_errors_status <= 32'd0;
-        main_mac_core_cdc_graycounter1_q <= 6'd0;
-        main_mac_core_cdc_graycounter1_q_binary <= 6'd0;
-        main_mac_packetizer_count <= 4'd0;
+        main_mac_core_rx_cdc_cdc_graycounter1_q <= 6'd0;
+        main_mac_core_rx_cdc_cdc_graycounter1_q_binary <= 6'd0;
+        main_mac_packetizer_count <= 2'd0;
+        main_mac_packetizer_sink_d_valid <= 1'd0;
+        main_mac_packetizer_sink_d_ready <= 1'd0;
+        main_mac_packetizer_sink_d_payload_ethernet_type <= 16'd0;
+        main_mac_packetizer_sink_d_payload_sender_mac <= 48'd0;
+        main_mac_packetizer_sink_d_payload_target_mac <= 48'd0;
+        main_mac_packetizer_sink_d_payload_data <= 32'd0;
+        main_mac_packetizer_sink_d_payload_last_be <= 4'd0;
+        main_mac_packetizer_sink_d_payload_error <= 4'd0;
         main_mac_packetizer_fsm_from_idle <= 1'd0;
-        main_mac_packetizer_delayed_last_be <= 1'd0;
-        main_mac_liteethmacdepacketizer_count <= 4'd0;
+        main_mac_packetizer_delayed_last_be <= 4'd0;
+        main_mac_liteethmacdepacketizer_count <= 2'd0;
+        main_mac_liteethmacdepacketizer_sink_d_valid <= 1'd0;
+        main_mac_liteethmacdepacketizer_sink_d_ready <= 1'd0;
+        main_mac_liteethmacdepacketizer_sink_d_payload_data <= 32'd0;
+        main_mac_liteethmacdepacketizer_sink_d_payload_last_be <= 4'd0;
+        main_mac_liteethmacdepacketizer_sink_d_payload_error <= 4'd0;
         main_mac_liteethmacdepacketizer_fsm_from_idle <= 1'd0;
-        main_mac_liteethmacdepacketizer_delayed_last_be <= 1'd0;
+        main_mac_liteethmacdepacketizer_delayed_last_be <= 4'd0;
         main_mac_liteethmacdepacketizer_was_in_copy <= 1'd0;
-        main_arp_packetizer_count <= 5'd0;
+        main_arp_packetizer_count <= 3'd0;
         main_arp_packetizer_fsm_from_idle <= 1'd0;
-        main_arp_packetizer_delayed_last_be <= 1'd0;
-        main_arp_rx_liteetharpdepacketizer_count <= 5'd0;
+        main_arp_packetizer_delayed_last_be <= 4'd0;
+        main_arp_rx_liteetharpdepacketizer_count <= 3'd0;
         main_arp_rx_liteetharpdepacketizer_fsm_from_idle <= 1'd0;
-        main_arp_rx_liteetharpdepacketizer_delayed_last_be <= 1'd0;
+        main_arp_rx_liteetharpdepacketizer_delayed_last_be <= 4'd0;
         main_arp_rx_liteetharpdepacketizer_was_in_copy <= 1'd0;
         main_arp_table_response_response_payload_failed <= 1'd0;
         main_arp_table_response_response_payload_mac_address <= 48'd0;
@@ -6977,48 +8356,78 @@ always @(posedge sys_clk) begin
         main_arp_table_cache_error <= 1'd0;
         main_arp_table_cache_count <= 27'd125000000;
         main_ip_tx_pipe_valid_source_valid <= 1'd0;
-        main_ip_tx_pipe_valid_source_payload_data <= 8'd0;
-        main_ip_tx_pipe_valid_source_payload_last_be <= 1'd0;
-        main_ip_tx_pipe_valid_source_payload_error <= 1'd0;
+        main_ip_tx_pipe_valid_source_payload_data <= 32'd0;
+        main_ip_tx_pipe_valid_source_payload_last_be <= 4'd0;
+        main_ip_tx_pipe_valid_source_payload_error <= 4'd0;
         main_ip_tx_liteethipv4checksum_counter <= 4'd0;
-        main_ip_tx_packetizer_count <= 5'd0;
+        main_ip_tx_packetizer_count <= 3'd0;
         main_ip_tx_packetizer_fsm_from_idle <= 1'd0;
-        main_ip_tx_packetizer_delayed_last_be <= 1'd0;
-        main_ip_rx_liteethipv4depacketizer_count <= 5'd0;
+        main_ip_tx_packetizer_delayed_last_be <= 4'd0;
+        main_ip_rx_liteethipv4depacketizer_count <= 3'd0;
         main_ip_rx_liteethipv4depacketizer_fsm_from_idle <= 1'd0;
-        main_ip_rx_liteethipv4depacketizer_delayed_last_be <= 1'd0;
+        main_ip_rx_liteethipv4depacketizer_delayed_last_be <= 4'd0;
         main_ip_rx_liteethipv4depacketizer_was_in_copy <= 1'd0;
         main_ip_rx_liteethipv4checksum_counter <= 4'd0;
-        main_icmp_tx_packetizer_count <= 3'd0;
+        main_icmp_tx_packetizer_count <= 1'd0;
         main_icmp_tx_packetizer_fsm_from_idle <= 1'd0;
-        main_icmp_tx_packetizer_delayed_last_be <= 1'd0;
-        main_icmp_rx_liteethicmpdepacketizer_count <= 3'd0;
+        main_icmp_tx_packetizer_delayed_last_be <= 4'd0;
+        main_icmp_rx_liteethicmpdepacketizer_count <= 1'd0;
         main_icmp_rx_liteethicmpdepacketizer_fsm_from_idle <= 1'd0;
-        main_icmp_rx_liteethicmpdepacketizer_delayed_last_be <= 1'd0;
+        main_icmp_rx_liteethicmpdepacketizer_delayed_last_be <= 4'd0;
         main_icmp_rx_liteethicmpdepacketizer_was_in_copy <= 1'd0;
         main_icmp_echo_payload_fifo_readable <= 1'd0;
-        main_icmp_echo_payload_fifo_level0 <= 8'd0;
-        main_icmp_echo_payload_fifo_produce <= 7'd0;
-        main_icmp_echo_payload_fifo_consume <= 7'd0;
+        main_icmp_echo_payload_fifo_level0 <= 6'd0;
+        main_icmp_echo_payload_fifo_produce <= 5'd0;
+        main_icmp_echo_payload_fifo_consume <= 5'd0;
         main_icmp_echo_param_fifo_readable <= 1'd0;
         main_icmp_echo_param_fifo_level0 <= 2'd0;
         main_icmp_echo_param_fifo_produce <= 1'd0;
         main_icmp_echo_param_fifo_consume <= 1'd0;
-        main_packetizer_count <= 3'd0;
-        main_packetizer_fsm_from_idle <= 1'd0;
-        main_packetizer_delayed_last_be <= 1'd0;
-        main_holdingudprx_liteethudpdepacketizer_count <= 3'd0;
-        main_holdingudprx_liteethudpdepacketizer_fsm_from_idle <= 1'd0;
-        main_holdingudprx_liteethudpdepacketizer_delayed_last_be <= 1'd0;
-        main_holdingudprx_liteethudpdepacketizer_was_in_copy <= 1'd0;
-        main_holdingudprx_count <= 16'd0;
-        main_holdingudprx_err <= 1'd0;
-        main_holdingudprx_held <= 8'd0;
-        main_holdingudprx0 <= 16'd0;
-        main_holdingudprx1 <= 16'd0;
-        main_holdingudprx2 <= 16'd0;
-        main_holdingudprx3 <= 32'd0;
-        main_holdingudprx_rest <= 16'd0;
+        main_udp_strideconverter0_converter_mux <= 2'd0;
+        main_udp_lastbytetrim_err <= 1'd0;
+        main_udp_holdingudprx_liteethudpdepacketizer_count <= 3'd0;
+        main_udp_holdingudprx_liteethudpdepacketizer_fsm_from_idle <= 1'd0;
+        main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be <= 1'd0;
+        main_udp_holdingudprx_liteethudpdepacketizer_was_in_copy <= 1'd0;
+        main_udp_holdingudprx_count <= 16'd0;
+        main_udp_holdingudprx_err <= 1'd0;
+        main_udp_holdingudprx_held <= 8'd0;
+        main_udp_holdingudprx0 <= 16'd0;
+        main_udp_holdingudprx1 <= 16'd0;
+        main_udp_holdingudprx2 <= 16'd0;
+        main_udp_holdingudprx3 <= 32'd0;
+        main_udp_holdingudprx_rest <= 16'd0;
+        main_udp_liteethudptx_packetizer_count <= 3'd0;
+        main_udp_liteethudptx_packetizer_fsm_from_idle <= 1'd0;
+        main_udp_liteethudptx_packetizer_delayed_last_be <= 1'd0;
+        main_udp_strideconverter1_converter_source_payload_data <= 40'd0;
+        main_udp_strideconverter1_converter_source_payload_valid_token_count <= 3'd0;
+        main_udp_strideconverter1_converter_demux <= 2'd0;
+        main_udp_strideconverter1_converter_strobe_all <= 1'd0;
+        main_udp_buffer0_pipe_valid_source_valid <= 1'd0;
+        main_udp_buffer0_pipe_valid_source_payload_data <= 8'd0;
+        main_udp_buffer0_pipe_valid_source_payload_last_be <= 1'd0;
+        main_udp_buffer0_pipe_valid_source_payload_error <= 1'd0;
+        main_udp_buffer0_pipe_ready_valid <= 1'd0;
+        main_udp_buffer0_pipe_ready_sink_d_valid <= 1'd0;
+        main_udp_buffer0_pipe_ready_sink_d_ready <= 1'd0;
+        main_udp_buffer0_pipe_ready_sink_d_payload_data <= 8'd0;
+        main_udp_buffer0_pipe_ready_sink_d_payload_last_be <= 1'd0;
+        main_udp_buffer0_pipe_ready_sink_d_payload_error <= 1'd0;
+        main_udp_buffer1_pipe_valid_source_valid <= 1'd0;
+        main_udp_buffer1_pipe_valid_source_payload_data <= 8'd0;
+        main_udp_buffer1_pipe_valid_source_payload_last_be <= 1'd0;
+        main_udp_buffer1_pipe_valid_source_payload_error <= 1'd0;
+        main_udp_buffer1_pipe_ready_valid <= 1'd0;
+        main_udp_buffer1_pipe_ready_sink_d_valid <= 1'd0;
+        main_udp_buffer1_pipe_ready_sink_d_ready <= 1'd0;
+        main_udp_buffer1_pipe_ready_sink_d_payload_data <= 8'd0;
+        main_udp_buffer1_pipe_ready_sink_d_payload_last_be <= 1'd0;
+        main_udp_buffer1_pipe_ready_sink_d_payload_error <= 1'd0;
+        main_pulsemerge0_backlog0 <= 3'd0;
+        main_pulsemerge0_backlog1 <= 3'd0;
+        main_pulsemerge1_backlog0 <= 3'd0;
+        main_pulsemerge1_backlog1 <= 3'd0;
         builder_liteethmac_grant <= 1'd0;
         builder_liteethmac_status0_first <= 1'd1;
         builder_liteethmac_status0_ongoing1 <= 1'd0;
@@ -7059,15 +8468,16 @@ always @(posedge sys_clk) begin
         builder_liteethicmprx_fsm0_state <= 2'd0;
         builder_liteethicmprx_fsm1_state <= 1'd0;
         builder_liteethicmprx_state <= 2'd0;
-        builder_liteethudp_liteethudptx_fsm0_state <= 2'd0;
-        builder_liteethudp_liteethudptx_fsm1_state <= 1'd0;
-        builder_liteethudp_liteethudptx_state <= 1'd0;
-        builder_liteethudp_holdingudprx_fsm0_state <= 2'd0;
-        builder_liteethudp_holdingudprx_fsm1_state <= 1'd0;
-        builder_liteethudp_holdingudprx_state <= 3'd0;
-        builder_liteethudp_first <= 1'd1;
-        builder_liteethudp_ongoing1 <= 1'd0;
-        builder_liteethudp_sel_ongoing <= 1'd0;
+        builder_portudp_lastbytetrim_state <= 1'd0;
+        builder_portudp_holdingudprx_fsm0_state <= 2'd0;
+        builder_portudp_holdingudprx_fsm1_state <= 1'd0;
+        builder_portudp_holdingudprx_state <= 3'd0;
+        builder_portudp_liteethudptx_fsm0_state <= 2'd0;
+        builder_portudp_liteethudptx_fsm1_state <= 1'd0;
+        builder_portudp_liteethudptx_state <= 1'd0;
+        builder_portudp_first <= 1'd1;
+        builder_portudp_ongoing1 <= 1'd0;
+        builder_portudp_sel_ongoing <= 1'd0;
         builder_state <= 1'd0;
     end
     builder_multiregimpl1_regs0 <= main_mac_core_tx_cdc_cdc_graycounter1_q;
@@ -7076,7 +8486,7 @@ always @(posedge sys_clk) begin
     builder_multiregimpl2_regs1 <= builder_multiregimpl2_regs0;
     builder_multiregimpl3_regs0 <= main_mac_core_pulsesynchronizer1_toggle_i;
     builder_multiregimpl3_regs1 <= builder_multiregimpl3_regs0;
-    builder_multiregimpl4_regs0 <= main_mac_core_cdc_graycounter0_q;
+    builder_multiregimpl4_regs0 <= main_mac_core_rx_cdc_cdc_graycounter0_q;
     builder_multiregimpl4_regs1 <= builder_multiregimpl4_regs0;
 end
 
@@ -7086,13 +8496,13 @@ end
 //------------------------------------------------------------------------------
 
 //------------------------------------------------------------------------------
-// Memory storage: 32-words x 12-bit
+// Memory storage: 32-words x 42-bit
 //------------------------------------------------------------------------------
-// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 12 
+// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 42 
 // Port 1 | Read: Sync  | Write: ---- | 
-reg [11:0] storage[0:31];
-reg [11:0] storage_dat0;
-reg [11:0] storage_dat1;
+reg [41:0] storage[0:31];
+reg [41:0] storage_dat0;
+reg [41:0] storage_dat1;
 always @(posedge sys_clk) begin
 	if (main_mac_core_tx_cdc_cdc_wrport_we)
 		storage[main_mac_core_tx_cdc_cdc_wrport_adr] <= main_mac_core_tx_cdc_cdc_wrport_dat_w;
@@ -7124,23 +8534,23 @@ assign main_mac_core_liteethmaccrc32checker_syncfifo_rdport_dat_r = storage_1[ma
 
 
 //------------------------------------------------------------------------------
-// Memory storage_2: 32-words x 12-bit
+// Memory storage_2: 32-words x 42-bit
 //------------------------------------------------------------------------------
-// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 12 
+// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 42 
 // Port 1 | Read: Sync  | Write: ---- | 
-reg [11:0] storage_2[0:31];
-reg [11:0] storage_2_dat0;
-reg [11:0] storage_2_dat1;
+reg [41:0] storage_2[0:31];
+reg [41:0] storage_2_dat0;
+reg [41:0] storage_2_dat1;
 always @(posedge eth_rx_clk) begin
-	if (main_mac_core_cdc_wrport_we)
-		storage_2[main_mac_core_cdc_wrport_adr] <= main_mac_core_cdc_wrport_dat_w;
-	storage_2_dat0 <= storage_2[main_mac_core_cdc_wrport_adr];
+	if (main_mac_core_rx_cdc_cdc_wrport_we)
+		storage_2[main_mac_core_rx_cdc_cdc_wrport_adr] <= main_mac_core_rx_cdc_cdc_wrport_dat_w;
+	storage_2_dat0 <= storage_2[main_mac_core_rx_cdc_cdc_wrport_adr];
 end
 always @(posedge sys_clk) begin
-	storage_2_dat1 <= storage_2[main_mac_core_cdc_rdport_adr];
+	storage_2_dat1 <= storage_2[main_mac_core_rx_cdc_cdc_rdport_adr];
 end
-assign main_mac_core_cdc_wrport_dat_r = storage_2_dat0;
-assign main_mac_core_cdc_rdport_dat_r = storage_2_dat1;
+assign main_mac_core_rx_cdc_cdc_wrport_dat_r = storage_2_dat0;
+assign main_mac_core_rx_cdc_cdc_rdport_dat_r = storage_2_dat1;
 
 
 //------------------------------------------------------------------------------
@@ -7162,13 +8572,13 @@ assign main_arp_table_cache_mem_rd_port_dat_r = mem[main_arp_table_cache_mem_rd_
 
 
 //------------------------------------------------------------------------------
-// Memory storage_3: 128-words x 12-bit
+// Memory storage_3: 32-words x 42-bit
 //------------------------------------------------------------------------------
-// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 12 
+// Port 0 | Read: Sync  | Write: Sync | Mode: Read-First  | Write-Granularity: 42 
 // Port 1 | Read: Sync  | Write: ---- | 
-reg [11:0] storage_3[0:127];
-reg [11:0] storage_3_dat0;
-reg [11:0] storage_3_dat1;
+reg [41:0] storage_3[0:31];
+reg [41:0] storage_3_dat0;
+reg [41:0] storage_3_dat1;
 always @(posedge sys_clk) begin
 	if (main_icmp_echo_payload_fifo_wrport_we)
 		storage_3[main_icmp_echo_payload_fifo_wrport_adr] <= main_icmp_echo_payload_fifo_wrport_dat_w;
