@@ -271,6 +271,12 @@ module rfl_gsubscriber #(
     // chosen as it starts (step == G_FIRST) as the bank no held record has; wcnt counts each
     // bank's bytes written (one bit more: 2**CW fit). The publisher reads the bank of meta_*.
     reg        nxt_drop, nxt_bank, meta_bank, fbank;
+`ifdef FORMAL
+    // (proofs only) records numbered as handed over: f_in the next number, f_out the next to
+    // be released, f_head and f_nxt those held, f_own0/1 the number of the record whose
+    // frame writes (wrote) each bank
+    reg [2:0]  f_in, f_out, f_head, f_nxt, f_own0, f_own1;
+`endif
     reg [31:0] nxt_out_len;
     reg [CW:0] wcnt0, wcnt1;
     wire [CW-1:0] waddr = fbank ? wcnt1[CW-1:0] : wcnt0[CW-1:0];  // where the next carried byte goes
@@ -285,12 +291,21 @@ module rfl_gsubscriber #(
                 nxt_drop <= drop;
                 nxt_out_len <= len;
                 nxt_bank <= fbank;
+`ifdef FORMAL
+                f_nxt <= f_in;
+`endif
             end else begin
                 meta_valid <= 1'b1;
                 meta_drop <= drop;
                 meta_out_len <= len;
                 meta_bank <= fbank;
+`ifdef FORMAL
+                f_head <= f_in;
+`endif
             end
+`ifdef FORMAL
+            f_in <= f_in + 3'd1;
+`endif
         end
     endtask
 
@@ -488,10 +503,18 @@ module rfl_gsubscriber #(
             fbank <= 1'b0;
             wcnt0 <= {(CW + 1){1'b0}};
             wcnt1 <= {(CW + 1){1'b0}};
+`ifdef FORMAL
+            f_own0 <= 3'd0;
+            f_own1 <= 3'd0;
+`endif
         end else if (step == G_FIRST) begin  // a frame starts: its bank, empty
             fbank <= fbank_nx;
             if (fbank_nx) wcnt1 <= {(CW + 1){1'b0}};
             else wcnt0 <= {(CW + 1){1'b0}};
+`ifdef FORMAL
+            if (fbank_nx) f_own1 <= f_in;
+            else f_own0 <= f_in;
+`endif
         end else if (carry_we) begin
             if (fbank) wcnt1 <= wcnt1 + 1'b1;
             else wcnt0 <= wcnt0 + 1'b1;
@@ -541,6 +564,12 @@ module rfl_gsubscriber #(
             nxt_out_len <= 32'd0;
             nxt_drop <= 1'b0;
             nxt_bank <= 1'b0;
+`ifdef FORMAL
+            f_in <= 3'd0;
+            f_out <= 3'd0;
+            f_head <= 3'd0;
+            f_nxt <= 3'd0;
+`endif
             status_valid <= 1'b0;
             status <= SUB_OK;
         end else begin
@@ -551,6 +580,10 @@ module rfl_gsubscriber #(
                 meta_out_len <= nxt_out_len;
                 meta_bank <= nxt_bank;
                 nxt_valid <= 1'b0;
+`ifdef FORMAL
+                f_head <= f_nxt;
+                f_out <= f_out + 3'd1;
+`endif
             end
             if (take) begin
                 pos <= pos_next;
@@ -595,6 +628,7 @@ module rfl_gsubscriber #(
                             last_f <= c_n1;
                             room <= n;
                             streamed <= 1'b0;
+                            released <= 1'b0;
                             out_len <= 32'd0;
                             depth <= {DB{1'b0}};
                             quiet <= 8'd0;
@@ -716,7 +750,8 @@ module rfl_gsubscriber #(
                         last_b <= c_body1;
                         if (sub == SUB_STREAM) streamed <= 1'b1;
                         pad_then(pad_e, S_BODY);
-                        if (STREAM_EARLY && sub == SUB_STREAM) begin  // nothing after can refuse
+                        if (STREAM_EARLY && sub == SUB_STREAM && !released) begin  // nothing
+                            // after can refuse (and a frame hands over once)
                             hand_over(1'b0, p_out_early);
                             released <= 1'b1;
                         end
@@ -786,6 +821,50 @@ module rfl_gsubscriber #(
     always @(*) if (rst_n && settled != 2'd0)
         assert(w_nx == prog_next(pc) && w_jp == prog_jump(pc) && pc_nx == pc + 16'd1
                && pc_jp == jump + 16'd1);
+    // The records: the publisher takes them in the order they were handed over, each once, none
+    // lost (the held ones are the oldest not yet released: meta_* the oldest, then nxt_*) ...
+    always @(*) if (rst_n) begin
+        assert(!nxt_valid || meta_valid);
+        assert(f_in == f_out + {2'd0, meta_valid} + {2'd0, nxt_valid});
+        if (meta_valid) assert(f_head == f_out);
+        if (nxt_valid) assert(f_nxt == f_out + 3'd1 && nxt_bank != meta_bank);
+        // ... each held record's bank holds its own frame's bytes (no later frame took it) ...
+        if (meta_valid) assert((meta_bank ? f_own1 : f_own0) == f_head);
+        if (nxt_valid) assert((nxt_bank ? f_own1 : f_own0) == f_nxt);
+        // ... and a frame being walked (it writes only then) writes its own bank (its record's
+        // number: handed over early, or still to come)
+        if (state != S_FLEN && state != S_FCHK && state != S_SKIP) begin
+            assert((fbank ? f_own1 : f_own0) == f_in - {2'd0, released});
+            // (it started with nxt_* empty; handed over early, its record is the newest)
+            if (!released) assert(!nxt_valid);
+            else assert(!meta_valid || (nxt_valid ? nxt_bank : meta_bank) == fbank);
+        end
+        if ((state == S_FLEN && cnt[1:0] != 2'd0) || state == S_FCHK) assert(!nxt_valid);
+        if (carry_we) assert(state == S_COUNT || state == S_BODY);
+    end
+    // A frame hands over at most one record: one (drop) if refused after its stream went out,
+    // none if refused before (a dropped frame's record never reaches the publisher). f_at: f_in as the frame's length was checked (S_FCHK: nothing handed over).
+    reg [2:0] f_at;
+    reg       f_atv = 1'b0;             // f_at is set (a frame length was checked)
+    reg       f_streamed, f_released, f_first;
+    always @(posedge clk) begin
+        if (state == S_FCHK) f_at <= f_in;
+        if (!rst_n) f_atv <= 1'b0;
+        else if (state == S_FCHK) f_atv <= 1'b1;
+        f_streamed <= streamed;
+        f_released <= released;
+        f_first <= (state == S_FCHK);
+        if (rst_n && f_atv && state != S_FCHK)
+            assert(f_in == f_at || f_in == f_at + 3'd1);
+        // (while walking: handed over only early; early, its stream has begun)
+        if (rst_n && state != S_FLEN && state != S_FCHK && state != S_SKIP)
+            assert(f_atv && f_in == f_at + {2'd0, released} && (!released || streamed));
+        if (rst_n && f_atv && status_valid && !f_first && status != SUB_OK) begin
+            if (f_streamed && !f_released)
+                assert(f_in == f_at + 3'd1 && (nxt_valid ? nxt_drop : meta_drop));
+            else if (!f_streamed) assert(f_in == f_at);
+        end
+    end
 `endif
 endmodule
 
