@@ -582,7 +582,7 @@ module rfl_gsubscriber #(
                 nxt_valid <= 1'b0;
 `ifdef FORMAL
                 f_head <= f_nxt;
-                f_out <= f_out + 3'd1;
+                f_out <= f_out + {2'd0, meta_valid};  // (a release of nothing: no record)
 `endif
             end
             if (take) begin
