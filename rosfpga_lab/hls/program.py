@@ -770,8 +770,10 @@ def stream_clocks(prog: Program, frames: list[bytes], *, latency: int = 0) -> li
     ``RECORDS`` before (``RELEASE_TO_TAKE``); the publisher starts a frame once handed over
     and done with the last (``DONE_TO_PUBLISH`` after its release). So in steady state a frame
     costs the larger of the subscriber's clocks and the publisher's, not their sum. Exact while
-    the stream's FIFOs (the one after the application holds a whole stream, ``axis_depth`` beats
-    with streaming early release) never make the subscriber wait.
+    the stream's path never makes the subscriber wait: the FIFO after the application holds a
+    whole stream (``axis_depth`` beats with streaming early release), and the next frame's
+    stream queues behind this one's; a video window flushing a small image's last lines holds
+    the next frame back (16x8 mono8 dilated over 3: 265 clocks a frame, the model says 255).
 
     Raises:
         Refused: the circuit refuses a frame.
