@@ -92,8 +92,11 @@ def _register_cycles(subparsers: argparse._SubParsersAction) -> None:
         description="Generate the configuration's project and simulate each of its test "
         "frames through the generated top with and without random output backpressure; print "
         "the clocks from the first byte in to the last byte out beside the walk's cycle model "
-        "(hls.program.frame_clocks, exact without backpressure) and the publisher's span. An "
-        "Image configuration takes --size and --encoding (one table per encoding).")
+        "(hls.program.frame_clocks, exact without backpressure) and the publisher's span; then "
+        "each frame --copies times back to back, its clocks per frame in steady state (the "
+        "subscriber reads the next frame while the publisher writes one) beside "
+        "hls.program.stream_clocks. An Image configuration takes --size and --encoding (one "
+        "table per encoding).")
     _common(parser)
     parser.add_argument("--size", type=_size, metavar="WxH",
                         help="image size (default: the configuration's)")
@@ -101,6 +104,10 @@ def _register_cycles(subparsers: argparse._SubParsersAction) -> None:
                         help=f"the backpressure of the second row, {PER_MILLE_HELP} (default 500)")
     parser.add_argument("--encoding", action="append", metavar="ENC",
                         help="Image: these encodings (repeatable; default: the configuration's)")
+    parser.add_argument("--copies", type=int, default=4, metavar="N",
+                        help="also send each frame N times back to back (no backpressure) and "
+                        "print its clocks per frame in steady state beside the model "
+                        "(hls.program.stream_clocks); 0: not (default 4)")
     parser.set_defaults(func=run_cycles)
 
 
@@ -379,7 +386,9 @@ def run_cycles(args: argparse.Namespace) -> int:
 
     from rosfpga_lab.config import load_config
     from rosfpga_lab.hw import PIXEL_FORMATS
-    from rosfpga_lab.rtl.cycles import format_generic_rows, generic_rows
+    from rosfpga_lab.rtl.cycles import (
+        SteadyRow, format_generic_rows, format_steady_rows, generic_rows,
+    )
 
     config = load_config(args.config)
     image_only = [flag for flag, given in (("--size", args.size), ("--encoding", args.encoding))
@@ -405,12 +414,20 @@ def run_cycles(args: argparse.Namespace) -> int:
     for cfg in configs:
         what = (f" ({cfg.image.encoding} {cfg.image.width}x{cfg.image.height})"
                 if cfg.is_image else "")
-        rows = generic_rows(cfg, bp=args.bp, simulator=args.simulator, progress=_say)
+        steady: list[SteadyRow] = []
+        rows = generic_rows(cfg, bp=args.bp, simulator=args.simulator, progress=_say,
+                            copies=args.copies, steady=steady)
         print(f"Clocks per frame of the generated {cfg.subscriber.type} circuit on {cfg.wire}"
               f"{what}, first byte in to last byte out ({cfg.application.op}); model: the walk's "
               "cycle model (hls.program.frame_clocks), exact without backpressure")
         print(format_generic_rows(rows))
         exact = exact and all(r.model == r.rtl for r in rows if r.bp == 0)
+        if steady:
+            print(f"Back to back ({args.copies} copies, no backpressure): clocks per frame in "
+                  "steady state (what each copy after the first adds); model: "
+                  "hls.program.stream_clocks, exact unless the stream's path holds the next "
+                  "frame back (a video window flushing a small image's last lines)")
+            print(format_steady_rows(steady))
     _say(f"done in {time.perf_counter() - start:.1f} s")
     return 0 if exact else 1
 

@@ -35,7 +35,8 @@ from rosfpga_lab.hls.csim import BINARY, CXXFLAGS, HLS_HEADERS, SOURCES, TB_EXPE
 from rosfpga_lab.hls.compiler import program_from_cdr, program_from_layout
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.program import (
-    ALIGN_ORIGIN, ENCAP_PAD_MASK, MAX_LOOP_DEPTH, Op, Program, Pub, Sub, stream_latency,
+    ALIGN_ORIGIN, ENCAP_PAD_MASK, MAX_LOOP_DEPTH, RECORDS, Op, Program, Pub, Sub,
+    stream_latency,
 )
 from rosfpga_lab.hw import limits as hw_limits
 from rosfpga_lab.hw.cdrlayout import END_ALIGN
@@ -341,7 +342,7 @@ def context(spec: GenericSpec) -> dict[str, object]:
         "consts": prog.const_table, "const_rows": _hex_rows(prog.const_table),
         "loop_depth": loop_depth(prog), "max_instr_steps": max_steps(prog),
         "stream_early": prog.stream_early,
-        "carry_bytes": max(1, prog.carry_bytes),
+        "carry_bytes": max(1, prog.carry_bytes), "records": RECORDS,
         "meta_fields": meta_fields(prog), "meta_bits": sum(f[1] for f in meta_fields(prog)),
         "carry_count_bits": meta_fields(prog)[1][1],
         "flavour": spec.flavour, "tool": HLS_TOOLS[spec.flavour],

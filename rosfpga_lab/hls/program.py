@@ -627,9 +627,19 @@ def run_program(prog: Program, frames: list[bytes], apply: Callable[[bytes], byt
 
 
 
+#: Frames' records the subscriber holds for the publisher (its output length, drop flag and a
+#: carry bank each: ``rfl_gsubscriber``'s meta_* and nxt_*; the HLS meta FIFO's depth, the carry
+#: FIFO's that many frames): it reads the next frame while the publisher writes one.
+RECORDS = 2
 #: Clocks from the subscriber accepting a frame to the publisher's first byte (its fields are
 #: handed over on a register; the publisher leaves its idle state on the next clock).
 ACCEPT_TO_PUBLISH = 2
+#: Back to back (:func:`stream_clocks`): from the publisher's release of a frame (P_DONE, the
+#: clock after its timeline) to its next frame's first byte, and to the subscriber's first
+#: byte of the frame that waited for that record (counted, as the subscriber's timeline is,
+#: from the input's handshake: the rx FIFO and its register slice come before the subscriber).
+DONE_TO_PUBLISH = 2
+RELEASE_TO_TAKE = 0
 #: Clocks from the publisher's byte to the node's output: the register slice before the tx
 #: FIFO (one), then the FIFO (two).
 TX_LATENCY = 3
@@ -687,6 +697,46 @@ class FrameClocks:
     out_bytes: int
 
 
+@dataclass(frozen=True)
+class _Walk:
+    """One accepted frame's walks: the subscriber's clocks (its timeline, then the announced end
+    padding it skips after acceptance), where it hands the frame over, the publisher's timeline
+    and the marks of both (:func:`subscribe`, :func:`publish`)."""
+
+    sub_clocks: int
+    busy: int
+    start: int
+    pub_tl: bytes
+    sub_marks: dict[str, int]
+    pub_marks: dict[str, int]
+    out_bytes: int
+
+
+def _walk(prog: Program, frame: bytes) -> _Walk:
+    sub_tl, pub_tl = bytearray(), bytearray()
+    sub_marks: dict[str, int] = {}
+    pub_marks: dict[str, int] = {}
+    carry, stream, out_len = subscribe(prog, frame, sub_tl, sub_marks)
+    out = publish(prog, carry, stream, out_len, prog.seq_start, pub_tl, pub_marks)
+    start = len(sub_tl) if prog.stream_early is None else sub_marks["release"]
+    return _Walk(len(sub_tl), len(sub_tl) + len(frame) - sub_tl.count(1), start, bytes(pub_tl),
+                 sub_marks, pub_marks, len(out))
+
+
+def _publisher_wait(prog: Program, w: _Walk, sub_at: int, pub_at: int, latency: int) -> int:
+    """Clocks the publisher of ``w`` waits, its timeline index 0 at clock ``pub_at`` and the
+    subscriber's at ``sub_at``: with streaming early release, for the stream's first byte (then
+    the stream flows a byte per clock, as it writes) and for each carried byte after the
+    stream; else none (the publisher starts with all of them in)."""
+    if prog.stream_early is None:
+        return 0
+    wait = max(0, sub_at + w.start + 1 + latency - (pub_at + w.pub_marks["stream"]))
+    for key, at in w.sub_marks.items():
+        if key.startswith("carried_"):
+            wait = max(wait, sub_at + at + CARRY_PATH - (pub_at + w.pub_marks[key]))
+    return wait
+
+
 def frame_clocks(prog: Program, frame: bytes, ready: float = 1.0, *,
                  latency: int = 0) -> FrameClocks:
     """The clocks of ``frame`` through the generated circuit (see :class:`FrameClocks`), the
@@ -699,26 +749,47 @@ def frame_clocks(prog: Program, frame: bytes, ready: float = 1.0, *,
     """
     if not 0 < ready <= 1:
         raise ValueError(f"ready must be in (0, 1], got {ready}")
-    sub_tl, pub_tl = bytearray(), bytearray()
-    sub_marks: dict[str, int] = {}
-    pub_marks: dict[str, int] = {}
-    carry, stream, out_len = subscribe(prog, frame, sub_tl, sub_marks)
-    out = publish(prog, carry, stream, out_len, prog.seq_start, pub_tl, pub_marks)
-    start = len(sub_tl)
-    wait = 0
-    if prog.stream_early is not None:
-        start = sub_marks["release"]
-        # the publisher's timeline index i is at clock start + ACCEPT_TO_PUBLISH + i; it waits
-        # for the stream's first byte (then the stream flows a byte per clock, as it writes)
-        # and for each carried byte after the stream
-        first = start + ACCEPT_TO_PUBLISH + pub_marks["stream"]
-        wait = max(0, start + 1 + latency - first)
-        for key, at in sub_marks.items():
-            if key.startswith("carried_"):
-                wait = max(wait, at + CARRY_PATH - (start + ACCEPT_TO_PUBLISH + pub_marks[key]))
-    pub = pub_tl.rindex(1) + 1 + wait
+    w = _walk(prog, frame)
+    start = w.start
+    # the publisher's timeline index i is at clock start + ACCEPT_TO_PUBLISH + i
+    pub = w.pub_tl.rindex(1) + 1 + _publisher_wait(prog, w, 0, start + ACCEPT_TO_PUBLISH,
+                                                   latency)
     total = start + ACCEPT_TO_PUBLISH - 1 + pub + TX_LATENCY
     if ready < 1:
         total = max(total, start + ACCEPT_TO_PUBLISH + TX_LATENCY - 1
-                    + -(-len(out) * 1000 // round(ready * 1000)))
-    return FrameClocks(len(sub_tl), pub, total, len(frame), len(out))
+                    + -(-w.out_bytes * 1000 // round(ready * 1000)))
+    return FrameClocks(w.sub_clocks, pub, total, len(frame), w.out_bytes)
+
+
+def stream_clocks(prog: Program, frames: list[bytes], *, latency: int = 0) -> list[int]:
+    """Frames back to back through the generated circuit (their bytes always there, the output
+    always ready): for each, the clocks from the first frame's first byte in to its own last
+    byte out (the first's is :func:`frame_clocks`'s ``total``). The subscriber takes a frame
+    once it is done with the last (its timeline, then the end padding it skips) and fewer than
+    :data:`RECORDS` records are held, i.e. once the publisher has released the frame
+    ``RECORDS`` before (``RELEASE_TO_TAKE``); the publisher starts a frame once handed over
+    and done with the last (``DONE_TO_PUBLISH`` after its release). So in steady state a frame
+    costs the larger of the subscriber's clocks and the publisher's, not their sum. Exact while
+    the stream's path never makes the subscriber wait: the FIFO after the application holds a
+    whole stream (``axis_depth`` beats with streaming early release), and the next frame's
+    stream queues behind this one's; a video window flushing a small image's last lines holds
+    the next frame back (16x8 mono8 dilated over 3: 265 clocks a frame, the model says 255).
+
+    Raises:
+        Refused: the circuit refuses a frame.
+    """
+    ends: list[int] = []
+    released: list[int] = []            # the clock each frame's record is released
+    sub_at = 0                          # the clock the subscriber's timeline starts
+    for k, frame in enumerate(frames):
+        w = _walk(prog, frame)
+        if k >= RECORDS:
+            sub_at = max(sub_at, released[k - RECORDS] + RELEASE_TO_TAKE)
+        pub_at = sub_at + w.start + ACCEPT_TO_PUBLISH
+        if k:
+            pub_at = max(pub_at, released[-1] + DONE_TO_PUBLISH)
+        wait = _publisher_wait(prog, w, sub_at, pub_at, latency)
+        ends.append(pub_at + w.pub_tl.rindex(1) + wait + TX_LATENCY)
+        released.append(pub_at + wait + len(w.pub_tl))
+        sub_at += w.busy
+    return ends

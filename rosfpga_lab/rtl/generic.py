@@ -57,7 +57,10 @@ TEMPLATES = Path(__file__).resolve().parent / "templates"
 def out_depth(spec: GenericSpec) -> int:
     """Beats of ``rfl_gtop``'s FIFO after the application: a whole stream (and 2) when the
     publisher starts a frame only once the subscriber has read all of it, ``axis_depth`` with
-    streaming early release (:attr:`rosfpga_lab.hls.program.Program.stream_early`)."""
+    streaming early release (:attr:`rosfpga_lab.hls.program.Program.stream_early`). Back to back
+    the next frame's stream queues behind it and flows as the publisher takes this one's (the
+    subscriber then waits only if the publisher reaches its stream later than the subscriber
+    did: ``hls.program.stream_clocks`` assumes it does not)."""
     if spec.program.stream_early is not None:
         return max(2, spec.axis_depth)
     return max(spec.axis_depth, beat_shape(spec)["count"] + 2)

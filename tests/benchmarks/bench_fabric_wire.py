@@ -17,7 +17,8 @@ output's last byte out: RTL latency in the circuit, not wire latency (no PHY, no
 take. Beside them: the closed commercial RTPS core's 2.5 us (312 clocks at 125 MHz), which it
 states for send/receive.
 
-Measured (2026-11-29, Verilator 5.048, cocotb 2.1, this worktree): see the fabric docs
+Measured (2026-11-29, Verilator 5.048, cocotb 2.1, after the generated subscriber's double
+buffering: the LaserScan at the output's line rate, 12 of 12): see the fabric docs
 (rosfpga_lab/rtl/fabric/vendor/README.md, "At line rate"), printed by
 
     python tests/benchmarks/bench_fabric_wire.py [--image 64x48] [--samples 6] [--no-watch]

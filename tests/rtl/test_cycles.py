@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 from tests.support.rtltools import require_iverilog
 from rosfpga_lab.hls.compiler import program_from_cdr
 from rosfpga_lab.hls.generic import spec_from_layout, stream_path
-from rosfpga_lab.hls.program import Refused, frame_clocks
+from rosfpga_lab.hls.program import RECORDS, Refused, frame_clocks, stream_clocks
 from rosfpga_lab.hw import image_frame
 from rosfpga_lab.hw.cdrlayout import derive_cdr_layout
 from rosfpga_lab.hw.layout import Action, StepKind, derive_layout
@@ -54,7 +54,8 @@ def test_the_generated_circuits_clocks_equal_the_walks_model(
     """Random message definitions (the models' strategy: every field kind, nesting, arrays of
     messages), each on TCPROS or CDR: every accepted frame's clocks in the RTL (``make rtlsim``,
     no backpressure), first byte in to last byte out, and the publisher's span, equal
-    ``hls.program.frame_clocks``'s (the RTL is the oracle; Icarus Verilog only, no C++)."""
+    ``hls.program.frame_clocks``'s, and the accepted frames back to back ``stream_clocks``'s
+    (the RTL is the oracle; Icarus Verilog only, no C++)."""
     require_iverilog()
     reg, type_name, stream = data.draw(definitions())
     cdr = data.draw(st.booleans())
@@ -82,6 +83,7 @@ def test_the_generated_circuits_clocks_equal_the_walks_model(
     for name, blob in project_files(spec).items():
         (where / name).parent.mkdir(parents=True, exist_ok=True)
         (where / name).write_bytes(blob)
+    accepted = []
     for frame in frames:
         _out, statuses = simulate_project(where, frame, target="rtlsim", simulator="iverilog",
                                           out="c")
@@ -95,6 +97,14 @@ def test_the_generated_circuits_clocks_equal_the_walks_model(
         assert rtl["tx"].last - rtl["rx"].first + 1 == model.total
         assert rtl["publisher_out"].last - rtl["publisher_out"].first + 1 == model.publisher
         assert rtl["tx"].count == model.out_bytes and rtl["rx"].count >= model.in_bytes - 3
+        accepted.append(frame)
+    if accepted:  # back to back, three times over (hls.program.stream_clocks)
+        _out, statuses = simulate_project(where, b"".join(accepted * 3), target="rtlsim",
+                                          simulator="iverilog", out="b")
+        assert statuses == ["SUB_OK"] * 3 * len(accepted)
+        rtl = read_stats(where / "b" / "stats.txt")
+        assert rtl["tx"].last - rtl["rx"].first + 1 == \
+            stream_clocks(prog, accepted * 3, latency=stream_path(spec))[-1]
 
 
 def test_cli_rtl_cycles_of_a_generated_circuit(capsys: pytest.CaptureFixture[str]) -> None:
@@ -109,8 +119,11 @@ def test_cli_rtl_cycles_of_a_generated_circuit(capsys: pytest.CaptureFixture[str
     captured = capsys.readouterr()
     rows = [line.split() for line in captured.out.splitlines()
             if line.startswith("frame ") and line.split()[1].isdigit()]
-    assert len(rows) == 4 and "generating the project" in captured.err
-    for row in rows:
+    # two test frames, without and with backpressure, then each 4 times back to back
+    assert len(rows) == 6 and "generating the project" in captured.err
+    for row in rows[4:]:
+        assert row[5] == row[6] and row[7] == "+0.00%" and row[8] == row[9], row
+    for row in rows[:4]:
         out_bytes, bp, model, rtl = (int(row[3].replace(",", "")), row[4],
                                      int(row[5].replace(",", "")), int(row[6].replace(",", "")))
         if bp == "0%":
@@ -197,3 +210,49 @@ def test_streaming_early_release_keeps_the_cycle_model_exact() -> None:
             for gap, bp in ((300, 300), (0, 700)):
                 assert run(sim, both, gap=gap, bp=bp, seed=5).output == \
                     node_model_output(config, both), label
+
+
+def test_frames_back_to_back_keep_the_cycle_model_exact() -> None:
+    """Frames back to back (no gaps, no backpressure): the subscriber reads the next frame while
+    the publisher writes one (``rfl_gsubscriber``'s RECORDS records), and the clocks from the
+    first byte in to the last byte out equal ``hls.program.stream_clocks`` (the RTL is the
+    oracle). A short message whose stream only fixed fields follow (early release) and one whose
+    string follows it (whole frames): a long frame, then short ones, so that the subscriber waits
+    for the publisher to release the long frame's record; then each shipped LaserScan's test
+    frames repeated, where a frame costs the subscriber's walk alone in steady state, not the
+    walk and the publisher's span one after the other (the single record's 3,120 clocks a
+    1,504-byte frame)."""
+    from rosfpga_lab.config import load_config
+    from rosfpga_lab.msg.registry import MsgRegistry
+    from rosfpga_lab.rtl.cycles import SteadyRow, generic_rows
+
+    require_iverilog()
+    assert RECORDS == 2
+    reg = MsgRegistry.with_defaults()
+    reg.add("lab_msgs/Tail", "string name\nuint8[] data\nuint64 stamp\nuint8 mode\n")
+    reg.add("lab_msgs/Head", "uint8[] data\nstring name\n")
+    for type_name, fields in (("lab_msgs/Tail", {"stamp": 5, "mode": 7}), ("lab_msgs/Head", {})):
+        layout = derive_layout(reg, type_name, stream="data", stream_length=6)
+        spec = spec_from_layout(layout, reg, op="erode", ksize=3)
+        assert (spec.program.stream_early is not None) == (type_name == "lab_msgs/Tail")
+
+        def frame(name: str) -> bytes:
+            body = serialize(reg, type_name, {"name": name, "data": list(range(6)), **fields})
+            return struct.pack("<I", len(body)) + body
+
+        long, short = frame("x" * 200), frame("")
+        sim = build(spec, simulator="iverilog", cache=True)
+        for frames in ([long, short], [long, short, short, short], [short, long, short] * 2):
+            s = run(sim, b"".join(frames)).streams
+            assert s["tx"].last - s["rx"].first + 1 == \
+                stream_clocks(spec.program, frames, latency=stream_path(spec))[-1], type_name
+    data = Path(__file__).resolve().parents[2] / "data"
+    for name in ("fpga_laserscan_min_cdr.yaml", "fpga_laserscan_min.yaml"):
+        steady: list[SteadyRow] = []
+        generic_rows(load_config(data / name), bp=0, simulator="iverilog", copies=3,
+                     steady=steady)
+        assert steady, name
+        for row in steady:
+            assert (row.model, row.model_alone) == (row.rtl, row.rtl_alone), name
+            # the larger of the two walks, not their sum: under the frame's bytes in and out
+            assert row.rtl_per_frame < 1.1 * max(row.in_bytes, row.out_bytes), (name, row)

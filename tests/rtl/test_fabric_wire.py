@@ -350,3 +350,31 @@ def test_ipv4_lengths_and_fragments_are_dropped_at_the_ip_layer(wire: dict) -> N
         frames = len(wire["fams"][k].frames)
         assert moved["rx_packets"] == 0 and moved["rx_header"] + moved["rx_length"] == frames, \
             (name, moved)
+
+
+#: LaserScans sent back to back at line rate by the line-rate test (after a warm-up and one alone).
+LINE_RATE_SAMPLES = 6
+#: The share of the wire's bound (wire bytes a sample / 125 MB/s) the node must sustain: the
+#: first sample's latency is in the measured span, the rest is at the wire's pace.
+LINE_RATE_SHARE = 0.95
+
+
+@pytest.mark.timeout(900)
+def test_the_laserscan_keeps_up_with_gigabit_line_rate(tmp_path: Path) -> None:
+    """Issue #31 item 5: LINE_RATE_SAMPLES LaserScans (data/fpga_laserscan_min_cdr.yaml, each
+    two DATA_FRAGs) at the GMII side back to back at line rate (a byte a clock at 125 MHz, 8-byte
+    preamble, 12-byte gap): every one comes out, the output exact, at the wire's pace (within
+    LINE_RATE_SHARE of its bound). The generated circuit takes the next sample while it
+    publishes the last (rfl_gsubscriber's two records): 1,597 clocks a 1,504-byte sample back to
+    back, under the 1,772 wire bytes it comes in; with one record it took 3,120 and sustained
+    39,962/s of the bound's 70,542/s (tests/benchmarks/bench_fabric_wire.py prints both)."""
+    from tests.benchmarks.bench_fabric_wire import measure
+
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        cocotb_verilator(monkeypatch)
+        monkeypatch.syspath_prepend(str(TB_DIR))
+        r = measure(CONFIG, LINE_RATE_SAMPLES, False, tmp_path)
+    assert r["exact"]
+    assert r["delivered"] == r["samples"] == LINE_RATE_SAMPLES, r["counters"]
+    assert r["sustained_per_s"] >= LINE_RATE_SHARE * r["bound_per_s"], \
+        (r["sustained_per_s"], r["bound_per_s"])

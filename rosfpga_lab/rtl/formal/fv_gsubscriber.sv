@@ -40,11 +40,13 @@ module fv_gsubscriber #(parameter CW = 3) (
         else if (m_tvalid && m_tready) streamed <= streamed + 8'd1;
     end
 
-    // the frame's fields were handed over since its first byte (early: before its end)
+    // the frame's fields were handed over since its first byte (early: before its end), seen
+    // as meta_valid rising (a record handed over behind a held one is not visible on the ports:
+    // the module's own assertions hold the records' order, banks and count per frame)
     reg handed;
     always @(posedge clk) begin
         if (!rst_n || frame_start) handed <= 1'b0;
-        else if (meta_valid) handed <= 1'b1;
+        else if (meta_valid && !$past(meta_valid)) handed <= 1'b1;
     end
 
     always @(posedge clk) if (!fv_init && rst_n) begin

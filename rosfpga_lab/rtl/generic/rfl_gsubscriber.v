@@ -4,9 +4,12 @@
 // into the carry memory, in order, lengths included, for the publisher), checked (against the
 // program's constants or bounds) or streamed (out on m_*, to the element packer). It adds up
 // the length of the message the publisher will write (out_len). When it has read a whole frame
-// (or refused one after its stream went out) it raises meta_valid until the publisher's
-// meta_release; a new frame waits for that. A refused frame is skipped to its end. Each frame
-// ends in a one-clock status_valid pulse with the status code (0: accepted).
+// (or refused one after its stream went out) it hands the frame's record (out_len, drop, its
+// carry bank) to the publisher: meta_* show the oldest record, meta_valid until the publisher's
+// meta_release. It holds RECORDS (2) records, each with a bank of the carry memory of its own,
+// so it reads frame n+1 while the publisher writes frame n; a new frame waits only while both
+// are held. A refused frame is skipped to its end (no record unless its stream went out). Each
+// frame ends in a one-clock status_valid pulse with the status code (0: accepted).
 // CDR samples (a sample length, then the payload): OP_ENCAP checks the encapsulation header and
 // takes the payload's end padding from its options (skipped after the last field); before each
 // field the bytes that align it are skipped (S_PAD); a string's count includes its NUL, which
@@ -23,15 +26,15 @@
 // nothing after the stream's count can refuse the frame (TCPROS: its count fills the frame
 // exactly with fixed fields that are skipped or carried; CDR: the stream is the last field and
 // its elements end the payload, or leave only the unannounced end padding, checked at the count
-// as c_early_bad), the frame is handed over (meta_valid, out_len +
-// EARLY_ADD) at the count's decision, so the publisher writes it while the stream flows; the
-// frame's end then raises no meta_valid. The publisher may read the carry memory while the
-// fields after the stream are written into it: a byte is read only once written (craddr <
-// waddr), and carry_valid says the carried byte at hand is there.
+// as c_early_bad), the frame is handed over (its record, out_len + EARLY_ADD) at the count's
+// decision, so the publisher writes it while the stream flows; the frame's end then hands
+// nothing over. The publisher may read the frame's carry bank while the fields after the stream
+// are written into it: a byte is read only once written (craddr < the bank's count), and
+// carry_valid says the carried byte at hand is there.
 `default_nettype none
 
 module rfl_gsubscriber #(
-    parameter CARRY_BYTES = 64,                 // the carry memory (at least 1)
+    parameter CARRY_BYTES = 64,                 // the carry memory of one frame (at least 1)
     parameter CW = 6,                           // its address bits
     parameter MIN_BODY = 0,                     // shortest frame length accepted
     parameter MAX_FRAME = 67108864,             // longest frame length accepted
@@ -71,6 +74,8 @@ module rfl_gsubscriber #(
             $fatal(1, "rfl_gsubscriber: MIN_BODY must be at most MAX_FRAME");
         if (EARLY != -1 && EARLY != STREAM_EARLY)
             $fatal(1, "rfl_gsubscriber: EARLY must be the walk's STREAM_EARLY (rfl_layout.vh)");
+        if (RECORDS != 2)
+            $fatal(1, "rfl_gsubscriber: holds 2 records (rfl_layout.vh's RECORDS)");
     end
 `else
     if (CARRY_BYTES < 1 || CW < 1 || CW > 16 || (1 << CW) < CARRY_BYTES) begin : g_bad_carry
@@ -81,6 +86,9 @@ module rfl_gsubscriber #(
     end
     if (EARLY != -1 && EARLY != STREAM_EARLY) begin : g_bad_early
         $error("rfl_gsubscriber: EARLY must be the walk's STREAM_EARLY (rfl_layout.vh)");
+    end
+    if (RECORDS != 2) begin : g_bad_records
+        $error("rfl_gsubscriber: holds 2 records (rfl_layout.vh's RECORDS)");
     end
 `endif
 
@@ -110,14 +118,14 @@ module rfl_gsubscriber #(
                                                 // every byte of it is taken before a decision)
     reg        released;                        // handed over early (STREAM_EARLY)
     reg [31:0] out_len;
-    reg [CW:0] waddr;                           // carried bytes written (one bit more: 2**CW fit)
     // elements left of each open loop, 32 bits each (a vector, not a memory: Verilator keeps
     // a memory's every write site, the reset's one per entry, as work on every clock)
     reg [32*LOOPS-1:0] left;
     reg [LOOPS-1:0] quiet_of;              // that loop is written empty
     reg [DB-1:0] depth;
     reg [7:0]  quiet;
-    reg [7:0]  carry_mem [0:CARRY_BYTES-1];
+    // the carry memory: two banks of 2**CW bytes, a frame's in the bank of its record
+    reg [7:0]  carry_mem [0:(2 << CW)-1];
 
     // The decisions' registers (r_out_*, the bounds' masks and keys, the next instructions, p_*
     // and c_*) load on every clock but a field's bytes (S_BODY), where nothing reads them and a
@@ -154,9 +162,10 @@ module rfl_gsubscriber #(
     wire [31:0] elem_min = w[31:0];
     wire [1:0]  lsize = w[223:222];
 
-    // A new frame waits until the publisher has taken the previous frame's meta. (In S_FLEN,
-    // as in S_COUNT, cnt counts the length's bytes, 0..3.)
-    wire stall = (state == S_FLEN) && (cnt[1:0] == 2'd0) && meta_valid;
+    // A new frame waits while both records are held (the publisher has not taken the older).
+    // (In S_FLEN, as in S_COUNT, cnt counts the length's bytes, 0..3.)
+    reg        nxt_valid;                       // the second record is held (behind meta_*)
+    wire stall = (state == S_FLEN) && (cnt[1:0] == 2'd0) && nxt_valid;
     wire streaming = (state == S_BODY) && (sub == SUB_STREAM);
     wire reading = (state == S_FLEN && !stall) || state == S_COUNT || state == S_BODY
                    || state == S_SKIP || state == S_PAD || state == S_TAIL;
@@ -256,28 +265,70 @@ module rfl_gsubscriber #(
         hi_key <= order_key(bound(kaddr + size[15:0], size), sign_m, all_m, kind);
     end
 
-    always @(posedge clk) begin
-        if (take && keep && (state == S_COUNT || state == S_BODY)) carry_mem[waddr[CW-1:0]] <= s_tdata;
-    end
+    // The records and the carry memory's banks. The walk hands a frame over (hand_over, below)
+    // into meta_* when they are free (or being released), else into nxt_*, the second record;
+    // meta_release moves nxt_* into meta_*. A frame writes its carried bytes into bank fbank,
+    // chosen as it starts (step == G_FIRST) as the bank no held record has; wcnt counts each
+    // bank's bytes written (one bit more: 2**CW fit). The publisher reads the bank of meta_*.
+    reg        nxt_drop, nxt_bank, meta_bank, fbank;
+`ifdef FORMAL
+    // (proofs only) records numbered as handed over: f_in the next number, f_out the next to
+    // be released, f_head and f_nxt those held, f_own0/1 the number of the record whose
+    // frame writes (wrote) each bank
+    reg [2:0]  f_in, f_out, f_head, f_nxt, f_own0, f_own1;
+`endif
+    reg [31:0] nxt_out_len;
+    reg [CW:0] wcnt0, wcnt1;
+    wire [CW-1:0] waddr = fbank ? wcnt1[CW-1:0] : wcnt0[CW-1:0];  // where the next carried byte goes
+    wire       carry_we = take && keep && (state == S_COUNT || state == S_BODY);
 
-    // The carry memory's read side: the publisher takes the carried bytes in order, from the
-    // first, once per frame (carry_restart, then carry_pop for each); a new frame waits for
-    // meta_release, so waddr holds its frame's count while they are read. They are read ahead
-    // into two registers, as rfl_fifo's OUTREG does: the block RAM's read register (cq), then
-    // carry_rdata in the fabric, so that the publisher's byte does not start from a block RAM's
-    // slow clock-to-output (100 MHz timing on an ECP5). A byte is read only once written
-    // (craddr < waddr): with STREAM_EARLY the publisher starts before the carried fields after
-    // the stream are in; carry_valid says carry_rdata holds the next carried byte. Two clocks
-    // after carry_restart the first byte is in carry_rdata (the publisher's first carried byte
-    // comes after the frame length's 4 bytes and a decode); from then on each carry_pop moves
-    // the next one in (when written).
+    // Hand the frame over: its record behind the held one, if one is held and not being
+    // released now (a frame starts with nxt_* empty and hands over at most once).
+    task hand_over(input drop, input [31:0] len);
+        begin
+            if (meta_valid && !meta_release) begin
+                nxt_valid <= 1'b1;
+                nxt_drop <= drop;
+                nxt_out_len <= len;
+                nxt_bank <= fbank;
+`ifdef FORMAL
+                f_nxt <= f_in;
+`endif
+            end else begin
+                meta_valid <= 1'b1;
+                meta_drop <= drop;
+                meta_out_len <= len;
+                meta_bank <= fbank;
+`ifdef FORMAL
+                f_head <= f_in;
+`endif
+            end
+`ifdef FORMAL
+            f_in <= f_in + 3'd1;
+`endif
+        end
+    endtask
+
+    // The carry memory's read side: the publisher takes the carried bytes of meta_*'s bank in
+    // order, from the first, once per frame (carry_restart, then carry_pop for each); no other
+    // frame writes the bank before meta_release (a new frame takes the other bank), so its
+    // count holds while they are read. They are read ahead into two registers, as rfl_fifo's
+    // OUTREG does: the block RAM's read register (cq), then carry_rdata in the fabric, so that
+    // the publisher's byte does not start from a block RAM's slow clock-to-output (100 MHz
+    // timing on an ECP5). A byte is read only once written
+    // (craddr < the bank's count): with STREAM_EARLY the publisher starts before the carried
+    // fields after the stream are in; carry_valid says carry_rdata holds the next carried byte.
+    // Two clocks after carry_restart the first byte is in carry_rdata (the publisher's first
+    // carried byte comes after the frame length's 4 bytes and a decode); from then on each
+    // carry_pop moves the next one in (when written).
     reg [CW:0] craddr;                          // the next byte to read
     reg [7:0]  cq;                              // the byte after carry_rdata
     reg        cq_valid;
+    wire [CW:0] rcnt = meta_bank ? wcnt1 : wcnt0;                     // the bank's bytes written
     wire       c_move = cq_valid && (!carry_valid || carry_pop);      // cq -> carry_rdata
-    wire       c_read = (!cq_valid || c_move) && (craddr != waddr);   // memory -> cq
+    wire       c_read = (!cq_valid || c_move) && (craddr != rcnt);    // memory -> cq
     always @(posedge clk) begin
-        if (c_read) cq <= carry_mem[craddr[CW-1:0]];
+        if (c_read) cq <= carry_mem[{meta_bank, craddr[CW-1:0]}];
         if (c_move) carry_rdata <= cq;
         if (!rst_n || carry_restart) begin
             craddr <= {(CW + 1){1'b0}};
@@ -393,10 +444,8 @@ module rfl_gsubscriber #(
             status_valid <= 1'b1;
             status <= code;
             cnt <= 32'd0;
-            if (streamed && !released) begin  // (never released: STREAM_EARLY's rule)
-                meta_valid <= 1'b1;
-                meta_drop <= 1'b1;
-            end
+            if (streamed && !released) hand_over(1'b1, out_len);  // (never released:
+            // STREAM_EARLY's rule; the publisher reads no length of a dropped frame)
             if (to_end) begin
                 state <= S_FLEN;
                 pos <= 32'd0;
@@ -411,11 +460,7 @@ module rfl_gsubscriber #(
         begin
             status_valid <= 1'b1;
             status <= SUB_OK;
-            if (!released) begin  // (STREAM_EARLY: handed over at the stream's count)
-                meta_valid <= 1'b1;
-                meta_drop <= 1'b0;
-                meta_out_len <= out_len;
-            end
+            if (!released) hand_over(1'b0, out_len);  // (STREAM_EARLY: at the stream's count)
             released <= 1'b0;
             cnt <= 32'd0;
             if (to_end) begin
@@ -450,6 +495,32 @@ module rfl_gsubscriber #(
             endcase
     end
 
+    // The carry memory's write side (a frame's bank and its count: see hand_over).
+    wire       fbank_nx = meta_valid ? !meta_bank : fbank;   // (nxt_* is empty as a frame starts)
+    always @(posedge clk) begin
+        if (carry_we) carry_mem[{fbank, waddr}] <= s_tdata;
+        if (!rst_n) begin
+            fbank <= 1'b0;
+            wcnt0 <= {(CW + 1){1'b0}};
+            wcnt1 <= {(CW + 1){1'b0}};
+`ifdef FORMAL
+            f_own0 <= 3'd0;
+            f_own1 <= 3'd0;
+`endif
+        end else if (step == G_FIRST) begin  // a frame starts: its bank, empty
+            fbank <= fbank_nx;
+            if (fbank_nx) wcnt1 <= {(CW + 1){1'b0}};
+            else wcnt0 <= {(CW + 1){1'b0}};
+`ifdef FORMAL
+            if (fbank_nx) f_own1 <= f_in;
+            else f_own0 <= f_in;
+`endif
+        end else if (carry_we) begin
+            if (fbank) wcnt1 <= wcnt1 + 1'b1;
+            else wcnt0 <= wcnt0 + 1'b1;
+        end
+    end
+
     // Go on with the instruction `step` loads.
     task go;
         begin
@@ -480,7 +551,6 @@ module rfl_gsubscriber #(
             same <= 1'b0;
             streamed <= 1'b0;
             out_len <= 32'd0;
-            waddr <= {(CW + 1){1'b0}};
             released <= 1'b0;
             depth <= {DB{1'b0}};
             quiet <= 8'd0;
@@ -489,18 +559,38 @@ module rfl_gsubscriber #(
             meta_valid <= 1'b0;
             meta_out_len <= 32'd0;
             meta_drop <= 1'b0;
+            meta_bank <= 1'b0;
+            nxt_valid <= 1'b0;
+            nxt_out_len <= 32'd0;
+            nxt_drop <= 1'b0;
+            nxt_bank <= 1'b0;
+`ifdef FORMAL
+            f_in <= 3'd0;
+            f_out <= 3'd0;
+            f_head <= 3'd0;
+            f_nxt <= 3'd0;
+`endif
             status_valid <= 1'b0;
             status <= SUB_OK;
         end else begin
             status_valid <= 1'b0;
-            if (meta_release) meta_valid <= 1'b0;
+            if (meta_release) begin  // the second record moves up (hand_over may follow)
+                meta_valid <= nxt_valid;
+                meta_drop <= nxt_drop;
+                meta_out_len <= nxt_out_len;
+                meta_bank <= nxt_bank;
+                nxt_valid <= 1'b0;
+`ifdef FORMAL
+                f_head <= f_nxt;
+                f_out <= f_out + {2'd0, meta_valid};  // (a release of nothing: no record)
+`endif
+            end
             if (take) begin
                 pos <= pos_next;
                 room <= room - 32'd1;
                 left_f <= left_f - 32'd1;
                 last_f <= (left_f == 32'd2);
                 cnt <= cnt + 32'd1;
-                if (keep && (state == S_COUNT || state == S_BODY)) waddr <= waddr + 1'b1;
             end
             // a SUB_RANGE or OP_ENCAP field's bytes: taken whenever offered (the same byte again
             // until it is taken; only a streamed one waits for m_tready), so that take's fan-out
@@ -538,11 +628,10 @@ module rfl_gsubscriber #(
                             last_f <= c_n1;
                             room <= n;
                             streamed <= 1'b0;
+                            released <= 1'b0;
                             out_len <= 32'd0;
-                            waddr <= {(CW + 1){1'b0}};
                             depth <= {DB{1'b0}};
                             quiet <= 8'd0;
-                            meta_drop <= 1'b0;
                             go;
                         end
                     end
@@ -661,10 +750,9 @@ module rfl_gsubscriber #(
                         last_b <= c_body1;
                         if (sub == SUB_STREAM) streamed <= 1'b1;
                         pad_then(pad_e, S_BODY);
-                        if (STREAM_EARLY && sub == SUB_STREAM) begin  // nothing after can refuse
-                            meta_valid <= 1'b1;
-                            meta_drop <= 1'b0;
-                            meta_out_len <= p_out_early;
+                        if (STREAM_EARLY && sub == SUB_STREAM && !released) begin  // nothing
+                            // after can refuse (and a frame hands over once)
+                            hand_over(1'b0, p_out_early);
                             released <= 1'b1;
                         end
                     end
@@ -733,6 +821,50 @@ module rfl_gsubscriber #(
     always @(*) if (rst_n && settled != 2'd0)
         assert(w_nx == prog_next(pc) && w_jp == prog_jump(pc) && pc_nx == pc + 16'd1
                && pc_jp == jump + 16'd1);
+    // The records: the publisher takes them in the order they were handed over, each once, none
+    // lost (the held ones are the oldest not yet released: meta_* the oldest, then nxt_*) ...
+    always @(*) if (rst_n) begin
+        assert(!nxt_valid || meta_valid);
+        assert(f_in == f_out + {2'd0, meta_valid} + {2'd0, nxt_valid});
+        if (meta_valid) assert(f_head == f_out);
+        if (nxt_valid) assert(f_nxt == f_out + 3'd1 && nxt_bank != meta_bank);
+        // ... each held record's bank holds its own frame's bytes (no later frame took it) ...
+        if (meta_valid) assert((meta_bank ? f_own1 : f_own0) == f_head);
+        if (nxt_valid) assert((nxt_bank ? f_own1 : f_own0) == f_nxt);
+        // ... and a frame being walked (it writes only then) writes its own bank (its record's
+        // number: handed over early, or still to come)
+        if (state != S_FLEN && state != S_FCHK && state != S_SKIP) begin
+            assert((fbank ? f_own1 : f_own0) == f_in - {2'd0, released});
+            // (it started with nxt_* empty; handed over early, its record is the newest)
+            if (!released) assert(!nxt_valid);
+            else assert(!meta_valid || (nxt_valid ? nxt_bank : meta_bank) == fbank);
+        end
+        if ((state == S_FLEN && cnt[1:0] != 2'd0) || state == S_FCHK) assert(!nxt_valid);
+        if (carry_we) assert(state == S_COUNT || state == S_BODY);
+    end
+    // A frame hands over at most one record: one (drop) if refused after its stream went out,
+    // none if refused before (a dropped frame's record never reaches the publisher). f_at: f_in as the frame's length was checked (S_FCHK: nothing handed over).
+    reg [2:0] f_at;
+    reg       f_atv = 1'b0;             // f_at is set (a frame length was checked)
+    reg       f_streamed, f_released, f_first;
+    always @(posedge clk) begin
+        if (state == S_FCHK) f_at <= f_in;
+        if (!rst_n) f_atv <= 1'b0;
+        else if (state == S_FCHK) f_atv <= 1'b1;
+        f_streamed <= streamed;
+        f_released <= released;
+        f_first <= (state == S_FCHK);
+        if (rst_n && f_atv && state != S_FCHK)
+            assert(f_in == f_at || f_in == f_at + 3'd1);
+        // (while walking: handed over only early; early, its stream has begun)
+        if (rst_n && state != S_FLEN && state != S_FCHK && state != S_SKIP)
+            assert(f_atv && f_in == f_at + {2'd0, released} && (!released || streamed));
+        if (rst_n && f_atv && status_valid && !f_first && status != SUB_OK) begin
+            if (f_streamed && !f_released)
+                assert(f_in == f_at + 3'd1 && (nxt_valid ? nxt_drop : meta_drop));
+            else if (!f_streamed) assert(f_in == f_at);
+        end
+    end
 `endif
 endmodule
 

@@ -15,7 +15,14 @@
 // STREAM_EARLY, from Program.stream_early: nothing after the stream's count can refuse the
 // frame): the subscriber hands the frame over at the count, the publisher writes it while the
 // stream flows, and OUT_DEPTH needs only 2. The carry memory lives in the subscriber; the publisher
-// reads it in order (the subscriber reads it ahead into registers).
+// reads it in order (the subscriber reads it ahead into registers). The subscriber holds two
+// frames' records (and carry banks), so it reads frame n+1 while the publisher writes frame n:
+// back to back a frame costs the slower walker, not both. Frame n+1's stream queues behind
+// frame n's in the FIFOs: with OUT_DEPTH = LENGTH + 2 it flows once the publisher reads frame
+// n's stream (the AXIS FIFO, the application's registers and 2 beats take the rest), so the
+// overlap is whole when the publisher reaches its stream no later than the subscriber does;
+// with EARLY the FIFOs hold a few beats and frame n+1's stream follows frame n's through the
+// application.
 // The FIFOs that feed logic (rx, axis in, axis out) register their RAM's output once more
 // (rfl_fifo's OUTREG, when at least 3 deep): what reads them does not start from a block RAM's
 // slow clock-to-output (100 MHz timing on an ECP5); same entries, two more clocks of latency.

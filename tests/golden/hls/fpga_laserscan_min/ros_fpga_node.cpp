@@ -39,6 +39,7 @@ int ros_fpga_node(byte_stream& in, byte_stream& out) {
     HLS_PRAGMA(HLS STREAM variable = to_filter depth = AXIS_FIFO_DEPTH)
     HLS_PRAGMA(HLS STREAM variable = from_filter depth = AXIS_FIFO_DEPTH)
     HLS_PRAGMA(HLS STREAM variable = carry depth = CARRY_FIFO_DEPTH)
+    HLS_PRAGMA(HLS STREAM variable = meta depth = META_RECORDS)
     ap_uint<8> status = 0;
     subscriber(in, stream_bytes, carry, meta, status);
     if (!stream_bytes.empty()) {  // the stream went out: through the application

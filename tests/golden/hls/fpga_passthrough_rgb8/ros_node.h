@@ -46,9 +46,10 @@ typedef elem_beat pixel_beat;                // the video application's names fo
 typedef elem_stream pixel_stream;
 
 // What the subscriber hands the publisher per frame whose stream or carried bytes went out: one
-// narrow FIFO word (43 bits of fields). The carried bytes themselves (in wire order,
-// lengths included) travel on a byte FIFO of their own, carry (depth CARRY_BYTES), as the
-// stream's bytes do on theirs.
+// narrow FIFO word (43 bits of fields), on a FIFO of META_RECORDS words (the
+// subscriber reads the next frame while the publisher writes one). The carried bytes themselves
+// (in wire order, lengths included) travel on a byte FIFO of their own, carry (depth
+// META_RECORDS x CARRY_BYTES), as the stream's bytes do on theirs.
 struct frame_meta {
     ap_uint<32> out_len;  // the publisher's frame length
     ap_uint<9> carried;  // bytes this frame put on the carry FIFO
@@ -56,7 +57,8 @@ struct frame_meta {
     bool drop;  // refused after that: the publisher drops the frame
 };
 typedef hls::stream<frame_meta> meta_stream;
-#define CARRY_FIFO_DEPTH CARRY_BYTES
+#define META_RECORDS 2
+#define CARRY_FIFO_DEPTH (META_RECORDS * CARRY_BYTES)
 
 void subscriber_connection_header(byte_stream& out);
 void publisher_connection_header(byte_stream& out);

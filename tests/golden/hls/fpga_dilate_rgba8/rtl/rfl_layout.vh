@@ -41,6 +41,7 @@ localparam [7:0] ENCAP_PAD_MASK = 8'd3;            // CDR: options bits counting
 // stream's count, with out_len + EARLY_ADD (the count, the array, the fixed fields after it)
 localparam STREAM_EARLY = 1;
 localparam [31:0] EARLY_ADD = 32'd1228804;
+localparam RECORDS = 2;                              // frames' records the subscriber holds for the publisher
 localparam LOOP_DEPTH = 1;                        // deepest nesting of arrays of messages
 localparam [7:0] SUB_OK = 8'd0, SUB_BAD_FRAME_LENGTH = 8'd1;
 localparam [7:0] SUB_BAD_HEADER_FRAME_ID_LENGTH = 8'd2;  // header.frame_id length
