@@ -511,7 +511,8 @@ def test_iverilog_wall_and_yosys_check_are_silent(tmp_path: Path) -> None:
     yosys = yosys_command()
     assert yosys is not None
     (tmp_path / "check.ys").write_text(
-        f"read_verilog -I{FABRIC} {' '.join(map(str, SOURCES))}\nhierarchy -check -top rfl_rtps_rx\nproc\n"
+        f"read_verilog -I{FABRIC} {' '.join(map(str, SOURCES))}\n"
+        "hierarchy -check -top rfl_rtps_rx\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys, "-q", "check.ys"], cwd=tmp_path, capture_output=True,
                           text=True, timeout=300)

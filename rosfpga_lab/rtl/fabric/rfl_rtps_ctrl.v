@@ -104,7 +104,7 @@ module rfl_rtps_ctrl #(
     localparam [255:0] IDS = IDS_W[255:0];
     localparam [63:0] MSGS = MSGS_W[63:0];
     localparam [63:0] LASTS = LASTS_W[63:0];
-`include "rfl_rtps_wire.vh"             // ID_*, FLAG_E
+`include "rfl_rtps_wire.vh"             // ID_*
 
     assign s_axis_tready = 1'b1;
     wire take = s_axis_tvalid;
@@ -122,10 +122,9 @@ module rfl_rtps_ctrl #(
     reg drop;
     /* verilator lint_off PINCONNECTEMPTY */
     rfl_rtps_walk #(.POS_BITS(16)) u_walk (
-        .clk(clk), .rst_n(rst_n), .s_axis_tdata(s_axis_tdata), .s_axis_tvalid(s_axis_tvalid),
-        .s_axis_tready(1'b1), .s_axis_tlast(s_axis_tlast), .drop(drop), .m_hdr(w_hdr),
-        .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx), .m_sub_id(),
-        .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(w_mis),
+        .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
+        .drop(drop), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
+        .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(w_mis),
         .m_sub_last(w_last), .m_hdr_bad(w_hdr_bad));
     /* verilator lint_on PINCONNECTEMPTY */
 

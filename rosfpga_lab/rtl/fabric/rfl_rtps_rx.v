@@ -98,7 +98,7 @@ module rfl_rtps_rx #(
 
     localparam [3:0] S_HDR = 4'd0, S_SUBHDR = 4'd1, S_FIELDS = 4'd2, S_D1 = 4'd3, S_D2 = 4'd4,
                      S_GAP = 4'd5, S_QOS = 4'd6, S_PAY = 4'd7, S_SKIP = 4'd8, S_DROP = 4'd9;
-`include "rfl_rtps_wire.vh"             // ID_*, FLAG_E
+`include "rfl_rtps_wire.vh"             // ID_*
 
     reg [3:0] ph;                               // in a body: S_FIELDS .. S_SKIP
     reg dwait;                                  // in S_D1 or S_D2 (timing: no state decode)
@@ -124,11 +124,10 @@ module rfl_rtps_rx #(
     reg drop;
     /* verilator lint_off PINCONNECTEMPTY */
     rfl_rtps_walk #(.POS_BITS(6)) u_walk (
-        .clk(clk), .rst_n(rst_n), .s_axis_tdata(s_axis_tdata), .s_axis_tvalid(s_axis_tvalid),
-        .s_axis_tready(s_axis_tready), .s_axis_tlast(s_axis_tlast), .drop(drop),
-        .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
-        .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(w_len), .m_sub_pos(pos),
-        .m_sub_mis(w_mis), .m_sub_last(w_last), .m_hdr_bad(w_hdr_bad));
+        .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
+        .drop(drop), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
+        .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(w_len), .m_sub_pos(pos), .m_sub_mis(w_mis),
+        .m_sub_last(w_last), .m_hdr_bad(w_hdr_bad));
     /* verilator lint_on PINCONNECTEMPTY */
     // the state, as one number (rtl/tb/rfl_fabric_demo_tb.v dumps it): the walk's, or ph
     /* verilator lint_off UNUSEDSIGNAL */

@@ -1,10 +1,10 @@
 // rfl_rtps_walk -- the RTPS message walk the fabric's receiving stages share (issue #31):
 // rfl_rtps_rx (the data reader), rfl_rtps_ctrl (HEARTBEAT / ACKNACK) and rfl_spdp_peer (SPDP)
 // each instantiate it beside their own field logic, so where the header, the submessage
-// headers and the bodies are is decided once. It watches a datagram stream (8-bit AXI4-Stream,
-// TLAST on a datagram's last byte; a byte is taken when s_axis_tvalid and the stage's
-// s_axis_tready) and tells, for the byte offered now, where it is (combinational from its
-// registers, the byte and TLAST; it advances on each byte taken):
+// headers and the bodies are is decided once. It watches the stage's input stream (8-bit
+// AXI4-Stream, TLAST on a datagram's last byte): in_data and in_last are its TDATA and TLAST,
+// in_take its TVALID and TREADY (a byte taken). It tells, for the byte offered now, where it
+// is (combinational from its registers, the byte and TLAST; it advances on each byte taken):
 //   m_hdr      the 20-byte RTPS header, byte m_idx (0..19): "RTPS", major version 2, vendor
 //              id, the sender's GUID prefix (bytes 8..19).
 //   m_subhdr   a submessage header, byte m_idx (0..3): id, flags (FLAG_E: the byte order of
@@ -32,10 +32,9 @@ module rfl_rtps_walk #(
 ) (
     input  wire                clk,
     input  wire                rst_n,
-    input  wire [7:0]          s_axis_tdata,
-    input  wire                s_axis_tvalid,
-    input  wire                s_axis_tready,   // the stage's: the walk follows its takes
-    input  wire                s_axis_tlast,
+    input  wire [7:0]          in_data,         // the stage's input stream: TDATA,
+    input  wire                in_take,         // TVALID and TREADY (a byte taken),
+    input  wire                in_last,         // TLAST
     input  wire                drop,
     output wire                m_hdr,
     output wire                m_subhdr,
@@ -59,12 +58,12 @@ module rfl_rtps_walk #(
         $error("rfl_rtps_walk: POS_BITS must be 1..16");
     end
 `endif
-`include "rfl_rtps_wire.vh"             // ID_*, RTPS_MAGIC, RTPS_VERSION, FLAG_E
+`include "rfl_rtps_wire.vh"             // ID_PAD, ID_INFO_TS, RTPS_MAGIC, RTPS_VERSION, FLAG_E
     localparam [1:0] W_HDR = 2'd0, W_SUB = 2'd1, W_BODY = 2'd2, W_DROP = 2'd3;
 
-    wire take = s_axis_tvalid && s_axis_tready;
-    wire [7:0] b = s_axis_tdata;
-    wire tl = s_axis_tlast;
+    wire take = in_take;
+    wire [7:0] b = in_data;
+    wire tl = in_last;
 
     reg [1:0] st;
     reg [4:0] idx;

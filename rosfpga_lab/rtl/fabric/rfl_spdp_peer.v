@@ -101,7 +101,7 @@ module rfl_spdp_peer #(
     localparam [TW-1:0] TICK_LAST = TICK_LAST_32[TW-1:0];
     localparam [31:0] RESEND_32 = RESEND;
     localparam [RW-1:0] RESEND_N = RESEND_32[RW-1:0];
-`include "rfl_rtps_wire.vh"             // ID_*, FLAG_E
+`include "rfl_rtps_wire.vh"             // ID_*
     // within a DATA: the fixed fields, the inline QoS's parameter heads and values, the
     // encapsulation, the payload's heads and values, done (the sentinel), ignored
     localparam [2:0] P_FIX = 3'd0, P_QHEAD = 3'd1, P_QVAL = 3'd2, P_ENC = 3'd3,
@@ -122,11 +122,10 @@ module rfl_spdp_peer #(
     wire [15:0] pos;                            // the body's byte
     /* verilator lint_off PINCONNECTEMPTY */
     rfl_rtps_walk #(.POS_BITS(16)) u_walk (
-        .clk(clk), .rst_n(rst_n), .s_axis_tdata(s_axis_tdata), .s_axis_tvalid(s_axis_tvalid),
-        .s_axis_tready(1'b1), .s_axis_tlast(s_axis_tlast), .drop(1'b0), .m_hdr(w_hdr),
-        .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx), .m_sub_id(w_id),
-        .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(), .m_sub_last(w_last),
-        .m_hdr_bad());
+        .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
+        .drop(1'b0), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
+        .m_sub_id(w_id), .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(),
+        .m_sub_last(w_last), .m_hdr_bad());
     /* verilator lint_on PINCONNECTEMPTY */
 
     reg [95:0] src;                             // the header's prefix, shifted in (the last
