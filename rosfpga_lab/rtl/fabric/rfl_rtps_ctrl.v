@@ -309,8 +309,7 @@ module rfl_rtps_ctrl #(
                     src <= src_sh_n;
                     own_chk <= !w_hdr_bad;      // ours, looped back: dropped two clocks late
                 end
-            end
-            if (take && w_sub) begin
+            end else if (take && w_sub) begin
                 if (w_idx == 5'd0) begin
                     k_ack <= (b == ID_ACKNACK);
                     k_hb <= (b == ID_HEARTBEAT);
@@ -321,8 +320,7 @@ module rfl_rtps_ctrl #(
                 at_need <= 1'b0;                // (body byte 0 is no field's last)
                 // the datagram ends in or right after a submessage header (not empty)
                 if (tl && !w_last) n_bad <= n_bad + 1'b1;
-            end
-            if (take && w_body) begin
+            end else if (take && w_body) begin
                 acc_e <= acc_e_n;
                 acc_b <= acc_b_n[23:0];
                 fields_done <= done_n;

@@ -227,7 +227,7 @@ module rfl_rtps_rx #(
     endtask
 
     // a malformed submessage: it and the rest of the packet are dropped (the walk's drop,
-    // set with it below: drop_n)
+    // set in the same clock by the always @(*) below)
     task malformed;
         begin
             p_mal <= 1'b1;

@@ -115,7 +115,6 @@ module rfl_spdp_peer #(
     // the walk: where the byte is (the header, a submessage header or body, dropped)
     wire w_hdr, w_sub, w_body, w_last;
     wire [4:0] w_idx;
-    wire [7:0] w_id;
     /* verilator lint_off UNUSEDSIGNAL */
     wire [7:0] w_flags;                         // (E, Q, D, K read: 0..3)
     /* verilator lint_on UNUSEDSIGNAL */
@@ -124,7 +123,7 @@ module rfl_spdp_peer #(
     rfl_rtps_walk #(.POS_BITS(16)) u_walk (
         .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
         .drop(1'b0), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
-        .m_sub_id(w_id), .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(),
+        .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(),
         .m_sub_last(w_last), .m_hdr_bad());
     /* verilator lint_on PINCONNECTEMPTY */
 
@@ -133,7 +132,7 @@ module rfl_spdp_peer #(
     reg [7:0] len_lo;                           // octetsToInlineQos' first byte
     wire le = w_flags[0];                       // the submessage's byte order (FLAG_E)
     wire f_q = w_flags[1], f_d = w_flags[2], f_k = w_flags[3];
-    wire k_data = (w_id == ID_DATA);
+    reg k_data;                                 // the submessage is a DATA (decoded once)
     reg [2:0] ph;
     reg ple;                                    // the parameter list's byte order
     reg [1:0] hcnt;                             // byte of a parameter head / encapsulation
@@ -227,6 +226,7 @@ module rfl_spdp_peer #(
             sedp <= 1'b0;
             if (take && w_hdr && w_idx >= 5'd8) src <= {src[87:0], b};
             if (take && w_sub) begin
+                if (w_idx == 5'd0) k_data <= (b == ID_DATA);
                 ph <= P_FIX;
                 wid_ok <= 1'b0;
                 f_bad <= 1'b0;
@@ -237,8 +237,7 @@ module rfl_spdp_peer #(
                 user_src <= 1'b0;
                 have_lease <= 1'b0;
                 pl_ok <= 1'b0;
-            end
-            if (take && w_body) begin
+            end else if (take && w_body) begin
                 acc_e <= acc_e_n;
                 acc_b <= acc_b_n[23:0];
                 if (pos == 16'd3) dstart_m1 <= 16'd3 + len_n;   // (bytes 2, 3 in le's order)
