@@ -165,12 +165,14 @@ PROOFS: tuple[Proof, ...] = (
           "header, submessage header, body, dropped, its place following from the byte before "
           "(a datagram's first byte its header's byte 0: nothing walked past a TLAST; indices "
           "and body positions up by one; a bad header or a drop: dropped to the TLAST); "
-          "m_sub_last only in a body or an empty submessage's header; all reachable states",
+          "m_sub_last only in a body, m_sub_empty only at a submessage header's end; all "
+          "reachable states",
           ("FV_PROVE",)),
     Proof("rtps_walk", ("rfl_rtps_walk.v",), "bmc", 36,
           "rfl_rtps_walk (as above), against the bytes: the id, flags and length the "
           "submessage header's; a body never past its length, m_sub_last on its last byte "
-          "exactly (length 0: on the TLAST; empty exactly for PAD or INFO_TS); m_hdr_bad "
+          "exactly (length 0: on the TLAST), m_sub_empty exactly for PAD or INFO_TS of length 0; "
+          "m_hdr_bad "
           "exactly for bad magic or version, or a datagram shorter than a header; 36 clocks"),
     Proof("rtps_rx", RTPS_RX, "prove", 3,
           "rfl_rtps_rx (any input bytes, any configuration): output stream rules with TLAST, "

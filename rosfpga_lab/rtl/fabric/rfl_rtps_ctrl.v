@@ -113,7 +113,7 @@ module rfl_rtps_ctrl #(
     assign rx_byte = take;
 
     // the walk: where the byte is (the header, a submessage header or body, dropped)
-    wire w_hdr, w_sub, w_body, w_last, w_mis, w_hdr_bad;
+    wire w_hdr, w_sub, w_body, w_last, w_empty, w_mis, w_hdr_bad;
     wire [4:0] w_idx;
     /* verilator lint_off UNUSEDSIGNAL */
     wire [7:0] w_flags;                         // (E, F read: 0..1)
@@ -125,7 +125,7 @@ module rfl_rtps_ctrl #(
         .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
         .drop(drop), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
         .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(w_mis),
-        .m_sub_last(w_last), .m_hdr_bad(w_hdr_bad));
+        .m_sub_last(w_last), .m_sub_empty(w_empty), .m_hdr_bad(w_hdr_bad));
     /* verilator lint_on PINCONNECTEMPTY */
 
     reg [95:0] src;
@@ -319,7 +319,7 @@ module rfl_rtps_ctrl #(
                 fields_done <= 1'b0;
                 at_need <= 1'b0;                // (body byte 0 is no field's last)
                 // the datagram ends in or right after a submessage header (not empty)
-                if (tl && !w_last) n_bad <= n_bad + 1'b1;
+                if (tl && !w_empty) n_bad <= n_bad + 1'b1;
             end else if (take && w_body) begin
                 acc_e <= acc_e_n;
                 acc_b <= acc_b_n[23:0];

@@ -114,7 +114,7 @@ module rfl_rtps_rx #(
     wire tl = s_axis_tlast;
 
     // the walk: where the byte is (the header, a submessage header or body, dropped)
-    wire w_hdr, w_sub, w_body, w_last, w_mis, w_hdr_bad;
+    wire w_hdr, w_sub, w_body, w_last, w_empty, w_mis, w_hdr_bad;
     wire [4:0] w_idx;
     /* verilator lint_off UNUSEDSIGNAL */
     wire [7:0] w_flags;                         // (E, Q (INFO_TS: I), D, K read: 0..3)
@@ -127,7 +127,7 @@ module rfl_rtps_rx #(
         .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
         .drop(drop), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
         .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(w_len), .m_sub_pos(pos), .m_sub_mis(w_mis),
-        .m_sub_last(w_last), .m_hdr_bad(w_hdr_bad));
+        .m_sub_last(w_last), .m_sub_empty(w_empty), .m_hdr_bad(w_hdr_bad));
     /* verilator lint_on PINCONNECTEMPTY */
     // the state, as one number (rtl/tb/rfl_fabric_demo_tb.v dumps it): the walk's, or ph
     /* verilator lint_off UNUSEDSIGNAL */
@@ -266,7 +266,7 @@ module rfl_rtps_rx #(
         end else if (take) begin
             if (w_hdr) drop = (w_idx == 5'd19) && own_n;     // our own message, looped back
             else if (w_sub) drop = (w_idx == 5'd3) &&        // D and K; INFO_TS without time
-                                   ((k_data && sm_flags[3:2] == 2'b11) || (w_last && fields_kind));
+                                   ((k_data && sm_flags[3:2] == 2'b11) || (w_empty && fields_kind));
             else if (w_body) case (ph)
                 S_FIELDS: drop = (pos == fields_last) ? (!k_data && !k_frag && end_bad) : body_end;
                 S_GAP:    drop = body_end && (!g1 || sm_flags[1] || end_bad);
@@ -397,7 +397,7 @@ module rfl_rtps_rx #(
                     if (w_len != 16'd0 || fields_kind) p_mal <= 1'b1;
                 end else if (k_data && sm_flags[3:2] == 2'b11) begin
                     p_mal <= 1'b1;              // D and K: invalid (RTPS 2.3 8.3.7.2)
-                end else if (w_last) begin      // empty (PAD, INFO_TS of length 0)
+                end else if (w_empty) begin     // empty (PAD, INFO_TS of length 0)
                     if (fields_kind) p_mal <= 1'b1;     // INFO_TS without its time
                 end else ph <= fields_kind ? S_FIELDS : S_SKIP;
             end else if (tl) p_mal <= 1'b1;     // a submessage header cut short

@@ -12,19 +12,19 @@
 //   m_body     a submessage body, byte m_sub_pos (from 0; counts modulo 2^POS_BITS).
 //   m_dropped  the rest of a datagram abandoned (a bad header, or the stage's drop).
 // With them: m_sub_id (from the submessage header's byte 1 on), m_sub_flags (from byte 2 on),
-// m_sub_mis (the length is not a multiple of 4; in the body), m_sub_last (the submessage's
-// last byte: the body's byte length - 1; a length 0 means "to the end of the message", the
-// datagram's last byte, except for PAD and INFO_TS, which are empty then: their header's byte
-// 3 is their last), m_hdr_bad (at the header's byte 19: bad magic or major version; or at a
-// TLAST before it: a datagram shorter than a header). A submessage cut short by the
-// datagram's end (TLAST without m_sub_last) is the stage's to refuse; the next byte after a
-// TLAST is always a header's byte 0.
+// m_sub_mis (the length is not a multiple of 4; in the body), m_sub_last (the body's last
+// byte: its byte length - 1; a length 0 means "to the end of the message", the datagram's last
+// byte), m_sub_empty (at a submessage header's byte 3: a PAD or INFO_TS of length 0, empty,
+// this its last byte; the next is a submessage header), m_hdr_bad (at the header's byte 19:
+// bad magic or major version; or at a TLAST before it: a datagram shorter than a header). A
+// submessage cut short by the datagram's end (TLAST without m_sub_last) is the stage's to
+// refuse; the next byte after a TLAST is always a header's byte 0.
 // drop: abandon the rest of the datagram (no sideband but m_dropped up to its TLAST), with a
 // byte taken (the header's last or any later one: the byte is walked, the ones after it are
 // not) or in a clock without one (past the header). Ignored in the header before its byte 19
 // and with a TLAST taken (the datagram ends anyway).
 // Timing: the outputs decode registers (the state, the id's kind, sub_left == 1 registered)
-// and the byte only where a length is read (m_sub_len, m_sub_last at an empty submessage).
+// and the byte only where a length is read (m_sub_len, m_sub_empty).
 `default_nettype none
 
 module rfl_rtps_walk #(
@@ -47,6 +47,7 @@ module rfl_rtps_walk #(
     output wire [POS_BITS-1:0] m_sub_pos,
     output wire                m_sub_mis,
     output wire                m_sub_last,
+    output wire                m_sub_empty,
     output wire                m_hdr_bad
 );
 `ifdef __ICARUS__
@@ -93,7 +94,8 @@ module rfl_rtps_walk #(
     assign m_sub_len = len_n;
     assign m_sub_pos = pos;
     assign m_sub_mis = mis;
-    assign m_sub_last = (m_body && body_last) || (m_subhdr && (idx == 5'd3) && empty_n);
+    assign m_sub_last = m_body && body_last;
+    assign m_sub_empty = m_subhdr && (idx == 5'd3) && empty_n;
     assign m_hdr_bad = m_hdr && (((idx == 5'd19) && hdr_bad) || (tl && (idx != 5'd19)));
 
     always @(posedge clk) begin

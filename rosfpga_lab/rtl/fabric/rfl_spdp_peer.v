@@ -124,7 +124,7 @@ module rfl_spdp_peer #(
         .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
         .drop(1'b0), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
         .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(),
-        .m_sub_last(w_last), .m_hdr_bad());
+        .m_sub_last(w_last), .m_sub_empty(), .m_hdr_bad());
     /* verilator lint_on PINCONNECTEMPTY */
 
     reg [95:0] src;                             // the header's prefix, shifted in (the last
