@@ -65,9 +65,13 @@ The network side of a ROS 2 node in the fabric (issue #31) starts in ``fabric/``
 ``rfl_rtps_rx`` walks RTPS datagrams (one UDP payload per AXI4-Stream packet) and streams one
 writer's DATA / DATA_FRAG samples out (its header comment is the design note; proof
 ``rtps_rx``; tested against :func:`rosfpga_lab.rtps.parse_message` in
-``tests/rtl/test_fabric_rtps_rx.py``); ``rfl_rtps_to_cdr`` turns its sample packets into the
-records a generated ``wire: cdr`` circuit's subscriber reads (the length, then the payload),
-forwarding a sample only once it ended good, through a ring that fills while it sends (proof
+``tests/rtl/test_fabric_rtps_rx.py``). The receiving stages (``rfl_rtps_rx``, ``rfl_rtps_ctrl``,
+``rfl_spdp_peer``) share one walk of the RTPS header and submessages, ``rfl_rtps_walk``: per byte
+its place (header, submessage header, body and its position, the submessage's last byte, a bad
+header) beside each stage's own field logic (proofs ``rtps_walk``; each stage's file list:
+``proofs.RTPS_RX``, ``RTPS_CTRL``, ``SPDP_PEER``). ``rfl_rtps_to_cdr`` turns its sample packets
+into the records a generated ``wire: cdr`` circuit's subscriber reads (the length, then the
+payload), forwarding a sample only once it ended good, through a ring that fills while it sends (proof
 ``rtps_to_cdr``; alone in ``tests/rtl/test_fabric_seam.py``; datagrams through both into a
 generated top in ``tests/rtl/test_fabric_rtps_cdr.py``). ``rfl_rtps_tx`` is the way back: the
 generated publisher's records become the data writer's RTPS datagrams (DATA, or DATA_FRAGs

@@ -38,9 +38,9 @@ from rosfpga_lab.rtl.sim import VERILOG_DIR, find_tool
 FORMAL_DIR = Path(__file__).resolve().parent / "formal"
 #: The network side of the node in the fabric (issue #31): modules proven here, not in a project.
 FABRIC_DIR = Path(__file__).resolve().parent / "fabric"
-FABRIC_MODULES = ("rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v",
-                  "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v", "rfl_udp_port.v",
-                  "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_spdp_peer.v",
+FABRIC_MODULES = ("rfl_rtps_walk.v", "rfl_rtps_rx.v", "rfl_rtps_disc_rom.v", "rfl_rtps_to_cdr.v",
+                  "rfl_rtps_tx.v", "rfl_rtps_ctrl.v", "rfl_rtps_disc_answer.v", "rfl_udp_store.v",
+                  "rfl_udp_port.v", "rfl_frame_arbiter.v", "rfl_fabric_node.v", "rfl_spdp_peer.v",
                   "rfl_counter_readout.v", "rfl_fabric_top.v", "rfl_board_5a75b.v")
 ENV_INCLUDE = "fv_env.vh"
 #: Included from FABRIC_DIR: the parameter lists the fabric's tops share (declared, passed on),
@@ -48,9 +48,13 @@ ENV_INCLUDE = "fv_env.vh"
 FABRIC_INCLUDES = ("rfl_fabric_node_params.vh", "rfl_fabric_node_pass.vh",
                    "rfl_fabric_top_params.vh", "rfl_fabric_top_pass.vh", "rfl_rtps_wire.vh",
                    "rfl_fabric_counters.vh")
+#: The receiving stages' files: each instantiates the RTPS walk (rfl_rtps_walk) they share.
+RTPS_RX = ("rfl_rtps_walk.v", "rfl_rtps_rx.v")
+RTPS_CTRL = ("rfl_rtps_walk.v", "rfl_rtps_ctrl.v")
+SPDP_PEER = ("rfl_rtps_walk.v", "rfl_spdp_peer.v")
 #: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node aside:
 #: the project's; the proof's wrapper has its own).
-FABRIC_NODE = ("rfl_rtps_rx.v", "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
+FABRIC_NODE = (*RTPS_RX, "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
                "rfl_rtps_disc_answer.v", "rfl_rtps_disc_rom.v", "rfl_frame_arbiter.v",
                "rfl_fabric_node.v")
 #: rfl_fabric_top's files for simulation (LiteEth's GMII variant), relative to FABRIC_DIR.
@@ -157,7 +161,21 @@ PROOFS: tuple[Proof, ...] = (
           "bytes per frame, writes nothing for a dropped one; 26 clocks (a whole frame)",
           (), True),
     # the fabric's network side (rtl/fabric, issue #31)
-    Proof("rtps_rx", ("rfl_rtps_rx.v",), "prove", 3,
+    Proof("rtps_walk", ("rfl_rtps_walk.v",), "prove", 4,
+          "rfl_rtps_walk (any input bytes, any ready, any drop): each byte exactly one of "
+          "header, submessage header, body, dropped, its place following from the byte before "
+          "(a datagram's first byte its header's byte 0: nothing walked past a TLAST; indices "
+          "and body positions up by one; a bad header or a drop: dropped to the TLAST); "
+          "m_sub_last only in a body, m_sub_empty only at a submessage header's end; all "
+          "reachable states",
+          ("FV_PROVE",)),
+    Proof("rtps_walk", ("rfl_rtps_walk.v",), "bmc", 36,
+          "rfl_rtps_walk (as above), against the bytes: the id, flags and length the "
+          "submessage header's; a body never past its length, m_sub_last on its last byte "
+          "exactly (length 0: on the TLAST), m_sub_empty exactly for PAD or INFO_TS of length 0; "
+          "m_hdr_bad "
+          "exactly for bad magic or version, or a datagram shorter than a header; 36 clocks"),
+    Proof("rtps_rx", RTPS_RX, "prove", 3,
           "rfl_rtps_rx (any input bytes, any configuration): output stream rules with TLAST, "
           "TUSER and the sample's sideband, TUSER only with TLAST, input taken only when the "
           "output register is free; all reachable states", ("FV_PROVE",)),
@@ -204,7 +222,7 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_udp_port (16-byte buffers, 2 payloads each way, any LiteEth stream and payloads): "
           "both outputs keep the stream rules with their sideband, LiteEth never held back; 20 "
           "clocks"),
-    Proof("fabric_top", ("rfl_udp_store.v", "rfl_udp_port.v", "rfl_spdp_peer.v",
+    Proof("fabric_top", ("rfl_udp_store.v", "rfl_udp_port.v", *SPDP_PEER,
                          "rfl_frame_arbiter.v", "rfl_counter_readout.v", "rfl_fabric_top.v"),
           "bmc", 16,
           "rfl_fabric_top's glue (LiteEth and rfl_fabric_node as models of any streams, "
@@ -216,12 +234,12 @@ PROOFS: tuple[Proof, ...] = (
           "the top's two resets low for 18 clocks, then high; the peer learned (cfg_learn high, no "
           "send_sedp of its own); the addresses and ids the parameters; the LED on exactly when "
           "a datagram was taken; 32 clocks"),
-    Proof("spdp_peer", ("rfl_spdp_peer.v",), "prove", 4,
+    Proof("spdp_peer", SPDP_PEER, "prove", 4,
           "rfl_spdp_peer (any input bytes, sources and prefix): always ready; the peer's "
           "registers zero until one is taken, kept after, changed only with a send_sedp pulse; "
           "at most two pulses per peer taken or changed, at most one change a second (TICK "
           "clocks); counters never fall; all reachable states"),
-    Proof("rtps_ctrl", ("rfl_rtps_ctrl.v",), "prove", 4,
+    Proof("rtps_ctrl", RTPS_CTRL, "prove", 4,
           "rfl_rtps_ctrl (two slots, any input bytes, any prefix): request stream rules, every "
           "request names an answer of the table, always ready; all reachable states"),
     Proof("rtps_disc_answer", ("rfl_rtps_disc_answer.v",), "prove", 6,

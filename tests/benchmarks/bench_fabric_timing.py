@@ -27,12 +27,14 @@ from pathlib import Path
 
 from rosfpga_lab.rtl.discrom import render_rom, tx_parameters, verilog_parameters
 from rosfpga_lab.rtl.limits import ECP5_DEVICE, ECP5_PACKAGE
-from rosfpga_lab.rtl.proofs import FABRIC_DIR
+from rosfpga_lab.rtl.proofs import FABRIC_DIR, FABRIC_INCLUDES, RTPS_CTRL, RTPS_RX, SPDP_PEER
 from rosfpga_lab.rtl.limits import PNR_TIMEOUT, SYNTH_TIMEOUT
 from rosfpga_lab.rtl.timing import choose_tools, parse_report
 
 ROOT = Path(__file__).resolve().parents[2]
 CLOCK_MHZ = 125.0
+#: A module's files, when it instantiates another (a receiving stage's RTPS walk).
+FILES = {"rfl_rtps_rx": RTPS_RX, "rfl_rtps_ctrl": RTPS_CTRL, "rfl_spdp_peer": SPDP_PEER}
 
 
 def module_parameters(module: str) -> dict[str, str]:
@@ -50,10 +52,13 @@ def place(module: str, seeds: list[int]) -> list[str]:
     lines = []
     with tempfile.TemporaryDirectory(prefix="rosfpga-fabric-") as tmp:
         work = Path(tmp)
-        (work / f"{module}.v").write_bytes((FABRIC_DIR / f"{module}.v").read_bytes())
+        files = FILES.get(module, (f"{module}.v",))
+        for name in (*files, *FABRIC_INCLUDES):
+            (work / name).write_bytes((FABRIC_DIR / name).read_bytes())
         chparam = f"chparam {sets} {module}\n" if sets else ""
         (work / "synth.ys").write_text(
-            f"read_verilog -defer {module}.v\n{chparam}hierarchy -check -top {module}\nproc\n"
+            f"read_verilog -defer {' '.join(files)}\n{chparam}"
+            f"hierarchy -check -top {module}\nproc\n"
             f"check -assert\nsynth_ecp5 -top {module} -json netlist.json\n")
         subprocess.run([*ytool.command, "-q", "-l", "yosys.log", "synth.ys"], cwd=work,
                        check=True, capture_output=True, timeout=SYNTH_TIMEOUT)

@@ -34,7 +34,7 @@ from rosfpga_lab.hls.vectors import model_output_cdr
 from rosfpga_lab.hw.cdrlayout import cdr_layout_from_config
 from rosfpga_lab.msg.cdr import serialize_cdr
 from rosfpga_lab.rtps import build as b
-from rosfpga_lab.rtl.proofs import PROOFS, prove
+from rosfpga_lab.rtl.proofs import PROOFS, RTPS_RX, prove
 from tests.support.rtltools import TB_DIR, require_cocotb, require_formal, run_bench
 from tests.hls.test_generic_project_cdr import statuses_of
 from tests.rtl.test_fabric_rtps_rx import LOCAL, OTHER_READER, READER, REMOTES, WRITER, reference
@@ -170,7 +170,7 @@ def test_rtps_datagrams_through_the_seam_publish_the_models_records(
                        "dropped": 1, "too_long": len(records) - len(kept)}}
     (tmp_path / "case.json").write_text(json.dumps(case))
     rtl = sorted(p for p in (gen / "rtl").glob("*.v") if p.name != "rfl_tb.v")
-    sources = [FABRIC / "rfl_rtps_rx.v", FABRIC / "rfl_rtps_to_cdr.v", *rtl,
+    sources = [*(FABRIC / m for m in RTPS_RX), FABRIC / "rfl_rtps_to_cdr.v", *rtl,
                TB_DIR / "rtps_cdr_top.v"]
     runner = get_runner(sim)
     runner.build(sources=sources, includes=[gen / "rtl", FABRIC], hdl_toplevel="rtps_cdr_top",

@@ -32,7 +32,7 @@ from rosfpga_lab.rtps.errors import RtpsError
 from rosfpga_lab.rtps.message import (
     ANY_PARTICIPANT, HEADER_SIZE, Data, DataFrag, InfoTs, parse_message,
 )
-from rosfpga_lab.rtl.proofs import PROOFS, prove
+from rosfpga_lab.rtl.proofs import PROOFS, RTPS_RX, prove
 from tests.support.rtltools import (
     run_bench,
     TB_DIR, require_cocotb, require_formal, require_iverilog, require_verilator, require_yosys,
@@ -42,6 +42,7 @@ pytestmark = pytest.mark.rtl
 
 FABRIC = Path(__file__).resolve().parents[2] / "rosfpga_lab" / "rtl" / "fabric"
 SOURCE = FABRIC / "rfl_rtps_rx.v"
+SOURCES = [FABRIC / m for m in RTPS_RX]   # with the walk it instantiates
 LOCAL = bytes.fromhex("010f4a5b00112233445566aa")
 REMOTES = (bytes.fromhex("010fcafe0000000100000001"), bytes.fromhex("0110beef0000000200000007"))
 OTHER_DST = bytes.fromhex("010f000000000000000000ff")
@@ -459,7 +460,7 @@ def cosimulate(tmp_path: Path, seed: int, gap: int, bp: int, datagrams: list[byt
             "counts": counts}
     (tmp_path / "case.json").write_text(json.dumps(case))
     runner = get_runner(sim)
-    runner.build(sources=[SOURCE], includes=[FABRIC], hdl_toplevel="rfl_rtps_rx",
+    runner.build(sources=SOURCES, includes=[FABRIC], hdl_toplevel="rfl_rtps_rx",
                  build_dir=tmp_path / "build",
                  timescale=("1ns", "1ps"), log_file=tmp_path / "build.log")
     run_bench(runner, "bench_rfl_rtps_rx", "rfl_rtps_rx", tmp_path / "build", tmp_path,
@@ -491,7 +492,8 @@ def test_rtps_rx_skips_repeated_fragments(gap: int, bp: int, tmp_path: Path,
 def test_verilator_wall_has_no_warning(tmp_path: Path) -> None:
     """Verilator -Wall is silent (the parameter contract is tests/rtl/test_house_rules.py's)."""
     verilator = require_verilator()
-    done = subprocess.run([verilator, "--lint-only", "-Wall", f"-I{FABRIC}", str(SOURCE)],
+    done = subprocess.run([verilator, "--lint-only", "-Wall", f"-I{FABRIC}", "--top-module",
+                           "rfl_rtps_rx", *map(str, SOURCES)],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-3000:]
 
@@ -500,7 +502,7 @@ def test_iverilog_wall_and_yosys_check_are_silent(tmp_path: Path) -> None:
     """Icarus -Wall says nothing; Yosys finds no latch, loop, multiple or missing driver."""
     iverilog = require_iverilog()
     done = subprocess.run([iverilog, "-g2005", "-Wall", f"-I{FABRIC}", "-o", "m.vvp",
-                           str(SOURCE)],
+                           "-s", "rfl_rtps_rx", *map(str, SOURCES)],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
     require_yosys()
@@ -509,7 +511,8 @@ def test_iverilog_wall_and_yosys_check_are_silent(tmp_path: Path) -> None:
     yosys = yosys_command()
     assert yosys is not None
     (tmp_path / "check.ys").write_text(
-        f"read_verilog -I{FABRIC} {SOURCE}\nhierarchy -check -top rfl_rtps_rx\nproc\n"
+        f"read_verilog -I{FABRIC} {' '.join(map(str, SOURCES))}\n"
+        "hierarchy -check -top rfl_rtps_rx\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys, "-q", "check.ys"], cwd=tmp_path, capture_output=True,
                           text=True, timeout=300)

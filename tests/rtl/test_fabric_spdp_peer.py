@@ -28,7 +28,7 @@ from pathlib import Path
 import pytest
 
 from rosfpga_lab.rtl.discrom import spdp_parameters, verilog_parameters
-from rosfpga_lab.rtl.proofs import FABRIC_DIR
+from rosfpga_lab.rtl.proofs import FABRIC_DIR, SPDP_PEER
 from rosfpga_lab.rtps import build as b
 from rosfpga_lab.rtps.entities import SPDP_READER, SPDP_WRITER
 from rosfpga_lab.rtps.limits import MAX_LEASE_SECONDS
@@ -93,7 +93,7 @@ def _run(datagrams: list[tuple[bytes, int]], tmp_path: Path, tick: int = TICK) -
     params: dict[str, object] = {k: v for k, v in spdp_parameters().items()}
     params.update(TICK=tick, RESEND=RESEND)
     runner = runner_mod.get_runner("icarus")
-    runner.build(sources=[FABRIC_DIR / "rfl_spdp_peer.v"], includes=[FABRIC_DIR],
+    runner.build(sources=[FABRIC_DIR / m for m in SPDP_PEER], includes=[FABRIC_DIR],
                  hdl_toplevel="rfl_spdp_peer",
                  build_dir=tmp_path / "build", timescale=("1ns", "1ps"), parameters=params)
     (tmp_path / "case.json").write_text(json.dumps(

@@ -448,3 +448,36 @@ def test_planted_bugs_fail_the_spdp_peer_proof(tmp_path: Path, old: str, new: st
     proof = next(p for p in PROOFS if p.name == "spdp_peer")
     result = prove(proof, replace={name: buggy})
     assert result.status in status, format_results([result])
+
+
+@pytest.mark.parametrize(("old", "new", "mode"), [
+    # the body's position not restarted at a submessage: its body does not begin at 0
+    ("                pos <= {POS_BITS{1'b0}};\n", "", "bmc"),
+    # a TLAST in a body not ending the walk: the next datagram's header walked as a body
+    ("                if (tl) st <= W_HDR;\n                else if (drop) st <= W_DROP;\n"
+     "                else if (body_last) st <= W_SUB;\n",
+     "                if (drop) st <= W_DROP;\n                else if (body_last) st <= W_SUB;\n",
+     "bmc"),
+    # a drop with a byte not abandoning the datagram
+    ("                else if (drop) st <= W_DROP;\n                else if (body_last)",
+     "                else if (body_last)", "bmc"),
+    # the last byte one early: the submessage's end before its length
+    ("sl1 <= (sub_left == 16'd2);", "sl1 <= (sub_left == 16'd3);", "bmc"),
+    # a length 0 INFO_DST taken as empty (only PAD and INFO_TS are)
+    ("k_empty <= (b == ID_PAD) || (b == ID_INFO_TS);",
+     "k_empty <= (b == ID_PAD) || (b == ID_INFO_TS) || (b == ID_INFO_DST);", "bmc"),
+], ids=["pos-not-restarted", "tlast-ignored", "drop-ignored", "last-early", "empty-dst"])
+def test_planted_bugs_fail_the_rtps_walk_proofs(tmp_path: Path, old: str, new: str,
+                                                mode: str) -> None:
+    """The RTPS walk's bounded check sees a body position not restarted, a walk past a TLAST,
+    a drop ignored, a submessage's last byte early, an empty submessage that is not (a header
+    is 20 bytes: past the induction's depth from reset, where the induction fails to close)."""
+    require_formal()
+    name = "rfl_rtps_walk.v"
+    text = (FABRIC_DIR / name).read_text()
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp_path / name
+    buggy.write_text(text.replace(old, new))
+    proof = next(p for p in PROOFS if p.name == "rtps_walk" and p.mode == mode)
+    result = prove(proof, replace={name: buggy})
+    assert result.status == "FAIL", format_results([result])

@@ -145,6 +145,7 @@ CONTRACTS = [
      "rfl_subscriber: MIN_BODY must be below 2**24 and at most MAX_FRAME"),
     ("rfl_publisher", {"ENC_LEN": 0}, "rfl_publisher: ENC_LEN must be 1..32"),
     ("rfl_publisher", {"FRAME_ID_MAX": 0}, "rfl_publisher: FRAME_ID_MAX must be at least 1"),
+    ("rfl_rtps_walk", {"POS_BITS": 17}, "rfl_rtps_walk: POS_BITS must be 1..16"),
     ("rfl_rtps_rx", {"COUNT_BITS": 33}, "rfl_rtps_rx: COUNT_BITS must be 1..32"),
     ("rfl_rtps_disc_rom", {"ROM_BYTES": 65537},
      "rfl_rtps_disc_rom: ROM_BYTES must be 1..65536 (16-bit offsets)"),
@@ -209,6 +210,16 @@ def _source(module: str) -> str:
     raise FileNotFoundError(f"no Verilog file for module {module}")
 
 
+def _sources(module: str) -> list[str]:
+    """The module's file and the ones it instantiates (a receiving stage's walk)."""
+    from rosfpga_lab.rtl.proofs import FABRIC_DIR, RTPS_CTRL, RTPS_RX, SPDP_PEER
+
+    stages = {"rfl_rtps_rx": RTPS_RX, "rfl_rtps_ctrl": RTPS_CTRL, "rfl_spdp_peer": SPDP_PEER}
+    if module in stages:
+        return [str(FABRIC_DIR / name) for name in stages[module]]
+    return [_source(module)]
+
+
 @pytest.mark.rtl
 @pytest.mark.parametrize("module,params,message", CONTRACTS, ids=_IDS)
 def test_verilator_refuses_an_illegal_parameter(module: str, params: dict[str, int],
@@ -216,7 +227,7 @@ def test_verilator_refuses_an_illegal_parameter(module: str, params: dict[str, i
     verilator = require_verilator()
     sets = [f"-G{k}={v}" for k, v in params.items()]
     done = subprocess.run([verilator, "--lint-only", f"-I{Path(_source(module)).parent}", "--top-module", module,
-                           *sets, _source(module)], cwd=tmp_path, capture_output=True, text=True,
+                           *sets, *_sources(module)], cwd=tmp_path, capture_output=True, text=True,
                           timeout=120)
     assert done.returncode != 0 and "USERERROR" in done.stderr and message in done.stderr, \
         done.stderr[-3000:]
@@ -229,7 +240,7 @@ def test_icarus_refuses_an_illegal_parameter(module: str, params: dict[str, int]
     iverilog = require_iverilog()
     sets = [f"-P{module}.{k}={v}" for k, v in params.items()]
     done = subprocess.run([iverilog, "-g2005", f"-I{Path(_source(module)).parent}", "-s", module, *sets, "-o",
-                           "m.vvp", _source(module)], cwd=tmp_path, capture_output=True,
+                           "m.vvp", *_sources(module)], cwd=tmp_path, capture_output=True,
                           text=True, timeout=120)
     if any((module, k) in ICARUS_ELABORATION_FAILS for k in params):
         assert done.returncode != 0 and "error" in done.stderr, done.stdout + done.stderr
@@ -251,7 +262,8 @@ def test_yosys_refuses_an_illegal_parameter(module: str, params: dict[str, int],
     yosys = yosys_command()
     assert yosys is not None
     sets = " ".join(f"-chparam {k} {v}" for k, v in params.items())
-    (tmp_path / "m.ys").write_text(f"read_verilog -defer -I{Path(_source(module)).parent} {_source(module)}\n"
+    (tmp_path / "m.ys").write_text(f"read_verilog -defer -I{Path(_source(module)).parent} "
+                                   f"{' '.join(_sources(module))}\n"
                                    f"hierarchy -check -top {module} {sets}\n")
     done = subprocess.run([*yosys, "-q", "m.ys"], cwd=tmp_path, capture_output=True, text=True,
                           timeout=300)
@@ -265,12 +277,12 @@ def test_legal_defaults_pass_every_contract(module: str, tmp_path: Path) -> None
     """The defaults (and the edge values the shipped tops use) elaborate in all three."""
     verilator = require_verilator()
     done = subprocess.run([verilator, "--lint-only", "-Wno-fatal", f"-I{Path(_source(module)).parent}",
-                           "--top-module", module, _source(module)], cwd=tmp_path,
+                           "--top-module", module, *_sources(module)], cwd=tmp_path,
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "USERERROR" not in done.stderr, done.stderr[-3000:]
     iverilog = require_iverilog()
     done = subprocess.run([iverilog, "-g2005", f"-I{Path(_source(module)).parent}", "-s", module, "-o", "m.vvp",
-                           _source(module)], cwd=tmp_path, capture_output=True, text=True,
+                           *_sources(module)], cwd=tmp_path, capture_output=True, text=True,
                           timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     run = subprocess.run(["vvp", "-n", "m.vvp"], cwd=tmp_path, capture_output=True, text=True,

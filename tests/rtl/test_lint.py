@@ -195,8 +195,10 @@ def test_answer_path_is_clean_under_three_linters(top: str, name: str, tmp_path:
     rom = render_rom(DATA / f"{name}.yaml")
     write_rom(rom, tmp_path)
     given = answer_params(rom)
+    from rosfpga_lab.rtl.proofs import RTPS_CTRL
+
     fabric = Path(VERILOG_DIR).parent / "fabric"
-    source = str(fabric / f"{top}.v")
+    sources = [str(fabric / m) for m in (RTPS_CTRL if top == "rfl_rtps_ctrl" else (f"{top}.v",))]
     if top == "rfl_rtps_ctrl":
         params = {k: given[k] for k in ("SLOTS", "SLOT_IDS", "SLOT_MSGS", "SLOT_LASTS")}
     else:
@@ -205,18 +207,18 @@ def test_answer_path_is_clean_under_three_linters(top: str, name: str, tmp_path:
                   **{k: given[k] for k in ("DST_AT", "BASE_AT", "COUNT_START", "BURST",
                                            "RATE")}}
     done = subprocess.run([require_verilator(), "--lint-only", "-Wall", f"-I{fabric}",
-                           *(f"-G{k}={v}" for k, v in params.items()), source], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=120)
+                           "--top-module", top, *(f"-G{k}={v}" for k, v in params.items()),
+                           *sources], cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
     done = subprocess.run([require_iverilog(), "-g2005", "-Wall", f"-I{fabric}", "-s", top,
                            "-o", "m.vvp",
-                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), *sources],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
     require_yosys()
     sets = " ".join(f"-set {k} {v}" for k, v in params.items())
     (tmp_path / "check.ys").write_text(
-        f"read_verilog -defer -I{fabric} {source}\nchparam {sets} {top}\n"
+        f"read_verilog -defer -I{fabric} {' '.join(sources)}\nchparam {sets} {top}\n"
         f"hierarchy -check -top {top}\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
@@ -275,13 +277,13 @@ def test_rtps_tx_is_clean_under_three_linters(name: str, info_ts: bool, frag: in
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
     done = subprocess.run([require_iverilog(), "-g2005", "-Wall", f"-I{fabric}", "-s", top,
                            "-o", "m.vvp",
-                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), *sources],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
     require_yosys()
     sets = " ".join(f"-set {k} {v}" for k, v in params.items())
     (tmp_path / "check.ys").write_text(
-        f"read_verilog -defer -I{fabric} {source}\nchparam {sets} {top}\n"
+        f"read_verilog -defer -I{fabric} {' '.join(sources)}\nchparam {sets} {top}\n"
         f"hierarchy -check -top {top}\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,

@@ -20,7 +20,8 @@ from rosfpga_lab.rtps.message import MAGIC
 WIRE = FABRIC_DIR / "rfl_rtps_wire.vh"
 IDS = ("PAD", "ACKNACK", "HEARTBEAT", "INFO_TS", "INFO_SRC", "INFO_DST", "DATA", "DATA_FRAG")
 #: the stages that include the header (they walk or write RTPS messages)
-STAGES = ("rfl_rtps_rx.v", "rfl_rtps_ctrl.v", "rfl_rtps_tx.v", "rfl_spdp_peer.v")
+STAGES = ("rfl_rtps_walk.v", "rfl_rtps_rx.v", "rfl_rtps_ctrl.v", "rfl_rtps_tx.v",
+          "rfl_spdp_peer.v")
 
 
 def _owners() -> dict[str, int]:

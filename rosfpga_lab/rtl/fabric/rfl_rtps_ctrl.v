@@ -10,15 +10,16 @@
 // participant sends). Slot i: entity id SLOT_IDS[32i +: 32], first answer message
 // SLOT_MSGS[8i +: 8], last sequence number SLOT_LASTS[8i +: 8] (a writer: 1..8; 0: a built-in
 // reader).
-// The walk (a byte per clock, never a wait):
-//   S_HDR     the 20-byte header: "RTPS", major version 2, the sender's GUID prefix (the
-//             source); a bad header (magic, version) or a datagram shorter than a header:
-//             ignored and counted (cnt_bad_header, as rfl_rtps_rx's); a message from
-//             cfg_prefix (our own, looped back): the rest of the datagram is ignored, uncounted.
-//             The destination resets to "any" at each message.
-//   S_SUBHDR  id, flags (bit 0 E: byte order of the rest), octetsToNextHeader (0: to the end
-//             of the message, but for PAD and INFO_TS).
-//   S_BODY    INFO_DST (the destination: ours or all-zero keeps what follows), INFO_SRC (the
+// The walk (a byte per clock, never a wait; where each byte is: rfl_rtps_walk):
+//   header    "RTPS", major version 2, the sender's GUID prefix (the source); a bad header
+//             (magic, version) or a datagram shorter than a header: ignored and counted
+//             (cnt_bad_header, as rfl_rtps_rx's); a message from cfg_prefix (our own, looped
+//             back): the rest of the datagram is ignored, uncounted (found two clocks after
+//             the header: a datagram that ends before is walked whole). The destination resets
+//             to "any" at each message.
+//   submessage headers: id, flags (bit 0 E: byte order of the rest), octetsToNextHeader (0:
+//             to the end of the message, but for PAD and INFO_TS).
+//   bodies    INFO_DST (the destination: ours or all-zero keeps what follows), INFO_SRC (the
 //             source), ACKNACK (readerId, writerId, readerSNState base, numBits, the first
 //             bitmap word, count) and HEARTBEAT (readerId, writerId, firstSN, lastSN, count);
 //             other submessages are skipped by length.
@@ -103,8 +104,7 @@ module rfl_rtps_ctrl #(
     localparam [255:0] IDS = IDS_W[255:0];
     localparam [63:0] MSGS = MSGS_W[63:0];
     localparam [63:0] LASTS = LASTS_W[63:0];
-    localparam [1:0] S_HDR = 2'd0, S_SUBHDR = 2'd1, S_BODY = 2'd2, S_DROP = 2'd3;
-`include "rfl_rtps_wire.vh"             // ID_*, RTPS_MAGIC, RTPS_VERSION, FLAG_E
+`include "rfl_rtps_wire.vh"             // ID_*
 
     assign s_axis_tready = 1'b1;
     wire take = s_axis_tvalid;
@@ -112,21 +112,30 @@ module rfl_rtps_ctrl #(
     wire tl = s_axis_tlast;
     assign rx_byte = take;
 
-    reg [1:0] st;
-    reg [4:0] idx;                              // byte of the header / submessage header
-    reg hdr_bad;
+    // the walk: where the byte is (the header, a submessage header or body, dropped)
+    wire w_hdr, w_sub, w_body, w_last, w_empty, w_mis, w_hdr_bad;
+    wire [4:0] w_idx;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [7:0] w_flags;                         // (E, F read: 0..1)
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [15:0] pos;                            // body byte
+    reg drop;
+    /* verilator lint_off PINCONNECTEMPTY */
+    rfl_rtps_walk #(.POS_BITS(16)) u_walk (
+        .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
+        .drop(drop), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
+        .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(w_mis),
+        .m_sub_last(w_last), .m_sub_empty(w_empty), .m_hdr_bad(w_hdr_bad));
+    /* verilator lint_on PINCONNECTEMPTY */
+
     reg [95:0] src;
     reg [87:0] src_sh, dst_sh;           // the last 11 bytes of a prefix coming in
     reg dst_ok;                                 // the submessages are for us
     reg [95:0] dst;                             // the last INFO_DST's prefix
     reg dst_chk, own_chk;                       // compare dst / src with ours (two clocks late)
     reg dst_chk2, own_chk2, dst_eq, own_eq;
-    reg [7:0] kind, len_lo;
-    reg le, flag_f;
+    wire le = w_flags[0], flag_f = w_flags[1];
     reg k_ack, k_hb, k_dst, k_src;
-    reg [15:0] pos;                             // body byte
-    reg [15:0] sub_left;                        // body bytes left (not with to_end)
-    reg to_end, misaligned;
     reg [31:0] acc_e;
     reg [23:0] acc_b;
     reg [31:0] f_rid, f_wid, f_hi, f_lo, f_nbits, f_word0;
@@ -137,9 +146,7 @@ module rfl_rtps_ctrl #(
     wire [31:0] acc_e_n = le ? {b, acc_e[31:8]} : {acc_e[23:0], b};
     wire [31:0] acc_b_n = {acc_b, b};
     wire [3:0] nwords = acc_e_n[8:5] + {3'd0, |acc_e_n[4:0]};   // bitmap words (<= 256 bits)
-    wire [15:0] len_n = le ? {b, len_lo} : {len_lo, b};
-    reg sl1;                                    // sub_left == 1, registered (timing)
-    wire body_last = to_end ? tl : sl1;
+    wire body_last = w_last;
     wire trunc = tl && !body_last;
     // the byte at pos is the last of the submessage's fields (registered a byte ahead: timing;
     // an ACKNACK's last is known from byte 19 on, and is at least 23)
@@ -149,8 +156,11 @@ module rfl_rtps_ctrl #(
     // numBits > 256, from its register the byte after (timing)
     wire nbits_bad = k_ack && (pos == 16'd20) && (|f_nbits[31:9] || (f_nbits[8] && |f_nbits[7:0]));
     // the end of a submessage: its fields short, cut, or misaligned and not the last
-    wire sub_bad = trunc || (body_last && ((parsed && !done_n) || (misaligned && !tl)));
+    wire sub_bad = trunc || (body_last && ((parsed && !done_n) || (w_mis && !tl)));
     wire [95:0] src_sh_n = {src_sh[87:0], b};
+    // the rest of the datagram ignored: a malformed submessage, or our own message (the walk
+    // ignores it once the datagram has ended)
+    always @(*) drop = (take && w_body && (nbits_bad || sub_bad)) || (own_chk2 && own_eq);
     wire [95:0] dst_sh_n = {dst_sh[87:0], b};
 
     // the decision stage
@@ -273,9 +283,6 @@ module rfl_rtps_ctrl #(
 
     always @(posedge clk) begin
         if (!rst_n) begin
-            st <= S_HDR;
-            idx <= 5'd0;
-            hdr_bad <= 1'b0;
             dst_ok <= 1'b1;
             dst_chk <= 1'b0;
             own_chk <= 1'b0;
@@ -294,118 +301,65 @@ module rfl_rtps_ctrl #(
             d_valid <= 1'b0;
             dst_chk <= 1'b0;                    // (pulses, set below)
             own_chk <= 1'b0;
-            if (take) begin
-                case (st)
-                S_HDR: begin
-                    hdr_bad <= (idx != 5'd0 && hdr_bad) ||
-                               (idx == 5'd0 && b != RTPS_MAGIC[31:24]) ||
-                               (idx == 5'd1 && b != RTPS_MAGIC[23:16]) ||
-                               (idx == 5'd2 && b != RTPS_MAGIC[15:8]) ||
-                               (idx == 5'd3 && b != RTPS_MAGIC[7:0]) ||
-                               (idx == 5'd4 && b != RTPS_VERSION[15:8]);
-                    src_sh <= src_sh_n[87:0];
-                    idx <= idx + 1'b1;
-                    dst_ok <= 1'b1;
-                    // (hdr_bad holds bytes 0..4 by byte 19)
-                    if ((idx == 5'd19 && hdr_bad) || (tl && idx != 5'd19))
-                        n_hdr <= n_hdr + 1'b1;
-                    if (tl) begin
-                        idx <= 5'd0;
-                    end else if (idx == 5'd19) begin
-                        idx <= 5'd0;
-                        src <= src_sh_n;
-                        st <= hdr_bad ? S_DROP : S_SUBHDR;
-                        own_chk <= !hdr_bad;    // ours, looped back: dropped two clocks late
-                    end
+            if (take && w_hdr) begin
+                src_sh <= src_sh_n[87:0];
+                dst_ok <= 1'b1;
+                if (w_hdr_bad) n_hdr <= n_hdr + 1'b1;
+                if (w_idx == 5'd19 && !tl) begin
+                    src <= src_sh_n;
+                    own_chk <= !w_hdr_bad;      // ours, looped back: dropped two clocks late
                 end
-                S_SUBHDR: begin
-                    idx <= idx + 1'b1;
-                    if (idx == 5'd0) begin
-                        kind <= b;
-                        k_ack <= (b == ID_ACKNACK);
-                        k_hb <= (b == ID_HEARTBEAT);
-                        k_dst <= (b == ID_INFO_DST);
-                        k_src <= (b == ID_INFO_SRC);
-                    end
-                    if (idx == 5'd1) begin
-                        le <= b[0];
-                        flag_f <= b[1];
-                    end
-                    if (idx == 5'd2) len_lo <= b;
-                    pos <= 16'd0;
-                    fields_done <= 1'b0;
-                    at_need <= 1'b0;                // (body byte 0 is no field's last)
-                    if (tl) begin
-                        // the datagram ends in or right after a submessage header
-                        if (idx != 5'd3 || (len_n != 16'd0 || (kind != ID_PAD && kind != ID_INFO_TS)))
-                            n_bad <= n_bad + 1'b1;
-                        st <= S_HDR;
-                        idx <= 5'd0;
-                    end else if (idx == 5'd3) begin
-                        idx <= 5'd0;
-                        sub_left <= len_n;
-                        sl1 <= (len_n == 16'd1);
-                        to_end <= (len_n == 16'd0);
-                        misaligned <= (len_n[1:0] != 2'd0);
-                        // an empty PAD or INFO_TS: the next submessage header
-                        st <= (len_n == 16'd0 && (kind == ID_PAD || kind == ID_INFO_TS))
-                              ? S_SUBHDR : S_BODY;
-                    end
+            end else if (take && w_sub) begin
+                if (w_idx == 5'd0) begin
+                    k_ack <= (b == ID_ACKNACK);
+                    k_hb <= (b == ID_HEARTBEAT);
+                    k_dst <= (b == ID_INFO_DST);
+                    k_src <= (b == ID_INFO_SRC);
                 end
-                S_BODY: begin
-                    acc_e <= acc_e_n;
-                    acc_b <= acc_b_n[23:0];
-                    pos <= pos + 1'b1;
-                    sub_left <= sub_left - 1'b1;
-                    sl1 <= (sub_left == 16'd2);
-                    fields_done <= done_n;
-                    at_need <= k_ack ? (pos == need_m1) : k_hb ? (pos == 16'd26) :
-                               k_dst ? (pos == 16'd10) : (pos == 16'd18);
-                    if (k_dst && pos < 16'd12) dst_sh <= dst_sh_n[87:0];
-                    if (k_src && pos >= 16'd8 && pos < 16'd20) src_sh <= src_sh_n[87:0];
-                    if (pos == 16'd3) f_rid <= acc_b_n;
-                    if (pos == 16'd7) f_wid <= acc_b_n;
-                    if (pos == 16'd11 && k_ack) f_hi <= acc_e_n;
-                    if (pos == 16'd15 && k_ack) f_lo <= acc_e_n;
-                    if (pos == 16'd19 && k_hb) f_hi <= acc_e_n;
-                    if (pos == 16'd23 && k_hb) f_lo <= acc_e_n;
-                    if (pos == 16'd19) begin
-                        f_nbits <= acc_e_n;
-                        need_m1 <= 16'd22 + {10'd0, nwords, 2'b00};
-                    end
-                    if (pos == 16'd23) f_word0 <= acc_e_n;
-                    if (k_dst && pos == 16'd11) begin
-                        dst <= dst_sh_n;
-                        dst_chk <= 1'b1;
-                    end
-                    if (k_src && pos == 16'd19) src <= src_sh_n;
-                    if (body_last) begin
-                        // every submessage's fields, taken at its end (timing: no condition
-                        // but the end; d_valid says whether they are a decision; the next
-                        // end is at least 5 bytes later, after the slots have used them)
-                        d_ack <= k_ack;
-                        d_final <= flag_f;
-                        d_rid <= f_rid;
-                        d_wid <= f_wid;
-                        d_hi <= f_hi;
-                        d_lo <= f_lo;               // HEARTBEAT: lastSN's low half
-                        d_nbits <= f_nbits[8:0];    // (0: no number asked, whatever word0)
-                        d_word0 <= f_word0;
-                        d_prefix <= src;
-                    end
-                    if (nbits_bad || sub_bad) begin
-                        n_bad <= n_bad + 1'b1;
-                        st <= tl ? S_HDR : S_DROP;
-                    end else if (body_last) begin
-                        st <= tl ? S_HDR : S_SUBHDR;
-                        if ((k_ack || k_hb) && dst_ok) d_valid <= 1'b1;
-                    end else if (tl) begin
-                        st <= S_HDR;
-                    end
+                fields_done <= 1'b0;
+                at_need <= 1'b0;                // (body byte 0 is no field's last)
+                // the datagram ends in or right after a submessage header (not empty)
+                if (tl && !w_empty) n_bad <= n_bad + 1'b1;
+            end else if (take && w_body) begin
+                acc_e <= acc_e_n;
+                acc_b <= acc_b_n[23:0];
+                fields_done <= done_n;
+                at_need <= k_ack ? (pos == need_m1) : k_hb ? (pos == 16'd26) :
+                           k_dst ? (pos == 16'd10) : (pos == 16'd18);
+                if (k_dst && pos < 16'd12) dst_sh <= dst_sh_n[87:0];
+                if (k_src && pos >= 16'd8 && pos < 16'd20) src_sh <= src_sh_n[87:0];
+                if (pos == 16'd3) f_rid <= acc_b_n;
+                if (pos == 16'd7) f_wid <= acc_b_n;
+                if (pos == 16'd11 && k_ack) f_hi <= acc_e_n;
+                if (pos == 16'd15 && k_ack) f_lo <= acc_e_n;
+                if (pos == 16'd19 && k_hb) f_hi <= acc_e_n;
+                if (pos == 16'd23 && k_hb) f_lo <= acc_e_n;
+                if (pos == 16'd19) begin
+                    f_nbits <= acc_e_n;
+                    need_m1 <= 16'd22 + {10'd0, nwords, 2'b00};
                 end
-                default: if (tl) st <= S_HDR;    // S_DROP: the rest of the datagram
-                endcase
-                if (tl) idx <= 5'd0;
+                if (pos == 16'd23) f_word0 <= acc_e_n;
+                if (k_dst && pos == 16'd11) begin
+                    dst <= dst_sh_n;
+                    dst_chk <= 1'b1;
+                end
+                if (k_src && pos == 16'd19) src <= src_sh_n;
+                if (body_last) begin
+                    // every submessage's fields, taken at its end (timing: no condition
+                    // but the end; d_valid says whether they are a decision; the next
+                    // end is at least 5 bytes later, after the slots have used them)
+                    d_ack <= k_ack;
+                    d_final <= flag_f;
+                    d_rid <= f_rid;
+                    d_wid <= f_wid;
+                    d_hi <= f_hi;
+                    d_lo <= f_lo;               // HEARTBEAT: lastSN's low half
+                    d_nbits <= f_nbits[8:0];    // (0: no number asked, whatever word0)
+                    d_word0 <= f_word0;
+                    d_prefix <= src;
+                end
+                if (nbits_bad || sub_bad) n_bad <= n_bad + 1'b1;
+                else if (body_last && (k_ack || k_hb) && dst_ok) d_valid <= 1'b1;
             end
             // the late comparisons (timing): INFO_DST's prefix ours or any; the message ours
             // (each compared into a register, then acted on: two clocks)
@@ -414,7 +368,6 @@ module rfl_rtps_ctrl #(
             dst_chk2 <= dst_chk;
             own_chk2 <= own_chk;
             if (dst_chk2) dst_ok <= dst_eq;
-            if (own_chk2 && own_eq && !(take && tl)) st <= S_DROP;
             // the slots: a request set taken, or dropped (busy); the next request out
             if (any_want) begin
                 if (any_busy) n_busy <= n_busy + 1'b1;

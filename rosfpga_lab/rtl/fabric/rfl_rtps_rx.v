@@ -3,7 +3,8 @@
 // serialized payloads (CDR encapsulation header + data, as carried) of the DATA / DATA_FRAG
 // samples of one writer out, a packet per sample, a byte per clock.
 //
-// How the walk works (one state machine, a byte per clock; st):
+// How the walk works (a byte per clock; st: where the byte is in the message, rfl_rtps_walk's
+// S_HDR, S_SUBHDR, S_DROP, and in a submessage's body this stage's own ph):
 //   S_HDR     the 20-byte header: "RTPS", major version 2, vendor id, the sender's 12-byte GUID
 //             prefix (the source). Bad magic/version or a packet shorter than 20 bytes: the
 //             packet is dropped and counted (cnt_bad_header); a message from cfg_prefix (our
@@ -36,7 +37,8 @@
 //             up to PID_SENTINEL; S_PAY the payload: streamed when taken (a DATA's to the end
 //             of the submessage; a DATA_FRAG's fragments up to the sample's end), else skipped.
 //   S_SKIP    the rest of a submessage (HEARTBEAT, ACKNACK, GAP, unknown ids: skipped by
-//             length, RTPS 8.3.4.1); S_DROP the rest of a packet after an error.
+//             length, RTPS 8.3.4.1); S_DROP the rest of a packet after an error (the walk's
+//             drop).
 // Output: m_axis_* a sample per packet; TLAST on its last byte; TUSER (on the TLAST beat) set:
 // the sample is dropped, discard the packet (a fragment missing, out of order or malformed, a
 // truncated or malformed submessage). A packet with TUSER may end with a byte 0 that is not
@@ -96,11 +98,11 @@ module rfl_rtps_rx #(
 
     localparam [3:0] S_HDR = 4'd0, S_SUBHDR = 4'd1, S_FIELDS = 4'd2, S_D1 = 4'd3, S_D2 = 4'd4,
                      S_GAP = 4'd5, S_QOS = 4'd6, S_PAY = 4'd7, S_SKIP = 4'd8, S_DROP = 4'd9;
-`include "rfl_rtps_wire.vh"             // ID_*, RTPS_MAGIC, RTPS_VERSION, FLAG_E
+`include "rfl_rtps_wire.vh"             // ID_*
 
-    reg [3:0] st;
+    reg [3:0] ph;                               // in a body: S_FIELDS .. S_SKIP
     reg dwait;                                  // in S_D1 or S_D2 (timing: no state decode)
-    reg [5:0] idx;                              // byte of the header / fields / parameter
+    reg [2:0] idx;                              // byte of an inline QoS parameter's head
 
     // the output register
     reg [7:0] o_data;
@@ -111,8 +113,29 @@ module rfl_rtps_rx #(
     wire [7:0] b = s_axis_tdata;
     wire tl = s_axis_tlast;
 
+    // the walk: where the byte is (the header, a submessage header or body, dropped)
+    wire w_hdr, w_sub, w_body, w_last, w_empty, w_mis, w_hdr_bad;
+    wire [4:0] w_idx;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [7:0] w_flags;                         // (E, Q (INFO_TS: I), D, K read: 0..3)
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [15:0] w_len;
+    wire [5:0] pos;                             // the body's byte (the fields: 0..31)
+    reg drop;
+    /* verilator lint_off PINCONNECTEMPTY */
+    rfl_rtps_walk #(.POS_BITS(6)) u_walk (
+        .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
+        .drop(drop), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
+        .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(w_len), .m_sub_pos(pos), .m_sub_mis(w_mis),
+        .m_sub_last(w_last), .m_sub_empty(w_empty), .m_hdr_bad(w_hdr_bad));
+    /* verilator lint_on PINCONNECTEMPTY */
+    // the state, as one number (rtl/tb/rfl_fabric_demo_tb.v dumps it): the walk's, or ph
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [3:0] st = dwait ? ph : w_hdr ? S_HDR : w_sub ? S_SUBHDR : w_body ? ph : S_DROP;
+    /* verilator lint_on UNUSEDSIGNAL */
+
     // the message
-    reg hdr_bad, own_eq;
+    reg own_eq;
     reg [95:0] cmp_sh;                          // cfg_prefix, shifted a byte per byte compared
     reg [95:0] src_prefix;
     reg dst_ok, dst_cfg, dst_zero;
@@ -120,19 +143,11 @@ module rfl_rtps_rx #(
     reg [63:0] ts;
     reg ts_valid;
     wire cmp_eq = (b == cmp_sh[95:88]);
-    wire [7:0] magic = (idx[1:0] == 2'd0) ? RTPS_MAGIC[31:24] :
-                       (idx[1:0] == 2'd1) ? RTPS_MAGIC[23:16] :
-                       (idx[1:0] == 2'd2) ? RTPS_MAGIC[15:8] : RTPS_MAGIC[7:0];
-    wire hdr_bad_n = ((idx != 6'd0) && hdr_bad) || ((idx < 6'd4) && (b != magic)) ||
-                     ((idx == 6'd4) && (b != RTPS_VERSION[15:8]));
-    wire own_n = ((idx == 6'd8) || own_eq) && cmp_eq;
+    wire own_n = ((w_idx == 5'd8) || own_eq) && cmp_eq;
 
     // the submessage
-    reg k_ts, k_dst, k_src, k_data, k_frag, k_pad;   // the submessage id, decoded once
-    reg [3:0] sm_flags;                         // E, Q (INFO_TS: I), D, K
-    reg [15:0] sub_left;                        // body bytes left (not with to_end)
-    reg to_end, mis;
-    reg sl1;                                    // sub_left == 1, registered (timing)
+    reg k_ts, k_dst, k_src, k_data, k_frag;     // the submessage id, decoded once
+    wire [3:0] sm_flags = w_flags[3:0];         // E, Q (INFO_TS: I), D, K
     reg [31:0] acc_e;                           // the last four bytes, in E order
     reg [23:0] acc_b;                           // the last three bytes, as they came
     wire le = sm_flags[0];
@@ -140,13 +155,12 @@ module rfl_rtps_rx #(
     wire [31:0] acc_b_n = {acc_b, b};
     wire [15:0] e16 = le ? acc_e_n[31:16] : acc_e_n[15:0];      // a 16-bit field ending here
     wire is_frag = k_frag;
-    wire empty_kind = k_pad || k_ts;
     wire fields_kind = k_data || k_frag || k_dst || k_src || (k_ts && !sm_flags[1]);
     wire [5:0] fields_last = k_ts ? 6'd7 : k_dst ? 6'd11 : k_frag ? 6'd31 : 6'd19;
-    wire body_last = to_end ? tl : sl1;
+    wire body_last = w_last;                    // (in a body)
     wire body_end = body_last || tl;            // the submessage's last byte in this packet
     wire trunc = tl && !body_last;
-    wire end_bad = trunc || (body_last && mis && !tl);   // cut short; misaligned, not last
+    wire end_bad = trunc || (body_last && w_mis && !tl); // cut short; misaligned, not last
 
     // DATA / DATA_FRAG fields
     reg [16:0] gap;                             // signed: bytes from the fields to the QoS
@@ -157,7 +171,7 @@ module rfl_rtps_rx #(
     reg q_sent, ql1, q_pid1, q_z2, g1;         // ql1: q_left == 1; g1: gap == 1
     wire gap_pos = !gap[16] && (gap != 17'd0);
     wire q_len0 = q_z2 && (b == 8'h00);        // the parameter's length is 0
-    wire q_done = ((idx == 6'd3) && q_len0 && q_pid1) || ((idx == 6'd4) && ql1 && q_sent);
+    wire q_done = ((idx == 3'd3) && q_len0 && q_pid1) || ((idx == 3'd4) && ql1 && q_sent);
 
     // the sample being streamed
     reg act, act_frag, beats, pay_on, hold, sm_acc;
@@ -212,33 +226,22 @@ module rfl_rtps_rx #(
         end
     endtask
 
-    // a malformed submessage: it and the rest of the packet are dropped
-    task malformed(input pkt_end);
+    // a malformed submessage: it and the rest of the packet are dropped (the walk's drop,
+    // set in the same clock by the always @(*) below)
+    task malformed;
         begin
             p_mal <= 1'b1;
             if (sm_acc) abort_act;
-            idx <= 6'd0;
-            st <= pkt_end ? S_HDR : S_DROP;
-        end
-    endtask
-
-    task next_sub(input pkt_end);
-        begin
-            idx <= 6'd0;
-            st <= pkt_end ? S_HDR : S_SUBHDR;
         end
     endtask
 
     // the submessage ends where its payload would start (an empty payload)
     task end_no_payload;
         begin
-            if (end_bad) malformed(tl);
-            else begin
-                if (sm_acc && act) begin
-                    if (act_frag) abort_act;    // the fragment is missing
-                    else act <= 1'b0;           // a DATA with nothing in it: nothing sent
-                end
-                next_sub(tl);
+            if (end_bad) malformed;
+            else if (sm_acc && act) begin
+                if (act_frag) abort_act;        // the fragment is missing
+                else act <= 1'b0;               // a DATA with nothing in it: nothing sent
             end
         end
     endtask
@@ -252,6 +255,28 @@ module rfl_rtps_rx #(
             meta_ts_valid <= ts_valid;
         end
     endtask
+
+    // the rest of the packet dropped (the walk's drop), in the clock the state machine below
+    // finds the packet malformed or not ours (a TLAST taken ends it anyway)
+    always @(*) begin
+        drop = 1'b0;
+        if (dwait) begin
+            // S_D2: nothing after the fields, and they are bad
+            drop = (ph == S_D2) && o_free && !need_abort && d_body_end && !d_pkt_end && !d_ok;
+        end else if (take) begin
+            if (w_hdr) drop = (w_idx == 5'd19) && own_n;     // our own message, looped back
+            else if (w_sub) drop = (w_idx == 5'd3) &&        // D and K; INFO_TS without time
+                                   ((k_data && sm_flags[3:2] == 2'b11) || (w_empty && fields_kind));
+            else if (w_body) case (ph)
+                S_FIELDS: drop = (pos == fields_last) ? (!k_data && !k_frag && end_bad) : body_end;
+                S_GAP:    drop = body_end && (!g1 || sm_flags[1] || end_bad);
+                S_QOS:    drop = body_end && (!q_done || end_bad);
+                S_PAY:    drop = body_end && end_bad;
+                S_SKIP:   drop = end_bad;
+                default:  drop = 1'b0;
+            endcase
+        end
+    end
 
     always @(posedge clk) begin
         eq_pfx <= (src_prefix == meta_prefix);
@@ -267,129 +292,19 @@ module rfl_rtps_rx #(
         if (take) begin
             acc_e <= acc_e_n;
             acc_b <= acc_b_n[23:0];
-            if (!to_end && (st == S_FIELDS || st == S_GAP || st == S_QOS || st == S_PAY ||
-                            st == S_SKIP)) begin
-                sub_left <= sub_left - 16'd1;
-                sl1 <= (sub_left == 16'd2);
-            end
         end
         if (!rst_n) begin
-            st <= S_HDR;
+            ph <= S_FIELDS;
             dwait <= 1'b0;
-            idx <= 6'd0;
+            idx <= 3'd0;
             o_valid <= 1'b0;
             act <= 1'b0;
             hold <= 1'b0;
             pay_on <= 1'b0;
             sm_acc <= 1'b0;
             a_done <= 1'b0;
-        end else begin
-            case (st)
-            S_HDR: if (take) begin
-                hdr_bad <= hdr_bad_n;
-                if (idx == 6'd0) begin
-                    p_pkt <= 1'b1;
-                    dst_ok <= 1'b1;
-                    ts_valid <= 1'b0;
-                end
-                if (idx == 6'd7) cmp_sh <= cfg_prefix;
-                if (idx >= 6'd8) begin
-                    src_prefix <= {src_prefix[87:0], b};
-                    cmp_sh <= {cmp_sh[87:0], 8'h00};
-                    own_eq <= own_n;
-                end
-                if (idx == 6'd19) begin
-                    idx <= 6'd0;
-                    if (hdr_bad_n) p_badhdr <= 1'b1;
-                    st <= tl ? S_HDR : (hdr_bad_n || own_n) ? S_DROP : S_SUBHDR;
-                end else if (tl) begin
-                    p_badhdr <= 1'b1;           // shorter than a header
-                    idx <= 6'd0;
-                end else idx <= idx + 6'd1;
-            end
-            S_SUBHDR: if (take) begin
-                idx <= idx + 6'd1;
-                if (idx == 6'd0) begin
-                    k_ts <= (b == ID_INFO_TS);
-                    k_dst <= (b == ID_INFO_DST);
-                    k_src <= (b == ID_INFO_SRC);
-                    k_data <= (b == ID_DATA);
-                    k_frag <= (b == ID_DATA_FRAG);
-                    k_pad <= (b == ID_PAD);
-                    sm_acc <= 1'b0;
-                end
-                if (idx == 6'd1) sm_flags <= b[3:0];
-                if (idx == 6'd3) begin
-                    idx <= 6'd0;
-                    sub_left <= e16;
-                    sl1 <= (e16 == 16'd1);
-                    mis <= (e16[1:0] != 2'd0);
-                    to_end <= (e16 == 16'd0) && !empty_kind;
-                    if (k_ts && sm_flags[1]) ts_valid <= 1'b0;
-                    if (k_dst) begin
-                        cmp_sh <= cfg_prefix;
-                        dst_cfg <= 1'b1;
-                        dst_zero <= 1'b1;
-                    end
-                    if (tl) begin               // no body in this packet
-                        if (e16 != 16'd0 || fields_kind) p_mal <= 1'b1;
-                        st <= S_HDR;
-                    end else if (k_data && sm_flags[3:2] == 2'b11) begin
-                        p_mal <= 1'b1;          // D and K: invalid (RTPS 2.3 8.3.7.2)
-                        st <= S_DROP;
-                    end else if (e16 == 16'd0 && empty_kind) begin
-                        if (fields_kind) begin  // INFO_TS without its time
-                            p_mal <= 1'b1;
-                            st <= S_DROP;
-                        end
-                    end else st <= fields_kind ? S_FIELDS : S_SKIP;
-                end else if (tl) begin          // a submessage header cut short
-                    p_mal <= 1'b1;
-                    idx <= 6'd0;
-                    st <= S_HDR;
-                end
-            end
-            S_FIELDS: if (take) begin
-                idx <= idx + 6'd1;
-                if (k_ts) begin
-                    if (idx == 6'd3) ts_sec <= acc_e_n;
-                    if (idx == 6'd7) begin
-                        ts <= {ts_sec, acc_e_n};
-                        ts_valid <= 1'b1;
-                    end
-                end else if (k_dst) begin
-                    dst_cfg <= dst_cfg && cmp_eq;
-                    dst_zero <= dst_zero && (b == 8'h00);
-                    cmp_sh <= {cmp_sh[87:0], 8'h00};
-                    if (idx == 6'd11) dst_ok <= (dst_cfg && cmp_eq) || (dst_zero && b == 8'h00);
-                end else if (k_src) begin
-                    if (idx >= 6'd8) src_prefix <= {src_prefix[87:0], b};
-                end else begin                  // DATA, DATA_FRAG
-                    if (idx == 6'd3) begin
-                        gap <= {1'b0, e16} - (is_frag ? 17'd28 : 17'd16);
-                        g1 <= (e16 == (is_frag ? 16'd29 : 16'd17));
-                    end
-                    if (idx == 6'd7) reader <= acc_b_n;
-                    if (idx == 6'd11) writer <= acc_b_n;
-                    if (idx == 6'd15) seq[63:32] <= acc_e_n;
-                    if (idx == 6'd19) seq[31:0] <= acc_e_n;
-                    if (idx == 6'd23) frag_start <= acc_e_n;
-                    if (idx == 6'd25) frag_count <= e16;
-                    if (idx == 6'd27) frag_size <= e16;
-                    if (idx == 6'd31) sample_size <= acc_e_n;
-                end
-                if (idx == fields_last) begin
-                    if (k_data || k_frag) begin
-                        d_body_end <= body_end;
-                        d_pkt_end <= tl;
-                        d_bad <= end_bad;
-                        dwait <= 1'b1;
-                        st <= S_D1;
-                    end else if (end_bad) malformed(tl);
-                    else if (body_end) next_sub(tl);
-                    else st <= S_SKIP;
-                end else if (body_end) malformed(tl);    // fields missing
-            end
+        end else if (dwait) begin
+            case (ph)
             S_D1: begin
                 f_k_eq <= eq_pfx && eq_wr && eq_seq;    // DATA_FRAG: writerSN is 12 bytes old
                 f_start_eq <= (frag_start == next_frag);
@@ -403,9 +318,9 @@ module rfl_rtps_rx #(
                 f_matched <= dst_ok && (reader == 32'd0 || reader == cfg_reader) &&
                              (cfg_writer == 32'd0 || writer == cfg_writer) && !seq[63] &&
                              (seq != 64'd0) && (is_frag || sm_flags[3:2] == 2'b01);
-                st <= S_D2;
+                ph <= S_D2;
             end
-            S_D2: if (o_free) begin
+            default: if (o_free) begin          // S_D2
                 if (need_abort) abort_act;      // then decide again, without it
                 else begin
                     dwait <= 1'b0;
@@ -431,7 +346,8 @@ module rfl_rtps_rx #(
                         al1 <= (sample_size == 32'd1);
                     end else if (rep_now) p_rep <= 1'b1;
                     else if (f_matched && !cont_now) p_drop <= 1'b1;        // out of order
-                    if (d_body_end) begin       // nothing after the fields
+                    if (d_body_end) begin       // nothing after the fields (the walk is past
+                                                // them: at the next submessage or packet)
                         if (!d_ok) p_mal <= 1'b1;
                         if ((start_now || cont_now) && (is_frag || !d_ok)) begin
                             if (cont_now && beats) emit(8'h00, 1'b1, 1'b1);
@@ -441,46 +357,123 @@ module rfl_rtps_rx #(
                             act <= 1'b0;
                             pay_on <= 1'b0;
                         end
-                        idx <= 6'd0;
-                        st <= d_pkt_end ? S_HDR : d_ok ? S_SUBHDR : S_DROP;
                     end else begin
-                        idx <= 6'd0;
-                        st <= gap_pos ? S_GAP : sm_flags[1] ? S_QOS : S_PAY;
+                        idx <= 3'd0;
+                        ph <= gap_pos ? S_GAP : sm_flags[1] ? S_QOS : S_PAY;
                     end
                 end
             end
-            S_GAP: if (take) begin
+            endcase
+        end else if (take && w_hdr) begin
+            if (w_hdr_bad) p_badhdr <= 1'b1;    // bad magic or version, shorter than a header
+            if (w_idx == 5'd0) begin
+                p_pkt <= 1'b1;
+                dst_ok <= 1'b1;
+                ts_valid <= 1'b0;
+            end
+            if (w_idx == 5'd7) cmp_sh <= cfg_prefix;
+            if (w_idx >= 5'd8) begin
+                src_prefix <= {src_prefix[87:0], b};
+                cmp_sh <= {cmp_sh[87:0], 8'h00};
+                own_eq <= own_n;
+            end
+        end else if (take && w_sub) begin
+            if (w_idx == 5'd0) begin
+                k_ts <= (b == ID_INFO_TS);
+                k_dst <= (b == ID_INFO_DST);
+                k_src <= (b == ID_INFO_SRC);
+                k_data <= (b == ID_DATA);
+                k_frag <= (b == ID_DATA_FRAG);
+                sm_acc <= 1'b0;
+            end
+            if (w_idx == 5'd3) begin
+                if (k_ts && sm_flags[1]) ts_valid <= 1'b0;
+                if (k_dst) begin
+                    cmp_sh <= cfg_prefix;
+                    dst_cfg <= 1'b1;
+                    dst_zero <= 1'b1;
+                end
+                if (tl) begin                   // no body in this packet
+                    if (w_len != 16'd0 || fields_kind) p_mal <= 1'b1;
+                end else if (k_data && sm_flags[3:2] == 2'b11) begin
+                    p_mal <= 1'b1;              // D and K: invalid (RTPS 2.3 8.3.7.2)
+                end else if (w_empty) begin     // empty (PAD, INFO_TS of length 0)
+                    if (fields_kind) p_mal <= 1'b1;     // INFO_TS without its time
+                end else ph <= fields_kind ? S_FIELDS : S_SKIP;
+            end else if (tl) p_mal <= 1'b1;     // a submessage header cut short
+        end else if (take && w_body) begin
+            case (ph)
+            S_FIELDS: begin
+                if (k_ts) begin
+                    if (pos == 6'd3) ts_sec <= acc_e_n;
+                    if (pos == 6'd7) begin
+                        ts <= {ts_sec, acc_e_n};
+                        ts_valid <= 1'b1;
+                    end
+                end else if (k_dst) begin
+                    dst_cfg <= dst_cfg && cmp_eq;
+                    dst_zero <= dst_zero && (b == 8'h00);
+                    cmp_sh <= {cmp_sh[87:0], 8'h00};
+                    if (pos == 6'd11) dst_ok <= (dst_cfg && cmp_eq) || (dst_zero && b == 8'h00);
+                end else if (k_src) begin
+                    if (pos >= 6'd8) src_prefix <= {src_prefix[87:0], b};
+                end else begin                  // DATA, DATA_FRAG
+                    if (pos == 6'd3) begin
+                        gap <= {1'b0, e16} - (is_frag ? 17'd28 : 17'd16);
+                        g1 <= (e16 == (is_frag ? 16'd29 : 16'd17));
+                    end
+                    if (pos == 6'd7) reader <= acc_b_n;
+                    if (pos == 6'd11) writer <= acc_b_n;
+                    if (pos == 6'd15) seq[63:32] <= acc_e_n;
+                    if (pos == 6'd19) seq[31:0] <= acc_e_n;
+                    if (pos == 6'd23) frag_start <= acc_e_n;
+                    if (pos == 6'd25) frag_count <= e16;
+                    if (pos == 6'd27) frag_size <= e16;
+                    if (pos == 6'd31) sample_size <= acc_e_n;
+                end
+                if (pos == fields_last) begin
+                    if (k_data || k_frag) begin
+                        d_body_end <= body_end;
+                        d_pkt_end <= tl;
+                        d_bad <= end_bad;
+                        dwait <= 1'b1;
+                        ph <= S_D1;
+                    end else if (end_bad) malformed;
+                    else if (!body_end) ph <= S_SKIP;
+                end else if (body_end) malformed;   // fields missing
+            end
+            S_GAP: begin
                 gap <= gap - 17'd1;
                 g1 <= (gap == 17'd2);
                 if (g1) begin
                     if (body_end) begin
-                        if (sm_flags[1]) malformed(tl);     // the inline QoS is missing
+                        if (sm_flags[1]) malformed;     // the inline QoS is missing
                         else end_no_payload;
-                    end else st <= sm_flags[1] ? S_QOS : S_PAY;
-                end else if (body_end) malformed(tl);
+                    end else ph <= sm_flags[1] ? S_QOS : S_PAY;
+                end else if (body_end) malformed;
             end
-            S_QOS: if (take) begin
-                if (idx == 6'd4) begin          // in a parameter's value
+            S_QOS: begin
+                if (idx == 3'd4) begin          // in a parameter's value
                     q_left <= q_left - 16'd1;
                     ql1 <= (q_left == 16'd2);
-                    if (ql1) idx <= 6'd0;
-                end else if (idx == 6'd3) begin
+                    if (ql1) idx <= 3'd0;
+                end else if (idx == 3'd3) begin
                     q_left <= e16;
                     ql1 <= (e16 == 16'd1);
                     q_sent <= q_pid1;
-                    idx <= q_len0 ? 6'd0 : 6'd4;
-                end else idx <= idx + 6'd1;
-                if (idx == 6'd1) q_pid1 <= (e16 == 16'h0001);   // the parameter id
-                if (idx == 6'd2) q_z2 <= (b == 8'h00);
+                    idx <= q_len0 ? 3'd0 : 3'd4;
+                end else idx <= idx + 3'd1;
+                if (idx == 3'd1) q_pid1 <= (e16 == 16'h0001);   // the parameter id
+                if (idx == 3'd2) q_z2 <= (b == 8'h00);
                 if (body_end) begin
                     if (q_done) end_no_payload;
-                    else malformed(tl);
+                    else malformed;
                 end else if (q_done) begin
-                    idx <= 6'd0;
-                    st <= S_PAY;
+                    idx <= 3'd0;
+                    ph <= S_PAY;
                 end
             end
-            S_PAY: if (take) begin
+            S_PAY: begin
                 if (pay_on) begin
                     if (act_frag) begin
                         a_left <= a_left - 32'd1;
@@ -521,22 +514,9 @@ module rfl_rtps_rx #(
                     act <= 1'b0;
                     a_done <= act_frag && !end_bad;
                 end else if (body_end && end_bad && sm_acc) abort_act;
-                if (body_end) begin
-                    if (end_bad) begin
-                        p_mal <= 1'b1;
-                        idx <= 6'd0;
-                        st <= tl ? S_HDR : S_DROP;
-                    end else next_sub(tl);
-                end
+                if (body_end && end_bad) p_mal <= 1'b1;
             end
-            S_SKIP: if (take) begin
-                if (end_bad) malformed(tl);
-                else if (body_end) next_sub(tl);
-            end
-            default: if (take && tl) begin      // S_DROP
-                idx <= 6'd0;
-                st <= S_HDR;
-            end
+            default: if (end_bad) malformed;    // S_SKIP
             endcase
         end
     end

@@ -32,10 +32,10 @@
 // cfg_prefix, looped back) is ignored, as is a goodbye (of the peer: it ends the peer's place).
 // Not read: INFO_SRC (the header's prefix names the participant), INFO_DST (an announcement is
 // the participant's whoever it is addressed to).
-// The walk: a byte a clock, as rfl_rtps_ctrl's (header, submessage headers, bodies by
-// length, octetsToNextHeader 0 to the end of the message), then in an SPDP DATA the inline QoS
-// (flag Q, walked by its parameters' lengths for PID_STATUS_INFO), the encapsulation
-// (PL_CDR_BE or PL_CDR_LE: the parameters' byte order) and the parameters.
+// The walk: a byte a clock, the header, submessage headers and bodies by rfl_rtps_walk (a bad
+// header: the datagram ignored), then in an SPDP DATA the inline QoS (flag Q, walked by its
+// parameters' lengths for PID_STATUS_INFO), the encapsulation (PL_CDR_BE or PL_CDR_LE: the
+// parameters' byte order) and the parameters.
 `default_nettype none
 
 module rfl_spdp_peer #(
@@ -101,8 +101,7 @@ module rfl_spdp_peer #(
     localparam [TW-1:0] TICK_LAST = TICK_LAST_32[TW-1:0];
     localparam [31:0] RESEND_32 = RESEND;
     localparam [RW-1:0] RESEND_N = RESEND_32[RW-1:0];
-    localparam [1:0] S_HDR = 2'd0, S_SUBHDR = 2'd1, S_BODY = 2'd2, S_DROP = 2'd3;
-`include "rfl_rtps_wire.vh"             // ID_*, RTPS_MAGIC, RTPS_VERSION, FLAG_E
+`include "rfl_rtps_wire.vh"             // ID_*
     // within a DATA: the fixed fields, the inline QoS's parameter heads and values, the
     // encapsulation, the payload's heads and values, done (the sentinel), ignored
     localparam [2:0] P_FIX = 3'd0, P_QHEAD = 3'd1, P_QVAL = 3'd2, P_ENC = 3'd3,
@@ -113,17 +112,27 @@ module rfl_spdp_peer #(
     wire [7:0] b = s_axis_tdata;
     wire tl = s_axis_tlast;
 
-    reg [1:0] st;
-    reg [4:0] idx;
-    reg hdr_bad;
+    // the walk: where the byte is (the header, a submessage header or body, dropped)
+    wire w_hdr, w_sub, w_body, w_last;
+    wire [4:0] w_idx;
+    /* verilator lint_off UNUSEDSIGNAL */
+    wire [7:0] w_flags;                         // (E, Q, D, K read: 0..3)
+    /* verilator lint_on UNUSEDSIGNAL */
+    wire [15:0] pos;                            // the body's byte
+    /* verilator lint_off PINCONNECTEMPTY */
+    rfl_rtps_walk #(.POS_BITS(16)) u_walk (
+        .clk(clk), .rst_n(rst_n), .in_data(s_axis_tdata), .in_take(take), .in_last(s_axis_tlast),
+        .drop(1'b0), .m_hdr(w_hdr), .m_subhdr(w_sub), .m_body(w_body), .m_dropped(), .m_idx(w_idx),
+        .m_sub_id(), .m_sub_flags(w_flags), .m_sub_len(), .m_sub_pos(pos), .m_sub_mis(),
+        .m_sub_last(w_last), .m_sub_empty(), .m_hdr_bad());
+    /* verilator lint_on PINCONNECTEMPTY */
+
     reg [95:0] src;                             // the header's prefix, shifted in (the last
                                                 // candidate's is used 2 clocks after its end)
-    reg [7:0] kind, len_lo;
-    reg le;                                     // the submessage's byte order
-    reg f_q, f_d, f_k;
-    reg k_data;
-    reg [15:0] pos, sub_left;
-    reg sl1, to_end;
+    reg [7:0] len_lo;                           // octetsToInlineQos' first byte
+    wire le = w_flags[0];                       // the submessage's byte order (FLAG_E)
+    wire f_q = w_flags[1], f_d = w_flags[2], f_k = w_flags[3];
+    reg k_data;                                 // the submessage is a DATA (decoded once)
     reg [2:0] ph;
     reg ple;                                    // the parameter list's byte order
     reg [1:0] hcnt;                             // byte of a parameter head / encapsulation
@@ -153,8 +162,7 @@ module rfl_spdp_peer #(
     wire [15:0] hpid = ple ? acc_e_n[15:0] : acc_e_n[31:16];
     wire [15:0] hlen = ple ? acc_e_n[31:16] : acc_e_n[15:0];
     wire [15:0] pid_n = hpid[15] ? hpid : {2'b00, hpid[13:0]};    // must-understand bit off
-    wire body_last = to_end ? tl : sl1;
-    wire sub_end = body_last || tl;             // (tl first: cut short)
+    wire sub_end = w_last || tl;                // (tl first: cut short)
     wire spdp_data = k_data && wid_ok;
     wire announce = spdp_data && f_d && !f_k && !f_gone;
     // a UDPv4 locator with a port of 1..65535, its value's bytes 0..7 taken
@@ -197,9 +205,6 @@ module rfl_spdp_peer #(
 
     always @(posedge clk) begin
         if (!rst_n) begin
-            st <= S_HDR;
-            idx <= 5'd0;
-            hdr_bad <= 1'b0;
             c_valid <= 1'b0;
             e_valid <= 1'b0;
             have <= 1'b0;
@@ -219,169 +224,120 @@ module rfl_spdp_peer #(
         end else begin
             c_valid <= 1'b0;
             sedp <= 1'b0;
-            if (take) begin
-                case (st)
-                S_HDR: begin
-                    hdr_bad <= (idx != 5'd0 && hdr_bad) ||
-                               (idx == 5'd0 && b != RTPS_MAGIC[31:24]) ||
-                               (idx == 5'd1 && b != RTPS_MAGIC[23:16]) ||
-                               (idx == 5'd2 && b != RTPS_MAGIC[15:8]) ||
-                               (idx == 5'd3 && b != RTPS_MAGIC[7:0]) ||
-                               (idx == 5'd4 && b != RTPS_VERSION[15:8]);
-                    if (idx >= 5'd8) src <= {src[87:0], b};
-                    idx <= idx + 1'b1;
-                    if (tl) begin
-                        idx <= 5'd0;
-                    end else if (idx == 5'd19) begin
-                        idx <= 5'd0;
-                        st <= hdr_bad ? S_DROP : S_SUBHDR;
+            if (take && w_hdr && w_idx >= 5'd8) src <= {src[87:0], b};
+            if (take && w_sub) begin
+                if (w_idx == 5'd0) k_data <= (b == ID_DATA);
+                ph <= P_FIX;
+                wid_ok <= 1'b0;
+                f_bad <= 1'b0;
+                f_gone <= 1'b0;
+                have_meta <= 1'b0;
+                have_user <= 1'b0;
+                meta_src <= 1'b0;
+                user_src <= 1'b0;
+                have_lease <= 1'b0;
+                pl_ok <= 1'b0;
+            end else if (take && w_body) begin
+                acc_e <= acc_e_n;
+                acc_b <= acc_b_n[23:0];
+                if (pos == 16'd3) dstart_m1 <= 16'd3 + len_n;   // (bytes 2, 3 in le's order)
+                if (pos == 16'd10) wid <= acc_b_n[23:0];
+                if (pos == 16'd11) wid_ok <= ({wid, b} == SPDP_WRITER_ID);
+                if (pos == 16'd2) len_lo <= b;
+                case (ph)
+                P_FIX: if (pos == 16'd4 && dstart_m1 < 16'd19) begin
+                    // octetsToInlineQos below 16 (or past 65532: 3 + it wraps), checked
+                    // from its register (timing)
+                    f_bad <= 1'b1;
+                    ph <= P_IGN;
+                end else if (pos >= 16'd19 && pos == dstart_m1) begin
+                    ph <= f_q ? P_QHEAD : P_ENC;
+                    ple <= le;
+                    hcnt <= 2'd0;
+                end
+                P_QHEAD, P_HEAD: begin
+                    hcnt <= hcnt + 1'b1;
+                    if (hcnt == 2'd3) begin
+                        k_meta <= (ph == P_HEAD) && pid_n == PID_META;
+                        k_user <= (ph == P_HEAD) && pid_n == PID_USER;
+                        k_lease <= (ph == P_HEAD) && pid_n == PID_LEASE;
+                        k_status <= (ph == P_QHEAD) && pid_n == PID_STATUS;
+                        vleft <= hlen;
+                        vl1 <= (hlen == 16'd1);
+                        vpos <= 5'd0;
+                        if (pid_n == PID_SENTINEL) begin
+                            ph <= (ph == P_QHEAD) ? P_ENC : P_END;
+                            if (ph == P_HEAD) pl_ok <= 1'b1;
+                        end else if (hlen != 16'd0) begin
+                            ph <= (ph == P_QHEAD) ? P_QVAL : P_VAL;
+                        end
                     end
                 end
-                S_SUBHDR: begin
-                    idx <= idx + 1'b1;
-                    if (idx == 5'd0) begin
-                        kind <= b;
-                        k_data <= (b == ID_DATA);
+                P_QVAL, P_VAL: begin
+                    vleft <= vleft - 1'b1;
+                    vl1 <= (vleft == 16'd2);
+                    if (vpos != 5'd31) vpos <= vpos + 1'b1;
+                    if (vpos == 5'd3) v_kind <= acc_e_n;      // a locator's kind, or seconds
+                    if (vpos == 5'd7) v_port <= acc_e_n;
+                    // StatusInfo_t: octet[4], the flags in the last
+                    if (k_status && vpos == 5'd3 && b[1:0] != 2'b00) f_gone <= 1'b1;
+                    if (k_lease && vpos == 5'd3) begin
+                        lease_sec <= acc_e_n;
+                        have_lease <= 1'b1;
                     end
-                    if (idx == 5'd1) begin
-                        le <= b[0];
-                        f_q <= b[1];
-                        f_d <= b[2];
-                        f_k <= b[3];
+                    if (vpos == 5'd22) m_hi <= acc_b_n[23:0] == s_src_ip[31:8];
+                    if (k_meta && vpos == 5'd23 && loc_ok &&
+                        (!have_meta || (src_match && !meta_src))) begin
+                        have_meta <= 1'b1;
+                        meta_src <= src_match;
+                        meta_ip <= acc_b_n;
+                        meta_port <= v_port[15:0];
                     end
-                    if (idx == 5'd2) len_lo <= b;
-                    pos <= 16'd0;
-                    ph <= P_FIX;
-                    wid_ok <= 1'b0;
-                    f_bad <= 1'b0;
-                    f_gone <= 1'b0;
-                    have_meta <= 1'b0;
-                    have_user <= 1'b0;
-                    meta_src <= 1'b0;
-                    user_src <= 1'b0;
-                    have_lease <= 1'b0;
-                    pl_ok <= 1'b0;
-                    if (tl) begin
-                        st <= S_HDR;
-                        idx <= 5'd0;
-                    end else if (idx == 5'd3) begin
-                        idx <= 5'd0;
-                        sub_left <= len_n;
-                        sl1 <= (len_n == 16'd1);
-                        to_end <= (len_n == 16'd0);
-                        st <= (len_n == 16'd0 && (kind == ID_PAD || kind == ID_INFO_TS))
-                              ? S_SUBHDR : S_BODY;
+                    if (k_user && vpos == 5'd23 && loc_ok &&
+                        (!have_user || (src_match && !user_src))) begin
+                        have_user <= 1'b1;
+                        user_src <= src_match;
+                        user_ip <= acc_b_n;
+                        user_port <= v_port[15:0];
                     end
-                end
-                S_BODY: begin
-                    acc_e <= acc_e_n;
-                    acc_b <= acc_b_n[23:0];
-                    pos <= pos + 1'b1;
-                    sub_left <= sub_left - 1'b1;
-                    sl1 <= (sub_left == 16'd2);
-                    if (pos == 16'd3) dstart_m1 <= 16'd3 + len_n;   // (bytes 2, 3 in le's order)
-                    if (pos == 16'd10) wid <= acc_b_n[23:0];
-                    if (pos == 16'd11) wid_ok <= ({wid, b} == SPDP_WRITER_ID);
-                    if (pos == 16'd2) len_lo <= b;
-                    case (ph)
-                    P_FIX: if (pos == 16'd4 && dstart_m1 < 16'd19) begin
-                        // octetsToInlineQos below 16 (or past 65532: 3 + it wraps), checked
-                        // from its register (timing)
-                        f_bad <= 1'b1;
-                        ph <= P_IGN;
-                    end else if (pos >= 16'd19 && pos == dstart_m1) begin
-                        ph <= f_q ? P_QHEAD : P_ENC;
-                        ple <= le;
+                    if (vl1) begin
+                        ph <= (ph == P_QVAL) ? P_QHEAD : P_HEAD;
                         hcnt <= 2'd0;
                     end
-                    P_QHEAD, P_HEAD: begin
-                        hcnt <= hcnt + 1'b1;
-                        if (hcnt == 2'd3) begin
-                            k_meta <= (ph == P_HEAD) && pid_n == PID_META;
-                            k_user <= (ph == P_HEAD) && pid_n == PID_USER;
-                            k_lease <= (ph == P_HEAD) && pid_n == PID_LEASE;
-                            k_status <= (ph == P_QHEAD) && pid_n == PID_STATUS;
-                            vleft <= hlen;
-                            vl1 <= (hlen == 16'd1);
-                            vpos <= 5'd0;
-                            if (pid_n == PID_SENTINEL) begin
-                                ph <= (ph == P_QHEAD) ? P_ENC : P_END;
-                                if (ph == P_HEAD) pl_ok <= 1'b1;
-                            end else if (hlen != 16'd0) begin
-                                ph <= (ph == P_QHEAD) ? P_QVAL : P_VAL;
-                            end
+                end
+                P_ENC: begin
+                    hcnt <= hcnt + 1'b1;
+                    if (hcnt == 2'd1) begin
+                        if (acc_b_n[15:0] == ENC_BE) ple <= 1'b0;
+                        else if (acc_b_n[15:0] == ENC_LE) ple <= 1'b1;
+                        else begin
+                            f_bad <= 1'b1;
+                            ph <= P_IGN;
                         end
                     end
-                    P_QVAL, P_VAL: begin
-                        vleft <= vleft - 1'b1;
-                        vl1 <= (vleft == 16'd2);
-                        if (vpos != 5'd31) vpos <= vpos + 1'b1;
-                        if (vpos == 5'd3) v_kind <= acc_e_n;      // a locator's kind, or seconds
-                        if (vpos == 5'd7) v_port <= acc_e_n;
-                        // StatusInfo_t: octet[4], the flags in the last
-                        if (k_status && vpos == 5'd3 && b[1:0] != 2'b00) f_gone <= 1'b1;
-                        if (k_lease && vpos == 5'd3) begin
-                            lease_sec <= acc_e_n;
-                            have_lease <= 1'b1;
-                        end
-                        if (vpos == 5'd22) m_hi <= acc_b_n[23:0] == s_src_ip[31:8];
-                        if (k_meta && vpos == 5'd23 && loc_ok &&
-                            (!have_meta || (src_match && !meta_src))) begin
-                            have_meta <= 1'b1;
-                            meta_src <= src_match;
-                            meta_ip <= acc_b_n;
-                            meta_port <= v_port[15:0];
-                        end
-                        if (k_user && vpos == 5'd23 && loc_ok &&
-                            (!have_user || (src_match && !user_src))) begin
-                            have_user <= 1'b1;
-                            user_src <= src_match;
-                            user_ip <= acc_b_n;
-                            user_port <= v_port[15:0];
-                        end
-                        if (vl1) begin
-                            ph <= (ph == P_QVAL) ? P_QHEAD : P_HEAD;
-                            hcnt <= 2'd0;
-                        end
+                    if (hcnt == 2'd3) ph <= P_HEAD;
+                end
+                default: ;                  // P_END, P_IGN: to the submessage's end
+                endcase
+                if (sub_end) begin
+                    // (this byte's own field is not needed: an announcement ends after
+                    // its sentinel, the last byte of which is taken above at hcnt 3)
+                    if (spdp_data && f_gone) begin
+                        c_valid <= 1'b1;
+                        c_bye <= 1'b1;
                     end
-                    P_ENC: begin
-                        hcnt <= hcnt + 1'b1;
-                        if (hcnt == 2'd1) begin
-                            if (acc_b_n[15:0] == ENC_BE) ple <= 1'b0;
-                            else if (acc_b_n[15:0] == ENC_LE) ple <= 1'b1;
-                            else begin
-                                f_bad <= 1'b1;
-                                ph <= P_IGN;
-                            end
-                        end
-                        if (hcnt == 2'd3) ph <= P_HEAD;
-                    end
-                    default: ;                  // P_END, P_IGN: to the submessage's end
-                    endcase
-                    if (sub_end) begin
-                        st <= tl ? S_HDR : S_SUBHDR;
-                        // (this byte's own field is not needed: an announcement ends after
-                        // its sentinel, the last byte of which is taken above at hcnt 3)
-                        if (spdp_data && f_gone) begin
+                    if (announce) begin
+                        c_bye <= 1'b0;
+                        if (!f_bad && (pl_ok || (ph == P_HEAD && hcnt == 2'd3 &&
+                                                  pid_n == PID_SENTINEL))
+                            && have_meta && have_user) begin
                             c_valid <= 1'b1;
-                            c_bye <= 1'b1;
-                        end
-                        if (announce) begin
-                            c_bye <= 1'b0;
-                            if (!f_bad && (pl_ok || (ph == P_HEAD && hcnt == 2'd3 &&
-                                                      pid_n == PID_SENTINEL))
-                                && have_meta && have_user) begin
-                                c_valid <= 1'b1;
-                                c_lease <= lease_n + 16'd1;
-                            end else if (n_refused != {COUNT_BITS{1'b1}}) begin
-                                n_refused <= n_refused + 1'b1;
-                            end
+                            c_lease <= lease_n + 16'd1;
+                        end else if (n_refused != {COUNT_BITS{1'b1}}) begin
+                            n_refused <= n_refused + 1'b1;
                         end
                     end
                 end
-                default: if (tl) st <= S_HDR;    // S_DROP: the rest of the datagram
-                endcase
-                if (tl) idx <= 5'd0;
             end
             // the candidate compared (registered: timing), then acted on
             e_valid <= c_valid;
