@@ -211,12 +211,14 @@ module rfl_gpublisher #(
             kleft <= 16'd0;
         end else begin
             if (put) cnt <= cnt + 32'd1;
-            if (state != P_BODY) begin  // (a body starts with cnt 0)
+            if (state == P_BODY) begin  // (read, then written: a simulation copies neither)
+                if (put) begin
+                    if (kleft != 16'd0) kleft <= kleft - 16'd1;
+                    kp <= kp + 16'd1;
+                end
+            end else begin  // (a body starts with cnt 0)
                 kp <= kaddr;
                 kleft <= klen;
-            end else if (put) begin
-                kp <= kp + 16'd1;
-                if (kleft != 16'd0) kleft <= kleft - 16'd1;
             end
             if (put) opos <= opos + 32'd1;
             case (state)
@@ -323,7 +325,7 @@ module rfl_gpublisher #(
         if (state == P_BODY)
             assert(kp == kaddr + cnt[15:0]
                    && (kleft == 16'd0
-                               || (cnt < {16'd0, klen} && kleft == klen - cnt[15:0])));
+                       || (cnt < {16'd0, klen} && kleft == klen - cnt[15:0])));
         for (fd = 0; fd < LOOPS; fd = fd + 1) assert(last_of[fd] == (left[32 * fd +: 32] == 32'd1));
     end
 `endif

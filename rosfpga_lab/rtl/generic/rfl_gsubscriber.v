@@ -500,13 +500,6 @@ module rfl_gsubscriber #(
         end else begin
             status_valid <= 1'b0;
             if (meta_release) meta_valid <= 1'b0;
-            if (state != S_BODY) begin  // (a body starts with cnt 0)
-                kp <= kaddr;
-                kleft <= klen;
-            end else if (take) begin
-                kp <= kp + 16'd1;
-                if (kleft != 16'd0) kleft <= kleft - 16'd1;
-            end
             if (take) begin
                 pos <= pos_next;
                 room <= room - 32'd1;
@@ -725,6 +718,16 @@ module rfl_gsubscriber #(
                 end
                 default: state <= S_FLEN;
             endcase
+            // (after the walk's reads of kp and kleft above: a simulation copies neither)
+            if (state == S_BODY) begin
+                if (take) begin
+                    if (kleft != 16'd0) kleft <= kleft - 16'd1;
+                    kp <= kp + 16'd1;
+                end
+            end else begin  // (a body starts with cnt 0)
+                kp <= kaddr;
+                kleft <= klen;
+            end
         end
         // (w follows pc: w_nx and w_jp are the words of pc_nx and pc_jp)
         if (!rst_n || step != G_STAY) begin
@@ -740,7 +743,7 @@ module rfl_gsubscriber #(
     always @(*) if (rst_n && state == S_BODY)
         assert(kp == kaddr + cnt[15:0]
                && (kleft == 16'd0
-                           || (cnt < {16'd0, klen} && kleft == klen - cnt[15:0])));
+                   || (cnt < {16'd0, klen} && kleft == klen - cnt[15:0])));
     always @(*) if (rst_n && !STREAM_EARLY) assert(!released);
     // a decision settles only in its own state, from 0 (each decision ends at 2 with 0)
     always @(*) if (rst_n)
