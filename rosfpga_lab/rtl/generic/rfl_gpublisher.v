@@ -74,6 +74,10 @@ module rfl_gpublisher #(
     reg        last_b;                          // left_b == 1
     reg [LOOPS-1:0] last_of;                    // left[d] == 1
     reg [DB-1:0] depth;
+    // PUB_CONST's next byte in a body: its constant's address (kaddr + cnt) and the constant's
+    // bytes left (klen - cnt, 0 once past), counted with cnt so that the output byte starts
+    // from flip-flops, not from an adder and a 32-bit comparison (Fmax)
+    reg [15:0] kp, kleft;
 
     // The current instruction, prog_word(pc): a memory of one word (a register on an FPGA),
     // written at one place, so that Verilator copies its 224 bits only on the clocks it loads
@@ -102,7 +106,9 @@ module rfl_gpublisher #(
                             : (pub == PUB_STREAM) ? count : {31'd0, nul};
     wire from_stream = (state == P_BODY) && (pub == PUB_STREAM);
     wire [7:0] len_byte = meta_out_len[8 * cnt[1:0] +: 8];
-    wire [7:0] cnt_byte = own_count[8 * cnt[1:0] +: 8];
+    // (a count not carried is n, loaded with own_count as P_COUNT starts: the byte comes from
+    // flip-flops, not from own_count's adder)
+    wire [7:0] cnt_byte = n[8 * cnt[1:0] +: 8];
     wire [7:0] seq_byte = seq[8 * cnt[1:0] +: 8];
 
     wire carried = (state == P_COUNT || state == P_BODY) && (pub == PUB_CARRY);
@@ -115,7 +121,7 @@ module rfl_gpublisher #(
             P_COUNT: other = cnt_byte;
             P_BODY: case (pub)
                 PUB_CONST:  // then a NUL (an if, not ?:, so that the ROM is looked up only here)
-                    if (cnt < {16'd0, klen}) other = konst(kaddr + cnt[15:0]);
+                    if (kleft != 16'd0) other = konst(kp);
                     else other = 8'd0;
                 PUB_COUNT: other = (cnt < 32'd4) ? seq_byte : 8'd0;
                 PUB_STREAM: other = s_tdata;
@@ -201,8 +207,19 @@ module rfl_gpublisher #(
             pad_ret <= P_IDLE;
             depth <= {DB{1'b0}};
             left <= {(32 * LOOPS){1'b0}};
+            kp <= 16'd0;
+            kleft <= 16'd0;
         end else begin
             if (put) cnt <= cnt + 32'd1;
+            if (state == P_BODY) begin  // (read, then written: a simulation copies neither)
+                if (put) begin
+                    if (kleft != 16'd0) kleft <= kleft - 16'd1;
+                    kp <= kp + 16'd1;
+                end
+            end else begin  // (a body starts with cnt 0)
+                kp <= kaddr;
+                kleft <= klen;
+            end
             if (put) opos <= opos + 32'd1;
             case (state)
                 P_IDLE: if (meta_valid) begin
@@ -303,6 +320,12 @@ module rfl_gpublisher #(
         assert(n_zero == (n == 32'd0));
         assert(last_b == (left_b == 35'd1));
         if (state == P_LEN || state == P_COUNT) assert(cnt < 32'd4);
+        if ((state == P_COUNT || (state == P_PAD && pad_ret == P_COUNT)) && pub != PUB_CARRY)
+            assert(n == own_count);
+        if (state == P_BODY)
+            assert(kp == kaddr + cnt[15:0]
+                   && (kleft == 16'd0
+                       || (cnt < {16'd0, klen} && kleft == klen - cnt[15:0])));
         for (fd = 0; fd < LOOPS; fd = fd + 1) assert(last_of[fd] == (left[32 * fd +: 32] == 32'd1));
     end
 `endif

@@ -117,6 +117,10 @@ module rfl_gsubscriber #(
     reg        streamed;                        // the stream went out (set as its body starts:
                                                 // every byte of it is taken before a decision)
     reg        released;                        // handed over early (STREAM_EARLY)
+    // SUB_CHECK's next byte in a body: its constant's address (kaddr + cnt) and the constant's
+    // bytes left (klen - cnt, 0 once past), counted with cnt so that the check starts from
+    // flip-flops, not from an adder and a 32-bit comparison (Fmax)
+    reg [15:0] kp, kleft;
     reg [31:0] out_len;
     // elements left of each open loop, 32 bits each (a vector, not a memory: Verilator keeps
     // a memory's every write site, the reset's one per entry, as work on every clock)
@@ -572,6 +576,8 @@ module rfl_gsubscriber #(
 `endif
             status_valid <= 1'b0;
             status <= SUB_OK;
+            kp <= 16'd0;
+            kleft <= 16'd0;
         end else begin
             status_valid <= 1'b0;
             if (meta_release) begin  // the second record moves up (hand_over may follow)
@@ -765,8 +771,8 @@ module rfl_gsubscriber #(
                     left_b <= left_b - 35'd1;
                     last_b <= (left_b == 35'd2);
                     if (nul && last_b) nul_bad <= (s_tdata != 8'd0);
-                    else if (cnt >= {16'd0, klen}) same <= 1'b0;
-                    else if (s_tdata != konst(kaddr + cnt[15:0])) same <= 1'b0;  // (the ROM
+                    else if (kleft == 16'd0) same <= 1'b0;
+                    else if (s_tdata != konst(kp)) same <= 1'b0;  // (the ROM
                     // looked up only for a byte that has a constant: not on every clock)
                     if (last_b) state <= S_FINISH;
                 end
@@ -800,6 +806,16 @@ module rfl_gsubscriber #(
                 end
                 default: state <= S_FLEN;
             endcase
+            // (after the walk's reads of kp and kleft above: a simulation copies neither)
+            if (state == S_BODY) begin
+                if (take) begin
+                    if (kleft != 16'd0) kleft <= kleft - 16'd1;
+                    kp <= kp + 16'd1;
+                end
+            end else begin  // (a body starts with cnt 0)
+                kp <= kaddr;
+                kleft <= klen;
+            end
         end
         // (w follows pc: w_nx and w_jp are the words of pc_nx and pc_jp)
         if (!rst_n || step != G_STAY) begin
@@ -812,6 +828,10 @@ module rfl_gsubscriber #(
     // the instruction register holds the word of pc (an invariant the proofs carry)
     always @(*) if (rst_n) assert(w == prog_word(pc));
     always @(*) if (rst_n) assert(last_b == (left_b == 35'd1));
+    always @(*) if (rst_n && state == S_BODY)
+        assert(kp == kaddr + cnt[15:0]
+               && (kleft == 16'd0
+                   || (cnt < {16'd0, klen} && kleft == klen - cnt[15:0])));
     always @(*) if (rst_n && !STREAM_EARLY) assert(!released);
     // a decision settles only in its own state, from 0 (each decision ends at 2 with 0)
     always @(*) if (rst_n)
