@@ -155,6 +155,7 @@ def test_rom_files_hold_the_image_and_its_table(tmp_path: Path) -> None:
     # LOCATOR_KIND_UDPv4 1, the default lease 100 s (8.5.3.1), the lab's cap 300 s
     assert index["rfl_fabric_top"] == {
         "SPDP_PORT": "9650", "META_PORT": "9662", "USER_PORT": "9663",
+        "COUNTERS_PORT": "9658",            # the counter readout's: the SPDP port + 8, unused by RTPS
         "SPDP_GROUP": "32'hefff0001", "SPDP_WRITER_ID": "32'h100c2",
         "SPDP_PIDS": "80'h710001000200310032", "SPDP_ENCAPS": "32'h20003",
         "SPDP_LOCATOR_KIND": "32'h1", "SPDP_LEASE_DEFAULT": "100", "SPDP_LEASE_MAX": "300"}

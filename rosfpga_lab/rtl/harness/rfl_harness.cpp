@@ -257,13 +257,15 @@ struct Sim {
                 rnd = xorshift(rnd);
                 nr = (rnd % 1000) >= bp;
             }
-            if (t->frame_start) frame_off = sub_bytes;
-            if (hs & 1) ++sub_bytes;
+            // as the testbench: a status comes a clock after its frame's deciding byte, when the
+            // next frame may already start (two records), so it is kept before frame_off moves on
             if (t->status_valid) {
                 statuses.emplace_back(frame_off, t->status);
                 ++frames;
                 if (t->status != 0) ++refused;
             }
+            if (t->frame_start) frame_off = sub_bytes;
+            if (hs & 1) ++sub_bytes;
             if (hs) {
                 if (Taps && hs != on) runs(hs);
                 if ((hs & 1) && !req_first) req_first = cycle;
