@@ -212,13 +212,13 @@ def test_answer_path_is_clean_under_three_linters(top: str, name: str, tmp_path:
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
     done = subprocess.run([require_iverilog(), "-g2005", "-Wall", f"-I{fabric}", "-s", top,
                            "-o", "m.vvp",
-                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), *sources],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and done.stdout + done.stderr == "", done.stdout + done.stderr
     require_yosys()
     sets = " ".join(f"-set {k} {v}" for k, v in params.items())
     (tmp_path / "check.ys").write_text(
-        f"read_verilog -defer -I{fabric} {source}\nchparam {sets} {top}\n"
+        f"read_verilog -defer -I{fabric} {' '.join(sources)}\nchparam {sets} {top}\n"
         f"hierarchy -check -top {top}\nproc\n"
         "select -assert-none t:$dlatch t:$adlatch t:$dlatchsr t:$sr\ncheck -assert\n")
     done = subprocess.run([*yosys_command(), "-q", "check.ys"], cwd=tmp_path,
@@ -313,7 +313,7 @@ def test_fabric_node_is_clean_under_verilator_and_icarus(tmp_path: Path) -> None
     assert done.returncode == 0 and "%Warning" not in done.stderr, done.stderr[-4000:]
     done = subprocess.run([require_iverilog(), "-g2005", "-Wall", "-s", top, "-o", "m.vvp",
                            f"-I{gen / 'rtl'}", f"-I{FABRIC_DIR}",
-                           *(f"-P{top}.{k}={v}" for k, v in params.items()), source],
+                           *(f"-P{top}.{k}={v}" for k, v in params.items()), *sources],
                           cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stdout + done.stderr
     for name in ("rfl_fabric_node.v", "rfl_frame_arbiter.v"):     # (its stages: their own cases)
