@@ -10,8 +10,9 @@ and its walkers' :class:`~rosfpga_lab.hls.program.Program`. The Python models ta
 (:meth:`Circuit.model`: :class:`~rosfpga_lab.hw.msgpipeline.MessagePipeline` on TCPROS,
 :class:`~rosfpga_lab.hw.cdrpipeline.CdrPipeline` on CDR), the HLS renderer its ``spec``, the
 component its model and its program's clocks (:meth:`Circuit.frame_clocks`, the generated
-circuit's, first byte in to last byte out). The RTL tools can take it in place of
-``spec_from_config`` (the same spec, derived once).
+circuit's, first byte in to last byte out; :meth:`Circuit.stream_clocks`, frames back to
+back). The RTL tools can take it in place of ``spec_from_config`` (the same spec, derived
+once).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from functools import cached_property
 
 from rosfpga_lab.config import NodeConfig
 from rosfpga_lab.hls.generic import GenericSpec, spec_from_layouts, stream_path
-from rosfpga_lab.hls.program import FrameClocks, Program, frame_clocks
+from rosfpga_lab.hls.program import FrameClocks, Program, frame_clocks, stream_clocks
 from rosfpga_lab.hw.cdrlayout import CdrLayout
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline
 from rosfpga_lab.hw.circuit import CircuitLayouts, ConfigCache, circuit_layouts
@@ -93,6 +94,18 @@ class Circuit:
             Refused: the circuit refuses the frame.
         """
         return frame_clocks(self.program, frame, latency=stream_path(self.spec))
+
+    def stream_clocks(self, frames: list[bytes]) -> list[int]:
+        """The generated circuit's clocks for ``frames`` back to back, no backpressure: for
+        each, from the first frame's first byte in to its own last byte out
+        (:func:`~rosfpga_lab.hls.program.stream_clocks`; the differences of consecutive ones
+        are the clocks a frame costs in steady state).
+
+        Raises:
+            GenerateError: as :attr:`spec`.
+            Refused: the circuit refuses a frame.
+        """
+        return stream_clocks(self.program, frames, latency=stream_path(self.spec))
 
     def model(self, model: str = "fast") -> MessagePipeline:
         """A fresh Python model of the TCPROS circuit (its own publisher count).

@@ -11,7 +11,7 @@ from rosfpga_lab.config import load_config
 from rosfpga_lab.hls.circuit import circuit_of
 from rosfpga_lab.hls.errors import GenerateError
 from rosfpga_lab.hls.generic import spec_from_config, stream_path
-from rosfpga_lab.hls.program import frame_clocks
+from rosfpga_lab.hls.program import frame_clocks, stream_clocks
 from rosfpga_lab.hls.vectors import sample_frames
 
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -30,6 +30,11 @@ def test_one_record_per_configuration_holds_the_spec_program_and_models(name: st
     spec = spec_from_config(config)
     assert circuit.frame_clocks(first) == frame_clocks(spec.program, first,
                                                        latency=stream_path(spec))
+    # back to back, with the stream's path too (notebook 05's frame rate): the first frame's
+    # clocks are its clocks alone
+    ends = circuit.stream_clocks([first] * 3)
+    assert ends == stream_clocks(spec.program, [first] * 3, latency=stream_path(spec))
+    assert ends[0] == circuit.frame_clocks(first).total
     if config.wire == "cdr":
         out = circuit.cdr_model().run_record(first).output_record
     else:
