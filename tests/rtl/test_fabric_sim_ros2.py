@@ -25,24 +25,22 @@ build per domain, address and sample bound; each cached after the first, some 15
 from __future__ import annotations
 
 import contextlib
-import gc
 import json
 import os
 import signal
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import cv2
 import numpy as np
 import pytest
 
 from rosfpga_lab.component.fabricsim import (
-    TAP_NAME, TAP_NODE_ADDRESS, fabric_peer_uri, fabric_tap_peer_uri, fastdds_peer_profile,
+    TAP_NAME, TAP_NODE_ADDRESS, fabric_tap_peer_uri, fastdds_peer_profile,
 )
 from rosfpga_lab.config import NodeConfig, load_config
 from rosfpga_lab.hw.cdrpipeline import CdrPipeline
@@ -53,7 +51,8 @@ from tests.support.generictools import window_oracle
 from tests.msg.test_typehash_realros2 import GOLDEN
 from tests.support.realros import ROS_PROGRAMS, require_ros2
 from tests.support.proctools import interruptible, kill_if_running, stop_with
-from tests.support.ros2tools import cyclone, image, qos, wait
+from tests.support.fabricpeer import CyclonePeer, fabric_cyclone
+from tests.support.ros2tools import image, wait
 from tests.support.realros import skip_or_fail
 from tests.support.rtltools import REQUIRE, require_fabric_sim
 from tests.support.wiretools import require_tshark
@@ -133,38 +132,10 @@ def _build(config: NodeConfig, domain: int = DOMAIN, *, address: str = "127.0.0.
     print(f"build {build.seconds:.1f} s (0: cached), {time.monotonic() - start:.1f} s")
 
 
-class _CyclonePeer:
-    """A Cyclone DDS participant of ``domain`` writing ``topic_in`` and reading ``topic_out`` of
-    ``kind`` with ROS 2's default QoS, matched with the fabric's node (``log``: the command's
-    stderr, for the failure's message); :meth:`close` says goodbye (the next test's peer is its
-    own)."""
-
-    def __init__(self, dds: Any, domain: int, topic_in: str, topic_out: str, kind: Any,
-                 log: Callable[[], str]) -> None:
-        self.log = log
-        self.dp = dds.DomainParticipant(domain)
-        self.writer = dds.DataWriter(self.dp, dds.Topic(self.dp, topic_in, kind), qos=qos(dds))
-        self.reader = dds.DataReader(self.dp, dds.Topic(self.dp, topic_out, kind), qos=qos(dds))
-        assert wait(lambda: self.writer.get_matched_subscriptions()
-                    and self.reader.get_matched_publications(), 15), log()
-
-    def take(self, n: int, timeout: float) -> list:
-        """``n`` samples from the reader, within ``timeout`` seconds."""
-        got: list = []
-        assert wait(lambda: got.extend(self.reader.take(10)) or len(got) >= n, timeout), \
-            (len(got), self.log())
-        return got
-
-    def close(self) -> None:
-        del self.writer, self.reader, self.dp
-        gc.collect()
-
-
 def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     require_fabric_sim()
-    dds = cyclone()
-    monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
+    dds = fabric_cyclone(monkeypatch)
     from tests.support import cdrtypes as T
 
     config = load_config(SCAN_CDR)
@@ -172,11 +143,9 @@ def test_cyclone_talks_to_the_simulated_fabric_and_gets_exact_scans(
     sent = _scans(T, SCANS)
     with _running_cli(tmp_path) as cli:
         t0 = time.monotonic()
-        peer = _CyclonePeer(dds, DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_, cli.log)
+        peer = CyclonePeer(dds, DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_, cli.log)
         matched = time.monotonic() - t0
-        for msg in sent:
-            peer.writer.write(msg)
-            time.sleep(0.3)
+        peer.send(sent, 0.3)
         got = peer.take(SCANS, 15)
         print(f"matched after {matched:.2f} s, {SCANS} scans back after "
               f"{time.monotonic() - t0:.2f} s")
@@ -216,18 +185,15 @@ def test_fabric_counters_reads_the_circuit_after_a_cyclone_exchange(
     path's, the RTPS stages'); the readout's own say one request answered. With nothing running
     on the port: a clear error, exit 1, within the timeout."""
     require_fabric_sim()
-    dds = cyclone()
-    monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
+    dds = fabric_cyclone(monkeypatch)
     from tests.support import cdrtypes as T
 
     config = load_config(SCAN_CDR)
     _build(config)
     sent = _scans(T, SCANS)
     with _running_cli(tmp_path) as cli:
-        peer = _CyclonePeer(dds, DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_, cli.log)
-        for msg in sent:
-            peer.writer.write(msg)
-            time.sleep(0.3)
+        peer = CyclonePeer(dds, DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_, cli.log)
+        peer.send(sent, 0.3)
         peer.take(SCANS, 15)
         read = _read_counters("127.0.0.1", DOMAIN)
         peer.close()
@@ -390,20 +356,18 @@ def test_cyclone_images_64x48_through_the_simulated_fabric_exact(
     """sensor_msgs/Image 64x48 rgba8 (12 kB: ten DATA_FRAG datagrams each way) through the
     fabric's dilation, exact against OpenCV's 3x3 dilation of what was sent."""
     require_fabric_sim()
-    dds = cyclone()
-    monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
+    dds = fabric_cyclone(monkeypatch)
     path = tmp_path / "fpga_dilate_64x48_cdr.yaml"
     path.write_text(IMAGE_CONFIG)
     _build(load_config(path), max_bytes=IMAGE_MAX_BYTES)
     rng = np.random.default_rng(31)
     pictures = [rng.integers(0, 256, (48, 64, 4), dtype=np.uint8) for _ in range(IMAGES)]
     with _running_cli(tmp_path, path, "--max-bytes", str(IMAGE_MAX_BYTES)) as cli:
-        peer = _CyclonePeer(dds, DOMAIN, "rt/image_raw", "rt/image_dilated", dds.Image_,
+        peer = CyclonePeer(dds, DOMAIN, "rt/image_raw", "rt/image_dilated", dds.Image_,
                             cli.log)
         t0 = time.monotonic()
-        for k, pic in enumerate(pictures):
-            peer.writer.write(image(dds, pic, "rgba8", sec=k, frame_id="cam"))
-            time.sleep(0.5)
+        peer.send((image(dds, pic, "rgba8", sec=k, frame_id="cam")
+                   for k, pic in enumerate(pictures)), 0.5)
         got = peer.take(IMAGES, 15)
         print(f"{IMAGES} images back after {time.monotonic() - t0:.2f} s")
         peer.close()
@@ -434,8 +398,7 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
     if reason:
         skip_or_fail(reason, REQUIRE)
     tshark = require_tshark()
-    dds = cyclone()
-    monkeypatch.setenv("CYCLONEDDS_URI", fabric_tap_peer_uri())
+    dds = fabric_cyclone(monkeypatch, fabric_tap_peer_uri())
     from tests.support import cdrtypes as T
 
     config = load_config(SCAN_CDR)
@@ -449,11 +412,9 @@ def test_cyclone_over_a_tap_interface_and_tshark_finds_nothing_malformed(
                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                                     preexec_fn=interruptible)
             assert wait(capture.exists, 10), "tshark did not start"
-            peer = _CyclonePeer(dds, TAP_DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_,
+            peer = CyclonePeer(dds, TAP_DOMAIN, "rt/scan", "rt/scan_min", T.LaserScan_,
                                 cli.log)
-            for msg in sent:
-                peer.writer.write(msg)
-                time.sleep(0.3)
+            peer.send(sent, 0.3)
             got = peer.take(SCANS, 15)
             read = _read_counters(TAP_NODE_ADDRESS, TAP_DOMAIN)    # over the TAP interface
             time.sleep(0.5)
@@ -490,13 +451,12 @@ def test_one_640x480_image_fragments_through_the_simulated_fabric_exact(
     DATA_FRAGs each way, stored whole in the circuit's buffer, --max-bytes) exact against
     OpenCV; the clock unthrottled (--rate 0). Some 10 s here, a first build some 45 s."""
     require_fabric_sim()
-    dds = cyclone()
-    monkeypatch.setenv("CYCLONEDDS_URI", fabric_peer_uri())
+    dds = fabric_cyclone(monkeypatch)
     _build(load_config(BIG_CONFIG), BIG_DOMAIN, max_bytes=BIG_MAX_BYTES)
     pic = np.random.default_rng(5).integers(0, 256, (480, 640, 4), dtype=np.uint8)
     with _running_cli(tmp_path, BIG_CONFIG, "--max-bytes", str(BIG_MAX_BYTES), "--rate", "0",
                       domain=BIG_DOMAIN) as cli:
-        peer = _CyclonePeer(dds, BIG_DOMAIN, "rt/image_raw", "rt/image_dilated", dds.Image_,
+        peer = CyclonePeer(dds, BIG_DOMAIN, "rt/image_raw", "rt/image_dilated", dds.Image_,
                             cli.log)
         t0 = time.monotonic()
         peer.writer.write(image(dds, pic, "rgba8", sec=1, frame_id="cam"))

@@ -161,15 +161,6 @@ def test_the_circuit_learns_its_peer_from_spdp_and_refuses_the_rest(tmp_path: Pa
 
 
 CYCLONE_DOMAIN = 227
-CAPTURE = """
-import gc, sys, time
-from cyclonedds.domain import DomainParticipant
-dp = DomainParticipant(int(sys.argv[1]))
-time.sleep(float(sys.argv[2]))
-del dp       # deleting the participant sends its goodbye
-gc.collect()
-time.sleep(1.0)
-"""
 
 
 def test_a_cyclone_dds_participants_spdp_and_goodbye_are_learned(tmp_path: Path) -> None:
@@ -181,25 +172,21 @@ def test_a_cyclone_dds_participants_spdp_and_goodbye_are_learned(tmp_path: Path)
     (``rtps.discovery.parse_parameters``, ``rtps.build.Locator.decode``); another participant
     (B) is refused while Cyclone's lives, and taken at once after Cyclone's own goodbye
     (its status info, read here with ``rtps.build``'s ids, disposed and unregistered)."""
-    import importlib.util
-    import os
     import socket
-    import subprocess
-    import sys
 
-    from rosfpga_lab.component.fabricsim import fabric_peer_uri
     from rosfpga_lab.rtps.discovery import PL_CDR_BE, PL_CDR_LE, parse_parameters
     from rosfpga_lab.rtps.entities import discovery_port
     from rosfpga_lab.rtps.message import Data, parse_message
-    from tests.support.realros import skip_or_fail as skip
+    from tests.support.fabricpeer import fabric_participant
 
-    if importlib.util.find_spec("cyclonedds") is None:
-        skip("cyclonedds not installed (pip install cyclonedds)", "ROSFPGA_REQUIRE_ROS2")
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.bind(("127.0.0.1", discovery_port(CYCLONE_DOMAIN, 0)))
     sock.settimeout(15)
-    env = dict(os.environ, CYCLONEDDS_URI=fabric_peer_uri(lease_seconds=7))
-    proc = subprocess.Popen([sys.executable, "-c", CAPTURE, str(CYCLONE_DOMAIN), "2"], env=env)
+    try:
+        proc = fabric_participant(CYCLONE_DOMAIN, 2, lease_seconds=7)
+    except BaseException:
+        sock.close()
+        raise
     announce: tuple[bytes, bytes, Data] | None = None
     bye = None
     try:

