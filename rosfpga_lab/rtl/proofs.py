@@ -157,7 +157,7 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_gsubscriber (formal_program without the exact fit: no early release, any input "
           "bytes): fields held unchanged until released, each frame handed over streamed "
           "exactly the array's 2 bytes, never more, accepted: the answer's length in range; "
-          "50 clocks", ("FV_WHOLE",), True),
+          "50 clocks", ("FV_WHOLE",), True, abc=True),
     Proof("gpublisher", ("rfl_gpublisher.v",), "prove", 4,
           "rfl_gpublisher (formal_program, fields held until released): output stream rules; "
           "all reachable states", ("FV_PROVE",), True),
@@ -366,12 +366,13 @@ def sby_command() -> list[str]:
 
 def bmc_engine(proof: Proof) -> str:
     """The ``[engines]`` line of ``proof``: ``abc bmc3`` for a bounded check marked ``abc``
-    where ``yosys-abc`` is found, else ``smtbmc yices``. Measured on the early depth-50
-    gsubscriber bmc (same model, depth and properties, both PASS), CPU seconds at a load of
-    about 16 on two cores: ABC's bmc3 129 s (77 s of it ABC, the rest Yosys building the model),
-    smtbmc with Yices more than 175 s by its 41st clock of 50 (425 s wall on an idle core); a
-    second record is never handed over in those 50 clocks, so the records' hand-over is the
-    induction's (tests/rtl/test_formal.py plants bugs in it)."""
+    where ``yosys-abc`` is found, else ``smtbmc yices``. Measured on the depth-50 gsubscriber
+    bmcs (same model, depth and properties, all PASS), CPU seconds at a load of 8 to 18 on two
+    cores: early release, ABC's bmc3 129 s (77 s of it ABC, the rest Yosys building the model),
+    smtbmc with Yices more than 175 s by its 41st clock of 50 (425 s wall on an idle core);
+    FV_WHOLE, ABC 71 s (15 s ABC), smtbmc 230 s. In the early one a second record is never
+    handed over in those 50 clocks, so the records' hand-over is the induction's
+    (tests/rtl/test_formal.py plants bugs in it)."""
     if proof.abc and proof.mode == "bmc" and find_tool("yosys-abc"):
         return "abc bmc3"
     return "smtbmc yices"
