@@ -369,7 +369,7 @@ def bmc_engine(proof: Proof) -> str:
     where ``yosys-abc`` is found, else ``smtbmc yices``. Measured on the depth-50 gsubscriber
     bmcs (same model, depth and properties, all PASS), CPU seconds at a load of 8 to 18 on two
     cores: early release, ABC's bmc3 129 s (77 s of it ABC, the rest Yosys building the model),
-    smtbmc with Yices more than 175 s by its 41st clock of 50 (425 s wall on an idle core);
+    smtbmc with Yices 490 s (425 s wall on an idle core);
     FV_WHOLE, ABC 71 s (15 s ABC), smtbmc 230 s. In the early one a second record is never
     handed over in those 50 clocks, so the records' hand-over is the induction's
     (tests/rtl/test_formal.py plants bugs in it)."""
