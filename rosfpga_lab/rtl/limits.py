@@ -25,8 +25,11 @@ VCD_MAX_HEADER_BYTES = 16 << 20
 VCD_MAX_SIGNAL_BITS = 1 << 16
 
 #: Seconds allowed for one formal check (SymbiYosys): the generated subscriber's depth-50 bounded
-#: check, the longest, takes some 425 s on an idle core since the subscriber keeps two frame
-#: records (82 s with one), and a loaded machine makes it half as long again.
+#: check, the longest, takes some 425 s on an idle core with smtbmc and Yices since the subscriber
+#: keeps two frame records (82 s with one), and a loaded machine makes it half as long again (at
+#: a load of 18 on two cores it reached this limit at its 41st clock of 50). Where ``yosys-abc``
+#: is found it runs on ABC's bmc3 (``proofs.bmc_engine``): 129 s of CPU (871 s wall) at a load
+#: of 16, where smtbmc took 490 s of CPU (2,071 s wall; the limit is per run of one check).
 FORMAL_TIMEOUT = 1200.0
 
 #: Largest request to the long-lived simulator of ``--model rtl`` (bytes).

@@ -11,8 +11,10 @@ an element packer that drops TLAST).
 from __future__ import annotations
 
 import dataclasses
+import os
 import re
 import struct
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
@@ -22,7 +24,7 @@ from pathlib import Path
 from rosfpga_lab.hls.program import frame_clocks
 from rosfpga_lab.rtl.generic import GENERIC_MODULES, GENERIC_VERILOG_DIR, LAYOUT_INCLUDE
 from rosfpga_lab.rtl.proofs import (
-    FABRIC_DIR, FABRIC_MODULES, FORMAL_DIR, PROOFS, Proof, ProofResult, design_path,
+    FABRIC_DIR, FABRIC_MODULES, FORMAL_DIR, PROOFS, Proof, ProofResult, bmc_engine, design_path,
     format_results, formal_layout, formal_program, prove,
     sby_text,
 )
@@ -63,11 +65,13 @@ def test_every_module_has_a_proof() -> None:
 @pytest.mark.timeout(1500)  # the proofs take some 450 s on two idle cores; a loaded machine more
 def test_every_proof_passes() -> None:
     """All checks, two at a time (the tools are single-threaded), the deepest bounded checks
-    started first: the gsubscriber bmc (depth 50: some 425 s on an idle core since the
-    subscriber keeps two frame records, 82 s with one; 146 s with FV_WHOLE) takes longer than
-    the other checks together, so started late it made the whole longer than its own time. With
-    streaming early release there are two (the early walk and FV_WHOLE's), started together on
-    the two workers. (The exhibit's seven checks run from ``tests/rtl/test_exhibit.py``.)"""
+    started first: the gsubscriber bmc (depth 50: with smtbmc and Yices some 425 s on an idle
+    core since the subscriber keeps two frame records, 82 s with one; 146 s with FV_WHOLE) took
+    longer than the other checks together, so started late it made the whole longer than its
+    own time; the early one runs on ABC's bmc3 where ``yosys-abc`` is found (see
+    :func:`rosfpga_lab.rtl.proofs.bmc_engine`). With streaming early release there are two (the
+    early walk and FV_WHOLE's), started together on the two workers. (The exhibit's seven
+    checks run from ``tests/rtl/test_exhibit.py``.)"""
     require_formal()
     first = sorted(PROOFS, key=lambda p: p.depth if p.mode == "bmc" else 0, reverse=True)
     with ThreadPoolExecutor(max_workers=2) as pool:
@@ -82,6 +86,50 @@ def test_every_proof_passes() -> None:
             assert "successful proof by k-induction" in r.log, r.proof
         else:
             assert f"depth {r.proof.depth}" in sby_text(r.proof, [])
+            # (smtbmc says "pass", ABC "PASS")
+            assert f"engine_0 ({bmc_engine(r.proof)}) returned pass" in r.log.lower(), r.proof
+
+
+def test_the_subscribers_bmcs_run_on_abc_where_found(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The two depth-50 gsubscriber bmcs (early release and FV_WHOLE) are ABC's bmc3 where
+    ``yosys-abc`` is found, smtbmc with Yices where not (same depth, same script); every other
+    check keeps smtbmc."""
+    from rosfpga_lab.rtl import proofs
+
+    deep = [p for p in PROOFS if p.name == "gsubscriber" and p.mode == "bmc"]
+    assert len(deep) == 2 and all(p.depth == 50 for p in deep)
+    for found in ("/usr/bin/yosys-abc", None):
+        monkeypatch.setattr(proofs, "find_tool", lambda name, f=found: f if name == "yosys-abc"
+                            else f"/bin/{name}")
+        engine = "abc bmc3" if found else "smtbmc yices"
+        for p in PROOFS:
+            text = sby_text(p, [])
+            assert f"[engines]\n{engine if p in deep else 'smtbmc yices'}\n" in text, p
+            assert f"mode {p.mode}\ndepth {p.depth}\n" in text
+        assert (["--abc", found] == proofs.sby_command()[-2:]) == bool(found)
+
+
+def test_a_check_past_its_time_leaves_no_tool_running(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch) -> None:
+    """A check that runs past FORMAL_TIMEOUT is an RtlError and takes SymbiYosys' tools with it
+    (Yosys, smtbmc, the solver: killing sby alone left them running to the end of the suite)."""
+    require_formal()
+    from rosfpga_lab.rtl import proofs
+    from rosfpga_lab.rtl.errors import RtlError
+
+    monkeypatch.setattr(proofs, "FORMAL_TIMEOUT", 4.0)
+    proof = next(p for p in PROOFS if p.name == "gsubscriber" and p.mode == "bmc")
+    with pytest.raises(RtlError, match="ran longer than 4 s"):
+        prove(proof, work_dir=tmp_path)
+    time.sleep(0.5)
+    left = []
+    for proc in Path("/proc").iterdir():
+        try:
+            if proc.name.isdigit() and str(tmp_path) in os.readlink(proc / "cwd"):
+                left.append((proc / "cmdline").read_bytes().replace(b"\0", b" ").decode())
+        except OSError:
+            pass
+    assert not left, left
 
 
 def test_a_planted_bug_fails_the_fifo_proof() -> None:
@@ -197,6 +245,60 @@ def test_planted_bugs_fail_the_generic_proofs(tmp_path: Path) -> None:
     result = failures(proof, name, buggy)
     assert any(line.startswith("assert(m_tlast == (idx % LINE == LINE - 1));")
                for line in failed_lines(proof, result)), result.failed
+
+
+@pytest.mark.parametrize("old,new", [
+    # a frame handed over in the clock its predecessor is released goes behind nothing
+    ("if (meta_valid && !meta_release) begin", "if (meta_valid) begin"),
+    # a release leaves the second record held: it would be handed to the publisher twice
+    ("nxt_valid <= 1'b0;\n`ifdef FORMAL\n                f_head <= f_nxt;",
+     "`ifdef FORMAL\n                f_head <= f_nxt;"),
+    # the second record moves up without its bank: the publisher reads the older frame's bytes
+    ("meta_bank <= nxt_bank;", "meta_bank <= meta_bank;"),
+])
+def test_planted_bugs_in_the_record_hand_over_fail_the_subscribers_induction(
+        tmp_path: Path, old: str, new: str) -> None:
+    """The two records' hand-over (a frame's record behind the held one, moved up on
+    meta_release) is proven by the gsubscriber's induction (all reachable states), not by its
+    bounded check: a second record is first handed over after some 90 clocks, past the bmc's 50
+    (the first at step 46). Each bug breaks a record invariant of rfl_gsubscriber.v's own
+    assertions (order, count, banks), so the induction does not pass (about 5 s each)."""
+    require_formal()
+    name = "rfl_gsubscriber.v"
+    text = (GENERIC_VERILOG_DIR / name).read_text()
+    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
+    buggy = tmp_path / name
+    buggy.write_text(text.replace(old, new))
+    proof = next(p for p in PROOFS if p.name == "gsubscriber" and p.mode == "prove")
+    result = prove(proof, replace={name: buggy})
+    assert result.status in ("FAIL", "UNKNOWN"), format_results([result])
+    lines = buggy.read_text().splitlines()
+    failed = [lines[int(f.split(":")[1].split(".")[0]) - 1].strip() for f in result.failed]
+    assert failed and all(f.startswith(f"{name}:") for f in result.failed), result.failed
+    records = ("assert(!nxt_valid || meta_valid)", "assert(f_in == f_out",
+               "if (meta_valid) assert(", "if (nxt_valid) assert(", "else assert(!meta_valid ||")
+    assert any(line.startswith(records) for line in failed), failed
+
+
+def test_a_planted_bug_fails_the_subscribers_early_bmc_with_its_assertion_named(
+        tmp_path: Path) -> None:
+    """A subscriber that reports a frame length too long with a code outside the table fails the
+    early bmc, with the wrapper's assertion named: where it runs on ABC (which names only the
+    clock), smtbmc locates it (rtl.proofs._located)."""
+    require_formal()
+    name = "rfl_gsubscriber.v"
+    buggy = plant(tmp_path, name, "wait for the next frame length.\n"
+                  "                            status_valid <= 1'b1;\n"
+                  "                            status <= SUB_BAD_FRAME_LENGTH;",
+                  "wait for the next frame length.\n"
+                  "                            status_valid <= 1'b1;\n"
+                  "                            status <= 8'd7;")
+    proof = next(p for p in PROOFS if p.name == "gsubscriber" and p.mode == "bmc"
+                 and not p.defines)
+    result = failures(proof, name, buggy)
+    assert "if (status_valid) assert(status <= 8'd4);           // a code of the table" in \
+        failed_lines(proof, result), result.failed
+    assert f"engine_0 ({bmc_engine(proof)}) returned fail" in result.log.lower()
 
 
 # -- rtl prove CONFIG: the stream rules on a configuration's own generated top ---------------------
