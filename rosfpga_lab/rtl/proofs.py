@@ -53,8 +53,9 @@ FABRIC_INCLUDES = ("rfl_fabric_node_params.vh", "rfl_fabric_node_pass.vh",
 RTPS_RX = ("rfl_rtps_walk.v", "rfl_rtps_rx.v")
 RTPS_CTRL = ("rfl_rtps_walk.v", "rfl_rtps_ctrl.v")
 SPDP_PEER = ("rfl_rtps_walk.v", "rfl_spdp_peer.v")
-#: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node aside:
-#: the project's; the proof's wrapper has its own).
+#: rfl_fabric_node's files: its stages, the arbiter, itself (the generated top rfl_node and
+#: the lab's rfl_slice aside: the generated project's, rtl.generic.LAB_MODULES; the proof's
+#: wrapper has its own rfl_node).
 FABRIC_NODE = (*RTPS_RX, "rfl_rtps_to_cdr.v", "rfl_rtps_tx.v", "rfl_rtps_ctrl.v",
                "rfl_rtps_disc_answer.v", "rfl_rtps_disc_rom.v", "rfl_frame_arbiter.v",
                "rfl_fabric_node.v")
@@ -267,14 +268,14 @@ PROOFS: tuple[Proof, ...] = (
           "destination held over an answer, an answer exactly 28 beats starting with the magic "
           "word and the count, bytes out at most the well-formed requests' bytes in, an answer "
           "at most every GAP clocks, always ready, counters never fall; all reachable states"),
-    Proof("fabric_node", FABRIC_NODE, "prove", 4,
+    Proof("fabric_node", ("rfl_slice.v", *FABRIC_NODE), "prove", 4,
           "rfl_fabric_node (every stage, small sizes, ROMs of any contents, any payloads in, "
           "the generated top a passthrough): output stream rules with TDEST and the prefix, "
-          "each beat in to the side of its packet's first-beat kind alone, metatraffic never "
-          "held back, answers' bytes out at most BURST + RATE x metatraffic bytes in, the "
+          "each beat in (past the input slice) to the side of its packet's first-beat kind "
+          "alone, metatraffic never held back there, answers' bytes out at most BURST + RATE x metatraffic bytes in, the "
           "arbiter's atomicity and wait bound and the stages' invariants in place; all "
           "reachable states", ("FV_PROVE",)),
-    Proof("fabric_node", FABRIC_NODE, "bmc", 24,
+    Proof("fabric_node", ("rfl_slice.v", *FABRIC_NODE), "bmc", 24,
           "rfl_fabric_node (as above): TDEST and the prefix constant inside a datagram; 24 "
           "clocks (SPDP datagrams of any length out, packets of both kinds in)"),
 )

@@ -97,11 +97,12 @@ def test_make_bitstream_meets_timing_at_liteeths_core_clock(built: tuple[Path, s
 
 @pytest.mark.timeout(1800)
 @pytest.mark.xfail(strict=True, reason=(
-    "issue 31: measured 2026-11-29 (seed 1, Yosys 0.70 and nextpnr-0.11.1 of yowasp): clk "
-    "75.2 MHz (its critical path the node's: rfl_rtps_ctrl into rfl_rtps_rx's queue and "
-    "state) and the PHY's rgmii_rx_clk 118.7 MHz (LiteEth's receive path: its CRC checker into "
-    "its FIFO) against 125 MHz; LiteEth's core eth_clk 55.4 of 52.1, met "
-    "(rtl/fabric/vendor/README.md, Timing)"))
+    "issue 31: measured 2026-11-29 (seed 1, Yosys 0.70 and nextpnr-0.11.1 of yowasp), with "
+    "rfl_fabric_node's register slices in: clk 70.0 MHz (its critical path the send side's "
+    "ready chain: rfl_udp_port's send queue through the node's arbiter and answer path into "
+    "rfl_rtps_tx's state; before the slices 75.2 MHz, the receive side's) and the PHY's "
+    "rgmii_rx_clk 114.6 MHz (LiteEth's receive path: into its CRC checker's FIFO) against "
+    "125 MHz; LiteEth's core eth_clk 58.3 of 52.1, met (rtl/fabric/vendor/README.md, Timing)"))
 def test_make_bitstream_meets_timing_at_125_mhz(built: tuple[Path, str, float]) -> None:
     _, stdout, _ = built
     short = _short(stdout, {"clk", "rgmii_rx_clk"})

@@ -1,4 +1,6 @@
 // rfl_fabric_node -- the ROS 2 node in the fabric behind one UDP payload interface (issue 31).
+// Timing: register slices (rfl_slice) on the way in and between rfl_rtps_rx and the seam cut
+// the combinational paths across modules (each a clock of latency, no byte changed).
 // In: UDP payloads, one datagram per packet (TLAST on its last byte), s_axis_tuser its kind as
 // rfl_udp_port's destination port tells it (1: the user-data port, 0: a metatraffic port; read
 // on a packet's first beat and held for the packet). User-data datagrams go through
@@ -62,19 +64,30 @@ module rfl_fabric_node #(
 `endif
     localparam [1:0] UDEST = USER_DEST[1:0];
 
+    // ---- a register slice in (rfl_slice; timing): the stages' input decode starts at its
+    // flip-flops, not at the top's port compare and rfl_udp_port's store, and s_axis_tready
+    // is a flip-flop, not rfl_rtps_rx's ready through the routing below (a clock of latency)
+    wire [7:0] i_tdata;
+    wire i_tvalid, i_tready, i_tlast, i_tuser;
+    rfl_slice #(.WIDTH(10)) u_in (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata({s_axis_tuser, s_axis_tlast, s_axis_tdata}), .s_tvalid(s_axis_tvalid),
+        .s_tready(s_axis_tready),
+        .m_tdata({i_tuser, i_tlast, i_tdata}), .m_tvalid(i_tvalid), .m_tready(i_tready));
+
     // ---- routing in: the kind of a packet is its first beat's TUSER
     reg in_pkt, in_kind;
-    wire kind = in_pkt ? in_kind : s_axis_tuser;
+    wire kind = in_pkt ? in_kind : i_tuser;
     wire rx_in_ready, ctrl_in_ready;
-    wire rx_in_valid = s_axis_tvalid && kind;
-    wire ctrl_in_valid = s_axis_tvalid && !kind;
-    assign s_axis_tready = kind ? rx_in_ready : ctrl_in_ready;
+    wire rx_in_valid = i_tvalid && kind;
+    wire ctrl_in_valid = i_tvalid && !kind;
+    assign i_tready = kind ? rx_in_ready : ctrl_in_ready;
     always @(posedge clk) begin
         if (!rst_n) begin
             in_pkt <= 1'b0;
             in_kind <= 1'b0;
-        end else if (s_axis_tvalid && s_axis_tready) begin
-            in_pkt <= !s_axis_tlast;
+        end else if (i_tvalid && i_tready) begin
+            in_pkt <= !i_tlast;
             in_kind <= kind;
         end
     end
@@ -95,19 +108,27 @@ module rfl_fabric_node #(
     /* verilator lint_on UNUSEDSIGNAL */
     rfl_rtps_rx u_rx (
         .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .cfg_reader(cfg_reader),
-        .cfg_writer(cfg_writer), .s_axis_tdata(s_axis_tdata),
+        .cfg_writer(cfg_writer), .s_axis_tdata(i_tdata),
         .s_axis_tvalid(rx_in_valid), .s_axis_tready(rx_in_ready),
-        .s_axis_tlast(s_axis_tlast),
+        .s_axis_tlast(i_tlast),
         .m_axis_tdata(rx_tdata), .m_axis_tvalid(rx_tvalid), .m_axis_tready(rx_tready),
         .m_axis_tlast(rx_tlast), .m_axis_tuser(rx_tuser), .m_sample_guid(guid),
         .m_sample_seq(seq), .m_sample_ts(ts), .m_sample_ts_valid(ts_valid),
         .cnt_packets(cnt_packets), .cnt_bad_header(cnt_bad_header),
         .cnt_malformed(cnt_malformed), .cnt_samples(cnt_rx_samples),
         .cnt_dropped(cnt_rx_dropped), .cnt_repeated(cnt_rx_repeated));
+    // a register slice (timing): the seam's ready (its ring's fill compare) does not reach
+    // rfl_rtps_rx's take, nor its output rfl_rtps_rx's input
+    wire [7:0] rs_tdata;
+    wire rs_tvalid, rs_tready, rs_tlast, rs_tuser;
+    rfl_slice #(.WIDTH(10)) u_rx_out (
+        .clk(clk), .rst_n(rst_n),
+        .s_tdata({rx_tuser, rx_tlast, rx_tdata}), .s_tvalid(rx_tvalid), .s_tready(rx_tready),
+        .m_tdata({rs_tuser, rs_tlast, rs_tdata}), .m_tvalid(rs_tvalid), .m_tready(rs_tready));
     rfl_rtps_to_cdr #(.MAX_BYTES(MAX_BYTES)) u_seam (
         .clk(clk), .rst_n(rst_n),
-        .s_axis_tdata(rx_tdata), .s_axis_tvalid(rx_tvalid), .s_axis_tready(rx_tready),
-        .s_axis_tlast(rx_tlast), .s_axis_tuser(rx_tuser),
+        .s_axis_tdata(rs_tdata), .s_axis_tvalid(rs_tvalid), .s_axis_tready(rs_tready),
+        .s_axis_tlast(rs_tlast), .s_axis_tuser(rs_tuser),
         .m_tdata(rec_tdata), .m_tvalid(rec_tvalid), .m_tready(rec_tready),
         .cnt_samples(cnt_seam_samples), .cnt_dropped(cnt_seam_dropped),
         .cnt_too_long(cnt_too_long));
@@ -136,9 +157,9 @@ module rfl_fabric_node #(
     wire [95:0] an_prefix;
     rfl_rtps_ctrl #(.SLOTS(SLOTS), .SLOT_IDS(SLOT_IDS), .SLOT_MSGS(SLOT_MSGS),
                     .SLOT_LASTS(SLOT_LASTS)) u_ctrl (
-        .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .s_axis_tdata(s_axis_tdata),
+        .clk(clk), .rst_n(rst_n), .cfg_prefix(GUID_PREFIX), .s_axis_tdata(i_tdata),
         .s_axis_tvalid(ctrl_in_valid), .s_axis_tready(ctrl_in_ready),
-        .s_axis_tlast(s_axis_tlast), .m_axis_tdata(req_tdata), .m_axis_tvalid(req_tvalid),
+        .s_axis_tlast(i_tlast), .m_axis_tdata(req_tdata), .m_axis_tvalid(req_tvalid),
         .m_axis_tready(req_tready), .rx_byte(rx_byte), .cnt_requests(cnt_requests),
         .cnt_busy(cnt_busy), .cnt_malformed(cnt_ctrl_malformed),
         .cnt_bad_header(cnt_ctrl_bad_header));
@@ -176,10 +197,10 @@ module rfl_fabric_node #(
         .m_axis_tdest(m_axis_tdest), .m_axis_tuser(m_dst_prefix));
 
 `ifdef FORMAL
-    // The routing in, on the ports (fv_fabric_node proves it): f_pkt, a packet's beat taken and
-    // not yet its TLAST; f_kind, the TUSER of its first beat. Each beat is offered to the side
-    // of its packet's kind alone, taken when that side is ready; metatraffic is never held back
-    // (rfl_rtps_ctrl is always ready). The latch agrees with f_pkt, f_kind (the invariant).
+    // The routing in, on the input slice's output (fv_fabric_node proves it): f_pkt, a packet's
+    // beat taken and not yet its TLAST; f_kind, the TUSER of its first beat. Each beat is offered
+    // to the side of its packet's kind alone, taken when that side is ready; metatraffic is
+    // never held back there (rfl_rtps_ctrl is always ready). The latch agrees with f_pkt, f_kind (the invariant).
     // The answers' credit is earned by each metatraffic byte taken and by nothing else: with
     // rfl_rtps_disc_answer's bound (its FORMAL block, in place), the answers' bytes out are never
     // more than BURST + RATE x the metatraffic bytes in.
@@ -188,20 +209,20 @@ module rfl_fabric_node #(
         if (!rst_n) begin
             f_pkt <= 1'b0;
             f_kind <= 1'b0;
-        end else if (s_axis_tvalid && s_axis_tready) begin
-            if (!f_pkt) f_kind <= s_axis_tuser;
-            f_pkt <= !s_axis_tlast;
+        end else if (i_tvalid && i_tready) begin
+            if (!f_pkt) f_kind <= i_tuser;
+            f_pkt <= !i_tlast;
         end
     end
-    wire f_k = f_pkt ? f_kind : s_axis_tuser;
+    wire f_k = f_pkt ? f_kind : i_tuser;
     always @(*) if (rst_n) begin
-        assert(rx_in_valid == (s_axis_tvalid && f_k));
-        assert(ctrl_in_valid == (s_axis_tvalid && !f_k));
-        assert(s_axis_tready == (f_k ? rx_in_ready : ctrl_in_ready));
-        if (s_axis_tvalid && !f_k) assert(s_axis_tready);
+        assert(rx_in_valid == (i_tvalid && f_k));
+        assert(ctrl_in_valid == (i_tvalid && !f_k));
+        assert(i_tready == (f_k ? rx_in_ready : ctrl_in_ready));
+        if (i_tvalid && !f_k) assert(i_tready);
         assert(in_pkt == f_pkt);
         if (f_pkt) assert(in_kind == f_kind);
-        assert(rx_byte == (s_axis_tvalid && s_axis_tready && !f_k));
+        assert(rx_byte == (i_tvalid && i_tready && !f_k));
     end
 `endif
 endmodule
