@@ -386,13 +386,17 @@ class PortUDP(LiteXModule):
         # core's critical path
         self.rx_buffer = renamed(stream.Buffer(narrow, pipe_valid=True, pipe_ready=True))
         self.tx_buffer = renamed(stream.Buffer(narrow, pipe_valid=True, pipe_ready=True))
+        # and between the UDP receiver and the crossbar: its FSM's outputs went through the
+        # crossbar's port select into the lab port's input register (clk's critical path)
+        self.rx_out = renamed(stream.Buffer(eth_udp_user_description(8), pipe_valid=True))
         self.comb += [
             ip_port.source.connect(self.rx_cdc.sink),
             self.rx_cdc.source.connect(self.rx_converter.sink),
             self.rx_converter.source.connect(self.rx_trim.sink),
             self.rx_trim.source.connect(self.rx_buffer.sink),
             self.rx_buffer.source.connect(self.rx.sink),
-            self.rx.source.connect(self.crossbar.master.sink),
+            self.rx.source.connect(self.rx_out.sink),
+            self.rx_out.source.connect(self.crossbar.master.sink),
             self.crossbar.master.source.connect(self.tx.sink),
             self.tx.source.connect(self.tx_buffer.sink),
             self.tx_buffer.source.connect(self.tx_converter.sink),
@@ -463,7 +467,8 @@ class UDPPortCore(SoCMini):
             with_icmp=bool(cfg.get("with_icmp", True)),
             with_ip_broadcast=take_group,
             with_sys_datapath=bool(cfg.get("with_sys_datapath", False)),
-            tx_cdc_depth=int(cfg.get("tx_cdc_depth", 32)), tx_cdc_buffered=False,
+            tx_cdc_depth=int(cfg.get("tx_cdc_depth", 32)),
+            tx_cdc_buffered=bool(cfg.get("tx_cdc_buffered", False)),
             rx_cdc_depth=int(cfg.get("rx_cdc_depth", 32)), rx_cdc_buffered=False)
         # LiteEth's send path on the PHY's clock: its FIFO's read side, the 32-to-8 converter,
         # padding, CRC, preamble, gap: one combinational ready chain from the CRC back to the

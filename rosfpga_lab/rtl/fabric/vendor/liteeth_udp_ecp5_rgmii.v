@@ -91,9 +91,10 @@ UDPPortCore
 │    │    │    └─── tx_datapath (TXDatapath)
 │    │    │    │    └─── clockdomaincrossing_0* (ClockDomainCrossing)
 │    │    │    │    │    └─── asyncfifo_0* (AsyncFIFO)
-│    │    │    │    │    │    └─── fifo (AsyncFIFO)
-│    │    │    │    │    │    │    └─── graycounter_0* (GrayCounter)
-│    │    │    │    │    │    │    └─── graycounter_1* (GrayCounter)
+│    │    │    │    │    │    └─── fifo (AsyncFIFOBuffered)
+│    │    │    │    │    │    │    └─── fifo (AsyncFIFO)
+│    │    │    │    │    │    │    │    └─── graycounter_0* (GrayCounter)
+│    │    │    │    │    │    │    │    └─── graycounter_1* (GrayCounter)
 │    │    │    │    └─── strideconverter_0* (StrideConverter)
 │    │    │    │    │    └─── converter_0* (Converter)
 │    │    │    │    │    │    └─── _downconverter_0* (_DownConverter)
@@ -267,6 +268,9 @@ UDPPortCore
 │    │    │    └─── pipe_valid (PipeValid)
 │    │    │    └─── pipe_ready (PipeReady)
 │    │    │    └─── pipeline (Pipeline)
+│    │    └─── rx_out (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipeline (Pipeline)
 └─── rx_drop_header_core (PulseMerge)
 └─── rx_drop_header_cdc (PulseSynchronizer)
 └─── rx_drop_header_port (PulseMerge)
@@ -284,21 +288,21 @@ UDPPortCore
 │    │    └─── csrstorage_0* (CSRStorage)
 │    │    └─── csrstatus_0* (CSRStatus)
 └─── csr_interconnect (InterconnectShared)
-└─── [IDDRX1F]
+└─── [ODDRX1F]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
 └─── [FD1S3BX]
 └─── [FD1S3BX]
 └─── [ODDRX1F]
 └─── [ODDRX1F]
 └─── [ODDRX1F]
 └─── [ODDRX1F]
-└─── [IDDRX1F]
 └─── [ODDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
-└─── [ODDRX1F]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
+└─── [IDDRX1F]
+└─── [IDDRX1F]
 * : Generated name.
 []: BlackBox.
 */
@@ -763,6 +767,50 @@ wire          buffer1_source_source_ready0;
 wire          buffer1_source_source_ready1;
 wire          buffer1_source_source_valid0;
 wire          buffer1_source_source_valid1;
+wire          buffer2_pipe_valid_sink_first;
+wire          buffer2_pipe_valid_sink_last;
+wire   [15:0] buffer2_pipe_valid_sink_param_dst_port;
+wire   [31:0] buffer2_pipe_valid_sink_param_ip_address;
+wire   [15:0] buffer2_pipe_valid_sink_param_length;
+wire   [15:0] buffer2_pipe_valid_sink_param_src_port;
+wire    [7:0] buffer2_pipe_valid_sink_payload_data;
+wire          buffer2_pipe_valid_sink_payload_error;
+wire          buffer2_pipe_valid_sink_payload_last_be;
+wire          buffer2_pipe_valid_sink_ready;
+wire          buffer2_pipe_valid_sink_valid;
+reg           buffer2_pipe_valid_source_first = 1'd0;
+reg           buffer2_pipe_valid_source_last = 1'd0;
+reg    [15:0] buffer2_pipe_valid_source_param_dst_port = 16'd0;
+reg    [31:0] buffer2_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] buffer2_pipe_valid_source_param_length = 16'd0;
+reg    [15:0] buffer2_pipe_valid_source_param_src_port = 16'd0;
+reg     [7:0] buffer2_pipe_valid_source_payload_data = 8'd0;
+reg           buffer2_pipe_valid_source_payload_error = 1'd0;
+reg           buffer2_pipe_valid_source_payload_last_be = 1'd0;
+wire          buffer2_pipe_valid_source_ready;
+reg           buffer2_pipe_valid_source_valid = 1'd0;
+wire          buffer2_sink_sink_first;
+wire          buffer2_sink_sink_last;
+wire   [15:0] buffer2_sink_sink_param_dst_port;
+wire   [31:0] buffer2_sink_sink_param_ip_address;
+wire   [15:0] buffer2_sink_sink_param_length;
+wire   [15:0] buffer2_sink_sink_param_src_port;
+wire    [7:0] buffer2_sink_sink_payload_data;
+wire          buffer2_sink_sink_payload_error;
+wire          buffer2_sink_sink_payload_last_be;
+wire          buffer2_sink_sink_ready;
+wire          buffer2_sink_sink_valid;
+wire          buffer2_source_source_first;
+wire          buffer2_source_source_last;
+wire   [15:0] buffer2_source_source_param_dst_port;
+wire   [31:0] buffer2_source_source_param_ip_address;
+wire   [15:0] buffer2_source_source_param_length;
+wire   [15:0] buffer2_source_source_param_src_port;
+wire    [7:0] buffer2_source_source_payload_data;
+wire          buffer2_source_source_payload_error;
+wire          buffer2_source_source_payload_last_be;
+wire          buffer2_source_source_ready;
+wire          buffer2_source_source_valid;
 wire   [39:0] cases_slice_proxy;
 wire   [31:0] csrbank0_bus_errors_r;
 reg           csrbank0_bus_errors_re = 1'd0;
@@ -2064,6 +2112,7 @@ wire          mac_core_tx_cdc_cdc_asyncfifo_readable;
 wire          mac_core_tx_cdc_cdc_asyncfifo_we;
 wire          mac_core_tx_cdc_cdc_asyncfifo_writable;
 wire    [5:0] mac_core_tx_cdc_cdc_consume_wdomain;
+reg    [41:0] mac_core_tx_cdc_cdc_dout = 42'd0;
 wire          mac_core_tx_cdc_cdc_fifo_in_first;
 wire          mac_core_tx_cdc_cdc_fifo_in_last;
 wire   [31:0] mac_core_tx_cdc_cdc_fifo_in_payload_data;
@@ -2087,6 +2136,8 @@ reg     [5:0] mac_core_tx_cdc_cdc_graycounter1_q_next_binary = 6'd0;
 wire    [5:0] mac_core_tx_cdc_cdc_produce_rdomain;
 wire    [4:0] mac_core_tx_cdc_cdc_rdport_adr;
 wire   [41:0] mac_core_tx_cdc_cdc_rdport_dat_r;
+wire          mac_core_tx_cdc_cdc_re;
+reg           mac_core_tx_cdc_cdc_readable = 1'd0;
 wire          mac_core_tx_cdc_cdc_sink_first;
 wire          mac_core_tx_cdc_cdc_sink_last;
 wire   [31:0] mac_core_tx_cdc_cdc_sink_payload_data;
@@ -3076,7 +3127,7 @@ assign mac_core_tx_cdc_source_source_payload_data = mac_core_tx_cdc_cdc_source_p
 assign mac_core_tx_cdc_source_source_payload_last_be = mac_core_tx_cdc_cdc_source_payload_last_be;
 assign mac_core_tx_cdc_source_source_payload_error = mac_core_tx_cdc_cdc_source_payload_error;
 assign mac_core_tx_cdc_cdc_asyncfifo_din = {mac_core_tx_cdc_cdc_fifo_in_last, mac_core_tx_cdc_cdc_fifo_in_first, mac_core_tx_cdc_cdc_fifo_in_payload_error, mac_core_tx_cdc_cdc_fifo_in_payload_last_be, mac_core_tx_cdc_cdc_fifo_in_payload_data};
-assign {mac_core_tx_cdc_cdc_fifo_out_last, mac_core_tx_cdc_cdc_fifo_out_first, mac_core_tx_cdc_cdc_fifo_out_payload_error, mac_core_tx_cdc_cdc_fifo_out_payload_last_be, mac_core_tx_cdc_cdc_fifo_out_payload_data} = mac_core_tx_cdc_cdc_asyncfifo_dout;
+assign {mac_core_tx_cdc_cdc_fifo_out_last, mac_core_tx_cdc_cdc_fifo_out_first, mac_core_tx_cdc_cdc_fifo_out_payload_error, mac_core_tx_cdc_cdc_fifo_out_payload_last_be, mac_core_tx_cdc_cdc_fifo_out_payload_data} = mac_core_tx_cdc_cdc_dout;
 assign mac_core_tx_cdc_cdc_sink_ready = mac_core_tx_cdc_cdc_asyncfifo_writable;
 assign mac_core_tx_cdc_cdc_asyncfifo_we = mac_core_tx_cdc_cdc_sink_valid;
 assign mac_core_tx_cdc_cdc_fifo_in_first = mac_core_tx_cdc_cdc_sink_first;
@@ -3084,13 +3135,14 @@ assign mac_core_tx_cdc_cdc_fifo_in_last = mac_core_tx_cdc_cdc_sink_last;
 assign mac_core_tx_cdc_cdc_fifo_in_payload_data = mac_core_tx_cdc_cdc_sink_payload_data;
 assign mac_core_tx_cdc_cdc_fifo_in_payload_last_be = mac_core_tx_cdc_cdc_sink_payload_last_be;
 assign mac_core_tx_cdc_cdc_fifo_in_payload_error = mac_core_tx_cdc_cdc_sink_payload_error;
-assign mac_core_tx_cdc_cdc_source_valid = mac_core_tx_cdc_cdc_asyncfifo_readable;
+assign mac_core_tx_cdc_cdc_source_valid = mac_core_tx_cdc_cdc_readable;
 assign mac_core_tx_cdc_cdc_source_first = mac_core_tx_cdc_cdc_fifo_out_first;
 assign mac_core_tx_cdc_cdc_source_last = mac_core_tx_cdc_cdc_fifo_out_last;
 assign mac_core_tx_cdc_cdc_source_payload_data = mac_core_tx_cdc_cdc_fifo_out_payload_data;
 assign mac_core_tx_cdc_cdc_source_payload_last_be = mac_core_tx_cdc_cdc_fifo_out_payload_last_be;
 assign mac_core_tx_cdc_cdc_source_payload_error = mac_core_tx_cdc_cdc_fifo_out_payload_error;
-assign mac_core_tx_cdc_cdc_asyncfifo_re = mac_core_tx_cdc_cdc_source_ready;
+assign mac_core_tx_cdc_cdc_re = mac_core_tx_cdc_cdc_source_ready;
+assign mac_core_tx_cdc_cdc_asyncfifo_re = (mac_core_tx_cdc_cdc_re | (~mac_core_tx_cdc_cdc_readable));
 assign mac_core_tx_cdc_cdc_graycounter0_ce = (mac_core_tx_cdc_cdc_asyncfifo_writable & mac_core_tx_cdc_cdc_asyncfifo_we);
 assign mac_core_tx_cdc_cdc_graycounter1_ce = (mac_core_tx_cdc_cdc_asyncfifo_readable & mac_core_tx_cdc_cdc_asyncfifo_re);
 assign mac_core_tx_cdc_cdc_asyncfifo_writable = (((mac_core_tx_cdc_cdc_graycounter0_q[5] == mac_core_tx_cdc_cdc_consume_wdomain[5]) | (mac_core_tx_cdc_cdc_graycounter0_q[4] == mac_core_tx_cdc_cdc_consume_wdomain[4])) | (mac_core_tx_cdc_cdc_graycounter0_q[3:0] != mac_core_tx_cdc_cdc_consume_wdomain[3:0]));
@@ -6436,17 +6488,28 @@ assign holdingudprx_sink_payload_error = buffer0_source_source_payload_error1;
 assign holdingudprx_sink_param_length = buffer0_source_source_param_length;
 assign holdingudprx_sink_param_protocol = buffer0_source_source_param_protocol;
 assign holdingudprx_sink_param_ip_address = buffer0_source_source_param_ip_address;
-assign maskedudpcrossbar_sink_valid = holdingudprx_source_valid;
-assign holdingudprx_source_ready = maskedudpcrossbar_sink_ready;
-assign maskedudpcrossbar_sink_first = holdingudprx_source_first;
-assign maskedudpcrossbar_sink_last = holdingudprx_source_last;
-assign maskedudpcrossbar_sink_payload_data = holdingudprx_source_payload_data;
-assign maskedudpcrossbar_sink_payload_last_be = holdingudprx_source_payload_last_be;
-assign maskedudpcrossbar_sink_payload_error = holdingudprx_source_payload_error;
-assign maskedudpcrossbar_sink_param_src_port = holdingudprx_source_param_src_port;
-assign maskedudpcrossbar_sink_param_dst_port = holdingudprx_source_param_dst_port;
-assign maskedudpcrossbar_sink_param_ip_address = holdingudprx_source_param_ip_address;
-assign maskedudpcrossbar_sink_param_length = holdingudprx_source_param_length;
+assign buffer2_sink_sink_valid = holdingudprx_source_valid;
+assign holdingudprx_source_ready = buffer2_sink_sink_ready;
+assign buffer2_sink_sink_first = holdingudprx_source_first;
+assign buffer2_sink_sink_last = holdingudprx_source_last;
+assign buffer2_sink_sink_payload_data = holdingudprx_source_payload_data;
+assign buffer2_sink_sink_payload_last_be = holdingudprx_source_payload_last_be;
+assign buffer2_sink_sink_payload_error = holdingudprx_source_payload_error;
+assign buffer2_sink_sink_param_src_port = holdingudprx_source_param_src_port;
+assign buffer2_sink_sink_param_dst_port = holdingudprx_source_param_dst_port;
+assign buffer2_sink_sink_param_ip_address = holdingudprx_source_param_ip_address;
+assign buffer2_sink_sink_param_length = holdingudprx_source_param_length;
+assign maskedudpcrossbar_sink_valid = buffer2_source_source_valid;
+assign buffer2_source_source_ready = maskedudpcrossbar_sink_ready;
+assign maskedudpcrossbar_sink_first = buffer2_source_source_first;
+assign maskedudpcrossbar_sink_last = buffer2_source_source_last;
+assign maskedudpcrossbar_sink_payload_data = buffer2_source_source_payload_data;
+assign maskedudpcrossbar_sink_payload_last_be = buffer2_source_source_payload_last_be;
+assign maskedudpcrossbar_sink_payload_error = buffer2_source_source_payload_error;
+assign maskedudpcrossbar_sink_param_src_port = buffer2_source_source_param_src_port;
+assign maskedudpcrossbar_sink_param_dst_port = buffer2_source_source_param_dst_port;
+assign maskedudpcrossbar_sink_param_ip_address = buffer2_source_source_param_ip_address;
+assign maskedudpcrossbar_sink_param_length = buffer2_source_source_param_length;
 assign liteethudptx_sink_sink_valid = maskedudpcrossbar_source_valid;
 assign maskedudpcrossbar_source_ready = liteethudptx_sink_sink_ready;
 assign liteethudptx_sink_sink_first = maskedudpcrossbar_source_first;
@@ -7592,6 +7655,29 @@ assign buffer1_source_source_payload_error1 = buffer1_pipe_ready_source_payload_
 assign buffer1_source_source_param_length = buffer1_pipe_ready_source_param_length;
 assign buffer1_source_source_param_protocol = buffer1_pipe_ready_source_param_protocol;
 assign buffer1_source_source_param_ip_address = buffer1_pipe_ready_source_param_ip_address;
+assign buffer2_pipe_valid_sink_ready = ((~buffer2_pipe_valid_source_valid) | buffer2_pipe_valid_source_ready);
+assign buffer2_pipe_valid_sink_valid = buffer2_sink_sink_valid;
+assign buffer2_sink_sink_ready = buffer2_pipe_valid_sink_ready;
+assign buffer2_pipe_valid_sink_first = buffer2_sink_sink_first;
+assign buffer2_pipe_valid_sink_last = buffer2_sink_sink_last;
+assign buffer2_pipe_valid_sink_payload_data = buffer2_sink_sink_payload_data;
+assign buffer2_pipe_valid_sink_payload_last_be = buffer2_sink_sink_payload_last_be;
+assign buffer2_pipe_valid_sink_payload_error = buffer2_sink_sink_payload_error;
+assign buffer2_pipe_valid_sink_param_src_port = buffer2_sink_sink_param_src_port;
+assign buffer2_pipe_valid_sink_param_dst_port = buffer2_sink_sink_param_dst_port;
+assign buffer2_pipe_valid_sink_param_ip_address = buffer2_sink_sink_param_ip_address;
+assign buffer2_pipe_valid_sink_param_length = buffer2_sink_sink_param_length;
+assign buffer2_source_source_valid = buffer2_pipe_valid_source_valid;
+assign buffer2_pipe_valid_source_ready = buffer2_source_source_ready;
+assign buffer2_source_source_first = buffer2_pipe_valid_source_first;
+assign buffer2_source_source_last = buffer2_pipe_valid_source_last;
+assign buffer2_source_source_payload_data = buffer2_pipe_valid_source_payload_data;
+assign buffer2_source_source_payload_last_be = buffer2_pipe_valid_source_payload_last_be;
+assign buffer2_source_source_payload_error = buffer2_pipe_valid_source_payload_error;
+assign buffer2_source_source_param_src_port = buffer2_pipe_valid_source_param_src_port;
+assign buffer2_source_source_param_dst_port = buffer2_pipe_valid_source_param_dst_port;
+assign buffer2_source_source_param_ip_address = buffer2_pipe_valid_source_param_ip_address;
+assign buffer2_source_source_param_length = buffer2_pipe_valid_source_param_length;
 assign pulsemerge0_total0 = ((((1'd0 + mac_cut) + ip_rx_cut) + ip_rx_drop_header) + pulsemerge0_backlog0);
 assign pulsemerge0_o0 = (pulsemerge0_total0 != 1'd0);
 assign pulsesynchronizer0_o = (pulsesynchronizer0_toggle_o ^ pulsesynchronizer0_toggle_o_r);
@@ -7962,6 +8048,10 @@ always @(posedge eth_rx_clk) begin
 end
 
 always @(posedge eth_tx_clk) begin
+    if ((mac_core_tx_cdc_cdc_re | (~mac_core_tx_cdc_cdc_readable))) begin
+        mac_core_tx_cdc_cdc_dout <= mac_core_tx_cdc_cdc_asyncfifo_dout;
+        mac_core_tx_cdc_cdc_readable <= mac_core_tx_cdc_cdc_asyncfifo_readable;
+    end
     mac_core_tx_cdc_cdc_graycounter1_q_binary <= mac_core_tx_cdc_cdc_graycounter1_q_next_binary;
     mac_core_tx_cdc_cdc_graycounter1_q <= mac_core_tx_cdc_cdc_graycounter1_q_next;
     if ((mac_core_tx_converter_converter_source_valid & mac_core_tx_converter_converter_source_ready)) begin
@@ -8037,6 +8127,7 @@ always @(posedge eth_tx_clk) begin
         buffer0_pipe_ready_sink_d_payload_error0 <= buffer0_pipe_ready_sink_payload_error0;
     end
     if (eth_tx_rst) begin
+        mac_core_tx_cdc_cdc_readable <= 1'd0;
         mac_core_tx_cdc_cdc_graycounter1_q <= 6'd0;
         mac_core_tx_cdc_cdc_graycounter1_q_binary <= 6'd0;
         mac_core_tx_converter_converter_mux <= 2'd0;
@@ -8269,6 +8360,18 @@ always @(posedge port_clk) begin
         buffer1_pipe_ready_sink_d_param_protocol <= buffer1_pipe_ready_sink_param_protocol;
         buffer1_pipe_ready_sink_d_param_ip_address <= buffer1_pipe_ready_sink_param_ip_address;
     end
+    if (((~buffer2_pipe_valid_source_valid) | buffer2_pipe_valid_source_ready)) begin
+        buffer2_pipe_valid_source_valid <= buffer2_pipe_valid_sink_valid;
+        buffer2_pipe_valid_source_first <= buffer2_pipe_valid_sink_first;
+        buffer2_pipe_valid_source_last <= buffer2_pipe_valid_sink_last;
+        buffer2_pipe_valid_source_payload_data <= buffer2_pipe_valid_sink_payload_data;
+        buffer2_pipe_valid_source_payload_last_be <= buffer2_pipe_valid_sink_payload_last_be;
+        buffer2_pipe_valid_source_payload_error <= buffer2_pipe_valid_sink_payload_error;
+        buffer2_pipe_valid_source_param_src_port <= buffer2_pipe_valid_sink_param_src_port;
+        buffer2_pipe_valid_source_param_dst_port <= buffer2_pipe_valid_sink_param_dst_port;
+        buffer2_pipe_valid_source_param_ip_address <= buffer2_pipe_valid_sink_param_ip_address;
+        buffer2_pipe_valid_source_param_length <= buffer2_pipe_valid_sink_param_length;
+    end
     pulsesynchronizer0_toggle_o_r <= pulsesynchronizer0_toggle_o;
     pulsemerge0_backlog1 <= (pulsemerge0_total1 - pulsemerge0_o1);
     pulsesynchronizer1_toggle_o_r <= pulsesynchronizer1_toggle_o;
@@ -8320,6 +8423,10 @@ always @(posedge port_clk) begin
         buffer1_pipe_ready_sink_d_payload_data <= 8'd0;
         buffer1_pipe_ready_sink_d_payload_last_be <= 1'd0;
         buffer1_pipe_ready_sink_d_payload_error <= 1'd0;
+        buffer2_pipe_valid_source_valid <= 1'd0;
+        buffer2_pipe_valid_source_payload_data <= 8'd0;
+        buffer2_pipe_valid_source_payload_last_be <= 1'd0;
+        buffer2_pipe_valid_source_payload_error <= 1'd0;
         pulsemerge0_backlog1 <= 3'd0;
         pulsemerge1_backlog1 <= 3'd0;
         portudp_lastbytetrim_state <= 1'd0;

@@ -246,6 +246,9 @@ UDPPortCore
 │    │    │    └─── pipe_valid (PipeValid)
 │    │    │    └─── pipe_ready (PipeReady)
 │    │    │    └─── pipeline (Pipeline)
+│    │    └─── rx_out (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipeline (Pipeline)
 └─── rx_drop_header_core (PulseMerge)
 └─── rx_drop_header_port (PulseMerge)
 └─── rx_drop_other_core (PulseMerge)
@@ -2427,6 +2430,50 @@ wire          main_udp_buffer1_source_source_payload_error;
 wire          main_udp_buffer1_source_source_payload_last_be;
 wire          main_udp_buffer1_source_source_ready;
 wire          main_udp_buffer1_source_source_valid;
+wire          main_udp_buffer2_pipe_valid_sink_first;
+wire          main_udp_buffer2_pipe_valid_sink_last;
+wire   [15:0] main_udp_buffer2_pipe_valid_sink_param_dst_port;
+wire   [31:0] main_udp_buffer2_pipe_valid_sink_param_ip_address;
+wire   [15:0] main_udp_buffer2_pipe_valid_sink_param_length;
+wire   [15:0] main_udp_buffer2_pipe_valid_sink_param_src_port;
+wire    [7:0] main_udp_buffer2_pipe_valid_sink_payload_data;
+wire          main_udp_buffer2_pipe_valid_sink_payload_error;
+wire          main_udp_buffer2_pipe_valid_sink_payload_last_be;
+wire          main_udp_buffer2_pipe_valid_sink_ready;
+wire          main_udp_buffer2_pipe_valid_sink_valid;
+reg           main_udp_buffer2_pipe_valid_source_first = 1'd0;
+reg           main_udp_buffer2_pipe_valid_source_last = 1'd0;
+reg    [15:0] main_udp_buffer2_pipe_valid_source_param_dst_port = 16'd0;
+reg    [31:0] main_udp_buffer2_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer2_pipe_valid_source_param_length = 16'd0;
+reg    [15:0] main_udp_buffer2_pipe_valid_source_param_src_port = 16'd0;
+reg     [7:0] main_udp_buffer2_pipe_valid_source_payload_data = 8'd0;
+reg           main_udp_buffer2_pipe_valid_source_payload_error = 1'd0;
+reg           main_udp_buffer2_pipe_valid_source_payload_last_be = 1'd0;
+wire          main_udp_buffer2_pipe_valid_source_ready;
+reg           main_udp_buffer2_pipe_valid_source_valid = 1'd0;
+wire          main_udp_buffer2_sink_sink_first;
+wire          main_udp_buffer2_sink_sink_last;
+wire   [15:0] main_udp_buffer2_sink_sink_param_dst_port;
+wire   [31:0] main_udp_buffer2_sink_sink_param_ip_address;
+wire   [15:0] main_udp_buffer2_sink_sink_param_length;
+wire   [15:0] main_udp_buffer2_sink_sink_param_src_port;
+wire    [7:0] main_udp_buffer2_sink_sink_payload_data;
+wire          main_udp_buffer2_sink_sink_payload_error;
+wire          main_udp_buffer2_sink_sink_payload_last_be;
+wire          main_udp_buffer2_sink_sink_ready;
+wire          main_udp_buffer2_sink_sink_valid;
+wire          main_udp_buffer2_source_source_first;
+wire          main_udp_buffer2_source_source_last;
+wire   [15:0] main_udp_buffer2_source_source_param_dst_port;
+wire   [31:0] main_udp_buffer2_source_source_param_ip_address;
+wire   [15:0] main_udp_buffer2_source_source_param_length;
+wire   [15:0] main_udp_buffer2_source_source_param_src_port;
+wire    [7:0] main_udp_buffer2_source_source_payload_data;
+wire          main_udp_buffer2_source_source_payload_error;
+wire          main_udp_buffer2_source_source_payload_last_be;
+wire          main_udp_buffer2_source_source_ready;
+wire          main_udp_buffer2_source_source_valid;
 reg    [15:0] main_udp_holdingudprx0 = 16'd0;
 reg    [15:0] main_udp_holdingudprx0_holdingudprx_next_value5 = 16'd0;
 reg           main_udp_holdingudprx0_holdingudprx_next_value_ce5 = 1'd0;
@@ -6221,17 +6268,28 @@ assign main_udp_holdingudprx_sink_payload_error = main_udp_buffer0_source_source
 assign main_udp_holdingudprx_sink_param_length = main_udp_buffer0_source_source_param_length;
 assign main_udp_holdingudprx_sink_param_protocol = main_udp_buffer0_source_source_param_protocol;
 assign main_udp_holdingudprx_sink_param_ip_address = main_udp_buffer0_source_source_param_ip_address;
-assign main_udp_maskedudpcrossbar_sink_valid = main_udp_holdingudprx_source_valid;
-assign main_udp_holdingudprx_source_ready = main_udp_maskedudpcrossbar_sink_ready;
-assign main_udp_maskedudpcrossbar_sink_first = main_udp_holdingudprx_source_first;
-assign main_udp_maskedudpcrossbar_sink_last = main_udp_holdingudprx_source_last;
-assign main_udp_maskedudpcrossbar_sink_payload_data = main_udp_holdingudprx_source_payload_data;
-assign main_udp_maskedudpcrossbar_sink_payload_last_be = main_udp_holdingudprx_source_payload_last_be;
-assign main_udp_maskedudpcrossbar_sink_payload_error = main_udp_holdingudprx_source_payload_error;
-assign main_udp_maskedudpcrossbar_sink_param_src_port = main_udp_holdingudprx_source_param_src_port;
-assign main_udp_maskedudpcrossbar_sink_param_dst_port = main_udp_holdingudprx_source_param_dst_port;
-assign main_udp_maskedudpcrossbar_sink_param_ip_address = main_udp_holdingudprx_source_param_ip_address;
-assign main_udp_maskedudpcrossbar_sink_param_length = main_udp_holdingudprx_source_param_length;
+assign main_udp_buffer2_sink_sink_valid = main_udp_holdingudprx_source_valid;
+assign main_udp_holdingudprx_source_ready = main_udp_buffer2_sink_sink_ready;
+assign main_udp_buffer2_sink_sink_first = main_udp_holdingudprx_source_first;
+assign main_udp_buffer2_sink_sink_last = main_udp_holdingudprx_source_last;
+assign main_udp_buffer2_sink_sink_payload_data = main_udp_holdingudprx_source_payload_data;
+assign main_udp_buffer2_sink_sink_payload_last_be = main_udp_holdingudprx_source_payload_last_be;
+assign main_udp_buffer2_sink_sink_payload_error = main_udp_holdingudprx_source_payload_error;
+assign main_udp_buffer2_sink_sink_param_src_port = main_udp_holdingudprx_source_param_src_port;
+assign main_udp_buffer2_sink_sink_param_dst_port = main_udp_holdingudprx_source_param_dst_port;
+assign main_udp_buffer2_sink_sink_param_ip_address = main_udp_holdingudprx_source_param_ip_address;
+assign main_udp_buffer2_sink_sink_param_length = main_udp_holdingudprx_source_param_length;
+assign main_udp_maskedudpcrossbar_sink_valid = main_udp_buffer2_source_source_valid;
+assign main_udp_buffer2_source_source_ready = main_udp_maskedudpcrossbar_sink_ready;
+assign main_udp_maskedudpcrossbar_sink_first = main_udp_buffer2_source_source_first;
+assign main_udp_maskedudpcrossbar_sink_last = main_udp_buffer2_source_source_last;
+assign main_udp_maskedudpcrossbar_sink_payload_data = main_udp_buffer2_source_source_payload_data;
+assign main_udp_maskedudpcrossbar_sink_payload_last_be = main_udp_buffer2_source_source_payload_last_be;
+assign main_udp_maskedudpcrossbar_sink_payload_error = main_udp_buffer2_source_source_payload_error;
+assign main_udp_maskedudpcrossbar_sink_param_src_port = main_udp_buffer2_source_source_param_src_port;
+assign main_udp_maskedudpcrossbar_sink_param_dst_port = main_udp_buffer2_source_source_param_dst_port;
+assign main_udp_maskedudpcrossbar_sink_param_ip_address = main_udp_buffer2_source_source_param_ip_address;
+assign main_udp_maskedudpcrossbar_sink_param_length = main_udp_buffer2_source_source_param_length;
 assign main_udp_liteethudptx_sink_sink_valid = main_udp_maskedudpcrossbar_source_valid;
 assign main_udp_maskedudpcrossbar_source_ready = main_udp_liteethudptx_sink_sink_ready;
 assign main_udp_liteethudptx_sink_sink_first = main_udp_maskedudpcrossbar_source_first;
@@ -7259,6 +7317,29 @@ assign main_udp_buffer1_source_source_payload_error = main_udp_buffer1_pipe_read
 assign main_udp_buffer1_source_source_param_length = main_udp_buffer1_pipe_ready_source_param_length;
 assign main_udp_buffer1_source_source_param_protocol = main_udp_buffer1_pipe_ready_source_param_protocol;
 assign main_udp_buffer1_source_source_param_ip_address = main_udp_buffer1_pipe_ready_source_param_ip_address;
+assign main_udp_buffer2_pipe_valid_sink_ready = ((~main_udp_buffer2_pipe_valid_source_valid) | main_udp_buffer2_pipe_valid_source_ready);
+assign main_udp_buffer2_pipe_valid_sink_valid = main_udp_buffer2_sink_sink_valid;
+assign main_udp_buffer2_sink_sink_ready = main_udp_buffer2_pipe_valid_sink_ready;
+assign main_udp_buffer2_pipe_valid_sink_first = main_udp_buffer2_sink_sink_first;
+assign main_udp_buffer2_pipe_valid_sink_last = main_udp_buffer2_sink_sink_last;
+assign main_udp_buffer2_pipe_valid_sink_payload_data = main_udp_buffer2_sink_sink_payload_data;
+assign main_udp_buffer2_pipe_valid_sink_payload_last_be = main_udp_buffer2_sink_sink_payload_last_be;
+assign main_udp_buffer2_pipe_valid_sink_payload_error = main_udp_buffer2_sink_sink_payload_error;
+assign main_udp_buffer2_pipe_valid_sink_param_src_port = main_udp_buffer2_sink_sink_param_src_port;
+assign main_udp_buffer2_pipe_valid_sink_param_dst_port = main_udp_buffer2_sink_sink_param_dst_port;
+assign main_udp_buffer2_pipe_valid_sink_param_ip_address = main_udp_buffer2_sink_sink_param_ip_address;
+assign main_udp_buffer2_pipe_valid_sink_param_length = main_udp_buffer2_sink_sink_param_length;
+assign main_udp_buffer2_source_source_valid = main_udp_buffer2_pipe_valid_source_valid;
+assign main_udp_buffer2_pipe_valid_source_ready = main_udp_buffer2_source_source_ready;
+assign main_udp_buffer2_source_source_first = main_udp_buffer2_pipe_valid_source_first;
+assign main_udp_buffer2_source_source_last = main_udp_buffer2_pipe_valid_source_last;
+assign main_udp_buffer2_source_source_payload_data = main_udp_buffer2_pipe_valid_source_payload_data;
+assign main_udp_buffer2_source_source_payload_last_be = main_udp_buffer2_pipe_valid_source_payload_last_be;
+assign main_udp_buffer2_source_source_payload_error = main_udp_buffer2_pipe_valid_source_payload_error;
+assign main_udp_buffer2_source_source_param_src_port = main_udp_buffer2_pipe_valid_source_param_src_port;
+assign main_udp_buffer2_source_source_param_dst_port = main_udp_buffer2_pipe_valid_source_param_dst_port;
+assign main_udp_buffer2_source_source_param_ip_address = main_udp_buffer2_pipe_valid_source_param_ip_address;
+assign main_udp_buffer2_source_source_param_length = main_udp_buffer2_pipe_valid_source_param_length;
 assign main_pulsemerge0_total0 = ((((1'd0 + main_mac_cut) + main_ip_rx_cut) + main_ip_rx_drop_header) + main_pulsemerge0_backlog0);
 assign main_pulsemerge0_o0 = (main_pulsemerge0_total0 != 1'd0);
 assign main_pulsemerge0_total1 = ((((1'd0 + main_pulsemerge0_o0) + main_udp_holdingudprx_cut0) + main_udp_holdingudprx_drop_header) + main_pulsemerge0_backlog1);
@@ -8345,6 +8426,18 @@ always @(posedge sys_clk) begin
         main_udp_buffer1_pipe_ready_sink_d_param_protocol <= main_udp_buffer1_pipe_ready_sink_param_protocol;
         main_udp_buffer1_pipe_ready_sink_d_param_ip_address <= main_udp_buffer1_pipe_ready_sink_param_ip_address;
     end
+    if (((~main_udp_buffer2_pipe_valid_source_valid) | main_udp_buffer2_pipe_valid_source_ready)) begin
+        main_udp_buffer2_pipe_valid_source_valid <= main_udp_buffer2_pipe_valid_sink_valid;
+        main_udp_buffer2_pipe_valid_source_first <= main_udp_buffer2_pipe_valid_sink_first;
+        main_udp_buffer2_pipe_valid_source_last <= main_udp_buffer2_pipe_valid_sink_last;
+        main_udp_buffer2_pipe_valid_source_payload_data <= main_udp_buffer2_pipe_valid_sink_payload_data;
+        main_udp_buffer2_pipe_valid_source_payload_last_be <= main_udp_buffer2_pipe_valid_sink_payload_last_be;
+        main_udp_buffer2_pipe_valid_source_payload_error <= main_udp_buffer2_pipe_valid_sink_payload_error;
+        main_udp_buffer2_pipe_valid_source_param_src_port <= main_udp_buffer2_pipe_valid_sink_param_src_port;
+        main_udp_buffer2_pipe_valid_source_param_dst_port <= main_udp_buffer2_pipe_valid_sink_param_dst_port;
+        main_udp_buffer2_pipe_valid_source_param_ip_address <= main_udp_buffer2_pipe_valid_sink_param_ip_address;
+        main_udp_buffer2_pipe_valid_source_param_length <= main_udp_buffer2_pipe_valid_sink_param_length;
+    end
     main_pulsemerge0_backlog0 <= (main_pulsemerge0_total0 - main_pulsemerge0_o0);
     main_pulsemerge0_backlog1 <= (main_pulsemerge0_total1 - main_pulsemerge0_o1);
     main_pulsemerge1_backlog0 <= (main_pulsemerge1_total0 - main_pulsemerge1_o0);
@@ -8506,6 +8599,10 @@ always @(posedge sys_clk) begin
         main_udp_buffer1_pipe_ready_sink_d_payload_data <= 8'd0;
         main_udp_buffer1_pipe_ready_sink_d_payload_last_be <= 1'd0;
         main_udp_buffer1_pipe_ready_sink_d_payload_error <= 1'd0;
+        main_udp_buffer2_pipe_valid_source_valid <= 1'd0;
+        main_udp_buffer2_pipe_valid_source_payload_data <= 8'd0;
+        main_udp_buffer2_pipe_valid_source_payload_last_be <= 1'd0;
+        main_udp_buffer2_pipe_valid_source_payload_error <= 1'd0;
         main_pulsemerge0_backlog0 <= 3'd0;
         main_pulsemerge0_backlog1 <= 3'd0;
         main_pulsemerge1_backlog0 <= 3'd0;
