@@ -85,6 +85,7 @@ from liteeth import phy as liteeth_phys
 from liteeth.core import LiteEthIPCore
 from liteeth.gen import _io, get_udp_raw_port_ios
 from liteeth.mac.common import LiteEthMACCrossbar
+from liteeth.mac.crc import LiteEthMACCRC32Checker
 from liteeth.phy.ecp5rgmii import LiteEthPHYRGMIIRX
 from litex.build.generic_platform import Pins, Subsignal
 from litex.build.io import CRG
@@ -265,7 +266,12 @@ class HoldingUDPRX(LiteXModule):
         self.depacketizer = dep = LiteEthUDPDepacketizer(dw)
         self.comb += sink.connect(dep.sink)
         d = dep.source
+        # count: the number of the byte after this one (from 1); more: this byte is not the
+        # payload's last (count < payload_len a byte earlier, a register: the compare after the
+        # UDP length's subtraction sat on the clock's critical path between the depacketizer's
+        # header and this FSM)
         count = Signal(16)
+        more = Signal()
         err = Signal()
         held = Signal(8)
         sport, dport, length, ip = Signal(16), Signal(16), Signal(16), Signal(32)
@@ -279,11 +285,12 @@ class HoldingUDPRX(LiteXModule):
             payload_len.eq(d.length - udp_header.length),
             cut.eq(rest != 0),
         ]
-        take = [NextValue(count, count + 1), If(cut, NextValue(rest, rest - 1))]
+        take = [NextValue(count, count + 1), NextValue(more, count < payload_len),
+                If(cut, NextValue(rest, rest - 1))]
         self.drop_header = Signal()
         self.fsm = fsm = FSM(reset_state="IDLE")
         fsm.act("IDLE",
-            NextValue(count, 1), NextValue(err, 0),
+            NextValue(count, 2), NextValue(more, payload_len > 1), NextValue(err, 0),
             NextValue(rest, sink.length - (udp_header.length + 1)),
             If(sink.length <= udp_header.length, NextValue(rest, 0)),
             If(d.valid, NextState("DROP"),
@@ -294,7 +301,7 @@ class HoldingUDPRX(LiteXModule):
             source.src_port.eq(d.src_port), source.dst_port.eq(d.dst_port),
             source.length.eq(payload_len), source.ip_address.eq(sink.ip_address),
             source.data.eq(d.data),
-            If(d.last | (count < payload_len),
+            If(d.last | more,
                 source.valid.eq(d.valid), d.ready.eq(source.ready),
                 source.last.eq(d.last), source.error.eq(d.error | err),
                 If(d.last & cut, source.length.eq(0)),
@@ -379,13 +386,17 @@ class PortUDP(LiteXModule):
         # core's critical path
         self.rx_buffer = renamed(stream.Buffer(narrow, pipe_valid=True, pipe_ready=True))
         self.tx_buffer = renamed(stream.Buffer(narrow, pipe_valid=True, pipe_ready=True))
+        # and between the UDP receiver and the crossbar: its FSM's outputs went through the
+        # crossbar's port select into the lab port's input register (clk's critical path)
+        self.rx_out = renamed(stream.Buffer(eth_udp_user_description(8), pipe_valid=True))
         self.comb += [
             ip_port.source.connect(self.rx_cdc.sink),
             self.rx_cdc.source.connect(self.rx_converter.sink),
             self.rx_converter.source.connect(self.rx_trim.sink),
             self.rx_trim.source.connect(self.rx_buffer.sink),
             self.rx_buffer.source.connect(self.rx.sink),
-            self.rx.source.connect(self.crossbar.master.sink),
+            self.rx.source.connect(self.rx_out.sink),
+            self.rx_out.source.connect(self.crossbar.master.sink),
             self.crossbar.master.source.connect(self.tx.sink),
             self.tx.source.connect(self.tx_buffer.sink),
             self.tx_buffer.source.connect(self.tx_converter.sink),
@@ -456,7 +467,8 @@ class UDPPortCore(SoCMini):
             with_icmp=bool(cfg.get("with_icmp", True)),
             with_ip_broadcast=take_group,
             with_sys_datapath=bool(cfg.get("with_sys_datapath", False)),
-            tx_cdc_depth=int(cfg.get("tx_cdc_depth", 32)), tx_cdc_buffered=False,
+            tx_cdc_depth=int(cfg.get("tx_cdc_depth", 32)),
+            tx_cdc_buffered=bool(cfg.get("tx_cdc_buffered", False)),
             rx_cdc_depth=int(cfg.get("rx_cdc_depth", 32)), rx_cdc_buffered=False)
         # LiteEth's send path on the PHY's clock: its FIFO's read side, the 32-to-8 converter,
         # padding, CRC, preamble, gap: one combinational ready chain from the CRC back to the
@@ -469,6 +481,15 @@ class UDPPortCore(SoCMini):
             eth_phy_description(dw), pipe_valid=True, pipe_ready=True))
         self.core.mac.core.tx_datapath.tx_buffer = tx_buffer
         tx_path.insert(at + 1, tx_buffer)
+        # Its receive path on the PHY's clock: the CRC checker's error (the CRC of the byte in,
+        # compared with the residue) went on through the padding checker into the 8-to-32
+        # converter's register, the PHY clock's critical path (118 MHz): a register after it.
+        rx_path = self.core.mac.core.rx_datapath.pipeline
+        (at,) = [k for k, m in enumerate(rx_path) if isinstance(m, LiteEthMACCRC32Checker)]
+        rx_buffer = ClockDomainsRenamer("eth_rx")(stream.Buffer(
+            eth_phy_description(len(ethphy.source.data)), pipe_valid=True))
+        self.core.mac.core.rx_datapath.rx_buffer = rx_buffer
+        rx_path.insert(at + 1, rx_buffer)
         self.core.udp = PortUDP(self.core.ip, ip_address, dw, cd,
                                 rx_depth=int(cfg.get("port_rx_cdc_depth", 16)),
                                 tx_depth=int(cfg.get("port_tx_cdc_depth", 16)))

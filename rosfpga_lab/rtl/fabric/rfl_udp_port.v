@@ -87,34 +87,53 @@ module rfl_udp_port #(
     // RX_BITS, TX_BITS and QUEUE_BITS are checked by rfl_udp_store.
 
     // ---- receive ------------------------------------------------------------------------------
+    // LiteEth's stream is registered first (r_*): it comes out of LiteEth's UDP receiver and
+    // crossbar through a long combinational path, which the length check and the store's
+    // commit logic lengthened past 125 MHz. The receiver never waits (the store discards a
+    // payload without room), so the register needs no ready.
     // LiteEth's error flag is taken from whichever beat of the payload carries it.
-    reg [15:0] rx_n;                            // bytes of this payload so far
+    reg [7:0] r_data;
+    reg r_valid, r_last, r_error;
+    reg [31:0] r_ip;
+    reg [15:0] r_src_port, r_dst_port, r_length;
+    always @(posedge clk) begin
+        r_valid <= rst_n && le_rx_valid;
+        r_data <= le_rx_data;
+        r_last <= le_rx_last;
+        r_error <= le_rx_error;
+        r_ip <= le_rx_ip;
+        r_src_port <= le_rx_src_port;
+        r_dst_port <= le_rx_dst_port;
+        r_length <= le_rx_length;
+    end
+    assign le_rx_ready = 1'b1;
+
+    reg [15:0] rx_n;                            // bytes of this payload with this beat
     reg rx_err_seen;
-    wire rx_take = le_rx_valid && le_rx_ready;
-    wire [15:0] rx_n_next = rx_n + 16'd1;
-    wire rx_short = (rx_n_next != le_rx_length);
-    wire rx_err = le_rx_error || rx_err_seen;
+    wire rx_short = (rx_n != r_length);
+    wire rx_err = r_error || rx_err_seen;
     wire rx_bad = rx_err || rx_short;
-    wire rx_keep, rx_drop, rx_user;
+    wire rx_keep, rx_drop, rx_user, rx_store_ready;
     always @(posedge clk) begin
         if (!rst_n) begin
-            rx_n <= 16'd0;
+            rx_n <= 16'd1;
             rx_err_seen <= 1'b0;
-        end else if (rx_take) begin
-            rx_n <= le_rx_last ? 16'd0 : rx_n_next;
-            rx_err_seen <= !le_rx_last && rx_err;
+        end else if (r_valid) begin
+            rx_n <= r_last ? 16'd1 : rx_n + 16'd1;
+            rx_err_seen <= !r_last && rx_err;
         end
     end
 
     rfl_udp_store #(.ADDR_BITS(RX_BITS), .QUEUE_BITS(QUEUE_BITS), .META_W(64), .WAIT(0)) u_rx (
         .clk(clk), .rst_n(rst_n),
-        .s_axis_tdata(le_rx_data), .s_axis_tvalid(le_rx_valid), .s_axis_tready(le_rx_ready),
-        .s_axis_tlast(le_rx_last), .s_axis_tuser(rx_bad),
-        .s_meta({le_rx_ip, le_rx_src_port, le_rx_dst_port}),
+        .s_axis_tdata(r_data), .s_axis_tvalid(r_valid), .s_axis_tready(rx_store_ready),
+        .s_axis_tlast(r_last), .s_axis_tuser(rx_bad),
+        .s_meta({r_ip, r_src_port, r_dst_port}),
         .m_axis_tdata(m_axis_tdata), .m_axis_tvalid(m_axis_tvalid),
         .m_axis_tready(m_axis_tready), .m_axis_tlast(m_axis_tlast),
         .m_meta({m_udp_ip, m_udp_src_port, m_udp_dst_port}), .m_len(m_udp_length),
         .done_keep(rx_keep), .done_drop(rx_drop), .done_user(rx_user));
+    wire unused_rx_ok = rx_store_ready;         // 1: WAIT 0 never waits
 
     // ---- send -------------------------------------------------------------------------------
     wire tx_keep, tx_drop, tx_user;
@@ -130,7 +149,7 @@ module rfl_udp_port #(
     // ---- counters (saturating) --------------------------------------------------------------
     reg [COUNT_BITS-1:0] c_rx, c_err, c_len, c_ovf, c_tx, c_tovf, c_hdr, c_oth;
     wire [COUNT_BITS-1:0] top = {COUNT_BITS{1'b1}};
-    wire rx_fin = rx_take && le_rx_last;
+    wire rx_fin = r_valid && r_last;
     always @(posedge clk) begin
         if (!rst_n) begin
             c_rx <= {COUNT_BITS{1'b0}};

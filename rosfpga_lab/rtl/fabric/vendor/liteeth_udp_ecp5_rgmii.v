@@ -91,9 +91,10 @@ UDPPortCore
 │    │    │    └─── tx_datapath (TXDatapath)
 │    │    │    │    └─── clockdomaincrossing_0* (ClockDomainCrossing)
 │    │    │    │    │    └─── asyncfifo_0* (AsyncFIFO)
-│    │    │    │    │    │    └─── fifo (AsyncFIFO)
-│    │    │    │    │    │    │    └─── graycounter_0* (GrayCounter)
-│    │    │    │    │    │    │    └─── graycounter_1* (GrayCounter)
+│    │    │    │    │    │    └─── fifo (AsyncFIFOBuffered)
+│    │    │    │    │    │    │    └─── fifo (AsyncFIFO)
+│    │    │    │    │    │    │    │    └─── graycounter_0* (GrayCounter)
+│    │    │    │    │    │    │    │    └─── graycounter_1* (GrayCounter)
 │    │    │    │    └─── strideconverter_0* (StrideConverter)
 │    │    │    │    │    └─── converter_0* (Converter)
 │    │    │    │    │    │    └─── _downconverter_0* (_DownConverter)
@@ -142,6 +143,9 @@ UDPPortCore
 │    │    │    │    │    │    └─── fifo (AsyncFIFO)
 │    │    │    │    │    │    │    └─── graycounter_0* (GrayCounter)
 │    │    │    │    │    │    │    └─── graycounter_1* (GrayCounter)
+│    │    │    │    └─── rx_buffer (Buffer)
+│    │    │    │    │    └─── pipe_valid (PipeValid)
+│    │    │    │    │    └─── pipeline (Pipeline)
 │    │    │    │    └─── pipeline_0* (Pipeline)
 │    │    └─── crossbar (FilteringMACCrossbar)
 │    │    │    └─── arbiter (Arbiter)
@@ -264,6 +268,9 @@ UDPPortCore
 │    │    │    └─── pipe_valid (PipeValid)
 │    │    │    └─── pipe_ready (PipeReady)
 │    │    │    └─── pipeline (Pipeline)
+│    │    └─── rx_out (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
+│    │    │    └─── pipeline (Pipeline)
 └─── rx_drop_header_core (PulseMerge)
 └─── rx_drop_header_cdc (PulseSynchronizer)
 └─── rx_drop_header_port (PulseMerge)
@@ -281,18 +288,18 @@ UDPPortCore
 │    │    └─── csrstorage_0* (CSRStorage)
 │    │    └─── csrstatus_0* (CSRStatus)
 └─── csr_interconnect (InterconnectShared)
+└─── [ODDRX1F]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [FD1S3BX]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
+└─── [ODDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
-└─── [ODDRX1F]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [FD1S3BX]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
-└─── [ODDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
 └─── [IDDRX1F]
@@ -540,77 +547,127 @@ reg           arp_table_source_payload_reply = 1'd0;
 reg           arp_table_source_payload_request = 1'd0;
 wire          arp_table_source_ready;
 reg           arp_table_source_valid = 1'd0;
-reg           buffer0_pipe_ready_sink_d_first = 1'd0;
-reg           buffer0_pipe_ready_sink_d_last = 1'd0;
+reg           buffer0_pipe_ready_sink_d_first0 = 1'd0;
+reg           buffer0_pipe_ready_sink_d_first1 = 1'd0;
+reg           buffer0_pipe_ready_sink_d_last0 = 1'd0;
+reg           buffer0_pipe_ready_sink_d_last1 = 1'd0;
 reg    [31:0] buffer0_pipe_ready_sink_d_param_ip_address = 32'd0;
 reg    [15:0] buffer0_pipe_ready_sink_d_param_length = 16'd0;
 reg     [7:0] buffer0_pipe_ready_sink_d_param_protocol = 8'd0;
-reg     [7:0] buffer0_pipe_ready_sink_d_payload_data = 8'd0;
-reg           buffer0_pipe_ready_sink_d_payload_error = 1'd0;
-reg           buffer0_pipe_ready_sink_d_payload_last_be = 1'd0;
-reg           buffer0_pipe_ready_sink_d_ready = 1'd0;
-reg           buffer0_pipe_ready_sink_d_valid = 1'd0;
-wire          buffer0_pipe_ready_sink_first;
-wire          buffer0_pipe_ready_sink_last;
+reg    [31:0] buffer0_pipe_ready_sink_d_payload_data0 = 32'd0;
+reg     [7:0] buffer0_pipe_ready_sink_d_payload_data1 = 8'd0;
+reg     [3:0] buffer0_pipe_ready_sink_d_payload_error0 = 4'd0;
+reg           buffer0_pipe_ready_sink_d_payload_error1 = 1'd0;
+reg     [3:0] buffer0_pipe_ready_sink_d_payload_last_be0 = 4'd0;
+reg           buffer0_pipe_ready_sink_d_payload_last_be1 = 1'd0;
+reg           buffer0_pipe_ready_sink_d_ready0 = 1'd0;
+reg           buffer0_pipe_ready_sink_d_ready1 = 1'd0;
+reg           buffer0_pipe_ready_sink_d_valid0 = 1'd0;
+reg           buffer0_pipe_ready_sink_d_valid1 = 1'd0;
+wire          buffer0_pipe_ready_sink_first0;
+wire          buffer0_pipe_ready_sink_first1;
+wire          buffer0_pipe_ready_sink_last0;
+wire          buffer0_pipe_ready_sink_last1;
 wire   [31:0] buffer0_pipe_ready_sink_param_ip_address;
 wire   [15:0] buffer0_pipe_ready_sink_param_length;
 wire    [7:0] buffer0_pipe_ready_sink_param_protocol;
-wire    [7:0] buffer0_pipe_ready_sink_payload_data;
-wire          buffer0_pipe_ready_sink_payload_error;
-wire          buffer0_pipe_ready_sink_payload_last_be;
-wire          buffer0_pipe_ready_sink_ready;
-wire          buffer0_pipe_ready_sink_valid;
-reg           buffer0_pipe_ready_source_first = 1'd0;
-reg           buffer0_pipe_ready_source_last = 1'd0;
+wire   [31:0] buffer0_pipe_ready_sink_payload_data0;
+wire    [7:0] buffer0_pipe_ready_sink_payload_data1;
+wire    [3:0] buffer0_pipe_ready_sink_payload_error0;
+wire          buffer0_pipe_ready_sink_payload_error1;
+wire    [3:0] buffer0_pipe_ready_sink_payload_last_be0;
+wire          buffer0_pipe_ready_sink_payload_last_be1;
+wire          buffer0_pipe_ready_sink_ready0;
+wire          buffer0_pipe_ready_sink_ready1;
+wire          buffer0_pipe_ready_sink_valid0;
+wire          buffer0_pipe_ready_sink_valid1;
+reg           buffer0_pipe_ready_source_first0 = 1'd0;
+reg           buffer0_pipe_ready_source_first1 = 1'd0;
+reg           buffer0_pipe_ready_source_last0 = 1'd0;
+reg           buffer0_pipe_ready_source_last1 = 1'd0;
 reg    [31:0] buffer0_pipe_ready_source_param_ip_address = 32'd0;
 reg    [15:0] buffer0_pipe_ready_source_param_length = 16'd0;
 reg     [7:0] buffer0_pipe_ready_source_param_protocol = 8'd0;
-reg     [7:0] buffer0_pipe_ready_source_payload_data = 8'd0;
-reg           buffer0_pipe_ready_source_payload_error = 1'd0;
-reg           buffer0_pipe_ready_source_payload_last_be = 1'd0;
-wire          buffer0_pipe_ready_source_ready;
-reg           buffer0_pipe_ready_source_valid = 1'd0;
-reg           buffer0_pipe_ready_valid = 1'd0;
-wire          buffer0_pipe_valid_sink_first;
-wire          buffer0_pipe_valid_sink_last;
+reg    [31:0] buffer0_pipe_ready_source_payload_data0 = 32'd0;
+reg     [7:0] buffer0_pipe_ready_source_payload_data1 = 8'd0;
+reg     [3:0] buffer0_pipe_ready_source_payload_error0 = 4'd0;
+reg           buffer0_pipe_ready_source_payload_error1 = 1'd0;
+reg     [3:0] buffer0_pipe_ready_source_payload_last_be0 = 4'd0;
+reg           buffer0_pipe_ready_source_payload_last_be1 = 1'd0;
+wire          buffer0_pipe_ready_source_ready0;
+wire          buffer0_pipe_ready_source_ready1;
+reg           buffer0_pipe_ready_source_valid0 = 1'd0;
+reg           buffer0_pipe_ready_source_valid1 = 1'd0;
+reg           buffer0_pipe_ready_valid0 = 1'd0;
+reg           buffer0_pipe_ready_valid1 = 1'd0;
+wire          buffer0_pipe_valid_sink_first0;
+wire          buffer0_pipe_valid_sink_first1;
+wire          buffer0_pipe_valid_sink_last0;
+wire          buffer0_pipe_valid_sink_last1;
 wire   [31:0] buffer0_pipe_valid_sink_param_ip_address;
 wire   [15:0] buffer0_pipe_valid_sink_param_length;
 wire    [7:0] buffer0_pipe_valid_sink_param_protocol;
-wire    [7:0] buffer0_pipe_valid_sink_payload_data;
-wire          buffer0_pipe_valid_sink_payload_error;
-wire          buffer0_pipe_valid_sink_payload_last_be;
-wire          buffer0_pipe_valid_sink_ready;
-wire          buffer0_pipe_valid_sink_valid;
-reg           buffer0_pipe_valid_source_first = 1'd0;
-reg           buffer0_pipe_valid_source_last = 1'd0;
+wire   [31:0] buffer0_pipe_valid_sink_payload_data0;
+wire    [7:0] buffer0_pipe_valid_sink_payload_data1;
+wire    [3:0] buffer0_pipe_valid_sink_payload_error0;
+wire          buffer0_pipe_valid_sink_payload_error1;
+wire    [3:0] buffer0_pipe_valid_sink_payload_last_be0;
+wire          buffer0_pipe_valid_sink_payload_last_be1;
+wire          buffer0_pipe_valid_sink_ready0;
+wire          buffer0_pipe_valid_sink_ready1;
+wire          buffer0_pipe_valid_sink_valid0;
+wire          buffer0_pipe_valid_sink_valid1;
+reg           buffer0_pipe_valid_source_first0 = 1'd0;
+reg           buffer0_pipe_valid_source_first1 = 1'd0;
+reg           buffer0_pipe_valid_source_last0 = 1'd0;
+reg           buffer0_pipe_valid_source_last1 = 1'd0;
 reg    [31:0] buffer0_pipe_valid_source_param_ip_address = 32'd0;
 reg    [15:0] buffer0_pipe_valid_source_param_length = 16'd0;
 reg     [7:0] buffer0_pipe_valid_source_param_protocol = 8'd0;
-reg     [7:0] buffer0_pipe_valid_source_payload_data = 8'd0;
-reg           buffer0_pipe_valid_source_payload_error = 1'd0;
-reg           buffer0_pipe_valid_source_payload_last_be = 1'd0;
-wire          buffer0_pipe_valid_source_ready;
-reg           buffer0_pipe_valid_source_valid = 1'd0;
-wire          buffer0_sink_sink_first;
-wire          buffer0_sink_sink_last;
+reg    [31:0] buffer0_pipe_valid_source_payload_data0 = 32'd0;
+reg     [7:0] buffer0_pipe_valid_source_payload_data1 = 8'd0;
+reg     [3:0] buffer0_pipe_valid_source_payload_error0 = 4'd0;
+reg           buffer0_pipe_valid_source_payload_error1 = 1'd0;
+reg     [3:0] buffer0_pipe_valid_source_payload_last_be0 = 4'd0;
+reg           buffer0_pipe_valid_source_payload_last_be1 = 1'd0;
+wire          buffer0_pipe_valid_source_ready0;
+wire          buffer0_pipe_valid_source_ready1;
+reg           buffer0_pipe_valid_source_valid0 = 1'd0;
+reg           buffer0_pipe_valid_source_valid1 = 1'd0;
+wire          buffer0_sink_sink_first0;
+wire          buffer0_sink_sink_first1;
+wire          buffer0_sink_sink_last0;
+wire          buffer0_sink_sink_last1;
 wire   [31:0] buffer0_sink_sink_param_ip_address;
 wire   [15:0] buffer0_sink_sink_param_length;
 wire    [7:0] buffer0_sink_sink_param_protocol;
-wire    [7:0] buffer0_sink_sink_payload_data;
-wire          buffer0_sink_sink_payload_error;
-wire          buffer0_sink_sink_payload_last_be;
-wire          buffer0_sink_sink_ready;
-wire          buffer0_sink_sink_valid;
-wire          buffer0_source_source_first;
-wire          buffer0_source_source_last;
+wire   [31:0] buffer0_sink_sink_payload_data0;
+wire    [7:0] buffer0_sink_sink_payload_data1;
+wire    [3:0] buffer0_sink_sink_payload_error0;
+wire          buffer0_sink_sink_payload_error1;
+wire    [3:0] buffer0_sink_sink_payload_last_be0;
+wire          buffer0_sink_sink_payload_last_be1;
+wire          buffer0_sink_sink_ready0;
+wire          buffer0_sink_sink_ready1;
+wire          buffer0_sink_sink_valid0;
+wire          buffer0_sink_sink_valid1;
+wire          buffer0_source_source_first0;
+wire          buffer0_source_source_first1;
+wire          buffer0_source_source_last0;
+wire          buffer0_source_source_last1;
 wire   [31:0] buffer0_source_source_param_ip_address;
 wire   [15:0] buffer0_source_source_param_length;
 wire    [7:0] buffer0_source_source_param_protocol;
-wire    [7:0] buffer0_source_source_payload_data;
-wire          buffer0_source_source_payload_error;
-wire          buffer0_source_source_payload_last_be;
-wire          buffer0_source_source_ready;
-wire          buffer0_source_source_valid;
+wire   [31:0] buffer0_source_source_payload_data0;
+wire    [7:0] buffer0_source_source_payload_data1;
+wire    [3:0] buffer0_source_source_payload_error0;
+wire          buffer0_source_source_payload_error1;
+wire    [3:0] buffer0_source_source_payload_last_be0;
+wire          buffer0_source_source_payload_last_be1;
+wire          buffer0_source_source_ready0;
+wire          buffer0_source_source_ready1;
+wire          buffer0_source_source_valid0;
+wire          buffer0_source_source_valid1;
 reg           buffer1_pipe_ready_sink_d_first = 1'd0;
 reg           buffer1_pipe_ready_sink_d_last = 1'd0;
 reg    [31:0] buffer1_pipe_ready_sink_d_param_ip_address = 32'd0;
@@ -642,46 +699,118 @@ reg           buffer1_pipe_ready_source_payload_last_be = 1'd0;
 wire          buffer1_pipe_ready_source_ready;
 reg           buffer1_pipe_ready_source_valid = 1'd0;
 reg           buffer1_pipe_ready_valid = 1'd0;
-wire          buffer1_pipe_valid_sink_first;
-wire          buffer1_pipe_valid_sink_last;
+wire          buffer1_pipe_valid_sink_first0;
+wire          buffer1_pipe_valid_sink_first1;
+wire          buffer1_pipe_valid_sink_last0;
+wire          buffer1_pipe_valid_sink_last1;
 wire   [31:0] buffer1_pipe_valid_sink_param_ip_address;
 wire   [15:0] buffer1_pipe_valid_sink_param_length;
 wire    [7:0] buffer1_pipe_valid_sink_param_protocol;
-wire    [7:0] buffer1_pipe_valid_sink_payload_data;
-wire          buffer1_pipe_valid_sink_payload_error;
-wire          buffer1_pipe_valid_sink_payload_last_be;
-wire          buffer1_pipe_valid_sink_ready;
-wire          buffer1_pipe_valid_sink_valid;
-reg           buffer1_pipe_valid_source_first = 1'd0;
-reg           buffer1_pipe_valid_source_last = 1'd0;
+wire    [7:0] buffer1_pipe_valid_sink_payload_data0;
+wire    [7:0] buffer1_pipe_valid_sink_payload_data1;
+wire          buffer1_pipe_valid_sink_payload_error0;
+wire          buffer1_pipe_valid_sink_payload_error1;
+wire          buffer1_pipe_valid_sink_payload_last_be0;
+wire          buffer1_pipe_valid_sink_payload_last_be1;
+wire          buffer1_pipe_valid_sink_ready0;
+wire          buffer1_pipe_valid_sink_ready1;
+wire          buffer1_pipe_valid_sink_valid0;
+wire          buffer1_pipe_valid_sink_valid1;
+reg           buffer1_pipe_valid_source_first0 = 1'd0;
+reg           buffer1_pipe_valid_source_first1 = 1'd0;
+reg           buffer1_pipe_valid_source_last0 = 1'd0;
+reg           buffer1_pipe_valid_source_last1 = 1'd0;
 reg    [31:0] buffer1_pipe_valid_source_param_ip_address = 32'd0;
 reg    [15:0] buffer1_pipe_valid_source_param_length = 16'd0;
 reg     [7:0] buffer1_pipe_valid_source_param_protocol = 8'd0;
-reg     [7:0] buffer1_pipe_valid_source_payload_data = 8'd0;
-reg           buffer1_pipe_valid_source_payload_error = 1'd0;
-reg           buffer1_pipe_valid_source_payload_last_be = 1'd0;
-wire          buffer1_pipe_valid_source_ready;
-reg           buffer1_pipe_valid_source_valid = 1'd0;
-wire          buffer1_sink_sink_first;
-wire          buffer1_sink_sink_last;
+reg     [7:0] buffer1_pipe_valid_source_payload_data0 = 8'd0;
+reg     [7:0] buffer1_pipe_valid_source_payload_data1 = 8'd0;
+reg           buffer1_pipe_valid_source_payload_error0 = 1'd0;
+reg           buffer1_pipe_valid_source_payload_error1 = 1'd0;
+reg           buffer1_pipe_valid_source_payload_last_be0 = 1'd0;
+reg           buffer1_pipe_valid_source_payload_last_be1 = 1'd0;
+wire          buffer1_pipe_valid_source_ready0;
+wire          buffer1_pipe_valid_source_ready1;
+reg           buffer1_pipe_valid_source_valid0 = 1'd0;
+reg           buffer1_pipe_valid_source_valid1 = 1'd0;
+wire          buffer1_sink_sink_first0;
+wire          buffer1_sink_sink_first1;
+wire          buffer1_sink_sink_last0;
+wire          buffer1_sink_sink_last1;
 wire   [31:0] buffer1_sink_sink_param_ip_address;
 wire   [15:0] buffer1_sink_sink_param_length;
 wire    [7:0] buffer1_sink_sink_param_protocol;
-wire    [7:0] buffer1_sink_sink_payload_data;
-wire          buffer1_sink_sink_payload_error;
-wire          buffer1_sink_sink_payload_last_be;
-wire          buffer1_sink_sink_ready;
-wire          buffer1_sink_sink_valid;
-wire          buffer1_source_source_first;
-wire          buffer1_source_source_last;
+wire    [7:0] buffer1_sink_sink_payload_data0;
+wire    [7:0] buffer1_sink_sink_payload_data1;
+wire          buffer1_sink_sink_payload_error0;
+wire          buffer1_sink_sink_payload_error1;
+wire          buffer1_sink_sink_payload_last_be0;
+wire          buffer1_sink_sink_payload_last_be1;
+wire          buffer1_sink_sink_ready0;
+wire          buffer1_sink_sink_ready1;
+wire          buffer1_sink_sink_valid0;
+wire          buffer1_sink_sink_valid1;
+wire          buffer1_source_source_first0;
+wire          buffer1_source_source_first1;
+wire          buffer1_source_source_last0;
+wire          buffer1_source_source_last1;
 wire   [31:0] buffer1_source_source_param_ip_address;
 wire   [15:0] buffer1_source_source_param_length;
 wire    [7:0] buffer1_source_source_param_protocol;
-wire    [7:0] buffer1_source_source_payload_data;
-wire          buffer1_source_source_payload_error;
-wire          buffer1_source_source_payload_last_be;
-wire          buffer1_source_source_ready;
-wire          buffer1_source_source_valid;
+wire    [7:0] buffer1_source_source_payload_data0;
+wire    [7:0] buffer1_source_source_payload_data1;
+wire          buffer1_source_source_payload_error0;
+wire          buffer1_source_source_payload_error1;
+wire          buffer1_source_source_payload_last_be0;
+wire          buffer1_source_source_payload_last_be1;
+wire          buffer1_source_source_ready0;
+wire          buffer1_source_source_ready1;
+wire          buffer1_source_source_valid0;
+wire          buffer1_source_source_valid1;
+wire          buffer2_pipe_valid_sink_first;
+wire          buffer2_pipe_valid_sink_last;
+wire   [15:0] buffer2_pipe_valid_sink_param_dst_port;
+wire   [31:0] buffer2_pipe_valid_sink_param_ip_address;
+wire   [15:0] buffer2_pipe_valid_sink_param_length;
+wire   [15:0] buffer2_pipe_valid_sink_param_src_port;
+wire    [7:0] buffer2_pipe_valid_sink_payload_data;
+wire          buffer2_pipe_valid_sink_payload_error;
+wire          buffer2_pipe_valid_sink_payload_last_be;
+wire          buffer2_pipe_valid_sink_ready;
+wire          buffer2_pipe_valid_sink_valid;
+reg           buffer2_pipe_valid_source_first = 1'd0;
+reg           buffer2_pipe_valid_source_last = 1'd0;
+reg    [15:0] buffer2_pipe_valid_source_param_dst_port = 16'd0;
+reg    [31:0] buffer2_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] buffer2_pipe_valid_source_param_length = 16'd0;
+reg    [15:0] buffer2_pipe_valid_source_param_src_port = 16'd0;
+reg     [7:0] buffer2_pipe_valid_source_payload_data = 8'd0;
+reg           buffer2_pipe_valid_source_payload_error = 1'd0;
+reg           buffer2_pipe_valid_source_payload_last_be = 1'd0;
+wire          buffer2_pipe_valid_source_ready;
+reg           buffer2_pipe_valid_source_valid = 1'd0;
+wire          buffer2_sink_sink_first;
+wire          buffer2_sink_sink_last;
+wire   [15:0] buffer2_sink_sink_param_dst_port;
+wire   [31:0] buffer2_sink_sink_param_ip_address;
+wire   [15:0] buffer2_sink_sink_param_length;
+wire   [15:0] buffer2_sink_sink_param_src_port;
+wire    [7:0] buffer2_sink_sink_payload_data;
+wire          buffer2_sink_sink_payload_error;
+wire          buffer2_sink_sink_payload_last_be;
+wire          buffer2_sink_sink_ready;
+wire          buffer2_sink_sink_valid;
+wire          buffer2_source_source_first;
+wire          buffer2_source_source_last;
+wire   [15:0] buffer2_source_source_param_dst_port;
+wire   [31:0] buffer2_source_source_param_ip_address;
+wire   [15:0] buffer2_source_source_param_length;
+wire   [15:0] buffer2_source_source_param_src_port;
+wire    [7:0] buffer2_source_source_payload_data;
+wire          buffer2_source_source_payload_error;
+wire          buffer2_source_source_payload_last_be;
+wire          buffer2_source_source_ready;
+wire          buffer2_source_source_valid;
 wire   [39:0] cases_slice_proxy;
 wire   [31:0] csrbank0_bus_errors_r;
 reg           csrbank0_bus_errors_re = 1'd0;
@@ -749,17 +878,17 @@ wire          ethphy_we;
 reg     [2:0] fsm_next_state = 3'd0;
 reg     [2:0] fsm_state = 3'd0;
 reg    [15:0] holdingudprx0 = 16'd0;
-reg    [15:0] holdingudprx0_holdingudprx_next_value4 = 16'd0;
-reg           holdingudprx0_holdingudprx_next_value_ce4 = 1'd0;
+reg    [15:0] holdingudprx0_holdingudprx_next_value5 = 16'd0;
+reg           holdingudprx0_holdingudprx_next_value_ce5 = 1'd0;
 reg    [15:0] holdingudprx1 = 16'd0;
-reg    [15:0] holdingudprx1_holdingudprx_next_value5 = 16'd0;
-reg           holdingudprx1_holdingudprx_next_value_ce5 = 1'd0;
+reg    [15:0] holdingudprx1_holdingudprx_next_value6 = 16'd0;
+reg           holdingudprx1_holdingudprx_next_value_ce6 = 1'd0;
 reg    [15:0] holdingudprx2 = 16'd0;
-reg    [15:0] holdingudprx2_holdingudprx_next_value6 = 16'd0;
-reg           holdingudprx2_holdingudprx_next_value_ce6 = 1'd0;
+reg    [15:0] holdingudprx2_holdingudprx_next_value7 = 16'd0;
+reg           holdingudprx2_holdingudprx_next_value_ce7 = 1'd0;
 reg    [31:0] holdingudprx3 = 32'd0;
-reg    [31:0] holdingudprx3_holdingudprx_next_value7 = 32'd0;
-reg           holdingudprx3_holdingudprx_next_value_ce7 = 1'd0;
+reg    [31:0] holdingudprx3_holdingudprx_next_value8 = 32'd0;
+reg           holdingudprx3_holdingudprx_next_value_ce8 = 1'd0;
 reg    [15:0] holdingudprx_count = 16'd0;
 reg    [15:0] holdingudprx_count_holdingudprx_next_value0 = 16'd0;
 reg           holdingudprx_count_holdingudprx_next_value_ce0 = 1'd0;
@@ -767,13 +896,13 @@ wire          holdingudprx_cut0;
 wire          holdingudprx_cut1;
 reg           holdingudprx_drop_header = 1'd0;
 reg           holdingudprx_err = 1'd0;
-reg           holdingudprx_err_holdingudprx_next_value1 = 1'd0;
-reg           holdingudprx_err_holdingudprx_next_value_ce1 = 1'd0;
+reg           holdingudprx_err_holdingudprx_next_value2 = 1'd0;
+reg           holdingudprx_err_holdingudprx_next_value_ce2 = 1'd0;
 reg           holdingudprx_fsm_is_ongoing0 = 1'd0;
 reg           holdingudprx_fsm_is_ongoing1 = 1'd0;
 reg     [7:0] holdingudprx_held = 8'd0;
-reg     [7:0] holdingudprx_held_holdingudprx_next_value3 = 8'd0;
-reg           holdingudprx_held_holdingudprx_next_value_ce3 = 1'd0;
+reg     [7:0] holdingudprx_held_holdingudprx_next_value4 = 8'd0;
+reg           holdingudprx_held_holdingudprx_next_value_ce4 = 1'd0;
 reg     [2:0] holdingudprx_liteethudpdepacketizer_count = 3'd0;
 reg     [2:0] holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 = 3'd0;
 reg           holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 = 1'd0;
@@ -819,10 +948,13 @@ reg    [63:0] holdingudprx_liteethudpdepacketizer_sr = 64'd0;
 reg           holdingudprx_liteethudpdepacketizer_sr_shift = 1'd0;
 reg           holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
 reg           holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
+reg           holdingudprx_more = 1'd0;
+reg           holdingudprx_more_holdingudprx_next_value1 = 1'd0;
+reg           holdingudprx_more_holdingudprx_next_value_ce1 = 1'd0;
 wire   [15:0] holdingudprx_payload_len;
 reg    [15:0] holdingudprx_rest = 16'd0;
-reg    [15:0] holdingudprx_rest_holdingudprx_next_value2 = 16'd0;
-reg           holdingudprx_rest_holdingudprx_next_value_ce2 = 1'd0;
+reg    [15:0] holdingudprx_rest_holdingudprx_next_value3 = 16'd0;
+reg           holdingudprx_rest_holdingudprx_next_value_ce3 = 1'd0;
 wire          holdingudprx_sink_first;
 wire          holdingudprx_sink_last;
 wire   [31:0] holdingudprx_sink_param_ip_address;
@@ -1980,6 +2112,7 @@ wire          mac_core_tx_cdc_cdc_asyncfifo_readable;
 wire          mac_core_tx_cdc_cdc_asyncfifo_we;
 wire          mac_core_tx_cdc_cdc_asyncfifo_writable;
 wire    [5:0] mac_core_tx_cdc_cdc_consume_wdomain;
+reg    [41:0] mac_core_tx_cdc_cdc_dout = 42'd0;
 wire          mac_core_tx_cdc_cdc_fifo_in_first;
 wire          mac_core_tx_cdc_cdc_fifo_in_last;
 wire   [31:0] mac_core_tx_cdc_cdc_fifo_in_payload_data;
@@ -2003,6 +2136,8 @@ reg     [5:0] mac_core_tx_cdc_cdc_graycounter1_q_next_binary = 6'd0;
 wire    [5:0] mac_core_tx_cdc_cdc_produce_rdomain;
 wire    [4:0] mac_core_tx_cdc_cdc_rdport_adr;
 wire   [41:0] mac_core_tx_cdc_cdc_rdport_dat_r;
+wire          mac_core_tx_cdc_cdc_re;
+reg           mac_core_tx_cdc_cdc_readable = 1'd0;
 wire          mac_core_tx_cdc_cdc_sink_first;
 wire          mac_core_tx_cdc_cdc_sink_last;
 wire   [31:0] mac_core_tx_cdc_cdc_sink_payload_data;
@@ -2378,42 +2513,6 @@ reg     [4:0] multiregimpl8_regs1 = 5'd0;
 reg     [4:0] multiregimpl9_regs0 = 5'd0;
 reg     [4:0] multiregimpl9_regs1 = 5'd0;
 reg           next_state = 1'd0;
-reg           pipe_ready_sink_d_first = 1'd0;
-reg           pipe_ready_sink_d_last = 1'd0;
-reg    [31:0] pipe_ready_sink_d_payload_data = 32'd0;
-reg     [3:0] pipe_ready_sink_d_payload_error = 4'd0;
-reg     [3:0] pipe_ready_sink_d_payload_last_be = 4'd0;
-reg           pipe_ready_sink_d_ready = 1'd0;
-reg           pipe_ready_sink_d_valid = 1'd0;
-wire          pipe_ready_sink_first;
-wire          pipe_ready_sink_last;
-wire   [31:0] pipe_ready_sink_payload_data;
-wire    [3:0] pipe_ready_sink_payload_error;
-wire    [3:0] pipe_ready_sink_payload_last_be;
-wire          pipe_ready_sink_ready;
-wire          pipe_ready_sink_valid;
-reg           pipe_ready_source_first = 1'd0;
-reg           pipe_ready_source_last = 1'd0;
-reg    [31:0] pipe_ready_source_payload_data = 32'd0;
-reg     [3:0] pipe_ready_source_payload_error = 4'd0;
-reg     [3:0] pipe_ready_source_payload_last_be = 4'd0;
-wire          pipe_ready_source_ready;
-reg           pipe_ready_source_valid = 1'd0;
-reg           pipe_ready_valid = 1'd0;
-wire          pipe_valid_sink_first;
-wire          pipe_valid_sink_last;
-wire   [31:0] pipe_valid_sink_payload_data;
-wire    [3:0] pipe_valid_sink_payload_error;
-wire    [3:0] pipe_valid_sink_payload_last_be;
-wire          pipe_valid_sink_ready;
-wire          pipe_valid_sink_valid;
-reg           pipe_valid_source_first = 1'd0;
-reg           pipe_valid_source_last = 1'd0;
-reg    [31:0] pipe_valid_source_payload_data = 32'd0;
-reg     [3:0] pipe_valid_source_payload_error = 4'd0;
-reg     [3:0] pipe_valid_source_payload_last_be = 4'd0;
-wire          pipe_valid_source_ready;
-reg           pipe_valid_source_valid = 1'd0;
 wire          por_clk;
 wire          port_clk;
 wire          port_rst;
@@ -2680,20 +2779,6 @@ wire    [9:0] rx_converter_source_source_payload_data;
 wire          rx_converter_source_source_ready;
 wire          rx_converter_source_source_valid;
 wire          rx_converter_source_valid;
-wire          sink_sink_first;
-wire          sink_sink_last;
-wire   [31:0] sink_sink_payload_data;
-wire    [3:0] sink_sink_payload_error;
-wire    [3:0] sink_sink_payload_last_be;
-wire          sink_sink_ready;
-wire          sink_sink_valid;
-wire          source_source_first;
-wire          source_source_last;
-wire   [31:0] source_source_payload_data;
-wire    [3:0] source_source_payload_error;
-wire    [3:0] source_source_payload_last_be;
-wire          source_source_ready;
-wire          source_source_valid;
 reg           state = 1'd0;
 wire          strideconverter0_converter_first;
 wire          strideconverter0_converter_last;
@@ -3042,7 +3127,7 @@ assign mac_core_tx_cdc_source_source_payload_data = mac_core_tx_cdc_cdc_source_p
 assign mac_core_tx_cdc_source_source_payload_last_be = mac_core_tx_cdc_cdc_source_payload_last_be;
 assign mac_core_tx_cdc_source_source_payload_error = mac_core_tx_cdc_cdc_source_payload_error;
 assign mac_core_tx_cdc_cdc_asyncfifo_din = {mac_core_tx_cdc_cdc_fifo_in_last, mac_core_tx_cdc_cdc_fifo_in_first, mac_core_tx_cdc_cdc_fifo_in_payload_error, mac_core_tx_cdc_cdc_fifo_in_payload_last_be, mac_core_tx_cdc_cdc_fifo_in_payload_data};
-assign {mac_core_tx_cdc_cdc_fifo_out_last, mac_core_tx_cdc_cdc_fifo_out_first, mac_core_tx_cdc_cdc_fifo_out_payload_error, mac_core_tx_cdc_cdc_fifo_out_payload_last_be, mac_core_tx_cdc_cdc_fifo_out_payload_data} = mac_core_tx_cdc_cdc_asyncfifo_dout;
+assign {mac_core_tx_cdc_cdc_fifo_out_last, mac_core_tx_cdc_cdc_fifo_out_first, mac_core_tx_cdc_cdc_fifo_out_payload_error, mac_core_tx_cdc_cdc_fifo_out_payload_last_be, mac_core_tx_cdc_cdc_fifo_out_payload_data} = mac_core_tx_cdc_cdc_dout;
 assign mac_core_tx_cdc_cdc_sink_ready = mac_core_tx_cdc_cdc_asyncfifo_writable;
 assign mac_core_tx_cdc_cdc_asyncfifo_we = mac_core_tx_cdc_cdc_sink_valid;
 assign mac_core_tx_cdc_cdc_fifo_in_first = mac_core_tx_cdc_cdc_sink_first;
@@ -3050,13 +3135,14 @@ assign mac_core_tx_cdc_cdc_fifo_in_last = mac_core_tx_cdc_cdc_sink_last;
 assign mac_core_tx_cdc_cdc_fifo_in_payload_data = mac_core_tx_cdc_cdc_sink_payload_data;
 assign mac_core_tx_cdc_cdc_fifo_in_payload_last_be = mac_core_tx_cdc_cdc_sink_payload_last_be;
 assign mac_core_tx_cdc_cdc_fifo_in_payload_error = mac_core_tx_cdc_cdc_sink_payload_error;
-assign mac_core_tx_cdc_cdc_source_valid = mac_core_tx_cdc_cdc_asyncfifo_readable;
+assign mac_core_tx_cdc_cdc_source_valid = mac_core_tx_cdc_cdc_readable;
 assign mac_core_tx_cdc_cdc_source_first = mac_core_tx_cdc_cdc_fifo_out_first;
 assign mac_core_tx_cdc_cdc_source_last = mac_core_tx_cdc_cdc_fifo_out_last;
 assign mac_core_tx_cdc_cdc_source_payload_data = mac_core_tx_cdc_cdc_fifo_out_payload_data;
 assign mac_core_tx_cdc_cdc_source_payload_last_be = mac_core_tx_cdc_cdc_fifo_out_payload_last_be;
 assign mac_core_tx_cdc_cdc_source_payload_error = mac_core_tx_cdc_cdc_fifo_out_payload_error;
-assign mac_core_tx_cdc_cdc_asyncfifo_re = mac_core_tx_cdc_cdc_source_ready;
+assign mac_core_tx_cdc_cdc_re = mac_core_tx_cdc_cdc_source_ready;
+assign mac_core_tx_cdc_cdc_asyncfifo_re = (mac_core_tx_cdc_cdc_re | (~mac_core_tx_cdc_cdc_readable));
 assign mac_core_tx_cdc_cdc_graycounter0_ce = (mac_core_tx_cdc_cdc_asyncfifo_writable & mac_core_tx_cdc_cdc_asyncfifo_we);
 assign mac_core_tx_cdc_cdc_graycounter1_ce = (mac_core_tx_cdc_cdc_asyncfifo_readable & mac_core_tx_cdc_cdc_asyncfifo_re);
 assign mac_core_tx_cdc_cdc_asyncfifo_writable = (((mac_core_tx_cdc_cdc_graycounter0_q[5] == mac_core_tx_cdc_cdc_consume_wdomain[5]) | (mac_core_tx_cdc_cdc_graycounter0_q[4] == mac_core_tx_cdc_cdc_consume_wdomain[4])) | (mac_core_tx_cdc_cdc_graycounter0_q[3:0] != mac_core_tx_cdc_cdc_consume_wdomain[3:0]));
@@ -3514,52 +3600,52 @@ always @(*) begin
         end
     endcase
 end
-assign pipe_valid_sink_ready = ((~pipe_valid_source_valid) | pipe_valid_source_ready);
-assign pipe_ready_sink_ready = (~pipe_ready_valid);
+assign buffer0_pipe_valid_sink_ready0 = ((~buffer0_pipe_valid_source_valid0) | buffer0_pipe_valid_source_ready0);
+assign buffer0_pipe_ready_sink_ready0 = (~buffer0_pipe_ready_valid0);
 always @(*) begin
-    pipe_ready_source_first <= 1'd0;
-    pipe_ready_source_last <= 1'd0;
-    pipe_ready_source_payload_data <= 32'd0;
-    pipe_ready_source_payload_error <= 4'd0;
-    pipe_ready_source_payload_last_be <= 4'd0;
-    pipe_ready_source_valid <= 1'd0;
-    if (pipe_ready_valid) begin
-        pipe_ready_source_valid <= pipe_ready_sink_d_valid;
-        pipe_ready_source_first <= pipe_ready_sink_d_first;
-        pipe_ready_source_last <= pipe_ready_sink_d_last;
-        pipe_ready_source_payload_data <= pipe_ready_sink_d_payload_data;
-        pipe_ready_source_payload_last_be <= pipe_ready_sink_d_payload_last_be;
-        pipe_ready_source_payload_error <= pipe_ready_sink_d_payload_error;
+    buffer0_pipe_ready_source_first0 <= 1'd0;
+    buffer0_pipe_ready_source_last0 <= 1'd0;
+    buffer0_pipe_ready_source_payload_data0 <= 32'd0;
+    buffer0_pipe_ready_source_payload_error0 <= 4'd0;
+    buffer0_pipe_ready_source_payload_last_be0 <= 4'd0;
+    buffer0_pipe_ready_source_valid0 <= 1'd0;
+    if (buffer0_pipe_ready_valid0) begin
+        buffer0_pipe_ready_source_valid0 <= buffer0_pipe_ready_sink_d_valid0;
+        buffer0_pipe_ready_source_first0 <= buffer0_pipe_ready_sink_d_first0;
+        buffer0_pipe_ready_source_last0 <= buffer0_pipe_ready_sink_d_last0;
+        buffer0_pipe_ready_source_payload_data0 <= buffer0_pipe_ready_sink_d_payload_data0;
+        buffer0_pipe_ready_source_payload_last_be0 <= buffer0_pipe_ready_sink_d_payload_last_be0;
+        buffer0_pipe_ready_source_payload_error0 <= buffer0_pipe_ready_sink_d_payload_error0;
     end else begin
-        pipe_ready_source_valid <= pipe_ready_sink_valid;
-        pipe_ready_source_first <= pipe_ready_sink_first;
-        pipe_ready_source_last <= pipe_ready_sink_last;
-        pipe_ready_source_payload_data <= pipe_ready_sink_payload_data;
-        pipe_ready_source_payload_last_be <= pipe_ready_sink_payload_last_be;
-        pipe_ready_source_payload_error <= pipe_ready_sink_payload_error;
+        buffer0_pipe_ready_source_valid0 <= buffer0_pipe_ready_sink_valid0;
+        buffer0_pipe_ready_source_first0 <= buffer0_pipe_ready_sink_first0;
+        buffer0_pipe_ready_source_last0 <= buffer0_pipe_ready_sink_last0;
+        buffer0_pipe_ready_source_payload_data0 <= buffer0_pipe_ready_sink_payload_data0;
+        buffer0_pipe_ready_source_payload_last_be0 <= buffer0_pipe_ready_sink_payload_last_be0;
+        buffer0_pipe_ready_source_payload_error0 <= buffer0_pipe_ready_sink_payload_error0;
     end
 end
-assign pipe_valid_sink_valid = sink_sink_valid;
-assign sink_sink_ready = pipe_valid_sink_ready;
-assign pipe_valid_sink_first = sink_sink_first;
-assign pipe_valid_sink_last = sink_sink_last;
-assign pipe_valid_sink_payload_data = sink_sink_payload_data;
-assign pipe_valid_sink_payload_last_be = sink_sink_payload_last_be;
-assign pipe_valid_sink_payload_error = sink_sink_payload_error;
-assign pipe_ready_sink_valid = pipe_valid_source_valid;
-assign pipe_valid_source_ready = pipe_ready_sink_ready;
-assign pipe_ready_sink_first = pipe_valid_source_first;
-assign pipe_ready_sink_last = pipe_valid_source_last;
-assign pipe_ready_sink_payload_data = pipe_valid_source_payload_data;
-assign pipe_ready_sink_payload_last_be = pipe_valid_source_payload_last_be;
-assign pipe_ready_sink_payload_error = pipe_valid_source_payload_error;
-assign source_source_valid = pipe_ready_source_valid;
-assign pipe_ready_source_ready = source_source_ready;
-assign source_source_first = pipe_ready_source_first;
-assign source_source_last = pipe_ready_source_last;
-assign source_source_payload_data = pipe_ready_source_payload_data;
-assign source_source_payload_last_be = pipe_ready_source_payload_last_be;
-assign source_source_payload_error = pipe_ready_source_payload_error;
+assign buffer0_pipe_valid_sink_valid0 = buffer0_sink_sink_valid0;
+assign buffer0_sink_sink_ready0 = buffer0_pipe_valid_sink_ready0;
+assign buffer0_pipe_valid_sink_first0 = buffer0_sink_sink_first0;
+assign buffer0_pipe_valid_sink_last0 = buffer0_sink_sink_last0;
+assign buffer0_pipe_valid_sink_payload_data0 = buffer0_sink_sink_payload_data0;
+assign buffer0_pipe_valid_sink_payload_last_be0 = buffer0_sink_sink_payload_last_be0;
+assign buffer0_pipe_valid_sink_payload_error0 = buffer0_sink_sink_payload_error0;
+assign buffer0_pipe_ready_sink_valid0 = buffer0_pipe_valid_source_valid0;
+assign buffer0_pipe_valid_source_ready0 = buffer0_pipe_ready_sink_ready0;
+assign buffer0_pipe_ready_sink_first0 = buffer0_pipe_valid_source_first0;
+assign buffer0_pipe_ready_sink_last0 = buffer0_pipe_valid_source_last0;
+assign buffer0_pipe_ready_sink_payload_data0 = buffer0_pipe_valid_source_payload_data0;
+assign buffer0_pipe_ready_sink_payload_last_be0 = buffer0_pipe_valid_source_payload_last_be0;
+assign buffer0_pipe_ready_sink_payload_error0 = buffer0_pipe_valid_source_payload_error0;
+assign buffer0_source_source_valid0 = buffer0_pipe_ready_source_valid0;
+assign buffer0_pipe_ready_source_ready0 = buffer0_source_source_ready0;
+assign buffer0_source_source_first0 = buffer0_pipe_ready_source_first0;
+assign buffer0_source_source_last0 = buffer0_pipe_ready_source_last0;
+assign buffer0_source_source_payload_data0 = buffer0_pipe_ready_source_payload_data0;
+assign buffer0_source_source_payload_last_be0 = buffer0_pipe_ready_source_payload_last_be0;
+assign buffer0_source_source_payload_error0 = buffer0_pipe_ready_source_payload_error0;
 assign mac_core_tx_cdc_sink_sink_valid = mac_core_sink_valid;
 assign mac_core_sink_ready = mac_core_tx_cdc_sink_sink_ready;
 assign mac_core_tx_cdc_sink_sink_first = mac_core_sink_first;
@@ -3567,20 +3653,20 @@ assign mac_core_tx_cdc_sink_sink_last = mac_core_sink_last;
 assign mac_core_tx_cdc_sink_sink_payload_data = mac_core_sink_payload_data;
 assign mac_core_tx_cdc_sink_sink_payload_last_be = mac_core_sink_payload_last_be;
 assign mac_core_tx_cdc_sink_sink_payload_error = mac_core_sink_payload_error;
-assign sink_sink_valid = mac_core_tx_cdc_source_source_valid;
-assign mac_core_tx_cdc_source_source_ready = sink_sink_ready;
-assign sink_sink_first = mac_core_tx_cdc_source_source_first;
-assign sink_sink_last = mac_core_tx_cdc_source_source_last;
-assign sink_sink_payload_data = mac_core_tx_cdc_source_source_payload_data;
-assign sink_sink_payload_last_be = mac_core_tx_cdc_source_source_payload_last_be;
-assign sink_sink_payload_error = mac_core_tx_cdc_source_source_payload_error;
-assign mac_core_tx_converter_sink_valid = source_source_valid;
-assign source_source_ready = mac_core_tx_converter_sink_ready;
-assign mac_core_tx_converter_sink_first = source_source_first;
-assign mac_core_tx_converter_sink_last = source_source_last;
-assign mac_core_tx_converter_sink_payload_data = source_source_payload_data;
-assign mac_core_tx_converter_sink_payload_last_be = source_source_payload_last_be;
-assign mac_core_tx_converter_sink_payload_error = source_source_payload_error;
+assign buffer0_sink_sink_valid0 = mac_core_tx_cdc_source_source_valid;
+assign mac_core_tx_cdc_source_source_ready = buffer0_sink_sink_ready0;
+assign buffer0_sink_sink_first0 = mac_core_tx_cdc_source_source_first;
+assign buffer0_sink_sink_last0 = mac_core_tx_cdc_source_source_last;
+assign buffer0_sink_sink_payload_data0 = mac_core_tx_cdc_source_source_payload_data;
+assign buffer0_sink_sink_payload_last_be0 = mac_core_tx_cdc_source_source_payload_last_be;
+assign buffer0_sink_sink_payload_error0 = mac_core_tx_cdc_source_source_payload_error;
+assign mac_core_tx_converter_sink_valid = buffer0_source_source_valid0;
+assign buffer0_source_source_ready0 = mac_core_tx_converter_sink_ready;
+assign mac_core_tx_converter_sink_first = buffer0_source_source_first0;
+assign mac_core_tx_converter_sink_last = buffer0_source_source_last0;
+assign mac_core_tx_converter_sink_payload_data = buffer0_source_source_payload_data0;
+assign mac_core_tx_converter_sink_payload_last_be = buffer0_source_source_payload_last_be0;
+assign mac_core_tx_converter_sink_payload_error = buffer0_source_source_payload_error0;
 assign mac_core_tx_last_be_sink_sink_valid = mac_core_tx_converter_source_valid;
 assign mac_core_tx_converter_source_ready = mac_core_tx_last_be_sink_sink_ready;
 assign mac_core_tx_last_be_sink_sink_first = mac_core_tx_converter_source_first;
@@ -3966,6 +4052,21 @@ always @(*) begin
     end
 end
 assign mac_core_rx_cdc_cdc_graycounter1_q_next = (mac_core_rx_cdc_cdc_graycounter1_q_next_binary ^ mac_core_rx_cdc_cdc_graycounter1_q_next_binary[5:1]);
+assign buffer1_pipe_valid_sink_ready0 = ((~buffer1_pipe_valid_source_valid0) | buffer1_pipe_valid_source_ready0);
+assign buffer1_pipe_valid_sink_valid0 = buffer1_sink_sink_valid0;
+assign buffer1_sink_sink_ready0 = buffer1_pipe_valid_sink_ready0;
+assign buffer1_pipe_valid_sink_first0 = buffer1_sink_sink_first0;
+assign buffer1_pipe_valid_sink_last0 = buffer1_sink_sink_last0;
+assign buffer1_pipe_valid_sink_payload_data0 = buffer1_sink_sink_payload_data0;
+assign buffer1_pipe_valid_sink_payload_last_be0 = buffer1_sink_sink_payload_last_be0;
+assign buffer1_pipe_valid_sink_payload_error0 = buffer1_sink_sink_payload_error0;
+assign buffer1_source_source_valid0 = buffer1_pipe_valid_source_valid0;
+assign buffer1_pipe_valid_source_ready0 = buffer1_source_source_ready0;
+assign buffer1_source_source_first0 = buffer1_pipe_valid_source_first0;
+assign buffer1_source_source_last0 = buffer1_pipe_valid_source_last0;
+assign buffer1_source_source_payload_data0 = buffer1_pipe_valid_source_payload_data0;
+assign buffer1_source_source_payload_last_be0 = buffer1_pipe_valid_source_payload_last_be0;
+assign buffer1_source_source_payload_error0 = buffer1_pipe_valid_source_payload_error0;
 assign mac_core_rx_preamble_sink_valid = ethphy_source_valid;
 assign ethphy_source_ready = mac_core_rx_preamble_sink_ready;
 assign mac_core_rx_preamble_sink_first = ethphy_source_first;
@@ -3980,13 +4081,20 @@ assign mac_core_bufferizeendpoints_sink_sink_last = mac_core_rx_preamble_source_
 assign mac_core_bufferizeendpoints_sink_sink_payload_data = mac_core_rx_preamble_source_payload_data;
 assign mac_core_bufferizeendpoints_sink_sink_payload_last_be = mac_core_rx_preamble_source_payload_last_be;
 assign mac_core_bufferizeendpoints_sink_sink_payload_error = mac_core_rx_preamble_source_payload_error;
-assign mac_core_rx_padding_sink_valid = mac_core_liteethmaccrc32checker_source_source_valid;
-assign mac_core_liteethmaccrc32checker_source_source_ready = mac_core_rx_padding_sink_ready;
-assign mac_core_rx_padding_sink_first = mac_core_liteethmaccrc32checker_source_source_first;
-assign mac_core_rx_padding_sink_last = mac_core_liteethmaccrc32checker_source_source_last;
-assign mac_core_rx_padding_sink_payload_data = mac_core_liteethmaccrc32checker_source_source_payload_data;
-assign mac_core_rx_padding_sink_payload_last_be = mac_core_liteethmaccrc32checker_source_source_payload_last_be;
-assign mac_core_rx_padding_sink_payload_error = mac_core_liteethmaccrc32checker_source_source_payload_error;
+assign buffer1_sink_sink_valid0 = mac_core_liteethmaccrc32checker_source_source_valid;
+assign mac_core_liteethmaccrc32checker_source_source_ready = buffer1_sink_sink_ready0;
+assign buffer1_sink_sink_first0 = mac_core_liteethmaccrc32checker_source_source_first;
+assign buffer1_sink_sink_last0 = mac_core_liteethmaccrc32checker_source_source_last;
+assign buffer1_sink_sink_payload_data0 = mac_core_liteethmaccrc32checker_source_source_payload_data;
+assign buffer1_sink_sink_payload_last_be0 = mac_core_liteethmaccrc32checker_source_source_payload_last_be;
+assign buffer1_sink_sink_payload_error0 = mac_core_liteethmaccrc32checker_source_source_payload_error;
+assign mac_core_rx_padding_sink_valid = buffer1_source_source_valid0;
+assign buffer1_source_source_ready0 = mac_core_rx_padding_sink_ready;
+assign mac_core_rx_padding_sink_first = buffer1_source_source_first0;
+assign mac_core_rx_padding_sink_last = buffer1_source_source_last0;
+assign mac_core_rx_padding_sink_payload_data = buffer1_source_source_payload_data0;
+assign mac_core_rx_padding_sink_payload_last_be = buffer1_source_source_payload_last_be0;
+assign mac_core_rx_padding_sink_payload_error = buffer1_source_source_payload_error0;
 assign mac_core_rx_last_be_sink_valid = mac_core_rx_padding_source_valid;
 assign mac_core_rx_padding_source_ready = mac_core_rx_last_be_sink_ready;
 assign mac_core_rx_last_be_sink_first = mac_core_rx_padding_source_first;
@@ -6360,37 +6468,48 @@ assign lastbytetrim_sink_payload_error = strideconverter0_source_payload_error;
 assign lastbytetrim_sink_param_length = strideconverter0_source_param_length;
 assign lastbytetrim_sink_param_protocol = strideconverter0_source_param_protocol;
 assign lastbytetrim_sink_param_ip_address = strideconverter0_source_param_ip_address;
-assign buffer0_sink_sink_valid = lastbytetrim_source_valid;
-assign lastbytetrim_source_ready = buffer0_sink_sink_ready;
-assign buffer0_sink_sink_first = lastbytetrim_source_first;
-assign buffer0_sink_sink_last = lastbytetrim_source_last;
-assign buffer0_sink_sink_payload_data = lastbytetrim_source_payload_data;
-assign buffer0_sink_sink_payload_last_be = lastbytetrim_source_payload_last_be;
-assign buffer0_sink_sink_payload_error = lastbytetrim_source_payload_error;
+assign buffer0_sink_sink_valid1 = lastbytetrim_source_valid;
+assign lastbytetrim_source_ready = buffer0_sink_sink_ready1;
+assign buffer0_sink_sink_first1 = lastbytetrim_source_first;
+assign buffer0_sink_sink_last1 = lastbytetrim_source_last;
+assign buffer0_sink_sink_payload_data1 = lastbytetrim_source_payload_data;
+assign buffer0_sink_sink_payload_last_be1 = lastbytetrim_source_payload_last_be;
+assign buffer0_sink_sink_payload_error1 = lastbytetrim_source_payload_error;
 assign buffer0_sink_sink_param_length = lastbytetrim_source_param_length;
 assign buffer0_sink_sink_param_protocol = lastbytetrim_source_param_protocol;
 assign buffer0_sink_sink_param_ip_address = lastbytetrim_source_param_ip_address;
-assign holdingudprx_sink_valid = buffer0_source_source_valid;
-assign buffer0_source_source_ready = holdingudprx_sink_ready;
-assign holdingudprx_sink_first = buffer0_source_source_first;
-assign holdingudprx_sink_last = buffer0_source_source_last;
-assign holdingudprx_sink_payload_data = buffer0_source_source_payload_data;
-assign holdingudprx_sink_payload_last_be = buffer0_source_source_payload_last_be;
-assign holdingudprx_sink_payload_error = buffer0_source_source_payload_error;
+assign holdingudprx_sink_valid = buffer0_source_source_valid1;
+assign buffer0_source_source_ready1 = holdingudprx_sink_ready;
+assign holdingudprx_sink_first = buffer0_source_source_first1;
+assign holdingudprx_sink_last = buffer0_source_source_last1;
+assign holdingudprx_sink_payload_data = buffer0_source_source_payload_data1;
+assign holdingudprx_sink_payload_last_be = buffer0_source_source_payload_last_be1;
+assign holdingudprx_sink_payload_error = buffer0_source_source_payload_error1;
 assign holdingudprx_sink_param_length = buffer0_source_source_param_length;
 assign holdingudprx_sink_param_protocol = buffer0_source_source_param_protocol;
 assign holdingudprx_sink_param_ip_address = buffer0_source_source_param_ip_address;
-assign maskedudpcrossbar_sink_valid = holdingudprx_source_valid;
-assign holdingudprx_source_ready = maskedudpcrossbar_sink_ready;
-assign maskedudpcrossbar_sink_first = holdingudprx_source_first;
-assign maskedudpcrossbar_sink_last = holdingudprx_source_last;
-assign maskedudpcrossbar_sink_payload_data = holdingudprx_source_payload_data;
-assign maskedudpcrossbar_sink_payload_last_be = holdingudprx_source_payload_last_be;
-assign maskedudpcrossbar_sink_payload_error = holdingudprx_source_payload_error;
-assign maskedudpcrossbar_sink_param_src_port = holdingudprx_source_param_src_port;
-assign maskedudpcrossbar_sink_param_dst_port = holdingudprx_source_param_dst_port;
-assign maskedudpcrossbar_sink_param_ip_address = holdingudprx_source_param_ip_address;
-assign maskedudpcrossbar_sink_param_length = holdingudprx_source_param_length;
+assign buffer2_sink_sink_valid = holdingudprx_source_valid;
+assign holdingudprx_source_ready = buffer2_sink_sink_ready;
+assign buffer2_sink_sink_first = holdingudprx_source_first;
+assign buffer2_sink_sink_last = holdingudprx_source_last;
+assign buffer2_sink_sink_payload_data = holdingudprx_source_payload_data;
+assign buffer2_sink_sink_payload_last_be = holdingudprx_source_payload_last_be;
+assign buffer2_sink_sink_payload_error = holdingudprx_source_payload_error;
+assign buffer2_sink_sink_param_src_port = holdingudprx_source_param_src_port;
+assign buffer2_sink_sink_param_dst_port = holdingudprx_source_param_dst_port;
+assign buffer2_sink_sink_param_ip_address = holdingudprx_source_param_ip_address;
+assign buffer2_sink_sink_param_length = holdingudprx_source_param_length;
+assign maskedudpcrossbar_sink_valid = buffer2_source_source_valid;
+assign buffer2_source_source_ready = maskedudpcrossbar_sink_ready;
+assign maskedudpcrossbar_sink_first = buffer2_source_source_first;
+assign maskedudpcrossbar_sink_last = buffer2_source_source_last;
+assign maskedudpcrossbar_sink_payload_data = buffer2_source_source_payload_data;
+assign maskedudpcrossbar_sink_payload_last_be = buffer2_source_source_payload_last_be;
+assign maskedudpcrossbar_sink_payload_error = buffer2_source_source_payload_error;
+assign maskedudpcrossbar_sink_param_src_port = buffer2_source_source_param_src_port;
+assign maskedudpcrossbar_sink_param_dst_port = buffer2_source_source_param_dst_port;
+assign maskedudpcrossbar_sink_param_ip_address = buffer2_source_source_param_ip_address;
+assign maskedudpcrossbar_sink_param_length = buffer2_source_source_param_length;
 assign liteethudptx_sink_sink_valid = maskedudpcrossbar_source_valid;
 assign maskedudpcrossbar_source_ready = liteethudptx_sink_sink_ready;
 assign liteethudptx_sink_sink_first = maskedudpcrossbar_source_first;
@@ -6402,23 +6521,23 @@ assign liteethudptx_sink_sink_param_src_port = maskedudpcrossbar_source_param_sr
 assign liteethudptx_sink_sink_param_dst_port = maskedudpcrossbar_source_param_dst_port;
 assign liteethudptx_sink_sink_param_ip_address = maskedudpcrossbar_source_param_ip_address;
 assign liteethudptx_sink_sink_param_length = maskedudpcrossbar_source_param_length;
-assign buffer1_sink_sink_valid = liteethudptx_source_source_valid;
-assign liteethudptx_source_source_ready = buffer1_sink_sink_ready;
-assign buffer1_sink_sink_first = liteethudptx_source_source_first;
-assign buffer1_sink_sink_last = liteethudptx_source_source_last;
-assign buffer1_sink_sink_payload_data = liteethudptx_source_source_payload_data;
-assign buffer1_sink_sink_payload_last_be = liteethudptx_source_source_payload_last_be;
-assign buffer1_sink_sink_payload_error = liteethudptx_source_source_payload_error;
+assign buffer1_sink_sink_valid1 = liteethudptx_source_source_valid;
+assign liteethudptx_source_source_ready = buffer1_sink_sink_ready1;
+assign buffer1_sink_sink_first1 = liteethudptx_source_source_first;
+assign buffer1_sink_sink_last1 = liteethudptx_source_source_last;
+assign buffer1_sink_sink_payload_data1 = liteethudptx_source_source_payload_data;
+assign buffer1_sink_sink_payload_last_be1 = liteethudptx_source_source_payload_last_be;
+assign buffer1_sink_sink_payload_error1 = liteethudptx_source_source_payload_error;
 assign buffer1_sink_sink_param_length = liteethudptx_source_source_param_length;
 assign buffer1_sink_sink_param_protocol = liteethudptx_source_source_param_protocol;
 assign buffer1_sink_sink_param_ip_address = liteethudptx_source_source_param_ip_address;
-assign strideconverter1_sink_valid = buffer1_source_source_valid;
-assign buffer1_source_source_ready = strideconverter1_sink_ready;
-assign strideconverter1_sink_first = buffer1_source_source_first;
-assign strideconverter1_sink_last = buffer1_source_source_last;
-assign strideconverter1_sink_payload_data = buffer1_source_source_payload_data;
-assign strideconverter1_sink_payload_last_be = buffer1_source_source_payload_last_be;
-assign strideconverter1_sink_payload_error = buffer1_source_source_payload_error;
+assign strideconverter1_sink_valid = buffer1_source_source_valid1;
+assign buffer1_source_source_ready1 = strideconverter1_sink_ready;
+assign strideconverter1_sink_first = buffer1_source_source_first1;
+assign strideconverter1_sink_last = buffer1_source_source_last1;
+assign strideconverter1_sink_payload_data = buffer1_source_source_payload_data1;
+assign strideconverter1_sink_payload_last_be = buffer1_source_source_payload_last_be1;
+assign strideconverter1_sink_payload_error = buffer1_source_source_payload_error1;
 assign strideconverter1_sink_param_length = buffer1_source_source_param_length;
 assign strideconverter1_sink_param_protocol = buffer1_source_source_param_protocol;
 assign strideconverter1_sink_param_ip_address = buffer1_source_source_param_ip_address;
@@ -6761,24 +6880,26 @@ always @(*) begin
     endcase
 end
 always @(*) begin
-    holdingudprx0_holdingudprx_next_value4 <= 16'd0;
-    holdingudprx0_holdingudprx_next_value_ce4 <= 1'd0;
-    holdingudprx1_holdingudprx_next_value5 <= 16'd0;
-    holdingudprx1_holdingudprx_next_value_ce5 <= 1'd0;
-    holdingudprx2_holdingudprx_next_value6 <= 16'd0;
-    holdingudprx2_holdingudprx_next_value_ce6 <= 1'd0;
-    holdingudprx3_holdingudprx_next_value7 <= 32'd0;
-    holdingudprx3_holdingudprx_next_value_ce7 <= 1'd0;
+    holdingudprx0_holdingudprx_next_value5 <= 16'd0;
+    holdingudprx0_holdingudprx_next_value_ce5 <= 1'd0;
+    holdingudprx1_holdingudprx_next_value6 <= 16'd0;
+    holdingudprx1_holdingudprx_next_value_ce6 <= 1'd0;
+    holdingudprx2_holdingudprx_next_value7 <= 16'd0;
+    holdingudprx2_holdingudprx_next_value_ce7 <= 1'd0;
+    holdingudprx3_holdingudprx_next_value8 <= 32'd0;
+    holdingudprx3_holdingudprx_next_value_ce8 <= 1'd0;
     holdingudprx_count_holdingudprx_next_value0 <= 16'd0;
     holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd0;
     holdingudprx_drop_header <= 1'd0;
-    holdingudprx_err_holdingudprx_next_value1 <= 1'd0;
-    holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd0;
-    holdingudprx_held_holdingudprx_next_value3 <= 8'd0;
-    holdingudprx_held_holdingudprx_next_value_ce3 <= 1'd0;
+    holdingudprx_err_holdingudprx_next_value2 <= 1'd0;
+    holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd0;
+    holdingudprx_held_holdingudprx_next_value4 <= 8'd0;
+    holdingudprx_held_holdingudprx_next_value_ce4 <= 1'd0;
     holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
-    holdingudprx_rest_holdingudprx_next_value2 <= 16'd0;
-    holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd0;
+    holdingudprx_more_holdingudprx_next_value1 <= 1'd0;
+    holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd0;
+    holdingudprx_rest_holdingudprx_next_value3 <= 16'd0;
+    holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd0;
     holdingudprx_source_last <= 1'd0;
     holdingudprx_source_param_dst_port <= 16'd0;
     holdingudprx_source_param_ip_address <= 32'd0;
@@ -6796,7 +6917,7 @@ always @(*) begin
             holdingudprx_source_param_length <= holdingudprx_payload_len;
             holdingudprx_source_param_ip_address <= holdingudprx_sink_param_ip_address;
             holdingudprx_source_payload_data <= holdingudprx_liteethudpdepacketizer_source_payload_data;
-            if ((holdingudprx_liteethudpdepacketizer_source_last | (holdingudprx_count < holdingudprx_payload_len))) begin
+            if ((holdingudprx_liteethudpdepacketizer_source_last | holdingudprx_more)) begin
                 holdingudprx_source_valid <= holdingudprx_liteethudpdepacketizer_source_valid;
                 holdingudprx_liteethudpdepacketizer_source_ready <= holdingudprx_source_ready;
                 holdingudprx_source_last <= holdingudprx_liteethudpdepacketizer_source_last;
@@ -6807,12 +6928,14 @@ always @(*) begin
                 if ((holdingudprx_liteethudpdepacketizer_source_valid & holdingudprx_source_ready)) begin
                     holdingudprx_count_holdingudprx_next_value0 <= (holdingudprx_count + 1'd1);
                     holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                    holdingudprx_more_holdingudprx_next_value1 <= (holdingudprx_count < holdingudprx_payload_len);
+                    holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd1;
                     if (holdingudprx_cut1) begin
-                        holdingudprx_rest_holdingudprx_next_value2 <= (holdingudprx_rest - 1'd1);
-                        holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+                        holdingudprx_rest_holdingudprx_next_value3 <= (holdingudprx_rest - 1'd1);
+                        holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
                     end
-                    holdingudprx_err_holdingudprx_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
-                    holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                    holdingudprx_err_holdingudprx_next_value2 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
+                    holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd1;
                     if (holdingudprx_liteethudpdepacketizer_source_last) begin
                         portudp_holdingudprx_next_state <= 1'd0;
                     end
@@ -6820,23 +6943,25 @@ always @(*) begin
             end else begin
                 holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
                 if (holdingudprx_liteethudpdepacketizer_source_valid) begin
-                    holdingudprx_held_holdingudprx_next_value3 <= holdingudprx_liteethudpdepacketizer_source_payload_data;
-                    holdingudprx_held_holdingudprx_next_value_ce3 <= 1'd1;
-                    holdingudprx_err_holdingudprx_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
-                    holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
-                    holdingudprx0_holdingudprx_next_value4 <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
-                    holdingudprx0_holdingudprx_next_value_ce4 <= 1'd1;
-                    holdingudprx1_holdingudprx_next_value5 <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
-                    holdingudprx1_holdingudprx_next_value_ce5 <= 1'd1;
-                    holdingudprx2_holdingudprx_next_value6 <= holdingudprx_payload_len;
-                    holdingudprx2_holdingudprx_next_value_ce6 <= 1'd1;
-                    holdingudprx3_holdingudprx_next_value7 <= holdingudprx_sink_param_ip_address;
-                    holdingudprx3_holdingudprx_next_value_ce7 <= 1'd1;
+                    holdingudprx_held_holdingudprx_next_value4 <= holdingudprx_liteethudpdepacketizer_source_payload_data;
+                    holdingudprx_held_holdingudprx_next_value_ce4 <= 1'd1;
+                    holdingudprx_err_holdingudprx_next_value2 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
+                    holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd1;
+                    holdingudprx0_holdingudprx_next_value5 <= holdingudprx_liteethudpdepacketizer_source_param_src_port;
+                    holdingudprx0_holdingudprx_next_value_ce5 <= 1'd1;
+                    holdingudprx1_holdingudprx_next_value6 <= holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+                    holdingudprx1_holdingudprx_next_value_ce6 <= 1'd1;
+                    holdingudprx2_holdingudprx_next_value7 <= holdingudprx_payload_len;
+                    holdingudprx2_holdingudprx_next_value_ce7 <= 1'd1;
+                    holdingudprx3_holdingudprx_next_value8 <= holdingudprx_sink_param_ip_address;
+                    holdingudprx3_holdingudprx_next_value_ce8 <= 1'd1;
                     holdingudprx_count_holdingudprx_next_value0 <= (holdingudprx_count + 1'd1);
                     holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                    holdingudprx_more_holdingudprx_next_value1 <= (holdingudprx_count < holdingudprx_payload_len);
+                    holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd1;
                     if (holdingudprx_cut1) begin
-                        holdingudprx_rest_holdingudprx_next_value2 <= (holdingudprx_rest - 1'd1);
-                        holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+                        holdingudprx_rest_holdingudprx_next_value3 <= (holdingudprx_rest - 1'd1);
+                        holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
                     end
                     portudp_holdingudprx_next_state <= 2'd2;
                 end
@@ -6845,18 +6970,20 @@ always @(*) begin
         2'd2: begin
             holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
             if (holdingudprx_liteethudpdepacketizer_source_valid) begin
-                holdingudprx_err_holdingudprx_next_value1 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
-                holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                holdingudprx_err_holdingudprx_next_value2 <= (holdingudprx_err | holdingudprx_liteethudpdepacketizer_source_payload_error);
+                holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd1;
                 holdingudprx_count_holdingudprx_next_value0 <= (holdingudprx_count + 1'd1);
                 holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                holdingudprx_more_holdingudprx_next_value1 <= (holdingudprx_count < holdingudprx_payload_len);
+                holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd1;
                 if (holdingudprx_cut1) begin
-                    holdingudprx_rest_holdingudprx_next_value2 <= (holdingudprx_rest - 1'd1);
-                    holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+                    holdingudprx_rest_holdingudprx_next_value3 <= (holdingudprx_rest - 1'd1);
+                    holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
                 end
                 if (holdingudprx_liteethudpdepacketizer_source_last) begin
                     if (holdingudprx_cut1) begin
-                        holdingudprx2_holdingudprx_next_value6 <= 1'd0;
-                        holdingudprx2_holdingudprx_next_value_ce6 <= 1'd1;
+                        holdingudprx2_holdingudprx_next_value7 <= 1'd0;
+                        holdingudprx2_holdingudprx_next_value_ce7 <= 1'd1;
                     end
                     portudp_holdingudprx_next_state <= 2'd3;
                 end
@@ -6882,15 +7009,17 @@ always @(*) begin
             end
         end
         default: begin
-            holdingudprx_count_holdingudprx_next_value0 <= 1'd1;
+            holdingudprx_count_holdingudprx_next_value0 <= 2'd2;
             holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
-            holdingudprx_err_holdingudprx_next_value1 <= 1'd0;
-            holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
-            holdingudprx_rest_holdingudprx_next_value2 <= (holdingudprx_sink_param_length - 4'd9);
-            holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+            holdingudprx_more_holdingudprx_next_value1 <= (holdingudprx_payload_len > 1'd1);
+            holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd1;
+            holdingudprx_err_holdingudprx_next_value2 <= 1'd0;
+            holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd1;
+            holdingudprx_rest_holdingudprx_next_value3 <= (holdingudprx_sink_param_length - 4'd9);
+            holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
             if ((holdingudprx_sink_param_length <= 4'd8)) begin
-                holdingudprx_rest_holdingudprx_next_value2 <= 1'd0;
-                holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+                holdingudprx_rest_holdingudprx_next_value3 <= 1'd0;
+                holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
             end
             if (holdingudprx_liteethudpdepacketizer_source_valid) begin
                 portudp_holdingudprx_next_state <= 3'd4;
@@ -7398,71 +7527,71 @@ always @(*) begin
 end
 assign portudp_last = ((maskedudpcrossbar_sink_valid & maskedudpcrossbar_sink_last) & maskedudpcrossbar_sink_ready);
 assign portudp_ongoing0 = ((maskedudpcrossbar_sink_valid | portudp_ongoing1) & (~portudp_last));
-assign buffer0_pipe_valid_sink_ready = ((~buffer0_pipe_valid_source_valid) | buffer0_pipe_valid_source_ready);
-assign buffer0_pipe_ready_sink_ready = (~buffer0_pipe_ready_valid);
+assign buffer0_pipe_valid_sink_ready1 = ((~buffer0_pipe_valid_source_valid1) | buffer0_pipe_valid_source_ready1);
+assign buffer0_pipe_ready_sink_ready1 = (~buffer0_pipe_ready_valid1);
 always @(*) begin
-    buffer0_pipe_ready_source_first <= 1'd0;
-    buffer0_pipe_ready_source_last <= 1'd0;
+    buffer0_pipe_ready_source_first1 <= 1'd0;
+    buffer0_pipe_ready_source_last1 <= 1'd0;
     buffer0_pipe_ready_source_param_ip_address <= 32'd0;
     buffer0_pipe_ready_source_param_length <= 16'd0;
     buffer0_pipe_ready_source_param_protocol <= 8'd0;
-    buffer0_pipe_ready_source_payload_data <= 8'd0;
-    buffer0_pipe_ready_source_payload_error <= 1'd0;
-    buffer0_pipe_ready_source_payload_last_be <= 1'd0;
-    buffer0_pipe_ready_source_valid <= 1'd0;
-    if (buffer0_pipe_ready_valid) begin
-        buffer0_pipe_ready_source_valid <= buffer0_pipe_ready_sink_d_valid;
-        buffer0_pipe_ready_source_first <= buffer0_pipe_ready_sink_d_first;
-        buffer0_pipe_ready_source_last <= buffer0_pipe_ready_sink_d_last;
-        buffer0_pipe_ready_source_payload_data <= buffer0_pipe_ready_sink_d_payload_data;
-        buffer0_pipe_ready_source_payload_last_be <= buffer0_pipe_ready_sink_d_payload_last_be;
-        buffer0_pipe_ready_source_payload_error <= buffer0_pipe_ready_sink_d_payload_error;
+    buffer0_pipe_ready_source_payload_data1 <= 8'd0;
+    buffer0_pipe_ready_source_payload_error1 <= 1'd0;
+    buffer0_pipe_ready_source_payload_last_be1 <= 1'd0;
+    buffer0_pipe_ready_source_valid1 <= 1'd0;
+    if (buffer0_pipe_ready_valid1) begin
+        buffer0_pipe_ready_source_valid1 <= buffer0_pipe_ready_sink_d_valid1;
+        buffer0_pipe_ready_source_first1 <= buffer0_pipe_ready_sink_d_first1;
+        buffer0_pipe_ready_source_last1 <= buffer0_pipe_ready_sink_d_last1;
+        buffer0_pipe_ready_source_payload_data1 <= buffer0_pipe_ready_sink_d_payload_data1;
+        buffer0_pipe_ready_source_payload_last_be1 <= buffer0_pipe_ready_sink_d_payload_last_be1;
+        buffer0_pipe_ready_source_payload_error1 <= buffer0_pipe_ready_sink_d_payload_error1;
         buffer0_pipe_ready_source_param_length <= buffer0_pipe_ready_sink_d_param_length;
         buffer0_pipe_ready_source_param_protocol <= buffer0_pipe_ready_sink_d_param_protocol;
         buffer0_pipe_ready_source_param_ip_address <= buffer0_pipe_ready_sink_d_param_ip_address;
     end else begin
-        buffer0_pipe_ready_source_valid <= buffer0_pipe_ready_sink_valid;
-        buffer0_pipe_ready_source_first <= buffer0_pipe_ready_sink_first;
-        buffer0_pipe_ready_source_last <= buffer0_pipe_ready_sink_last;
-        buffer0_pipe_ready_source_payload_data <= buffer0_pipe_ready_sink_payload_data;
-        buffer0_pipe_ready_source_payload_last_be <= buffer0_pipe_ready_sink_payload_last_be;
-        buffer0_pipe_ready_source_payload_error <= buffer0_pipe_ready_sink_payload_error;
+        buffer0_pipe_ready_source_valid1 <= buffer0_pipe_ready_sink_valid1;
+        buffer0_pipe_ready_source_first1 <= buffer0_pipe_ready_sink_first1;
+        buffer0_pipe_ready_source_last1 <= buffer0_pipe_ready_sink_last1;
+        buffer0_pipe_ready_source_payload_data1 <= buffer0_pipe_ready_sink_payload_data1;
+        buffer0_pipe_ready_source_payload_last_be1 <= buffer0_pipe_ready_sink_payload_last_be1;
+        buffer0_pipe_ready_source_payload_error1 <= buffer0_pipe_ready_sink_payload_error1;
         buffer0_pipe_ready_source_param_length <= buffer0_pipe_ready_sink_param_length;
         buffer0_pipe_ready_source_param_protocol <= buffer0_pipe_ready_sink_param_protocol;
         buffer0_pipe_ready_source_param_ip_address <= buffer0_pipe_ready_sink_param_ip_address;
     end
 end
-assign buffer0_pipe_valid_sink_valid = buffer0_sink_sink_valid;
-assign buffer0_sink_sink_ready = buffer0_pipe_valid_sink_ready;
-assign buffer0_pipe_valid_sink_first = buffer0_sink_sink_first;
-assign buffer0_pipe_valid_sink_last = buffer0_sink_sink_last;
-assign buffer0_pipe_valid_sink_payload_data = buffer0_sink_sink_payload_data;
-assign buffer0_pipe_valid_sink_payload_last_be = buffer0_sink_sink_payload_last_be;
-assign buffer0_pipe_valid_sink_payload_error = buffer0_sink_sink_payload_error;
+assign buffer0_pipe_valid_sink_valid1 = buffer0_sink_sink_valid1;
+assign buffer0_sink_sink_ready1 = buffer0_pipe_valid_sink_ready1;
+assign buffer0_pipe_valid_sink_first1 = buffer0_sink_sink_first1;
+assign buffer0_pipe_valid_sink_last1 = buffer0_sink_sink_last1;
+assign buffer0_pipe_valid_sink_payload_data1 = buffer0_sink_sink_payload_data1;
+assign buffer0_pipe_valid_sink_payload_last_be1 = buffer0_sink_sink_payload_last_be1;
+assign buffer0_pipe_valid_sink_payload_error1 = buffer0_sink_sink_payload_error1;
 assign buffer0_pipe_valid_sink_param_length = buffer0_sink_sink_param_length;
 assign buffer0_pipe_valid_sink_param_protocol = buffer0_sink_sink_param_protocol;
 assign buffer0_pipe_valid_sink_param_ip_address = buffer0_sink_sink_param_ip_address;
-assign buffer0_pipe_ready_sink_valid = buffer0_pipe_valid_source_valid;
-assign buffer0_pipe_valid_source_ready = buffer0_pipe_ready_sink_ready;
-assign buffer0_pipe_ready_sink_first = buffer0_pipe_valid_source_first;
-assign buffer0_pipe_ready_sink_last = buffer0_pipe_valid_source_last;
-assign buffer0_pipe_ready_sink_payload_data = buffer0_pipe_valid_source_payload_data;
-assign buffer0_pipe_ready_sink_payload_last_be = buffer0_pipe_valid_source_payload_last_be;
-assign buffer0_pipe_ready_sink_payload_error = buffer0_pipe_valid_source_payload_error;
+assign buffer0_pipe_ready_sink_valid1 = buffer0_pipe_valid_source_valid1;
+assign buffer0_pipe_valid_source_ready1 = buffer0_pipe_ready_sink_ready1;
+assign buffer0_pipe_ready_sink_first1 = buffer0_pipe_valid_source_first1;
+assign buffer0_pipe_ready_sink_last1 = buffer0_pipe_valid_source_last1;
+assign buffer0_pipe_ready_sink_payload_data1 = buffer0_pipe_valid_source_payload_data1;
+assign buffer0_pipe_ready_sink_payload_last_be1 = buffer0_pipe_valid_source_payload_last_be1;
+assign buffer0_pipe_ready_sink_payload_error1 = buffer0_pipe_valid_source_payload_error1;
 assign buffer0_pipe_ready_sink_param_length = buffer0_pipe_valid_source_param_length;
 assign buffer0_pipe_ready_sink_param_protocol = buffer0_pipe_valid_source_param_protocol;
 assign buffer0_pipe_ready_sink_param_ip_address = buffer0_pipe_valid_source_param_ip_address;
-assign buffer0_source_source_valid = buffer0_pipe_ready_source_valid;
-assign buffer0_pipe_ready_source_ready = buffer0_source_source_ready;
-assign buffer0_source_source_first = buffer0_pipe_ready_source_first;
-assign buffer0_source_source_last = buffer0_pipe_ready_source_last;
-assign buffer0_source_source_payload_data = buffer0_pipe_ready_source_payload_data;
-assign buffer0_source_source_payload_last_be = buffer0_pipe_ready_source_payload_last_be;
-assign buffer0_source_source_payload_error = buffer0_pipe_ready_source_payload_error;
+assign buffer0_source_source_valid1 = buffer0_pipe_ready_source_valid1;
+assign buffer0_pipe_ready_source_ready1 = buffer0_source_source_ready1;
+assign buffer0_source_source_first1 = buffer0_pipe_ready_source_first1;
+assign buffer0_source_source_last1 = buffer0_pipe_ready_source_last1;
+assign buffer0_source_source_payload_data1 = buffer0_pipe_ready_source_payload_data1;
+assign buffer0_source_source_payload_last_be1 = buffer0_pipe_ready_source_payload_last_be1;
+assign buffer0_source_source_payload_error1 = buffer0_pipe_ready_source_payload_error1;
 assign buffer0_source_source_param_length = buffer0_pipe_ready_source_param_length;
 assign buffer0_source_source_param_protocol = buffer0_pipe_ready_source_param_protocol;
 assign buffer0_source_source_param_ip_address = buffer0_pipe_ready_source_param_ip_address;
-assign buffer1_pipe_valid_sink_ready = ((~buffer1_pipe_valid_source_valid) | buffer1_pipe_valid_source_ready);
+assign buffer1_pipe_valid_sink_ready1 = ((~buffer1_pipe_valid_source_valid1) | buffer1_pipe_valid_source_ready1);
 assign buffer1_pipe_ready_sink_ready = (~buffer1_pipe_ready_valid);
 always @(*) begin
     buffer1_pipe_ready_source_first <= 1'd0;
@@ -7496,36 +7625,59 @@ always @(*) begin
         buffer1_pipe_ready_source_param_ip_address <= buffer1_pipe_ready_sink_param_ip_address;
     end
 end
-assign buffer1_pipe_valid_sink_valid = buffer1_sink_sink_valid;
-assign buffer1_sink_sink_ready = buffer1_pipe_valid_sink_ready;
-assign buffer1_pipe_valid_sink_first = buffer1_sink_sink_first;
-assign buffer1_pipe_valid_sink_last = buffer1_sink_sink_last;
-assign buffer1_pipe_valid_sink_payload_data = buffer1_sink_sink_payload_data;
-assign buffer1_pipe_valid_sink_payload_last_be = buffer1_sink_sink_payload_last_be;
-assign buffer1_pipe_valid_sink_payload_error = buffer1_sink_sink_payload_error;
+assign buffer1_pipe_valid_sink_valid1 = buffer1_sink_sink_valid1;
+assign buffer1_sink_sink_ready1 = buffer1_pipe_valid_sink_ready1;
+assign buffer1_pipe_valid_sink_first1 = buffer1_sink_sink_first1;
+assign buffer1_pipe_valid_sink_last1 = buffer1_sink_sink_last1;
+assign buffer1_pipe_valid_sink_payload_data1 = buffer1_sink_sink_payload_data1;
+assign buffer1_pipe_valid_sink_payload_last_be1 = buffer1_sink_sink_payload_last_be1;
+assign buffer1_pipe_valid_sink_payload_error1 = buffer1_sink_sink_payload_error1;
 assign buffer1_pipe_valid_sink_param_length = buffer1_sink_sink_param_length;
 assign buffer1_pipe_valid_sink_param_protocol = buffer1_sink_sink_param_protocol;
 assign buffer1_pipe_valid_sink_param_ip_address = buffer1_sink_sink_param_ip_address;
-assign buffer1_pipe_ready_sink_valid = buffer1_pipe_valid_source_valid;
-assign buffer1_pipe_valid_source_ready = buffer1_pipe_ready_sink_ready;
-assign buffer1_pipe_ready_sink_first = buffer1_pipe_valid_source_first;
-assign buffer1_pipe_ready_sink_last = buffer1_pipe_valid_source_last;
-assign buffer1_pipe_ready_sink_payload_data = buffer1_pipe_valid_source_payload_data;
-assign buffer1_pipe_ready_sink_payload_last_be = buffer1_pipe_valid_source_payload_last_be;
-assign buffer1_pipe_ready_sink_payload_error = buffer1_pipe_valid_source_payload_error;
+assign buffer1_pipe_ready_sink_valid = buffer1_pipe_valid_source_valid1;
+assign buffer1_pipe_valid_source_ready1 = buffer1_pipe_ready_sink_ready;
+assign buffer1_pipe_ready_sink_first = buffer1_pipe_valid_source_first1;
+assign buffer1_pipe_ready_sink_last = buffer1_pipe_valid_source_last1;
+assign buffer1_pipe_ready_sink_payload_data = buffer1_pipe_valid_source_payload_data1;
+assign buffer1_pipe_ready_sink_payload_last_be = buffer1_pipe_valid_source_payload_last_be1;
+assign buffer1_pipe_ready_sink_payload_error = buffer1_pipe_valid_source_payload_error1;
 assign buffer1_pipe_ready_sink_param_length = buffer1_pipe_valid_source_param_length;
 assign buffer1_pipe_ready_sink_param_protocol = buffer1_pipe_valid_source_param_protocol;
 assign buffer1_pipe_ready_sink_param_ip_address = buffer1_pipe_valid_source_param_ip_address;
-assign buffer1_source_source_valid = buffer1_pipe_ready_source_valid;
-assign buffer1_pipe_ready_source_ready = buffer1_source_source_ready;
-assign buffer1_source_source_first = buffer1_pipe_ready_source_first;
-assign buffer1_source_source_last = buffer1_pipe_ready_source_last;
-assign buffer1_source_source_payload_data = buffer1_pipe_ready_source_payload_data;
-assign buffer1_source_source_payload_last_be = buffer1_pipe_ready_source_payload_last_be;
-assign buffer1_source_source_payload_error = buffer1_pipe_ready_source_payload_error;
+assign buffer1_source_source_valid1 = buffer1_pipe_ready_source_valid;
+assign buffer1_pipe_ready_source_ready = buffer1_source_source_ready1;
+assign buffer1_source_source_first1 = buffer1_pipe_ready_source_first;
+assign buffer1_source_source_last1 = buffer1_pipe_ready_source_last;
+assign buffer1_source_source_payload_data1 = buffer1_pipe_ready_source_payload_data;
+assign buffer1_source_source_payload_last_be1 = buffer1_pipe_ready_source_payload_last_be;
+assign buffer1_source_source_payload_error1 = buffer1_pipe_ready_source_payload_error;
 assign buffer1_source_source_param_length = buffer1_pipe_ready_source_param_length;
 assign buffer1_source_source_param_protocol = buffer1_pipe_ready_source_param_protocol;
 assign buffer1_source_source_param_ip_address = buffer1_pipe_ready_source_param_ip_address;
+assign buffer2_pipe_valid_sink_ready = ((~buffer2_pipe_valid_source_valid) | buffer2_pipe_valid_source_ready);
+assign buffer2_pipe_valid_sink_valid = buffer2_sink_sink_valid;
+assign buffer2_sink_sink_ready = buffer2_pipe_valid_sink_ready;
+assign buffer2_pipe_valid_sink_first = buffer2_sink_sink_first;
+assign buffer2_pipe_valid_sink_last = buffer2_sink_sink_last;
+assign buffer2_pipe_valid_sink_payload_data = buffer2_sink_sink_payload_data;
+assign buffer2_pipe_valid_sink_payload_last_be = buffer2_sink_sink_payload_last_be;
+assign buffer2_pipe_valid_sink_payload_error = buffer2_sink_sink_payload_error;
+assign buffer2_pipe_valid_sink_param_src_port = buffer2_sink_sink_param_src_port;
+assign buffer2_pipe_valid_sink_param_dst_port = buffer2_sink_sink_param_dst_port;
+assign buffer2_pipe_valid_sink_param_ip_address = buffer2_sink_sink_param_ip_address;
+assign buffer2_pipe_valid_sink_param_length = buffer2_sink_sink_param_length;
+assign buffer2_source_source_valid = buffer2_pipe_valid_source_valid;
+assign buffer2_pipe_valid_source_ready = buffer2_source_source_ready;
+assign buffer2_source_source_first = buffer2_pipe_valid_source_first;
+assign buffer2_source_source_last = buffer2_pipe_valid_source_last;
+assign buffer2_source_source_payload_data = buffer2_pipe_valid_source_payload_data;
+assign buffer2_source_source_payload_last_be = buffer2_pipe_valid_source_payload_last_be;
+assign buffer2_source_source_payload_error = buffer2_pipe_valid_source_payload_error;
+assign buffer2_source_source_param_src_port = buffer2_pipe_valid_source_param_src_port;
+assign buffer2_source_source_param_dst_port = buffer2_pipe_valid_source_param_dst_port;
+assign buffer2_source_source_param_ip_address = buffer2_pipe_valid_source_param_ip_address;
+assign buffer2_source_source_param_length = buffer2_pipe_valid_source_param_length;
 assign pulsemerge0_total0 = ((((1'd0 + mac_cut) + ip_rx_cut) + ip_rx_drop_header) + pulsemerge0_backlog0);
 assign pulsemerge0_o0 = (pulsemerge0_total0 != 1'd0);
 assign pulsesynchronizer0_o = (pulsesynchronizer0_toggle_o ^ pulsesynchronizer0_toggle_o_r);
@@ -7851,6 +8003,14 @@ always @(posedge eth_rx_clk) begin
     end
     mac_core_rx_cdc_cdc_graycounter0_q_binary <= mac_core_rx_cdc_cdc_graycounter0_q_next_binary;
     mac_core_rx_cdc_cdc_graycounter0_q <= mac_core_rx_cdc_cdc_graycounter0_q_next;
+    if (((~buffer1_pipe_valid_source_valid0) | buffer1_pipe_valid_source_ready0)) begin
+        buffer1_pipe_valid_source_valid0 <= buffer1_pipe_valid_sink_valid0;
+        buffer1_pipe_valid_source_first0 <= buffer1_pipe_valid_sink_first0;
+        buffer1_pipe_valid_source_last0 <= buffer1_pipe_valid_sink_last0;
+        buffer1_pipe_valid_source_payload_data0 <= buffer1_pipe_valid_sink_payload_data0;
+        buffer1_pipe_valid_source_payload_last_be0 <= buffer1_pipe_valid_sink_payload_last_be0;
+        buffer1_pipe_valid_source_payload_error0 <= buffer1_pipe_valid_sink_payload_error0;
+    end
     if (eth_rx_rst) begin
         ethphy_source_valid <= 1'd0;
         ethphy_source_payload_data <= 8'd0;
@@ -7876,6 +8036,10 @@ always @(posedge eth_rx_clk) begin
         mac_core_rx_converter_converter_strobe_all <= 1'd0;
         mac_core_rx_cdc_cdc_graycounter0_q <= 6'd0;
         mac_core_rx_cdc_cdc_graycounter0_q_binary <= 6'd0;
+        buffer1_pipe_valid_source_valid0 <= 1'd0;
+        buffer1_pipe_valid_source_payload_data0 <= 8'd0;
+        buffer1_pipe_valid_source_payload_last_be0 <= 1'd0;
+        buffer1_pipe_valid_source_payload_error0 <= 1'd0;
         liteethmac_rxdatapath_liteethmacpreamblechecker_state <= 1'd0;
         liteethmac_rxdatapath_bufferizeendpoints_state <= 2'd0;
     end
@@ -7884,6 +8048,10 @@ always @(posedge eth_rx_clk) begin
 end
 
 always @(posedge eth_tx_clk) begin
+    if ((mac_core_tx_cdc_cdc_re | (~mac_core_tx_cdc_cdc_readable))) begin
+        mac_core_tx_cdc_cdc_dout <= mac_core_tx_cdc_cdc_asyncfifo_dout;
+        mac_core_tx_cdc_cdc_readable <= mac_core_tx_cdc_cdc_asyncfifo_readable;
+    end
     mac_core_tx_cdc_cdc_graycounter1_q_binary <= mac_core_tx_cdc_cdc_graycounter1_q_next_binary;
     mac_core_tx_cdc_cdc_graycounter1_q <= mac_core_tx_cdc_cdc_graycounter1_q_next;
     if ((mac_core_tx_converter_converter_source_valid & mac_core_tx_converter_converter_source_ready)) begin
@@ -7934,31 +8102,32 @@ always @(posedge eth_tx_clk) begin
     if (mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value_ce) begin
         mac_core_tx_gap_counter <= mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value;
     end
-    if (((~pipe_valid_source_valid) | pipe_valid_source_ready)) begin
-        pipe_valid_source_valid <= pipe_valid_sink_valid;
-        pipe_valid_source_first <= pipe_valid_sink_first;
-        pipe_valid_source_last <= pipe_valid_sink_last;
-        pipe_valid_source_payload_data <= pipe_valid_sink_payload_data;
-        pipe_valid_source_payload_last_be <= pipe_valid_sink_payload_last_be;
-        pipe_valid_source_payload_error <= pipe_valid_sink_payload_error;
+    if (((~buffer0_pipe_valid_source_valid0) | buffer0_pipe_valid_source_ready0)) begin
+        buffer0_pipe_valid_source_valid0 <= buffer0_pipe_valid_sink_valid0;
+        buffer0_pipe_valid_source_first0 <= buffer0_pipe_valid_sink_first0;
+        buffer0_pipe_valid_source_last0 <= buffer0_pipe_valid_sink_last0;
+        buffer0_pipe_valid_source_payload_data0 <= buffer0_pipe_valid_sink_payload_data0;
+        buffer0_pipe_valid_source_payload_last_be0 <= buffer0_pipe_valid_sink_payload_last_be0;
+        buffer0_pipe_valid_source_payload_error0 <= buffer0_pipe_valid_sink_payload_error0;
     end
-    if ((pipe_ready_sink_valid & (~pipe_ready_source_ready))) begin
-        pipe_ready_valid <= 1'd1;
+    if ((buffer0_pipe_ready_sink_valid0 & (~buffer0_pipe_ready_source_ready0))) begin
+        buffer0_pipe_ready_valid0 <= 1'd1;
     end else begin
-        if (pipe_ready_source_ready) begin
-            pipe_ready_valid <= 1'd0;
+        if (buffer0_pipe_ready_source_ready0) begin
+            buffer0_pipe_ready_valid0 <= 1'd0;
         end
     end
-    if (((~pipe_ready_source_ready) & (~pipe_ready_valid))) begin
-        pipe_ready_sink_d_valid <= pipe_ready_sink_valid;
-        pipe_ready_sink_d_ready <= pipe_ready_sink_ready;
-        pipe_ready_sink_d_first <= pipe_ready_sink_first;
-        pipe_ready_sink_d_last <= pipe_ready_sink_last;
-        pipe_ready_sink_d_payload_data <= pipe_ready_sink_payload_data;
-        pipe_ready_sink_d_payload_last_be <= pipe_ready_sink_payload_last_be;
-        pipe_ready_sink_d_payload_error <= pipe_ready_sink_payload_error;
+    if (((~buffer0_pipe_ready_source_ready0) & (~buffer0_pipe_ready_valid0))) begin
+        buffer0_pipe_ready_sink_d_valid0 <= buffer0_pipe_ready_sink_valid0;
+        buffer0_pipe_ready_sink_d_ready0 <= buffer0_pipe_ready_sink_ready0;
+        buffer0_pipe_ready_sink_d_first0 <= buffer0_pipe_ready_sink_first0;
+        buffer0_pipe_ready_sink_d_last0 <= buffer0_pipe_ready_sink_last0;
+        buffer0_pipe_ready_sink_d_payload_data0 <= buffer0_pipe_ready_sink_payload_data0;
+        buffer0_pipe_ready_sink_d_payload_last_be0 <= buffer0_pipe_ready_sink_payload_last_be0;
+        buffer0_pipe_ready_sink_d_payload_error0 <= buffer0_pipe_ready_sink_payload_error0;
     end
     if (eth_tx_rst) begin
+        mac_core_tx_cdc_cdc_readable <= 1'd0;
         mac_core_tx_cdc_cdc_graycounter1_q <= 6'd0;
         mac_core_tx_cdc_cdc_graycounter1_q_binary <= 6'd0;
         mac_core_tx_converter_converter_mux <= 2'd0;
@@ -7969,16 +8138,16 @@ always @(posedge eth_tx_clk) begin
         mac_core_tx_crc_pipe_valid_source_payload_data <= 8'd0;
         mac_core_tx_crc_pipe_valid_source_payload_last_be <= 1'd0;
         mac_core_tx_crc_pipe_valid_source_payload_error <= 1'd0;
-        pipe_valid_source_valid <= 1'd0;
-        pipe_valid_source_payload_data <= 32'd0;
-        pipe_valid_source_payload_last_be <= 4'd0;
-        pipe_valid_source_payload_error <= 4'd0;
-        pipe_ready_valid <= 1'd0;
-        pipe_ready_sink_d_valid <= 1'd0;
-        pipe_ready_sink_d_ready <= 1'd0;
-        pipe_ready_sink_d_payload_data <= 32'd0;
-        pipe_ready_sink_d_payload_last_be <= 4'd0;
-        pipe_ready_sink_d_payload_error <= 4'd0;
+        buffer0_pipe_valid_source_valid0 <= 1'd0;
+        buffer0_pipe_valid_source_payload_data0 <= 32'd0;
+        buffer0_pipe_valid_source_payload_last_be0 <= 4'd0;
+        buffer0_pipe_valid_source_payload_error0 <= 4'd0;
+        buffer0_pipe_ready_valid0 <= 1'd0;
+        buffer0_pipe_ready_sink_d_valid0 <= 1'd0;
+        buffer0_pipe_ready_sink_d_ready0 <= 1'd0;
+        buffer0_pipe_ready_sink_d_payload_data0 <= 32'd0;
+        buffer0_pipe_ready_sink_d_payload_last_be0 <= 4'd0;
+        buffer0_pipe_ready_sink_d_payload_error0 <= 4'd0;
         liteethmac_txdatapath_liteethmactxlastbe_state <= 1'd0;
         liteethmac_txdatapath_liteethmacpaddinginserter_state <= 1'd0;
         liteethmac_txdatapath_bufferizeendpoints_state <= 2'd0;
@@ -8029,26 +8198,29 @@ always @(posedge port_clk) begin
     if (holdingudprx_count_holdingudprx_next_value_ce0) begin
         holdingudprx_count <= holdingudprx_count_holdingudprx_next_value0;
     end
-    if (holdingudprx_err_holdingudprx_next_value_ce1) begin
-        holdingudprx_err <= holdingudprx_err_holdingudprx_next_value1;
+    if (holdingudprx_more_holdingudprx_next_value_ce1) begin
+        holdingudprx_more <= holdingudprx_more_holdingudprx_next_value1;
     end
-    if (holdingudprx_rest_holdingudprx_next_value_ce2) begin
-        holdingudprx_rest <= holdingudprx_rest_holdingudprx_next_value2;
+    if (holdingudprx_err_holdingudprx_next_value_ce2) begin
+        holdingudprx_err <= holdingudprx_err_holdingudprx_next_value2;
     end
-    if (holdingudprx_held_holdingudprx_next_value_ce3) begin
-        holdingudprx_held <= holdingudprx_held_holdingudprx_next_value3;
+    if (holdingudprx_rest_holdingudprx_next_value_ce3) begin
+        holdingudprx_rest <= holdingudprx_rest_holdingudprx_next_value3;
     end
-    if (holdingudprx0_holdingudprx_next_value_ce4) begin
-        holdingudprx0 <= holdingudprx0_holdingudprx_next_value4;
+    if (holdingudprx_held_holdingudprx_next_value_ce4) begin
+        holdingudprx_held <= holdingudprx_held_holdingudprx_next_value4;
     end
-    if (holdingudprx1_holdingudprx_next_value_ce5) begin
-        holdingudprx1 <= holdingudprx1_holdingudprx_next_value5;
+    if (holdingudprx0_holdingudprx_next_value_ce5) begin
+        holdingudprx0 <= holdingudprx0_holdingudprx_next_value5;
     end
-    if (holdingudprx2_holdingudprx_next_value_ce6) begin
-        holdingudprx2 <= holdingudprx2_holdingudprx_next_value6;
+    if (holdingudprx1_holdingudprx_next_value_ce6) begin
+        holdingudprx1 <= holdingudprx1_holdingudprx_next_value6;
     end
-    if (holdingudprx3_holdingudprx_next_value_ce7) begin
-        holdingudprx3 <= holdingudprx3_holdingudprx_next_value7;
+    if (holdingudprx2_holdingudprx_next_value_ce7) begin
+        holdingudprx2 <= holdingudprx2_holdingudprx_next_value7;
+    end
+    if (holdingudprx3_holdingudprx_next_value_ce8) begin
+        holdingudprx3 <= holdingudprx3_holdingudprx_next_value8;
     end
     if (liteethudptx_packetizer_sr_load) begin
         liteethudptx_packetizer_sr <= liteethudptx_packetizer_header;
@@ -8128,43 +8300,43 @@ always @(posedge port_clk) begin
             portudp_first <= 1'd0;
         end
     end
-    if (((~buffer0_pipe_valid_source_valid) | buffer0_pipe_valid_source_ready)) begin
-        buffer0_pipe_valid_source_valid <= buffer0_pipe_valid_sink_valid;
-        buffer0_pipe_valid_source_first <= buffer0_pipe_valid_sink_first;
-        buffer0_pipe_valid_source_last <= buffer0_pipe_valid_sink_last;
-        buffer0_pipe_valid_source_payload_data <= buffer0_pipe_valid_sink_payload_data;
-        buffer0_pipe_valid_source_payload_last_be <= buffer0_pipe_valid_sink_payload_last_be;
-        buffer0_pipe_valid_source_payload_error <= buffer0_pipe_valid_sink_payload_error;
+    if (((~buffer0_pipe_valid_source_valid1) | buffer0_pipe_valid_source_ready1)) begin
+        buffer0_pipe_valid_source_valid1 <= buffer0_pipe_valid_sink_valid1;
+        buffer0_pipe_valid_source_first1 <= buffer0_pipe_valid_sink_first1;
+        buffer0_pipe_valid_source_last1 <= buffer0_pipe_valid_sink_last1;
+        buffer0_pipe_valid_source_payload_data1 <= buffer0_pipe_valid_sink_payload_data1;
+        buffer0_pipe_valid_source_payload_last_be1 <= buffer0_pipe_valid_sink_payload_last_be1;
+        buffer0_pipe_valid_source_payload_error1 <= buffer0_pipe_valid_sink_payload_error1;
         buffer0_pipe_valid_source_param_length <= buffer0_pipe_valid_sink_param_length;
         buffer0_pipe_valid_source_param_protocol <= buffer0_pipe_valid_sink_param_protocol;
         buffer0_pipe_valid_source_param_ip_address <= buffer0_pipe_valid_sink_param_ip_address;
     end
-    if ((buffer0_pipe_ready_sink_valid & (~buffer0_pipe_ready_source_ready))) begin
-        buffer0_pipe_ready_valid <= 1'd1;
+    if ((buffer0_pipe_ready_sink_valid1 & (~buffer0_pipe_ready_source_ready1))) begin
+        buffer0_pipe_ready_valid1 <= 1'd1;
     end else begin
-        if (buffer0_pipe_ready_source_ready) begin
-            buffer0_pipe_ready_valid <= 1'd0;
+        if (buffer0_pipe_ready_source_ready1) begin
+            buffer0_pipe_ready_valid1 <= 1'd0;
         end
     end
-    if (((~buffer0_pipe_ready_source_ready) & (~buffer0_pipe_ready_valid))) begin
-        buffer0_pipe_ready_sink_d_valid <= buffer0_pipe_ready_sink_valid;
-        buffer0_pipe_ready_sink_d_ready <= buffer0_pipe_ready_sink_ready;
-        buffer0_pipe_ready_sink_d_first <= buffer0_pipe_ready_sink_first;
-        buffer0_pipe_ready_sink_d_last <= buffer0_pipe_ready_sink_last;
-        buffer0_pipe_ready_sink_d_payload_data <= buffer0_pipe_ready_sink_payload_data;
-        buffer0_pipe_ready_sink_d_payload_last_be <= buffer0_pipe_ready_sink_payload_last_be;
-        buffer0_pipe_ready_sink_d_payload_error <= buffer0_pipe_ready_sink_payload_error;
+    if (((~buffer0_pipe_ready_source_ready1) & (~buffer0_pipe_ready_valid1))) begin
+        buffer0_pipe_ready_sink_d_valid1 <= buffer0_pipe_ready_sink_valid1;
+        buffer0_pipe_ready_sink_d_ready1 <= buffer0_pipe_ready_sink_ready1;
+        buffer0_pipe_ready_sink_d_first1 <= buffer0_pipe_ready_sink_first1;
+        buffer0_pipe_ready_sink_d_last1 <= buffer0_pipe_ready_sink_last1;
+        buffer0_pipe_ready_sink_d_payload_data1 <= buffer0_pipe_ready_sink_payload_data1;
+        buffer0_pipe_ready_sink_d_payload_last_be1 <= buffer0_pipe_ready_sink_payload_last_be1;
+        buffer0_pipe_ready_sink_d_payload_error1 <= buffer0_pipe_ready_sink_payload_error1;
         buffer0_pipe_ready_sink_d_param_length <= buffer0_pipe_ready_sink_param_length;
         buffer0_pipe_ready_sink_d_param_protocol <= buffer0_pipe_ready_sink_param_protocol;
         buffer0_pipe_ready_sink_d_param_ip_address <= buffer0_pipe_ready_sink_param_ip_address;
     end
-    if (((~buffer1_pipe_valid_source_valid) | buffer1_pipe_valid_source_ready)) begin
-        buffer1_pipe_valid_source_valid <= buffer1_pipe_valid_sink_valid;
-        buffer1_pipe_valid_source_first <= buffer1_pipe_valid_sink_first;
-        buffer1_pipe_valid_source_last <= buffer1_pipe_valid_sink_last;
-        buffer1_pipe_valid_source_payload_data <= buffer1_pipe_valid_sink_payload_data;
-        buffer1_pipe_valid_source_payload_last_be <= buffer1_pipe_valid_sink_payload_last_be;
-        buffer1_pipe_valid_source_payload_error <= buffer1_pipe_valid_sink_payload_error;
+    if (((~buffer1_pipe_valid_source_valid1) | buffer1_pipe_valid_source_ready1)) begin
+        buffer1_pipe_valid_source_valid1 <= buffer1_pipe_valid_sink_valid1;
+        buffer1_pipe_valid_source_first1 <= buffer1_pipe_valid_sink_first1;
+        buffer1_pipe_valid_source_last1 <= buffer1_pipe_valid_sink_last1;
+        buffer1_pipe_valid_source_payload_data1 <= buffer1_pipe_valid_sink_payload_data1;
+        buffer1_pipe_valid_source_payload_last_be1 <= buffer1_pipe_valid_sink_payload_last_be1;
+        buffer1_pipe_valid_source_payload_error1 <= buffer1_pipe_valid_sink_payload_error1;
         buffer1_pipe_valid_source_param_length <= buffer1_pipe_valid_sink_param_length;
         buffer1_pipe_valid_source_param_protocol <= buffer1_pipe_valid_sink_param_protocol;
         buffer1_pipe_valid_source_param_ip_address <= buffer1_pipe_valid_sink_param_ip_address;
@@ -8188,6 +8360,18 @@ always @(posedge port_clk) begin
         buffer1_pipe_ready_sink_d_param_protocol <= buffer1_pipe_ready_sink_param_protocol;
         buffer1_pipe_ready_sink_d_param_ip_address <= buffer1_pipe_ready_sink_param_ip_address;
     end
+    if (((~buffer2_pipe_valid_source_valid) | buffer2_pipe_valid_source_ready)) begin
+        buffer2_pipe_valid_source_valid <= buffer2_pipe_valid_sink_valid;
+        buffer2_pipe_valid_source_first <= buffer2_pipe_valid_sink_first;
+        buffer2_pipe_valid_source_last <= buffer2_pipe_valid_sink_last;
+        buffer2_pipe_valid_source_payload_data <= buffer2_pipe_valid_sink_payload_data;
+        buffer2_pipe_valid_source_payload_last_be <= buffer2_pipe_valid_sink_payload_last_be;
+        buffer2_pipe_valid_source_payload_error <= buffer2_pipe_valid_sink_payload_error;
+        buffer2_pipe_valid_source_param_src_port <= buffer2_pipe_valid_sink_param_src_port;
+        buffer2_pipe_valid_source_param_dst_port <= buffer2_pipe_valid_sink_param_dst_port;
+        buffer2_pipe_valid_source_param_ip_address <= buffer2_pipe_valid_sink_param_ip_address;
+        buffer2_pipe_valid_source_param_length <= buffer2_pipe_valid_sink_param_length;
+    end
     pulsesynchronizer0_toggle_o_r <= pulsesynchronizer0_toggle_o;
     pulsemerge0_backlog1 <= (pulsemerge0_total1 - pulsemerge0_o1);
     pulsesynchronizer1_toggle_o_r <= pulsesynchronizer1_toggle_o;
@@ -8202,6 +8386,7 @@ always @(posedge port_clk) begin
         holdingudprx_liteethudpdepacketizer_delayed_last_be <= 1'd0;
         holdingudprx_liteethudpdepacketizer_was_in_copy <= 1'd0;
         holdingudprx_count <= 16'd0;
+        holdingudprx_more <= 1'd0;
         holdingudprx_err <= 1'd0;
         holdingudprx_held <= 8'd0;
         holdingudprx0 <= 16'd0;
@@ -8218,26 +8403,30 @@ always @(posedge port_clk) begin
         strideconverter1_converter_strobe_all <= 1'd0;
         tx_cdc_cdc_graycounter0_q <= 5'd0;
         tx_cdc_cdc_graycounter0_q_binary <= 5'd0;
-        buffer0_pipe_valid_source_valid <= 1'd0;
-        buffer0_pipe_valid_source_payload_data <= 8'd0;
-        buffer0_pipe_valid_source_payload_last_be <= 1'd0;
-        buffer0_pipe_valid_source_payload_error <= 1'd0;
-        buffer0_pipe_ready_valid <= 1'd0;
-        buffer0_pipe_ready_sink_d_valid <= 1'd0;
-        buffer0_pipe_ready_sink_d_ready <= 1'd0;
-        buffer0_pipe_ready_sink_d_payload_data <= 8'd0;
-        buffer0_pipe_ready_sink_d_payload_last_be <= 1'd0;
-        buffer0_pipe_ready_sink_d_payload_error <= 1'd0;
-        buffer1_pipe_valid_source_valid <= 1'd0;
-        buffer1_pipe_valid_source_payload_data <= 8'd0;
-        buffer1_pipe_valid_source_payload_last_be <= 1'd0;
-        buffer1_pipe_valid_source_payload_error <= 1'd0;
+        buffer0_pipe_valid_source_valid1 <= 1'd0;
+        buffer0_pipe_valid_source_payload_data1 <= 8'd0;
+        buffer0_pipe_valid_source_payload_last_be1 <= 1'd0;
+        buffer0_pipe_valid_source_payload_error1 <= 1'd0;
+        buffer0_pipe_ready_valid1 <= 1'd0;
+        buffer0_pipe_ready_sink_d_valid1 <= 1'd0;
+        buffer0_pipe_ready_sink_d_ready1 <= 1'd0;
+        buffer0_pipe_ready_sink_d_payload_data1 <= 8'd0;
+        buffer0_pipe_ready_sink_d_payload_last_be1 <= 1'd0;
+        buffer0_pipe_ready_sink_d_payload_error1 <= 1'd0;
+        buffer1_pipe_valid_source_valid1 <= 1'd0;
+        buffer1_pipe_valid_source_payload_data1 <= 8'd0;
+        buffer1_pipe_valid_source_payload_last_be1 <= 1'd0;
+        buffer1_pipe_valid_source_payload_error1 <= 1'd0;
         buffer1_pipe_ready_valid <= 1'd0;
         buffer1_pipe_ready_sink_d_valid <= 1'd0;
         buffer1_pipe_ready_sink_d_ready <= 1'd0;
         buffer1_pipe_ready_sink_d_payload_data <= 8'd0;
         buffer1_pipe_ready_sink_d_payload_last_be <= 1'd0;
         buffer1_pipe_ready_sink_d_payload_error <= 1'd0;
+        buffer2_pipe_valid_source_valid <= 1'd0;
+        buffer2_pipe_valid_source_payload_data <= 8'd0;
+        buffer2_pipe_valid_source_payload_last_be <= 1'd0;
+        buffer2_pipe_valid_source_payload_error <= 1'd0;
         pulsemerge0_backlog1 <= 3'd0;
         pulsemerge1_backlog1 <= 3'd0;
         portudp_lastbytetrim_state <= 1'd0;

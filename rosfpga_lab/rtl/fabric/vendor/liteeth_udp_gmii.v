@@ -129,6 +129,9 @@ UDPPortCore
 │    │    │    │    │    │    └─── fifo (AsyncFIFO)
 │    │    │    │    │    │    │    └─── graycounter_0* (GrayCounter)
 │    │    │    │    │    │    │    └─── graycounter_1* (GrayCounter)
+│    │    │    │    └─── rx_buffer (Buffer)
+│    │    │    │    │    └─── pipe_valid (PipeValid)
+│    │    │    │    │    └─── pipeline (Pipeline)
 │    │    │    │    └─── pipeline_0* (Pipeline)
 │    │    └─── crossbar (FilteringMACCrossbar)
 │    │    │    └─── arbiter (Arbiter)
@@ -242,6 +245,9 @@ UDPPortCore
 │    │    └─── tx_buffer (Buffer)
 │    │    │    └─── pipe_valid (PipeValid)
 │    │    │    └─── pipe_ready (PipeReady)
+│    │    │    └─── pipeline (Pipeline)
+│    │    └─── rx_out (Buffer)
+│    │    │    └─── pipe_valid (PipeValid)
 │    │    │    └─── pipeline (Pipeline)
 └─── rx_drop_header_core (PulseMerge)
 └─── rx_drop_header_port (PulseMerge)
@@ -761,6 +767,84 @@ reg           main_arp_table_source_payload_reply = 1'd0;
 reg           main_arp_table_source_payload_request = 1'd0;
 wire          main_arp_table_source_ready;
 reg           main_arp_table_source_valid = 1'd0;
+reg           main_buffer0_pipe_ready_sink_d_first = 1'd0;
+reg           main_buffer0_pipe_ready_sink_d_last = 1'd0;
+reg    [31:0] main_buffer0_pipe_ready_sink_d_payload_data = 32'd0;
+reg     [3:0] main_buffer0_pipe_ready_sink_d_payload_error = 4'd0;
+reg     [3:0] main_buffer0_pipe_ready_sink_d_payload_last_be = 4'd0;
+reg           main_buffer0_pipe_ready_sink_d_ready = 1'd0;
+reg           main_buffer0_pipe_ready_sink_d_valid = 1'd0;
+wire          main_buffer0_pipe_ready_sink_first;
+wire          main_buffer0_pipe_ready_sink_last;
+wire   [31:0] main_buffer0_pipe_ready_sink_payload_data;
+wire    [3:0] main_buffer0_pipe_ready_sink_payload_error;
+wire    [3:0] main_buffer0_pipe_ready_sink_payload_last_be;
+wire          main_buffer0_pipe_ready_sink_ready;
+wire          main_buffer0_pipe_ready_sink_valid;
+reg           main_buffer0_pipe_ready_source_first = 1'd0;
+reg           main_buffer0_pipe_ready_source_last = 1'd0;
+reg    [31:0] main_buffer0_pipe_ready_source_payload_data = 32'd0;
+reg     [3:0] main_buffer0_pipe_ready_source_payload_error = 4'd0;
+reg     [3:0] main_buffer0_pipe_ready_source_payload_last_be = 4'd0;
+wire          main_buffer0_pipe_ready_source_ready;
+reg           main_buffer0_pipe_ready_source_valid = 1'd0;
+reg           main_buffer0_pipe_ready_valid = 1'd0;
+wire          main_buffer0_pipe_valid_sink_first;
+wire          main_buffer0_pipe_valid_sink_last;
+wire   [31:0] main_buffer0_pipe_valid_sink_payload_data;
+wire    [3:0] main_buffer0_pipe_valid_sink_payload_error;
+wire    [3:0] main_buffer0_pipe_valid_sink_payload_last_be;
+wire          main_buffer0_pipe_valid_sink_ready;
+wire          main_buffer0_pipe_valid_sink_valid;
+reg           main_buffer0_pipe_valid_source_first = 1'd0;
+reg           main_buffer0_pipe_valid_source_last = 1'd0;
+reg    [31:0] main_buffer0_pipe_valid_source_payload_data = 32'd0;
+reg     [3:0] main_buffer0_pipe_valid_source_payload_error = 4'd0;
+reg     [3:0] main_buffer0_pipe_valid_source_payload_last_be = 4'd0;
+wire          main_buffer0_pipe_valid_source_ready;
+reg           main_buffer0_pipe_valid_source_valid = 1'd0;
+wire          main_buffer0_sink_sink_first;
+wire          main_buffer0_sink_sink_last;
+wire   [31:0] main_buffer0_sink_sink_payload_data;
+wire    [3:0] main_buffer0_sink_sink_payload_error;
+wire    [3:0] main_buffer0_sink_sink_payload_last_be;
+wire          main_buffer0_sink_sink_ready;
+wire          main_buffer0_sink_sink_valid;
+wire          main_buffer0_source_source_first;
+wire          main_buffer0_source_source_last;
+wire   [31:0] main_buffer0_source_source_payload_data;
+wire    [3:0] main_buffer0_source_source_payload_error;
+wire    [3:0] main_buffer0_source_source_payload_last_be;
+wire          main_buffer0_source_source_ready;
+wire          main_buffer0_source_source_valid;
+wire          main_buffer1_pipe_valid_sink_first;
+wire          main_buffer1_pipe_valid_sink_last;
+wire    [7:0] main_buffer1_pipe_valid_sink_payload_data;
+wire          main_buffer1_pipe_valid_sink_payload_error;
+wire          main_buffer1_pipe_valid_sink_payload_last_be;
+wire          main_buffer1_pipe_valid_sink_ready;
+wire          main_buffer1_pipe_valid_sink_valid;
+reg           main_buffer1_pipe_valid_source_first = 1'd0;
+reg           main_buffer1_pipe_valid_source_last = 1'd0;
+reg     [7:0] main_buffer1_pipe_valid_source_payload_data = 8'd0;
+reg           main_buffer1_pipe_valid_source_payload_error = 1'd0;
+reg           main_buffer1_pipe_valid_source_payload_last_be = 1'd0;
+wire          main_buffer1_pipe_valid_source_ready;
+reg           main_buffer1_pipe_valid_source_valid = 1'd0;
+wire          main_buffer1_sink_sink_first;
+wire          main_buffer1_sink_sink_last;
+wire    [7:0] main_buffer1_sink_sink_payload_data;
+wire          main_buffer1_sink_sink_payload_error;
+wire          main_buffer1_sink_sink_payload_last_be;
+wire          main_buffer1_sink_sink_ready;
+wire          main_buffer1_sink_sink_valid;
+wire          main_buffer1_source_source_first;
+wire          main_buffer1_source_source_last;
+wire    [7:0] main_buffer1_source_source_payload_data;
+wire          main_buffer1_source_source_payload_error;
+wire          main_buffer1_source_source_payload_last_be;
+wire          main_buffer1_source_source_ready;
+wire          main_buffer1_source_source_valid;
 reg           main_bus_error = 1'd0;
 reg    [31:0] main_bus_errors = 32'd0;
 reg           main_bus_errors_re = 1'd0;
@@ -2006,42 +2090,6 @@ reg           main_mac_packetizer_source_valid = 1'd0;
 reg   [111:0] main_mac_packetizer_sr = 112'd0;
 reg           main_mac_packetizer_sr_load = 1'd0;
 reg           main_mac_packetizer_sr_shift = 1'd0;
-reg           main_pipe_ready_sink_d_first = 1'd0;
-reg           main_pipe_ready_sink_d_last = 1'd0;
-reg    [31:0] main_pipe_ready_sink_d_payload_data = 32'd0;
-reg     [3:0] main_pipe_ready_sink_d_payload_error = 4'd0;
-reg     [3:0] main_pipe_ready_sink_d_payload_last_be = 4'd0;
-reg           main_pipe_ready_sink_d_ready = 1'd0;
-reg           main_pipe_ready_sink_d_valid = 1'd0;
-wire          main_pipe_ready_sink_first;
-wire          main_pipe_ready_sink_last;
-wire   [31:0] main_pipe_ready_sink_payload_data;
-wire    [3:0] main_pipe_ready_sink_payload_error;
-wire    [3:0] main_pipe_ready_sink_payload_last_be;
-wire          main_pipe_ready_sink_ready;
-wire          main_pipe_ready_sink_valid;
-reg           main_pipe_ready_source_first = 1'd0;
-reg           main_pipe_ready_source_last = 1'd0;
-reg    [31:0] main_pipe_ready_source_payload_data = 32'd0;
-reg     [3:0] main_pipe_ready_source_payload_error = 4'd0;
-reg     [3:0] main_pipe_ready_source_payload_last_be = 4'd0;
-wire          main_pipe_ready_source_ready;
-reg           main_pipe_ready_source_valid = 1'd0;
-reg           main_pipe_ready_valid = 1'd0;
-wire          main_pipe_valid_sink_first;
-wire          main_pipe_valid_sink_last;
-wire   [31:0] main_pipe_valid_sink_payload_data;
-wire    [3:0] main_pipe_valid_sink_payload_error;
-wire    [3:0] main_pipe_valid_sink_payload_last_be;
-wire          main_pipe_valid_sink_ready;
-wire          main_pipe_valid_sink_valid;
-reg           main_pipe_valid_source_first = 1'd0;
-reg           main_pipe_valid_source_last = 1'd0;
-reg    [31:0] main_pipe_valid_source_payload_data = 32'd0;
-reg     [3:0] main_pipe_valid_source_payload_error = 4'd0;
-reg     [3:0] main_pipe_valid_source_payload_last_be = 4'd0;
-wire          main_pipe_valid_source_ready;
-reg           main_pipe_valid_source_valid = 1'd0;
 wire          main_port_internal_port_sink_first;
 wire          main_port_internal_port_sink_last;
 wire   [15:0] main_port_internal_port_sink_param_dst_port;
@@ -2229,13 +2277,6 @@ wire    [7:0] main_sink_payload_data;
 wire          main_sink_payload_error;
 wire          main_sink_payload_last_be;
 reg           main_sink_ready = 1'd0;
-wire          main_sink_sink_first;
-wire          main_sink_sink_last;
-wire   [31:0] main_sink_sink_payload_data;
-wire    [3:0] main_sink_sink_payload_error;
-wire    [3:0] main_sink_sink_payload_last_be;
-wire          main_sink_sink_ready;
-wire          main_sink_sink_valid;
 wire          main_sink_valid;
 reg           main_soc_rst = 1'd0;
 reg           main_source_first = 1'd0;
@@ -2244,13 +2285,6 @@ reg     [7:0] main_source_payload_data = 8'd0;
 reg           main_source_payload_error = 1'd0;
 wire          main_source_payload_last_be;
 wire          main_source_ready;
-wire          main_source_source_first;
-wire          main_source_source_last;
-wire   [31:0] main_source_source_payload_data;
-wire    [3:0] main_source_source_payload_error;
-wire    [3:0] main_source_source_payload_last_be;
-wire          main_source_source_ready;
-wire          main_source_source_valid;
 reg           main_source_valid = 1'd0;
 reg           main_storage = 1'd0;
 wire          main_take_group;
@@ -2396,18 +2430,62 @@ wire          main_udp_buffer1_source_source_payload_error;
 wire          main_udp_buffer1_source_source_payload_last_be;
 wire          main_udp_buffer1_source_source_ready;
 wire          main_udp_buffer1_source_source_valid;
+wire          main_udp_buffer2_pipe_valid_sink_first;
+wire          main_udp_buffer2_pipe_valid_sink_last;
+wire   [15:0] main_udp_buffer2_pipe_valid_sink_param_dst_port;
+wire   [31:0] main_udp_buffer2_pipe_valid_sink_param_ip_address;
+wire   [15:0] main_udp_buffer2_pipe_valid_sink_param_length;
+wire   [15:0] main_udp_buffer2_pipe_valid_sink_param_src_port;
+wire    [7:0] main_udp_buffer2_pipe_valid_sink_payload_data;
+wire          main_udp_buffer2_pipe_valid_sink_payload_error;
+wire          main_udp_buffer2_pipe_valid_sink_payload_last_be;
+wire          main_udp_buffer2_pipe_valid_sink_ready;
+wire          main_udp_buffer2_pipe_valid_sink_valid;
+reg           main_udp_buffer2_pipe_valid_source_first = 1'd0;
+reg           main_udp_buffer2_pipe_valid_source_last = 1'd0;
+reg    [15:0] main_udp_buffer2_pipe_valid_source_param_dst_port = 16'd0;
+reg    [31:0] main_udp_buffer2_pipe_valid_source_param_ip_address = 32'd0;
+reg    [15:0] main_udp_buffer2_pipe_valid_source_param_length = 16'd0;
+reg    [15:0] main_udp_buffer2_pipe_valid_source_param_src_port = 16'd0;
+reg     [7:0] main_udp_buffer2_pipe_valid_source_payload_data = 8'd0;
+reg           main_udp_buffer2_pipe_valid_source_payload_error = 1'd0;
+reg           main_udp_buffer2_pipe_valid_source_payload_last_be = 1'd0;
+wire          main_udp_buffer2_pipe_valid_source_ready;
+reg           main_udp_buffer2_pipe_valid_source_valid = 1'd0;
+wire          main_udp_buffer2_sink_sink_first;
+wire          main_udp_buffer2_sink_sink_last;
+wire   [15:0] main_udp_buffer2_sink_sink_param_dst_port;
+wire   [31:0] main_udp_buffer2_sink_sink_param_ip_address;
+wire   [15:0] main_udp_buffer2_sink_sink_param_length;
+wire   [15:0] main_udp_buffer2_sink_sink_param_src_port;
+wire    [7:0] main_udp_buffer2_sink_sink_payload_data;
+wire          main_udp_buffer2_sink_sink_payload_error;
+wire          main_udp_buffer2_sink_sink_payload_last_be;
+wire          main_udp_buffer2_sink_sink_ready;
+wire          main_udp_buffer2_sink_sink_valid;
+wire          main_udp_buffer2_source_source_first;
+wire          main_udp_buffer2_source_source_last;
+wire   [15:0] main_udp_buffer2_source_source_param_dst_port;
+wire   [31:0] main_udp_buffer2_source_source_param_ip_address;
+wire   [15:0] main_udp_buffer2_source_source_param_length;
+wire   [15:0] main_udp_buffer2_source_source_param_src_port;
+wire    [7:0] main_udp_buffer2_source_source_payload_data;
+wire          main_udp_buffer2_source_source_payload_error;
+wire          main_udp_buffer2_source_source_payload_last_be;
+wire          main_udp_buffer2_source_source_ready;
+wire          main_udp_buffer2_source_source_valid;
 reg    [15:0] main_udp_holdingudprx0 = 16'd0;
-reg    [15:0] main_udp_holdingudprx0_holdingudprx_next_value4 = 16'd0;
-reg           main_udp_holdingudprx0_holdingudprx_next_value_ce4 = 1'd0;
+reg    [15:0] main_udp_holdingudprx0_holdingudprx_next_value5 = 16'd0;
+reg           main_udp_holdingudprx0_holdingudprx_next_value_ce5 = 1'd0;
 reg    [15:0] main_udp_holdingudprx1 = 16'd0;
-reg    [15:0] main_udp_holdingudprx1_holdingudprx_next_value5 = 16'd0;
-reg           main_udp_holdingudprx1_holdingudprx_next_value_ce5 = 1'd0;
+reg    [15:0] main_udp_holdingudprx1_holdingudprx_next_value6 = 16'd0;
+reg           main_udp_holdingudprx1_holdingudprx_next_value_ce6 = 1'd0;
 reg    [15:0] main_udp_holdingudprx2 = 16'd0;
-reg    [15:0] main_udp_holdingudprx2_holdingudprx_next_value6 = 16'd0;
-reg           main_udp_holdingudprx2_holdingudprx_next_value_ce6 = 1'd0;
+reg    [15:0] main_udp_holdingudprx2_holdingudprx_next_value7 = 16'd0;
+reg           main_udp_holdingudprx2_holdingudprx_next_value_ce7 = 1'd0;
 reg    [31:0] main_udp_holdingudprx3 = 32'd0;
-reg    [31:0] main_udp_holdingudprx3_holdingudprx_next_value7 = 32'd0;
-reg           main_udp_holdingudprx3_holdingudprx_next_value_ce7 = 1'd0;
+reg    [31:0] main_udp_holdingudprx3_holdingudprx_next_value8 = 32'd0;
+reg           main_udp_holdingudprx3_holdingudprx_next_value_ce8 = 1'd0;
 reg    [15:0] main_udp_holdingudprx_count = 16'd0;
 reg    [15:0] main_udp_holdingudprx_count_holdingudprx_next_value0 = 16'd0;
 reg           main_udp_holdingudprx_count_holdingudprx_next_value_ce0 = 1'd0;
@@ -2415,13 +2493,13 @@ wire          main_udp_holdingudprx_cut0;
 wire          main_udp_holdingudprx_cut1;
 reg           main_udp_holdingudprx_drop_header = 1'd0;
 reg           main_udp_holdingudprx_err = 1'd0;
-reg           main_udp_holdingudprx_err_holdingudprx_next_value1 = 1'd0;
-reg           main_udp_holdingudprx_err_holdingudprx_next_value_ce1 = 1'd0;
+reg           main_udp_holdingudprx_err_holdingudprx_next_value2 = 1'd0;
+reg           main_udp_holdingudprx_err_holdingudprx_next_value_ce2 = 1'd0;
 reg           main_udp_holdingudprx_fsm_is_ongoing0 = 1'd0;
 reg           main_udp_holdingudprx_fsm_is_ongoing1 = 1'd0;
 reg     [7:0] main_udp_holdingudprx_held = 8'd0;
-reg     [7:0] main_udp_holdingudprx_held_holdingudprx_next_value3 = 8'd0;
-reg           main_udp_holdingudprx_held_holdingudprx_next_value_ce3 = 1'd0;
+reg     [7:0] main_udp_holdingudprx_held_holdingudprx_next_value4 = 8'd0;
+reg           main_udp_holdingudprx_held_holdingudprx_next_value_ce4 = 1'd0;
 reg     [2:0] main_udp_holdingudprx_liteethudpdepacketizer_count = 3'd0;
 reg     [2:0] main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value0 = 3'd0;
 reg           main_udp_holdingudprx_liteethudpdepacketizer_count_holdingudprx_fsm0_next_value_ce0 = 1'd0;
@@ -2467,10 +2545,13 @@ reg    [63:0] main_udp_holdingudprx_liteethudpdepacketizer_sr = 64'd0;
 reg           main_udp_holdingudprx_liteethudpdepacketizer_sr_shift = 1'd0;
 reg           main_udp_holdingudprx_liteethudpdepacketizer_sr_shift_leftover = 1'd0;
 reg           main_udp_holdingudprx_liteethudpdepacketizer_was_in_copy = 1'd0;
+reg           main_udp_holdingudprx_more = 1'd0;
+reg           main_udp_holdingudprx_more_holdingudprx_next_value1 = 1'd0;
+reg           main_udp_holdingudprx_more_holdingudprx_next_value_ce1 = 1'd0;
 wire   [15:0] main_udp_holdingudprx_payload_len;
 reg    [15:0] main_udp_holdingudprx_rest = 16'd0;
-reg    [15:0] main_udp_holdingudprx_rest_holdingudprx_next_value2 = 16'd0;
-reg           main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 = 1'd0;
+reg    [15:0] main_udp_holdingudprx_rest_holdingudprx_next_value3 = 16'd0;
+reg           main_udp_holdingudprx_rest_holdingudprx_next_value_ce3 = 1'd0;
 wire          main_udp_holdingudprx_sink_first;
 wire          main_udp_holdingudprx_sink_last;
 wire   [31:0] main_udp_holdingudprx_sink_param_ip_address;
@@ -3299,52 +3380,52 @@ always @(*) begin
         end
     endcase
 end
-assign main_pipe_valid_sink_ready = ((~main_pipe_valid_source_valid) | main_pipe_valid_source_ready);
-assign main_pipe_ready_sink_ready = (~main_pipe_ready_valid);
+assign main_buffer0_pipe_valid_sink_ready = ((~main_buffer0_pipe_valid_source_valid) | main_buffer0_pipe_valid_source_ready);
+assign main_buffer0_pipe_ready_sink_ready = (~main_buffer0_pipe_ready_valid);
 always @(*) begin
-    main_pipe_ready_source_first <= 1'd0;
-    main_pipe_ready_source_last <= 1'd0;
-    main_pipe_ready_source_payload_data <= 32'd0;
-    main_pipe_ready_source_payload_error <= 4'd0;
-    main_pipe_ready_source_payload_last_be <= 4'd0;
-    main_pipe_ready_source_valid <= 1'd0;
-    if (main_pipe_ready_valid) begin
-        main_pipe_ready_source_valid <= main_pipe_ready_sink_d_valid;
-        main_pipe_ready_source_first <= main_pipe_ready_sink_d_first;
-        main_pipe_ready_source_last <= main_pipe_ready_sink_d_last;
-        main_pipe_ready_source_payload_data <= main_pipe_ready_sink_d_payload_data;
-        main_pipe_ready_source_payload_last_be <= main_pipe_ready_sink_d_payload_last_be;
-        main_pipe_ready_source_payload_error <= main_pipe_ready_sink_d_payload_error;
+    main_buffer0_pipe_ready_source_first <= 1'd0;
+    main_buffer0_pipe_ready_source_last <= 1'd0;
+    main_buffer0_pipe_ready_source_payload_data <= 32'd0;
+    main_buffer0_pipe_ready_source_payload_error <= 4'd0;
+    main_buffer0_pipe_ready_source_payload_last_be <= 4'd0;
+    main_buffer0_pipe_ready_source_valid <= 1'd0;
+    if (main_buffer0_pipe_ready_valid) begin
+        main_buffer0_pipe_ready_source_valid <= main_buffer0_pipe_ready_sink_d_valid;
+        main_buffer0_pipe_ready_source_first <= main_buffer0_pipe_ready_sink_d_first;
+        main_buffer0_pipe_ready_source_last <= main_buffer0_pipe_ready_sink_d_last;
+        main_buffer0_pipe_ready_source_payload_data <= main_buffer0_pipe_ready_sink_d_payload_data;
+        main_buffer0_pipe_ready_source_payload_last_be <= main_buffer0_pipe_ready_sink_d_payload_last_be;
+        main_buffer0_pipe_ready_source_payload_error <= main_buffer0_pipe_ready_sink_d_payload_error;
     end else begin
-        main_pipe_ready_source_valid <= main_pipe_ready_sink_valid;
-        main_pipe_ready_source_first <= main_pipe_ready_sink_first;
-        main_pipe_ready_source_last <= main_pipe_ready_sink_last;
-        main_pipe_ready_source_payload_data <= main_pipe_ready_sink_payload_data;
-        main_pipe_ready_source_payload_last_be <= main_pipe_ready_sink_payload_last_be;
-        main_pipe_ready_source_payload_error <= main_pipe_ready_sink_payload_error;
+        main_buffer0_pipe_ready_source_valid <= main_buffer0_pipe_ready_sink_valid;
+        main_buffer0_pipe_ready_source_first <= main_buffer0_pipe_ready_sink_first;
+        main_buffer0_pipe_ready_source_last <= main_buffer0_pipe_ready_sink_last;
+        main_buffer0_pipe_ready_source_payload_data <= main_buffer0_pipe_ready_sink_payload_data;
+        main_buffer0_pipe_ready_source_payload_last_be <= main_buffer0_pipe_ready_sink_payload_last_be;
+        main_buffer0_pipe_ready_source_payload_error <= main_buffer0_pipe_ready_sink_payload_error;
     end
 end
-assign main_pipe_valid_sink_valid = main_sink_sink_valid;
-assign main_sink_sink_ready = main_pipe_valid_sink_ready;
-assign main_pipe_valid_sink_first = main_sink_sink_first;
-assign main_pipe_valid_sink_last = main_sink_sink_last;
-assign main_pipe_valid_sink_payload_data = main_sink_sink_payload_data;
-assign main_pipe_valid_sink_payload_last_be = main_sink_sink_payload_last_be;
-assign main_pipe_valid_sink_payload_error = main_sink_sink_payload_error;
-assign main_pipe_ready_sink_valid = main_pipe_valid_source_valid;
-assign main_pipe_valid_source_ready = main_pipe_ready_sink_ready;
-assign main_pipe_ready_sink_first = main_pipe_valid_source_first;
-assign main_pipe_ready_sink_last = main_pipe_valid_source_last;
-assign main_pipe_ready_sink_payload_data = main_pipe_valid_source_payload_data;
-assign main_pipe_ready_sink_payload_last_be = main_pipe_valid_source_payload_last_be;
-assign main_pipe_ready_sink_payload_error = main_pipe_valid_source_payload_error;
-assign main_source_source_valid = main_pipe_ready_source_valid;
-assign main_pipe_ready_source_ready = main_source_source_ready;
-assign main_source_source_first = main_pipe_ready_source_first;
-assign main_source_source_last = main_pipe_ready_source_last;
-assign main_source_source_payload_data = main_pipe_ready_source_payload_data;
-assign main_source_source_payload_last_be = main_pipe_ready_source_payload_last_be;
-assign main_source_source_payload_error = main_pipe_ready_source_payload_error;
+assign main_buffer0_pipe_valid_sink_valid = main_buffer0_sink_sink_valid;
+assign main_buffer0_sink_sink_ready = main_buffer0_pipe_valid_sink_ready;
+assign main_buffer0_pipe_valid_sink_first = main_buffer0_sink_sink_first;
+assign main_buffer0_pipe_valid_sink_last = main_buffer0_sink_sink_last;
+assign main_buffer0_pipe_valid_sink_payload_data = main_buffer0_sink_sink_payload_data;
+assign main_buffer0_pipe_valid_sink_payload_last_be = main_buffer0_sink_sink_payload_last_be;
+assign main_buffer0_pipe_valid_sink_payload_error = main_buffer0_sink_sink_payload_error;
+assign main_buffer0_pipe_ready_sink_valid = main_buffer0_pipe_valid_source_valid;
+assign main_buffer0_pipe_valid_source_ready = main_buffer0_pipe_ready_sink_ready;
+assign main_buffer0_pipe_ready_sink_first = main_buffer0_pipe_valid_source_first;
+assign main_buffer0_pipe_ready_sink_last = main_buffer0_pipe_valid_source_last;
+assign main_buffer0_pipe_ready_sink_payload_data = main_buffer0_pipe_valid_source_payload_data;
+assign main_buffer0_pipe_ready_sink_payload_last_be = main_buffer0_pipe_valid_source_payload_last_be;
+assign main_buffer0_pipe_ready_sink_payload_error = main_buffer0_pipe_valid_source_payload_error;
+assign main_buffer0_source_source_valid = main_buffer0_pipe_ready_source_valid;
+assign main_buffer0_pipe_ready_source_ready = main_buffer0_source_source_ready;
+assign main_buffer0_source_source_first = main_buffer0_pipe_ready_source_first;
+assign main_buffer0_source_source_last = main_buffer0_pipe_ready_source_last;
+assign main_buffer0_source_source_payload_data = main_buffer0_pipe_ready_source_payload_data;
+assign main_buffer0_source_source_payload_last_be = main_buffer0_pipe_ready_source_payload_last_be;
+assign main_buffer0_source_source_payload_error = main_buffer0_pipe_ready_source_payload_error;
 assign main_mac_core_tx_cdc_sink_sink_valid = main_mac_core_sink_valid;
 assign main_mac_core_sink_ready = main_mac_core_tx_cdc_sink_sink_ready;
 assign main_mac_core_tx_cdc_sink_sink_first = main_mac_core_sink_first;
@@ -3352,20 +3433,20 @@ assign main_mac_core_tx_cdc_sink_sink_last = main_mac_core_sink_last;
 assign main_mac_core_tx_cdc_sink_sink_payload_data = main_mac_core_sink_payload_data;
 assign main_mac_core_tx_cdc_sink_sink_payload_last_be = main_mac_core_sink_payload_last_be;
 assign main_mac_core_tx_cdc_sink_sink_payload_error = main_mac_core_sink_payload_error;
-assign main_sink_sink_valid = main_mac_core_tx_cdc_source_source_valid;
-assign main_mac_core_tx_cdc_source_source_ready = main_sink_sink_ready;
-assign main_sink_sink_first = main_mac_core_tx_cdc_source_source_first;
-assign main_sink_sink_last = main_mac_core_tx_cdc_source_source_last;
-assign main_sink_sink_payload_data = main_mac_core_tx_cdc_source_source_payload_data;
-assign main_sink_sink_payload_last_be = main_mac_core_tx_cdc_source_source_payload_last_be;
-assign main_sink_sink_payload_error = main_mac_core_tx_cdc_source_source_payload_error;
-assign main_mac_core_tx_converter_sink_valid = main_source_source_valid;
-assign main_source_source_ready = main_mac_core_tx_converter_sink_ready;
-assign main_mac_core_tx_converter_sink_first = main_source_source_first;
-assign main_mac_core_tx_converter_sink_last = main_source_source_last;
-assign main_mac_core_tx_converter_sink_payload_data = main_source_source_payload_data;
-assign main_mac_core_tx_converter_sink_payload_last_be = main_source_source_payload_last_be;
-assign main_mac_core_tx_converter_sink_payload_error = main_source_source_payload_error;
+assign main_buffer0_sink_sink_valid = main_mac_core_tx_cdc_source_source_valid;
+assign main_mac_core_tx_cdc_source_source_ready = main_buffer0_sink_sink_ready;
+assign main_buffer0_sink_sink_first = main_mac_core_tx_cdc_source_source_first;
+assign main_buffer0_sink_sink_last = main_mac_core_tx_cdc_source_source_last;
+assign main_buffer0_sink_sink_payload_data = main_mac_core_tx_cdc_source_source_payload_data;
+assign main_buffer0_sink_sink_payload_last_be = main_mac_core_tx_cdc_source_source_payload_last_be;
+assign main_buffer0_sink_sink_payload_error = main_mac_core_tx_cdc_source_source_payload_error;
+assign main_mac_core_tx_converter_sink_valid = main_buffer0_source_source_valid;
+assign main_buffer0_source_source_ready = main_mac_core_tx_converter_sink_ready;
+assign main_mac_core_tx_converter_sink_first = main_buffer0_source_source_first;
+assign main_mac_core_tx_converter_sink_last = main_buffer0_source_source_last;
+assign main_mac_core_tx_converter_sink_payload_data = main_buffer0_source_source_payload_data;
+assign main_mac_core_tx_converter_sink_payload_last_be = main_buffer0_source_source_payload_last_be;
+assign main_mac_core_tx_converter_sink_payload_error = main_buffer0_source_source_payload_error;
 assign main_mac_core_tx_last_be_sink_sink_valid = main_mac_core_tx_converter_source_valid;
 assign main_mac_core_tx_converter_source_ready = main_mac_core_tx_last_be_sink_sink_ready;
 assign main_mac_core_tx_last_be_sink_sink_first = main_mac_core_tx_converter_source_first;
@@ -3751,6 +3832,21 @@ always @(*) begin
     end
 end
 assign main_mac_core_rx_cdc_cdc_graycounter1_q_next = (main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary ^ main_mac_core_rx_cdc_cdc_graycounter1_q_next_binary[5:1]);
+assign main_buffer1_pipe_valid_sink_ready = ((~main_buffer1_pipe_valid_source_valid) | main_buffer1_pipe_valid_source_ready);
+assign main_buffer1_pipe_valid_sink_valid = main_buffer1_sink_sink_valid;
+assign main_buffer1_sink_sink_ready = main_buffer1_pipe_valid_sink_ready;
+assign main_buffer1_pipe_valid_sink_first = main_buffer1_sink_sink_first;
+assign main_buffer1_pipe_valid_sink_last = main_buffer1_sink_sink_last;
+assign main_buffer1_pipe_valid_sink_payload_data = main_buffer1_sink_sink_payload_data;
+assign main_buffer1_pipe_valid_sink_payload_last_be = main_buffer1_sink_sink_payload_last_be;
+assign main_buffer1_pipe_valid_sink_payload_error = main_buffer1_sink_sink_payload_error;
+assign main_buffer1_source_source_valid = main_buffer1_pipe_valid_source_valid;
+assign main_buffer1_pipe_valid_source_ready = main_buffer1_source_source_ready;
+assign main_buffer1_source_source_first = main_buffer1_pipe_valid_source_first;
+assign main_buffer1_source_source_last = main_buffer1_pipe_valid_source_last;
+assign main_buffer1_source_source_payload_data = main_buffer1_pipe_valid_source_payload_data;
+assign main_buffer1_source_source_payload_last_be = main_buffer1_pipe_valid_source_payload_last_be;
+assign main_buffer1_source_source_payload_error = main_buffer1_pipe_valid_source_payload_error;
 assign main_mac_core_rx_preamble_sink_valid = main_source_valid;
 assign main_source_ready = main_mac_core_rx_preamble_sink_ready;
 assign main_mac_core_rx_preamble_sink_first = main_source_first;
@@ -3765,13 +3861,20 @@ assign main_mac_core_bufferizeendpoints_sink_sink_last = main_mac_core_rx_preamb
 assign main_mac_core_bufferizeendpoints_sink_sink_payload_data = main_mac_core_rx_preamble_source_payload_data;
 assign main_mac_core_bufferizeendpoints_sink_sink_payload_last_be = main_mac_core_rx_preamble_source_payload_last_be;
 assign main_mac_core_bufferizeendpoints_sink_sink_payload_error = main_mac_core_rx_preamble_source_payload_error;
-assign main_mac_core_rx_padding_sink_valid = main_mac_core_liteethmaccrc32checker_source_source_valid;
-assign main_mac_core_liteethmaccrc32checker_source_source_ready = main_mac_core_rx_padding_sink_ready;
-assign main_mac_core_rx_padding_sink_first = main_mac_core_liteethmaccrc32checker_source_source_first;
-assign main_mac_core_rx_padding_sink_last = main_mac_core_liteethmaccrc32checker_source_source_last;
-assign main_mac_core_rx_padding_sink_payload_data = main_mac_core_liteethmaccrc32checker_source_source_payload_data;
-assign main_mac_core_rx_padding_sink_payload_last_be = main_mac_core_liteethmaccrc32checker_source_source_payload_last_be;
-assign main_mac_core_rx_padding_sink_payload_error = main_mac_core_liteethmaccrc32checker_source_source_payload_error;
+assign main_buffer1_sink_sink_valid = main_mac_core_liteethmaccrc32checker_source_source_valid;
+assign main_mac_core_liteethmaccrc32checker_source_source_ready = main_buffer1_sink_sink_ready;
+assign main_buffer1_sink_sink_first = main_mac_core_liteethmaccrc32checker_source_source_first;
+assign main_buffer1_sink_sink_last = main_mac_core_liteethmaccrc32checker_source_source_last;
+assign main_buffer1_sink_sink_payload_data = main_mac_core_liteethmaccrc32checker_source_source_payload_data;
+assign main_buffer1_sink_sink_payload_last_be = main_mac_core_liteethmaccrc32checker_source_source_payload_last_be;
+assign main_buffer1_sink_sink_payload_error = main_mac_core_liteethmaccrc32checker_source_source_payload_error;
+assign main_mac_core_rx_padding_sink_valid = main_buffer1_source_source_valid;
+assign main_buffer1_source_source_ready = main_mac_core_rx_padding_sink_ready;
+assign main_mac_core_rx_padding_sink_first = main_buffer1_source_source_first;
+assign main_mac_core_rx_padding_sink_last = main_buffer1_source_source_last;
+assign main_mac_core_rx_padding_sink_payload_data = main_buffer1_source_source_payload_data;
+assign main_mac_core_rx_padding_sink_payload_last_be = main_buffer1_source_source_payload_last_be;
+assign main_mac_core_rx_padding_sink_payload_error = main_buffer1_source_source_payload_error;
 assign main_mac_core_rx_last_be_sink_valid = main_mac_core_rx_padding_source_valid;
 assign main_mac_core_rx_padding_source_ready = main_mac_core_rx_last_be_sink_ready;
 assign main_mac_core_rx_last_be_sink_first = main_mac_core_rx_padding_source_first;
@@ -6165,17 +6268,28 @@ assign main_udp_holdingudprx_sink_payload_error = main_udp_buffer0_source_source
 assign main_udp_holdingudprx_sink_param_length = main_udp_buffer0_source_source_param_length;
 assign main_udp_holdingudprx_sink_param_protocol = main_udp_buffer0_source_source_param_protocol;
 assign main_udp_holdingudprx_sink_param_ip_address = main_udp_buffer0_source_source_param_ip_address;
-assign main_udp_maskedudpcrossbar_sink_valid = main_udp_holdingudprx_source_valid;
-assign main_udp_holdingudprx_source_ready = main_udp_maskedudpcrossbar_sink_ready;
-assign main_udp_maskedudpcrossbar_sink_first = main_udp_holdingudprx_source_first;
-assign main_udp_maskedudpcrossbar_sink_last = main_udp_holdingudprx_source_last;
-assign main_udp_maskedudpcrossbar_sink_payload_data = main_udp_holdingudprx_source_payload_data;
-assign main_udp_maskedudpcrossbar_sink_payload_last_be = main_udp_holdingudprx_source_payload_last_be;
-assign main_udp_maskedudpcrossbar_sink_payload_error = main_udp_holdingudprx_source_payload_error;
-assign main_udp_maskedudpcrossbar_sink_param_src_port = main_udp_holdingudprx_source_param_src_port;
-assign main_udp_maskedudpcrossbar_sink_param_dst_port = main_udp_holdingudprx_source_param_dst_port;
-assign main_udp_maskedudpcrossbar_sink_param_ip_address = main_udp_holdingudprx_source_param_ip_address;
-assign main_udp_maskedudpcrossbar_sink_param_length = main_udp_holdingudprx_source_param_length;
+assign main_udp_buffer2_sink_sink_valid = main_udp_holdingudprx_source_valid;
+assign main_udp_holdingudprx_source_ready = main_udp_buffer2_sink_sink_ready;
+assign main_udp_buffer2_sink_sink_first = main_udp_holdingudprx_source_first;
+assign main_udp_buffer2_sink_sink_last = main_udp_holdingudprx_source_last;
+assign main_udp_buffer2_sink_sink_payload_data = main_udp_holdingudprx_source_payload_data;
+assign main_udp_buffer2_sink_sink_payload_last_be = main_udp_holdingudprx_source_payload_last_be;
+assign main_udp_buffer2_sink_sink_payload_error = main_udp_holdingudprx_source_payload_error;
+assign main_udp_buffer2_sink_sink_param_src_port = main_udp_holdingudprx_source_param_src_port;
+assign main_udp_buffer2_sink_sink_param_dst_port = main_udp_holdingudprx_source_param_dst_port;
+assign main_udp_buffer2_sink_sink_param_ip_address = main_udp_holdingudprx_source_param_ip_address;
+assign main_udp_buffer2_sink_sink_param_length = main_udp_holdingudprx_source_param_length;
+assign main_udp_maskedudpcrossbar_sink_valid = main_udp_buffer2_source_source_valid;
+assign main_udp_buffer2_source_source_ready = main_udp_maskedudpcrossbar_sink_ready;
+assign main_udp_maskedudpcrossbar_sink_first = main_udp_buffer2_source_source_first;
+assign main_udp_maskedudpcrossbar_sink_last = main_udp_buffer2_source_source_last;
+assign main_udp_maskedudpcrossbar_sink_payload_data = main_udp_buffer2_source_source_payload_data;
+assign main_udp_maskedudpcrossbar_sink_payload_last_be = main_udp_buffer2_source_source_payload_last_be;
+assign main_udp_maskedudpcrossbar_sink_payload_error = main_udp_buffer2_source_source_payload_error;
+assign main_udp_maskedudpcrossbar_sink_param_src_port = main_udp_buffer2_source_source_param_src_port;
+assign main_udp_maskedudpcrossbar_sink_param_dst_port = main_udp_buffer2_source_source_param_dst_port;
+assign main_udp_maskedudpcrossbar_sink_param_ip_address = main_udp_buffer2_source_source_param_ip_address;
+assign main_udp_maskedudpcrossbar_sink_param_length = main_udp_buffer2_source_source_param_length;
 assign main_udp_liteethudptx_sink_sink_valid = main_udp_maskedudpcrossbar_source_valid;
 assign main_udp_maskedudpcrossbar_source_ready = main_udp_liteethudptx_sink_sink_ready;
 assign main_udp_liteethudptx_sink_sink_first = main_udp_maskedudpcrossbar_source_first;
@@ -6488,24 +6602,26 @@ always @(*) begin
 end
 always @(*) begin
     builder_portudp_holdingudprx_next_state <= 3'd0;
-    main_udp_holdingudprx0_holdingudprx_next_value4 <= 16'd0;
-    main_udp_holdingudprx0_holdingudprx_next_value_ce4 <= 1'd0;
-    main_udp_holdingudprx1_holdingudprx_next_value5 <= 16'd0;
-    main_udp_holdingudprx1_holdingudprx_next_value_ce5 <= 1'd0;
-    main_udp_holdingudprx2_holdingudprx_next_value6 <= 16'd0;
-    main_udp_holdingudprx2_holdingudprx_next_value_ce6 <= 1'd0;
-    main_udp_holdingudprx3_holdingudprx_next_value7 <= 32'd0;
-    main_udp_holdingudprx3_holdingudprx_next_value_ce7 <= 1'd0;
+    main_udp_holdingudprx0_holdingudprx_next_value5 <= 16'd0;
+    main_udp_holdingudprx0_holdingudprx_next_value_ce5 <= 1'd0;
+    main_udp_holdingudprx1_holdingudprx_next_value6 <= 16'd0;
+    main_udp_holdingudprx1_holdingudprx_next_value_ce6 <= 1'd0;
+    main_udp_holdingudprx2_holdingudprx_next_value7 <= 16'd0;
+    main_udp_holdingudprx2_holdingudprx_next_value_ce7 <= 1'd0;
+    main_udp_holdingudprx3_holdingudprx_next_value8 <= 32'd0;
+    main_udp_holdingudprx3_holdingudprx_next_value_ce8 <= 1'd0;
     main_udp_holdingudprx_count_holdingudprx_next_value0 <= 16'd0;
     main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd0;
     main_udp_holdingudprx_drop_header <= 1'd0;
-    main_udp_holdingudprx_err_holdingudprx_next_value1 <= 1'd0;
-    main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd0;
-    main_udp_holdingudprx_held_holdingudprx_next_value3 <= 8'd0;
-    main_udp_holdingudprx_held_holdingudprx_next_value_ce3 <= 1'd0;
+    main_udp_holdingudprx_err_holdingudprx_next_value2 <= 1'd0;
+    main_udp_holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd0;
+    main_udp_holdingudprx_held_holdingudprx_next_value4 <= 8'd0;
+    main_udp_holdingudprx_held_holdingudprx_next_value_ce4 <= 1'd0;
     main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd0;
-    main_udp_holdingudprx_rest_holdingudprx_next_value2 <= 16'd0;
-    main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd0;
+    main_udp_holdingudprx_more_holdingudprx_next_value1 <= 1'd0;
+    main_udp_holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd0;
+    main_udp_holdingudprx_rest_holdingudprx_next_value3 <= 16'd0;
+    main_udp_holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd0;
     main_udp_holdingudprx_source_last <= 1'd0;
     main_udp_holdingudprx_source_param_dst_port <= 16'd0;
     main_udp_holdingudprx_source_param_ip_address <= 32'd0;
@@ -6522,7 +6638,7 @@ always @(*) begin
             main_udp_holdingudprx_source_param_length <= main_udp_holdingudprx_payload_len;
             main_udp_holdingudprx_source_param_ip_address <= main_udp_holdingudprx_sink_param_ip_address;
             main_udp_holdingudprx_source_payload_data <= main_udp_holdingudprx_liteethudpdepacketizer_source_payload_data;
-            if ((main_udp_holdingudprx_liteethudpdepacketizer_source_last | (main_udp_holdingudprx_count < main_udp_holdingudprx_payload_len))) begin
+            if ((main_udp_holdingudprx_liteethudpdepacketizer_source_last | main_udp_holdingudprx_more)) begin
                 main_udp_holdingudprx_source_valid <= main_udp_holdingudprx_liteethudpdepacketizer_source_valid;
                 main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= main_udp_holdingudprx_source_ready;
                 main_udp_holdingudprx_source_last <= main_udp_holdingudprx_liteethudpdepacketizer_source_last;
@@ -6533,12 +6649,14 @@ always @(*) begin
                 if ((main_udp_holdingudprx_liteethudpdepacketizer_source_valid & main_udp_holdingudprx_source_ready)) begin
                     main_udp_holdingudprx_count_holdingudprx_next_value0 <= (main_udp_holdingudprx_count + 1'd1);
                     main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                    main_udp_holdingudprx_more_holdingudprx_next_value1 <= (main_udp_holdingudprx_count < main_udp_holdingudprx_payload_len);
+                    main_udp_holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd1;
                     if (main_udp_holdingudprx_cut1) begin
-                        main_udp_holdingudprx_rest_holdingudprx_next_value2 <= (main_udp_holdingudprx_rest - 1'd1);
-                        main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+                        main_udp_holdingudprx_rest_holdingudprx_next_value3 <= (main_udp_holdingudprx_rest - 1'd1);
+                        main_udp_holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
                     end
-                    main_udp_holdingudprx_err_holdingudprx_next_value1 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
-                    main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                    main_udp_holdingudprx_err_holdingudprx_next_value2 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
+                    main_udp_holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd1;
                     if (main_udp_holdingudprx_liteethudpdepacketizer_source_last) begin
                         builder_portudp_holdingudprx_next_state <= 1'd0;
                     end
@@ -6546,23 +6664,25 @@ always @(*) begin
             end else begin
                 main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
                 if (main_udp_holdingudprx_liteethudpdepacketizer_source_valid) begin
-                    main_udp_holdingudprx_held_holdingudprx_next_value3 <= main_udp_holdingudprx_liteethudpdepacketizer_source_payload_data;
-                    main_udp_holdingudprx_held_holdingudprx_next_value_ce3 <= 1'd1;
-                    main_udp_holdingudprx_err_holdingudprx_next_value1 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
-                    main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
-                    main_udp_holdingudprx0_holdingudprx_next_value4 <= main_udp_holdingudprx_liteethudpdepacketizer_source_param_src_port;
-                    main_udp_holdingudprx0_holdingudprx_next_value_ce4 <= 1'd1;
-                    main_udp_holdingudprx1_holdingudprx_next_value5 <= main_udp_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
-                    main_udp_holdingudprx1_holdingudprx_next_value_ce5 <= 1'd1;
-                    main_udp_holdingudprx2_holdingudprx_next_value6 <= main_udp_holdingudprx_payload_len;
-                    main_udp_holdingudprx2_holdingudprx_next_value_ce6 <= 1'd1;
-                    main_udp_holdingudprx3_holdingudprx_next_value7 <= main_udp_holdingudprx_sink_param_ip_address;
-                    main_udp_holdingudprx3_holdingudprx_next_value_ce7 <= 1'd1;
+                    main_udp_holdingudprx_held_holdingudprx_next_value4 <= main_udp_holdingudprx_liteethudpdepacketizer_source_payload_data;
+                    main_udp_holdingudprx_held_holdingudprx_next_value_ce4 <= 1'd1;
+                    main_udp_holdingudprx_err_holdingudprx_next_value2 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
+                    main_udp_holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd1;
+                    main_udp_holdingudprx0_holdingudprx_next_value5 <= main_udp_holdingudprx_liteethudpdepacketizer_source_param_src_port;
+                    main_udp_holdingudprx0_holdingudprx_next_value_ce5 <= 1'd1;
+                    main_udp_holdingudprx1_holdingudprx_next_value6 <= main_udp_holdingudprx_liteethudpdepacketizer_source_param_dst_port;
+                    main_udp_holdingudprx1_holdingudprx_next_value_ce6 <= 1'd1;
+                    main_udp_holdingudprx2_holdingudprx_next_value7 <= main_udp_holdingudprx_payload_len;
+                    main_udp_holdingudprx2_holdingudprx_next_value_ce7 <= 1'd1;
+                    main_udp_holdingudprx3_holdingudprx_next_value8 <= main_udp_holdingudprx_sink_param_ip_address;
+                    main_udp_holdingudprx3_holdingudprx_next_value_ce8 <= 1'd1;
                     main_udp_holdingudprx_count_holdingudprx_next_value0 <= (main_udp_holdingudprx_count + 1'd1);
                     main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                    main_udp_holdingudprx_more_holdingudprx_next_value1 <= (main_udp_holdingudprx_count < main_udp_holdingudprx_payload_len);
+                    main_udp_holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd1;
                     if (main_udp_holdingudprx_cut1) begin
-                        main_udp_holdingudprx_rest_holdingudprx_next_value2 <= (main_udp_holdingudprx_rest - 1'd1);
-                        main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+                        main_udp_holdingudprx_rest_holdingudprx_next_value3 <= (main_udp_holdingudprx_rest - 1'd1);
+                        main_udp_holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
                     end
                     builder_portudp_holdingudprx_next_state <= 2'd2;
                 end
@@ -6571,18 +6691,20 @@ always @(*) begin
         2'd2: begin
             main_udp_holdingudprx_liteethudpdepacketizer_source_ready <= 1'd1;
             if (main_udp_holdingudprx_liteethudpdepacketizer_source_valid) begin
-                main_udp_holdingudprx_err_holdingudprx_next_value1 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
-                main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
+                main_udp_holdingudprx_err_holdingudprx_next_value2 <= (main_udp_holdingudprx_err | main_udp_holdingudprx_liteethudpdepacketizer_source_payload_error);
+                main_udp_holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd1;
                 main_udp_holdingudprx_count_holdingudprx_next_value0 <= (main_udp_holdingudprx_count + 1'd1);
                 main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
+                main_udp_holdingudprx_more_holdingudprx_next_value1 <= (main_udp_holdingudprx_count < main_udp_holdingudprx_payload_len);
+                main_udp_holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd1;
                 if (main_udp_holdingudprx_cut1) begin
-                    main_udp_holdingudprx_rest_holdingudprx_next_value2 <= (main_udp_holdingudprx_rest - 1'd1);
-                    main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+                    main_udp_holdingudprx_rest_holdingudprx_next_value3 <= (main_udp_holdingudprx_rest - 1'd1);
+                    main_udp_holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
                 end
                 if (main_udp_holdingudprx_liteethudpdepacketizer_source_last) begin
                     if (main_udp_holdingudprx_cut1) begin
-                        main_udp_holdingudprx2_holdingudprx_next_value6 <= 1'd0;
-                        main_udp_holdingudprx2_holdingudprx_next_value_ce6 <= 1'd1;
+                        main_udp_holdingudprx2_holdingudprx_next_value7 <= 1'd0;
+                        main_udp_holdingudprx2_holdingudprx_next_value_ce7 <= 1'd1;
                     end
                     builder_portudp_holdingudprx_next_state <= 2'd3;
                 end
@@ -6608,15 +6730,17 @@ always @(*) begin
             end
         end
         default: begin
-            main_udp_holdingudprx_count_holdingudprx_next_value0 <= 1'd1;
+            main_udp_holdingudprx_count_holdingudprx_next_value0 <= 2'd2;
             main_udp_holdingudprx_count_holdingudprx_next_value_ce0 <= 1'd1;
-            main_udp_holdingudprx_err_holdingudprx_next_value1 <= 1'd0;
-            main_udp_holdingudprx_err_holdingudprx_next_value_ce1 <= 1'd1;
-            main_udp_holdingudprx_rest_holdingudprx_next_value2 <= (main_udp_holdingudprx_sink_param_length - 4'd9);
-            main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+            main_udp_holdingudprx_more_holdingudprx_next_value1 <= (main_udp_holdingudprx_payload_len > 1'd1);
+            main_udp_holdingudprx_more_holdingudprx_next_value_ce1 <= 1'd1;
+            main_udp_holdingudprx_err_holdingudprx_next_value2 <= 1'd0;
+            main_udp_holdingudprx_err_holdingudprx_next_value_ce2 <= 1'd1;
+            main_udp_holdingudprx_rest_holdingudprx_next_value3 <= (main_udp_holdingudprx_sink_param_length - 4'd9);
+            main_udp_holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
             if ((main_udp_holdingudprx_sink_param_length <= 4'd8)) begin
-                main_udp_holdingudprx_rest_holdingudprx_next_value2 <= 1'd0;
-                main_udp_holdingudprx_rest_holdingudprx_next_value_ce2 <= 1'd1;
+                main_udp_holdingudprx_rest_holdingudprx_next_value3 <= 1'd0;
+                main_udp_holdingudprx_rest_holdingudprx_next_value_ce3 <= 1'd1;
             end
             if (main_udp_holdingudprx_liteethudpdepacketizer_source_valid) begin
                 builder_portudp_holdingudprx_next_state <= 3'd4;
@@ -7193,6 +7317,29 @@ assign main_udp_buffer1_source_source_payload_error = main_udp_buffer1_pipe_read
 assign main_udp_buffer1_source_source_param_length = main_udp_buffer1_pipe_ready_source_param_length;
 assign main_udp_buffer1_source_source_param_protocol = main_udp_buffer1_pipe_ready_source_param_protocol;
 assign main_udp_buffer1_source_source_param_ip_address = main_udp_buffer1_pipe_ready_source_param_ip_address;
+assign main_udp_buffer2_pipe_valid_sink_ready = ((~main_udp_buffer2_pipe_valid_source_valid) | main_udp_buffer2_pipe_valid_source_ready);
+assign main_udp_buffer2_pipe_valid_sink_valid = main_udp_buffer2_sink_sink_valid;
+assign main_udp_buffer2_sink_sink_ready = main_udp_buffer2_pipe_valid_sink_ready;
+assign main_udp_buffer2_pipe_valid_sink_first = main_udp_buffer2_sink_sink_first;
+assign main_udp_buffer2_pipe_valid_sink_last = main_udp_buffer2_sink_sink_last;
+assign main_udp_buffer2_pipe_valid_sink_payload_data = main_udp_buffer2_sink_sink_payload_data;
+assign main_udp_buffer2_pipe_valid_sink_payload_last_be = main_udp_buffer2_sink_sink_payload_last_be;
+assign main_udp_buffer2_pipe_valid_sink_payload_error = main_udp_buffer2_sink_sink_payload_error;
+assign main_udp_buffer2_pipe_valid_sink_param_src_port = main_udp_buffer2_sink_sink_param_src_port;
+assign main_udp_buffer2_pipe_valid_sink_param_dst_port = main_udp_buffer2_sink_sink_param_dst_port;
+assign main_udp_buffer2_pipe_valid_sink_param_ip_address = main_udp_buffer2_sink_sink_param_ip_address;
+assign main_udp_buffer2_pipe_valid_sink_param_length = main_udp_buffer2_sink_sink_param_length;
+assign main_udp_buffer2_source_source_valid = main_udp_buffer2_pipe_valid_source_valid;
+assign main_udp_buffer2_pipe_valid_source_ready = main_udp_buffer2_source_source_ready;
+assign main_udp_buffer2_source_source_first = main_udp_buffer2_pipe_valid_source_first;
+assign main_udp_buffer2_source_source_last = main_udp_buffer2_pipe_valid_source_last;
+assign main_udp_buffer2_source_source_payload_data = main_udp_buffer2_pipe_valid_source_payload_data;
+assign main_udp_buffer2_source_source_payload_last_be = main_udp_buffer2_pipe_valid_source_payload_last_be;
+assign main_udp_buffer2_source_source_payload_error = main_udp_buffer2_pipe_valid_source_payload_error;
+assign main_udp_buffer2_source_source_param_src_port = main_udp_buffer2_pipe_valid_source_param_src_port;
+assign main_udp_buffer2_source_source_param_dst_port = main_udp_buffer2_pipe_valid_source_param_dst_port;
+assign main_udp_buffer2_source_source_param_ip_address = main_udp_buffer2_pipe_valid_source_param_ip_address;
+assign main_udp_buffer2_source_source_param_length = main_udp_buffer2_pipe_valid_source_param_length;
 assign main_pulsemerge0_total0 = ((((1'd0 + main_mac_cut) + main_ip_rx_cut) + main_ip_rx_drop_header) + main_pulsemerge0_backlog0);
 assign main_pulsemerge0_o0 = (main_pulsemerge0_total0 != 1'd0);
 assign main_pulsemerge0_total1 = ((((1'd0 + main_pulsemerge0_o0) + main_udp_holdingudprx_cut0) + main_udp_holdingudprx_drop_header) + main_pulsemerge0_backlog1);
@@ -7486,6 +7633,14 @@ always @(posedge eth_rx_clk) begin
     end
     main_mac_core_rx_cdc_cdc_graycounter0_q_binary <= main_mac_core_rx_cdc_cdc_graycounter0_q_next_binary;
     main_mac_core_rx_cdc_cdc_graycounter0_q <= main_mac_core_rx_cdc_cdc_graycounter0_q_next;
+    if (((~main_buffer1_pipe_valid_source_valid) | main_buffer1_pipe_valid_source_ready)) begin
+        main_buffer1_pipe_valid_source_valid <= main_buffer1_pipe_valid_sink_valid;
+        main_buffer1_pipe_valid_source_first <= main_buffer1_pipe_valid_sink_first;
+        main_buffer1_pipe_valid_source_last <= main_buffer1_pipe_valid_sink_last;
+        main_buffer1_pipe_valid_source_payload_data <= main_buffer1_pipe_valid_sink_payload_data;
+        main_buffer1_pipe_valid_source_payload_last_be <= main_buffer1_pipe_valid_sink_payload_last_be;
+        main_buffer1_pipe_valid_source_payload_error <= main_buffer1_pipe_valid_sink_payload_error;
+    end
     if (eth_rx_rst) begin
         main_source_valid <= 1'd0;
         main_source_payload_data <= 8'd0;
@@ -7506,6 +7661,10 @@ always @(posedge eth_rx_clk) begin
         main_mac_core_rx_converter_converter_strobe_all <= 1'd0;
         main_mac_core_rx_cdc_cdc_graycounter0_q <= 6'd0;
         main_mac_core_rx_cdc_cdc_graycounter0_q_binary <= 6'd0;
+        main_buffer1_pipe_valid_source_valid <= 1'd0;
+        main_buffer1_pipe_valid_source_payload_data <= 8'd0;
+        main_buffer1_pipe_valid_source_payload_last_be <= 1'd0;
+        main_buffer1_pipe_valid_source_payload_error <= 1'd0;
         builder_liteethmac_rxdatapath_liteethmacpreamblechecker_state <= 1'd0;
         builder_liteethmac_rxdatapath_bufferizeendpoints_state <= 2'd0;
     end
@@ -7568,29 +7727,29 @@ always @(posedge eth_tx_clk) begin
     if (main_mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value_ce) begin
         main_mac_core_tx_gap_counter <= main_mac_core_tx_gap_counter_liteethmac_clockdomainsrenamer3_next_value;
     end
-    if (((~main_pipe_valid_source_valid) | main_pipe_valid_source_ready)) begin
-        main_pipe_valid_source_valid <= main_pipe_valid_sink_valid;
-        main_pipe_valid_source_first <= main_pipe_valid_sink_first;
-        main_pipe_valid_source_last <= main_pipe_valid_sink_last;
-        main_pipe_valid_source_payload_data <= main_pipe_valid_sink_payload_data;
-        main_pipe_valid_source_payload_last_be <= main_pipe_valid_sink_payload_last_be;
-        main_pipe_valid_source_payload_error <= main_pipe_valid_sink_payload_error;
+    if (((~main_buffer0_pipe_valid_source_valid) | main_buffer0_pipe_valid_source_ready)) begin
+        main_buffer0_pipe_valid_source_valid <= main_buffer0_pipe_valid_sink_valid;
+        main_buffer0_pipe_valid_source_first <= main_buffer0_pipe_valid_sink_first;
+        main_buffer0_pipe_valid_source_last <= main_buffer0_pipe_valid_sink_last;
+        main_buffer0_pipe_valid_source_payload_data <= main_buffer0_pipe_valid_sink_payload_data;
+        main_buffer0_pipe_valid_source_payload_last_be <= main_buffer0_pipe_valid_sink_payload_last_be;
+        main_buffer0_pipe_valid_source_payload_error <= main_buffer0_pipe_valid_sink_payload_error;
     end
-    if ((main_pipe_ready_sink_valid & (~main_pipe_ready_source_ready))) begin
-        main_pipe_ready_valid <= 1'd1;
+    if ((main_buffer0_pipe_ready_sink_valid & (~main_buffer0_pipe_ready_source_ready))) begin
+        main_buffer0_pipe_ready_valid <= 1'd1;
     end else begin
-        if (main_pipe_ready_source_ready) begin
-            main_pipe_ready_valid <= 1'd0;
+        if (main_buffer0_pipe_ready_source_ready) begin
+            main_buffer0_pipe_ready_valid <= 1'd0;
         end
     end
-    if (((~main_pipe_ready_source_ready) & (~main_pipe_ready_valid))) begin
-        main_pipe_ready_sink_d_valid <= main_pipe_ready_sink_valid;
-        main_pipe_ready_sink_d_ready <= main_pipe_ready_sink_ready;
-        main_pipe_ready_sink_d_first <= main_pipe_ready_sink_first;
-        main_pipe_ready_sink_d_last <= main_pipe_ready_sink_last;
-        main_pipe_ready_sink_d_payload_data <= main_pipe_ready_sink_payload_data;
-        main_pipe_ready_sink_d_payload_last_be <= main_pipe_ready_sink_payload_last_be;
-        main_pipe_ready_sink_d_payload_error <= main_pipe_ready_sink_payload_error;
+    if (((~main_buffer0_pipe_ready_source_ready) & (~main_buffer0_pipe_ready_valid))) begin
+        main_buffer0_pipe_ready_sink_d_valid <= main_buffer0_pipe_ready_sink_valid;
+        main_buffer0_pipe_ready_sink_d_ready <= main_buffer0_pipe_ready_sink_ready;
+        main_buffer0_pipe_ready_sink_d_first <= main_buffer0_pipe_ready_sink_first;
+        main_buffer0_pipe_ready_sink_d_last <= main_buffer0_pipe_ready_sink_last;
+        main_buffer0_pipe_ready_sink_d_payload_data <= main_buffer0_pipe_ready_sink_payload_data;
+        main_buffer0_pipe_ready_sink_d_payload_last_be <= main_buffer0_pipe_ready_sink_payload_last_be;
+        main_buffer0_pipe_ready_sink_d_payload_error <= main_buffer0_pipe_ready_sink_payload_error;
     end
     if (eth_tx_rst) begin
         main_sink_ready <= 1'd0;
@@ -7604,16 +7763,16 @@ always @(posedge eth_tx_clk) begin
         main_mac_core_tx_crc_pipe_valid_source_payload_data <= 8'd0;
         main_mac_core_tx_crc_pipe_valid_source_payload_last_be <= 1'd0;
         main_mac_core_tx_crc_pipe_valid_source_payload_error <= 1'd0;
-        main_pipe_valid_source_valid <= 1'd0;
-        main_pipe_valid_source_payload_data <= 32'd0;
-        main_pipe_valid_source_payload_last_be <= 4'd0;
-        main_pipe_valid_source_payload_error <= 4'd0;
-        main_pipe_ready_valid <= 1'd0;
-        main_pipe_ready_sink_d_valid <= 1'd0;
-        main_pipe_ready_sink_d_ready <= 1'd0;
-        main_pipe_ready_sink_d_payload_data <= 32'd0;
-        main_pipe_ready_sink_d_payload_last_be <= 4'd0;
-        main_pipe_ready_sink_d_payload_error <= 4'd0;
+        main_buffer0_pipe_valid_source_valid <= 1'd0;
+        main_buffer0_pipe_valid_source_payload_data <= 32'd0;
+        main_buffer0_pipe_valid_source_payload_last_be <= 4'd0;
+        main_buffer0_pipe_valid_source_payload_error <= 4'd0;
+        main_buffer0_pipe_ready_valid <= 1'd0;
+        main_buffer0_pipe_ready_sink_d_valid <= 1'd0;
+        main_buffer0_pipe_ready_sink_d_ready <= 1'd0;
+        main_buffer0_pipe_ready_sink_d_payload_data <= 32'd0;
+        main_buffer0_pipe_ready_sink_d_payload_last_be <= 4'd0;
+        main_buffer0_pipe_ready_sink_d_payload_error <= 4'd0;
         builder_liteethmac_txdatapath_liteethmactxlastbe_state <= 1'd0;
         builder_liteethmac_txdatapath_liteethmacpaddinginserter_state <= 1'd0;
         builder_liteethmac_txdatapath_bufferizeendpoints_state <= 2'd0;
@@ -8107,26 +8266,29 @@ always @(posedge sys_clk) begin
     if (main_udp_holdingudprx_count_holdingudprx_next_value_ce0) begin
         main_udp_holdingudprx_count <= main_udp_holdingudprx_count_holdingudprx_next_value0;
     end
-    if (main_udp_holdingudprx_err_holdingudprx_next_value_ce1) begin
-        main_udp_holdingudprx_err <= main_udp_holdingudprx_err_holdingudprx_next_value1;
+    if (main_udp_holdingudprx_more_holdingudprx_next_value_ce1) begin
+        main_udp_holdingudprx_more <= main_udp_holdingudprx_more_holdingudprx_next_value1;
     end
-    if (main_udp_holdingudprx_rest_holdingudprx_next_value_ce2) begin
-        main_udp_holdingudprx_rest <= main_udp_holdingudprx_rest_holdingudprx_next_value2;
+    if (main_udp_holdingudprx_err_holdingudprx_next_value_ce2) begin
+        main_udp_holdingudprx_err <= main_udp_holdingudprx_err_holdingudprx_next_value2;
     end
-    if (main_udp_holdingudprx_held_holdingudprx_next_value_ce3) begin
-        main_udp_holdingudprx_held <= main_udp_holdingudprx_held_holdingudprx_next_value3;
+    if (main_udp_holdingudprx_rest_holdingudprx_next_value_ce3) begin
+        main_udp_holdingudprx_rest <= main_udp_holdingudprx_rest_holdingudprx_next_value3;
     end
-    if (main_udp_holdingudprx0_holdingudprx_next_value_ce4) begin
-        main_udp_holdingudprx0 <= main_udp_holdingudprx0_holdingudprx_next_value4;
+    if (main_udp_holdingudprx_held_holdingudprx_next_value_ce4) begin
+        main_udp_holdingudprx_held <= main_udp_holdingudprx_held_holdingudprx_next_value4;
     end
-    if (main_udp_holdingudprx1_holdingudprx_next_value_ce5) begin
-        main_udp_holdingudprx1 <= main_udp_holdingudprx1_holdingudprx_next_value5;
+    if (main_udp_holdingudprx0_holdingudprx_next_value_ce5) begin
+        main_udp_holdingudprx0 <= main_udp_holdingudprx0_holdingudprx_next_value5;
     end
-    if (main_udp_holdingudprx2_holdingudprx_next_value_ce6) begin
-        main_udp_holdingudprx2 <= main_udp_holdingudprx2_holdingudprx_next_value6;
+    if (main_udp_holdingudprx1_holdingudprx_next_value_ce6) begin
+        main_udp_holdingudprx1 <= main_udp_holdingudprx1_holdingudprx_next_value6;
     end
-    if (main_udp_holdingudprx3_holdingudprx_next_value_ce7) begin
-        main_udp_holdingudprx3 <= main_udp_holdingudprx3_holdingudprx_next_value7;
+    if (main_udp_holdingudprx2_holdingudprx_next_value_ce7) begin
+        main_udp_holdingudprx2 <= main_udp_holdingudprx2_holdingudprx_next_value7;
+    end
+    if (main_udp_holdingudprx3_holdingudprx_next_value_ce8) begin
+        main_udp_holdingudprx3 <= main_udp_holdingudprx3_holdingudprx_next_value8;
     end
     if (main_udp_liteethudptx_packetizer_sr_load) begin
         main_udp_liteethudptx_packetizer_sr <= main_udp_liteethudptx_packetizer_header;
@@ -8264,6 +8426,18 @@ always @(posedge sys_clk) begin
         main_udp_buffer1_pipe_ready_sink_d_param_protocol <= main_udp_buffer1_pipe_ready_sink_param_protocol;
         main_udp_buffer1_pipe_ready_sink_d_param_ip_address <= main_udp_buffer1_pipe_ready_sink_param_ip_address;
     end
+    if (((~main_udp_buffer2_pipe_valid_source_valid) | main_udp_buffer2_pipe_valid_source_ready)) begin
+        main_udp_buffer2_pipe_valid_source_valid <= main_udp_buffer2_pipe_valid_sink_valid;
+        main_udp_buffer2_pipe_valid_source_first <= main_udp_buffer2_pipe_valid_sink_first;
+        main_udp_buffer2_pipe_valid_source_last <= main_udp_buffer2_pipe_valid_sink_last;
+        main_udp_buffer2_pipe_valid_source_payload_data <= main_udp_buffer2_pipe_valid_sink_payload_data;
+        main_udp_buffer2_pipe_valid_source_payload_last_be <= main_udp_buffer2_pipe_valid_sink_payload_last_be;
+        main_udp_buffer2_pipe_valid_source_payload_error <= main_udp_buffer2_pipe_valid_sink_payload_error;
+        main_udp_buffer2_pipe_valid_source_param_src_port <= main_udp_buffer2_pipe_valid_sink_param_src_port;
+        main_udp_buffer2_pipe_valid_source_param_dst_port <= main_udp_buffer2_pipe_valid_sink_param_dst_port;
+        main_udp_buffer2_pipe_valid_source_param_ip_address <= main_udp_buffer2_pipe_valid_sink_param_ip_address;
+        main_udp_buffer2_pipe_valid_source_param_length <= main_udp_buffer2_pipe_valid_sink_param_length;
+    end
     main_pulsemerge0_backlog0 <= (main_pulsemerge0_total0 - main_pulsemerge0_o0);
     main_pulsemerge0_backlog1 <= (main_pulsemerge0_total1 - main_pulsemerge0_o1);
     main_pulsemerge1_backlog0 <= (main_pulsemerge1_total0 - main_pulsemerge1_o0);
@@ -8390,6 +8564,7 @@ always @(posedge sys_clk) begin
         main_udp_holdingudprx_liteethudpdepacketizer_delayed_last_be <= 1'd0;
         main_udp_holdingudprx_liteethudpdepacketizer_was_in_copy <= 1'd0;
         main_udp_holdingudprx_count <= 16'd0;
+        main_udp_holdingudprx_more <= 1'd0;
         main_udp_holdingudprx_err <= 1'd0;
         main_udp_holdingudprx_held <= 8'd0;
         main_udp_holdingudprx0 <= 16'd0;
@@ -8424,6 +8599,10 @@ always @(posedge sys_clk) begin
         main_udp_buffer1_pipe_ready_sink_d_payload_data <= 8'd0;
         main_udp_buffer1_pipe_ready_sink_d_payload_last_be <= 1'd0;
         main_udp_buffer1_pipe_ready_sink_d_payload_error <= 1'd0;
+        main_udp_buffer2_pipe_valid_source_valid <= 1'd0;
+        main_udp_buffer2_pipe_valid_source_payload_data <= 8'd0;
+        main_udp_buffer2_pipe_valid_source_payload_last_be <= 1'd0;
+        main_udp_buffer2_pipe_valid_source_payload_error <= 1'd0;
         main_pulsemerge0_backlog0 <= 3'd0;
         main_pulsemerge0_backlog1 <= 3'd0;
         main_pulsemerge1_backlog0 <= 3'd0;
