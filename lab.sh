@@ -99,7 +99,7 @@ case "$cmd" in
     # built once); ROSFPGA_TEST_WORKERS=N sets how many, 0 runs in this one process.
     workers="${ROSFPGA_TEST_WORKERS:-$( [ "$(nproc 2>/dev/null || echo 1)" -ge 2 ] && echo 2 || echo 0 )}"
     parallel=()
-    if [ "$workers" != 0 ]; then parallel=(-n "$workers" --dist loadfile); fi
+    if [ "$workers" != 0 ]; then parallel=(-n "$workers" --dist loadfile --no-loadscope-reorder); fi
     exec "$venv/bin/python" -m pytest "${parallel[@]}" "$@" ;;
   setup)
     if [ "${1:-}" = "--test" ]; then setup "[test]"; else setup ""; fi ;;

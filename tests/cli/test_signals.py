@@ -117,21 +117,29 @@ def test_node_command_waits_for_a_master_that_comes_later(tmp_path) -> None:
 
     port = free_port()
     uri = f"http://127.0.0.1:{port}/"
-    proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(CONFIG), "-q",
-                             "--master-uri", uri], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, preexec_fn=interruptible)
+    log = tmp_path / "stderr"       # (a file, read while the node runs: it said it waits)
+    with log.open("w") as stderr:
+        proc = subprocess.Popen([sys.executable, "-m", "rosfpga_lab", "node", str(CONFIG), "-q",
+                                 "--master-uri", uri], stdout=subprocess.PIPE,
+                                stderr=stderr, text=True, preexec_fn=interruptible)
     try:
-        time.sleep(1.5)
-        assert proc.poll() is None, proc.communicate()
+        # the master comes only once the node said it waits (a fixed sleep lost the race on a
+        # loaded machine, where the node's start-up alone took longer)
+        deadline = time.monotonic() + 60
+        while ("waiting for it and trying again" not in log.read_text()
+               and proc.poll() is None and time.monotonic() < deadline):
+            time.sleep(0.05)
+        assert proc.poll() is None, (proc.communicate(), log.read_text())
         with EmbeddedMaster(port=port) as master:
             deadline = time.monotonic() + 20
             while "/fpga_dilate" not in nodes_of(master.uri) and time.monotonic() < deadline:
                 time.sleep(0.05)
             assert "/fpga_dilate" in nodes_of(master.uri)
-            _out, err = stop_with(proc, signal.SIGTERM)
+            stop_with(proc, signal.SIGTERM)
     finally:
         kill_if_running(proc)
-    assert proc.returncode == 0
+    err = log.read_text()
+    assert proc.returncode == 0, err
     assert err.count("waiting for it and trying again") == 1, err
     assert f"the ROS master at {uri} answers now" in err
 

@@ -49,3 +49,10 @@ def test_rtl_python_files_are_tests_or_benches_named_after_their_module() -> Non
             modules = ["_".join(words[:n]) for n in range(len(words), 0, -1)]
             assert any(re.search(rf"\bmodule\s+{m}\b", verilog) for m in modules), \
                 f"{path.name}: no module {modules[0]}"
+
+
+def test_the_heavy_files_run_first_exist() -> None:
+    from tests.conftest import HEAVY_FIRST
+
+    assert [name for name in HEAVY_FIRST if not (REPO / name).is_file()] == []
+    assert len(set(HEAVY_FIRST)) == len(HEAVY_FIRST)
