@@ -196,12 +196,13 @@ def test_the_subscribers_bounded_check_sees_every_frame_length_handed_over() -> 
     assert f"{min(clocks)} to {max(clocks)} clocks to acceptance" in bmc.claim
 
 
-def plant(tmp: Path, name: str, old: str, new: str) -> Path:
-    """A copy of generic/``name`` with the line ``old`` replaced by the bug ``new``."""
-    text = (GENERIC_VERILOG_DIR / name).read_text()
+def plant(tmp: Path, name: str, old: str, new: str, folder: Path = GENERIC_VERILOG_DIR) -> Path:
+    """A copy of ``folder``/``name`` with the text ``old`` replaced by the bug ``new``, marked by
+    a block comment (harmless between any two tokens)."""
+    text = (folder / name).read_text()
     assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
     buggy = tmp / name
-    buggy.write_text(text.replace(old, new + "   // PLANTED BUG"))
+    buggy.write_text(text.replace(old, new + "   /* PLANTED BUG */"))
     return buggy
 
 
@@ -254,7 +255,7 @@ def test_planted_bugs_fail_the_generic_proofs(tmp_path: Path) -> None:
     ("nxt_valid <= 1'b0;\n`ifdef FORMAL\n                f_head <= f_nxt;",
      "`ifdef FORMAL\n                f_head <= f_nxt;"),
     # the second record moves up without its bank: the publisher reads the older frame's bytes
-    ("meta_bank <= nxt_bank;", "meta_bank <= meta_bank;"),
+    ("meta_bank <= nxt_valid ? nxt_bank : fbank;", "meta_bank <= nxt_valid ? meta_bank : fbank;"),
 ])
 def test_planted_bugs_in_the_record_hand_over_fail_the_subscribers_induction(
         tmp_path: Path, old: str, new: str) -> None:
@@ -265,10 +266,7 @@ def test_planted_bugs_in_the_record_hand_over_fail_the_subscribers_induction(
     assertions (order, count, banks), so the induction does not pass (about 5 s each)."""
     require_formal()
     name = "rfl_gsubscriber.v"
-    text = (GENERIC_VERILOG_DIR / name).read_text()
-    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
-    buggy = tmp_path / name
-    buggy.write_text(text.replace(old, new))
+    buggy = plant(tmp_path, name, old, new)
     proof = next(p for p in PROOFS if p.name == "gsubscriber" and p.mode == "prove")
     result = prove(proof, replace={name: buggy})
     assert result.status in ("FAIL", "UNKNOWN"), format_results([result])
@@ -468,11 +466,9 @@ def test_a_planted_bug_fails_the_fabric_node_proof(tmp_path: Path) -> None:
     a packet's later beats to the other side: the node's proof fails on the routing."""
     require_formal()
     name = "rfl_fabric_node.v"
-    text = (FABRIC_DIR / name).read_text()
     old = "in_kind <= kind;"
-    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
-    buggy = tmp_path / name
-    buggy.write_text(text.replace(old, "in_kind <= s_axis_tuser;   // PLANTED BUG"))
+    buggy = plant(tmp_path, name, old, "in_kind <= s_axis_tuser;", FABRIC_DIR)
+    text = (FABRIC_DIR / name).read_text()
     proof = next(p for p in PROOFS if p.name == "fabric_node" and p.mode == "prove")
     result = prove(proof, replace={name: buggy})
     assert result.status == "FAIL", format_results([result])
@@ -491,11 +487,9 @@ def test_a_planted_bug_fails_the_answers_byte_bound(tmp_path: Path) -> None:
     case of 4 clocks takes no ACKNACK in: the induction step finds it)."""
     require_formal()
     name = "rfl_rtps_disc_answer.v"
-    text = (FABRIC_DIR / name).read_text()
     old = "if (start) cred <= cred - e_len;"
-    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
-    buggy = tmp_path / name
-    buggy.write_text(text.replace(old, "if (start) cred <= cred;   // PLANTED BUG"))
+    buggy = plant(tmp_path, name, old, "if (start) cred <= cred;", FABRIC_DIR)
+    text = (FABRIC_DIR / name).read_text()
     lines = text.splitlines()
     bound = "assert(f_allow >= {16'd0, cred} + (sending ? {16'd0, left} : 32'd0));"
     node = next(p for p in PROOFS if p.name == "fabric_node" and p.mode == "prove")
@@ -519,10 +513,7 @@ def test_planted_bugs_fail_the_board_proof(tmp_path: Path, old: str, new: str) -
     misses datagrams."""
     require_formal()
     name = "rfl_board_5a75b.v"
-    text = (FABRIC_DIR / name).read_text()
-    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
-    buggy = tmp_path / name
-    buggy.write_text(text.replace(old, f"{new} /* PLANTED BUG */"))
+    buggy = plant(tmp_path, name, old, new, FABRIC_DIR)
     proof = next(p for p in PROOFS if p.name == "board_5a75b")
     result = prove(proof, replace={name: buggy})
     assert result.status == "FAIL", format_results([result])
@@ -543,10 +534,7 @@ def test_planted_bugs_fail_the_spdp_peer_proof(tmp_path: Path, old: str, new: st
     changes in a second."""
     require_formal()
     name = "rfl_spdp_peer.v"
-    text = (FABRIC_DIR / name).read_text()
-    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
-    buggy = tmp_path / name
-    buggy.write_text(text.replace(old, new))
+    buggy = plant(tmp_path, name, old, new, FABRIC_DIR)
     proof = next(p for p in PROOFS if p.name == "spdp_peer")
     result = prove(proof, replace={name: buggy})
     assert result.status in status, format_results([result])
@@ -576,10 +564,7 @@ def test_planted_bugs_fail_the_rtps_walk_proofs(tmp_path: Path, old: str, new: s
     is 20 bytes: past the induction's depth from reset, where the induction fails to close)."""
     require_formal()
     name = "rfl_rtps_walk.v"
-    text = (FABRIC_DIR / name).read_text()
-    assert text.count(old) == 1, f"{name} no longer has {old!r}: update the planted bug"
-    buggy = tmp_path / name
-    buggy.write_text(text.replace(old, new))
+    buggy = plant(tmp_path, name, old, new, FABRIC_DIR)
     proof = next(p for p in PROOFS if p.name == "rtps_walk" and p.mode == mode)
     result = prove(proof, replace={name: buggy})
     assert result.status == "FAIL", format_results([result])
