@@ -279,6 +279,7 @@ application: {op: dilate, ksize: 3}
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(900)       # 30 s idle; 248 s seen beside the proofs on a loaded machine
 def test_yosys_synthesizes_a_generated_project(tmp_path: Path) -> None:
     """The smallest generic project that has every part (a carried string, a stream; about 30 s
     of Yosys): synth_xilinx elaborates it from rfl_node with no latch, no multiple driver, and
