@@ -272,9 +272,9 @@ PROOFS: tuple[Proof, ...] = (
           "rfl_fabric_node (every stage, small sizes, ROMs of any contents, any payloads in, "
           "the generated top a passthrough): output stream rules with TDEST and the prefix, "
           "each beat in (past the input slice) to the side of its packet's first-beat kind "
-          "alone, metatraffic never held back there, answers' bytes out at most BURST + RATE x metatraffic bytes in, the "
-          "arbiter's atomicity and wait bound and the stages' invariants in place; all "
-          "reachable states", ("FV_PROVE",)),
+          "alone, metatraffic never held back there, answers' bytes out at most BURST + "
+          "RATE x metatraffic bytes in, the arbiter's atomicity and wait bound and the "
+          "stages' invariants in place; all reachable states", ("FV_PROVE",)),
     Proof("fabric_node", ("rfl_slice.v", *FABRIC_NODE), "bmc", 24,
           "rfl_fabric_node (as above): TDEST and the prefix constant inside a datagram; 24 "
           "clocks (SPDP datagrams of any length out, packets of both kinds in)"),
